@@ -1,0 +1,54 @@
+# ancfdrv: the two commands of the README quick start. Both are idempotent and do all
+# set-up they need on a fresh Debian/Ubuntu machine: missing apt packages, a .venv with
+# the package and its Python dependencies, the Meson build.
+#   make demo   the crane-boom example of seed 000 (statics sweep), results in results/
+#   make test   the whole test suite (pytest)
+
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.ancfdrv-installed
+APT_PACKAGES := gfortran libmumps-seq-dev liblapack-dev libopenblas-dev pkg-config
+SOURCES := $(shell find fortran python -name '*.f90' -o -name '*.py' -o -name '.f2py_f2cmap') \
+           meson.build pyproject.toml
+DEMO_OUT := results/boom_static_sweep
+
+.PHONY: demo test install system-packages clean benchmark
+
+demo: $(STAMP)
+	$(VENV)/bin/ancf sweep inputs/boom_static.nml --vary boom.angle_deg=0,15,30,45,60 \
+	    --vary loads.tip_mass=0,50 --vary beam.nodes=4,10,16,22,28 -o $(DEMO_OUT)
+	$(VENV)/bin/ancf run inputs/boom_static.nml --set boom.angle_deg=30 -o results/boom_static_30deg.h5
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+benchmark: $(STAMP)
+	$(PY) benchmarks/static_scaling.py
+
+install: $(STAMP)
+
+# apt packages only when one is missing (root, or sudo when available)
+system-packages:
+	@missing=""; \
+	for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if ! $(PYTHON) -c 'import ensurepip, sysconfig, os, sys; sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' 2>/dev/null; then \
+	    missing="$$missing python3-venv python3-dev"; fi; \
+	if [ -n "$$missing" ]; then \
+	    echo "installing system packages:$$missing"; \
+	    if [ "$$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi; \
+	    $$sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -qq $$missing; \
+	fi
+
+$(PY): | system-packages
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+
+$(STAMP): $(SOURCES) | system-packages $(PY)
+	$(PY) -m pip install -q meson-python meson ninja numpy
+	$(PY) -m pip install -q --no-build-isolation '.[test]'
+	touch $(STAMP)
+
+clean:
+	rm -rf $(VENV) build results .pytest_cache

@@ -1,0 +1,213 @@
+!> The one f2py-facing layer: plain subroutines over plain arrays and integer handles.
+!> Every routine returns an error code (info) instead of stopping; Python turns
+!> non-zero codes into exceptions. Array sizes are passed explicitly.
+
+!> Element arrays of a beam mesh: compact mass (8 x 8) and small-strain stiffness K0
+!> (24 x 24) per element. info = 10*element + code.
+subroutine beam_element_arrays(nel, lengths, width, height, density, youngs, poisson, &
+                               reference, mass_compact, stiffness, info)
+  use ancf_kinds, only: dp
+  use beam_element, only: beam_mass_compact, beam_linear_stiffness
+  implicit none
+  integer, intent(in) :: nel
+  real(dp), intent(in) :: lengths(nel), width, height, density, youngs, poisson
+  real(dp), intent(in) :: reference(3, 8, nel)
+  real(dp), intent(out) :: mass_compact(8, 8, nel), stiffness(24, 24, nel)
+  integer, intent(out) :: info
+  integer :: el, code
+  info = 0
+  do el = 1, nel
+    call beam_mass_compact(lengths(el), width, height, density, mass_compact(:, :, el), code)
+    if (code == 0) call beam_linear_stiffness(reference(:, :, el), lengths(el), width, height, &
+                                              youngs, poisson, stiffness(:, :, el), code)
+    if (code /= 0) then
+      info = 10 * el + code
+      return
+    end if
+  end do
+end subroutine beam_element_arrays
+
+!> Generalized gravity forces (3 x 8) per element (seed 000, eqs. 22-25).
+subroutine beam_gravity(nel, lengths, width, height, density, gravity, gravity_force, info)
+  use ancf_kinds, only: dp
+  use beam_element, only: beam_gravity_compact
+  implicit none
+  integer, intent(in) :: nel
+  real(dp), intent(in) :: lengths(nel), width, height, density, gravity(3)
+  real(dp), intent(out) :: gravity_force(3, 8, nel)
+  integer, intent(out) :: info
+  integer :: el
+  info = 0
+  do el = 1, nel
+    call beam_gravity_compact(lengths(el), width, height, density, gravity, gravity_force(:, :, el), info)
+    if (info /= 0) return
+  end do
+end subroutine beam_gravity
+
+!> Shape functions and their parameter derivatives at npts material points.
+subroutine beam_shape_functions(npts, xi, y, z, lengths, shape, dshape_dx, dshape_dy, dshape_dz)
+  use ancf_kinds, only: dp
+  use beam_element, only: beam_shape
+  implicit none
+  integer, intent(in) :: npts
+  real(dp), intent(in) :: xi(npts), y(npts), z(npts), lengths(npts)
+  real(dp), intent(out) :: shape(8, npts), dshape_dx(8, npts), dshape_dy(8, npts), dshape_dz(8, npts)
+  integer :: p
+  do p = 1, npts
+    call beam_shape(xi(p), y(p), z(p), lengths(p), shape(:, p), dshape_dx(:, p), &
+                    dshape_dy(:, p), dshape_dz(:, p))
+  end do
+end subroutine beam_shape_functions
+
+!> Compact mass of a point mass at a material point of an element.
+subroutine beam_point_mass(xi, y, z, length, point_mass, mass_compact)
+  use ancf_kinds, only: dp
+  use beam_element, only: beam_point_mass_compact
+  implicit none
+  real(dp), intent(in) :: xi, y, z, length, point_mass
+  real(dp), intent(out) :: mass_compact(8, 8)
+  call beam_point_mass_compact(xi, y, z, length, point_mass, mass_compact)
+end subroutine beam_point_mass
+
+!> FFR elastic force and strain energy of a beam mesh.
+subroutine ffr_elastic_force(ndof, nel, dofs, stiffness0, rotation, e, e0_frame, force, energy)
+  use ancf_kinds, only: dp
+  use ffr_elastic, only: ffr_force
+  implicit none
+  integer, intent(in) :: ndof, nel, dofs(24, nel)
+  real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3), e(ndof), e0_frame(ndof)
+  real(dp), intent(out) :: force(ndof), energy
+  call ffr_force(ndof, nel, dofs, stiffness0, rotation, e, e0_frame, force, energy)
+end subroutine ffr_elastic_force
+
+!> FFR element stiffness matrices rotated into the global frame.
+subroutine ffr_element_stiffness(nel, stiffness0, rotation, stiffness)
+  use ancf_kinds, only: dp
+  use ffr_elastic, only: ffr_stiffness
+  implicit none
+  integer, intent(in) :: nel
+  real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3)
+  real(dp), intent(out) :: stiffness(24, 24, nel)
+  call ffr_stiffness(nel, stiffness0, rotation, stiffness)
+end subroutine ffr_element_stiffness
+
+!> Generalized force of a dead moment on a section director, with its first and
+!> second derivatives.
+subroutine moment_generalized_force(director, axis, magnitude, force, jacobian, hessian, info)
+  use ancf_kinds, only: dp
+  use section_moment, only: moment_force
+  implicit none
+  real(dp), intent(in) :: director(3), axis(3), magnitude
+  real(dp), intent(out) :: force(3), jacobian(3, 3), hessian(3, 3, 3)
+  integer, intent(out) :: info
+  call moment_force(director, axis, magnitude, force, jacobian, hessian, info)
+end subroutine moment_generalized_force
+
+!> A drive's phi, phi', phi'' at nt times.
+subroutine drive_values(kind, params, nt, t, phi, dphi, ddphi, info)
+  use ancf_kinds, only: dp
+  use drives, only: drive_eval
+  implicit none
+  integer, intent(in) :: kind, nt
+  real(dp), intent(in) :: params(8), t(nt)
+  real(dp), intent(out) :: phi(nt), dphi(nt), ddphi(nt)
+  integer, intent(out) :: info
+  integer :: i
+  info = 0
+  do i = 1, nt
+    call drive_eval(kind, params, t(i), phi(i), dphi(i), ddphi(i), info)
+    if (info /= 0) return
+  end do
+end subroutine drive_values
+
+!> Constraint values, sparse gradients, constant Hessians, Phi_t, Phi_tt and the
+!> acceleration right-hand side gamma at (e, e_dot, t).
+subroutine constraint_evaluate(ncon, ints, reals, ndrive, drive_kinds, drive_params, ndof, e, e_dot, &
+                               t, values, gradients, hessians, phi_t, phi_tt, gamma, info)
+  use ancf_kinds, only: dp
+  use constraints, only: constraint_eval
+  implicit none
+  integer, intent(in) :: ncon, ndrive, ndof
+  integer, intent(in) :: ints(8, ncon), drive_kinds(ndrive)
+  real(dp), intent(in) :: reals(8, ncon), drive_params(8, ndrive), e(ndof), e_dot(ndof), t
+  real(dp), intent(out) :: values(ncon), gradients(6, ncon), hessians(6, 6, ncon)
+  real(dp), intent(out) :: phi_t(ncon), phi_tt(ncon), gamma(ncon)
+  integer, intent(out) :: info
+  call constraint_eval(ncon, ints, reals, ndrive, drive_kinds, drive_params, ndof, e, e_dot, t, &
+                       values, gradients, hessians, phi_t, phi_tt, gamma, info)
+end subroutine constraint_evaluate
+
+!> Pattern size of an n x n matrix coupled by element dof lists.
+subroutine sparse_pattern_count(n, ndofe, nel, dofs, nnz, info)
+  use sparse_pattern, only: pattern_count
+  implicit none
+  integer, intent(in) :: n, ndofe, nel, dofs(ndofe, nel)
+  integer, intent(out) :: nnz, info
+  integer :: row_length(n)
+  call pattern_count(n, ndofe, nel, dofs, row_length, nnz, info)
+end subroutine sparse_pattern_count
+
+!> CSR pattern (1-based) and scatter map for element matrices.
+subroutine sparse_pattern_build(n, ndofe, nel, dofs, nnz, row_ptr, col_index, scatter_map, info)
+  use sparse_pattern, only: pattern_fill
+  implicit none
+  integer, intent(in) :: n, ndofe, nel, dofs(ndofe, nel), nnz
+  integer, intent(out) :: row_ptr(n + 1), col_index(nnz), scatter_map(ndofe, ndofe, nel), info
+  call pattern_fill(n, ndofe, nel, dofs, nnz, row_ptr, col_index, scatter_map, info)
+end subroutine sparse_pattern_build
+
+!> CSR values from element matrices through a scatter map.
+subroutine sparse_assemble(nnz, ndofe, nel, scatter_map, element_values, values)
+  use ancf_kinds, only: dp
+  use sparse_pattern, only: pattern_assemble
+  implicit none
+  integer, intent(in) :: nnz, ndofe, nel, scatter_map(ndofe, ndofe, nel)
+  real(dp), intent(in) :: element_values(ndofe, ndofe, nel)
+  real(dp), intent(out) :: values(nnz)
+  call pattern_assemble(nnz, ndofe, nel, scatter_map, element_values, values)
+end subroutine sparse_assemble
+
+subroutine direct_create(symmetry, handle, info, info_detail)
+  use sparse_direct, only: solver_create
+  implicit none
+  integer, intent(in) :: symmetry
+  integer, intent(out) :: handle, info, info_detail
+  call solver_create(symmetry, handle, info, info_detail)
+end subroutine direct_create
+
+subroutine direct_analyse(handle, n, nnz, rows, cols, info, info_detail)
+  use sparse_direct, only: solver_analyse
+  implicit none
+  integer, intent(in) :: handle, n, nnz, rows(nnz), cols(nnz)
+  integer, intent(out) :: info, info_detail
+  call solver_analyse(handle, n, nnz, rows, cols, info, info_detail)
+end subroutine direct_analyse
+
+subroutine direct_factorize(handle, nnz, values, info, info_detail)
+  use ancf_kinds, only: dp
+  use sparse_direct, only: solver_factorize
+  implicit none
+  integer, intent(in) :: handle, nnz
+  real(dp), intent(in) :: values(nnz)
+  integer, intent(out) :: info, info_detail
+  call solver_factorize(handle, nnz, values, info, info_detail)
+end subroutine direct_factorize
+
+subroutine direct_solve(handle, n, nrhs, rhs, info, info_detail)
+  use ancf_kinds, only: dp
+  use sparse_direct, only: solver_solve
+  implicit none
+  integer, intent(in) :: handle, n, nrhs
+  real(dp), intent(inout) :: rhs(n, nrhs)
+  !f2py intent(in,out) :: rhs
+  integer, intent(out) :: info, info_detail
+  call solver_solve(handle, n, nrhs, rhs, info, info_detail)
+end subroutine direct_solve
+
+subroutine direct_destroy(handle, info)
+  use sparse_direct, only: solver_destroy
+  implicit none
+  integer, intent(in) :: handle
+  integer, intent(out) :: info
+  call solver_destroy(handle, info)
+end subroutine direct_destroy

@@ -1,0 +1,222 @@
+!> Two-node segment of the multi-node 3D ANCF beam of seed 000 (eqs. 1-12),
+!> the kinematics of Chrono's ChElementBeamANCF_3243.
+!>
+!> Each node carries 12 coordinates [r, r_x, r_y, r_z]. With xi = x/L in [0, 1]
+!> and section coordinates y (height h) and z (width w), centred on the neutral axis,
+!>
+!>   r(x, y, z) = sum_a N_a q_a,   N = [N1, L N2, y (1 - xi), z (1 - xi), N3, L N4, y xi, z xi]
+!>
+!> with the cubic Hermite N1..N4 (eqs. 4-5, with f_yR = b a, f_zR = c a: the printed
+!> "b - a" is a misprint, see REFERENCES.md). Compact arrays (8 x 8, 3 x 8) act on the
+!> eight nodal 3-vectors q_a; the full 24 x 24 matrices are the compact ones times I3
+!> (mass) or are built per 3 x 3 block (stiffness).
+module beam_element
+  use ancf_kinds, only: dp
+  use quadrature, only: gauss_legendre
+  implicit none
+  private
+  public :: beam_shape, beam_mass_compact, beam_gravity_compact, &
+            beam_linear_stiffness, beam_point_mass_compact
+
+  !> Gauss points along the axis and across each section direction: exact for the
+  !> mass (degree 6 in xi, 2 in y, z) and the linear stiffness (degree 4 in xi).
+  integer, parameter :: n_axial = 4, n_section = 2
+
+contains
+
+  !> Shape functions N(8) at (xi, y, z) and their derivatives with respect to the
+  !> element parameters (x = xi L, y, z).
+  pure subroutine beam_shape(xi, y, z, length, shape, dshape_dx, dshape_dy, dshape_dz)
+    real(dp), intent(in) :: xi, y, z, length
+    real(dp), intent(out) :: shape(8), dshape_dx(8), dshape_dy(8), dshape_dz(8)
+    real(dp) :: xi2, xi3
+    xi2 = xi * xi
+    xi3 = xi2 * xi
+    shape = [1.0_dp - 3.0_dp * xi2 + 2.0_dp * xi3, length * (xi - 2.0_dp * xi2 + xi3), &
+             y * (1.0_dp - xi), z * (1.0_dp - xi), &
+             3.0_dp * xi2 - 2.0_dp * xi3, length * (xi3 - xi2), y * xi, z * xi]
+    dshape_dx = [(-6.0_dp * xi + 6.0_dp * xi2) / length, 1.0_dp - 4.0_dp * xi + 3.0_dp * xi2, &
+                 -y / length, -z / length, &
+                 (6.0_dp * xi - 6.0_dp * xi2) / length, 3.0_dp * xi2 - 2.0_dp * xi, &
+                 y / length, z / length]
+    dshape_dy = [0.0_dp, 0.0_dp, 1.0_dp - xi, 0.0_dp, 0.0_dp, 0.0_dp, xi, 0.0_dp]
+    dshape_dz = [0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp - xi, 0.0_dp, 0.0_dp, 0.0_dp, xi]
+  end subroutine beam_shape
+
+  !> Gauss points and weights over the element volume in parameter coordinates
+  !> (xi in [0,1], y in [-h/2,h/2], z in [-w/2,w/2]); weights include the volume
+  !> element L dxi dy dz of a straight reference.
+  pure subroutine volume_rule(length, width, height, xi, y, z, weight, info)
+    real(dp), intent(in) :: length, width, height
+    real(dp), intent(out) :: xi(n_axial), y(n_section), z(n_section)
+    real(dp), intent(out) :: weight(n_axial, n_section, n_section)
+    integer, intent(out) :: info
+    real(dp) :: pa(n_axial), wa(n_axial), ps(n_section), ws(n_section)
+    integer :: i, j, k, info_section
+    call gauss_legendre(n_axial, pa, wa, info)
+    call gauss_legendre(n_section, ps, ws, info_section)
+    info = max(info, info_section)
+    xi = 0.5_dp * (pa + 1.0_dp)
+    y = 0.5_dp * height * ps
+    z = 0.5_dp * width * ps
+    do k = 1, n_section
+      do j = 1, n_section
+        do i = 1, n_axial
+          weight(i, j, k) = wa(i) * ws(j) * ws(k) * 0.125_dp * length * height * width
+        end do
+      end do
+    end do
+  end subroutine volume_rule
+
+  !> Compact consistent mass matrix m_ab = int rho N_a N_b dV (8 x 8); the full
+  !> element mass matrix is kron(mass, I3). Exact Gauss quadrature.
+  pure subroutine beam_mass_compact(length, width, height, density, mass, info)
+    real(dp), intent(in) :: length, width, height, density
+    real(dp), intent(out) :: mass(8, 8)
+    integer, intent(out) :: info
+    real(dp) :: xi(n_axial), y(n_section), z(n_section), weight(n_axial, n_section, n_section)
+    real(dp) :: shape(8), d_dx(8), d_dy(8), d_dz(8)
+    integer :: i, j, k, a
+    call volume_rule(length, width, height, xi, y, z, weight, info)
+    mass = 0.0_dp
+    do k = 1, n_section
+      do j = 1, n_section
+        do i = 1, n_axial
+          call beam_shape(xi(i), y(j), z(k), length, shape, d_dx, d_dy, d_dz)
+          do a = 1, 8
+            mass(:, a) = mass(:, a) + density * weight(i, j, k) * shape * shape(a)
+          end do
+        end do
+      end do
+    end do
+  end subroutine beam_mass_compact
+
+  !> Generalized gravity force (eqs. 22-24): Q_a = int rho N_a g dV, as 3 x 8.
+  pure subroutine beam_gravity_compact(length, width, height, density, gravity, force, info)
+    real(dp), intent(in) :: length, width, height, density, gravity(3)
+    real(dp), intent(out) :: force(3, 8)
+    integer, intent(out) :: info
+    real(dp) :: xi(n_axial), y(n_section), z(n_section), weight(n_axial, n_section, n_section)
+    real(dp) :: shape(8), d_dx(8), d_dy(8), d_dz(8)
+    integer :: i, j, k, a
+    call volume_rule(length, width, height, xi, y, z, weight, info)
+    force = 0.0_dp
+    do k = 1, n_section
+      do j = 1, n_section
+        do i = 1, n_axial
+          call beam_shape(xi(i), y(j), z(k), length, shape, d_dx, d_dy, d_dz)
+          do a = 1, 8
+            force(:, a) = force(:, a) + density * weight(i, j, k) * shape(a) * gravity
+          end do
+        end do
+      end do
+    end do
+  end subroutine beam_gravity_compact
+
+  !> Compact mass of a point mass at the material point (xi, y, z): mass N_a N_b.
+  pure subroutine beam_point_mass_compact(xi, y, z, length, point_mass, mass)
+    real(dp), intent(in) :: xi, y, z, length, point_mass
+    real(dp), intent(out) :: mass(8, 8)
+    real(dp) :: shape(8), d_dx(8), d_dy(8), d_dz(8)
+    integer :: a
+    call beam_shape(xi, y, z, length, shape, d_dx, d_dy, d_dz)
+    do a = 1, 8
+      mass(:, a) = point_mass * shape * shape(a)
+    end do
+  end subroutine beam_point_mass_compact
+
+  !> Constant small-strain stiffness K0 (eqs. 13-21) of the element in its reference
+  !> configuration reference(3, 8) (nodal vectors, expressed in the floating frame).
+  !> Strain eps = [e_xx, e_yy, e_zz, g_xy, g_yz, g_xz] of u = S (e - e0) with respect
+  !> to the reference material coordinates X = r0(x, y, z); isotropic law (E, nu), which
+  !> for nu = 0 is the paper's Q = diag(E, E, E, E/2, E/2, E/2) (eq. 18).
+  !> info: 0 ok, 1 bad quadrature, 2 degenerate reference (det J0 <= 0).
+  pure subroutine beam_linear_stiffness(reference, length, width, height, youngs, poisson, &
+                                        stiffness, info)
+    real(dp), intent(in) :: reference(3, 8), length, width, height, youngs, poisson
+    real(dp), intent(out) :: stiffness(24, 24)
+    integer, intent(out) :: info
+    real(dp) :: xi(n_axial), y(n_section), z(n_section), weight(n_axial, n_section, n_section)
+    real(dp) :: shape(8), dshape(8, 3), jacobian0(3, 3), inverse0(3, 3), det0
+    real(dp) :: material_gradient(8, 3), strain_matrix(6, 24), elasticity(6, 6)
+    integer :: i, j, k
+    call volume_rule(length, width, height, xi, y, z, weight, info)
+    call isotropic_elasticity(youngs, poisson, elasticity)
+    stiffness = 0.0_dp
+    do k = 1, n_section
+      do j = 1, n_section
+        do i = 1, n_axial
+          call beam_shape(xi(i), y(j), z(k), length, shape, dshape(:, 1), dshape(:, 2), dshape(:, 3))
+          jacobian0 = matmul(reference, dshape)
+          call invert3(jacobian0, inverse0, det0)
+          if (det0 <= 0.0_dp) then
+            info = 2
+            return
+          end if
+          material_gradient = matmul(dshape, inverse0)
+          call small_strain_matrix(material_gradient, strain_matrix)
+          stiffness = stiffness + weight(i, j, k) * det0 * &
+                      matmul(transpose(strain_matrix), matmul(elasticity, strain_matrix))
+        end do
+      end do
+    end do
+  end subroutine beam_linear_stiffness
+
+  !> B(6, 24) with eps = B u for u = sum_a N_a u_a, given dN_a/dX_j = gradient(a, j).
+  pure subroutine small_strain_matrix(gradient, strain_matrix)
+    real(dp), intent(in) :: gradient(8, 3)
+    real(dp), intent(out) :: strain_matrix(6, 24)
+    integer :: a, c
+    strain_matrix = 0.0_dp
+    do a = 1, 8
+      c = 3 * (a - 1)
+      strain_matrix(1, c + 1) = gradient(a, 1)
+      strain_matrix(2, c + 2) = gradient(a, 2)
+      strain_matrix(3, c + 3) = gradient(a, 3)
+      strain_matrix(4, c + 1) = gradient(a, 2)
+      strain_matrix(4, c + 2) = gradient(a, 1)
+      strain_matrix(5, c + 2) = gradient(a, 3)
+      strain_matrix(5, c + 3) = gradient(a, 2)
+      strain_matrix(6, c + 1) = gradient(a, 3)
+      strain_matrix(6, c + 3) = gradient(a, 1)
+    end do
+  end subroutine small_strain_matrix
+
+  !> Isotropic elasticity in Voigt form with engineering shear strains.
+  pure subroutine isotropic_elasticity(youngs, poisson, elasticity)
+    real(dp), intent(in) :: youngs, poisson
+    real(dp), intent(out) :: elasticity(6, 6)
+    real(dp) :: lame, shear
+    integer :: i
+    lame = youngs * poisson / ((1.0_dp + poisson) * (1.0_dp - 2.0_dp * poisson))
+    shear = youngs / (2.0_dp * (1.0_dp + poisson))
+    elasticity = 0.0_dp
+    elasticity(1:3, 1:3) = lame
+    do i = 1, 3
+      elasticity(i, i) = lame + 2.0_dp * shear
+      elasticity(i + 3, i + 3) = shear
+    end do
+  end subroutine isotropic_elasticity
+
+  !> Inverse and determinant of a 3 x 3 matrix (inverse left at zero when singular).
+  pure subroutine invert3(matrix, inverse, det)
+    real(dp), intent(in) :: matrix(3, 3)
+    real(dp), intent(out) :: inverse(3, 3), det
+    inverse(1, 1) = matrix(2, 2) * matrix(3, 3) - matrix(2, 3) * matrix(3, 2)
+    inverse(1, 2) = matrix(1, 3) * matrix(3, 2) - matrix(1, 2) * matrix(3, 3)
+    inverse(1, 3) = matrix(1, 2) * matrix(2, 3) - matrix(1, 3) * matrix(2, 2)
+    inverse(2, 1) = matrix(2, 3) * matrix(3, 1) - matrix(2, 1) * matrix(3, 3)
+    inverse(2, 2) = matrix(1, 1) * matrix(3, 3) - matrix(1, 3) * matrix(3, 1)
+    inverse(2, 3) = matrix(1, 3) * matrix(2, 1) - matrix(1, 1) * matrix(2, 3)
+    inverse(3, 1) = matrix(2, 1) * matrix(3, 2) - matrix(2, 2) * matrix(3, 1)
+    inverse(3, 2) = matrix(1, 2) * matrix(3, 1) - matrix(1, 1) * matrix(3, 2)
+    inverse(3, 3) = matrix(1, 1) * matrix(2, 2) - matrix(1, 2) * matrix(2, 1)
+    det = matrix(1, 1) * inverse(1, 1) + matrix(1, 2) * inverse(2, 1) + matrix(1, 3) * inverse(3, 1)
+    if (det /= 0.0_dp) then
+      inverse = inverse / det
+    else
+      inverse = 0.0_dp
+    end if
+  end subroutine invert3
+
+end module beam_element

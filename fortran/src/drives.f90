@@ -1,0 +1,64 @@
+!> Prescribed time functions phi(t), phi'(t), phi''(t) that drive rheonomic constraints.
+!>   kind 0  constant:  phi = p(1)
+!>   kind 1  luffing profile of SPEC section 5 (smooth start, constant rate, smooth brake):
+!>           p = [omega, t_s, t_b, phi_end, phi_start]
+module drives
+  use ancf_kinds, only: dp
+  implicit none
+  private
+  public :: drive_eval
+
+  integer, parameter, public :: drive_constant = 0, drive_luffing = 1
+  real(dp), parameter :: pi = 3.14159265358979323846_dp
+
+contains
+
+  !> info = 1 for an unknown kind, 2 for non-physical parameters.
+  pure subroutine drive_eval(kind, params, t, phi, dphi, ddphi, info)
+    integer, intent(in) :: kind
+    real(dp), intent(in) :: params(8), t
+    real(dp), intent(out) :: phi, dphi, ddphi
+    integer, intent(out) :: info
+    real(dp) :: omega, t_s, t_b, t_c, t_1, t_2, tau
+    info = 0
+    phi = 0.0_dp
+    dphi = 0.0_dp
+    ddphi = 0.0_dp
+    select case (kind)
+    case (drive_constant)
+      phi = params(1)
+    case (drive_luffing)
+      omega = params(1)
+      t_s = params(2)
+      t_b = params(3)
+      t_c = params(4) / omega - 0.5_dp * (t_s + t_b)
+      if (omega <= 0.0_dp .or. t_s <= 0.0_dp .or. t_b <= 0.0_dp .or. t_c < 0.0_dp) then
+        info = 2
+        return
+      end if
+      t_1 = t_s + t_c
+      t_2 = t_1 + t_b
+      if (t < 0.0_dp) then
+        phi = 0.0_dp
+      else if (t < t_s) then
+        phi = 0.5_dp * omega * (t - t_s / pi * sin(pi * t / t_s))
+        dphi = 0.5_dp * omega * (1.0_dp - cos(pi * t / t_s))
+        ddphi = 0.5_dp * omega * pi / t_s * sin(pi * t / t_s)
+      else if (t < t_1) then
+        phi = 0.5_dp * omega * t_s + omega * (t - t_s)
+        dphi = omega
+      else if (t < t_2) then
+        tau = t - t_1
+        phi = 0.5_dp * omega * t_s + omega * t_c + 0.5_dp * omega * (tau + t_b / pi * sin(pi * tau / t_b))
+        dphi = 0.5_dp * omega * (1.0_dp + cos(pi * tau / t_b))
+        ddphi = -0.5_dp * omega * pi / t_b * sin(pi * tau / t_b)
+      else
+        phi = params(4)
+      end if
+      phi = phi + params(5)
+    case default
+      info = 1
+    end select
+  end subroutine drive_eval
+
+end module drives

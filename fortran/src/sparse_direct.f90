@@ -1,0 +1,206 @@
+!> Sparse direct solves with sequential MUMPS behind integer handles: analyse a
+!> pattern once, factorize as often as the values change, solve many right-hand
+!> sides per factorization, release cleanly. The handle table is the kernel's only
+!> module state. MUMPS never prints (ICNTL 1-4).
+!> info: 0 ok; 1 bad handle or no free slot; 2 call out of sequence (solve before
+!> factorize, ...); 3 size mismatch; < 0 MUMPS INFOG(1) (-10: numerically singular),
+!> with INFOG(2) in info_detail.
+module sparse_direct
+  use ancf_kinds, only: dp
+  implicit none
+  private
+  include 'mpif.h'
+  include 'dmumps_struc.h'
+  public :: solver_create, solver_analyse, solver_factorize, solver_solve, solver_destroy
+
+  type :: solver_slot
+    type(dmumps_struc) :: id
+    logical :: in_use = .false.
+    logical :: analysed = .false.
+    logical :: factorized = .false.
+  end type solver_slot
+
+  integer, parameter :: max_slots = 256
+  type(solver_slot), target, save :: slots(max_slots)
+  logical, save :: mpi_ready = .false.
+
+contains
+
+  !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only).
+  subroutine solver_create(symmetry, handle, info, info_detail)
+    integer, intent(in) :: symmetry
+    integer, intent(out) :: handle, info, info_detail
+    integer :: h, ierr
+    handle = 0
+    info_detail = 0
+    info = 1
+    if (symmetry /= 0 .and. symmetry /= 1 .and. symmetry /= 2) return
+    if (.not. mpi_ready) then
+      call mpi_init(ierr)
+      mpi_ready = .true.
+    end if
+    do h = 1, max_slots
+      if (.not. slots(h)%in_use) then
+        slots(h)%id%comm = mpi_comm_world
+        slots(h)%id%par = 1
+        slots(h)%id%sym = symmetry
+        slots(h)%id%job = -1
+        call dmumps(slots(h)%id)
+        if (slots(h)%id%infog(1) < 0) then
+          info = slots(h)%id%infog(1)
+          info_detail = slots(h)%id%infog(2)
+          return
+        end if
+        call silence(slots(h)%id)
+        slots(h)%in_use = .true.
+        slots(h)%analysed = .false.
+        slots(h)%factorized = .false.
+        nullify (slots(h)%id%irn, slots(h)%id%jcn, slots(h)%id%a, slots(h)%id%rhs)
+        handle = h
+        info = 0
+        return
+      end if
+    end do
+  end subroutine solver_create
+
+  !> Symbolic analysis of the n x n pattern given by 1-based coordinates (rows, cols).
+  subroutine solver_analyse(handle, n, nnz, rows, cols, info, info_detail)
+    integer, intent(in) :: handle, n, nnz, rows(nnz), cols(nnz)
+    integer, intent(out) :: info, info_detail
+    info_detail = 0
+    if (.not. valid(handle)) then
+      info = 1
+      return
+    end if
+    if (any(rows < 1) .or. any(rows > n) .or. any(cols < 1) .or. any(cols > n)) then
+      info = 3
+      return
+    end if
+    associate (id => slots(handle)%id)
+      call release_arrays(id)
+      allocate (id%irn(nnz), id%jcn(nnz), id%a(nnz))
+      id%irn = rows
+      id%jcn = cols
+      id%a = 0.0_dp
+      id%n = n
+      id%nnz = int(nnz, kind(id%nnz))
+      id%job = 1
+      call dmumps(id)
+      info = min(id%infog(1), 0)
+      info_detail = id%infog(2)
+    end associate
+    slots(handle)%analysed = info == 0
+    slots(handle)%factorized = .false.
+  end subroutine solver_analyse
+
+  !> Numerical factorization with new values on the analysed pattern. Retries with
+  !> more workspace when MUMPS asks for it.
+  subroutine solver_factorize(handle, nnz, values, info, info_detail)
+    integer, intent(in) :: handle, nnz
+    real(dp), intent(in) :: values(nnz)
+    integer, intent(out) :: info, info_detail
+    integer :: attempt
+    info_detail = 0
+    if (.not. valid(handle)) then
+      info = 1
+      return
+    end if
+    if (.not. slots(handle)%analysed) then
+      info = 2
+      return
+    end if
+    associate (id => slots(handle)%id)
+      if (size(id%a) /= nnz) then
+        info = 3
+        return
+      end if
+      id%a = values
+      do attempt = 1, 4
+        id%job = 2
+        call dmumps(id)
+        if (id%infog(1) /= -8 .and. id%infog(1) /= -9 .and. id%infog(1) /= -14 &
+            .and. id%infog(1) /= -15 .and. id%infog(1) /= -17) exit
+        id%icntl(14) = 2 * max(id%icntl(14), 20)
+      end do
+      info = min(id%infog(1), 0)
+      info_detail = id%infog(2)
+    end associate
+    slots(handle)%factorized = info == 0
+  end subroutine solver_factorize
+
+  !> Solves for nrhs right-hand sides in place (rhs is n x nrhs).
+  subroutine solver_solve(handle, n, nrhs, rhs, info, info_detail)
+    integer, intent(in) :: handle, n, nrhs
+    real(dp), intent(inout), target :: rhs(n, nrhs)
+    integer, intent(out) :: info, info_detail
+    real(dp), pointer :: flat(:)
+    info_detail = 0
+    if (.not. valid(handle)) then
+      info = 1
+      return
+    end if
+    if (.not. slots(handle)%factorized) then
+      info = 2
+      return
+    end if
+    associate (id => slots(handle)%id)
+      if (id%n /= n) then
+        info = 3
+        return
+      end if
+      allocate (flat(n * nrhs))
+      flat = reshape(rhs, [n * nrhs])
+      id%rhs => flat
+      id%nrhs = nrhs
+      id%lrhs = n
+      id%job = 3
+      call dmumps(id)
+      info = min(id%infog(1), 0)
+      info_detail = id%infog(2)
+      if (info == 0) rhs = reshape(flat, [n, nrhs])
+      nullify (id%rhs)
+      deallocate (flat)
+    end associate
+  end subroutine solver_solve
+
+  !> Releases the solver and its handle.
+  subroutine solver_destroy(handle, info)
+    integer, intent(in) :: handle
+    integer, intent(out) :: info
+    if (.not. valid(handle)) then
+      info = 1
+      return
+    end if
+    associate (id => slots(handle)%id)
+      id%job = -2
+      call dmumps(id)
+      info = min(id%infog(1), 0)
+      call release_arrays(id)
+    end associate
+    slots(handle)%in_use = .false.
+    slots(handle)%analysed = .false.
+    slots(handle)%factorized = .false.
+  end subroutine solver_destroy
+
+  logical function valid(handle)
+    integer, intent(in) :: handle
+    valid = .false.
+    if (handle >= 1 .and. handle <= max_slots) valid = slots(handle)%in_use
+  end function valid
+
+  subroutine silence(id)
+    type(dmumps_struc), intent(inout) :: id
+    id%icntl(1) = -1
+    id%icntl(2) = -1
+    id%icntl(3) = -1
+    id%icntl(4) = 0
+  end subroutine silence
+
+  subroutine release_arrays(id)
+    type(dmumps_struc), intent(inout) :: id
+    if (associated(id%irn)) deallocate (id%irn)
+    if (associated(id%jcn)) deallocate (id%jcn)
+    if (associated(id%a)) deallocate (id%a)
+  end subroutine release_arrays
+
+end module sparse_direct

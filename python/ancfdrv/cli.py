@@ -1,0 +1,136 @@
+"""The ``ancf`` command (SPEC section 2).
+
+    ancf run SCENE.nml [-o OUT.h5] [--set GROUP.KEY=VALUE ...]
+    ancf sweep SCENE.nml --vary GROUP.KEY=V1,V2,... [--vary ...] [-o DIR] [--workers N | --scheduler ADDR]
+    ancf info OUT.h5
+    ancf plot OUT.h5 [-o PNG]
+
+Exit status: 0 success, 2 bad input, 3 solver failure (the output file already holds
+what was computed, with the failure message in its ``message`` attribute).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from .errors import AncfError, InputError
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from .plots import plot_result
+    from .runner import run_scene
+    outcome = run_scene(args.scene, args.set, args.output)
+    for warning in outcome.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+    s = outcome.static
+    from .results import read_summary
+    summary = read_summary(outcome.output)
+    tip = summary["static.deflection.tip"]
+    print(f"{outcome.scene['scene']['title']}")
+    print(f"  model        {summary['model.nnodes']} nodes, {summary['model.ndof']} coordinates, "
+          f"{summary['model.nconstraints']} constraints")
+    print(f"  static       {s.method}: {s.iterations} iterations, relative residual "
+          f"{s.residual_norm:.2e}, {1e3 * s.wall_time_s:.2f} ms")
+    print(f"  tip          axial {1e3 * tip[0]:+.4f} mm, transverse {1e3 * tip[1]:+.4f} mm, "
+          f"lateral {1e3 * tip[2]:+.4f} mm (rigid frame)")
+    png = plot_result(outcome.output)
+    print(f"  written      {outcome.output}, {png}")
+    return 0
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from .sweep import run_sweep, table_lines
+    if args.workers is not None and args.scheduler:
+        raise InputError("give --workers or --scheduler, not both")
+    out = args.output or str(Path("results") / (Path(args.scene).stem + "_sweep"))
+    rows = run_sweep(args.scene, args.vary, out, base=args.set, workers=args.workers,
+                     scheduler=args.scheduler)
+    keys = [v.split("=", 1)[0].strip().lower() for v in args.vary]
+    print("\n".join(table_lines(rows, keys)))
+    print(f"\nwritten {out}/summary.md, summary.csv, *.png and one .h5 per case")
+    failed = [r for r in rows if r["status"] != "ok"]
+    if failed:
+        print(f"{len(failed)} case(s) failed; see {out}/summary.md", file=sys.stderr)
+        return max(r["exit_code"] for r in failed)
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    from .results import read_summary
+    path = Path(args.file)
+    if not path.is_file():
+        raise InputError("result file not found", file=str(path))
+    try:
+        summary = read_summary(path)
+    except OSError as exc:
+        raise InputError(f"not a readable HDF5 result file ({exc})", file=str(path)) from None
+    skip = {"scene"}
+    for key, value in summary.items():
+        if key in skip or (isinstance(value, str) and not value):
+            continue
+        if isinstance(value, str) and "\n" in value:
+            value = value.replace("\n", "; ")
+        if isinstance(value, np.ndarray):
+            value = np.array2string(value, precision=6)
+        print(f"{key:32s} {value}")
+    return 0
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    from .plots import plot_result
+    path = Path(args.file)
+    if not path.is_file():
+        raise InputError("result file not found", file=str(path))
+    try:
+        png = plot_result(path, args.output)
+    except (ValueError, KeyError, OSError) as exc:
+        raise InputError(str(exc), file=str(path)) from None
+    print(f"written {png}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="ancf", description="ANCF flexible multibody "
+                                     "simulations from Fortran namelist scenes")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("run", help="run one scene")
+    p.add_argument("scene")
+    p.add_argument("-o", "--output", help="HDF5 result file (default from &output)")
+    p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE",
+                   help="override a namelist value (repeatable)")
+    p.set_defaults(func=_cmd_run)
+    p = sub.add_parser("sweep", help="run every combination of --vary values")
+    p.add_argument("scene")
+    p.add_argument("--vary", action="append", required=True, metavar="GROUP.KEY=V1,V2,...")
+    p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE")
+    p.add_argument("-o", "--output", help="output directory")
+    p.add_argument("--workers", type=int, help="parallel processes (default: all cores)")
+    p.add_argument("--scheduler", help="address of a Dask distributed scheduler")
+    p.set_defaults(func=_cmd_sweep)
+    p = sub.add_parser("info", help="summarize a result file")
+    p.add_argument("file")
+    p.set_defaults(func=_cmd_info)
+    p = sub.add_parser("plot", help="plot a result file")
+    p.add_argument("file")
+    p.add_argument("-o", "--output", help="PNG file (default: beside the HDF5)")
+    p.set_defaults(func=_cmd_plot)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except AncfError as exc:
+        print(f"ancf {args.command}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print(f"ancf {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,34 @@
+"""Exceptions with the exit status the command line maps them to (SPEC section 2)."""
+from __future__ import annotations
+
+
+class AncfError(Exception):
+    """Base class of every error ancfdrv raises on purpose."""
+
+    exit_code = 1
+
+
+class InputError(AncfError):
+    """Bad input: unknown group or key, wrong size, non-physical value, missing file.
+
+    The message names the file, the namelist group and the key where they are known.
+    """
+
+    exit_code = 2
+
+    def __init__(self, message: str, *, file: str | None = None, group: str | None = None,
+                 key: str | None = None) -> None:
+        self.file, self.group, self.key = file, group, key
+        where = []
+        if file:
+            where.append(str(file))
+        if group:
+            where.append(f"&{group}" + (f" {key}" if key else ""))
+        prefix = ": ".join(where)
+        super().__init__(f"{prefix}: {message}" if prefix else message)
+
+
+class SolverError(AncfError):
+    """A solver failed: Newton did not converge, a matrix was singular, a kernel refused."""
+
+    exit_code = 3

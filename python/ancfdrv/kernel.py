@@ -1,0 +1,188 @@
+"""Typed access to the compiled Fortran kernel (the f2py module ``_kernel``).
+
+Every kernel routine returns an error code; the wrappers here turn non-zero codes into
+:class:`~ancfdrv.errors.SolverError` / :class:`~ancfdrv.errors.InputError` with a clear
+message. Arrays are handed over in Fortran order so f2py does not copy them twice.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import _kernel
+from .errors import InputError, SolverError
+
+__all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
+           "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
+           "constraint_evaluate", "SparsePattern", "DirectSolver"]
+
+
+def _f(a, dtype=np.float64) -> np.ndarray:
+    return np.asfortranarray(a, dtype=dtype)
+
+
+def beam_element_arrays(lengths, width, height, density, youngs, poisson, reference):
+    """Compact mass (8, 8, nel) and small-strain stiffness K0 (24, 24, nel) per element.
+
+    ``reference`` is (3, 8, nel): the element's nodal vectors in the floating frame.
+    """
+    mass, stiffness, info = _kernel.beam_element_arrays(_f(lengths), width, height, density,
+                                                        youngs, poisson, _f(reference))
+    if info:
+        element, code = divmod(info, 10)
+        reason = {1: "unsupported quadrature", 2: "degenerate reference geometry (det J0 <= 0)"}
+        raise InputError(f"beam element {element}: {reason.get(code, f'code {code}')}")
+    return mass, stiffness
+
+
+def beam_gravity(lengths, width, height, density, gravity) -> np.ndarray:
+    """Generalized gravity (3, 8, nel) per element."""
+    force, info = _kernel.beam_gravity(_f(lengths), width, height, density, _f(gravity))
+    if info:
+        raise SolverError(f"beam gravity: kernel code {info}")
+    return force
+
+
+def beam_shape(xi, y, z, lengths):
+    """Shape functions (8, npts) and derivatives d/dx, d/dy, d/dz at material points."""
+    return _kernel.beam_shape_functions(_f(xi), _f(y), _f(z), _f(lengths))
+
+
+def beam_point_mass(xi, y, z, length, mass) -> np.ndarray:
+    """Compact (8, 8) mass of a point mass at a material point of an element."""
+    return _kernel.beam_point_mass(xi, y, z, length, mass)
+
+
+def ffr_force(dofs, stiffness0, rotation, e, e0_frame):
+    """FFR elastic force T K0 (T^T e - e0) and strain energy. ``dofs`` are 0-based (24, nel)."""
+    return _kernel.ffr_elastic_force(_f(dofs + 1, np.int32), stiffness0, _f(rotation), _f(e),
+                                     _f(e0_frame))
+
+
+def ffr_element_stiffness(stiffness0, rotation) -> np.ndarray:
+    """Element stiffness matrices T K0 T^T (24, 24, nel)."""
+    return _kernel.ffr_element_stiffness(stiffness0, _f(rotation))
+
+
+def moment_force(director, axis, magnitude):
+    """Dead moment on a section director: force (3,), Jacobian (3, 3), Hessian (3, 3, 3)."""
+    force, jacobian, hessian, info = _kernel.moment_generalized_force(_f(director), _f(axis),
+                                                                      magnitude)
+    if info:
+        raise SolverError("bending moment: the section director became parallel to the "
+                          "moment axis, the section rotation is undefined")
+    return force, jacobian, hessian
+
+
+def drive_values(kind: int, params, t):
+    """phi, phi', phi'' of a drive at the times t."""
+    p = np.zeros(8)
+    p[:len(params)] = params
+    phi, dphi, ddphi, info = _kernel.drive_values(kind, p, _f(np.atleast_1d(t)))
+    if info:
+        raise InputError(f"drive kind {kind} with parameters {list(params)}: "
+                         + ("unknown kind" if info == 1 else "non-physical parameters"))
+    return phi, dphi, ddphi
+
+
+def constraint_evaluate(ints, reals, drive_kinds, drive_params, e, e_dot, t):
+    """Values, gradients (6, ncon), Hessians (6, 6, ncon), Phi_t, Phi_tt, gamma."""
+    values, gradients, hessians, phi_t, phi_tt, gamma, info = _kernel.constraint_evaluate(
+        _f(ints, np.int32), _f(reals), _f(drive_kinds, np.int32), _f(drive_params), _f(e),
+        _f(e_dot), t)
+    if info > 0:
+        raise InputError(f"constraint {info} is malformed (kind or dof indices)")
+    if info < 0:
+        raise InputError(f"the drive of constraint {-info} has non-physical parameters")
+    return values, gradients, hessians, phi_t, phi_tt, gamma
+
+
+class SparsePattern:
+    """CSR pattern of an n x n matrix built once from element dof lists (0-based, -1 = none),
+    with the scatter map that assembles element matrices without searching."""
+
+    def __init__(self, n: int, dofs: np.ndarray) -> None:
+        dofs1 = _f(np.asarray(dofs) + 1, np.int32)
+        nnz, info = _kernel.sparse_pattern_count(n, dofs1)
+        if info:
+            raise InputError("sparse pattern: a dof index is out of range")
+        row_ptr, col_index, scatter_map, info = _kernel.sparse_pattern_build(n, dofs1, nnz)
+        if info:
+            raise SolverError(f"sparse pattern: kernel code {info}")
+        self.n, self.nnz = n, int(nnz)
+        self.row_ptr = row_ptr - 1
+        self.col_index = col_index - 1
+        self.scatter_map = scatter_map
+        self.rows = np.repeat(np.arange(n), np.diff(self.row_ptr))
+
+    def assemble(self, element_values: np.ndarray) -> np.ndarray:
+        """CSR values (nnz,) from element matrices (ndofe, ndofe, nel)."""
+        return _kernel.sparse_assemble(self.nnz, self.scatter_map, _f(element_values))
+
+    def to_scipy(self, values: np.ndarray):
+        import scipy.sparse as sp
+        return sp.csr_matrix((values, self.col_index, self.row_ptr), shape=(self.n, self.n))
+
+
+_MUMPS_MESSAGES = {-10: "the matrix is numerically singular",
+                   -9: "MUMPS workspace too small", -13: "MUMPS could not allocate memory",
+                   -6: "the matrix is structurally singular", -5: "MUMPS out of memory"}
+
+
+class DirectSolver:
+    """Sparse direct solver (sequential MUMPS) behind a kernel handle.
+
+    Analyse a coordinate pattern once, factorize as values change, solve many right-hand
+    sides per factorization. Use as a context manager or call :meth:`close`.
+    """
+
+    def __init__(self, n: int, rows: np.ndarray, cols: np.ndarray, *, symmetric: bool = False,
+                 what: str = "system matrix") -> None:
+        self.what = what
+        handle, info, detail = _kernel.direct_create(2 if symmetric else 0)
+        self._check(info, detail, "create")
+        self.handle, self.n, self.nnz = handle, n, len(rows)
+        self.factorizations = 0
+        self.solves = 0
+        info, detail = _kernel.direct_analyse(handle, n, _f(np.asarray(rows) + 1, np.int32),
+                                              _f(np.asarray(cols) + 1, np.int32))
+        self._check(info, detail, "analyse")
+
+    def _check(self, info: int, detail: int, step: str) -> None:
+        if info == 0:
+            return
+        if info < 0:
+            reason = _MUMPS_MESSAGES.get(info, f"MUMPS error INFOG(1) = {info}")
+            raise SolverError(f"{self.what}: {step} failed: {reason} (INFOG(2) = {detail})")
+        reason = {1: "invalid handle", 2: "called out of sequence", 3: "size mismatch"}[info]
+        raise SolverError(f"{self.what}: {step} failed: {reason}")
+
+    def factorize(self, values: np.ndarray) -> None:
+        info, detail = _kernel.direct_factorize(self.handle, _f(values))
+        self._check(info, detail, "factorization")
+        self.factorizations += 1
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solution for rhs of shape (n,) or (n, k)."""
+        b = np.asarray(rhs, dtype=np.float64)
+        matrix = _f(b.reshape(self.n, -1))
+        x, info, detail = _kernel.direct_solve(self.handle, matrix)
+        self._check(info, detail, "solve")
+        self.solves += matrix.shape[1]
+        return x.reshape(b.shape)
+
+    def close(self) -> None:
+        if getattr(self, "handle", 0):
+            _kernel.direct_destroy(self.handle)
+            self.handle = 0
+
+    def __enter__(self) -> "DirectSolver":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass

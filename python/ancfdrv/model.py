@@ -1,0 +1,287 @@
+"""Models built over the Fortran kernel: the multi-node ANCF-FFR beam of seed 000.
+
+A :class:`BeamModel` holds the mesh, the constant element arrays (mass, K0 in the
+floating frame), the constraints, the loads of the effects the scene lists (and only
+those), the probes, and counters of every kernel evaluation. Builders:
+:func:`build_boom` (SPEC section 5) and :func:`build_cantilever`; :func:`build_model`
+picks the one the scene asks for.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import kernel
+from .constraints import DRIVE_CONSTANT, ConstraintSet
+from .scene import EFFECTS_AVAILABLE, Scene
+
+NODE_DOFS = 12
+#: Offsets of a node's r, r_x, r_y, r_z within its 12 coordinates.
+R, RX, RY, RZ = 0, 3, 6, 9
+
+
+def node_dofs(node: int, part: int = R, count: int = 3) -> list[int]:
+    """0-based global indices of ``count`` coordinates of ``part`` of ``node``."""
+    start = NODE_DOFS * node + part
+    return list(range(start, start + count))
+
+
+def rotation_z(angle: float) -> np.ndarray:
+    """Rotation matrix about +r3."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+@dataclass
+class Moment:
+    """Dead moment ``magnitude`` about ``axis`` on the section of a node (director r_y)."""
+
+    node: int
+    axis: np.ndarray
+    magnitude: float
+    effect: str
+
+    @property
+    def dofs(self) -> list[int]:
+        return node_dofs(self.node, RY)
+
+
+@dataclass
+class Probe:
+    """A material point: element, xi in [0, 1], section coordinates y, z."""
+
+    element: int
+    xi: float
+    y: float = 0.0
+    z: float = 0.0
+
+
+@dataclass
+class BeamModel:
+    """A straight multi-node ANCF beam with the FFR elastic model."""
+
+    node_s: np.ndarray            # arc length of every node (m)
+    width: float
+    height: float
+    density: float
+    youngs: float
+    poisson: float
+    rotation: np.ndarray          # floating frame A (3 x 3)
+    origin_offset: np.ndarray     # frame position of the neutral axis start (3,)
+    effects: tuple[str, ...]
+    constraints: ConstraintSet = field(default_factory=ConstraintSet)
+    moments: list[Moment] = field(default_factory=list)
+    point_masses: list[tuple[int, float]] = field(default_factory=list)
+    probes: dict[str, Probe] = field(default_factory=dict)
+    counters: Counter = field(default_factory=Counter)
+    warnings: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        for effect in EFFECTS_AVAILABLE:
+            self.counters[effect] += 0
+        self.nnodes = len(self.node_s)
+        self.nel = self.nnodes - 1
+        self.ndof = NODE_DOFS * self.nnodes
+        self.lengths = np.diff(self.node_s)
+        self.dofs = np.array([np.arange(24) + NODE_DOFS * el for el in range(self.nel)]).T
+        # reference (rigid) configuration in the frame: straight along x
+        e0 = np.zeros((self.nnodes, NODE_DOFS))
+        e0[:, 0:3] = self.origin_offset
+        e0[:, 0] += self.node_s
+        e0[:, 3:12] = np.eye(3).ravel()
+        self.e0_frame = e0.ravel()
+        reference = self.e0_frame[self.dofs].reshape(3, 8, self.nel, order="F")
+        self.mass_compact, self.stiffness0 = kernel.beam_element_arrays(
+            self.lengths, self.width, self.height, self.density, self.youngs, self.poisson,
+            reference)
+        self.counters["element_arrays"] += self.nel
+        self.pattern = kernel.SparsePattern(self.ndof, self.dofs)
+        self._gravity_force: np.ndarray | None = None
+        self._point_force = np.zeros(self.ndof)
+
+    # -- configuration ---------------------------------------------------------------
+    @property
+    def e0(self) -> np.ndarray:
+        """Rigid configuration in the global frame, T(A) e0_frame."""
+        return self.to_global(self.e0_frame)
+
+    def to_global(self, v: np.ndarray) -> np.ndarray:
+        """T(A) v: rotate every 3-vector of a coordinate vector into the global frame."""
+        return (v.reshape(-1, 3) @ self.rotation.T).ravel()
+
+    def to_frame(self, v: np.ndarray) -> np.ndarray:
+        """T(A)^T v."""
+        return (v.reshape(-1, 3) @ self.rotation).ravel()
+
+    # -- matrices --------------------------------------------------------------------
+    def mass_matrix(self) -> sp.csr_matrix:
+        """Constant mass matrix: kron(compact, I3) per element plus point masses."""
+        element = np.einsum("abe,ij->aibje", self.mass_compact, np.eye(3)).reshape(24, 24, -1)
+        mass = self.pattern.to_scipy(self.pattern.assemble(element)).tolil()
+        for node, m in self.point_masses:
+            for d in node_dofs(node, R):
+                mass[d, d] += m
+        return mass.tocsr()
+
+    def stiffness_values(self) -> np.ndarray:
+        """CSR values (on ``pattern``) of K = T K0 T^T."""
+        self.counters["stiffness_assembly"] += 1
+        return self.pattern.assemble(kernel.ffr_element_stiffness(self.stiffness0, self.rotation))
+
+    def stiffness_matrix(self) -> sp.csr_matrix:
+        return self.pattern.to_scipy(self.stiffness_values())
+
+    # -- forces ----------------------------------------------------------------------
+    def elastic_force(self, e: np.ndarray) -> tuple[np.ndarray, float]:
+        """FFR elastic force T K0 (T^T e - e0_frame) and the strain energy."""
+        self.counters["elastic_force"] += 1
+        return kernel.ffr_force(self.dofs, self.stiffness0, self.rotation, e, self.e0_frame)
+
+    def constant_force(self) -> np.ndarray:
+        """Configuration-independent loads of the listed effects (gravity, tip loads)."""
+        force = self._point_force.copy()
+        if self._gravity_force is not None:
+            force += self._gravity_force
+        return force
+
+    def moment_terms(self, e: np.ndarray):
+        """Per moment: (dofs, force, Jacobian, Hessian) at e."""
+        out = []
+        for moment in self.moments:
+            self.counters[moment.effect] += 1
+            f, j, h = kernel.moment_force(e[moment.dofs], moment.axis, moment.magnitude)
+            out.append((moment.dofs, f, j, h))
+        return out
+
+    def external_force(self, e: np.ndarray) -> np.ndarray:
+        force = self.constant_force()
+        for dofs, f, _, _ in self.moment_terms(e):
+            force[dofs] += f
+        return force
+
+    # -- loads set-up (only for listed effects) ----------------------------------------
+    def add_gravity(self, g: np.ndarray) -> None:
+        elements = kernel.beam_gravity(self.lengths, self.width, self.height, self.density, g)
+        force = np.zeros(self.ndof)
+        np.add.at(force, self.dofs.reshape(-1, order="F"), elements.reshape(-1, order="F"))
+        for node, m in self.point_masses:
+            force[node_dofs(node, R)] += m * g
+        self._gravity_force = force
+        self.counters["gravity"] += 1
+
+    def add_point_force(self, node: int, force: np.ndarray, effect: str) -> None:
+        self._point_force[node_dofs(node, R)] += force
+        self.counters[effect] += 1
+
+    # -- output quantities --------------------------------------------------------------
+    def probe_positions(self, e: np.ndarray) -> dict[str, np.ndarray]:
+        out = {}
+        for name, probe in self.probes.items():
+            shape, *_ = kernel.beam_shape([probe.xi], [probe.y], [probe.z],
+                                          [self.lengths[probe.element]])
+            q = e[self.dofs[:, probe.element]].reshape(8, 3)
+            out[name] = shape[:, 0] @ q
+        return out
+
+    def deflections(self, e: np.ndarray) -> dict[str, np.ndarray]:
+        """Probe displacement from the rigid configuration, in frame components."""
+        rigid = self.probe_positions(self.e0)
+        return {name: self.rotation.T @ (p - rigid[name])
+                for name, p in self.probe_positions(e).items()}
+
+    def summary(self) -> dict[str, int]:
+        return {"ndof": self.ndof, "nnodes": self.nnodes, "nelements": self.nel,
+                "nconstraints": len(self.constraints)}
+
+
+def _mesh(scene: Scene) -> np.ndarray:
+    beam = scene["beam"]
+    per_segment = (beam["nodes"] - 1) // len(beam["segments"])
+    edges = np.concatenate([[0.0], np.cumsum(beam["segments"])])
+    s = [np.linspace(a, b, per_segment + 1)[:-1] for a, b in zip(edges[:-1], edges[1:])]
+    return np.concatenate(s + [[edges[-1]]])
+
+
+def _model(scene: Scene, rotation: np.ndarray, offset: np.ndarray) -> BeamModel:
+    beam, material = scene["beam"], scene["material"]
+    return BeamModel(node_s=_mesh(scene), width=beam["width"], height=beam["height"],
+                     density=material["density"], youngs=material["youngs_modulus"],
+                     poisson=material["poisson_ratio"], rotation=rotation,
+                     origin_offset=offset, effects=scene.effects)
+
+
+def _apply_loads(model: BeamModel, scene: Scene) -> None:
+    loads, effects = scene["loads"], scene.effects
+    tip = model.nnodes - 1
+    model.probes["tip"] = Probe(element=model.nel - 1, xi=1.0)
+    if "tip_mass" in effects:
+        model.point_masses.append((tip, loads["tip_mass"]))
+        model.counters["tip_mass"] += 1
+    elif loads["tip_mass"] > 0:
+        model.warnings.append("loads.tip_mass is set but 'tip_mass' is not in scene.effects: "
+                              "not applied")
+    if "gravity" in effects:
+        model.add_gravity(np.array([0.0, -loads["gravity"], 0.0]))
+    if "tip_force" in effects:
+        model.add_point_force(tip, np.asarray(loads["tip_force"]), "tip_force")
+    if "end_moment" in effects:
+        model.moments.append(Moment(tip, np.array([0.0, 0.0, 1.0]), loads["end_moment"],
+                                    "end_moment"))
+    for key, effect in (("tip_force", "tip_force"), ("end_moment", "end_moment"),
+                        ("moment", "bending_moment")):
+        if effect not in effects and np.any(np.asarray(loads[key]) != 0):
+            model.warnings.append(f"loads.{key} is set but {effect!r} is not in scene.effects: "
+                                  "not applied")
+
+
+def build_boom(scene: Scene) -> BeamModel:
+    """The crane boom of seed 000 with the supports of eqs. 30-36 (SPEC section 5).
+
+    Frame A = R(phi) about the pivot O; rigid configuration: A1 = R(phi)(0, H, 0), axis
+    R(phi)(1, 0, 0), section y axis R(phi)(0, 1, 0). A2 is the node at the end of the
+    first segment, driven to R(phi)(a, H, 0).
+    """
+    boom, beam = scene["boom"], scene["beam"]
+    phi = np.radians(boom["angle_deg"])
+    height_h = boom["pivot_offset"]
+    model = _model(scene, rotation_z(phi), np.array([0.0, height_h, 0.0]))
+    a = beam["segments"][0]
+    a2 = (beam["nodes"] - 1) // 3
+    c = model.constraints
+    r1, ry1, r2 = node_dofs(0, R), node_dofs(0, RY), node_dofs(a2, R)
+    c.cross(r1, ry1, (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), dependent=r1[0],
+            name="eq. 30: r_y(A1) parallel to O A1")
+    c.distance(r1, (0.0, 0.0, 0.0), height_h, dependent=r1[1], name="eq. 31: |O A1| = H")
+    c.coordinate(r1[2], name="eq. 32: r3(A1) = 0")
+    c.coordinate(ry1[2], name="eq. 33: r_y3(A1) = 0")
+    drive = c.add_drive(DRIVE_CONSTANT, [phi])
+    c.coordinate(r2[0], cos_coef=a, sin_coef=-height_h, drive=drive,
+                 name="eq. 34: r1(A2) = a cos(phi) - H sin(phi)")
+    c.coordinate(r2[1], cos_coef=height_h, sin_coef=a, drive=drive,
+                 name="eq. 35: r2(A2) = a sin(phi) + H cos(phi)")
+    c.coordinate(r2[2], name="eq. 36: r3(A2) = 0")
+    _apply_loads(model, scene)
+    if "bending_moment" in scene.effects:
+        model.moments.append(Moment(a2, np.array([0.0, 0.0, 1.0]), scene["loads"]["moment"],
+                                    "bending_moment"))
+    return model
+
+
+def build_cantilever(scene: Scene) -> BeamModel:
+    """A cantilever along +r1 clamped at the origin (frame A = I)."""
+    model = _model(scene, np.eye(3), np.zeros(3))
+    parts = (R, RY, RZ) if scene["cantilever"]["clamp"] == "section" else (R, RX, RY, RZ)
+    e0 = model.e0
+    for part in parts:
+        for d in node_dofs(0, part):
+            model.constraints.coordinate(d, e0[d], name=f"clamp e[{d}]")
+    _apply_loads(model, scene)
+    return model
+
+
+def build_model(scene: Scene) -> BeamModel:
+    """The model the scene describes."""
+    return {"boom": build_boom, "cantilever": build_cantilever}[scene.kind](scene)

@@ -1,0 +1,101 @@
+"""HDF5 result files (SPEC section 4), written with h5py.
+
+A file is created (and its root, /model and /counters written) before any solve, so a
+failed run still leaves a readable file that says what was attempted.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from . import __version__
+from .model import BeamModel
+from .scene import Scene
+from .static import StaticResult
+
+
+def _attrs(target: h5py.AttributeManager, values: dict[str, Any]) -> None:
+    for key, value in values.items():
+        target[key] = value
+
+
+def create(path: Path, scene: Scene, model: BeamModel) -> None:
+    """New result file with the root attributes and /model."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with h5py.File(path, "w") as h5:
+        _attrs(h5.attrs, {
+            "ancfdrv_version": __version__,
+            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+            "scene": scene.text,
+            "scene_file": str(scene.path),
+            "overrides": "\n".join(scene.overrides),
+            "title": scene["scene"]["title"],
+            "kind": scene.kind,
+            "formulation": scene["scene"]["formulation"],
+            "effects": ",".join(scene.effects),
+            "warnings": "\n".join(model.warnings),
+            "status": "running",
+        })
+        group = h5.create_group("model")
+        _attrs(group.attrs, model.summary())
+        group.create_dataset("node_s", data=model.node_s)
+        group.create_dataset("e0", data=model.e0)
+        group.attrs["constraint_names"] = "\n".join(model.constraints.names)
+
+
+def write_static(path: Path, model: BeamModel, result: StaticResult) -> None:
+    """The /static group: q, lambda, probes, deflections and solver statistics."""
+    with h5py.File(path, "a") as h5:
+        if "static" in h5:
+            del h5["static"]
+        group = h5.create_group("static")
+        group.create_dataset("q", data=result.e)
+        group.create_dataset("lambda", data=result.lam)
+        group.create_dataset("residual_history", data=np.asarray(result.history))
+        for name, position in model.probe_positions(result.e).items():
+            group.create_dataset(f"probes/{name}", data=position)
+        for name, deflection in model.deflections(result.e).items():
+            group.create_dataset(f"deflection/{name}", data=deflection)
+        _attrs(group.attrs, {"method": result.method, "iterations": result.iterations,
+                             "residual_norm": result.residual_norm,
+                             "constraint_norm": result.constraint_norm,
+                             "wall_time_s": result.wall_time_s, **result.extra})
+
+
+def finish(path: Path, model: BeamModel, timing: dict[str, float], status: str,
+           message: str = "") -> None:
+    """Counters, timing and the final status (also after a failure)."""
+    with h5py.File(path, "a") as h5:
+        for name in ("counters", "timing"):
+            if name in h5:
+                del h5[name]
+        counters = h5.create_group("counters")
+        _attrs(counters.attrs, {k: int(v) for k, v in sorted(model.counters.items())})
+        counters.attrs["constraint_evaluations"] = model.constraints.evaluations
+        group = h5.create_group("timing")
+        _attrs(group.attrs, {k: float(v) for k, v in timing.items()})
+        h5.attrs["status"] = status
+        h5.attrs["message"] = message
+
+
+def read_summary(path: Path) -> dict[str, Any]:
+    """The main figures of a result file as a flat dict (used by info, sweep, plot)."""
+    out: dict[str, Any] = {}
+    with h5py.File(path, "r") as h5:
+        out.update({k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()})
+        out.update({f"model.{k}": v for k, v in h5["model"].attrs.items()})
+        if "static" in h5:
+            static = h5["static"]
+            out.update({f"static.{k}": v for k, v in static.attrs.items()})
+            for name in static["deflection"]:
+                out[f"static.deflection.{name}"] = static["deflection"][name][()]
+                out[f"static.probes.{name}"] = static["probes"][name][()]
+        if "timing" in h5:
+            out.update({f"timing.{k}": v for k, v in h5["timing"].attrs.items()})
+        if "counters" in h5:
+            out.update({f"counters.{k}": v for k, v in h5["counters"].attrs.items()})
+    return out

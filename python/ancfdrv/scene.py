@@ -1,0 +1,311 @@
+"""Scenes: Fortran namelist files, parsed with f90nml and validated against a schema.
+
+Every group and key a scene may use is declared in :data:`SCHEMA` with its type, default,
+physical range and a one-line meaning. Unknown groups or keys, missing required keys,
+wrong sizes and non-physical values raise :class:`~ancfdrv.errors.InputError` naming the
+file, the group and the key (exit status 2 on the command line).
+"""
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import f90nml
+
+from .errors import InputError
+
+REQUIRED = object()
+
+#: Effects a scene may list in ``&scene effects``; what is not listed is never computed.
+EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment")
+#: Effects of later capabilities, recognised so the message can say so.
+EFFECTS_PLANNED = ("contact", "friction", "prestress", "damping")
+
+
+@dataclass(frozen=True)
+class Key:
+    """One namelist key: its type, default (or REQUIRED), check and meaning."""
+
+    kind: str  # 'float', 'int', 'str', 'bool', 'floats', 'strs'
+    default: Any = REQUIRED
+    check: Callable[[Any], str | None] | None = None
+    doc: str = ""
+    size: int | None = None  # exact length for list kinds
+
+
+def positive(v: Any) -> str | None:
+    return None if v > 0 else "must be positive"
+
+
+def non_negative(v: Any) -> str | None:
+    return None if v >= 0 else "must not be negative"
+
+
+def one_of(*choices: str) -> Callable[[Any], str | None]:
+    def check(v: Any) -> str | None:
+        return None if v in choices else f"must be one of {', '.join(repr(c) for c in choices)}"
+    return check
+
+
+def within(lo: float, hi: float, *, open_hi: bool = False) -> Callable[[Any], str | None]:
+    def check(v: Any) -> str | None:
+        ok = lo <= v < hi if open_hi else lo <= v <= hi
+        return None if ok else f"must lie in [{lo}, {hi}{')' if open_hi else ']'}"
+    return check
+
+
+SCHEMA: dict[str, dict[str, Key]] = {
+    "scene": {
+        "title": Key("str", doc="a line describing the scene"),
+        "analysis": Key("str", "static", one_of("static", "dynamic", "static+dynamic"),
+                        "which analysis runs"),
+        "formulation": Key("str", "ffr", one_of("ffr", "nonlinear"), "elastic model"),
+        "effects": Key("strs", [], doc="force effects to compute; nothing else is computed"),
+    },
+    "beam": {
+        "length": Key("float", check=positive, doc="length of the neutral axis (m)"),
+        "width": Key("float", check=positive, doc="section width w, along z (m)"),
+        "height": Key("float", check=positive, doc="section height h, along y (m)"),
+        "nodes": Key("int", check=lambda v: None if v >= 2 else "must be at least 2",
+                     doc="total nodes on the beam"),
+        "segments": Key("floats", None, doc="segment lengths between fixed nodes (m); "
+                        "each is split into equal elements"),
+    },
+    "material": {
+        "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
+        "density": Key("float", check=positive, doc="rho (kg/m^3)"),
+        "poisson_ratio": Key("float", 0.0, within(0.0, 0.5, open_hi=True),
+                             doc="nu in the elastic law; 0 avoids Poisson locking"),
+    },
+    "boom": {
+        "pivot_offset": Key("float", 0.295, positive, "H = |O A1| (m)"),
+        "angle_deg": Key("float", 0.0, within(-180.0, 180.0), "static luffing angle phi (deg)"),
+    },
+    "cantilever": {
+        "clamp": Key("str", "section", one_of("section", "full"),
+                     "'section' fixes r, r_y, r_z of the root node; 'full' also r_x"),
+    },
+    "loads": {
+        "gravity": Key("float", 9.81, non_negative, "gravitational acceleration (m/s^2)"),
+        "tip_mass": Key("float", 0.0, non_negative, "lumped mass at the tip (kg)"),
+        "moment": Key("float", 0.0, doc="boom: moment M_B about +r3 on the section at A2 (N m)"),
+        "tip_force": Key("floats", [0.0, 0.0, 0.0], size=3, doc="force at the tip (N)"),
+        "end_moment": Key("float", 0.0, doc="moment about +r3 on the tip section (N m)"),
+    },
+    "solver": {
+        "static_method": Key("str", "split", one_of("split", "newton"),
+                             "static solver: split iteration or Newton-Raphson"),
+        "tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+                   "relative tolerance of the static solve"),
+        "max_iter": Key("int", 50, positive, "iteration limit of the static solve"),
+        "split_p": Key("float", 0.0, within(0.0, 1.0, open_hi=True),
+                       "splitting parameter p of K_RR = K_RR1 + K_RR2, in [0, 1)"),
+        "dt": Key("float", 1e-3, positive, "time step (s), dynamic analyses"),
+        "t_end": Key("float", 10.0, non_negative, "end time (s), dynamic analyses"),
+    },
+    "output": {
+        "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),
+    },
+}
+
+#: Groups that define what is built; a scene has exactly one of them.
+MODEL_GROUPS = ("boom", "cantilever")
+COMMON_GROUPS = ("scene", "beam", "material", "loads", "solver")
+
+
+@dataclass
+class Scene:
+    """A validated scene: typed values per group, the source path and namelist text."""
+
+    path: Path
+    values: dict[str, dict[str, Any]]
+    text: str
+    overrides: list[str] = field(default_factory=list)
+
+    @property
+    def kind(self) -> str:
+        """The model the scene builds: 'boom' or 'cantilever'."""
+        return next(g for g in MODEL_GROUPS if g in self.values)
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        return tuple(self.values["scene"]["effects"])
+
+    def get(self, dotted: str) -> Any:
+        group, key = dotted.split(".")
+        return self.values[group][key]
+
+    def __getitem__(self, group: str) -> dict[str, Any]:
+        return self.values[group]
+
+    @property
+    def output_file(self) -> Path:
+        name = self.values.get("output", {}).get("file")
+        return Path(name) if name else Path("results") / (self.path.stem + ".h5")
+
+
+def _coerce(kind: str, raw: Any, where: dict) -> Any:
+    def bad(expected: str) -> InputError:
+        return InputError(f"expected {expected}, got {raw!r}", **where)
+
+    def as_float(x: Any) -> float:
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            raise bad("a number")
+        if not math.isfinite(float(x)):
+            raise bad("a finite number")
+        return float(x)
+
+    if kind == "float":
+        return as_float(raw)
+    if kind == "int":
+        if isinstance(raw, bool) or not isinstance(raw, int):
+            if isinstance(raw, float) and raw.is_integer():
+                return int(raw)
+            raise bad("an integer")
+        return raw
+    if kind == "str":
+        if not isinstance(raw, str):
+            raise bad("a string")
+        return raw.strip()
+    if kind == "bool":
+        if not isinstance(raw, bool):
+            raise bad(".true. or .false.")
+        return raw
+    if kind == "floats":
+        items = raw if isinstance(raw, list) else [raw]
+        return [as_float(x) for x in items]
+    if kind == "strs":
+        items = raw if isinstance(raw, list) else [raw]
+        if not all(isinstance(x, str) for x in items):
+            raise bad("a list of strings")
+        return [x.strip() for x in items if x is not None]
+    raise AssertionError(kind)
+
+
+def _parse_override_value(kind: str, text: str, where: dict) -> Any:
+    """Parse the VALUE of --set GROUP.KEY=VALUE, typed like the namelist entry."""
+    text = text.strip()
+    if kind in ("str", "strs"):
+        items = [t.strip().strip("'\"") for t in text.split(",")] if kind == "strs" else None
+        return items if kind == "strs" else text.strip("'\"")
+    try:
+        parsed = f90nml.reads(f"&x v = {text} /")["x"]["v"]
+    except Exception as exc:  # f90nml raises several types
+        raise InputError(f"cannot parse override value {text!r}: {exc}", **where) from None
+    return parsed
+
+
+def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
+    """Read, override and validate a scene file. Raises InputError on any problem."""
+    path = Path(path)
+    file = str(path)
+    if not path.is_file():
+        raise InputError("scene file not found", file=file)
+    try:
+        nml = f90nml.read(str(path))
+    except Exception as exc:
+        raise InputError(f"not a valid Fortran namelist: {exc}", file=file) from None
+    for group, entries in nml.items():
+        if group not in SCHEMA:
+            raise InputError(f"unknown group; known groups: {', '.join(SCHEMA)}", file=file,
+                             group=group)
+        if isinstance(entries, list):
+            raise InputError("group given more than once", file=file, group=group)
+
+    applied = []
+    for item in overrides or []:
+        if "=" not in item or "." not in item.split("=", 1)[0]:
+            raise InputError(f"override {item!r} is not of the form GROUP.KEY=VALUE", file=file)
+        dotted, value = item.split("=", 1)
+        group, key = (s.strip().lower() for s in dotted.split(".", 1))
+        where = dict(file=file, group=group, key=key)
+        if group not in SCHEMA:
+            raise InputError(f"unknown group in override {item!r}", file=file, group=group)
+        if key not in SCHEMA[group]:
+            raise InputError(f"unknown key in override {item!r}; known keys: "
+                             f"{', '.join(SCHEMA[group])}", **where)
+        if group not in nml:
+            nml[group] = f90nml.Namelist()
+        nml[group][key] = _parse_override_value(SCHEMA[group][key].kind, value, where)
+        applied.append(f"{group}.{key}={value}")
+
+    values: dict[str, dict[str, Any]] = {}
+    for group, entries in nml.items():
+        typed: dict[str, Any] = {}
+        for key, raw in entries.items():
+            where = dict(file=file, group=group, key=key)
+            if key not in SCHEMA[group]:
+                raise InputError(f"unknown key; known keys of &{group}: "
+                                 f"{', '.join(SCHEMA[group])}", **where)
+            spec = SCHEMA[group][key]
+            value = _coerce(spec.kind, raw, where)
+            if spec.size is not None and len(value) != spec.size:
+                raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
+            if spec.check is not None:
+                items = value if spec.kind in ("floats",) else [value]
+                for item in items:
+                    message = spec.check(item)
+                    if message:
+                        raise InputError(f"{value!r} {message}", **where)
+            typed[key] = value
+        for key, spec in SCHEMA[group].items():
+            if key not in typed:
+                if spec.default is REQUIRED:
+                    raise InputError("required key is missing", file=file, group=group, key=key)
+                typed[key] = spec.default
+        values[group] = typed
+
+    models = [g for g in MODEL_GROUPS if g in values]
+    if len(models) != 1:
+        raise InputError(f"a scene needs exactly one of the groups "
+                         f"{', '.join('&' + g for g in MODEL_GROUPS)} (found "
+                         f"{', '.join('&' + g for g in models) or 'none'})", file=file)
+    for group in COMMON_GROUPS:
+        if group not in values:
+            if any(spec.default is REQUIRED for spec in SCHEMA[group].values()):
+                raise InputError("required group is missing", file=file, group=group)
+            values[group] = {k: s.default for k, s in SCHEMA[group].items()}
+    _check_consistency(values, file)
+    buffer = io.StringIO()
+    nml.write(buffer)
+    return Scene(path=path, values=values, text=buffer.getvalue(), overrides=applied)
+
+
+def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
+    scene = values["scene"]
+    for effect in scene["effects"]:
+        if effect in EFFECTS_PLANNED:
+            raise InputError(f"effect {effect!r} is not available in this version (available: "
+                             f"{', '.join(EFFECTS_AVAILABLE)})", file=file, group="scene",
+                             key="effects")
+        if effect not in EFFECTS_AVAILABLE:
+            raise InputError(f"unknown effect {effect!r}; known effects: "
+                             f"{', '.join(EFFECTS_AVAILABLE)}", file=file, group="scene",
+                             key="effects")
+    if scene["analysis"] != "static":
+        raise InputError(f"analysis {scene['analysis']!r} is not available in this version; "
+                         "only 'static' is", file=file, group="scene", key="analysis")
+    if scene["formulation"] != "ffr":
+        raise InputError(f"formulation {scene['formulation']!r} is not available in this "
+                         "version; only 'ffr' is", file=file, group="scene", key="formulation")
+    beam = values["beam"]
+    if beam["segments"] is None:
+        beam["segments"] = [beam["length"]]
+    segments = beam["segments"]
+    if any(s <= 0 for s in segments):
+        raise InputError("segment lengths must be positive", file=file, group="beam",
+                         key="segments")
+    if abs(sum(segments) - beam["length"]) > 1e-9 * beam["length"]:
+        raise InputError(f"segments add up to {sum(segments):g} m, not beam.length = "
+                         f"{beam['length']:g} m", file=file, group="beam", key="segments")
+    k = len(segments)
+    if (beam["nodes"] - 1) % k:
+        raise InputError(f"nodes = {beam['nodes']}: with {k} segments the beam needs "
+                         f"{k}j+1 nodes ({', '.join(str(k * j + 1) for j in range(1, 5))}, ...)",
+                         file=file, group="beam", key="nodes")
+    if "boom" in values and k != 3:
+        raise InputError("the boom needs three segments A1-A2, A2-A3, A3-A4", file=file,
+                         group="beam", key="segments")

@@ -1,0 +1,204 @@
+"""Parameter sweeps: every combination of ``--vary`` values, run in parallel processes (or
+on a Dask distributed scheduler), one HDF5 per case, and the accuracy-versus-time report:
+``summary.csv``, ``summary.md`` and plots.
+
+Error is taken against the finest case of the sweep with the same non-resolution
+parameters (most ``beam.nodes``, smallest ``solver.dt``); for boom scenes the error against
+the closed-form small-deflection solution (docs/boom_closed_form.md) is reported too.
+"""
+from __future__ import annotations
+
+import csv
+import itertools
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from .errors import AncfError, InputError
+from .scene import SCHEMA, load_scene
+
+#: Parameters that refine a model; the finest value is the reference of the others.
+RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min}
+
+
+def parse_vary(items: list[str], scene_file: str) -> list[tuple[str, list[str]]]:
+    """``GROUP.KEY=V1,V2,...`` -> (dotted key, values); keys are checked against the schema."""
+    out = []
+    for item in items:
+        if "=" not in item or "." not in item.split("=", 1)[0]:
+            raise InputError(f"--vary {item!r} is not of the form GROUP.KEY=V1,V2,...",
+                             file=scene_file)
+        dotted, values = item.split("=", 1)
+        group, key = dotted.strip().lower().split(".", 1)
+        if group not in SCHEMA or key not in SCHEMA[group]:
+            raise InputError(f"--vary names an unknown key {dotted!r}", file=scene_file,
+                             group=group, key=key)
+        vals = [v.strip() for v in values.split(",") if v.strip()]
+        if not vals:
+            raise InputError(f"--vary {dotted} has no values", file=scene_file, group=group,
+                             key=key)
+        out.append((f"{group}.{key}", vals))
+    return out
+
+
+def case_name(params: dict[str, str]) -> str:
+    return "_".join(f"{k.split('.')[1]}-{v}" for k, v in params.items()).replace("'", "")
+
+
+def run_case(scene_file: str, params: dict[str, str], base: list[str], output: str) -> dict:
+    """Run one case in a worker; never raises (failures become a row with a message)."""
+    from .runner import run_scene
+    row: dict[str, Any] = dict(params)
+    row["file"] = output
+    try:
+        outcome = run_scene(scene_file, base + [f"{k}={v}" for k, v in params.items()], output)
+    except AncfError as exc:
+        row.update(status="failed", message=str(exc), exit_code=exc.exit_code)
+        return row
+    static = outcome.static
+    from .results import read_summary
+    summary = read_summary(Path(output))
+    axial, transverse, lateral = summary["static.deflection.tip"]
+    row.update(status="ok", message="", exit_code=0, tip_axial=axial, tip_transverse=transverse,
+               tip_lateral=lateral, iterations=static.iterations,
+               residual=static.residual_norm, solve_time_s=static.wall_time_s,
+               total_time_s=summary["timing.total"], ndof=summary["model.ndof"])
+    return row
+
+
+def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | None:
+    """Relative error of the tip sag against the boom's closed form (None if not a boom)."""
+    from .analytic import boom_static_tip_deflection
+    params = [f"{k}={row[k]}" for k in row if "." in k]
+    scene = load_scene(scene_file, base + params)
+    if scene.kind != "boom" or row.get("status") != "ok":
+        return None
+    effects, loads = scene.effects, scene["loads"]
+    beam, material = scene["beam"], scene["material"]
+    _, reference = boom_static_tip_deflection(
+        scene["boom"]["angle_deg"], loads["tip_mass"] if "tip_mass" in effects else 0.0,
+        length=beam["length"], a=beam["segments"][0], H=scene["boom"]["pivot_offset"],
+        width=beam["width"], height=beam["height"], youngs=material["youngs_modulus"],
+        density=material["density"], poisson=material["poisson_ratio"],
+        gravity=loads["gravity"] if "gravity" in effects else 0.0,
+        moment=loads["moment"] if "bending_moment" in effects else 0.0, shear=True)
+    row["tip_transverse_closed_form"] = reference
+    return abs(row["tip_transverse"] - reference) / max(abs(reference), 1e-300)
+
+
+def add_errors(rows: list[dict], varied: list[str]) -> None:
+    """err_vs_finest per row: against the finest resolution with the other keys equal."""
+    resolution = [k for k in varied if k in RESOLUTION_KEYS]
+    others = [k for k in varied if k not in RESOLUTION_KEYS]
+    groups: dict[tuple, list[dict]] = {}
+    for row in rows:
+        if row["status"] == "ok":
+            groups.setdefault(tuple(row[k] for k in others), []).append(row)
+    for members in groups.values():
+        def rank(row: dict) -> tuple:
+            return tuple((-1 if RESOLUTION_KEYS[k] is max else 1) * float(row[k])
+                         for k in resolution)
+        finest = min(members, key=rank)
+        for row in members:
+            ref = finest["tip_transverse"]
+            row["err_vs_finest"] = abs(row["tip_transverse"] - ref) / max(abs(ref), 1e-300)
+
+
+def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: list[str] | None = None,
+              workers: int | None = None, scheduler: str | None = None,
+              progress: bool | None = None) -> list[dict]:
+    """Run every combination and write the report into ``outdir``. Returns the rows."""
+    base = base or []
+    load_scene(scene_file, base)  # fail early on a bad scene or override
+    grid = parse_vary(vary, scene_file)
+    keys = [k for k, _ in grid]
+    combos = [dict(zip(keys, values)) for values in itertools.product(*[v for _, v in grid])]
+    for params in combos:  # validate every case before spending time on any
+        load_scene(scene_file, base + [f"{k}={v}" for k, v in params.items()])
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    jobs = [(scene_file, p, base, str(outdir / f"{case_name(p)}.h5")) for p in combos]
+    show = sys.stderr.isatty() if progress is None else progress
+    rows: list[dict] = []
+    bar = tqdm(total=len(jobs), desc="sweep", unit="case", disable=not show)
+    if scheduler:
+        try:
+            from dask.distributed import Client, as_completed as dask_completed
+        except ImportError:
+            raise InputError("--scheduler needs dask[distributed]: pip install 'dask[distributed]'")
+        with Client(scheduler) as client:
+            futures = [client.submit(run_case, *job, pure=False) for job in jobs]
+            for future in dask_completed(futures):
+                rows.append(future.result())
+                bar.update()
+    elif (workers or os.cpu_count() or 1) > 1 and len(jobs) > 1:
+        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
+            futures = [pool.submit(run_case, *job) for job in jobs]
+            for future in as_completed(futures):
+                rows.append(future.result())
+                bar.update()
+    else:
+        for job in jobs:
+            rows.append(run_case(*job))
+            bar.update()
+    bar.close()
+    order = {case_name(p): i for i, p in enumerate(combos)}
+    rows.sort(key=lambda r: order[case_name({k: r[k] for k in keys})])
+    add_errors(rows, keys)
+    for row in rows:
+        if row["status"] == "ok":
+            err = closed_form_error(scene_file, row, base)
+            if err is not None:
+                row["err_vs_closed_form"] = err
+    write_report(rows, keys, outdir)
+    from .plots import plot_sweep
+    plot_sweep(rows, keys, outdir)
+    return rows
+
+
+COLUMNS = [("tip_transverse", "tip sag (mm)", 1e3, "{:.4f}"),
+           ("tip_transverse_closed_form", "closed form (mm)", 1e3, "{:.4f}"),
+           ("err_vs_closed_form", "err vs closed form", 1.0, "{:.2e}"),
+           ("err_vs_finest", "err vs finest", 1.0, "{:.2e}"),
+           ("iterations", "iterations", 1, "{}"),
+           ("solve_time_s", "solve time (ms)", 1e3, "{:.2f}"),
+           ("total_time_s", "case time (ms)", 1e3, "{:.1f}"),
+           ("status", "status", None, "{}")]
+
+
+def table_lines(rows: list[dict], keys: list[str]) -> list[str]:
+    """The Markdown table of a sweep (what `make demo` prints)."""
+    cols = [c for c in COLUMNS if any(c[0] in r for r in rows)]
+    header = keys + [c[1] for c in cols]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for row in rows:
+        cells = [str(row[k]) for k in keys]
+        for key, _, scale, fmt in cols:
+            value = row.get(key)
+            if value is None or value == "":
+                cells.append("-")
+            else:
+                cells.append(fmt.format(value * scale if scale not in (None, 1) else value))
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def write_report(rows: list[dict], keys: list[str], outdir: Path) -> None:
+    fields = keys + sorted({k for r in rows for k in r} - set(keys))
+    with open(outdir / "summary.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=fields)
+        writer.writeheader()
+        for row in rows:
+            writer.writerow(row)
+    failed = [r for r in rows if r["status"] != "ok"]
+    lines = ["# Sweep summary", "", f"{len(rows)} cases, {len(failed)} failed. Error is the "
+             "relative difference of the tip sag (transverse tip deflection in the rigid frame); "
+             "times are wall-clock seconds of this machine.", ""]
+    lines += table_lines(rows, keys)
+    for row in failed:
+        lines += ["", f"- {case_name({k: row[k] for k in keys})}: {row['message']}"]
+    (outdir / "summary.md").write_text("\n".join(lines) + "\n")
