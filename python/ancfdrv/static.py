@@ -44,6 +44,20 @@ class StaticResult:
     extra: dict[str, float] = field(default_factory=dict)
 
 
+#: A correction smaller than this relative to the displacement is at round-off level: the
+#: state can no longer improve, so the solve stops there (and reports its residual).
+STEP_FLOOR = 1e-13
+
+
+def converged(force_res: float, con_res: float, step: float, size: float, tol: float) -> str:
+    """'' while iterating; 'residual' or 'step' (round-off floor reached) when converged."""
+    if force_res <= tol and con_res <= tol:
+        return "residual"
+    if step <= STEP_FLOOR * size and force_res <= 1e3 * tol and con_res <= 1e3 * tol:
+        return "step"
+    return ""
+
+
 def residuals(model: BeamModel, d: np.ndarray, lam: np.ndarray, stiffness: sp.csr_matrix):
     """Relative force residual |K d - Q - Phi_e^T lam| / scale and max |Phi| / length at the
     displacement d = e - e0 (carried instead of e so K d loses no digits)."""
@@ -88,42 +102,46 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50) ->
     timing["assembly"] += time.perf_counter() - t0
     history = []
     with DirectSolver(n + ncon, rows, cols, what="static Newton saddle-point matrix") as solver:
-        for iteration in range(1, max_iter + 1):
-            t0 = time.perf_counter()
-            e = model.e0 + d
-            phi, _, _, grads = model.constraints.jacobian(e, n)
-            reaction = np.zeros(n)
-            np.add.at(reaction, j_cols, grads * lam[j_rows])
-            moments = model.moment_terms(e)
-            external = model.constant_force()
-            for dofs, f, _, _ in moments:
-                external[dofs] += f
-            residual = stiffness @ d - external - reaction
-            values = np.concatenate([k_values, -lam[h_con] * h_vals,
-                                     *[-j.ravel() for _, _, j, _ in moments], -grads, -grads])
-            timing["assembly"] += time.perf_counter() - t0
-            t0 = time.perf_counter()
-            solver.factorize(values)
-            timing["factorization"] += time.perf_counter() - t0
-            t0 = time.perf_counter()
-            step = solver.solve(np.concatenate([-residual, phi]))
-            timing["solve"] += time.perf_counter() - t0
-            if not np.all(np.isfinite(step)):
-                raise SolverError(f"static Newton: non-finite step at iteration {iteration}")
-            d += step[:n]
-            lam += step[n:]
-            force_res, con_res = residuals(model, d, lam, stiffness)
-            history.append(force_res)
-            if force_res <= tol and con_res <= tol:
-                break
-        else:
-            raise SolverError(f"static Newton did not converge in {max_iter} iterations "
-                              f"(relative residual {force_res:.3e}, constraint {con_res:.3e})")
-        model.counters["factorizations"] += solver.factorizations
-        model.counters["solves"] += solver.solves
+        try:
+            for iteration in range(1, max_iter + 1):
+                t0 = time.perf_counter()
+                e = model.e0 + d
+                phi, _, _, grads = model.constraints.jacobian(e, n)
+                reaction = np.zeros(n)
+                np.add.at(reaction, j_cols, grads * lam[j_rows])
+                moments = model.moment_terms(e)
+                external = model.constant_force()
+                for dofs, f, _, _ in moments:
+                    external[dofs] += f
+                residual = stiffness @ d - external - reaction
+                values = np.concatenate([k_values, -lam[h_con] * h_vals,
+                                         *[-j.ravel() for _, _, j, _ in moments], -grads, -grads])
+                timing["assembly"] += time.perf_counter() - t0
+                t0 = time.perf_counter()
+                solver.factorize(values)
+                timing["factorization"] += time.perf_counter() - t0
+                t0 = time.perf_counter()
+                step = solver.solve(np.concatenate([-residual, phi]))
+                timing["solve"] += time.perf_counter() - t0
+                if not np.all(np.isfinite(step)):
+                    raise SolverError(f"static Newton: non-finite step at iteration {iteration}")
+                d += step[:n]
+                lam += step[n:]
+                force_res, con_res = residuals(model, d, lam, stiffness)
+                history.append(force_res)
+                how = converged(force_res, con_res, np.linalg.norm(step[:n]), np.linalg.norm(d), tol)
+                if how:
+                    break
+            else:
+                raise SolverError(f"static Newton did not converge in {max_iter} iterations "
+                                  f"(relative residual {force_res:.3e}, constraint {con_res:.3e})")
+        finally:
+            model.counters["factorizations"] += solver.factorizations
+            model.counters["solves"] += solver.solves
     wall = time.perf_counter() - start
     timing["total"] = wall
-    return StaticResult(model.e0 + d, lam, "newton", iteration, force_res, con_res, wall, history, timing)
+    return StaticResult(model.e0 + d, lam, "newton", iteration, force_res, con_res, wall, history,
+                        timing, extra={"converged_by": how})
 
 
 class Jet:
@@ -211,6 +229,7 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
     k_dd = stiffness[dep][:, dep].toarray()
     timing["assembly"] += time.perf_counter() - t0
     d_r, d_d, lam = np.zeros(len(rest)), np.zeros(nd), np.zeros(ncon)
+    disp = np.zeros(n)
     history, inner_total = [], 0
     scale_length = model.node_s[-1] - model.node_s[0]
     with DirectSolver(len(rest), k_rr.row, k_rr.col, what="split iteration K_RR") as solver:
@@ -220,64 +239,69 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
         dd_grad = np.zeros((nd, m))
         dd_grad[:, :nd] = np.eye(nd)
         d_d_jet = Jet(d_d, dd_grad, np.zeros((nd, m, m)))
-        for outer in range(1, max_iter + 1):
-            d_d_jet.value = d_d
-            d_r_jet = Jet(d_r.copy(), np.zeros((len(rest), m)), np.zeros((len(rest), m, m)))
-            for inner in range(1, max_inner + 1):
-                t0 = time.perf_counter()
+        try:
+            for outer in range(1, max_iter + 1):
+                d_d_jet.value = d_d
+                d_r_jet = Jet(d_r.copy(), np.zeros((len(rest), m)), np.zeros((len(rest), m, m)))
+                for inner in range(1, max_inner + 1):
+                    t0 = time.perf_counter()
+                    d = Jet.zeros(n, m)
+                    d.value[rest], d.grad[rest], d.hess[rest] = d_r_jet.value, d_r_jet.grad, d_r_jet.hess
+                    d.value[dep], d.grad[dep] = d_d_jet.value, d_d_jet.grad
+                    force = _force_jet(model, d, lam, nd)[rest]
+                    rhs = force.stack()
+                    rhs[:, :1 + m] -= np.hstack([(k_rd @ d_d)[:, None], k_rd @ dd_grad])
+                    timing["assembly"] += time.perf_counter() - t0
+                    t0 = time.perf_counter()
+                    solved = Jet.unstack(solver.solve(rhs), m)
+                    timing["solve"] += time.perf_counter() - t0
+                    new = d_r_jet.combine(p, solved, 1.0 - p)
+                    change = new.distance(d_r_jet)
+                    d_r_jet = new
+                    if change <= inner_tol * max(scale_length, 1.0):
+                        break
+                inner_total += inner
+                # linearized D-equations and constraints in delta = (delta e_D, delta lambda)
                 d = Jet.zeros(n, m)
-                d.value[rest], d.grad[rest], d.hess[rest] = d_r_jet.value, d_r_jet.grad, d_r_jet.hess
-                d.value[dep], d.grad[dep] = d_d_jet.value, d_d_jet.grad
-                force = _force_jet(model, d, lam, nd)[rest]
-                rhs = force.stack()
-                rhs[:, :1 + m] -= np.hstack([(k_rd @ d_d)[:, None], k_rd @ dd_grad])
-                timing["assembly"] += time.perf_counter() - t0
-                t0 = time.perf_counter()
-                solved = Jet.unstack(solver.solve(rhs), m)
-                timing["solve"] += time.perf_counter() - t0
-                new = d_r_jet.combine(p, solved, 1.0 - p)
-                change = new.distance(d_r_jet)
-                d_r_jet = new
-                if change <= inner_tol * max(scale_length, 1.0):
+                d.value[rest], d.grad[rest] = d_r_jet.value, d_r_jet.grad
+                d.value[dep], d.grad[dep] = d_d, dd_grad
+                force = _force_jet(model, d, lam, nd)[dep]
+                r_value = k_dr @ d_r_jet.value + k_dd @ d_d - force.value
+                r_grad = k_dr @ d_r_jet.grad + k_dd @ dd_grad - force.grad
+                phi, rows, cols, grads = model.constraints.jacobian(model.e0 + d.value, n)
+                phi_grad = np.zeros((ncon, m))
+                np.add.at(phi_grad, rows, grads[:, None] * d.grad[cols])
+                system = np.vstack([r_grad, phi_grad])
+                try:
+                    delta = np.linalg.solve(system, -np.concatenate([r_value, phi]))
+                except np.linalg.LinAlgError:
+                    raise SolverError("split iteration: the reduced system in (e_D, lambda) is "
+                                      "singular; the dependent coordinates do not fit the "
+                                      "constraints") from None
+                d_r = d_r_jet.evaluate(delta)
+                d_d = d_d + delta[:nd]
+                lam = lam + delta[nd:]
+                previous = disp
+                disp = np.zeros(n)
+                disp[rest], disp[dep] = d_r, d_d
+                force_res, con_res = residuals(model, disp, lam, stiffness)
+                history.append(force_res)
+                if not np.isfinite(force_res):
+                    raise SolverError(f"split iteration: non-finite state at pass {outer}")
+                how = converged(force_res, con_res, np.linalg.norm(disp - previous),
+                                np.linalg.norm(disp), tol)
+                if how:
                     break
-            inner_total += inner
-            # linearized D-equations and constraints in delta = (delta e_D, delta lambda)
-            d = Jet.zeros(n, m)
-            d.value[rest], d.grad[rest] = d_r_jet.value, d_r_jet.grad
-            d.value[dep], d.grad[dep] = d_d, dd_grad
-            force = _force_jet(model, d, lam, nd)[dep]
-            r_value = k_dr @ d_r_jet.value + k_dd @ d_d - force.value
-            r_grad = k_dr @ d_r_jet.grad + k_dd @ dd_grad - force.grad
-            phi, rows, cols, grads = model.constraints.jacobian(model.e0 + d.value, n)
-            phi_grad = np.zeros((ncon, m))
-            np.add.at(phi_grad, rows, grads[:, None] * d.grad[cols])
-            system = np.vstack([r_grad, phi_grad])
-            try:
-                delta = np.linalg.solve(system, -np.concatenate([r_value, phi]))
-            except np.linalg.LinAlgError:
-                raise SolverError("split iteration: the reduced system in (e_D, lambda) is "
-                                  "singular; the dependent coordinates do not fit the "
-                                  "constraints") from None
-            d_r = d_r_jet.evaluate(delta)
-            d_d = d_d + delta[:nd]
-            lam = lam + delta[nd:]
-            disp = np.zeros(n)
-            disp[rest], disp[dep] = d_r, d_d
-            force_res, con_res = residuals(model, disp, lam, stiffness)
-            history.append(force_res)
-            if not np.isfinite(force_res):
-                raise SolverError(f"split iteration: non-finite state at pass {outer}")
-            if force_res <= tol and con_res <= tol:
-                break
-        else:
-            raise SolverError(f"split iteration did not converge in {max_iter} passes "
-                              f"(relative residual {force_res:.3e}, constraint {con_res:.3e})")
-        model.counters["factorizations"] += solver.factorizations
-        model.counters["solves"] += solver.solves
+            else:
+                raise SolverError(f"split iteration did not converge in {max_iter} passes "
+                                  f"(relative residual {force_res:.3e}, constraint {con_res:.3e})")
+        finally:
+            model.counters["factorizations"] += solver.factorizations
+            model.counters["solves"] += solver.solves
     wall = time.perf_counter() - start
     timing["total"] = wall
     return StaticResult(model.e0 + disp, lam, "split", outer, force_res, con_res, wall, history, timing,
-                        extra={"inner_iterations": inner_total, "p": p})
+                        extra={"inner_iterations": inner_total, "p": p, "converged_by": how})
 
 
 def solve_static(model: BeamModel, method: str, *, tol: float, max_iter: int,

@@ -1,0 +1,159 @@
+"""The ancf command: run/sweep/info/plot, HDF5 layout (SPEC section 4), and bad input
+(exit 2 naming file, group and key) and solver failure (exit 3, file kept)."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from ancfdrv.cli import main
+
+BOOM = """
+&scene title = 'test boom', analysis = 'static', formulation = 'ffr',
+       effects = 'gravity', 'tip_mass', 'bending_moment' /
+&beam length = 7.791, width = 0.1, height = 0.1, nodes = 10, segments = 1.791, 3.0, 3.0 /
+&material youngs_modulus = 2.1e11, density = 7850.0 /
+&boom angle_deg = 15 /
+&loads tip_mass = 50.0, moment = 1000.0 /
+&solver static_method = 'split' /
+"""
+
+
+def test_run_writes_spec_layout_and_plot(boom_scene, tmp_path, capsys):
+    out = tmp_path / "boom.h5"
+    code = main(["run", str(boom_scene), "-o", str(out), "--set", "beam.nodes=10",
+                 "--set", "solver.static_method='newton'", "--set", "loads.tip_mass=50"])
+    assert code == 0
+    assert "tip" in capsys.readouterr().out
+    with h5py.File(out) as h5:
+        for key in ("ancfdrv_version", "created", "scene", "formulation", "effects"):
+            assert key in h5.attrs
+        assert "nodes = 10" in h5.attrs["scene"]
+        assert h5["model"].attrs["ndof"] == 120 and h5["model"].attrs["nnodes"] == 10
+        assert h5["model"].attrs["nconstraints"] == 7
+        static = h5["static"]
+        assert static["q"].shape == (120,) and static["lambda"].shape == (7,)
+        assert static["probes/tip"].shape == (3,) and static["deflection/tip"].shape == (3,)
+        assert static.attrs["method"] == "newton"
+        for key in ("iterations", "residual_norm", "wall_time_s"):
+            assert key in static.attrs
+        assert static["deflection/tip"][1] < 0  # sags
+        assert h5["counters"].attrs["gravity"] == 1
+        assert h5["counters"].attrs["end_moment"] == 0
+        assert {"total", "output"} <= set(h5["timing"].attrs)
+        assert h5.attrs["status"] == "ok"
+    assert out.with_suffix(".png").stat().st_size > 1000
+    assert main(["info", str(out)]) == 0
+    assert "static.iterations" in capsys.readouterr().out
+    png = tmp_path / "x.png"
+    assert main(["plot", str(out), "-o", str(png)]) == 0 and png.exists()
+
+
+def test_sweep_table_errors_and_plots(write_scene, tmp_path, capsys):
+    scene = write_scene(BOOM)
+    out = tmp_path / "sweep"
+    code = main(["sweep", str(scene), "--vary", "boom.angle_deg=0,30", "--vary",
+                 "beam.nodes=4,10", "-o", str(out), "--workers", "2"])
+    assert code == 0
+    rows = list(csv.DictReader(open(out / "summary.csv")))
+    assert len(rows) == 4 and all(r["status"] == "ok" for r in rows)
+    fine = [r for r in rows if r["beam.nodes"] == "10"]
+    assert all(float(r["err_vs_finest"]) == 0 for r in fine)
+    coarse = [r for r in rows if r["beam.nodes"] == "4"]
+    assert all(float(r["err_vs_closed_form"]) > float(f["err_vs_closed_form"])
+               for r, f in zip(coarse, fine))
+    assert (out / "summary.md").read_text().count("|") > 20
+    assert (out / "tip_deflection.png").exists() and (out / "error_vs_time.png").exists()
+    assert len(list(out.glob("*.h5"))) == 4
+    assert "err vs closed form" in capsys.readouterr().out
+
+
+def expect_input_error(args, capsys, *fragments):
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    for fragment in fragments:
+        assert fragment in err, err
+    return err
+
+
+def test_unknown_group(write_scene, capsys):
+    path = write_scene(BOOM + "&wind speed = 3.0 /\n")
+    expect_input_error(["run", str(path)], capsys, str(path), "&wind", "unknown group")
+
+
+def test_unknown_key(write_scene, capsys):
+    path = write_scene(BOOM.replace("angle_deg = 15", "angle_deg = 15, angel = 3"))
+    expect_input_error(["run", str(path)], capsys, str(path), "&boom angel", "unknown key")
+
+
+def test_unknown_override_key(boom_scene, capsys):
+    expect_input_error(["run", str(boom_scene), "--set", "beam.nodez=10"], capsys,
+                       "&beam nodez", "unknown key")
+
+
+def test_nodes_not_3k_plus_1(write_scene, capsys):
+    path = write_scene(BOOM.replace("nodes = 10", "nodes = 12"))
+    expect_input_error(["run", str(path)], capsys, str(path), "&beam nodes", "3j+1")
+
+
+@pytest.mark.parametrize("group,key,text,bad", [
+    ("material", "youngs_modulus", "youngs_modulus = 2.1e11", "youngs_modulus = -2.1e11"),
+    ("material", "density", "density = 7850.0", "density = 0.0"),
+    ("beam", "width", "width = 0.1", "width = 0.0"),
+    ("beam", "height", "height = 0.1", "height = -0.1"),
+    ("beam", "length", "length = 7.791", "length = -7.791"),
+])
+def test_non_physical_values(write_scene, capsys, group, key, text, bad):
+    path = write_scene(BOOM.replace(text, bad, 1))
+    expect_input_error(["run", str(path)], capsys, str(path), f"&{group} {key}")
+
+
+def test_missing_file(tmp_path, capsys):
+    missing = tmp_path / "nope.nml"
+    expect_input_error(["run", str(missing)], capsys, str(missing), "not found")
+    expect_input_error(["info", str(tmp_path / "nope.h5")], capsys, "not found")
+
+
+def test_missing_required_key(write_scene, capsys):
+    path = write_scene(BOOM.replace("density = 7850.0", ""))
+    expect_input_error(["run", str(path)], capsys, "&material density", "required")
+
+
+def test_wrong_size_and_type(write_scene, capsys):
+    path = write_scene(BOOM.replace("moment = 1000.0", "moment = 1000.0, tip_force = 1, 2"))
+    expect_input_error(["run", str(path)], capsys, "&loads tip_force", "expected 3 values")
+    path = write_scene(BOOM.replace("nodes = 10", "nodes = 'ten'"), "b.nml")
+    expect_input_error(["run", str(path)], capsys, "&beam nodes", "integer")
+
+
+def test_unknown_effect_and_unavailable_analysis(write_scene, capsys):
+    path = write_scene(BOOM.replace("'bending_moment'", "'wind'"))
+    expect_input_error(["run", str(path)], capsys, "&scene effects", "unknown effect 'wind'")
+    path = write_scene(BOOM.replace("analysis = 'static'", "analysis = 'dynamic'"), "d.nml")
+    expect_input_error(["run", str(path)], capsys, "&scene analysis", "not available")
+
+
+def test_solver_failure_exit_3_keeps_file(write_scene, tmp_path, capsys):
+    path = write_scene(BOOM.replace("static_method = 'split'",
+                                    "static_method = 'newton', max_iter = 1, tol = 1e-14"))
+    out = tmp_path / "fail.h5"
+    assert main(["run", str(path), "-o", str(out)]) == 3
+    err = capsys.readouterr().err
+    assert "did not converge in 1 iterations" in err
+    with h5py.File(out) as h5:
+        assert h5.attrs["status"] == "failed"
+        assert "did not converge" in h5.attrs["message"]
+        assert h5["model"].attrs["ndof"] == 120
+        assert h5["counters"].attrs["factorizations"] == 1  # the one iteration it made
+
+
+def test_override_strings_with_or_without_quotes(boom_scene, tmp_path):
+    for value in ("newton", "'newton'", '"newton"'):
+        out = tmp_path / "q.h5"
+        assert main(["run", str(boom_scene), "-o", str(out), "--set", "beam.nodes=4",
+                     "--set", f"solver.static_method={value}"]) == 0
+        with h5py.File(out) as h5:
+            assert h5["static"].attrs["method"] == "newton"
