@@ -47,7 +47,7 @@ $(PY): | system-packages
 
 $(STAMP): $(SOURCES) | system-packages $(PY)
 	$(PY) -m pip install -q meson-python meson ninja numpy
-	$(PY) -m pip install -q --no-build-isolation '.[test]'
+	PATH="$(abspath $(VENV))/bin:$$PATH" $(PY) -m pip install -q --no-build-isolation '.[test]'
 	touch $(STAMP)
 
 clean:
