@@ -1,9 +1,10 @@
 #!/usr/bin/env python
 """Scaling of the boom statics with the mesh size, and how far the solvers are from the floor.
 
-For every node count (3k+1) of the boom of ``inputs/boom_static.nml`` this measures, wall
-clock (``time.perf_counter``), best of N repeats where N is chosen so that the repeats of
-one measurement take at least ``--min-time`` seconds together:
+For every node count (3k+1) of the boom of ``inputs/boom_static.nml`` this measures the
+wall clock (``time.perf_counter``), best of N repeats; N is chosen so that the repeats of
+one measurement take at least ``--min-time`` seconds and number at least
+``--min-repeats``, unless they already took ``--max-time`` (see :class:`Budget`):
 
 * ``build_model`` (element arrays, sparse pattern, constraints, loads);
 * one stiffness assembly ``model.stiffness_values()``;
@@ -26,10 +27,13 @@ matrix it works with: analyse + one factorization + one solve of the saddle-poin
 (MUMPS), or ``spsolve`` of it. The ratios static time / floor say how much a full
 nonlinear solve costs over one linear solve of the same size.
 
-Each static solve is first tried at ``--tol``; when it does not converge (the relative
-residual of the fine meshes stagnates above a floor that grows with the mesh), the failure
-is recorded and the solve is timed again at ``--fallback-tol``, so that a converged time
-is always reported together with the tolerance it was reached at.
+Each static solve is first timed at ``--tol``; when it does not converge there (the
+relative residual of fine meshes stagnates at a round-off floor that grows with the mesh),
+the failure is recorded and the solve is timed at ``--fallback-tol``, so a converged time
+is always reported with the tolerance it was reached at and how the solver stopped
+(``converged_by``: residual, or step at the round-off floor, where the solver reports it).
+Process CPU time (user/system) and minor page faults of the best repeat are recorded too:
+a large system share means time spent page-faulting freshly allocated memory.
 
 Results: a table on stdout and JSON (machine info, one record per node count, growth
 exponents) in ``benchmarks/results/``. Run from the repository root::
@@ -46,6 +50,7 @@ import json
 import math
 import os
 import platform
+import resource
 import sys
 import time
 from dataclasses import asdict, dataclass, field
@@ -75,18 +80,42 @@ SOLVERS: dict[str, StaticSolver] = {"newton": solve_newton, "split": solve_split
 
 
 # -- timing ----------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Budget:
+    """How often a measurement is repeated: until the repeats took ``min_time`` seconds
+    together and there were ``min_repeats`` of them, unless they already took
+    ``max_time`` seconds; never more than ``max_repeats``; always at least once."""
+
+    min_time: float = 0.2
+    min_repeats: int = 3
+    max_time: float = 5.0
+    max_repeats: int = 10_000
+
+    def done(self, spent: float, calls: int) -> bool:
+        if calls == 0:
+            return False
+        if calls >= self.max_repeats or spent >= self.max_time:
+            return True
+        return spent >= self.min_time and calls >= self.min_repeats
+
+
 @dataclass
 class Timing:
-    """Best-of-N wall time of one measurement.
+    """Best-of-N wall time of one measurement, with what the best repeat reported.
 
-    ``phases`` are the sub-timings (seconds) the measured call reported in its best
-    repeat, e.g. analyse / factorize / solve, or a static solve's ``timing`` dict.
+    ``phases`` are the sub-timings (seconds) the measured call returned, e.g. analyse /
+    factorize / solve, or a static solve's ``timing`` dict; ``cpu_user_s``, ``cpu_sys_s``
+    and ``minor_faults`` are the process's resource usage during the best repeat (all
+    threads; system time and page faults reveal allocation of fresh memory).
     """
 
     best_s: float
     median_s: float
     repeats: int
     phases: dict[str, float] = field(default_factory=dict)
+    cpu_user_s: float = math.nan
+    cpu_sys_s: float = math.nan
+    minor_faults: int = 0
     discarded: int = 0
 
 
@@ -95,32 +124,38 @@ class Discard(Exception):
     converge this time although it did before)."""
 
 
-def best_of(run: Callable[[], object], *, min_time: float, max_repeats: int,
-            first: tuple[float, dict[str, float]] | None = None) -> Timing:
-    """Call ``run`` until the calls took ``min_time`` seconds together (at least once, at
-    most ``max_repeats`` times) and keep the fastest. When ``run`` returns a dict, it is
-    taken as the phase timings of that call. ``first`` is an already measured sample
-    (wall time, phases) counted as a repeat."""
-    samples: list[tuple[float, dict[str, float]]] = [first] if first else []
-    spent, calls, discarded = sum(s for s, _ in samples), len(samples), 0
+def best_of(run: Callable[[], object], budget: Budget) -> Timing:
+    """Call ``run`` as often as ``budget`` says and keep the fastest call. When ``run``
+    returns a dict, it is taken as the phase timings of that call; when it raises
+    :class:`Discard`, the call is not a sample (but its time counts against the budget);
+    any other exception propagates."""
+    samples: list[Timing] = []
+    spent, calls, discarded = 0.0, 0, 0
     gc.collect()
-    while not samples or (spent < min_time and calls < max_repeats):
+    while not samples or not budget.done(spent, calls):
+        r0 = resource.getrusage(resource.RUSAGE_SELF)
         t0 = time.perf_counter()
         try:
             out = run()
         except Discard:
             out = Discard
         elapsed = time.perf_counter() - t0
+        r1 = resource.getrusage(resource.RUSAGE_SELF)
         spent, calls = spent + elapsed, calls + 1
         if out is Discard:
             discarded += 1
             if discarded > max(3, calls // 2):
                 raise RuntimeError("best_of: most repeats were discarded")
             continue
-        samples.append((elapsed, dict(out) if isinstance(out, dict) else {}))
-    best = min(samples, key=lambda s: s[0])
-    return Timing(best_s=best[0], median_s=float(np.median([s for s, _ in samples])),
-                  repeats=len(samples), phases=best[1], discarded=discarded)
+        samples.append(Timing(best_s=elapsed, median_s=elapsed, repeats=1,
+                              phases=dict(out) if isinstance(out, dict) else {},
+                              cpu_user_s=r1.ru_utime - r0.ru_utime,
+                              cpu_sys_s=r1.ru_stime - r0.ru_stime,
+                              minor_faults=r1.ru_minflt - r0.ru_minflt))
+    best = min(samples, key=lambda t: t.best_s)
+    best.median_s = float(np.median([t.best_s for t in samples]))
+    best.repeats, best.discarded = len(samples), discarded
+    return best
 
 
 # -- matrices ----------------------------------------------------------------------------
@@ -149,10 +184,10 @@ def newton_saddle_system(model: BeamModel) -> LinearSystem:
     h_con, h_rows, h_cols, h_vals = _hessian_triplets(model, e)
     phi, j_rows, j_cols, grads = model.constraints.jacobian(e, n)
     moments = model.moment_terms(e)
-    rows = np.concatenate([model.pattern.rows, h_rows, *[np.repeat(m.dofs, 3) for m in
-                                                         model.moments], n + j_rows, j_cols])
-    cols = np.concatenate([model.pattern.col_index, h_cols, *[np.tile(m.dofs, 3) for m in
-                                                              model.moments], j_cols, n + j_rows])
+    m_rows = [np.repeat(m.dofs, 3) for m in model.moments]
+    m_cols = [np.tile(m.dofs, 3) for m in model.moments]
+    rows = np.concatenate([model.pattern.rows, h_rows, *m_rows, n + j_rows, j_cols])
+    cols = np.concatenate([model.pattern.col_index, h_cols, *m_cols, j_cols, n + j_rows])
     values = np.concatenate([k_values, -lam[h_con] * h_vals,
                              *[-j.ravel() for _, _, j, _ in moments], -grads, -grads])
     external = model.constant_force()
@@ -181,10 +216,11 @@ def relative_residual(system: LinearSystem, x: np.ndarray) -> float:
 
 
 # -- measurements -------------------------------------------------------------------------
-def time_mumps(system: LinearSystem, what: str, *, min_time: float,
-               max_repeats: int) -> tuple[Timing, np.ndarray | None, str | None]:
-    """Analyse + factorize + one solve with DirectSolver; phases analyse/factorize/solve.
-    Returns the timing, the solution and the solver's error message (then no timing)."""
+def time_mumps(system: LinearSystem, what: str,
+               budget: Budget) -> tuple[Timing, np.ndarray | None, str | None]:
+    """Create + analyse + factorize + one solve + destroy with DirectSolver (phases
+    analyse, factorize, solve). Returns the timing, the solution and, when MUMPS refused
+    the matrix, its error message (the timing is then empty)."""
     solution: list[np.ndarray] = []
 
     def run() -> dict[str, float]:
@@ -200,14 +236,13 @@ def time_mumps(system: LinearSystem, what: str, *, min_time: float,
         return {"analyse": t1 - t0, "factorize": t2 - t1, "solve": t3 - t2}
 
     try:
-        timing = best_of(run, min_time=min_time, max_repeats=max_repeats)
+        timing = best_of(run, budget)
     except SolverError as exc:
         return Timing(math.nan, math.nan, 0), None, str(exc)
     return timing, solution[0], None
 
 
-def time_spsolve(system: LinearSystem, *, min_time: float,
-                 max_repeats: int) -> tuple[Timing, np.ndarray]:
+def time_spsolve(system: LinearSystem, budget: Budget) -> tuple[Timing, np.ndarray]:
     """scipy's spsolve (SuperLU) of the system; the CSC conversion is not timed."""
     matrix = system.to_csc()
     solution: list[np.ndarray] = []
@@ -215,43 +250,47 @@ def time_spsolve(system: LinearSystem, *, min_time: float,
     def run() -> None:
         solution[:] = [spla.spsolve(matrix, system.rhs)]
 
-
-    return best_of(run, min_time=min_time, max_repeats=max_repeats), solution[0]
+    return best_of(run, budget), solution[0]
 
 
 def time_static(model: BeamModel, method: str, tols: list[float], *, max_iter: int,
-                min_time: float, max_repeats: int) -> dict[str, Any]:
-    """A static solve at the first tolerance of ``tols`` that converges; failed attempts
-    are recorded with their message and time to failure."""
+                budget: Budget) -> dict[str, Any]:
+    """A static solve timed at the first tolerance of ``tols`` it reaches. A solve that
+    fails on its first call at a tolerance is recorded (message, time to failure) and the
+    next tolerance is tried; one that fails on a later repeat is dropped from the samples
+    and recorded too (near the round-off floor convergence may flicker)."""
     solve = SOLVERS[method]
     failures: list[dict[str, Any]] = []
     for tol in tols:
-        t0 = time.perf_counter()
-        try:
-            result = solve(model, tol=tol, max_iter=max_iter)
-        except SolverError as exc:
-            failures.append({"tol": tol, "error": str(exc),
-                             "time_to_failure_s": time.perf_counter() - t0})
-            continue
-        first = (time.perf_counter() - t0, dict(result.timing))
-        results = [result]
+        results: list[StaticResult] = []
 
         def run() -> dict[str, float]:
             try:
                 results.append(solve(model, tol=tol, max_iter=max_iter))
-            except SolverError as exc:  # near the residual floor, convergence may flicker
-                failures.append({"tol": tol, "error": f"repeat: {exc}",
+            except SolverError as exc:
+                if not results:
+                    raise
+                failures.append({"tol": tol, "error": f"on a repeat: {exc}",
                                  "time_to_failure_s": math.nan})
                 raise Discard from exc
             return results[-1].timing
 
-        timing = best_of(run, min_time=min_time, max_repeats=max_repeats, first=first)
+        t0 = time.perf_counter()
+        try:
+            timing = best_of(run, budget)
+        except SolverError as exc:
+            failures.append({"tol": tol, "error": str(exc),
+                             "time_to_failure_s": time.perf_counter() - t0})
+            continue
         phases = timing.phases
         phases["other"] = phases["total"] - sum(phases[k] for k in
                                                 ("assembly", "factorization", "solve"))
+        result = results[0]
         return {"method": method, "converged": True, "tol": tol,
-                "converged_at_requested_tol": tol == tols[0], "failures": failures,
-                "iterations": result.iterations, "residual_norm": result.residual_norm,
+                "converged_at_requested_tol": tol == tols[0],
+                "converged_by": result.extra.get("converged_by", "residual"),
+                "failures": failures, "iterations": result.iterations,
+                "residual_norm": result.residual_norm,
                 "constraint_norm": result.constraint_norm, "history": result.history,
                 "extra": result.extra, "timing": asdict(timing)}
     return {"method": method, "converged": False, "failures": failures}
@@ -259,41 +298,42 @@ def time_static(model: BeamModel, method: str, tols: list[float], *, max_iter: i
 
 def measure(nodes: int, args: argparse.Namespace) -> dict[str, Any]:
     """All measurements of one node count."""
-    opts = {"min_time": args.min_time, "max_repeats": args.max_repeats}
+    budget = args.budget
     scene = load_scene(SCENE, [f"beam.nodes={nodes}", f"boom.angle_deg={args.angle}"])
-    build = best_of(lambda: build_model(scene), **opts)
+    build = best_of(lambda: build_model(scene), budget)
     model = build_model(scene)
-    assembly = best_of(model.stiffness_values, **opts)
+    assembly = best_of(model.stiffness_values, budget)
 
     saddle = newton_saddle_system(model)
-    k_rr = stiffness_system(model, reduced=True)
-    k_full = stiffness_system(model, reduced=False)
+    systems = {"saddle": saddle, "K_RR": stiffness_system(model, reduced=True),
+               "K": stiffness_system(model, reduced=False)}
     mumps: dict[str, Any] = {}
-    saddle_x = None
-    for name, system in (("saddle", saddle), ("K_RR", k_rr), ("K", k_full)):
-        timing, x, error = time_mumps(system, f"benchmark {name}", **opts)
+    solutions: dict[str, np.ndarray | None] = {}
+    for name, system in systems.items():
+        timing, solutions[name], error = time_mumps(system, f"benchmark {name}", budget)
         mumps[name] = {"n": system.n, "nnz_triplets": len(system.values),
                        "timing": asdict(timing), "error": error}
-        if name == "saddle":
-            saddle_x = x
-    scipy_timing, scipy_x = time_spsolve(saddle, **opts)
+    scipy_timing, scipy_x = time_spsolve(saddle, budget)
+    mumps_x = solutions["saddle"]
     check = {"relative_difference": math.nan, "residual_mumps": math.nan,
              "residual_spsolve": relative_residual(saddle, scipy_x)}
-    if saddle_x is not None:
-        check["relative_difference"] = float(np.linalg.norm(scipy_x - saddle_x)
+    if mumps_x is not None:
+        check["relative_difference"] = float(np.linalg.norm(scipy_x - mumps_x)
                                              / np.linalg.norm(scipy_x))
-        check["residual_mumps"] = relative_residual(saddle, saddle_x)
+        check["residual_mumps"] = relative_residual(saddle, mumps_x)
 
     static = {method: time_static(model, method, [args.tol, args.fallback_tol],
-                                  max_iter=args.max_iter, **opts) for method in SOLVERS}
+                                  max_iter=args.max_iter, budget=budget)
+              for method in SOLVERS}
 
-    phases = mumps["saddle"]["timing"]["phases"]
-    floor_mumps = sum(phases.get(k, math.nan) for k in ("analyse", "factorize", "solve"))
-    floor_mumps_no_analyse = phases.get("factorize", math.nan) + phases.get("solve", math.nan)
+    saddle_timing = mumps["saddle"]["timing"]
+    floor_mumps = saddle_timing["best_s"]
+    floor_mumps_no_analyse = (saddle_timing["phases"].get("factorize", math.nan)
+                              + saddle_timing["phases"].get("solve", math.nan))
     floor_scipy = scipy_timing.best_s
     ratios: dict[str, float] = {}
     for method, rec in static.items():
-        total = rec["timing"]["best_s"] if rec["converged"] else math.nan
+        total = _static_best(rec)
         ratios[f"{method}_over_mumps_floor"] = total / floor_mumps
         ratios[f"{method}_over_mumps_factorize_solve"] = total / floor_mumps_no_analyse
         ratios[f"{method}_over_spsolve"] = total / floor_scipy
@@ -313,6 +353,7 @@ def measure(nodes: int, args: argparse.Namespace) -> dict[str, Any]:
 
 # -- reporting ----------------------------------------------------------------------------
 def machine_info() -> dict[str, Any]:
+    """Platform, CPUs, library versions, thread settings and the current load."""
     try:
         usable = len(os.sched_getaffinity(0))
     except AttributeError:  # not on Linux
@@ -323,21 +364,28 @@ def machine_info() -> dict[str, Any]:
             "processor": platform.processor(), "python": sys.version.split()[0],
             "cpu_count": os.cpu_count(), "cpus_usable": usable, "numpy": np.__version__,
             "scipy": scipy.__version__, "ancfdrv": getattr(ancfdrv, "__version__", None),
-            "thread_env": threads}
+            "thread_env": threads, "load_average_at_start": _load()}
 
 
-def _static_best(rec: dict[str, Any], key: str = "best_s") -> float:
-    return rec["timing"][key] if rec["converged"] else math.nan
+def _load() -> list[float] | None:
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        return None
+
+
+def _static_best(rec: dict[str, Any]) -> float:
+    return rec["timing"]["best_s"] if rec["converged"] else math.nan
 
 
 def growth_exponents(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Local exponents d log(time) / d log(ndof) between consecutive node counts."""
     series: dict[str, Callable[[dict[str, Any]], float]] = {
         "build_model": lambda r: r["build_model"]["best_s"],
-        "stiffness_assembly": lambda r: r["stiffness_assembly"]["best_s"],
-        "mumps_saddle_floor": lambda r: r["floor"]["mumps_analyse_factorize_solve_s"],
+        "assembly": lambda r: r["stiffness_assembly"]["best_s"],
+        "mumps_saddle": lambda r: r["floor"]["mumps_analyse_factorize_solve_s"],
         "mumps_K_RR": lambda r: r["mumps"]["K_RR"]["timing"]["best_s"],
-        "spsolve_saddle": lambda r: r["floor"]["spsolve_s"],
+        "spsolve": lambda r: r["floor"]["spsolve_s"],
         "newton": lambda r: _static_best(r["static"]["newton"]),
         "split": lambda r: _static_best(r["static"]["split"]),
     }
@@ -349,112 +397,121 @@ def growth_exponents(records: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def _ms(seconds: float) -> str:
-    return "     -" if not math.isfinite(seconds) else f"{1e3 * seconds:9.3f}"
+def _ms(seconds: float, width: int = 9) -> str:
+    return f"{'-':>{width}}" if not math.isfinite(seconds) else f"{1e3 * seconds:{width}.3f}"
 
 
-def _tol_mark(rec: dict[str, Any]) -> str:
+def _iterations(rec: dict[str, Any]) -> str:
+    """Iterations with how the solve stopped: r residual <= tol, s step at round-off
+    (residual up to 1e3 tol), * only at the fallback tolerance."""
     if not rec["converged"]:
         return "FAIL"
-    return f"{rec['iterations']}" + ("" if rec["converged_at_requested_tol"] else "*")
+    how = {"residual": "r", "step": "s"}.get(rec["converged_by"], "?")
+    return f"{rec['iterations']}{how}{'' if rec['converged_at_requested_tol'] else '*'}"
+
+
+def _table(head: list[tuple[str, int]], rows: list[list[str]]) -> None:
+    print(" ".join(f"{h:>{w}}" for h, w in head))
+    print("-" * (sum(w for _, w in head) + len(head) - 1))
+    for row in rows:
+        print(" ".join(f"{c:>{w}}" for c, (_, w) in zip(row, head)))
 
 
 def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
                  args: argparse.Namespace) -> None:
     """Readable tables of the records (times in ms, best of N)."""
-    print(f"\nBoom statics at {args.angle} deg, times in ms (best of N, >= {args.min_time} s "
-          "per measurement)")
-    print("\n[1] model and MUMPS analyse+factorize (a+f); K is singular (rigid modes)")
-    head = (f"{'nodes':>6} {'ndof':>6} {'nnz K':>8} {'build':>9} {'assemble':>9} "
-            f"{'saddle a+f':>10} {'K_RR a+f':>9} {'K a+f':>9}")
-    print(head)
-    print("-" * len(head))
+    b = args.budget
+    print(f"\nBoom statics at {args.angle:g} deg; times in ms, best of N repeats (N >= "
+          f"{b.min_repeats} and >= {b.min_time:g} s per measurement, unless one took "
+          f">= {b.max_time:g} s)")
+
+    print("\n[1] model, assembly, MUMPS create+analyse+factorize (a+f); "
+          "K is singular (6 rigid-body modes), timed for its size only")
+    rows = []
     for r in records:
         af = {name: (m["timing"]["phases"].get("analyse", math.nan)
                      + m["timing"]["phases"].get("factorize", math.nan))
               for name, m in r["mumps"].items()}
-        print(f"{r['nodes']:>6} {r['ndof']:>6} {r['nnz_K']:>8} "
-              f"{_ms(r['build_model']['best_s'])} {_ms(r['stiffness_assembly']['best_s'])} "
-              f"{_ms(af['saddle']):>10} {_ms(af['K_RR'])} {_ms(af['K'])}")
+        rows.append([str(r["nodes"]), str(r["ndof"]), str(r["nnz_K"]),
+                     _ms(r["build_model"]["best_s"]), _ms(r["stiffness_assembly"]["best_s"]),
+                     _ms(af["saddle"]), _ms(af["K_RR"]), _ms(af["K"])])
+    _table([("nodes", 5), ("ndof", 6), ("nnz K", 7), ("build", 9), ("assemble", 9),
+            ("saddle a+f", 10), ("K_RR a+f", 9), ("K a+f", 9)], rows)
 
-    print("\n[2] static solves vs the floor (one analyse+factorize+solve of the saddle "
-          "matrix)")
-    print(f"    iterations: * = converged only at --fallback-tol {args.fallback_tol:g} "
-          f"(not at --tol {args.tol:g})")
-    head = (f"{'nodes':>6} {'floor':>9} {'spsolve':>9} {'newton':>9} {'it':>3} "
-            f"{'N/floor':>8} {'N/spsol':>8} {'split':>9} {'it':>3} {'S/floor':>8} "
-            f"{'S/spsol':>8} {'S solve%':>8}")
-    print(head)
-    print("-" * len(head))
+    print("\n[2] static solves against the floor = one create+analyse+factorize+solve of "
+          "the Newton saddle-point matrix (MUMPS), or spsolve of it")
+    print(f"    it: iterations (split: passes); r = residual <= --tol {args.tol:g}, s = "
+          "stopped at the round-off step floor, * = only at --fallback-tol "
+          f"{args.fallback_tol:g}; res = final relative residual")
+    rows = []
     for r in records:
-        newton, split, ratios = r["static"]["newton"], r["static"]["split"], r["ratios"]
-        split_share = (100 * split["timing"]["phases"]["solve"] / split["timing"]["phases"]
-                       ["total"] if split["converged"] else math.nan)
-        print(f"{r['nodes']:>6} {_ms(r['floor']['mumps_analyse_factorize_solve_s'])} "
-              f"{_ms(r['floor']['spsolve_s'])} {_ms(_static_best(newton))} "
-              f"{_tol_mark(newton):>3} {ratios['newton_over_mumps_floor']:8.2f} "
-              f"{ratios['newton_over_spsolve']:8.2f} {_ms(_static_best(split))} "
-              f"{_tol_mark(split):>3} {ratios['split_over_mumps_floor']:8.2f} "
-              f"{ratios['split_over_spsolve']:8.2f} {split_share:8.1f}")
+        row = [str(r["nodes"]), _ms(r["floor"]["mumps_analyse_factorize_solve_s"]),
+               _ms(r["floor"]["spsolve_s"])]
+        for method in ("newton", "split"):
+            rec, ratios = r["static"][method], r["ratios"]
+            row += [_ms(_static_best(rec), 10), _iterations(rec),
+                    f"{rec['residual_norm']:.1e}" if rec["converged"] else "-",
+                    f"{ratios[f'{method}_over_mumps_floor']:.2f}",
+                    f"{ratios[f'{method}_over_spsolve']:.2f}"]
+        rows.append(row)
+    _table([("nodes", 5), ("floor", 9), ("spsolve", 9), ("newton", 10), ("it", 4),
+            ("res", 7), ("N/floor", 7), ("N/spsol", 7), ("split", 10), ("it", 4),
+            ("res", 7), ("S/floor", 7), ("S/spsol", 7)], rows)
 
-    print("\n[3] where the static time goes (ms, phases of the best repeat; other = "
-          "analyse, residuals, jets, Python)")
-    head = (f"{'nodes':>6} | {'newton asm':>10} {'fact':>9} {'solve':>9} {'other':>9} | "
-            f"{'split asm':>9} {'fact':>9} {'solve':>9} {'other':>9} {'inner':>5}")
-    print(head)
-    print("-" * len(head))
+    print("\n[3] where the static time goes: phases of the best repeat (ms); other = "
+          "analyse, residuals, jet algebra, Python; sys = share of CPU time in the kernel, "
+          "mflt = minor page faults (thousands)")
+    rows = []
     for r in records:
-        cells = []
+        row = [str(r["nodes"])]
         for method in ("newton", "split"):
             rec = r["static"][method]
-            ph = rec["timing"]["phases"] if rec["converged"] else {}
-            cells.append(" ".join(_ms(ph.get(k, math.nan)) for k in
-                                  ("assembly", "factorization", "solve", "other")))
-        inner = r["static"]["split"].get("extra", {}).get("inner_iterations", "-")
-        print(f"{r['nodes']:>6} | {cells[0]:>41} | {cells[1]:>39} {inner:>5}")
+            t = rec["timing"] if rec["converged"] else {"phases": {}}
+            ph = t["phases"]
+            cpu = t.get("cpu_user_s", math.nan) + t.get("cpu_sys_s", math.nan)
+            row += [_ms(ph.get(k, math.nan)) for k in ("assembly", "factorization", "solve",
+                                                       "other")]
+            row += [f"{100 * t.get('cpu_sys_s', math.nan) / cpu:.0f}%" if cpu > 0 else "-",
+                    f"{t.get('minor_faults', 0) / 1e3:.1f}"]
+        rows.append(row)
+    _table([("nodes", 5), ("N asm", 8), ("N fact", 8), ("N solve", 8), ("N other", 8),
+            ("sys", 4), ("mflt", 6), ("S asm", 9), ("S fact", 8), ("S solve", 9),
+            ("S other", 9), ("sys", 4), ("mflt", 6)], rows)
 
-    print("\n[4] growth exponents d log t / d log ndof (1 = linear)")
-    keys = list(exponents[0].keys())[1:] if exponents else []
-    head = f"{'nodes':>11} " + " ".join(f"{k[:12]:>12}" for k in keys)
-    print(head)
-    print("-" * len(head))
-    for g in exponents:
-        span = f"{g['nodes'][0]}->{g['nodes'][1]}"
-        print(f"{span:>11} " + " ".join(f"{g[k]:12.2f}" for k in keys))
+    print("\n[4] growth exponents d log t / d log ndof between consecutive meshes "
+          "(1 = linear)")
+    keys = [k for k in (exponents[0] if exponents else {}) if k != "nodes"]
+    _table([("nodes", 10)] + [(k, max(8, len(k))) for k in keys],
+           [[f"{g['nodes'][0]}->{g['nodes'][1]}"] + [f"{g[k]:.2f}" for k in keys]
+            for g in exponents])
 
     failures = [(r["nodes"], m, f) for r in records for m, rec in r["static"].items()
                 for f in rec["failures"]]
     if failures:
-        print("\nstatic solves that did not converge:")
+        print("\n[5] static solves that did not converge")
         for nodes, method, f in failures:
             print(f"  {nodes:>5} nodes {method:>6} tol {f['tol']:g}: {f['error']} "
-                  f"({f['time_to_failure_s']:.2f} s)")
-    print("\n[5] saddle-point solution check: |x_mumps - x_spsolve| / |x_spsolve| and "
+                  f"(after {f['time_to_failure_s']:.2f} s)")
+    print("\n[6] saddle-point solution check: |x_mumps - x_spsolve| / |x_spsolve| and "
           "residuals |Ax - b| / |b|")
-    for r in records:
-        c = r["saddle_solution_check"]
-        print(f"{r['nodes']:>6} difference {c['relative_difference']:9.2e}   MUMPS "
-              f"{c['residual_mumps']:9.2e}   spsolve {c['residual_spsolve']:9.2e}")
-
-
-def _jsonable(value: Any) -> Any:
-    """json.dump default: numpy scalars and arrays; NaN is written as null by the caller."""
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(f"not JSON serializable: {type(value).__name__}")
+    _table([("nodes", 5), ("difference", 10), ("MUMPS res", 10), ("spsolve res", 11)],
+           [[str(r["nodes"])] + [f"{r['saddle_solution_check'][k]:.2e}" for k in
+                                 ("relative_difference", "residual_mumps", "residual_spsolve")]
+            for r in records])
 
 
 def _nan_to_none(value: Any) -> Any:
+    """JSON-ready copy: numpy scalars and arrays to Python, NaN and inf to None."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, np.generic):
+        value = value.item()
     if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, dict):
         return {k: _nan_to_none(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_nan_to_none(v) for v in value]
-    if isinstance(value, np.generic):
-        return _nan_to_none(value.item())
     return value
 
 
@@ -471,11 +528,17 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="tolerance timed when --tol is not reached (default 1e-8)")
     parser.add_argument("--max-iter", type=int, default=10,
                         help="static iteration limit (default 10: both solvers converge in "
-                             "2-3 iterations where they converge at all; a stagnating split "
-                             "solve costs ~1 s per pass at 2002 nodes)")
-    parser.add_argument("--min-time", type=float, default=0.2,
-                        help="seconds the repeats of one measurement take together")
-    parser.add_argument("--max-repeats", type=int, default=10_000)
+                             "2-3 iterations where they converge at all, and a stagnating "
+                             "split solve costs about 1 s per pass at 2002 nodes)")
+    defaults = Budget()
+    parser.add_argument("--min-time", type=float, default=defaults.min_time,
+                        help="seconds the repeats of one measurement take at least")
+    parser.add_argument("--min-repeats", type=int, default=defaults.min_repeats,
+                        help="repeats of one measurement at least ...")
+    parser.add_argument("--max-time", type=float, default=defaults.max_time,
+                        help="... unless they already took this many seconds")
+    parser.add_argument("--max-repeats", type=int, default=defaults.max_repeats,
+                        help="repeats of one measurement at most")
     parser.add_argument("--output", type=Path, default=None,
                         help="JSON file (default benchmarks/results/static_scaling.json, "
                              "static_scaling_quick.json with --quick)")
@@ -484,6 +547,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     if any(n < 4 or (n - 1) % 3 for n in nodes):
         parser.error("every node count must be 3k+1 with k >= 1")
     args.nodes = nodes
+    args.budget = Budget(args.min_time, args.min_repeats, args.max_time, args.max_repeats)
     if args.output is None:
         args.output = RESULTS / ("static_scaling_quick.json" if args.quick
                                  else "static_scaling.json")
@@ -493,27 +557,29 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     start = time.perf_counter()
+    machine = machine_info()
     records = []
     for nodes in args.nodes:
         t0 = time.perf_counter()
         records.append(measure(nodes, args))
         print(f"  {nodes:>5} nodes measured in {time.perf_counter() - t0:6.1f} s",
               file=sys.stderr, flush=True)
+    machine["load_average_at_end"] = _load()
     exponents = growth_exponents(records)
     print_tables(records, exponents, args)
     report = {
         "benchmark": "static_scaling", "scene": str(SCENE.relative_to(REPO)),
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "settings": {"angle_deg": args.angle, "tol": args.tol, "fallback_tol": args.fallback_tol,
-                     "max_iter": args.max_iter, "min_time_s": args.min_time,
-                     "max_repeats": args.max_repeats, "quick": args.quick},
-        "machine": machine_info(), "records": records, "growth_exponents": exponents,
+        "settings": {"nodes": args.nodes, "angle_deg": args.angle, "tol": args.tol,
+                     "fallback_tol": args.fallback_tol, "max_iter": args.max_iter,
+                     "budget": asdict(args.budget), "quick": args.quick},
+        "units": "seconds; ratios are static solve time / floor time",
+        "machine": machine, "records": records, "growth_exponents": exponents,
         "wall_time_s": time.perf_counter() - start,
     }
     args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(json.dumps(_nan_to_none(report), indent=1, default=_jsonable,
-                                      allow_nan=False) + "\n")
-    print(f"\nwrote {args.output} ({report['wall_time_s']:.1f} s)")
+    args.output.write_text(json.dumps(_nan_to_none(report), indent=1, allow_nan=False) + "\n")
+    print(f"\nwrote {args.output} in {report['wall_time_s']:.1f} s")
     return 0
 
 

@@ -103,6 +103,17 @@ subroutine moment_generalized_force(director, axis, magnitude, force, jacobian, 
   call moment_force(director, axis, magnitude, force, jacobian, hessian, info)
 end subroutine moment_generalized_force
 
+!> Rotation of a section director about an axis from a reference direction; the dead
+!> moment's potential is -magnitude * angle.
+subroutine moment_rotation_angle(director, axis, reference, angle)
+  use ancf_kinds, only: dp
+  use section_moment, only: moment_angle
+  implicit none
+  real(dp), intent(in) :: director(3), axis(3), reference(3)
+  real(dp), intent(out) :: angle
+  angle = moment_angle(director, axis, reference)
+end subroutine moment_rotation_angle
+
 !> A drive's phi, phi', phi'' at nt times.
 subroutine drive_values(kind, params, nt, t, phi, dphi, ddphi, info)
   use ancf_kinds, only: dp
@@ -211,3 +222,92 @@ subroutine direct_destroy(handle, info)
   integer, intent(out) :: info
   call solver_destroy(handle, info)
 end subroutine direct_destroy
+
+!> Advances nsteps Newmark steps of an ANCF-FFR beam (module newmark_ffr). The model
+!> arrays are those Python builds once; the state (t, e, v, a, lam, work) is updated in
+!> place; one output row per step. status(1) = steps done, status(2) = info,
+!> status(3) = detail (see newmark_chunk).
+subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, nq, &
+                           dofs, stiffness0, e0_frame, mass_row_ptr, mass_col, mass_values, &
+                           constant_force, moment_dofs, moment_axis, moment_magnitude, &
+                           moment_reference, con_ints, con_reals, drive_kinds, drive_params, &
+                           frame_drive, frame_axis, frame_base, solver_handle, block_first, &
+                           flexibility, flexibility_cc, probe_dofs, probe_shape, probe_reference, &
+                           h, beta, gamma, tol, length_scale, max_newton, &
+                           t, e, v, a, lam, work, out_time, out_probe, out_deflection, out_lambda, &
+                           out_energy, out_constraint, out_newton, out_q, status)
+  use ancf_kinds, only: dp
+  use newmark_ffr, only: ffr_system, newmark_settings, newmark_chunk
+  implicit none
+  integer, intent(in) :: ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, nq
+  integer, intent(in) :: dofs(24, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
+  real(dp), intent(in) :: stiffness0(24, 24, nel), e0_frame(ndof), mass_values(nnz_mass)
+  real(dp), intent(in) :: constant_force(ndof)
+  integer, intent(in) :: moment_dofs(3, nmoment)
+  real(dp), intent(in) :: moment_axis(3, nmoment), moment_magnitude(nmoment), moment_reference(3, nmoment)
+  integer, intent(in) :: con_ints(8, ncon), drive_kinds(ndrive)
+  real(dp), intent(in) :: con_reals(8, ncon), drive_params(8, ndrive)
+  integer, intent(in) :: frame_drive, solver_handle, block_first(nblock)
+  real(dp), intent(in) :: frame_axis(3), frame_base(3, 3)
+  real(dp), intent(in) :: flexibility(ndof, 3 * nblock), flexibility_cc(3 * nblock, 3 * nblock)
+  integer, intent(in) :: probe_dofs(24, nprobe)
+  real(dp), intent(in) :: probe_shape(8, nprobe), probe_reference(3, nprobe)
+  real(dp), intent(in) :: h, beta, gamma, tol, length_scale
+  integer, intent(in) :: max_newton
+  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), lam(ncon), work(2)
+  !f2py intent(in,out) :: t, e, v, a, lam, work
+  real(dp), intent(out) :: out_time(nsteps), out_probe(3, nprobe, nsteps)
+  real(dp), intent(out) :: out_deflection(3, nprobe, nsteps), out_lambda(ncon, nsteps)
+  real(dp), intent(out) :: out_energy(7, nsteps), out_constraint(nsteps), out_q(ndof, nq)
+  integer, intent(out) :: out_newton(nsteps), status(3)
+  type(ffr_system) :: sys
+  type(newmark_settings) :: cfg
+  sys%ndof = ndof
+  sys%nel = nel
+  sys%ncon = ncon
+  sys%nmoment = nmoment
+  sys%nblock = nblock
+  sys%nprobe = nprobe
+  sys%dofs = dofs
+  sys%stiffness0 = stiffness0
+  sys%e0_frame = e0_frame
+  sys%mass_row_ptr = mass_row_ptr
+  sys%mass_col = mass_col
+  sys%mass_values = mass_values
+  sys%constant_force = constant_force
+  sys%moment_dofs = moment_dofs
+  sys%moment_axis = moment_axis
+  sys%moment_magnitude = moment_magnitude
+  sys%moment_reference = moment_reference
+  sys%con_ints = con_ints
+  sys%con_reals = con_reals
+  sys%drive_kinds = drive_kinds
+  sys%drive_params = drive_params
+  sys%frame_drive = frame_drive
+  sys%frame_axis = frame_axis
+  sys%frame_base = frame_base
+  sys%solver_handle = solver_handle
+  sys%block_first = block_first
+  sys%flexibility = flexibility
+  sys%flexibility_cc = flexibility_cc
+  sys%probe_dofs = probe_dofs
+  sys%probe_shape = probe_shape
+  sys%probe_reference = probe_reference
+  cfg%h = h
+  cfg%beta = beta
+  cfg%gamma = gamma
+  cfg%tol = tol
+  cfg%length_scale = length_scale
+  cfg%max_newton = max_newton
+  out_time = 0.0_dp
+  out_probe = 0.0_dp
+  out_deflection = 0.0_dp
+  out_lambda = 0.0_dp
+  out_energy = 0.0_dp
+  out_constraint = 0.0_dp
+  out_newton = 0
+  out_q = 0.0_dp
+  call newmark_chunk(sys, cfg, nsteps, t, e, v, a, lam, work, out_time, out_probe, out_deflection, &
+                     out_lambda, out_energy, out_constraint, out_newton, nq == nsteps, out_q, &
+                     status(1), status(2), status(3))
+end subroutine newmark_advance

@@ -16,19 +16,25 @@ contains
     real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3), e(ndof), e0_frame(ndof)
     real(dp), intent(out) :: force(ndof), energy
     real(dp) :: local_disp(24), local_force(24)
-    integer :: el, a
+    integer :: el, a, i
     force = 0.0_dp
     energy = 0.0_dp
     do el = 1, nel
       do a = 0, 7
-        local_disp(3 * a + 1:3 * a + 3) = matmul(transpose(rotation), e(dofs(3 * a + 1:3 * a + 3, el))) &
-                                          - e0_frame(dofs(3 * a + 1:3 * a + 3, el))
+        ! A^T e_a - e0_a, written out: (A^T v)_j = sum_i A(i, j) v_i
+        local_disp(3 * a + 1:3 * a + 3) = rotation(1, :) * e(dofs(3 * a + 1, el)) &
+                                          + rotation(2, :) * e(dofs(3 * a + 2, el)) &
+                                          + rotation(3, :) * e(dofs(3 * a + 3, el))
       end do
+      local_disp = local_disp - e0_frame(dofs(:, el))
       local_force = matmul(stiffness0(:, :, el), local_disp)
       energy = energy + 0.5_dp * dot_product(local_disp, local_force)
       do a = 0, 7
-        force(dofs(3 * a + 1:3 * a + 3, el)) = force(dofs(3 * a + 1:3 * a + 3, el)) &
-                                               + matmul(rotation, local_force(3 * a + 1:3 * a + 3))
+        do i = 1, 3
+          force(dofs(3 * a + i, el)) = force(dofs(3 * a + i, el)) + rotation(i, 1) * local_force(3 * a + 1) &
+                                       + rotation(i, 2) * local_force(3 * a + 2) &
+                                       + rotation(i, 3) * local_force(3 * a + 3)
+        end do
       end do
     end do
   end subroutine ffr_force

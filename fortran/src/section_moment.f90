@@ -11,7 +11,7 @@ module section_moment
   use ancf_kinds, only: dp
   implicit none
   private
-  public :: moment_force
+  public :: moment_force, moment_angle
 
 contains
 
@@ -56,5 +56,18 @@ contains
       end do
     end do
   end subroutine moment_force
+
+  !> Rotation angle of the director about the axis, measured from a reference direction
+  !> (both projected on the plane normal to the axis), in (-pi, pi]. The potential of the
+  !> dead moment is -magnitude * angle.
+  pure real(dp) function moment_angle(director, axis, reference) result(angle)
+    real(dp), intent(in) :: director(3), axis(3), reference(3)
+    real(dp) :: k(3), p(3), q(3)
+    k = axis / norm2(axis)
+    p = director - dot_product(k, director) * k
+    q = reference - dot_product(k, reference) * k
+    angle = atan2(dot_product(k, [q(2) * p(3) - q(3) * p(2), q(3) * p(1) - q(1) * p(3), &
+                                  q(1) * p(2) - q(2) * p(1)]), dot_product(q, p))
+  end function moment_angle
 
 end module section_moment

@@ -1,10 +1,14 @@
-!> Sparse direct solves with sequential MUMPS behind integer handles: analyse a
-!> pattern once, factorize as often as the values change, solve many right-hand
-!> sides per factorization, release cleanly. The handle table is the kernel's only
-!> module state. MUMPS never prints (ICNTL 1-4).
+!> Sparse direct solves behind integer handles: analyse a pattern once, factorize as often
+!> as the values change, solve many right-hand sides per factorization, release cleanly.
+!> Two kinds share the API: sequential MUMPS (any sparse matrix; it never prints, ICNTL
+!> 1-4), and LAPACK's banded Cholesky (dpbtrf/dpbtrs) for symmetric positive-definite
+!> matrices with a narrow band, such as a beam's iteration matrix, whose solves cost
+!> O(n kd) with none of MUMPS's per-call overhead. The handle table is the kernel's
+!> only module state.
 !> info: 0 ok; 1 bad handle or no free slot; 2 call out of sequence (solve before
 !> factorize, ...); 3 size mismatch; < 0 MUMPS INFOG(1) (-10: numerically singular),
-!> with INFOG(2) in info_detail.
+!> with INFOG(2) in info_detail; the banded kind reports a non-positive-definite matrix
+!> as -10 with the failing column in info_detail.
 module sparse_direct
   use ancf_kinds, only: dp
   implicit none
@@ -13,8 +17,15 @@ module sparse_direct
   include 'dmumps_struc.h'
   public :: solver_create, solver_analyse, solver_factorize, solver_solve, solver_destroy
 
+  !> symmetry code that selects the banded LAPACK Cholesky
+  integer, parameter, public :: banded_spd = 3
+
   type :: solver_slot
     type(dmumps_struc) :: id
+    logical :: banded = .false.
+    integer :: n = 0, bandwidth = 0
+    integer, allocatable :: rows(:), cols(:)
+    real(dp), allocatable :: band(:, :)
     logical :: in_use = .false.
     logical :: analysed = .false.
     logical :: factorized = .false.
@@ -26,7 +37,8 @@ module sparse_direct
 
 contains
 
-  !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only).
+  !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only),
+  !> 3 = symmetric positive definite, banded LAPACK Cholesky (give both triangles or one).
   subroutine solver_create(symmetry, handle, info, info_detail)
     integer, intent(in) :: symmetry
     integer, intent(out) :: handle, info, info_detail
@@ -34,7 +46,21 @@ contains
     handle = 0
     info_detail = 0
     info = 1
-    if (symmetry /= 0 .and. symmetry /= 1 .and. symmetry /= 2) return
+    if (symmetry < 0 .or. symmetry > 3) return
+    if (symmetry == banded_spd) then
+      do h = 1, max_slots
+        if (.not. slots(h)%in_use) then
+          slots(h)%in_use = .true.
+          slots(h)%banded = .true.
+          slots(h)%analysed = .false.
+          slots(h)%factorized = .false.
+          handle = h
+          info = 0
+          return
+        end if
+      end do
+      return
+    end if
     if (.not. mpi_ready) then
       call mpi_init(ierr)
       mpi_ready = .true.
@@ -53,6 +79,7 @@ contains
         end if
         call silence(slots(h)%id)
         slots(h)%in_use = .true.
+        slots(h)%banded = .false.
         slots(h)%analysed = .false.
         slots(h)%factorized = .false.
         nullify (slots(h)%id%irn, slots(h)%id%jcn, slots(h)%id%a, slots(h)%id%rhs)
@@ -74,6 +101,18 @@ contains
     end if
     if (any(rows < 1) .or. any(rows > n) .or. any(cols < 1) .or. any(cols > n)) then
       info = 3
+      return
+    end if
+    if (slots(handle)%banded) then
+      slots(handle)%n = n
+      slots(handle)%rows = rows
+      slots(handle)%cols = cols
+      slots(handle)%bandwidth = maxval(abs(rows - cols))
+      if (allocated(slots(handle)%band)) deallocate (slots(handle)%band)
+      allocate (slots(handle)%band(slots(handle)%bandwidth + 1, n))
+      slots(handle)%analysed = .true.
+      slots(handle)%factorized = .false.
+      info = 0
       return
     end if
     associate (id => slots(handle)%id)
@@ -107,6 +146,11 @@ contains
     end if
     if (.not. slots(handle)%analysed) then
       info = 2
+      return
+    end if
+    if (slots(handle)%banded) then
+      call banded_factorize(slots(handle), nnz, values, info, info_detail)
+      slots(handle)%factorized = info == 0
       return
     end if
     associate (id => slots(handle)%id)
@@ -143,6 +187,17 @@ contains
       info = 2
       return
     end if
+    if (slots(handle)%banded) then
+      if (slots(handle)%n /= n) then
+        info = 3
+        return
+      end if
+      associate (slot => slots(handle))
+        call dpbtrs('U', n, slot%bandwidth, nrhs, slot%band, slot%bandwidth + 1, rhs, n, info_detail)
+      end associate
+      info = merge(0, 3, info_detail == 0)
+      return
+    end if
     associate (id => slots(handle)%id)
       if (id%n /= n) then
         info = 3
@@ -171,6 +226,15 @@ contains
       info = 1
       return
     end if
+    if (slots(handle)%banded) then
+      if (allocated(slots(handle)%band)) deallocate (slots(handle)%band)
+      if (allocated(slots(handle)%rows)) deallocate (slots(handle)%rows, slots(handle)%cols)
+      slots(handle)%in_use = .false.
+      slots(handle)%analysed = .false.
+      slots(handle)%factorized = .false.
+      info = 0
+      return
+    end if
     associate (id => slots(handle)%id)
       id%job = -2
       call dmumps(id)
@@ -181,6 +245,30 @@ contains
     slots(handle)%analysed = .false.
     slots(handle)%factorized = .false.
   end subroutine solver_destroy
+
+  !> Banded Cholesky of the upper triangle (entries below the diagonal are ignored, so
+  !> both triangles or the upper one may be given; duplicates are summed).
+  subroutine banded_factorize(slot, nnz, values, info, info_detail)
+    type(solver_slot), intent(inout) :: slot
+    integer, intent(in) :: nnz
+    real(dp), intent(in) :: values(nnz)
+    integer, intent(out) :: info, info_detail
+    integer :: k, kd
+    info_detail = 0
+    if (size(slot%rows) /= nnz) then
+      info = 3
+      return
+    end if
+    kd = slot%bandwidth
+    slot%band = 0.0_dp
+    do k = 1, nnz
+      if (slot%rows(k) <= slot%cols(k)) slot%band(kd + 1 + slot%rows(k) - slot%cols(k), slot%cols(k)) = &
+        slot%band(kd + 1 + slot%rows(k) - slot%cols(k), slot%cols(k)) + values(k)
+    end do
+    call dpbtrf('U', slot%n, kd, slot%band, kd + 1, info_detail)
+    info = 0
+    if (info_detail /= 0) info = -10
+  end subroutine banded_factorize
 
   logical function valid(handle)
     integer, intent(in) :: handle

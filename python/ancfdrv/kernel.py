@@ -123,7 +123,7 @@ class SparsePattern:
         return sp.csr_matrix((values, self.col_index, self.row_ptr), shape=(self.n, self.n))
 
 
-_MUMPS_MESSAGES = {-10: "the matrix is numerically singular",
+_MUMPS_MESSAGES = {-10: "the matrix is numerically singular (or, banded: not positive definite)",
                    -9: "MUMPS workspace too small", -13: "MUMPS could not allocate memory",
                    -6: "the matrix is structurally singular", -5: "MUMPS out of memory"}
 
@@ -136,9 +136,11 @@ class DirectSolver:
     """
 
     def __init__(self, n: int, rows: np.ndarray, cols: np.ndarray, *, symmetric: bool = False,
-                 what: str = "system matrix") -> None:
+                 banded_spd: bool = False, what: str = "system matrix") -> None:
+        """``banded_spd`` selects LAPACK's banded Cholesky (symmetric positive definite,
+        narrow band: O(n kd) solves without MUMPS's per-call overhead)."""
         self.what = what
-        handle, info, detail = _kernel.direct_create(2 if symmetric else 0)
+        handle, info, detail = _kernel.direct_create(3 if banded_spd else 2 if symmetric else 0)
         self._check(info, detail, "create")
         self.handle, self.n, self.nnz = handle, n, len(rows)
         self.factorizations = 0
@@ -164,7 +166,7 @@ class DirectSolver:
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solution for rhs of shape (n,) or (n, k)."""
         b = np.asarray(rhs, dtype=np.float64)
-        matrix = _f(b.reshape(self.n, -1))
+        matrix = np.array(b.reshape(self.n, -1), dtype=np.float64, order="F")  # kernel solves in place
         x, info, detail = _kernel.direct_solve(self.handle, matrix)
         self._check(info, detail, "solve")
         self.solves += matrix.shape[1]

@@ -14,8 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from scipy.spatial.transform import Rotation
+
 from . import kernel
-from .constraints import DRIVE_CONSTANT, ConstraintSet
+from .constraints import DRIVE_CONSTANT, DRIVE_LUFFING, ConstraintSet
 from .scene import EFFECTS_AVAILABLE, Scene
 
 NODE_DOFS = 12
@@ -69,9 +71,12 @@ class BeamModel:
     density: float
     youngs: float
     poisson: float
-    rotation: np.ndarray          # floating frame A (3 x 3)
+    rotation: np.ndarray          # floating frame A at t = 0 (3 x 3)
     origin_offset: np.ndarray     # frame position of the neutral axis start (3,)
     effects: tuple[str, ...]
+    frame_drive: int = 0          # drive of the frame angle (0: the frame is fixed)
+    frame_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    frame_base: np.ndarray | None = None  # A(t) = Rot(axis, phi(t)) frame_base
     constraints: ConstraintSet = field(default_factory=ConstraintSet)
     moments: list[Moment] = field(default_factory=list)
     point_masses: list[tuple[int, float]] = field(default_factory=list)
@@ -101,6 +106,9 @@ class BeamModel:
         self.pattern = kernel.SparsePattern(self.ndof, self.dofs)
         self._gravity_force: np.ndarray | None = None
         self._point_force = np.zeros(self.ndof)
+        if self.frame_base is None:
+            self.frame_base = self.rotation.copy()
+        self.length_scale = float(self.node_s[-1] - self.node_s[0])
 
     # -- configuration ---------------------------------------------------------------
     @property
@@ -115,6 +123,15 @@ class BeamModel:
     def to_frame(self, v: np.ndarray) -> np.ndarray:
         """T(A)^T v."""
         return (v.reshape(-1, 3) @ self.rotation).ravel()
+
+    def frame_at(self, t: float) -> np.ndarray:
+        """The floating frame A(t) = Rot(axis, phi(t)) A_base (A_base when not driven)."""
+        if not self.frame_drive:
+            return self.frame_base
+        phi, _, _ = kernel.drive_values(self.constraints.drive_kinds[self.frame_drive - 1],
+                                        self.constraints.drive_params[self.frame_drive - 1], t)
+        axis = self.frame_axis / np.linalg.norm(self.frame_axis)
+        return Rotation.from_rotvec(phi[0] * axis).as_matrix() @ self.frame_base
 
     # -- matrices --------------------------------------------------------------------
     def mass_matrix(self) -> sp.csr_matrix:
@@ -139,6 +156,11 @@ class BeamModel:
         """FFR elastic force T K0 (T^T e - e0_frame) and the strain energy."""
         self.counters["elastic_force"] += 1
         return kernel.ffr_force(self.dofs, self.stiffness0, self.rotation, e, self.e0_frame)
+
+    def elastic_force_at(self, e: np.ndarray, t: float) -> tuple[np.ndarray, float]:
+        """FFR elastic force and strain energy with the frame A(t)."""
+        self.counters["elastic_force"] += 1
+        return kernel.ffr_force(self.dofs, self.stiffness0, self.frame_at(t), e, self.e0_frame)
 
     def constant_force(self) -> np.ndarray:
         """Configuration-independent loads of the listed effects (gravity, tip loads)."""
@@ -187,10 +209,14 @@ class BeamModel:
         return out
 
     def deflections(self, e: np.ndarray) -> dict[str, np.ndarray]:
-        """Probe displacement from the rigid configuration, in frame components."""
-        rigid = self.probe_positions(self.e0)
-        return {name: self.rotation.T @ (p - rigid[name])
-                for name, p in self.probe_positions(e).items()}
+        """Probe displacement from the rigid configuration, in frame components (t = 0)."""
+        return self.deflections_at(e, 0.0)
+
+    def deflections_at(self, e: np.ndarray, t: float) -> dict[str, np.ndarray]:
+        """Probe displacement from the rigid configuration at t, in the frame A(t)."""
+        rigid = self.probe_positions(self.e0_frame)
+        frame = self.frame_at(t)
+        return {name: frame.T @ p - rigid[name] for name, p in self.probe_positions(e).items()}
 
     def summary(self) -> dict[str, int]:
         return {"ndof": self.ndof, "nnodes": self.nnodes, "nelements": self.nel,
@@ -257,7 +283,13 @@ def build_boom(scene: Scene) -> BeamModel:
     c.distance(r1, (0.0, 0.0, 0.0), height_h, dependent=r1[1], name="eq. 31: |O A1| = H")
     c.coordinate(r1[2], name="eq. 32: r3(A1) = 0")
     c.coordinate(ry1[2], name="eq. 33: r_y3(A1) = 0")
-    drive = c.add_drive(DRIVE_CONSTANT, [phi])
+    if scene["scene"]["analysis"] != "static" and boom["omega"] > 0:
+        sweep = np.radians(boom["angle_end_deg"] - boom["angle_deg"])
+        drive = c.add_drive(DRIVE_LUFFING, [boom["omega"] * np.sign(sweep), boom["t_start"],
+                                            boom["t_brake"], sweep, phi])
+    else:
+        drive = c.add_drive(DRIVE_CONSTANT, [phi])
+    model.frame_drive, model.frame_base = drive, np.eye(3)
     c.coordinate(r2[0], cos_coef=a, sin_coef=-height_h, drive=drive,
                  name="eq. 34: r1(A2) = a cos(phi) - H sin(phi)")
     c.coordinate(r2[1], cos_coef=height_h, sin_coef=a, drive=drive,

@@ -99,3 +99,73 @@ def read_summary(path: Path) -> dict[str, Any]:
         if "counters" in h5:
             out.update({f"counters.{k}": v for k, v in h5["counters"].attrs.items()})
     return out
+
+
+class DynamicWriter:
+    """Appends each chunk of a dynamic run to /dynamic and closes the file after it, so
+    every completed chunk is on disk whatever happens next (SPEC section 4)."""
+
+    def __init__(self, path: Path, model: BeamModel, store_q: bool) -> None:
+        from .dynamic import ENERGY_NAMES
+        self.path, self.names, self.store_q = path, list(model.probes), store_q
+        self.energy_names = ENERGY_NAMES
+        self.rows = 0
+        ncon, ndof = len(model.constraints), model.ndof
+        with h5py.File(path, "a") as h5:
+            if "dynamic" in h5:
+                del h5["dynamic"]
+            group = h5.create_group("dynamic")
+            group.attrs["status"] = "running"
+
+            def series(name: str, width: tuple[int, ...] = ()) -> None:
+                group.create_dataset(name, shape=(0, *width), maxshape=(None, *width),
+                                     dtype="f8", chunks=(1024, *width) if width != (ndof,)
+                                     else (16, ndof))
+            series("time")
+            for name in self.names:
+                series(f"probes/{name}", (3,))
+                series(f"deflection/{name}", (3,))
+            series("lambda", (ncon,))
+            for name in ENERGY_NAMES:
+                series(f"energy/{name}")
+            series("energy/balance")
+            series("constraint_violation")
+            series("newton_iterations")
+            if store_q:
+                series("q", (ndof,))
+
+    def __call__(self, chunk) -> None:
+        n = len(chunk.time)
+        with h5py.File(self.path, "a") as h5:
+            group = h5["dynamic"]
+
+            def append(name: str, values: np.ndarray) -> None:
+                data = group[name]
+                data.resize(self.rows + n, axis=0)
+                data[self.rows:] = values
+            append("time", chunk.time)
+            for p, name in enumerate(self.names):
+                append(f"probes/{name}", chunk.probes[:, p, :])
+                append(f"deflection/{name}", chunk.deflections[:, p, :])
+            append("lambda", chunk.lam)
+            for k, name in enumerate(self.energy_names):
+                append(f"energy/{name}", chunk.energy[:, k])
+            total0 = group["energy/total"][0] if self.rows else chunk.energy[0, 4]
+            append("energy/balance", chunk.energy[:, 4] - total0 - chunk.energy[:, 5]
+                   - chunk.energy[:, 6])
+            append("constraint_violation", chunk.constraint)
+            append("newton_iterations", chunk.newton)
+            if self.store_q and chunk.q is not None:
+                append("q", chunk.q)
+            self.rows += n
+            group.attrs["rows"] = self.rows
+
+
+def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, float]) -> None:
+    """Integrator statistics and the per-stage summary (attributes of /dynamic)."""
+    with h5py.File(path, "a") as h5:
+        group = h5["dynamic"]
+        _attrs(group.attrs, attrs)
+        if stages:
+            stage_group = group.require_group("stages")
+            _attrs(stage_group.attrs, stages)

@@ -82,7 +82,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
     },
     "boom": {
         "pivot_offset": Key("float", 0.295, positive, "H = |O A1| (m)"),
-        "angle_deg": Key("float", 0.0, within(-180.0, 180.0), "static luffing angle phi (deg)"),
+        "angle_deg": Key("float", 0.0, within(-180.0, 180.0),
+                         "luffing angle phi of the rigid configuration at t = 0 (deg)"),
+        "omega": Key("float", 0.2, non_negative, "luffing rate (rad/s); 0 holds phi fixed"),
+        "t_start": Key("float", 1.0, positive, "t_s: duration of the smooth start (s)"),
+        "t_brake": Key("float", 1.0, positive, "t_b: duration of the smooth braking (s)"),
+        "angle_end_deg": Key("float", 60.0, within(-180.0, 180.0),
+                             "luffing angle reached at the end of braking (deg)"),
     },
     "cantilever": {
         "clamp": Key("str", "section", one_of("section", "full"),
@@ -105,9 +111,19 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "splitting parameter p of K_RR = K_RR1 + K_RR2, in [0, 1)"),
         "dt": Key("float", 1e-3, positive, "time step (s), dynamic analyses"),
         "t_end": Key("float", 10.0, non_negative, "end time (s), dynamic analyses"),
+        "integrator": Key("str", "newmark", one_of("newmark"), "time integrator"),
+        "beta": Key("float", 0.25, lambda v: None if 0 < v <= 0.5 else "must lie in (0, 0.5]",
+                    "Newmark beta (1/4: average acceleration, the paper's choice)"),
+        "gamma": Key("float", 0.5, within(0.5, 1.0), "Newmark gamma (1/2: no damping)"),
+        "newton_tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+                          "a step ends when its Newton correction is below newton_tol * length"),
+        "max_newton": Key("int", 10, positive, "Newton iterations allowed per step"),
     },
     "output": {
         "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),
+        "q": Key("bool", False, doc="store the coordinates q at every step"),
+        "chunk_steps": Key("int", 1000, positive,
+                           "steps per kernel call; each chunk is flushed to the file"),
     },
 }
 
@@ -285,9 +301,6 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
             raise InputError(f"unknown effect {effect!r}; known effects: "
                              f"{', '.join(EFFECTS_AVAILABLE)}", file=file, group="scene",
                              key="effects")
-    if scene["analysis"] != "static":
-        raise InputError(f"analysis {scene['analysis']!r} is not available in this version; "
-                         "only 'static' is", file=file, group="scene", key="analysis")
     if scene["formulation"] != "ffr":
         raise InputError(f"formulation {scene['formulation']!r} is not available in this "
                          "version; only 'ffr' is", file=file, group="scene", key="formulation")
@@ -309,3 +322,13 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
     if "boom" in values and k != 3:
         raise InputError("the boom needs three segments A1-A2, A2-A3, A3-A4", file=file,
                          group="beam", key="segments")
+    boom = values.get("boom")
+    if boom and scene["analysis"] != "static" and boom["omega"] > 0:
+        sweep = math.radians(boom["angle_end_deg"] - boom["angle_deg"])
+        if sweep <= 0:
+            raise InputError("luffing needs angle_end_deg > angle_deg (or omega = 0 to hold "
+                             "the angle)", file=file, group="boom", key="angle_end_deg")
+        if sweep / boom["omega"] < 0.5 * (boom["t_start"] + boom["t_brake"]):
+            raise InputError(f"omega = {boom['omega']} rad/s sweeps the {math.degrees(sweep):g} "
+                             "deg before start and braking are over; lower omega or shorten "
+                             "t_start/t_brake", file=file, group="boom", key="omega")

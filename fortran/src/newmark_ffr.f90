@@ -1,0 +1,383 @@
+!> Newmark time stepping (seed 000, eqs. 58-62) of the constrained ANCF-FFR beam
+!>   M e'' + T K0 (T^T e - e0) = Q(e) + Phi_e^T lambda,   Phi(e, t) = 0,
+!> with the floating frame A(t) = Rot(axis, phi_frame(t)) A_base of a prescribed motion.
+!>
+!> The structure of ANCF-FFR makes one factorization serve the whole run: every 3 x 3
+!> block of M is a scalar times I3, so M/(beta h^2) + T K0 T^T = T S T^T with the constant
+!> S = M/(beta h^2) + K0 (factorized once, a MUMPS handle). The multipliers enter through a
+!> Schur complement built from the constant flexibility S^{-1} E_c at the 3-vectors the
+!> constraints touch (E_c: their unit vectors in the frame), so a Newton correction costs
+!> one forward/back substitution plus small dense algebra (LAPACK dgesv). The Jacobians of
+!> the moment and of lambda . Phi_ee are left out of the iteration matrix (modified Newton:
+!> they are many orders below S); the residual is exact.
+!> Convergence: a correction with max |de| <= tol * length_scale ends the step.
+!> No I/O; failures return codes (see newmark_chunk).
+module newmark_ffr
+  use ancf_kinds, only: dp
+  use drives, only: drive_eval
+  use constraints, only: constraint_eval
+  use ffr_elastic, only: ffr_force
+  use section_moment, only: moment_force, moment_angle
+  use sparse_direct, only: solver_solve
+  implicit none
+  private
+  public :: ffr_system, newmark_settings, newmark_chunk, frame_rotation, csr_matvec
+  public :: energy_kinetic, energy_strain, energy_loads, energy_moment, energy_total, &
+            work_drive, work_frame, energy_count
+
+  integer, parameter :: energy_kinetic = 1, energy_strain = 2, energy_loads = 3, &
+                        energy_moment = 4, energy_total = 5, work_drive = 6, work_frame = 7, &
+                        energy_count = 7
+
+  !> The model, as the stepper reads it (never changed by a step).
+  type :: ffr_system
+    integer :: ndof = 0, nel = 0, ncon = 0, nmoment = 0, nblock = 0, nprobe = 0
+    integer, allocatable :: dofs(:, :)                 ! (24, nel)
+    real(dp), allocatable :: stiffness0(:, :, :)       ! (24, 24, nel)
+    real(dp), allocatable :: e0_frame(:)
+    integer, allocatable :: mass_row_ptr(:), mass_col(:)
+    real(dp), allocatable :: mass_values(:)
+    real(dp), allocatable :: constant_force(:)         ! gravity, tip loads
+    integer, allocatable :: moment_dofs(:, :)          ! (3, nmoment) director dofs
+    real(dp), allocatable :: moment_axis(:, :), moment_magnitude(:), moment_reference(:, :)
+    integer, allocatable :: con_ints(:, :), drive_kinds(:)
+    real(dp), allocatable :: con_reals(:, :), drive_params(:, :)
+    integer :: frame_drive = 0                         ! 0: A = A_base
+    real(dp) :: frame_axis(3) = [0.0_dp, 0.0_dp, 1.0_dp], frame_base(3, 3)
+    integer :: solver_handle = 0                       ! S = M/(beta h^2) + K0, factorized
+    integer, allocatable :: block_first(:)             ! (nblock) first dof of touched 3-vectors
+    real(dp), allocatable :: flexibility(:, :)         ! S^{-1} E_c (ndof, 3 nblock)
+    real(dp), allocatable :: flexibility_cc(:, :)      ! E_c^T S^{-1} E_c
+    integer, allocatable :: probe_dofs(:, :)           ! (24, nprobe)
+    real(dp), allocatable :: probe_shape(:, :)         ! (8, nprobe)
+    real(dp), allocatable :: probe_reference(:, :)     ! (3, nprobe) rigid position in frame
+  end type ffr_system
+
+  type :: newmark_settings
+    real(dp) :: h, beta = 0.25_dp, gamma = 0.5_dp, tol = 1e-10_dp, length_scale = 1.0_dp
+    integer :: max_newton = 10
+  end type newmark_settings
+
+contains
+
+  !> A(t) and phi_frame'(t).
+  subroutine frame_rotation(sys, t, rotation, rate, info)
+    type(ffr_system), intent(in) :: sys
+    real(dp), intent(in) :: t
+    real(dp), intent(out) :: rotation(3, 3), rate
+    integer, intent(out) :: info
+    real(dp) :: phi, ddphi, k(3), skew(3, 3), turn(3, 3)
+    integer :: i
+    info = 0
+    rate = 0.0_dp
+    rotation = sys%frame_base
+    if (sys%frame_drive == 0) return
+    call drive_eval(sys%drive_kinds(sys%frame_drive), sys%drive_params(:, sys%frame_drive), t, &
+                    phi, rate, ddphi, info)
+    if (info /= 0) return
+    k = sys%frame_axis / norm2(sys%frame_axis)
+    skew = reshape([0.0_dp, k(3), -k(2), -k(3), 0.0_dp, k(1), k(2), -k(1), 0.0_dp], [3, 3])
+    turn = sin(phi) * skew + (1.0_dp - cos(phi)) * matmul(skew, skew)
+    do i = 1, 3
+      turn(i, i) = turn(i, i) + 1.0_dp
+    end do
+    rotation = matmul(turn, sys%frame_base)
+  end subroutine frame_rotation
+
+  !> y = M x for the CSR mass matrix (1-based).
+  pure subroutine csr_matvec(row_ptr, col, values, x, y)
+    integer, intent(in) :: row_ptr(:), col(:)
+    real(dp), intent(in) :: values(:), x(:)
+    real(dp), intent(out) :: y(:)
+    integer :: i, k
+    real(dp) :: total
+    do i = 1, size(row_ptr) - 1
+      total = 0.0_dp
+      do k = row_ptr(i), row_ptr(i + 1) - 1
+        total = total + values(k) * x(col(k))
+      end do
+      y(i) = total
+    end do
+  end subroutine csr_matvec
+
+  !> T^T x (to the frame) or T x (to the global frame), 3-vector by 3-vector.
+  pure subroutine rotate_all(rotation, x, transpose_first, y)
+    real(dp), intent(in) :: rotation(3, 3), x(:)
+    logical, intent(in) :: transpose_first
+    real(dp), intent(out) :: y(:)
+    integer :: b
+    do b = 0, size(x) / 3 - 1
+      if (transpose_first) then
+        y(3 * b + 1:3 * b + 3) = matmul(transpose(rotation), x(3 * b + 1:3 * b + 3))
+      else
+        y(3 * b + 1:3 * b + 3) = matmul(rotation, x(3 * b + 1:3 * b + 3))
+      end if
+    end do
+  end subroutine rotate_all
+
+  !> Residual r = M a + Q_el(e) - Q(e) - Phi_e^T lambda at time t, with the constraint
+  !> values and gradients, the strain energy and the frame power dU/dt.
+  subroutine residual(sys, t, e, acceleration, lam, rotation, r, phi, gradients, strain, info)
+    type(ffr_system), intent(in) :: sys
+    real(dp), intent(in) :: t, e(:), acceleration(:), lam(:), rotation(3, 3)
+    real(dp), intent(out) :: r(:), phi(:), gradients(:, :), strain
+    integer, intent(out) :: info
+    real(dp) :: elastic(sys%ndof), inertia(sys%ndof), force(3), jacobian(3, 3), hessian(3, 3, 3)
+    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    integer :: m, c, i
+    call ffr_force(sys%ndof, sys%nel, sys%dofs, sys%stiffness0, rotation, e, sys%e0_frame, &
+                   elastic, strain)
+    call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, acceleration, inertia)
+    r = inertia + elastic - sys%constant_force
+    do m = 1, sys%nmoment
+      call moment_force(e(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
+                        sys%moment_magnitude(m), force, jacobian, hessian, info)
+      if (info /= 0) then
+        info = 6
+        return
+      end if
+      r(sys%moment_dofs(:, m)) = r(sys%moment_dofs(:, m)) - force
+    end do
+    call constraint_eval(sys%ncon, sys%con_ints, sys%con_reals, size(sys%drive_kinds), &
+                         sys%drive_kinds, sys%drive_params, sys%ndof, e, e, t, phi, gradients, &
+                         hessians, phi_t, phi_tt, gamma, info)
+    if (info /= 0) then
+      info = 5
+      return
+    end if
+    do c = 1, sys%ncon
+      do i = 1, 6
+        if (sys%con_ints(2 + i, c) > 0) r(sys%con_ints(2 + i, c)) = &
+          r(sys%con_ints(2 + i, c)) - gradients(i, c) * lam(c)
+      end do
+    end do
+  end subroutine residual
+
+  !> Advances nsteps Newmark steps from (t, e, v, a, lambda), writing one output row per
+  !> step. info: 0 ok; 1 Newton did not converge; 2 non-finite state; 3 linear solve
+  !> failed (detail = MUMPS code); 4 singular Schur complement (detail = dgesv info);
+  !> 5 constraint or drive evaluation failed; 6 moment undefined. steps_done counts the
+  !> completed steps; the state is that of the last completed step.
+  subroutine newmark_chunk(sys, cfg, nsteps, t, e, v, a, lam, work, out_time, out_probe, &
+                           out_deflection, out_lambda, out_energy, out_constraint, out_newton, &
+                           store_q, out_q, steps_done, info, detail)
+    type(ffr_system), intent(in) :: sys
+    type(newmark_settings), intent(in) :: cfg
+    integer, intent(in) :: nsteps
+    real(dp), intent(inout) :: t, e(:), v(:), a(:), lam(:), work(2)
+    real(dp), intent(out) :: out_time(:), out_probe(:, :, :), out_deflection(:, :, :)
+    real(dp), intent(out) :: out_lambda(:, :), out_energy(:, :), out_constraint(:)
+    integer, intent(out) :: out_newton(:)
+    logical, intent(in) :: store_q
+    real(dp), intent(out) :: out_q(:, :)
+    integer, intent(out) :: steps_done, info, detail
+    real(dp) :: e_new(sys%ndof), a_new(sys%ndof), lam_new(sys%ncon), e_hat(sys%ndof), v_hat(sys%ndof)
+    real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof), phi(sys%ncon), gradients(6, sys%ncon)
+    real(dp) :: w(3 * sys%nblock, sys%ncon), schur(sys%ncon, sys%ncon), dlam(sys%ncon, 1)
+    real(dp) :: rotation(3, 3), rate, strain, powers_old(2), powers_new(2), t_new, h, beta
+    integer :: step, it, ipiv(sys%ncon), lapack_info
+    logical :: done
+    info = 0
+    detail = 0
+    steps_done = 0
+    h = cfg%h
+    beta = cfg%beta
+    call frame_rotation(sys, t, rotation, rate, info)
+    if (info /= 0) then
+      info = 5
+      return
+    end if
+    call step_powers(sys, e, v, lam, rotation, rate, t, powers_old, strain, info)
+    if (info /= 0) return
+    do step = 1, nsteps
+      t_new = t + h
+      e_hat = e + h * v + h * h * (0.5_dp - beta) * a
+      v_hat = v + h * (1.0_dp - cfg%gamma) * a
+      a_new = a
+      lam_new = lam
+      e_new = e_hat + beta * h * h * a_new
+      call frame_rotation(sys, t_new, rotation, rate, info)
+      if (info /= 0) then
+        info = 5
+        return
+      end if
+      done = .false.
+      do it = 1, cfg%max_newton
+        call residual(sys, t_new, e_new, a_new, lam_new, rotation, r, phi, gradients, strain, info)
+        if (info /= 0) return
+        ! z = T S^{-1} T^T r
+        call rotate_all(rotation, r, .true., z(:, 1))
+        call solver_solve(sys%solver_handle, sys%ndof, 1, z, info, detail)
+        if (info /= 0) then
+          detail = info
+          info = 3
+          return
+        end if
+        call rotate_all(rotation, z(:, 1), .false., direction)
+        ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
+        call frame_gradients(sys, rotation, gradients, w)
+        schur = matmul(transpose(w), matmul(sys%flexibility_cc, w))
+        dlam(:, 1) = gradient_dot(sys, gradients, direction) - phi
+        if (sys%ncon > 0) then
+          call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
+          if (lapack_info /= 0) then
+            info = 4
+            detail = lapack_info
+            return
+          end if
+          call rotate_all(rotation, matmul(sys%flexibility, matmul(w, dlam(:, 1))), .false., &
+                          correction)
+          correction = correction - direction
+        else
+          correction = -direction
+        end if
+        e_new = e_new + correction
+        a_new = a_new + correction / (beta * h * h)
+        lam_new = lam_new + dlam(:, 1)
+        if (.not. (all(abs(correction) < huge(1.0_dp)) .and. all(abs(lam_new) < huge(1.0_dp)))) then
+          info = 2
+          return
+        end if
+        if (maxval(abs(correction)) <= cfg%tol * cfg%length_scale) then
+          done = .true.
+          exit
+        end if
+      end do
+      if (.not. done) then
+        info = 1
+        return
+      end if
+      ! accept the step
+      v = v_hat + h * cfg%gamma * a_new
+      e = e_new
+      a = a_new
+      lam = lam_new
+      t = t_new
+      call step_powers(sys, e, v, lam, rotation, rate, t, powers_new, strain, info)
+      if (info /= 0) return
+      work = work + 0.5_dp * h * (powers_old + powers_new)
+      powers_old = powers_new
+      steps_done = step
+      out_time(step) = t
+      out_newton(step) = it
+      out_lambda(:, step) = lam
+      call record(sys, e, v, rotation, work, strain, out_probe(:, :, step), out_deflection(:, :, step), &
+                  out_energy(:, step), out_constraint(step), t, info)
+      if (info /= 0) return
+      if (store_q) out_q(:, step) = e
+    end do
+  end subroutine newmark_chunk
+
+  !> W(3 nblock, ncon): frame components (T^T Phi_e^T) at the touched 3-vectors.
+  subroutine frame_gradients(sys, rotation, gradients, w)
+    type(ffr_system), intent(in) :: sys
+    real(dp), intent(in) :: rotation(3, 3), gradients(:, :)
+    real(dp), intent(out) :: w(:, :)
+    integer :: c, i, dof, b, comp
+    w = 0.0_dp
+    do c = 1, sys%ncon
+      do i = 1, 6
+        dof = sys%con_ints(2 + i, c)
+        if (dof == 0) cycle
+        b = findloc(sys%block_first, dof - modulo(dof - 1, 3), dim=1)
+        comp = modulo(dof - 1, 3) + 1
+        w(3 * (b - 1) + 1:3 * b, c) = w(3 * (b - 1) + 1:3 * b, c) + rotation(comp, :) * gradients(i, c)
+      end do
+    end do
+  end subroutine frame_gradients
+
+  !> Phi_e x for every constraint.
+  pure function gradient_dot(sys, gradients, x) result(y)
+    type(ffr_system), intent(in) :: sys
+    real(dp), intent(in) :: gradients(:, :), x(:)
+    real(dp) :: y(sys%ncon)
+    integer :: c, i
+    y = 0.0_dp
+    do c = 1, sys%ncon
+      do i = 1, 6
+        if (sys%con_ints(2 + i, c) > 0) y(c) = y(c) + gradients(i, c) * x(sys%con_ints(2 + i, c))
+      end do
+    end do
+  end function gradient_dot
+
+  !> Powers of the constraint forces (lambda . Phi_e v: the drive) and of the moving frame,
+  !> dU/dt at fixed e = -phi' sum_b f_b . (k x x_b), f = K0 u, u = T^T e - e0, x = T^T e,
+  !> with the strain energy U, all from one pass over the elements.
+  subroutine step_powers(sys, e, v, lam, rotation, rate, t, powers, strain, info)
+    type(ffr_system), intent(in) :: sys
+    real(dp), intent(in) :: e(:), v(:), lam(:), rotation(3, 3), rate, t
+    real(dp), intent(out) :: powers(2), strain
+    integer, intent(out) :: info
+    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), hessians(6, 6, sys%ncon)
+    real(dp) :: phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    real(dp) :: frame_coords(24), local(24), frame_force(24), k(3), x(3)
+    integer :: el, b
+    call constraint_eval(sys%ncon, sys%con_ints, sys%con_reals, size(sys%drive_kinds), &
+                         sys%drive_kinds, sys%drive_params, sys%ndof, e, v, t, phi, gradients, &
+                         hessians, phi_t, phi_tt, gamma, info)
+    if (info /= 0) then
+      info = 5
+      return
+    end if
+    powers(1) = dot_product(lam, gradient_dot(sys, gradients, v))
+    powers(2) = 0.0_dp
+    strain = 0.0_dp
+    k = sys%frame_axis / norm2(sys%frame_axis)
+    do el = 1, sys%nel
+      do b = 0, 7
+        frame_coords(3 * b + 1:3 * b + 3) = rotation(1, :) * e(sys%dofs(3 * b + 1, el)) &
+                                            + rotation(2, :) * e(sys%dofs(3 * b + 2, el)) &
+                                            + rotation(3, :) * e(sys%dofs(3 * b + 3, el))
+      end do
+      local = frame_coords - sys%e0_frame(sys%dofs(:, el))
+      frame_force = matmul(sys%stiffness0(:, :, el), local)
+      strain = strain + 0.5_dp * dot_product(local, frame_force)
+      if (rate == 0.0_dp) cycle
+      do b = 0, 7
+        x = frame_coords(3 * b + 1:3 * b + 3)
+        powers(2) = powers(2) - rate * dot_product(frame_force(3 * b + 1:3 * b + 3), &
+                    [k(2) * x(3) - k(3) * x(2), k(3) * x(1) - k(1) * x(3), k(1) * x(2) - k(2) * x(1)])
+      end do
+    end do
+  end subroutine step_powers
+
+  !> One output row: probes, deflections in the frame, energies, constraint violation.
+  subroutine record(sys, e, v, rotation, work, strain, probe, deflection, energy, violation, t, info)
+    type(ffr_system), intent(in) :: sys
+    real(dp), intent(in) :: e(:), v(:), rotation(3, 3), work(2), strain, t
+    real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:), violation
+    integer, intent(out) :: info
+    real(dp) :: mv(sys%ndof), phi(sys%ncon), gradients(6, sys%ncon)
+    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    integer :: p, a, m
+    do p = 1, sys%nprobe
+      probe(:, p) = 0.0_dp
+      do a = 0, 7
+        probe(:, p) = probe(:, p) + sys%probe_shape(a + 1, p) * e(sys%probe_dofs(3 * a + 1:3 * a + 3, p))
+      end do
+      deflection(:, p) = matmul(transpose(rotation), probe(:, p)) - sys%probe_reference(:, p)
+    end do
+    call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, v, mv)
+    energy(energy_kinetic) = 0.5_dp * dot_product(v, mv)
+    energy(energy_strain) = strain
+    energy(energy_loads) = -dot_product(sys%constant_force, e)
+    energy(energy_moment) = 0.0_dp
+    do m = 1, sys%nmoment
+      energy(energy_moment) = energy(energy_moment) - sys%moment_magnitude(m) * &
+        moment_angle(e(sys%moment_dofs(:, m)), sys%moment_axis(:, m), sys%moment_reference(:, m))
+    end do
+    energy(energy_total) = sum(energy(energy_kinetic:energy_moment))
+    energy(work_drive) = work(1)
+    energy(work_frame) = work(2)
+    call constraint_eval(sys%ncon, sys%con_ints, sys%con_reals, size(sys%drive_kinds), &
+                         sys%drive_kinds, sys%drive_params, sys%ndof, e, v, t, phi, gradients, &
+                         hessians, phi_t, phi_tt, gamma, info)
+    if (info /= 0) then
+      info = 5
+      return
+    end if
+    violation = maxval(abs(phi), mask=.true.)
+    if (sys%ncon == 0) violation = 0.0_dp
+  end subroutine record
+
+end module newmark_ffr

@@ -1,0 +1,288 @@
+"""Newmark dynamics of the constrained ANCF-FFR beam (seed 000, eqs. 58-62).
+
+Python prepares what never changes during a run and hands the stepping to the Fortran
+kernel (``fortran/src/newmark_ffr.f90``), which advances whole chunks of steps per call:
+
+* S = M/(beta h^2) + K0 in the floating frame, factorized once by MUMPS. Because every
+  3 x 3 block of M is a scalar times I3, M/(beta h^2) + T K0 T^T = T S T^T for any frame
+  rotation A(t), so this one factorization serves every step of the run.
+* The flexibility S^{-1} E_c at the 3-vectors the constraints touch (one solve per
+  touched coordinate, once), from which the kernel builds the multipliers' Schur
+  complement at each Newton iteration without further solves.
+* The consistent initial acceleration from [[M, -Phi_e^T], [-Phi_e, 0]] [a; lambda] =
+  [Q - Q_el; -gamma].
+
+Each chunk's outputs go to a ``sink`` (the HDF5 writer) before the next chunk starts, so
+an interrupted or failed run keeps every completed chunk.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+from tqdm import tqdm
+
+from . import _kernel
+from .errors import SolverError
+from .kernel import DirectSolver, _f
+from .model import BeamModel
+
+ENERGY_NAMES = ("kinetic", "strain", "gravity", "moment", "total", "drive_work", "frame_work")
+
+_FAILURES = {
+    1: "Newton did not converge within {max_newton} iterations",
+    2: "the state became non-finite (NaN or overflow)",
+    3: "the linear solve failed (MUMPS code {detail})",
+    4: "the multipliers' Schur complement is singular (dgesv info {detail}): the "
+       "constraints are redundant or lost rank",
+    5: "a constraint or drive could not be evaluated",
+    6: "a bending moment's section director became parallel to its axis",
+}
+
+
+@dataclass
+class DynamicSettings:
+    """Integrator settings (``&solver`` and ``&output`` of a scene)."""
+
+    dt: float
+    t_end: float
+    beta: float = 0.25
+    gamma: float = 0.5
+    tol: float = 1e-10
+    max_newton: int = 10
+    chunk_steps: int = 1000
+    store_q: bool = False
+
+
+@dataclass
+class Chunk:
+    """Outputs of consecutive steps (one row per step)."""
+
+    time: np.ndarray
+    probes: np.ndarray        # (nt, nprobe, 3)
+    deflections: np.ndarray   # (nt, nprobe, 3)
+    lam: np.ndarray           # (nt, ncon)
+    energy: np.ndarray        # (nt, 7): ENERGY_NAMES
+    constraint: np.ndarray    # (nt,) max |Phi|
+    newton: np.ndarray        # (nt,) Newton corrections per step
+    q: np.ndarray | None      # (nt, ndof) when stored
+
+
+@dataclass
+class DynamicResult:
+    """Statistics of a completed run."""
+
+    steps: int
+    newton_iterations: int
+    factorizations: int
+    solves_setup: int
+    wall_time_s: float
+    timing: dict[str, float] = field(default_factory=dict)
+
+
+def _saddle_solve(model: BeamModel, matrix: sp.spmatrix, rhs_top: np.ndarray,
+                  rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str):
+    """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]."""
+    n, ncon = model.ndof, len(model.constraints)
+    _, rows, cols, grads = model.constraints.jacobian(e, n, t)
+    coo = matrix.tocoo()
+    r = np.concatenate([coo.row, cols, n + rows])
+    c = np.concatenate([coo.col, n + rows, cols])
+    v = np.concatenate([coo.data, -grads, -grads])
+    with DirectSolver(n + ncon, r, c, what=what) as solver:
+        solver.factorize(v)
+        x = solver.solve(np.concatenate([rhs_top, rhs_bottom]))
+    return x[:n], x[n:]
+
+
+def initial_acceleration(model: BeamModel, e: np.ndarray, v: np.ndarray, t: float):
+    """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma."""
+    *_, gamma = model.constraints.evaluate(e, t, v)
+    elastic, _ = model.elastic_force_at(e, t)
+    external = model.external_force(e)
+    return _saddle_solve(model, model.mass_matrix(), external - elastic, -gamma, e, t,
+                         "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]")
+
+
+class NewmarkIntegrator:
+    """The constant data of a Newmark run and the chunked stepping over the kernel."""
+
+    def __init__(self, model: BeamModel, settings: DynamicSettings) -> None:
+        if settings.dt <= 0:
+            raise SolverError(f"time step dt = {settings.dt} must be positive")
+        self.model, self.settings = model, settings
+        start = time.perf_counter()
+        h, beta = settings.dt, settings.beta
+        mass = model.mass_matrix()
+        self.mass = mass
+        stiffness0 = model.pattern.to_scipy(model.pattern.assemble(model.stiffness0))
+        iteration_matrix = (mass / (beta * h * h) + stiffness0).tocoo()
+        self.solver = DirectSolver(model.ndof, iteration_matrix.row, iteration_matrix.col,
+                                   banded_spd=True,
+                                   what="Newmark iteration matrix M/(beta h^2) + K0")
+        self.solver.factorize(iteration_matrix.data)
+        model.counters["factorizations"] += 1
+        table = model.constraints.dof_table()
+        used = table[table >= 0]
+        self.block_first = np.unique(used - used % 3)
+        columns = np.zeros((model.ndof, 3 * len(self.block_first)))
+        for b, first in enumerate(self.block_first):
+            columns[first:first + 3, 3 * b:3 * b + 3] = np.eye(3)
+        self.flexibility = self.solver.solve(columns) if columns.size else columns
+        block_dofs = (self.block_first[:, None] + np.arange(3)).ravel()
+        self.flexibility_cc = self.flexibility[block_dofs] if columns.size else np.zeros((0, 0))
+        self.setup_solves = columns.shape[1]
+        self.setup_time = time.perf_counter() - start
+        self._arrays = self._kernel_arrays()
+
+    def _kernel_arrays(self) -> dict:
+        model = self.model
+        ints, reals, kinds, params = model.constraints.arrays()
+        moments = model.moments
+        probes = list(model.probes.values())
+        shapes, references, probe_dofs = [], [], []
+        from . import kernel
+        for probe in probes:
+            shape, *_ = kernel.beam_shape([probe.xi], [probe.y], [probe.z],
+                                          [model.lengths[probe.element]])
+            shapes.append(shape[:, 0])
+            dofs = model.dofs[:, probe.element]
+            references.append(shape[:, 0] @ model.e0_frame[dofs].reshape(8, 3))
+            probe_dofs.append(dofs + 1)
+        csr = self.mass.tocsr()
+        csr.eliminate_zeros()  # the x, y, z blocks of M are decoupled: 2/3 of the pattern is 0
+        csr.sort_indices()
+        return dict(
+            dofs=_f(model.dofs + 1, np.int32), stiffness0=model.stiffness0,
+            e0_frame=_f(model.e0_frame), mass_row_ptr=_f(csr.indptr + 1, np.int32),
+            mass_col=_f(csr.indices + 1, np.int32), mass_values=_f(csr.data),
+            constant_force=_f(model.constant_force()),
+            moment_dofs=_f(np.array([np.array(m.dofs) + 1 for m in moments],
+                                    dtype=np.int32).reshape(-1, 3).T, np.int32),
+            moment_axis=_f(np.array([m.axis for m in moments]).reshape(-1, 3).T),
+            moment_magnitude=_f(np.array([m.magnitude for m in moments])),
+            moment_reference=_f(np.array([model.e0[m.dofs] for m in moments]).reshape(-1, 3).T),
+            con_ints=_f(ints, np.int32), con_reals=_f(reals), drive_kinds=_f(kinds, np.int32),
+            drive_params=_f(params), frame_drive=model.frame_drive,
+            frame_axis=_f(model.frame_axis), frame_base=_f(model.frame_base),
+            solver_handle=self.solver.handle, block_first=_f(self.block_first + 1, np.int32),
+            flexibility=_f(self.flexibility), flexibility_cc=_f(self.flexibility_cc),
+            probe_dofs=_f(np.array(probe_dofs, dtype=np.int32).reshape(-1, 24).T, np.int32),
+            probe_shape=_f(np.array(shapes).reshape(-1, 8).T),
+            probe_reference=_f(np.array(references).reshape(-1, 3).T),
+        )
+
+    def close(self) -> None:
+        self.solver.close()
+
+    def advance(self, state: dict, nsteps: int) -> tuple[Chunk, int, int]:
+        """Advance ``nsteps`` steps; ``state`` (t, e, v, a, lam, work) is updated in place.
+        Returns the chunk of completed steps, the kernel's info and detail codes."""
+        s, m = self.settings, self.model
+        nq = nsteps if s.store_q else 1
+        out = _kernel.newmark_advance(
+            **self._arrays, nsteps=nsteps, nq=nq, h=s.dt, beta=s.beta, gamma=s.gamma, tol=s.tol,
+            length_scale=m.length_scale, max_newton=s.max_newton,
+            t=state["t"], e=_f(state["e"]), v=_f(state["v"]), a=_f(state["a"]),
+            lam=_f(state["lam"]), work=_f(state["work"]))
+        (t, e, v, a, lam, work, o_time, o_probe, o_defl, o_lam, o_energy, o_con, o_newton, o_q,
+         status) = out
+        state.update(t=float(t), e=e, v=v, a=a, lam=lam, work=work)
+        done, info, detail = (int(x) for x in status)
+        chunk = Chunk(time=o_time[:done], probes=np.transpose(o_probe[:, :, :done], (2, 1, 0)),
+                      deflections=np.transpose(o_defl[:, :, :done], (2, 1, 0)),
+                      lam=o_lam[:, :done].T, energy=o_energy[:, :done].T,
+                      constraint=o_con[:done], newton=o_newton[:done],
+                      q=o_q[:, :done].T if s.store_q else None)
+        return chunk, info, detail
+
+    def failure_message(self, info: int, detail: int, t: float) -> str:
+        reason = _FAILURES.get(info, f"kernel code {info}").format(
+            max_newton=self.settings.max_newton, detail=detail)
+        return f"Newmark step from t = {t:.6g} s to t = {t + self.settings.dt:.6g} s failed: {reason}"
+
+
+def initial_row(model: BeamModel, state: dict, mass: sp.spmatrix) -> Chunk:
+    """The output row of the initial state, with the kernel's energy definitions."""
+    e, v, t = state["e"], state["v"], state["t"]
+    positions = model.probe_positions(e)
+    deflections = model.deflections_at(e, t)
+    _, strain = model.elastic_force_at(e, t)
+    moment = -sum(m.magnitude * float(_kernel.moment_rotation_angle(e[m.dofs], m.axis,
+                                                                   model.e0[m.dofs]))
+                  for m in model.moments)
+    kinetic = 0.5 * v @ (mass @ v)
+    loads = -model.constant_force() @ e
+    energy = np.array([kinetic, strain, loads, moment, kinetic + strain + loads + moment,
+                       state["work"][0], state["work"][1]])
+    values, *_ = model.constraints.evaluate(e, t)
+    names = list(model.probes)
+    return Chunk(time=np.array([t]), probes=np.array([[positions[n] for n in names]]),
+                 deflections=np.array([[deflections[n] for n in names]]),
+                 lam=state["lam"][None, :], energy=energy[None, :],
+                 constraint=np.array([np.abs(values).max(initial=0.0)]),
+                 newton=np.array([0]), q=e[None, :].copy())
+
+
+def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
+              v0: np.ndarray | None = None, t0: float = 0.0, *,
+              sink: Callable[[Chunk], None] | None = None,
+              progress: bool | None = None) -> DynamicResult:
+    """Integrate from (t0, e0, v0) to settings.t_end. Each chunk goes to ``sink`` as soon
+    as it is computed (the first one holds the initial state). A failed step raises
+    SolverError after the completed steps have gone to the sink."""
+    start = time.perf_counter()
+    timing = {"setup": 0.0, "stepping": 0.0, "output": 0.0}
+    if settings.t_end < t0:
+        raise SolverError(f"t_end = {settings.t_end} lies before the start time {t0}")
+    v0 = np.zeros(model.ndof) if v0 is None else v0
+    integrator = NewmarkIntegrator(model, settings)
+    try:
+        a0, lam0 = initial_acceleration(model, e0, v0, t0)
+        state = dict(t=t0, e=e0.copy(), v=v0.copy(), a=a0, lam=lam0, work=np.zeros(2))
+        timing["setup"] = time.perf_counter() - start
+        t0_out = time.perf_counter()
+        if sink:
+            first = initial_row(model, state, integrator.mass)
+            if not settings.store_q:
+                first.q = None
+            sink(first)
+        timing["output"] += time.perf_counter() - t0_out
+        total = int(round((settings.t_end - t0) / settings.dt))
+        show = sys.stderr.isatty() if progress is None else progress
+        bar = tqdm(total=round(settings.t_end - t0, 9), unit="s", disable=not show,
+                   desc="Newmark", bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s "
+                   "[{elapsed}<{remaining}{postfix}]")
+        steps = newton = 0
+        try:
+            while steps < total:
+                n = min(settings.chunk_steps, total - steps)
+                t_before = state["t"]
+                t1 = time.perf_counter()
+                chunk, info, detail = integrator.advance(state, n)
+                timing["stepping"] += time.perf_counter() - t1
+                steps += len(chunk.time)
+                newton += int(chunk.newton.sum())
+                t1 = time.perf_counter()
+                if sink and len(chunk.time):
+                    sink(chunk)
+                timing["output"] += time.perf_counter() - t1
+                bar.update(round(state["t"] - t_before, 9))
+                bar.set_postfix(steps=steps, newton=newton)
+                if info:
+                    raise SolverError(integrator.failure_message(info, detail, state["t"]))
+        finally:
+            bar.close()
+        model.counters["newmark_steps"] += steps
+        model.counters["newton_iterations"] += newton
+        model.counters["solves"] += newton + integrator.setup_solves
+    finally:
+        integrator.close()
+    wall = time.perf_counter() - start
+    timing["total"] = wall
+    return DynamicResult(steps=steps, newton_iterations=newton, factorizations=1,
+                         solves_setup=integrator.setup_solves, wall_time_s=wall, timing=timing)

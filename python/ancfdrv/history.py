@@ -1,0 +1,55 @@
+"""Post-processing of time histories: the luffing stages of SPEC section 5, their
+min/max, and the dominant frequency and amplitude of the vibration stage."""
+from __future__ import annotations
+
+import numpy as np
+
+STAGES = ("start", "luffing", "braking", "vibration")
+
+
+def luffing_stage_bounds(omega: float, t_start: float, t_brake: float, sweep: float,
+                         t_end: float) -> dict[str, tuple[float, float]]:
+    """[t0, t1) of each stage: start [0, t_s), luffing [t_s, t1), braking [t1, t2),
+    steady-state vibration [t2, t_end]."""
+    t_c = sweep / omega - 0.5 * (t_start + t_brake)
+    t1 = t_start + t_c
+    t2 = t1 + t_brake
+    return {"start": (0.0, t_start), "luffing": (t_start, t1), "braking": (t1, t2),
+            "vibration": (t2, t_end)}
+
+
+def dominant_frequency(time: np.ndarray, signal: np.ndarray) -> tuple[float, float]:
+    """Dominant frequency (Hz) of a uniformly sampled signal, from the peak of its
+    Hann-windowed spectrum refined by parabolic interpolation, and the amplitude
+    (half the peak-to-peak of the mean-free signal)."""
+    if len(time) < 8:
+        return float("nan"), float("nan")
+    y = signal - signal.mean()
+    dt = float(np.mean(np.diff(time)))
+    n = 8 * len(y)
+    spectrum = np.abs(np.fft.rfft(y * np.hanning(len(y)), n))
+    k = int(np.argmax(spectrum[1:])) + 1
+    if 1 <= k < len(spectrum) - 1:
+        a, b, c = np.log(spectrum[k - 1:k + 2] + 1e-300)
+        k = k + 0.5 * (a - c) / (a - 2 * b + c)
+    return k / (n * dt), 0.5 * float(y.max() - y.min())
+
+
+def stage_summary(time: np.ndarray, transverse: np.ndarray,
+                  bounds: dict[str, tuple[float, float]]) -> dict[str, float]:
+    """min/max of the transverse tip deflection per stage; frequency and amplitude of the
+    vibration stage."""
+    out: dict[str, float] = {}
+    for stage, (t0, t1) in bounds.items():
+        mask = (time >= t0) & ((time < t1) if stage != "vibration" else (time <= t1))
+        if not mask.any():
+            continue
+        out[f"{stage}_t0"], out[f"{stage}_t1"] = t0, t1
+        out[f"{stage}_min"] = float(transverse[mask].min())
+        out[f"{stage}_max"] = float(transverse[mask].max())
+        if stage == "vibration":
+            freq, amp = dominant_frequency(time[mask], transverse[mask])
+            out["vibration_frequency_hz"] = freq
+            out["vibration_amplitude"] = amp
+            out["vibration_mean"] = float(transverse[mask].mean())
+    return out
