@@ -226,7 +226,8 @@ end subroutine direct_destroy
 !> Advances nsteps Newmark steps of an ANCF-FFR beam (module newmark_ffr). The model
 !> arrays are those Python builds once; the state (t, e, v, a, lam, work) is updated in
 !> place; one output row per step. status(1) = steps done, status(2) = info,
-!> status(3) = detail (see newmark_chunk).
+!> status(3) = detail, last_correction = size of the last Newton correction (see
+!> newmark_chunk).
 subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, nq, &
                            dofs, stiffness0, e0_frame, mass_row_ptr, mass_col, mass_values, &
                            constant_force, moment_dofs, moment_axis, moment_magnitude, &
@@ -235,7 +236,7 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
                            flexibility, flexibility_cc, probe_dofs, probe_shape, probe_reference, &
                            h, beta, gamma, tol, length_scale, max_newton, &
                            t, e, v, a, lam, work, out_time, out_probe, out_deflection, out_lambda, &
-                           out_energy, out_constraint, out_newton, out_q, status)
+                           out_energy, out_constraint, out_newton, out_q, status, last_correction)
   use ancf_kinds, only: dp
   use newmark_ffr, only: ffr_system, newmark_settings, newmark_chunk
   implicit none
@@ -243,23 +244,26 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
   integer, intent(in) :: dofs(24, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
   real(dp), intent(in) :: stiffness0(24, 24, nel), e0_frame(ndof), mass_values(nnz_mass)
   real(dp), intent(in) :: constant_force(ndof)
-  integer, intent(in) :: moment_dofs(3, nmoment)
-  real(dp), intent(in) :: moment_axis(3, nmoment), moment_magnitude(nmoment), moment_reference(3, nmoment)
-  integer, intent(in) :: con_ints(8, ncon), drive_kinds(ndrive)
-  real(dp), intent(in) :: con_reals(8, ncon), drive_params(8, ndrive)
-  integer, intent(in) :: frame_drive, solver_handle, block_first(nblock)
+  integer, intent(in) :: moment_dofs(3, max(1, nmoment))
+  real(dp), intent(in) :: moment_axis(3, max(1, nmoment)), moment_magnitude(max(1, nmoment))
+  real(dp), intent(in) :: moment_reference(3, max(1, nmoment))
+  integer, intent(in) :: con_ints(8, max(1, ncon)), drive_kinds(ndrive)
+  real(dp), intent(in) :: con_reals(8, max(1, ncon)), drive_params(8, ndrive)
+  integer, intent(in) :: frame_drive, solver_handle, block_first(max(1, nblock))
   real(dp), intent(in) :: frame_axis(3), frame_base(3, 3)
-  real(dp), intent(in) :: flexibility(ndof, 3 * nblock), flexibility_cc(3 * nblock, 3 * nblock)
+  real(dp), intent(in) :: flexibility(ndof, max(3, 3 * nblock))
+  real(dp), intent(in) :: flexibility_cc(max(3, 3 * nblock), max(3, 3 * nblock))
   integer, intent(in) :: probe_dofs(24, nprobe)
   real(dp), intent(in) :: probe_shape(8, nprobe), probe_reference(3, nprobe)
   real(dp), intent(in) :: h, beta, gamma, tol, length_scale
   integer, intent(in) :: max_newton
-  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), lam(ncon), work(2)
+  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), lam(max(1, ncon)), work(2)
   !f2py intent(in,out) :: t, e, v, a, lam, work
   real(dp), intent(out) :: out_time(nsteps), out_probe(3, nprobe, nsteps)
-  real(dp), intent(out) :: out_deflection(3, nprobe, nsteps), out_lambda(ncon, nsteps)
+  real(dp), intent(out) :: out_deflection(3, nprobe, nsteps), out_lambda(max(1, ncon), nsteps)
   real(dp), intent(out) :: out_energy(7, nsteps), out_constraint(nsteps), out_q(ndof, nq)
   integer, intent(out) :: out_newton(nsteps), status(3)
+  real(dp), intent(out) :: last_correction
   type(ffr_system) :: sys
   type(newmark_settings) :: cfg
   sys%ndof = ndof
@@ -275,21 +279,22 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
   sys%mass_col = mass_col
   sys%mass_values = mass_values
   sys%constant_force = constant_force
-  sys%moment_dofs = moment_dofs
-  sys%moment_axis = moment_axis
-  sys%moment_magnitude = moment_magnitude
-  sys%moment_reference = moment_reference
-  sys%con_ints = con_ints
-  sys%con_reals = con_reals
+  ! arrays of optional items carry max(1, n) columns (f2py refuses zero sizes); use n
+  sys%moment_dofs = moment_dofs(:, 1:nmoment)
+  sys%moment_axis = moment_axis(:, 1:nmoment)
+  sys%moment_magnitude = moment_magnitude(1:nmoment)
+  sys%moment_reference = moment_reference(:, 1:nmoment)
+  sys%con_ints = con_ints(:, 1:ncon)
+  sys%con_reals = con_reals(:, 1:ncon)
   sys%drive_kinds = drive_kinds
   sys%drive_params = drive_params
   sys%frame_drive = frame_drive
   sys%frame_axis = frame_axis
   sys%frame_base = frame_base
   sys%solver_handle = solver_handle
-  sys%block_first = block_first
-  sys%flexibility = flexibility
-  sys%flexibility_cc = flexibility_cc
+  sys%block_first = block_first(1:nblock)
+  sys%flexibility = flexibility(:, 1:3 * nblock)
+  sys%flexibility_cc = flexibility_cc(1:3 * nblock, 1:3 * nblock)
   sys%probe_dofs = probe_dofs
   sys%probe_shape = probe_shape
   sys%probe_reference = probe_reference
@@ -307,7 +312,7 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
   out_constraint = 0.0_dp
   out_newton = 0
   out_q = 0.0_dp
-  call newmark_chunk(sys, cfg, nsteps, t, e, v, a, lam, work, out_time, out_probe, out_deflection, &
-                     out_lambda, out_energy, out_constraint, out_newton, nq == nsteps, out_q, &
-                     status(1), status(2), status(3))
+  call newmark_chunk(sys, cfg, nsteps, t, e, v, a, lam(1:ncon), work, out_time, out_probe, out_deflection, &
+                     out_lambda(1:ncon, :), out_energy, out_constraint, out_newton, nq == nsteps, out_q, &
+                     status(1), status(2), status(3), last_correction)
 end subroutine newmark_advance

@@ -157,10 +157,11 @@ contains
   !> step. info: 0 ok; 1 Newton did not converge; 2 non-finite state; 3 linear solve
   !> failed (detail = MUMPS code); 4 singular Schur complement (detail = dgesv info);
   !> 5 constraint or drive evaluation failed; 6 moment undefined. steps_done counts the
-  !> completed steps; the state is that of the last completed step.
+  !> completed steps; the state is that of the last completed step; last_correction is the
+  !> size of the last Newton correction (why a step failed to converge).
   subroutine newmark_chunk(sys, cfg, nsteps, t, e, v, a, lam, work, out_time, out_probe, &
                            out_deflection, out_lambda, out_energy, out_constraint, out_newton, &
-                           store_q, out_q, steps_done, info, detail)
+                           store_q, out_q, steps_done, info, detail, last_correction)
     type(ffr_system), intent(in) :: sys
     type(newmark_settings), intent(in) :: cfg
     integer, intent(in) :: nsteps
@@ -171,6 +172,7 @@ contains
     logical, intent(in) :: store_q
     real(dp), intent(out) :: out_q(:, :)
     integer, intent(out) :: steps_done, info, detail
+    real(dp), intent(out) :: last_correction  ! max |de| of the last Newton correction (m)
     real(dp) :: e_new(sys%ndof), a_new(sys%ndof), lam_new(sys%ncon), e_hat(sys%ndof), v_hat(sys%ndof)
     real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof), phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: w(3 * sys%nblock, sys%ncon), schur(sys%ncon, sys%ncon), dlam(sys%ncon, 1)
@@ -180,6 +182,7 @@ contains
     info = 0
     detail = 0
     steps_done = 0
+    last_correction = 0.0_dp
     h = cfg%h
     beta = cfg%beta
     call frame_rotation(sys, t, rotation, rate, info)
@@ -238,7 +241,8 @@ contains
           info = 2
           return
         end if
-        if (maxval(abs(correction)) <= cfg%tol * cfg%length_scale) then
+        last_correction = maxval(abs(correction))
+        if (last_correction <= cfg%tol * cfg%length_scale) then
           done = .true.
           exit
         end if

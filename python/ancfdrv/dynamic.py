@@ -153,6 +153,12 @@ class NewmarkIntegrator:
             dofs = model.dofs[:, probe.element]
             references.append(shape[:, 0] @ model.e0_frame[dofs].reshape(8, 3))
             probe_dofs.append(dofs + 1)
+        def pad(a: np.ndarray) -> np.ndarray:
+            """f2py refuses zero-size arrays: give one unused column; counts say how many
+            are real."""
+            if a.shape[-1]:
+                return a
+            return np.zeros(a.shape[:-1] + (1,), dtype=a.dtype, order="F")
         csr = self.mass.tocsr()
         csr.eliminate_zeros()  # the x, y, z blocks of M are decoupled: 2/3 of the pattern is 0
         csr.sort_indices()
@@ -161,16 +167,22 @@ class NewmarkIntegrator:
             e0_frame=_f(model.e0_frame), mass_row_ptr=_f(csr.indptr + 1, np.int32),
             mass_col=_f(csr.indices + 1, np.int32), mass_values=_f(csr.data),
             constant_force=_f(model.constant_force()),
-            moment_dofs=_f(np.array([np.array(m.dofs) + 1 for m in moments],
-                                    dtype=np.int32).reshape(-1, 3).T, np.int32),
-            moment_axis=_f(np.array([m.axis for m in moments]).reshape(-1, 3).T),
-            moment_magnitude=_f(np.array([m.magnitude for m in moments])),
-            moment_reference=_f(np.array([model.e0[m.dofs] for m in moments]).reshape(-1, 3).T),
-            con_ints=_f(ints, np.int32), con_reals=_f(reals), drive_kinds=_f(kinds, np.int32),
+            nmoment=len(moments),
+            moment_dofs=pad(_f(np.array([np.array(m.dofs) + 1 for m in moments],
+                                        dtype=np.int32).reshape(-1, 3).T, np.int32)),
+            moment_axis=pad(_f(np.array([m.axis for m in moments]).reshape(-1, 3).T)),
+            moment_magnitude=pad(_f(np.array([m.magnitude for m in moments]))),
+            moment_reference=pad(_f(np.array([model.e0[m.dofs] for m in moments]).reshape(-1, 3).T)),
+            ncon=len(model.constraints),
+            con_ints=pad(_f(ints, np.int32)), con_reals=pad(_f(reals)), drive_kinds=_f(kinds, np.int32),
             drive_params=_f(params), frame_drive=model.frame_drive,
             frame_axis=_f(model.frame_axis), frame_base=_f(model.frame_base),
-            solver_handle=self.solver.handle, block_first=_f(self.block_first + 1, np.int32),
-            flexibility=_f(self.flexibility), flexibility_cc=_f(self.flexibility_cc),
+            solver_handle=self.solver.handle, nblock=len(self.block_first),
+            block_first=pad(_f(self.block_first + 1, np.int32)),
+            flexibility=_f(self.flexibility) if len(self.block_first)
+            else np.zeros((model.ndof, 3), order="F"),
+            flexibility_cc=_f(self.flexibility_cc) if len(self.block_first)
+            else np.zeros((3, 3), order="F"),
             probe_dofs=_f(np.array(probe_dofs, dtype=np.int32).reshape(-1, 24).T, np.int32),
             probe_shape=_f(np.array(shapes).reshape(-1, 8).T),
             probe_reference=_f(np.array(references).reshape(-1, 3).T),
@@ -188,22 +200,27 @@ class NewmarkIntegrator:
             **self._arrays, nsteps=nsteps, nq=nq, h=s.dt, beta=s.beta, gamma=s.gamma, tol=s.tol,
             length_scale=m.length_scale, max_newton=s.max_newton,
             t=state["t"], e=_f(state["e"]), v=_f(state["v"]), a=_f(state["a"]),
-            lam=_f(state["lam"]), work=_f(state["work"]))
+            lam=_f(state["lam"]) if len(state["lam"]) else np.zeros(1), work=_f(state["work"]))
         (t, e, v, a, lam, work, o_time, o_probe, o_defl, o_lam, o_energy, o_con, o_newton, o_q,
-         status) = out
-        state.update(t=float(t), e=e, v=v, a=a, lam=lam, work=work)
+         status, self.last_correction) = out
+        state.update(t=float(t), e=e, v=v, a=a, lam=lam[:len(m.constraints)], work=work)
         done, info, detail = (int(x) for x in status)
         chunk = Chunk(time=o_time[:done], probes=np.transpose(o_probe[:, :, :done], (2, 1, 0)),
                       deflections=np.transpose(o_defl[:, :, :done], (2, 1, 0)),
-                      lam=o_lam[:, :done].T, energy=o_energy[:, :done].T,
+                      lam=o_lam[:len(m.constraints), :done].T, energy=o_energy[:, :done].T,
                       constraint=o_con[:done], newton=o_newton[:done],
                       q=o_q[:, :done].T if s.store_q else None)
         return chunk, info, detail
 
     def failure_message(self, info: int, detail: int, t: float) -> str:
-        reason = _FAILURES.get(info, f"kernel code {info}").format(
-            max_newton=self.settings.max_newton, detail=detail)
-        return f"Newmark step from t = {t:.6g} s to t = {t + self.settings.dt:.6g} s failed: {reason}"
+        s = self.settings
+        reason = _FAILURES.get(info, f"kernel code {info}").format(max_newton=s.max_newton,
+                                                                  detail=detail)
+        if info == 1:
+            reason += (f" (last correction {self.last_correction:.3e} m, tolerance "
+                       f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length; raise "
+                       "solver.max_newton or lower solver.dt)")
+        return f"Newmark step from t = {t:.6g} s to t = {t + s.dt:.6g} s failed: {reason}"
 
 
 def initial_row(model: BeamModel, state: dict, mass: sp.spmatrix) -> Chunk:

@@ -53,3 +53,14 @@ def stage_summary(time: np.ndarray, transverse: np.ndarray,
             out["vibration_amplitude"] = amp
             out["vibration_mean"] = float(transverse[mask].mean())
     return out
+
+
+def crossing_frequency(time: np.ndarray, signal: np.ndarray) -> float:
+    """Frequency (Hz) from the upward zero crossings of the mean-free signal, located by
+    linear interpolation: precise for a clean, nearly harmonic record of many periods."""
+    y = signal - signal.mean()
+    up = np.nonzero((y[:-1] < 0) & (y[1:] >= 0))[0]
+    if len(up) < 2:
+        return float("nan")
+    crossings = time[up] - y[up] * (time[up + 1] - time[up]) / (y[up + 1] - y[up])
+    return (len(crossings) - 1) / (crossings[-1] - crossings[0])

@@ -204,9 +204,10 @@ def _coerce(kind: str, raw: Any, where: dict) -> Any:
 def _parse_override_value(kind: str, text: str, where: dict) -> Any:
     """Parse the VALUE of --set GROUP.KEY=VALUE, typed like the namelist entry."""
     text = text.strip()
-    if kind in ("str", "strs"):
-        items = [t.strip().strip("'\"") for t in text.split(",")] if kind == "strs" else None
-        return items if kind == "strs" else text.strip("'\"")
+    if kind == "strs":  # an empty value is the empty list
+        return [t.strip().strip("'\"") for t in text.split(",") if t.strip().strip("'\"")]
+    if kind == "str":
+        return text.strip("'\"")
     try:
         parsed = f90nml.reads(f"&x v = {text} /")["x"]["v"]
     except Exception as exc:  # f90nml raises several types
