@@ -31,7 +31,8 @@ Each static solve is first timed at ``--tol``; when it does not converge there (
 relative residual of fine meshes stagnates at a round-off floor that grows with the mesh),
 the failure is recorded and the solve is timed at ``--fallback-tol``, so a converged time
 is always reported with the tolerance it was reached at and how the solver stopped
-(``converged_by``: residual, or step at the round-off floor, where the solver reports it).
+(``converged_by``, from the solvers' shared test :func:`ancfdrv.static.converged`:
+residual, or step at the round-off floor with the residual below sqrt(tol)).
 Process CPU time (user/system) and minor page faults of the best repeat are recorded too:
 a large system share means time spent page-faulting freshly allocated memory.
 
@@ -224,7 +225,7 @@ def time_mumps(system: LinearSystem, what: str,
     solution: list[np.ndarray] = []
 
     def run() -> dict[str, float]:
-        rhs = system.rhs.copy()  # DirectSolver.solve overwrites a contiguous rhs in place
+        rhs = system.rhs.copy()  # DirectSolver.solve copies rhs now; kept for older builds
         t0 = time.perf_counter()
         with DirectSolver(system.n, system.rows, system.cols, what=what) as solver:
             t1 = time.perf_counter()
@@ -402,8 +403,9 @@ def _ms(seconds: float, width: int = 9) -> str:
 
 
 def _iterations(rec: dict[str, Any]) -> str:
-    """Iterations with how the solve stopped: r residual <= tol, s step at round-off
-    (residual up to 1e3 tol), * only at the fallback tolerance."""
+    """Iterations with how the solve stopped (:func:`ancfdrv.static.converged`): r
+    residual <= tol, s step <= tol |d| at round-off (residual up to sqrt(tol)), * only at
+    the fallback tolerance."""
     if not rec["converged"]:
         return "FAIL"
     how = {"residual": "r", "step": "s"}.get(rec["converged_by"], "?")
@@ -443,6 +445,11 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
     print(f"    it: iterations (split: passes); r = residual <= --tol {args.tol:g}, s = "
           "stopped at the round-off step floor, * = only at --fallback-tol "
           f"{args.fallback_tol:g}; res = final relative residual")
+    nonlinear = sorted({r["static"]["split"]["extra"].get("nonlinear_coordinates")
+                        for r in records if r["static"]["split"]["converged"]} - {None})
+    if nonlinear:
+        print("    split: jets on " + "/".join(map(str, nonlinear))
+              + " nonlinear coordinates (extra['nonlinear_coordinates'])")
     rows = []
     for r in records:
         row = [str(r["nodes"]), _ms(r["floor"]["mumps_analyse_factorize_solve_s"]),
@@ -459,8 +466,9 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
             ("res", 7), ("S/floor", 7), ("S/spsol", 7)], rows)
 
     print("\n[3] where the static time goes: phases of the best repeat (ms); other = "
-          "analyse, residuals, jet algebra, Python; sys = share of CPU time in the kernel, "
-          "mflt = minor page faults (thousands)")
+          "analyse, residuals, set-up, Python; S asm = K assembly + the split's passes (jets, "
+          "reduced system, residuals: solve_split books its pass loop as 'assembly'); sys = "
+          "share of CPU time in the kernel, mflt = minor page faults (thousands)")
     rows = []
     for r in records:
         row = [str(r["nodes"])]
@@ -528,8 +536,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="tolerance timed when --tol is not reached (default 1e-8)")
     parser.add_argument("--max-iter", type=int, default=10,
                         help="static iteration limit (default 10: both solvers converge in "
-                             "2-3 iterations where they converge at all, and a stagnating "
-                             "split solve costs about 1 s per pass at 2002 nodes)")
+                             "2-3 iterations where they converge at all, and a solve "
+                             "stagnating at the round-off floor runs all of them)")
     defaults = Budget()
     parser.add_argument("--min-time", type=float, default=defaults.min_time,
                         help="seconds the repeats of one measurement take at least")

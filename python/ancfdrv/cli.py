@@ -21,24 +21,48 @@ from .errors import AncfError, InputError
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .plots import plot_result
+    from .results import read_summary
     from .runner import run_scene
     outcome = run_scene(args.scene, args.set, args.output)
     for warning in outcome.warnings:
         print(f"warning: {warning}", file=sys.stderr)
-    s = outcome.static
-    from .results import read_summary
     summary = read_summary(outcome.output)
-    tip = summary["static.deflection.tip"]
     print(f"{outcome.scene['scene']['title']}")
     print(f"  model        {summary['model.nnodes']} nodes, {summary['model.ndof']} coordinates, "
           f"{summary['model.nconstraints']} constraints")
-    print(f"  static       {s.method}: {s.iterations} iterations, relative residual "
-          f"{s.residual_norm:.2e}, {1e3 * s.wall_time_s:.2f} ms")
-    print(f"  tip          axial {1e3 * tip[0]:+.4f} mm, transverse {1e3 * tip[1]:+.4f} mm, "
-          f"lateral {1e3 * tip[2]:+.4f} mm (rigid frame)")
+    s = outcome.static
+    if s is not None:
+        tip = summary["static.deflection.tip"]
+        print(f"  static       {s.method}: {s.iterations} iterations, relative residual "
+              f"{s.residual_norm:.2e}, {1e3 * s.wall_time_s:.2f} ms")
+        print(f"  tip          axial {1e3 * tip[0]:+.4f} mm, transverse {1e3 * tip[1]:+.4f} mm, "
+              f"lateral {1e3 * tip[2]:+.4f} mm (rigid frame)")
+    d = outcome.dynamic
+    if d is not None:
+        print(f"  dynamic      {d.steps} steps of {summary['dynamic.dt']:g} s, "
+              f"{d.newton_iterations / max(d.steps, 1):.2f} Newton corrections per step, "
+              f"{d.factorizations} factorization, {d.wall_time_s:.2f} s")
+        if outcome.stages:
+            print(stage_table(outcome.stages))
     png = plot_result(outcome.output)
     print(f"  written      {outcome.output}, {png}")
     return 0
+
+
+def stage_table(stages: dict[str, float]) -> str:
+    """The per-stage summary of a luffing run as aligned text."""
+    from .history import STAGES
+    lines = ["  stage        t (s)            tip sag min..max (mm)"]
+    for stage in STAGES:
+        if f"{stage}_min" not in stages:
+            continue
+        lines.append(f"  {stage:12s} {stages[stage + '_t0']:6.3f}..{stages[stage + '_t1']:<7.3f}"
+                     f"  {1e3 * stages[stage + '_min']:9.3f} .. {1e3 * stages[stage + '_max']:9.3f}")
+    if "vibration_frequency_hz" in stages:
+        lines.append(f"  vibration    {stages['vibration_frequency_hz']:.4f} Hz, amplitude "
+                     f"{1e3 * stages['vibration_amplitude']:.4f} mm about "
+                     f"{1e3 * stages['vibration_mean']:.3f} mm")
+    return "\n".join(lines)
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:

@@ -12,9 +12,57 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
+STAGE_COLOURS = {"start": "#dbe9f6", "luffing": "#fdf1d6", "braking": "#f8dcdc",
+                 "vibration": "#e2f2df"}
+
+
 def plot_result(h5_path: str | Path, png: str | Path | None = None) -> Path:
-    """Static result: deflection of the neutral axis along the beam, in the rigid frame."""
+    """A result file: the dynamic histories when there are any, else the static
+    deflection line."""
     h5_path = Path(h5_path)
+    with h5py.File(h5_path, "r") as h5:
+        dynamic = "dynamic" in h5 and len(h5["dynamic/time"]) > 1
+    return plot_dynamic(h5_path, png) if dynamic else plot_static(h5_path, png)
+
+
+def plot_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
+    """Tip deflection in the rigid frame (stages shaded) and the energy balance."""
+    png = Path(png) if png else h5_path.with_suffix(".png")
+    with h5py.File(h5_path, "r") as h5:
+        dyn = h5["dynamic"]
+        t = dyn["time"][()]
+        sag = dyn["deflection/tip"][:, 1]
+        energy = {k: dyn[f"energy/{k}"][()] for k in dyn["energy"]}
+        stages = dict(dyn["stages"].attrs) if "stages" in dyn else {}
+        title = h5.attrs["title"]
+        nodes = h5["model"].attrs["nnodes"]
+        status = h5.attrs["status"]
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True, constrained_layout=True)
+    for stage, colour in STAGE_COLOURS.items():
+        if f"{stage}_t0" in stages:
+            for ax in (ax1, ax2):
+                ax.axvspan(stages[f"{stage}_t0"], stages[f"{stage}_t1"], color=colour, lw=0)
+            ax1.text(0.5 * (stages[f"{stage}_t0"] + stages[f"{stage}_t1"]), 1.0, stage,
+                     transform=ax1.get_xaxis_transform(), ha="center", va="bottom", fontsize=8)
+    ax1.plot(t, 1e3 * sag, lw=1.0)
+    ax1.set_ylabel("tip deflection, transverse (mm)")
+    ax1.set_title(f"{title}: {nodes} nodes ({status})\n", fontsize=9)
+    scale = max(np.abs(energy["drive_work"]).max(), np.abs(energy["kinetic"]).max(), 1e-300)
+    ax2.plot(t, energy["total"] - energy["total"][0], label="E - E(0)")
+    ax2.plot(t, energy["drive_work"], "--", label="drive work")
+    ax2.set_ylabel("energy (J)")
+    twin = ax2.twinx()
+    twin.plot(t, energy["balance"] / scale, color="C3", lw=0.8, label="balance / scale")
+    twin.set_ylabel("(E - E(0) - W) / max W", color="C3")
+    ax2.set_xlabel("time (s)")
+    ax2.legend(loc="upper left", fontsize=8)
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+    return png
+
+
+def plot_static(h5_path: Path, png: str | Path | None = None) -> Path:
+    """Static result: deflection of the neutral axis along the beam, in the rigid frame."""
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
         if "static" not in h5:
@@ -50,13 +98,15 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
     if not ok:
         return []
     out = []
+    if any(r.get("dynamic") for r in ok):
+        out += plot_histories(ok, keys, outdir)
     nodes_key = "beam.nodes" if "beam.nodes" in keys else None
     others = [k for k in keys if k not in ("beam.nodes", "solver.dt")]
     x_key = others[0] if others else None
     panel_keys = others[1:]
     panels = sorted({tuple(r[k] for k in panel_keys) for r in ok}, key=lambda t: [float(v) if
                     _isnum(v) else v for v in t])
-    if x_key:
+    if x_key and all("tip_transverse" in r for r in ok):
         fig, axes = plt.subplots(1, len(panels), figsize=(5.5 * len(panels), 4), squeeze=False,
                                  constrained_layout=True)
         for ax, panel in zip(axes[0], panels):
@@ -86,10 +136,17 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
     if pts:
         fig, ax = plt.subplots(figsize=(6, 4.2), constrained_layout=True)
         groups = sorted({r.get(nodes_key, "") for r in pts}, key=_num)
+        markers = {dt: m for dt, m in zip(sorted({r.get("solver.dt", "") for r in pts},
+                                                 key=_num), "osD^v<>p*")}
         for g in groups:
-            sel = [r for r in pts if r.get(nodes_key, "") == g]
-            ax.loglog([r["total_time_s"] for r in sel], [r[err_key] for r in sel], "o", ms=5,
-                      label=f"{g} nodes" if nodes_key else None)
+            for dt, marker in markers.items():
+                sel = [r for r in pts if r.get(nodes_key, "") == g and r.get("solver.dt", "") == dt]
+                if not sel:
+                    continue
+                label = (f"{g} nodes" if nodes_key else "") + (f", dt {dt}" if len(markers) > 1
+                                                               else "")
+                ax.loglog([r["total_time_s"] for r in sel], [r[err_key] for r in sel], marker,
+                          ms=5, color=f"C{groups.index(g) % 10}", label=label or None)
         ax.set_xlabel("wall time per case (s)")
         ax.set_ylabel(err_key.replace("_", " "))
         ax.set_title("what accuracy costs in time")
@@ -98,6 +155,51 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
             ax.legend(fontsize=8)
         path = outdir / "error_vs_time.png"
         fig.savefig(path, dpi=120)
+        plt.close(fig)
+        out.append(path)
+    return out
+
+
+def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
+    """Tip sag histories of every node count (at the finest dt), the whole run and one
+    panel per luffing stage (the paper's Figs. 6-15); one figure per value of the other
+    varied keys."""
+    import h5py as _h5
+    others = [k for k in keys if k not in ("beam.nodes", "solver.dt")]
+    finest_dt = min((float(r["solver.dt"]) for r in rows if "solver.dt" in r), default=None)
+    chosen = [r for r in rows if finest_dt is None or float(r["solver.dt"]) == finest_dt]
+    out = []
+    for panel in sorted({tuple(r[k] for k in others) for r in chosen}):
+        members = sorted([r for r in chosen if tuple(r[k] for k in others) == panel],
+                         key=lambda r: _num(r.get("beam.nodes", 0)))
+        stages = [s for s in STAGE_COLOURS if f"stage_{s}_t0" in members[0]]
+        fig = plt.figure(figsize=(11, 7.5), constrained_layout=True)
+        grid = fig.add_gridspec(2, max(len(stages), 1))
+        whole = fig.add_subplot(grid[0, :])
+        zooms = [fig.add_subplot(grid[1, i]) for i in range(len(stages))]
+        for row in members:
+            with _h5.File(row["file"], "r") as h5:
+                t = h5["dynamic/time"][()]
+                sag = 1e3 * h5["dynamic/deflection/tip"][:, 1]
+            label = f"{row.get('beam.nodes', '')} nodes"
+            whole.plot(t, sag, lw=0.9, label=label)
+            for ax, stage in zip(zooms, stages):
+                mask = (t >= row[f"stage_{stage}_t0"]) & (t <= row[f"stage_{stage}_t1"])
+                ax.plot(t[mask], sag[mask], lw=0.9)
+        for stage in stages:
+            whole.axvspan(members[0][f"stage_{stage}_t0"], members[0][f"stage_{stage}_t1"],
+                          color=STAGE_COLOURS[stage], lw=0)
+        for ax, stage in zip(zooms, stages):
+            ax.set_title(stage, fontsize=9)
+            ax.set_facecolor(STAGE_COLOURS[stage])
+            ax.set_xlabel("time (s)")
+        whole.set_ylabel("tip sag (mm)")
+        whole.set_title(", ".join(f"{k} = {v}" for k, v in zip(others, panel))
+                        + (f" (dt = {finest_dt:g} s)" if finest_dt else ""), fontsize=9)
+        whole.legend(fontsize=8, ncol=len(members))
+        name = "histories" + "".join(f"_{k.split('.')[1]}-{v}" for k, v in zip(others, panel))
+        path = outdir / f"{name}.png"
+        fig.savefig(path, dpi=110)
         plt.close(fig)
         out.append(path)
     return out

@@ -94,6 +94,15 @@ def read_summary(path: Path) -> dict[str, Any]:
             for name in static["deflection"]:
                 out[f"static.deflection.{name}"] = static["deflection"][name][()]
                 out[f"static.probes.{name}"] = static["probes"][name][()]
+        if "dynamic" in h5:
+            dynamic = h5["dynamic"]
+            out.update({f"dynamic.{k}": v for k, v in dynamic.attrs.items()})
+            if "stages" in dynamic:
+                out.update({f"stages.{k}": v for k, v in dynamic["stages"].attrs.items()})
+            if len(dynamic["time"]):
+                out["dynamic.t_reached"] = float(dynamic["time"][-1])
+                for name in dynamic["deflection"]:
+                    out[f"dynamic.deflection.{name}.final"] = dynamic["deflection"][name][-1]
         if "timing" in h5:
             out.update({f"timing.{k}": v for k, v in h5["timing"].attrs.items()})
         if "counters" in h5:

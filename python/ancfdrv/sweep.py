@@ -16,6 +16,8 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 from typing import Any
 
+import h5py
+import numpy as np
 from tqdm import tqdm
 
 from .errors import AncfError, InputError
@@ -59,15 +61,52 @@ def run_case(scene_file: str, params: dict[str, str], base: list[str], output: s
     except AncfError as exc:
         row.update(status="failed", message=str(exc), exit_code=exc.exit_code)
         return row
-    static = outcome.static
     from .results import read_summary
     summary = read_summary(Path(output))
-    axial, transverse, lateral = summary["static.deflection.tip"]
-    row.update(status="ok", message="", exit_code=0, tip_axial=axial, tip_transverse=transverse,
-               tip_lateral=lateral, iterations=static.iterations,
-               residual=static.residual_norm, solve_time_s=static.wall_time_s,
-               total_time_s=summary["timing.total"], ndof=summary["model.ndof"])
+    row.update(status="ok", message="", exit_code=0, total_time_s=summary["timing.total"],
+               ndof=summary["model.ndof"])
+    static, dynamic = outcome.static, outcome.dynamic
+    if static is not None:
+        axial, transverse, lateral = summary["static.deflection.tip"]
+        row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral,
+                   iterations=static.iterations, residual=static.residual_norm,
+                   solve_time_s=static.wall_time_s)
+    if dynamic is not None:
+        row.update(dynamic=True, steps=dynamic.steps, newton_iterations=dynamic.newton_iterations,
+                   factorizations=dynamic.factorizations, dynamic_time_s=dynamic.wall_time_s,
+                   **{f"stage_{k}": v for k, v in outcome.stages.items()})
     return row
+
+
+def _tip_history(path: str) -> tuple[np.ndarray, np.ndarray]:
+    with h5py.File(path, "r") as h5:
+        return h5["dynamic/time"][()], h5["dynamic/deflection/tip"][:, 1]
+
+
+def add_history_errors(rows: list[dict], varied: list[str]) -> None:
+    """Dynamic cases: against the finest case with the same other keys, the amplitude
+    error max|y - y_ref| / max|y_ref| of the tip sag history, and the phase error
+    accumulated over the vibration stage, 360 (f - f_ref) T_vib in degrees, from
+    zero-crossing frequencies."""
+    from .history import crossing_frequency
+    for members, finest in _reference_groups(rows, varied):
+        t_ref, y_ref = _tip_history(finest["file"])
+        scale = max(np.abs(y_ref).max(), 1e-300)
+        t0, t1 = finest.get("stage_vibration_t0"), finest.get("stage_vibration_t1")
+        f_ref = None
+        if t0 is not None:
+            mask = t_ref >= t0
+            f_ref = crossing_frequency(t_ref[mask], y_ref[mask])
+        for row in members:
+            t, y = _tip_history(row["file"])
+            common = t_ref <= t[-1]
+            row["err_vs_finest"] = float(np.abs(np.interp(t_ref[common], t, y)
+                                                - y_ref[common]).max() / scale)
+            if f_ref is not None:
+                mask = t >= t0
+                f = crossing_frequency(t[mask], y[mask])
+                row["vibration_frequency_hz"] = f
+                row["phase_err_deg"] = float(360.0 * (f - f_ref) * (t1 - t0))
 
 
 def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | None:
@@ -90,8 +129,8 @@ def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | No
     return abs(row["tip_transverse"] - reference) / max(abs(reference), 1e-300)
 
 
-def add_errors(rows: list[dict], varied: list[str]) -> None:
-    """err_vs_finest per row: against the finest resolution with the other keys equal."""
+def _reference_groups(rows: list[dict], varied: list[str]):
+    """(members, finest) per group of successful rows equal in the non-resolution keys."""
     resolution = [k for k in varied if k in RESOLUTION_KEYS]
     others = [k for k in varied if k not in RESOLUTION_KEYS]
     groups: dict[tuple, list[dict]] = {}
@@ -102,7 +141,15 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
         def rank(row: dict) -> tuple:
             return tuple((-1 if RESOLUTION_KEYS[k] is max else 1) * float(row[k])
                          for k in resolution)
-        finest = min(members, key=rank)
+        yield members, min(members, key=rank)
+
+
+def add_errors(rows: list[dict], varied: list[str]) -> None:
+    """err_vs_finest per row: against the finest resolution with the other keys equal."""
+    if any(r.get("dynamic") for r in rows):
+        add_history_errors(rows, varied)
+        return
+    for members, finest in _reference_groups(rows, varied):
         for row in members:
             ref = finest["tip_transverse"]
             row["err_vs_finest"] = abs(row["tip_transverse"] - ref) / max(abs(ref), 1e-300)
@@ -150,7 +197,7 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
     rows.sort(key=lambda r: order[case_name({k: r[k] for k in keys})])
     add_errors(rows, keys)
     for row in rows:
-        if row["status"] == "ok":
+        if row["status"] == "ok" and not row.get("dynamic"):
             err = closed_form_error(scene_file, row, base)
             if err is not None:
                 row["err_vs_closed_form"] = err
@@ -160,13 +207,19 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
     return rows
 
 
-COLUMNS = [("tip_transverse", "tip sag (mm)", 1e3, "{:.4f}"),
+COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
            ("tip_transverse_closed_form", "closed form (mm)", 1e3, "{:.4f}"),
            ("err_vs_closed_form", "err vs closed form", 1.0, "{:.2e}"),
            ("err_vs_finest", "err vs finest", 1.0, "{:.2e}"),
+           ("phase_err_deg", "phase err (deg)", 1.0, "{:+.2f}"),
+           ("vibration_frequency_hz", "f vib (Hz)", 1.0, "{:.4f}"),
            ("iterations", "iterations", 1, "{}"),
            ("solve_time_s", "solve time (ms)", 1e3, "{:.2f}"),
-           ("total_time_s", "case time (ms)", 1e3, "{:.1f}"),
+           ("steps", "steps", 1, "{}"),
+           ("newton_iterations", "Newton", 1, "{}"),
+           ("factorizations", "factor.", 1, "{}"),
+           ("dynamic_time_s", "dynamic (s)", 1.0, "{:.3f}"),
+           ("total_time_s", "case time (s)", 1.0, "{:.3f}"),
            ("status", "status", None, "{}")]
 
 
@@ -195,9 +248,13 @@ def write_report(rows: list[dict], keys: list[str], outdir: Path) -> None:
         for row in rows:
             writer.writerow(row)
     failed = [r for r in rows if r["status"] != "ok"]
-    lines = ["# Sweep summary", "", f"{len(rows)} cases, {len(failed)} failed. Error is the "
-             "relative difference of the tip sag (transverse tip deflection in the rigid frame); "
-             "times are wall-clock seconds of this machine.", ""]
+    dynamic = any(r.get("dynamic") for r in rows)
+    what = ("max |sag(t) - sag_ref(t)| / max |sag_ref| over the history; the phase error is "
+            "accumulated over the vibration stage" if dynamic else
+            "the relative difference of the tip sag")
+    lines = ["# Sweep summary", "", f"{len(rows)} cases, {len(failed)} failed. Error against "
+             f"the finest case: {what} (tip sag = transverse tip deflection in the rigid frame). "
+             "Times are wall-clock seconds of this machine.", ""]
     lines += table_lines(rows, keys)
     for row in failed:
         lines += ["", f"- {case_name({k: row[k] for k in keys})}: {row['message']}"]
