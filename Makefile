@@ -12,14 +12,20 @@ STAMP := $(VENV)/.ancfdrv-installed
 APT_PACKAGES := gfortran libmumps-seq-dev liblapack-dev libopenblas-dev pkg-config
 SOURCES := $(shell find fortran python -name '*.f90' -o -name '*.py' -o -name '.f2py_f2cmap') \
            meson.build pyproject.toml
-DEMO_OUT := results/boom_static_sweep
+DEMO_STATIC := results/boom_static_sweep
+DEMO_LUFFING := results/boom_luffing_sweep
 
 .PHONY: demo test install system-packages clean benchmark
 
 demo: $(STAMP)
+	@echo "== Statics (seed 000, Figs. 4-5): 5 angles x 2 masses x 5 meshes, against the closed form"
 	$(VENV)/bin/ancf sweep inputs/boom_static.nml --vary boom.angle_deg=0,15,30,45,60 \
-	    --vary loads.tip_mass=0,50 --vary beam.nodes=4,10,16,22,28 -o $(DEMO_OUT)
-	$(VENV)/bin/ancf run inputs/boom_static.nml --set boom.angle_deg=30 -o results/boom_static_30deg.h5
+	    --vary loads.tip_mass=0,50 --vary beam.nodes=4,10,16,22,28 -o $(DEMO_STATIC)
+	@echo "== Luffing dynamics (seed 000, Figs. 6-15): 2 masses x 5 meshes x 2 time steps"
+	$(VENV)/bin/ancf sweep inputs/boom_luffing.nml --vary loads.tip_mass=0,50 \
+	    --vary beam.nodes=4,10,16,22,28 --vary solver.dt=2e-3,1e-3 -o $(DEMO_LUFFING)
+	@echo "== One luffing run, 28 nodes, 50 kg"
+	$(VENV)/bin/ancf run inputs/boom_luffing.nml -o results/boom_luffing.h5
 
 test: $(STAMP)
 	$(PY) -m pytest -q
