@@ -115,6 +115,20 @@ contains
     end do
   end subroutine rotate_all
 
+  !> Constraint values and gradients at (e, t) (velocities only feed terms not used here).
+  !> info = 5 when a constraint or drive cannot be evaluated.
+  subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
+    type(ffr_system), intent(in) :: sys
+    real(dp), intent(in) :: e(:), t
+    real(dp), intent(out) :: phi(:), gradients(:, :)
+    integer, intent(out) :: info
+    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    call constraint_eval(sys%ncon, sys%con_ints, sys%con_reals, size(sys%drive_kinds), &
+                         sys%drive_kinds, sys%drive_params, sys%ndof, e, e, t, phi, gradients, &
+                         hessians, phi_t, phi_tt, gamma, info)
+    if (info /= 0) info = 5
+  end subroutine evaluate_constraints
+
   !> Residual r = M a + Q_el(e) - Q(e) - Phi_e^T lambda at time t, with the constraint
   !> values and gradients, the strain energy and the frame power dU/dt.
   subroutine residual(sys, t, e, acceleration, lam, rotation, r, phi, gradients, strain, info)
@@ -123,7 +137,6 @@ contains
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :), strain
     integer, intent(out) :: info
     real(dp) :: elastic(sys%ndof), inertia(sys%ndof), force(3), jacobian(3, 3), hessian(3, 3, 3)
-    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
     integer :: m, c, i
     call ffr_force(sys%ndof, sys%nel, sys%dofs, sys%stiffness0, rotation, e, sys%e0_frame, &
                    elastic, strain)
@@ -138,13 +151,8 @@ contains
       end if
       r(sys%moment_dofs(:, m)) = r(sys%moment_dofs(:, m)) - force
     end do
-    call constraint_eval(sys%ncon, sys%con_ints, sys%con_reals, size(sys%drive_kinds), &
-                         sys%drive_kinds, sys%drive_params, sys%ndof, e, e, t, phi, gradients, &
-                         hessians, phi_t, phi_tt, gamma, info)
-    if (info /= 0) then
-      info = 5
-      return
-    end if
+    call evaluate_constraints(sys, e, t, phi, gradients, info)
+    if (info /= 0) return
     do c = 1, sys%ncon
       do i = 1, 6
         if (sys%con_ints(2 + i, c) > 0) r(sys%con_ints(2 + i, c)) = &
@@ -312,17 +320,11 @@ contains
     real(dp), intent(in) :: e(:), v(:), lam(:), rotation(3, 3), rate, t
     real(dp), intent(out) :: powers(2), strain
     integer, intent(out) :: info
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), hessians(6, 6, sys%ncon)
-    real(dp) :: phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: frame_coords(24), local(24), frame_force(24), k(3), x(3)
     integer :: el, b
-    call constraint_eval(sys%ncon, sys%con_ints, sys%con_reals, size(sys%drive_kinds), &
-                         sys%drive_kinds, sys%drive_params, sys%ndof, e, v, t, phi, gradients, &
-                         hessians, phi_t, phi_tt, gamma, info)
-    if (info /= 0) then
-      info = 5
-      return
-    end if
+    call evaluate_constraints(sys, e, t, phi, gradients, info)
+    if (info /= 0) return
     powers(1) = dot_product(lam, gradient_dot(sys, gradients, v))
     powers(2) = 0.0_dp
     strain = 0.0_dp
@@ -352,7 +354,6 @@ contains
     real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:), violation
     integer, intent(out) :: info
     real(dp) :: mv(sys%ndof), phi(sys%ncon), gradients(6, sys%ncon)
-    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
     integer :: p, a, m
     do p = 1, sys%nprobe
       probe(:, p) = 0.0_dp
@@ -373,13 +374,8 @@ contains
     energy(energy_total) = sum(energy(energy_kinetic:energy_moment))
     energy(work_drive) = work(1)
     energy(work_frame) = work(2)
-    call constraint_eval(sys%ncon, sys%con_ints, sys%con_reals, size(sys%drive_kinds), &
-                         sys%drive_kinds, sys%drive_params, sys%ndof, e, v, t, phi, gradients, &
-                         hessians, phi_t, phi_tt, gamma, info)
-    if (info /= 0) then
-      info = 5
-      return
-    end if
+    call evaluate_constraints(sys, e, t, phi, gradients, info)
+    if (info /= 0) return
     violation = maxval(abs(phi), mask=.true.)
     if (sys%ncon == 0) violation = 0.0_dp
   end subroutine record
