@@ -525,7 +525,7 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     machine = machine_info()
     if args.nodes:  # first calls (lazy imports, MUMPS/MPI start-up) stay out of the records
-        prepare(min(args.nodes), args).integrator.close()
+        prepare(min(NODES), args).integrator.close()
     records = []
     for nodes in args.nodes:
         t0 = time.perf_counter()

@@ -129,11 +129,14 @@ def test_wrong_size_and_type(write_scene, capsys):
     expect_input_error(["run", str(path)], capsys, "&beam nodes", "integer")
 
 
-def test_unknown_effect_and_unavailable_formulation(write_scene, capsys):
+def test_unknown_effect_and_formulation_conflicts(write_scene, capsys):
     path = write_scene(BOOM.replace("'bending_moment'", "'wind'"))
     expect_input_error(["run", str(path)], capsys, "&scene effects", "unknown effect 'wind'")
-    path = write_scene(BOOM.replace("formulation = 'ffr'", "formulation = 'nonlinear'"), "d.nml")
-    expect_input_error(["run", str(path)], capsys, "&scene formulation", "not available")
+    nonlinear = BOOM.replace("formulation = 'ffr'", "formulation = 'nonlinear'")
+    path = write_scene(nonlinear, "d.nml")
+    expect_input_error(["run", str(path)], capsys, "&solver static_method", "needs")
+    path = write_scene(nonlinear.replace("analysis = 'static'", "analysis = 'dynamic'"), "e.nml")
+    expect_input_error(["run", str(path)], capsys, "&scene formulation", "static analyses only")
 
 
 def test_solver_failure_exit_3_keeps_file(write_scene, tmp_path, capsys):

@@ -44,6 +44,61 @@ subroutine beam_gravity(nel, lengths, width, height, density, gravity, gravity_f
   end do
 end subroutine beam_gravity
 
+!> Number of Gauss points per element of the large-deformation beam.
+subroutine beam_nonlinear_points(npts)
+  use beam_nonlinear, only: nonlinear_points
+  implicit none
+  integer, intent(out) :: npts
+  npts = nonlinear_points
+end subroutine beam_nonlinear_points
+
+!> Material shape-function gradients and weights at the Gauss points of every element,
+!> computed once from the reference configuration. info = 10*element + code.
+subroutine beam_nonlinear_setup(nel, npts, reference, lengths, width, height, gradients, &
+                                weights, info)
+  use ancf_kinds, only: dp
+  use beam_nonlinear, only: nonlinear_setup
+  implicit none
+  integer, intent(in) :: nel, npts
+  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), width, height
+  real(dp), intent(out) :: gradients(8, 3, npts, nel), weights(npts, nel)
+  integer, intent(out) :: info
+  integer :: el, code
+  info = 0
+  do el = 1, nel
+    call nonlinear_setup(reference(:, :, el), lengths(el), width, height, gradients(:, :, :, el), &
+                         weights(:, el), code)
+    if (code /= 0) then
+      info = 10 * el + code
+      return
+    end if
+  end do
+end subroutine beam_nonlinear_setup
+
+!> Large-deformation elastic force (global), strain energy and, when want_tangent /= 0,
+!> the element tangents (24 x 24 x nel) of a beam mesh.
+subroutine beam_nonlinear_forces(ndof, nel, npts, dofs, e, gradients, weights, youngs, poisson, &
+                                 want_tangent, force, energy, tangent)
+  use ancf_kinds, only: dp
+  use beam_nonlinear, only: nonlinear_element
+  implicit none
+  integer, intent(in) :: ndof, nel, npts, dofs(24, nel), want_tangent
+  real(dp), intent(in) :: e(ndof), gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
+  real(dp), intent(out) :: force(ndof), energy, tangent(24, 24, nel)
+  real(dp) :: element_force(24), element_energy
+  integer :: el
+  force = 0.0_dp
+  energy = 0.0_dp
+  tangent = 0.0_dp
+  do el = 1, nel
+    call nonlinear_element(reshape(e(dofs(:, el)), [3, 8]), gradients(:, :, :, el), weights(:, el), &
+                           youngs, poisson, want_tangent /= 0, element_force, element_energy, &
+                           tangent(:, :, el))
+    force(dofs(:, el)) = force(dofs(:, el)) + element_force
+    energy = energy + element_energy
+  end do
+end subroutine beam_nonlinear_forces
+
 !> Shape functions and their parameter derivatives at npts material points.
 subroutine beam_shape_functions(npts, xi, y, z, lengths, shape, dshape_dx, dshape_dy, dshape_dz)
   use ancf_kinds, only: dp

@@ -13,6 +13,7 @@
 module beam_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
+  use matrix3, only: invert3
   implicit none
   private
   public :: beam_shape, beam_mass_compact, beam_gravity_compact, &
@@ -197,26 +198,5 @@ contains
       elasticity(i + 3, i + 3) = shear
     end do
   end subroutine isotropic_elasticity
-
-  !> Inverse and determinant of a 3 x 3 matrix (inverse left at zero when singular).
-  pure subroutine invert3(matrix, inverse, det)
-    real(dp), intent(in) :: matrix(3, 3)
-    real(dp), intent(out) :: inverse(3, 3), det
-    inverse(1, 1) = matrix(2, 2) * matrix(3, 3) - matrix(2, 3) * matrix(3, 2)
-    inverse(1, 2) = matrix(1, 3) * matrix(3, 2) - matrix(1, 2) * matrix(3, 3)
-    inverse(1, 3) = matrix(1, 2) * matrix(2, 3) - matrix(1, 3) * matrix(2, 2)
-    inverse(2, 1) = matrix(2, 3) * matrix(3, 1) - matrix(2, 1) * matrix(3, 3)
-    inverse(2, 2) = matrix(1, 1) * matrix(3, 3) - matrix(1, 3) * matrix(3, 1)
-    inverse(2, 3) = matrix(1, 3) * matrix(2, 1) - matrix(1, 1) * matrix(2, 3)
-    inverse(3, 1) = matrix(2, 1) * matrix(3, 2) - matrix(2, 2) * matrix(3, 1)
-    inverse(3, 2) = matrix(1, 2) * matrix(3, 1) - matrix(1, 1) * matrix(3, 2)
-    inverse(3, 3) = matrix(1, 1) * matrix(2, 2) - matrix(1, 2) * matrix(2, 1)
-    det = matrix(1, 1) * inverse(1, 1) + matrix(1, 2) * inverse(2, 1) + matrix(1, 3) * inverse(3, 1)
-    if (det /= 0.0_dp) then
-      inverse = inverse / det
-    else
-      inverse = 0.0_dp
-    end if
-  end subroutine invert3
 
 end module beam_element

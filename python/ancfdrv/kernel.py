@@ -52,6 +52,25 @@ def beam_point_mass(xi, y, z, length, mass) -> np.ndarray:
     return _kernel.beam_point_mass(xi, y, z, length, mass)
 
 
+def beam_nonlinear_setup(reference, lengths, width, height):
+    """Material gradients (8, 3, npts, nel) and weights (npts, nel) at the Gauss points of
+    the large-deformation beam, from the reference configuration (3, 8, nel)."""
+    npts = int(_kernel.beam_nonlinear_points())
+    gradients, weights, info = _kernel.beam_nonlinear_setup(npts, _f(reference), _f(lengths),
+                                                            width, height)
+    if info:
+        element, code = divmod(info, 10)
+        raise InputError(f"beam element {element}: degenerate reference geometry "
+                         f"(det J0 <= 0, code {code})")
+    return gradients, weights
+
+
+def beam_nonlinear_forces(dofs, e, gradients, weights, youngs, poisson, want_tangent: bool):
+    """Large-deformation elastic force, strain energy and element tangents (24, 24, nel)."""
+    return _kernel.beam_nonlinear_forces(_f(dofs + 1, np.int32), _f(e), gradients, weights,
+                                         youngs, poisson, int(want_tangent))
+
+
 def ffr_force(dofs, stiffness0, rotation, e, e0_frame):
     """FFR elastic force T K0 (T^T e - e0) and strain energy. ``dofs`` are 0-based (24, nel)."""
     return _kernel.ffr_elastic_force(_f(dofs + 1, np.int32), stiffness0, _f(rotation), _f(e),

@@ -77,6 +77,8 @@ class BeamModel:
     frame_drive: int = 0          # drive of the frame angle (0: the frame is fixed)
     frame_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     frame_base: np.ndarray | None = None  # A(t) = Rot(axis, phi(t)) frame_base
+    formulation: str = "ffr"      # 'ffr' (small strain in the frame) or 'nonlinear'
+    load_factor: float = 1.0      # scales every external load (load stepping)
     constraints: ConstraintSet = field(default_factory=ConstraintSet)
     moments: list[Moment] = field(default_factory=list)
     point_masses: list[tuple[int, float]] = field(default_factory=list)
@@ -103,6 +105,10 @@ class BeamModel:
             self.lengths, self.width, self.height, self.density, self.youngs, self.poisson,
             reference)
         self.counters["element_arrays"] += self.nel
+        if self.formulation == "nonlinear":
+            self.gauss_gradients, self.gauss_weights = kernel.beam_nonlinear_setup(
+                self.to_global(self.e0_frame)[self.dofs].reshape(3, 8, self.nel, order="F"),
+                self.lengths, self.width, self.height)
         self.pattern = kernel.SparsePattern(self.ndof, self.dofs)
         self._gravity_force: np.ndarray | None = None
         self._point_force = np.zeros(self.ndof)
@@ -162,19 +168,37 @@ class BeamModel:
         self.counters["elastic_force"] += 1
         return kernel.ffr_force(self.dofs, self.stiffness0, self.frame_at(t), e, self.e0_frame)
 
+    def internal_force(self, e: np.ndarray, t: float = 0.0,
+                       want_tangent: bool = False) -> tuple[np.ndarray, float, np.ndarray | None]:
+        """Elastic force, strain energy and (nonlinear, on request) the CSR values of the
+        tangent, for the scene's formulation."""
+        if self.formulation == "ffr":
+            force, energy = self.elastic_force_at(e, t)
+            return force, energy, self.stiffness_values() if want_tangent else None
+        self.counters["elastic_force"] += 1
+        force, energy, tangent = kernel.beam_nonlinear_forces(
+            self.dofs, e, self.gauss_gradients, self.gauss_weights, self.youngs, self.poisson,
+            want_tangent)
+        if want_tangent:
+            self.counters["stiffness_assembly"] += 1
+            return force, energy, self.pattern.assemble(tangent)
+        return force, energy, None
+
     def constant_force(self) -> np.ndarray:
-        """Configuration-independent loads of the listed effects (gravity, tip loads)."""
+        """Configuration-independent loads of the listed effects (gravity, tip loads),
+        times the load factor."""
         force = self._point_force.copy()
         if self._gravity_force is not None:
             force += self._gravity_force
-        return force
+        return self.load_factor * force
 
     def moment_terms(self, e: np.ndarray):
         """Per moment: (dofs, force, Jacobian, Hessian) at e."""
         out = []
         for moment in self.moments:
             self.counters[moment.effect] += 1
-            f, j, h = kernel.moment_force(e[moment.dofs], moment.axis, moment.magnitude)
+            f, j, h = kernel.moment_force(e[moment.dofs], moment.axis,
+                                          self.load_factor * moment.magnitude)
             out.append((moment.dofs, f, j, h))
         return out
 
@@ -236,7 +260,8 @@ def _model(scene: Scene, rotation: np.ndarray, offset: np.ndarray) -> BeamModel:
     return BeamModel(node_s=_mesh(scene), width=beam["width"], height=beam["height"],
                      density=material["density"], youngs=material["youngs_modulus"],
                      poisson=material["poisson_ratio"], rotation=rotation,
-                     origin_offset=offset, effects=scene.effects)
+                     origin_offset=offset, effects=scene.effects,
+                     formulation=scene["scene"]["formulation"])
 
 
 def _apply_loads(model: BeamModel, scene: Scene) -> None:

@@ -100,7 +100,8 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
         if analysis in ("static", "static+dynamic"):
             solver = scene["solver"]
             static = solve_static(model, solver["static_method"], tol=solver["tol"],
-                                  max_iter=solver["max_iter"], p=solver["split_p"])
+                                  max_iter=solver["max_iter"], p=solver["split_p"],
+                                  load_steps=solver["load_steps"])
             for phase, seconds in static.timing.items():
                 timing[f"static_{phase}"] = seconds
             t0 = time.perf_counter()

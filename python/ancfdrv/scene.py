@@ -107,6 +107,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                    "relative tolerance of the static solve"),
         "max_iter": Key("int", 50, positive, "iteration limit of the static solve"),
+        "load_steps": Key("int", 1, positive, "load increments of the static Newton solve "
+                          "(large deformation)"),
         "split_p": Key("float", 0.0, within(0.0, 1.0, open_hi=True),
                        "splitting parameter p of K_RR = K_RR1 + K_RR2, in [0, 1)"),
         "dt": Key("float", 1e-3, positive, "time step (s), dynamic analyses"),
@@ -302,9 +304,14 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
             raise InputError(f"unknown effect {effect!r}; known effects: "
                              f"{', '.join(EFFECTS_AVAILABLE)}", file=file, group="scene",
                              key="effects")
-    if scene["formulation"] != "ffr":
-        raise InputError(f"formulation {scene['formulation']!r} is not available in this "
-                         "version; only 'ffr' is", file=file, group="scene", key="formulation")
+    if scene["formulation"] == "nonlinear":
+        if scene["analysis"] != "static":
+            raise InputError("formulation 'nonlinear' is available for static analyses only in "
+                             "this version", file=file, group="scene", key="formulation")
+        if values["solver"]["static_method"] != "newton":
+            raise InputError("formulation 'nonlinear' needs static_method = 'newton' (the split "
+                             "iteration relies on the constant FFR stiffness)", file=file,
+                             group="solver", key="static_method")
     beam = values["beam"]
     if beam["segments"] is None:
         beam["segments"] = [beam["length"]]

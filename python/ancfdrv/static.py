@@ -62,14 +62,14 @@ def converged(force_res: float, con_res: float, step: float, size: float, tol: f
     return ""
 
 
-def residuals(model: BeamModel, d: np.ndarray, lam: np.ndarray, stiffness: sp.csr_matrix):
-    """Relative force residual |K d - Q - Phi_e^T lam| / scale and max |Phi| / length at the
-    displacement d = e - e0 (carried instead of e so K d loses no digits)."""
+def residuals(model: BeamModel, d: np.ndarray, lam: np.ndarray, elastic: np.ndarray):
+    """Relative force residual |Q_el - Q - Phi_e^T lam| / scale and max |Phi| / length at the
+    displacement d = e - e0, given the elastic force Q_el (for FFR K d, computed from d so
+    it loses no digits)."""
     e = model.e0 + d
     values, rows, cols, grads = model.constraints.jacobian(e, model.ndof)
     reaction = np.zeros(model.ndof)
     np.add.at(reaction, cols, grads * lam[rows])
-    elastic = stiffness @ d
     external = model.external_force(e)
     residual = elastic - external - reaction
     scale = max(np.linalg.norm(external), np.linalg.norm(reaction), np.linalg.norm(elastic),
@@ -88,15 +88,30 @@ def _hessian_triplets(model: BeamModel, e: np.ndarray):
     return c_idx, table[a_idx, c_idx], table[b_idx, c_idx], hessians[a_idx, b_idx, c_idx]
 
 
-def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50) -> StaticResult:
-    """Full Newton-Raphson on (e, lambda) from the rigid configuration."""
+def _elastic_function(model: BeamModel):
+    """elastic(d, want_tangent) -> (Q_el, CSR tangent values or None) for the formulation:
+    FFR uses its constant K on d (no cancellation), the nonlinear beam its kernel."""
+    if model.formulation == "ffr":
+        k_values = model.stiffness_values()
+        stiffness = model.pattern.to_scipy(k_values)
+        return lambda d, want: (stiffness @ d, k_values if want else None)
+
+    def nonlinear(d: np.ndarray, want: bool):
+        force, _, tangent = model.internal_force(model.e0 + d, want_tangent=want)
+        return force, tangent
+    return nonlinear
+
+
+def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
+                 load_steps: int = 1) -> StaticResult:
+    """Full Newton-Raphson on (e, lambda) from the rigid configuration; the loads are
+    applied in ``load_steps`` equal increments (large deformation), each solved to tol."""
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)
     d, lam = np.zeros(n), np.zeros(ncon)
     t0 = time.perf_counter()
-    k_values = model.stiffness_values()
-    stiffness = model.pattern.to_scipy(k_values)
+    elastic = _elastic_function(model)
     h_con, h_rows, h_cols, h_vals = _hessian_triplets(model, model.e0)
     _, j_rows, j_cols, _ = model.constraints.jacobian(model.e0, n)
     m_rows = [np.repeat(m.dofs, 3) for m in model.moments]
@@ -104,48 +119,58 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50) ->
     rows = np.concatenate([model.pattern.rows, h_rows, *m_rows, n + j_rows, j_cols])
     cols = np.concatenate([model.pattern.col_index, h_cols, *m_cols, j_cols, n + j_rows])
     timing["assembly"] += time.perf_counter() - t0
-    history = []
+    history, total = [], 0
     with DirectSolver(n + ncon, rows, cols, what="static Newton saddle-point matrix") as solver:
         try:
-            for iteration in range(1, max_iter + 1):
-                t0 = time.perf_counter()
-                e = model.e0 + d
-                phi, _, _, grads = model.constraints.jacobian(e, n)
-                reaction = np.zeros(n)
-                np.add.at(reaction, j_cols, grads * lam[j_rows])
-                moments = model.moment_terms(e)
-                external = model.constant_force()
-                for dofs, f, _, _ in moments:
-                    external[dofs] += f
-                residual = stiffness @ d - external - reaction
-                values = np.concatenate([k_values, -lam[h_con] * h_vals,
-                                         *[-j.ravel() for _, _, j, _ in moments], -grads, -grads])
-                timing["assembly"] += time.perf_counter() - t0
-                t0 = time.perf_counter()
-                solver.factorize(values)
-                timing["factorization"] += time.perf_counter() - t0
-                t0 = time.perf_counter()
-                step = solver.solve(np.concatenate([-residual, phi]))
-                timing["solve"] += time.perf_counter() - t0
-                if not np.all(np.isfinite(step)):
-                    raise SolverError(f"static Newton: non-finite step at iteration {iteration}")
-                d += step[:n]
-                lam += step[n:]
-                force_res, con_res = residuals(model, d, lam, stiffness)
-                history.append(force_res)
-                how = converged(force_res, con_res, np.linalg.norm(step[:n]), np.linalg.norm(d), tol)
-                if how:
-                    break
-            else:
-                raise SolverError(f"static Newton did not converge in {max_iter} iterations "
-                                  f"(relative residual {force_res:.3e}, constraint {con_res:.3e})")
+            for load_step in range(1, load_steps + 1):
+                model.load_factor = load_step / load_steps
+                for iteration in range(1, max_iter + 1):
+                    t0 = time.perf_counter()
+                    e = model.e0 + d
+                    phi, _, _, grads = model.constraints.jacobian(e, n)
+                    reaction = np.zeros(n)
+                    np.add.at(reaction, j_cols, grads * lam[j_rows])
+                    moments = model.moment_terms(e)
+                    external = model.constant_force()
+                    for dofs, f, _, _ in moments:
+                        external[dofs] += f
+                    internal, k_values = elastic(d, True)
+                    residual = internal - external - reaction
+                    values = np.concatenate([k_values, -lam[h_con] * h_vals,
+                                             *[-j.ravel() for _, _, j, _ in moments], -grads,
+                                             -grads])
+                    timing["assembly"] += time.perf_counter() - t0
+                    t0 = time.perf_counter()
+                    solver.factorize(values)
+                    timing["factorization"] += time.perf_counter() - t0
+                    t0 = time.perf_counter()
+                    step = solver.solve(np.concatenate([-residual, phi]))
+                    timing["solve"] += time.perf_counter() - t0
+                    if not np.all(np.isfinite(step)):
+                        raise SolverError(f"static Newton: non-finite step at iteration "
+                                          f"{iteration} of load step {load_step}")
+                    d += step[:n]
+                    lam += step[n:]
+                    force_res, con_res = residuals(model, d, lam, elastic(d, False)[0])
+                    history.append(force_res)
+                    how = converged(force_res, con_res, np.linalg.norm(step[:n]),
+                                    np.linalg.norm(d), tol)
+                    if how:
+                        break
+                else:
+                    raise SolverError(
+                        f"static Newton did not converge in {max_iter} iterations at load step "
+                        f"{load_step} of {load_steps} (relative residual {force_res:.3e}, "
+                        f"constraint {con_res:.3e}); raise solver.load_steps or max_iter")
+                total += iteration
         finally:
+            model.load_factor = 1.0
             model.counters["factorizations"] += solver.factorizations
             model.counters["solves"] += solver.solves
     wall = time.perf_counter() - start
     timing["total"] = wall
-    return StaticResult(model.e0 + d, lam, "newton", iteration, force_res, con_res, wall, history,
-                        timing, extra={"converged_by": how})
+    return StaticResult(model.e0 + d, lam, "newton", total, force_res, con_res, wall, history,
+                        timing, extra={"converged_by": how, "load_steps": load_steps})
 
 
 class Jet:
@@ -229,6 +254,9 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
     """
     if not 0.0 <= p < 1.0:
         raise SolverError(f"split iteration: p = {p} outside [0, 1)")
+    if model.formulation != "ffr":
+        raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
+                          "formulation; use solver.static_method = 'newton'")
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)
@@ -321,7 +349,7 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
         disp = np.zeros(n)
         disp[rest], disp[dep] = d_r, d_d_new
         d_d = d_d_new
-        force_res, con_res = residuals(model, disp, lam, stiffness)
+        force_res, con_res = residuals(model, disp, lam, stiffness @ disp)
         history.append(force_res)
         if not np.isfinite(force_res):
             raise SolverError(f"split iteration: non-finite state at pass {outer}")
@@ -341,10 +369,10 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
 
 
 def solve_static(model: BeamModel, method: str, *, tol: float, max_iter: int,
-                 p: float = 0.0) -> StaticResult:
+                 p: float = 0.0, load_steps: int = 1) -> StaticResult:
     """Dispatch on ``solver.static_method``."""
     if method == "newton":
-        return solve_newton(model, tol=tol, max_iter=max_iter)
+        return solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
     if method == "split":
         return solve_split(model, tol=tol, max_iter=max_iter, p=p)
     raise SolverError(f"unknown static method {method!r}")

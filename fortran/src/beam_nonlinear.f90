@@ -1,0 +1,169 @@
+!> Large-deformation elastic forces of the 12-coordinate ANCF beam (kinematics of
+!> beam_element): continuum mechanics with the Green-Lagrange strain and a St. Venant-
+!> Kirchhoff material, F = J J0^{-1} so a curved reference is strain-free (seed 003,
+!> eqs. 1-2). With the material gradients g_a = J0^{-T} grad N_a precomputed at the Gauss
+!> points,
+!>   F = sum_a q_a g_a^T,  E = (F^T F - I)/2,  S = D : E,
+!>   Q_a = int F S g_a dV0,  K_ab = int B_a^T D B_b dV0 + int (g_a^T S g_b) I3 dV0.
+!> At the reference (F = I, S = 0) the tangent equals the small-strain K0 of the FFR model.
+!>
+!> Poisson locking (the section fields are linear in y, z): D is split into the Poisson-free
+!> part D0 = diag(E, E, E, G, G, G), integrated over the whole section, and the Poisson
+!> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
+!> mechanics); with nu = 0 both coincide with the plain law.
+module beam_nonlinear
+  use ancf_kinds, only: dp
+  use quadrature, only: gauss_legendre
+  use beam_element, only: beam_shape
+  use matrix3, only: invert3
+  implicit none
+  private
+  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element
+
+  integer, parameter :: n_axial = 4, n_section = 2
+  !> Gauss points per element: the volume rule plus the neutral-axis points.
+  integer, parameter, public :: nonlinear_points = n_axial * n_section * n_section + n_axial
+
+contains
+
+  pure integer function nonlinear_rule_size()
+    nonlinear_rule_size = nonlinear_points
+  end function nonlinear_rule_size
+
+  !> Material gradients g_a (8, 3, point) and weights (volume element det J0 included) of
+  !> one element: first the n_axial x n_section^2 volume points, then the n_axial
+  !> neutral-axis points whose weights carry the section area. info = 2 for det J0 <= 0.
+  pure subroutine nonlinear_setup(reference, length, width, height, gradients, weights, info)
+    real(dp), intent(in) :: reference(3, 8), length, width, height
+    real(dp), intent(out) :: gradients(8, 3, nonlinear_points), weights(nonlinear_points)
+    integer, intent(out) :: info
+    real(dp) :: pa(n_axial), wa(n_axial), ps(n_section), ws(n_section)
+    real(dp) :: shape(8), dshape(8, 3), jac0(3, 3), inv0(3, 3), det0
+    integer :: i, j, k, p, info_section
+    call gauss_legendre(n_axial, pa, wa, info)
+    call gauss_legendre(n_section, ps, ws, info_section)
+    info = max(info, info_section)
+    if (info /= 0) return
+    p = 0
+    do k = 1, n_section + 1
+      do j = 1, n_section
+        do i = 1, n_axial
+          if (k <= n_section) then
+            p = p + 1
+            call beam_shape(0.5_dp * (pa(i) + 1.0_dp), 0.5_dp * height * ps(j), &
+                            0.5_dp * width * ps(k), length, shape, dshape(:, 1), dshape(:, 2), &
+                            dshape(:, 3))
+            weights(p) = wa(i) * ws(j) * ws(k) * 0.125_dp * length * height * width
+          else if (j == 1) then
+            p = p + 1
+            call beam_shape(0.5_dp * (pa(i) + 1.0_dp), 0.0_dp, 0.0_dp, length, shape, &
+                            dshape(:, 1), dshape(:, 2), dshape(:, 3))
+            weights(p) = wa(i) * 0.5_dp * length * height * width
+          else
+            cycle
+          end if
+          jac0 = matmul(reference, dshape)
+          call invert3(jac0, inv0, det0)
+          if (det0 <= 0.0_dp) then
+            info = 2
+            return
+          end if
+          gradients(:, :, p) = matmul(dshape, inv0)
+          weights(p) = weights(p) * det0
+        end do
+      end do
+    end do
+  end subroutine nonlinear_setup
+
+  !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
+  !> one element with nodal vectors q(3, 8).
+  pure subroutine nonlinear_element(q, gradients, weights, youngs, poisson, want_tangent, &
+                                    force, energy, tangent)
+    real(dp), intent(in) :: q(3, 8), gradients(8, 3, nonlinear_points), weights(nonlinear_points)
+    real(dp), intent(in) :: youngs, poisson
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, tangent(24, 24)
+    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: stress(6), stress_matrix(3, 3), b(6, 24), db(6, 24), sg(3), geometric
+    integer :: p, a, c
+    call split_laws(youngs, poisson, law_free, law_poisson)
+    force = 0.0_dp
+    energy = 0.0_dp
+    tangent = 0.0_dp
+    do p = 1, nonlinear_points
+      if (p <= n_axial * n_section * n_section) then
+        law = law_free
+      else
+        law = law_poisson
+        if (all(law == 0.0_dp)) cycle
+      end if
+      deformation = matmul(q, gradients(:, :, p))
+      call green_lagrange(deformation, strain)
+      stress = matmul(law, strain)
+      energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
+      call strain_matrix(deformation, gradients(:, :, p), b)
+      force = force + weights(p) * matmul(transpose(b), stress)
+      if (.not. want_tangent) cycle
+      db = matmul(law, b)
+      tangent = tangent + weights(p) * matmul(transpose(b), db)
+      stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
+                               stress(6), stress(5), stress(3)], [3, 3])
+      do a = 1, 8
+        sg = matmul(stress_matrix, gradients(a, :, p))
+        do c = 1, 8
+          geometric = weights(p) * dot_product(gradients(c, :, p), sg)
+          tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) = tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) + geometric
+          tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) = tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) + geometric
+          tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) = tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) + geometric
+        end do
+      end do
+    end do
+  end subroutine nonlinear_element
+
+  !> Green-Lagrange strain in Voigt form with engineering shears [E11, E22, E33, 2E12, 2E23, 2E13].
+  pure subroutine green_lagrange(deformation, strain)
+    real(dp), intent(in) :: deformation(3, 3)
+    real(dp), intent(out) :: strain(6)
+    real(dp) :: c(3, 3)
+    c = matmul(transpose(deformation), deformation)
+    strain = [0.5_dp * (c(1, 1) - 1.0_dp), 0.5_dp * (c(2, 2) - 1.0_dp), 0.5_dp * (c(3, 3) - 1.0_dp), &
+              c(1, 2), c(2, 3), c(1, 3)]
+  end subroutine green_lagrange
+
+  !> B(6, 24): d strain = B dq, columns (a, i) -> 3(a-1)+i.
+  pure subroutine strain_matrix(deformation, gradient, b)
+    real(dp), intent(in) :: deformation(3, 3), gradient(8, 3)
+    real(dp), intent(out) :: b(6, 24)
+    integer :: a, i, col
+    do a = 1, 8
+      do i = 1, 3
+        col = 3 * (a - 1) + i
+        b(1, col) = deformation(i, 1) * gradient(a, 1)
+        b(2, col) = deformation(i, 2) * gradient(a, 2)
+        b(3, col) = deformation(i, 3) * gradient(a, 3)
+        b(4, col) = deformation(i, 1) * gradient(a, 2) + deformation(i, 2) * gradient(a, 1)
+        b(5, col) = deformation(i, 2) * gradient(a, 3) + deformation(i, 3) * gradient(a, 2)
+        b(6, col) = deformation(i, 1) * gradient(a, 3) + deformation(i, 3) * gradient(a, 1)
+      end do
+    end do
+  end subroutine strain_matrix
+
+  !> D0 = diag(E, E, E, G, G, G) and the Poisson part D - D0 of the isotropic law.
+  pure subroutine split_laws(youngs, poisson, law_free, law_poisson)
+    real(dp), intent(in) :: youngs, poisson
+    real(dp), intent(out) :: law_free(6, 6), law_poisson(6, 6)
+    real(dp) :: lame, shear
+    integer :: i
+    lame = youngs * poisson / ((1.0_dp + poisson) * (1.0_dp - 2.0_dp * poisson))
+    shear = youngs / (2.0_dp * (1.0_dp + poisson))
+    law_free = 0.0_dp
+    law_poisson = 0.0_dp
+    law_poisson(1:3, 1:3) = lame
+    do i = 1, 3
+      law_free(i, i) = youngs
+      law_free(i + 3, i + 3) = shear
+      law_poisson(i, i) = lame + 2.0_dp * shear - youngs
+    end do
+  end subroutine split_laws
+
+end module beam_nonlinear
