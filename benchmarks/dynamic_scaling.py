@@ -3,7 +3,7 @@
 from the floor of one forward/back substitution.
 
 For every node count (3k+1) of the boom of ``inputs/boom_luffing.nml`` this prepares a run
-exactly as :func:`ancfdrv.runner.run_scene` does (``build_model``, static start with
+as :func:`ancfdrv.runner.run_scene` does for this scene (``build_model``, static start with
 ``solve_split``, :class:`ancfdrv.dynamic.NewmarkIntegrator`, consistent initial
 acceleration), integrates through the smooth start to the beginning of the luffing stage
 (:func:`ancfdrv.runner.boom_stages`, t = 1 s) and measures there, with
@@ -35,8 +35,8 @@ exponents d log t / d log ndof between consecutive meshes (1 = linear). Results:
 on stdout and JSON (machine info, one record per node count, growth exponents) in
 ``benchmarks/results/``. Run from the repository root::
 
-    python benchmarks/dynamic_scaling.py            # 4 ... 2002 nodes, about 1 min
-    python benchmarks/dynamic_scaling.py --quick    # up to 301 nodes
+    python benchmarks/dynamic_scaling.py            # 4 ... 2002 nodes, about 1.5 min
+    python benchmarks/dynamic_scaling.py --quick    # up to 301 nodes, 3 repeats
 """
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
@@ -143,7 +143,7 @@ def bandwidth(model: BeamModel) -> int:
     return int(np.max(np.abs(model.pattern.rows - model.pattern.col_index)))
 
 
-def prepare(nodes: int, args: argparse.Namespace) -> Prepared:
+def prepare(nodes: int) -> Prepared:
     """Build, solve the statics, set up the integrator and integrate to the window start,
     timing each phase once."""
     setup: dict[str, Any] = {}
@@ -151,7 +151,7 @@ def prepare(nodes: int, args: argparse.Namespace) -> Prepared:
     stages = boom_stages(scene)
     if stages is None:
         raise RuntimeError(f"{SCENE} does not luff: no {WINDOW_STAGE} stage to measure")
-    window = tuple(float(x) for x in stages[WINDOW_STAGE])
+    t_first, t_last = (float(x) for x in stages[WINDOW_STAGE])
     t0 = time.perf_counter()
     model = build_model(scene)
     setup["build_model_s"] = time.perf_counter() - t0
@@ -176,7 +176,7 @@ def prepare(nodes: int, args: argparse.Namespace) -> Prepared:
     state: State = dict(t=0.0, e=static.e.copy(), v=v0, a=a0, lam=lam0, work=np.zeros(2))
 
     # warm-up through the start stage, in the run's chunks: one pass, also a measurement
-    warm_steps = int(round((window[0] - state["t"]) / settings.dt))
+    warm_steps = int(round((t_first - state["t"]) / settings.dt))
     newton: list[np.ndarray] = []
     t0 = time.perf_counter()
     done = 0
@@ -189,9 +189,9 @@ def prepare(nodes: int, args: argparse.Namespace) -> Prepared:
     setup["start_stage"] = {"t": [0.0, state["t"]], "steps": warm_steps,
                             "step_s": elapsed / warm_steps if warm_steps else math.nan,
                             "newton_mean": float(counts.mean()) if counts.size else math.nan}
-    window_steps = int(math.floor((window[1] - state["t"]) / settings.dt + 1e-9))
+    window_steps = int(math.floor((t_last - state["t"]) / settings.dt + 1e-9))
     return Prepared(nodes, scene, model, settings, integrator, copy_state(state),
-                    (state["t"], window[1]), window_steps, setup)
+                    (state["t"], t_last), window_steps, setup)
 
 
 def time_steps(prep: Prepared, args: argparse.Namespace) -> dict[str, Any]:
@@ -211,9 +211,9 @@ def time_steps(prep: Prepared, args: argparse.Namespace) -> dict[str, Any]:
         spent = 0.0
         newton.clear()
         for _ in range(calls):
-            state = copy_state(prep.start)
+            run_state = copy_state(prep.start)
             t0 = time.perf_counter()
-            newton.append(advance_checked(integrator, state, nsteps))
+            newton.append(advance_checked(integrator, run_state, nsteps))
             spent += time.perf_counter() - t0
         return spent
 
@@ -235,9 +235,9 @@ def time_call_overhead(prep: Prepared, step_s: float, args: argparse.Namespace) 
     def sample(calls: int) -> float:
         spent = 0.0
         for _ in range(calls):
-            state = copy_state(prep.start)
+            run_state = copy_state(prep.start)
             t0 = time.perf_counter()
-            advance_checked(integrator, state, 1)
+            advance_checked(integrator, run_state, 1)
             spent += time.perf_counter() - t0
         return spent
 
@@ -277,7 +277,7 @@ def time_floor(prep: Prepared, args: argparse.Namespace) -> dict[str, Any]:
 
 def measure(nodes: int, args: argparse.Namespace) -> dict[str, Any]:
     """All measurements of one node count."""
-    prep = prepare(nodes, args)
+    prep = prepare(nodes)
     try:
         steps = time_steps(prep, args)
         overhead = time_call_overhead(prep, steps["step_s"], args)
@@ -485,15 +485,16 @@ def _nan_to_none(value: Any) -> Any:
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
-                        help=f"only node counts up to {QUICK_MAX_NODES}")
+                        help=f"only node counts up to {QUICK_MAX_NODES}, 3 repeats")
     parser.add_argument("--nodes", type=int, nargs="*", default=None,
                         help=f"node counts, each 3k+1 (default {' '.join(map(str, NODES))}); "
                              "none: only the run_scene measurement")
     parser.add_argument("--min-time", type=float, default=0.3,
                         help="seconds one sample takes at least (default 0.3)")
-    parser.add_argument("--repeats", type=int, default=5,
-                        help="samples per measurement, the fastest is kept (default 5: the "
-                             "speed of a shared machine drifts over seconds)")
+    parser.add_argument("--repeats", type=int, default=None,
+                        help="samples per measurement, the fastest is kept (default 5, 3 "
+                             "with --quick: the speed of a shared machine drifts over "
+                             "seconds)")
     parser.add_argument("--probe-steps", type=int, default=20,
                         help="steps of the probe that sizes a sample (default 20)")
     parser.add_argument("--bulk-rhs", type=int, default=32,
@@ -507,6 +508,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="JSON file (default benchmarks/results/dynamic_scaling.json, "
                              "dynamic_scaling_quick.json with --quick)")
     args = parser.parse_args(argv)
+    if args.repeats is None:
+        args.repeats = 3 if args.quick else 5
     nodes = args.nodes if args.nodes is not None else [
         n for n in NODES if not args.quick or n <= QUICK_MAX_NODES]
     if any(n < 4 or (n - 1) % 3 for n in nodes + ([args.run_nodes] if args.run_nodes else [])):
@@ -525,7 +528,7 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     machine = machine_info()
     if args.nodes:  # first calls (lazy imports, MUMPS/MPI start-up) stay out of the records
-        prepare(min(NODES), args).integrator.close()
+        prepare(min(NODES)).integrator.close()
     records = []
     for nodes in args.nodes:
         t0 = time.perf_counter()

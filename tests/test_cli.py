@@ -135,8 +135,9 @@ def test_unknown_effect_and_formulation_conflicts(write_scene, capsys):
     nonlinear = BOOM.replace("formulation = 'ffr'", "formulation = 'nonlinear'")
     path = write_scene(nonlinear, "d.nml")
     expect_input_error(["run", str(path)], capsys, "&solver static_method", "needs")
-    path = write_scene(nonlinear.replace("analysis = 'static'", "analysis = 'dynamic'"), "e.nml")
-    expect_input_error(["run", str(path)], capsys, "&scene formulation", "static analyses only")
+    path = write_scene(nonlinear.replace("static_method = 'split'", "static_method = 'newton', "
+                                         "integrator = 'rk4'"), "e.nml")
+    expect_input_error(["run", str(path)], capsys, "&solver integrator", "must be one of")
 
 
 def test_solver_failure_exit_3_keeps_file(write_scene, tmp_path, capsys):

@@ -59,3 +59,15 @@ def test_singular_matrix_raises_clear_error():
             solver.factorize(np.array([1.0, 2.0, 2.0, 4.0]))
         with pytest.raises(SolverError, match="out of sequence"):
             solver.solve(np.ones(2))
+
+
+def test_scipy_view_owns_its_pattern():
+    """Regression: scipy shared the pattern's index arrays, and an in-place
+    eliminate_zeros on the matrix corrupted the model's sparsity pattern."""
+    dofs = np.array([[0, 1, 2], [1, 2, 3]]).T
+    pattern = SparsePattern(4, dofs)
+    before = pattern.col_index.copy(), pattern.row_ptr.copy()
+    matrix = pattern.to_scipy(np.zeros(pattern.nnz))
+    matrix.eliminate_zeros()
+    np.testing.assert_array_equal(pattern.col_index, before[0])
+    np.testing.assert_array_equal(pattern.row_ptr, before[1])

@@ -278,24 +278,30 @@ subroutine direct_destroy(handle, info)
   call solver_destroy(handle, info)
 end subroutine direct_destroy
 
-!> Advances nsteps Newmark steps of an ANCF-FFR beam (module newmark_ffr). The model
-!> arrays are those Python builds once; the state (t, e, v, a, lam, work) is updated in
-!> place; one output row per step. status(1) = steps done, status(2) = info,
-!> status(3) = detail, last_correction = size of the last Newton correction (see
-!> newmark_chunk).
-subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, nq, &
-                           dofs, stiffness0, e0_frame, mass_row_ptr, mass_col, mass_values, &
-                           constant_force, moment_dofs, moment_axis, moment_magnitude, &
-                           moment_reference, con_ints, con_reals, drive_kinds, drive_params, &
-                           frame_drive, frame_axis, frame_base, solver_handle, block_first, &
-                           flexibility, flexibility_cc, probe_dofs, probe_shape, probe_reference, &
-                           h, beta, gamma, tol, length_scale, max_newton, &
-                           t, e, v, a, lam, work, out_time, out_probe, out_deflection, out_lambda, &
-                           out_energy, out_constraint, out_newton, out_q, status, last_correction)
+!> Advances nsteps steps of the generalized-alpha method (Newmark: alpha_m = alpha_f = 0)
+!> for an ANCF beam (module time_integrator). formulation 0: ANCF-FFR, S factorized once
+!> by the caller behind solver_handle, with the flexibility given; 1: large deformation,
+!> S refactorized per step on the pattern (scatter_map, mass_pattern) of solver_handle.
+!> The state (t, e, v, a, accel, lam, work) is updated in place; one output row per step.
+!> status = [steps done, info, detail]; last_correction = size of the last Newton
+!> correction. Arrays of optional items carry max(1, n) columns (f2py refuses zero sizes).
+subroutine integrator_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, &
+                              nq, npts, ngauss, nnz_pattern, formulation, dofs, stiffness0, &
+                              e0_frame, mass_row_ptr, mass_col, mass_values, constant_force, &
+                              moment_dofs, moment_axis, moment_magnitude, moment_reference, &
+                              con_ints, con_reals, drive_kinds, drive_params, frame_drive, &
+                              frame_axis, frame_base, solver_handle, block_first, flexibility, &
+                              flexibility_cc, probe_dofs, probe_shape, probe_reference, youngs, &
+                              poisson, gauss_gradients, gauss_weights, scatter_map, mass_pattern, &
+                              h, beta, gamma, alpha_m, alpha_f, tol, length_scale, max_newton, &
+                              t, e, v, a, accel, lam, work, out_time, out_probe, out_deflection, &
+                              out_lambda, out_energy, out_constraint, out_newton, out_q, status, &
+                              last_correction)
   use ancf_kinds, only: dp
-  use newmark_ffr, only: ffr_system, newmark_settings, newmark_chunk
+  use time_integrator, only: beam_system, integrator_settings, integrator_chunk
   implicit none
   integer, intent(in) :: ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, nq
+  integer, intent(in) :: npts, ngauss, nnz_pattern, formulation
   integer, intent(in) :: dofs(24, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
   real(dp), intent(in) :: stiffness0(24, 24, nel), e0_frame(ndof), mass_values(nnz_mass)
   real(dp), intent(in) :: constant_force(ndof)
@@ -310,17 +316,21 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
   real(dp), intent(in) :: flexibility_cc(max(3, 3 * nblock), max(3, 3 * nblock))
   integer, intent(in) :: probe_dofs(24, nprobe)
   real(dp), intent(in) :: probe_shape(8, nprobe), probe_reference(3, nprobe)
-  real(dp), intent(in) :: h, beta, gamma, tol, length_scale
+  real(dp), intent(in) :: youngs, poisson, gauss_gradients(8, 3, npts, ngauss), gauss_weights(npts, ngauss)
+  integer, intent(in) :: scatter_map(24, 24, nel)
+  real(dp), intent(in) :: mass_pattern(nnz_pattern)
+  real(dp), intent(in) :: h, beta, gamma, alpha_m, alpha_f, tol, length_scale
   integer, intent(in) :: max_newton
-  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), lam(max(1, ncon)), work(2)
-  !f2py intent(in,out) :: t, e, v, a, lam, work
+  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), accel(ndof), lam(max(1, ncon)), work(2)
+  !f2py intent(in,out) :: t, e, v, a, accel, lam, work
   real(dp), intent(out) :: out_time(nsteps), out_probe(3, nprobe, nsteps)
   real(dp), intent(out) :: out_deflection(3, nprobe, nsteps), out_lambda(max(1, ncon), nsteps)
   real(dp), intent(out) :: out_energy(7, nsteps), out_constraint(nsteps), out_q(ndof, nq)
   integer, intent(out) :: out_newton(nsteps), status(3)
   real(dp), intent(out) :: last_correction
-  type(ffr_system) :: sys
-  type(newmark_settings) :: cfg
+  type(beam_system) :: sys
+  type(integrator_settings) :: cfg
+  sys%formulation = formulation
   sys%ndof = ndof
   sys%nel = nel
   sys%ncon = ncon
@@ -334,7 +344,6 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
   sys%mass_col = mass_col
   sys%mass_values = mass_values
   sys%constant_force = constant_force
-  ! arrays of optional items carry max(1, n) columns (f2py refuses zero sizes); use n
   sys%moment_dofs = moment_dofs(:, 1:nmoment)
   sys%moment_axis = moment_axis(:, 1:nmoment)
   sys%moment_magnitude = moment_magnitude(1:nmoment)
@@ -353,9 +362,19 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
   sys%probe_dofs = probe_dofs
   sys%probe_shape = probe_shape
   sys%probe_reference = probe_reference
+  sys%youngs = youngs
+  sys%poisson = poisson
+  if (formulation == 1) then
+    sys%gauss_gradients = gauss_gradients
+    sys%gauss_weights = gauss_weights
+    sys%scatter_map = scatter_map
+    sys%mass_pattern = mass_pattern
+  end if
   cfg%h = h
   cfg%beta = beta
   cfg%gamma = gamma
+  cfg%alpha_m = alpha_m
+  cfg%alpha_f = alpha_f
   cfg%tol = tol
   cfg%length_scale = length_scale
   cfg%max_newton = max_newton
@@ -367,7 +386,8 @@ subroutine newmark_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz
   out_constraint = 0.0_dp
   out_newton = 0
   out_q = 0.0_dp
-  call newmark_chunk(sys, cfg, nsteps, t, e, v, a, lam(1:ncon), work, out_time, out_probe, out_deflection, &
-                     out_lambda(1:ncon, :), out_energy, out_constraint, out_newton, nq == nsteps, out_q, &
-                     status(1), status(2), status(3), last_correction)
-end subroutine newmark_advance
+  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, out_time, out_probe, &
+                        out_deflection, out_lambda(1:ncon, :), out_energy, out_constraint, &
+                        out_newton, nq == nsteps, out_q, status(1), status(2), status(3), &
+                        last_correction)
+end subroutine integrator_advance

@@ -1,14 +1,17 @@
-"""Newmark dynamics of the constrained ANCF-FFR beam (seed 000, eqs. 58-62).
+"""Implicit dynamics of the constrained ANCF beam: Newmark (seed 000, eqs. 58-62) and
+generalized-alpha (Chung-Hulbert; Arnold-Bruels for constrained systems).
 
 Python prepares what never changes during a run and hands the stepping to the Fortran
-kernel (``fortran/src/newmark_ffr.f90``), which advances whole chunks of steps per call:
+kernel (``fortran/src/time_integrator.f90``), which advances whole chunks of steps per call:
 
-* S = M/(beta h^2) + K0 in the floating frame, factorized once by MUMPS. Because every
-  3 x 3 block of M is a scalar times I3, M/(beta h^2) + T K0 T^T = T S T^T for any frame
-  rotation A(t), so this one factorization serves every step of the run.
-* The flexibility S^{-1} E_c at the 3-vectors the constraints touch (one solve per
-  touched coordinate, once), from which the kernel builds the multipliers' Schur
-  complement at each Newton iteration without further solves.
+* ANCF-FFR: S = beta' M + K0 in the floating frame (beta' = (1 - alpha_m) / (beta h^2
+  (1 - alpha_f))), factorized once (banded Cholesky). Because every 3 x 3 block of M is a
+  scalar times I3, beta' M + T K0 T^T = T S T^T for any frame rotation A(t), so this one
+  factorization serves every step of the run; and the flexibility S^{-1} E_c at the
+  3-vectors the constraints touch (one solve per touched coordinate, once), from which the
+  kernel builds the multipliers' Schur complement without further solves.
+* Large deformation: the kernel refactorizes S = beta' M + K_t(q) once per step on the
+  same banded pattern, with the flexibility.
 * The consistent initial acceleration from [[M, -Phi_e^T], [-Phi_e, 0]] [a; lambda] =
   [Q - Q_el; -gamma].
 
@@ -46,16 +49,40 @@ _FAILURES = {
 
 @dataclass
 class DynamicSettings:
-    """Integrator settings (``&solver`` and ``&output`` of a scene)."""
+    """Integrator settings (``&solver`` and ``&output`` of a scene). Newmark is
+    alpha_m = alpha_f = 0; :meth:`generalized_alpha` sets all four from rho_inf."""
 
     dt: float
     t_end: float
     beta: float = 0.25
     gamma: float = 0.5
+    alpha_m: float = 0.0
+    alpha_f: float = 0.0
     tol: float = 1e-10
     max_newton: int = 10
     chunk_steps: int = 1000
     store_q: bool = False
+
+
+    @classmethod
+    def generalized_alpha(cls, dt: float, t_end: float, rho_inf: float,
+                          **kwargs) -> "DynamicSettings":
+        """Chung-Hulbert parameters for the spectral radius at infinity rho_inf in [0, 1]:
+        alpha_m = (2 rho - 1)/(rho + 1), alpha_f = rho/(rho + 1), gamma = 1/2 - alpha_m +
+        alpha_f, beta = (1 - alpha_m + alpha_f)^2 / 4 (second order, unconditionally stable,
+        high frequencies damped to rho_inf per step)."""
+        if not 0.0 <= rho_inf <= 1.0:
+            raise SolverError(f"rho_inf = {rho_inf} outside [0, 1]")
+        alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
+        alpha_f = rho_inf / (rho_inf + 1.0)
+        gamma = 0.5 - alpha_m + alpha_f
+        return cls(dt=dt, t_end=t_end, beta=0.25 * (gamma + 0.5) ** 2, gamma=gamma,
+                   alpha_m=alpha_m, alpha_f=alpha_f, **kwargs)
+
+    @property
+    def beta_prime(self) -> float:
+        """d q''_{n+1} / d q_{n+1} = (1 - alpha_m) / (beta h^2 (1 - alpha_f))."""
+        return (1.0 - self.alpha_m) / (self.beta * self.dt**2 * (1.0 - self.alpha_f))
 
 
 @dataclass
@@ -102,40 +129,44 @@ def _saddle_solve(model: BeamModel, matrix: sp.spmatrix, rhs_top: np.ndarray,
 def initial_acceleration(model: BeamModel, e: np.ndarray, v: np.ndarray, t: float):
     """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma."""
     *_, gamma = model.constraints.evaluate(e, t, v)
-    elastic, _ = model.elastic_force_at(e, t)
+    elastic, _, _ = model.internal_force(e, t)
     external = model.external_force(e)
     return _saddle_solve(model, model.mass_matrix(), external - elastic, -gamma, e, t,
                          "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]")
 
 
-class NewmarkIntegrator:
-    """The constant data of a Newmark run and the chunked stepping over the kernel."""
+class TimeIntegrator:
+    """The constant data of a run and the chunked stepping over the kernel."""
 
     def __init__(self, model: BeamModel, settings: DynamicSettings) -> None:
         if settings.dt <= 0:
             raise SolverError(f"time step dt = {settings.dt} must be positive")
         self.model, self.settings = model, settings
         start = time.perf_counter()
-        h, beta = settings.dt, settings.beta
-        mass = model.mass_matrix()
-        self.mass = mass
-        stiffness0 = model.pattern.to_scipy(model.pattern.assemble(model.stiffness0))
-        iteration_matrix = (mass / (beta * h * h) + stiffness0).tocoo()
-        self.solver = DirectSolver(model.ndof, iteration_matrix.row, iteration_matrix.col,
-                                   banded_spd=True,
-                                   what="Newmark iteration matrix M/(beta h^2) + K0")
-        self.solver.factorize(iteration_matrix.data)
-        model.counters["factorizations"] += 1
+        self.mass = model.mass_matrix()
+        self.mass_pattern = model.mass_values()
+        self.nonlinear = model.formulation == "nonlinear"
         table = model.constraints.dof_table()
         used = table[table >= 0]
         self.block_first = np.unique(used - used % 3)
-        columns = np.zeros((model.ndof, 3 * len(self.block_first)))
-        for b, first in enumerate(self.block_first):
-            columns[first:first + 3, 3 * b:3 * b + 3] = np.eye(3)
-        self.flexibility = self.solver.solve(columns) if columns.size else columns
-        block_dofs = (self.block_first[:, None] + np.arange(3)).ravel()
-        self.flexibility_cc = self.flexibility[block_dofs] if columns.size else np.zeros((0, 0))
-        self.setup_solves = columns.shape[1]
+        self.solver = DirectSolver(model.ndof, model.pattern.rows, model.pattern.col_index,
+                                   banded_spd=True,
+                                   what="iteration matrix beta' M + K (banded Cholesky)")
+        self.setup_solves = 0
+        self.flexibility = np.zeros((model.ndof, 3 * len(self.block_first)))
+        self.flexibility_cc = np.zeros((3 * len(self.block_first),) * 2)
+        if not self.nonlinear:  # S = beta' M + K0 in the frame: once for the whole run
+            k0 = model.pattern.assemble(model.stiffness0)
+            self.solver.factorize(settings.beta_prime * self.mass_pattern + k0)
+            model.counters["factorizations"] += 1
+            columns = np.zeros((model.ndof, 3 * len(self.block_first)))
+            for b, first in enumerate(self.block_first):
+                columns[first:first + 3, 3 * b:3 * b + 3] = np.eye(3)
+            if columns.size:
+                self.flexibility = self.solver.solve(columns)
+                block_dofs = (self.block_first[:, None] + np.arange(3)).ravel()
+                self.flexibility_cc = self.flexibility[block_dofs]
+            self.setup_solves = columns.shape[1]
         self.setup_time = time.perf_counter() - start
         self._arrays = self._kernel_arrays()
 
@@ -177,6 +208,12 @@ class NewmarkIntegrator:
             con_ints=pad(_f(ints, np.int32)), con_reals=pad(_f(reals)), drive_kinds=_f(kinds, np.int32),
             drive_params=_f(params), frame_drive=model.frame_drive,
             frame_axis=_f(model.frame_axis), frame_base=_f(model.frame_base),
+            formulation=1 if self.nonlinear else 0, youngs=model.youngs, poisson=model.poisson,
+            gauss_gradients=model.gauss_gradients if self.nonlinear
+            else np.zeros((8, 3, 1, 1), order="F"),
+            gauss_weights=model.gauss_weights if self.nonlinear
+            else np.zeros((1, 1), order="F"),
+            scatter_map=model.pattern.scatter_map, mass_pattern=_f(self.mass_pattern),
             solver_handle=self.solver.handle, nblock=len(self.block_first),
             block_first=pad(_f(self.block_first + 1, np.int32)),
             flexibility=_f(self.flexibility) if len(self.block_first)
@@ -192,18 +229,22 @@ class NewmarkIntegrator:
         self.solver.close()
 
     def advance(self, state: dict, nsteps: int) -> tuple[Chunk, int, int]:
-        """Advance ``nsteps`` steps; ``state`` (t, e, v, a, lam, work) is updated in place.
+        """Advance ``nsteps`` steps; ``state`` (t, e, v, a, accel, lam, work) is updated in
+        place (a: the generalized-alpha acceleration variable, accel: q'').
         Returns the chunk of completed steps, the kernel's info and detail codes."""
         s, m = self.settings, self.model
         nq = nsteps if s.store_q else 1
-        out = _kernel.newmark_advance(
-            **self._arrays, nsteps=nsteps, nq=nq, h=s.dt, beta=s.beta, gamma=s.gamma, tol=s.tol,
+        out = _kernel.integrator_advance(
+            **self._arrays, nsteps=nsteps, nq=nq, h=s.dt, beta=s.beta, gamma=s.gamma,
+            alpha_m=s.alpha_m, alpha_f=s.alpha_f, tol=s.tol,
             length_scale=m.length_scale, max_newton=s.max_newton,
             t=state["t"], e=_f(state["e"]), v=_f(state["v"]), a=_f(state["a"]),
+            accel=_f(state["accel"]),
             lam=_f(state["lam"]) if len(state["lam"]) else np.zeros(1), work=_f(state["work"]))
-        (t, e, v, a, lam, work, o_time, o_probe, o_defl, o_lam, o_energy, o_con, o_newton, o_q,
-         status, self.last_correction) = out
-        state.update(t=float(t), e=e, v=v, a=a, lam=lam[:len(m.constraints)], work=work)
+        (t, e, v, a, accel, lam, work, o_time, o_probe, o_defl, o_lam, o_energy, o_con,
+         o_newton, o_q, status, self.last_correction) = out
+        state.update(t=float(t), e=e, v=v, a=a, accel=accel, lam=lam[:len(m.constraints)],
+                     work=work)
         done, info, detail = (int(x) for x in status)
         chunk = Chunk(time=o_time[:done], probes=np.transpose(o_probe[:, :, :done], (2, 1, 0)),
                       deflections=np.transpose(o_defl[:, :, :done], (2, 1, 0)),
@@ -228,7 +269,7 @@ def initial_row(model: BeamModel, state: dict, mass: sp.spmatrix) -> Chunk:
     e, v, t = state["e"], state["v"], state["t"]
     positions = model.probe_positions(e)
     deflections = model.deflections_at(e, t)
-    _, strain = model.elastic_force_at(e, t)
+    _, strain, _ = model.internal_force(e, t)
     moment = -sum(m.magnitude * float(_kernel.moment_rotation_angle(e[m.dofs], m.axis,
                                                                    model.e0[m.dofs]))
                   for m in model.moments)
@@ -257,10 +298,11 @@ def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
     if settings.t_end < t0:
         raise SolverError(f"t_end = {settings.t_end} lies before the start time {t0}")
     v0 = np.zeros(model.ndof) if v0 is None else v0
-    integrator = NewmarkIntegrator(model, settings)
+    integrator = TimeIntegrator(model, settings)
     try:
         a0, lam0 = initial_acceleration(model, e0, v0, t0)
-        state = dict(t=t0, e=e0.copy(), v=v0.copy(), a=a0, lam=lam0, work=np.zeros(2))
+        state = dict(t=t0, e=e0.copy(), v=v0.copy(), a=a0.copy(), accel=a0, lam=lam0,
+                     work=np.zeros(2))
         timing["setup"] = time.perf_counter() - start
         t0_out = time.perf_counter()
         if sink:
@@ -272,7 +314,7 @@ def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
         total = int(round((settings.t_end - t0) / settings.dt))
         show = sys.stderr.isatty() if progress is None else progress
         bar = tqdm(total=round(settings.t_end - t0, 9), unit="s", disable=not show,
-                   desc="Newmark", bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s "
+                   desc="dynamics", bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s "
                    "[{elapsed}<{remaining}{postfix}]")
         steps = newton = 0
         try:
@@ -301,5 +343,7 @@ def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
         integrator.close()
     wall = time.perf_counter() - start
     timing["total"] = wall
-    return DynamicResult(steps=steps, newton_iterations=newton, factorizations=1,
+    factorizations = steps if integrator.nonlinear else 1
+    model.counters["factorizations"] += factorizations if integrator.nonlinear else 0
+    return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
                          solves_setup=integrator.setup_solves, wall_time_s=wall, timing=timing)

@@ -138,8 +138,11 @@ class SparsePattern:
         return _kernel.sparse_assemble(self.nnz, self.scatter_map, _f(element_values))
 
     def to_scipy(self, values: np.ndarray):
+        """A scipy CSR matrix with its own copy of the pattern (scipy shares index arrays,
+        and in-place operations such as eliminate_zeros would corrupt this pattern)."""
         import scipy.sparse as sp
-        return sp.csr_matrix((values, self.col_index, self.row_ptr), shape=(self.n, self.n))
+        return sp.csr_matrix((values.copy(), self.col_index.copy(), self.row_ptr.copy()),
+                             shape=(self.n, self.n))
 
 
 _MUMPS_MESSAGES = {-10: "the matrix is numerically singular (or, banded: not positive definite)",

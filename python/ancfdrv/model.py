@@ -142,12 +142,17 @@ class BeamModel:
     # -- matrices --------------------------------------------------------------------
     def mass_matrix(self) -> sp.csr_matrix:
         """Constant mass matrix: kron(compact, I3) per element plus point masses."""
+        return self.pattern.to_scipy(self.mass_values())
+
+    def mass_values(self) -> np.ndarray:
+        """CSR values of the mass matrix on ``pattern`` (point masses on the diagonal)."""
         element = np.einsum("abe,ij->aibje", self.mass_compact, np.eye(3)).reshape(24, 24, -1)
-        mass = self.pattern.to_scipy(self.pattern.assemble(element)).tolil()
+        values = self.pattern.assemble(element)
         for node, m in self.point_masses:
             for d in node_dofs(node, R):
-                mass[d, d] += m
-        return mass.tocsr()
+                row = self.pattern.col_index[self.pattern.row_ptr[d]:self.pattern.row_ptr[d + 1]]
+                values[self.pattern.row_ptr[d] + np.searchsorted(row, d)] += m
+        return values
 
     def stiffness_values(self) -> np.ndarray:
         """CSR values (on ``pattern``) of K = T K0 T^T."""

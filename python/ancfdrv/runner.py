@@ -45,11 +45,15 @@ def run_scene(path: str | Path, overrides: list[str] | None = None,
 
 
 def dynamic_settings(scene: Scene) -> DynamicSettings:
+    """Newmark with the scene's beta and gamma, or generalized-alpha from rho_inf."""
     solver, output = scene["solver"], scene["output"]
+    common = dict(tol=solver["newton_tol"], max_newton=solver["max_newton"],
+                  chunk_steps=output["chunk_steps"], store_q=output["q"])
+    if solver["integrator"] == "generalized_alpha":
+        return DynamicSettings.generalized_alpha(solver["dt"], solver["t_end"],
+                                                 solver["rho_inf"], **common)
     return DynamicSettings(dt=solver["dt"], t_end=solver["t_end"], beta=solver["beta"],
-                           gamma=solver["gamma"], tol=solver["newton_tol"],
-                           max_newton=solver["max_newton"], chunk_steps=output["chunk_steps"],
-                           store_q=output["q"])
+                           gamma=solver["gamma"], **common)
 
 
 def boom_stages(scene: Scene) -> dict[str, tuple[float, float]] | None:
@@ -78,7 +82,9 @@ def _run_dynamic(scene: Scene, model: BeamModel, out: Path, e_start: np.ndarray,
         stages = stage_summary(t, transverse, bounds)
     results.write_dynamic_attrs(out, {
         "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
-        "gamma": settings.gamma, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
+        "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
+        "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
+        "generalized_alpha" else 1.0, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
         "factorizations": dyn.factorizations, "setup_solves": dyn.solves_setup,
         "wall_time_s": dyn.wall_time_s, "status": "ok"}, stages)
     return dyn, stages

@@ -113,7 +113,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "splitting parameter p of K_RR = K_RR1 + K_RR2, in [0, 1)"),
         "dt": Key("float", 1e-3, positive, "time step (s), dynamic analyses"),
         "t_end": Key("float", 10.0, non_negative, "end time (s), dynamic analyses"),
-        "integrator": Key("str", "newmark", one_of("newmark"), "time integrator"),
+        "integrator": Key("str", "newmark", one_of("newmark", "generalized_alpha"),
+                          "time integrator"),
+        "rho_inf": Key("float", 0.9, within(0.0, 1.0),
+                       "generalized-alpha: spectral radius at infinite frequency (1: no "
+                       "numerical damping)"),
         "beta": Key("float", 0.25, lambda v: None if 0 < v <= 0.5 else "must lie in (0, 0.5]",
                     "Newmark beta (1/4: average acceleration, the paper's choice)"),
         "gamma": Key("float", 0.5, within(0.5, 1.0), "Newmark gamma (1/2: no damping)"),
@@ -304,10 +308,7 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
             raise InputError(f"unknown effect {effect!r}; known effects: "
                              f"{', '.join(EFFECTS_AVAILABLE)}", file=file, group="scene",
                              key="effects")
-    if scene["formulation"] == "nonlinear":
-        if scene["analysis"] != "static":
-            raise InputError("formulation 'nonlinear' is available for static analyses only in "
-                             "this version", file=file, group="scene", key="formulation")
+    if scene["formulation"] == "nonlinear" and scene["analysis"] != "dynamic":
         if values["solver"]["static_method"] != "newton":
             raise InputError("formulation 'nonlinear' needs static_method = 'newton' (the split "
                              "iteration relies on the constant FFR stiffness)", file=file,

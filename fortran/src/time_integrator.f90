@@ -1,36 +1,48 @@
-!> Newmark time stepping (seed 000, eqs. 58-62) of the constrained ANCF-FFR beam
-!>   M e'' + T K0 (T^T e - e0) = Q(e) + Phi_e^T lambda,   Phi(e, t) = 0,
-!> with the floating frame A(t) = Rot(axis, phi_frame(t)) A_base of a prescribed motion.
+!> Implicit time stepping of the constrained ANCF beam (seed 000, eqs. 58-62):
+!>   M q'' + Q_el(q, t) = Q(q) + Phi_q^T lambda,   Phi(q, t) = 0,
+!> by the generalized-alpha method (Chung-Hulbert, in the form of Arnold and Bruels for
+!> constrained systems) with Newmark (alpha_m = alpha_f = 0) as its special case:
+!>   (1 - alpha_m) a_{n+1} + alpha_m a_n = (1 - alpha_f) q''_{n+1} + alpha_f q''_n,
+!>   q_{n+1} = q_n + h v_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}),
+!>   v_{n+1} = v_n + h ((1 - gamma) a_n + gamma a_{n+1}),
+!> Newton on (q_{n+1}, lambda_{n+1}) with the iteration matrix beta' M + K, beta' = (1 -
+!> alpha_m) / (beta h^2 (1 - alpha_f)).
 !>
-!> The structure of ANCF-FFR makes one factorization serve the whole run: every 3 x 3
-!> block of M is a scalar times I3, so M/(beta h^2) + T K0 T^T = T S T^T with the constant
-!> S = M/(beta h^2) + K0 (factorized once, a MUMPS handle). The multipliers enter through a
-!> Schur complement built from the constant flexibility S^{-1} E_c at the 3-vectors the
-!> constraints touch (E_c: their unit vectors in the frame), so a Newton correction costs
-!> one forward/back substitution plus small dense algebra (LAPACK dgesv). The Jacobians of
-!> the moment and of lambda . Phi_ee are left out of the iteration matrix (modified Newton:
-!> they are many orders below S); the residual is exact.
-!> Convergence: a correction with max |de| <= tol * length_scale ends the step.
-!> No I/O; failures return codes (see newmark_chunk).
-module newmark_ffr
+!> Two elastic models share the driver:
+!> * ANCF-FFR (Q_el = T K0 (T^T q - e0), frame A(t) = Rot(axis, phi(t)) A_base): every 3 x 3
+!>   block of M is a scalar times I3, so beta' M + T K0 T^T = T S T^T with the constant
+!>   S = beta' M + K0, factorized once per run;
+!> * large deformation (beam_nonlinear): S = beta' M + K_t(q) is refactorized once per step
+!>   at the predicted state and reused by the step's iterations (modified Newton).
+!> The multipliers enter through a Schur complement built from the flexibility S^{-1} E_c at
+!> the 3-vectors the constraints touch (E_c: their unit vectors in the frame), so a Newton
+!> correction costs one back-substitution plus small dense algebra (LAPACK dgesv). The
+!> Jacobians of the moment and of lambda . Phi_qq are left out of the iteration matrix; the
+!> residual is exact. A correction with max |dq| <= tol * length_scale ends the step.
+!> No I/O; failures return codes (see integrator_chunk).
+module time_integrator
   use ancf_kinds, only: dp
   use drives, only: drive_eval
   use constraints, only: constraint_eval
   use ffr_elastic, only: ffr_force
+  use beam_nonlinear, only: nonlinear_element
   use section_moment, only: moment_force, moment_angle
-  use sparse_direct, only: solver_solve
+  use sparse_pattern, only: pattern_assemble
+  use sparse_direct, only: solver_solve, solver_factorize
   implicit none
   private
-  public :: ffr_system, newmark_settings, newmark_chunk, frame_rotation, csr_matvec
+  public :: beam_system, integrator_settings, integrator_chunk, frame_rotation, csr_matvec
   public :: energy_kinetic, energy_strain, energy_loads, energy_moment, energy_total, &
             work_drive, work_frame, energy_count
 
   integer, parameter :: energy_kinetic = 1, energy_strain = 2, energy_loads = 3, &
                         energy_moment = 4, energy_total = 5, work_drive = 6, work_frame = 7, &
                         energy_count = 7
+  integer, parameter, public :: formulation_ffr = 0, formulation_nonlinear = 1
 
   !> The model, as the stepper reads it (never changed by a step).
-  type :: ffr_system
+  type :: beam_system
+    integer :: formulation = formulation_ffr
     integer :: ndof = 0, nel = 0, ncon = 0, nmoment = 0, nblock = 0, nprobe = 0
     integer, allocatable :: dofs(:, :)                 ! (24, nel)
     real(dp), allocatable :: stiffness0(:, :, :)       ! (24, 24, nel)
@@ -44,25 +56,31 @@ module newmark_ffr
     real(dp), allocatable :: con_reals(:, :), drive_params(:, :)
     integer :: frame_drive = 0                         ! 0: A = A_base
     real(dp) :: frame_axis(3) = [0.0_dp, 0.0_dp, 1.0_dp], frame_base(3, 3)
-    integer :: solver_handle = 0                       ! S = M/(beta h^2) + K0, factorized
+    integer :: solver_handle = 0                       ! S (FFR: factorized once by Python)
     integer, allocatable :: block_first(:)             ! (nblock) first dof of touched 3-vectors
-    real(dp), allocatable :: flexibility(:, :)         ! S^{-1} E_c (ndof, 3 nblock)
-    real(dp), allocatable :: flexibility_cc(:, :)      ! E_c^T S^{-1} E_c
+    real(dp), allocatable :: flexibility(:, :)         ! FFR: S^{-1} E_c (ndof, 3 nblock)
+    real(dp), allocatable :: flexibility_cc(:, :)      ! FFR: E_c^T S^{-1} E_c
+    ! large deformation: Gauss data, the pattern S is assembled on, M on that pattern
+    real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp
+    real(dp), allocatable :: gauss_gradients(:, :, :, :), gauss_weights(:, :)
+    integer, allocatable :: scatter_map(:, :, :)
+    real(dp), allocatable :: mass_pattern(:)
     integer, allocatable :: probe_dofs(:, :)           ! (24, nprobe)
     real(dp), allocatable :: probe_shape(:, :)         ! (8, nprobe)
     real(dp), allocatable :: probe_reference(:, :)     ! (3, nprobe) rigid position in frame
-  end type ffr_system
+  end type beam_system
 
-  type :: newmark_settings
-    real(dp) :: h, beta = 0.25_dp, gamma = 0.5_dp, tol = 1e-10_dp, length_scale = 1.0_dp
+  type :: integrator_settings
+    real(dp) :: h, beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
+    real(dp) :: tol = 1e-10_dp, length_scale = 1.0_dp
     integer :: max_newton = 10
-  end type newmark_settings
+  end type integrator_settings
 
 contains
 
   !> A(t) and phi_frame'(t).
   subroutine frame_rotation(sys, t, rotation, rate, info)
-    type(ffr_system), intent(in) :: sys
+    type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: t
     real(dp), intent(out) :: rotation(3, 3), rate
     integer, intent(out) :: info
@@ -118,7 +136,7 @@ contains
   !> Constraint values and gradients at (e, t) (velocities only feed terms not used here).
   !> info = 5 when a constraint or drive cannot be evaluated.
   subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
-    type(ffr_system), intent(in) :: sys
+    type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), t
     real(dp), intent(out) :: phi(:), gradients(:, :)
     integer, intent(out) :: info
@@ -129,17 +147,82 @@ contains
     if (info /= 0) info = 5
   end subroutine evaluate_constraints
 
-  !> Residual r = M a + Q_el(e) - Q(e) - Phi_e^T lambda at time t, with the constraint
-  !> values and gradients, the strain energy and the frame power dU/dt.
+  !> Elastic force and strain energy of the formulation (FFR with the frame rotation).
+  subroutine elastic_force(sys, rotation, e, force, strain)
+    type(beam_system), intent(in) :: sys
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    real(dp), intent(out) :: force(:), strain
+    real(dp) :: element_force(24), element_energy, unused(24, 24)
+    integer :: el
+    if (sys%formulation == formulation_ffr) then
+      call ffr_force(sys%ndof, sys%nel, sys%dofs, sys%stiffness0, rotation, e, sys%e0_frame, &
+                     force, strain)
+      return
+    end if
+    force = 0.0_dp
+    strain = 0.0_dp
+    do el = 1, sys%nel
+      call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
+                             sys%gauss_weights(:, el), sys%youngs, sys%poisson, .false., &
+                             element_force, element_energy, unused)
+      force(sys%dofs(:, el)) = force(sys%dofs(:, el)) + element_force
+      strain = strain + element_energy
+    end do
+  end subroutine elastic_force
+
+  !> Large deformation: factorize S = beta' M + K_t(e) on the solver's pattern and compute
+  !> the flexibility S^{-1} E_c and E_c^T S^{-1} E_c for the Schur complement.
+  subroutine refactorize(sys, beta_prime, e, flexibility, flexibility_cc, info, detail)
+    type(beam_system), intent(in) :: sys
+    real(dp), intent(in) :: beta_prime, e(:)
+    real(dp), intent(out) :: flexibility(:, :), flexibility_cc(:, :)
+    integer, intent(out) :: info, detail
+    real(dp) :: tangents(24, 24, sys%nel), element_force(24), element_energy
+    real(dp) :: values(size(sys%mass_pattern))
+    integer :: el, b, j
+    do el = 1, sys%nel
+      call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
+                             sys%gauss_weights(:, el), sys%youngs, sys%poisson, .true., &
+                             element_force, element_energy, tangents(:, :, el))
+    end do
+    call pattern_assemble(size(values), 24, sys%nel, sys%scatter_map, tangents, values)
+    values = values + beta_prime * sys%mass_pattern
+    call solver_factorize(sys%solver_handle, size(values), values, info, detail)
+    if (info /= 0) then
+      detail = info
+      info = 3
+      return
+    end if
+    if (sys%nblock == 0) return
+    flexibility = 0.0_dp
+    do b = 1, sys%nblock
+      do j = 1, 3
+        flexibility(sys%block_first(b) + j - 1, 3 * (b - 1) + j) = 1.0_dp
+      end do
+    end do
+    call solver_solve(sys%solver_handle, sys%ndof, 3 * sys%nblock, flexibility, info, detail)
+    if (info /= 0) then
+      detail = info
+      info = 3
+      return
+    end if
+    do b = 1, sys%nblock
+      do j = 1, 3
+        flexibility_cc(3 * (b - 1) + j, :) = flexibility(sys%block_first(b) + j - 1, :)
+      end do
+    end do
+  end subroutine refactorize
+
+  !> Residual r = M q'' + Q_el(q) - Q(q) - Phi_q^T lambda at time t, with the constraint
+  !> values and gradients and the strain energy.
   subroutine residual(sys, t, e, acceleration, lam, rotation, r, phi, gradients, strain, info)
-    type(ffr_system), intent(in) :: sys
+    type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: t, e(:), acceleration(:), lam(:), rotation(3, 3)
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :), strain
     integer, intent(out) :: info
     real(dp) :: elastic(sys%ndof), inertia(sys%ndof), force(3), jacobian(3, 3), hessian(3, 3, 3)
     integer :: m, c, i
-    call ffr_force(sys%ndof, sys%nel, sys%dofs, sys%stiffness0, rotation, e, sys%e0_frame, &
-                   elastic, strain)
+    call elastic_force(sys, rotation, e, elastic, strain)
     call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, acceleration, inertia)
     r = inertia + elastic - sys%constant_force
     do m = 1, sys%nmoment
@@ -161,19 +244,20 @@ contains
     end do
   end subroutine residual
 
-  !> Advances nsteps Newmark steps from (t, e, v, a, lambda), writing one output row per
-  !> step. info: 0 ok; 1 Newton did not converge; 2 non-finite state; 3 linear solve
-  !> failed (detail = MUMPS code); 4 singular Schur complement (detail = dgesv info);
+  !> Advances nsteps steps from (t, q = e, v, a, q'' = accel, lambda), writing one output
+  !> row per step; a is the generalized-alpha acceleration-like variable (= q'' for
+  !> Newmark). info: 0 ok; 1 Newton did not converge; 2 non-finite state; 3 linear solve
+  !> failed (detail = solver code); 4 singular Schur complement (detail = dgesv info);
   !> 5 constraint or drive evaluation failed; 6 moment undefined. steps_done counts the
   !> completed steps; the state is that of the last completed step; last_correction is the
   !> size of the last Newton correction (why a step failed to converge).
-  subroutine newmark_chunk(sys, cfg, nsteps, t, e, v, a, lam, work, out_time, out_probe, &
-                           out_deflection, out_lambda, out_energy, out_constraint, out_newton, &
-                           store_q, out_q, steps_done, info, detail, last_correction)
-    type(ffr_system), intent(in) :: sys
-    type(newmark_settings), intent(in) :: cfg
+  subroutine integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam, work, out_time, out_probe, &
+                              out_deflection, out_lambda, out_energy, out_constraint, out_newton, &
+                              store_q, out_q, steps_done, info, detail, last_correction)
+    type(beam_system), intent(in) :: sys
+    type(integrator_settings), intent(in) :: cfg
     integer, intent(in) :: nsteps
-    real(dp), intent(inout) :: t, e(:), v(:), a(:), lam(:), work(2)
+    real(dp), intent(inout) :: t, e(:), v(:), a(:), accel(:), lam(:), work(2)
     real(dp), intent(out) :: out_time(:), out_probe(:, :, :), out_deflection(:, :, :)
     real(dp), intent(out) :: out_lambda(:, :), out_energy(:, :), out_constraint(:)
     integer, intent(out) :: out_newton(:)
@@ -181,10 +265,13 @@ contains
     real(dp), intent(out) :: out_q(:, :)
     integer, intent(out) :: steps_done, info, detail
     real(dp), intent(out) :: last_correction  ! max |de| of the last Newton correction (m)
-    real(dp) :: e_new(sys%ndof), a_new(sys%ndof), lam_new(sys%ncon), e_hat(sys%ndof), v_hat(sys%ndof)
-    real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof), phi(sys%ncon), gradients(6, sys%ncon)
+    real(dp) :: e_new(sys%ndof), a_new(sys%ndof), accel_new(sys%ndof), lam_new(sys%ncon)
+    real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof)
+    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: w(3 * sys%nblock, sys%ncon), schur(sys%ncon, sys%ncon), dlam(sys%ncon, 1)
-    real(dp) :: rotation(3, 3), rate, strain, powers_old(2), powers_new(2), t_new, h, beta
+    real(dp) :: flexibility(sys%ndof, 3 * sys%nblock), flexibility_cc(3 * sys%nblock, 3 * sys%nblock)
+    real(dp) :: rotation(3, 3), transform(3, 3), rate, strain, powers_old(2), powers_new(2)
+    real(dp) :: t_new, h, beta_prime
     integer :: step, it, ipiv(sys%ncon), lapack_info
     logical :: done
     info = 0
@@ -192,7 +279,11 @@ contains
     steps_done = 0
     last_correction = 0.0_dp
     h = cfg%h
-    beta = cfg%beta
+    beta_prime = (1.0_dp - cfg%alpha_m) / (cfg%beta * h * h * (1.0_dp - cfg%alpha_f))
+    if (sys%formulation == formulation_ffr) then
+      flexibility = sys%flexibility
+      flexibility_cc = sys%flexibility_cc
+    end if
     call frame_rotation(sys, t, rotation, rate, info)
     if (info /= 0) then
       info = 5
@@ -202,32 +293,41 @@ contains
     if (info /= 0) return
     do step = 1, nsteps
       t_new = t + h
-      e_hat = e + h * v + h * h * (0.5_dp - beta) * a
-      v_hat = v + h * (1.0_dp - cfg%gamma) * a
-      a_new = a
+      ! predictor: q''_{n+1} = q''_n
+      accel_new = accel
+      a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
+              / (1.0_dp - cfg%alpha_m)
+      e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
       lam_new = lam
-      e_new = e_hat + beta * h * h * a_new
       call frame_rotation(sys, t_new, rotation, rate, info)
       if (info /= 0) then
         info = 5
         return
       end if
+      ! the solve works in the frame of S: the floating frame for FFR, the global frame
+      ! for large deformation (where A(t) only resolves the output deflections)
+      transform = rotation
+      if (sys%formulation == formulation_nonlinear) then
+        transform = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
+        call refactorize(sys, beta_prime, e_new, flexibility, flexibility_cc, info, detail)
+        if (info /= 0) return
+      end if
       done = .false.
       do it = 1, cfg%max_newton
-        call residual(sys, t_new, e_new, a_new, lam_new, rotation, r, phi, gradients, strain, info)
+        call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, info)
         if (info /= 0) return
         ! z = T S^{-1} T^T r
-        call rotate_all(rotation, r, .true., z(:, 1))
+        call rotate_all(transform, r, .true., z(:, 1))
         call solver_solve(sys%solver_handle, sys%ndof, 1, z, info, detail)
         if (info /= 0) then
           detail = info
           info = 3
           return
         end if
-        call rotate_all(rotation, z(:, 1), .false., direction)
+        call rotate_all(transform, z(:, 1), .false., direction)
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
-        call frame_gradients(sys, rotation, gradients, w)
-        schur = matmul(transpose(w), matmul(sys%flexibility_cc, w))
+        call frame_gradients(sys, transform, gradients, w)
+        schur = matmul(transpose(w), matmul(flexibility_cc, w))
         dlam(:, 1) = gradient_dot(sys, gradients, direction) - phi
         if (sys%ncon > 0) then
           call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
@@ -236,14 +336,14 @@ contains
             detail = lapack_info
             return
           end if
-          call rotate_all(rotation, matmul(sys%flexibility, matmul(w, dlam(:, 1))), .false., &
+          call rotate_all(transform, matmul(flexibility, matmul(w, dlam(:, 1))), .false., &
                           correction)
           correction = correction - direction
         else
           correction = -direction
         end if
         e_new = e_new + correction
-        a_new = a_new + correction / (beta * h * h)
+        accel_new = accel_new + beta_prime * correction
         lam_new = lam_new + dlam(:, 1)
         if (.not. (all(abs(correction) < huge(1.0_dp)) .and. all(abs(lam_new) < huge(1.0_dp)))) then
           info = 2
@@ -260,9 +360,12 @@ contains
         return
       end if
       ! accept the step
-      v = v_hat + h * cfg%gamma * a_new
+      a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
+              / (1.0_dp - cfg%alpha_m)
+      v = v + h * ((1.0_dp - cfg%gamma) * a + cfg%gamma * a_new)
       e = e_new
       a = a_new
+      accel = accel_new
       lam = lam_new
       t = t_new
       call step_powers(sys, e, v, lam, rotation, rate, t, powers_new, strain, info)
@@ -278,11 +381,11 @@ contains
       if (info /= 0) return
       if (store_q) out_q(:, step) = e
     end do
-  end subroutine newmark_chunk
+  end subroutine integrator_chunk
 
   !> W(3 nblock, ncon): frame components (T^T Phi_e^T) at the touched 3-vectors.
   subroutine frame_gradients(sys, rotation, gradients, w)
-    type(ffr_system), intent(in) :: sys
+    type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: rotation(3, 3), gradients(:, :)
     real(dp), intent(out) :: w(:, :)
     integer :: c, i, dof, b, comp
@@ -300,7 +403,7 @@ contains
 
   !> Phi_e x for every constraint.
   pure function gradient_dot(sys, gradients, x) result(y)
-    type(ffr_system), intent(in) :: sys
+    type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: gradients(:, :), x(:)
     real(dp) :: y(sys%ncon)
     integer :: c, i
@@ -312,21 +415,26 @@ contains
     end do
   end function gradient_dot
 
-  !> Powers of the constraint forces (lambda . Phi_e v: the drive) and of the moving frame,
-  !> dU/dt at fixed e = -phi' sum_b f_b . (k x x_b), f = K0 u, u = T^T e - e0, x = T^T e,
-  !> with the strain energy U, all from one pass over the elements.
+  !> Powers of the constraint forces (lambda . Phi_e v: the drive) and, for FFR, of the moving
+  !> frame, dU/dt at fixed e = -phi' sum_b f_b . (k x x_b), f = K0 u, u = T^T e - e0,
+  !> x = T^T e, with the strain energy U, all from one pass over the elements.
   subroutine step_powers(sys, e, v, lam, rotation, rate, t, powers, strain, info)
-    type(ffr_system), intent(in) :: sys
+    type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), v(:), lam(:), rotation(3, 3), rate, t
     real(dp), intent(out) :: powers(2), strain
     integer, intent(out) :: info
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: frame_coords(24), local(24), frame_force(24), k(3), x(3)
+    real(dp) :: frame_force_global(sys%ndof)
     integer :: el, b
     call evaluate_constraints(sys, e, t, phi, gradients, info)
     if (info /= 0) return
     powers(1) = dot_product(lam, gradient_dot(sys, gradients, v))
     powers(2) = 0.0_dp
+    if (sys%formulation /= formulation_ffr) then
+      call elastic_force(sys, rotation, e, frame_force_global, strain)
+      return
+    end if
     strain = 0.0_dp
     k = sys%frame_axis / norm2(sys%frame_axis)
     do el = 1, sys%nel
@@ -349,7 +457,7 @@ contains
 
   !> One output row: probes, deflections in the frame, energies, constraint violation.
   subroutine record(sys, e, v, rotation, work, strain, probe, deflection, energy, violation, t, info)
-    type(ffr_system), intent(in) :: sys
+    type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), v(:), rotation(3, 3), work(2), strain, t
     real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:), violation
     integer, intent(out) :: info
@@ -380,4 +488,4 @@ contains
     if (sys%ncon == 0) violation = 0.0_dp
   end subroutine record
 
-end module newmark_ffr
+end module time_integrator
