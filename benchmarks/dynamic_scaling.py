@@ -4,10 +4,10 @@ from the floor of one forward/back substitution.
 
 For every node count (3k+1) of the boom of ``inputs/boom_luffing.nml`` this prepares a run
 as :func:`ancfdrv.runner.run_scene` does for this scene (``build_model``, static start with
-``solve_split``, :class:`ancfdrv.dynamic.NewmarkIntegrator`, consistent initial
-acceleration), integrates through the smooth start to the beginning of the luffing stage
-(:func:`ancfdrv.runner.boom_stages`, t = 1 s) and measures there, with
-``time.perf_counter``:
+``solve_split``, :class:`ancfdrv.dynamic.NewmarkIntegrator` - ``TimeIntegrator`` after the
+generalized-alpha rework -, consistent initial acceleration), integrates through the
+smooth start to the beginning of the luffing stage (:func:`ancfdrv.runner.boom_stages`,
+t = 1 s) and measures there, with ``time.perf_counter``:
 
 * the wall time per Newmark step: ``integrator.advance(state, nsteps)`` from a copy of the
   state at the start of the luffing stage, so every sample integrates the same steps
@@ -59,11 +59,16 @@ import numpy as np
 import scipy
 
 import ancfdrv
-from ancfdrv.dynamic import DynamicSettings, NewmarkIntegrator, initial_acceleration
+from ancfdrv.dynamic import DynamicSettings, initial_acceleration
 from ancfdrv.model import BeamModel, build_model
 from ancfdrv.runner import boom_stages, dynamic_settings, run_scene
 from ancfdrv.scene import Scene, load_scene
 from ancfdrv.static import solve_split
+
+try:  # the generalized-alpha rework renames NewmarkIntegrator (same constructor, advance)
+    from ancfdrv.dynamic import TimeIntegrator as Integrator
+except ImportError:
+    from ancfdrv.dynamic import NewmarkIntegrator as Integrator
 
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "inputs" / "boom_luffing.nml"
@@ -91,12 +96,12 @@ class Timing:
         return self.best_s / self.per
 
 
-def best_of(sample: Callable[[int], float], per: int, repeats: int, min_time: float) -> Timing:
+def best_of(sample: Callable[[int], float], repeats: int, min_time: float) -> Timing:
     """Time ``sample(count)``, which does ``count`` operations and returns the seconds they
     took (it times itself, so set-up such as copying a state stays out). ``count`` is first
-    raised until one sample takes ``min_time``; then ``repeats`` samples are taken and the
-    fastest kept. ``per`` is the initial count (at least 1)."""
-    count = max(1, per)
+    raised from 1 until one sample takes ``min_time``; then ``repeats`` samples are taken
+    and the fastest kept."""
+    count = 1
     gc.collect()
     while True:
         elapsed = sample(count)
@@ -110,11 +115,11 @@ def best_of(sample: Callable[[int], float], per: int, repeats: int, min_time: fl
 
 
 def copy_state(state: State) -> State:
-    """Deep copy of an integrator state (t, e, v, a, lam, work)."""
+    """Deep copy of an integrator state (t, e, v, a, accel, lam, work)."""
     return {k: v.copy() if isinstance(v, np.ndarray) else v for k, v in state.items()}
 
 
-def advance_checked(integrator: NewmarkIntegrator, state: State, nsteps: int) -> np.ndarray:
+def advance_checked(integrator: Integrator, state: State, nsteps: int) -> np.ndarray:
     """``integrator.advance`` that raises on a kernel failure; returns Newton counts."""
     chunk, info, detail = integrator.advance(state, nsteps)
     if info:
@@ -131,7 +136,7 @@ class Prepared:
     scene: Scene
     model: BeamModel
     settings: DynamicSettings
-    integrator: NewmarkIntegrator
+    integrator: Integrator
     start: State
     window: tuple[float, float]
     window_steps: int
@@ -166,14 +171,17 @@ def prepare(nodes: int) -> Prepared:
 
     settings = dynamic_settings(scene)
     t0 = time.perf_counter()
-    integrator = NewmarkIntegrator(model, settings)
+    integrator = Integrator(model, settings)
     setup["integrator_setup_s"] = time.perf_counter() - t0
     setup["integrator_setup_solves"] = integrator.setup_solves
     t0 = time.perf_counter()
     v0 = np.zeros(model.ndof)
     a0, lam0 = initial_acceleration(model, static.e, v0, 0.0)
     setup["initial_acceleration_s"] = time.perf_counter() - t0
-    state: State = dict(t=0.0, e=static.e.copy(), v=v0, a=a0, lam=lam0, work=np.zeros(2))
+    # as integrate() builds it; "accel" (q'', apart from the generalized-alpha variable a)
+    # is read by the generalized-alpha integrator and ignored by the Newmark-only one
+    state: State = dict(t=0.0, e=static.e.copy(), v=v0, a=a0.copy(), accel=a0, lam=lam0,
+                        work=np.zeros(2))
 
     # warm-up through the start stage, in the run's chunks: one pass, also a measurement
     warm_steps = int(round((t_first - state["t"]) / settings.dt))
@@ -217,7 +225,7 @@ def time_steps(prep: Prepared, args: argparse.Namespace) -> dict[str, Any]:
             spent += time.perf_counter() - t0
         return spent
 
-    timing = best_of(sample, 1, args.repeats, args.min_time)
+    timing = best_of(sample, args.repeats, args.min_time)
     counts = np.concatenate(newton)
     step = timing.best_s / (timing.per * nsteps)
     t_end = prep.start["t"] + nsteps * prep.settings.dt
@@ -228,7 +236,8 @@ def time_steps(prep: Prepared, args: argparse.Namespace) -> dict[str, Any]:
             "probe_step_s": estimate}
 
 
-def time_call_overhead(prep: Prepared, step_s: float, args: argparse.Namespace) -> dict:
+def time_call_overhead(prep: Prepared, step_s: float,
+                       args: argparse.Namespace) -> dict[str, Any]:
     """Wall time of ``advance(copy, 1)`` and its excess over one step of the window."""
     integrator = prep.integrator
 
@@ -241,7 +250,7 @@ def time_call_overhead(prep: Prepared, step_s: float, args: argparse.Namespace) 
             spent += time.perf_counter() - t0
         return spent
 
-    timing = best_of(sample, 1, args.repeats, args.min_time)
+    timing = best_of(sample, args.repeats, args.min_time)
     return {"one_step_call_s": timing.each_s, "overhead_s": timing.each_s - step_s,
             "calls": timing.per}
 
@@ -264,8 +273,8 @@ def time_floor(prep: Prepared, args: argparse.Namespace) -> dict[str, Any]:
             solver.solve(bulk_rhs)
         return time.perf_counter() - t0
 
-    single = best_of(sample_single, 1, args.repeats, args.min_time)
-    bulk = best_of(sample_bulk, 1, args.repeats, args.min_time)
+    single = best_of(sample_single, args.repeats, args.min_time)
+    bulk = best_of(sample_bulk, args.repeats, args.min_time)
     kd = bandwidth(prep.model)
     bulk_s = bulk.each_s / k
     return {"bandwidth_kd": kd, "single_s": single.each_s, "single_calls": single.per,

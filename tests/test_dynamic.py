@@ -171,7 +171,7 @@ def test_newton_failure_exit_3_keeps_finished_chunks(capsys, tmp_path):
                  "--set", "output.chunk_steps=50"])
     assert code == 3
     err = capsys.readouterr().err
-    assert "Newmark step from t = " in err and "did not converge within 1 iterations" in err
+    assert "time step from t = " in err and "did not converge within 1 iterations" in err
     assert "last correction" in err
     with h5py.File(out) as h5:
         assert h5.attrs["status"] == "failed"

@@ -2,13 +2,15 @@
 !>   kind 0  constant:  phi = p(1)
 !>   kind 1  luffing profile of SPEC section 5 (smooth start, constant rate, smooth brake):
 !>           p = [omega, t_s, t_b, phi_end, phi_start]
+!>   kind 2  spin-up of Simo & Vu-Quoc (REFERENCES.md): p = [W, T, phi_start],
+!>           phi = (W/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)) for t < T, W t - W T/2 after
 module drives
   use ancf_kinds, only: dp
   implicit none
   private
   public :: drive_eval
 
-  integer, parameter, public :: drive_constant = 0, drive_luffing = 1
+  integer, parameter, public :: drive_constant = 0, drive_luffing = 1, drive_spinup = 2
   real(dp), parameter :: pi = 3.14159265358979323846_dp
 
 contains
@@ -19,7 +21,7 @@ contains
     real(dp), intent(in) :: params(8), t
     real(dp), intent(out) :: phi, dphi, ddphi
     integer, intent(out) :: info
-    real(dp) :: omega, t_s, t_b, t_c, t_1, t_2, tau
+    real(dp) :: omega, t_s, t_b, t_c, t_1, t_2, tau, period
     info = 0
     phi = 0.0_dp
     dphi = 0.0_dp
@@ -56,6 +58,25 @@ contains
         phi = params(4)
       end if
       phi = phi + params(5)
+    case (drive_spinup)
+      omega = params(1)
+      period = params(2)
+      if (period <= 0.0_dp) then
+        info = 2
+        return
+      end if
+      if (t < 0.0_dp) then
+        phi = 0.0_dp
+      else if (t < period) then
+        phi = omega / period * (0.5_dp * t * t + (period / (2.0_dp * pi))**2 &
+                                * (cos(2.0_dp * pi * t / period) - 1.0_dp))
+        dphi = omega / period * (t - period / (2.0_dp * pi) * sin(2.0_dp * pi * t / period))
+        ddphi = omega / period * (1.0_dp - cos(2.0_dp * pi * t / period))
+      else
+        phi = omega * t - 0.5_dp * omega * period
+        dphi = omega
+      end if
+      phi = phi + params(3)
     case default
       info = 1
     end select

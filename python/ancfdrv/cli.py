@@ -41,7 +41,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if d is not None:
         print(f"  dynamic      {d.steps} steps of {summary['dynamic.dt']:g} s, "
               f"{d.newton_iterations / max(d.steps, 1):.2f} Newton corrections per step, "
-              f"{d.factorizations} factorization, {d.wall_time_s:.2f} s")
+              f"{d.factorizations} factorization{'s' if d.factorizations != 1 else ''}, "
+              f"{d.wall_time_s:.2f} s")
         if outcome.stages:
             print(stage_table(outcome.stages))
     png = plot_result(outcome.output)

@@ -14,7 +14,7 @@ import numpy as np
 from . import kernel
 
 KIND_COORDINATE, KIND_DISTANCE, KIND_CROSS, KIND_DOT = 1, 2, 3, 4
-DRIVE_CONSTANT, DRIVE_LUFFING = 0, 1
+DRIVE_CONSTANT, DRIVE_LUFFING, DRIVE_SPINUP = 0, 1, 2
 
 
 @dataclass

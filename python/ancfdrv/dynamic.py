@@ -261,7 +261,7 @@ class TimeIntegrator:
             reason += (f" (last correction {self.last_correction:.3e} m, tolerance "
                        f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length; raise "
                        "solver.max_newton or lower solver.dt)")
-        return f"Newmark step from t = {t:.6g} s to t = {t + s.dt:.6g} s failed: {reason}"
+        return f"time step from t = {t:.6g} s to t = {t + s.dt:.6g} s failed: {reason}"
 
 
 def initial_row(model: BeamModel, state: dict, mass: sp.spmatrix) -> Chunk:

@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from scipy.spatial.transform import Rotation
 
 from . import kernel
-from .constraints import DRIVE_CONSTANT, DRIVE_LUFFING, ConstraintSet
+from .constraints import DRIVE_CONSTANT, DRIVE_LUFFING, DRIVE_SPINUP, ConstraintSet
 from .scene import EFFECTS_AVAILABLE, Scene
 
 NODE_DOFS = 12
@@ -333,9 +333,11 @@ def build_boom(scene: Scene) -> BeamModel:
 
 
 def build_cantilever(scene: Scene) -> BeamModel:
-    """A cantilever along +r1 clamped at the origin (frame A = I)."""
+    """A beam along +r1 with its root node clamped at the origin or hinged about r3
+    (``cantilever.clamp``); frame A = I."""
     model = _model(scene, np.eye(3), np.zeros(3))
-    parts = (R, RY, RZ) if scene["cantilever"]["clamp"] == "section" else (R, RX, RY, RZ)
+    parts = {"section": (R, RY, RZ), "full": (R, RX, RY, RZ), "pin": (R, RZ)}[
+        scene["cantilever"]["clamp"]]
     e0 = model.e0
     for part in parts:
         for d in node_dofs(0, part):
@@ -344,6 +346,57 @@ def build_cantilever(scene: Scene) -> BeamModel:
     return model
 
 
+def build_spinup(scene: Scene) -> BeamModel:
+    """The spin-up beam of Simo & Vu-Quoc (REFERENCES.md): the root section clamped to a
+    hub turning about r3 with the prescribed angle phi(t); the floating frame is the hub's,
+    A(t) = R(phi(t)), in which the probe deflections are resolved."""
+    spin = scene["spinup"]
+    model = _model(scene, np.eye(3), np.zeros(3))
+    c = model.constraints
+    drive = c.add_drive(DRIVE_SPINUP, [spin["omega"], spin["period"], 0.0])
+    model.frame_drive, model.frame_base = drive, np.eye(3)
+    for d in node_dofs(0, R):
+        c.coordinate(d, name=f"hub: e[{d}] = 0")
+    r_y, r_z = node_dofs(0, RY), node_dofs(0, RZ)
+    c.coordinate(r_y[0], sin_coef=-1.0, drive=drive, name="hub: r_y1 = -sin(phi)")
+    c.coordinate(r_y[1], cos_coef=1.0, drive=drive, name="hub: r_y2 = cos(phi)")
+    c.coordinate(r_y[2], name="hub: r_y3 = 0")
+    for k, d in enumerate(r_z):
+        c.coordinate(d, 1.0 if k == 2 else 0.0, name=f"hub: r_z{k + 1}")
+    _apply_loads(model, scene)
+    return model
+
+
+def first_bending_frequency(model: BeamModel) -> float:
+    """Clamped-free first bending frequency (rad/s) of the beam in its weak direction,
+    (beta_1 L)^2 sqrt(EI / (rho A L^4)): the scale against which FFR's validity is judged."""
+    length = model.length_scale
+    inertia = model.width * model.height**3 / 12.0
+    area = model.width * model.height
+    return 1.875104068711961**2 * np.sqrt(model.youngs * inertia
+                                          / (model.density * area * length**4))
+
+
+def check_ffr_validity(model: BeamModel, scene: Scene) -> None:
+    """Warn when an 'ffr' scene leaves the model's assumptions: a frame turning at a speed
+    near or above the first bending frequency (no geometric stiffening in FFR)."""
+    if model.formulation != "ffr" or not model.frame_drive:
+        return
+    kind = model.constraints.drive_kinds[model.frame_drive - 1]
+    params = model.constraints.drive_params[model.frame_drive - 1]
+    rate = {DRIVE_LUFFING: params[0], DRIVE_SPINUP: params[0]}.get(kind, 0.0)
+    omega1 = first_bending_frequency(model)
+    if rate > 0.3 * omega1:
+        model.warnings.append(
+            f"formulation 'ffr' outside its assumptions: the frame turns at {rate:.3g} rad/s, "
+            f"{rate / omega1:.2f} of the first bending frequency {omega1:.3g} rad/s; FFR has no "
+            "geometric (centrifugal) stiffening and becomes unstable near and above it - use "
+            "formulation = 'nonlinear'")
+
+
 def build_model(scene: Scene) -> BeamModel:
     """The model the scene describes."""
-    return {"boom": build_boom, "cantilever": build_cantilever}[scene.kind](scene)
+    builders = {"boom": build_boom, "cantilever": build_cantilever, "spinup": build_spinup}
+    model = builders[scene.kind](scene)
+    check_ffr_validity(model, scene)
+    return model

@@ -80,6 +80,7 @@ def finish(path: Path, model: BeamModel, timing: dict[str, float], status: str,
         _attrs(group.attrs, {k: float(v) for k, v in timing.items()})
         h5.attrs["status"] = status
         h5.attrs["message"] = message
+        h5.attrs["warnings"] = "\n".join(model.warnings)
 
 
 def read_summary(path: Path) -> dict[str, Any]:

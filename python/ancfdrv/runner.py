@@ -74,6 +74,13 @@ def _run_dynamic(scene: Scene, model: BeamModel, out: Path, e_start: np.ndarray,
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     stages: dict[str, float] = {}
+    with h5py.File(out, "r") as h5:
+        deflection = h5["dynamic/deflection/tip"][()]
+    ratio = np.abs(deflection).max() / model.length_scale
+    if model.formulation == "ffr" and ratio > 0.05:
+        model.warnings.append(
+            f"formulation 'ffr' outside its assumptions: the tip deflects by {ratio:.2%} of the "
+            "length (small deformation assumed); compare with formulation = 'nonlinear'")
     bounds = boom_stages(scene)
     if bounds:
         with h5py.File(out, "r") as h5:

@@ -91,8 +91,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
                              "luffing angle reached at the end of braking (deg)"),
     },
     "cantilever": {
-        "clamp": Key("str", "section", one_of("section", "full"),
-                     "'section' fixes r, r_y, r_z of the root node; 'full' also r_x"),
+        "clamp": Key("str", "section", one_of("section", "full", "pin"),
+                     "'section' fixes r, r_y, r_z of the root node; 'full' also r_x; 'pin' "
+                     "fixes r and r_z (a hinge about r3)"),
+    },
+    "spinup": {
+        "omega": Key("float", 6.0, positive, "final hub speed W (rad/s)"),
+        "period": Key("float", 15.0, positive, "spin-up time T (s)"),
     },
     "loads": {
         "gravity": Key("float", 9.81, non_negative, "gravitational acceleration (m/s^2)"),
@@ -134,7 +139,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
 }
 
 #: Groups that define what is built; a scene has exactly one of them.
-MODEL_GROUPS = ("boom", "cantilever")
+MODEL_GROUPS = ("boom", "cantilever", "spinup")
 COMMON_GROUPS = ("scene", "beam", "material", "loads", "solver")
 
 
@@ -203,7 +208,7 @@ def _coerce(kind: str, raw: Any, where: dict) -> Any:
         items = raw if isinstance(raw, list) else [raw]
         if not all(isinstance(x, str) for x in items):
             raise bad("a list of strings")
-        return [x.strip() for x in items if x is not None]
+        return [x.strip() for x in items if x is not None and x.strip()]  # '' = none
     raise AssertionError(kind)
 
 
