@@ -44,21 +44,29 @@ class StaticResult:
     extra: dict[str, float] = field(default_factory=dict)
 
 
-def converged(force_res: float, con_res: float, step: float, size: float, tol: float) -> str:
+def converged(force_res: float, con_res: float, step: float, size: float, tol: float,
+              previous_res: float = np.inf) -> str:
     """One test for both static solvers: '' while iterating, else why it stopped.
 
     'residual': relative force residual and constraint violation below tol.
-    'step': the correction is below tol relative to the displacement (with the constraint
-    met and the residual below sqrt(tol)). The residual of absolute ANCF coordinates has a
-    round-off floor that grows with the mesh (about 5e-9 at 2000 nodes), so a residual
-    test alone cannot be met on fine meshes while the displacement is converged.
+    The residual of absolute ANCF coordinates has a round-off floor that grows with the
+    mesh (about 5e-9 at 2000 nodes), so on fine meshes a residual test alone cannot be met
+    although the state is converged. With the constraint met and the residual below
+    sqrt(tol), the solve also stops when
+    'step': the correction is below tol relative to the displacement (the split
+    iteration's change between passes goes to zero), or
+    'floor': the residual no longer decreases (Newton's corrections are then solves of
+    round-off noise, which do not shrink).
     """
     if con_res > tol:
         return ""
     if force_res <= tol:
         return "residual"
-    if step <= tol * size and force_res <= np.sqrt(tol):
-        return "step"
+    if force_res <= np.sqrt(tol):
+        if step <= tol * size:
+            return "step"
+        if force_res >= 0.5 * previous_res:
+            return "floor"
     return ""
 
 
@@ -152,9 +160,10 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
                     d += step[:n]
                     lam += step[n:]
                     force_res, con_res = residuals(model, d, lam, elastic(d, False)[0])
+                    previous = history[-1] if history and iteration > 1 else np.inf
                     history.append(force_res)
                     how = converged(force_res, con_res, np.linalg.norm(step[:n]),
-                                    np.linalg.norm(d), tol)
+                                    np.linalg.norm(d), tol, previous)
                     if how:
                         break
                 else:
