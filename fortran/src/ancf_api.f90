@@ -85,18 +85,22 @@ subroutine beam_nonlinear_forces(ndof, nel, npts, dofs, e, gradients, weights, y
   integer, intent(in) :: ndof, nel, npts, dofs(24, nel), want_tangent
   real(dp), intent(in) :: e(ndof), gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
   real(dp), intent(out) :: force(ndof), energy, tangent(24, 24, nel)
-  real(dp) :: element_force(24), element_energy
+  real(dp) :: element_force(24, nel), element_energy(nel)
   integer :: el
   force = 0.0_dp
-  energy = 0.0_dp
   tangent = 0.0_dp
+  ! elements in parallel (OpenMP, when built with it), then a serial scatter
+  !$omp parallel do schedule(static)
   do el = 1, nel
     call nonlinear_element(reshape(e(dofs(:, el)), [3, 8]), gradients(:, :, :, el), weights(:, el), &
-                           youngs, poisson, want_tangent /= 0, element_force, element_energy, &
-                           tangent(:, :, el))
-    force(dofs(:, el)) = force(dofs(:, el)) + element_force
-    energy = energy + element_energy
+                           youngs, poisson, want_tangent /= 0, element_force(:, el), &
+                           element_energy(el), tangent(:, :, el))
   end do
+  !$omp end parallel do
+  do el = 1, nel
+    force(dofs(:, el)) = force(dofs(:, el)) + element_force(:, el)
+  end do
+  energy = sum(element_energy)
 end subroutine beam_nonlinear_forces
 
 !> Shape functions and their parameter derivatives at npts material points.

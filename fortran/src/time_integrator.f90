@@ -161,7 +161,7 @@ contains
     type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: rotation(3, 3), e(:)
     real(dp), intent(out) :: force(:), strain
-    real(dp) :: element_force(24), element_energy, unused(24, 24)
+    real(dp) :: element_force(24, sys%nel), element_energy(sys%nel), unused(24, 24)
     integer :: el
     if (sys%formulation == formulation_ffr) then
       call ffr_force(sys%ndof, sys%nel, sys%dofs, sys%stiffness0, rotation, e, sys%e0_frame, &
@@ -169,14 +169,18 @@ contains
       return
     end if
     force = 0.0_dp
-    strain = 0.0_dp
+    ! elements in parallel (OpenMP, when built with it), then a serial scatter
+    !$omp parallel do schedule(static) private(unused)
     do el = 1, sys%nel
       call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
                              sys%gauss_weights(:, el), sys%youngs, sys%poisson, .false., &
-                             element_force, element_energy, unused)
-      force(sys%dofs(:, el)) = force(sys%dofs(:, el)) + element_force
-      strain = strain + element_energy
+                             element_force(:, el), element_energy(el), unused)
     end do
+    !$omp end parallel do
+    do el = 1, sys%nel
+      force(sys%dofs(:, el)) = force(sys%dofs(:, el)) + element_force(:, el)
+    end do
+    strain = sum(element_energy)
   end subroutine elastic_force
 
   !> Large deformation: factorize S = beta' M + K_t(e) on the solver's pattern and compute
@@ -189,11 +193,13 @@ contains
     real(dp) :: tangents(24, 24, sys%nel), element_force(24), element_energy
     real(dp) :: values(size(sys%mass_pattern))
     integer :: el, b, j
+    !$omp parallel do schedule(static) private(element_force, element_energy)
     do el = 1, sys%nel
       call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
                              sys%gauss_weights(:, el), sys%youngs, sys%poisson, .true., &
                              element_force, element_energy, tangents(:, :, el))
     end do
+    !$omp end parallel do
     call pattern_assemble(size(values), 24, sys%nel, sys%scatter_map, tangents, values)
     values = values + beta_prime * sys%mass_pattern
     call solver_factorize(sys%solver_handle, size(values), values, info, detail)

@@ -5,4 +5,13 @@ Fortran kernel by :mod:`ancfdrv.model`, solved by :mod:`ancfdrv.static`, and sto
 HDF5 by :mod:`ancfdrv.results`; :mod:`ancfdrv.runner` ties these together and
 :mod:`ancfdrv.cli` is the ``ancf`` command.
 """
+import os as _os
+
+# The kernel's OpenMP element loops (large-deformation beam) run on one thread unless the
+# user sets OMP_NUM_THREADS: sweeps already fill the cores with processes. OpenBLAS stays
+# single-threaded unless OPENBLAS_NUM_THREADS says otherwise: its threaded banded Cholesky
+# was measured 10x slower than the single-threaded one on the beam's narrow band.
+_os.environ.setdefault("OMP_NUM_THREADS", "1")
+_os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 __version__ = "0.1.0"
