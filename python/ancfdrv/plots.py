@@ -102,8 +102,9 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
         out += plot_histories(ok, keys, outdir)
     nodes_key = "beam.nodes" if "beam.nodes" in keys else None
     others = [k for k in keys if k not in ("beam.nodes", "solver.dt")]
-    x_key = others[0] if others else None
-    panel_keys = others[1:]
+    numeric = [k for k in others if all(_isnum(r[k]) for r in ok)]
+    x_key = numeric[0] if numeric else None  # the x axis; string keys become panels
+    panel_keys = [k for k in others if k != x_key]
     panels = sorted({tuple(r[k] for k in panel_keys) for r in ok}, key=lambda t: [float(v) if
                     _isnum(v) else v for v in t])
     if x_key and all("tip_transverse" in r for r in ok):
