@@ -59,6 +59,7 @@ import numpy as np
 import scipy
 
 import ancfdrv
+from _common import json_ready, load_average, machine_info, print_table
 from ancfdrv.dynamic import DynamicSettings, initial_acceleration
 from ancfdrv.model import BeamModel, build_model
 from ancfdrv.runner import boom_stages, dynamic_settings, run_scene
@@ -343,26 +344,8 @@ def time_import(repeats: int) -> float:
 
 
 # -- reporting ----------------------------------------------------------------------------
-def machine_info() -> dict[str, Any]:
-    """Platform, CPUs, library versions, thread settings and the current load."""
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        usable = os.cpu_count()
-    threads = {k: os.environ[k] for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
-                                          "MKL_NUM_THREADS") if k in os.environ}
-    return {"platform": platform.platform(), "machine": platform.machine(),
-            "python": sys.version.split()[0], "cpu_count": os.cpu_count(),
-            "cpus_usable": usable, "numpy": np.__version__, "scipy": scipy.__version__,
-            "ancfdrv": getattr(ancfdrv, "__version__", None), "thread_env": threads,
-            "load_average_at_start": _load()}
 
 
-def _load() -> list[float] | None:
-    try:
-        return [round(x, 2) for x in os.getloadavg()]
-    except OSError:
-        return None
 
 
 SERIES: dict[str, Callable[[dict[str, Any]], float]] = {
@@ -397,11 +380,6 @@ def _ms(seconds: float, width: int = 8) -> str:
     return f"{'-':>{width}}" if not math.isfinite(seconds) else f"{1e3 * seconds:{width}.2f}"
 
 
-def _table(head: list[tuple[str, int]], rows: list[list[str]]) -> None:
-    print(" ".join(f"{h:>{w}}" for h, w in head))
-    print("-" * (sum(w for _, w in head) + len(head) - 1))
-    for row in rows:
-        print(" ".join(f"{c:>{w}}" for c, (_, w) in zip(row, head)))
 
 
 def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
@@ -429,7 +407,7 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
                          f"{q['step_over_floor_bulk']:.1f}",
                          f"{q['correction_over_floor_bulk']:.1f}",
                          f"{100 * q['solve_share']:.0f}%", f"{f['bulk_gflops']:.2f}"])
-        _table([("nodes", 5), ("ndof", 6), ("kd", 3), ("steps x calls", 13),
+        print_table([("nodes", 5), ("ndof", 6), ("kd", 3), ("steps x calls", 13),
                 ("step", 9), ("newton", 6), ("single", 8), ("bulk", 8), ("/single", 8),
                 ("/bulk", 6), ("/corr", 6), ("solve", 5), ("GF/s", 5)], rows)
 
@@ -445,14 +423,14 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
                          _us(su["start_stage"]["step_s"]),
                          f"{su['start_stage']['newton_mean']:.2f}",
                          _us(c["one_step_call_s"]), _us(c["overhead_s"])])
-        _table([("nodes", 5), ("build", 8), ("static", 8), ("it", 3), ("setup", 8),
+        print_table([("nodes", 5), ("build", 8), ("static", 8), ("it", 3), ("setup", 8),
                 ("a0", 8), ("start/step", 10), ("newton", 6), ("1-step call", 11),
                 ("overhead", 9)], rows)
 
         print("\n[3] growth exponents d log t / d log ndof between consecutive meshes "
               "(1 = linear)")
         keys = list(SERIES)
-        _table([("nodes", 10)] + [(k, max(8, len(k))) for k in keys],
+        print_table([("nodes", 10)] + [(k, max(8, len(k))) for k in keys],
                [[f"{g['nodes'][0]}->{g['nodes'][1]}"]
                 + [f"{g[k]:.2f}" if math.isfinite(g[k]) else "-" for k in keys]
                 for g in exponents])
@@ -476,19 +454,6 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
               f"{run['repeats']})")
 
 
-def _nan_to_none(value: Any) -> Any:
-    """JSON-ready copy: numpy scalars and arrays to Python, NaN and inf to None."""
-    if isinstance(value, np.ndarray):
-        value = value.tolist()
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _nan_to_none(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_nan_to_none(v) for v in value]
-    return value
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -550,7 +515,7 @@ def main(argv: list[str] | None = None) -> int:
         run = time_run_scene(args.run_nodes, args)
         print(f"  run_scene at {args.run_nodes} nodes x {args.run_repeats} in "
               f"{time.perf_counter() - t0:6.1f} s", file=sys.stderr, flush=True)
-    machine["load_average_at_end"] = _load()
+    machine["load_average_at_end"] = load_average()
     exponents = growth_exponents(records)
     print_tables(records, exponents, run, args)
     report = {
@@ -566,7 +531,7 @@ def main(argv: list[str] | None = None) -> int:
         "run_scene": run, "wall_time_s": time.perf_counter() - start,
     }
     args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(json.dumps(_nan_to_none(report), indent=1, allow_nan=False) + "\n")
+    args.output.write_text(json.dumps(json_ready(report), indent=1, allow_nan=False) + "\n")
     print(f"\nwrote {args.output} in {report['wall_time_s']:.1f} s")
     return 0
 

@@ -64,6 +64,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 import ancfdrv
+from _common import json_ready, load_average, machine_info, print_table
 from ancfdrv.errors import SolverError
 from ancfdrv.kernel import DirectSolver
 from ancfdrv.model import BeamModel, build_model
@@ -353,26 +354,8 @@ def measure(nodes: int, args: argparse.Namespace) -> dict[str, Any]:
 
 
 # -- reporting ----------------------------------------------------------------------------
-def machine_info() -> dict[str, Any]:
-    """Platform, CPUs, library versions, thread settings and the current load."""
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        usable = os.cpu_count()
-    threads = {k: os.environ[k] for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
-                                          "MKL_NUM_THREADS") if k in os.environ}
-    return {"platform": platform.platform(), "machine": platform.machine(),
-            "processor": platform.processor(), "python": sys.version.split()[0],
-            "cpu_count": os.cpu_count(), "cpus_usable": usable, "numpy": np.__version__,
-            "scipy": scipy.__version__, "ancfdrv": getattr(ancfdrv, "__version__", None),
-            "thread_env": threads, "load_average_at_start": _load()}
 
 
-def _load() -> list[float] | None:
-    try:
-        return [round(x, 2) for x in os.getloadavg()]
-    except OSError:
-        return None
 
 
 def _static_best(rec: dict[str, Any]) -> float:
@@ -412,11 +395,6 @@ def _iterations(rec: dict[str, Any]) -> str:
     return f"{rec['iterations']}{how}{'' if rec['converged_at_requested_tol'] else '*'}"
 
 
-def _table(head: list[tuple[str, int]], rows: list[list[str]]) -> None:
-    print(" ".join(f"{h:>{w}}" for h, w in head))
-    print("-" * (sum(w for _, w in head) + len(head) - 1))
-    for row in rows:
-        print(" ".join(f"{c:>{w}}" for c, (_, w) in zip(row, head)))
 
 
 def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
@@ -437,7 +415,7 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
         rows.append([str(r["nodes"]), str(r["ndof"]), str(r["nnz_K"]),
                      _ms(r["build_model"]["best_s"]), _ms(r["stiffness_assembly"]["best_s"]),
                      _ms(af["saddle"]), _ms(af["K_RR"]), _ms(af["K"])])
-    _table([("nodes", 5), ("ndof", 6), ("nnz K", 7), ("build", 9), ("assemble", 9),
+    print_table([("nodes", 5), ("ndof", 6), ("nnz K", 7), ("build", 9), ("assemble", 9),
             ("saddle a+f", 10), ("K_RR a+f", 9), ("K a+f", 9)], rows)
 
     print("\n[2] static solves against the floor = one create+analyse+factorize+solve of "
@@ -461,7 +439,7 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
                     f"{ratios[f'{method}_over_mumps_floor']:.2f}",
                     f"{ratios[f'{method}_over_spsolve']:.2f}"]
         rows.append(row)
-    _table([("nodes", 5), ("floor", 9), ("spsolve", 9), ("newton", 10), ("it", 4),
+    print_table([("nodes", 5), ("floor", 9), ("spsolve", 9), ("newton", 10), ("it", 4),
             ("res", 7), ("N/floor", 7), ("N/spsol", 7), ("split", 10), ("it", 4),
             ("res", 7), ("S/floor", 7), ("S/spsol", 7)], rows)
 
@@ -482,14 +460,14 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
             row += [f"{100 * t.get('cpu_sys_s', math.nan) / cpu:.0f}%" if cpu > 0 else "-",
                     f"{t.get('minor_faults', 0) / 1e3:.1f}"]
         rows.append(row)
-    _table([("nodes", 5), ("N asm", 8), ("N fact", 8), ("N solve", 8), ("N other", 8),
+    print_table([("nodes", 5), ("N asm", 8), ("N fact", 8), ("N solve", 8), ("N other", 8),
             ("sys", 4), ("mflt", 6), ("S asm", 9), ("S fact", 8), ("S solve", 9),
             ("S other", 9), ("sys", 4), ("mflt", 6)], rows)
 
     print("\n[4] growth exponents d log t / d log ndof between consecutive meshes "
           "(1 = linear)")
     keys = [k for k in (exponents[0] if exponents else {}) if k != "nodes"]
-    _table([("nodes", 10)] + [(k, max(8, len(k))) for k in keys],
+    print_table([("nodes", 10)] + [(k, max(8, len(k))) for k in keys],
            [[f"{g['nodes'][0]}->{g['nodes'][1]}"] + [f"{g[k]:.2f}" for k in keys]
             for g in exponents])
 
@@ -502,25 +480,12 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
                   f"(after {f['time_to_failure_s']:.2f} s)")
     print("\n[6] saddle-point solution check: |x_mumps - x_spsolve| / |x_spsolve| and "
           "residuals |Ax - b| / |b|")
-    _table([("nodes", 5), ("difference", 10), ("MUMPS res", 10), ("spsolve res", 11)],
+    print_table([("nodes", 5), ("difference", 10), ("MUMPS res", 10), ("spsolve res", 11)],
            [[str(r["nodes"])] + [f"{r['saddle_solution_check'][k]:.2e}" for k in
                                  ("relative_difference", "residual_mumps", "residual_spsolve")]
             for r in records])
 
 
-def _nan_to_none(value: Any) -> Any:
-    """JSON-ready copy: numpy scalars and arrays to Python, NaN and inf to None."""
-    if isinstance(value, np.ndarray):
-        value = value.tolist()
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _nan_to_none(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_nan_to_none(v) for v in value]
-    return value
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -572,7 +537,7 @@ def main(argv: list[str] | None = None) -> int:
         records.append(measure(nodes, args))
         print(f"  {nodes:>5} nodes measured in {time.perf_counter() - t0:6.1f} s",
               file=sys.stderr, flush=True)
-    machine["load_average_at_end"] = _load()
+    machine["load_average_at_end"] = load_average()
     exponents = growth_exponents(records)
     print_tables(records, exponents, args)
     report = {
@@ -586,7 +551,7 @@ def main(argv: list[str] | None = None) -> int:
         "wall_time_s": time.perf_counter() - start,
     }
     args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(json.dumps(_nan_to_none(report), indent=1, allow_nan=False) + "\n")
+    args.output.write_text(json.dumps(json_ready(report), indent=1, allow_nan=False) + "\n")
     print(f"\nwrote {args.output} in {report['wall_time_s']:.1f} s")
     return 0
 
