@@ -1,10 +1,11 @@
 !> Sparse direct solves behind integer handles: analyse a pattern once, factorize as often
 !> as the values change, solve many right-hand sides per factorization, release cleanly.
 !> Two kinds share the API: sequential MUMPS (any sparse matrix; it never prints, ICNTL
-!> 1-4), and LAPACK's banded Cholesky (dpbtrf/dpbtrs) for symmetric positive-definite
-!> matrices with a narrow band, such as a beam's iteration matrix, whose solves cost
-!> O(n kd) with none of MUMPS's per-call overhead. The handle table is the kernel's
-!> only module state.
+!> 1-4), and LAPACK's banded Cholesky (dpbtrf/dpbtrs) for symmetric matrices with a narrow
+!> band, such as a beam's iteration matrix, whose solves cost O(n kd) with none of MUMPS's
+!> per-call overhead. When the Cholesky finds the matrix not positive definite (a tangent
+!> stiffness under compression), the same handle falls back to the banded LU with partial
+!> pivoting (dgbtrf/dgbtrs). The handle table is the kernel's only module state.
 !> info: 0 ok; 1 bad handle or no free slot; 2 call out of sequence (solve before
 !> factorize, ...); 3 size mismatch; < 0 MUMPS INFOG(1) (-10: numerically singular),
 !> with INFOG(2) in info_detail; the banded kind reports a non-positive-definite matrix
@@ -24,8 +25,9 @@ module sparse_direct
     type(dmumps_struc) :: id
     logical :: banded = .false.
     integer :: n = 0, bandwidth = 0
-    integer, allocatable :: rows(:), cols(:)
-    real(dp), allocatable :: band(:, :)
+    integer, allocatable :: rows(:), cols(:), pivots(:)
+    real(dp), allocatable :: band(:, :), general_band(:, :)
+    logical :: pivoted_lu = .false.
     logical :: in_use = .false.
     logical :: analysed = .false.
     logical :: factorized = .false.
@@ -193,7 +195,12 @@ contains
         return
       end if
       associate (slot => slots(handle))
-        call dpbtrs('U', n, slot%bandwidth, nrhs, slot%band, slot%bandwidth + 1, rhs, n, info_detail)
+        if (slot%pivoted_lu) then
+          call dgbtrs('N', n, slot%bandwidth, slot%bandwidth, nrhs, slot%general_band, &
+                      3 * slot%bandwidth + 1, slot%pivots, rhs, n, info_detail)
+        else
+          call dpbtrs('U', n, slot%bandwidth, nrhs, slot%band, slot%bandwidth + 1, rhs, n, info_detail)
+        end if
       end associate
       info = merge(0, 3, info_detail == 0)
       return
@@ -228,6 +235,8 @@ contains
     end if
     if (slots(handle)%banded) then
       if (allocated(slots(handle)%band)) deallocate (slots(handle)%band)
+      if (allocated(slots(handle)%general_band)) deallocate (slots(handle)%general_band)
+      if (allocated(slots(handle)%pivots)) deallocate (slots(handle)%pivots)
       if (allocated(slots(handle)%rows)) deallocate (slots(handle)%rows, slots(handle)%cols)
       slots(handle)%in_use = .false.
       slots(handle)%analysed = .false.
@@ -247,13 +256,15 @@ contains
   end subroutine solver_destroy
 
   !> Banded Cholesky of the upper triangle (entries below the diagonal are ignored, so
-  !> both triangles or the upper one may be given; duplicates are summed).
+  !> both triangles or the upper one may be given; duplicates are summed). A matrix that
+  !> is not positive definite is factorized by the pivoted banded LU instead, which needs
+  !> both triangles; info = -10 only when that fails too (singular).
   subroutine banded_factorize(slot, nnz, values, info, info_detail)
     type(solver_slot), intent(inout) :: slot
     integer, intent(in) :: nnz
     real(dp), intent(in) :: values(nnz)
     integer, intent(out) :: info, info_detail
-    integer :: k, kd
+    integer :: k, kd, row_in_band
     info_detail = 0
     if (size(slot%rows) /= nnz) then
       info = 3
@@ -266,7 +277,20 @@ contains
         slot%band(kd + 1 + slot%rows(k) - slot%cols(k), slot%cols(k)) + values(k)
     end do
     call dpbtrf('U', slot%n, kd, slot%band, kd + 1, info_detail)
+    slot%pivoted_lu = info_detail /= 0
     info = 0
+    if (.not. slot%pivoted_lu) return
+    ! not positive definite: general band storage, kl = ku = kd, with room for the fill-in
+    if (.not. allocated(slot%general_band)) then
+      allocate (slot%general_band(3 * kd + 1, slot%n), slot%pivots(slot%n))
+    end if
+    slot%general_band = 0.0_dp
+    do k = 1, nnz
+      row_in_band = 2 * kd + 1 + slot%rows(k) - slot%cols(k)
+      slot%general_band(row_in_band, slot%cols(k)) = slot%general_band(row_in_band, slot%cols(k)) &
+                                                     + values(k)
+    end do
+    call dgbtrf(slot%n, slot%n, kd, kd, slot%general_band, 3 * kd + 1, slot%pivots, info_detail)
     if (info_detail /= 0) info = -10
   end subroutine banded_factorize
 

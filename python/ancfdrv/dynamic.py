@@ -39,7 +39,7 @@ ENERGY_NAMES = ("kinetic", "strain", "gravity", "moment", "total", "drive_work",
 _FAILURES = {
     1: "Newton did not converge within {max_newton} iterations",
     2: "the state became non-finite (NaN or overflow)",
-    3: "the linear solve failed (MUMPS code {detail})",
+    3: "the linear solve failed (solver code {detail}: -10 = singular matrix)",
     4: "the multipliers' Schur complement is singular (dgesv info {detail}): the "
        "constraints are redundant or lost rank",
     5: "a constraint or drive could not be evaluated",

@@ -145,7 +145,7 @@ class SparsePattern:
                              shape=(self.n, self.n))
 
 
-_MUMPS_MESSAGES = {-10: "the matrix is numerically singular (or, banded: not positive definite)",
+_MUMPS_MESSAGES = {-10: "the matrix is numerically singular",
                    -9: "MUMPS workspace too small", -13: "MUMPS could not allocate memory",
                    -6: "the matrix is structurally singular", -5: "MUMPS out of memory"}
 
@@ -159,8 +159,10 @@ class DirectSolver:
 
     def __init__(self, n: int, rows: np.ndarray, cols: np.ndarray, *, symmetric: bool = False,
                  banded_spd: bool = False, what: str = "system matrix") -> None:
-        """``banded_spd`` selects LAPACK's banded Cholesky (symmetric positive definite,
-        narrow band: O(n kd) solves without MUMPS's per-call overhead)."""
+        """``banded_spd`` selects LAPACK's banded Cholesky for a symmetric matrix with a narrow
+        band (O(n kd) solves without MUMPS's per-call overhead); a matrix that turns out not
+        to be positive definite is factorized by the pivoted banded LU instead (give both
+        triangles)."""
         self.what = what
         handle, info, detail = _kernel.direct_create(3 if banded_spd else 2 if symmetric else 0)
         self._check(info, detail, "create")

@@ -1,0 +1,880 @@
+#!/usr/bin/env python
+"""Accuracy against wall time: ancfdrv's large-deformation beam and Exudyn's ANCFCable2D on
+the two hard cases of ../shared/REFERENCES.md.
+
+Problems (the physical data are read from the ancfdrv scenes, so both codes solve the
+same beam):
+
+* ``pendulum``: the flexible pendulum (Berzeri & Shabana 2000), ``inputs/hard/pendulum.nml``;
+  hinged at the root, released horizontal under gravity; compared quantity: the tip's
+  global y over 0 ... 1 s;
+* ``spinup``: the spin-up beam (Simo & Vu-Quoc 1986) at W = 4 rad/s,
+  ``inputs/hard/spinup.nml`` with ``spinup.omega=4``; compared quantity: the tip's
+  transverse deflection in the rotating hub frame over 0 ... 20 s.
+
+ancfdrv runs :func:`ancfdrv.runner.run_scene` on the scene with ``--set``-style overrides
+(``beam.nodes``, ``solver.dt``, ``solver.t_end``): the scene's generalized-alpha
+integrator, rho_inf and Newton tolerance, HDF5 output to a temporary directory. Exudyn
+builds the same beam from ``ObjectANCFCable2D`` elements (2D Euler-Bernoulli cable, EA
+and EI from the scene's section) and integrates with its generalized-alpha solver
+(index-3 constraints, the scene's rho_inf, fixed step, sparse LU). Constraints:
+
+* pendulum: ancfdrv fixes r and r_z of the root node (a hinge about r3); Exudyn fixes the
+  root's position, the slope stays free;
+* spin-up: ancfdrv prescribes r = 0, r_y = (-sin phi, cos phi, 0), r_z = e3 at the root;
+  Exudyn prescribes r = 0 and the slope r' = (cos phi, sin phi) (``CoordinateConstraint``
+  with an offset user function), which also fixes the axial stretch of the root point
+  (strains there are ~3e-5: no visible effect). phi(t) is the profile of REFERENCES.md,
+  checked against ancfdrv's drive (``kernel.drive_values``).
+
+Each code runs a grid of meshes and steps; its finest run is its converged reference.
+For every run this records the wall time (model build, solve and output of one call,
+best of repeats until ``--min-time``; interpreter start-up and imports excluded) and the
+error of the tip history, max_k |y_k - y_ref(t_k)| on a uniform grid of sample times
+(every ``sample_dt``; every step size divides it):
+
+* ``error``: against ancfdrv's reference (the common reference of the brief);
+* ``self_error``: against the run's own code's reference (discretization error of its
+  own model).
+
+The references are compared with each other: where they differ by more than the
+discretization errors, the codes solve different continuum models and ``error`` of the
+Exudyn runs measures the model difference, not their accuracy. For the pendulum (axial
+strains of several percent: EA = 1260 N carries the weight and the centrifugal force) this
+is the case: ancfdrv's continuum element uses the Green-Lagrange strain with a St.
+Venant-Kirchhoff law (axial force EA lambda (lambda^2 - 1) / 2 at stretch lambda), Exudyn's
+cable EA (lambda - 1). A third run of Exudyn at its reference resolution with that
+St. Venant-Kirchhoff axial force (Python user functions: slow, not timed against ancfdrv)
+tests this explanation.
+
+Dominance: ancfdrv's curve dominates when for every Exudyn run some ancfdrv run reaches
+the same error or smaller in the same time or less; for each Exudyn run the table gives
+the time of the cheapest ancfdrv run at least as accurate (and vice versa). It is judged
+on ``self_error`` (each code against its own converged model) and on ``error`` (common
+reference).
+
+Where ancfdrv's time goes: per ancfdrv run, the phases run_scene reports (model, set-up,
+stepping, output) and an estimate of the stepping from kernel costs measured in this
+process at the run's mesh: element evaluations (one force + tangent per step for the
+iteration matrix, one force per Newton correction and one for the step's energy), the
+banded Cholesky factorization of beta' M + K_t, and the substitutions (the flexibility
+S^-1 E_c, 3 per constrained 3-vector, and one per Newton correction).
+
+Results: tables on stdout and JSON in ``benchmarks/results/peer_exudyn.json``
+(``peer_exudyn_quick.json`` with ``--quick``). Run from the repository root::
+
+    python benchmarks/peer_exudyn.py            # about 2.5 min on 2 cores
+    python benchmarks/peer_exudyn.py --quick    # coarser grids and references, about 35 s
+    python benchmarks/peer_exudyn.py --omp-threads 2 --no-exudyn   # ancfdrv on 2 threads
+
+When Exudyn cannot be imported (``pip install exudyn``), its runs are skipped and
+ancfdrv's curve is still reported.
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import datetime as _dt
+import importlib
+import io
+import json
+import math
+import os
+import sys
+import tempfile
+import time
+import warnings
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any, Callable
+
+import h5py
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+RESULTS = REPO / "benchmarks" / "results"
+#: Another engineer reinstalls ancfdrv from time to time: how long to wait before retrying.
+IMPORT_RETRY_S, IMPORT_ATTEMPTS = 30.0, 4
+#: Exudyn's Newton: relative tolerance (its default) and the absolute tolerances tried in
+#: turn. Its default absolute tolerance (1e-10) lies below the round-off floor of the
+#: spin-up's residual (EA = 2.8e7 N): Newton then never converges and the fixed-step solve
+#: stops; the first tolerance that works is recorded with the run.
+EXUDYN_RELATIVE_TOL = 1e-8
+EXUDYN_ABSOLUTE_TOLS = (1e-10, 1e-8, 1e-6, 1e-4)
+
+Grid = tuple[tuple[int, float], ...]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One comparison: the scene, the compared history and the run grids.
+
+    ``ancfdrv_runs`` are (nodes, dt), ``exudyn_runs`` (elements, dt); the last entry of
+    each grid is that code's reference and should be its finest run."""
+
+    name: str
+    scene: str
+    overrides: tuple[str, ...]
+    t_end: float
+    sample_dt: float
+    quantity: str
+    ancfdrv_runs: Grid
+    exudyn_runs: Grid
+    svk_check: tuple[int, float] | None = None
+
+
+PROBLEMS: dict[str, Problem] = {
+    "pendulum": Problem(
+        name="pendulum", scene="inputs/hard/pendulum.nml", overrides=(), t_end=1.0,
+        sample_dt=0.01, quantity="tip y (m), global",
+        ancfdrv_runs=((5, 1e-3), (9, 1e-3), (9, 5e-4), (17, 1e-3), (17, 5e-4),
+                      (33, 5e-4), (33, 2.5e-4), (65, 2.5e-4)),
+        exudyn_runs=((4, 1e-3), (8, 1e-3), (8, 5e-4), (16, 1e-3), (16, 5e-4),
+                     (32, 5e-4), (32, 2.5e-4), (64, 1.25e-4)),
+        svk_check=(32, 2.5e-4)),
+    "spinup": Problem(
+        name="spinup", scene="inputs/hard/spinup.nml", overrides=("spinup.omega=4",),
+        t_end=20.0, sample_dt=0.05, quantity="tip deflection (m), transverse, hub frame",
+        ancfdrv_runs=((6, 1e-2), (6, 5e-3), (11, 1e-2), (11, 5e-3), (21, 5e-3),
+                      (41, 5e-3), (41, 2.5e-3), (81, 2.5e-3)),
+        exudyn_runs=((5, 1e-2), (5, 5e-3), (10, 1e-2), (10, 5e-3), (20, 5e-3),
+                     (40, 5e-3), (40, 2.5e-3), (80, 1.25e-3))),
+}
+#: --quick: coarser grids and references, the same problems.
+QUICK_PROBLEMS: dict[str, Problem] = {
+    "pendulum": replace(
+        PROBLEMS["pendulum"],
+        ancfdrv_runs=((5, 1e-3), (9, 1e-3), (17, 1e-3), (17, 5e-4), (33, 5e-4)),
+        exudyn_runs=((4, 1e-3), (8, 1e-3), (16, 1e-3), (16, 5e-4), (32, 5e-4)),
+        svk_check=(16, 5e-4)),
+    "spinup": replace(
+        PROBLEMS["spinup"],
+        ancfdrv_runs=((6, 1e-2), (11, 1e-2), (11, 5e-3), (21, 5e-3)),
+        exudyn_runs=((5, 1e-2), (10, 1e-2), (10, 5e-3), (20, 5e-3))),
+}
+
+
+# -- results of one run --------------------------------------------------------------------
+@dataclass
+class Run:
+    """One solve of one code: its settings, cost and sampled tip history."""
+
+    code: str
+    mesh: int                      # ancfdrv: nodes; Exudyn: elements
+    elements: int
+    dt: float
+    ok: bool = False
+    message: str = ""
+    wall_s: float = math.nan       # best of the repeats
+    repeats: int = 0
+    steps: int = 0
+    newton_iterations: int = 0
+    details: dict[str, Any] = field(default_factory=dict)
+    history: np.ndarray | None = None   # samples on the problem's grid
+    error: float = math.nan        # max |y - y_ref(ancfdrv)|
+    self_error: float = math.nan   # max |y - y_ref(own code)|
+    reference: bool = False
+
+    @property
+    def samples(self) -> np.ndarray:
+        """The sampled history of a successful run."""
+        if self.history is None:
+            raise ValueError(f"{self.code} mesh {self.mesh} dt {self.dt:g} has no history")
+        return self.history
+
+    def summary(self) -> dict[str, Any]:
+        out = asdict(self)
+        out.pop("history")
+        return out
+
+
+def max_difference(a: Run, b: Run) -> float:
+    """max_k |y_a(t_k) - y_b(t_k)| over the sample times."""
+    return float(np.max(np.abs(a.samples - b.samples)))
+
+
+def sample_grid(problem: Problem) -> np.ndarray:
+    count = int(round(problem.t_end / problem.sample_dt))
+    return problem.sample_dt * np.arange(count + 1)
+
+
+def resample(problem: Problem, time_: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """The history at the sample times (every step size divides sample_dt, so this picks
+    computed values; interpolation only absorbs round-off in the time column)."""
+    grid = sample_grid(problem)
+    if time_[-1] < grid[-1] - 1e-6 * problem.sample_dt:
+        raise ValueError(f"the history ends at t = {time_[-1]:g} s, before {grid[-1]:g} s")
+    return np.interp(grid, time_, values)
+
+
+def best_of(solve: Callable[[], tuple[np.ndarray, dict[str, Any]]], min_time: float,
+            max_repeats: int) -> tuple[float, int, np.ndarray, dict[str, Any]]:
+    """Repeat ``solve`` until the repeats took ``min_time`` (at most ``max_repeats``);
+    the fastest repeat's time, the count and the last result."""
+    times: list[float] = []
+    history: np.ndarray = np.empty(0)
+    details: dict[str, Any] = {}
+    while not times or (sum(times) < min_time and len(times) < max_repeats):
+        t0 = time.perf_counter()
+        history, details = solve()
+        times.append(time.perf_counter() - t0)
+    return min(times), len(times), history, details
+
+
+# -- ancfdrv ---------------------------------------------------------------------------------
+def import_ancfdrv() -> None:
+    """Import the package (retried while a reinstall may be under way)."""
+    for attempt in range(IMPORT_ATTEMPTS):
+        try:
+            importlib.import_module("ancfdrv.runner")
+            from ancfdrv import _kernel
+            _kernel.beam_nonlinear_points()
+            return
+        except (ImportError, AttributeError) as exc:
+            if attempt == IMPORT_ATTEMPTS - 1:
+                raise
+            print(f"import ancfdrv failed ({exc}); retrying in {IMPORT_RETRY_S:g} s",
+                  file=sys.stderr, flush=True)
+            time.sleep(IMPORT_RETRY_S)
+
+
+def ancfdrv_overrides(problem: Problem, nodes: int, dt: float) -> list[str]:
+    return [*problem.overrides, f"beam.nodes={nodes}", f"solver.dt={dt!r}",
+            f"solver.t_end={problem.t_end!r}"]
+
+
+def tip_history(problem: Problem, path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Time and the compared tip quantity from an ancfdrv result file."""
+    with h5py.File(path, "r") as h5:
+        t = h5["dynamic/time"][()]
+        if problem.name == "pendulum":
+            return t, h5["dynamic/probes/tip"][:, 1]
+        return t, h5["dynamic/deflection/tip"][:, 1]
+
+
+def run_ancfdrv(problem: Problem, nodes: int, dt: float, workdir: Path,
+                args: argparse.Namespace) -> Run:
+    """One run_scene call (repeated for timing); a SolverError is recorded, not raised."""
+    from ancfdrv.errors import AncfError
+    from ancfdrv.runner import run_scene
+
+    run = Run("ancfdrv", nodes, nodes - 1, dt)
+    out = workdir / f"{problem.name}_{nodes}_{dt:g}.h5"
+    scene = REPO / problem.scene
+
+    def solve() -> tuple[np.ndarray, dict[str, Any]]:
+        outcome = run_scene(scene, ancfdrv_overrides(problem, nodes, dt), out, progress=False)
+        dyn = outcome.dynamic
+        assert dyn is not None
+        with h5py.File(out, "r") as h5:
+            timing = {k: float(v) for k, v in h5["timing"].attrs.items()}
+        t, y = tip_history(problem, out)
+        return resample(problem, t, y), {"steps": dyn.steps, "newton": dyn.newton_iterations,
+                                         "timing": timing, "warnings": outcome.warnings}
+
+    t0 = time.perf_counter()
+    try:
+        run.wall_s, run.repeats, run.history, details = best_of(solve, args.min_time,
+                                                                args.max_repeats)
+    except (AncfError, ValueError) as exc:
+        run.message = str(exc)
+        run.details["time_to_failure_s"] = time.perf_counter() - t0
+        return run
+    run.ok = True
+    run.steps, run.newton_iterations = details.pop("steps"), details.pop("newton")
+    run.details.update(details)
+    return run
+
+
+_KERNEL_COSTS: dict[tuple[str, int], dict[str, float]] = {}
+
+
+def kernel_costs(problem: Problem, run: Run, args: argparse.Namespace) -> dict[str, float]:
+    """Per-call times (s) of the kernel operations of one step at the run's mesh, measured
+    once per problem and mesh: element force, force + tangent, banded factorization of
+    beta' M + K0 (the pattern and band of beta' M + K_t), one substitution, and the
+    substitutions of the flexibility S^-1 E_c."""
+    key = (problem.name, run.mesh)
+    if key in _KERNEL_COSTS:
+        return _KERNEL_COSTS[key]
+    from element_cost import time_call
+
+    from ancfdrv import _kernel
+    from ancfdrv.dynamic import DynamicSettings
+    from ancfdrv.kernel import DirectSolver
+    from ancfdrv.model import build_model
+    from ancfdrv.runner import dynamic_settings
+    from ancfdrv.scene import load_scene
+
+    scene = load_scene(REPO / problem.scene, ancfdrv_overrides(problem, run.mesh, run.dt))
+    model = build_model(scene)
+    settings: DynamicSettings = dynamic_settings(scene)
+    dofs = np.asfortranarray(model.dofs + 1, dtype=np.int32)
+    e = np.asfortranarray(model.e0)
+
+    def forces(want_tangent: int) -> Callable[[], object]:
+        return lambda: _kernel.beam_nonlinear_forces(dofs, e, model.gauss_gradients,
+                                                     model.gauss_weights, model.youngs,
+                                                     model.poisson, want_tangent)
+
+    force = time_call(forces(0), args.kernel_min_time, 3).per_call_s
+    tangent = time_call(forces(1), args.kernel_min_time, 3).per_call_s
+    values = (settings.beta_prime * model.mass_values()
+              + model.pattern.assemble(model.stiffness0))
+    table = model.constraints.dof_table()
+    used = table[table >= 0]
+    flexibility_rhs = 3 * len(np.unique(used - used % 3))
+    with DirectSolver(model.ndof, model.pattern.rows, model.pattern.col_index,
+                      banded_spd=True, what="beta' M + K0") as solver:
+        factorize = time_call(lambda: solver.factorize(values), args.kernel_min_time, 3).per_call_s
+        rhs1 = np.ones(model.ndof)
+        rhs_flex = np.ones((model.ndof, max(flexibility_rhs, 1)))
+        solve1 = time_call(lambda: solver.solve(rhs1), args.kernel_min_time, 3).per_call_s
+        solve_flex = time_call(lambda: solver.solve(rhs_flex), args.kernel_min_time,
+                               3).per_call_s
+    costs = {"force": force, "force_tangent": tangent, "factorize": factorize,
+             "solve_1rhs": solve1, "solve_flexibility": solve_flex,
+             "flexibility_rhs": float(flexibility_rhs)}
+    _KERNEL_COSTS[key] = costs
+    return costs
+
+
+def ancfdrv_breakdown(problem: Problem, run: Run, args: argparse.Namespace) -> dict[str, float]:
+    """Estimated split of ancfdrv's stepping time (see the module docstring) from the kernel
+    costs at the run's mesh; the shares are of the stepping time run_scene measured."""
+    c = kernel_costs(problem, run, args)
+    stepping = run.details["timing"].get("dynamic_stepping", math.nan)
+    steps, newton = run.steps, run.newton_iterations
+    parts = {"elements": steps * c["force_tangent"] + (newton + steps) * c["force"],
+             "factorization": steps * c["factorize"],
+             "substitutions": steps * c["solve_flexibility"] + newton * c["solve_1rhs"]}
+    shares = {f"{k}_share": v / stepping for k, v in parts.items()}
+    return {"stepping_s": stepping, "per_step_ms": 1e3 * stepping / max(steps, 1),
+            "newton_per_step": newton / max(steps, 1),
+            **{f"{k}_us": 1e6 * v for k, v in c.items() if k != "flexibility_rhs"},
+            "flexibility_rhs": int(c["flexibility_rhs"]),
+            **{f"{k}_s": v for k, v in parts.items()}, **shares,
+            "rest_share": 1.0 - sum(shares.values())}
+
+
+# -- Exudyn ------------------------------------------------------------------------------------
+def import_exudyn() -> tuple[Any, str | None]:
+    """The exudyn module, or None and the reason it cannot be used."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            import exudyn
+            import exudyn.beams  # noqa: F401
+            import exudyn.itemInterface  # noqa: F401
+        return exudyn, None
+    except Exception as exc:  # any import failure means: skip the peer
+        return None, f"{type(exc).__name__}: {exc}"
+
+
+def exudyn_version(exu: Any) -> str:
+    config = getattr(exu, "config", None)
+    if config is not None and hasattr(config, "Version"):
+        return str(config.Version())
+    return str(exu.GetVersionString())
+
+
+@dataclass(frozen=True)
+class Beam:
+    """What the cable needs, from the ancfdrv scene."""
+
+    length: float
+    mass_per_length: float
+    axial_stiffness: float
+    bending_stiffness: float
+    gravity: float
+    rho_inf: float
+    omega: float = 0.0
+    period: float = 1.0
+
+
+def beam_from_scene(problem: Problem) -> Beam:
+    from ancfdrv.scene import load_scene
+
+    scene = load_scene(REPO / problem.scene, list(problem.overrides))
+    beam, material, solver = scene["beam"], scene["material"], scene["solver"]
+    area = beam["width"] * beam["height"]
+    inertia = beam["width"] * beam["height"] ** 3 / 12.0  # bending in the x-y plane
+    gravity = scene["loads"]["gravity"] if "gravity" in scene.effects else 0.0
+    spin = scene.values.get("spinup", {})
+    return Beam(length=beam["length"], mass_per_length=material["density"] * area,
+                axial_stiffness=material["youngs_modulus"] * area,
+                bending_stiffness=material["youngs_modulus"] * inertia, gravity=gravity,
+                rho_inf=solver["rho_inf"], omega=spin.get("omega", 0.0),
+                period=spin.get("period", 1.0))
+
+
+def spinup_angle(beam: Beam, t: float) -> float:
+    """Hub angle of REFERENCES.md: (W/T)[t^2/2 + (T/2pi)^2 (cos(2 pi t/T) - 1)] for t < T,
+    W t - W T/2 after."""
+    w, period = beam.omega, beam.period
+    if t < period:
+        return w / period * (0.5 * t * t + (period / (2.0 * math.pi)) ** 2
+                             * (math.cos(2.0 * math.pi * t / period) - 1.0))
+    return w * t - 0.5 * w * period
+
+
+def check_spinup_angle(beam: Beam) -> float:
+    """Largest difference between :func:`spinup_angle` and ancfdrv's drive."""
+    from ancfdrv.constraints import DRIVE_SPINUP
+    from ancfdrv.kernel import drive_values
+
+    t = np.linspace(0.0, 2.0 * beam.period, 301)
+    phi, _, _ = drive_values(DRIVE_SPINUP, [beam.omega, beam.period, 0.0], t)
+    return float(np.max(np.abs(phi - [spinup_angle(beam, x) for x in t])))
+
+
+def exudyn_model(exu: Any, problem: Problem, beam: Beam, nel: int,
+                 svk_axial: bool = False) -> tuple[Any, Any, int]:
+    """The cable on a fresh system: (system container, mbs, tip sensor)."""
+    from exudyn.beams import GenerateBeamElementsAlongLine
+    from exudyn.itemInterface import (CoordinateConstraint, MarkerNodeCoordinate,
+                                      NodePointGround, ObjectANCFCable2D, SensorNode)
+
+    container = exu.SystemContainer()
+    mbs = container.AddSystem()
+    user: dict[str, Any] = {}
+    if svk_axial:
+        def axial_force(mbs_: Any, t: float, item: int, x: float, strain: float,
+                        strain_t: float, strain_ref: float, stiffness: float,
+                        damping: float, curvature: float, curvature_t: float,
+                        curvature_ref: float) -> float:
+            stretch = 1.0 + strain
+            return stiffness * stretch * (stretch * stretch - 1.0) * 0.5
+
+        def bending_moment(mbs_: Any, t: float, item: int, x: float, curvature: float,
+                           curvature_t: float, curvature_ref: float, stiffness: float,
+                           damping: float, strain: float, strain_t: float,
+                           strain_ref: float) -> float:
+            return stiffness * (curvature - curvature_ref)
+
+        # Exudyn calls the user functions only when both are given
+        user = {"axialForceUserFunction": axial_force,
+                "bendingMomentUserFunction": bending_moment}
+    template = ObjectANCFCable2D(physicsMassPerLength=beam.mass_per_length,
+                                 physicsBendingStiffness=beam.bending_stiffness,
+                                 physicsAxialStiffness=beam.axial_stiffness, **user)
+    pinned = problem.name == "pendulum"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        items = GenerateBeamElementsAlongLine(
+            mbs, positionStart=[0.0, 0.0, 0.0], positionEnd=[beam.length, 0.0, 0.0],
+            numberOfElements=nel, beamTemplate=template,
+            gravity=[0.0, -beam.gravity, 0.0], groundConstraintsStart=[1, 1, 0, 0])
+    if not pinned:  # clamp the slope to the hub: r' = (cos phi, sin phi), as displacements
+        root = items["nodes"][0]
+        ground = mbs.AddNode(NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
+        ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+        slopes = {2: lambda m, t, i, o: math.cos(spinup_angle(beam, t)) - 1.0,
+                  3: lambda m, t, i, o: math.sin(spinup_angle(beam, t))}
+        for coordinate, offset in slopes.items():
+            marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=root, coordinate=coordinate))
+            mbs.AddObject(CoordinateConstraint(markerNumbers=[ground_marker, marker],
+                                               offsetUserFunction=offset))
+    sensor = mbs.AddSensor(SensorNode(nodeNumber=items["nodes"][-1], storeInternal=True,
+                                      outputVariableType=exu.OutputVariableType.Position))
+    mbs.Assemble()
+    return container, mbs, sensor
+
+
+def exudyn_settings(exu: Any, problem: Problem, beam: Beam, dt: float,
+                    absolute_tol: float) -> Any:
+    settings = exu.SimulationSettings()
+    integration = settings.timeIntegration
+    integration.numberOfSteps = int(round(problem.t_end / dt))
+    integration.endTime = problem.t_end
+    integration.generalizedAlpha.spectralRadius = beam.rho_inf
+    integration.adaptiveStep = False  # fixed steps, as ancfdrv
+    integration.verboseMode = 0
+    integration.newton.relativeTolerance = EXUDYN_RELATIVE_TOL
+    integration.newton.absoluteTolerance = absolute_tol
+    settings.parallel.numberOfThreads = 1
+    for path, value in (("linearSolver.solverType", exu.LinearSolverType.EigenSparse),
+                        ("show.statistics", False), ("show.computationTime", False),
+                        ("solution.file.write", False), ("solution.sensors.writePeriod", dt)):
+        _set_setting(settings, path, value)
+    return settings
+
+
+#: Exudyn 1.12+ names of settings and the names older versions use (now deprecated).
+_OLD_SETTING_NAMES = {"linearSolver.solverType": "linearSolverType",
+                      "show.statistics": "displayStatistics",
+                      "show.computationTime": "displayComputationTime",
+                      "solution.file.write": "solutionSettings.writeSolutionToFile",
+                      "solution.sensors.writePeriod": "solutionSettings.sensorsWritePeriod"}
+
+
+def _set_setting(settings: Any, path: str, value: Any) -> None:
+    """Set a simulation setting by its current dotted name, or its older one."""
+    for name in (path, _OLD_SETTING_NAMES[path]):
+        *parents, leaf = name.split(".")
+        try:
+            target = settings
+            for parent in parents:
+                target = getattr(target, parent)
+            getattr(target, leaf)
+        except AttributeError:
+            continue
+        setattr(target, leaf, value)
+        return
+    raise AttributeError(f"Exudyn has no setting {path!r}")
+
+
+def exudyn_history(problem: Problem, beam: Beam, data: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Time and the compared tip quantity from the sensor's (t, x, y, z) rows."""
+    t, x, y = data[:, 0], data[:, 1], data[:, 2]
+    if problem.name == "pendulum":
+        return t, y
+    phi = np.array([spinup_angle(beam, s) for s in t])
+    return t, -np.sin(phi) * x + np.cos(phi) * y   # (A(t)^T p - (L, 0))_y
+
+
+def run_exudyn(exu: Any, problem: Problem, beam: Beam, nel: int, dt: float,
+               args: argparse.Namespace, svk_axial: bool = False) -> Run:
+    """One Exudyn solve (repeated for timing) at the first absolute tolerance that works."""
+    run = Run("exudyn-svk" if svk_axial else "exudyn", nel, nel, dt)
+    failures: list[str] = []
+    failed_s = 0.0
+    for tol in EXUDYN_ABSOLUTE_TOLS:
+        def solve(tol: float = tol) -> tuple[np.ndarray, dict[str, Any]]:
+            _, mbs, sensor = exudyn_model(exu, problem, beam, nel, svk_axial)
+            settings = exudyn_settings(exu, problem, beam, dt, tol)
+            with contextlib.redirect_stdout(io.StringIO()) as banner:
+                try:
+                    mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.GeneralizedAlpha)
+                except Exception as exc:  # Exudyn raises its own SolverError and others
+                    raise RuntimeError(f"{type(exc).__name__}: {exc} "
+                                       f"{banner.getvalue().strip()[:200]}") from None
+            it = mbs.sys["dynamicSolver"].it
+            t, y = exudyn_history(problem, beam, mbs.GetSensorStoredData(sensor))
+            return resample(problem, t, y), {"steps": int(it.currentStepIndex) - 1,
+                                             "newton": int(it.newtonStepsCount),
+                                             "jacobians": int(it.newtonJacobiCount)}
+        t0 = time.perf_counter()
+        try:
+            run.wall_s, run.repeats, run.history, details = best_of(solve, args.min_time,
+                                                                    args.max_repeats)
+        except (RuntimeError, ValueError) as exc:
+            failed_s += time.perf_counter() - t0
+            failures.append(f"absolute tol {tol:g}: {exc}")
+            continue
+        run.ok = True
+        run.steps, run.newton_iterations = details.pop("steps"), details.pop("newton")
+        run.details.update(details, absolute_tol=tol, relative_tol=EXUDYN_RELATIVE_TOL)
+        break
+    run.details.update(failed_attempts=failures, failed_attempts_s=failed_s)
+    if not run.ok:
+        run.message = "; ".join(failures)
+    return run
+
+
+# -- comparison ----------------------------------------------------------------------------------
+def assign_errors(runs: list[Run], reference: Run, field_name: str) -> None:
+    for run in runs:
+        if run.ok and reference.ok:
+            setattr(run, field_name, max_difference(run, reference))
+
+
+def cheapest_as_accurate(point: Run, others: list[Run], key: str) -> Run | None:
+    """The fastest run of ``others`` whose error (``key``) is at most ``point``'s."""
+    target = getattr(point, key)
+    good = [r for r in others if r.ok and getattr(r, key) <= target]
+    return min(good, key=lambda r: r.wall_s) if good else None
+
+
+def pareto(runs: list[Run], key: str) -> list[Run]:
+    """Runs not beaten by another run of the same code in both time and error."""
+    front, best = [], math.inf
+    for run in sorted((r for r in runs if r.ok), key=lambda r: (r.wall_s, getattr(r, key))):
+        if getattr(run, key) < best:
+            front.append(run)
+            best = getattr(run, key)
+    return front
+
+
+def dominance(ours: list[Run], peer: list[Run], key: str) -> dict[str, Any]:
+    """Does ``ours`` reach every error of ``peer`` in at most the time (and vice versa)?"""
+    ours = [r for r in ours if r.ok and math.isfinite(getattr(r, key))]
+    peer = [r for r in peer if r.ok and math.isfinite(getattr(r, key))]
+    pairs = []
+    for run in peer:
+        match = cheapest_as_accurate(run, ours, key)
+        pairs.append({"exudyn": [run.mesh, run.dt], "exudyn_error": getattr(run, key),
+                      "exudyn_wall_s": run.wall_s,
+                      "ancfdrv": [match.mesh, match.dt] if match else None,
+                      "ancfdrv_wall_s": match.wall_s if match else None,
+                      "time_ratio_ancfdrv_over_exudyn":
+                          match.wall_s / run.wall_s if match else None})
+    reverse = []
+    for run in ours:
+        match = cheapest_as_accurate(run, peer, key)
+        reverse.append({"ancfdrv": [run.mesh, run.dt], "ancfdrv_error": getattr(run, key),
+                        "ancfdrv_wall_s": run.wall_s,
+                        "exudyn": [match.mesh, match.dt] if match else None,
+                        "exudyn_wall_s": match.wall_s if match else None})
+    ancfdrv_dominates = bool(peer) and all(
+        p["ancfdrv_wall_s"] is not None and p["ancfdrv_wall_s"] <= p["exudyn_wall_s"]
+        for p in pairs)
+    exudyn_dominates = bool(ours) and all(
+        p["exudyn_wall_s"] is not None and p["exudyn_wall_s"] <= p["ancfdrv_wall_s"]
+        for p in reverse)
+    return {"key": key, "ancfdrv_dominates": ancfdrv_dominates,
+            "exudyn_dominates": exudyn_dominates, "for_each_exudyn_run": pairs,
+            "for_each_ancfdrv_run": reverse,
+            "pareto_ancfdrv": [[r.mesh, r.dt, r.wall_s, getattr(r, key)] for r in pareto(ours, key)],
+            "pareto_exudyn": [[r.mesh, r.dt, r.wall_s, getattr(r, key)] for r in pareto(peer, key)]}
+
+
+def compare_problem(problem: Problem, exu: Any, workdir: Path,
+                    args: argparse.Namespace) -> dict[str, Any]:
+    """All runs of one problem, the references and the comparisons."""
+    beam = beam_from_scene(problem)
+    record: dict[str, Any] = {"problem": asdict(problem), "beam": asdict(beam),
+                              "sample_times": sample_grid(problem)}
+    if problem.name == "spinup":
+        record["spinup_angle_vs_ancfdrv_drive_max_abs"] = check_spinup_angle(beam)
+
+    ancfdrv_runs = []
+    for nodes, dt in problem.ancfdrv_runs:
+        run = run_ancfdrv(problem, nodes, dt, workdir, args)
+        if run.ok and args.breakdown:
+            run.details["breakdown"] = ancfdrv_breakdown(problem, run, args)
+        ancfdrv_runs.append(run)
+        _progress(problem, run)
+    exudyn_runs: list[Run] = []
+    svk: Run | None = None
+    if exu is not None:
+        for nel, dt in problem.exudyn_runs:
+            exudyn_runs.append(run_exudyn(exu, problem, beam, nel, dt, args))
+            _progress(problem, exudyn_runs[-1])
+        if problem.svk_check and args.svk_check:
+            svk = run_exudyn(exu, problem, beam, *problem.svk_check, args, svk_axial=True)
+            _progress(problem, svk)
+
+    reference = ancfdrv_runs[-1]
+    reference.reference = True
+    if not reference.ok:
+        raise RuntimeError(f"{problem.name}: ancfdrv's reference run failed: {reference.message}")
+    peer_reference = exudyn_runs[-1] if exudyn_runs else None
+    assign_errors(ancfdrv_runs + exudyn_runs + ([svk] if svk else []), reference, "error")
+    assign_errors(ancfdrv_runs, reference, "self_error")
+    references: dict[str, Any] = {
+        "ancfdrv": [reference.mesh, reference.dt],
+        "ancfdrv_amplitude": float(np.max(np.abs(reference.samples))),
+        "ancfdrv_closest_other_run": min((r.self_error for r in ancfdrv_runs
+                                          if r.ok and not r.reference), default=math.nan)}
+    if peer_reference is not None:
+        peer_reference.reference = True
+        if peer_reference.ok:
+            assign_errors(exudyn_runs, peer_reference, "self_error")
+            references.update({
+                "exudyn": [peer_reference.mesh, peer_reference.dt],
+                "exudyn_closest_other_run": min((r.self_error for r in exudyn_runs
+                                                 if r.ok and not r.reference),
+                                                default=math.nan),
+                "max_abs_difference": peer_reference.error,
+                # the gap between the references exceeds every Exudyn run's own error: the
+                # codes converge to different solutions, ``error`` of Exudyn is the gap
+                "model_gap_dominates": peer_reference.error > max(
+                    (r.self_error for r in exudyn_runs if r.ok and not r.reference),
+                    default=math.inf),
+                "max_abs_difference_time": float(sample_grid(problem)[np.argmax(np.abs(
+                    peer_reference.samples - reference.samples))])})
+    if svk is not None and svk.ok:
+        references["exudyn_svk_axial"] = [svk.mesh, svk.dt]
+        references["svk_max_abs_difference_to_ancfdrv"] = svk.error
+        if peer_reference is not None and peer_reference.ok:
+            references["svk_max_abs_difference_to_exudyn"] = max_difference(
+                svk, peer_reference)
+    record["references"] = references
+    # the references themselves are not points of the curves they define
+    ours_common = [r for r in ancfdrv_runs if not r.reference]
+    ours_self = ours_common
+    peer_self = [r for r in exudyn_runs if not r.reference]
+    record["dominance"] = {
+        "self_error": dominance(ours_self, peer_self, "self_error"),
+        "error": dominance(ours_common, exudyn_runs, "error"),
+    } if exudyn_runs else {}
+    record["runs"] = [r.summary() for r in ancfdrv_runs + exudyn_runs + ([svk] if svk else [])]
+    record["histories"] = {f"{r.code}_{r.mesh}_{r.dt:g}": r.samples
+                           for r in ancfdrv_runs + exudyn_runs + ([svk] if svk else [])
+                           if r.ok and (r.reference or r.code == "exudyn-svk")}
+    return record
+
+
+def _progress(problem: Problem, run: Run) -> None:
+    state = f"{run.wall_s:7.2f} s" if run.ok else "FAILED"
+    print(f"  {problem.name:>8} {run.code:>10} mesh {run.mesh:>3} dt {run.dt:<8g} {state}",
+          file=sys.stderr, flush=True)
+
+
+# -- reporting -------------------------------------------------------------------------------
+def _g(value: float | None, fmt: str = ".2e") -> str:
+    return "-" if value is None or not math.isfinite(value) else format(value, fmt)
+
+
+def print_tables(records: dict[str, dict[str, Any]], exudyn_note: str | None) -> None:
+    from _common import print_table
+
+    for name, rec in records.items():
+        problem = rec["problem"]
+        refs = rec["references"]
+        print(f"\n== {name}: {problem['quantity']} over 0 ... {problem['t_end']:g} s, sampled "
+              f"every {problem['sample_dt']:g} s; error = max |y - y_ref|, m")
+        print(f"   references: ancfdrv {refs['ancfdrv'][0]} nodes, dt {refs['ancfdrv'][1]:g} "
+              f"(|y| up to {refs['ancfdrv_amplitude']:.3g} m; its closest other run differs by "
+              f"{_g(refs['ancfdrv_closest_other_run'])})"
+              + (f"; Exudyn {refs['exudyn'][0]} elements, dt {refs['exudyn'][1]:g} (closest "
+                 f"other run {_g(refs['exudyn_closest_other_run'])})" if "exudyn" in refs else ""))
+        if "max_abs_difference" in refs:
+            print(f"   ancfdrv reference vs Exudyn reference: max |difference| "
+                  f"{_g(refs['max_abs_difference'])} m (at t = {refs['max_abs_difference_time']:g} s)")
+        if refs.get("model_gap_dominates"):
+            print("   NOTE: the references differ by more than any Exudyn run from its own "
+                  "reference: the codes converge to different solutions (different continuum "
+                  "models), so 'error' of the Exudyn runs is that gap, not their accuracy")
+        if "svk_max_abs_difference_to_ancfdrv" in refs:
+            print(f"   Exudyn with the St. Venant-Kirchhoff axial force EA l (l^2 - 1)/2 "
+                  f"({refs['exudyn_svk_axial'][0]} elements, dt {refs['exudyn_svk_axial'][1]:g}):"
+                  f" {_g(refs['svk_max_abs_difference_to_ancfdrv'])} m from ancfdrv's reference, "
+                  f"{_g(refs.get('svk_max_abs_difference_to_exudyn'))} m from Exudyn's")
+        if "spinup_angle_vs_ancfdrv_drive_max_abs" in rec:
+            print(f"   hub angle used for Exudyn vs ancfdrv's drive: max |difference| "
+                  f"{rec['spinup_angle_vs_ancfdrv_drive_max_abs']:.1e} rad")
+        rows = []
+        for r in rec["runs"]:
+            b = r["details"].get("breakdown", {})
+            extra = (f"tol {r['details']['absolute_tol']:g}, jac {r['details']['jacobians']}"
+                     if r["code"].startswith("exudyn") and r["ok"] else "")
+            if b:
+                extra = (f"{b['per_step_ms']:.3f} ms/step: elem {100 * b['elements_share']:.0f}% "
+                         f"fact {100 * b['factorization_share']:.0f}% "
+                         f"subst {100 * b['substitutions_share']:.0f}% "
+                         f"rest {100 * b['rest_share']:.0f}%")
+            rows.append([r["code"] + ("*" if r["reference"] else ""), str(r["mesh"]),
+                         str(r["elements"]), f"{r['dt']:g}",
+                         _g(r["wall_s"], ".3f") if r["ok"] else "FAIL",
+                         str(r["steps"]) if r["ok"] else "-",
+                         f"{r['newton_iterations'] / max(r['steps'], 1):.2f}" if r["ok"] else "-",
+                         _g(r["error"]), _g(r["self_error"]), extra])
+        print_table([("code", 11), ("mesh", 4), ("nel", 4), ("dt", 7), ("wall s", 8),
+                     ("steps", 6), ("newt/st", 7), ("error", 9), ("self err", 9),
+                     ("", 1)], rows)
+        print("   mesh: ancfdrv nodes, Exudyn elements; * = the code's reference; error: against "
+              "ancfdrv's reference; self err: against the own code's reference; ms/step and % "
+              "(ancfdrv): stepping time per step and its estimated split (element evaluations, "
+              "banded factorization, substitutions; rest = the remainder, negative where the "
+              "estimate from separately timed kernel calls overshoots); tol, jac (Exudyn): "
+              "Newton absolute tolerance used, Jacobian updates")
+        failed = [r for r in rec["runs"] if not r["ok"]]
+        for r in failed:
+            print(f"   FAILED {r['code']} mesh {r['mesh']} dt {r['dt']:g}: {r['message'][:300]}")
+        for key, dom in rec["dominance"].items():
+            label = ("each code against its own reference" if key == "self_error"
+                     else "both against ancfdrv's reference")
+            print(f"\n   [{key}: {label}] ancfdrv dominates: "
+                  f"{'yes' if dom['ancfdrv_dominates'] else 'no'}; Exudyn dominates: "
+                  f"{'yes' if dom['exudyn_dominates'] else 'no'}")
+            rows = []
+            for p in dom["for_each_exudyn_run"]:
+                rows.append([f"{p['exudyn'][0]} / {p['exudyn'][1]:g}", _g(p["exudyn_error"]),
+                             _g(p["exudyn_wall_s"], ".3f"),
+                             f"{p['ancfdrv'][0]} / {p['ancfdrv'][1]:g}" if p["ancfdrv"] else "none",
+                             _g(p["ancfdrv_wall_s"], ".3f"),
+                             _g(p["time_ratio_ancfdrv_over_exudyn"], ".1f")])
+            print_table([("Exudyn nel/dt", 16), ("error", 9), ("wall s", 8),
+                         ("ancfdrv as good", 16), ("wall s", 8), ("t ratio", 7)], rows)
+    if exudyn_note:
+        print(f"\nExudyn was skipped: {exudyn_note}")
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true",
+                        help="coarser grids and references (under 2 minutes)")
+    parser.add_argument("--problems", nargs="+", choices=sorted(PROBLEMS),
+                        default=sorted(PROBLEMS), help="which problems (default both)")
+    parser.add_argument("--min-time", type=float, default=1.0,
+                        help="repeat a run until the repeats took this long (default 1 s)")
+    parser.add_argument("--max-repeats", type=int, default=3,
+                        help="repeats of one run at most (default 3)")
+    parser.add_argument("--kernel-min-time", type=float, default=0.05,
+                        help="sample length of the kernel timings of the breakdown")
+    parser.add_argument("--no-breakdown", dest="breakdown", action="store_false",
+                        help="skip the estimate of where ancfdrv's stepping time goes")
+    parser.add_argument("--no-svk-check", dest="svk_check", action="store_false",
+                        help="skip Exudyn with the St. Venant-Kirchhoff axial force")
+    parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
+    parser.add_argument("--omp-threads", type=int, default=None,
+                        help="OMP_NUM_THREADS for ancfdrv's kernel (default: the environment's, "
+                             "else ancfdrv's own default of 1); Exudyn runs on 1 thread")
+    parser.add_argument("--output", type=Path, default=None,
+                        help="JSON file (default benchmarks/results/peer_exudyn.json, "
+                             "peer_exudyn_quick.json with --quick)")
+    args = parser.parse_args(argv)
+    if args.output is None:
+        args.output = RESULTS / ("peer_exudyn_quick.json" if args.quick else "peer_exudyn.json")
+    return args
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    start = time.perf_counter()
+    if args.omp_threads is not None:  # read when the kernel is loaded: set it before
+        os.environ["OMP_NUM_THREADS"] = str(args.omp_threads)
+    import_ancfdrv()
+    from _common import json_ready, load_average, machine_info
+    from element_cost import omp_max_threads, openmp_runtime
+
+    from ancfdrv import _kernel
+
+    exu, exudyn_note = (None, "--no-exudyn") if args.no_exudyn else import_exudyn()
+    machine = machine_info()
+    kernel_file = Path(_kernel.__file__)
+    kernel_mtime = kernel_file.stat().st_mtime
+    problems = QUICK_PROBLEMS if args.quick else PROBLEMS
+    records: dict[str, dict[str, Any]] = {}
+    with tempfile.TemporaryDirectory(prefix="peer_exudyn_") as tmp:
+        for name in args.problems:
+            records[name] = compare_problem(problems[name], exu, Path(tmp), args)
+    machine["load_average_at_end"] = load_average()
+    threads = omp_max_threads(openmp_runtime())
+    print(f"\nancfdrv kernel: OpenMP {'threads: %d' % threads if threads else 'not loaded'}"
+          f" (OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS')}); Exudyn: "
+          + (f"{exudyn_version(exu)}, 1 thread" if exu is not None else "skipped"))
+    print_tables(records, exudyn_note)
+    reinstalled = kernel_file.stat().st_mtime != kernel_mtime
+    if reinstalled:
+        print("\nWARNING: ancfdrv's kernel module changed during the run (a reinstall): "
+              "the runs may mix two builds.")
+    report = {
+        "benchmark": "peer_exudyn",
+        "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "settings": {"quick": args.quick, "min_time_s": args.min_time,
+                     "max_repeats": args.max_repeats, "breakdown": args.breakdown,
+                     "svk_check": args.svk_check,
+                     "exudyn_relative_tol": EXUDYN_RELATIVE_TOL,
+                     "exudyn_absolute_tols_tried": EXUDYN_ABSOLUTE_TOLS},
+        "units": "seconds, metres",
+        "machine": machine,
+        "ancfdrv_kernel": {"module": str(kernel_file), "reinstalled_during_run": reinstalled,
+                           "omp_num_threads_env": os.environ.get("OMP_NUM_THREADS"),
+                           "openmp_runtime": openmp_runtime(),
+                           "omp_get_max_threads": omp_max_threads(openmp_runtime())},
+        "exudyn": {"available": exu is not None, "skipped_because": exudyn_note,
+                   "version": exudyn_version(exu) if exu is not None else None},
+        "problems": records,
+        "wall_time_s": time.perf_counter() - start,
+    }
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    args.output.write_text(json.dumps(json_ready(report), indent=1, allow_nan=False) + "\n")
+    print(f"\nwrote {args.output} in {report['wall_time_s']:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
