@@ -58,3 +58,13 @@ def print_table(head: list[tuple[str, int]], rows: list[list[str]]) -> None:
     print("-" * (sum(w for _, w in head) + len(head) - 1))
     for row in rows:
         print(" ".join(f"{c:>{w}}" for c, (_, w) in zip(row, head)))
+
+
+def write_report(path, report: dict[str, Any]) -> None:
+    """Write the JSON report (NaN and inf as null) and say where."""
+    import json
+    from pathlib import Path
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(json_ready(report), indent=1, allow_nan=False) + "\n")
+    print(f"\nwrote {path} in {report['wall_time_s']:.1f} s")

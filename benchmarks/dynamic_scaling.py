@@ -43,10 +43,7 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import gc
-import json
 import math
-import os
-import platform
 import subprocess
 import sys
 import tempfile
@@ -56,10 +53,8 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
-import scipy
 
-import ancfdrv
-from _common import json_ready, load_average, machine_info, print_table
+from _common import load_average, machine_info, print_table, write_report
 from ancfdrv.dynamic import DynamicSettings, initial_acceleration
 from ancfdrv.model import BeamModel, build_model
 from ancfdrv.runner import boom_stages, dynamic_settings, run_scene
@@ -530,9 +525,7 @@ def main(argv: list[str] | None = None) -> int:
         "machine": machine, "records": records, "growth_exponents": exponents,
         "run_scene": run, "wall_time_s": time.perf_counter() - start,
     }
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(json.dumps(json_ready(report), indent=1, allow_nan=False) + "\n")
-    print(f"\nwrote {args.output} in {report['wall_time_s']:.1f} s")
+    write_report(args.output, report)
     return 0
 
 

@@ -382,7 +382,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.worker:
         json.dump(worker(args), sys.stdout)
         return 0
-    from _common import json_ready, load_average, machine_info
+    from _common import load_average, machine_info, write_report
 
     start = time.perf_counter()
     machine = machine_info()
@@ -410,9 +410,7 @@ def main(argv: list[str] | None = None) -> int:
         "runs": {str(t): r for t, r in runs.items()},
         "wall_time_s": time.perf_counter() - start,
     }
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(json.dumps(json_ready(report), indent=1, allow_nan=False) + "\n")
-    print(f"\nwrote {args.output} in {report['wall_time_s']:.1f} s")
+    write_report(args.output, report)
     return 0
 
 

@@ -77,7 +77,6 @@ import contextlib
 import datetime as _dt
 import importlib
 import io
-import json
 import math
 import os
 import sys
@@ -827,7 +826,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.omp_threads is not None:  # read when the kernel is loaded: set it before
         os.environ["OMP_NUM_THREADS"] = str(args.omp_threads)
     import_ancfdrv()
-    from _common import json_ready, load_average, machine_info
+    from _common import load_average, machine_info, write_report
     from element_cost import omp_max_threads, openmp_runtime
 
     from ancfdrv import _kernel
@@ -870,9 +869,7 @@ def main(argv: list[str] | None = None) -> int:
         "problems": records,
         "wall_time_s": time.perf_counter() - start,
     }
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(json.dumps(json_ready(report), indent=1, allow_nan=False) + "\n")
-    print(f"\nwrote {args.output} in {report['wall_time_s']:.1f} s")
+    write_report(args.output, report)
     return 0
 
 
