@@ -174,7 +174,7 @@ def test_newton_failure_exit_3_keeps_finished_chunks(capsys, tmp_path):
     assert "time step from t = " in err and "did not converge within 1 iterations" in err
     assert "last correction" in err
     with h5py.File(out) as h5:
-        assert h5.attrs["status"] == "failed"
+        assert h5.attrs["status"] == "failed" and h5["dynamic"].attrs["status"] == "failed"
         rows = len(h5["dynamic/time"])
         assert rows > 51  # the initial row, the finished chunks and the failing chunk's
         # completed steps: every step before the failure is kept

@@ -81,6 +81,8 @@ def finish(path: Path, model: BeamModel, timing: dict[str, float], status: str,
         h5.attrs["status"] = status
         h5.attrs["message"] = message
         h5.attrs["warnings"] = "\n".join(model.warnings)
+        if "dynamic" in h5 and status != "ok":
+            h5["dynamic"].attrs["status"] = status
 
 
 def read_summary(path: Path) -> dict[str, Any]:
