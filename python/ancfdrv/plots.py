@@ -53,7 +53,7 @@ def plot_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
     ax2.set_ylabel("energy (J)")
     twin = ax2.twinx()
     twin.plot(t, energy["balance"] / scale, color="C3", lw=0.8, label="balance / scale")
-    twin.set_ylabel("(E - E(0) - W) / max W", color="C3")
+    twin.set_ylabel("balance / max(|W|, kinetic)", color="C3")
     ax2.set_xlabel("time (s)")
     ax2.legend(loc="upper left", fontsize=8)
     fig.savefig(png, dpi=120)
