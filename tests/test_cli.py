@@ -196,3 +196,20 @@ def test_sweep_on_a_dask_scheduler(write_scene, tmp_path):
     assert [r["status"] for r in remote] == ["ok", "ok"]
     for a, b in zip(remote, local):
         assert a["tip_transverse"] == pytest.approx(b["tip_transverse"], rel=1e-12)
+
+
+def test_sweep_compares_formulations_side_by_side(tmp_path):
+    """--vary scene.formulation=ffr,nonlinear: each case's difference from the
+    large-deformation model with the same other keys (a luffing history here)."""
+    from conftest import INPUTS
+    out = tmp_path / "side"
+    code = main(["sweep", str(INPUTS / "boom_luffing.nml"), "--vary",
+                 "scene.formulation=ffr,nonlinear", "--set", "beam.nodes=4", "--set",
+                 "solver.static_method=newton", "--set", "solver.t_end=2.0", "--set",
+                 "solver.dt=2e-3", "-o", str(out), "--workers", "1"])
+    assert code == 0
+    rows = {r["scene.formulation"]: r for r in csv.DictReader(open(out / "summary.csv"))}
+    assert float(rows["nonlinear"]["diff_vs_nonlinear"]) == 0.0
+    assert 1e-4 < float(rows["ffr"]["diff_vs_nonlinear"]) < 0.2
+    assert int(rows["nonlinear"]["factorizations"]) == 1000  # one per step
+    assert int(rows["ffr"]["factorizations"]) == 1  # one per run
