@@ -184,22 +184,30 @@ contains
   end subroutine elastic_force
 
   !> Large deformation: factorize S = beta' M + K_t(e) on the solver's pattern and compute
-  !> the flexibility S^{-1} E_c and E_c^T S^{-1} E_c for the Schur complement.
-  subroutine refactorize(sys, beta_prime, e, flexibility, flexibility_cc, info, detail)
+  !> the flexibility S^{-1} E_c and E_c^T S^{-1} E_c for the Schur complement; the elastic
+  !> force and strain energy at e come out of the same element pass.
+  subroutine refactorize(sys, beta_prime, e, flexibility, flexibility_cc, force, strain, info, &
+                         detail)
     type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: beta_prime, e(:)
-    real(dp), intent(out) :: flexibility(:, :), flexibility_cc(:, :)
+    real(dp), intent(out) :: flexibility(:, :), flexibility_cc(:, :), force(:), strain
     integer, intent(out) :: info, detail
-    real(dp) :: tangents(24, 24, sys%nel), element_force(24), element_energy
+    real(dp) :: tangents(24, 24, sys%nel), element_force(24, sys%nel), element_energy(sys%nel)
     real(dp) :: values(size(sys%mass_pattern))
     integer :: el, b, j
-    !$omp parallel do schedule(static) private(element_force, element_energy)
+    !$omp parallel do schedule(static)
     do el = 1, sys%nel
       call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
                              sys%gauss_weights(:, el), sys%youngs, sys%poisson, .true., &
-                             element_force, element_energy, tangents(:, :, el))
+                             element_force(:, el), element_energy(el), tangents(:, :, el))
     end do
     !$omp end parallel do
+    ! the elastic force at e comes with the tangent: the step's first residual reuses it
+    force = 0.0_dp
+    do el = 1, sys%nel
+      force(sys%dofs(:, el)) = force(sys%dofs(:, el)) + element_force(:, el)
+    end do
+    strain = sum(element_energy)
     call pattern_assemble(size(values), 24, sys%nel, sys%scatter_map, tangents, values)
     values = values + beta_prime * sys%mass_pattern
     call solver_factorize(sys%solver_handle, size(values), values, info, detail)
@@ -230,14 +238,21 @@ contains
 
   !> Residual r = M q'' + Q_el(q) - Q(q) - Phi_q^T lambda at time t, with the constraint
   !> values and gradients and the strain energy.
-  subroutine residual(sys, t, e, acceleration, lam, rotation, r, phi, gradients, strain, info)
+  subroutine residual(sys, t, e, acceleration, lam, rotation, r, phi, gradients, strain, info, &
+                      known_elastic)
     type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: t, e(:), acceleration(:), lam(:), rotation(3, 3)
-    real(dp), intent(out) :: r(:), phi(:), gradients(:, :), strain
+    real(dp), intent(inout) :: strain  ! out; in with known_elastic
+    real(dp), intent(out) :: r(:), phi(:), gradients(:, :)
     integer, intent(out) :: info
+    real(dp), intent(in), optional :: known_elastic(:)  ! elastic force at e, already computed
     real(dp) :: elastic(sys%ndof), inertia(sys%ndof), force(3), jacobian(3, 3), hessian(3, 3, 3)
     integer :: m, c, i
-    call elastic_force(sys, rotation, e, elastic, strain)
+    if (present(known_elastic)) then
+      elastic = known_elastic
+    else
+      call elastic_force(sys, rotation, e, elastic, strain)
+    end if
     call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, acceleration, inertia)
     r = inertia + elastic - sys%constant_force
     do m = 1, sys%nmoment
@@ -285,6 +300,7 @@ contains
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: w(3 * sys%nblock, sys%ncon), schur(sys%ncon, sys%ncon), dlam(sys%ncon, 1)
     real(dp) :: flexibility(sys%ndof, 3 * sys%nblock), flexibility_cc(3 * sys%nblock, 3 * sys%nblock)
+    real(dp) :: predicted_elastic(sys%ndof)
     real(dp) :: rotation(3, 3), transform(3, 3), rate, strain, powers_old(2), powers_new(2)
     real(dp) :: t_new, h, beta_prime
     integer :: step, it, ipiv(sys%ncon), lapack_info
@@ -324,12 +340,18 @@ contains
       transform = rotation
       if (sys%formulation == formulation_nonlinear) then
         transform = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
-        call refactorize(sys, beta_prime, e_new, flexibility, flexibility_cc, info, detail)
+        call refactorize(sys, beta_prime, e_new, flexibility, flexibility_cc, predicted_elastic, &
+                         strain, info, detail)
         if (info /= 0) return
       end if
       done = .false.
       do it = 1, cfg%max_newton
-        call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, info)
+        if (it == 1 .and. sys%formulation == formulation_nonlinear) then
+          call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, &
+                        info, predicted_elastic)
+        else
+          call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, info)
+        end if
         if (info /= 0) return
         ! z = T S^{-1} T^T r
         call rotate_all(transform, r, .true., z(:, 1))
