@@ -72,7 +72,6 @@ LENGTH, WIDTH, HEIGHT = 10.0, 0.1, 0.1
 YOUNGS, DENSITY = 2.1e11, 7850.0
 OPENMP_RUNTIMES = ("libgomp", "libomp", "libiomp")
 #: Another engineer reinstalls ancfdrv from time to time: how long to wait before retrying.
-IMPORT_RETRY_S, IMPORT_ATTEMPTS = 30.0, 4
 KERNELS = ("nonlinear_force", "nonlinear_force_tangent", "ffr_force", "ffr_stiffness")
 LABELS = {"nonlinear_force": "(a) force", "nonlinear_force_tangent": "(b) force+tangent",
           "ffr_force": "(c) FFR force", "ffr_stiffness": "FFR K"}
@@ -91,19 +90,10 @@ class Sample:
 
 
 def import_kernel() -> Any:
-    """``ancfdrv._kernel`` (retried while a reinstall may be under way)."""
-    for attempt in range(IMPORT_ATTEMPTS):
-        try:
-            from ancfdrv import _kernel
-            _kernel.beam_nonlinear_points()
-            return _kernel
-        except (ImportError, AttributeError) as exc:
-            if attempt == IMPORT_ATTEMPTS - 1:
-                raise
-            print(f"import ancfdrv._kernel failed ({exc}); retrying in {IMPORT_RETRY_S:g} s",
-                  file=sys.stderr, flush=True)
-            time.sleep(IMPORT_RETRY_S)
-    raise AssertionError("unreachable")
+    """The compiled kernel (checked to be the build with the large-deformation beam)."""
+    from ancfdrv import _kernel
+    _kernel.beam_nonlinear_points()
+    return _kernel
 
 
 def openmp_runtime() -> list[str]:
@@ -240,15 +230,11 @@ def run_worker(threads: int, args: argparse.Namespace) -> dict[str, Any]:
     command = [sys.executable, str(Path(__file__).resolve()), "--worker",
                "--elements", *map(str, args.elements), "--poisson", *map(str, args.poisson),
                "--min-time", str(args.min_time), "--repeats", str(args.repeats)]
-    for attempt in range(2):
-        done = subprocess.run(command, env=env, capture_output=True, text=True)
-        if done.returncode == 0:
-            return json.loads(done.stdout)
-        print(f"worker with OMP_NUM_THREADS={threads} failed:\n{done.stderr[-2000:]}",
-              file=sys.stderr, flush=True)
-        if attempt == 0:
-            time.sleep(IMPORT_RETRY_S)
-    raise RuntimeError(f"the measurement with OMP_NUM_THREADS={threads} failed twice")
+    done = subprocess.run(command, env=env, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"the measurement with OMP_NUM_THREADS={threads} failed:\n"
+                           f"{done.stderr[-2000:]}")
+    return json.loads(done.stdout)
 
 
 def merge_rounds(rounds: list[dict[str, Any]]) -> dict[str, Any]:

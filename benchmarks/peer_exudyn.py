@@ -93,7 +93,6 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
 #: Another engineer reinstalls ancfdrv from time to time: how long to wait before retrying.
-IMPORT_RETRY_S, IMPORT_ATTEMPTS = 30.0, 4
 #: Exudyn's Newton: relative tolerance (its default) and the absolute tolerances tried in
 #: turn. Its default absolute tolerance (1e-10) lies below the round-off floor of the
 #: spin-up's residual (EA = 2.8e7 N): Newton then never converges and the fixed-step solve
@@ -222,19 +221,8 @@ def best_of(solve: Callable[[], tuple[np.ndarray, dict[str, Any]]], min_time: fl
 
 # -- ancfdrv ---------------------------------------------------------------------------------
 def import_ancfdrv() -> None:
-    """Import the package (retried while a reinstall may be under way)."""
-    for attempt in range(IMPORT_ATTEMPTS):
-        try:
-            importlib.import_module("ancfdrv.runner")
-            from ancfdrv import _kernel
-            _kernel.beam_nonlinear_points()
-            return
-        except (ImportError, AttributeError) as exc:
-            if attempt == IMPORT_ATTEMPTS - 1:
-                raise
-            print(f"import ancfdrv failed ({exc}); retrying in {IMPORT_RETRY_S:g} s",
-                  file=sys.stderr, flush=True)
-            time.sleep(IMPORT_RETRY_S)
+    """Import the package up front, so import time stays out of the first measurement."""
+    importlib.import_module("ancfdrv.runner")
 
 
 def ancfdrv_overrides(problem: Problem, nodes: int, dt: float) -> list[str]:
