@@ -301,7 +301,7 @@ contains
     real(dp) :: w(3 * sys%nblock, sys%ncon), schur(sys%ncon, sys%ncon), dlam(sys%ncon, 1)
     real(dp) :: flexibility(sys%ndof, 3 * sys%nblock), flexibility_cc(3 * sys%nblock, 3 * sys%nblock)
     real(dp) :: predicted_elastic(sys%ndof)
-    real(dp) :: rotation(3, 3), transform(3, 3), rate, strain, powers_old(2), powers_new(2)
+    real(dp) :: rotation(3, 3), transform(3, 3), rate, strain, violation, powers_old(2), powers_new(2)
     real(dp) :: t_new, h, beta_prime
     integer :: step, it, ipiv(sys%ncon), lapack_info
     logical :: done
@@ -320,7 +320,7 @@ contains
       info = 5
       return
     end if
-    call step_powers(sys, e, v, lam, rotation, rate, t, powers_old, strain, info)
+    call step_powers(sys, e, v, lam, rotation, rate, t, powers_old, strain, violation, info)
     if (info /= 0) return
     do step = 1, nsteps
       t_new = t + h
@@ -405,7 +405,8 @@ contains
       accel = accel_new
       lam = lam_new
       t = t_new
-      call step_powers(sys, e, v, lam, rotation, rate, t, powers_new, strain, info)
+      call step_powers(sys, e, v, lam, rotation, rate, t, powers_new, strain, out_constraint(step), &
+                       info)
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers_old + powers_new)
       powers_old = powers_new
@@ -414,8 +415,7 @@ contains
       out_newton(step) = it
       out_lambda(:, step) = lam
       call record(sys, e, v, rotation, work, strain, out_probe(:, :, step), out_deflection(:, :, step), &
-                  out_energy(:, step), out_constraint(step), t, info)
-      if (info /= 0) return
+                  out_energy(:, step))
       if (store_q) out_q(:, step) = e
     end do
   end subroutine integrator_chunk
@@ -454,11 +454,12 @@ contains
 
   !> Powers of the constraint forces (lambda . Phi_e v: the drive) and, for FFR, of the moving
   !> frame, dU/dt at fixed e = -phi' sum_b f_b . (k x x_b), f = K0 u, u = T^T e - e0,
-  !> x = T^T e, with the strain energy U, all from one pass over the elements.
-  subroutine step_powers(sys, e, v, lam, rotation, rate, t, powers, strain, info)
+  !> x = T^T e, with the strain energy U, all from one pass over the elements, and the
+  !> constraint violation max |Phi| at (e, t).
+  subroutine step_powers(sys, e, v, lam, rotation, rate, t, powers, strain, violation, info)
     type(beam_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), v(:), lam(:), rotation(3, 3), rate, t
-    real(dp), intent(out) :: powers(2), strain
+    real(dp), intent(out) :: powers(2), strain, violation
     integer, intent(out) :: info
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: frame_coords(24), local(24), frame_force(24), k(3), x(3)
@@ -466,6 +467,8 @@ contains
     integer :: el, b
     call evaluate_constraints(sys, e, t, phi, gradients, info)
     if (info /= 0) return
+    violation = 0.0_dp
+    if (sys%ncon > 0) violation = maxval(abs(phi))
     powers(1) = dot_product(lam, gradient_dot(sys, gradients, v))
     powers(2) = 0.0_dp
     if (sys%formulation /= formulation_ffr) then
@@ -492,13 +495,12 @@ contains
     end do
   end subroutine step_powers
 
-  !> One output row: probes, deflections in the frame, energies, constraint violation.
-  subroutine record(sys, e, v, rotation, work, strain, probe, deflection, energy, violation, t, info)
+  !> One output row: probes, deflections in the frame, energies.
+  subroutine record(sys, e, v, rotation, work, strain, probe, deflection, energy)
     type(beam_system), intent(in) :: sys
-    real(dp), intent(in) :: e(:), v(:), rotation(3, 3), work(2), strain, t
-    real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:), violation
-    integer, intent(out) :: info
-    real(dp) :: mv(sys%ndof), phi(sys%ncon), gradients(6, sys%ncon)
+    real(dp), intent(in) :: e(:), v(:), rotation(3, 3), work(2), strain
+    real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:)
+    real(dp) :: mv(sys%ndof)
     integer :: p, a, m
     do p = 1, sys%nprobe
       probe(:, p) = 0.0_dp
@@ -519,10 +521,6 @@ contains
     energy(energy_total) = sum(energy(energy_kinetic:energy_moment))
     energy(work_drive) = work(1)
     energy(work_frame) = work(2)
-    call evaluate_constraints(sys, e, t, phi, gradients, info)
-    if (info /= 0) return
-    violation = maxval(abs(phi), mask=.true.)
-    if (sys%ncon == 0) violation = 0.0_dp
   end subroutine record
 
 end module time_integrator

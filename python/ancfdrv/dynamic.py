@@ -334,16 +334,17 @@ def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
                 bar.set_postfix(steps=steps, newton=newton)
                 if info:
                     raise SolverError(integrator.failure_message(info, detail, state["t"]))
-        finally:
+        finally:  # the counters hold what was done, also when a step failed
             bar.close()
-        model.counters["newmark_steps"] += steps
-        model.counters["newton_iterations"] += newton
-        model.counters["solves"] += newton + integrator.setup_solves
+            model.counters["time_steps"] += steps
+            model.counters["newton_iterations"] += newton
+            model.counters["solves"] += newton + integrator.setup_solves
+            if integrator.nonlinear:  # FFR counted its single factorization at set-up
+                model.counters["factorizations"] += steps
     finally:
         integrator.close()
     wall = time.perf_counter() - start
     timing["total"] = wall
     factorizations = steps if integrator.nonlinear else 1
-    model.counters["factorizations"] += factorizations if integrator.nonlinear else 0
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
                          solves_setup=integrator.setup_solves, wall_time_s=wall, timing=timing)

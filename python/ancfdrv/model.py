@@ -154,33 +154,25 @@ class BeamModel:
                 values[self.pattern.row_ptr[d] + np.searchsorted(row, d)] += m
         return values
 
-    def stiffness_values(self) -> np.ndarray:
-        """CSR values (on ``pattern``) of K = T K0 T^T."""
+    def stiffness_values(self, t: float = 0.0) -> np.ndarray:
+        """CSR values (on ``pattern``) of the FFR stiffness K = T K0 T^T in the frame A(t)."""
         self.counters["stiffness_assembly"] += 1
-        return self.pattern.assemble(kernel.ffr_element_stiffness(self.stiffness0, self.rotation))
+        return self.pattern.assemble(kernel.ffr_element_stiffness(self.stiffness0,
+                                                                  self.frame_at(t)))
 
     def stiffness_matrix(self) -> sp.csr_matrix:
         return self.pattern.to_scipy(self.stiffness_values())
 
     # -- forces ----------------------------------------------------------------------
-    def elastic_force(self, e: np.ndarray) -> tuple[np.ndarray, float]:
-        """FFR elastic force T K0 (T^T e - e0_frame) and the strain energy."""
-        self.counters["elastic_force"] += 1
-        return kernel.ffr_force(self.dofs, self.stiffness0, self.rotation, e, self.e0_frame)
-
-    def elastic_force_at(self, e: np.ndarray, t: float) -> tuple[np.ndarray, float]:
-        """FFR elastic force and strain energy with the frame A(t)."""
-        self.counters["elastic_force"] += 1
-        return kernel.ffr_force(self.dofs, self.stiffness0, self.frame_at(t), e, self.e0_frame)
-
     def internal_force(self, e: np.ndarray, t: float = 0.0,
                        want_tangent: bool = False) -> tuple[np.ndarray, float, np.ndarray | None]:
-        """Elastic force, strain energy and (nonlinear, on request) the CSR values of the
-        tangent, for the scene's formulation."""
-        if self.formulation == "ffr":
-            force, energy = self.elastic_force_at(e, t)
-            return force, energy, self.stiffness_values() if want_tangent else None
+        """Elastic force, strain energy and, on request, the CSR values of the tangent, for
+        the scene's formulation (FFR: T K0 (T^T e - e0) in the frame A(t))."""
         self.counters["elastic_force"] += 1
+        if self.formulation == "ffr":
+            force, energy = kernel.ffr_force(self.dofs, self.stiffness0, self.frame_at(t), e,
+                                             self.e0_frame)
+            return force, energy, self.stiffness_values(t) if want_tangent else None
         force, energy, tangent = kernel.beam_nonlinear_forces(
             self.dofs, e, self.gauss_gradients, self.gauss_weights, self.youngs, self.poisson,
             want_tangent)
