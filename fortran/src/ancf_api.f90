@@ -150,6 +150,109 @@ subroutine ffr_element_stiffness(nel, stiffness0, rotation, stiffness)
   call ffr_stiffness(nel, stiffness0, rotation, stiffness)
 end subroutine ffr_element_stiffness
 
+
+! ---------------------------------------------------------------------------------------
+! Thin plate element (plate_element): 36 coordinates per element, (3, 12) per element
+! ---------------------------------------------------------------------------------------
+
+!> Sizes of the plate element's Gauss rule.
+subroutine plate_rule(npoints)
+  use plate_element, only: plate_points
+  implicit none
+  integer, intent(out) :: npoints
+  npoints = plate_points
+end subroutine plate_rule
+
+!> Shape functions (12) and their x, y, xx, yy, xy derivatives (12, 5) at (xi, eta).
+subroutine plate_shape_functions(xi, eta, a, b, shape, derivs)
+  use ancf_kinds, only: dp
+  use plate_element, only: plate_shape
+  implicit none
+  real(dp), intent(in) :: xi, eta, a, b
+  real(dp), intent(out) :: shape(12), derivs(12, 5)
+  call plate_shape(xi, eta, a, b, shape, derivs)
+end subroutine plate_shape_functions
+
+!> Compact mass matrices (12, 12, nel) and the generalized force (3, 12, nel) of a
+!> constant load per unit area.
+subroutine plate_element_arrays(nel, a, b, thickness, density, load, mass, load_force, info)
+  use ancf_kinds, only: dp
+  use plate_element, only: plate_mass, plate_surface_load
+  implicit none
+  integer, intent(in) :: nel
+  real(dp), intent(in) :: a(nel), b(nel), thickness, density, load(3)
+  real(dp), intent(out) :: mass(12, 12, nel), load_force(3, 12, nel)
+  integer, intent(out) :: info
+  integer :: el, info_load
+  info = 0
+  do el = 1, nel
+    call plate_mass(a(el), b(el), thickness, density, mass(:, :, el), info)
+    call plate_surface_load(a(el), b(el), load, load_force(:, :, el), info_load)
+    info = max(info, info_load)
+    if (info /= 0) return
+  end do
+end subroutine plate_element_arrays
+
+!> Reference data at the Gauss points of every element (variant 0 plain, 1 completed).
+!> info = 2 + 1000 el: degenerate reference in element el (1-based).
+subroutine plate_reference(nel, npts, reference, a, b, variant, derivs, frame, curvature0, &
+                           weights, info)
+  use ancf_kinds, only: dp
+  use plate_element, only: plate_setup
+  implicit none
+  integer, intent(in) :: nel, npts, variant
+  real(dp), intent(in) :: reference(3, 12, nel), a(nel), b(nel)
+  real(dp), intent(out) :: derivs(12, 5, npts, nel), frame(2, 2, npts, nel)
+  real(dp), intent(out) :: curvature0(3, npts, nel), weights(npts, nel)
+  integer, intent(out) :: info
+  integer :: el
+  info = 0
+  do el = 1, nel
+    call plate_setup(reference(:, :, el), a(el), b(el), variant, derivs(:, :, :, el), &
+                     frame(:, :, :, el), curvature0(:, :, el), weights(:, el), info)
+    if (info /= 0) then
+      info = info + 1000 * el
+      return
+    end if
+  end do
+end subroutine plate_reference
+
+!> Elastic force (ndof), strain energy and element tangents (36, 36, nel) of a plate mesh.
+!> info = 2 + 1000 el: the normal vanished in element el.
+subroutine plate_elastic_forces(ndof, nel, npts, dofs, e, derivs, frame, curvature0, weights, &
+                                youngs, poisson, thickness, want_tangent, force, energy, &
+                                tangent, info)
+  use ancf_kinds, only: dp
+  use plate_element, only: plate_forces
+  implicit none
+  integer, intent(in) :: ndof, nel, npts, dofs(36, nel), want_tangent
+  real(dp), intent(in) :: e(ndof), derivs(12, 5, npts, nel), frame(2, 2, npts, nel)
+  real(dp), intent(in) :: curvature0(3, npts, nel), weights(npts, nel)
+  real(dp), intent(in) :: youngs, poisson, thickness
+  real(dp), intent(out) :: force(ndof), energy, tangent(36, 36, nel)
+  integer, intent(out) :: info
+  real(dp) :: element_force(36, nel), element_energy(nel)
+  integer :: el, element_info(nel)
+  force = 0.0_dp
+  !$omp parallel do schedule(static)
+  do el = 1, nel
+    call plate_forces(reshape(e(dofs(:, el)), [3, 12]), derivs(:, :, :, el), frame(:, :, :, el), &
+                      curvature0(:, :, el), weights(:, el), youngs, poisson, thickness, &
+                      want_tangent /= 0, element_force(:, el), element_energy(el), &
+                      tangent(:, :, el), element_info(el))
+  end do
+  !$omp end parallel do
+  info = 0
+  do el = 1, nel
+    if (element_info(el) /= 0) then
+      info = element_info(el) + 1000 * el
+      return
+    end if
+    force(dofs(:, el)) = force(dofs(:, el)) + element_force(:, el)
+  end do
+  energy = sum(element_energy)
+end subroutine plate_elastic_forces
+
 !> Generalized force of a dead moment on a section director, with its first and
 !> second derivatives.
 subroutine moment_generalized_force(director, axis, magnitude, force, jacobian, hessian, info)
@@ -283,31 +386,35 @@ subroutine direct_destroy(handle, info)
 end subroutine direct_destroy
 
 !> Advances nsteps steps of the generalized-alpha method (Newmark: alpha_m = alpha_f = 0)
-!> for an ANCF beam (module time_integrator). formulation 0: ANCF-FFR, S factorized once
-!> by the caller behind solver_handle, with the flexibility given; 1: large deformation,
-!> S refactorized per step on the pattern (scatter_map, mass_pattern) of solver_handle.
+!> (module time_integrator). formulation 0: ANCF-FFR beam, S factorized once by the caller
+!> behind solver_handle, with the flexibility given; 1: large-deformation beam, 2: thin
+!> plate (nde = 36), both with S refactorized per step on the pattern (scatter_map,
+!> mass_pattern) of solver_handle. Arrays a formulation does not use may be (.., 1, 1).
 !> The state (t, e, v, a, accel, lam, work) is updated in place; one output row per step.
-!> status = [steps done, info, detail]; last_correction = size of the last Newton
+!> status = [steps done, info, detail, refactorizations]; last_correction = size of the last Newton
 !> correction. Arrays of optional items carry max(1, n) columns (f2py refuses zero sizes).
-subroutine integrator_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, &
-                              nq, npts, ngauss, nnz_pattern, formulation, dofs, stiffness0, &
+subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nblock, nprobe, &
+                              nshape, nnz_mass, nsteps, nq, npts, ngauss, nplate_pts, nplate_el, &
+                              nnz_pattern, formulation, dofs, stiffness0, &
                               e0_frame, mass_row_ptr, mass_col, mass_values, constant_force, &
                               moment_dofs, moment_axis, moment_magnitude, moment_reference, &
                               con_ints, con_reals, drive_kinds, drive_params, frame_drive, &
                               frame_axis, frame_base, solver_handle, block_first, flexibility, &
                               flexibility_cc, probe_dofs, probe_shape, probe_reference, youngs, &
-                              poisson, gauss_gradients, gauss_weights, scatter_map, mass_pattern, &
+                              poisson, gauss_gradients, gauss_weights, plate_derivs, plate_frame, &
+                              plate_curvature0, plate_weights, thickness, scatter_map, mass_pattern, &
                               h, beta, gamma, alpha_m, alpha_f, tol, length_scale, max_newton, &
                               t, e, v, a, accel, lam, work, out_time, out_probe, out_deflection, &
                               out_lambda, out_energy, out_constraint, out_newton, out_q, status, &
                               last_correction)
   use ancf_kinds, only: dp
-  use time_integrator, only: beam_system, integrator_settings, integrator_chunk
+  use time_integrator, only: mechanical_system, integrator_settings, integrator_chunk
   implicit none
-  integer, intent(in) :: ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, nnz_mass, nsteps, nq
-  integer, intent(in) :: npts, ngauss, nnz_pattern, formulation
-  integer, intent(in) :: dofs(24, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
-  real(dp), intent(in) :: stiffness0(24, 24, nel), e0_frame(ndof), mass_values(nnz_mass)
+  integer, intent(in) :: ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nblock, nprobe, nshape
+  integer, intent(in) :: nnz_mass, nsteps, nq
+  integer, intent(in) :: npts, ngauss, nplate_pts, nplate_el, nnz_pattern, formulation
+  integer, intent(in) :: dofs(nde, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
+  real(dp), intent(in) :: stiffness0(nde, nde, nstiff), e0_frame(ndof), mass_values(nnz_mass)
   real(dp), intent(in) :: constant_force(ndof)
   integer, intent(in) :: moment_dofs(3, max(1, nmoment))
   real(dp), intent(in) :: moment_axis(3, max(1, nmoment)), moment_magnitude(max(1, nmoment))
@@ -318,10 +425,14 @@ subroutine integrator_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, 
   real(dp), intent(in) :: frame_axis(3), frame_base(3, 3)
   real(dp), intent(in) :: flexibility(ndof, max(3, 3 * nblock))
   real(dp), intent(in) :: flexibility_cc(max(3, 3 * nblock), max(3, 3 * nblock))
-  integer, intent(in) :: probe_dofs(24, nprobe)
-  real(dp), intent(in) :: probe_shape(8, nprobe), probe_reference(3, nprobe)
+  integer, intent(in) :: probe_dofs(nde, nprobe)
+  real(dp), intent(in) :: probe_shape(nshape, nprobe), probe_reference(3, nprobe)
   real(dp), intent(in) :: youngs, poisson, gauss_gradients(8, 3, npts, ngauss), gauss_weights(npts, ngauss)
-  integer, intent(in) :: scatter_map(24, 24, nel)
+  real(dp), intent(in) :: plate_derivs(12, 5, nplate_pts, nplate_el)
+  real(dp), intent(in) :: plate_frame(2, 2, nplate_pts, nplate_el)
+  real(dp), intent(in) :: plate_curvature0(3, nplate_pts, nplate_el)
+  real(dp), intent(in) :: plate_weights(nplate_pts, nplate_el), thickness
+  integer, intent(in) :: scatter_map(nde, nde, nel)
   real(dp), intent(in) :: mass_pattern(nnz_pattern)
   real(dp), intent(in) :: h, beta, gamma, alpha_m, alpha_f, tol, length_scale
   integer, intent(in) :: max_newton
@@ -330,11 +441,12 @@ subroutine integrator_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, 
   real(dp), intent(out) :: out_time(nsteps), out_probe(3, nprobe, nsteps)
   real(dp), intent(out) :: out_deflection(3, nprobe, nsteps), out_lambda(max(1, ncon), nsteps)
   real(dp), intent(out) :: out_energy(7, nsteps), out_constraint(nsteps), out_q(ndof, nq)
-  integer, intent(out) :: out_newton(nsteps), status(3)
+  integer, intent(out) :: out_newton(nsteps), status(4)
   real(dp), intent(out) :: last_correction
-  type(beam_system) :: sys
+  type(mechanical_system) :: sys
   type(integrator_settings) :: cfg
   sys%formulation = formulation
+  sys%element_dofs = nde
   sys%ndof = ndof
   sys%nel = nel
   sys%ncon = ncon
@@ -371,6 +483,15 @@ subroutine integrator_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, 
   if (formulation == 1) then
     sys%gauss_gradients = gauss_gradients
     sys%gauss_weights = gauss_weights
+  end if
+  if (formulation == 2) then
+    sys%plate_derivs = plate_derivs
+    sys%plate_frame = plate_frame
+    sys%plate_curvature0 = plate_curvature0
+    sys%plate_weights = plate_weights
+    sys%thickness = thickness
+  end if
+  if (formulation /= 0) then
     sys%scatter_map = scatter_map
     sys%mass_pattern = mass_pattern
   end if
@@ -393,5 +514,5 @@ subroutine integrator_advance(ndof, nel, ncon, ndrive, nmoment, nblock, nprobe, 
   call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, out_time, out_probe, &
                         out_deflection, out_lambda(1:ncon, :), out_energy, out_constraint, &
                         out_newton, nq == nsteps, out_q, status(1), status(2), status(3), &
-                        last_correction)
+                        status(4), last_correction)
 end subroutine integrator_advance

@@ -1,4 +1,4 @@
-!> Implicit time stepping of the constrained ANCF beam (seed 000, eqs. 58-62):
+!> Implicit time stepping of constrained ANCF models (seed 000, eqs. 58-62; seed 003 eq. 38):
 !>   M q'' + Q_el(q, t) = Q(q) + Phi_q^T lambda,   Phi(q, t) = 0,
 !> by the generalized-alpha method (Chung-Hulbert, in the form of Arnold and Bruels for
 !> constrained systems) with Newmark (alpha_m = alpha_f = 0) as its special case:
@@ -8,12 +8,13 @@
 !> Newton on (q_{n+1}, lambda_{n+1}) with the iteration matrix beta' M + K, beta' = (1 -
 !> alpha_m) / (beta h^2 (1 - alpha_f)).
 !>
-!> Two elastic models share the driver:
+!> Three elastic models share the driver:
 !> * ANCF-FFR (Q_el = T K0 (T^T q - e0), frame A(t) = Rot(axis, phi(t)) A_base): every 3 x 3
 !>   block of M is a scalar times I3, so beta' M + T K0 T^T = T S T^T with the constant
 !>   S = beta' M + K0, factorized once per run;
-!> * large deformation (beam_nonlinear): S = beta' M + K_t(q) is refactorized once per step
-!>   at the predicted state and reused by the step's iterations (modified Newton).
+!> * large deformation (beam_nonlinear, and the thin plate of plate_element): S = beta' M +
+!>   K_t(q) is refactorized once per step at the predicted state and reused by the step's
+!>   iterations (modified Newton).
 !> The multipliers enter through a Schur complement built from the flexibility S^{-1} E_c at
 !> the 3-vectors the constraints touch (E_c: their unit vectors in the frame), so a Newton
 !> correction costs one back-substitution plus small dense algebra (LAPACK dgesv). The
@@ -26,26 +27,29 @@ module time_integrator
   use constraints, only: constraint_eval
   use ffr_elastic, only: ffr_force
   use beam_nonlinear, only: nonlinear_element
+  use plate_element, only: plate_forces
   use section_moment, only: moment_force, moment_angle
   use sparse_pattern, only: pattern_assemble
   use sparse_direct, only: solver_solve, solver_factorize
   implicit none
   private
-  public :: beam_system, integrator_settings, integrator_chunk, frame_rotation, csr_matvec
+  public :: mechanical_system, integrator_settings, integrator_chunk, frame_rotation, csr_matvec
   public :: energy_kinetic, energy_strain, energy_loads, energy_moment, energy_total, &
             work_drive, work_frame, energy_count
 
   integer, parameter :: energy_kinetic = 1, energy_strain = 2, energy_loads = 3, &
                         energy_moment = 4, energy_total = 5, work_drive = 6, work_frame = 7, &
                         energy_count = 7
-  integer, parameter, public :: formulation_ffr = 0, formulation_nonlinear = 1
+  integer, parameter, public :: formulation_ffr = 0, formulation_nonlinear = 1, &
+                                formulation_plate = 2
 
   !> The model, as the stepper reads it (never changed by a step).
-  type :: beam_system
+  type :: mechanical_system
     integer :: formulation = formulation_ffr
     integer :: ndof = 0, nel = 0, ncon = 0, nmoment = 0, nblock = 0, nprobe = 0
-    integer, allocatable :: dofs(:, :)                 ! (24, nel)
-    real(dp), allocatable :: stiffness0(:, :, :)       ! (24, 24, nel)
+    integer :: element_dofs = 24                       ! beam 24, plate 36
+    integer, allocatable :: dofs(:, :)                 ! (element_dofs, nel)
+    real(dp), allocatable :: stiffness0(:, :, :)       ! FFR: (24, 24, nel)
     real(dp), allocatable :: e0_frame(:)
     integer, allocatable :: mass_row_ptr(:), mass_col(:)
     real(dp), allocatable :: mass_values(:)
@@ -63,12 +67,16 @@ module time_integrator
     ! large deformation: Gauss data, the pattern S is assembled on, M on that pattern
     real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp
     real(dp), allocatable :: gauss_gradients(:, :, :, :), gauss_weights(:, :)
+    ! thin plate (plate_element): reference data at the Gauss points, thickness
+    real(dp), allocatable :: plate_derivs(:, :, :, :), plate_frame(:, :, :, :)
+    real(dp), allocatable :: plate_curvature0(:, :, :), plate_weights(:, :)
+    real(dp) :: thickness = 0.0_dp
     integer, allocatable :: scatter_map(:, :, :)
     real(dp), allocatable :: mass_pattern(:)
-    integer, allocatable :: probe_dofs(:, :)           ! (24, nprobe)
-    real(dp), allocatable :: probe_shape(:, :)         ! (8, nprobe)
+    integer, allocatable :: probe_dofs(:, :)           ! (element_dofs, nprobe)
+    real(dp), allocatable :: probe_shape(:, :)         ! (element_dofs / 3, nprobe)
     real(dp), allocatable :: probe_reference(:, :)     ! (3, nprobe) rigid position in frame
-  end type beam_system
+  end type mechanical_system
 
   type :: integrator_settings
     real(dp) :: h, beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
@@ -80,7 +88,7 @@ contains
 
   !> A(t) and phi_frame'(t).
   subroutine frame_rotation(sys, t, rotation, rate, info)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: t
     real(dp), intent(out) :: rotation(3, 3), rate
     integer, intent(out) :: info
@@ -145,7 +153,7 @@ contains
   !> Constraint values and gradients at (e, t) (velocities only feed terms not used here).
   !> info = 5 when a constraint or drive cannot be evaluated.
   subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), t
     real(dp), intent(out) :: phi(:), gradients(:, :)
     integer, intent(out) :: info
@@ -157,58 +165,100 @@ contains
   end subroutine evaluate_constraints
 
   !> Elastic force and strain energy of the formulation (FFR with the frame rotation).
-  subroutine elastic_force(sys, rotation, e, force, strain)
-    type(beam_system), intent(in) :: sys
+  !> info = 7: a plate element's normal vanished.
+  subroutine elastic_force(sys, rotation, e, force, strain, info)
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: rotation(3, 3), e(:)
     real(dp), intent(out) :: force(:), strain
-    real(dp) :: element_force(24, sys%nel), element_energy(sys%nel), unused(24, 24)
-    integer :: el
+    integer, intent(out) :: info
+    real(dp) :: element_force(sys%element_dofs, sys%nel), element_energy(sys%nel)
+    real(dp) :: unused(sys%element_dofs, sys%element_dofs, 1)
+    info = 0
     if (sys%formulation == formulation_ffr) then
       call ffr_force(sys%ndof, sys%nel, sys%dofs, sys%stiffness0, rotation, e, sys%e0_frame, &
                      force, strain)
       return
     end if
-    force = 0.0_dp
-    ! elements in parallel (OpenMP, when built with it), then a serial scatter
+    call element_pass(sys, e, .false., element_force, element_energy, unused, info)
+    call scatter_forces(sys, element_force, element_energy, force, strain)
+  end subroutine elastic_force
+
+  !> Forces, energies and (on request) tangents of every element of the large-deformation
+  !> formulations (beam_nonlinear, plate_element); elements in parallel (OpenMP, when built
+  !> with it). info = 7: a plate element's normal vanished.
+  subroutine element_pass(sys, e, want_tangent, element_force, element_energy, tangents, info)
+    type(mechanical_system), intent(in) :: sys
+    real(dp), intent(in) :: e(:)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: element_force(:, :), element_energy(:), tangents(:, :, :)
+    integer, intent(out) :: info
+    real(dp) :: unused(sys%element_dofs, sys%element_dofs)
+    integer :: el, element_info(sys%nel)
+    element_info = 0
     !$omp parallel do schedule(static) private(unused)
     do el = 1, sys%nel
-      call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
-                             sys%gauss_weights(:, el), sys%youngs, sys%poisson, .false., &
-                             element_force(:, el), element_energy(el), unused)
+      if (sys%formulation == formulation_plate) then
+        if (want_tangent) then
+          call plate_forces(reshape(e(sys%dofs(:, el)), [3, 12]), sys%plate_derivs(:, :, :, el), &
+                            sys%plate_frame(:, :, :, el), sys%plate_curvature0(:, :, el), &
+                            sys%plate_weights(:, el), sys%youngs, sys%poisson, sys%thickness, &
+                            .true., element_force(:, el), element_energy(el), tangents(:, :, el), &
+                            element_info(el))
+        else
+          call plate_forces(reshape(e(sys%dofs(:, el)), [3, 12]), sys%plate_derivs(:, :, :, el), &
+                            sys%plate_frame(:, :, :, el), sys%plate_curvature0(:, :, el), &
+                            sys%plate_weights(:, el), sys%youngs, sys%poisson, sys%thickness, &
+                            .false., element_force(:, el), element_energy(el), unused, &
+                            element_info(el))
+        end if
+      else if (want_tangent) then
+        call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
+                               sys%gauss_weights(:, el), sys%youngs, sys%poisson, .true., &
+                               element_force(:, el), element_energy(el), tangents(:, :, el))
+      else
+        call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
+                               sys%gauss_weights(:, el), sys%youngs, sys%poisson, .false., &
+                               element_force(:, el), element_energy(el), unused)
+      end if
     end do
     !$omp end parallel do
+    info = 0
+    if (any(element_info /= 0)) info = 7
+  end subroutine element_pass
+
+  !> Global force and total energy from the element forces (serial scatter).
+  pure subroutine scatter_forces(sys, element_force, element_energy, force, strain)
+    type(mechanical_system), intent(in) :: sys
+    real(dp), intent(in) :: element_force(:, :), element_energy(:)
+    real(dp), intent(out) :: force(:), strain
+    integer :: el
+    force = 0.0_dp
     do el = 1, sys%nel
       force(sys%dofs(:, el)) = force(sys%dofs(:, el)) + element_force(:, el)
     end do
     strain = sum(element_energy)
-  end subroutine elastic_force
+  end subroutine scatter_forces
 
   !> Large deformation: factorize S = beta' M + K_t(e) on the solver's pattern and compute
   !> the flexibility S^{-1} E_c and E_c^T S^{-1} E_c for the Schur complement; the elastic
   !> force and strain energy at e come out of the same element pass.
   subroutine refactorize(sys, beta_prime, e, flexibility, flexibility_cc, force, strain, info, &
                          detail)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: beta_prime, e(:)
     real(dp), intent(out) :: flexibility(:, :), flexibility_cc(:, :), force(:), strain
     integer, intent(out) :: info, detail
-    real(dp) :: tangents(24, 24, sys%nel), element_force(24, sys%nel), element_energy(sys%nel)
+    real(dp) :: tangents(sys%element_dofs, sys%element_dofs, sys%nel)
+    real(dp) :: element_force(sys%element_dofs, sys%nel), element_energy(sys%nel)
     real(dp) :: values(size(sys%mass_pattern))
-    integer :: el, b, j
-    !$omp parallel do schedule(static)
-    do el = 1, sys%nel
-      call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &
-                             sys%gauss_weights(:, el), sys%youngs, sys%poisson, .true., &
-                             element_force(:, el), element_energy(el), tangents(:, :, el))
-    end do
-    !$omp end parallel do
+    integer :: b, j
+    detail = 0
+    call element_pass(sys, e, .true., element_force, element_energy, tangents, info)
+    if (info /= 0) return
     ! the elastic force at e comes with the tangent: the step's first residual reuses it
-    force = 0.0_dp
-    do el = 1, sys%nel
-      force(sys%dofs(:, el)) = force(sys%dofs(:, el)) + element_force(:, el)
-    end do
-    strain = sum(element_energy)
-    call pattern_assemble(size(values), 24, sys%nel, sys%scatter_map, tangents, values)
+    call scatter_forces(sys, element_force, element_energy, force, strain)
+    call pattern_assemble(size(values), sys%element_dofs, sys%nel, sys%scatter_map, tangents, &
+                          values)
     values = values + beta_prime * sys%mass_pattern
     call solver_factorize(sys%solver_handle, size(values), values, info, detail)
     if (info /= 0) then
@@ -240,7 +290,7 @@ contains
   !> values and gradients and the strain energy.
   subroutine residual(sys, t, e, acceleration, lam, rotation, r, phi, gradients, strain, info, &
                       known_elastic)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: t, e(:), acceleration(:), lam(:), rotation(3, 3)
     real(dp), intent(inout) :: strain  ! out; in with known_elastic
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :)
@@ -251,7 +301,8 @@ contains
     if (present(known_elastic)) then
       elastic = known_elastic
     else
-      call elastic_force(sys, rotation, e, elastic, strain)
+      call elastic_force(sys, rotation, e, elastic, strain, info)
+      if (info /= 0) return
     end if
     call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, acceleration, inertia)
     r = inertia + elastic - sys%constant_force
@@ -278,13 +329,15 @@ contains
   !> row per step; a is the generalized-alpha acceleration-like variable (= q'' for
   !> Newmark). info: 0 ok; 1 Newton did not converge; 2 non-finite state; 3 linear solve
   !> failed (detail = solver code); 4 singular Schur complement (detail = dgesv info);
-  !> 5 constraint or drive evaluation failed; 6 moment undefined. steps_done counts the
+  !> 5 constraint or drive evaluation failed; 6 moment undefined; 7 a plate element's normal
+  !> vanished. steps_done counts the
   !> completed steps; the state is that of the last completed step; last_correction is the
   !> size of the last Newton correction (why a step failed to converge).
   subroutine integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam, work, out_time, out_probe, &
                               out_deflection, out_lambda, out_energy, out_constraint, out_newton, &
-                              store_q, out_q, steps_done, info, detail, last_correction)
-    type(beam_system), intent(in) :: sys
+                              store_q, out_q, steps_done, info, detail, refactorizations, &
+                              last_correction)
+    type(mechanical_system), intent(in) :: sys
     type(integrator_settings), intent(in) :: cfg
     integer, intent(in) :: nsteps
     real(dp), intent(inout) :: t, e(:), v(:), a(:), accel(:), lam(:), work(2)
@@ -294,6 +347,7 @@ contains
     logical, intent(in) :: store_q
     real(dp), intent(out) :: out_q(:, :)
     integer, intent(out) :: steps_done, info, detail
+    integer, intent(out) :: refactorizations  ! of S during this call (large deformation)
     real(dp), intent(out) :: last_correction  ! max |de| of the last Newton correction (m)
     real(dp) :: e_new(sys%ndof), a_new(sys%ndof), accel_new(sys%ndof), lam_new(sys%ncon)
     real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof)
@@ -304,8 +358,10 @@ contains
     real(dp) :: rotation(3, 3), transform(3, 3), rate, strain, violation, powers_old(2), powers_new(2)
     real(dp) :: t_new, h, beta_prime
     integer :: step, it, ipiv(sys%ncon), lapack_info
-    logical :: done
+    logical :: done, fresh_force
+    real(dp) :: previous_correction
     info = 0
+    refactorizations = 0
     detail = 0
     steps_done = 0
     last_correction = 0.0_dp
@@ -338,21 +394,25 @@ contains
       ! the solve works in the frame of S: the floating frame for FFR, the global frame
       ! for large deformation (where A(t) only resolves the output deflections)
       transform = rotation
-      if (sys%formulation == formulation_nonlinear) then
+      if (sys%formulation /= formulation_ffr) then
         transform = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
         call refactorize(sys, beta_prime, e_new, flexibility, flexibility_cc, predicted_elastic, &
                          strain, info, detail)
         if (info /= 0) return
+        refactorizations = refactorizations + 1
       end if
       done = .false.
+      fresh_force = sys%formulation /= formulation_ffr
+      previous_correction = huge(1.0_dp)
       do it = 1, cfg%max_newton
-        if (it == 1 .and. sys%formulation == formulation_nonlinear) then
+        if (fresh_force) then
           call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, &
                         info, predicted_elastic)
         else
           call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, info)
         end if
         if (info /= 0) return
+        fresh_force = .false.
         ! z = T S^{-1} T^T r
         call rotate_all(transform, r, .true., z(:, 1))
         call solver_solve(sys%solver_handle, sys%ndof, 1, z, info, detail)
@@ -391,6 +451,17 @@ contains
           done = .true.
           exit
         end if
+        ! large deformation: when the step's tangent no longer halves the correction
+        ! (a strongly nonlinear step), update it at the current iterate (full Newton)
+        if (sys%formulation /= formulation_ffr .and. it < cfg%max_newton .and. &
+            last_correction > 0.5_dp * previous_correction) then
+          call refactorize(sys, beta_prime, e_new, flexibility, flexibility_cc, &
+                           predicted_elastic, strain, info, detail)
+          if (info /= 0) return
+          refactorizations = refactorizations + 1
+          fresh_force = .true.
+        end if
+        previous_correction = last_correction
       end do
       if (.not. done) then
         info = 1
@@ -422,7 +493,7 @@ contains
 
   !> W(3 nblock, ncon): frame components (T^T Phi_e^T) at the touched 3-vectors.
   subroutine frame_gradients(sys, rotation, gradients, w)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: rotation(3, 3), gradients(:, :)
     real(dp), intent(out) :: w(:, :)
     integer :: c, i, dof, b, comp
@@ -440,7 +511,7 @@ contains
 
   !> Phi_e x for every constraint.
   pure function gradient_dot(sys, gradients, x) result(y)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: gradients(:, :), x(:)
     real(dp) :: y(sys%ncon)
     integer :: c, i
@@ -457,7 +528,7 @@ contains
   !> x = T^T e, with the strain energy U, all from one pass over the elements, and the
   !> constraint violation max |Phi| at (e, t).
   subroutine step_powers(sys, e, v, lam, rotation, rate, t, powers, strain, violation, info)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), v(:), lam(:), rotation(3, 3), rate, t
     real(dp), intent(out) :: powers(2), strain, violation
     integer, intent(out) :: info
@@ -472,7 +543,7 @@ contains
     powers(1) = dot_product(lam, gradient_dot(sys, gradients, v))
     powers(2) = 0.0_dp
     if (sys%formulation /= formulation_ffr) then
-      call elastic_force(sys, rotation, e, frame_force_global, strain)
+      call elastic_force(sys, rotation, e, frame_force_global, strain, info)
       return
     end if
     strain = 0.0_dp
@@ -497,14 +568,14 @@ contains
 
   !> One output row: probes, deflections in the frame, energies.
   subroutine record(sys, e, v, rotation, work, strain, probe, deflection, energy)
-    type(beam_system), intent(in) :: sys
+    type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), v(:), rotation(3, 3), work(2), strain
     real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:)
     real(dp) :: mv(sys%ndof)
     integer :: p, a, m
     do p = 1, sys%nprobe
       probe(:, p) = 0.0_dp
-      do a = 0, 7
+      do a = 0, size(sys%probe_shape, 1) - 1
         probe(:, p) = probe(:, p) + sys%probe_shape(a + 1, p) * e(sys%probe_dofs(3 * a + 1:3 * a + 3, p))
       end do
       deflection(:, p) = matmul(transpose(rotation), probe(:, p)) - sys%probe_reference(:, p)

@@ -32,11 +32,17 @@ def _cmd_run(args: argparse.Namespace) -> int:
           f"{summary['model.nconstraints']} constraints")
     s = outcome.static
     if s is not None:
-        tip = summary["static.deflection.tip"]
         print(f"  static       {s.method}: {s.iterations} iterations, relative residual "
               f"{s.residual_norm:.2e}, {1e3 * s.wall_time_s:.2f} ms")
-        print(f"  tip          axial {1e3 * tip[0]:+.4f} mm, transverse {1e3 * tip[1]:+.4f} mm, "
-              f"lateral {1e3 * tip[2]:+.4f} mm (rigid frame)")
+        if "static.deflection.tip" in summary:
+            tip = summary["static.deflection.tip"]
+            print(f"  tip          axial {1e3 * tip[0]:+.4f} mm, transverse {1e3 * tip[1]:+.4f} "
+                  f"mm, lateral {1e3 * tip[2]:+.4f} mm (rigid frame)")
+        for key, value in summary.items():
+            if key.startswith("static.deflection.") and key != "static.deflection.tip":
+                name = key.rsplit(".", 1)[1]
+                print(f"  {name:12s} displacement ({1e3 * value[0]:+.4f}, {1e3 * value[1]:+.4f}, "
+                      f"{1e3 * value[2]:+.4f}) mm")
     d = outcome.dynamic
     if d is not None:
         print(f"  dynamic      {d.steps} steps of {summary['dynamic.dt']:g} s, "

@@ -10,7 +10,8 @@ kernel (``fortran/src/time_integrator.f90``), which advances whole chunks of ste
   factorization serves every step of the run; and the flexibility S^{-1} E_c at the
   3-vectors the constraints touch (one solve per touched coordinate, once), from which the
   kernel builds the multipliers' Schur complement without further solves.
-* Large deformation: the kernel refactorizes S = beta' M + K_t(q) once per step on the
+* Large deformation: the kernel refactorizes S = beta' M + K_t(q) once per step (and again
+  within a step whose Newton correction does not halve per iteration) on the
   same banded pattern, with the flexibility.
 * The consistent initial acceleration from [[M, -Phi_e^T], [-Phi_e, 0]] [a; lambda] =
   [Q - Q_el; -gamma].
@@ -145,7 +146,7 @@ class TimeIntegrator:
         start = time.perf_counter()
         self.mass = model.mass_matrix()
         self.mass_pattern = model.mass_values()
-        self.nonlinear = model.formulation == "nonlinear"
+        self.nonlinear = model.formulation != "ffr"  # refactorized every step
         table = model.constraints.dof_table()
         used = table[table >= 0]
         self.block_first = np.unique(used - used % 3)
@@ -167,23 +168,17 @@ class TimeIntegrator:
                 block_dofs = (self.block_first[:, None] + np.arange(3)).ravel()
                 self.flexibility_cc = self.flexibility[block_dofs]
             self.setup_solves = columns.shape[1]
+        self.refactorizations = 0  # large deformation: factorizations of S by the kernel
         self.setup_time = time.perf_counter() - start
         self._arrays = self._kernel_arrays()
 
     def _kernel_arrays(self) -> dict:
+        """The stepper's arguments: the model's element part (``model.stepper_arrays``)
+        and the mass, loads, moments, constraints and solver data common to all models."""
         model = self.model
         ints, reals, kinds, params = model.constraints.arrays()
         moments = model.moments
-        probes = list(model.probes.values())
-        shapes, references, probe_dofs = [], [], []
-        from . import kernel
-        for probe in probes:
-            shape, *_ = kernel.beam_shape([probe.xi], [probe.y], [probe.z],
-                                          [model.lengths[probe.element]])
-            shapes.append(shape[:, 0])
-            dofs = model.dofs[:, probe.element]
-            references.append(shape[:, 0] @ model.e0_frame[dofs].reshape(8, 3))
-            probe_dofs.append(dofs + 1)
+
         def pad(a: np.ndarray) -> np.ndarray:
             """f2py refuses zero-size arrays: give one unused column; counts say how many
             are real."""
@@ -193,9 +188,14 @@ class TimeIntegrator:
         csr = self.mass.tocsr()
         csr.eliminate_zeros()  # the x, y, z blocks of M are decoupled: 2/3 of the pattern is 0
         csr.sort_indices()
-        return dict(
-            dofs=_f(model.dofs + 1, np.int32), stiffness0=model.stiffness0,
-            e0_frame=_f(model.e0_frame), mass_row_ptr=_f(csr.indptr + 1, np.int32),
+        arrays = dict(
+            plate_derivs=np.zeros((12, 5, 1, 1), order="F"),
+            plate_frame=np.zeros((2, 2, 1, 1), order="F"),
+            plate_curvature0=np.zeros((3, 1, 1), order="F"),
+            plate_weights=np.zeros((1, 1), order="F"), thickness=0.0)
+        arrays.update(model.stepper_arrays())
+        arrays.update(
+            mass_row_ptr=_f(csr.indptr + 1, np.int32),
             mass_col=_f(csr.indices + 1, np.int32), mass_values=_f(csr.data),
             constant_force=_f(model.constant_force()),
             nmoment=len(moments),
@@ -206,13 +206,7 @@ class TimeIntegrator:
             moment_reference=pad(_f(np.array([model.e0[m.dofs] for m in moments]).reshape(-1, 3).T)),
             ncon=len(model.constraints),
             con_ints=pad(_f(ints, np.int32)), con_reals=pad(_f(reals)), drive_kinds=_f(kinds, np.int32),
-            drive_params=_f(params), frame_drive=model.frame_drive,
-            frame_axis=_f(model.frame_axis), frame_base=_f(model.frame_base),
-            formulation=1 if self.nonlinear else 0, youngs=model.youngs, poisson=model.poisson,
-            gauss_gradients=model.gauss_gradients if self.nonlinear
-            else np.zeros((8, 3, 1, 1), order="F"),
-            gauss_weights=model.gauss_weights if self.nonlinear
-            else np.zeros((1, 1), order="F"),
+            drive_params=_f(params),
             scatter_map=model.pattern.scatter_map, mass_pattern=_f(self.mass_pattern),
             solver_handle=self.solver.handle, nblock=len(self.block_first),
             block_first=pad(_f(self.block_first + 1, np.int32)),
@@ -220,10 +214,8 @@ class TimeIntegrator:
             else np.zeros((model.ndof, 3), order="F"),
             flexibility_cc=_f(self.flexibility_cc) if len(self.block_first)
             else np.zeros((3, 3), order="F"),
-            probe_dofs=_f(np.array(probe_dofs, dtype=np.int32).reshape(-1, 24).T, np.int32),
-            probe_shape=_f(np.array(shapes).reshape(-1, 8).T),
-            probe_reference=_f(np.array(references).reshape(-1, 3).T),
         )
+        return arrays
 
     def close(self) -> None:
         self.solver.close()
@@ -245,7 +237,8 @@ class TimeIntegrator:
          o_newton, o_q, status, self.last_correction) = out
         state.update(t=float(t), e=e, v=v, a=a, accel=accel, lam=lam[:len(m.constraints)],
                      work=work)
-        done, info, detail = (int(x) for x in status)
+        done, info, detail, refactorizations = (int(x) for x in status)
+        self.refactorizations += refactorizations
         chunk = Chunk(time=o_time[:done], probes=np.transpose(o_probe[:, :, :done], (2, 1, 0)),
                       deflections=np.transpose(o_defl[:, :, :done], (2, 1, 0)),
                       lam=o_lam[:len(m.constraints), :done].T, energy=o_energy[:, :done].T,
@@ -340,11 +333,11 @@ def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
             model.counters["newton_iterations"] += newton
             model.counters["solves"] += newton + integrator.setup_solves
             if integrator.nonlinear:  # FFR counted its single factorization at set-up
-                model.counters["factorizations"] += steps
+                model.counters["factorizations"] += integrator.refactorizations
     finally:
         integrator.close()
     wall = time.perf_counter() - start
     timing["total"] = wall
-    factorizations = steps if integrator.nonlinear else 1
+    factorizations = integrator.refactorizations if integrator.nonlinear else 1
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
                          solves_setup=integrator.setup_solves, wall_time_s=wall, timing=timing)

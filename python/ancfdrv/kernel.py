@@ -13,7 +13,8 @@ from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
-           "constraint_evaluate", "SparsePattern", "DirectSolver"]
+           "constraint_evaluate", "SparsePattern", "DirectSolver", "plate_shape",
+           "plate_element_arrays", "plate_reference", "plate_forces", "PlateReference"]
 
 
 def _f(a, dtype=np.float64) -> np.ndarray:
@@ -69,6 +70,56 @@ def beam_nonlinear_forces(dofs, e, gradients, weights, youngs, poisson, want_tan
     """Large-deformation elastic force, strain energy and element tangents (24, 24, nel)."""
     return _kernel.beam_nonlinear_forces(_f(dofs + 1, np.int32), _f(e), gradients, weights,
                                          youngs, poisson, int(want_tangent))
+
+
+PLATE_VARIANTS = {"plain": 0, "completed": 1}
+
+
+def plate_shape(xi: float, eta: float, a: float, b: float) -> tuple[np.ndarray, np.ndarray]:
+    """Thin-plate shape functions (12,) and their x, y, xx, yy, xy derivatives (12, 5)."""
+    return _kernel.plate_shape_functions(xi, eta, a, b)
+
+
+def plate_element_arrays(a, b, thickness: float, density: float, load) -> tuple[np.ndarray,
+                                                                               np.ndarray]:
+    """Compact plate mass matrices (12, 12, nel) and the generalized force (3, 12, nel) of a
+    constant load per unit area (e.g. rho h g)."""
+    mass, force, info = _kernel.plate_element_arrays(_f(a), _f(b), thickness, density, _f(load))
+    if info:
+        raise SolverError(f"plate element arrays: kernel code {info}")
+    return mass, force
+
+
+class PlateReference:
+    """Reference data of a plate mesh at the Gauss points (plate_element.plate_setup):
+    shape derivatives, the frame maps K, the reference curvatures and the weights."""
+
+    def __init__(self, reference: np.ndarray, a, b, variant: str) -> None:
+        npts = int(_kernel.plate_rule())
+        if variant not in PLATE_VARIANTS:
+            raise InputError(f"plate variant '{variant}': expected one of "
+                             f"{sorted(PLATE_VARIANTS)}")
+        self.variant = variant
+        (self.derivs, self.frame, self.curvature0, self.weights,
+         info) = _kernel.plate_reference(npts, _f(reference), _f(a), _f(b),
+                                         PLATE_VARIANTS[variant])
+        if info:
+            element, code = divmod(info, 1000)
+            raise InputError(f"plate element {element}: degenerate reference geometry "
+                             f"(r_x parallel to r_y, code {code})")
+
+
+def plate_forces(dofs, e, reference: PlateReference, youngs: float, poisson: float,
+                 thickness: float, want_tangent: bool):
+    """Plate elastic force (ndof,), strain energy and element tangents (36, 36, nel)."""
+    force, energy, tangent, info = _kernel.plate_elastic_forces(
+        _f(dofs + 1, np.int32), _f(e), reference.derivs, reference.frame, reference.curvature0,
+        reference.weights, youngs, poisson, thickness, int(want_tangent))
+    if info:
+        element, code = divmod(info, 1000)
+        raise SolverError(f"plate element {element}: the mid-surface normal vanished "
+                          f"(r_x parallel to r_y): the configuration is degenerate")
+    return force, energy, tangent
 
 
 def ffr_force(dofs, stiffness0, rotation, e, e0_frame):

@@ -239,6 +239,33 @@ class BeamModel:
         frame = self.frame_at(t)
         return {name: frame.T @ p - rigid[name] for name, p in self.probe_positions(e).items()}
 
+    def stepper_arrays(self) -> dict:
+        """The element part of the kernel stepper's arguments (formulation 0 FFR, 1 large
+        deformation)."""
+        shapes, references, probe_dofs = [], [], []
+        for probe in self.probes.values():
+            shape, *_ = kernel.beam_shape([probe.xi], [probe.y], [probe.z],
+                                          [self.lengths[probe.element]])
+            shapes.append(shape[:, 0])
+            dofs = self.dofs[:, probe.element]
+            references.append(shape[:, 0] @ self.e0_frame[dofs].reshape(8, 3))
+            probe_dofs.append(dofs + 1)
+        nonlinear = self.formulation == "nonlinear"
+        f = np.asfortranarray
+        return dict(
+            formulation=1 if nonlinear else 0, dofs=f(self.dofs + 1, dtype=np.int32),
+            stiffness0=self.stiffness0, e0_frame=f(self.e0_frame),
+            youngs=self.youngs, poisson=self.poisson,
+            gauss_gradients=self.gauss_gradients if nonlinear
+            else np.zeros((8, 3, 1, 1), order="F"),
+            gauss_weights=self.gauss_weights if nonlinear else np.zeros((1, 1), order="F"),
+            frame_drive=self.frame_drive, frame_axis=f(self.frame_axis, dtype=float),
+            frame_base=f(self.frame_base, dtype=float),
+            probe_dofs=f(np.array(probe_dofs, dtype=np.int32).reshape(-1, 24).T),
+            probe_shape=f(np.array(shapes).reshape(-1, 8).T),
+            probe_reference=f(np.array(references).reshape(-1, 3).T),
+        )
+
     def summary(self) -> dict[str, int]:
         return {"ndof": self.ndof, "nnodes": self.nnodes, "nelements": self.nel,
                 "nconstraints": len(self.constraints)}
@@ -386,9 +413,11 @@ def check_ffr_validity(model: BeamModel, scene: Scene) -> None:
             "formulation = 'nonlinear'")
 
 
-def build_model(scene: Scene) -> BeamModel:
+def build_model(scene: Scene):
     """The model the scene describes."""
-    builders = {"boom": build_boom, "cantilever": build_cantilever, "spinup": build_spinup}
+    from .plate import build_leaf, build_plate
+    builders = {"boom": build_boom, "cantilever": build_cantilever, "spinup": build_spinup,
+                "plate": build_plate, "leaf": build_leaf}
     model = builders[scene.kind](scene)
     check_ffr_validity(model, scene)
     return model

@@ -22,7 +22,70 @@ def plot_result(h5_path: str | Path, png: str | Path | None = None) -> Path:
     h5_path = Path(h5_path)
     with h5py.File(h5_path, "r") as h5:
         dynamic = "dynamic" in h5 and len(h5["dynamic/time"]) > 1
+        plate = "nodes" in h5["model"]
+    if plate:
+        return plot_plate_dynamic(h5_path, png) if dynamic else plot_plate_static(h5_path, png)
     return plot_dynamic(h5_path, png) if dynamic else plot_static(h5_path, png)
+
+
+def plot_plate_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
+    """Plate or leaf run: displacement of each probe (x, y, z) and the energy balance
+    (kinetic, strain, potential of the loads, and the total's drift)."""
+    png = Path(png) if png else h5_path.with_suffix(".png")
+    with h5py.File(h5_path, "r") as h5:
+        dyn = h5["dynamic"]
+        t = dyn["time"][()]
+        probes = {name: dyn[f"deflection/{name}"][()] for name in dyn["deflection"]}
+        energy = {k: dyn[f"energy/{k}"][()] for k in dyn["energy"]}
+        title, status = h5.attrs["title"], h5.attrs["status"]
+        nel = h5["model"].attrs["nelements"]
+    fig, axes = plt.subplots(len(probes) + 1, 1, figsize=(9, 2.6 * (len(probes) + 1)),
+                             sharex=True, constrained_layout=True)
+    for ax, (name, d) in zip(axes, probes.items()):
+        for k, label in enumerate("xyz"):
+            ax.plot(t, 1e3 * d[:, k], lw=1.0, label=f"u_{label}")
+        ax.set_ylabel(f"{name} displacement (mm)")
+        ax.legend(fontsize=8, ncol=3)
+    axes[0].set_title(f"{title}: {nel} elements ({status})", fontsize=9)
+    ax = axes[-1]
+    for key in ("kinetic", "strain", "gravity"):
+        ax.plot(t, energy[key], lw=1.0, label=key if key != "gravity" else "load potential")
+    drift = energy["total"] - energy["total"][0]
+    ax.plot(t, drift, "k--", lw=1.0, label="E - E(0)")
+    scale = max(np.abs(energy["kinetic"]).max(), np.abs(energy["strain"]).max(), 1e-300)
+    ax.set_title(f"max |E - E(0)| = {np.abs(drift).max() / scale:.2e} of the largest kinetic "
+                 "or strain energy", fontsize=9)
+    ax.set_ylabel("energy (J)")
+    ax.set_xlabel("time (s)")
+    ax.legend(fontsize=8, ncol=4)
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+    return png
+
+
+def plot_plate_static(h5_path: Path, png: str | Path | None = None) -> Path:
+    """Plate or leaf equilibrium: the out-of-plane displacement over the initial mid-surface."""
+    png = Path(png) if png else h5_path.with_suffix(".png")
+    with h5py.File(h5_path, "r") as h5:
+        if "static" not in h5:
+            raise ValueError(f"{h5_path}: no /static group to plot (status: "
+                             f"{h5.attrs.get('status')})")
+        nodes = h5["model/nodes"][()]
+        q = h5["static/q"][()].reshape(len(nodes), -1)[:, :3]
+        title = h5.attrs["title"]
+    w = q[:, 2] - nodes[:, 2]
+    fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
+    art = ax.tricontourf(nodes[:, 0], nodes[:, 1], 1e3 * w, levels=20, cmap="viridis")
+    ax.plot(nodes[:, 0], nodes[:, 1], "k.", ms=2)
+    fig.colorbar(art, ax=ax, label="displacement along r3 (mm)")
+    ax.set_aspect("equal")
+    ax.set_xlabel("r1 (m)")
+    ax.set_ylabel("r2 (m)")
+    ax.set_title(f"{title}\nextreme displacement {1e3 * w[np.argmax(np.abs(w))]:.4g} mm",
+                 fontsize=9)
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+    return png
 
 
 def plot_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:

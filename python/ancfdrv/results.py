@@ -42,7 +42,12 @@ def create(path: Path, scene: Scene, model: BeamModel) -> None:
         })
         group = h5.create_group("model")
         _attrs(group.attrs, model.summary())
-        group.create_dataset("node_s", data=model.node_s)
+        mesh = getattr(model, "mesh", None)
+        if mesh is not None:  # plate models: initial node positions and connectivity
+            group.create_dataset("nodes", data=mesh.coords[:, :3])
+            group.create_dataset("elements", data=mesh.elements)
+        else:
+            group.create_dataset("node_s", data=model.node_s)
         group.create_dataset("e0", data=model.e0)
         group.attrs["constraint_names"] = "\n".join(model.constraints.names)
 
@@ -93,6 +98,9 @@ def finish(path: Path, model: BeamModel, timing: dict[str, float], status: str,
         h5.attrs["warnings"] = "\n".join(model.warnings)
         if "dynamic" in h5 and status != "ok":
             h5["dynamic"].attrs["status"] = status
+        has_motion = "dynamic/mesh_nodes" in h5
+    if has_motion:
+        write_xdmf(path)
 
 
 def read_summary(path: Path) -> dict[str, Any]:
@@ -130,6 +138,8 @@ class DynamicWriter:
     def __init__(self, path: Path, model: BeamModel, store_q: bool) -> None:
         from .dynamic import ENERGY_NAMES
         self.path, self.names, self.store_q = path, list(model.probes), store_q
+        mesh = getattr(model, "mesh", None)
+        self.nnodes = mesh.nnodes if mesh is not None and store_q else 0
         self.energy_names = ENERGY_NAMES
         self.rows = 0
         ncon, ndof = len(model.constraints), model.ndof
@@ -155,6 +165,10 @@ class DynamicWriter:
             series("newton_iterations")
             if store_q:
                 series("q", (ndof,))
+            if self.nnodes:  # plate models: node positions per step, for ParaView (XDMF)
+                group.create_dataset("mesh_nodes", shape=(0, self.nnodes, 3),
+                                     maxshape=(None, self.nnodes, 3), dtype="f8",
+                                     chunks=(16, self.nnodes, 3))
 
     def __call__(self, chunk) -> None:
         n = len(chunk.time)
@@ -179,6 +193,8 @@ class DynamicWriter:
             append("newton_iterations", chunk.newton)
             if self.store_q and chunk.q is not None:
                 append("q", chunk.q)
+                if self.nnodes:
+                    append("mesh_nodes", chunk.q.reshape(n, self.nnodes, -1)[:, :, :3])
             self.rows += n
             group.attrs["rows"] = self.rows
 
@@ -191,3 +207,36 @@ def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, flo
         if stages:
             stage_group = group.require_group("stages")
             _attrs(stage_group.attrs, stages)
+
+
+def write_xdmf(path: Path) -> Path:
+    """An XDMF file beside the HDF5 result of a plate model: one quadrilateral grid per
+    output step (the elements' corner nodes) with the node positions of
+    /dynamic/mesh_nodes, and the nodal displacement; opens in ParaView as a time series."""
+    with h5py.File(path, "r") as h5:
+        times = h5["dynamic/time"][()]
+        nnodes = h5["dynamic/mesh_nodes"].shape[1]
+        nel = h5["model/elements"].shape[0]
+    name = path.name
+    grids = []
+    for k, t in enumerate(times):
+        slab = (f'<DataItem ItemType="HyperSlab" Dimensions="{nnodes} 3" Type="HyperSlab">'
+                f'<DataItem Dimensions="3 3" Format="XML">{k} 0 0 1 1 1 1 {nnodes} 3</DataItem>'
+                f'<DataItem Dimensions="{len(times)} {nnodes} 3" NumberType="Float" '
+                f'Precision="8" Format="HDF">{name}:/dynamic/mesh_nodes</DataItem></DataItem>')
+        grids.append(
+            f'<Grid Name="step {k}" GridType="Uniform"><Time Value="{t:.9g}"/>'
+            f'<Topology TopologyType="Quadrilateral" NumberOfElements="{nel}">'
+            f'<DataItem Dimensions="{nel} 4" NumberType="Int" Precision="8" Format="HDF">'
+            f'{name}:/model/elements</DataItem></Topology>'
+            f'<Geometry GeometryType="XYZ">{slab}</Geometry>'
+            f'<Attribute Name="displacement" AttributeType="Vector" Center="Node">'
+            f'<DataItem ItemType="Function" Function="$0 - $1" Dimensions="{nnodes} 3">'
+            f'{slab}<DataItem Dimensions="{nnodes} 3" NumberType="Float" Precision="8" '
+            f'Format="HDF">{name}:/model/nodes</DataItem></DataItem></Attribute></Grid>')
+    text = ('<?xml version="1.0" ?>\n<Xdmf Version="3.0"><Domain>'
+            '<Grid Name="motion" GridType="Collection" CollectionType="Temporal">\n'
+            + "\n".join(grids) + "\n</Grid></Domain></Xdmf>\n")
+    out = path.with_suffix(".xdmf")
+    out.write_text(text)
+    return out

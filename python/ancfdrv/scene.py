@@ -20,9 +20,10 @@ from .errors import InputError
 REQUIRED = object()
 
 #: Effects a scene may list in ``&scene effects``; what is not listed is never computed.
-EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment")
+EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
+                     "pressure", "prestress")
 #: Effects of later capabilities, recognised so the message can say so.
-EFFECTS_PLANNED = ("contact", "friction", "prestress", "damping")
+EFFECTS_PLANNED = ("contact", "friction", "damping")
 
 
 @dataclass(frozen=True)
@@ -99,12 +100,48 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "omega": Key("float", 6.0, positive, "final hub speed W (rad/s)"),
         "period": Key("float", 15.0, positive, "spin-up time T (s)"),
     },
+    "plate": {
+        "length_x": Key("float", check=positive, doc="side along r1 (m)"),
+        "length_y": Key("float", check=positive, doc="side along r2 (m)"),
+        "thickness": Key("float", check=positive, doc="plate thickness h (m)"),
+        "nx": Key("int", 4, positive, "elements along r1"),
+        "ny": Key("int", 4, positive, "elements along r2"),
+        "variant": Key("str", "completed", one_of("plain", "completed"),
+                       "thin plate element (seed 003): 'plain' (Dufva-Shabana) or "
+                       "'completed' (unit normal as third gradient)"),
+        "support": Key("str", "corner_spherical",
+                       one_of("corner_spherical", "simply_supported", "clamped_edge"),
+                       "'corner_spherical': spherical joint at the corner (0, 0, 0); "
+                       "'simply_supported': w = 0 on all edges; 'clamped_edge': edge x = 0 "
+                       "clamped"),
+    },
+    "leaf": {
+        "arc_length": Key("float", check=positive, doc="mid-surface arc length (m)"),
+        "radius": Key("float", check=positive, doc="mid-surface radius of the initial "
+                      "(assembled) shape (m); concave up, symmetric about r1 = 0"),
+        "free_radius": Key("float", None, positive, "radius of the stress-free shape (m); "
+                           "differs from radius only with the effect 'prestress' "
+                           "(default: radius)"),
+        "width": Key("float", check=positive, doc="leaf width along r2 (m)"),
+        "thickness": Key("float", check=positive, doc="leaf thickness (m)"),
+        "nx": Key("int", 8, lambda v: None if v >= 2 and v % 2 == 0 else
+                  "must be even (the middle of the leaf is a node line)",
+                  "elements along the arc"),
+        "ny": Key("int", 1, positive, "elements across the width"),
+        "variant": Key("str", "completed", one_of("plain", "completed"),
+                       "'completed' removes the initial strain of the curved reference; "
+                       "'plain' springs back toward flat (seed 003's motivation)"),
+        "support": Key("str", "middle_clamp", one_of("middle_clamp", "free"),
+                       "'middle_clamp': r and r_x of the middle node line fixed (the "
+                       "axle's U-bolts, seed 003); 'free': unsupported"),
+    },
     "loads": {
         "gravity": Key("float", 9.81, non_negative, "gravitational acceleration (m/s^2)"),
         "tip_mass": Key("float", 0.0, non_negative, "lumped mass at the tip (kg)"),
         "moment": Key("float", 0.0, doc="boom: moment M_B about +r3 on the section at A2 (N m)"),
         "tip_force": Key("floats", [0.0, 0.0, 0.0], size=3, doc="force at the tip (N)"),
         "end_moment": Key("float", 0.0, doc="moment about +r3 on the tip section (N m)"),
+        "pressure": Key("float", 0.0, doc="plate: dead pressure along -r3 (Pa)"),
     },
     "solver": {
         "static_method": Key("str", "split", one_of("split", "newton"),
@@ -139,8 +176,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
 }
 
 #: Groups that define what is built; a scene has exactly one of them.
-MODEL_GROUPS = ("boom", "cantilever", "spinup")
-COMMON_GROUPS = ("scene", "beam", "material", "loads", "solver")
+MODEL_GROUPS = ("boom", "cantilever", "spinup", "plate", "leaf")
+#: Models built from thin plate elements (seed 003); the others are beams (seed 000).
+PLATE_KINDS = ("plate", "leaf")
+COMMON_GROUPS = ("scene", "material", "loads", "solver", "output")
 
 
 @dataclass
@@ -154,7 +193,7 @@ class Scene:
 
     @property
     def kind(self) -> str:
-        """The model the scene builds: 'boom' or 'cantilever'."""
+        """The model the scene builds: one of MODEL_GROUPS."""
         return next(g for g in MODEL_GROUPS if g in self.values)
 
     @property
@@ -291,18 +330,21 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
         raise InputError(f"a scene needs exactly one of the groups "
                          f"{', '.join('&' + g for g in MODEL_GROUPS)} (found "
                          f"{', '.join('&' + g for g in models) or 'none'})", file=file)
-    for group in COMMON_GROUPS:
+    kind = models[0]
+    if kind in PLATE_KINDS and "beam" in values:
+        raise InputError(f"&beam does not apply to a &{kind} scene", file=file, group="beam")
+    for group in COMMON_GROUPS + (() if kind in PLATE_KINDS else ("beam",)):
         if group not in values:
             if any(spec.default is REQUIRED for spec in SCHEMA[group].values()):
                 raise InputError("required group is missing", file=file, group=group)
             values[group] = {k: s.default for k, s in SCHEMA[group].items()}
-    _check_consistency(values, file)
+    _check_consistency(values, file, kind)
     buffer = io.StringIO()
     nml.write(buffer)
     return Scene(path=path, values=values, text=buffer.getvalue(), overrides=applied)
 
 
-def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
+def _check_consistency(values: dict[str, dict[str, Any]], file: str, kind: str) -> None:
     scene = values["scene"]
     for effect in scene["effects"]:
         if effect in EFFECTS_PLANNED:
@@ -318,6 +360,13 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
             raise InputError("formulation 'nonlinear' needs static_method = 'newton' (the split "
                              "iteration relies on the constant FFR stiffness)", file=file,
                              group="solver", key="static_method")
+    if kind in PLATE_KINDS:
+        _check_plate(values, file, kind)
+        return
+    for effect in ("pressure", "prestress"):
+        if effect in scene["effects"]:
+            raise InputError(f"effect {effect!r} applies to plate and leaf scenes only",
+                             file=file, group="scene", key="effects")
     beam = values["beam"]
     if beam["segments"] is None:
         beam["segments"] = [beam["length"]]
@@ -346,3 +395,41 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str) -> None:
             raise InputError(f"omega = {boom['omega']} rad/s sweeps the {math.degrees(sweep):g} "
                              "deg before start and braking are over; lower omega or shorten "
                              "t_start/t_brake", file=file, group="boom", key="omega")
+
+
+def _check_plate(values: dict[str, dict[str, Any]], file: str, kind: str) -> None:
+    """Plate and leaf scenes: the thin plate is a large-deformation element."""
+    scene = values["scene"]
+    if scene["formulation"] != "nonlinear":
+        raise InputError(f"a &{kind} scene needs formulation = 'nonlinear' (the thin plate "
+                         "element has no floating-frame model)", file=file, group="scene",
+                         key="formulation")
+    effects = scene["effects"]
+    for effect in ("tip_mass", "bending_moment", "tip_force", "end_moment"):
+        if effect in effects:
+            raise InputError(f"effect {effect!r} applies to beam scenes only", file=file,
+                             group="scene", key="effects")
+    if "pressure" in effects and kind != "plate":
+        raise InputError("effect 'pressure' applies to &plate scenes", file=file,
+                         group="scene", key="effects")
+    if kind == "leaf":
+        leaf = values["leaf"]
+        if leaf["free_radius"] is None:
+            leaf["free_radius"] = leaf["radius"]
+        differs = abs(leaf["free_radius"] - leaf["radius"]) > 1e-12 * leaf["radius"]
+        if differs and "prestress" not in effects:
+            raise InputError(f"free_radius = {leaf['free_radius']:g} m differs from radius = "
+                             f"{leaf['radius']:g} m: list 'prestress' in scene.effects (or "
+                             "remove free_radius)", file=file, group="leaf", key="free_radius")
+        if "prestress" in effects and not differs:
+            raise InputError("effect 'prestress' needs leaf.free_radius different from "
+                             "leaf.radius", file=file, group="leaf", key="free_radius")
+        if differs and leaf["variant"] != "completed":
+            raise InputError("prestress needs variant = 'completed' (the plain element has no "
+                             "stress-free reference)", file=file, group="leaf", key="variant")
+        if leaf["arc_length"] >= 2 * math.pi * min(leaf["radius"], leaf["free_radius"]):
+            raise InputError("arc_length must be shorter than the circle of the radius",
+                             file=file, group="leaf", key="arc_length")
+    elif "prestress" in effects:
+        raise InputError("effect 'prestress' applies to &leaf scenes", file=file,
+                         group="scene", key="effects")

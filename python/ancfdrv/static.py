@@ -70,10 +70,12 @@ def converged(force_res: float, con_res: float, step: float, size: float, tol: f
     return ""
 
 
-def residuals(model: BeamModel, d: np.ndarray, lam: np.ndarray, elastic: np.ndarray):
+def residuals(model: BeamModel, d: np.ndarray, lam: np.ndarray, elastic: np.ndarray,
+              scale_floor: float = 0.0):
     """Relative force residual |Q_el - Q - Phi_e^T lam| / scale and max |Phi| / length at the
     displacement d = e - e0, given the elastic force Q_el (for FFR K d, computed from d so
-    it loses no digits)."""
+    it loses no digits). ``scale_floor`` keeps the scale of a self-equilibrated problem
+    (a prestressed body without loads) at the forces met on the way."""
     e = model.e0 + d
     values, rows, cols, grads = model.constraints.jacobian(e, model.ndof)
     reaction = np.zeros(model.ndof)
@@ -81,9 +83,9 @@ def residuals(model: BeamModel, d: np.ndarray, lam: np.ndarray, elastic: np.ndar
     external = model.external_force(e)
     residual = elastic - external - reaction
     scale = max(np.linalg.norm(external), np.linalg.norm(reaction), np.linalg.norm(elastic),
-                1e-300)
-    length = model.node_s[-1] - model.node_s[0]
-    return np.linalg.norm(residual) / scale, np.max(np.abs(values), initial=0.0) / length
+                scale_floor, 1e-300)
+    return (np.linalg.norm(residual) / scale,
+            np.max(np.abs(values), initial=0.0) / model.length_scale)
 
 
 def _hessian_triplets(model: BeamModel, e: np.ndarray):
@@ -128,6 +130,7 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
     cols = np.concatenate([model.pattern.col_index, h_cols, *m_cols, j_cols, n + j_rows])
     timing["assembly"] += time.perf_counter() - t0
     history, total = [], 0
+    force_scale = 0.0
     with DirectSolver(n + ncon, rows, cols, what="static Newton saddle-point matrix") as solver:
         try:
             for load_step in range(1, load_steps + 1):
@@ -143,6 +146,8 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
                     for dofs, f, _, _ in moments:
                         external[dofs] += f
                     internal, k_values = elastic(d, True)
+                    force_scale = max(force_scale, np.linalg.norm(internal),
+                                      np.linalg.norm(external))
                     residual = internal - external - reaction
                     values = np.concatenate([k_values, -lam[h_con] * h_vals,
                                              *[-j.ravel() for _, _, j, _ in moments], -grads,
@@ -159,7 +164,8 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
                                           f"{iteration} of load step {load_step}")
                     d += step[:n]
                     lam += step[n:]
-                    force_res, con_res = residuals(model, d, lam, elastic(d, False)[0])
+                    force_res, con_res = residuals(model, d, lam, elastic(d, False)[0],
+                                                   force_scale)
                     previous = history[-1] if history and iteration > 1 else np.inf
                     history.append(force_res)
                     how = converged(force_res, con_res, np.linalg.norm(step[:n]),

@@ -1,0 +1,356 @@
+!> The gradient-deficient ANCF thin plate element (Dufva & Shabana 2005; seed 003 eqs. 3-8)
+!> and its completed variant (seed 003 eqs. 9-16).
+!>
+!> Kinematics: 4 nodes x [r, r_x, r_y] = 36 coordinates, r(x, y) = S(x, y) e with the
+!> 12 incomplete bicubic (Adini-Clough-Melosh) shape functions of xi = x/a, eta = y/b, nodes
+!> at (0,0), (a,0), (a,b), (0,b). Mass and surface loads are integrated over the parent
+!> rectangle (for the curved leaves, meshed by arc length, this is the reference area).
+!>
+!> Elastic energy per unit reference area, plane stress, D = E/(1-nu^2) [1 nu 0; nu 1 0;
+!> 0 0 (1-nu)/2]:
+!>   membrane  W_m = h/2 eps^T D eps,          eps = [E11, E22, 2 E12],  E = (F^T F - I)/2
+!>   bending   W_b = h^3/24 kappa^T D kappa,   kappa = [k11, k22, 2 k12]
+!> with the curvatures of eq. 6, c_ab = r_ab . g / |g|^3, g = r_x x r_y (the unnormalized
+!> normal: see REFERENCES.md on eq. 6 vs eq. 7).
+!>  * plain:     F = [r_x r_y], k_ab = c_ab (a curved reference carries initial strain);
+!>  * completed: J = [r_x r_y n] J0^{-1}. Because n is a unit vector normal to r_x and r_y,
+!>    J^T J = blockdiag(A, 1) with A the in-plane metric, so eps_ZZ, eps_XZ, eps_YZ of eq. 10
+!>    vanish identically and their n-derivatives (eqs. 12-13, 16) cancel exactly; what
+!>    remains is the in-plane block in the reference's orthonormal tangent frame (t1, t2):
+!>    F = [r_x r_y] K, K = ([t1 t2]^T [r0_x r0_y])^{-1}, and k = K^T (c - c0) K (eq. 14),
+!>    integrated over the reference area |r0_x x r0_y| dx dy. For a flat rectangular
+!>    reference K = I, c0 = 0 and both variants coincide.
+!>
+!> Implementation: at each Gauss point the energy density is a function of the 15 numbers
+!> z = (r_x, r_y, r_xx, r_yy, r_xy); its gradient and Hessian with respect to z are
+!> analytic, and Q = sum_A dS_A^T dW/dz_A, K_t = sum_AB dS_A^T d2W/dz_A dz_B dS_B.
+module plate_element
+  use ancf_kinds, only: dp
+  use quadrature, only: gauss_legendre
+  implicit none
+  private
+  public :: plate_shape, plate_mass, plate_surface_load, plate_setup, plate_forces, &
+            plate_curvatures
+
+  integer, parameter, public :: plate_shapes = 12, plate_dofs = 36, plate_fields = 5
+  integer, parameter, public :: plate_variant_plain = 0, plate_variant_completed = 1
+  !> Gauss points per direction of the elastic, mass and load integrals.
+  integer, parameter, public :: plate_gauss_1d = 4
+  integer, parameter, public :: plate_points = plate_gauss_1d * plate_gauss_1d
+  !> Field indices of z: r_x, r_y, r_xx, r_yy, r_xy.
+  integer, parameter :: f_x = 1, f_y = 2, f_xx = 3, f_yy = 4, f_xy = 5
+
+  !> Monomial coefficients of the 12 shape functions in xi, eta (rows: 1, xi, eta, xi^2,
+  !> xi eta, eta^2, xi^3, xi^2 eta, xi eta^2, eta^3, xi^3 eta, xi eta^3; columns: node 1
+  !> r, r_x, r_y, node 2 r, r_x, r_y, ...). The r_x columns carry a factor a, the r_y
+  !> columns a factor b, applied in plate_shape.
+  real(dp), parameter :: coefficients(12, 12) = reshape([ &
+    1, 0, 0, -3, -1, -3, 2, 3, 3, 2, -2, -2, &
+    0, 1, 0, -2, -1, 0, 1, 2, 0, 0, -1, 0, &
+    0, 0, 1, 0, -1, -2, 0, 0, 2, 1, 0, -1, &
+    0, 0, 0, 3, 1, 0, -2, -3, -3, 0, 2, 2, &
+    0, 0, 0, -1, 0, 0, 1, 1, 0, 0, -1, 0, &
+    0, 0, 0, 0, 1, 0, 0, 0, -2, 0, 0, 1, &
+    0, 0, 0, 0, -1, 0, 0, 3, 3, 0, -2, -2, &
+    0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, &
+    0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 1, &
+    0, 0, 0, 0, 1, 3, 0, -3, -3, -2, 2, 2, &
+    0, 0, 0, 0, 1, 0, 0, -2, 0, 0, 1, 0, &
+    0, 0, 0, 0, 0, -1, 0, 0, 1, 1, 0, -1], [12, 12])
+
+contains
+
+  !> Shape functions at (xi, eta) in [0,1]^2 and their derivatives with respect to the
+  !> parent coordinates x = a xi, y = b eta: derivs(:, 1..5) = S_x, S_y, S_xx, S_yy, S_xy.
+  pure subroutine plate_shape(xi, eta, a, b, shape, derivs)
+    real(dp), intent(in) :: xi, eta, a, b
+    real(dp), intent(out) :: shape(plate_shapes), derivs(plate_shapes, plate_fields)
+    real(dp) :: m(12), mx(12), my(12), mxx(12), myy(12), mxy(12), scale(12)
+    integer :: k
+    m = [1.0_dp, xi, eta, xi**2, xi * eta, eta**2, xi**3, xi**2 * eta, xi * eta**2, eta**3, &
+         xi**3 * eta, xi * eta**3]
+    mx = [0.0_dp, 1.0_dp, 0.0_dp, 2 * xi, eta, 0.0_dp, 3 * xi**2, 2 * xi * eta, eta**2, &
+          0.0_dp, 3 * xi**2 * eta, eta**3]
+    my = [0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, xi, 2 * eta, 0.0_dp, xi**2, 2 * xi * eta, &
+          3 * eta**2, xi**3, 3 * xi * eta**2]
+    mxx = [0.0_dp, 0.0_dp, 0.0_dp, 2.0_dp, 0.0_dp, 0.0_dp, 6 * xi, 2 * eta, 0.0_dp, 0.0_dp, &
+           6 * xi * eta, 0.0_dp]
+    myy = [0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 2.0_dp, 0.0_dp, 0.0_dp, 2 * xi, 6 * eta, &
+           0.0_dp, 6 * xi * eta]
+    mxy = [0.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 2 * xi, 2 * eta, 0.0_dp, &
+           3 * xi**2, 3 * eta**2]
+    do k = 0, 3
+      scale(3 * k + 1:3 * k + 3) = [1.0_dp, a, b]
+    end do
+    shape = matmul(m, coefficients) * scale
+    derivs(:, f_x) = matmul(mx, coefficients) * scale / a
+    derivs(:, f_y) = matmul(my, coefficients) * scale / b
+    derivs(:, f_xx) = matmul(mxx, coefficients) * scale / a**2
+    derivs(:, f_yy) = matmul(myy, coefficients) * scale / b**2
+    derivs(:, f_xy) = matmul(mxy, coefficients) * scale / (a * b)
+  end subroutine plate_shape
+
+  !> Compact mass matrix (12 x 12; the element's is kron(mass, I3)): rho h int S^T S dx dy.
+  pure subroutine plate_mass(a, b, thickness, density, mass, info)
+    real(dp), intent(in) :: a, b, thickness, density
+    real(dp), intent(out) :: mass(plate_shapes, plate_shapes)
+    integer, intent(out) :: info
+    real(dp) :: points(plate_gauss_1d), weights(plate_gauss_1d), shape(plate_shapes)
+    real(dp) :: derivs(plate_shapes, plate_fields)
+    integer :: i, j, k
+    call gauss_legendre(plate_gauss_1d, points, weights, info)
+    mass = 0.0_dp
+    if (info /= 0) return
+    do j = 1, plate_gauss_1d
+      do i = 1, plate_gauss_1d
+        call plate_shape(0.5_dp * (points(i) + 1), 0.5_dp * (points(j) + 1), a, b, shape, derivs)
+        do k = 1, plate_shapes
+          mass(:, k) = mass(:, k) + 0.25_dp * weights(i) * weights(j) * shape * shape(k)
+        end do
+      end do
+    end do
+    mass = density * thickness * a * b * mass
+  end subroutine plate_mass
+
+  !> Generalized force (3, 12) of a constant load per unit area (gravity: rho h g;
+  !> pressure: q times the reference normal): int S^T load dx dy.
+  pure subroutine plate_surface_load(a, b, load, force, info)
+    real(dp), intent(in) :: a, b, load(3)
+    real(dp), intent(out) :: force(3, plate_shapes)
+    integer, intent(out) :: info
+    real(dp) :: points(plate_gauss_1d), weights(plate_gauss_1d), shape(plate_shapes)
+    real(dp) :: derivs(plate_shapes, plate_fields), integral(plate_shapes)
+    integer :: i, j, k
+    call gauss_legendre(plate_gauss_1d, points, weights, info)
+    integral = 0.0_dp
+    do j = 1, plate_gauss_1d
+      do i = 1, plate_gauss_1d
+        call plate_shape(0.5_dp * (points(i) + 1), 0.5_dp * (points(j) + 1), a, b, shape, derivs)
+        integral = integral + 0.25_dp * weights(i) * weights(j) * a * b * shape
+      end do
+    end do
+    do k = 1, plate_shapes
+      force(:, k) = integral(k) * load
+    end do
+  end subroutine plate_surface_load
+
+  pure function cross(u, v) result(w)
+    real(dp), intent(in) :: u(3), v(3)
+    real(dp) :: w(3)
+    w = [u(2) * v(3) - u(3) * v(2), u(3) * v(1) - u(1) * v(3), u(1) * v(2) - u(2) * v(1)]
+  end function cross
+
+  pure function skew(u) result(s)
+    real(dp), intent(in) :: u(3)
+    real(dp) :: s(3, 3)
+    s = reshape([0.0_dp, u(3), -u(2), -u(3), 0.0_dp, u(1), u(2), -u(1), 0.0_dp], [3, 3])
+  end function skew
+
+  !> The three curvatures c_11, c_22, c_12 = r_ab . g / |g|^3 of eq. 6 at the fields z.
+  pure subroutine plate_curvatures(fields, curvatures)
+    real(dp), intent(in) :: fields(3, plate_fields)
+    real(dp), intent(out) :: curvatures(3)
+    real(dp) :: g(3), norm3
+    g = cross(fields(:, f_x), fields(:, f_y))
+    norm3 = norm2(g)**3
+    curvatures = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
+                  dot_product(fields(:, f_xy), g)] / norm3
+  end subroutine plate_curvatures
+
+  !> Reference data of one element at the Gauss points: shape derivatives, the frame map K,
+  !> the reference curvatures c0 and the weights (reference area included). The plain
+  !> variant uses K = I, c0 = 0 and the parent area. info = 2: degenerate reference.
+  pure subroutine plate_setup(reference, a, b, variant, derivs, frame, curvature0, weights, info)
+    real(dp), intent(in) :: reference(3, plate_shapes), a, b
+    integer, intent(in) :: variant
+    real(dp), intent(out) :: derivs(plate_shapes, plate_fields, plate_points)
+    real(dp), intent(out) :: frame(2, 2, plate_points), curvature0(3, plate_points)
+    real(dp), intent(out) :: weights(plate_points)
+    integer, intent(out) :: info
+    real(dp) :: points(plate_gauss_1d), w1(plate_gauss_1d), shape(plate_shapes)
+    real(dp) :: fields(3, plate_fields), g(3), t1(3), t2(3), metric(2, 2), det
+    integer :: i, j, p
+    call gauss_legendre(plate_gauss_1d, points, w1, info)
+    if (info /= 0) return
+    p = 0
+    do j = 1, plate_gauss_1d
+      do i = 1, plate_gauss_1d
+        p = p + 1
+        call plate_shape(0.5_dp * (points(i) + 1), 0.5_dp * (points(j) + 1), a, b, shape, &
+                         derivs(:, :, p))
+        weights(p) = 0.25_dp * w1(i) * w1(j) * a * b
+        frame(:, :, p) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [2, 2])
+        curvature0(:, p) = 0.0_dp
+        if (variant /= plate_variant_completed) cycle
+        fields = matmul(reference, derivs(:, :, p))
+        g = cross(fields(:, f_x), fields(:, f_y))
+        if (norm2(g) <= epsilon(1.0_dp) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
+          info = 2
+          return
+        end if
+        t1 = fields(:, f_x) / norm2(fields(:, f_x))
+        t2 = cross(g / norm2(g), t1)
+        metric = reshape([dot_product(t1, fields(:, f_x)), dot_product(t2, fields(:, f_x)), &
+                          dot_product(t1, fields(:, f_y)), dot_product(t2, fields(:, f_y))], [2, 2])
+        det = metric(1, 1) * metric(2, 2) - metric(1, 2) * metric(2, 1)
+        frame(:, :, p) = reshape([metric(2, 2), -metric(2, 1), -metric(1, 2), metric(1, 1)], &
+                                 [2, 2]) / det
+        weights(p) = weights(p) * det
+        call plate_curvatures(fields, curvature0(:, p))
+      end do
+    end do
+  end subroutine plate_setup
+
+  !> Energy density W(z) at one Gauss point, its gradient (3, 5) and, on request, its
+  !> Hessian (15, 15) with respect to z = (r_x, r_y, r_xx, r_yy, r_xy).
+  pure subroutine point_energy(fields, frame, curvature0, membrane_d, bending_d, want_hessian, &
+                               energy, gradient, hessian)
+    real(dp), intent(in) :: fields(3, plate_fields), frame(2, 2), curvature0(3)
+    real(dp), intent(in) :: membrane_d(3, 3), bending_d(3, 3)
+    logical, intent(in) :: want_hessian
+    real(dp), intent(out) :: energy, gradient(3, plate_fields), hessian(15, 15)
+    real(dp) :: deformation(3, 2), strain(3), stress(3), stress_tensor(2, 2), geometric(2, 2)
+    real(dp) :: b_strain(3, 6), g(3), gnorm, u(3), v(3), c(3), to_local(3, 3), kappa(3)
+    real(dp) :: moment(3), omega(3), dcurv(3, 15), dkappa(3, 15), w_eff(3), wg, h_eff(3)
+    real(dp) :: hwg(3, 3), hgg(3, 3), gu(3, 3), gv(3, 3), k(2, 2)
+    integer :: gamma, i, f, row, col
+    k = frame
+    u = fields(:, f_x)
+    v = fields(:, f_y)
+    ! membrane: F = [r_x r_y] K
+    deformation = matmul(fields(:, f_x:f_y), k)
+    strain = [0.5_dp * (dot_product(deformation(:, 1), deformation(:, 1)) - 1.0_dp), &
+              0.5_dp * (dot_product(deformation(:, 2), deformation(:, 2)) - 1.0_dp), &
+              dot_product(deformation(:, 1), deformation(:, 2))]
+    stress = matmul(membrane_d, strain)
+    do gamma = 1, 2
+      b_strain(1, 3 * gamma - 2:3 * gamma) = k(gamma, 1) * deformation(:, 1)
+      b_strain(2, 3 * gamma - 2:3 * gamma) = k(gamma, 2) * deformation(:, 2)
+      b_strain(3, 3 * gamma - 2:3 * gamma) = k(gamma, 1) * deformation(:, 2) &
+                                             + k(gamma, 2) * deformation(:, 1)
+    end do
+    energy = 0.5_dp * dot_product(strain, stress)
+    gradient = 0.0_dp
+    gradient(:, f_x:f_y) = reshape(matmul(stress, b_strain), [3, 2])
+    ! bending: c_ab = r_ab . g / |g|^3, local kappa = K^T (c - c0) K in Voigt form
+    g = cross(u, v)
+    gnorm = norm2(g)
+    c = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
+         dot_product(fields(:, f_xy), g)] / gnorm**3
+    to_local(1, :) = [k(1, 1)**2, k(2, 1)**2, 2 * k(1, 1) * k(2, 1)]
+    to_local(2, :) = [k(1, 2)**2, k(2, 2)**2, 2 * k(1, 2) * k(2, 2)]
+    to_local(3, :) = 2 * [k(1, 1) * k(1, 2), k(2, 1) * k(2, 2), k(1, 1) * k(2, 2) + k(2, 1) * k(1, 2)]
+    kappa = matmul(to_local, c - curvature0)
+    moment = matmul(bending_d, kappa)
+    energy = energy + 0.5_dp * dot_product(kappa, moment)
+    omega = matmul(moment, to_local)        ! dW/dc
+    ! dc/dz: dc/du = v x h, dc/dv = h x u, dc/dw = g/|g|^3, h = dc/dg
+    dcurv = 0.0_dp
+    do i = 1, 3
+      h_eff = fields(:, f_xx + i - 1) / gnorm**3 &
+              - 3.0_dp * dot_product(fields(:, f_xx + i - 1), g) * g / gnorm**5
+      dcurv(i, 1:3) = cross(v, h_eff)
+      dcurv(i, 4:6) = cross(h_eff, u)
+      dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g / gnorm**3
+    end do
+    gradient = gradient + reshape(matmul(omega, dcurv), [3, plate_fields])
+    if (.not. want_hessian) return
+    ! membrane: B^T D B + kron(K S K^T, I3)
+    hessian = 0.0_dp
+    hessian(1:6, 1:6) = matmul(transpose(b_strain), matmul(membrane_d, b_strain))
+    stress_tensor = reshape([stress(1), stress(3), stress(3), stress(2)], [2, 2])
+    geometric = matmul(k, matmul(stress_tensor, transpose(k)))
+    do col = 1, 2
+      do row = 1, 2
+        do i = 1, 3
+          hessian(3 * row - 3 + i, 3 * col - 3 + i) = hessian(3 * row - 3 + i, 3 * col - 3 + i) &
+                                                      + geometric(row, col)
+        end do
+      end do
+    end do
+    ! bending, material part
+    dkappa = matmul(to_local, dcurv)
+    hessian = hessian + matmul(transpose(dkappa), matmul(bending_d, dkappa))
+    ! bending, geometric part: sum_c omega_c d2c/dz2; c is linear in w, so the (u, v)
+    ! blocks are those of one curvature with w_eff = sum_c omega_c w_c
+    w_eff = omega(1) * fields(:, f_xx) + omega(2) * fields(:, f_yy) + omega(3) * fields(:, f_xy)
+    wg = dot_product(w_eff, g)
+    h_eff = w_eff / gnorm**3 - 3.0_dp * wg * g / gnorm**5
+    do i = 1, 3
+      hwg(:, i) = -3.0_dp * g * g(i) / gnorm**5
+      hwg(i, i) = hwg(i, i) + 1.0_dp / gnorm**3
+      hgg(:, i) = -3.0_dp * (w_eff * g(i) + g * w_eff(i)) / gnorm**5 &
+                  + 15.0_dp * wg * g * g(i) / gnorm**7
+      hgg(i, i) = hgg(i, i) - 3.0_dp * wg / gnorm**5
+    end do
+    gu = -skew(v)
+    gv = skew(u)
+    hessian(1:3, 1:3) = hessian(1:3, 1:3) + matmul(transpose(gu), matmul(hgg, gu))
+    hessian(4:6, 4:6) = hessian(4:6, 4:6) + matmul(transpose(gv), matmul(hgg, gv))
+    hessian(1:3, 4:6) = hessian(1:3, 4:6) + matmul(transpose(gu), matmul(hgg, gv)) - skew(h_eff)
+    hessian(4:6, 1:3) = hessian(4:6, 1:3) + transpose(matmul(transpose(gu), matmul(hgg, gv)) &
+                                                      - skew(h_eff))
+    do i = 1, 3
+      f = f_xx + i - 1
+      hessian(3 * f - 2:3 * f, 1:3) = hessian(3 * f - 2:3 * f, 1:3) + omega(i) * matmul(hwg, gu)
+      hessian(3 * f - 2:3 * f, 4:6) = hessian(3 * f - 2:3 * f, 4:6) + omega(i) * matmul(hwg, gv)
+      hessian(1:3, 3 * f - 2:3 * f) = hessian(1:3, 3 * f - 2:3 * f) &
+                                      + omega(i) * transpose(matmul(hwg, gu))
+      hessian(4:6, 3 * f - 2:3 * f) = hessian(4:6, 3 * f - 2:3 * f) &
+                                      + omega(i) * transpose(matmul(hwg, gv))
+    end do
+  end subroutine point_energy
+
+  !> Elastic force (36), strain energy and, on request, tangent (36 x 36) of one element at
+  !> coordinates (3, 12), from the reference data of plate_setup. info = 2: the normal
+  !> vanished (a degenerate configuration).
+  pure subroutine plate_forces(coords, derivs, frame, curvature0, weights, youngs, poisson, &
+                               thickness, want_tangent, force, energy, tangent, info)
+    real(dp), intent(in) :: coords(3, plate_shapes)
+    real(dp), intent(in) :: derivs(plate_shapes, plate_fields, plate_points)
+    real(dp), intent(in) :: frame(2, 2, plate_points), curvature0(3, plate_points)
+    real(dp), intent(in) :: weights(plate_points), youngs, poisson, thickness
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(plate_dofs), energy, tangent(plate_dofs, plate_dofs)
+    integer, intent(out) :: info
+    real(dp) :: plane_stress(3, 3), membrane_d(3, 3), bending_d(3, 3)
+    real(dp) :: fields(3, plate_fields), point_w, gradient(3, plate_fields), hessian(15, 15)
+    real(dp) :: nodal(3, plate_shapes), block(3, 3)
+    integer :: p, fa, fb, ka, kb
+    info = 0
+    plane_stress = youngs / (1.0_dp - poisson**2) * reshape([1.0_dp, poisson, 0.0_dp, poisson, &
+                   1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp * (1.0_dp - poisson)], [3, 3])
+    membrane_d = thickness * plane_stress
+    bending_d = thickness**3 / 12.0_dp * plane_stress
+    force = 0.0_dp
+    energy = 0.0_dp
+    tangent = 0.0_dp
+    nodal = 0.0_dp
+    do p = 1, plate_points
+      fields = matmul(coords, derivs(:, :, p))
+      if (norm2(cross(fields(:, f_x), fields(:, f_y))) <= tiny(1.0_dp)**0.25_dp) then
+        info = 2
+        return
+      end if
+      call point_energy(fields, frame(:, :, p), curvature0(:, p), membrane_d, bending_d, &
+                        want_tangent, point_w, gradient, hessian)
+      energy = energy + weights(p) * point_w
+      nodal = nodal + weights(p) * matmul(gradient, transpose(derivs(:, :, p)))
+      if (.not. want_tangent) cycle
+      do fb = 1, plate_fields
+        do fa = 1, plate_fields
+          block = weights(p) * hessian(3 * fa - 2:3 * fa, 3 * fb - 2:3 * fb)
+          do kb = 1, plate_shapes
+            do ka = 1, plate_shapes
+              tangent(3 * ka - 2:3 * ka, 3 * kb - 2:3 * kb) = &
+                tangent(3 * ka - 2:3 * ka, 3 * kb - 2:3 * kb) &
+                + derivs(ka, fa, p) * derivs(kb, fb, p) * block
+            end do
+          end do
+        end do
+      end do
+    end do
+    force = reshape(nodal, [plate_dofs])
+  end subroutine plate_forces
+
+end module plate_element
