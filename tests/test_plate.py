@@ -319,3 +319,20 @@ def test_plate_scene_without_gravity_computes_no_gravity(tmp_path):
     with h5py.File(out.output, "r") as h5:
         assert h5["counters"].attrs["gravity"] == 0
         assert np.abs(h5["dynamic/deflection/corner"][()]).max() < 1e-14  # nothing moves
+
+
+def test_command_line_runs_and_plots_plate_scenes(tmp_path, capsys):
+    from ancfdrv.cli import main
+    out = tmp_path / "pressure.h5"
+    assert main(["run", str(INPUTS / "plate_pressure.nml"), "-o", str(out),
+                 "--set", "plate.nx=4", "--set", "plate.ny=4"]) == 0
+    printed = capsys.readouterr().out
+    assert "centre" in printed and out.with_suffix(".png").exists()
+    leaf = tmp_path / "leaf.h5"
+    assert main(["run", str(INPUTS / "curved_leaf.nml"), "-o", str(leaf),
+                 "--set", "solver.t_end=0.002"]) == 0
+    png = tmp_path / "again.png"
+    assert main(["plot", str(leaf), "-o", str(png)]) == 0 and png.exists()
+    # a bad key names the group and the key, exit 2
+    assert main(["run", str(INPUTS / "curved_leaf.nml"), "--set", "leaf.radius=-1"]) == 2
+    assert "leaf" in capsys.readouterr().err

@@ -71,11 +71,16 @@ def plot_plate_static(h5_path: Path, png: str | Path | None = None) -> Path:
             raise ValueError(f"{h5_path}: no /static group to plot (status: "
                              f"{h5.attrs.get('status')})")
         nodes = h5["model/nodes"][()]
+        elements = h5["model/elements"][()]
         q = h5["static/q"][()].reshape(len(nodes), -1)[:, :3]
         title = h5.attrs["title"]
     w = q[:, 2] - nodes[:, 2]
+    triangles = np.concatenate([elements[:, [0, 1, 2]], elements[:, [0, 2, 3]]])
     fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
-    art = ax.tricontourf(nodes[:, 0], nodes[:, 1], 1e3 * w, levels=20, cmap="viridis")
+    span = max(np.ptp(w), 1e-300)
+    levels = 1e3 * np.linspace(w.min() - 1e-6 * span, w.max() + 1e-6 * span, 21)
+    art = ax.tricontourf(nodes[:, 0], nodes[:, 1], triangles, 1e3 * w, levels=levels,
+                         cmap="viridis")
     ax.plot(nodes[:, 0], nodes[:, 1], "k.", ms=2)
     fig.colorbar(art, ax=ax, label="displacement along r3 (mm)")
     ax.set_aspect("equal")
