@@ -177,6 +177,9 @@ def _navier_centre_coefficient(terms: int = 199) -> float:
 
 def test_simply_supported_plate_under_pressure_converges_to_kirchhoff():
     navier = _navier_centre_coefficient()
+    from ancfdrv.analytic import navier_plate_centre_deflection
+    assert navier_plate_centre_deflection(1.0, 1.0, 1.0, 12 * (1 - 0.09), 0.3, 1.0) == \
+        pytest.approx(navier, rel=1e-12)  # D = 1
     assert navier == pytest.approx(0.00406, abs=5e-6)  # REFERENCES.md's 0.00406
     errors = []
     for n in (4, 8, 16):
@@ -336,3 +339,16 @@ def test_command_line_runs_and_plots_plate_scenes(tmp_path, capsys):
     # a bad key names the group and the key, exit 2
     assert main(["run", str(INPUTS / "curved_leaf.nml"), "--set", "leaf.radius=-1"]) == 2
     assert "leaf" in capsys.readouterr().err
+
+
+def test_sweep_over_tied_plate_mesh_keys_reports_error_against_navier(tmp_path):
+    from ancfdrv.sweep import run_sweep
+    rows = run_sweep(str(INPUTS / "plate_pressure.nml"), ["plate.nx+plate.ny=4,8"], tmp_path,
+                     workers=1, progress=False)
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    # the same figures as the convergence test: +6.5 % and +1.65 % against Navier
+    assert rows[0]["err_vs_closed_form"] == pytest.approx(0.0654, abs=2e-3)
+    assert rows[1]["err_vs_closed_form"] == pytest.approx(0.0165, abs=1e-3)
+    assert rows[1]["err_vs_finest"] == 0.0 and rows[0]["err_vs_finest"] > 0.04
+    assert (tmp_path / "summary.md").read_text().count("| 8 |") == 1
+    assert (tmp_path / "error_vs_time.png").exists()

@@ -484,3 +484,18 @@ def elastica_tip_load(k: float, *, nodes: int = 2001, tol: float = 1e-10) -> tup
             raise RuntimeError(f"elastica BVP failed at k = {kk}: {solution.message}")
     x_tip, w_tip = solution.sol(1.0)[2:4]
     return float(w_tip), float(1.0 - x_tip)
+
+
+def navier_plate_centre_deflection(pressure: float, length_x: float, length_y: float,
+                                   youngs: float, poisson: float, thickness: float,
+                                   terms: int = 199) -> float:
+    """Centre deflection of a simply supported rectangular Kirchhoff plate under a uniform
+    pressure, by Navier's double series (Timoshenko & Woinowsky-Krieger, section 30):
+    w = 16 q / (pi^6 D) sum_{m,n odd} sin(m pi/2) sin(n pi/2) / (m n (m^2/a^2 + n^2/b^2)^2),
+    D = E h^3 / (12 (1 - nu^2)); 0.00406 q a^4 / D for a square plate."""
+    rigidity = youngs * thickness**3 / (12.0 * (1.0 - poisson**2))
+    odd = np.arange(1, terms + 1, 2, dtype=float)
+    m, n = np.meshgrid(odd, odd, indexing="ij")
+    signs = (-1.0) ** ((m + n) / 2 - 1)
+    series = signs / (m * n * (m**2 / length_x**2 + n**2 / length_y**2) ** 2)
+    return 16.0 * pressure / (np.pi**6 * rigidity) * float(series.sum())

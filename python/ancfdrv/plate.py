@@ -178,6 +178,8 @@ class PlateModel:
     counters: Counter = field(default_factory=Counter)
     warnings: list[str] = field(default_factory=list)
     formulation: str = "plate"
+    #: the probe and component sweeps compare (set by the builders)
+    response: tuple[str, int] = ("corner", 2)
 
     def __post_init__(self) -> None:
         from .scene import EFFECTS_AVAILABLE
@@ -373,6 +375,8 @@ def build_plate(scene) -> PlateModel:
         model.add_surface_load(np.array([0.0, 0.0, -loads["pressure"]]), "pressure")
     model.probes["corner"] = PlateProbe(*mesh.element_at(1.0, 1.0))
     model.probes["centre"] = PlateProbe(*mesh.element_at(0.5, 0.5))
+    # sweeps compare the displacement along r3: of the corner (pendulum), else the centre
+    model.response = ("corner", 2) if support == "corner_spherical" else ("centre", 2)
     return model
 
 
@@ -399,4 +403,5 @@ def build_leaf(scene) -> PlateModel:
         model.add_gravity(np.array([0.0, 0.0, -loads["gravity"]]))
     model.probes["end"] = PlateProbe(*mesh.element_at(1.0, 0.5))
     model.probes["middle"] = PlateProbe(*mesh.element_at(0.5, 0.5))
+    model.response = ("end", 2)  # what sweeps compare: the end's displacement along r3
     return model

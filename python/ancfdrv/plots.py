@@ -11,6 +11,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .sweep import static_value  # noqa: E402
+
 
 STAGE_COLOURS = {"start": "#dbe9f6", "luffing": "#fdf1d6", "braking": "#f8dcdc",
                  "vibration": "#e2f2df"}
@@ -168,8 +170,10 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
     out = []
     if any(r.get("dynamic") for r in ok):
         out += plot_histories(ok, keys, outdir)
-    nodes_key = "beam.nodes" if "beam.nodes" in keys else None
-    others = [k for k in keys if k not in ("beam.nodes", "solver.dt")]
+    from .sweep import is_resolution
+    mesh_keys = [k for k in keys if is_resolution(k) and k != "solver.dt"]
+    nodes_key = mesh_keys[0] if mesh_keys else None
+    others = [k for k in keys if not is_resolution(k)]
     numeric = [k for k in others if all(_isnum(r[k]) for r in ok)]
     x_key = numeric[0] if numeric else None  # the x axis; string keys become panels
     panel_keys = [k for k in others if k != x_key]
@@ -182,10 +186,10 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
             members = [r for r in ok if tuple(r[k] for k in panel_keys) == panel]
             curves = sorted({r.get(nodes_key, "") for r in members}, key=_num)
             for curve in curves:
-                pts = sorted(((float(r[x_key]), r["tip_transverse"]) for r in members
+                pts = sorted(((float(r[x_key]), static_value(r)) for r in members
                               if r.get(nodes_key, "") == curve))
                 ax.plot([p[0] for p in pts], [1e3 * p[1] for p in pts], "o-", ms=3,
-                        label=f"{curve} nodes" if nodes_key else "model")
+                        label=_mesh_label(nodes_key, curve))
             ref = sorted({(float(r[x_key]), r["tip_transverse_closed_form"]) for r in members
                           if "tip_transverse_closed_form" in r})
             if ref:
@@ -212,8 +216,8 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
                 sel = [r for r in pts if r.get(nodes_key, "") == g and r.get("solver.dt", "") == dt]
                 if not sel:
                     continue
-                label = (f"{g} nodes" if nodes_key else "") + (f", dt {dt}" if len(markers) > 1
-                                                               else "")
+                label = (_mesh_label(nodes_key, g) if nodes_key else "") + (
+                    f", dt {dt}" if len(markers) > 1 else "")
                 ax.loglog([r["total_time_s"] for r in sel], [r[err_key] for r in sel], marker,
                           ms=5, color=f"C{groups.index(g) % 10}", label=label or None)
         ax.set_xlabel("wall time per case (s)")
@@ -234,13 +238,15 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
     panel per luffing stage (the paper's Figs. 6-15); one figure per value of the other
     varied keys."""
     import h5py as _h5
-    others = [k for k in keys if k not in ("beam.nodes", "solver.dt")]
+    from .sweep import is_resolution
+    others = [k for k in keys if not is_resolution(k)]
+    mesh_keys = [k for k in keys if is_resolution(k) and k != "solver.dt"]
     finest_dt = min((float(r["solver.dt"]) for r in rows if "solver.dt" in r), default=None)
     chosen = [r for r in rows if finest_dt is None or float(r["solver.dt"]) == finest_dt]
     out = []
     for panel in sorted({tuple(r[k] for k in others) for r in chosen}):
         members = sorted([r for r in chosen if tuple(r[k] for k in others) == panel],
-                         key=lambda r: _num(r.get("beam.nodes", 0)))
+                         key=lambda r: _num(r.get(mesh_keys[0], 0)) if mesh_keys else 0)
         stages = [s for s in STAGE_COLOURS if f"stage_{s}_t0" in members[0]]
         fig = plt.figure(figsize=(11, 7.5), constrained_layout=True)
         grid = fig.add_gridspec(2, max(len(stages), 1))
@@ -249,8 +255,10 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
         for row in members:
             with _h5.File(row["file"], "r") as h5:
                 t = h5["dynamic/time"][()]
-                sag = 1e3 * h5["dynamic/deflection/tip"][:, 1]
-            label = f"{row.get('beam.nodes', '')} nodes"
+                probe = h5.attrs.get("response_probe", "tip")
+                component = int(h5.attrs.get("response_component", 1))
+                sag = 1e3 * h5[f"dynamic/deflection/{probe}"][:, component]
+            label = _mesh_label(mesh_keys[0], row[mesh_keys[0]]) if mesh_keys else "model"
             whole.plot(t, sag, lw=0.9, label=label)
             for ax, stage in zip(zooms, stages):
                 mask = (t >= row[f"stage_{stage}_t0"]) & (t <= row[f"stage_{stage}_t1"])
@@ -272,6 +280,15 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
         plt.close(fig)
         out.append(path)
     return out
+
+
+def _mesh_label(key: str | None, value) -> str:
+    """'28 nodes' for beams, 'nx+ny = 8' for plates."""
+    if key is None:
+        return "model"
+    if key == "beam.nodes":
+        return f"{value} nodes"
+    return "+".join(part.split(".")[1] for part in key.split("+")) + f" = {value}"
 
 
 def _isnum(v) -> bool:

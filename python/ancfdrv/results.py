@@ -39,6 +39,9 @@ def create(path: Path, scene: Scene, model: BeamModel) -> None:
             "effects": ",".join(scene.effects),
             "warnings": "\n".join(model.warnings),
             "status": "running",
+            # what sweeps compare: probe and component (beams: the tip sag)
+            "response_probe": getattr(model, "response", ("tip", 1))[0],
+            "response_component": getattr(model, "response", ("tip", 1))[1],
         })
         group = h5.create_group("model")
         _attrs(group.attrs, model.summary())

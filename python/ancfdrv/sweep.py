@@ -24,31 +24,53 @@ from .errors import AncfError, InputError
 from .scene import SCHEMA, load_scene
 
 #: Parameters that refine a model; the finest value is the reference of the others.
-RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min}
+RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min, "plate.nx": max, "plate.ny": max,
+                   "leaf.nx": max, "leaf.ny": max}
+
+
+def is_resolution(key: str) -> bool:
+    """A refining key, or keys tied with '+' that all refine (plate.nx+plate.ny)."""
+    return all(part in RESOLUTION_KEYS for part in key.split("+"))
+
+
+def resolution_sense(key: str):
+    return RESOLUTION_KEYS[key.split("+")[0]]
+
+
+def expand(params: dict[str, str]) -> list[str]:
+    """Overrides of a case; a tied key 'a.x+a.y' sets every key it names."""
+    return [f"{part}={v}" for k, v in params.items() for part in k.split("+")]
 
 
 def parse_vary(items: list[str], scene_file: str) -> list[tuple[str, list[str]]]:
-    """``GROUP.KEY=V1,V2,...`` -> (dotted key, values); keys are checked against the schema."""
+    """``GROUP.KEY=V1,V2,...`` -> (dotted key, values); keys are checked against the schema.
+    Keys joined by '+' vary together (``plate.nx+plate.ny=2,4,8``: 2x2, 4x4, 8x8)."""
     out = []
     for item in items:
         if "=" not in item or "." not in item.split("=", 1)[0]:
             raise InputError(f"--vary {item!r} is not of the form GROUP.KEY=V1,V2,...",
                              file=scene_file)
         dotted, values = item.split("=", 1)
-        group, key = dotted.strip().lower().split(".", 1)
-        if group not in SCHEMA or key not in SCHEMA[group]:
-            raise InputError(f"--vary names an unknown key {dotted!r}", file=scene_file,
-                             group=group, key=key)
+        dotted = dotted.strip().lower()
+        for part in dotted.split("+"):
+            if "." not in part:
+                raise InputError(f"--vary names {part!r}, not GROUP.KEY", file=scene_file)
+            group, key = part.split(".", 1)
+            if group not in SCHEMA or key not in SCHEMA[group]:
+                raise InputError(f"--vary names an unknown key {part!r}", file=scene_file,
+                                 group=group, key=key)
         vals = [v.strip() for v in values.split(",") if v.strip()]
         if not vals:
             raise InputError(f"--vary {dotted} has no values", file=scene_file, group=group,
                              key=key)
-        out.append((f"{group}.{key}", vals))
+        out.append((dotted, vals))
     return out
 
 
 def case_name(params: dict[str, str]) -> str:
-    return "_".join(f"{k.split('.')[1]}-{v}" for k, v in params.items()).replace("'", "")
+    def short(key: str) -> str:
+        return "+".join(part.split(".")[1] for part in key.split("+"))
+    return "_".join(f"{short(k)}-{v}" for k, v in params.items()).replace("'", "")
 
 
 def run_case(scene_file: str, params: dict[str, str], base: list[str], output: str) -> dict:
@@ -57,7 +79,7 @@ def run_case(scene_file: str, params: dict[str, str], base: list[str], output: s
     row: dict[str, Any] = dict(params)
     row["file"] = output
     try:
-        outcome = run_scene(scene_file, base + [f"{k}={v}" for k, v in params.items()], output)
+        outcome = run_scene(scene_file, base + expand(params), output)
     except AncfError as exc:
         row.update(status="failed", message=str(exc), exit_code=exc.exit_code)
         return row
@@ -67,10 +89,14 @@ def run_case(scene_file: str, params: dict[str, str], base: list[str], output: s
                ndof=summary["model.ndof"])
     static, dynamic = outcome.static, outcome.dynamic
     if static is not None:
-        axial, transverse, lateral = summary["static.deflection.tip"]
-        row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral,
-                   iterations=static.iterations, residual=static.residual_norm,
+        row.update(iterations=static.iterations, residual=static.residual_norm,
                    solve_time_s=static.wall_time_s)
+        if "static.deflection.tip" in summary:
+            axial, transverse, lateral = summary["static.deflection.tip"]
+            row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral)
+        else:
+            probe, component = _response_of(summary)
+            row["response"] = float(summary[f"static.deflection.{probe}"][component])
     if dynamic is not None:
         row.update(dynamic=True, steps=dynamic.steps, newton_iterations=dynamic.newton_iterations,
                    factorizations=dynamic.factorizations, dynamic_time_s=dynamic.wall_time_s,
@@ -78,9 +104,24 @@ def run_case(scene_file: str, params: dict[str, str], base: list[str], output: s
     return row
 
 
+def _response_of(attrs) -> tuple[str, int]:
+    """The probe and component a sweep compares: the beam's tip sag (tip, transverse), or
+    what the model names in the result file's 'response_probe' attributes."""
+    probe = attrs.get("response_probe", "tip")
+    return (probe.decode() if isinstance(probe, bytes) else str(probe),
+            int(attrs.get("response_component", 1)))
+
+
+def static_value(row: dict) -> float:
+    """The static quantity a sweep compares (tip sag for beams)."""
+    return row["tip_transverse"] if "tip_transverse" in row else row["response"]
+
+
 def _tip_history(path: str) -> tuple[np.ndarray, np.ndarray]:
+    """Time and the compared history (the tip sag for beams)."""
     with h5py.File(path, "r") as h5:
-        return h5["dynamic/time"][()], h5["dynamic/deflection/tip"][:, 1]
+        probe, component = _response_of(h5.attrs)
+        return h5["dynamic/time"][()], h5[f"dynamic/deflection/{probe}"][:, component]
 
 
 def add_history_errors(rows: list[dict], varied: list[str]) -> None:
@@ -112,9 +153,13 @@ def add_history_errors(rows: list[dict], varied: list[str]) -> None:
 def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | None:
     """Relative error of the tip sag against the boom's closed form (None if not a boom)."""
     from .analytic import boom_static_tip_deflection
-    params = [f"{k}={row[k]}" for k in row if "." in k]
+    params = expand({k: row[k] for k in row if "." in k})
     scene = load_scene(scene_file, base + params)
-    if scene.kind != "boom" or row.get("status") != "ok":
+    if row.get("status") != "ok":
+        return None
+    if scene.kind == "plate":
+        return _navier_error(scene, row)
+    if scene.kind != "boom":
         return None
     effects, loads = scene.effects, scene["loads"]
     beam, material = scene["beam"], scene["material"]
@@ -129,17 +174,31 @@ def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | No
     return abs(row["tip_transverse"] - reference) / max(abs(reference), 1e-300)
 
 
+def _navier_error(scene, row: dict) -> float | None:
+    """Simply supported plate under pressure alone: error of the centre deflection against
+    Navier's series (REFERENCES.md: 0.00406 q a^4 / D for the square plate)."""
+    from .analytic import navier_plate_centre_deflection
+    plate, material = scene["plate"], scene["material"]
+    if plate["support"] != "simply_supported" or set(scene.effects) != {"pressure"}:
+        return None
+    reference = -navier_plate_centre_deflection(
+        scene["loads"]["pressure"], plate["length_x"], plate["length_y"],
+        material["youngs_modulus"], material["poisson_ratio"], plate["thickness"])
+    row["response_closed_form"] = reference
+    return abs(row["response"] - reference) / max(abs(reference), 1e-300)
+
+
 def _reference_groups(rows: list[dict], varied: list[str]):
     """(members, finest) per group of successful rows equal in the non-resolution keys."""
-    resolution = [k for k in varied if k in RESOLUTION_KEYS]
-    others = [k for k in varied if k not in RESOLUTION_KEYS]
+    resolution = [k for k in varied if is_resolution(k)]
+    others = [k for k in varied if not is_resolution(k)]
     groups: dict[tuple, list[dict]] = {}
     for row in rows:
         if row["status"] == "ok":
             groups.setdefault(tuple(row[k] for k in others), []).append(row)
     for members in groups.values():
         def rank(row: dict) -> tuple:
-            return tuple((-1 if RESOLUTION_KEYS[k] is max else 1) * float(row[k])
+            return tuple((-1 if resolution_sense(k) is max else 1) * float(row[k])
                          for k in resolution)
         yield members, min(members, key=rank)
 
@@ -166,8 +225,8 @@ def add_formulation_difference(rows: list[dict], varied: list[str]) -> None:
             row["diff_vs_nonlinear"] = float(np.abs(np.interp(t_ref[common], t, y) - y_ref[common])
                                              .max() / max(np.abs(y_ref).max(), 1e-300))
         else:
-            row["diff_vs_nonlinear"] = abs(row["tip_transverse"] - ref["tip_transverse"]) / max(
-                abs(ref["tip_transverse"]), 1e-300)
+            row["diff_vs_nonlinear"] = abs(static_value(row) - static_value(ref)) / max(
+                abs(static_value(ref)), 1e-300)
 
 
 def add_errors(rows: list[dict], varied: list[str]) -> None:
@@ -177,8 +236,8 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
         return
     for members, finest in _reference_groups(rows, varied):
         for row in members:
-            ref = finest["tip_transverse"]
-            row["err_vs_finest"] = abs(row["tip_transverse"] - ref) / max(abs(ref), 1e-300)
+            ref = static_value(finest)
+            row["err_vs_finest"] = abs(static_value(row) - ref) / max(abs(ref), 1e-300)
 
 
 def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: list[str] | None = None,
@@ -191,7 +250,7 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
     keys = [k for k, _ in grid]
     combos = [dict(zip(keys, values)) for values in itertools.product(*[v for _, v in grid])]
     for params in combos:  # validate every case before spending time on any
-        load_scene(scene_file, base + [f"{k}={v}" for k, v in params.items()])
+        load_scene(scene_file, base + expand(params))
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     jobs = [(scene_file, p, base, str(outdir / f"{case_name(p)}.h5")) for p in combos]
@@ -235,6 +294,8 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
 
 
 COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
+           ("response", "static response (mm)", 1e3, "{:.5f}"),
+           ("response_closed_form", "closed form (mm)", 1e3, "{:.5f}"),
            ("tip_transverse_closed_form", "closed form (mm)", 1e3, "{:.4f}"),
            ("err_vs_closed_form", "err vs closed form", 1.0, "{:.2e}"),
            ("err_vs_finest", "err vs finest", 1.0, "{:.2e}"),
@@ -281,7 +342,8 @@ def write_report(rows: list[dict], keys: list[str], outdir: Path) -> None:
             "accumulated over the vibration stage" if dynamic else
             "the relative difference of the tip sag")
     lines = ["# Sweep summary", "", f"{len(rows)} cases, {len(failed)} failed. Error against "
-             f"the finest case: {what} (tip sag = transverse tip deflection in the rigid frame). "
+             f"the finest case: {what} (beams: tip sag = transverse tip deflection in the rigid "
+             "frame; plates and leaves: the r3 displacement of the corner, centre or end probe). "
              "Times are wall-clock seconds of this machine.", ""]
     lines += table_lines(rows, keys)
     for row in failed:
