@@ -315,8 +315,8 @@ contains
     integer, intent(out) :: info
     real(dp) :: plane_stress(3, 3), membrane_d(3, 3), bending_d(3, 3)
     real(dp) :: fields(3, plate_fields), point_w, gradient(3, plate_fields), hessian(15, 15)
-    real(dp) :: nodal(3, plate_shapes), block(3, 3)
-    integer :: p, fa, fb, ka, kb
+    real(dp) :: nodal(3, plate_shapes), half(15, plate_dofs)
+    integer :: p, i, j, ka, kb
     info = 0
     plane_stress = youngs / (1.0_dp - poisson**2) * reshape([1.0_dp, poisson, 0.0_dp, poisson, &
                    1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp * (1.0_dp - poisson)], [3, 3])
@@ -337,16 +337,17 @@ contains
       energy = energy + weights(p) * point_w
       nodal = nodal + weights(p) * matmul(gradient, transpose(derivs(:, :, p)))
       if (.not. want_tangent) cycle
-      do fb = 1, plate_fields
-        do fa = 1, plate_fields
-          block = weights(p) * hessian(3 * fa - 2:3 * fa, 3 * fb - 2:3 * fb)
-          do kb = 1, plate_shapes
-            do ka = 1, plate_shapes
-              tangent(3 * ka - 2:3 * ka, 3 * kb - 2:3 * kb) = &
-                tangent(3 * ka - 2:3 * ka, 3 * kb - 2:3 * kb) &
-                + derivs(ka, fa, p) * derivs(kb, fb, p) * block
-            end do
-          end do
+      ! K += L^T H L with L = kron(dS^T, I3), in two passes: half = H L (15 x 36), then
+      ! L^T half
+      do kb = 1, plate_shapes
+        do j = 1, 3
+          half(:, 3 * kb - 3 + j) = weights(p) * matmul(hessian(:, j:15:3), derivs(kb, :, p))
+        end do
+      end do
+      do ka = 1, plate_shapes
+        do i = 1, 3
+          tangent(3 * ka - 3 + i, :) = tangent(3 * ka - 3 + i, :) &
+                                       + matmul(derivs(ka, :, p), half(i:15:3, :))
         end do
       end do
     end do
