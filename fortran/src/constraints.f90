@@ -10,6 +10,7 @@
 module constraints
   use ancf_kinds, only: dp
   use drives, only: drive_eval
+  use matrix3, only: cross
   implicit none
   private
   public :: constraint_eval, constraint_kind_coordinate, constraint_kind_distance, &
@@ -128,11 +129,5 @@ contains
       gamma(c) = -dot_product(v, matmul(hessians(:, :, c), v)) - phi_tt(c)
     end do
   end subroutine constraint_eval
-
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c = [a(2) * b(3) - a(3) * b(2), a(3) * b(1) - a(1) * b(3), a(1) * b(2) - a(2) * b(1)]
-  end function cross
 
 end module constraints

@@ -3,9 +3,23 @@ module matrix3
   use ancf_kinds, only: dp
   implicit none
   private
-  public :: invert3
+  public :: invert3, cross, skew
 
 contains
+
+  !> The vector product u x v.
+  pure function cross(u, v) result(w)
+    real(dp), intent(in) :: u(3), v(3)
+    real(dp) :: w(3)
+    w = [u(2) * v(3) - u(3) * v(2), u(3) * v(1) - u(1) * v(3), u(1) * v(2) - u(2) * v(1)]
+  end function cross
+
+  !> The skew matrix [u]x with [u]x v = u x v.
+  pure function skew(u) result(s)
+    real(dp), intent(in) :: u(3)
+    real(dp) :: s(3, 3)
+    s = reshape([0.0_dp, u(3), -u(2), -u(3), 0.0_dp, u(1), u(2), -u(1), 0.0_dp], [3, 3])
+  end function skew
 
   !> Inverse and determinant of a 3 x 3 matrix (inverse left at zero when singular).
   pure subroutine invert3(matrix, inverse, det)

@@ -27,6 +27,7 @@
 module plate_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
+  use matrix3, only: cross, skew
   implicit none
   private
   public :: plate_shape, plate_mass, plate_surface_load, plate_setup, plate_forces, &
@@ -133,18 +134,6 @@ contains
       force(:, k) = integral(k) * load
     end do
   end subroutine plate_surface_load
-
-  pure function cross(u, v) result(w)
-    real(dp), intent(in) :: u(3), v(3)
-    real(dp) :: w(3)
-    w = [u(2) * v(3) - u(3) * v(2), u(3) * v(1) - u(1) * v(3), u(1) * v(2) - u(2) * v(1)]
-  end function cross
-
-  pure function skew(u) result(s)
-    real(dp), intent(in) :: u(3)
-    real(dp) :: s(3, 3)
-    s = reshape([0.0_dp, u(3), -u(2), -u(3), 0.0_dp, u(1), u(2), -u(1), 0.0_dp], [3, 3])
-  end function skew
 
   !> The three curvatures c_11, c_22, c_12 = r_ab . g / |g|^3 of eq. 6 at the fields z.
   pure subroutine plate_curvatures(fields, curvatures)

@@ -61,8 +61,31 @@ class Probe:
     z: float = 0.0
 
 
+class DeadMomentLoads:
+    """External loads shared by the models: the constant loads of ``constant_force()`` plus
+    dead moments on nodal direction vectors (``moments``: dofs, axis, magnitude, effect),
+    all scaled by ``load_factor``; each moment evaluation is counted under its effect."""
+
+    def moment_terms(self, e: np.ndarray):
+        """Per moment: (dofs, force, Jacobian, Hessian) at e."""
+        out = []
+        for moment in self.moments:
+            self.counters[moment.effect] += 1
+            f, j, h = kernel.moment_force(e[moment.dofs], moment.axis,
+                                          self.load_factor * moment.magnitude)
+            out.append((moment.dofs, f, j, h))
+        return out
+
+    def external_force(self, e: np.ndarray) -> np.ndarray:
+        """Constant loads plus the dead moments at e."""
+        force = self.constant_force()
+        for dofs, f, _, _ in self.moment_terms(e):
+            force[dofs] += f
+        return force
+
+
 @dataclass
-class BeamModel:
+class BeamModel(DeadMomentLoads):
     """A straight multi-node ANCF beam with the FFR elastic model."""
 
     node_s: np.ndarray            # arc length of every node (m)
@@ -188,22 +211,6 @@ class BeamModel:
         if self._gravity_force is not None:
             force += self._gravity_force
         return self.load_factor * force
-
-    def moment_terms(self, e: np.ndarray):
-        """Per moment: (dofs, force, Jacobian, Hessian) at e."""
-        out = []
-        for moment in self.moments:
-            self.counters[moment.effect] += 1
-            f, j, h = kernel.moment_force(e[moment.dofs], moment.axis,
-                                          self.load_factor * moment.magnitude)
-            out.append((moment.dofs, f, j, h))
-        return out
-
-    def external_force(self, e: np.ndarray) -> np.ndarray:
-        force = self.constant_force()
-        for dofs, f, _, _ in self.moment_terms(e):
-            force[dofs] += f
-        return force
 
     # -- loads set-up (only for listed effects) ----------------------------------------
     def add_gravity(self, g: np.ndarray) -> None:

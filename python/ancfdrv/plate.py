@@ -23,6 +23,7 @@ import scipy.sparse as sp
 from . import kernel
 from .constraints import ConstraintSet
 from .errors import InputError
+from .model import DeadMomentLoads
 
 PLATE_NODE_DOFS = 9
 #: Offsets of a node's r, r_x, r_y within its 9 coordinates.
@@ -160,7 +161,7 @@ class PlateProbe:
 
 
 @dataclass
-class PlateModel:
+class PlateModel(DeadMomentLoads):
     """A thin-plate mesh with the plain or completed element (seed 003)."""
 
     mesh: PlateMesh
@@ -232,22 +233,6 @@ class PlateModel:
     def constant_force(self) -> np.ndarray:
         """Configuration-independent loads of the listed effects, times the load factor."""
         return self.load_factor * (self._surface_force + self._point_force)
-
-    def moment_terms(self, e: np.ndarray):
-        """Per moment: (dofs, force, Jacobian, Hessian) at e."""
-        out = []
-        for moment in self.moments:
-            self.counters[moment.effect] += 1
-            f, j, h = kernel.moment_force(e[moment.dofs], moment.axis,
-                                          self.load_factor * moment.magnitude)
-            out.append((moment.dofs, f, j, h))
-        return out
-
-    def external_force(self, e: np.ndarray) -> np.ndarray:
-        force = self.constant_force()
-        for dofs, f, _, _ in self.moment_terms(e):
-            force[dofs] += f
-        return force
 
     # -- loads set-up (only for listed effects) -------------------------------------------
     def add_surface_load(self, load_per_area: np.ndarray, effect: str) -> None:
