@@ -352,3 +352,18 @@ def test_sweep_over_tied_plate_mesh_keys_reports_error_against_navier(tmp_path):
     assert rows[1]["err_vs_finest"] == 0.0 and rows[0]["err_vs_finest"] > 0.04
     assert (tmp_path / "summary.md").read_text().count("| 8 |") == 1
     assert (tmp_path / "error_vs_time.png").exists()
+
+
+def test_unsupported_leaf_falls_freely_without_straining(tmp_path):
+    """No constraints at all (lambda has zero columns): gravity on a free, completed leaf is
+    a rigid translation, -g t^2 / 2, with no strain."""
+    out = run_scene(INPUTS / "curved_leaf.nml", ["leaf.support=free", "scene.effects=gravity",
+                                                  "solver.t_end=0.01"],
+                    output=tmp_path / "free.h5", progress=False)
+    with h5py.File(out.output, "r") as h5:
+        t = h5["dynamic/time"][()]
+        for probe in ("end", "middle"):
+            np.testing.assert_allclose(h5[f"dynamic/deflection/{probe}"][:, 2],
+                                       -0.5 * 9.81 * t**2, atol=1e-12)
+        assert np.abs(h5["dynamic/energy/strain"][()]).max() < 1e-12
+        assert h5["dynamic/lambda"].shape == (len(t), 0)

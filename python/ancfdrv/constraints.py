@@ -80,6 +80,9 @@ class ConstraintSet:
     def evaluate(self, e: np.ndarray, t: float = 0.0, e_dot: np.ndarray | None = None):
         """Values, gradients (6, ncon), Hessians (6, 6, ncon), Phi_t, Phi_tt, gamma."""
         self.evaluations += 1
+        if not self.ints:  # an unconstrained model (f2py refuses zero-size arrays)
+            empty = np.zeros(0)
+            return empty, np.zeros((6, 0)), np.zeros((6, 6, 0)), empty, empty, empty
         ints, reals, kinds, params = self.arrays()
         e_dot = np.zeros_like(e) if e_dot is None else e_dot
         return kernel.constraint_evaluate(ints, reals, kinds, params, e, e_dot, t)

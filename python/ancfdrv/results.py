@@ -153,8 +153,12 @@ class DynamicWriter:
             group.attrs["status"] = "running"
 
             def series(name: str, width: tuple[int, ...] = ()) -> None:
-                group.create_dataset(name, shape=(0, *width), maxshape=(None, *width),
-                                     dtype="f8", chunks=(1024, *width) if width != (ndof,)
+                # a model without constraints has lambda[nt, 0]: HDF5 chunks must be
+                # positive, so that axis gets a free maximum
+                chunk = tuple(max(1, w) for w in width)
+                limit = tuple(w if w else None for w in width)
+                group.create_dataset(name, shape=(0, *width), maxshape=(None, *limit),
+                                     dtype="f8", chunks=(1024, *chunk) if width != (ndof,)
                                      else (16, ndof))
             series("time")
             for name in self.names:
