@@ -105,6 +105,35 @@ def test_completed_element_is_strain_free_in_its_curved_reference_plain_is_not(a
     assert energy_plain == pytest.approx(bending, rel=2e-3)
 
 
+def stretched_element(sx: float, sy: float, radius: float | None) -> np.ndarray:
+    """An a x b parent element whose reference gradients are sx e1 and sy e2 (a stretched
+    parametrization, K != I), flat or rolled onto a cylinder of the given radius about r2
+    (arc length sx x along r1)."""
+    q = np.zeros((3, 12))
+    for k, (x, y) in enumerate(NODES):
+        if radius is None:
+            q[:, 3 * k], q[:, 3 * k + 1] = [sx * x, sy * y, 0.0], [sx, 0.0, 0.0]
+        else:
+            th = sx * x / radius
+            q[:, 3 * k] = [radius * np.sin(th), sy * y, radius * (1 - np.cos(th))]
+            q[:, 3 * k + 1] = sx * np.array([np.cos(th), 0.0, np.sin(th)])
+        q[:, 3 * k + 2] = [0.0, sy, 0.0]
+    return q
+
+
+@pytest.mark.parametrize("sx, sy", [(1.0, 1.0), (1.5, 0.8), (2.0, 1.0)])
+def test_completed_bending_energy_is_independent_of_the_reference_parametrization(sx, sy):
+    """Rolling a flat plate of physical size (sx a) x (sy b) onto a cylinder of radius R
+    stores 1/2 D_eff / R^2 per physical area whatever the parent element's scaling: the
+    frame map K and |g0|^2 turn parent curvatures into physical ones. D_eff: the
+    cylindrical bending with r_y held (no anticlastic curvature), D = E h^3/(12(1-nu^2))."""
+    radius = 5.0
+    force, energy, _ = element_forces(stretched_element(sx, sy, None),
+                                      stretched_element(sx, sy, radius), "completed")
+    rigidity = 2e11 * H**3 / (12 * (1 - 0.3**2))
+    assert energy == pytest.approx(0.5 * rigidity / radius**2 * sx * A * sy * B, rel=2e-3)
+
+
 @pytest.mark.parametrize("variant", ["plain", "completed"])
 @pytest.mark.parametrize("curved", [False, True])
 def test_analytic_force_and_tangent_match_central_differences(variant, curved):
@@ -367,3 +396,15 @@ def test_unsupported_leaf_falls_freely_without_straining(tmp_path):
                                        -0.5 * 9.81 * t**2, atol=1e-12)
         assert np.abs(h5["dynamic/energy/strain"][()]).max() < 1e-12
         assert h5["dynamic/lambda"].shape == (len(t), 0)
+
+
+@pytest.mark.parametrize("scene, overrides", [
+    ("plate_pendulum.nml", ["scene.analysis=static", "solver.static_method=newton"]),
+    ("curved_leaf.nml", ["leaf.support=free", "scene.analysis=static",
+                         "solver.static_method=newton"]),
+])
+def test_static_analysis_of_an_unsupported_plate_is_refused(scene, overrides):
+    """A spherical joint or no support leaves rigid motions free: no static equilibrium
+    (Newton would otherwise wander off along them)."""
+    with pytest.raises(InputError, match="rigid-body motions"):
+        load_scene(INPUTS / scene, overrides)

@@ -17,9 +17,11 @@
 !>    J^T J = blockdiag(A, 1) with A the in-plane metric, so eps_ZZ, eps_XZ, eps_YZ of eq. 10
 !>    vanish identically and their n-derivatives (eqs. 12-13, 16) cancel exactly; what
 !>    remains is the in-plane block in the reference's orthonormal tangent frame (t1, t2):
-!>    F = [r_x r_y] K, K = ([t1 t2]^T [r0_x r0_y])^{-1}, and k = K^T (c - c0) K (eq. 14),
-!>    integrated over the reference area |r0_x x r0_y| dx dy. For a flat rectangular
-!>    reference K = I, c0 = 0 and both variants coincide.
+!>    F = [r_x r_y] K, K = ([t1 t2]^T [r0_x r0_y])^{-1}, and k = |g0|^2 K^T (c - c0) K
+!>    (eq. 14; |g0|^2 c is the covariant curvature r_ab . n at the reference metric),
+!>    integrated over the reference area |g0| dx dy, |g0| = |r0_x x r0_y| = 1/det K. With
+!>    unit, orthogonal reference gradients (our rectangles and arc-length leaves) K = I;
+!>    a flat one also has c0 = 0, and then both variants coincide.
 !>
 !> Implementation: at each Gauss point the energy density is a function of the 15 numbers
 !> z = (r_x, r_y, r_xx, r_yy, r_xy); its gradient and Hessian with respect to z are
@@ -229,6 +231,10 @@ contains
     to_local(1, :) = [k(1, 1)**2, k(2, 1)**2, 2 * k(1, 1) * k(2, 1)]
     to_local(2, :) = [k(1, 2)**2, k(2, 2)**2, 2 * k(1, 2) * k(2, 2)]
     to_local(3, :) = 2 * [k(1, 1) * k(1, 2), k(2, 1) * k(2, 2), k(1, 1) * k(2, 2) + k(2, 1) * k(1, 2)]
+    ! c = b / |g|^2 with b_ab = r_ab . n the covariant curvature tensor; K^T b K is the
+    ! curvature in the reference's orthonormal frame, so c is rescaled by the reference
+    ! |g0|^2 = 1 / det(K)^2 (1 for unit, orthogonal reference gradients and for plain)
+    to_local = to_local / (k(1, 1) * k(2, 2) - k(1, 2) * k(2, 1))**2
     kappa = matmul(to_local, c - curvature0)
     moment = matmul(bending_d, kappa)
     energy = energy + 0.5_dp * dot_product(kappa, moment)
@@ -317,7 +323,8 @@ contains
     nodal = 0.0_dp
     do p = 1, plate_points
       fields = matmul(coords, derivs(:, :, p))
-      if (norm2(cross(fields(:, f_x), fields(:, f_y))) <= tiny(1.0_dp)**0.25_dp) then
+      if (norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
+          sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
         info = 2
         return
       end if

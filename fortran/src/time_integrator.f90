@@ -14,7 +14,8 @@
 !>   S = beta' M + K0, factorized once per run;
 !> * large deformation (beam_nonlinear, and the thin plate of plate_element): S = beta' M +
 !>   K_t(q) is refactorized once per step at the predicted state and reused by the step's
-!>   iterations (modified Newton).
+!>   iterations (modified Newton), and again at the current iterate whenever a correction
+!>   is not below half the previous one (strongly nonlinear steps).
 !> The multipliers enter through a Schur complement built from the flexibility S^{-1} E_c at
 !> the 3-vectors the constraints touch (E_c: their unit vectors in the frame), so a Newton
 !> correction costs one back-substitution plus small dense algebra (LAPACK dgesv). The

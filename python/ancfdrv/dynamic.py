@@ -45,6 +45,8 @@ _FAILURES = {
        "constraints are redundant or lost rank",
     5: "a constraint or drive could not be evaluated",
     6: "a bending moment's section director became parallel to its axis",
+    7: "a plate element's mid-surface normal vanished (r_x parallel to r_y: the element "
+       "folded onto a line)",
 }
 
 

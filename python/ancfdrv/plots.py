@@ -190,8 +190,10 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
                               if r.get(nodes_key, "") == curve))
                 ax.plot([p[0] for p in pts], [1e3 * p[1] for p in pts], "o-", ms=3,
                         label=_mesh_label(nodes_key, curve))
-            ref = sorted({(float(r[x_key]), r["tip_transverse_closed_form"]) for r in members
-                          if "tip_transverse_closed_form" in r})
+            ref = sorted({(float(r[x_key]), r.get("tip_transverse_closed_form",
+                                                  r.get("response_closed_form")))
+                          for r in members if "tip_transverse_closed_form" in r
+                          or "response_closed_form" in r})
             if ref:
                 ax.plot([p[0] for p in ref], [1e3 * p[1] for p in ref], "k--", lw=1.2,
                         label="closed form")

@@ -405,6 +405,11 @@ def _check_plate(values: dict[str, dict[str, Any]], file: str, kind: str) -> Non
                          "element has no floating-frame model)", file=file, group="scene",
                          key="formulation")
     effects = scene["effects"]
+    support = values[kind]["support"]
+    if scene["analysis"] != "dynamic" and support in ("corner_spherical", "free"):
+        raise InputError(f"support '{support}' leaves rigid-body motions free: it has no "
+                         "static equilibrium; use analysis = 'dynamic' or another support",
+                         file=file, group=kind, key="support")
     for effect in ("tip_mass", "bending_moment", "tip_force", "end_moment"):
         if effect in effects:
             raise InputError(f"effect {effect!r} applies to beam scenes only", file=file,

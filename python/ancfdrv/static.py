@@ -146,8 +146,8 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
                     for dofs, f, _, _ in moments:
                         external[dofs] += f
                     internal, k_values = elastic(d, True)
-                    force_scale = max(force_scale, np.linalg.norm(internal),
-                                      np.linalg.norm(external))
+                    if load_step == 1 and iteration == 1:  # the start: loads and prestress
+                        force_scale = max(np.linalg.norm(internal), np.linalg.norm(external))
                     residual = internal - external - reaction
                     values = np.concatenate([k_values, -lam[h_con] * h_vals,
                                              *[-j.ravel() for _, _, j, _ in moments], -grads,
