@@ -69,9 +69,7 @@ def plot_plate_static(h5_path: Path, png: str | Path | None = None) -> Path:
     """Plate or leaf equilibrium: the out-of-plane displacement over the initial mid-surface."""
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
-        if "static" not in h5:
-            raise ValueError(f"{h5_path}: no /static group to plot (status: "
-                             f"{h5.attrs.get('status')})")
+        _require_static(h5, h5_path)
         nodes = h5["model/nodes"][()]
         elements = h5["model/elements"][()]
         q = h5["static/q"][()].reshape(len(nodes), -1)[:, :3]
@@ -135,9 +133,7 @@ def plot_static(h5_path: Path, png: str | Path | None = None) -> Path:
     """Static result: deflection of the neutral axis along the beam, in the rigid frame."""
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
-        if "static" not in h5:
-            raise ValueError(f"{h5_path}: no /static group to plot (status: "
-                             f"{h5.attrs.get('status')})")
+        _require_static(h5, h5_path)
         s = h5["model/node_s"][()]
         e0 = h5["model/e0"][()].reshape(-1, 12)
         q = h5["static/q"][()].reshape(-1, 12)
@@ -282,6 +278,12 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
         plt.close(fig)
         out.append(path)
     return out
+
+
+def _require_static(h5: h5py.File, h5_path: Path) -> None:
+    if "static" not in h5:
+        raise ValueError(f"{h5_path}: no /static group to plot (status: "
+                         f"{h5.attrs.get('status')})")
 
 
 def _mesh_label(key: str | None, value) -> str:
