@@ -253,6 +253,85 @@ subroutine plate_elastic_forces(ndof, nel, npts, dofs, e, derivs, frame, curvatu
   energy = sum(element_energy)
 end subroutine plate_elastic_forces
 
+!> Mass matrix of an ANCF reference node (rigid body; seed 003 eq. 32).
+subroutine reference_node_mass(mass, centre, inertia, mass_matrix, info)
+  use ancf_kinds, only: dp
+  use rigid_body, only: rigid_body_mass
+  implicit none
+  real(dp), intent(in) :: mass, centre(3), inertia(3, 3)
+  real(dp), intent(out) :: mass_matrix(12, 12)
+  integer, intent(out) :: info
+  call rigid_body_mass(mass, centre, inertia, mass_matrix, info)
+end subroutine reference_node_mass
+
+!> One contact pair (leaf_contact%contact_point): upper element at local (xi_q, eta_q),
+!> lower-leaf point at (xi_p, eta_p).
+subroutine contact_pair(upper, upper_rates, a_u, b_u, xi_q, eta_q, lower, lower_rates, a_l, b_l, &
+                        xi_p, eta_p, params, velocity_factor, force_upper, force_lower, jacobian, &
+                        record, potential, powers, active, info)
+  use ancf_kinds, only: dp
+  use leaf_contact, only: contact_point
+  implicit none
+  real(dp), intent(in) :: upper(3, 12), upper_rates(3, 12), a_u, b_u, xi_q, eta_q
+  real(dp), intent(in) :: lower(3, 12), lower_rates(3, 12), a_l, b_l, xi_p, eta_p
+  real(dp), intent(in) :: params(8), velocity_factor
+  real(dp), intent(out) :: force_upper(36), force_lower(36), jacobian(72, 72), record(4)
+  real(dp), intent(out) :: potential, powers(2)
+  integer, intent(out) :: active, info
+  logical :: is_active
+  call contact_point(upper, upper_rates, a_u, b_u, xi_q, eta_q, lower, lower_rates, a_l, b_l, &
+                     xi_p, eta_p, params, velocity_factor, .true., force_upper, force_lower, &
+                     jacobian, record, potential, powers, is_active, info)
+  active = merge(1, 0, is_active)
+end subroutine contact_pair
+
+!> Closest point of the upper leaf's mid-surface (elements grid(n_l, n_w), leaf-level
+!> coordinates) to p, from guess; counts = [Newton iterations, fallback sweeps].
+subroutine contact_projection(nfull, nel, ngrid_l, ngrid_w, e, dofs, sizes, grid, p, guess, &
+                              counts, info)
+  use ancf_kinds, only: dp
+  use leaf_contact, only: project_point
+  implicit none
+  integer, intent(in) :: nfull, nel, ngrid_l, ngrid_w, dofs(36, nel), grid(ngrid_l, ngrid_w)
+  real(dp), intent(in) :: e(nfull), sizes(2, nel), p(3)
+  real(dp), intent(inout) :: guess(2)
+  !f2py intent(in,out) :: guess
+  integer, intent(out) :: counts(2), info
+  counts = 0
+  call project_point(e, dofs, grid, sizes, p, guess, counts(1), counts(2), info)
+end subroutine contact_projection
+
+!> Contact forces of all points at (e, rates) (leaf_contact%contact_assemble), with the
+!> Jacobian on the CSR pattern (row_ptr, col) when want_jacobian /= 0.
+subroutine contact_evaluate(nfull, nel, ncontact, ngrid_l, ngrid_w, nnz, e, rates, dofs, sizes, &
+                            grid, point_element, point_local, params, velocity_factor, &
+                            want_jacobian, row_ptr, col, guesses, counts, force, records, &
+                            potential, powers, values, info)
+  use ancf_kinds, only: dp
+  use leaf_contact, only: contact_assemble
+  implicit none
+  integer, intent(in) :: nfull, nel, ncontact, ngrid_l, ngrid_w, nnz, want_jacobian
+  integer, intent(in) :: dofs(36, nel), grid(ngrid_l, ngrid_w), point_element(ncontact)
+  integer, intent(in) :: row_ptr(nfull + 1), col(nnz)
+  real(dp), intent(in) :: e(nfull), rates(nfull), sizes(2, nel), point_local(2, ncontact)
+  real(dp), intent(in) :: params(8), velocity_factor
+  real(dp), intent(inout) :: guesses(2, ncontact)
+  integer, intent(inout) :: counts(6)
+  !f2py intent(in,out) :: guesses, counts
+  real(dp), intent(out) :: force(nfull), records(6, ncontact), potential, powers(2), values(nnz)
+  integer, intent(out) :: info
+  force = 0.0_dp
+  values = 0.0_dp
+  if (want_jacobian /= 0) then
+    call contact_assemble(e, rates, dofs, sizes, grid, point_element, point_local, params, &
+                          velocity_factor, guesses, force, records, potential, powers, counts, &
+                          info, row_ptr, col, values)
+  else
+    call contact_assemble(e, rates, dofs, sizes, grid, point_element, point_local, params, &
+                          velocity_factor, guesses, force, records, potential, powers, counts, info)
+  end if
+end subroutine contact_evaluate
+
 !> Generalized force of a dead moment on a section director, with its first and
 !> second derivatives.
 subroutine moment_generalized_force(director, axis, magnitude, force, jacobian, hessian, info)
@@ -395,7 +474,8 @@ end subroutine direct_destroy
 !> correction. Arrays of optional items carry max(1, n) columns (f2py refuses zero sizes).
 subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nblock, nprobe, &
                               nshape, nnz_mass, nsteps, nq, npts, ngauss, nplate_pts, nplate_el, &
-                              nnz_pattern, formulation, dofs, stiffness0, &
+                              nnz_pattern, nfull, nnz_b, nplan, nnz_full, ncontact, ngrid_l, &
+                              ngrid_w, formulation, dofs, stiffness0, &
                               e0_frame, mass_row_ptr, mass_col, mass_values, constant_force, &
                               moment_dofs, moment_axis, moment_magnitude, moment_reference, &
                               con_ints, con_reals, drive_kinds, drive_params, frame_drive, &
@@ -403,16 +483,22 @@ subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nbl
                               flexibility_cc, probe_dofs, probe_shape, probe_reference, youngs, &
                               poisson, gauss_gradients, gauss_weights, plate_derivs, plate_frame, &
                               plate_curvature0, plate_weights, thickness, scatter_map, mass_pattern, &
+                              reduced, reduction_ptr, reduction_col, reduction_values, &
+                              reduction_offset, plan_source, plan_target, plan_coef, full_row_ptr, &
+                              full_col, force_drive, drive_force, element_size, contact_grid, &
+                              contact_element, contact_local, contact_params, &
                               h, beta, gamma, alpha_m, alpha_f, tol, length_scale, max_newton, &
-                              t, e, v, a, accel, lam, work, out_time, out_probe, out_deflection, &
-                              out_lambda, out_energy, out_constraint, out_newton, out_q, status, &
-                              last_correction)
+                              t, e, v, a, accel, lam, work, contact_guess, contact_counts, out_time, &
+                              out_probe, out_deflection, out_lambda, out_energy, out_constraint, &
+                              out_newton, out_contact, out_q, status, last_correction)
   use ancf_kinds, only: dp
-  use time_integrator, only: mechanical_system, integrator_settings, integrator_chunk
+  use time_integrator, only: mechanical_system, integrator_settings, integrator_chunk, &
+                             contact_state
   implicit none
   integer, intent(in) :: ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nblock, nprobe, nshape
   integer, intent(in) :: nnz_mass, nsteps, nq
   integer, intent(in) :: npts, ngauss, nplate_pts, nplate_el, nnz_pattern, formulation
+  integer, intent(in) :: nfull, nnz_b, nplan, nnz_full, ncontact, ngrid_l, ngrid_w
   integer, intent(in) :: dofs(nde, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
   real(dp), intent(in) :: stiffness0(nde, nde, nstiff), e0_frame(ndof), mass_values(nnz_mass)
   real(dp), intent(in) :: constant_force(ndof)
@@ -434,17 +520,29 @@ subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nbl
   real(dp), intent(in) :: plate_weights(nplate_pts, nplate_el), thickness
   integer, intent(in) :: scatter_map(nde, nde, nel)
   real(dp), intent(in) :: mass_pattern(nnz_pattern)
+  integer, intent(in) :: reduced, reduction_ptr(nfull + 1), reduction_col(max(1, nnz_b))
+  real(dp), intent(in) :: reduction_values(max(1, nnz_b)), reduction_offset(nfull)
+  integer, intent(in) :: plan_source(max(1, nplan)), plan_target(max(1, nplan))
+  real(dp), intent(in) :: plan_coef(max(1, nplan))
+  integer, intent(in) :: full_row_ptr(nfull + 1), full_col(nnz_full), force_drive
+  real(dp), intent(in) :: drive_force(ndof), element_size(2, nel)
+  integer, intent(in) :: contact_grid(ngrid_l, ngrid_w), contact_element(max(1, ncontact))
+  real(dp), intent(in) :: contact_local(2, max(1, ncontact)), contact_params(8)
   real(dp), intent(in) :: h, beta, gamma, alpha_m, alpha_f, tol, length_scale
   integer, intent(in) :: max_newton
-  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), accel(ndof), lam(max(1, ncon)), work(2)
-  !f2py intent(in,out) :: t, e, v, a, accel, lam, work
+  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), accel(ndof), lam(max(1, ncon)), work(4)
+  real(dp), intent(inout) :: contact_guess(2, max(1, ncontact))
+  integer, intent(inout) :: contact_counts(6)
+  !f2py intent(in,out) :: t, e, v, a, accel, lam, work, contact_guess, contact_counts
   real(dp), intent(out) :: out_time(nsteps), out_probe(3, nprobe, nsteps)
   real(dp), intent(out) :: out_deflection(3, nprobe, nsteps), out_lambda(max(1, ncon), nsteps)
-  real(dp), intent(out) :: out_energy(7, nsteps), out_constraint(nsteps), out_q(ndof, nq)
+  real(dp), intent(out) :: out_energy(10, nsteps), out_constraint(nsteps), out_q(ndof, nq)
+  real(dp), intent(out) :: out_contact(6, max(1, ncontact), nsteps)
   integer, intent(out) :: out_newton(nsteps), status(4)
   real(dp), intent(out) :: last_correction
   type(mechanical_system) :: sys
   type(integrator_settings) :: cfg
+  type(contact_state) :: state
   sys%formulation = formulation
   sys%element_dofs = nde
   sys%ndof = ndof
@@ -495,6 +593,31 @@ subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nbl
     sys%scatter_map = scatter_map
     sys%mass_pattern = mass_pattern
   end if
+  sys%nfull = nfull
+  sys%reduced = reduced /= 0
+  if (sys%reduced) then
+    sys%reduction_ptr = reduction_ptr
+    sys%reduction_col = reduction_col(1:nnz_b)
+    sys%reduction_values = reduction_values(1:nnz_b)
+    sys%reduction_offset = reduction_offset
+    sys%plan_source = plan_source(1:nplan)
+    sys%plan_target = plan_target(1:nplan)
+    sys%plan_coef = plan_coef(1:nplan)
+  end if
+  sys%full_row_ptr = full_row_ptr
+  sys%full_col = full_col
+  sys%force_drive = force_drive
+  sys%drive_force = drive_force
+  sys%ncontact = ncontact
+  sys%element_size = element_size
+  if (ncontact > 0) then
+    sys%contact_grid = contact_grid
+    sys%contact_element = contact_element(1:ncontact)
+    sys%contact_local = contact_local(:, 1:ncontact)
+    sys%contact_params = contact_params
+  end if
+  state%guesses = contact_guess(:, 1:max(1, ncontact))
+  state%counts = contact_counts
   cfg%h = h
   cfg%beta = beta
   cfg%gamma = gamma
@@ -511,8 +634,11 @@ subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nbl
   out_constraint = 0.0_dp
   out_newton = 0
   out_q = 0.0_dp
-  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, out_time, out_probe, &
-                        out_deflection, out_lambda(1:ncon, :), out_energy, out_constraint, &
-                        out_newton, nq == nsteps, out_q, status(1), status(2), status(3), &
-                        status(4), last_correction)
+  out_contact = 0.0_dp
+  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, state, out_time, &
+                        out_probe, out_deflection, out_lambda(1:ncon, :), out_energy, &
+                        out_constraint, out_newton, out_contact, nq == nsteps, out_q, status(1), &
+                        status(2), status(3), status(4), last_correction)
+  contact_guess(:, 1:max(1, ncontact)) = state%guesses
+  contact_counts = state%counts
 end subroutine integrator_advance

@@ -4,7 +4,8 @@
 !>   kind 2  distance    |e(i1:i3) - p|^2 - d^2 = 0                    (p = c1:c3, d = c4)
 !>   kind 3  cross       k . ((e(i1:i3) - p) x e(i4:i6)) = 0           (p = c1:c3, k = c4:c6):
 !>                       a gradient parallel to a position vector, in the plane normal to k
-!>   kind 4  dot         e(i1:i3) . e(i4:i6) - c1 = 0
+!>   kind 4  dot         e(i1:i3) . e(i4:i6) - c1 = 0   (an unused index: a component held
+!>                       at zero, e.g. eliminated by a planar guide)
 !> phi is the value of the constraint's drive (drives module; no drive: phi = 0).
 !> Layout: ints(8, n) = [kind, drive, i1..i6] (1-based dofs, 0 = unused), reals(8, n).
 module constraints
@@ -110,8 +111,8 @@ contains
         hessians(1:3, 4:6, c) = reshape([0.0_dp, -k(3), k(2), k(3), 0.0_dp, -k(1), &
                                           -k(2), k(1), 0.0_dp], [3, 3])
         hessians(4:6, 1:3, c) = transpose(hessians(1:3, 4:6, c))
-      case (constraint_kind_dot)
-        if (any(idx == 0)) then
+      case (constraint_kind_dot)  ! unused entries: components held at zero
+        if (all(idx(1:3) == 0) .or. all(idx(4:6) == 0)) then
           info = c
           return
         end if

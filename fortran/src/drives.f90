@@ -4,13 +4,16 @@
 !>           p = [omega, t_s, t_b, phi_end, phi_start]
 !>   kind 2  spin-up of Simo & Vu-Quoc (REFERENCES.md): p = [W, T, phi_start],
 !>           phi = (W/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)) for t < T, W t - W T/2 after
+!>   kind 3  load cycle: p = [amplitude, T, t_0]: phi = amplitude (1 - cos(2 pi (t - t_0)/T))/2
+!>           on [t_0, t_0 + T] (0 -> amplitude -> 0 with zero rate at both ends), 0 outside
 module drives
   use ancf_kinds, only: dp
   implicit none
   private
   public :: drive_eval
 
-  integer, parameter, public :: drive_constant = 0, drive_luffing = 1, drive_spinup = 2
+  integer, parameter, public :: drive_constant = 0, drive_luffing = 1, drive_spinup = 2, &
+                                   drive_cycle = 3
   real(dp), parameter :: pi = 3.14159265358979323846_dp
 
 contains
@@ -77,6 +80,18 @@ contains
         dphi = omega
       end if
       phi = phi + params(3)
+    case (drive_cycle)
+      period = params(2)
+      if (period <= 0.0_dp) then
+        info = 2
+        return
+      end if
+      tau = t - params(3)
+      if (tau > 0.0_dp .and. tau < period) then
+        phi = 0.5_dp * params(1) * (1.0_dp - cos(2.0_dp * pi * tau / period))
+        dphi = params(1) * pi / period * sin(2.0_dp * pi * tau / period)
+        ddphi = 2.0_dp * params(1) * (pi / period)**2 * cos(2.0_dp * pi * tau / period)
+      end if
     case default
       info = 1
     end select

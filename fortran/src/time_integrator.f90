@@ -21,6 +21,12 @@
 !> correction costs one back-substitution plus small dense algebra (LAPACK dgesv). The
 !> Jacobians of the moment and of lambda . Phi_qq are left out of the iteration matrix; the
 !> residual is exact. A correction with max |dq| <= tol * length_scale ends the step.
+!> Linear constraints (seed 003 eqs. 34-37: hinges to ANCF reference nodes, fixed or tied
+!> coordinates) are eliminated before the solve: the stepper's unknowns are the independent
+!> coordinates q_i, the elements see q = B q_i + q0, forces are reduced by B^T and the
+!> iteration matrix by a precomputed plan of B^T S B (Python builds B, the plan, and
+!> M_ii = B^T M B). Leaf contact (leaf_contact) adds velocity-dependent forces; its Jacobian
+!> enters the iteration matrix with d q'/d q = gamma / (beta h).
 !> No I/O; failures return codes (see integrator_chunk).
 module time_integrator
   use ancf_kinds, only: dp
@@ -32,15 +38,18 @@ module time_integrator
   use section_moment, only: moment_force, moment_angle
   use sparse_pattern, only: pattern_assemble
   use sparse_direct, only: solver_solve, solver_factorize
+  use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record
   implicit none
   private
-  public :: mechanical_system, integrator_settings, integrator_chunk, frame_rotation, csr_matvec
+  public :: mechanical_system, integrator_settings, integrator_chunk, frame_rotation, csr_matvec, &
+            contact_state
   public :: energy_kinetic, energy_strain, energy_loads, energy_moment, energy_total, &
-            work_drive, work_frame, energy_count
+            work_drive, work_frame, energy_contact, work_damping, work_friction, energy_count
 
   integer, parameter :: energy_kinetic = 1, energy_strain = 2, energy_loads = 3, &
                         energy_moment = 4, energy_total = 5, work_drive = 6, work_frame = 7, &
-                        energy_count = 7
+                        energy_contact = 8, work_damping = 9, work_friction = 10, &
+                        energy_count = 10
   integer, parameter, public :: formulation_ffr = 0, formulation_nonlinear = 1, &
                                 formulation_plate = 2
 
@@ -77,7 +86,30 @@ module time_integrator
     integer, allocatable :: probe_dofs(:, :)           ! (element_dofs, nprobe)
     real(dp), allocatable :: probe_shape(:, :)         ! (element_dofs / 3, nprobe)
     real(dp), allocatable :: probe_reference(:, :)     ! (3, nprobe) rigid position in frame
+    ! linear-constraint elimination q = B q_i + q0 (reduced = .false.: B = I, q0 = 0);
+    ! dofs, scatter_map, probe_dofs and the contact data index the full q
+    logical :: reduced = .false.
+    integer :: nfull = 0
+    integer, allocatable :: reduction_ptr(:), reduction_col(:)      ! B, CSR (nfull rows)
+    real(dp), allocatable :: reduction_values(:), reduction_offset(:)
+    integer, allocatable :: plan_source(:), plan_target(:)         ! B^T S B on the pattern
+    real(dp), allocatable :: plan_coef(:)
+    integer, allocatable :: full_row_ptr(:), full_col(:)           ! pattern of the full S
+    ! time-dependent load Q(t) = constant_force + phi(t) drive_force (force_drive = 0: none)
+    integer :: force_drive = 0
+    real(dp), allocatable :: drive_force(:)
+    ! leaf contact (ncontact = 0: never evaluated)
+    integer :: ncontact = 0
+    integer, allocatable :: contact_grid(:, :), contact_element(:)
+    real(dp), allocatable :: contact_local(:, :), element_size(:, :)
+    real(dp) :: contact_params(cp_count) = 0.0_dp
   end type mechanical_system
+
+  !> What the contact evaluation carries from iteration to iteration and step to step.
+  type :: contact_state
+    real(dp), allocatable :: guesses(:, :)     ! (2, ncontact) leaf-level projections
+    integer :: counts(contact_counters) = 0
+  end type contact_state
 
   type :: integrator_settings
     real(dp) :: h, beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
@@ -134,6 +166,10 @@ contains
     real(dp), intent(out) :: y(:)
     integer :: b, i
     ! written out: a generic matmul call per 3-vector cost a tenth of a step
+    if (mod(size(x), 3) /= 0) then  ! reduced coordinates (large deformation: A = I)
+      y = x
+      return
+    end if
     if (transpose_first) then
       do b = 0, size(x) / 3 - 1
         do i = 1, 3
@@ -174,15 +210,87 @@ contains
     integer, intent(out) :: info
     real(dp) :: element_force(sys%element_dofs, sys%nel), element_energy(sys%nel)
     real(dp) :: unused(sys%element_dofs, sys%element_dofs, 1)
+    real(dp) :: e_full(sys%nfull), force_full(sys%nfull)
     info = 0
     if (sys%formulation == formulation_ffr) then
       call ffr_force(sys%ndof, sys%nel, sys%dofs, sys%stiffness0, rotation, e, sys%e0_frame, &
                      force, strain)
       return
     end if
-    call element_pass(sys, e, .false., element_force, element_energy, unused, info)
-    call scatter_forces(sys, element_force, element_energy, force, strain)
+    call to_full(sys, e, .true., e_full)
+    call element_pass(sys, e_full, .false., element_force, element_energy, unused, info)
+    call scatter_forces(sys, element_force, element_energy, force_full, strain)
+    call to_reduced(sys, force_full, force)
   end subroutine elastic_force
+
+  !> q = B q_i + q0 (with_offset; velocities and accelerations without).
+  pure subroutine to_full(sys, x, with_offset, full)
+    type(mechanical_system), intent(in) :: sys
+    real(dp), intent(in) :: x(:)
+    logical, intent(in) :: with_offset
+    real(dp), intent(out) :: full(:)
+    integer :: i, k
+    if (.not. sys%reduced) then
+      full = x
+      return
+    end if
+    do i = 1, sys%nfull
+      full(i) = 0.0_dp
+      if (with_offset) full(i) = sys%reduction_offset(i)
+      do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
+        full(i) = full(i) + sys%reduction_values(k) * x(sys%reduction_col(k))
+      end do
+    end do
+  end subroutine to_full
+
+  !> Q_i = B^T Q (seed 003 eq. 37).
+  pure subroutine to_reduced(sys, full, x)
+    type(mechanical_system), intent(in) :: sys
+    real(dp), intent(in) :: full(:)
+    real(dp), intent(out) :: x(:)
+    integer :: i, k
+    if (.not. sys%reduced) then
+      x = full
+      return
+    end if
+    x = 0.0_dp
+    do i = 1, sys%nfull
+      do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
+        x(sys%reduction_col(k)) = x(sys%reduction_col(k)) + sys%reduction_values(k) * full(i)
+      end do
+    end do
+  end subroutine to_reduced
+
+  !> Contact forces (reduced) at the reduced state (e, v), the per-point records, the
+  !> penalty potential and the powers (damping, friction); with values_full, the contact
+  !> Jacobian (velocity_factor = d q'/d q) is added to the full pattern's values.
+  !> info = 7 (normal vanished) or 8 (projection failed).
+  subroutine contact_force(sys, e, v, velocity_factor, state, force, records, potential, powers, &
+                           info, values_full)
+    type(mechanical_system), intent(in) :: sys
+    real(dp), intent(in) :: e(:), v(:), velocity_factor
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: force(:), records(:, :), potential, powers(2)
+    integer, intent(out) :: info
+    real(dp), intent(inout), optional :: values_full(:)
+    real(dp) :: e_full(sys%nfull), v_full(sys%nfull), force_full(sys%nfull)
+    call to_full(sys, e, .true., e_full)
+    call to_full(sys, v, .false., v_full)
+    force_full = 0.0_dp
+    if (present(values_full)) then
+      call contact_assemble(e_full, v_full, sys%dofs, sys%element_size, sys%contact_grid, &
+                            sys%contact_element, sys%contact_local, sys%contact_params, &
+                            velocity_factor, state%guesses, force_full, records, potential, &
+                            powers, state%counts, info, sys%full_row_ptr, sys%full_col, &
+                            values_full)
+    else
+      call contact_assemble(e_full, v_full, sys%dofs, sys%element_size, sys%contact_grid, &
+                            sys%contact_element, sys%contact_local, sys%contact_params, &
+                            velocity_factor, state%guesses, force_full, records, potential, &
+                            powers, state%counts, info)
+    end if
+    call to_reduced(sys, force_full, force)
+  end subroutine contact_force
 
   !> Forces, energies and (on request) tangents of every element of the large-deformation
   !> formulations (beam_nonlinear, plate_element); elements in parallel (OpenMP, when built
@@ -243,23 +351,42 @@ contains
   !> Large deformation: factorize S = beta' M + K_t(e) on the solver's pattern and compute
   !> the flexibility S^{-1} E_c and E_c^T S^{-1} E_c for the Schur complement; the elastic
   !> force and strain energy at e come out of the same element pass.
-  subroutine refactorize(sys, beta_prime, e, flexibility, flexibility_cc, force, strain, info, &
-                         detail)
+  subroutine refactorize(sys, beta_prime, velocity_factor, e, v, state, flexibility, &
+                         flexibility_cc, force, strain, info, detail)
     type(mechanical_system), intent(in) :: sys
-    real(dp), intent(in) :: beta_prime, e(:)
+    real(dp), intent(in) :: beta_prime, velocity_factor, e(:), v(:)
+    type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: flexibility(:, :), flexibility_cc(:, :), force(:), strain
     integer, intent(out) :: info, detail
     real(dp) :: tangents(sys%element_dofs, sys%element_dofs, sys%nel)
     real(dp) :: element_force(sys%element_dofs, sys%nel), element_energy(sys%nel)
-    real(dp) :: values(size(sys%mass_pattern))
-    integer :: b, j
+    real(dp) :: values(size(sys%mass_pattern)), values_full(size(sys%full_col))
+    real(dp) :: e_full(sys%nfull), force_full(sys%nfull), unused_force(sys%ndof)
+    real(dp) :: records(contact_record, sys%ncontact), potential, powers(2)
+    integer :: b, j, k
     detail = 0
-    call element_pass(sys, e, .true., element_force, element_energy, tangents, info)
+    call to_full(sys, e, .true., e_full)
+    call element_pass(sys, e_full, .true., element_force, element_energy, tangents, info)
     if (info /= 0) return
     ! the elastic force at e comes with the tangent: the step's first residual reuses it
-    call scatter_forces(sys, element_force, element_energy, force, strain)
-    call pattern_assemble(size(values), sys%element_dofs, sys%nel, sys%scatter_map, tangents, &
-                          values)
+    call scatter_forces(sys, element_force, element_energy, force_full, strain)
+    call to_reduced(sys, force_full, force)
+    call pattern_assemble(size(values_full), sys%element_dofs, sys%nel, sys%scatter_map, &
+                          tangents, values_full)
+    if (sys%ncontact > 0) then
+      call contact_force(sys, e, v, velocity_factor, state, unused_force, records, potential, &
+                         powers, info, values_full)
+      if (info /= 0) return
+    end if
+    if (sys%reduced) then  ! B^T S B by the plan
+      values = 0.0_dp
+      do k = 1, size(sys%plan_source)
+        values(sys%plan_target(k)) = values(sys%plan_target(k)) &
+                                     + sys%plan_coef(k) * values_full(sys%plan_source(k))
+      end do
+    else
+      values = values_full
+    end if
     values = values + beta_prime * sys%mass_pattern
     call solver_factorize(sys%solver_handle, size(values), values, info, detail)
     if (info /= 0) then
@@ -289,16 +416,19 @@ contains
 
   !> Residual r = M q'' + Q_el(q) - Q(q) - Phi_q^T lambda at time t, with the constraint
   !> values and gradients and the strain energy.
-  subroutine residual(sys, t, e, acceleration, lam, rotation, r, phi, gradients, strain, info, &
-                      known_elastic)
+  subroutine residual(sys, t, e, v, acceleration, lam, rotation, state, r, phi, gradients, &
+                      strain, info, known_elastic)
     type(mechanical_system), intent(in) :: sys
-    real(dp), intent(in) :: t, e(:), acceleration(:), lam(:), rotation(3, 3)
+    real(dp), intent(in) :: t, e(:), v(:), acceleration(:), lam(:), rotation(3, 3)
+    type(contact_state), intent(inout) :: state
     real(dp), intent(inout) :: strain  ! out; in with known_elastic
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :)
     integer, intent(out) :: info
     real(dp), intent(in), optional :: known_elastic(:)  ! elastic force at e, already computed
     real(dp) :: elastic(sys%ndof), inertia(sys%ndof), force(3), jacobian(3, 3), hessian(3, 3, 3)
+    real(dp) :: contact(sys%ndof), records(contact_record, sys%ncontact), potential, powers(2)
     integer :: m, c, i
+    info = 0
     if (present(known_elastic)) then
       elastic = known_elastic
     else
@@ -307,6 +437,13 @@ contains
     end if
     call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, acceleration, inertia)
     r = inertia + elastic - sys%constant_force
+    if (sys%force_drive > 0) r = r - load_factor(sys, t, info) * sys%drive_force
+    if (info /= 0) return
+    if (sys%ncontact > 0) then
+      call contact_force(sys, e, v, 0.0_dp, state, contact, records, potential, powers, info)
+      if (info /= 0) return
+      r = r - contact
+    end if
     do m = 1, sys%nmoment
       call moment_force(e(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
                         sys%moment_magnitude(m), force, jacobian, hessian, info)
@@ -334,14 +471,16 @@ contains
   !> vanished. steps_done counts the
   !> completed steps; the state is that of the last completed step; last_correction is the
   !> size of the last Newton correction (why a step failed to converge).
-  subroutine integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam, work, out_time, out_probe, &
-                              out_deflection, out_lambda, out_energy, out_constraint, out_newton, &
-                              store_q, out_q, steps_done, info, detail, refactorizations, &
-                              last_correction)
+  subroutine integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam, work, state, out_time, &
+                              out_probe, out_deflection, out_lambda, out_energy, out_constraint, &
+                              out_newton, out_contact, store_q, out_q, steps_done, info, detail, &
+                              refactorizations, last_correction)
     type(mechanical_system), intent(in) :: sys
     type(integrator_settings), intent(in) :: cfg
     integer, intent(in) :: nsteps
-    real(dp), intent(inout) :: t, e(:), v(:), a(:), accel(:), lam(:), work(2)
+    real(dp), intent(inout) :: t, e(:), v(:), a(:), accel(:), lam(:), work(4)
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: out_contact(:, :, :)  ! (contact_record, ncontact, nsteps)
     real(dp), intent(out) :: out_time(:), out_probe(:, :, :), out_deflection(:, :, :)
     real(dp), intent(out) :: out_lambda(:, :), out_energy(:, :), out_constraint(:)
     integer, intent(out) :: out_newton(:)
@@ -355,9 +494,9 @@ contains
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: w(3 * sys%nblock, sys%ncon), schur(sys%ncon, sys%ncon), dlam(sys%ncon, 1)
     real(dp) :: flexibility(sys%ndof, 3 * sys%nblock), flexibility_cc(3 * sys%nblock, 3 * sys%nblock)
-    real(dp) :: predicted_elastic(sys%ndof)
-    real(dp) :: rotation(3, 3), transform(3, 3), rate, strain, violation, powers_old(2), powers_new(2)
-    real(dp) :: t_new, h, beta_prime
+    real(dp) :: predicted_elastic(sys%ndof), v_new(sys%ndof)
+    real(dp) :: rotation(3, 3), transform(3, 3), rate, strain, violation, powers_old(4), powers_new(4)
+    real(dp) :: t_new, h, beta_prime, velocity_factor, contact_potential, step_cap
     integer :: step, it, ipiv(sys%ncon), lapack_info
     logical :: done, fresh_force
     real(dp) :: previous_correction
@@ -368,6 +507,7 @@ contains
     last_correction = 0.0_dp
     h = cfg%h
     beta_prime = (1.0_dp - cfg%alpha_m) / (cfg%beta * h * h * (1.0_dp - cfg%alpha_f))
+    velocity_factor = cfg%gamma / (cfg%beta * h)
     if (sys%formulation == formulation_ffr) then
       flexibility = sys%flexibility
       flexibility_cc = sys%flexibility_cc
@@ -377,15 +517,26 @@ contains
       info = 5
       return
     end if
-    call step_powers(sys, e, v, lam, rotation, rate, t, powers_old, strain, violation, info)
+    call step_powers(sys, e, v, lam, rotation, rate, t, state, powers_old, strain, violation, &
+                     contact_potential, out_contact(:, :, 1), info)
     if (info /= 0) return
     do step = 1, nsteps
       t_new = t + h
-      ! predictor: q''_{n+1} = q''_n
-      accel_new = accel
-      a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
-              / (1.0_dp - cfg%alpha_m)
-      e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
+      if (sys%ncontact == 0) then
+        ! predictor: q''_{n+1} = q''_n
+        accel_new = accel
+        a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
+                / (1.0_dp - cfg%alpha_m)
+        e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
+      else
+        ! penalty contact: q_{n+1} = q_n (an acceleration predictor carries a contact
+        ! impulse of the last step into the next one, far through the other leaf)
+        e_new = e
+        a_new = -(v / h + (0.5_dp - cfg%beta) * a) / cfg%beta
+        accel_new = ((1.0_dp - cfg%alpha_m) * a_new + cfg%alpha_m * a - cfg%alpha_f * accel) &
+                    / (1.0_dp - cfg%alpha_f)
+      end if
+      v_new = v + h * ((1.0_dp - cfg%gamma) * a + cfg%gamma * a_new)
       lam_new = lam
       call frame_rotation(sys, t_new, rotation, rate, info)
       if (info /= 0) then
@@ -397,8 +548,8 @@ contains
       transform = rotation
       if (sys%formulation /= formulation_ffr) then
         transform = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
-        call refactorize(sys, beta_prime, e_new, flexibility, flexibility_cc, predicted_elastic, &
-                         strain, info, detail)
+        call refactorize(sys, beta_prime, velocity_factor, e_new, v_new, state, flexibility, &
+                         flexibility_cc, predicted_elastic, strain, info, detail)
         if (info /= 0) return
         refactorizations = refactorizations + 1
       end if
@@ -407,10 +558,11 @@ contains
       previous_correction = huge(1.0_dp)
       do it = 1, cfg%max_newton
         if (fresh_force) then
-          call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, &
-                        info, predicted_elastic)
+          call residual(sys, t_new, e_new, v_new, accel_new, lam_new, rotation, state, r, phi, &
+                        gradients, strain, info, predicted_elastic)
         else
-          call residual(sys, t_new, e_new, accel_new, lam_new, rotation, r, phi, gradients, strain, info)
+          call residual(sys, t_new, e_new, v_new, accel_new, lam_new, rotation, state, r, phi, &
+                        gradients, strain, info)
         end if
         if (info /= 0) return
         fresh_force = .false.
@@ -440,8 +592,19 @@ contains
         else
           correction = -direction
         end if
+        if (sys%ncontact > 0) then
+          ! damped Newton with contact: no correction moves a coordinate by more than half
+          ! a leaf thickness (a contact that is open at the linearization point has no
+          ! stiffness there, and a full step would jump far through the other leaf)
+          step_cap = 0.5_dp * min(sys%contact_params(5), sys%contact_params(6))
+          if (maxval(abs(correction)) > step_cap) then
+            dlam = dlam * (step_cap / maxval(abs(correction)))
+            correction = correction * (step_cap / maxval(abs(correction)))
+          end if
+        end if
         e_new = e_new + correction
         accel_new = accel_new + beta_prime * correction
+        v_new = v_new + velocity_factor * correction
         lam_new = lam_new + dlam(:, 1)
         if (.not. (all(abs(correction) < huge(1.0_dp)) .and. all(abs(lam_new) < huge(1.0_dp)))) then
           info = 2
@@ -456,8 +619,8 @@ contains
         ! (a strongly nonlinear step), update it at the current iterate (full Newton)
         if (sys%formulation /= formulation_ffr .and. it < cfg%max_newton .and. &
             last_correction > 0.5_dp * previous_correction) then
-          call refactorize(sys, beta_prime, e_new, flexibility, flexibility_cc, &
-                           predicted_elastic, strain, info, detail)
+          call refactorize(sys, beta_prime, velocity_factor, e_new, v_new, state, flexibility, &
+                           flexibility_cc, predicted_elastic, strain, info, detail)
           if (info /= 0) return
           refactorizations = refactorizations + 1
           fresh_force = .true.
@@ -477,8 +640,8 @@ contains
       accel = accel_new
       lam = lam_new
       t = t_new
-      call step_powers(sys, e, v, lam, rotation, rate, t, powers_new, strain, out_constraint(step), &
-                       info)
+      call step_powers(sys, e, v, lam, rotation, rate, t, state, powers_new, strain, &
+                       out_constraint(step), contact_potential, out_contact(:, :, step), info)
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers_old + powers_new)
       powers_old = powers_new
@@ -486,8 +649,8 @@ contains
       out_time(step) = t
       out_newton(step) = it
       out_lambda(:, step) = lam
-      call record(sys, e, v, rotation, work, strain, out_probe(:, :, step), out_deflection(:, :, step), &
-                  out_energy(:, step))
+      call record(sys, e, v, t, rotation, work, strain, contact_potential, out_probe(:, :, step), &
+                  out_deflection(:, :, step), out_energy(:, step))
       if (store_q) out_q(:, step) = e
     end do
   end subroutine integrator_chunk
@@ -503,8 +666,10 @@ contains
       do i = 1, 6
         dof = sys%con_ints(2 + i, c)
         if (dof == 0) cycle
-        b = findloc(sys%block_first, dof - modulo(dof - 1, 3), dim=1)
-        comp = modulo(dof - 1, 3) + 1
+        do b = 1, sys%nblock  ! the first block holding dof
+          if (dof >= sys%block_first(b) .and. dof <= sys%block_first(b) + 2) exit
+        end do
+        comp = dof - sys%block_first(b) + 1
         w(3 * (b - 1) + 1:3 * b, c) = w(3 * (b - 1) + 1:3 * b, c) + rotation(comp, :) * gradients(i, c)
       end do
     end do
@@ -528,10 +693,13 @@ contains
   !> frame, dU/dt at fixed e = -phi' sum_b f_b . (k x x_b), f = K0 u, u = T^T e - e0,
   !> x = T^T e, with the strain energy U, all from one pass over the elements, and the
   !> constraint violation max |Phi| at (e, t).
-  subroutine step_powers(sys, e, v, lam, rotation, rate, t, powers, strain, violation, info)
+  subroutine step_powers(sys, e, v, lam, rotation, rate, t, state, powers, strain, violation, &
+                         contact_potential, contact_records, info)
     type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: e(:), v(:), lam(:), rotation(3, 3), rate, t
-    real(dp), intent(out) :: powers(2), strain, violation
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: powers(4), strain, violation, contact_potential
+    real(dp), intent(out) :: contact_records(:, :)
     integer, intent(out) :: info
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: frame_coords(24), local(24), frame_force(24), k(3), x(3)
@@ -542,7 +710,13 @@ contains
     violation = 0.0_dp
     if (sys%ncon > 0) violation = maxval(abs(phi))
     powers(1) = dot_product(lam, gradient_dot(sys, gradients, v))
-    powers(2) = 0.0_dp
+    powers(2:4) = 0.0_dp
+    contact_potential = 0.0_dp
+    if (sys%ncontact > 0) then
+      call contact_force(sys, e, v, 0.0_dp, state, frame_force_global, contact_records, &
+                         contact_potential, powers(3:4), info)
+      if (info /= 0) return
+    end if
     if (sys%formulation /= formulation_ffr) then
       call elastic_force(sys, rotation, e, frame_force_global, strain, info)
       return
@@ -568,16 +742,19 @@ contains
   end subroutine step_powers
 
   !> One output row: probes, deflections in the frame, energies.
-  subroutine record(sys, e, v, rotation, work, strain, probe, deflection, energy)
+  subroutine record(sys, e, v, t, rotation, work, strain, contact_potential, probe, deflection, &
+                    energy)
     type(mechanical_system), intent(in) :: sys
-    real(dp), intent(in) :: e(:), v(:), rotation(3, 3), work(2), strain
+    real(dp), intent(in) :: e(:), v(:), t, rotation(3, 3), work(4), strain, contact_potential
     real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:)
-    real(dp) :: mv(sys%ndof)
-    integer :: p, a, m
+    real(dp) :: mv(sys%ndof), e_full(sys%nfull), factor
+    integer :: p, a, m, info
+    call to_full(sys, e, .true., e_full)
     do p = 1, sys%nprobe
       probe(:, p) = 0.0_dp
       do a = 0, size(sys%probe_shape, 1) - 1
-        probe(:, p) = probe(:, p) + sys%probe_shape(a + 1, p) * e(sys%probe_dofs(3 * a + 1:3 * a + 3, p))
+        probe(:, p) = probe(:, p) + sys%probe_shape(a + 1, p) &
+                      * e_full(sys%probe_dofs(3 * a + 1:3 * a + 3, p))
       end do
       deflection(:, p) = matmul(transpose(rotation), probe(:, p)) - sys%probe_reference(:, p)
     end do
@@ -585,14 +762,32 @@ contains
     energy(energy_kinetic) = 0.5_dp * dot_product(v, mv)
     energy(energy_strain) = strain
     energy(energy_loads) = -dot_product(sys%constant_force, e)
+    if (sys%force_drive > 0) then
+      factor = load_factor(sys, t, info)
+      energy(energy_loads) = energy(energy_loads) - factor * dot_product(sys%drive_force, e)
+    end if
     energy(energy_moment) = 0.0_dp
     do m = 1, sys%nmoment
       energy(energy_moment) = energy(energy_moment) - sys%moment_magnitude(m) * &
         moment_angle(e(sys%moment_dofs(:, m)), sys%moment_axis(:, m), sys%moment_reference(:, m))
     end do
-    energy(energy_total) = sum(energy(energy_kinetic:energy_moment))
+    energy(energy_contact) = contact_potential
+    energy(energy_total) = sum(energy(energy_kinetic:energy_moment)) + contact_potential
     energy(work_drive) = work(1)
     energy(work_frame) = work(2)
+    energy(work_damping) = work(3)
+    energy(work_friction) = work(4)
   end subroutine record
+
+  !> phi(t) of the time-dependent load (info = 5 when its drive fails).
+  function load_factor(sys, t, info) result(factor)
+    type(mechanical_system), intent(in) :: sys
+    real(dp), intent(in) :: t
+    integer, intent(out) :: info
+    real(dp) :: factor, rate, second
+    call drive_eval(sys%drive_kinds(sys%force_drive), sys%drive_params(:, sys%force_drive), t, &
+                    factor, rate, second, info)
+    if (info /= 0) info = 5
+  end function load_factor
 
 end module time_integrator

@@ -35,7 +35,13 @@ from .errors import SolverError
 from .kernel import DirectSolver, _f
 from .model import BeamModel
 
-ENERGY_NAMES = ("kinetic", "strain", "gravity", "moment", "total", "drive_work", "frame_work")
+ENERGY_NAMES = ("kinetic", "strain", "gravity", "moment", "total", "drive_work", "frame_work",
+                "contact", "damping_work", "friction_work")
+#: what a contact record (per point and step) holds
+CONTACT_FIELDS = ("penetration", "normal_force", "friction_force", "slip_speed", "xi", "eta")
+CONTACT_COUNTERS = ("contact_points", "contact_active", "friction_evaluations",
+                    "contact_projection_iterations", "contact_projection_fallbacks",
+                    "contact_jacobian_dropped")
 
 _FAILURES = {
     1: "Newton did not converge within {max_newton} iterations",
@@ -47,6 +53,8 @@ _FAILURES = {
     6: "a bending moment's section director became parallel to its axis",
     7: "a plate element's mid-surface normal vanished (r_x parallel to r_y: the element "
        "folded onto a line)",
+    8: "the contact search found no closest point on the upper leaf (the projection "
+       "diverged even from the sampled restart)",
 }
 
 
@@ -96,10 +104,11 @@ class Chunk:
     probes: np.ndarray        # (nt, nprobe, 3)
     deflections: np.ndarray   # (nt, nprobe, 3)
     lam: np.ndarray           # (nt, ncon)
-    energy: np.ndarray        # (nt, 7): ENERGY_NAMES
+    energy: np.ndarray        # (nt, 10): ENERGY_NAMES
     constraint: np.ndarray    # (nt,) max |Phi|
     newton: np.ndarray        # (nt,) Newton corrections per step
     q: np.ndarray | None      # (nt, ndof) when stored
+    contact: np.ndarray | None = None  # (nt, npoints, 6): CONTACT_FIELDS
 
 
 @dataclass
@@ -151,10 +160,16 @@ class TimeIntegrator:
         self.nonlinear = model.formulation != "ffr"  # refactorized every step
         table = model.constraints.dof_table()
         used = table[table >= 0]
-        self.block_first = np.unique(used - used % 3)
-        self.solver = DirectSolver(model.ndof, model.pattern.rows, model.pattern.col_index,
-                                   banded_spd=True,
-                                   what="iteration matrix beta' M + K (banded Cholesky)")
+        # blocks of 3 consecutive unknowns holding every constrained one (the kernel takes
+        # the first block that holds a dof; the last block is kept inside the vector)
+        self.block_first = np.unique(np.minimum(used - used % 3, model.ndof - 3))
+        if getattr(model, "solver_kind", "banded") == "banded":
+            self.solver = DirectSolver(model.ndof, model.pattern.rows, model.pattern.col_index,
+                                       banded_spd=True,
+                                       what="iteration matrix beta' M + K (banded Cholesky)")
+        else:  # coupled bodies and friction: unsymmetric, not banded (sequential MUMPS)
+            self.solver = DirectSolver(model.ndof, model.pattern.rows, model.pattern.col_index,
+                                       what="iteration matrix beta' M + K (MUMPS)")
         self.setup_solves = 0
         self.flexibility = np.zeros((model.ndof, 3 * len(self.block_first)))
         self.flexibility_cc = np.zeros((3 * len(self.block_first),) * 2)
@@ -196,6 +211,7 @@ class TimeIntegrator:
             plate_curvature0=np.zeros((3, 1, 1), order="F"),
             plate_weights=np.zeros((1, 1), order="F"), thickness=0.0)
         arrays.update(model.stepper_arrays())
+        arrays.update(extension_arrays(model, arrays["dofs"].shape[1]))
         arrays.update(
             mass_row_ptr=_f(csr.indptr + 1, np.int32),
             mass_col=_f(csr.indices + 1, np.int32), mass_values=_f(csr.data),
@@ -209,7 +225,8 @@ class TimeIntegrator:
             ncon=len(model.constraints),
             con_ints=pad(_f(ints, np.int32)), con_reals=pad(_f(reals)), drive_kinds=_f(kinds, np.int32),
             drive_params=_f(params),
-            scatter_map=model.pattern.scatter_map, mass_pattern=_f(self.mass_pattern),
+            scatter_map=arrays.get("scatter_map", getattr(model.pattern, "scatter_map", None)),
+            mass_pattern=_f(self.mass_pattern),
             solver_handle=self.solver.handle, nblock=len(self.block_first),
             block_first=pad(_f(self.block_first + 1, np.int32)),
             flexibility=_f(self.flexibility) if len(self.block_first)
@@ -234,18 +251,22 @@ class TimeIntegrator:
             length_scale=m.length_scale, max_newton=s.max_newton,
             t=state["t"], e=_f(state["e"]), v=_f(state["v"]), a=_f(state["a"]),
             accel=_f(state["accel"]),
-            lam=_f(state["lam"]) if len(state["lam"]) else np.zeros(1), work=_f(state["work"]))
-        (t, e, v, a, accel, lam, work, o_time, o_probe, o_defl, o_lam, o_energy, o_con,
-         o_newton, o_q, status, self.last_correction) = out
+            lam=_f(state["lam"]) if len(state["lam"]) else np.zeros(1), work=_f(state["work"]),
+            contact_guess=_f(state["contact_guess"]),
+            contact_counts=_f(state["contact_counts"], np.int32))
+        (t, e, v, a, accel, lam, work, guess, counts, o_time, o_probe, o_defl, o_lam, o_energy,
+         o_con, o_newton, o_contact, o_q, status, self.last_correction) = out
         state.update(t=float(t), e=e, v=v, a=a, accel=accel, lam=lam[:len(m.constraints)],
-                     work=work)
+                     work=work, contact_guess=guess, contact_counts=counts)
         done, info, detail, refactorizations = (int(x) for x in status)
         self.refactorizations += refactorizations
         chunk = Chunk(time=o_time[:done], probes=np.transpose(o_probe[:, :, :done], (2, 1, 0)),
                       deflections=np.transpose(o_defl[:, :, :done], (2, 1, 0)),
                       lam=o_lam[:len(m.constraints), :done].T, energy=o_energy[:, :done].T,
                       constraint=o_con[:done], newton=o_newton[:done],
-                      q=o_q[:, :done].T if s.store_q else None)
+                      q=o_q[:, :done].T if s.store_q else None,
+                      contact=np.transpose(o_contact[:, :, :done], (2, 1, 0))
+                      if getattr(m, "contact", None) is not None else None)
         return chunk, info, detail
 
     def failure_message(self, info: int, detail: int, t: float) -> str:
@@ -259,6 +280,44 @@ class TimeIntegrator:
         return f"time step from t = {t:.6g} s to t = {t + s.dt:.6g} s failed: {reason}"
 
 
+def extension_arrays(model, nel: int) -> dict:
+    """The stepper's arguments for linear-constraint elimination, a time-dependent load and
+    leaf contact; neutral values for models without them."""
+    f = np.asfortranarray
+    reduction = getattr(model, "reduction", None)
+    full = reduction.full_pattern if reduction is not None else model.pattern
+    out = dict(nfull=full.n, full_row_ptr=f(full.row_ptr + 1, dtype=np.int32),
+               full_col=f(full.col_index + 1, dtype=np.int32), reduced=0,
+               reduction_ptr=np.ones(full.n + 1, dtype=np.int32), reduction_col=np.ones(1, np.int32),
+               reduction_values=np.zeros(1), reduction_offset=np.zeros(full.n),
+               plan_source=np.ones(1, np.int32), plan_target=np.ones(1, np.int32),
+               plan_coef=np.zeros(1), nnz_b=0, nplan=0, force_drive=0, drive_force=np.zeros(model.ndof),
+               element_size=np.ones((2, nel), order="F"), ncontact=0,
+               contact_grid=np.ones((1, 1), dtype=np.int32, order="F"),
+               contact_element=np.ones(1, np.int32), contact_local=np.zeros((2, 1), order="F"),
+               contact_params=np.zeros(8))
+    if reduction is not None:
+        b = reduction.matrix
+        out.update(reduced=1, reduction_ptr=f(b.indptr + 1, dtype=np.int32),
+                   reduction_col=f(b.indices + 1, dtype=np.int32), reduction_values=f(b.data),
+                   reduction_offset=f(reduction.offset), plan_source=f(reduction.plan_source + 1,
+                                                                        dtype=np.int32),
+                   plan_target=f(reduction.plan_target + 1, dtype=np.int32),
+                   plan_coef=f(reduction.plan_coef), nnz_b=len(b.data),
+                   nplan=len(reduction.plan_coef))
+    if getattr(model, "force_drive", None) is not None:
+        out.update(force_drive=model.force_drive_index + 1, drive_force=f(model.drive_force))
+    contact = getattr(model, "contact", None)
+    if hasattr(model, "element_sizes"):
+        out.update(element_size=f(model.element_sizes()))
+    if contact is not None:
+        out.update(ncontact=len(contact.point_element),
+                   contact_grid=f(contact.grid + 1, dtype=np.int32),
+                   contact_element=f(contact.point_element + 1, dtype=np.int32),
+                   contact_local=f(contact.point_local), contact_params=f(contact.params))
+    return out
+
+
 def initial_row(model: BeamModel, state: dict, mass: sp.spmatrix) -> Chunk:
     """The output row of the initial state, with the kernel's energy definitions."""
     e, v, t = state["e"], state["v"], state["t"]
@@ -270,15 +329,22 @@ def initial_row(model: BeamModel, state: dict, mass: sp.spmatrix) -> Chunk:
                   for m in model.moments)
     kinetic = 0.5 * v @ (mass @ v)
     loads = -model.constant_force() @ e
-    energy = np.array([kinetic, strain, loads, moment, kinetic + strain + loads + moment,
-                       state["work"][0], state["work"][1]])
+    contact_energy, records = 0.0, None
+    if getattr(model, "contact", None) is not None:
+        _, records, contact_energy, _ = model.contact_forces(e, v)
+    if getattr(model, "force_drive", None) is not None:
+        loads -= model.load_factor(t) * (model.drive_force @ e)
+    energy = np.array([kinetic, strain, loads, moment,
+                       kinetic + strain + loads + moment + contact_energy,
+                       *state["work"][:2], contact_energy, *state["work"][2:]])
     values, *_ = model.constraints.evaluate(e, t)
     names = list(model.probes)
     return Chunk(time=np.array([t]), probes=np.array([[positions[n] for n in names]]),
                  deflections=np.array([[deflections[n] for n in names]]),
                  lam=state["lam"][None, :], energy=energy[None, :],
                  constraint=np.array([np.abs(values).max(initial=0.0)]),
-                 newton=np.array([0]), q=e[None, :].copy())
+                 newton=np.array([0]), q=e[None, :].copy(),
+                 contact=None if records is None else records.T[None, :, :])
 
 
 def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
@@ -296,8 +362,12 @@ def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
     integrator = TimeIntegrator(model, settings)
     try:
         a0, lam0 = initial_acceleration(model, e0, v0, t0)
+        contact = getattr(model, "contact", None)
         state = dict(t=t0, e=e0.copy(), v=v0.copy(), a=a0.copy(), accel=a0, lam=lam0,
-                     work=np.zeros(2))
+                     work=np.zeros(4),
+                     contact_guess=contact.guesses.copy() if contact is not None
+                     else np.zeros((2, 1)),
+                     contact_counts=np.zeros(6, dtype=np.int32))
         timing["setup"] = time.perf_counter() - start
         t0_out = time.perf_counter()
         if sink:
@@ -336,6 +406,10 @@ def integrate(model: BeamModel, settings: DynamicSettings, e0: np.ndarray,
             model.counters["solves"] += newton + integrator.setup_solves
             if integrator.nonlinear:  # FFR counted its single factorization at set-up
                 model.counters["factorizations"] += integrator.refactorizations
+            if getattr(model, "contact", None) is not None:
+                for name, count in zip(CONTACT_COUNTERS, state["contact_counts"]):
+                    model.counters[name] += int(count)
+                model.contact.guesses = state["contact_guess"].copy()
     finally:
         integrator.close()
     wall = time.perf_counter() - start

@@ -263,3 +263,74 @@ class DirectSolver:
             self.close()
         except Exception:
             pass
+
+
+# -- rigid bodies and leaf contact (seed 003, eqs. 17-32) ---------------------------------
+def reference_node_mass(mass: float, centre, inertia) -> np.ndarray:
+    """12 x 12 mass matrix of an ANCF reference node (eq. 32), coordinates [r, r_x, r_y, r_z]."""
+    matrix, info = _kernel.reference_node_mass(mass, _f(centre), _f(inertia))
+    if info == 1:
+        raise InputError(f"rigid body mass {mass} must be positive")
+    if info == 2:
+        raise InputError("rigid body inertia tensor is not symmetric or not physical (its "
+                         "principal moments violate the triangle inequality)")
+    return matrix
+
+
+#: contact_params layout of fortran/src/leaf_contact.f90
+CONTACT_PARAMS = ("stiffness", "damping", "friction", "slip_velocity", "upper_thickness",
+                  "lower_thickness", "friction_on")
+
+
+def contact_params(stiffness: float, damping: float, friction: float, slip_velocity: float,
+                   upper_thickness: float, lower_thickness: float, friction_on: bool) -> np.ndarray:
+    return np.array([stiffness, damping, friction, slip_velocity, upper_thickness,
+                     lower_thickness, 1.0 if friction_on else 0.0, 0.0])
+
+
+def contact_pair(upper, upper_rates, a_u, b_u, xi_q, eta_q, lower, lower_rates, a_l, b_l, xi_p,
+                 eta_p, params, velocity_factor: float = 0.0) -> dict:
+    """One contact pair: element coordinates (3, 12) and rates; forces on the upper and lower
+    element, Jacobian of minus the forces (72 x 72), record (penetration, F_n, |F_t|, slip),
+    penalty potential and powers (damping, friction)."""
+    (fu, fl, jac, record, potential, powers, active, info) = _kernel.contact_pair(
+        _f(upper), _f(upper_rates), a_u, b_u, xi_q, eta_q, _f(lower), _f(lower_rates), a_l, b_l,
+        xi_p, eta_p, _f(params), velocity_factor)
+    if info:
+        raise SolverError("contact pair: a mid-surface normal vanished")
+    return dict(force_upper=fu, force_lower=fl, jacobian=jac, record=record,
+                potential=float(potential), powers=powers, active=bool(active))
+
+
+def contact_projection(e, dofs, sizes, grid, point, guess) -> tuple[np.ndarray, int, int]:
+    """Closest point (leaf-level coordinates) of the upper mid-surface grid to ``point``;
+    returns it with the Newton iterations and fallback sweeps used."""
+    guess, counts, info = _kernel.contact_projection(
+        _f(e), _f(np.asarray(dofs) + 1, np.int32), _f(sizes), _f(np.asarray(grid) + 1, np.int32),
+        _f(point), _f(guess))
+    if info:
+        raise SolverError("contact search: no closest point found")
+    return guess, int(counts[0]), int(counts[1])
+
+
+def contact_evaluate(e, rates, dofs, sizes, grid, point_element, point_local, params, guesses,
+                     counts, velocity_factor: float = 0.0, pattern: "SparsePattern | None" = None):
+    """All contact points (see leaf_contact%contact_assemble): force (full), records
+    (6, npoints), potential, powers, updated guesses and counters, and the Jacobian's CSR
+    values on ``pattern`` when given."""
+    n = len(e)
+    if pattern is None:
+        row_ptr, col, want = np.ones(n + 1, np.int32), np.ones(1, np.int32), 0
+    else:
+        row_ptr, col, want = pattern.row_ptr + 1, pattern.col_index + 1, 1
+    (guesses, counts, force, records, potential, powers, values, info) = _kernel.contact_evaluate(
+        _f(e), _f(rates), _f(np.asarray(dofs) + 1, np.int32), _f(sizes),
+        _f(np.asarray(grid) + 1, np.int32), _f(np.asarray(point_element) + 1, np.int32),
+        _f(point_local), _f(params), velocity_factor, want, _f(row_ptr, np.int32),
+        _f(col, np.int32), _f(guesses), _f(counts, np.int32))
+    if info == 8:
+        raise SolverError("contact search: no closest point found on the upper leaf")
+    if info:
+        raise SolverError("contact: a mid-surface normal vanished")
+    return dict(force=force, records=records, potential=float(potential), powers=powers,
+                guesses=guesses, counts=counts, values=values if pattern is not None else None)

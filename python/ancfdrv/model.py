@@ -422,9 +422,10 @@ def check_ffr_validity(model: BeamModel, scene: Scene) -> None:
 
 def build_model(scene: Scene):
     """The model the scene describes."""
+    from .leaf_spring import build_spring
     from .plate import build_leaf, build_plate
     builders = {"boom": build_boom, "cantilever": build_cantilever, "spinup": build_spinup,
-                "plate": build_plate, "leaf": build_leaf}
+                "plate": build_plate, "leaf": build_leaf, "spring": build_spring}
     model = builders[scene.kind](scene)
     check_ffr_validity(model, scene)
     return model

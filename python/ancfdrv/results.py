@@ -139,8 +139,12 @@ class DynamicWriter:
     every completed chunk is on disk whatever happens next (SPEC section 4)."""
 
     def __init__(self, path: Path, model: BeamModel, store_q: bool) -> None:
-        from .dynamic import ENERGY_NAMES
+        from .dynamic import CONTACT_FIELDS, ENERGY_NAMES
         self.path, self.names, self.store_q = path, list(model.probes), store_q
+        self.node_positions = getattr(model, "node_positions", None)
+        contact = getattr(model, "contact", None)
+        self.npoints = 0 if contact is None else len(contact.point_element)
+        self.contact_fields = CONTACT_FIELDS
         mesh = getattr(model, "mesh", None)
         self.nnodes = mesh.nnodes if mesh is not None and store_q else 0
         self.energy_names = ENERGY_NAMES
@@ -170,6 +174,10 @@ class DynamicWriter:
             series("energy/balance")
             series("constraint_violation")
             series("newton_iterations")
+            if self.npoints:  # per contact point: penetration, forces, slip, projection
+                for name in CONTACT_FIELDS:
+                    series(f"contact/{name}", (self.npoints,))
+                group["contact"].attrs["points"] = "\n".join(contact.names)
             if store_q:
                 series("q", (ndof,))
             if self.nnodes:  # plate models: node positions per step, for ParaView (XDMF)
@@ -194,13 +202,19 @@ class DynamicWriter:
             for k, name in enumerate(self.energy_names):
                 append(f"energy/{name}", chunk.energy[:, k])
             total0 = group["energy/total"][0] if self.rows else chunk.energy[0, 4]
+            # total - total(0) - work of drives, moving frame, contact damping and friction
             append("energy/balance", chunk.energy[:, 4] - total0 - chunk.energy[:, 5]
-                   - chunk.energy[:, 6])
+                   - chunk.energy[:, 6] - chunk.energy[:, 8] - chunk.energy[:, 9])
+            if self.npoints and chunk.contact is not None:
+                for k, name in enumerate(self.contact_fields):
+                    append(f"contact/{name}", chunk.contact[:, :, k])
             append("constraint_violation", chunk.constraint)
             append("newton_iterations", chunk.newton)
             if self.store_q and chunk.q is not None:
                 append("q", chunk.q)
-                if self.nnodes:
+                if self.nnodes and self.node_positions is not None:
+                    append("mesh_nodes", self.node_positions(chunk.q))
+                elif self.nnodes:
                     append("mesh_nodes", chunk.q.reshape(n, self.nnodes, -1)[:, :, :3])
             self.rows += n
             group.attrs["rows"] = self.rows

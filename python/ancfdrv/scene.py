@@ -21,9 +21,9 @@ REQUIRED = object()
 
 #: Effects a scene may list in ``&scene effects``; what is not listed is never computed.
 EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
-                     "pressure", "prestress")
+                     "pressure", "prestress", "contact", "friction", "load_cycle")
 #: Effects of later capabilities, recognised so the message can say so.
-EFFECTS_PLANNED = ("contact", "friction", "damping")
+EFFECTS_PLANNED = ("damping",)
 
 
 @dataclass(frozen=True)
@@ -116,9 +116,14 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "clamped"),
     },
     "leaf": {
-        "arc_length": Key("float", check=positive, doc="mid-surface arc length (m)"),
-        "radius": Key("float", check=positive, doc="mid-surface radius of the initial "
-                      "(assembled) shape (m); concave up, symmetric about r1 = 0"),
+        "arc_length": Key("float", None, positive, "mid-surface arc length (m); required "
+                          "in &leaf scenes (in &spring scenes the leaves' lengths are in &spring)"),
+        "radius": Key("float", None, positive, "mid-surface radius of the initial "
+                      "(assembled) shape (m); concave up, symmetric about r1 = 0; required in "
+                      "&leaf scenes"),
+        "prestress": Key("bool", False, doc="&spring scenes: the lower leaf's stress-free "
+                         "radius is free_radius (needs the effect 'prestress'); off: it is "
+                         "stress-free as assembled"),
         "free_radius": Key("float", None, positive, "radius of the stress-free shape (m); "
                            "differs from radius only with the effect 'prestress' "
                            "(default: radius)"),
@@ -134,6 +139,38 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "support": Key("str", "middle_clamp", one_of("middle_clamp", "free"),
                        "'middle_clamp': r and r_x of the middle node line fixed (the "
                        "axle's U-bolts, seed 003); 'free': unsupported"),
+    },
+    "spring": {
+        "main_arc_length": Key("float", 1.2, positive, "main (upper) leaf arc length (m)"),
+        "main_radius": Key("float", 2.0, positive, "main leaf mid-surface radius (m)"),
+        "main_nx": Key("int", 12, lambda v: None if v >= 2 and v % 2 == 0 else
+                       "must be even (the middle of the leaf is a node line)",
+                       "main leaf elements along the arc"),
+        "lower_arc_length": Key("float", 0.8, positive, "lower leaf arc length (m)"),
+        "lower_radius": Key("float", None, positive, "lower leaf mid-surface radius as "
+                            "assembled (m); default main_radius + thickness (concentric, "
+                            "touching)"),
+        "lower_nx": Key("int", 8, lambda v: None if v >= 2 and v % 2 == 0 else
+                        "must be even (the middle of the leaf is a node line)",
+                        "lower leaf elements along the arc"),
+        "chassis_mass": Key("float", 500.0, positive, "chassis mass (kg)"),
+        "chassis_inertia": Key("float", 50.0, positive, "chassis inertia about r2 (kg m^2)"),
+        "shackle_length": Key("float", 0.1, positive, "shackle length, eye to chassis (m)"),
+        "shackle_mass": Key("float", 2.0, positive, "shackle mass (kg)"),
+        "guide": Key("str", "planar", one_of("planar", "vertical"),
+                     "'planar': chassis free in the r1-r3 plane; 'vertical': only its "
+                     "vertical translation is free (load cycle)"),
+        "contact_stiffness": Key("float", 1.0e6, positive, "penalty stiffness K (N/m)"),
+        "contact_damping": Key("float", 1.0e4, non_negative,
+                               "contact damping C in F_n = K d - C d' d"),
+        "friction_coefficient": Key("float", 0.3, non_negative, "Coulomb coefficient mu"),
+        "slip_velocity": Key("float", 0.08, positive, "critical slip velocity V_t (m/s)"),
+        "contact_points": Key("int", 3, lambda v: None if v >= 2 else "must be at least 2",
+                              "contact points per end edge of the lower leaf"),
+        "cycle_force": Key("float", 0.0, non_negative, "effect 'load_cycle': peak downward "
+                           "force on the chassis (N)"),
+        "cycle_period": Key("float", 4.0, positive, "effect 'load_cycle': duration of the "
+                            "cycle 0 -> peak -> 0 (s)"),
     },
     "loads": {
         "gravity": Key("float", 9.81, non_negative, "gravitational acceleration (m/s^2)"),
@@ -176,9 +213,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
 }
 
 #: Groups that define what is built; a scene has exactly one of them.
-MODEL_GROUPS = ("boom", "cantilever", "spinup", "plate", "leaf")
+MODEL_GROUPS = ("boom", "cantilever", "spinup", "plate", "leaf", "spring")
 #: Models built from thin plate elements (seed 003); the others are beams (seed 000).
-PLATE_KINDS = ("plate", "leaf")
+PLATE_KINDS = ("plate", "leaf", "spring")
 COMMON_GROUPS = ("scene", "material", "loads", "solver", "output")
 
 
@@ -194,6 +231,8 @@ class Scene:
     @property
     def kind(self) -> str:
         """The model the scene builds: one of MODEL_GROUPS."""
+        if "spring" in self.values:  # its &leaf group describes the leaf pack
+            return "spring"
         return next(g for g in MODEL_GROUPS if g in self.values)
 
     @property
@@ -326,6 +365,8 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
         values[group] = typed
 
     models = [g for g in MODEL_GROUPS if g in values]
+    if "spring" in models and "leaf" in models:  # &leaf: the spring's leaf pack
+        models.remove("leaf")
     if len(models) != 1:
         raise InputError(f"a scene needs exactly one of the groups "
                          f"{', '.join('&' + g for g in MODEL_GROUPS)} (found "
@@ -405,6 +446,13 @@ def _check_plate(values: dict[str, dict[str, Any]], file: str, kind: str) -> Non
                          "element has no floating-frame model)", file=file, group="scene",
                          key="formulation")
     effects = scene["effects"]
+    for effect in ("contact", "friction", "load_cycle"):
+        if effect in effects and kind != "spring":
+            raise InputError(f"effect {effect!r} applies to &spring scenes", file=file,
+                             group="scene", key="effects")
+    if kind == "spring":
+        _check_spring(values, file)
+        return
     support = values[kind]["support"]
     if scene["analysis"] != "dynamic" and support in ("corner_spherical", "free"):
         raise InputError(f"support '{support}' leaves rigid-body motions free: it has no "
@@ -419,6 +467,13 @@ def _check_plate(values: dict[str, dict[str, Any]], file: str, kind: str) -> Non
                          group="scene", key="effects")
     if kind == "leaf":
         leaf = values["leaf"]
+        for key in ("arc_length", "radius"):
+            if leaf[key] is None:
+                raise InputError("required key is missing", file=file, group="leaf", key=key)
+        if leaf["prestress"]:
+            raise InputError("leaf.prestress applies to &spring scenes; a single leaf is "
+                             "prestressed by free_radius with the effect 'prestress'",
+                             file=file, group="leaf", key="prestress")
         if leaf["free_radius"] is None:
             leaf["free_radius"] = leaf["radius"]
         differs = abs(leaf["free_radius"] - leaf["radius"]) > 1e-12 * leaf["radius"]
@@ -438,3 +493,39 @@ def _check_plate(values: dict[str, dict[str, Any]], file: str, kind: str) -> Non
     elif "prestress" in effects:
         raise InputError("effect 'prestress' applies to &leaf scenes", file=file,
                          group="scene", key="effects")
+
+
+def _check_spring(values: dict[str, dict[str, Any]], file: str) -> None:
+    """The leaf spring (SPEC section 7): dynamics only, a consistent prestress and contact
+    set-up."""
+    scene, leaf, spring = values["scene"], values.get("leaf"), values["spring"]
+    effects = scene["effects"]
+    if leaf is None:
+        raise InputError("a &spring scene needs the &leaf group (width, thickness, ...)",
+                         file=file, group="leaf")
+    for key in ("width", "thickness"):
+        if leaf[key] is None:
+            raise InputError("required key is missing", file=file, group="leaf", key=key)
+    if scene["analysis"] != "dynamic":
+        raise InputError("the leaf spring runs dynamics only (use a slow 'load_cycle' for "
+                         "quasi-static loading)", file=file, group="scene", key="analysis")
+    if leaf["prestress"]:
+        if "prestress" not in effects:
+            raise InputError("leaf.prestress = .true. needs the effect 'prestress' in "
+                             "scene.effects", file=file, group="leaf", key="prestress")
+        if leaf["free_radius"] is None:
+            raise InputError("leaf.prestress needs leaf.free_radius (the lower leaf's "
+                             "stress-free radius)", file=file, group="leaf", key="free_radius")
+        if leaf["variant"] != "completed":
+            raise InputError("prestress needs variant = 'completed'", file=file, group="leaf",
+                             key="variant")
+    if "friction" in effects and "contact" not in effects:
+        raise InputError("effect 'friction' needs the effect 'contact'", file=file,
+                         group="scene", key="effects")
+    cycle = "load_cycle" in effects
+    if cycle != (spring["cycle_force"] > 0):
+        raise InputError("spring.cycle_force > 0 and the effect 'load_cycle' go together",
+                         file=file, group="spring", key="cycle_force")
+    if spring["lower_arc_length"] >= spring["main_arc_length"]:
+        raise InputError("the lower leaf must be shorter than the main leaf", file=file,
+                         group="spring", key="lower_arc_length")
