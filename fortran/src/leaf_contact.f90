@@ -376,6 +376,10 @@ contains
         info = 8
         return
       end if
+      records(:, c) = 0.0_dp
+      records(5:6, c) = guesses(:, c)
+      ! a point beyond the upper leaf's ends has no closest point inside it: no contact
+      if (guesses(1, c) <= 0.0_dp .or. guesses(1, c) >= real(size(grid, 1), dp)) cycle
       call locate(grid, guesses(1, c), guesses(2, c), upper, xi_q, eta_q)
       call contact_point(reshape(e(dofs(:, upper)), [3, 12]), reshape(rates(dofs(:, upper)), &
                          [3, 12]), sizes(1, upper), sizes(2, upper), xi_q, eta_q, &

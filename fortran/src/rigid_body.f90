@@ -55,8 +55,9 @@ contains
     compact(1, 2:4) = mass * centre
     compact(2:4, 1) = mass * centre
     do a = 1, 3
-      do b = 1, 3
+      do b = a, 3  ! one triangle, mirrored: exactly symmetric
         compact(1 + a, 1 + b) = mass * centre(a) * centre(b) + spread_about_centre(a, b)
+        compact(1 + b, 1 + a) = compact(1 + a, 1 + b)
       end do
     end do
     do a = 1, 4

@@ -338,6 +338,8 @@ class AssemblyModel:
             mass = mass + sp.csr_matrix((block.ravel(), (rows.ravel(), cols.ravel())),
                                         shape=(self.nfull, self.nfull))
         self.mass_full = mass.tocsr()
+        for body in self.bodies:  # every body's reference point is a probe
+            self.probes.setdefault(body.name, BodyProbe(body))
         self._mass = (red.matrix.T @ self.mass_full @ red.matrix).tocsr()
         # orthonormality (eq. 30) as dot constraints on independent coordinates
         column = -np.ones(self.nfull, dtype=int)
