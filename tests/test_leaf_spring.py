@@ -376,3 +376,26 @@ def test_spring_without_prestress_conserves_energy_balance(spring_runs):
     scale = 500 * 9.81 * abs(off["z"].min())
     assert np.abs(off["energy"]["balance"]).max() < 1e-5 * scale
     assert off["penetration"].max() < 0.2 * 0.014
+
+
+def test_load_cycle_loop_area_equals_friction_and_damping_work(tmp_path):
+    """inputs/leaf_spring_cycle.nml (shortened to a 2 s cycle): the work of the applied force
+    around the loop equals the work dissipated by friction and contact damping plus the
+    change of mechanical energy (energy identity, counted after the prestress has been
+    released in the first 0.15 s, when the force is still below 3 % of its peak)."""
+    out = tmp_path / "cycle.h5"
+    run_scene(INPUTS / "leaf_spring_cycle.nml", ["solver.t_end=2.0", "spring.cycle_period=2.0"],
+              out, progress=False)
+    with h5py.File(out) as h5:
+        t = h5["dynamic/time"][()]
+        z = h5["dynamic/deflection/chassis"][:, 2]
+        energy = {k: h5[f"dynamic/energy/{k}"][()] for k in h5["dynamic/energy"]}
+    start = np.searchsorted(t, 0.15)
+    force = 9810.0 * 0.5 * (1 - np.cos(2 * np.pi * t / 2.0))   # downward, on the chassis
+    work = -np.trapezoid(force[start:], z[start:])  # work of the force along its motion
+    mechanical = energy["kinetic"] + energy["strain"] + energy["contact"]
+    dissipated = -(energy["friction_work"][-1] + energy["damping_work"][-1]
+                   - energy["friction_work"][start] - energy["damping_work"][start])
+    stored = mechanical[-1] - mechanical[start]
+    assert dissipated > 0 and work > 0
+    assert abs(work - (dissipated + stored)) < 0.05 * dissipated

@@ -299,10 +299,13 @@ class AssemblyModel:
         self._orthonormal_pairs = getattr(self, "_orthonormal_pairs", []) + [(body, pairs)]
 
     def guide_vertically(self, body: RigidBody) -> None:
-        """Only the vertical translation r3 stays free (load-cycle guide)."""
+        """Load-cycle guide: the body translates in the r1-r3 plane without turning. Its
+        horizontal drift stays free: with the axle and the front eye both held along r1 the
+        front half-leaf could not flatten without stretching (a far stiffer, different
+        spring)."""
         for part in range(4):
             for comp in range(3):
-                if not (part == 0 and comp == 2):
+                if not (part == 0 and comp in (0, 2)):
                     self.fix(body.dof(part, comp), f"{body.name}: vertical guide")
         self._orthonormal_pairs = [(b, p) for b, p in getattr(self, "_orthonormal_pairs", [])
                                    if b is not body]

@@ -158,8 +158,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "shackle_length": Key("float", 0.1, positive, "shackle length, eye to chassis (m)"),
         "shackle_mass": Key("float", 2.0, positive, "shackle mass (kg)"),
         "guide": Key("str", "planar", one_of("planar", "vertical"),
-                     "'planar': chassis free in the r1-r3 plane; 'vertical': only its "
-                     "vertical translation is free (load cycle)"),
+                     "'planar': chassis free in the r1-r3 plane; 'vertical': it translates "
+                     "without turning (load cycle; its horizontal drift stays free, as the "
+                     "axle and the front eye are both held along r1)"),
         "contact_stiffness": Key("float", 1.0e6, positive, "penalty stiffness K (N/m)"),
         "contact_damping": Key("float", 1.0e4, non_negative,
                                "contact damping C in F_n = K d - C d' d"),
