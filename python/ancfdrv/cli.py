@@ -3,7 +3,7 @@
     ancf run SCENE.nml [-o OUT.h5] [--set GROUP.KEY=VALUE ...]
     ancf sweep SCENE.nml --vary GROUP.KEY=V1,V2,... [--vary ...] [-o DIR] [--workers N | --scheduler ADDR]
     ancf info OUT.h5
-    ancf plot OUT.h5 [-o PNG]
+    ancf plot OUT.h5 [OUT2.h5 ...] [-o PNG]   (several files: leaf spring runs overlaid)
 
 Exit status: 0 success, 2 bad input, 3 solver failure (the output file already holds
 what was computed, with the failure message in its ``message`` attribute).
@@ -111,14 +111,16 @@ def _cmd_info(args: argparse.Namespace) -> int:
 
 
 def _cmd_plot(args: argparse.Namespace) -> int:
-    from .plots import plot_result
-    path = Path(args.file)
-    if not path.is_file():
-        raise InputError("result file not found", file=str(path))
+    from .plots import plot_result, plot_results
+    paths = [Path(f) for f in args.file]
+    for path in paths:
+        if not path.is_file():
+            raise InputError("result file not found", file=str(path))
     try:
-        png = plot_result(path, args.output)
+        png = plot_result(paths[0], args.output) if len(paths) == 1 else \
+            plot_results(paths, args.output)
     except (ValueError, KeyError, OSError) as exc:
-        raise InputError(str(exc), file=str(path)) from None
+        raise InputError(str(exc), file=", ".join(map(str, paths))) from None
     print(f"written {png}")
     return 0
 
@@ -144,9 +146,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("info", help="summarize a result file")
     p.add_argument("file")
     p.set_defaults(func=_cmd_info)
-    p = sub.add_parser("plot", help="plot a result file")
-    p.add_argument("file")
-    p.add_argument("-o", "--output", help="PNG file (default: beside the HDF5)")
+    p = sub.add_parser("plot", help="plot a result file (several: leaf spring runs overlaid)")
+    p.add_argument("file", nargs="+", help="HDF5 result file; several only for leaf spring "
+                   "runs (kind 'spring'), e.g. prestress on and off")
+    p.add_argument("-o", "--output", help="PNG file (default: beside the (first) HDF5, "
+                   "<first>_compare.png for several)")
     p.set_defaults(func=_cmd_plot)
     return parser
 

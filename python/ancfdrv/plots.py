@@ -1,7 +1,9 @@
-"""Plots people would rather look at than read: a run's deflection line, and a sweep's
+"""Plots people would rather look at than read: a run's deflection line, the leaf spring's
+histories and load-cycle loop (several runs overlaid), and a sweep's
 result-against-parameter curves and error-against-wall-time (Pareto) chart."""
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -25,9 +27,281 @@ def plot_result(h5_path: str | Path, png: str | Path | None = None) -> Path:
     with h5py.File(h5_path, "r") as h5:
         dynamic = "dynamic" in h5 and len(h5["dynamic/time"]) > 1
         plate = "nodes" in h5["model"]
+        kind = _text(h5.attrs.get("kind", ""))
+    if kind == "spring":
+        return plot_spring([h5_path], png)
     if plate:
         return plot_plate_dynamic(h5_path, png) if dynamic else plot_plate_static(h5_path, png)
     return plot_dynamic(h5_path, png) if dynamic else plot_static(h5_path, png)
+
+
+def plot_results(h5_paths: list[str | Path], png: str | Path | None = None) -> Path:
+    """One file: :func:`plot_result`. Several files: leaf spring runs (root attribute kind
+    'spring') overlaid in one figure (:func:`plot_spring`); other kinds plot one file at a
+    time."""
+    paths = [Path(p) for p in h5_paths]
+    if not paths:
+        raise ValueError("no result file to plot")
+    if len(paths) == 1:
+        return plot_result(paths[0], png)
+    kinds = {}
+    for path in paths:
+        with h5py.File(path, "r") as h5:
+            kinds[path] = _text(h5.attrs.get("kind", ""))
+    others = [f"{p.name} ({k or 'unknown'})" for p, k in kinds.items() if k != "spring"]
+    if others:
+        raise ValueError("several result files are plotted together only for leaf spring runs "
+                         f"(kind 'spring'); not: {', '.join(others)}")
+    return plot_spring(paths, png)
+
+
+@dataclass
+class SpringRun:
+    """What the leaf spring plots read from one result file."""
+
+    path: Path
+    title: str
+    status: str
+    effects: tuple[str, ...]
+    values: dict[str, dict]  # the scene's groups with the file's overrides applied
+    time: np.ndarray
+    chassis: np.ndarray        # vertical displacement of the chassis reference point (m)
+    chassis_z: np.ndarray      # its vertical position (m)
+    energy: dict[str, np.ndarray]
+    contact: dict[str, np.ndarray]  # CONTACT_FIELDS -> (nt, npoints); empty without contact
+    points: list[str]
+
+    @property
+    def prestress(self) -> bool:
+        return bool(self.values.get("leaf", {}).get("prestress", False))
+
+    @property
+    def label(self) -> str:
+        leaf = self.values.get("leaf", {})
+        if self.prestress:
+            return f"prestress on (free R {leaf.get('free_radius', float('nan')):g} m)"
+        return "prestress off"
+
+    @property
+    def cycle(self) -> bool:
+        return "load_cycle" in self.effects
+
+    def cycle_force(self) -> np.ndarray:
+        """Downward force on the chassis, F(t) = F_c (1 - cos(2 pi t / T)) / 2 for
+        0 < t < T, else 0 (drive kind 3 of fortran/src/drives.f90): the file does not record
+        it, so F_c and T come from the scene's spring.cycle_force and spring.cycle_period."""
+        spring = self.values["spring"]
+        amplitude, period = float(spring["cycle_force"]), float(spring["cycle_period"])
+        t = self.time
+        inside = (t > 0.0) & (t < period)
+        return np.where(inside, 0.5 * amplitude * (1.0 - np.cos(2.0 * np.pi * t / period)), 0.0)
+
+
+def scene_values(h5: h5py.File) -> dict[str, dict]:
+    """The scene a result file was run with (root attributes 'scene' and 'overrides'),
+    validated with the schema's defaults filled in."""
+    import tempfile
+
+    from .scene import load_scene
+    text = _text(h5.attrs.get("scene", ""))
+    overrides = [o for o in _text(h5.attrs.get("overrides", "")).splitlines() if o.strip()]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "scene.nml"
+        path.write_text(text)
+        return load_scene(path, overrides).values
+
+
+def read_spring(h5_path: str | Path) -> SpringRun:
+    """The histories of a leaf spring result file (at least two output rows)."""
+    h5_path = Path(h5_path)
+    with h5py.File(h5_path, "r") as h5:
+        if _text(h5.attrs.get("kind", "")) != "spring":
+            raise ValueError(f"{h5_path}: not a leaf spring result (kind "
+                             f"{_text(h5.attrs.get('kind', ''))!r})")
+        if "dynamic" not in h5 or len(h5["dynamic/time"]) < 2:
+            raise ValueError(f"{h5_path}: no dynamic steps to plot (status: "
+                             f"{_text(h5.attrs.get('status', ''))})")
+        dyn = h5["dynamic"]
+        contact, points = {}, []
+        if "contact" in dyn:
+            contact = {k: dyn[f"contact/{k}"][()] for k in dyn["contact"]}
+            points = _text(dyn["contact"].attrs.get("points", "")).splitlines()
+        probe = _text(h5.attrs.get("response_probe", "chassis"))
+        return SpringRun(
+            path=h5_path, title=_text(h5.attrs["title"]), status=_text(h5.attrs["status"]),
+            effects=tuple(e for e in _text(h5.attrs.get("effects", "")).split(",") if e),
+            values=scene_values(h5), time=dyn["time"][()],
+            chassis=dyn[f"deflection/{probe}"][:, 2], chassis_z=dyn[f"probes/{probe}"][:, 2],
+            energy={k: dyn[f"energy/{k}"][()] for k in dyn["energy"]}, contact=contact,
+            points=points)
+
+
+def load_cycle_summary(run: SpringRun, threshold: float = 0.03) -> dict[str, float | np.ndarray]:
+    """Force against downward chassis deflection over a 'load_cycle' run and its energies:
+
+    * ``area``: the loop's enclosed area, the trapezoid rule of F d(delta) around the closed
+      loop (the last point joined to the first), delta = -(vertical displacement); it is the
+      work of the applied force, positive when the spring dissipates;
+    * ``dissipated``: -(friction work + contact damping work) from /dynamic/energy, end minus
+      start (both works are negative);
+    * ``mechanical_change``: change of kinetic + strain + contact (+ gravity) energy, the
+      recorded total without the load cycle's potential F(t) z_chassis;
+    * ``residual``: area - dissipated - mechanical_change (zero when the books balance);
+    * the same from ``t_from``, the first output time at which F reaches ``threshold`` of its
+      peak (``work_from``, ``dissipated_from``, ``mechanical_change_from``,
+      ``residual_from``): a prestressed pack is released at t = 0 and the impact of the
+      leaves dominates the first steps' works."""
+    force = run.cycle_force()
+    delta = -run.chassis
+    loop_f, loop_d = np.append(force, force[0]), np.append(delta, delta[0])
+    area = float(np.sum(0.5 * (loop_f[1:] + loop_f[:-1]) * np.diff(loop_d)))
+    e = run.energy
+    work = e["friction_work"] + e["damping_work"]
+    mechanical = e["total"] - force * run.chassis_z
+    dissipated = float(-(work[-1] - work[0]))
+    change = float(mechanical[-1] - mechanical[0])
+    k = int(np.argmax(force >= threshold * force.max())) if force.max() > 0 else 0
+    work_from = float(np.sum(0.5 * (force[k + 1:] + force[k:-1]) * np.diff(delta[k:])))
+    dissipated_from = float(-(work[-1] - work[k]))
+    change_from = float(mechanical[-1] - mechanical[k])
+    return {"force": force, "deflection": delta, "area": area, "dissipated": dissipated,
+            "friction_work": float(e["friction_work"][-1] - e["friction_work"][0]),
+            "damping_work": float(e["damping_work"][-1] - e["damping_work"][0]),
+            "mechanical_change": change, "residual": area - dissipated - change,
+            "t_from": float(run.time[k]), "work_from": work_from,
+            "dissipated_from": dissipated_from, "mechanical_change_from": change_from,
+            "residual_from": work_from - dissipated_from - change_from,
+            "peak_force": float(force.max()), "peak_deflection": float(delta.max())}
+
+
+LINESTYLES = ("-", "--", ":", "-.")
+
+
+def plot_spring(h5_paths: list[str | Path], png: str | Path | None = None) -> Path:
+    """Leaf spring runs, one or several overlaid (e.g. prestress on and off): the chassis's
+    vertical displacement, each contact point's normal force and penetration, the energy
+    books and, for runs with the effect 'load_cycle', the force-deflection loop with its
+    enclosed area and the friction + damping work."""
+    runs = [read_spring(p) for p in h5_paths]
+    first = runs[0].path
+    png = Path(png) if png else (first.with_suffix(".png") if len(runs) == 1 else
+                                 first.with_name(f"{first.stem}_compare.png"))
+    labels = [r.label for r in runs]
+    if len(set(labels)) < len(labels):  # same prestress: tell the files apart
+        labels = [f"{lab} [{r.path.stem}]" for lab, r in zip(labels, runs)]
+    colours = [f"C{i % 10}" for i in range(len(runs))]
+    with_contact = any(r.contact for r in runs)
+    cycles = [r for r in runs if r.cycle]
+    rows = 4 if with_contact else 2
+    fig = plt.figure(figsize=(14.5 if cycles else 9, 2.4 * rows + 1.0), constrained_layout=True)
+    grid = fig.add_gridspec(rows, 2 if cycles else 1, width_ratios=[1.25, 1] if cycles else None)
+    axes = [fig.add_subplot(grid[0, 0])]
+    axes += [fig.add_subplot(grid[i, 0], sharex=axes[0]) for i in range(1, rows)]
+    ax = axes[0]
+    for run, label, colour in zip(runs, labels, colours):
+        ax.plot(run.time, 1e3 * run.chassis, color=colour, lw=0.9, label=label)
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_ylabel("chassis vertical\ndisplacement (mm)")
+    ax.legend(fontsize=8)
+    heading = runs[0].title if len({r.title for r in runs}) == 1 else "leaf spring runs"
+    status = ", ".join(sorted({r.status for r in runs}))
+    ax.set_title(f"{heading} ({status})", fontsize=9)
+    if with_contact:
+        _contact_panels(axes[1], axes[2], runs, labels)
+    _energy_panel(axes[-1], runs, labels, colours)
+    axes[-1].set_xlabel("time (s)")
+    for a in axes[:-1]:
+        a.tick_params(labelbottom=False)
+    if cycles:  # the loop above, its figures (legend) in the bottom row
+        loop = fig.add_subplot(grid[:rows - 1, 1])
+        _loop_panel(loop, runs, labels, colours)
+        notes = fig.add_subplot(grid[rows - 1, 1])
+        notes.axis("off")
+        notes.legend(*loop.get_legend_handles_labels(), fontsize=7, loc="upper left",
+                     frameon=False)
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+    return png
+
+
+def _contact_panels(ax_force, ax_pen, runs: list[SpringRun], labels: list[str]) -> None:
+    """Normal force and penetration of every contact point: colour per point (greens on the
+    front edge, purples on the rear edge), line style per file."""
+    from matplotlib.lines import Line2D
+    handles = []
+    for k, (run, label) in enumerate(zip(runs, labels)):
+        if not run.contact:
+            continue
+        style = LINESTYLES[k % len(LINESTYLES)]
+        names = run.points or [f"point {i}" for i in range(run.contact["normal_force"].shape[1])]
+        front = [i for i, n in enumerate(names) if n.startswith("front")]
+        rear = [i for i in range(len(names)) if i not in front]
+        colour = {}
+        for ids, cmap in ((front, plt.cm.Greens), (rear, plt.cm.Purples)):
+            for j, i in enumerate(ids):
+                colour[i] = cmap(0.45 + 0.5 * j / max(len(ids) - 1, 1))
+        for i, name in enumerate(names):
+            show = k == 0 and (len(names) <= 8 or i in (front[:1] + rear[:1]))
+            text = name if len(names) <= 8 else (
+                f"{name.split(',')[0]} ({len(front) if i in front else len(rear)} points)")
+            ax_force.plot(run.time, run.contact["normal_force"][:, i], style, color=colour[i],
+                          lw=0.8, label=text if show else None)
+            ax_pen.plot(run.time, 1e3 * run.contact["penetration"][:, i], style,
+                        color=colour[i], lw=0.8)
+        handles.append(Line2D([], [], color="0.3", ls=style, label=label))
+    ax_force.set_ylabel("contact normal\nforce (N)")
+    ax_force.legend(fontsize=7, ncol=2, loc="upper right")
+    ax_pen.set_ylabel("penetration (mm)")
+    if len(runs) > 1:
+        ax_pen.legend(handles=handles, fontsize=7, loc="upper right")
+
+
+def _energy_panel(ax, runs: list[SpringRun], labels: list[str], colours: list[str]) -> None:
+    """Per file: mechanical energy change (kinetic + strain + contact + gravity), the work
+    of friction and contact damping, and the balance (recorded total - total(0) minus the
+    works; it also holds the work of a load cycle's force, whose potential is not kept)."""
+    for run, colour in zip(runs, colours):
+        e = run.energy
+        mechanical = e["total"] - (run.cycle_force() * run.chassis_z if run.cycle else 0.0)
+        ax.plot(run.time, mechanical - mechanical[0], color=colour, lw=0.9)
+        ax.plot(run.time, e["friction_work"] + e["damping_work"], "--", color=colour, lw=0.9)
+        if not run.cycle:
+            ax.plot(run.time, e["balance"], ":", color=colour, lw=0.9)
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], color="0.3", ls="-", label="E_mech - E_mech(0)"),
+               Line2D([], [], color="0.3", ls="--", label="friction + damping work")]
+    if any(not r.cycle for r in runs):
+        handles.append(Line2D([], [], color="0.3", ls=":", label="balance"))
+    ax.legend(handles=handles, fontsize=7, ncol=3, loc="lower left")
+    ax.set_ylabel("energy (J)")
+
+
+def _loop_panel(ax, runs: list[SpringRun], labels: list[str], colours: list[str]) -> None:
+    """Force against downward deflection of the load-cycle runs: loading (t < T/2) solid,
+    unloading dashed; area and works per run in the line labels."""
+    for run, label, colour in zip(runs, labels, colours):
+        if not run.cycle:
+            continue
+        s = load_cycle_summary(run)
+        half = run.time <= 0.5 * float(run.values["spring"]["cycle_period"])
+        text = (f"{label}\nloop area {s['area']:.4g} J; friction + damping "
+                f"{s['dissipated']:.4g} J (friction {-s['friction_work']:.4g} J, damping "
+                f"{-s['damping_work']:.4g} J);\nE_mech change {s['mechanical_change']:.3g} J, "
+                f"unbalanced {s['residual']:.3g} J\nfrom t = {s['t_from']:.3g} s (F > 3 % of "
+                f"peak): work of F {s['work_from']:.4g} J, friction + damping "
+                f"{s['dissipated_from']:.4g} J,\nE_mech change "
+                f"{s['mechanical_change_from']:.3g} J, unbalanced {s['residual_from']:.2g} J")
+        ax.plot(1e3 * s["deflection"][half], 1e-3 * s["force"][half], color=colour, lw=0.8,
+                label=text)
+        ax.plot(1e3 * s["deflection"][~half], 1e-3 * s["force"][~half], "--", color=colour,
+                lw=0.8)
+    ax.axvline(0.0, color="0.6", lw=0.6)
+    ax.set_xlabel("chassis deflection, downward (mm)")
+    ax.set_ylabel("force on the chassis, downward (kN)")
+    ax.set_title("load cycle: F = F_c (1 - cos(2 pi t / T)) / 2 (from spring.cycle_force, "
+                 "cycle_period);\nloading solid, unloading dashed; area = closed-loop "
+                 "trapezoid of F d(delta)", fontsize=8)
+    ax.grid(alpha=0.3)
 
 
 def plot_plate_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
@@ -278,6 +552,11 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
         plt.close(fig)
         out.append(path)
     return out
+
+
+def _text(value) -> str:
+    """An HDF5 string attribute as str (h5py returns bytes for some)."""
+    return value.decode() if isinstance(value, bytes) else str(value)
 
 
 def _require_static(h5: h5py.File, h5_path: Path) -> None:
