@@ -223,7 +223,7 @@ def test_pushed_plate_sticks_below_mu_n_and_slides_above(ratio):
     upper plate. Below mu m g the slip speed settles below the critical V_t at the creep
     speed of f(s) = P/(mu m g); above it the plate accelerates at (P - mu m g)/m."""
     mu, v_t = 0.3, 0.01
-    probe_model, weight = _plate_on_plate()
+    _, weight = _plate_on_plate()
     push = ratio * mu * weight
     model, weight = _plate_on_plate(k=1e6, c=1e3, mu=mu, v_t=v_t, push=push, friction=True)
     rows = Rows()
@@ -244,7 +244,6 @@ def test_pushed_plate_sticks_below_mu_n_and_slides_above(ratio):
         accel = 2 * np.polyfit(t[late], x[late], 2)[0]
         mass = weight / 9.81
         assert abs(accel - (push - mu * weight) / mass) < 0.02 * (push - mu * weight) / mass
-    del probe_model
 
 
 def test_projection_crosses_element_boundaries():

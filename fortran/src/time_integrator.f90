@@ -166,10 +166,6 @@ contains
     real(dp), intent(out) :: y(:)
     integer :: b, i
     ! written out: a generic matmul call per 3-vector cost a tenth of a step
-    if (mod(size(x), 3) /= 0) then  ! reduced coordinates (large deformation: A = I)
-      y = x
-      return
-    end if
     if (transpose_first) then
       do b = 0, size(x) / 3 - 1
         do i = 1, 3
@@ -186,6 +182,20 @@ contains
       end do
     end if
   end subroutine rotate_all
+
+  !> rotate_all for FFR (S lives in the floating frame); a copy for large deformation, whose
+  !> S lives in the global frame (and whose reduced vectors need not hold whole 3-vectors).
+  pure subroutine to_solver_frame(sys, rotation, x, transpose_first, y)
+    type(mechanical_system), intent(in) :: sys
+    real(dp), intent(in) :: rotation(3, 3), x(:)
+    logical, intent(in) :: transpose_first
+    real(dp), intent(out) :: y(:)
+    if (sys%formulation == formulation_ffr) then
+      call rotate_all(rotation, x, transpose_first, y)
+    else
+      y = x
+    end if
+  end subroutine to_solver_frame
 
   !> Constraint values and gradients at (e, t) (velocities only feed terms not used here).
   !> info = 5 when a constraint or drive cannot be evaluated.
@@ -350,7 +360,8 @@ contains
 
   !> Large deformation: factorize S = beta' M + K_t(e) on the solver's pattern and compute
   !> the flexibility S^{-1} E_c and E_c^T S^{-1} E_c for the Schur complement; the elastic
-  !> force and strain energy at e come out of the same element pass.
+  !> force and strain energy at e come out of the same element pass, and force returns the
+  !> elastic minus the contact force at (e, v) (the contact Jacobian's evaluation).
   subroutine refactorize(sys, beta_prime, velocity_factor, e, v, state, flexibility, &
                          flexibility_cc, force, strain, info, detail)
     type(mechanical_system), intent(in) :: sys
@@ -361,7 +372,7 @@ contains
     real(dp) :: tangents(sys%element_dofs, sys%element_dofs, sys%nel)
     real(dp) :: element_force(sys%element_dofs, sys%nel), element_energy(sys%nel)
     real(dp) :: values(size(sys%mass_pattern)), values_full(size(sys%full_col))
-    real(dp) :: e_full(sys%nfull), force_full(sys%nfull), unused_force(sys%ndof)
+    real(dp) :: e_full(sys%nfull), force_full(sys%nfull), contact(sys%ndof)
     real(dp) :: records(contact_record, sys%ncontact), potential, powers(2)
     integer :: b, j, k
     detail = 0
@@ -374,9 +385,10 @@ contains
     call pattern_assemble(size(values_full), sys%element_dofs, sys%nel, sys%scatter_map, &
                           tangents, values_full)
     if (sys%ncontact > 0) then
-      call contact_force(sys, e, v, velocity_factor, state, unused_force, records, potential, &
+      call contact_force(sys, e, v, velocity_factor, state, contact, records, potential, &
                          powers, info, values_full)
       if (info /= 0) return
+      force = force - contact
     end if
     if (sys%reduced) then  ! B^T S B by the plan
       values = 0.0_dp
@@ -417,33 +429,34 @@ contains
   !> Residual r = M q'' + Q_el(q) - Q(q) - Phi_q^T lambda at time t, with the constraint
   !> values and gradients and the strain energy.
   subroutine residual(sys, t, e, v, acceleration, lam, rotation, state, r, phi, gradients, &
-                      strain, info, known_elastic)
+                      strain, info, known_internal)
     type(mechanical_system), intent(in) :: sys
     real(dp), intent(in) :: t, e(:), v(:), acceleration(:), lam(:), rotation(3, 3)
     type(contact_state), intent(inout) :: state
-    real(dp), intent(inout) :: strain  ! out; in with known_elastic
+    real(dp), intent(inout) :: strain  ! out; in with known_internal
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :)
     integer, intent(out) :: info
-    real(dp), intent(in), optional :: known_elastic(:)  ! elastic force at e, already computed
+    ! elastic minus contact force at (e, v), already computed (by refactorize)
+    real(dp), intent(in), optional :: known_internal(:)
     real(dp) :: elastic(sys%ndof), inertia(sys%ndof), force(3), jacobian(3, 3), hessian(3, 3, 3)
     real(dp) :: contact(sys%ndof), records(contact_record, sys%ncontact), potential, powers(2)
     integer :: m, c, i
     info = 0
-    if (present(known_elastic)) then
-      elastic = known_elastic
+    if (present(known_internal)) then
+      elastic = known_internal
     else
       call elastic_force(sys, rotation, e, elastic, strain, info)
       if (info /= 0) return
+      if (sys%ncontact > 0) then
+        call contact_force(sys, e, v, 0.0_dp, state, contact, records, potential, powers, info)
+        if (info /= 0) return
+        elastic = elastic - contact
+      end if
     end if
     call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, acceleration, inertia)
     r = inertia + elastic - sys%constant_force
     if (sys%force_drive > 0) r = r - load_factor(sys, t, info) * sys%drive_force
     if (info /= 0) return
-    if (sys%ncontact > 0) then
-      call contact_force(sys, e, v, 0.0_dp, state, contact, records, potential, powers, info)
-      if (info /= 0) return
-      r = r - contact
-    end if
     do m = 1, sys%nmoment
       call moment_force(e(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
                         sys%moment_magnitude(m), force, jacobian, hessian, info)
@@ -567,14 +580,14 @@ contains
         if (info /= 0) return
         fresh_force = .false.
         ! z = T S^{-1} T^T r
-        call rotate_all(transform, r, .true., z(:, 1))
+        call to_solver_frame(sys, transform, r, .true., z(:, 1))
         call solver_solve(sys%solver_handle, sys%ndof, 1, z, info, detail)
         if (info /= 0) then
           detail = info
           info = 3
           return
         end if
-        call rotate_all(transform, z(:, 1), .false., direction)
+        call to_solver_frame(sys, transform, z(:, 1), .false., direction)
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
         call frame_gradients(sys, transform, gradients, w)
         schur = matmul(transpose(w), matmul(flexibility_cc, w))
@@ -586,7 +599,7 @@ contains
             detail = lapack_info
             return
           end if
-          call rotate_all(transform, matmul(flexibility, matmul(w, dlam(:, 1))), .false., &
+          call to_solver_frame(sys, transform, matmul(flexibility, matmul(w, dlam(:, 1))), .false., &
                           correction)
           correction = correction - direction
         else

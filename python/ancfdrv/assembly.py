@@ -191,13 +191,11 @@ def build_reduction(nfull: int, relations: list[LinearRelation], q_full: np.ndar
         i, j = f_rows[kk], f_cols[kk]
         ra = slice(b.indptr[i], b.indptr[i + 1])
         rc = slice(b.indptr[j], b.indptr[j + 1])
-        aa, va = np.meshgrid(b.indices[ra], b.data[ra], indexing="ij")[0], b.data[ra]
         for a_col, a_val in zip(b.indices[ra], b.data[ra]):
             for c_col, c_val in zip(b.indices[rc], b.data[rc]):
                 sources.append(np.array([kk]))
                 targets.append(pattern.positions(np.array([a_col]), np.array([c_col])))
                 coefs.append(np.array([a_val * c_val]))
-        del aa, va
     source = np.concatenate(sources)
     target = np.concatenate(targets)
     coef = np.concatenate(coefs)
@@ -331,7 +329,6 @@ class AssemblyModel:
         self.pattern = red.pattern
         self.contact = contact
         # mass: plates on their pattern, bodies as dense 12 x 12 blocks; M_ii = B^T M B
-        mass = sp.lil_matrix((self.nfull, self.nfull))
         plate_mass = plates.mass_matrix().tocoo()
         mass = sp.coo_matrix((plate_mass.data, (plate_mass.row, plate_mass.col)),
                              shape=(self.nfull, self.nfull)).tocsr()
@@ -419,15 +416,9 @@ class AssemblyModel:
     # -- output -------------------------------------------------------------------------
     def probe_positions(self, e: np.ndarray) -> dict[str, np.ndarray]:
         full = self.expand(e)
-        plate_probes = {n: p for n, p in self.probes.items() if not isinstance(p, BodyProbe)}
-        saved = self.plates.probes
-        self.plates.probes = plate_probes
-        out = self.plates.probe_positions(full[:self.nplate])
-        self.plates.probes = saved
-        for name, probe in self.probes.items():
-            if isinstance(probe, BodyProbe):
-                out[name] = full[probe.body.dof(0, 0):probe.body.dof(0, 0) + 3]
-        return {name: out[name] for name in self.probes}
+        return {name: full[probe.body.first:probe.body.first + 3] if isinstance(probe, BodyProbe)
+                else self.plates.point_position(probe, full[:self.nplate])
+                for name, probe in self.probes.items()}
 
     def deflections(self, e: np.ndarray) -> dict[str, np.ndarray]:
         initial = self.probe_positions(self.e0)

@@ -275,13 +275,14 @@ class PlateModel(DeadMomentLoads):
                                             name=f"{name or 'fixed'}: node {node} e[{dof}]")
 
     # -- output quantities --------------------------------------------------------------
+    def point_position(self, probe: PlateProbe, e: np.ndarray) -> np.ndarray:
+        """Position of a mid-surface material point at coordinates e."""
+        shape, _ = kernel.plate_shape(probe.xi, probe.eta, self.mesh.a[probe.element],
+                                      self.mesh.b[probe.element])
+        return shape @ e[self.dofs[:, probe.element]].reshape(12, 3)
+
     def probe_positions(self, e: np.ndarray) -> dict[str, np.ndarray]:
-        out = {}
-        for name, probe in self.probes.items():
-            shape, _ = kernel.plate_shape(probe.xi, probe.eta, self.mesh.a[probe.element],
-                                          self.mesh.b[probe.element])
-            out[name] = shape @ e[self.dofs[:, probe.element]].reshape(12, 3)
-        return out
+        return {name: self.point_position(probe, e) for name, probe in self.probes.items()}
 
     def deflections(self, e: np.ndarray) -> dict[str, np.ndarray]:
         """Probe displacement from the initial configuration (global components)."""
