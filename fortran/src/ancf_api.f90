@@ -103,6 +103,65 @@ subroutine beam_nonlinear_forces(ndof, nel, npts, dofs, e, gradients, weights, y
   energy = sum(element_energy)
 end subroutine beam_nonlinear_forces
 
+!> Number of strain terms per element of the structural ("cubic") beam.
+subroutine beam_structural_size(nterms)
+  use beam_structural, only: structural_terms
+  implicit none
+  integer, intent(out) :: nterms
+  nterms = structural_terms
+end subroutine beam_structural_size
+
+!> Strain forms, reference strains and stiffnesses of the structural ("cubic") beam per
+!> element, from the reference configuration. info = 10*element + code.
+subroutine beam_structural_setup(nel, nterms, reference, lengths, width, height, youngs, poisson, &
+                                 forms, strain0, stiffness, info)
+  use ancf_kinds, only: dp
+  use beam_structural, only: structural_setup
+  implicit none
+  integer, intent(in) :: nel, nterms
+  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), width, height, youngs, poisson
+  real(dp), intent(out) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
+  integer, intent(out) :: info
+  integer :: el, code
+  info = 0
+  do el = 1, nel
+    call structural_setup(reference(:, :, el), lengths(el), width, height, youngs, poisson, &
+                          forms(:, :, :, el), strain0(:, el), stiffness(:, el), code)
+    if (code /= 0) then
+      info = 10 * el + code
+      return
+    end if
+  end do
+end subroutine beam_structural_setup
+
+!> Structural ("cubic") elastic force (global), strain energy and, when want_tangent /= 0,
+!> the element tangents (24 x 24 x nel) of a beam mesh.
+subroutine beam_structural_forces(ndof, nel, nterms, dofs, e, forms, strain0, stiffness, &
+                                  want_tangent, force, energy, tangent)
+  use ancf_kinds, only: dp
+  use beam_structural, only: structural_element
+  implicit none
+  integer, intent(in) :: ndof, nel, nterms, dofs(24, nel), want_tangent
+  real(dp), intent(in) :: e(ndof), forms(8, 8, nterms, nel), strain0(nterms, nel)
+  real(dp), intent(in) :: stiffness(nterms, nel)
+  real(dp), intent(out) :: force(ndof), energy, tangent(24, 24, nel)
+  real(dp) :: element_force(24, nel), element_energy(nel)
+  integer :: el
+  force = 0.0_dp
+  tangent = 0.0_dp
+  !$omp parallel do schedule(static)
+  do el = 1, nel
+    call structural_element(reshape(e(dofs(:, el)), [3, 8]), forms(:, :, :, el), strain0(:, el), &
+                            stiffness(:, el), want_tangent /= 0, element_force(:, el), &
+                            element_energy(el), tangent(:, :, el))
+  end do
+  !$omp end parallel do
+  do el = 1, nel
+    force(dofs(:, el)) = force(dofs(:, el)) + element_force(:, el)
+  end do
+  energy = sum(element_energy)
+end subroutine beam_structural_forces
+
 !> Shape functions and their parameter derivatives at npts material points.
 subroutine beam_shape_functions(npts, xi, y, z, lengths, shape, dshape_dx, dshape_dy, dshape_dz)
   use ancf_kinds, only: dp
@@ -467,7 +526,8 @@ end subroutine direct_destroy
 !> Advances nsteps steps of the generalized-alpha method (Newmark: alpha_m = alpha_f = 0)
 !> (module time_integrator). formulation 0: ANCF-FFR beam, S factorized once by the caller
 !> behind solver_handle, with the flexibility given; 1: large-deformation beam, 2: thin
-!> plate (nde = 36), both with S refactorized per step on the pattern (scatter_map,
+!> plate (nde = 36), 3: large-deformation beam with 'cubic' bending (beam_structural), all
+!> with S refactorized per step on the pattern (scatter_map,
 !> mass_pattern) of solver_handle. Arrays a formulation does not use may be (.., 1, 1).
 !> The state (t, e, v, a, accel, lam, work) is updated in place; one output row per step.
 !> status = [steps done, info, detail, refactorizations]; last_correction = size of the last Newton
@@ -475,13 +535,14 @@ end subroutine direct_destroy
 subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nblock, nprobe, &
                               nshape, nnz_mass, nsteps, nq, npts, ngauss, nplate_pts, nplate_el, &
                               nnz_pattern, nfull, nnz_b, nplan, nnz_full, ncontact, ngrid_l, &
-                              ngrid_w, formulation, dofs, stiffness0, &
+                              ngrid_w, nterms, nstructural, formulation, dofs, stiffness0, &
                               e0_frame, mass_row_ptr, mass_col, mass_values, constant_force, &
                               moment_dofs, moment_axis, moment_magnitude, moment_reference, &
                               con_ints, con_reals, drive_kinds, drive_params, frame_drive, &
                               frame_axis, frame_base, solver_handle, block_first, flexibility, &
                               flexibility_cc, probe_dofs, probe_shape, probe_reference, youngs, &
-                              poisson, gauss_gradients, gauss_weights, plate_derivs, plate_frame, &
+                              poisson, gauss_gradients, gauss_weights, structural_forms, &
+                              structural_strain0, structural_stiffness, plate_derivs, plate_frame, &
                               plate_curvature0, plate_weights, thickness, scatter_map, mass_pattern, &
                               reduced, reduction_ptr, reduction_col, reduction_values, &
                               reduction_offset, plan_source, plan_target, plan_coef, full_row_ptr, &
@@ -499,6 +560,7 @@ subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nbl
   integer, intent(in) :: nnz_mass, nsteps, nq
   integer, intent(in) :: npts, ngauss, nplate_pts, nplate_el, nnz_pattern, formulation
   integer, intent(in) :: nfull, nnz_b, nplan, nnz_full, ncontact, ngrid_l, ngrid_w
+  integer, intent(in) :: nterms, nstructural
   integer, intent(in) :: dofs(nde, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
   real(dp), intent(in) :: stiffness0(nde, nde, nstiff), e0_frame(ndof), mass_values(nnz_mass)
   real(dp), intent(in) :: constant_force(ndof)
@@ -514,6 +576,9 @@ subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nbl
   integer, intent(in) :: probe_dofs(nde, nprobe)
   real(dp), intent(in) :: probe_shape(nshape, nprobe), probe_reference(3, nprobe)
   real(dp), intent(in) :: youngs, poisson, gauss_gradients(8, 3, npts, ngauss), gauss_weights(npts, ngauss)
+  real(dp), intent(in) :: structural_forms(8, 8, nterms, nstructural)
+  real(dp), intent(in) :: structural_strain0(nterms, nstructural)
+  real(dp), intent(in) :: structural_stiffness(nterms, nstructural)
   real(dp), intent(in) :: plate_derivs(12, 5, nplate_pts, nplate_el)
   real(dp), intent(in) :: plate_frame(2, 2, nplate_pts, nplate_el)
   real(dp), intent(in) :: plate_curvature0(3, nplate_pts, nplate_el)
@@ -581,6 +646,11 @@ subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nbl
   if (formulation == 1) then
     sys%gauss_gradients = gauss_gradients
     sys%gauss_weights = gauss_weights
+  end if
+  if (formulation == 3) then
+    sys%structural_forms = structural_forms
+    sys%structural_strain0 = structural_strain0
+    sys%structural_stiffness = structural_stiffness
   end if
   if (formulation == 2) then
     sys%plate_derivs = plate_derivs

@@ -34,6 +34,7 @@ module time_integrator
   use constraints, only: constraint_eval
   use ffr_elastic, only: ffr_force
   use beam_nonlinear, only: nonlinear_element
+  use beam_structural, only: structural_element
   use plate_element, only: plate_forces
   use section_moment, only: moment_force, moment_angle
   use sparse_pattern, only: pattern_assemble
@@ -51,7 +52,7 @@ module time_integrator
                         energy_contact = 8, work_damping = 9, work_friction = 10, &
                         energy_count = 10
   integer, parameter, public :: formulation_ffr = 0, formulation_nonlinear = 1, &
-                                formulation_plate = 2
+                                formulation_plate = 2, formulation_structural = 3
 
   !> The model, as the stepper reads it (never changed by a step).
   type :: mechanical_system
@@ -77,6 +78,9 @@ module time_integrator
     ! large deformation: Gauss data, the pattern S is assembled on, M on that pattern
     real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp
     real(dp), allocatable :: gauss_gradients(:, :, :, :), gauss_weights(:, :)
+    ! large deformation, 'cubic' bending (beam_structural): strain forms per element
+    real(dp), allocatable :: structural_forms(:, :, :, :), structural_strain0(:, :)
+    real(dp), allocatable :: structural_stiffness(:, :)
     ! thin plate (plate_element): reference data at the Gauss points, thickness
     real(dp), allocatable :: plate_derivs(:, :, :, :), plate_frame(:, :, :, :)
     real(dp), allocatable :: plate_curvature0(:, :, :), plate_weights(:, :)
@@ -303,7 +307,7 @@ contains
   end subroutine contact_force
 
   !> Forces, energies and (on request) tangents of every element of the large-deformation
-  !> formulations (beam_nonlinear, plate_element); elements in parallel (OpenMP, when built
+  !> formulations (beam_nonlinear, beam_structural, plate_element); elements in parallel (OpenMP, when built
   !> with it). info = 7: a plate element's normal vanished.
   subroutine element_pass(sys, e, want_tangent, element_force, element_energy, tangents, info)
     type(mechanical_system), intent(in) :: sys
@@ -329,6 +333,18 @@ contains
                             sys%plate_weights(:, el), sys%youngs, sys%poisson, sys%thickness, &
                             .false., element_force(:, el), element_energy(el), unused, &
                             element_info(el))
+        end if
+      else if (sys%formulation == formulation_structural) then
+        if (want_tangent) then
+          call structural_element(reshape(e(sys%dofs(:, el)), [3, 8]), &
+                                  sys%structural_forms(:, :, :, el), sys%structural_strain0(:, el), &
+                                  sys%structural_stiffness(:, el), .true., element_force(:, el), &
+                                  element_energy(el), tangents(:, :, el))
+        else
+          call structural_element(reshape(e(sys%dofs(:, el)), [3, 8]), &
+                                  sys%structural_forms(:, :, :, el), sys%structural_strain0(:, el), &
+                                  sys%structural_stiffness(:, el), .false., element_force(:, el), &
+                                  element_energy(el), unused)
         end if
       else if (want_tangent) then
         call nonlinear_element(reshape(e(sys%dofs(:, el)), [3, 8]), sys%gauss_gradients(:, :, :, el), &

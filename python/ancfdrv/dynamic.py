@@ -209,7 +209,10 @@ class TimeIntegrator:
             plate_derivs=np.zeros((12, 5, 1, 1), order="F"),
             plate_frame=np.zeros((2, 2, 1, 1), order="F"),
             plate_curvature0=np.zeros((3, 1, 1), order="F"),
-            plate_weights=np.zeros((1, 1), order="F"), thickness=0.0)
+            plate_weights=np.zeros((1, 1), order="F"), thickness=0.0,
+            structural_forms=np.zeros((8, 8, 1, 1), order="F"),
+            structural_strain0=np.zeros((1, 1), order="F"),
+            structural_stiffness=np.zeros((1, 1), order="F"))
         arrays.update(model.stepper_arrays())
         arrays.update(extension_arrays(model, arrays["dofs"].shape[1]))
         arrays.update(

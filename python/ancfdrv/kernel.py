@@ -14,7 +14,8 @@ from .errors import InputError, SolverError
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
            "constraint_evaluate", "SparsePattern", "DirectSolver", "plate_shape",
-           "plate_element_arrays", "plate_reference", "plate_forces", "PlateReference"]
+           "plate_element_arrays", "plate_reference", "plate_forces", "PlateReference",
+           "StructuralBeam"]
 
 
 def _f(a, dtype=np.float64) -> np.ndarray:
@@ -70,6 +71,27 @@ def beam_nonlinear_forces(dofs, e, gradients, weights, youngs, poisson, want_tan
     """Large-deformation elastic force, strain energy and element tangents (24, 24, nel)."""
     return _kernel.beam_nonlinear_forces(_f(dofs + 1, np.int32), _f(e), gradients, weights,
                                          youngs, poisson, int(want_tangent))
+
+
+class StructuralBeam:
+    """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
+    (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel)."""
+
+    def __init__(self, reference, lengths, width, height, youngs, poisson) -> None:
+        nterms = int(_kernel.beam_structural_size())
+        (self.forms, self.strain0, self.stiffness,
+         info) = _kernel.beam_structural_setup(nterms, _f(reference), _f(lengths), width, height,
+                                               youngs, poisson)
+        if info:
+            element, code = divmod(info, 10)
+            reason = {1: "unsupported quadrature",
+                      2: "degenerate reference geometry (r0_x vanishes)"}
+            raise InputError(f"beam element {element}: {reason.get(code, f'code {code}')}")
+
+    def forces(self, dofs, e, want_tangent: bool):
+        """Elastic force, strain energy and element tangents (24, 24, nel) at e."""
+        return _kernel.beam_structural_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
+                                              self.strain0, self.stiffness, int(want_tangent))
 
 
 PLATE_VARIANTS = {"plain": 0, "completed": 1}

@@ -101,6 +101,7 @@ class BeamModel(DeadMomentLoads):
     frame_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     frame_base: np.ndarray | None = None  # A(t) = Rot(axis, phi(t)) frame_base
     formulation: str = "ffr"      # 'ffr' (small strain in the frame) or 'nonlinear'
+    bending: str = "continuum"    # 'continuum' (the paper's element) or 'cubic' (r_xx)
     load_factor: float = 1.0      # scales every external load (load stepping)
     constraints: ConstraintSet = field(default_factory=ConstraintSet)
     moments: list[Moment] = field(default_factory=list)
@@ -128,7 +129,19 @@ class BeamModel(DeadMomentLoads):
             self.lengths, self.width, self.height, self.density, self.youngs, self.poisson,
             reference)
         self.counters["element_arrays"] += self.nel
-        if self.formulation == "nonlinear":
+        self.structural: kernel.StructuralBeam | None = None
+        if self.bending == "cubic":
+            # FFR: K0 is the structural tangent at the reference in the frame; nonlinear:
+            # the forms from the reference in the global frame (only what the scene runs)
+            frame_reference = self.formulation == "ffr"
+            self.structural = kernel.StructuralBeam(
+                (self.e0_frame if frame_reference else self.to_global(self.e0_frame))[
+                    self.dofs].reshape(3, 8, self.nel, order="F"),
+                self.lengths, self.width, self.height, self.youngs, self.poisson)
+            if frame_reference:
+                *_, self.stiffness0 = self.structural.forces(self.dofs, self.e0_frame, True)
+                self.structural = None
+        elif self.formulation == "nonlinear":
             self.gauss_gradients, self.gauss_weights = kernel.beam_nonlinear_setup(
                 self.to_global(self.e0_frame)[self.dofs].reshape(3, 8, self.nel, order="F"),
                 self.lengths, self.width, self.height)
@@ -196,9 +209,12 @@ class BeamModel(DeadMomentLoads):
             force, energy = kernel.ffr_force(self.dofs, self.stiffness0, self.frame_at(t), e,
                                              self.e0_frame)
             return force, energy, self.stiffness_values(t) if want_tangent else None
-        force, energy, tangent = kernel.beam_nonlinear_forces(
-            self.dofs, e, self.gauss_gradients, self.gauss_weights, self.youngs, self.poisson,
-            want_tangent)
+        if self.structural is not None:
+            force, energy, tangent = self.structural.forces(self.dofs, e, want_tangent)
+        else:
+            force, energy, tangent = kernel.beam_nonlinear_forces(
+                self.dofs, e, self.gauss_gradients, self.gauss_weights, self.youngs,
+                self.poisson, want_tangent)
         if want_tangent:
             self.counters["stiffness_assembly"] += 1
             return force, energy, self.pattern.assemble(tangent)
@@ -248,7 +264,7 @@ class BeamModel(DeadMomentLoads):
 
     def stepper_arrays(self) -> dict:
         """The element part of the kernel stepper's arguments (formulation 0 FFR, 1 large
-        deformation)."""
+        deformation, 3 large deformation with 'cubic' bending)."""
         shapes, references, probe_dofs = [], [], []
         for probe in self.probes.values():
             shape, *_ = kernel.beam_shape([probe.xi], [probe.y], [probe.z],
@@ -257,10 +273,18 @@ class BeamModel(DeadMomentLoads):
             dofs = self.dofs[:, probe.element]
             references.append(shape[:, 0] @ self.e0_frame[dofs].reshape(8, 3))
             probe_dofs.append(dofs + 1)
-        nonlinear = self.formulation == "nonlinear"
+        nonlinear = self.formulation == "nonlinear" and self.structural is None
+        structural = self.structural
         f = np.asfortranarray
         return dict(
-            formulation=1 if nonlinear else 0, dofs=f(self.dofs + 1, dtype=np.int32),
+            formulation=3 if structural is not None else 1 if nonlinear else 0,
+            dofs=f(self.dofs + 1, dtype=np.int32),
+            structural_forms=structural.forms if structural is not None
+            else np.zeros((8, 8, 1, 1), order="F"),
+            structural_strain0=structural.strain0 if structural is not None
+            else np.zeros((1, 1), order="F"),
+            structural_stiffness=structural.stiffness if structural is not None
+            else np.zeros((1, 1), order="F"),
             stiffness0=self.stiffness0, e0_frame=f(self.e0_frame),
             youngs=self.youngs, poisson=self.poisson,
             gauss_gradients=self.gauss_gradients if nonlinear
@@ -292,7 +316,7 @@ def _model(scene: Scene, rotation: np.ndarray, offset: np.ndarray) -> BeamModel:
                      density=material["density"], youngs=material["youngs_modulus"],
                      poisson=material["poisson_ratio"], rotation=rotation,
                      origin_offset=offset, effects=scene.effects,
-                     formulation=scene["scene"]["formulation"])
+                     formulation=scene["scene"]["formulation"], bending=beam["bending"])
 
 
 def _apply_loads(model: BeamModel, scene: Scene) -> None:

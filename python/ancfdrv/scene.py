@@ -74,6 +74,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                      doc="total nodes on the beam"),
         "segments": Key("floats", None, doc="segment lengths between fixed nodes (m); "
                         "each is split into equal elements"),
+        "bending": Key("str", "continuum", one_of("continuum", "cubic"),
+                       "'continuum': the paper's element (curvature constant per element); "
+                       "'cubic': curvature from the cubic centre line r_xx, higher accuracy "
+                       "(docs/theory.md section 12)"),
     },
     "material": {
         "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),

@@ -1,0 +1,194 @@
+!> Structural ("cubic") elastic forces of the 12-coordinate ANCF beam (kinematics of
+!> beam_element): the higher-accuracy bending option of both formulations.
+!>
+!> In the continuum element the bending strain is the section gradient's rate r_y,x . r_x,
+!> constant along an element because r_y is linear in x. Here the curvature follows the
+!> cubic centre line: with r_x, r_xx, r_y, r_z on the neutral axis,
+!>
+!>   kappa_z = - r_y,x . r_x + r_xx . r_y - mean_el(r_xx . r_y)      (and z for y)
+!>
+!> the section rotation carries the element mean of the curvature (a clamped or loaded
+!> section passes its moment on without a penalty) and r_xx its linear variation. Shear
+!> gamma_y = r_x . r_y is sampled at the nodes only, where r_x and r_y are both nodal:
+!> n + 1 tying conditions for n + 1 section rotations, so it cannot lock, and a constant
+!> shear is integrated exactly. Small strain: kappa = theta' + v'' - mean(v''), gamma =
+!> v' - theta; the element reproduces the Timoshenko beam under end loads and uniform load
+!> exactly with one element (tests/test_structural.py). Torsion 1/2 (r_y,x . r_z -
+!> r_z,x . r_y); axial Green strain (r_x . r_x - 1)/2; section strains (r_y . r_y - 1)/2,
+!> (r_z . r_z - 1)/2, r_y . r_z at the nodes.
+!>
+!> Every strain is a quadratic form of the nodal vectors q_a minus its reference value,
+!>   s = 1/2 sum_ab C_ab q_a . q_b - s0,      U = 1/2 sum_terms k s^2,
+!> so dS/dq_a = sum_b C_ab q_b, the tangent is k (g g^T + s C x I3), rigid motions leave
+!> every s unchanged, and a curved reference is strain-free by s0. Stiffnesses: EA, EI_z
+!> = E w h^3/12, EI_y = E h w^3/12, G J with J = I_y + I_z and G A (k = 1), as the continuum
+!> element with nu = 0 has, so the two options differ in the bending interpolation only.
+module beam_structural
+  use ancf_kinds, only: dp
+  use quadrature, only: gauss_legendre
+  implicit none
+  private
+  public :: structural_setup, structural_element
+
+  !> Axial points of the axial and bending strains, of the torsion.
+  integer, parameter :: n_line = 3, n_axial = 3, n_torsion = 2
+  !> Nodal terms per node: shear y, shear z, section yy, zz, yz.
+  integer, parameter :: n_nodal = 5
+  integer, parameter, public :: structural_terms = 2 * n_line + n_axial + n_torsion + 2 * n_nodal
+
+contains
+
+  !> Coefficient rows of the neutral-axis fields at xi: r_x = sum_a slope_a q_a, r_xx,
+  !> r_y, r_z and the (constant) r_y,x, r_z,x.
+  pure subroutine centreline_rows(xi, length, slope, second, dir_y, dir_z, dir_y_x, dir_z_x)
+    real(dp), intent(in) :: xi, length
+    real(dp), intent(out) :: slope(8), second(8), dir_y(8), dir_z(8), dir_y_x(8), dir_z_x(8)
+    slope = [(-6.0_dp * xi + 6.0_dp * xi**2) / length, 1.0_dp - 4.0_dp * xi + 3.0_dp * xi**2, &
+             0.0_dp, 0.0_dp, (6.0_dp * xi - 6.0_dp * xi**2) / length, 3.0_dp * xi**2 - 2.0_dp * xi, &
+             0.0_dp, 0.0_dp]
+    second = [(-6.0_dp + 12.0_dp * xi) / length**2, (-4.0_dp + 6.0_dp * xi) / length, 0.0_dp, &
+              0.0_dp, (6.0_dp - 12.0_dp * xi) / length**2, (6.0_dp * xi - 2.0_dp) / length, &
+              0.0_dp, 0.0_dp]
+    dir_y = [0.0_dp, 0.0_dp, 1.0_dp - xi, 0.0_dp, 0.0_dp, 0.0_dp, xi, 0.0_dp]
+    dir_z = [0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp - xi, 0.0_dp, 0.0_dp, 0.0_dp, xi]
+    dir_y_x = [0.0_dp, 0.0_dp, -1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp] / length
+    dir_z_x = [0.0_dp, 0.0_dp, 0.0_dp, -1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp] / length
+  end subroutine centreline_rows
+
+  !> a b^T + b a^T: the form of the dot product (sum a_i q_i) . (sum b_j q_j).
+  pure function product_form(a, b) result(form)
+    real(dp), intent(in) :: a(8), b(8)
+    real(dp) :: form(8, 8)
+    form = spread(a, 2, 8) * spread(b, 1, 8) + spread(b, 2, 8) * spread(a, 1, 8)
+  end function product_form
+
+  !> Quadratic forms C (8, 8, term), reference values s0 and stiffnesses k (material times
+  !> line element |r0_x| L dxi) of one element. info = 1: quadrature unavailable; 2: the
+  !> reference tangent r0_x vanishes somewhere.
+  pure subroutine structural_setup(reference, length, width, height, youngs, poisson, forms, &
+                                   strain0, stiffness, info)
+    real(dp), intent(in) :: reference(3, 8), length, width, height, youngs, poisson
+    real(dp), intent(out) :: forms(8, 8, structural_terms), strain0(structural_terms)
+    real(dp), intent(out) :: stiffness(structural_terms)
+    integer, intent(out) :: info
+    real(dp) :: points(n_line), weights(n_line), p2(n_torsion), w2(n_torsion)
+    real(dp) :: pa(n_axial), wa(n_axial)
+    real(dp) :: slope(8), second(8), dir_y(8), dir_z(8), dir_y_x(8), dir_z_x(8)
+    real(dp) :: mean_y(8, 8), mean_z(8, 8), area, inertia_z, inertia_y, shear, line, xi
+    integer :: i, t, node, info_torsion
+    forms = 0.0_dp
+    strain0 = 0.0_dp
+    stiffness = 0.0_dp
+    call gauss_legendre(n_line, points, weights, info)
+    call gauss_legendre(n_torsion, p2, w2, info_torsion)
+    info = max(info, info_torsion)
+    call gauss_legendre(n_axial, pa, wa, info_torsion)
+    info = max(info, info_torsion)
+    if (info /= 0) return
+    area = width * height
+    inertia_z = width * height**3 / 12.0_dp
+    inertia_y = height * width**3 / 12.0_dp
+    shear = youngs / (2.0_dp * (1.0_dp + poisson))
+    ! element means of r_xx . r_y and r_xx . r_z (quadratic in xi: 2 points are exact)
+    mean_y = 0.0_dp
+    mean_z = 0.0_dp
+    do i = 1, n_torsion
+      call centreline_rows(0.5_dp * (p2(i) + 1.0_dp), length, slope, second, dir_y, dir_z, &
+                           dir_y_x, dir_z_x)
+      mean_y = mean_y + 0.5_dp * w2(i) * product_form(second, dir_y)
+      mean_z = mean_z + 0.5_dp * w2(i) * product_form(second, dir_z)
+    end do
+    t = 0
+    do i = 1, n_line
+      xi = 0.5_dp * (points(i) + 1.0_dp)
+      call centreline_rows(xi, length, slope, second, dir_y, dir_z, dir_y_x, dir_z_x)
+      line = 0.5_dp * weights(i) * length * norm2(matmul(reference, slope))
+      forms(:, :, t + 1) = product_form(second, dir_y) - product_form(dir_y_x, slope) - mean_y
+      stiffness(t + 1) = youngs * inertia_z * line
+      forms(:, :, t + 2) = product_form(second, dir_z) - product_form(dir_z_x, slope) - mean_z
+      stiffness(t + 2) = youngs * inertia_y * line
+      t = t + 2
+    end do
+    do i = 1, n_axial
+      xi = 0.5_dp * (pa(i) + 1.0_dp)
+      call centreline_rows(xi, length, slope, second, dir_y, dir_z, dir_y_x, dir_z_x)
+      t = t + 1
+      forms(:, :, t) = spread(slope, 2, 8) * spread(slope, 1, 8)
+      stiffness(t) = youngs * area * 0.5_dp * wa(i) * length * norm2(matmul(reference, slope))
+    end do
+    do i = 1, n_torsion
+      call centreline_rows(0.5_dp * (p2(i) + 1.0_dp), length, slope, second, dir_y, dir_z, &
+                           dir_y_x, dir_z_x)
+      line = 0.5_dp * w2(i) * length * norm2(matmul(reference, slope))
+      t = t + 1
+      forms(:, :, t) = 0.5_dp * (product_form(dir_y_x, dir_z) - product_form(dir_z_x, dir_y))
+      stiffness(t) = shear * (inertia_y + inertia_z) * line
+    end do
+    do node = 0, 1
+      call centreline_rows(real(node, dp), length, slope, second, dir_y, dir_z, dir_y_x, dir_z_x)
+      line = 0.5_dp * length * norm2(matmul(reference, slope))
+      forms(:, :, t + 1) = product_form(slope, dir_y)
+      stiffness(t + 1) = shear * area * line
+      forms(:, :, t + 2) = product_form(slope, dir_z)
+      stiffness(t + 2) = shear * area * line
+      forms(:, :, t + 3) = spread(dir_y, 2, 8) * spread(dir_y, 1, 8)
+      stiffness(t + 3) = youngs * area * line
+      forms(:, :, t + 4) = spread(dir_z, 2, 8) * spread(dir_z, 1, 8)
+      stiffness(t + 4) = youngs * area * line
+      forms(:, :, t + 5) = product_form(dir_y, dir_z)
+      stiffness(t + 5) = shear * area * line
+      t = t + n_nodal
+    end do
+    if (any(stiffness(2 * n_line + 1:2 * n_line + n_axial) <= 0.0_dp) .or. &
+        minval(stiffness) < 0.0_dp) then
+      info = 2
+      return
+    end if
+    do t = 1, structural_terms
+      strain0(t) = 0.5_dp * sum(reference * matmul(reference, forms(:, :, t)))
+    end do
+  end subroutine structural_setup
+
+  !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
+  !> one element with nodal vectors q(3, 8).
+  pure subroutine structural_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
+                                     tangent)
+    real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
+    real(dp), intent(in) :: stiffness(structural_terms)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, tangent(24, 24)
+    real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
+    integer :: t, j, a, c, i
+    force = 0.0_dp
+    energy = 0.0_dp
+    tangent = 0.0_dp
+    geometric = 0.0_dp
+    do t = 1, structural_terms
+      gradient = matmul(q, forms(:, :, t))
+      strain = 0.5_dp * sum(q * gradient) - strain0(t)
+      energy = energy + 0.5_dp * stiffness(t) * strain**2
+      flat = reshape(gradient, [24])
+      force = force + stiffness(t) * strain * flat
+      if (.not. want_tangent) cycle
+      do j = 1, 24
+        scaled = stiffness(t) * flat(j)
+        tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
+      end do
+      geometric = geometric + stiffness(t) * strain * forms(:, :, t)
+    end do
+    if (.not. want_tangent) return
+    do c = 1, 8
+      do a = 1, 8
+        do i = 1, 3
+          tangent(3 * (a - 1) + i, 3 * (c - 1) + i) = tangent(3 * (a - 1) + i, 3 * (c - 1) + i) &
+                                                      + geometric(a, c)
+        end do
+      end do
+    end do
+    ! the rank-one parts filled the lower triangle; the geometric part is symmetric
+    do j = 2, 24
+      tangent(1:j - 1, j) = tangent(j, 1:j - 1)
+    end do
+  end subroutine structural_element
+
+end module beam_structural
