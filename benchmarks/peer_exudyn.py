@@ -13,7 +13,8 @@ same beam):
   transverse deflection in the rotating hub frame over 0 ... 20 s.
 
 ancfdrv runs :func:`ancfdrv.runner.run_scene` on the scene with ``--set``-style overrides
-(``beam.nodes``, ``solver.dt``, ``solver.t_end``): the scene's generalized-alpha
+(``beam.nodes``, ``solver.dt``, ``solver.t_end``, ``beam.bending``: one curve for each
+bending option, 'cubic' and 'continuum', by default): the scene's generalized-alpha
 integrator, rho_inf and Newton tolerance, HDF5 output to a temporary directory. Exudyn
 builds the same beam from ``ObjectANCFCable2D`` elements (2D Euler-Bernoulli cable, EA
 and EI from the scene's section) and integrates with its generalized-alpha solver
@@ -47,7 +48,7 @@ cable EA (lambda - 1). A third run of Exudyn at its reference resolution with th
 St. Venant-Kirchhoff axial force (Python user functions: slow, not timed against ancfdrv)
 tests this explanation.
 
-Dominance: ancfdrv's curve dominates when for every Exudyn run some ancfdrv run reaches
+Dominance (for each bending option): ancfdrv's curve dominates when for every Exudyn run some ancfdrv run reaches
 the same error or smaller in the same time or less; for each Exudyn run the table gives
 the time of the cheapest ancfdrv run at least as accurate (and vice versa). It is judged
 on ``self_error`` (each code against its own converged model) and on ``error`` (common
@@ -161,6 +162,7 @@ class Run:
     mesh: int                      # ancfdrv: nodes; Exudyn: elements
     elements: int
     dt: float
+    bending: str = ""              # ancfdrv's beam.bending ('' for Exudyn)
     ok: bool = False
     message: str = ""
     wall_s: float = math.nan       # best of the repeats
@@ -225,9 +227,9 @@ def import_ancfdrv() -> None:
     importlib.import_module("ancfdrv.runner")
 
 
-def ancfdrv_overrides(problem: Problem, nodes: int, dt: float) -> list[str]:
+def ancfdrv_overrides(problem: Problem, nodes: int, dt: float, bending: str) -> list[str]:
     return [*problem.overrides, f"beam.nodes={nodes}", f"solver.dt={dt!r}",
-            f"solver.t_end={problem.t_end!r}"]
+            f"solver.t_end={problem.t_end!r}", f"beam.bending={bending}"]
 
 
 def tip_history(problem: Problem, path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -239,18 +241,19 @@ def tip_history(problem: Problem, path: Path) -> tuple[np.ndarray, np.ndarray]:
         return t, h5["dynamic/deflection/tip"][:, 1]
 
 
-def run_ancfdrv(problem: Problem, nodes: int, dt: float, workdir: Path,
+def run_ancfdrv(problem: Problem, nodes: int, dt: float, bending: str, workdir: Path,
                 args: argparse.Namespace) -> Run:
     """One run_scene call (repeated for timing); a SolverError is recorded, not raised."""
     from ancfdrv.errors import AncfError
     from ancfdrv.runner import run_scene
 
-    run = Run("ancfdrv", nodes, nodes - 1, dt)
-    out = workdir / f"{problem.name}_{nodes}_{dt:g}.h5"
+    run = Run(f"ancfdrv/{bending}", nodes, nodes - 1, dt, bending)
+    out = workdir / f"{problem.name}_{bending}_{nodes}_{dt:g}.h5"
     scene = REPO / problem.scene
 
     def solve() -> tuple[np.ndarray, dict[str, Any]]:
-        outcome = run_scene(scene, ancfdrv_overrides(problem, nodes, dt), out, progress=False)
+        outcome = run_scene(scene, ancfdrv_overrides(problem, nodes, dt, bending), out,
+                            progress=False)
         dyn = outcome.dynamic
         assert dyn is not None
         with h5py.File(out, "r") as h5:
@@ -273,7 +276,7 @@ def run_ancfdrv(problem: Problem, nodes: int, dt: float, workdir: Path,
     return run
 
 
-_KERNEL_COSTS: dict[tuple[str, int], dict[str, float]] = {}
+_KERNEL_COSTS: dict[tuple[str, str, int], dict[str, float]] = {}
 
 
 def kernel_costs(problem: Problem, run: Run, args: argparse.Namespace) -> dict[str, float]:
@@ -281,7 +284,7 @@ def kernel_costs(problem: Problem, run: Run, args: argparse.Namespace) -> dict[s
     once per problem and mesh: element force, force + tangent, banded factorization of
     beta' M + K0 (the pattern and band of beta' M + K_t), one substitution, and the
     substitutions of the flexibility S^-1 E_c."""
-    key = (problem.name, run.mesh)
+    key = (problem.name, run.bending, run.mesh)
     if key in _KERNEL_COSTS:
         return _KERNEL_COSTS[key]
     from element_cost import time_call
@@ -293,13 +296,16 @@ def kernel_costs(problem: Problem, run: Run, args: argparse.Namespace) -> dict[s
     from ancfdrv.runner import dynamic_settings
     from ancfdrv.scene import load_scene
 
-    scene = load_scene(REPO / problem.scene, ancfdrv_overrides(problem, run.mesh, run.dt))
+    scene = load_scene(REPO / problem.scene,
+                       ancfdrv_overrides(problem, run.mesh, run.dt, run.bending))
     model = build_model(scene)
     settings: DynamicSettings = dynamic_settings(scene)
     dofs = np.asfortranarray(model.dofs + 1, dtype=np.int32)
     e = np.asfortranarray(model.e0)
 
     def forces(want_tangent: int) -> Callable[[], object]:
+        if model.structural is not None:
+            return lambda: model.structural.forces(model.dofs, e, bool(want_tangent))
         return lambda: _kernel.beam_nonlinear_forces(dofs, e, model.gauss_gradients,
                                                      model.gauss_weights, model.youngs,
                                                      model.poisson, want_tangent)
@@ -625,13 +631,16 @@ def compare_problem(problem: Problem, exu: Any, workdir: Path,
     if problem.name == "spinup":
         record["spinup_angle_vs_ancfdrv_drive_max_abs"] = check_spinup_angle(beam)
 
-    ancfdrv_runs = []
-    for nodes, dt in problem.ancfdrv_runs:
-        run = run_ancfdrv(problem, nodes, dt, workdir, args)
-        if run.ok and args.breakdown:
-            run.details["breakdown"] = ancfdrv_breakdown(problem, run, args)
-        ancfdrv_runs.append(run)
-        _progress(problem, run)
+    groups: dict[str, list[Run]] = {}
+    for bending in args.bending:
+        groups[bending] = []
+        for nodes, dt in problem.ancfdrv_runs:
+            run = run_ancfdrv(problem, nodes, dt, bending, workdir, args)
+            if run.ok and args.breakdown:
+                run.details["breakdown"] = ancfdrv_breakdown(problem, run, args)
+            groups[bending].append(run)
+            _progress(problem, run)
+    ancfdrv_runs = [run for runs in groups.values() for run in runs]
     exudyn_runs: list[Run] = []
     svk: Run | None = None
     if exu is not None:
@@ -642,18 +651,24 @@ def compare_problem(problem: Problem, exu: Any, workdir: Path,
             svk = run_exudyn(exu, problem, beam, *problem.svk_check, args, svk_axial=True)
             _progress(problem, svk)
 
-    reference = ancfdrv_runs[-1]
-    reference.reference = True
-    if not reference.ok:
-        raise RuntimeError(f"{problem.name}: ancfdrv's reference run failed: {reference.message}")
+    # the common reference: the finest run of the first bending option listed
+    for bending, runs in groups.items():
+        runs[-1].reference = True
+        if not runs[-1].ok:
+            raise RuntimeError(f"{problem.name}: ancfdrv's reference run ({bending}) failed: "
+                               f"{runs[-1].message}")
+        assign_errors(runs, runs[-1], "self_error")
+    reference = groups[args.bending[0]][-1]
     peer_reference = exudyn_runs[-1] if exudyn_runs else None
     assign_errors(ancfdrv_runs + exudyn_runs + ([svk] if svk else []), reference, "error")
-    assign_errors(ancfdrv_runs, reference, "self_error")
     references: dict[str, Any] = {
         "ancfdrv": [reference.mesh, reference.dt],
+        "ancfdrv_bending": reference.bending,
         "ancfdrv_amplitude": float(np.max(np.abs(reference.samples))),
-        "ancfdrv_closest_other_run": min((r.self_error for r in ancfdrv_runs
-                                          if r.ok and not r.reference), default=math.nan)}
+        "ancfdrv_closest_other_run": min((r.self_error for r in groups[args.bending[0]]
+                                          if r.ok and not r.reference), default=math.nan),
+        "bending_references_max_abs_difference": {
+            bending: runs[-1].error for bending, runs in groups.items()}}
     if peer_reference is not None:
         peer_reference.reference = True
         if peer_reference.ok:
@@ -679,13 +694,13 @@ def compare_problem(problem: Problem, exu: Any, workdir: Path,
                 svk, peer_reference)
     record["references"] = references
     # the references themselves are not points of the curves they define
-    ours_common = [r for r in ancfdrv_runs if not r.reference]
-    ours_self = ours_common
     peer_self = [r for r in exudyn_runs if not r.reference]
     record["dominance"] = {
-        "self_error": dominance(ours_self, peer_self, "self_error"),
-        "error": dominance(ours_common, exudyn_runs, "error"),
-    } if exudyn_runs else {}
+        bending: {"self_error": dominance([r for r in runs if not r.reference], peer_self,
+                                          "self_error"),
+                  "error": dominance([r for r in runs if not r.reference], exudyn_runs,
+                                     "error")}
+        for bending, runs in groups.items()} if exudyn_runs else {}
     record["runs"] = [r.summary() for r in ancfdrv_runs + exudyn_runs + ([svk] if svk else [])]
     record["histories"] = {f"{r.code}_{r.mesh}_{r.dt:g}": r.samples
                            for r in ancfdrv_runs + exudyn_runs + ([svk] if svk else [])
@@ -695,7 +710,7 @@ def compare_problem(problem: Problem, exu: Any, workdir: Path,
 
 def _progress(problem: Problem, run: Run) -> None:
     state = f"{run.wall_s:7.2f} s" if run.ok else "FAILED"
-    print(f"  {problem.name:>8} {run.code:>10} mesh {run.mesh:>3} dt {run.dt:<8g} {state}",
+    print(f"  {problem.name:>8} {run.code:>17} mesh {run.mesh:>3} dt {run.dt:<8g} {state}",
           file=sys.stderr, flush=True)
 
 
@@ -748,7 +763,7 @@ def print_tables(records: dict[str, dict[str, Any]], exudyn_note: str | None) ->
                          str(r["steps"]) if r["ok"] else "-",
                          f"{r['newton_iterations'] / max(r['steps'], 1):.2f}" if r["ok"] else "-",
                          _g(r["error"]), _g(r["self_error"]), extra])
-        print_table([("code", 11), ("mesh", 4), ("nel", 4), ("dt", 7), ("wall s", 8),
+        print_table([("code", 17), ("mesh", 4), ("nel", 4), ("dt", 7), ("wall s", 8),
                      ("steps", 6), ("newt/st", 7), ("error", 9), ("self err", 9),
                      ("", 1)], rows)
         print("   mesh: ancfdrv nodes, Exudyn elements; * = the code's reference; error: against "
@@ -760,10 +775,11 @@ def print_tables(records: dict[str, dict[str, Any]], exudyn_note: str | None) ->
         failed = [r for r in rec["runs"] if not r["ok"]]
         for r in failed:
             print(f"   FAILED {r['code']} mesh {r['mesh']} dt {r['dt']:g}: {r['message'][:300]}")
-        for key, dom in rec["dominance"].items():
+        for bending, key, dom in ((b, k, d) for b, doms in rec["dominance"].items()
+                                  for k, d in doms.items()):
             label = ("each code against its own reference" if key == "self_error"
                      else "both against ancfdrv's reference")
-            print(f"\n   [{key}: {label}] ancfdrv dominates: "
+            print(f"\n   [ancfdrv bending '{bending}', {key}: {label}] ancfdrv dominates: "
                   f"{'yes' if dom['ancfdrv_dominates'] else 'no'}; Exudyn dominates: "
                   f"{'yes' if dom['exudyn_dominates'] else 'no'}")
             rows = []
@@ -796,6 +812,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--no-svk-check", dest="svk_check", action="store_false",
                         help="skip Exudyn with the St. Venant-Kirchhoff axial force")
     parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
+    parser.add_argument("--bending", nargs="+", choices=("cubic", "continuum"),
+                        default=["cubic", "continuum"],
+                        help="ancfdrv's beam.bending options to run, one curve each; the "
+                             "first one's finest run is the common reference (default both)")
     parser.add_argument("--omp-threads", type=int, default=None,
                         help="OMP_NUM_THREADS for ancfdrv's kernel (default: the environment's, "
                              "else ancfdrv's own default of 1); Exudyn runs on 1 thread")
@@ -843,7 +863,7 @@ def main(argv: list[str] | None = None) -> int:
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "settings": {"quick": args.quick, "min_time_s": args.min_time,
                      "max_repeats": args.max_repeats, "breakdown": args.breakdown,
-                     "svk_check": args.svk_check,
+                     "svk_check": args.svk_check, "bending": args.bending,
                      "exudyn_relative_tol": EXUDYN_RELATIVE_TOL,
                      "exudyn_absolute_tols_tried": EXUDYN_ABSOLUTE_TOLS},
         "units": "seconds, metres",
