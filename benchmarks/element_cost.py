@@ -11,6 +11,9 @@ Python side calls (arrays prepared once in Fortran order, so no conversion is ti
   Venant-Kirchhoff law, at the Gauss rule of ``_kernel.beam_nonlinear_points()``);
 * ``nonlinear force + tangent``: the same with the element tangents (24 x 24 per element),
   ``want_tangent=1``;
+* ``cubic force`` and ``cubic force + tangent``: the same for ``beam.bending = 'cubic'``
+  (``_kernel.beam_structural_forces``: 21 strain forms per element, docs/theory.md
+  section 12);
 * ``FFR force``: the floating-frame elastic force T K0 (T^T e - e0),
   ``_kernel.ffr_elastic_force``;
 * ``FFR stiffness``: the element matrices T K0 T^T, ``_kernel.ffr_element_stiffness`` (what
@@ -72,8 +75,10 @@ LENGTH, WIDTH, HEIGHT = 10.0, 0.1, 0.1
 YOUNGS, DENSITY = 2.1e11, 7850.0
 OPENMP_RUNTIMES = ("libgomp", "libomp", "libiomp")
 #: Another engineer reinstalls ancfdrv from time to time: how long to wait before retrying.
-KERNELS = ("nonlinear_force", "nonlinear_force_tangent", "ffr_force", "ffr_stiffness")
+KERNELS = ("nonlinear_force", "nonlinear_force_tangent", "cubic_force", "cubic_force_tangent",
+           "ffr_force", "ffr_stiffness")
 LABELS = {"nonlinear_force": "(a) force", "nonlinear_force_tangent": "(b) force+tangent",
+          "cubic_force": "cubic force", "cubic_force_tangent": "cubic force+tan",
           "ffr_force": "(c) FFR force", "ffr_stiffness": "FFR K"}
 
 
@@ -166,7 +171,11 @@ def beam_arrays(kernel: Any, nel: int, poisson: float) -> dict[str, Any]:
     e[:, 3:6] = 1.01 * np.column_stack([np.cos(angle), np.sin(angle), 0.0 * s])
     e[:, 6:9] = np.column_stack([-np.sin(angle) + 0.01, np.cos(angle), 0.0 * s])
     e[:, 9:12] = [0.0, 0.0, 1.0]
-    return {"npts": int(kernel.beam_nonlinear_points()), "ndof": model.ndof,
+    cubic = BeamModel(node_s=model.node_s, width=WIDTH, height=HEIGHT, density=DENSITY,
+                      youngs=YOUNGS, poisson=poisson, rotation=np.eye(3),
+                      origin_offset=np.zeros(3), effects=(), formulation="nonlinear",
+                      bending="cubic").structural
+    return {"npts": int(kernel.beam_nonlinear_points()), "ndof": model.ndof, "cubic": cubic,
             "dofs": np.asfortranarray(model.dofs + 1, dtype=np.int32),
             "e": np.asfortranarray(e.ravel()), "e0_frame": np.asfortranarray(model.e0_frame),
             "gradients": model.gauss_gradients, "weights": model.gauss_weights,
@@ -187,6 +196,10 @@ def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
     calls: dict[str, Callable[[], Any]] = {
         "nonlinear_force": nonlinear(0),
         "nonlinear_force_tangent": nonlinear(1),
+        "cubic_force": lambda: kernel.beam_structural_forces(
+            a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 0),
+        "cubic_force_tangent": lambda: kernel.beam_structural_forces(
+            a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 1),
         "ffr_force": lambda: kernel.ffr_elastic_force(a["dofs"], a["stiffness0"], a["rotation"],
                                                       a["e"], a["e0_frame"]),
         "ffr_stiffness": lambda: kernel.ffr_element_stiffness(a["stiffness0"], a["rotation"]),

@@ -183,7 +183,7 @@ def test_pendulum_conserves_energy(tmp_path):
     with h5py.File(out) as h5:
         t, total = h5["dynamic/time"][()], h5["dynamic/energy/total"][()]
         gravity, probe = h5["dynamic/energy/gravity"][()], h5["dynamic/probes/tip"][()]
-        assert h5.attrs["status"] == "ok"
+        assert h5.attrs["status"] == "ok" and h5.attrs["bending"] == "cubic"
     drift = np.abs(total - total[0]).max() / np.abs(gravity - gravity[0]).max()
     print(f"\npendulum, cubic bending: energy drift {drift:.2e}")
     assert t[-1] == pytest.approx(1.0) and drift < 1e-3

@@ -43,6 +43,8 @@ def create(path: Path, scene: Scene, model: BeamModel) -> None:
             "response_probe": getattr(model, "response", ("tip", 1))[0],
             "response_component": getattr(model, "response", ("tip", 1))[1],
         })
+        if hasattr(model, "bending"):  # beams: 'continuum' or 'cubic' (beam.bending)
+            h5.attrs["bending"] = model.bending
         group = h5.create_group("model")
         _attrs(group.attrs, model.summary())
         mesh = getattr(model, "mesh", None)
