@@ -150,48 +150,31 @@ contains
   end subroutine structural_setup
 
   !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
-  !> one element with nodal vectors q(3, 8). Each form couples at most 6 of the 8 nodal
-  !> vectors (the nodal terms 2): the loops run over the vectors it couples.
+  !> one element with nodal vectors q(3, 8).
   pure subroutine structural_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
                                      tangent)
     real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
     real(dp), intent(in) :: stiffness(structural_terms)
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
-    real(dp) :: gradient(3, 8), strain, geometric(8, 8), scaled(3)
-    integer :: t, n, a, c, i, k, l, active(8)
+    real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
+    integer :: t, j, a, c, i
     force = 0.0_dp
     energy = 0.0_dp
     tangent = 0.0_dp
     geometric = 0.0_dp
     do t = 1, structural_terms
-      n = 0
-      do a = 1, 8
-        if (any(forms(:, a, t) /= 0.0_dp)) then
-          n = n + 1
-          active(n) = a
-        end if
-      end do
-      gradient(:, 1:n) = matmul(q(:, active(1:n)), forms(active(1:n), active(1:n), t))
-      strain = 0.5_dp * sum(q(:, active(1:n)) * gradient(:, 1:n)) - strain0(t)
+      gradient = matmul(q, forms(:, :, t))
+      strain = 0.5_dp * sum(q * gradient) - strain0(t)
       energy = energy + 0.5_dp * stiffness(t) * strain**2
-      do k = 1, n
-        a = 3 * (active(k) - 1)
-        force(a + 1:a + 3) = force(a + 1:a + 3) + stiffness(t) * strain * gradient(:, k)
-      end do
+      flat = reshape(gradient, [24])
+      force = force + stiffness(t) * strain * flat
       if (.not. want_tangent) cycle
-      do l = 1, n
-        c = 3 * (active(l) - 1)
-        do i = 1, 3
-          scaled = stiffness(t) * gradient(i, l) * [1.0_dp, 1.0_dp, 1.0_dp]
-          do k = 1, n
-            a = 3 * (active(k) - 1)
-            tangent(a + 1:a + 3, c + i) = tangent(a + 1:a + 3, c + i) + scaled * gradient(:, k)
-          end do
-        end do
+      do j = 1, 24
+        scaled = stiffness(t) * flat(j)
+        tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
       end do
-      geometric(active(1:n), active(1:n)) = geometric(active(1:n), active(1:n)) &
-                                            + stiffness(t) * strain * forms(active(1:n), active(1:n), t)
+      geometric = geometric + stiffness(t) * strain * forms(:, :, t)
     end do
     if (.not. want_tangent) return
     do c = 1, 8
@@ -201,6 +184,10 @@ contains
                                                       + geometric(a, c)
         end do
       end do
+    end do
+    ! the rank-one parts filled the lower triangle; the geometric part is symmetric
+    do j = 2, 24
+      tangent(1:j - 1, j) = tangent(j, 1:j - 1)
     end do
   end subroutine structural_element
 
