@@ -4,7 +4,7 @@ from the floor of one forward/back substitution.
 
 For every node count (3k+1) of the boom of ``inputs/boom_luffing.nml`` this prepares a run
 as :func:`ancfdrv.runner.run_scene` does for this scene (``build_model``, static start with
-``solve_split``, :class:`ancfdrv.dynamic.NewmarkIntegrator` - ``TimeIntegrator`` after the
+``solve_split``, :class:`ancfdrv.solvers.dynamic.NewmarkIntegrator` - ``TimeIntegrator`` after the
 generalized-alpha rework -, consistent initial acceleration), integrates through the
 smooth start to the beginning of the luffing stage (:func:`ancfdrv.runner.boom_stages`,
 t = 1 s) and measures there, with ``time.perf_counter``:
@@ -55,16 +55,16 @@ from typing import Any, Callable
 import numpy as np
 
 from _common import load_average, machine_info, print_table, write_report
-from ancfdrv.dynamic import DynamicSettings, initial_acceleration
+from ancfdrv.solvers.dynamic import DynamicSettings, initial_acceleration
 from ancfdrv.model import BeamModel, build_model
 from ancfdrv.runner import boom_stages, dynamic_settings, run_scene
-from ancfdrv.scene import Scene, load_scene
-from ancfdrv.static import solve_split
+from ancfdrv.io.scene import Scene, load_scene
+from ancfdrv.solvers.static import solve_split
 
 try:  # the generalized-alpha rework renames NewmarkIntegrator (same constructor, advance)
-    from ancfdrv.dynamic import TimeIntegrator as Integrator
+    from ancfdrv.solvers.dynamic import TimeIntegrator as Integrator
 except ImportError:
-    from ancfdrv.dynamic import NewmarkIntegrator as Integrator
+    from ancfdrv.solvers.dynamic import NewmarkIntegrator as Integrator
 
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "inputs" / "boom_luffing.nml"

@@ -105,7 +105,7 @@ def contact_setup(points: int) -> dict[str, Any]:
     from ancfdrv import _kernel, kernel
     from ancfdrv.model import build_model
     from ancfdrv.plate import P_R, plate_node_dofs
-    from ancfdrv.scene import load_scene
+    from ancfdrv.io.scene import load_scene
 
     scene = load_scene(SCENE, [f"spring.contact_points={points}"])
     model = build_model(scene)
@@ -217,10 +217,10 @@ def measure_contact(args: argparse.Namespace) -> dict[str, Any]:
 def run_case(name: str, t_end: float) -> dict[str, Any]:
     """One run of a case through the library; a SolverError is recorded."""
     from ancfdrv.errors import SolverError
-    from ancfdrv.dynamic import integrate
+    from ancfdrv.solvers.dynamic import integrate
     from ancfdrv.model import build_model
     from ancfdrv.runner import dynamic_settings
-    from ancfdrv.scene import load_scene
+    from ancfdrv.io.scene import load_scene
 
     scene = load_scene(SCENE, CASES[name] + [f"solver.t_end={t_end!r}"])
     t0 = time.perf_counter()

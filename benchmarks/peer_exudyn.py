@@ -290,11 +290,11 @@ def kernel_costs(problem: Problem, run: Run, args: argparse.Namespace) -> dict[s
     from element_cost import time_call
 
     from ancfdrv import _kernel
-    from ancfdrv.dynamic import DynamicSettings
+    from ancfdrv.solvers.dynamic import DynamicSettings
     from ancfdrv.kernel import DirectSolver
     from ancfdrv.model import build_model
     from ancfdrv.runner import dynamic_settings
-    from ancfdrv.scene import load_scene
+    from ancfdrv.io.scene import load_scene
 
     scene = load_scene(REPO / problem.scene,
                        ancfdrv_overrides(problem, run.mesh, run.dt, run.bending))
@@ -386,7 +386,7 @@ class Beam:
 
 
 def beam_from_scene(problem: Problem) -> Beam:
-    from ancfdrv.scene import load_scene
+    from ancfdrv.io.scene import load_scene
 
     scene = load_scene(REPO / problem.scene, list(problem.overrides))
     beam, material, solver = scene["beam"], scene["material"], scene["solver"]

@@ -299,11 +299,11 @@ def measure_elements(kernel: Any, omp: OpenMP, args: argparse.Namespace) -> dict
 def pendulum_run(n: int, variant: str, args: argparse.Namespace) -> dict[str, Any]:
     """One mesh of the pendulum, best wall time of up to ``args.pendulum_repeats`` runs,
     with the histories of the first run."""
-    from ancfdrv.dynamic import integrate
+    from ancfdrv.solvers.dynamic import integrate
     from ancfdrv.errors import SolverError
     from ancfdrv.model import build_model
     from ancfdrv.runner import dynamic_settings
-    from ancfdrv.scene import load_scene
+    from ancfdrv.io.scene import load_scene
 
     overrides = [f"plate.nx={n}", f"plate.ny={n}", f"plate.variant={variant}",
                  f"solver.dt={args.dt!r}"]

@@ -12,9 +12,9 @@ one measurement take at least ``--min-time`` seconds and number at least
 
   - the Newton saddle-point matrix [[K - dQ/de - lambda.H, -Phi_e^T], [-Phi_e, 0]] at the
     rigid configuration, assembled exactly as the first iteration of
-    :func:`ancfdrv.static.solve_newton` assembles it;
+    :func:`ancfdrv.solvers.static.solve_newton` assembles it;
   - K_RR, the stiffness without the split's dependent coordinates (what
-    :func:`ancfdrv.static.solve_split` factorizes once);
+    :func:`ancfdrv.solvers.static.solve_split` factorizes once);
   - K itself (singular: the floating-frame stiffness has six rigid-body modes; timed for
     its size only, its solution is meaningless);
 
@@ -31,7 +31,7 @@ Each static solve is first timed at ``--tol``; when it does not converge there (
 relative residual of fine meshes stagnates at a round-off floor that grows with the mesh),
 the failure is recorded and the solve is timed at ``--fallback-tol``, so a converged time
 is always reported with the tolerance it was reached at and how the solver stopped
-(``converged_by``, from the solvers' shared test :func:`ancfdrv.static.converged`:
+(``converged_by``, from the solvers' shared test :func:`ancfdrv.solvers.static.converged`:
 residual, or step at the round-off floor with the residual below sqrt(tol)).
 Process CPU time (user/system) and minor page faults of the best repeat are recorded too:
 a large system share means time spent page-faulting freshly allocated memory.
@@ -63,8 +63,8 @@ from _common import load_average, machine_info, print_table, write_report
 from ancfdrv.errors import SolverError
 from ancfdrv.kernel import DirectSolver
 from ancfdrv.model import BeamModel, build_model
-from ancfdrv.scene import load_scene
-from ancfdrv.static import StaticResult, _hessian_triplets, solve_newton, solve_split
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers.static import StaticResult, _hessian_triplets, solve_newton, solve_split
 
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "inputs" / "boom_static.nml"
@@ -173,7 +173,7 @@ class LinearSystem:
 
 def newton_saddle_system(model: BeamModel) -> LinearSystem:
     """The saddle-point system of the first Newton iteration (d = 0, lambda = 0), with the
-    same triplet pattern as :func:`ancfdrv.static.solve_newton`."""
+    same triplet pattern as :func:`ancfdrv.solvers.static.solve_newton`."""
     n, ncon = model.ndof, len(model.constraints)
     e = model.e0
     lam = np.zeros(ncon)
@@ -381,7 +381,7 @@ def _ms(seconds: float, width: int = 9) -> str:
 
 
 def _iterations(rec: dict[str, Any]) -> str:
-    """Iterations with how the solve stopped (:func:`ancfdrv.static.converged`): r
+    """Iterations with how the solve stopped (:func:`ancfdrv.solvers.static.converged`): r
     residual <= tol, s step <= tol |d| at round-off (residual up to sqrt(tol)), * only at
     the fallback tolerance."""
     if not rec["converged"]:

@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ancfdrv.analytic import boom_static_tip_deflection
+from ancfdrv.reference.analytic import boom_static_tip_deflection
 from ancfdrv.model import build_model
-from ancfdrv.scene import load_scene
-from ancfdrv.static import solve_newton, solve_split
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers.static import solve_newton, solve_split
 
 ANGLES = (0, 15, 30, 45, 60)
 MASSES = (0, 50)

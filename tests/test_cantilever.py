@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ancfdrv import analytic
+from ancfdrv.reference import analytic
 from ancfdrv.model import build_model
-from ancfdrv.scene import load_scene
-from ancfdrv.static import solve_newton, solve_split
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers.static import solve_newton, solve_split
 
 E, L, B = 2.1e11, 2.0, 0.05
 A, I, G = B * B, B**4 / 12, 2.1e11 / 2

@@ -15,14 +15,14 @@ import h5py
 import numpy as np
 import pytest
 
-from ancfdrv import analytic
+from ancfdrv.reference import analytic
 from ancfdrv.cli import main
-from ancfdrv.dynamic import DynamicSettings, integrate
+from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 from ancfdrv.history import crossing_frequency
 from ancfdrv.model import build_model
 from ancfdrv.runner import run_scene
-from ancfdrv.scene import load_scene
-from ancfdrv.static import solve_newton
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers.static import solve_newton
 
 from conftest import INPUTS
 

@@ -88,7 +88,7 @@ def test_pendulum_converges_with_mesh_and_step(tmp_path):
 
 def test_elastica_scene(tmp_path):
     """c. inputs/hard/elastica.nml (PL^2/EI = 10, 65 nodes) against the elastica."""
-    from ancfdrv import analytic
+    from ancfdrv.reference import analytic
     out = tmp_path / "el.h5"
     run_scene(INPUTS / "hard" / "elastica.nml", [], out)
     (tip,) = read(out, "static/deflection/tip")

@@ -16,7 +16,6 @@ package is older than the working tree.
 """
 from __future__ import annotations
 
-import importlib.util
 import math
 import sys
 from pathlib import Path
@@ -26,26 +25,9 @@ import pytest
 from scipy.integrate import solve_bvp
 from scipy.optimize import minimize_scalar
 
-_SOURCE = Path(__file__).resolve().parents[1] / "python" / "ancfdrv" / "leaf_reference.py"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from reference import leaf_reference as lr  # noqa: E402  (tests/reference: never imported by a run)
 
-
-def _load_reference():
-    """ancfdrv.leaf_reference if the installed copy is this working tree's file, else the
-    file itself (an installed package older than the working tree)."""
-    try:
-        import ancfdrv.leaf_reference as installed
-        if Path(installed.__file__).read_bytes() == _SOURCE.read_bytes():
-            return installed
-    except ImportError:
-        pass
-    spec = importlib.util.spec_from_file_location("leaf_reference", _SOURCE)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["leaf_reference"] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-lr = _load_reference()
 
 SPEC = lr.SPEC
 EI = lr.BEAM_EI

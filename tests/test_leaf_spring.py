@@ -9,11 +9,11 @@ from scipy.integrate import solve_ivp
 
 from ancfdrv import kernel
 from ancfdrv.assembly import AssemblyModel, ContactSet, RigidBody
-from ancfdrv.dynamic import DynamicSettings, integrate
+from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 from ancfdrv.leaf_spring import _combine, _element_grid
 from ancfdrv.plate import PlateModel, PlateProbe, rectangle_mesh
 from ancfdrv.runner import run_scene
-from ancfdrv.scene import EFFECTS_AVAILABLE
+from ancfdrv.io.scene import EFFECTS_AVAILABLE
 
 from conftest import INPUTS
 

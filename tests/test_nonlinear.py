@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from ancfdrv import analytic, kernel
+from ancfdrv import kernel
+from ancfdrv.reference import analytic
 from ancfdrv.model import BeamModel, build_model
-from ancfdrv.scene import load_scene
-from ancfdrv.static import solve_newton
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers.static import solve_newton
 
 from conftest import INPUTS
 
@@ -171,7 +172,7 @@ def test_boom_nonlinear_against_ffr(angle, low, high):
     large-deformation model sags more (P-delta), which FFR neglects. A second-order estimate
     of that amplification (beam under axial load, derived with docs/boom_closed_form.md's
     solution) gave +1.72%; measured +1.67%."""
-    from ancfdrv.static import solve_split
+    from ancfdrv.solvers.static import solve_split
     boom = INPUTS / "boom_static.nml"
     common = ["beam.nodes=28", f"boom.angle_deg={angle}"]
     ffr = build_model(load_scene(boom, common))

@@ -12,14 +12,14 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from ancfdrv import kernel
-from ancfdrv.dynamic import integrate
+from ancfdrv.solvers.dynamic import integrate
 from ancfdrv.errors import InputError
 from ancfdrv.model import build_model
 from ancfdrv.plate import (P_R, P_RX, P_RY, PlateModel, PlateProbe, arc_mesh,
                            rectangle_mesh)
 from ancfdrv.runner import dynamic_settings, run_scene
-from ancfdrv.scene import load_scene
-from ancfdrv.static import solve_newton
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers.static import solve_newton
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 A, B, H = 0.3, 0.2, 0.01
@@ -206,7 +206,7 @@ def _navier_centre_coefficient(terms: int = 199) -> float:
 
 def test_simply_supported_plate_under_pressure_converges_to_kirchhoff():
     navier = _navier_centre_coefficient()
-    from ancfdrv.analytic import navier_plate_centre_deflection
+    from ancfdrv.reference.analytic import navier_plate_centre_deflection
     assert navier_plate_centre_deflection(1.0, 1.0, 1.0, 12 * (1 - 0.09), 0.3, 1.0) == \
         pytest.approx(navier, rel=1e-12)  # D = 1
     assert navier == pytest.approx(0.00406, abs=5e-6)  # REFERENCES.md's 0.00406

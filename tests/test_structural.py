@@ -13,12 +13,13 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from ancfdrv import analytic, kernel
-from ancfdrv.analytic import boom_static_tip_deflection
+from ancfdrv import kernel
+from ancfdrv.reference import analytic
+from ancfdrv.reference.analytic import boom_static_tip_deflection
 from ancfdrv.model import BeamModel, build_model
 from ancfdrv.runner import run_scene
-from ancfdrv.scene import load_scene
-from ancfdrv.static import solve_newton
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers.static import solve_newton
 
 from conftest import INPUTS
 

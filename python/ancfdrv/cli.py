@@ -21,7 +21,7 @@ from .errors import AncfError, InputError
 
 def _cmd_run(args: argparse.Namespace) -> int:
     from .plots import plot_result
-    from .results import read_summary
+    from .io.hdf5 import read_summary
     from .runner import run_scene
     outcome = run_scene(args.scene, args.set, args.output)
     for warning in outcome.warnings:
@@ -90,7 +90,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    from .results import read_summary
+    from .io.hdf5 import read_summary
     path = Path(args.file)
     if not path.is_file():
         raise InputError("result file not found", file=str(path))

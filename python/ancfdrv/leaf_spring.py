@@ -15,7 +15,7 @@ import numpy as np
 
 from . import kernel
 from .assembly import AssemblyModel, BodyProbe, ContactSet, LinearRelation, RigidBody
-from .dynamic import CONTACT_COUNTERS
+from .solvers.dynamic import CONTACT_COUNTERS
 from .plate import (P_R, P_RX, PlateMesh, PlateModel, PlateProbe, arc_mesh, arc_point,
                     plate_node_dofs)
 

@@ -18,7 +18,7 @@ from scipy.spatial.transform import Rotation
 
 from . import kernel
 from .constraints import DRIVE_CONSTANT, DRIVE_LUFFING, DRIVE_SPINUP, ConstraintSet
-from .scene import EFFECTS_AVAILABLE, Scene
+from .io.scene import EFFECTS_AVAILABLE, Scene
 
 NODE_DOFS = 12
 #: Offsets of a node's r, r_x, r_y, r_z within its 12 coordinates.

@@ -183,7 +183,7 @@ class PlateModel(DeadMomentLoads):
     response: tuple[str, int] = ("corner", 2)
 
     def __post_init__(self) -> None:
-        from .scene import EFFECTS_AVAILABLE
+        from .io.scene import EFFECTS_AVAILABLE
         for effect in EFFECTS_AVAILABLE:
             self.counters[effect] += 0
         if self.reference is not None and self.variant != "completed":

@@ -102,7 +102,7 @@ def scene_values(h5: h5py.File) -> dict[str, dict]:
     validated with the schema's defaults filled in."""
     import tempfile
 
-    from .scene import load_scene
+    from .io.scene import load_scene
     text = _text(h5.attrs.get("scene", ""))
     overrides = [o for o in _text(h5.attrs.get("overrides", "")).splitlines() if o.strip()]
     with tempfile.TemporaryDirectory() as tmp:

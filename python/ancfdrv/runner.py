@@ -14,13 +14,13 @@ from typing import Any
 import h5py
 import numpy as np
 
-from . import results
-from .dynamic import DynamicResult, DynamicSettings, integrate
+from .io import hdf5 as results
+from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
 from .errors import AncfError
 from .history import luffing_stage_bounds, stage_summary
 from .model import BeamModel, build_model
-from .scene import PLATE_KINDS, Scene, load_scene
-from .static import StaticResult, solve_static
+from .io.scene import PLATE_KINDS, Scene, load_scene
+from .solvers.static import StaticResult, solve_static
 
 
 @dataclass

@@ -21,7 +21,7 @@ import numpy as np
 from tqdm import tqdm
 
 from .errors import AncfError, InputError
-from .scene import SCHEMA, load_scene
+from .io.scene import SCHEMA, load_scene
 
 #: Parameters that refine a model; the finest value is the reference of the others.
 RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min, "plate.nx": max, "plate.ny": max,
@@ -83,7 +83,7 @@ def run_case(scene_file: str, params: dict[str, str], base: list[str], output: s
     except AncfError as exc:
         row.update(status="failed", message=str(exc), exit_code=exc.exit_code)
         return row
-    from .results import read_summary
+    from .io.hdf5 import read_summary
     summary = read_summary(Path(output))
     row.update(status="ok", message="", exit_code=0, total_time_s=summary["timing.total"],
                ndof=summary["model.ndof"])
@@ -152,7 +152,7 @@ def add_history_errors(rows: list[dict], varied: list[str]) -> None:
 
 def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | None:
     """Relative error of the tip sag against the boom's closed form (None if not a boom)."""
-    from .analytic import boom_static_tip_deflection
+    from .reference.analytic import boom_static_tip_deflection
     params = expand({k: row[k] for k in row if "." in k})
     scene = load_scene(scene_file, base + params)
     if row.get("status") != "ok":
@@ -177,7 +177,7 @@ def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | No
 def _navier_error(scene, row: dict) -> float | None:
     """Simply supported plate under pressure alone: error of the centre deflection against
     Navier's series (REFERENCES.md: 0.00406 q a^4 / D for the square plate)."""
-    from .analytic import navier_plate_centre_deflection
+    from .reference.analytic import navier_plate_centre_deflection
     plate, material = scene["plate"], scene["material"]
     if plate["support"] != "simply_supported" or set(scene.effects) != {"pressure"}:
         return None

@@ -15,7 +15,7 @@ from typing import Any, Callable
 
 import f90nml
 
-from .errors import InputError
+from ..errors import InputError
 
 REQUIRED = object()
 

@@ -12,10 +12,10 @@ from typing import Any
 import h5py
 import numpy as np
 
-from . import __version__
-from .model import BeamModel
+from .. import __version__
+from ..model import BeamModel
 from .scene import Scene
-from .static import StaticResult
+from ..solvers.static import StaticResult
 
 
 def _attrs(target: h5py.AttributeManager, values: dict[str, Any]) -> None:
@@ -105,6 +105,7 @@ def finish(path: Path, model: BeamModel, timing: dict[str, float], status: str,
             h5["dynamic"].attrs["status"] = status
         has_motion = "dynamic/mesh_nodes" in h5
     if has_motion:
+        from .xdmf import write_xdmf
         write_xdmf(path)
 
 
@@ -141,7 +142,7 @@ class DynamicWriter:
     every completed chunk is on disk whatever happens next (SPEC section 4)."""
 
     def __init__(self, path: Path, model: BeamModel, store_q: bool) -> None:
-        from .dynamic import CONTACT_FIELDS, ENERGY_NAMES
+        from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
         self.path, self.names, self.store_q = path, list(model.probes), store_q
         self.node_positions = getattr(model, "node_positions", None)
         contact = getattr(model, "contact", None)
@@ -230,36 +231,3 @@ def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, flo
         if stages:
             stage_group = group.require_group("stages")
             _attrs(stage_group.attrs, stages)
-
-
-def write_xdmf(path: Path) -> Path:
-    """An XDMF file beside the HDF5 result of a plate model: one quadrilateral grid per
-    output step (the elements' corner nodes) with the node positions of
-    /dynamic/mesh_nodes, and the nodal displacement; opens in ParaView as a time series."""
-    with h5py.File(path, "r") as h5:
-        times = h5["dynamic/time"][()]
-        nnodes = h5["dynamic/mesh_nodes"].shape[1]
-        nel = h5["model/elements"].shape[0]
-    name = path.name
-    grids = []
-    for k, t in enumerate(times):
-        slab = (f'<DataItem ItemType="HyperSlab" Dimensions="{nnodes} 3" Type="HyperSlab">'
-                f'<DataItem Dimensions="3 3" Format="XML">{k} 0 0 1 1 1 1 {nnodes} 3</DataItem>'
-                f'<DataItem Dimensions="{len(times)} {nnodes} 3" NumberType="Float" '
-                f'Precision="8" Format="HDF">{name}:/dynamic/mesh_nodes</DataItem></DataItem>')
-        grids.append(
-            f'<Grid Name="step {k}" GridType="Uniform"><Time Value="{t:.9g}"/>'
-            f'<Topology TopologyType="Quadrilateral" NumberOfElements="{nel}">'
-            f'<DataItem Dimensions="{nel} 4" NumberType="Int" Precision="8" Format="HDF">'
-            f'{name}:/model/elements</DataItem></Topology>'
-            f'<Geometry GeometryType="XYZ">{slab}</Geometry>'
-            f'<Attribute Name="displacement" AttributeType="Vector" Center="Node">'
-            f'<DataItem ItemType="Function" Function="$0 - $1" Dimensions="{nnodes} 3">'
-            f'{slab}<DataItem Dimensions="{nnodes} 3" NumberType="Float" Precision="8" '
-            f'Format="HDF">{name}:/model/nodes</DataItem></DataItem></Attribute></Grid>')
-    text = ('<?xml version="1.0" ?>\n<Xdmf Version="3.0"><Domain>'
-            '<Grid Name="motion" GridType="Collection" CollectionType="Temporal">\n'
-            + "\n".join(grids) + "\n</Grid></Domain></Xdmf>\n")
-    out = path.with_suffix(".xdmf")
-    out.write_text(text)
-    return out

@@ -30,10 +30,10 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm import tqdm
 
-from . import _kernel
-from .errors import SolverError
-from .kernel import DirectSolver, _f
-from .model import BeamModel
+from .. import _kernel
+from ..errors import SolverError
+from ..kernel import DirectSolver, _f
+from ..model import BeamModel
 
 ENERGY_NAMES = ("kinetic", "strain", "gravity", "moment", "total", "drive_work", "frame_work",
                 "contact", "damping_work", "friction_work")

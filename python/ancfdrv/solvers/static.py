@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import SolverError
-from .kernel import DirectSolver
-from .model import BeamModel
+from ..errors import SolverError
+from ..kernel import DirectSolver
+from ..model import BeamModel
 
 
 @dataclass
