@@ -122,22 +122,39 @@ def test_clamped_free_roots():
     assert bf.clamped_free_beta_l(3) == pytest.approx(bf.CLAMPED_FREE_BETA_L, rel=1e-14)
 
 
-def test_clamped_free_frequencies_converge_both_planes():
-    """Cantilever frequencies (beta_n L)^2 sqrt(EI/(rho A L^4)), beta_n L = 1.8751..., in
-    the two bending planes of a 3D rectangular beam (Iz: width, Iy: height); the error of
-    the consistent-mass Hermite element falls with the mesh (about h^4)."""
+def test_clamped_free_frequencies_converge():
+    """Cantilever frequencies (beta_n L)^2 sqrt(EI/(rho A L^4)), beta_n L = 1.8751, 4.6941,
+    7.8548: the consistent-mass Hermite element converges as h^4 (ratio 16 per halving);
+    with 32 elements the third mode is within 2.6e-6 (observed 2.51e-6)."""
     sec, L = fr.rectangle(0.05, 0.1), 2.0
+    expected = bf.euler_bernoulli_frequency(bf.CLAMPED_FREE_BETA_L, L, E * sec.Iz, RHO * sec.A)
     errors = []
     for n_el in (8, 16, 32):
-        frame, _ = _cantilever(n_el, L, sec, planar=False)
-        omega = frame.solve_modes(8).omega
-        # bending modes: 3 per plane among the lowest 8 (the others are torsion / axial)
-        w_width = bf.euler_bernoulli_frequency(bf.CLAMPED_FREE_BETA_L, L, E * sec.Iz, RHO * sec.A)
-        w_height = bf.euler_bernoulli_frequency(bf.CLAMPED_FREE_BETA_L, L, E * sec.Iy, RHO * sec.A)
-        err = [np.min(np.abs(omega - w)) / w for w in np.concatenate([w_width, w_height])]
-        errors.append(max(err))
-    assert errors[0] / errors[1] > 14.0 and errors[1] / errors[2] > 14.0   # h^4: 16 per halving
-    assert errors[2] < 3e-6
+        omega = _cantilever(n_el, L, sec)[0].solve_modes(3).omega
+        assert np.all(omega >= expected)             # consistent mass: upper bounds
+        errors.append(_rel(omega, expected))
+    assert errors[0] / errors[1] > 14.0 and errors[1] / errors[2] > 14.0
+    assert errors[2] < 2.6e-6
+
+
+def test_3d_bending_planes_use_iz_and_iy():
+    """A 3D cantilever of a 0.05 x 0.1 rectangle (height along global z): its modes
+    polarized along y (the width) have the frequencies of the planar model bending with
+    Iz, those along z (the height) the frequencies of the planar model whose height axis
+    lies in the plane (bending with Iy), to rounding, on the same mesh."""
+    sec, L, n_el = fr.rectangle(0.05, 0.1), 2.0, 8
+    modes = _cantilever(n_el, L, sec, planar=False)[0].solve_modes(8)
+    along_y = np.abs(modes.modes[:, -1, 1]) > np.abs(modes.modes[:, -1, 2])
+    bending = np.abs(modes.modes[:, -1, 1:3]).max(axis=1) > 1e-6 * np.abs(modes.modes[:, -1]).max(axis=1)
+    width = _cantilever(n_el, L, sec)[0].solve_modes(3).omega
+    frame = fr.Frame(planar=True)
+    nodes = frame.add_beam_line((0.0, 0.0), (L, 0.0), n_el, E, G, sec, RHO, height_axis=(0.0, 1.0, 0.0))
+    frame.fix(nodes[0])
+    height = frame.solve_modes(3).omega
+    assert width[0] < height[0]                      # Iz < Iy for this section
+    assert modes.omega[bending & along_y][:3] == pytest.approx(width, rel=1e-10)
+    assert modes.omega[bending & ~along_y][:3] == pytest.approx(height, rel=1e-10)
+    assert height == pytest.approx(width * math.sqrt(sec.Iy / sec.Iz), rel=1e-10)
 
 
 def _simply_supported(n_el: int, L: float, sec: fr.Section, theory: str) -> tuple[fr.Frame, list[int]]:
@@ -156,7 +173,8 @@ def test_simply_supported_beam_statics_and_frequencies(theory):
     Timoshenko (shear and rotary inertia) the lower root of the simply supported
     Timoshenko quadratic. Convergence: h^4 for Hermite elements; h^2 for the Timoshenko
     element on this deep beam (its consistent mass comes from static shape functions and
-    phi = 12 EI/(GA h^2) grows as the mesh is refined: 4.1 per halving observed)."""
+    phi = 12 EI/(GA h^2) grows as the mesh is refined: 4.1 per halving observed). The
+    matrices of that element are checked against their published closed forms below."""
     sec, L, q = fr.rectangle(0.2, 0.3), 4.0, -1.0e4      # deep beam: L/w = 20, so shear matters
     timo = theory == "timoshenko"
     EI, GAs = E * sec.Iz, G * sec.A
@@ -172,8 +190,8 @@ def test_simply_supported_beam_statics_and_frequencies(theory):
         assert np.all(plain - expected > 3e-3 * expected)        # shear + rotary inertia matter here
     else:
         expected = bf.euler_bernoulli_frequency(bf.simply_supported_beta_l(3), L, EI, RHO * sec.A)
-    errors = [_rel(_simply_supported(n, L, sec, theory)[0].solve_modes(3).omega, expected) for n in (16, 32, 64)]
-    rate, final = (3.8, 5e-5) if timo else (14.0, 4e-7)      # observed: 4.1e-5, 3.3e-7
+    errors = [_rel(_simply_supported(n, L, sec, theory)[0].solve_modes(3).omega, expected) for n in (8, 16, 32)]
+    rate, final = (3.8, 1.8e-4) if timo else (14.0, 5.5e-6)      # observed: 1.66e-4, 5.2e-6
     assert errors[0] / errors[1] > rate and errors[1] / errors[2] > rate
     assert errors[2] < final
 
@@ -503,6 +521,40 @@ def test_knuckle_boom_statics_equilibrium_and_virtual_work(branch):
         assert st.pivot_moment[i] == pytest.approx(dPi_da, rel=1e-6)
     with pytest.raises(ValueError, match="out of reach"):
         mc.knuckle_boom_statics(**KB, actuator_length=5.0)
+
+
+def test_knuckle_boom_with_lift_cylinder():
+    """With a lift cylinder the ground moment vanishes and the boom is in equilibrium
+    under pivot force, lift force, knuckle force, actuator force and weight; the lift
+    force equals the held moment divided by its moment arm, and agrees with virtual
+    work: f_lift = -dPi/dL_lift with the boom angle moving with the lift length."""
+    ground, lug = (0.5, -0.4), (1.2, -0.1)
+    lengths = np.array([1.9, 2.1])
+    st = mc.knuckle_boom_statics(**KB, actuator_length=lengths, branch=-1, lift_ground_point=ground, lift_boom_point=lug)
+    held = mc.knuckle_boom_statics(**KB, actuator_length=lengths, branch=-1)
+    cross = lambda a, b: a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]  # noqa: E731
+    g, m1 = np.array(KB["gravity"]), KB["boom_mass"]
+    fl = st.lift_force[:, None] * st.lift_direction
+    fu = st.actuator_force[:, None] * st.actuator_direction
+    c1 = 0.5 * (st.pivot + st.knuckle)
+    scale = 450.0 * 9.81 * 5.0
+    assert np.all(st.pivot_moment == 0.0) and st.knuckle_force == pytest.approx(held.knuckle_force, rel=1e-14)
+    assert np.max(np.abs(st.pivot_force + fl - st.knuckle_force + fu + m1 * g)) < 1e-12 * scale
+    moments = cross(st.lift_boom_point, fl) + cross(st.knuckle, -st.knuckle_force) + cross(st.boom_point, fu) + cross(c1, m1 * g)
+    assert np.max(np.abs(moments)) < 1e-12 * scale
+    # virtual work: the boom angle as a function of the lift length (|G - P2(a)| = L_lift)
+    lug_vec = np.array(lug)
+
+    def lift_length(angle: float) -> float:
+        e = np.array([math.cos(angle), math.sin(angle)])
+        return float(np.linalg.norm(np.array(ground) - (lug_vec[0] * e + lug_vec[1] * np.array([-e[1], e[0]]))))
+
+    h = 1e-6
+    a0 = KB["boom_angle"]
+    dL_da = (lift_length(a0 + h) - lift_length(a0 - h)) / (2 * h)
+    for i, L in enumerate(lengths):
+        dPi_da = (_potential(a0 + h, L, -1) - _potential(a0 - h, L, -1)) / (2 * h)
+        assert st.lift_force[i] == pytest.approx(-dPi_da / dL_da, rel=1e-6)
 
 
 def _knuckle_frame(p: dict, n_el: int, theory: str, actuator_EA: float):

@@ -19,7 +19,7 @@ Conventions
 from __future__ import annotations
 
 import math
-from typing import Optional, Sequence
+from typing import Optional
 
 import numpy as np
 from numpy.typing import NDArray
@@ -80,15 +80,17 @@ def simply_supported_uniform_load(q: float, L: float, EI: float, GAs: Optional[f
 
 def _bracketed_roots(f, lo: float, hi: float, n_roots: int, step: float) -> NDArray[np.float64]:
     """First ``n_roots`` roots of the continuous function ``f`` on (lo, hi): sign changes on
-    a grid of spacing ``step``, each refined by brentq to machine precision."""
+    a grid of spacing ``step`` (``f`` is evaluated on the whole grid at once, so it must
+    accept arrays), each refined by brentq to machine precision."""
     grid = np.arange(lo, hi + step, step)
-    values = np.array([f(x) for x in grid])
+    values = f(grid)
     roots: list[float] = []
-    for a, b, fa, fb in zip(grid[:-1], grid[1:], values[:-1], values[1:]):
-        if fa == 0.0:
-            roots.append(float(a))
-        elif fa * fb < 0.0:
-            roots.append(brentq(f, a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200))
+    for i in np.flatnonzero(values[:-1] * values[1:] <= 0.0):
+        a, b = float(grid[i]), float(grid[i + 1])
+        if values[i] == 0.0:
+            roots.append(a)
+        else:
+            roots.append(brentq(lambda x: float(f(x)), a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200))
         if len(roots) == n_roots:
             return np.array(roots)
     raise ValueError(f"found only {len(roots)} of {n_roots} roots below {hi}")
@@ -97,7 +99,7 @@ def _bracketed_roots(f, lo: float, hi: float, n_roots: int, step: float) -> NDAr
 def clamped_free_beta_l(n_modes: int = 3) -> NDArray[np.float64]:
     """Roots beta_n L of 1 + cos(x) cosh(x) = 0 (clamped-free Euler-Bernoulli beam),
     computed with brentq; the first three equal ``CLAMPED_FREE_BETA_L``."""
-    return _bracketed_roots(lambda x: math.cos(x) + 1.0 / math.cosh(x), 0.5, 4.0 * n_modes + 4.0, n_modes, 0.05)
+    return _bracketed_roots(lambda x: np.cos(x) + 1.0 / np.cosh(x), 0.5, 4.0 * n_modes + 4.0, n_modes, 0.05)
 
 
 def simply_supported_beta_l(n_modes: int = 3) -> NDArray[np.float64]:
@@ -112,8 +114,9 @@ def euler_bernoulli_frequency(beta_l, L: float, EI: float, rho_A: float):
     return np.asarray(beta_l, dtype=float) ** 2 * math.sqrt(EI / (rho_A * L**4))
 
 
-def _tip_mass_determinant(lam: float, mu: float, j: float, eps: float) -> float:
-    """Determinant of the two tip conditions of a clamped-free beam with a tip body.
+def _tip_mass_determinant(lam, mu: float, j: float, eps: float):
+    """Determinant of the two tip conditions of a clamped-free beam with a tip body
+    (``lam`` a scalar or an array).
 
     Mode shape W(xi) = A (cosh lam xi - cos lam xi) + B (sinh lam xi - sin lam xi),
     xi = x/L (clamped at xi = 0). The tip body (mass ratio mu = M/(rho A L), rotary
@@ -126,7 +129,8 @@ def _tip_mass_determinant(lam: float, mu: float, j: float, eps: float) -> float:
 
     The row coefficients are divided by cosh(lam) to keep them O(1).
     """
-    ch, sh, c, s = math.cosh(lam), math.sinh(lam), math.cos(lam), math.sin(lam)
+    lam = np.asarray(lam, dtype=float)
+    ch, sh, c, s = np.cosh(lam), np.sinh(lam), np.cos(lam), np.sin(lam)
     w = np.array([ch - c, sh - s])
     w1 = lam * np.array([sh + s, ch - c])
     w2 = lam**2 * np.array([ch + c, sh + s])
@@ -135,7 +139,7 @@ def _tip_mass_determinant(lam: float, mu: float, j: float, eps: float) -> float:
     tip = w + eps * w1
     row1 = w3 + mu * l4 * tip
     row2 = w2 - l4 * (mu * eps * tip + j * w1)
-    return float((row1[0] * row2[1] - row1[1] * row2[0]) / ch**2)
+    return (row1[0] * row2[1] - row1[1] * row2[0]) / ch**2
 
 
 def tip_mass_beta_l(mass_ratio: float, inertia_ratio: float = 0.0, offset_ratio: float = 0.0,

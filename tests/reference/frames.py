@@ -70,8 +70,8 @@ inverse form (see ``Frame.solve_modes``), so massless dofs need no special treat
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Iterable, Mapping, Optional, Sequence, Union
+from dataclasses import dataclass
+from typing import Iterable, Mapping, Optional, Sequence
 
 import numpy as np
 import scipy.linalg
@@ -333,7 +333,6 @@ class ModalResult:
         return self.omega / (2.0 * np.pi)
 
 
-@dataclass
 class Frame:
     """A linear frame model, built by method calls, then solved.
 
@@ -342,15 +341,16 @@ class Frame:
     the ``add_*`` methods.
     """
 
-    planar: bool = False
-    _nodes: list = field(default_factory=list)
-    _beams: list = field(default_factory=list)
-    _bars: list = field(default_factory=list)
-    _masses: list = field(default_factory=list)        # (node, 6x6 mass, mass, offset)
-    _fixed: set = field(default_factory=set)           # global dof indices
-    _ties: list = field(default_factory=list)          # dict {global dof: coefficient}
-    _nodal: dict = field(default_factory=dict)         # node -> 6-vector
-    _distributed: list = field(default_factory=list)   # (beam index, global q 3-vector)
+    def __init__(self, planar: bool = False) -> None:
+        self.planar = bool(planar)
+        self._nodes: list[NDArray[np.float64]] = []
+        self._beams: list[_Beam] = []
+        self._bars: list[_Bar] = []
+        self._masses: list[tuple] = []          # (node, 6x6 mass, mass, offset, has rotary inertia)
+        self._fixed: set[int] = set()           # global dof indices
+        self._ties: list[dict[int, float]] = [] # rows {global dof: coefficient}, sum = 0
+        self._nodal: dict[int, NDArray[np.float64]] = {}
+        self._distributed: list[tuple[int, NDArray[np.float64]]] = []   # (beam, global q)
 
     # --- geometry and members -------------------------------------------------------
     def add_node(self, position: ArrayLike) -> int:

@@ -21,6 +21,7 @@ Conventions
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
@@ -120,9 +121,10 @@ def pendulum(t: ArrayLike, angle0: float, rate0: float, length: float, rod_mass:
     if I_O <= 0.0:
         raise ValueError("the pendulum has no inertia about its pivot")
 
+    gx, gy = float(g[0]), float(g[1])
+
     def rhs(_t, y):
-        e_perp = np.array([-np.sin(y[0]), np.cos(y[0])])
-        return [y[1], S * (e_perp @ g) / I_O]
+        return [y[1], S * (-math.sin(y[0]) * gx + math.cos(y[0]) * gy) / I_O]
 
     y = _integrate(rhs, t, np.array([angle0, rate0], dtype=float), rtol, atol)
     e = _unit(y[:, 0])
@@ -192,13 +194,17 @@ def double_pendulum(t: ArrayLike, angles0: Sequence[float], rates0: Sequence[flo
     c = 0.5 * m2 * L1 * L2
     s1, s2 = m1 * L1 / 2.0 + m2 * L1, m2 * L2 / 2.0
 
+    m11, m22 = m1 * L1**2 / 3.0 + m2 * L1**2, m2 * L2**2 / 3.0
+    gx, gy = float(g[0]), float(g[1])
+
     def rhs(_t, y):
         a1, a2, w1, w2 = y
-        D = a1 - a2
-        M = double_pendulum_mass_matrix((a1, a2), lengths, masses)
-        q = np.array([s1 * (np.array([-np.sin(a1), np.cos(a1)]) @ g) - c * np.sin(D) * w2**2,
-                      s2 * (np.array([-np.sin(a2), np.cos(a2)]) @ g) + c * np.sin(D) * w1**2])
-        return np.concatenate([[w1, w2], np.linalg.solve(M, q)])
+        sD, cD = math.sin(a1 - a2), math.cos(a1 - a2)
+        m12 = c * cD
+        q1 = s1 * (-math.sin(a1) * gx + math.cos(a1) * gy) - c * sD * w2**2
+        q2 = s2 * (-math.sin(a2) * gx + math.cos(a2) * gy) + c * sD * w1**2
+        det = m11 * m22 - m12**2                       # the 2x2 solve by Cramer's rule
+        return [w1, w2, (m22 * q1 - m12 * q2) / det, (m11 * q2 - m12 * q1) / det]
 
     y = _integrate(rhs, t, np.array([*angles0, *rates0], dtype=float), rtol, atol)
     angles, rates = y[:, :2], y[:, 2:]
@@ -325,8 +331,10 @@ class KnuckleBoomStatics:
     from P to Q; ``actuator_force`` [N] its axial force, tension positive (it pulls P and
     Q together). ``pivot_force`` [N] force of the ground on the boom at O;
     ``pivot_moment`` [N m] moment of the ground on the boom (what holds the boom angle,
-    e.g. a prescribed-rotation drive or a clamp); ``knuckle_force`` [N] force of the boom
-    on the jib at B.
+    e.g. a prescribed-rotation drive or a clamp; 0 with a lift cylinder);
+    ``knuckle_force`` [N] force of the boom on the jib at B. With a lift cylinder:
+    ``lift_boom_point`` (its end on the boom), ``lift_direction`` (unit vector from there
+    to its ground point), ``lift_force`` [N] (tension positive); otherwise None.
     """
 
     boom_angle: float
@@ -341,6 +349,9 @@ class KnuckleBoomStatics:
     pivot_force: NDArray[np.float64]
     pivot_moment: NDArray[np.float64]
     knuckle_force: NDArray[np.float64]
+    lift_boom_point: Optional[NDArray[np.float64]] = None
+    lift_direction: Optional[NDArray[np.float64]] = None
+    lift_force: Optional[NDArray[np.float64]] = None
 
 
 def knuckle_boom_jib_angle(boom_length: float, boom_angle: float, boom_point: Sequence[float],
@@ -374,7 +385,8 @@ def knuckle_boom_statics(boom_length: float, boom_mass: float, jib_length: float
                          boom_angle: float, boom_point: Sequence[float], jib_point: Sequence[float],
                          actuator_length: ArrayLike, gravity: ArrayLike = (0.0, -9.81),
                          tip_load: ArrayLike = (0.0, 0.0), branch: int = 1,
-                         pivot: ArrayLike = (0.0, 0.0)) -> KnuckleBoomStatics:
+                         pivot: ArrayLike = (0.0, 0.0), lift_ground_point: Optional[Sequence[float]] = None,
+                         lift_boom_point: Optional[Sequence[float]] = None) -> KnuckleBoomStatics:
     """Rigid knuckle boom in quasi-static equilibrium.
 
     Boom: uniform rod (length L1 = ``boom_length``, mass m1) hinged to ground at ``pivot``
@@ -389,6 +401,12 @@ def knuckle_boom_statics(boom_length: float, boom_mass: float, jib_length: float
     actuator tension f (u from P to Q); jib forces give the knuckle force
     R_B = f u - m2 g - F. Boom: R_O = R_B - f u - m1 g and, moments about O,
     M_O = -[(B - O) x (-R_B) + (P - O) x f u + (C1 - O) x m1 g].
+
+    Optional lift cylinder (a second massless two-force member) from
+    ``lift_ground_point`` G (global) to ``lift_boom_point`` P2 ((s, n) in the boom frame):
+    it carries M_O instead of the ground, f_lift = M_O / ((P2 - O) x u_l) with u_l from P2
+    toward G, and the pivot force becomes R_O - f_lift u_l (the boom angle is still the
+    input: it fixes the lift cylinder's length |G - P2|).
     """
     g = _vec2(gravity, "gravity")
     F = _vec2(tip_load, "tip_load")
@@ -412,7 +430,19 @@ def knuckle_boom_statics(boom_length: float, boom_mass: float, jib_length: float
     R_B = f[..., None] * u - jib_mass * g - F
     R_O = R_B - f[..., None] * u - boom_mass * g
     M_O = -(_cross(B - O, -R_B) + _cross(P - O, f[..., None] * u) + _cross(C1 - O, boom_mass * g))
-    return KnuckleBoomStatics(float(boom_angle), a2, O, B, P, Q, T, u, f, R_O, M_O, R_B)
+    if (lift_ground_point is None) != (lift_boom_point is None):
+        raise ValueError("a lift cylinder needs both lift_ground_point and lift_boom_point")
+    if lift_ground_point is None:
+        return KnuckleBoomStatics(float(boom_angle), a2, O, B, P, Q, T, u, f, R_O, M_O, R_B)
+    P2 = O + lift_boom_point[0] * e1 + lift_boom_point[1] * _perp(e1)
+    d_l = _vec2(lift_ground_point, "lift_ground_point") - P2
+    u_l = d_l / np.linalg.norm(d_l)
+    lift_arm = _cross(P2 - O, u_l)
+    if abs(lift_arm) < 1e-12 * boom_length:
+        raise ValueError("the lift cylinder line passes through the pivot: no moment arm")
+    f_l = M_O / lift_arm
+    return KnuckleBoomStatics(float(boom_angle), a2, O, B, P, Q, T, u, f, R_O - f_l[..., None] * u_l,
+                              np.zeros_like(M_O), R_B, P2, u_l, f_l)
 
 
 # ------------------------------------------------------------ (e) flexible knuckle boom
