@@ -16,6 +16,7 @@ Conventions
   beam axis toward the positive deflection.
 * Small deflections, linear elastic material, straight prismatic members.
 """
+
 from __future__ import annotations
 
 import math
@@ -50,7 +51,9 @@ def _shear_term(value: float, GAs: Optional[float]) -> float:
     return 0.0 if GAs is None else value / GAs
 
 
-def cantilever_tip_load(P: float, L: float, EI: float, GAs: Optional[float] = None) -> tuple[float, float]:
+def cantilever_tip_load(
+    P: float, L: float, EI: float, GAs: Optional[float] = None
+) -> tuple[float, float]:
     """Cantilever of length ``L`` clamped at one end, transverse point load ``P`` at the
     free end: returns (tip deflection, tip rotation) = (P L^3/(3EI) + P L/GAs, P L^2/(2EI)).
 
@@ -60,7 +63,9 @@ def cantilever_tip_load(P: float, L: float, EI: float, GAs: Optional[float] = No
     return P * L**3 / (3.0 * EI) + _shear_term(P * L, GAs), P * L**2 / (2.0 * EI)
 
 
-def cantilever_uniform_load(q: float, L: float, EI: float, GAs: Optional[float] = None) -> tuple[float, float]:
+def cantilever_uniform_load(
+    q: float, L: float, EI: float, GAs: Optional[float] = None
+) -> tuple[float, float]:
     """Cantilever of length ``L`` under a uniform transverse load ``q`` [N/m]: returns
     (tip deflection, tip section rotation) = (q L^4/(8EI) + q L^2/(2 GAs), q L^3/(6EI))."""
     return q * L**4 / (8.0 * EI) + _shear_term(q * L**2 / 2.0, GAs), q * L**3 / (6.0 * EI)
@@ -90,7 +95,9 @@ def _bracketed_roots(f, lo: float, hi: float, n_roots: int, step: float) -> NDAr
         if values[i] == 0.0:
             roots.append(a)
         else:
-            roots.append(brentq(lambda x: float(f(x)), a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200))
+            roots.append(
+                brentq(lambda x: float(f(x)), a, b, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+            )
         if len(roots) == n_roots:
             return np.array(roots)
     raise ValueError(f"found only {len(roots)} of {n_roots} roots below {hi}")
@@ -99,7 +106,9 @@ def _bracketed_roots(f, lo: float, hi: float, n_roots: int, step: float) -> NDAr
 def clamped_free_beta_l(n_modes: int = 3) -> NDArray[np.float64]:
     """Roots beta_n L of 1 + cos(x) cosh(x) = 0 (clamped-free Euler-Bernoulli beam),
     computed with brentq; the first three equal ``CLAMPED_FREE_BETA_L``."""
-    return _bracketed_roots(lambda x: np.cos(x) + 1.0 / np.cosh(x), 0.5, 4.0 * n_modes + 4.0, n_modes, 0.05)
+    return _bracketed_roots(
+        lambda x: np.cos(x) + 1.0 / np.cosh(x), 0.5, 4.0 * n_modes + 4.0, n_modes, 0.05
+    )
 
 
 def simply_supported_beta_l(n_modes: int = 3) -> NDArray[np.float64]:
@@ -142,8 +151,9 @@ def _tip_mass_determinant(lam, mu: float, j: float, eps: float):
     return (row1[0] * row2[1] - row1[1] * row2[0]) / ch**2
 
 
-def tip_mass_beta_l(mass_ratio: float, inertia_ratio: float = 0.0, offset_ratio: float = 0.0,
-                    n_modes: int = 1) -> NDArray[np.float64]:
+def tip_mass_beta_l(
+    mass_ratio: float, inertia_ratio: float = 0.0, offset_ratio: float = 0.0, n_modes: int = 1
+) -> NDArray[np.float64]:
     """Eigenvalues lambda_n = beta_n L of an Euler-Bernoulli clamped-free beam carrying a
     rigid tip body.
 
@@ -158,8 +168,15 @@ def tip_mass_beta_l(mass_ratio: float, inertia_ratio: float = 0.0, offset_ratio:
     return _bracketed_roots(f, 1e-3, 4.0 * n_modes + 8.0, n_modes, 0.01)
 
 
-def tip_mass_frequencies(L: float, EI: float, rho_A: float, tip_mass: float, tip_inertia: float = 0.0,
-                         offset: float = 0.0, n_modes: int = 1) -> NDArray[np.float64]:
+def tip_mass_frequencies(
+    L: float,
+    EI: float,
+    rho_A: float,
+    tip_mass: float,
+    tip_inertia: float = 0.0,
+    offset: float = 0.0,
+    n_modes: int = 1,
+) -> NDArray[np.float64]:
     """Lowest angular frequencies [rad/s] of a clamped-free Euler-Bernoulli beam (length
     ``L``, bending stiffness ``EI``, mass per length ``rho_A``) with a rigid body at its
     free end: mass ``tip_mass`` [kg], rotary inertia ``tip_inertia`` [kg m^2] about its
@@ -169,8 +186,9 @@ def tip_mass_frequencies(L: float, EI: float, rho_A: float, tip_mass: float, tip
     return euler_bernoulli_frequency(lam, L, EI, rho_A)
 
 
-def simply_supported_timoshenko_frequencies(L: float, EI: float, GAs: float, rho_A: float, rho_I: float,
-                                            n_modes: int = 3) -> NDArray[np.float64]:
+def simply_supported_timoshenko_frequencies(
+    L: float, EI: float, GAs: float, rho_A: float, rho_I: float, n_modes: int = 3
+) -> NDArray[np.float64]:
     """Flexural angular frequencies [rad/s] of a simply supported Timoshenko beam.
 
     Equations rho_A w_tt = GAs (w'' - theta'), rho_I theta_tt = EI theta'' + GAs (w' - theta)
@@ -190,10 +208,18 @@ def simply_supported_timoshenko_frequencies(L: float, EI: float, GAs: float, rho
     return np.sqrt(2.0 * c / (b + np.sqrt(b**2 - 4.0 * a * c)))
 
 
-def l_frame_tip_displacement(H: float, L: float, Fx: float, Fy: float,
-                             column_EA: float, column_EI: float, beam_EA: float, beam_EI: float,
-                             column_GAs: Optional[float] = None, beam_GAs: Optional[float] = None
-                             ) -> tuple[float, float]:
+def l_frame_tip_displacement(
+    H: float,
+    L: float,
+    Fx: float,
+    Fy: float,
+    column_EA: float,
+    column_EI: float,
+    beam_EA: float,
+    beam_EI: float,
+    column_GAs: Optional[float] = None,
+    beam_GAs: Optional[float] = None,
+) -> tuple[float, float]:
     """Planar L-frame by the unit-load method (virtual work with M, N and V).
 
     The column runs from the clamped base (0, 0) up to the corner (0, H); the beam runs
@@ -204,14 +230,30 @@ def l_frame_tip_displacement(H: float, L: float, Fx: float, Fy: float,
         dx = Fx L/EA_b + (Fx H^3/3 - Fy L H^2/2)/EI_c + Fx H/GAs_c
         dy = Fy L^3/(3 EI_b) + L (Fy L H - Fx H^2/2)/EI_c + Fy H/EA_c + Fy L/GAs_b
     """
-    dx = Fx * L / beam_EA + (Fx * H**3 / 3.0 - Fy * L * H**2 / 2.0) / column_EI + _shear_term(Fx * H, column_GAs)
-    dy = (Fy * L**3 / (3.0 * beam_EI) + L * (Fy * L * H - Fx * H**2 / 2.0) / column_EI
-          + Fy * H / column_EA + _shear_term(Fy * L, beam_GAs))
+    dx = (
+        Fx * L / beam_EA
+        + (Fx * H**3 / 3.0 - Fy * L * H**2 / 2.0) / column_EI
+        + _shear_term(Fx * H, column_GAs)
+    )
+    dy = (
+        Fy * L**3 / (3.0 * beam_EI)
+        + L * (Fy * L * H - Fx * H**2 / 2.0) / column_EI
+        + Fy * H / column_EA
+        + _shear_term(Fy * L, beam_GAs)
+    )
     return dx, dy
 
 
-def l_grillage_tip_deflection(P: float, L1: float, L2: float, EI1: float, GJ1: float, EI2: float,
-                              GAs1: Optional[float] = None, GAs2: Optional[float] = None) -> float:
+def l_grillage_tip_deflection(
+    P: float,
+    L1: float,
+    L2: float,
+    EI1: float,
+    GJ1: float,
+    EI2: float,
+    GAs1: Optional[float] = None,
+    GAs2: Optional[float] = None,
+) -> float:
     """Out-of-plane deflection of a horizontal L (grillage): member 1 (length ``L1``)
     clamped at its root, member 2 (length ``L2``) rigidly joined at right angles to its
     end, load ``P`` normal to the plane of the L at the free end of member 2.
@@ -221,6 +263,8 @@ def l_grillage_tip_deflection(P: float, L1: float, L2: float, EI1: float, GJ1: f
     d = P [L1^3/(3 EI1) + L2^3/(3 EI2) + L1 L2^2/GJ1] (+ P L1/GAs1 + P L2/GAs2).
     ``EI1``, ``EI2`` are the stiffnesses for bending out of the plane of the L.
     """
-    return (P * (L1**3 / (3.0 * EI1) + L2**3 / (3.0 * EI2) + L1 * L2**2 / GJ1)
-            + _shear_term(P * L1, GAs1) + _shear_term(P * L2, GAs2))
-
+    return (
+        P * (L1**3 / (3.0 * EI1) + L2**3 / (3.0 * EI2) + L1 * L2**2 / GJ1)
+        + _shear_term(P * L1, GAs1)
+        + _shear_term(P * L2, GAs2)
+    )

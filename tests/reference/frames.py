@@ -30,10 +30,12 @@ properties (see the helpers ``rectangle``, ``box``, ``tube``, ``circle``):
 * ``Iy = integral z^2 dA`` resists bending in the local x-z plane (deflection along the
   height), ``Iz = integral y^2 dA`` bending in the local x-y plane (deflection along the
   width). In a planar frame with the default height axis (global z), the in-plane
-  bending stiffness is therefore E * Iz.
+  bending stiffness is therefore E * Iz; give an in-plane ``height_axis`` (normal to
+  the element) to bend with E * Iy instead.
 * ``J = Iy + Iz``, the *polar* second moment, is used for the torsional stiffness G J
-  and the torsional mass rho J for every section, consistently (this is exact for
-  circles and tubes and an approximation for the others, as in the project).
+  of every section, consistently (exact for circles and tubes; for rectangles and
+  boxes it overestimates the Saint-Venant torsion constant). The torsional mass rho J
+  is the exact polar mass moment per length for any section.
 * The Timoshenko shear area is ``k A`` in both planes, with the shear coefficient
   ``k`` given per element (default 1.0, i.e. shear area = A, the project's choice).
 
@@ -65,9 +67,11 @@ Other members
 Constraints are imposed exactly: fixed dofs are removed, ties are eliminated with an
 orthonormal null-space basis of the tie equations on the dofs they involve. A node
 touched by no beam element and no rigid body gets its three rotations fixed
-automatically (they carry no stiffness and no mass), unless a tie involves them. Natural modes are solved in
-inverse form (see ``Frame.solve_modes``), so massless dofs need no special treatment.
+automatically (they carry no stiffness and no mass), unless a tie involves them.
+Natural modes are solved in inverse form (see ``Frame.solve_modes``), so massless dofs
+need no special treatment.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -131,7 +135,9 @@ def box(width: float, height: float, wall: float) -> Section:
     outer rectangle minus the inner (w - 2t) x (h - 2t) one; J = Iy + Iz."""
     _positive(width=width, height=height, wall=wall)
     if 2.0 * wall >= min(width, height):
-        raise ValueError(f"box wall {wall} must be less than half of min(width, height) = {min(width, height)}")
+        raise ValueError(
+            f"box wall {wall} must be less than half of min(width, height) = {min(width, height)}"
+        )
     outer, inner = rectangle(width, height), rectangle(width - 2 * wall, height - 2 * wall)
     return Section(outer.A - inner.A, outer.Iy - inner.Iy, outer.Iz - inner.Iz, outer.J - inner.J)
 
@@ -162,14 +168,14 @@ def _positive(**values: float) -> None:
 
 # ------------------------------------------------------------------- element matrices
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
-_GAUSS_XI = 0.5 * (_GAUSS_X + 1.0)     # points on [0, 1]
-_GAUSS_WXI = 0.5 * _GAUSS_W            # weights on [0, 1]
+_GAUSS_XI = 0.5 * (_GAUSS_X + 1.0)  # points on [0, 1]
+_GAUSS_WXI = 0.5 * _GAUSS_W  # weights on [0, 1]
 
 # local dof order: u1 v1 w1 rx1 ry1 rz1 u2 v2 w2 rx2 ry2 rz2
 _AXIAL = np.array([0, 6])
 _TORSION = np.array([3, 9])
-_PLANE_XY = np.array([1, 5, 7, 11])          # (v, rz): rz = +dv/dx
-_PLANE_XZ = np.array([2, 4, 8, 10])          # (w, ry): ry = -dw/dx
+_PLANE_XY = np.array([1, 5, 7, 11])  # (v, rz): rz = +dv/dx
+_PLANE_XZ = np.array([2, 4, 8, 10])  # (w, ry): ry = -dw/dx
 _SIGN_XZ = np.array([1.0, -1.0, 1.0, -1.0])
 
 
@@ -183,30 +189,42 @@ def _bending_shapes(L: NDArray, phi: NDArray):
     L = L[:, None]
     p = phi[:, None]
     d = 1.0 + p
-    nv = np.stack([
-        (2 * x**3 - 3 * x**2 - p * x + 1 + p) / d,
-        L * (x**3 - (2 + p / 2) * x**2 + (1 + p / 2) * x) / d,
-        -(2 * x**3 - 3 * x**2 - p * x) / d,
-        L * (x**3 - (1 - p / 2) * x**2 - (p / 2) * x) / d,
-    ], axis=-1)
-    dnv = np.stack([
-        (6 * x**2 - 6 * x - p) / (d * L),
-        (3 * x**2 - (4 + p) * x + 1 + p / 2) / d,
-        -(6 * x**2 - 6 * x - p) / (d * L),
-        (3 * x**2 - (2 - p) * x - p / 2) / d,
-    ], axis=-1)
-    nt = np.stack([
-        6 * (x**2 - x) / (d * L),
-        (3 * x**2 - (4 + p) * x + 1 + p) / d,
-        -6 * (x**2 - x) / (d * L),
-        (3 * x**2 - (2 - p) * x) / d,
-    ], axis=-1)
-    dnt = np.stack([
-        6 * (2 * x - 1) / (d * L**2),
-        (6 * x - (4 + p)) / (d * L),
-        -6 * (2 * x - 1) / (d * L**2),
-        (6 * x - (2 - p)) / (d * L),
-    ], axis=-1)
+    nv = np.stack(
+        [
+            (2 * x**3 - 3 * x**2 - p * x + 1 + p) / d,
+            L * (x**3 - (2 + p / 2) * x**2 + (1 + p / 2) * x) / d,
+            -(2 * x**3 - 3 * x**2 - p * x) / d,
+            L * (x**3 - (1 - p / 2) * x**2 - (p / 2) * x) / d,
+        ],
+        axis=-1,
+    )
+    dnv = np.stack(
+        [
+            (6 * x**2 - 6 * x - p) / (d * L),
+            (3 * x**2 - (4 + p) * x + 1 + p / 2) / d,
+            -(6 * x**2 - 6 * x - p) / (d * L),
+            (3 * x**2 - (2 - p) * x - p / 2) / d,
+        ],
+        axis=-1,
+    )
+    nt = np.stack(
+        [
+            6 * (x**2 - x) / (d * L),
+            (3 * x**2 - (4 + p) * x + 1 + p) / d,
+            -6 * (x**2 - x) / (d * L),
+            (3 * x**2 - (2 - p) * x) / d,
+        ],
+        axis=-1,
+    )
+    dnt = np.stack(
+        [
+            6 * (2 * x - 1) / (d * L**2),
+            (6 * x - (4 + p)) / (d * L),
+            -6 * (2 * x - 1) / (d * L**2),
+            (6 * x - (2 - p)) / (d * L),
+        ],
+        axis=-1,
+    )
     return nv, dnv, nt, dnt
 
 
@@ -215,13 +233,15 @@ def _plane_matrices(L, EI, GAs, rhoA, rhoI, timoshenko):
     elements: K = int EI t'^2 + GAs (v' - t)^2, M = int rhoA v^2 + rhoI t^2, f = int Nv."""
     phi = np.where(timoshenko, 12.0 * EI / (GAs * L**2), 0.0)
     nv, dnv, nt, dnt = _bending_shapes(L, phi)
-    wl = _GAUSS_WXI[None, :] * L[:, None]                       # (ne, ng) weights * L
+    wl = _GAUSS_WXI[None, :] * L[:, None]  # (ne, ng) weights * L
     gamma = dnv - nt
     shear = np.where(timoshenko, GAs, 0.0)
-    K = np.einsum("eg,egi,egj->eij", wl * EI[:, None], dnt, dnt) \
-        + np.einsum("eg,egi,egj->eij", wl * shear[:, None], gamma, gamma)
-    M = np.einsum("eg,egi,egj->eij", wl * rhoA[:, None], nv, nv) \
-        + np.einsum("eg,egi,egj->eij", wl * rhoI[:, None], nt, nt)
+    K = np.einsum("eg,egi,egj->eij", wl * EI[:, None], dnt, dnt) + np.einsum(
+        "eg,egi,egj->eij", wl * shear[:, None], gamma, gamma
+    )
+    M = np.einsum("eg,egi,egj->eij", wl * rhoA[:, None], nv, nv) + np.einsum(
+        "eg,egi,egj->eij", wl * rhoI[:, None], nt, nt
+    )
     f = np.einsum("eg,egi->ei", wl, nv)
     return K, M, f
 
@@ -234,7 +254,9 @@ def beam_local_matrices(L, E, G, A, Iy, Iz, J, rho, timoshenko, rotary_inertia, 
     ``rotary_inertia`` boolean). Returns K (ne, 12, 12), M (ne, 12, 12), Q (ne, 12, 3)
     with f_local = Q @ q_local. Local dof order u1 v1 w1 rx1 ry1 rz1 u2 ... rz2.
     """
-    L, E, G, A, Iy, Iz, J, rho, k = (np.asarray(a, dtype=float) for a in (L, E, G, A, Iy, Iz, J, rho, shear_coefficient))
+    L, E, G, A, Iy, Iz, J, rho, k = (
+        np.asarray(a, dtype=float) for a in (L, E, G, A, Iy, Iz, J, rho, shear_coefficient)
+    )
     timoshenko = np.asarray(timoshenko, dtype=bool)
     rot = np.asarray(rotary_inertia, dtype=bool)
     ne = L.shape[0]
@@ -249,7 +271,9 @@ def beam_local_matrices(L, E, G, A, Iy, Iz, J, rho, timoshenko, rotary_inertia, 
     Q[:, _AXIAL, 0] = 0.5 * L[:, None]
     GAs = G * k * A
     for idx, sign, inertia, axis in ((_PLANE_XY, np.ones(4), Iz, 1), (_PLANE_XZ, _SIGN_XZ, Iy, 2)):
-        Kp, Mp, fp = _plane_matrices(L, E * inertia, GAs, rho * A, np.where(rot, rho * inertia, 0.0), timoshenko)
+        Kp, Mp, fp = _plane_matrices(
+            L, E * inertia, GAs, rho * A, np.where(rot, rho * inertia, 0.0), timoshenko
+        )
         s = np.outer(sign, sign)
         K[:, idx[:, None], idx[None, :]] = Kp * s
         M[:, idx[:, None], idx[None, :]] = Mp * s
@@ -346,11 +370,11 @@ class Frame:
         self._nodes: list[NDArray[np.float64]] = []
         self._beams: list[_Beam] = []
         self._bars: list[_Bar] = []
-        self._masses: list[tuple] = []          # (node, 6x6 mass, mass, offset, has rotary inertia)
-        self._fixed: set[int] = set()           # global dof indices
-        self._ties: list[dict[int, float]] = [] # rows {global dof: coefficient}, sum = 0
+        self._masses: list[tuple] = []  # (node, 6x6 mass, mass, offset, has rotary inertia)
+        self._fixed: set[int] = set()  # global dof indices
+        self._ties: list[dict[int, float]] = []  # rows {global dof: coefficient}, sum = 0
         self._nodal: dict[int, NDArray[np.float64]] = {}
-        self._distributed: list[tuple[int, NDArray[np.float64]]] = []   # (beam, global q)
+        self._distributed: list[tuple[int, NDArray[np.float64]]] = []  # (beam, global q)
 
     # --- geometry and members -------------------------------------------------------
     def add_node(self, position: ArrayLike) -> int:
@@ -365,9 +389,19 @@ class Frame:
         self._nodes.append(p)
         return len(self._nodes) - 1
 
-    def add_beam(self, n1: int, n2: int, E: float, G: float, section: Section, rho: float = 0.0,
-                 theory: Theory = "euler-bernoulli", shear_coefficient: float = 1.0,
-                 rotary_inertia: Optional[bool] = None, height_axis: Optional[ArrayLike] = None) -> int:
+    def add_beam(
+        self,
+        n1: int,
+        n2: int,
+        E: float,
+        G: float,
+        section: Section,
+        rho: float = 0.0,
+        theory: Theory = "euler-bernoulli",
+        shear_coefficient: float = 1.0,
+        rotary_inertia: Optional[bool] = None,
+        height_axis: Optional[ArrayLike] = None,
+    ) -> int:
         """Add a beam element between nodes ``n1`` and ``n2``.
 
         ``E``, ``G`` [Pa]; ``section`` (A, Iy, Iz, J); ``rho`` [kg/m^3] (0: massless);
@@ -383,14 +417,28 @@ class Frame:
         timo = theory == "timoshenko"
         rot = timo if rotary_inertia is None else bool(rotary_inertia)
         axis = None if height_axis is None else np.asarray(height_axis, dtype=float)
-        _local_axes(self._nodes[n1], self._nodes[n2], axis)   # validates now
-        self._beams.append(_Beam(n1, n2, float(E), float(G), section, float(rho), timo, rot,
-                                 float(shear_coefficient), axis))
+        _local_axes(self._nodes[n1], self._nodes[n2], axis)  # validates now
+        self._beams.append(
+            _Beam(
+                n1, n2, float(E), float(G), section, float(rho), timo, rot, float(shear_coefficient), axis
+            )
+        )
         return len(self._beams) - 1
 
-    def add_beam_line(self, start: ArrayLike, end: ArrayLike, n_elements: int, E: float, G: float,
-                      section: Section, rho: float = 0.0, start_node: Optional[int] = None,
-                      end_node: Optional[int] = None, interior: Sequence[float] = (), **options) -> list[int]:
+    def add_beam_line(
+        self,
+        start: ArrayLike,
+        end: ArrayLike,
+        n_elements: int,
+        E: float,
+        G: float,
+        section: Section,
+        rho: float = 0.0,
+        start_node: Optional[int] = None,
+        end_node: Optional[int] = None,
+        interior: Sequence[float] = (),
+        **options,
+    ) -> list[int]:
         """Mesh a straight member from ``start`` to ``end`` into ``n_elements`` equal
         elements per segment, returning the list of its node indices in order.
 
@@ -405,7 +453,9 @@ class Frame:
         cuts = np.unique(np.concatenate([[0.0], np.asarray(interior, dtype=float), [1.0]]))
         if cuts[0] < 0.0 or cuts[-1] > 1.0:
             raise ValueError("interior fractions must lie in (0, 1)")
-        fractions = np.unique(np.concatenate([np.linspace(c0, c1, n_elements + 1) for c0, c1 in zip(cuts[:-1], cuts[1:])]))
+        fractions = np.unique(
+            np.concatenate([np.linspace(c0, c1, n_elements + 1) for c0, c1 in zip(cuts[:-1], cuts[1:])])
+        )
         nodes: list[int] = []
         for i, t in enumerate(fractions):
             pos = a + t * (b - a)
@@ -431,8 +481,9 @@ class Frame:
         self._bars.append(_Bar(n1, n2, float(EA), float(rho_A)))
         return len(self._bars) - 1
 
-    def add_rigid_body(self, node: int, mass: float, inertia: ArrayLike = 0.0,
-                       offset: ArrayLike = (0.0, 0.0, 0.0)) -> None:
+    def add_rigid_body(
+        self, node: int, mass: float, inertia: ArrayLike = 0.0, offset: ArrayLike = (0.0, 0.0, 0.0)
+    ) -> None:
         """Attach a rigid body to ``node``: ``mass`` [kg], ``inertia`` [kg m^2] about its
         centre of mass in global axes (3x3, or 3 principal values, or one scalar used for
         all three), centre of mass at ``offset`` [m] from the node (2 or 3 components).
@@ -491,8 +542,10 @@ class Frame:
         # two unit vectors normal to the axis: the relative rotation has no component along them
         basis = scipy.linalg.null_space(a[None, :]).T
         for p in basis:
-            self.add_constraint({(node_a, r): p[i] for i, r in enumerate(("rx", "ry", "rz"))}
-                                | {(node_b, r): -p[i] for i, r in enumerate(("rx", "ry", "rz"))})
+            self.add_constraint(
+                {(node_a, r): p[i] for i, r in enumerate(("rx", "ry", "rz"))}
+                | {(node_b, r): -p[i] for i, r in enumerate(("rx", "ry", "rz"))}
+            )
 
     def add_rigid_link(self, master: int, slave: int) -> None:
         """Tie ``slave`` rigidly to ``master`` (a massless rigid arm, e.g. a lug offset):
@@ -510,8 +563,9 @@ class Frame:
         self.add_tie(master, slave, ("rx", "ry", "rz"))
 
     # --- loads -------------------------------------------------------------------------
-    def add_nodal_load(self, node: int, force: ArrayLike = (0.0, 0.0, 0.0),
-                       moment: ArrayLike = (0.0, 0.0, 0.0)) -> None:
+    def add_nodal_load(
+        self, node: int, force: ArrayLike = (0.0, 0.0, 0.0), moment: ArrayLike = (0.0, 0.0, 0.0)
+    ) -> None:
         """Add a point ``force`` [N] (2 or 3 components) and ``moment`` [N m] (3 components,
         or one scalar = moment about z) at ``node``, global axes."""
         self._check_node(node)
@@ -549,22 +603,38 @@ class Frame:
         """Global 12x12 K, M, the 12x3 global load operator and the dof maps of all beams."""
         ne = len(self._beams)
         if ne == 0:
-            return np.zeros((0, 12, 12)), np.zeros((0, 12, 12)), np.zeros((0, 12, 3)), np.zeros((0, 12), int), np.zeros(0)
+            return (
+                np.zeros((0, 12, 12)),
+                np.zeros((0, 12, 12)),
+                np.zeros((0, 12, 3)),
+                np.zeros((0, 12), int),
+                np.zeros(0),
+            )
         L = np.empty(ne)
         R = np.empty((ne, 3, 3))
         for e, b in enumerate(self._beams):
             L[e], R[e] = _local_axes(self._nodes[b.n1], self._nodes[b.n2], b.height_axis)
         get = lambda attr: np.array([getattr(b, attr) for b in self._beams])  # noqa: E731
         sec = lambda attr: np.array([getattr(b.section, attr) for b in self._beams])  # noqa: E731
-        Kl, Ml, Ql = beam_local_matrices(L, get("E"), get("G"), sec("A"), sec("Iy"), sec("Iz"), sec("J"),
-                                         get("rho"), get("timoshenko"), get("rotary_inertia"),
-                                         get("shear_coefficient"))
+        Kl, Ml, Ql = beam_local_matrices(
+            L,
+            get("E"),
+            get("G"),
+            sec("A"),
+            sec("Iy"),
+            sec("Iz"),
+            sec("J"),
+            get("rho"),
+            get("timoshenko"),
+            get("rotary_inertia"),
+            get("shear_coefficient"),
+        )
         T = np.zeros((ne, 12, 12))
         for k in range(4):
-            T[:, 3 * k:3 * k + 3, 3 * k:3 * k + 3] = R
+            T[:, 3 * k : 3 * k + 3, 3 * k : 3 * k + 3] = R
         Kg = np.einsum("eai,eab,ebj->eij", T, Kl, T)
         Mg = np.einsum("eai,eab,ebj->eij", T, Ml, T)
-        Qg = np.einsum("eai,eab,ebj->eij", T, Ql, R)       # global q -> global nodal loads
+        Qg = np.einsum("eai,eab,ebj->eij", T, Ql, R)  # global q -> global nodal loads
         n1, n2 = get("n1"), get("n2")
         dofs = np.concatenate([6 * n1[:, None] + np.arange(6), 6 * n2[:, None] + np.arange(6)], axis=1)
         return Kg, Mg, Qg, dofs, sec("A") * get("rho")
@@ -596,14 +666,16 @@ class Frame:
             k = bar.EA / L * np.outer(e, e)
             idx = np.concatenate([6 * bar.n1 + np.arange(3), 6 * bar.n2 + np.arange(3)])
             K[np.ix_(idx, idx)] += np.block([[k, -k], [-k, k]])
-            M[np.ix_(idx, idx)] += bar.rho_A * L / 6.0 * np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3))
+            M[np.ix_(idx, idx)] += (
+                bar.rho_A * L / 6.0 * np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3))
+            )
             f[idx] += np.tile(0.5 * bar.rho_A * L * g, 2)
         for node, Mb, mass, c, _ in self._masses:
             idx = 6 * node + np.arange(6)
             M[np.ix_(idx, idx)] += Mb
             f[idx] += np.concatenate([mass * g, np.cross(c, mass * g)])
         for node, load in self._nodal.items():
-            f[6 * node:6 * node + 6] += load
+            f[6 * node : 6 * node + 6] += load
         return K, M, f
 
     def _basis(self):
@@ -612,8 +684,12 @@ class Frame:
         fixed = set(self._fixed)
         if self.planar:
             fixed |= {6 * i + _DOF_INDEX[d] for i in range(self.n_nodes) for d in _PLANAR_FIXED}
-        rotating = ({b.n1 for b in self._beams} | {b.n2 for b in self._beams} | {m[0] for m in self._masses if m[4]}
-                    | {d // 6 for row in self._ties for d in row if d % 6 >= 3})
+        rotating = (
+            {b.n1 for b in self._beams}
+            | {b.n2 for b in self._beams}
+            | {m[0] for m in self._masses if m[4]}
+            | {d // 6 for row in self._ties for d in row if d % 6 >= 3}
+        )
         fixed |= {6 * i + r for i in range(self.n_nodes) if i not in rotating for r in (3, 4, 5)}
         free = np.array([i for i in range(n) if i not in fixed], dtype=int)
         col = {d: j for j, d in enumerate(free)}
@@ -644,8 +720,10 @@ class Frame:
         try:
             cho = scipy.linalg.cho_factor(Kr)
         except np.linalg.LinAlgError as exc:
-            raise ValueError("the constrained stiffness matrix is singular: the frame is a mechanism "
-                             "or is not supported enough") from exc
+            raise ValueError(
+                "the constrained stiffness matrix is singular: the frame is a mechanism "
+                "or is not supported enough"
+            ) from exc
         u = T @ scipy.linalg.cho_solve(cho, T.T @ f)
         reactions = np.zeros_like(f)
         reactions[fixed] = (K @ u - f)[fixed]
@@ -689,7 +767,9 @@ class Frame:
 
     def _check_position(self, node: int, position: NDArray) -> None:
         self._check_node(node)
-        if not np.allclose(self._nodes[node], position, rtol=0.0, atol=1e-12 * max(1.0, np.abs(position).max())):
+        if not np.allclose(
+            self._nodes[node], position, rtol=0.0, atol=1e-12 * max(1.0, np.abs(position).max())
+        ):
             raise ValueError(f"node {node} at {self._nodes[node]} is not at {position}")
 
     @staticmethod

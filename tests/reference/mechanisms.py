@@ -19,6 +19,7 @@ Conventions
   n along the left normal (rotated +90 degrees): position = hinge + s e + n e_perp with
   e = (cos a, sin a), e_perp = (-sin a, cos a).
 """
+
 from __future__ import annotations
 
 import math
@@ -97,17 +98,27 @@ class PendulumSolution:
     energy: NDArray[np.float64]
 
 
-def _pendulum_constants(length: float, rod_mass: float, point_mass: float,
-                        point_mass_distance: Optional[float]) -> tuple[float, float]:
+def _pendulum_constants(
+    length: float, rod_mass: float, point_mass: float, point_mass_distance: Optional[float]
+) -> tuple[float, float]:
     """Inertia about the pivot I_O = m L^2/3 + M d^2 and first moment S = m L/2 + M d."""
     d = length if point_mass_distance is None else point_mass_distance
     return rod_mass * length**2 / 3.0 + point_mass * d**2, rod_mass * length / 2.0 + point_mass * d
 
 
-def pendulum(t: ArrayLike, angle0: float, rate0: float, length: float, rod_mass: float,
-             gravity: ArrayLike = (0.0, -9.81), point_mass: float = 0.0,
-             point_mass_distance: Optional[float] = None, pivot: ArrayLike = (0.0, 0.0),
-             rtol: float = _RTOL, atol: float = _ATOL) -> PendulumSolution:
+def pendulum(
+    t: ArrayLike,
+    angle0: float,
+    rate0: float,
+    length: float,
+    rod_mass: float,
+    gravity: ArrayLike = (0.0, -9.81),
+    point_mass: float = 0.0,
+    point_mass_distance: Optional[float] = None,
+    pivot: ArrayLike = (0.0, 0.0),
+    rtol: float = _RTOL,
+    atol: float = _ATOL,
+) -> PendulumSolution:
     """Rigid physical pendulum: a uniform rod (``length`` L, ``rod_mass`` m) hinged at
     one end to ground at ``pivot``, optionally carrying a point mass M at distance d
     (``point_mass_distance``, default L: at the tip) along the rod.
@@ -129,12 +140,18 @@ def pendulum(t: ArrayLike, angle0: float, rate0: float, length: float, rod_mass:
     y = _integrate(rhs, t, np.array([angle0, rate0], dtype=float), rtol, atol)
     e = _unit(y[:, 0])
     energy = 0.5 * I_O * y[:, 1] ** 2 - S * (e @ g)
-    return PendulumSolution(np.asarray(t, dtype=float), y[:, 0], y[:, 1],
-                            _vec2(pivot, "pivot") + length * e, energy)
+    return PendulumSolution(
+        np.asarray(t, dtype=float), y[:, 0], y[:, 1], _vec2(pivot, "pivot") + length * e, energy
+    )
 
 
-def pendulum_small_amplitude_period(length: float, rod_mass: float, g: float, point_mass: float = 0.0,
-                                    point_mass_distance: Optional[float] = None) -> float:
+def pendulum_small_amplitude_period(
+    length: float,
+    rod_mass: float,
+    g: float,
+    point_mass: float = 0.0,
+    point_mass_distance: Optional[float] = None,
+) -> float:
     """Small-amplitude period 2 pi sqrt(I_O / (S g)) of ``pendulum`` (g the magnitude of
     gravity); 2 pi sqrt(2L/(3g)) for the bare rod."""
     I_O, S = _pendulum_constants(length, rod_mass, point_mass, point_mass_distance)
@@ -156,7 +173,9 @@ class DoublePendulumSolution:
     energy: NDArray[np.float64]
 
 
-def double_pendulum_mass_matrix(angles: ArrayLike, lengths: Sequence[float], masses: Sequence[float]) -> NDArray:
+def double_pendulum_mass_matrix(
+    angles: ArrayLike, lengths: Sequence[float], masses: Sequence[float]
+) -> NDArray:
     """Mass matrix of two uniform rods hinged in series (rod 1 to ground at one end,
     rod 2 to the free end of rod 1), in the absolute angles (a1, a2):
 
@@ -175,9 +194,17 @@ def double_pendulum_mass_matrix(angles: ArrayLike, lengths: Sequence[float], mas
     return M
 
 
-def double_pendulum(t: ArrayLike, angles0: Sequence[float], rates0: Sequence[float], lengths: Sequence[float],
-                    masses: Sequence[float], gravity: ArrayLike = (0.0, -9.81), pivot: ArrayLike = (0.0, 0.0),
-                    rtol: float = _RTOL, atol: float = _ATOL) -> DoublePendulumSolution:
+def double_pendulum(
+    t: ArrayLike,
+    angles0: Sequence[float],
+    rates0: Sequence[float],
+    lengths: Sequence[float],
+    masses: Sequence[float],
+    gravity: ArrayLike = (0.0, -9.81),
+    pivot: ArrayLike = (0.0, 0.0),
+    rtol: float = _RTOL,
+    atol: float = _ATOL,
+) -> DoublePendulumSolution:
     """Planar double pendulum of two uniform rods (lengths L1, L2, masses m1, m2) hinged
     in series, rod 1 hinged to ground at ``pivot``, under ``gravity``.
 
@@ -203,7 +230,7 @@ def double_pendulum(t: ArrayLike, angles0: Sequence[float], rates0: Sequence[flo
         m12 = c * cD
         q1 = s1 * (-math.sin(a1) * gx + math.cos(a1) * gy) - c * sD * w2**2
         q2 = s2 * (-math.sin(a2) * gx + math.cos(a2) * gy) + c * sD * w1**2
-        det = m11 * m22 - m12**2                       # the 2x2 solve by Cramer's rule
+        det = m11 * m22 - m12**2  # the 2x2 solve by Cramer's rule
         return [w1, w2, (m22 * q1 - m12 * q2) / det, (m11 * q2 - m12 * q1) / det]
 
     y = _integrate(rhs, t, np.array([*angles0, *rates0], dtype=float), rtol, atol)
@@ -214,12 +241,14 @@ def double_pendulum(t: ArrayLike, angles0: Sequence[float], rates0: Sequence[flo
     potential = -(s1 * (e1 @ g) + s2 * (e2 @ g))
     p0 = _vec2(pivot, "pivot")
     knee = p0 + L1 * e1
-    return DoublePendulumSolution(np.asarray(t, dtype=float), angles, rates, knee, knee + L2 * e2,
-                                  kinetic + potential)
+    return DoublePendulumSolution(
+        np.asarray(t, dtype=float), angles, rates, knee, knee + L2 * e2, kinetic + potential
+    )
 
 
-def double_pendulum_linear_frequencies(lengths: Sequence[float], masses: Sequence[float],
-                                       g: float) -> tuple[NDArray, NDArray]:
+def double_pendulum_linear_frequencies(
+    lengths: Sequence[float], masses: Sequence[float], g: float
+) -> tuple[NDArray, NDArray]:
     """Angular frequencies [rad/s] (ascending) and mode shapes of small oscillations of
     ``double_pendulum`` about the hanging equilibrium (g = |gravity|): the generalized
     eigenproblem K v = w^2 M0 v with M0 the mass matrix at a1 = a2 and
@@ -259,13 +288,24 @@ class SliderCrankSolution:
     potential: NDArray[np.float64]
 
 
-def slider_crank(t: ArrayLike, crank_length: float, rod_length: float, crank_mass: float, rod_mass: float,
-                 slider_mass: float, omega: float, theta0: float = 0.0,
-                 gravity: ArrayLike = (0.0, 0.0)) -> SliderCrankSolution:
-    """Planar in-line slider-crank driven at constant crank speed.
+def slider_crank(
+    t: ArrayLike,
+    crank_length: float,
+    rod_length: float,
+    crank_mass: float,
+    rod_mass: float,
+    slider_mass: float,
+    omega: float,
+    theta0: float = 0.0,
+    gravity: ArrayLike = (0.0, 0.0),
+    angular_acceleration: float = 0.0,
+) -> SliderCrankSolution:
+    """Planar in-line slider-crank with a prescribed crank motion (constant speed by
+    default).
 
     Crank: uniform rod (length r = ``crank_length``, mass m1) hinged to ground at the
-    origin, angle theta(t) = ``theta0`` + ``omega`` t (prescribed). Connecting rod:
+    origin, angle theta(t) = ``theta0`` + ``omega`` t + ``angular_acceleration`` t^2/2
+    (prescribed; ``omega`` [rad/s] is the speed at t = 0). Connecting rod:
     uniform rod (length l = ``rod_length`` > r, mass m2) hinged to the crank tip
     A = r (cos theta, sin theta) and to the slider B = (x, 0) (point mass m3) that slides
     without friction along the x axis, on the side x > 0. Closed-form kinematics:
@@ -283,14 +323,14 @@ def slider_crank(t: ArrayLike, crank_length: float, rod_length: float, crank_mas
     if not l > r > 0.0:
         raise ValueError(f"need rod_length > crank_length > 0, got l = {l}, r = {r}")
     g = _vec2(gravity, "gravity")
-    t = np.asarray(t, dtype=float)
-    th = theta0 + omega * t
-    thd, thdd = omega * np.ones_like(t), np.zeros_like(t)
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    th = theta0 + omega * t + 0.5 * angular_acceleration * t**2
+    thd, thdd = omega + angular_acceleration * t, np.full_like(t, float(angular_acceleration))
     st, ct = np.sin(th), np.cos(th)
     sp = -(r / l) * st
     cp = np.sqrt(1.0 - sp**2)
     psi = np.arctan2(sp, cp)
-    dpsi = -(r / l) * ct / cp                          # d psi / d theta
+    dpsi = -(r / l) * ct / cp  # d psi / d theta
     psid = dpsi * thd
     psidd = ((r / l) * (st * thd**2 - ct * thdd) + sp * psid**2) / cp
     # positions, Jacobians d/dtheta, accelerations of the centres of mass
@@ -298,7 +338,7 @@ def slider_crank(t: ArrayLike, crank_length: float, rod_length: float, crank_mas
     dA = r * np.stack([-st, ct], axis=-1)
     aA = r * np.stack([-ct * thd**2 - st * thdd, -st * thd**2 + ct * thdd], axis=-1)
     u = np.stack([cp, sp], axis=-1)
-    du = _perp(u)                                       # d u / d psi
+    du = _perp(u)  # d u / d psi
     x = A[:, 0] + l * cp
     dx = dA[:, 0] + l * du[:, 0] * dpsi
     xd = dx * thd
@@ -309,12 +349,17 @@ def slider_crank(t: ArrayLike, crank_length: float, rod_length: float, crank_mas
     ac2 = aA + 0.5 * l * (du * psidd[:, None] - u * (psid**2)[:, None])
     m1, m2, m3 = crank_mass, rod_mass, slider_mass
     I1, I2 = m1 * r**2 / 12.0, m2 * l**2 / 12.0
-    torque = (m1 * np.einsum("ni,ni->n", ac1 - g, dc1) + I1 * thdd
-              + m2 * np.einsum("ni,ni->n", ac2 - g, dc2) + I2 * psidd * dpsi
-              + m3 * (xdd - g[0]) * dx)
+    torque = (
+        m1 * np.einsum("ni,ni->n", ac1 - g, dc1)
+        + I1 * thdd
+        + m2 * np.einsum("ni,ni->n", ac2 - g, dc2)
+        + I2 * psidd * dpsi
+        + m3 * (xdd - g[0]) * dx
+    )
     v1, v2 = dc1 * thd[:, None], dc2 * thd[:, None]
-    kinetic = 0.5 * (m1 * np.sum(v1**2, axis=1) + I1 * thd**2 + m2 * np.sum(v2**2, axis=1)
-                     + I2 * psid**2 + m3 * xd**2)
+    kinetic = 0.5 * (
+        m1 * np.sum(v1**2, axis=1) + I1 * thd**2 + m2 * np.sum(v2**2, axis=1) + I2 * psid**2 + m3 * xd**2
+    )
     potential = -(m1 * c1 @ g + m2 * c2 @ g + m3 * x * g[0])
     return SliderCrankSolution(t, th, A, x, xd, xdd, psi, psid, psidd, torque, kinetic, potential)
 
@@ -354,8 +399,14 @@ class KnuckleBoomStatics:
     lift_force: Optional[NDArray[np.float64]] = None
 
 
-def knuckle_boom_jib_angle(boom_length: float, boom_angle: float, boom_point: Sequence[float],
-                           jib_point: Sequence[float], actuator_length: ArrayLike, branch: int = 1) -> NDArray:
+def knuckle_boom_jib_angle(
+    boom_length: float,
+    boom_angle: float,
+    boom_point: Sequence[float],
+    jib_point: Sequence[float],
+    actuator_length: ArrayLike,
+    branch: int = 1,
+) -> NDArray:
     """Jib angle [rad] for which the actuator between P (``boom_point`` (s, n) in the
     boom frame) and Q (``jib_point`` (s, n) in the jib frame) has length
     ``actuator_length`` (scalar or array).
@@ -375,18 +426,30 @@ def knuckle_boom_jib_angle(boom_length: float, boom_angle: float, boom_point: Se
     L = np.asarray(actuator_length, dtype=float)
     c = (L**2 - nd**2 - nq**2) / (2.0 * nd * nq)
     if np.any(np.abs(c) > 1.0):
-        raise ValueError(f"actuator length out of reach: needs |P B| - |B Q| <= L <= |P B| + |B Q| "
-                         f"= [{abs(nd - nq)}, {nd + nq}]")
+        raise ValueError(
+            f"actuator length out of reach: needs |P B| - |B Q| <= L <= |P B| + |B Q| "
+            f"= [{abs(nd - nq)}, {nd + nq}]"
+        )
     a2 = np.arctan2(d[1], d[0]) - np.arctan2(q[1], q[0]) + branch * np.arccos(c)
     return np.angle(np.exp(1j * a2))
 
 
-def knuckle_boom_statics(boom_length: float, boom_mass: float, jib_length: float, jib_mass: float,
-                         boom_angle: float, boom_point: Sequence[float], jib_point: Sequence[float],
-                         actuator_length: ArrayLike, gravity: ArrayLike = (0.0, -9.81),
-                         tip_load: ArrayLike = (0.0, 0.0), branch: int = 1,
-                         pivot: ArrayLike = (0.0, 0.0), lift_ground_point: Optional[Sequence[float]] = None,
-                         lift_boom_point: Optional[Sequence[float]] = None) -> KnuckleBoomStatics:
+def knuckle_boom_statics(
+    boom_length: float,
+    boom_mass: float,
+    jib_length: float,
+    jib_mass: float,
+    boom_angle: float,
+    boom_point: Sequence[float],
+    jib_point: Sequence[float],
+    actuator_length: ArrayLike,
+    gravity: ArrayLike = (0.0, -9.81),
+    tip_load: ArrayLike = (0.0, 0.0),
+    branch: int = 1,
+    pivot: ArrayLike = (0.0, 0.0),
+    lift_ground_point: Optional[Sequence[float]] = None,
+    lift_boom_point: Optional[Sequence[float]] = None,
+) -> KnuckleBoomStatics:
     """Rigid knuckle boom in quasi-static equilibrium.
 
     Boom: uniform rod (length L1 = ``boom_length``, mass m1) hinged to ground at ``pivot``
@@ -441,8 +504,23 @@ def knuckle_boom_statics(boom_length: float, boom_mass: float, jib_length: float
     if abs(lift_arm) < 1e-12 * boom_length:
         raise ValueError("the lift cylinder line passes through the pivot: no moment arm")
     f_l = M_O / lift_arm
-    return KnuckleBoomStatics(float(boom_angle), a2, O, B, P, Q, T, u, f, R_O - f_l[..., None] * u_l,
-                              np.zeros_like(M_O), R_B, P2, u_l, f_l)
+    return KnuckleBoomStatics(
+        float(boom_angle),
+        a2,
+        O,
+        B,
+        P,
+        Q,
+        T,
+        u,
+        f,
+        R_O - f_l[..., None] * u_l,
+        np.zeros_like(M_O),
+        R_B,
+        P2,
+        u_l,
+        f_l,
+    )
 
 
 # ------------------------------------------------------------ (e) flexible knuckle boom
@@ -463,8 +541,9 @@ class KnuckleBoomSag:
     statics: KnuckleBoomStatics
 
 
-def _cantilever_point(s: float, a: float, P_t: float, P_a: float, EI: float, EA: float,
-                      GAs: Optional[float]) -> tuple[float, float]:
+def _cantilever_point(
+    s: float, a: float, P_t: float, P_a: float, EI: float, EA: float, GAs: Optional[float]
+) -> tuple[float, float]:
     """(axial, transverse) displacement at s of a cantilever clamped at 0 under point
     loads P_a (axial) and P_t (transverse) at a: u = P_a min(s, a)/EA;
     v = P_t s^2 (3a - s)/(6EI) for s <= a, P_t a^2 (3s - a)/(6EI) beyond, + P_t min(s, a)/GAs."""
@@ -475,8 +554,9 @@ def _cantilever_point(s: float, a: float, P_t: float, P_a: float, EI: float, EA:
     return P_a * m / EA, v
 
 
-def _cantilever_uniform(s: float, L: float, q_t: float, q_a: float, EI: float, EA: float,
-                        GAs: Optional[float]) -> tuple[float, float]:
+def _cantilever_uniform(
+    s: float, L: float, q_t: float, q_a: float, EI: float, EA: float, GAs: Optional[float]
+) -> tuple[float, float]:
     """(axial, transverse) displacement at s of a cantilever (clamped at 0, length L)
     under uniform loads q_a, q_t per length: u = q_a (L s - s^2/2)/EA,
     v = q_t s^2 (6L^2 - 4Ls + s^2)/(24EI) + q_t (L s - s^2/2)/GAs."""
@@ -486,13 +566,27 @@ def _cantilever_uniform(s: float, L: float, q_t: float, q_a: float, EI: float, E
     return q_a * (L * s - s**2 / 2.0) / EA, v
 
 
-def knuckle_boom_flexible_sag(boom_length: float, boom_mass: float, jib_length: float, jib_mass: float,
-                              boom_angle: float, boom_point_s: float, jib_point_s: float, actuator_length: float,
-                              boom_EA: float, boom_EI: float, jib_EA: float, jib_EI: float,
-                              boom_GAs: Optional[float] = None, jib_GAs: Optional[float] = None,
-                              actuator_EA: float = np.inf, gravity: ArrayLike = (0.0, -9.81),
-                              tip_load: ArrayLike = (0.0, 0.0), branch: int = 1,
-                              pivot: ArrayLike = (0.0, 0.0)) -> KnuckleBoomSag:
+def knuckle_boom_flexible_sag(
+    boom_length: float,
+    boom_mass: float,
+    jib_length: float,
+    jib_mass: float,
+    boom_angle: float,
+    boom_point_s: float,
+    jib_point_s: float,
+    actuator_length: float,
+    boom_EA: float,
+    boom_EI: float,
+    jib_EA: float,
+    jib_EI: float,
+    boom_GAs: Optional[float] = None,
+    jib_GAs: Optional[float] = None,
+    actuator_EA: float = np.inf,
+    gravity: ArrayLike = (0.0, -9.81),
+    tip_load: ArrayLike = (0.0, 0.0),
+    branch: int = 1,
+    pivot: ArrayLike = (0.0, 0.0),
+) -> KnuckleBoomSag:
     """Static sag of the knuckle boom of ``knuckle_boom_statics`` made of two flexible
     straight beams, by superposition (small deflections, loads on the undeformed shape).
 
@@ -514,8 +608,20 @@ def knuckle_boom_flexible_sag(boom_length: float, boom_mass: float, jib_length: 
        (d_Q - d_P) . u = f L_act / EA_act with d_Q = d_B + u_e(a) e2 + alpha a e2_perp.
     4. d_T = d_B + u_e(L2) e2 + (alpha L2 + w_e) e2_perp.
     """
-    st = knuckle_boom_statics(boom_length, boom_mass, jib_length, jib_mass, boom_angle, (boom_point_s, 0.0),
-                              (jib_point_s, 0.0), actuator_length, gravity, tip_load, branch, pivot)
+    st = knuckle_boom_statics(
+        boom_length,
+        boom_mass,
+        jib_length,
+        jib_mass,
+        boom_angle,
+        (boom_point_s, 0.0),
+        (jib_point_s, 0.0),
+        actuator_length,
+        gravity,
+        tip_load,
+        branch,
+        pivot,
+    )
     if np.ndim(st.jib_angle) != 0:
         raise ValueError("knuckle_boom_flexible_sag takes one actuator length at a time")
     if not (0.0 < boom_point_s <= boom_length and 0.0 < jib_point_s <= jib_length):
