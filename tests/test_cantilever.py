@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ancfdrv.reference import analytic
-from ancfdrv.model import build_model
+from ancfdrv.builders import build_model
 from ancfdrv.io.scene import load_scene
 from ancfdrv.solvers.static import solve_newton, solve_split
 

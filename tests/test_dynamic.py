@@ -19,7 +19,7 @@ from ancfdrv.reference import analytic
 from ancfdrv.cli import main
 from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 from ancfdrv.history import crossing_frequency
-from ancfdrv.model import build_model
+from ancfdrv.builders import build_model
 from ancfdrv.runner import run_scene
 from ancfdrv.io.scene import load_scene
 from ancfdrv.solvers.static import solve_newton

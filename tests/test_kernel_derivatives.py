@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from ancfdrv import kernel
-from ancfdrv.constraints import DRIVE_LUFFING, ConstraintSet
+from ancfdrv.codes import (CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE,
+                           CONSTRAINT_DOT, DRIVE_LUFFING, DRIVE_SINE)
+from ancfdrv.system.constraint_set import ConstraintSet
 
 RNG = np.random.default_rng(7)
 
@@ -42,12 +44,24 @@ def test_moment_force_rejects_director_along_axis():
 
 
 def random_constraints(ndof: int) -> ConstraintSet:
-    c = ConstraintSet()
-    drive = c.add_drive(DRIVE_LUFFING, [0.2, 1.0, 1.0, np.pi / 3, 0.1])
-    c.coordinate(4, 0.5, cos_coef=1.7, sin_coef=-0.3, drive=drive)
-    c.distance([0, 1, 2], (0.1, -0.2, 0.3), 0.9, dependent=0)
-    c.cross([3, 4, 5], [9, 10, 11], (0.5, 0.5, 0.0), (0.2, 0.3, 0.9), dependent=3)
-    c._add(4, 0, [6, 7, 8, 12, 13, 14], [0.4], 6, "dot")
+    """One constraint of every kind, with operands that combine several coordinates (as a
+    rigid body's point r + J u does) and driven values."""
+    c = ConstraintSet(drive_kinds=[DRIVE_LUFFING, DRIVE_SINE],
+                      drive_params=[[0.2, 1.0, 1.0, np.pi / 3, 0.1],
+                                    [0.3, 0.7, 0.2, 1.1, 0.0, 0.5]])
+
+    def single(dofs):
+        return [({d: 1.0}, 0.0) for d in dofs]
+    c.add(CONSTRAINT_COORDINATE, [({4: 1.0, 7: -0.6}, 0.2)], [0.5, 1.7, -0.3, 0.4], 0,
+          "driven coordinate")
+    c.add(CONSTRAINT_DISTANCE, single([0, 1, 2]) + [({}, 0.1), ({}, -0.2), ({}, 0.3)],
+          [0.9, 0.0], -1, "distance to a point")
+    c.add(CONSTRAINT_DISTANCE, [({0: 1.0, 3: 0.4}, 0.0), ({1: 1.0, 4: 0.4}, 0.0),
+                                ({2: 1.0, 5: 0.4}, 0.0)] + single([12, 13, 14]),
+          [0.0, 1.0], 1, "driven distance between two points")
+    c.add(CONSTRAINT_CROSS, [({3: 1.0}, -0.5), ({4: 1.0}, -0.5), ({5: 1.0}, 0.0)]
+          + single([9, 10, 11]), [0.2, 0.3, 0.9], -1, "cross")
+    c.add(CONSTRAINT_DOT, single([6, 7, 8, 12, 13, 14]), [0.4], -1, "dot")
     return c
 
 
@@ -58,23 +72,24 @@ def test_constraint_gradients_hessians_and_time_derivatives(t):
     e = RNG.standard_normal(ndof)
     e_dot = RNG.standard_normal(ndof)
     values, grads, hess, phi_t, phi_tt, gamma = c.evaluate(e, t, e_dot)
-    table = c.dof_table()
+    jacobian = c.gradient_rows(e, ndof, t)
+    hessian = np.zeros((len(c), ndof, ndof))
+    for k, row, col, value in zip(*c.hessian_triplets(e)):
+        hessian[k, row, col] += value
     h = 1e-6
-    for k in range(len(c)):
-        for a in range(6):
-            if table[a, k] < 0:
-                continue
-            step = np.zeros(ndof)
-            step[table[a, k]] = h
-            fd = (c.evaluate(e + step, t)[0][k] - c.evaluate(e - step, t)[0][k]) / (2 * h)
-            assert grads[a, k] == pytest.approx(fd, rel=1e-7, abs=1e-8)
-            gp = c.evaluate(e + step, t)[1][:, k]
-            gm = c.evaluate(e - step, t)[1][:, k]
-            np.testing.assert_allclose((gp - gm) / (2 * h), hess[:, a, k], atol=1e-7)
+    for j in range(ndof):
+        step = np.zeros(ndof)
+        step[j] = h
+        fd = (c.evaluate(e + step, t)[0] - c.evaluate(e - step, t)[0]) / (2 * h)
+        np.testing.assert_allclose(jacobian[:, j], fd, rtol=1e-7, atol=1e-8)
+        fd_rows = (c.gradient_rows(e + step, ndof, t)
+                   - c.gradient_rows(e - step, ndof, t)) / (2 * h)
+        np.testing.assert_allclose(hessian[:, :, j], fd_rows, atol=1e-7)
     ht = 1e-5
     fd_t = (c.evaluate(e, t + ht)[0] - c.evaluate(e, t - ht)[0]) / (2 * ht)
     np.testing.assert_allclose(phi_t, fd_t, atol=1e-8)
-    fd_tt = (c.evaluate(e, t + ht)[0] - 2 * values + c.evaluate(e, t - ht)[0]) / ht**2
+    htt = 1e-4  # a second difference: round-off eps |Phi| / h^2 wants a larger step
+    fd_tt = (c.evaluate(e, t + htt)[0] - 2 * values + c.evaluate(e, t - htt)[0]) / htt**2
     np.testing.assert_allclose(phi_tt, fd_tt, atol=1e-5)
     # gamma = -d/dt(Phi_e e_dot) - Phi_tt along a path e(t) = e + t e_dot (e'' = 0):
     # then d2 Phi/dt2 = -gamma, checked by central differences along the path

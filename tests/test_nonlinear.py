@@ -15,11 +15,12 @@ from scipy.spatial.transform import Rotation
 
 from ancfdrv import kernel
 from ancfdrv.reference import analytic
-from ancfdrv.model import BeamModel, build_model
+from ancfdrv.builders import build_model
 from ancfdrv.io.scene import load_scene
 from ancfdrv.solvers.static import solve_newton
 
 from conftest import INPUTS
+from helpers import beam_model, rect
 
 RNG = np.random.default_rng(5)
 CANTILEVER = INPUTS / "cantilever.nml"
@@ -28,11 +29,9 @@ SLENDER = ["beam.length=1", "beam.width=0.01", "beam.height=0.01",
 EI_SLENDER = 2.1e11 * 0.01**4 / 12
 
 
-def beam(formulation: str, nodes: int = 4, poisson: float = 0.0) -> BeamModel:
-    return BeamModel(node_s=np.linspace(0.0, 1.5, nodes), width=0.06, height=0.1,
-                     density=7850.0, youngs=2.1e11, poisson=poisson, rotation=np.eye(3),
-                     origin_offset=np.array([0.2, 0.1, -0.3]), effects=(),
-                     formulation=formulation)
+def beam(formulation: str, nodes: int = 4, poisson: float = 0.0):
+    return beam_model(nodes, 1.5, width=0.06, height=0.1, poisson=poisson,
+                      offset=(0.2, 0.1, -0.3), formulation=formulation, bending="continuum")
 
 
 @pytest.mark.parametrize("poisson", [0.0, 0.3])
@@ -87,21 +86,24 @@ def test_curved_reference_is_strain_free():
         normal = np.array([-np.sin(angle), np.cos(angle), 0.0])
         return np.stack([position, tangent, normal, [0.0, 0.0, 1.0]])
     reference = np.concatenate([arc(0.0), arc(length)]).T.reshape(3, 8, 1)
-    gradients, weights = kernel.beam_nonlinear_setup(reference, [length], 0.02, 0.03)
+    gradients, weights, nvolume = kernel.beam_nonlinear_setup(reference, [length],
+                                                                 rect(0.02, 0.03))
     dofs = np.arange(24)[:, None]
     e0 = reference[:, :, 0].T.ravel()
-    force, energy, _ = kernel.beam_nonlinear_forces(dofs, e0, gradients, weights, 2e11, 0.3, False)
+    force, energy, _ = kernel.beam_nonlinear_forces(dofs, e0, gradients, weights, nvolume, 2e11, 0.3,
+                                                    False)
     assert abs(energy) < 1e-12 and np.abs(force).max() < 1e-3
     rot = Rotation.from_euler("zyx", [2.5, -0.7, 1.9]).as_matrix()
     moved = (e0.reshape(8, 3) @ rot.T)
     moved[[0, 4]] += [1.0, 2.0, 3.0]
     force, energy, _ = kernel.beam_nonlinear_forces(dofs, moved.ravel(), gradients, weights,
-                                                    2e11, 0.3, False)
+                                                    nvolume, 2e11, 0.3, False)
     assert abs(energy) < 1e-9 and np.abs(force).max() < 1e-3
     # bending it further costs energy: the reference curvature is the zero of the strain
     bent = e0.copy()
     bent[12:15] += [0.0, 1e-3, 0.0]
-    assert kernel.beam_nonlinear_forces(dofs, bent, gradients, weights, 2e11, 0.3, False)[1] > 0
+    assert kernel.beam_nonlinear_forces(dofs, bent, gradients, weights, nvolume, 2e11, 0.3,
+                                        False)[1] > 0
 
 
 def elastica(nodes: int, k: float):

@@ -14,9 +14,10 @@ from scipy.spatial.transform import Rotation
 from ancfdrv import kernel
 from ancfdrv.solvers.dynamic import integrate
 from ancfdrv.errors import InputError
-from ancfdrv.model import build_model
-from ancfdrv.plate import (P_R, P_RX, P_RY, PlateModel, PlateProbe, arc_mesh,
-                           rectangle_mesh)
+from ancfdrv.builders import build_model
+from ancfdrv.builders import build_system
+from ancfdrv.system import System
+from ancfdrv.system.meshes import arc_mesh
 from ancfdrv.runner import dynamic_settings, run_scene
 from ancfdrv.io.scene import load_scene
 from ancfdrv.solvers.static import solve_newton
@@ -165,19 +166,27 @@ def test_analytic_force_and_tangent_match_central_differences(variant, curved):
 def _strip(nx: int, poisson: float, force: float = 0.0, moment: float = 0.0) -> float:
     """Tip deflection of a clamped strip in cylindrical bending (r_y held: a strip of a wide
     plate, as Kirchhoff's per-unit-width formula assumes)."""
-    mesh = rectangle_mesh(1.0, 0.1, nx, 1)
-    model = PlateModel(mesh, 0.01, density=7800.0, youngs=2e11, poisson=poisson,
-                       variant="completed", effects=("tip_force", "end_moment"))
+    s = System("strip", effects=("tip_force", "end_moment"))
+    steel = s.material("steel", youngs_modulus=2e11, density=7800.0, poisson_ratio=poisson)
+    plate = s.plate("strip", material=steel, thickness=0.01, corner=(0, 0, 0),
+                    edge_x=(1.0, 0, 0), edge_y=(0, 0.1, 0), nx=nx, ny=1)
+    mesh = plate.mesh
     root, tip = mesh.node_sets["edge_x0"], mesh.node_sets["edge_x1"]
-    for part in (P_R, P_RX, P_RY):
-        model.fix(root, part)
-    model.fix(np.setdiff1d(np.arange(mesh.nnodes), root), P_RY)
-    for node in tip:
+    nodes = mesh.coords[:, :3]
+    for vector in ("r", "r_x", "r_y"):
+        s.joint(f"root {vector}", "fix", "ground", "strip", point=nodes[root].ravel(),
+                vector=vector)
+    s.joint("r_y held", "fix", "ground", "strip", vector="r_y",
+            point=nodes[np.setdiff1d(np.arange(mesh.nnodes), root)].ravel())
+    for k, node in enumerate(tip):
         if force:
-            model.add_point_force(node, np.array([0.0, 0.0, force / len(tip)]), "tip_force")
-    if moment:
-        model.add_edge_moment(tip, np.array([0.0, -1.0, 0.0]), moment, "end_moment")
-    model.probes["tip"] = PlateProbe(*mesh.element_at(1.0, 0.5))
+            s.load(f"force {k}", "force", body="strip", point=nodes[node],
+                   vector=(0.0, 0.0, force / len(tip)), effect="tip_force")
+        if moment:  # the edge moment shared by the tip nodes (equal tributary widths)
+            s.load(f"moment {k}", "moment", body="strip", point=nodes[node],
+                   vector=(0.0, -moment / len(tip), 0.0), effect="end_moment")
+    s.probe("tip", "strip", (1.0, 0.05, 0.0))
+    model = s.assemble()
     result = solve_newton(model, tol=1e-12)
     return model.deflections(result.e)["tip"][2]
 
@@ -282,7 +291,7 @@ def _leaf_static(overrides: list[str]):
 
 def _end_radius(model, e: np.ndarray, half_length: float) -> float:
     """Radius of the arc through the middle clamp and the end slope: (L/2) / theta_end."""
-    rx = e.reshape(-1, 9)[model.mesh.node_sets["edge_x1"], 3:6].mean(axis=0)
+    rx = e.reshape(-1, 9)[model.plate_bodies()[0].mesh.node_sets["edge_x1"], 3:6].mean(axis=0)
     return half_length / np.arctan2(rx[2], rx[0])
 
 
@@ -293,7 +302,8 @@ def test_plain_leaf_springs_back_to_flat():
     sagitta = leaf["radius"] * (1 - np.cos(0.5 * leaf["arc_length"] / leaf["radius"]))
     drop = model.deflections(result.e)["end"][2]
     assert drop == pytest.approx(-sagitta, rel=0.01)  # measured -40.1 mm vs -40.2 mm
-    rx = result.e.reshape(-1, 9)[model.mesh.node_sets["edge_x1"], 3:6].mean(axis=0)
+    edge = model.plate_bodies()[0].mesh.node_sets["edge_x1"]
+    rx = result.e.reshape(-1, 9)[edge, 3:6].mean(axis=0)
     assert abs(rx[2]) < 1e-3  # the end slope is gone: flat
 
 
@@ -308,10 +318,17 @@ def test_prestressed_leaf_reaches_its_free_shape_and_carries_the_assembly_moment
     # held at the assembled radius by end moments EI (1/R_free - 1/R_assembled)
     stiffness = material["youngs_modulus"] * leaf["width"] * leaf["thickness"] ** 3 / 12
     moment = stiffness * (1 / leaf["free_radius"] - 1 / leaf["radius"])
-    _, model = _leaf_static(overrides)
+    scene = load_scene(INPUTS / "curved_leaf.nml",
+                       ["scene.analysis=static", "solver.static_method=newton", "leaf.nx=16"]
+                       + overrides)
+    system = build_system(scene).system
+    mesh = system.bodies["leaf"].mesh
     for edge, sign in (("edge_x1", 1.0), ("edge_x0", -1.0)):
-        model.add_edge_moment(model.mesh.node_sets[edge], np.array([0.0, sign, 0.0]), moment,
-                              "end_moment")
+        nodes = mesh.node_sets[edge]  # the edge moment shared by its nodes (equal widths)
+        for k, node in enumerate(nodes):
+            system.load(f"{edge} moment {k}", "moment", body="leaf", point=mesh.coords[node, :3],
+                        vector=(0.0, sign * moment / len(nodes), 0.0), effect="end_moment")
+    model = system.assemble(effects=scene.effects + ("end_moment",))
     held = solve_newton(model, tol=1e-12)
     radius = _end_radius(model, held.e, half)
     carried = stiffness * (1 / leaf["free_radius"] - 1 / radius)

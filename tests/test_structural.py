@@ -16,12 +16,13 @@ from scipy.spatial.transform import Rotation
 from ancfdrv import kernel
 from ancfdrv.reference import analytic
 from ancfdrv.reference.analytic import boom_static_tip_deflection
-from ancfdrv.model import BeamModel, build_model
+from ancfdrv.builders import build_model
 from ancfdrv.runner import run_scene
 from ancfdrv.io.scene import load_scene
 from ancfdrv.solvers.static import solve_newton
 
 from conftest import INPUTS
+from helpers import beam_model, rect
 
 RNG = np.random.default_rng(11)
 CANTILEVER = INPUTS / "cantilever.nml"
@@ -29,16 +30,14 @@ E, L, B = 2.1e11, 2.0, 0.05
 A, I, G = B * B, B**4 / 12, 2.1e11 / 2
 
 
-def beam(formulation: str, nodes: int = 4, poisson: float = 0.0) -> BeamModel:
-    return BeamModel(node_s=np.linspace(0.0, 1.5, nodes), width=0.06, height=0.1,
-                     density=7850.0, youngs=2.1e11, poisson=poisson, rotation=np.eye(3),
-                     origin_offset=np.array([0.2, 0.1, -0.3]), effects=(),
-                     formulation=formulation, bending="cubic")
+def beam(formulation: str, nodes: int = 4, poisson: float = 0.0):
+    return beam_model(nodes, 1.5, width=0.06, height=0.1, poisson=poisson,
+                      offset=(0.2, 0.1, -0.3), formulation=formulation, bending="cubic")
 
 
 def test_stiffness_has_exactly_the_six_rigid_modes_and_matches_the_tangent():
     ffr = beam("ffr", nodes=2)
-    k0 = ffr.stiffness0[:, :, 0]
+    k0 = ffr.sets[0].stiffness0[:, :, 0]
     assert np.abs(k0 - k0.T).max() < 1e-12 * np.abs(k0).max()
     eigenvalues = np.linalg.eigvalsh(k0)
     assert np.sum(np.abs(eigenvalues) < 1e-9 * eigenvalues.max()) == 6
@@ -52,10 +51,7 @@ def test_stiffness_has_exactly_the_six_rigid_modes_and_matches_the_tangent():
 
 
 def test_mass_is_the_continuum_elements():
-    cubic, continuum = beam("ffr"), BeamModel(
-        node_s=np.linspace(0.0, 1.5, 4), width=0.06, height=0.1, density=7850.0,
-        youngs=2.1e11, poisson=0.0, rotation=np.eye(3), origin_offset=np.zeros(3),
-        effects=(), formulation="ffr")
+    cubic, continuum = beam("ffr"), beam_model(4, 1.5, width=0.06, height=0.1)
     m = cubic.mass_matrix().toarray()
     np.testing.assert_array_equal(m, continuum.mass_matrix().toarray())
     assert np.abs(m - m.T).max() < 1e-14 * np.abs(m).max()
@@ -99,7 +95,7 @@ def test_curved_reference_is_strain_free():
                          [np.cos(angle), np.sin(angle), 0.0],
                          [-np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
     reference = np.concatenate([arc(0.0), arc(length)]).T.reshape(3, 8, 1)
-    element = kernel.StructuralBeam(reference, [length], 0.02, 0.03, 2e11, 0.3)
+    element = kernel.StructuralBeam(reference, [length], rect(0.02, 0.03), 2e11, 0.3)
     dofs = np.arange(24)[:, None]
     e0 = reference[:, :, 0].T.ravel()
     force, energy, _ = element.forces(dofs, e0, False)

@@ -1,9 +1,10 @@
 """ancfdrv: flexible multibody dynamics with the Absolute Nodal Coordinate Formulation.
 
-Scenes (Fortran namelists) are read by :mod:`ancfdrv.scene`, turned into models over the
-Fortran kernel by :mod:`ancfdrv.model`, solved by :mod:`ancfdrv.static`, and stored in
-HDF5 by :mod:`ancfdrv.results`; :mod:`ancfdrv.runner` ties these together and
-:mod:`ancfdrv.cli` is the ``ancf`` command.
+Compose a system in Python (``from ancfdrv import System``, :mod:`ancfdrv.system`) or in a
+namelist scene (:mod:`ancfdrv.io.scene`; template scenes are built by
+:mod:`ancfdrv.builders` over the same API), solve it (:mod:`ancfdrv.solvers`: static and
+dynamic) and store the results in HDF5 (:mod:`ancfdrv.io.hdf5`); :mod:`ancfdrv.runner` ties
+these together and :mod:`ancfdrv.cli` is the ``ancf`` command.
 """
 import os as _os
 
@@ -19,3 +20,9 @@ _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 __version__ = "0.1.0"
+
+from .system import (Beam, Box, Circle, Constant, Cycle, Leaf, Luffing, Material, Model,  # noqa: E402
+                     Plate, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
+
+__all__ = ["System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Rectangle",
+           "Box", "Tube", "Circle", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table"]

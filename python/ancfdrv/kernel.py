@@ -8,27 +8,68 @@ from __future__ import annotations
 
 import numpy as np
 
+from dataclasses import dataclass
+
 from . import _kernel
+from .codes import DRIVE_TABLE, SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
 from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
-           "constraint_evaluate", "SparsePattern", "DirectSolver", "plate_shape",
-           "plate_element_arrays", "plate_reference", "plate_forces", "PlateReference",
-           "StructuralBeam"]
+           "SparsePattern", "DirectSolver", "plate_shape", "plate_element_arrays",
+           "plate_reference", "plate_forces", "PlateReference", "StructuralBeam", "SectionData",
+           "section_data"]
 
 
 def _f(a, dtype=np.float64) -> np.ndarray:
     return np.asfortranarray(a, dtype=dtype)
 
 
-def beam_element_arrays(lengths, width, height, density, youngs, poisson, reference):
+@dataclass(frozen=True)
+class SectionData:
+    """A beam cross-section as the kernel integrates it (beam_section.f90): the quadrature
+    points (y along the section height, z along its width) with area weights, and the
+    properties A, I_y = int z^2 dA, I_z = int y^2 dA and the polar moment."""
+
+    kind: int
+    dims: tuple[float, float, float]
+    y: np.ndarray
+    z: np.ndarray
+    weights: np.ndarray
+    area: float
+    inertia_y: float
+    inertia_z: float
+    polar: float
+
+
+_SECTION_NAMES = {SECTION_RECTANGLE: "rectangle", SECTION_BOX: "box", SECTION_TUBE: "tube",
+                  SECTION_CIRCLE: "circle"}
+
+
+def section_data(kind: int, dims) -> SectionData:
+    """The section rule and properties of a section kind (codes.SECTION_*)."""
+    dims3 = tuple(float(d) for d in (list(dims) + [0.0, 0.0, 0.0])[:3])
+    (npoints, y, z, w, area, iy, iz, polar,
+     info) = _kernel.beam_section_data(kind, _f(dims3))
+    if info:
+        what = _SECTION_NAMES.get(kind, f"kind {kind}")
+        raise InputError(f"{what} section with dimensions {list(dims)}: " +
+                         ("unknown section kind" if info == 1 else
+                          "non-physical dimensions (not positive, or a wall of half the "
+                          "section or more)"))
+    n = int(npoints)
+    return SectionData(kind, dims3, y[:n].copy(), z[:n].copy(), w[:n].copy(), float(area),
+                       float(iy), float(iz), float(polar))
+
+
+def beam_element_arrays(lengths, section: SectionData, density, youngs, poisson, reference):
     """Compact mass (8, 8, nel) and small-strain stiffness K0 (24, 24, nel) per element.
 
     ``reference`` is (3, 8, nel): the element's nodal vectors in the floating frame.
     """
-    mass, stiffness, info = _kernel.beam_element_arrays(_f(lengths), width, height, density,
-                                                        youngs, poisson, _f(reference))
+    mass, stiffness, info = _kernel.beam_element_arrays(
+        _f(lengths), _f(section.y), _f(section.z), _f(section.weights), density, youngs, poisson,
+        _f(reference))
     if info:
         element, code = divmod(info, 10)
         reason = {1: "unsupported quadrature", 2: "degenerate reference geometry (det J0 <= 0)"}
@@ -36,9 +77,10 @@ def beam_element_arrays(lengths, width, height, density, youngs, poisson, refere
     return mass, stiffness
 
 
-def beam_gravity(lengths, width, height, density, gravity) -> np.ndarray:
+def beam_gravity(lengths, section: SectionData, density, gravity) -> np.ndarray:
     """Generalized gravity (3, 8, nel) per element."""
-    force, info = _kernel.beam_gravity(_f(lengths), width, height, density, _f(gravity))
+    force, info = _kernel.beam_gravity(_f(lengths), _f(section.y), _f(section.z),
+                                       _f(section.weights), density, _f(gravity))
     if info:
         raise SolverError(f"beam gravity: kernel code {info}")
     return force
@@ -54,34 +96,38 @@ def beam_point_mass(xi, y, z, length, mass) -> np.ndarray:
     return _kernel.beam_point_mass(xi, y, z, length, mass)
 
 
-def beam_nonlinear_setup(reference, lengths, width, height):
-    """Material gradients (8, 3, npts, nel) and weights (npts, nel) at the Gauss points of
-    the large-deformation beam, from the reference configuration (3, 8, nel)."""
-    npts = int(_kernel.beam_nonlinear_points())
-    gradients, weights, info = _kernel.beam_nonlinear_setup(npts, _f(reference), _f(lengths),
-                                                            width, height)
+def beam_nonlinear_setup(reference, lengths, section: SectionData):
+    """Material gradients (8, 3, npts, nel), weights (npts, nel) and the number of volume
+    points of the large-deformation beam's Gauss rule, from the reference configuration
+    (3, 8, nel); the remaining points are on the neutral axis."""
+    nsec = len(section.weights)
+    npts = int(_kernel.beam_nonlinear_points(nsec))
+    gradients, weights, info = _kernel.beam_nonlinear_setup(
+        npts, _f(reference), _f(lengths), _f(section.y), _f(section.z), _f(section.weights))
     if info:
         element, code = divmod(info, 10)
         raise InputError(f"beam element {element}: degenerate reference geometry "
                          f"(det J0 <= 0, code {code})")
-    return gradients, weights
+    return gradients, weights, npts - npts // (nsec + 1)
 
 
-def beam_nonlinear_forces(dofs, e, gradients, weights, youngs, poisson, want_tangent: bool):
+def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poisson,
+                          want_tangent: bool):
     """Large-deformation elastic force, strain energy and element tangents (24, 24, nel)."""
-    return _kernel.beam_nonlinear_forces(_f(dofs + 1, np.int32), _f(e), gradients, weights,
-                                         youngs, poisson, int(want_tangent))
+    return _kernel.beam_nonlinear_forces(nvolume, _f(dofs + 1, np.int32), _f(e), gradients,
+                                         weights, youngs, poisson, int(want_tangent))
 
 
 class StructuralBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
     (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel)."""
 
-    def __init__(self, reference, lengths, width, height, youngs, poisson) -> None:
+    def __init__(self, reference, lengths, section: SectionData, youngs, poisson) -> None:
         nterms = int(_kernel.beam_structural_size())
         (self.forms, self.strain0, self.stiffness,
-         info) = _kernel.beam_structural_setup(nterms, _f(reference), _f(lengths), width, height,
-                                               youngs, poisson)
+         info) = _kernel.beam_structural_setup(nterms, _f(reference), _f(lengths), section.area,
+                                               section.inertia_y, section.inertia_z,
+                                               section.polar, youngs, poisson)
         if info:
             element, code = divmod(info, 10)
             reason = {1: "unsupported quadrature",
@@ -144,10 +190,11 @@ def plate_forces(dofs, e, reference: PlateReference, youngs: float, poisson: flo
     return force, energy, tangent
 
 
-def ffr_force(dofs, stiffness0, rotation, e, e0_frame):
-    """FFR elastic force T K0 (T^T e - e0) and strain energy. ``dofs`` are 0-based (24, nel)."""
-    return _kernel.ffr_elastic_force(_f(dofs + 1, np.int32), stiffness0, _f(rotation), _f(e),
-                                     _f(e0_frame))
+def ffr_force(dofs, stiffness0, rotation, e, reference):
+    """FFR elastic force T K0 (T^T e - e0) and strain energy. ``dofs`` are 0-based (24, nel),
+    ``reference`` the rigid configuration in the frame per element (24, nel)."""
+    return _kernel.ffr_elastic_force(_f(dofs + 1, np.int32), stiffness0, _f(reference),
+                                     _f(rotation), _f(e))
 
 
 def ffr_element_stiffness(stiffness0, rotation) -> np.ndarray:
@@ -166,26 +213,17 @@ def moment_force(director, axis, magnitude):
 
 
 def drive_values(kind: int, params, t):
-    """phi, phi', phi'' of a drive at the times t."""
-    p = np.zeros(8)
-    p[:len(params)] = params
-    phi, dphi, ddphi, info = _kernel.drive_values(kind, p, _f(np.atleast_1d(t)))
+    """phi, phi', phi'' of a drive at the times t (params: its parameters, any length)."""
+    p = np.asarray(params, dtype=float).ravel()
+    if kind != DRIVE_TABLE and p.size < 8:  # unused trailing parameters are zero
+        p = np.concatenate([p, np.zeros(8 - p.size)])
+    if p.size == 0:
+        p = np.zeros(1)
+    phi, dphi, ddphi, info = _kernel.drive_values(kind, _f(p), _f(np.atleast_1d(t)))
     if info:
         raise InputError(f"drive kind {kind} with parameters {list(params)}: "
                          + ("unknown kind" if info == 1 else "non-physical parameters"))
     return phi, dphi, ddphi
-
-
-def constraint_evaluate(ints, reals, drive_kinds, drive_params, e, e_dot, t):
-    """Values, gradients (6, ncon), Hessians (6, 6, ncon), Phi_t, Phi_tt, gamma."""
-    values, gradients, hessians, phi_t, phi_tt, gamma, info = _kernel.constraint_evaluate(
-        _f(ints, np.int32), _f(reals), _f(drive_kinds, np.int32), _f(drive_params), _f(e),
-        _f(e_dot), t)
-    if info > 0:
-        raise InputError(f"constraint {info} is malformed (kind or dof indices)")
-    if info < 0:
-        raise InputError(f"the drive of constraint {-info} has non-physical parameters")
-    return values, gradients, hessians, phi_t, phi_tt, gamma
 
 
 class SparsePattern:
@@ -299,11 +337,6 @@ def reference_node_mass(mass: float, centre, inertia) -> np.ndarray:
     return matrix
 
 
-#: contact_params layout of fortran/src/leaf_contact.f90
-CONTACT_PARAMS = ("stiffness", "damping", "friction", "slip_velocity", "upper_thickness",
-                  "lower_thickness", "friction_on")
-
-
 def contact_params(stiffness: float, damping: float, friction: float, slip_velocity: float,
                    upper_thickness: float, lower_thickness: float, friction_on: bool) -> np.ndarray:
     return np.array([stiffness, damping, friction, slip_velocity, upper_thickness,
@@ -356,3 +389,226 @@ def contact_evaluate(e, rates, dofs, sizes, grid, point_element, point_local, pa
         raise SolverError("contact: a mid-surface normal vanished")
     return dict(force=force, records=records, potential=float(potential), powers=powers,
                 guesses=guesses, counts=counts, values=values if pattern is not None else None)
+
+
+# -- a mechanical system behind a kernel handle (fortran/src/api/system_api.f90) ----------
+def _i(a) -> np.ndarray:
+    return np.asfortranarray(a, dtype=np.int32)
+
+
+def _pad_last(a: np.ndarray, dtype=np.float64) -> np.ndarray:
+    """f2py refuses zero-size arrays: one unused entry along the last axis."""
+    a = np.asarray(a, dtype=dtype)
+    if a.shape[-1] == 0:
+        a = np.zeros(a.shape[:-1] + (1,), dtype=dtype)
+    return np.asfortranarray(a)
+
+
+class KernelSystem:
+    """A mechanical system held by the kernel (system_store): built once by the set-up
+    methods (indices are 0-based here, 1-based in the kernel), then evaluated or stepped
+    chunk by chunk without sending its arrays again. Use as a context manager or call
+    :meth:`close`."""
+
+    def __init__(self, ndof: int, nfull: int) -> None:
+        handle, info = _kernel.system_create(ndof, nfull)
+        if info:
+            raise SolverError("the kernel's system table is full (256 systems alive)")
+        self.handle, self.ndof, self.nfull = int(handle), ndof, nfull
+        self.ncon = self.nprobe = self.npoint = 0
+        self.nnz_pattern = 0
+
+    def _check(self, info: int, what: str) -> None:
+        if info:
+            raise SolverError(f"kernel system set-up ({what}): code {info} "
+                              f"({'stale handle' if info == 1 else 'inconsistent sizes'})")
+
+    # element sets: dofs 0-based (nde, nel), scatter 1-based (Pattern.scatter), frame: the
+    # 1-based frame id (0: none)
+    def add_ffr_set(self, dofs, scatter, stiffness0, reference, frame: int) -> int:
+        index, info = _kernel.system_add_ffr_set(self.handle, _i(dofs + 1), _i(scatter),
+                                                 _f(stiffness0), _f(reference), frame)
+        self._check(info, "FFR beam set")
+        return int(index)
+
+    def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
+                          poisson: float, frame: int) -> int:
+        index, info = _kernel.system_add_continuum_set(
+            self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights), youngs,
+            poisson, frame)
+        self._check(info, "continuum beam set")
+        return int(index)
+
+    def add_structural_set(self, dofs, scatter, forms, strain0, stiffness, frame: int) -> int:
+        index, info = _kernel.system_add_structural_set(
+            self.handle, _i(dofs + 1), _i(scatter), _f(forms), _f(strain0), _f(stiffness),
+            frame)
+        self._check(info, "structural beam set")
+        return int(index)
+
+    def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
+                      poisson: float, thickness: float) -> int:
+        index, info = _kernel.system_add_plate_set(
+            self.handle, _i(dofs + 1), _i(scatter), reference.derivs, reference.frame,
+            reference.curvature0, reference.weights, youngs, poisson, thickness)
+        self._check(info, "plate set")
+        return int(index)
+
+    def set_frames(self, drives, axes, bases, pivots) -> None:
+        """Frames: drive (0-based drive index, -1: fixed), axis, base (3, 3), pivot."""
+        n = len(drives)
+        info = _kernel.system_set_frames(
+            self.handle, n, _pad_last(np.asarray(drives, dtype=np.int32) + 1, np.int32),
+            _pad_last(np.asarray(axes, dtype=float).reshape(-1, 3).T),
+            _pad_last(np.transpose(np.asarray(bases, dtype=float).reshape(-1, 3, 3), (1, 2, 0))),
+            _pad_last(np.asarray(pivots, dtype=float).reshape(-1, 3).T))
+        self._check(info, "frames")
+
+    def set_drives(self, kinds, params: list) -> None:
+        ptr = np.concatenate([[0], np.cumsum([len(p) for p in params])]).astype(np.int32) + 1
+        data = np.concatenate([np.asarray(p, dtype=float) for p in params]) if params else \
+            np.zeros(0)
+        info = _kernel.system_set_drives(self.handle, len(kinds), len(data),
+                                         _pad_last(np.asarray(kinds, dtype=np.int32), np.int32),
+                                         _i(ptr), _pad_last(data))
+        self._check(info, "drives")
+
+    def set_matrices(self, mass_csr, full_pattern, solver_handle: int, policy: int,
+                     mass_pattern, vector_frame, block_first) -> None:
+        """M (scipy CSR on the independent coordinates), the full pattern (row_ptr,
+        col_index, 0-based), the solver and its policy, M on the solver's pattern, the frame
+        of each reduced 3-vector (0: global; frames 1-based here) and the blocks' first dofs."""
+        full_row_ptr, full_col = full_pattern
+        self.nnz_pattern = len(mass_pattern)
+        info = _kernel.system_set_matrices(
+            self.handle, _i(mass_csr.indptr + 1), _i(mass_csr.indices + 1), _f(mass_csr.data),
+            _i(np.asarray(full_row_ptr) + 1), _i(np.asarray(full_col) + 1), solver_handle,
+            policy, _f(mass_pattern), len(vector_frame),
+            _pad_last(np.asarray(vector_frame, dtype=np.int32), np.int32), len(block_first),
+            _pad_last(np.asarray(block_first, dtype=np.int32) + 1, np.int32), ndof=self.ndof,
+            nfull=self.nfull)
+        self._check(info, "matrices")
+
+    def set_reduction(self, b_csr, offset, plan_source, plan_target, plan_coef) -> None:
+        info = _kernel.system_set_reduction(
+            self.handle, len(b_csr.data), _i(b_csr.indptr + 1),
+            _pad_last(b_csr.indices + 1, np.int32), _pad_last(b_csr.data), _f(offset),
+            len(plan_coef), _pad_last(np.asarray(plan_source) + 1, np.int32),
+            _pad_last(np.asarray(plan_target) + 1, np.int32), _pad_last(plan_coef),
+            nfull=self.nfull)
+        self._check(info, "reduction")
+
+    def set_loads(self, constant_force, force_drives, force_vectors, moment_dofs, moment_axes,
+                  magnitudes, moment_references) -> None:
+        """Driven forces: 0-based drive indices and vectors (ndof, n); moments: full director
+        dofs (n, 3, 0-based), axes, magnitudes, directors at t = 0."""
+        nforce, nmoment = len(force_drives), len(magnitudes)
+        info = _kernel.system_set_loads(
+            self.handle, _f(constant_force), nforce,
+            _pad_last(np.asarray(force_drives, dtype=np.int32) + 1, np.int32),
+            _pad_last(np.asarray(force_vectors, dtype=float).reshape(self.ndof, nforce)), nmoment,
+            _pad_last(np.asarray(moment_dofs, dtype=np.int32).reshape(-1, 3).T + 1, np.int32),
+            _pad_last(np.asarray(moment_axes, dtype=float).reshape(-1, 3).T),
+            _pad_last(np.asarray(magnitudes, dtype=float)),
+            _pad_last(np.asarray(moment_references, dtype=float).reshape(-1, 3).T),
+            ndof=self.ndof)
+        self._check(info, "loads")
+
+    def set_constraints(self, layout: "ConstraintLayout") -> None:
+        ncon, nterm = len(layout.kinds), len(layout.term_dof)
+        info = _kernel.system_set_constraints(
+            self.handle, ncon, nterm, _pad_last(layout.kinds, np.int32),
+            _pad_last(np.asarray(layout.drives) + 1, np.int32), _pad_last(layout.params),
+            _pad_last(layout.operand_const), _i(np.asarray(layout.term_ptr) + 1),
+            _pad_last(np.asarray(layout.term_dof) + 1, np.int32), _pad_last(layout.term_coef))
+        self._check(info, "constraints")
+        self.ncon = ncon
+
+    def add_contact_pair(self, dofs, sizes, grid, point_element, point_local, params) -> None:
+        info = _kernel.system_add_contact_pair(
+            self.handle, _i(np.asarray(dofs) + 1), _f(sizes), _i(np.asarray(grid) + 1),
+            _i(np.asarray(point_element) + 1), _f(point_local), _f(params))
+        self._check(info, "contact pair")
+        self.npoint += len(point_element)
+
+    def set_probes(self, ptr, dofs, coefs, frames, reference) -> None:
+        """Probe p = sum coef q[dof:dof+3] over terms ptr[p]:ptr[p+1] (0-based dofs),
+        deflection frame (0: global, frames 1-based), rigid position in it (nprobe, 3)."""
+        nprobe = len(ptr) - 1
+        info = _kernel.system_set_probes(
+            self.handle, len(dofs), _i(np.asarray(ptr) + 1),
+            _pad_last(np.asarray(dofs, dtype=np.int32) + 1, np.int32), _pad_last(coefs),
+            _pad_last(np.asarray(frames, dtype=np.int32), np.int32),
+            _pad_last(np.asarray(reference, dtype=float).reshape(-1, 3).T))
+        self._check(info, "probes")
+        self.nprobe = nprobe
+
+    def evaluate(self, t: float, e, v, guesses, counts, *, load_factor: float = 1.0,
+                 velocity_factor: float = 0.0, want_tangent: bool = False) -> dict:
+        """Internal forces B^T (Q_el - Q_c - lf Q_M), external lf Q(t), strain energy, contact
+        potential and records, and on request the tangent on the solver's pattern; the
+        contact guesses and counters are updated (returned)."""
+        nnz = self.nnz_pattern if want_tangent else 1
+        out = _kernel.system_evaluate(self.handle, nnz, self.npoint, t, _f(e), _f(v), load_factor,
+                                      velocity_factor, int(want_tangent), _f(guesses),
+                                      _i(counts), ndof=self.ndof)
+        guesses, counts, internal, external, strain, potential, records, tangent, info = out
+        if info:
+            self._failure(info, "force evaluation")
+        return dict(internal=internal, external=external, strain=float(strain),
+                    contact_potential=float(potential), records=records[:, :self.npoint],
+                    tangent=tangent if want_tangent else None, guesses=guesses, counts=counts)
+
+    def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
+        out = _kernel.system_output_row(
+            self.handle, self.ncon, self.nprobe, self.npoint, t, _f(e), _f(v),
+            _f(lam) if len(lam) else np.zeros(1), _f(work), _f(guesses), _i(counts),
+            ndof=self.ndof)
+        guesses, counts, probe, deflection, energy, violation, records, info = out
+        if info:
+            self._failure(info, "output row")
+        return dict(probes=probe[:, :self.nprobe].T.copy(),
+                    deflections=deflection[:, :self.nprobe].T.copy(), energy=energy,
+                    violation=float(violation), records=records[:, :self.npoint],
+                    guesses=guesses, counts=counts)
+
+    def _failure(self, info: int, what: str) -> None:
+        from .codes import STEP_FAILURES
+        reason = STEP_FAILURES.get(int(info), f"kernel code {info}")
+        raise SolverError(f"{what}: " + reason.format(max_newton="?", detail="?"))
+
+    def advance(self, nsteps: int, settings, state: dict, store_q: bool):
+        """Advance nsteps steps (time_integrator) from state (t, e, v, a, accel, lam, work,
+        guesses, counts; updated in place); returns the raw outputs and status."""
+        nq = nsteps if store_q else 1
+        out = _kernel.system_advance(
+            self.handle, self.ncon, self.nprobe, self.npoint, nsteps, nq, settings.dt,
+            settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f, settings.tol,
+            settings.length_scale, settings.max_newton, settings.jacobian_code,
+            settings.contraction, state["t"], _f(state["e"]), _f(state["v"]), _f(state["a"]),
+            _f(state["accel"]), _f(state["lam"]) if len(state["lam"]) else np.zeros(1),
+            _f(state["work"]), _f(state["guesses"]), _i(state["counts"]), ndof=self.ndof)
+        (t, e, v, a, accel, lam, work, guesses, counts, o_time, o_probe, o_defl, o_lam, o_energy,
+         o_con, o_stats, o_contact, o_q, status, last_correction) = out
+        state.update(t=float(t), e=e, v=v, a=a, accel=accel, lam=lam[:self.ncon], work=work,
+                     guesses=guesses, counts=counts)
+        return dict(time=o_time, probes=o_probe, deflections=o_defl, lam=o_lam, energy=o_energy,
+                    constraint=o_con, stats=o_stats, contact=o_contact, q=o_q,
+                    status=[int(s) for s in status], last_correction=float(last_correction))
+
+    def close(self) -> None:
+        if getattr(self, "handle", 0):
+            _kernel.system_destroy(self.handle)
+            self.handle = 0
+
+    def __enter__(self) -> "KernelSystem":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass

@@ -18,8 +18,9 @@ from .io import hdf5 as results
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
 from .errors import AncfError
 from .history import luffing_stage_bounds, stage_summary
-from .model import BeamModel, build_model
-from .io.scene import PLATE_KINDS, Scene, load_scene
+from .builders import build_model
+from .io.scene import Scene, load_scene
+from .system import Model
 from .solvers.static import StaticResult, solve_static
 
 
@@ -48,7 +49,8 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
     """Newmark with the scene's beta and gamma, or generalized-alpha from rho_inf."""
     solver, output = scene["solver"], scene["output"]
     common = dict(tol=solver["newton_tol"], max_newton=solver["max_newton"],
-                  chunk_steps=output["chunk_steps"], store_q=output["q"])
+                  chunk_steps=output["chunk_steps"], store_q=output["q"],
+                  jacobian=solver["jacobian"], contraction=solver["contraction"])
     if solver["integrator"] == "generalized_alpha":
         return DynamicSettings.generalized_alpha(solver["dt"], solver["t_end"],
                                                  solver["rho_inf"], **common)
@@ -66,17 +68,17 @@ def boom_stages(scene: Scene) -> dict[str, tuple[float, float]] | None:
                                 scene["solver"]["t_end"])
 
 
-def _run_dynamic(scene: Scene, model: BeamModel, out: Path, e_start: np.ndarray,
+def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                  timing: dict[str, Any], progress: bool | None) -> tuple[DynamicResult, dict]:
     settings = dynamic_settings(scene)
-    if scene.kind in PLATE_KINDS:
+    if model.plate_bodies():
         settings.store_q = True  # the node positions for ParaView (XDMF) come from q
     writer = results.DynamicWriter(out, model, settings.store_q)
     dyn = integrate(model, settings, e_start, sink=writer, progress=progress)
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     stages: dict[str, float] = {}
-    if model.formulation == "ffr":
+    if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
         with h5py.File(out, "r") as h5:
             deflection = h5["dynamic/deflection/tip"][()]
         ratio = np.abs(deflection).max() / model.length_scale
@@ -96,7 +98,8 @@ def _run_dynamic(scene: Scene, model: BeamModel, out: Path, e_start: np.ndarray,
         "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
         "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
         "generalized_alpha" else 1.0, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
-        "factorizations": dyn.factorizations, "setup_solves": dyn.solves_setup,
+        "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,
+        "jacobian_policy": "constant" if model.constant_policy else settings.jacobian,
         "wall_time_s": dyn.wall_time_s, "status": "ok"}, stages)
     return dyn, stages
 
@@ -105,10 +108,18 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
                start: float | None = None, progress: bool | None = None) -> RunOutcome:
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
-    analysis = scene["scene"]["analysis"]
     t0 = time.perf_counter()
     model = build_model(scene)
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
+    try:
+        return _run_model(scene, model, out, timing, start, progress)
+    finally:
+        model.close()
+
+
+def _run_model(scene: Scene, model: Model, out: Path, timing: dict, start: float,
+               progress: bool | None) -> RunOutcome:
+    analysis = scene["scene"]["analysis"]
     results.create(out, scene, model)
     static = dynamic = None
     stages: dict[str, float] = {}

@@ -19,9 +19,9 @@ module beam_element
   public :: beam_shape, beam_mass_compact, beam_gravity_compact, &
             beam_linear_stiffness, beam_point_mass_compact
 
-  !> Gauss points along the axis and across each section direction: exact for the
-  !> mass (degree 6 in xi, 2 in y, z) and the linear stiffness (degree 4 in xi).
-  integer, parameter :: n_axial = 4, n_section = 2
+  !> Gauss points along the axis: exact for the mass (degree 6 in xi) and the linear
+  !> stiffness (degree 4 in xi); the section rules come from beam_section.
+  integer, parameter :: n_axial = 4
 
 contains
 
@@ -44,71 +44,61 @@ contains
     dshape_dz = [0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp - xi, 0.0_dp, 0.0_dp, 0.0_dp, xi]
   end subroutine beam_shape
 
-  !> Gauss points and weights over the element volume in parameter coordinates
-  !> (xi in [0,1], y in [-h/2,h/2], z in [-w/2,w/2]); weights include the volume
-  !> element L dxi dy dz of a straight reference.
-  pure subroutine volume_rule(length, width, height, xi, y, z, weight, info)
-    real(dp), intent(in) :: length, width, height
-    real(dp), intent(out) :: xi(n_axial), y(n_section), z(n_section)
-    real(dp), intent(out) :: weight(n_axial, n_section, n_section)
+  !> Gauss points along the axis (xi in [0, 1]) and the volume weights of the axial points
+  !> times the section points: weight(i, s) = L dxi_i dA_s for a straight reference.
+  pure subroutine volume_rule(length, section_w, xi, weight, info)
+    real(dp), intent(in) :: length, section_w(:)
+    real(dp), intent(out) :: xi(n_axial), weight(n_axial, size(section_w))
     integer, intent(out) :: info
-    real(dp) :: pa(n_axial), wa(n_axial), ps(n_section), ws(n_section)
-    integer :: i, j, k, info_section
+    real(dp) :: pa(n_axial), wa(n_axial)
+    integer :: i, s
     call gauss_legendre(n_axial, pa, wa, info)
-    call gauss_legendre(n_section, ps, ws, info_section)
-    info = max(info, info_section)
     xi = 0.5_dp * (pa + 1.0_dp)
-    y = 0.5_dp * height * ps
-    z = 0.5_dp * width * ps
-    do k = 1, n_section
-      do j = 1, n_section
-        do i = 1, n_axial
-          weight(i, j, k) = wa(i) * ws(j) * ws(k) * 0.125_dp * length * height * width
-        end do
+    do s = 1, size(section_w)
+      do i = 1, n_axial
+        weight(i, s) = 0.5_dp * wa(i) * length * section_w(s)
       end do
     end do
   end subroutine volume_rule
 
-  !> Compact consistent mass matrix m_ab = int rho N_a N_b dV (8 x 8); the full
-  !> element mass matrix is kron(mass, I3). Exact Gauss quadrature.
-  pure subroutine beam_mass_compact(length, width, height, density, mass, info)
-    real(dp), intent(in) :: length, width, height, density
+  !> Compact consistent mass matrix m_ab = int rho N_a N_b dV (8 x 8) over the section rule
+  !> (section_y, section_z, section_w) (beam_section); the full element mass matrix is
+  !> kron(mass, I3). Exact for the section rules of beam_section.
+  pure subroutine beam_mass_compact(length, section_y, section_z, section_w, density, mass, info)
+    real(dp), intent(in) :: length, section_y(:), section_z(:), section_w(:), density
     real(dp), intent(out) :: mass(8, 8)
     integer, intent(out) :: info
-    real(dp) :: xi(n_axial), y(n_section), z(n_section), weight(n_axial, n_section, n_section)
+    real(dp) :: xi(n_axial), weight(n_axial, size(section_w))
     real(dp) :: shape(8), d_dx(8), d_dy(8), d_dz(8)
-    integer :: i, j, k, a
-    call volume_rule(length, width, height, xi, y, z, weight, info)
+    integer :: i, s, a
+    call volume_rule(length, section_w, xi, weight, info)
     mass = 0.0_dp
-    do k = 1, n_section
-      do j = 1, n_section
-        do i = 1, n_axial
-          call beam_shape(xi(i), y(j), z(k), length, shape, d_dx, d_dy, d_dz)
-          do a = 1, 8
-            mass(:, a) = mass(:, a) + density * weight(i, j, k) * shape * shape(a)
-          end do
+    do s = 1, size(section_w)
+      do i = 1, n_axial
+        call beam_shape(xi(i), section_y(s), section_z(s), length, shape, d_dx, d_dy, d_dz)
+        do a = 1, 8
+          mass(:, a) = mass(:, a) + density * weight(i, s) * shape * shape(a)
         end do
       end do
     end do
   end subroutine beam_mass_compact
 
   !> Generalized gravity force (eqs. 22-24): Q_a = int rho N_a g dV, as 3 x 8.
-  pure subroutine beam_gravity_compact(length, width, height, density, gravity, force, info)
-    real(dp), intent(in) :: length, width, height, density, gravity(3)
+  pure subroutine beam_gravity_compact(length, section_y, section_z, section_w, density, &
+                                       gravity, force, info)
+    real(dp), intent(in) :: length, section_y(:), section_z(:), section_w(:), density, gravity(3)
     real(dp), intent(out) :: force(3, 8)
     integer, intent(out) :: info
-    real(dp) :: xi(n_axial), y(n_section), z(n_section), weight(n_axial, n_section, n_section)
+    real(dp) :: xi(n_axial), weight(n_axial, size(section_w))
     real(dp) :: shape(8), d_dx(8), d_dy(8), d_dz(8)
-    integer :: i, j, k, a
-    call volume_rule(length, width, height, xi, y, z, weight, info)
+    integer :: i, s, a
+    call volume_rule(length, section_w, xi, weight, info)
     force = 0.0_dp
-    do k = 1, n_section
-      do j = 1, n_section
-        do i = 1, n_axial
-          call beam_shape(xi(i), y(j), z(k), length, shape, d_dx, d_dy, d_dz)
-          do a = 1, 8
-            force(:, a) = force(:, a) + density * weight(i, j, k) * shape(a) * gravity
-          end do
+    do s = 1, size(section_w)
+      do i = 1, n_axial
+        call beam_shape(xi(i), section_y(s), section_z(s), length, shape, d_dx, d_dy, d_dz)
+        do a = 1, 8
+          force(:, a) = force(:, a) + density * weight(i, s) * shape(a) * gravity
         end do
       end do
     end do
@@ -132,33 +122,33 @@ contains
   !> to the reference material coordinates X = r0(x, y, z); isotropic law (E, nu), which
   !> for nu = 0 is the paper's Q = diag(E, E, E, E/2, E/2, E/2) (eq. 18).
   !> info: 0 ok, 1 bad quadrature, 2 degenerate reference (det J0 <= 0).
-  pure subroutine beam_linear_stiffness(reference, length, width, height, youngs, poisson, &
-                                        stiffness, info)
-    real(dp), intent(in) :: reference(3, 8), length, width, height, youngs, poisson
+  pure subroutine beam_linear_stiffness(reference, length, section_y, section_z, section_w, &
+                                        youngs, poisson, stiffness, info)
+    real(dp), intent(in) :: reference(3, 8), length, section_y(:), section_z(:), section_w(:)
+    real(dp), intent(in) :: youngs, poisson
     real(dp), intent(out) :: stiffness(24, 24)
     integer, intent(out) :: info
-    real(dp) :: xi(n_axial), y(n_section), z(n_section), weight(n_axial, n_section, n_section)
+    real(dp) :: xi(n_axial), weight(n_axial, size(section_w))
     real(dp) :: shape(8), dshape(8, 3), jacobian0(3, 3), inverse0(3, 3), det0
     real(dp) :: material_gradient(8, 3), strain_matrix(6, 24), elasticity(6, 6)
-    integer :: i, j, k
-    call volume_rule(length, width, height, xi, y, z, weight, info)
+    integer :: i, s
+    call volume_rule(length, section_w, xi, weight, info)
     call isotropic_elasticity(youngs, poisson, elasticity)
     stiffness = 0.0_dp
-    do k = 1, n_section
-      do j = 1, n_section
-        do i = 1, n_axial
-          call beam_shape(xi(i), y(j), z(k), length, shape, dshape(:, 1), dshape(:, 2), dshape(:, 3))
-          jacobian0 = matmul(reference, dshape)
-          call invert3(jacobian0, inverse0, det0)
-          if (det0 <= 0.0_dp) then
-            info = 2
-            return
-          end if
-          material_gradient = matmul(dshape, inverse0)
-          call small_strain_matrix(material_gradient, strain_matrix)
-          stiffness = stiffness + weight(i, j, k) * det0 * &
-                      matmul(transpose(strain_matrix), matmul(elasticity, strain_matrix))
-        end do
+    do s = 1, size(section_w)
+      do i = 1, n_axial
+        call beam_shape(xi(i), section_y(s), section_z(s), length, shape, dshape(:, 1), &
+                        dshape(:, 2), dshape(:, 3))
+        jacobian0 = matmul(reference, dshape)
+        call invert3(jacobian0, inverse0, det0)
+        if (det0 <= 0.0_dp) then
+          info = 2
+          return
+        end if
+        material_gradient = matmul(dshape, inverse0)
+        call small_strain_matrix(material_gradient, strain_matrix)
+        stiffness = stiffness + weight(i, s) * det0 * &
+                    matmul(transpose(strain_matrix), matmul(elasticity, strain_matrix))
       end do
     end do
   end subroutine beam_linear_stiffness

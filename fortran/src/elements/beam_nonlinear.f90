@@ -20,66 +20,67 @@ module beam_nonlinear
   private
   public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element
 
-  integer, parameter :: n_axial = 4, n_section = 2
-  !> Gauss points per element: the volume rule plus the neutral-axis points.
-  integer, parameter, public :: nonlinear_points = n_axial * n_section * n_section + n_axial
+  !> Gauss points along the axis; the section rule comes from beam_section.
+  integer, parameter, public :: nonlinear_axial_points = 4
 
 contains
 
-  pure integer function nonlinear_rule_size()
-    nonlinear_rule_size = nonlinear_points
+  !> Points per element for a section rule of nsection points: the volume points, then the
+  !> neutral-axis points.
+  pure integer function nonlinear_rule_size(nsection)
+    integer, intent(in) :: nsection
+    nonlinear_rule_size = nonlinear_axial_points * (nsection + 1)
   end function nonlinear_rule_size
 
   !> Material gradients g_a (8, 3, point) and weights (volume element det J0 included) of
-  !> one element: first the n_axial x n_section^2 volume points, then the n_axial
+  !> one element: first the axial x section volume points (section point outer), then the
   !> neutral-axis points whose weights carry the section area. info = 2 for det J0 <= 0.
-  pure subroutine nonlinear_setup(reference, length, width, height, gradients, weights, info)
-    real(dp), intent(in) :: reference(3, 8), length, width, height
-    real(dp), intent(out) :: gradients(8, 3, nonlinear_points), weights(nonlinear_points)
+  pure subroutine nonlinear_setup(reference, length, section_y, section_z, section_w, &
+                                  gradients, weights, info)
+    real(dp), intent(in) :: reference(3, 8), length, section_y(:), section_z(:), section_w(:)
+    real(dp), intent(out) :: gradients(:, :, :), weights(:)   ! (8, 3, npts), (npts)
     integer, intent(out) :: info
-    real(dp) :: pa(n_axial), wa(n_axial), ps(n_section), ws(n_section)
-    real(dp) :: shape(8), dshape(8, 3), jac0(3, 3), inv0(3, 3), det0
-    integer :: i, j, k, p, info_section
-    call gauss_legendre(n_axial, pa, wa, info)
-    call gauss_legendre(n_section, ps, ws, info_section)
-    info = max(info, info_section)
+    real(dp) :: pa(nonlinear_axial_points), wa(nonlinear_axial_points)
+    real(dp) :: shape(8), dshape(8, 3), jac0(3, 3), inv0(3, 3), det0, y, z
+    integer :: i, s, p, nsection
+    nsection = size(section_w)
+    call gauss_legendre(nonlinear_axial_points, pa, wa, info)
     if (info /= 0) return
     p = 0
-    do k = 1, n_section + 1
-      do j = 1, n_section
-        do i = 1, n_axial
-          if (k <= n_section) then
-            p = p + 1
-            call beam_shape(0.5_dp * (pa(i) + 1.0_dp), 0.5_dp * height * ps(j), &
-                            0.5_dp * width * ps(k), length, shape, dshape(:, 1), dshape(:, 2), &
-                            dshape(:, 3))
-            weights(p) = wa(i) * ws(j) * ws(k) * 0.125_dp * length * height * width
-          else if (j == 1) then
-            p = p + 1
-            call beam_shape(0.5_dp * (pa(i) + 1.0_dp), 0.0_dp, 0.0_dp, length, shape, &
-                            dshape(:, 1), dshape(:, 2), dshape(:, 3))
-            weights(p) = wa(i) * 0.5_dp * length * height * width
-          else
-            cycle
-          end if
-          jac0 = matmul(reference, dshape)
-          call invert3(jac0, inv0, det0)
-          if (det0 <= 0.0_dp) then
-            info = 2
-            return
-          end if
-          gradients(:, :, p) = matmul(dshape, inv0)
-          weights(p) = weights(p) * det0
-        end do
+    do s = 1, nsection + 1
+      do i = 1, nonlinear_axial_points
+        p = p + 1
+        if (s <= nsection) then
+          y = section_y(s)
+          z = section_z(s)
+          weights(p) = 0.5_dp * wa(i) * length * section_w(s)
+        else
+          y = 0.0_dp
+          z = 0.0_dp
+          weights(p) = 0.5_dp * wa(i) * length * sum(section_w)
+        end if
+        call beam_shape(0.5_dp * (pa(i) + 1.0_dp), y, z, length, shape, dshape(:, 1), &
+                        dshape(:, 2), dshape(:, 3))
+        jac0 = matmul(reference, dshape)
+        call invert3(jac0, inv0, det0)
+        if (det0 <= 0.0_dp) then
+          info = 2
+          return
+        end if
+        gradients(:, :, p) = matmul(dshape, inv0)
+        weights(p) = weights(p) * det0
       end do
     end do
   end subroutine nonlinear_setup
 
   !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
   !> one element with nodal vectors q(3, 8).
-  pure subroutine nonlinear_element(q, gradients, weights, youngs, poisson, want_tangent, &
-                                    force, energy, tangent)
-    real(dp), intent(in) :: q(3, 8), gradients(8, 3, nonlinear_points), weights(nonlinear_points)
+  !> The first volume_points points integrate the Poisson-free law over the volume, the
+  !> others (the neutral-axis points) the Poisson part.
+  pure subroutine nonlinear_element(q, gradients, weights, volume_points, youngs, poisson, &
+                                    want_tangent, force, energy, tangent)
+    real(dp), intent(in) :: q(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
     real(dp), intent(in) :: youngs, poisson
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
@@ -90,8 +91,8 @@ contains
     force = 0.0_dp
     energy = 0.0_dp
     tangent = 0.0_dp
-    do p = 1, nonlinear_points
-      if (p <= n_axial * n_section * n_section) then
+    do p = 1, size(weights)
+      if (p <= volume_points) then
         law = law_free
       else
         law = law_poisson

@@ -20,9 +20,10 @@
 !> Every strain is a quadratic form of the nodal vectors q_a minus its reference value,
 !>   s = 1/2 sum_ab C_ab q_a . q_b - s0,      U = 1/2 sum_terms k s^2,
 !> so dS/dq_a = sum_b C_ab q_b, the tangent is k (g g^T + s C x I3), rigid motions leave
-!> every s unchanged, and a curved reference is strain-free by s0. Stiffnesses: EA, EI_z
-!> = E w h^3/12, EI_y = E h w^3/12, G J with J = I_y + I_z and G A (k = 1), as the continuum
-!> element with nu = 0 has, so the two options differ in the bending interpolation only.
+!> every s unchanged, and a curved reference is strain-free by s0. Stiffnesses: EA, EI_z,
+!> EI_y, G J with J = I_y + I_z and G A (k = 1) of the section (beam_section), as the
+!> continuum element with nu = 0 has, so the two options differ in the bending
+!> interpolation only.
 module beam_structural
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
@@ -65,16 +66,19 @@ contains
   !> Quadratic forms C (8, 8, term), reference values s0 and stiffnesses k (material times
   !> line element |r0_x| L dxi) of one element. info = 1: quadrature unavailable; 2: the
   !> reference tangent r0_x vanishes somewhere.
-  pure subroutine structural_setup(reference, length, width, height, youngs, poisson, forms, &
-                                   strain0, stiffness, info)
-    real(dp), intent(in) :: reference(3, 8), length, width, height, youngs, poisson
+  !> Section data (beam_section): area, I_y = int z^2 dA, I_z = int y^2 dA, the torsion
+  !> constant (the polar moment).
+  pure subroutine structural_setup(reference, length, area, inertia_y, inertia_z, polar, youngs, &
+                                   poisson, forms, strain0, stiffness, info)
+    real(dp), intent(in) :: reference(3, 8), length, area, inertia_y, inertia_z, polar
+    real(dp), intent(in) :: youngs, poisson
     real(dp), intent(out) :: forms(8, 8, structural_terms), strain0(structural_terms)
     real(dp), intent(out) :: stiffness(structural_terms)
     integer, intent(out) :: info
     real(dp) :: points(n_line), weights(n_line), p2(n_torsion), w2(n_torsion)
     real(dp) :: pa(n_axial), wa(n_axial)
     real(dp) :: slope(8), second(8), dir_y(8), dir_z(8), dir_y_x(8), dir_z_x(8)
-    real(dp) :: mean_y(8, 8), mean_z(8, 8), area, inertia_z, inertia_y, shear, line, xi
+    real(dp) :: mean_y(8, 8), mean_z(8, 8), shear, line, xi
     integer :: i, t, node, info_torsion
     forms = 0.0_dp
     strain0 = 0.0_dp
@@ -85,9 +89,6 @@ contains
     call gauss_legendre(n_axial, pa, wa, info_torsion)
     info = max(info, info_torsion)
     if (info /= 0) return
-    area = width * height
-    inertia_z = width * height**3 / 12.0_dp
-    inertia_y = height * width**3 / 12.0_dp
     shear = youngs / (2.0_dp * (1.0_dp + poisson))
     ! element means of r_xx . r_y and r_xx . r_z (quadratic in xi: 2 points are exact)
     mean_y = 0.0_dp
@@ -122,7 +123,7 @@ contains
       line = 0.5_dp * w2(i) * length * norm2(matmul(reference, slope))
       t = t + 1
       forms(:, :, t) = 0.5_dp * (product_form(dir_y_x, dir_z) - product_form(dir_z_x, dir_y))
-      stiffness(t) = shear * (inertia_y + inertia_z) * line
+      stiffness(t) = shear * polar * line
     end do
     do node = 0, 1
       call centreline_rows(real(node, dp), length, slope, second, dir_y, dir_z, dir_y_x, dir_z_x)

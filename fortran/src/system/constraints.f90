@@ -1,43 +1,84 @@
 !> Holonomic constraints Phi(e, t) = 0 from a small general set, each a polynomial of
-!> degree <= 2 in the coordinates, so its Hessian is constant:
-!>   kind 1  coordinate  e(i1) - (c1 + c2 cos phi + c3 sin phi) = 0   (fixed when undriven)
-!>   kind 2  distance    |e(i1:i3) - p|^2 - d^2 = 0                    (p = c1:c3, d = c4)
-!>   kind 3  cross       k . ((e(i1:i3) - p) x e(i4:i6)) = 0           (p = c1:c3, k = c4:c6):
-!>                       a gradient parallel to a position vector, in the plane normal to k
-!>   kind 4  dot         e(i1:i3) . e(i4:i6) - c1 = 0   (an unused index: a component held
-!>                       at zero, e.g. eliminated by a planar guide)
+!> degree <= 2 in its operands, so its Hessian is constant. A constraint has six scalar
+!> operands x_s (two 3-vectors x(1:3), x(4:6)), each an affine combination of coordinates,
+!>   x_s = c_s + sum_k a_k e(i_k),
+!> which expresses nodal vectors, material points of rigid bodies (r + J u) and coordinates
+!> eliminated by linear constraints alike. The kinds:
+!>   kind 1  coordinate  x_1 - (p1 + p2 cos phi + p3 sin phi + p4 phi) = 0
+!>   kind 2  distance    |x(1:3) - x(4:6)|^2 - (p1 + p2 phi)^2 = 0  (a driven length with p2 = 1)
+!>   kind 3  cross       k . (x(1:3) x x(4:6)) = 0,  k = p(1:3): a vector parallel to a
+!>                       position vector in the plane normal to k
+!>   kind 4  dot         x(1:3) . x(4:6) - p1 = 0
 !> phi is the value of the constraint's drive (drives module; no drive: phi = 0).
-!> Layout: ints(8, n) = [kind, drive, i1..i6] (1-based dofs, 0 = unused), reals(8, n).
+!> Layout: kinds(n), drives(n), params(8, n), operand_const(6, n), and the terms of operand
+!> s of constraint c at term_ptr(6 (c - 1) + s) ... term_ptr(6 (c - 1) + s + 1) - 1 of
+!> term_dof (1-based) and term_coef. Drives: drive_kinds(m), and the parameters of drive d
+!> at drive_data(drive_ptr(d) : drive_ptr(d + 1) - 1).
 module constraints
   use ancf_kinds, only: dp
   use drives, only: drive_eval
   use matrix3, only: cross
   implicit none
   private
-  public :: constraint_eval, constraint_kind_coordinate, constraint_kind_distance, &
-            constraint_kind_cross, constraint_kind_dot
+  public :: constraint_eval, operand_values, drive_value
 
-  integer, parameter :: constraint_kind_coordinate = 1, constraint_kind_distance = 2, &
-                        constraint_kind_cross = 3, constraint_kind_dot = 4
+  integer, parameter, public :: constraint_kind_coordinate = 1, constraint_kind_distance = 2, &
+                                constraint_kind_cross = 3, constraint_kind_dot = 4
 
 contains
 
-  !> Values, sparse gradients (over the dofs ints(3:8)), constant Hessians, Phi_t and
-  !> Phi_tt at (e, t); gamma = -(e_dot^T H e_dot) - Phi_tt is the right-hand side of
-  !> the acceleration equation Phi_e e'' = gamma (no Phi_et terms: drives enter only
-  !> as additive targets). info: 0 ok, k > 0 constraint k is malformed, -k drive of
-  !> constraint k failed.
-  pure subroutine constraint_eval(ncon, ints, reals, ndrive, drive_kinds, drive_params, &
-                                  ndof, e, e_dot, t, values, gradients, hessians, &
-                                  phi_t, phi_tt, gamma, info)
-    integer, intent(in) :: ncon, ndrive, ndof
-    integer, intent(in) :: ints(8, ncon), drive_kinds(ndrive)
-    real(dp), intent(in) :: reals(8, ncon), drive_params(8, ndrive), e(ndof), e_dot(ndof), t
-    real(dp), intent(out) :: values(ncon), gradients(6, ncon), hessians(6, 6, ncon)
-    real(dp), intent(out) :: phi_t(ncon), phi_tt(ncon), gamma(ncon)
+  !> phi, phi', phi'' of drive d (d = 0: no drive, all zero). info /= 0: the drive failed.
+  pure subroutine drive_value(d, drive_kinds, drive_ptr, drive_data, t, phi, dphi, ddphi, info)
+    integer, intent(in) :: d, drive_kinds(:), drive_ptr(:)
+    real(dp), intent(in) :: drive_data(:), t
+    real(dp), intent(out) :: phi, dphi, ddphi
     integer, intent(out) :: info
-    integer :: c, m, idx(6), drive, drive_info
-    real(dp) :: phi, dphi, ddphi, x(6), v(6), a(3), b(3), k(3)
+    phi = 0.0_dp
+    dphi = 0.0_dp
+    ddphi = 0.0_dp
+    info = 0
+    if (d == 0) return
+    if (d < 0 .or. d > size(drive_kinds)) then
+      info = 1
+      return
+    end if
+    call drive_eval(drive_kinds(d), drive_data(drive_ptr(d):drive_ptr(d + 1) - 1), t, phi, dphi, &
+                    ddphi, info)
+  end subroutine drive_value
+
+  !> Operand values of constraint c at x (with the constants) or their rates (without).
+  pure function operand_values(c, operand_const, term_ptr, term_dof, term_coef, x, &
+                               with_constant) result(values)
+    integer, intent(in) :: c, term_ptr(:), term_dof(:)
+    real(dp), intent(in) :: operand_const(:, :), term_coef(:), x(:)
+    logical, intent(in) :: with_constant
+    real(dp) :: values(6)
+    integer :: s, k
+    do s = 1, 6
+      values(s) = 0.0_dp
+      if (with_constant) values(s) = operand_const(s, c)
+      do k = term_ptr(6 * (c - 1) + s), term_ptr(6 * (c - 1) + s + 1) - 1
+        values(s) = values(s) + term_coef(k) * x(term_dof(k))
+      end do
+    end do
+  end function operand_values
+
+  !> Values, gradients and (constant) Hessians with respect to the operands, Phi_t, Phi_tt
+  !> and gamma = -(x'^T H x') - Phi_tt (x' = the operands' rates at e_dot), the right-hand
+  !> side of the acceleration equation Phi_e e'' = gamma. info: 0 ok, k > 0 constraint k is
+  !> malformed (kind, drive or term indices), -k the drive of constraint k failed.
+  pure subroutine constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
+                                  term_coef, drive_kinds, drive_ptr, drive_data, e, e_dot, t, &
+                                  values, gradients, hessians, phi_t, phi_tt, gamma, info)
+    integer, intent(in) :: ncon, kinds(:), drives(:), term_ptr(:), term_dof(:)
+    integer, intent(in) :: drive_kinds(:), drive_ptr(:)
+    real(dp), intent(in) :: params(:, :), operand_const(:, :), term_coef(:), drive_data(:)
+    real(dp), intent(in) :: e(:), e_dot(:), t
+    real(dp), intent(out) :: values(:), gradients(:, :), hessians(:, :, :)
+    real(dp), intent(out) :: phi_t(:), phi_tt(:), gamma(:)
+    integer, intent(out) :: info
+    integer :: c, m, drive_info
+    real(dp) :: phi, dphi, ddphi, x(6), v(6), a(3), k(3), length
     values = 0.0_dp
     gradients = 0.0_dp
     hessians = 0.0_dp
@@ -45,78 +86,59 @@ contains
     phi_tt = 0.0_dp
     gamma = 0.0_dp
     info = 0
-    do c = 1, ncon
-      idx = ints(3:8, c)
-      if (any(idx < 0) .or. any(idx > ndof)) then
-        info = c
+    if (ncon > 0) then
+      if (any(term_dof(1:term_ptr(6 * ncon + 1) - 1) < 1) .or. &
+          any(term_dof(1:term_ptr(6 * ncon + 1) - 1) > size(e))) then
+        info = 1
         return
       end if
-      x = 0.0_dp
-      v = 0.0_dp
-      do m = 1, 6
-        if (idx(m) > 0) then
-          x(m) = e(idx(m))
-          v(m) = e_dot(idx(m))
-        end if
-      end do
-      drive = ints(2, c)
-      phi = 0.0_dp
-      dphi = 0.0_dp
-      ddphi = 0.0_dp
-      if (drive > 0) then
-        if (drive > ndrive) then
-          info = c
-          return
-        end if
-        call drive_eval(drive_kinds(drive), drive_params(:, drive), t, phi, dphi, ddphi, drive_info)
-        if (drive_info /= 0) then
-          info = -c
-          return
-        end if
+    end if
+    do c = 1, ncon
+      x = operand_values(c, operand_const, term_ptr, term_dof, term_coef, e, .true.)
+      v = operand_values(c, operand_const, term_ptr, term_dof, term_coef, e_dot, .false.)
+      call drive_value(drives(c), drive_kinds, drive_ptr, drive_data, t, phi, dphi, ddphi, &
+                       drive_info)
+      if (drive_info /= 0) then
+        info = merge(c, -c, drives(c) < 0 .or. drives(c) > size(drive_kinds))
+        return
       end if
-      select case (ints(1, c))
+      select case (kinds(c))
       case (constraint_kind_coordinate)
-        if (idx(1) == 0) then
-          info = c
+        if (term_ptr(6 * (c - 1) + 2) == term_ptr(6 * (c - 1) + 1)) then
+          info = c  ! no coordinate in the first operand
           return
         end if
-        values(c) = x(1) - (reals(1, c) + reals(2, c) * cos(phi) + reals(3, c) * sin(phi))
+        values(c) = x(1) - (params(1, c) + params(2, c) * cos(phi) + params(3, c) * sin(phi) &
+                            + params(4, c) * phi)
         gradients(1, c) = 1.0_dp
-        phi_t(c) = -(-reals(2, c) * sin(phi) + reals(3, c) * cos(phi)) * dphi
-        phi_tt(c) = -((-reals(2, c) * cos(phi) - reals(3, c) * sin(phi)) * dphi**2 &
-                      + (-reals(2, c) * sin(phi) + reals(3, c) * cos(phi)) * ddphi)
+        phi_t(c) = -(-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * dphi
+        phi_tt(c) = -((-params(2, c) * cos(phi) - params(3, c) * sin(phi)) * dphi**2 &
+                      + (-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * ddphi)
       case (constraint_kind_distance)
-        if (any(idx(1:3) == 0)) then
-          info = c
-          return
-        end if
-        a = x(1:3) - reals(1:3, c)
-        values(c) = dot_product(a, a) - reals(4, c)**2
+        a = x(1:3) - x(4:6)
+        length = params(1, c) + params(2, c) * phi
+        values(c) = dot_product(a, a) - length**2
         gradients(1:3, c) = 2.0_dp * a
+        gradients(4:6, c) = -2.0_dp * a
         do m = 1, 3
           hessians(m, m, c) = 2.0_dp
+          hessians(m + 3, m + 3, c) = 2.0_dp
+          hessians(m, m + 3, c) = -2.0_dp
+          hessians(m + 3, m, c) = -2.0_dp
         end do
+        phi_t(c) = -2.0_dp * length * params(2, c) * dphi
+        phi_tt(c) = -2.0_dp * (params(2, c) * dphi)**2 - 2.0_dp * length * params(2, c) * ddphi
       case (constraint_kind_cross)
-        if (any(idx == 0)) then
-          info = c
-          return
-        end if
-        a = x(1:3) - reals(1:3, c)
-        b = x(4:6)
-        k = reals(4:6, c)
-        values(c) = dot_product(k, cross(a, b))
-        gradients(1:3, c) = cross(b, k)
-        gradients(4:6, c) = cross(k, a)
+        k = params(1:3, c)
+        values(c) = dot_product(k, cross(x(1:3), x(4:6)))
+        gradients(1:3, c) = cross(x(4:6), k)
+        gradients(4:6, c) = cross(k, x(1:3))
         ! d2/da db of k.(a x b) = a^T S b with S(i, j) = k . (u_i x u_j)
         hessians(1:3, 4:6, c) = reshape([0.0_dp, -k(3), k(2), k(3), 0.0_dp, -k(1), &
                                           -k(2), k(1), 0.0_dp], [3, 3])
         hessians(4:6, 1:3, c) = transpose(hessians(1:3, 4:6, c))
-      case (constraint_kind_dot)  ! unused entries: components held at zero
-        if (all(idx(1:3) == 0) .or. all(idx(4:6) == 0)) then
-          info = c
-          return
-        end if
-        values(c) = dot_product(x(1:3), x(4:6)) - reals(1, c)
+      case (constraint_kind_dot)
+        values(c) = dot_product(x(1:3), x(4:6)) - params(1, c)
         gradients(1:3, c) = x(4:6)
         gradients(4:6, c) = x(1:3)
         do m = 1, 3

@@ -6,6 +6,13 @@
 !>           phi = (W/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)) for t < T, W t - W T/2 after
 !>   kind 3  load cycle: p = [amplitude, T, t_0]: phi = amplitude (1 - cos(2 pi (t - t_0)/T))/2
 !>           on [t_0, t_0 + T] (0 -> amplitude -> 0 with zero rate at both ends), 0 outside
+!>   kind 4  sine: p = [amplitude, frequency (Hz), phase (rad), offset, t_0, t_ramp]:
+!>           phi = offset + amplitude r(tau) sin(2 pi f tau + phase), tau = t - t_0, with the
+!>           envelope r = 0 before t_0, (1 - cos(pi tau / t_ramp))/2 while tau < t_ramp, 1 after
+!>           (t_ramp = 0: a plain sine from t_0 on)
+!>   kind 5  table: p = [t_1 .. t_n, v_1 .. v_n] with increasing t_k: phi linear in between,
+!>           constant outside [t_1, t_n]; phi'' = 0 (use smooth drives for prescribed motion)
+!> A drive's parameters are an array of any length (the caller slices a packed store).
 module drives
   use ancf_kinds, only: dp
   implicit none
@@ -13,7 +20,7 @@ module drives
   public :: drive_eval
 
   integer, parameter, public :: drive_constant = 0, drive_luffing = 1, drive_spinup = 2, &
-                                   drive_cycle = 3
+                                   drive_cycle = 3, drive_sine = 4, drive_table = 5
   real(dp), parameter :: pi = 3.14159265358979323846_dp
 
 contains
@@ -21,11 +28,18 @@ contains
   !> info = 1 for an unknown kind, 2 for non-physical parameters.
   pure subroutine drive_eval(kind, params, t, phi, dphi, ddphi, info)
     integer, intent(in) :: kind
-    real(dp), intent(in) :: params(8), t
+    real(dp), intent(in) :: params(:), t
     real(dp), intent(out) :: phi, dphi, ddphi
     integer, intent(out) :: info
     real(dp) :: omega, t_s, t_b, t_c, t_1, t_2, tau, period
     info = 0
+    if (size(params) < minimum_parameters(kind)) then
+      info = merge(1, 2, minimum_parameters(kind) < 0)
+      phi = 0.0_dp
+      dphi = 0.0_dp
+      ddphi = 0.0_dp
+      return
+    end if
     phi = 0.0_dp
     dphi = 0.0_dp
     ddphi = 0.0_dp
@@ -92,9 +106,107 @@ contains
         dphi = params(1) * pi / period * sin(2.0_dp * pi * tau / period)
         ddphi = 2.0_dp * params(1) * (pi / period)**2 * cos(2.0_dp * pi * tau / period)
       end if
+    case (drive_sine)
+      call sine(params, t, phi, dphi, ddphi, info)
+    case (drive_table)
+      call table(params, t, phi, dphi, ddphi, info)
     case default
       info = 1
     end select
   end subroutine drive_eval
+
+  !> Parameters a kind needs at least (-1: unknown kind).
+  pure integer function minimum_parameters(kind)
+    integer, intent(in) :: kind
+    select case (kind)
+    case (drive_constant)
+      minimum_parameters = 1
+    case (drive_luffing)
+      minimum_parameters = 5
+    case (drive_spinup, drive_cycle)
+      minimum_parameters = 3
+    case (drive_sine)
+      minimum_parameters = 6
+    case (drive_table)
+      minimum_parameters = 2
+    case default
+      minimum_parameters = -1
+    end select
+  end function minimum_parameters
+
+  pure subroutine sine(params, t, phi, dphi, ddphi, info)
+    real(dp), intent(in) :: params(:), t
+    real(dp), intent(out) :: phi, dphi, ddphi
+    integer, intent(out) :: info
+    real(dp) :: amplitude, omega, tau, ramp, r, dr, ddr, s, ds, dds
+    info = 0
+    amplitude = params(1)
+    omega = 2.0_dp * pi * params(2)
+    ramp = params(6)
+    phi = params(4)
+    dphi = 0.0_dp
+    ddphi = 0.0_dp
+    if (params(2) < 0.0_dp .or. ramp < 0.0_dp) then
+      info = 2
+      return
+    end if
+    tau = t - params(5)
+    if (tau < 0.0_dp) return
+    if (tau < ramp) then
+      r = 0.5_dp * (1.0_dp - cos(pi * tau / ramp))
+      dr = 0.5_dp * pi / ramp * sin(pi * tau / ramp)
+      ddr = 0.5_dp * (pi / ramp)**2 * cos(pi * tau / ramp)
+    else
+      r = 1.0_dp
+      dr = 0.0_dp
+      ddr = 0.0_dp
+    end if
+    s = amplitude * sin(omega * tau + params(3))
+    ds = amplitude * omega * cos(omega * tau + params(3))
+    dds = -omega**2 * s
+    phi = phi + r * s
+    dphi = dr * s + r * ds
+    ddphi = ddr * s + 2.0_dp * dr * ds + r * dds
+  end subroutine sine
+
+  pure subroutine table(params, t, phi, dphi, ddphi, info)
+    real(dp), intent(in) :: params(:), t
+    real(dp), intent(out) :: phi, dphi, ddphi
+    integer, intent(out) :: info
+    integer :: n, lo, hi, mid
+    info = 0
+    phi = 0.0_dp
+    dphi = 0.0_dp
+    ddphi = 0.0_dp
+    n = size(params) / 2
+    if (2 * n /= size(params) .or. n < 1) then
+      info = 2
+      return
+    end if
+    if (t <= params(1)) then
+      phi = params(n + 1)
+      return
+    end if
+    if (t >= params(n)) then
+      phi = params(2 * n)
+      return
+    end if
+    lo = 1
+    hi = n
+    do while (hi - lo > 1)
+      mid = (lo + hi) / 2
+      if (params(mid) <= t) then
+        lo = mid
+      else
+        hi = mid
+      end if
+    end do
+    if (params(hi) <= params(lo)) then
+      info = 2
+      return
+    end if
+    dphi = (params(n + hi) - params(n + lo)) / (params(hi) - params(lo))
+    phi = params(n + lo) + dphi * (t - params(lo))
+  end subroutine table
 
 end module drives

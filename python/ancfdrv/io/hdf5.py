@@ -13,7 +13,8 @@ import h5py
 import numpy as np
 
 from .. import __version__
-from ..model import BeamModel
+from ..system.bodies import Beam
+from ..system.model import Model
 from .scene import Scene
 from ..solvers.static import StaticResult
 
@@ -23,7 +24,7 @@ def _attrs(target: h5py.AttributeManager, values: dict[str, Any]) -> None:
         target[key] = value
 
 
-def create(path: Path, scene: Scene, model: BeamModel) -> None:
+def create(path: Path, scene: Scene, model: Model) -> None:
     """New result file with the root attributes and /model."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with h5py.File(path, "w") as h5:
@@ -40,24 +41,31 @@ def create(path: Path, scene: Scene, model: BeamModel) -> None:
             "warnings": "\n".join(model.warnings),
             "status": "running",
             # what sweeps compare: probe and component (beams: the tip sag)
-            "response_probe": getattr(model, "response", ("tip", 1))[0],
-            "response_component": getattr(model, "response", ("tip", 1))[1],
+            "response_probe": (model.response or ("", 0))[0],
+            "response_component": (model.response or ("", 0))[1],
+            "linear_joints": model.linear_joints,
+            "jacobian_policy_model": "constant" if model.constant_policy else "refactor",
         })
-        if hasattr(model, "bending"):  # beams: 'continuum' or 'cubic' (beam.bending)
-            h5.attrs["bending"] = model.bending
+        beams = [b for b in model.bodies if isinstance(b, Beam)]
+        if beams:  # 'continuum' or 'cubic' (beam.bending) of the first beam
+            h5.attrs["bending"] = beams[0].bending
         group = h5.create_group("model")
         _attrs(group.attrs, model.summary())
-        mesh = getattr(model, "mesh", None)
-        if mesh is not None:  # plate models: initial node positions and connectivity
-            group.create_dataset("nodes", data=mesh.coords[:, :3])
-            group.create_dataset("elements", data=mesh.elements)
-        else:
-            group.create_dataset("node_s", data=model.node_s)
+        geometry = model.plate_geometry()
+        if geometry is not None:  # plates: initial node positions and connectivity
+            group.create_dataset("nodes", data=geometry[0])
+            group.create_dataset("elements", data=geometry[1])
+        if len(beams) == 1:
+            group.create_dataset("node_s", data=beams[0].stations)
         group.create_dataset("e0", data=model.e0)
         group.attrs["constraint_names"] = "\n".join(model.constraints.names)
+        group.attrs["bodies"] = "\n".join(f"{b.name}: {type(b).__name__.lower()}"
+                                          for b in model.bodies)
+        if model.notes:
+            group.attrs["notes"] = "\n".join(model.notes)
 
 
-def write_static(path: Path, model: BeamModel, result: StaticResult) -> None:
+def write_static(path: Path, model: Model, result: StaticResult) -> None:
     """The /static group: q, lambda, probes, deflections and solver statistics."""
     with h5py.File(path, "a") as h5:
         if "static" in h5:
@@ -76,7 +84,7 @@ def write_static(path: Path, model: BeamModel, result: StaticResult) -> None:
                              "wall_time_s": result.wall_time_s, **result.extra})
 
 
-def finish(path: Path, model: BeamModel, timing: dict[str, float], status: str,
+def finish(path: Path, model: Model, timing: dict[str, float], status: str,
            message: str = "") -> None:
     """Counters, timing and the final status (also after a failure)."""
     with h5py.File(path, "a") as h5:
@@ -141,15 +149,14 @@ class DynamicWriter:
     """Appends each chunk of a dynamic run to /dynamic and closes the file after it, so
     every completed chunk is on disk whatever happens next (SPEC section 4)."""
 
-    def __init__(self, path: Path, model: BeamModel, store_q: bool) -> None:
+    def __init__(self, path: Path, model: Model, store_q: bool) -> None:
         from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
         self.path, self.names, self.store_q = path, list(model.probes), store_q
-        self.node_positions = getattr(model, "node_positions", None)
-        contact = getattr(model, "contact", None)
-        self.npoints = 0 if contact is None else len(contact.point_element)
+        self.node_positions = model.node_positions if model.plate_bodies() else None
+        self.npoints = model.npoint
         self.contact_fields = CONTACT_FIELDS
-        mesh = getattr(model, "mesh", None)
-        self.nnodes = mesh.nnodes if mesh is not None and store_q else 0
+        geometry = model.plate_geometry()
+        self.nnodes = len(geometry[0]) if geometry is not None and store_q else 0
         self.energy_names = ENERGY_NAMES
         self.rows = 0
         ncon, ndof = len(model.constraints), model.ndof
@@ -177,10 +184,12 @@ class DynamicWriter:
             series("energy/balance")
             series("constraint_violation")
             series("newton_iterations")
+            series("factorizations")
+            series("jacobian_evaluations")
             if self.npoints:  # per contact point: penetration, forces, slip, projection
                 for name in CONTACT_FIELDS:
                     series(f"contact/{name}", (self.npoints,))
-                group["contact"].attrs["points"] = "\n".join(contact.names)
+                group["contact"].attrs["points"] = "\n".join(model.contact_point_names)
             if store_q:
                 series("q", (ndof,))
             if self.nnodes:  # plate models: node positions per step, for ParaView (XDMF)
@@ -205,14 +214,18 @@ class DynamicWriter:
             for k, name in enumerate(self.energy_names):
                 append(f"energy/{name}", chunk.energy[:, k])
             total0 = group["energy/total"][0] if self.rows else chunk.energy[0, 4]
-            # total - total(0) - work of drives, moving frame, contact damping and friction
+            # total - total(0) - work of drives, moving frames, contact damping, friction and
+            # material damping
             append("energy/balance", chunk.energy[:, 4] - total0 - chunk.energy[:, 5]
-                   - chunk.energy[:, 6] - chunk.energy[:, 8] - chunk.energy[:, 9])
+                   - chunk.energy[:, 6] - chunk.energy[:, 8] - chunk.energy[:, 9]
+                   - chunk.energy[:, 10])
             if self.npoints and chunk.contact is not None:
                 for k, name in enumerate(self.contact_fields):
                     append(f"contact/{name}", chunk.contact[:, :, k])
             append("constraint_violation", chunk.constraint)
-            append("newton_iterations", chunk.newton)
+            append("newton_iterations", chunk.stats[:, 0])
+            append("factorizations", chunk.stats[:, 1])
+            append("jacobian_evaluations", chunk.stats[:, 2])
             if self.store_q and chunk.q is not None:
                 append("q", chunk.q)
                 if self.nnodes and self.node_positions is not None:

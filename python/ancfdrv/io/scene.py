@@ -208,6 +208,18 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "newton_tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                           "a step ends when its Newton correction is below newton_tol * length"),
         "max_newton": Key("int", 10, positive, "Newton iterations allowed per step"),
+        "jacobian": Key("str", "step", one_of("step", "iteration", "reuse"),
+                        "when a refactorized model's iteration matrix is refreshed: 'step' (at "
+                        "each step, and when a correction does not halve), 'iteration' (full "
+                        "Newton), 'reuse' (modified Newton across steps); pure FFR systems "
+                        "factorize once whatever this says"),
+        "contraction": Key("float", 0.5, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+                           "jacobian = 'reuse': refresh when a correction exceeds this fraction "
+                           "of the previous one"),
+        "linear_joints": Key("str", "auto", one_of("auto", "eliminate", "multipliers"),
+                             "linear joint equations: eliminated (q = B e + q0, seed 003) or "
+                             "kept with multipliers (seed 000); 'auto' eliminates when the "
+                             "system has rigid bodies"),
     },
     "output": {
         "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),

@@ -25,7 +25,7 @@ import scipy.sparse as sp
 
 from ..errors import SolverError
 from ..kernel import DirectSolver
-from ..model import BeamModel
+from ..system.model import Model
 
 
 @dataclass
@@ -70,49 +70,36 @@ def converged(force_res: float, con_res: float, step: float, size: float, tol: f
     return ""
 
 
-def residuals(model: BeamModel, d: np.ndarray, lam: np.ndarray, elastic: np.ndarray,
-              scale_floor: float = 0.0):
-    """Relative force residual |Q_el - Q - Phi_e^T lam| / scale and max |Phi| / length at the
-    displacement d = e - e0, given the elastic force Q_el (for FFR K d, computed from d so
-    it loses no digits). ``scale_floor`` keeps the scale of a self-equilibrated problem
+def residuals(model: Model, d: np.ndarray, lam: np.ndarray, internal: np.ndarray,
+              external: np.ndarray, scale_floor: float = 0.0):
+    """Relative force residual |Q_int - Q - Phi_e^T lam| / scale and max |Phi| / length at
+    the displacement d = e - e0, given the internal force Q_int (elastic minus contact minus
+    the dead moments; for the split iteration K d minus the moments, so it loses no digits)
+    and the external loads Q. ``scale_floor`` keeps the scale of a self-equilibrated problem
     (a prestressed body without loads) at the forces met on the way."""
     e = model.e0 + d
     values, rows, cols, grads = model.constraints.jacobian(e, model.ndof)
     reaction = np.zeros(model.ndof)
     np.add.at(reaction, cols, grads * lam[rows])
-    external = model.external_force(e)
-    residual = elastic - external - reaction
-    scale = max(np.linalg.norm(external), np.linalg.norm(reaction), np.linalg.norm(elastic),
+    residual = internal - external - reaction
+    scale = max(np.linalg.norm(external), np.linalg.norm(reaction), np.linalg.norm(internal),
                 scale_floor, 1e-300)
     return (np.linalg.norm(residual) / scale,
             np.max(np.abs(values), initial=0.0) / model.length_scale)
 
 
-def _hessian_triplets(model: BeamModel, e: np.ndarray):
-    """Constant constraint Hessians as (constraint, row, col, value) over used dofs."""
-    _, _, hessians, *_ = model.constraints.evaluate(e)
-    table = model.constraints.dof_table()
-    c_idx, a_idx, b_idx = np.nonzero(np.transpose(hessians, (2, 0, 1)))
-    keep = (table[a_idx, c_idx] >= 0) & (table[b_idx, c_idx] >= 0)
-    c_idx, a_idx, b_idx = c_idx[keep], a_idx[keep], b_idx[keep]
-    return c_idx, table[a_idx, c_idx], table[b_idx, c_idx], hessians[a_idx, b_idx, c_idx]
+def _hessian_triplets(model: Model, e: np.ndarray):
+    """Constant constraint Hessians as (constraint, row, col, value) in the coordinates."""
+    return model.constraints.hessian_triplets(e)
 
 
-def _elastic_function(model: BeamModel):
-    """elastic(d, want_tangent) -> (Q_el, CSR tangent values or None) for the formulation:
-    FFR uses its constant K on d (no cancellation), the nonlinear beam its kernel."""
-    if model.formulation == "ffr":
-        k_values = model.stiffness_values()
-        stiffness = model.pattern.to_scipy(k_values)
-        return lambda d, want: (stiffness @ d, k_values if want else None)
-
-    def nonlinear(d: np.ndarray, want: bool):
-        force, _, tangent = model.internal_force(model.e0 + d, want_tangent=want)
-        return force, tangent
-    return nonlinear
+def _forces(model: Model, d: np.ndarray, want_tangent: bool, t: float = 0.0):
+    """(internal, external, tangent values or None) at e0 + d from the kernel."""
+    out = model.forces(model.e0 + d, t, want_tangent=want_tangent)
+    return out["internal"], out["external"], out["tangent"]
 
 
-def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
+def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                  load_steps: int = 1) -> StaticResult:
     """Full Newton-Raphson on (e, lambda) from the rigid configuration; the loads are
     applied in ``load_steps`` equal increments (large deformation), each solved to tol."""
@@ -121,11 +108,11 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
     n, ncon = model.ndof, len(model.constraints)
     d, lam = np.zeros(n), np.zeros(ncon)
     t0 = time.perf_counter()
-    elastic = _elastic_function(model)
     h_con, h_rows, h_cols, h_vals = _hessian_triplets(model, model.e0)
     _, j_rows, j_cols, _ = model.constraints.jacobian(model.e0, n)
-    m_rows = [np.repeat(m.dofs, 3) for m in model.moments]
-    m_cols = [np.tile(m.dofs, 3) for m in model.moments]
+    moment_cols = [cols for cols, *_ in model.moment_terms(model.e0)]
+    m_rows = [np.repeat(cols, len(cols)) for cols in moment_cols]
+    m_cols = [np.tile(cols, len(cols)) for cols in moment_cols]
     rows = np.concatenate([model.pattern.rows, h_rows, *m_rows, n + j_rows, j_cols])
     cols = np.concatenate([model.pattern.col_index, h_cols, *m_cols, j_cols, n + j_rows])
     timing["assembly"] += time.perf_counter() - t0
@@ -142,10 +129,7 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
                     reaction = np.zeros(n)
                     np.add.at(reaction, j_cols, grads * lam[j_rows])
                     moments = model.moment_terms(e)
-                    external = model.constant_force()
-                    for dofs, f, _, _ in moments:
-                        external[dofs] += f
-                    internal, k_values = elastic(d, True)
+                    internal, external, k_values = _forces(model, d, True)
                     if load_step == 1 and iteration == 1:  # the start: loads and prestress
                         force_scale = max(np.linalg.norm(internal), np.linalg.norm(external))
                     residual = internal - external - reaction
@@ -164,7 +148,8 @@ def solve_newton(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50,
                                           f"{iteration} of load step {load_step}")
                     d += step[:n]
                     lam += step[n:]
-                    force_res, con_res = residuals(model, d, lam, elastic(d, False)[0],
+                    internal, external, _ = _forces(model, d, False)
+                    force_res, con_res = residuals(model, d, lam, internal, external,
                                                    force_scale)
                     previous = history[-1] if history and iteration > 1 else np.inf
                     history.append(force_res)
@@ -223,7 +208,7 @@ class Jet:
                    np.max(np.abs(self.hess - other.hess), initial=0.0))
 
 
-def _force_jet(model: BeamModel, rel: np.ndarray, d: Jet, lam: np.ndarray, nd: int) -> Jet:
+def _force_jet(model: Model, rel: np.ndarray, d: Jet, lam: np.ndarray, nd: int) -> Jet:
     """Jet of the configuration-dependent forces Q_M(e0 + d) + Phi_e(e0 + d)^T lambda on
     the coordinates ``rel`` (which hold every moment director and constrained coordinate),
     for the jet ``d`` of the displacement on ``rel`` and lambda = lam + delta_lambda
@@ -233,30 +218,31 @@ def _force_jet(model: BeamModel, rel: np.ndarray, d: Jet, lam: np.ndarray, nd: i
     e = model.e0.copy()
     e[rel] += d.value
     out = Jet.zeros(n, m)
-    for dofs, f, j, h in model.moment_terms(e):
-        idx = [where[k] for k in dofs]
+    # the moments and constraints act through the forces on rel: -Q_M enters the internal
+    # force, so the jet carries Q_M + Phi_e^T lambda
+    for cols, f, j, h in model.moment_terms(e):
+        idx = [where[k] for k in cols]
         gx, hx = d.grad[idx], d.hess[idx]
         out.value[idx] += f
         out.grad[idx] += j @ gx
         out.hess[idx] += np.einsum("ij,jab->iab", j, hx) + np.einsum("ijl,ja,lb->iab", h, gx, gx)
     _, gradients, hessians, *_ = model.constraints.evaluate(e)
-    table = model.constraints.dof_table()
     for c in range(len(model.constraints)):
-        used = table[:, c] >= 0
-        idx = [where[k] for k in table[used, c]]
-        hc = hessians[np.ix_(used, used, [c])][:, :, 0]
-        g_val, g_grad = gradients[used, c], hc @ d.grad[idx]
-        g_hess = np.einsum("ij,jab->iab", hc, d.hess[idx])
+        operands, _ = model.constraints.operand_map(c, rel)   # (6, n) d x / d e_rel
+        g_val = operands.T @ gradients[:, c]
+        hc = operands.T @ hessians[:, :, c] @ operands
+        g_grad = hc @ d.grad
+        g_hess = np.einsum("ij,jab->iab", hc, d.hess)
         unit = np.zeros(m)
         unit[nd + c] = 1.0
-        out.value[idx] += lam[c] * g_val
-        out.grad[idx] += lam[c] * g_grad + np.outer(g_val, unit)
+        out.value += lam[c] * g_val
+        out.grad += lam[c] * g_grad + np.outer(g_val, unit)
         cross = np.einsum("ia,b->iab", g_grad, unit)
-        out.hess[idx] += lam[c] * g_hess + cross + np.transpose(cross, (0, 2, 1))
+        out.hess += lam[c] * g_hess + cross + np.transpose(cross, (0, 2, 1))
     return out
 
 
-def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: float = 0.0,
+def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: float = 0.0,
                 inner_tol: float = 1e-13, max_inner: int = 200) -> StaticResult:
     """The split iteration of seed 000 with re-expansion until convergence (module doc).
 
@@ -269,9 +255,10 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
     """
     if not 0.0 <= p < 1.0:
         raise SolverError(f"split iteration: p = {p} outside [0, 1)")
-    if model.formulation != "ffr":
+    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
         raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
-                          "formulation; use solver.static_method = 'newton'")
+                          "formulation (every body) without contact; use "
+                          "solver.static_method = 'newton'")
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)
@@ -280,8 +267,8 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
         raise SolverError("split iteration: two constraints share a dependent coordinate")
     rest = np.setdiff1d(np.arange(n), dep)
     nd, m = len(dep), len(dep) + ncon
-    table = model.constraints.dof_table()
-    touched = set(table[table >= 0].tolist()) | {k for mo in model.moments for k in mo.dofs}
+    touched = set(model.constraints.touched().tolist()) | {
+        int(k) for cols, *_ in model.moment_terms(model.e0) for k in cols}
     nonlinear = np.array(sorted(touched - set(dep.tolist())), dtype=int)
     local = np.searchsorted(rest, nonlinear)  # rows of N_l within e_R
     rel = np.concatenate([nonlinear, dep])
@@ -364,7 +351,10 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
         disp = np.zeros(n)
         disp[rest], disp[dep] = d_r, d_d_new
         d_d = d_d_new
-        force_res, con_res = residuals(model, disp, lam, stiffness @ disp)
+        internal = stiffness @ disp
+        for cols, f, _, _ in model.moment_terms(model.e0 + disp):
+            internal[cols] -= f
+        force_res, con_res = residuals(model, disp, lam, internal, constant)
         history.append(force_res)
         if not np.isfinite(force_res):
             raise SolverError(f"split iteration: non-finite state at pass {outer}")
@@ -383,7 +373,7 @@ def solve_split(model: BeamModel, *, tol: float = 1e-10, max_iter: int = 50, p: 
                                        "converged_by": how, "nonlinear_coordinates": nl})
 
 
-def solve_static(model: BeamModel, method: str, *, tol: float, max_iter: int,
+def solve_static(model: Model, method: str, *, tol: float, max_iter: int,
                  p: float = 0.0, load_steps: int = 1) -> StaticResult:
     """Dispatch on ``solver.static_method``."""
     if method == "newton":

@@ -1,25 +1,28 @@
-!> The one f2py-facing layer: plain subroutines over plain arrays and integer handles.
-!> Every routine returns an error code (info) instead of stopping; Python turns
-!> non-zero codes into exceptions. Array sizes are passed explicitly.
+!> The f2py-facing layer, part 1 (with system_api.f90 the one thin binding `_kernel`):
+!> element-level routines over plain arrays, used to set models up and by the tests.
+!> Every routine returns an error code (info) instead of stopping; Python turns non-zero
+!> codes into exceptions. Array sizes are passed explicitly.
 
 !> Element arrays of a beam mesh: compact mass (8 x 8) and small-strain stiffness K0
-!> (24 x 24) per element. info = 10*element + code.
-subroutine beam_element_arrays(nel, lengths, width, height, density, youngs, poisson, &
-                               reference, mass_compact, stiffness, info)
+!> (24 x 24) per element, over a section rule (beam_section_rule). info = 10*element + code.
+subroutine beam_element_arrays(nel, nsec, lengths, section_y, section_z, section_w, density, &
+                               youngs, poisson, reference, mass_compact, stiffness, info)
   use ancf_kinds, only: dp
   use beam_element, only: beam_mass_compact, beam_linear_stiffness
   implicit none
-  integer, intent(in) :: nel
-  real(dp), intent(in) :: lengths(nel), width, height, density, youngs, poisson
-  real(dp), intent(in) :: reference(3, 8, nel)
+  integer, intent(in) :: nel, nsec
+  real(dp), intent(in) :: lengths(nel), section_y(nsec), section_z(nsec), section_w(nsec)
+  real(dp), intent(in) :: density, youngs, poisson, reference(3, 8, nel)
   real(dp), intent(out) :: mass_compact(8, 8, nel), stiffness(24, 24, nel)
   integer, intent(out) :: info
   integer :: el, code
   info = 0
   do el = 1, nel
-    call beam_mass_compact(lengths(el), width, height, density, mass_compact(:, :, el), code)
-    if (code == 0) call beam_linear_stiffness(reference(:, :, el), lengths(el), width, height, &
-                                              youngs, poisson, stiffness(:, :, el), code)
+    call beam_mass_compact(lengths(el), section_y, section_z, section_w, density, &
+                           mass_compact(:, :, el), code)
+    if (code == 0) call beam_linear_stiffness(reference(:, :, el), lengths(el), section_y, &
+                                              section_z, section_w, youngs, poisson, &
+                                              stiffness(:, :, el), code)
     if (code /= 0) then
       info = 10 * el + code
       return
@@ -28,46 +31,67 @@ subroutine beam_element_arrays(nel, lengths, width, height, density, youngs, poi
 end subroutine beam_element_arrays
 
 !> Generalized gravity forces (3 x 8) per element (seed 000, eqs. 22-25).
-subroutine beam_gravity(nel, lengths, width, height, density, gravity, gravity_force, info)
+subroutine beam_gravity(nel, nsec, lengths, section_y, section_z, section_w, density, gravity, &
+                        gravity_force, info)
   use ancf_kinds, only: dp
   use beam_element, only: beam_gravity_compact
   implicit none
-  integer, intent(in) :: nel
-  real(dp), intent(in) :: lengths(nel), width, height, density, gravity(3)
+  integer, intent(in) :: nel, nsec
+  real(dp), intent(in) :: lengths(nel), section_y(nsec), section_z(nsec), section_w(nsec)
+  real(dp), intent(in) :: density, gravity(3)
   real(dp), intent(out) :: gravity_force(3, 8, nel)
   integer, intent(out) :: info
   integer :: el
   info = 0
   do el = 1, nel
-    call beam_gravity_compact(lengths(el), width, height, density, gravity, gravity_force(:, :, el), info)
+    call beam_gravity_compact(lengths(el), section_y, section_z, section_w, density, gravity, &
+                              gravity_force(:, :, el), info)
     if (info /= 0) return
   end do
 end subroutine beam_gravity
 
-!> Number of Gauss points per element of the large-deformation beam.
-subroutine beam_nonlinear_points(npts)
-  use beam_nonlinear, only: nonlinear_points
+!> Section rule (points, area weights; the first npoints of max_section_points entries)
+!> and properties of a section kind (beam_section). info: 1 unknown kind, 2 dimensions.
+subroutine beam_section_data(kind, dims, npoints, y, z, weight, area, inertia_y, inertia_z, &
+                             polar, info)
+  use ancf_kinds, only: dp
+  use beam_section, only: section_rule, section_properties, max_section_points
   implicit none
+  integer, intent(in) :: kind
+  real(dp), intent(in) :: dims(3)
+  integer, intent(out) :: npoints, info
+  real(dp), intent(out) :: y(18), z(18), weight(18), area, inertia_y, inertia_z, polar
+  call section_rule(kind, dims, npoints, y, z, weight, info)
+  if (info == 0) call section_properties(kind, dims, area, inertia_y, inertia_z, polar, info)
+end subroutine beam_section_data
+
+!> Number of Gauss points per element of the large-deformation beam for a section rule of
+!> nsec points.
+subroutine beam_nonlinear_points(nsec, npts)
+  use beam_nonlinear, only: nonlinear_rule_size
+  implicit none
+  integer, intent(in) :: nsec
   integer, intent(out) :: npts
-  npts = nonlinear_points
+  npts = nonlinear_rule_size(nsec)
 end subroutine beam_nonlinear_points
 
 !> Material shape-function gradients and weights at the Gauss points of every element,
 !> computed once from the reference configuration. info = 10*element + code.
-subroutine beam_nonlinear_setup(nel, npts, reference, lengths, width, height, gradients, &
-                                weights, info)
+subroutine beam_nonlinear_setup(nel, npts, nsec, reference, lengths, section_y, section_z, &
+                                section_w, gradients, weights, info)
   use ancf_kinds, only: dp
   use beam_nonlinear, only: nonlinear_setup
   implicit none
-  integer, intent(in) :: nel, npts
-  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), width, height
+  integer, intent(in) :: nel, npts, nsec
+  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel)
+  real(dp), intent(in) :: section_y(nsec), section_z(nsec), section_w(nsec)
   real(dp), intent(out) :: gradients(8, 3, npts, nel), weights(npts, nel)
   integer, intent(out) :: info
   integer :: el, code
   info = 0
   do el = 1, nel
-    call nonlinear_setup(reference(:, :, el), lengths(el), width, height, gradients(:, :, :, el), &
-                         weights(:, el), code)
+    call nonlinear_setup(reference(:, :, el), lengths(el), section_y, section_z, section_w, &
+                         gradients(:, :, :, el), weights(:, el), code)
     if (code /= 0) then
       info = 10 * el + code
       return
@@ -76,24 +100,24 @@ subroutine beam_nonlinear_setup(nel, npts, reference, lengths, width, height, gr
 end subroutine beam_nonlinear_setup
 
 !> Large-deformation elastic force (global), strain energy and, when want_tangent /= 0,
-!> the element tangents (24 x 24 x nel) of a beam mesh.
-subroutine beam_nonlinear_forces(ndof, nel, npts, dofs, e, gradients, weights, youngs, poisson, &
-                                 want_tangent, force, energy, tangent)
+!> the element tangents (24 x 24 x nel) of a beam mesh; the first nvolume Gauss points of
+!> an element are its volume points.
+subroutine beam_nonlinear_forces(ndof, nel, npts, nvolume, dofs, e, gradients, weights, youngs, &
+                                 poisson, want_tangent, force, energy, tangent)
   use ancf_kinds, only: dp
   use beam_nonlinear, only: nonlinear_element
   implicit none
-  integer, intent(in) :: ndof, nel, npts, dofs(24, nel), want_tangent
+  integer, intent(in) :: ndof, nel, npts, nvolume, dofs(24, nel), want_tangent
   real(dp), intent(in) :: e(ndof), gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
   real(dp), intent(out) :: force(ndof), energy, tangent(24, 24, nel)
   real(dp) :: element_force(24, nel), element_energy(nel)
   integer :: el
   force = 0.0_dp
   tangent = 0.0_dp
-  ! elements in parallel (OpenMP, when built with it), then a serial scatter
   !$omp parallel do schedule(static)
   do el = 1, nel
     call nonlinear_element(reshape(e(dofs(:, el)), [3, 8]), gradients(:, :, :, el), weights(:, el), &
-                           youngs, poisson, want_tangent /= 0, element_force(:, el), &
+                           nvolume, youngs, poisson, want_tangent /= 0, element_force(:, el), &
                            element_energy(el), tangent(:, :, el))
   end do
   !$omp end parallel do
@@ -112,21 +136,23 @@ subroutine beam_structural_size(nterms)
 end subroutine beam_structural_size
 
 !> Strain forms, reference strains and stiffnesses of the structural ("cubic") beam per
-!> element, from the reference configuration. info = 10*element + code.
-subroutine beam_structural_setup(nel, nterms, reference, lengths, width, height, youngs, poisson, &
-                                 forms, strain0, stiffness, info)
+!> element, from the reference configuration and the section properties. info =
+!> 10*element + code.
+subroutine beam_structural_setup(nel, nterms, reference, lengths, area, inertia_y, inertia_z, &
+                                 polar, youngs, poisson, forms, strain0, stiffness, info)
   use ancf_kinds, only: dp
   use beam_structural, only: structural_setup
   implicit none
   integer, intent(in) :: nel, nterms
-  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), width, height, youngs, poisson
+  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), area, inertia_y, inertia_z, polar
+  real(dp), intent(in) :: youngs, poisson
   real(dp), intent(out) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
   integer, intent(out) :: info
   integer :: el, code
   info = 0
   do el = 1, nel
-    call structural_setup(reference(:, :, el), lengths(el), width, height, youngs, poisson, &
-                          forms(:, :, :, el), strain0(:, el), stiffness(:, el), code)
+    call structural_setup(reference(:, :, el), lengths(el), area, inertia_y, inertia_z, polar, &
+                          youngs, poisson, forms(:, :, :, el), strain0(:, el), stiffness(:, el), code)
     if (code /= 0) then
       info = 10 * el + code
       return
@@ -187,15 +213,17 @@ subroutine beam_point_mass(xi, y, z, length, point_mass, mass_compact)
   call beam_point_mass_compact(xi, y, z, length, point_mass, mass_compact)
 end subroutine beam_point_mass
 
-!> FFR elastic force and strain energy of a beam mesh.
-subroutine ffr_elastic_force(ndof, nel, dofs, stiffness0, rotation, e, e0_frame, force, energy)
+!> FFR elastic force and strain energy of a beam mesh (reference: the rigid configuration
+!> in the frame, per element).
+subroutine ffr_elastic_force(ndof, nel, dofs, stiffness0, reference, rotation, e, force, energy)
   use ancf_kinds, only: dp
   use ffr_elastic, only: ffr_force
   implicit none
   integer, intent(in) :: ndof, nel, dofs(24, nel)
-  real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3), e(ndof), e0_frame(ndof)
+  real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), rotation(3, 3), e(ndof)
   real(dp), intent(out) :: force(ndof), energy
-  call ffr_force(ndof, nel, dofs, stiffness0, rotation, e, e0_frame, force, energy)
+  force = 0.0_dp
+  call ffr_force(nel, dofs, stiffness0, reference, rotation, e, force, energy)
 end subroutine ffr_elastic_force
 
 !> FFR element stiffness matrices rotated into the global frame.
@@ -414,13 +442,13 @@ subroutine moment_rotation_angle(director, axis, reference, angle)
   angle = moment_angle(director, axis, reference)
 end subroutine moment_rotation_angle
 
-!> A drive's phi, phi', phi'' at nt times.
-subroutine drive_values(kind, params, nt, t, phi, dphi, ddphi, info)
+!> A drive's phi, phi', phi'' at nt times (params: its parameters, any length).
+subroutine drive_values(kind, nparams, params, nt, t, phi, dphi, ddphi, info)
   use ancf_kinds, only: dp
   use drives, only: drive_eval
   implicit none
-  integer, intent(in) :: kind, nt
-  real(dp), intent(in) :: params(8), t(nt)
+  integer, intent(in) :: kind, nparams, nt
+  real(dp), intent(in) :: params(nparams), t(nt)
   real(dp), intent(out) :: phi(nt), dphi(nt), ddphi(nt)
   integer, intent(out) :: info
   integer :: i
@@ -431,21 +459,27 @@ subroutine drive_values(kind, params, nt, t, phi, dphi, ddphi, info)
   end do
 end subroutine drive_values
 
-!> Constraint values, sparse gradients, constant Hessians, Phi_t, Phi_tt and the
-!> acceleration right-hand side gamma at (e, e_dot, t).
-subroutine constraint_evaluate(ncon, ints, reals, ndrive, drive_kinds, drive_params, ndof, e, e_dot, &
-                               t, values, gradients, hessians, phi_t, phi_tt, gamma, info)
+!> Constraint values, operand gradients (6, ncon), constant operand Hessians, Phi_t,
+!> Phi_tt and the acceleration right-hand side gamma at (e, e_dot, t) (constraints module
+!> layout).
+subroutine constraint_evaluate(ncon, ndof, nterm, ndrive, ndata, kinds, drives, params, &
+                               operand_const, term_ptr, term_dof, term_coef, drive_kinds, &
+                               drive_ptr, drive_data, e, e_dot, t, values, gradients, hessians, &
+                               phi_t, phi_tt, gamma, info)
   use ancf_kinds, only: dp
   use constraints, only: constraint_eval
   implicit none
-  integer, intent(in) :: ncon, ndrive, ndof
-  integer, intent(in) :: ints(8, ncon), drive_kinds(ndrive)
-  real(dp), intent(in) :: reals(8, ncon), drive_params(8, ndrive), e(ndof), e_dot(ndof), t
+  integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata
+  integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
+  integer, intent(in) :: drive_kinds(ndrive), drive_ptr(ndrive + 1)
+  real(dp), intent(in) :: params(8, ncon), operand_const(6, ncon), term_coef(nterm)
+  real(dp), intent(in) :: drive_data(ndata), e(ndof), e_dot(ndof), t
   real(dp), intent(out) :: values(ncon), gradients(6, ncon), hessians(6, 6, ncon)
   real(dp), intent(out) :: phi_t(ncon), phi_tt(ncon), gamma(ncon)
   integer, intent(out) :: info
-  call constraint_eval(ncon, ints, reals, ndrive, drive_kinds, drive_params, ndof, e, e_dot, t, &
-                       values, gradients, hessians, phi_t, phi_tt, gamma, info)
+  call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, term_coef, &
+                       drive_kinds, drive_ptr, drive_data, e, e_dot, t, values, gradients, &
+                       hessians, phi_t, phi_tt, gamma, info)
 end subroutine constraint_evaluate
 
 !> Pattern size of an n x n matrix coupled by element dof lists.
@@ -523,192 +557,3 @@ subroutine direct_destroy(handle, info)
   call solver_destroy(handle, info)
 end subroutine direct_destroy
 
-!> Advances nsteps steps of the generalized-alpha method (Newmark: alpha_m = alpha_f = 0)
-!> (module time_integrator). formulation 0: ANCF-FFR beam, S factorized once by the caller
-!> behind solver_handle, with the flexibility given; 1: large-deformation beam, 2: thin
-!> plate (nde = 36), 3: large-deformation beam with 'cubic' bending (beam_structural), all
-!> with S refactorized per step on the pattern (scatter_map,
-!> mass_pattern) of solver_handle. Arrays a formulation does not use may be (.., 1, 1).
-!> The state (t, e, v, a, accel, lam, work) is updated in place; one output row per step.
-!> status = [steps done, info, detail, refactorizations]; last_correction = size of the last Newton
-!> correction. Arrays of optional items carry max(1, n) columns (f2py refuses zero sizes).
-subroutine integrator_advance(ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nblock, nprobe, &
-                              nshape, nnz_mass, nsteps, nq, npts, ngauss, nplate_pts, nplate_el, &
-                              nnz_pattern, nfull, nnz_b, nplan, nnz_full, ncontact, ngrid_l, &
-                              ngrid_w, nterms, nstructural, formulation, dofs, stiffness0, &
-                              e0_frame, mass_row_ptr, mass_col, mass_values, constant_force, &
-                              moment_dofs, moment_axis, moment_magnitude, moment_reference, &
-                              con_ints, con_reals, drive_kinds, drive_params, frame_drive, &
-                              frame_axis, frame_base, solver_handle, block_first, flexibility, &
-                              flexibility_cc, probe_dofs, probe_shape, probe_reference, youngs, &
-                              poisson, gauss_gradients, gauss_weights, structural_forms, &
-                              structural_strain0, structural_stiffness, plate_derivs, plate_frame, &
-                              plate_curvature0, plate_weights, thickness, scatter_map, mass_pattern, &
-                              reduced, reduction_ptr, reduction_col, reduction_values, &
-                              reduction_offset, plan_source, plan_target, plan_coef, full_row_ptr, &
-                              full_col, force_drive, drive_force, element_size, contact_grid, &
-                              contact_element, contact_local, contact_params, &
-                              h, beta, gamma, alpha_m, alpha_f, tol, length_scale, max_newton, &
-                              t, e, v, a, accel, lam, work, contact_guess, contact_counts, out_time, &
-                              out_probe, out_deflection, out_lambda, out_energy, out_constraint, &
-                              out_newton, out_contact, out_q, status, last_correction)
-  use ancf_kinds, only: dp
-  use time_integrator, only: mechanical_system, integrator_settings, integrator_chunk, &
-                             contact_state
-  implicit none
-  integer, intent(in) :: ndof, nel, nde, nstiff, ncon, ndrive, nmoment, nblock, nprobe, nshape
-  integer, intent(in) :: nnz_mass, nsteps, nq
-  integer, intent(in) :: npts, ngauss, nplate_pts, nplate_el, nnz_pattern, formulation
-  integer, intent(in) :: nfull, nnz_b, nplan, nnz_full, ncontact, ngrid_l, ngrid_w
-  integer, intent(in) :: nterms, nstructural
-  integer, intent(in) :: dofs(nde, nel), mass_row_ptr(ndof + 1), mass_col(nnz_mass)
-  real(dp), intent(in) :: stiffness0(nde, nde, nstiff), e0_frame(ndof), mass_values(nnz_mass)
-  real(dp), intent(in) :: constant_force(ndof)
-  integer, intent(in) :: moment_dofs(3, max(1, nmoment))
-  real(dp), intent(in) :: moment_axis(3, max(1, nmoment)), moment_magnitude(max(1, nmoment))
-  real(dp), intent(in) :: moment_reference(3, max(1, nmoment))
-  integer, intent(in) :: con_ints(8, max(1, ncon)), drive_kinds(ndrive)
-  real(dp), intent(in) :: con_reals(8, max(1, ncon)), drive_params(8, ndrive)
-  integer, intent(in) :: frame_drive, solver_handle, block_first(max(1, nblock))
-  real(dp), intent(in) :: frame_axis(3), frame_base(3, 3)
-  real(dp), intent(in) :: flexibility(ndof, max(3, 3 * nblock))
-  real(dp), intent(in) :: flexibility_cc(max(3, 3 * nblock), max(3, 3 * nblock))
-  integer, intent(in) :: probe_dofs(nde, nprobe)
-  real(dp), intent(in) :: probe_shape(nshape, nprobe), probe_reference(3, nprobe)
-  real(dp), intent(in) :: youngs, poisson, gauss_gradients(8, 3, npts, ngauss), gauss_weights(npts, ngauss)
-  real(dp), intent(in) :: structural_forms(8, 8, nterms, nstructural)
-  real(dp), intent(in) :: structural_strain0(nterms, nstructural)
-  real(dp), intent(in) :: structural_stiffness(nterms, nstructural)
-  real(dp), intent(in) :: plate_derivs(12, 5, nplate_pts, nplate_el)
-  real(dp), intent(in) :: plate_frame(2, 2, nplate_pts, nplate_el)
-  real(dp), intent(in) :: plate_curvature0(3, nplate_pts, nplate_el)
-  real(dp), intent(in) :: plate_weights(nplate_pts, nplate_el), thickness
-  integer, intent(in) :: scatter_map(nde, nde, nel)
-  real(dp), intent(in) :: mass_pattern(nnz_pattern)
-  integer, intent(in) :: reduced, reduction_ptr(nfull + 1), reduction_col(max(1, nnz_b))
-  real(dp), intent(in) :: reduction_values(max(1, nnz_b)), reduction_offset(nfull)
-  integer, intent(in) :: plan_source(max(1, nplan)), plan_target(max(1, nplan))
-  real(dp), intent(in) :: plan_coef(max(1, nplan))
-  integer, intent(in) :: full_row_ptr(nfull + 1), full_col(nnz_full), force_drive
-  real(dp), intent(in) :: drive_force(ndof), element_size(2, nel)
-  integer, intent(in) :: contact_grid(ngrid_l, ngrid_w), contact_element(max(1, ncontact))
-  real(dp), intent(in) :: contact_local(2, max(1, ncontact)), contact_params(8)
-  real(dp), intent(in) :: h, beta, gamma, alpha_m, alpha_f, tol, length_scale
-  integer, intent(in) :: max_newton
-  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), accel(ndof), lam(max(1, ncon)), work(4)
-  real(dp), intent(inout) :: contact_guess(2, max(1, ncontact))
-  integer, intent(inout) :: contact_counts(6)
-  !f2py intent(in,out) :: t, e, v, a, accel, lam, work, contact_guess, contact_counts
-  real(dp), intent(out) :: out_time(nsteps), out_probe(3, nprobe, nsteps)
-  real(dp), intent(out) :: out_deflection(3, nprobe, nsteps), out_lambda(max(1, ncon), nsteps)
-  real(dp), intent(out) :: out_energy(10, nsteps), out_constraint(nsteps), out_q(ndof, nq)
-  real(dp), intent(out) :: out_contact(6, max(1, ncontact), nsteps)
-  integer, intent(out) :: out_newton(nsteps), status(4)
-  real(dp), intent(out) :: last_correction
-  type(mechanical_system) :: sys
-  type(integrator_settings) :: cfg
-  type(contact_state) :: state
-  sys%formulation = formulation
-  sys%element_dofs = nde
-  sys%ndof = ndof
-  sys%nel = nel
-  sys%ncon = ncon
-  sys%nmoment = nmoment
-  sys%nblock = nblock
-  sys%nprobe = nprobe
-  sys%dofs = dofs
-  sys%stiffness0 = stiffness0
-  sys%e0_frame = e0_frame
-  sys%mass_row_ptr = mass_row_ptr
-  sys%mass_col = mass_col
-  sys%mass_values = mass_values
-  sys%constant_force = constant_force
-  sys%moment_dofs = moment_dofs(:, 1:nmoment)
-  sys%moment_axis = moment_axis(:, 1:nmoment)
-  sys%moment_magnitude = moment_magnitude(1:nmoment)
-  sys%moment_reference = moment_reference(:, 1:nmoment)
-  sys%con_ints = con_ints(:, 1:ncon)
-  sys%con_reals = con_reals(:, 1:ncon)
-  sys%drive_kinds = drive_kinds
-  sys%drive_params = drive_params
-  sys%frame_drive = frame_drive
-  sys%frame_axis = frame_axis
-  sys%frame_base = frame_base
-  sys%solver_handle = solver_handle
-  sys%block_first = block_first(1:nblock)
-  sys%flexibility = flexibility(:, 1:3 * nblock)
-  sys%flexibility_cc = flexibility_cc(1:3 * nblock, 1:3 * nblock)
-  sys%probe_dofs = probe_dofs
-  sys%probe_shape = probe_shape
-  sys%probe_reference = probe_reference
-  sys%youngs = youngs
-  sys%poisson = poisson
-  if (formulation == 1) then
-    sys%gauss_gradients = gauss_gradients
-    sys%gauss_weights = gauss_weights
-  end if
-  if (formulation == 3) then
-    sys%structural_forms = structural_forms
-    sys%structural_strain0 = structural_strain0
-    sys%structural_stiffness = structural_stiffness
-  end if
-  if (formulation == 2) then
-    sys%plate_derivs = plate_derivs
-    sys%plate_frame = plate_frame
-    sys%plate_curvature0 = plate_curvature0
-    sys%plate_weights = plate_weights
-    sys%thickness = thickness
-  end if
-  if (formulation /= 0) then
-    sys%scatter_map = scatter_map
-    sys%mass_pattern = mass_pattern
-  end if
-  sys%nfull = nfull
-  sys%reduced = reduced /= 0
-  if (sys%reduced) then
-    sys%reduction_ptr = reduction_ptr
-    sys%reduction_col = reduction_col(1:nnz_b)
-    sys%reduction_values = reduction_values(1:nnz_b)
-    sys%reduction_offset = reduction_offset
-    sys%plan_source = plan_source(1:nplan)
-    sys%plan_target = plan_target(1:nplan)
-    sys%plan_coef = plan_coef(1:nplan)
-  end if
-  sys%full_row_ptr = full_row_ptr
-  sys%full_col = full_col
-  sys%force_drive = force_drive
-  sys%drive_force = drive_force
-  sys%ncontact = ncontact
-  sys%element_size = element_size
-  if (ncontact > 0) then
-    sys%contact_grid = contact_grid
-    sys%contact_element = contact_element(1:ncontact)
-    sys%contact_local = contact_local(:, 1:ncontact)
-    sys%contact_params = contact_params
-  end if
-  state%guesses = contact_guess(:, 1:max(1, ncontact))
-  state%counts = contact_counts
-  cfg%h = h
-  cfg%beta = beta
-  cfg%gamma = gamma
-  cfg%alpha_m = alpha_m
-  cfg%alpha_f = alpha_f
-  cfg%tol = tol
-  cfg%length_scale = length_scale
-  cfg%max_newton = max_newton
-  out_time = 0.0_dp
-  out_probe = 0.0_dp
-  out_deflection = 0.0_dp
-  out_lambda = 0.0_dp
-  out_energy = 0.0_dp
-  out_constraint = 0.0_dp
-  out_newton = 0
-  out_q = 0.0_dp
-  out_contact = 0.0_dp
-  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, state, out_time, &
-                        out_probe, out_deflection, out_lambda(1:ncon, :), out_energy, &
-                        out_constraint, out_newton, out_contact, nq == nsteps, out_q, status(1), &
-                        status(2), status(3), status(4), last_correction)
-  contact_guess(:, 1:max(1, ncontact)) = state%guesses
-  contact_counts = state%counts
-end subroutine integrator_advance

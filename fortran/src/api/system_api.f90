@@ -1,0 +1,612 @@
+!> The f2py-facing layer, part 2: a mechanical system behind an integer handle
+!> (system_store, mechanical_system), built once piece by piece and then evaluated or
+!> stepped without sending its arrays again. Counts of optional items may be 0; their
+!> arrays then carry one unused entry (f2py refuses zero sizes). info: 0 ok; 1 not a live
+!> handle; 2 sizes inconsistent with the system; other codes as documented per routine.
+
+!> A new, empty system of ndof independent and nfull full coordinates.
+subroutine system_create(ndof, nfull, handle, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_create, store_get
+  implicit none
+  integer, intent(in) :: ndof, nfull
+  integer, intent(out) :: handle, info
+  type(system_model), pointer :: sys
+  call store_create(handle, info)
+  if (info /= 0) return
+  call store_get(handle, sys, info)
+  sys%ndof = ndof
+  sys%nfull = nfull
+  allocate (sys%sets(0), sys%frames(0), sys%pairs(0))
+  allocate (sys%drive_kinds(0), sys%drive_ptr(1), sys%drive_data(0))
+  sys%drive_ptr = 1
+  allocate (sys%constant_force(ndof), sys%force_drive(0), sys%force_vectors(ndof, 0))
+  sys%constant_force = 0.0_dp
+  allocate (sys%moment_dofs(3, 0), sys%moment_axis(3, 0), sys%moment_magnitude(0), &
+            sys%moment_reference(3, 0))
+  allocate (sys%con_kind(0), sys%con_drive(0), sys%term_ptr(1), sys%term_dof(0), &
+            sys%con_params(8, 0), sys%operand_const(6, 0), sys%term_coef(0))
+  sys%term_ptr = 1
+  allocate (sys%probe_ptr(1), sys%probe_dof(0), sys%probe_frame(0), sys%probe_coef(0), &
+            sys%probe_reference(3, 0))
+  sys%probe_ptr = 1
+  allocate (sys%block_first(0), sys%flexibility(ndof, 0), sys%flexibility_cc(0, 0))
+end subroutine system_create
+
+subroutine system_destroy(handle, info)
+  use system_store, only: store_destroy
+  implicit none
+  integer, intent(in) :: handle
+  integer, intent(out) :: info
+  call store_destroy(handle, info)
+end subroutine system_destroy
+
+!> ANCF-FFR beam elements: K0 and the rigid configuration (24, nel) in the floating frame
+!> `frame` (1-based index into the system's frames), the element dofs (full, 1-based) and
+!> the scatter map into the full pattern.
+subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference, frame, index, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, append_set
+  use element_sets, only: element_set, set_ffr
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nel, dofs(24, nel), scatter(24, 24, nel), frame
+  real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel)
+  integer, intent(out) :: index, info
+  type(system_model), pointer :: sys
+  type(element_set) :: set
+  index = 0
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. frame < 1) then
+    info = 2
+    return
+  end if
+  set%kind = set_ffr
+  set%nel = nel
+  set%nde = 24
+  set%frame = frame
+  set%dofs = dofs
+  set%scatter = scatter
+  set%stiffness0 = stiffness0
+  set%reference = reference
+  call append_set(sys, set, index)
+end subroutine system_add_ffr_set
+
+!> Large-deformation (continuum) beam elements: material gradients and weights at npts
+!> Gauss points of which the first nvolume are volume points (beam_nonlinear).
+subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, gradients, &
+                                    weights, youngs, poisson, frame, index, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, append_set
+  use element_sets, only: element_set, set_continuum
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nel, npts, nvolume, dofs(24, nel), scatter(24, 24, nel), frame
+  real(dp), intent(in) :: gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
+  integer, intent(out) :: index, info
+  type(system_model), pointer :: sys
+  type(element_set) :: set
+  index = 0
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (any(dofs < 1) .or. any(dofs > sys%nfull)) then
+    info = 2
+    return
+  end if
+  set%kind = set_continuum
+  set%nel = nel
+  set%nde = 24
+  set%frame = frame
+  set%dofs = dofs
+  set%scatter = scatter
+  set%volume_points = nvolume
+  set%gradients = gradients
+  set%weights = weights
+  set%youngs = youngs
+  set%poisson = poisson
+  call append_set(sys, set, index)
+end subroutine system_add_continuum_set
+
+!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural).
+subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, strain0, &
+                                     stiffness, frame, index, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, append_set
+  use element_sets, only: element_set, set_structural
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nel, nterms, dofs(24, nel), scatter(24, 24, nel), frame
+  real(dp), intent(in) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
+  integer, intent(out) :: index, info
+  type(system_model), pointer :: sys
+  type(element_set) :: set
+  index = 0
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (any(dofs < 1) .or. any(dofs > sys%nfull)) then
+    info = 2
+    return
+  end if
+  set%kind = set_structural
+  set%nel = nel
+  set%nde = 24
+  set%frame = frame
+  set%dofs = dofs
+  set%scatter = scatter
+  set%forms = forms
+  set%strain0 = strain0
+  set%term_stiffness = stiffness
+  call append_set(sys, set, index)
+end subroutine system_add_structural_set
+
+!> Thin plate elements (plate_element): reference data at npts Gauss points.
+subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_frame, curvature0, &
+                                weights, youngs, poisson, thickness, index, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, append_set
+  use element_sets, only: element_set, set_plate
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nel, npts, dofs(36, nel), scatter(36, 36, nel)
+  real(dp), intent(in) :: derivs(12, 5, npts, nel), plate_frame(2, 2, npts, nel)
+  real(dp), intent(in) :: curvature0(3, npts, nel), weights(npts, nel), youngs, poisson, thickness
+  integer, intent(out) :: index, info
+  type(system_model), pointer :: sys
+  type(element_set) :: set
+  index = 0
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (any(dofs < 1) .or. any(dofs > sys%nfull)) then
+    info = 2
+    return
+  end if
+  set%kind = set_plate
+  set%nel = nel
+  set%nde = 36
+  set%dofs = dofs
+  set%scatter = scatter
+  set%derivs = derivs
+  set%plate_frame = plate_frame
+  set%curvature0 = curvature0
+  set%weights = weights
+  set%youngs = youngs
+  set%poisson = poisson
+  set%thickness = thickness
+  call append_set(sys, set, index)
+end subroutine system_add_plate_set
+
+!> Floating frames A_f(t) = Rot(axis_f, phi_d(t)) base_f about pivot_f (drive 0: fixed).
+subroutine system_set_frames(handle, nframe, drives, axes, bases, pivots, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nframe, drives(max(1, nframe))
+  real(dp), intent(in) :: axes(3, max(1, nframe)), bases(3, 3, max(1, nframe))
+  real(dp), intent(in) :: pivots(3, max(1, nframe))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  integer :: f
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  deallocate (sys%frames)
+  allocate (sys%frames(nframe))
+  do f = 1, nframe
+    if (drives(f) /= 0 .and. norm2(axes(:, f)) == 0.0_dp) then
+      info = 2
+      return
+    end if
+    sys%frames(f)%drive = drives(f)
+    sys%frames(f)%axis = axes(:, f)
+    sys%frames(f)%base = bases(:, :, f)
+    sys%frames(f)%pivot = pivots(:, f)
+  end do
+end subroutine system_set_frames
+
+!> Drives (drives module): kinds and the packed parameters of drive d at
+!> data(ptr(d):ptr(d+1)-1).
+subroutine system_set_drives(handle, ndrive, ndata, kinds, ptr, data, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ndrive, ndata, kinds(max(1, ndrive)), ptr(ndrive + 1)
+  real(dp), intent(in) :: data(max(1, ndata))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (ptr(1) /= 1 .or. ptr(ndrive + 1) /= ndata + 1) then
+    info = 2
+    return
+  end if
+  sys%drive_kinds = kinds(1:ndrive)
+  sys%drive_ptr = ptr
+  sys%drive_data = data(1:ndata)
+end subroutine system_set_drives
+
+!> The mass matrix on the independent coordinates (CSR, 1-based; zero entries may be left
+!> out) and on the solver's pattern (mass_pattern, aligned with the pattern analysed by the
+!> solver), the full pattern of the tangents, the solver handle and its policy
+!> (0 constant, 1 refactorized), the frame of every reduced 3-vector (policy constant; 0:
+!> global) and the first dofs of the 3-vector blocks the constraints touch.
+subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_values, &
+                               nfull, nnz_full, full_row_ptr, full_col, solver_handle, policy, &
+                               nnz_pattern, mass_pattern, nvec, vector_frame, nblock, block_first, &
+                               info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ndof, nnz_mass, mass_row_ptr(ndof + 1), mass_col(nnz_mass)
+  real(dp), intent(in) :: mass_values(nnz_mass)
+  integer, intent(in) :: nfull, nnz_full, full_row_ptr(nfull + 1), full_col(nnz_full)
+  integer, intent(in) :: solver_handle, policy, nnz_pattern, nvec, nblock
+  real(dp), intent(in) :: mass_pattern(nnz_pattern)
+  integer, intent(in) :: vector_frame(max(1, nvec)), block_first(max(1, nblock))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. nfull /= sys%nfull) then
+    info = 2
+    return
+  end if
+  sys%mass_row_ptr = mass_row_ptr
+  sys%mass_col = mass_col
+  sys%mass_values = mass_values
+  sys%full_row_ptr = full_row_ptr
+  sys%full_col = full_col
+  sys%solver_handle = solver_handle
+  sys%policy = policy
+  sys%mass_pattern = mass_pattern
+  if (allocated(sys%vector_frame)) deallocate (sys%vector_frame)
+  if (nvec > 0) sys%vector_frame = vector_frame(1:nvec)
+  sys%block_first = block_first(1:nblock)
+  deallocate (sys%flexibility, sys%flexibility_cc)
+  allocate (sys%flexibility(ndof, 3 * nblock), sys%flexibility_cc(3 * nblock, 3 * nblock))
+  sys%factorized = .false.
+end subroutine system_set_matrices
+
+!> q = B e + q0 (B CSR over nfull rows, 1-based) and the plan of B^T S B: values(target)
+!> += coef * full_values(source).
+subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, offset, nplan, &
+                                plan_source, plan_target, plan_coef, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nfull, nnz_b, b_ptr(nfull + 1), b_col(max(1, nnz_b)), nplan
+  real(dp), intent(in) :: b_values(max(1, nnz_b)), offset(nfull)
+  integer, intent(in) :: plan_source(max(1, nplan)), plan_target(max(1, nplan))
+  real(dp), intent(in) :: plan_coef(max(1, nplan))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (nfull /= sys%nfull) then
+    info = 2
+    return
+  end if
+  sys%reduced = .true.
+  sys%reduction_ptr = b_ptr
+  sys%reduction_col = b_col(1:nnz_b)
+  sys%reduction_values = b_values(1:nnz_b)
+  sys%reduction_offset = offset
+  sys%plan_source = plan_source(1:nplan)
+  sys%plan_target = plan_target(1:nplan)
+  sys%plan_coef = plan_coef(1:nplan)
+end subroutine system_set_reduction
+
+!> Loads: the constant force (independent coordinates), driven forces phi_d(t) f_d, dead
+!> moments on director coordinates of the full vector (axis, magnitude, the director at
+!> t = 0 for the potential).
+subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, force_vectors, &
+                            nmoment, moment_dofs, moment_axis, moment_magnitude, moment_reference, &
+                            info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ndof, nforce, nmoment
+  real(dp), intent(in) :: constant_force(ndof), force_vectors(ndof, max(1, nforce))
+  integer, intent(in) :: force_drive(max(1, nforce)), moment_dofs(3, max(1, nmoment))
+  real(dp), intent(in) :: moment_axis(3, max(1, nmoment)), moment_magnitude(max(1, nmoment))
+  real(dp), intent(in) :: moment_reference(3, max(1, nmoment))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (ndof /= sys%ndof) then
+    info = 2
+    return
+  end if
+  if (nmoment > 0) then
+    if (any(moment_dofs(:, 1:nmoment) < 1) .or. any(moment_dofs(:, 1:nmoment) > sys%nfull)) then
+      info = 2
+      return
+    end if
+  end if
+  sys%constant_force = constant_force
+  sys%force_drive = force_drive(1:nforce)
+  sys%force_vectors = force_vectors(:, 1:nforce)
+  sys%moment_dofs = moment_dofs(:, 1:nmoment)
+  sys%moment_axis = moment_axis(:, 1:nmoment)
+  sys%moment_magnitude = moment_magnitude(1:nmoment)
+  sys%moment_reference = moment_reference(:, 1:nmoment)
+end subroutine system_set_loads
+
+!> Constraints with multipliers, in the constraints module's layout over the independent
+!> coordinates.
+subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, operand_const, &
+                                  term_ptr, term_dof, term_coef, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ncon, nterm
+  integer, intent(in) :: kinds(max(1, ncon)), drives(max(1, ncon)), term_ptr(6 * ncon + 1)
+  integer, intent(in) :: term_dof(max(1, nterm))
+  real(dp), intent(in) :: params(8, max(1, ncon)), operand_const(6, max(1, ncon))
+  real(dp), intent(in) :: term_coef(max(1, nterm))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (term_ptr(6 * ncon + 1) /= nterm + 1) then
+    info = 2
+    return
+  end if
+  if (nterm > 0) then
+    if (any(term_dof(1:nterm) < 1) .or. any(term_dof(1:nterm) > sys%ndof)) then
+      info = 2
+      return
+    end if
+  end if
+  sys%ncon = ncon
+  sys%con_kind = kinds(1:ncon)
+  sys%con_drive = drives(1:ncon)
+  sys%con_params = params(:, 1:ncon)
+  sys%operand_const = operand_const(:, 1:ncon)
+  sys%term_ptr = term_ptr
+  sys%term_dof = term_dof(1:nterm)
+  sys%term_coef = term_coef(1:nterm)
+end subroutine system_set_constraints
+
+!> A contact pair (leaf_contact): the pair's element columns (dofs into the full vector,
+!> sizes), the grid of the searched surface and the points (element column, local xi, eta),
+!> with the contact parameters.
+subroutine system_add_contact_pair(handle, nel, dofs, sizes, ngrid_l, ngrid_w, grid, npoint, &
+                                   point_element, point_local, params, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_pair
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nel, dofs(36, nel), ngrid_l, ngrid_w, grid(ngrid_l, ngrid_w)
+  integer, intent(in) :: npoint, point_element(npoint)
+  real(dp), intent(in) :: sizes(2, nel), point_local(2, npoint), params(8)
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  type(contact_pair), allocatable :: grown(:)
+  integer :: n
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. any(grid < 1) .or. any(grid > nel) .or. &
+      any(point_element < 1) .or. any(point_element > nel)) then
+    info = 2
+    return
+  end if
+  n = size(sys%pairs)
+  allocate (grown(n + 1))
+  grown(1:n) = sys%pairs
+  grown(n + 1)%nel = nel
+  grown(n + 1)%npoint = npoint
+  grown(n + 1)%first_point = sys%npoint
+  grown(n + 1)%dofs = dofs
+  grown(n + 1)%sizes = sizes
+  grown(n + 1)%grid = grid
+  grown(n + 1)%point_element = point_element
+  grown(n + 1)%point_local = point_local
+  grown(n + 1)%params = params
+  call move_alloc(grown, sys%pairs)
+  sys%npoint = sys%npoint + npoint
+end subroutine system_add_contact_pair
+
+!> Probes: positions sum_k coef_k q(dof_k:dof_k+2) over the terms ptr(p):ptr(p+1)-1, the
+!> frame their deflections are resolved in (0: global) and the rigid position in it.
+subroutine system_set_probes(handle, nprobe, nterm, ptr, dofs, coefs, frames, reference, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nprobe, nterm, ptr(nprobe + 1), dofs(max(1, nterm))
+  integer, intent(in) :: frames(max(1, nprobe))
+  real(dp), intent(in) :: coefs(max(1, nterm)), reference(3, max(1, nprobe))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (nterm > 0) then
+    if (any(dofs(1:nterm) < 1) .or. any(dofs(1:nterm) + 2 > sys%nfull)) then
+      info = 2
+      return
+    end if
+  end if
+  if (nprobe > 0) then
+    if (any(frames(1:nprobe) < 0) .or. any(frames(1:nprobe) > size(sys%frames))) then
+      info = 2
+      return
+    end if
+  end if
+  sys%nprobe = nprobe
+  sys%probe_ptr = ptr
+  sys%probe_dof = dofs(1:nterm)
+  sys%probe_coef = coefs(1:nterm)
+  sys%probe_frame = frames(1:nprobe)
+  sys%probe_reference = reference(:, 1:nprobe)
+end subroutine system_set_probes
+
+!> The configuration-dependent forces at (e, e', t): internal = B^T (Q_el - Q_c -
+!> load_factor Q_M), external = load_factor Q(t), strain energy, contact potential and
+!> records, and with want_tangent /= 0 the tangent (sets, plus velocity_factor times the
+!> contact Jacobian) on the solver's (reduced) pattern in global coordinates. Codes as the
+!> stepper's (5 drive, 6 moment, 7 plate normal, 8 contact search).
+subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velocity_factor, &
+                           want_tangent, guesses, counts, internal, external, strain, &
+                           contact_potential, records, tangent, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
+                               external_forces
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ndof, nnz, npoint, want_tangent
+  real(dp), intent(in) :: t, e(ndof), v(ndof), load_factor, velocity_factor
+  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  integer, intent(inout) :: counts(6)
+  !f2py intent(in,out) :: guesses, counts
+  real(dp), intent(out) :: internal(ndof), external(ndof), strain, contact_potential
+  real(dp), intent(out) :: records(6, max(1, npoint)), tangent(nnz)
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  type(contact_state) :: state
+  real(dp), allocatable :: rotations(:, :, :), rates(:)
+  real(dp) :: powers(2)
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. npoint /= sys%npoint .or. (want_tangent /= 0 .and. &
+      nnz /= size(sys%mass_pattern))) then
+    info = 2
+    return
+  end if
+  allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)))
+  call frame_rotations(sys, t, rotations, rates, info)
+  if (info /= 0) return
+  state%guesses = guesses
+  state%counts = counts
+  records = 0.0_dp
+  tangent = 0.0_dp
+  if (want_tangent /= 0) then  ! the tangent in global coordinates
+    call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
+                         strain, contact_potential, powers, records, info, rotations, tangent)
+  else
+    call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
+                         strain, contact_potential, powers, records, info)
+  end if
+  if (info /= 0) return
+  call external_forces(sys, t, load_factor, external, info)
+  guesses = state%guesses
+  counts = state%counts
+end subroutine system_evaluate
+
+!> One output row (probes, deflections, energies, constraint violation, contact records)
+!> of the state (t, e, e', lambda) with the accumulated works.
+subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, work, guesses, &
+                             counts, probe, deflection, energy, violation, records, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state, power_count, energy_count
+  use time_integrator, only: output_row
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ndof, ncon, nprobe, npoint
+  real(dp), intent(in) :: t, e(ndof), v(ndof), lam(max(1, ncon)), work(5)
+  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  integer, intent(inout) :: counts(6)
+  !f2py intent(in,out) :: guesses, counts
+  real(dp), intent(out) :: probe(3, max(1, nprobe)), deflection(3, max(1, nprobe)), energy(11)
+  real(dp), intent(out) :: violation, records(6, max(1, npoint))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  type(contact_state) :: state
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. nprobe /= sys%nprobe .or. &
+      npoint /= sys%npoint .or. power_count /= 5 .or. energy_count /= 11) then
+    info = 2
+    return
+  end if
+  state%guesses = guesses
+  state%counts = counts
+  probe = 0.0_dp
+  deflection = 0.0_dp
+  records = 0.0_dp
+  call output_row(sys, t, e, v, lam(1:ncon), work, state, probe(:, 1:nprobe), &
+                  deflection(:, 1:nprobe), energy, violation, records(:, 1:npoint), info)
+  guesses = state%guesses
+  counts = state%counts
+end subroutine system_output_row
+
+!> Advances nsteps steps of the generalized-alpha method (time_integrator), one output row
+!> per step. The state (t, e, v, a, accel, lam, work, contact guesses and counters) is
+!> updated in place. status = [steps done, info, detail]; stats(:, step) = Newton
+!> corrections, factorizations, Jacobian evaluations. jacobian: 1 per step, 2 per
+!> iteration, 3 reused across steps (time_integrator).
+subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, beta, gamma, alpha_m, &
+                          alpha_f, tol, length_scale, max_newton, jacobian, contraction, t, e, v, &
+                          a, accel, lam, work, guesses, counts, out_time, out_probe, &
+                          out_deflection, out_lambda, out_energy, out_constraint, out_stats, &
+                          out_contact, out_q, status, last_correction)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state, power_count, energy_count
+  use time_integrator, only: integrator_settings, integrator_chunk, stat_count
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ndof, ncon, nprobe, npoint, nsteps, nq, max_newton, jacobian
+  real(dp), intent(in) :: h, beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
+  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), accel(ndof), lam(max(1, ncon)), work(5)
+  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  integer, intent(inout) :: counts(6)
+  !f2py intent(in,out) :: t, e, v, a, accel, lam, work, guesses, counts
+  real(dp), intent(out) :: out_time(nsteps), out_probe(3, max(1, nprobe), nsteps)
+  real(dp), intent(out) :: out_deflection(3, max(1, nprobe), nsteps)
+  real(dp), intent(out) :: out_lambda(max(1, ncon), nsteps), out_energy(11, nsteps)
+  real(dp), intent(out) :: out_constraint(nsteps), out_contact(6, max(1, npoint), nsteps)
+  real(dp), intent(out) :: out_q(ndof, nq)
+  integer, intent(out) :: out_stats(3, nsteps), status(3)
+  real(dp), intent(out) :: last_correction
+  type(system_model), pointer :: sys
+  type(integrator_settings) :: cfg
+  type(contact_state) :: state
+  integer :: info
+  out_time = 0.0_dp
+  out_probe = 0.0_dp
+  out_deflection = 0.0_dp
+  out_lambda = 0.0_dp
+  out_energy = 0.0_dp
+  out_constraint = 0.0_dp
+  out_contact = 0.0_dp
+  out_q = 0.0_dp
+  out_stats = 0
+  last_correction = 0.0_dp
+  status = 0
+  call store_get(handle, sys, info)
+  if (info /= 0) then
+    status(2) = 9
+    return
+  end if
+  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. nprobe /= sys%nprobe .or. &
+      npoint /= sys%npoint .or. power_count /= 5 .or. energy_count /= 11 .or. stat_count /= 3) then
+    status(2) = 9
+    return
+  end if
+  cfg%h = h
+  cfg%beta = beta
+  cfg%gamma = gamma
+  cfg%alpha_m = alpha_m
+  cfg%alpha_f = alpha_f
+  cfg%tol = tol
+  cfg%length_scale = length_scale
+  cfg%max_newton = max_newton
+  cfg%jacobian = jacobian
+  cfg%contraction = contraction
+  state%guesses = guesses
+  state%counts = counts
+  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, state, out_time, &
+                        out_probe(:, 1:nprobe, :), out_deflection(:, 1:nprobe, :), &
+                        out_lambda(1:ncon, :), out_energy, out_constraint, out_stats, &
+                        out_contact(:, 1:npoint, :), nq == nsteps, out_q, status(1), status(2), &
+                        status(3), last_correction)
+  guesses = state%guesses
+  counts = state%counts
+end subroutine system_advance

@@ -1,0 +1,176 @@
+!> Element sets: the elements of one body (or of several bodies of the same kind and
+!> material) with everything their forces need, precomputed from the reference
+!> configuration. Four kinds share one interface:
+!>   ffr         ANCF-FFR beam (ffr_elastic): K0 and the rigid configuration in the
+!>               body's floating frame;
+!>   continuum   large-deformation beam (beam_nonlinear): material gradients at the
+!>               Gauss points of the section rule;
+!>   structural  large-deformation beam with 'cubic' bending (beam_structural): strain forms;
+!>   plate       thin plate, plain or completed (plate_element): reference data at the
+!>               Gauss points.
+!> Element dofs index the FULL coordinate vector (before the elimination of linear
+!> constraints); scatter(:, :, el) holds each element-matrix entry's position in the values
+!> of the full sparse pattern.
+module element_sets
+  use ancf_kinds, only: dp
+  use ffr_elastic, only: ffr_force, ffr_stiffness, ffr_energy_power
+  use beam_nonlinear, only: nonlinear_element
+  use beam_structural, only: structural_element
+  use plate_element, only: plate_forces
+  implicit none
+  private
+  public :: element_set, set_forces, set_tangent_values, set_energy_power
+
+  integer, parameter, public :: set_ffr = 1, set_continuum = 2, set_structural = 3, set_plate = 4
+
+  type :: element_set
+    integer :: kind = 0
+    integer :: nel = 0
+    integer :: nde = 0                                 ! dofs per element: beams 24, plates 36
+    integer :: frame = 0                               ! FFR: the floating frame (system frames)
+    integer, allocatable :: dofs(:, :)                 ! (nde, nel), 1-based full coordinates
+    integer, allocatable :: scatter(:, :, :)           ! (nde, nde, nel) positions in full values
+    real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp, thickness = 0.0_dp
+    ! ffr: K0 (24, 24, nel) and the rigid configuration in the frame (24, nel)
+    real(dp), allocatable :: stiffness0(:, :, :), reference(:, :)
+    ! continuum: gradients (8, 3, npts, nel), weights (npts, nel); the first volume_points
+    ! points carry the Poisson-free law
+    integer :: volume_points = 0
+    real(dp), allocatable :: gradients(:, :, :, :), weights(:, :)
+    ! structural: forms (8, 8, nterms, nel), reference strains and stiffnesses (nterms, nel)
+    real(dp), allocatable :: forms(:, :, :, :), strain0(:, :), term_stiffness(:, :)
+    ! plate: derivs (12, 5, npts, nel), frame maps (2, 2, npts, nel), reference curvatures
+    ! (3, npts, nel), weights (npts, nel)
+    real(dp), allocatable :: derivs(:, :, :, :), plate_frame(:, :, :, :), curvature0(:, :, :)
+  end type element_set
+
+contains
+
+  !> Strain energy at e and, for an FFR set in a moving frame (unit axis, rate phi'), the
+  !> power of the frame's motion at fixed e (ffr_energy_power); 0 for the other kinds.
+  subroutine set_energy_power(set, rotation, axis, rate, e, energy, power, info)
+    type(element_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), axis(3), rate, e(:)
+    real(dp), intent(out) :: energy, power
+    integer, intent(out) :: info
+    real(dp), allocatable :: unused(:)
+    info = 0
+    power = 0.0_dp
+    if (set%kind == set_ffr) then
+      call ffr_energy_power(set%nel, set%dofs, set%stiffness0, set%reference, rotation, axis, &
+                            rate, e, energy, power)
+      return
+    end if
+    allocate (unused(size(e)))
+    unused = 0.0_dp
+    call set_forces(set, rotation, e, unused, energy, info)
+  end subroutine set_energy_power
+
+  !> Adds the set's elastic force at the full coordinates e to force and returns the strain
+  !> energy; FFR elements use the frame rotation. With tangent_values present, the element
+  !> tangents (FFR: T K0 T^T with tangent_rotation, by default the same rotation) are added
+  !> to the full pattern's values. Elements in parallel
+  !> (OpenMP, when built with it) for the large-deformation kinds. info = 7: a plate
+  !> element's normal vanished.
+  subroutine set_forces(set, rotation, e, force, energy, info, tangent_values, tangent_rotation)
+    type(element_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), intent(inout), optional :: tangent_values(:)
+    real(dp), intent(in), optional :: tangent_rotation(3, 3)  ! FFR: default rotation
+    real(dp), allocatable :: element_force(:, :), element_energy(:), tangents(:, :, :)
+    logical :: want_tangent
+    integer :: el, element_info(set%nel)
+    info = 0
+    want_tangent = present(tangent_values)
+    if (set%kind == set_ffr) then
+      call ffr_force(set%nel, set%dofs, set%stiffness0, set%reference, rotation, e, force, energy)
+      if (want_tangent) then
+        if (present(tangent_rotation)) then
+          call set_tangent_values(set, tangent_rotation, tangent_values)
+        else
+          call set_tangent_values(set, rotation, tangent_values)
+        end if
+      end if
+      return
+    end if
+    allocate (element_force(set%nde, set%nel), element_energy(set%nel))
+    if (want_tangent) then
+      allocate (tangents(set%nde, set%nde, set%nel))
+    else
+      allocate (tangents(set%nde, set%nde, 1))
+    end if
+    element_info = 0
+    !$omp parallel do schedule(static)
+    do el = 1, set%nel
+      call element_forces(set, el, e, want_tangent, element_force(:, el), element_energy(el), &
+                          tangents(:, :, merge(el, 1, want_tangent)), element_info(el))
+    end do
+    !$omp end parallel do
+    if (any(element_info /= 0)) then
+      info = 7
+      energy = 0.0_dp
+      return
+    end if
+    do el = 1, set%nel
+      force(set%dofs(:, el)) = force(set%dofs(:, el)) + element_force(:, el)
+    end do
+    energy = sum(element_energy)
+    if (want_tangent) call scatter_add(set, tangents, tangent_values)
+  end subroutine set_forces
+
+  !> One element of a large-deformation set.
+  pure subroutine element_forces(set, el, e, want_tangent, force, energy, tangent, info)
+    type(element_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: e(:)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), energy, tangent(:, :)
+    integer, intent(out) :: info
+    info = 0
+    select case (set%kind)
+    case (set_continuum)
+      call nonlinear_element(reshape(e(set%dofs(:, el)), [3, 8]), set%gradients(:, :, :, el), &
+                             set%weights(:, el), set%volume_points, set%youngs, set%poisson, &
+                             want_tangent, force, energy, tangent)
+    case (set_structural)
+      call structural_element(reshape(e(set%dofs(:, el)), [3, 8]), set%forms(:, :, :, el), &
+                              set%strain0(:, el), set%term_stiffness(:, el), want_tangent, force, &
+                              energy, tangent)
+    case (set_plate)
+      call plate_forces(reshape(e(set%dofs(:, el)), [3, 12]), set%derivs(:, :, :, el), &
+                        set%plate_frame(:, :, :, el), set%curvature0(:, :, el), &
+                        set%weights(:, el), set%youngs, set%poisson, set%thickness, &
+                        want_tangent, force, energy, tangent, info)
+    end select
+  end subroutine element_forces
+
+  !> FFR: adds T K0 T^T of every element to the full pattern's values.
+  subroutine set_tangent_values(set, rotation, values)
+    type(element_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3)
+    real(dp), intent(inout) :: values(:)
+    real(dp), allocatable :: stiffness(:, :, :)
+    allocate (stiffness(24, 24, set%nel))
+    call ffr_stiffness(set%nel, set%stiffness0, rotation, stiffness)
+    call scatter_add(set, stiffness, values)
+  end subroutine set_tangent_values
+
+  pure subroutine scatter_add(set, matrices, values)
+    type(element_set), intent(in) :: set
+    real(dp), intent(in) :: matrices(:, :, :)
+    real(dp), intent(inout) :: values(:)
+    integer :: el, a, b
+    do el = 1, set%nel
+      do b = 1, set%nde
+        do a = 1, set%nde
+          if (set%scatter(a, b, el) > 0) values(set%scatter(a, b, el)) = &
+            values(set%scatter(a, b, el)) + matrices(a, b, el)
+        end do
+      end do
+    end do
+  end subroutine scatter_add
+
+end module element_sets

@@ -1,0 +1,634 @@
+!> A mechanical system as the kernel holds it behind a handle (system_store): element sets
+!> of any kinds, rigid bodies (through their constant mass), floating frames, drives,
+!> loads, constraints with Lagrange multipliers, linear constraints eliminated by a
+!> constant matrix B, contact pairs, probes, and the iteration matrix's solver.
+!>
+!> Coordinates. The full vector q holds every body's coordinates; linear constraints give
+!> q = B e + q0 with the independent coordinates e, the unknowns of the solvers (without
+!> reduction B = I, q0 = 0). Element sets, contact pairs, moments and probes index q;
+!> the mass, the loads, the constraints (whose operands are affine in e) and the solver's
+!> pattern index e. Forces are accumulated in full coordinates and reduced once (B^T).
+!>
+!> Equations of motion (seed 000 eqs. 58-62, seed 003 eq. 38):
+!>   M e'' + B^T (Q_el(q) - Q_c(q, q') - Q_M(q)) - Q(t) - Phi_e^T lambda = 0,   Phi(e, t) = 0,
+!> Q_el the elastic forces of the sets, Q_c the contact forces, Q_M the dead moments, Q(t) the
+!> constant loads plus driven forces phi_d(t) f_d.
+!>
+!> The iteration matrix S = beta' M + B^T (K + c_v C_c) B (K the sets' tangents, C_c the
+!> contact Jacobian with c_v = d q'/d q) lives on the reduced pattern. Policy 'constant'
+!> (pure FFR systems): S is assembled in the solver frame, where every 3-vector of a body
+!> in a moving frame A(t) is resolved in A(t) (S = U S_c U^T, U = diag(A_f(t)) per
+!> vector): S_c is constant and factorized once per run. Otherwise S is assembled in
+!> global coordinates and refactorized as the stepper's policy asks.
+!> No I/O; failures return codes.
+module mechanical_system
+  use ancf_kinds, only: dp
+  use constraints, only: constraint_eval, operand_values, drive_value
+  use element_sets, only: element_set, set_forces, set_energy_power, set_ffr
+  use section_moment, only: moment_force, moment_angle
+  use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record
+  use sparse_direct, only: solver_solve, solver_factorize
+  implicit none
+  private
+  public :: system_model, frame_def, contact_pair, contact_state
+  public :: frame_rotations, to_full, to_reduced, csr_matvec, internal_forces, external_forces, &
+            evaluate_constraints, constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
+            frame_gradients, energies, probe_output, tangent_rotations, append_set
+
+  integer, parameter, public :: policy_constant = 0, policy_refactor = 1
+  !> energy(:) layout of an output row
+  integer, parameter, public :: energy_kinetic = 1, energy_strain = 2, energy_loads = 3, &
+                                energy_moment = 4, energy_total = 5, work_drive = 6, &
+                                work_frame = 7, energy_contact = 8, work_contact_damping = 9, &
+                                work_friction = 10, work_material_damping = 11, energy_count = 11
+  !> work(:) layout of the accumulated works (powers integrated by the stepper)
+  integer, parameter, public :: power_drive = 1, power_frame = 2, power_contact_damping = 3, &
+                                power_friction = 4, power_material_damping = 5, power_count = 5
+
+  !> A floating frame A(t) = Rot(axis, phi(t)) base about pivot (drive 0: A = base).
+  type :: frame_def
+    integer :: drive = 0
+    real(dp) :: axis(3) = [0.0_dp, 0.0_dp, 1.0_dp]
+    real(dp) :: base(3, 3) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, 0.0_dp, &
+                                      0.0_dp, 1.0_dp], [3, 3])
+    real(dp) :: pivot(3) = 0.0_dp
+  end type frame_def
+
+  !> Points on one plate surface searched on another's mid-surface (leaf_contact). Element
+  !> columns 1..nel of dofs: the upper body's grid elements and the points' elements.
+  type :: contact_pair
+    integer :: nel = 0, npoint = 0, first_point = 0
+    integer, allocatable :: dofs(:, :), grid(:, :), point_element(:)
+    real(dp), allocatable :: sizes(:, :), point_local(:, :)
+    real(dp) :: params(cp_count) = 0.0_dp
+  end type contact_pair
+
+  !> What contact carries from iteration to iteration and step to step.
+  type :: contact_state
+    real(dp), allocatable :: guesses(:, :)     ! (2, npoint) leaf-level projections
+    integer :: counts(contact_counters) = 0
+  end type contact_state
+
+  type :: system_model
+    integer :: ndof = 0, nfull = 0
+    type(element_set), allocatable :: sets(:)
+    type(frame_def), allocatable :: frames(:)
+    integer, allocatable :: drive_kinds(:), drive_ptr(:)
+    real(dp), allocatable :: drive_data(:)
+    ! mass M (reduced, CSR, 1-based), used for M a and the kinetic energy
+    integer, allocatable :: mass_row_ptr(:), mass_col(:)
+    real(dp), allocatable :: mass_values(:)
+    ! full pattern of the tangents; q = B e + q0 and the plan of B^T S B
+    integer, allocatable :: full_row_ptr(:), full_col(:)
+    logical :: reduced = .false.
+    integer, allocatable :: reduction_ptr(:), reduction_col(:)
+    real(dp), allocatable :: reduction_values(:), reduction_offset(:)
+    integer, allocatable :: plan_source(:), plan_target(:)
+    real(dp), allocatable :: plan_coef(:)
+    ! loads: constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
+    ! director coordinates
+    real(dp), allocatable :: constant_force(:)
+    integer, allocatable :: force_drive(:)
+    real(dp), allocatable :: force_vectors(:, :)
+    integer, allocatable :: moment_dofs(:, :)
+    real(dp), allocatable :: moment_axis(:, :), moment_magnitude(:), moment_reference(:, :)
+    ! constraints with multipliers (constraints module layout)
+    integer :: ncon = 0
+    integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
+    real(dp), allocatable :: con_params(:, :), operand_const(:, :), term_coef(:)
+    ! contact
+    integer :: npoint = 0
+    type(contact_pair), allocatable :: pairs(:)
+    ! probes: positions sum coef q(dof:dof+2); deflection A_f(t)^T (p - pivot_f) - reference
+    integer :: nprobe = 0
+    integer, allocatable :: probe_ptr(:), probe_dof(:), probe_frame(:)
+    real(dp), allocatable :: probe_coef(:), probe_reference(:, :)
+    ! iteration matrix: solver handle (sparse_direct), M on its pattern, policy, the
+    ! frame of each reduced 3-vector (policy constant), the touched 3-vector blocks
+    integer :: solver_handle = 0, policy = policy_refactor
+    real(dp), allocatable :: mass_pattern(:)
+    integer, allocatable :: vector_frame(:), block_first(:)
+    ! the current factorization: its flexibility S^{-1} E_c and E_c^T S^{-1} E_c
+    logical :: factorized = .false.
+    real(dp) :: factor_beta_prime = 0.0_dp
+    real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
+  end type system_model
+
+contains
+
+  !> Appends an element set; index: its 1-based position.
+  subroutine append_set(sys, set, index)
+    type(system_model), intent(inout) :: sys
+    type(element_set), intent(in) :: set
+    integer, intent(out) :: index
+    type(element_set), allocatable :: grown(:)
+    allocate (grown(size(sys%sets) + 1))
+    grown(1:size(sys%sets)) = sys%sets
+    grown(size(grown)) = set
+    call move_alloc(grown, sys%sets)
+    index = size(sys%sets)
+  end subroutine append_set
+
+  !> Rotations A_f(t) (index 0: the identity) and rates phi_f'(t) of every frame. info = 5:
+  !> a drive failed.
+  subroutine frame_rotations(sys, t, rotations, rates, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t
+    real(dp), intent(out) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
+    integer, intent(out) :: info
+    real(dp) :: phi, ddphi, k(3), skew(3, 3), turn(3, 3)
+    integer :: f, i
+    info = 0
+    rotations = 0.0_dp
+    rates = 0.0_dp
+    do i = 1, 3
+      rotations(i, i, 0) = 1.0_dp
+    end do
+    do f = 1, size(sys%frames)
+      rotations(:, :, f) = sys%frames(f)%base
+      if (sys%frames(f)%drive == 0) cycle
+      call drive_value(sys%frames(f)%drive, sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+                       phi, rates(f), ddphi, info)
+      if (info /= 0) then
+        info = 5
+        return
+      end if
+      k = sys%frames(f)%axis / norm2(sys%frames(f)%axis)
+      skew = reshape([0.0_dp, k(3), -k(2), -k(3), 0.0_dp, k(1), k(2), -k(1), 0.0_dp], [3, 3])
+      turn = sin(phi) * skew + (1.0_dp - cos(phi)) * matmul(skew, skew)
+      do i = 1, 3
+        turn(i, i) = turn(i, i) + 1.0_dp
+      end do
+      rotations(:, :, f) = matmul(turn, sys%frames(f)%base)
+    end do
+  end subroutine frame_rotations
+
+  !> The rotation each set's tangent is assembled with: its frame's, except in the constant
+  !> policy, where a moving frame's sets are assembled in the frame itself (identity).
+  pure function tangent_rotations(sys, rotations) result(out)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rotations(:, :, 0:)
+    real(dp) :: out(3, 3, 0:size(sys%frames))
+    integer :: f
+    out = rotations
+    if (sys%policy /= policy_constant) return
+    do f = 1, size(sys%frames)
+      if (sys%frames(f)%drive /= 0) out(:, :, f) = rotations(:, :, 0)
+    end do
+  end function tangent_rotations
+
+  !> y = M x for a CSR matrix (1-based).
+  pure subroutine csr_matvec(row_ptr, col, values, x, y)
+    integer, intent(in) :: row_ptr(:), col(:)
+    real(dp), intent(in) :: values(:), x(:)
+    real(dp), intent(out) :: y(:)
+    integer :: i, k
+    real(dp) :: total
+    do i = 1, size(row_ptr) - 1
+      total = 0.0_dp
+      do k = row_ptr(i), row_ptr(i + 1) - 1
+        total = total + values(k) * x(col(k))
+      end do
+      y(i) = total
+    end do
+  end subroutine csr_matvec
+
+  !> q = B e + q0 (with_offset; velocities without).
+  pure subroutine to_full(sys, x, with_offset, full)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: x(:)
+    logical, intent(in) :: with_offset
+    real(dp), intent(out) :: full(:)
+    integer :: i, k
+    if (.not. sys%reduced) then
+      full = x
+      return
+    end if
+    do i = 1, sys%nfull
+      full(i) = 0.0_dp
+      if (with_offset) full(i) = sys%reduction_offset(i)
+      do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
+        full(i) = full(i) + sys%reduction_values(k) * x(sys%reduction_col(k))
+      end do
+    end do
+  end subroutine to_full
+
+  !> x = B^T full (seed 003 eq. 37).
+  pure subroutine to_reduced(sys, full, x)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: full(:)
+    real(dp), intent(out) :: x(:)
+    integer :: i, k
+    if (.not. sys%reduced) then
+      x = full
+      return
+    end if
+    x = 0.0_dp
+    do i = 1, sys%nfull
+      do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
+        x(sys%reduction_col(k)) = x(sys%reduction_col(k)) + sys%reduction_values(k) * full(i)
+      end do
+    end do
+  end subroutine to_reduced
+
+  !> Elastic minus contact forces minus the dead moments (times load_factor), reduced: the
+  !> configuration-dependent part of the residual at (e, e') and t; strain energy, contact
+  !> potential, contact powers (damping, friction) and per-point records. With
+  !> tangent_values (reduced pattern; tangent_rotation then required) the sets' tangents
+  !> (FFR: in the tangent_rotation frames) plus
+  !> velocity_factor times the contact Jacobian, reduced by the plan, are returned too.
+  !> info = 6 (moment undefined), 7 (a plate normal vanished), 8 (contact search failed).
+  subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
+                             strain, contact_potential, contact_powers, records, info, &
+                             tangent_rotation, tangent_values)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: force(:), strain, contact_potential, contact_powers(2)
+    real(dp), intent(out) :: records(:, :)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: tangent_rotation(:, :, 0:)
+    real(dp), intent(out), optional :: tangent_values(:)
+    real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
+    real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3)
+    logical :: want_tangent
+    integer :: s, m, k, f
+    want_tangent = present(tangent_values)
+    allocate (e_full(sys%nfull), full_force(sys%nfull))
+    call to_full(sys, e, .true., e_full)
+    full_force = 0.0_dp
+    strain = 0.0_dp
+    if (want_tangent) then
+      allocate (values_full(size(sys%full_col)))
+      values_full = 0.0_dp
+    end if
+    do s = 1, size(sys%sets)
+      f = sys%sets(s)%frame
+      if (want_tangent) then
+        call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info, &
+                        values_full, tangent_rotation(:, :, f))
+      else
+        call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info)
+      end if
+      if (info /= 0) return
+      strain = strain + set_energy
+    end do
+    contact_potential = 0.0_dp
+    contact_powers = 0.0_dp
+    if (sys%npoint > 0) then
+      allocate (v_full(sys%nfull))
+      call to_full(sys, v, .false., v_full)
+      call contact_forces(sys, e_full, v_full, velocity_factor, state, full_force, records, &
+                          contact_potential, contact_powers, info, values_full)
+      if (info /= 0) return
+    end if
+    do m = 1, size(sys%moment_magnitude)
+      call moment_force(e_full(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
+                        load_factor * sys%moment_magnitude(m), moment, jacobian, hessian, info)
+      if (info /= 0) then
+        info = 6
+        return
+      end if
+      full_force(sys%moment_dofs(:, m)) = full_force(sys%moment_dofs(:, m)) - moment
+    end do
+    call to_reduced(sys, full_force, force)
+    if (.not. want_tangent) return
+    if (sys%reduced) then  ! B^T S B by the plan
+      tangent_values = 0.0_dp
+      do k = 1, size(sys%plan_source)
+        tangent_values(sys%plan_target(k)) = tangent_values(sys%plan_target(k)) &
+                                             + sys%plan_coef(k) * values_full(sys%plan_source(k))
+      end do
+    else
+      tangent_values = values_full
+    end if
+  end subroutine internal_forces
+
+  !> Contact forces of every pair subtracted from full_force (they are external: the
+  !> residual carries elastic minus contact), with the Jacobian of minus the forces added
+  !> to values_full when allocated. info = 7 (normal vanished) or 8 (projection failed).
+  subroutine contact_forces(sys, e_full, v_full, velocity_factor, state, full_force, records, &
+                            potential, powers, info, values_full)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: e_full(:), v_full(:), velocity_factor
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(inout) :: full_force(:)
+    real(dp), intent(out) :: records(:, :), potential, powers(2)
+    integer, intent(out) :: info
+    real(dp), allocatable, intent(inout) :: values_full(:)
+    real(dp), allocatable :: pair_force(:)
+    real(dp) :: pair_potential, pair_powers(2)
+    integer :: p, first, last
+    potential = 0.0_dp
+    powers = 0.0_dp
+    info = 0
+    allocate (pair_force(sys%nfull))
+    do p = 1, size(sys%pairs)
+      first = sys%pairs(p)%first_point + 1
+      last = sys%pairs(p)%first_point + sys%pairs(p)%npoint
+      pair_force = 0.0_dp
+      if (allocated(values_full)) then
+        call contact_assemble(e_full, v_full, sys%pairs(p)%dofs, sys%pairs(p)%sizes, &
+                              sys%pairs(p)%grid, sys%pairs(p)%point_element, &
+                              sys%pairs(p)%point_local, sys%pairs(p)%params, velocity_factor, &
+                              state%guesses(:, first:last), pair_force, records(:, first:last), &
+                              pair_potential, pair_powers, state%counts, info, sys%full_row_ptr, &
+                              sys%full_col, values_full)
+      else
+        call contact_assemble(e_full, v_full, sys%pairs(p)%dofs, sys%pairs(p)%sizes, &
+                              sys%pairs(p)%grid, sys%pairs(p)%point_element, &
+                              sys%pairs(p)%point_local, sys%pairs(p)%params, velocity_factor, &
+                              state%guesses(:, first:last), pair_force, records(:, first:last), &
+                              pair_potential, pair_powers, state%counts, info)
+      end if
+      if (info /= 0) return
+      full_force = full_force - pair_force
+      potential = potential + pair_potential
+      powers = powers + pair_powers
+    end do
+  end subroutine contact_forces
+
+  !> Configuration-independent external loads at t, times load_factor: the constant loads
+  !> plus the driven forces. info = 5 when a drive fails.
+  subroutine external_forces(sys, t, load_factor, force, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, load_factor
+    real(dp), intent(out) :: force(:)
+    integer, intent(out) :: info
+    real(dp) :: phi, dphi, ddphi
+    integer :: d
+    info = 0
+    force = load_factor * sys%constant_force
+    do d = 1, size(sys%force_drive)
+      call drive_value(sys%force_drive(d), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+                       phi, dphi, ddphi, info)
+      if (info /= 0) then
+        info = 5
+        return
+      end if
+      force = force + load_factor * phi * sys%force_vectors(:, d)
+    end do
+  end subroutine external_forces
+
+  !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
+  !> drive cannot be evaluated.
+  subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: e(:), t
+    real(dp), intent(out) :: phi(:), gradients(:, :)
+    integer, intent(out) :: info
+    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    call constraint_eval(sys%ncon, sys%con_kind, sys%con_drive, sys%con_params, &
+                         sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
+                         sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, e, t, phi, gradients, &
+                         hessians, phi_t, phi_tt, gamma, info)
+    if (info /= 0) info = 5
+  end subroutine evaluate_constraints
+
+  !> r = r - Phi_e^T lambda.
+  pure subroutine constraint_reaction(sys, gradients, lam, r)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: gradients(:, :), lam(:)
+    real(dp), intent(inout) :: r(:)
+    integer :: c, s, k
+    do c = 1, sys%ncon
+      do s = 1, 6
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          r(sys%term_dof(k)) = r(sys%term_dof(k)) - gradients(s, c) * sys%term_coef(k) * lam(c)
+        end do
+      end do
+    end do
+  end subroutine constraint_reaction
+
+  !> Phi_e x for every constraint.
+  pure function gradient_dot(sys, gradients, x) result(y)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: gradients(:, :), x(:)
+    real(dp) :: y(sys%ncon)
+    integer :: c, s, k
+    y = 0.0_dp
+    do c = 1, sys%ncon
+      do s = 1, 6
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          y(c) = y(c) + gradients(s, c) * sys%term_coef(k) * x(sys%term_dof(k))
+        end do
+      end do
+    end do
+  end function gradient_dot
+
+  !> The solver frame: policy constant rotates each reduced 3-vector of a moving frame's
+  !> bodies into that frame (U^T x, transpose_first) or back (U x); otherwise a copy.
+  pure subroutine to_solver_frame(sys, rotations, x, transpose_first, y)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rotations(:, :, 0:), x(:)
+    logical, intent(in) :: transpose_first
+    real(dp), intent(out) :: y(:)
+    integer :: b, i, f
+    if (sys%policy /= policy_constant .or. .not. allocated(sys%vector_frame)) then
+      y = x
+      return
+    end if
+    do b = 0, size(x) / 3 - 1
+      f = sys%vector_frame(b + 1)
+      if (f == 0) then
+        y(3 * b + 1:3 * b + 3) = x(3 * b + 1:3 * b + 3)
+      else if (transpose_first) then
+        do i = 1, 3  ! written out: a generic matmul per 3-vector cost a tenth of a step
+          y(3 * b + i) = rotations(1, i, f) * x(3 * b + 1) + rotations(2, i, f) * x(3 * b + 2) &
+                         + rotations(3, i, f) * x(3 * b + 3)
+        end do
+      else
+        do i = 1, 3
+          y(3 * b + i) = rotations(i, 1, f) * x(3 * b + 1) + rotations(i, 2, f) * x(3 * b + 2) &
+                         + rotations(i, 3, f) * x(3 * b + 3)
+        end do
+      end if
+    end do
+  end subroutine to_solver_frame
+
+  !> Frame of the reduced 3-vector holding dof (0: global).
+  pure integer function dof_frame(sys, dof)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: dof
+    dof_frame = 0
+    if (sys%policy /= policy_constant .or. .not. allocated(sys%vector_frame)) return
+    dof_frame = sys%vector_frame((dof - 1) / 3 + 1)
+  end function dof_frame
+
+  !> W(3 nblock, ncon): the solver-frame components of Phi_e^T at the touched blocks.
+  pure subroutine frame_gradients(sys, rotations, gradients, w)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rotations(:, :, 0:), gradients(:, :)
+    real(dp), intent(out) :: w(:, :)
+    integer :: c, s, k, dof, b, comp, f
+    real(dp) :: g
+    w = 0.0_dp
+    do c = 1, sys%ncon
+      do s = 1, 6
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          dof = sys%term_dof(k)
+          g = gradients(s, c) * sys%term_coef(k)
+          do b = 1, size(sys%block_first)  ! the first block holding dof
+            if (dof >= sys%block_first(b) .and. dof <= sys%block_first(b) + 2) exit
+          end do
+          comp = dof - sys%block_first(b) + 1
+          f = dof_frame(sys, dof)
+          w(3 * (b - 1) + 1:3 * b, c) = w(3 * (b - 1) + 1:3 * b, c) + rotations(comp, :, f) * g
+        end do
+      end do
+    end do
+  end subroutine frame_gradients
+
+  !> Factorizes S = beta' M + B^T (K + c_v C_c) B at (e, e') (K in the policy's frames) and
+  !> computes the flexibility S^{-1} E_c and E_c^T S^{-1} E_c for the Schur complement; the
+  !> internal force at (e, e') comes out of the same pass (force, strain), with the number
+  !> of active contact points. info: 3 (solver failure, detail = its code) or the
+  !> internal_forces codes.
+  subroutine refactorize(sys, beta_prime, velocity_factor, rotations, e, v, state, force, &
+                         strain, active, info, detail)
+    type(system_model), intent(inout) :: sys
+    real(dp), intent(in) :: beta_prime, velocity_factor, rotations(:, :, 0:), e(:), v(:)
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: force(:), strain
+    integer, intent(out) :: active, info, detail
+    real(dp), allocatable :: values(:), records(:, :)
+    real(dp) :: potential, powers(2)
+    integer :: b, j
+    detail = 0
+    allocate (values(size(sys%mass_pattern)), records(contact_record, max(1, sys%npoint)))
+    call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
+                         potential, powers, records, info, tangent_rotations(sys, rotations), &
+                         values)
+    if (info /= 0) return
+    active = 0
+    if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
+    values = values + beta_prime * sys%mass_pattern
+    sys%factorized = .false.
+    call solver_factorize(sys%solver_handle, size(values), values, info, detail)
+    if (info /= 0) then
+      detail = info
+      info = 3
+      return
+    end if
+    sys%factorized = .true.
+    sys%factor_beta_prime = beta_prime
+    if (size(sys%block_first) == 0) return
+    sys%flexibility = 0.0_dp
+    do b = 1, size(sys%block_first)
+      do j = 1, 3
+        sys%flexibility(sys%block_first(b) + j - 1, 3 * (b - 1) + j) = 1.0_dp
+      end do
+    end do
+    call solver_solve(sys%solver_handle, sys%ndof, 3 * size(sys%block_first), sys%flexibility, &
+                      info, detail)
+    if (info /= 0) then
+      detail = info
+      info = 3
+      return
+    end if
+    do b = 1, size(sys%block_first)
+      do j = 1, 3
+        sys%flexibility_cc(3 * (b - 1) + j, :) = sys%flexibility(sys%block_first(b) + j - 1, :)
+      end do
+    end do
+  end subroutine refactorize
+
+  !> Strain energy, the load potentials and the powers of the moving frames (FFR sets) and
+  !> of the constraints (lambda . Phi_e e') at (e, e', t); contact potential, powers and
+  !> records; the constraint violation max |Phi|.
+  subroutine energies(sys, rotations, rates, e, v, lam, t, state, strain, powers, &
+                      contact_potential, violation, records, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rotations(:, :, 0:), rates(0:), e(:), v(:), lam(:), t
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: strain, powers(power_count), contact_potential, violation
+    real(dp), intent(out) :: records(:, :)
+    integer, intent(out) :: info
+    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), set_energy, set_power
+    real(dp), allocatable :: e_full(:), v_full(:), unused(:), values_unused(:)
+    integer :: s, f
+    call evaluate_constraints(sys, e, t, phi, gradients, info)
+    if (info /= 0) return
+    violation = 0.0_dp
+    if (sys%ncon > 0) violation = maxval(abs(phi))
+    powers = 0.0_dp
+    powers(power_drive) = dot_product(lam, gradient_dot(sys, gradients, v))
+    allocate (e_full(sys%nfull))
+    call to_full(sys, e, .true., e_full)
+    strain = 0.0_dp
+    do s = 1, size(sys%sets)
+      f = sys%sets(s)%frame
+      call set_energy_power(sys%sets(s), rotations(:, :, f), sys_axis(sys, f), rates(f), e_full, &
+                            set_energy, set_power, info)
+      if (info /= 0) return
+      strain = strain + set_energy
+      powers(power_frame) = powers(power_frame) + set_power
+    end do
+    contact_potential = 0.0_dp
+    if (sys%npoint > 0) then
+      allocate (v_full(sys%nfull), unused(sys%nfull))
+      call to_full(sys, v, .false., v_full)
+      unused = 0.0_dp
+      call contact_forces(sys, e_full, v_full, 0.0_dp, state, unused, records, &
+                          contact_potential, powers(power_contact_damping:power_friction), info, &
+                          values_unused)
+    end if
+  end subroutine energies
+
+  pure function sys_axis(sys, f) result(axis)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: f
+    real(dp) :: axis(3)
+    axis = [0.0_dp, 0.0_dp, 1.0_dp]
+    if (f > 0) axis = sys%frames(f)%axis
+  end function sys_axis
+
+  !> One output row's probes (positions), deflections (A_f^T (p - pivot_f) - reference) and
+  !> energies (kinetic, strain, loads, moments, total, works, contact).
+  subroutine probe_output(sys, rotations, e, v, t, work, strain, contact_potential, probe, &
+                          deflection, energy, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), t, work(:), strain
+    real(dp), intent(in) :: contact_potential
+    real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:)
+    integer, intent(out) :: info
+    real(dp), allocatable :: e_full(:), mv(:), loads(:)
+    real(dp) :: pivot(3)
+    integer :: p, k, f, m
+    info = 0
+    allocate (e_full(sys%nfull), mv(sys%ndof), loads(sys%ndof))
+    call to_full(sys, e, .true., e_full)
+    do p = 1, sys%nprobe
+      probe(:, p) = 0.0_dp
+      do k = sys%probe_ptr(p), sys%probe_ptr(p + 1) - 1
+        probe(:, p) = probe(:, p) + sys%probe_coef(k) &
+                      * e_full(sys%probe_dof(k):sys%probe_dof(k) + 2)
+      end do
+      f = sys%probe_frame(p)
+      pivot = 0.0_dp
+      if (f > 0) pivot = sys%frames(f)%pivot
+      deflection(:, p) = matmul(transpose(rotations(:, :, f)), probe(:, p) - pivot) &
+                         - sys%probe_reference(:, p)
+    end do
+    call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, v, mv)
+    energy = 0.0_dp
+    energy(energy_kinetic) = 0.5_dp * dot_product(v, mv)
+    energy(energy_strain) = strain
+    call external_forces(sys, t, 1.0_dp, loads, info)
+    if (info /= 0) return
+    energy(energy_loads) = -dot_product(loads, e)
+    do m = 1, size(sys%moment_magnitude)
+      energy(energy_moment) = energy(energy_moment) - sys%moment_magnitude(m) * &
+        moment_angle(e_full(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
+                     sys%moment_reference(:, m))
+    end do
+    energy(energy_contact) = contact_potential
+    energy(energy_total) = sum(energy(energy_kinetic:energy_moment)) + contact_potential
+    energy(work_drive) = work(power_drive)
+    energy(work_frame) = work(power_frame)
+    energy(work_contact_damping) = work(power_contact_damping)
+    energy(work_friction) = work(power_friction)
+    energy(work_material_damping) = work(power_material_damping)
+  end subroutine probe_output
+
+end module mechanical_system

@@ -1,0 +1,48 @@
+"""The crane boom of seed 000 with the supports of eqs. 30-36 (SPEC section 5).
+
+Frame A = R(phi) about the pivot O at the origin; rigid configuration: A1 = R(phi)(0, H, 0),
+axis R(phi)(1, 0, 0), section height along R(phi)(0, 1, 0). A1 hangs on the massless arm O-A1
+(joint 'arm': eqs. 30-33), A2 (the end of the first segment) is driven on its circle
+(joint 'prescribed': eqs. 34-36) by the luffing profile or held at the angle.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..system import System
+from ..system.bodies import rotation_about
+from .common import BuiltSystem, beam_loads, material, rectangle
+
+
+def build(scene) -> BuiltSystem:
+    boom, beam, loads = scene["boom"], scene["beam"], scene["loads"]
+    effects = scene.effects
+    s = System(scene["scene"]["title"], effects=effects)
+    built = BuiltSystem(s, ("tip", 1))
+    steel = material(s, scene)
+    phi = np.radians(boom["angle_deg"])
+    height_h = boom["pivot_offset"]
+    if scene["scene"]["analysis"] != "static" and boom["omega"] > 0:
+        sweep = np.radians(boom["angle_end_deg"] - boom["angle_deg"])
+        drive = s.drive("luffing", "luffing", omega=boom["omega"] * np.sign(sweep),
+                        t_start=boom["t_start"], t_brake=boom["t_brake"], sweep=sweep, start=phi)
+    else:
+        drive = s.drive("angle", "constant", value=phi)
+    turn = rotation_about((0.0, 0.0, 1.0), phi)
+    a1 = turn @ np.array([0.0, height_h, 0.0])
+    tangent, height = turn @ np.array([1.0, 0.0, 0.0]), turn @ np.array([0.0, 1.0, 0.0])
+    tip = a1 + beam["length"] * tangent
+    b = s.beam("boom", material=steel, start=a1, end=tip, nodes=beam["nodes"],
+               section=rectangle(scene), height_axis=height,
+               formulation=scene["scene"]["formulation"], bending=beam["bending"],
+               segments=beam["segments"], frame_drive=drive, frame_axis=(0.0, 0.0, 1.0),
+               frame_pivot=(0.0, 0.0, 0.0))
+    s.joint("A1", "arm", "ground", "boom", point=a1, pivot=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0))
+    a2 = a1 + beam["segments"][0] * tangent
+    s.joint("A2", "prescribed", "ground", "boom", point=a2, pivot=(0.0, 0.0, 0.0),
+            axis=(0.0, 0.0, 1.0), drive=drive)
+    beam_loads(built, scene, b, tip)
+    if "bending_moment" in effects and loads["moment"] != 0.0:
+        s.load("moment", "moment", body="boom", point=a2, vector=(0.0, 0.0, loads["moment"]),
+               effect="bending_moment")
+    return built

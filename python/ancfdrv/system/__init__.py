@@ -1,0 +1,17 @@
+"""Compose any system: bodies, joints, drives, loads, contacts and probes (SPEC section 8).
+
+:class:`System` collects named items and :meth:`System.assemble` builds the
+:class:`~.model.Model` the solvers run. Modules: ``sections`` (beam cross-sections),
+``bodies``, ``drives``, ``joints``, ``loads``, ``contact``, ``probes``, ``system`` (the
+container and its name checks), ``assembly`` (numbering, elimination of linear joints,
+patterns, the kernel handle), ``model`` (the assembled model).
+"""
+from .bodies import Beam, Leaf, Material, Plate, RigidBody
+from .drives import Constant, Cycle, Drive, Luffing, Sine, SpinUp, Table
+from .model import Model
+from .sections import Box, Circle, Rectangle, Section, Tube
+from .system import System
+
+__all__ = ["System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Section",
+           "Rectangle", "Box", "Tube", "Circle", "Drive", "Constant", "Luffing", "SpinUp",
+           "Cycle", "Sine", "Table"]

@@ -1,0 +1,536 @@
+"""From a :class:`~.system.System` to the :class:`~.model.Model` the solvers run: numbering,
+element sets, mass, the loads of the listed effects (and only those), joint equations
+(linear ones eliminated by B or kept with multipliers), redundancy, contact pairs, probes,
+the sparse patterns, the iteration matrix's policy and solver, and the kernel handle that
+holds it all (SPEC section 9: System -> Assembly -> Solver).
+"""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .. import kernel
+from ..codes import CONSTRAINT_COORDINATE, CONTACT_COUNTERS, POLICY_CONSTANT, POLICY_REFACTOR
+from ..errors import InputError
+from .bodies import Beam, Body, Ground, Leaf, Plate, RigidBody, rotation_about
+from .constraint_set import ConstraintSet
+from .expressions import Scalar
+from .joints import Constraint, LinearEquation, orthonormality, planar_fixes
+from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
+from .model import FrameInfo, MomentInfo, Model, ProbeInfo, SetInfo
+from .patterns import Elimination, Pattern, eliminate, reduction_plan
+
+#: effects every model reports (a zero count proves an effect was not computed)
+EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
+                     "point_loads", "pressure", "prestress", "contact", "friction",
+                     "load_cycle", "damping")
+LINEAR_JOINTS = ("auto", "eliminate", "multipliers")
+
+
+@dataclass
+class _Active:
+    """The items of the listed effects."""
+
+    gravity: list[Gravity]
+    forces: list[PointForce]
+    moments: list[DeadMoment]
+    masses: list[PointMass]
+    pressures: list[Pressure]
+    contacts: list
+
+
+def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "auto") -> Model:
+    """The model of ``system`` with the listed effects (None: every effect it uses)."""
+    if linear_joints not in LINEAR_JOINTS:
+        raise InputError(f"linear_joints {linear_joints!r} must be one of {LINEAR_JOINTS}")
+    if not any(b.flexible or isinstance(b, RigidBody) for b in system.bodies.values()):
+        raise InputError("the system has no body")
+    active_effects = set(system.effects_used() if effects is None else effects)
+    counters: Counter = Counter({name: 0 for name in EFFECTS_AVAILABLE + CONTACT_COUNTERS})
+    for name in active_effects:
+        counters[name] += 0
+    warnings: list[str] = []
+    notes: list[str] = []
+    act = _select(system, active_effects, warnings)
+
+    bodies = list(system.bodies.values())
+    first = 0
+    for body in bodies:
+        body.first = first
+        first += body.ncoordinates
+    nfull = first
+    q0 = np.concatenate([b.coordinates() for b in bodies])
+    drives = list(system.drives.values())
+    drive_index = {id(d): i for i, d in enumerate(drives)}
+
+    frames, beam_frame = _frames(bodies, drive_index)
+    sets, set_blocks = _element_sets(bodies, frames, beam_frame, act, active_effects, counters,
+                                     warnings)
+    contact_pairs, contact_blocks = _contact(act.contacts, q0, active_effects, counters)
+    rigid_blocks = [np.arange(b.first, b.first + b.ncoordinates) for b in bodies
+                    if isinstance(b, RigidBody)]
+    full_pattern = Pattern.from_blocks(nfull, set_blocks + rigid_blocks + contact_blocks)
+    for info in sets:
+        info.scatter = full_pattern.scatter(info.dofs)
+
+    # mass and loads in full coordinates
+    mass_full = _mass(bodies, sets, act.masses, full_pattern, counters)
+    gravity, constant, driven = _loads(bodies, sets, act, drive_index, counters, nfull)
+    moments = _moments(act.moments, q0, counters)
+
+    # joints: eliminate or keep with multipliers
+    has_rigid = any(isinstance(b, RigidBody) for b in bodies)
+    mode = linear_joints if linear_joints != "auto" else ("eliminate" if has_rigid else
+                                                          "multipliers")
+    equations = _equations(system, bodies, q0)
+    linear = [eq for eq in equations if isinstance(eq, LinearEquation)]
+    reduction = None
+    if mode == "eliminate" and linear:
+        elimination = eliminate(linear, q0)
+        notes += [f"redundant joint equation dropped: {name}" for name in elimination.redundant]
+        reduction = reduction_plan(nfull, elimination, q0, full_pattern)
+        constraints_eq = [eq for eq in equations if isinstance(eq, Constraint)]
+    else:
+        elimination = Elimination({}, [])
+        constraints_eq = [_as_constraint(eq) if isinstance(eq, LinearEquation) else eq
+                          for eq in equations]
+    ndof = nfull if reduction is None else len(reduction.independent)
+    column = np.arange(nfull) if reduction is None else _columns(nfull, reduction)
+    e0 = q0 if reduction is None else q0[reduction.independent].copy()
+    constraints = _constraint_set(constraints_eq, elimination, column, drives, drive_index, e0,
+                                  ndof, notes)
+
+    pattern = full_pattern if reduction is None else reduction.pattern
+    if reduction is None:
+        mass = mass_full
+    else:
+        b = reduction.matrix
+        mass = (b.T @ mass_full @ b).tocsr()
+    mass.sort_indices()
+
+    def reduce(v: np.ndarray) -> np.ndarray:
+        return v if reduction is None else reduction.reduce(v)
+    probes = _probes(system, frames, beam_frame, q0)
+    model = Model(
+        title=system.title, effects=tuple(sorted(active_effects)), counters=counters,
+        warnings=warnings, notes=notes, bodies=bodies, sets=sets, frames=frames, drives=drives,
+        q0=q0, e0=e0, reduction=reduction, full_pattern=full_pattern, pattern=pattern, mass=mass,
+        constant_force=reduce(constant + gravity),
+        driven_forces=[(i, reduce(v)) for i, v in driven],
+        moments=moments, constraints=constraints, contact_pairs=contact_pairs, probes=probes,
+        point_masses=[(m.body.name, m.point, m.mass) for m in act.masses],
+        linear_joints=mode)
+    _policy(model)
+    model.build_kernel()
+    return model
+
+
+# -- effects ---------------------------------------------------------------------------------
+def _select(system, active: set[str], warnings: list[str]) -> _Active:
+    loads = list(system.loads.values())
+    for load in loads:
+        if load.effect not in active:
+            warnings.append(f"load {load.name!r} belongs to the effect {load.effect!r}, which is "
+                            "not listed: not applied")
+    on = [load for load in loads if load.effect in active]
+    contacts = list(system.contacts.values()) if "contact" in active else []
+    if system.contacts and "contact" not in active:
+        warnings.append("contact pairs are defined but the effect 'contact' is not listed: no "
+                        "contact is computed")
+    return _Active([x for x in on if isinstance(x, Gravity)],
+                   [x for x in on if isinstance(x, PointForce)],
+                   [x for x in on if isinstance(x, DeadMoment)],
+                   [x for x in on if isinstance(x, PointMass)],
+                   [x for x in on if isinstance(x, Pressure)], contacts)
+
+
+# -- frames and element sets -----------------------------------------------------------------
+def _frames(bodies: list[Body], drive_index: dict) -> tuple[list[FrameInfo], dict[str, int]]:
+    """One frame per beam (its body frame, turned by its frame drive): 1-based ids."""
+    frames, beam_frame = [], {}
+    for body in bodies:
+        if not isinstance(body, Beam):
+            continue
+        drive = body.frame_drive
+        base = body.orientation
+        if drive is not None:
+            base = rotation_about(body.frame_axis, -drive.value(0.0)) @ body.orientation
+        frames.append(FrameInfo(-1 if drive is None else drive_index[id(drive)],
+                                body.frame_axis / np.linalg.norm(body.frame_axis), base,
+                                body.frame_pivot, drive))
+        beam_frame[body.name] = len(frames)
+    return frames, beam_frame
+
+
+def _element_sets(bodies, frames, beam_frame, act: _Active, active: set[str], counters: Counter,
+                  warnings: list[str]) -> tuple[list[SetInfo], list[np.ndarray]]:
+    sets, blocks = [], []
+    for body in bodies:
+        if isinstance(body, Beam):
+            info = _beam_set(body, frames[beam_frame[body.name] - 1], beam_frame[body.name])
+        elif isinstance(body, Plate):
+            info = _plate_set(body, active, counters, warnings)
+        else:
+            continue
+        counters["element_arrays"] += info.nel
+        sets.append(info)
+        blocks.append(info.dofs)
+    return sets, blocks
+
+
+def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
+    dofs = beam.element_dofs()
+    local = dofs - beam.first
+    q = beam.coordinates()
+    rotation0 = frame.rotation(0.0)
+    frame_q = (q.reshape(-1, 3) @ rotation0).ravel()       # A0^T v for every 3-vector
+    positions = q.reshape(-1, 4, 3)[:, 0, :] - frame.pivot
+    frame_q.reshape(-1, 4, 3)[:, 0, :] = positions @ rotation0
+    section = beam.section.data
+    m = beam.material
+    frame_ref = frame_q[local].reshape(3, 8, beam.nel, order="F")
+    global_ref = q[local].reshape(3, 8, beam.nel, order="F")
+    mass_compact, stiffness0 = kernel.beam_element_arrays(
+        beam.lengths, section, m.density, m.youngs_modulus, m.poisson_ratio, frame_ref)
+    info = SetInfo(body=beam, kind="", dofs=dofs, nel=beam.nel, frame=frame_id,
+                   mass_compact=mass_compact)
+    if beam.formulation == "ffr":
+        info.kind = "ffr"
+        if beam.bending == "cubic":  # K0: the structural tangent at the reference, in the frame
+            structural = kernel.StructuralBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
+                                               m.poisson_ratio)
+            *_, stiffness0 = structural.forces(local, frame_q, True)
+        info.stiffness0 = np.asfortranarray(stiffness0)
+        info.reference = np.asfortranarray(frame_q[local])
+    elif beam.bending == "cubic":
+        info.kind = "structural"
+        info.structural = kernel.StructuralBeam(global_ref, beam.lengths, section,
+                                                m.youngs_modulus, m.poisson_ratio)
+    else:
+        info.kind = "continuum"
+        info.gradients, info.weights, info.nvolume = kernel.beam_nonlinear_setup(
+            global_ref, beam.lengths, section)
+    return info
+
+
+def _plate_set(plate: Plate, active: set[str], counters: Counter, warnings: list[str]) -> SetInfo:
+    mesh = plate.mesh
+    dofs = plate.element_dofs()
+    local = dofs - plate.first
+    reference = mesh.coords
+    if isinstance(plate, Leaf) and plate.prestressed:
+        if "prestress" in active:
+            reference = plate.reference_coords
+            counters["prestress"] += 1
+        else:
+            warnings.append(f"leaf {plate.name!r} has a free radius but the effect 'prestress' is "
+                            "not listed: it is stress-free as built")
+    ref = kernel.PlateReference(reference.ravel()[local].reshape(3, 12, mesh.nel, order="F"),
+                                mesh.a, mesh.b, plate.variant)
+    mass_compact, _ = kernel.plate_element_arrays(mesh.a, mesh.b, plate.thickness,
+                                                  plate.material.density, np.zeros(3))
+    return SetInfo(body=plate, kind="plate", dofs=dofs, nel=mesh.nel, frame=0,
+                   mass_compact=mass_compact, plate_reference=ref)
+
+
+# -- mass and loads --------------------------------------------------------------------------
+def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern,
+          counters: Counter) -> sp.csr_matrix:
+    """M in full coordinates: element masses, rigid bodies, point masses."""
+    values = np.zeros(pattern.nnz)
+    for info in sets:
+        compact = info.mass_compact.copy()
+        for pm in masses:
+            if pm.body is info.body:
+                at = pm.body.locate(pm.point, node=False, what=f"load {pm.name!r}")
+                if isinstance(info.body, Beam):
+                    compact[:, :, at.element] += kernel.beam_point_mass(
+                        *at.local, info.body.lengths[at.element], pm.mass)
+                else:
+                    shape, _ = kernel.plate_shape(*at.local, info.body.mesh.a[at.element],
+                                                  info.body.mesh.b[at.element])
+                    compact[:, :, at.element] += pm.mass * np.outer(shape, shape)
+        n = compact.shape[0]
+        element = np.einsum("abe,ij->aibje", compact, np.eye(3)).reshape(3 * n, 3 * n, -1)
+        np.add.at(values, info.scatter.ravel() - 1, element.ravel())
+    for body in bodies:
+        if not isinstance(body, RigidBody):
+            continue
+        block = body.mass_matrix.copy()
+        for pm in masses:
+            if pm.body is body:
+                u = pm.point - body.centre
+                compact = pm.mass * np.outer(np.concatenate([[1.0], u]), np.concatenate([[1.0], u]))
+                block += np.kron(compact, np.eye(3))
+        dofs = np.arange(body.first, body.first + 12)
+        rows, cols = np.meshgrid(dofs, dofs, indexing="ij")
+        np.add.at(values, pattern.positions(rows.ravel(), cols.ravel()), block.ravel())
+    for pm in masses:
+        counters[pm.effect] += 1
+    return pattern.to_scipy(values)
+
+
+def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counters: Counter,
+           nfull: int):
+    """Gravity, constant point forces and pressures, and the driven forces (per drive) in
+    full coordinates."""
+    gravity = np.zeros(nfull)
+    g = sum((load.vector for load in act.gravity), np.zeros(3))
+    if act.gravity:
+        for info in sets:
+            body = info.body
+            if isinstance(body, Beam):
+                elements = kernel.beam_gravity(body.lengths, body.section.data,
+                                               body.material.density, g)
+                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
+                          elements.reshape(-1, order="F"))
+            else:
+                _, elements = kernel.plate_element_arrays(
+                    body.mesh.a, body.mesh.b, body.thickness, body.material.density,
+                    body.material.density * body.thickness * g)
+                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
+                          elements.reshape(-1, order="F"))
+        for body in bodies:
+            if isinstance(body, RigidBody):
+                gravity[body.first:body.first + 3] += body.mass * g
+        for pm in act.masses:
+            _add_point_vector(gravity, pm.body, pm.point, pm.mass * g, pm.name)
+        for load in act.gravity:
+            counters[load.effect] += 1
+    constant = np.zeros(nfull)
+    driven: dict[int, np.ndarray] = {}
+    for load in act.forces:
+        target = constant if load.drive is None else \
+            driven.setdefault(drive_index[id(load.drive)], np.zeros(nfull))
+        _add_point_vector(target, load.body, load.point, load.vector, load.name)
+        counters[load.effect] += 1
+    for load in act.pressures:
+        plate = load.body
+        dofs = next(s.dofs for s in sets if s.body is plate)
+        for el in range(plate.nel):
+            _, element = kernel.plate_element_arrays(
+                plate.mesh.a[el:el + 1], plate.mesh.b[el:el + 1], plate.thickness,
+                plate.material.density, -load.value * plate.initial_normal(el))
+            np.add.at(constant, dofs[:, el], element[:, :, 0].reshape(-1, order="F"))
+        counters[load.effect] += 1
+    return gravity, constant, sorted(driven.items())
+
+
+def _add_point_vector(target: np.ndarray, body: Body, point, vector, name: str) -> None:
+    """Generalized force of a dead force at a material point (its shape functions)."""
+    at = body.locate(point, node=False, what=f"load {name!r}")
+    position = body.position(at)
+    for first, coef in position.terms.items():
+        target[first:first + 3] += coef * np.asarray(vector)
+
+
+def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list[MomentInfo]:
+    """A dead moment acts on the nodal director least parallel to its axis."""
+    out = []
+    for load in loads:
+        body = load.body
+        at = body.locate(load.point, node=not isinstance(body, RigidBody),
+                         what=f"load {load.name!r}")
+        axis = load.vector / np.linalg.norm(load.vector)
+        best = None
+        for which in body.directors(at):
+            first = next(iter(body.vector(at, which).terms))
+            d = q0[first:first + 3]
+            score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
+            if best is None or score > best[0] + 1e-12:
+                best = (score, first, which)
+        out.append(MomentInfo(load.name, np.arange(best[1], best[1] + 3), axis,
+                              float(np.linalg.norm(load.vector)), load.effect,
+                              q0[best[1]:best[1] + 3].copy()))
+        counters[load.effect] += 1
+    return out
+
+
+# -- joints ----------------------------------------------------------------------------------
+def _equations(system, bodies, q0: np.ndarray) -> list:
+    """Every joint's equations in the order of the joints, then each rigid body's planar
+    guide and orthonormality."""
+    out = []
+    for joint in system.joints.values():
+        out += joint.equations(q0)
+    for body in bodies:
+        if isinstance(body, RigidBody):
+            if body.planar:
+                out += planar_fixes(body, q0)
+            out += orthonormality(body)
+    return out
+
+
+def _as_constraint(eq: LinearEquation) -> Constraint:
+    """A linear equation kept with a multiplier: x1 = sum a q, x1 - (-c) = 0."""
+    return Constraint(CONSTRAINT_COORDINATE, [Scalar(eq.expr.terms, 0.0)], [-eq.expr.const],
+                      None, eq.name, eq.prefer)
+
+
+def _columns(nfull: int, reduction) -> np.ndarray:
+    column = -np.ones(nfull, dtype=np.int64)
+    column[reduction.independent] = np.arange(len(reduction.independent))
+    return column
+
+
+def _constraint_set(equations: list[Constraint], elimination: Elimination, column: np.ndarray,
+                    drives, drive_index: dict, e0: np.ndarray, ndof: int,
+                    notes: list[str]) -> ConstraintSet:
+    """The multiplier constraints over the independent coordinates; constant ones (satisfied
+    identically through the eliminated coordinates) and redundant ones (their gradient lies
+    in the span of the earlier ones at t = 0) are dropped, the split iteration's dependent
+    coordinate chosen for each."""
+    out = ConstraintSet(drive_kinds=[d.kind for d in drives],
+                        drive_params=[d.params() for d in drives])
+    prefer = []
+    for eq in equations:
+        operands = []
+        for operand in eq.operands:
+            s = elimination.substitute(operand)
+            operands.append(({int(column[d]): c for d, c in s.terms.items()}, s.const))
+        out.add(eq.kind, operands, eq.params,
+                -1 if eq.drive is None else drive_index[id(eq.drive)], eq.name)
+        prefer.append([int(column[d]) for d in eq.prefer if column[d] >= 0])
+    if not len(out):
+        return out
+    values, *_ = out.evaluate(e0, 0.0)
+    keep, basis = [], []
+    gradients = out.gradient_rows(e0, ndof)
+    scale = max(1.0, float(np.abs(e0).max(initial=0.0)))
+    for c in range(len(out)):
+        name = out.names[c]
+        if abs(values[c]) > 1e-8 * scale ** 2:
+            raise InputError(f"{name}: the initial configuration violates this joint equation "
+                             f"by {values[c]:.3e} (check the points, the bodies and the drives' "
+                             "values at t = 0)")
+        g = gradients[c]
+        norm = np.linalg.norm(g)
+        if norm == 0.0 or not any(out.terms[c]):
+            notes.append(f"redundant joint equation dropped: {name} (satisfied identically)")
+            continue
+        r = g.copy()
+        for b in basis:
+            r -= (b @ r) * b
+        if np.linalg.norm(r) <= 1e-8 * norm:
+            notes.append(f"redundant joint equation dropped: {name} (implied by the others)")
+            continue
+        basis.append(r / np.linalg.norm(r))
+        keep.append(c)
+    out = out.select(keep)
+    taken: set[int] = set()
+    for k, c in enumerate(keep):
+        row = gradients[c]
+        choice = next((d for d in prefer[c] if d not in taken and abs(row[d]) > 1e-12), None)
+        if choice is None:
+            order = np.argsort(-np.abs(row), kind="stable")
+            choice = next((int(d) for d in order if int(d) not in taken), int(order[0]))
+        taken.add(choice)
+        out.dependent.append(choice)
+    return out
+
+
+# -- contact, probes -------------------------------------------------------------------------
+def _contact(pairs, q0: np.ndarray, active: set[str], counters: Counter):
+    """Kernel data of every pair (leaf_contact layout) and the couplings its points add to
+    the pattern (the searched elements near each point's projection)."""
+    out, blocks = [], []
+    for pair in pairs:
+        upper, lower = pair.body1, pair.body2
+        friction_on = "friction" in active and pair.friction > 0
+        params = kernel.contact_params(pair.stiffness, pair.damping, pair.friction,
+                                       pair.slip_speed, upper.thickness, lower.thickness,
+                                       friction_on)
+        counters["contact"] += 1
+        if friction_on:
+            counters["friction"] += 1
+        du, dl = upper.element_dofs(), lower.element_dofs()
+        dofs = np.hstack([du, dl])
+        sizes = np.vstack([np.concatenate([upper.mesh.a, lower.mesh.a]),
+                           np.concatenate([upper.mesh.b, lower.mesh.b])])
+        nxu, nyu = upper.nx, upper.ny
+        grid = np.arange(nxu * nyu).reshape(nyu, nxu).T
+        lower_grid = upper.nel + np.arange(lower.nx * lower.ny).reshape(lower.ny, lower.nx).T
+        elements, local, names, guesses = [], [], [], []
+        sx, sy = upper.length_stations()
+        for edge, column_, xi in (("front", 0, 0.0), ("rear", lower.nx - 1, 1.0)):
+            for f in np.linspace(0.0, 1.0, pair.points):
+                j = min(int(f * lower.ny), lower.ny - 1)
+                el = int(lower_grid[column_, j])
+                elements.append(el)
+                local.append([xi, f * lower.ny - j])
+                width = lower.length_stations()[1][-1]
+                names.append(f"{pair.name}: {edge} edge, y = {(f - 0.5) * width:+.4f} m")
+                shape, _ = kernel.plate_shape(xi, f * lower.ny - j, lower.mesh.a[el - upper.nel],
+                                              lower.mesh.b[el - upper.nel])
+                point = shape @ q0[dofs[:, el]].reshape(12, 3)
+                x, y, _ = upper.surface_coordinates(point)
+                guess = np.array([np.clip(x / sx[-1], 0.0, 1.0) * nxu,
+                                  np.clip(y / sy[-1], 0.0, 1.0) * nyu])
+                guess, *_ = kernel.contact_projection(q0, dofs, sizes, grid, point, guess)
+                guesses.append(guess)
+                col = int(min(guess[0], nxu - 1e-9))
+                for c in range(max(col - 1, 0), min(col + 2, nxu)):
+                    for row in range(nyu):
+                        blocks.append(np.concatenate([dofs[:, grid[c, row]], dofs[:, el]]))
+        out.append(dict(name=pair.name, dofs=dofs, sizes=sizes, grid=grid,
+                        point_element=np.array(elements), point_local=np.array(local, float).T,
+                        params=params, guesses=np.array(guesses).T, point_names=names))
+    return out, blocks
+
+
+def _probes(system, frames: list[FrameInfo], beam_frame: dict[str, int],
+            q0: np.ndarray) -> dict[str, ProbeInfo]:
+    out = {}
+    for probe in system.probes.values():
+        body = probe.body
+        at = body.locate(probe.point, node=False, what=f"probe {probe.name!r}")
+        position = body.position(at)
+        p0 = position.value(q0)
+        frame = beam_frame.get(body.name, 0)
+        reference = p0
+        if frame:
+            info = frames[frame - 1]
+            reference = info.rotation(0.0).T @ (p0 - info.pivot)
+        out[probe.name] = ProbeInfo(probe.name, body.name, sorted(position.terms.items()), frame,
+                                    reference, at)
+    return out
+
+
+# -- the iteration matrix --------------------------------------------------------------------
+def _policy(model: Model) -> None:
+    """'constant' (factorized once) when every element set is FFR, there is no contact and
+    the solver-frame assembly is exact (checked numerically); else 'refactor'."""
+    model.policy, model.vector_frame = POLICY_REFACTOR, np.zeros(0, dtype=np.int64)
+    if model.contact_pairs or any(s.kind != "ffr" for s in model.sets):
+        return
+    moving = [i + 1 for i, f in enumerate(model.frames) if f.drive >= 0]
+    if not moving:
+        model.policy = POLICY_CONSTANT
+        return
+    if model.ndof % 3:
+        return
+    frame_of_body = {s.body.name: s.frame for s in model.sets}
+    independent = np.arange(model.nfull) if model.reduction is None else \
+        model.reduction.independent
+    owner = np.empty(model.nfull, dtype=object)
+    for body in model.bodies:
+        owner[body.first:body.first + body.ncoordinates] = body
+    vector_frame = np.zeros(model.ndof // 3, dtype=np.int64)
+    for v in range(model.ndof // 3):
+        full = independent[3 * v:3 * v + 3]
+        if full[0] % 3 or np.any(np.diff(full) != 1):
+            return  # a reduced 3-vector that is not one nodal vector
+        body = owner[full[0]]
+        if isinstance(body, Beam):
+            f = frame_of_body[body.name]
+            vector_frame[v] = f if model.frames[f - 1].drive >= 0 else 0
+        elif len(moving) == 1:
+            vector_frame[v] = moving[0]
+    model.vector_frame = vector_frame
+    if model.solver_frame_exact():
+        model.policy = POLICY_CONSTANT
+    else:
+        model.vector_frame = np.zeros(0, dtype=np.int64)

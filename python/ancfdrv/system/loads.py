@@ -1,0 +1,108 @@
+"""Loads, each belonging to an effect (what ``scene.effects`` switches on):
+
+- :class:`Gravity` (effect 'gravity'): the weight of every body and point mass;
+- :class:`PointForce` (effect 'point_loads'): a dead force at a material point, constant or
+  scaled by a drive;
+- :class:`DeadMoment` (effect 'point_loads'): a constant moment (vector: axis times
+  magnitude, N m) on a node's section (beams, plates) or on a rigid body;
+- :class:`PointMass` (effect 'tip_mass'): a lumped mass at a material point (mass matrix
+  and, with gravity, its weight);
+- :class:`Pressure` (effect 'pressure'): a dead pressure on a plate or leaf along minus its
+  initial normal (r_x x r_y), per element at its centre.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from .bodies import Body, Plate
+from .drives import Drive
+
+
+def _vector(value, what: str) -> np.ndarray:
+    v = np.asarray(value, dtype=float).ravel()
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise InputError(f"{what}: expected three finite numbers, got {value!r}")
+    return v
+
+
+class Load:
+    """Base of the loads: a name and the effect it belongs to."""
+
+    name: str
+    effect: str
+
+
+@dataclass
+class Gravity(Load):
+    name: str
+    vector: np.ndarray
+    effect: str = "gravity"
+
+    def __post_init__(self) -> None:
+        self.vector = _vector(self.vector, f"load {self.name!r}: vector")
+
+
+@dataclass
+class PointForce(Load):
+    name: str
+    body: Body
+    point: np.ndarray
+    vector: np.ndarray
+    drive: Drive | None = None
+    effect: str = "point_loads"
+
+    def __post_init__(self) -> None:
+        self.point = _vector(self.point, f"load {self.name!r}: point")
+        self.vector = _vector(self.vector, f"load {self.name!r}: vector")
+
+
+@dataclass
+class DeadMoment(Load):
+    name: str
+    body: Body
+    point: np.ndarray
+    vector: np.ndarray
+    effect: str = "point_loads"
+
+    def __post_init__(self) -> None:
+        self.point = _vector(self.point, f"load {self.name!r}: point")
+        self.vector = _vector(self.vector, f"load {self.name!r}: vector")
+        if np.linalg.norm(self.vector) == 0.0:
+            raise InputError(f"load {self.name!r}: the moment vector must not vanish (it gives "
+                             "the axis)")
+
+
+@dataclass
+class PointMass(Load):
+    name: str
+    body: Body
+    point: np.ndarray
+    mass: float
+    effect: str = "tip_mass"
+
+    def __post_init__(self) -> None:
+        self.point = _vector(self.point, f"load {self.name!r}: point")
+        if not (np.isfinite(self.mass) and self.mass >= 0):
+            raise InputError(f"load {self.name!r}: mass {self.mass!r} must not be negative")
+
+
+@dataclass
+class Pressure(Load):
+    name: str
+    body: Body
+    value: float
+    effect: str = "pressure"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.body, Plate):
+            raise InputError(f"load {self.name!r}: a pressure acts on a plate or leaf, not on "
+                             f"{self.body.name!r}")
+        if not np.isfinite(self.value):
+            raise InputError(f"load {self.name!r}: value must be finite")
+
+
+LOAD_TYPES = {"gravity": Gravity, "force": PointForce, "moment": DeadMoment,
+              "point_mass": PointMass, "pressure": Pressure}

@@ -1,0 +1,384 @@
+"""The assembled :class:`Model`: what the static and dynamic solvers and the result writers
+use (the one Model protocol of the package), over a kernel handle that holds the system
+(:class:`~ancfdrv.kernel.KernelSystem`).
+
+Coordinates: the solvers' unknowns are the independent coordinates e (with linear joints
+eliminated, q = B e + q0; otherwise e = q). Forces, tangents and output rows come from the
+kernel; the constraints are a :class:`~.constraint_set.ConstraintSet`.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from .. import kernel
+from ..codes import POLICY_CONSTANT, POLICY_REFACTOR
+from ..errors import SolverError
+from .bodies import Beam, Body, Plate, RigidBody, rotation_about
+from .constraint_set import ConstraintSet
+from .drives import Drive
+from .patterns import Pattern, Reduction
+
+
+@dataclass
+class FrameInfo:
+    """A beam's frame: A(t) = Rot(axis, phi(t)) base about pivot (drive -1: A = base)."""
+
+    drive: int
+    axis: np.ndarray
+    base: np.ndarray
+    pivot: np.ndarray
+    drive_obj: Drive | None = None
+
+    def rotation(self, t: float) -> np.ndarray:
+        if self.drive_obj is None:
+            return self.base
+        return rotation_about(self.axis, self.drive_obj.value(t)) @ self.base
+
+
+@dataclass
+class SetInfo:
+    """An element set as assembled (one per flexible body)."""
+
+    body: Body
+    kind: str                 # 'ffr', 'continuum', 'structural', 'plate'
+    dofs: np.ndarray          # (nde, nel) full coordinates, 0-based
+    nel: int
+    frame: int                # 1-based frame id (0: none)
+    mass_compact: np.ndarray
+    scatter: np.ndarray | None = None
+    stiffness0: np.ndarray | None = None
+    reference: np.ndarray | None = None
+    gradients: np.ndarray | None = None
+    weights: np.ndarray | None = None
+    nvolume: int = 0
+    structural: kernel.StructuralBeam | None = None
+    plate_reference: kernel.PlateReference | None = None
+
+
+@dataclass
+class MomentInfo:
+    """A dead moment on the nodal director q[dofs] (full coordinates)."""
+
+    name: str
+    dofs: np.ndarray
+    axis: np.ndarray
+    magnitude: float
+    effect: str
+    reference: np.ndarray
+
+
+@dataclass
+class ProbeInfo:
+    """p = sum coef q[first:first+3]; deflection A_f(t)^T (p - pivot) - reference."""
+
+    name: str
+    body: str
+    terms: list[tuple[int, float]]
+    frame: int
+    reference: np.ndarray
+    attachment: object = None
+
+
+class Model:
+    """An assembled system (built by ``ancfdrv.system.assembly.assemble``): the interface
+    the solvers and the result writers use."""
+
+    def __init__(self, *, title: str, effects: tuple[str, ...], counters: Counter,
+                 warnings: list[str], notes: list[str], bodies: list[Body], sets: list[SetInfo],
+                 frames: list[FrameInfo], drives: list[Drive], q0: np.ndarray, e0: np.ndarray,
+                 reduction: Reduction | None, full_pattern: Pattern, pattern: Pattern,
+                 mass: sp.csr_matrix, constant_force: np.ndarray, driven_forces: list,
+                 moments: list[MomentInfo], constraints: ConstraintSet, contact_pairs: list[dict],
+                 probes: dict[str, ProbeInfo], point_masses: list, linear_joints: str) -> None:
+        self.title, self.effects, self.counters = title, effects, counters
+        self.warnings, self.notes = warnings, notes
+        self.bodies, self.sets, self.frames, self.drives = bodies, sets, frames, drives
+        self.q0, self.e0, self.reduction = q0, e0, reduction
+        self.full_pattern, self.pattern, self.mass = full_pattern, pattern, mass
+        self.constant_force_vector = constant_force
+        self.driven_forces, self.moments, self.constraints = driven_forces, moments, constraints
+        self.contact_pairs, self.probes, self.point_masses = contact_pairs, probes, point_masses
+        self.linear_joints = linear_joints
+        self.policy = POLICY_REFACTOR
+        self.vector_frame = np.zeros(0, dtype=np.int64)
+        self.load_factor = 1.0
+        self.ndof, self.nfull = len(e0), len(q0)
+        self.kernel: kernel.KernelSystem | None = None
+        self.solver: kernel.DirectSolver | None = None
+        self.contact_guesses = np.hstack([p["guesses"] for p in contact_pairs]) \
+            if contact_pairs else np.zeros((2, 1))
+        self.contact_counts = np.zeros(6, dtype=np.int32)
+        flexible = [b.coordinates().reshape(-1, 3) for b in bodies if b.flexible]
+        extent = float(np.ptp(np.vstack(flexible or [q0.reshape(-1, 3)]), axis=0).max())
+        self.length_scale = extent if extent > 0 else 1.0
+        #: the probe and component sweeps compare (builders may set it)
+        self.response: tuple[str, int] | None = None
+        if probes:
+            first = next(iter(probes.values()))
+            body = next(b for b in bodies if b.name == first.body)
+            self.response = (first.name, 1 if isinstance(body, Beam) else 2)
+
+    # -- identity ---------------------------------------------------------------------------
+    @property
+    def npoint(self) -> int:
+        return sum(len(p["point_element"]) for p in self.contact_pairs)
+
+    @property
+    def contact_point_names(self) -> list[str]:
+        return [n for p in self.contact_pairs for n in p["point_names"]]
+
+    def summary(self) -> dict[str, int]:
+        """The /model attributes of a result file."""
+        beams = [b for b in self.bodies if isinstance(b, Beam)]
+        plates = [b for b in self.bodies if isinstance(b, Plate)]
+        nodes = sum(b.nodes for b in beams) + sum(b.mesh.nnodes for b in plates)
+        return {"ndof": self.ndof, "nfull": self.nfull, "nnodes": nodes,
+                "nelements": sum(s.nel for s in self.sets),
+                "nbodies": len(self.bodies), "nrigid_bodies":
+                    sum(isinstance(b, RigidBody) for b in self.bodies),
+                "nconstraints": len(self.constraints),
+                "nlinear_eliminated": 0 if self.reduction is None else
+                    len(self.reduction.relations),
+                "ncontact_points": self.npoint}
+
+    # -- coordinates --------------------------------------------------------------------------
+    def expand(self, e: np.ndarray, with_offset: bool = True) -> np.ndarray:
+        """Full coordinates q (rows of e may be time steps)."""
+        if self.reduction is None:
+            return np.array(e, dtype=float, copy=True)
+        return self.reduction.expand(e, with_offset)
+
+    def reduce(self, full: np.ndarray) -> np.ndarray:
+        return full if self.reduction is None else self.reduction.reduce(full)
+
+    # -- matrices ---------------------------------------------------------------------------
+    def mass_matrix(self) -> sp.csr_matrix:
+        return self.mass.copy()
+
+    def mass_values(self) -> np.ndarray:
+        """M on the solvers' pattern."""
+        return self.pattern.values_of(self.mass)
+
+    def stiffness_values(self, t: float = 0.0, e: np.ndarray | None = None) -> np.ndarray:
+        """The tangent (global coordinates) on the pattern at e (default e0) and t."""
+        return self.forces(self.e0 if e is None else e, t, want_tangent=True)["tangent"]
+
+    def stiffness_matrix(self, t: float = 0.0) -> sp.csr_matrix:
+        return self.pattern.to_scipy(self.stiffness_values(t))
+
+    # -- forces -----------------------------------------------------------------------------
+    def forces(self, e: np.ndarray, t: float = 0.0, v: np.ndarray | None = None, *,
+               load_factor: float | None = None, velocity_factor: float = 0.0,
+               want_tangent: bool = False) -> dict:
+        """From the kernel: internal = B^T (Q_el - Q_contact - lf Q_M), external = lf Q(t),
+        strain energy, contact potential and records, and on request the tangent (sets plus
+        velocity_factor times the contact Jacobian) on :attr:`pattern`."""
+        lf = self.load_factor if load_factor is None else load_factor
+        out = self.kernel.evaluate(t, e, np.zeros(self.ndof) if v is None else v,
+                                   self.contact_guesses, self.contact_counts, load_factor=lf,
+                                   velocity_factor=velocity_factor, want_tangent=want_tangent)
+        self.counters["elastic_force"] += 1
+        if want_tangent:
+            self.counters["stiffness_assembly"] += 1
+        if self.moments:
+            for m in self.moments:
+                self.counters[m.effect] += 1
+        self.contact_guesses, self.contact_counts = out["guesses"], out["counts"]
+        return out
+
+    def internal_force(self, e: np.ndarray, t: float = 0.0, want_tangent: bool = False):
+        """B^T (Q_el - Q_contact - Q_M), strain energy and (on request) the tangent values."""
+        out = self.forces(e, t, want_tangent=want_tangent)
+        return out["internal"], out["strain"], out["tangent"]
+
+    def constant_force(self) -> np.ndarray:
+        """Configuration-independent loads of the listed effects (at t = 0), times the load
+        factor."""
+        force = self.constant_force_vector.copy()
+        for index, vector in self.driven_forces:
+            force += self.drives[index].value(0.0) * vector
+        return self.load_factor * force
+
+    def moment_terms(self, e: np.ndarray, load_factor: float | None = None):
+        """Per dead moment: (coordinates, force, Jacobian, Hessian) over the coordinates its
+        director depends on (through B when reduced)."""
+        lf = self.load_factor if load_factor is None else load_factor
+        q = self.expand(e)
+        out = []
+        for m in self.moments:
+            self.counters[m.effect] += 1
+            f, j, h = kernel.moment_force(q[m.dofs], m.axis, lf * m.magnitude)
+            cols, b = self._director_map(m.dofs)
+            out.append((cols, b.T @ f, b.T @ j @ b, np.einsum("ijl,ia,jb,lc->abc", h, b, b, b)))
+        return out
+
+    def _director_map(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Coordinates e the full coordinates q[dofs] depend on, and dq[dofs]/de there."""
+        if self.reduction is None:
+            return np.asarray(dofs), np.eye(len(dofs))
+        rows = self.reduction.matrix[dofs].tocoo()
+        cols = np.unique(rows.col)
+        b = np.zeros((len(dofs), len(cols)))
+        b[rows.row, np.searchsorted(cols, rows.col)] = rows.data
+        return cols, b
+
+    # -- probes -----------------------------------------------------------------------------
+    def probe_positions(self, e: np.ndarray) -> dict[str, np.ndarray]:
+        q = self.expand(e)
+        return {name: sum((coef * q[first:first + 3] for first, coef in p.terms), np.zeros(3))
+                for name, p in self.probes.items()}
+
+    def frame_rotation(self, frame: int, t: float) -> np.ndarray:
+        return np.eye(3) if frame == 0 else self.frames[frame - 1].rotation(t)
+
+    def deflections_at(self, e: np.ndarray, t: float) -> dict[str, np.ndarray]:
+        """Probe displacements from the rigid configuration in each probe's frame at t
+        (beams: their frame; other bodies: global components)."""
+        out = {}
+        for name, position in self.probe_positions(e).items():
+            p = self.probes[name]
+            pivot = np.zeros(3) if p.frame == 0 else self.frames[p.frame - 1].pivot
+            out[name] = self.frame_rotation(p.frame, t).T @ (position - pivot) - p.reference
+        return out
+
+    def deflections(self, e: np.ndarray) -> dict[str, np.ndarray]:
+        return self.deflections_at(e, 0.0)
+
+    # -- geometry for the result files ---------------------------------------------------------
+    def plate_bodies(self) -> list[Plate]:
+        return [b for b in self.bodies if isinstance(b, Plate)]
+
+    def node_positions(self, q_reduced: np.ndarray) -> np.ndarray:
+        """Plate and leaf node positions (nt, nnodes, 3) from coordinates (nt, ndof)."""
+        full = self.expand(np.atleast_2d(q_reduced))
+        parts = []
+        for plate in self.plate_bodies():
+            block = full[:, plate.first:plate.first + plate.ncoordinates]
+            parts.append(block.reshape(len(full), plate.mesh.nnodes, 9)[:, :, :3])
+        return np.concatenate(parts, axis=1)
+
+    def plate_geometry(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Initial node positions and quadrilaterals (global node numbering) of every plate
+        and leaf, or None without plates."""
+        plates = self.plate_bodies()
+        if not plates:
+            return None
+        nodes, elements, offset = [], [], 0
+        for plate in plates:
+            nodes.append(plate.mesh.coords[:, :3])
+            elements.append(plate.mesh.elements + offset)
+            offset += plate.mesh.nnodes
+        return np.vstack(nodes), np.vstack(elements)
+
+    # -- the kernel ---------------------------------------------------------------------------
+    def solver_frame_exact(self) -> bool:
+        """Whether S in the solver frame is constant: B^T (M + K(phi)) B = U (B^T (M + K_c) B)
+        U^T for a test turn of every moving frame (U: each reduced 3-vector's frame)."""
+        def reduced(values_full: np.ndarray) -> sp.csr_matrix:
+            m = self.full_pattern.to_scipy(values_full)
+            if self.reduction is not None:
+                m = self.reduction.matrix.T @ m @ self.reduction.matrix
+            return sp.csr_matrix(m)
+
+        def stiffness(turn: float) -> np.ndarray:
+            values = np.zeros(self.full_pattern.nnz)
+            for s in self.sets:
+                frame = self.frames[s.frame - 1]
+                rotation = frame.base
+                if frame.drive >= 0:
+                    rotation = rotation_about(frame.axis, turn) @ frame.base if turn else \
+                        np.eye(3)
+                element = kernel.ffr_element_stiffness(s.stiffness0, np.asfortranarray(rotation))
+                np.add.at(values, s.scatter.ravel() - 1, element.ravel())
+            return values
+        turn = 0.9
+        k_c, k_t = reduced(stiffness(0.0)), reduced(stiffness(turn))
+        blocks = [np.eye(3) if f == 0 else
+                  rotation_about(self.frames[f - 1].axis, turn) @ self.frames[f - 1].base
+                  for f in self.vector_frame]
+        u = sp.block_diag(blocks, format="csr")
+        scale = max(abs(k_c).max(), 1e-300)
+        mass = self.mass
+        ok_k = abs(k_t - u @ k_c @ u.T).max() <= 1e-9 * scale
+        ok_m = abs(mass - u @ mass @ u.T).max() <= 1e-12 * max(abs(mass).max(), 1e-300)
+        return bool(ok_k and ok_m)
+
+    def touched_blocks(self) -> np.ndarray:
+        """First coordinates (0-based) of the 3-vector blocks holding every constrained
+        coordinate (the last block kept inside the vector)."""
+        used = self.constraints.touched()
+        if not len(used):
+            return np.zeros(0, dtype=np.int64)
+        return np.unique(np.minimum(used - used % 3, self.ndof - 3))
+
+    def banded(self) -> bool:
+        """The banded Cholesky (with LU fallback) for symmetric matrices with a narrow band:
+        no contact (its Jacobian is unsymmetric) and half-bandwidth <= max(64, n / 4)."""
+        return not self.contact_pairs and self.pattern.bandwidth() <= max(64, self.ndof // 4)
+
+    def build_kernel(self) -> None:
+        """Hand the system to the kernel (once) and analyse the iteration matrix's pattern."""
+        ks = kernel.KernelSystem(self.ndof, self.nfull)
+        for s in self.sets:
+            if s.kind == "ffr":
+                ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame)
+            elif s.kind == "continuum":
+                ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
+                                     s.body.material.youngs_modulus,
+                                     s.body.material.poisson_ratio, s.frame)
+            elif s.kind == "structural":
+                ks.add_structural_set(s.dofs, s.scatter, s.structural.forms, s.structural.strain0,
+                                      s.structural.stiffness, s.frame)
+            else:
+                ks.add_plate_set(s.dofs, s.scatter, s.plate_reference,
+                                 s.body.material.youngs_modulus, s.body.material.poisson_ratio,
+                                 s.body.thickness)
+        ks.set_frames([f.drive for f in self.frames], [f.axis for f in self.frames],
+                      [f.base for f in self.frames], [f.pivot for f in self.frames])
+        ks.set_drives([d.kind for d in self.drives], [d.params() for d in self.drives])
+        banded = self.banded()
+        self.solver = kernel.DirectSolver(
+            self.ndof, self.pattern.rows, self.pattern.col_index, banded_spd=banded,
+            what="iteration matrix beta' M + K " + ("(banded Cholesky)" if banded else "(MUMPS)"))
+        mass = self.mass.copy()
+        mass.eliminate_zeros()  # the x, y, z blocks of M are decoupled: 2/3 of it is 0
+        mass.sort_indices()
+        ks.set_matrices(mass, (self.full_pattern.row_ptr, self.full_pattern.col_index),
+                        self.solver.handle, self.policy, self.mass_values(), self.vector_frame,
+                        self.touched_blocks())
+        if self.reduction is not None:
+            r = self.reduction
+            ks.set_reduction(r.matrix, r.offset, r.plan_source, r.plan_target, r.plan_coef)
+        ks.set_loads(self.constant_force_vector, [i for i, _ in self.driven_forces],
+                     np.array([v for _, v in self.driven_forces]).T.reshape(self.ndof, -1),
+                     [m.dofs for m in self.moments], [m.axis for m in self.moments],
+                     [m.magnitude for m in self.moments], [m.reference for m in self.moments])
+        ks.set_constraints(self.constraints.layout())
+        for pair in self.contact_pairs:
+            ks.add_contact_pair(pair["dofs"], pair["sizes"], pair["grid"], pair["point_element"],
+                                pair["point_local"], pair["params"])
+        ptr = np.concatenate([[0], np.cumsum([len(p.terms) for p in self.probes.values()])])
+        ks.set_probes(ptr, [d for p in self.probes.values() for d, _ in p.terms],
+                      [c for p in self.probes.values() for _, c in p.terms],
+                      [p.frame for p in self.probes.values()],
+                      [p.reference for p in self.probes.values()])
+        self.kernel = ks
+
+    @property
+    def constant_policy(self) -> bool:
+        return self.policy == POLICY_CONSTANT
+
+    def close(self) -> None:
+        """Release the kernel's system and solver."""
+        if self.kernel is not None:
+            self.kernel.close()
+        if self.solver is not None:
+            self.solver.close()
+
+    def check_alive(self) -> None:
+        if self.kernel is None or not self.kernel.handle:
+            raise SolverError("the model's kernel system was released (model.close())")

@@ -1,0 +1,225 @@
+"""Sparse patterns of the assembled matrices and the elimination of linear constraints.
+
+:class:`Pattern` is a CSR pattern (sorted columns) built once from coupling blocks (element
+dofs, rigid bodies, contact pairs) with the scatter map of element matrices into it.
+:func:`eliminate` turns time-independent linear equations into q = B e + q0 (seed 003 eqs.
+34-37), choosing a dependent coordinate per equation after substituting the earlier ones, so
+chains and closed loops need no special case and an equation the others already imply is
+recognised as redundant. :func:`reduction_plan` forms the plan of B^T S B on the reduced
+pattern, which the kernel applies to every assembled matrix.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+from .expressions import Scalar
+
+
+class Pattern:
+    """CSR pattern of an n x n matrix (0-based, sorted columns)."""
+
+    def __init__(self, n: int, row_ptr: np.ndarray, col_index: np.ndarray) -> None:
+        self.n = n
+        self.row_ptr = np.asarray(row_ptr, dtype=np.int64)
+        self.col_index = np.asarray(col_index, dtype=np.int64)
+        self.nnz = len(self.col_index)
+        self.rows = np.repeat(np.arange(n), np.diff(self.row_ptr))
+        self._keys = self.rows * n + self.col_index
+
+    @classmethod
+    def from_blocks(cls, n: int, blocks: list[np.ndarray]) -> "Pattern":
+        """Every pair of dofs within a block (an array of dofs, or of columns of dofs) is
+        coupled; the diagonal is always present."""
+        rows, cols = [np.arange(n)], [np.arange(n)]
+        for block in blocks:
+            b = np.asarray(block)
+            if b.ndim == 1:
+                b = b[:, None]
+            b = b[:, np.all(b >= 0, axis=0)] if b.size else b
+            k = b.shape[0]
+            rows.append(np.repeat(b, k, axis=0).T.ravel())
+            cols.append(np.tile(b, (k, 1)).T.ravel())
+        r, c = np.concatenate(rows), np.concatenate(cols)
+        matrix = sp.csr_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
+        matrix.sum_duplicates()
+        matrix.sort_indices()
+        return cls(n, matrix.indptr, matrix.indices)
+
+    def positions(self, rows, cols) -> np.ndarray:
+        """Positions of entries (rows, cols) in the values array (-1 when absent)."""
+        wanted = np.asarray(rows, dtype=np.int64) * self.n + np.asarray(cols, dtype=np.int64)
+        pos = np.minimum(np.searchsorted(self._keys, wanted), len(self._keys) - 1)
+        return np.where(self._keys[pos] == wanted, pos, -1)
+
+    def scatter(self, dofs: np.ndarray) -> np.ndarray:
+        """(nde, nde, nel) positions of element-matrix entries (a, b) of elements with dofs
+        (nde, nel), 1-based (the kernel's layout; 0 = absent)."""
+        nde, nel = dofs.shape
+        rows = np.broadcast_to(dofs[:, None, :], (nde, nde, nel))
+        cols = np.broadcast_to(dofs[None, :, :], (nde, nde, nel))
+        pos = self.positions(rows.ravel(), cols.ravel()).reshape(nde, nde, nel)
+        if (pos < 0).any():
+            raise AssertionError("an element entry is missing from the pattern")
+        return pos + 1
+
+    def values_of(self, matrix: sp.spmatrix) -> np.ndarray:
+        """Values of ``matrix`` on this pattern (entries outside it must be zero)."""
+        m = sp.csr_matrix(matrix)
+        return np.asarray(m[self.rows, self.col_index]).ravel()
+
+    def to_scipy(self, values: np.ndarray) -> sp.csr_matrix:
+        """A scipy CSR matrix with its own copy of the pattern."""
+        return sp.csr_matrix((np.array(values, dtype=float), self.col_index.copy(),
+                              self.row_ptr.copy()), shape=(self.n, self.n))
+
+    def bandwidth(self) -> int:
+        return int(np.abs(self.rows - self.col_index).max(initial=0))
+
+
+@dataclass
+class Reduction:
+    """q = B e + q0 and the plan of B^T S B (source: full-pattern positions, target: reduced
+    pattern positions, coefficient)."""
+
+    matrix: sp.csr_matrix          # B (nfull x nred)
+    offset: np.ndarray             # q0 (nfull)
+    independent: np.ndarray        # full index of each reduced coordinate
+    pattern: Pattern               # of B^T S B
+    plan_source: np.ndarray
+    plan_target: np.ndarray
+    plan_coef: np.ndarray
+    relations: dict[int, Scalar] = field(default_factory=dict)
+
+    def expand(self, x: np.ndarray, with_offset: bool = True) -> np.ndarray:
+        """Full coordinates (or, without the offset, velocities) from reduced ones; x may be
+        (nred,) or (nt, nred)."""
+        full = (self.matrix @ np.asarray(x).T).T
+        return full + self.offset if with_offset else full
+
+    def reduce(self, full: np.ndarray) -> np.ndarray:
+        """B^T Q (eq. 37)."""
+        return self.matrix.T @ full
+
+
+@dataclass
+class Elimination:
+    """The outcome of :func:`eliminate`: relations q_d = c + sum a_j q_j over independent
+    coordinates, the dropped (redundant) equations' names."""
+
+    relations: dict[int, Scalar]
+    redundant: list[str]
+
+    def substitute(self, expr: Scalar) -> Scalar:
+        """expr over independent coordinates only."""
+        out = Scalar({}, expr.const)
+        for dof, coef in expr.terms.items():
+            if dof in self.relations:
+                out = out + self.relations[dof].scaled(coef)
+            else:
+                out = out + Scalar({dof: coef}, 0.0)
+        return out
+
+
+def eliminate(equations, q0: np.ndarray) -> Elimination:
+    """Relations from linear equations (in their order): each equation, written over the
+    coordinates still independent, makes one of them dependent (its preferred ones first,
+    else the largest coefficient). An equation that reduces to a constant is redundant when
+    the constant vanishes and contradicts the others otherwise (InputError naming it)."""
+    scale = max(1.0, float(np.abs(q0).max(initial=0.0)))
+    result = Elimination({}, [])
+    users: dict[int, set[int]] = {}   # independent dof -> dependents whose relation uses it
+    for eq in equations:
+        violation = eq.expr.value(q0)
+        if abs(violation) > 1e-9 * scale:
+            raise InputError(f"{eq.name}: the initial configuration violates this joint "
+                             f"equation by {violation:.3e} (check the points and bodies)")
+        s = result.substitute(eq.expr)
+        big = max((abs(c) for c in s.terms.values()), default=0.0)
+        s = Scalar({d: c for d, c in s.terms.items() if abs(c) > 1e-12 * big}, s.const)
+        if not s.terms:
+            if abs(s.const) <= 1e-9 * scale:
+                result.redundant.append(eq.name)
+                continue
+            raise InputError(f"{eq.name}: contradicts the other joint equations (off by "
+                             f"{s.const:.3e})")
+        choice = next((d for d in eq.prefer if d in s.terms and abs(s.terms[d]) >= 1e-6 * big),
+                      None)
+        if choice is None:
+            choice = max(s.terms, key=lambda d: (abs(s.terms[d]), -d))
+        coef = s.terms[choice]
+        relation = Scalar({d: -c / coef for d, c in s.terms.items() if d != choice},
+                          -s.const / coef)
+        for dependent in users.pop(choice, set()):  # substitute into the relations using it
+            old = result.relations[dependent]
+            terms = dict(old.terms)
+            a = terms.pop(choice, 0.0)  # (0: a substitution cancelled the term)
+            if a == 0.0:
+                continue
+            new = Scalar(terms, old.const) + relation.scaled(a)
+            result.relations[dependent] = new
+            for d in new.terms:
+                users.setdefault(d, set()).add(dependent)
+        result.relations[choice] = relation
+        for d in relation.terms:
+            users.setdefault(d, set()).add(choice)
+    return result
+
+
+def reduction_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
+                   full_pattern: Pattern) -> Reduction:
+    """B, q0 (checked against the initial configuration), the reduced pattern (structure of
+    B^T P B plus the diagonal) and the plan forming B^T S B on it."""
+    relations = elimination.relations
+    independent = np.array([i for i in range(nfull) if i not in relations], dtype=np.int64)
+    column = -np.ones(nfull, dtype=np.int64)
+    column[independent] = np.arange(len(independent))
+    rows, cols, vals = [], [], []
+    offset = np.zeros(nfull)
+    for i in range(nfull):
+        if i in relations:
+            offset[i] = relations[i].const
+            for d, c in relations[i].terms.items():
+                rows.append(i)
+                cols.append(column[d])
+                vals.append(c)
+        else:
+            rows.append(i)
+            cols.append(column[i])
+            vals.append(1.0)
+    b = sp.csr_matrix((vals, (rows, cols)), shape=(nfull, len(independent)))
+    b.sort_indices()
+    mismatch = np.abs(b @ q0[independent] + offset - q0)
+    if mismatch.max(initial=0.0) > 1e-9 * max(1.0, np.abs(q0).max(initial=0.0)):
+        raise AssertionError(f"the reduction misses the initial configuration by "
+                             f"{mismatch.max():.3e}")
+    p = sp.csr_matrix((np.ones(full_pattern.nnz), full_pattern.col_index, full_pattern.row_ptr),
+                      shape=(nfull, nfull))
+    babs = abs(b)
+    reduced = (babs.T @ p @ babs + sp.identity(b.shape[1])).tocsr()
+    reduced.sort_indices()
+    pattern = Pattern(b.shape[1], reduced.indptr, reduced.indices)
+    # plan: every full entry (i, j) and every pair of B entries in rows i and j
+    counts = np.diff(b.indptr)
+    f_rows, f_cols = full_pattern.rows, full_pattern.col_index
+    simple = (counts[f_rows] == 1) & (counts[f_cols] == 1)
+    k = np.nonzero(simple)[0]
+    sources, targets, coefs = [k], [pattern.positions(b.indices[b.indptr[f_rows[k]]],
+                                                      b.indices[b.indptr[f_cols[k]]])], \
+        [b.data[b.indptr[f_rows[k]]] * b.data[b.indptr[f_cols[k]]]]
+    for kk in np.nonzero(~simple & (counts[f_rows] > 0) & (counts[f_cols] > 0))[0]:
+        ra = slice(b.indptr[f_rows[kk]], b.indptr[f_rows[kk] + 1])
+        rc = slice(b.indptr[f_cols[kk]], b.indptr[f_cols[kk] + 1])
+        a_cols, a_vals = b.indices[ra], b.data[ra]
+        c_cols, c_vals = b.indices[rc], b.data[rc]
+        sources.append(np.full(len(a_cols) * len(c_cols), kk))
+        targets.append(pattern.positions(np.repeat(a_cols, len(c_cols)),
+                                         np.tile(c_cols, len(a_cols))))
+        coefs.append(np.outer(a_vals, c_vals).ravel())
+    source, target, coef = np.concatenate(sources), np.concatenate(targets), np.concatenate(coefs)
+    if (target < 0).any():
+        raise AssertionError("reduced pattern misses an entry of B^T S B")
+    return Reduction(b, offset, independent, pattern, source, target, coef, relations)
