@@ -78,6 +78,7 @@ def build(scene) -> BuiltSystem:
         s.load("cycle", "force", body="chassis", point=chassis_at, vector=(0.0, 0.0, 1.0),
                drive="cycle", effect="load_cycle")
     s.probe("chassis", "chassis", chassis_at)
+    s.probe("shackle", "shackle", eye + [0.0, 0.0, ls / 2])
     s.probe("main_tip", "main", main.material_point(0.5 * main_l, 0.0))
     s.probe("lower_tip", "lower", lower.material_point(0.5 * low_l, 0.0))
     return BuiltSystem(s, ("chassis", 2))

@@ -83,6 +83,23 @@ class ProbeInfo:
     attachment: object = None
 
 
+def length_scale(bodies: list[Body]) -> float:
+    """The length the Newton tolerances are relative to: the largest flexible body's size
+    (a beam's length, the largest extent of a plate's or leaf's nodes along a coordinate
+    axis), else the spread of the rigid bodies' centres (1 m when they coincide)."""
+    sizes = []
+    for body in bodies:
+        if isinstance(body, Beam):
+            sizes.append(body.length)
+        elif isinstance(body, Plate):
+            sizes.append(float(np.ptp(body.mesh.coords[:, :3], axis=0).max()))
+    if sizes:
+        return max(sizes)
+    centres = np.array([b.centre for b in bodies if isinstance(b, RigidBody)])
+    spread = float(np.linalg.norm(np.ptp(centres, axis=0))) if len(centres) else 0.0
+    return spread if spread > 0 else 1.0
+
+
 class Model:
     """An assembled system (built by ``ancfdrv.system.assembly.assemble``): the interface
     the solvers and the result writers use."""
@@ -112,9 +129,7 @@ class Model:
         self.contact_guesses = np.hstack([p["guesses"] for p in contact_pairs]) \
             if contact_pairs else np.zeros((2, 1))
         self.contact_counts = np.zeros(6, dtype=np.int32)
-        flexible = [b.coordinates().reshape(-1, 3) for b in bodies if b.flexible]
-        extent = float(np.ptp(np.vstack(flexible or [q0.reshape(-1, 3)]), axis=0).max())
-        self.length_scale = extent if extent > 0 else 1.0
+        self.length_scale = length_scale(bodies)
         #: the probe and component sweeps compare (builders may set it)
         self.response: tuple[str, int] | None = None
         if probes:
