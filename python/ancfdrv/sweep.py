@@ -34,8 +34,8 @@ from tqdm import tqdm
 
 from .errors import InputError
 from .io.scene import SCHEMA, load_scene
-from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, failure, remove_quietly,
-                         response_of, run_dask, run_inline, run_processes)
+from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
+                         remove_quietly, response_of, run_dask, run_inline, run_processes)
 
 #: Parameters that refine a model; the finest value is the reference of the others.
 RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min, "plate.nx": max, "plate.ny": max,
@@ -299,20 +299,40 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
     for params in combos:  # validate every case before spending time on any
         load_scene(scene_file, base + expand(params))
     outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
     sweep_id = uuid.uuid4().hex
     cases = _make_cases(combos, outdir, sweep_id)
+    client = connect(scheduler, connect_timeout) if scheduler else None  # before any output
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+        rows, interrupted = _run_cases(scene_file, base, cases, sweep_id, client=client,
+                                       workers=workers, start_method=start_method,
+                                       progress=progress, scene_text=scene.text)
+    finally:
+        if client is not None:
+            client.close()
+    check_sweep_ids(rows, sweep_id)
+    report(rows, keys, outdir, scene_file, base)
+    if interrupted:
+        raise SweepInterrupted(rows, outdir)
+    return rows
+
+
+def _run_cases(scene_file: str, base: list[str], cases: list[Case], sweep_id: str, *,
+               client: Any, workers: int | None, start_method: str | None,
+               progress: bool | None, scene_text: str) -> tuple[list[dict], bool]:
+    """Every case's row (in the order of ``cases``), and whether Ctrl-C stopped the sweep.
+    Each file is moved to its final name with this sweep's id as it arrives."""
     rows: dict[int, dict] = {}
     show = sys.stderr.isatty() if progress is None else progress
     bar = tqdm(total=len(cases), desc="sweep", unit="case", disable=not show)
+    client_scene = str(Path(scene_file).resolve())
 
     def record(case: Case, row: dict, data: bytes | None) -> None:
         if case.index in rows:
             return
         row["case"] = case.name
         row["file"] = store_case_file(case, sweep_id, data,
-                                      scene_file=str(Path(scene_file).resolve())
-                                      if data is not None else None)
+                                      scene_file=client_scene if data is not None else None)
         if row["status"] == "ok" and not row["file"]:
             row.update(status="failed", exit_code=1, message="the case reported success but "
                        "its result file is missing or unreadable")
@@ -320,9 +340,8 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
         bar.update()
 
     try:
-        if scheduler:
-            interrupted = run_dask(scheduler, scene.text, str(scene_file), cases, record,
-                                   timeout=connect_timeout)
+        if client is not None:
+            interrupted = run_dask(client, scene_text, str(scene_file), cases, record)
         elif (workers or os.cpu_count() or 1) > 1 and len(cases) > 1:
             interrupted = run_processes(scene_file, base, cases, record,
                                         workers=workers or os.cpu_count() or 1,
@@ -335,12 +354,7 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
         if case.index not in rows:
             record(case, failure(case.params, "interrupted", "stopped by Ctrl-C",
                                  INTERRUPTED_EXIT), None)
-    ordered = [rows[case.index] for case in cases]
-    check_sweep_ids(ordered, sweep_id)
-    report(ordered, keys, outdir, scene_file, base)
-    if interrupted:
-        raise SweepInterrupted(ordered, outdir)
-    return ordered
+    return [rows[case.index] for case in cases], interrupted
 
 
 def _make_cases(combos: list[dict[str, str]], outdir: Path, sweep_id: str) -> list[Case]:
@@ -484,10 +498,12 @@ def reference_notes(rows: list[dict], keys: list[str]) -> list[str]:
                                          "of summary.csv)" if len(finest) > 4 else "")
         lines.append(f"err vs finest: reference {shown} (the finest case"
                      f"{' of each group' if len(finest) > 1 else ''})")
+    status = {r.get("case"): r["status"] for r in rows}
     for name, row in refs.items():
         if not row.get("err_reference_is_finest", True):
-            lines.append(f"* err vs finest: reference {name}, NOT the finest case requested: "
-                         f"{row['err_finest_requested']} failed")
+            requested = row["err_finest_requested"]
+            lines.append(f"* err vs finest: reference {name}, NOT the finest case requested "
+                         f"({requested}: {status.get(requested, 'failed')})")
     return lines
 
 

@@ -163,6 +163,7 @@ def _worker_main(conn: Connection) -> None:
     None or its parent goes away. Ctrl-C is the parent's to handle (it stops the workers it
     needs to), so the worker ignores SIGINT."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _exit_on_sigterm)
     try:
         while True:
             try:
@@ -174,6 +175,12 @@ def _worker_main(conn: Connection) -> None:
             conn.send(run_case(*job))
     finally:
         conn.close()
+
+
+def _exit_on_sigterm(signum: int, frame: Any) -> None:
+    """SIGTERM (the parent stopping a busy worker) unwinds the case: its HDF5 file is closed
+    and the process's resources are released."""
+    raise SystemExit(128 + signum)
 
 
 class _Worker:
@@ -204,9 +211,14 @@ class _Worker:
             self.proc.join()
             return None
 
-    def stop(self, now: bool = False) -> None:
+    def stop(self, now: bool = False, grace: float = 5.0) -> None:
+        """End the worker: after its case (now=False) or at once (SIGTERM, then SIGKILL
+        after ``grace`` seconds)."""
         if now:
             self.proc.terminate()
+            self.proc.join(grace)
+            if self.proc.is_alive():
+                self.proc.kill()
         else:
             try:
                 self.conn.send(None)
@@ -319,38 +331,37 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
         return Client(address, timeout=timeout, set_as_default=False)
     except Exception as exc:  # OSError on timeout; ValueError, TypeError on a bad address
         detail = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
-        raise InputError(f"cannot reach the Dask scheduler at {address!r} within {timeout:g} s "
-                         f"({detail})") from None
+        raise InputError(f"cannot reach the Dask scheduler {address!r}: {detail}") from None
 
 
-def run_dask(address: str, scene_text: str, scene_label: str, cases: list[Case],
-             record: Recorder, *, timeout: float = CONNECT_TIMEOUT_S) -> bool:
-    """The cases as tasks of a Dask scheduler (see :func:`run_case_remote`). A task that
-    raises, or whose workers all died (KilledWorker), fails its case only. Returns True
-    when Ctrl-C stopped the sweep (the remaining tasks are cancelled)."""
+def run_dask(client: Any, scene_text: str, scene_label: str, cases: list[Case],
+             record: Recorder) -> bool:
+    """The cases as tasks of the Dask scheduler of ``client`` (see :func:`connect` and
+    :func:`run_case_remote`). A task that raises, or whose workers all died (KilledWorker),
+    fails its case only. Returns True when Ctrl-C stopped the sweep (the remaining tasks
+    are cancelled)."""
     from distributed import as_completed
-    client = connect(address, timeout)
-    with client:
-        futures = {client.submit(run_case_remote, scene_text, scene_label, case.params,
-                                 case.overrides, pure=False, key=f"ancf-case-{case.name}-"
-                                 f"{os.urandom(4).hex()}"): case for case in cases}
-        finished: set[int] = set()
-        try:
-            for future in as_completed(list(futures), loop=client.loop):
-                case = futures[future]
-                try:
-                    row, data = future.result()
-                except Exception as exc:
-                    row, data = failure(case.params, "failed", internal_error(exc), 1), None
-                record(case, row, data)
-                finished.add(case.index)
-        except KeyboardInterrupt:
-            rest = [f for f, c in futures.items() if c.index not in finished]
-            running = _processing_keys(client)
-            client.cancel(rest)
-            _stop_rows([futures[f] for f in rest if f.key in running],
-                       [futures[f] for f in rest if f.key not in running], record)
-            return True
+    tag = os.urandom(4).hex()  # task keys unique on a shared scheduler
+    futures = {client.submit(run_case_remote, scene_text, scene_label, case.params,
+                             case.overrides, pure=False, key=f"ancf-case-{case.name}-{tag}"):
+               case for case in cases}
+    finished: set[int] = set()
+    try:
+        for future in as_completed(list(futures), loop=client.loop):
+            case = futures[future]
+            try:
+                row, data = future.result()
+            except Exception as exc:
+                row, data = failure(case.params, "failed", internal_error(exc), 1), None
+            record(case, row, data)
+            finished.add(case.index)
+    except KeyboardInterrupt:
+        rest = [f for f, c in futures.items() if c.index not in finished]
+        running = _processing_keys(client)
+        client.cancel(rest)
+        _stop_rows([futures[f] for f in rest if f.key in running],
+                   [futures[f] for f in rest if f.key not in running], record)
+        return True
     return False
 
 
