@@ -129,11 +129,12 @@ def case_name(params: dict[str, str]) -> str:
 
 def case_names(combos: list[dict[str, str]]) -> list[str]:
     """:func:`case_name` of every case, with the hash appended also where two cases would
-    otherwise share a name (values equal after sanitizing, or differing only in case)."""
+    otherwise share a name (values equal after sanitizing, or differing only in letter
+    case, which some filesystems do not distinguish)."""
     names = [case_name(p) for p in combos]
     count = Counter(n.lower() for n in names)
-    return [f"{_plain_name(p)[0]}_{_digest(p)}" if count[n.lower()] > 1 and n == _plain_name(p)[0]
-            else n for n, p in zip(names, combos)]
+    return [f"{name}_{_digest(params)}" if count[name.lower()] > 1 and not _plain_name(params)[1]
+            else name for name, params in zip(names, combos)]
 
 
 def static_value(row: dict) -> float:

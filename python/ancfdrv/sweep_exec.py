@@ -6,9 +6,11 @@ Ctrl-C stops becomes a row with a status ('ok', 'failed', 'interrupted', 'cancel
 message and an exit code; the other cases go on.
 
 - :func:`run_inline`: one case after the other in this process (one worker).
-- :func:`run_processes`: one child process per case, at most ``workers`` at a time. A child
-  that dies (killed by a signal, or exiting without a result) is detected from its exit
-  status; its case is retried once in a fresh process, then marked failed naming the signal.
+- :func:`run_processes`: ``workers`` local worker processes, each running one case at a
+  time, so a worker that dies (killed by a signal, or exiting without a result) is
+  attributed to its case from its exit status; that case is retried once on a fresh
+  worker, then marked failed naming the signal. (A ProcessPoolExecutor cannot do this: one
+  dead worker breaks the pool and fails every pending case.)
 - :func:`run_dask`: the cases go to a Dask distributed scheduler. Nothing is shared but the
   network: each task carries the scene text and the case's overrides, runs in a private
   temporary directory on the worker and returns the row and the HDF5 file as bytes.
@@ -82,6 +84,9 @@ def run_case(scene_file: str, params: dict[str, str], overrides: list[str],
         return failure(params, "failed", str(exc), exc.exit_code)
     except Exception as exc:  # a bug or an environment problem: still only this case's
         return failure(params, "failed", internal_error(exc), 1)
+    if not Path(output).is_file():
+        return failure(params, "failed", f"the run reported success but wrote no result file "
+                       f"where the sweep asked for it ({output})", 1)
     try:
         return dict(params, **_result_fields(outcome, Path(output)))
     except Exception as exc:
@@ -148,8 +153,9 @@ def _stop_rows(running: list[Case], queued: list[Case], record: Recorder) -> Non
 
 def process_context(start_method: str | None = None) -> multiprocessing.context.BaseContext:
     """The multiprocessing context of the local workers: 'forkserver' where available (a
-    clean process with ancfdrv imported once, then forked per case, so no thread or lock
-    of this process is inherited), else 'spawn'; or the method asked for."""
+    clean process with ancfdrv imported once, then forked per worker, so no thread or lock
+    of this process is inherited), else 'spawn'; or the method asked for ('fork' lets the
+    workers inherit what this process changed, e.g. a test's fault injection)."""
     methods = multiprocessing.get_all_start_methods()
     method = start_method or ("forkserver" if "forkserver" in methods else "spawn")
     ctx = multiprocessing.get_context(method)
@@ -338,8 +344,9 @@ def run_dask(client: Any, scene_text: str, scene_label: str, cases: list[Case],
              record: Recorder) -> bool:
     """The cases as tasks of the Dask scheduler of ``client`` (see :func:`connect` and
     :func:`run_case_remote`). A task that raises, or whose workers all died (KilledWorker),
-    fails its case only. Returns True when Ctrl-C stopped the sweep (the remaining tasks
-    are cancelled)."""
+    fails its case only. Returns True when Ctrl-C stopped the sweep: the remaining tasks
+    are cancelled (Dask cannot stop a task a worker thread is already running; it finishes
+    there and its result is dropped)."""
     from distributed import as_completed
     tag = os.urandom(4).hex()  # task keys unique on a shared scheduler
     futures = {client.submit(run_case_remote, scene_text, scene_label, case.params,
