@@ -25,6 +25,7 @@ import multiprocessing
 import os
 import signal
 import tempfile
+import threading
 import traceback
 from collections import deque
 from dataclasses import dataclass
@@ -170,6 +171,10 @@ def _worker_main(conn: Connection) -> None:
     needs to), so the worker ignores SIGINT."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    # one case at a time: a thread lock for tqdm rather than its default multiprocessing
+    # semaphore, which a killed worker would leave to the resource tracker (a warning)
+    from tqdm import tqdm
+    tqdm.set_lock(threading.RLock())
     try:
         while True:
             try:
