@@ -289,7 +289,7 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
     ``workers``: local processes (default: all cores; 1 runs the cases in this process);
     ``scheduler``: the address of a Dask distributed scheduler instead (no shared
     filesystem needed); ``start_method``: multiprocessing start method of the local
-    workers (default forkserver); ``connect_timeout``: seconds to reach the scheduler."""
+    workers (default: the platform's); ``connect_timeout``: seconds to reach the scheduler."""
     base = base or []
     if workers is not None and workers < 1:
         raise InputError(f"--workers {workers}: needs at least 1")

@@ -153,22 +153,21 @@ def _stop_rows(running: list[Case], queued: list[Case], record: Recorder) -> Non
 # --- local child processes ---------------------------------------------------------
 
 def process_context(start_method: str | None = None) -> multiprocessing.context.BaseContext:
-    """The multiprocessing context of the local workers: 'forkserver' where available (a
-    clean process with ancfdrv imported once, then forked per worker, so no thread or lock
-    of this process is inherited), else 'spawn'; or the method asked for ('fork' lets the
-    workers inherit what this process changed, e.g. a test's fault injection)."""
-    methods = multiprocessing.get_all_start_methods()
-    method = start_method or ("forkserver" if "forkserver" in methods else "spawn")
-    ctx = multiprocessing.get_context(method)
-    if method == "forkserver":
+    """The multiprocessing context of the local workers: the platform's default start method
+    (as ProcessPoolExecutor uses: 'fork' on Linux up to Python 3.13, so a script without a
+    ``__main__`` guard still works), or the one asked for. Under 'forkserver' the server
+    imports ancfdrv once, so that each worker starts warm."""
+    ctx = multiprocessing.get_context(start_method)
+    if ctx.get_start_method() == "forkserver":
         ctx.set_forkserver_preload(["ancfdrv.sweep_exec", "ancfdrv.runner"])
     return ctx
 
 
-def _worker_main(conn: Connection) -> None:
+def _worker_main(conn: Connection, parent_end: Connection) -> None:
     """A local worker process: run the cases it is sent, one at a time, until it receives
     None or its parent goes away. Ctrl-C is the parent's to handle (it stops the workers it
     needs to), so the worker ignores SIGINT."""
+    parent_end.close()  # the copy a fork gave us: the parent's death must be EOF here
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _exit_on_sigterm)
     # one case at a time: a thread lock for tqdm rather than its default multiprocessing
@@ -199,8 +198,8 @@ class _Worker:
 
     def __init__(self, ctx: Any) -> None:
         self.conn, child = ctx.Pipe()
-        self.proc = ctx.Process(target=_worker_main, args=(child,), name="ancf-sweep-worker",
-                                daemon=True)
+        self.proc = ctx.Process(target=_worker_main, args=(child, self.conn),
+                                name="ancf-sweep-worker", daemon=True)
         self.proc.start()
         child.close()  # the worker holds the only other end: its death is EOF here
         self.case: Case | None = None
