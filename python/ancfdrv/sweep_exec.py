@@ -21,6 +21,7 @@ True so that the caller can still write the report of what finished.
 """
 from __future__ import annotations
 
+import logging
 import multiprocessing
 import os
 import signal
@@ -347,11 +348,12 @@ def connect(address: str, timeout: float = CONNECT_TIMEOUT_S) -> Any:
 def run_dask(client: Any, scene_text: str, scene_label: str, cases: list[Case],
              record: Recorder) -> bool:
     """The cases as tasks of the Dask scheduler of ``client`` (see :func:`connect` and
-    :func:`run_case_remote`). A task that raises, or whose workers all died (KilledWorker),
-    fails its case only. Returns True when Ctrl-C stopped the sweep: the remaining tasks
+    :func:`run_case_remote`; the client is closed on return). A task that raises, whose
+    workers all died (KilledWorker) or whose scheduler went away, fails its case only. Returns True when Ctrl-C stopped the sweep: the remaining tasks
     are cancelled (Dask cannot stop a task a worker thread is already running; it finishes
     there and its result is dropped)."""
     from distributed import as_completed
+    quiet = _Quiet("distributed.client")  # a lost scheduler: each case's row says it
     tag = os.urandom(4).hex()  # task keys unique on a shared scheduler
     futures = {client.submit(run_case_remote, scene_text, scene_label, case.params,
                              case.overrides, pure=False, key=f"ancf-case-{case.name}-{tag}"):
@@ -373,7 +375,22 @@ def run_dask(client: Any, scene_text: str, scene_label: str, cases: list[Case],
         _stop_rows([futures[f] for f in rest if f.key in running],
                    [futures[f] for f in rest if f.key not in running], record)
         return True
+    finally:
+        client.close()
+        quiet.restore()
     return False
+
+
+class _Quiet:
+    """Raise a logger's level to CRITICAL until restore()."""
+
+    def __init__(self, name: str) -> None:
+        self.logger = logging.getLogger(name)
+        self.level = self.logger.level
+        self.logger.setLevel(logging.CRITICAL)
+
+    def restore(self) -> None:
+        self.logger.setLevel(self.level)
 
 
 def _processing_keys(client: Any) -> set:
