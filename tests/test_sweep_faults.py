@@ -111,6 +111,23 @@ def test_killed_worker_is_retried_once(monkeypatch, tmp_path):
     assert read_sweep_id(rows[1]["file"]) == read_sweep_id(rows[0]["file"])
 
 
+def test_retry_that_fails_otherwise_says_both(monkeypatch, tmp_path):
+    marker = tmp_path / "killed-once"
+
+    def fault(overrides):
+        if "beam.nodes=7" in overrides:
+            if not marker.exists():
+                marker.touch()
+                os.kill(os.getpid(), signal.SIGKILL)
+            raise SolverError("injected on the retry")
+    inject(monkeypatch, fault)
+    rows = run_sweep(str(BOOM), NODES, tmp_path / "s", workers=2, start_method="fork",
+                     progress=False)
+    assert [(r["status"], r["exit_code"]) for r in rows] == [("ok", 0), ("failed", 3), ("ok", 0)]
+    assert rows[1]["message"] == ("injected on the retry (on the retry: its worker process was "
+                                  "killed by signal SIGKILL (9) before)")
+
+
 def test_worker_that_always_dies_fails_its_case(monkeypatch, tmp_path):
     attempts = tmp_path / "attempts"
 

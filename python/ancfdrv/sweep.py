@@ -277,8 +277,8 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
             row["err_vs_finest"] = abs(static_value(row) - ref) / max(abs(ref), 1e-300)
 
 
-def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: list[str] | None = None,
-              workers: int | None = None, scheduler: str | None = None,
+def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
+              base: list[str] | None = None, workers: int | None = None, scheduler: str | None = None,
               progress: bool | None = None, start_method: str | None = None,
               connect_timeout: float = CONNECT_TIMEOUT_S) -> list[dict]:
     """Run every combination and write the report into ``outdir``. Returns the rows, one per

@@ -284,8 +284,10 @@ def run_processes(scene_file: str, base: list[str], cases: list[Case], record: R
                         continue
                     row = failure(case.params, "failed", _death_message(causes), 1)
                 elif case.index in deaths:
-                    row["message"] = (f"its worker process was {deaths[case.index][-1]}; the "
-                                      "retry on a fresh worker succeeded")
+                    note = f"its worker process was {deaths[case.index][-1]}"
+                    row["message"] = (f"{note}; the retry on a fresh worker succeeded"
+                                      if row["status"] == "ok" else
+                                      f"{row['message']} (on the retry: {note} before)")
                 record(case, row, None)
     except KeyboardInterrupt:
         running = [w.case for w in pool if w.case is not None]
@@ -349,9 +351,10 @@ def run_dask(client: Any, scene_text: str, scene_label: str, cases: list[Case],
              record: Recorder) -> bool:
     """The cases as tasks of the Dask scheduler of ``client`` (see :func:`connect` and
     :func:`run_case_remote`; the client is closed on return). A task that raises, whose
-    workers all died (KilledWorker) or whose scheduler went away, fails its case only. Returns True when Ctrl-C stopped the sweep: the remaining tasks
-    are cancelled (Dask cannot stop a task a worker thread is already running; it finishes
-    there and its result is dropped)."""
+    workers all died (KilledWorker) or whose scheduler went away, fails its case only.
+    Returns True when Ctrl-C stopped the sweep: the remaining tasks are cancelled (Dask
+    cannot stop a task a worker thread is already running; it finishes there and its result
+    is dropped)."""
     from distributed import as_completed
     quiet = _Quiet("distributed.client")  # a lost scheduler: each case's row says it
     tag = os.urandom(4).hex()  # task keys unique on a shared scheduler
