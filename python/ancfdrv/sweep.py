@@ -278,8 +278,9 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
 
 
 def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
-              base: list[str] | None = None, workers: int | None = None, scheduler: str | None = None,
-              progress: bool | None = None, start_method: str | None = None,
+              base: list[str] | None = None, workers: int | None = None,
+              scheduler: str | None = None, progress: bool | None = None,
+              start_method: str | None = None,
               connect_timeout: float = CONNECT_TIMEOUT_S) -> list[dict]:
     """Run every combination and write the report into ``outdir``. Returns the rows, one per
     case in the order of the combinations, each with a 'status' ('ok' or 'failed'), a
