@@ -73,12 +73,18 @@ def stage_table(stages: dict[str, float]) -> str:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from .sweep import run_sweep, table_lines
+    from .sweep import SweepInterrupted, run_sweep, table_lines
     if args.workers is not None and args.scheduler:
         raise InputError("give --workers or --scheduler, not both")
     out = args.output or str(Path("results") / (Path(args.scene).stem + "_sweep"))
-    rows = run_sweep(args.scene, args.vary, out, base=args.set, workers=args.workers,
-                     scheduler=args.scheduler)
+    try:
+        rows = run_sweep(args.scene, args.vary, out, base=args.set, workers=args.workers,
+                         scheduler=args.scheduler)
+    except SweepInterrupted as stop:
+        done = sum(r["status"] in ("ok", "failed") for r in stop.rows)
+        print(f"ancf sweep: interrupted: {done} of {len(stop.rows)} cases finished, the others "
+              f"cancelled; report in {out}/summary.md", file=sys.stderr)
+        return 130
     keys = [v.split("=", 1)[0].strip().lower() for v in args.vary]
     print("\n".join(table_lines(rows, keys)))
     print(f"\nwritten {out}/summary.md, summary.csv, *.png and one .h5 per case")

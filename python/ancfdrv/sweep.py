@@ -3,16 +3,28 @@ on a Dask distributed scheduler), one HDF5 per case, and the accuracy-versus-tim
 ``summary.csv``, ``summary.md`` and plots.
 
 Error is taken against the finest case of the sweep with the same non-resolution
-parameters (most ``beam.nodes``, smallest ``solver.dt``); for boom scenes the error against
-the closed-form small-deflection solution (docs/boom_closed_form.md) is reported too.
+parameters (most ``beam.nodes``, smallest ``solver.dt``); the report names that reference
+and says when it is not the finest requested case (because that one failed). For boom
+scenes the error against the closed-form small-deflection solution
+(docs/boom_closed_form.md) is reported too.
+
+Robustness (how the cases run: :mod:`ancfdrv.sweep_exec`): a case that fails in any way -
+an ancfdrv error, any other exception, a worker process killed by a signal - is that case's
+row (status, message, exit code), and the sweep goes on; Ctrl-C writes the report of what
+finished and raises :class:`SweepInterrupted`. Case files are named from sanitized values
+and always land in the sweep directory, and every one carries the root attribute
+``sweep_id`` of the sweep that wrote it: the tables read only this sweep's files.
 """
 from __future__ import annotations
 
 import csv
+import hashlib
 import itertools
 import os
+import re
 import sys
-from concurrent.futures import ProcessPoolExecutor, as_completed
+import uuid
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -20,12 +32,27 @@ import h5py
 import numpy as np
 from tqdm import tqdm
 
-from .errors import AncfError, InputError
+from .errors import InputError
 from .io.scene import SCHEMA, load_scene
+from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
+                         remove_quietly, response_of, run_dask, run_inline, run_processes)
 
 #: Parameters that refine a model; the finest value is the reference of the others.
 RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min, "plate.nx": max, "plate.ny": max,
                    "leaf.nx": max, "leaf.ny": max}
+
+#: Case file names: these characters only, at most this long (before the hash suffix).
+_UNSAFE = re.compile(r"[^A-Za-z0-9._+-]")
+MAX_NAME_CHARS = 96
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a sweep; the report of what finished is written. ``rows`` are all
+    cases ('ok', 'failed', 'interrupted' or 'cancelled'), ``outdir`` the sweep directory."""
+
+    def __init__(self, rows: list[dict], outdir: Path) -> None:
+        super().__init__("sweep interrupted")
+        self.rows, self.outdir = rows, outdir
 
 
 def is_resolution(key: str) -> bool:
@@ -63,53 +90,51 @@ def parse_vary(items: list[str], scene_file: str) -> list[tuple[str, list[str]]]
         if not vals:
             raise InputError(f"--vary {dotted} has no values", file=scene_file, group=group,
                              key=key)
+        repeated = [v for v, n in Counter(_unquote(v) for v in vals).items() if n > 1]
+        if repeated:
+            raise InputError(f"--vary {dotted} gives the value {repeated[0]!r} more than once",
+                             file=scene_file, group=group, key=key)
         out.append((dotted, vals))
     return out
 
 
+def _short_key(key: str) -> str:
+    return "+".join(part.split(".", 1)[1] for part in key.split("+"))
+
+
+def _unquote(value: str) -> str:
+    return value.strip().strip("'\"").strip()
+
+
+def _digest(params: dict[str, str]) -> str:
+    text = "\n".join(f"{k}={v}" for k, v in params.items())
+    return hashlib.sha256(text.encode()).hexdigest()[:8]
+
+
+def _plain_name(params: dict[str, str]) -> tuple[str, bool]:
+    """The readable name ``key-value_key-value`` with unsafe characters replaced and the
+    length bounded, and whether that changed anything."""
+    raw = "_".join(f"{_short_key(k)}-{_unquote(v)}" for k, v in params.items())
+    safe = _UNSAFE.sub("_", raw)[:MAX_NAME_CHARS]
+    return safe, safe != raw
+
+
 def case_name(params: dict[str, str]) -> str:
-    def short(key: str) -> str:
-        return "+".join(part.split(".")[1] for part in key.split("+"))
-    return "_".join(f"{short(k)}-{v}" for k, v in params.items()).replace("'", "")
+    """File stem of a case: ``nodes-28_dt-0.001``; only ``[A-Za-z0-9._+-]``, at most
+    MAX_NAME_CHARS, and a short hash of the values appended when sanitizing changed them
+    (``title-.._.._escape_1f2e3d4c``). A single path component: never a directory."""
+    safe, changed = _plain_name(params)
+    return f"{safe}_{_digest(params)}" if changed else safe
 
 
-def run_case(scene_file: str, params: dict[str, str], base: list[str], output: str) -> dict:
-    """Run one case in a worker; never raises (failures become a row with a message)."""
-    from .runner import run_scene
-    row: dict[str, Any] = dict(params)
-    row["file"] = output
-    try:
-        outcome = run_scene(scene_file, base + expand(params), output)
-    except AncfError as exc:
-        row.update(status="failed", message=str(exc), exit_code=exc.exit_code)
-        return row
-    from .io.hdf5 import read_summary
-    summary = read_summary(Path(output))
-    row.update(status="ok", message="", exit_code=0, total_time_s=summary["timing.total"],
-               ndof=summary["model.ndof"])
-    static, dynamic = outcome.static, outcome.dynamic
-    if static is not None:
-        row.update(iterations=static.iterations, residual=static.residual_norm,
-                   solve_time_s=static.wall_time_s)
-        if "static.deflection.tip" in summary:
-            axial, transverse, lateral = summary["static.deflection.tip"]
-            row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral)
-        else:
-            probe, component = _response_of(summary)
-            row["response"] = float(summary[f"static.deflection.{probe}"][component])
-    if dynamic is not None:
-        row.update(dynamic=True, steps=dynamic.steps, newton_iterations=dynamic.newton_iterations,
-                   factorizations=dynamic.factorizations, dynamic_time_s=dynamic.wall_time_s,
-                   **{f"stage_{k}": v for k, v in outcome.stages.items()})
-    return row
-
-
-def _response_of(attrs) -> tuple[str, int]:
-    """The probe and component a sweep compares: the beam's tip sag (tip, transverse), or
-    what the model names in the result file's 'response_probe' attributes."""
-    probe = attrs.get("response_probe", "tip")
-    return (probe.decode() if isinstance(probe, bytes) else str(probe),
-            int(attrs.get("response_component", 1)))
+def case_names(combos: list[dict[str, str]]) -> list[str]:
+    """:func:`case_name` of every case, with the hash appended also where two cases would
+    otherwise share a name (values equal after sanitizing, or differing only in letter
+    case, which some filesystems do not distinguish)."""
+    names = [case_name(p) for p in combos]
+    count = Counter(n.lower() for n in names)
+    return [f"{name}_{_digest(params)}" if count[name.lower()] > 1 and not _plain_name(params)[1]
+            else name for name, params in zip(names, combos)]
 
 
 def static_value(row: dict) -> float:
@@ -120,7 +145,7 @@ def static_value(row: dict) -> float:
 def _tip_history(path: str) -> tuple[np.ndarray, np.ndarray]:
     """Time and the compared history (the tip sag for beams)."""
     with h5py.File(path, "r") as h5:
-        probe, component = _response_of(h5.attrs)
+        probe, component = response_of(h5.attrs)
         return h5["dynamic/time"][()], h5[f"dynamic/deflection/{probe}"][:, component]
 
 
@@ -189,18 +214,30 @@ def _navier_error(scene, row: dict) -> float | None:
 
 
 def _reference_groups(rows: list[dict], varied: list[str]):
-    """(members, finest) per group of successful rows equal in the non-resolution keys."""
+    """(successful members, reference) per group of rows equal in the non-resolution keys.
+    The reference is the finest successful case of the group; each member records its name
+    in 'err_reference', and 'err_reference_is_finest' says whether it is the finest case
+    requested (False when that one failed: 'err_finest_requested' names it)."""
     resolution = [k for k in varied if is_resolution(k)]
     others = [k for k in varied if not is_resolution(k)]
     groups: dict[tuple, list[dict]] = {}
     for row in rows:
-        if row["status"] == "ok":
-            groups.setdefault(tuple(row[k] for k in others), []).append(row)
+        groups.setdefault(tuple(row[k] for k in others), []).append(row)
+
+    def rank(row: dict) -> tuple:
+        return tuple((-1 if resolution_sense(k) is max else 1) * float(row[k])
+                     for k in resolution)
     for members in groups.values():
-        def rank(row: dict) -> tuple:
-            return tuple((-1 if resolution_sense(k) is max else 1) * float(row[k])
-                         for k in resolution)
-        yield members, min(members, key=rank)
+        ok = [r for r in members if r["status"] == "ok"]
+        if not ok:
+            continue
+        requested, reference = min(members, key=rank), min(ok, key=rank)
+        for row in ok:
+            row["err_reference"] = reference["case"]
+            row["err_reference_is_finest"] = reference is requested
+            if reference is not requested:
+                row["err_finest_requested"] = requested["case"]
+        yield ok, reference
 
 
 def add_formulation_difference(rows: list[dict], varied: list[str]) -> None:
@@ -240,46 +277,153 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
             row["err_vs_finest"] = abs(static_value(row) - ref) / max(abs(ref), 1e-300)
 
 
-def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: list[str] | None = None,
-              workers: int | None = None, scheduler: str | None = None,
-              progress: bool | None = None) -> list[dict]:
-    """Run every combination and write the report into ``outdir``. Returns the rows."""
+def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
+              base: list[str] | None = None, workers: int | None = None,
+              scheduler: str | None = None, progress: bool | None = None,
+              start_method: str | None = None,
+              connect_timeout: float = CONNECT_TIMEOUT_S) -> list[dict]:
+    """Run every combination and write the report into ``outdir``. Returns the rows, one per
+    case in the order of the combinations, each with a 'status' ('ok' or 'failed'), a
+    'message' and an 'exit_code'. Bad input raises InputError before any case runs. Ctrl-C
+    writes the report of what finished and raises :class:`SweepInterrupted`.
+
+    ``workers``: local processes (default: all cores; 1 runs the cases in this process);
+    ``scheduler``: the address of a Dask distributed scheduler instead (no shared
+    filesystem needed); ``start_method``: multiprocessing start method of the local
+    workers (default: the platform's); ``connect_timeout``: seconds to reach the scheduler."""
     base = base or []
-    load_scene(scene_file, base)  # fail early on a bad scene or override
+    if workers is not None and workers < 1:
+        raise InputError(f"--workers {workers}: needs at least 1")
+    scene = load_scene(scene_file, base)  # fail early on a bad scene or override
     grid = parse_vary(vary, scene_file)
     keys = [k for k, _ in grid]
     combos = [dict(zip(keys, values)) for values in itertools.product(*[v for _, v in grid])]
     for params in combos:  # validate every case before spending time on any
         load_scene(scene_file, base + expand(params))
     outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    jobs = [(scene_file, p, base, str(outdir / f"{case_name(p)}.h5")) for p in combos]
+    sweep_id = uuid.uuid4().hex
+    cases = _make_cases(combos, outdir, sweep_id)
+    client = connect(scheduler, connect_timeout) if scheduler else None  # before any output
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+        rows, interrupted = _run_cases(scene_file, base, cases, sweep_id, client=client,
+                                       workers=workers, start_method=start_method,
+                                       progress=progress, scene_text=scene.text)
+    finally:
+        if client is not None:
+            client.close()
+    check_sweep_ids(rows, sweep_id)
+    report(rows, keys, outdir, scene_file, base)
+    if interrupted:
+        raise SweepInterrupted(rows, outdir)
+    return rows
+
+
+def _run_cases(scene_file: str, base: list[str], cases: list[Case], sweep_id: str, *,
+               client: Any, workers: int | None, start_method: str | None,
+               progress: bool | None, scene_text: str) -> tuple[list[dict], bool]:
+    """Every case's row (in the order of ``cases``), and whether Ctrl-C stopped the sweep.
+    Each file is moved to its final name with this sweep's id as it arrives."""
+    rows: dict[int, dict] = {}
     show = sys.stderr.isatty() if progress is None else progress
-    rows: list[dict] = []
-    bar = tqdm(total=len(jobs), desc="sweep", unit="case", disable=not show)
-    if scheduler:
-        try:
-            from dask.distributed import Client, as_completed as dask_completed
-        except ImportError:
-            raise InputError("--scheduler needs dask[distributed]: pip install 'dask[distributed]'")
-        with Client(scheduler) as client:
-            futures = [client.submit(run_case, *job, pure=False) for job in jobs]
-            for future in dask_completed(futures):
-                rows.append(future.result())
-                bar.update()
-    elif (workers or os.cpu_count() or 1) > 1 and len(jobs) > 1:
-        with ProcessPoolExecutor(max_workers=workers or os.cpu_count()) as pool:
-            futures = [pool.submit(run_case, *job) for job in jobs]
-            for future in as_completed(futures):
-                rows.append(future.result())
-                bar.update()
-    else:
-        for job in jobs:
-            rows.append(run_case(*job))
-            bar.update()
-    bar.close()
-    order = {case_name(p): i for i, p in enumerate(combos)}
-    rows.sort(key=lambda r: order[case_name({k: r[k] for k in keys})])
+    bar = tqdm(total=len(cases), desc="sweep", unit="case", disable=not show)
+    client_scene = str(Path(scene_file).resolve())
+
+    def record(case: Case, row: dict, data: bytes | None) -> None:
+        if case.index in rows:
+            return
+        row["case"] = case.name
+        row["file"] = store_case_file(case, sweep_id, data,
+                                      scene_file=client_scene if data is not None else None)
+        if row["status"] == "ok" and not row["file"]:
+            row.update(status="failed", exit_code=1, message="the case reported success but "
+                       "its result file is missing or unreadable")
+        rows[case.index] = row
+        bar.update()
+
+    try:
+        if client is not None:
+            interrupted = run_dask(client, scene_text, str(scene_file), cases, record)
+        elif (workers or os.cpu_count() or 1) > 1 and len(cases) > 1:
+            interrupted = run_processes(scene_file, base, cases, record,
+                                        workers=workers or os.cpu_count() or 1,
+                                        start_method=start_method)
+        else:
+            interrupted = run_inline(scene_file, base, cases, record)
+    finally:
+        bar.close()
+    for case in cases:  # a case Ctrl-C caught between two steps
+        if case.index not in rows:
+            record(case, failure(case.params, "interrupted", "stopped by Ctrl-C",
+                                 INTERRUPTED_EXIT), None)
+    return [rows[case.index] for case in cases], interrupted
+
+
+def _make_cases(combos: list[dict[str, str]], outdir: Path, sweep_id: str) -> list[Case]:
+    """The cases with their file names; every file is a direct child of ``outdir``."""
+    names = case_names(combos)
+    if len({n.lower() for n in names}) != len(names):
+        raise InputError("two cases of the sweep would share a result file name: "
+                         f"{', '.join(sorted(n for n in names if names.count(n) > 1))}")
+    cases = []
+    for index, (params, name) in enumerate(zip(combos, names)):
+        output = outdir / f"{name}.h5"
+        if output.resolve().parent != outdir.resolve():  # cannot happen: no separator
+            raise InputError(f"case file {output} would leave the sweep directory {outdir}")
+        cases.append(Case(index, name, params, expand(params), output,
+                          outdir / f".{name}.{sweep_id[:12]}.part.h5"))
+    return cases
+
+
+def store_case_file(case: Case, sweep_id: str, data: bytes | None = None, *,
+                    scene_file: str | None = None) -> str:
+    """Move a case's file from its part path to its final name in the sweep directory
+    (writing ``data`` there first when the case ran remotely), with the root attribute
+    ``sweep_id`` (and 'scene_file', the client's scene, for a remote case). Returns the
+    final path, or '' when the case left no readable file."""
+    if data is not None:
+        case.part.write_bytes(data)
+    if not case.part.is_file():
+        return ""
+    try:
+        with h5py.File(case.part, "a") as h5:
+            h5.attrs["sweep_id"] = sweep_id
+            if scene_file:
+                h5.attrs["scene_file"] = scene_file
+    except OSError:  # a file its killed process left half-written
+        remove_quietly(case.part)
+        return ""
+    os.replace(case.part, case.output)
+    return str(case.output)
+
+
+def read_sweep_id(path: str | Path) -> str | None:
+    """The 'sweep_id' root attribute of a result file (None when absent or unreadable)."""
+    try:
+        with h5py.File(path, "r") as h5:
+            value = h5.attrs.get("sweep_id")
+    except OSError:
+        return None
+    return value.decode() if isinstance(value, bytes) else (None if value is None else str(value))
+
+
+def check_sweep_ids(rows: list[dict], sweep_id: str) -> None:
+    """Fail every 'ok' row whose file does not carry this sweep's id: the tables never
+    read a file another run left under the same name."""
+    for row in rows:
+        if row["status"] != "ok":
+            continue
+        found = read_sweep_id(row["file"]) if row.get("file") else None
+        if found != sweep_id:
+            what = f"sweep_id {found}" if found else "no sweep_id"
+            row.update(status="failed", exit_code=1, message=(
+                f"{row.get('file') or 'the result file'} has {what}, not this sweep's "
+                f"{sweep_id}: a file of another run, not used"))
+
+
+def report(rows: list[dict], keys: list[str], outdir: Path, scene_file: str,
+           base: list[str]) -> None:
+    """Errors, closed-form comparisons, summary.csv, summary.md and the plots."""
     add_errors(rows, keys)
     add_formulation_difference(rows, keys)
     for row in rows:
@@ -288,9 +432,13 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *, base: lis
             if err is not None:
                 row["err_vs_closed_form"] = err
     write_report(rows, keys, outdir)
+    if not any(r["status"] == "ok" for r in rows):
+        return
     from .plots import plot_sweep
-    plot_sweep(rows, keys, outdir)
-    return rows
+    try:
+        plot_sweep(rows, keys, outdir)
+    except Exception as exc:  # the tables are written; a plot bug must not lose them
+        print(f"warning: sweep plots not written: {type(exc).__name__}: {exc}", file=sys.stderr)
 
 
 COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
@@ -313,7 +461,9 @@ COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
 
 
 def table_lines(rows: list[dict], keys: list[str]) -> list[str]:
-    """The Markdown table of a sweep (what `make demo` prints)."""
+    """The Markdown table of a sweep (what `make demo` prints), followed by the note naming
+    the reference of 'err vs finest'. An error against a reference that is not the finest
+    case requested (it failed) is marked '*'."""
     cols = [c for c in COLUMNS if any(c[0] in r for r in rows)]
     header = keys + [c[1] for c in cols]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
@@ -325,7 +475,37 @@ def table_lines(rows: list[dict], keys: list[str]) -> list[str]:
                 cells.append("-")
             else:
                 cells.append(fmt.format(value * scale if scale not in (None, 1) else value))
+                if key == "err_vs_finest" and not row.get("err_reference_is_finest", True):
+                    cells[-1] += " *"
         lines.append("| " + " | ".join(cells) + " |")
+    notes = reference_notes(rows, keys)
+    return lines + ([""] + notes if notes else [])
+
+
+def reference_notes(rows: list[dict], keys: list[str]) -> list[str]:
+    """Which case each 'err vs finest' is taken against, and where that is not the finest
+    case requested because the finest failed: never silently."""
+    if not any(is_resolution(k) for k in keys):
+        return []
+    refs: dict[str, dict] = {}
+    for row in rows:
+        if "err_vs_finest" in row:
+            refs.setdefault(row["err_reference"], row)
+    if not refs:
+        return []
+    finest = [name for name, row in refs.items() if row.get("err_reference_is_finest", True)]
+    lines = []
+    if finest:
+        shown = ", ".join(finest[:4]) + (f" and {len(finest) - 4} more (column err_reference "
+                                         "of summary.csv)" if len(finest) > 4 else "")
+        lines.append(f"err vs finest: reference {shown} (the finest case"
+                     f"{' of each group' if len(finest) > 1 else ''})")
+    status = {r.get("case"): r["status"] for r in rows}
+    for name, row in refs.items():
+        if not row.get("err_reference_is_finest", True):
+            requested = row["err_finest_requested"]
+            lines.append(f"* err vs finest: reference {name}, NOT the finest case requested "
+                         f"({requested}: {status.get(requested, 'failed')})")
     return lines
 
 
@@ -336,16 +516,23 @@ def write_report(rows: list[dict], keys: list[str], outdir: Path) -> None:
         writer.writeheader()
         for row in rows:
             writer.writerow(row)
-    failed = [r for r in rows if r["status"] != "ok"]
+    counts = Counter(r["status"] for r in rows)
     dynamic = any(r.get("dynamic") for r in rows)
     what = ("max |sag(t) - sag_ref(t)| / max |sag_ref| over the history; the phase error is "
             "accumulated over the vibration stage" if dynamic else
             "the relative difference of the tip sag")
-    lines = ["# Sweep summary", "", f"{len(rows)} cases, {len(failed)} failed. Error against "
+    status = ", ".join(f"{n} {s}" for s, n in counts.items() if s != "ok")
+    lines = ["# Sweep summary", "", f"{len(rows)} cases, {counts['ok']} ok"
+             f"{', ' + status if status else ''}. Error against "
              f"the finest case: {what} (beams: tip sag = transverse tip deflection in the rigid "
              "frame; plates and leaves: the r3 displacement of the corner, centre or end probe). "
              "Times are wall-clock seconds of this machine.", ""]
     lines += table_lines(rows, keys)
-    for row in failed:
-        lines += ["", f"- {case_name({k: row[k] for k in keys})}: {row['message']}"]
+    noted = [r for r in rows if r.get("message")]
+    if noted:
+        lines.append("")
+    for row in noted:
+        lines.append(f"- {row['case']} ({row['status']}"
+                     f"{', exit ' + str(row['exit_code']) if row['status'] != 'ok' else ''}): "
+                     f"{row['message']}")
     (outdir / "summary.md").write_text("\n".join(lines) + "\n")
