@@ -241,7 +241,8 @@ def test_interrupted_static_solve_is_marked(scene, tmp_path, monkeypatch, capsys
     out = tmp_path / "static.h5"
     assert main(["run", str(scene), "-o", str(out), *TINY]) == 130
     err = capsys.readouterr().err
-    assert err.strip() == f"ancf run: interrupted by SIGINT in {out} (status 'interrupted')"
+    assert err.strip() == (f"ancf run: interrupted by SIGINT before any result; {out} holds "
+                           "the model only (status 'interrupted')")
     with h5py.File(out, "r") as h5:
         assert h5.attrs["status"] == "interrupted" and "static" not in h5
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored

@@ -93,7 +93,7 @@ def _writable_parent(out: Path) -> None:
     """The output's directory exists and is writable, or can be created."""
     parent = out.parent if str(out.parent) else Path(".")
     existing = parent
-    while not existing.exists():
+    while not existing.exists() and existing.parent != existing:
         if existing.is_symlink():
             raise InputError(f"cannot create the output directory: {existing} is a broken "
                              "symbolic link", file=str(out))
@@ -231,42 +231,40 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
         raise InputError(f"cannot create the output directory {out.parent}: {exc.strerror}",
                          file=str(out)) from None
     with OutputLock(out), StopRequest() as stop:
-        try:
-            outcome = _run_locked(scene, out, start, progress, stop)
-        except Interrupted as exc:
-            raise Interrupted(_interrupt_message(out, exc, stop), signum=stop.signum
-                              or exc.signum) from None
+        outcome = _run_locked(scene, out, start, progress, stop)
     if stop.signum is not None:  # after the last step: the file is complete, the process stops
         raise Interrupted(f"interrupted by {signal_name(stop.signum)} after the run completed; "
                           f"{out} is complete (status 'ok')", signum=stop.signum)
     return outcome
 
 
-def _interrupt_message(out: Path, exc: Interrupted, stop: StopRequest) -> str:
-    what = f"interrupted by {signal_name(stop.signum or exc.signum)}"
-    if not out.exists():
-        return f"{what} before the output was written"
+def _interrupt_message(out: Path, signum: int | None) -> str:
+    """What an interrupted run left in its output file, in one line."""
+    what = f"interrupted by {signal_name(signum)}"
     try:
         summary = results.read_summary(out)
     except AncfError:
         return f"{what}; see {out}"
-    if summary.get("status") != "interrupted":
-        return f"{what} before the output was written; {out} was not touched"
-    kept = ""
     if "dynamic.t_reached" in summary:
         kept = (f" at t = {summary['dynamic.t_reached']:.6g} s; "
-                f"{summary.get('dynamic.steps', 0)} steps kept")
+                f"{summary.get('dynamic.steps', 0)} steps kept in {out}")
     elif "static.iterations" in summary:
-        kept = "; the static solution is kept"
-    return f"{what}{kept} in {out} (status 'interrupted')"
+        kept = f" after the static solve; its solution is kept in {out}"
+    else:
+        kept = f" before any result; {out} holds the model only"
+    return f"{what}{kept} (status 'interrupted')"
 
 
 def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
                 stop: StopRequest) -> RunOutcome:
     analysis = scene["scene"]["analysis"]
     t0 = time.perf_counter()
-    with stop.immediate():  # nothing is written yet: a signal ends the run at once
-        model = build_model(scene)
+    try:
+        with stop.immediate():  # nothing is written yet: a signal ends the run at once
+            model = build_model(scene)
+    except Interrupted as exc:
+        raise Interrupted(f"interrupted by {signal_name(exc.signum)} before the output was "
+                          f"written; {out} was not touched", signum=exc.signum) from None
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
     results.create(out, scene, model)
     static = dynamic = None
@@ -289,12 +287,14 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
             results.write_static(out, model, static)
             timing["output"] = time.perf_counter() - t0
             e_start = static.e
-            stop.check()
+            if analysis == "static+dynamic":
+                stop.check()
         if analysis in ("dynamic", "static+dynamic"):
             dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop)
     except Interrupted as exc:
-        finish("interrupted", f"interrupted by {signal_name(stop.signum or exc.signum)}")
-        raise
+        signum = stop.signum or exc.signum
+        finish("interrupted", f"interrupted by {signal_name(signum)}")
+        raise Interrupted(_interrupt_message(out, signum), signum=signum) from None
     except KeyboardInterrupt:  # no handler installed (not the main thread)
         finish("interrupted", "interrupted (KeyboardInterrupt)")
         raise
