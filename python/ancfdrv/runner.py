@@ -266,14 +266,18 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
         raise Interrupted(f"interrupted by {signal_name(exc.signum)} before the output was "
                           f"written; {out} was not touched", signum=exc.signum) from None
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
-    results.create(out, scene, model)
     static = dynamic = None
     stages: dict[str, float] = {}
 
-    def finish(status: str, message: str = "") -> None:
+    def finish(status: str, message: str = "", *, after_error: bool = True) -> None:
         timing["total"] = time.perf_counter() - start
-        results.finish(out, model, timing, status, message)
+        try:
+            results.finish(out, model, timing, status, message)
+        except OSError:
+            if not after_error:
+                raise  # after an error, the error being raised matters more
     try:
+        results.create(out, scene, model)
         e_start = model.e0
         if analysis in ("static", "static+dynamic"):
             solver = scene["solver"]
@@ -304,5 +308,5 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
     except BaseException as exc:  # a bug: the file must not claim to be running
         finish("failed", f"internal error: {type(exc).__name__}: {exc}")
         raise
-    finish("ok")
+    finish("ok", after_error=False)
     return RunOutcome(scene, out, static, dynamic, model.warnings, stages)
