@@ -410,9 +410,13 @@ class DynamicWriter:
             return
         with _open_write(self.path) as h5:
             group = h5["dynamic"]
+            first = self.rows
             for chunk in self._pending:
                 self._append(group, chunk)
             group.attrs["rows"] = np.int64(self.rows)
+            if self.nnodes:  # the per-step views the XDMF description names
+                from .xdmf import add_step_views
+                add_step_views(h5, first, self.rows)
         self._pending, self._pending_rows = [], 0
         self._last_write = time.monotonic()
 
