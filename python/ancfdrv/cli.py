@@ -214,7 +214,16 @@ def _internal_error(command: str, exc: BaseException, debug: bool) -> int:
     return 1
 
 
+_COMMAND_PID = os.getpid()
+
+
 def _terminate(signum: int, frame: object) -> None:
+    """SIGTERM outside a run: end the command with one line (exit 143). A process forked
+    from the command (a sweep's worker) inherits this handler: it dies as by default."""
+    if os.getpid() != _COMMAND_PID:
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+        return
     raise Interrupted("terminated by SIGTERM", signum=signum)
 
 
@@ -223,8 +232,10 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     command = args.command
     # SIGTERM outside a run (which handles it itself) ends the command without a trace
+    global _COMMAND_PID
     previous = None
     if threading.current_thread() is threading.main_thread():
+        _COMMAND_PID = os.getpid()
         previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         return args.func(args)
