@@ -146,6 +146,22 @@ def test_output_in_a_read_only_directory(scene, tmp_path, capsys):
         locked.chmod(0o755)
 
 
+def test_read_only_directory_message(scene, tmp_path, monkeypatch, capsys):
+    """The rule above as an unprivileged user sees it, also where the tests run as root:
+    os.access answers as it would for a directory without write permission."""
+    locked = tmp_path / "ro"
+    locked.mkdir()
+    real = os.access
+    monkeypatch.setattr(runner.os, "access", lambda path, mode, *a, **k:
+                        False if Path(path) == locked and mode & os.W_OK else
+                        real(path, mode, *a, **k))
+    refused(capsys, ["run", str(scene), "-o", str(locked / "x.h5"), *TINY],
+            f"the output directory {locked} is not writable")
+    refused(capsys, ["run", str(scene), "-o", str(locked / "new" / "x.h5"), *TINY],
+            f"the output parent directory {locked} is not writable")
+    assert list(locked.iterdir()) == []
+
+
 def test_existing_file_that_is_not_hdf5_is_not_overwritten(scene, tmp_path, capsys):
     other = tmp_path / "other.nml"
     other.write_text("&scene /\n")
@@ -173,6 +189,9 @@ def test_second_writer_is_refused_naming_the_first(scene, tmp_path, capsys):
     err = refused(capsys, ["run", str(scene), "-o", str(out), *TINY],
                   f"is being written by another run (pid {first.pid} on host")
     assert "since 20" in err
+    assert main(["info", str(out)]) == 0
+    assert capsys.readouterr().out.startswith(
+        f"{out}: running: being written by pid {first.pid} on host")
     _, err1 = first.communicate(timeout=HANG_GUARD_S)
     assert first.returncode == 0, err1
     with h5py.File(out, "r") as h5:  # the first run's scene and data, complete
