@@ -1,22 +1,48 @@
 """The ``ancf`` command (SPEC section 2).
 
+    ancf [--debug] [--version] COMMAND ...
     ancf run SCENE.nml [-o OUT.h5] [--set GROUP.KEY=VALUE ...]
     ancf sweep SCENE.nml --vary GROUP.KEY=V1,V2,... [--vary ...] [-o DIR] [--workers N | --scheduler ADDR]
     ancf info OUT.h5
     ancf plot OUT.h5 [OUT2.h5 ...] [-o PNG]   (several files: leaf spring runs overlaid)
 
-Exit status: 0 success, 2 bad input, 3 solver failure (the output file already holds
-what was computed, with the failure message in its ``message`` attribute).
+Exit status:
+    0    success
+    1    internal error (a bug): one line on stderr, the full trace in a file it names;
+         ``--debug`` prints the trace instead
+    2    bad input: scene, override, output path refused or in use by another run, not a
+         result file (the message names file, group and key)
+    3    solver failure (the output file already holds what was computed, with the
+         failure message in its ``message`` attribute)
+    130  interrupted by SIGINT (Ctrl-C), 143 by SIGTERM: the run stopped at a step
+         boundary, the output file holds every step computed and says 'interrupted'
+    141  the pipe the output went to was closed (``ancf info OUT.h5 | head -1``)
 """
 from __future__ import annotations
 
 import argparse
+import datetime as _dt
+import os
+import signal
 import sys
+import tempfile
+import threading
+import traceback
 from pathlib import Path
 
 import numpy as np
 
-from .errors import AncfError, InputError
+from . import __version__
+from .errors import AncfError, InputError, Interrupted
+
+EXIT_CODES = """exit status:
+  0    success
+  1    internal error (a bug): one line, the full trace in a file it names (--debug prints it)
+  2    bad input (scene, override, output path refused or in use, not a result file)
+  3    solver failure (the output file holds what was computed, status 'failed')
+  130  interrupted by SIGINT (Ctrl-C), 143 by SIGTERM (the output file holds every step
+       computed, status 'interrupted')
+  141  the pipe our output went to was closed (e.g. ancf info F | head -1)"""
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -96,15 +122,14 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    from .io.hdf5 import read_summary
+    """The verdict on the first line (ok, failed, interrupted, running, abandoned), then
+    the main figures."""
+    from .io.hdf5 import read_summary, verdict
     path = Path(args.file)
-    if not path.is_file():
-        raise InputError("result file not found", file=str(path))
-    try:
-        summary = read_summary(path)
-    except OSError as exc:
-        raise InputError(f"not a readable HDF5 result file ({exc})", file=str(path)) from None
-    skip = {"scene"}
+    summary = read_summary(path)  # InputError (exit 2) when missing, not HDF5, not ours
+    word, detail = verdict(path, summary)
+    print(f"{path}: {word}: {detail}")
+    skip = {"scene", "status", "message"}
     for key, value in summary.items():
         if key in skip or (isinstance(value, str) and not value):
             continue
@@ -133,11 +158,18 @@ def _cmd_plot(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="ancf", description="ANCF flexible multibody "
-                                     "simulations from Fortran namelist scenes")
+                                     "simulations from Fortran namelist scenes",
+                                     epilog=EXIT_CODES,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"ancf (ancfdrv) {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="print the full trace of an internal error (exit status 1)")
     sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("run", help="run one scene")
+    p = sub.add_parser("run", help="run one scene", epilog=EXIT_CODES,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scene")
-    p.add_argument("-o", "--output", help="HDF5 result file (default from &output)")
+    p.add_argument("-o", "--output", help="HDF5 result file (default from &output); never "
+                   "an input file; refused while another run writes it")
     p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE",
                    help="override a namelist value (repeatable)")
     p.set_defaults(func=_cmd_run)
@@ -149,7 +181,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, help="parallel processes (default: all cores)")
     p.add_argument("--scheduler", help="address of a Dask distributed scheduler")
     p.set_defaults(func=_cmd_sweep)
-    p = sub.add_parser("info", help="summarize a result file")
+    p = sub.add_parser("info", help="summarize a result file; the first line says whether "
+                       "the run finished (ok), failed, was interrupted, is running or was "
+                       "abandoned (its writer was killed)")
     p.add_argument("file")
     p.set_defaults(func=_cmd_info)
     p = sub.add_parser("plot", help="plot a result file (several: leaf spring runs overlaid)")
@@ -161,16 +195,76 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _trace_file(command: str) -> Path:
+    """Write the current exception's trace to a new file in the temporary directory."""
+    stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    fd, name = tempfile.mkstemp(prefix=f"ancf-{command}-{stamp}-", suffix=".trace.txt")
+    with os.fdopen(fd, "w") as f:
+        f.write(f"ancfdrv {__version__}, python {sys.version.split()[0]}\n")
+        f.write(f"command: {' '.join(sys.argv)}\n\n")
+        f.write(traceback.format_exc())
+    return Path(name)
+
+
+def _internal_error(command: str, exc: BaseException, debug: bool) -> int:
+    if debug:
+        traceback.print_exc()
+        return 1
+    summary = f"{type(exc).__name__}: {exc}".splitlines()[0] if str(exc) else type(exc).__name__
+    try:
+        where = f"full trace in {_trace_file(command)}"
+    except OSError:
+        where = "the trace could not be written"
+    print(f"ancf {command}: internal error: {summary} ({where}; run with --debug to see it)",
+          file=sys.stderr)
+    return 1
+
+
+_COMMAND_PID = os.getpid()
+
+
+def _terminate(signum: int, frame: object) -> None:
+    """SIGTERM outside a run: end the command with one line (exit 143). A process forked
+    from the command (a sweep's worker) inherits this handler: it dies as by default."""
+    if os.getpid() != _COMMAND_PID:
+        signal.signal(signum, signal.SIG_DFL)
+        os.kill(os.getpid(), signum)
+        return
+    raise Interrupted("terminated by SIGTERM", signum=signum)
+
+
 def main(argv: list[str] | None = None) -> int:
+    """The ``ancf`` command; returns the exit status (see the module docstring)."""
     args = build_parser().parse_args(argv)
+    command = args.command
+    # SIGTERM outside a run (which handles it itself) ends the command without a trace
+    global _COMMAND_PID
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        _COMMAND_PID = os.getpid()
+        previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         return args.func(args)
+    except Interrupted as exc:
+        print(f"ancf {command}: {exc}", file=sys.stderr)
+        return exc.exit_code
     except AncfError as exc:
-        print(f"ancf {args.command}: error: {exc}", file=sys.stderr)
+        print(f"ancf {command}: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt:
-        print(f"ancf {args.command}: interrupted", file=sys.stderr)
+        print(f"ancf {command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of our output went away (ancf info F | head -1)
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except OSError:
+            pass
+        return 128 + signal.SIGPIPE
+    except Exception as exc:  # noqa: BLE001 - a bug: one line, the trace in a file
+        return _internal_error(command, exc, args.debug)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

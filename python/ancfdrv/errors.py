@@ -32,3 +32,21 @@ class SolverError(AncfError):
     """A solver failed: Newton did not converge, a matrix was singular, a kernel refused."""
 
     exit_code = 3
+
+
+class Interrupted(AncfError):
+    """The run was stopped on request (SIGINT or SIGTERM) at a step boundary; the output
+    file holds every step computed until then and says status = 'interrupted'.
+
+    The exit status is 128 + the signal number (130 for SIGINT, 143 for SIGTERM), the
+    shell's convention for a process ended by a signal.
+    """
+
+    def __init__(self, message: str = "interrupted", *, signum: int | None = None) -> None:
+        self.signum = signum
+        super().__init__(message)
+
+    @property
+    def exit_code(self) -> int:  # type: ignore[override]
+        import signal
+        return 128 + (self.signum or signal.SIGINT)

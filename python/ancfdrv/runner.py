@@ -3,25 +3,43 @@
 This is the path every command takes; read it top to bottom to follow a run:
 ``static`` solves the equilibrium; ``dynamic`` integrates from the rigid configuration at
 rest; ``static+dynamic`` integrates from the static equilibrium (SPEC section 5).
+
+A run never loses or mislabels data:
+
+* the output path is checked before anything is computed (:func:`check_output_path`:
+  not a directory, not below a regular file, writable, never an input file);
+* the run holds an exclusive lock on the output (:class:`~ancfdrv.io.lock.OutputLock`):
+  a second run writing the same file is refused, naming the first one;
+* SIGINT and SIGTERM stop the run at the next step boundary (:mod:`ancfdrv.interrupt`):
+  what was computed is flushed and the file says status = 'interrupted';
+* whatever ends the run (success, bad input found late, solver failure, interrupt,
+  unexpected exception), the file's final status says so.
 """
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 import h5py
 import numpy as np
 
-from .io import hdf5 as results
-from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
-from .errors import AncfError
+from .errors import AncfError, InputError, Interrupted
 from .history import luffing_stage_bounds, stage_summary
+from .interrupt import StopRequest, signal_name
+from .io import hdf5 as results
+from .io.lock import OutputLock, lock_path
 from .builders import build_model
-from .io.scene import Scene, load_scene
+from .io.scene import PLATE_KINDS, Scene, load_scene
 from .system import Model
+from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
 from .solvers.static import StaticResult, solve_static
+
+#: files written beside the result (suffix): the plot of ``ancf run``, the XDMF of plates
+DERIVED_SUFFIXES = {".png": "the plot", ".xdmf": "the XDMF description"}
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 @dataclass
@@ -38,11 +56,103 @@ class RunOutcome:
 
 def run_scene(path: str | Path, overrides: list[str] | None = None,
               output: str | Path | None = None, *, progress: bool | None = None) -> RunOutcome:
-    """Run a scene file. Raises InputError (bad input) or SolverError (solver failure);
-    in the latter case the output file already holds everything computed until then."""
+    """Run a scene file. Raises InputError (bad input, output path refused or in use),
+    SolverError (solver failure) or Interrupted (SIGINT/SIGTERM); in the last two cases
+    the output file already holds everything computed until then."""
     start = time.perf_counter()
     scene = load_scene(path, overrides)
     return run_loaded(scene, output, start=start, progress=progress)
+
+
+def input_files(scene: Scene) -> list[Path]:
+    """The files a scene reads: the scene file and any file it names
+    (``Scene.input_files`` when the scene layer lists some)."""
+    return [Path(scene.path), *(Path(p) for p in getattr(scene, "input_files", ()) or ())]
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
+
+
+def _is_hdf5(path: Path) -> bool:
+    """HDF5's signature at offset 0, 512, 1024, ... (where a superblock may start)."""
+    size = path.stat().st_size
+    with open(path, "rb") as f:
+        offset = 0
+        while offset + len(_HDF5_SIGNATURE) <= size:
+            f.seek(offset)
+            if f.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE:
+                return True
+            offset = 512 if offset == 0 else 2 * offset
+    return False
+
+
+def _writable_parent(out: Path) -> None:
+    """The output's directory exists and is writable, or can be created."""
+    parent = out.parent if str(out.parent) else Path(".")
+    existing = parent
+    while not existing.exists() and existing.parent != existing:
+        if existing.is_symlink():
+            raise InputError(f"cannot create the output directory: {existing} is a broken "
+                             "symbolic link", file=str(out))
+        existing = existing.parent
+    if not existing.is_dir():
+        raise InputError(f"cannot create the output directory: {existing} is not a directory",
+                         file=str(out))
+    if not os.access(existing, os.W_OK | os.X_OK):
+        what = "directory" if existing == parent else "parent directory"
+        raise InputError(f"the output {what} {existing} is not writable", file=str(out))
+
+
+def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = False) -> None:
+    """Refuse, before anything is computed, an output that cannot be written or whose
+    writing would destroy something: raises InputError naming the path.
+
+    Refused: a directory; a path below a regular file; a directory without write
+    permission; an input file (compared as files: same inode, symbolic links followed),
+    also through the plot or XDMF written beside the result; an existing file that is
+    neither empty nor HDF5 (never overwritten); for plate models (``xdmf``) a ':' in the
+    file name, which XDMF cannot express.
+    """
+    out = Path(out)
+    if out.name in ("", ".", ".."):
+        raise InputError("the output must name a file, e.g. results/run.h5", file=str(out))
+    if out.is_dir():
+        raise InputError("the output is a directory; give a file name such as "
+                         f"{out / 'run.h5'}", file=str(out))
+    for suffix, what in DERIVED_SUFFIXES.items():
+        if out.with_suffix(suffix) == out:
+            raise InputError(f"the output must not end in {suffix}: {what} is written beside "
+                             "the result under that name (use .h5)", file=str(out))
+    if xdmf and ":" in out.name:
+        raise InputError("the file name must not contain ':' (the XDMF description cannot "
+                         "name such a file)", file=str(out))
+    derived = {out: "the output", out.with_suffix(".png"): "the plot written beside it",
+               out.with_suffix(".xdmf"): "the XDMF written beside it",
+               lock_path(out): "its lock file"}
+    for source in inputs:
+        for path, what in derived.items():
+            if path.exists() and source.exists() and _same_file(path, source):
+                if path == out:
+                    raise InputError(f"the output is the input file {source}; choose another "
+                                     "output file", file=str(out))
+                raise InputError(f"{what} ({path}) would overwrite the input file {source}; "
+                                 "choose another output file", file=str(out))
+    _writable_parent(out)
+    if out.exists() or out.is_symlink():
+        if not out.exists():
+            raise InputError("the output is a broken symbolic link", file=str(out))
+        if not out.is_file():
+            raise InputError("the output exists and is not a regular file", file=str(out))
+        if not os.access(out, os.W_OK):
+            raise InputError("the output file exists and is not writable", file=str(out))
+        if out.stat().st_size and not _is_hdf5(out):
+            raise InputError("the output file exists and is not an HDF5 file; refusing to "
+                             "overwrite it (remove it or choose another output file)",
+                             file=str(out))
 
 
 def dynamic_settings(scene: Scene) -> DynamicSettings:
@@ -69,12 +179,23 @@ def boom_stages(scene: Scene) -> dict[str, tuple[float, float]] | None:
 
 
 def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
-                 timing: dict[str, Any], progress: bool | None) -> tuple[DynamicResult, dict]:
+                 timing: dict[str, Any], progress: bool | None,
+                 stop: StopRequest) -> tuple[DynamicResult, dict]:
     settings = dynamic_settings(scene)
     if model.plate_bodies():
         settings.store_q = True  # the node positions for ParaView (XDMF) come from q
-    writer = results.DynamicWriter(out, model, settings.store_q)
-    dyn = integrate(model, settings, e_start, sink=writer, progress=progress)
+    writer = results.DynamicWriter(out, model, settings.store_q, settings.chunk_steps)
+    attrs: dict[str, Any] = {
+        "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
+        "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
+        "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
+        "generalized_alpha" else 1.0, "t_end": settings.t_end}
+    try:
+        dyn = integrate(model, settings, e_start, sink=writer, progress=progress,
+                        should_stop=stop)
+    finally:  # also after a failure or an interrupt: every computed step goes to the file
+        writer.flush()
+        results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     stages: dict[str, float] = {}
@@ -94,10 +215,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
             transverse = h5["dynamic/deflection/tip"][:, 1]
         stages = stage_summary(t, transverse, bounds)
     results.write_dynamic_attrs(out, {
-        "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
-        "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
-        "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
-        "generalized_alpha" else 1.0, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
+        **attrs, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
         "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,
         "jacobian_policy": "constant" if model.constant_policy else settings.jacobian,
         "wall_time_s": dyn.wall_time_s, "status": "ok"}, stages)
@@ -106,42 +224,94 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
 
 def run_loaded(scene: Scene, output: str | Path | None = None, *,
                start: float | None = None, progress: bool | None = None) -> RunOutcome:
+    """Run a loaded scene (see :func:`run_scene`)."""
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
-    t0 = time.perf_counter()
-    model = build_model(scene)
-    timing: dict[str, Any] = {"model": time.perf_counter() - t0}
+    check_output_path(out, input_files(scene), xdmf=scene.kind in PLATE_KINDS)
     try:
-        return _run_model(scene, model, out, timing, start, progress)
-    finally:
-        model.close()
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot create the output directory {out.parent}: {exc.strerror}",
+                         file=str(out)) from None
+    with OutputLock(out), StopRequest() as stop:
+        outcome = _run_locked(scene, out, start, progress, stop)
+    if stop.signum is not None:  # after the last step: the file is complete, the process stops
+        raise Interrupted(f"interrupted by {signal_name(stop.signum)} after the run completed; "
+                          f"{out} is complete (status 'ok')", signum=stop.signum)
+    return outcome
 
 
-def _run_model(scene: Scene, model: Model, out: Path, timing: dict, start: float,
-               progress: bool | None) -> RunOutcome:
+def _interrupt_message(out: Path, signum: int | None) -> str:
+    """What an interrupted run left in its output file, in one line."""
+    what = f"interrupted by {signal_name(signum)}"
+    try:
+        summary = results.read_summary(out)
+    except AncfError:
+        return f"{what}; see {out}"
+    if "dynamic.t_reached" in summary:
+        kept = (f" at t = {summary['dynamic.t_reached']:.6g} s; "
+                f"{summary.get('dynamic.steps', 0)} steps kept in {out}")
+    elif "static.iterations" in summary:
+        kept = f" after the static solve; its solution is kept in {out}"
+    else:
+        kept = f" before any result; {out} holds the model only"
+    return f"{what}{kept} (status 'interrupted')"
+
+
+def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
+                stop: StopRequest) -> RunOutcome:
     analysis = scene["scene"]["analysis"]
-    results.create(out, scene, model)
+    t0 = time.perf_counter()
+    try:
+        with stop.immediate():  # nothing is written yet: a signal ends the run at once
+            model = build_model(scene)
+    except Interrupted as exc:
+        raise Interrupted(f"interrupted by {signal_name(exc.signum)} before the output was "
+                          f"written; {out} was not touched", signum=exc.signum) from None
+    timing: dict[str, Any] = {"model": time.perf_counter() - t0}
     static = dynamic = None
     stages: dict[str, float] = {}
+
+    def finish(status: str, message: str = "", *, after_error: bool = True) -> None:
+        timing["total"] = time.perf_counter() - start
+        try:
+            results.finish(out, model, timing, status, message)
+        except OSError:
+            if not after_error:
+                raise  # after an error, the error being raised matters more
     try:
+        results.create(out, scene, model)
         e_start = model.e0
         if analysis in ("static", "static+dynamic"):
             solver = scene["solver"]
-            static = solve_static(model, solver["static_method"], tol=solver["tol"],
-                                  max_iter=solver["max_iter"], p=solver["split_p"],
-                                  load_steps=solver["load_steps"])
+            with stop.immediate():  # the static solvers write nothing while they iterate
+                static = solve_static(model, solver["static_method"], tol=solver["tol"],
+                                      max_iter=solver["max_iter"], p=solver["split_p"],
+                                      load_steps=solver["load_steps"])
             for phase, seconds in static.timing.items():
                 timing[f"static_{phase}"] = seconds
             t0 = time.perf_counter()
             results.write_static(out, model, static)
             timing["output"] = time.perf_counter() - t0
             e_start = static.e
+            if analysis == "static+dynamic":
+                stop.check()
         if analysis in ("dynamic", "static+dynamic"):
-            dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress)
-    except AncfError as exc:
-        timing["total"] = time.perf_counter() - start
-        results.finish(out, model, timing, "failed", str(exc))
+            dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop)
+    except Interrupted as exc:
+        signum = stop.signum or exc.signum
+        finish("interrupted", f"interrupted by {signal_name(signum)}")
+        raise Interrupted(_interrupt_message(out, signum), signum=signum) from None
+    except KeyboardInterrupt:  # no handler installed (not the main thread)
+        finish("interrupted", "interrupted (KeyboardInterrupt)")
         raise
-    timing["total"] = time.perf_counter() - start
-    results.finish(out, model, timing, "ok")
+    except AncfError as exc:
+        finish("failed", str(exc))
+        raise
+    except BaseException as exc:  # a bug: the file must not claim to be running
+        finish("failed", f"internal error: {type(exc).__name__}: {exc}")
+        raise
+    finally:
+        model.close()
+    finish("ok", after_error=False)
     return RunOutcome(scene, out, static, dynamic, model.warnings, stages)

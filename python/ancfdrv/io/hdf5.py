@@ -2,10 +2,30 @@
 
 A file is created (and its root, /model and /counters written) before any solve, so a
 failed run still leaves a readable file that says what was attempted.
+
+Conventions:
+
+* every dataset has a ``units`` attribute (SI: m, s, N, J, ...; '1' for dimensionless,
+  'count' for counters, 'index' for connectivity); integer counters are stored as int64;
+* the root attribute ``status`` is 'running' while the run writes, then 'ok', 'failed'
+  (with ``message``) or 'interrupted' (SIGINT/SIGTERM: every step computed before the
+  signal is in the file); /dynamic has the same ``status``. A file that still says
+  'running' while no process holds its lock (:mod:`ancfdrv.io.lock`) was abandoned:
+  its writer was killed (every flushed chunk is kept);
+* the root attributes carry the provenance: package version, git commit (when run from
+  a checkout), library versions, compiler, platform, thread settings, command line.
 """
 from __future__ import annotations
 
 import datetime as _dt
+import functools
+import json
+import os
+import platform
+import shlex
+import subprocess
+import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -13,23 +33,155 @@ import h5py
 import numpy as np
 
 from .. import __version__
+from ..errors import InputError
 from ..system.bodies import Beam
 from ..system.model import Model
 from .scene import Scene
 from ..solvers.static import StaticResult
 
+#: the statuses a result file can carry (root attribute and /dynamic attribute)
+STATUSES = ("running", "ok", "failed", "interrupted")
+#: generalized coordinates: positions (m) and position gradients (dimensionless)
+COORDINATE_UNITS = "mixed (m for positions, 1 for gradients)"
+#: constraint multipliers: forces for position constraints, moments for gradient ones
+MULTIPLIER_UNITS = "mixed (N for position constraints, N m for gradient constraints)"
+#: constraint values: lengths for position constraints, numbers for gradient ones
+CONSTRAINT_UNITS = "mixed (m for position constraints, 1 for gradient constraints)"
+CONTACT_UNITS = {"penetration": "m", "normal_force": "N", "friction_force": "N",
+                 "slip_speed": "m/s", "xi": "1", "eta": "1"}
+#: a buffered dynamic writer writes at least this often (and every chunk_steps rows)
+FLUSH_SECONDS = 1.0
+
 
 def _attrs(target: h5py.AttributeManager, values: dict[str, Any]) -> None:
     for key, value in values.items():
+        if isinstance(value, (bool, np.bool_)):
+            value = np.int64(value)
+        elif isinstance(value, (int, np.integer)):
+            value = np.int64(value)
         target[key] = value
 
 
+def _dataset(group: h5py.Group, name: str, data: Any, units: str) -> h5py.Dataset:
+    data = np.asarray(data)
+    if data.dtype.kind in "iub":
+        data = data.astype(np.int64)
+    dataset = group.create_dataset(name, data=data)
+    dataset.attrs["units"] = units
+    return dataset
+
+
+def _run(command: list[str], cwd: str | None = None) -> str:
+    """First line of a command's output ('' when it fails or is missing)."""
+    try:
+        done = subprocess.run(command, cwd=cwd, capture_output=True, text=True, timeout=5,
+                              check=False)
+    except (OSError, subprocess.SubprocessError):
+        return ""
+    lines = done.stdout.strip().splitlines()
+    return lines[0].strip() if done.returncode == 0 and lines else ""
+
+
+def _git_commit() -> str:
+    """'<sha>' or '<sha> (modified)' when the package runs from a git checkout."""
+    here = str(Path(__file__).resolve().parent)
+    sha = _run(["git", "rev-parse", "HEAD"], cwd=here)
+    if not sha:
+        return ""
+    dirty = _run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=here)
+    return sha + (" (modified)" if dirty else "")
+
+
+def _compiler() -> str:
+    """The Fortran compiler that built the kernel (Meson's record in an editable build),
+    else the first line of ``gfortran --version`` on PATH."""
+    try:
+        from .. import _kernel
+        for parent in Path(_kernel.__file__).resolve().parents[:3]:
+            info = parent / "meson-info" / "intro-compilers.json"
+            if info.is_file():
+                return json.loads(info.read_text())["host"]["fortran"]["full_version"]
+    except Exception:  # noqa: BLE001 - provenance is best effort, never fatal
+        pass
+    line = _run(["gfortran", "--version"])
+    return f"{line} (gfortran on PATH)" if line else ""
+
+
+def _mumps() -> str:
+    """The MUMPS library the kernel loaded, with its Debian package version if any."""
+    try:
+        from .. import _kernel  # noqa: F401 - loads the library
+        with open("/proc/self/maps") as maps:
+            libraries = {line.split()[-1] for line in maps if "dmumps" in line}
+    except OSError:
+        return ""
+    if not libraries:
+        return ""
+    library = sorted(libraries)[0]
+    owner = _run(["dpkg-query", "-S", library]).split(":")[0]
+    version = _run(["dpkg-query", "-W", "-f=${Version}", owner]) if owner else ""
+    return f"{Path(library).name}" + (f" (Debian {owner} {version})" if version else "")
+
+
+@functools.lru_cache(maxsize=1)
+def _static_provenance() -> dict[str, str]:
+    import scipy
+    return {"git_commit": _git_commit(), "numpy_version": np.__version__,
+            "scipy_version": scipy.__version__, "h5py_version": h5py.__version__,
+            "hdf5_version": h5py.version.hdf5_version, "mumps": _mumps(),
+            "compiler": _compiler(), "python_version": platform.python_version(),
+            "platform": platform.platform()}
+
+
+def provenance() -> dict[str, str]:
+    """What produced a result: versions, compiler, platform, threads, command line."""
+    out = {"ancfdrv_version": __version__, **_static_provenance()}
+    for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS"):
+        out[name] = os.environ.get(name, "")
+    out["command"] = shlex.join(sys.argv)
+    return out
+
+
+def open_result(path: str | Path, attempts: int = 50) -> h5py.File:
+    """Open a result file for reading; retries while a writer holds HDF5's own lock (a
+    running run opens the file for each chunk it writes). Raises InputError when the
+    file is missing or is not HDF5."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("result file not found", file=str(path))
+    if not h5py.is_hdf5(path):
+        raise InputError("not an HDF5 file", file=str(path))
+    for attempt in range(attempts):
+        try:
+            return h5py.File(path, "r")
+        except OSError as exc:
+            if attempt == attempts - 1 or "lock" not in str(exc).lower():
+                raise InputError(f"cannot read the HDF5 file ({exc})", file=str(path)) from None
+            time.sleep(0.02)
+    raise AssertionError("unreachable")
+
+
+def _open_write(path: Path, mode: str = "a") -> h5py.File:
+    """Open for writing. A reader holding HDF5's lock (``ancf info``, a viewer) delays a
+    write by at most about a second; after that the writer goes on without HDF5's lock
+    (the run's own lock, :mod:`ancfdrv.io.lock`, already excludes other writers), so a
+    reader never makes a run fail."""
+    for _ in range(50):
+        try:
+            return h5py.File(path, mode)
+        except OSError as exc:
+            if "lock" not in str(exc).lower():
+                raise
+            time.sleep(0.02)
+    return h5py.File(path, mode, locking=False)
+
+
 def create(path: Path, scene: Scene, model: Model) -> None:
-    """New result file with the root attributes and /model."""
+    """New result file with the root attributes (provenance included) and /model."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    with h5py.File(path, "w") as h5:
+    with _open_write(path, "w") as h5:
         _attrs(h5.attrs, {
-            "ancfdrv_version": __version__,
+            **provenance(),
             "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             "scene": scene.text,
             "scene_file": str(scene.path),
@@ -40,11 +192,12 @@ def create(path: Path, scene: Scene, model: Model) -> None:
             "effects": ",".join(scene.effects),
             "warnings": "\n".join(model.warnings),
             "status": "running",
+            "message": "",
             # what sweeps compare: probe and component (beams: the tip sag)
             "response_probe": (model.response or ("", 0))[0],
-            "response_component": (model.response or ("", 0))[1],
+            "response_component": np.int64((model.response or ("", 0))[1]),
             "linear_joints": model.linear_joints,
-            "jacobian_policy_model": "constant" if model.constant_policy else "refactor",
+            "iteration_matrix": "constant" if model.constant_policy else "refactorized",
         })
         beams = [b for b in model.bodies if isinstance(b, Beam)]
         if beams:  # 'continuum' or 'cubic' (beam.bending) of the first beam
@@ -52,12 +205,13 @@ def create(path: Path, scene: Scene, model: Model) -> None:
         group = h5.create_group("model")
         _attrs(group.attrs, model.summary())
         geometry = model.plate_geometry()
-        if geometry is not None:  # plates: initial node positions and connectivity
-            group.create_dataset("nodes", data=geometry[0])
-            group.create_dataset("elements", data=geometry[1])
+        if geometry is not None:  # plates and leaves: initial node positions, connectivity
+            _dataset(group, "nodes", geometry[0], "m")
+            elements = _dataset(group, "elements", geometry[1], "index")
+            elements.attrs["description"] = "corner nodes of each element (0-based rows of nodes)"
         if len(beams) == 1:
-            group.create_dataset("node_s", data=beams[0].stations)
-        group.create_dataset("e0", data=model.e0)
+            _dataset(group, "node_s", beams[0].stations, "m")
+        _dataset(group, "e0", model.e0, COORDINATE_UNITS)
         group.attrs["constraint_names"] = "\n".join(model.constraints.names)
         group.attrs["bodies"] = "\n".join(f"{b.name}: {type(b).__name__.lower()}"
                                           for b in model.bodies)
@@ -67,17 +221,19 @@ def create(path: Path, scene: Scene, model: Model) -> None:
 
 def write_static(path: Path, model: Model, result: StaticResult) -> None:
     """The /static group: q, lambda, probes, deflections and solver statistics."""
-    with h5py.File(path, "a") as h5:
+    with _open_write(path) as h5:
         if "static" in h5:
             del h5["static"]
         group = h5.create_group("static")
-        group.create_dataset("q", data=result.e)
-        group.create_dataset("lambda", data=result.lam)
-        group.create_dataset("residual_history", data=np.asarray(result.history))
+        _dataset(group, "q", result.e, COORDINATE_UNITS)
+        _dataset(group, "lambda", result.lam, MULTIPLIER_UNITS)
+        history = _dataset(group, "residual_history", np.asarray(result.history, dtype=float),
+                           "1")
+        history.attrs["description"] = "relative force residual per iteration"
         for name, position in model.probe_positions(result.e).items():
-            group.create_dataset(f"probes/{name}", data=position)
+            _dataset(group, f"probes/{name}", position, "m")
         for name, deflection in model.deflections(result.e).items():
-            group.create_dataset(f"deflection/{name}", data=deflection)
+            _dataset(group, f"deflection/{name}", deflection, "m")
         _attrs(group.attrs, {"method": result.method, "iterations": result.iterations,
                              "residual_norm": result.residual_norm,
                              "constraint_norm": result.constraint_norm,
@@ -86,14 +242,16 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
 
 def finish(path: Path, model: Model, timing: dict[str, float], status: str,
            message: str = "") -> None:
-    """Counters, timing and the final status (also after a failure)."""
-    with h5py.File(path, "a") as h5:
+    """Counters, timing and the final status (also after a failure or an interrupt)."""
+    if status not in STATUSES:
+        raise ValueError(f"unknown status {status!r}")
+    with _open_write(path) as h5:
         for name in ("counters", "timing"):
             if name in h5:
                 del h5[name]
         counters = h5.create_group("counters")
         _attrs(counters.attrs, {k: int(v) for k, v in sorted(model.counters.items())})
-        counters.attrs["constraint_evaluations"] = model.constraints.evaluations
+        counters.attrs["constraint_evaluations"] = np.int64(model.constraints.evaluations)
         group = h5.create_group("timing")
         _attrs(group.attrs, {k: float(v) for k, v in timing.items()})
         # the phases SPEC section 4 names, summed over the analyses (dynamic stepping counts
@@ -108,35 +266,43 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
             "total": float(timing.get("total", 0.0))})
         h5.attrs["status"] = status
         h5.attrs["message"] = message
+        h5.attrs["finished"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
         h5.attrs["warnings"] = "\n".join(model.warnings)
-        if "dynamic" in h5 and status != "ok":
+        if "dynamic" in h5:
             h5["dynamic"].attrs["status"] = status
-        has_motion = "dynamic/mesh_nodes" in h5
+        has_motion = "dynamic/mesh_nodes" in h5 and len(h5["dynamic/time"]) > 0
     if has_motion:
         from .xdmf import write_xdmf
         write_xdmf(path)
 
 
+def _text(value: Any) -> Any:
+    return value.decode() if isinstance(value, bytes) else value
+
+
 def read_summary(path: Path) -> dict[str, Any]:
-    """The main figures of a result file as a flat dict (used by info, sweep, plot)."""
+    """The main figures of a result file as a flat dict (used by info, sweep, plot).
+    Raises InputError when the file is missing, not HDF5 or not an ancfdrv result."""
     out: dict[str, Any] = {}
-    with h5py.File(path, "r") as h5:
-        out.update({k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()})
-        out.update({f"model.{k}": v for k, v in h5["model"].attrs.items()})
+    with open_result(path) as h5:
+        if not isinstance(h5.get("model"), h5py.Group):
+            raise InputError("not an ancfdrv result file (no /model group)", file=str(path))
+        out.update({k: _text(v) for k, v in h5.attrs.items()})
+        out.update({f"model.{k}": _text(v) for k, v in h5["model"].attrs.items()})
         if "static" in h5:
             static = h5["static"]
-            out.update({f"static.{k}": v for k, v in static.attrs.items()})
-            for name in static["deflection"]:
+            out.update({f"static.{k}": _text(v) for k, v in static.attrs.items()})
+            for name in static.get("deflection", {}):
                 out[f"static.deflection.{name}"] = static["deflection"][name][()]
                 out[f"static.probes.{name}"] = static["probes"][name][()]
         if "dynamic" in h5:
             dynamic = h5["dynamic"]
-            out.update({f"dynamic.{k}": v for k, v in dynamic.attrs.items()})
+            out.update({f"dynamic.{k}": _text(v) for k, v in dynamic.attrs.items()})
             if "stages" in dynamic:
                 out.update({f"stages.{k}": v for k, v in dynamic["stages"].attrs.items()})
-            if len(dynamic["time"]):
+            if "time" in dynamic and len(dynamic["time"]):
                 out["dynamic.t_reached"] = float(dynamic["time"][-1])
-                for name in dynamic["deflection"]:
+                for name in dynamic.get("deflection", {}):
                     out[f"dynamic.deflection.{name}.final"] = dynamic["deflection"][name][-1]
         if "timing" in h5:
             out.update({f"timing.{k}": v for k, v in h5["timing"].attrs.items()})
@@ -145,100 +311,164 @@ def read_summary(path: Path) -> dict[str, Any]:
     return out
 
 
-class DynamicWriter:
-    """Appends each chunk of a dynamic run to /dynamic and closes the file after it, so
-    every completed chunk is on disk whatever happens next (SPEC section 4)."""
+def verdict(path: Path, summary: dict[str, Any] | None = None) -> tuple[str, str]:
+    """What became of the run that wrote a result file: ('ok' | 'failed' | 'interrupted'
+    | 'running' | 'abandoned' | 'unknown', one line saying why)."""
+    from .lock import holder
+    summary = read_summary(path) if summary is None else summary
+    status = str(summary.get("status", ""))
+    message = str(summary.get("message", "")).replace("\n", "; ")
+    rows = ""
+    if "dynamic.t_reached" in summary:
+        rows = f"dynamic reached t = {summary['dynamic.t_reached']:.6g} s"
+    if status == "running":
+        writer = holder(path)
+        if writer is not None:
+            return "running", f"being written by {writer.describe()}" + (
+                f"; {rows} so far" if rows else "")
+        return "abandoned", ("status 'running' but no process writes it: the writer was "
+                             "killed; the steps flushed before are kept"
+                             + (f" ({rows})" if rows else ""))
+    if status == "ok":
+        return "ok", "the run finished" + (f"; {rows}" if rows else "")
+    if status in ("failed", "interrupted"):
+        detail = message or status
+        return status, detail + (f" ({rows})" if rows and rows not in detail else "")
+    return "unknown", f"status attribute {status!r}"
 
-    def __init__(self, path: Path, model: Model, store_q: bool) -> None:
+
+class DynamicWriter:
+    """Appends the chunks of a dynamic run to /dynamic (SPEC section 4).
+
+    Chunks are buffered and written together, with the file closed after each write,
+    whenever ``flush_rows`` rows are waiting or FLUSH_SECONDS have passed since the
+    last write (the initial row is written at once); :meth:`flush` writes the rest. So
+    the file on disk lags the computation by at most one output chunk or about a
+    second, and a run that stops (failure, SIGINT, SIGTERM) flushes everything.
+    """
+
+    def __init__(self, path: Path, model: Model, store_q: bool,
+                 flush_rows: int = 1) -> None:
         from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
         self.path, self.names, self.store_q = path, list(model.probes), store_q
+        self.flush_rows = max(1, int(flush_rows))
         self.node_positions = model.node_positions if model.plate_bodies() else None
         self.npoints = model.npoint
         self.contact_fields = CONTACT_FIELDS
         geometry = model.plate_geometry()
         self.nnodes = len(geometry[0]) if geometry is not None and store_q else 0
+        self.reference_nodes = geometry[0] if self.nnodes else None
         self.energy_names = ENERGY_NAMES
         self.rows = 0
+        self._pending: list[Any] = []
+        self._pending_rows = 0
+        self._last_write = time.monotonic()
         ncon, ndof = len(model.constraints), model.ndof
-        with h5py.File(path, "a") as h5:
+        with _open_write(path) as h5:
             if "dynamic" in h5:
                 del h5["dynamic"]
             group = h5.create_group("dynamic")
             group.attrs["status"] = "running"
+            group.attrs["rows"] = np.int64(0)
 
-            def series(name: str, width: tuple[int, ...] = ()) -> None:
+            def series(name: str, units: str, width: tuple[int, ...] = (),
+                       dtype: str = "f8") -> None:
                 # a model without constraints has lambda[nt, 0]: HDF5 chunks must be
                 # positive, so that axis gets a free maximum
                 chunk = tuple(max(1, w) for w in width)
                 limit = tuple(w if w else None for w in width)
-                group.create_dataset(name, shape=(0, *width), maxshape=(None, *limit),
-                                     dtype="f8", chunks=(1024, *chunk) if width != (ndof,)
-                                     else (16, ndof))
-            series("time")
+                data = group.create_dataset(name, shape=(0, *width), maxshape=(None, *limit),
+                                            dtype=dtype, chunks=(1024, *chunk)
+                                            if width != (ndof,) else (16, ndof))
+                data.attrs["units"] = units
+            series("time", "s")
             for name in self.names:
-                series(f"probes/{name}", (3,))
-                series(f"deflection/{name}", (3,))
-            series("lambda", (ncon,))
+                series(f"probes/{name}", "m", (3,))
+                series(f"deflection/{name}", "m", (3,))
+            series("lambda", MULTIPLIER_UNITS, (ncon,))
             for name in ENERGY_NAMES:
-                series(f"energy/{name}")
-            series("energy/balance")
-            series("constraint_violation")
-            series("newton_iterations")
-            series("factorizations")
-            series("jacobian_evaluations")
+                series(f"energy/{name}", "J")
+            series("energy/balance", "J")
+            series("constraint_violation", CONSTRAINT_UNITS)
+            series("newton_iterations", "count", dtype="i8")
+            series("factorizations", "count", dtype="i8")
+            series("jacobian_evaluations", "count", dtype="i8")
             if self.npoints:  # per contact point: penetration, forces, slip, projection
                 for name in CONTACT_FIELDS:
-                    series(f"contact/{name}", (self.npoints,))
+                    series(f"contact/{name}", CONTACT_UNITS.get(name, "1"), (self.npoints,))
                 group["contact"].attrs["points"] = "\n".join(model.contact_point_names)
             if store_q:
-                series("q", (ndof,))
+                series("q", COORDINATE_UNITS, (ndof,))
             if self.nnodes:  # plate models: node positions per step, for ParaView (XDMF)
-                group.create_dataset("mesh_nodes", shape=(0, self.nnodes, 3),
-                                     maxshape=(None, self.nnodes, 3), dtype="f8",
-                                     chunks=(16, self.nnodes, 3))
+                for name in ("mesh_nodes", "mesh_displacement"):
+                    data = group.create_dataset(name, shape=(0, self.nnodes, 3),
+                                                maxshape=(None, self.nnodes, 3), dtype="f8",
+                                                chunks=(16, self.nnodes, 3))
+                    data.attrs["units"] = "m"
 
     def __call__(self, chunk) -> None:
-        n = len(chunk.time)
-        with h5py.File(self.path, "a") as h5:
-            group = h5["dynamic"]
+        self._pending.append(chunk)
+        self._pending_rows += len(chunk.time)
+        if (self.rows == 0 or self._pending_rows >= self.flush_rows
+                or time.monotonic() - self._last_write >= FLUSH_SECONDS):
+            self.flush()
 
-            def append(name: str, values: np.ndarray) -> None:
-                data = group[name]
-                data.resize(self.rows + n, axis=0)
-                data[self.rows:] = values
-            append("time", chunk.time)
-            for p, name in enumerate(self.names):
-                append(f"probes/{name}", chunk.probes[:, p, :])
-                append(f"deflection/{name}", chunk.deflections[:, p, :])
-            append("lambda", chunk.lam)
-            for k, name in enumerate(self.energy_names):
-                append(f"energy/{name}", chunk.energy[:, k])
-            total0 = group["energy/total"][0] if self.rows else chunk.energy[0, 4]
-            # total - total(0) - work of drives, moving frames, contact damping, friction and
-            # material damping
-            append("energy/balance", chunk.energy[:, 4] - total0 - chunk.energy[:, 5]
-                   - chunk.energy[:, 6] - chunk.energy[:, 8] - chunk.energy[:, 9]
-                   - chunk.energy[:, 10])
-            if self.npoints and chunk.contact is not None:
-                for k, name in enumerate(self.contact_fields):
-                    append(f"contact/{name}", chunk.contact[:, :, k])
-            append("constraint_violation", chunk.constraint)
-            append("newton_iterations", chunk.stats[:, 0])
-            append("factorizations", chunk.stats[:, 1])
-            append("jacobian_evaluations", chunk.stats[:, 2])
-            if self.store_q and chunk.q is not None:
-                append("q", chunk.q)
-                if self.nnodes and self.node_positions is not None:
-                    append("mesh_nodes", self.node_positions(chunk.q))
-                elif self.nnodes:
-                    append("mesh_nodes", chunk.q.reshape(n, self.nnodes, -1)[:, :, :3])
-            self.rows += n
-            group.attrs["rows"] = self.rows
+    def flush(self) -> None:
+        """Write every buffered chunk (one open of the file)."""
+        if not self._pending:
+            return
+        with _open_write(self.path) as h5:
+            group = h5["dynamic"]
+            first = self.rows
+            for chunk in self._pending:
+                self._append(group, chunk)
+            group.attrs["rows"] = np.int64(self.rows)
+            if self.nnodes:  # the per-step views the XDMF description names
+                from .xdmf import add_step_views
+                add_step_views(h5, first, self.rows)
+        self._pending, self._pending_rows = [], 0
+        self._last_write = time.monotonic()
+
+    def _append(self, group: h5py.Group, chunk) -> None:
+        n = len(chunk.time)
+
+        def append(name: str, values: np.ndarray) -> None:
+            data = group[name]
+            data.resize(self.rows + n, axis=0)
+            data[self.rows:] = values
+        append("time", chunk.time)
+        for p, name in enumerate(self.names):
+            append(f"probes/{name}", chunk.probes[:, p, :])
+            append(f"deflection/{name}", chunk.deflections[:, p, :])
+        append("lambda", chunk.lam)
+        for k, name in enumerate(self.energy_names):
+            append(f"energy/{name}", chunk.energy[:, k])
+        total0 = group["energy/total"][0] if self.rows else chunk.energy[0, 4]
+        # total - total(0) - work of drives, moving frames, contact damping, friction and
+        # material damping
+        append("energy/balance", chunk.energy[:, 4] - total0 - chunk.energy[:, 5]
+               - chunk.energy[:, 6] - chunk.energy[:, 8] - chunk.energy[:, 9]
+               - chunk.energy[:, 10])
+        if self.npoints and chunk.contact is not None:
+            for k, name in enumerate(self.contact_fields):
+                append(f"contact/{name}", chunk.contact[:, :, k])
+        append("constraint_violation", chunk.constraint)
+        append("newton_iterations", np.rint(chunk.stats[:, 0]).astype(np.int64))
+        append("factorizations", np.rint(chunk.stats[:, 1]).astype(np.int64))
+        append("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64))
+        if self.store_q and chunk.q is not None:
+            append("q", chunk.q)
+            if self.nnodes:
+                nodes = (self.node_positions(chunk.q) if self.node_positions is not None
+                         else chunk.q.reshape(n, self.nnodes, -1)[:, :, :3])
+                append("mesh_nodes", nodes)
+                append("mesh_displacement", nodes - self.reference_nodes[None, :, :])
+        self.rows += n
 
 
 def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, float]) -> None:
     """Integrator statistics and the per-stage summary (attributes of /dynamic)."""
-    with h5py.File(path, "a") as h5:
+    with _open_write(path) as h5:
         group = h5["dynamic"]
         _attrs(group.attrs, attrs)
         if stages:
