@@ -564,13 +564,13 @@ class KernelSystem:
             self.handle, self.ncon, self.nprobe, self.npoint, t, _f(e), _f(v),
             _f(lam) if len(lam) else np.zeros(1), _f(work), _f(guesses), _i(counts),
             ndof=self.ndof)
-        guesses, counts, probe, deflection, energy, violation, records, info = out
+        guesses, counts, probe, deflection, energy, violation, records, powers, info = out
         if info:
             self._failure(info, "output row")
         return dict(probes=probe[:, :self.nprobe].T.copy(),
                     deflections=deflection[:, :self.nprobe].T.copy(), energy=energy,
                     violation=float(violation), records=records[:, :self.npoint],
-                    guesses=guesses, counts=counts)
+                    guesses=guesses, counts=counts, powers=powers)
 
     def _failure(self, info: int, what: str) -> None:
         from .codes import STEP_FAILURES
@@ -579,7 +579,7 @@ class KernelSystem:
 
     def advance(self, nsteps: int, settings, state: dict, store_q: bool):
         """Advance nsteps steps (time_integrator) from state (t, e, v, a, accel, lam, work,
-        guesses, counts; updated in place); returns the raw outputs and status."""
+        powers, guesses, counts; updated in place); returns the raw outputs and status."""
         nq = nsteps if store_q else 1
         out = _kernel.system_advance(
             self.handle, self.ncon, self.nprobe, self.npoint, nsteps, nq, settings.dt,
@@ -587,11 +587,12 @@ class KernelSystem:
             settings.length_scale, settings.max_newton, settings.jacobian_code,
             settings.contraction, state["t"], _f(state["e"]), _f(state["v"]), _f(state["a"]),
             _f(state["accel"]), _f(state["lam"]) if len(state["lam"]) else np.zeros(1),
-            _f(state["work"]), _f(state["guesses"]), _i(state["counts"]), ndof=self.ndof)
-        (t, e, v, a, accel, lam, work, guesses, counts, o_time, o_probe, o_defl, o_lam, o_energy,
-         o_con, o_stats, o_contact, o_q, status, last_correction) = out
+            _f(state["work"]), _f(state["powers"]), _f(state["guesses"]), _i(state["counts"]),
+            ndof=self.ndof)
+        (t, e, v, a, accel, lam, work, powers, guesses, counts, o_time, o_probe, o_defl, o_lam,
+         o_energy, o_con, o_stats, o_contact, o_q, status, last_correction) = out
         state.update(t=float(t), e=e, v=v, a=a, accel=accel, lam=lam[:self.ncon], work=work,
-                     guesses=guesses, counts=counts)
+                     powers=powers, guesses=guesses, counts=counts)
         return dict(time=o_time, probes=o_probe, deflections=o_defl, lam=o_lam, energy=o_energy,
                     constraint=o_con, stats=o_stats, contact=o_contact, q=o_q,
                     status=[int(s) for s in status], last_correction=float(last_correction))

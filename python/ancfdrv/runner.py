@@ -155,6 +155,13 @@ def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = Fa
                              file=str(out))
 
 
+def has_plates(scene: Scene) -> bool:
+    """Whether the scene's model has plates or leaves (its runs write XDMF)."""
+    if scene.kind == "general":
+        return any(group in ("plate", "leaf") for group, _ in scene.items)
+    return scene.kind in PLATE_KINDS
+
+
 def dynamic_settings(scene: Scene) -> DynamicSettings:
     """Newmark with the scene's beta and gamma, or generalized-alpha from rho_inf."""
     solver, output = scene["solver"], scene["output"]
@@ -227,7 +234,7 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
     """Run a loaded scene (see :func:`run_scene`)."""
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
-    check_output_path(out, input_files(scene), xdmf=scene.kind in PLATE_KINDS)
+    check_output_path(out, input_files(scene), xdmf=has_plates(scene))
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

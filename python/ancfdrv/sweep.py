@@ -33,7 +33,7 @@ import numpy as np
 from tqdm import tqdm
 
 from .errors import InputError
-from .io.scene import SCHEMA, load_scene
+from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
 from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
                          remove_quietly, response_of, run_dask, run_inline, run_processes)
 
@@ -55,13 +55,19 @@ class SweepInterrupted(KeyboardInterrupt):
         self.rows, self.outdir = rows, outdir
 
 
+def _plain_key(part: str) -> str:
+    """'beam[upper].nodes' -> 'beam.nodes' (the schema key a named group's key stands for)."""
+    group, _, key = parse_address(part)
+    return f"{group}.{key}"
+
+
 def is_resolution(key: str) -> bool:
     """A refining key, or keys tied with '+' that all refine (plate.nx+plate.ny)."""
-    return all(part in RESOLUTION_KEYS for part in key.split("+"))
+    return all(_plain_key(part) in RESOLUTION_KEYS for part in key.split("+"))
 
 
 def resolution_sense(key: str):
-    return RESOLUTION_KEYS[key.split("+")[0]]
+    return RESOLUTION_KEYS[_plain_key(key.split("+")[0])]
 
 
 def expand(params: dict[str, str]) -> list[str]:
@@ -70,22 +76,30 @@ def expand(params: dict[str, str]) -> list[str]:
 
 
 def parse_vary(items: list[str], scene_file: str) -> list[tuple[str, list[str]]]:
-    """``GROUP.KEY=V1,V2,...`` -> (dotted key, values); keys are checked against the schema.
-    Keys joined by '+' vary together (``plate.nx+plate.ny=2,4,8``: 2x2, 4x4, 8x8)."""
+    """``GROUP.KEY=V1,V2,...`` or ``GROUP[NAME].KEY=...`` (a named group of a general scene)
+    -> (dotted key, values); keys are checked against the schema (every case is validated
+    with its scene before any runs). Keys joined by '+' vary together
+    (``plate.nx+plate.ny=2,4,8``: 2x2, 4x4, 8x8)."""
     out = []
     for item in items:
         if "=" not in item or "." not in item.split("=", 1)[0]:
             raise InputError(f"--vary {item!r} is not of the form GROUP.KEY=V1,V2,...",
                              file=scene_file)
         dotted, values = item.split("=", 1)
-        dotted = dotted.strip().lower()
+        parts = []
         for part in dotted.split("+"):
-            if "." not in part:
-                raise InputError(f"--vary names {part!r}, not GROUP.KEY", file=scene_file)
-            group, key = part.split(".", 1)
-            if group not in SCHEMA or key not in SCHEMA[group]:
-                raise InputError(f"--vary names an unknown key {part!r}", file=scene_file,
-                                 group=group, key=key)
+            try:
+                group, name, key = parse_address(part)
+            except ValueError:
+                raise InputError(f"--vary names {part.strip()!r}, not GROUP.KEY or "
+                                 "GROUP[NAME].KEY", file=scene_file) from None
+            schema = GENERAL_SCHEMA.get(group, {}) if name is not None else \
+                {**SCHEMA.get(group, {}), **GENERAL_SCHEMA.get(group, {})}
+            if key not in schema:
+                raise InputError(f"--vary names an unknown key {part.strip()!r}",
+                                 file=scene_file, group=group, key=key)
+            parts.append(f"{group}.{key}" if name is None else f"{group}[{name}].{key}")
+        dotted = "+".join(parts)
         vals = [v.strip() for v in values.split(",") if v.strip()]
         if not vals:
             raise InputError(f"--vary {dotted} has no values", file=scene_file, group=group,
@@ -99,7 +113,7 @@ def parse_vary(items: list[str], scene_file: str) -> list[tuple[str, list[str]]]
 
 
 def _short_key(key: str) -> str:
-    return "+".join(part.split(".", 1)[1] for part in key.split("+"))
+    return "+".join(part.rpartition(".")[2] for part in key.split("+"))
 
 
 def _unquote(value: str) -> str:

@@ -503,7 +503,7 @@ end subroutine system_evaluate
 !> One output row (probes, deflections, energies, constraint violation, contact records)
 !> of the state (t, e, e', lambda) with the accumulated works.
 subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, work, guesses, &
-                             counts, probe, deflection, energy, violation, records, info)
+                             counts, probe, deflection, energy, violation, records, powers, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, power_count, energy_count
   use time_integrator, only: output_row
@@ -515,10 +515,11 @@ subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, w
   integer, intent(inout) :: counts(6)
   !f2py intent(in,out) :: guesses, counts
   real(dp), intent(out) :: probe(3, max(1, nprobe)), deflection(3, max(1, nprobe)), energy(11)
-  real(dp), intent(out) :: violation, records(6, max(1, npoint))
+  real(dp), intent(out) :: violation, records(6, max(1, npoint)), powers(5)
   integer, intent(out) :: info
   type(system_model), pointer :: sys
   type(contact_state) :: state
+  powers = 0.0_dp
   call store_get(handle, sys, info)
   if (info /= 0) return
   if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. nprobe /= sys%nprobe .or. &
@@ -532,19 +533,20 @@ subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, w
   deflection = 0.0_dp
   records = 0.0_dp
   call output_row(sys, t, e, v, lam(1:ncon), work, state, probe(:, 1:nprobe), &
-                  deflection(:, 1:nprobe), energy, violation, records(:, 1:npoint), info)
+                  deflection(:, 1:nprobe), energy, violation, records(:, 1:npoint), powers, info)
   guesses = state%guesses
   counts = state%counts
 end subroutine system_output_row
 
 !> Advances nsteps steps of the generalized-alpha method (time_integrator), one output row
-!> per step. The state (t, e, v, a, accel, lam, work, contact guesses and counters) is
-!> updated in place. status = [steps done, info, detail]; stats(:, step) = Newton
+!> per step. The state (t, e, v, a, accel, lam, work, the powers at the state, contact
+!> guesses and counters) is updated in place: calls may split a run anywhere without
+!> changing its result. status = [steps done, info, detail]; stats(:, step) = Newton
 !> corrections, factorizations, Jacobian evaluations. jacobian: 1 per step, 2 per
 !> iteration, 3 reused across steps (time_integrator).
 subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, beta, gamma, alpha_m, &
                           alpha_f, tol, length_scale, max_newton, jacobian, contraction, t, e, v, &
-                          a, accel, lam, work, guesses, counts, out_time, out_probe, &
+                          a, accel, lam, work, powers, guesses, counts, out_time, out_probe, &
                           out_deflection, out_lambda, out_energy, out_constraint, out_stats, &
                           out_contact, out_q, status, last_correction)
   use ancf_kinds, only: dp
@@ -555,9 +557,9 @@ subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, bet
   integer, intent(in) :: handle, ndof, ncon, nprobe, npoint, nsteps, nq, max_newton, jacobian
   real(dp), intent(in) :: h, beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
   real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), accel(ndof), lam(max(1, ncon)), work(5)
-  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  real(dp), intent(inout) :: powers(5), guesses(2, max(1, npoint))
   integer, intent(inout) :: counts(6)
-  !f2py intent(in,out) :: t, e, v, a, accel, lam, work, guesses, counts
+  !f2py intent(in,out) :: t, e, v, a, accel, lam, work, powers, guesses, counts
   real(dp), intent(out) :: out_time(nsteps), out_probe(3, max(1, nprobe), nsteps)
   real(dp), intent(out) :: out_deflection(3, max(1, nprobe), nsteps)
   real(dp), intent(out) :: out_lambda(max(1, ncon), nsteps), out_energy(11, nsteps)
@@ -602,7 +604,8 @@ subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, bet
   cfg%contraction = contraction
   state%guesses = guesses
   state%counts = counts
-  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, state, out_time, &
+  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, powers, state, &
+                        out_time, &
                         out_probe(:, 1:nprobe, :), out_deflection(:, 1:nprobe, :), &
                         out_lambda(1:ncon, :), out_energy, out_constraint, out_stats, &
                         out_contact(:, 1:npoint, :), nq == nsteps, out_q, status(1), status(2), &

@@ -100,7 +100,8 @@ contains
   !> plate element's normal vanished; 8 contact search failed. steps_done counts the
   !> completed steps; the state is that of the last completed step; last_correction is the
   !> size of the last Newton correction (why a step failed to converge).
-  subroutine integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam, work, state, out_time, &
+  subroutine integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam, work, powers, state, &
+                              out_time, &
                               out_probe, out_deflection, out_lambda, out_energy, out_constraint, &
                               out_stats, out_contact, store_q, out_q, steps_done, info, detail, &
                               last_correction)
@@ -108,6 +109,7 @@ contains
     type(integrator_settings), intent(in) :: cfg
     integer, intent(in) :: nsteps
     real(dp), intent(inout) :: t, e(:), v(:), a(:), accel(:), lam(:), work(power_count)
+    real(dp), intent(inout) :: powers(power_count)  ! the powers at the current state
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: out_time(:), out_probe(:, :, :), out_deflection(:, :, :)
     real(dp), intent(out) :: out_lambda(:, :), out_energy(:, :), out_constraint(:)
@@ -120,9 +122,9 @@ contains
     real(dp) :: e_new(sys%ndof), a_new(sys%ndof), accel_new(sys%ndof), v_new(sys%ndof)
     real(dp) :: lam_new(sys%ncon), predicted_internal(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
-    real(dp) :: powers_old(power_count), powers_new(power_count), strain, violation
+    real(dp) :: powers_new(power_count), strain
     real(dp) :: contact_potential, h, beta_prime, velocity_factor
-    integer :: step, attempt, stats(stat_count), factor_active
+    integer :: step, attempt, stats(stat_count)
     logical :: done, fresh_matrix
     info = 0
     detail = 0
@@ -132,12 +134,6 @@ contains
     h = cfg%h
     beta_prime = (1.0_dp - cfg%alpha_m) / (cfg%beta * h * h * (1.0_dp - cfg%alpha_f))
     velocity_factor = cfg%gamma / (cfg%beta * h)
-    call frame_rotations(sys, t, rotations, rates, info)
-    if (info /= 0) return
-    call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_old, &
-                  contact_potential, violation, out_contact(:, :, 1), info)
-    if (info /= 0) return
-    factor_active = -1
     do step = 1, nsteps
       stats = 0
       call frame_rotations(sys, t + h, rotations, rates, info)
@@ -148,14 +144,14 @@ contains
         fresh_matrix = .false.
         if (needs_factorization(sys, cfg, beta_prime, attempt)) then
           call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                           predicted_internal, strain, factor_active, info, detail)
+                           predicted_internal, strain, sys%factor_active, info, detail)
           if (info /= 0) return
           stats(stat_factorizations) = stats(stat_factorizations) + 1
           stats(stat_jacobians) = stats(stat_jacobians) + 1
           fresh_matrix = sys%policy /= policy_constant
         end if
         call newton(sys, cfg, t + h, rotations, beta_prime, velocity_factor, e_new, v_new, &
-                    accel_new, lam_new, state, predicted_internal, fresh_matrix, factor_active, &
+                    accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, info, detail)
         if (info /= 0) return
         ! a step that failed with a matrix of an earlier step gets one retry with a fresh one
@@ -178,8 +174,8 @@ contains
       call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
                     contact_potential, out_constraint(step), out_contact(:, :, step), info)
       if (info /= 0) return
-      work = work + 0.5_dp * h * (powers_old + powers_new)
-      powers_old = powers_new
+      work = work + 0.5_dp * h * (powers + powers_new)
+      powers = powers_new
       steps_done = step
       out_time(step) = t
       out_stats(:, step) = stats
@@ -225,7 +221,7 @@ contains
   !> Newton iterations of one step from the predicted state (updated in place). done: the
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, t_new, rotations, beta_prime, velocity_factor, e_new, v_new, &
-                    accel_new, lam_new, state, predicted_internal, fresh_matrix, factor_active, &
+                    accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, info, detail)
     type(system_model), intent(inout) :: sys
     type(integrator_settings), intent(in) :: cfg
@@ -234,7 +230,7 @@ contains
     type(contact_state), intent(inout) :: state
     real(dp), intent(inout) :: predicted_internal(:)
     logical, intent(in) :: fresh_matrix
-    integer, intent(inout) :: factor_active, stats(stat_count)
+    integer, intent(inout) :: stats(stat_count)
     logical, intent(out) :: done
     real(dp), intent(inout) :: last_correction
     integer, intent(out) :: info, detail
@@ -249,7 +245,7 @@ contains
     done = .false.
     use_known = fresh_matrix
     previous_correction = huge(1.0_dp)
-    active = factor_active
+    active = sys%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
         call residual(sys, t_new, rotations, e_new, v_new, accel_new, lam_new, state, r, phi, &
@@ -262,7 +258,7 @@ contains
       use_known = .false.
       ! reuse: a changed contact set invalidates the matrix before it is used
       if (cfg%jacobian == jacobian_reuse .and. sys%policy /= policy_constant .and. &
-          sys%npoint > 0 .and. active /= factor_active .and. it < cfg%max_newton) then
+          sys%npoint > 0 .and. active /= sys%factor_active .and. it < cfg%max_newton) then
         call refresh_matrix()
         if (info /= 0) return
         call residual(sys, t_new, rotations, e_new, v_new, accel_new, lam_new, state, r, phi, &
@@ -349,27 +345,28 @@ contains
 
     subroutine refresh_matrix()
       call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                       predicted_internal, strain, factor_active, info, detail)
+                       predicted_internal, strain, sys%factor_active, info, detail)
       if (info /= 0) return
       stats(stat_factorizations) = stats(stat_factorizations) + 1
       stats(stat_jacobians) = stats(stat_jacobians) + 1
-      active = factor_active
+      active = sys%factor_active
     end subroutine refresh_matrix
 
   end subroutine newton
 
   !> One output row (probes, deflections, energies, constraint violation, contact records) of
-  !> a state that was not stepped to (the initial state).
+  !> a state that was not stepped to (the initial state), with the powers there (the start
+  !> of the stepper's work integrals).
   subroutine output_row(sys, t, e, v, lam, work, state, probe, deflection, energy, violation, &
-                        contact, info)
+                        contact, powers, info)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: t, e(:), v(:), lam(:), work(power_count)
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(energy_count), violation
-    real(dp), intent(out) :: contact(:, :)
+    real(dp), intent(out) :: contact(:, :), powers(power_count)
     integer, intent(out) :: info
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
-    real(dp) :: strain, powers(power_count), contact_potential
+    real(dp) :: strain, contact_potential
     call frame_rotations(sys, t, rotations, rates, info)
     if (info /= 0) return
     call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers, contact_potential, &

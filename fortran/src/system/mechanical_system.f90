@@ -111,6 +111,7 @@ module mechanical_system
     ! the current factorization: its flexibility S^{-1} E_c and E_c^T S^{-1} E_c
     logical :: factorized = .false.
     real(dp) :: factor_beta_prime = 0.0_dp
+    integer :: factor_active = -1                      ! active contact points at it
     real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
   end type system_model
 

@@ -163,7 +163,8 @@ class TimeIntegrator:
               lam: np.ndarray) -> dict:
         """A stepper state at t with q'' = a (the generalized-alpha variable starts at a)."""
         return dict(t=t, e=e.copy(), v=v.copy(), a=a.copy(), accel=a.copy(), lam=lam.copy(),
-                    work=np.zeros(5), guesses=self.model.contact_guesses.copy(),
+                    work=np.zeros(5), powers=np.zeros(5),
+                    guesses=self.model.contact_guesses.copy(),
                     counts=np.zeros(6, dtype=np.int32))
 
     def advance(self, state: dict, nsteps: int) -> tuple[Chunk, int, int]:
@@ -196,9 +197,11 @@ class TimeIntegrator:
 
 
 def initial_row(model: Model, state: dict) -> Chunk:
-    """The output row of the initial state, with the kernel's energy definitions."""
+    """The output row of the initial state, with the kernel's energy definitions; the state
+    gets the powers there (the start of the works the stepper integrates)."""
     row = model.kernel.output_row(state["t"], state["e"], state["v"], state["lam"],
                                   state["work"], state["guesses"], state["counts"])
+    state["powers"] = row["powers"]
     return Chunk(time=np.array([state["t"]]), probes=row["probes"][None], deflections=
                  row["deflections"][None], lam=state["lam"][None, :], energy=row["energy"][None],
                  constraint=np.array([row["violation"]]), stats=np.zeros((1, 3), dtype=np.int64),
@@ -229,8 +232,8 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     state = integrator.state(t0, e0, v0, a0, lam0)
     timing["setup"] = time.perf_counter() - start
     t1 = time.perf_counter()
+    first = initial_row(model, state)
     if sink:
-        first = initial_row(model, state)
         if not settings.store_q:
             first.q = None
         sink(first)

@@ -1,0 +1,156 @@
+"""General scenes (SPEC section 8): a thin reader over the System API. Every named group
+is one call, in file order: ``&material`` -> System.material, ``&beam`` -> System.beam, ...
+Errors of a call (an unknown body in a joint, a non-physical value) are reported with the
+file and the group, e.g. ``scene.nml: &joint[lift]: unknown body 'jib'``.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..builders.common import BuiltSystem
+from ..errors import InputError
+from ..system import System
+from ..system.sections import SECTIONS
+from ..system.system import LOAD_EFFECTS
+
+#: drive parameters per type: namelist key -> API keyword (with a conversion)
+_DRIVE_KEYS: dict[str, dict[str, str]] = {
+    "constant": {"value": "value"},
+    "spinup": {"omega": "omega", "period": "period", "start": "start"},
+    "cycle": {"amplitude": "amplitude", "period": "period", "t0": "t0"},
+    "sine": {"amplitude": "amplitude", "frequency": "frequency", "phase": "phase",
+             "offset": "offset", "t0": "t0", "ramp": "ramp"},
+}
+_REQUIRED_DRIVE = {"constant": ("value",), "luffing": ("omega", "t_start", "t_brake", "start_deg",
+                                                       "end_deg"),
+                   "spinup": ("omega", "period"), "cycle": ("amplitude", "period"),
+                   "sine": ("amplitude", "frequency"), "table": ()}
+
+
+def effects_of(items: list[tuple[str, dict[str, Any]]]) -> set[str]:
+    """The effects the items of a general scene belong to."""
+    out = set()
+    for group, v in items:
+        if group == "load":
+            out.add(v["effect"] or LOAD_EFFECTS[v["type"]])
+        elif group == "contact":
+            out.add("contact")
+            if v["friction"] > 0:
+                out.add("friction")
+        elif group == "leaf" and v["free_radius"] is not None:
+            out.add("prestress")
+    return out
+
+
+def _section(v: dict[str, Any]):
+    kind = v["section"]
+    keys = {"rectangle": ("width", "height"), "box": ("width", "height", "wall"),
+            "tube": ("diameter", "wall"), "circle": ("diameter",)}[kind]
+    missing = [k for k in keys if v[k] is None]
+    if missing:
+        raise InputError(f"section {kind!r} needs {', '.join(missing)}")
+    extra = [k for k in ("width", "height", "wall", "diameter") if k not in keys and
+             v[k] is not None]
+    if extra:
+        raise InputError(f"section {kind!r} does not take {', '.join(extra)}")
+    return SECTIONS[kind](*(v[k] for k in keys))
+
+
+def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:
+    kind = v["type"]
+    given = {k for k, x in v.items() if x is not None and k not in ("name", "type")}
+    missing = [k for k in _REQUIRED_DRIVE[kind] if v[k] is None]
+    if kind == "table":
+        if (v["file"] is None) == (v["times"] is None):
+            raise InputError("a 'table' drive needs either file or times and values")
+        allowed = {"file"} if v["file"] is not None else {"times", "values"}
+    elif kind == "luffing":
+        allowed = {"omega", "t_start", "t_brake", "start_deg", "end_deg"}
+    else:
+        allowed = set(_DRIVE_KEYS[kind])
+    if missing:
+        raise InputError(f"type {kind!r} needs {', '.join(missing)}")
+    extra = sorted(given - allowed)
+    if extra:
+        raise InputError(f"type {kind!r} does not take {', '.join(extra)}")
+    if kind == "luffing":
+        start, end = math.radians(v["start_deg"]), math.radians(v["end_deg"])
+        s.drive(v["name"], "luffing", omega=abs(v["omega"]) * np.sign(end - start),
+                t_start=v["t_start"], t_brake=v["t_brake"], sweep=end - start, start=start)
+    elif kind == "table":
+        if v["file"] is not None:
+            path = Path(v["file"])
+            s.drive(v["name"], "table", file=path if path.is_absolute() else scene_dir / path)
+        else:
+            s.drive(v["name"], "table", times=v["times"], values=v["values"] or [])
+    else:
+        s.drive(v["name"], kind, **{_DRIVE_KEYS[kind][k]: v[k] for k in given})
+
+
+def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> None:
+    """One namelist group, one call of the System API."""
+    if group == "material":
+        s.material(v["name"], youngs_modulus=v["youngs_modulus"], density=v["density"],
+                   poisson_ratio=v["poisson_ratio"])
+    elif group == "beam":
+        s.beam(v["name"], material=v["material"], start=v["start"], end=v["end"],
+               nodes=v["nodes"], section=_section(v), height_axis=v["height_axis"],
+               formulation=v["formulation"] or scene["scene"]["formulation"],
+               bending=v["bending"], segments=v["segments"], frame_drive=v["frame_drive"],
+               frame_axis=v["frame_axis"], frame_pivot=v["frame_pivot"])
+    elif group == "plate":
+        s.plate(v["name"], material=v["material"], thickness=v["thickness"], corner=v["corner"],
+                edge_x=v["edge_x"], edge_y=v["edge_y"], nx=v["nx"], ny=v["ny"],
+                variant=v["variant"])
+    elif group == "leaf":
+        s.leaf(v["name"], material=v["material"], thickness=v["thickness"], width=v["width"],
+               arc_length=v["arc_length"], radius=v["radius"], centre=v["centre"], nx=v["nx"],
+               ny=v["ny"], variant=v["variant"], free_radius=v["free_radius"])
+    elif group == "rigid_body":
+        s.rigid_body(v["name"], mass=v["mass"], inertia=v["inertia"], position=v["position"],
+                     planar=v["planar"], plane_normal=v["plane_normal"])
+    elif group == "drive":
+        _drive(s, v, scene_dir)
+    elif group == "joint":
+        s.joint(v["name"], v["type"], v["body1"], v["body2"], point=v["point"], axis=v["axis"],
+                drive=v["drive"], point1=v["point1"], point2=v["point2"], pivot=v["pivot"],
+                vector=v["vector"])
+    elif group == "load":
+        s.load(v["name"], v["type"], body=v["body"], point=v["point"], vector=v["vector"],
+               mass=v["mass"], value=v["value"], drive=v["drive"], effect=v["effect"])
+    elif group == "contact":
+        s.contact(v["name"], v["body1"], v["body2"], stiffness=v["stiffness"],
+                  damping=v["damping"], friction=v["friction"], slip_speed=v["slip_speed"],
+                  points=v["points"])
+    elif group == "probe":
+        s.probe(v["name"], v["body"], v["point"])
+    else:  # the schema admits no other group
+        raise AssertionError(group)
+
+
+def build_general(scene) -> BuiltSystem:
+    """The System of a general scene (its groups in file order)."""
+    s = System(scene["scene"]["title"], effects=scene.effects)
+    # materials and drives first, then the bodies (numbered in file order), then what refers
+    # to them: a scene may list its groups in any order
+    rank = {"material": 0, "drive": 1, "beam": 2, "plate": 2, "leaf": 2, "rigid_body": 2}
+    order = sorted(scene.items, key=lambda item: rank.get(item[0], 3))
+    for group, values in order:
+        try:
+            _call(s, group, values, scene, scene.path.parent)
+        except InputError as exc:
+            raise InputError(str(exc), file=str(scene.path),
+                             group=f"{group}[{values['name']}]") from None
+    response = None
+    if scene["scene"].get("response"):
+        name = scene["scene"]["response"]
+        if name not in s.probes:
+            raise InputError(f"response {name!r} is not a probe (probes: "
+                             f"{', '.join(s.probes) or 'none'})", file=str(scene.path),
+                             group="scene", key="response")
+        response = (name, scene["scene"]["response_component"])
+    return BuiltSystem(s, response)

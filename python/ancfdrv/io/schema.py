@@ -1,0 +1,437 @@
+"""The schema of scenes: every group and key a namelist may use, with its type, default,
+physical range and a one-line meaning.
+
+Template scenes (SPEC section 3) use :data:`SCHEMA`: one model group (``&boom``,
+``&cantilever``, ``&spinup``, ``&plate``, ``&leaf``, ``&spring``) and the common groups. General
+scenes (SPEC section 8) use the repeatable, named groups of :data:`GENERAL_SCHEMA` (each
+one call of the System API, :mod:`ancfdrv.io.general`) with ``&scene``, ``&solver`` and
+``&output``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from ..errors import InputError
+
+REQUIRED = object()
+
+#: Effects a scene may list in ``&scene effects``; what is not listed is never computed.
+EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
+                     "point_loads", "pressure", "prestress", "contact", "friction", "load_cycle")
+#: Effects of later capabilities, recognised so the message can say so.
+EFFECTS_PLANNED = ("damping",)
+
+
+@dataclass(frozen=True)
+class Key:
+    """One namelist key: its type, default (or REQUIRED), check and meaning."""
+
+    kind: str  # 'float', 'int', 'str', 'bool', 'floats', 'strs'
+    default: Any = REQUIRED
+    check: Callable[[Any], str | None] | None = None
+    doc: str = ""
+    size: int | None = None  # exact length for list kinds
+
+
+def positive(v: Any) -> str | None:
+    return None if v > 0 else "must be positive"
+
+
+def non_negative(v: Any) -> str | None:
+    return None if v >= 0 else "must not be negative"
+
+
+def one_of(*choices: str) -> Callable[[Any], str | None]:
+    def check(v: Any) -> str | None:
+        return None if v in choices else f"must be one of {', '.join(repr(c) for c in choices)}"
+    return check
+
+
+def within(lo: float, hi: float, *, open_hi: bool = False) -> Callable[[Any], str | None]:
+    def check(v: Any) -> str | None:
+        ok = lo <= v < hi if open_hi else lo <= v <= hi
+        return None if ok else f"must lie in [{lo}, {hi}{')' if open_hi else ']'}"
+    return check
+
+
+SCHEMA: dict[str, dict[str, Key]] = {
+    "scene": {
+        "title": Key("str", doc="a line describing the scene"),
+        "analysis": Key("str", "static", one_of("static", "dynamic", "static+dynamic"),
+                        "which analysis runs"),
+        "formulation": Key("str", "ffr", one_of("ffr", "nonlinear"), "elastic model"),
+        "effects": Key("strs", [], doc="force effects to compute; nothing else is computed "
+                       "(general scenes: default every effect their items belong to)"),
+        "response": Key("str", None, doc="general scenes: the probe sweeps compare (default: "
+                        "the first probe)"),
+        "response_component": Key("int", 2, within(0, 2), "general scenes: the component of the "
+                                  "response probe's deflection compared (0, 1, 2 = x, y, z; beams "
+                                  "in their frame)"),
+    },
+    "beam": {
+        "length": Key("float", check=positive, doc="length of the neutral axis (m)"),
+        "width": Key("float", check=positive, doc="section width w, along z (m)"),
+        "height": Key("float", check=positive, doc="section height h, along y (m)"),
+        "nodes": Key("int", check=lambda v: None if v >= 2 else "must be at least 2",
+                     doc="total nodes on the beam"),
+        "segments": Key("floats", None, doc="segment lengths between fixed nodes (m); "
+                        "each is split into equal elements"),
+        "bending": Key("str", "continuum", one_of("continuum", "cubic"),
+                       "'continuum': the paper's element (curvature constant per element); "
+                       "'cubic': curvature from the cubic centre line r_xx, higher accuracy "
+                       "(docs/theory.md section 12)"),
+    },
+    "material": {
+        "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
+        "density": Key("float", check=positive, doc="rho (kg/m^3)"),
+        "poisson_ratio": Key("float", 0.0, within(0.0, 0.5, open_hi=True),
+                             doc="nu in the elastic law; 0 avoids Poisson locking"),
+    },
+    "boom": {
+        "pivot_offset": Key("float", 0.295, positive, "H = |O A1| (m)"),
+        "angle_deg": Key("float", 0.0, within(-180.0, 180.0),
+                         "luffing angle phi of the rigid configuration at t = 0 (deg)"),
+        "omega": Key("float", 0.2, non_negative, "luffing rate (rad/s); 0 holds phi fixed"),
+        "t_start": Key("float", 1.0, positive, "t_s: duration of the smooth start (s)"),
+        "t_brake": Key("float", 1.0, positive, "t_b: duration of the smooth braking (s)"),
+        "angle_end_deg": Key("float", 60.0, within(-180.0, 180.0),
+                             "luffing angle reached at the end of braking (deg)"),
+    },
+    "cantilever": {
+        "clamp": Key("str", "section", one_of("section", "full", "pin"),
+                     "'section' fixes r, r_y, r_z of the root node; 'full' also r_x; 'pin' "
+                     "fixes r and r_z (a hinge about r3)"),
+    },
+    "spinup": {
+        "omega": Key("float", 6.0, positive, "final hub speed W (rad/s)"),
+        "period": Key("float", 15.0, positive, "spin-up time T (s)"),
+    },
+    "plate": {
+        "length_x": Key("float", check=positive, doc="side along r1 (m)"),
+        "length_y": Key("float", check=positive, doc="side along r2 (m)"),
+        "thickness": Key("float", check=positive, doc="plate thickness h (m)"),
+        "nx": Key("int", 4, positive, "elements along r1"),
+        "ny": Key("int", 4, positive, "elements along r2"),
+        "variant": Key("str", "completed", one_of("plain", "completed"),
+                       "thin plate element (seed 003): 'plain' (Dufva-Shabana) or "
+                       "'completed' (unit normal as third gradient)"),
+        "support": Key("str", "corner_spherical",
+                       one_of("corner_spherical", "simply_supported", "clamped_edge"),
+                       "'corner_spherical': spherical joint at the corner (0, 0, 0); "
+                       "'simply_supported': w = 0 on all edges; 'clamped_edge': edge x = 0 "
+                       "clamped"),
+    },
+    "leaf": {
+        "arc_length": Key("float", None, positive, "mid-surface arc length (m); required "
+                          "in &leaf scenes (in &spring scenes the leaves' lengths are in &spring)"),
+        "radius": Key("float", None, positive, "mid-surface radius of the initial "
+                      "(assembled) shape (m); concave up, symmetric about r1 = 0; required in "
+                      "&leaf scenes"),
+        "prestress": Key("bool", False, doc="&spring scenes: the lower leaf's stress-free "
+                         "radius is free_radius (needs the effect 'prestress'); off: it is "
+                         "stress-free as assembled"),
+        "free_radius": Key("float", None, positive, "radius of the stress-free shape (m); "
+                           "differs from radius only with the effect 'prestress' "
+                           "(default: radius)"),
+        "width": Key("float", check=positive, doc="leaf width along r2 (m)"),
+        "thickness": Key("float", check=positive, doc="leaf thickness (m)"),
+        "nx": Key("int", 8, lambda v: None if v >= 2 and v % 2 == 0 else
+                  "must be even (the middle of the leaf is a node line)",
+                  "elements along the arc"),
+        "ny": Key("int", 1, positive, "elements across the width"),
+        "variant": Key("str", "completed", one_of("plain", "completed"),
+                       "'completed' removes the initial strain of the curved reference; "
+                       "'plain' springs back toward flat (seed 003's motivation)"),
+        "support": Key("str", "middle_clamp", one_of("middle_clamp", "free"),
+                       "'middle_clamp': r and r_x of the middle node line fixed (the "
+                       "axle's U-bolts, seed 003); 'free': unsupported"),
+    },
+    "spring": {
+        "main_arc_length": Key("float", 1.2, positive, "main (upper) leaf arc length (m)"),
+        "main_radius": Key("float", 2.0, positive, "main leaf mid-surface radius (m)"),
+        "main_nx": Key("int", 12, lambda v: None if v >= 2 and v % 2 == 0 else
+                       "must be even (the middle of the leaf is a node line)",
+                       "main leaf elements along the arc"),
+        "lower_arc_length": Key("float", 0.8, positive, "lower leaf arc length (m)"),
+        "lower_radius": Key("float", None, positive, "lower leaf mid-surface radius as "
+                            "assembled (m); default main_radius + thickness (concentric, "
+                            "touching)"),
+        "lower_nx": Key("int", 8, lambda v: None if v >= 2 and v % 2 == 0 else
+                        "must be even (the middle of the leaf is a node line)",
+                        "lower leaf elements along the arc"),
+        "chassis_mass": Key("float", 500.0, positive, "chassis mass (kg)"),
+        "chassis_inertia": Key("float", 50.0, positive, "chassis inertia about r2 (kg m^2)"),
+        "shackle_length": Key("float", 0.1, positive, "shackle length, eye to chassis (m)"),
+        "shackle_mass": Key("float", 2.0, positive, "shackle mass (kg)"),
+        "guide": Key("str", "planar", one_of("planar", "vertical"),
+                     "'planar': chassis free in the r1-r3 plane; 'vertical': it translates "
+                     "without turning (load cycle; its horizontal drift stays free, as the "
+                     "axle and the front eye are both held along r1)"),
+        "contact_stiffness": Key("float", 1.0e6, positive, "penalty stiffness K (N/m)"),
+        "contact_damping": Key("float", 1.0e4, non_negative,
+                               "contact damping C in F_n = K d - C d' d"),
+        "friction_coefficient": Key("float", 0.3, non_negative, "Coulomb coefficient mu"),
+        "slip_velocity": Key("float", 0.08, positive, "critical slip velocity V_t (m/s)"),
+        "contact_points": Key("int", 3, lambda v: None if v >= 2 else "must be at least 2",
+                              "contact points per end edge of the lower leaf"),
+        "cycle_force": Key("float", 0.0, non_negative, "effect 'load_cycle': peak downward "
+                           "force on the chassis (N)"),
+        "cycle_period": Key("float", 4.0, positive, "effect 'load_cycle': duration of the "
+                            "cycle 0 -> peak -> 0 (s)"),
+    },
+    "loads": {
+        "gravity": Key("float", 9.81, non_negative, "gravitational acceleration (m/s^2)"),
+        "tip_mass": Key("float", 0.0, non_negative, "lumped mass at the tip (kg)"),
+        "moment": Key("float", 0.0, doc="boom: moment M_B about +r3 on the section at A2 (N m)"),
+        "tip_force": Key("floats", [0.0, 0.0, 0.0], size=3, doc="force at the tip (N)"),
+        "end_moment": Key("float", 0.0, doc="moment about +r3 on the tip section (N m)"),
+        "pressure": Key("float", 0.0, doc="plate: dead pressure along -r3 (Pa)"),
+    },
+    "solver": {
+        "static_method": Key("str", "split", one_of("split", "newton"),
+                             "static solver: split iteration or Newton-Raphson"),
+        "tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+                   "relative tolerance of the static solve"),
+        "max_iter": Key("int", 50, positive, "iteration limit of the static solve"),
+        "load_steps": Key("int", 1, positive, "load increments of the static Newton solve "
+                          "(large deformation)"),
+        "split_p": Key("float", 0.0, within(0.0, 1.0, open_hi=True),
+                       "splitting parameter p of K_RR = K_RR1 + K_RR2, in [0, 1)"),
+        "dt": Key("float", 1e-3, positive, "time step (s), dynamic analyses"),
+        "t_end": Key("float", 10.0, non_negative, "end time (s), dynamic analyses"),
+        "integrator": Key("str", "newmark", one_of("newmark", "generalized_alpha"),
+                          "time integrator"),
+        "rho_inf": Key("float", 0.9, within(0.0, 1.0),
+                       "generalized-alpha: spectral radius at infinite frequency (1: no "
+                       "numerical damping)"),
+        "beta": Key("float", 0.25, lambda v: None if 0 < v <= 0.5 else "must lie in (0, 0.5]",
+                    "Newmark beta (1/4: average acceleration, the paper's choice)"),
+        "gamma": Key("float", 0.5, within(0.5, 1.0), "Newmark gamma (1/2: no damping)"),
+        "newton_tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+                          "a step ends when its Newton correction is below newton_tol * length"),
+        "max_newton": Key("int", 10, positive, "Newton iterations allowed per step"),
+        "jacobian": Key("str", "step", one_of("step", "iteration", "reuse"),
+                        "when a refactorized model's iteration matrix is refreshed: 'step' (at "
+                        "each step, and when a correction does not halve), 'iteration' (full "
+                        "Newton), 'reuse' (modified Newton across steps); pure FFR systems "
+                        "factorize once whatever this says"),
+        "contraction": Key("float", 0.5, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+                           "jacobian = 'reuse': refresh when a correction exceeds this fraction "
+                           "of the previous one"),
+        "linear_joints": Key("str", "auto", one_of("auto", "eliminate", "multipliers"),
+                             "linear joint equations: eliminated (q = B e + q0, seed 003) or "
+                             "kept with multipliers (seed 000); 'auto' eliminates when the "
+                             "system has rigid bodies"),
+    },
+    "output": {
+        "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),
+        "q": Key("bool", False, doc="store the coordinates q at every step"),
+        "chunk_steps": Key("int", 1000, positive,
+                           "steps per kernel call; each chunk is flushed to the file"),
+    },
+}
+
+#: Groups that define what is built; a scene has exactly one of them.
+MODEL_GROUPS = ("boom", "cantilever", "spinup", "plate", "leaf", "spring")
+#: Models built from thin plate elements (seed 003); the others are beams (seed 000).
+PLATE_KINDS = ("plate", "leaf", "spring")
+COMMON_GROUPS = ("scene", "material", "loads", "solver", "output")
+
+
+def coerce(kind: str, raw: Any, where: dict) -> Any:
+    def bad(expected: str) -> InputError:
+        return InputError(f"expected {expected}, got {raw!r}", **where)
+
+    def as_float(x: Any) -> float:
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            raise bad("a number")
+        if not math.isfinite(float(x)):
+            raise bad("a finite number")
+        return float(x)
+
+    if kind == "float":
+        return as_float(raw)
+    if kind == "int":
+        if isinstance(raw, bool) or not isinstance(raw, int):
+            if isinstance(raw, float) and raw.is_integer():
+                return int(raw)
+            raise bad("an integer")
+        return raw
+    if kind == "str":
+        if not isinstance(raw, str):
+            raise bad("a string")
+        return raw.strip()
+    if kind == "bool":
+        if not isinstance(raw, bool):
+            raise bad(".true. or .false.")
+        return raw
+    if kind == "floats":
+        items = raw if isinstance(raw, list) else [raw]
+        return [as_float(x) for x in items]
+    if kind == "strs":
+        items = raw if isinstance(raw, list) else [raw]
+        if not all(isinstance(x, str) for x in items):
+            raise bad("a list of strings")
+        return [x.strip() for x in items if x is not None and x.strip()]  # '' = none
+    raise AssertionError(kind)
+
+
+def vector3(v: Any) -> str | None:
+    return None if len(v) == 3 else f"must be three numbers (x, y, z), got {len(v)}"
+
+
+def points3(v: Any) -> str | None:
+    return None if len(v) and len(v) % 3 == 0 else \
+        f"must be x, y, z (or several points: a multiple of 3 numbers), got {len(v)} numbers"
+
+
+def at_least(n: int) -> Callable[[Any], str | None]:
+    def check(v: Any) -> str | None:
+        return None if v >= n else f"must be at least {n}"
+    return check
+
+
+def _name(doc: str = "a unique name of the item") -> Key:
+    return Key("str", doc=doc)
+
+
+#: Repeatable, named groups of general scenes (SPEC section 8); list kinds are checked as a
+#: whole (vector3, points3) rather than per item.
+GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
+    "material": {
+        "name": _name(),
+        "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
+        "density": Key("float", check=positive, doc="rho (kg/m^3)"),
+        "poisson_ratio": Key("float", 0.0, within(0.0, 0.5, open_hi=True), "nu"),
+    },
+    "beam": {
+        "name": _name(),
+        "material": Key("str", doc="name of a &material"),
+        "start": Key("floats", check=vector3, doc="start of the neutral axis (m)"),
+        "end": Key("floats", check=vector3, doc="end of the neutral axis (m)"),
+        "nodes": Key("int", check=at_least(2), doc="nodes on the beam (>= 2)"),
+        "segments": Key("floats", None, doc="segment lengths (m) each split equally (keeps "
+                        "their ends as nodes); default: one segment"),
+        "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle"),
+                       "cross-section: 'rectangle' (width, height), 'box' (width, height, wall), "
+                       "'tube' (diameter, wall), 'circle' (diameter)"),
+        "width": Key("float", None, positive, "section width along r_z (m)"),
+        "height": Key("float", None, positive, "section height along r_y (m)"),
+        "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
+        "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+        "height_axis": Key("floats", None, vector3, "direction of the section height "
+                           "(default: global z, or y for a beam along z)"),
+        "formulation": Key("str", None, one_of("ffr", "nonlinear"),
+                           "'ffr' or 'nonlinear' (default: the scene's)"),
+        "bending": Key("str", "continuum", one_of("continuum", "cubic"), "bending option"),
+        "frame_drive": Key("str", None, doc="drive turning the beam's frame (FFR: the "
+                           "floating frame; both: the frame of the probe deflections)"),
+        "frame_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the frame's turn"),
+        "frame_pivot": Key("floats", None, vector3, "point of the frame's axis (default: start)"),
+    },
+    "plate": {
+        "name": _name(),
+        "material": Key("str", doc="name of a &material"),
+        "thickness": Key("float", check=positive, doc="thickness (m)"),
+        "corner": Key("floats", check=vector3, doc="first corner (m)"),
+        "edge_x": Key("floats", check=vector3, doc="edge vector along the length (m)"),
+        "edge_y": Key("floats", check=vector3, doc="edge vector across, orthogonal (m)"),
+        "nx": Key("int", check=positive, doc="elements along edge_x"),
+        "ny": Key("int", check=positive, doc="elements along edge_y"),
+        "variant": Key("str", "completed", one_of("plain", "completed"), "thin plate variant"),
+    },
+    "leaf": {
+        "name": _name(),
+        "material": Key("str", doc="name of a &material"),
+        "thickness": Key("float", check=positive, doc="thickness (m)"),
+        "width": Key("float", check=positive, doc="width along r2 (m)"),
+        "arc_length": Key("float", check=positive, doc="mid-surface arc length (m)"),
+        "radius": Key("float", check=positive, doc="mid-surface radius, concave up (m)"),
+        "centre": Key("floats", check=vector3, doc="midpoint (lowest point) of the arc (m)"),
+        "nx": Key("int", check=positive, doc="elements along the arc (even)"),
+        "ny": Key("int", 1, positive, "elements across the width"),
+        "variant": Key("str", "completed", one_of("plain", "completed"), "thin plate variant"),
+        "free_radius": Key("float", None, positive, "stress-free radius (prestress; needs the "
+                           "effect 'prestress')"),
+    },
+    "rigid_body": {
+        "name": _name(),
+        "mass": Key("float", check=positive, doc="mass (kg)"),
+        "inertia": Key("floats", size=6, doc="Ixx, Iyy, Izz, Ixy, Iyz, Ixz about the centre of "
+                       "mass, global axes at t = 0 (kg m^2)"),
+        "position": Key("floats", check=vector3, doc="centre of mass at t = 0 (m)"),
+        "planar": Key("bool", False, doc="kept in the plane normal to plane_normal"),
+        "plane_normal": Key("floats", [0.0, 1.0, 0.0], vector3,
+                            "normal of the plane of a planar body (a coordinate axis)"),
+    },
+    "joint": {
+        "name": _name(),
+        "type": Key("str", check=one_of("weld", "revolute", "spherical", "distance", "prescribed",
+                                        "fix", "arm", "hub"), doc="joint type (SPEC section 8)"),
+        "body1": Key("str", "ground", doc="first body (or 'ground')"),
+        "body2": Key("str", doc="second body"),
+        "point": Key("floats", None, points3, "joint point(s) (nodes of beams and plates)"),
+        "axis": Key("floats", None, vector3, "hinge axis / direction"),
+        "drive": Key("str", None, doc="drive of 'distance', 'prescribed', 'hub'"),
+        "point1": Key("floats", None, vector3, "'distance': point on body1"),
+        "point2": Key("floats", None, vector3, "'distance': point on body2"),
+        "pivot": Key("floats", None, vector3, "'prescribed', 'arm', 'hub': centre of rotation"),
+        "vector": Key("str", "r", one_of("r", "r_x", "r_y", "r_z"), "'fix': the nodal vector held"),
+    },
+    "drive": {
+        "name": _name(),
+        "type": Key("str", check=one_of("constant", "luffing", "spinup", "cycle", "sine", "table"),
+                    doc="drive type"),
+        "value": Key("float", None, doc="'constant': the value"),
+        "omega": Key("float", None, doc="'luffing', 'spinup': rate (rad/s)"),
+        "t_start": Key("float", None, positive, "'luffing': smooth start (s)"),
+        "t_brake": Key("float", None, positive, "'luffing': smooth braking (s)"),
+        "start_deg": Key("float", None, doc="'luffing': angle at t = 0 (deg)"),
+        "end_deg": Key("float", None, doc="'luffing': angle after braking (deg)"),
+        "period": Key("float", None, positive, "'spinup': spin-up time; 'cycle': duration (s)"),
+        "start": Key("float", None, doc="'spinup': angle at t = 0 (rad)"),
+        "amplitude": Key("float", None, doc="'cycle', 'sine': amplitude"),
+        "t0": Key("float", None, doc="'cycle', 'sine': start time (s)"),
+        "frequency": Key("float", None, non_negative, "'sine': frequency (Hz)"),
+        "phase": Key("float", None, doc="'sine': phase (rad)"),
+        "offset": Key("float", None, doc="'sine': offset"),
+        "ramp": Key("float", None, non_negative, "'sine': smooth ramp-in time (s)"),
+        "file": Key("str", None, doc="'table': CSV file of (t, value) rows, relative to the scene"),
+        "times": Key("floats", None, doc="'table': times (s), increasing"),
+        "values": Key("floats", None, doc="'table': values at the times"),
+    },
+    "load": {
+        "name": _name(),
+        "type": Key("str", check=one_of("gravity", "force", "moment", "point_mass", "pressure"),
+                    doc="load type"),
+        "body": Key("str", None, doc="the loaded body"),
+        "point": Key("floats", None, vector3, "material point (m)"),
+        "vector": Key("floats", None, vector3, "gravity (m/s^2), force (N), moment (N m)"),
+        "mass": Key("float", None, non_negative, "'point_mass': mass (kg)"),
+        "value": Key("float", None, doc="'pressure': pressure (Pa) against the normal"),
+        "drive": Key("str", None, doc="'force': scales the vector with the drive's value"),
+        "effect": Key("str", None, doc="the effect it belongs to (default by type: gravity, "
+                      "point_loads, point_loads, tip_mass, pressure)"),
+    },
+    "contact": {
+        "name": _name(),
+        "body1": Key("str", doc="the searched (upper) plate or leaf"),
+        "body2": Key("str", doc="the plate or leaf whose end edges carry the points"),
+        "stiffness": Key("float", check=positive, doc="penalty K (N/m)"),
+        "damping": Key("float", 0.0, non_negative, "C in F_n = K d - C d' d"),
+        "friction": Key("float", 0.0, non_negative, "Coulomb mu"),
+        "slip_speed": Key("float", 0.08, positive, "critical slip speed V_t (m/s)"),
+        "points": Key("int", 3, at_least(2), "contact points per end edge"),
+    },
+    "probe": {
+        "name": _name(),
+        "body": Key("str", doc="the body"),
+        "point": Key("floats", check=vector3, doc="material point (m)"),
+    },
+}
+#: Groups of general scenes that occur once (shared with the template scenes).
+GENERAL_SINGLE_GROUPS = ("scene", "solver", "output")
+#: Groups only general scenes have.
+GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe")
