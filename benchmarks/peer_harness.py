@@ -672,7 +672,7 @@ def compare_boom_ffr(runs: BoomRuns) -> dict[str, Any]:
             "exudyn_over_ancfdrv_solve": ratio(cheapest.solve_s, ffr.solve_s)
             if cheapest else None}
     record["histories"] = histories(runs.grid, {"reference": reference, "ancfdrv_ffr": ffr,
-                                                "exudyn": best}, 0.01)
+                                                "exudyn": best}, 0.02)
     return record
 
 
@@ -699,6 +699,8 @@ def compare_boom_nonlinear(runs: BoomRuns) -> dict[str, Any]:
         return record
     peer = [runs.exudyn(k) for k in plan.boom_exudyn_per_segment]
     finest = peer[-1]
+    for row, run in zip(record["ancfdrv"], ours):
+        row["error_vs_exudyn_finest"] = boom_error(run, finest, sag_range)
     record["exudyn"] = [run_row(r, {
         "error_vs_reference": boom_error(r, reference, sag_range),
         "error_vs_exudyn_finest": boom_error(r, finest, sag_range)}) for r in peer]
@@ -733,17 +735,25 @@ def compare_boom_nonlinear(runs: BoomRuns) -> dict[str, Any]:
         "error": pe.dominance(mine, theirs, "error")}
     record["histories"] = histories(runs.grid, {"reference": reference, "ancfdrv": headline,
                                                 "exudyn": exu_headline, "exudyn_finest": finest},
-                                    0.01)
+                                    0.02)
     return record
+
+
+def compact(values: np.ndarray, digits: int = 10) -> list[Any]:
+    """Values rounded to ``digits`` significant digits, for the JSON (far finer than any
+    difference the reports compare)."""
+    array = np.asarray(values, dtype=float)
+    rounded = [float(f"{x:.{digits}g}") for x in array.ravel()]
+    return np.array(rounded).reshape(array.shape).tolist()
 
 
 def histories(grid: np.ndarray, runs: dict[str, Timed | None], every: float) -> dict[str, Any]:
     """The runs' histories every ``every`` seconds (a multiple of the grid's step)."""
     step = max(1, int(round(every / (grid[1] - grid[0]))))
-    out: dict[str, Any] = {"time": grid[::step]}
+    out: dict[str, Any] = {"time": compact(grid[::step])}
     for name, run in runs.items():
         if run is not None and run.ok and run.values is not None:
-            out[name] = run.values[::step]
+            out[name] = compact(run.values[::step])
     return out
 
 
@@ -886,17 +896,17 @@ def compare_plate(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace)
                                     "exudyn_over_ancfdrv_solve": ratio(r.solve_s, ours.solve_s),
                                     "exudyn_over_ancfdrv_whole": ratio(r.whole_s, ours.whole_s)})
                         for r in peers]
-    same = peers[0]
-    if same.ok and ours.ok:
-        record["headline"] = {
-            "ancfdrv": ours.label, "exudyn": same.label,
-            "ancfdrv_solve_s": ours.solve_s, "exudyn_solve_s": same.solve_s,
-            "ancfdrv_whole_s": ours.whole_s, "exudyn_whole_s": same.whole_s,
-            "exudyn_over_ancfdrv_solve": ratio(same.solve_s, ours.solve_s),
-            "exudyn_over_ancfdrv_whole": ratio(same.whole_s, ours.whole_s),
-            "distance_between_codes_m": max_difference(same.history, ours.history),
-            "ancfdrv_distance_to_reference_m": errors(ours)["distance_to_reference_m"],
-            "exudyn_distance_to_reference_m": errors(same)["distance_to_reference_m"]}
+    for key, peer in (("headline", peers[0]), ("headline_reduced_integration", peers[1])):
+        if peer.ok and ours.ok:
+            record[key] = {
+                "ancfdrv": ours.label, "exudyn": peer.label,
+                "ancfdrv_solve_s": ours.solve_s, "exudyn_solve_s": peer.solve_s,
+                "ancfdrv_whole_s": ours.whole_s, "exudyn_whole_s": peer.whole_s,
+                "exudyn_over_ancfdrv_solve": ratio(peer.solve_s, ours.solve_s),
+                "exudyn_over_ancfdrv_whole": ratio(peer.whole_s, ours.whole_s),
+                "distance_between_codes_m": max_difference(peer.history, ours.history),
+                "ancfdrv_distance_to_reference_m": errors(ours)["distance_to_reference_m"],
+                "exudyn_distance_to_reference_m": errors(peer)["distance_to_reference_m"]}
     record["histories"] = histories(grid, {"ancfdrv": ours, "reference": reference,
                                            "exudyn": peers[0], "exudyn_sri": peers[1]},
                                     plan.plate_sample_dt)
@@ -973,7 +983,7 @@ def compare_leaf(plan: Plan, workdir: Path, args: argparse.Namespace,
         "ms_per_step": 1e3 * run.solve_s / max(steps, 1),
         "newton_per_step": run.counts.get("newton_iterations", 0) / max(steps, 1),
         "factorizations_per_step": run.counts.get("factorizations", 0) / max(steps, 1),
-        "history": {"time": grid, "chassis": run.history,
+        "history": {"time": compact(grid), "chassis": compact(run.history),
                     "store_dt": plan.leaf_store_dt}})
     if plan.leaf_t_end is None:
         earlier = STORED_FIGURES["leaf"]
@@ -1019,10 +1029,14 @@ def _f(value: Any, fmt: str = ".3f") -> str:
 def ratio_rows(problems: dict[str, Any]) -> list[dict[str, Any]]:
     """One row per headline comparison: the times and the ratio."""
     rows: list[dict[str, Any]] = []
-    for name in ("boom_ffr", "boom_nonlinear", "plate"):
-        head = problems.get(name, {}).get("headline")
+    for name, key, label in (("boom_ffr", "headline", "boom_ffr"),
+                             ("boom_nonlinear", "headline", "boom_nonlinear"),
+                             ("plate", "headline", "plate"),
+                             ("plate", "headline_reduced_integration", "plate (Exudyn SRI)")):
+        head = problems.get(name, {}).get(key)
         if head:
-            rows.append({"problem": name, **head, "stored": STORED_FIGURES.get(name)})
+            rows.append({"problem": label, **head,
+                         "stored": STORED_FIGURES.get(name) if key == "headline" else None})
     for name in ("spinup_w4", "spinup_w6", "pendulum"):
         rec = problems.get(name)
         if rec and "summary" in rec:
@@ -1065,7 +1079,7 @@ def markdown(report: dict[str, Any]) -> str:
                   "ratio solve | ratio whole | error ancfdrv | error Exudyn | stored figure |",
                   "|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---|"]
     for row in headlines:
-        if row["problem"] == "plate":
+        if row["problem"].startswith("plate"):
             errs = (f"{_f(1e3 * row['ancfdrv_distance_to_reference_m'], '.1f')} mm",
                     f"{_f(1e3 * row['exudyn_distance_to_reference_m'], '.1f')} mm")
         else:
@@ -1078,7 +1092,7 @@ def markdown(report: dict[str, Any]) -> str:
                      f"{_f(row['exudyn_solve_s'])} | {_f(row['exudyn_whole_s'])} | "
                      f"{_f(row['exudyn_over_ancfdrv_solve'], '.2f')} | "
                      f"{_f(row['exudyn_over_ancfdrv_whole'], '.2f')} | {errs[0]} | {errs[1]} | "
-                     f"{stored.get('source', '')}: {stored_text} |")
+                     + (f"{stored.get('source', '')}: {stored_text}" if stored else "-") + " |")
     if headlines:
         lines += ["", "Errors: boom: max |sag - sag_ref| over the history in % of the reference's "
                   "sag range, against ancfdrv's converged reference; plate: largest distance of "
@@ -1177,6 +1191,12 @@ def _boom_nonlinear_md(rec: dict[str, Any] | None) -> list[str]:
                 f"{gap['finest_runs'][1]}: {_f(gap['max_abs_m'], '.2e')} m "
                 f"({_f(gap['percent_of_range'], '.3f')} % of the range). Against ancfdrv's "
                 "reference Exudyn's error cannot fall below this gap."]
+        closed = rec.get("static_sag_closed_form", {})
+        if "euler_bernoulli_m" in closed:
+            out += ["", f"Static sag at t = 0 (m): ancfdrv {_f(rec['reference_run'].get('static_sag_m'), '.6f')}"
+                    f", Exudyn {_f(rec['exudyn'][-1].get('static_sag_m'), '.6f')}; linear closed "
+                    f"form (`ancfdrv.reference.analytic`) {closed['euler_bernoulli_m']:.6f} "
+                    f"(Euler-Bernoulli), {closed['timoshenko_k1_m']:.6f} (Timoshenko, k = 1)."]
     for key, dom in rec.get("dominance", {}).items():
         out += ["", f"Dominance ({key}; time = dynamic solve): ancfdrv dominates: "
                 f"{'yes' if dom['ancfdrv_dominates'] else 'no'}; Exudyn dominates: "
