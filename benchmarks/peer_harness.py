@@ -72,8 +72,8 @@ Output: ``benchmarks/results/peer_harness.json`` and ``peer_harness.md`` (with `
 ``peer_harness_quick.json``, ignored by git, and the Markdown inside the JSON only).
 Run from the repository root::
 
-    python benchmarks/peer_harness.py             # all problems, about 10 minutes on 2 cores
-    python benchmarks/peer_harness.py --quick     # short runs and coarse grids, a smoke run
+    python benchmarks/peer_harness.py             # all problems, about 6 minutes on 2 cores
+    python benchmarks/peer_harness.py --quick     # short runs and coarse grids, ~30 s smoke run
     python benchmarks/peer_harness.py --only boom_ffr,plate --repeats 5
     python benchmarks/peer_harness.py --no-exudyn # ancfdrv only
 
