@@ -1098,7 +1098,8 @@ def markdown(report: dict[str, Any]) -> str:
                   "sag range, against ancfdrv's converged reference; plate: largest distance of "
                   "the corner from ancfdrv's finer reference mesh. Stored figures are quoted, not "
                   "measured here.", ""]
-    curves = [row for row in report["ratios"] if "dominance" in row]
+    curves = [row for row in report["ratios"] if "dominance" in row
+              and ("self_error" in row["dominance"] or "error" in row["dominance"])]
     if curves:
         lines += ["Error-against-time curves (whole-call times; for each Exudyn run the cheapest "
                   "ancfdrv run at least as accurate; ratio = ancfdrv's time / Exudyn's):", "",
