@@ -74,10 +74,8 @@ ancfdrv's curve is still reported.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import datetime as _dt
 import importlib
-import io
 import math
 import os
 import sys
@@ -90,6 +88,7 @@ from typing import Any, Callable
 
 import h5py
 import numpy as np
+from _peer import exudyn_version, import_exudyn, quiet_settings, run_quietly
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
@@ -351,26 +350,6 @@ def ancfdrv_breakdown(problem: Problem, run: Run, args: argparse.Namespace) -> d
 
 
 # -- Exudyn ------------------------------------------------------------------------------------
-def import_exudyn() -> tuple[Any, str | None]:
-    """The exudyn module, or None and the reason it cannot be used."""
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            import exudyn
-            import exudyn.beams  # noqa: F401
-            import exudyn.itemInterface  # noqa: F401
-        return exudyn, None
-    except Exception as exc:  # any import failure means: skip the peer
-        return None, f"{type(exc).__name__}: {exc}"
-
-
-def exudyn_version(exu: Any) -> str:
-    config = getattr(exu, "config", None)
-    if config is not None and hasattr(config, "Version"):
-        return str(config.Version())
-    return str(exu.GetVersionString())
-
-
 @dataclass(frozen=True)
 class Beam:
     """What the cable needs, from the ancfdrv scene."""
@@ -421,9 +400,35 @@ def check_spinup_angle(beam: Beam) -> float:
     return float(np.max(np.abs(phi - [spinup_angle(beam, x) for x in t])))
 
 
+def symbolic_slope_offsets(exu: Any, mbs: Any, beam: Beam) -> dict[int, Any]:
+    """The spin-up's root slope offsets (cos phi - 1, sin phi) as Exudyn symbolic user
+    functions, which Exudyn evaluates without calling Python; the same values as
+    :func:`spinup_angle`. Keep them alive as long as the system uses them."""
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    esym = exu.symbolic
+    w, period = beam.omega, beam.period
+
+    def angle(t: Any) -> Any:
+        start = w / period * (0.5 * t * t + (period / (2.0 * math.pi)) ** 2
+                              * (esym.cos(2.0 * math.pi * t / period) - 1.0))
+        return esym.IfThenElse(t < period, start, w * t - esym.Real(0.5 * w * period))
+
+    def cos_offset(mbs_: Any, t: Any, item: int, offset: Any) -> Any:
+        return esym.cos(angle(t)) - 1.0
+
+    def sin_offset(mbs_: Any, t: Any, item: int, offset: Any) -> Any:
+        return esym.sin(angle(t))
+
+    return {coordinate: CreateSymbolicUserFunction(
+        mbs, function, "offsetUserFunction", itemTypeName="ObjectConnectorCoordinate")
+        for coordinate, function in ((2, cos_offset), (3, sin_offset))}
+
+
 def exudyn_model(exu: Any, problem: Problem, beam: Beam, nel: int,
-                 svk_axial: bool = False) -> tuple[Any, Any, int]:
-    """The cable on a fresh system: (system container, mbs, tip sensor)."""
+                 svk_axial: bool = False, symbolic_drive: bool = False) -> tuple[Any, Any, int]:
+    """The cable on a fresh system: (system container, mbs, tip sensor). The spin-up's
+    drive is a Python user function, or with ``symbolic_drive`` a symbolic one."""
     from exudyn.beams import GenerateBeamElementsAlongLine
     from exudyn.itemInterface import (CoordinateConstraint, MarkerNodeCoordinate,
                                       NodePointGround, ObjectANCFCable2D, SensorNode)
@@ -462,8 +467,11 @@ def exudyn_model(exu: Any, problem: Problem, beam: Beam, nel: int,
         root = items["nodes"][0]
         ground = mbs.AddNode(NodePointGround(referenceCoordinates=[0.0, 0.0, 0.0]))
         ground_marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
-        slopes = {2: lambda m, t, i, o: math.cos(spinup_angle(beam, t)) - 1.0,
-                  3: lambda m, t, i, o: math.sin(spinup_angle(beam, t))}
+        slopes: dict[int, Any] = {2: lambda m, t, i, o: math.cos(spinup_angle(beam, t)) - 1.0,
+                                  3: lambda m, t, i, o: math.sin(spinup_angle(beam, t))}
+        if symbolic_drive:
+            slopes = symbolic_slope_offsets(exu, mbs, beam)
+            mbs.variables["symbolic_user_functions"] = list(slopes.values())  # keep alive
         for coordinate, offset in slopes.items():
             marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=root, coordinate=coordinate))
             mbs.AddObject(CoordinateConstraint(markerNumbers=[ground_marker, marker],
@@ -485,36 +493,8 @@ def exudyn_settings(exu: Any, problem: Problem, beam: Beam, dt: float,
     integration.verboseMode = 0
     integration.newton.relativeTolerance = EXUDYN_RELATIVE_TOL
     integration.newton.absoluteTolerance = absolute_tol
-    settings.parallel.numberOfThreads = 1
-    for path, value in (("linearSolver.solverType", exu.LinearSolverType.EigenSparse),
-                        ("show.statistics", False), ("show.computationTime", False),
-                        ("solution.file.write", False), ("solution.sensors.writePeriod", dt)):
-        _set_setting(settings, path, value)
+    quiet_settings(exu, settings, dt)
     return settings
-
-
-#: Exudyn 1.12+ names of settings and the names older versions use (now deprecated).
-_OLD_SETTING_NAMES = {"linearSolver.solverType": "linearSolverType",
-                      "show.statistics": "displayStatistics",
-                      "show.computationTime": "displayComputationTime",
-                      "solution.file.write": "solutionSettings.writeSolutionToFile",
-                      "solution.sensors.writePeriod": "solutionSettings.sensorsWritePeriod"}
-
-
-def _set_setting(settings: Any, path: str, value: Any) -> None:
-    """Set a simulation setting by its current dotted name, or its older one."""
-    for name in (path, _OLD_SETTING_NAMES[path]):
-        *parents, leaf = name.split(".")
-        try:
-            target = settings
-            for parent in parents:
-                target = getattr(target, parent)
-            getattr(target, leaf)
-        except AttributeError:
-            continue
-        setattr(target, leaf, value)
-        return
-    raise AttributeError(f"Exudyn has no setting {path!r}")
 
 
 def exudyn_history(problem: Problem, beam: Beam, data: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -530,18 +510,16 @@ def run_exudyn(exu: Any, problem: Problem, beam: Beam, nel: int, dt: float,
                args: argparse.Namespace, svk_axial: bool = False) -> Run:
     """One Exudyn solve (repeated for timing) at the first absolute tolerance that works."""
     run = Run("exudyn-svk" if svk_axial else "exudyn", nel, nel, dt)
+    symbolic = bool(getattr(args, "exudyn_symbolic_drive", False))
     failures: list[str] = []
     failed_s = 0.0
     for tol in EXUDYN_ABSOLUTE_TOLS:
         def solve(tol: float = tol) -> tuple[np.ndarray, dict[str, Any]]:
-            _, mbs, sensor = exudyn_model(exu, problem, beam, nel, svk_axial)
+            _, mbs, sensor = exudyn_model(exu, problem, beam, nel, svk_axial,
+                                          symbolic_drive=symbolic)
             settings = exudyn_settings(exu, problem, beam, dt, tol)
-            with contextlib.redirect_stdout(io.StringIO()) as banner:
-                try:
-                    mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.GeneralizedAlpha)
-                except Exception as exc:  # Exudyn raises its own SolverError and others
-                    raise RuntimeError(f"{type(exc).__name__}: {exc} "
-                                       f"{banner.getvalue().strip()[:200]}") from None
+            run_quietly(lambda: mbs.SolveDynamic(
+                settings, solverType=exu.DynamicSolverType.GeneralizedAlpha))
             it = mbs.sys["dynamicSolver"].it
             t, y = exudyn_history(problem, beam, mbs.GetSensorStoredData(sensor))
             return resample(problem, t, y), {"steps": int(it.currentStepIndex) - 1,
@@ -557,7 +535,8 @@ def run_exudyn(exu: Any, problem: Problem, beam: Beam, nel: int, dt: float,
             continue
         run.ok = True
         run.steps, run.newton_iterations = details.pop("steps"), details.pop("newton")
-        run.details.update(details, absolute_tol=tol, relative_tol=EXUDYN_RELATIVE_TOL)
+        run.details.update(details, absolute_tol=tol, relative_tol=EXUDYN_RELATIVE_TOL,
+                           drive="symbolic" if symbolic else "python")
         break
     run.details.update(failed_attempts=failures, failed_attempts_s=failed_s)
     if not run.ok:
@@ -812,6 +791,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--no-svk-check", dest="svk_check", action="store_false",
                         help="skip Exudyn with the St. Venant-Kirchhoff axial force")
     parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
+    parser.add_argument("--exudyn-symbolic-drive", action="store_true",
+                        help="the spin-up's hub drive in Exudyn as a symbolic user function "
+                             "(evaluated in C++) instead of a Python one")
     parser.add_argument("--bending", nargs="+", choices=("cubic", "continuum"),
                         default=["cubic", "continuum"],
                         help="ancfdrv's beam.bending options to run, one curve each; the "
@@ -864,6 +846,7 @@ def main(argv: list[str] | None = None) -> int:
         "settings": {"quick": args.quick, "min_time_s": args.min_time,
                      "max_repeats": args.max_repeats, "breakdown": args.breakdown,
                      "svk_check": args.svk_check, "bending": args.bending,
+                     "exudyn_symbolic_drive": args.exudyn_symbolic_drive,
                      "exudyn_relative_tol": EXUDYN_RELATIVE_TOL,
                      "exudyn_absolute_tols_tried": EXUDYN_ABSOLUTE_TOLS},
         "units": "seconds, metres",
