@@ -489,6 +489,12 @@ class KernelSystem:
             nfull=self.nfull)
         self._check(info, "matrices")
 
+    def set_kron_mass(self, scalar_csr) -> None:
+        """M = kron(Mbar, I3): Mbar's CSR on the 3-vectors replaces M in the products."""
+        info = _kernel.system_set_kron_mass(self.handle, _i(scalar_csr.indptr + 1),
+                                            _i(scalar_csr.indices + 1), _f(scalar_csr.data))
+        self._check(info, "kron mass")
+
     def set_reduction(self, b_csr, offset, plan_source, plan_target, plan_coef) -> None:
         info = _kernel.system_set_reduction(
             self.handle, len(b_csr.data), _i(b_csr.indptr + 1),

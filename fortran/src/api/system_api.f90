@@ -263,12 +263,40 @@ subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, m
   sys%policy = policy
   sys%mass_pattern = mass_pattern
   if (allocated(sys%vector_frame)) deallocate (sys%vector_frame)
-  if (nvec > 0) sys%vector_frame = vector_frame(1:nvec)
+  sys%single_frame = -1
+  if (nvec > 0) then
+    sys%vector_frame = vector_frame(1:nvec)
+    if (all(vector_frame(1:nvec) == vector_frame(1)) .and. vector_frame(1) > 0) &
+      sys%single_frame = vector_frame(1)
+  end if
   sys%block_first = block_first(1:nblock)
   deallocate (sys%flexibility, sys%flexibility_cc)
   allocate (sys%flexibility(ndof, 3 * nblock), sys%flexibility_cc(3 * nblock, 3 * nblock))
   sys%factorized = .false.
 end subroutine system_set_matrices
+
+!> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),
+!> replacing the CSR of system_set_matrices in products (a ninth of the entries).
+subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nvec, nnz, row_ptr(nvec + 1), col(nnz)
+  real(dp), intent(in) :: values(nnz)
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (3 * nvec /= sys%ndof .or. any(col < 1) .or. any(col > nvec)) then
+    info = 2
+    return
+  end if
+  sys%mass_row_ptr = row_ptr
+  sys%mass_col = col
+  sys%mass_values = values
+  sys%mass_kron = .true.
+end subroutine system_set_kron_mass
 
 !> q = B e + q0 (B CSR over nfull rows, 1-based) and the plan of B^T S B: values(target)
 !> += coef * full_values(source).

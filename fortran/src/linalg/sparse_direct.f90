@@ -39,6 +39,38 @@ module sparse_direct
 
 contains
 
+  !> Solves U^T U x = b for the banded Cholesky factor U in LAPACK's upper band storage
+  !> (band(kd + 1 + i - j, j) = U(i, j)): the forward and backward substitutions written
+  !> out over the band's contiguous columns (the same arithmetic as dpbtrs, without its
+  !> per-column BLAS calls, which dominated a narrow band's solve).
+  pure subroutine cholesky_band_solve(n, kd, nrhs, band, rhs)
+    integer, intent(in) :: n, kd, nrhs
+    real(dp), intent(in) :: band(kd + 1, n)
+    real(dp), intent(inout) :: rhs(n, nrhs)
+    integer :: i, j, k, first, offset
+    real(dp) :: total, x
+    do k = 1, nrhs
+      do j = 1, n  ! U^T y = b
+        first = max(1, j - kd)
+        offset = kd + 1 - j
+        total = rhs(j, k)
+        do i = first, j - 1
+          total = total - band(offset + i, j) * rhs(i, k)
+        end do
+        rhs(j, k) = total / band(kd + 1, j)
+      end do
+      do j = n, 1, -1  ! U x = y
+        x = rhs(j, k) / band(kd + 1, j)
+        rhs(j, k) = x
+        first = max(1, j - kd)
+        offset = kd + 1 - j
+        do i = first, j - 1
+          rhs(i, k) = rhs(i, k) - x * band(offset + i, j)
+        end do
+      end do
+    end do
+  end subroutine cholesky_band_solve
+
   !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only),
   !> 3 = symmetric positive definite, banded LAPACK Cholesky (give both triangles or one).
   subroutine solver_create(symmetry, handle, info, info_detail)
@@ -199,7 +231,7 @@ contains
           call dgbtrs('N', n, slot%bandwidth, slot%bandwidth, nrhs, slot%general_band, &
                       3 * slot%bandwidth + 1, slot%pivots, rhs, n, info_detail)
         else
-          call dpbtrs('U', n, slot%bandwidth, nrhs, slot%band, slot%bandwidth + 1, rhs, n, info_detail)
+          call cholesky_band_solve(n, slot%bandwidth, nrhs, slot%band, rhs)
         end if
       end associate
       info = merge(0, 3, info_detail == 0)

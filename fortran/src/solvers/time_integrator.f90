@@ -32,7 +32,7 @@
 !> No I/O; failures return codes (see integrator_chunk).
 module time_integrator
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, contact_state, frame_rotations, csr_matvec, &
+  use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
                                internal_forces, external_forces, evaluate_constraints, &
                                constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
                                frame_gradients, energies, probe_output, policy_constant, &
@@ -82,7 +82,7 @@ contains
       if (info /= 0) return
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if
-    call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, acceleration, r)
+    call mass_product(sys, acceleration, r)
     call external_forces(sys, t, 1.0_dp, loads, info)
     if (info /= 0) return
     r = r + internal - loads
@@ -315,9 +315,18 @@ contains
         return
       end if
       last_correction = maxval(abs(correction))
-      if (last_correction <= cfg%tol * cfg%length_scale) then
-        done = .true.
-        return
+      if (converged(sys, cfg, it, last_correction, previous_correction)) then
+        ! accepted on the contraction estimate with a correction larger than the tolerance:
+        ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
+        ! too, in the units of the tightest of length and angle
+        if (sys%ncon > 0 .and. last_correction > cfg%tol * cfg%length_scale) then
+          call evaluate_constraints(sys, e_new, t_new, phi, gradients, info)
+          if (info /= 0) return
+          done = maxval(abs(phi)) <= cfg%tol * min(1.0_dp, cfg%length_scale)
+        else
+          done = .true.
+        end if
+        if (done) return
       end if
       if (sys%policy == policy_constant .or. it >= cfg%max_newton) then
         previous_correction = last_correction
@@ -353,6 +362,42 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> Whether the Newton iteration of a step has converged after correction it of size
+  !> last (the one before: previous). jacobian_step and _iteration: last <= tol L. The
+  !> simplified Newton of the policy constant and of jacobian_reuse (Hairer & Wanner's
+  !> criterion): theta / (1 - theta) last <= tol L, the error left after the correction,
+  !> with the contraction theta = last / previous from the second correction on. With the
+  !> constant policy's matrix (the same for the whole run, its contraction with it) the first
+  !> correction uses twice the theta last measured, and a confirming correction re-measures
+  !> it every confirm_every accepted steps; reuse measures it in every step (the matrix ages).
+  logical function converged(sys, cfg, it, last, previous) result(ok)
+    type(system_model), intent(inout) :: sys
+    type(integrator_settings), intent(in) :: cfg
+    integer, intent(in) :: it
+    real(dp), intent(in) :: last, previous
+    integer, parameter :: confirm_every = 20
+    real(dp) :: limit, theta
+    limit = cfg%tol * cfg%length_scale
+    ok = last <= limit
+    if (sys%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
+    if (it == 1) then
+      ! (reuse: the matrix ages, its contraction with it: measured in every step)
+      if (ok .or. sys%theta < 0.0_dp .or. sys%unconfirmed >= confirm_every .or. &
+          sys%policy /= policy_constant) then
+        if (ok) sys%unconfirmed = sys%unconfirmed + 1
+        return
+      end if
+      theta = min(0.9_dp, 2.0_dp * sys%theta)
+      ok = theta / (1.0_dp - theta) * last <= limit
+      if (ok) sys%unconfirmed = sys%unconfirmed + 1
+      return
+    end if
+    theta = last / previous
+    sys%theta = theta
+    sys%unconfirmed = 0
+    ok = ok .or. (theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit)
+  end function converged
 
   !> One output row (probes, deflections, energies, constraint violation, contact records) of
   !> a state that was not stepped to (the initial state), with the powers there (the start

@@ -69,7 +69,8 @@ contains
   !> malformed (kind, drive or term indices), -k the drive of constraint k failed.
   pure subroutine constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
                                   term_coef, drive_kinds, drive_ptr, drive_data, e, e_dot, t, &
-                                  values, gradients, hessians, phi_t, phi_tt, gamma, info)
+                                  values, gradients, hessians, phi_t, phi_tt, gamma, info, &
+                                  first_order_only)
     integer, intent(in) :: ncon, kinds(:), drives(:), term_ptr(:), term_dof(:)
     integer, intent(in) :: drive_kinds(:), drive_ptr(:)
     real(dp), intent(in) :: params(:, :), operand_const(:, :), term_coef(:), drive_data(:)
@@ -77,14 +78,22 @@ contains
     real(dp), intent(out) :: values(:), gradients(:, :), hessians(:, :, :)
     real(dp), intent(out) :: phi_t(:), phi_tt(:), gamma(:)
     integer, intent(out) :: info
+    !> values and gradients only (hessians, phi_t, phi_tt, gamma left undefined): the
+    !> stepper's residual needs no more
+    logical, intent(in), optional :: first_order_only
     integer :: c, m, drive_info
     real(dp) :: phi, dphi, ddphi, x(6), v(6), a(3), k(3), length
+    logical :: second
+    second = .true.
+    if (present(first_order_only)) second = .not. first_order_only
     values = 0.0_dp
     gradients = 0.0_dp
-    hessians = 0.0_dp
-    phi_t = 0.0_dp
-    phi_tt = 0.0_dp
-    gamma = 0.0_dp
+    if (second) then
+      hessians = 0.0_dp
+      phi_t = 0.0_dp
+      phi_tt = 0.0_dp
+      gamma = 0.0_dp
+    end if
     info = 0
     if (ncon > 0) then
       if (any(term_dof(1:term_ptr(6 * ncon + 1) - 1) < 1) .or. &
@@ -95,7 +104,8 @@ contains
     end if
     do c = 1, ncon
       x = operand_values(c, operand_const, term_ptr, term_dof, term_coef, e, .true.)
-      v = operand_values(c, operand_const, term_ptr, term_dof, term_coef, e_dot, .false.)
+      if (second) v = operand_values(c, operand_const, term_ptr, term_dof, term_coef, e_dot, &
+                                     .false.)
       call drive_value(drives(c), drive_kinds, drive_ptr, drive_data, t, phi, dphi, ddphi, &
                        drive_info)
       if (drive_info /= 0) then
@@ -111,6 +121,7 @@ contains
         values(c) = x(1) - (params(1, c) + params(2, c) * cos(phi) + params(3, c) * sin(phi) &
                             + params(4, c) * phi)
         gradients(1, c) = 1.0_dp
+        if (.not. second) cycle
         phi_t(c) = -(-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * dphi
         phi_tt(c) = -((-params(2, c) * cos(phi) - params(3, c) * sin(phi)) * dphi**2 &
                       + (-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * ddphi)
@@ -120,6 +131,7 @@ contains
         values(c) = dot_product(a, a) - length**2
         gradients(1:3, c) = 2.0_dp * a
         gradients(4:6, c) = -2.0_dp * a
+        if (.not. second) cycle
         do m = 1, 3
           hessians(m, m, c) = 2.0_dp
           hessians(m + 3, m + 3, c) = 2.0_dp
@@ -133,6 +145,7 @@ contains
         values(c) = dot_product(k, cross(x(1:3), x(4:6)))
         gradients(1:3, c) = cross(x(4:6), k)
         gradients(4:6, c) = cross(k, x(1:3))
+        if (.not. second) cycle
         ! d2/da db of k.(a x b) = a^T S b with S(i, j) = k . (u_i x u_j)
         hessians(1:3, 4:6, c) = reshape([0.0_dp, -k(3), k(2), k(3), 0.0_dp, -k(1), &
                                           -k(2), k(1), 0.0_dp], [3, 3])
@@ -141,6 +154,7 @@ contains
         values(c) = dot_product(x(1:3), x(4:6)) - params(1, c)
         gradients(1:3, c) = x(4:6)
         gradients(4:6, c) = x(1:3)
+        if (.not. second) cycle
         do m = 1, 3
           hessians(m, m + 3, c) = 1.0_dp
           hessians(m + 3, m, c) = 1.0_dp

@@ -31,7 +31,8 @@ module mechanical_system
   implicit none
   private
   public :: system_model, frame_def, contact_pair, contact_state
-  public :: frame_rotations, to_full, to_reduced, csr_matvec, internal_forces, external_forces, &
+  public :: frame_rotations, to_full, to_reduced, csr_matvec, mass_product, internal_forces, &
+            external_forces, &
             evaluate_constraints, constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set
 
@@ -75,9 +76,12 @@ module mechanical_system
     type(frame_def), allocatable :: frames(:)
     integer, allocatable :: drive_kinds(:), drive_ptr(:)
     real(dp), allocatable :: drive_data(:)
-    ! mass M (reduced, CSR, 1-based), used for M a and the kinetic energy
+    ! mass M (reduced, CSR, 1-based), used for M a and the kinetic energy; when M is
+    ! kron(Mbar, I3) over whole 3-vectors (beams, plates and rigid bodies all are), the CSR
+    ! of Mbar on the 3-vectors instead (a ninth of the entries)
     integer, allocatable :: mass_row_ptr(:), mass_col(:)
     real(dp), allocatable :: mass_values(:)
+    logical :: mass_kron = .false.
     ! full pattern of the tangents; q = B e + q0 and the plan of B^T S B
     integer, allocatable :: full_row_ptr(:), full_col(:)
     logical :: reduced = .false.
@@ -108,10 +112,15 @@ module mechanical_system
     integer :: solver_handle = 0, policy = policy_refactor
     real(dp), allocatable :: mass_pattern(:)
     integer, allocatable :: vector_frame(:), block_first(:)
+    integer :: single_frame = -1                       ! the frame of every vector, or -1
     ! the current factorization: its flexibility S^{-1} E_c and E_c^T S^{-1} E_c
     logical :: factorized = .false.
     real(dp) :: factor_beta_prime = 0.0_dp
     integer :: factor_active = -1                      ! active contact points at it
+    ! the simplified-Newton contraction rate measured with it (-1: not yet) and the steps
+    ! accepted since without measuring it again
+    real(dp) :: theta = -1.0_dp
+    integer :: unconfirmed = 0
     real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
   end type system_model
 
@@ -177,6 +186,30 @@ contains
       if (sys%frames(f)%drive /= 0) out(:, :, f) = rotations(:, :, 0)
     end do
   end function tangent_rotations
+
+  !> y = M x with the system's mass (CSR, or kron(Mbar, I3) with Mbar's CSR on 3-vectors).
+  pure subroutine mass_product(sys, x, y)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: x(:)
+    real(dp), intent(out) :: y(:)
+    integer :: i, k, j
+    real(dp) :: total(3), m
+    if (.not. sys%mass_kron) then
+      call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, x, y)
+      return
+    end if
+    do i = 1, size(sys%mass_row_ptr) - 1
+      total = 0.0_dp
+      do k = sys%mass_row_ptr(i), sys%mass_row_ptr(i + 1) - 1
+        j = 3 * (sys%mass_col(k) - 1)
+        m = sys%mass_values(k)
+        total(1) = total(1) + m * x(j + 1)
+        total(2) = total(2) + m * x(j + 2)
+        total(3) = total(3) + m * x(j + 3)
+      end do
+      y(3 * i - 2:3 * i) = total
+    end do
+  end subroutine mass_product
 
   !> y = M x for a CSR matrix (1-based).
   pure subroutine csr_matvec(row_ptr, col, values, x, y)
@@ -382,7 +415,7 @@ contains
     call constraint_eval(sys%ncon, sys%con_kind, sys%con_drive, sys%con_params, &
                          sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
                          sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, e, t, phi, gradients, &
-                         hessians, phi_t, phi_tt, gamma, info)
+                         hessians, phi_t, phi_tt, gamma, info, first_order_only=.true.)
     if (info /= 0) info = 5
   end subroutine evaluate_constraints
 
@@ -425,8 +458,19 @@ contains
     logical, intent(in) :: transpose_first
     real(dp), intent(out) :: y(:)
     integer :: b, i, f
+    real(dp) :: r(3, 3)
     if (sys%policy /= policy_constant .or. .not. allocated(sys%vector_frame)) then
       y = x
+      return
+    end if
+    if (sys%single_frame > 0) then  ! every vector in one frame: one rotation, no look-up
+      r = rotations(:, :, sys%single_frame)
+      if (.not. transpose_first) r = transpose(r)
+      do b = 0, size(x) / 3 - 1
+        y(3 * b + 1) = r(1, 1) * x(3 * b + 1) + r(2, 1) * x(3 * b + 2) + r(3, 1) * x(3 * b + 3)
+        y(3 * b + 2) = r(1, 2) * x(3 * b + 1) + r(2, 2) * x(3 * b + 2) + r(3, 2) * x(3 * b + 3)
+        y(3 * b + 3) = r(1, 3) * x(3 * b + 1) + r(2, 3) * x(3 * b + 2) + r(3, 3) * x(3 * b + 3)
+      end do
       return
     end if
     do b = 0, size(x) / 3 - 1
@@ -513,6 +557,8 @@ contains
     end if
     sys%factorized = .true.
     sys%factor_beta_prime = beta_prime
+    sys%theta = -1.0_dp
+    sys%unconfirmed = 0
     if (size(sys%block_first) == 0) return
     sys%flexibility = 0.0_dp
     do b = 1, size(sys%block_first)
@@ -611,7 +657,7 @@ contains
       deflection(:, p) = matmul(transpose(rotations(:, :, f)), probe(:, p) - pivot) &
                          - sys%probe_reference(:, p)
     end do
-    call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, v, mv)
+    call mass_product(sys, v, mv)
     energy = 0.0_dp
     energy(energy_kinetic) = 0.5_dp * dot_product(v, mv)
     energy(energy_strain) = strain

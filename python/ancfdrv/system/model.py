@@ -83,6 +83,20 @@ class ProbeInfo:
     attachment: object = None
 
 
+def kron_scalar(mass: sp.csr_matrix) -> sp.csr_matrix | None:
+    """Mbar when M = kron(Mbar, I3) exactly (every 3 x 3 block a scalar times I3 over whole
+    3-vectors), else None."""
+    if mass.shape[0] % 3:
+        return None
+    scalar = sp.csr_matrix(mass[0::3, 0::3])
+    difference = sp.kron(scalar, sp.identity(3), format="csr") - mass
+    if difference.nnz and abs(difference).max() != 0.0:
+        return None
+    scalar.eliminate_zeros()
+    scalar.sort_indices()
+    return scalar
+
+
 def length_scale(bodies: list[Body]) -> float:
     """The length the Newton tolerances are relative to: the largest flexible body's size
     (a beam's length, the largest extent of a plate's or leaf's nodes along a coordinate
@@ -365,6 +379,9 @@ class Model:
         ks.set_matrices(mass, (self.full_pattern.row_ptr, self.full_pattern.col_index),
                         self.solver.handle, self.policy, self.mass_values(), self.vector_frame,
                         self.touched_blocks())
+        scalar = kron_scalar(mass)
+        if scalar is not None:
+            ks.set_kron_mass(scalar)
         if self.reduction is not None:
             r = self.reduction
             ks.set_reduction(r.matrix, r.offset, r.plan_source, r.plan_target, r.plan_coef)
