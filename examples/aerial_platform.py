@@ -5,7 +5,10 @@ The model (gravity along -z):
 
 * the boom: 8 m steel box girder (250 mm wide, 300 mm high, 6 mm wall) along x, section
   height along z, formulation 'nonlinear' with 'cubic' bending; its frame turns with the
-  slewing drive, so the beam's probe deflections come in the turning frame;
+  slewing drive, so the beam's probe deflections come in the turning frame. (Not 'ffr':
+  welded to a rigid body, whose axes stay unit vectors, an FFR section that turns is
+  shortened to second order, which its linear strain resists: the tip would come out
+  0.7 % too stiff on 9 nodes, an error proportional to the element length);
 * the turntable: a 'hub' joint clamps the boom root and turns it about the vertical axis by
   the angle of the drive 'slew' (a constant for the statics and the free vibration);
 * the basket: a rigid body of 300 kg (a 1.2 x 0.8 x 1.1 m box's inertia), its centre of mass
