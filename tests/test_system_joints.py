@@ -476,12 +476,13 @@ def test_joint_residual_and_jacobian(kind, formulation):
         model.close()
 
 
+@pytest.mark.parametrize("formulation", ["ffr", "nonlinear"])
 @pytest.mark.parametrize("kind", sorted(JOINTS))
-def test_eliminated_joints_hold_for_any_coordinates(kind):
+def test_eliminated_joints_hold_for_any_coordinates(kind, formulation):
     """With the linear joint equations eliminated (q = B e + q0), every linear equation of the
     joint holds for any independent coordinates e (random, 1e-10 of the coordinate scale),
     and the multiplier constraints that remain vanish at e0."""
-    s = _joint_system(kind, "nonlinear")
+    s = _joint_system(kind, formulation)
     model = s.assemble(linear_joints="eliminate")
     try:
         equations = [eq for eq in s.joints["j"].equations(model.q0)
