@@ -650,7 +650,7 @@ def test_driven_coordinate_held_by_a_planar_guide_is_refused_by_name():
                  plane_normal=(0, 0, 1))
     s.joint("jack", "prescribed", "ground", "body", point=(0, 0, 0), axis=(0, 0, 1),
             drive="lift")
-    with pytest.raises(InputError, match=r"jack: z\(t\).*drive 'lift'"):
+    with pytest.raises(InputError, match=r"jack: z\(t\): .*\b(hold|held)\b"):
         s.assemble()
     s = System("hub on a planar body")
     s.drive("spin", "spinup", omega=1.0, period=1.0)
