@@ -13,10 +13,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import kernel
-from ..codes import CONSTRAINT_COORDINATE, CONTACT_COUNTERS, POLICY_CONSTANT, POLICY_REFACTOR
+from ..codes import (CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE,
+                     CONTACT_COUNTERS, POLICY_CONSTANT, POLICY_REFACTOR)
 from ..errors import InputError
 from .bodies import Beam, Body, Ground, Leaf, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
+from .drives import Constant
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation, orthonormality, planar_fixes
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
@@ -328,23 +330,46 @@ def _add_point_vector(target: np.ndarray, body: Body, point, vector, name: str) 
 
 
 def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list[MomentInfo]:
-    """A dead moment acts on the nodal director least parallel to its axis."""
+    """A dead moment acts on the nodal directors that measure the rotation about its axis.
+
+    A rigid body: the director least parallel to the axis. A beam or plate section with
+    the two directors d1, d2 (beam r_y, r_z; plate r_x, r_y) and the normal n = d1 x d2 at
+    t = 0: the moment's components about d1 and d2 act on d2 and d1, its component about n
+    on both, in the shares that turn the section without shearing it (Beam.torsion_shares;
+    halves on a plate): a single director would also load the section's shear, an error of
+    the order M / (G A h) that grows as the mesh is refined."""
     out = []
     for load in loads:
         body = load.body
         at = body.locate(load.point, node=not isinstance(body, RigidBody),
                          what=f"load {load.name!r}")
         axis = load.vector / np.linalg.norm(load.vector)
-        best = None
-        for which in body.directors(at):
-            first = next(iter(body.vector(at, which).terms))
-            d = q0[first:first + 3]
-            score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
-            if best is None or score > best[0] + 1e-12:
-                best = (score, first, which)
-        out.append(MomentInfo(load.name, np.arange(best[1], best[1] + 3), axis,
-                              float(np.linalg.norm(load.vector)), load.effect,
-                              q0[best[1]:best[1] + 3].copy()))
+        magnitude = float(np.linalg.norm(load.vector))
+        firsts = {which: next(iter(body.vector(at, which).terms))
+                  for which in body.directors(at)}
+        if isinstance(body, RigidBody):
+            best = None
+            for which, first in firsts.items():
+                d = q0[first:first + 3]
+                score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
+                if best is None or score > best[0] + 1e-12:
+                    best = (score, first)
+            parts = [(best[1], axis, magnitude)]
+        else:
+            f1, f2 = firsts.values()
+            u1 = q0[f1:f1 + 3] / np.linalg.norm(q0[f1:f1 + 3])
+            u2 = q0[f2:f2 + 3] / np.linalg.norm(q0[f2:f2 + 3])
+            normal = np.cross(u1, u2)
+            normal /= np.linalg.norm(normal)
+            m_n, m_1, m_2 = (float(magnitude * axis @ u) for u in (normal, u1, u2))
+            w1, w2 = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
+            parts = [(f1, normal, w1 * m_n), (f2, normal, w2 * m_n), (f2, u1, m_1),
+                     (f1, u2, m_2)]
+            parts = [(f, np.sign(m) * k, abs(m)) for f, k, m in parts
+                     if abs(m) > 1e-14 * magnitude]
+        for first, k, m in parts:
+            out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
+                                  q0[first:first + 3].copy()))
         counters[load.effect] += 1
     return out
 
@@ -386,11 +411,15 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
     out = ConstraintSet(drive_kinds=[d.kind for d in drives],
                         drive_params=[d.params() for d in drives])
     prefer = []
+    scale = max(1.0, float(np.abs(e0).max(initial=0.0)))
     for eq in equations:
         operands = []
         for operand in eq.operands:
             s = elimination.substitute(operand)
             operands.append(({int(column[d]): c for d, c in s.terms.items()}, s.const))
+        if not any(terms for terms, _ in operands):
+            _constant_constraint(eq, [c for _, c in operands], 1e-8 * scale ** 2, notes)
+            continue
         out.add(eq.kind, operands, eq.params,
                 -1 if eq.drive is None else drive_index[id(eq.drive)], eq.name)
         prefer.append([int(column[d]) for d in eq.prefer if column[d] >= 0])
@@ -451,6 +480,32 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
         taken.add(choice)
         out.dependent.append(choice)
     return out
+
+
+def _constant_constraint(eq: Constraint, x: list[float], tol: float, notes: list[str]) -> None:
+    """A constraint whose operands the eliminated coordinates make constant (e.g. a driven
+    coordinate that a planar guide already holds): it is noted as redundant when it holds
+    for every value of its drive, else it contradicts the other joints."""
+    x = np.array(list(x) + [0.0] * (6 - len(x)))
+    p = np.array(list(eq.params) + [0.0] * (8 - len(eq.params)))
+    phi0 = 0.0 if eq.drive is None else eq.drive.value(0.0)
+    samples = [phi0] if eq.drive is None or isinstance(eq.drive, Constant) else \
+        [phi0, phi0 + 0.3, phi0 - 1.1]
+    for phi in samples:
+        if eq.kind == CONSTRAINT_COORDINATE:
+            value = x[0] - (p[0] + p[1] * np.cos(phi) + p[2] * np.sin(phi) + p[3] * phi)
+        elif eq.kind == CONSTRAINT_DISTANCE:
+            value = float(np.sum((x[:3] - x[3:]) ** 2)) - (p[0] + p[1] * phi) ** 2
+        elif eq.kind == CONSTRAINT_CROSS:
+            value = float(p[:3] @ np.cross(x[:3], x[3:]))
+        else:
+            value = float(x[:3] @ x[3:]) - p[0]
+        if abs(value) > tol:
+            raise InputError(f"{eq.name}: the other joints hold every coordinate of this "
+                             f"equation, which it would move (off by {value:.3e}"
+                             + ("" if eq.drive is None else
+                                f" at the value {phi:g} of drive {eq.drive.name!r}") + ")")
+    notes.append(f"redundant joint equation dropped: {eq.name} (satisfied identically)")
 
 
 # -- contact, probes -------------------------------------------------------------------------

@@ -294,6 +294,17 @@ class Beam(Body):
     def directors(self, at: Attachment) -> list[str]:
         return ["r_y", "r_z"]
 
+    def torsion_shares(self) -> tuple[float, float]:
+        """How a torque about the axis divides between the directors r_y and r_z when the
+        section turns without shearing: halves with 'cubic' bending (its twist is
+        (r_y,x . r_z - r_z,x . r_y)/2); in the continuum element r_y's turn shears the fibres
+        at distance y (along the height) and r_z's those at distance z, so int y^2 dA / J
+        and int z^2 dA / J."""
+        if self.bending == "cubic":
+            return 0.5, 0.5
+        data = self.section.data
+        return data.inertia_z / data.polar, data.inertia_y / data.polar
+
 
 class Plate(Body):
     """A thin plate (seed 003): flat rectangle from ``corner`` along the orthogonal edge

@@ -8,7 +8,9 @@ Types (SPEC section 8, plus what the template scenes need):
 
 - ``weld``: the positions coincide and body2's section or orientation (beam: r_y, r_z;
   plate: r_x, r_y; rigid body: its three axes) follows body1's directions at the point
-  (a constant combination of body1's nodal vectors or axes);
+  (a constant combination of body1's nodal vectors or axes; a rigid body's axes carry a
+  flexible body's section whichever is body1; a direction along a beam's axis is its
+  section normal, not the sheared tangent r_x: see :func:`_section_ties`);
 - ``revolute``: positions coincide and the two bodies' vectors along ``axis`` coincide;
 - ``spherical``: positions coincide;
 - ``distance``: |p2 - p1| is held at its initial value, or follows ``drive`` (a hydraulic
@@ -34,7 +36,7 @@ import numpy as np
 
 from ..codes import CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE, CONSTRAINT_DOT
 from ..errors import InputError
-from .bodies import Attachment, Body, Ground, RigidBody, rotation_about
+from .bodies import Attachment, Beam, Body, Ground, RigidBody, rotation_about
 from .drives import Drive
 from .expressions import Scalar, Vec3, combination
 
@@ -177,22 +179,32 @@ class Joint:
 
     def _weld(self, at1, at2, q0, name) -> list[Equation]:
         out = self._spherical(at1, at2, q0, name)
-        basis = self.body1.basis(at1)
+        base, at_b, held, at_h = self.body1, at1, self.body2, at2
+        if isinstance(held, RigidBody) and base.flexible:
+            # a rigid body's axes carry the flexible body's section (they neither shear nor
+            # stretch), whatever the order the joint names the bodies in
+            base, at_b, held, at_h = held, at_h, base, at_b
+        basis = base.basis(at_b)
         initial = [b.value(q0) for b in basis]
-        for which in self.body2.held_vectors(at2):
-            v2 = self.body2.vector(at2, which)
-            coef = _express(basis, initial, v2.value(q0), f"joint {name!r}")
-            out += vector_equations(v2, combination(basis, coef), f"{name}: {which}")
+        ties = []
+        for which in held.held_vectors(at_h):
+            v = held.vector(at_h, which)
+            ties.append((which, v, _express(basis, initial, v.value(q0), f"joint {name!r}")))
+        if isinstance(base, Beam) and any(coef[0] != 0.0 for *_, coef in ties):
+            return out + _section_ties(base, at_b, held, at_h, ties, q0, name)
+        for which, v, coef in ties:
+            out += vector_equations(v, combination(basis, coef), f"{name}: {which}")
         return out
 
     def _revolute(self, at1, at2, q0, name) -> list[Equation]:
         out = self._spherical(at1, at2, q0, name)
         axes = []
         for body, at in ((self.body1, at1), (self.body2, at2)):
-            basis = body.basis(at)
-            coef = _express(basis, [b.value(q0) for b in basis], self.axis, f"joint {name!r}")
-            axes.append(combination(basis, coef) if basis else Vec3.constant(self.axis))
-        return out + vector_equations(axes[1], axes[0], f"{name}: axis")
+            components, kept = _carried(body, at, self.axis, q0, name)
+            axes.append(components)
+            out += kept
+        return out + [LinearEquation(axes[1][i] - axes[0][i], f"{name}: axis [{'xyz'[i]}]",
+                                     list(axes[1][i].terms)) for i in range(3)]
 
     def _fix(self, at1, at2, q0, name) -> list[Equation]:
         v = self.body2.vector(at2, self.vector)
@@ -276,6 +288,107 @@ class Joint:
             params = [0.0, 1.0]
         return [Constraint(CONSTRAINT_DISTANCE, p2.components() + p1.components(), params,
                            self.drive, f"{self.name}: length")]
+
+
+def _dot(u: Vec3, v: Vec3, q0: np.ndarray, name: str, prefer: list[int]) -> Constraint:
+    """u . v kept at its initial value."""
+    return Constraint(CONSTRAINT_DOT, u.components() + v.components(),
+                      [float(u.value(q0) @ v.value(q0))], None, name, prefer)
+
+
+def _small_turn(beam: Beam) -> bool:
+    """Whether the beam's section turns are small and its kinematics linear (FFR, fixed
+    frame): then directions it carries are linear in its coordinates (:func:`_turned`)."""
+    return beam.formulation == "ffr" and beam.frame_drive is None
+
+
+def _turned(beam: Beam, at: Attachment, v0: np.ndarray) -> list[Scalar]:
+    """The components of v0 + w x v0: the direction v0 (at t = 0) turned with the small
+    rotation w of the beam's section, from its directors d_y, d_z (e: their initial
+    directions): w_x = s_y d_y . e_z - s_z d_z . e_y (s: the beam's torsion shares),
+    w_y = d_z . e_x, w_z = -d_y . e_x. Free of the section's stretch and shear, and of the
+    centre line's slope r_x (which also turns with the shear strain)."""
+    e = beam.orientation.T   # rows e_x, e_y, e_z
+    d_y, d_z = (beam.vector(at, w) for w in ("r_y", "r_z"))
+    s_y, s_z = beam.torsion_shares()
+    rotation = [d_y.along(e[2]).scaled(s_y) - d_z.along(e[1]).scaled(s_z), d_z.along(e[0]),
+                d_y.along(e[0]).scaled(-1.0)]
+    out = []
+    for i in range(3):
+        expr = Scalar({}, float(v0[i]))
+        for k in range(3):
+            expr = expr + rotation[k].scaled(float(np.cross(e[k], v0)[i]))
+        out.append(expr)
+    return out
+
+
+def _kept(body: Body, at: Attachment, names: list[str], q0: np.ndarray, name: str
+          ) -> list[Constraint]:
+    """The lengths and mutual angles of the body's nodal vectors ``names`` at the attachment
+    kept as built (dot products): a rigid section, so that ties to one of its directors
+    turn it as a whole instead of shearing it."""
+    vectors = [body.vector(at, n) for n in names]
+    return [_dot(vectors[i], vectors[j], q0, f"{name}: {body.name}'s {names[i]} . {names[j]} "
+                 "kept", []) for i in range(len(names)) for j in range(i, len(names))]
+
+
+def _carried(body: Body, at: Attachment, k0: np.ndarray, q0: np.ndarray, name: str
+             ) -> tuple[list[Scalar], list[Constraint]]:
+    """The direction k0 (at t = 0) as the body carries it at the attachment (components),
+    and the equations that make it turn with the body's section: a beam's section turn
+    (:func:`_turned`) for an FFR beam in a fixed frame; otherwise its section directors with
+    the section kept rigid there (:func:`_kept`); for other bodies a constant combination of
+    their directions (the ground's are fixed)."""
+    if isinstance(body, Ground):
+        return [Scalar({}, float(c)) for c in k0], []
+    basis = body.basis(at)
+    coef = _express(basis, [b.value(q0) for b in basis], k0, f"joint {name!r}")
+    if isinstance(body, Beam):
+        if _small_turn(body):
+            return _turned(body, at, k0), []
+        if coef[0] == 0.0:
+            directors = [body.vector(at, w) for w in ("r_y", "r_z")]
+            return combination(directors, coef[1:]).components(), \
+                _kept(body, at, ["r_y", "r_z"], q0, name)
+    return combination(basis, coef).components(), []
+
+
+def _section_ties(base: Beam, at_b: Attachment, held: Body, at_h: Attachment, ties: list,
+                  q0: np.ndarray, name: str) -> list[Equation]:
+    """Weld ties of the held vectors v0 = a n + b d_y + c d_z when some have a component a
+    along the beam's axis n (d_y, d_z: its section directors r_y, r_z at the joint).
+
+    The beam's r_x is the tangent of its centre line, which also turns with the shear strain
+    and stretches; and a single director turns with the section's own shear. Tying v to
+    either would pass the joint's moments through the beam's shear at one node, an error
+    that grows as the mesh is refined. The held vectors follow the section's rotation:
+
+    * an FFR beam in a fixed frame (small rotations, linear kinematics): v = v0 + w x v0
+      (:func:`_turned`), linear equations consistent with the beam's kinematics;
+    * otherwise (large rotations) v - b d_y - c d_z stays normal to both directors (two dot
+      products) where a is not zero, v = b d_y + c d_z where it is, and the sections at the
+      joint (the directors' lengths and angles, on both bodies) are kept as built, so that
+      these ties measure rotations only (a rigid connector at the joint).
+    """
+    out: list[Equation] = []
+    if _small_turn(base):
+        for which, v, _ in ties:
+            turned = _turned(base, at_b, v.value(q0))
+            out += [LinearEquation(v.component(i) - turned[i],
+                                   f"{name}: {which} [{'xyz'[i]}] (section turn)", _dofs(v, i))
+                    for i in range(3)]
+        return out
+    directors = [base.vector(at_b, w) for w in ("r_y", "r_z")]
+    for which, v, coef in ties:
+        if coef[0] == 0.0:
+            out += vector_equations(v, combination(directors, coef[1:]), f"{name}: {which}")
+            continue
+        w = v - combination(directors, coef[1:])
+        prefer = [d for i in range(3) for d in _dofs(v, i)]
+        out += [_dot(w, d, q0, f"{name}: {which} normal to {base.name}'s {dn}", prefer)
+                for d, dn in zip(directors, ("r_y", "r_z"))]
+    return out + _kept(base, at_b, ["r_y", "r_z"], q0, name) + \
+        _kept(held, at_h, held.held_vectors(at_h), q0, name)
 
 
 def orthonormality(body: RigidBody) -> list[Constraint]:
