@@ -374,14 +374,9 @@ def test_luffing_drive_follows_spec_section_5():
     _check_rates(drive, smooth, omega * np.pi / t_s)
 
 
-@pytest.mark.xfail(strict=True, raises=InputError,
-                   reason="kernel drives.f90 refuses omega <= 0 for the luffing profile, while "
-                          "Luffing documents 'sign gives the direction' and io/general.py passes "
-                          "a negative omega when end_deg < start_deg")
 def test_luffing_drive_downwards_mirrors_upwards():
     """A downward luffing (omega = -0.2 rad/s, sweep = -60 degrees, from 60 degrees) is the
-    mirror image of the upward one: phi_down(t) = 2 start - phi_up(t) with the same start.
-    (Known failure, reported: the kernel refuses a negative omega.)"""
+    mirror image of the upward one: phi_down(t) = 2 start - phi_up(t) with the same start."""
     s = System()
     up = s.drive("up", "luffing", omega=0.2, t_start=1.0, t_brake=1.0, sweep=np.pi / 3,
                  start=np.pi / 3)

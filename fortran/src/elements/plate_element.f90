@@ -310,19 +310,25 @@ contains
     integer, intent(out) :: info
     real(dp) :: plane_stress(3, 3), membrane_d(3, 3), bending_d(3, 3)
     real(dp) :: fields(3, plate_fields), point_w, gradient(3, plate_fields), hessian(15, 15)
-    real(dp) :: nodal(3, plate_shapes), half(15, plate_dofs)
-    integer :: p, i, j, ka, kb
+    real(dp) :: nodal(3, plate_shapes), half(15, plate_dofs), shape_d(plate_fields, plate_shapes)
+    real(dp) :: total
+    integer :: p, i, j, ka, kb, f, row, col
     info = 0
     plane_stress = youngs / (1.0_dp - poisson**2) * reshape([1.0_dp, poisson, 0.0_dp, poisson, &
                    1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp * (1.0_dp - poisson)], [3, 3])
     membrane_d = thickness * plane_stress
     bending_d = thickness**3 / 12.0_dp * plane_stress
-    force = 0.0_dp
     energy = 0.0_dp
-    tangent = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
     nodal = 0.0_dp
     do p = 1, plate_points
-      fields = matmul(coords, derivs(:, :, p))
+      shape_d = transpose(derivs(:, :, p))
+      fields = 0.0_dp
+      do ka = 1, plate_shapes
+        do f = 1, plate_fields
+          fields(:, f) = fields(:, f) + coords(:, ka) * shape_d(f, ka)
+        end do
+      end do
       if (norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
           sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
         info = 2
@@ -331,22 +337,46 @@ contains
       call point_energy(fields, frame(:, :, p), curvature0(:, p), membrane_d, bending_d, &
                         want_tangent, point_w, gradient, hessian)
       energy = energy + weights(p) * point_w
-      nodal = nodal + weights(p) * matmul(gradient, transpose(derivs(:, :, p)))
-      if (.not. want_tangent) cycle
-      ! K += L^T H L with L = kron(dS^T, I3), in two passes: half = H L (15 x 36), then
-      ! L^T half
-      do kb = 1, plate_shapes
-        do j = 1, 3
-          half(:, 3 * kb - 3 + j) = weights(p) * matmul(hessian(:, j:15:3), derivs(kb, :, p))
+      gradient = weights(p) * gradient
+      do ka = 1, plate_shapes
+        do f = 1, plate_fields
+          nodal(:, ka) = nodal(:, ka) + gradient(:, f) * shape_d(f, ka)
         end do
       end do
-      do ka = 1, plate_shapes
-        do i = 1, 3
-          tangent(3 * ka - 3 + i, :) = tangent(3 * ka - 3 + i, :) &
-                                       + matmul(derivs(ka, :, p), half(i:15:3, :))
+      if (.not. want_tangent) cycle
+      ! K += L^T H L with L = kron(dS^T, I3), in two passes: half = w H L (15 x 36), then
+      ! the upper triangle of L^T half (the lower one is its mirror: H is symmetric)
+      do kb = 1, plate_shapes
+        do j = 1, 3
+          col = 3 * kb - 3 + j
+          do row = 1, 15
+            total = 0.0_dp
+            do f = 1, plate_fields
+              total = total + hessian(row, 3 * f - 3 + j) * shape_d(f, kb)
+            end do
+            half(row, col) = weights(p) * total
+          end do
+        end do
+      end do
+      do col = 1, plate_dofs
+        do ka = 1, (col + 2) / 3
+          do i = 1, 3
+            total = 0.0_dp
+            do f = 1, plate_fields
+              total = total + shape_d(f, ka) * half(3 * f - 3 + i, col)
+            end do
+            tangent(3 * ka - 3 + i, col) = tangent(3 * ka - 3 + i, col) + total
+          end do
         end do
       end do
     end do
+    if (want_tangent) then
+      do col = 1, plate_dofs
+        do row = col + 1, plate_dofs
+          tangent(row, col) = tangent(col, row)
+        end do
+      end do
+    end if
     force = reshape(nodal, [plate_dofs])
   end subroutine plate_forces
 

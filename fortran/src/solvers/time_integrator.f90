@@ -199,8 +199,13 @@ contains
               / (1.0_dp - cfg%alpha_m)
       e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
     else
-      e_new = e
-      a_new = -(v / h + (0.5_dp - cfg%beta) * a) / cfg%beta
+      if (maxval(abs(h * v)) <= contact_step_cap(sys)) then
+        e_new = e + h * v
+        a_new = -((0.5_dp - cfg%beta) * a) / cfg%beta
+      else
+        e_new = e
+        a_new = -(v / h + (0.5_dp - cfg%beta) * a) / cfg%beta
+      end if
       accel_new = ((1.0_dp - cfg%alpha_m) * a_new + cfg%alpha_m * a - cfg%alpha_f * accel) &
                   / (1.0_dp - cfg%alpha_f)
     end if
@@ -295,11 +300,7 @@ contains
         ! damped Newton with contact: no correction moves a coordinate by more than half a
         ! leaf thickness (a contact that is open at the linearization point has no stiffness
         ! there, and a full step would jump far through the other leaf)
-        step_cap = huge(1.0_dp)
-        do pair = 1, size(sys%pairs)
-          step_cap = min(step_cap, 0.5_dp * sys%pairs(pair)%params(cp_upper_thickness), &
-                         0.5_dp * sys%pairs(pair)%params(cp_lower_thickness))
-        end do
+        step_cap = contact_step_cap(sys)
         if (maxval(abs(correction)) > step_cap) then
           dlam = dlam * (step_cap / maxval(abs(correction)))
           correction = correction * (step_cap / maxval(abs(correction)))
@@ -362,6 +363,18 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> Half the thinnest leaf of any contact pair: no Newton correction moves a coordinate
+  !> further.
+  pure real(dp) function contact_step_cap(sys) result(cap)
+    type(system_model), intent(in) :: sys
+    integer :: pair
+    cap = huge(1.0_dp)
+    do pair = 1, size(sys%pairs)
+      cap = min(cap, 0.5_dp * sys%pairs(pair)%params(cp_upper_thickness), &
+                0.5_dp * sys%pairs(pair)%params(cp_lower_thickness))
+    end do
+  end function contact_step_cap
 
   !> Whether the Newton iteration of a step has converged after correction it of size
   !> last (the one before: previous). jacobian_step and _iteration: last <= tol L. The

@@ -1,7 +1,7 @@
 !> Prescribed time functions phi(t), phi'(t), phi''(t) that drive rheonomic constraints.
 !>   kind 0  constant:  phi = p(1)
 !>   kind 1  luffing profile of SPEC section 5 (smooth start, constant rate, smooth brake):
-!>           p = [omega, t_s, t_b, phi_end, phi_start]
+!>           p = [omega, t_s, t_b, sweep, phi_start] (omega and sweep of one sign)
 !>   kind 2  spin-up of Simo & Vu-Quoc (REFERENCES.md): p = [W, T, phi_start],
 !>           phi = (W/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)) for t < T, W t - W T/2 after
 !>   kind 3  load cycle: p = [amplitude, T, t_0]: phi = amplitude (1 - cos(2 pi (t - t_0)/T))/2
@@ -51,7 +51,7 @@ contains
       t_s = params(2)
       t_b = params(3)
       t_c = params(4) / omega - 0.5_dp * (t_s + t_b)
-      if (omega <= 0.0_dp .or. t_s <= 0.0_dp .or. t_b <= 0.0_dp .or. t_c < 0.0_dp) then
+      if (omega == 0.0_dp .or. t_s <= 0.0_dp .or. t_b <= 0.0_dp .or. t_c < 0.0_dp) then
         info = 2
         return
       end if

@@ -129,21 +129,25 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(:), energy, tangent(:, :)
     integer, intent(out) :: info
+    real(dp) :: coords(3, set%nde / 3)
+    integer :: node
     info = 0
+    ! the element's coordinates as (3, shapes), copied in place of a reshape temporary
+    do node = 1, set%nde / 3
+      coords(:, node) = e(set%dofs(3 * node - 2:3 * node, el))
+    end do
     select case (set%kind)
     case (set_continuum)
-      call nonlinear_element(reshape(e(set%dofs(:, el)), [3, 8]), set%gradients(:, :, :, el), &
-                             set%weights(:, el), set%volume_points, set%youngs, set%poisson, &
-                             want_tangent, force, energy, tangent)
+      call nonlinear_element(coords, set%gradients(:, :, :, el), set%weights(:, el), &
+                             set%volume_points, set%youngs, set%poisson, want_tangent, force, &
+                             energy, tangent)
     case (set_structural)
-      call structural_element(reshape(e(set%dofs(:, el)), [3, 8]), set%forms(:, :, :, el), &
-                              set%strain0(:, el), set%term_stiffness(:, el), want_tangent, force, &
-                              energy, tangent)
+      call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
+                              set%term_stiffness(:, el), want_tangent, force, energy, tangent)
     case (set_plate)
-      call plate_forces(reshape(e(set%dofs(:, el)), [3, 12]), set%derivs(:, :, :, el), &
-                        set%plate_frame(:, :, :, el), set%curvature0(:, :, el), &
-                        set%weights(:, el), set%youngs, set%poisson, set%thickness, &
-                        want_tangent, force, energy, tangent, info)
+      call plate_forces(coords, set%derivs(:, :, :, el), set%plate_frame(:, :, :, el), &
+                        set%curvature0(:, :, el), set%weights(:, el), set%youngs, set%poisson, &
+                        set%thickness, want_tangent, force, energy, tangent, info)
     end select
   end subroutine element_forces
 

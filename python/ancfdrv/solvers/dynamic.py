@@ -202,8 +202,10 @@ def initial_row(model: Model, state: dict) -> Chunk:
     row = model.kernel.output_row(state["t"], state["e"], state["v"], state["lam"],
                                   state["work"], state["guesses"], state["counts"])
     state["powers"] = row["powers"]
-    return Chunk(time=np.array([state["t"]]), probes=row["probes"][None], deflections=
-                 row["deflections"][None], lam=state["lam"][None, :], energy=row["energy"][None],
+    # copies: the kernel updates the state's arrays in place as it steps on
+    return Chunk(time=np.array([state["t"]]), probes=row["probes"][None],
+                 deflections=row["deflections"][None], lam=state["lam"][None, :].copy(),
+                 energy=row["energy"][None],
                  constraint=np.array([row["violation"]]), stats=np.zeros((1, 3), dtype=np.int64),
                  q=state["e"][None, :].copy(),
                  contact=row["records"].T[None] if model.contact_pairs else None)

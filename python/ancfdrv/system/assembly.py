@@ -425,28 +425,6 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
         prefer.append([int(column[d]) for d in eq.prefer if column[d] >= 0])
     if not len(out):
         return out
-    scale = max(1.0, float(np.abs(e0).max(initial=0.0)))
-    # a coordinate equation whose coordinate the eliminated linear joints already fix (e.g.
-    # the z of a prescribed point of a planar body) has no term left, which the kernel
-    # refuses: it holds identically if it is constant and met, else the joints conflict
-    fixed = [c for c in range(len(out))
-             if out.kinds[c] == CONSTRAINT_COORDINATE and not out.terms[c][0]]
-    for c in fixed:
-        p, name = out.params[c], out.names[c]
-        if out.drives[c] >= 0 and any(p[1:4]):
-            raise InputError(f"{name}: the coordinate this drive moves is held by other joints "
-                             "(no free coordinate is left for it)")
-        value = out.operand_const[c][0] - p[0] - p[1]
-        if abs(value) > 1e-8 * scale ** 2:
-            raise InputError(f"{name}: the initial configuration violates this joint equation "
-                             f"by {value:.3e} (check the points, the bodies and the drives' "
-                             "values at t = 0)")
-        notes.append(f"redundant joint equation dropped: {name} (satisfied identically)")
-    if fixed:
-        live = [c for c in range(len(out)) if c not in set(fixed)]
-        out, prefer = out.select(live), [prefer[c] for c in live]
-        if not len(out):
-            return out
     values, *_ = out.evaluate(e0, 0.0)
     keep, basis = [], []
     gradients = out.gradient_rows(e0, ndof)
@@ -501,10 +479,12 @@ def _constant_constraint(eq: Constraint, x: list[float], tol: float, notes: list
         else:
             value = float(x[:3] @ x[3:]) - p[0]
         if abs(value) > tol:
-            raise InputError(f"{eq.name}: the other joints hold every coordinate of this "
-                             f"equation, which it would move (off by {value:.3e}"
-                             + ("" if eq.drive is None else
-                                f" at the value {phi:g} of drive {eq.drive.name!r}") + ")")
+            if eq.drive is None:
+                raise InputError(f"{eq.name}: every coordinate of this equation is held by other "
+                                 f"joints, which violate it by {value:.3e}")
+            raise InputError(f"{eq.name}: the coordinate this drive moves is held by other "
+                             f"joints (no free coordinate is left for it; off by {value:.3e} "
+                             f"at the value {phi:g} of drive {eq.drive.name!r})")
     notes.append(f"redundant joint equation dropped: {eq.name} (satisfied identically)")
 
 
