@@ -18,7 +18,15 @@ contains
   pure function skew(u) result(s)
     real(dp), intent(in) :: u(3)
     real(dp) :: s(3, 3)
-    s = reshape([0.0_dp, u(3), -u(2), -u(3), 0.0_dp, u(1), u(2), -u(1), 0.0_dp], [3, 3])
+    s(1, 1) = 0.0_dp
+    s(2, 1) = u(3)
+    s(3, 1) = -u(2)
+    s(1, 2) = -u(3)
+    s(2, 2) = 0.0_dp
+    s(3, 2) = u(1)
+    s(1, 3) = u(2)
+    s(2, 3) = -u(1)
+    s(3, 3) = 0.0_dp
   end function skew
 
   !> Inverse and determinant of a 3 x 3 matrix (inverse left at zero when singular).

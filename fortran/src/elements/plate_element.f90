@@ -222,7 +222,12 @@ contains
     end do
     energy = 0.5_dp * dot_product(strain, stress)
     gradient = 0.0_dp
-    gradient(:, f_x:f_y) = reshape(matmul(stress, b_strain), [3, 2])
+    do gamma = 1, 2
+      do i = 1, 3
+        gradient(:, f_x + gamma - 1) = gradient(:, f_x + gamma - 1) &
+                                       + stress(i) * b_strain(i, 3 * gamma - 2:3 * gamma)
+      end do
+    end do
     ! bending: c_ab = r_ab . g / |g|^3, local kappa = K^T (c - c0) K in Voigt form
     g = cross(u, v)
     gnorm = norm2(g)
@@ -248,7 +253,11 @@ contains
       dcurv(i, 4:6) = cross(h_eff, u)
       dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g / gnorm**3
     end do
-    gradient = gradient + reshape(matmul(omega, dcurv), [3, plate_fields])
+    do f = 1, plate_fields
+      do i = 1, 3
+        gradient(:, f) = gradient(:, f) + omega(i) * dcurv(i, 3 * f - 2:3 * f)
+      end do
+    end do
     if (.not. want_hessian) return
     ! membrane: B^T D B + kron(K S K^T, I3)
     hessian = 0.0_dp

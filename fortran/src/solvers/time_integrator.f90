@@ -154,9 +154,10 @@ contains
                     accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, info, detail)
         if (info /= 0) return
-        ! a step that failed with a matrix of an earlier step gets one retry with a fresh one
+        ! a step that started with a matrix of an earlier step and failed (even if it
+        ! refreshed the matrix on the way) gets one retry from its start with a fresh one
         if (done .or. cfg%jacobian /= jacobian_reuse .or. sys%policy == policy_constant &
-            .or. stats(stat_factorizations) > 0) exit
+            .or. fresh_matrix) exit
       end do
       if (.not. done) then
         info = 1
@@ -242,7 +243,7 @@ contains
     real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof)
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: w(3 * size(sys%block_first), sys%ncon), schur(sys%ncon, sys%ncon)
-    real(dp) :: dlam(sys%ncon, 1), strain, previous_correction, step_cap
+    real(dp) :: dlam(sys%ncon, 1), strain, previous_correction, step_cap, step_theta
     integer :: it, pair, ipiv(sys%ncon), lapack_info, active
     logical :: use_known, refresh
     info = 0
@@ -250,6 +251,7 @@ contains
     done = .false.
     use_known = fresh_matrix
     previous_correction = huge(1.0_dp)
+    step_theta = 0.0_dp
     active = sys%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
@@ -316,7 +318,7 @@ contains
         return
       end if
       last_correction = maxval(abs(correction))
-      if (converged(sys, cfg, it, last_correction, previous_correction)) then
+      if (converged(sys, cfg, it, last_correction, previous_correction, step_theta)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -384,11 +386,12 @@ contains
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
   !> it every confirm_every accepted steps; reuse measures it in every step (the matrix ages).
-  logical function converged(sys, cfg, it, last, previous) result(ok)
+  logical function converged(sys, cfg, it, last, previous, step_theta) result(ok)
     type(system_model), intent(inout) :: sys
     type(integrator_settings), intent(in) :: cfg
     integer, intent(in) :: it
     real(dp), intent(in) :: last, previous
+    real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
     integer, parameter :: confirm_every = 20
     real(dp) :: limit, theta
     limit = cfg%tol * cfg%length_scale
@@ -409,7 +412,16 @@ contains
     theta = last / previous
     sys%theta = theta
     sys%unconfirmed = 0
-    ok = ok .or. (theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit)
+    ! the largest contraction of the step: a contact point that moves, sticks or slips
+    ! makes the corrections fall irregularly, and a small ratio after a large one is no
+    ! evidence that the next would be as small
+    ! (and the first ratio, from the predictor's error, mostly measures the linear part)
+    if (it == 2 .and. sys%policy /= policy_constant) then
+      step_theta = theta
+      return
+    end if
+    step_theta = max(step_theta, theta)
+    ok = ok .or. (step_theta < 1.0_dp .and. step_theta / (1.0_dp - step_theta) * last <= limit)
   end function converged
 
   !> One output row (probes, deflections, energies, constraint violation, contact records) of

@@ -59,6 +59,18 @@ module leaf_contact
 
 contains
 
+  !> The coordinates (or rates) of one element as (3, 12), from the system vector x at the
+  !> element's dofs.
+  pure function element_coords(x, element_dofs) result(coords)
+    real(dp), intent(in) :: x(:)
+    integer, intent(in) :: element_dofs(:)
+    real(dp) :: coords(3, plate_shapes)
+    integer :: k
+    do k = 1, plate_shapes
+      coords(:, k) = x(element_dofs(3 * k - 2:3 * k))
+    end do
+  end function element_coords
+
   !> Position, velocity, unit normal, its rate and dN/de (3 x 36) at local (xi, eta) of an
   !> element with coordinates coords(3, 12) and velocities rates(3, 12); shape(12) are
   !> the shape functions there. info = 1 when r_x x r_y vanishes.
@@ -91,11 +103,13 @@ contains
       projector(i, i) = projector(i, i) + 1.0_dp
     end do
     projector = projector / length
+    ! dg/de_k = S_y,k [r_x]x - S_x,k [r_y]x = [S_y,k r_x - S_x,k r_y]x (skew is linear)
+    normal_rate = 0.0_dp
     do k = 1, plate_shapes
-      normal_gradient(:, 3 * k - 2:3 * k) = matmul(projector, derivs(k, 2) * skew(r_x) &
-                                                   - derivs(k, 1) * skew(r_y))
+      normal_gradient(:, 3 * k - 2:3 * k) = matmul(projector, &
+                                                   skew(derivs(k, 2) * r_x - derivs(k, 1) * r_y))
+      normal_rate = normal_rate + matmul(normal_gradient(:, 3 * k - 2:3 * k), rates(:, k))
     end do
-    normal_rate = matmul(normal_gradient, reshape(rates, [3 * plate_shapes]))
   end subroutine surface_frame
 
   !> Element and local coordinates of the leaf-level point (s, t) of grid(n_l, n_w).
@@ -123,7 +137,7 @@ contains
     call locate(grid, s, t, element, xi, eta)
     a = sizes(1, element)
     b = sizes(2, element)
-    coords = reshape(e(dofs(:, element)), [3, plate_shapes])
+    coords = element_coords(e, dofs(:, element))
     call plate_shape(xi, eta, a, b, shape, derivs)
     d = matmul(coords, shape) - p
     r_s = a * matmul(coords, derivs(:, 1))
@@ -274,8 +288,10 @@ contains
     map_p = map_p + 0.5_dp * h_l * grad_np
     relative(:, 1:36) = map_q
     relative(:, 37:72) = -map_p
-    rates(1:36) = reshape(upper_rates, [36])
-    rates(37:72) = reshape(lower_rates, [36])
+    do k = 1, plate_shapes
+      rates(3 * k - 2:3 * k) = upper_rates(:, k)
+      rates(36 + 3 * k - 2:36 + 3 * k) = lower_rates(:, k)
+    end do
     v_rel = matmul(relative, rates)
     rate = dot_product(gap_gradient, rates)
     normal_force = k_pen * delta - c_pen * rate * delta
@@ -350,8 +366,8 @@ contains
     integer, intent(in), optional :: row_ptr(:), col(:)
     real(dp), intent(inout), optional :: values(:)
     real(dp) :: force_upper(36), force_lower(36), jacobian(72, 72), record(4), point_potential
-    real(dp) :: point_powers(2), p(3), shape(plate_shapes), unused_v(3), unused_n(3, 2)
-    real(dp) :: unused_g(3, 36), xi_q, eta_q
+    real(dp) :: point_powers(2), p(3), shape(plate_shapes), point_derivs(plate_shapes, 5)
+    real(dp) :: xi_q, eta_q
     integer :: c, upper, lower, index(72), i, j, pos
     logical :: active, want_jacobian
     info = 0
@@ -362,14 +378,10 @@ contains
     do c = 1, size(point_element)
       lower = point_element(c)
       counts(cc_points) = counts(cc_points) + 1
-      call surface_frame(reshape(e(dofs(:, lower)), [3, 12]), reshape(rates(dofs(:, lower)), &
-                         [3, 12]), point_local(1, c), point_local(2, c), sizes(1, lower), &
-                         sizes(2, lower), shape, p, unused_v, unused_n(:, 1), unused_n(:, 2), &
-                         unused_g, info)
-      if (info /= 0) then
-        info = 7
-        return
-      end if
+      ! the point's position on the lower leaf
+      call plate_shape(point_local(1, c), point_local(2, c), sizes(1, lower), sizes(2, lower), &
+                       shape, point_derivs)
+      p = matmul(element_coords(e, dofs(:, lower)), shape)
       call project_point(e, dofs, grid, sizes, p, guesses(:, c), counts(cc_iterations), &
                          counts(cc_fallbacks), info)
       if (info /= 0) then
@@ -381,10 +393,10 @@ contains
       ! a point beyond the upper leaf's ends has no closest point inside it: no contact
       if (guesses(1, c) <= 0.0_dp .or. guesses(1, c) >= real(size(grid, 1), dp)) cycle
       call locate(grid, guesses(1, c), guesses(2, c), upper, xi_q, eta_q)
-      call contact_point(reshape(e(dofs(:, upper)), [3, 12]), reshape(rates(dofs(:, upper)), &
-                         [3, 12]), sizes(1, upper), sizes(2, upper), xi_q, eta_q, &
-                         reshape(e(dofs(:, lower)), [3, 12]), reshape(rates(dofs(:, lower)), &
-                         [3, 12]), sizes(1, lower), sizes(2, lower), point_local(1, c), &
+      call contact_point(element_coords(e, dofs(:, upper)), element_coords(rates, dofs(:, upper)), &
+                         sizes(1, upper), sizes(2, upper), xi_q, eta_q, &
+                         element_coords(e, dofs(:, lower)), element_coords(rates, dofs(:, lower)), &
+                         sizes(1, lower), sizes(2, lower), point_local(1, c), &
                          point_local(2, c), params, velocity_factor, want_jacobian, force_upper, &
                          force_lower, jacobian, record, point_potential, point_powers, active, info)
       if (info /= 0) then
