@@ -1,0 +1,105 @@
+"""The integer codes and layouts of ancfdrv.codes against the Fortran sources they mirror:
+every `integer, parameter` the Python side relies on is read from its module's source and
+compared, so a renumbering on either side fails here instead of silently mislabelling
+results."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from ancfdrv import codes
+
+SRC = Path(__file__).resolve().parents[1] / "fortran" / "src"
+
+
+def parameters(relative: str) -> dict[str, int]:
+    """name -> value of every integer parameter declared in a Fortran source file
+    (continuation lines joined, comments dropped)."""
+    text = (SRC / relative).read_text()
+    lines = [line.split("!")[0].rstrip() for line in text.splitlines()]
+    joined = re.sub(r"&\s*\n\s*&?", " ", "\n".join(lines))
+    values: dict[str, int] = {}
+    for declaration in re.findall(r"integer\s*,\s*parameter[^:]*::(.*)", joined, re.I):
+        for name, value in re.findall(r"(\w+)\s*=\s*(-?\d+)\b", declaration):
+            values[name.lower()] = int(value)
+    return values
+
+
+def layout(params: dict[str, int], names: list[str]) -> tuple[int, ...]:
+    return tuple(params[n] for n in names)
+
+
+def test_element_set_kinds():
+    p = parameters("system/element_sets.f90")
+    assert (codes.SET_FFR, codes.SET_CONTINUUM, codes.SET_STRUCTURAL, codes.SET_PLATE) == \
+        layout(p, ["set_ffr", "set_continuum", "set_structural", "set_plate"])
+
+
+def test_constraint_kinds():
+    p = parameters("system/constraints.f90")
+    assert (codes.CONSTRAINT_COORDINATE, codes.CONSTRAINT_DISTANCE, codes.CONSTRAINT_CROSS,
+            codes.CONSTRAINT_DOT) == layout(p, [f"constraint_kind_{k}" for k in
+                                                ("coordinate", "distance", "cross", "dot")])
+
+
+def test_drive_kinds():
+    p = parameters("system/drives.f90")
+    kinds = ("constant", "luffing", "spinup", "cycle", "sine", "table")
+    assert (codes.DRIVE_CONSTANT, codes.DRIVE_LUFFING, codes.DRIVE_SPINUP, codes.DRIVE_CYCLE,
+            codes.DRIVE_SINE, codes.DRIVE_TABLE) == layout(p, [f"drive_{k}" for k in kinds])
+
+
+def test_section_kinds():
+    p = parameters("elements/beam_section.f90")
+    kinds = ("rectangle", "box", "tube", "circle")
+    assert (codes.SECTION_RECTANGLE, codes.SECTION_BOX, codes.SECTION_TUBE,
+            codes.SECTION_CIRCLE) == layout(p, [f"section_{k}" for k in kinds])
+    assert codes.MAX_SECTION_POINTS == p["max_section_points"]
+
+
+def test_policies_energy_and_power_layouts():
+    p = parameters("system/mechanical_system.f90")
+    assert (codes.POLICY_CONSTANT, codes.POLICY_REFACTOR) == \
+        layout(p, ["policy_constant", "policy_refactor"])
+    energy = ["energy_kinetic", "energy_strain", "energy_loads", "energy_moment", "energy_total",
+              "work_drive", "work_frame", "energy_contact", "work_contact_damping",
+              "work_friction", "work_material_damping"]
+    assert layout(p, energy) == tuple(range(1, len(codes.ENERGY_NAMES) + 1))
+    assert p["energy_count"] == len(codes.ENERGY_NAMES)
+    power = ["power_drive", "power_frame", "power_contact_damping", "power_friction",
+             "power_material_damping"]
+    assert layout(p, power) == tuple(range(1, len(codes.POWER_NAMES) + 1))
+    assert p["power_count"] == len(codes.POWER_NAMES)
+    # the Python names follow the Fortran order
+    assert [n.split("_", 1)[1] for n in power] == list(codes.POWER_NAMES)
+
+
+def test_jacobian_policies_and_step_statistics():
+    p = parameters("solvers/time_integrator.f90")
+    assert (codes.JACOBIAN_STEP, codes.JACOBIAN_ITERATION, codes.JACOBIAN_REUSE) == \
+        layout(p, ["jacobian_step", "jacobian_iteration", "jacobian_reuse"])
+    stats = ["stat_corrections", "stat_factorizations", "stat_jacobians"]
+    assert layout(p, stats) == tuple(range(1, len(codes.STAT_NAMES) + 1))
+    assert p["stat_count"] == len(codes.STAT_NAMES)
+    assert [n.split("_", 1)[1] for n in stats] == list(codes.STAT_NAMES)
+
+
+def test_contact_layouts():
+    p = parameters("system/leaf_contact.f90")
+    assert p["contact_record"] == len(codes.CONTACT_RECORD)
+    counters = ["cc_points", "cc_active", "cc_friction", "cc_iterations", "cc_fallbacks",
+                "cc_dropped"]
+    assert layout(p, counters) == tuple(range(1, len(codes.CONTACT_COUNTERS) + 1))
+    assert p["contact_counters"] == len(codes.CONTACT_COUNTERS)
+    params = [f"cp_{n}" for n in codes.CONTACT_PARAMS]
+    assert layout(p, params) == tuple(range(1, len(codes.CONTACT_PARAMS) + 1))
+    assert p["cp_count"] >= len(codes.CONTACT_PARAMS)
+
+
+@pytest.mark.parametrize("code", sorted(codes.STEP_FAILURES))
+def test_every_step_failure_code_is_set_by_the_kernel(code):
+    """Each failure message belongs to a code the stepper or the system layer returns."""
+    sources = "\n".join(path.read_text() for path in SRC.rglob("*.f90"))
+    assert re.search(rf"\b(info|status\(2\))\s*=\s*{code}\b", sources), code
