@@ -20,7 +20,7 @@ from .bodies import Beam, Body, Ground, Leaf, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
 from .drives import Constant
 from .expressions import Scalar
-from .joints import Constraint, LinearEquation, orthonormality, planar_fixes
+from .joints import Constraint, LinearEquation, orthonormality, planar_fixes, small_turn
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
 from .model import FrameInfo, MomentInfo, Model, ProbeInfo, SetInfo
 from .patterns import Elimination, Pattern, eliminate, reduction_plan
@@ -87,7 +87,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     has_rigid = any(isinstance(b, RigidBody) for b in bodies)
     mode = linear_joints if linear_joints != "auto" else ("eliminate" if has_rigid else
                                                           "multipliers")
-    equations = _equations(system, bodies, q0)
+    equations = _equations(system, bodies, q0, notes, warnings)
     linear = [eq for eq in equations if isinstance(eq, LinearEquation)]
     reduction = None
     if mode == "eliminate" and linear:
@@ -375,17 +375,57 @@ def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list
 
 
 # -- joints ----------------------------------------------------------------------------------
-def _equations(system, bodies, q0: np.ndarray) -> list:
+def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[str]) -> list:
     """Every joint's equations in the order of the joints, then each rigid body's planar
-    guide and orthonormality."""
+    guide and orthonormality, except for linearized bodies (:func:`_linearized`: noted)."""
     out = []
     for joint in system.joints.values():
         out += joint.equations(q0)
+    linearized = _linearized(system, warnings)
     for body in bodies:
         if isinstance(body, RigidBody):
             if body.planar:
                 out += planar_fixes(body, q0)
+            if body.name in linearized:
+                notes.append(f"rigid body {body.name!r}: its axes follow the small section turn "
+                             f"of an FFR beam (weld {linearized[body.name]!r}), linearized; "
+                             "orthonormality not imposed")
+                continue
             out += orthonormality(body)
+    return out
+
+
+def _linearized(system, warnings: list[str]) -> dict[str, str]:
+    """Rigid bodies whose axes are linear in the coordinates, name -> the weld that makes them
+    so: welded to an FFR beam in a fixed frame (Joint.linearized_body), or to such a body
+    through welds between rigid bodies. Their axes are orthonormal to first order only, as
+    the beam's kinematics: imposing J^T J = I would hold the turn at zero. A warning names
+    the welds and revolutes that tie such axes to a body with finite rotations (a nonlinear
+    beam, a plate or leaf, an FFR beam in a moving frame): its directions then follow them
+    to first order only (they stretch by the square of the turn)."""
+    joints = list(system.joints.values())
+    out = {}
+    for joint in joints:
+        body = joint.linearized_body()
+        if body is not None:
+            out.setdefault(body.name, joint.name)
+    grown = True
+    while grown:
+        grown = False
+        for joint in joints:
+            a, b = joint.bodies
+            if joint.type == "weld" and isinstance(a, RigidBody) and isinstance(b, RigidBody):
+                for body, other in ((a, b), (b, a)):
+                    if other.name in out and body.name not in out:
+                        out[body.name], grown = out[other.name], True
+    for joint in (j for j in joints if j.type in ("weld", "revolute")):
+        for body, other in (joint.bodies, joint.bodies[::-1]):
+            if body.name in out and other.flexible and not small_turn(other):
+                warnings.append(
+                    f"joint {joint.name!r} ties the axes of rigid body {body.name!r}, linearized "
+                    f"by the FFR weld {out[body.name]!r}, to {other.name!r}, which turns without "
+                    "that linearization: its directions there follow the body to first order "
+                    "only (use one formulation for the beams on a rigid body)")
     return out
 
 

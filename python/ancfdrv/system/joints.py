@@ -9,8 +9,10 @@ Types (SPEC section 8, plus what the template scenes need):
 - ``weld``: the positions coincide and body2's section or orientation (beam: r_y, r_z;
   plate: r_x, r_y; rigid body: its three axes) follows body1's directions at the point
   (a constant combination of body1's nodal vectors or axes; a rigid body's axes carry a
-  flexible body's section whichever is body1; a direction along a beam's axis is its
-  section normal, not the sheared tangent r_x: see :func:`_section_ties`);
+  flexible body's section whichever is body1, except that an FFR beam in a fixed frame
+  carries a rigid body's axes by its section's small turn, linearly: see
+  :func:`_weld_roles`; a direction along a beam's axis is its section normal, not the
+  sheared tangent r_x: see :func:`_section_ties`);
 - ``revolute``: positions coincide and the two bodies' vectors along ``axis`` coincide;
 - ``spherical``: positions coincide;
 - ``distance``: |p2 - p1| is held at its initial value, or follows ``drive`` (a hydraulic
@@ -177,13 +179,23 @@ class Joint:
         return vector_equations(self.body2.position(at2), self.body1.position(at1),
                                 f"{name}: position")
 
+    def linearized_body(self) -> RigidBody | None:
+        """The rigid body whose axes this weld ties linearly to an FFR beam's small section
+        turn (:func:`_weld_roles`), else None. Its axes are then I + [w]x, orthonormal to
+        first order only, like the beam's own kinematics: the assembly does not impose its
+        orthonormality (it would hold w at zero)."""
+        if self.type != "weld":
+            return None
+        base, held = self.body1, self.body2
+        if isinstance(base, RigidBody):
+            base, held = held, base
+        if isinstance(held, RigidBody) and small_turn(base):
+            return held
+        return None
+
     def _weld(self, at1, at2, q0, name) -> list[Equation]:
         out = self._spherical(at1, at2, q0, name)
-        base, at_b, held, at_h = self.body1, at1, self.body2, at2
-        if isinstance(held, RigidBody) and base.flexible:
-            # a rigid body's axes carry the flexible body's section (they neither shear nor
-            # stretch), whatever the order the joint names the bodies in
-            base, at_b, held, at_h = held, at_h, base, at_b
+        base, at_b, held, at_h = _weld_roles(self.body1, at1, self.body2, at2)
         basis = base.basis(at_b)
         initial = [b.value(q0) for b in basis]
         ties = []
@@ -296,10 +308,41 @@ def _dot(u: Vec3, v: Vec3, q0: np.ndarray, name: str, prefer: list[int]) -> Cons
                       [float(u.value(q0) @ v.value(q0))], None, name, prefer)
 
 
+def small_turn(body: Body) -> bool:
+    """Whether the body is a beam whose section turns are small and kinematics linear (FFR
+    in a fixed frame, :func:`_small_turn`)."""
+    return isinstance(body, Beam) and _small_turn(body)
+
+
 def _small_turn(beam: Beam) -> bool:
     """Whether the beam's section turns are small and its kinematics linear (FFR, fixed
     frame): then directions it carries are linear in its coordinates (:func:`_turned`)."""
     return beam.formulation == "ffr" and beam.frame_drive is None
+
+
+def _weld_roles(body1: Body, at1: Attachment, body2: Body, at2: Attachment
+                ) -> tuple[Body, Attachment, Body, Attachment]:
+    """(base, its attachment, held, its attachment) of a weld: the held body's vectors
+    follow the base's directions. A rigid body welded to a flexible body, whatever the
+    order the joint names them in:
+
+    * to an FFR beam in a fixed frame (:func:`_small_turn`): the beam is the base and the
+      body's axes follow its section's small turn v0 + w x v0 (:func:`_turned`, linear).
+      Tying the beam's directors to the body's orthonormal axes instead would hold them at
+      unit length through a finite turn: the FFR element's linear section strains would
+      read the (cos t - 1) of every component as a stretch and resist the turn with the
+      section stiffness E A L_e / 2 of the joint's node (a spurious moment E A L_e t^3 / 4:
+      the tip of an 8 m FFR 'cubic' cantilever 2.1e-3 too stiff on 2 elements, 2.6e-4 on
+      16);
+    * otherwise the body is the base: its axes carry the flexible body's section (they
+      neither shear nor stretch). This includes an FFR beam in a moving frame, whose
+      linear tie would have time-dependent coefficients: there the stiffening above remains.
+    """
+    if isinstance(body2, RigidBody) and body1.flexible:
+        body1, at1, body2, at2 = body2, at2, body1, at1
+    if isinstance(body1, RigidBody) and small_turn(body2):
+        body1, at1, body2, at2 = body2, at2, body1, at1
+    return body1, at1, body2, at2
 
 
 def _turned(beam: Beam, at: Attachment, v0: np.ndarray) -> list[Scalar]:
