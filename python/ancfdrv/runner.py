@@ -35,7 +35,7 @@ from .builders import build_model
 from .io.scene import PLATE_KINDS, Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
-from .solvers.static import StaticResult, solve_static
+from .solvers.static import StaticResult, solve_newton, solve_static
 
 #: files written beside the result (suffix): the plot of ``ancf run``, the XDMF of plates
 DERIVED_SUFFIXES = {".png": "the plot", ".xdmf": "the XDMF description"}
@@ -185,6 +185,34 @@ def boom_stages(scene: Scene) -> dict[str, tuple[float, float]] | None:
                                 scene["solver"]["t_end"])
 
 
+def settle_mode(scene: Scene) -> str:
+    """How a dynamic run starts: 'none' (from the assembled configuration), 'unloaded'
+    (at rest in the equilibrium of the internal forces alone: prestress carried by
+    contact, the external loads off) or 'loaded' (at rest in the static equilibrium under
+    every load). The spring's ``spring.settle`` ('none' | 'prestress' | 'gravity') names
+    the last two after what they settle."""
+    if scene.kind == "spring":
+        return {"none": "none", "prestress": "unloaded",
+                "gravity": "loaded"}[scene["spring"].get("settle", "none")]
+    return scene["solver"].get("settle", "none")
+
+
+def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str, Any],
+            stop: StopRequest) -> StaticResult:
+    """The static equilibrium a settled dynamic run starts from (Newton, loads scaled by
+    0 or 1), written to /static with the attribute settle."""
+    solver = scene["solver"]
+    with stop.immediate():
+        result = solve_newton(model, tol=solver["tol"], max_iter=solver["max_iter"],
+                              load_steps=solver["load_steps"],
+                              loads=0.0 if settle == "unloaded" else 1.0)
+    result.extra["settle"] = settle
+    for phase, seconds in result.timing.items():
+        timing[f"settle_{phase}"] = seconds
+    results.write_static(out, model, result)
+    return result
+
+
 def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
@@ -303,6 +331,11 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
             e_start = static.e
             if analysis == "static+dynamic":
                 stop.check()
+        settle = settle_mode(scene)
+        if analysis == "dynamic" and settle != "none":
+            static = _settle(scene, model, out, settle, timing, stop)
+            e_start = static.e
+            stop.check()
         if analysis in ("dynamic", "static+dynamic"):
             dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop)
     except Interrupted as exc:

@@ -48,10 +48,16 @@ def build(scene) -> BuiltSystem:
     s.rigid_body("shackle", mass=ms, inertia=ms / 12 * np.diag([ls**2 + h**2, ls**2 + width**2,
                                                                 width**2 + h**2]),
                  position=eye + [0.0, 0.0, ls / 2], planar=True)
-    # axle: r and r_x of both middle node lines
+    # axle: r and r_x of both middle node lines; with a road input the clamp's position
+    # follows it along r3 (the clamp's slope stays held)
+    road = road_drive(s, spring)
     for body in (main, lower):
         middle = body.mesh.coords[body.mesh.node_sets["middle_x"], :3].ravel()
-        s.joint(f"axle {body.name} r", "fix", "ground", body.name, point=middle, vector="r")
+        if road is None:
+            s.joint(f"axle {body.name} r", "fix", "ground", body.name, point=middle, vector="r")
+        else:
+            s.joint(f"axle {body.name} r", "prescribed", "ground", body.name, point=middle,
+                    axis=(0.0, 0.0, 1.0), drive=road)
         s.joint(f"axle {body.name} r_x", "fix", "ground", body.name, point=middle, vector="r_x")
     # hinges about r2: the shackle's top on the chassis, the eye edges' nodes on the chassis
     # (front) and the shackle (rear): points of two bodies kept together, two per edge
@@ -82,3 +88,18 @@ def build(scene) -> BuiltSystem:
     s.probe("main_tip", "main", main.material_point(0.5 * main_l, 0.0))
     s.probe("lower_tip", "lower", lower.material_point(0.5 * low_l, 0.0))
     return BuiltSystem(s, ("chassis", 2))
+
+
+def road_drive(s: System, spring) -> str | None:
+    """The vertical road input at the axle (``spring.road``): 'sine' (amplitude, frequency,
+    raised smoothly over ``road_ramp`` s), 'table' (t, z rows of the CSV ``road_file``,
+    linear in between; z relative to its value at t = 0), or None ('none')."""
+    kind = spring.get("road", "none")
+    if kind == "none":
+        return None
+    if kind == "sine":
+        s.drive("road", "sine", amplitude=spring["road_amplitude"],
+                frequency=spring["road_frequency"], ramp=spring["road_ramp"])
+    else:
+        s.drive("road", "table", file=spring["road_file"])
+    return "road"

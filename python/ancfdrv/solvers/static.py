@@ -100,9 +100,12 @@ def _forces(model: Model, d: np.ndarray, want_tangent: bool, t: float = 0.0):
 
 
 def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
-                 load_steps: int = 1) -> StaticResult:
+                 load_steps: int = 1, loads: float = 1.0) -> StaticResult:
     """Full Newton-Raphson on (e, lambda) from the rigid configuration; the loads are
-    applied in ``load_steps`` equal increments (large deformation), each solved to tol."""
+    applied in ``load_steps`` equal increments (large deformation), each solved to tol.
+    ``loads`` scales the external loads (gravity, forces, moments, pressure) of the last
+    increment: 0 gives the equilibrium of the internal forces alone (prestress carried by
+    contact), the start of a settled run."""
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)
@@ -121,7 +124,7 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     with DirectSolver(n + ncon, rows, cols, what="static Newton saddle-point matrix") as solver:
         try:
             for load_step in range(1, load_steps + 1):
-                model.load_factor = load_step / load_steps
+                model.load_factor = loads * load_step / load_steps
                 for iteration in range(1, max_iter + 1):
                     t0 = time.perf_counter()
                     e = model.e0 + d
@@ -130,9 +133,17 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                     np.add.at(reaction, j_cols, grads * lam[j_rows])
                     moments = model.moment_terms(e)
                     internal, external, k_values = _forces(model, d, True)
+                    residual = internal - external - reaction
                     if load_step == 1 and iteration == 1:  # the start: loads and prestress
                         force_scale = max(np.linalg.norm(internal), np.linalg.norm(external))
-                    residual = internal - external - reaction
+                        # nothing loads the structure (e.g. settling a spring without
+                        # prestress and with the loads off): the start is the equilibrium
+                        stiff = np.abs(k_values).max(initial=0.0) * model.length_scale
+                        if (load_steps == 1 and np.linalg.norm(residual) <= 1e-13 * stiff
+                                and np.abs(phi).max(initial=0.0) <= tol * model.length_scale):
+                            how, force_res, con_res = "unloaded start", 0.0, 0.0
+                            iteration = 0
+                            break
                     values = np.concatenate([k_values, -lam[h_con] * h_vals,
                                              *[-j.ravel() for _, _, j, _ in moments], -grads,
                                              -grads])
@@ -170,7 +181,8 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     wall = time.perf_counter() - start
     timing["total"] = wall
     return StaticResult(model.e0 + d, lam, "newton", total, force_res, con_res, wall, history,
-                        timing, extra={"converged_by": how, "load_steps": load_steps})
+                        timing, extra={"converged_by": how, "load_steps": load_steps,
+                                       "load_factor": loads})
 
 
 class Jet:
