@@ -224,6 +224,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     caps the following ones, never more than settings.chunk_steps), and ``should_stop`` is
     asked after every chunk: when it says True, Interrupted is raised after the sink got
     the chunk, so a stop request (SIGINT) is answered within about a second."""
+    model.require_runnable()
     start = time.perf_counter()
     timing = {"setup": 0.0, "stepping": 0.0, "output": 0.0}
     if settings.t_end < t0:

@@ -106,6 +106,7 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     ``loads`` scales the external loads (gravity, forces, moments, pressure) of the last
     increment: 0 gives the equilibrium of the internal forces alone (prestress carried by
     contact), the start of a settled run."""
+    model.require_runnable()
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)
@@ -271,6 +272,7 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
         raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
                           "formulation (every body) without contact; use "
                           "solver.static_method = 'newton'")
+    model.require_runnable()
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)

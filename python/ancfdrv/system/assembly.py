@@ -44,8 +44,11 @@ class _Active:
     contacts: list
 
 
-def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "auto") -> Model:
-    """The model of ``system`` with the listed effects (None: every effect it uses)."""
+def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "auto",
+             check_frames: bool = True) -> Model:
+    """The model of ``system`` with the listed effects (None: every effect it uses).
+    ``check_frames=False`` assembles an 'ffr' beam whose frame nothing holds (for checks of
+    joint equations alone); the solvers refuse to run such a model."""
     if linear_joints not in LINEAR_JOINTS:
         raise InputError(f"linear_joints {linear_joints!r} must be one of {LINEAR_JOINTS}")
     if not any(b.flexible or isinstance(b, RigidBody) for b in system.bodies.values()):
@@ -68,6 +71,9 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     drives = list(system.drives.values())
     drive_index = {id(d): i for i, d in enumerate(drives)}
 
+    frame_problems = ffr_frame_problems(system)
+    if frame_problems and check_frames:
+        raise InputError(frame_problems[0])
     frames, beam_frame = _frames(bodies, drive_index)
     sets, set_blocks = _element_sets(bodies, frames, beam_frame, act, active_effects, counters,
                                      warnings)
@@ -125,6 +131,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         moments=moments, constraints=constraints, contact_pairs=contact_pairs, probes=probes,
         point_masses=[(m.body.name, m.point, m.mass) for m in act.masses],
         linear_joints=mode)
+    model.frame_problems = frame_problems
     _policy(model)
     model.build_kernel()
     return model
@@ -526,6 +533,73 @@ def _constant_constraint(eq: Constraint, x: list[float], tol: float, notes: list
                              f"joints (no free coordinate is left for it; off by {value:.3e} "
                              f"at the value {phi:g} of drive {eq.drive.name!r})")
     notes.append(f"redundant joint equation dropped: {eq.name} (satisfied identically)")
+
+
+# -- FFR frames ------------------------------------------------------------------------------
+_DRIVING = ("prescribed", "hub", "arm")
+
+
+def _moving(drive) -> str | None:
+    """A drive's name, None for no drive or a constant one (it does not move anything)."""
+    return None if drive is None or isinstance(drive, Constant) else drive.name
+
+
+def _anchors(body: Body, joints) -> set:
+    """What holds body to the ground: None for a joint that does not move (weld, revolute,
+    fix, ...), a drive's name for a joint that moves it by that drive (prescribed, hub,
+    arm)."""
+    out = set()
+    for joint in joints:
+        if body not in (joint.body1, joint.body2):
+            continue
+        if isinstance(joint.body1, Ground) or isinstance(joint.body2, Ground):
+            out.add(_moving(joint.drive) if joint.type in _DRIVING else None)
+    return out
+
+
+def ffr_frame_problems(system) -> list[str]:
+    """Why an 'ffr' beam is refused (one message per beam; empty: none is): an 'ffr' beam whose floating frame would have to follow moving bodies: the
+    kernel moves an FFR frame only by its own drive about a fixed pivot. The bodies joined
+    to the beam, directly or through others, must be held to the ground somewhere, and a
+    moving frame's drive must be one that moves them ('prescribed', 'hub' or 'arm' to the
+    ground). (Large motion about a hinge is not caught here: the run warns when the
+    deflection from the frame grows beyond the small-deformation range.)"""
+    joints = list(system.joints.values())
+    problems = []
+    for beam in system.bodies.values():
+        if not isinstance(beam, Beam) or beam.formulation != "ffr":
+            continue
+        component, todo = {beam}, [beam]
+        while todo:  # the bodies joined to the beam, directly or through others
+            body = todo.pop()
+            for j in joints:
+                if body in (j.body1, j.body2):
+                    other = j.body2 if j.body1 is body else j.body1
+                    if not isinstance(other, Ground) and other not in component:
+                        component.add(other)
+                        todo.append(other)
+        if len(component) == 1 and not any(beam in (j.body1, j.body2) for j in joints):
+            continue  # a beam without joints: nothing to follow (statics says it is free)
+        anchors = set().union(*(_anchors(body, joints) for body in component))
+        if _moving(beam.frame_drive) in anchors:
+            continue
+        where = f"beam {beam.name!r}"
+        if _moving(beam.frame_drive) is None:
+            others = sorted(b.name for b in component if b is not beam)
+            problems.append(
+                f"{where}: formulation 'ffr' needs its floating frame held, but neither the "
+                "beam nor any body joined to it" + (f" ({', '.join(map(repr, others))})"
+                                                    if others else "")
+                + " is held by a joint to the ground: its frame would have to follow their "
+                "motion, which the FFR model cannot do; use formulation = 'nonlinear' for it, "
+                "or join the assembly to the ground")
+            continue
+        problems.append(
+            f"{where}: its floating frame turns with drive {beam.frame_drive.name!r}, but no "
+            "joint moves the beam or a body joined to it with that drive ('prescribed', 'hub' "
+            f"or 'arm' to the ground with drive = {beam.frame_drive.name!r}); use formulation "
+            "= 'nonlinear' if something else moves it")
+    return problems
 
 
 # -- contact, probes -------------------------------------------------------------------------

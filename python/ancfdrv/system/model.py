@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from .. import kernel
 from ..codes import POLICY_CONSTANT, POLICY_REFACTOR
-from ..errors import SolverError
+from ..errors import InputError, SolverError
 from .bodies import Beam, Body, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
 from .drives import Drive
@@ -144,12 +144,19 @@ class Model:
             if contact_pairs else np.zeros((2, 1))
         self.contact_counts = np.zeros(6, dtype=np.int32)
         self.length_scale = length_scale(bodies)
+        #: why the model must not be run (assembled with check_frames=False)
+        self.frame_problems: list[str] = []
         #: the probe and component sweeps compare (builders may set it)
         self.response: tuple[str, int] | None = None
         if probes:
             first = next(iter(probes.values()))
             body = next(b for b in bodies if b.name == first.body)
             self.response = (first.name, 1 if isinstance(body, Beam) else 2)
+
+    def require_runnable(self) -> None:
+        """Refuse a model assembled for checks alone (an 'ffr' frame nothing holds)."""
+        if self.frame_problems:
+            raise InputError(self.frame_problems[0])
 
     # -- identity ---------------------------------------------------------------------------
     @property

@@ -280,10 +280,14 @@ class System:
             out.add("prestress")
         return out
 
-    def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto"):
+    def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
+                 check_frames: bool = True):
         """The model of this system (``ancfdrv.system.assembly.assemble``): only the effects
-        listed (default: the system's own list, else all it uses) are computed."""
+        listed (default: the system's own list, else all it uses) are computed. An 'ffr'
+        beam whose floating frame nothing holds is refused (InputError); with
+        ``check_frames=False`` it is assembled for checks of the joint equations alone, and
+        the solvers refuse to run it."""
         from .assembly import assemble
         chosen = effects if effects is not None else self.effects
         return assemble(self, tuple(chosen) if chosen is not None else None,
-                        linear_joints=linear_joints)
+                        linear_joints=linear_joints, check_frames=check_frames)
