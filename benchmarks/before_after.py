@@ -56,7 +56,7 @@ table as Markdown next to it (``before_after_quick.*`` with ``--quick``)::
 
     python benchmarks/before_after.py --before /work/baseline/.venv/bin/python \\
         --before-dir /work/baseline --after .venv/bin/python --after-dir .
-    python benchmarks/before_after.py ... --quick          # short runs, once: ~1 min
+    python benchmarks/before_after.py ... --quick          # short runs, once: ~30 s
     python benchmarks/before_after.py ... --cases boom_luffing spinup --repeats 5
 """
 from __future__ import annotations
