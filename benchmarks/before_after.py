@@ -419,6 +419,29 @@ def table_rows(cases: dict[str, Any]) -> list[list[str]]:
     return rows
 
 
+PHASE_HEAD = ["case", "stepping before", "stepping after", "before/after", "output before",
+              "output after", "rest before", "rest after", "run_scene before",
+              "run_scene after"]
+
+
+def phase_rows(cases: dict[str, Any]) -> list[list[str]]:
+    """Stepping, dynamic output and the rest of the whole call, per case and version."""
+    rows = []
+    for name, r in cases.items():
+        b, a = r["before"], r["after"]
+        if "error" in b or "error" in a:
+            continue
+        tb, ta = b.get("timing") or {}, a.get("timing") or {}
+        sb, sa = tb.get("dynamic_stepping"), ta.get("dynamic_stepping")
+        rows.append([name, _f(sb, ".3f"), _f(sa, ".3f"),
+                     _f(sb / sa if sb and sa else None, ".2f"),
+                     _f(tb.get("dynamic_output"), ".3f"), _f(ta.get("dynamic_output"), ".3f"),
+                     _f(tb.get("total", math.nan) - b["solve_s"], ".3f"),
+                     _f(ta.get("total", math.nan) - a["solve_s"], ".3f"),
+                     f"{b['run_scene_s']:.3f}", f"{a['run_scene_s']:.3f}"])
+    return rows
+
+
 HEAD = ["case", "before s", "after s", "before/after", "steps", "Newton corrections",
         "factorizations", "history difference (relative)"]
 
@@ -443,12 +466,16 @@ def markdown(report: dict[str, Any]) -> str:
              "(static: to |before|).", "",
              "| " + " | ".join(HEAD) + " |", "|---|---:|---:|---:|---:|---:|---:|---|"]
     lines += ["| " + " | ".join(row) + " |" for row in table_rows(report["cases"])]
-    whole = [(n, r) for n, r in report["cases"].items() if "run_scene_s" in r["before"]
-             and "run_scene_s" in r["after"]]
-    if whole:
-        lines += ["", "Whole `run_scene` call (model, solves, HDF5; imports apart), best of the "
-                  "repeats: " + "; ".join(f"{n} {r['before']['run_scene_s']:.3f} -> "
-                                          f"{r['after']['run_scene_s']:.3f} s" for n, r in whole)]
+    phases = phase_rows(report["cases"])
+    if phases:
+        lines += ["", "Where the time goes (seconds, from `/timing` of the run whose solve time "
+                  "is given above; the whole `run_scene` call is the best of the repeats): "
+                  "stepping = the kernel's steps (`dynamic_stepping`), output = the HDF5 sink "
+                  "during the dynamics (`dynamic_output`), rest = the whole call minus the "
+                  "static and dynamic solves (model build, file creation, final flush, XDMF, "
+                  "provenance).", "", "| " + " | ".join(PHASE_HEAD) + " |",
+                  "|---|" + "---:|" * (len(PHASE_HEAD) - 1)]
+        lines += ["| " + " | ".join(row) + " |" for row in phases]
     d = report.get("dispatch")
     if d:
         lines += ["", f"## Dispatch overhead per kernel call ({d['scene']}, FFR 28 nodes, "
@@ -473,6 +500,9 @@ def print_report(report: dict[str, Any]) -> None:
     print()
     widths = [16, 9, 9, 12, 22, 22, 16, 34]
     print_table(list(zip(HEAD, widths)), table_rows(report["cases"]))
+    print("\nwhere the time goes (s): stepping, dynamic output, rest of run_scene; whole call")
+    print_table(list(zip(PHASE_HEAD, [16] + [max(9, len(h)) for h in PHASE_HEAD[1:]])),
+                phase_rows(report["cases"]))
     d = report.get("dispatch")
     if d:
         print(f"\ndispatch overhead, {d['scene']}, {d['steps']} steps from t = 1 s:")
@@ -493,13 +523,16 @@ def print_report(report: dict[str, Any]) -> None:
 # -- command line --------------------------------------------------------------------------------
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--before", type=Path, required=True,
+    parser.add_argument("--render", type=Path, default=None, metavar="JSON",
+                        help="only write the tables of an earlier run's JSON again (stdout "
+                             "and the .md next to it); no runs")
+    parser.add_argument("--before", type=Path, default=None,
                         help="Python interpreter of the 'before' version")
-    parser.add_argument("--before-dir", type=Path, required=True,
+    parser.add_argument("--before-dir", type=Path, default=None,
                         help="checkout of the 'before' version (cwd and scene files)")
-    parser.add_argument("--after", type=Path, required=True,
+    parser.add_argument("--after", type=Path, default=None,
                         help="Python interpreter of the 'after' version")
-    parser.add_argument("--after-dir", type=Path, required=True,
+    parser.add_argument("--after-dir", type=Path, default=None,
                         help="checkout of the 'after' version")
     parser.add_argument("--cases", nargs="+", choices=list(CASES), default=None,
                         help=f"cases (default {' '.join(DEFAULT_CASES)})")
@@ -526,6 +559,15 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                              "before_after_quick.json with --quick); the Markdown table goes "
                              "next to it with the suffix .md")
     args = parser.parse_args(argv)
+    if args.render is not None:
+        if not args.render.is_file():
+            parser.error(f"--render {args.render}: no such file")
+        return args
+    missing = [f"--{flag.replace('_', '-')}" for flag in ("before", "before_dir", "after",
+                                                          "after_dir")
+               if getattr(args, flag) is None]
+    if missing:
+        parser.error(f"{', '.join(missing)} required (or --render JSON)")
     q = args.quick
     args.cases = args.cases or list(DEFAULT_CASES)
     if args.repeats is None:
@@ -555,6 +597,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    if args.render is not None:
+        report = json.loads(args.render.read_text())
+        print_report(report)
+        md = args.render.with_suffix(".md")
+        md.write_text(markdown(report))
+        print(f"wrote {md}")
+        return 0
     start = time.perf_counter()
     machine = machine_info()
     sides = {"before": Side("before", args.before, args.before_dir),
