@@ -397,9 +397,11 @@ def print_tables(runs: dict[int, dict[str, Any]], summary: dict[str, Any],
         rows = []
         for rec in run["records"]:
             k = rec["kernels"]
-            rows.append([str(rec["elements"]), f"{rec['poisson']:g}"]
-                        + [f"{k[name]['per_element_us']:.3f} ({k[name]['per_call_s'] / k[ref]['per_call_s']:.2f})"
-                           for name, ref in pairs.items()])
+            cells = []
+            for name, ref in pairs.items():
+                ratio = k[name]["per_call_s"] / k[ref]["per_call_s"]
+                cells.append(f"{k[name]['per_element_us']:.3f} ({ratio:.2f})")
+            rows.append([str(rec["elements"]), f"{rec['poisson']:g}"] + cells)
         print_table([("nel", 5), ("nu", 4)] + [(LABELS[n], 17) for n in SYSTEM_KERNELS], rows)
     if summary["speedup_over_1_thread"]:
         print("\nspeed-up over OMP_NUM_THREADS=1 (time with 1 thread / time with n threads)")
