@@ -4,10 +4,10 @@ from the floor of one forward/back substitution.
 
 For every node count (3k+1) of the boom of ``inputs/boom_luffing.nml`` this prepares a run
 as :func:`ancfdrv.runner.run_scene` does for this scene (``build_model``, static start with
-``solve_split``, :class:`ancfdrv.solvers.dynamic.NewmarkIntegrator` - ``TimeIntegrator`` after the
-generalized-alpha rework -, consistent initial acceleration), integrates through the
-smooth start to the beginning of the luffing stage (:func:`ancfdrv.runner.boom_stages`,
-t = 1 s) and measures there, with ``time.perf_counter``:
+``solve_split``, :class:`ancfdrv.solvers.dynamic.TimeIntegrator`, consistent initial
+acceleration, the initial output row), integrates through the smooth start to the
+beginning of the luffing stage (:func:`ancfdrv.runner.boom_stages`, t = 1 s) and measures
+there, with ``time.perf_counter``:
 
 * the wall time per Newmark step: ``integrator.advance(state, nsteps)`` from a copy of the
   state at the start of the luffing stage, so every sample integrates the same steps
@@ -16,19 +16,32 @@ t = 1 s) and measures there, with ``time.perf_counter``:
   ``--repeats`` samples of at least ``--min-time`` seconds each; with the Newton
   corrections per step (``chunk.newton``);
 * the floor: one forward/back substitution with the step's own factor (LAPACK banded
-  Cholesky of S = M/(beta h^2) + K0), ``integrator.solver.solve(rhs)`` called from Python
-  one right-hand side at a time (includes the f2py call and the copy in
-  ``DirectSolver.solve``) and in bulk, ``solve(np.ones((n, k))) / k`` (the substitution
-  alone, nearly);
-* the overhead of one ``advance`` call (``advance(state, 1)`` minus one step): the kernel
-  call copies the model's arrays, which ``chunk_steps`` amortizes;
-* once, the time to build the model, the static solve, the integrator's set-up
-  (factorization, flexibility solves), the initial acceleration, and the per-step time of
-  the start stage (one pass, from the warm-up);
+  Cholesky of S = beta' M + K0 in the solver frame, factorized by the kernel on its first
+  step), ``model.solver.solve(rhs)`` (the DirectSolver whose handle the kernel system
+  uses) called from Python one right-hand side at a time (includes the f2py call and the
+  copy in ``DirectSolver.solve``) and in bulk, ``solve(np.ones((n, k))) / k`` (the
+  substitution alone, nearly);
+* the overhead of one ``advance`` call (``advance(state, 1)`` minus one step): the model
+  lives in the kernel behind a handle, so a call passes only the state and settings and
+  unpacks the step outputs into a ``Chunk``;
+* once, the time to build the model (which also hands it to the kernel), the static
+  solve, the integrator's set-up, the initial acceleration, and the per-step time of the
+  start stage (one pass, from the warm-up);
 
 and, for one mesh (``--run-nodes``, 28), the whole 10 s luffing through
 :func:`ancfdrv.runner.run_scene` (model, static solve, dynamics, HDF5 output), best of
 ``--run-repeats``: wall time of the call and ``outcome.dynamic.wall_time_s``.
+
+Ported to the general-system model layer: the kernel factorizes S (and the flexibility
+S^-1 E_c, ``setup.integrator_setup_solves`` right-hand sides) inside the first ``advance``
+call of a model, not in the integrator's constructor, so ``setup.integrator_setup_s`` is the
+first one-step call minus a later one-step call from the window start
+(``call.one_step_call_s``; ``setup.first_step_call_s`` and
+``setup.integrator_init_s``, the constructor alone, are recorded too). The kernel keeps the
+factor and the contraction estimate of the constant policy (Hairer's theta) in the system
+between calls, so a replay from a copied state may take a few Newton corrections more or
+less than the first pass (``newton_min``/``newton_max``). JSON keys are unchanged, with
+``jacobian_policy`` added per record.
 
 The tables give per-step time / floor, per Newton correction / floor, and the growth
 exponents d log t / d log ndof between consecutive meshes (1 = linear). Results: a table
@@ -36,7 +49,8 @@ on stdout and JSON (machine info, one record per node count, growth exponents) i
 ``benchmarks/results/``. Run from the repository root::
 
     python benchmarks/dynamic_scaling.py            # 4 ... 2002 nodes, about 1.5 min
-    python benchmarks/dynamic_scaling.py --quick    # up to 301 nodes, 3 repeats
+    python benchmarks/dynamic_scaling.py --quick    # up to 100 nodes, 3 short samples,
+                                                    # one run_scene: a smoke run, ~30 s
 """
 from __future__ import annotations
 
@@ -55,22 +69,21 @@ from typing import Any, Callable
 import numpy as np
 
 from _common import load_average, machine_info, print_table, write_report
-from ancfdrv.solvers.dynamic import DynamicSettings, initial_acceleration
-from ancfdrv.model import BeamModel, build_model
-from ancfdrv.runner import boom_stages, dynamic_settings, run_scene
+from ancfdrv.builders import build_model
 from ancfdrv.io.scene import Scene, load_scene
+from ancfdrv.runner import boom_stages, dynamic_settings, run_scene
+from ancfdrv.solvers.dynamic import (DynamicSettings, TimeIntegrator, initial_acceleration,
+                                     initial_row)
 from ancfdrv.solvers.static import solve_split
+from ancfdrv.system.model import Model
 
-try:  # the generalized-alpha rework renames NewmarkIntegrator (same constructor, advance)
-    from ancfdrv.solvers.dynamic import TimeIntegrator as Integrator
-except ImportError:
-    from ancfdrv.solvers.dynamic import NewmarkIntegrator as Integrator
+Integrator = TimeIntegrator
 
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "inputs" / "boom_luffing.nml"
 RESULTS = REPO / "benchmarks" / "results"
 NODES = (4, 10, 16, 22, 28, 100, 301, 1000, 2002)
-QUICK_MAX_NODES = 301
+QUICK_MAX_NODES = 100
 WINDOW_STAGE = "luffing"
 
 State = dict[str, Any]
@@ -111,7 +124,8 @@ def best_of(sample: Callable[[int], float], repeats: int, min_time: float) -> Ti
 
 
 def copy_state(state: State) -> State:
-    """Deep copy of an integrator state (t, e, v, a, accel, lam, work)."""
+    """Deep copy of an integrator state (t, e, v, a, accel, lam, work, powers, contact
+    guesses and counters)."""
     return {k: v.copy() if isinstance(v, np.ndarray) else v for k, v in state.items()}
 
 
@@ -130,7 +144,7 @@ class Prepared:
 
     nodes: int
     scene: Scene
-    model: BeamModel
+    model: Model
     settings: DynamicSettings
     integrator: Integrator
     start: State
@@ -139,9 +153,9 @@ class Prepared:
     setup: dict[str, Any] = field(default_factory=dict)
 
 
-def bandwidth(model: BeamModel) -> int:
+def bandwidth(model: Model) -> int:
     """Half bandwidth kd of the iteration matrix (M and K0 share the element pattern)."""
-    return int(np.max(np.abs(model.pattern.rows - model.pattern.col_index)))
+    return model.pattern.bandwidth()
 
 
 def prepare(nodes: int) -> Prepared:
@@ -168,30 +182,37 @@ def prepare(nodes: int) -> Prepared:
     settings = dynamic_settings(scene)
     t0 = time.perf_counter()
     integrator = Integrator(model, settings)
-    setup["integrator_setup_s"] = time.perf_counter() - t0
-    setup["integrator_setup_solves"] = integrator.setup_solves
+    setup["integrator_init_s"] = time.perf_counter() - t0
+    # the constant policy's set-up solves: S^-1 E_c, 3 per constrained 3-vector
+    setup["integrator_setup_solves"] = (3 * len(model.touched_blocks())
+                                        if model.constant_policy else 0)
+    setup["jacobian_policy"] = "constant" if model.constant_policy else settings.jacobian
     t0 = time.perf_counter()
     v0 = np.zeros(model.ndof)
     a0, lam0 = initial_acceleration(model, static.e, v0, 0.0)
     setup["initial_acceleration_s"] = time.perf_counter() - t0
-    # as integrate() builds it; "accel" (q'', apart from the generalized-alpha variable a)
-    # is read by the generalized-alpha integrator and ignored by the Newmark-only one
-    state: State = dict(t=0.0, e=static.e.copy(), v=v0, a=a0.copy(), accel=a0, lam=lam0,
-                        work=np.zeros(2))
+    # as integrate() builds it, with the powers of the initial output row
+    state: State = integrator.state(0.0, static.e, v0, a0, lam0)
+    initial_row(model, state)
 
-    # warm-up through the start stage, in the run's chunks: one pass, also a measurement
+    # warm-up through the start stage, in the run's chunks: one pass, also a measurement;
+    # the first call of one step holds the kernel's factorization of S
     warm_steps = int(round((t_first - state["t"]) / settings.dt))
-    newton: list[np.ndarray] = []
     t0 = time.perf_counter()
-    done = 0
+    newton: list[np.ndarray] = [advance_checked(integrator, state, 1)]
+    first_call = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    done = 1
     while done < warm_steps:
         n = min(settings.chunk_steps, warm_steps - done)
         newton.append(advance_checked(integrator, state, n))
         done += n
     elapsed = time.perf_counter() - t0
     counts = np.concatenate(newton) if newton else np.zeros(0)
+    step_s = elapsed / (warm_steps - 1) if warm_steps > 1 else math.nan
+    setup["first_step_call_s"] = first_call  # integrator_setup_s: in measure()
     setup["start_stage"] = {"t": [0.0, state["t"]], "steps": warm_steps,
-                            "step_s": elapsed / warm_steps if warm_steps else math.nan,
+                            "step_s": step_s,
                             "newton_mean": float(counts.mean()) if counts.size else math.nan}
     window_steps = int(math.floor((t_last - state["t"]) / settings.dt + 1e-9))
     return Prepared(nodes, scene, model, settings, integrator, copy_state(state),
@@ -254,7 +275,7 @@ def time_call_overhead(prep: Prepared, step_s: float,
 def time_floor(prep: Prepared, args: argparse.Namespace) -> dict[str, Any]:
     """One forward/back substitution with the step's factor: single right-hand sides from
     Python, and ``--bulk-rhs`` of them per call."""
-    solver, n, k = prep.integrator.solver, prep.model.ndof, args.bulk_rhs
+    solver, n, k = prep.model.solver, prep.model.ndof, args.bulk_rhs
     single_rhs, bulk_rhs = np.ones(n), np.ones((n, k))
 
     def sample_single(calls: int) -> float:
@@ -288,13 +309,19 @@ def measure(nodes: int, args: argparse.Namespace) -> dict[str, Any]:
         overhead = time_call_overhead(prep, steps["step_s"], args)
         floor = time_floor(prep, args)
     finally:
-        prep.integrator.close()
+        prep.model.close()
+    # the first call's excess over a one-step call: the kernel's factorization of S and
+    # the flexibility solves
+    prep.setup["integrator_setup_s"] = (prep.setup["first_step_call_s"]
+                                        - overhead["one_step_call_s"])
     step, newton = steps["step_s"], steps["newton_mean"]
     ratios = {"step_over_floor_bulk": step / floor["bulk_s"],
               "step_over_floor_single": step / floor["single_s"],
               "correction_over_floor_bulk": step / (newton * floor["bulk_s"]),
               "solve_share": newton * floor["bulk_s"] / step}
-    return {"nodes": nodes, "ndof": prep.model.ndof, "elements": prep.model.nel,
+    return {"nodes": nodes, "ndof": prep.model.ndof,
+            "elements": sum(s.nel for s in prep.model.sets),
+            "jacobian_policy": prep.setup["jacobian_policy"],
             "dt": prep.settings.dt,
             "nconstraints": len(prep.model.constraints), "window": list(prep.window),
             "window_steps": prep.window_steps, "setup": prep.setup, "steps": steps,
@@ -454,12 +481,14 @@ def print_tables(records: list[dict[str, Any]], exponents: list[dict[str, Any]],
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
-                        help=f"only node counts up to {QUICK_MAX_NODES}, 3 repeats")
+                        help=f"only node counts up to {QUICK_MAX_NODES}, 3 repeats of "
+                             "0.1 s samples, one run_scene")
     parser.add_argument("--nodes", type=int, nargs="*", default=None,
                         help=f"node counts, each 3k+1 (default {' '.join(map(str, NODES))}); "
                              "none: only the run_scene measurement")
-    parser.add_argument("--min-time", type=float, default=0.3,
-                        help="seconds one sample takes at least (default 0.3)")
+    parser.add_argument("--min-time", type=float, default=None,
+                        help="seconds one sample takes at least (default 0.3; 0.1 with "
+                             "--quick)")
     parser.add_argument("--repeats", type=int, default=None,
                         help="samples per measurement, the fastest is kept (default 5, 3 "
                              "with --quick: the speed of a shared machine drifts over "
@@ -471,14 +500,19 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--run-nodes", type=int, default=28,
                         help="node count of the whole run_scene measurement (default 28; "
                              "0 skips it)")
-    parser.add_argument("--run-repeats", type=int, default=3,
-                        help="run_scene repeats, the fastest is kept (default 3)")
+    parser.add_argument("--run-repeats", type=int, default=None,
+                        help="run_scene repeats, the fastest is kept (default 3; 1 with "
+                             "--quick)")
     parser.add_argument("--output", type=Path, default=None,
                         help="JSON file (default benchmarks/results/dynamic_scaling.json, "
                              "dynamic_scaling_quick.json with --quick)")
     args = parser.parse_args(argv)
     if args.repeats is None:
         args.repeats = 3 if args.quick else 5
+    if args.min_time is None:
+        args.min_time = 0.1 if args.quick else 0.3
+    if args.run_repeats is None:
+        args.run_repeats = 1 if args.quick else 3
     nodes = args.nodes if args.nodes is not None else [
         n for n in NODES if not args.quick or n <= QUICK_MAX_NODES]
     if any(n < 4 or (n - 1) % 3 for n in nodes + ([args.run_nodes] if args.run_nodes else [])):
@@ -497,7 +531,7 @@ def main(argv: list[str] | None = None) -> int:
     start = time.perf_counter()
     machine = machine_info()
     if args.nodes:  # first calls (lazy imports, MUMPS/MPI start-up) stay out of the records
-        prepare(min(NODES)).integrator.close()
+        prepare(min(NODES)).model.close()
     records = []
     for nodes in args.nodes:
         t0 = time.perf_counter()

@@ -8,7 +8,7 @@ Python side calls (arrays prepared once in Fortran order, so no conversion is ti
 
 * ``nonlinear force``: the large-deformation internal force and strain energy alone,
   ``_kernel.beam_nonlinear_forces(..., want_tangent=0)`` (Green-Lagrange strain, St.
-  Venant-Kirchhoff law, at the Gauss rule of ``_kernel.beam_nonlinear_points()``);
+  Venant-Kirchhoff law, at the Gauss rule of ``_kernel.beam_nonlinear_points(nsec)``);
 * ``nonlinear force + tangent``: the same with the element tangents (24 x 24 per element),
   ``want_tangent=1``;
 * ``cubic force`` and ``cubic force + tangent``: the same for ``beam.bending = 'cubic'``
@@ -18,8 +18,13 @@ Python side calls (arrays prepared once in Fortran order, so no conversion is ti
   ``_kernel.ffr_elastic_force``;
 * ``FFR stiffness``: the element matrices T K0 T^T, ``_kernel.ffr_element_stiffness`` (what
   the FFR model uses where the large-deformation model needs its tangent);
-* the floor of an f2py call, ``_kernel.beam_nonlinear_points()``, which every per-call time
-  above includes once (it matters at 10 elements only).
+* ``system ... force`` and ``system ... force + tangent`` for each of the three (nonlinear,
+  cubic, FFR): the same beam as a one-body model of the general-system layer, evaluated
+  through its kernel handle (``model.kernel.evaluate``, ``_kernel.system_evaluate``): the
+  element loop the solvers and the stepper actually run, with the assembly of the force
+  vector and, with the tangent, of the matrix on the model's sparse pattern;
+* the floor of an f2py call, ``_kernel.beam_nonlinear_points(4)``, which every per-call
+  time above includes once (it matters at 10 elements only).
 
 Cost per element = call time / elements. A sample is a loop of calls lasting at least
 ``--min-time`` (0.2 s); the time is the best of all samples: ``--repeats`` samples (3; 2
@@ -41,11 +46,19 @@ reports whether an OpenMP runtime (libgomp, libomp, libiomp) is mapped into the 
 after ``import ancfdrv._kernel``. Without one, the thread counts must agree within the
 timing noise, and the table says so.
 
+Ported to the general-system model layer: the element arrays (material gradients and
+weights, strain forms, K0 and the frame reference) come from the element sets of a
+``System`` with one beam along x (``model.sets[0]``), the standalone entry points take the
+new argument lists (``beam_nonlinear_forces`` the number of volume points first,
+``ffr_elastic_force`` the reference before the rotation), and the ``system_*`` kernels are
+new. The JSON keeps its layout; the new kernels appear beside the old ones in
+``records[].kernels`` and in the speed-ups.
+
 Results: tables on stdout and JSON in ``benchmarks/results/element_cost.json``
 (``element_cost_quick.json`` with ``--quick``). Run from the repository root::
 
-    python benchmarks/element_cost.py            # 10, 100, 1000 elements, about 1 min
-    python benchmarks/element_cost.py --quick    # 2 repeats, nu = 0 only, about 20 s
+    python benchmarks/element_cost.py            # 10, 100, 1000 elements, about 2 min
+    python benchmarks/element_cost.py --quick    # 1 round, 0.05 s samples, nu = 0, ~20 s
 """
 from __future__ import annotations
 
@@ -75,11 +88,20 @@ LENGTH, WIDTH, HEIGHT = 10.0, 0.1, 0.1
 YOUNGS, DENSITY = 2.1e11, 7850.0
 OPENMP_RUNTIMES = ("libgomp", "libomp", "libiomp")
 #: Another engineer reinstalls ancfdrv from time to time: how long to wait before retrying.
-KERNELS = ("nonlinear_force", "nonlinear_force_tangent", "cubic_force", "cubic_force_tangent",
-           "ffr_force", "ffr_stiffness")
+ELEMENT_KERNELS = ("nonlinear_force", "nonlinear_force_tangent", "cubic_force",
+                   "cubic_force_tangent", "ffr_force", "ffr_stiffness")
+SYSTEM_KERNELS = ("system_nonlinear_force", "system_nonlinear_force_tangent",
+                  "system_cubic_force", "system_cubic_force_tangent", "system_ffr_force",
+                  "system_ffr_force_tangent")
+KERNELS = ELEMENT_KERNELS + SYSTEM_KERNELS
 LABELS = {"nonlinear_force": "(a) force", "nonlinear_force_tangent": "(b) force+tangent",
           "cubic_force": "cubic force", "cubic_force_tangent": "cubic force+tan",
-          "ffr_force": "(c) FFR force", "ffr_stiffness": "FFR K"}
+          "ffr_force": "(c) FFR force", "ffr_stiffness": "FFR K",
+          "system_nonlinear_force": "sys force", "system_nonlinear_force_tangent": "sys f+tangent",
+          "system_cubic_force": "sys cubic f", "system_cubic_force_tangent": "sys cubic f+K",
+          "system_ffr_force": "sys FFR f", "system_ffr_force_tangent": "sys FFR f+K"}
+#: the section rule's points (a rectangle: 2 x 2), the argument of beam_nonlinear_points
+SECTION_POINTS = 4
 
 
 # -- worker: runs inside a subprocess with OMP_NUM_THREADS set ----------------------------
@@ -97,7 +119,7 @@ class Sample:
 def import_kernel() -> Any:
     """The compiled kernel (checked to be the build with the large-deformation beam)."""
     from ancfdrv import _kernel
-    _kernel.beam_nonlinear_points()
+    _kernel.beam_nonlinear_points(SECTION_POINTS)
     return _kernel
 
 
@@ -153,34 +175,53 @@ def time_call(call: Callable[[], object], min_time: float, repeats: int) -> Samp
     return Sample(per_call[best], float(np.median(per_call)), calls, repeats, faults[best])
 
 
+def beam_model(nel: int, poisson: float, formulation: str, bending: str) -> Any:
+    """A one-beam model of the general-system layer: straight along x, section height along
+    y, no supports and no loads (only its element set and kernel handle are used)."""
+    from ancfdrv import Rectangle, System
+
+    system = System(f"element cost {formulation} {bending}", effects=())
+    steel = system.material("steel", youngs_modulus=YOUNGS, density=DENSITY,
+                            poisson_ratio=poisson)
+    system.beam("beam", material=steel, start=(0.0, 0.0, 0.0), end=(LENGTH, 0.0, 0.0),
+                nodes=nel + 1, section=Rectangle(WIDTH, HEIGHT), height_axis=(0.0, 1.0, 0.0),
+                formulation=formulation, bending=bending)
+    return system.assemble(effects=())
+
+
 def beam_arrays(kernel: Any, nel: int, poisson: float) -> dict[str, Any]:
     """Kernel-ready arrays of a straight beam along x (the reference) and a deformed
     configuration: bent into an arc of 90 degrees, stretched by 1 %, sections sheared a
-    little, so every strain and stress component is non-zero."""
-    from ancfdrv.model import BeamModel
-
-    model = BeamModel(node_s=np.linspace(0.0, LENGTH, nel + 1), width=WIDTH, height=HEIGHT,
-                      density=DENSITY, youngs=YOUNGS, poisson=poisson, rotation=np.eye(3),
-                      origin_offset=np.zeros(3), effects=(), formulation="nonlinear")
-    s = model.node_s
+    little, so every strain and stress component is non-zero; with the three one-beam
+    models (close them with ``model.close()``)."""
+    models = {"nonlinear": beam_model(nel, poisson, "nonlinear", "continuum"),
+              "cubic": beam_model(nel, poisson, "nonlinear", "cubic"),
+              "ffr": beam_model(nel, poisson, "ffr", "continuum")}
+    continuum, cubic, ffr = (models[k].sets[0] for k in ("nonlinear", "cubic", "ffr"))
+    s = continuum.body.stations
     radius = LENGTH / (0.5 * math.pi)
     angle = s / radius
-    e = np.zeros((model.nnodes, 12))
+    e = np.zeros((nel + 1, 12))
     e[:, 0] = 1.01 * radius * np.sin(angle)
     e[:, 1] = 1.01 * radius * (1.0 - np.cos(angle))
     e[:, 3:6] = 1.01 * np.column_stack([np.cos(angle), np.sin(angle), 0.0 * s])
     e[:, 6:9] = np.column_stack([-np.sin(angle) + 0.01, np.cos(angle), 0.0 * s])
     e[:, 9:12] = [0.0, 0.0, 1.0]
-    cubic = BeamModel(node_s=model.node_s, width=WIDTH, height=HEIGHT, density=DENSITY,
-                      youngs=YOUNGS, poisson=poisson, rotation=np.eye(3),
-                      origin_offset=np.zeros(3), effects=(), formulation="nonlinear",
-                      bending="cubic").structural
-    return {"npts": int(kernel.beam_nonlinear_points()), "ndof": model.ndof, "cubic": cubic,
-            "dofs": np.asfortranarray(model.dofs + 1, dtype=np.int32),
-            "e": np.asfortranarray(e.ravel()), "e0_frame": np.asfortranarray(model.e0_frame),
-            "gradients": model.gauss_gradients, "weights": model.gauss_weights,
-            "stiffness0": model.stiffness0, "rotation": np.asfortranarray(np.eye(3)),
-            "youngs": model.youngs, "poisson": model.poisson}
+    return {"npts": int(continuum.weights.shape[0]), "nvolume": continuum.nvolume,
+            "ndof": models["nonlinear"].ndof, "cubic": cubic.structural, "models": models,
+            "dofs": np.asfortranarray(continuum.dofs + 1, dtype=np.int32),
+            "e": np.asfortranarray(e.ravel()), "reference": ffr.reference,
+            "gradients": continuum.gradients, "weights": continuum.weights,
+            "stiffness0": ffr.stiffness0, "rotation": np.asfortranarray(np.eye(3)),
+            "youngs": YOUNGS, "poisson": poisson}
+
+
+def system_call(model: Any, e: np.ndarray, want_tangent: bool) -> Callable[[], Any]:
+    """One force (+ tangent) evaluation of a model through its kernel handle, as the
+    solvers call it (``KernelSystem.evaluate``)."""
+    v = np.zeros(model.ndof)
+    guesses, counts = model.contact_guesses, model.contact_counts
+    return lambda: model.kernel.evaluate(0.0, e, v, guesses, counts, want_tangent=want_tangent)
 
 
 def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
@@ -189,9 +230,9 @@ def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
     a = beam_arrays(kernel, nel, poisson)
 
     def nonlinear(want_tangent: int) -> Callable[[], Any]:
-        return lambda: kernel.beam_nonlinear_forces(a["dofs"], a["e"], a["gradients"],
-                                                    a["weights"], a["youngs"], a["poisson"],
-                                                    want_tangent)
+        return lambda: kernel.beam_nonlinear_forces(a["nvolume"], a["dofs"], a["e"],
+                                                    a["gradients"], a["weights"], a["youngs"],
+                                                    a["poisson"], want_tangent)
 
     calls: dict[str, Callable[[], Any]] = {
         "nonlinear_force": nonlinear(0),
@@ -200,10 +241,13 @@ def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
             a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 0),
         "cubic_force_tangent": lambda: kernel.beam_structural_forces(
             a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 1),
-        "ffr_force": lambda: kernel.ffr_elastic_force(a["dofs"], a["stiffness0"], a["rotation"],
-                                                      a["e"], a["e0_frame"]),
+        "ffr_force": lambda: kernel.ffr_elastic_force(a["dofs"], a["stiffness0"],
+                                                      a["reference"], a["rotation"], a["e"]),
         "ffr_stiffness": lambda: kernel.ffr_element_stiffness(a["stiffness0"], a["rotation"]),
     }
+    for name, model in a["models"].items():
+        calls[f"system_{name}_force"] = system_call(model, a["e"], False)
+        calls[f"system_{name}_force_tangent"] = system_call(model, a["e"], True)
     # sanity: the force of the deformed beam is finite and non-zero, the tangent symmetric
     force, _, tangent = calls["nonlinear_force_tangent"]()
     force_only, _, _ = calls["nonlinear_force"]()
@@ -211,12 +255,23 @@ def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
             and np.allclose(force, force_only, rtol=1e-12, atol=0.0)):
         raise RuntimeError(f"kernel force check failed at {nel} elements")
     asym = np.abs(tangent - tangent.transpose(1, 0, 2)).max() / np.abs(tangent).max()
+    # the system's internal force of the large-deformation beam is the element force
+    system_force = calls["system_nonlinear_force"]()["internal"]
+    system_difference = float(np.abs(system_force - force).max() / np.abs(force).max())
+    if system_difference > 1e-12:
+        raise RuntimeError(f"system and element force differ by {system_difference:.2e} "
+                           f"at {nel} elements")
     record: dict[str, Any] = {"elements": nel, "poisson": poisson, "ndof": a["ndof"],
-                              "tangent_asymmetry": float(asym), "kernels": {}}
-    for name, call in calls.items():
-        sample = time_call(call, min_time, repeats)
-        record["kernels"][name] = {**asdict(sample), "per_element_us":
-                                   1e6 * sample.per_call_s / nel}
+                              "tangent_asymmetry": float(asym),
+                              "system_vs_element_force": system_difference, "kernels": {}}
+    try:
+        for name, call in calls.items():
+            sample = time_call(call, min_time, repeats)
+            record["kernels"][name] = {**asdict(sample), "per_element_us":
+                                       1e6 * sample.per_call_s / nel}
+    finally:
+        for model in a["models"].values():
+            model.close()
     return record
 
 
@@ -225,13 +280,14 @@ def worker(args: argparse.Namespace) -> dict[str, Any]:
     kernel = import_kernel()
     libraries = openmp_runtime()
     so_path = Path(kernel.__file__)
-    floor = time_call(kernel.beam_nonlinear_points, args.min_time, args.repeats)
+    floor = time_call(lambda: kernel.beam_nonlinear_points(SECTION_POINTS), args.min_time,
+                      args.repeats)
     records = [measure_mesh(kernel, nel, nu, args.min_time, args.repeats)
                for nu in args.poisson for nel in args.elements]
     return {"omp_num_threads_env": os.environ.get("OMP_NUM_THREADS"),
             "openmp_runtime": libraries, "omp_get_max_threads": omp_max_threads(libraries),
             "kernel_module": str(so_path), "kernel_mtime": so_path.stat().st_mtime,
-            "gauss_points": int(kernel.beam_nonlinear_points()),
+            "gauss_points": int(kernel.beam_nonlinear_points(SECTION_POINTS)),
             "f2py_call_floor_s": floor.per_call_s, "records": records}
 
 
@@ -321,15 +377,32 @@ def print_tables(runs: dict[int, dict[str, Any]], summary: dict[str, Any],
             k = rec["kernels"]
             pts = active_points(rec, npts, axis)
             rows.append([str(rec["elements"]), f"{rec['poisson']:g}", str(pts)]
-                        + [f"{k[name]['per_element_us']:.3f}" for name in KERNELS]
+                        + [f"{k[name]['per_element_us']:.3f}" for name in ELEMENT_KERNELS]
                         + [f"{1e3 * k['nonlinear_force']['per_element_us'] / pts:.0f}",
                            f"{1e3 * k['nonlinear_force_tangent']['per_element_us'] / pts:.0f}",
                            f"{k['nonlinear_force_tangent']['per_element_us'] / k['nonlinear_force']['per_element_us']:.1f}",
                            f"{k['nonlinear_force']['per_element_us'] / k['ffr_force']['per_element_us']:.0f}",
                            f"{k['nonlinear_force']['minor_faults_per_call']:.0f}"])
-        print_table([("nel", 5), ("nu", 4), ("pts", 4)] + [(LABELS[n], 17) for n in KERNELS]
+        print_table([("nel", 5), ("nu", 4), ("pts", 4)]
+                    + [(LABELS[n], 17) for n in ELEMENT_KERNELS]
                     + [("ns/pt a", 8), ("ns/pt b", 8), ("b/a", 5), ("a/FFR", 6),
                        ("flt/call", 8)], rows)
+        print("  through the model's kernel handle (system_evaluate: element loop + assembly "
+              "on the pattern), us per element, and / the element entry point's time")
+        pairs = {"system_nonlinear_force": "nonlinear_force",
+                 "system_nonlinear_force_tangent": "nonlinear_force_tangent",
+                 "system_cubic_force": "cubic_force",
+                 "system_cubic_force_tangent": "cubic_force_tangent",
+                 "system_ffr_force": "ffr_force", "system_ffr_force_tangent": "ffr_stiffness"}
+        rows = []
+        for rec in run["records"]:
+            k = rec["kernels"]
+            cells = []
+            for name, ref in pairs.items():
+                ratio = k[name]["per_call_s"] / k[ref]["per_call_s"]
+                cells.append(f"{k[name]['per_element_us']:.3f} ({ratio:.2f})")
+            rows.append([str(rec["elements"]), f"{rec['poisson']:g}"] + cells)
+        print_table([("nel", 5), ("nu", 4)] + [(LABELS[n], 17) for n in SYSTEM_KERNELS], rows)
     if summary["speedup_over_1_thread"]:
         print("\nspeed-up over OMP_NUM_THREADS=1 (time with 1 thread / time with n threads)")
         rows = [[str(s["threads"]), str(s["elements"]), f"{s['poisson']:g}"]
@@ -347,19 +420,20 @@ def print_tables(runs: dict[int, dict[str, Any]], summary: dict[str, Any],
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
-                        help="2 repeats per round and nu = 0 only")
+                        help="1 round of 2 repeats of 0.05 s samples, nu = 0 only")
     parser.add_argument("--elements", type=int, nargs="+", default=list(ELEMENTS),
                         help=f"element counts (default {' '.join(map(str, ELEMENTS))})")
     parser.add_argument("--poisson", type=float, nargs="+", default=None,
                         help="Poisson ratios (default 0 0.3; 0 with --quick)")
     parser.add_argument("--threads", type=int, nargs="+", default=list(THREADS),
                         help="OMP_NUM_THREADS of the subprocesses (default 1 2)")
-    parser.add_argument("--min-time", type=float, default=0.2,
-                        help="seconds one sample lasts at least (default 0.2)")
+    parser.add_argument("--min-time", type=float, default=None,
+                        help="seconds one sample lasts at least (default 0.2; 0.05 with "
+                             "--quick)")
     parser.add_argument("--repeats", type=int, default=None,
                         help="samples per measurement and round (default 3; 2 with --quick)")
-    parser.add_argument("--rounds", type=int, default=2,
-                        help="rounds over all thread counts (default 2)")
+    parser.add_argument("--rounds", type=int, default=None,
+                        help="rounds over all thread counts (default 2; 1 with --quick)")
     parser.add_argument("--output", type=Path, default=None,
                         help="JSON file (default benchmarks/results/element_cost.json, "
                              "element_cost_quick.json with --quick)")
@@ -369,6 +443,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         args.poisson = [0.0] if args.quick else [0.0, 0.3]
     if args.repeats is None:
         args.repeats = 2 if args.quick else 3
+    if args.rounds is None:
+        args.rounds = 1 if args.quick else 2
+    if args.min_time is None:
+        args.min_time = 0.05 if args.quick else 0.2
     if min(args.elements + args.threads + [args.rounds, args.repeats]) < 1:
         parser.error("element and thread counts must be positive")
     if args.output is None:

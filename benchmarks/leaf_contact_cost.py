@@ -59,6 +59,15 @@ the contact counters and the raw times of part 1 at the scene's 3 points per edg
 (factorizations x raw + Jacobian + (evaluations - factorizations) x raw) per step over the
 seconds per step.
 
+Ported to the general-system model layer: the contact data are the model's contact pair
+(``model.contact_pairs[0]``: element coordinates of both leaves, sizes, grid, points,
+parameters, guesses; the lower leaf is the body 'lower'), the Jacobian's pattern is
+``model.full_pattern``, and the runs build with ``ancfdrv.builders.build_model`` (released
+after each run). The stepper of the new kernel evaluates the contact inside
+``system_evaluate``/``system_advance`` (the same ``contact_assemble``), so the raw calls
+remain the per-evaluation cost; the share estimate keeps its formula. Records and keys are
+unchanged.
+
 Results: tables on stdout and JSON in ``benchmarks/results/leaf_contact_cost.json``
 (``leaf_contact_cost_quick.json`` with ``--quick``). Run from the repository root::
 
@@ -103,36 +112,38 @@ LABELS = {"wrapper": "wrapper", "wrapper_jacobian": "wrapper+J", "raw": "raw",
 def contact_setup(points: int) -> dict[str, Any]:
     """Model with ``points`` contact points per edge, the timed state and the four calls."""
     from ancfdrv import _kernel, kernel
-    from ancfdrv.model import build_model
-    from ancfdrv.plate import P_R, plate_node_dofs
+    from ancfdrv.builders import build_model
     from ancfdrv.io.scene import load_scene
+    from ancfdrv.system.meshes import P_R, PLATE_NODE_DOFS
 
     scene = load_scene(SCENE, [f"spring.contact_points={points}"])
     model = build_model(scene)
-    contact, plates = model.contact, model.plates
-    e = model.expand(model.e0).copy()
+    model.close()  # only the assembled arrays are used here, not the kernel system
+    pair = model.contact_pairs[0]
+    lower = next(b for b in model.bodies if b.name == "lower")
+    e = model.expand(model.e0).copy()   # contact works on the full coordinates
     rates = np.zeros_like(e)
-    first_lower = scene["spring"]["main_nx"] * scene["leaf"]["ny"]
-    for node in np.unique(model.mesh.elements[first_lower:]):
-        dofs = plate_node_dofs(int(node), P_R)
-        e[dofs[2]] += RAISE
-        rates[dofs[0]] = SLIDE
-    sizes = np.asfortranarray(model.element_sizes())
-    guesses = np.asfortranarray(contact.guesses, dtype=np.float64).copy(order="F")
+    for node in range(lower.mesh.nnodes):
+        first = lower.first + PLATE_NODE_DOFS * node + P_R
+        e[first + 2] += RAISE
+        rates[first] = SLIDE
+    sizes = np.asfortranarray(pair["sizes"], dtype=np.float64)
+    guesses = np.asfortranarray(pair["guesses"], dtype=np.float64).copy(order="F")
     counts = np.zeros(6, np.int32)
     pattern = model.full_pattern
 
     def wrapper(jacobian: bool) -> Callable[[], Any]:
         return lambda: kernel.contact_evaluate(
-            e, rates, plates.dofs, sizes, contact.grid, contact.point_element,
-            contact.point_local, contact.params, guesses, counts,
+            e, rates, pair["dofs"], sizes, pair["grid"], pair["point_element"],
+            pair["point_local"], pair["params"], guesses, counts,
             pattern=pattern if jacobian else None)
 
     f = np.asfortranarray
-    raw_args = dict(e=f(e), rates=f(rates), dofs=f(plates.dofs + 1, np.int32), sizes=sizes,
-                    grid=f(contact.grid + 1, np.int32),
-                    point_element=f(contact.point_element + 1, np.int32),
-                    point_local=f(contact.point_local, np.float64), params=f(contact.params))
+    raw_args = dict(e=f(e), rates=f(rates), dofs=f(pair["dofs"] + 1, np.int32), sizes=sizes,
+                    grid=f(pair["grid"] + 1, np.int32),
+                    point_element=f(pair["point_element"] + 1, np.int32),
+                    point_local=f(pair["point_local"], np.float64),
+                    params=f(pair["params"], np.float64))
     row_ptr, col = f(pattern.row_ptr + 1, np.int32), f(pattern.col_index + 1, np.int32)
     dummy_ptr, dummy_col = np.ones(len(e) + 1, np.int32), np.ones(1, np.int32)
 
@@ -145,7 +156,7 @@ def contact_setup(points: int) -> dict[str, Any]:
 
     calls = {"wrapper": wrapper(False), "wrapper_jacobian": wrapper(True),
              "raw": raw(False), "raw_jacobian": raw(True)}
-    return {"points_per_edge": points, "points": len(contact.point_element),
+    return {"points_per_edge": points, "points": len(pair["point_element"]),
             "nfull": model.nfull, "ndof": model.ndof, "nnz_full": len(pattern.col_index),
             "calls": calls, "counts": counts}
 
@@ -216,11 +227,11 @@ def measure_contact(args: argparse.Namespace) -> dict[str, Any]:
 # -- part 2: runs ---------------------------------------------------------------------------
 def run_case(name: str, t_end: float) -> dict[str, Any]:
     """One run of a case through the library; a SolverError is recorded."""
+    from ancfdrv.builders import build_model
     from ancfdrv.errors import SolverError
-    from ancfdrv.solvers.dynamic import integrate
-    from ancfdrv.model import build_model
-    from ancfdrv.runner import dynamic_settings
     from ancfdrv.io.scene import load_scene
+    from ancfdrv.runner import dynamic_settings
+    from ancfdrv.solvers.dynamic import integrate
 
     scene = load_scene(SCENE, CASES[name] + [f"solver.t_end={t_end!r}"])
     t0 = time.perf_counter()
@@ -239,6 +250,8 @@ def run_case(name: str, t_end: float) -> dict[str, Any]:
     except SolverError as exc:
         out.update(error=str(exc), failed_after_s=time.perf_counter() - t0)
         result = None
+    finally:
+        model.close()
     if chunks:
         t = np.concatenate([c.time for c in chunks])
         chassis = np.concatenate([c.deflections for c in chunks])[:, list(model.probes).index(

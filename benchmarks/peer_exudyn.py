@@ -56,16 +56,25 @@ reference).
 
 Where ancfdrv's time goes: per ancfdrv run, the phases run_scene reports (model, set-up,
 stepping, output) and an estimate of the stepping from kernel costs measured in this
-process at the run's mesh: element evaluations (one force + tangent per step for the
-iteration matrix, one force per Newton correction and one for the step's energy), the
-banded Cholesky factorization of beta' M + K_t, and the substitutions (the flexibility
-S^-1 E_c, 3 per constrained 3-vector, and one per Newton correction).
+process at the run's mesh: force evaluations of the whole model through its kernel handle
+(``model.kernel.evaluate``: element loop, loads and assembly; one force + tangent per
+factorization, at the predicted state, whose force is the step's first residual, then one
+force per further Newton correction and one for the step's energy: about one force per
+correction), the banded Cholesky factorization of beta' M + K_t (per factorization the
+run's file reports), and the substitutions (the flexibility S^-1 E_c, 3 per constrained
+3-vector, per factorization, and one per Newton correction).
+
+Ported to the general-system model layer: the kernel costs come from a model built by
+``ancfdrv.builders.build_model`` (released after the measurement) and the spin-up drive
+check from ``ancfdrv.codes.DRIVE_SPINUP``; the breakdown counts factorizations from the
+run (``DynamicResult.factorizations``) instead of one per step.
 
 Results: tables on stdout and JSON in ``benchmarks/results/peer_exudyn.json``
 (``peer_exudyn_quick.json`` with ``--quick``). Run from the repository root::
 
     python benchmarks/peer_exudyn.py            # about 2.5 min on 2 cores
-    python benchmarks/peer_exudyn.py --quick    # coarser grids and references, about 35 s
+    python benchmarks/peer_exudyn.py --quick    # coarser grids, 'cubic' only, one repeat:
+                                                # a smoke run, ~25 s on an idle machine
     python benchmarks/peer_exudyn.py --omp-threads 2 --no-exudyn   # ancfdrv on 2 threads
 
 When Exudyn cannot be imported (``pip install exudyn``), its runs are skipped and
@@ -259,6 +268,7 @@ def run_ancfdrv(problem: Problem, nodes: int, dt: float, bending: str, workdir: 
             timing = {k: float(v) for k, v in h5["timing"].attrs.items()}
         t, y = tip_history(problem, out)
         return resample(problem, t, y), {"steps": dyn.steps, "newton": dyn.newton_iterations,
+                                         "factorizations": dyn.factorizations,
                                          "timing": timing, "warnings": outcome.warnings}
 
     t0 = time.perf_counter()
@@ -280,50 +290,47 @@ _KERNEL_COSTS: dict[tuple[str, str, int], dict[str, float]] = {}
 
 def kernel_costs(problem: Problem, run: Run, args: argparse.Namespace) -> dict[str, float]:
     """Per-call times (s) of the kernel operations of one step at the run's mesh, measured
-    once per problem and mesh: element force, force + tangent, banded factorization of
-    beta' M + K0 (the pattern and band of beta' M + K_t), one substitution, and the
-    substitutions of the flexibility S^-1 E_c."""
+    once per problem and mesh: force and force + tangent of the model through its kernel
+    handle, banded factorization of beta' M + K (the pattern and band of the iteration
+    matrix), one substitution, and the substitutions of the flexibility S^-1 E_c."""
     key = (problem.name, run.bending, run.mesh)
     if key in _KERNEL_COSTS:
         return _KERNEL_COSTS[key]
     from element_cost import time_call
 
-    from ancfdrv import _kernel
-    from ancfdrv.solvers.dynamic import DynamicSettings
-    from ancfdrv.kernel import DirectSolver
-    from ancfdrv.model import build_model
-    from ancfdrv.runner import dynamic_settings
+    from ancfdrv.builders import build_model
     from ancfdrv.io.scene import load_scene
+    from ancfdrv.kernel import DirectSolver
+    from ancfdrv.runner import dynamic_settings
+    from ancfdrv.solvers.dynamic import DynamicSettings
 
     scene = load_scene(REPO / problem.scene,
                        ancfdrv_overrides(problem, run.mesh, run.dt, run.bending))
     model = build_model(scene)
-    settings: DynamicSettings = dynamic_settings(scene)
-    dofs = np.asfortranarray(model.dofs + 1, dtype=np.int32)
-    e = np.asfortranarray(model.e0)
+    try:
+        settings: DynamicSettings = dynamic_settings(scene)
+        e, v = model.e0.copy(), np.zeros(model.ndof)
 
-    def forces(want_tangent: int) -> Callable[[], object]:
-        if model.structural is not None:
-            return lambda: model.structural.forces(model.dofs, e, bool(want_tangent))
-        return lambda: _kernel.beam_nonlinear_forces(dofs, e, model.gauss_gradients,
-                                                     model.gauss_weights, model.youngs,
-                                                     model.poisson, want_tangent)
+        def forces(want_tangent: bool) -> Callable[[], object]:
+            return lambda: model.kernel.evaluate(0.0, e, v, model.contact_guesses,
+                                                 model.contact_counts,
+                                                 want_tangent=want_tangent)
 
-    force = time_call(forces(0), args.kernel_min_time, 3).per_call_s
-    tangent = time_call(forces(1), args.kernel_min_time, 3).per_call_s
-    values = (settings.beta_prime * model.mass_values()
-              + model.pattern.assemble(model.stiffness0))
-    table = model.constraints.dof_table()
-    used = table[table >= 0]
-    flexibility_rhs = 3 * len(np.unique(used - used % 3))
-    with DirectSolver(model.ndof, model.pattern.rows, model.pattern.col_index,
-                      banded_spd=True, what="beta' M + K0") as solver:
-        factorize = time_call(lambda: solver.factorize(values), args.kernel_min_time, 3).per_call_s
-        rhs1 = np.ones(model.ndof)
-        rhs_flex = np.ones((model.ndof, max(flexibility_rhs, 1)))
-        solve1 = time_call(lambda: solver.solve(rhs1), args.kernel_min_time, 3).per_call_s
-        solve_flex = time_call(lambda: solver.solve(rhs_flex), args.kernel_min_time,
-                               3).per_call_s
+        force = time_call(forces(False), args.kernel_min_time, 3).per_call_s
+        tangent = time_call(forces(True), args.kernel_min_time, 3).per_call_s
+        values = settings.beta_prime * model.mass_values() + model.stiffness_values()
+        flexibility_rhs = 3 * len(model.touched_blocks())
+        with DirectSolver(model.ndof, model.pattern.rows, model.pattern.col_index,
+                          banded_spd=True, what="beta' M + K") as solver:
+            factorize = time_call(lambda: solver.factorize(values), args.kernel_min_time,
+                                  3).per_call_s
+            rhs1 = np.ones(model.ndof)
+            rhs_flex = np.ones((model.ndof, max(flexibility_rhs, 1)))
+            solve1 = time_call(lambda: solver.solve(rhs1), args.kernel_min_time, 3).per_call_s
+            solve_flex = time_call(lambda: solver.solve(rhs_flex), args.kernel_min_time,
+                                   3).per_call_s
+    finally:
+        model.close()
     costs = {"force": force, "force_tangent": tangent, "factorize": factorize,
              "solve_1rhs": solve1, "solve_flexibility": solve_flex,
              "flexibility_rhs": float(flexibility_rhs)}
@@ -337,9 +344,11 @@ def ancfdrv_breakdown(problem: Problem, run: Run, args: argparse.Namespace) -> d
     c = kernel_costs(problem, run, args)
     stepping = run.details["timing"].get("dynamic_stepping", math.nan)
     steps, newton = run.steps, run.newton_iterations
-    parts = {"elements": steps * c["force_tangent"] + (newton + steps) * c["force"],
-             "factorization": steps * c["factorize"],
-             "substitutions": steps * c["solve_flexibility"] + newton * c["solve_1rhs"]}
+    factorizations = run.details.get("factorizations", steps)
+    parts = {"elements": factorizations * c["force_tangent"] + newton * c["force"],
+             "factorization": factorizations * c["factorize"],
+             "substitutions": factorizations * c["solve_flexibility"]
+             + newton * c["solve_1rhs"]}
     shares = {f"{k}_share": v / stepping for k, v in parts.items()}
     return {"stepping_s": stepping, "per_step_ms": 1e3 * stepping / max(steps, 1),
             "newton_per_step": newton / max(steps, 1),
@@ -392,7 +401,7 @@ def spinup_angle(beam: Beam, t: float) -> float:
 
 def check_spinup_angle(beam: Beam) -> float:
     """Largest difference between :func:`spinup_angle` and ancfdrv's drive."""
-    from ancfdrv.constraints import DRIVE_SPINUP
+    from ancfdrv.codes import DRIVE_SPINUP
     from ancfdrv.kernel import drive_values
 
     t = np.linspace(0.0, 2.0 * beam.period, 301)
@@ -777,11 +786,13 @@ def print_tables(records: dict[str, dict[str, Any]], exudyn_note: str | None) ->
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
-                        help="coarser grids and references (under 2 minutes)")
+                        help="coarser grids and references, one repeat per run, "
+                             "bending 'cubic' only unless --bending is given")
     parser.add_argument("--problems", nargs="+", choices=sorted(PROBLEMS),
                         default=sorted(PROBLEMS), help="which problems (default both)")
-    parser.add_argument("--min-time", type=float, default=1.0,
-                        help="repeat a run until the repeats took this long (default 1 s)")
+    parser.add_argument("--min-time", type=float, default=None,
+                        help="repeat a run until the repeats took this long (default 1 s; 0 "
+                             "with --quick)")
     parser.add_argument("--max-repeats", type=int, default=3,
                         help="repeats of one run at most (default 3)")
     parser.add_argument("--kernel-min-time", type=float, default=0.05,
@@ -795,9 +806,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="the spin-up's hub drive in Exudyn as a symbolic user function "
                              "(evaluated in C++) instead of a Python one")
     parser.add_argument("--bending", nargs="+", choices=("cubic", "continuum"),
-                        default=["cubic", "continuum"],
+                        default=None,
                         help="ancfdrv's beam.bending options to run, one curve each; the "
-                             "first one's finest run is the common reference (default both)")
+                             "first one's finest run is the common reference (default both; "
+                             "cubic with --quick)")
     parser.add_argument("--omp-threads", type=int, default=None,
                         help="OMP_NUM_THREADS for ancfdrv's kernel (default: the environment's, "
                              "else ancfdrv's own default of 1); Exudyn runs on 1 thread")
@@ -805,6 +817,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="JSON file (default benchmarks/results/peer_exudyn.json, "
                              "peer_exudyn_quick.json with --quick)")
     args = parser.parse_args(argv)
+    if args.min_time is None:
+        args.min_time = 0.0 if args.quick else 1.0
+    if args.bending is None:
+        args.bending = ["cubic"] if args.quick else ["cubic", "continuum"]
     if args.output is None:
         args.output = RESULTS / ("peer_exudyn_quick.json" if args.quick else "peer_exudyn.json")
     return args

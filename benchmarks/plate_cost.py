@@ -50,6 +50,14 @@ message (and the history up to the failure) and the next mesh runs. The 4 x 4 me
 runs with variant 'plain': for the flat plate both variants must give the same history to
 round-off.
 
+Ported to the general-system model layer: the meshes come from ``ancfdrv.system.meshes``
+and the kernel arrays of part 1 from ``ancfdrv.kernel.PlateReference`` on the element
+coordinates (as the assembly builds a plate set), so no model is built there; the
+pendulum's model is ``ancfdrv.builders.build_model`` (released after each run). The
+stepper of the new kernel decides its factorizations itself (``jacobian`` policy 'step'
+for the scene), so 'factorizations' and the Newton counts come from its per-step
+statistics. Records and keys are unchanged.
+
 Results: tables on stdout and JSON in ``benchmarks/results/plate_cost.json``
 (``plate_cost_quick.json`` with ``--quick``). Run from the repository root::
 
@@ -128,7 +136,7 @@ class OpenMP:
 # -- part 1: cost per element ------------------------------------------------------------
 def element_meshes(args: argparse.Namespace) -> list[dict[str, Any]]:
     """The meshes of part 1: label, mesh and thickness."""
-    from ancfdrv.plate import arc_mesh, rectangle_mesh
+    from ancfdrv.system.meshes import arc_mesh, rectangle_mesh
 
     meshes = [{"label": f"flat {n}x{n}", "kind": "flat", "mesh":
                rectangle_mesh(PLATE_SIDE, PLATE_SIDE, n, n), "thickness": PLATE_THICKNESS}
@@ -142,21 +150,24 @@ def element_meshes(args: argparse.Namespace) -> list[dict[str, Any]]:
 
 def kernel_arrays(mesh_info: dict[str, Any], variant: str, e: np.ndarray) -> dict[str, Any]:
     """Kernel-ready arrays of one mesh and variant at the configuration e."""
-    from ancfdrv.kernel import PLATE_VARIANTS
-    from ancfdrv.plate import PlateModel
+    from ancfdrv.kernel import PLATE_VARIANTS, PlateReference
+    from ancfdrv.system.meshes import PLATE_NODE_DOFS
 
-    model = PlateModel(mesh_info["mesh"], mesh_info["thickness"], density=DENSITY,
-                       youngs=YOUNGS, poisson=POISSON, variant=variant, effects=())
-    ref = model.reference_data
+    mesh = mesh_info["mesh"]
+    # (36, nel) element coordinates, as Plate.element_dofs numbers them (first = 0)
+    dofs = (PLATE_NODE_DOFS * mesh.elements[:, :, None]
+            + np.arange(PLATE_NODE_DOFS)).reshape(mesh.nel, 36).T
+    e0 = mesh.coords.ravel()
     f = np.asfortranarray
-    return {"nel": model.nel, "ndof": model.ndof,
-            "dofs": f(model.dofs + 1, dtype=np.int32), "e": f(e, dtype=np.float64),
-            "e0": f(model.e0, dtype=np.float64),
+    reference = f(e0[dofs].reshape(3, 12, mesh.nel, order="F"))
+    ref = PlateReference(reference, mesh.a, mesh.b, variant)
+    return {"nel": mesh.nel, "ndof": len(e0),
+            "dofs": f(dofs + 1, dtype=np.int32), "e": f(e, dtype=np.float64),
+            "e0": f(e0, dtype=np.float64),
             "derivs": ref.derivs, "frame": ref.frame, "curvature0": ref.curvature0,
-            "weights": ref.weights,
-            "reference": f(model.e0[model.dofs].reshape(3, 12, model.nel, order="F")),
-            "a": f(model.mesh.a, dtype=np.float64), "b": f(model.mesh.b, dtype=np.float64),
-            "variant": PLATE_VARIANTS[variant], "thickness": model.thickness}
+            "weights": ref.weights, "reference": reference,
+            "a": f(mesh.a, dtype=np.float64), "b": f(mesh.b, dtype=np.float64),
+            "variant": PLATE_VARIANTS[variant], "thickness": mesh_info["thickness"]}
 
 
 def kernel_calls(kernel: Any, a: dict[str, Any]) -> dict[str, Callable[[], Any]]:
@@ -299,11 +310,11 @@ def measure_elements(kernel: Any, omp: OpenMP, args: argparse.Namespace) -> dict
 def pendulum_run(n: int, variant: str, args: argparse.Namespace) -> dict[str, Any]:
     """One mesh of the pendulum, best wall time of up to ``args.pendulum_repeats`` runs,
     with the histories of the first run."""
-    from ancfdrv.solvers.dynamic import integrate
+    from ancfdrv.builders import build_model
     from ancfdrv.errors import SolverError
-    from ancfdrv.model import build_model
-    from ancfdrv.runner import dynamic_settings
     from ancfdrv.io.scene import load_scene
+    from ancfdrv.runner import dynamic_settings
+    from ancfdrv.solvers.dynamic import integrate
 
     overrides = [f"plate.nx={n}", f"plate.ny={n}", f"plate.variant={variant}",
                  f"solver.dt={args.dt!r}"]
@@ -324,6 +335,8 @@ def pendulum_run(n: int, variant: str, args: argparse.Namespace) -> dict[str, An
         except SolverError as exc:
             record["error"] = str(exc)
             result = None
+        finally:
+            model.close()
         spent += time.perf_counter() - t0 + build_s
         history = {"time": np.concatenate([c.time for c in chunks]),
                    "corner": np.concatenate([c.probes for c in chunks])[
@@ -331,7 +344,8 @@ def pendulum_run(n: int, variant: str, args: argparse.Namespace) -> dict[str, An
                    "energy": np.concatenate([c.energy for c in chunks])}
         if first is None:
             first = history
-            record.update(ndof=model.ndof, elements=model.nel, t_end=settings.t_end,
+            record.update(ndof=model.ndof, elements=sum(s.nel for s in model.sets),
+                          t_end=settings.t_end,
                           dt=settings.dt)
         else:
             record["reproducible"] = bool(np.array_equal(first["corner"], history["corner"]))

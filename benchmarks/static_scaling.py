@@ -36,6 +36,15 @@ residual, or step at the round-off floor with the residual below sqrt(tol)).
 Process CPU time (user/system) and minor page faults of the best repeat are recorded too:
 a large system share means time spent page-faulting freshly allocated memory.
 
+Ported to the general-system model layer (``ancfdrv.builders.build_model`` returns an
+``ancfdrv.system.model.Model`` whose forces come from a kernel handle): ``build_model`` now
+also hands the system to the kernel and analyses the iteration matrix's pattern, and each
+timed build is closed again (``model.close()``: the kernel holds at most 256 systems); the
+stiffness assembly is ``model.stiffness_values()``, a force + tangent evaluation of the
+kernel system; the Newton saddle-point system is assembled as the new
+:func:`ancfdrv.solvers.static.solve_newton` assembles its first iteration (right-hand side
+[-(Q_int - Q), Phi] from ``model.forces``). Records, keys and tables are unchanged.
+
 Results: a table on stdout and JSON (machine info, one record per node count, growth
 exponents) in ``benchmarks/results/``. Run from the repository root::
 
@@ -61,10 +70,11 @@ import scipy.sparse.linalg as spla
 
 from _common import load_average, machine_info, print_table, write_report
 from ancfdrv.errors import SolverError
-from ancfdrv.kernel import DirectSolver
-from ancfdrv.model import BeamModel, build_model
+from ancfdrv.builders import build_model
 from ancfdrv.io.scene import load_scene
+from ancfdrv.kernel import DirectSolver
 from ancfdrv.solvers.static import StaticResult, _hessian_triplets, solve_newton, solve_split
+from ancfdrv.system.model import Model
 
 REPO = Path(__file__).resolve().parents[1]
 SCENE = REPO / "inputs" / "boom_static.nml"
@@ -171,30 +181,27 @@ class LinearSystem:
                              shape=(self.n, self.n)).tocsc()
 
 
-def newton_saddle_system(model: BeamModel) -> LinearSystem:
+def newton_saddle_system(model: Model) -> LinearSystem:
     """The saddle-point system of the first Newton iteration (d = 0, lambda = 0), with the
-    same triplet pattern as :func:`ancfdrv.solvers.static.solve_newton`."""
+    same triplet pattern and values as :func:`ancfdrv.solvers.static.solve_newton`."""
     n, ncon = model.ndof, len(model.constraints)
     e = model.e0
     lam = np.zeros(ncon)
-    k_values = model.stiffness_values()
     h_con, h_rows, h_cols, h_vals = _hessian_triplets(model, e)
     phi, j_rows, j_cols, grads = model.constraints.jacobian(e, n)
     moments = model.moment_terms(e)
-    m_rows = [np.repeat(m.dofs, 3) for m in model.moments]
-    m_cols = [np.tile(m.dofs, 3) for m in model.moments]
+    m_rows = [np.repeat(cols, len(cols)) for cols, *_ in moments]
+    m_cols = [np.tile(cols, len(cols)) for cols, *_ in moments]
+    forces = model.forces(e, 0.0, want_tangent=True)
     rows = np.concatenate([model.pattern.rows, h_rows, *m_rows, n + j_rows, j_cols])
     cols = np.concatenate([model.pattern.col_index, h_cols, *m_cols, j_cols, n + j_rows])
-    values = np.concatenate([k_values, -lam[h_con] * h_vals,
+    values = np.concatenate([forces["tangent"], -lam[h_con] * h_vals,
                              *[-j.ravel() for _, _, j, _ in moments], -grads, -grads])
-    external = model.constant_force()
-    for dofs, f, _, _ in moments:
-        external[dofs] += f
-    # residual at d = 0, lambda = 0 is -external; Newton solves A step = [-residual, phi]
-    return LinearSystem(n + ncon, rows, cols, values, np.concatenate([external, phi]))
+    residual = forces["internal"] - forces["external"]  # the reactions vanish at lambda = 0
+    return LinearSystem(n + ncon, rows, cols, values, np.concatenate([-residual, phi]))
 
 
-def stiffness_system(model: BeamModel, *, reduced: bool) -> LinearSystem:
+def stiffness_system(model: Model, *, reduced: bool) -> LinearSystem:
     """K (``reduced=False``) or K_RR, K without the split's dependent coordinates, with
     the constant load as right-hand side."""
     stiffness = model.stiffness_matrix()
@@ -250,7 +257,7 @@ def time_spsolve(system: LinearSystem, budget: Budget) -> tuple[Timing, np.ndarr
     return best_of(run, budget), solution[0]
 
 
-def time_static(model: BeamModel, method: str, tols: list[float], *, max_iter: int,
+def time_static(model: Model, method: str, tols: list[float], *, max_iter: int,
                 budget: Budget) -> dict[str, Any]:
     """A static solve timed at the first tolerance of ``tols`` it reaches. A solve that
     fails on its first call at a tolerance is recorded (message, time to failure) and the
@@ -297,8 +304,21 @@ def measure(nodes: int, args: argparse.Namespace) -> dict[str, Any]:
     """All measurements of one node count."""
     budget = args.budget
     scene = load_scene(SCENE, [f"beam.nodes={nodes}", f"boom.angle_deg={args.angle}"])
-    build = best_of(lambda: build_model(scene), budget)
+    def build_and_release() -> None:
+        build_model(scene).close()  # the kernel holds at most 256 systems alive
+
+    build = best_of(build_and_release, budget)
     model = build_model(scene)
+    try:
+        return _measure_model(model, nodes, build, args)
+    finally:
+        model.close()
+
+
+def _measure_model(model: Model, nodes: int, build: Timing,
+                   args: argparse.Namespace) -> dict[str, Any]:
+    """The measurements on a built model (``build``: the timing of ``build_model``)."""
+    budget = args.budget
     assembly = best_of(model.stiffness_values, budget)
 
     saddle = newton_saddle_system(model)

@@ -1,0 +1,97 @@
+"""Smoke runs of the benchmark scripts on the smallest settings: each runs over the current
+API and writes the JSON its docstring documents, with finite positive measurements and the
+exact expectations that do not depend on timing (mesh sizes, convergence, the identical
+histories of a version compared with itself). Nothing here asserts a time."""
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCHMARKS = ROOT / "benchmarks"
+
+
+def run_script(name: str, *args: str, timeout: float = 120.0) -> None:
+    done = subprocess.run([sys.executable, str(BENCHMARKS / name), *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=timeout)
+    assert done.returncode == 0, done.stderr[-3000:]
+
+
+def positive(x) -> bool:
+    return isinstance(x, (int, float)) and math.isfinite(x) and x > 0
+
+
+def test_static_scaling_smoke(tmp_path):
+    out = tmp_path / "static.json"
+    run_script("static_scaling.py", "--nodes", "4", "--min-time", "0", "--min-repeats", "1",
+               "--output", str(out))
+    report = json.loads(out.read_text())
+    assert report["benchmark"] == "static_scaling"
+    (record,) = report["records"]
+    assert record["nodes"] == 4 and record["ndof"] == 4 * 12
+    assert record["nconstraints"] == 7   # the boom's supports, eqs. 30-36
+    for method in ("newton", "split"):
+        static = record["static"][method]
+        assert static["converged"] and static["converged_at_requested_tol"]
+        assert static["residual_norm"] <= 1e-10
+        assert positive(static["timing"]["best_s"])
+    for key in ("build_model", "stiffness_assembly"):
+        assert positive(record[key]["best_s"])
+    assert all(positive(v) for v in record["floor"].values())
+    # MUMPS and SuperLU solve the same saddle-point system
+    assert record["saddle_solution_check"]["relative_difference"] < 1e-8
+
+
+def test_dynamic_scaling_smoke(tmp_path):
+    out = tmp_path / "dynamic.json"
+    run_script("dynamic_scaling.py", "--nodes", "4", "--min-time", "0.01", "--repeats", "1",
+               "--run-nodes", "0", "--output", str(out))
+    report = json.loads(out.read_text())
+    (record,) = report["records"]
+    assert record["nodes"] == 4 and record["ndof"] == 48 and record["elements"] == 3
+    assert record["jacobian_policy"] == "constant"          # the FFR boom
+    # the luffing stage starts after the 1 s smooth start (SPEC section 5)
+    assert abs(record["window"][0] - 1.0) < 1e-9
+    steps = record["steps"]
+    assert positive(steps["step_s"]) and steps["newton_min"] >= 1
+    assert positive(record["floor"]["bulk_s"]) and positive(record["floor"]["single_s"])
+    assert positive(record["call"]["one_step_call_s"])
+    assert record["setup"]["integrator_setup_solves"] > 0   # S^-1 E_c of the constant policy
+    assert report["run_scene"] is None
+
+
+def test_before_after_same_version(tmp_path):
+    """A version against itself: the machinery runs both sides and finds identical
+    histories and counts (the runs are deterministic)."""
+    out = tmp_path / "ba.json"
+    python = sys.executable
+    run_script("before_after.py", "--before", python, "--before-dir", str(ROOT), "--after",
+               python, "--after-dir", str(ROOT), "--quick", "--cases", "boom_static",
+               "pendulum", "--dispatch-steps", "20", "--dispatch-repeats", "1",
+               "--output", str(out), timeout=300.0)
+    report = json.loads(out.read_text())
+    static, pendulum = report["cases"]["boom_static"], report["cases"]["pendulum"]
+    for case in (static, pendulum):
+        for side in ("before", "after"):
+            assert "error" not in case[side], case[side]
+            assert positive(case[side]["solve_s"]) and positive(case[side]["run_scene_s"])
+        assert case["history"]["max_abs_difference"] == 0.0
+        assert positive(case["speedup"])
+    assert static["history"]["kind"] == "static"
+    assert static["before"]["static_iterations"] == static["after"]["static_iterations"]
+    h = pendulum["history"]
+    assert h["kind"] == "dynamic" and h["same_times"] and h["moving"]
+    # quick: 0.2 s at the scene's dt = 5e-4
+    assert pendulum["before"]["steps"] == pendulum["after"]["steps"] == 400
+    assert pendulum["before"]["newton_iterations"] == pendulum["after"]["newton_iterations"]
+    for side in ("before", "after"):
+        d = report["dispatch"][side]
+        assert d["new_api"] is True and positive(d["per_step_us"])
+        assert set(d["overhead_per_call_us"]) == {"calls_of_10", "calls_of_1", "raw_calls_of_1"}
+        # a run split into kernel calls gives the same state
+        assert all(v == 0.0 for v in d["final_state_max_difference"].values())
+    table = out.with_suffix(".md").read_text()
+    assert "| boom_static |" in table and "| pendulum |" in table
