@@ -583,6 +583,11 @@ class KernelSystem:
         reason = STEP_FAILURES.get(int(info), f"kernel code {info}")
         raise SolverError(f"{what}: " + reason.format(max_newton="?", detail="?"))
 
+    def reset_stepper(self) -> None:
+        """Forget the stepper's state of earlier runs (contraction estimate, a matrix
+        factorized at another state): a run from a new initial state is reproducible."""
+        self._check(_kernel.system_reset_stepper(self.handle), "reset_stepper")
+
     def advance(self, nsteps: int, settings, state: dict, store_q: bool):
         """Advance nsteps steps (time_integrator) from state (t, e, v, a, accel, lam, work,
         powers, guesses, counts; updated in place); returns the raw outputs and status."""

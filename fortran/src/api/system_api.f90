@@ -42,6 +42,23 @@ subroutine system_destroy(handle, info)
   call store_destroy(handle, info)
 end subroutine system_destroy
 
+!> Forgets what the stepper learned in earlier runs (the contraction estimate; a matrix
+!> factorized at another state, except the constant policy's, which depends on the step
+!> alone): a run from a new initial state then gives the same result on any handle.
+subroutine system_reset_stepper(handle, info)
+  use mechanical_system, only: system_model, policy_constant
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  sys%theta = -1.0d0
+  sys%unconfirmed = 0
+  if (sys%policy /= policy_constant) sys%factorized = .false.
+end subroutine system_reset_stepper
+
 !> ANCF-FFR beam elements: K0 and the rigid configuration (24, nel) in the floating frame
 !> `frame` (1-based index into the system's frames), the element dofs (full, 1-based) and
 !> the scatter map into the full pattern.

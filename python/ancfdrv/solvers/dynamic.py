@@ -161,7 +161,9 @@ class TimeIntegrator:
 
     def state(self, t: float, e: np.ndarray, v: np.ndarray, a: np.ndarray,
               lam: np.ndarray) -> dict:
-        """A stepper state at t with q'' = a (the generalized-alpha variable starts at a)."""
+        """A stepper state at t with q'' = a (the generalized-alpha variable starts at a);
+        the kernel forgets what it learned in earlier runs, so runs are reproducible."""
+        self.model.kernel.reset_stepper()
         return dict(t=t, e=e.copy(), v=v.copy(), a=a.copy(), accel=a.copy(), lam=lam.copy(),
                     work=np.zeros(5), powers=np.zeros(5),
                     guesses=self.model.contact_guesses.copy(),
