@@ -11,6 +11,13 @@
 !> part D0 = diag(E, E, E, G, G, G), integrated over the whole section, and the Poisson
 !> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
 !> mechanics); with nu = 0 both coincide with the plain law.
+!>
+!> Kelvin-Voigt material damping (retardation time tau): S = D : (E + tau E'), with the
+!> strain rate E' = B(F) q' (the Voigt form of sym(F^T F')), so the damping force is
+!> Q_d = int tau B^T D E' dV0 and the dissipated power int tau E'^T D E' dV0 >= 0; a rigid
+!> motion has E' = 0 (objective). Its derivatives: d/dq' = tau int B^T D B, d/dq = the
+!> geometric term with the damping stress tau D E' plus tau int B(F)^T D B(F') (E' is
+!> bilinear in F and F'), which is not symmetric.
 module beam_nonlinear
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
@@ -77,16 +84,34 @@ contains
   !> one element with nodal vectors q(3, 8).
   !> The first volume_points points integrate the Poisson-free law over the volume, the
   !> others (the neutral-axis points) the Poisson part.
+  !> With rates (q', 3 x 8) and damping_time tau > 0 the force includes the Kelvin-Voigt
+  !> damping, dissipation returns its power and the tangent is dQ/dq + rate_factor dQ/dq'
+  !> (not symmetric); otherwise none of it is computed (dissipation 0).
   pure subroutine nonlinear_element(q, gradients, weights, volume_points, youngs, poisson, &
-                                    want_tangent, force, energy, tangent)
+                                    want_tangent, force, energy, tangent, rates, damping_time, &
+                                    rate_factor, dissipation)
     real(dp), intent(in) :: q(3, 8), gradients(:, :, :), weights(:)
     integer, intent(in) :: volume_points
     real(dp), intent(in) :: youngs, poisson
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
+    real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
+    real(dp), intent(out), optional :: dissipation
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
     real(dp) :: stress(6), stress_matrix(3, 3), b(6, 24), db(6, 24), sg(3), geometric
+    real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6), b_rate(6, 24)
+    real(dp) :: tau, material_factor, power
+    logical :: damped
     integer :: p, a, c
+    damped = .false.
+    if (present(rates)) damped = damping_time > 0.0_dp
+    tau = 0.0_dp
+    material_factor = 1.0_dp
+    if (damped) then
+      tau = damping_time
+      material_factor = 1.0_dp + rate_factor * tau
+    end if
+    power = 0.0_dp
     call split_laws(youngs, poisson, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
@@ -103,10 +128,23 @@ contains
       stress = matmul(law, strain)
       energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
       call strain_matrix(deformation, gradients(:, :, p), b)
+      if (damped) then
+        deformation_rate = matmul(rates, gradients(:, :, p))
+        call green_lagrange_rate(deformation, deformation_rate, strain_rate)
+        damping_stress = tau * matmul(law, strain_rate)
+        power = power + weights(p) * dot_product(strain_rate, damping_stress)
+        stress = stress + damping_stress
+      end if
       force = force + weights(p) * matmul(transpose(b), stress)
       if (.not. want_tangent) cycle
       db = matmul(law, b)
-      tangent = tangent + weights(p) * matmul(transpose(b), db)
+      if (damped) then
+        tangent = tangent + (material_factor * weights(p)) * matmul(transpose(b), db)
+        call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
+        tangent = tangent + (tau * weights(p)) * matmul(transpose(b), matmul(law, b_rate))
+      else
+        tangent = tangent + weights(p) * matmul(transpose(b), db)
+      end if
       stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
                                stress(6), stress(5), stress(3)], [3, 3])
       do a = 1, 8
@@ -119,6 +157,7 @@ contains
         end do
       end do
     end do
+    if (present(dissipation)) dissipation = power
   end subroutine nonlinear_element
 
   !> Green-Lagrange strain in Voigt form with engineering shears [E11, E22, E33, 2E12, 2E23, 2E13].
@@ -130,6 +169,22 @@ contains
     strain = [0.5_dp * (c(1, 1) - 1.0_dp), 0.5_dp * (c(2, 2) - 1.0_dp), 0.5_dp * (c(3, 3) - 1.0_dp), &
               c(1, 2), c(2, 3), c(1, 3)]
   end subroutine green_lagrange
+
+  !> The rate of the Green-Lagrange strain (Voigt, engineering shears) at the deformation
+  !> gradient F and its rate F': the Voigt form of sym(F^T F'), i.e. B(F) q'.
+  pure subroutine green_lagrange_rate(deformation, deformation_rate, strain_rate)
+    real(dp), intent(in) :: deformation(3, 3), deformation_rate(3, 3)
+    real(dp), intent(out) :: strain_rate(6)
+    strain_rate(1) = dot_product(deformation(:, 1), deformation_rate(:, 1))
+    strain_rate(2) = dot_product(deformation(:, 2), deformation_rate(:, 2))
+    strain_rate(3) = dot_product(deformation(:, 3), deformation_rate(:, 3))
+    strain_rate(4) = dot_product(deformation(:, 1), deformation_rate(:, 2)) &
+                     + dot_product(deformation(:, 2), deformation_rate(:, 1))
+    strain_rate(5) = dot_product(deformation(:, 2), deformation_rate(:, 3)) &
+                     + dot_product(deformation(:, 3), deformation_rate(:, 2))
+    strain_rate(6) = dot_product(deformation(:, 1), deformation_rate(:, 3)) &
+                     + dot_product(deformation(:, 3), deformation_rate(:, 1))
+  end subroutine green_lagrange_rate
 
   !> B(6, 24): d strain = B dq, columns (a, i) -> 3(a-1)+i.
   pure subroutine strain_matrix(deformation, gradient, b)

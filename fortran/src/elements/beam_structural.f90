@@ -24,6 +24,12 @@
 !> EI_y, G J with J = I_y + I_z and G A (k = 1) of the section (beam_section), as the
 !> continuum element with nu = 0 has, so the two options differ in the bending
 !> interpolation only.
+!>
+!> Kelvin-Voigt material damping (retardation time tau) acts on every strain:
+!> s -> s + tau s' with s' = q' . C q, so Q_d = sum_terms k tau s' C q, the dissipated power
+!> sum k tau s'^2 >= 0 (rigid motions leave every s', too, at zero), and the tangent
+!> dQ/dq + c dQ/dq' = sum k ((1 + c tau) g g^T + tau g (C q')^T + (s + tau s') C x I3)
+!> (g = C q), not symmetric.
 module beam_structural
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
@@ -152,14 +158,30 @@ contains
 
   !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
   !> one element with nodal vectors q(3, 8).
+  !> With rates (q', 3 x 8) and damping_time tau > 0 the force includes the Kelvin-Voigt
+  !> damping, dissipation returns its power and the tangent is dQ/dq + rate_factor dQ/dq'
+  !> (not symmetric); otherwise none of it is computed (dissipation 0).
   pure subroutine structural_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
-                                     tangent)
+                                     tangent, rates, damping_time, rate_factor, dissipation)
     real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
     real(dp), intent(in) :: stiffness(structural_terms)
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
+    real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
+    real(dp), intent(out), optional :: dissipation
     real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
+    real(dp) :: rate_gradient(3, 8), flat_rate(24), strain_rate, tau, material_factor, power
+    logical :: damped
     integer :: t, j, a, c, i
+    damped = .false.
+    if (present(rates)) damped = damping_time > 0.0_dp
+    tau = 0.0_dp
+    material_factor = 1.0_dp
+    if (damped) then
+      tau = damping_time
+      material_factor = 1.0_dp + rate_factor * tau
+    end if
+    power = 0.0_dp
     force = 0.0_dp
     energy = 0.0_dp
     tangent = 0.0_dp
@@ -169,14 +191,31 @@ contains
       strain = 0.5_dp * sum(q * gradient) - strain0(t)
       energy = energy + 0.5_dp * stiffness(t) * strain**2
       flat = reshape(gradient, [24])
+      if (damped) then
+        ! s' = q' . C q; s + tau s' carries the force and the geometric term
+        strain_rate = sum(rates * gradient)
+        power = power + tau * stiffness(t) * strain_rate**2
+        strain = strain + tau * strain_rate
+      end if
       force = force + stiffness(t) * strain * flat
       if (.not. want_tangent) cycle
-      do j = 1, 24
-        scaled = stiffness(t) * flat(j)
-        tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
-      end do
+      if (damped) then
+        ! the full columns: k g ((1 + c tau) g + tau C q')^T
+        rate_gradient = matmul(rates, forms(:, :, t))
+        flat_rate = reshape(rate_gradient, [24])
+        do j = 1, 24
+          scaled = stiffness(t) * (material_factor * flat(j) + tau * flat_rate(j))
+          tangent(:, j) = tangent(:, j) + scaled * flat
+        end do
+      else
+        do j = 1, 24
+          scaled = stiffness(t) * flat(j)
+          tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
+        end do
+      end if
       geometric = geometric + stiffness(t) * strain * forms(:, :, t)
     end do
+    if (present(dissipation)) dissipation = power
     if (.not. want_tangent) return
     do c = 1, 8
       do a = 1, 8
@@ -186,6 +225,7 @@ contains
         end do
       end do
     end do
+    if (damped) return  ! the damped rank-one parts filled whole columns
     ! the rank-one parts filled the lower triangle; the geometric part is symmetric
     do j = 2, 24
       tangent(1:j - 1, j) = tangent(j, 1:j - 1)

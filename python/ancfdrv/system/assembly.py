@@ -50,7 +50,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         raise InputError(f"linear_joints {linear_joints!r} must be one of {LINEAR_JOINTS}")
     if not any(b.flexible or isinstance(b, RigidBody) for b in system.bodies.values()):
         raise InputError("the system has no body")
-    active_effects = set(system.effects_used() if effects is None else effects)
+    active_effects = set(_effects_used(system) if effects is None else effects)
     counters: Counter = Counter({name: 0 for name in EFFECTS_AVAILABLE + CONTACT_COUNTERS})
     for name in active_effects:
         counters[name] += 0
@@ -131,6 +131,15 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
 
 
 # -- effects ---------------------------------------------------------------------------------
+def _effects_used(system) -> set[str]:
+    """Every effect an item of the system belongs to: its loads', contacts' and leaves'
+    (System.effects_used) and 'damping' when a flexible body's material has a damping time."""
+    used = set(system.effects_used())
+    if any(b.flexible and b.material.damping_time > 0 for b in system.bodies.values()):
+        used.add("damping")
+    return used
+
+
 def _select(system, active: set[str], warnings: list[str]) -> _Active:
     loads = list(system.loads.values())
     for load in loads:
@@ -178,6 +187,9 @@ def _element_sets(bodies, frames, beam_frame, act: _Active, active: set[str], co
         else:
             continue
         counters["element_arrays"] += info.nel
+        if "damping" in active and body.material.damping_time > 0:
+            info.damping_time = float(body.material.damping_time)
+            counters["damping"] += 1
         sets.append(info)
         blocks.append(info.dofs)
     return sets, blocks

@@ -57,6 +57,9 @@ class SetInfo:
     nvolume: int = 0
     structural: kernel.StructuralBeam | None = None
     plate_reference: kernel.PlateReference | None = None
+    #: Kelvin-Voigt retardation time (s) handed to the kernel: the material's with the
+    #: effect 'damping' listed, else 0 (no damping code runs)
+    damping_time: float = 0.0
 
 
 @dataclass
@@ -153,6 +156,12 @@ class Model:
 
     # -- identity ---------------------------------------------------------------------------
     @property
+    def damped(self) -> bool:
+        """Whether any element set carries material damping (the effect 'damping' listed and
+        a material with damping_time > 0)."""
+        return any(s.damping_time > 0 for s in self.sets)
+
+    @property
     def npoint(self) -> int:
         return sum(len(p["point_element"]) for p in self.contact_pairs)
 
@@ -213,6 +222,8 @@ class Model:
         self.counters["elastic_force"] += 1
         if want_tangent:
             self.counters["stiffness_assembly"] += 1
+        if self.damped:
+            self.counters["damping"] += 1
         if self.moments:
             for m in self.moments:
                 self.counters[m.effect] += 1
@@ -354,18 +365,19 @@ class Model:
         ks = kernel.KernelSystem(self.ndof, self.nfull)
         for s in self.sets:
             if s.kind == "ffr":
-                ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame)
+                ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame,
+                               s.damping_time)
             elif s.kind == "continuum":
                 ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
                                      s.body.material.youngs_modulus,
-                                     s.body.material.poisson_ratio, s.frame)
+                                     s.body.material.poisson_ratio, s.frame, s.damping_time)
             elif s.kind == "structural":
                 ks.add_structural_set(s.dofs, s.scatter, s.structural.forms, s.structural.strain0,
-                                      s.structural.stiffness, s.frame)
+                                      s.structural.stiffness, s.frame, s.damping_time)
             else:
                 ks.add_plate_set(s.dofs, s.scatter, s.plate_reference,
                                  s.body.material.youngs_modulus, s.body.material.poisson_ratio,
-                                 s.body.thickness)
+                                 s.body.thickness, s.damping_time)
         ks.set_frames([f.drive for f in self.frames], [f.axis for f in self.frames],
                       [f.base for f in self.frames], [f.pivot for f in self.frames])
         ks.set_drives([d.kind for d in self.drives], [d.params() for d in self.drives])
