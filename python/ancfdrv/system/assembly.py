@@ -187,12 +187,27 @@ def _element_sets(bodies, frames, beam_frame, act: _Active, active: set[str], co
         else:
             continue
         counters["element_arrays"] += info.nel
-        if "damping" in active and body.material.damping_time > 0:
-            info.damping_time = float(body.material.damping_time)
-            counters["damping"] += 1
+        _damping(info, body, active, counters, warnings)
         sets.append(info)
         blocks.append(info.dofs)
     return sets, blocks
+
+
+def _damping(info: SetInfo, body: Body, active: set[str], counters: Counter,
+             warnings: list[str]) -> None:
+    """The set's Kelvin-Voigt retardation time: its material's with the effect 'damping'
+    listed (one count per damped set), else 0 with a warning when the material has one."""
+    tau = body.material.damping_time
+    if tau <= 0:
+        return
+    if "damping" in active:
+        info.damping_time = float(tau)
+        counters["damping"] += 1
+        return
+    message = (f"material {body.material.name!r} has damping_time = {tau:g} s but the effect "
+               "'damping' is not listed: not applied")
+    if message not in warnings:
+        warnings.append(message)
 
 
 def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
