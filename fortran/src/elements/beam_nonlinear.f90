@@ -12,12 +12,12 @@
 !> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
 !> mechanics); with nu = 0 both coincide with the plain law.
 !>
-!> Kelvin-Voigt material damping (retardation time tau): S = D : (E + tau E'), with the
-!> strain rate E' = B(F) q' (the Voigt form of sym(F^T F')), so the damping force is
-!> Q_d = int tau B^T D E' dV0 and the dissipated power int tau E'^T D E' dV0 >= 0; a rigid
-!> motion has E' = 0 (objective). Its derivatives: d/dq' = tau int B^T D B, d/dq = the
-!> geometric term with the damping stress tau D E' plus tau int B(F)^T D B(F') (E' is
-!> bilinear in F and F'), which is not symmetric.
+!> Kelvin-Voigt material damping (retardation time tau, nonlinear_element_damped):
+!> S = D : (E + tau E'), with the strain rate E' = B(F) q' (the Voigt form of sym(F^T F'),
+!> F' = q' g^T), so the damping force is Q_d = int tau B^T D E' dV0 and the dissipated power
+!> int tau E'^T D E' dV0 >= 0; a rigid motion has E' = 0 (objective). Its derivatives:
+!> d/dq' = tau int B^T D B; d/dq = the geometric term of the damping stress tau D E' plus
+!> tau int B(F)^T D B(F') (E' is bilinear in F and F'), not symmetric.
 module beam_nonlinear
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
@@ -25,7 +25,7 @@ module beam_nonlinear
   use matrix3, only: invert3
   implicit none
   private
-  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element
+  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, nonlinear_element_damped
 
   !> Gauss points along the axis; the section rule comes from beam_section.
   integer, parameter, public :: nonlinear_axial_points = 4
@@ -84,34 +84,16 @@ contains
   !> one element with nodal vectors q(3, 8).
   !> The first volume_points points integrate the Poisson-free law over the volume, the
   !> others (the neutral-axis points) the Poisson part.
-  !> With rates (q', 3 x 8) and damping_time tau > 0 the force includes the Kelvin-Voigt
-  !> damping, dissipation returns its power and the tangent is dQ/dq + rate_factor dQ/dq'
-  !> (not symmetric); otherwise none of it is computed (dissipation 0).
   pure subroutine nonlinear_element(q, gradients, weights, volume_points, youngs, poisson, &
-                                    want_tangent, force, energy, tangent, rates, damping_time, &
-                                    rate_factor, dissipation)
+                                    want_tangent, force, energy, tangent)
     real(dp), intent(in) :: q(3, 8), gradients(:, :, :), weights(:)
     integer, intent(in) :: volume_points
     real(dp), intent(in) :: youngs, poisson
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
-    real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
-    real(dp), intent(out), optional :: dissipation
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
     real(dp) :: stress(6), stress_matrix(3, 3), b(6, 24), db(6, 24), sg(3), geometric
-    real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6), b_rate(6, 24)
-    real(dp) :: tau, material_factor, power
-    logical :: damped
     integer :: p, a, c
-    damped = .false.
-    if (present(rates)) damped = damping_time > 0.0_dp
-    tau = 0.0_dp
-    material_factor = 1.0_dp
-    if (damped) then
-      tau = damping_time
-      material_factor = 1.0_dp + rate_factor * tau
-    end if
-    power = 0.0_dp
     call split_laws(youngs, poisson, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
@@ -128,23 +110,10 @@ contains
       stress = matmul(law, strain)
       energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
       call strain_matrix(deformation, gradients(:, :, p), b)
-      if (damped) then
-        deformation_rate = matmul(rates, gradients(:, :, p))
-        call green_lagrange_rate(deformation, deformation_rate, strain_rate)
-        damping_stress = tau * matmul(law, strain_rate)
-        power = power + weights(p) * dot_product(strain_rate, damping_stress)
-        stress = stress + damping_stress
-      end if
       force = force + weights(p) * matmul(transpose(b), stress)
       if (.not. want_tangent) cycle
       db = matmul(law, b)
-      if (damped) then
-        tangent = tangent + (material_factor * weights(p)) * matmul(transpose(b), db)
-        call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
-        tangent = tangent + (tau * weights(p)) * matmul(transpose(b), matmul(law, b_rate))
-      else
-        tangent = tangent + weights(p) * matmul(transpose(b), db)
-      end if
+      tangent = tangent + weights(p) * matmul(transpose(b), db)
       stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
                                stress(6), stress(5), stress(3)], [3, 3])
       do a = 1, 8
@@ -157,18 +126,64 @@ contains
         end do
       end do
     end do
-    if (present(dissipation)) dissipation = power
   end subroutine nonlinear_element
 
-  !> Green-Lagrange strain in Voigt form with engineering shears [E11, E22, E33, 2E12, 2E23, 2E13].
-  pure subroutine green_lagrange(deformation, strain)
-    real(dp), intent(in) :: deformation(3, 3)
-    real(dp), intent(out) :: strain(6)
-    real(dp) :: c(3, 3)
-    c = matmul(transpose(deformation), deformation)
-    strain = [0.5_dp * (c(1, 1) - 1.0_dp), 0.5_dp * (c(2, 2) - 1.0_dp), 0.5_dp * (c(3, 3) - 1.0_dp), &
-              c(1, 2), c(2, 3), c(1, 3)]
-  end subroutine green_lagrange
+  !> nonlinear_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
+  !> q'(3, 8): the force includes the damping force, dissipation is its power and the
+  !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
+  pure subroutine nonlinear_element_damped(q, rates, gradients, weights, volume_points, youngs, &
+                                           poisson, damping_time, rate_factor, want_tangent, &
+                                           force, energy, dissipation, tangent)
+    real(dp), intent(in) :: q(3, 8), rates(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
+    real(dp), intent(in) :: youngs, poisson, damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
+    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: stress(6), stress_matrix(3, 3), b(6, 24), b_rate(6, 24), sg(3), geometric
+    real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
+    integer :: p, a, c
+    call split_laws(youngs, poisson, law_free, law_poisson)
+    force = 0.0_dp
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    tangent = 0.0_dp
+    do p = 1, size(weights)
+      if (p <= volume_points) then
+        law = law_free
+      else
+        law = law_poisson
+        if (all(law == 0.0_dp)) cycle
+      end if
+      deformation = matmul(q, gradients(:, :, p))
+      deformation_rate = matmul(rates, gradients(:, :, p))
+      call green_lagrange(deformation, strain)
+      call green_lagrange_rate(deformation, deformation_rate, strain_rate)
+      stress = matmul(law, strain)
+      damping_stress = damping_time * matmul(law, strain_rate)
+      energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
+      dissipation = dissipation + weights(p) * dot_product(strain_rate, damping_stress)
+      stress = stress + damping_stress
+      call strain_matrix(deformation, gradients(:, :, p), b)
+      force = force + weights(p) * matmul(transpose(b), stress)
+      if (.not. want_tangent) cycle
+      ! (1 + c tau) B^T D B + tau B^T D B(F') + the geometric term of the total stress
+      call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
+      tangent = tangent + weights(p) * matmul(transpose(b), &
+                matmul(law, (1.0_dp + rate_factor * damping_time) * b + damping_time * b_rate))
+      stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
+                               stress(6), stress(5), stress(3)], [3, 3])
+      do a = 1, 8
+        sg = matmul(stress_matrix, gradients(a, :, p))
+        do c = 1, 8
+          geometric = weights(p) * dot_product(gradients(c, :, p), sg)
+          tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) = tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) + geometric
+          tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) = tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) + geometric
+          tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) = tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) + geometric
+        end do
+      end do
+    end do
+  end subroutine nonlinear_element_damped
 
   !> The rate of the Green-Lagrange strain (Voigt, engineering shears) at the deformation
   !> gradient F and its rate F': the Voigt form of sym(F^T F'), i.e. B(F) q'.
@@ -185,6 +200,16 @@ contains
     strain_rate(6) = dot_product(deformation(:, 1), deformation_rate(:, 3)) &
                      + dot_product(deformation(:, 3), deformation_rate(:, 1))
   end subroutine green_lagrange_rate
+
+  !> Green-Lagrange strain in Voigt form with engineering shears [E11, E22, E33, 2E12, 2E23, 2E13].
+  pure subroutine green_lagrange(deformation, strain)
+    real(dp), intent(in) :: deformation(3, 3)
+    real(dp), intent(out) :: strain(6)
+    real(dp) :: c(3, 3)
+    c = matmul(transpose(deformation), deformation)
+    strain = [0.5_dp * (c(1, 1) - 1.0_dp), 0.5_dp * (c(2, 2) - 1.0_dp), 0.5_dp * (c(3, 3) - 1.0_dp), &
+              c(1, 2), c(2, 3), c(1, 3)]
+  end subroutine green_lagrange
 
   !> B(6, 24): d strain = B dq, columns (a, i) -> 3(a-1)+i.
   pure subroutine strain_matrix(deformation, gradient, b)

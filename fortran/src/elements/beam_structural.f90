@@ -25,17 +25,17 @@
 !> continuum element with nu = 0 has, so the two options differ in the bending
 !> interpolation only.
 !>
-!> Kelvin-Voigt material damping (retardation time tau) acts on every strain:
-!> s -> s + tau s' with s' = q' . C q, so Q_d = sum_terms k tau s' C q, the dissipated power
-!> sum k tau s'^2 >= 0 (rigid motions leave every s', too, at zero), and the tangent
-!> dQ/dq + c dQ/dq' = sum k ((1 + c tau) g g^T + tau g (C q')^T + (s + tau s') C x I3)
+!> Kelvin-Voigt material damping (retardation time tau, structural_element_damped) acts on
+!> every strain: s -> s + tau s' with s' = q' . C q, so Q_d = sum_terms k tau s' C q, the
+!> dissipated power sum k tau s'^2 >= 0 (a rigid motion leaves every s' at zero), and the
+!> tangent dQ/dq + c dQ/dq' = sum k ((1 + c tau) g g^T + tau g (C q')^T + (s + tau s') C x I3)
 !> (g = C q), not symmetric.
 module beam_structural
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
   implicit none
   private
-  public :: structural_setup, structural_element
+  public :: structural_setup, structural_element, structural_element_damped
 
   !> Axial points of the axial and bending strains, of the torsion.
   integer, parameter :: n_line = 3, n_axial = 3, n_torsion = 2
@@ -158,30 +158,14 @@ contains
 
   !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
   !> one element with nodal vectors q(3, 8).
-  !> With rates (q', 3 x 8) and damping_time tau > 0 the force includes the Kelvin-Voigt
-  !> damping, dissipation returns its power and the tangent is dQ/dq + rate_factor dQ/dq'
-  !> (not symmetric); otherwise none of it is computed (dissipation 0).
   pure subroutine structural_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
-                                     tangent, rates, damping_time, rate_factor, dissipation)
+                                     tangent)
     real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
     real(dp), intent(in) :: stiffness(structural_terms)
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
-    real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
-    real(dp), intent(out), optional :: dissipation
     real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
-    real(dp) :: rate_gradient(3, 8), flat_rate(24), strain_rate, tau, material_factor, power
-    logical :: damped
     integer :: t, j, a, c, i
-    damped = .false.
-    if (present(rates)) damped = damping_time > 0.0_dp
-    tau = 0.0_dp
-    material_factor = 1.0_dp
-    if (damped) then
-      tau = damping_time
-      material_factor = 1.0_dp + rate_factor * tau
-    end if
-    power = 0.0_dp
     force = 0.0_dp
     energy = 0.0_dp
     tangent = 0.0_dp
@@ -191,31 +175,14 @@ contains
       strain = 0.5_dp * sum(q * gradient) - strain0(t)
       energy = energy + 0.5_dp * stiffness(t) * strain**2
       flat = reshape(gradient, [24])
-      if (damped) then
-        ! s' = q' . C q; s + tau s' carries the force and the geometric term
-        strain_rate = sum(rates * gradient)
-        power = power + tau * stiffness(t) * strain_rate**2
-        strain = strain + tau * strain_rate
-      end if
       force = force + stiffness(t) * strain * flat
       if (.not. want_tangent) cycle
-      if (damped) then
-        ! the full columns: k g ((1 + c tau) g + tau C q')^T
-        rate_gradient = matmul(rates, forms(:, :, t))
-        flat_rate = reshape(rate_gradient, [24])
-        do j = 1, 24
-          scaled = stiffness(t) * (material_factor * flat(j) + tau * flat_rate(j))
-          tangent(:, j) = tangent(:, j) + scaled * flat
-        end do
-      else
-        do j = 1, 24
-          scaled = stiffness(t) * flat(j)
-          tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
-        end do
-      end if
+      do j = 1, 24
+        scaled = stiffness(t) * flat(j)
+        tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
+      end do
       geometric = geometric + stiffness(t) * strain * forms(:, :, t)
     end do
-    if (present(dissipation)) dissipation = power
     if (.not. want_tangent) return
     do c = 1, 8
       do a = 1, 8
@@ -225,11 +192,63 @@ contains
         end do
       end do
     end do
-    if (damped) return  ! the damped rank-one parts filled whole columns
     ! the rank-one parts filled the lower triangle; the geometric part is symmetric
     do j = 2, 24
       tangent(1:j - 1, j) = tangent(j, 1:j - 1)
     end do
   end subroutine structural_element
+
+  !> structural_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
+  !> q'(3, 8): the force includes the damping force, dissipation is its power and the
+  !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
+  pure subroutine structural_element_damped(q, rates, forms, strain0, stiffness, damping_time, &
+                                            rate_factor, want_tangent, force, energy, &
+                                            dissipation, tangent)
+    real(dp), intent(in) :: q(3, 8), rates(3, 8), forms(8, 8, structural_terms)
+    real(dp), intent(in) :: strain0(structural_terms), stiffness(structural_terms)
+    real(dp), intent(in) :: damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
+    real(dp) :: gradient(3, 8), rate_gradient(3, 8), strain, strain_rate, total
+    real(dp) :: geometric(8, 8), row(24), column(24)
+    integer :: t, j, a, c, i
+    force = 0.0_dp
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    tangent = 0.0_dp
+    geometric = 0.0_dp
+    do t = 1, structural_terms
+      gradient = matmul(q, forms(:, :, t))
+      strain = 0.5_dp * sum(q * gradient) - strain0(t)
+      strain_rate = sum(rates * gradient)                 ! s' = q' . C q
+      total = strain + damping_time * strain_rate
+      energy = energy + 0.5_dp * stiffness(t) * strain**2
+      dissipation = dissipation + damping_time * stiffness(t) * strain_rate**2
+      do a = 1, 8  ! the 3 x 8 gradient as 24 numbers, copied in place of a reshape
+        column(3 * a - 2:3 * a) = gradient(:, a)
+      end do
+      force = force + stiffness(t) * total * column
+      if (.not. want_tangent) cycle
+      ! k g ((1 + c tau) g + tau C q')^T, whole columns
+      rate_gradient = matmul(rates, forms(:, :, t))
+      do a = 1, 8
+        row(3 * a - 2:3 * a) = stiffness(t) * ((1.0_dp + rate_factor * damping_time) &
+                               * gradient(:, a) + damping_time * rate_gradient(:, a))
+      end do
+      do j = 1, 24
+        tangent(:, j) = tangent(:, j) + row(j) * column
+      end do
+      geometric = geometric + stiffness(t) * total * forms(:, :, t)
+    end do
+    if (.not. want_tangent) return
+    do c = 1, 8
+      do a = 1, 8
+        do i = 1, 3
+          tangent(3 * (a - 1) + i, 3 * (c - 1) + i) = tangent(3 * (a - 1) + i, 3 * (c - 1) + i) &
+                                                      + geometric(a, c)
+        end do
+      end do
+    end do
+  end subroutine structural_element_damped
 
 end module beam_structural

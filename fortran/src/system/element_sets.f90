@@ -20,9 +20,9 @@ module element_sets
   use ancf_kinds, only: dp
   use ffr_elastic, only: ffr_force, ffr_stiffness, ffr_energy_power, ffr_damped_force, &
                          ffr_damped_stiffness
-  use beam_nonlinear, only: nonlinear_element
-  use beam_structural, only: structural_element
-  use plate_element, only: plate_forces
+  use beam_nonlinear, only: nonlinear_element, nonlinear_element_damped
+  use beam_structural, only: structural_element, structural_element_damped
+  use plate_element, only: plate_forces, plate_forces_damped
   implicit none
   private
   public :: element_set, set_forces, set_tangent_values, set_energy_power, frame_omega
@@ -209,7 +209,8 @@ contains
   end subroutine set_forces
 
   !> One element of a large-deformation set; with the full coordinate rates v (a damped
-  !> set), the damping force, the combined tangent (rate_factor) and the dissipated power.
+  !> set: then rate_factor and dissipation too), the damping force, the combined tangent and
+  !> the dissipated power (the element modules' *_damped routines).
   pure subroutine element_forces(set, el, e, want_tangent, force, energy, tangent, info, v, &
                                  rate_factor, dissipation)
     type(element_set), intent(in) :: set
@@ -233,18 +234,21 @@ contains
       end do
       select case (set%kind)
       case (set_continuum)
-        call nonlinear_element(coords, set%gradients(:, :, :, el), set%weights(:, el), &
-                               set%volume_points, set%youngs, set%poisson, want_tangent, force, &
-                               energy, tangent, rates, set%damping_time, rate_factor, dissipation)
+        call nonlinear_element_damped(coords, rates, set%gradients(:, :, :, el), &
+                                      set%weights(:, el), set%volume_points, set%youngs, &
+                                      set%poisson, set%damping_time, rate_factor, want_tangent, &
+                                      force, energy, dissipation, tangent)
       case (set_structural)
-        call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
-                                set%term_stiffness(:, el), want_tangent, force, energy, tangent, &
-                                rates, set%damping_time, rate_factor, dissipation)
+        call structural_element_damped(coords, rates, set%forms(:, :, :, el), &
+                                       set%strain0(:, el), set%term_stiffness(:, el), &
+                                       set%damping_time, rate_factor, want_tangent, force, &
+                                       energy, dissipation, tangent)
       case (set_plate)
-        call plate_forces(coords, set%derivs(:, :, :, el), set%plate_frame(:, :, :, el), &
-                          set%curvature0(:, :, el), set%weights(:, el), set%youngs, set%poisson, &
-                          set%thickness, want_tangent, force, energy, tangent, info, rates, &
-                          set%damping_time, rate_factor, dissipation)
+        call plate_forces_damped(coords, rates, set%derivs(:, :, :, el), &
+                                 set%plate_frame(:, :, :, el), set%curvature0(:, :, el), &
+                                 set%weights(:, el), set%youngs, set%poisson, set%thickness, &
+                                 set%damping_time, rate_factor, want_tangent, force, energy, &
+                                 dissipation, tangent, info)
       end select
       return
     end if
