@@ -357,7 +357,14 @@ class Model:
 
     def banded(self) -> bool:
         """The banded Cholesky (with LU fallback) for symmetric matrices with a narrow band:
-        no contact (its Jacobian is unsymmetric) and half-bandwidth <= max(64, n / 4)."""
+        no contact (its Jacobian is unsymmetric) and half-bandwidth <= max(64, n / 4).
+        Material damping makes a refactorized model's tangent unsymmetric too (the strain
+        rate's dependence on e, tau B(e)^T D B(e'), and an FFR frame's omega term), and not
+        small against beta' M along the rigid modes (a steel plate swinging at 10 rad/s with
+        tau = 2e-3 s: Newton with the Cholesky's upper triangle diverged), so MUMPS factorizes
+        it; the constant policy's beta' M + (1 + c tau) K0 stays symmetric."""
+        if self.damped and self.policy != POLICY_CONSTANT:
+            return False
         return not self.contact_pairs and self.pattern.bandwidth() <= max(64, self.ndof // 4)
 
     def build_kernel(self) -> None:
