@@ -424,33 +424,37 @@ class KernelSystem:
                               f"({'stale handle' if info == 1 else 'inconsistent sizes'})")
 
     # element sets: dofs 0-based (nde, nel), scatter 1-based (Pattern.scatter), frame: the
-    # 1-based frame id (0: none)
-    def add_ffr_set(self, dofs, scatter, stiffness0, reference, frame: int) -> int:
+    # 1-based frame id (0: none); damping_time: the Kelvin-Voigt retardation time tau (s) of
+    # the set's material damping (0: none, and none of its code runs)
+    def add_ffr_set(self, dofs, scatter, stiffness0, reference, frame: int,
+                    damping_time: float = 0.0) -> int:
         index, info = _kernel.system_add_ffr_set(self.handle, _i(dofs + 1), _i(scatter),
-                                                 _f(stiffness0), _f(reference), frame)
+                                                 _f(stiffness0), _f(reference), frame,
+                                                 damping_time)
         self._check(info, "FFR beam set")
         return int(index)
 
     def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
-                          poisson: float, frame: int) -> int:
+                          poisson: float, frame: int, damping_time: float = 0.0) -> int:
         index, info = _kernel.system_add_continuum_set(
             self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights), youngs,
-            poisson, frame)
+            poisson, frame, damping_time)
         self._check(info, "continuum beam set")
         return int(index)
 
-    def add_structural_set(self, dofs, scatter, forms, strain0, stiffness, frame: int) -> int:
+    def add_structural_set(self, dofs, scatter, forms, strain0, stiffness, frame: int,
+                           damping_time: float = 0.0) -> int:
         index, info = _kernel.system_add_structural_set(
             self.handle, _i(dofs + 1), _i(scatter), _f(forms), _f(strain0), _f(stiffness),
-            frame)
+            frame, damping_time)
         self._check(info, "structural beam set")
         return int(index)
 
     def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
-                      poisson: float, thickness: float) -> int:
+                      poisson: float, thickness: float, damping_time: float = 0.0) -> int:
         index, info = _kernel.system_add_plate_set(
             self.handle, _i(dofs + 1), _i(scatter), reference.derivs, reference.frame,
-            reference.curvature0, reference.weights, youngs, poisson, thickness)
+            reference.curvature0, reference.weights, youngs, poisson, thickness, damping_time)
         self._check(info, "plate set")
         return int(index)
 

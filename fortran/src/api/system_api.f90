@@ -61,22 +61,25 @@ end subroutine system_reset_stepper
 
 !> ANCF-FFR beam elements: K0 and the rigid configuration (24, nel) in the floating frame
 !> `frame` (1-based index into the system's frames), the element dofs (full, 1-based) and
-!> the scatter map into the full pattern.
-subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference, frame, index, info)
+!> the scatter map into the full pattern. damping_time: the Kelvin-Voigt retardation time
+!> (s; 0: no material damping). info = 2 also for a negative damping_time.
+subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference, frame, &
+                              damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set, set_ffr
   use system_store, only: store_get
   implicit none
   integer, intent(in) :: handle, nel, dofs(24, nel), scatter(24, 24, nel), frame
-  real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel)
+  real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
   type(element_set) :: set
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
-  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. frame < 1) then
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. frame < 1 .or. &
+      .not. (damping_time >= 0.0_dp)) then
     info = 2
     return
   end if
@@ -88,13 +91,15 @@ subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference,
   set%scatter = scatter
   set%stiffness0 = stiffness0
   set%reference = reference
+  set%damping_time = damping_time
   call append_set(sys, set, index)
 end subroutine system_add_ffr_set
 
 !> Large-deformation (continuum) beam elements: material gradients and weights at npts
-!> Gauss points of which the first nvolume are volume points (beam_nonlinear).
+!> Gauss points of which the first nvolume are volume points (beam_nonlinear);
+!> damping_time as system_add_ffr_set.
 subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, gradients, &
-                                    weights, youngs, poisson, frame, index, info)
+                                    weights, youngs, poisson, frame, damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set, set_continuum
@@ -102,13 +107,14 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   implicit none
   integer, intent(in) :: handle, nel, npts, nvolume, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
+  real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
   type(element_set) :: set
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
-  if (any(dofs < 1) .or. any(dofs > sys%nfull)) then
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
     info = 2
     return
   end if
@@ -123,12 +129,14 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   set%weights = weights
   set%youngs = youngs
   set%poisson = poisson
+  set%damping_time = damping_time
   call append_set(sys, set, index)
 end subroutine system_add_continuum_set
 
-!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural).
+!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural);
+!> damping_time as system_add_ffr_set.
 subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, strain0, &
-                                     stiffness, frame, index, info)
+                                     stiffness, frame, damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set, set_structural
@@ -136,13 +144,14 @@ subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, 
   implicit none
   integer, intent(in) :: handle, nel, nterms, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
+  real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
   type(element_set) :: set
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
-  if (any(dofs < 1) .or. any(dofs > sys%nfull)) then
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
     info = 2
     return
   end if
@@ -155,12 +164,14 @@ subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, 
   set%forms = forms
   set%strain0 = strain0
   set%term_stiffness = stiffness
+  set%damping_time = damping_time
   call append_set(sys, set, index)
 end subroutine system_add_structural_set
 
-!> Thin plate elements (plate_element): reference data at npts Gauss points.
+!> Thin plate elements (plate_element): reference data at npts Gauss points; damping_time
+!> as system_add_ffr_set.
 subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_frame, curvature0, &
-                                weights, youngs, poisson, thickness, index, info)
+                                weights, youngs, poisson, thickness, damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set, set_plate
@@ -169,13 +180,14 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
   integer, intent(in) :: handle, nel, npts, dofs(36, nel), scatter(36, 36, nel)
   real(dp), intent(in) :: derivs(12, 5, npts, nel), plate_frame(2, 2, npts, nel)
   real(dp), intent(in) :: curvature0(3, npts, nel), weights(npts, nel), youngs, poisson, thickness
+  real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
   type(element_set) :: set
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
-  if (any(dofs < 1) .or. any(dofs > sys%nfull)) then
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
     info = 2
     return
   end if
@@ -191,6 +203,7 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
   set%youngs = youngs
   set%poisson = poisson
   set%thickness = thickness
+  set%damping_time = damping_time
   call append_set(sys, set, index)
 end subroutine system_add_plate_set
 
@@ -496,7 +509,9 @@ end subroutine system_set_probes
 !> The configuration-dependent forces at (e, e', t): internal = B^T (Q_el - Q_c -
 !> load_factor Q_M), external = load_factor Q(t), strain energy, contact potential and
 !> records, and with want_tangent /= 0 the tangent (sets, plus velocity_factor times the
-!> contact Jacobian) on the solver's (reduced) pattern in global coordinates. Codes as the
+!> contact Jacobian) on the solver's (reduced) pattern in global coordinates. Damped sets
+!> add their damping force at e' (with the frames' angular velocities at t) and their
+!> tangent is dQ/de + velocity_factor dQ/de'. Codes as the
 !> stepper's (5 drive, 6 moment, 7 plate normal, 8 contact search).
 subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velocity_factor, &
                            want_tangent, guesses, counts, internal, external, strain, &
@@ -534,10 +549,11 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velo
   tangent = 0.0_dp
   if (want_tangent /= 0) then  ! the tangent in global coordinates
     call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
-                         strain, contact_potential, powers, records, info, rotations, tangent)
+                         strain, contact_potential, powers, records, info, rotations, tangent, &
+                         rates)
   else
     call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
-                         strain, contact_potential, powers, records, info)
+                         strain, contact_potential, powers, records, info, rates=rates)
   end if
   if (info /= 0) return
   call external_forces(sys, t, load_factor, external, info)

@@ -11,6 +11,13 @@
 !> part D0 = diag(E, E, E, G, G, G), integrated over the whole section, and the Poisson
 !> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
 !> mechanics); with nu = 0 both coincide with the plain law.
+!>
+!> Kelvin-Voigt material damping (retardation time tau, nonlinear_element_damped):
+!> S = D : (E + tau E'), with the strain rate E' = B(F) q' (the Voigt form of sym(F^T F'),
+!> F' = q' g^T), so the damping force is Q_d = int tau B^T D E' dV0 and the dissipated power
+!> int tau E'^T D E' dV0 >= 0; a rigid motion has E' = 0 (objective). Its derivatives:
+!> d/dq' = tau int B^T D B; d/dq = the geometric term of the damping stress tau D E' plus
+!> tau int B(F)^T D B(F') (E' is bilinear in F and F'), not symmetric.
 module beam_nonlinear
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
@@ -18,7 +25,7 @@ module beam_nonlinear
   use matrix3, only: invert3
   implicit none
   private
-  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element
+  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, nonlinear_element_damped
 
   !> Gauss points along the axis; the section rule comes from beam_section.
   integer, parameter, public :: nonlinear_axial_points = 4
@@ -120,6 +127,79 @@ contains
       end do
     end do
   end subroutine nonlinear_element
+
+  !> nonlinear_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
+  !> q'(3, 8): the force includes the damping force, dissipation is its power and the
+  !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
+  pure subroutine nonlinear_element_damped(q, rates, gradients, weights, volume_points, youngs, &
+                                           poisson, damping_time, rate_factor, want_tangent, &
+                                           force, energy, dissipation, tangent)
+    real(dp), intent(in) :: q(3, 8), rates(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
+    real(dp), intent(in) :: youngs, poisson, damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
+    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: stress(6), stress_matrix(3, 3), b(6, 24), b_rate(6, 24), sg(3), geometric
+    real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
+    integer :: p, a, c
+    call split_laws(youngs, poisson, law_free, law_poisson)
+    force = 0.0_dp
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    tangent = 0.0_dp
+    do p = 1, size(weights)
+      if (p <= volume_points) then
+        law = law_free
+      else
+        law = law_poisson
+        if (all(law == 0.0_dp)) cycle
+      end if
+      deformation = matmul(q, gradients(:, :, p))
+      deformation_rate = matmul(rates, gradients(:, :, p))
+      call green_lagrange(deformation, strain)
+      call green_lagrange_rate(deformation, deformation_rate, strain_rate)
+      stress = matmul(law, strain)
+      damping_stress = damping_time * matmul(law, strain_rate)
+      energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
+      dissipation = dissipation + weights(p) * dot_product(strain_rate, damping_stress)
+      stress = stress + damping_stress
+      call strain_matrix(deformation, gradients(:, :, p), b)
+      force = force + weights(p) * matmul(transpose(b), stress)
+      if (.not. want_tangent) cycle
+      ! (1 + c tau) B^T D B + tau B^T D B(F') + the geometric term of the total stress
+      call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
+      tangent = tangent + weights(p) * matmul(transpose(b), &
+                matmul(law, (1.0_dp + rate_factor * damping_time) * b + damping_time * b_rate))
+      stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
+                               stress(6), stress(5), stress(3)], [3, 3])
+      do a = 1, 8
+        sg = matmul(stress_matrix, gradients(a, :, p))
+        do c = 1, 8
+          geometric = weights(p) * dot_product(gradients(c, :, p), sg)
+          tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) = tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) + geometric
+          tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) = tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) + geometric
+          tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) = tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) + geometric
+        end do
+      end do
+    end do
+  end subroutine nonlinear_element_damped
+
+  !> The rate of the Green-Lagrange strain (Voigt, engineering shears) at the deformation
+  !> gradient F and its rate F': the Voigt form of sym(F^T F'), i.e. B(F) q'.
+  pure subroutine green_lagrange_rate(deformation, deformation_rate, strain_rate)
+    real(dp), intent(in) :: deformation(3, 3), deformation_rate(3, 3)
+    real(dp), intent(out) :: strain_rate(6)
+    strain_rate(1) = dot_product(deformation(:, 1), deformation_rate(:, 1))
+    strain_rate(2) = dot_product(deformation(:, 2), deformation_rate(:, 2))
+    strain_rate(3) = dot_product(deformation(:, 3), deformation_rate(:, 3))
+    strain_rate(4) = dot_product(deformation(:, 1), deformation_rate(:, 2)) &
+                     + dot_product(deformation(:, 2), deformation_rate(:, 1))
+    strain_rate(5) = dot_product(deformation(:, 2), deformation_rate(:, 3)) &
+                     + dot_product(deformation(:, 3), deformation_rate(:, 2))
+    strain_rate(6) = dot_product(deformation(:, 1), deformation_rate(:, 3)) &
+                     + dot_product(deformation(:, 3), deformation_rate(:, 1))
+  end subroutine green_lagrange_rate
 
   !> Green-Lagrange strain in Voigt form with engineering shears [E11, E22, E33, 2E12, 2E23, 2E13].
   pure subroutine green_lagrange(deformation, strain)

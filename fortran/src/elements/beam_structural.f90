@@ -24,12 +24,18 @@
 !> EI_y, G J with J = I_y + I_z and G A (k = 1) of the section (beam_section), as the
 !> continuum element with nu = 0 has, so the two options differ in the bending
 !> interpolation only.
+!>
+!> Kelvin-Voigt material damping (retardation time tau, structural_element_damped) acts on
+!> every strain: s -> s + tau s' with s' = q' . C q, so Q_d = sum_terms k tau s' C q, the
+!> dissipated power sum k tau s'^2 >= 0 (a rigid motion leaves every s' at zero), and the
+!> tangent dQ/dq + c dQ/dq' = sum k ((1 + c tau) g g^T + tau g (C q')^T + (s + tau s') C x I3)
+!> (g = C q), not symmetric.
 module beam_structural
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
   implicit none
   private
-  public :: structural_setup, structural_element
+  public :: structural_setup, structural_element, structural_element_damped
 
   !> Axial points of the axial and bending strains, of the torsion.
   integer, parameter :: n_line = 3, n_axial = 3, n_torsion = 2
@@ -191,5 +197,58 @@ contains
       tangent(1:j - 1, j) = tangent(j, 1:j - 1)
     end do
   end subroutine structural_element
+
+  !> structural_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
+  !> q'(3, 8): the force includes the damping force, dissipation is its power and the
+  !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
+  pure subroutine structural_element_damped(q, rates, forms, strain0, stiffness, damping_time, &
+                                            rate_factor, want_tangent, force, energy, &
+                                            dissipation, tangent)
+    real(dp), intent(in) :: q(3, 8), rates(3, 8), forms(8, 8, structural_terms)
+    real(dp), intent(in) :: strain0(structural_terms), stiffness(structural_terms)
+    real(dp), intent(in) :: damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
+    real(dp) :: gradient(3, 8), rate_gradient(3, 8), strain, strain_rate, total
+    real(dp) :: geometric(8, 8), row(24), column(24)
+    integer :: t, j, a, c, i
+    force = 0.0_dp
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    tangent = 0.0_dp
+    geometric = 0.0_dp
+    do t = 1, structural_terms
+      gradient = matmul(q, forms(:, :, t))
+      strain = 0.5_dp * sum(q * gradient) - strain0(t)
+      strain_rate = sum(rates * gradient)                 ! s' = q' . C q
+      total = strain + damping_time * strain_rate
+      energy = energy + 0.5_dp * stiffness(t) * strain**2
+      dissipation = dissipation + damping_time * stiffness(t) * strain_rate**2
+      do a = 1, 8  ! the 3 x 8 gradient as 24 numbers, copied in place of a reshape
+        column(3 * a - 2:3 * a) = gradient(:, a)
+      end do
+      force = force + stiffness(t) * total * column
+      if (.not. want_tangent) cycle
+      ! k g ((1 + c tau) g + tau C q')^T, whole columns
+      rate_gradient = matmul(rates, forms(:, :, t))
+      do a = 1, 8
+        row(3 * a - 2:3 * a) = stiffness(t) * ((1.0_dp + rate_factor * damping_time) &
+                               * gradient(:, a) + damping_time * rate_gradient(:, a))
+      end do
+      do j = 1, 24
+        tangent(:, j) = tangent(:, j) + row(j) * column
+      end do
+      geometric = geometric + stiffness(t) * total * forms(:, :, t)
+    end do
+    if (.not. want_tangent) return
+    do c = 1, 8
+      do a = 1, 8
+        do i = 1, 3
+          tangent(3 * (a - 1) + i, 3 * (c - 1) + i) = tangent(3 * (a - 1) + i, 3 * (c - 1) + i) &
+                                                      + geometric(a, c)
+        end do
+      end do
+    end do
+  end subroutine structural_element_damped
 
 end module beam_structural

@@ -5,11 +5,21 @@
 !> reference(24, nel)). A rigid translation of the frame's origin changes T^T e - e0 by a
 !> uniform translation of the position vectors, which K0 annihilates: only the frame's
 !> rotation enters.
+!>
+!> Kelvin-Voigt material damping (retardation time tau) on the linear strain in the frame:
+!> with the frame's angular velocity omega (A' = [omega]x A; omega_l = A^T omega in the
+!> frame), each nodal vector's rate in the frame is x'_a = A^T e'_a - omega_l x (A^T e_a)
+!> (the pivot's share, omega_l x A^T p on the positions, is a uniform translation rate that
+!> K0 annihilates), and
+!>   Q_d = tau T K0 x',   power tau x'^T K0 x' >= 0,
+!> zero for a rigid motion. dQ_d/de' = tau T K0 T^T, dQ_d/de = -tau T K0 T^T [omega]x per
+!> vector (= -tau T K0 [omega_l]x T^T): the combined tangent block of a pair of nodal
+!> vectors is A K0_ab ((1 + c tau) I - tau [omega_l]x) A^T.
 module ffr_elastic
   use ancf_kinds, only: dp
   implicit none
   private
-  public :: ffr_force, ffr_stiffness, ffr_energy_power
+  public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_damped_force, ffr_damped_stiffness
 
 contains
 
@@ -27,6 +37,58 @@ contains
     end do
     local = local - reference
   end function frame_displacement
+
+  !> Rates x'_a = A^T e'_a - omega_l x (A^T e_a) of one element's eight nodal vectors in the
+  !> frame (omega_l: the frame's angular velocity in the frame).
+  pure function frame_rate(rotation, omega_local, e, v, dofs) result(rate)
+    real(dp), intent(in) :: rotation(3, 3), omega_local(3), e(:), v(:)
+    integer, intent(in) :: dofs(24)
+    real(dp) :: rate(24)
+    real(dp) :: x(3)
+    integer :: a
+    do a = 0, 7
+      x = rotation(1, :) * e(dofs(3 * a + 1)) + rotation(2, :) * e(dofs(3 * a + 2)) &
+          + rotation(3, :) * e(dofs(3 * a + 3))
+      rate(3 * a + 1:3 * a + 3) = rotation(1, :) * v(dofs(3 * a + 1)) &
+                                  + rotation(2, :) * v(dofs(3 * a + 2)) &
+                                  + rotation(3, :) * v(dofs(3 * a + 3)) &
+                                  - [omega_local(2) * x(3) - omega_local(3) * x(2), &
+                                     omega_local(3) * x(1) - omega_local(1) * x(3), &
+                                     omega_local(1) * x(2) - omega_local(2) * x(1)]
+    end do
+  end function frame_rate
+
+  !> Adds the global elastic plus Kelvin-Voigt damping force T K0 (u + tau x') to force and
+  !> returns the strain energy and the dissipated power tau x'^T K0 x' (v: the coordinate
+  !> rates, omega_local: the frame's angular velocity in the frame).
+  pure subroutine ffr_damped_force(nel, dofs, stiffness0, reference, rotation, omega_local, &
+                                   damping_time, e, v, force, energy, dissipation)
+    integer, intent(in) :: nel, dofs(24, nel)
+    real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), rotation(3, 3)
+    real(dp), intent(in) :: omega_local(3), damping_time, e(:), v(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy, dissipation
+    real(dp) :: local_disp(24), local_rate(24), local_force(24), damping_force(24)
+    integer :: el, a, i
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    do el = 1, nel
+      local_disp = frame_displacement(rotation, e, dofs(:, el), reference(:, el))
+      local_rate = frame_rate(rotation, omega_local, e, v, dofs(:, el))
+      local_force = matmul(stiffness0(:, :, el), local_disp)
+      damping_force = damping_time * matmul(stiffness0(:, :, el), local_rate)
+      energy = energy + 0.5_dp * dot_product(local_disp, local_force)
+      dissipation = dissipation + dot_product(local_rate, damping_force)
+      local_force = local_force + damping_force
+      do a = 0, 7
+        do i = 1, 3
+          force(dofs(3 * a + i, el)) = force(dofs(3 * a + i, el)) + rotation(i, 1) * local_force(3 * a + 1) &
+                                       + rotation(i, 2) * local_force(3 * a + 2) &
+                                       + rotation(i, 3) * local_force(3 * a + 3)
+        end do
+      end do
+    end do
+  end subroutine ffr_damped_force
 
   !> Adds the global elastic force to force and returns the strain energy; dofs(24, nel)
   !> are 1-based indices into e and force.
@@ -55,14 +117,25 @@ contains
   !> Strain energy and the power of the moving frame at fixed e, dU/dt = -phi' sum_b
   !> f_b . (k x x_b) with f = K0 u in the frame, u = T^T e - e0, x = T^T e (k: the unit axis
   !> of the frame's rotation, rate = phi').
+  !> With v (the coordinate rates), omega_local and damping_time tau > 0 the frame's power
+  !> adds that of the damping force, -sum_b (tau K0 x')_b . (omega_l x x_b) (the frame turns
+  !> under the total force, so the balance closes with total + dissipated work), and
+  !> dissipation returns tau x'^T K0 x'; otherwise dissipation is 0.
   pure subroutine ffr_energy_power(nel, dofs, stiffness0, reference, rotation, axis, rate, e, &
-                                   energy, power)
+                                   energy, power, v, omega_local, damping_time, dissipation)
     integer, intent(in) :: nel, dofs(24, nel)
     real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), rotation(3, 3)
     real(dp), intent(in) :: axis(3), rate, e(:)
     real(dp), intent(out) :: energy, power
-    real(dp) :: local(24), frame_force(24), x(3), k(3)
+    real(dp), intent(in), optional :: v(:), omega_local(3), damping_time
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: local(24), frame_force(24), x(3), k(3), local_rate(24), damping_force(24)
+    real(dp) :: w(3)
+    logical :: damped
     integer :: el, b
+    damped = .false.
+    if (present(v)) damped = damping_time > 0.0_dp
+    if (present(dissipation)) dissipation = 0.0_dp
     energy = 0.0_dp
     power = 0.0_dp
     k = axis / norm2(axis)
@@ -70,6 +143,17 @@ contains
       local = frame_displacement(rotation, e, dofs(:, el), reference(:, el))
       frame_force = matmul(stiffness0(:, :, el), local)
       energy = energy + 0.5_dp * dot_product(local, frame_force)
+      if (damped) then
+        local_rate = frame_rate(rotation, omega_local, e, v, dofs(:, el))
+        damping_force = damping_time * matmul(stiffness0(:, :, el), local_rate)
+        if (present(dissipation)) dissipation = dissipation + dot_product(local_rate, damping_force)
+        w = omega_local
+        do b = 0, 7
+          x = local(3 * b + 1:3 * b + 3) + reference(3 * b + 1:3 * b + 3, el)
+          power = power - dot_product(damping_force(3 * b + 1:3 * b + 3), &
+                  [w(2) * x(3) - w(3) * x(2), w(3) * x(1) - w(1) * x(3), w(1) * x(2) - w(2) * x(1)])
+        end do
+      end if
       if (rate == 0.0_dp) cycle
       do b = 0, 7
         x = local(3 * b + 1:3 * b + 3) + reference(3 * b + 1:3 * b + 3, el)
@@ -78,6 +162,40 @@ contains
       end do
     end do
   end subroutine ffr_energy_power
+
+  !> Combined element tangents dQ/de + c dQ/de' of the damped FFR elements in the frame
+  !> rotation: blocks A K0_ab ((1 + c tau) I - tau [omega_l]x) A^T (omega_l = 0: the
+  !> stiffness (1 + c tau) T K0 T^T alone).
+  pure subroutine ffr_damped_stiffness(nel, stiffness0, rotation, omega_local, rate_factor, &
+                                       damping_time, stiffness)
+    integer, intent(in) :: nel
+    real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3), omega_local(3)
+    real(dp), intent(in) :: rate_factor, damping_time
+    real(dp), intent(out) :: stiffness(24, 24, nel)
+    real(dp) :: right(3, 3), turn(3, 3)
+    integer :: el, a, b, i
+    ! right = ((1 + c tau) I - tau [omega_l]x) A^T
+    turn = 0.0_dp
+    turn(2, 1) = omega_local(3)
+    turn(3, 1) = -omega_local(2)
+    turn(1, 2) = -omega_local(3)
+    turn(3, 2) = omega_local(1)
+    turn(1, 3) = omega_local(2)
+    turn(2, 3) = -omega_local(1)
+    turn = -damping_time * turn
+    do i = 1, 3
+      turn(i, i) = turn(i, i) + 1.0_dp + rate_factor * damping_time
+    end do
+    right = matmul(turn, transpose(rotation))
+    do el = 1, nel
+      do b = 0, 7
+        do a = 0, 7
+          stiffness(3 * a + 1:3 * a + 3, 3 * b + 1:3 * b + 3, el) = matmul(rotation, &
+            matmul(stiffness0(3 * a + 1:3 * a + 3, 3 * b + 1:3 * b + 3, el), right))
+        end do
+      end do
+    end do
+  end subroutine ffr_damped_stiffness
 
   !> Element stiffness matrices in the global frame, T K0 T^T, block by block.
   pure subroutine ffr_stiffness(nel, stiffness0, rotation, stiffness)

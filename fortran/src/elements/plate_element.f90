@@ -26,6 +26,16 @@
 !> Implementation: at each Gauss point the energy density is a function of the 15 numbers
 !> z = (r_x, r_y, r_xx, r_yy, r_xy); its gradient and Hessian with respect to z are
 !> analytic, and Q = sum_A dS_A^T dW/dz_A, K_t = sum_AB dS_A^T d2W/dz_A dz_B dS_B.
+!>
+!> Kelvin-Voigt material damping (retardation time tau, plate_forces_damped): the membrane
+!> stress and the bending moment become D (eps + tau eps') and D (kappa + tau kappa'), with
+!> the rates eps' = (d eps/dz) z' and kappa' = (d kappa/dz) z' of the field rates z'
+!> (objective: a rigid motion leaves both at zero). Writing s = (eps, kappa) and J = ds/dz,
+!> the damping force density is tau J^T D J z', its power tau s'^T D s' >= 0, and the
+!> combined point tangent d/dz + c d/dz' is
+!>   (1 + c tau) J^T D J + sum_k [D (s - s0 + tau s')]_k d2s_k/dz2 + tau J^T D (d2s/dz2 z'),
+!> the last term (the strain rate's dependence on z: B(F') for the membrane, the
+!> curvature Hessians applied to z' for the bending) not symmetric.
 module plate_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
@@ -33,7 +43,7 @@ module plate_element
   implicit none
   private
   public :: plate_shape, plate_mass, plate_surface_load, plate_setup, plate_forces, &
-            plate_curvatures
+            plate_curvatures, plate_forces_damped
 
   integer, parameter, public :: plate_shapes = 12, plate_dofs = 36, plate_fields = 5
   integer, parameter, public :: plate_variant_plain = 0, plate_variant_completed = 1
@@ -388,5 +398,243 @@ contains
     end if
     force = reshape(nodal, [plate_dofs])
   end subroutine plate_forces
+
+  !> plate_forces with Kelvin-Voigt damping (damping_time tau > 0) at the coordinate rates
+  !> (3, 12): the force includes the damping force, dissipation is its power and the tangent
+  !> (when want_tangent) the combined dQ/dq + rate_factor dQ/dq', both triangles (it is not
+  !> symmetric). info = 2: the normal vanished.
+  pure subroutine plate_forces_damped(coords, rates, derivs, frame, curvature0, weights, youngs, &
+                                      poisson, thickness, damping_time, rate_factor, &
+                                      want_tangent, force, energy, dissipation, tangent, info)
+    real(dp), intent(in) :: coords(3, plate_shapes), rates(3, plate_shapes)
+    real(dp), intent(in) :: derivs(plate_shapes, plate_fields, plate_points)
+    real(dp), intent(in) :: frame(2, 2, plate_points), curvature0(3, plate_points)
+    real(dp), intent(in) :: weights(plate_points), youngs, poisson, thickness
+    real(dp), intent(in) :: damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(plate_dofs), energy, dissipation
+    real(dp), intent(out) :: tangent(plate_dofs, plate_dofs)
+    integer, intent(out) :: info
+    real(dp) :: plane_stress(3, 3), membrane_d(3, 3), bending_d(3, 3)
+    real(dp) :: fields(3, plate_fields), field_rates(3, plate_fields), point_w, point_power
+    real(dp) :: gradient(3, plate_fields), hessian(15, 15), nodal(3, plate_shapes)
+    real(dp) :: half(15, plate_dofs), shape_d(plate_fields, plate_shapes), total
+    integer :: p, i, j, ka, kb, f, row, col
+    info = 0
+    plane_stress = youngs / (1.0_dp - poisson**2) * reshape([1.0_dp, poisson, 0.0_dp, poisson, &
+                   1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp * (1.0_dp - poisson)], [3, 3])
+    membrane_d = thickness * plane_stress
+    bending_d = thickness**3 / 12.0_dp * plane_stress
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
+    nodal = 0.0_dp
+    do p = 1, plate_points
+      shape_d = transpose(derivs(:, :, p))
+      fields = 0.0_dp
+      field_rates = 0.0_dp
+      do ka = 1, plate_shapes
+        do f = 1, plate_fields
+          fields(:, f) = fields(:, f) + coords(:, ka) * shape_d(f, ka)
+          field_rates(:, f) = field_rates(:, f) + rates(:, ka) * shape_d(f, ka)
+        end do
+      end do
+      if (norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
+          sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
+        info = 2
+        return
+      end if
+      call point_energy_damped(fields, field_rates, frame(:, :, p), curvature0(:, p), membrane_d, &
+                               bending_d, damping_time, rate_factor, want_tangent, point_w, &
+                               point_power, gradient, hessian)
+      energy = energy + weights(p) * point_w
+      dissipation = dissipation + weights(p) * point_power
+      gradient = weights(p) * gradient
+      do ka = 1, plate_shapes
+        do f = 1, plate_fields
+          nodal(:, ka) = nodal(:, ka) + gradient(:, f) * shape_d(f, ka)
+        end do
+      end do
+      if (.not. want_tangent) cycle
+      ! K += L^T H L with L = kron(dS^T, I3): half = w H L (15 x 36), then L^T half, every
+      ! entry (H is not symmetric)
+      do kb = 1, plate_shapes
+        do j = 1, 3
+          col = 3 * kb - 3 + j
+          do row = 1, 15
+            total = 0.0_dp
+            do f = 1, plate_fields
+              total = total + hessian(row, 3 * f - 3 + j) * shape_d(f, kb)
+            end do
+            half(row, col) = weights(p) * total
+          end do
+        end do
+      end do
+      do col = 1, plate_dofs
+        do ka = 1, plate_shapes
+          do i = 1, 3
+            total = 0.0_dp
+            do f = 1, plate_fields
+              total = total + shape_d(f, ka) * half(3 * f - 3 + i, col)
+            end do
+            tangent(3 * ka - 3 + i, col) = tangent(3 * ka - 3 + i, col) + total
+          end do
+        end do
+      end do
+    end do
+    force = reshape(nodal, [plate_dofs])
+  end subroutine plate_forces_damped
+
+  !> point_energy with Kelvin-Voigt damping at the field rates z': the elastic energy
+  !> density, the dissipated power density, the gradient of the total (elastic plus
+  !> damping) force and, on request, the combined Hessian d/dz + rate_factor d/dz'.
+  !> The bending part is point_energy's at the shifted reference curvature c0 - tau c'
+  !> (c' = (dc/dz) z'): its moment is then D (kappa + tau kappa'), which its gradient and
+  !> its geometric Hessian carry; the membrane damping stress, the rate derivative
+  !> c tau J^T D J and the rate terms tau J^T D (d2s/dz2 z') are added here.
+  pure subroutine point_energy_damped(fields, field_rates, frame, curvature0, membrane_d, &
+                                      bending_d, tau, rate_factor, want_hessian, energy, &
+                                      power, gradient, hessian)
+    real(dp), intent(in) :: fields(3, plate_fields), field_rates(3, plate_fields), frame(2, 2)
+    real(dp), intent(in) :: curvature0(3), membrane_d(3, 3), bending_d(3, 3), tau, rate_factor
+    logical, intent(in) :: want_hessian
+    real(dp), intent(out) :: energy, power, gradient(3, plate_fields), hessian(15, 15)
+    real(dp) :: deformation(3, 2), deformation_rate(3, 2), strain(3), strain_rate(3)
+    real(dp) :: damping_stress(3), b_strain(3, 6), b_rate(3, 6), stress_tensor(2, 2)
+    real(dp) :: geometric(2, 2), g(3), gnorm, c(3), to_local(3, 3), kappa(3), kappa_rate(3)
+    real(dp) :: dcurv(3, 15), curvature_rate(3), dkappa(3, 15), curvature_hessian_rate(3, 15)
+    real(dp) :: shifted_energy
+    integer :: gamma, i, f, row, col
+    ! bending: curvatures, their gradients and rates
+    g = cross(fields(:, f_x), fields(:, f_y))
+    gnorm = norm2(g)
+    c = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
+         dot_product(fields(:, f_xy), g)] / gnorm**3
+    call curvature_map(frame, to_local)
+    call curvature_gradients(fields, g, gnorm, dcurv)
+    do i = 1, 3
+      curvature_rate(i) = 0.0_dp
+      do f = 1, plate_fields
+        curvature_rate(i) = curvature_rate(i) &
+                            + dot_product(dcurv(i, 3 * f - 2:3 * f), field_rates(:, f))
+      end do
+    end do
+    kappa = matmul(to_local, c - curvature0)
+    kappa_rate = matmul(to_local, curvature_rate)
+    call point_energy(fields, frame, curvature0 - tau * curvature_rate, membrane_d, bending_d, &
+                      want_hessian, shifted_energy, gradient, hessian)
+    ! membrane: the damping stress tau D eps', eps' = B(F) z'
+    deformation = matmul(fields(:, f_x:f_y), frame)
+    deformation_rate = matmul(field_rates(:, f_x:f_y), frame)
+    strain = [0.5_dp * (dot_product(deformation(:, 1), deformation(:, 1)) - 1.0_dp), &
+              0.5_dp * (dot_product(deformation(:, 2), deformation(:, 2)) - 1.0_dp), &
+              dot_product(deformation(:, 1), deformation(:, 2))]
+    strain_rate = [dot_product(deformation(:, 1), deformation_rate(:, 1)), &
+                   dot_product(deformation(:, 2), deformation_rate(:, 2)), &
+                   dot_product(deformation(:, 1), deformation_rate(:, 2)) &
+                   + dot_product(deformation(:, 2), deformation_rate(:, 1))]
+    damping_stress = tau * matmul(membrane_d, strain_rate)
+    call membrane_strain_matrix(frame, deformation, b_strain)
+    do gamma = 1, 2
+      do i = 1, 3
+        gradient(:, f_x + gamma - 1) = gradient(:, f_x + gamma - 1) &
+                                       + damping_stress(i) * b_strain(i, 3 * gamma - 2:3 * gamma)
+      end do
+    end do
+    ! the elastic energy (not the shifted one) and the dissipated power
+    energy = 0.5_dp * dot_product(strain, matmul(membrane_d, strain)) &
+             + 0.5_dp * dot_product(kappa, matmul(bending_d, kappa))
+    power = dot_product(strain_rate, damping_stress) &
+            + tau * dot_product(kappa_rate, matmul(bending_d, kappa_rate))
+    if (.not. want_hessian) return
+    ! membrane: geometric term of the damping stress, c tau B^T D B + tau B^T D B(F')
+    stress_tensor = reshape([damping_stress(1), damping_stress(3), damping_stress(3), &
+                             damping_stress(2)], [2, 2])
+    geometric = matmul(frame, matmul(stress_tensor, transpose(frame)))
+    do col = 1, 2
+      do row = 1, 2
+        do i = 1, 3
+          hessian(3 * row - 3 + i, 3 * col - 3 + i) = hessian(3 * row - 3 + i, 3 * col - 3 + i) &
+                                                      + geometric(row, col)
+        end do
+      end do
+    end do
+    call membrane_strain_matrix(frame, deformation_rate, b_rate)
+    hessian(1:6, 1:6) = hessian(1:6, 1:6) + matmul(transpose(b_strain), &
+      matmul(membrane_d, rate_factor * tau * b_strain + tau * b_rate))
+    ! bending: c tau dkappa^T D dkappa + tau dkappa^T D K-map((d2c/dz2) z')
+    dkappa = matmul(to_local, dcurv)
+    call curvature_gradient_rate(fields, field_rates, g, gnorm, curvature_hessian_rate)
+    hessian = hessian + matmul(transpose(dkappa), matmul(bending_d, &
+      rate_factor * tau * dkappa + tau * matmul(to_local, curvature_hessian_rate)))
+  end subroutine point_energy_damped
+
+  !> B(3, 6) of the membrane strain with respect to (r_x, r_y) at F = [r_x r_y] K (or, with
+  !> F' in place of F, the derivative of eps' = B(F) z' with respect to z).
+  pure subroutine membrane_strain_matrix(k, deformation, b_strain)
+    real(dp), intent(in) :: k(2, 2), deformation(3, 2)
+    real(dp), intent(out) :: b_strain(3, 6)
+    integer :: gamma
+    do gamma = 1, 2
+      b_strain(1, 3 * gamma - 2:3 * gamma) = k(gamma, 1) * deformation(:, 1)
+      b_strain(2, 3 * gamma - 2:3 * gamma) = k(gamma, 2) * deformation(:, 2)
+      b_strain(3, 3 * gamma - 2:3 * gamma) = k(gamma, 1) * deformation(:, 2) &
+                                             + k(gamma, 2) * deformation(:, 1)
+    end do
+  end subroutine membrane_strain_matrix
+
+  !> The map kappa = to_local c of point_energy (Voigt, rescaled by the reference metric).
+  pure subroutine curvature_map(k, to_local)
+    real(dp), intent(in) :: k(2, 2)
+    real(dp), intent(out) :: to_local(3, 3)
+    to_local(1, :) = [k(1, 1)**2, k(2, 1)**2, 2 * k(1, 1) * k(2, 1)]
+    to_local(2, :) = [k(1, 2)**2, k(2, 2)**2, 2 * k(1, 2) * k(2, 2)]
+    to_local(3, :) = 2 * [k(1, 1) * k(1, 2), k(2, 1) * k(2, 2), k(1, 1) * k(2, 2) + k(2, 1) * k(1, 2)]
+    to_local = to_local / (k(1, 1) * k(2, 2) - k(1, 2) * k(2, 1))**2
+  end subroutine curvature_map
+
+  !> dc_i/dz (rows i, columns z) of the curvatures c_i = w_i . g / |g|^3: dc/du = v x h,
+  !> dc/dv = h x u, dc/dw_i = g / |g|^3, h = dc/dg (as point_energy).
+  pure subroutine curvature_gradients(fields, g, gnorm, dcurv)
+    real(dp), intent(in) :: fields(3, plate_fields), g(3), gnorm
+    real(dp), intent(out) :: dcurv(3, 15)
+    real(dp) :: h(3)
+    integer :: i
+    dcurv = 0.0_dp
+    do i = 1, 3
+      h = fields(:, f_xx + i - 1) / gnorm**3 &
+          - 3.0_dp * dot_product(fields(:, f_xx + i - 1), g) * g / gnorm**5
+      dcurv(i, 1:3) = cross(fields(:, f_y), h)
+      dcurv(i, 4:6) = cross(h, fields(:, f_x))
+      dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g / gnorm**3
+    end do
+  end subroutine curvature_gradients
+
+  !> d/dt (dc_i/dz) = (d2c_i/dz2) z' of the three curvatures (rows i, columns z): with
+  !> g' = u' x v + u x v' and h_i = dc_i/dg,
+  !>   d/dt (v x h_i) = v' x h_i + v x h_i',  d/dt (h_i x u) = h_i' x u + h_i x u',
+  !>   d/dt (g / |g|^3) = g' / |g|^3 - 3 (g . g') g / |g|^5.
+  pure subroutine curvature_gradient_rate(fields, field_rates, g, gnorm, rate)
+    real(dp), intent(in) :: fields(3, plate_fields), field_rates(3, plate_fields), g(3), gnorm
+    real(dp), intent(out) :: rate(3, 15)
+    real(dp) :: g_rate(3), gg, w(3), w_rate(3), wg, h(3), h_rate(3)
+    integer :: i, f
+    g_rate = cross(field_rates(:, f_x), fields(:, f_y)) + cross(fields(:, f_x), field_rates(:, f_y))
+    gg = dot_product(g, g_rate)
+    rate = 0.0_dp
+    do i = 1, 3
+      f = f_xx + i - 1
+      w = fields(:, f)
+      w_rate = field_rates(:, f)
+      wg = dot_product(w, g)
+      h = w / gnorm**3 - 3.0_dp * wg * g / gnorm**5
+      h_rate = w_rate / gnorm**3 - 3.0_dp * gg * w / gnorm**5 &
+               - 3.0_dp * ((dot_product(w_rate, g) + dot_product(w, g_rate)) * g + wg * g_rate) &
+                 / gnorm**5 + 15.0_dp * wg * gg * g / gnorm**7
+      rate(i, 1:3) = cross(field_rates(:, f_y), h) + cross(fields(:, f_y), h_rate)
+      rate(i, 4:6) = cross(h_rate, fields(:, f_x)) + cross(h, field_rates(:, f_x))
+      rate(i, 3 * f - 2:3 * f) = g_rate / gnorm**3 - 3.0_dp * gg * g / gnorm**5
+    end do
+  end subroutine curvature_gradient_rate
 
 end module plate_element

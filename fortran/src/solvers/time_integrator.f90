@@ -61,10 +61,11 @@ contains
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
   !> constraint values and gradients, the strain energy and the number of active contact
   !> points; known_internal: B^T (Q_el - Q_c - Q_M) already computed (by refactorize).
-  subroutine residual(sys, t, rotations, e, v, acceleration, lam, state, r, phi, gradients, &
-                      strain, active, info, known_internal)
+  subroutine residual(sys, t, rotations, rates, e, v, acceleration, lam, state, r, phi, &
+                      gradients, strain, active, info, known_internal)
     type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: t, rotations(:, :, 0:), e(:), v(:), acceleration(:), lam(:)
+    real(dp), intent(in) :: t, rotations(:, :, 0:), rates(0:), e(:), v(:), acceleration(:)
+    real(dp), intent(in) :: lam(:)
     type(contact_state), intent(inout) :: state
     real(dp), intent(inout) :: strain  ! out; in with known_internal
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :)
@@ -78,7 +79,7 @@ contains
       internal = known_internal
     else
       call internal_forces(sys, rotations, e, v, 1.0_dp, 0.0_dp, state, internal, strain, &
-                           potential, powers, records, info)
+                           potential, powers, records, info, rates=rates)
       if (info /= 0) return
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if
@@ -144,14 +145,14 @@ contains
         fresh_matrix = .false.
         if (needs_factorization(sys, cfg, beta_prime, attempt)) then
           call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                           predicted_internal, strain, sys%factor_active, info, detail)
+                           predicted_internal, strain, sys%factor_active, info, detail, rates)
           if (info /= 0) return
           stats(stat_factorizations) = stats(stat_factorizations) + 1
           stats(stat_jacobians) = stats(stat_jacobians) + 1
           fresh_matrix = sys%policy /= policy_constant
         end if
-        call newton(sys, cfg, t + h, rotations, beta_prime, velocity_factor, e_new, v_new, &
-                    accel_new, lam_new, state, predicted_internal, fresh_matrix, &
+        call newton(sys, cfg, t + h, rotations, rates, beta_prime, velocity_factor, e_new, &
+                    v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, info, detail)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
@@ -226,12 +227,12 @@ contains
 
   !> Newton iterations of one step from the predicted state (updated in place). done: the
   !> last correction met the tolerance.
-  subroutine newton(sys, cfg, t_new, rotations, beta_prime, velocity_factor, e_new, v_new, &
+  subroutine newton(sys, cfg, t_new, rotations, rates, beta_prime, velocity_factor, e_new, v_new, &
                     accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, info, detail)
     type(system_model), intent(inout) :: sys
     type(integrator_settings), intent(in) :: cfg
-    real(dp), intent(in) :: t_new, rotations(:, :, 0:), beta_prime, velocity_factor
+    real(dp), intent(in) :: t_new, rotations(:, :, 0:), rates(0:), beta_prime, velocity_factor
     real(dp), intent(inout) :: e_new(:), v_new(:), accel_new(:), lam_new(:)
     type(contact_state), intent(inout) :: state
     real(dp), intent(inout) :: predicted_internal(:)
@@ -255,11 +256,11 @@ contains
     active = sys%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
-        call residual(sys, t_new, rotations, e_new, v_new, accel_new, lam_new, state, r, phi, &
-                      gradients, strain, active, info, predicted_internal)
+        call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
+                      phi, gradients, strain, active, info, predicted_internal)
       else
-        call residual(sys, t_new, rotations, e_new, v_new, accel_new, lam_new, state, r, phi, &
-                      gradients, strain, active, info)
+        call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
+                      phi, gradients, strain, active, info)
       end if
       if (info /= 0) return
       use_known = .false.
@@ -268,8 +269,8 @@ contains
           sys%npoint > 0 .and. active /= sys%factor_active .and. it < cfg%max_newton) then
         call refresh_matrix()
         if (info /= 0) return
-        call residual(sys, t_new, rotations, e_new, v_new, accel_new, lam_new, state, r, phi, &
-                      gradients, strain, active, info, predicted_internal)
+        call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
+                      phi, gradients, strain, active, info, predicted_internal)
         if (info /= 0) return
       end if
       ! z = U S^{-1} U^T r
@@ -357,7 +358,7 @@ contains
 
     subroutine refresh_matrix()
       call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                       predicted_internal, strain, sys%factor_active, info, detail)
+                       predicted_internal, strain, sys%factor_active, info, detail, rates)
       if (info /= 0) return
       stats(stat_factorizations) = stats(stat_factorizations) + 1
       stats(stat_jacobians) = stats(stat_jacobians) + 1

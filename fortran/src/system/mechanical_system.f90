@@ -20,11 +20,19 @@
 !> in a moving frame A(t) is resolved in A(t) (S = U S_c U^T, U = diag(A_f(t)) per
 !> vector): S_c is constant and factorized once per run. Otherwise S is assembled in
 !> global coordinates and refactorized as the stepper's policy asks.
+!>
+!> Material damping (Kelvin-Voigt, element sets with a retardation time tau > 0): the sets
+!> get the full coordinate rates and their frame's angular velocity (the frame rates
+!> phi'_f), the tangent becomes K + c_v C (C = dQ/dq') and the dissipated power is a work
+!> of the output rows (power_material_damping = -sum tau s'^T D s'). In the policy
+!> 'constant' the factorized matrix holds beta' M + (1 + c_v tau) K0 in the solver frame;
+!> the moving frame's term -tau T K0 T^T [omega]x of the damping force's derivative (it
+!> varies with phi') is left to the simplified Newton, whose residual is exact.
 !> No I/O; failures return codes.
 module mechanical_system
   use ancf_kinds, only: dp
   use constraints, only: constraint_eval, operand_values, drive_value
-  use element_sets, only: element_set, set_forces, set_energy_power, set_ffr
+  use element_sets, only: element_set, set_forces, set_energy_power, set_ffr, frame_omega
   use section_moment, only: moment_force, moment_angle
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record
   use sparse_direct, only: solver_solve, solver_factorize
@@ -34,7 +42,8 @@ module mechanical_system
   public :: frame_rotations, to_full, to_reduced, csr_matvec, mass_product, internal_forces, &
             external_forces, &
             evaluate_constraints, constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
-            frame_gradients, energies, probe_output, tangent_rotations, append_set
+            frame_gradients, energies, probe_output, tangent_rotations, append_set, &
+            tangent_frame_rates, damped_sets
 
   integer, parameter, public :: policy_constant = 0, policy_refactor = 1
   !> energy(:) layout of an output row
@@ -187,6 +196,41 @@ contains
     end do
   end function tangent_rotations
 
+  !> The frame rates the tangent's damping terms use: each frame's, except in the constant
+  !> policy, where the sets of a moving frame are assembled in the frame itself and the
+  !> angular velocity's term is left out (0), as tangent_rotations does for the rotation.
+  pure function tangent_frame_rates(sys, rates) result(out)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rates(0:)
+    real(dp) :: out(0:size(sys%frames))
+    integer :: f
+    out = rates
+    if (sys%policy /= policy_constant) return
+    do f = 1, size(sys%frames)
+      if (sys%frames(f)%drive /= 0) out(f) = 0.0_dp
+    end do
+  end function tangent_frame_rates
+
+  !> Whether any element set carries material damping (tau > 0).
+  pure logical function damped_sets(sys)
+    type(system_model), intent(in) :: sys
+    integer :: s
+    damped_sets = .false.
+    do s = 1, size(sys%sets)
+      if (sys%sets(s)%damping_time > 0.0_dp) damped_sets = .true.
+    end do
+  end function damped_sets
+
+  !> The angular velocity of frame f at rate phi', in the rotation's frame (0 for no frame).
+  pure function set_omega(sys, f, rotation, rate) result(omega_local)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: f
+    real(dp), intent(in) :: rotation(3, 3), rate
+    real(dp) :: omega_local(3)
+    omega_local = 0.0_dp
+    if (f > 0) omega_local = frame_omega(rotation, sys%frames(f)%axis, rate)
+  end function set_omega
+
   !> y = M x with the system's mass (CSR, or kron(Mbar, I3) with Mbar's CSR on 3-vectors).
   pure subroutine mass_product(sys, x, y)
     type(system_model), intent(in) :: sys
@@ -271,10 +315,13 @@ contains
   !> tangent_values (reduced pattern; tangent_rotation then required) the sets' tangents
   !> (FFR: in the tangent_rotation frames) plus
   !> velocity_factor times the contact Jacobian, reduced by the plan, are returned too.
+  !> Damped sets add their damping force at e' with the frames' rates phi'_f (rates; 0 when
+  !> absent) and their combined tangent dQ/dq + velocity_factor dQ/dq' (the FFR omega term
+  !> with tangent_rates, by default rates).
   !> info = 6 (moment undefined), 7 (a plate normal vanished), 8 (contact search failed).
   subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
                              strain, contact_potential, contact_powers, records, info, &
-                             tangent_rotation, tangent_values)
+                             tangent_rotation, tangent_values, rates, tangent_rates)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
     type(contact_state), intent(inout) :: state
@@ -283,8 +330,9 @@ contains
     integer, intent(out) :: info
     real(dp), intent(in), optional :: tangent_rotation(:, :, 0:)
     real(dp), intent(out), optional :: tangent_values(:)
+    real(dp), intent(in), optional :: rates(0:), tangent_rates(0:)
     real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
-    real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3)
+    real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3), rate, tangent_rate
     logical :: want_tangent
     integer :: s, m, k, f
     want_tangent = present(tangent_values)
@@ -296,9 +344,28 @@ contains
       allocate (values_full(size(sys%full_col)))
       values_full = 0.0_dp
     end if
+    if (sys%npoint > 0 .or. damped_sets(sys)) then
+      allocate (v_full(sys%nfull))
+      call to_full(sys, v, .false., v_full)
+    end if
     do s = 1, size(sys%sets)
       f = sys%sets(s)%frame
-      if (want_tangent) then
+      if (sys%sets(s)%damping_time > 0.0_dp) then
+        rate = 0.0_dp
+        if (present(rates)) rate = rates(f)
+        tangent_rate = rate
+        if (present(tangent_rates)) tangent_rate = tangent_rates(f)
+        if (want_tangent) then
+          call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info, &
+                          values_full, tangent_rotation(:, :, f), v=v_full, &
+                          omega_local=set_omega(sys, f, rotations(:, :, f), rate), &
+                          rate_factor=velocity_factor, &
+                          tangent_omega=set_omega(sys, f, tangent_rotation(:, :, f), tangent_rate))
+        else
+          call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info, &
+                          v=v_full, omega_local=set_omega(sys, f, rotations(:, :, f), rate))
+        end if
+      else if (want_tangent) then
         call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info, &
                         values_full, tangent_rotation(:, :, f))
       else
@@ -310,8 +377,6 @@ contains
     contact_potential = 0.0_dp
     contact_powers = 0.0_dp
     if (sys%npoint > 0) then
-      allocate (v_full(sys%nfull))
-      call to_full(sys, v, .false., v_full)
       call contact_forces(sys, e_full, v_full, velocity_factor, state, full_force, records, &
                           contact_potential, contact_powers, info, values_full)
       if (info /= 0) return
@@ -530,20 +595,23 @@ contains
   !> of active contact points. info: 3 (solver failure, detail = its code) or the
   !> internal_forces codes.
   subroutine refactorize(sys, beta_prime, velocity_factor, rotations, e, v, state, force, &
-                         strain, active, info, detail)
+                         strain, active, info, detail, rates)
     type(system_model), intent(inout) :: sys
     real(dp), intent(in) :: beta_prime, velocity_factor, rotations(:, :, 0:), e(:), v(:)
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: force(:), strain
     integer, intent(out) :: active, info, detail
+    real(dp), intent(in), optional :: rates(0:)  ! the frames' phi' (material damping)
     real(dp), allocatable :: values(:), records(:, :)
-    real(dp) :: potential, powers(2)
+    real(dp) :: potential, powers(2), frame_rates(0:size(sys%frames))
     integer :: b, j
     detail = 0
     allocate (values(size(sys%mass_pattern)), records(contact_record, max(1, sys%npoint)))
+    frame_rates = 0.0_dp
+    if (present(rates)) frame_rates = rates
     call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
                          potential, powers, records, info, tangent_rotations(sys, rotations), &
-                         values)
+                         values, frame_rates, tangent_frame_rates(sys, frame_rates))
     if (info /= 0) return
     active = 0
     if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
@@ -591,7 +659,7 @@ contains
     real(dp), intent(out) :: strain, powers(power_count), contact_potential, violation
     real(dp), intent(out) :: records(:, :)
     integer, intent(out) :: info
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), set_energy, set_power
+    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), set_energy, set_power, dissipation
     real(dp), allocatable :: e_full(:), v_full(:), unused(:), values_unused(:)
     integer :: s, f
     call evaluate_constraints(sys, e, t, phi, gradients, info)
@@ -602,19 +670,30 @@ contains
     powers(power_drive) = dot_product(lam, gradient_dot(sys, gradients, v))
     allocate (e_full(sys%nfull))
     call to_full(sys, e, .true., e_full)
+    if (sys%npoint > 0 .or. damped_sets(sys)) then
+      allocate (v_full(sys%nfull))
+      call to_full(sys, v, .false., v_full)
+    end if
     strain = 0.0_dp
     do s = 1, size(sys%sets)
       f = sys%sets(s)%frame
-      call set_energy_power(sys%sets(s), rotations(:, :, f), sys_axis(sys, f), rates(f), e_full, &
-                            set_energy, set_power, info)
+      if (sys%sets(s)%damping_time > 0.0_dp) then
+        ! the dissipated power is lost (a negative work); an FFR set's frame power includes
+        ! that of its damping force
+        call set_energy_power(sys%sets(s), rotations(:, :, f), sys_axis(sys, f), rates(f), &
+                              e_full, set_energy, set_power, info, v_full, dissipation)
+        powers(power_material_damping) = powers(power_material_damping) - dissipation
+      else
+        call set_energy_power(sys%sets(s), rotations(:, :, f), sys_axis(sys, f), rates(f), &
+                              e_full, set_energy, set_power, info)
+      end if
       if (info /= 0) return
       strain = strain + set_energy
       powers(power_frame) = powers(power_frame) + set_power
     end do
     contact_potential = 0.0_dp
     if (sys%npoint > 0) then
-      allocate (v_full(sys%nfull), unused(sys%nfull))
-      call to_full(sys, v, .false., v_full)
+      allocate (unused(sys%nfull))
       unused = 0.0_dp
       call contact_forces(sys, e_full, v_full, 0.0_dp, state, unused, records, &
                           contact_potential, powers(power_contact_damping:power_friction), info, &

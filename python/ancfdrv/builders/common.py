@@ -23,7 +23,7 @@ class BuiltSystem:
 def material(system: System, scene, name: str = "material"):
     m = scene["material"]
     return system.material(name, youngs_modulus=m["youngs_modulus"], density=m["density"],
-                           poisson_ratio=m["poisson_ratio"])
+                           poisson_ratio=m["poisson_ratio"], damping_time=m["damping_time"])
 
 
 def rectangle(scene) -> Rectangle:

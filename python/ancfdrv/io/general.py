@@ -43,6 +43,8 @@ def effects_of(items: list[tuple[str, dict[str, Any]]]) -> set[str]:
                 out.add("friction")
         elif group == "leaf" and v["free_radius"] is not None:
             out.add("prestress")
+        elif group == "material" and v["damping_time"] > 0:
+            out.add("damping")
     return out
 
 
@@ -95,7 +97,7 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
     """One namelist group, one call of the System API."""
     if group == "material":
         s.material(v["name"], youngs_modulus=v["youngs_modulus"], density=v["density"],
-                   poisson_ratio=v["poisson_ratio"])
+                   poisson_ratio=v["poisson_ratio"], damping_time=v["damping_time"])
     elif group == "beam":
         s.beam(v["name"], material=v["material"], start=v["start"], end=v["end"],
                nodes=v["nodes"], section=_section(v), height_axis=v["height_axis"],

@@ -16,12 +16,16 @@ from typing import Any, Callable
 from ..errors import InputError
 
 REQUIRED = object()
+#: the material damping key (both schemas)
+DAMPING_TIME_DOC = ("Kelvin-Voigt retardation time tau (s): stress D (strain + tau strain rate), "
+                    "modal damping ratio tau omega / 2; needs the effect 'damping'")
 
 #: Effects a scene may list in ``&scene effects``; what is not listed is never computed.
 EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
-                     "point_loads", "pressure", "prestress", "contact", "friction", "load_cycle")
+                     "point_loads", "pressure", "prestress", "contact", "friction", "load_cycle",
+                     "damping")
 #: Effects of later capabilities, recognised so the message can say so.
-EFFECTS_PLANNED = ("damping",)
+EFFECTS_PLANNED: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -88,6 +92,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "density": Key("float", check=positive, doc="rho (kg/m^3)"),
         "poisson_ratio": Key("float", 0.0, within(0.0, 0.5, open_hi=True),
                              doc="nu in the elastic law; 0 avoids Poisson locking"),
+        "damping_time": Key("float", 0.0, non_negative, DAMPING_TIME_DOC),
     },
     "boom": {
         "pivot_offset": Key("float", 0.295, positive, "H = |O A1| (m)"),
@@ -305,6 +310,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
         "density": Key("float", check=positive, doc="rho (kg/m^3)"),
         "poisson_ratio": Key("float", 0.0, within(0.0, 0.5, open_hi=True), "nu"),
+        "damping_time": Key("float", 0.0, non_negative, DAMPING_TIME_DOC),
     },
     "beam": {
         "name": _name(),

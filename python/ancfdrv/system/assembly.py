@@ -53,7 +53,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         raise InputError(f"linear_joints {linear_joints!r} must be one of {LINEAR_JOINTS}")
     if not any(b.flexible or isinstance(b, RigidBody) for b in system.bodies.values()):
         raise InputError("the system has no body")
-    active_effects = set(system.effects_used() if effects is None else effects)
+    active_effects = set(_effects_used(system) if effects is None else effects)
     counters: Counter = Counter({name: 0 for name in EFFECTS_AVAILABLE + CONTACT_COUNTERS})
     for name in active_effects:
         counters[name] += 0
@@ -138,6 +138,15 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
 
 
 # -- effects ---------------------------------------------------------------------------------
+def _effects_used(system) -> set[str]:
+    """Every effect an item of the system belongs to: its loads', contacts' and leaves'
+    (System.effects_used) and 'damping' when a flexible body's material has a damping time."""
+    used = set(system.effects_used())
+    if any(b.flexible and b.material.damping_time > 0 for b in system.bodies.values()):
+        used.add("damping")
+    return used
+
+
 def _select(system, active: set[str], warnings: list[str]) -> _Active:
     loads = list(system.loads.values())
     for load in loads:
@@ -185,9 +194,27 @@ def _element_sets(bodies, frames, beam_frame, act: _Active, active: set[str], co
         else:
             continue
         counters["element_arrays"] += info.nel
+        _damping(info, body, active, counters, warnings)
         sets.append(info)
         blocks.append(info.dofs)
     return sets, blocks
+
+
+def _damping(info: SetInfo, body: Body, active: set[str], counters: Counter,
+             warnings: list[str]) -> None:
+    """The set's Kelvin-Voigt retardation time: its material's with the effect 'damping'
+    listed (one count per damped set), else 0 with a warning when the material has one."""
+    tau = body.material.damping_time
+    if tau <= 0:
+        return
+    if "damping" in active:
+        info.damping_time = float(tau)
+        counters["damping"] += 1
+        return
+    message = (f"material {body.material.name!r} has damping_time = {tau:g} s but the effect "
+               "'damping' is not listed: not applied")
+    if message not in warnings:
+        warnings.append(message)
 
 
 def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:

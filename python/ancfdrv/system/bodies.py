@@ -56,12 +56,16 @@ def rotation_about(axis, angle: float) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Material:
-    """Isotropic elastic material."""
+    """Isotropic elastic material, with optional Kelvin-Voigt damping: the stress is
+    D (strain + damping_time * strain rate) for every strain the elements use (applied only
+    when the effect 'damping' is listed; a linear structure then has the stiffness-
+    proportional damping C = damping_time K, modal damping ratios damping_time omega_n / 2)."""
 
     name: str
     youngs_modulus: float
     density: float
     poisson_ratio: float = 0.0
+    damping_time: float = 0.0
 
     def __post_init__(self) -> None:
         _positive(self.youngs_modulus, "youngs_modulus", f"material {self.name!r}")
@@ -69,6 +73,10 @@ class Material:
         if not 0.0 <= self.poisson_ratio < 0.5:
             raise InputError(f"material {self.name!r}: poisson_ratio {self.poisson_ratio} must "
                              "lie in [0, 0.5)")
+        if not (isinstance(self.damping_time, (int, float)) and np.isfinite(self.damping_time)
+                and self.damping_time >= 0):
+            raise InputError(f"material {self.name!r}: damping_time {self.damping_time!r} must "
+                             "be a finite number >= 0 (s)")
 
 
 @dataclass

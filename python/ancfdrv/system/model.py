@@ -57,6 +57,9 @@ class SetInfo:
     nvolume: int = 0
     structural: kernel.StructuralBeam | None = None
     plate_reference: kernel.PlateReference | None = None
+    #: Kelvin-Voigt retardation time (s) handed to the kernel: the material's with the
+    #: effect 'damping' listed, else 0 (no damping code runs)
+    damping_time: float = 0.0
 
 
 @dataclass
@@ -160,6 +163,12 @@ class Model:
 
     # -- identity ---------------------------------------------------------------------------
     @property
+    def damped(self) -> bool:
+        """Whether any element set carries material damping (the effect 'damping' listed and
+        a material with damping_time > 0)."""
+        return any(s.damping_time > 0 for s in self.sets)
+
+    @property
     def npoint(self) -> int:
         return sum(len(p["point_element"]) for p in self.contact_pairs)
 
@@ -220,6 +229,8 @@ class Model:
         self.counters["elastic_force"] += 1
         if want_tangent:
             self.counters["stiffness_assembly"] += 1
+        if self.damped:
+            self.counters["damping"] += 1
         if self.moments:
             for m in self.moments:
                 self.counters[m.effect] += 1
@@ -353,7 +364,14 @@ class Model:
 
     def banded(self) -> bool:
         """The banded Cholesky (with LU fallback) for symmetric matrices with a narrow band:
-        no contact (its Jacobian is unsymmetric) and half-bandwidth <= max(64, n / 4)."""
+        no contact (its Jacobian is unsymmetric) and half-bandwidth <= max(64, n / 4).
+        Material damping makes a refactorized model's tangent unsymmetric too (the strain
+        rate's dependence on e, tau B(e)^T D B(e'), and an FFR frame's omega term), and not
+        small against beta' M along the rigid modes (a steel plate swinging at 10 rad/s with
+        tau = 2e-3 s: Newton with the Cholesky's upper triangle diverged), so MUMPS factorizes
+        it; the constant policy's beta' M + (1 + c tau) K0 stays symmetric."""
+        if self.damped and self.policy != POLICY_CONSTANT:
+            return False
         return not self.contact_pairs and self.pattern.bandwidth() <= max(64, self.ndof // 4)
 
     def build_kernel(self) -> None:
@@ -361,18 +379,19 @@ class Model:
         ks = kernel.KernelSystem(self.ndof, self.nfull)
         for s in self.sets:
             if s.kind == "ffr":
-                ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame)
+                ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame,
+                               s.damping_time)
             elif s.kind == "continuum":
                 ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
                                      s.body.material.youngs_modulus,
-                                     s.body.material.poisson_ratio, s.frame)
+                                     s.body.material.poisson_ratio, s.frame, s.damping_time)
             elif s.kind == "structural":
                 ks.add_structural_set(s.dofs, s.scatter, s.structural.forms, s.structural.strain0,
-                                      s.structural.stiffness, s.frame)
+                                      s.structural.stiffness, s.frame, s.damping_time)
             else:
                 ks.add_plate_set(s.dofs, s.scatter, s.plate_reference,
                                  s.body.material.youngs_modulus, s.body.material.poisson_ratio,
-                                 s.body.thickness)
+                                 s.body.thickness, s.damping_time)
         ks.set_frames([f.drive for f in self.frames], [f.axis for f in self.frames],
                       [f.base for f in self.frames], [f.pivot for f in self.frames])
         ks.set_drives([d.kind for d in self.drives], [d.params() for d in self.drives])

@@ -103,9 +103,10 @@ class System:
 
     # -- items ----------------------------------------------------------------------------
     def material(self, name: str, *, youngs_modulus: float, density: float,
-                 poisson_ratio: float = 0.0) -> Material:
+                 poisson_ratio: float = 0.0, damping_time: float = 0.0) -> Material:
         name = self._new_name(name, self.materials, "material")
-        self.materials[name] = Material(name, youngs_modulus, density, poisson_ratio)
+        self.materials[name] = Material(name, youngs_modulus, density, poisson_ratio,
+                                        damping_time)
         return self.materials[name]
 
     def _add_body(self, body: Body) -> Body:
