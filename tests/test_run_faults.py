@@ -183,7 +183,7 @@ def test_a_previous_result_survives_a_refused_run(scene, tmp_path, capsys):
 
 def test_second_writer_is_refused_naming_the_first(scene, tmp_path, capsys):
     out = tmp_path / "shared.h5"
-    first = ancf("run", str(scene), "-o", str(out), *LONG[:-4], "--set", "beam.nodes=10",
+    first = ancf("run", str(scene), "-o", str(out), *LONG[2:-4], "--set", "beam.nodes=10",
                  "--set", "solver.t_end=4")
     wait_for_rows(out, first, 2)
     err = refused(capsys, ["run", str(scene), "-o", str(out), *TINY],

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from ..errors import InputError
+from .validate import check_int32
 
 REQUIRED = object()
 
@@ -255,10 +256,10 @@ def coerce(kind: str, raw: Any, where: dict) -> Any:
         return as_float(raw)
     if kind == "int":
         if isinstance(raw, bool) or not isinstance(raw, int):
-            if isinstance(raw, float) and raw.is_integer():
-                return int(raw)
-            raise bad("an integer")
-        return raw
+            if not (isinstance(raw, float) and raw.is_integer()):
+                raise bad("an integer")
+            raw = int(raw)
+        return check_int32(raw, where)
     if kind == "str":
         if not isinstance(raw, str):
             raise bad("a string")
