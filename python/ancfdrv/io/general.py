@@ -84,11 +84,43 @@ def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:
     elif kind == "table":
         if v["file"] is not None:
             path = Path(v["file"])
-            s.drive(v["name"], "table", file=path if path.is_absolute() else scene_dir / path)
+            path = path if path.is_absolute() else scene_dir / path
+            _check_text_file(path)
+            s.drive(v["name"], "table", file=path)
         else:
             s.drive(v["name"], "table", times=v["times"], values=v["values"] or [])
     else:
         s.drive(v["name"], kind, **{_DRIVE_KEYS[kind][k]: v[k] for k in given})
+
+
+def _check_text_file(path: Path) -> None:
+    """A table's CSV file must be UTF-8 text (the CSV reader would fail on the bytes)."""
+    if not path.is_file():
+        return  # the drive reports the missing file
+    try:
+        path.read_bytes().decode("utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot read the table file {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"the table file {str(path)!r} is not a text file (byte {exc.start} "
+                         "is not UTF-8)") from None
+
+
+def _check_joint_points(s: System, scene) -> None:
+    """Every joint point is a node of the beams, plates and leaves it joins (a material
+    point of rigid bodies), checked now so that the message names the file and the joint;
+    the assembly makes the same check when it writes the joint's equations."""
+    for joint in s.joints.values():
+        points = [joint.point1, joint.point2] if joint.type == "distance" else joint.points
+        bodies = [joint.body1, joint.body2] if joint.type == "distance" else None
+        try:
+            for k, point in enumerate(points):
+                for body in (bodies[k],) if bodies else joint.bodies:
+                    if body.name != "ground":
+                        joint._locate(body, point)
+        except InputError as exc:
+            raise InputError(str(exc), file=str(scene.path),
+                             group=f"joint[{joint.name}]") from None
 
 
 def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> None:
@@ -145,6 +177,7 @@ def build_general(scene) -> BuiltSystem:
         except InputError as exc:
             raise InputError(str(exc), file=str(scene.path),
                              group=f"{group}[{values['name']}]") from None
+    _check_joint_points(s, scene)
     response = None
     if scene["scene"].get("response"):
         name = scene["scene"]["response"]

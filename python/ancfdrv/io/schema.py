@@ -243,7 +243,8 @@ COMMON_GROUPS = ("scene", "material", "loads", "solver", "output")
 
 def coerce(kind: str, raw: Any, where: dict) -> Any:
     def bad(expected: str) -> InputError:
-        return InputError(f"expected {expected}, got {raw!r}", **where)
+        got = "no value" if raw is None else repr(raw)
+        return InputError(f"expected {expected}, got {got}", **where)
 
     def as_float(x: Any) -> float:
         if isinstance(x, bool) or not isinstance(x, (int, float)):

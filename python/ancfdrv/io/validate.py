@@ -30,8 +30,9 @@ for a named group of a general scene) and the key:
    and 12,000 nodes and plates of 30 x 30 and 60 x 60 elements), plus the contact points.
    It must stay below :data:`MEMORY_FRACTION` of the memory the machine has available
    (``/proc/meminfo`` MemAvailable, else ``os.sysconf``). A dynamic run is also refused when
-   even the fastest rate measured (:data:`SECONDS_PER_COORDINATE_STEP`, the boom's constant
-   FFR steps run at about 3 times that) would take longer than :data:`MAX_RUN_SECONDS`.
+   a lower bound of its time (:data:`SECONDS_PER_COORDINATE_STEP` per coordinate and step
+   of each body type, several times faster than any run measured) exceeds
+   :data:`MAX_RUN_SECONDS` (30 days).
 """
 from __future__ import annotations
 
@@ -51,9 +52,10 @@ MIN_DT = 1e-12
 STEP_TOLERANCE = 1e-9
 #: at most this many time steps in one run (well below the kernel's 32-bit counters)
 MAX_STEPS = 10**8
-#: a lower bound of the cost of one step per coordinate (s): below every rate measured
-#: (boom, constant FFR iteration matrix: 3.1e-7 s; plates and leaves: 1.4e-5 to 2.4e-5 s)
-SECONDS_PER_COORDINATE_STEP = 1e-7
+#: lower bounds of the cost of one step per coordinate of each body type (s), a third to
+#: a fifth of the fastest rates measured (the boom's beam with its constant FFR iteration
+#: matrix: 3.1e-7 s; the plate pendulum and the leaf spring: 1.4e-5 and 2.4e-5 s)
+SECONDS_PER_COORDINATE_STEP = {"beam": 1e-7, "plate": 3e-6, "leaf": 3e-6, "rigid_body": 1e-7}
 #: runs whose lower-bound time estimate exceeds this are refused (30 days)
 MAX_RUN_SECONDS = 30 * 86400.0
 #: sparse-pattern nonzeros per coordinate of each body type (a beam node couples with its
@@ -372,6 +374,12 @@ class Estimate:
         return sum(p.nodes * p.per_node * NONZEROS_PER_COORDINATE[p.kind] for p in self.parts)
 
     @property
+    def seconds_per_step(self) -> float:
+        """A lower bound of the time of one step (s)."""
+        return sum(p.nodes * p.per_node * SECONDS_PER_COORDINATE_STEP[p.kind]
+                   for p in self.parts)
+
+    @property
     def memory_bytes(self) -> int:
         return (BASE_BYTES + BYTES_PER_NONZERO * self.nonzeros
                 + BYTES_PER_CONTACT_POINT * self.contact_points)
@@ -466,11 +474,11 @@ def check_resources(estimate: Estimate, file: str, solver: dict[str, Any] | None
     if solver is None or analysis not in ("dynamic", "static+dynamic"):
         return
     steps = steps_of(solver["dt"], solver["t_end"])
-    seconds = steps * estimate.coordinates * SECONDS_PER_COORDINATE_STEP
+    seconds = steps * estimate.seconds_per_step
     if seconds > MAX_RUN_SECONDS:
         raise InputError(
             f"{steps:,} steps of {estimate.coordinates:,} coordinates would take at least "
-            f"{seconds / 86400:.3g} days (at {SECONDS_PER_COORDINATE_STEP:g} s per coordinate "
-            f"and step, faster than any run measured); the limit is "
+            f"{seconds / 86400:.3g} days (at {estimate.seconds_per_step:.3g} s per step, "
+            "several times faster than any run measured); the limit is "
             f"{MAX_RUN_SECONDS / 86400:.3g} days: raise dt, shorten t_end or use a coarser "
             "mesh", file=file, group="solver", key="dt")
