@@ -443,6 +443,8 @@ CASES: list[Case] = [
         where="{dir}/notes.txt/out.h5"),
     run("output-not-hdf5", BOOM, "not an HDF5 file", args=("-o", "{dir}/notes.h5"),
         files={"notes.h5": "keep me\n"}, where="{dir}/notes.h5"),
+    run("output-colon-with-xdmf", LUFFING, "must not contain ':'", "output.xdmf = .false.",
+        args=("-o", "{dir}/a:b.h5"), where="{dir}/a:b.h5"),
     run("output-ends-in-png", BOOM, "must not end in .png", args=("-o", "{dir}/out.png"),
         where="{dir}/out.png"),
     run("output-file-in-scene-is-scene", edit("BOOM", ("&solver", "&output file = 'scene.nml' /\n"

@@ -348,16 +348,25 @@ class DynamicWriter:
     """
 
     def __init__(self, path: Path, model: Model, store_q: bool,
-                 flush_rows: int = 1) -> None:
+                 flush_rows: int = 1, *, xdmf: bool | None = None, total_rows: int = 0,
+                 frames: int = 1000) -> None:
+        """``xdmf``: write the node positions of every body for the XDMF description
+        (needs ``store_q``; None: for models with plates, as before), at most ``frames``
+        of the ``total_rows`` rows the run will write (:func:`~.xdmf.frame_rows`)."""
         from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
+        from .xdmf import MeshLayout, frame_rows, write_layout
         self.path, self.names, self.store_q = path, list(model.probes), store_q
         self.flush_rows = max(1, int(flush_rows))
-        self.node_positions = model.node_positions if model.plate_bodies() else None
+        self.model = model
         self.npoints = model.npoint
         self.contact_fields = CONTACT_FIELDS
-        geometry = model.plate_geometry()
-        self.nnodes = len(geometry[0]) if geometry is not None and store_q else 0
-        self.reference_nodes = geometry[0] if self.nnodes else None
+        if xdmf is None:
+            xdmf = bool(model.plate_bodies())
+        self.layout = MeshLayout.from_model(model) if xdmf and store_q else None
+        self.nnodes = self.layout.npoints if self.layout is not None else 0
+        self.stride, self.last_row = frame_rows(total_rows, frames) if total_rows > 0 \
+            else (1, -1)
+        self.frames = 0
         self.energy_names = ENERGY_NAMES
         self.rows = 0
         self._pending: list[Any] = []
@@ -399,12 +408,16 @@ class DynamicWriter:
                 group["contact"].attrs["points"] = "\n".join(model.contact_point_names)
             if store_q:
                 series("q", COORDINATE_UNITS, (ndof,))
-            if self.nnodes:  # plate models: node positions per step, for ParaView (XDMF)
+            if self.nnodes:  # points of every body per frame, for ParaView (XDMF)
+                write_layout(h5, self.layout)
                 for name in ("mesh_nodes", "mesh_displacement"):
                     data = group.create_dataset(name, shape=(0, self.nnodes, 3),
                                                 maxshape=(None, self.nnodes, 3), dtype="f8",
                                                 chunks=(16, self.nnodes, 3))
                     data.attrs["units"] = "m"
+                series("mesh_rows", "index", dtype="i8")
+                group["mesh_rows"].attrs["description"] = (
+                    "the row of /dynamic/time of each row of mesh_nodes (XDMF frames)")
 
     def __call__(self, chunk) -> None:
         self._pending.append(chunk)
@@ -419,13 +432,13 @@ class DynamicWriter:
             return
         with _open_write(self.path) as h5:
             group = h5["dynamic"]
-            first = self.rows
+            first = self.frames
             for chunk in self._pending:
                 self._append(group, chunk)
             group.attrs["rows"] = np.int64(self.rows)
-            if self.nnodes:  # the per-step views the XDMF description names
+            if self.nnodes:  # the per-frame views the XDMF description names
                 from .xdmf import add_step_views
-                add_step_views(h5, first, self.rows)
+                add_step_views(h5, first, self.frames)
         self._pending, self._pending_rows = [], 0
         self._last_write = time.monotonic()
 
@@ -459,11 +472,24 @@ class DynamicWriter:
         if self.store_q and chunk.q is not None:
             append("q", chunk.q)
             if self.nnodes:
-                nodes = (self.node_positions(chunk.q) if self.node_positions is not None
-                         else chunk.q.reshape(n, self.nnodes, -1)[:, :, :3])
-                append("mesh_nodes", nodes)
-                append("mesh_displacement", nodes - self.reference_nodes[None, :, :])
+                self._append_frames(group, chunk.q)
         self.rows += n
+
+    def _append_frames(self, group: h5py.Group, q: np.ndarray) -> None:
+        """The points' positions at the chunk's frame rows (every stride-th and the last)."""
+        rows = self.rows + np.arange(len(q))
+        pick = (rows % self.stride == 0) | (rows == self.last_row)
+        if not pick.any():
+            return
+        nodes = self.layout.positions(self.model, q[pick])
+        k = self.frames
+        for name, values in (("mesh_nodes", nodes),
+                             ("mesh_displacement", nodes - self.layout.points[None, :, :]),
+                             ("mesh_rows", rows[pick])):
+            data = group[name]
+            data.resize(k + len(values), axis=0)
+            data[k:] = values
+        self.frames += len(nodes)
 
 
 def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, float]) -> None:

@@ -57,6 +57,12 @@ def within(lo: float, hi: float, *, open_hi: bool = False) -> Callable[[Any], st
     return check
 
 
+def at_least(n: int) -> Callable[[Any], str | None]:
+    def check(v: Any) -> str | None:
+        return None if v >= n else f"must be at least {n}"
+    return check
+
+
 SCHEMA: dict[str, dict[str, Key]] = {
     "scene": {
         "title": Key("str", doc="a line describing the scene"),
@@ -231,6 +237,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "q": Key("bool", False, doc="store the coordinates q at every step"),
         "chunk_steps": Key("int", 1000, positive,
                            "steps per kernel call; each chunk is flushed to the file"),
+        "xdmf": Key("bool", True, doc="dynamic runs: write OUT.xdmf beside the result, the "
+                    "motion of every body for ParaView (plates as quadrilaterals, beams as "
+                    "polylines, rigid bodies as their centre and axes); stores q"),
+        "xdmf_frames": Key("int", 1000, at_least(2), "the most frames the XDMF holds: longer "
+                           "runs show every k-th step (and the last)"),
     },
 }
 
@@ -287,12 +298,6 @@ def vector3(v: Any) -> str | None:
 def points3(v: Any) -> str | None:
     return None if len(v) and len(v) % 3 == 0 else \
         f"must be x, y, z (or several points: a multiple of 3 numbers), got {len(v)} numbers"
-
-
-def at_least(n: int) -> Callable[[Any], str | None]:
-    def check(v: Any) -> str | None:
-        return None if v >= n else f"must be at least {n}"
-    return check
 
 
 def _name(doc: str = "a unique name of the item") -> Key:
