@@ -116,6 +116,8 @@ class Case:
     argv: list[str]
     expect: tuple[str, ...]
     files: dict[str, str | bytes] = field(default_factory=dict)
+    #: found while the model is assembled (the others are refused before it is built)
+    assembles: bool = False
 
 
 def run(id: str, scene: str, *expect: str, args: tuple[str, ...] = (),
@@ -411,6 +413,32 @@ CASES: list[Case] = [
         args=("--set", "leaf.nx=4")),
     run("general-set-huge", GENERAL, "&beam[arm] nodes", HUGE,
         args=("--set", "beam[arm].nodes=10000000")),
+    Case("general-distance-points-coincide", edit("GENERAL", (
+        "type = 'spherical', body1 = 'arm', body2 = 'box', point = 2.0, 0.0, 0.0",
+        "type = 'distance', body1 = 'arm', body2 = 'box', point1 = 2.0, 0.0, 0.0, "
+        "point2 = 2.0, 0.0, 0.0")), ["run", "{scene}"],
+        ("{scene}", "&joint[tip]", "point1 and point2 coincide"), assembles=True),
+    Case("general-drive-contradicts-joint", GENERAL + (
+        "&drive name = 'length', type = 'constant', value = 5.0 /\n"
+        "&joint name = 'cylinder', type = 'distance', body1 = 'ground', body2 = 'box', "
+        "point1 = 2.0, 1.0, 0.0, point2 = 2.0, 0.0, 0.0, drive = 'length' /\n"),
+        ["run", "{scene}"], ("{scene}", "&joint[cylinder]", "gives the length 5 m at t = 0"),
+        assembles=True),
+    run("general-name-with-slash", edit("GENERAL", ("&probe name = 'tip'",
+                                                    "&probe name = 'tip/x'")),
+        "&probe[tip/x] name", "must not contain '/'"),
+    run("general-name-with-bracket", edit("GENERAL", ("name = 'box'", "name = 'b]x'")),
+        "&rigid_body[b]x] name", "must not contain"),
+    run("general-name-dot", edit("GENERAL", ("&probe name = 'tip'", "&probe name = '.'")),
+        "&probe[.] name", "nor be '.'"),
+    run("general-inertia-zero", edit("GENERAL", ("inertia = 0.1, 0.1, 0.1, 0.0, 0.0, 0.0",
+                                                 "inertia = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0")),
+        "&rigid_body[box] inertia", "positive Ixx"),
+    run("huge-youngs-modulus", edit("BOOM", ("youngs_modulus = 2.1e11", "youngs_modulus = 1e300")),
+        "&material youngs_modulus", "largest magnitude"),
+    run("huge-position", edit("GENERAL", ("end = 2.0, 0.0, 0.0", "end = 1e300, 0.0, 0.0")),
+        "&beam[arm] end", "largest magnitude"),
+    sets("set-huge-force", "BOOM", ["loads.moment=1e300"], "&loads moment", "largest magnitude"),
     run("general-leaf-prestress-plain", edit("GENERAL_SPRING", (
         "nx = 8, ny = 1           !", "nx = 8, ny = 1, variant = 'plain'           !")),
         "&leaf[lower]", "completed"),
@@ -467,7 +495,8 @@ CASES: list[Case] = [
 
 #: cases that also run as a separate process (the console entry point, real exit status)
 SUBPROCESS = ("huge-beam", "set-smuggles-group", "t-end-not-whole-steps", "group-twice",
-              "general-joint-not-a-node", "table-csv-binary", "output-is-scene")
+              "general-joint-not-a-node", "table-csv-binary", "output-is-scene",
+              "general-drive-contradicts-joint")
 
 
 def _prepare(case: Case, directory: Path) -> tuple[list[str], tuple[str, ...]]:
@@ -530,9 +559,10 @@ def test_bad_input_exits_2_naming_where(case, tmp_path, monkeypatch, capsys):
     import ancfdrv.sweep  # noqa: F401
     monkeypatch.chdir(tmp_path)  # a default output (results/...) would appear here
 
-    def built(scene):  # every case must be refused before its model is built
+    def built(scene):  # the other cases must be refused before the model is built
         raise AssertionError(f"case {case.id!r} got past validation: the model was built")
-    monkeypatch.setattr(ancfdrv.runner, "build_model", built)
+    if not case.assembles:
+        monkeypatch.setattr(ancfdrv.runner, "build_model", built)
     argv, expect = _prepare(case, tmp_path)
     before = _snapshot(tmp_path)
     tracemalloc.start()

@@ -30,6 +30,7 @@ from .errors import AncfError, InputError, Interrupted
 from .history import luffing_stage_bounds, stage_summary
 from .interrupt import StopRequest, signal_name
 from .io import hdf5 as results
+from .io.general import locate_error
 from .io.lock import OutputLock, lock_path
 from .builders import build_model
 from .io.scene import PLATE_KINDS, Scene, load_scene
@@ -246,13 +247,23 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
     check_output_path(out, input_files(scene), xdmf=writes_xdmf(scene))
+    made = [p for p in (out.parent, *out.parent.parents) if not p.exists()]
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(f"cannot create the output directory {out.parent}: {exc.strerror}",
                          file=str(out)) from None
-    with OutputLock(out), StopRequest() as stop:
-        outcome = _run_locked(scene, out, start, progress, stop)
+    try:
+        with OutputLock(out), StopRequest() as stop:
+            outcome = _run_locked(scene, out, start, progress, stop)
+    except BaseException:
+        if not out.exists():  # refused before writing (bad input found late): leave no trace
+            for directory in made:
+                try:
+                    directory.rmdir()
+                except OSError:
+                    break
+        raise
     if stop.signum is not None:  # after the last step: the file is complete, the process stops
         raise Interrupted(f"interrupted by {signal_name(stop.signum)} after the run completed; "
                           f"{out} is complete (status 'ok')", signum=stop.signum)
@@ -286,6 +297,8 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
     except Interrupted as exc:
         raise Interrupted(f"interrupted by {signal_name(exc.signum)} before the output was "
                           f"written; {out} was not touched", signum=exc.signum) from None
+    except InputError as exc:  # found while assembling: name the scene file and the item
+        raise locate_error(exc, scene) from None
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
     static = dynamic = None
     stages: dict[str, float] = {}

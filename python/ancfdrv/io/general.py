@@ -6,6 +6,7 @@ file and the group, e.g. ``scene.nml: &joint[lift]: unknown body 'jib'``.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -162,6 +163,35 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
         s.probe(v["name"], v["body"], v["point"])
     else:  # the schema admits no other group
         raise AssertionError(group)
+
+
+_ITEM_WORDS = {"joint": "joint", "drive": "drive", "load": "load", "probe": "probe",
+               "contact": "contact", "beam": "beam", "plate": "plate", "leaf": "leaf",
+               "rigid body": "rigid_body", "material": "material", "body": None}
+_ITEM_PREFIX = re.compile(r"^(%s) '([^']*)'" % "|".join(_ITEM_WORDS))
+
+
+def locate_error(exc: InputError, scene) -> InputError:
+    """An InputError raised while a scene's model is assembled (a joint equation the
+    initial configuration violates, coinciding points, ...) with the scene file and, for
+    general scenes, the group[name] of the item its message starts with (``joint 'lift':
+    ...`` or an equation name ``lift: position``, ``lift #2: ...``)."""
+    if exc.file is not None:
+        return exc
+    message = str(exc)
+    group = None
+    if scene.kind == "general":
+        names = {(g, v["name"]) for g, v in scene.items}
+        match = _ITEM_PREFIX.match(message)
+        if match:
+            word, name = match.group(1), re.sub(r" #\d+$", "", match.group(2))
+            kinds = [_ITEM_WORDS[word]] if _ITEM_WORDS[word] else \
+                ["beam", "plate", "leaf", "rigid_body"]
+            group = next((f"{g}[{name}]" for g in kinds if (g, name) in names), None)
+        else:
+            head = re.sub(r" #\d+$", "", message.split(":", 1)[0])
+            group = next((f"{g}[{n}]" for g, n in sorted(names) if n == head), None)
+    return InputError(message, file=str(scene.path), group=group)
 
 
 def build_general(scene) -> BuiltSystem:

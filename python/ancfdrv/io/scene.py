@@ -20,7 +20,7 @@ from ..errors import InputError
 from . import validate
 from .schema import (COMMON_GROUPS, EFFECTS_AVAILABLE, EFFECTS_PLANNED, GENERAL_ONLY_GROUPS,
                      GENERAL_SCHEMA, GENERAL_SINGLE_GROUPS, MODEL_GROUPS, PLATE_KINDS, REQUIRED,
-                     SCHEMA, Key, coerce, points3, vector3)
+                     SCHEMA, WHOLE_LIST_CHECKS, Key, coerce)
 
 __all__ = ["Scene", "load_scene", "parse_address", "is_general", "SCHEMA", "GENERAL_SCHEMA",
            "EFFECTS_AVAILABLE", "MODEL_GROUPS", "PLATE_KINDS"]
@@ -176,7 +176,7 @@ def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str) -
         if spec.size is not None and len(value) != spec.size:
             raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
         if spec.check is not None:
-            whole = spec.check in (vector3, points3)
+            whole = spec.check in WHOLE_LIST_CHECKS
             items = [value] if whole or spec.kind != "floats" else value
             for item in items:
                 message = spec.check(item)

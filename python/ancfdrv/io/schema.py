@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from ..errors import InputError
-from .validate import check_int32
+from .validate import check_int32, check_magnitude, check_name
 
 REQUIRED = object()
 
@@ -262,7 +262,7 @@ def coerce(kind: str, raw: Any, where: dict) -> Any:
             raise bad("a number")
         if not math.isfinite(float(x)):
             raise bad("a finite number")
-        return float(x)
+        return check_magnitude(float(x), where)
 
     if kind == "float":
         return as_float(raw)
@@ -301,7 +301,11 @@ def points3(v: Any) -> str | None:
 
 
 def _name(doc: str = "a unique name of the item") -> Key:
-    return Key("str", doc=doc)
+    return Key("str", check=check_name, doc=doc)
+
+
+def principal_positive(v: Any) -> str | None:
+    return None if min(v[:3]) > 0 else "must have positive Ixx, Iyy and Izz"
 
 
 #: Repeatable, named groups of general scenes (SPEC section 8); list kinds are checked as a
@@ -366,7 +370,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
     "rigid_body": {
         "name": _name(),
         "mass": Key("float", check=positive, doc="mass (kg)"),
-        "inertia": Key("floats", size=6, doc="Ixx, Iyy, Izz, Ixy, Iyz, Ixz about the centre of "
+        "inertia": Key("floats", size=6, check=principal_positive, doc="Ixx, Iyy, Izz, Ixy, Iyz, Ixz about the centre of "
                        "mass, global axes at t = 0 (kg m^2)"),
         "position": Key("floats", check=vector3, doc="centre of mass at t = 0 (m)"),
         "planar": Key("bool", False, doc="kept in the plane normal to plane_normal"),
@@ -442,3 +446,5 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
 GENERAL_SINGLE_GROUPS = ("scene", "solver", "output")
 #: Groups only general scenes have.
 GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe")
+#: checks that take a list key's whole value (the others take each item)
+WHOLE_LIST_CHECKS = (vector3, points3, principal_positive)

@@ -17,7 +17,9 @@ for a named group of a general scene) and the key:
    namelist text (``7.791 / &beam nodes=7``) is refused. The same key given twice on the
    command line is refused (:func:`check_unique_overrides`).
 3. **Types and ranges** (the schema, :mod:`ancfdrv.io.schema`): every integer must fit the
-   kernel's 32-bit integers (:data:`INT32_MAX`), every real must be finite.
+   kernel's 32-bit integers (:data:`INT32_MAX`), every real must be finite and at most
+   :data:`MAX_MAGNITUDE` in magnitude (SI units), names of general scenes must be usable as
+   HDF5 names and command-line addresses (:func:`check_name`).
 4. **Time settings** of dynamic analyses (:func:`check_time`): ``t_end > 0``,
    ``MIN_DT <= dt <= t_end`` and ``t_end`` a whole number of steps (within a relative
    :data:`STEP_TOLERANCE`); otherwise the message names the nearest ``t_end`` values that
@@ -302,6 +304,33 @@ def check_int32(value: int, where: dict) -> int:
         raise InputError(f"{value} does not fit the kernel's 32-bit integers (at most "
                          f"{INT32_MAX})", **where)
     return value
+
+
+#: the largest magnitude of a real input (SI units): beyond it products such as E I or a
+#: squared length overflow; nothing the model describes comes near it
+MAX_MAGNITUDE = 1e20
+
+
+def check_magnitude(value: float, where: dict) -> float:
+    """A real whose magnitude the model can handle, else InputError."""
+    if abs(value) > MAX_MAGNITUDE:
+        raise InputError(f"{value:g} is beyond the largest magnitude accepted "
+                         f"({MAX_MAGNITUDE:g}; values are in SI units)", **where)
+    return value
+
+
+_NAME_FORBIDDEN = set("/[]")
+
+
+def check_name(name: str) -> str | None:
+    """Names of general scenes become HDF5 dataset names (probes) and command-line
+    addresses (``beam[NAME].nodes``): no '/', '[' or ']', no control characters, not '.'
+    or '..'. Returns the problem or None (a schema check)."""
+    if not name:
+        return "must not be empty"
+    if _NAME_FORBIDDEN & set(name) or any(ord(c) < 32 for c in name) or name in (".", ".."):
+        return "must not contain '/', '[', ']' or control characters, nor be '.' or '..'"
+    return None
 
 
 # -- 4. time settings --------------------------------------------------------------------
