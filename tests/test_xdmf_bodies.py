@@ -181,3 +181,24 @@ def test_sweep_cases_have_xdmf_naming_their_final_file(tmp_path):
         points, cells, frames = read_series(h5_path.with_suffix(".xdmf"))
         assert len(frames) == 11 and cells[0].type == "line"
     assert not list(out.glob(".*"))
+
+
+def test_a_failed_run_ends_its_motion_at_the_last_step(tmp_path):
+    """A run that fails between frames (exit 3 here) still shows its last computed step."""
+    from ancfdrv.errors import SolverError
+    out = tmp_path / "failed.h5"
+    with pytest.raises(SolverError):
+        run_scene(INPUTS / "hard" / "newton_failure.nml",
+                  ["output.xdmf_frames=101"], out, progress=False)
+    with h5py.File(out) as h5:
+        time = h5["dynamic/time"][()]
+        rows = h5["dynamic/mesh_rows"][()]
+        tip = h5["dynamic/probes/tip"][-1]
+        reference = h5["model/mesh/points"][()]
+        assert h5.attrs["status"] == "failed"
+    # 10001 rows planned in at most 101 frames: every 100th row; the run failed between two
+    assert len(time) % 100 != 1
+    np.testing.assert_array_equal(rows, list(range(0, len(time), 100)) + [len(time) - 1])
+    _, _, frames = read_series(out.with_suffix(".xdmf"))
+    assert frames[-1][0] == time[-1]
+    np.testing.assert_allclose(reference[-1] + frames[-1][1][-1], tip, atol=1e-12)  # the tip

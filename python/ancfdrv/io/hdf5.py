@@ -271,9 +271,35 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
         if "dynamic" in h5:
             h5["dynamic"].attrs["status"] = status
         has_motion = "dynamic/mesh_nodes" in h5 and len(h5["dynamic/time"]) > 0
+        if has_motion:
+            _last_frame(h5, model)
     if has_motion:
         from .xdmf import write_xdmf
         write_xdmf(path)
+
+
+def _last_frame(h5: h5py.File, model: Model) -> None:
+    """A run that stopped (failure, interrupt) between XDMF frames: its last row becomes
+    a frame too (from the stored q), so the motion ends where the run ended."""
+    from .xdmf import MeshLayout, add_step_views
+    group = h5["dynamic"]
+    last = len(group["time"]) - 1
+    if "mesh_rows" not in group or "q" not in group or len(group["q"]) != last + 1:
+        return
+    rows = group["mesh_rows"]
+    if len(rows) and rows[-1] >= last:
+        return
+    layout = MeshLayout.from_model(model)
+    if layout is None or layout.npoints != group["mesh_nodes"].shape[1]:
+        return
+    nodes = layout.positions(model, group["q"][last:last + 1])
+    k = len(rows)
+    for name, values in (("mesh_nodes", nodes),
+                         ("mesh_displacement", nodes - layout.points[None, :, :]),
+                         ("mesh_rows", np.array([last]))):
+        group[name].resize(k + 1, axis=0)
+        group[name][k:] = values
+    add_step_views(h5, k, k + 1)
 
 
 def _text(value: Any) -> Any:
