@@ -83,14 +83,23 @@ def wait_for_rows(path: Path, proc: subprocess.Popen, rows: int) -> int:
 
 
 def assert_consistent_dynamic(path: Path, dt: float) -> int:
-    """Every /dynamic series has the same length; time advances by dt per row."""
+    """Every /dynamic series has the same length; time advances by dt per row. The XDMF
+    frames (mesh_*, one per frame, and their views under xdmf/) are consistent among
+    themselves and name rows that were written."""
+    frames = ("mesh_nodes", "mesh_displacement", "mesh_rows")
     with h5py.File(path, "r") as h5:
         group = h5["dynamic"]
         t = group["time"][()]
         lengths = set()
         group.visititems(lambda name, obj: lengths.add(obj.shape[0])
-                         if isinstance(obj, h5py.Dataset) and obj.ndim else None)
+                         if isinstance(obj, h5py.Dataset) and obj.ndim and name not in frames
+                         and not name.startswith("xdmf/") else None)
         assert lengths == {len(t)}
+        if "mesh_rows" in group:
+            rows = group["mesh_rows"][()]
+            assert {group[name].shape[0] for name in frames} == {len(rows)}
+            assert len(rows) and rows[0] == 0 and np.all(np.diff(rows) > 0)
+            assert rows[-1] < len(t)
         assert np.allclose(np.diff(t), dt, rtol=0, atol=1e-9)
         assert group.attrs["rows"] == len(t)
         return len(t)
@@ -183,7 +192,7 @@ def test_a_previous_result_survives_a_refused_run(scene, tmp_path, capsys):
 
 def test_second_writer_is_refused_naming_the_first(scene, tmp_path, capsys):
     out = tmp_path / "shared.h5"
-    first = ancf("run", str(scene), "-o", str(out), *LONG[:-4], "--set", "beam.nodes=10",
+    first = ancf("run", str(scene), "-o", str(out), *LONG[2:-4], "--set", "beam.nodes=10",
                  "--set", "solver.t_end=4")
     wait_for_rows(out, first, 2)
     err = refused(capsys, ["run", str(scene), "-o", str(out), *TINY],

@@ -169,7 +169,7 @@ def test_ctrl_c_reports_what_finished_and_exits_130(tmp_path):
     the queued ones 'cancelled', the report written, exit 130."""
     out = tmp_path / "s"
     cmd = [sys.executable, "-m", "ancfdrv.cli", "sweep", str(INPUTS / "boom_luffing.nml"),
-           "--vary", "solver.dt=0.01,5e-5,5.1e-5,5.2e-5", "--set", "beam.nodes=4",
+           "--vary", "solver.dt=0.01,5e-5,4e-5,2e-5", "--set", "beam.nodes=4",
            "--workers", "2", "-o", str(out)]
     # a shell may start background jobs with SIGINT ignored; the user's terminal does not
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -190,14 +190,14 @@ def test_ctrl_c_reports_what_finished_and_exits_130(tmp_path):
     assert len(lines) == 1 and lines[0].startswith("ancf sweep: interrupted: 1 of 4 cases"), stderr
     rows = read_csv(out / "summary.csv")
     assert rows["dt-0.01"]["status"] == "ok" and float(rows["dt-0.01"]["steps"]) == 1000
-    # dt-5.1e-5 starts on the worker dt-0.01 frees, just after that file appears
+    # dt-4e-5 starts on the worker dt-0.01 frees, just after that file appears
     assert rows["dt-5e-5"]["status"] == "interrupted"
-    assert rows["dt-5.1e-5"]["status"] in ("interrupted", "cancelled")
-    assert rows["dt-5.2e-5"]["status"] == "cancelled"
-    assert all(rows[c]["exit_code"] == "130" for c in ("dt-5e-5", "dt-5.1e-5", "dt-5.2e-5"))
+    assert rows["dt-4e-5"]["status"] in ("interrupted", "cancelled")
+    assert rows["dt-2e-5"]["status"] == "cancelled"
+    assert all(rows[c]["exit_code"] == "130" for c in ("dt-5e-5", "dt-4e-5", "dt-2e-5"))
     summary = (out / "summary.md").read_text()
     assert re.search(r"4 cases, 1 ok, [12] interrupted, [12] cancelled\.", summary)
-    assert "dt-5.2e-5 (cancelled, exit 130): cancelled by Ctrl-C before it started" in summary
+    assert "dt-2e-5 (cancelled, exit 130): cancelled by Ctrl-C before it started" in summary
     assert (out / "histories.png").exists()
     assert not list(out.glob(".*part*"))
 

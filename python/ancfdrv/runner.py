@@ -30,6 +30,7 @@ from .errors import AncfError, InputError, Interrupted
 from .history import luffing_stage_bounds, stage_summary
 from .interrupt import StopRequest, signal_name
 from .io import hdf5 as results
+from .io.general import locate_error
 from .io.lock import OutputLock, lock_path
 from .builders import build_model
 from .io.scene import PLATE_KINDS, Scene, load_scene
@@ -114,8 +115,8 @@ def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = Fa
     Refused: a directory; a path below a regular file; a directory without write
     permission; an input file (compared as files: same inode, symbolic links followed),
     also through the plot or XDMF written beside the result; an existing file that is
-    neither empty nor HDF5 (never overwritten); for plate models (``xdmf``) a ':' in the
-    file name, which XDMF cannot express.
+    neither empty nor HDF5 (never overwritten); when the run writes XDMF (``xdmf``) a ':'
+    in the file name, which XDMF cannot express.
     """
     out = Path(out)
     if out.name in ("", ".", ".."):
@@ -129,7 +130,7 @@ def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = Fa
                              "the result under that name (use .h5)", file=str(out))
     if xdmf and ":" in out.name:
         raise InputError("the file name must not contain ':' (the XDMF description cannot "
-                         "name such a file)", file=str(out))
+                         "name such a file; or set output.xdmf = .false.)", file=str(out))
     derived = {out: "the output", out.with_suffix(".png"): "the plot written beside it",
                out.with_suffix(".xdmf"): "the XDMF written beside it",
                lock_path(out): "its lock file"}
@@ -156,10 +157,17 @@ def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = Fa
 
 
 def has_plates(scene: Scene) -> bool:
-    """Whether the scene's model has plates or leaves (its runs write XDMF)."""
+    """Whether the scene's model has plates or leaves."""
     if scene.kind == "general":
         return any(group in ("plate", "leaf") for group, _ in scene.items)
     return scene.kind in PLATE_KINDS
+
+
+def writes_xdmf(scene: Scene) -> bool:
+    """Whether a run of the scene writes the XDMF description (dynamic runs with
+    output.xdmf, the default)."""
+    return (scene["scene"]["analysis"] != "static"
+            and bool(scene["output"].get("xdmf", True)))
 
 
 def dynamic_settings(scene: Scene) -> DynamicSettings:
@@ -217,9 +225,13 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
     settings = dynamic_settings(scene)
-    if model.plate_bodies():
+    xdmf = scene["output"].get("xdmf", True)
+    if xdmf:
         settings.store_q = True  # the node positions for ParaView (XDMF) come from q
-    writer = results.DynamicWriter(out, model, settings.store_q, settings.chunk_steps)
+    writer = results.DynamicWriter(
+        out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
+        total_rows=int(round(settings.t_end / settings.dt)) + 1,
+        frames=scene["output"].get("xdmf_frames", 1000))
     attrs: dict[str, Any] = {
         "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
         "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
@@ -262,14 +274,24 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
     """Run a loaded scene (see :func:`run_scene`)."""
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
-    check_output_path(out, input_files(scene), xdmf=has_plates(scene))
+    check_output_path(out, input_files(scene), xdmf=writes_xdmf(scene))
+    made = [p for p in (out.parent, *out.parent.parents) if not p.exists()]
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise InputError(f"cannot create the output directory {out.parent}: {exc.strerror}",
                          file=str(out)) from None
-    with OutputLock(out), StopRequest() as stop:
-        outcome = _run_locked(scene, out, start, progress, stop)
+    try:
+        with OutputLock(out), StopRequest() as stop:
+            outcome = _run_locked(scene, out, start, progress, stop)
+    except BaseException:
+        if not out.exists():  # refused before writing (bad input found late): leave no trace
+            for directory in made:
+                try:
+                    directory.rmdir()
+                except OSError:
+                    break
+        raise
     if stop.signum is not None:  # after the last step: the file is complete, the process stops
         raise Interrupted(f"interrupted by {signal_name(stop.signum)} after the run completed; "
                           f"{out} is complete (status 'ok')", signum=stop.signum)
@@ -303,6 +325,8 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
     except Interrupted as exc:
         raise Interrupted(f"interrupted by {signal_name(exc.signum)} before the output was "
                           f"written; {out} was not touched", signum=exc.signum) from None
+    except InputError as exc:  # found while assembling: name the scene file and the item
+        raise locate_error(exc, scene) from None
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
     static = dynamic = None
     stages: dict[str, float] = {}

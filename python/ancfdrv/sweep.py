@@ -397,16 +397,24 @@ def store_case_file(case: Case, sweep_id: str, data: bytes | None = None, *,
     final path, or '' when the case left no readable file."""
     if data is not None:
         case.part.write_bytes(data)
+    stale = case.part.with_suffix(".xdmf")  # names the part file: rewritten below
     if not case.part.is_file():
+        remove_quietly(stale)
         return ""
     try:
         with h5py.File(case.part, "a") as h5:
             h5.attrs["sweep_id"] = sweep_id
             if scene_file:
                 h5.attrs["scene_file"] = scene_file
+            motion = "dynamic/mesh_nodes" in h5 and len(h5["dynamic/time"]) > 0
     except OSError:  # a file its killed process left half-written
         remove_quietly(case.part)
+        remove_quietly(stale)
         return ""
+    remove_quietly(stale)
+    if motion:  # written for the final name before the file appears there
+        from .io.xdmf import write_xdmf
+        write_xdmf(case.part, as_name=case.output)
     os.replace(case.part, case.output)
     return str(case.output)
 

@@ -6,6 +6,7 @@ file and the group, e.g. ``scene.nml: &joint[lift]: unknown body 'jib'``.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -86,11 +87,43 @@ def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:
     elif kind == "table":
         if v["file"] is not None:
             path = Path(v["file"])
-            s.drive(v["name"], "table", file=path if path.is_absolute() else scene_dir / path)
+            path = path if path.is_absolute() else scene_dir / path
+            _check_text_file(path)
+            s.drive(v["name"], "table", file=path)
         else:
             s.drive(v["name"], "table", times=v["times"], values=v["values"] or [])
     else:
         s.drive(v["name"], kind, **{_DRIVE_KEYS[kind][k]: v[k] for k in given})
+
+
+def _check_text_file(path: Path) -> None:
+    """A table's CSV file must be UTF-8 text (the CSV reader would fail on the bytes)."""
+    if not path.is_file():
+        return  # the drive reports the missing file
+    try:
+        path.read_bytes().decode("utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot read the table file {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"the table file {str(path)!r} is not a text file (byte {exc.start} "
+                         "is not UTF-8)") from None
+
+
+def _check_joint_points(s: System, scene) -> None:
+    """Every joint point is a node of the beams, plates and leaves it joins (a material
+    point of rigid bodies), checked now so that the message names the file and the joint;
+    the assembly makes the same check when it writes the joint's equations."""
+    for joint in s.joints.values():
+        points = [joint.point1, joint.point2] if joint.type == "distance" else joint.points
+        bodies = [joint.body1, joint.body2] if joint.type == "distance" else None
+        try:
+            for k, point in enumerate(points):
+                for body in (bodies[k],) if bodies else joint.bodies:
+                    if body.name != "ground":
+                        joint._locate(body, point)
+        except InputError as exc:
+            raise InputError(str(exc), file=str(scene.path),
+                             group=f"joint[{joint.name}]") from None
 
 
 def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> None:
@@ -134,6 +167,35 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
         raise AssertionError(group)
 
 
+_ITEM_WORDS = {"joint": "joint", "drive": "drive", "load": "load", "probe": "probe",
+               "contact": "contact", "beam": "beam", "plate": "plate", "leaf": "leaf",
+               "rigid body": "rigid_body", "material": "material", "body": None}
+_ITEM_PREFIX = re.compile(r"^(%s) '([^']*)'" % "|".join(_ITEM_WORDS))
+
+
+def locate_error(exc: InputError, scene) -> InputError:
+    """An InputError raised while a scene's model is assembled (a joint equation the
+    initial configuration violates, coinciding points, ...) with the scene file and, for
+    general scenes, the group[name] of the item its message starts with (``joint 'lift':
+    ...`` or an equation name ``lift: position``, ``lift #2: ...``)."""
+    if exc.file is not None:
+        return exc
+    message = str(exc)
+    group = None
+    if scene.kind == "general":
+        names = {(g, v["name"]) for g, v in scene.items}
+        match = _ITEM_PREFIX.match(message)
+        if match:
+            word, name = match.group(1), re.sub(r" #\d+$", "", match.group(2))
+            kinds = [_ITEM_WORDS[word]] if _ITEM_WORDS[word] else \
+                ["beam", "plate", "leaf", "rigid_body"]
+            group = next((f"{g}[{name}]" for g in kinds if (g, name) in names), None)
+        else:
+            head = re.sub(r" #\d+$", "", message.split(":", 1)[0])
+            group = next((f"{g}[{n}]" for g, n in sorted(names) if n == head), None)
+    return InputError(message, file=str(scene.path), group=group)
+
+
 def build_general(scene) -> BuiltSystem:
     """The System of a general scene (its groups in file order)."""
     s = System(scene["scene"]["title"], effects=scene.effects)
@@ -147,6 +209,7 @@ def build_general(scene) -> BuiltSystem:
         except InputError as exc:
             raise InputError(str(exc), file=str(scene.path),
                              group=f"{group}[{values['name']}]") from None
+    _check_joint_points(s, scene)
     response = None
     if scene["scene"].get("response"):
         name = scene["scene"]["response"]

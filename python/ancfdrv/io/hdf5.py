@@ -271,9 +271,35 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
         if "dynamic" in h5:
             h5["dynamic"].attrs["status"] = status
         has_motion = "dynamic/mesh_nodes" in h5 and len(h5["dynamic/time"]) > 0
+        if has_motion:
+            _last_frame(h5, model)
     if has_motion:
         from .xdmf import write_xdmf
         write_xdmf(path)
+
+
+def _last_frame(h5: h5py.File, model: Model) -> None:
+    """A run that stopped (failure, interrupt) between XDMF frames: its last row becomes
+    a frame too (from the stored q), so the motion ends where the run ended."""
+    from .xdmf import MeshLayout, add_step_views
+    group = h5["dynamic"]
+    last = len(group["time"]) - 1
+    if "mesh_rows" not in group or "q" not in group or len(group["q"]) != last + 1:
+        return
+    rows = group["mesh_rows"]
+    if len(rows) and rows[-1] >= last:
+        return
+    layout = MeshLayout.from_model(model)
+    if layout is None or layout.npoints != group["mesh_nodes"].shape[1]:
+        return
+    nodes = layout.positions(model, group["q"][last:last + 1])
+    k = len(rows)
+    for name, values in (("mesh_nodes", nodes),
+                         ("mesh_displacement", nodes - layout.points[None, :, :]),
+                         ("mesh_rows", np.array([last]))):
+        group[name].resize(k + 1, axis=0)
+        group[name][k:] = values
+    add_step_views(h5, k, k + 1)
 
 
 def _text(value: Any) -> Any:
@@ -348,16 +374,25 @@ class DynamicWriter:
     """
 
     def __init__(self, path: Path, model: Model, store_q: bool,
-                 flush_rows: int = 1) -> None:
+                 flush_rows: int = 1, *, xdmf: bool | None = None, total_rows: int = 0,
+                 frames: int = 1000) -> None:
+        """``xdmf``: write the node positions of every body for the XDMF description
+        (needs ``store_q``; None: for models with plates, as before), at most ``frames``
+        of the ``total_rows`` rows the run will write (:func:`~.xdmf.frame_rows`)."""
         from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
+        from .xdmf import MeshLayout, frame_rows, write_layout
         self.path, self.names, self.store_q = path, list(model.probes), store_q
         self.flush_rows = max(1, int(flush_rows))
-        self.node_positions = model.node_positions if model.plate_bodies() else None
+        self.model = model
         self.npoints = model.npoint
         self.contact_fields = CONTACT_FIELDS
-        geometry = model.plate_geometry()
-        self.nnodes = len(geometry[0]) if geometry is not None and store_q else 0
-        self.reference_nodes = geometry[0] if self.nnodes else None
+        if xdmf is None:
+            xdmf = bool(model.plate_bodies())
+        self.layout = MeshLayout.from_model(model) if xdmf and store_q else None
+        self.nnodes = self.layout.npoints if self.layout is not None else 0
+        self.stride, self.last_row = frame_rows(total_rows, frames) if total_rows > 0 \
+            else (1, -1)
+        self.frames = 0
         self.energy_names = ENERGY_NAMES
         self.rows = 0
         self._pending: list[Any] = []
@@ -399,12 +434,16 @@ class DynamicWriter:
                 group["contact"].attrs["points"] = "\n".join(model.contact_point_names)
             if store_q:
                 series("q", COORDINATE_UNITS, (ndof,))
-            if self.nnodes:  # plate models: node positions per step, for ParaView (XDMF)
+            if self.nnodes:  # points of every body per frame, for ParaView (XDMF)
+                write_layout(h5, self.layout)
                 for name in ("mesh_nodes", "mesh_displacement"):
                     data = group.create_dataset(name, shape=(0, self.nnodes, 3),
                                                 maxshape=(None, self.nnodes, 3), dtype="f8",
                                                 chunks=(16, self.nnodes, 3))
                     data.attrs["units"] = "m"
+                series("mesh_rows", "index", dtype="i8")
+                group["mesh_rows"].attrs["description"] = (
+                    "the row of /dynamic/time of each row of mesh_nodes (XDMF frames)")
 
     def __call__(self, chunk) -> None:
         self._pending.append(chunk)
@@ -419,13 +458,13 @@ class DynamicWriter:
             return
         with _open_write(self.path) as h5:
             group = h5["dynamic"]
-            first = self.rows
+            first = self.frames
             for chunk in self._pending:
                 self._append(group, chunk)
             group.attrs["rows"] = np.int64(self.rows)
-            if self.nnodes:  # the per-step views the XDMF description names
+            if self.nnodes:  # the per-frame views the XDMF description names
                 from .xdmf import add_step_views
-                add_step_views(h5, first, self.rows)
+                add_step_views(h5, first, self.frames)
         self._pending, self._pending_rows = [], 0
         self._last_write = time.monotonic()
 
@@ -459,11 +498,24 @@ class DynamicWriter:
         if self.store_q and chunk.q is not None:
             append("q", chunk.q)
             if self.nnodes:
-                nodes = (self.node_positions(chunk.q) if self.node_positions is not None
-                         else chunk.q.reshape(n, self.nnodes, -1)[:, :, :3])
-                append("mesh_nodes", nodes)
-                append("mesh_displacement", nodes - self.reference_nodes[None, :, :])
+                self._append_frames(group, chunk.q)
         self.rows += n
+
+    def _append_frames(self, group: h5py.Group, q: np.ndarray) -> None:
+        """The points' positions at the chunk's frame rows (every stride-th and the last)."""
+        rows = self.rows + np.arange(len(q))
+        pick = (rows % self.stride == 0) | (rows == self.last_row)
+        if not pick.any():
+            return
+        nodes = self.layout.positions(self.model, q[pick])
+        k = self.frames
+        for name, values in (("mesh_nodes", nodes),
+                             ("mesh_displacement", nodes - self.layout.points[None, :, :]),
+                             ("mesh_rows", rows[pick])):
+            data = group[name]
+            data.resize(k + len(values), axis=0)
+            data[k:] = values
+        self.frames += len(nodes)
 
 
 def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, float]) -> None:

@@ -17,9 +17,10 @@ from typing import Any, Callable
 import f90nml
 
 from ..errors import InputError
+from . import validate
 from .schema import (COMMON_GROUPS, EFFECTS_AVAILABLE, EFFECTS_PLANNED, GENERAL_ONLY_GROUPS,
                      GENERAL_SCHEMA, GENERAL_SINGLE_GROUPS, MODEL_GROUPS, PLATE_KINDS, REQUIRED,
-                     SCHEMA, Key, coerce, points3, vector3)
+                     SCHEMA, WHOLE_LIST_CHECKS, Key, coerce)
 
 __all__ = ["Scene", "load_scene", "parse_address", "is_general", "SCHEMA", "GENERAL_SCHEMA",
            "EFFECTS_AVAILABLE", "MODEL_GROUPS", "PLATE_KINDS"]
@@ -73,17 +74,9 @@ class Scene:
 
 
 def _parse_override_value(kind: str, text: str, where: dict) -> Any:
-    """Parse the VALUE of --set GROUP.KEY=VALUE, typed like the namelist entry."""
-    text = text.strip()
-    if kind == "strs":  # an empty value is the empty list
-        return [t.strip().strip("'\"") for t in text.split(",") if t.strip().strip("'\"")]
-    if kind == "str":
-        return text.strip("'\"")
-    try:
-        parsed = f90nml.reads(f"&x v = {text} /")["x"]["v"]
-    except Exception as exc:  # f90nml raises several types
-        raise InputError(f"cannot parse override value {text!r}: {exc}", **where) from None
-    return parsed
+    """Parse the VALUE of --set GROUP.KEY=VALUE: one value of the key's type, written as
+    in a namelist (:func:`ancfdrv.io.validate.parse_value`)."""
+    return validate.parse_value(kind, text, where)
 
 
 def is_general(nml: f90nml.Namelist) -> bool:
@@ -160,7 +153,7 @@ def _apply_override(nml: f90nml.Namelist, item: str, general: bool, file: str) -
         instances[0][key] = parsed
     else:
         nml[group] = f90nml.Namelist({key: parsed})
-    return f"{dotted.strip()}={value}"
+    return f"{dotted.strip()}={value.strip()}"
 
 
 def _schema_of(group: str, general: bool) -> dict[str, Key] | None:
@@ -183,7 +176,7 @@ def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str) -
         if spec.size is not None and len(value) != spec.size:
             raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
         if spec.check is not None:
-            whole = spec.check in (vector3, points3)
+            whole = spec.check in WHOLE_LIST_CHECKS
             items = [value] if whole or spec.kind != "floats" else value
             for item in items:
                 message = spec.check(item)
@@ -198,18 +191,50 @@ def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str) -
     return typed
 
 
+def _read_text(path: Path, file: str) -> str:
+    if not path.exists():
+        raise InputError("scene file not found", file=file)
+    if not path.is_file():
+        raise InputError("the scene is not a regular file", file=file)
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read the scene file: {exc.strerror}", file=file) from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not a text file (byte {exc.start} is not UTF-8)", file=file) from None
+
+
+def _override_addresses(overrides: list[str], file: str) -> None:
+    """The same GROUP.KEY (or GROUP[NAME].KEY) given twice on the command line."""
+    addresses = []
+    for item in overrides:
+        dotted = item.split("=", 1)[0]
+        try:
+            group, name, key = parse_address(dotted)
+        except ValueError:
+            continue  # reported when the override is applied
+        addresses.append((group, name, key, item))
+    validate.check_unique_overrides(addresses, file)
+
+
 def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     """Read, override and validate a scene file (template or general). Raises InputError
-    on any problem."""
+    on any problem; every rule is applied before anything is built (the rules:
+    :mod:`ancfdrv.io.validate`)."""
     path = Path(path)
     file = str(path)
-    if not path.is_file():
-        raise InputError("scene file not found", file=file)
+    text = _read_text(path, file)
     try:
-        nml = f90nml.read(str(path))
-    except Exception as exc:
-        raise InputError(f"not a valid Fortran namelist: {exc}", file=file) from None
+        nml = f90nml.reads(text)
+    except Exception as exc:  # f90nml raises several types
+        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
     general = is_general(nml)
+    validate.check_repeats(file, validate.scan_groups(text),
+                           GENERAL_SCHEMA if general else ())
+    _override_addresses(overrides or [], file)
     seen: Counter = Counter()
     for group, _ in nml.items():  # a repeated group comes once per occurrence
         if _schema_of(group, general) is None:
@@ -248,6 +273,9 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
                 raise InputError("required group is missing", file=file, group=group)
             values[group] = {k: s.default for k, s in SCHEMA[group].items()}
     _check_consistency(values, file, kind)
+    validate.check_time(values["solver"], values["scene"]["analysis"], file)
+    validate.check_resources(validate.estimate_template(values, kind), file, values["solver"],
+                             values["scene"]["analysis"])
     buffer = io.StringIO()
     nml.write(buffer)
     return Scene(path=path, values=values, text=buffer.getvalue(), overrides=applied)
@@ -288,6 +316,9 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scen
     if not listed:
         values["scene"]["effects"] = sorted(effects_of(items))
     _check_general(values, file, {e for e in effects_of(items)})
+    validate.check_time(values["solver"], values["scene"]["analysis"], file)
+    validate.check_resources(validate.estimate_general(items), file, values["solver"],
+                             values["scene"]["analysis"])
     build_general(scene)  # every name, reference and value checked, no kernel work
     return scene
 

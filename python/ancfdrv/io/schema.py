@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from ..errors import InputError
+from .validate import check_int32, check_magnitude, check_name
 
 REQUIRED = object()
 #: the material damping key (both schemas)
@@ -57,6 +58,12 @@ def within(lo: float, hi: float, *, open_hi: bool = False) -> Callable[[Any], st
     def check(v: Any) -> str | None:
         ok = lo <= v < hi if open_hi else lo <= v <= hi
         return None if ok else f"must lie in [{lo}, {hi}{')' if open_hi else ']'}"
+    return check
+
+
+def at_least(n: int) -> Callable[[Any], str | None]:
+    def check(v: Any) -> str | None:
+        return None if v >= n else f"must be at least {n}"
     return check
 
 
@@ -235,6 +242,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "q": Key("bool", False, doc="store the coordinates q at every step"),
         "chunk_steps": Key("int", 1000, positive,
                            "steps per kernel call; each chunk is flushed to the file"),
+        "xdmf": Key("bool", True, doc="dynamic runs: write OUT.xdmf beside the result, the "
+                    "motion of every body for ParaView (plates as quadrilaterals, beams as "
+                    "polylines, rigid bodies as their centre and axes); stores q"),
+        "xdmf_frames": Key("int", 1000, at_least(2), "the most frames the XDMF holds: longer "
+                           "runs show every k-th step (and the last)"),
     },
 }
 
@@ -247,23 +259,24 @@ COMMON_GROUPS = ("scene", "material", "loads", "solver", "output")
 
 def coerce(kind: str, raw: Any, where: dict) -> Any:
     def bad(expected: str) -> InputError:
-        return InputError(f"expected {expected}, got {raw!r}", **where)
+        got = "no value" if raw is None else repr(raw)
+        return InputError(f"expected {expected}, got {got}", **where)
 
     def as_float(x: Any) -> float:
         if isinstance(x, bool) or not isinstance(x, (int, float)):
             raise bad("a number")
         if not math.isfinite(float(x)):
             raise bad("a finite number")
-        return float(x)
+        return check_magnitude(float(x), where)
 
     if kind == "float":
         return as_float(raw)
     if kind == "int":
         if isinstance(raw, bool) or not isinstance(raw, int):
-            if isinstance(raw, float) and raw.is_integer():
-                return int(raw)
-            raise bad("an integer")
-        return raw
+            if not (isinstance(raw, float) and raw.is_integer()):
+                raise bad("an integer")
+            raw = int(raw)
+        return check_int32(raw, where)
     if kind == "str":
         if not isinstance(raw, str):
             raise bad("a string")
@@ -292,14 +305,12 @@ def points3(v: Any) -> str | None:
         f"must be x, y, z (or several points: a multiple of 3 numbers), got {len(v)} numbers"
 
 
-def at_least(n: int) -> Callable[[Any], str | None]:
-    def check(v: Any) -> str | None:
-        return None if v >= n else f"must be at least {n}"
-    return check
-
-
 def _name(doc: str = "a unique name of the item") -> Key:
-    return Key("str", doc=doc)
+    return Key("str", check=check_name, doc=doc)
+
+
+def principal_positive(v: Any) -> str | None:
+    return None if min(v[:3]) > 0 else "must have positive Ixx, Iyy and Izz"
 
 
 #: Repeatable, named groups of general scenes (SPEC section 8); list kinds are checked as a
@@ -365,7 +376,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
     "rigid_body": {
         "name": _name(),
         "mass": Key("float", check=positive, doc="mass (kg)"),
-        "inertia": Key("floats", size=6, doc="Ixx, Iyy, Izz, Ixy, Iyz, Ixz about the centre of "
+        "inertia": Key("floats", size=6, check=principal_positive, doc="Ixx, Iyy, Izz, Ixy, Iyz, Ixz about the centre of "
                        "mass, global axes at t = 0 (kg m^2)"),
         "position": Key("floats", check=vector3, doc="centre of mass at t = 0 (m)"),
         "planar": Key("bool", False, doc="kept in the plane normal to plane_normal"),
@@ -441,3 +452,5 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
 GENERAL_SINGLE_GROUPS = ("scene", "solver", "output")
 #: Groups only general scenes have.
 GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe")
+#: checks that take a list key's whole value (the others take each item)
+WHOLE_LIST_CHECKS = (vector3, points3, principal_positive)

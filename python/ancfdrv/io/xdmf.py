@@ -1,28 +1,176 @@
-"""XDMF descriptions of result files, for ParaView (and meshio).
+"""XDMF descriptions of result files, for ParaView (and meshio): every body of the model.
 
-The XDMF 3 file beside ``OUT.h5`` is a temporal collection with one uniform grid per
-output step. Every DataItem is a plain ``Format="HDF"`` item naming one dataset, which is
-what both ParaView's XDMF 3 reader and meshio's ``meshio.xdmf.TimeSeriesReader``
-understand (meshio reads neither HyperSlab nor Function items). The per-step items are
-HDF5 virtual datasets, ``/dynamic/xdmf/position/<k>`` and ``/dynamic/xdmf/displacement/<k>``,
-that map row k of ``/dynamic/mesh_nodes`` and ``/dynamic/mesh_displacement``: no data is
-copied (the dynamic writer adds them as rows are written, :func:`add_step_views`). The XML is built with ElementTree, so any file name (``&``, ``<``, quotes)
-gives valid XML; a ``:`` in the HDF5 file name cannot be expressed in XDMF's
-``file:/path`` notation and is refused.
+The XDMF 3 file beside ``OUT.h5`` is a temporal collection with one uniform grid per frame
+(an output step; long runs are thinned to at most ``output.xdmf_frames`` frames, evenly,
+always with the first and the last step). The grid shows
+
+* plates and leaves as quadrilaterals (the elements' corner nodes), as before;
+* beams as polylines: a 2-node line per element through the node positions r;
+* rigid bodies as their centre r with their body axes: three lines from the centre along
+  r_x, r_y, r_z, as long as the body's radius of gyration sqrt(tr(I) / 2m). (A lone point
+  is not used: in a ``Mixed`` topology VTK reads a Polyvertex with a node count and meshio
+  without one, so no vertex encoding works for both readers.)
+
+With one kind of cell the topology is ``Quadrilateral`` or ``Polyline`` (2 nodes per line);
+with several it is ``Mixed`` (quad: 5 a b c d, line: 2 2 a b). The points' positions come
+from the stored coordinates: q of each step expanded to the full coordinates
+(:meth:`Model.expand`) and mapped by the sparse matrix of :class:`MeshLayout`.
+
+Every DataItem is a plain ``Format="HDF"`` item naming one dataset, which is what both
+ParaView's XDMF 3 reader and meshio's ``meshio.xdmf.TimeSeriesReader`` understand (meshio
+reads neither HyperSlab nor Function items). The per-frame items are HDF5 virtual datasets,
+``/dynamic/xdmf/position/<k>`` and ``/dynamic/xdmf/displacement/<k>``, that map row k of
+``/dynamic/mesh_nodes`` and ``/dynamic/mesh_displacement``: no data is copied (the dynamic
+writer adds them as frames are written, :func:`add_step_views`). meshio reads the geometry
+of the first frame only: the motion is in the ``displacement`` attribute of every frame.
+The XML is built with ElementTree, so any file name (``&``, ``<``, quotes) gives valid XML;
+a ``:`` in the HDF5 file name cannot be expressed in XDMF's ``file:/path`` notation and is
+refused.
 """
 from __future__ import annotations
 
+import math
 import os
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
 import numpy as np
+import scipy.sparse as sp
 from h5py import h5a, h5d, h5p, h5s, h5t
 
 from ..errors import InputError
+from ..system.bodies import Beam, Plate, RigidBody
 
 _STEPS_GROUP = "dynamic/xdmf"
+#: XDMF cell codes of a Mixed topology
+_QUAD, _LINE = 5, 2
+
+
+@dataclass
+class MeshLayout:
+    """The points and cells XDMF shows for a model, and the map from full coordinates to
+    the points' positions."""
+
+    points: np.ndarray        # (npoints, 3) initial positions
+    quads: np.ndarray         # (nquad, 4) point indices
+    lines: np.ndarray         # (nline, 2) point indices
+    map: sp.csr_matrix        # (3 npoints, nfull): positions = map @ q_full
+    bodies: list[str]         # 'name: kind, points a..b' per body shown
+
+    @classmethod
+    def from_model(cls, model) -> "MeshLayout | None":
+        """The layout of every plate (first, in the order of ``model.plate_geometry``),
+        beam and rigid body of the model; None when it has none of them."""
+        rows: list[int] = []
+        cols: list[int] = []
+        coefs: list[float] = []
+        quads, lines, bodies = [], [], []
+        count = 0
+
+        def point(terms: list[tuple[int, float]]) -> int:
+            """A new point at sum coef * q[first + (0, 1, 2)]; returns its index."""
+            nonlocal count
+            for first, coef in terms:
+                for axis in range(3):
+                    rows.append(3 * count + axis)
+                    cols.append(first + axis)
+                    coefs.append(coef)
+            count += 1
+            return count - 1
+
+        def node_points(first: int, nnodes: int, stride: int) -> int:
+            start = count
+            for node in range(nnodes):
+                point([(first + stride * node, 1.0)])
+            return start
+
+        kinds = ((Plate, "plate"), (Beam, "beam"), (RigidBody, "rigid body"))
+        for body_type, word in kinds:
+            for body in [b for b in model.bodies if isinstance(b, body_type)]:
+                start = count
+                if isinstance(body, Plate):
+                    base = node_points(body.first, body.mesh.nnodes, 9)
+                    quads.append(body.mesh.elements + base)
+                    word = "leaf" if type(body).__name__ == "Leaf" else "plate"
+                elif isinstance(body, Beam):
+                    base = node_points(body.first, body.nodes, 12)
+                    nodes = base + np.arange(body.nodes)
+                    lines.append(np.column_stack([nodes[:-1], nodes[1:]]))
+                else:
+                    size = _display_length(body)
+                    centre = point([(body.first, 1.0)])
+                    for k in (1, 2, 3):  # r + size r_x, r + size r_y, r + size r_z
+                        tip = point([(body.first, 1.0), (body.first + 3 * k, size)])
+                        lines.append(np.array([[centre, tip]]))
+                bodies.append(f"{body.name}: {word}, points {start}..{count - 1}")
+        if count == 0:
+            return None
+        matrix = sp.csr_matrix((coefs, (rows, cols)), shape=(3 * count, model.nfull))
+        points = (matrix @ model.q0).reshape(count, 3)
+        return cls(points, _stack(quads, 4), _stack(lines, 2), matrix, bodies)
+
+    @property
+    def npoints(self) -> int:
+        return len(self.points)
+
+    def positions(self, model, e: np.ndarray) -> np.ndarray:
+        """Point positions (nt, npoints, 3) from (reduced) coordinates e (nt, ndof)."""
+        full = model.expand(np.atleast_2d(e))
+        return (self.map @ full.T).T.reshape(len(full), self.npoints, 3)
+
+    def topology(self) -> tuple[str, np.ndarray, int]:
+        """(XDMF topology type, connectivity, number of cells): 'Quadrilateral' or
+        'Polyline' (ncells, nodes) with one kind of cell, else 'Mixed' (flat)."""
+        if len(self.lines) == 0:
+            return "Quadrilateral", self.quads, len(self.quads)
+        if len(self.quads) == 0:
+            return "Polyline", self.lines, len(self.lines)
+        flat = np.concatenate([
+            np.column_stack([np.full(len(self.quads), _QUAD), self.quads]).ravel(),
+            np.column_stack([np.full(len(self.lines), _LINE), np.full(len(self.lines), 2),
+                             self.lines]).ravel()])
+        return "Mixed", flat, len(self.quads) + len(self.lines)
+
+
+def _stack(blocks: list[np.ndarray], width: int) -> np.ndarray:
+    return np.vstack(blocks).astype(np.int64) if blocks else np.zeros((0, width), np.int64)
+
+
+def _display_length(body: RigidBody) -> float:
+    """The radius of gyration about the centre of mass, sqrt(tr(I) / 2m) (the root mean
+    square distance of the mass from the centre): the length of the axes shown."""
+    size = math.sqrt(max(float(np.trace(body.inertia)), 0.0) / (2.0 * body.mass))
+    return size if size > 0 else 1.0
+
+
+def frame_rows(total_rows: int, frames: int) -> tuple[int, int]:
+    """(stride, last row): a run of ``total_rows`` output rows shows rows 0, stride,
+    2 stride, ... and the last row, at most ``frames`` frames (frames >= 2)."""
+    if total_rows <= frames:
+        return 1, total_rows - 1
+    return math.ceil((total_rows - 1) / (frames - 1)), total_rows - 1
+
+
+def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
+    """/model/mesh: the initial points, the connectivity and what each point belongs to."""
+    if "model/mesh" in h5:
+        del h5["model/mesh"]
+    group = h5.create_group("model/mesh")
+    points = group.create_dataset("points", data=layout.points)
+    points.attrs["units"] = "m"
+    kind, connectivity, ncells = layout.topology()
+    topology = group.create_dataset("topology", data=connectivity.astype(np.int64))
+    topology.attrs["units"] = "index"
+    topology.attrs["description"] = (
+        "XDMF connectivity (0-based rows of points): " + {
+            "Quadrilateral": "the corner points of each plate element",
+            "Polyline": "2-point lines (beam elements, rigid body axes)",
+            "Mixed": "per cell its XDMF code, then quad: 4 points; line: 2, 2 points"}[kind])
+    group.attrs["topology_type"] = kind
+    group.attrs["ncells"] = np.int64(ncells)
+    group.attrs["bodies"] = "\n".join(layout.bodies)
 
 
 def _item(parent: ET.Element, dims: tuple[int, ...], h5_name: str, dataset: str,
@@ -35,10 +183,11 @@ def _item(parent: ET.Element, dims: tuple[int, ...], h5_name: str, dataset: str,
 
 def add_step_views(h5: h5py.File, first: int, stop: int) -> None:
     """Virtual datasets /dynamic/xdmf/position/<k> = /dynamic/mesh_nodes[k] and
-    /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for first <= k < stop,
-    each with its source's ``units``. The dynamic writer calls this at each flush, so the
-    cost (~0.3 ms per view) is spread over the run and a stopped run does not wait for
-    it. (h5py's low-level API: its high-level VirtualLayout took ~1 ms per view.)"""
+    /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for frames
+    first <= k < stop, each with its source's ``units``. The dynamic writer calls this at
+    each flush, so the cost (~0.2 ms per view) is spread over the run and a stopped run
+    does not wait for it. (h5py's low-level API: its high-level VirtualLayout took ~1 ms
+    per view.)"""
     for source, name in (("dynamic/mesh_nodes", "position"),
                          ("dynamic/mesh_displacement", "displacement")):
         if source not in h5:
@@ -64,38 +213,54 @@ def add_step_views(h5: h5py.File, first: int, stop: int) -> None:
             h5a.create(view, b"units", text_type, scalar).write(units)
 
 
-def write_xdmf(path: Path) -> Path:
-    """An XDMF file beside the HDF5 result of a plate model: one quadrilateral grid per
-    output step (the elements' corner nodes) at the node positions of the step, with the
-    nodal displacement from /model/nodes; opens in ParaView as a time series."""
+def _topology_of(h5: h5py.File) -> tuple[str, tuple[int, ...], str, int, int]:
+    """(type, dims, dataset, ncells, npoints) of the file's mesh: /model/mesh, or for
+    files written before it the plates' /model/elements and /model/nodes."""
+    if "model/mesh" in h5:
+        group = h5["model/mesh"]
+        return (str(group.attrs["topology_type"]), group["topology"].shape, "/model/mesh/topology",
+                int(group.attrs["ncells"]), len(group["points"]))
+    shape = h5["model/elements"].shape
+    return "Quadrilateral", shape, "/model/elements", shape[0], len(h5["model/nodes"])
+
+
+def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
+    """An XDMF file beside the HDF5 result of a dynamic run: one grid per frame at the
+    points' positions of that step, with their displacement from t = 0; opens in ParaView
+    as a time series. ``as_name``: the name the HDF5 file will have (it is about to be
+    moved there); the XDMF is written beside that name and refers to it."""
     path = Path(path)
-    name = path.name
+    target = Path(as_name) if as_name is not None else path
+    name = target.name
     if ":" in name:
         raise InputError("XDMF cannot name an HDF5 file with ':' in its name", file=str(path))
     with h5py.File(path, "a") as h5:
         times = h5["dynamic/time"][()]
-        nsteps = min(len(times), h5["dynamic/mesh_nodes"].shape[0])
-        nnodes = h5["dynamic/mesh_nodes"].shape[1]
-        nel, corners = h5["model/elements"].shape
-        add_step_views(h5, 0, nsteps)  # those the writer has not made (older files)
+        nframes = h5["dynamic/mesh_nodes"].shape[0]
+        rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(nframes)
+        nframes = min(nframes, int(np.searchsorted(rows, len(times))))
+        kind, dims, topology_data, ncells, npoints = _topology_of(h5)
+        add_step_views(h5, 0, nframes)  # those the writer has not made (older files)
         displacement = "dynamic/mesh_displacement" in h5
     root = ET.Element("Xdmf", Version="3.0")
     domain = ET.SubElement(root, "Domain")
     series = ET.SubElement(domain, "Grid", Name="motion", GridType="Collection",
                            CollectionType="Temporal")
-    for k in range(nsteps):
-        grid = ET.SubElement(series, "Grid", Name=f"step {k}", GridType="Uniform")
-        ET.SubElement(grid, "Time", Value=f"{times[k]:.17g}")
-        topology = ET.SubElement(grid, "Topology", TopologyType="Quadrilateral",
-                                 NumberOfElements=str(nel))
-        _item(topology, (nel, corners), name, "/model/elements", "Int")
+    for k in range(nframes):
+        grid = ET.SubElement(series, "Grid", Name=f"step {rows[k]}", GridType="Uniform")
+        ET.SubElement(grid, "Time", Value=f"{times[rows[k]]:.17g}")
+        topology = ET.SubElement(grid, "Topology", TopologyType=kind,
+                                 NumberOfElements=str(ncells))
+        if kind == "Polyline":
+            topology.set("NodesPerElement", "2")
+        _item(topology, dims, name, topology_data, "Int")
         geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
-        _item(geometry, (nnodes, 3), name, f"/{_STEPS_GROUP}/position/{k}")
+        _item(geometry, (npoints, 3), name, f"/{_STEPS_GROUP}/position/{k}")
         if displacement:
             attribute = ET.SubElement(grid, "Attribute", Name="displacement",
                                       AttributeType="Vector", Center="Node")
-            _item(attribute, (nnodes, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
-    out = path.with_suffix(".xdmf")
+            _item(attribute, (npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
+    out = target.with_suffix(".xdmf")
     partial = out.with_name(out.name + ".partial")
     ET.ElementTree(root).write(partial, encoding="utf-8", xml_declaration=True)
     os.replace(partial, out)

@@ -1,0 +1,204 @@
+"""The XDMF description shows every body (issue 14, item 5): beams as polylines through
+their nodes, plates and leaves as quadrilaterals, rigid bodies as their centre and axes.
+
+meshio's TimeSeriesReader reads each file back; the points are checked against quantities
+computed another way: the probes the kernel records (a beam's tip, the chassis and shackle
+centres), the beam's node stations, and the rigid motion of the rigid bodies' axes. The
+Mixed connectivity is also parsed by the rule VTK (ParaView) follows, where a polyline
+carries its node count, and must give meshio's cells.
+"""
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import INPUTS
+from ancfdrv.runner import run_scene
+
+meshio = pytest.importorskip("meshio")
+
+
+def read_series(xdmf: Path):
+    """(points at t = 0, cells, [(t, displacement)] per frame) as meshio reads them."""
+    with meshio.xdmf.TimeSeriesReader(xdmf) as reader:
+        points, cells = reader.read_points_cells()
+        frames = []
+        for k in range(reader.num_steps):
+            t, point_data, _ = reader.read_data(k)
+            frames.append((t, point_data["displacement"]))
+    return points, cells, frames
+
+
+def vtk_cells(flat: np.ndarray) -> list[tuple[str, tuple[int, ...]]]:
+    """Cells of an XDMF Mixed topology read the way VTK's XDMF 3 reader does: code 5 is a
+    quad of 4 nodes; codes 1 (polyvertex), 2 (polyline) and 3 (polygon) give their node
+    count first."""
+    out, k = [], 0
+    while k < len(flat):
+        code = int(flat[k])
+        k += 1
+        if code == 5:
+            n, kind = 4, "quad"
+        elif code in (1, 2, 3):
+            n, kind = int(flat[k]), {1: "vertex", 2: "line", 3: "polygon"}[code]
+            k += 1
+        else:
+            raise AssertionError(f"unexpected cell code {code}")
+        out.append((kind, tuple(int(i) for i in flat[k:k + n])))
+        k += n
+    return out
+
+
+@pytest.fixture(scope="module")
+def beam(tmp_path_factory) -> Path:
+    """The luffing boom, 4 nodes, 0.5 s (500 steps), thinned to 11 frames."""
+    out = tmp_path_factory.mktemp("beam") / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.5",
+                                            "output.xdmf_frames=11"], out, progress=False)
+    return out
+
+
+def test_beam_is_a_polyline_through_its_nodes(beam):
+    points, cells, frames = read_series(beam.with_suffix(".xdmf"))
+    with h5py.File(beam) as h5:
+        time = h5["dynamic/time"][()]
+        tip = h5["dynamic/probes/tip"][()]
+        stations = h5["model/node_s"][()]
+        reference = h5["model/mesh/points"][()]
+        assert h5["dynamic/q"].shape == (501, h5["model"].attrs["ndof"])  # stored for XDMF
+    # displacements from the rigid configuration at phi = 0: A1 = (0, H, 0), the axis along
+    # r1 (SPEC section 5); meshio's points are the first frame's: the static equilibrium
+    np.testing.assert_allclose(reference, np.column_stack(
+        [stations, np.full(4, 0.295), np.zeros(4)]), atol=1e-12)
+    np.testing.assert_allclose(points, reference + frames[0][1], atol=1e-15)
+    assert points[3][1] < 0.295 - 0.05  # the tip sags
+    assert [c.type for c in cells] == ["line"]
+    np.testing.assert_array_equal(cells[0].data, [[0, 1], [1, 2], [2, 3]])
+    # 500 steps in at most 11 frames: rows 0, 50, ..., 500
+    assert [t for t, _ in frames] == pytest.approx(time[::50], abs=0) and len(frames) == 11
+    for k, (t, displacement) in enumerate(frames):
+        np.testing.assert_allclose(reference[3] + displacement[3], tip[50 * k], atol=1e-12)
+    assert np.linalg.norm(frames[-1][1][3] - frames[0][1][3]) > 0.05  # the boom luffed
+
+
+def test_every_step_is_a_frame_up_to_the_limit(tmp_path):
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.02",
+                                            "scene.analysis=dynamic"], out, progress=False)
+    root = ET.parse(out.with_suffix(".xdmf")).getroot()
+    assert len(root.findall("./Domain/Grid/Grid")) == 21
+    with h5py.File(out) as h5:
+        np.testing.assert_array_equal(h5["dynamic/mesh_rows"][()], np.arange(21))
+
+
+def test_no_xdmf_when_switched_off(tmp_path):
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.02",
+                                            "output.xdmf=.false."], out, progress=False)
+    assert not out.with_suffix(".xdmf").exists()
+    with h5py.File(out) as h5:
+        assert "mesh_nodes" not in h5["dynamic"] and "q" not in h5["dynamic"]
+
+
+def test_plate_is_quadrilaterals(tmp_path):
+    out = tmp_path / "plate.h5"
+    run_scene(INPUTS / "plate_pendulum.nml", ["plate.nx=2", "plate.ny=2", "solver.t_end=0.02"],
+              out, progress=False)
+    points, cells, frames = read_series(out.with_suffix(".xdmf"))
+    with h5py.File(out) as h5:
+        corner = h5["dynamic/probes/corner"][()]
+        np.testing.assert_array_equal(cells[0].data, h5["model/elements"][()])
+    assert [c.type for c in cells] == ["quad"] and len(cells[0].data) == 4
+    assert len(frames) == 21
+    at = int(np.argmin(np.linalg.norm(points - [0.3, 0.3, 0.0], axis=1)))
+    np.testing.assert_allclose(points[at], [0.3, 0.3, 0.0], atol=1e-15)
+    for k, (_, displacement) in enumerate(frames):
+        np.testing.assert_allclose(points[at] + displacement[at], corner[k], atol=1e-12)
+    assert displacement[at][2] < -1e-4  # it falls
+
+
+@pytest.fixture(scope="module")
+def spring(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("spring") / "spring.h5"
+    run_scene(INPUTS / "leaf_spring.nml", ["solver.t_end=0.01"], out, progress=False)
+    return out
+
+
+def test_leaf_spring_shows_leaves_chassis_and_shackle(spring):
+    points, cells, frames = read_series(spring.with_suffix(".xdmf"))
+    with h5py.File(spring) as h5:
+        mesh = h5["model/mesh"]
+        assert mesh.attrs["topology_type"] == "Mixed"
+        flat = mesh["topology"][()]
+        bodies = mesh.attrs["bodies"].splitlines()
+        reference = h5["model/mesh/points"][()]
+        chassis = h5["dynamic/probes/chassis"][()]
+        shackle = h5["dynamic/probes/shackle"][()]
+    # leaves 12 x 1 and 8 x 1 elements (13 x 2 and 9 x 2 nodes), two rigid bodies of 4 points
+    assert len(points) == 26 + 18 + 8
+    assert [(c.type, len(c.data)) for c in cells] == [("quad", 20), ("line", 6)]
+    assert vtk_cells(flat) == [("quad", tuple(c)) for c in cells[0].data] + \
+        [("line", tuple(c)) for c in cells[1].data]
+    assert [b.split(":")[0] for b in bodies] == ["main", "lower", "chassis", "shackle"]
+    centres = {}
+    for line in bodies[2:]:
+        name, rest = line.split(": rigid body, points ")
+        centres[name] = int(rest.split("..")[0])
+    np.testing.assert_array_equal(points, reference)  # released from the assembled state
+    assert len(frames) == 11
+    for k, (_, displacement) in enumerate(frames):
+        now = reference + displacement
+        np.testing.assert_allclose(now[centres["chassis"]], chassis[k], atol=1e-12)
+        # the shackle probe is its centre (the link's middle)
+        np.testing.assert_allclose(now[centres["shackle"]], shackle[k], atol=1e-12)
+        for name, c in centres.items():  # the axes move rigidly: orthogonal, same lengths
+            axes = now[c + 1:c + 4] - now[c]
+            axes0 = points[c + 1:c + 4] - points[c]
+            np.testing.assert_allclose(axes @ axes.T, axes0 @ axes0.T, atol=1e-9)
+    # at t = 0 the axes are the global axes, as long as the radius of gyration
+    axes0 = points[centres["chassis"] + 1:centres["chassis"] + 4] - points[centres["chassis"]]
+    np.testing.assert_allclose(axes0, np.sqrt(3 * 50.0 / (2 * 500.0)) * np.eye(3), atol=1e-12)
+    assert np.abs(frames[-1][1]).max() > 1e-6  # it moved
+
+
+def test_sweep_cases_have_xdmf_naming_their_final_file(tmp_path):
+    """A sweep writes each case to a hidden part file and then moves it: the XDMF beside
+    the final file refers to the final file, and no part file remains."""
+    from ancfdrv.sweep import run_sweep
+    out = tmp_path / "sweep"
+    rows = run_sweep(str(INPUTS / "boom_luffing.nml"), ["beam.nodes=4,7"], out,
+                     base=["solver.t_end=0.01"], workers=1, progress=False)
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    for row in rows:
+        h5_path = Path(row["file"])
+        root = ET.parse(h5_path.with_suffix(".xdmf")).getroot()
+        texts = {item.text.split(":")[0] for item in root.iter("DataItem")}
+        assert texts == {h5_path.name}
+        points, cells, frames = read_series(h5_path.with_suffix(".xdmf"))
+        assert len(frames) == 11 and cells[0].type == "line"
+    assert not list(out.glob(".*"))
+
+
+def test_a_failed_run_ends_its_motion_at_the_last_step(tmp_path):
+    """A run that fails between frames (exit 3 here) still shows its last computed step."""
+    from ancfdrv.errors import SolverError
+    out = tmp_path / "failed.h5"
+    with pytest.raises(SolverError):
+        run_scene(INPUTS / "hard" / "newton_failure.nml",
+                  ["output.xdmf_frames=101"], out, progress=False)
+    with h5py.File(out) as h5:
+        time = h5["dynamic/time"][()]
+        rows = h5["dynamic/mesh_rows"][()]
+        tip = h5["dynamic/probes/tip"][-1]
+        reference = h5["model/mesh/points"][()]
+        assert h5.attrs["status"] == "failed"
+    # 10001 rows planned in at most 101 frames: every 100th row; the run failed between two
+    assert len(time) % 100 != 1
+    np.testing.assert_array_equal(rows, list(range(0, len(time), 100)) + [len(time) - 1])
+    _, _, frames = read_series(out.with_suffix(".xdmf"))
+    assert frames[-1][0] == time[-1]
+    np.testing.assert_allclose(reference[-1] + frames[-1][1][-1], tip, atol=1e-12)  # the tip
