@@ -231,7 +231,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     writer = results.DynamicWriter(
         out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
-        frames=scene["output"].get("xdmf_frames", 1000))
+        frames=scene["output"]["xdmf_frames"])
     attrs: dict[str, Any] = {
         "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
         "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,

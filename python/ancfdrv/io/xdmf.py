@@ -181,13 +181,13 @@ def _item(parent: ET.Element, dims: tuple[int, ...], h5_name: str, dataset: str,
     return item
 
 
-def add_step_views(h5: h5py.File, first: int, stop: int) -> None:
+def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = False) -> None:
     """Virtual datasets /dynamic/xdmf/position/<k> = /dynamic/mesh_nodes[k] and
     /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for frames
     first <= k < stop, each with its source's ``units``. The dynamic writer calls this at
     each flush, so the cost (~0.2 ms per view) is spread over the run and a stopped run
     does not wait for it. (h5py's low-level API: its high-level VirtualLayout took ~1 ms
-    per view.)"""
+    per view.) ``existing``: some of the views may exist already (an older file)."""
     for source, name in (("dynamic/mesh_nodes", "position"),
                          ("dynamic/mesh_displacement", "displacement")):
         if source not in h5:
@@ -204,7 +204,7 @@ def add_step_views(h5: h5py.File, first: int, stop: int) -> None:
         units = np.array(data.attrs.get("units", "m"), dtype=text)
         count = (1, *shape[1:])
         for k in range(first, min(stop, shape[0])):
-            if str(k) in group:
+            if existing and str(k) in group:
                 continue
             selection.select_hyperslab((k,) + (0,) * (len(shape) - 1), count)
             plist = h5p.create(h5p.DATASET_CREATE)
@@ -240,7 +240,7 @@ def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
         rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(nframes)
         nframes = min(nframes, int(np.searchsorted(rows, len(times))))
         kind, dims, topology_data, ncells, npoints = _topology_of(h5)
-        add_step_views(h5, 0, nframes)  # those the writer has not made (older files)
+        add_step_views(h5, 0, nframes, existing=True)  # those the writer has not made
         displacement = "dynamic/mesh_displacement" in h5
     root = ET.Element("Xdmf", Version="3.0")
     domain = ET.SubElement(root, "Domain")
