@@ -15,6 +15,7 @@ from ancfdrv.system import System
 from ancfdrv.system.meshes import rectangle_mesh
 
 from conftest import INPUTS
+from reference import leaf_reference as lr  # noqa: E402  (tests/reference: never imported by a run)
 
 STEEL = dict(density=7810.0, youngs_modulus=2.1e11, poisson_ratio=0.3)
 
@@ -323,7 +324,8 @@ def test_contact_and_friction_dissipate_never_create_energy():
 @pytest.fixture(scope="module")
 def spring_runs(tmp_path_factory):
     """Short runs of inputs/leaf_spring.nml (0.8 s: a full bounce) with and without prestress,
-    without friction, and without contact."""
+    without friction, and without contact, each started at rest from the equilibrium
+    without gravity (spring.settle = 'prestress')."""
     out = tmp_path_factory.mktemp("spring")
     runs = {}
     cases = {"on": [], "off": ["leaf.prestress=.false."],
@@ -334,6 +336,8 @@ def spring_runs(tmp_path_factory):
                   progress=False)
         with h5py.File(out / f"{name}.h5") as h5:
             runs[name] = dict(z=h5["dynamic/deflection/chassis"][:, 2],
+                              settled=h5["static/deflection/chassis"][2]
+                              if "static" in h5 else 0.0,
                               t=h5["dynamic/time"][()],
                               counters=dict(h5["counters"].attrs),
                               penetration=h5["dynamic/contact/penetration"][()]
@@ -353,21 +357,40 @@ def test_spring_computes_only_listed_effects(spring_runs):
     assert {"contact", "friction", "load_cycle"} <= set(EFFECTS_AVAILABLE)
 
 
-def test_prestress_lowers_the_chassis_amplitude(spring_runs):
-    """Seed Fig. 12: released from the assembled state, the chassis drops less and
-    oscillates less with the prestressed lower leaf."""
-    on, off = spring_runs["on"]["z"], spring_runs["off"]["z"]
-    assert on.min() > 0.75 * off.min()          # measured: -36 vs -59 mm
-    assert np.ptp(on) < 0.75 * np.ptp(off)
+def test_prestress_preloads_the_settled_spring(spring_runs):
+    """Seed Fig. 12 from a settled start (spring.settle = 'prestress', the default): the
+    prestressed lower leaf, carried by contact, lifts the eyes before gravity acts by the
+    reference's eye lift (tests/reference/leaf_reference.py, prestress_preload: 11.38 mm for
+    the beam stiffness, 11.35 mm for the plate's, with the penalty of 3 points x 1e6 N/m per
+    edge; measured 11.30 mm), and the chassis then drops by about the same sag as without
+    prestress (linear theory: the preload shifts the spring, its stiffness with the contact
+    closed is the same; measured 29.3 and 29.7 mm): a pre-loaded spring, not an impact."""
+    lifts = [lr.prestress_preload(ei, contact_stiffness=3e6)["eye_lift"]
+             for ei in lr.bending_stiffness_bounds().values()]
+    on, off = spring_runs["on"], spring_runs["off"]
+    assert on["settled"] == pytest.approx(np.mean(lifts), rel=0.02)
+    assert off["settled"] == 0.0
+    drop_on, drop_off = on["settled"] - on["z"].min(), -off["z"].min()
+    print(f"\nsettled lift {on['settled'] * 1e3:.3f} mm (reference {min(lifts) * 1e3:.3f}.."
+          f"{max(lifts) * 1e3:.3f}); drops {drop_on * 1e3:.2f} / {drop_off * 1e3:.2f} mm")
+    assert drop_on == pytest.approx(drop_off, rel=0.03)
+    # no release impact: from the assembled state friction took 146 J and contact damping
+    # 134 J in the first 0.1 s; from the settled state they take 0.46 J and 4e-4 J
+    first = np.searchsorted(on["t"], 0.1)
+    lost = -(on["energy"]["friction_work"][first] + on["energy"]["damping_work"][first])
+    assert 0.0 < lost < 1.0
 
 
-def test_spring_without_prestress_conserves_energy_balance(spring_runs):
-    """Without prestress the start is smooth: energy + contact damping and friction work
-    balance to 1e-5 of the chassis's potential drop (m g z_max)."""
-    off = spring_runs["off"]
-    scale = 500 * 9.81 * abs(off["z"].min())
-    assert np.abs(off["energy"]["balance"]).max() < 1e-5 * scale
-    assert off["penetration"].max() < 0.2 * 0.014
+@pytest.mark.parametrize("case", ["on", "off"])
+def test_settled_spring_conserves_energy_balance(spring_runs, case):
+    """From a settled start, prestress on and off, energy + contact damping and friction
+    work balance to 1e-5 of the chassis's potential drop (m g times its drop; issue 15
+    asks < 1 %); measured 2e-3 J and 9e-4 J against about 145 J. Penetration stays far
+    below the 15 % of the thickness the stability matrix allows."""
+    run = spring_runs[case]
+    scale = 500 * 9.81 * (run["settled"] - run["z"].min())
+    assert np.abs(run["energy"]["balance"]).max() < 1e-5 * scale
+    assert run["penetration"].max() < 0.15 * 0.014
 
 
 def test_load_cycle_loop_area_equals_friction_and_damping_work(tmp_path):

@@ -201,8 +201,8 @@ def settle_mode(scene: Scene) -> str:
     the last two after what they settle."""
     if scene.kind == "spring":
         return {"none": "none", "prestress": "unloaded",
-                "gravity": "loaded"}[scene["spring"].get("settle", "none")]
-    return scene["solver"].get("settle", "none")
+                "gravity": "loaded"}[scene["spring"]["settle"]]
+    return scene["solver"]["settle"]
 
 
 def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str, Any],

@@ -50,7 +50,7 @@ def build(scene) -> BuiltSystem:
                  position=eye + [0.0, 0.0, ls / 2], planar=True)
     # axle: r and r_x of both middle node lines; with a road input the clamp's position
     # follows it along r3 (the clamp's slope stays held)
-    road = road_drive(s, spring)
+    road = road_drive(s, spring, scene)
     for body in (main, lower):
         middle = body.mesh.coords[body.mesh.node_sets["middle_x"], :3].ravel()
         if road is None:
@@ -90,16 +90,16 @@ def build(scene) -> BuiltSystem:
     return BuiltSystem(s, ("chassis", 2))
 
 
-def road_drive(s: System, spring) -> str | None:
+def road_drive(s: System, spring, scene) -> str | None:
     """The vertical road input at the axle (``spring.road``): 'sine' (amplitude, frequency,
     raised smoothly over ``road_ramp`` s), 'table' (t, z rows of the CSV ``road_file``,
     linear in between; z relative to its value at t = 0), or None ('none')."""
-    kind = spring.get("road", "none")
+    kind = spring["road"]
     if kind == "none":
         return None
     if kind == "sine":
         s.drive("road", "sine", amplitude=spring["road_amplitude"],
                 frequency=spring["road_frequency"], ramp=spring["road_ramp"])
     else:
-        s.drive("road", "table", file=spring["road_file"])
+        s.drive("road", "table", file=scene.resolve(spring["road_file"]))
     return "road"

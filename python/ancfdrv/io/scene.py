@@ -52,9 +52,15 @@ class Scene:
         out = []
         for group, values in self.items or []:
             if group == "drive" and values.get("file"):
-                path = Path(values["file"])
-                out.append(path if path.is_absolute() else self.path.parent / path)
+                out.append(self.resolve(values["file"]))
+        if self.kind == "spring" and self.values["spring"]["road"] == "table":
+            out.append(self.resolve(self.values["spring"]["road_file"]))
         return out
+
+    def resolve(self, name: str | Path) -> Path:
+        """A file named in the scene: absolute, or relative to the scene file."""
+        path = Path(name)
+        return path if path.is_absolute() else self.path.parent / path
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -479,3 +485,12 @@ def _check_spring(values: dict[str, dict[str, Any]], file: str) -> None:
     if spring["lower_arc_length"] >= spring["main_arc_length"]:
         raise InputError("the lower leaf must be shorter than the main leaf", file=file,
                          group="spring", key="lower_arc_length")
+    if spring["road"] == "sine" and spring["road_amplitude"] <= 0:
+        raise InputError("road = 'sine' needs road_amplitude > 0 (m)", file=file,
+                         group="spring", key="road_amplitude")
+    if spring["road"] == "table" and not spring["road_file"]:
+        raise InputError("road = 'table' needs road_file (a CSV of t, z rows)", file=file,
+                         group="spring", key="road_file")
+    if spring["road"] != "none" and spring["guide"] == "vertical" and cycle:
+        raise InputError("a road input and a load cycle are separate experiments: set one",
+                         file=file, group="spring", key="road")

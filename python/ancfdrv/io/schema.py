@@ -192,6 +192,20 @@ SCHEMA: dict[str, dict[str, Key]] = {
                            "force on the chassis (N)"),
         "cycle_period": Key("float", 4.0, positive, "effect 'load_cycle': duration of the "
                             "cycle 0 -> peak -> 0 (s)"),
+        "settle": Key("str", "prestress", one_of("prestress", "gravity", "none"),
+                      "dynamic start at rest: 'prestress' from the equilibrium of the "
+                      "assembled spring without gravity (the prestress carried by contact), "
+                      "'gravity' from the static equilibrium under gravity as well (road "
+                      "input, load cycles), 'none' from the assembled configuration"),
+        "road": Key("str", "none", one_of("none", "sine", "table"),
+                    "vertical road input at the axle clamp: 'sine' (road_amplitude, "
+                    "road_frequency, raised over road_ramp) or 'table' (road_file)"),
+        "road_amplitude": Key("float", 0.0, non_negative, "road = 'sine': amplitude (m)"),
+        "road_frequency": Key("float", 1.0, positive, "road = 'sine': frequency (Hz)"),
+        "road_ramp": Key("float", 1.0, non_negative, "road = 'sine': time over which the "
+                         "amplitude rises smoothly from 0 (s)"),
+        "road_file": Key("str", None, doc="road = 'table': CSV of (t in s, z in m) rows, "
+                         "linear in between; relative to the scene file"),
     },
     "loads": {
         "gravity": Key("float", 9.81, non_negative, "gravitational acceleration (m/s^2)"),
@@ -224,14 +238,20 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "newton_tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                           "a step ends when its Newton correction is below newton_tol * length"),
         "max_newton": Key("int", 10, positive, "Newton iterations allowed per step"),
-        "jacobian": Key("str", "step", one_of("step", "iteration", "reuse"),
-                        "when a refactorized model's iteration matrix is refreshed: 'step' (at "
-                        "each step, and when a correction does not halve), 'iteration' (full "
-                        "Newton), 'reuse' (modified Newton across steps); pure FFR systems "
-                        "factorize once whatever this says"),
+        "jacobian": Key("str", "reuse", one_of("step", "iteration", "reuse"),
+                        "when a refactorized model's iteration matrix is refreshed: 'reuse' "
+                        "(kept across steps while Newton contracts; docs/theory.md section "
+                        "14), 'step' (at each step, and when a correction does not halve), "
+                        "'iteration' (full Newton); pure FFR systems factorize once whatever "
+                        "this says"),
         "contraction": Key("float", 0.5, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                            "jacobian = 'reuse': refresh when a correction exceeds this fraction "
                            "of the previous one"),
+        "settle": Key("str", "none", one_of("none", "unloaded", "loaded"),
+                      "dynamic runs start at rest from: 'none' the assembled configuration; "
+                      "'unloaded' the equilibrium of the internal forces alone (prestress "
+                      "carried by contact, loads off); 'loaded' the static equilibrium under "
+                      "every load (written to /static)"),
         "linear_joints": Key("str", "auto", one_of("auto", "eliminate", "multipliers"),
                              "linear joint equations: eliminated (q = B e + q0, seed 003) or "
                              "kept with multipliers (seed 000); 'auto' eliminates when the "
