@@ -213,5 +213,6 @@ def test_sweep_compares_formulations_side_by_side(tmp_path):
     rows = {r["scene.formulation"]: r for r in csv.DictReader(open(out / "summary.csv"))}
     assert float(rows["nonlinear"]["diff_vs_nonlinear"]) == 0.0
     assert 1e-4 < float(rows["ffr"]["diff_vs_nonlinear"]) < 0.2
-    assert int(rows["nonlinear"]["factorizations"]) == 1000  # one per step
+    # refactorized, but reused across steps (jacobian = 'reuse'; 'step' made 1000)
+    assert 1 < int(rows["nonlinear"]["factorizations"]) < 500
     assert int(rows["ffr"]["factorizations"]) == 1  # one per run
