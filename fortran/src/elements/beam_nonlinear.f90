@@ -92,8 +92,8 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
-    real(dp) :: stress(6), stress_matrix(3, 3), b(6, 24), db(6, 24), sg(3), geometric
-    integer :: p, a, c
+    real(dp) :: stress(6), b(6, 24), db(6, 24)
+    integer :: p
     call split_laws(youngs, poisson, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
@@ -114,17 +114,7 @@ contains
       if (.not. want_tangent) cycle
       db = matmul(law, b)
       tangent = tangent + weights(p) * matmul(transpose(b), db)
-      stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
-                               stress(6), stress(5), stress(3)], [3, 3])
-      do a = 1, 8
-        sg = matmul(stress_matrix, gradients(a, :, p))
-        do c = 1, 8
-          geometric = weights(p) * dot_product(gradients(c, :, p), sg)
-          tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) = tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) + geometric
-          tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) = tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) + geometric
-          tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) = tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) + geometric
-        end do
-      end do
+      call add_geometric_stiffness(stress, gradients(:, :, p), weights(p), tangent)
     end do
   end subroutine nonlinear_element
 
@@ -140,9 +130,9 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
-    real(dp) :: stress(6), stress_matrix(3, 3), b(6, 24), b_rate(6, 24), sg(3), geometric
+    real(dp) :: stress(6), b(6, 24), b_rate(6, 24)
     real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
-    integer :: p, a, c
+    integer :: p
     call split_laws(youngs, poisson, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
@@ -171,17 +161,7 @@ contains
       call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
       tangent = tangent + weights(p) * matmul(transpose(b), &
                 matmul(law, (1.0_dp + rate_factor * damping_time) * b + damping_time * b_rate))
-      stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
-                               stress(6), stress(5), stress(3)], [3, 3])
-      do a = 1, 8
-        sg = matmul(stress_matrix, gradients(a, :, p))
-        do c = 1, 8
-          geometric = weights(p) * dot_product(gradients(c, :, p), sg)
-          tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) = tangent(3 * (a - 1) + 1, 3 * (c - 1) + 1) + geometric
-          tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) = tangent(3 * (a - 1) + 2, 3 * (c - 1) + 2) + geometric
-          tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) = tangent(3 * (a - 1) + 3, 3 * (c - 1) + 3) + geometric
-        end do
-      end do
+      call add_geometric_stiffness(stress, gradients(:, :, p), weights(p), tangent)
     end do
   end subroutine nonlinear_element_damped
 
@@ -246,5 +226,26 @@ contains
       law_poisson(i, i) = lame + 2.0_dp * shear - youngs
     end do
   end subroutine split_laws
+
+  !> tangent += w kron(G S G^T, I3): the geometric stiffness of the second Piola-Kirchhoff
+  !> stress S (Voigt) with the material gradients G (8, 3) of the shape functions.
+  pure subroutine add_geometric_stiffness(stress, point_gradients, weight, tangent)
+    real(dp), intent(in) :: stress(6), point_gradients(8, 3), weight
+    real(dp), intent(inout) :: tangent(24, 24)
+    real(dp) :: stress_matrix(3, 3), sg(3), geometric
+    integer :: a, c, i
+    stress_matrix = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
+                             stress(6), stress(5), stress(3)], [3, 3])
+    do a = 1, 8
+      sg = matmul(stress_matrix, point_gradients(a, :))
+      do c = 1, 8
+        geometric = weight * dot_product(point_gradients(c, :), sg)
+        do i = 1, 3
+          tangent(3 * (a - 1) + i, 3 * (c - 1) + i) = tangent(3 * (a - 1) + i, 3 * (c - 1) + i) &
+                                                      + geometric
+        end do
+      end do
+    end do
+  end subroutine add_geometric_stiffness
 
 end module beam_nonlinear

@@ -165,7 +165,7 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
-    integer :: t, j, a, c, i
+    integer :: t, j
     force = 0.0_dp
     energy = 0.0_dp
     tangent = 0.0_dp
@@ -184,14 +184,7 @@ contains
       geometric = geometric + stiffness(t) * strain * forms(:, :, t)
     end do
     if (.not. want_tangent) return
-    do c = 1, 8
-      do a = 1, 8
-        do i = 1, 3
-          tangent(3 * (a - 1) + i, 3 * (c - 1) + i) = tangent(3 * (a - 1) + i, 3 * (c - 1) + i) &
-                                                      + geometric(a, c)
-        end do
-      end do
-    end do
+    call add_kron_identity(geometric, tangent)
     ! the rank-one parts filled the lower triangle; the geometric part is symmetric
     do j = 2, 24
       tangent(1:j - 1, j) = tangent(j, 1:j - 1)
@@ -211,7 +204,7 @@ contains
     real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
     real(dp) :: gradient(3, 8), rate_gradient(3, 8), strain, strain_rate, total
     real(dp) :: geometric(8, 8), row(24), column(24)
-    integer :: t, j, a, c, i
+    integer :: t, j, a
     force = 0.0_dp
     energy = 0.0_dp
     dissipation = 0.0_dp
@@ -241,6 +234,14 @@ contains
       geometric = geometric + stiffness(t) * total * forms(:, :, t)
     end do
     if (.not. want_tangent) return
+    call add_kron_identity(geometric, tangent)
+  end subroutine structural_element_damped
+
+  !> tangent += kron(geometric, I3): an (8, 8) form acting alike on the three components.
+  pure subroutine add_kron_identity(geometric, tangent)
+    real(dp), intent(in) :: geometric(8, 8)
+    real(dp), intent(inout) :: tangent(24, 24)
+    integer :: a, c, i
     do c = 1, 8
       do a = 1, 8
         do i = 1, 3
@@ -249,6 +250,6 @@ contains
         end do
       end do
     end do
-  end subroutine structural_element_damped
+  end subroutine add_kron_identity
 
 end module beam_structural

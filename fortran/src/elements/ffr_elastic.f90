@@ -69,7 +69,7 @@ contains
     real(dp), intent(inout) :: force(:)
     real(dp), intent(out) :: energy, dissipation
     real(dp) :: local_disp(24), local_rate(24), local_force(24), damping_force(24)
-    integer :: el, a, i
+    integer :: el
     energy = 0.0_dp
     dissipation = 0.0_dp
     do el = 1, nel
@@ -80,13 +80,7 @@ contains
       energy = energy + 0.5_dp * dot_product(local_disp, local_force)
       dissipation = dissipation + dot_product(local_rate, damping_force)
       local_force = local_force + damping_force
-      do a = 0, 7
-        do i = 1, 3
-          force(dofs(3 * a + i, el)) = force(dofs(3 * a + i, el)) + rotation(i, 1) * local_force(3 * a + 1) &
-                                       + rotation(i, 2) * local_force(3 * a + 2) &
-                                       + rotation(i, 3) * local_force(3 * a + 3)
-        end do
-      end do
+      call add_global_force(rotation, local_force, dofs(:, el), force)
     end do
   end subroutine ffr_damped_force
 
@@ -98,19 +92,13 @@ contains
     real(dp), intent(inout) :: force(:)
     real(dp), intent(out) :: energy
     real(dp) :: local_disp(24), local_force(24)
-    integer :: el, a, i
+    integer :: el
     energy = 0.0_dp
     do el = 1, nel
       local_disp = frame_displacement(rotation, e, dofs(:, el), reference(:, el))
       local_force = matmul(stiffness0(:, :, el), local_disp)
       energy = energy + 0.5_dp * dot_product(local_disp, local_force)
-      do a = 0, 7
-        do i = 1, 3
-          force(dofs(3 * a + i, el)) = force(dofs(3 * a + i, el)) + rotation(i, 1) * local_force(3 * a + 1) &
-                                       + rotation(i, 2) * local_force(3 * a + 2) &
-                                       + rotation(i, 3) * local_force(3 * a + 3)
-        end do
-      end do
+      call add_global_force(rotation, local_force, dofs(:, el), force)
     end do
   end subroutine ffr_force
 
@@ -212,5 +200,21 @@ contains
       end do
     end do
   end subroutine ffr_stiffness
+
+  !> force(dofs) += T f for the frame force f (24) of one element, T = blockdiag(A, ..., A).
+  pure subroutine add_global_force(rotation, local_force, element_dofs, force)
+    real(dp), intent(in) :: rotation(3, 3), local_force(24)
+    integer, intent(in) :: element_dofs(24)
+    real(dp), intent(inout) :: force(:)
+    integer :: a, i
+    do a = 0, 7
+      do i = 1, 3
+        force(element_dofs(3 * a + i)) = force(element_dofs(3 * a + i)) &
+                                         + rotation(i, 1) * local_force(3 * a + 1) &
+                                         + rotation(i, 2) * local_force(3 * a + 2) &
+                                         + rotation(i, 3) * local_force(3 * a + 3)
+      end do
+    end do
+  end subroutine add_global_force
 
 end module ffr_elastic

@@ -327,67 +327,28 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(plate_dofs), energy, tangent(plate_dofs, plate_dofs)
     integer, intent(out) :: info
-    real(dp) :: plane_stress(3, 3), membrane_d(3, 3), bending_d(3, 3)
+    real(dp) :: membrane_d(3, 3), bending_d(3, 3)
     real(dp) :: fields(3, plate_fields), point_w, gradient(3, plate_fields), hessian(15, 15)
-    real(dp) :: nodal(3, plate_shapes), half(15, plate_dofs), shape_d(plate_fields, plate_shapes)
-    real(dp) :: total
-    integer :: p, i, j, ka, kb, f, row, col
+    real(dp) :: nodal(3, plate_shapes), shape_d(plate_fields, plate_shapes)
+    integer :: p, row, col
     info = 0
-    plane_stress = youngs / (1.0_dp - poisson**2) * reshape([1.0_dp, poisson, 0.0_dp, poisson, &
-                   1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp * (1.0_dp - poisson)], [3, 3])
-    membrane_d = thickness * plane_stress
-    bending_d = thickness**3 / 12.0_dp * plane_stress
+    call elastic_matrices(youngs, poisson, thickness, membrane_d, bending_d)
     energy = 0.0_dp
     if (want_tangent) tangent = 0.0_dp
     nodal = 0.0_dp
     do p = 1, plate_points
       shape_d = transpose(derivs(:, :, p))
-      fields = 0.0_dp
-      do ka = 1, plate_shapes
-        do f = 1, plate_fields
-          fields(:, f) = fields(:, f) + coords(:, ka) * shape_d(f, ka)
-        end do
-      end do
-      if (norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
-          sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
+      call interpolate(coords, shape_d, fields)
+      if (degenerate(fields)) then
         info = 2
         return
       end if
       call point_energy(fields, frame(:, :, p), curvature0(:, p), membrane_d, bending_d, &
                         want_tangent, point_w, gradient, hessian)
       energy = energy + weights(p) * point_w
-      gradient = weights(p) * gradient
-      do ka = 1, plate_shapes
-        do f = 1, plate_fields
-          nodal(:, ka) = nodal(:, ka) + gradient(:, f) * shape_d(f, ka)
-        end do
-      end do
-      if (.not. want_tangent) cycle
-      ! K += L^T H L with L = kron(dS^T, I3), in two passes: half = w H L (15 x 36), then
-      ! the upper triangle of L^T half (the lower one is its mirror: H is symmetric)
-      do kb = 1, plate_shapes
-        do j = 1, 3
-          col = 3 * kb - 3 + j
-          do row = 1, 15
-            total = 0.0_dp
-            do f = 1, plate_fields
-              total = total + hessian(row, 3 * f - 3 + j) * shape_d(f, kb)
-            end do
-            half(row, col) = weights(p) * total
-          end do
-        end do
-      end do
-      do col = 1, plate_dofs
-        do ka = 1, (col + 2) / 3
-          do i = 1, 3
-            total = 0.0_dp
-            do f = 1, plate_fields
-              total = total + shape_d(f, ka) * half(3 * f - 3 + i, col)
-            end do
-            tangent(3 * ka - 3 + i, col) = tangent(3 * ka - 3 + i, col) + total
-          end do
-        end do
-      end do
+      call add_nodal_force(weights(p) * gradient, shape_d, nodal)
+      ! H is symmetric: the upper triangle, mirrored at the end
+      if (want_tangent) call add_point_tangent(hessian, shape_d, weights(p), .true., tangent)
     end do
     if (want_tangent) then
       do col = 1, plate_dofs
@@ -415,32 +376,22 @@ contains
     real(dp), intent(out) :: force(plate_dofs), energy, dissipation
     real(dp), intent(out) :: tangent(plate_dofs, plate_dofs)
     integer, intent(out) :: info
-    real(dp) :: plane_stress(3, 3), membrane_d(3, 3), bending_d(3, 3)
+    real(dp) :: membrane_d(3, 3), bending_d(3, 3)
     real(dp) :: fields(3, plate_fields), field_rates(3, plate_fields), point_w, point_power
     real(dp) :: gradient(3, plate_fields), hessian(15, 15), nodal(3, plate_shapes)
-    real(dp) :: half(15, plate_dofs), shape_d(plate_fields, plate_shapes), total
-    integer :: p, i, j, ka, kb, f, row, col
+    real(dp) :: shape_d(plate_fields, plate_shapes)
+    integer :: p
     info = 0
-    plane_stress = youngs / (1.0_dp - poisson**2) * reshape([1.0_dp, poisson, 0.0_dp, poisson, &
-                   1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp * (1.0_dp - poisson)], [3, 3])
-    membrane_d = thickness * plane_stress
-    bending_d = thickness**3 / 12.0_dp * plane_stress
+    call elastic_matrices(youngs, poisson, thickness, membrane_d, bending_d)
     energy = 0.0_dp
     dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp
     nodal = 0.0_dp
     do p = 1, plate_points
       shape_d = transpose(derivs(:, :, p))
-      fields = 0.0_dp
-      field_rates = 0.0_dp
-      do ka = 1, plate_shapes
-        do f = 1, plate_fields
-          fields(:, f) = fields(:, f) + coords(:, ka) * shape_d(f, ka)
-          field_rates(:, f) = field_rates(:, f) + rates(:, ka) * shape_d(f, ka)
-        end do
-      end do
-      if (norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
-          sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
+      call interpolate(coords, shape_d, fields)
+      call interpolate(rates, shape_d, field_rates)
+      if (degenerate(fields)) then
         info = 2
         return
       end if
@@ -449,38 +400,9 @@ contains
                                point_power, gradient, hessian)
       energy = energy + weights(p) * point_w
       dissipation = dissipation + weights(p) * point_power
-      gradient = weights(p) * gradient
-      do ka = 1, plate_shapes
-        do f = 1, plate_fields
-          nodal(:, ka) = nodal(:, ka) + gradient(:, f) * shape_d(f, ka)
-        end do
-      end do
-      if (.not. want_tangent) cycle
-      ! K += L^T H L with L = kron(dS^T, I3): half = w H L (15 x 36), then L^T half, every
-      ! entry (H is not symmetric)
-      do kb = 1, plate_shapes
-        do j = 1, 3
-          col = 3 * kb - 3 + j
-          do row = 1, 15
-            total = 0.0_dp
-            do f = 1, plate_fields
-              total = total + hessian(row, 3 * f - 3 + j) * shape_d(f, kb)
-            end do
-            half(row, col) = weights(p) * total
-          end do
-        end do
-      end do
-      do col = 1, plate_dofs
-        do ka = 1, plate_shapes
-          do i = 1, 3
-            total = 0.0_dp
-            do f = 1, plate_fields
-              total = total + shape_d(f, ka) * half(3 * f - 3 + i, col)
-            end do
-            tangent(3 * ka - 3 + i, col) = tangent(3 * ka - 3 + i, col) + total
-          end do
-        end do
-      end do
+      call add_nodal_force(weights(p) * gradient, shape_d, nodal)
+      ! H is not symmetric: every entry
+      if (want_tangent) call add_point_tangent(hessian, shape_d, weights(p), .false., tangent)
     end do
     force = reshape(nodal, [plate_dofs])
   end subroutine plate_forces_damped
@@ -636,5 +558,85 @@ contains
       rate(i, 3 * f - 2:3 * f) = g_rate / gnorm**3 - 3.0_dp * gg * g / gnorm**5
     end do
   end subroutine curvature_gradient_rate
+
+  !> The plane-stress membrane (h D) and bending (h^3/12 D) matrices.
+  pure subroutine elastic_matrices(youngs, poisson, thickness, membrane_d, bending_d)
+    real(dp), intent(in) :: youngs, poisson, thickness
+    real(dp), intent(out) :: membrane_d(3, 3), bending_d(3, 3)
+    real(dp) :: plane_stress(3, 3)
+    plane_stress = youngs / (1.0_dp - poisson**2) * reshape([1.0_dp, poisson, 0.0_dp, poisson, &
+                   1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 0.5_dp * (1.0_dp - poisson)], [3, 3])
+    membrane_d = thickness * plane_stress
+    bending_d = thickness**3 / 12.0_dp * plane_stress
+  end subroutine elastic_matrices
+
+  !> The fields z = (r_x, r_y, r_xx, r_yy, r_xy) (or their rates) at a Gauss point from the
+  !> nodal values (3, 12) and the shape derivatives there, shape_d(field, shape).
+  pure subroutine interpolate(values, shape_d, fields)
+    real(dp), intent(in) :: values(3, plate_shapes), shape_d(plate_fields, plate_shapes)
+    real(dp), intent(out) :: fields(3, plate_fields)
+    integer :: ka, f
+    fields = 0.0_dp
+    do ka = 1, plate_shapes
+      do f = 1, plate_fields
+        fields(:, f) = fields(:, f) + values(:, ka) * shape_d(f, ka)
+      end do
+    end do
+  end subroutine interpolate
+
+  !> Whether the normal r_x x r_y (nearly) vanishes: a degenerate configuration.
+  pure logical function degenerate(fields)
+    real(dp), intent(in) :: fields(3, plate_fields)
+    degenerate = norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
+                 sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))
+  end function degenerate
+
+  !> nodal += dS^T-weighted gradient: the point's share of the generalized force.
+  pure subroutine add_nodal_force(gradient, shape_d, nodal)
+    real(dp), intent(in) :: gradient(3, plate_fields), shape_d(plate_fields, plate_shapes)
+    real(dp), intent(inout) :: nodal(3, plate_shapes)
+    integer :: ka, f
+    do ka = 1, plate_shapes
+      do f = 1, plate_fields
+        nodal(:, ka) = nodal(:, ka) + gradient(:, f) * shape_d(f, ka)
+      end do
+    end do
+  end subroutine add_nodal_force
+
+  !> tangent += w L^T H L with L = kron(dS^T, I3), in two passes: half = w H L (15 x 36),
+  !> then L^T half; with upper_only the upper triangle alone (H symmetric; the caller
+  !> mirrors it).
+  pure subroutine add_point_tangent(hessian, shape_d, weight, upper_only, tangent)
+    real(dp), intent(in) :: hessian(15, 15), shape_d(plate_fields, plate_shapes), weight
+    logical, intent(in) :: upper_only
+    real(dp), intent(inout) :: tangent(plate_dofs, plate_dofs)
+    real(dp) :: half(15, plate_dofs), total
+    integer :: ka, kb, i, j, f, row, col, last
+    do kb = 1, plate_shapes
+      do j = 1, 3
+        col = 3 * kb - 3 + j
+        do row = 1, 15
+          total = 0.0_dp
+          do f = 1, plate_fields
+            total = total + hessian(row, 3 * f - 3 + j) * shape_d(f, kb)
+          end do
+          half(row, col) = weight * total
+        end do
+      end do
+    end do
+    do col = 1, plate_dofs
+      last = plate_shapes
+      if (upper_only) last = (col + 2) / 3
+      do ka = 1, last
+        do i = 1, 3
+          total = 0.0_dp
+          do f = 1, plate_fields
+            total = total + shape_d(f, ka) * half(3 * f - 3 + i, col)
+          end do
+          tangent(3 * ka - 3 + i, col) = tangent(3 * ka - 3 + i, col) + total
+        end do
+      end do
+    end do
+  end subroutine add_point_tangent
 
 end module plate_element

@@ -245,7 +245,7 @@ contains
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: w(3 * size(sys%block_first), sys%ncon), schur(sys%ncon, sys%ncon)
     real(dp) :: dlam(sys%ncon, 1), strain, previous_correction, step_cap, step_theta
-    integer :: it, pair, ipiv(sys%ncon), lapack_info, active
+    integer :: it, ipiv(sys%ncon), lapack_info, active
     logical :: use_known, refresh
     info = 0
     detail = 0
