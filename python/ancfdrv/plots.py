@@ -142,21 +142,28 @@ def load_cycle_summary(run: SpringRun, threshold: float = 0.03) -> dict[str, flo
     * ``area``: the loop's enclosed area, the trapezoid rule of F d(delta) around the closed
       loop (the last point joined to the first), delta = -(vertical displacement); it is the
       work of the applied force, positive when the spring dissipates;
-    * ``dissipated``: -(friction work + contact damping work) from /dynamic/energy, end minus
-      start (both works are negative);
-    * ``mechanical_change``: change of kinetic + strain + contact (+ gravity) energy, the
-      recorded total without the load cycle's potential F(t) z_chassis;
-    * ``residual``: area - dissipated - mechanical_change (zero when the books balance);
+    * ``friction_work``, ``damping_work`` (contact damping), ``material_damping_work``: the
+      works of /dynamic/energy over the run (negative: dissipated), and ``dissipated``,
+      minus their sum;
+    * ``mechanical_change`` (``left``): change of kinetic + strain + contact (+ gravity)
+      energy, the recorded total without the load cycle's potential F(t) z_chassis: what the
+      cycle leaves in the spring (a vibration, a state held by friction);
+    * ``residual``: area - dissipated - mechanical_change, the energy balance's error (zero
+      when the books balance; a spring released from its assembled state, ``spring.settle =
+      'none'``, loses hundreds of J in the first steps' impact that no work accounts for);
     * the same from ``t_from``, the first output time at which F reaches ``threshold`` of its
       peak (``work_from``, ``dissipated_from``, ``mechanical_change_from``,
-      ``residual_from``): a prestressed pack is released at t = 0 and the impact of the
-      leaves dominates the first steps' works."""
+      ``residual_from``), which leaves such a release out;
+    * ``secant_stiffness``: F / delta between the start and the peak force;
+    * ``hysteresis``: delta minus a cubic in F fitted over the cycle: the loop without its
+      mean curve encloses the same area and shows the friction band (and any vibration)."""
     force = run.cycle_force()
     delta = -run.chassis
     loop_f, loop_d = np.append(force, force[0]), np.append(delta, delta[0])
     area = float(np.sum(0.5 * (loop_f[1:] + loop_f[:-1]) * np.diff(loop_d)))
     e = run.energy
-    work = e["friction_work"] + e["damping_work"]
+    material = e.get("material_damping_work", np.zeros_like(e["friction_work"]))
+    work = e["friction_work"] + e["damping_work"] + material
     mechanical = e["total"] - force * run.chassis_z
     dissipated = float(-(work[-1] - work[0]))
     change = float(mechanical[-1] - mechanical[0])
@@ -164,14 +171,24 @@ def load_cycle_summary(run: SpringRun, threshold: float = 0.03) -> dict[str, flo
     work_from = float(np.sum(0.5 * (force[k + 1:] + force[k:-1]) * np.diff(delta[k:])))
     dissipated_from = float(-(work[-1] - work[k]))
     change_from = float(mechanical[-1] - mechanical[k])
+    peak = int(np.argmax(force))
+    secant = (force[peak] - force[0]) / (delta[peak] - delta[0]) if peak > 0 else np.inf
+    # the mean curve delta(F): a cubic in F fitted over the cycle (any function of F leaves
+    # the area of the loop unchanged: F d(p(F)) is a total differential)
+    scale = max(float(force.max()), 1.0)
+    mean = np.polyval(np.polyfit(force / scale, delta, 3), force / scale) \
+        if peak > 0 else np.full_like(delta, delta[0])
     return {"force": force, "deflection": delta, "area": area, "dissipated": dissipated,
             "friction_work": float(e["friction_work"][-1] - e["friction_work"][0]),
             "damping_work": float(e["damping_work"][-1] - e["damping_work"][0]),
-            "mechanical_change": change, "residual": area - dissipated - change,
+            "material_damping_work": float(material[-1] - material[0]),
+            "mechanical_change": change, "left": change, "residual": area - dissipated - change,
             "t_from": float(run.time[k]), "work_from": work_from,
             "dissipated_from": dissipated_from, "mechanical_change_from": change_from,
             "residual_from": work_from - dissipated_from - change_from,
-            "peak_force": float(force.max()), "peak_deflection": float(delta.max())}
+            "peak_force": float(force.max()), "peak_deflection": float(delta.max()),
+            "secant_stiffness": float(secant),
+            "hysteresis": delta - mean}
 
 
 LINESTYLES = ("-", "--", ":", "-.")
@@ -212,13 +229,12 @@ def plot_spring(h5_paths: list[str | Path], png: str | Path | None = None) -> Pa
     axes[-1].set_xlabel("time (s)")
     for a in axes[:-1]:
         a.tick_params(labelbottom=False)
-    if cycles:  # the loop above, its figures (legend) in the bottom row
-        loop = fig.add_subplot(grid[:rows - 1, 1])
-        _loop_panel(loop, runs, labels, colours)
+    if cycles:  # the loop, its friction band magnified, and its energy books as a table
+        loop = fig.add_subplot(grid[:max(rows - 2, 1), 1])
+        band = fig.add_subplot(grid[rows - 2, 1]) if rows > 2 else None
         notes = fig.add_subplot(grid[rows - 1, 1])
-        notes.axis("off")
-        notes.legend(*loop.get_legend_handles_labels(), fontsize=7, loc="upper left",
-                     frameon=False)
+        _loop_panel(loop, band, runs, labels, colours)
+        _loop_table(notes, runs, labels, colours)
     fig.savefig(png, dpi=120)
     plt.close(fig)
     return png
@@ -276,32 +292,74 @@ def _energy_panel(ax, runs: list[SpringRun], labels: list[str], colours: list[st
     ax.set_ylabel("energy (J)")
 
 
-def _loop_panel(ax, runs: list[SpringRun], labels: list[str], colours: list[str]) -> None:
-    """Force against downward deflection of the load-cycle runs: loading (t < T/2) solid,
-    unloading dashed; area and works per run in the line labels."""
+def _loop_panel(ax, band, runs: list[SpringRun], labels: list[str],
+                colours: list[str]) -> None:
+    """Force against downward deflection of the load-cycle runs (loading solid, unloading
+    dashed, the start a dot) and, in ``band``, the same loops without their mean curve
+    (``load_cycle_summary``'s hysteresis): the friction band, magnified."""
     for run, label, colour in zip(runs, labels, colours):
         if not run.cycle:
             continue
         s = load_cycle_summary(run)
         half = run.time <= 0.5 * float(run.values["spring"]["cycle_period"])
-        text = (f"{label}\nloop area {s['area']:.4g} J; friction + damping "
-                f"{s['dissipated']:.4g} J (friction {-s['friction_work']:.4g} J, damping "
-                f"{-s['damping_work']:.4g} J);\nE_mech change {s['mechanical_change']:.3g} J, "
-                f"unbalanced {s['residual']:.3g} J\nfrom t = {s['t_from']:.3g} s (F > 3 % of "
-                f"peak): work of F {s['work_from']:.4g} J, friction + damping "
-                f"{s['dissipated_from']:.4g} J,\nE_mech change "
-                f"{s['mechanical_change_from']:.3g} J, unbalanced {s['residual_from']:.2g} J")
-        ax.plot(1e3 * s["deflection"][half], 1e-3 * s["force"][half], color=colour, lw=0.8,
-                label=text)
-        ax.plot(1e3 * s["deflection"][~half], 1e-3 * s["force"][~half], "--", color=colour,
-                lw=0.8)
+        f, d, h = 1e-3 * s["force"], 1e3 * s["deflection"], 1e3 * s["hysteresis"]
+        ax.plot(d[half], f[half], color=colour, lw=0.9, label=label)
+        ax.plot(d[~half], f[~half], "--", color=colour, lw=0.9)
+        ax.plot(d[:1], f[:1], "o", color=colour, ms=4)
+        if band is not None:
+            band.plot(h[half], f[half], color=colour, lw=0.9)
+            band.plot(h[~half], f[~half], "--", color=colour, lw=0.9)
+            band.plot(h[:1], f[:1], "o", color=colour, ms=4)
     ax.axvline(0.0, color="0.6", lw=0.6)
-    ax.set_xlabel("chassis deflection, downward (mm)")
+    ax.set_xlabel("chassis deflection from the assembled spring, downward (mm)")
     ax.set_ylabel("force on the chassis, downward (kN)")
-    ax.set_title("load cycle: F = F_c (1 - cos(2 pi t / T)) / 2 (from spring.cycle_force, "
-                 "cycle_period);\nloading solid, unloading dashed; area = closed-loop "
-                 "trapezoid of F d(delta)", fontsize=8)
+    ax.set_title("load cycle F = F_c (1 - cos(2 pi t / T)) / 2: loading solid, unloading "
+                 "dashed, start (settled state) o", fontsize=8)
+    ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)
+    if band is not None:
+        band.axvline(0.0, color="0.6", lw=0.6)
+        band.set_xlabel("deflection - its mean curve, a cubic in F (mm): the loop "
+                        "magnified, same area", fontsize=9)
+        band.set_ylabel("force (kN)")
+        band.grid(alpha=0.3)
+
+
+def _loop_table(ax, runs: list[SpringRun], labels: list[str], colours: list[str]) -> None:
+    """The loop's energy books per run: the area (the work of the applied force around the
+    loop) against the works that dissipate it and what the cycle left in the spring."""
+    ax.axis("off")
+    header = ["run", "loop area", "friction", "contact\ndamping", "material\ndamping",
+              "left in\nthe spring", "balance\nerror"]
+    rows, row_colours = [], []
+    for run, label, colour in zip(runs, labels, colours):
+        if not run.cycle:
+            continue
+        s = load_cycle_summary(run)
+        settle = str(run.values.get("spring", {}).get("settle", ""))
+        rows.append([f"{label}\n(settle '{settle}')" if settle else label,
+                     *(_joules(v) for v in (s["area"], -s["friction_work"],
+                                             -s["damping_work"], -s["material_damping_work"],
+                                             s["left"], s["residual"]))])
+        row_colours.append(colour)
+    if not rows:
+        return
+    table = ax.table(cellText=rows, colLabels=header, loc="upper center", cellLoc="center",
+                     colWidths=[0.34] + [0.11] * 6)
+    table.auto_set_font_size(False)
+    table.set_fontsize(7)
+    table.scale(1.0, 2.4)
+    for i, colour in enumerate(row_colours, start=1):
+        table[i, 0].get_text().set_color(colour)
+    ax.set_title("loop area = friction + contact damping + material damping + left in the "
+                 "spring + balance error\n(dissipated works counted positive; 'left': "
+                 "kinetic + strain + contact energy at the end minus at the start)",
+                 fontsize=7.5)
+
+
+def _joules(value: float) -> str:
+    """An energy for the loop table: three significant digits, no '-0'."""
+    return "0" if value == 0.0 else f"{value:.3g} J"
 
 
 def plot_plate_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
