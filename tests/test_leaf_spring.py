@@ -393,24 +393,132 @@ def test_settled_spring_conserves_energy_balance(spring_runs, case):
     assert run["penetration"].max() < 0.15 * 0.014
 
 
-def test_load_cycle_loop_area_equals_friction_and_damping_work(tmp_path):
-    """inputs/leaf_spring_cycle.nml (shortened to a 2 s cycle): the work of the applied force
-    around the loop equals the work dissipated by friction and contact damping plus the
-    change of mechanical energy (energy identity, counted after the prestress has been
-    released in the first 0.15 s, when the force is still below 3 % of its peak)."""
-    out = tmp_path / "cycle.h5"
-    run_scene(INPUTS / "leaf_spring_cycle.nml", ["solver.t_end=2.0", "spring.cycle_period=2.0"],
-              out, progress=False)
-    with h5py.File(out) as h5:
-        t = h5["dynamic/time"][()]
-        z = h5["dynamic/deflection/chassis"][:, 2]
-        energy = {k: h5[f"dynamic/energy/{k}"][()] for k in h5["dynamic/energy"]}
-    start = np.searchsorted(t, 0.15)
-    force = 9810.0 * 0.5 * (1 - np.cos(2 * np.pi * t / 2.0))   # downward, on the chassis
-    work = -np.trapezoid(force[start:], z[start:])  # work of the force along its motion
-    mechanical = energy["kinetic"] + energy["strain"] + energy["contact"]
-    dissipated = -(energy["friction_work"][-1] + energy["damping_work"][-1]
-                   - energy["friction_work"][start] - energy["damping_work"][start])
-    stored = mechanical[-1] - mechanical[start]
-    assert dissipated > 0 and work > 0
-    assert abs(work - (dissipated + stored)) < 0.05 * dissipated
+# -- the load cycle from the settled state (issue 15, item 4) -------------------------------
+CYCLE_FORCE, CYCLE_PERIOD = 9810.0, 8.0       # inputs/leaf_spring_cycle.nml
+#: everything that moves with the chassis: chassis, shackle, both leaves (kg)
+MOVING_MASS = 500.0 + 2.0 + 7810.0 * 0.07 * 0.014 * (1.2 + 0.8)
+
+
+def _static_cycle_curve(prestress: bool, forces: np.ndarray) -> np.ndarray:
+    """The chassis's vertical displacement (from the assembled spring) in the frictionless
+    static equilibrium under a constant downward force on the chassis, for each force: the
+    quasi-static curve a loop without friction and inertia would follow. Static Newton on the
+    cycle scene's model, the load cycle's drive replaced by a dead force scaled by the load
+    factor."""
+    from ancfdrv.builders import build_system
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.solvers.static import solve_newton
+    scene = load_scene(INPUTS / "leaf_spring_cycle.nml",
+                       [] if prestress else ["leaf.prestress=.false."])
+    system = build_system(scene).system
+    system.load("static force", "force", body="chassis", point=system.probes["chassis"].point,
+                vector=(0.0, 0.0, -forces.max()))
+    effects = tuple(e for e in scene.effects if e not in ("load_cycle", "friction"))
+    model = system.assemble(effects=effects + ("point_loads",))
+    z0 = model.probe_positions(model.e0)["chassis"][2]
+    out = []
+    for force in forces:
+        result = solve_newton(model, tol=1e-12, loads=force / forces.max())
+        out.append(model.probe_positions(result.e)["chassis"][2] - z0)
+    return np.array(out)
+
+
+def _cycle_run(path, overrides):
+    from ancfdrv.plots import load_cycle_summary, read_spring
+    run_scene(INPUTS / "leaf_spring_cycle.nml", ["output.xdmf=.false."] + overrides, path,
+              progress=False)
+    run = read_spring(path)
+    return run, load_cycle_summary(run)
+
+
+@pytest.fixture(scope="module")
+def cycle_runs(tmp_path_factory):
+    """inputs/leaf_spring_cycle.nml as shipped (8 s cycle, settled start), prestress on and
+    off, with the frictionless static curve of each."""
+    from scipy.interpolate import CubicSpline
+    out = tmp_path_factory.mktemp("cycle")
+    runs = {}
+    for name, extra in (("on", []), ("off", ["leaf.prestress=.false."])):
+        run, summary = _cycle_run(out / f"{name}.h5", extra)
+        forces = np.linspace(0.0, CYCLE_FORCE, 11)
+        static = _static_cycle_curve(name == "on", forces)
+        runs[name] = dict(run=run, summary=summary, forces=forces, static=static,
+                          deviation=run.chassis - CubicSpline(forces, static)(summary["force"]))
+    return runs
+
+
+@pytest.mark.parametrize("case", ["on", "off"])
+def test_load_cycle_loop_area_equals_friction_and_damping_work(cycle_runs, case):
+    """The loop of the shipped load cycle, started from the settled state, prestress on and
+    off: its area (the work of the applied force around the closed force-deflection loop,
+    plots.load_cycle_summary) equals the friction + contact damping work (material damping
+    is off) within what the cycle leaves in the spring.
+
+    What may be left is the bounce the force's onset and end excite: F = F_c (1 - cos Omega
+    t) / 2 steps its second derivative at both ends, so an undamped oscillator of stiffness k
+    and frequency omega keeps a free vibration of amplitude a = F_c r^2 / (2 k (1 - r^2)),
+    r = Omega / omega, from each end (closed form), at most 2 a after the cycle, which holds
+    the energy k (2 a)^2 / 2. With k the static curve's secant and the mass of everything
+    that moves (517 kg: an upper bound of the effective mass, hence of r) this bound is
+    1.2e-3 J: 1.3 % (on) and 2 % (off) of the dissipated work. Measured: area 0.09212 J
+    against 0.09201 J dissipated (on) and 0.0581 against 0.0579 J (off); the energy books
+    (area = dissipated + left) close to 3e-5 J."""
+    s = cycle_runs[case]["summary"]
+    forces, static = cycle_runs[case]["forces"], cycle_runs[case]["static"]
+    k = forces[-1] / (static[0] - static[-1])
+    omega = np.sqrt(k / MOVING_MASS)
+    r2 = (2 * np.pi / CYCLE_PERIOD / omega) ** 2
+    a = CYCLE_FORCE * r2 / (2 * k * (1 - r2))
+    bound = 0.5 * k * (2 * a) ** 2
+    print(f"\nprestress {case}: area {s['area']:.5f} J, friction {-s['friction_work']:.5f} J, "
+          f"contact damping {-s['damping_work']:.2e} J, left {s['left']:.2e} J (bound "
+          f"{bound:.2e} J), books {s['residual']:.1e} J")
+    assert s["dissipated"] > 0 and s["area"] > 0
+    assert s["material_damping_work"] == 0.0
+    assert abs(s["residual"]) < 1e-3 * s["dissipated"]          # the energy books close
+    assert abs(s["left"]) < bound < 0.025 * s["dissipated"]
+    assert s["area"] == pytest.approx(s["dissipated"], rel=0.025)
+
+
+@pytest.mark.parametrize("case", ["on", "off"])
+def test_load_cycle_from_settled_state_does_not_ring(cycle_runs, case, tmp_path):
+    """Without ringing: the chassis follows the frictionless static curve z_static(F(t))
+    (static Newton solves of the same model at 11 forces, spline-interpolated) to within
+    0.5 % of the loop's deflection range at every output step; the rest is the friction band
+    and the bounce of amplitude a (previous test's closed form, 0.06 mm). Measured: 0.10 mm
+    of 59 mm (0.17 %), both cases. The old start from the assembled spring (spring.settle =
+    'none', prestress on) rang at 2.8 Hz by +-20 mm: between 0.25 and 1 s it leaves the static
+    curve by more than ten times the tolerance (measured 11.6 mm, 20 % of the range)."""
+    runs = cycle_runs[case]
+    span = np.ptp(runs["static"])
+    deviation = np.abs(runs["deviation"]).max()
+    print(f"\nprestress {case}: max |z - z_static(F)| {deviation * 1e3:.3f} mm of "
+          f"{span * 1e3:.1f} mm")
+    assert deviation < 0.005 * span
+    assert runs["run"].chassis[0] == pytest.approx(runs["static"][0], abs=1e-6)  # settled
+    if case == "on":
+        from scipy.interpolate import CubicSpline
+        run, summary = _cycle_run(tmp_path / "none.h5", ["spring.settle=none",
+                                                         "solver.t_end=1.0"])
+        released = run.chassis - CubicSpline(runs["forces"], runs["static"])(summary["force"])
+        later = run.time >= 0.25   # after the release itself: the ringing it leaves
+        assert np.abs(released[later]).max() > 10 * 0.005 * span
+
+
+def test_load_cycle_plot_shows_the_friction_band(cycle_runs, tmp_path):
+    """`ancf plot` of the two shipped cycles writes its figure, and the magnified loop's
+    bounce averaging (plots._bounce_average) takes a free bounce off a slow curve: a
+    0.06 mm, 2.84 Hz sine on a 0.01 mm band over the 8 s cycle comes back to the band within
+    3 % of the bounce's amplitude away from the ends (one period at each end averages what
+    there is)."""
+    from ancfdrv.cli import main
+    from ancfdrv.plots import _bounce_average
+    png = tmp_path / "cycle.png"
+    paths = [str(cycle_runs[c]["run"].path) for c in ("on", "off")]
+    assert main(["plot", *paths, "-o", str(png)]) == 0 and png.stat().st_size > 0
+    t = np.arange(0.0, 8.0 + 1e-9, 1e-3)
+    band = 1e-5 * np.sin(np.pi * t / 8.0)
+    bounce = 6e-5 * np.sin(2 * np.pi * 2.84 * t + 0.3)
+    smooth = _bounce_average(t, band + bounce)
+    inner = (t > 0.5) & (t < 7.5)
+    assert np.abs(smooth - band)[inner].max() < 0.03 * 6e-5

@@ -307,9 +307,11 @@ def _loop_panel(ax, band, runs: list[SpringRun], labels: list[str],
         ax.plot(d[~half], f[~half], "--", color=colour, lw=0.9)
         ax.plot(d[:1], f[:1], "o", color=colour, ms=4)
         if band is not None:
-            band.plot(h[half], f[half], color=colour, lw=0.9)
-            band.plot(h[~half], f[~half], "--", color=colour, lw=0.9)
-            band.plot(h[:1], f[:1], "o", color=colour, ms=4)
+            smooth = _bounce_average(run.time, h)
+            band.plot(h, f, color=colour, lw=0.5, alpha=0.35)
+            band.plot(smooth[half], f[half], color=colour, lw=1.2)
+            band.plot(smooth[~half], f[~half], "--", color=colour, lw=1.2)
+            band.plot(smooth[:1], f[:1], "o", color=colour, ms=4)
     ax.axvline(0.0, color="0.6", lw=0.6)
     ax.set_xlabel("chassis deflection from the assembled spring, downward (mm)")
     ax.set_ylabel("force on the chassis, downward (kN)")
@@ -319,10 +321,31 @@ def _loop_panel(ax, band, runs: list[SpringRun], labels: list[str],
     ax.grid(alpha=0.3)
     if band is not None:
         band.axvline(0.0, color="0.6", lw=0.6)
-        band.set_xlabel("deflection - its mean curve, a cubic in F (mm): the loop "
-                        "magnified, same area", fontsize=9)
+        band.set_xlabel("deflection - its mean curve, a cubic in F (mm): the loop magnified; "
+                        "thin: as computed, with the small bounce\nthe force's onset excites; "
+                        "thick: averaged over one bounce period (the friction band)", fontsize=8)
         band.set_ylabel("force (kN)")
         band.grid(alpha=0.3)
+
+
+def _bounce_average(time: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """``values`` averaged over one period of their strongest oscillation above 0.5 Hz (a
+    centred moving average; the ends average what there is): removes a free bounce riding on
+    a slow curve."""
+    if len(time) < 8:
+        return values
+    dt = float(np.mean(np.diff(time)))
+    spectrum = np.abs(np.fft.rfft(values - values.mean()))
+    freq = np.fft.rfftfreq(len(values), dt)
+    above = freq > 0.5
+    if not above.any():
+        return values
+    width = int(round(1.0 / (freq[above][np.argmax(spectrum[above])] * dt)))
+    if width < 2:
+        return values
+    kernel = np.ones(width)
+    return (np.convolve(values, kernel, "same") /
+            np.convolve(np.ones_like(values), kernel, "same"))
 
 
 def _loop_table(ax, runs: list[SpringRun], labels: list[str], colours: list[str]) -> None:
