@@ -56,6 +56,9 @@ subroutine system_reset_stepper(handle, info)
   if (info /= 0) return
   sys%theta = -1.0d0
   sys%unconfirmed = 0
+  sys%reuse_failures = 0
+  sys%reuse_backoff = 0
+  sys%reuse_skip = 0
   if (sys%policy /= policy_constant) sys%factorized = .false.
 end subroutine system_reset_stepper
 

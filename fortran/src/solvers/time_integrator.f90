@@ -25,7 +25,11 @@
 !>   contracts; refreshed at the current iterate when a correction is not below
 !>   `contraction` times the previous one, when the number of active contact points
 !>   differs from the factorization's, when beta' changed; a step that fails with a
-!>   matrix from an earlier step is retried once from its start with a fresh one.
+!>   matrix from an earlier step is retried once from its start with a fresh one. Where the
+!>   matrix of an earlier step does not serve (two steps in a row that started with it had
+!>   to refresh it: a fast rotation turns the stiff directions in every step), the next
+!>   steps start with a fresh matrix, 1, 2, 4 .. max_reuse_backoff of them before reuse is
+!>   tried again; a step that succeeds with an old matrix halves the back-off.
 !> Penalty contact uses the predictor q_{n+1} = q_n and damps corrections to half a
 !> thickness (an acceleration predictor carries a contact impulse of the last step into the
 !> next one, far through the other leaf).
@@ -44,6 +48,8 @@ module time_integrator
   public :: integrator_settings, integrator_chunk, output_row
 
   integer, parameter, public :: jacobian_step = 1, jacobian_iteration = 2, jacobian_reuse = 3
+  !> the most steps jacobian_reuse starts with a fresh matrix before trying an old one again
+  integer, parameter :: max_reuse_backoff = 64
   !> per-step statistics: Newton corrections, factorizations, Jacobian evaluations
   integer, parameter, public :: stat_corrections = 1, stat_factorizations = 2, &
                                 stat_jacobians = 3, stat_count = 3
@@ -126,7 +132,7 @@ contains
     real(dp) :: powers_new(power_count), strain
     real(dp) :: contact_potential, h, beta_prime, velocity_factor
     integer :: step, attempt, stats(stat_count)
-    logical :: done, fresh_matrix
+    logical :: done, fresh_matrix, start_fresh, started_old
     info = 0
     detail = 0
     steps_done = 0
@@ -139,17 +145,22 @@ contains
       stats = 0
       call frame_rotations(sys, t + h, rotations, rates, info)
       if (info /= 0) return
+      start_fresh = sys%reuse_skip > 0
+      if (start_fresh) sys%reuse_skip = sys%reuse_skip - 1
+      started_old = .false.
       do attempt = 1, 2
         call predict(sys, cfg, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
         lam_new = lam
         fresh_matrix = .false.
-        if (needs_factorization(sys, cfg, beta_prime, attempt)) then
+        if (needs_factorization(sys, cfg, beta_prime, attempt) .or. start_fresh) then
           call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
                            predicted_internal, strain, sys%factor_active, info, detail, rates)
           if (info /= 0) return
           stats(stat_factorizations) = stats(stat_factorizations) + 1
           stats(stat_jacobians) = stats(stat_jacobians) + 1
           fresh_matrix = sys%policy /= policy_constant
+        else if (attempt == 1) then
+          started_old = sys%policy /= policy_constant
         end if
         call newton(sys, cfg, t + h, rotations, rates, beta_prime, velocity_factor, e_new, &
                     v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
@@ -164,6 +175,7 @@ contains
         info = 1
         return
       end if
+      if (started_old) call update_reuse_backoff(sys, stats(stat_factorizations) > 0)
       ! accept the step
       a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
               / (1.0_dp - cfg%alpha_m)
@@ -213,6 +225,23 @@ contains
     end if
     v_new = v + h * ((1.0_dp - cfg%gamma) * a + cfg%gamma * a_new)
   end subroutine predict
+
+  !> jacobian_reuse's back-off after a step that started with a matrix of an earlier step:
+  !> refreshed, it had to refresh that matrix (or retry with a fresh one).
+  pure subroutine update_reuse_backoff(sys, refreshed)
+    type(system_model), intent(inout) :: sys
+    logical, intent(in) :: refreshed
+    if (refreshed) then
+      sys%reuse_failures = sys%reuse_failures + 1
+      if (sys%reuse_failures >= 2) then
+        sys%reuse_backoff = min(max(1, 2 * sys%reuse_backoff), max_reuse_backoff)
+        sys%reuse_skip = sys%reuse_backoff
+      end if
+    else
+      sys%reuse_failures = 0
+      sys%reuse_backoff = sys%reuse_backoff / 2
+    end if
+  end subroutine update_reuse_backoff
 
   !> Whether the step starts with a new factorization.
   pure logical function needs_factorization(sys, cfg, beta_prime, attempt)

@@ -130,6 +130,10 @@ module mechanical_system
     ! accepted since without measuring it again
     real(dp) :: theta = -1.0_dp
     integer :: unconfirmed = 0
+    ! jacobian_reuse back-off: steps that started with a matrix of an earlier step and had
+    ! to refresh it (in a row), the current back-off and the steps still to start with a
+    ! fresh matrix
+    integer :: reuse_failures = 0, reuse_backoff = 0, reuse_skip = 0
     real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
   end type system_model
 
