@@ -59,7 +59,7 @@ module time_integrator
     real(dp) :: tol = 1e-10_dp, length_scale = 1.0_dp
     integer :: max_newton = 10
     integer :: jacobian = jacobian_step
-    real(dp) :: contraction = 0.5_dp
+    real(dp) :: contraction = 0.25_dp
   end type integrator_settings
 
 contains

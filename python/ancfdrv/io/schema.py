@@ -244,9 +244,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                         "14), 'step' (at each step, and when a correction does not halve), "
                         "'iteration' (full Newton); pure FFR systems factorize once whatever "
                         "this says"),
-        "contraction": Key("float", 0.5, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+        "contraction": Key("float", 0.25, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                            "jacobian = 'reuse': refresh when a correction exceeds this fraction "
-                           "of the previous one"),
+                           "of the previous one (0.25: an old matrix that contracts more slowly "
+                           "costs more corrections than a new one costs to factorize)"),
         "settle": Key("str", "none", one_of("none", "unloaded", "loaded"),
                       "dynamic runs start at rest from: 'none' the assembled configuration; "
                       "'unloaded' the equilibrium of the internal forces alone (prestress "

@@ -60,7 +60,7 @@ class DynamicSettings:
     chunk_steps: int = 1000
     store_q: bool = False
     jacobian: str = "step"
-    contraction: float = 0.5
+    contraction: float = 0.25
     length_scale: float = 1.0
 
     @classmethod
