@@ -105,13 +105,13 @@ contains
         law = law_poisson
         if (all(law == 0.0_dp)) cycle
       end if
-      deformation = matmul(q, gradients(:, :, p))
+      call deformation_gradient(q, gradients(:, :, p), deformation)
       call green_lagrange(deformation, strain)
       stress = matmul(law, strain)
       energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
-      call strain_matrix(deformation, gradients(:, :, p), b)
-      force = force + weights(p) * matmul(transpose(b), stress)
+      call add_nodal_force(deformation, stress, gradients(:, :, p), weights(p), force)
       if (.not. want_tangent) cycle
+      call strain_matrix(deformation, gradients(:, :, p), b)
       db = matmul(law, b)
       tangent = tangent + weights(p) * matmul(transpose(b), db)
       call add_geometric_stiffness(stress, gradients(:, :, p), weights(p), tangent)
@@ -145,8 +145,8 @@ contains
         law = law_poisson
         if (all(law == 0.0_dp)) cycle
       end if
-      deformation = matmul(q, gradients(:, :, p))
-      deformation_rate = matmul(rates, gradients(:, :, p))
+      call deformation_gradient(q, gradients(:, :, p), deformation)
+      call deformation_gradient(rates, gradients(:, :, p), deformation_rate)
       call green_lagrange(deformation, strain)
       call green_lagrange_rate(deformation, deformation_rate, strain_rate)
       stress = matmul(law, strain)
@@ -154,9 +154,9 @@ contains
       energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
       dissipation = dissipation + weights(p) * dot_product(strain_rate, damping_stress)
       stress = stress + damping_stress
-      call strain_matrix(deformation, gradients(:, :, p), b)
-      force = force + weights(p) * matmul(transpose(b), stress)
+      call add_nodal_force(deformation, stress, gradients(:, :, p), weights(p), force)
       if (.not. want_tangent) cycle
+      call strain_matrix(deformation, gradients(:, :, p), b)
       ! (1 + c tau) B^T D B + tau B^T D B(F') + the geometric term of the total stress
       call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
       tangent = tangent + weights(p) * matmul(transpose(b), &
@@ -180,6 +180,40 @@ contains
     strain_rate(6) = dot_product(deformation(:, 1), deformation_rate(:, 3)) &
                      + dot_product(deformation(:, 3), deformation_rate(:, 1))
   end subroutine green_lagrange_rate
+
+  !> F = sum_a q_a g_a^T (or its rate, with the nodal rates for q) at one point.
+  pure subroutine deformation_gradient(q, point_gradients, deformation)
+    real(dp), intent(in) :: q(3, 8), point_gradients(8, 3)
+    real(dp), intent(out) :: deformation(3, 3)
+    integer :: a, k
+    deformation = 0.0_dp
+    do k = 1, 3
+      do a = 1, 8
+        deformation(:, k) = deformation(:, k) + q(:, a) * point_gradients(a, k)
+      end do
+    end do
+  end subroutine deformation_gradient
+
+  !> force += w B^T S, as Q_a += w F S g_a (S the symmetric stress matrix of the Voigt
+  !> stress): without forming B, which only the tangent needs.
+  pure subroutine add_nodal_force(deformation, stress, point_gradients, weight, force)
+    real(dp), intent(in) :: deformation(3, 3), stress(6), point_gradients(8, 3), weight
+    real(dp), intent(inout) :: force(24)
+    real(dp) :: piola(3, 3)
+    integer :: a
+    ! w F S, column by column of S = [S1 S4 S6; S4 S2 S5; S6 S5 S3]
+    piola(:, 1) = weight * (deformation(:, 1) * stress(1) + deformation(:, 2) * stress(4) &
+                            + deformation(:, 3) * stress(6))
+    piola(:, 2) = weight * (deformation(:, 1) * stress(4) + deformation(:, 2) * stress(2) &
+                            + deformation(:, 3) * stress(5))
+    piola(:, 3) = weight * (deformation(:, 1) * stress(6) + deformation(:, 2) * stress(5) &
+                            + deformation(:, 3) * stress(3))
+    do a = 1, 8
+      force(3 * a - 2:3 * a) = force(3 * a - 2:3 * a) + piola(:, 1) * point_gradients(a, 1) &
+                               + piola(:, 2) * point_gradients(a, 2) &
+                               + piola(:, 3) * point_gradients(a, 3)
+    end do
+  end subroutine add_nodal_force
 
   !> Green-Lagrange strain in Voigt form with engineering shears [E11, E22, E33, 2E12, 2E23, 2E13].
   pure subroutine green_lagrange(deformation, strain)
