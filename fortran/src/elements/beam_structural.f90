@@ -165,7 +165,7 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
-    integer :: t, j
+    integer :: t, j, a
     force = 0.0_dp
     energy = 0.0_dp
     tangent = 0.0_dp
@@ -174,7 +174,9 @@ contains
       gradient = matmul(q, forms(:, :, t))
       strain = 0.5_dp * sum(q * gradient) - strain0(t)
       energy = energy + 0.5_dp * stiffness(t) * strain**2
-      flat = reshape(gradient, [24])
+      do a = 1, 8  ! the 3 x 8 gradient as 24 numbers, copied in place of a reshape
+        flat(3 * a - 2:3 * a) = gradient(:, a)
+      end do
       force = force + stiffness(t) * strain * flat
       if (.not. want_tangent) cycle
       do j = 1, 24
