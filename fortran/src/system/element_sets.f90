@@ -28,6 +28,10 @@ module element_sets
   public :: element_set, set_forces, set_tangent_values, set_energy_power, frame_omega
 
   integer, parameter, public :: set_ffr = 1, set_continuum = 2, set_structural = 3, set_plate = 4
+  !> Work of an element loop (microseconds on one thread) below which it runs on one thread
+  !> whatever OMP_NUM_THREADS says: waking the sleeping team (OMP_WAIT_POLICY passive) costs
+  !> more than it saves (2 threads made the 4-node cubic boom 5.6 times slower)
+  real(dp), parameter :: threaded_work = 200.0_dp
 
   type :: element_set
     integer :: kind = 0
@@ -179,7 +183,7 @@ contains
     element_info = 0
     if (damped) then
       allocate (element_power(set%nel))
-      !$omp parallel do schedule(static)
+      !$omp parallel do schedule(static) if(loop_work(set, want_tangent) >= threaded_work)
       do el = 1, set%nel
         call element_forces(set, el, e, want_tangent, element_force(:, el), element_energy(el), &
                             tangents(:, :, merge(el, 1, want_tangent)), element_info(el), v, &
@@ -187,7 +191,7 @@ contains
       end do
       !$omp end parallel do
     else
-      !$omp parallel do schedule(static)
+      !$omp parallel do schedule(static) if(loop_work(set, want_tangent) >= threaded_work)
       do el = 1, set%nel
         call element_forces(set, el, e, want_tangent, element_force(:, el), element_energy(el), &
                             tangents(:, :, merge(el, 1, want_tangent)), element_info(el))
@@ -207,6 +211,24 @@ contains
     if (present(dissipation)) dissipation = power
     if (want_tangent) call scatter_add(set, tangents, tangent_values)
   end subroutine set_forces
+
+  !> Estimated work of one pass over a set's elements, microseconds on one thread (per
+  !> element, as benchmarks/element_cost.py and plate_cost.py measured: force / force +
+  !> tangent: continuum beam 1.2 / 15, cubic beam 1.2 / 3, plate 6 / 80).
+  pure real(dp) function loop_work(set, want_tangent)
+    type(element_set), intent(in) :: set
+    logical, intent(in) :: want_tangent
+    real(dp) :: per_element
+    select case (set%kind)
+    case (set_continuum)
+      per_element = merge(15.0_dp, 1.2_dp, want_tangent)
+    case (set_structural)
+      per_element = merge(3.0_dp, 1.2_dp, want_tangent)
+    case default
+      per_element = merge(80.0_dp, 6.0_dp, want_tangent)
+    end select
+    loop_work = per_element * set%nel
+  end function loop_work
 
   !> One element of a large-deformation set; with the full coordinate rates v (a damped
   !> set: then rate_factor and dissipation too), the damping force, the combined tangent and
