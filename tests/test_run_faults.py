@@ -27,10 +27,11 @@ from ancfdrv.cli import main
 from ancfdrv.errors import Interrupted
 
 TINY = ["--set", "beam.nodes=4", "--set", "solver.t_end=0.5"]
-# ~1 ms per step, 20000 steps: long enough to be signalled, and one output chunk of 10000
-# steps would take ~10 s in one kernel call without the integrator's sub-chunks
+# 0.2-1 ms per step, 60000 steps: long enough to be signalled after the first chunk (every
+# test that uses it stops the run), and one output chunk of 10000 steps would take 2-10 s
+# in one kernel call without the integrator's sub-chunks
 LONG = ["--set", "beam.nodes=28", "--set", "scene.formulation=nonlinear", "--set",
-        "solver.static_method=newton", "--set", "solver.t_end=20", "--set",
+        "solver.static_method=newton", "--set", "solver.t_end=60", "--set",
         "output.chunk_steps=10000"]
 HANG_GUARD_S = 60  # a bound against hanging, not a measurement
 
@@ -193,20 +194,26 @@ def test_a_previous_result_survives_a_refused_run(scene, tmp_path, capsys):
 def test_second_writer_is_refused_naming_the_first(scene, tmp_path, capsys):
     out = tmp_path / "shared.h5"
     first = ancf("run", str(scene), "-o", str(out), *LONG[2:-4], "--set", "beam.nodes=10",
-                 "--set", "solver.t_end=4")
+                 "--set", "solver.t_end=10")
     wait_for_rows(out, first, 2)
-    err = refused(capsys, ["run", str(scene), "-o", str(out), *TINY],
-                  f"is being written by another run (pid {first.pid} on host")
-    assert "since 20" in err
-    assert main(["info", str(out)]) == 0
-    assert capsys.readouterr().out.startswith(
-        f"{out}: running: being written by pid {first.pid} on host")
+    # the first run is held (SIGSTOP) while the second tries: it still writes then, however
+    # fast the kernel has become
+    first.send_signal(signal.SIGSTOP)
+    try:
+        err = refused(capsys, ["run", str(scene), "-o", str(out), *TINY],
+                      f"is being written by another run (pid {first.pid} on host")
+        assert "since 20" in err
+        assert main(["info", str(out)]) == 0
+        assert capsys.readouterr().out.startswith(
+            f"{out}: running: being written by pid {first.pid} on host")
+    finally:
+        first.send_signal(signal.SIGCONT)
     _, err1 = first.communicate(timeout=HANG_GUARD_S)
     assert first.returncode == 0, err1
     with h5py.File(out, "r") as h5:  # the first run's scene and data, complete
         assert h5.attrs["status"] == "ok"
         assert "nodes = 10" in h5.attrs["scene"] and h5["model"].attrs["nnodes"] == 10
-        assert len(h5["dynamic/time"]) == 4001
+        assert len(h5["dynamic/time"]) == 10001
     assert_consistent_dynamic(out, 1e-3)
     assert not Path(str(out) + ".lock").exists()
 
