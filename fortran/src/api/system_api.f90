@@ -59,6 +59,8 @@ subroutine system_reset_stepper(handle, info)
   sys%reuse_failures = 0
   sys%reuse_backoff = 0
   sys%reuse_skip = 0
+  sys%accel_before_valid = .false.
+  sys%predict_from_before = .false.
   if (sys%policy /= policy_constant) sys%factorized = .false.
 end subroutine system_reset_stepper
 

@@ -30,6 +30,12 @@
 !>   to refresh it: a fast rotation turns the stiff directions in every step), the next
 !>   steps start with a fresh matrix, 1, 2, 4 .. max_reuse_backoff of them before reuse is
 !>   tried again; a step that succeeds with an old matrix halves the back-off.
+!> The predictor without contact takes e''_{n+1} = e''_n, or e''_{n-1} where that predicted
+!> the last step better: the trapezoidal rule (Newmark 1/4, 1/2; generalized-alpha at
+!> rho_inf = 1) leaves index-3 constraints an undamped acceleration and multiplier
+!> oscillation of period 2 h that does not move the positions (e_{n+1} - 2 e_n + e_{n-1} =
+!> h^2/4 (a_{n+1} + 2 a_n + a_{n-1})), and e''_{n-1} predicts it exactly: the luffing boom's
+!> first correction 3e-8 to 5e-7 m instead of 1.3e-5, 2.2 corrections per step instead of 3.0.
 !> Penalty contact uses the predictor q_{n+1} = q_n and damps corrections to half a
 !> thickness (an acceleration predictor carries a contact impulse of the last step into the
 !> next one, far through the other leaf).
@@ -182,6 +188,12 @@ contains
       v = v + h * ((1.0_dp - cfg%gamma) * a + cfg%gamma * a_new)
       e = e_new
       a = a_new
+      ! the predictor of the next step: the one of e''_n and e''_{n-1} nearer e''_{n+1}
+      if (.not. allocated(sys%accel_before)) allocate (sys%accel_before(sys%ndof))
+      if (sys%accel_before_valid) sys%predict_from_before = &
+        maxval(abs(accel_new - sys%accel_before)) < maxval(abs(accel_new - accel))
+      sys%accel_before = accel
+      sys%accel_before_valid = .true.
       accel = accel_new
       lam = lam_new
       t = t + h
@@ -201,14 +213,19 @@ contains
     end do
   end subroutine integrator_chunk
 
-  !> The predictor: e''_{n+1} = e''_n; with penalty contact e_{n+1} = e_n.
+  !> The predictor: e''_{n+1} = e''_n (or e''_{n-1}, see the module's notes); with penalty
+  !> contact e_{n+1} = e_n.
   pure subroutine predict(sys, cfg, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
     type(system_model), intent(in) :: sys
     type(integrator_settings), intent(in) :: cfg
     real(dp), intent(in) :: h, e(:), v(:), a(:), accel(:)
     real(dp), intent(out) :: e_new(:), v_new(:), a_new(:), accel_new(:)
     if (sys%npoint == 0) then
-      accel_new = accel
+      if (sys%predict_from_before .and. sys%policy /= policy_constant) then
+        accel_new = sys%accel_before
+      else
+        accel_new = accel
+      end if
       a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
               / (1.0_dp - cfg%alpha_m)
       e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
