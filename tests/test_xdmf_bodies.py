@@ -69,7 +69,10 @@ def test_beam_is_a_polyline_through_its_nodes(beam):
         tip = h5["dynamic/probes/tip"][()]
         stations = h5["model/node_s"][()]
         reference = h5["model/mesh/points"][()]
-        assert h5["dynamic/q"].shape == (501, h5["model"].attrs["ndof"])  # stored for XDMF
+        # output.q is off: the file keeps the frames, not q of every step, and the last
+        # row's q (where a run that stops between frames ends): node 3's r is the tip
+        assert "q" not in h5["dynamic"]
+        np.testing.assert_allclose(h5["dynamic/q_last"][36:39], tip[-1], atol=1e-14)
     # displacements from the rigid configuration at phi = 0: A1 = (0, H, 0), the axis along
     # r1 (SPEC section 5); meshio's points are the first frame's: the static equilibrium
     np.testing.assert_allclose(reference, np.column_stack(
@@ -83,6 +86,21 @@ def test_beam_is_a_polyline_through_its_nodes(beam):
     for k, (t, displacement) in enumerate(frames):
         np.testing.assert_allclose(reference[3] + displacement[3], tip[50 * k], atol=1e-12)
     assert np.linalg.norm(frames[-1][1][3] - frames[0][1][3]) > 0.05  # the boom luffed
+
+
+def test_output_q_stores_every_step_beside_the_frames(tmp_path):
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.05",
+                                            "output.q=.true.", "output.xdmf_frames=6"], out,
+              progress=False)
+    with h5py.File(out) as h5:
+        q = h5["dynamic/q"][()]
+        assert q.shape == (51, h5["model"].attrs["ndof"]) and "q_last" not in h5["dynamic"]
+        rows = h5["dynamic/mesh_rows"][()]
+        np.testing.assert_array_equal(rows, np.arange(0, 51, 10))
+        # the frames' node positions are the stored rows' r
+        np.testing.assert_allclose(h5["dynamic/mesh_nodes"][:, 3, :], q[rows, 36:39],
+                                   atol=1e-14)
 
 
 def test_every_step_is_a_frame_up_to_the_limit(tmp_path):

@@ -226,12 +226,16 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
     settings = dynamic_settings(scene)
     xdmf = scene["output"].get("xdmf", True)
+    write_q = settings.store_q  # output.q: /dynamic/q at every step
     if xdmf:
-        settings.store_q = True  # the node positions for ParaView (XDMF) come from q
+        # the node positions for ParaView (XDMF) come from q: the kernel returns it, the
+        # file keeps the frames only (storing every step cost a third of the FFR boom's
+        # solver time and 27 MB)
+        settings.store_q = True
     writer = results.DynamicWriter(
         out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
-        frames=scene["output"]["xdmf_frames"])
+        frames=scene["output"]["xdmf_frames"], write_q=write_q)
     attrs: dict[str, Any] = {
         "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
         "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,

@@ -280,11 +280,17 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
 
 def _last_frame(h5: h5py.File, model: Model) -> None:
     """A run that stopped (failure, interrupt) between XDMF frames: its last row becomes
-    a frame too (from the stored q), so the motion ends where the run ended."""
+    a frame too (from the stored q or q_last), so the motion ends where the run ended."""
     from .xdmf import MeshLayout, add_step_views
     group = h5["dynamic"]
     last = len(group["time"]) - 1
-    if "mesh_rows" not in group or "q" not in group or len(group["q"]) != last + 1:
+    if "q" in group and len(group["q"]) == last + 1:
+        q_last = group["q"][last:last + 1]
+    elif "q_last" in group:
+        q_last = group["q_last"][()][None, :]
+    else:
+        return
+    if "mesh_rows" not in group:
         return
     rows = group["mesh_rows"]
     if len(rows) and rows[-1] >= last:
@@ -292,7 +298,7 @@ def _last_frame(h5: h5py.File, model: Model) -> None:
     layout = MeshLayout.from_model(model)
     if layout is None or layout.npoints != group["mesh_nodes"].shape[1]:
         return
-    nodes = layout.positions(model, group["q"][last:last + 1])
+    nodes = layout.positions(model, q_last)
     k = len(rows)
     for name, values in (("mesh_nodes", nodes),
                          ("mesh_displacement", nodes - layout.points[None, :, :]),
@@ -375,13 +381,17 @@ class DynamicWriter:
 
     def __init__(self, path: Path, model: Model, store_q: bool,
                  flush_rows: int = 1, *, xdmf: bool | None = None, total_rows: int = 0,
-                 frames: int = 1000) -> None:
-        """``xdmf``: write the node positions of every body for the XDMF description
-        (needs ``store_q``; None: for models with plates, as before), at most ``frames``
-        of the ``total_rows`` rows the run will write (:func:`~.xdmf.frame_rows`)."""
+                 frames: int = 1000, write_q: bool | None = None) -> None:
+        """``store_q``: the chunks carry the coordinates q of every step. ``write_q``: they
+        go to /dynamic/q (None: whenever the chunks carry them); otherwise only the last
+        row's, as /dynamic/q_last. ``xdmf``: write the node positions of every body for
+        the XDMF description (needs ``store_q``; None: for models with plates, as before),
+        at most ``frames`` of the ``total_rows`` rows the run will write
+        (:func:`~.xdmf.frame_rows`)."""
         from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
         from .xdmf import MeshLayout, frame_rows, write_layout
         self.path, self.names, self.store_q = path, list(model.probes), store_q
+        self.write_q = store_q if write_q is None else bool(write_q and store_q)
         self.flush_rows = max(1, int(flush_rows))
         self.model = model
         self.npoints = model.npoint
@@ -432,8 +442,11 @@ class DynamicWriter:
                 for name in CONTACT_FIELDS:
                     series(f"contact/{name}", CONTACT_UNITS.get(name, "1"), (self.npoints,))
                 group["contact"].attrs["points"] = "\n".join(model.contact_point_names)
-            if store_q:
+            if self.write_q:
                 series("q", COORDINATE_UNITS, (ndof,))
+            elif store_q:  # where a run that stops between XDMF frames ends
+                group.create_dataset("q_last", shape=(ndof,), dtype="f8").attrs["units"] = \
+                    COORDINATE_UNITS
             if self.nnodes:  # points of every body per frame, for ParaView (XDMF)
                 write_layout(h5, self.layout)
                 for name in ("mesh_nodes", "mesh_displacement"):
@@ -496,7 +509,10 @@ class DynamicWriter:
         append("factorizations", np.rint(chunk.stats[:, 1]).astype(np.int64))
         append("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64))
         if self.store_q and chunk.q is not None:
-            append("q", chunk.q)
+            if self.write_q:
+                append("q", chunk.q)
+            elif n:
+                group["q_last"][...] = chunk.q[-1]
             if self.nnodes:
                 self._append_frames(group, chunk.q)
         self.rows += n
