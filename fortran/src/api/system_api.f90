@@ -145,6 +145,7 @@ subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, 
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set, set_structural
+  use beam_structural, only: structural_pattern, structural_terms
   use system_store, only: store_get
   implicit none
   integer, intent(in) :: handle, nel, nterms, dofs(24, nel), scatter(24, 24, nel), frame
@@ -156,7 +157,8 @@ subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, 
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
-  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp) .or. &
+      nterms /= structural_terms) then
     info = 2
     return
   end if
@@ -169,6 +171,8 @@ subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, 
   set%forms = forms
   set%strain0 = strain0
   set%term_stiffness = stiffness
+  allocate (set%form_pairs(2, 64, nterms), set%form_npairs(nterms))
+  call structural_pattern(forms, set%form_pairs, set%form_npairs)
   set%damping_time = damping_time
   call append_set(sys, set, index)
 end subroutine system_add_structural_set

@@ -50,6 +50,8 @@ module element_sets
     real(dp), allocatable :: gradients(:, :, :, :), weights(:, :)
     ! structural: forms (8, 8, nterms, nel), reference strains and stiffnesses (nterms, nel)
     real(dp), allocatable :: forms(:, :, :, :), strain0(:, :), term_stiffness(:, :)
+    ! and the forms' nonzero entries (structural_pattern): (2, 64, nterms), (nterms)
+    integer, allocatable :: form_pairs(:, :, :), form_npairs(:)
     ! plate: derivs (12, 5, npts, nel), frame maps (2, 2, npts, nel), reference curvatures
     ! (3, npts, nel), weights (npts, nel)
     real(dp), allocatable :: derivs(:, :, :, :), plate_frame(:, :, :, :), curvature0(:, :, :)
@@ -281,7 +283,8 @@ contains
                              energy, tangent)
     case (set_structural)
       call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
-                              set%term_stiffness(:, el), want_tangent, force, energy, tangent)
+                              set%term_stiffness(:, el), want_tangent, force, energy, tangent, &
+                              set%form_pairs, set%form_npairs)
     case (set_plate)
       call plate_forces(coords, set%derivs(:, :, :, el), set%plate_frame(:, :, :, el), &
                         set%curvature0(:, :, el), set%weights(:, el), set%youngs, set%poisson, &
