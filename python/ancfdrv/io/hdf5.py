@@ -369,6 +369,22 @@ def verdict(path: Path, summary: dict[str, Any] | None = None) -> tuple[str, str
     return "unknown", f"status attribute {status!r}"
 
 
+def _append_rows(group_id: h5py.h5g.GroupID, name: str, start: int,
+                 values: np.ndarray) -> None:
+    """Rows start.. of the extendable dataset group/name := values, through h5py's
+    low-level API (its high-level lookup, resize and slice assignment cost ~0.2 ms per
+    series and flush: a third of the output time of a small model's run)."""
+    data = h5py.h5d.open(group_id, name.encode())
+    shape = data.shape
+    values = np.ascontiguousarray(values, dtype=data.dtype)
+    data.set_extent((start + len(values), *shape[1:]))
+    if values.size == 0:
+        return
+    space = data.get_space()
+    space.select_hyperslab((start,) + (0,) * (len(shape) - 1), values.shape)
+    data.write(h5py.h5s.create_simple(values.shape), space, values)
+
+
 class DynamicWriter:
     """Appends the chunks of a dynamic run to /dynamic (SPEC section 4).
 
@@ -485,9 +501,7 @@ class DynamicWriter:
         n = len(chunk.time)
 
         def append(name: str, values: np.ndarray) -> None:
-            data = group[name]
-            data.resize(self.rows + n, axis=0)
-            data[self.rows:] = values
+            _append_rows(group.id, name, self.rows, values)
         append("time", chunk.time)
         for p, name in enumerate(self.names):
             append(f"probes/{name}", chunk.probes[:, p, :])
