@@ -97,7 +97,7 @@ contains
     call split_laws(youngs, poisson, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
-    tangent = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
       if (p <= volume_points) then
         law = law_free
@@ -137,7 +137,7 @@ contains
     force = 0.0_dp
     energy = 0.0_dp
     dissipation = 0.0_dp
-    tangent = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
       if (p <= volume_points) then
         law = law_free

@@ -191,7 +191,7 @@ contains
     integer :: t, j, a, k
     force = 0.0_dp
     energy = 0.0_dp
-    tangent = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     geometric = 0.0_dp
     do t = 1, structural_terms
       if (present(pairs)) then
@@ -241,7 +241,7 @@ contains
     force = 0.0_dp
     energy = 0.0_dp
     dissipation = 0.0_dp
-    tangent = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     geometric = 0.0_dp
     do t = 1, structural_terms
       gradient = matmul(q, forms(:, :, t))
