@@ -183,3 +183,33 @@ def test_boom_nonlinear_against_ffr(angle, low, high):
                                                       "solver.static_method=newton"]))
     sag_nl = nonlinear.deflections(solve_newton(nonlinear).e)["tip"][1]
     assert low < sag_nl / sag_ffr - 1.0 < high
+
+
+def test_threads_change_no_number(tmp_path):
+    """The element loops run on OMP_NUM_THREADS threads when their estimated work reaches
+    200 us (the 28-node beam's tangents) and on one thread below (its forces): each element
+    is evaluated alone and assembled in order, so 1 and 2 threads give the same history to
+    the last bit."""
+    import os
+    import subprocess
+    import sys
+
+    import h5py
+    histories = []
+    for threads in ("1", "2"):
+        out = tmp_path / f"boom_{threads}.h5"
+        subprocess.run([sys.executable, "-m", "ancfdrv.cli", "run",
+                        str(INPUTS / "boom_luffing.nml"), "-o", str(out),
+                        "--set", "scene.formulation=nonlinear", "--set",
+                        "solver.static_method=newton", "--set", "solver.t_end=0.2",
+                        "--set", "solver.jacobian=step"],
+                       check=True, capture_output=True,
+                       env={**os.environ, "OMP_NUM_THREADS": threads})
+        with h5py.File(out) as h5:
+            assert h5.attrs["OMP_NUM_THREADS"] == threads
+            histories.append((h5["dynamic/probes/tip"][()], h5["dynamic/q_last"][()],
+                              int(h5["dynamic"].attrs["factorizations"])))
+    (tip1, q1, f1), (tip2, q2, f2) = histories
+    assert f1 == f2 >= 200  # a tangent per step: the threaded loop ran every step
+    np.testing.assert_array_equal(tip1, tip2)
+    np.testing.assert_array_equal(q1, q2)
