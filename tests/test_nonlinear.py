@@ -9,6 +9,11 @@ elastica under a dead tip load solved independently with scipy's BVP solver
 """
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
+import h5py
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -190,11 +195,6 @@ def test_threads_change_no_number(tmp_path):
     200 us (the 28-node beam's tangents) and on one thread below (its forces): each element
     is evaluated alone and assembled in order, so 1 and 2 threads give the same history to
     the last bit."""
-    import os
-    import subprocess
-    import sys
-
-    import h5py
     histories = []
     for threads in ("1", "2"):
         out = tmp_path / f"boom_{threads}.h5"

@@ -59,7 +59,7 @@ subroutine system_reset_stepper(handle, info)
   sys%reuse_failures = 0
   sys%reuse_backoff = 0
   sys%reuse_skip = 0
-  sys%accel_before_valid = .false.
+  if (allocated(sys%accel_before)) deallocate (sys%accel_before)
   sys%predict_from_before = .false.
   if (sys%policy /= policy_constant) sys%factorized = .false.
 end subroutine system_reset_stepper

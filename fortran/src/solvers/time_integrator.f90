@@ -189,11 +189,16 @@ contains
       e = e_new
       a = a_new
       ! the predictor of the next step: the one of e''_n and e''_{n-1} nearer e''_{n+1}
-      if (.not. allocated(sys%accel_before)) allocate (sys%accel_before(sys%ndof))
-      if (sys%accel_before_valid) sys%predict_from_before = &
-        maxval(abs(accel_new - sys%accel_before)) < maxval(abs(accel_new - accel))
-      sys%accel_before = accel
-      sys%accel_before_valid = .true.
+      ! (refactorized systems without contact only: the others never use it)
+      if (sys%npoint == 0 .and. sys%policy /= policy_constant) then
+        if (allocated(sys%accel_before)) then
+          sys%predict_from_before = &
+            maxval(abs(accel_new - sys%accel_before)) < maxval(abs(accel_new - accel))
+        else
+          allocate (sys%accel_before(sys%ndof))
+        end if
+        sys%accel_before = accel
+      end if
       accel = accel_new
       lam = lam_new
       t = t + h
@@ -221,7 +226,7 @@ contains
     real(dp), intent(in) :: h, e(:), v(:), a(:), accel(:)
     real(dp), intent(out) :: e_new(:), v_new(:), a_new(:), accel_new(:)
     if (sys%npoint == 0) then
-      if (sys%predict_from_before .and. sys%policy /= policy_constant) then
+      if (sys%predict_from_before) then
         accel_new = sys%accel_before
       else
         accel_new = accel

@@ -134,10 +134,11 @@ module mechanical_system
     ! to refresh it (in a row), the current back-off and the steps still to start with a
     ! fresh matrix
     integer :: reuse_failures = 0, reuse_backoff = 0, reuse_skip = 0
-    ! the stepper's predictor without contact: e'' of the step before the last (valid once
-    ! two steps are done) and whether it predicted the last step better than e''_n did
+    ! the stepper's predictor of refactorized systems without contact: e'' of the step
+    ! before the last (allocated once a step is done) and whether it predicted the last
+    ! step better than e''_n did
     real(dp), allocatable :: accel_before(:)
-    logical :: accel_before_valid = .false., predict_from_before = .false.
+    logical :: predict_from_before = .false.
     real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
   end type system_model
 

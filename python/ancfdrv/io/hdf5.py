@@ -315,8 +315,7 @@ def _last_frame(h5: h5py.File, model: Model) -> None:
     for name, values in (("mesh_nodes", nodes),
                          ("mesh_displacement", nodes - layout.points[None, :, :]),
                          ("mesh_rows", np.array([last]))):
-        group[name].resize(k + 1, axis=0)
-        group[name][k:] = values
+        _append_rows(group.id, name, k, values)
     add_step_views(h5, k, k + 1)
 
 
@@ -550,13 +549,10 @@ class DynamicWriter:
         if not pick.any():
             return
         nodes = self.layout.positions(self.model, q[pick])
-        k = self.frames
         for name, values in (("mesh_nodes", nodes),
                              ("mesh_displacement", nodes - self.layout.points[None, :, :]),
                              ("mesh_rows", rows[pick])):
-            data = group[name]
-            data.resize(k + len(values), axis=0)
-            data[k:] = values
+            _append_rows(group.id, name, self.frames, values)
         self.frames += len(nodes)
 
 
