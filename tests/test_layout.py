@@ -1,14 +1,17 @@
 """The package's module graph has no import cycles (issue 12: the old model -> plate ->
 assembly -> plate -> model cycle was held together by a function-local import). The graph
-is read from the sources: module-level imports between the package's own .py modules
-(function-local imports are deliberate deferrals and are not counted; the compiled
-`_kernel` extension imports nothing of the package)."""
+is read from the sources: every import between the package's own modules, function-local
+ones included (a deferred import is still a dependency); `from . import name` of a name
+that is no module is an import of the package itself. The compiled extension
+`ancfdrv._kernel` (no .py file; it imports nothing of the package) is a leaf that only
+the thin binding `ancfdrv.kernel` imports."""
 from __future__ import annotations
 
 import ast
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1] / "python"
+EXTENSION = "ancfdrv._kernel"
 
 
 def module_graph() -> dict[str, set[str]]:
@@ -17,22 +20,23 @@ def module_graph() -> dict[str, set[str]]:
         parts = path.relative_to(ROOT).with_suffix("").parts
         name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
         files[name] = path
-    graph: dict[str, set[str]] = {name: set() for name in files}
+    modules = set(files) | {EXTENSION}
+    graph: dict[str, set[str]] = {name: set() for name in modules}
     for name, path in files.items():
         package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        for node in ast.parse(path.read_text()).body:
+        for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.ImportFrom):
                 base = package.split(".")[:len(package.split(".")) - node.level + 1] \
                     if node.level else []
                 target = ".".join(base + ([node.module] if node.module else []))
                 for alias in node.names:
                     full = f"{target}.{alias.name}"
-                    if full in files:
+                    if full in modules:
                         graph[name].add(full)
-                    elif target in files and alias.name not in ("_kernel",):
+                    elif target in modules:
                         graph[name].add(target)
             elif isinstance(node, ast.Import):
-                graph[name] |= {a.name for a in node.names if a.name in files}
+                graph[name] |= {a.name for a in node.names if a.name in modules}
     return graph
 
 
@@ -63,6 +67,18 @@ def test_graph_is_read():
 
 def test_no_import_cycles():
     assert cycles(module_graph()) == []
+
+
+def test_only_the_binding_imports_the_compiled_kernel():
+    graph = module_graph()
+    assert {name for name, targets in graph.items() if EXTENSION in targets} == {"ancfdrv.kernel"}
+
+
+def test_no_module_imports_the_package_itself():
+    """A layer imports only below itself: nothing inside the package imports `ancfdrv`
+    (its __init__ re-exports the system API and so sits above everything)."""
+    graph = module_graph()
+    assert {name for name, targets in graph.items() if "ancfdrv" in targets} == set()
 
 
 def test_cycle_detection_finds_a_cycle():

@@ -19,7 +19,7 @@ _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 # slower than 1 thread (measured 6.1 s vs 2.8 s, 2.4 s with the passive policy).
 _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
-__version__ = "0.1.0"
+from ._version import __version__  # noqa: E402,F401
 
 from .system import (Beam, Box, Circle, Constant, Cycle, Leaf, Luffing, Material, Model,  # noqa: E402
                      Plate, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__
+from ._version import __version__
 from .errors import AncfError, InputError, Interrupted
 
 EXIT_CODES = """exit status:

@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .sweep import static_value  # noqa: E402
+from .sweep_keys import is_resolution, static_value  # noqa: E402
 
 
 STAGE_COLOURS = {"start": "#dbe9f6", "luffing": "#fdf1d6", "braking": "#f8dcdc",
@@ -521,7 +521,6 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
     out = []
     if any(r.get("dynamic") for r in ok):
         out += plot_histories(ok, keys, outdir)
-    from .sweep import is_resolution
     mesh_keys = [k for k in keys if is_resolution(k) and k != "solver.dt"]
     nodes_key = mesh_keys[0] if mesh_keys else None
     others = [k for k in keys if not is_resolution(k)]
@@ -591,7 +590,6 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
     panel per luffing stage (the paper's Figs. 6-15); one figure per value of the other
     varied keys."""
     import h5py as _h5
-    from .sweep import is_resolution
     others = [k for k in keys if not is_resolution(k)]
     mesh_keys = [k for k in keys if is_resolution(k) and k != "solver.dt"]
     finest_dt = min((float(r["solver.dt"]) for r in rows if "solver.dt" in r), default=None)

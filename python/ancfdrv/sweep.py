@@ -33,13 +33,10 @@ import numpy as np
 from tqdm import tqdm
 
 from .errors import InputError
+from .sweep_keys import is_resolution, resolution_sense, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
 from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
                          remove_quietly, response_of, run_dask, run_inline, run_processes)
-
-#: Parameters that refine a model; the finest value is the reference of the others.
-RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min, "plate.nx": max, "plate.ny": max,
-                   "leaf.nx": max, "leaf.ny": max}
 
 #: Case file names: these characters only, at most this long (before the hash suffix).
 _UNSAFE = re.compile(r"[^A-Za-z0-9._+-]")
@@ -53,21 +50,6 @@ class SweepInterrupted(KeyboardInterrupt):
     def __init__(self, rows: list[dict], outdir: Path) -> None:
         super().__init__("sweep interrupted")
         self.rows, self.outdir = rows, outdir
-
-
-def _plain_key(part: str) -> str:
-    """'beam[upper].nodes' -> 'beam.nodes' (the schema key a named group's key stands for)."""
-    group, _, key = parse_address(part)
-    return f"{group}.{key}"
-
-
-def is_resolution(key: str) -> bool:
-    """A refining key, or keys tied with '+' that all refine (plate.nx+plate.ny)."""
-    return all(_plain_key(part) in RESOLUTION_KEYS for part in key.split("+"))
-
-
-def resolution_sense(key: str):
-    return RESOLUTION_KEYS[_plain_key(key.split("+")[0])]
 
 
 def expand(params: dict[str, str]) -> list[str]:
@@ -149,11 +131,6 @@ def case_names(combos: list[dict[str, str]]) -> list[str]:
     count = Counter(n.lower() for n in names)
     return [f"{name}_{_digest(params)}" if count[name.lower()] > 1 and not _plain_name(params)[1]
             else name for name, params in zip(names, combos)]
-
-
-def static_value(row: dict) -> float:
-    """The static quantity a sweep compares (tip sag for beams)."""
-    return row["tip_transverse"] if "tip_transverse" in row else row["response"]
 
 
 def _tip_history(path: str) -> tuple[np.ndarray, np.ndarray]:

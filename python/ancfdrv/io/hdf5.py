@@ -32,7 +32,7 @@ from typing import Any
 import h5py
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..errors import InputError
 from ..system.bodies import Beam
 from ..system.model import Model
@@ -96,7 +96,7 @@ def _compiler() -> str:
     """The Fortran compiler that built the kernel (Meson's record in an editable build),
     else the first line of ``gfortran --version`` on PATH."""
     try:
-        from .. import _kernel
+        from ..kernel import _kernel
         for parent in Path(_kernel.__file__).resolve().parents[:3]:
             info = parent / "meson-info" / "intro-compilers.json"
             if info.is_file():
@@ -115,7 +115,7 @@ def _mumps() -> str:
     """The MUMPS library the kernel loaded, with the version its header declares
     (MUMPS_VERSION; asking dpkg for the package took 80 ms of every run)."""
     try:
-        from .. import _kernel  # noqa: F401 - loads the library
+        from ..kernel import _kernel  # noqa: F401 - loads the library
         with open("/proc/self/maps") as maps:
             libraries = {line.split()[-1] for line in maps if "dmumps" in line}
     except OSError:

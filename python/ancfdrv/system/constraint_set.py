@@ -12,9 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import _kernel
 from ..errors import InputError
-from ..kernel import _f
+from ..kernel import _f, _kernel
 
 
 @dataclass
