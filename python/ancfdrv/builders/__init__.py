@@ -27,7 +27,9 @@ def build_model(scene) -> Model:
     """The assembled model of a scene: only the scene's effects are computed."""
     built = build_system(scene)
     model = built.system.assemble(effects=scene.effects,
-                                  linear_joints=scene["solver"].get("linear_joints", "auto"))
+                                  linear_joints=scene["solver"].get("linear_joints", "auto"),
+                                  unused_effects="refuse" if scene.kind == "general"
+                                  else "allow")
     model.warnings[:0] = built.warnings
     if built.response is not None:
         model.response = built.response

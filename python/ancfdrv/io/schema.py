@@ -281,10 +281,11 @@ COMMON_GROUPS = ("scene", "material", "loads", "solver", "output")
 
 def coerce(kind: str, raw: Any, where: dict) -> Any:
     def bad(expected: str) -> InputError:
-        got = "no value" if raw is None else repr(raw)
+        got = "no value" if raw is None else short_repr(raw)
         return InputError(f"expected {expected}, got {got}", **where)
 
     def as_float(x: Any) -> float:
+        x = plain_value(x)  # numpy scalars (np.float32 too) count as numbers
         if isinstance(x, bool) or not isinstance(x, (int, float)):
             raise bad("a number")
         if not math.isfinite(float(x)):
@@ -294,6 +295,7 @@ def coerce(kind: str, raw: Any, where: dict) -> Any:
     if kind == "float":
         return as_float(raw)
     if kind == "int":
+        raw = plain_value(raw)
         if isinstance(raw, bool) or not isinstance(raw, int):
             if not (isinstance(raw, float) and raw.is_integer()):
                 raise bad("an integer")
@@ -476,3 +478,63 @@ GENERAL_SINGLE_GROUPS = ("scene", "solver", "output")
 GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe")
 #: checks that take a list key's whole value (the others take each item)
 WHOLE_LIST_CHECKS = (vector3, points3, principal_positive)
+
+
+# -- the Python API's door: the same types, ranges and messages as the namelist -----------
+
+def plain_value(value: Any) -> Any:
+    """A value as plain Python for checks and messages: numpy scalars become int/float
+    (messages print ``2.2``, not ``np.float64(2.2)``), arrays and tuples become lists;
+    anything else is returned unchanged (and refused by the type check that follows)."""
+    import numpy as np
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return [plain_value(x) for x in value.ravel().tolist()]
+    if isinstance(value, (list, tuple)):
+        out: list[Any] = []
+        for item in value:
+            item = plain_value(item)
+            out.extend(item if isinstance(item, list) else [item])
+        return out
+    return value
+
+
+def short_repr(value: Any, limit: int = 60) -> str:
+    """repr of a value cut to ``limit`` characters (a message never echoes a whole file)."""
+    text = repr(plain_value(value))
+    if len(text) <= limit:
+        return text
+    return text[:limit - 4] + "..." + text[-1]
+
+
+def check_call(group: str, label: str, values: dict[str, Any]) -> dict[str, Any]:
+    """The values of one System API call checked against the general scene schema's key of
+    the same name (type, finiteness, magnitude, size and range): the checks and messages of
+    a namelist group (``&material[steel] youngs_modulus: expected a number, got 'abc'``).
+    Keys given as None (not given) and keys the schema does not have are passed through
+    unchanged; returns the checked values (plain Python numbers and lists)."""
+    schema = GENERAL_SCHEMA[group]
+    out = dict(values)
+    for key, raw in values.items():
+        spec = schema.get(key)
+        if spec is None or raw is None:
+            continue
+        where = dict(group=label, key=key)
+        raw = plain_value(raw)
+        if spec.kind == "str" and not isinstance(raw, str):
+            raise InputError(f"expected a string, got {short_repr(raw)}", **where)
+        if spec.kind == "floats" and not isinstance(raw, list):
+            raw = [raw]
+        value = coerce(spec.kind, raw, where)
+        if spec.size is not None and len(value) != spec.size:
+            raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
+        if spec.check is not None:
+            whole = spec.check in WHOLE_LIST_CHECKS
+            items = [value] if whole or spec.kind != "floats" else value
+            for item in items:
+                message = spec.check(item)
+                if message:
+                    raise InputError(f"{short_repr(value)} {message}", **where)
+        out[key] = value
+    return out

@@ -456,7 +456,39 @@ def estimate_general(items: list[tuple[str, dict[str, Any]]]) -> Estimate:
 
 def available_memory() -> int:
     """Memory available to a new process now (bytes): MemAvailable of /proc/meminfo (free
-    plus reclaimable caches), else the free physical pages (os.sysconf)."""
+    plus reclaimable caches), else the free physical pages (os.sysconf); at most what the
+    process's own limits leave (:func:`limit_memory`: ``ulimit -v``, a cgroup)."""
+    return min(_machine_memory(), limit_memory())
+
+
+def limit_memory() -> int:
+    """Memory the process may still take under its address-space limit (RLIMIT_AS, less
+    what it maps now) and its cgroup's memory.max (less the cgroup's current use); a very
+    large number when neither is set."""
+    room = 2**63 - 1
+    try:
+        import resource
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+        if soft != resource.RLIM_INFINITY:
+            mapped = 0
+            with open("/proc/self/status") as status:
+                for line in status:
+                    if line.startswith("VmSize:"):
+                        mapped = int(line.split()[1]) * 1024
+            room = min(room, max(soft - mapped, 0))
+    except (OSError, ValueError, ImportError):
+        pass
+    try:
+        with open("/sys/fs/cgroup/memory.max") as f:
+            text = f.read().strip()
+        if text != "max":  # the cgroup's whole budget (its page cache is reclaimable)
+            room = min(room, int(text))
+    except (OSError, ValueError):
+        pass
+    return room
+
+
+def _machine_memory() -> int:
     try:
         with open("/proc/meminfo") as meminfo:
             for line in meminfo:
@@ -511,3 +543,69 @@ def check_resources(estimate: Estimate, file: str, solver: dict[str, Any] | None
             "several times faster than any run measured); the limit is "
             f"{MAX_RUN_SECONDS / 86400:.3g} days: raise dt, shorten t_end or use a coarser "
             "mesh", file=file, group="solver", key="dt")
+
+
+# -- 6. arguments of the solver functions (the Python API's door) -------------------------
+
+def _plain_number(value: Any) -> Any:
+    try:
+        import numpy as np
+        if isinstance(value, np.generic):
+            return value.item()
+    except ImportError:  # pragma: no cover
+        pass
+    return value
+
+
+def check_arguments(function: str, **values: Any) -> dict[str, Any]:
+    """The keyword arguments of a solver function checked at its entry (InputError naming
+    the function and the argument): ``tol`` a finite number > 0, ``max_iter``,
+    ``load_steps``, ``max_newton`` and ``chunk_steps`` integers >= 1 within 32 bits,
+    ``loads`` and ``p`` finite numbers, ``dt`` at least MIN_DT, ``t_end`` finite and > 0,
+    at most MAX_STEPS steps. Returns the values as plain Python numbers."""
+    out = {}
+    for key, raw in values.items():
+        value = _plain_number(raw)
+        where: dict = {}
+        name = f"{function}: {key}"
+        if key in ("max_iter", "load_steps", "max_newton", "chunk_steps", "max_inner"):
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise InputError(f"{name}: expected an integer >= 1, got {value!r}")
+            if value < 1:
+                raise InputError(f"{name} = {value} must be at least 1")
+            check_int32(value, {})
+        else:
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise InputError(f"{name}: expected a number, got {value!r}")
+            value = float(value)
+            if not math.isfinite(value):
+                raise InputError(f"{name}: expected a finite number, got {value!r}")
+            if key in ("tol", "inner_tol") and value <= 0:
+                raise InputError(f"{name} = {value:g} must be positive")
+            if key == "dt" and value < MIN_DT:
+                raise InputError(f"{function}: dt = {value:g} s is below the smallest step "
+                                 f"accepted ({MIN_DT:g} s)")
+            if key == "t_end" and value <= 0:
+                raise InputError(f"{function}: t_end = {value:g} s must be positive")
+        out[key] = value
+    if "dt" in out and "t_end" in out and out["t_end"] / out["dt"] > MAX_STEPS:
+        raise InputError(f"{function}: t_end / dt = {out['t_end'] / out['dt']:.3g} steps; at "
+                         f"most {MAX_STEPS:.0e} steps are accepted")
+    return out
+
+
+def check_state(function: str, key: str, value: Any, size: int):
+    """A state vector given to a solver (e0, v0): ``size`` finite numbers, else InputError
+    (before it reaches the compiled kernel)."""
+    import numpy as np
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{function}: {key}: expected {size} numbers, got "
+                         f"{type(value).__name__}") from None
+    if array.shape != (size,):
+        raise InputError(f"{function}: {key}: expected a vector of the model's {size} "
+                         f"coordinates, got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise InputError(f"{function}: {key} must be finite numbers")
+    return array

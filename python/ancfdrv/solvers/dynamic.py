@@ -32,6 +32,7 @@ from tqdm import tqdm
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
                      JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES, STEP_FAILURES)
 from ..errors import Interrupted, SolverError
+from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver
 from ..system.model import Model
 
@@ -226,6 +227,10 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     caps the following ones, never more than settings.chunk_steps), and ``should_stop`` is
     asked after every chunk: when it says True, Interrupted is raised after the sink got
     the chunk, so a stop request (SIGINT) is answered within about a second."""
+    check_arguments("integrate", dt=settings.dt, t_end=settings.t_end, tol=settings.tol,
+                    max_newton=settings.max_newton, chunk_steps=settings.chunk_steps, t0=t0)
+    e0 = check_state("integrate", "e0", e0, model.ndof)
+    v0 = None if v0 is None else check_state("integrate", "v0", v0, model.ndof)
     model.require_runnable()
     start = time.perf_counter()
     timing = {"setup": 0.0, "stepping": 0.0, "output": 0.0}

@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SolverError
+from ..io.validate import check_arguments
 from ..kernel import DirectSolver
 from ..system.model import Model
 
@@ -106,6 +107,8 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     ``loads`` scales the external loads (gravity, forces, moments, pressure) of the last
     increment: 0 gives the equilibrium of the internal forces alone (prestress carried by
     contact), the start of a settled run."""
+    check_arguments("solve_newton", tol=tol, max_iter=max_iter, load_steps=load_steps,
+                    loads=loads)
     model.require_runnable()
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
@@ -266,6 +269,8 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     needs d_R only on N_l, so the Taylor jets live on those rows and every inner
     iteration is small dense algebra; d_R is rebuilt in full once per pass.
     """
+    check_arguments("solve_split", tol=tol, max_iter=max_iter, p=p, inner_tol=inner_tol,
+                    max_inner=max_inner)
     if not 0.0 <= p < 1.0:
         raise SolverError(f"split iteration: p = {p} outside [0, 1)")
     if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:

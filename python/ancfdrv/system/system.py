@@ -25,6 +25,8 @@ from typing import Iterable
 import numpy as np
 
 from ..errors import InputError
+from ..io import validate
+from ..io.schema import EFFECTS_AVAILABLE, check_call, plain_value, short_repr
 from .bodies import Beam, Body, Ground, Leaf, Material, Plate, RigidBody
 from .contact import ContactPair
 from .drives import DRIVE_TYPES, Drive, Table
@@ -36,6 +38,28 @@ from .sections import Section
 #: effects an item may belong to, with the default of each load type (SPEC section 8)
 LOAD_EFFECTS = {"gravity": "gravity", "force": "point_loads", "moment": "point_loads",
                 "point_mass": "tip_mass", "pressure": "pressure"}
+
+
+def _api(method):
+    """A System method of the API door: whatever a value the checks did not foresee makes
+    numpy or a constructor raise (TypeError, ValueError, ...) becomes an InputError naming
+    the call and the item, so that the API raises only the documented exceptions."""
+    import functools
+
+    @functools.wraps(method)
+    def call(self, *args, **kwargs):
+        try:
+            return method(self, *args, **kwargs)
+        except (TypeError, ValueError, AttributeError, KeyError, IndexError, ZeroDivisionError,
+                OverflowError, FloatingPointError) as exc:
+            item = args[0] if args and isinstance(args[0], str) else ""
+            label = f"{method.__name__}[{item}]" if item else method.__name__
+            text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise InputError(f"{text[:200]}", group=label) from None
+        except MemoryError:
+            raise InputError("not enough memory to build this item: use a coarser mesh",
+                             group=method.__name__) from None
+    return call
 
 
 def _points(value) -> list[np.ndarray]:
@@ -51,8 +75,11 @@ class System:
     """A mechanical system under construction (see the module documentation)."""
 
     def __init__(self, title: str = "", *, effects: Iterable[str] | None = None) -> None:
+        if not isinstance(title, str):
+            raise InputError(f"the title must be a string, got {short_repr(title)}",
+                             group="scene", key="title")
         self.title = title
-        self.effects = None if effects is None else tuple(effects)
+        self.effects = None if effects is None else check_effects(effects)
         self.materials: dict[str, Material] = {}
         self.bodies: dict[str, Body] = {}
         self.drives: dict[str, Drive] = {}
@@ -69,6 +96,9 @@ class System:
         if not isinstance(name, str) or not name.strip():
             raise InputError(f"{what}: a name is required")
         name = name.strip()
+        problem = validate.check_name(name)
+        if problem:
+            raise InputError(f"{what} name {short_repr(name)} {problem}")
         if name in table:
             raise InputError(f"{what} {name!r} is defined twice")
         return name
@@ -102,9 +132,15 @@ class System:
         return self.drives[name]
 
     # -- items ----------------------------------------------------------------------------
+    @_api
     def material(self, name: str, *, youngs_modulus: float, density: float,
                  poisson_ratio: float = 0.0, damping_time: float = 0.0) -> Material:
         name = self._new_name(name, self.materials, "material")
+        v = check_call("material", f"material[{name}]", dict(
+            youngs_modulus=youngs_modulus, density=density, poisson_ratio=poisson_ratio,
+            damping_time=damping_time))
+        youngs_modulus, density = v["youngs_modulus"], v["density"]
+        poisson_ratio, damping_time = v["poisson_ratio"], v["damping_time"]
         self.materials[name] = Material(name, youngs_modulus, density, poisson_ratio,
                                         damping_time)
         return self.materials[name]
@@ -113,6 +149,7 @@ class System:
         self.bodies[body.name] = body
         return body
 
+    @_api
     def beam(self, name: str, *, material: str | Material, start, end, nodes: int,
              section: Section | None = None, height_axis=None, formulation: str = "ffr",
              bending: str = "continuum", segments=None, frame_drive: str | Drive | None = None,
@@ -120,32 +157,62 @@ class System:
         """An ANCF beam (:class:`~.bodies.Beam`)."""
         name = self._body_name(name)
         where = f"beam {name!r}"
+        v = check_call("beam", f"beam[{name}]", dict(
+            start=start, end=end, nodes=nodes, segments=segments, height_axis=height_axis,
+            formulation=formulation, bending=bending, frame_axis=frame_axis,
+            frame_pivot=frame_pivot))
+        nodes = v["nodes"]
+        self._check_size(validate.Part(f"beam[{name}]", "nodes", "beam", nodes, 12))
         return self._add_body(Beam(name, self._material(material, where), start, end, nodes,
                                    section, height_axis=height_axis, formulation=formulation,
                                    bending=bending, segments=segments,
                                    frame_drive=self._drive(frame_drive, where),
                                    frame_axis=frame_axis, frame_pivot=frame_pivot))
 
+    @_api
     def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,
               edge_y, nx: int, ny: int, variant: str = "completed") -> Plate:
         """A flat thin plate (:class:`~.bodies.Plate`)."""
         name = self._body_name(name)
+        v = check_call("plate", f"plate[{name}]", dict(
+            thickness=thickness, corner=corner, edge_x=edge_x, edge_y=edge_y, nx=nx, ny=ny,
+            variant=variant))
+        thickness, nx, ny = v["thickness"], v["nx"], v["ny"]
+        self._check_size(validate.Part(f"plate[{name}]", "nx", "plate", (nx + 1) * (ny + 1), 9))
         return self._add_body(Plate(name, self._material(material, f"plate {name!r}"),
                                     thickness, corner, edge_x, edge_y, nx, ny, variant=variant))
 
+    @_api
     def leaf(self, name: str, *, material: str | Material, thickness: float, width: float,
              arc_length: float, radius: float, centre, nx: int, ny: int,
              variant: str = "completed", free_radius: float | None = None) -> Leaf:
         """A curved leaf (:class:`~.bodies.Leaf`)."""
         name = self._body_name(name)
+        v = check_call("leaf", f"leaf[{name}]", dict(
+            thickness=thickness, width=width, arc_length=arc_length, radius=radius,
+            centre=centre, nx=nx, ny=ny, variant=variant, free_radius=free_radius))
+        thickness, width, arc_length, radius = (v["thickness"], v["width"], v["arc_length"],
+                                                v["radius"])
+        nx, ny, free_radius = v["nx"], v["ny"], v["free_radius"]
+        self._check_size(validate.Part(f"leaf[{name}]", "nx", "leaf", (nx + 1) * (ny + 1), 9))
         return self._add_body(Leaf(name, self._material(material, f"leaf {name!r}"), thickness,
                                    width, arc_length, radius, centre, nx, ny, variant=variant,
                                    free_radius=free_radius))
 
+    @_api
     def rigid_body(self, name: str, *, mass: float, inertia, position, planar: bool = False,
                    plane_normal=(0.0, 1.0, 0.0)) -> RigidBody:
         """A rigid body as an ANCF reference node (:class:`~.bodies.RigidBody`)."""
         name = self._body_name(name)
+        flat = plain_value(inertia)
+        v = check_call("rigid_body", f"rigid_body[{name}]", dict(
+            mass=mass, position=position, planar=planar, plane_normal=plane_normal,
+            inertia=inertia if not (isinstance(flat, list) and len(flat) == 9) else None))
+        if isinstance(flat, list) and len(flat) == 9:  # a 3 x 3 tensor: numbers only here
+            check_call("rigid_body", f"rigid_body[{name}]", dict(position=flat[:3]))
+            check_call("rigid_body", f"rigid_body[{name}]", dict(position=flat[3:6]))
+            check_call("rigid_body", f"rigid_body[{name}]", dict(position=flat[6:]))
+        mass, planar = v["mass"], v["planar"]
         return self._add_body(RigidBody(name, mass, inertia, position, planar=planar,
                                         plane_normal=plane_normal))
 
@@ -154,6 +221,27 @@ class System:
             raise InputError("the body name 'ground' is reserved")
         return self._new_name(name, self.bodies, "body")
 
+    def _check_size(self, part: "validate.Part") -> None:
+        """The memory estimate of the bodies so far and the new one, before it allocates
+        anything (the namelist's check, ``validate.check_resources``)."""
+        validate.check_resources(validate.Estimate(self._parts() + [part]), None, None,
+                                 "static")
+
+    def _parts(self) -> "list[validate.Part]":
+        parts = []
+        for body in self.bodies.values():
+            if isinstance(body, Beam):
+                parts.append(validate.Part(f"beam[{body.name}]", "nodes", "beam", body.nodes, 12))
+            elif isinstance(body, Plate):
+                kind = "leaf" if isinstance(body, Leaf) else "plate"
+                parts.append(validate.Part(f"{kind}[{body.name}]", "nx", kind,
+                                           body.mesh.nnodes, 9))
+            elif isinstance(body, RigidBody):
+                parts.append(validate.Part(f"rigid_body[{body.name}]", "mass", "rigid_body",
+                                           1, 12))
+        return parts
+
+    @_api
     def drive(self, name: str, type: str, **params) -> Drive:
         """A drive (``ancfdrv.system.drives``): type 'constant' (value), 'luffing' (omega,
         t_start, t_brake, sweep, start), 'spinup' (omega, period, start), 'cycle'
@@ -161,8 +249,10 @@ class System:
         'table' (times, values, or file = CSV path)."""
         name = self._new_name(name, self.drives, "drive")
         where = f"drive {name!r}"
-        if type not in DRIVE_TYPES:
-            raise InputError(f"{where}: type {type!r} must be one of {', '.join(DRIVE_TYPES)}")
+        if not isinstance(type, str) or type not in DRIVE_TYPES:
+            raise InputError(f"{where}: type {short_repr(type)} must be one of "
+                             f"{', '.join(DRIVE_TYPES)}")
+        params = check_drive_params(name, type, params)
         try:
             if type == "table" and "file" in params:
                 extra = set(params) - {"file"}
@@ -182,6 +272,7 @@ class System:
         self.drives[name] = drive
         return drive
 
+    @_api
     def joint(self, name: str, type: str, body1: str | Body, body2: str | Body, *, point=None,
               axis=None, drive: str | Drive | None = None, point1=None, point2=None,
               pivot=None, vector: str = "r") -> Joint:
@@ -189,6 +280,10 @@ class System:
         then acts at each)."""
         name = self._new_name(name, self.joints, "joint")
         where = f"joint {name!r}"
+        v = check_call("joint", f"joint[{name}]", dict(
+            type=type, point=point, axis=axis, point1=point1, point2=point2, pivot=pivot,
+            vector=vector))
+        type, axis = v["type"], v["axis"]
         try:
             points = [] if point is None else _points(point)
             p1 = None if point1 is None else _points(point1)[0]
@@ -201,6 +296,7 @@ class System:
         self.joints[name] = joint
         return joint
 
+    @_api
     def load(self, name: str, type: str, *, body: str | Body | None = None, point=None,
              vector=None, mass: float | None = None, value: float | None = None,
              drive: str | Drive | None = None, effect: str | None = None) -> Load:
@@ -209,8 +305,15 @@ class System:
         'pressure' (body, value); ``effect`` defaults by type (SPEC section 8)."""
         name = self._new_name(name, self.loads, "load")
         where = f"load {name!r}"
-        if type not in LOAD_TYPES:
-            raise InputError(f"{where}: type {type!r} must be one of {', '.join(LOAD_TYPES)}")
+        if not isinstance(type, str) or type not in LOAD_TYPES:
+            raise InputError(f"{where}: type {short_repr(type)} must be one of "
+                             f"{', '.join(LOAD_TYPES)}")
+        v = check_call("load", f"load[{name}]", dict(point=point, vector=vector, mass=mass,
+                                                     value=value, effect=effect))
+        point, vector, mass, value, effect = (v["point"], v["vector"], v["mass"], v["value"],
+                                              v["effect"])
+        if effect is not None:
+            check_effects([effect], what=f"load[{name}]")
         effect = effect or LOAD_EFFECTS[type]
         needs = {"gravity": ("vector",), "force": ("body", "point", "vector"),
                  "moment": ("body", "point", "vector"), "point_mass": ("body", "point", "mass"),
@@ -243,21 +346,29 @@ class System:
         self.loads[name] = load
         return load
 
+    @_api
     def contact(self, name: str, body1: str | Body, body2: str | Body, *, stiffness: float,
                 damping: float = 0.0, friction: float = 0.0, slip_speed: float = 0.08,
                 points: int = 3) -> ContactPair:
         """A contact pair (``ancfdrv.system.contact``)."""
         name = self._new_name(name, self.contacts, "contact")
         where = f"contact {name!r}"
+        v = check_call("contact", f"contact[{name}]", dict(
+            stiffness=stiffness, damping=damping, friction=friction, slip_speed=slip_speed,
+            points=points))
+        stiffness, damping, friction = v["stiffness"], v["damping"], v["friction"]
+        slip_speed, points = v["slip_speed"], v["points"]
         pair = ContactPair(name, self.body(body1, used_by=where), self.body(body2, used_by=where),
                            stiffness, damping, friction, slip_speed, points)
         self.contacts[name] = pair
         return pair
 
+    @_api
     def probe(self, name: str, body: str | Body, point) -> Probe:
         """A probe at a material point of a body."""
         name = self._new_name(name, self.probes, "probe")
         where = f"probe {name!r}"
+        point = check_call("probe", f"probe[{name}]", dict(point=point))["point"]
         target = self.body(body, used_by=where)
         if isinstance(target, Ground):
             raise InputError(f"{where}: the ground does not move")
@@ -270,6 +381,20 @@ class System:
         return self.probes[name]
 
     # -- the model ------------------------------------------------------------------------
+    def check_effects_used(self, effects: Iterable[str]) -> None:
+        """Every effect listed is one an item of the system belongs to (an effect that
+        nothing uses is a typo or a forgotten item: InputError naming it)."""
+        used = self.effects_used()
+        if any(b.material.damping_time > 0 for b in self.bodies.values()
+               if hasattr(b, "material")):
+            used.add("damping")
+        unused = [e for e in effects if e not in used]
+        if unused:
+            raise InputError(f"effect {', '.join(map(repr, unused))} is listed but no item of "
+                             f"the system belongs to it (effects used: "
+                             f"{', '.join(sorted(used)) or 'none'}): remove it or add the item",
+                             group="scene", key="effects")
+
     def effects_used(self) -> set[str]:
         """Every effect an item of the system belongs to."""
         out = {load.effect for load in self.loads.values()}
@@ -281,14 +406,81 @@ class System:
             out.add("prestress")
         return out
 
+    @_api
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
-                 check_frames: bool = True):
+                 check_frames: bool = True, unused_effects: str = "refuse"):
         """The model of this system (``ancfdrv.system.assembly.assemble``): only the effects
         listed (default: the system's own list, else all it uses) are computed. An 'ffr'
         beam whose floating frame nothing holds is refused (InputError); with
         ``check_frames=False`` it is assembled for checks of the joint equations alone, and
-        the solvers refuse to run it."""
+        the solvers refuse to run it. An effect listed that no item belongs to is refused
+        (InputError) unless ``unused_effects='allow'`` (template scenes, whose effects
+        switch loads that a value of 0 leaves out)."""
         from .assembly import assemble
+        if effects is not None:
+            effects = check_effects(effects)
         chosen = effects if effects is not None else self.effects
+        if chosen is not None and unused_effects == "refuse":
+            self.check_effects_used(chosen)
+        validate.check_resources(validate.Estimate(self._parts(), contact_points=sum(
+            2 * c.points for c in self.contacts.values())), None, None, "static")
         return assemble(self, tuple(chosen) if chosen is not None else None,
                         linear_joints=linear_joints, check_frames=check_frames)
+
+
+#: drive parameters of the API per type (keyword -> schema key of &drive checked against)
+DRIVE_PARAMS = {
+    "constant": {"value": "value"},
+    "luffing": {"omega": "omega", "t_start": "t_start", "t_brake": "t_brake",
+                "sweep": "start", "start": "start"},
+    "spinup": {"omega": "omega", "period": "period", "start": "start"},
+    "cycle": {"amplitude": "amplitude", "period": "period", "t0": "t0"},
+    "sine": {"amplitude": "amplitude", "frequency": "frequency", "phase": "phase",
+             "offset": "offset", "t0": "t0", "ramp": "ramp"},
+    "table": {"times": "times", "values": "values", "file": "file"},
+}
+
+
+def check_drive_params(name: str, type: str, params: dict) -> dict:
+    """A drive's keyword parameters: known for its type, each a finite number (times and
+    values lists of them, file a path), with the checks of the namelist's &drive keys."""
+    label = f"drive[{name}]"
+    known = DRIVE_PARAMS[type]
+    unknown = sorted(set(params) - set(known))
+    if unknown:
+        raise InputError(f"type {type!r} does not take {', '.join(unknown)} (parameters: "
+                         f"{', '.join(known)})", group=label)
+    out = {}
+    for key, raw in params.items():
+        if key == "file":
+            if not isinstance(raw, (str, __import__("os").PathLike)):
+                raise InputError(f"expected a file path, got {short_repr(raw)}", group=label,
+                                 key=key)
+            out[key] = raw
+            continue
+        if raw is None:
+            raise InputError("expected a number, got None", group=label, key=key)
+        checked = check_call("drive", label, {known[key]: raw})[known[key]]
+        out[key] = checked
+    return out
+
+
+def check_effects(effects, *, what: str = "") -> tuple[str, ...]:
+    """A list of effect names (strings, each a known effect), else InputError (the
+    namelist's &scene effects check)."""
+    where = dict(group=what or "scene", key="effects" if not what else "effect")
+    if isinstance(effects, str):
+        effects = [effects]
+    try:
+        items = list(effects)
+    except TypeError:
+        raise InputError(f"expected a list of effect names, got {short_repr(effects)}",
+                         **where) from None
+    for effect in items:
+        if not isinstance(effect, str):
+            raise InputError(f"expected effect names (strings), got {short_repr(effect)}",
+                             **where)
+        if effect not in EFFECTS_AVAILABLE:
+            raise InputError(f"unknown effect {short_repr(effect)}; known effects: "
+                             f"{', '.join(EFFECTS_AVAILABLE)}", **where)
+    return tuple(items)
