@@ -49,7 +49,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from .plots import plot_result
     from .io.hdf5 import read_summary
     from .runner import run_scene
-    outcome = run_scene(args.scene, args.set, args.output)
+    # the plot is written while the output is still locked (a second run is refused)
+    outcome = run_scene(args.scene, args.set, args.output,
+                        after=lambda done: plot_result(done.output))
     for warning in outcome.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     summary = read_summary(outcome.output)
@@ -77,7 +79,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
               f"{d.wall_time_s:.2f} s")
         if outcome.stages:
             print(stage_table(outcome.stages))
-    png = plot_result(outcome.output)
+    png = outcome.after
     print(f"  written      {outcome.output}, {png}")
     return 0
 
@@ -237,6 +239,9 @@ def main(argv: list[str] | None = None) -> int:
     """The ``ancf`` command; returns the exit status (see the module docstring)."""
     args = build_parser().parse_args(argv)
     command = args.command
+    from .io.safe_write import ignore_file_size_signal
+    if threading.current_thread() is threading.main_thread():
+        ignore_file_size_signal()  # beyond ulimit -f a write fails (exit 3), no SIGXFSZ
     # SIGTERM outside a run (which handles it itself) ends the command without a trace
     global _COMMAND_PID
     previous = None
@@ -260,6 +265,13 @@ def main(argv: list[str] | None = None) -> int:
         except OSError:
             pass
         return 128 + signal.SIGPIPE
+    except OSError as exc:
+        from .io.safe_write import disk_full
+        if not disk_full(exc):
+            return _internal_error(command, exc, args.debug)
+        print(f"ancf {command}: error: cannot write: the disk or the file-size limit is full "
+              f"({str(exc).splitlines()[0][:200]})", file=sys.stderr)
+        return 3
     except Exception as exc:  # noqa: BLE001 - a bug: one line, the trace in a file
         return _internal_error(command, exc, args.debug)
     finally:

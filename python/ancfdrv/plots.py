@@ -13,6 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .io.safe_write import save_figure  # noqa: E402
 from .sweep_keys import is_resolution, static_value  # noqa: E402
 
 
@@ -235,7 +236,7 @@ def plot_spring(h5_paths: list[str | Path], png: str | Path | None = None) -> Pa
         notes = fig.add_subplot(grid[rows - 1, 1])
         _loop_panel(loop, band, runs, labels, colours)
         _loop_table(notes, runs, labels, colours)
-    fig.savefig(png, dpi=120)
+    save_figure(fig, png, dpi=120)
     plt.close(fig)
     return png
 
@@ -415,7 +416,7 @@ def plot_plate_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
     ax.set_ylabel("energy (J)")
     ax.set_xlabel("time (s)")
     ax.legend(fontsize=8, ncol=4)
-    fig.savefig(png, dpi=120)
+    save_figure(fig, png, dpi=120)
     plt.close(fig)
     return png
 
@@ -443,7 +444,7 @@ def plot_plate_static(h5_path: Path, png: str | Path | None = None) -> Path:
     ax.set_ylabel("r2 (m)")
     ax.set_title(f"{title}\nextreme displacement {1e3 * w[np.argmax(np.abs(w))]:.4g} mm",
                  fontsize=9)
-    fig.savefig(png, dpi=120)
+    save_figure(fig, png, dpi=120)
     plt.close(fig)
     return png
 
@@ -479,7 +480,7 @@ def plot_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
     twin.set_ylabel("balance / max(|W|, kinetic)", color="C3")
     ax2.set_xlabel("time (s)")
     ax2.legend(loc="upper left", fontsize=8)
-    fig.savefig(png, dpi=120)
+    save_figure(fig, png, dpi=120)
     plt.close(fig)
     return png
 
@@ -507,7 +508,7 @@ def plot_static(h5_path: Path, png: str | Path | None = None) -> Path:
     ax.set_ylabel("displacement (mm)")
     ax.set_title(f"{title}\n{len(s)} nodes, {method}: tip sag {1e3 * tip[1]:.3f} mm", fontsize=9)
     ax.legend()
-    fig.savefig(png, dpi=120)
+    save_figure(fig, png, dpi=120)
     plt.close(fig)
     return png
 
@@ -553,7 +554,7 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8)
         path = outdir / "tip_deflection.png"
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path, dpi=120)
         plt.close(fig)
         out.append(path)
     err_key = "err_vs_closed_form" if any("err_vs_closed_form" in r for r in ok) else "err_vs_finest"
@@ -579,7 +580,7 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
         if nodes_key:
             ax.legend(fontsize=8)
         path = outdir / "error_vs_time.png"
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path, dpi=120)
         plt.close(fig)
         out.append(path)
     return out
@@ -627,7 +628,7 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
         whole.legend(fontsize=8, ncol=len(members))
         name = "histories" + "".join(f"_{k.split('.')[1]}-{v}" for k, v in zip(others, panel))
         path = outdir / f"{name}.png"
-        fig.savefig(path, dpi=110)
+        save_figure(fig, path, dpi=110)
         plt.close(fig)
         out.append(path)
     return out

@@ -21,12 +21,13 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 import h5py
 import numpy as np
 
-from .errors import AncfError, InputError, Interrupted
+from .errors import AncfError, InputError, Interrupted, SolverError
+from .io.safe_write import disk_full
 from .history import luffing_stage_bounds, stage_summary
 from .interrupt import StopRequest, signal_name
 from .io import hdf5 as results
@@ -53,16 +54,21 @@ class RunOutcome:
     dynamic: DynamicResult | None
     warnings: list[str]
     stages: dict[str, float] = field(default_factory=dict)
+    #: what the ``after`` step of :func:`run_scene` returned (the plot's path for ``ancf run``)
+    after: Any = None
 
 
 def run_scene(path: str | Path, overrides: list[str] | None = None,
-              output: str | Path | None = None, *, progress: bool | None = None) -> RunOutcome:
+              output: str | Path | None = None, *, progress: bool | None = None,
+              after: Callable[[RunOutcome], Any] | None = None) -> RunOutcome:
     """Run a scene file. Raises InputError (bad input, output path refused or in use),
     SolverError (solver failure) or Interrupted (SIGINT/SIGTERM); in the last two cases
-    the output file already holds everything computed until then."""
+    the output file already holds everything computed until then. ``after(outcome)``
+    runs while the output is still locked (the plot of ``ancf run``: a second run on the
+    same output is refused until it is written); its result is ``outcome.after``."""
     start = time.perf_counter()
     scene = load_scene(path, overrides)
-    return run_loaded(scene, output, start=start, progress=progress)
+    return run_loaded(scene, output, start=start, progress=progress, after=after)
 
 
 def input_files(scene: Scene) -> list[Path]:
@@ -274,7 +280,8 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
 
 
 def run_loaded(scene: Scene, output: str | Path | None = None, *,
-               start: float | None = None, progress: bool | None = None) -> RunOutcome:
+               start: float | None = None, progress: bool | None = None,
+               after: Callable[[RunOutcome], Any] | None = None) -> RunOutcome:
     """Run a loaded scene (see :func:`run_scene`)."""
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
@@ -288,6 +295,14 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
     try:
         with OutputLock(out), StopRequest() as stop:
             outcome = _run_locked(scene, out, start, progress, stop)
+            if after is not None and stop.signum is None:
+                try:
+                    outcome.after = after(outcome)
+                except OSError as exc:
+                    if not disk_full(exc):
+                        raise
+                    raise SolverError(f"the run completed ({out} is complete, status 'ok') "
+                                      f"but its plot could not be written: {exc}") from None
     except BaseException:
         if not out.exists():  # refused before writing (bad input found late): leave no trace
             for directory in made:
@@ -376,6 +391,14 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
     except AncfError as exc:
         finish("failed", str(exc))
         raise
+    except OSError as exc:
+        if not disk_full(exc):
+            finish("failed", f"internal error: {type(exc).__name__}: {exc}")
+            raise
+        message = (f"cannot write {out}: the disk or the file-size limit is full "
+                   f"({str(exc).splitlines()[0][:200]}); the rows written before are kept")
+        finish("failed", message)
+        raise SolverError(message) from None
     except BaseException as exc:  # a bug: the file must not claim to be running
         finish("failed", f"internal error: {type(exc).__name__}: {exc}")
         raise

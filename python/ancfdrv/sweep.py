@@ -33,6 +33,7 @@ import numpy as np
 from tqdm import tqdm
 
 from .errors import InputError
+from .io.safe_write import replace_atomically, write_bytes, write_text
 from .sweep_keys import is_resolution, resolution_sense, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
 from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
@@ -373,7 +374,7 @@ def store_case_file(case: Case, sweep_id: str, data: bytes | None = None, *,
     ``sweep_id`` (and 'scene_file', the client's scene, for a remote case). Returns the
     final path, or '' when the case left no readable file."""
     if data is not None:
-        case.part.write_bytes(data)
+        write_bytes(case.part, data)
     stale = case.part.with_suffix(".xdmf")  # names the part file: rewritten below
     if not case.part.is_file():
         remove_quietly(stale)
@@ -510,7 +511,7 @@ def reference_notes(rows: list[dict], keys: list[str]) -> list[str]:
 
 def write_report(rows: list[dict], keys: list[str], outdir: Path) -> None:
     fields = keys + sorted({k for r in rows for k in r} - set(keys))
-    with open(outdir / "summary.csv", "w", newline="") as fh:
+    with replace_atomically(outdir / "summary.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=fields)
         writer.writeheader()
         for row in rows:
@@ -534,4 +535,4 @@ def write_report(rows: list[dict], keys: list[str], outdir: Path) -> None:
         lines.append(f"- {row['case']} ({row['status']}"
                      f"{', exit ' + str(row['exit_code']) if row['status'] != 'ok' else ''}): "
                      f"{row['message']}")
-    (outdir / "summary.md").write_text("\n".join(lines) + "\n")
+    write_text(outdir / "summary.md", "\n".join(lines) + "\n")

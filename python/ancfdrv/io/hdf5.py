@@ -36,6 +36,7 @@ from .._version import __version__
 from ..errors import InputError
 from ..system.bodies import Beam
 from ..system.model import Model
+from .safe_write import check_room, create_fresh
 from .scene import Scene
 from ..solvers.static import StaticResult
 
@@ -191,7 +192,9 @@ def _open_write(path: Path, mode: str = "a") -> h5py.File:
 def create(path: Path, scene: Scene, model: Model) -> None:
     """New result file with the root attributes (provenance included) and /model."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    with _open_write(path, "w") as h5:
+    create_fresh(path)  # never write through a symbolic link planted at the name
+    check_room(path, 16 * model.ndof * 8)  # a full disk: refused before HDF5 writes
+    with _open_write(path, "w-") as h5:
         _attrs(h5.attrs, {
             **provenance(),
             "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
@@ -436,6 +439,10 @@ class DynamicWriter:
         self._pending_rows = 0
         self._last_write = time.monotonic()
         ncon, ndof = len(model.constraints), model.ndof
+        # what a flush may allocate besides its rows: one HDF5 chunk of every series
+        self.chunk_bytes = 8 * (1024 * (4 + 6 * len(self.names) + max(ncon, 1) + 16
+                                        + 8 * self.npoints) + 16 * (ndof + 6 * self.nnodes))
+        check_room(path, self.chunk_bytes)
         with _open_write(path) as h5:
             if "dynamic" in h5:
                 del h5["dynamic"]
@@ -496,6 +503,13 @@ class DynamicWriter:
         """Write every buffered chunk (one open of the file)."""
         if not self._pending:
             return
+        # a full disk or file-size limit: refused before HDF5 writes (a write failing
+        # inside HDF5 can crash it), the rows written before stay readable
+        pending = sum(sum(getattr(getattr(chunk, f, None), "nbytes", 0)
+                          for f in ("time", "probes", "deflections", "lam", "energy",
+                                    "constraint", "stats", "q", "contact"))
+                      for chunk in self._pending)
+        check_room(self.path, 2 * pending + self.chunk_bytes)
         with _open_write(self.path) as h5:
             group = h5["dynamic"]
             first = self.frames

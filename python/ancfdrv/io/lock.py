@@ -70,7 +70,7 @@ def holder(path: str | Path) -> LockHolder | None:
     locked, finished, or its writer died)."""
     lock = lock_path(path)
     try:
-        fd = os.open(lock, os.O_RDONLY | os.O_CLOEXEC)
+        fd = os.open(lock, os.O_RDONLY | os.O_CLOEXEC | getattr(os, "O_NOFOLLOW", 0))
     except OSError:
         return None
     try:
@@ -151,8 +151,13 @@ class OutputLock:
 
     def _open(self) -> int:
         try:
-            return os.open(self.lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+            return os.open(self.lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC
+                           | getattr(os, "O_NOFOLLOW", 0), 0o644)
         except OSError as exc:
+            if exc.errno == errno.ELOOP:  # never write through a link planted at the name
+                raise InputError(f"the lock file {self.lock} is a symbolic link; remove it "
+                                 "(a run writes its lock file itself)",
+                                 file=str(self.path)) from None
             raise InputError(f"cannot create the lock file {self.lock}: {exc.strerror}",
                              file=str(self.path)) from None
 

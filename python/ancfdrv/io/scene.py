@@ -20,7 +20,7 @@ from ..errors import InputError
 from . import validate
 from .schema import (COMMON_GROUPS, EFFECTS_AVAILABLE, EFFECTS_PLANNED, GENERAL_ONLY_GROUPS,
                      GENERAL_SCHEMA, GENERAL_SINGLE_GROUPS, MODEL_GROUPS, PLATE_KINDS, REQUIRED,
-                     SCHEMA, WHOLE_LIST_CHECKS, Key, coerce)
+                     SCHEMA, WHOLE_LIST_CHECKS, Key, coerce, short_repr)
 
 __all__ = ["Scene", "load_scene", "parse_address", "is_general", "SCHEMA", "GENERAL_SCHEMA",
            "EFFECTS_AVAILABLE", "MODEL_GROUPS", "PLATE_KINDS"]
@@ -187,7 +187,7 @@ def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str) -
             for item in items:
                 message = spec.check(item)
                 if message:
-                    raise InputError(f"{value!r} {message}", **where)
+                    raise InputError(f"{short_repr(value)} {message}", **where)
         typed[key] = value
     for key, spec in schema.items():
         if key not in typed:

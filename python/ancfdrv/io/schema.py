@@ -17,6 +17,17 @@ from ..errors import InputError
 from .validate import check_int32, check_magnitude, check_name
 
 REQUIRED = object()
+#: the longest title accepted: it heads every plot (a 100 kB title took half a minute to
+#: draw) and the HDF5 attributes
+MAX_TITLE_CHARACTERS = 1000
+
+
+def title_problem(title: str) -> str | None:
+    """Why a title is refused (too long, several lines), or None."""
+    if len(title) > MAX_TITLE_CHARACTERS:
+        return (f"is {len(title)} characters long; at most {MAX_TITLE_CHARACTERS} are "
+                "accepted")
+    return None
 #: the material damping key (both schemas)
 DAMPING_TIME_DOC = ("Kelvin-Voigt retardation time tau (s): stress D (strain + tau strain rate), "
                     "modal damping ratio tau omega / 2; needs the effect 'damping'")
@@ -69,7 +80,8 @@ def at_least(n: int) -> Callable[[Any], str | None]:
 
 SCHEMA: dict[str, dict[str, Key]] = {
     "scene": {
-        "title": Key("str", doc="a line describing the scene"),
+        "title": Key("str", check=lambda v: title_problem(v), doc="a line describing the "
+                     "scene (at most 1000 characters)"),
         "analysis": Key("str", "static", one_of("static", "dynamic", "static+dynamic"),
                         "which analysis runs"),
         "formulation": Key("str", "ffr", one_of("ffr", "nonlinear"), "elastic model"),

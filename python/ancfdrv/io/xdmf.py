@@ -30,7 +30,6 @@ refused.
 from __future__ import annotations
 
 import math
-import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,6 +40,7 @@ import scipy.sparse as sp
 from h5py import h5a, h5d, h5p, h5s, h5t
 
 from ..errors import InputError
+from .safe_write import write_with
 from ..system.bodies import Beam, Plate, RigidBody
 
 _STEPS_GROUP = "dynamic/xdmf"
@@ -261,7 +261,6 @@ def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
                                       AttributeType="Vector", Center="Node")
             _item(attribute, (npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
     out = target.with_suffix(".xdmf")
-    partial = out.with_name(out.name + ".partial")
-    ET.ElementTree(root).write(partial, encoding="utf-8", xml_declaration=True)
-    os.replace(partial, out)
+    write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
+                                                            xml_declaration=True))
     return out

@@ -26,7 +26,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..io import validate
-from ..io.schema import EFFECTS_AVAILABLE, check_call, plain_value, short_repr
+from ..io.schema import (EFFECTS_AVAILABLE, check_call, plain_value, short_repr,
+                         title_problem)
 from .bodies import Beam, Body, Ground, Leaf, Material, Plate, RigidBody
 from .contact import ContactPair
 from .drives import DRIVE_TYPES, Drive, Table
@@ -78,6 +79,9 @@ class System:
         if not isinstance(title, str):
             raise InputError(f"the title must be a string, got {short_repr(title)}",
                              group="scene", key="title")
+        problem = title_problem(title)
+        if problem:
+            raise InputError(f"the title {problem}", group="scene", key="title")
         self.title = title
         self.effects = None if effects is None else check_effects(effects)
         self.materials: dict[str, Material] = {}
