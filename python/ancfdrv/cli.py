@@ -110,9 +110,10 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                          scheduler=args.scheduler)
     except SweepInterrupted as stop:
         done = sum(r["status"] in ("ok", "failed") for r in stop.rows)
-        print(f"ancf sweep: interrupted: {done} of {len(stop.rows)} cases finished, the others "
-              f"cancelled; report in {out}/summary.md", file=sys.stderr)
-        return 130
+        by = f" by {signal.Signals(stop.signum).name}" if stop.signum else ""
+        print(f"ancf sweep: interrupted{by}: {done} of {len(stop.rows)} cases finished, the "
+              f"others cancelled; report in {out}/summary.md", file=sys.stderr)
+        return stop.exit_code
     keys = [v.split("=", 1)[0].strip().lower() for v in args.vary]
     print("\n".join(table_lines(rows, keys)))
     print(f"\nwritten {out}/summary.md, summary.csv, *.png and one .h5 per case")
@@ -128,8 +129,13 @@ def _cmd_info(args: argparse.Namespace) -> int:
     the main figures."""
     from .io.hdf5 import read_summary, verdict
     path = Path(args.file)
-    summary = read_summary(path)  # InputError (exit 2) when missing, not HDF5, not ours
-    word, detail = verdict(path, summary)
+    try:
+        summary = read_summary(path)  # InputError (exit 2) when missing, not HDF5, not ours
+        word, detail = verdict(path, summary)
+    except AncfError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a damaged file: exit 2 naming it
+        raise corrupted(path, exc) from None
     print(f"{path}: {word}: {detail}")
     skip = {"scene", "status", "message"}
     for key, value in summary.items():
@@ -154,8 +160,20 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             plot_results(paths, args.output)
     except (ValueError, KeyError, OSError) as exc:
         raise InputError(str(exc), file=", ".join(map(str, paths))) from None
+    except AncfError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a damaged file: exit 2 naming it
+        raise corrupted(", ".join(map(str, paths)), exc) from None
     print(f"written {png}")
     return 0
+
+
+def corrupted(path: object, exc: BaseException) -> InputError:
+    """A result file that opens but whose content is damaged or not what a run writes."""
+    text = str(exc).splitlines()[0][:200] if str(exc) else ""
+    return InputError(f"cannot read it as an ancfdrv result file: damaged or not written by "
+                      f"a run ({type(exc).__name__}{': ' + text if text else ''})",
+                      file=str(path))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -180,7 +198,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--vary", action="append", required=True, metavar="GROUP.KEY=V1,V2,...")
     p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE")
     p.add_argument("-o", "--output", help="output directory")
-    p.add_argument("--workers", type=int, help="parallel processes (default: all cores)")
+    p.add_argument("--workers", type=int, help="parallel processes (default: all cores; "
+                   "at most one per core, per case and per 150 MB of available memory)")
     p.add_argument("--scheduler", help="address of a Dask distributed scheduler")
     p.set_defaults(func=_cmd_sweep)
     p = sub.add_parser("info", help="summarize a result file; the first line says whether "

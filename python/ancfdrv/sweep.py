@@ -33,11 +33,13 @@ import numpy as np
 from tqdm import tqdm
 
 from .errors import InputError
+from .io.lock import OutputLock
 from .io.safe_write import replace_atomically, write_bytes, write_text
 from .sweep_keys import is_resolution, resolution_sense, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
 from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
-                         remove_quietly, response_of, run_dask, run_inline, run_processes)
+                         remove_quietly, response_of, run_dask, run_inline, run_processes,
+                         worker_cap)
 
 #: Case file names: these characters only, at most this long (before the hash suffix).
 _UNSAFE = re.compile(r"[^A-Za-z0-9._+-]")
@@ -46,11 +48,64 @@ MAX_NAME_CHARS = 96
 
 class SweepInterrupted(KeyboardInterrupt):
     """Ctrl-C stopped a sweep; the report of what finished is written. ``rows`` are all
-    cases ('ok', 'failed', 'interrupted' or 'cancelled'), ``outdir`` the sweep directory."""
+    cases ('ok', 'failed', 'interrupted' or 'cancelled'), ``outdir`` the sweep directory,
+    ``signum`` the signal that stopped it (SIGINT or SIGTERM, when known)."""
 
-    def __init__(self, rows: list[dict], outdir: Path) -> None:
+    def __init__(self, rows: list[dict], outdir: Path, signum: int | None = None) -> None:
         super().__init__("sweep interrupted")
-        self.rows, self.outdir = rows, outdir
+        self.rows, self.outdir, self.signum = rows, outdir, signum
+
+    @property
+    def exit_code(self) -> int:
+        """128 + the signal (130 for SIGINT, 143 for SIGTERM)."""
+        import signal
+        if self.signum is not None:
+            return 128 + self.signum
+        codes = [r.get("exit_code") for r in self.rows if r.get("status") == "interrupted"]
+        return 128 + signal.SIGTERM if 128 + signal.SIGTERM in codes else 128 + signal.SIGINT
+
+
+class ParentSignals:
+    """SIGINT and SIGTERM sent to the sweep's parent process (``kill -INT PID``, not only a
+    terminal's Ctrl-C to the whole process group, and even when the shell started it with
+    SIGINT ignored) stop the sweep like Ctrl-C: the first one raises KeyboardInterrupt in
+    the executor (running cases stopped, queued ones cancelled, the report of the finished
+    ones written); later ones are only recorded. A worker process forked while the handler
+    is in place gets the default behaviour back."""
+
+    def __init__(self) -> None:
+        import signal
+        self.signals = (signal.SIGINT, signal.SIGTERM)
+        self.signum: int | None = None
+        self.armed = True
+        self._saved: dict[int, Any] = {}
+        self._pid = os.getpid()
+
+    def __enter__(self) -> "ParentSignals":
+        import signal
+        import threading
+        if threading.current_thread() is threading.main_thread():
+            for signum in self.signals:
+                self._saved[signum] = signal.signal(signum, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        import signal
+        for signum, previous in self._saved.items():
+            signal.signal(signum, previous)
+        self._saved.clear()
+
+    def _handle(self, signum: int, frame: object) -> None:
+        import signal
+        if os.getpid() != self._pid:  # a forked worker before it set its own handlers
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
+        if self.signum is None:
+            self.signum = signum
+        if self.armed:
+            self.armed = False
+            raise KeyboardInterrupt
 
 
 def expand(params: dict[str, str]) -> list[str]:
@@ -293,22 +348,56 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
     for params in combos:  # validate every case before spending time on any
         load_scene(scene_file, base + expand(params))
     outdir = Path(outdir)
+    check_sweep_dir(outdir, scene_file)
     sweep_id = uuid.uuid4().hex
     cases = _make_cases(combos, outdir, sweep_id)
+    if workers is not None:
+        workers = worker_cap(workers, len(cases))
     client = connect(scheduler, connect_timeout) if scheduler else None  # before any output
+    lock = None
     try:
-        outdir.mkdir(parents=True, exist_ok=True)
-        rows, interrupted = _run_cases(scene_file, base, cases, sweep_id, client=client,
-                                       workers=workers, start_method=start_method,
-                                       progress=progress, scene_text=scene.text)
+        try:
+            outdir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"cannot create the sweep directory: {exc.strerror}",
+                             file=str(outdir)) from None
+        # one sweep per directory, from its first case until its report is written
+        lock = OutputLock(outdir / "summary.csv")
+        lock.acquire()
+        with ParentSignals() as signals:
+            rows, interrupted = _run_cases(scene_file, base, cases, sweep_id, client=client,
+                                           workers=workers, start_method=start_method,
+                                           progress=progress, scene_text=scene.text)
+            signals.armed = False  # the report is written whatever comes now
+            check_sweep_ids(rows, sweep_id)
+            report(rows, keys, outdir, scene_file, base)
     finally:
         if client is not None:
             client.close()
-    check_sweep_ids(rows, sweep_id)
-    report(rows, keys, outdir, scene_file, base)
-    if interrupted:
-        raise SweepInterrupted(rows, outdir)
+        if lock is not None:
+            lock.release()
+    if interrupted or signals.signum is not None:
+        raise SweepInterrupted(rows, outdir, signals.signum)
     return rows
+
+
+def check_sweep_dir(outdir: Path, scene_file: str) -> None:
+    """The sweep's output must be a directory (or not exist yet): an existing file, the
+    scene itself included, is refused before anything runs (InputError, exit 2)."""
+    if outdir.is_symlink() and not outdir.exists():
+        raise InputError("the sweep directory is a broken symbolic link", file=str(outdir))
+    if outdir.exists() and not outdir.is_dir():
+        scene = Path(scene_file)
+        same = scene.exists() and os.path.samefile(outdir, scene)
+        raise InputError("the sweep output is " + ("the scene file itself" if same else
+                         "an existing file") + "; -o names a directory for the sweep's files",
+                         file=str(outdir))
+    parent = outdir
+    while not parent.exists() and parent.parent != parent:
+        parent = parent.parent
+    if parent.exists() and not parent.is_dir():
+        raise InputError(f"cannot create the sweep directory: {parent} is not a directory",
+                         file=str(outdir))
 
 
 def _run_cases(scene_file: str, base: list[str], cases: list[Case], sweep_id: str, *,

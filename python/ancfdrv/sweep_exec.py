@@ -34,7 +34,7 @@ from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Any, Callable
 
-from .errors import AncfError, InputError
+from .errors import AncfError, InputError, Interrupted
 
 #: Seconds a Dask client waits for the scheduler before the sweep gives up (exit 2).
 CONNECT_TIMEOUT_S = 5.0
@@ -82,6 +82,8 @@ def run_case(scene_file: str, params: dict[str, str], overrides: list[str],
     from . import runner
     try:
         outcome = runner.run_scene(scene_file, overrides, output, progress=False)
+    except Interrupted as exc:  # SIGINT/SIGTERM reached this process during the case
+        return failure(params, "interrupted", str(exc), exc.exit_code)
     except AncfError as exc:
         return failure(params, "failed", str(exc), exc.exit_code)
     except Exception as exc:  # a bug or an environment problem: still only this case's
@@ -136,6 +138,9 @@ def run_inline(scene_file: str, base: list[str], cases: list[Case], record: Reco
             row = run_case(scene_file, case.params, base + case.overrides, str(case.part))
             record(case, row, None)
             done += 1
+            if row["status"] == "interrupted":  # the run's own handler caught the signal
+                _stop_rows([], cases[done:], record)
+                return True
     except KeyboardInterrupt:
         _stop_rows(cases[done:done + 1], cases[done + 1:], record)
         return True
@@ -171,6 +176,7 @@ def _worker_main(conn: Connection, parent_end: Connection) -> None:
     parent_end.close()  # the copy a fork gave us: the parent's death must be EOF here
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    _die_with_parent()
     # one case at a time: a thread lock for tqdm rather than its default multiprocessing
     # semaphore, which a killed worker would leave to the resource tracker (a warning)
     from tqdm import tqdm
@@ -183,9 +189,42 @@ def _worker_main(conn: Connection, parent_end: Connection) -> None:
                 return
             if job is None:
                 return
-            conn.send(run_case(*job))
+            row = run_case(*job)
+            try:
+                conn.send(row)
+            except OSError:  # the parent went away (killed): nobody to report to
+                return
     finally:
         conn.close()
+
+
+def _die_with_parent() -> None:
+    """Ask the kernel to send this worker SIGTERM when its parent dies (Linux
+    PR_SET_PDEATHSIG): a killed sweep parent (SIGKILL) leaves no orphan running cases. The
+    case stops at its next step boundary; its row has nobody to go to and is dropped."""
+    parent = os.getppid()
+    try:
+        import ctypes
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, int(signal.SIGTERM), 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent:  # the parent died before the request was in place
+        os._exit(128 + signal.SIGTERM)
+
+
+def worker_cap(requested: int, cases: int) -> int:
+    """The number of local worker processes for ``requested`` (--workers) and ``cases``:
+    at most one per case, per core this process may run on, and per BASE_BYTES of the
+    memory available (each worker holds the interpreter, the libraries and a model), and
+    at least 1. So ``--workers 100000`` runs as many workers as the machine has cores."""
+    from .io.validate import BASE_BYTES, available_memory
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    by_memory = max(1, available_memory() // BASE_BYTES)
+    return max(1, min(requested, cases, cores, by_memory))
 
 
 def _exit_on_sigterm(signum: int, frame: Any) -> None:

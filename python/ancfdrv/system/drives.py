@@ -184,10 +184,30 @@ class Table(Drive):
                         continue  # header
                     raise InputError(f"drive {name!r}: {path}, line {number}: expected numbers "
                                      f"in columns {time_column + 1} and {value_column + 1}, got "
-                                     f"{row!r}") from None
+                                     f"{_token(row)}") from None
         table = cls(name, tuple(times), tuple(values))
         table.check()
         return table
+
+
+def _token(row: list[str]) -> str:
+    """The first cell of a row that is not a number, quoted and cut to a few characters: a
+    message never echoes the content of a file it could not parse."""
+    import re
+    cells = [c.strip() for c in row if c.strip()]
+    if not cells:
+        return "an empty row"
+    bad = next((c for c in cells if not _is_number(c)), cells[0])
+    token = re.match(r"[^\s:;,=/|'\"]*", bad).group()[:12]
+    return f"{token!r}" + (" ..." if token != bad else "")
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 DRIVE_TYPES = {"constant": Constant, "luffing": Luffing, "spinup": SpinUp, "cycle": Cycle,
