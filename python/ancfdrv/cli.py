@@ -49,6 +49,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from .plots import plot_result
     from .io.hdf5 import read_summary
     from .runner import run_scene
+    if args.force:
+        args.set = [*args.set, "scene.bounds=off"]
     # the plot is written while the output is still locked (a second run is refused)
     outcome = run_scene(args.scene, args.set, args.output,
                         after=lambda done: plot_result(done.output))
@@ -105,6 +107,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.workers is not None and args.scheduler:
         raise InputError("give --workers or --scheduler, not both")
     out = args.output or str(Path("results") / (Path(args.scene).stem + "_sweep"))
+    if args.force:
+        args.set = [*args.set, "scene.bounds=off"]
     try:
         rows = run_sweep(args.scene, args.vary, out, base=args.set, workers=args.workers,
                          scheduler=args.scheduler)
@@ -192,11 +196,15 @@ def build_parser() -> argparse.ArgumentParser:
                    "an input file; refused while another run writes it")
     p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE",
                    help="override a namelist value (repeatable)")
+    p.add_argument("--force", action="store_true", help="accept drives and loads beyond "
+                   "their physical bounds (the same as --set scene.bounds=off)")
     p.set_defaults(func=_cmd_run)
     p = sub.add_parser("sweep", help="run every combination of --vary values")
     p.add_argument("scene")
     p.add_argument("--vary", action="append", required=True, metavar="GROUP.KEY=V1,V2,...")
     p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE")
+    p.add_argument("--force", action="store_true", help="accept drives and loads beyond "
+                   "their physical bounds (the same as --set scene.bounds=off)")
     p.add_argument("-o", "--output", help="output directory")
     p.add_argument("--workers", type=int, help="parallel processes (default: all cores; "
                    "at most one per core, per case and per 150 MB of available memory)")

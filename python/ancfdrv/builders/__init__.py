@@ -29,7 +29,8 @@ def build_model(scene) -> Model:
     model = built.system.assemble(effects=scene.effects,
                                   linear_joints=scene["solver"].get("linear_joints", "auto"),
                                   unused_effects="refuse" if scene.kind == "general"
-                                  else "allow")
+                                  else "allow",
+                                  bounds=scene["scene"].get("bounds", "check"))
     model.warnings[:0] = built.warnings
     if built.response is not None:
         model.response = built.response

@@ -89,6 +89,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "(general scenes: default every effect their items belong to)"),
         "response": Key("str", None, doc="general scenes: the probe sweeps compare (default: "
                         "the first probe)"),
+        "bounds": Key("str", "check", one_of("check", "off"),
+                      "'check': drives and loads must stay within physical bounds "
+                      "(ancfdrv.io.validate.PHYSICAL_BOUNDS, e.g. a rate of at most 1e4 rad/s); "
+                      "'off' accepts any finite value (also: ancf run --force)"),
         "response_component": Key("int", 2, within(0, 2), "general scenes: the component of the "
                                   "response probe's deflection compared (0, 1, 2 = x, y, z; beams "
                                   "in their frame)"),

@@ -609,3 +609,32 @@ def check_state(function: str, key: str, value: Any, size: int):
     if not np.all(np.isfinite(array)):
         raise InputError(f"{function}: {key} must be finite numbers")
     return array
+
+
+# -- 7. physical bounds of drives and loads (absurd but finite input) ----------------------
+
+#: the largest magnitude accepted for each quantity of a drive or a load (SI units), with
+#: what it stands for; beyond it the input is almost surely a typo or a unit slip. A scene
+#: lifts them with ``&scene bounds = 'off'`` (``ancf run --force``), the Python API with
+#: ``System(..., bounds='off')``.
+PHYSICAL_BOUNDS: dict[str, tuple[float, str, str]] = {
+    "angular_rate": (1e4, "rad/s", "about 95,000 rpm, beyond the fastest turbines"),
+    "frequency": (1e5, "Hz", "far above any structural mode a beam or plate model resolves"),
+    "acceleration": (1e4, "m/s^2", "about 1000 g"),
+    "force": (1e10, "N", "the weight of a million tonnes"),
+    "moment": (1e10, "N m", "a million tonnes on a 1 m arm"),
+    "mass": (1e8, "kg", "a hundred thousand tonnes"),
+    "pressure": (1e10, "Pa", "10 GPa, beyond the strength of any structural material"),
+}
+#: how a bound is lifted (for the messages)
+BOUNDS_OVERRIDE = ("scene.bounds = 'off' (ancf run --force) or System(..., bounds='off')")
+
+
+def check_bound(quantity: str, value: float, what: str) -> None:
+    """InputError naming ``what``, the value and the bound when |value| exceeds the
+    physical bound of ``quantity`` (:data:`PHYSICAL_BOUNDS`)."""
+    limit, unit, meaning = PHYSICAL_BOUNDS[quantity]
+    if abs(value) > limit:
+        raise InputError(f"{what} = {value:g} {unit} is beyond the physical bound for "
+                         f"{quantity.replace('_', ' ')}, {limit:g} {unit} ({meaning}); "
+                         f"if this is meant, lift the bounds: {BOUNDS_OVERRIDE}")

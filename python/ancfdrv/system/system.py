@@ -75,7 +75,8 @@ def _points(value) -> list[np.ndarray]:
 class System:
     """A mechanical system under construction (see the module documentation)."""
 
-    def __init__(self, title: str = "", *, effects: Iterable[str] | None = None) -> None:
+    def __init__(self, title: str = "", *, effects: Iterable[str] | None = None,
+                 bounds: str = "check") -> None:
         if not isinstance(title, str):
             raise InputError(f"the title must be a string, got {short_repr(title)}",
                              group="scene", key="title")
@@ -84,6 +85,11 @@ class System:
             raise InputError(f"the title {problem}", group="scene", key="title")
         self.title = title
         self.effects = None if effects is None else check_effects(effects)
+        if bounds not in ("check", "off"):
+            raise InputError(f"bounds must be 'check' or 'off', got {short_repr(bounds)}",
+                             group="scene", key="bounds")
+        #: 'check': drives and loads within validate.PHYSICAL_BOUNDS at assembly; 'off'
+        self.bounds = bounds
         self.materials: dict[str, Material] = {}
         self.bodies: dict[str, Body] = {}
         self.drives: dict[str, Drive] = {}
@@ -385,6 +391,29 @@ class System:
         return self.probes[name]
 
     # -- the model ------------------------------------------------------------------------
+    def check_bounds(self) -> None:
+        """Every drive and load within the physical bounds (``validate.PHYSICAL_BOUNDS``:
+        rates, frequencies, accelerations, forces, moments, masses, pressures); InputError
+        naming the item, the value and the bound otherwise. Lifted by ``bounds='off'``."""
+        for drive in self.drives.values():
+            where = f"drive {drive.name!r}"
+            omega = getattr(drive, "omega", None)
+            if omega is not None:
+                validate.check_bound("angular_rate", float(omega), f"{where}: omega")
+            frequency = getattr(drive, "frequency", None)
+            if frequency is not None:
+                validate.check_bound("frequency", float(frequency), f"{where}: frequency")
+        quantity = {"gravity": ("acceleration", "vector"), "force": ("force", "vector"),
+                    "moment": ("moment", "vector"), "point_mass": ("mass", "mass"),
+                    "pressure": ("pressure", "value")}
+        types = {cls: name for name, cls in LOAD_TYPES.items()}
+        for load in self.loads.values():
+            kind, attribute = quantity[types[type(load)]]
+            value = getattr(load, attribute)
+            magnitude = float(np.linalg.norm(value)) if np.ndim(value) else float(value)
+            validate.check_bound(kind, magnitude, f"load {load.name!r}: |{attribute}|"
+                                 if np.ndim(value) else f"load {load.name!r}: {attribute}")
+
     def check_effects_used(self, effects: Iterable[str]) -> None:
         """Every effect listed is one an item of the system belongs to (an effect that
         nothing uses is a typo or a forgotten item: InputError naming it)."""
@@ -412,20 +441,25 @@ class System:
 
     @_api
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
-                 check_frames: bool = True, unused_effects: str = "refuse"):
+                 check_frames: bool = True, unused_effects: str = "refuse",
+                 bounds: str | None = None):
         """The model of this system (``ancfdrv.system.assembly.assemble``): only the effects
         listed (default: the system's own list, else all it uses) are computed. An 'ffr'
         beam whose floating frame nothing holds is refused (InputError); with
         ``check_frames=False`` it is assembled for checks of the joint equations alone, and
         the solvers refuse to run it. An effect listed that no item belongs to is refused
         (InputError) unless ``unused_effects='allow'`` (template scenes, whose effects
-        switch loads that a value of 0 leaves out)."""
+        switch loads that a value of 0 leaves out). Drives and loads beyond the physical
+        bounds are refused (:meth:`check_bounds`) unless ``bounds='off'`` (default: the
+        system's own setting)."""
         from .assembly import assemble
         if effects is not None:
             effects = check_effects(effects)
         chosen = effects if effects is not None else self.effects
         if chosen is not None and unused_effects == "refuse":
             self.check_effects_used(chosen)
+        if (bounds or self.bounds) == "check":
+            self.check_bounds()
         validate.check_resources(validate.Estimate(self._parts(), contact_points=sum(
             2 * c.points for c in self.contacts.values())), None, None, "static")
         return assemble(self, tuple(chosen) if chosen is not None else None,
