@@ -114,9 +114,9 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                          scheduler=args.scheduler)
     except SweepInterrupted as stop:
         done = sum(r["status"] in ("ok", "failed") for r in stop.rows)
-        by = f" by {signal.Signals(stop.signum).name}" if stop.signum else ""
-        print(f"ancf sweep: interrupted{by}: {done} of {len(stop.rows)} cases finished, the "
-              f"others cancelled; report in {out}/summary.md", file=sys.stderr)
+        by = f" (stopped by {signal.Signals(stop.signum).name})" if stop.signum else ""
+        print(f"ancf sweep: interrupted: {done} of {len(stop.rows)} cases finished, the "
+              f"others cancelled; report in {out}/summary.md{by}", file=sys.stderr)
         return stop.exit_code
     keys = [v.split("=", 1)[0].strip().lower() for v in args.vary]
     print("\n".join(table_lines(rows, keys)))

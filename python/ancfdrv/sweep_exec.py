@@ -194,6 +194,8 @@ def _worker_main(conn: Connection, parent_end: Connection) -> None:
                 conn.send(row)
             except OSError:  # the parent went away (killed): nobody to report to
                 return
+            if row.get("status") == "interrupted":  # SIGTERM (the parent stopping us)
+                return
     finally:
         conn.close()
 
