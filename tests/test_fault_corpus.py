@@ -582,3 +582,25 @@ def test_a_killed_sweep_parent_leaves_no_orphans_and_no_traceback(tmp_path):
     for part in out.glob(".*.part.h5"):  # what the workers wrote stays readable
         with h5py.File(part, "r") as h5:
             assert h5.attrs["status"] in ("interrupted", "running")
+
+
+def test_a_general_scene_beyond_a_bound_is_refused_when_read(tmp_path):
+    """The namelist door: the bound is checked when the scene is read (a sweep refuses it
+    before any case runs), naming the file and the group; bounds = 'off' lifts it."""
+    from ancfdrv.io.scene import load_scene
+    text = textwrap.dedent("""\
+        &scene title = 't'{extra} /
+        &material name = 'm', youngs_modulus = 2.1e11, density = 7850 /
+        &beam name = 'b', material = 'm', start = 0,0,0, end = 1,0,0, nodes = 3,
+              width = 0.1, height = 0.1 /
+        &joint name = 'r', type = 'weld', body1 = 'ground', body2 = 'b', point = 0,0,0 /
+        &load name = 'f', type = 'force', body = 'b', point = 1,0,0, vector = 0,-1e12,0 /
+        &probe name = 'tip', body = 'b', point = 1,0,0 /
+        """)
+    scene = tmp_path / "s.nml"
+    scene.write_text(text.format(extra=""))
+    with pytest.raises(InputError) as exc:
+        load_scene(scene)
+    assert str(exc.value).startswith(f"{scene}: &load[f]: load 'f': |vector| = 1e+12 N")
+    scene.write_text(text.format(extra=", bounds = 'off'"))
+    assert load_scene(scene)["scene"]["bounds"] == "off"

@@ -210,6 +210,11 @@ def build_general(scene) -> BuiltSystem:
             raise InputError(str(exc), file=str(scene.path),
                              group=f"{group}[{values['name']}]") from None
     _check_joint_points(s, scene)
+    if scene["scene"].get("bounds", "check") == "check":  # before any case of a sweep runs
+        try:
+            s.check_bounds()
+        except InputError as exc:
+            raise locate_error(exc, scene) from None
     response = None
     if scene["scene"].get("response"):
         name = scene["scene"]["response"]
