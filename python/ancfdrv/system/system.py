@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..io import validate
-from ..io.schema import (EFFECTS_AVAILABLE, check_call, plain_value, short_repr,
+from ..io.schema import (EFFECTS_AVAILABLE, check_call, coerce, plain_value, short_repr,
                          title_problem)
 from .bodies import Beam, Body, Ground, Leaf, Material, Plate, RigidBody
 from .contact import ContactPair
@@ -218,10 +218,8 @@ class System:
         v = check_call("rigid_body", f"rigid_body[{name}]", dict(
             mass=mass, position=position, planar=planar, plane_normal=plane_normal,
             inertia=inertia if not (isinstance(flat, list) and len(flat) == 9) else None))
-        if isinstance(flat, list) and len(flat) == 9:  # a 3 x 3 tensor: numbers only here
-            check_call("rigid_body", f"rigid_body[{name}]", dict(position=flat[:3]))
-            check_call("rigid_body", f"rigid_body[{name}]", dict(position=flat[3:6]))
-            check_call("rigid_body", f"rigid_body[{name}]", dict(position=flat[6:]))
+        if isinstance(flat, list) and len(flat) == 9:  # a 3 x 3 tensor: finite numbers
+            coerce("floats", flat, dict(group=f"rigid_body[{name}]", key="inertia"))
         mass, planar = v["mass"], v["planar"]
         return self._add_body(RigidBody(name, mass, inertia, position, planar=planar,
                                         plane_normal=plane_normal))
