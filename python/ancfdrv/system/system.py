@@ -289,9 +289,8 @@ class System:
         name = self._new_name(name, self.joints, "joint")
         where = f"joint {name!r}"
         v = check_call("joint", f"joint[{name}]", dict(
-            type=type, point=point, axis=axis, point1=point1, point2=point2, pivot=pivot,
-            vector=vector))
-        type, axis = v["type"], v["axis"]
+            point=point, axis=axis, point1=point1, point2=point2, pivot=pivot))
+        axis = v["axis"]
         try:
             points = [] if point is None else _points(point)
             p1 = None if point1 is None else _points(point1)[0]
@@ -481,7 +480,12 @@ def check_drive_params(name: str, type: str, params: dict) -> dict:
     """A drive's keyword parameters: known for its type, each a finite number (times and
     values lists of them, file a path), with the checks of the namelist's &drive keys."""
     label = f"drive[{name}]"
-    known = DRIVE_PARAMS[type]
+    if type not in DRIVE_PARAMS:  # a drive type this table does not know: numbers finite
+        known = {key: "times" if isinstance(plain_value(raw), list) else "value"
+                 for key, raw in params.items() if key not in ("file", "times", "values")}
+        known.update({k: k for k in ("file", "times", "values") if k in params})
+    else:
+        known = DRIVE_PARAMS[type]
     unknown = sorted(set(params) - set(known))
     if unknown:
         raise InputError(f"type {type!r} does not take {', '.join(unknown)} (parameters: "
