@@ -438,7 +438,7 @@ class System:
 
     @_api
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
-                 check_frames: bool = True, unused_effects: str = "refuse",
+                 check_frames: bool = True, unused_effects: str | None = None,
                  bounds: str | None = None):
         """The model of this system (``ancfdrv.system.assembly.assemble``): only the effects
         listed (default: the system's own list, else all it uses) are computed. An 'ffr'
@@ -446,13 +446,17 @@ class System:
         ``check_frames=False`` it is assembled for checks of the joint equations alone, and
         the solvers refuse to run it. An effect listed that no item belongs to is refused
         (InputError) unless ``unused_effects='allow'`` (template scenes, whose effects
-        switch loads that a value of 0 leaves out). Drives and loads beyond the physical
+        switch loads that a value of 0 leaves out); by default the system's own list is
+        checked so (``System(effects=...)``), a list given here is not (a caller switching
+        effects of a built system). Drives and loads beyond the physical
         bounds are refused (:meth:`check_bounds`) unless ``bounds='off'`` (default: the
         system's own setting)."""
         from .assembly import assemble
         if effects is not None:
             effects = check_effects(effects)
         chosen = effects if effects is not None else self.effects
+        if unused_effects is None:
+            unused_effects = "allow" if effects is not None else "refuse"
         if chosen is not None and unused_effects == "refuse":
             self.check_effects_used(chosen)
         if (bounds or self.bounds) == "check":
