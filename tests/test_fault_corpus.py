@@ -145,11 +145,14 @@ API_MISUSE = {
     "System effects unknown": (lambda: System("x", effects=["gravity", "wind"]),
                                "unknown effect 'wind'"),
     "System effects a number": (lambda: System("x", effects=3), "effect"),
-    "effect listed that nothing uses": (lambda: _unused_effect(), "'gravity' is listed but "
-                                        "no item of the system belongs to it"),
+    "effect listed that nothing uses, strict": (lambda: _unused_effect("refuse"),
+                                                "'gravity' is listed but no item of the "
+                                                "system belongs to it"),
     "probe point NaN": (lambda: arm().probe("p", "arm", (np.nan, 0, 0)), "point"),
-    "name with a slash": (lambda: System().material("a/b", youngs_modulus=1.0, density=1.0),
-                          "must not contain '/'"),
+    "probe name with a slash": (lambda: arm().probe("a/b", "arm", (1, 0, 0)),
+                                "must not contain '/'"),
+    "name with a newline": (lambda: System().material("a\nb", youngs_modulus=1.0,
+                                                      density=1.0), "control characters"),
     "title not a string": (lambda: System(title=5), "title"),
     "contact points 2.5": (lambda: _two_plates().contact("c", "p1", "p2", stiffness=1e5,
                                                          points=2.5), "points"),
@@ -164,9 +167,18 @@ API_MISUSE = {
 }
 
 
-def _unused_effect():
+def _unused_effect(mode: str | None = None):
     s = arm(steel(System("x", effects=["gravity"])))
-    s.assemble()
+    return s.assemble(unused_effects=mode)
+
+
+def test_an_effect_nothing_uses_is_a_warning_by_default():
+    """Not silent: the model's warnings (printed by ancf run) and a UserWarning say it; no
+    gravity is computed (its counter stays 0)."""
+    with pytest.warns(UserWarning, match="'gravity' is listed but no item"):
+        model = _unused_effect()
+    assert any("'gravity' is listed" in w for w in model.warnings)
+    assert model.counters["gravity"] == 0
 
 
 def _two_plates() -> System:

@@ -28,7 +28,7 @@ def build_model(scene) -> Model:
     built = build_system(scene)
     model = built.system.assemble(effects=scene.effects,
                                   linear_joints=scene["solver"].get("linear_joints", "auto"),
-                                  unused_effects="refuse" if scene.kind == "general"
+                                  unused_effects="warn" if scene.kind == "general"
                                   else "allow",
                                   bounds=scene["scene"].get("bounds", "check"))
     model.warnings[:0] = built.warnings

@@ -106,7 +106,11 @@ class System:
         if not isinstance(name, str) or not name.strip():
             raise InputError(f"{what}: a name is required")
         name = name.strip()
-        problem = validate.check_name(name)
+        # probe names become HDF5 dataset names: the general scenes' name rule; other
+        # items only must not hold control characters (builders use names like 'dw/dx')
+        problem = validate.check_name(name) if what == "probe" else \
+            ("must not contain control characters" if any(ord(c) < 32 for c in name)
+             else None)
         if problem:
             raise InputError(f"{what} name {short_repr(name)} {problem}")
         if name in table:
@@ -444,10 +448,11 @@ class System:
         listed (default: the system's own list, else all it uses) are computed. An 'ffr'
         beam whose floating frame nothing holds is refused (InputError); with
         ``check_frames=False`` it is assembled for checks of the joint equations alone, and
-        the solvers refuse to run it. An effect listed that no item belongs to is refused
-        (InputError) unless ``unused_effects='allow'`` (template scenes, whose effects
-        switch loads that a value of 0 leaves out); by default the system's own list is
-        checked so (``System(effects=...)``), a list given here is not (a caller switching
+        the solvers refuse to run it. An effect listed that no item belongs to is a warning
+        (``model.warnings`` and a UserWarning) with ``unused_effects='warn'``, refused
+        (InputError) with 'refuse', passed over with 'allow' (template scenes, whose effects
+        switch loads that a value of 0 leaves out); by default the system's own list
+        (``System(effects=...)``) gets 'warn', a list given here 'allow' (a caller switching
         effects of a built system). Drives and loads beyond the physical
         bounds are refused (:meth:`check_bounds`) unless ``bounds='off'`` (default: the
         system's own setting)."""
@@ -456,15 +461,29 @@ class System:
             effects = check_effects(effects)
         chosen = effects if effects is not None else self.effects
         if unused_effects is None:
-            unused_effects = "allow" if effects is not None else "refuse"
-        if chosen is not None and unused_effects == "refuse":
-            self.check_effects_used(chosen)
+            unused_effects = "allow" if effects is not None else "warn"
+        if unused_effects not in ("refuse", "warn", "allow"):
+            raise InputError(f"unused_effects must be 'refuse', 'warn' or 'allow', got "
+                             f"{short_repr(unused_effects)}")
+        unused_note = None
+        if chosen is not None and unused_effects != "allow":
+            try:
+                self.check_effects_used(chosen)
+            except InputError as exc:
+                if unused_effects == "refuse":
+                    raise
+                unused_note = str(exc).split(": ", 1)[1]
         if (bounds or self.bounds) == "check":
             self.check_bounds()
         validate.check_resources(validate.Estimate(self._parts(), contact_points=sum(
             2 * c.points for c in self.contacts.values())), None, None, "static")
-        return assemble(self, tuple(chosen) if chosen is not None else None,
-                        linear_joints=linear_joints, check_frames=check_frames)
+        model = assemble(self, tuple(chosen) if chosen is not None else None,
+                         linear_joints=linear_joints, check_frames=check_frames)
+        if unused_note:  # not silent: the run prints it, a script sees a UserWarning
+            import warnings
+            model.warnings.append(unused_note)
+            warnings.warn(unused_note, UserWarning, stacklevel=3)
+        return model
 
 
 #: drive parameters of the API per type (keyword -> schema key of &drive checked against)
