@@ -1,4 +1,10 @@
-"""Exceptions with the exit status the command line maps them to (SPEC section 2)."""
+"""Exceptions with the exit status the command line maps them to (SPEC section 2).
+
+These are the only exceptions the package raises on purpose, through either door: the
+command line maps them to exit statuses, and the Python API (``System`` and its calls,
+the solver functions) raises only them for bad input or a failed solve: a value of the
+wrong type, a NaN, an unknown effect, a model too large for the memory left or an argument
+such as ``max_iter=0`` is an :class:`InputError` with the namelist's message."""
 from __future__ import annotations
 
 
