@@ -46,7 +46,6 @@ EXIT_CODES = """exit status:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .plots import plot_result
     from .io.hdf5 import read_summary
     from .runner import run_scene
     outcome = run_scene(args.scene, args.set, args.output)
@@ -77,9 +76,23 @@ def _cmd_run(args: argparse.Namespace) -> int:
               f"{d.wall_time_s:.2f} s")
         if outcome.stages:
             print(stage_table(outcome.stages))
-    png = plot_result(outcome.output)
-    print(f"  written      {outcome.output}, {png}")
+    written = [str(outcome.output)]
+    for path in optional_outputs(outcome.output):
+        written.append(str(path))
+    print(f"  written      {', '.join(written)}")
     return 0
+
+
+def optional_outputs(result: Path) -> list[Path]:
+    """The plot beside a result file. A failure here is a warning on stderr, never a
+    failed run: the result file is already complete (status 'ok')."""
+    from .plots import plot_result
+    try:
+        return [plot_result(result)]
+    except Exception as exc:  # noqa: BLE001 - an optional output never fails a good run
+        print(f"warning: the plot of {result} was not written: {type(exc).__name__}: {exc}",
+              file=sys.stderr)
+        return []
 
 
 def stage_table(stages: dict[str, float]) -> str:
