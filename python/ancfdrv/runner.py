@@ -274,8 +274,11 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
 
 
 def run_loaded(scene: Scene, output: str | Path | None = None, *,
-               start: float | None = None, progress: bool | None = None) -> RunOutcome:
-    """Run a loaded scene (see :func:`run_scene`)."""
+               start: float | None = None, progress: bool | None = None,
+               model: Model | None = None) -> RunOutcome:
+    """Run a loaded scene (see :func:`run_scene`). ``model``: the model to run instead of
+    the one the scene builds (a System assembled in Python, :mod:`ancfdrv.results`; the
+    scene then carries only the analysis, solver and output settings)."""
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
     check_output_path(out, input_files(scene), xdmf=writes_xdmf(scene))
@@ -287,7 +290,7 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
                          file=str(out)) from None
     try:
         with OutputLock(out), StopRequest() as stop:
-            outcome = _run_locked(scene, out, start, progress, stop)
+            outcome = _run_locked(scene, out, start, progress, stop, model)
     except BaseException:
         if not out.exists():  # refused before writing (bad input found late): leave no trace
             for directory in made:
@@ -320,12 +323,12 @@ def _interrupt_message(out: Path, signum: int | None) -> str:
 
 
 def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
-                stop: StopRequest) -> RunOutcome:
+                stop: StopRequest, model: Model | None = None) -> RunOutcome:
     analysis = scene["scene"]["analysis"]
     t0 = time.perf_counter()
     try:
         with stop.immediate():  # nothing is written yet: a signal ends the run at once
-            model = build_model(scene)
+            model = build_model(scene) if model is None else model
     except Interrupted as exc:
         raise Interrupted(f"interrupted by {signal_name(exc.signum)} before the output was "
                           f"written; {out} was not touched", signum=exc.signum) from None

@@ -16,11 +16,14 @@ Example (a cantilever with a tip mass)::
     s.load("g", "gravity", vector=(0, -9.81, 0))
     s.load("payload", "point_mass", body="arm", point=(2, 0, 0), mass=10.0)
     s.probe("tip", "arm", (2, 0, 0))
-    model = s.assemble()
+    res = s.static()                      # or s.simulate(t_end=1.0, dt=1e-3)
+    res.deflection["tip"], res.counters   # by name (ancfdrv.results.Results)
+    res.save("results/cantilever.h5")     # the file `ancf run` writes; ancfdrv.open reads it
+    model = s.assemble()                  # the model alone, for the solvers' own API
 """
 from __future__ import annotations
 
-from typing import Iterable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -292,3 +295,39 @@ class System:
         chosen = effects if effects is not None else self.effects
         return assemble(self, tuple(chosen) if chosen is not None else None,
                         linear_joints=linear_joints, check_frames=check_frames)
+
+    # -- analyses (SPEC section 10, "Python") ------------------------------------------------
+    #: the analyses, registered by :mod:`ancfdrv.results` (which sits above this layer: it
+    #: runs the solvers and writes the result file)
+    _ANALYSES: dict[str, Callable[..., Any]] = {}
+
+    def _analysis(self, name: str) -> Callable[..., Any]:
+        if name not in self._ANALYSES:  # only when ancfdrv.results was never imported
+            raise RuntimeError("import ancfdrv (the package) to run analyses")
+        return self._ANALYSES[name]
+
+    def static(self, **options: Any):
+        """The static equilibrium, run exactly as ``ancf run`` runs a static scene, with
+        the CLI's defaults. Keywords: any key of the scene groups &solver and &output
+        (``static_method='split'`` by default as in the CLI, 'newton' where the split
+        iteration cannot run: a body not 'ffr', or contact; ``tol``, ``max_iter``,
+        ``load_steps``, ...; docs/scenes.md), ``effects`` (default: the system's list, else
+        every effect its items belong to), ``output`` (an HDF5 path; default a temporary
+        file, see :meth:`~ancfdrv.results.Results.save`), ``progress``.
+
+        Returns :class:`ancfdrv.results.Results`: ``.probes[name]``, ``.deflection[name]``,
+        ``.counters``, ``.timing``, ``.status``, ``.save(path)``, ... Raises InputError on
+        bad input and SolverError when the solve fails."""
+        return self._analysis("static")(self, **options)
+
+    def simulate(self, t_end: float, dt: float | None = None, *, from_static: bool = False,
+                 **options: Any):
+        """Dynamics from 0 to ``t_end`` (s) with the step ``dt`` (s; default the CLI's,
+        1e-3), run exactly as ``ancf run`` runs a dynamic scene, with the CLI's defaults
+        (Newmark average acceleration, ``jacobian='reuse'``, ...). ``from_static``: start
+        from the static equilibrium (analysis 'static+dynamic'), else at rest in the
+        assembled configuration. Other keywords as :meth:`static` (e.g.
+        ``integrator='generalized_alpha', rho_inf=0.8``, ``q=True``, ``xdmf=False``).
+        Returns :class:`ancfdrv.results.Results` with time histories (``.time``,
+        ``.probes[name]`` of shape (nt, 3), ``.energy``)."""
+        return self._analysis("simulate")(self, t_end, dt, from_static=from_static, **options)
