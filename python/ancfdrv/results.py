@@ -82,9 +82,12 @@ class Analysis:
 
     Static values have shape (3,) per probe; dynamic ones (nt, 3), with :attr:`time` (nt,)."""
 
-    def __init__(self, name: str, record: Record) -> None:
+    def __init__(self, name: str, record: Record, constraint_names: list[str] | None = None
+                 ) -> None:
         self.name = name
         self.record = record
+        #: the joint equations, in the order of the multipliers ``lambda``
+        self.constraint_names = list(constraint_names or [])
 
     @property
     def attrs(self) -> dict[str, Any]:
@@ -139,6 +142,16 @@ class Analysis:
         value = self.record.get("q")
         return None if value is None else np.asarray(value)
 
+    def multiplier(self, constraint: str) -> np.ndarray | float:
+        """The Lagrange multiplier of a named joint equation (``/model`` attribute
+        constraint_names, e.g. 'cylinder: length'): a force (N) for position equations, a
+        moment (N m) for gradient ones; (nt,) for a dynamic analysis."""
+        names = self.constraint_names
+        if constraint not in names:
+            raise KeyError(f"no joint equation {constraint!r} (equations: {', '.join(names)})")
+        lam = np.asarray(self.record["lambda"])
+        return lam[..., names.index(constraint)]
+
     def __getitem__(self, key: str) -> Any:
         return self.record[key]
 
@@ -164,8 +177,12 @@ class Results:
         self.path = Path(path)
         self.record = record
         self._owner = owner  # keeps a run's temporary directory alive with the object
-        self.static = Analysis("static", record["static"]) if "static" in record else None
-        self.dynamic = Analysis("dynamic", record["dynamic"]) if "dynamic" in record else None
+        names = [n for n in str(record.get("model", Record()).attrs.get(
+            "constraint_names", "")).split("\n") if n]
+        self.static = Analysis("static", record["static"], names) if "static" in record \
+            else None
+        self.dynamic = Analysis("dynamic", record["dynamic"], names) if "dynamic" in record \
+            else None
 
     # -- the run --------------------------------------------------------------------------
     @property
@@ -248,6 +265,10 @@ class Results:
     @property
     def time(self) -> np.ndarray | None:
         return self.main.time
+
+    def multiplier(self, constraint: str) -> np.ndarray | float:
+        """:meth:`Analysis.multiplier` of the main analysis."""
+        return self.main.multiplier(constraint)
 
     # -- files --------------------------------------------------------------------------------
     def save(self, path: str | Path, *, plot: bool = True) -> Path:
