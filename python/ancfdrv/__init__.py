@@ -24,7 +24,7 @@ _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 from ._version import __version__  # noqa: E402,F401
 
 from .system import (Beam, Box, Circle, Constant, Cycle, Leaf, Luffing, Material, Model,  # noqa: E402
-                     Plate, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
+                     Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
 
 from .results import Results, open_results  # noqa: E402  (gives System its analyses)
 
@@ -32,4 +32,4 @@ from .results import Results, open_results  # noqa: E402  (gives System its anal
 open = open_results  # noqa: A001 - the package's own name, as SPEC section 10 spells it
 
 __all__ = ["open", "open_results", "Results", "System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Rectangle",
-           "Box", "Tube", "Circle", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table"]
+           "Box", "Tube", "Circle", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table", "Ramp"]

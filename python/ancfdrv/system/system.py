@@ -161,17 +161,20 @@ class System:
         """A drive (``ancfdrv.system.drives``): type 'constant' (value), 'luffing' (omega,
         t_start, t_brake, sweep, start), 'spinup' (omega, period, start), 'cycle'
         (amplitude, period, t0), 'sine' (amplitude, frequency, phase, offset, t0, ramp),
-        'table' (times, values, or file = CSV path)."""
+        'table' (times, values, or file = CSV path; interpolation = 'linear' | 'cubic' |
+        'pchip'), 'ramp' (rate, t_ramp, start, t0). The namelist &drive takes the same
+        parameters (docs/scenes.md)."""
         name = self._new_name(name, self.drives, "drive")
         where = f"drive {name!r}"
         if type not in DRIVE_TYPES:
             raise InputError(f"{where}: type {type!r} must be one of {', '.join(DRIVE_TYPES)}")
         try:
             if type == "table" and "file" in params:
-                extra = set(params) - {"file"}
+                extra = set(params) - {"file", "interpolation"}
                 if extra:
                     raise TypeError(f"unexpected {sorted(extra)}")
-                drive = Table.from_csv(name, params["file"])
+                drive = Table.from_csv(name, params["file"],
+                                       interpolation=params.get("interpolation", "linear"))
             elif type == "table":
                 drive = Table(name, tuple(params.pop("times")), tuple(params.pop("values")),
                               **params)
