@@ -51,6 +51,7 @@ def non_negative(v: Any) -> str | None:
 def one_of(*choices: str) -> Callable[[Any], str | None]:
     def check(v: Any) -> str | None:
         return None if v in choices else f"must be one of {', '.join(repr(c) for c in choices)}"
+    check.choices = choices  # type: ignore[attr-defined]  (listed by docs/scenes.md)
     return check
 
 

@@ -39,6 +39,11 @@ from .sections import Section
 #: effects an item may belong to, with the default of each load type (SPEC section 8)
 LOAD_EFFECTS = {"gravity": "gravity", "force": "point_loads", "moment": "point_loads",
                 "point_mass": "tip_mass", "pressure": "pressure"}
+#: the parameters each load type needs (besides name, type, effect; 'force' also takes a
+#: drive), as :meth:`System.load` checks them (and docs/scenes.md lists them)
+LOAD_PARAMETERS = {"gravity": ("vector",), "force": ("body", "point", "vector"),
+                   "moment": ("body", "point", "vector"), "point_mass": ("body", "point", "mass"),
+                   "pressure": ("body", "value")}
 
 
 def _points(value) -> list[np.ndarray]:
@@ -218,9 +223,7 @@ class System:
         if type not in LOAD_TYPES:
             raise InputError(f"{where}: type {type!r} must be one of {', '.join(LOAD_TYPES)}")
         effect = effect or LOAD_EFFECTS[type]
-        needs = {"gravity": ("vector",), "force": ("body", "point", "vector"),
-                 "moment": ("body", "point", "vector"), "point_mass": ("body", "point", "mass"),
-                 "pressure": ("body", "value")}[type]
+        needs = LOAD_PARAMETERS[type]
         given = dict(body=body, point=point, vector=vector, mass=mass, value=value)
         missing = [k for k in needs if given[k] is None]
         if missing:
