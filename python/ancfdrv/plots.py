@@ -70,15 +70,25 @@ EXTRA_PLOTS: dict = {}
 
 
 def _probe_series(group: h5py.Group) -> dict[str, np.ndarray]:
-    """deflection/<name> of a /static or /dynamic group, by probe name (file order)."""
+    """The deflection of each probe of a /static or /dynamic group (file order): relative
+    to its beam's supports (deflection_support/<name>, general scenes) where the file has
+    it, else deflection/<name>."""
     if "deflection" not in group:
         return {}
-    return {name: group[f"deflection/{name}"][()] for name in group["deflection"]}
+    support = group.get("deflection_support", {})
+    return {name: (support[name] if name in support else group[f"deflection/{name}"])[()]
+            for name in group["deflection"]}
 
 
 def _deflection_label(group: h5py.Group) -> str:
-    """What the file says its deflections are (attribute 'reference' of the deflection
-    group), else the SPEC section 4 default."""
+    """What the plotted deflections are: 'relative to the supports' rigid motion' for the
+    probes on beams of general scenes, else what the file says (attribute 'reference' of
+    the deflection group) or the SPEC section 4 default."""
+    if "deflection_support" in group and len(group["deflection_support"]):
+        names = list(group["deflection_support"])
+        others = [n for n in group.get("deflection", {}) if n not in names]
+        text = "relative to the rigid motion of the beam's supports (x chord, y height)"
+        return text + (f"; {', '.join(others)}: displacement from t = 0" if others else "")
     if "deflection" in group:
         text = _text(group["deflection"].attrs.get("reference", ""))
         if text:

@@ -111,6 +111,13 @@ class Analysis:
         return self._group("deflection")
 
     @property
+    def deflection_support(self) -> Record:
+        """General scenes: the deflections of the probes on beams relative to the rigid
+        motion of their beam's supports (m), by name (:mod:`ancfdrv.system.supports`;
+        ``.attrs['reference']`` says so)."""
+        return self._group("deflection_support")
+
+    @property
     def reactions(self) -> Record:
         """Joint and force-element reactions by name (SPEC section 10), when present."""
         return self._group("reactions")
@@ -245,6 +252,10 @@ class Results:
     @property
     def deflection(self) -> Record:
         return self.main.deflection
+
+    @property
+    def deflection_support(self) -> Record:
+        return self.main.deflection_support
 
     @property
     def reactions(self) -> Record:
@@ -382,6 +393,8 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
     model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
                             linear_joints=solver["linear_joints"])
     model.kind = "general"
+    from .system.supports import support_frames
+    model.support_frames = support_frames(system)
     if "static_method" not in options and (any(s.kind != "ffr" for s in model.sets)
                                            or model.contact_pairs):
         # the CLI's default 'split' needs every body 'ffr' and no contact: where it cannot
