@@ -68,6 +68,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
                 name = key.rsplit(".", 1)[1]
                 print(f"  {name:12s} displacement ({1e3 * value[0]:+.4f}, {1e3 * value[1]:+.4f}, "
                       f"{1e3 * value[2]:+.4f}) mm")
+        for key, value in summary.items():  # general scenes: relative to the supports
+            if key.startswith("static.deflection_support."):
+                name = key.rsplit(".", 1)[1]
+                print(f"  {name:12s} deflection   ({1e3 * value[0]:+.4f}, {1e3 * value[1]:+.4f}, "
+                      f"{1e3 * value[2]:+.4f}) mm relative to its beam's supports")
     d = outcome.dynamic
     if d is not None:
         print(f"  dynamic      {d.steps} steps of {summary['dynamic.dt']:g} s, "
