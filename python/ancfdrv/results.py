@@ -359,7 +359,7 @@ def _script_text(system) -> tuple[Path, str]:
     script's text when there is one, else a listing of the system's items."""
     main = sys.modules.get("__main__")
     script = Path(getattr(main, "__file__", "") or "")
-    if script.suffix == ".py" and script.is_file():
+    if script.suffix == ".py" and script.is_file() and "site-packages" not in script.parts:
         try:
             return script.resolve(), script.read_text()
         except (OSError, UnicodeDecodeError):
