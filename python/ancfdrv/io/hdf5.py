@@ -287,7 +287,11 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
             _last_frame(h5, model)
     if has_motion:
         from .xdmf import write_xdmf
-        write_xdmf(path)
+        try:
+            write_xdmf(path)
+        except Exception as exc:  # noqa: BLE001 - an optional output never fails a good run
+            model.warnings.append(f"the XDMF description of {path} was not written: "
+                                  f"{type(exc).__name__}: {exc}")
 
 
 def _last_frame(h5: h5py.File, model: Model) -> None:
