@@ -141,3 +141,18 @@ def test_renamed_probe_and_failing_plot_are_not_failures(tmp_path, capsys, monke
     with h5py.File(out2) as h5:
         assert h5.attrs["status"] == "ok"
     assert not out2.with_suffix(".png").exists()
+
+
+def test_failing_xdmf_is_a_warning(tmp_path, capsys, monkeypatch):
+    """The XDMF description is an optional output too: when it cannot be written the run
+    still exits 0 with its result complete (status 'ok') and says why on stderr."""
+    from ancfdrv.io import xdmf
+
+    def broken(*_args, **_kwargs):
+        raise OSError("disk full")
+    monkeypatch.setattr(xdmf, "write_xdmf", broken)
+    out = tmp_path / "fb.h5"
+    assert _run(SCENES / "four_bar.nml", out, "solver.t_end=0.01") == 0
+    assert "XDMF description" in capsys.readouterr().err
+    with h5py.File(out) as h5:
+        assert h5.attrs["status"] == "ok" and len(h5["dynamic/time"]) == 11
