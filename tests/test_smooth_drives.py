@@ -138,3 +138,33 @@ def test_namelist_drives_take_the_python_parameters(tmp_path):
     path.write_text(SCENE.replace("sweep = 0.3, start = 1.8", "sweep = 0.3, start_deg = 3.0"))
     with pytest.raises(InputError, match="does not take start_deg"):
         load_scene(path)
+
+
+def test_cylinder_on_a_spline_table_lifts_a_boom_by_the_closed_form_geometry():
+    """A rigid boom hinged at O = 0 about z, lifted by a 'distance' joint (a cylinder from
+    the ground point C to the boom point P at s = 1 m) whose length follows a 'cubic'
+    table: its angle is the closed-form geometry |P(a) - C| = L(t) on the branch of a(0) = 0
+    (as tests/test_system_mechanisms.py does for a sine drive), through System.simulate."""
+    ground_point = np.array([0.4, -0.6, 0.0])
+    length0 = float(np.linalg.norm([1.0, 0.0, 0.0] - ground_point))
+    s = System("cylinder on a table")
+    s.drive("stroke", "table", times=[0.0, 0.1, 0.3, 0.4],
+            values=[length0, length0 + 0.02, length0 + 0.12, length0 + 0.15],
+            interpolation="cubic")
+    inertia = 40.0 * 4.0 / 12.0
+    s.rigid_body("boom", mass=40.0, inertia=(1e-3, inertia, inertia, 0, 0, 0),
+                 position=(1.0, 0, 0))
+    s.joint("pivot", "revolute", "ground", "boom", point=(0, 0, 0), axis=(0, 0, 1))
+    s.joint("cylinder", "distance", "ground", "boom", point1=ground_point, point2=(1, 0, 0),
+            drive="stroke")
+    s.load("g", "gravity", vector=(0, -9.81, 0))
+    s.probe("end", "boom", (2.0, 0, 0))
+    res = s.simulate(0.4, 2e-3, integrator="generalized_alpha", rho_inf=1.0, xdmf=False)
+    stroke = s.drives["stroke"].values(res.time)[0]
+    c2 = ground_point[:2]
+    base = np.arctan2(c2[1], c2[0])
+    angle = base + np.arccos((1.0 + c2 @ c2 - stroke**2) / (2.0 * np.hypot(*c2)))
+    angle -= angle[0]                                 # the branch through a(0) = 0
+    expected = 2.0 * np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    assert np.ptp(angle) > 0.1
+    np.testing.assert_allclose(res.probes["end"][:, :2], expected, rtol=0, atol=1e-8)
