@@ -114,6 +114,7 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
         title = _text(h5.attrs.get("title", h5_path.stem))
         status = _text(h5.attrs.get("status", ""))
         label = _deflection_label(dyn)
+        beam_frame = set(dyn.get("deflection_support", {}))
     if len(probes) > MAX_PROBE_PANELS:
         ranked = sorted(probes, key=lambda n: -float(np.abs(probes[n]).max(initial=0.0)))
         probes = {n: probes[n] for n in ranked[:MAX_PROBE_PANELS]}
@@ -122,8 +123,8 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
                              sharex=True, constrained_layout=True, squeeze=False)
     axes = axes[:, 0]
     for ax, (name, d) in zip(axes, probes.items()):
-        for k, component in enumerate("xyz"):
-            ax.plot(t, 1e3 * d[:, k], lw=1.0, label=f"u_{component}")
+        for k, component in enumerate(_components(name in beam_frame)):
+            ax.plot(t, 1e3 * d[:, k], lw=1.0, label=component)
         ax.set_ylabel(f"{name} (mm)")
         ax.legend(fontsize=8, ncol=3, loc="upper left")
     if energy:
@@ -145,6 +146,11 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
     fig.savefig(png, dpi=110)
     plt.close(fig)
     return png
+
+
+def _components(support: bool) -> tuple[str, str, str]:
+    """Legend of a probe's three components: along the support frame's axes, or x, y, z."""
+    return ("axial (x)", "transverse (y)", "lateral (z)") if support else ("x", "y", "z")
 
 
 def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
