@@ -163,3 +163,23 @@ def test_failing_xdmf_is_a_warning(tmp_path, capsys, monkeypatch):
     assert "XDMF description" in capsys.readouterr().err
     with h5py.File(out) as h5:
         assert h5.attrs["status"] == "ok" and len(h5["dynamic/time"]) == 11
+
+
+def test_extra_plots_of_optional_groups_are_called(tmp_path, monkeypatch):
+    """plots.EXTRA_PLOTS: a plot registered for a root group (e.g. 'modal') is drawn beside
+    the main plot when the file holds that group, and not otherwise."""
+    from ancfdrv import plots
+    out = tmp_path / "c.h5"
+    assert _run(GENERAL / "cantilever.nml", out) == 0
+    calls = []
+
+    def extra(h5_path, png):
+        calls.append(Path(png).name)
+        return png
+    monkeypatch.setitem(plots.EXTRA_PLOTS, "modal", extra)
+    plots.plot_result(out)
+    assert calls == []
+    with h5py.File(out, "a") as h5:
+        h5.create_group("modal").create_dataset("frequency", data=[1.0, 2.0])
+    plots.plot_result(out)
+    assert calls == ["c_modal.png"]
