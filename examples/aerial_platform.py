@@ -42,10 +42,9 @@ from typing import Sequence
 import numpy as np
 from scipy.optimize import curve_fit
 
-from example_utils import ResultFile, Recorder, arguments, reference, relative, write_table
+from example_utils import arguments, reference, relative, write_table
 
 from ancfdrv import Box, System
-from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 from ancfdrv.solvers.static import solve_newton
 
 GRAVITY = 9.81
@@ -185,25 +184,13 @@ def dynamic(p: Platform, nodes: int, dt: float, t_end: float, slew: Slew | None 
     """From the static equilibrium (turntable at rest), integrate to t_end
     (generalized-alpha, rho_inf = 0.9: hardly any numerical damping at the sway)."""
     system = build(p, nodes, slew, push)
-    model = system.assemble()
-    try:
-        file = ResultFile(out, model, title, Path(__file__)) if out is not None else None
-        start = solve_newton(model, tol=1e-10)
-        if file:
-            file.static(start)
-        recorder = file.recorder() if file else Recorder(model)
-        settings = DynamicSettings.generalized_alpha(dt, t_end, rho_inf=0.9, tol=1e-10,
-                                                     max_newton=20)
-        result = integrate(model, settings, start.e, sink=recorder, progress=False)
-        recorder.close(settings, result)
-        if file:
-            file.finish()
-        t = recorder.time
-        return Run(t, recorder.probe("basket"), recorder.probe("tip"),
-                   recorder.energy_balance(), recorder.energy("kinetic"),
-                   system.drives["slew"].values(t)[0])
-    finally:
-        model.close()
+    t_end = dt * np.ceil(t_end / dt - 1e-9)  # a whole number of steps (as scenes require)
+    res = system.simulate(t_end, dt, from_static=True, static_method="newton", tol=1e-10,
+                          integrator="generalized_alpha", rho_inf=0.9, newton_tol=1e-10,
+                          max_newton=20, output=out)
+    t = res.time
+    return Run(t, res.probes["basket"], res.probes["tip"], res.energy["balance"],
+               res.energy["kinetic"], system.drives["slew"].values(t)[0])
 
 
 def turning_frame(points: np.ndarray, angle: np.ndarray) -> np.ndarray:

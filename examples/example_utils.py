@@ -1,8 +1,8 @@
-"""Small helpers the example scripts share: the command line, result files (HDF5 in the
-layout of SPEC section 4, so ``ancf info`` and ``ancf plot`` read them), Markdown/CSV
-tables and the optional comparison with the repository's independent references.
-
-Copy this file along with an example when you take the example elsewhere.
+"""Reporting helpers the example scripts share: the command line (--quick, --out),
+Markdown/CSV tables and the optional comparison with the repository's independent
+references (tests/reference). Running a model and writing its result file needs none of
+this: ``System.static()`` / ``System.simulate()`` return the results and ``.save()`` (or
+``output=``) writes the file ``ancf run`` writes (``ancfdrv.results``).
 """
 from __future__ import annotations
 
@@ -10,8 +10,6 @@ import argparse
 import csv
 import importlib.util
 import sys
-import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Sequence
@@ -22,11 +20,6 @@ matplotlib.use("Agg")  # files only: the examples run without a display
 
 import numpy as np  # noqa: E402
 
-from ancfdrv.io import hdf5  # noqa: E402
-from ancfdrv.io.scene import Scene  # noqa: E402
-from ancfdrv.solvers.dynamic import Chunk, DynamicResult, DynamicSettings  # noqa: E402
-from ancfdrv.solvers.static import StaticResult  # noqa: E402
-from ancfdrv.system import Model  # noqa: E402
 
 #: where the examples write, relative to the working directory (the repository root)
 RESULTS = Path("results") / "examples"
@@ -60,108 +53,6 @@ def reference(name: str) -> ModuleType | None:
     sys.modules[module_name] = module  # dataclasses look their module up while it loads
     spec.loader.exec_module(module)
     return module
-
-
-# -- dynamic runs --------------------------------------------------------------------------
-class Recorder:
-    """A sink for :func:`ancfdrv.solvers.dynamic.integrate`: keeps every output row in
-    memory and, given a result file, appends it there too (``/dynamic`` of SPEC section 4).
-
-    The integrator hands over arrays it may reuse for the next steps, so each chunk is
-    copied when it arrives."""
-
-    def __init__(self, model: Model, path: Path | None = None, store_q: bool = False) -> None:
-        self.model = model
-        self.chunks: list[Chunk] = []
-        self.writer = hdf5.DynamicWriter(path, model, store_q) if path is not None else None
-
-    def __call__(self, chunk: Chunk) -> None:
-        copy = Chunk(**{k: (None if v is None else np.array(v, copy=True))
-                        for k, v in vars(chunk).items()})
-        self.chunks.append(copy)
-        if self.writer is not None:
-            self.writer(copy)
-
-    def close(self, settings: DynamicSettings, result: DynamicResult) -> None:
-        """Flush the result file and record the integrator's settings and statistics."""
-        if self.writer is None:
-            return
-        self.writer.flush()
-        hdf5.write_dynamic_attrs(self.writer.path, {
-            "integrator": "generalized_alpha" if settings.alpha_m or settings.alpha_f
-            else "newmark", "dt": settings.dt, "t_end": settings.t_end,
-            "beta": settings.beta, "gamma": settings.gamma, "alpha_m": settings.alpha_m,
-            "alpha_f": settings.alpha_f, "steps": result.steps,
-            "newton_iterations": result.newton_iterations,
-            "factorizations": result.factorizations, "wall_time_s": result.wall_time_s,
-            "status": "ok"}, {})
-
-    def _stack(self, attribute: str) -> np.ndarray:
-        return np.concatenate([getattr(c, attribute) for c in self.chunks])
-
-    @property
-    def time(self) -> np.ndarray:
-        """(nt,) output times [s]."""
-        return self._stack("time")
-
-    def probe(self, name: str) -> np.ndarray:
-        """(nt, 3) global positions of a probe [m]."""
-        return self._stack("probes")[:, list(self.model.probes).index(name)]
-
-    def multiplier(self, constraint: str) -> np.ndarray:
-        """(nt,) Lagrange multiplier of the named joint equation (``model.constraints``)."""
-        return self._stack("lam")[:, self.model.constraints.names.index(constraint)]
-
-    def energy(self, name: str) -> np.ndarray:
-        """(nt,) one of ``ancfdrv.codes.ENERGY_NAMES`` [J]."""
-        from ancfdrv.codes import ENERGY_NAMES
-        return self._stack("energy")[:, ENERGY_NAMES.index(name)]
-
-    def energy_balance(self) -> np.ndarray:
-        """(nt,) total energy change minus the work of drives, moving frames, contact
-        damping, friction and material damping (the HDF5 ``energy/balance``): zero for an
-        exact integration."""
-        e = self._stack("energy")
-        return e[:, 4] - e[0, 4] - e[:, 5] - e[:, 6] - e[:, 8] - e[:, 9] - e[:, 10]
-
-    def contact(self, field_name: str) -> np.ndarray:
-        """(nt, npoints) a contact record field (``ancfdrv.codes.CONTACT_RECORD``)."""
-        from ancfdrv.codes import CONTACT_RECORD
-        return self._stack("contact")[:, :, CONTACT_RECORD.index(field_name)]
-
-
-# -- result files ----------------------------------------------------------------------------
-@dataclass
-class ResultFile:
-    """One HDF5 result file of a model built in Python (SPEC section 4): root attributes
-    with the script as the 'scene', /model, then /static and /dynamic as they come, and
-    /counters and /timing with the status 'ok' at :meth:`finish`."""
-
-    path: Path
-    model: Model
-    title: str
-    script: Path
-    started: float = field(default_factory=time.perf_counter)
-
-    def __post_init__(self) -> None:
-        scene = Scene(path=self.script, values={"scene": {
-            "title": self.title, "formulation": _formulation(self.model),
-            "effects": list(self.model.effects)}}, text=self.script.read_text(), items=[])
-        hdf5.create(self.path, scene, self.model)
-
-    def static(self, result: StaticResult) -> None:
-        hdf5.write_static(self.path, self.model, result)
-
-    def recorder(self, store_q: bool = False) -> Recorder:
-        return Recorder(self.model, self.path, store_q)
-
-    def finish(self) -> None:
-        hdf5.finish(self.path, self.model, {"total": time.perf_counter() - self.started}, "ok")
-
-
-def _formulation(model: Model) -> str:
-    kinds = sorted({s.kind for s in model.sets})
-    return ",".join(kinds) if kinds else "rigid"
 
 
 # -- tables ------------------------------------------------------------------------------------

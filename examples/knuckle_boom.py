@@ -40,11 +40,9 @@ from typing import Sequence
 
 import numpy as np
 
-from example_utils import ResultFile, Recorder, arguments, reference, relative, write_table
+from example_utils import arguments, reference, relative, write_table
 
 from ancfdrv import Box, System
-from ancfdrv.solvers.dynamic import DynamicSettings, integrate
-from ancfdrv.solvers.static import solve_newton
 
 GRAVITY = 9.81
 
@@ -179,27 +177,19 @@ class StaticCase:
 def solve_statics(p: KnuckleBoom, stroke: float, mesh: Mesh,
                   out: Path | None = None) -> StaticCase:
     """Static equilibrium at a cylinder length (optionally written to ``out``)."""
-    model = build(p, stroke, mesh).assemble()
-    try:
-        result = solve_newton(model, tol=1e-10)
-        if out is not None:
-            file = ResultFile(out, model, f"Knuckle boom, statics at L = {stroke} m",
-                              Path(__file__))
-            file.static(result)
-            file.finish()
-        return _static_case(p, stroke, model, result)
-    finally:
-        model.close()
+    res = build(p, stroke, mesh).static(static_method="newton", tol=1e-10, output=out)
+    return _static_case(p, stroke, res)
 
 
-def _static_case(p: KnuckleBoom, stroke: float, model, result) -> StaticCase:
+def _static_case(p: KnuckleBoom, stroke: float, res) -> StaticCase:
+    """The figures of a static result (``res.static``: probes, multipliers)."""
     pts = p.points(stroke)
-    at = model.probe_positions(result.e)
+    at = res.static.probes
     chord = at["jib lug"] - at["knuckle"]
     tip = at["tip"] - pts["T"]
-    force = cylinder_force(result.lam[model.constraints.names.index("cylinder: length")], stroke)
+    force = cylinder_force(res.static.multiplier("cylinder: length"), stroke)
     return StaticCase(stroke, p.jib_angle(stroke), float(np.arctan2(chord[1], chord[0])), tip,
-                      float(tip @ pts["n2"]), float(force), model.ndof)
+                      float(tip @ pts["n2"]), float(force), int(res.model.attrs["ndof"]))
 
 
 @dataclass
@@ -225,29 +215,15 @@ def lift(p: KnuckleBoom, strokes: tuple[float, float], mesh: Mesh, dt: float, ho
     profile = dict(omega=rate, t_start=ramp, t_brake=ramp, sweep=travel)
     ramp_end = travel / rate + ramp  # start and stop each take ramp/2 longer than at rate
     system = build(p, strokes[0], mesh, lift=profile)
-    model = system.assemble()
-    try:
-        file = ResultFile(out, model, "Knuckle boom: static at L = 1.8 m, then the lift",
-                          Path(__file__)) if out is not None else None
-        start = solve_newton(model, tol=1e-10)
-        settings = DynamicSettings.generalized_alpha(dt, ramp_end + hold, rho_inf=0.8,
-                                                     tol=1e-10, max_newton=20)
-        recorder = file.recorder() if file else Recorder(model)
-        if file:
-            file.static(start)
-        result = integrate(model, settings, start.e, sink=recorder, progress=False)
-        recorder.close(settings, result)
-        if file:
-            file.finish()
-        t = recorder.time
-        stroke = system.drives["stroke"].values(t)[0]
-        return Lift(t, stroke, recorder.probe("tip"),
-                    cylinder_force(recorder.multiplier("cylinder: length"), stroke),
-                    p.rigid_cylinder_force(stroke), recorder.energy_balance(),
-                    recorder.energy("drive_work"), _static_case(p, strokes[0], model, start),
-                    ramp_end)
-    finally:
-        model.close()
+    res = system.simulate(ramp_end + hold, dt, from_static=True, static_method="newton",
+                          tol=1e-10, integrator="generalized_alpha", rho_inf=0.8,
+                          newton_tol=1e-10, max_newton=20, output=out)
+    t = res.time
+    stroke = system.drives["stroke"].values(t)[0]
+    return Lift(t, stroke, res.probes["tip"],
+                cylinder_force(res.multiplier("cylinder: length"), stroke),
+                p.rigid_cylinder_force(stroke), res.energy["balance"],
+                res.energy["drive_work"], _static_case(p, strokes[0], res), ramp_end)
 
 
 def plot(p: KnuckleBoom, run: Lift, path: Path) -> None:

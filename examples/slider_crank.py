@@ -38,10 +38,9 @@ from typing import Sequence
 
 import numpy as np
 
-from example_utils import Recorder, ResultFile, arguments, reference, write_table
+from example_utils import arguments, reference, write_table
 
 from ancfdrv import Circle, System
-from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 
 
 @dataclass(frozen=True)
@@ -111,30 +110,24 @@ def simulate(p: SliderCrank, diameter: float, nodes: int, dt: float, revolutions
              out: Path | None = None) -> Run:
     """Spin up from rest, then ``revolutions`` turns at constant speed."""
     system = build(p, diameter, nodes)
-    model = system.assemble()
-    try:
-        file = ResultFile(out, model, system.title, Path(__file__)) if out else None
-        settings = DynamicSettings.generalized_alpha(
-            dt, p.spinup + revolutions * 2 * np.pi / p.omega, rho_inf=0.8, max_newton=20)
-        recorder = file.recorder() if file else Recorder(model)
-        result = integrate(model, settings, model.e0, sink=recorder, progress=False)
-        recorder.close(settings, result)
-        if file:
-            file.finish()
-        t = recorder.time
-        pin, wrist, mid = (recorder.probe(n) for n in ("crank pin", "slider", "midpoint"))
-        chord = wrist - pin
-        normal = np.column_stack([-chord[:, 1], chord[:, 0]]) / np.linalg.norm(
-            chord[:, :2], axis=1)[:, None]
-        deflection = np.einsum("ij,ij->i", mid[:, :2] - 0.5 * (pin[:, :2] + wrist[:, :2]),
-                               normal)
-        # the prescribed joint's multipliers are the force on the crank pin: torque A x F
-        fx, fy = (recorder.multiplier(f"crank drive: {c}(t)") for c in "xy")
-        torque = pin[:, 0] * fy - pin[:, 1] * fx
-        return Run(diameter, t, system.drives["crank"].values(t)[0], wrist[:, 0], deflection,
-                   torque, list(model.notes), model.ndof)
-    finally:
-        model.close()
+    t_end = p.spinup + revolutions * 2 * np.pi / p.omega
+    t_end = dt * np.ceil(t_end / dt - 1e-9)  # a whole number of steps (as scenes require)
+    res = system.simulate(t_end, dt,
+                          integrator="generalized_alpha", rho_inf=0.8, max_newton=20,
+                          output=out)
+    t = res.time
+    pin, wrist, mid = (res.probes[n] for n in ("crank pin", "slider", "midpoint"))
+    chord = wrist - pin
+    normal = np.column_stack([-chord[:, 1], chord[:, 0]]) / np.linalg.norm(
+        chord[:, :2], axis=1)[:, None]
+    deflection = np.einsum("ij,ij->i", mid[:, :2] - 0.5 * (pin[:, :2] + wrist[:, :2]),
+                           normal)
+    # the prescribed joint's multipliers are the force on the crank pin: torque A x F
+    fx, fy = (res.multiplier(f"crank drive: {c}(t)") for c in "xy")
+    torque = pin[:, 0] * fy - pin[:, 1] * fx
+    notes = [n for n in str(res.model.attrs.get("notes", "")).split("\n") if n]
+    return Run(diameter, t, system.drives["crank"].values(t)[0], wrist[:, 0], deflection,
+               torque, notes, int(res.model.attrs["ndof"]))
 
 
 def rigid_reference(p: SliderCrank, run: Run):

@@ -4,7 +4,9 @@ Compose a system in Python (``from ancfdrv import System``, :mod:`ancfdrv.system
 namelist scene (:mod:`ancfdrv.io.scene`; template scenes are built by
 :mod:`ancfdrv.builders` over the same API), solve it (:mod:`ancfdrv.solvers`: static and
 dynamic) and store the results in HDF5 (:mod:`ancfdrv.io.hdf5`); :mod:`ancfdrv.runner` ties
-these together and :mod:`ancfdrv.cli` is the ``ancf`` command.
+these together and :mod:`ancfdrv.cli` is the ``ancf`` command. From Python,
+``System.static()`` and ``System.simulate()`` run the same path and return
+:class:`~ancfdrv.results.Results`; ``ancfdrv.open(path)`` reads any result file.
 """
 import os as _os
 
@@ -22,7 +24,12 @@ _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 from ._version import __version__  # noqa: E402,F401
 
 from .system import (Beam, Box, Circle, Constant, Cycle, Leaf, Luffing, Material, Model,  # noqa: E402
-                     Plate, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
+                     Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
 
-__all__ = ["System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Rectangle",
-           "Box", "Tube", "Circle", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table"]
+from .results import Results, open_results  # noqa: E402  (gives System its analyses)
+
+#: ``ancfdrv.open(path)``: any result file as :class:`~ancfdrv.results.Results`
+open = open_results  # noqa: A001 - the package's own name, as SPEC section 10 spells it
+
+__all__ = ["open", "open_results", "Results", "System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Rectangle",
+           "Box", "Tube", "Circle", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table", "Ramp"]

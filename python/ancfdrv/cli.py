@@ -46,14 +46,13 @@ EXIT_CODES = """exit status:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .plots import plot_result
     from .io.hdf5 import read_summary
     from .runner import run_scene
     if args.force:
         args.set = [*args.set, "scene.bounds=off"]
     # the plot is written while the output is still locked (a second run is refused)
     outcome = run_scene(args.scene, args.set, args.output,
-                        after=lambda done: plot_result(done.output))
+                        after=lambda done: optional_outputs(done.output))
     for warning in outcome.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     summary = read_summary(outcome.output)
@@ -73,6 +72,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
                 name = key.rsplit(".", 1)[1]
                 print(f"  {name:12s} displacement ({1e3 * value[0]:+.4f}, {1e3 * value[1]:+.4f}, "
                       f"{1e3 * value[2]:+.4f}) mm")
+        for key, value in summary.items():  # general scenes: relative to the supports
+            if key.startswith("static.deflection_support."):
+                name = key.rsplit(".", 1)[1]
+                print(f"  {name:12s} deflection   ({1e3 * value[0]:+.4f}, {1e3 * value[1]:+.4f}, "
+                      f"{1e3 * value[2]:+.4f}) mm relative to its beam's supports")
     d = outcome.dynamic
     if d is not None:
         print(f"  dynamic      {d.steps} steps of {summary['dynamic.dt']:g} s, "
@@ -81,9 +85,21 @@ def _cmd_run(args: argparse.Namespace) -> int:
               f"{d.wall_time_s:.2f} s")
         if outcome.stages:
             print(stage_table(outcome.stages))
-    png = outcome.after
-    print(f"  written      {outcome.output}, {png}")
+    written = [str(outcome.output)] + [str(path) for path in (outcome.after or [])]
+    print(f"  written      {', '.join(written)}")
     return 0
+
+
+def optional_outputs(result: Path) -> list[Path]:
+    """The plot beside a result file. A failure here is a warning on stderr, never a
+    failed run: the result file is already complete (status 'ok')."""
+    from .plots import plot_result
+    try:
+        return [plot_result(result)]
+    except Exception as exc:  # noqa: BLE001 - an optional output never fails a good run
+        print(f"warning: the plot of {result} was not written: {type(exc).__name__}: {exc}",
+              file=sys.stderr)
+        return []
 
 
 def stage_table(stages: dict[str, float]) -> str:

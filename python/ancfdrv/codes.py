@@ -13,6 +13,8 @@ CONSTRAINT_COORDINATE, CONSTRAINT_DISTANCE, CONSTRAINT_CROSS, CONSTRAINT_DOT = 1
 
 # fortran/src/system/drives.f90
 DRIVE_CONSTANT, DRIVE_LUFFING, DRIVE_SPINUP, DRIVE_CYCLE, DRIVE_SINE, DRIVE_TABLE = 0, 1, 2, 3, 4, 5
+#: the smooth drives of issue 22 (fortran/src/system/drives.f90 kinds 10 and 11)
+DRIVE_RAMP, DRIVE_HERMITE = 10, 11
 
 # fortran/src/elements/beam_section.f90
 SECTION_RECTANGLE, SECTION_BOX, SECTION_TUBE, SECTION_CIRCLE = 1, 2, 3, 4

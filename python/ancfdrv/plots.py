@@ -23,17 +23,166 @@ STAGE_COLOURS = {"start": "#dbe9f6", "luffing": "#fdf1d6", "braking": "#f8dcdc",
 
 def plot_result(h5_path: str | Path, png: str | Path | None = None) -> Path:
     """A result file: the dynamic histories when there are any, else the static
-    deflection line."""
+    deflection line. The template plots (leaf spring, plate, the beam's tip and
+    deflection line) are drawn when the file holds what they read; any other result
+    (any probe names, any number of bodies) gets the general plots
+    (:func:`plot_general_dynamic`, :func:`plot_general_static`). The plots of
+    :data:`EXTRA_PLOTS` whose group the file holds are written beside it."""
     h5_path = Path(h5_path)
     with h5py.File(h5_path, "r") as h5:
-        dynamic = "dynamic" in h5 and len(h5["dynamic/time"]) > 1
+        dynamic = "dynamic" in h5 and "time" in h5["dynamic"] and len(h5["dynamic/time"]) > 1
         plate = "nodes" in h5["model"]
         kind = _text(h5.attrs.get("kind", ""))
-    if kind == "spring":
+        single_beam = "node_s" in h5["model"]
+        group = h5["dynamic"] if dynamic else h5.get("static")
+        has_tip = group is not None and "deflection" in group and "tip" in group["deflection"]
+        has_energy = dynamic and all(f"energy/{k}" in h5["dynamic"] for k in
+                                     ("kinetic", "strain", "gravity", "total",
+                                      "drive_work", "balance"))
+        extras = [(name, function) for name, function in EXTRA_PLOTS.items()
+                  if name in h5]
+    if kind == "spring" and dynamic:
         return plot_spring([h5_path], png)
-    if plate:
-        return plot_plate_dynamic(h5_path, png) if dynamic else plot_plate_static(h5_path, png)
-    return plot_dynamic(h5_path, png) if dynamic else plot_static(h5_path, png)
+    if plate and kind in ("plate", "leaf", "general", ""):
+        try:
+            return plot_plate_dynamic(h5_path, png) if dynamic else \
+                plot_plate_static(h5_path, png)
+        except (KeyError, ValueError, IndexError):
+            pass  # a plate among other bodies: the general plot below
+    if dynamic:
+        out = plot_dynamic(h5_path, png) if has_tip and has_energy and kind != "general" \
+            else plot_general_dynamic(h5_path, png)
+    elif single_beam and has_tip and kind != "general":
+        try:
+            out = plot_static(h5_path, png)
+        except (KeyError, ValueError, IndexError):  # not the template's layout
+            out = plot_general_static(h5_path, png)
+    else:
+        out = plot_general_static(h5_path, png)
+    for name, function in extras:  # e.g. modes, buckling, reactions (other modules)
+        function(h5_path, out.with_name(f"{out.stem}_{name}.png"))
+    return out
+
+
+#: plots of optional result groups: {root group name: function(h5_path, png) -> Path};
+#: :func:`plot_result` calls each whose group the file holds (modules that add a group
+#: register their plot here)
+EXTRA_PLOTS: dict = {}
+
+
+def _probe_series(group: h5py.Group) -> dict[str, np.ndarray]:
+    """The deflection of each probe of a /static or /dynamic group (file order): relative
+    to its beam's supports (deflection_support/<name>, general scenes) where the file has
+    it, else deflection/<name>."""
+    if "deflection" not in group:
+        return {}
+    support = group.get("deflection_support", {})
+    return {name: (support[name] if name in support else group[f"deflection/{name}"])[()]
+            for name in group["deflection"]}
+
+
+def _deflection_label(group: h5py.Group) -> str:
+    """What the plotted deflections are: 'relative to the supports' rigid motion' for the
+    probes on beams of general scenes, else what the file says (attribute 'reference' of
+    the deflection group) or the SPEC section 4 default."""
+    if "deflection_support" in group and len(group["deflection_support"]):
+        names = list(group["deflection_support"])
+        others = [n for n in group.get("deflection", {}) if n not in names]
+        text = "relative to the rigid motion of the beam's supports (x chord, y height)"
+        return text + (f"; {', '.join(others)}: displacement from t = 0" if others else "")
+    if "deflection" in group:
+        text = _text(group["deflection"].attrs.get("reference", ""))
+        if text:
+            return text
+    return "displacement from the rigid configuration"
+
+
+#: at most this many probes get a panel of their own in the general dynamic plot
+MAX_PROBE_PANELS = 6
+
+
+def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
+    """Any dynamic result: each probe's deflection components (x, y, z in its frame) over
+    time (at most :data:`MAX_PROBE_PANELS` probes, then the largest-moving ones), and the
+    energies the file holds."""
+    h5_path = Path(h5_path)
+    png = Path(png) if png else h5_path.with_suffix(".png")
+    with h5py.File(h5_path, "r") as h5:
+        dyn = h5["dynamic"]
+        t = dyn["time"][()]
+        probes = _probe_series(dyn)
+        energy = {k: dyn[f"energy/{k}"][()] for k in dyn["energy"]} if "energy" in dyn else {}
+        title = _text(h5.attrs.get("title", h5_path.stem))
+        status = _text(h5.attrs.get("status", ""))
+        label = _deflection_label(dyn)
+        beam_frame = set(dyn.get("deflection_support", {}))
+    if len(probes) > MAX_PROBE_PANELS:
+        ranked = sorted(probes, key=lambda n: -float(np.abs(probes[n]).max(initial=0.0)))
+        probes = {n: probes[n] for n in ranked[:MAX_PROBE_PANELS]}
+    panels = len(probes) + (1 if energy else 0)
+    fig, axes = plt.subplots(max(panels, 1), 1, figsize=(9, 2.4 * max(panels, 1) + 0.6),
+                             sharex=True, constrained_layout=True, squeeze=False)
+    axes = axes[:, 0]
+    for ax, (name, d) in zip(axes, probes.items()):
+        for k, component in enumerate(_components(name in beam_frame)):
+            ax.plot(t, 1e3 * d[:, k], lw=1.0, label=component)
+        ax.set_ylabel(f"{name} (mm)")
+        ax.legend(fontsize=8, ncol=3, loc="upper left")
+    if energy:
+        ax = axes[len(probes)]
+        for key in ("kinetic", "strain", "gravity"):
+            if key in energy:
+                ax.plot(t, energy[key], lw=1.0, label=key)
+        if "total" in energy and len(energy["total"]):
+            ax.plot(t, energy["total"] - energy["total"][0], "k--", lw=1.0, label="E - E(0)")
+        if "drive_work" in energy:
+            ax.plot(t, energy["drive_work"], ":", lw=1.0, label="drive work")
+        ax.set_ylabel("energy (J)")
+        ax.legend(fontsize=8, ncol=5, loc="upper left")
+    if not panels:
+        axes[0].text(0.5, 0.5, "no probes and no energies in this file", ha="center",
+                     transform=axes[0].transAxes)
+    axes[-1].set_xlabel("time (s)")
+    axes[0].set_title(f"{title} ({status})\nprobe deflection: {label}", fontsize=9)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return png
+
+
+def _components(support: bool) -> tuple[str, str, str]:
+    """Legend of a probe's three components: along the support frame's axes, or x, y, z."""
+    return ("axial (x)", "transverse (y)", "lateral (z)") if support else ("x", "y", "z")
+
+
+def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
+    """Any static result: every probe's deflection components (mm) as grouped bars."""
+    h5_path = Path(h5_path)
+    png = Path(png) if png else h5_path.with_suffix(".png")
+    with h5py.File(h5_path, "r") as h5:
+        _require_static(h5, h5_path)
+        static = h5["static"]
+        probes = _probe_series(static)
+        title = _text(h5.attrs.get("title", h5_path.stem))
+        method = _text(static.attrs.get("method", ""))
+        label = _deflection_label(static)
+    names = list(probes)
+    fig, ax = plt.subplots(figsize=(max(6.0, 1.2 * len(names) + 3), 3.8),
+                           constrained_layout=True)
+    if names:
+        d = 1e3 * np.array([probes[n] for n in names]).reshape(len(names), -1)
+        x = np.arange(len(names))
+        for k, component in enumerate("xyz"):
+            ax.bar(x + (k - 1) * 0.27, d[:, k], width=0.27, label=f"u_{component}")
+        ax.set_xticks(x, names, rotation=30 if len(names) > 4 else 0)
+        ax.axhline(0.0, color="0.6", lw=0.8)
+        ax.legend(fontsize=8)
+    else:
+        ax.text(0.5, 0.5, "no probes in this file", ha="center", transform=ax.transAxes)
+    ax.set_ylabel("deflection (mm)")
+    ax.set_title(f"{title} ({method})\nprobe deflection: {label}", fontsize=9)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return png
 
 
 def plot_results(h5_paths: list[str | Path], png: str | Path | None = None) -> Path:

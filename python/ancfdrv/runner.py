@@ -224,7 +224,58 @@ def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str
     for phase, seconds in result.timing.items():
         timing[f"settle_{phase}"] = seconds
     results.write_static(out, model, result)
+    _write_static_supports(out, model, result)
     return result
+
+
+def _write_static_supports(out: Path, model: Model, static: StaticResult) -> None:
+    """/static/deflection_support of a general scene (:mod:`ancfdrv.system.supports`)."""
+    frames = getattr(model, "support_frames", None)
+    if not frames:
+        return
+    from .system.supports import (DISPLACEMENT_REFERENCE, SUPPORT_REFERENCE,
+                                  support_deflections)
+    values = {k: v[0] for k, v in support_deflections(model, frames,
+                                                      model.expand(static.e)).items()}
+    results.write_support_deflections(
+        out, "static", values, {n: frames[model.probes[n].body].describe() for n in values},
+        SUPPORT_REFERENCE, DISPLACEMENT_REFERENCE)
+
+
+class SupportRecorder:
+    """Collects the support deflections of a dynamic run from each chunk's q (written at
+    the end, also after a failure or an interrupt)."""
+
+    def __init__(self, model: Model, frames: dict) -> None:
+        self.model, self.frames = model, frames
+        self.rows: list[dict[str, np.ndarray]] = []
+
+    @classmethod
+    def of(cls, model: Model) -> "SupportRecorder | None":
+        frames = getattr(model, "support_frames", None)
+        if not frames or not any(p.body in frames for p in model.probes.values()):
+            return None
+        return cls(model, frames)
+
+    def wrap(self, writer):
+        def sink(chunk) -> None:
+            if chunk.q is not None:
+                from .system.supports import support_deflections
+                self.rows.append(support_deflections(self.model, self.frames,
+                                                     self.model.expand(chunk.q)))
+            writer(chunk)
+        return sink
+
+    def write(self, out: Path, rows: int) -> None:
+        from .system.supports import DISPLACEMENT_REFERENCE, SUPPORT_REFERENCE
+        if not self.rows:
+            return
+        values = {name: np.concatenate([r[name] for r in self.rows])[:rows]
+                  for name in self.rows[0]}
+        results.write_support_deflections(
+            out, "dynamic", values,
+            {n: self.frames[self.model.probes[n].body].describe() for n in values},
+            SUPPORT_REFERENCE, DISPLACEMENT_REFERENCE)
 
 
 def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
@@ -238,20 +289,26 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
         # file keeps the frames only (storing every step cost a third of the FFR boom's
         # solver time and 27 MB)
         settings.store_q = True
+    supports = SupportRecorder.of(model)
+    if supports is not None:  # the support deflections come from q at every step
+        settings.store_q = True
     writer = results.DynamicWriter(
         out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
         frames=scene["output"]["xdmf_frames"], write_q=write_q)
+    sink = writer if supports is None else supports.wrap(writer)
     attrs: dict[str, Any] = {
         "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
         "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
         "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
         "generalized_alpha" else 1.0, "t_end": settings.t_end}
     try:
-        dyn = integrate(model, settings, e_start, sink=writer, progress=progress,
+        dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
                         should_stop=stop)
     finally:  # also after a failure or an interrupt: every computed step goes to the file
         writer.flush()
+        if supports is not None:
+            supports.write(out, writer.rows)
         results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
@@ -281,8 +338,13 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
 
 def run_loaded(scene: Scene, output: str | Path | None = None, *,
                start: float | None = None, progress: bool | None = None,
-               after: Callable[[RunOutcome], Any] | None = None) -> RunOutcome:
-    """Run a loaded scene (see :func:`run_scene`)."""
+               after: Callable[[RunOutcome], Any] | None = None,
+               model: Model | None = None) -> RunOutcome:
+    """Run a loaded scene (see :func:`run_scene`). ``model``: the model to run instead of
+    the one the scene builds (a System assembled in Python, :mod:`ancfdrv.results`; the
+    scene then carries only the analysis, solver and output settings). ``after``: called
+    with the outcome while the output is still locked (plots), its value in
+    ``outcome.after``."""
     start = time.perf_counter() if start is None else start
     out = Path(output) if output else scene.output_file
     check_output_path(out, input_files(scene), xdmf=writes_xdmf(scene))
@@ -294,7 +356,7 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
                          file=str(out)) from None
     try:
         with OutputLock(out), StopRequest() as stop:
-            outcome = _run_locked(scene, out, start, progress, stop)
+            outcome = _run_locked(scene, out, start, progress, stop, model)
             if after is not None and stop.signum is None:
                 try:
                     outcome.after = after(outcome)
@@ -335,12 +397,12 @@ def _interrupt_message(out: Path, signum: int | None) -> str:
 
 
 def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
-                stop: StopRequest) -> RunOutcome:
+                stop: StopRequest, model: Model | None = None) -> RunOutcome:
     analysis = scene["scene"]["analysis"]
     t0 = time.perf_counter()
     try:
         with stop.immediate():  # nothing is written yet: a signal ends the run at once
-            model = build_model(scene)
+            model = build_model(scene) if model is None else model
     except Interrupted as exc:
         raise Interrupted(f"interrupted by {signal_name(exc.signum)} before the output was "
                           f"written; {out} was not touched", signum=exc.signum) from None
@@ -370,6 +432,7 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
                 timing[f"static_{phase}"] = seconds
             t0 = time.perf_counter()
             results.write_static(out, model, static)
+            _write_static_supports(out, model, static)
             timing["output"] = time.perf_counter() - t0
             e_start = static.e
             if analysis == "static+dynamic":

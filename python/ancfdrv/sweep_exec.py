@@ -107,12 +107,17 @@ def _result_fields(outcome: Any, output: Path) -> dict:
     if static is not None:
         row.update(iterations=static.iterations, residual=static.residual_norm,
                    solve_time_s=static.wall_time_s)
+        # general scenes: the deflection relative to the supports' rigid motion when the
+        # file has it (ancfdrv.system.supports), not the mechanism's rigid motion
+        support = "static.deflection_support.tip"
         if "static.deflection.tip" in summary:
-            axial, transverse, lateral = summary["static.deflection.tip"]
+            axial, transverse, lateral = summary.get(support, summary["static.deflection.tip"])
             row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral)
         else:
             probe, component = response_of(summary)
-            row["response"] = float(summary[f"static.deflection.{probe}"][component])
+            values = summary.get(f"static.deflection_support.{probe}",
+                                 summary[f"static.deflection.{probe}"])
+            row["response"] = float(values[component])
     if dynamic is not None:
         row.update(dynamic=True, steps=dynamic.steps, newton_iterations=dynamic.newton_iterations,
                    factorizations=dynamic.factorizations, dynamic_time_s=dynamic.wall_time_s,

@@ -12,6 +12,14 @@
 !>           (t_ramp = 0: a plain sine from t_0 on)
 !>   kind 5  table: p = [t_1 .. t_n, v_1 .. v_n] with increasing t_k: phi linear in between,
 !>           constant outside [t_1, t_n]; phi'' = 0 (use smooth drives for prescribed motion)
+!>   kind 10 ramp: p = [rate, t_ramp, phi_start, t_0]: phi = phi_start before t_0, then the
+!>           rate rises smoothly, phi' = rate (tau/T - sin(2 pi tau/T)/(2 pi)) ... in closed form:
+!>           phi = phi_start + (rate/T) (tau^2/2 + (T/(2 pi))^2 (cos(2 pi tau/T) - 1)) for
+!>           tau = t - t_0 < T = t_ramp, phi_start + rate (tau - T/2) after (phi'' continuous,
+!>           zero at both ends of the ramp); t_ramp = 0: the rate at once from t_0
+!>   kind 11 piecewise cubic Hermite table: p = [t_1 .. t_n, v_1 .. v_n, s_1 .. s_n] with
+!>           increasing t_k, values v_k and slopes s_k at the points (the caller chooses the
+!>           slopes: a C2 cubic spline or PCHIP); constant outside [t_1, t_n]
 !> A drive's parameters are an array of any length (the caller slices a packed store).
 module drives
   use ancf_kinds, only: dp
@@ -20,7 +28,8 @@ module drives
   public :: drive_eval
 
   integer, parameter, public :: drive_constant = 0, drive_luffing = 1, drive_spinup = 2, &
-                                   drive_cycle = 3, drive_sine = 4, drive_table = 5
+                                   drive_cycle = 3, drive_sine = 4, drive_table = 5, &
+                                   drive_ramp = 10, drive_hermite = 11
   real(dp), parameter :: pi = 3.14159265358979323846_dp
 
 contains
@@ -110,6 +119,10 @@ contains
       call sine(params, t, phi, dphi, ddphi, info)
     case (drive_table)
       call table(params, t, phi, dphi, ddphi, info)
+    case (drive_ramp)
+      call ramp(params, t, phi, dphi, ddphi, info)
+    case (drive_hermite)
+      call hermite_table(params, t, phi, dphi, ddphi, info)
     case default
       info = 1
     end select
@@ -129,6 +142,10 @@ contains
       minimum_parameters = 6
     case (drive_table)
       minimum_parameters = 2
+    case (drive_ramp)
+      minimum_parameters = 4
+    case (drive_hermite)
+      minimum_parameters = 3
     case default
       minimum_parameters = -1
     end select
@@ -208,5 +225,88 @@ contains
     dphi = (params(n + hi) - params(n + lo)) / (params(hi) - params(lo))
     phi = params(n + lo) + dphi * (t - params(lo))
   end subroutine table
+
+  !> The ramp to a constant rate (kind 10).
+  pure subroutine ramp(params, t, phi, dphi, ddphi, info)
+    real(dp), intent(in) :: params(:), t
+    real(dp), intent(out) :: phi, dphi, ddphi
+    integer, intent(out) :: info
+    real(dp) :: rate, period, tau, angle
+    info = 0
+    rate = params(1)
+    period = params(2)
+    phi = params(3)
+    dphi = 0.0_dp
+    ddphi = 0.0_dp
+    if (period < 0.0_dp) then
+      info = 2
+      return
+    end if
+    tau = t - params(4)
+    if (tau <= 0.0_dp) return
+    if (tau < period) then
+      angle = 2.0_dp * pi * tau / period
+      phi = phi + rate / period * (0.5_dp * tau * tau + (period / (2.0_dp * pi))**2 &
+                                   * (cos(angle) - 1.0_dp))
+      dphi = rate / period * (tau - period / (2.0_dp * pi) * sin(angle))
+      ddphi = rate / period * (1.0_dp - cos(angle))
+    else
+      phi = phi + rate * (tau - 0.5_dp * period)
+      dphi = rate
+    end if
+  end subroutine ramp
+
+  !> The piecewise cubic Hermite table (kind 11): on [t_k, t_k+1] with h = t_k+1 - t_k and
+  !> u = (t - t_k)/h, phi = h00 v_k + h h10 s_k + h01 v_k+1 + h h11 s_k+1.
+  pure subroutine hermite_table(params, t, phi, dphi, ddphi, info)
+    real(dp), intent(in) :: params(:), t
+    real(dp), intent(out) :: phi, dphi, ddphi
+    integer, intent(out) :: info
+    integer :: n, lo, hi, mid
+    real(dp) :: h, u, v0, v1, s0, s1
+    info = 0
+    phi = 0.0_dp
+    dphi = 0.0_dp
+    ddphi = 0.0_dp
+    n = size(params) / 3
+    if (3 * n /= size(params) .or. n < 1) then
+      info = 2
+      return
+    end if
+    if (t <= params(1)) then
+      phi = params(n + 1)
+      return
+    end if
+    if (t >= params(n)) then
+      phi = params(2 * n)
+      return
+    end if
+    lo = 1
+    hi = n
+    do while (hi - lo > 1)
+      mid = (lo + hi) / 2
+      if (params(mid) <= t) then
+        lo = mid
+      else
+        hi = mid
+      end if
+    end do
+    h = params(hi) - params(lo)
+    if (h <= 0.0_dp) then
+      info = 2
+      return
+    end if
+    u = (t - params(lo)) / h
+    v0 = params(n + lo)
+    v1 = params(n + hi)
+    s0 = params(2 * n + lo)
+    s1 = params(2 * n + hi)
+    phi = (2.0_dp * u**3 - 3.0_dp * u**2 + 1.0_dp) * v0 + h * (u**3 - 2.0_dp * u**2 + u) * s0 &
+          + (-2.0_dp * u**3 + 3.0_dp * u**2) * v1 + h * (u**3 - u**2) * s1
+    dphi = (6.0_dp * u**2 - 6.0_dp * u) * (v0 - v1) / h + (3.0_dp * u**2 - 4.0_dp * u + 1.0_dp) * s0 &
+           + (3.0_dp * u**2 - 2.0_dp * u) * s1
+    ddphi = ((12.0_dp * u - 6.0_dp) * (v0 - v1) / h + (6.0_dp * u - 4.0_dp) * s0 &
+             + (6.0_dp * u - 2.0_dp) * s1) / h
+  end subroutine hermite_table
 
 end module drives

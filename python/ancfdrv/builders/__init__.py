@@ -36,6 +36,9 @@ def build_model(scene) -> Model:
         model.response = built.response
     model.kind = scene.kind
     check_ffr_validity(model, built.system)
+    if scene.kind == "general":  # deflection relative to the supports' rigid motion
+        from ..system.supports import support_frames
+        model.support_frames = support_frames(built.system)
     return model
 
 

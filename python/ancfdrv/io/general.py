@@ -25,11 +25,13 @@ _DRIVE_KEYS: dict[str, dict[str, str]] = {
     "cycle": {"amplitude": "amplitude", "period": "period", "t0": "t0"},
     "sine": {"amplitude": "amplitude", "frequency": "frequency", "phase": "phase",
              "offset": "offset", "t0": "t0", "ramp": "ramp"},
+    "ramp": {"rate": "rate", "t_ramp": "t_ramp", "start": "start", "t0": "t0"},
 }
 _REQUIRED_DRIVE = {"constant": ("value",), "luffing": ("omega", "t_start", "t_brake", "start_deg",
                                                        "end_deg"),
                    "spinup": ("omega", "period"), "cycle": ("amplitude", "period"),
-                   "sine": ("amplitude", "frequency"), "table": ()}
+                   "sine": ("amplitude", "frequency"), "table": (),
+                   "ramp": ("rate", "t_ramp")}
 
 
 def effects_of(items: list[tuple[str, dict[str, Any]]]) -> set[str]:
@@ -67,10 +69,16 @@ def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:
     kind = v["type"]
     given = {k for k, x in v.items() if x is not None and k not in ("name", "type")}
     missing = [k for k in _REQUIRED_DRIVE[kind] if v[k] is None]
+    python_luffing = kind == "luffing" and v["sweep"] is not None
+    if python_luffing:  # the Python API's parameters: omega, t_start, t_brake, sweep, start
+        missing = [k for k in ("omega", "t_start", "t_brake") if v[k] is None]
     if kind == "table":
         if (v["file"] is None) == (v["times"] is None):
             raise InputError("a 'table' drive needs either file or times and values")
-        allowed = {"file"} if v["file"] is not None else {"times", "values"}
+        allowed = ({"file"} if v["file"] is not None else {"times", "values"}) | \
+            {"interpolation"}
+    elif python_luffing:
+        allowed = {"omega", "t_start", "t_brake", "sweep", "start"}
     elif kind == "luffing":
         allowed = {"omega", "t_start", "t_brake", "start_deg", "end_deg"}
     else:
@@ -80,7 +88,11 @@ def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:
     extra = sorted(given - allowed)
     if extra:
         raise InputError(f"type {kind!r} does not take {', '.join(extra)}")
-    if kind == "luffing":
+    if python_luffing:
+        s.drive(v["name"], "luffing", omega=abs(v["omega"]) * np.sign(v["sweep"]),
+                t_start=v["t_start"], t_brake=v["t_brake"], sweep=v["sweep"],
+                start=v["start"] or 0.0)
+    elif kind == "luffing":
         start, end = math.radians(v["start_deg"]), math.radians(v["end_deg"])
         s.drive(v["name"], "luffing", omega=abs(v["omega"]) * np.sign(end - start),
                 t_start=v["t_start"], t_brake=v["t_brake"], sweep=end - start, start=start)
@@ -89,9 +101,11 @@ def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:
             path = Path(v["file"])
             path = path if path.is_absolute() else scene_dir / path
             _check_text_file(path)
-            s.drive(v["name"], "table", file=path)
+            s.drive(v["name"], "table", file=path,
+                    interpolation=v["interpolation"] or "linear")
         else:
-            s.drive(v["name"], "table", times=v["times"], values=v["values"] or [])
+            s.drive(v["name"], "table", times=v["times"], values=v["values"] or [],
+                    interpolation=v["interpolation"] or "linear")
     else:
         s.drive(v["name"], kind, **{_DRIVE_KEYS[kind][k]: v[k] for k in given})
 

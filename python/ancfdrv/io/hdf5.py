@@ -290,7 +290,11 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
             _last_frame(h5, model)
     if has_motion:
         from .xdmf import write_xdmf
-        write_xdmf(path)
+        try:
+            write_xdmf(path)
+        except Exception as exc:  # noqa: BLE001 - an optional output never fails a good run
+            model.warnings.append(f"the XDMF description of {path} was not written: "
+                                  f"{type(exc).__name__}: {exc}")
 
 
 def _last_frame(h5: h5py.File, model: Model) -> None:
@@ -341,6 +345,9 @@ def read_summary(path: Path) -> dict[str, Any]:
             for name in static.get("deflection", {}):
                 out[f"static.deflection.{name}"] = static["deflection"][name][()]
                 out[f"static.probes.{name}"] = static["probes"][name][()]
+            for name in static.get("deflection_support", {}):  # general scenes
+                out[f"static.deflection_support.{name}"] = \
+                    static["deflection_support"][name][()]
         if "dynamic" in h5:
             dynamic = h5["dynamic"]
             out.update({f"dynamic.{k}": _text(v) for k, v in dynamic.attrs.items()})
@@ -350,6 +357,10 @@ def read_summary(path: Path) -> dict[str, Any]:
                 out["dynamic.t_reached"] = float(dynamic["time"][-1])
                 for name in dynamic.get("deflection", {}):
                     out[f"dynamic.deflection.{name}.final"] = dynamic["deflection"][name][-1]
+                for name in dynamic.get("deflection_support", {}):  # general scenes
+                    series = dynamic["deflection_support"][name]
+                    if len(series):
+                        out[f"dynamic.deflection_support.{name}.final"] = series[-1]
         if "timing" in h5:
             out.update({f"timing.{k}": v for k, v in h5["timing"].attrs.items()})
         if "counters" in h5:
@@ -578,3 +589,27 @@ def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, flo
         if stages:
             stage_group = group.require_group("stages")
             _attrs(stage_group.attrs, stages)
+
+
+def write_support_deflections(path: Path, analysis: str, deflections: dict[str, np.ndarray],
+                              frames: dict, reference: str, displacement: str) -> None:
+    """/<analysis>/deflection_support/<probe> (the probes' deflection relative to the rigid
+    motion of their beam's supports, :mod:`ancfdrv.system.supports`), with the attribute
+    ``reference`` saying what it is, each probe's ``frame`` (beam and joints), and the
+    attribute ``reference`` of /<analysis>/deflection saying what that one is
+    (``displacement``)."""
+    with _open_write(path) as h5:
+        group = h5[analysis]
+        if "deflection" in group:
+            group["deflection"].attrs["reference"] = displacement
+        if not deflections:
+            return
+        if "deflection_support" in group:
+            del group["deflection_support"]
+        support = group.create_group("deflection_support")
+        support.attrs["reference"] = reference
+        for name, values in deflections.items():
+            data = _dataset(support, name, values, "m")
+            frame = frames.get(name)
+            if frame is not None:
+                data.attrs["frame"] = frame

@@ -62,6 +62,7 @@ def non_negative(v: Any) -> str | None:
 def one_of(*choices: str) -> Callable[[Any], str | None]:
     def check(v: Any) -> str | None:
         return None if v in choices else f"must be one of {', '.join(repr(c) for c in choices)}"
+    check.choices = choices  # type: ignore[attr-defined]  (listed by docs/scenes.md)
     return check
 
 
@@ -439,18 +440,21 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
     },
     "drive": {
         "name": _name(),
-        "type": Key("str", check=one_of("constant", "luffing", "spinup", "cycle", "sine", "table"),
+        "type": Key("str", check=one_of("constant", "luffing", "spinup", "cycle", "sine", "table",
+                                        "ramp"),
                     doc="drive type"),
         "value": Key("float", None, doc="'constant': the value"),
-        "omega": Key("float", None, doc="'luffing', 'spinup': rate (rad/s)"),
+        "omega": Key("float", None, doc="'luffing', 'spinup': rate (rad/s, or the drive's "
+                      "unit per s)"),
         "t_start": Key("float", None, positive, "'luffing': smooth start (s)"),
         "t_brake": Key("float", None, positive, "'luffing': smooth braking (s)"),
         "start_deg": Key("float", None, doc="'luffing': angle at t = 0 (deg)"),
         "end_deg": Key("float", None, doc="'luffing': angle after braking (deg)"),
         "period": Key("float", None, positive, "'spinup': spin-up time; 'cycle': duration (s)"),
-        "start": Key("float", None, doc="'spinup': angle at t = 0 (rad)"),
+        "start": Key("float", None, doc="'spinup', 'ramp', 'luffing' (with sweep): value at "
+                      "the start (rad, or the drive's unit)"),
         "amplitude": Key("float", None, doc="'cycle', 'sine': amplitude"),
-        "t0": Key("float", None, doc="'cycle', 'sine': start time (s)"),
+        "t0": Key("float", None, doc="'cycle', 'sine', 'ramp': start time (s)"),
         "frequency": Key("float", None, non_negative, "'sine': frequency (Hz)"),
         "phase": Key("float", None, doc="'sine': phase (rad)"),
         "offset": Key("float", None, doc="'sine': offset"),
@@ -458,6 +462,15 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "file": Key("str", None, doc="'table': CSV file of (t, value) rows, relative to the scene"),
         "times": Key("floats", None, doc="'table': times (s), increasing"),
         "values": Key("floats", None, doc="'table': values at the times"),
+        "interpolation": Key("str", None, one_of("linear", "cubic", "pchip"),
+                             "'table': 'linear' (default; the rate jumps at the points), "
+                             "'cubic' (C2 cubic spline) or 'pchip' (monotone piecewise cubic); "
+                             "both cubic kinds start and end with zero rate"),
+        "rate": Key("float", None, doc="'ramp': the rate reached (units/s)"),
+        "t_ramp": Key("float", None, non_negative, "'ramp': time to reach the rate smoothly (s)"),
+        "sweep": Key("float", None, doc="'luffing' (as the Python API): total change (rad, or "
+                     "the drive's unit, e.g. m for a cylinder length), instead of "
+                     "start_deg/end_deg; with start"),
     },
     "load": {
         "name": _name(),

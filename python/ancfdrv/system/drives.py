@@ -9,9 +9,14 @@ scale loads.
 - :class:`Cycle` a load cycle amplitude (1 - cos(2 pi (t - t0) / period)) / 2 on one period;
 - :class:`Sine` offset + amplitude r(t) sin(2 pi f (t - t0) + phase) with a smooth ramp-in r
   over ``ramp`` seconds;
-- :class:`Table` (t, value) pairs, linear in between, constant outside (from a CSV file with
-  :meth:`Table.from_csv`); its rate jumps at the points, so prefer smooth drives for
-  prescribed motion.
+- :class:`Table` (t, value) pairs, constant outside (from a CSV file with
+  :meth:`Table.from_csv`), with ``interpolation`` 'linear' (the default: its rate jumps at
+  the points), 'cubic' (a C2 cubic spline) or 'pchip' (piecewise cubic, C1, monotone
+  between monotone points: no overshoot); both cubic kinds have zero rate at the first and
+  last points, so the rate is continuous where the table starts and stops holding;
+- :class:`Ramp` a rate reached smoothly: from ``start`` at ``t0`` the rate rises to
+  ``rate`` over ``t_ramp`` seconds (the acceleration (rate/t_ramp) (1 - cos 2 pi tau/t_ramp)
+  is continuous and zero at both ends), then stays.
 """
 from __future__ import annotations
 
@@ -24,6 +29,7 @@ import numpy as np
 
 from .. import kernel
 from ..codes import DRIVE_CONSTANT, DRIVE_CYCLE, DRIVE_LUFFING, DRIVE_SINE, DRIVE_SPINUP, DRIVE_TABLE
+from ..codes import DRIVE_HERMITE, DRIVE_RAMP
 from ..errors import InputError
 
 
@@ -140,17 +146,88 @@ class Sine(Drive):
         super().check()
 
 
+#: how a table interpolates between its points
+INTERPOLATIONS = ("linear", "cubic", "pchip")
+
+
+def spline_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Slopes at the points of the C2 cubic spline through (t, v) with zero slope at both
+    ends (clamped): continuity of the second derivative at every inner point gives
+    h_k s_{k-1} + 2 (h_{k-1} + h_k) s_k + h_{k-1} s_{k+1} = 3 (h_k d_{k-1} + h_{k-1} d_k)
+    with h_k = t_{k+1} - t_k and d_k = (v_{k+1} - v_k)/h_k (a tridiagonal system)."""
+    n = len(t)
+    slopes = np.zeros(n)
+    if n < 3:
+        return slopes
+    h = np.diff(t)
+    d = np.diff(v) / h
+    lower, diag, upper = h[1:], 2.0 * (h[:-1] + h[1:]), h[:-1]
+    rhs = 3.0 * (h[1:] * d[:-1] + h[:-1] * d[1:])
+    # Thomas algorithm on the inner points (the end slopes are zero)
+    m = n - 2
+    c, r = np.zeros(m), np.zeros(m)
+    c[0], r[0] = upper[0] / diag[0], rhs[0] / diag[0]
+    for k in range(1, m):
+        denom = diag[k] - lower[k] * c[k - 1]
+        c[k] = upper[k] / denom if k < m - 1 else 0.0
+        r[k] = (rhs[k] - lower[k] * r[k - 1]) / denom
+    inner = np.zeros(m)
+    inner[-1] = r[-1]
+    for k in range(m - 2, -1, -1):
+        inner[k] = r[k] - c[k] * inner[k + 1]
+    slopes[1:-1] = inner
+    return slopes
+
+
+def pchip_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Slopes of the monotone piecewise cubic (Fritsch & Carlson 1980, with the weighted
+    harmonic mean of Fritsch & Butland 1984 at inner points): zero where the neighbouring
+    secants differ in sign or one is zero (a local extremum stays at the point), zero at
+    both ends. Between monotone points the interpolant is monotone."""
+    n = len(t)
+    slopes = np.zeros(n)
+    if n < 3:
+        return slopes
+    h = np.diff(t)
+    d = np.diff(v) / h
+    for k in range(1, n - 1):
+        if d[k - 1] * d[k] <= 0.0:
+            continue
+        w1, w2 = 2.0 * h[k] + h[k - 1], h[k] + 2.0 * h[k - 1]
+        slopes[k] = (w1 + w2) / (w1 / d[k - 1] + w2 / d[k])
+    return slopes
+
+
 @dataclass
 class Table(Drive):
-    """Piecewise linear through (times, values); times strictly increasing."""
+    """Through (times, values), times strictly increasing, constant outside;
+    ``interpolation`` 'linear' (default), 'cubic' (C2 spline, zero end slopes) or 'pchip'
+    (monotone piecewise cubic, zero end slopes)."""
 
     name: str
     times: tuple[float, ...]
     values_: tuple[float, ...]
-    kind = DRIVE_TABLE
+    interpolation: str = "linear"
+
+    @property
+    def kind(self) -> int:  # type: ignore[override]
+        return DRIVE_TABLE if self.interpolation == "linear" else DRIVE_HERMITE
+
+    def slopes(self) -> np.ndarray:
+        """The rate at each point ('cubic', 'pchip'; 'linear' has none: zeros)."""
+        t = np.asarray(self.times, dtype=float)
+        v = np.asarray(self.values_, dtype=float)
+        if self.interpolation == "cubic":
+            return spline_slopes(t, v)
+        if self.interpolation == "pchip":
+            return pchip_slopes(t, v)
+        return np.zeros(len(t))
 
     def params(self) -> list[float]:
-        return [float(t) for t in self.times] + [float(v) for v in self.values_]
+        out = [float(t) for t in self.times] + [float(v) for v in self.values_]
+        if self.interpolation != "linear":
+            out += [float(s) for s in self.slopes()]
+        return out
 
     def check(self) -> None:
         t = np.asarray(self.times, dtype=float)
@@ -161,11 +238,14 @@ class Table(Drive):
             raise InputError(f"drive {self.name!r}: table entries must be finite")
         if np.any(np.diff(t) <= 0):
             raise InputError(f"drive {self.name!r}: table times must increase strictly")
+        if self.interpolation not in INTERPOLATIONS:
+            raise InputError(f"drive {self.name!r}: interpolation {self.interpolation!r} must "
+                             f"be one of {', '.join(INTERPOLATIONS)}")
         super().check()
 
     @classmethod
     def from_csv(cls, name: str, path: str | Path, *, time_column: int = 0,
-                 value_column: int = 1) -> "Table":
+                 value_column: int = 1, interpolation: str = "linear") -> "Table":
         """A table from a CSV file of (time, value) rows; a first row that is not numeric is
         a header."""
         path = Path(path)
@@ -185,7 +265,7 @@ class Table(Drive):
                     raise InputError(f"drive {name!r}: {path}, line {number}: expected numbers "
                                      f"in columns {time_column + 1} and {value_column + 1}, got "
                                      f"{_token(row)}") from None
-        table = cls(name, tuple(times), tuple(values))
+        table = cls(name, tuple(times), tuple(values), interpolation)
         table.check()
         return table
 
@@ -210,5 +290,29 @@ def _is_number(text: str) -> bool:
     return True
 
 
+@dataclass
+class Ramp(Drive):
+    """From ``start`` (held until ``t0``) the rate rises smoothly to ``rate`` (units/s)
+    over ``t_ramp`` seconds, then stays: phi = start + (rate/T) (tau^2/2 + (T/(2 pi))^2
+    (cos(2 pi tau/T) - 1)) for tau = t - t0 < T = t_ramp, start + rate (tau - T/2) after;
+    phi'' = (rate/T) (1 - cos(2 pi tau/T)) is continuous (zero at both ends of the ramp).
+    ``t_ramp = 0``: the rate at once from t0."""
+
+    name: str
+    rate: float
+    t_ramp: float
+    start: float = 0.0
+    t0: float = 0.0
+    kind = DRIVE_RAMP
+
+    def params(self) -> list[float]:
+        return [float(self.rate), float(self.t_ramp), float(self.start), float(self.t0)]
+
+    def check(self) -> None:
+        if self.t_ramp < 0:
+            raise InputError(f"drive {self.name!r}: t_ramp must not be negative")
+        super().check()
+
+
 DRIVE_TYPES = {"constant": Constant, "luffing": Luffing, "spinup": SpinUp, "cycle": Cycle,
-               "sine": Sine, "table": Table}
+               "sine": Sine, "table": Table, "ramp": Ramp}

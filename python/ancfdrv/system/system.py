@@ -16,11 +16,14 @@ Example (a cantilever with a tip mass)::
     s.load("g", "gravity", vector=(0, -9.81, 0))
     s.load("payload", "point_mass", body="arm", point=(2, 0, 0), mass=10.0)
     s.probe("tip", "arm", (2, 0, 0))
-    model = s.assemble()
+    res = s.static()                      # or s.simulate(t_end=1.0, dt=1e-3)
+    res.deflection["tip"], res.counters   # by name (ancfdrv.results.Results)
+    res.save("results/cantilever.h5")     # the file `ancf run` writes; ancfdrv.open reads it
+    model = s.assemble()                  # the model alone, for the solvers' own API
 """
 from __future__ import annotations
 
-from typing import Iterable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -39,6 +42,11 @@ from .sections import Section
 #: effects an item may belong to, with the default of each load type (SPEC section 8)
 LOAD_EFFECTS = {"gravity": "gravity", "force": "point_loads", "moment": "point_loads",
                 "point_mass": "tip_mass", "pressure": "pressure"}
+#: the parameters each load type needs (besides name, type, effect; 'force' also takes a
+#: drive), as :meth:`System.load` checks them (and docs/scenes.md lists them)
+LOAD_PARAMETERS = {"gravity": ("vector",), "force": ("body", "point", "vector"),
+                   "moment": ("body", "point", "vector"), "point_mass": ("body", "point", "mass"),
+                   "pressure": ("body", "value")}
 
 
 def _api(method):
@@ -258,7 +266,9 @@ class System:
         """A drive (``ancfdrv.system.drives``): type 'constant' (value), 'luffing' (omega,
         t_start, t_brake, sweep, start), 'spinup' (omega, period, start), 'cycle'
         (amplitude, period, t0), 'sine' (amplitude, frequency, phase, offset, t0, ramp),
-        'table' (times, values, or file = CSV path)."""
+        'table' (times, values, or file = CSV path; interpolation = 'linear' | 'cubic' |
+        'pchip'), 'ramp' (rate, t_ramp, start, t0). The namelist &drive takes the same
+        parameters (docs/scenes.md)."""
         name = self._new_name(name, self.drives, "drive")
         where = f"drive {name!r}"
         if not isinstance(type, str) or type not in DRIVE_TYPES:
@@ -267,10 +277,11 @@ class System:
         params = check_drive_params(name, type, params)
         try:
             if type == "table" and "file" in params:
-                extra = set(params) - {"file"}
+                extra = set(params) - {"file", "interpolation"}
                 if extra:
                     raise TypeError(f"unexpected {sorted(extra)}")
-                drive = Table.from_csv(name, params["file"])
+                drive = Table.from_csv(name, params["file"],
+                                       interpolation=params.get("interpolation", "linear"))
             elif type == "table":
                 drive = Table(name, tuple(params.pop("times")), tuple(params.pop("values")),
                               **params)
@@ -326,9 +337,7 @@ class System:
         if effect is not None:
             check_effects([effect], what=f"load[{name}]")
         effect = effect or LOAD_EFFECTS[type]
-        needs = {"gravity": ("vector",), "force": ("body", "point", "vector"),
-                 "moment": ("body", "point", "vector"), "point_mass": ("body", "point", "mass"),
-                 "pressure": ("body", "value")}[type]
+        needs = LOAD_PARAMETERS[type]
         given = dict(body=body, point=point, vector=vector, mass=mass, value=value)
         missing = [k for k in needs if given[k] is None]
         if missing:
@@ -485,17 +494,56 @@ class System:
             warnings.warn(unused_note, UserWarning, stacklevel=3)
         return model
 
+    # -- analyses (SPEC section 10, "Python") ------------------------------------------------
+    #: the analyses, registered by :mod:`ancfdrv.results` (which sits above this layer: it
+    #: runs the solvers and writes the result file)
+    _ANALYSES: dict[str, Callable[..., Any]] = {}
+
+    def _analysis(self, name: str) -> Callable[..., Any]:
+        if name not in self._ANALYSES:  # only when ancfdrv.results was never imported
+            raise RuntimeError("import ancfdrv (the package) to run analyses")
+        return self._ANALYSES[name]
+
+    def static(self, **options: Any):
+        """The static equilibrium, run exactly as ``ancf run`` runs a static scene, with
+        the CLI's defaults. Keywords: any key of the scene groups &solver and &output
+        (``static_method='split'`` by default as in the CLI, 'newton' where the split
+        iteration cannot run: a body not 'ffr', or contact; ``tol``, ``max_iter``,
+        ``load_steps``, ...; docs/scenes.md), ``effects`` (default: the system's list, else
+        every effect its items belong to), ``output`` (an HDF5 path; default a temporary
+        file, see :meth:`~ancfdrv.results.Results.save`), ``progress``.
+
+        Returns :class:`ancfdrv.results.Results`: ``.probes[name]``, ``.deflection[name]``,
+        ``.counters``, ``.timing``, ``.status``, ``.save(path)``, ... Raises InputError on
+        bad input and SolverError when the solve fails."""
+        return self._analysis("static")(self, **options)
+
+    def simulate(self, t_end: float, dt: float | None = None, *, from_static: bool = False,
+                 **options: Any):
+        """Dynamics from 0 to ``t_end`` (s) with the step ``dt`` (s; default the CLI's,
+        1e-3), run exactly as ``ancf run`` runs a dynamic scene, with the CLI's defaults
+        (Newmark average acceleration, ``jacobian='reuse'``, ...). ``from_static``: start
+        from the static equilibrium (analysis 'static+dynamic'), else at rest in the
+        assembled configuration. Other keywords as :meth:`static` (e.g.
+        ``integrator='generalized_alpha', rho_inf=0.8``, ``q=True``, ``xdmf=False``).
+        Returns :class:`ancfdrv.results.Results` with time histories (``.time``,
+        ``.probes[name]`` of shape (nt, 3), ``.energy``)."""
+        return self._analysis("simulate")(self, t_end, dt, from_static=from_static, **options)
+
+
 
 #: drive parameters of the API per type (keyword -> schema key of &drive checked against)
 DRIVE_PARAMS = {
     "constant": {"value": "value"},
     "luffing": {"omega": "omega", "t_start": "t_start", "t_brake": "t_brake",
-                "sweep": "start", "start": "start"},
+                "sweep": "sweep", "start": "start"},
     "spinup": {"omega": "omega", "period": "period", "start": "start"},
     "cycle": {"amplitude": "amplitude", "period": "period", "t0": "t0"},
     "sine": {"amplitude": "amplitude", "frequency": "frequency", "phase": "phase",
              "offset": "offset", "t0": "t0", "ramp": "ramp"},
-    "table": {"times": "times", "values": "values", "file": "file"},
+    "table": {"times": "times", "values": "values", "file": "file",
+              "interpolation": "interpolation"},
+    "ramp": {"rate": "rate", "t_ramp": "t_ramp", "start": "start", "t0": "t0"},
 }
 
 

@@ -1,0 +1,216 @@
+"""The scene reference ``docs/scenes.md``, generated from the schema (:mod:`ancfdrv.io.schema`)
+and the general scenes' type tables: every group and key with its type, unit, default and
+meaning, and which drive, joint and load type takes which parameters.
+
+Regenerate after changing the schema (``tests/test_scenedoc.py`` fails until you do)::
+
+    python -m ancfdrv.scenedoc -o docs/scenes.md
+"""
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+from .io.general import _DRIVE_KEYS, _REQUIRED_DRIVE
+from .io.schema import GENERAL_SCHEMA, MODEL_GROUPS, REQUIRED, SCHEMA, Key
+from .system.drives import DRIVE_TYPES
+from .system.joints import JOINT_TYPES
+from .system.system import LOAD_EFFECTS, LOAD_PARAMETERS
+
+#: the parameters each joint type takes (besides name, type, body1, body2), as
+#: :class:`~ancfdrv.system.joints.Joint` checks them: (required, optional)
+JOINT_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "weld": (("point",), ()),
+    "revolute": (("point", "axis"), ()),
+    "spherical": (("point",), ()),
+    "distance": (("point1", "point2"), ("drive",)),
+    "prescribed": (("point", "drive", "axis"), ("pivot",)),
+    "fix": (("point",), ("vector", "axis")),
+    "arm": (("point", "axis", "pivot"), ()),
+    "hub": (("point", "axis", "pivot", "drive"), ()),
+}
+JOINT_MEANING = {
+    "weld": "positions coincide; body2's section or axes follow body1's at the point",
+    "revolute": "positions coincide; relative rotation only about axis",
+    "spherical": "positions coincide",
+    "distance": "|p2 - p1| held, or following drive (a hydraulic cylinder's length)",
+    "prescribed": "body2's point follows a rotation about pivot and axis by the drive's angle, "
+                  "or without pivot a translation along axis by its value (body1: ground)",
+    "fix": "body2's nodal vector (vector = 'r', 'r_x', 'r_y', 'r_z') held, or only its "
+           "component along axis (body1: ground)",
+    "arm": "the boom's support: the node on a massless arm hinged at pivot about axis",
+    "hub": "a driven clamp: node and section turn with the drive about axis through pivot",
+}
+DRIVE_MEANING = {
+    "constant": "phi = value",
+    "luffing": "SPEC section 5's profile: smooth start (t_start), constant rate omega, smooth "
+               "braking (t_brake); in degrees (start_deg, end_deg) or, as the Python API, in "
+               "any unit (sweep, start; e.g. metres of a cylinder)",
+    "spinup": "Simo & Vu-Quoc's spin-up to the rate omega in period s, from start",
+    "cycle": "amplitude (1 - cos(2 pi (t - t0)/period))/2 on one period, 0 outside",
+    "sine": "offset + amplitude r(t) sin(2 pi frequency (t - t0) + phase), r rising over ramp s",
+    "table": "through (times, values) or a CSV file, held outside; interpolation 'linear' "
+             "(default), 'cubic' (C2 spline) or 'pchip' (monotone), the cubic kinds with zero "
+             "rate at both ends",
+    "ramp": "from start (held until t0) the rate rises smoothly to rate over t_ramp s, then "
+            "stays (continuous acceleration)",
+}
+#: the heading suffix of a template scene's group that general scenes also have
+TEMPLATE_SUFFIX = " (template scenes)"
+#: unit-looking parenthesised text in a key's meaning
+_UNIT = re.compile(r"\(((?:[a-zA-Z]{1,3}(?:\^-?\d)?(?:[ /*][a-zA-Z]{1,3}(?:\^-?\d)?)*)|1)"
+                   r"(?:[,;][^()]*)?\)")
+_UNITS = {"m", "s", "Pa", "kg", "N", "J", "Hz", "rad", "deg", "W"}
+
+
+def unit_of(key: Key) -> str:
+    """The SI unit a key's meaning states in parentheses, e.g. '(m)', '(kg/m^3)'; '' when
+    none (numbers without a unit, names, switches)."""
+    for match in _UNIT.finditer(key.doc):
+        text = match.group(1)
+        symbols = re.findall(r"[a-zA-Z]+", text)
+        if symbols and all(s in _UNITS for s in symbols):
+            return text
+    return ""
+
+
+def _default(key: Key) -> str:
+    if key.default is REQUIRED:
+        return "**required**"
+    if key.default is None:
+        return "-"
+    value = key.default
+    if isinstance(value, bool):
+        return ".true." if value else ".false."
+    if isinstance(value, str):
+        return f"'{value}'"
+    if isinstance(value, list):
+        return ", ".join(_default(Key(key.kind, v)) for v in value) if value else "(none)"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _type(key: Key) -> str:
+    kinds = {"float": "real", "int": "integer", "str": "string", "bool": "logical",
+             "floats": "reals", "strs": "strings"}
+    text = kinds[key.kind]
+    if key.size:
+        text += f" [{key.size}]"
+    return text
+
+
+def _cell(text: Any) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _meaning(spec: Key) -> str:
+    """The key's meaning, with its choices when it takes one of a few words."""
+    choices = getattr(spec.check, "choices", None)
+    if choices:
+        return f"{spec.doc}; one of {', '.join(repr(c) for c in choices)}"
+    return spec.doc
+
+
+def group_table(name: str, keys: dict[str, Key], suffix: str = "") -> list[str]:
+    lines = [f"### `&{name}`{suffix}", "", "| key | type | unit | default | meaning |",
+             "|---|---|---|---|---|"]
+    for key, spec in keys.items():
+        lines.append(f"| `{key}` | {_type(spec)} | {_cell(unit_of(spec)) or '-'} | "
+                     f"{_cell(_default(spec))} | {_cell(_meaning(spec))} |")
+    return lines + [""]
+
+
+def drive_parameters() -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
+    """(required, optional) parameters of each drive type, as the namelist reader
+    (:mod:`ancfdrv.io.general`) checks them."""
+    out = {}
+    for kind in DRIVE_TYPES:
+        required = tuple(_REQUIRED_DRIVE.get(kind, ()))
+        if kind == "table":
+            out[kind] = (("times, values (or file)",), ("interpolation",))
+        elif kind == "luffing":
+            out[kind] = (("omega", "t_start", "t_brake", "start_deg, end_deg (or sweep)"),
+                         ("start (with sweep)",))
+        else:
+            optional = tuple(k for k in _DRIVE_KEYS[kind] if k not in required)
+            out[kind] = (required, optional)
+    return out
+
+
+def _type_table(title: str, parameters: dict, meaning: dict, extra: str = "") -> list[str]:
+    lines = [f"### {title}", "", f"| type | required | optional | meaning |",
+             "|---|---|---|---|"]
+    for kind, (required, optional) in parameters.items():
+        lines.append(f"| `{kind}` | {_cell(', '.join(required)) or '-'} | "
+                     f"{_cell(', '.join(optional)) or '-'} | {_cell(meaning.get(kind, ''))} |")
+    return lines + ([""] + [extra] if extra else []) + [""]
+
+
+def render() -> str:
+    """The text of docs/scenes.md."""
+    lines = [
+        "# Scene reference",
+        "",
+        "<!-- generated by `python -m ancfdrv.scenedoc -o docs/scenes.md` from "
+        "python/ancfdrv/io/schema.py; do not edit (tests/test_scenedoc.py compares) -->",
+        "",
+        "A scene is one Fortran namelist file (SPEC section 3). Unknown groups or keys, "
+        "missing required keys and non-physical values are errors (exit 2) naming file, "
+        "group and key. Units are SI. Lists are comma-separated (`start = 0.0, 1.0, 0.0`); "
+        "strings are quoted; logicals are `.true.` / `.false.`. `--set GROUP.KEY=VALUE` "
+        "overrides a key, `--set 'GROUP[name].KEY=VALUE'` a key of a named item.",
+        "",
+        "The `&solver` and `&output` keys are also the keywords of `System.static()` and "
+        "`System.simulate()` in Python, with the same defaults.",
+        "",
+        "## General scenes (SPEC section 8)",
+        "",
+        "A scene without a template group is a general scene: `&scene`, `&solver`, "
+        "`&output` once each, and any number of the named groups below, each one call of "
+        "the Python `System` API (`System.material`, `.beam`, `.plate`, `.leaf`, "
+        "`.rigid_body`, `.drive`, `.joint`, `.load`, `.contact`, `.probe`) with the same "
+        "parameters.",
+        "",
+    ]
+    for group in ("scene", "solver", "output"):
+        lines += group_table(group, SCHEMA[group])
+    for group, keys in GENERAL_SCHEMA.items():
+        lines += group_table(group, keys)
+    lines += ["## Which type takes which parameters", ""]
+    lines += _type_table("Drives (`&drive type = ...`)", drive_parameters(), DRIVE_MEANING)
+    lines += _type_table("Joints (`&joint type = ...`; besides body1, body2)",
+                         {k: JOINT_PARAMETERS[k] for k in JOINT_TYPES}, JOINT_MEANING,
+                         "`point` may list several points (a multiple of 3 numbers): the "
+                         "joint acts at each.")
+    loads = {kind: (needs, ("drive",) if kind == "force" else ())
+             for kind, needs in LOAD_PARAMETERS.items()}
+    effects = {kind: f"effect default: '{LOAD_EFFECTS[kind]}'" for kind in LOAD_PARAMETERS}
+    lines += _type_table("Loads (`&load type = ...`; optional `effect`)", loads, effects)
+    lines += ["## Template scenes (SPEC section 3)", "",
+              "A template scene has exactly one model group (" +
+              ", ".join(f"`&{g}`" for g in MODEL_GROUPS) + ") and the common groups "
+              "`&scene`, `&beam`/`&material`/`&loads` where the model uses them, `&solver`, "
+              "`&output`.", ""]
+    for group, keys in SCHEMA.items():
+        if group in ("scene", "solver", "output"):
+            continue
+        lines += group_table(group, keys, TEMPLATE_SUFFIX if group in GENERAL_SCHEMA else "")
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description="write the scene reference (docs/scenes.md)")
+    parser.add_argument("-o", "--output", help="file to write (default: standard output)")
+    args = parser.parse_args(argv)
+    text = render()
+    if args.output:
+        Path(args.output).write_text(text)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
