@@ -1,0 +1,465 @@
+"""Engineering answers from a solved state (SPEC section 10): joint reactions by name,
+section forces along beams and stresses at the sections' outer fibres or walls.
+
+Reactions
+    The constraint forces in the full coordinates q are Phi_q^T lambda (the constraints
+    kept with multipliers; the solvers' convention M e'' + Q_int - Q - Phi_e^T lambda = 0
+    makes Phi^T lambda the force the constraints apply) plus A^T mu for the linear joint
+    equations A q = b that the assembly eliminated (q = B e + q0). Their multipliers mu are
+    recovered from the residual of the equations of motion in the full coordinates,
+    r = M q'' + Q_int(q, q') - Q(t) = Phi_q^T lambda + A^T mu, by least squares
+    (A A^T) mu = A (r - Phi_q^T lambda): r - Phi_q^T lambda lies in the range of A^T
+    because B^T (r - Phi_q^T lambda) = 0 is the solved (reduced) equation and B spans the
+    null space of A. Each joint owns its equations' rows; its generalized force on body2's
+    coordinates is reduced to a force (the sum over the position vectors r) and a moment
+    about the joint's point p, M = sum (r_i - p) x Q_r,i + sum d_j x Q_d,j over the
+    position vectors r_i and the direction vectors d_j (a rigid rotation delta theta moves
+    every vector v by delta theta x v: the virtual work is delta theta . M). Global axes;
+    what body1 exerts on body2 (as the user named them). A distance joint's ``axial`` is
+    the tension: minus the force on body2 along p2 - p1.
+
+Section forces
+    At ``stations`` points per element (equally spaced, both ends included) from the
+    element's own strain measures (``fortran/src/elements/beam_structural.f90``) and the
+    section's stiffness, relative to the reference configuration: axial Green strain
+    (r_x . r_x - 1)/2, bending strains b_y = -r_y,x . r_x (+ r_xx . r_y - mean(r_xx . r_y)
+    with 'cubic' bending), b_z likewise with r_z, twist 1/2 (r_y,x . r_z - r_z,x . r_y)
+    ('cubic'; the continuum element's (I_z r_y,x . r_z - I_y r_z,x . r_y) / I_p), shear
+    gamma_y = r_x . r_y (nodal values interpolated linearly with 'cubic'). Sign convention:
+    what the part of the beam beyond s (larger arc length) exerts on the part before it,
+    on the section at s: N = E A eps (tension positive), T = G J twist, Q = k G A gamma
+    along the section's height and width, M = (-E I_y b_z, E I_z b_y) along the height and
+    width axes (the moment vector's components; a cantilever along x with a tip load P
+    along +y has M_width = P (L - s) and Q_height = P).
+
+Stresses
+    sigma_x(y, z) = N / A - M_width y / I_z + M_height z / I_y at the section's outer
+    fibre points (Section.fibre_points), the shear stress of torsion (rectangle:
+    Saint-Venant, its maximum at the middle of the long sides from the series solution;
+    box: Bredt T / (2 A_m t); tube and circle: T r / J) and of the shear forces
+    (Jourawski: rectangle 3/2 Q / A (1 - (2y/h)^2), circle 4/3 Q / A (1 - (y/r)^2), tube and
+    box the thin-walled shear flow), their magnitudes added (conservative), and von Mises
+    sqrt(sigma^2 + 3 tau^2). ``sigma_x`` is the normal stress of largest magnitude over the
+    fibres (signed), ``von_mises`` the largest von Mises stress.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .bodies import Beam, Ground, Plate, RigidBody
+from .constraint_set import ConstraintSet
+from .joints import Constraint, LinearEquation
+from .model import Model
+from .sections import Box, Circle, Rectangle, Tube
+
+#: output.stations default: points per element where section forces are evaluated
+DEFAULT_STATIONS = 3
+
+
+@dataclass
+class Reaction:
+    """What body1 exerts on body2 at a joint (global axes, N and N m about ``point``)."""
+
+    force: np.ndarray
+    moment: np.ndarray
+    point: np.ndarray
+    axial: float | None = None   # distance joints: tension positive (N)
+
+
+@dataclass
+class SectionForces:
+    """Section forces along a beam: arc length s (m), N, T, Q (ns, 2) and M (ns, 2)
+    (components along the section's height and width axes); N, N m."""
+
+    s: np.ndarray
+    N: np.ndarray
+    T: np.ndarray
+    Q: np.ndarray
+    M: np.ndarray
+
+
+@dataclass
+class Stress:
+    """Stresses at the outer fibres along a beam (Pa): the signed normal stress of largest
+    magnitude and the largest von Mises stress per station."""
+
+    s: np.ndarray
+    sigma_x: np.ndarray
+    von_mises: np.ndarray
+
+
+# -- reactions -------------------------------------------------------------------------------
+class ReactionMap:
+    """The data of a model's reactions, built once: the multiplier constraints in the full
+    coordinates, the eliminated linear rows A with a factorization of A A^T, the joints'
+    rows and the coordinates of their body2."""
+
+    def __init__(self, model: Model) -> None:
+        self.model = model
+        self.joints = getattr(model, "joint_items", {})
+        owner = getattr(model, "equation_owner", {})
+        equations = getattr(model, "full_equations", {})
+        cs = model.constraints
+        full = ConstraintSet(drive_kinds=cs.drive_kinds, drive_params=cs.drive_params)
+        for c, name in enumerate(cs.names):
+            eq = equations.get(name)
+            if isinstance(eq, LinearEquation):
+                eq = Constraint(_coordinate_kind(), [eq.expr.__class__(eq.expr.terms, 0.0)],
+                                [-eq.expr.const], None, eq.name)
+            if eq is None:  # not an equation of the system (cannot happen for joints)
+                full.add(cs.kinds[c], [({}, 0.0)], cs.params[c], cs.drives[c], name)
+                continue
+            full.add(eq.kind, [(dict(op.terms), op.const) for op in eq.operands], eq.params,
+                     cs.drives[c], name)
+        self.full = full
+        self.multiplier_owner = [owner.get(n) for n in cs.names]
+        eliminated = getattr(model, "eliminated", [])
+        self.linear_owner = [owner.get(eq.name) for eq in eliminated]
+        self.factor = None
+        if eliminated:
+            rows, cols, vals = [], [], []
+            for i, eq in enumerate(eliminated):
+                for d, a in eq.expr.terms.items():
+                    rows.append(i)
+                    cols.append(d)
+                    vals.append(a)
+            self.a = sp.csr_matrix((vals, (rows, cols)), shape=(len(eliminated), model.nfull))
+            self.factor = spla.splu(sp.csc_matrix(self.a @ self.a.T))
+        self.wanted = any(o is not None for o in self.multiplier_owner + self.linear_owner)
+
+    def residual(self, e: np.ndarray, v: np.ndarray, a: np.ndarray | None, t: float,
+                 load_factor: float) -> np.ndarray:
+        """r = M q'' + Q_int(q, q') - Q(t) in the full coordinates at the solvers' state
+        (e, e', e'')."""
+        m = self.model
+        internal = m.kernel.full_forces(t, e, v, m.contact_guesses, load_factor=load_factor)
+        constant, driven = m.full_loads
+        external = constant.copy()
+        for index, vector in driven:
+            external += m.drives[index].value(t) * vector
+        r = internal - load_factor * external
+        if a is not None:
+            r += m.mass_full @ m.expand(a, with_offset=False)
+        return r
+
+    def generalized(self, q_full: np.ndarray, lam: np.ndarray, t: float,
+                    residual: np.ndarray | None) -> dict[str, np.ndarray]:
+        """Each joint's constraint force in the full coordinates (nfull,)."""
+        n = self.model.nfull
+        out: dict[str, np.ndarray] = {}
+        total = np.zeros(n)
+        if len(self.full):
+            _, rows, cols, vals = self.full.jacobian(q_full, n, t)
+            contrib = vals * lam[rows]
+            np.add.at(total, cols, contrib)
+            for c, owner in enumerate(self.multiplier_owner):
+                if owner is None:
+                    continue
+                mask = rows == c
+                vec = out.setdefault(owner, np.zeros(n))
+                np.add.at(vec, cols[mask], contrib[mask])
+        if self.factor is not None and residual is not None:
+            mu = self.factor.solve(self.a @ (residual - total))
+            rows_a = self.a.tocoo()
+            for i, owner in enumerate(self.linear_owner):
+                if owner is None:
+                    continue
+                mask = rows_a.row == i
+                vec = out.setdefault(owner, np.zeros(n))
+                np.add.at(vec, rows_a.col[mask], rows_a.data[mask] * mu[i])
+        return out
+
+    def reactions(self, q_full: np.ndarray, lam: np.ndarray, t: float = 0.0,
+                  residual: np.ndarray | None = None) -> dict[str, Reaction]:
+        gen = self.generalized(q_full, lam, t, residual)
+        out = {}
+        for name, joint in self.joints.items():
+            out[name] = _reduce_to_point(joint, gen.get(name, np.zeros(self.model.nfull)),
+                                         q_full)
+        return out
+
+
+def _coordinate_kind() -> int:
+    from ..codes import CONSTRAINT_COORDINATE
+    return CONSTRAINT_COORDINATE
+
+
+def _vector_blocks(body) -> tuple[int, int]:
+    """(coordinates per node, number of nodes) of a body's coordinates; the first vector
+    of each node is its position."""
+    if isinstance(body, RigidBody):
+        return 12, 1
+    if isinstance(body, Beam):
+        return 12, body.nodes
+    if isinstance(body, Plate):
+        return 9, body.mesh.nnodes
+    return 0, 0
+
+
+def _joint_point(joint, q_full: np.ndarray) -> np.ndarray:
+    body = joint.body2
+    point = joint.point2 if joint.type == "distance" else joint.points[0]
+    at = body.locate(point, node=False, what=f"joint {joint.name!r}")
+    return body.position(at).value(q_full)
+
+
+def _reduce_to_point(joint, generalized: np.ndarray, q_full: np.ndarray) -> Reaction:
+    """Force and moment about the joint's point of the generalized force on body2."""
+    body = joint.body2
+    per, nodes = _vector_blocks(body)
+    point = _joint_point(joint, q_full)
+    force, moment = np.zeros(3), np.zeros(3)
+    if per:
+        block = generalized[body.first:body.first + per * nodes].reshape(nodes, per // 3, 3)
+        values = q_full[body.first:body.first + per * nodes].reshape(nodes, per // 3, 3)
+        force = block[:, 0, :].sum(axis=0)
+        moment = np.cross(values[:, 0, :] - point, block[:, 0, :]).sum(axis=0)
+        moment += np.cross(values[:, 1:, :], block[:, 1:, :]).sum(axis=(0, 1))
+    if getattr(joint, "swapped", False):
+        force, moment = -force, -moment
+    axial = None
+    if joint.type == "distance":
+        at1 = joint.body1.locate(joint.point1, node=False, what=f"joint {joint.name!r}")
+        p1 = joint.body1.position(at1).value(q_full)
+        u = point - p1
+        u /= np.linalg.norm(u)
+        on_body2 = -force if getattr(joint, "swapped", False) else force
+        axial = float(-on_body2 @ u)
+    return Reaction(force, moment, point, axial)
+
+
+def reaction_map(model: Model) -> ReactionMap:
+    """The model's reaction data (built once, kept on the model)."""
+    cached = getattr(model, "_reaction_map", None)
+    if cached is None:
+        cached = ReactionMap(model)
+        model._reaction_map = cached
+    return cached
+
+
+def reactions(model: Model, e: np.ndarray, lam: np.ndarray, *, t: float = 0.0,
+              v: np.ndarray | None = None, a: np.ndarray | None = None,
+              load_factor: float | None = None) -> dict[str, Reaction]:
+    """Reactions of every joint by name at the solved state (e: the solvers' coordinates,
+    lam: the multipliers; for a dynamic state its velocities v and accelerations a = e'').
+    Static states need neither v nor a."""
+    rm = reaction_map(model)
+    q = model.expand(e)
+    residual = None
+    if rm.factor is not None:
+        lf = model.load_factor if load_factor is None else load_factor
+        v = np.zeros(model.ndof) if v is None else v
+        residual = rm.residual(np.asarray(e, dtype=float), v, a, t, lf)
+    return rm.reactions(q, np.asarray(lam, dtype=float), t, residual)
+
+
+# -- section forces --------------------------------------------------------------------------
+def _rows(xi: np.ndarray, length: float):
+    """Coefficient rows (n, 8) of r_x, r_xx, r_y, r_z, r_y,x, r_z,x on the element's eight
+    nodal vectors [r1, r1_x, r1_y, r1_z, r2, ...] (beam_structural.centreline_rows)."""
+    z = np.zeros_like(xi)
+    o = np.ones_like(xi)
+    slope = np.column_stack([(-6 * xi + 6 * xi**2) / length, 1 - 4 * xi + 3 * xi**2, z, z,
+                             (6 * xi - 6 * xi**2) / length, 3 * xi**2 - 2 * xi, z, z])
+    second = np.column_stack([(-6 + 12 * xi) / length**2, (-4 + 6 * xi) / length, z, z,
+                              (6 - 12 * xi) / length**2, (6 * xi - 2) / length, z, z])
+    dir_y = np.column_stack([z, z, 1 - xi, z, z, z, xi, z])
+    dir_z = np.column_stack([z, z, z, 1 - xi, z, z, z, xi])
+    dir_y_x = np.column_stack([z, z, -o, z, z, z, o, z]) / length
+    dir_z_x = np.column_stack([z, z, z, -o, z, z, z, o]) / length
+    return slope, second, dir_y, dir_z, dir_y_x, dir_z_x
+
+
+def _strains(beam: Beam, vectors: np.ndarray, xi: np.ndarray) -> np.ndarray:
+    """(nel, nxi, 6) strain measures [eps, b_y, b_z, twist, gamma_y, gamma_z] of every
+    element at the local stations xi, from the nodal vectors (nel, 8, 3) (vectorized over
+    the elements)."""
+    cubic = beam.bending == "cubic"
+    data = beam.section.data
+    lengths = beam.lengths
+
+    def fields(points: np.ndarray) -> list[np.ndarray]:
+        """r_x, r_xx, r_y, r_z, r_y,x, r_z,x at the points: (nel, npoints, 3) each."""
+        out = []
+        per_element = [_rows(points, length) for length in np.unique(lengths)]
+        index = np.searchsorted(np.unique(lengths), lengths)
+        for k in range(6):
+            table = np.stack([rows_k[k] for rows_k in per_element])[index]  # (nel, np, 8)
+            out.append(np.einsum("epa,eai->epi", table, vectors))
+        return out
+
+    def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return np.einsum("epi,epi->ep", a, b)
+    rx, rxx, ry, rz, ryx, rzx = fields(xi)
+    eps = 0.5 * (dot(rx, rx) - 1.0)
+    b_y = -dot(ryx, rx)
+    b_z = -dot(rzx, rx)
+    if cubic:
+        gauss = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
+        g = fields(gauss)
+        b_y = b_y + dot(rxx, ry) - dot(g[1], g[2]).mean(axis=1)[:, None]
+        b_z = b_z + dot(rxx, rz) - dot(g[1], g[3]).mean(axis=1)[:, None]
+        twist = 0.5 * (dot(ryx, rz) - dot(rzx, ry))
+        nodal = fields(np.array([0.0, 1.0]))
+        shear_y, shear_z = dot(nodal[0], nodal[2]), dot(nodal[0], nodal[3])
+        gamma_y = shear_y[:, :1] * (1 - xi) + shear_y[:, 1:] * xi
+        gamma_z = shear_z[:, :1] * (1 - xi) + shear_z[:, 1:] * xi
+    else:
+        twist = (data.inertia_z * dot(ryx, rz) - data.inertia_y * dot(rzx, ry)) / data.polar
+        gamma_y, gamma_z = dot(rx, ry), dot(rx, rz)
+    return np.stack([eps, b_y, b_z, twist, gamma_y, gamma_z], axis=-1)
+
+
+def _beam_vectors(beam: Beam, q_full: np.ndarray) -> np.ndarray:
+    nodal = q_full[beam.first:beam.first + beam.ncoordinates].reshape(beam.nodes, 4, 3)
+    return np.concatenate([nodal[:-1], nodal[1:]], axis=1)   # (nel, 8, 3)
+
+
+def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_STATIONS,
+                        frame: np.ndarray | None = None) -> SectionForces:
+    """Section forces of one beam at ``stations`` points per element (see the module
+    documentation for the strains and the sign convention). An 'ffr' beam's strains are
+    the small-strain (linear) part in its frame, whose rotation at the state's time is
+    ``frame`` (default: the beam's frame at t = 0); every strain measure is a quadratic
+    form of the nodal vectors, so its linear part about the reference x0 is exactly
+    (f(x0 + d) - f(x0 - d)) / 2 with d the displacement in the frame."""
+    if stations < 2:
+        raise ValueError("stations must be at least 2 (both ends of each element)")
+    xi = np.linspace(0.0, 1.0, stations)
+    current = _beam_vectors(beam, q_full)
+    reference = _beam_vectors(beam, _reference_coordinates(beam, q_full))
+    strain0 = _strains(beam, reference, xi)
+    if beam.formulation == "ffr":
+        pivot = beam.frame_pivot
+        rotation0 = beam.orientation if frame is None else frame
+        local = current @ rotation0            # R^T v for every vector (rows)
+        local_ref = reference @ beam.orientation
+        local[:, [0, 4], :] -= pivot @ rotation0
+        local_ref[:, [0, 4], :] -= pivot @ beam.orientation
+        d = local - local_ref
+        # the reference in the frame is the beam's own shape (orientation at t = 0)
+        change = 0.5 * (_strains(beam, local_ref + d, xi) - _strains(beam, local_ref - d, xi))
+    else:
+        change = _strains(beam, current, xi) - strain0
+    d = change.reshape(-1, 6)
+    data, section, mat = beam.section.data, beam.section, beam.material
+    e_mod = mat.youngs_modulus
+    g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
+    k_y, k_z = section.shear_factors
+    s = (beam.stations[:-1, None] + np.outer(beam.lengths, xi)).ravel()
+    return SectionForces(
+        s=s, N=e_mod * data.area * d[:, 0], T=g_mod * section.torsion_constant * d[:, 3],
+        Q=np.column_stack([k_y * g_mod * data.area * d[:, 4], k_z * g_mod * data.area * d[:, 5]]),
+        M=np.column_stack([-e_mod * data.inertia_y * d[:, 2], e_mod * data.inertia_z * d[:, 1]]))
+
+
+def _reference_coordinates(beam: Beam, q_full: np.ndarray) -> np.ndarray:
+    ref = np.zeros_like(q_full)
+    ref[beam.first:beam.first + beam.ncoordinates] = beam.coordinates()
+    return ref
+
+
+def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS, *,
+                   t: float = 0.0) -> dict[str, SectionForces]:
+    """Section forces of every beam of the model by name at the state e (time t: where an
+    'ffr' beam's frame is)."""
+    q = model.expand(e)
+    frame_of = {s.body.name: s.frame for s in model.sets}
+    out = {}
+    for b in model.bodies:
+        if isinstance(b, Beam):
+            f = frame_of.get(b.name, 0)
+            rotation = model.frames[f - 1].rotation(t) if f else None
+            out[b.name] = beam_section_forces(b, q, stations, rotation)
+    return out
+
+
+# -- stresses --------------------------------------------------------------------------------
+def _rectangle_torsion(long: float, short: float) -> tuple[float, float]:
+    """Saint-Venant torsion of a solid rectangle (Timoshenko & Goodier, Theory of
+    Elasticity, sec. 109): J = beta a b^3 (a the long, b the short side) and k in the
+    largest shear stress tau = T b k / J, at the middle of the long sides (square:
+    beta = 0.1406, k = 0.675, tau = T / (0.208 a^3))."""
+    ratio = long / short
+    n = np.arange(1, 60, 2, dtype=float)
+    beta = (1.0 - 192.0 / np.pi**5 / ratio * np.sum(np.tanh(n * np.pi * ratio / 2) / n**5)) / 3
+    with np.errstate(over="ignore"):
+        k = 1.0 - 8.0 / np.pi**2 * np.sum(1.0 / (n**2 * np.cosh(n * np.pi * ratio / 2)))
+    return beta * long * short**3, k
+
+
+def fibre_stresses(section, forces: SectionForces) -> tuple[np.ndarray, np.ndarray]:
+    """(sigma_x, tau) at the section's fibre points for every station: (ns, npoints)."""
+    data = section.data
+    points = np.asarray(section.fibre_points, dtype=float)
+    y, z = points[:, 0], points[:, 1]
+    n, t = forces.N[:, None], forces.T[:, None]
+    q_h, q_w = forces.Q[:, 0:1], forces.Q[:, 1:2]
+    m_h, m_w = forces.M[:, 0:1], forces.M[:, 1:2]
+    sigma = n / data.area - m_w * y / data.inertia_z + m_h * z / data.inertia_y
+    half_y, half_z = section.extent
+    if isinstance(section, Rectangle):
+        long, short = max(section.height, section.width), min(section.height, section.width)
+        j_sv, k_long = _rectangle_torsion(long, short)
+        tau_max = np.abs(t) * short * k_long / j_sv
+        # along each side parabolic from zero at the corners to the largest value in its
+        # middle (on the short sides an overestimate: conservative)
+        on_y_side = np.isclose(np.abs(y), half_y)     # top and bottom (along the width)
+        u = np.where(on_y_side, z / half_z, y / half_y)
+        tau_t = tau_max * (1.0 - u**2)
+        tau_q = 1.5 * (np.abs(q_h) * (1 - (y / half_y) ** 2)
+                       + np.abs(q_w) * (1 - (z / half_z) ** 2)) / data.area
+    elif isinstance(section, Box):
+        wall = section.wall
+        h_m, w_m = section.height - wall, section.width - wall
+        tau_t = np.abs(t) / (2.0 * h_m * w_m * wall) * np.ones_like(y)
+        tau_q = (np.abs(q_h) * _box_flow(y, z, h_m, w_m, wall, data.inertia_z)
+                 + np.abs(q_w) * _box_flow(z, y, w_m, h_m, wall, data.inertia_y)) / wall
+    elif isinstance(section, (Tube, Circle)):
+        r_o = 0.5 * section.diameter
+        r_i = r_o - section.wall if isinstance(section, Tube) else 0.0
+        tau_t = np.abs(t) * r_o / section.torsion_constant * np.ones_like(y)
+        first = 2.0 / 3.0 * (r_o**3 - r_i**3)        # first moment of half the section
+        peak = first / (data.inertia_z * 2.0 * (r_o - r_i))   # tau at the neutral axis per Q
+        tau_q = peak * (np.abs(q_h) * (1 - (y / r_o) ** 2) + np.abs(q_w) * (1 - (z / r_o) ** 2))
+    else:  # a general section: torsion T r / J at the fibre's distance, mean shear
+        r = np.hypot(y, z)
+        tau_t = np.abs(t) * r / section.torsion_constant
+        tau_q = (np.abs(q_h) + np.abs(q_w)) / data.area * np.ones_like(y)
+    return sigma, tau_t + tau_q
+
+
+def _box_flow(y, z, h_m, w_m, wall, inertia) -> np.ndarray:
+    """Shear flow per unit shear force (1/m) of a thin-walled box under a shear force
+    along y (midline height h_m, width w_m): zero in the middle of the flanges, growing
+    linearly to the corners and parabolically down the webs; at an outline point (y, z)."""
+    on_flange = np.abs(np.abs(y) - (h_m + wall) / 2) < 1e-12 + 1e-9 * h_m
+    zz = np.minimum(np.abs(z), w_m / 2)
+    yy = np.minimum(np.abs(y), h_m / 2)
+    flange = wall * (h_m / 2) * zz / inertia
+    corner = wall * h_m * w_m / 4 / inertia
+    web = corner + wall * (h_m**2 / 4 - yy**2) / 2 / inertia
+    return np.where(on_flange, flange, web)
+
+
+def beam_stress(section, forces: SectionForces) -> Stress:
+    """Stresses along a beam from its section forces."""
+    sigma, tau = fibre_stresses(section, forces)
+    worst = np.argmax(np.abs(sigma), axis=1)
+    return Stress(s=forces.s, sigma_x=sigma[np.arange(len(worst)), worst],
+                  von_mises=np.sqrt(sigma**2 + 3.0 * tau**2).max(axis=1))
+
+
+def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress]:
+    """Stresses of every beam by name from its section forces."""
+    beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+    return {name: beam_stress(beams[name].section, f) for name, f in forces.items()}
+
+
+__all__ = ["Reaction", "SectionForces", "Stress", "reactions", "section_forces",
+           "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
+           "DEFAULT_STATIONS"]
