@@ -218,7 +218,34 @@ def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str
     for phase, seconds in result.timing.items():
         timing[f"settle_{phase}"] = seconds
     results.write_static(out, model, result)
+    _write_static_answers(scene, model, out, result)
     return result
+
+
+def _write_static_answers(scene: Scene, model: Model, out: Path, result: StaticResult) -> None:
+    """Reactions, section forces and stresses of the static state (SPEC section 10)."""
+    results.write_static_answers(out, model, result.e, result.lam,
+                                 scene["output"].get("stations", 3))
+
+
+def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
+                      e_start: np.ndarray):
+    """The recorder of the dynamic reactions, section forces and stress envelope (None
+    when the model has neither joints nor beams)."""
+    from .solvers.dynamic import initial_acceleration
+    from .system.answers import DynamicAnswers, reaction_map
+    from .system.bodies import Beam
+    if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies):
+        return None
+    recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
+                              alpha_m=settings.alpha_m, alpha_f=settings.alpha_f,
+                              stations=scene["output"].get("stations", 3),
+                              keep_sections=bool(scene["output"].get("sections", False)))
+    if recorder.need_acceleration:
+        v0 = np.zeros(model.ndof)
+        a0, _ = initial_acceleration(model, e_start, v0, 0.0)
+        recorder.initial = (v0, a0)
+    return recorder
 
 
 def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
@@ -232,6 +259,9 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
         # file keeps the frames only (storing every step cost a third of the FFR boom's
         # solver time and 27 MB)
         settings.store_q = True
+    recorder = _answers_recorder(scene, model, settings, e_start)
+    if recorder is not None:
+        settings.store_q = True  # the answers need every step's coordinates (not written)
     writer = results.DynamicWriter(
         out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
@@ -241,11 +271,18 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
         "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
         "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
         "generalized_alpha" else 1.0, "t_end": settings.t_end}
+    sink = writer
+    if recorder is not None:
+        def sink(chunk) -> None:
+            recorder(chunk)
+            writer(chunk)
     try:
-        dyn = integrate(model, settings, e_start, sink=writer, progress=progress,
+        dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
                         should_stop=stop)
     finally:  # also after a failure or an interrupt: every computed step goes to the file
         writer.flush()
+        if recorder is not None:
+            results.write_dynamic_answers(out, recorder)
         results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
@@ -355,6 +392,7 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
                 timing[f"static_{phase}"] = seconds
             t0 = time.perf_counter()
             results.write_static(out, model, static)
+            _write_static_answers(scene, model, out, static)
             timing["output"] = time.perf_counter() - t0
             e_start = static.e
             if analysis == "static+dynamic":

@@ -564,3 +564,96 @@ def write_dynamic_attrs(path: Path, attrs: dict[str, Any], stages: dict[str, flo
         if stages:
             stage_group = group.require_group("stages")
             _attrs(stage_group.attrs, stages)
+
+
+# -- engineering answers (SPEC section 10) -----------------------------------------------------
+def _reaction_group(group: h5py.Group, name: str, force, moment, axial) -> None:
+    sub = group.create_group(name)
+    _dataset(sub, "force", np.asarray(force, dtype=float), "N")
+    _dataset(sub, "moment", np.asarray(moment, dtype=float), "N m")
+    if axial is not None:
+        _dataset(sub, "axial", np.asarray(axial, dtype=float), "N")
+    sub.attrs["description"] = ("what body1 exerts on body2, global axes; moment about the "
+                                "joint's point on body2; axial: tension positive")
+
+
+def _section_group(group: h5py.Group, name: str, forces) -> None:
+    sub = group.create_group(name)
+    _dataset(sub, "s", forces.s, "m")
+    for key, units in (("N", "N"), ("T", "N m"), ("Q", "N"), ("M", "N m")):
+        _dataset(sub, key, getattr(forces, key), units)
+    sub.attrs["description"] = ("what the part beyond s exerts on the part before it; Q and M: "
+                                "components along the section's height and width axes")
+
+
+def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarray,
+                         stations: int = 3) -> None:
+    """/static/reactions/<joint>, /static/sections/<beam>, /static/stress/<beam> of the
+    static state (ancfdrv.system.answers), and /model/constraint_joints (the joint of each
+    row of lambda)."""
+    from ..system.answers import constraint_joints, reactions, section_forces, stresses
+    found = reactions(model, e, lam)
+    forces = section_forces(model, e, stations)
+    stress = stresses(model, forces)
+    with _open_write(path) as h5:
+        group = h5.require_group("static")
+        for key in ("reactions", "sections", "stress"):
+            if key in group:
+                del group[key]
+        if found:
+            reactions_group = group.create_group("reactions")
+            for name, r in found.items():
+                _reaction_group(reactions_group, name, r.force, r.moment, r.axial)
+        if forces:
+            sections_group = group.create_group("sections")
+            stress_group = group.create_group("stress")
+            for name, f in forces.items():
+                _section_group(sections_group, name, f)
+                sub = stress_group.create_group(name)
+                _dataset(sub, "s", f.s, "m")
+                _dataset(sub, "sigma_x", stress[name].sigma_x, "Pa")
+                _dataset(sub, "von_mises", stress[name].von_mises, "Pa")
+                k = int(np.argmax(stress[name].von_mises))
+                _attrs(sub.attrs, {"max": float(stress[name].von_mises[k]),
+                                   "s_max": float(f.s[k])})
+        if "model" in h5 and len(model.constraints):
+            if "constraint_joints" in h5["model"]:
+                del h5["model/constraint_joints"]
+            h5["model"].create_dataset("constraint_joints",
+                                       data=np.array(constraint_joints(model), dtype="S"))
+
+
+def write_dynamic_answers(path: Path, recorder) -> None:
+    """/dynamic/reactions/<joint> (leading time axis), /dynamic/sections/<beam> (when the
+    recorder keeps them) and the stress envelope /dynamic/stress/<beam> (von_mises_max,
+    t_max per station; attributes max, s_max, t_max) of a DynamicAnswers recorder."""
+    if not recorder.time:
+        return
+    with _open_write(path) as h5:
+        group = h5.require_group("dynamic")
+        for key in ("reactions", "sections", "stress"):
+            if key in group:
+                del group[key]
+        if recorder.reactions:
+            reactions_group = group.create_group("reactions")
+            for name, rows in recorder.reactions.items():
+                axial = None if rows[0].axial is None else [r.axial for r in rows]
+                _reaction_group(reactions_group, name, [r.force for r in rows],
+                                [r.moment for r in rows], axial)
+        if recorder.sections:
+            sections_group = group.create_group("sections")
+            for name, chunks in recorder.sections.items():
+                sub = sections_group.create_group(name)
+                _dataset(sub, "s", chunks[0].s, "m")
+                for key, units in (("N", "N"), ("T", "N m"), ("Q", "N"), ("M", "N m")):
+                    _dataset(sub, key, np.concatenate([getattr(c, key) for c in chunks]), units)
+        if recorder.envelope:
+            stress_group = group.create_group("stress")
+            for name, (s, best, when) in recorder.envelope.items():
+                sub = stress_group.create_group(name)
+                _dataset(sub, "s", s, "m")
+                _dataset(sub, "von_mises_max", best, "Pa")
+                _dataset(sub, "t_max", when, "s")
+                k = int(np.argmax(best))
+                _attrs(sub.attrs, {"max": float(best[k]), "s_max": float(s[k]),
+                                   "t_max": float(when[k])})

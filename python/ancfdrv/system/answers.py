@@ -130,6 +130,8 @@ class ReactionMap:
             self.a = sp.csr_matrix((vals, (rows, cols)), shape=(len(eliminated), model.nfull))
             self.factor = spla.splu(sp.csc_matrix(self.a @ self.a.T))
         self.wanted = any(o is not None for o in self.multiplier_owner + self.linear_owner)
+        self.a_coo = self.a.tocoo() if self.factor is not None else None
+        self.points = {name: _joint_points(joint) for name, joint in self.joints.items()}
 
     def residual(self, e: np.ndarray, v: np.ndarray, a: np.ndarray | None, t: float,
                  load_factor: float) -> np.ndarray:
@@ -146,31 +148,59 @@ class ReactionMap:
             r += m.mass_full @ m.expand(a, with_offset=False)
         return r
 
+    def _term_arrays(self) -> None:
+        """Flat arrays of the multiplier constraints' terms (constraint, operand slot, dof,
+        coefficient) and, per joint, which terms and eliminated-row entries fall on body2's
+        coordinates (built once)."""
+        con, slot, dof, coef = [], [], [], []
+        for c, per in enumerate(self.full.terms):
+            for k, terms in enumerate(per):
+                for d, a in terms:
+                    con.append(c)
+                    slot.append(k)
+                    dof.append(d)
+                    coef.append(a)
+        self.t_con, self.t_slot = np.array(con, dtype=np.int64), np.array(slot, dtype=np.int64)
+        self.t_dof, self.t_coef = np.array(dof, dtype=np.int64), np.array(coef, dtype=float)
+        owner_of_con = np.array([o or "" for o in self.multiplier_owner], dtype=object)
+        owner_of_row = np.array([o or "" for o in self.linear_owner], dtype=object)
+        self.selection = {}
+        for name, joint in self.joints.items():
+            first = joint.body2.first
+            size = joint.body2.ncoordinates
+            terms = np.flatnonzero((owner_of_con[self.t_con] == name) if len(self.t_con)
+                                   else np.zeros(0, dtype=bool))
+            terms = terms[(self.t_dof[terms] >= first) & (self.t_dof[terms] < first + size)]
+            entries = np.zeros(0, dtype=np.int64)
+            if self.a_coo is not None:
+                entries = np.flatnonzero(owner_of_row[self.a_coo.row] == name)
+                cols = self.a_coo.col[entries]
+                entries = entries[(cols >= first) & (cols < first + size)]
+            self.selection[name] = (terms, entries, first, size)
+
     def generalized(self, q_full: np.ndarray, lam: np.ndarray, t: float,
                     residual: np.ndarray | None) -> dict[str, np.ndarray]:
-        """Each joint's constraint force in the full coordinates (nfull,)."""
-        n = self.model.nfull
-        out: dict[str, np.ndarray] = {}
-        total = np.zeros(n)
+        """Each joint's constraint force on body2's coordinates (body2.ncoordinates,)."""
+        if not hasattr(self, "selection"):
+            self._term_arrays()
+        contrib = np.zeros(0)
         if len(self.full):
-            _, rows, cols, vals = self.full.jacobian(q_full, n, t)
-            contrib = vals * lam[rows]
-            np.add.at(total, cols, contrib)
-            for c, owner in enumerate(self.multiplier_owner):
-                if owner is None:
-                    continue
-                mask = rows == c
-                vec = out.setdefault(owner, np.zeros(n))
-                np.add.at(vec, cols[mask], contrib[mask])
+            _, gradients, *_ = self.full.evaluate(q_full, t)
+            contrib = self.t_coef * gradients[self.t_slot, self.t_con] * lam[self.t_con]
+        mu = None
         if self.factor is not None and residual is not None:
+            total = np.bincount(self.t_dof, contrib, minlength=self.model.nfull) \
+                if len(contrib) else np.zeros(self.model.nfull)
             mu = self.factor.solve(self.a @ (residual - total))
-            rows_a = self.a.tocoo()
-            for i, owner in enumerate(self.linear_owner):
-                if owner is None:
-                    continue
-                mask = rows_a.row == i
-                vec = out.setdefault(owner, np.zeros(n))
-                np.add.at(vec, rows_a.col[mask], rows_a.data[mask] * mu[i])
+        out = {}
+        for name, (terms, entries, first, size) in self.selection.items():
+            vec = np.bincount(self.t_dof[terms] - first, contrib[terms], minlength=size) \
+                if len(terms) else np.zeros(size)
+            if mu is not None and len(entries):
+                a = self.a_coo
+                vec += np.bincount(a.col[entries] - first, a.data[entries] * mu[a.row[entries]],
+                                   minlength=size)
+            out[name] = vec
         return out
 
     def reactions(self, q_full: np.ndarray, lam: np.ndarray, t: float = 0.0,
@@ -178,8 +208,7 @@ class ReactionMap:
         gen = self.generalized(q_full, lam, t, residual)
         out = {}
         for name, joint in self.joints.items():
-            out[name] = _reduce_to_point(joint, gen.get(name, np.zeros(self.model.nfull)),
-                                         q_full)
+            out[name] = _reduce_to_point(joint, gen[name], q_full, self.points[name])
         return out
 
 
@@ -200,35 +229,48 @@ def _vector_blocks(body) -> tuple[int, int]:
     return 0, 0
 
 
-def _joint_point(joint, q_full: np.ndarray) -> np.ndarray:
+def _joint_points(joint) -> tuple:
+    """The joint's point on body2 (and for a distance joint point1 on body1) as
+    expressions in the full coordinates."""
+    where = f"joint {joint.name!r}"
     body = joint.body2
     point = joint.point2 if joint.type == "distance" else joint.points[0]
-    at = body.locate(point, node=False, what=f"joint {joint.name!r}")
-    return body.position(at).value(q_full)
+    p2 = body.position(body.locate(point, node=False, what=where))
+    p1 = None
+    if joint.type == "distance":
+        p1 = joint.body1.position(joint.body1.locate(joint.point1, node=False, what=where))
+    return p2, p1
 
 
-def _reduce_to_point(joint, generalized: np.ndarray, q_full: np.ndarray) -> Reaction:
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b along the last axis (broadcast), without np.cross's overhead."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+def _reduce_to_point(joint, generalized: np.ndarray, q_full: np.ndarray,
+                     points: tuple) -> Reaction:
     """Force and moment about the joint's point of the generalized force on body2."""
     body = joint.body2
     per, nodes = _vector_blocks(body)
-    point = _joint_point(joint, q_full)
+    p2, p1 = points
+    point = p2.value(q_full)
     force, moment = np.zeros(3), np.zeros(3)
     if per:
-        block = generalized[body.first:body.first + per * nodes].reshape(nodes, per // 3, 3)
+        block = generalized.reshape(nodes, per // 3, 3)
         values = q_full[body.first:body.first + per * nodes].reshape(nodes, per // 3, 3)
         force = block[:, 0, :].sum(axis=0)
-        moment = np.cross(values[:, 0, :] - point, block[:, 0, :]).sum(axis=0)
-        moment += np.cross(values[:, 1:, :], block[:, 1:, :]).sum(axis=(0, 1))
-    if getattr(joint, "swapped", False):
+        moment = _cross(values[:, 0, :] - point, block[:, 0, :]).sum(axis=0)
+        moment += _cross(values[:, 1:, :], block[:, 1:, :]).sum(axis=(0, 1))
+    swapped = getattr(joint, "swapped", False)
+    if swapped:
         force, moment = -force, -moment
     axial = None
-    if joint.type == "distance":
-        at1 = joint.body1.locate(joint.point1, node=False, what=f"joint {joint.name!r}")
-        p1 = joint.body1.position(at1).value(q_full)
-        u = point - p1
+    if p1 is not None:
+        u = point - p1.value(q_full)
         u /= np.linalg.norm(u)
-        on_body2 = -force if getattr(joint, "swapped", False) else force
-        axial = float(-on_body2 @ u)
+        axial = float((force if swapped else -force) @ u)
     return Reaction(force, moment, point, axial)
 
 
@@ -274,106 +316,133 @@ def _rows(xi: np.ndarray, length: float):
     return slope, second, dir_y, dir_z, dir_y_x, dir_z_x
 
 
-def _strains(beam: Beam, vectors: np.ndarray, xi: np.ndarray) -> np.ndarray:
-    """(nel, nxi, 6) strain measures [eps, b_y, b_z, twist, gamma_y, gamma_z] of every
-    element at the local stations xi, from the nodal vectors (nel, 8, 3) (vectorized over
-    the elements)."""
+class _Tables:
+    """A beam's coefficient rows at the stations, the Gauss points and the element ends
+    (per element: (nel, npoints, 8) for each of the six fields) and its reference strains."""
+
+    def __init__(self, beam: Beam, stations: int) -> None:
+        self.xi = np.linspace(0.0, 1.0, stations)
+        gauss = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
+        unique, index = np.unique(beam.lengths, return_inverse=True)
+
+        def table(points: np.ndarray) -> list[np.ndarray]:
+            per = [_rows(points, length) for length in unique]
+            return [np.stack([rows[k] for rows in per])[index] for k in range(6)]
+        self.at, self.gauss, self.ends = table(self.xi), table(gauss), table(np.array([0.0, 1.0]))
+        self.s = (beam.stations[:-1, None] + np.outer(beam.lengths, self.xi)).ravel()
+        self.reference = _beam_vectors(beam, beam.coordinates(), 0)
+        self.strain0 = _strains(beam, self.reference, self)
+
+
+def _tables(beam: Beam, stations: int) -> _Tables:
+    cache = beam.__dict__.setdefault("_answer_tables", {})
+    if stations not in cache:
+        cache[stations] = _Tables(beam, stations)
+    return cache[stations]
+
+
+def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
+    """(..., nel, nxi, 6) strain measures [eps, b_y, b_z, twist, gamma_y, gamma_z] of
+    every element at the stations, from the nodal vectors (..., nel, 8, 3) (vectorized over
+    the elements and any leading axes, e.g. time rows)."""
     cubic = beam.bending == "cubic"
     data = beam.section.data
-    lengths = beam.lengths
+    xi = tables.xi
 
-    def fields(points: np.ndarray) -> list[np.ndarray]:
-        """r_x, r_xx, r_y, r_z, r_y,x, r_z,x at the points: (nel, npoints, 3) each."""
-        out = []
-        per_element = [_rows(points, length) for length in np.unique(lengths)]
-        index = np.searchsorted(np.unique(lengths), lengths)
-        for k in range(6):
-            table = np.stack([rows_k[k] for rows_k in per_element])[index]  # (nel, np, 8)
-            out.append(np.einsum("epa,eai->epi", table, vectors))
-        return out
+    def fields(table: list[np.ndarray]) -> list[np.ndarray]:
+        return [np.einsum("epa,...eai->...epi", t, vectors) for t in table]
 
     def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return np.einsum("epi,epi->ep", a, b)
-    rx, rxx, ry, rz, ryx, rzx = fields(xi)
+        return np.einsum("...i,...i->...", a, b)
+    rx, rxx, ry, rz, ryx, rzx = fields(tables.at)
     eps = 0.5 * (dot(rx, rx) - 1.0)
     b_y = -dot(ryx, rx)
     b_z = -dot(rzx, rx)
     if cubic:
-        gauss = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
-        g = fields(gauss)
-        b_y = b_y + dot(rxx, ry) - dot(g[1], g[2]).mean(axis=1)[:, None]
-        b_z = b_z + dot(rxx, rz) - dot(g[1], g[3]).mean(axis=1)[:, None]
+        g = fields(tables.gauss)
+        b_y = b_y + dot(rxx, ry) - dot(g[1], g[2]).mean(axis=-1)[..., None]
+        b_z = b_z + dot(rxx, rz) - dot(g[1], g[3]).mean(axis=-1)[..., None]
         twist = 0.5 * (dot(ryx, rz) - dot(rzx, ry))
-        nodal = fields(np.array([0.0, 1.0]))
+        nodal = fields(tables.ends)
         shear_y, shear_z = dot(nodal[0], nodal[2]), dot(nodal[0], nodal[3])
-        gamma_y = shear_y[:, :1] * (1 - xi) + shear_y[:, 1:] * xi
-        gamma_z = shear_z[:, :1] * (1 - xi) + shear_z[:, 1:] * xi
+        gamma_y = shear_y[..., :1] * (1 - xi) + shear_y[..., 1:] * xi
+        gamma_z = shear_z[..., :1] * (1 - xi) + shear_z[..., 1:] * xi
     else:
         twist = (data.inertia_z * dot(ryx, rz) - data.inertia_y * dot(rzx, ry)) / data.polar
         gamma_y, gamma_z = dot(rx, ry), dot(rx, rz)
     return np.stack([eps, b_y, b_z, twist, gamma_y, gamma_z], axis=-1)
 
 
-def _beam_vectors(beam: Beam, q_full: np.ndarray) -> np.ndarray:
-    nodal = q_full[beam.first:beam.first + beam.ncoordinates].reshape(beam.nodes, 4, 3)
-    return np.concatenate([nodal[:-1], nodal[1:]], axis=1)   # (nel, 8, 3)
+def _beam_vectors(beam: Beam, q_full: np.ndarray, first: int | None = None) -> np.ndarray:
+    """The elements' nodal vectors (..., nel, 8, 3) from coordinates (..., n) holding the
+    beam's from ``first`` (default: the beam's first coordinate)."""
+    first = beam.first if first is None else first
+    block = q_full[..., first:first + beam.ncoordinates]
+    nodal = block.reshape(*block.shape[:-1], beam.nodes, 4, 3)
+    return np.concatenate([nodal[..., :-1, :, :], nodal[..., 1:, :, :]], axis=-2)
 
 
 def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_STATIONS,
                         frame: np.ndarray | None = None) -> SectionForces:
     """Section forces of one beam at ``stations`` points per element (see the module
-    documentation for the strains and the sign convention). An 'ffr' beam's strains are
-    the small-strain (linear) part in its frame, whose rotation at the state's time is
-    ``frame`` (default: the beam's frame at t = 0); every strain measure is a quadratic
-    form of the nodal vectors, so its linear part about the reference x0 is exactly
-    (f(x0 + d) - f(x0 - d)) / 2 with d the displacement in the frame."""
+    documentation for the strains and the sign convention) from the full coordinates
+    (nfull,) or rows of them (nt, nfull): the arrays then have a leading time axis. An
+    'ffr' beam's strains are the small-strain (linear) part in its frame, whose rotation
+    is ``frame`` ((3, 3) or (nt, 3, 3); default: the beam's frame at t = 0); every strain
+    measure is a quadratic form of the nodal vectors, so its linear part about the
+    reference x0 is exactly (f(x0 + d) - f(x0 - d)) / 2 with d the displacement in the
+    frame."""
     if stations < 2:
         raise ValueError("stations must be at least 2 (both ends of each element)")
-    xi = np.linspace(0.0, 1.0, stations)
-    current = _beam_vectors(beam, q_full)
-    reference = _beam_vectors(beam, _reference_coordinates(beam, q_full))
-    strain0 = _strains(beam, reference, xi)
+    tables = _tables(beam, stations)
+    current = _beam_vectors(beam, np.asarray(q_full, dtype=float))
     if beam.formulation == "ffr":
-        pivot = beam.frame_pivot
-        rotation0 = beam.orientation if frame is None else frame
-        local = current @ rotation0            # R^T v for every vector (rows)
-        local_ref = reference @ beam.orientation
-        local[:, [0, 4], :] -= pivot @ rotation0
-        local_ref[:, [0, 4], :] -= pivot @ beam.orientation
+        rotation = beam.orientation if frame is None else np.asarray(frame, dtype=float)
+        if rotation.ndim == 3:   # per row: R^T v for every vector
+            local = np.einsum("teai,tij->teaj", current, rotation)
+            shift = np.einsum("i,tij->tj", beam.frame_pivot, rotation)[:, None, None, :]
+        else:
+            local = current @ rotation
+            shift = beam.frame_pivot @ rotation
+        local = local.copy()
+        local[..., [0, 4], :] -= shift
+        local_ref = tables.reference @ beam.orientation
+        local_ref[..., [0, 4], :] -= beam.frame_pivot @ beam.orientation
         d = local - local_ref
-        # the reference in the frame is the beam's own shape (orientation at t = 0)
-        change = 0.5 * (_strains(beam, local_ref + d, xi) - _strains(beam, local_ref - d, xi))
+        change = 0.5 * (_strains(beam, local_ref + d, tables)
+                        - _strains(beam, local_ref - d, tables))
     else:
-        change = _strains(beam, current, xi) - strain0
-    d = change.reshape(-1, 6)
+        change = _strains(beam, current, tables) - tables.strain0
+    d = change.reshape(*change.shape[:-3], -1, 6)
     data, section, mat = beam.section.data, beam.section, beam.material
     e_mod = mat.youngs_modulus
     g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
     k_y, k_z = section.shear_factors
-    s = (beam.stations[:-1, None] + np.outer(beam.lengths, xi)).ravel()
     return SectionForces(
-        s=s, N=e_mod * data.area * d[:, 0], T=g_mod * section.torsion_constant * d[:, 3],
-        Q=np.column_stack([k_y * g_mod * data.area * d[:, 4], k_z * g_mod * data.area * d[:, 5]]),
-        M=np.column_stack([-e_mod * data.inertia_y * d[:, 2], e_mod * data.inertia_z * d[:, 1]]))
-
-
-def _reference_coordinates(beam: Beam, q_full: np.ndarray) -> np.ndarray:
-    ref = np.zeros_like(q_full)
-    ref[beam.first:beam.first + beam.ncoordinates] = beam.coordinates()
-    return ref
+        s=tables.s, N=e_mod * data.area * d[..., 0],
+        T=g_mod * section.torsion_constant * d[..., 3],
+        Q=np.stack([k_y * g_mod * data.area * d[..., 4], k_z * g_mod * data.area * d[..., 5]],
+                   axis=-1),
+        M=np.stack([-e_mod * data.inertia_y * d[..., 2], e_mod * data.inertia_z * d[..., 1]],
+                   axis=-1))
 
 
 def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS, *,
-                   t: float = 0.0) -> dict[str, SectionForces]:
+                   t: float | np.ndarray = 0.0) -> dict[str, SectionForces]:
     """Section forces of every beam of the model by name at the state e (time t: where an
-    'ffr' beam's frame is)."""
+    'ffr' beam's frame is); e may hold rows of states (nt, ndof) at the times t (nt,):
+    the arrays then have a leading time axis."""
     q = model.expand(e)
     frame_of = {s.body.name: s.frame for s in model.sets}
     out = {}
     for b in model.bodies:
         if isinstance(b, Beam):
             f = frame_of.get(b.name, 0)
-            rotation = model.frames[f - 1].rotation(t) if f else None
+            rotation = None
+            if f:
+                info = model.frames[f - 1]
+                rotation = np.array([info.rotation(float(x)) for x in np.atleast_1d(t)]) \
+                    if np.ndim(t) else info.rotation(float(t))
             out[b.name] = beam_section_forces(b, q, stations, rotation)
     return out
 
@@ -393,13 +462,13 @@ def _rectangle_torsion(long: float, short: float) -> tuple[float, float]:
 
 
 def fibre_stresses(section, forces: SectionForces) -> tuple[np.ndarray, np.ndarray]:
-    """(sigma_x, tau) at the section's fibre points for every station: (ns, npoints)."""
+    """(sigma_x, tau) at the section's fibre points for every station: (..., ns, npoints)."""
     data = section.data
     points = np.asarray(section.fibre_points, dtype=float)
     y, z = points[:, 0], points[:, 1]
-    n, t = forces.N[:, None], forces.T[:, None]
-    q_h, q_w = forces.Q[:, 0:1], forces.Q[:, 1:2]
-    m_h, m_w = forces.M[:, 0:1], forces.M[:, 1:2]
+    n, t = forces.N[..., None], forces.T[..., None]
+    q_h, q_w = forces.Q[..., 0:1], forces.Q[..., 1:2]
+    m_h, m_w = forces.M[..., 0:1], forces.M[..., 1:2]
     sigma = n / data.area - m_w * y / data.inertia_z + m_h * z / data.inertia_y
     half_y, half_z = section.extent
     if isinstance(section, Rectangle):
@@ -449,9 +518,9 @@ def _box_flow(y, z, h_m, w_m, wall, inertia) -> np.ndarray:
 def beam_stress(section, forces: SectionForces) -> Stress:
     """Stresses along a beam from its section forces."""
     sigma, tau = fibre_stresses(section, forces)
-    worst = np.argmax(np.abs(sigma), axis=1)
-    return Stress(s=forces.s, sigma_x=sigma[np.arange(len(worst)), worst],
-                  von_mises=np.sqrt(sigma**2 + 3.0 * tau**2).max(axis=1))
+    worst = np.argmax(np.abs(sigma), axis=-1)[..., None]
+    return Stress(s=forces.s, sigma_x=np.take_along_axis(sigma, worst, axis=-1)[..., 0],
+                  von_mises=np.sqrt(sigma**2 + 3.0 * tau**2).max(axis=-1))
 
 
 def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress]:
@@ -460,6 +529,90 @@ def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress
     return {name: beam_stress(beams[name].section, f) for name, f in forces.items()}
 
 
+def constraint_joints(model: Model) -> list[str]:
+    """The joint each multiplier (row of lambda) belongs to ('' for a body's own
+    constraints: a rigid body's orthonormality, a planar guide)."""
+    owner = getattr(model, "equation_owner", {})
+    return [owner.get(name, "") for name in model.constraints.names]
+
+
+class DynamicAnswers:
+    """Reactions, section forces and the stress envelope of a dynamic run, row by row
+    from the chunks of the stepper (a sink: ``recorder(chunk)``; the chunks must carry q).
+
+    The eliminated joints' reactions need the accelerations: they are rebuilt from the
+    coordinates of consecutive rows by the integrator's own relations (time_integrator:
+    e_{n+1} = e_n + h e'_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}),
+    e'_{n+1} = e'_n + h ((1 - gamma) a_n + gamma a_{n+1}), (1 - alpha_m) a_{n+1} + alpha_m
+    a_n = (1 - alpha_f) e''_{n+1} + alpha_f e''_n) from the initial state (v0, a0)."""
+
+    def __init__(self, model: Model, *, beta: float, gamma: float, alpha_m: float,
+                 alpha_f: float, stations: int = DEFAULT_STATIONS, keep_sections: bool = False,
+                 initial: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        self.model, self.stations, self.keep_sections = model, stations, keep_sections
+        self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
+        self.map = reaction_map(model)
+        self.need_acceleration = self.map.factor is not None
+        self.initial = initial
+        self.state: tuple | None = None
+        self.time: list[float] = []
+        self.reactions: dict[str, list[Reaction]] = {name: [] for name in self.map.joints}
+        self.sections: dict[str, list[SectionForces]] = {}
+        self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self.beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+
+    def _kinematics(self, t: float, e: np.ndarray):
+        """(e', e'') at the row, rebuilt from the previous row."""
+        if self.state is None:
+            v, a = self.initial if self.initial is not None else \
+                (np.zeros_like(e), np.zeros_like(e))
+            self.state = (t, e.copy(), v.copy(), a.copy(), a.copy())
+            return v, a
+        t0, e0, v0, a0, accel0 = self.state
+        h = t - t0
+        b, g, am, af = self.beta, self.gamma, self.alpha_m, self.alpha_f
+        a1 = (e - e0 - h * v0 - h * h * (0.5 - b) * a0) / (b * h * h)
+        v1 = v0 + h * ((1.0 - g) * a0 + g * a1)
+        accel1 = ((1.0 - am) * a1 + am * a0 - af * accel0) / (1.0 - af)
+        self.state = (t, e.copy(), v1, a1, accel1)
+        return v1, accel1
+
+    def __call__(self, chunk) -> None:
+        if chunk.q is None:
+            raise ValueError("DynamicAnswers needs the coordinates of every step (store_q)")
+        times = np.asarray(chunk.time, dtype=float)
+        if not len(times):
+            return
+        for row, t in enumerate(times):
+            e = chunk.q[row]
+            t = float(t)
+            if self.need_acceleration:
+                v, accel = self._kinematics(t, e)
+                found = reactions(self.model, e, chunk.lam[row], t=t, v=v, a=accel)
+            else:
+                found = reactions(self.model, e, chunk.lam[row], t=t)
+            for name, r in found.items():
+                self.reactions[name].append(r)
+        self.time.extend(times.tolist())
+        if not self.beams:
+            return
+        forces = section_forces(self.model, np.asarray(chunk.q), self.stations, t=times)
+        for name, f in forces.items():
+            if self.keep_sections:
+                self.sections.setdefault(name, []).append(f)
+            vm = beam_stress(self.beams[name].section, f).von_mises   # (nt, ns)
+            row = np.argmax(vm, axis=0)
+            peak = vm[row, np.arange(vm.shape[1])]
+            if name not in self.envelope:
+                self.envelope[name] = (f.s, peak.copy(), times[row].copy())
+            else:
+                _, best, when = self.envelope[name]
+                higher = peak > best
+                best[higher] = peak[higher]
+                when[higher] = times[row][higher]
+
+
 __all__ = ["Reaction", "SectionForces", "Stress", "reactions", "section_forces",
            "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
-           "DEFAULT_STATIONS"]
+           "DEFAULT_STATIONS",
+           "DynamicAnswers", "constraint_joints"]
