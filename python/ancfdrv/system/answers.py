@@ -329,6 +329,15 @@ class _Tables:
             per = [_rows(points, length) for length in unique]
             return [np.stack([rows[k] for rows in per])[index] for k in range(6)]
         self.at, self.gauss, self.ends = table(self.xi), table(gauss), table(np.array([0.0, 1.0]))
+        # the axial strain at the element's three axial Gauss points (the element's own
+        # sampling, beam_structural n_axial = 3), and the quadratic through them at the
+        # stations: the Green strain between them carries the spurious share of the
+        # bending slopes (v'^2/2 is quartic where u' is quadratic: membrane locking)
+        axial = 0.5 + np.array([-1.0, 0.0, 1.0]) * np.sqrt(0.15)
+        self.axial = table(axial)
+        self.axial_fit = np.array([[np.prod([(x - axial[m]) / (axial[k] - axial[m])
+                                             for m in range(3) if m != k]) for k in range(3)]
+                                   for x in self.xi])   # (nxi, 3) Lagrange weights
         self.s = (beam.stations[:-1, None] + np.outer(beam.lengths, self.xi)).ravel()
         self.reference = _beam_vectors(beam, beam.coordinates(), 0)
         self.strain0 = _strains(beam, self.reference, self)
@@ -355,7 +364,8 @@ def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
     def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return np.einsum("...i,...i->...", a, b)
     rx, rxx, ry, rz, ryx, rzx = fields(tables.at)
-    eps = 0.5 * (dot(rx, rx) - 1.0)
+    slope = np.einsum("epa,...eai->...epi", tables.axial[0], vectors)
+    eps = np.einsum("pk,...ek->...ep", tables.axial_fit, 0.5 * (dot(slope, slope) - 1.0))
     b_y = -dot(ryx, rx)
     b_z = -dot(rzx, rx)
     if cubic:
@@ -370,7 +380,12 @@ def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
     else:
         twist = (data.inertia_z * dot(ryx, rz) - data.inertia_y * dot(rzx, ry)) / data.polar
         gamma_y, gamma_z = dot(rx, ry), dot(rx, rz)
-    return np.stack([eps, b_y, b_z, twist, gamma_y, gamma_z], axis=-1)
+    # the directors' rates along the section normal n: the bending strains' share of the
+    # force on the section along n (their variation with r_x, -r_y,x . delta r_x)
+    normal = np.cross(ry, rz)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    c_y, c_z = -dot(ryx, normal), -dot(rzx, normal)
+    return np.stack([eps, b_y, b_z, twist, gamma_y, gamma_z, c_y, c_z], axis=-1)
 
 
 def _beam_vectors(beam: Beam, q_full: np.ndarray, first: int | None = None) -> np.ndarray:
@@ -412,14 +427,20 @@ def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_
         change = 0.5 * (_strains(beam, local_ref + d, tables)
                         - _strains(beam, local_ref - d, tables))
     else:
-        change = _strains(beam, current, tables) - tables.strain0
-    d = change.reshape(*change.shape[:-3], -1, 6)
+        now = _strains(beam, current, tables)
+        change = now - tables.strain0
+    d = change.reshape(*change.shape[:-3], -1, 8)
     data, section, mat = beam.section.data, beam.section, beam.material
     e_mod = mat.youngs_modulus
     g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
     k_y, k_z = section.shear_factors
+    axial = e_mod * data.area * d[..., 0]
+    if beam.formulation != "ffr":   # large deformation: the bending strains' axial share
+        rates = now[..., 6:].reshape(*d.shape[:-1], 2)
+        axial = axial + e_mod * (data.inertia_z * d[..., 1] * rates[..., 0]
+                                 + data.inertia_y * d[..., 2] * rates[..., 1])
     return SectionForces(
-        s=tables.s, N=e_mod * data.area * d[..., 0],
+        s=tables.s, N=axial,
         T=g_mod * section.torsion_constant * d[..., 3],
         Q=np.stack([k_y * g_mod * data.area * d[..., 4], k_z * g_mod * data.area * d[..., 5]],
                    axis=-1),
