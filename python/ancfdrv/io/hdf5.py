@@ -619,8 +619,12 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
         if "model" in h5 and len(model.constraints):
             if "constraint_joints" in h5["model"]:
                 del h5["model/constraint_joints"]
-            h5["model"].create_dataset("constraint_joints",
-                                       data=np.array(constraint_joints(model), dtype="S"))
+            names = h5["model"].create_dataset("constraint_joints",
+                                               data=np.array(constraint_joints(model),
+                                                             dtype="S"))
+            names.attrs["units"] = "name"
+            names.attrs["description"] = ("the joint each row of lambda belongs to (empty: "
+                                          "a body's own constraint)")
 
 
 def write_dynamic_answers(path: Path, recorder) -> None:
@@ -657,3 +661,43 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 k = int(np.argmax(best))
                 _attrs(sub.attrs, {"max": float(best[k]), "s_max": float(s[k]),
                                    "t_max": float(when[k])})
+
+
+def answer_headlines(path: Path) -> list[str]:
+    """The headline engineering figures of a result file (``ancf info``): the largest
+    reaction (static, and over the dynamic run with its time) and the largest von Mises
+    stress (static, and the dynamic envelope's, where and when). Empty when the file has
+    none of them."""
+    lines: list[str] = []
+    with open_result(path) as h5:
+        for phase in ("static", "dynamic"):
+            if phase not in h5:
+                continue
+            group = h5[phase]
+            if "reactions" in group:
+                best = None
+                for name, sub in group["reactions"].items():
+                    force = np.atleast_2d(sub["force"][()])
+                    size = np.linalg.norm(force, axis=1)
+                    k = int(np.argmax(size))
+                    if best is None or size[k] > best[1]:
+                        best = (name, float(size[k]), k, force[k])
+                if best is not None:
+                    when = ""
+                    if phase == "dynamic" and "time" in group:
+                        when = f" at t = {float(group['time'][best[2]]):.6g} s"
+                    force = ", ".join(f"{x:.6g}" for x in best[3])
+                    lines.append(f"{phase + '.largest_reaction':32s} joint {best[0]!r}: "
+                                 f"|F| = {best[1]:.6g} N ({force}){when}")
+            if "stress" in group:
+                best = None
+                for name, sub in group["stress"].items():
+                    peak = float(sub.attrs.get("max", 0.0))
+                    if best is None or peak > best[1]:
+                        best = (name, peak, float(sub.attrs.get("s_max", 0.0)),
+                                sub.attrs.get("t_max"))
+                if best is not None:
+                    when = "" if best[3] is None else f" at t = {float(best[3]):.6g} s"
+                    lines.append(f"{phase + '.largest_von_mises':32s} {best[1] / 1e6:.6g} MPa "
+                                 f"in beam {best[0]!r} at s = {best[2]:.6g} m{when}")
+    return lines
