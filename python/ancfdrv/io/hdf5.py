@@ -661,6 +661,7 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 k = int(np.argmax(best))
                 _attrs(sub.attrs, {"max": float(best[k]), "s_max": float(s[k]),
                                    "t_max": float(when[k])})
+            _stress_points(h5, stress_group, recorder)
 
 
 def answer_headlines(path: Path) -> list[str]:
@@ -701,3 +702,31 @@ def answer_headlines(path: Path) -> list[str]:
                     lines.append(f"{phase + '.largest_von_mises':32s} {best[1] / 1e6:.6g} MPa "
                                  f"in beam {best[0]!r} at s = {best[2]:.6g} m{when}")
     return lines
+
+
+def _stress_points(h5: h5py.File, stress_group: h5py.Group, recorder) -> None:
+    """/dynamic/stress/points_von_mises_max: the von Mises envelope at the XDMF mesh's
+    points (/model/mesh; a beam node takes the larger value of the two element ends that
+    meet there; other points 0), the node field ParaView colours the beams by."""
+    if "model/mesh" not in h5:
+        return
+    mesh = h5["model/mesh"]
+    values = np.zeros(len(mesh["points"]))
+    ranges = {}
+    for line in str(mesh.attrs.get("bodies", "")).split("\n"):
+        name, _, rest = line.rpartition(": ")
+        if rest.startswith("beam, points "):
+            first, last = rest.removeprefix("beam, points ").split("..")
+            ranges[name] = (int(first), int(last))
+    for name, (_, best, _) in recorder.envelope.items():
+        if name not in ranges:
+            continue
+        first, last = ranges[name]
+        nodes = last - first + 1
+        per = len(best) // max(nodes - 1, 1)
+        ends = best.reshape(nodes - 1, per)
+        node_values = np.zeros(nodes)
+        node_values[:-1] = ends[:, 0]
+        node_values[1:] = np.maximum(node_values[1:], ends[:, -1])
+        values[first:last + 1] = node_values
+    _dataset(stress_group, "points_von_mises_max", values, "Pa")
