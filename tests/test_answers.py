@@ -472,7 +472,7 @@ def test_run_writes_the_answers_by_name(tmp_path):
         assert env["von_mises_max"].shape == (27,)
         assert env.attrs["max"] == pytest.approx(env["von_mises_max"][()].max())
         # the envelope at the beam's nodes, the field ParaView colours the beam by
-        points = h5["dynamic/stress/points_von_mises_max"][()]
+        points = h5["dynamic/mesh_von_mises_max"][()]
         assert points.max() == pytest.approx(env.attrs["max"])
     assert "von_mises_max" in out.with_suffix(".xdmf").read_text()
     from ancfdrv.io.hdf5 import answer_headlines

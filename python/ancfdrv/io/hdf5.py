@@ -661,7 +661,7 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 k = int(np.argmax(best))
                 _attrs(sub.attrs, {"max": float(best[k]), "s_max": float(s[k]),
                                    "t_max": float(when[k])})
-            _stress_points(h5, stress_group, recorder)
+            _stress_points(h5, group, recorder)
 
 
 def answer_headlines(path: Path) -> list[str]:
@@ -704,8 +704,8 @@ def answer_headlines(path: Path) -> list[str]:
     return lines
 
 
-def _stress_points(h5: h5py.File, stress_group: h5py.Group, recorder) -> None:
-    """/dynamic/stress/points_von_mises_max: the von Mises envelope at the XDMF mesh's
+def _stress_points(h5: h5py.File, group: h5py.Group, recorder) -> None:
+    """/dynamic/mesh_von_mises_max: the von Mises envelope at the XDMF mesh's
     points (/model/mesh; a beam node takes the larger value of the two element ends that
     meet there; other points 0), the node field ParaView colours the beams by."""
     if "model/mesh" not in h5:
@@ -729,4 +729,6 @@ def _stress_points(h5: h5py.File, stress_group: h5py.Group, recorder) -> None:
         node_values[:-1] = ends[:, 0]
         node_values[1:] = np.maximum(node_values[1:], ends[:, -1])
         values[first:last + 1] = node_values
-    _dataset(stress_group, "points_von_mises_max", values, "Pa")
+    if "mesh_von_mises_max" in group:
+        del group["mesh_von_mises_max"]
+    _dataset(group, "mesh_von_mises_max", values, "Pa")

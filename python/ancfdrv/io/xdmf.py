@@ -242,7 +242,7 @@ def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
         kind, dims, topology_data, ncells, npoints = _topology_of(h5)
         add_step_views(h5, 0, nframes, existing=True)  # those the writer has not made
         displacement = "dynamic/mesh_displacement" in h5
-        stress_points = "dynamic/stress/points_von_mises_max" in h5
+        stress_points = "dynamic/mesh_von_mises_max" in h5
     root = ET.Element("Xdmf", Version="3.0")
     domain = ET.SubElement(root, "Domain")
     series = ET.SubElement(domain, "Grid", Name="motion", GridType="Collection",
@@ -264,7 +264,7 @@ def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
         if stress_points:  # the run's von Mises envelope at the beam nodes (Pa)
             attribute = ET.SubElement(grid, "Attribute", Name="von_mises_max",
                                       AttributeType="Scalar", Center="Node")
-            _item(attribute, (npoints,), name, "/dynamic/stress/points_von_mises_max")
+            _item(attribute, (npoints,), name, "/dynamic/mesh_von_mises_max")
     out = target.with_suffix(".xdmf")
     partial = out.with_name(out.name + ".partial")
     ET.ElementTree(root).write(partial, encoding="utf-8", xml_declaration=True)
