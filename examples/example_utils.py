@@ -151,6 +151,8 @@ class ResultFile:
 
     def static(self, result: StaticResult) -> None:
         hdf5.write_static(self.path, self.model, result)
+        # reactions by joint name, section forces and stresses (SPEC section 10)
+        hdf5.write_static_answers(self.path, self.model, result.e, result.lam)
 
     def recorder(self, store_q: bool = False) -> Recorder:
         return Recorder(self.model, self.path, store_q)
