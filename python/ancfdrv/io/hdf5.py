@@ -640,10 +640,12 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 del group[key]
         if recorder.reactions:
             reactions_group = group.create_group("reactions")
-            for name, rows in recorder.reactions.items():
-                axial = None if rows[0].axial is None else [r.axial for r in rows]
-                _reaction_group(reactions_group, name, [r.force for r in rows],
-                                [r.moment for r in rows], axial)
+            for name, chunks in recorder.reactions.items():
+                if not chunks:
+                    continue
+                axial = None if chunks[0][2] is None else np.concatenate([c[2] for c in chunks])
+                _reaction_group(reactions_group, name, np.concatenate([c[0] for c in chunks]),
+                                np.concatenate([c[1] for c in chunks]), axial)
         if recorder.sections:
             sections_group = group.create_group("sections")
             for name, chunks in recorder.sections.items():

@@ -178,38 +178,85 @@ class ReactionMap:
                 entries = entries[(cols >= first) & (cols < first + size)]
             self.selection[name] = (terms, entries, first, size)
 
-    def generalized(self, q_full: np.ndarray, lam: np.ndarray, t: float,
-                    residual: np.ndarray | None) -> dict[str, np.ndarray]:
-        """Each joint's constraint force on body2's coordinates (body2.ncoordinates,)."""
+    def _gradients(self, q_full: np.ndarray, t: float) -> np.ndarray:
+        """The multiplier constraints' operand gradients (6, ncon) at (q, t) from the kernel
+        (ConstraintSet.evaluate with the layout arrays built once)."""
+        if not hasattr(self, "_args"):
+            from ..kernel import _f, _kernel
+            full = self.full
+            lay = full.layout()
+            ptr = np.concatenate([[0], np.cumsum([len(p) for p in full.drive_params])]) + 1
+            data = np.concatenate([np.asarray(p, dtype=float) for p in full.drive_params]) \
+                if full.drive_params else np.zeros(1)
+            kinds = np.array(full.drive_kinds or [0], dtype=np.int32)
+            self._kernel = _kernel
+            self._args = (
+                _f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
+                _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
+                _f(lay.term_dof + 1 if len(lay.term_dof) else np.ones(1), np.int32),
+                _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
+                _f(ptr if len(full.drive_kinds) else np.ones(2), np.int32), _f(data))
+            self._zero = np.zeros(len(q_full))
+        out = self._kernel.constraint_evaluate(*self._args, np.asfortranarray(q_full),
+                                               self._zero, t)
+        if out[-1]:
+            raise ValueError(f"constraint evaluation failed (code {out[-1]})")
+        return out[1]
+
+    def generalized_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
+                         residual_rows: np.ndarray | None) -> dict[str, np.ndarray]:
+        """Each joint's constraint force on body2's coordinates, (nt, body2.ncoordinates),
+        for rows of states."""
         if not hasattr(self, "selection"):
             self._term_arrays()
-        contrib = np.zeros(0)
-        if len(self.full):
-            _, gradients, *_ = self.full.evaluate(q_full, t)
-            contrib = self.t_coef * gradients[self.t_slot, self.t_con] * lam[self.t_con]
+        nt = len(q_rows)
+        nterm = len(self.t_coef)
+        contrib = np.zeros((nt, nterm))
+        if len(self.full) and nterm:
+            for row in range(nt):
+                gradients = self._gradients(q_rows[row], float(times[row]))
+                contrib[row] = gradients[self.t_slot, self.t_con]
+            contrib *= self.t_coef * lam_rows[:, self.t_con]
         mu = None
-        if self.factor is not None and residual is not None:
-            total = np.bincount(self.t_dof, contrib, minlength=self.model.nfull) \
-                if len(contrib) else np.zeros(self.model.nfull)
-            mu = self.factor.solve(self.a @ (residual - total))
+        if self.factor is not None and residual_rows is not None:
+            if not hasattr(self, "_scatter_all"):
+                self._scatter_all = sp.csr_matrix(
+                    (np.ones(nterm), (np.arange(nterm), self.t_dof)),
+                    shape=(nterm, self.model.nfull))
+            total = (self._scatter_all.T @ contrib.T).T
+            rhs = self.a @ (residual_rows - total).T
+            mu = np.atleast_2d(self.factor.solve(rhs).T.reshape(nt, -1))
         out = {}
         for name, (terms, entries, first, size) in self.selection.items():
-            vec = np.bincount(self.t_dof[terms] - first, contrib[terms], minlength=size) \
-                if len(terms) else np.zeros(size)
+            vec = contrib[:, terms] @ _scatter(self.t_dof[terms] - first, size)
             if mu is not None and len(entries):
                 a = self.a_coo
-                vec += np.bincount(a.col[entries] - first, a.data[entries] * mu[a.row[entries]],
-                                   minlength=size)
+                vec = vec + (mu[:, a.row[entries]] * a.data[entries]) @ \
+                    _scatter(a.col[entries] - first, size)
             out[name] = vec
         return out
 
+    def reaction_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
+                      residual_rows: np.ndarray | None = None) -> dict[str, tuple]:
+        """Per joint (force (nt, 3), moment (nt, 3), point (nt, 3), axial (nt,) or None)
+        for rows of full coordinates and multipliers."""
+        gen = self.generalized_rows(q_rows, lam_rows, times, residual_rows)
+        return {name: _reduce_rows(joint, gen[name], q_rows, self.points[name])
+                for name, joint in self.joints.items()}
+
     def reactions(self, q_full: np.ndarray, lam: np.ndarray, t: float = 0.0,
                   residual: np.ndarray | None = None) -> dict[str, Reaction]:
-        gen = self.generalized(q_full, lam, t, residual)
-        out = {}
-        for name, joint in self.joints.items():
-            out[name] = _reduce_to_point(joint, gen[name], q_full, self.points[name])
-        return out
+        rows = self.reaction_rows(q_full[None], np.asarray(lam, dtype=float)[None],
+                                  np.array([t]), None if residual is None else residual[None])
+        return {name: Reaction(f[0], m[0], p[0], None if a is None else float(a[0]))
+                for name, (f, m, p, a) in rows.items()}
+
+
+def _scatter(index: np.ndarray, size: int) -> np.ndarray:
+    """(len(index), size) 0/1 matrix adding entry k into column index[k]."""
+    out = np.zeros((len(index), size))
+    out[np.arange(len(index)), index] = 1.0
+    return out
 
 
 def _coordinate_kind() -> int:
@@ -249,29 +296,38 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
 
 
-def _reduce_to_point(joint, generalized: np.ndarray, q_full: np.ndarray,
-                     points: tuple) -> Reaction:
-    """Force and moment about the joint's point of the generalized force on body2."""
+def _vec_rows(expr, q_rows: np.ndarray) -> np.ndarray:
+    """A Vec3 expression at rows of coordinates: (nt, 3)."""
+    out = np.tile(expr.const, (len(q_rows), 1))
+    for d, c in expr.terms.items():
+        out += c * q_rows[:, d:d + 3]
+    return out
+
+
+def _reduce_rows(joint, generalized: np.ndarray, q_rows: np.ndarray, points: tuple):
+    """Force and moment about the joint's point of the generalized forces on body2 (nt
+    rows), the point and a distance joint's axial force."""
     body = joint.body2
     per, nodes = _vector_blocks(body)
     p2, p1 = points
-    point = p2.value(q_full)
-    force, moment = np.zeros(3), np.zeros(3)
+    point = _vec_rows(p2, q_rows)
+    nt = len(q_rows)
+    force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
     if per:
-        block = generalized.reshape(nodes, per // 3, 3)
-        values = q_full[body.first:body.first + per * nodes].reshape(nodes, per // 3, 3)
-        force = block[:, 0, :].sum(axis=0)
-        moment = _cross(values[:, 0, :] - point, block[:, 0, :]).sum(axis=0)
-        moment += _cross(values[:, 1:, :], block[:, 1:, :]).sum(axis=(0, 1))
+        block = generalized.reshape(nt, nodes, per // 3, 3)
+        values = q_rows[:, body.first:body.first + per * nodes].reshape(nt, nodes, per // 3, 3)
+        force = block[:, :, 0, :].sum(axis=1)
+        moment = _cross(values[:, :, 0, :] - point[:, None, :], block[:, :, 0, :]).sum(axis=1)
+        moment += _cross(values[:, :, 1:, :], block[:, :, 1:, :]).sum(axis=(1, 2))
     swapped = getattr(joint, "swapped", False)
     if swapped:
         force, moment = -force, -moment
     axial = None
     if p1 is not None:
-        u = point - p1.value(q_full)
-        u /= np.linalg.norm(u)
-        axial = float((force if swapped else -force) @ u)
-    return Reaction(force, moment, point, axial)
+        u = point - _vec_rows(p1, q_rows)
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        axial = np.einsum("ti,ti->t", force if swapped else -force, u)
+    return force, moment, point, axial
 
 
 def reaction_map(model: Model) -> ReactionMap:
@@ -341,6 +397,26 @@ class _Tables:
         self.s = (beam.stations[:-1, None] + np.outer(beam.lengths, self.xi)).ravel()
         self.reference = _beam_vectors(beam, beam.coordinates(), 0)
         self.strain0 = _strains(beam, self.reference, self)
+        # an FFR beam: the reference nodal vectors in its frame at t = 0 (positions from the
+        # frame's pivot), and the linear strains' matrix (built on first use)
+        local = beam.coordinates().reshape(beam.nodes, 4, 3) @ beam.orientation
+        local[:, 0, :] -= beam.frame_pivot @ beam.orientation
+        self.local_reference = local
+        self._linear: np.ndarray | None = None
+
+    def linear_strain(self, beam: Beam) -> np.ndarray:
+        """(ncoordinates, nel * nxi * 8): the strains' linear part about the reference in
+        the frame, column by column (f(x0 + e_j) - f(x0 - e_j)) / 2, exact since every
+        measure is a quadratic form of the nodal vectors."""
+        if self._linear is None:
+            n = beam.ncoordinates
+            base = self.local_reference.reshape(-1)
+            unit = np.eye(n)
+            with np.errstate(invalid="ignore", divide="ignore"):  # (unused normals)
+                plus = _strains(beam, _beam_vectors(beam, base + unit, 0), self)
+                minus = _strains(beam, _beam_vectors(beam, base - unit, 0), self)
+            self._linear = (0.5 * (plus - minus)).reshape(n, -1)
+        return self._linear
 
 
 def _tables(beam: Beam, stations: int) -> _Tables:
@@ -359,13 +435,13 @@ def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
     xi = tables.xi
 
     def fields(table: list[np.ndarray]) -> list[np.ndarray]:
-        return [np.einsum("epa,...eai->...epi", t, vectors) for t in table]
+        return [np.matmul(t, vectors) for t in table]   # (nel, np, 8) @ (..., nel, 8, 3)
 
     def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return np.einsum("...i,...i->...", a, b)
+        return (a * b).sum(axis=-1)
     rx, rxx, ry, rz, ryx, rzx = fields(tables.at)
-    slope = np.einsum("epa,...eai->...epi", tables.axial[0], vectors)
-    eps = np.einsum("pk,...ek->...ep", tables.axial_fit, 0.5 * (dot(slope, slope) - 1.0))
+    slope = np.matmul(tables.axial[0], vectors)
+    eps = 0.5 * (dot(slope, slope) - 1.0) @ tables.axial_fit.T
     b_y = -dot(ryx, rx)
     b_z = -dot(rzx, rx)
     if cubic:
@@ -413,19 +489,19 @@ def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_
     current = _beam_vectors(beam, np.asarray(q_full, dtype=float))
     if beam.formulation == "ffr":
         rotation = beam.orientation if frame is None else np.asarray(frame, dtype=float)
+        nodal = np.asarray(q_full, dtype=float)[..., beam.first:beam.first + beam.ncoordinates]
+        nodal = nodal.reshape(*nodal.shape[:-1], beam.nodes, 4, 3)
         if rotation.ndim == 3:   # per row: R^T v for every vector
-            local = np.einsum("teai,tij->teaj", current, rotation)
-            shift = np.einsum("i,tij->tj", beam.frame_pivot, rotation)[:, None, None, :]
+            local = np.matmul(nodal.reshape(len(rotation), -1, 3), rotation)
+            local = local.reshape(nodal.shape)
+            shift = np.einsum("i,tij->tj", beam.frame_pivot, rotation)[:, None, :]
         else:
-            local = current @ rotation
+            local = nodal @ rotation
             shift = beam.frame_pivot @ rotation
-        local = local.copy()
-        local[..., [0, 4], :] -= shift
-        local_ref = tables.reference @ beam.orientation
-        local_ref[..., [0, 4], :] -= beam.frame_pivot @ beam.orientation
-        d = local - local_ref
-        change = 0.5 * (_strains(beam, local_ref + d, tables)
-                        - _strains(beam, local_ref - d, tables))
+        local[..., 0, :] -= shift
+        d_nodal = (local - tables.local_reference).reshape(*local.shape[:-3], -1)
+        change = (d_nodal @ tables.linear_strain(beam)).reshape(
+            *d_nodal.shape[:-1], beam.nel, len(tables.xi), 8)
     else:
         now = _strains(beam, current, tables)
         change = now - tables.strain0
@@ -462,8 +538,18 @@ def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS
             rotation = None
             if f:
                 info = model.frames[f - 1]
-                rotation = np.array([info.rotation(float(x)) for x in np.atleast_1d(t)]) \
-                    if np.ndim(t) else info.rotation(float(t))
+                if not np.ndim(t):
+                    rotation = info.rotation(float(t))
+                elif info.drive_obj is None:
+                    rotation = np.broadcast_to(info.base, (len(t), 3, 3))
+                else:   # Rodrigues about the frame axis, all rows at once
+                    angle = np.array([info.drive_obj.value(float(x)) for x in t])
+                    k = info.axis / np.linalg.norm(info.axis)
+                    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]],
+                                     [-k[1], k[0], 0.0]])
+                    turn = (np.eye(3) + np.sin(angle)[:, None, None] * skew
+                            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew))
+                    rotation = turn @ info.base
             out[b.name] = beam_section_forces(b, q, stations, rotation)
     return out
 
@@ -577,7 +663,8 @@ class DynamicAnswers:
         self.initial = initial
         self.state: tuple | None = None
         self.time: list[float] = []
-        self.reactions: dict[str, list[Reaction]] = {name: [] for name in self.map.joints}
+        #: per joint, per chunk: (force (nt, 3), moment (nt, 3), axial (nt,) or None)
+        self.reactions: dict[str, list[tuple]] = {name: [] for name in self.map.joints}
         self.sections: dict[str, list[SectionForces]] = {}
         self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
@@ -604,16 +691,20 @@ class DynamicAnswers:
         times = np.asarray(chunk.time, dtype=float)
         if not len(times):
             return
-        for row, t in enumerate(times):
-            e = chunk.q[row]
-            t = float(t)
-            if self.need_acceleration:
-                v, accel = self._kinematics(t, e)
-                found = reactions(self.model, e, chunk.lam[row], t=t, v=v, a=accel)
-            else:
-                found = reactions(self.model, e, chunk.lam[row], t=t)
-            for name, r in found.items():
-                self.reactions[name].append(r)
+        e_rows = np.asarray(chunk.q, dtype=float)
+        q_rows = self.model.expand(e_rows)
+        residual = None
+        if self.need_acceleration:
+            lf = self.model.load_factor
+            residual = np.empty_like(q_rows)
+            for row, t in enumerate(times):
+                v, accel = self._kinematics(float(t), e_rows[row])
+                residual[row] = self.map.residual(e_rows[row], v, accel, float(t), lf)
+        if self.map.joints:
+            found = self.map.reaction_rows(q_rows, np.asarray(chunk.lam, dtype=float), times,
+                                           residual)
+            for name, (force, moment, _, axial) in found.items():
+                self.reactions[name].append((force, moment, axial))
         self.time.extend(times.tolist())
         if not self.beams:
             return
