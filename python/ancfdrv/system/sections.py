@@ -58,7 +58,7 @@ class Section:
         if isinstance(self, (Tube, Circle)):
             angle = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
             return np.column_stack([half_y * np.cos(angle), half_y * np.sin(angle)])
-        edge = np.linspace(-1.0, 1.0, 9)
+        edge = np.linspace(-1.0, 1.0, 5)   # corners, quarters and middles of the edges
         ones = np.ones_like(edge)
         outline = np.vstack([np.column_stack([half_y * ones, half_z * edge]),
                              np.column_stack([-half_y * ones, half_z * edge]),
