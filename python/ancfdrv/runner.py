@@ -274,7 +274,15 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     sink = writer
     if recorder is not None:
         def sink(chunk) -> None:
-            recorder(chunk)
+            nonlocal recorder
+            if recorder is not None:
+                try:
+                    recorder(chunk)
+                except (AncfError, ValueError, FloatingPointError) as exc:
+                    # the answers never fail a run: the file keeps everything else
+                    model.warnings.append(f"dynamic reactions, section forces and stresses "
+                                          f"not recorded: {exc}")
+                    recorder = None
             writer(chunk)
     try:
         dyn = integrate(model, settings, e_start, sink=sink, progress=progress,

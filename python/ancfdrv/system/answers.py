@@ -134,11 +134,13 @@ class ReactionMap:
         self.points = {name: _joint_points(joint) for name, joint in self.joints.items()}
 
     def residual(self, e: np.ndarray, v: np.ndarray, a: np.ndarray | None, t: float,
-                 load_factor: float) -> np.ndarray:
+                 load_factor: float, guesses: np.ndarray | None = None) -> np.ndarray:
         """r = M q'' + Q_int(q, q') - Q(t) in the full coordinates at the solvers' state
-        (e, e', e'')."""
+        (e, e', e''); ``guesses``: the contact points' projections at that state (default:
+        the model's)."""
         m = self.model
-        internal = m.kernel.full_forces(t, e, v, m.contact_guesses, load_factor=load_factor)
+        internal = m.kernel.full_forces(t, e, v, m.contact_guesses if guesses is None
+                                        else guesses, load_factor=load_factor)
         constant, driven = m.full_loads
         external = constant.copy()
         for index, vector in driven:
@@ -699,7 +701,11 @@ class DynamicAnswers:
             residual = np.empty_like(q_rows)
             for row, t in enumerate(times):
                 v, accel = self._kinematics(float(t), e_rows[row])
-                residual[row] = self.map.residual(e_rows[row], v, accel, float(t), lf)
+                guesses = None
+                if getattr(chunk, "contact", None) is not None:   # xi, eta of each point
+                    guesses = np.ascontiguousarray(chunk.contact[row, :, 4:6].T)
+                residual[row] = self.map.residual(e_rows[row], v, accel, float(t), lf,
+                                                  guesses)
         if self.map.joints:
             found = self.map.reaction_rows(q_rows, np.asarray(chunk.lam, dtype=float), times,
                                            residual)
