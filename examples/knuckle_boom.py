@@ -45,6 +45,7 @@ from example_utils import ResultFile, Recorder, arguments, reference, relative, 
 from ancfdrv import Box, System
 from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 from ancfdrv.solvers.static import solve_newton
+from ancfdrv.system.answers import reactions
 
 GRAVITY = 9.81
 
@@ -197,7 +198,9 @@ def _static_case(p: KnuckleBoom, stroke: float, model, result) -> StaticCase:
     at = model.probe_positions(result.e)
     chord = at["jib lug"] - at["knuckle"]
     tip = at["tip"] - pts["T"]
-    force = cylinder_force(result.lam[model.constraints.names.index("cylinder: length")], stroke)
+    # the cylinder's axial force by the joint's name (the same as -2 lambda L, see
+    # cylinder_force; tests/test_answers.py checks that they agree)
+    force = reactions(model, result.e, result.lam)["cylinder"].axial
     return StaticCase(stroke, p.jib_angle(stroke), float(np.arctan2(chord[1], chord[0])), tip,
                       float(tip @ pts["n2"]), float(force), model.ndof)
 
