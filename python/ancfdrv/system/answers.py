@@ -50,8 +50,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .bodies import Beam, Ground, Plate, RigidBody
+from ..codes import CONSTRAINT_COORDINATE
+from .bodies import Beam, Plate, RigidBody
 from .constraint_set import ConstraintSet
+from .expressions import Scalar
 from .joints import Constraint, LinearEquation
 from .model import Model
 from .sections import Box, Circle, Rectangle, Tube
@@ -108,9 +110,10 @@ class ReactionMap:
         for c, name in enumerate(cs.names):
             eq = equations.get(name)
             if isinstance(eq, LinearEquation):
-                eq = Constraint(_coordinate_kind(), [eq.expr.__class__(eq.expr.terms, 0.0)],
+                # kept with a multiplier as the assembly keeps it (assembly._as_constraint)
+                eq = Constraint(CONSTRAINT_COORDINATE, [Scalar(eq.expr.terms, 0.0)],
                                 [-eq.expr.const], None, eq.name)
-            if eq is None:  # not an equation of the system (cannot happen for joints)
+            if eq is None:  # not a joint's or body's equation: no force on the coordinates
                 full.add(cs.kinds[c], [({}, 0.0)], cs.params[c], cs.drives[c], name)
                 continue
             full.add(eq.kind, [(dict(op.terms), op.const) for op in eq.operands], eq.params,
@@ -259,11 +262,6 @@ def _scatter(index: np.ndarray, size: int) -> np.ndarray:
     out = np.zeros((len(index), size))
     out[np.arange(len(index)), index] = 1.0
     return out
-
-
-def _coordinate_kind() -> int:
-    from ..codes import CONSTRAINT_COORDINATE
-    return CONSTRAINT_COORDINATE
 
 
 def _vector_blocks(body) -> tuple[int, int]:
