@@ -235,6 +235,8 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     from .solvers.dynamic import initial_acceleration
     from .system.answers import DynamicAnswers, reaction_map
     from .system.bodies import Beam
+    if not scene["output"].get("answers", True):
+        return None
     if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies):
         return None
     recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,

@@ -274,6 +274,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "sections": Key("bool", False, doc="dynamic runs: store the section forces of every "
                         "beam at every step (/dynamic/sections); the stress envelope is kept "
                         "either way"),
+        "answers": Key("bool", True, doc="dynamic runs: record the joint reactions and the "
+                       "stress envelope at every step (/dynamic/reactions, /dynamic/stress; "
+                       "about 0.1 ms of CPU per step for a 28-node beam)"),
     },
 }
 
