@@ -60,6 +60,8 @@ from .sections import Box, Circle, Rectangle, Tube
 
 #: output.stations default: points per element where section forces are evaluated
 DEFAULT_STATIONS = 3
+#: the largest FFR linear-strain matrix kept per beam (entries; 16 MB)
+LINEAR_MATRIX_LIMIT = 2_000_000
 
 
 @dataclass
@@ -499,9 +501,16 @@ def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_
             local = nodal @ rotation
             shift = beam.frame_pivot @ rotation
         local[..., 0, :] -= shift
-        d_nodal = (local - tables.local_reference).reshape(*local.shape[:-3], -1)
-        change = (d_nodal @ tables.linear_strain(beam)).reshape(
-            *d_nodal.shape[:-1], beam.nel, len(tables.xi), 8)
+        d = local - tables.local_reference
+        if beam.ncoordinates * beam.nel * len(tables.xi) * 8 <= LINEAR_MATRIX_LIMIT:
+            d_nodal = d.reshape(*local.shape[:-3], -1)
+            change = (d_nodal @ tables.linear_strain(beam)).reshape(
+                *d_nodal.shape[:-1], beam.nel, len(tables.xi), 8)
+        else:   # a long beam: the same linear part, element by element
+            x0 = _beam_vectors(beam, tables.local_reference.reshape(-1), 0)
+            dv = _beam_vectors(beam, d.reshape(*local.shape[:-3], -1), 0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                change = 0.5 * (_strains(beam, x0 + dv, tables) - _strains(beam, x0 - dv, tables))
     else:
         now = _strains(beam, current, tables)
         change = now - tables.strain0
