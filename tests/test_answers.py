@@ -545,3 +545,31 @@ def test_ffr_linear_strain_matrix_and_element_path_agree(monkeypatch):
     for key in ("N", "T", "Q", "M"):
         assert getattr(by_element, key) == pytest.approx(getattr(by_matrix, key), abs=1e-8 * 200)
     model.close()
+
+
+def test_static_answers_bundle_the_three(tmp_path):
+    """static_answers gives the same records as the three functions, and the file written
+    from it holds them under the joint's and the beam's names."""
+    from ancfdrv.io import hdf5
+    from ancfdrv.system.answers import static_answers
+    s = System("c")
+    steel = s.material("steel", **STEEL)
+    s.beam("arm", material=steel, start=(0, 0, 0), end=(2, 0, 0), nodes=5,
+           section=Tube(0.1, 0.005), height_axis=(0, 1, 0), formulation="nonlinear",
+           bending="cubic")
+    s.joint("root", "weld", "ground", "arm", point=(0, 0, 0))
+    s.load("tip", "force", body="arm", point=(2, 0, 0), vector=(0.0, -500.0, 0.0))
+    model, result = _solve(s)
+    every = static_answers(model, result.e, result.lam)
+    assert every.reactions["root"].force == pytest.approx([0.0, 500.0, 0.0], abs=1e-6)
+    assert every.sections["arm"].M[0, 1] == pytest.approx(-1000.0, rel=1e-4)
+    out = tmp_path / "c.h5"
+    with h5py.File(out, "w") as h5:
+        h5.create_group("model")
+    hdf5.write_static_answers(out, model, result.e, result.lam)
+    with h5py.File(out) as h5:
+        assert h5["static/reactions/root/force"][()] == pytest.approx([0.0, 500.0, 0.0], abs=1e-6)
+        assert h5["static/stress/arm/von_mises"][0] == pytest.approx(
+            every.stress["arm"].von_mises[0])
+        assert h5["static/stress/arm"].attrs["s_max"] == pytest.approx(0.0)
+    model.close()

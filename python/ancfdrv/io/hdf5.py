@@ -591,10 +591,9 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
     """/static/reactions/<joint>, /static/sections/<beam>, /static/stress/<beam> of the
     static state (ancfdrv.system.answers), and /model/constraint_joints (the joint of each
     row of lambda)."""
-    from ..system.answers import constraint_joints, reactions, section_forces, stresses
-    found = reactions(model, e, lam)
-    forces = section_forces(model, e, stations)
-    stress = stresses(model, forces)
+    from ..system.answers import constraint_joints, static_answers
+    answers = static_answers(model, e, lam, stations)
+    found, forces, stress = answers.reactions, answers.sections, answers.stress
     with _open_write(path) as h5:
         group = h5.require_group("static")
         for key in ("reactions", "sections", "stress"):

@@ -645,6 +645,23 @@ def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress
     return {name: beam_stress(beams[name].section, f) for name, f in forces.items()}
 
 
+@dataclass
+class Answers:
+    """Everything SPEC section 10 asks of one state, by name."""
+
+    reactions: dict[str, Reaction]
+    sections: dict[str, SectionForces]
+    stress: dict[str, Stress]
+
+
+def static_answers(model: Model, e: np.ndarray, lam: np.ndarray,
+                   stations: int = DEFAULT_STATIONS) -> Answers:
+    """Reactions, section forces and stresses of a static state (e, lambda): what the
+    result writers store under /static and the results object exposes."""
+    forces = section_forces(model, e, stations)
+    return Answers(reactions(model, e, lam), forces, stresses(model, forces))
+
+
 def constraint_joints(model: Model) -> list[str]:
     """The joint each multiplier (row of lambda) belongs to ('' for a body's own
     constraints: a rigid body's orthonormality, a planar guide)."""
@@ -737,7 +754,7 @@ class DynamicAnswers:
                 when[higher] = times[row][higher]
 
 
-__all__ = ["Reaction", "SectionForces", "Stress", "reactions", "section_forces",
+__all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions", "section_forces",
            "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
            "DEFAULT_STATIONS",
            "DynamicAnswers", "constraint_joints"]
