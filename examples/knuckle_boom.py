@@ -187,7 +187,9 @@ def _static_case(p: KnuckleBoom, stroke: float, res) -> StaticCase:
     at = res.static.probes
     chord = at["jib lug"] - at["knuckle"]
     tip = at["tip"] - pts["T"]
-    force = cylinder_force(res.static.multiplier("cylinder: length"), stroke)
+    # the cylinder's axial force by the joint's name (SPEC section 10; the same as
+    # -2 lambda L of cylinder_force, which tests/test_answers.py checks)
+    force = float(np.asarray(res.static.reactions["cylinder"]["axial"]))
     return StaticCase(stroke, p.jib_angle(stroke), float(np.arctan2(chord[1], chord[0])), tip,
                       float(tip @ pts["n2"]), float(force), int(res.model.attrs["ndof"]))
 

@@ -166,6 +166,12 @@ def _cmd_info(args: argparse.Namespace) -> int:
         if isinstance(value, np.ndarray):
             value = np.array2string(value, precision=6)
         print(f"{key:32s} {value}")
+    from .io.hdf5 import answer_headlines
+    try:
+        for line in answer_headlines(path):
+            print(line)
+    except (OSError, KeyError, ValueError):
+        pass  # an older or partial file: the summary above is what it has
     return 0
 
 
@@ -185,6 +191,14 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     except Exception as exc:  # noqa: BLE001 - a damaged file: exit 2 naming it
         raise corrupted(", ".join(map(str, paths)), exc) from None
     print(f"written {png}")
+    if len(paths) == 1:
+        from .plots import plot_sections
+        try:
+            extra = plot_sections(paths[0], _sections_png(args.output, paths[0]))
+        except (ValueError, KeyError, OSError):
+            extra = None  # no section forces in the file: the main figure is all
+        if extra is not None:
+            print(f"written {extra}")
     return 0
 
 
@@ -194,6 +208,12 @@ def corrupted(path: object, exc: BaseException) -> InputError:
     return InputError(f"cannot read it as an ancfdrv result file: damaged or not written by "
                       f"a run ({type(exc).__name__}{': ' + text if text else ''})",
                       file=str(path))
+
+
+def _sections_png(output: str | None, h5_path: Path) -> Path:
+    """Where the section-force figure goes: beside the main figure, suffix _sections."""
+    base = Path(output) if output else h5_path.with_suffix(".png")
+    return base.with_name(base.stem + "_sections.png")
 
 
 def build_parser() -> argparse.ArgumentParser:

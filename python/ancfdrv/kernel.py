@@ -569,6 +569,17 @@ class KernelSystem:
                     contact_potential=float(potential), records=records[:, :self.npoint],
                     tangent=tangent if want_tangent else None, guesses=guesses, counts=counts)
 
+    def full_forces(self, t: float, e, v, guesses, *, load_factor: float = 1.0) -> np.ndarray:
+        """Q_el - Q_c - lf Q_M at (t, e, e') in the full coordinates q (before B^T): what
+        the joint reactions of eliminated linear joints are recovered from. The caller's
+        contact guesses are not changed."""
+        full, info = _kernel.system_full_forces(self.handle, self.nfull, self.npoint, t, _f(e),
+                                                _f(v), load_factor, _f(np.array(guesses)),
+                                                ndof=self.ndof)
+        if info:
+            self._failure(info, "full force evaluation")
+        return full
+
     def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
         out = _kernel.system_output_row(
             self.handle, self.ncon, self.nprobe, self.npoint, t, _f(e), _f(v),

@@ -813,3 +813,48 @@ def _isnum(v) -> bool:
 
 def _num(v):
     return float(v) if _isnum(v) else 0.0
+
+
+def plot_sections(h5_path: str | Path, png: str | Path | None = None) -> Path | None:
+    """Section forces and stresses along every beam of a result file: N, the shear forces
+    Q, the torsion T, the moments M (components along the section's height and width axes)
+    and the von Mises stress of the static state, with the dynamic run's von Mises envelope
+    when there is one. None when the file has no section forces."""
+    h5_path = Path(h5_path)
+    with h5py.File(h5_path, "r") as h5:
+        if "static/sections" not in h5 and "dynamic/stress" not in h5:
+            return None
+        static = {name: {k: g[k][()] for k in g} for name, g in
+                  h5["static/sections"].items()} if "static/sections" in h5 else {}
+        stress = {name: g["von_mises"][()] for name, g in h5["static/stress"].items()} \
+            if "static/stress" in h5 else {}
+        envelope = {name: (g["s"][()], g["von_mises_max"][()]) for name, g in
+                    h5["dynamic/stress"].items()} if "dynamic/stress" in h5 else {}
+        title = _text(h5.attrs.get("title", h5_path.stem))
+    fig, axes = plt.subplots(2, 2, figsize=(12, 8), sharex=False)
+    (ax_n, ax_q), (ax_m, ax_s) = axes
+    for name, f in static.items():
+        s = f["s"]
+        ax_n.plot(s, f["N"] / 1e3, label=f"{name}: N")
+        ax_n.plot(s, f["T"] / 1e3, "--", label=f"{name}: T [kN m]")
+        ax_q.plot(s, f["Q"][:, 0] / 1e3, label=f"{name}: Q height")
+        ax_q.plot(s, f["Q"][:, 1] / 1e3, "--", label=f"{name}: Q width")
+        ax_m.plot(s, f["M"][:, 0] / 1e3, label=f"{name}: M height")
+        ax_m.plot(s, f["M"][:, 1] / 1e3, "--", label=f"{name}: M width")
+        if name in stress:
+            ax_s.plot(s, stress[name] / 1e6, label=f"{name}: static")
+    for name, (s, vm) in envelope.items():
+        ax_s.plot(s, vm / 1e6, ":", label=f"{name}: dynamic envelope")
+    for ax, ylabel in ((ax_n, "N [kN], T [kN m]"), (ax_q, "Q [kN]"), (ax_m, "M [kN m]"),
+                       (ax_s, "von Mises [MPa]")):
+        ax.set_xlabel("arc length s [m]")
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3)
+        if ax.lines:
+            ax.legend(fontsize=7)
+    fig.suptitle(f"{title}: section forces and stresses along the beams")
+    fig.tight_layout()
+    out = Path(png) if png else h5_path.with_name(h5_path.stem + "_sections.png")
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out

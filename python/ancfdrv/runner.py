@@ -225,6 +225,7 @@ def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str
         timing[f"settle_{phase}"] = seconds
     results.write_static(out, model, result)
     _write_static_supports(out, model, result)
+    _write_static_answers(scene, model, out, result)
     return result
 
 
@@ -278,6 +279,34 @@ class SupportRecorder:
             SUPPORT_REFERENCE, DISPLACEMENT_REFERENCE)
 
 
+def _write_static_answers(scene: Scene, model: Model, out: Path, result: StaticResult) -> None:
+    """Reactions, section forces and stresses of the static state (SPEC section 10)."""
+    results.write_static_answers(out, model, result.e, result.lam,
+                                 scene["output"].get("stations", 3))
+
+
+def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
+                      e_start: np.ndarray):
+    """The recorder of the dynamic reactions, section forces and stress envelope (None
+    when the model has neither joints nor beams)."""
+    from .solvers.dynamic import initial_acceleration
+    from .system.answers import DynamicAnswers, reaction_map
+    from .system.bodies import Beam
+    if not scene["output"].get("answers", True):
+        return None
+    if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies):
+        return None
+    recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
+                              alpha_m=settings.alpha_m, alpha_f=settings.alpha_f,
+                              stations=scene["output"].get("stations", 3),
+                              keep_sections=bool(scene["output"].get("sections", False)))
+    if recorder.need_acceleration:
+        v0 = np.zeros(model.ndof)
+        a0, _ = initial_acceleration(model, e_start, v0, 0.0)
+        recorder.initial = (v0, a0)
+    return recorder
+
+
 def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
@@ -292,16 +321,32 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     supports = SupportRecorder.of(model)
     if supports is not None:  # the support deflections come from q at every step
         settings.store_q = True
+    recorder = _answers_recorder(scene, model, settings, e_start)
+    if recorder is not None:
+        settings.store_q = True  # the answers need every step's coordinates (not written)
     writer = results.DynamicWriter(
         out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
         frames=scene["output"]["xdmf_frames"], write_q=write_q)
-    sink = writer if supports is None else supports.wrap(writer)
+    base_sink = writer if supports is None else supports.wrap(writer)
     attrs: dict[str, Any] = {
         "integrator": scene["solver"]["integrator"], "dt": settings.dt, "beta": settings.beta,
         "gamma": settings.gamma, "alpha_m": settings.alpha_m, "alpha_f": settings.alpha_f,
         "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
         "generalized_alpha" else 1.0, "t_end": settings.t_end}
+    sink = base_sink
+    if recorder is not None:
+        def sink(chunk) -> None:
+            nonlocal recorder
+            if recorder is not None:
+                try:
+                    recorder(chunk)
+                except (AncfError, ValueError, FloatingPointError) as exc:
+                    # the answers never fail a run: the file keeps everything else
+                    model.warnings.append(f"dynamic reactions, section forces and stresses "
+                                          f"not recorded: {exc}")
+                    recorder = None
+            base_sink(chunk)
     try:
         dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
                         should_stop=stop)
@@ -309,6 +354,8 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
         writer.flush()
         if supports is not None:
             supports.write(out, writer.rows)
+        if recorder is not None:
+            results.write_dynamic_answers(out, recorder)
         results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
@@ -433,6 +480,7 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
             t0 = time.perf_counter()
             results.write_static(out, model, static)
             _write_static_supports(out, model, static)
+            _write_static_answers(scene, model, out, static)
             timing["output"] = time.perf_counter() - t0
             e_start = static.e
             if analysis == "static+dynamic":

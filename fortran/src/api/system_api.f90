@@ -570,6 +570,41 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velo
   counts = state%counts
 end subroutine system_evaluate
 
+!> The configuration-dependent forces Q_el - Q_c - lf Q_M at (t, e, e') in the full
+!> coordinates q (before the reduction B^T): the joint reactions of eliminated linear joints
+!> are recovered from them (python/ancfdrv/system/answers.py). The contact guesses and
+!> counters are used and returned unchanged in the caller's copy.
+subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor, guesses, &
+                              full_force, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, ndof, nfull, npoint
+  real(dp), intent(in) :: t, e(ndof), v(ndof), load_factor
+  real(dp), intent(in) :: guesses(2, max(1, npoint))
+  real(dp), intent(out) :: full_force(nfull)
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  type(contact_state) :: state
+  real(dp), allocatable :: rotations(:, :, :), rates(:), reduced(:)
+  real(dp) :: strain, potential, powers(2), records(6, max(1, npoint))
+  full_force = 0.0_dp
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. nfull /= sys%nfull .or. npoint /= sys%npoint) then
+    info = 2
+    return
+  end if
+  allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)), reduced(ndof))
+  call frame_rotations(sys, t, rotations, rates, info)
+  if (info /= 0) return
+  state%guesses = guesses
+  state%counts = 0
+  call internal_forces(sys, rotations, e, v, load_factor, 0.0_dp, state, reduced, strain, &
+                       potential, powers, records, info, rates=rates, full_out=full_force)
+end subroutine system_full_forces
+
 !> One output row (probes, deflections, energies, constraint violation, contact records)
 !> of the state (t, e, e', lambda) with the accumulated works.
 subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, work, guesses, &

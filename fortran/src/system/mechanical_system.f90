@@ -330,7 +330,7 @@ contains
   !> info = 6 (moment undefined), 7 (a plate normal vanished), 8 (contact search failed).
   subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
                              strain, contact_potential, contact_powers, records, info, &
-                             tangent_rotation, tangent_values, rates, tangent_rates)
+                             tangent_rotation, tangent_values, rates, tangent_rates, full_out)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
     type(contact_state), intent(inout) :: state
@@ -340,6 +340,8 @@ contains
     real(dp), intent(in), optional :: tangent_rotation(:, :, 0:)
     real(dp), intent(out), optional :: tangent_values(:)
     real(dp), intent(in), optional :: rates(0:), tangent_rates(0:)
+    !> the same forces in the full coordinates q (before B^T), for the joint reactions
+    real(dp), intent(out), optional :: full_out(:)
     real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
     real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3), rate, tangent_rate
     logical :: want_tangent
@@ -399,6 +401,7 @@ contains
       end if
       full_force(sys%moment_dofs(:, m)) = full_force(sys%moment_dofs(:, m)) - moment
     end do
+    if (present(full_out)) full_out = full_force
     call to_reduced(sys, full_force, force)
     if (.not. want_tangent) return
     if (sys%reduced) then  ! B^T S B by the plan

@@ -613,3 +613,172 @@ def write_support_deflections(path: Path, analysis: str, deflections: dict[str, 
             frame = frames.get(name)
             if frame is not None:
                 data.attrs["frame"] = frame
+
+
+# -- engineering answers (SPEC section 10) -----------------------------------------------------
+def _reaction_group(group: h5py.Group, name: str, force, moment, axial) -> None:
+    sub = group.create_group(name)
+    _dataset(sub, "force", np.asarray(force, dtype=float), "N")
+    _dataset(sub, "moment", np.asarray(moment, dtype=float), "N m")
+    if axial is not None:
+        _dataset(sub, "axial", np.asarray(axial, dtype=float), "N")
+    sub.attrs["description"] = ("what body1 exerts on body2, global axes; moment about the "
+                                "joint's point on body2; axial: tension positive")
+
+
+def _section_group(group: h5py.Group, name: str, forces) -> None:
+    sub = group.create_group(name)
+    _dataset(sub, "s", forces.s, "m")
+    for key, units in (("N", "N"), ("T", "N m"), ("Q", "N"), ("M", "N m")):
+        _dataset(sub, key, getattr(forces, key), units)
+    sub.attrs["description"] = ("what the part beyond s exerts on the part before it; Q and M: "
+                                "components along the section's height and width axes")
+
+
+def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarray,
+                         stations: int = 3) -> None:
+    """/static/reactions/<joint>, /static/sections/<beam>, /static/stress/<beam> of the
+    static state (ancfdrv.system.answers), and /model/constraint_joints (the joint of each
+    row of lambda)."""
+    from ..system.answers import constraint_joints, static_answers
+    answers = static_answers(model, e, lam, stations)
+    found, forces, stress = answers.reactions, answers.sections, answers.stress
+    with _open_write(path) as h5:
+        group = h5.require_group("static")
+        for key in ("reactions", "sections", "stress"):
+            if key in group:
+                del group[key]
+        if found:
+            reactions_group = group.create_group("reactions")
+            for name, r in found.items():
+                _reaction_group(reactions_group, name, r.force, r.moment, r.axial)
+        if forces:
+            sections_group = group.create_group("sections")
+            stress_group = group.create_group("stress")
+            for name, f in forces.items():
+                _section_group(sections_group, name, f)
+                sub = stress_group.create_group(name)
+                _dataset(sub, "s", f.s, "m")
+                _dataset(sub, "sigma_x", stress[name].sigma_x, "Pa")
+                _dataset(sub, "von_mises", stress[name].von_mises, "Pa")
+                k = int(np.argmax(stress[name].von_mises))
+                _attrs(sub.attrs, {"max": float(stress[name].von_mises[k]),
+                                   "s_max": float(f.s[k])})
+        if "model" in h5 and len(model.constraints):
+            if "constraint_joints" in h5["model"]:
+                del h5["model/constraint_joints"]
+            names = h5["model"].create_dataset("constraint_joints",
+                                               data=np.array(constraint_joints(model),
+                                                             dtype="S"))
+            names.attrs["units"] = "name"
+            names.attrs["description"] = ("the joint each row of lambda belongs to (empty: "
+                                          "a body's own constraint)")
+
+
+def write_dynamic_answers(path: Path, recorder) -> None:
+    """/dynamic/reactions/<joint> (leading time axis), /dynamic/sections/<beam> (when the
+    recorder keeps them) and the stress envelope /dynamic/stress/<beam> (von_mises_max,
+    t_max per station; attributes max, s_max, t_max) of a DynamicAnswers recorder."""
+    if not recorder.time:
+        return
+    with _open_write(path) as h5:
+        group = h5.require_group("dynamic")
+        for key in ("reactions", "sections", "stress"):
+            if key in group:
+                del group[key]
+        if recorder.reactions:
+            reactions_group = group.create_group("reactions")
+            for name, chunks in recorder.reactions.items():
+                if not chunks:
+                    continue
+                axial = None if chunks[0][2] is None else np.concatenate([c[2] for c in chunks])
+                _reaction_group(reactions_group, name, np.concatenate([c[0] for c in chunks]),
+                                np.concatenate([c[1] for c in chunks]), axial)
+        if recorder.sections:
+            sections_group = group.create_group("sections")
+            for name, chunks in recorder.sections.items():
+                sub = sections_group.create_group(name)
+                _dataset(sub, "s", chunks[0].s, "m")
+                for key, units in (("N", "N"), ("T", "N m"), ("Q", "N"), ("M", "N m")):
+                    _dataset(sub, key, np.concatenate([getattr(c, key) for c in chunks]), units)
+        if recorder.envelope:
+            stress_group = group.create_group("stress")
+            for name, (s, best, when) in recorder.envelope.items():
+                sub = stress_group.create_group(name)
+                _dataset(sub, "s", s, "m")
+                _dataset(sub, "von_mises_max", best, "Pa")
+                _dataset(sub, "t_max", when, "s")
+                k = int(np.argmax(best))
+                _attrs(sub.attrs, {"max": float(best[k]), "s_max": float(s[k]),
+                                   "t_max": float(when[k])})
+            _stress_points(h5, group, recorder)
+
+
+def answer_headlines(path: Path) -> list[str]:
+    """The headline engineering figures of a result file (``ancf info``): the largest
+    reaction (static, and over the dynamic run with its time) and the largest von Mises
+    stress (static, and the dynamic envelope's, where and when). Empty when the file has
+    none of them."""
+    lines: list[str] = []
+    with open_result(path) as h5:
+        for phase in ("static", "dynamic"):
+            if phase not in h5:
+                continue
+            group = h5[phase]
+            if "reactions" in group:
+                best = None
+                for name, sub in group["reactions"].items():
+                    force = np.atleast_2d(sub["force"][()])
+                    size = np.linalg.norm(force, axis=1)
+                    k = int(np.argmax(size))
+                    if best is None or size[k] > best[1]:
+                        best = (name, float(size[k]), k, force[k])
+                if best is not None:
+                    when = ""
+                    if phase == "dynamic" and "time" in group:
+                        when = f" at t = {float(group['time'][best[2]]):.6g} s"
+                    force = ", ".join(f"{x:.6g}" for x in best[3])
+                    lines.append(f"{phase + '.largest_reaction':32s} joint {best[0]!r}: "
+                                 f"|F| = {best[1]:.6g} N ({force}){when}")
+            if "stress" in group:
+                best = None
+                for name, sub in group["stress"].items():
+                    peak = float(sub.attrs.get("max", 0.0))
+                    if best is None or peak > best[1]:
+                        best = (name, peak, float(sub.attrs.get("s_max", 0.0)),
+                                sub.attrs.get("t_max"))
+                if best is not None:
+                    when = "" if best[3] is None else f" at t = {float(best[3]):.6g} s"
+                    lines.append(f"{phase + '.largest_von_mises':32s} {best[1] / 1e6:.6g} MPa "
+                                 f"in beam {best[0]!r} at s = {best[2]:.6g} m{when}")
+    return lines
+
+
+def _stress_points(h5: h5py.File, group: h5py.Group, recorder) -> None:
+    """/dynamic/mesh_von_mises_max: the von Mises envelope at the XDMF mesh's
+    points (/model/mesh; a beam node takes the larger value of the two element ends that
+    meet there; other points 0), the node field ParaView colours the beams by."""
+    if "model/mesh" not in h5:
+        return
+    mesh = h5["model/mesh"]
+    values = np.zeros(len(mesh["points"]))
+    ranges = {}
+    for line in str(mesh.attrs.get("bodies", "")).split("\n"):
+        name, _, rest = line.rpartition(": ")
+        if rest.startswith("beam, points "):
+            first, last = rest.removeprefix("beam, points ").split("..")
+            ranges[name] = (int(first), int(last))
+    for name, (_, best, _) in recorder.envelope.items():
+        if name not in ranges:
+            continue
+        first, last = ranges[name]
+        nodes = last - first + 1
+        per = len(best) // max(nodes - 1, 1)
+        ends = best.reshape(nodes - 1, per)
+        node_values = np.zeros(nodes)
+        node_values[:-1] = ends[:, 0]
+        node_values[1:] = np.maximum(node_values[1:], ends[:, -1])
+        values[first:last + 1] = node_values
+    if "mesh_von_mises_max" in group:
+        del group["mesh_von_mises_max"]
+    _dataset(group, "mesh_von_mises_max", values, "Pa")

@@ -242,6 +242,7 @@ def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
         kind, dims, topology_data, ncells, npoints = _topology_of(h5)
         add_step_views(h5, 0, nframes, existing=True)  # those the writer has not made
         displacement = "dynamic/mesh_displacement" in h5
+        stress_points = "dynamic/mesh_von_mises_max" in h5
     root = ET.Element("Xdmf", Version="3.0")
     domain = ET.SubElement(root, "Domain")
     series = ET.SubElement(domain, "Grid", Name="motion", GridType="Collection",
@@ -260,6 +261,10 @@ def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
             attribute = ET.SubElement(grid, "Attribute", Name="displacement",
                                       AttributeType="Vector", Center="Node")
             _item(attribute, (npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
+        if stress_points:  # the run's von Mises envelope at the beam nodes (Pa)
+            attribute = ET.SubElement(grid, "Attribute", Name="von_mises_max",
+                                      AttributeType="Scalar", Center="Node")
+            _item(attribute, (npoints,), name, "/dynamic/mesh_von_mises_max")
     out = target.with_suffix(".xdmf")
     write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
                                                             xml_declaration=True))

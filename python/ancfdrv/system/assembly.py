@@ -132,9 +132,32 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         point_masses=[(m.body.name, m.point, m.mass) for m in act.masses],
         linear_joints=mode)
     model.frame_problems = frame_problems
+    _answer_inputs(model, system, equations, elimination, reduction, mass_full,
+                   constant + gravity, driven)
     _policy(model)
     model.build_kernel()
     return model
+
+
+def _answer_inputs(model: Model, system, equations: list, elimination: Elimination,
+                   reduction, mass_full: sp.csr_matrix, constant_full: np.ndarray,
+                   driven_full: list) -> None:
+    """What the joint reactions need besides the solution (``ancfdrv.system.answers``):
+    the joints and the owner of every joint equation (by its name), the equations in the
+    full coordinates q, the eliminated linear equations kept (not redundant), and the mass
+    and loads in the full coordinates (the residual of the eliminated rows is formed there)."""
+    owners = {}
+    for joint in system.joints.values():
+        for eq in joint.equations(model.q0):
+            owners[eq.name] = joint.name
+    model.joint_items = dict(system.joints)
+    model.equation_owner = owners
+    model.full_equations = {eq.name: eq for eq in equations}
+    model.eliminated = [] if reduction is None else \
+        [eq for eq in equations if isinstance(eq, LinearEquation)
+         and eq.name not in set(elimination.redundant)]
+    model.mass_full = mass_full
+    model.full_loads = (constant_full, driven_full)
 
 
 # -- effects ---------------------------------------------------------------------------------

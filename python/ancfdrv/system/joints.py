@@ -125,6 +125,9 @@ class Joint:
             raise InputError(f"{where}: type {self.type!r} must be one of {JOINT_TYPES}")
         if self.body1 is self.body2:
             raise InputError(f"{where}: body1 and body2 are the same body")
+        #: the user named the ground as body2: the bodies were swapped (reactions say what
+        #: the user's body1 exerts on the user's body2, so their sign turns back)
+        self.swapped = isinstance(self.body2, Ground)
         if isinstance(self.body2, Ground):  # the ground is always body1
             self.body1, self.body2 = self.body2, self.body1
         if self.axis is not None:

@@ -11,6 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 
+import numpy as np
+
 from .. import kernel
 from ..codes import SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
 
@@ -34,6 +36,35 @@ class Section:
     def extent(self) -> tuple[float, float]:
         """Half the section's size along y (height) and z (width)."""
         raise NotImplementedError
+
+    # -- what the section forces and stresses use (ancfdrv.system.answers) ------------------
+    @property
+    def torsion_constant(self) -> float:
+        """J (m^4) of the torsion moment T = G J theta' the section forces report; today
+        the kernel's I_y + I_z (exact for the tube and circle)."""
+        return self.data.polar
+
+    @property
+    def shear_factors(self) -> tuple[float, float]:
+        """Shear factors (k_y, k_z) of the shear forces Q = k G A gamma along the height and
+        width; today the kernel's k = 1."""
+        return (1.0, 1.0)
+
+    @property
+    def fibre_points(self) -> "np.ndarray":
+        """(n, 2) points (y along the height, z along the width; m) of the outer fibres or
+        walls where the stresses are evaluated: the outline of the section."""
+        half_y, half_z = self.extent
+        if isinstance(self, (Tube, Circle)):
+            angle = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+            return np.column_stack([half_y * np.cos(angle), half_y * np.sin(angle)])
+        edge = np.linspace(-1.0, 1.0, 5)   # corners, quarters and middles of the edges
+        ones = np.ones_like(edge)
+        outline = np.vstack([np.column_stack([half_y * ones, half_z * edge]),
+                             np.column_stack([-half_y * ones, half_z * edge]),
+                             np.column_stack([half_y * edge, half_z * ones]),
+                             np.column_stack([half_y * edge, -half_z * ones])])
+        return np.unique(outline, axis=0)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,760 @@
+"""Engineering answers from a solved state (SPEC section 10): joint reactions by name,
+section forces along beams and stresses at the sections' outer fibres or walls.
+
+Reactions
+    The constraint forces in the full coordinates q are Phi_q^T lambda (the constraints
+    kept with multipliers; the solvers' convention M e'' + Q_int - Q - Phi_e^T lambda = 0
+    makes Phi^T lambda the force the constraints apply) plus A^T mu for the linear joint
+    equations A q = b that the assembly eliminated (q = B e + q0). Their multipliers mu are
+    recovered from the residual of the equations of motion in the full coordinates,
+    r = M q'' + Q_int(q, q') - Q(t) = Phi_q^T lambda + A^T mu, by least squares
+    (A A^T) mu = A (r - Phi_q^T lambda): r - Phi_q^T lambda lies in the range of A^T
+    because B^T (r - Phi_q^T lambda) = 0 is the solved (reduced) equation and B spans the
+    null space of A. Each joint owns its equations' rows; its generalized force on body2's
+    coordinates is reduced to a force (the sum over the position vectors r) and a moment
+    about the joint's point p, M = sum (r_i - p) x Q_r,i + sum d_j x Q_d,j over the
+    position vectors r_i and the direction vectors d_j (a rigid rotation delta theta moves
+    every vector v by delta theta x v: the virtual work is delta theta . M). Global axes;
+    what body1 exerts on body2 (as the user named them). A distance joint's ``axial`` is
+    the tension: minus the force on body2 along p2 - p1.
+
+Section forces
+    At ``stations`` points per element (equally spaced, both ends included) from the
+    element's own strain measures (``fortran/src/elements/beam_structural.f90``) and the
+    section's stiffness, relative to the reference configuration: axial Green strain
+    (r_x . r_x - 1)/2, bending strains b_y = -r_y,x . r_x (+ r_xx . r_y - mean(r_xx . r_y)
+    with 'cubic' bending), b_z likewise with r_z, twist 1/2 (r_y,x . r_z - r_z,x . r_y)
+    ('cubic'; the continuum element's (I_z r_y,x . r_z - I_y r_z,x . r_y) / I_p), shear
+    gamma_y = r_x . r_y (nodal values interpolated linearly with 'cubic'). Sign convention:
+    what the part of the beam beyond s (larger arc length) exerts on the part before it,
+    on the section at s: N = E A eps (tension positive), T = G J twist, Q = k G A gamma
+    along the section's height and width, M = (-E I_y b_z, E I_z b_y) along the height and
+    width axes (the moment vector's components; a cantilever along x with a tip load P
+    along +y has M_width = P (L - s) and Q_height = P).
+
+Stresses
+    sigma_x(y, z) = N / A - M_width y / I_z + M_height z / I_y at the section's outer
+    fibre points (Section.fibre_points), the shear stress of torsion (rectangle:
+    Saint-Venant, its maximum at the middle of the long sides from the series solution;
+    box: Bredt T / (2 A_m t); tube and circle: T r / J) and of the shear forces
+    (Jourawski: rectangle 3/2 Q / A (1 - (2y/h)^2), circle 4/3 Q / A (1 - (y/r)^2), tube and
+    box the thin-walled shear flow), their magnitudes added (conservative), and von Mises
+    sqrt(sigma^2 + 3 tau^2). ``sigma_x`` is the normal stress of largest magnitude over the
+    fibres (signed), ``von_mises`` the largest von Mises stress.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..codes import CONSTRAINT_COORDINATE
+from .bodies import Beam, Plate, RigidBody
+from .constraint_set import ConstraintSet
+from .expressions import Scalar
+from .joints import Constraint, LinearEquation
+from .model import Model
+from .sections import Box, Circle, Rectangle, Tube
+
+#: output.stations default: points per element where section forces are evaluated
+DEFAULT_STATIONS = 3
+#: the largest FFR linear-strain matrix kept per beam (entries; 16 MB)
+LINEAR_MATRIX_LIMIT = 2_000_000
+
+
+@dataclass
+class Reaction:
+    """What body1 exerts on body2 at a joint (global axes, N and N m about ``point``)."""
+
+    force: np.ndarray
+    moment: np.ndarray
+    point: np.ndarray
+    axial: float | None = None   # distance joints: tension positive (N)
+
+
+@dataclass
+class SectionForces:
+    """Section forces along a beam: arc length s (m), N, T, Q (ns, 2) and M (ns, 2)
+    (components along the section's height and width axes); N, N m."""
+
+    s: np.ndarray
+    N: np.ndarray
+    T: np.ndarray
+    Q: np.ndarray
+    M: np.ndarray
+
+
+@dataclass
+class Stress:
+    """Stresses at the outer fibres along a beam (Pa): the signed normal stress of largest
+    magnitude and the largest von Mises stress per station."""
+
+    s: np.ndarray
+    sigma_x: np.ndarray
+    von_mises: np.ndarray
+
+
+# -- reactions -------------------------------------------------------------------------------
+class ReactionMap:
+    """The data of a model's reactions, built once: the multiplier constraints in the full
+    coordinates, the eliminated linear rows A with a factorization of A A^T, the joints'
+    rows and the coordinates of their body2."""
+
+    def __init__(self, model: Model) -> None:
+        self.model = model
+        self.joints = getattr(model, "joint_items", {})
+        owner = getattr(model, "equation_owner", {})
+        equations = getattr(model, "full_equations", {})
+        cs = model.constraints
+        full = ConstraintSet(drive_kinds=cs.drive_kinds, drive_params=cs.drive_params)
+        for c, name in enumerate(cs.names):
+            eq = equations.get(name)
+            if isinstance(eq, LinearEquation):
+                # kept with a multiplier as the assembly keeps it (assembly._as_constraint)
+                eq = Constraint(CONSTRAINT_COORDINATE, [Scalar(eq.expr.terms, 0.0)],
+                                [-eq.expr.const], None, eq.name)
+            if eq is None:  # not a joint's or body's equation: no force on the coordinates
+                full.add(cs.kinds[c], [({}, 0.0)], cs.params[c], cs.drives[c], name)
+                continue
+            full.add(eq.kind, [(dict(op.terms), op.const) for op in eq.operands], eq.params,
+                     cs.drives[c], name)
+        self.full = full
+        self.multiplier_owner = [owner.get(n) for n in cs.names]
+        eliminated = getattr(model, "eliminated", [])
+        self.linear_owner = [owner.get(eq.name) for eq in eliminated]
+        self.factor = None
+        if eliminated:
+            rows, cols, vals = [], [], []
+            for i, eq in enumerate(eliminated):
+                for d, a in eq.expr.terms.items():
+                    rows.append(i)
+                    cols.append(d)
+                    vals.append(a)
+            self.a = sp.csr_matrix((vals, (rows, cols)), shape=(len(eliminated), model.nfull))
+            self.factor = spla.splu(sp.csc_matrix(self.a @ self.a.T))
+        self.wanted = any(o is not None for o in self.multiplier_owner + self.linear_owner)
+        self.a_coo = self.a.tocoo() if self.factor is not None else None
+        self.points = {name: _joint_points(joint) for name, joint in self.joints.items()}
+
+    def residual(self, e: np.ndarray, v: np.ndarray, a: np.ndarray | None, t: float,
+                 load_factor: float, guesses: np.ndarray | None = None) -> np.ndarray:
+        """r = M q'' + Q_int(q, q') - Q(t) in the full coordinates at the solvers' state
+        (e, e', e''); ``guesses``: the contact points' projections at that state (default:
+        the model's)."""
+        m = self.model
+        internal = m.kernel.full_forces(t, e, v, m.contact_guesses if guesses is None
+                                        else guesses, load_factor=load_factor)
+        constant, driven = m.full_loads
+        external = constant.copy()
+        for index, vector in driven:
+            external += m.drives[index].value(t) * vector
+        r = internal - load_factor * external
+        if a is not None:
+            r += m.mass_full @ m.expand(a, with_offset=False)
+        return r
+
+    def _term_arrays(self) -> None:
+        """Flat arrays of the multiplier constraints' terms (constraint, operand slot, dof,
+        coefficient) and, per joint, which terms and eliminated-row entries fall on body2's
+        coordinates (built once)."""
+        con, slot, dof, coef = [], [], [], []
+        for c, per in enumerate(self.full.terms):
+            for k, terms in enumerate(per):
+                for d, a in terms:
+                    con.append(c)
+                    slot.append(k)
+                    dof.append(d)
+                    coef.append(a)
+        self.t_con, self.t_slot = np.array(con, dtype=np.int64), np.array(slot, dtype=np.int64)
+        self.t_dof, self.t_coef = np.array(dof, dtype=np.int64), np.array(coef, dtype=float)
+        owner_of_con = np.array([o or "" for o in self.multiplier_owner], dtype=object)
+        owner_of_row = np.array([o or "" for o in self.linear_owner], dtype=object)
+        self.selection = {}
+        for name, joint in self.joints.items():
+            first = joint.body2.first
+            size = joint.body2.ncoordinates
+            terms = np.flatnonzero((owner_of_con[self.t_con] == name) if len(self.t_con)
+                                   else np.zeros(0, dtype=bool))
+            terms = terms[(self.t_dof[terms] >= first) & (self.t_dof[terms] < first + size)]
+            entries = np.zeros(0, dtype=np.int64)
+            if self.a_coo is not None:
+                entries = np.flatnonzero(owner_of_row[self.a_coo.row] == name)
+                cols = self.a_coo.col[entries]
+                entries = entries[(cols >= first) & (cols < first + size)]
+            self.selection[name] = (terms, entries, first, size)
+
+    def _gradients(self, q_full: np.ndarray, t: float) -> np.ndarray:
+        """The multiplier constraints' operand gradients (6, ncon) at (q, t) from the kernel
+        (ConstraintSet.evaluate with the layout arrays built once)."""
+        if not hasattr(self, "_args"):
+            from ..kernel import _f, _kernel
+            full = self.full
+            lay = full.layout()
+            ptr = np.concatenate([[0], np.cumsum([len(p) for p in full.drive_params])]) + 1
+            data = np.concatenate([np.asarray(p, dtype=float) for p in full.drive_params]) \
+                if full.drive_params else np.zeros(1)
+            kinds = np.array(full.drive_kinds or [0], dtype=np.int32)
+            self._kernel = _kernel
+            self._args = (
+                _f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
+                _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
+                _f(lay.term_dof + 1 if len(lay.term_dof) else np.ones(1), np.int32),
+                _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
+                _f(ptr if len(full.drive_kinds) else np.ones(2), np.int32), _f(data))
+            self._zero = np.zeros(len(q_full))
+        out = self._kernel.constraint_evaluate(*self._args, np.asfortranarray(q_full),
+                                               self._zero, t)
+        if out[-1]:
+            raise ValueError(f"constraint evaluation failed (code {out[-1]})")
+        return out[1]
+
+    def generalized_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
+                         residual_rows: np.ndarray | None) -> dict[str, np.ndarray]:
+        """Each joint's constraint force on body2's coordinates, (nt, body2.ncoordinates),
+        for rows of states."""
+        if not hasattr(self, "selection"):
+            self._term_arrays()
+        nt = len(q_rows)
+        nterm = len(self.t_coef)
+        contrib = np.zeros((nt, nterm))
+        if len(self.full) and nterm:
+            for row in range(nt):
+                gradients = self._gradients(q_rows[row], float(times[row]))
+                contrib[row] = gradients[self.t_slot, self.t_con]
+            contrib *= self.t_coef * lam_rows[:, self.t_con]
+        mu = None
+        if self.factor is not None and residual_rows is not None:
+            if not hasattr(self, "_scatter_all"):
+                self._scatter_all = sp.csr_matrix(
+                    (np.ones(nterm), (np.arange(nterm), self.t_dof)),
+                    shape=(nterm, self.model.nfull))
+            total = (self._scatter_all.T @ contrib.T).T
+            rhs = self.a @ (residual_rows - total).T
+            mu = np.atleast_2d(self.factor.solve(rhs).T.reshape(nt, -1))
+        out = {}
+        for name, (terms, entries, first, size) in self.selection.items():
+            vec = contrib[:, terms] @ _scatter(self.t_dof[terms] - first, size)
+            if mu is not None and len(entries):
+                a = self.a_coo
+                vec = vec + (mu[:, a.row[entries]] * a.data[entries]) @ \
+                    _scatter(a.col[entries] - first, size)
+            out[name] = vec
+        return out
+
+    def reaction_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
+                      residual_rows: np.ndarray | None = None) -> dict[str, tuple]:
+        """Per joint (force (nt, 3), moment (nt, 3), point (nt, 3), axial (nt,) or None)
+        for rows of full coordinates and multipliers."""
+        gen = self.generalized_rows(q_rows, lam_rows, times, residual_rows)
+        return {name: _reduce_rows(joint, gen[name], q_rows, self.points[name])
+                for name, joint in self.joints.items()}
+
+    def reactions(self, q_full: np.ndarray, lam: np.ndarray, t: float = 0.0,
+                  residual: np.ndarray | None = None) -> dict[str, Reaction]:
+        rows = self.reaction_rows(q_full[None], np.asarray(lam, dtype=float)[None],
+                                  np.array([t]), None if residual is None else residual[None])
+        return {name: Reaction(f[0], m[0], p[0], None if a is None else float(a[0]))
+                for name, (f, m, p, a) in rows.items()}
+
+
+def _scatter(index: np.ndarray, size: int) -> np.ndarray:
+    """(len(index), size) 0/1 matrix adding entry k into column index[k]."""
+    out = np.zeros((len(index), size))
+    out[np.arange(len(index)), index] = 1.0
+    return out
+
+
+def _vector_blocks(body) -> tuple[int, int]:
+    """(coordinates per node, number of nodes) of a body's coordinates; the first vector
+    of each node is its position."""
+    if isinstance(body, RigidBody):
+        return 12, 1
+    if isinstance(body, Beam):
+        return 12, body.nodes
+    if isinstance(body, Plate):
+        return 9, body.mesh.nnodes
+    return 0, 0
+
+
+def _joint_points(joint) -> tuple:
+    """The joint's point on body2 (and for a distance joint point1 on body1) as
+    expressions in the full coordinates."""
+    where = f"joint {joint.name!r}"
+    body = joint.body2
+    point = joint.point2 if joint.type == "distance" else joint.points[0]
+    p2 = body.position(body.locate(point, node=False, what=where))
+    p1 = None
+    if joint.type == "distance":
+        p1 = joint.body1.position(joint.body1.locate(joint.point1, node=False, what=where))
+    return p2, p1
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b along the last axis (broadcast), without np.cross's overhead."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+def _vec_rows(expr, q_rows: np.ndarray) -> np.ndarray:
+    """A Vec3 expression at rows of coordinates: (nt, 3)."""
+    out = np.tile(expr.const, (len(q_rows), 1))
+    for d, c in expr.terms.items():
+        out += c * q_rows[:, d:d + 3]
+    return out
+
+
+def _reduce_rows(joint, generalized: np.ndarray, q_rows: np.ndarray, points: tuple):
+    """Force and moment about the joint's point of the generalized forces on body2 (nt
+    rows), the point and a distance joint's axial force."""
+    body = joint.body2
+    per, nodes = _vector_blocks(body)
+    p2, p1 = points
+    point = _vec_rows(p2, q_rows)
+    nt = len(q_rows)
+    force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
+    if per:
+        block = generalized.reshape(nt, nodes, per // 3, 3)
+        values = q_rows[:, body.first:body.first + per * nodes].reshape(nt, nodes, per // 3, 3)
+        force = block[:, :, 0, :].sum(axis=1)
+        moment = _cross(values[:, :, 0, :] - point[:, None, :], block[:, :, 0, :]).sum(axis=1)
+        moment += _cross(values[:, :, 1:, :], block[:, :, 1:, :]).sum(axis=(1, 2))
+    swapped = getattr(joint, "swapped", False)
+    if swapped:
+        force, moment = -force, -moment
+    axial = None
+    if p1 is not None:
+        u = point - _vec_rows(p1, q_rows)
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        axial = np.einsum("ti,ti->t", force if swapped else -force, u)
+    return force, moment, point, axial
+
+
+def reaction_map(model: Model) -> ReactionMap:
+    """The model's reaction data (built once, kept on the model)."""
+    cached = getattr(model, "_reaction_map", None)
+    if cached is None:
+        cached = ReactionMap(model)
+        model._reaction_map = cached
+    return cached
+
+
+def reactions(model: Model, e: np.ndarray, lam: np.ndarray, *, t: float = 0.0,
+              v: np.ndarray | None = None, a: np.ndarray | None = None,
+              load_factor: float | None = None) -> dict[str, Reaction]:
+    """Reactions of every joint by name at the solved state (e: the solvers' coordinates,
+    lam: the multipliers; for a dynamic state its velocities v and accelerations a = e'').
+    Static states need neither v nor a."""
+    rm = reaction_map(model)
+    q = model.expand(e)
+    residual = None
+    if rm.factor is not None:
+        lf = model.load_factor if load_factor is None else load_factor
+        v = np.zeros(model.ndof) if v is None else v
+        residual = rm.residual(np.asarray(e, dtype=float), v, a, t, lf)
+    return rm.reactions(q, np.asarray(lam, dtype=float), t, residual)
+
+
+# -- section forces --------------------------------------------------------------------------
+def _rows(xi: np.ndarray, length: float):
+    """Coefficient rows (n, 8) of r_x, r_xx, r_y, r_z, r_y,x, r_z,x on the element's eight
+    nodal vectors [r1, r1_x, r1_y, r1_z, r2, ...] (beam_structural.centreline_rows)."""
+    z = np.zeros_like(xi)
+    o = np.ones_like(xi)
+    slope = np.column_stack([(-6 * xi + 6 * xi**2) / length, 1 - 4 * xi + 3 * xi**2, z, z,
+                             (6 * xi - 6 * xi**2) / length, 3 * xi**2 - 2 * xi, z, z])
+    second = np.column_stack([(-6 + 12 * xi) / length**2, (-4 + 6 * xi) / length, z, z,
+                              (6 - 12 * xi) / length**2, (6 * xi - 2) / length, z, z])
+    dir_y = np.column_stack([z, z, 1 - xi, z, z, z, xi, z])
+    dir_z = np.column_stack([z, z, z, 1 - xi, z, z, z, xi])
+    dir_y_x = np.column_stack([z, z, -o, z, z, z, o, z]) / length
+    dir_z_x = np.column_stack([z, z, z, -o, z, z, z, o]) / length
+    return slope, second, dir_y, dir_z, dir_y_x, dir_z_x
+
+
+class _Tables:
+    """A beam's coefficient rows at the stations, the Gauss points and the element ends
+    (per element: (nel, npoints, 8) for each of the six fields) and its reference strains."""
+
+    def __init__(self, beam: Beam, stations: int) -> None:
+        self.xi = np.linspace(0.0, 1.0, stations)
+        gauss = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
+        unique, index = np.unique(beam.lengths, return_inverse=True)
+
+        def table(points: np.ndarray) -> list[np.ndarray]:
+            per = [_rows(points, length) for length in unique]
+            return [np.stack([rows[k] for rows in per])[index] for k in range(6)]
+        self.at, self.gauss, self.ends = table(self.xi), table(gauss), table(np.array([0.0, 1.0]))
+        # the axial strain at the element's three axial Gauss points (the element's own
+        # sampling, beam_structural n_axial = 3), and the quadratic through them at the
+        # stations: the Green strain between them carries the spurious share of the
+        # bending slopes (v'^2/2 is quartic where u' is quadratic: membrane locking)
+        axial = 0.5 + np.array([-1.0, 0.0, 1.0]) * np.sqrt(0.15)
+        self.axial = table(axial)
+        self.axial_fit = np.array([[np.prod([(x - axial[m]) / (axial[k] - axial[m])
+                                             for m in range(3) if m != k]) for k in range(3)]
+                                   for x in self.xi])   # (nxi, 3) Lagrange weights
+        self.s = (beam.stations[:-1, None] + np.outer(beam.lengths, self.xi)).ravel()
+        self.reference = _beam_vectors(beam, beam.coordinates(), 0)
+        self.strain0 = _strains(beam, self.reference, self)
+        # an FFR beam: the reference nodal vectors in its frame at t = 0 (positions from the
+        # frame's pivot), and the linear strains' matrix (built on first use)
+        local = beam.coordinates().reshape(beam.nodes, 4, 3) @ beam.orientation
+        local[:, 0, :] -= beam.frame_pivot @ beam.orientation
+        self.local_reference = local
+        self._linear: np.ndarray | None = None
+
+    def linear_strain(self, beam: Beam) -> np.ndarray:
+        """(ncoordinates, nel * nxi * 8): the strains' linear part about the reference in
+        the frame, column by column (f(x0 + e_j) - f(x0 - e_j)) / 2, exact since every
+        measure is a quadratic form of the nodal vectors."""
+        if self._linear is None:
+            n = beam.ncoordinates
+            base = self.local_reference.reshape(-1)
+            unit = np.eye(n)
+            with np.errstate(invalid="ignore", divide="ignore"):  # (unused normals)
+                plus = _strains(beam, _beam_vectors(beam, base + unit, 0), self)
+                minus = _strains(beam, _beam_vectors(beam, base - unit, 0), self)
+            self._linear = (0.5 * (plus - minus)).reshape(n, -1)
+        return self._linear
+
+
+def _tables(beam: Beam, stations: int) -> _Tables:
+    cache = beam.__dict__.setdefault("_answer_tables", {})
+    if stations not in cache:
+        cache[stations] = _Tables(beam, stations)
+    return cache[stations]
+
+
+def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
+    """(..., nel, nxi, 6) strain measures [eps, b_y, b_z, twist, gamma_y, gamma_z] of
+    every element at the stations, from the nodal vectors (..., nel, 8, 3) (vectorized over
+    the elements and any leading axes, e.g. time rows)."""
+    cubic = beam.bending == "cubic"
+    data = beam.section.data
+    xi = tables.xi
+
+    def fields(table: list[np.ndarray]) -> list[np.ndarray]:
+        return [np.matmul(t, vectors) for t in table]   # (nel, np, 8) @ (..., nel, 8, 3)
+
+    def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return (a * b).sum(axis=-1)
+    rx, rxx, ry, rz, ryx, rzx = fields(tables.at)
+    slope = np.matmul(tables.axial[0], vectors)
+    eps = 0.5 * (dot(slope, slope) - 1.0) @ tables.axial_fit.T
+    b_y = -dot(ryx, rx)
+    b_z = -dot(rzx, rx)
+    if cubic:
+        g = fields(tables.gauss)
+        b_y = b_y + dot(rxx, ry) - dot(g[1], g[2]).mean(axis=-1)[..., None]
+        b_z = b_z + dot(rxx, rz) - dot(g[1], g[3]).mean(axis=-1)[..., None]
+        twist = 0.5 * (dot(ryx, rz) - dot(rzx, ry))
+        nodal = fields(tables.ends)
+        shear_y, shear_z = dot(nodal[0], nodal[2]), dot(nodal[0], nodal[3])
+        gamma_y = shear_y[..., :1] * (1 - xi) + shear_y[..., 1:] * xi
+        gamma_z = shear_z[..., :1] * (1 - xi) + shear_z[..., 1:] * xi
+    else:
+        twist = (data.inertia_z * dot(ryx, rz) - data.inertia_y * dot(rzx, ry)) / data.polar
+        gamma_y, gamma_z = dot(rx, ry), dot(rx, rz)
+    # the directors' rates along the section normal n: the bending strains' share of the
+    # force on the section along n (their variation with r_x, -r_y,x . delta r_x)
+    normal = np.cross(ry, rz)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    c_y, c_z = -dot(ryx, normal), -dot(rzx, normal)
+    return np.stack([eps, b_y, b_z, twist, gamma_y, gamma_z, c_y, c_z], axis=-1)
+
+
+def _beam_vectors(beam: Beam, q_full: np.ndarray, first: int | None = None) -> np.ndarray:
+    """The elements' nodal vectors (..., nel, 8, 3) from coordinates (..., n) holding the
+    beam's from ``first`` (default: the beam's first coordinate)."""
+    first = beam.first if first is None else first
+    block = q_full[..., first:first + beam.ncoordinates]
+    nodal = block.reshape(*block.shape[:-1], beam.nodes, 4, 3)
+    return np.concatenate([nodal[..., :-1, :, :], nodal[..., 1:, :, :]], axis=-2)
+
+
+def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_STATIONS,
+                        frame: np.ndarray | None = None) -> SectionForces:
+    """Section forces of one beam at ``stations`` points per element (see the module
+    documentation for the strains and the sign convention) from the full coordinates
+    (nfull,) or rows of them (nt, nfull): the arrays then have a leading time axis. An
+    'ffr' beam's strains are the small-strain (linear) part in its frame, whose rotation
+    is ``frame`` ((3, 3) or (nt, 3, 3); default: the beam's frame at t = 0); every strain
+    measure is a quadratic form of the nodal vectors, so its linear part about the
+    reference x0 is exactly (f(x0 + d) - f(x0 - d)) / 2 with d the displacement in the
+    frame."""
+    if stations < 2:
+        raise ValueError("stations must be at least 2 (both ends of each element)")
+    tables = _tables(beam, stations)
+    current = _beam_vectors(beam, np.asarray(q_full, dtype=float))
+    if beam.formulation == "ffr":
+        rotation = beam.orientation if frame is None else np.asarray(frame, dtype=float)
+        nodal = np.asarray(q_full, dtype=float)[..., beam.first:beam.first + beam.ncoordinates]
+        nodal = nodal.reshape(*nodal.shape[:-1], beam.nodes, 4, 3)
+        if rotation.ndim == 3:   # per row: R^T v for every vector
+            local = np.matmul(nodal.reshape(len(rotation), -1, 3), rotation)
+            local = local.reshape(nodal.shape)
+            shift = np.einsum("i,tij->tj", beam.frame_pivot, rotation)[:, None, :]
+        else:
+            local = nodal @ rotation
+            shift = beam.frame_pivot @ rotation
+        local[..., 0, :] -= shift
+        d = local - tables.local_reference
+        if beam.ncoordinates * beam.nel * len(tables.xi) * 8 <= LINEAR_MATRIX_LIMIT:
+            d_nodal = d.reshape(*local.shape[:-3], -1)
+            change = (d_nodal @ tables.linear_strain(beam)).reshape(
+                *d_nodal.shape[:-1], beam.nel, len(tables.xi), 8)
+        else:   # a long beam: the same linear part, element by element
+            x0 = _beam_vectors(beam, tables.local_reference.reshape(-1), 0)
+            dv = _beam_vectors(beam, d.reshape(*local.shape[:-3], -1), 0)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                change = 0.5 * (_strains(beam, x0 + dv, tables) - _strains(beam, x0 - dv, tables))
+    else:
+        now = _strains(beam, current, tables)
+        change = now - tables.strain0
+    d = change.reshape(*change.shape[:-3], -1, 8)
+    data, section, mat = beam.section.data, beam.section, beam.material
+    e_mod = mat.youngs_modulus
+    g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
+    k_y, k_z = section.shear_factors
+    axial = e_mod * data.area * d[..., 0]
+    if beam.formulation != "ffr":   # large deformation: the bending strains' axial share
+        rates = now[..., 6:].reshape(*d.shape[:-1], 2)
+        axial = axial + e_mod * (data.inertia_z * d[..., 1] * rates[..., 0]
+                                 + data.inertia_y * d[..., 2] * rates[..., 1])
+    return SectionForces(
+        s=tables.s, N=axial,
+        T=g_mod * section.torsion_constant * d[..., 3],
+        Q=np.stack([k_y * g_mod * data.area * d[..., 4], k_z * g_mod * data.area * d[..., 5]],
+                   axis=-1),
+        M=np.stack([-e_mod * data.inertia_y * d[..., 2], e_mod * data.inertia_z * d[..., 1]],
+                   axis=-1))
+
+
+def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS, *,
+                   t: float | np.ndarray = 0.0) -> dict[str, SectionForces]:
+    """Section forces of every beam of the model by name at the state e (time t: where an
+    'ffr' beam's frame is); e may hold rows of states (nt, ndof) at the times t (nt,):
+    the arrays then have a leading time axis."""
+    q = model.expand(e)
+    frame_of = {s.body.name: s.frame for s in model.sets}
+    out = {}
+    for b in model.bodies:
+        if isinstance(b, Beam):
+            f = frame_of.get(b.name, 0)
+            rotation = None
+            if f:
+                info = model.frames[f - 1]
+                if not np.ndim(t):
+                    rotation = info.rotation(float(t))
+                elif info.drive_obj is None:
+                    rotation = np.broadcast_to(info.base, (len(t), 3, 3))
+                else:   # Rodrigues about the frame axis, all rows at once
+                    angle = np.array([info.drive_obj.value(float(x)) for x in t])
+                    k = info.axis / np.linalg.norm(info.axis)
+                    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]],
+                                     [-k[1], k[0], 0.0]])
+                    turn = (np.eye(3) + np.sin(angle)[:, None, None] * skew
+                            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew))
+                    rotation = turn @ info.base
+            out[b.name] = beam_section_forces(b, q, stations, rotation)
+    return out
+
+
+# -- stresses --------------------------------------------------------------------------------
+def _rectangle_torsion(long: float, short: float) -> tuple[float, float]:
+    """Saint-Venant torsion of a solid rectangle (Timoshenko & Goodier, Theory of
+    Elasticity, sec. 109): J = beta a b^3 (a the long, b the short side) and k in the
+    largest shear stress tau = T b k / J, at the middle of the long sides (square:
+    beta = 0.1406, k = 0.675, tau = T / (0.208 a^3))."""
+    ratio = long / short
+    n = np.arange(1, 60, 2, dtype=float)
+    beta = (1.0 - 192.0 / np.pi**5 / ratio * np.sum(np.tanh(n * np.pi * ratio / 2) / n**5)) / 3
+    with np.errstate(over="ignore"):
+        k = 1.0 - 8.0 / np.pi**2 * np.sum(1.0 / (n**2 * np.cosh(n * np.pi * ratio / 2)))
+    return beta * long * short**3, k
+
+
+def fibre_stresses(section, forces: SectionForces) -> tuple[np.ndarray, np.ndarray]:
+    """(sigma_x, tau) at the section's fibre points for every station: (..., ns, npoints)."""
+    data = section.data
+    points = np.asarray(section.fibre_points, dtype=float)
+    y, z = points[:, 0], points[:, 1]
+    n, t = forces.N[..., None], forces.T[..., None]
+    q_h, q_w = forces.Q[..., 0:1], forces.Q[..., 1:2]
+    m_h, m_w = forces.M[..., 0:1], forces.M[..., 1:2]
+    sigma = n / data.area - m_w * y / data.inertia_z + m_h * z / data.inertia_y
+    half_y, half_z = section.extent
+    if isinstance(section, Rectangle):
+        long, short = max(section.height, section.width), min(section.height, section.width)
+        j_sv, k_long = _rectangle_torsion(long, short)
+        tau_max = np.abs(t) * short * k_long / j_sv
+        # along each side parabolic from zero at the corners to the largest value in its
+        # middle (on the short sides an overestimate: conservative)
+        on_y_side = np.isclose(np.abs(y), half_y)     # top and bottom (along the width)
+        u = np.where(on_y_side, z / half_z, y / half_y)
+        tau_t = tau_max * (1.0 - u**2)
+        tau_q = 1.5 * (np.abs(q_h) * (1 - (y / half_y) ** 2)
+                       + np.abs(q_w) * (1 - (z / half_z) ** 2)) / data.area
+    elif isinstance(section, Box):
+        wall = section.wall
+        h_m, w_m = section.height - wall, section.width - wall
+        tau_t = np.abs(t) / (2.0 * h_m * w_m * wall) * np.ones_like(y)
+        tau_q = (np.abs(q_h) * _box_flow(y, z, h_m, w_m, wall, data.inertia_z)
+                 + np.abs(q_w) * _box_flow(z, y, w_m, h_m, wall, data.inertia_y)) / wall
+    elif isinstance(section, (Tube, Circle)):
+        r_o = 0.5 * section.diameter
+        r_i = r_o - section.wall if isinstance(section, Tube) else 0.0
+        tau_t = np.abs(t) * r_o / section.torsion_constant * np.ones_like(y)
+        first = 2.0 / 3.0 * (r_o**3 - r_i**3)        # first moment of half the section
+        peak = first / (data.inertia_z * 2.0 * (r_o - r_i))   # tau at the neutral axis per Q
+        tau_q = peak * (np.abs(q_h) * (1 - (y / r_o) ** 2) + np.abs(q_w) * (1 - (z / r_o) ** 2))
+    else:  # a general section: torsion T r / J at the fibre's distance, mean shear
+        r = np.hypot(y, z)
+        tau_t = np.abs(t) * r / section.torsion_constant
+        tau_q = (np.abs(q_h) + np.abs(q_w)) / data.area * np.ones_like(y)
+    return sigma, tau_t + tau_q
+
+
+def _box_flow(y, z, h_m, w_m, wall, inertia) -> np.ndarray:
+    """Shear flow per unit shear force (1/m) of a thin-walled box under a shear force
+    along y (midline height h_m, width w_m): zero in the middle of the flanges, growing
+    linearly to the corners and parabolically down the webs; at an outline point (y, z)."""
+    on_flange = np.abs(np.abs(y) - (h_m + wall) / 2) < 1e-12 + 1e-9 * h_m
+    zz = np.minimum(np.abs(z), w_m / 2)
+    yy = np.minimum(np.abs(y), h_m / 2)
+    flange = wall * (h_m / 2) * zz / inertia
+    corner = wall * h_m * w_m / 4 / inertia
+    web = corner + wall * (h_m**2 / 4 - yy**2) / 2 / inertia
+    return np.where(on_flange, flange, web)
+
+
+def beam_stress(section, forces: SectionForces) -> Stress:
+    """Stresses along a beam from its section forces."""
+    sigma, tau = fibre_stresses(section, forces)
+    worst = np.argmax(np.abs(sigma), axis=-1)[..., None]
+    return Stress(s=forces.s, sigma_x=np.take_along_axis(sigma, worst, axis=-1)[..., 0],
+                  von_mises=np.sqrt(sigma**2 + 3.0 * tau**2).max(axis=-1))
+
+
+def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress]:
+    """Stresses of every beam by name from its section forces."""
+    beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+    return {name: beam_stress(beams[name].section, f) for name, f in forces.items()}
+
+
+@dataclass
+class Answers:
+    """Everything SPEC section 10 asks of one state, by name."""
+
+    reactions: dict[str, Reaction]
+    sections: dict[str, SectionForces]
+    stress: dict[str, Stress]
+
+
+def static_answers(model: Model, e: np.ndarray, lam: np.ndarray,
+                   stations: int = DEFAULT_STATIONS) -> Answers:
+    """Reactions, section forces and stresses of a static state (e, lambda): what the
+    result writers store under /static and the results object exposes."""
+    forces = section_forces(model, e, stations)
+    return Answers(reactions(model, e, lam), forces, stresses(model, forces))
+
+
+def constraint_joints(model: Model) -> list[str]:
+    """The joint each multiplier (row of lambda) belongs to ('' for a body's own
+    constraints: a rigid body's orthonormality, a planar guide)."""
+    owner = getattr(model, "equation_owner", {})
+    return [owner.get(name, "") for name in model.constraints.names]
+
+
+class DynamicAnswers:
+    """Reactions, section forces and the stress envelope of a dynamic run, row by row
+    from the chunks of the stepper (a sink: ``recorder(chunk)``; the chunks must carry q).
+
+    The eliminated joints' reactions need the accelerations: they are rebuilt from the
+    coordinates of consecutive rows by the integrator's own relations (time_integrator:
+    e_{n+1} = e_n + h e'_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}),
+    e'_{n+1} = e'_n + h ((1 - gamma) a_n + gamma a_{n+1}), (1 - alpha_m) a_{n+1} + alpha_m
+    a_n = (1 - alpha_f) e''_{n+1} + alpha_f e''_n) from the initial state (v0, a0)."""
+
+    def __init__(self, model: Model, *, beta: float, gamma: float, alpha_m: float,
+                 alpha_f: float, stations: int = DEFAULT_STATIONS, keep_sections: bool = False,
+                 initial: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        self.model, self.stations, self.keep_sections = model, stations, keep_sections
+        self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
+        self.map = reaction_map(model)
+        self.need_acceleration = self.map.factor is not None
+        self.initial = initial
+        self.state: tuple | None = None
+        self.time: list[float] = []
+        #: per joint, per chunk: (force (nt, 3), moment (nt, 3), axial (nt,) or None)
+        self.reactions: dict[str, list[tuple]] = {name: [] for name in self.map.joints}
+        self.sections: dict[str, list[SectionForces]] = {}
+        self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self.beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+
+    def _kinematics(self, t: float, e: np.ndarray):
+        """(e', e'') at the row, rebuilt from the previous row."""
+        if self.state is None:
+            v, a = self.initial if self.initial is not None else \
+                (np.zeros_like(e), np.zeros_like(e))
+            self.state = (t, e.copy(), v.copy(), a.copy(), a.copy())
+            return v, a
+        t0, e0, v0, a0, accel0 = self.state
+        h = t - t0
+        b, g, am, af = self.beta, self.gamma, self.alpha_m, self.alpha_f
+        a1 = (e - e0 - h * v0 - h * h * (0.5 - b) * a0) / (b * h * h)
+        v1 = v0 + h * ((1.0 - g) * a0 + g * a1)
+        accel1 = ((1.0 - am) * a1 + am * a0 - af * accel0) / (1.0 - af)
+        self.state = (t, e.copy(), v1, a1, accel1)
+        return v1, accel1
+
+    def __call__(self, chunk) -> None:
+        if chunk.q is None:
+            raise ValueError("DynamicAnswers needs the coordinates of every step (store_q)")
+        times = np.asarray(chunk.time, dtype=float)
+        if not len(times):
+            return
+        e_rows = np.asarray(chunk.q, dtype=float)
+        q_rows = self.model.expand(e_rows)
+        residual = None
+        if self.need_acceleration:
+            lf = self.model.load_factor
+            residual = np.empty_like(q_rows)
+            for row, t in enumerate(times):
+                v, accel = self._kinematics(float(t), e_rows[row])
+                guesses = None
+                if getattr(chunk, "contact", None) is not None:   # xi, eta of each point
+                    guesses = np.ascontiguousarray(chunk.contact[row, :, 4:6].T)
+                residual[row] = self.map.residual(e_rows[row], v, accel, float(t), lf,
+                                                  guesses)
+        if self.map.joints:
+            found = self.map.reaction_rows(q_rows, np.asarray(chunk.lam, dtype=float), times,
+                                           residual)
+            for name, (force, moment, _, axial) in found.items():
+                self.reactions[name].append((force, moment, axial))
+        self.time.extend(times.tolist())
+        if not self.beams:
+            return
+        forces = section_forces(self.model, np.asarray(chunk.q), self.stations, t=times)
+        for name, f in forces.items():
+            if self.keep_sections:
+                self.sections.setdefault(name, []).append(f)
+            vm = beam_stress(self.beams[name].section, f).von_mises   # (nt, ns)
+            row = np.argmax(vm, axis=0)
+            peak = vm[row, np.arange(vm.shape[1])]
+            if name not in self.envelope:
+                self.envelope[name] = (f.s, peak.copy(), times[row].copy())
+            else:
+                _, best, when = self.envelope[name]
+                higher = peak > best
+                best[higher] = peak[higher]
+                when[higher] = times[row][higher]
+
+
+__all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions", "section_forces",
+           "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
+           "DEFAULT_STATIONS",
+           "DynamicAnswers", "constraint_joints"]
