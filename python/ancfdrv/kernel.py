@@ -202,6 +202,16 @@ def ffr_element_stiffness(stiffness0, rotation) -> np.ndarray:
     return _kernel.ffr_element_stiffness(stiffness0, _f(rotation))
 
 
+def vector_load_force(kind: int, vector, shares, a, b):
+    """A driven or follower point load (vector_loads.f90): forces (3, 3) on the slots
+    (a, b, p) and the Jacobian (3, 3, 3, 2): d force(i, slot) / d (a, b)(j)."""
+    force, jacobian, info = _kernel.vector_load_generalized_force(
+        kind, _f(vector), _f(shares), _f(a), _f(b))
+    if info:
+        raise SolverError(f"point load of unknown kind {kind}")
+    return force, jacobian
+
+
 def moment_force(director, axis, magnitude):
     """Dead moment on a section director: force (3,), Jacobian (3, 3), Hessian (3, 3, 3)."""
     force, jacobian, hessian, info = _kernel.moment_generalized_force(_f(director), _f(axis),
@@ -523,6 +533,24 @@ class KernelSystem:
             _pad_last(np.asarray(moment_references, dtype=float).reshape(-1, 3).T),
             ndof=self.ndof)
         self._check(info, "loads")
+
+    def set_vector_loads(self, loads) -> None:
+        """Driven and follower point loads (model.VectorLoadInfo)."""
+        ptr, dofs, coefs = [0], [], []
+        for load in loads:
+            for slot in load.slots:
+                dofs += [d for d, _ in slot]
+                coefs += [c for _, c in slot]
+                ptr.append(len(dofs))
+        info = _kernel.system_set_vector_loads(
+            self.handle, len(loads), len(dofs),
+            _pad_last(np.array([x.kind for x in loads], dtype=np.int32), np.int32),
+            _pad_last(np.array([x.drive + 1 for x in loads], dtype=np.int32), np.int32),
+            _pad_last(np.array([x.vector for x in loads], dtype=float).reshape(-1, 3).T),
+            _pad_last(np.array([x.shares for x in loads], dtype=float).reshape(-1, 2).T),
+            _i(np.array(ptr) + 1), _pad_last(np.array(dofs, dtype=np.int32) + 1, np.int32),
+            _pad_last(np.array(coefs, dtype=float)))
+        self._check(info, "vector loads")
 
     def set_constraints(self, layout: "ConstraintLayout") -> None:
         ncon, nterm = len(layout.kinds), len(layout.term_dof)

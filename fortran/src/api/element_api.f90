@@ -557,3 +557,15 @@ subroutine direct_destroy(handle, info)
   call solver_destroy(handle, info)
 end subroutine direct_destroy
 
+!> Generalized forces of one driven or follower point load (vector_loads) on its slots
+!> (a, b, p) and their Jacobian(i, slot, j, wrt) with respect to a (wrt 1) and b (wrt 2).
+subroutine vector_load_generalized_force(kind, vector, shares, a, b, force, jacobian, info)
+  use ancf_kinds, only: dp
+  use vector_loads, only: vector_load_force
+  implicit none
+  integer, intent(in) :: kind
+  real(dp), intent(in) :: vector(3), shares(2), a(3), b(3)
+  real(dp), intent(out) :: force(3, 3), jacobian(3, 3, 3, 2)
+  integer, intent(out) :: info
+  call vector_load_force(kind, vector, shares, a, b, force, jacobian, info)
+end subroutine vector_load_generalized_force

@@ -96,7 +96,7 @@ contains
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if
     call mass_product(sys, acceleration, r)
-    call external_forces(sys, t, 1.0_dp, loads, info)
+    call external_forces(sys, t, 1.0_dp, loads, info, e)
     if (info /= 0) return
     r = r + internal - loads
     call evaluate_constraints(sys, e, t, phi, gradients, info)

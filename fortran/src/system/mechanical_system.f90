@@ -34,6 +34,7 @@ module mechanical_system
   use constraints, only: constraint_eval, operand_values, drive_value
   use element_sets, only: element_set, set_forces, set_energy_power, set_ffr, frame_omega
   use section_moment, only: moment_force, moment_angle
+  use vector_loads, only: vector_load_force
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record
   use sparse_direct, only: solver_solve, solver_factorize
   implicit none
@@ -105,6 +106,12 @@ module mechanical_system
     real(dp), allocatable :: force_vectors(:, :)
     integer, allocatable :: moment_dofs(:, :)
     real(dp), allocatable :: moment_axis(:, :), moment_magnitude(:), moment_reference(:, :)
+    ! driven and follower point loads (vector_loads): per load a kind, a drive (0: none), a
+    ! vector, the torsion shares, and the terms of its slots a, b, p on full coordinates
+    ! (vload_ptr(3 (l - 1) + s) .. vload_ptr(3 (l - 1) + s + 1) - 1)
+    integer :: nvload = 0
+    integer, allocatable :: vload_kind(:), vload_drive(:), vload_ptr(:), vload_dof(:)
+    real(dp), allocatable :: vload_vector(:, :), vload_shares(:, :), vload_coef(:)
     ! constraints with multipliers (constraints module layout)
     integer :: ncon = 0
     integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
@@ -458,15 +465,27 @@ contains
 
   !> Configuration-independent external loads at t, times load_factor: the constant loads
   !> plus the driven forces. info = 5 when a drive fails.
-  subroutine external_forces(sys, t, load_factor, force, info)
+  !> With e, the driven and follower point loads at e are added (vector_load_forces).
+  subroutine external_forces(sys, t, load_factor, force, info, e)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: t, load_factor
     real(dp), intent(out) :: force(:)
     integer, intent(out) :: info
+    real(dp), intent(in), optional :: e(:)
     real(dp) :: phi, dphi, ddphi
+    real(dp), allocatable :: e_full(:), full_force(:), reduced(:)
     integer :: d
     info = 0
     force = load_factor * sys%constant_force
+    if (present(e) .and. sys%nvload > 0) then
+      allocate (e_full(sys%nfull), full_force(sys%nfull), reduced(sys%ndof))
+      call to_full(sys, e, .true., e_full)
+      full_force = 0.0_dp
+      call vector_load_forces(sys, t, e_full, load_factor, full_force, info)
+      if (info /= 0) return
+      call to_reduced(sys, full_force, reduced)
+      force = force + reduced
+    end if
     do d = 1, size(sys%force_drive)
       call drive_value(sys%force_drive(d), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
                        phi, dphi, ddphi, info)
@@ -477,6 +496,48 @@ contains
       force = force + load_factor * phi * sys%force_vectors(:, d)
     end do
   end subroutine external_forces
+
+  !> The driven and follower point loads at the full coordinates e_full and time t, times
+  !> load_factor, added to full_force. info = 5 when a drive fails, 6 for a malformed load.
+  subroutine vector_load_forces(sys, t, e_full, load_factor, full_force, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, e_full(:), load_factor
+    real(dp), intent(inout) :: full_force(:)
+    integer, intent(out) :: info
+    real(dp) :: phi, dphi, ddphi, x(3, 3), force(3, 3), jacobian(3, 3, 3, 2)
+    integer :: l, s, k, dof
+    info = 0
+    do l = 1, sys%nvload
+      phi = 1.0_dp
+      if (sys%vload_drive(l) > 0) then
+        call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+                         t, phi, dphi, ddphi, info)
+        if (info /= 0) then
+          info = 5
+          return
+        end if
+      end if
+      x = 0.0_dp
+      do s = 1, 2
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          dof = sys%vload_dof(k)
+          x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(dof:dof + 2)
+        end do
+      end do
+      call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
+                             sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
+      if (info /= 0) then
+        info = 6
+        return
+      end if
+      do s = 1, 3
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          dof = sys%vload_dof(k)
+          full_force(dof:dof + 2) = full_force(dof:dof + 2) + sys%vload_coef(k) * force(:, s)
+        end do
+      end do
+    end do
+  end subroutine vector_load_forces
 
   !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
   !> drive cannot be evaluated.

@@ -411,13 +411,19 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
                                         "fix", "arm", "hub"), doc="joint type (SPEC section 8)"),
         "body1": Key("str", "ground", doc="first body (or 'ground')"),
         "body2": Key("str", doc="second body"),
-        "point": Key("floats", None, points3, "joint point(s) (nodes of beams and plates)"),
+        "point": Key("floats", None, points3, "joint point(s): any material points of the bodies "
+                     "(between nodes, off a beam's axis)"),
         "axis": Key("floats", None, vector3, "hinge axis / direction"),
         "drive": Key("str", None, doc="drive of 'distance', 'prescribed', 'hub'"),
         "point1": Key("floats", None, vector3, "'distance': point on body1"),
         "point2": Key("floats", None, vector3, "'distance': point on body2"),
         "pivot": Key("floats", None, vector3, "'prescribed', 'arm', 'hub': centre of rotation"),
         "vector": Key("str", "r", one_of("r", "r_x", "r_y", "r_z"), "'fix': the nodal vector held"),
+        "edge": Key("str", None, one_of("x0", "x1", "y0", "y1"),
+                    "instead of point: every node of a plate's or leaf's side (x0, x1: the ends "
+                    "along edge_x; y0, y1: the sides along edge_y), whatever the mesh"),
+        "box": Key("floats", None, size=6, doc="instead of point: every node of the flexible body "
+                   "in the box x0, y0, z0, x1, y1, z1 (m), whatever the mesh"),
     },
     "drive": {
         "name": _name(),
@@ -450,7 +456,10 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "vector": Key("floats", None, vector3, "gravity (m/s^2), force (N), moment (N m)"),
         "mass": Key("float", None, non_negative, "'point_mass': mass (kg)"),
         "value": Key("float", None, doc="'pressure': pressure (Pa) against the normal"),
-        "drive": Key("str", None, doc="'force': scales the vector with the drive's value"),
+        "drive": Key("str", None, doc="'force', 'moment': scales the vector with the drive's "
+                     "value (a pulse, a table)"),
+        "follower": Key("bool", False, doc="'force', 'moment': the vector is fixed in the body's "
+                        "material frame at the point (given at t = 0) and turns with it"),
         "effect": Key("str", None, doc="the effect it belongs to (default by type: gravity, "
                       "point_loads, point_loads, tip_mass, pressure)"),
     },

@@ -22,7 +22,8 @@ from .drives import Constant
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation, orthonormality, planar_fixes, small_turn
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
-from .model import FrameInfo, MomentInfo, Model, ProbeInfo, SetInfo
+from .model import (VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_FORCE, VLOAD_FOLLOWER_MOMENT, FrameInfo,
+                    MomentInfo, Model, ProbeInfo, SetInfo, VectorLoadInfo)
 from .patterns import Elimination, Pattern, eliminate, reduction_plan
 
 #: effects every model reports (a zero count proves an effect was not computed)
@@ -86,6 +87,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
 
     # mass and loads in full coordinates
     mass_full = _mass(bodies, sets, act.masses, full_pattern, counters)
+    vector_loads = _vector_loads(act, q0, drive_index, counters)
     gravity, constant, driven = _loads(bodies, sets, act, drive_index, counters, nfull)
     moments = _moments(act.moments, q0, counters)
 
@@ -131,6 +133,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         moments=moments, constraints=constraints, contact_pairs=contact_pairs, probes=probes,
         point_masses=[(m.body.name, m.point, m.mass) for m in act.masses],
         linear_joints=mode)
+    model.vector_loads = vector_loads
     model.frame_problems = frame_problems
     _policy(model)
     model.build_kernel()
@@ -375,35 +378,96 @@ def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list
     out = []
     for load in loads:
         body = load.body
-        at = body.locate(load.point, node=not isinstance(body, RigidBody),
-                         what=f"load {load.name!r}")
         axis = load.vector / np.linalg.norm(load.vector)
-        magnitude = float(np.linalg.norm(load.vector))
-        firsts = {which: next(iter(body.vector(at, which).terms))
-                  for which in body.directors(at)}
-        if isinstance(body, RigidBody):
-            best = None
-            for which, first in firsts.items():
-                d = q0[first:first + 3]
-                score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
-                if best is None or score > best[0] + 1e-12:
-                    best = (score, first)
-            parts = [(best[1], axis, magnitude)]
+        for at, share in _moment_nodes(body, load):
+            out += _moment_parts(body, at, load, axis, share * float(np.linalg.norm(load.vector)),
+                                 q0)
+        counters[load.effect] += 1
+    return out
+
+
+def _moment_nodes(body: Body, load) -> list[tuple]:
+    """Where a moment acts: (attachment, share) at a node, or on a beam between nodes the
+    two nodes of its element in the shares (1 - xi, xi) by which its directors r_y, r_z
+    interpolate them there (the virtual work of the moment on the interpolated section's
+    turn); the point's offset from the axis does not matter for a moment."""
+    what = f"load {load.name!r}"
+    if isinstance(body, RigidBody):
+        return [(body.locate(load.point, node=False, what=what), 1.0)]
+    if isinstance(body, Beam):
+        at = body.locate(load.point, node=False, what=what)
+        if at.node is not None:
+            return [(at, 1.0)]
+        xi = at.local[0]
+        nodes = [(at.element, 1.0 - xi), (at.element + 1, xi)]
+        return [(type(at)(node, at.element, at.local), w) for node, w in nodes if w > 0.0]
+    return [(body.locate(load.point, node=True, what=what), 1.0)]
+
+
+def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
+                  q0: np.ndarray) -> list[MomentInfo]:
+    """The dead moment's parts on the directors of one node (see :func:`_moments`)."""
+    out = []
+    firsts = {which: next(iter(body.vector(at, which).terms))
+              for which in body.directors(at)}
+    if isinstance(body, RigidBody):
+        best = None
+        for which, first in firsts.items():
+            d = q0[first:first + 3]
+            score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
+            if best is None or score > best[0] + 1e-12:
+                best = (score, first)
+        parts = [(best[1], axis, magnitude)]
+    else:
+        f1, f2 = firsts.values()
+        u1 = q0[f1:f1 + 3] / np.linalg.norm(q0[f1:f1 + 3])
+        u2 = q0[f2:f2 + 3] / np.linalg.norm(q0[f2:f2 + 3])
+        normal = np.cross(u1, u2)
+        normal /= np.linalg.norm(normal)
+        m_n, m_1, m_2 = (float(magnitude * axis @ u) for u in (normal, u1, u2))
+        w1, w2 = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
+        parts = [(f1, normal, w1 * m_n), (f2, normal, w2 * m_n), (f2, u1, m_1),
+                 (f1, u2, m_2)]
+        parts = [(f, np.sign(m) * k, abs(m)) for f, k, m in parts
+                 if abs(m) > 1e-14 * magnitude]
+    for first, k, m in parts:
+        out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
+                              q0[first:first + 3].copy()))
+    return out
+
+
+def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
+                  counters: Counter) -> list[VectorLoadInfo]:
+    """The driven and follower point loads (kernel module vector_loads), taken out of the
+    dead forces and moments: a follower force, a moment with a drive or a follower moment.
+    Each acts through the two directions a, b of the body at its point (beam: r_y, r_z;
+    plate, leaf, rigid body: r_x, r_y; interpolated between nodes) and its position p; a
+    follower's vector is kept as its components on (a, b, a x b) at t = 0."""
+    out = []
+    chosen = [x for x in act.forces if x.follower] + \
+        [x for x in act.moments if x.follower or x.drive is not None]
+    act.forces[:] = [x for x in act.forces if not x.follower]
+    act.moments[:] = [x for x in act.moments if not (x.follower or x.drive is not None)]
+    for load in chosen:
+        body = load.body
+        at = body.locate(load.point, node=False, what=f"load {load.name!r}")
+        names = ("r_y", "r_z") if isinstance(body, Beam) else ("r_x", "r_y")
+        a, b = (body.vector(at, w) for w in names)
+        p = body.position(at)
+        a0, b0 = a.value(q0), b.value(q0)
+        frame = np.column_stack([a0, b0, np.cross(a0, b0)])
+        force = isinstance(load, PointForce)
+        if load.follower:
+            kind = VLOAD_FOLLOWER_FORCE if force else VLOAD_FOLLOWER_MOMENT
+            vector = np.linalg.solve(frame, load.vector)
         else:
-            f1, f2 = firsts.values()
-            u1 = q0[f1:f1 + 3] / np.linalg.norm(q0[f1:f1 + 3])
-            u2 = q0[f2:f2 + 3] / np.linalg.norm(q0[f2:f2 + 3])
-            normal = np.cross(u1, u2)
-            normal /= np.linalg.norm(normal)
-            m_n, m_1, m_2 = (float(magnitude * axis @ u) for u in (normal, u1, u2))
-            w1, w2 = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
-            parts = [(f1, normal, w1 * m_n), (f2, normal, w2 * m_n), (f2, u1, m_1),
-                     (f1, u2, m_2)]
-            parts = [(f, np.sign(m) * k, abs(m)) for f, k, m in parts
-                     if abs(m) > 1e-14 * magnitude]
-        for first, k, m in parts:
-            out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
-                                  q0[first:first + 3].copy()))
+            kind, vector = VLOAD_DEAD_MOMENT, load.vector.copy()
+        shares = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
+        slots = [sorted(a.terms.items()), sorted(b.terms.items()),
+                 sorted(p.terms.items()) if force else []]
+        drive = -1 if load.drive is None else drive_index[id(load.drive)]
+        out.append(VectorLoadInfo(load.name, kind, drive, vector, np.array(shares, float),
+                                  slots, load.effect))
         counters[load.effect] += 1
     return out
 

@@ -289,9 +289,18 @@ class Beam(Body):
         return Vec3({first + 3 * a: float(shape[a, 0]) for a in range(8) if shape[a, 0] != 0.0})
 
     def vector(self, at: Attachment, which: str) -> Vec3:
-        if at.node is None:
-            raise InputError(f"beam {self.name!r}: nodal vectors exist at nodes only")
-        return Vec3.of(self.node_first(at.node, which))
+        """A nodal vector at a node; between nodes or off the axis the same gradient of the
+        position field at the material point (through the shape functions: r_x = dr/dx,
+        r_y = dr/dy, r_z = dr/dz there; r_y and r_z interpolate the two nodes' directors)."""
+        if at.node is not None:
+            return Vec3.of(self.node_first(at.node, which))
+        if which == "r":
+            return self.position(at)
+        xi, y, z = at.local
+        derivs = kernel.beam_shape([xi], [y], [z], [self.lengths[at.element]])
+        weights = derivs[VECTOR_OFFSETS[which] // 3][:, 0]
+        first = self.first + BEAM_NODE_DOFS * at.element
+        return Vec3({first + 3 * a: float(weights[a]) for a in range(8) if weights[a] != 0.0})
 
     def basis(self, at: Attachment) -> list[Vec3]:
         return [self.vector(at, w) for w in ("r_x", "r_y", "r_z")]
@@ -423,10 +432,21 @@ class Plate(Body):
         return Vec3({int(dofs[3 * a]): float(shape[a]) for a in range(12) if shape[a] != 0.0})
 
     def vector(self, at: Attachment, which: str) -> Vec3:
-        if at.node is None:
-            raise InputError(f"{type(self).__name__.lower()} {self.name!r}: nodal vectors "
-                             "exist at nodes only")
-        return Vec3.of(self.node_first(at.node, which))
+        """A nodal vector at a node; elsewhere the gradient of the mid-surface at the point
+        (r_x = dr/dx, r_y = dr/dy through the shape functions)."""
+        if at.node is not None:
+            return Vec3.of(self.node_first(at.node, which))
+        if which == "r":
+            return self.position(at)
+        if which == "r_z":
+            raise InputError(f"{type(self).__name__.lower()} {self.name!r}: points carry r, "
+                             "r_x, r_y (no r_z)")
+        xi, eta = at.local
+        _, derivs = kernel.plate_shape(xi, eta, self.mesh.a[at.element], self.mesh.b[at.element])
+        weights = derivs[:, 0 if which == "r_x" else 1]
+        dofs = self.element_dofs()[:, at.element]
+        return Vec3({int(dofs[3 * a]): float(weights[a]) for a in range(12)
+                     if weights[a] != 0.0})
 
     def basis(self, at: Attachment) -> list[Vec3]:
         return [self.vector(at, "r_x"), self.vector(at, "r_y")]
