@@ -806,12 +806,12 @@ def test_duplicate_names_are_named(what):
         calls[what]()
 
 
-def test_joint_point_that_is_not_a_node_is_named():
-    """A weld at a point of the beam between its nodes (x = 0.7 m; nodes at 0, 1, 2 m):
-    InputError naming the joint, the beam and the nearest node."""
+def test_joint_point_off_the_body_is_named():
+    """A weld at a point beyond the beam's end (x = 2.5 m; the beam ends at 2 m): InputError
+    naming the joint and the beam (SPEC 8.1 allows any material point, between nodes too)."""
     s = _base()
-    s.joint("clamp", "weld", "ground", "beam", point=(0.7, 0, 0))
-    with pytest.raises(InputError, match=r"joint 'clamp'.*not a node of beam 'beam'.*nearest node"):
+    s.joint("clamp", "weld", "ground", "beam", point=(2.5, 0, 0))
+    with pytest.raises(InputError, match=r"joint 'clamp'.*not a material point of beam 'beam'"):
         s.assemble()
 
 
