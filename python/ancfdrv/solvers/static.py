@@ -26,6 +26,7 @@ import scipy.sparse as sp
 from ..errors import SolverError
 from ..kernel import DirectSolver
 from ..system.model import Model
+from .assumptions import check_ffr
 
 
 @dataclass
@@ -184,6 +185,7 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
             model.load_factor = 1.0
             model.counters["factorizations"] += solver.factorizations
             model.counters["solves"] += solver.solves
+    check_ffr(model, model.e0 + d, 0.0, when="in the static equilibrium")
     wall = time.perf_counter() - start
     timing["total"] = wall
     return StaticResult(model.e0 + d, lam, "newton", total, force_res, con_res, wall, history,
@@ -390,6 +392,7 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     timing["assembly"] += time.perf_counter() - t0
     wall = time.perf_counter() - start
     timing["total"] = wall
+    check_ffr(model, model.e0 + disp, 0.0, when="in the static equilibrium")
     return StaticResult(model.e0 + disp, lam, "split", outer, force_res, con_res, wall, history,
                         timing, extra={"inner_iterations": inner_total, "p": p,
                                        "converged_by": how, "nonlinear_coordinates": nl})

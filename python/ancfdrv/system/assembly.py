@@ -581,6 +581,7 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
         for b in basis:
             r -= (b @ r) * b
         if np.linalg.norm(r) <= 1e-8 * norm:
+            _check_consistent(out, c, keep, gradients, e0, scale)
             notes.append(f"redundant joint equation dropped: {name} (implied by the others)")
             continue
         basis.append(r / np.linalg.norm(r))
@@ -596,6 +597,37 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
         taken.add(choice)
         out.dependent.append(choice)
     return out
+
+
+#: times (s) at which a redundant driven equation is compared with those that imply it
+_CONSISTENCY_TIMES = (1e-3, 0.01, 0.05, 0.1, 0.25, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0, 30.0, 100.0)
+
+
+def _check_consistent(out: ConstraintSet, c: int, keep: list[int], gradients: np.ndarray,
+                      e0: np.ndarray, scale: float) -> None:
+    """A redundant equation (its gradient g_c = sum a_k g_k of the kept ones at t = 0) may be
+    dropped only if it agrees with them: with the configuration held at e0, its value must
+    stay sum a_k Phi_k(e0, t) at every sampled time (only driven equations change with t;
+    two contradictory 'prescribed' motions of one point differ). Checked where the equation
+    and those it combines are linear in the coordinates (coordinate kind: exact); else
+    InputError naming both joints."""
+    if out.drives[c] < 0 and all(out.drives[k] < 0 for k in keep):
+        return
+    rows = gradients[keep]
+    coef, *_ = np.linalg.lstsq(rows.T, gradients[c], rcond=None)
+    used = [k for k, a in zip(keep, coef) if abs(a) > 1e-12]
+    if any(out.kinds[k] != CONSTRAINT_COORDINATE for k in used + [c]):
+        return   # a nonlinear equation: the combination holds to first order only
+    tol = 1e-8 * scale
+    for t in _CONSISTENCY_TIMES:
+        values, *_ = out.evaluate(e0, t)
+        mismatch = float(values[c] - coef @ values[keep])
+        if abs(mismatch) > tol:
+            other = keep[int(np.argmax(np.abs(coef)))]
+            raise InputError(
+                f"{out.names[c]}: contradicts {out.names[other]}: the two joints hold the same "
+                f"coordinate (the equation is redundant) but prescribe different motions "
+                f"(off by {mismatch:.3e} at t = {t:g} s); remove one of them")
 
 
 def _constant_constraint(eq: Constraint, x: list[float], tol: float, notes: list[str]) -> None:
@@ -648,6 +680,31 @@ def _anchors(body: Body, joints) -> set:
     return out
 
 
+def _turned_by(beam: Beam, component: set, joints) -> str:
+    """Why an 'ffr' beam in a fixed frame cannot stay in it ('' when it can): no weld, fixed
+    hub or fixed section director clamps it to the ground, and a joint with a moving drive ('distance' as a
+    cylinder, 'prescribed', 'hub', 'arm') acts in the assembly it belongs to, so the drive
+    can turn it about its hinge (a knuckle crane's boom lifted by its cylinder) while its
+    elastic model stays in the frame of t = 0."""
+    if beam.frame_drive is not None:
+        return ""
+    for joint in joints:
+        if beam in (joint.body1, joint.body2) and isinstance(joint.body1, Ground) and (
+                joint.type == "weld" or (joint.type == "hub" and _moving(joint.drive) is None)
+                or (joint.type == "fix" and joint.vector in ("r_y", "r_z"))):
+            return ""
+    for joint in joints:
+        moving = _moving(joint.drive)
+        if moving is None or not ({joint.body1, joint.body2} & component):
+            continue
+        return (f"beam {beam.name!r}: formulation 'ffr' keeps its floating frame fixed, but "
+                f"joint {joint.name!r} moves the assembly it belongs to with drive {moving!r} "
+                "and no weld or fixed hub clamps the beam to the ground: the drive can turn "
+                "it through a large angle, which its frame does not follow; use formulation = "
+                "'nonlinear' for it, or a frame_drive that turns its frame with that motion")
+    return ""
+
+
 def ffr_frame_problems(system) -> list[str]:
     """Why an 'ffr' beam is refused (one message per beam; empty: none is): an 'ffr' beam whose floating frame would have to follow moving bodies: the
     kernel moves an FFR frame only by its own drive about a fixed pivot. The bodies joined
@@ -672,6 +729,10 @@ def ffr_frame_problems(system) -> list[str]:
         if len(component) == 1 and not any(beam in (j.body1, j.body2) for j in joints):
             continue  # a beam without joints: nothing to follow (statics says it is free)
         anchors = set().union(*(_anchors(body, joints) for body in component))
+        turned = _turned_by(beam, component, joints)
+        if turned:
+            problems.append(turned)
+            continue
         if _moving(beam.frame_drive) in anchors:
             continue
         where = f"beam {beam.name!r}"
