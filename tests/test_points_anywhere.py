@@ -158,3 +158,31 @@ def test_edge_and_box_refusals():
         s.joint("e", "weld", "ground", "b", edge="z0")
     with pytest.raises(InputError, match="joint 'f'.*either point, or edge/box"):
         s.joint("f", "weld", "ground", "b", point=(0, 0, 0), box=(0, 0, 0, 1, 1, 1))
+
+
+PLATE_SCENE = """
+&scene  title = 'clamped strip', analysis = 'static', formulation = 'nonlinear',
+        effects = 'pressure' /
+&material  name = 'steel', youngs_modulus = 2.0e11, density = 7800.0, poisson_ratio = 0.0 /
+&plate  name = 'p', material = 'steel', thickness = 0.005, corner = 0, 0, 0,
+        edge_x = 1, 0, 0, edge_y = 0, 0.2, 0, nx = 4, ny = 1 /
+&joint  name = 'clamp', type = 'weld', body1 = 'ground', body2 = 'p', edge = 'x0' /
+&load  name = 'q', type = 'pressure', body = 'p', value = 100.0 /
+&probe  name = 'tip', body = 'p', point = 1.0, 0.1, 0.0 /
+"""
+
+
+def test_namelist_edge_clamp_refined_with_set(write_scene, tmp_path):
+    """The namelist door: a plate clamped by edge = 'x0', refined from the command line
+    (--set plate[p].ny=4): the whole edge stays clamped, the tip on the closed form."""
+    import h5py
+
+    from ancfdrv.cli import main
+    scene = write_scene(PLATE_SCENE)
+    out = tmp_path / "strip.h5"
+    assert main(["run", str(scene), "-o", str(out), "--set", "plate[p].nx=8",
+                 "--set", "plate[p].ny=4"]) == 0
+    with h5py.File(out) as h5:
+        tip = h5["static/probes/tip"][()]
+    reference = 100.0 / (8 * E * 0.005**3 / 12)
+    assert -tip[2] == pytest.approx(reference, rel=1e-3)

@@ -273,8 +273,7 @@ class Beam(Body):
         at_node = abs(self.stations[nearest] - s) <= tol and abs(y) <= tol and abs(z) <= tol
         if node and not at_node:
             raise InputError(f"{what}: point {list(p)} is not a node of beam {self.name!r} "
-                             f"(nearest node at {list(self.node_positions()[nearest])}); joints "
-                             "act on nodes of beams")
+                             f"(nearest node at {list(self.node_positions()[nearest])})")
         s = min(max(s, 0.0), self.length)
         element = min(int(np.searchsorted(self.stations, s, side="right")) - 1, self.nel - 1)
         xi = (s - self.stations[element]) / self.lengths[element]
@@ -412,8 +411,9 @@ class Plate(Body):
         at_node = abs(sx[i] - x) <= tol and abs(sy[j] - y) <= tol
         if node and not at_node:
             raise InputError(f"{what}: point {list(p)} is not a node of "
-                             f"{type(self).__name__.lower()} {self.name!r}; joints act on "
-                             "nodes of plates and leaves")
+                             f"{type(self).__name__.lower()} {self.name!r}; a dead moment "
+                             "acts on a node of a plate or leaf (one with a drive or "
+                             "follower acts anywhere)")
         x = min(max(x, sx[0]), sx[-1])
         y = min(max(y, sy[0]), sy[-1])
         ei = min(int(np.searchsorted(sx, x, side="right")) - 1, self.nx - 1)
