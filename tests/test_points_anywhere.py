@@ -169,6 +169,7 @@ PLATE_SCENE = """
 &joint  name = 'clamp', type = 'weld', body1 = 'ground', body2 = 'p', edge = 'x0' /
 &load  name = 'q', type = 'pressure', body = 'p', value = 100.0 /
 &probe  name = 'tip', body = 'p', point = 1.0, 0.1, 0.0 /
+&solver  static_method = 'newton' /
 """
 
 

@@ -160,7 +160,8 @@ contains
         fresh_matrix = .false.
         if (needs_factorization(sys, cfg, beta_prime, attempt) .or. start_fresh) then
           call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                           predicted_internal, strain, sys%factor_active, info, detail, rates)
+                           predicted_internal, strain, sys%factor_active, info, detail, rates, &
+                           t + h)
           if (info /= 0) return
           stats(stat_factorizations) = stats(stat_factorizations) + 1
           stats(stat_jacobians) = stats(stat_jacobians) + 1
@@ -409,7 +410,8 @@ contains
 
     subroutine refresh_matrix()
       call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                       predicted_internal, strain, sys%factor_active, info, detail, rates)
+                       predicted_internal, strain, sys%factor_active, info, detail, rates, &
+                       t_new)
       if (info /= 0) return
       stats(stat_factorizations) = stats(stat_factorizations) + 1
       stats(stat_jacobians) = stats(stat_jacobians) + 1

@@ -337,7 +337,7 @@ contains
   !> info = 6 (moment undefined), 7 (a plate normal vanished), 8 (contact search failed).
   subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
                              strain, contact_potential, contact_powers, records, info, &
-                             tangent_rotation, tangent_values, rates, tangent_rates)
+                             tangent_rotation, tangent_values, rates, tangent_rates, t)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
     type(contact_state), intent(inout) :: state
@@ -347,6 +347,7 @@ contains
     real(dp), intent(in), optional :: tangent_rotation(:, :, 0:)
     real(dp), intent(out), optional :: tangent_values(:)
     real(dp), intent(in), optional :: rates(0:), tangent_rates(0:)
+    real(dp), intent(in), optional :: t  ! with the tangent: the point loads' Jacobian at t
     real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
     real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3), rate, tangent_rate
     logical :: want_tangent
@@ -408,6 +409,10 @@ contains
     end do
     call to_reduced(sys, full_force, force)
     if (.not. want_tangent) return
+    if (present(t) .and. sys%nvload > 0) then
+      call vector_load_tangent(sys, t, e_full, load_factor, values_full, info)
+      if (info /= 0) return
+    end if
     if (sys%reduced) then  ! B^T S B by the plan
       tangent_values = 0.0_dp
       do k = 1, size(sys%plan_source)
@@ -539,6 +544,75 @@ contains
     end do
   end subroutine vector_load_forces
 
+  !> Minus the Jacobian of the driven and follower point loads at (e_full, t), times
+  !> load_factor, added to values_full (the full pattern): the residual carries
+  !> internal - external. Entries outside the pattern (none: a load's slots lie in one
+  !> element or node) are skipped. info = 5 when a drive fails, 6 for a malformed load.
+  subroutine vector_load_tangent(sys, t, e_full, load_factor, values_full, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, e_full(:), load_factor
+    real(dp), intent(inout) :: values_full(:)
+    integer, intent(out) :: info
+    real(dp) :: phi, dphi, ddphi, x(3, 3), force(3, 3), jacobian(3, 3, 3, 2)
+    integer :: l, s, w, k, m, i, j, row, col, pos, base
+    info = 0
+    do l = 1, sys%nvload
+      phi = 1.0_dp
+      if (sys%vload_drive(l) > 0) then
+        call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+                         t, phi, dphi, ddphi, info)
+        if (info /= 0) then
+          info = 5
+          return
+        end if
+      end if
+      x = 0.0_dp
+      do s = 1, 2
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(sys%vload_dof(k):sys%vload_dof(k) + 2)
+        end do
+      end do
+      call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
+                             sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
+      if (info /= 0) then
+        info = 6
+        return
+      end if
+      do s = 1, 3
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          do w = 1, 2
+            base = 3 * (l - 1) + w
+            do m = sys%vload_ptr(base), sys%vload_ptr(base + 1) - 1
+              do i = 1, 3
+                row = sys%vload_dof(k) + i - 1
+                do j = 1, 3
+                  col = sys%vload_dof(m) + j - 1
+                  pos = pattern_position(sys, row, col)
+                  if (pos > 0) values_full(pos) = values_full(pos) - sys%vload_coef(k) &
+                                                  * sys%vload_coef(m) * jacobian(i, s, j, w)
+                end do
+              end do
+            end do
+          end do
+        end do
+      end do
+    end do
+  end subroutine vector_load_tangent
+
+  !> Position of (row, col) in the full pattern, 0 when absent.
+  pure integer function pattern_position(sys, row, col) result(pos)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: row, col
+    integer :: k
+    pos = 0
+    do k = sys%full_row_ptr(row), sys%full_row_ptr(row + 1) - 1
+      if (sys%full_col(k) == col) then
+        pos = k
+        return
+      end if
+    end do
+  end function pattern_position
+
   !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
   !> drive cannot be evaluated.
   subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
@@ -665,13 +739,14 @@ contains
   !> of active contact points. info: 3 (solver failure, detail = its code) or the
   !> internal_forces codes.
   subroutine refactorize(sys, beta_prime, velocity_factor, rotations, e, v, state, force, &
-                         strain, active, info, detail, rates)
+                         strain, active, info, detail, rates, t)
     type(system_model), intent(inout) :: sys
     real(dp), intent(in) :: beta_prime, velocity_factor, rotations(:, :, 0:), e(:), v(:)
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: force(:), strain
     integer, intent(out) :: active, info, detail
     real(dp), intent(in), optional :: rates(0:)  ! the frames' phi' (material damping)
+    real(dp), intent(in), optional :: t          ! the time (the point loads' Jacobian)
     real(dp), allocatable :: values(:), records(:, :)
     real(dp) :: potential, powers(2), frame_rates(0:size(sys%frames))
     integer :: b, j
@@ -681,7 +756,7 @@ contains
     if (present(rates)) frame_rates = rates
     call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
                          potential, powers, records, info, tangent_rotations(sys, rotations), &
-                         values, frame_rates, tangent_frame_rates(sys, frame_rates))
+                         values, frame_rates, tangent_frame_rates(sys, frame_rates), t)
     if (info /= 0) return
     active = 0
     if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)

@@ -425,8 +425,12 @@ class Model:
         rate's dependence on e, tau B(e)^T D B(e'), and an FFR frame's omega term), and not
         small against beta' M along the rigid modes (a steel plate swinging at 10 rad/s with
         tau = 2e-3 s: Newton with the Cholesky's upper triangle diverged), so MUMPS factorizes
-        it; the constant policy's beta' M + (1 + c tau) K0 stays symmetric."""
+        it; the constant policy's beta' M + (1 + c tau) K0 stays symmetric. Driven and
+        follower point loads add their unsymmetric Jacobian to a refactorized tangent: MUMPS
+        too."""
         if self.damped and self.policy != POLICY_CONSTANT:
+            return False
+        if self.vector_loads and self.policy != POLICY_CONSTANT:
             return False
         return not self.contact_pairs and self.pattern.bandwidth() <= max(64, self.ndof // 4)
 
