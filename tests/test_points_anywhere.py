@@ -187,3 +187,46 @@ def test_namelist_edge_clamp_refined_with_set(write_scene, tmp_path):
         tip = h5["static/probes/tip"][()]
     reference = 100.0 / (8 * E * 0.005**3 / 12)
     assert -tip[2] == pytest.approx(reference, rel=1e-3)
+
+
+def _rotated(q: np.ndarray, rotation: np.ndarray, shift: np.ndarray, positions) -> np.ndarray:
+    """q after the rigid motion x -> R x + shift: positions turned and shifted, gradients
+    (every other 3-vector) turned."""
+    out = q.reshape(-1, 3) @ rotation.T
+    out[positions] += shift
+    return out.ravel()
+
+
+@pytest.mark.parametrize("kind", ["beam", "plate"])
+def test_points_between_nodes_follow_a_rigid_motion_exactly(kind):
+    """A material point between nodes (off the axis for the beam) and its directions, as a
+    joint writes them: at t = 0 they are the point and the body's axes; after a rigid motion
+    of the body's coordinates (a 1.1 rad turn about a skew axis and a shift) they are the
+    turned point and axes, to round-off (the interpolation is exact for rigid motions)."""
+    from ancfdrv.system.bodies import rotation_about
+    s = System("x")
+    s.material("steel", youngs_modulus=E, density=7800.0)
+    if kind == "beam":
+        body = s.beam("b", material="steel", start=(0, 0, 0), end=(2, 0, 0), nodes=4,
+                      section=Rectangle(0.1, 0.2), height_axis=(0, 0, 1))
+        point, names, axes = np.array([0.9, 0.03, -0.07]), ("r_x", "r_y", "r_z"), np.eye(3)[
+            [0, 2, 1]] * [[1], [1], [-1]]
+        positions = slice(None, None, 4)   # r of every node (r, r_x, r_y, r_z)
+    else:
+        body = s.plate("p", material="steel", thickness=0.01, corner=(0, 0, 0),
+                       edge_x=(1, 0, 0), edge_y=(0, 0.5, 0), nx=3, ny=2)
+        point, names, axes = np.array([0.45, 0.3, 0.0]), ("r_x", "r_y"), np.eye(3)[:2]
+        positions = slice(None, None, 3)   # r of every node (r, r_x, r_y)
+    body.first = 0
+    q0 = body.coordinates()
+    at = body.locate(point, node=False, what="test")
+    assert at.node is None
+    assert np.allclose(body.position(at).value(q0), point, atol=1e-14)
+    for name, axis in zip(names, axes):
+        assert np.allclose(body.vector(at, name).value(q0), axis, atol=1e-12)
+    rotation = rotation_about((1.0, -2.0, 0.5), 1.1)
+    shift = np.array([0.3, -1.0, 2.0])
+    q1 = _rotated(q0, rotation, shift, positions)
+    assert np.allclose(body.position(at).value(q1), rotation @ point + shift, atol=1e-12)
+    for name, axis in zip(names, axes):
+        assert np.allclose(body.vector(at, name).value(q1), rotation @ axis, atol=1e-12)
