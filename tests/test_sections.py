@@ -61,16 +61,52 @@ def test_torsion_constants_of_box_tube_and_circle():
 
 def test_cowper_shear_factors():
     """Cowper (1966), table 1: rectangle 10(1+nu)/(12+11nu), circle 6(1+nu)/(7+6nu), thin
-    tube 2(1+nu)/(4+3nu), thin square box 20(1+nu)/(48+39nu)."""
+    tube 2(1+nu)/(4+3nu), thin square box 20(1+nu)/(48+39nu). By default (shear='unit') a
+    section keeps k = 1, the elements' behaviour before issue 20."""
     nu = 0.3
-    assert Rectangle(0.1, 0.2).shear_factors(nu) == pytest.approx((0.8497, 0.8497), abs=1e-4)
-    assert Circle(0.1).shear_factors(nu)[0] == pytest.approx(6 * 1.3 / (7 + 1.8), rel=1e-12)
-    assert Tube(1.0, 1e-4).shear_factors(nu)[0] == pytest.approx(2 * 1.3 / (4 + 0.9), rel=1e-3)
-    assert Box(1.0, 1.0, 1e-4).shear_factors(nu)[0] == pytest.approx(20 * 1.3 / (48 + 11.7),
-                                                                     rel=1e-3)
+    assert Rectangle(0.1, 0.2).cowper_shear_factors(nu) == pytest.approx((0.8497, 0.8497),
+                                                                         abs=1e-4)
+    assert Circle(0.1).cowper_shear_factors(nu)[0] == pytest.approx(6 * 1.3 / (7 + 1.8),
+                                                                    rel=1e-12)
+    assert Tube(1.0, 1e-4).cowper_shear_factors(nu)[0] == pytest.approx(2 * 1.3 / (4 + 0.9),
+                                                                        rel=1e-3)
+    assert Box(1.0, 1.0, 1e-4).cowper_shear_factors(nu)[0] == pytest.approx(
+        20 * 1.3 / (48 + 11.7), rel=1e-3)
     # a box's webs carry the shear: along its height it is stiffer in shear than across
-    ky, kz = Box(0.1, 0.4, 0.005).shear_factors(nu)
+    ky, kz = Box(0.1, 0.4, 0.005).cowper_shear_factors(nu)
     assert kz < ky
+    assert Rectangle(0.1, 0.2).shear_factors(nu) == (1.0, 1.0)
+    assert Rectangle(0.1, 0.2, shear="cowper").shear_factors(nu) == \
+        Rectangle(0.1, 0.2).cowper_shear_factors(nu)
+    with pytest.raises(InputError, match="shear"):
+        Rectangle(0.1, 0.2, shear="exact").shear_factors(nu)
+
+
+@pytest.mark.parametrize("bending, nodes, tolerance", [("cubic", 2, 1e-6),
+                                                       ("continuum", 17, 2e-3)])
+def test_cowper_shear_factor_reaches_the_deflection(bending, nodes, tolerance):
+    """A stubby cantilever (L = 0.3 m, 50 x 100 mm, height along the load) under a tip force:
+    Timoshenko's P L^3 / (3 E I) + P L / (k G A) with Cowper's k (the shear term is 11% of
+    the deflection here). The cubic element reproduces the Timoshenko cantilever exactly on
+    one element (test_structural), the continuum one converges at second order."""
+    length, force = 0.3, 1000.0
+    section = Rectangle(0.05, 0.1, shear="cowper")
+    s = System("shear")
+    steel = s.material("steel", youngs_modulus=E, density=7850.0, poisson_ratio=NU)
+    s.beam("bar", material=steel, start=(0, 0, 0), end=(length, 0, 0), nodes=nodes,
+           section=section, height_axis=(0, 1, 0), formulation="nonlinear", bending=bending)
+    s.joint("root", "weld", "ground", "bar", point=(0, 0, 0))
+    s.load("P", "force", body="bar", point=(length, 0, 0), vector=(0, -force, 0))
+    s.probe("tip", "bar", (length, 0, 0))
+    model = s.assemble()
+    try:
+        e = solve_newton(model, tol=1e-12).e
+        deflection = -(model.probe_positions(e)["tip"] - model.probe_positions(model.e0)["tip"])[1]
+    finally:
+        model.close()
+    k = section.cowper_shear_factors(NU)[0]
+    expected = force * length**3 / (3 * E * section.iz) + force * length / (k * G * section.area)
+    assert deflection == pytest.approx(expected, rel=tolerance)
 
 
 # ----------------------------------------------------------------------- pure torsion
