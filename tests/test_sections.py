@@ -205,8 +205,8 @@ LTB = {"strip": (Rectangle(0.001, 0.03), 1.0), "box": (Box(0.04, 0.4, 0.002), 6.
 def test_lateral_torsional_buckling_of_a_cantilever(name, bending):
     """Departure load on 17 nodes against Prandtl/Michell. Measured (P/P_cr at 5, 9, 17
     nodes): strip continuum 1.069, 1.016, 1.004; cubic 1.000, 1.000, 1.000; box continuum
-    1.086, 1.016, 1.003; cubic 0.995, 0.998, 0.999 (the continuum converges at second order,
-    the closed form's 4.013 is rounded). Before issue 20 (J = I_p): strip 21.4 and 21.1, box
+    1.094, 1.022, 1.009; cubic 1.000, 1.004, 1.005 (the continuum converges at second order;
+    the closed form's 4.013 is rounded and ignores the box's shear, k = 1 here). Before issue 20 (J = I_p): strip 21.4 and 21.1, box
     5.2 and 5.2 times P_cr."""
     section, length = LTB[name]
     p_cr = prandtl_michell(section, length)
