@@ -179,13 +179,13 @@ def _smallest_eigenvalue(section, bending, nodes, length, load):
 
 def _departure_load(section, bending, nodes, length, guess):
     """Load at which the tangent's smallest eigenvalue crosses zero (secant iteration)."""
-    a, b = 0.5 * guess, guess
+    a, b = 0.95 * guess, 1.05 * guess
     fa = _smallest_eigenvalue(section, bending, nodes, length, a)
     fb = _smallest_eigenvalue(section, bending, nodes, length, b)
     for _ in range(20):
         a, fa, b = b, fb, b - fb * (b - a) / (fb - fa)
         fb = _smallest_eigenvalue(section, bending, nodes, length, b)
-        if abs(b - a) < 1e-4 * guess:
+        if abs(b - a) < 1e-3 * guess:
             break
     return b
 
