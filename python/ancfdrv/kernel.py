@@ -62,14 +62,17 @@ def section_data(kind: int, dims) -> SectionData:
                        float(iy), float(iz), float(polar))
 
 
-def beam_element_arrays(lengths, section: SectionData, density, youngs, poisson, reference):
+def beam_element_arrays(lengths, section: SectionData, density, youngs, poisson, reference,
+                        shear_scales=(1.0, 0.0, 0.0)):
     """Compact mass (8, 8, nel) and small-strain stiffness K0 (24, 24, nel) per element.
 
-    ``reference`` is (3, 8, nel): the element's nodal vectors in the floating frame.
+    ``reference`` is (3, 8, nel): the element's nodal vectors in the floating frame;
+    ``shear_scales`` the section's torsion and shear correction [c, d_y, d_z]
+    (Section.shear_scales; the default is the plain law).
     """
     mass, stiffness, info = _kernel.beam_element_arrays(
         _f(lengths), _f(section.y), _f(section.z), _f(section.weights), density, youngs, poisson,
-        _f(reference))
+        _f(shear_scales), _f(reference))
     if info:
         element, code = divmod(info, 10)
         reason = {1: "unsupported quadrature", 2: "degenerate reference geometry (det J0 <= 0)"}
@@ -99,7 +102,8 @@ def beam_point_mass(xi, y, z, length, mass) -> np.ndarray:
 def beam_nonlinear_setup(reference, lengths, section: SectionData):
     """Material gradients (8, 3, npts, nel), weights (npts, nel) and the number of volume
     points of the large-deformation beam's Gauss rule, from the reference configuration
-    (3, 8, nel); the remaining points are on the neutral axis."""
+    (3, 8, nel); the remaining points are on the neutral axis and the section's twist
+    points (beam_nonlinear)."""
     nsec = len(section.weights)
     npts = int(_kernel.beam_nonlinear_points(nsec))
     gradients, weights, info = _kernel.beam_nonlinear_setup(
@@ -108,26 +112,33 @@ def beam_nonlinear_setup(reference, lengths, section: SectionData):
         element, code = divmod(info, 10)
         raise InputError(f"beam element {element}: degenerate reference geometry "
                          f"(det J0 <= 0, code {code})")
-    return gradients, weights, npts - npts // (nsec + 1)
+    return gradients, weights, nsec * (npts // (nsec + 5))   # the volume points
 
 
 def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poisson,
-                          want_tangent: bool):
-    """Large-deformation elastic force, strain energy and element tangents (24, 24, nel)."""
+                          want_tangent: bool, shear_scales=(1.0, 0.0, 0.0)):
+    """Large-deformation elastic force, strain energy and element tangents (24, 24, nel);
+    ``shear_scales`` the section's torsion and shear correction (default: the plain law)."""
     return _kernel.beam_nonlinear_forces(nvolume, _f(dofs + 1, np.int32), _f(e), gradients,
-                                         weights, youngs, poisson, int(want_tangent))
+                                         weights, youngs, poisson, _f(shear_scales),
+                                         int(want_tangent))
 
 
 class StructuralBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
-    (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel)."""
+    (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel);
+    ``torsion`` the Saint-Venant constant J (default: the polar moment) and
+    ``shear_factors`` (k_y, k_z) (default 1)."""
 
-    def __init__(self, reference, lengths, section: SectionData, youngs, poisson) -> None:
+    def __init__(self, reference, lengths, section: SectionData, youngs, poisson,
+                 torsion: float | None = None, shear_factors=(1.0, 1.0)) -> None:
         nterms = int(_kernel.beam_structural_size())
+        torsion = section.polar if torsion is None else torsion
         (self.forms, self.strain0, self.stiffness,
          info) = _kernel.beam_structural_setup(nterms, _f(reference), _f(lengths), section.area,
                                                section.inertia_y, section.inertia_z,
-                                               section.polar, youngs, poisson)
+                                               torsion, shear_factors[0], shear_factors[1],
+                                               youngs, poisson)
         if info:
             element, code = divmod(info, 10)
             reason = {1: "unsupported quadrature",
@@ -200,6 +211,16 @@ def ffr_force(dofs, stiffness0, rotation, e, reference):
 def ffr_element_stiffness(stiffness0, rotation) -> np.ndarray:
     """Element stiffness matrices T K0 T^T (24, 24, nel)."""
     return _kernel.ffr_element_stiffness(stiffness0, _f(rotation))
+
+
+def vector_load_force(kind: int, vector, shares, a, b):
+    """A driven or follower point load (vector_loads.f90): forces (3, 3) on the slots
+    (a, b, p) and the Jacobian (3, 3, 3, 2): d force(i, slot) / d (a, b)(j)."""
+    force, jacobian, info = _kernel.vector_load_generalized_force(
+        kind, _f(vector), _f(shares), _f(a), _f(b))
+    if info:
+        raise SolverError(f"point load of unknown kind {kind}")
+    return force, jacobian
 
 
 def moment_force(director, axis, magnitude):
@@ -435,10 +456,11 @@ class KernelSystem:
         return int(index)
 
     def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
-                          poisson: float, frame: int, damping_time: float = 0.0) -> int:
+                          poisson: float, frame: int, damping_time: float = 0.0,
+                          shear_scales=(1.0, 0.0, 0.0)) -> int:
         index, info = _kernel.system_add_continuum_set(
             self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights), youngs,
-            poisson, frame, damping_time)
+            poisson, _f(shear_scales), frame, damping_time)
         self._check(info, "continuum beam set")
         return int(index)
 
@@ -523,6 +545,24 @@ class KernelSystem:
             _pad_last(np.asarray(moment_references, dtype=float).reshape(-1, 3).T),
             ndof=self.ndof)
         self._check(info, "loads")
+
+    def set_vector_loads(self, loads) -> None:
+        """Driven and follower point loads (model.VectorLoadInfo)."""
+        ptr, dofs, coefs = [0], [], []
+        for load in loads:
+            for slot in load.slots:
+                dofs += [d for d, _ in slot]
+                coefs += [c for _, c in slot]
+                ptr.append(len(dofs))
+        info = _kernel.system_set_vector_loads(
+            self.handle, len(loads), len(dofs),
+            _pad_last(np.array([x.kind for x in loads], dtype=np.int32), np.int32),
+            _pad_last(np.array([x.drive + 1 for x in loads], dtype=np.int32), np.int32),
+            _pad_last(np.array([x.vector for x in loads], dtype=float).reshape(-1, 3).T),
+            _pad_last(np.array([x.shares for x in loads], dtype=float).reshape(-1, 2).T),
+            _i(np.array(ptr) + 1), _pad_last(np.array(dofs, dtype=np.int32) + 1, np.int32),
+            _pad_last(np.array(coefs, dtype=float)))
+        self._check(info, "vector loads")
 
     def set_constraints(self, layout: "ConstraintLayout") -> None:
         ncon, nterm = len(layout.kinds), len(layout.term_dof)

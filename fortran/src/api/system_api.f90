@@ -102,9 +102,11 @@ end subroutine system_add_ffr_set
 
 !> Large-deformation (continuum) beam elements: material gradients and weights at npts
 !> Gauss points of which the first nvolume are volume points (beam_nonlinear);
-!> damping_time as system_add_ffr_set.
+!> damping_time as system_add_ffr_set; shear_scales the section's torsion and shear
+!> correction [c, d_y, d_z].
 subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, gradients, &
-                                    weights, youngs, poisson, frame, damping_time, index, info)
+                                    weights, youngs, poisson, shear_scales, frame, damping_time, &
+                                    index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set, set_continuum
@@ -112,7 +114,7 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   implicit none
   integer, intent(in) :: handle, nel, npts, nvolume, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
-  real(dp), intent(in) :: damping_time
+  real(dp), intent(in) :: shear_scales(3), damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
   type(element_set) :: set
@@ -134,6 +136,7 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   set%weights = weights
   set%youngs = youngs
   set%poisson = poisson
+  set%shear_scales = shear_scales
   set%damping_time = damping_time
   call append_set(sys, set, index)
 end subroutine system_add_continuum_set
@@ -405,6 +408,51 @@ subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, f
   sys%moment_reference = moment_reference(:, 1:nmoment)
 end subroutine system_set_loads
 
+!> Driven and follower point loads (vector_loads): kinds, drives (1-based, 0: none), vectors
+!> (3, n), torsion shares (2, n), and per load and slot (a, b, p) the terms ptr(3 n + 1)
+!> over full coordinates dof (1-based, the first of a 3-vector) with coefficients coef.
+subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors, shares, ptr, &
+                                   dofs, coefs, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nload, nterm
+  integer, intent(in) :: kinds(max(1, nload)), drives(max(1, nload)), ptr(3 * nload + 1)
+  integer, intent(in) :: dofs(max(1, nterm))
+  real(dp), intent(in) :: vectors(3, max(1, nload)), shares(2, max(1, nload))
+  real(dp), intent(in) :: coefs(max(1, nterm))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (ptr(3 * nload + 1) /= nterm + 1) then
+    info = 2
+    return
+  end if
+  if (nterm > 0) then
+    if (any(dofs(1:nterm) < 1) .or. any(dofs(1:nterm) + 2 > sys%nfull)) then
+      info = 2
+      return
+    end if
+  end if
+  if (nload > 0) then
+    if (any(kinds(1:nload) < 1) .or. any(kinds(1:nload) > 3) .or. &
+        any(drives(1:nload) < 0) .or. any(drives(1:nload) > size(sys%drive_kinds))) then
+      info = 2
+      return
+    end if
+  end if
+  sys%nvload = nload
+  sys%vload_kind = kinds(1:nload)
+  sys%vload_drive = drives(1:nload)
+  sys%vload_vector = vectors(:, 1:nload)
+  sys%vload_shares = shares(:, 1:nload)
+  sys%vload_ptr = ptr
+  sys%vload_dof = dofs(1:nterm)
+  sys%vload_coef = coefs(1:nterm)
+end subroutine system_set_vector_loads
+
 !> Constraints with multipliers, in the constraints module's layout over the independent
 !> coordinates.
 subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, operand_const, &
@@ -565,7 +613,7 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velo
                          strain, contact_potential, powers, records, info, rates=rates)
   end if
   if (info /= 0) return
-  call external_forces(sys, t, load_factor, external, info)
+  call external_forces(sys, t, load_factor, external, info, e)
   guesses = state%guesses
   counts = state%counts
 end subroutine system_evaluate

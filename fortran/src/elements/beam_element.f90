@@ -121,24 +121,54 @@ contains
   !> Strain eps = [e_xx, e_yy, e_zz, g_xy, g_yz, g_xz] of u = S (e - e0) with respect
   !> to the reference material coordinates X = r0(x, y, z); isotropic law (E, nu), which
   !> for nu = 0 is the paper's Q = diag(E, E, E, E/2, E/2, E/2) (eq. 18).
+  !> Torsion and shear of the section (shear_scales = [c, d_y, d_z], as beam_nonlinear):
+  !> E/2 on g_xy, g_xz over the section, G d_y, G d_z on the neutral axis, and c G - E/2 on
+  !> g_xy at the twist points (0, +-sqrt(I_y/A)), on g_xz at (+-sqrt(I_z/A), 0) (weights
+  !> A/2), so the twist costs G J (c = J / I_p) and a uniform shear k G A (d = k - c).
   !> info: 0 ok, 1 bad quadrature, 2 degenerate reference (det J0 <= 0).
   pure subroutine beam_linear_stiffness(reference, length, section_y, section_z, section_w, &
-                                        youngs, poisson, stiffness, info)
+                                        youngs, poisson, shear_scales, stiffness, info)
     real(dp), intent(in) :: reference(3, 8), length, section_y(:), section_z(:), section_w(:)
-    real(dp), intent(in) :: youngs, poisson
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
     real(dp), intent(out) :: stiffness(24, 24)
     integer, intent(out) :: info
     real(dp) :: xi(n_axial), weight(n_axial, size(section_w))
     real(dp) :: shape(8), dshape(8, 3), jacobian0(3, 3), inverse0(3, 3), det0
     real(dp) :: material_gradient(8, 3), strain_matrix(6, 24), elasticity(6, 6)
-    integer :: i, s
+    real(dp) :: laws(6, 6, 3), shear, area, point_y(5), point_z(5), point_w(5), law(6, 6)
+    integer :: i, s, nsection, extra
     call volume_rule(length, section_w, xi, weight, info)
     call isotropic_elasticity(youngs, poisson, elasticity)
+    shear = elasticity(4, 4)
+    elasticity(4, 4) = 0.5_dp * youngs                       ! as beam_nonlinear's volume law
+    elasticity(6, 6) = 0.5_dp * youngs
+    laws = 0.0_dp
+    laws(4, 4, 1) = shear_scales(2) * shear                  ! neutral axis
+    laws(6, 6, 1) = shear_scales(3) * shear
+    laws(4, 4, 2) = shear_scales(1) * shear - 0.5_dp * youngs   ! twist points (0, +-z0)
+    laws(6, 6, 3) = shear_scales(1) * shear - 0.5_dp * youngs   ! twist points (+-y0, 0)
+    nsection = size(section_w)
+    area = sum(section_w)
+    point_y = [0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, -1.0_dp] * sqrt(sum(section_w * section_y**2) / area)
+    point_z = [0.0_dp, 1.0_dp, -1.0_dp, 0.0_dp, 0.0_dp] * sqrt(sum(section_w * section_z**2) / area)
+    point_w = [1.0_dp, 0.5_dp, 0.5_dp, 0.5_dp, 0.5_dp]       ! times the area
     stiffness = 0.0_dp
-    do s = 1, size(section_w)
+    do s = 1, nsection + 5
+      extra = s - nsection
+      if (extra >= 1) then
+        law = laws(:, :, min(extra, 1) + merge(1, 0, extra >= 2) + merge(1, 0, extra >= 4))
+        if (all(law == 0.0_dp)) cycle
+      else
+        law = elasticity
+      end if
       do i = 1, n_axial
-        call beam_shape(xi(i), section_y(s), section_z(s), length, shape, dshape(:, 1), &
-                        dshape(:, 2), dshape(:, 3))
+        if (extra < 1) then
+          call beam_shape(xi(i), section_y(s), section_z(s), length, shape, dshape(:, 1), &
+                          dshape(:, 2), dshape(:, 3))
+        else
+          call beam_shape(xi(i), point_y(extra), point_z(extra), length, shape, dshape(:, 1), &
+                          dshape(:, 2), dshape(:, 3))
+        end if
         jacobian0 = matmul(reference, dshape)
         call invert3(jacobian0, inverse0, det0)
         if (det0 <= 0.0_dp) then
@@ -147,8 +177,13 @@ contains
         end if
         material_gradient = matmul(dshape, inverse0)
         call small_strain_matrix(material_gradient, strain_matrix)
-        stiffness = stiffness + weight(i, s) * det0 * &
-                    matmul(transpose(strain_matrix), matmul(elasticity, strain_matrix))
+        if (extra < 1) then
+          stiffness = stiffness + weight(i, s) * det0 * &
+                      matmul(transpose(strain_matrix), matmul(law, strain_matrix))
+        else
+          stiffness = stiffness + point_w(extra) * sum(weight(i, :)) * det0 * &
+                      matmul(transpose(strain_matrix), matmul(law, strain_matrix))
+        end if
       end do
     end do
   end subroutine beam_linear_stiffness

@@ -8,9 +8,21 @@
 !> At the reference (F = I, S = 0) the tangent equals the small-strain K0 of the FFR model.
 !>
 !> Poisson locking (the section fields are linear in y, z): D is split into the Poisson-free
-!> part D0 = diag(E, E, E, G, G, G), integrated over the whole section, and the Poisson
-!> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
-!> mechanics); with nu = 0 both coincide with the plain law.
+!> part D0 = diag(E, E, E, E/2, G, E/2), integrated over the whole section, and the Poisson
+!> part D - D0 (its normal block), integrated on the neutral axis only (the splitting of
+!> enhanced continuum mechanics); the shears' G enters through the twist and axis points
+!> below. With nu = 0 all coincide with the plain law.
+!>
+!> Torsion and shear of the section (shear_scales = [c, d_y, d_z], docs/theory.md section
+!> 17): the linear section field has no warping; the shears 2E12 = a_y + y b_y + z t_y,
+!> 2E13 = a_z + y t_z + z b_z are linear in y, z for any F (a the transverse shears, t the
+!> twist, b the axial gradients of the section's stretch). Over the volume they take E/2
+!> (D0 is the Poisson-free law: with G there the b terms tied a spinning rod's deflection to
+!> nu); twist points, at each axial station a pair (0, +-z0), z0 = sqrt(I_y/A), weights A/2,
+!> with c G - E/2 on 2E12 only, and a pair (+-y0, 0), y0 = sqrt(I_z/A), with c G - E/2 on
+!> 2E13 only; the neutral-axis points add d G on 2E12, 2E13. With c = J / I_p and
+!> d = k - c the twist costs G J tau^2 and a uniform shear k G A, exactly (the pairs are
+!> symmetric), and b keeps E/2. Twist and axis points whose law vanishes are skipped.
 !>
 !> Kelvin-Voigt material damping (retardation time tau, nonlinear_element_damped):
 !> S = D : (E + tau E'), with the strain rate E' = B(F) q' (the Voigt form of sym(F^T F'),
@@ -32,16 +44,17 @@ module beam_nonlinear
 
 contains
 
-  !> Points per element for a section rule of nsection points: the volume points, then the
-  !> neutral-axis points.
+  !> Points per element for a section rule of nsection points: the volume points, the
+  !> neutral-axis points, the twist points (0, +-z0) and (+-y0, 0).
   pure integer function nonlinear_rule_size(nsection)
     integer, intent(in) :: nsection
-    nonlinear_rule_size = nonlinear_axial_points * (nsection + 1)
+    nonlinear_rule_size = nonlinear_axial_points * (nsection + 5)
   end function nonlinear_rule_size
 
   !> Material gradients g_a (8, 3, point) and weights (volume element det J0 included) of
   !> one element: first the axial x section volume points (section point outer), then the
-  !> neutral-axis points whose weights carry the section area. info = 2 for det J0 <= 0.
+  !> neutral-axis points whose weights carry the section area, then the twist points (0, z0),
+  !> (0, -z0), (y0, 0), (-y0, 0) of weight A/2. info = 2 for det J0 <= 0.
   pure subroutine nonlinear_setup(reference, length, section_y, section_z, section_w, &
                                   gradients, weights, info)
     real(dp), intent(in) :: reference(3, 8), length, section_y(:), section_z(:), section_w(:)
@@ -49,22 +62,31 @@ contains
     integer, intent(out) :: info
     real(dp) :: pa(nonlinear_axial_points), wa(nonlinear_axial_points)
     real(dp) :: shape(8), dshape(8, 3), jac0(3, 3), inv0(3, 3), det0, y, z
+    real(dp) :: area, twist_y(4), twist_z(4), twist_w(4)
     integer :: i, s, p, nsection
     nsection = size(section_w)
     call gauss_legendre(nonlinear_axial_points, pa, wa, info)
     if (info /= 0) return
+    area = sum(section_w)
+    twist_y = [0.0_dp, 0.0_dp, 1.0_dp, -1.0_dp] * sqrt(sum(section_w * section_y**2) / area)
+    twist_z = [1.0_dp, -1.0_dp, 0.0_dp, 0.0_dp] * sqrt(sum(section_w * section_z**2) / area)
+    twist_w = 0.5_dp * area
     p = 0
-    do s = 1, nsection + 1
+    do s = 1, nsection + 5
       do i = 1, nonlinear_axial_points
         p = p + 1
         if (s <= nsection) then
           y = section_y(s)
           z = section_z(s)
           weights(p) = 0.5_dp * wa(i) * length * section_w(s)
-        else
+        else if (s == nsection + 1) then
           y = 0.0_dp
           z = 0.0_dp
-          weights(p) = 0.5_dp * wa(i) * length * sum(section_w)
+          weights(p) = 0.5_dp * wa(i) * length * area
+        else
+          y = twist_y(s - nsection - 1)
+          z = twist_z(s - nsection - 1)
+          weights(p) = 0.5_dp * wa(i) * length * twist_w(s - nsection - 1)
         end if
         call beam_shape(0.5_dp * (pa(i) + 1.0_dp), y, z, length, shape, dshape(:, 1), &
                         dshape(:, 2), dshape(:, 3))
@@ -85,26 +107,24 @@ contains
   !> The first volume_points points integrate the Poisson-free law over the volume, the
   !> others (the neutral-axis points) the Poisson part.
   pure subroutine nonlinear_element(q, gradients, weights, volume_points, youngs, poisson, &
-                                    want_tangent, force, energy, tangent)
+                                    shear_scales, want_tangent, force, energy, tangent)
     real(dp), intent(in) :: q(3, 8), gradients(:, :, :), weights(:)
     integer, intent(in) :: volume_points
-    real(dp), intent(in) :: youngs, poisson
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: law_twist_y(6, 6), law_twist_z(6, 6)
     real(dp) :: stress(6), b(6, 24), db(6, 24)
     integer :: p
-    call split_laws(youngs, poisson, law_free, law_poisson)
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson, law_twist_y, &
+                    law_twist_z)
     force = 0.0_dp
     energy = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
-      if (p <= volume_points) then
-        law = law_free
-      else
-        law = law_poisson
-        if (all(law == 0.0_dp)) cycle
-      end if
+      law = point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z)
+      if (p > volume_points .and. all(law == 0.0_dp)) cycle
       call deformation_gradient(q, gradients(:, :, p), deformation)
       call green_lagrange(deformation, strain)
       stress = matmul(law, strain)
@@ -122,29 +142,27 @@ contains
   !> q'(3, 8): the force includes the damping force, dissipation is its power and the
   !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
   pure subroutine nonlinear_element_damped(q, rates, gradients, weights, volume_points, youngs, &
-                                           poisson, damping_time, rate_factor, want_tangent, &
-                                           force, energy, dissipation, tangent)
+                                           poisson, shear_scales, damping_time, rate_factor, &
+                                           want_tangent, force, energy, dissipation, tangent)
     real(dp), intent(in) :: q(3, 8), rates(3, 8), gradients(:, :, :), weights(:)
     integer, intent(in) :: volume_points
-    real(dp), intent(in) :: youngs, poisson, damping_time, rate_factor
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3), damping_time, rate_factor
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: law_twist_y(6, 6), law_twist_z(6, 6)
     real(dp) :: stress(6), b(6, 24), b_rate(6, 24)
     real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
     integer :: p
-    call split_laws(youngs, poisson, law_free, law_poisson)
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson, law_twist_y, &
+                    law_twist_z)
     force = 0.0_dp
     energy = 0.0_dp
     dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
-      if (p <= volume_points) then
-        law = law_free
-      else
-        law = law_poisson
-        if (all(law == 0.0_dp)) cycle
-      end if
+      law = point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z)
+      if (p > volume_points .and. all(law == 0.0_dp)) cycle
       call deformation_gradient(q, gradients(:, :, p), deformation)
       call deformation_gradient(rates, gradients(:, :, p), deformation_rate)
       call green_lagrange(deformation, strain)
@@ -243,10 +261,15 @@ contains
     end do
   end subroutine strain_matrix
 
-  !> D0 = diag(E, E, E, G, G, G) and the Poisson part D - D0 of the isotropic law.
-  pure subroutine split_laws(youngs, poisson, law_free, law_poisson)
-    real(dp), intent(in) :: youngs, poisson
+  !> D0 = diag(E, E, E, G, G, G) and the Poisson part D - D0 of the isotropic law, with the
+  !> section's torsion and shear correction shear_scales = [c, d_y, d_z]: G d_y and G d_z
+  !> on 2E12, 2E13 added to the neutral-axis law, (c - 1) G on 2E12 at the twist points
+  !> (0, +-z0) and on 2E13 at (+-y0, 0).
+  pure subroutine split_laws(youngs, poisson, shear_scales, law_free, law_poisson, &
+                             law_twist_y, law_twist_z)
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
     real(dp), intent(out) :: law_free(6, 6), law_poisson(6, 6)
+    real(dp), intent(out) :: law_twist_y(6, 6), law_twist_z(6, 6)
     real(dp) :: lame, shear
     integer :: i
     lame = youngs * poisson / ((1.0_dp + poisson) * (1.0_dp - 2.0_dp * poisson))
@@ -259,7 +282,38 @@ contains
       law_free(i + 3, i + 3) = shear
       law_poisson(i, i) = lame + 2.0_dp * shear - youngs
     end do
+    ! the shears that vary over the section (2E12, 2E13) take E/2, the Poisson-free law's
+    ! modulus, over the volume (docs/theory.md section 17: with G there, their y b_y and z b_z
+    ! parts tied the deflection of a spinning rod to nu); the twist points make the twist
+    ! c G I_p = G J and the neutral axis the uniform shear k G A
+    law_free(4, 4) = 0.5_dp * youngs
+    law_free(6, 6) = 0.5_dp * youngs
+    law_poisson(4, 4) = shear_scales(2) * shear
+    law_poisson(6, 6) = shear_scales(3) * shear
+    law_twist_y = 0.0_dp
+    law_twist_z = 0.0_dp
+    law_twist_y(4, 4) = shear_scales(1) * shear - 0.5_dp * youngs
+    law_twist_z(6, 6) = shear_scales(1) * shear - 0.5_dp * youngs
   end subroutine split_laws
+
+  !> The law of point p: volume points, then the neutral-axis points, the twist points
+  !> (0, +-z0) and (+-y0, 0), nonlinear_axial_points of each (nonlinear_setup's order).
+  pure function point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z) &
+      result(law)
+    integer, intent(in) :: p, volume_points
+    real(dp), intent(in) :: law_free(6, 6), law_poisson(6, 6), law_twist_y(6, 6)
+    real(dp), intent(in) :: law_twist_z(6, 6)
+    real(dp) :: law(6, 6)
+    if (p <= volume_points) then
+      law = law_free
+    else if (p <= volume_points + nonlinear_axial_points) then
+      law = law_poisson
+    else if (p <= volume_points + 3 * nonlinear_axial_points) then
+      law = law_twist_y
+    else
+      law = law_twist_z
+    end if
+  end function point_law
 
   !> tangent += w kron(G S G^T, I3): the geometric stiffness of the second Piola-Kirchhoff
   !> stress S (Voigt) with the material gradients G (8, 3) of the shape functions.

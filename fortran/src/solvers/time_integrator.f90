@@ -96,7 +96,7 @@ contains
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if
     call mass_product(sys, acceleration, r)
-    call external_forces(sys, t, 1.0_dp, loads, info)
+    call external_forces(sys, t, 1.0_dp, loads, info, e)
     if (info /= 0) return
     r = r + internal - loads
     call evaluate_constraints(sys, e, t, phi, gradients, info)
@@ -160,7 +160,8 @@ contains
         fresh_matrix = .false.
         if (needs_factorization(sys, cfg, beta_prime, attempt) .or. start_fresh) then
           call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                           predicted_internal, strain, sys%factor_active, info, detail, rates)
+                           predicted_internal, strain, sys%factor_active, info, detail, rates, &
+                           t + h)
           if (info /= 0) return
           stats(stat_factorizations) = stats(stat_factorizations) + 1
           stats(stat_jacobians) = stats(stat_jacobians) + 1
@@ -409,7 +410,8 @@ contains
 
     subroutine refresh_matrix()
       call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                       predicted_internal, strain, sys%factor_active, info, detail, rates)
+                       predicted_internal, strain, sys%factor_active, info, detail, rates, &
+                       t_new)
       if (info /= 0) return
       stats(stat_factorizations) = stats(stat_factorizations) + 1
       stats(stat_jacobians) = stats(stat_jacobians) + 1

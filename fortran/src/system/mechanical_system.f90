@@ -34,6 +34,7 @@ module mechanical_system
   use constraints, only: constraint_eval, operand_values, drive_value
   use element_sets, only: element_set, set_forces, set_energy_power, set_ffr, frame_omega
   use section_moment, only: moment_force, moment_angle
+  use vector_loads, only: vector_load_force
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record
   use sparse_direct, only: solver_solve, solver_factorize
   implicit none
@@ -105,6 +106,12 @@ module mechanical_system
     real(dp), allocatable :: force_vectors(:, :)
     integer, allocatable :: moment_dofs(:, :)
     real(dp), allocatable :: moment_axis(:, :), moment_magnitude(:), moment_reference(:, :)
+    ! driven and follower point loads (vector_loads): per load a kind, a drive (0: none), a
+    ! vector, the torsion shares, and the terms of its slots a, b, p on full coordinates
+    ! (vload_ptr(3 (l - 1) + s) .. vload_ptr(3 (l - 1) + s + 1) - 1)
+    integer :: nvload = 0
+    integer, allocatable :: vload_kind(:), vload_drive(:), vload_ptr(:), vload_dof(:)
+    real(dp), allocatable :: vload_vector(:, :), vload_shares(:, :), vload_coef(:)
     ! constraints with multipliers (constraints module layout)
     integer :: ncon = 0
     integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
@@ -330,7 +337,7 @@ contains
   !> info = 6 (moment undefined), 7 (a plate normal vanished), 8 (contact search failed).
   subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
                              strain, contact_potential, contact_powers, records, info, &
-                             tangent_rotation, tangent_values, rates, tangent_rates, full_out)
+                             tangent_rotation, tangent_values, rates, tangent_rates, full_out, t)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
     type(contact_state), intent(inout) :: state
@@ -342,6 +349,7 @@ contains
     real(dp), intent(in), optional :: rates(0:), tangent_rates(0:)
     !> the same forces in the full coordinates q (before B^T), for the joint reactions
     real(dp), intent(out), optional :: full_out(:)
+    real(dp), intent(in), optional :: t  ! with the tangent: the point loads' Jacobian at t
     real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
     real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3), rate, tangent_rate
     logical :: want_tangent
@@ -404,6 +412,10 @@ contains
     if (present(full_out)) full_out = full_force
     call to_reduced(sys, full_force, force)
     if (.not. want_tangent) return
+    if (present(t) .and. sys%nvload > 0) then
+      call vector_load_tangent(sys, t, e_full, load_factor, values_full, info)
+      if (info /= 0) return
+    end if
     if (sys%reduced) then  ! B^T S B by the plan
       tangent_values = 0.0_dp
       do k = 1, size(sys%plan_source)
@@ -461,15 +473,27 @@ contains
 
   !> Configuration-independent external loads at t, times load_factor: the constant loads
   !> plus the driven forces. info = 5 when a drive fails.
-  subroutine external_forces(sys, t, load_factor, force, info)
+  !> With e, the driven and follower point loads at e are added (vector_load_forces).
+  subroutine external_forces(sys, t, load_factor, force, info, e)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: t, load_factor
     real(dp), intent(out) :: force(:)
     integer, intent(out) :: info
+    real(dp), intent(in), optional :: e(:)
     real(dp) :: phi, dphi, ddphi
+    real(dp), allocatable :: e_full(:), full_force(:), reduced(:)
     integer :: d
     info = 0
     force = load_factor * sys%constant_force
+    if (present(e) .and. sys%nvload > 0) then
+      allocate (e_full(sys%nfull), full_force(sys%nfull), reduced(sys%ndof))
+      call to_full(sys, e, .true., e_full)
+      full_force = 0.0_dp
+      call vector_load_forces(sys, t, e_full, load_factor, full_force, info)
+      if (info /= 0) return
+      call to_reduced(sys, full_force, reduced)
+      force = force + reduced
+    end if
     do d = 1, size(sys%force_drive)
       call drive_value(sys%force_drive(d), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
                        phi, dphi, ddphi, info)
@@ -480,6 +504,117 @@ contains
       force = force + load_factor * phi * sys%force_vectors(:, d)
     end do
   end subroutine external_forces
+
+  !> The driven and follower point loads at the full coordinates e_full and time t, times
+  !> load_factor, added to full_force. info = 5 when a drive fails, 6 for a malformed load.
+  subroutine vector_load_forces(sys, t, e_full, load_factor, full_force, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, e_full(:), load_factor
+    real(dp), intent(inout) :: full_force(:)
+    integer, intent(out) :: info
+    real(dp) :: phi, dphi, ddphi, x(3, 3), force(3, 3), jacobian(3, 3, 3, 2)
+    integer :: l, s, k, dof
+    info = 0
+    do l = 1, sys%nvload
+      phi = 1.0_dp
+      if (sys%vload_drive(l) > 0) then
+        call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+                         t, phi, dphi, ddphi, info)
+        if (info /= 0) then
+          info = 5
+          return
+        end if
+      end if
+      x = 0.0_dp
+      do s = 1, 2
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          dof = sys%vload_dof(k)
+          x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(dof:dof + 2)
+        end do
+      end do
+      call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
+                             sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
+      if (info /= 0) then
+        info = 6
+        return
+      end if
+      do s = 1, 3
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          dof = sys%vload_dof(k)
+          full_force(dof:dof + 2) = full_force(dof:dof + 2) + sys%vload_coef(k) * force(:, s)
+        end do
+      end do
+    end do
+  end subroutine vector_load_forces
+
+  !> Minus the Jacobian of the driven and follower point loads at (e_full, t), times
+  !> load_factor, added to values_full (the full pattern): the residual carries
+  !> internal - external. Entries outside the pattern (none: a load's slots lie in one
+  !> element or node) are skipped. info = 5 when a drive fails, 6 for a malformed load.
+  subroutine vector_load_tangent(sys, t, e_full, load_factor, values_full, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, e_full(:), load_factor
+    real(dp), intent(inout) :: values_full(:)
+    integer, intent(out) :: info
+    real(dp) :: phi, dphi, ddphi, x(3, 3), force(3, 3), jacobian(3, 3, 3, 2)
+    integer :: l, s, w, k, m, i, j, row, col, pos, base
+    info = 0
+    do l = 1, sys%nvload
+      phi = 1.0_dp
+      if (sys%vload_drive(l) > 0) then
+        call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+                         t, phi, dphi, ddphi, info)
+        if (info /= 0) then
+          info = 5
+          return
+        end if
+      end if
+      x = 0.0_dp
+      do s = 1, 2
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(sys%vload_dof(k):sys%vload_dof(k) + 2)
+        end do
+      end do
+      call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
+                             sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
+      if (info /= 0) then
+        info = 6
+        return
+      end if
+      do s = 1, 3
+        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+          do w = 1, 2
+            base = 3 * (l - 1) + w
+            do m = sys%vload_ptr(base), sys%vload_ptr(base + 1) - 1
+              do i = 1, 3
+                row = sys%vload_dof(k) + i - 1
+                do j = 1, 3
+                  col = sys%vload_dof(m) + j - 1
+                  pos = pattern_position(sys, row, col)
+                  if (pos > 0) values_full(pos) = values_full(pos) - sys%vload_coef(k) &
+                                                  * sys%vload_coef(m) * jacobian(i, s, j, w)
+                end do
+              end do
+            end do
+          end do
+        end do
+      end do
+    end do
+  end subroutine vector_load_tangent
+
+  !> Position of (row, col) in the full pattern, 0 when absent.
+  pure integer function pattern_position(sys, row, col) result(pos)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: row, col
+    integer :: k
+    pos = 0
+    do k = sys%full_row_ptr(row), sys%full_row_ptr(row + 1) - 1
+      if (sys%full_col(k) == col) then
+        pos = k
+        return
+      end if
+    end do
+  end function pattern_position
 
   !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
   !> drive cannot be evaluated.
@@ -607,13 +742,14 @@ contains
   !> of active contact points. info: 3 (solver failure, detail = its code) or the
   !> internal_forces codes.
   subroutine refactorize(sys, beta_prime, velocity_factor, rotations, e, v, state, force, &
-                         strain, active, info, detail, rates)
+                         strain, active, info, detail, rates, t)
     type(system_model), intent(inout) :: sys
     real(dp), intent(in) :: beta_prime, velocity_factor, rotations(:, :, 0:), e(:), v(:)
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: force(:), strain
     integer, intent(out) :: active, info, detail
     real(dp), intent(in), optional :: rates(0:)  ! the frames' phi' (material damping)
+    real(dp), intent(in), optional :: t          ! the time (the point loads' Jacobian)
     real(dp), allocatable :: values(:), records(:, :)
     real(dp) :: potential, powers(2), frame_rates(0:size(sys%frames))
     integer :: b, j
@@ -623,7 +759,7 @@ contains
     if (present(rates)) frame_rates = rates
     call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
                          potential, powers, records, info, tangent_rotations(sys, rotations), &
-                         values, frame_rates, tangent_frame_rates(sys, frame_rates))
+                         values, frame_rates, tangent_frame_rates(sys, frame_rates), t)
     if (info /= 0) return
     active = 0
     if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)

@@ -380,13 +380,39 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "nodes": Key("int", check=at_least(2), doc="nodes on the beam (>= 2)"),
         "segments": Key("floats", None, doc="segment lengths (m) each split equally (keeps "
                         "their ends as nodes); default: one segment"),
-        "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle"),
+        "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle",
+                                                  "general"),
                        "cross-section: 'rectangle' (width, height), 'box' (width, height, wall), "
-                       "'tube' (diameter, wall), 'circle' (diameter)"),
+                       "'tube' (diameter, wall), 'circle' (diameter), 'general' (area, iy, iz, "
+                       "torsion_constant, shear_factor_y, shear_factor_z; optional "
+                       "mass_per_length, rotary_inertia, fibre_points)"),
         "width": Key("float", None, positive, "section width along r_z (m)"),
         "height": Key("float", None, positive, "section height along r_y (m)"),
         "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
         "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+        "shear": Key("str", None, one_of("unit", "cowper"), "shear factors of 'rectangle', "
+                     "'box', 'tube', 'circle': 'unit' (k = 1, the default) or 'cowper' "
+                     "(Cowper 1966, from the section and nu)"),
+        "area": Key("float", None, positive, "'general': cross-section area A (m^2)"),
+        "iy": Key("float", None, positive, "'general': I_y = int z^2 dA, bending along the "
+                  "width r_z (m^4)"),
+        "iz": Key("float", None, positive, "'general': I_z = int y^2 dA, bending along the "
+                  "height r_y (m^4)"),
+        "torsion_constant": Key("float", None, positive, "'general': Saint-Venant torsion "
+                                "constant J (m^4)"),
+        "shear_factor_y": Key("float", None, positive, "'general': shear factor k_y (shear "
+                              "stiffness k_y G A along the height)"),
+        "shear_factor_z": Key("float", None, positive, "'general': shear factor k_z (along the "
+                              "width)"),
+        "mass_per_length": Key("float", None, positive, "'general', optional: mass per unit "
+                               "length (kg/m; default density * area)"),
+        "rotary_inertia": Key("floats", None, vector3, "'general', optional: r_x, r_y, r_z, "
+                              "rotary inertia per unit length about the axis, the height and "
+                              "the width axes (kg m; r_x = r_y + r_z; default density * (iy + "
+                              "iz, iy, iz))"),
+        "fibre_points": Key("floats", None, doc="'general', optional: outer-fibre points y1, "
+                            "z1, y2, z2, ... in the section (m) for stresses (default: the "
+                            "corners of the rectangle of the same A, I_y, I_z)"),
         "height_axis": Key("floats", None, vector3, "direction of the section height "
                            "(default: global z, or y for a beam along z)"),
         "formulation": Key("str", None, one_of("ffr", "nonlinear"),
@@ -438,13 +464,19 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
                                         "fix", "arm", "hub"), doc="joint type (SPEC section 8)"),
         "body1": Key("str", "ground", doc="first body (or 'ground')"),
         "body2": Key("str", doc="second body"),
-        "point": Key("floats", None, points3, "joint point(s) (nodes of beams and plates)"),
+        "point": Key("floats", None, points3, "joint point(s): any material points of the bodies "
+                     "(between nodes, off a beam's axis)"),
         "axis": Key("floats", None, vector3, "hinge axis / direction"),
         "drive": Key("str", None, doc="drive of 'distance', 'prescribed', 'hub'"),
         "point1": Key("floats", None, vector3, "'distance': point on body1"),
         "point2": Key("floats", None, vector3, "'distance': point on body2"),
         "pivot": Key("floats", None, vector3, "'prescribed', 'arm', 'hub': centre of rotation"),
         "vector": Key("str", "r", one_of("r", "r_x", "r_y", "r_z"), "'fix': the nodal vector held"),
+        "edge": Key("str", None, one_of("x0", "x1", "y0", "y1"),
+                    "instead of point: every node of a plate's or leaf's side (x0, x1: the ends "
+                    "along edge_x; y0, y1: the sides along edge_y), whatever the mesh"),
+        "box": Key("floats", None, size=6, doc="instead of point: every node of the flexible body "
+                   "in the box x0, y0, z0, x1, y1, z1 (m), whatever the mesh"),
     },
     "drive": {
         "name": _name(),
@@ -489,7 +521,10 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "vector": Key("floats", None, vector3, "gravity (m/s^2), force (N), moment (N m)"),
         "mass": Key("float", None, non_negative, "'point_mass': mass (kg)"),
         "value": Key("float", None, doc="'pressure': pressure (Pa) against the normal"),
-        "drive": Key("str", None, doc="'force': scales the vector with the drive's value"),
+        "drive": Key("str", None, doc="'force', 'moment': scales the vector with the drive's "
+                     "value (a pulse, a table)"),
+        "follower": Key("bool", False, doc="'force', 'moment': the vector is fixed in the body's "
+                        "material frame at the point (given at t = 0) and turns with it"),
         "effect": Key("str", None, doc="the effect it belongs to (default by type: gravity, "
                       "point_loads, point_loads, tip_mass, pressure)"),
     },

@@ -35,6 +35,7 @@ from ..errors import Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver
 from ..system.model import Model
+from .assumptions import check_ffr
 
 #: what a contact record (per point and step) holds
 CONTACT_FIELDS = CONTACT_RECORD
@@ -269,12 +270,15 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             newton += int(chunk.stats[:, 0].sum())
             factorizations += int(chunk.stats[:, 1].sum())
             jacobians += int(chunk.stats[:, 2].sum())
+            chunk, outside = _check_assumptions(model, chunk, state, info)
             t1 = time.perf_counter()
             if sink and len(chunk.time):
                 sink(chunk)
             timing["output"] += time.perf_counter() - t1
             bar.update(round(state["t"] - t_before, 9))
             bar.set_postfix(steps=steps, newton=newton)
+            if outside:
+                raise SolverError(outside)
             if info:
                 raise SolverError(integrator.failure_message(info, detail, state["t"]))
             if should_stop is not None and should_stop():
@@ -294,6 +298,34 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     timing["total"] = wall
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
                          solves_setup=0, wall_time_s=wall, timing=timing, jacobians=jacobians)
+
+
+def _check_assumptions(model: Model, chunk: Chunk, state: dict,
+                       info: int) -> tuple[Chunk, str]:
+    """(the rows to keep, why the run stops or ''): an 'ffr' beam that leaves its
+    small-strain assumption (solvers.assumptions) stops the run at the first row that does
+    when the chunk holds q (the rows after it dropped), else at the chunk's last state."""
+    if not any(s.kind == "ffr" for s in model.sets) or not len(chunk.time):
+        return chunk, ""
+    if chunk.q is not None:
+        for row, (t, e) in enumerate(zip(chunk.time, chunk.q)):
+            why = _outside(model, e, float(t), "at")
+            if why:
+                return Chunk(**{k: (None if v is None else v[:row + 1])
+                                for k, v in vars(chunk).items()}), why
+        return chunk, ""
+    if info:
+        return chunk, ""
+    return chunk, _outside(model, state["e"], float(state["t"]), "by")
+
+
+def _outside(model: Model, e, t: float, how: str) -> str:
+    """Why the state e at t is outside the formulation's assumptions ('' when it is not)."""
+    try:
+        check_ffr(model, e, t, when=f"{how} t = {t:.6g} s")
+    except SolverError as exc:
+        return str(exc)
+    return ""
 
 
 __all__ = ["DynamicSettings", "Chunk", "DynamicResult", "TimeIntegrator", "integrate",

@@ -27,6 +27,7 @@ from ..errors import SolverError
 from ..io.validate import check_arguments
 from ..kernel import DirectSolver
 from ..system.model import Model
+from .assumptions import check_ffr
 
 
 @dataclass
@@ -120,6 +121,10 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     moment_cols = [cols for cols, *_ in model.moment_terms(model.e0)]
     m_rows = [np.repeat(cols, len(cols)) for cols in moment_cols]
     m_cols = [np.tile(cols, len(cols)) for cols in moment_cols]
+    # driven and follower point loads: their (non-symmetric) Jacobian, with the moments'
+    load_cols = [cols for cols, *_ in model.vector_load_terms(model.e0)]
+    m_rows += [np.repeat(cols, len(cols)) for cols in load_cols]
+    m_cols += [np.tile(cols, len(cols)) for cols in load_cols]
     rows = np.concatenate([model.pattern.rows, h_rows, *m_rows, n + j_rows, j_cols])
     cols = np.concatenate([model.pattern.col_index, h_cols, *m_cols, j_cols, n + j_rows])
     timing["assembly"] += time.perf_counter() - t0
@@ -136,6 +141,7 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                     reaction = np.zeros(n)
                     np.add.at(reaction, j_cols, grads * lam[j_rows])
                     moments = model.moment_terms(e)
+                    moments += [(c, f, j, None) for c, f, j in model.vector_load_terms(e)]
                     internal, external, k_values = _forces(model, d, True)
                     residual = internal - external - reaction
                     if load_step == 1 and iteration == 1:  # the start: loads and prestress
@@ -182,6 +188,7 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
             model.load_factor = 1.0
             model.counters["factorizations"] += solver.factorizations
             model.counters["solves"] += solver.solves
+    check_ffr(model, model.e0 + d, 0.0, when="in the static equilibrium")
     wall = time.perf_counter() - start
     timing["total"] = wall
     return StaticResult(model.e0 + d, lam, "newton", total, force_res, con_res, wall, history,
@@ -277,6 +284,9 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
         raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
                           "formulation (every body) without contact; use "
                           "solver.static_method = 'newton'")
+    if model.vector_loads:
+        raise SolverError("the split iteration takes dead loads only; driven moments and "
+                          "follower loads need solver.static_method = 'newton'")
     model.require_runnable()
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
@@ -387,6 +397,7 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     timing["assembly"] += time.perf_counter() - t0
     wall = time.perf_counter() - start
     timing["total"] = wall
+    check_ffr(model, model.e0 + disp, 0.0, when="in the static equilibrium")
     return StaticResult(model.e0 + disp, lam, "split", outer, force_res, con_res, wall, history,
                         timing, extra={"inner_iterations": inner_total, "p": p,
                                        "converged_by": how, "nonlinear_coordinates": nl})

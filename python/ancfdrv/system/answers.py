@@ -518,7 +518,7 @@ def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_
     data, section, mat = beam.section.data, beam.section, beam.material
     e_mod = mat.youngs_modulus
     g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
-    k_y, k_z = section.shear_factors
+    k_y, k_z = section.shear_factors(mat.poisson_ratio)
     axial = e_mod * data.area * d[..., 0]
     if beam.formulation != "ffr":   # large deformation: the bending strains' axial share
         rates = now[..., 6:].reshape(*d.shape[:-1], 2)
@@ -580,7 +580,7 @@ def _rectangle_torsion(long: float, short: float) -> tuple[float, float]:
 def fibre_stresses(section, forces: SectionForces) -> tuple[np.ndarray, np.ndarray]:
     """(sigma_x, tau) at the section's fibre points for every station: (..., ns, npoints)."""
     data = section.data
-    points = np.asarray(section.fibre_points, dtype=float)
+    points = np.asarray(section.fibre_points(), dtype=float)
     y, z = points[:, 0], points[:, 1]
     n, t = forces.N[..., None], forces.T[..., None]
     q_h, q_w = forces.Q[..., 0:1], forces.Q[..., 1:2]

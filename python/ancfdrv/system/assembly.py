@@ -22,7 +22,8 @@ from .drives import Constant
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation, orthonormality, planar_fixes, small_turn
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
-from .model import FrameInfo, MomentInfo, Model, ProbeInfo, SetInfo
+from .model import (VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_FORCE, VLOAD_FOLLOWER_MOMENT, FrameInfo,
+                    MomentInfo, Model, ProbeInfo, SetInfo, VectorLoadInfo)
 from .patterns import Elimination, Pattern, eliminate, reduction_plan
 
 #: effects every model reports (a zero count proves an effect was not computed)
@@ -86,6 +87,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
 
     # mass and loads in full coordinates
     mass_full = _mass(bodies, sets, act.masses, full_pattern, counters)
+    vector_loads = _vector_loads(act, q0, drive_index, counters)
     gravity, constant, driven = _loads(bodies, sets, act, drive_index, counters, nfull)
     moments = _moments(act.moments, q0, counters)
 
@@ -131,6 +133,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         moments=moments, constraints=constraints, contact_pairs=contact_pairs, probes=probes,
         point_masses=[(m.body.name, m.point, m.mass) for m in act.masses],
         linear_joints=mode)
+    model.vector_loads = vector_loads
     model.frame_problems = frame_problems
     _answer_inputs(model, system, equations, elimination, reduction, mass_full,
                    constant + gravity, driven)
@@ -252,26 +255,37 @@ def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
     m = beam.material
     frame_ref = frame_q[local].reshape(3, 8, beam.nel, order="F")
     global_ref = q[local].reshape(3, 8, beam.nel, order="F")
+    # torsion constant J and shear factors of the section (docs/theory.md, "Sections")
+    shear_scales = beam.section.shear_scales(m.poisson_ratio)
+    torsion = beam.section.torsion_constant
+    shear_factors = beam.section.shear_factors(m.poisson_ratio)
     mass_compact, stiffness0 = kernel.beam_element_arrays(
-        beam.lengths, section, m.density, m.youngs_modulus, m.poisson_ratio, frame_ref)
+        beam.lengths, section, m.density, m.youngs_modulus, m.poisson_ratio, frame_ref,
+        shear_scales)
+    mass_rule, mass_density = beam.section.mass_rule(m.density)
+    if mass_rule is not section:   # a general section's own mass and rotary inertia
+        mass_compact, _ = kernel.beam_element_arrays(
+            beam.lengths, mass_rule, mass_density, m.youngs_modulus, m.poisson_ratio, frame_ref)
     info = SetInfo(body=beam, kind="", dofs=dofs, nel=beam.nel, frame=frame_id,
                    mass_compact=mass_compact)
     if beam.formulation == "ffr":
         info.kind = "ffr"
         if beam.bending == "cubic":  # K0: the structural tangent at the reference, in the frame
             structural = kernel.StructuralBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
-                                               m.poisson_ratio)
+                                               m.poisson_ratio, torsion, shear_factors)
             *_, stiffness0 = structural.forces(local, frame_q, True)
         info.stiffness0 = np.asfortranarray(stiffness0)
         info.reference = np.asfortranarray(frame_q[local])
     elif beam.bending == "cubic":
         info.kind = "structural"
         info.structural = kernel.StructuralBeam(global_ref, beam.lengths, section,
-                                                m.youngs_modulus, m.poisson_ratio)
+                                                m.youngs_modulus, m.poisson_ratio, torsion,
+                                                shear_factors)
     else:
         info.kind = "continuum"
         info.gradients, info.weights, info.nvolume = kernel.beam_nonlinear_setup(
             global_ref, beam.lengths, section)
+        info.shear_scales = shear_scales
     return info
 
 
@@ -342,8 +356,8 @@ def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counter
         for info in sets:
             body = info.body
             if isinstance(body, Beam):
-                elements = kernel.beam_gravity(body.lengths, body.section.data,
-                                               body.material.density, g)
+                elements = kernel.beam_gravity(body.lengths,
+                                               *body.section.mass_rule(body.material.density), g)
                 np.add.at(gravity, info.dofs.reshape(-1, order="F"),
                           elements.reshape(-1, order="F"))
             else:
@@ -398,35 +412,96 @@ def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list
     out = []
     for load in loads:
         body = load.body
-        at = body.locate(load.point, node=not isinstance(body, RigidBody),
-                         what=f"load {load.name!r}")
         axis = load.vector / np.linalg.norm(load.vector)
-        magnitude = float(np.linalg.norm(load.vector))
-        firsts = {which: next(iter(body.vector(at, which).terms))
-                  for which in body.directors(at)}
-        if isinstance(body, RigidBody):
-            best = None
-            for which, first in firsts.items():
-                d = q0[first:first + 3]
-                score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
-                if best is None or score > best[0] + 1e-12:
-                    best = (score, first)
-            parts = [(best[1], axis, magnitude)]
+        for at, share in _moment_nodes(body, load):
+            out += _moment_parts(body, at, load, axis, share * float(np.linalg.norm(load.vector)),
+                                 q0)
+        counters[load.effect] += 1
+    return out
+
+
+def _moment_nodes(body: Body, load) -> list[tuple]:
+    """Where a moment acts: (attachment, share) at a node, or on a beam between nodes the
+    two nodes of its element in the shares (1 - xi, xi) by which its directors r_y, r_z
+    interpolate them there (the virtual work of the moment on the interpolated section's
+    turn); the point's offset from the axis does not matter for a moment."""
+    what = f"load {load.name!r}"
+    if isinstance(body, RigidBody):
+        return [(body.locate(load.point, node=False, what=what), 1.0)]
+    if isinstance(body, Beam):
+        at = body.locate(load.point, node=False, what=what)
+        if at.node is not None:
+            return [(at, 1.0)]
+        xi = at.local[0]
+        nodes = [(at.element, 1.0 - xi), (at.element + 1, xi)]
+        return [(type(at)(node, at.element, at.local), w) for node, w in nodes if w > 0.0]
+    return [(body.locate(load.point, node=True, what=what), 1.0)]
+
+
+def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
+                  q0: np.ndarray) -> list[MomentInfo]:
+    """The dead moment's parts on the directors of one node (see :func:`_moments`)."""
+    out = []
+    firsts = {which: next(iter(body.vector(at, which).terms))
+              for which in body.directors(at)}
+    if isinstance(body, RigidBody):
+        best = None
+        for which, first in firsts.items():
+            d = q0[first:first + 3]
+            score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
+            if best is None or score > best[0] + 1e-12:
+                best = (score, first)
+        parts = [(best[1], axis, magnitude)]
+    else:
+        f1, f2 = firsts.values()
+        u1 = q0[f1:f1 + 3] / np.linalg.norm(q0[f1:f1 + 3])
+        u2 = q0[f2:f2 + 3] / np.linalg.norm(q0[f2:f2 + 3])
+        normal = np.cross(u1, u2)
+        normal /= np.linalg.norm(normal)
+        m_n, m_1, m_2 = (float(magnitude * axis @ u) for u in (normal, u1, u2))
+        w1, w2 = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
+        parts = [(f1, normal, w1 * m_n), (f2, normal, w2 * m_n), (f2, u1, m_1),
+                 (f1, u2, m_2)]
+        parts = [(f, np.sign(m) * k, abs(m)) for f, k, m in parts
+                 if abs(m) > 1e-14 * magnitude]
+    for first, k, m in parts:
+        out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
+                              q0[first:first + 3].copy()))
+    return out
+
+
+def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
+                  counters: Counter) -> list[VectorLoadInfo]:
+    """The driven and follower point loads (kernel module vector_loads), taken out of the
+    dead forces and moments: a follower force, a moment with a drive or a follower moment.
+    Each acts through the two directions a, b of the body at its point (beam: r_y, r_z;
+    plate, leaf, rigid body: r_x, r_y; interpolated between nodes) and its position p; a
+    follower's vector is kept as its components on (a, b, a x b) at t = 0."""
+    out = []
+    chosen = [x for x in act.forces if x.follower] + \
+        [x for x in act.moments if x.follower or x.drive is not None]
+    act.forces[:] = [x for x in act.forces if not x.follower]
+    act.moments[:] = [x for x in act.moments if not (x.follower or x.drive is not None)]
+    for load in chosen:
+        body = load.body
+        at = body.locate(load.point, node=False, what=f"load {load.name!r}")
+        names = ("r_y", "r_z") if isinstance(body, Beam) else ("r_x", "r_y")
+        a, b = (body.vector(at, w) for w in names)
+        p = body.position(at)
+        a0, b0 = a.value(q0), b.value(q0)
+        frame = np.column_stack([a0, b0, np.cross(a0, b0)])
+        force = isinstance(load, PointForce)
+        if load.follower:
+            kind = VLOAD_FOLLOWER_FORCE if force else VLOAD_FOLLOWER_MOMENT
+            vector = np.linalg.solve(frame, load.vector)
         else:
-            f1, f2 = firsts.values()
-            u1 = q0[f1:f1 + 3] / np.linalg.norm(q0[f1:f1 + 3])
-            u2 = q0[f2:f2 + 3] / np.linalg.norm(q0[f2:f2 + 3])
-            normal = np.cross(u1, u2)
-            normal /= np.linalg.norm(normal)
-            m_n, m_1, m_2 = (float(magnitude * axis @ u) for u in (normal, u1, u2))
-            w1, w2 = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
-            parts = [(f1, normal, w1 * m_n), (f2, normal, w2 * m_n), (f2, u1, m_1),
-                     (f1, u2, m_2)]
-            parts = [(f, np.sign(m) * k, abs(m)) for f, k, m in parts
-                     if abs(m) > 1e-14 * magnitude]
-        for first, k, m in parts:
-            out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
-                                  q0[first:first + 3].copy()))
+            kind, vector = VLOAD_DEAD_MOMENT, load.vector.copy()
+        shares = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
+        slots = [sorted(a.terms.items()), sorted(b.terms.items()),
+                 sorted(p.terms.items()) if force else []]
+        drive = -1 if load.drive is None else drive_index[id(load.drive)]
+        out.append(VectorLoadInfo(load.name, kind, drive, vector, np.array(shares, float),
+                                  slots, load.effect))
         counters[load.effect] += 1
     return out
 
@@ -540,6 +615,7 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
         for b in basis:
             r -= (b @ r) * b
         if np.linalg.norm(r) <= 1e-8 * norm:
+            _check_consistent(out, c, keep, gradients, e0, scale)
             notes.append(f"redundant joint equation dropped: {name} (implied by the others)")
             continue
         basis.append(r / np.linalg.norm(r))
@@ -555,6 +631,37 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
         taken.add(choice)
         out.dependent.append(choice)
     return out
+
+
+#: times (s) at which a redundant driven equation is compared with those that imply it
+_CONSISTENCY_TIMES = (1e-3, 0.01, 0.05, 0.1, 0.25, 0.5, 1.0, 2.0, 3.0, 5.0, 10.0, 30.0, 100.0)
+
+
+def _check_consistent(out: ConstraintSet, c: int, keep: list[int], gradients: np.ndarray,
+                      e0: np.ndarray, scale: float) -> None:
+    """A redundant equation (its gradient g_c = sum a_k g_k of the kept ones at t = 0) may be
+    dropped only if it agrees with them: with the configuration held at e0, its value must
+    stay sum a_k Phi_k(e0, t) at every sampled time (only driven equations change with t;
+    two contradictory 'prescribed' motions of one point differ). Checked where the equation
+    and those it combines are linear in the coordinates (coordinate kind: exact); else
+    InputError naming both joints."""
+    if out.drives[c] < 0 and all(out.drives[k] < 0 for k in keep):
+        return
+    rows = gradients[keep]
+    coef, *_ = np.linalg.lstsq(rows.T, gradients[c], rcond=None)
+    used = [k for k, a in zip(keep, coef) if abs(a) > 1e-12]
+    if any(out.kinds[k] != CONSTRAINT_COORDINATE for k in used + [c]):
+        return   # a nonlinear equation: the combination holds to first order only
+    tol = 1e-8 * scale
+    for t in _CONSISTENCY_TIMES:
+        values, *_ = out.evaluate(e0, t)
+        mismatch = float(values[c] - coef @ values[keep])
+        if abs(mismatch) > tol:
+            other = keep[int(np.argmax(np.abs(coef)))]
+            raise InputError(
+                f"{out.names[c]}: contradicts {out.names[other]}: the two joints hold the same "
+                f"coordinate (the equation is redundant) but prescribe different motions "
+                f"(off by {mismatch:.3e} at t = {t:g} s); remove one of them")
 
 
 def _constant_constraint(eq: Constraint, x: list[float], tol: float, notes: list[str]) -> None:
@@ -607,6 +714,31 @@ def _anchors(body: Body, joints) -> set:
     return out
 
 
+def _turned_by(beam: Beam, component: set, joints) -> str:
+    """Why an 'ffr' beam in a fixed frame cannot stay in it ('' when it can): no weld, fixed
+    hub or fixed section director clamps it to the ground, and a joint with a moving drive ('distance' as a
+    cylinder, 'prescribed', 'hub', 'arm') acts in the assembly it belongs to, so the drive
+    can turn it about its hinge (a knuckle crane's boom lifted by its cylinder) while its
+    elastic model stays in the frame of t = 0."""
+    if beam.frame_drive is not None:
+        return ""
+    for joint in joints:
+        if beam in (joint.body1, joint.body2) and isinstance(joint.body1, Ground) and (
+                joint.type == "weld" or (joint.type == "hub" and _moving(joint.drive) is None)
+                or (joint.type == "fix" and joint.vector in ("r_y", "r_z"))):
+            return ""
+    for joint in joints:
+        moving = _moving(joint.drive)
+        if moving is None or not ({joint.body1, joint.body2} & component):
+            continue
+        return (f"beam {beam.name!r}: formulation 'ffr' keeps its floating frame fixed, but "
+                f"joint {joint.name!r} moves the assembly it belongs to with drive {moving!r} "
+                "and no weld or fixed hub clamps the beam to the ground: the drive can turn "
+                "it through a large angle, which its frame does not follow; use formulation = "
+                "'nonlinear' for it, or a frame_drive that turns its frame with that motion")
+    return ""
+
+
 def ffr_frame_problems(system) -> list[str]:
     """Why an 'ffr' beam is refused (one message per beam; empty: none is): an 'ffr' beam whose floating frame would have to follow moving bodies: the
     kernel moves an FFR frame only by its own drive about a fixed pivot. The bodies joined
@@ -631,6 +763,10 @@ def ffr_frame_problems(system) -> list[str]:
         if len(component) == 1 and not any(beam in (j.body1, j.body2) for j in joints):
             continue  # a beam without joints: nothing to follow (statics says it is free)
         anchors = set().union(*(_anchors(body, joints) for body in component))
+        turned = _turned_by(beam, component, joints)
+        if turned:
+            problems.append(turned)
+            continue
         if _moving(beam.frame_drive) in anchors:
             continue
         where = f"beam {beam.name!r}"

@@ -273,8 +273,7 @@ class Beam(Body):
         at_node = abs(self.stations[nearest] - s) <= tol and abs(y) <= tol and abs(z) <= tol
         if node and not at_node:
             raise InputError(f"{what}: point {list(p)} is not a node of beam {self.name!r} "
-                             f"(nearest node at {list(self.node_positions()[nearest])}); joints "
-                             "act on nodes of beams")
+                             f"(nearest node at {list(self.node_positions()[nearest])})")
         s = min(max(s, 0.0), self.length)
         element = min(int(np.searchsorted(self.stations, s, side="right")) - 1, self.nel - 1)
         xi = (s - self.stations[element]) / self.lengths[element]
@@ -289,9 +288,18 @@ class Beam(Body):
         return Vec3({first + 3 * a: float(shape[a, 0]) for a in range(8) if shape[a, 0] != 0.0})
 
     def vector(self, at: Attachment, which: str) -> Vec3:
-        if at.node is None:
-            raise InputError(f"beam {self.name!r}: nodal vectors exist at nodes only")
-        return Vec3.of(self.node_first(at.node, which))
+        """A nodal vector at a node; between nodes or off the axis the same gradient of the
+        position field at the material point (through the shape functions: r_x = dr/dx,
+        r_y = dr/dy, r_z = dr/dz there; r_y and r_z interpolate the two nodes' directors)."""
+        if at.node is not None:
+            return Vec3.of(self.node_first(at.node, which))
+        if which == "r":
+            return self.position(at)
+        xi, y, z = at.local
+        derivs = kernel.beam_shape([xi], [y], [z], [self.lengths[at.element]])
+        weights = derivs[VECTOR_OFFSETS[which] // 3][:, 0]
+        first = self.first + BEAM_NODE_DOFS * at.element
+        return Vec3({first + 3 * a: float(weights[a]) for a in range(8) if weights[a] != 0.0})
 
     def basis(self, at: Attachment) -> list[Vec3]:
         return [self.vector(at, w) for w in ("r_x", "r_y", "r_z")]
@@ -403,8 +411,9 @@ class Plate(Body):
         at_node = abs(sx[i] - x) <= tol and abs(sy[j] - y) <= tol
         if node and not at_node:
             raise InputError(f"{what}: point {list(p)} is not a node of "
-                             f"{type(self).__name__.lower()} {self.name!r}; joints act on "
-                             "nodes of plates and leaves")
+                             f"{type(self).__name__.lower()} {self.name!r}; a dead moment "
+                             "acts on a node of a plate or leaf (one with a drive or "
+                             "follower acts anywhere)")
         x = min(max(x, sx[0]), sx[-1])
         y = min(max(y, sy[0]), sy[-1])
         ei = min(int(np.searchsorted(sx, x, side="right")) - 1, self.nx - 1)
@@ -423,10 +432,21 @@ class Plate(Body):
         return Vec3({int(dofs[3 * a]): float(shape[a]) for a in range(12) if shape[a] != 0.0})
 
     def vector(self, at: Attachment, which: str) -> Vec3:
-        if at.node is None:
-            raise InputError(f"{type(self).__name__.lower()} {self.name!r}: nodal vectors "
-                             "exist at nodes only")
-        return Vec3.of(self.node_first(at.node, which))
+        """A nodal vector at a node; elsewhere the gradient of the mid-surface at the point
+        (r_x = dr/dx, r_y = dr/dy through the shape functions)."""
+        if at.node is not None:
+            return Vec3.of(self.node_first(at.node, which))
+        if which == "r":
+            return self.position(at)
+        if which == "r_z":
+            raise InputError(f"{type(self).__name__.lower()} {self.name!r}: points carry r, "
+                             "r_x, r_y (no r_z)")
+        xi, eta = at.local
+        _, derivs = kernel.plate_shape(xi, eta, self.mesh.a[at.element], self.mesh.b[at.element])
+        weights = derivs[:, 0 if which == "r_x" else 1]
+        dofs = self.element_dofs()[:, at.element]
+        return Vec3({int(dofs[3 * a]): float(weights[a]) for a in range(12)
+                     if weights[a] != 0.0})
 
     def basis(self, at: Attachment) -> list[Vec3]:
         return [self.vector(at, "r_x"), self.vector(at, "r_y")]

@@ -28,7 +28,10 @@ Types (SPEC section 8, plus what the template scenes need):
 - ``hub``: a driven clamp: body2's node and section turn with the drive's angle about
   ``axis`` through ``pivot`` (the spin-up beam's root).
 
-Points of joints must be nodes of beams, plates and leaves (any point of a rigid body).
+A joint's point may be any material point of a body (SPEC 8.1): between the nodes of a beam,
+plate or leaf its position and directions come from the element's shape functions, and off a
+beam's axis the point is carried by the section directors r_y, r_z (a plate's points lie on
+its mid-surface).
 """
 from __future__ import annotations
 
@@ -38,11 +41,14 @@ import numpy as np
 
 from ..codes import CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE, CONSTRAINT_DOT
 from ..errors import InputError
-from .bodies import Attachment, Beam, Body, Ground, RigidBody, rotation_about
+from .bodies import Attachment, Beam, Body, Ground, Plate, RigidBody, rotation_about
 from .drives import Drive
 from .expressions import Scalar, Vec3, combination
 
 JOINT_TYPES = ("weld", "revolute", "spherical", "distance", "prescribed", "fix", "arm", "hub")
+#: plate and leaf edges a joint can hold whole: x0 / x1 the ends along edge_x (a leaf's arc),
+#: y0 / y1 the sides along edge_y
+EDGES = ("x0", "x1", "y0", "y1")
 
 
 @dataclass
@@ -118,9 +124,29 @@ class Joint:
     point2: np.ndarray | None = None
     pivot: np.ndarray | None = None
     vector: str = "r"
+    #: a plate or leaf edge ('x0', 'x1', 'y0', 'y1') whose every node the joint holds
+    edge: str | None = None
+    #: a box (x0, y0, z0, x1, y1, z1) whose every node of the flexible body the joint holds
+    box: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         where = f"joint {self.name!r}"
+        if self.edge is not None and self.edge not in EDGES:
+            raise InputError(f"{where}: edge {self.edge!r} must be one of {EDGES}")
+        if self.box is not None:
+            self.box = np.asarray(self.box, dtype=float).ravel()
+            if self.box.shape != (6,) or not np.all(np.isfinite(self.box)) or \
+                    np.any(self.box[3:] < self.box[:3]):
+                raise InputError(f"{where}: box must be six finite numbers x0, y0, z0, x1, y1, "
+                                 "z1 with x1 >= x0, y1 >= y0, z1 >= z0")
+        if (self.edge is not None or self.box is not None) and (
+                self.points or self.type == "distance"):
+            raise InputError(f"{where}: give either point, or edge/box (not both; 'distance' "
+                             "takes point1 and point2)")
+        if self.edge is not None and self.box is not None:
+            raise InputError(f"{where}: give edge or box, not both")
+        if self.edge is not None or self.box is not None:
+            self.points = self._selected_points(where)
         if self.type not in JOINT_TYPES:
             raise InputError(f"{where}: type {self.type!r} must be one of {JOINT_TYPES}")
         if self.body1 is self.body2:
@@ -159,12 +185,40 @@ class Joint:
             raise InputError(f"{where}: a drive applies to types 'distance', 'prescribed' and "
                              "'hub'")
 
+    def _selected_points(self, where: str) -> list[np.ndarray]:
+        """The nodes of the joint's flexible body on its edge or in its box (at t = 0): a
+        selection that follows the mesh, so refining it leaves no part of a support free."""
+        body = self.body2 if self.body2.flexible else self.body1
+        if not body.flexible:
+            raise InputError(f"{where}: edge and box select nodes of a beam, plate or leaf; "
+                             f"neither {self.body1.name!r} nor {self.body2.name!r} is one")
+        if self.edge is not None:
+            if not isinstance(body, Plate):
+                raise InputError(f"{where}: edge selects a side of a plate or leaf, and "
+                                 f"{body.name!r} is not one (use box)")
+            grid = body.mesh.grid
+            nodes = {"x0": grid[0, :], "x1": grid[-1, :], "y0": grid[:, 0],
+                     "y1": grid[:, -1]}[self.edge]
+            positions = body.mesh.coords[nodes, 0:3]
+        else:
+            allnodes = body.mesh.coords[:, 0:3] if isinstance(body, Plate) else \
+                body.node_positions()
+            size = float(np.ptp(allnodes, axis=0).max())
+            tol = 1e-9 * max(size, 1.0)
+            inside = np.all((allnodes >= self.box[:3] - tol) & (allnodes <= self.box[3:] + tol),
+                            axis=1)
+            positions = allnodes[inside]
+        if not len(positions):
+            raise InputError(f"{where}: the box {list(self.box)} holds no node of "
+                             f"{body.name!r}")
+        return [np.array(p, dtype=float) for p in positions]
+
     @property
     def bodies(self) -> tuple[Body, Body]:
         return self.body1, self.body2
 
     def _locate(self, body: Body, point) -> Attachment:
-        return body.locate(point, node=not isinstance(body, RigidBody), what=f"joint {self.name!r}")
+        return body.locate(point, node=False, what=f"joint {self.name!r}")
 
     def equations(self, q0: np.ndarray) -> list[Equation]:
         """The joint's equations in the order the assembly keeps them."""

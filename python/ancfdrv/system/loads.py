@@ -1,10 +1,12 @@
 """Loads, each belonging to an effect (what ``scene.effects`` switches on):
 
 - :class:`Gravity` (effect 'gravity'): the weight of every body and point mass;
-- :class:`PointForce` (effect 'point_loads'): a dead force at a material point, constant or
-  scaled by a drive;
-- :class:`DeadMoment` (effect 'point_loads'): a constant moment (vector: axis times
-  magnitude, N m) on a node's section (beams, plates) or on a rigid body;
+- :class:`PointForce` (effect 'point_loads'): a force at a material point, constant or
+  scaled by a drive, dead or ``follower`` (fixed in the body's material frame there);
+- :class:`DeadMoment` (effect 'point_loads'): a moment (vector: axis times magnitude, N m)
+  on the section at a material point (beams: any point, between nodes through the shape
+  functions; plates: a node) or on a rigid body, constant, scaled by a drive, or
+  ``follower``;
 - :class:`PointMass` (effect 'tip_mass'): a lumped mass at a material point (mass matrix
   and, with gravity, its weight);
 - :class:`Pressure` (effect 'pressure'): a dead pressure on a plate or leaf along minus its
@@ -26,6 +28,12 @@ def _vector(value, what: str) -> np.ndarray:
     if v.shape != (3,) or not np.all(np.isfinite(v)):
         raise InputError(f"{what}: expected three finite numbers, got {value!r}")
     return v
+
+
+def _flag(value, what: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{what}: expected True or False, got {value!r}")
+    return bool(value)
 
 
 class Load:
@@ -53,23 +61,35 @@ class PointForce(Load):
     vector: np.ndarray
     drive: Drive | None = None
     effect: str = "point_loads"
+    #: fixed in the body's material frame at the point (the vector given at t = 0)
+    follower: bool = False
 
     def __post_init__(self) -> None:
         self.point = _vector(self.point, f"load {self.name!r}: point")
         self.vector = _vector(self.vector, f"load {self.name!r}: vector")
+        self.follower = _flag(self.follower, f"load {self.name!r}: follower")
 
 
 @dataclass
 class DeadMoment(Load):
+    """A moment (vector: axis times magnitude, N m) on the section at a material point:
+    without drive nor follower the constant moment of seed 000 (its rotation measured about
+    the fixed axis); with a ``drive`` it is scaled by the drive's value and acts on the
+    current section about the fixed spatial vector; ``follower``: its components in the
+    body's material frame at the point are kept (it turns with the body)."""
+
     name: str
     body: Body
     point: np.ndarray
     vector: np.ndarray
     effect: str = "point_loads"
+    drive: Drive | None = None
+    follower: bool = False
 
     def __post_init__(self) -> None:
         self.point = _vector(self.point, f"load {self.name!r}: point")
         self.vector = _vector(self.vector, f"load {self.name!r}: vector")
+        self.follower = _flag(self.follower, f"load {self.name!r}: follower")
         if np.linalg.norm(self.vector) == 0.0:
             raise InputError(f"load {self.name!r}: the moment vector must not vanish (it gives "
                              "the axis)")

@@ -55,6 +55,8 @@ class SetInfo:
     gradients: np.ndarray | None = None
     weights: np.ndarray | None = None
     nvolume: int = 0
+    #: the continuum beam's torsion and shear correction [c, d_y, d_z] (Section.shear_scales)
+    shear_scales: tuple[float, float, float] = (1.0, 0.0, 0.0)
     structural: kernel.StructuralBeam | None = None
     plate_reference: kernel.PlateReference | None = None
     #: Kelvin-Voigt retardation time (s) handed to the kernel: the material's with the
@@ -72,6 +74,26 @@ class MomentInfo:
     magnitude: float
     effect: str
     reference: np.ndarray
+
+
+#: kinds of the driven and follower point loads (fortran/src/system/vector_loads.f90)
+VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_MOMENT, VLOAD_FOLLOWER_FORCE = 1, 2, 3
+
+
+@dataclass
+class VectorLoadInfo:
+    """A driven or follower point load (kernel module vector_loads): kind, 0-based drive
+    (-1: none), vector (a dead moment's global vector, or a follower's components on the
+    body's directions a, b, a x b), torsion shares, and per slot (a, b, p) the terms
+    (first full coordinate of a 3-vector, coefficient)."""
+
+    name: str
+    kind: int
+    drive: int
+    vector: np.ndarray
+    shares: np.ndarray
+    slots: list[list[tuple[int, float]]]
+    effect: str
 
 
 @dataclass
@@ -120,6 +142,9 @@ def length_scale(bodies: list[Body]) -> float:
 class Model:
     """An assembled system (built by ``ancfdrv.system.assembly.assemble``): the interface
     the solvers and the result writers use."""
+
+    #: driven and follower point loads (set by the assembly; empty: none)
+    vector_loads: tuple | list = ()
 
     def __init__(self, *, title: str, effects: tuple[str, ...], counters: Counter,
                  warnings: list[str], notes: list[str], bodies: list[Body], sets: list[SetInfo],
@@ -263,6 +288,37 @@ class Model:
             out.append((cols, b.T @ f, b.T @ j @ b, np.einsum("ijl,ia,jb,lc->abc", h, b, b, b)))
         return out
 
+    def vector_load_terms(self, e: np.ndarray, t: float = 0.0,
+                          load_factor: float | None = None):
+        """Per driven or follower point load: (coordinates e, generalized force, its
+        Jacobian d force / d e) over the coordinates its directions and point depend on
+        (through B when reduced); the force is external (it enters the residual with a
+        minus sign)."""
+        lf = self.load_factor if load_factor is None else load_factor
+        q = self.expand(e)
+        out = []
+        for load in self.vector_loads:
+            self.counters[load.effect] += 1
+            phi = 1.0 if load.drive < 0 else self.drives[load.drive].value(t)
+            x = [sum((c * q[d:d + 3] for d, c in slot), np.zeros(3)) for slot in load.slots[:2]]
+            force, jac = kernel.vector_load_force(load.kind, lf * phi * load.vector, load.shares,
+                                                  x[0], x[1])
+            dofs = sorted({d + i for slot in load.slots for d, _ in slot for i in range(3)})
+            where = {d: k for k, d in enumerate(dofs)}
+            f = np.zeros(len(dofs))
+            j = np.zeros((len(dofs), len(dofs)))
+            for s, slot in enumerate(load.slots):
+                for d, c in slot:
+                    rows = [where[d + i] for i in range(3)]
+                    f[rows] += c * force[:, s]
+                    for w in range(2):
+                        for d2, c2 in load.slots[w]:
+                            cols = [where[d2 + i] for i in range(3)]
+                            j[np.ix_(rows, cols)] += c * c2 * jac[:, s, :, w]
+            cols, b = self._director_map(np.array(dofs))
+            out.append((cols, b.T @ f, b.T @ j @ b))
+        return out
+
     def _director_map(self, dofs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Coordinates e the full coordinates q[dofs] depend on, and dq[dofs]/de there."""
         if self.reduction is None:
@@ -369,8 +425,12 @@ class Model:
         rate's dependence on e, tau B(e)^T D B(e'), and an FFR frame's omega term), and not
         small against beta' M along the rigid modes (a steel plate swinging at 10 rad/s with
         tau = 2e-3 s: Newton with the Cholesky's upper triangle diverged), so MUMPS factorizes
-        it; the constant policy's beta' M + (1 + c tau) K0 stays symmetric."""
+        it; the constant policy's beta' M + (1 + c tau) K0 stays symmetric. Driven and
+        follower point loads add their unsymmetric Jacobian to a refactorized tangent: MUMPS
+        too."""
         if self.damped and self.policy != POLICY_CONSTANT:
+            return False
+        if self.vector_loads and self.policy != POLICY_CONSTANT:
             return False
         return not self.contact_pairs and self.pattern.bandwidth() <= max(64, self.ndof // 4)
 
@@ -384,7 +444,8 @@ class Model:
             elif s.kind == "continuum":
                 ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
                                      s.body.material.youngs_modulus,
-                                     s.body.material.poisson_ratio, s.frame, s.damping_time)
+                                     s.body.material.poisson_ratio, s.frame, s.damping_time,
+                                     s.shear_scales)
             elif s.kind == "structural":
                 ks.add_structural_set(s.dofs, s.scatter, s.structural.forms, s.structural.strain0,
                                       s.structural.stiffness, s.frame, s.damping_time)
@@ -415,6 +476,8 @@ class Model:
                      np.array([v for _, v in self.driven_forces]).T.reshape(self.ndof, -1),
                      [m.dofs for m in self.moments], [m.axis for m in self.moments],
                      [m.magnitude for m in self.moments], [m.reference for m in self.moments])
+        if self.vector_loads:
+            ks.set_vector_loads(self.vector_loads)
         ks.set_constraints(self.constraints.layout())
         for pair in self.contact_pairs:
             ks.add_contact_pair(pair["dofs"], pair["sizes"], pair["grid"], pair["point_element"],

@@ -298,9 +298,11 @@ class System:
     @_api
     def joint(self, name: str, type: str, body1: str | Body, body2: str | Body, *, point=None,
               axis=None, drive: str | Drive | None = None, point1=None, point2=None,
-              pivot=None, vector: str = "r") -> Joint:
+              pivot=None, vector: str = "r", edge: str | None = None, box=None) -> Joint:
         """A joint (``ancfdrv.system.joints``); ``point`` may list several points (the joint
-        then acts at each)."""
+        then acts at each), any material points of the bodies (SPEC 8.1). Instead of points,
+        ``edge`` ('x0', 'x1', 'y0', 'y1': a side of a plate or leaf) or ``box`` (x0, y0, z0,
+        x1, y1, z1) selects every node of the flexible body there, whatever the mesh."""
         name = self._new_name(name, self.joints, "joint")
         where = f"joint {name!r}"
         v = check_call("joint", f"joint[{name}]", dict(
@@ -314,17 +316,20 @@ class System:
         except ValueError as exc:
             raise InputError(f"{where}: {exc}") from None
         joint = Joint(name, type, self.body(body1, used_by=where), self.body(body2, used_by=where),
-                      points, axis, self._drive(drive, where), p1, p2, pv, vector)
+                      points, axis, self._drive(drive, where), p1, p2, pv, vector, edge, box)
         self.joints[name] = joint
         return joint
 
     @_api
     def load(self, name: str, type: str, *, body: str | Body | None = None, point=None,
              vector=None, mass: float | None = None, value: float | None = None,
-             drive: str | Drive | None = None, effect: str | None = None) -> Load:
+             drive: str | Drive | None = None, effect: str | None = None,
+             follower: bool = False) -> Load:
         """A load (``ancfdrv.system.loads``): 'gravity' (vector), 'force' (body, point,
-        vector, drive), 'moment' (body, point, vector), 'point_mass' (body, point, mass),
-        'pressure' (body, value); ``effect`` defaults by type (SPEC section 8)."""
+        vector, drive, follower), 'moment' (body, point, vector, drive, follower),
+        'point_mass' (body, point, mass), 'pressure' (body, value); ``effect`` defaults by
+        type (SPEC section 8). ``follower``: the vector is fixed in the body's material frame
+        at the point (given at t = 0) and turns with the body."""
         name = self._new_name(name, self.loads, "load")
         where = f"load {name!r}"
         if not isinstance(type, str) or type not in LOAD_TYPES:
@@ -343,8 +348,10 @@ class System:
         if missing:
             raise InputError(f"{where}: type {type!r} needs {', '.join(missing)}")
         extra = [k for k, v in given.items() if v is not None and k not in needs]
-        if drive is not None and type != "force":
+        if drive is not None and type not in ("force", "moment"):
             extra.append("drive")
+        if follower is not False and type not in ("force", "moment"):
+            extra.append("follower")
         if extra:
             raise InputError(f"{where}: type {type!r} does not take {', '.join(extra)}")
         target = None if body is None else self.body(body, used_by=where)
@@ -354,9 +361,10 @@ class System:
         if type == "gravity":
             load = cls(name, vector, effect)
         elif type == "force":
-            load = cls(name, target, point, vector, self._drive(drive, where), effect)
+            load = cls(name, target, point, vector, self._drive(drive, where), effect,
+                       follower)
         elif type == "moment":
-            load = cls(name, target, point, vector, effect)
+            load = cls(name, target, point, vector, effect, self._drive(drive, where), follower)
         elif type == "point_mass":
             load = cls(name, target, point, float(mass), effect)
         else:
