@@ -759,7 +759,7 @@ contains
     if (present(rates)) frame_rates = rates
     call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
                          potential, powers, records, info, tangent_rotations(sys, rotations), &
-                         values, frame_rates, tangent_frame_rates(sys, frame_rates), t)
+                         values, frame_rates, tangent_frame_rates(sys, frame_rates), t=t)
     if (info /= 0) return
     active = 0
     if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
