@@ -580,7 +580,7 @@ def _rectangle_torsion(long: float, short: float) -> tuple[float, float]:
 def fibre_stresses(section, forces: SectionForces) -> tuple[np.ndarray, np.ndarray]:
     """(sigma_x, tau) at the section's fibre points for every station: (..., ns, npoints)."""
     data = section.data
-    points = np.asarray(section.fibre_points(), dtype=float)
+    points = _outline_points(section)
     y, z = points[:, 0], points[:, 1]
     n, t = forces.N[..., None], forces.T[..., None]
     q_h, q_w = forces.Q[..., 0:1], forces.Q[..., 1:2]
@@ -616,6 +616,26 @@ def fibre_stresses(section, forces: SectionForces) -> tuple[np.ndarray, np.ndarr
         tau_t = np.abs(t) * r / section.torsion_constant
         tau_q = (np.abs(q_h) + np.abs(q_w)) / data.area * np.ones_like(y)
     return sigma, tau_t + tau_q
+
+
+def _outline_points(section) -> np.ndarray:
+    """(n, 2) points (y along the height, z along the width; m) where the stresses are
+    evaluated: a rectangle's or box's outline (corners, quarters and middles of the edges:
+    torsion and shear peak in the middles, bending at the corners), 48 points around a
+    circle or tube, else the section's own fibre points (a general section's)."""
+    half_y, half_z = section.extent
+    if isinstance(section, (Tube, Circle)):
+        angle = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+        return np.column_stack([half_y * np.cos(angle), half_y * np.sin(angle)])
+    if isinstance(section, (Rectangle, Box)):
+        edge = np.linspace(-1.0, 1.0, 5)
+        ones = np.ones_like(edge)
+        outline = np.vstack([np.column_stack([half_y * ones, half_z * edge]),
+                             np.column_stack([-half_y * ones, half_z * edge]),
+                             np.column_stack([half_y * edge, half_z * ones]),
+                             np.column_stack([half_y * edge, -half_z * ones])])
+        return np.unique(outline, axis=0)
+    return np.asarray(section.fibre_points(), dtype=float)
 
 
 def _box_flow(y, z, h_m, w_m, wall, inertia) -> np.ndarray:
