@@ -112,7 +112,8 @@ def beam_nonlinear_setup(reference, lengths, section: SectionData):
         element, code = divmod(info, 10)
         raise InputError(f"beam element {element}: degenerate reference geometry "
                          f"(det J0 <= 0, code {code})")
-    return gradients, weights, nsec * (npts // (nsec + 5))   # the volume points
+    naxial = (npts - 8) // (nsec + 1)        # 4 axial points; 4 x 2 twist points
+    return gradients, weights, nsec * naxial  # the volume points come first
 
 
 def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poisson,

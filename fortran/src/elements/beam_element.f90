@@ -136,8 +136,10 @@ contains
     real(dp) :: shape(8), dshape(8, 3), jacobian0(3, 3), inverse0(3, 3), det0
     real(dp) :: material_gradient(8, 3), strain_matrix(6, 24), elasticity(6, 6)
     real(dp) :: laws(6, 6, 3), shear, area, point_y(5), point_z(5), point_w(5), law(6, 6)
-    integer :: i, s, nsection, extra
+    real(dp) :: pt(2), wt(2), xi_point, weight_point
+    integer :: i, s, nsection, extra, naxial
     call volume_rule(length, section_w, xi, weight, info)
+    if (info == 0) call gauss_legendre(2, pt, wt, info)   ! the twist points' axial rule
     call isotropic_elasticity(youngs, poisson, elasticity)
     shear = elasticity(4, 4)
     elasticity(4, 4) = 0.5_dp * youngs                       ! as beam_nonlinear's volume law
@@ -161,13 +163,21 @@ contains
       else
         law = elasticity
       end if
-      do i = 1, n_axial
+      naxial = merge(2, n_axial, extra >= 2)
+      do i = 1, naxial
+        if (extra >= 2) then          ! twist points: 2 Gauss points, as beam_nonlinear
+          xi_point = 0.5_dp * (pt(i) + 1.0_dp)
+          weight_point = 0.5_dp * wt(i) * length * area
+        else
+          xi_point = xi(i)
+          weight_point = sum(weight(i, :))
+        end if
         if (extra < 1) then
           call beam_shape(xi(i), section_y(s), section_z(s), length, shape, dshape(:, 1), &
                           dshape(:, 2), dshape(:, 3))
         else
-          call beam_shape(xi(i), point_y(extra), point_z(extra), length, shape, dshape(:, 1), &
-                          dshape(:, 2), dshape(:, 3))
+          call beam_shape(xi_point, point_y(extra), point_z(extra), length, shape, &
+                          dshape(:, 1), dshape(:, 2), dshape(:, 3))
         end if
         jacobian0 = matmul(reference, dshape)
         call invert3(jacobian0, inverse0, det0)
@@ -181,7 +191,7 @@ contains
           stiffness = stiffness + weight(i, s) * det0 * &
                       matmul(transpose(strain_matrix), matmul(law, strain_matrix))
         else
-          stiffness = stiffness + point_w(extra) * sum(weight(i, :)) * det0 * &
+          stiffness = stiffness + point_w(extra) * weight_point * det0 * &
                       matmul(transpose(strain_matrix), matmul(law, strain_matrix))
         end if
       end do

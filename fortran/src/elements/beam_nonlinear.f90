@@ -20,7 +20,8 @@
 !> (D0 is the Poisson-free law: with G there the b terms tied a spinning rod's deflection to
 !> nu); twist points, at each axial station a pair (0, +-z0), z0 = sqrt(I_y/A), weights A/2,
 !> with c G - E/2 on 2E12 only, and a pair (+-y0, 0), y0 = sqrt(I_z/A), with c G - E/2 on
-!> 2E13 only; the neutral-axis points add d G on 2E12, 2E13. With c = J / I_p and
+!> 2E13 only (2 Gauss points along the element, the others 4); the neutral-axis points add
+!> d G on 2E12, 2E13. With c = J / I_p and
 !> d = k - c the twist costs G J tau^2 and a uniform shear k G A, exactly (the pairs are
 !> symmetric), and b keeps E/2. Twist and axis points whose law vanishes are skipped.
 !>
@@ -39,8 +40,10 @@ module beam_nonlinear
   private
   public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, nonlinear_element_damped
 
-  !> Gauss points along the axis; the section rule comes from beam_section.
+  !> Gauss points along the axis; the section rule comes from beam_section. The twist
+  !> points use 2 (t^2 is quadratic along the element: exact).
   integer, parameter, public :: nonlinear_axial_points = 4
+  integer, parameter :: twist_axial_points = 2
 
 contains
 
@@ -48,7 +51,7 @@ contains
   !> neutral-axis points, the twist points (0, +-z0) and (+-y0, 0).
   pure integer function nonlinear_rule_size(nsection)
     integer, intent(in) :: nsection
-    nonlinear_rule_size = nonlinear_axial_points * (nsection + 5)
+    nonlinear_rule_size = nonlinear_axial_points * (nsection + 1) + 4 * twist_axial_points
   end function nonlinear_rule_size
 
   !> Material gradients g_a (8, 3, point) and weights (volume element det J0 included) of
@@ -61,11 +64,14 @@ contains
     real(dp), intent(out) :: gradients(:, :, :), weights(:)   ! (8, 3, npts), (npts)
     integer, intent(out) :: info
     real(dp) :: pa(nonlinear_axial_points), wa(nonlinear_axial_points)
+    real(dp) :: pt(twist_axial_points), wt(twist_axial_points), xi, axial_weight
     real(dp) :: shape(8), dshape(8, 3), jac0(3, 3), inv0(3, 3), det0, y, z
     real(dp) :: area, twist_y(4), twist_z(4), twist_w(4)
-    integer :: i, s, p, nsection
+    integer :: i, s, p, nsection, naxial
     nsection = size(section_w)
     call gauss_legendre(nonlinear_axial_points, pa, wa, info)
+    if (info /= 0) return
+    call gauss_legendre(twist_axial_points, pt, wt, info)
     if (info /= 0) return
     area = sum(section_w)
     twist_y = [0.0_dp, 0.0_dp, 1.0_dp, -1.0_dp] * sqrt(sum(section_w * section_y**2) / area)
@@ -73,23 +79,30 @@ contains
     twist_w = 0.5_dp * area
     p = 0
     do s = 1, nsection + 5
-      do i = 1, nonlinear_axial_points
+      naxial = merge(nonlinear_axial_points, twist_axial_points, s <= nsection + 1)
+      do i = 1, naxial
         p = p + 1
+        if (s <= nsection + 1) then
+          xi = 0.5_dp * (pa(i) + 1.0_dp)
+          axial_weight = 0.5_dp * wa(i) * length
+        else
+          xi = 0.5_dp * (pt(i) + 1.0_dp)
+          axial_weight = 0.5_dp * wt(i) * length
+        end if
         if (s <= nsection) then
           y = section_y(s)
           z = section_z(s)
-          weights(p) = 0.5_dp * wa(i) * length * section_w(s)
+          weights(p) = axial_weight * section_w(s)
         else if (s == nsection + 1) then
           y = 0.0_dp
           z = 0.0_dp
-          weights(p) = 0.5_dp * wa(i) * length * area
+          weights(p) = axial_weight * area
         else
           y = twist_y(s - nsection - 1)
           z = twist_z(s - nsection - 1)
-          weights(p) = 0.5_dp * wa(i) * length * twist_w(s - nsection - 1)
+          weights(p) = axial_weight * twist_w(s - nsection - 1)
         end if
-        call beam_shape(0.5_dp * (pa(i) + 1.0_dp), y, z, length, shape, dshape(:, 1), &
-                        dshape(:, 2), dshape(:, 3))
+        call beam_shape(xi, y, z, length, shape, dshape(:, 1), dshape(:, 2), dshape(:, 3))
         jac0 = matmul(reference, dshape)
         call invert3(jac0, inv0, det0)
         if (det0 <= 0.0_dp) then
@@ -296,8 +309,9 @@ contains
     law_twist_z(6, 6) = shear_scales(1) * shear - 0.5_dp * youngs
   end subroutine split_laws
 
-  !> The law of point p: volume points, then the neutral-axis points, the twist points
-  !> (0, +-z0) and (+-y0, 0), nonlinear_axial_points of each (nonlinear_setup's order).
+  !> The law of point p: volume points, then the neutral-axis points (nonlinear_axial_points
+  !> of them), the twist points (0, +-z0) and (+-y0, 0) (twist_axial_points of each;
+  !> nonlinear_setup's order).
   pure function point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z) &
       result(law)
     integer, intent(in) :: p, volume_points
@@ -308,7 +322,7 @@ contains
       law = law_free
     else if (p <= volume_points + nonlinear_axial_points) then
       law = law_poisson
-    else if (p <= volume_points + 3 * nonlinear_axial_points) then
+    else if (p <= volume_points + nonlinear_axial_points + 2 * twist_axial_points) then
       law = law_twist_y
     else
       law = law_twist_z
