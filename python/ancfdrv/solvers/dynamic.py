@@ -17,6 +17,19 @@ and decides when to factorize the iteration matrix S = beta' M + K:
 
 Each chunk's outputs go to a ``sink`` (the HDF5 writer) before the next chunk starts, so an
 interrupted or failed run keeps every completed chunk.
+
+Step-size control (:class:`StepControl`, issue 26). The output stays on the user's grid
+t0 + k dt: every step lands on it exactly (no interpolation; a step is shortened to reach
+the next grid time). With ``step = 'fixed'`` the kernel steps whole chunks at dt; a step
+that fails (Newton diverges or stalls, the state turns non-finite, a linear solve or the
+contact search fails: a contact set that cycles shows as a Newton stall) is retried from its
+start with half the step, again and again down to ``dt_min``, and the step doubles back after
+GROW_AFTER successes in a row (at most to dt, where whole chunks resume). A failure at
+dt_min ends the run (SolverError, exit 3). A Newton stall at the round-off floor with a
+tolerance below what double precision resolves is not retried (a smaller step does not
+lower the floor). With ``step = 'adaptive'`` every step is sized by the local error
+estimate of Zienkiewicz & Xie (1991; see :func:`local_error`) to ``tolerance`` (bounded by
+dt and dt_min), and the same cuts apply to failed steps.
 """
 from __future__ import annotations
 
@@ -62,6 +75,17 @@ class DynamicSettings:
     jacobian: str = "step"
     contraction: float = 0.25
     length_scale: float = 1.0
+    #: the smallest step a failed step may be cut to (0: dt / 1024)
+    dt_min: float = 0.0
+    #: 'fixed' (dt, cut where a step fails) or 'adaptive' (sized by the local error estimate)
+    step: str = "fixed"
+    #: step = 'adaptive': the local error allowed per step, relative to the length scale
+    tolerance: float = 1e-6
+
+    @property
+    def smallest_step(self) -> float:
+        """dt_min, or dt / 1024 when it is 0 (the default)."""
+        return self.dt_min if self.dt_min > 0 else self.dt / 1024.0
 
     @classmethod
     def generalized_alpha(cls, dt: float, t_end: float, rho_inf: float,
@@ -104,6 +128,11 @@ class Chunk:
     stats: np.ndarray         # (nt, 3): STAT_NAMES (corrections, factorizations, jacobians)
     q: np.ndarray | None      # (nt, ndof) when stored
     contact: np.ndarray | None = None  # (nt, npoints, 6): CONTACT_FIELDS
+    #: per row: the smallest step taken to reach it (s; 0 for the initial row), the steps
+    #: taken and the step cuts in its interval (None: one step of the grid's size, no cut)
+    step_size: np.ndarray | None = None
+    substeps: np.ndarray | None = None
+    cuts: np.ndarray | None = None
 
     @property
     def newton(self) -> np.ndarray:
@@ -122,6 +151,14 @@ class DynamicResult:
     wall_time_s: float
     timing: dict[str, float] = field(default_factory=dict)
     jacobians: int = 0
+    #: step control (issue 26): failed steps retried with a smaller step, steps rejected by
+    #: the error estimate, steps taken (grid steps and their substeps), the smallest step,
+    #: steps whose Newton iteration converged at the round-off floor
+    step_cuts: int = 0
+    steps_rejected: int = 0
+    steps_taken: int = 0
+    smallest_step: float = 0.0
+    floor_accepts: int = 0
 
 
 def _saddle_solve(model: Model, matrix: sp.spmatrix, rhs_top: np.ndarray,
@@ -158,6 +195,8 @@ class TimeIntegrator:
         self.model, self.settings = model, settings
         settings.length_scale = model.length_scale
         self.last_correction = 0.0
+        self.floor_accepts = 0   # steps converged at the round-off floor (all calls)
+        self.failed_stats = np.zeros(3, dtype=np.int64)  # the last failed step's work
 
     def state(self, t: float, e: np.ndarray, v: np.ndarray, a: np.ndarray,
               lam: np.ndarray) -> dict:
@@ -169,12 +208,17 @@ class TimeIntegrator:
                     guesses=self.model.contact_guesses.copy(),
                     counts=np.zeros(6, dtype=np.int32))
 
-    def advance(self, state: dict, nsteps: int) -> tuple[Chunk, int, int]:
-        """Advance ``nsteps`` steps; ``state`` is updated in place. Returns the chunk of
-        completed steps, the kernel's info and detail codes."""
+    def advance(self, state: dict, nsteps: int, h: float | None = None
+                ) -> tuple[Chunk, int, int]:
+        """Advance ``nsteps`` steps of size h (default dt); ``state`` is updated in place.
+        Returns the chunk of completed steps, the kernel's info and detail codes (a failed
+        step's statistics go to ``failed_stats``)."""
         s, m = self.settings, self.model
-        out = m.kernel.advance(nsteps, s, state, s.store_q)
-        done, info, detail = out["status"]
+        out = m.kernel.advance(nsteps, s, state, s.store_q, h)
+        done, info, detail, floor = out["status"]
+        self.floor_accepts += floor
+        self.failed_stats = out["stats"][:, done].astype(np.int64) if info and done < nsteps \
+            else np.zeros(3, dtype=np.int64)
         self.last_correction = out["last_correction"]
         chunk = Chunk(time=out["time"][:done],
                       probes=np.transpose(out["probes"][:, :m.kernel.nprobe, :done], (2, 1, 0)),
@@ -187,15 +231,164 @@ class TimeIntegrator:
                       if m.contact_pairs else None)
         return chunk, info, detail
 
-    def failure_message(self, info: int, detail: int, t: float) -> str:
+    def failure_message(self, info: int, detail: int, t: float, h: float | None = None,
+                        cuts: int = 0) -> str:
         s = self.settings
+        h = s.dt if h is None else h
         reason = STEP_FAILURES.get(info, f"kernel code {info}").format(max_newton=s.max_newton,
                                                                        detail=detail)
         if info == 1:
+            reason = NEWTON_OUTCOMES.get(detail, reason).format(max_newton=s.max_newton)
             reason += (f" (last correction {self.last_correction:.3e} m, tolerance "
-                       f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length; raise "
-                       "solver.max_newton or lower solver.dt)")
-        return f"time step from t = {t:.6g} s to t = {t + s.dt:.6g} s failed: {reason}"
+                       f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length")
+            if detail == NEWTON_FLOOR_STALL:
+                reason += ("; the corrections cannot fall below the round-off of the "
+                           "coordinates: raise solver.newton_tol)")
+            else:
+                reason += "; raise solver.max_newton or lower solver.dt_min)"
+        if cuts:
+            reason += (f"; the step was cut {cuts} times, the last from {2 * h:.3g} s to "
+                       f"{h:.3g} s, and solver.dt_min = {s.smallest_step:.3g} s allows no "
+                       "smaller one")
+        return f"time step from t = {t:.6g} s to t = {t + h:.6g} s failed: {reason}"
+
+
+#: why a step's Newton iteration ended unconverged (time_integrator's newton_* codes)
+NEWTON_LIMIT, NEWTON_FLOOR_STALL, NEWTON_STALL, NEWTON_DIVERGED = 0, 1, 2, 3
+NEWTON_OUTCOMES = {
+    NEWTON_LIMIT: "Newton did not converge within {max_newton} iterations",
+    NEWTON_FLOOR_STALL: "Newton stalled at the round-off floor (the corrections stopped "
+                        "falling at the size double precision resolves, above a tolerance "
+                        "below it)",
+    NEWTON_STALL: "Newton stalled (four corrections in a row set no new minimum, above the "
+                  "round-off floor)",
+    NEWTON_DIVERGED: "Newton diverged (the corrections grew three times in a row, or one "
+                     "exceeded the length scale)",
+}
+#: kernel failures a smaller step may avoid (not: a constraint or drive that cannot be
+#: evaluated, a refused call)
+RETRYABLE = {1, 2, 3, 4, 6, 7, 8}
+#: successful steps in a row after which a cut step doubles again
+GROW_AFTER = 4
+
+
+def local_error(settings: DynamicSettings, h: float, accel_old: np.ndarray,
+                accel_new: np.ndarray) -> float:
+    """The local error estimate of Newmark's displacement update (Zienkiewicz & Xie 1991,
+    "A simple error estimator and adaptive time stepping procedure for dynamic analysis",
+    Earthquake Eng. Struct. Dyn. 20, 871-887): the Taylor remainder of
+    e_{n+1} = e_n + h e'_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}) against the exact motion
+    is (beta - 1/6) h^3 e^(3), with e^(3) ~ (a_{n+1} - a_n) / h:
+        eta = |beta - 1/6| h^2 max |a_{n+1} - a_n|,
+    here with the accelerations e'' (for generalized-alpha the same remainder with its beta).
+    Returned relative to tolerance x length scale: a step is accepted at <= 1."""
+    eta = abs(settings.beta - 1.0 / 6.0) * h * h * np.max(np.abs(accel_new - accel_old),
+                                                          initial=0.0)
+    return eta / (settings.tolerance * settings.length_scale)
+
+
+@dataclass
+class StepControl:
+    """The step-size control's state (issue 26), apart from the kernel's system: the
+    current step, the successes since the last cut, the counts of the run."""
+
+    settings: DynamicSettings
+    h: float = 0.0
+    successes: int = 0
+    cuts: int = 0
+    rejected: int = 0
+    taken: int = 0
+    smallest: float = np.inf
+
+    def __post_init__(self) -> None:
+        self.h = self.settings.dt
+
+    @property
+    def whole_chunks(self) -> bool:
+        """Whether the kernel may step whole chunks at dt (fixed steps, no cut pending)."""
+        return self.settings.step == "fixed" and self.h >= self.settings.dt
+
+    def succeeded(self, h: float, error: float | None = None) -> None:
+        self.taken += 1
+        self.smallest = min(self.smallest, h)
+        if error is not None:  # adaptive: the next step from the error estimate
+            factor = 2.0 if error <= 0.0 else min(2.0, max(0.2, 0.9 * error ** (-1.0 / 3.0)))
+            self.h = min(self.settings.dt, max(self.settings.smallest_step, factor * h))
+            return
+        self.successes += 1
+        if self.successes >= GROW_AFTER and self.h < self.settings.dt:
+            self.h = min(self.settings.dt, 2.0 * self.h)
+            self.successes = 0
+
+    def cut(self, h: float) -> bool:
+        """A step of size h failed: halve it; False when that falls below dt_min."""
+        self.successes = 0
+        if 0.5 * h < self.settings.smallest_step * (1.0 - 1e-12):
+            return False
+        self.cuts += 1
+        self.h = 0.5 * h
+        return True
+
+    def reject(self, h: float, error: float) -> None:
+        """The error estimate rejected a step of size h."""
+        self.rejected += 1
+        self.h = max(self.settings.smallest_step,
+                     h * max(0.2, 0.9 * error ** (-1.0 / 3.0)))
+
+
+_STATE_KEYS = ("t", "e", "v", "a", "accel", "lam", "work", "powers", "guesses", "counts")
+
+
+def _snapshot(state: dict) -> dict:
+    return {k: (state[k].copy() if isinstance(state[k], np.ndarray) else state[k])
+            for k in _STATE_KEYS}
+
+
+def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
+              t_target: float, stats0: np.ndarray | None = None, cuts0: int = 0) -> Chunk:
+    """Steps of the controller's size from state["t"] to the grid time t_target (landed on
+    exactly); returns the row at t_target with the interval's statistics (failed tries
+    included). Raises SolverError when a step fails at dt_min."""
+    s = integrator.settings
+    stats = np.zeros(3, dtype=np.int64) if stats0 is None else stats0.copy()
+    cuts, taken, smallest, last = cuts0, 0, np.inf, None
+    adaptive = s.step == "adaptive"
+    while True:
+        remaining = t_target - state["t"]
+        if remaining <= 1e-9 * s.smallest_step:
+            break
+        h = control.h
+        if h >= remaining * (1.0 - 1e-9):
+            h = remaining
+        before = _snapshot(state)
+        chunk, info, detail = integrator.advance(state, 1, h)
+        if info:
+            stats += integrator.failed_stats
+            retry = info in RETRYABLE and not (info == 1 and detail == NEWTON_FLOOR_STALL)
+            if not retry or not control.cut(h):
+                state.update(before)
+                raise SolverError(integrator.failure_message(info, detail, state["t"], h,
+                                                             cuts if retry else 0))
+            cuts += 1
+            state.update(before)
+            continue
+        stats += chunk.stats[0].astype(np.int64)
+        error = local_error(s, h, before["accel"], state["accel"]) if adaptive else None
+        if error is not None and error > 1.0 and h > s.smallest_step * (1.0 + 1e-12):
+            control.reject(h, error)
+            state.update(before)
+            continue
+        control.succeeded(h, error)
+        taken += 1
+        smallest = min(smallest, h)
+        last = chunk
+    state["t"] = t_target
+    last.time = np.array([t_target])
+    last.stats = stats[None, :]
+    last.step_size = np.array([smallest])
+    last.substeps = np.array([taken], dtype=np.int64)
+    last.cuts = np.array([cuts], dtype=np.int64)
+    return last
 
 
 def initial_row(model: Model, state: dict) -> Chunk:
@@ -249,17 +442,51 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
                bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s [{elapsed}<{remaining}{postfix}]")
     steps = newton = factorizations = jacobians = 0
     call_steps = min(settings.chunk_steps, 10)  # the first call measures a step's cost
+    if settings.step not in ("fixed", "adaptive"):
+        raise SolverError(f"solver.step = {settings.step!r} must be 'fixed' or 'adaptive'")
+    control = StepControl(settings)
+    failed = np.zeros(3, dtype=np.int64)  # work of failed tries before a row's interval
+    carried_cut = False  # a whole chunk's step failed and was cut: its row counts the cut
     try:
         while steps < total:
-            n = min(call_steps, total - steps)
             t_before = state["t"]
             t1 = time.perf_counter()
-            chunk, info, detail = integrator.advance(state, n)
-            elapsed = time.perf_counter() - t1
-            timing["stepping"] += elapsed
-            if len(chunk.time):  # calls of at most ~0.25 s: a stop request waits no longer
-                call_steps = max(1, min(settings.chunk_steps,
-                                        int(0.25 * len(chunk.time) / max(elapsed, 1e-9))))
+            pending = None  # a failed step of a whole chunk: redone with cut steps
+            if control.whole_chunks:
+                n = min(call_steps, total - steps)
+                chunk, info, detail = integrator.advance(state, n)
+                elapsed = time.perf_counter() - t1
+                if len(chunk.time):  # calls of at most ~0.25 s: a stop request waits no longer
+                    call_steps = max(1, min(settings.chunk_steps,
+                                            int(0.25 * len(chunk.time) / max(elapsed, 1e-9))))
+                control.taken += len(chunk.time)
+                if len(chunk.time):
+                    control.smallest = min(control.smallest, settings.dt)
+                if info:
+                    failed += integrator.failed_stats
+                    retry = info in RETRYABLE and not (info == 1
+                                                       and detail == NEWTON_FLOOR_STALL)
+                    if not retry or not control.cut(settings.dt):
+                        pending = SolverError(integrator.failure_message(info, detail,
+                                                                         state["t"]))
+                    else:
+                        carried_cut = True
+            else:
+                # the grid time the kernel's whole chunks would reach (t + dt each step)
+                t_target = t0 + (steps + 1) * settings.dt if settings.step == "adaptive" \
+                    else state["t"] + settings.dt
+                try:
+                    chunk = _interval(integrator, control, state, t_target, failed,
+                                      int(carried_cut))
+                except SolverError as exc:
+                    pending = exc
+                    chunk = Chunk(time=np.zeros(0), probes=np.zeros((0, 0, 3)),
+                                  deflections=np.zeros((0, 0, 3)), lam=np.zeros((0, 0)),
+                                  energy=np.zeros((0, 11)), constraint=np.zeros(0),
+                                  stats=np.zeros((0, 3)), q=None)
+                failed = np.zeros(3, dtype=np.int64)
+                carried_cut = False
+            timing["stepping"] += time.perf_counter() - t1
             steps += len(chunk.time)
             newton += int(chunk.stats[:, 0].sum())
             factorizations += int(chunk.stats[:, 1].sum())
@@ -270,8 +497,11 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             timing["output"] += time.perf_counter() - t1
             bar.update(round(state["t"] - t_before, 9))
             bar.set_postfix(steps=steps, newton=newton)
-            if info:
-                raise SolverError(integrator.failure_message(info, detail, state["t"]))
+            if isinstance(pending, SolverError):
+                newton += int(failed[0])
+                factorizations += int(failed[1])
+                jacobians += int(failed[2])
+                raise pending
             if should_stop is not None and should_stop():
                 raise Interrupted(f"stopped at t = {state['t']:.6g} s after {steps} steps")
     finally:  # the counters hold what was done, also when a step failed
@@ -281,6 +511,10 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
         model.counters["solves"] += newton
         model.counters["factorizations"] += factorizations
         model.counters["jacobian_evaluations"] += jacobians
+        for name, count in (("step_cuts", control.cuts), ("steps_rejected", control.rejected),
+                            ("steps_taken", control.taken),
+                            ("newton_floor_accepts", integrator.floor_accepts)):
+            model.counters[name] = model.counters.get(name, 0) + int(count)
         if model.contact_pairs:
             for name, count in zip(CONTACT_COUNTERS, state["counts"]):
                 model.counters[name] += int(count)
@@ -288,8 +522,13 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     wall = time.perf_counter() - start
     timing["total"] = wall
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
-                         solves_setup=0, wall_time_s=wall, timing=timing, jacobians=jacobians)
+                         solves_setup=0, wall_time_s=wall, timing=timing, jacobians=jacobians,
+                         step_cuts=control.cuts, steps_rejected=control.rejected,
+                         steps_taken=control.taken,
+                         smallest_step=float(control.smallest) if control.taken else 0.0,
+                         floor_accepts=integrator.floor_accepts)
 
 
 __all__ = ["DynamicSettings", "Chunk", "DynamicResult", "TimeIntegrator", "integrate",
+           "StepControl", "local_error",
            "initial_acceleration", "initial_row", "ENERGY_NAMES", "CONTACT_FIELDS", "STAT_NAMES"]
