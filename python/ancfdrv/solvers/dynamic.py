@@ -299,25 +299,34 @@ class StepControl:
     rejected: int = 0
     taken: int = 0
     smallest: float = np.inf
+    #: the size of the last step taken (a change restarts the method, :func:`_restart`)
+    last_h: float = 0.0
+    restarts: int = 0
 
     def __post_init__(self) -> None:
-        self.h = self.settings.dt
+        self.h = self.last_h = self.settings.dt
 
     @property
     def whole_chunks(self) -> bool:
         """Whether the kernel may step whole chunks at dt (fixed steps, no cut pending)."""
         return self.settings.step == "fixed" and self.h >= self.settings.dt
 
-    def succeeded(self, h: float, error: float | None = None) -> None:
+    def succeeded(self, h: float, remaining: float, error: float | None = None) -> None:
+        """A step of size h succeeded, ``remaining`` is left to the next grid time. Steps
+        are dt / 2^k: the step doubles after GROW_AFTER successes (adaptive: after a step
+        whose error estimate, ~h^3, stays below 1 at twice the step: error <= 0.9 / 8) where
+        the double step lands on the grid."""
         self.taken += 1
         self.smallest = min(self.smallest, h)
-        if error is not None:  # adaptive: the next step from the error estimate
-            factor = 2.0 if error <= 0.0 else min(2.0, max(0.2, 0.9 * error ** (-1.0 / 3.0)))
-            self.h = min(self.settings.dt, max(self.settings.smallest_step, factor * h))
-            return
         self.successes += 1
-        if self.successes >= GROW_AFTER and self.h < self.settings.dt:
-            self.h = min(self.settings.dt, 2.0 * self.h)
+        if error is not None:
+            grow = error <= 0.9 / 8.0
+        else:
+            grow = self.successes >= GROW_AFTER
+        double = 2.0 * self.h
+        aligned = remaining <= 0.0 or abs(remaining / double - round(remaining / double)) < 1e-6
+        if grow and self.h < self.settings.dt and aligned:
+            self.h = min(self.settings.dt, double)
             self.successes = 0
 
     def cut(self, h: float) -> bool:
@@ -330,10 +339,15 @@ class StepControl:
         return True
 
     def reject(self, h: float, error: float) -> None:
-        """The error estimate rejected a step of size h."""
+        """The error estimate rejected a step of size h: halved until the estimate (~h^3)
+        would meet the tolerance (at least once, at most to dt_min)."""
         self.rejected += 1
-        self.h = max(self.settings.smallest_step,
-                     h * max(0.2, 0.9 * error ** (-1.0 / 3.0)))
+        self.successes = 0
+        self.h = 0.5 * h
+        while error / 8.0 > 1.0 and 0.5 * self.h >= self.settings.smallest_step:
+            self.h *= 0.5
+            error /= 8.0
+        self.h = max(self.h, self.settings.smallest_step)
 
 
 _STATE_KEYS = ("t", "e", "v", "a", "accel", "lam", "work", "powers", "guesses", "counts")
@@ -342,6 +356,18 @@ _STATE_KEYS = ("t", "e", "v", "a", "accel", "lam", "work", "powers", "guesses", 
 def _snapshot(state: dict) -> dict:
     return {k: (state[k].copy() if isinstance(state[k], np.ndarray) else state[k])
             for k in _STATE_KEYS}
+
+
+def _restart(model: Model, state: dict) -> None:
+    """A restart of the method at a change of the step: the acceleration and the
+    multipliers consistent with the state (:func:`initial_acceleration`), the
+    generalized-alpha variable a = e''. At rho_inf = 1 the method leaves a period-2
+    oscillation of a - e'' and of the multipliers undamped forever (docs/theory.md section
+    14), and a change of the step turns it into an error of order (constraint violation) /
+    h^2 that is never damped either; the restart removes it (accuracy is kept: a and e''
+    differ by O(h^2) at rho_inf = 1)."""
+    accel, lam = initial_acceleration(model, state["e"], state["v"], state["t"])
+    state["a"], state["accel"], state["lam"] = accel.copy(), accel.copy(), lam.copy()
 
 
 def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
@@ -360,6 +386,9 @@ def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
         h = control.h
         if h >= remaining * (1.0 - 1e-9):
             h = remaining
+        if abs(h - control.last_h) > 1e-9 * h:
+            _restart(integrator.model, state)
+            control.restarts += 1
         before = _snapshot(state)
         chunk, info, detail = integrator.advance(state, 1, h)
         if info:
@@ -378,7 +407,8 @@ def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
             control.reject(h, error)
             state.update(before)
             continue
-        control.succeeded(h, error)
+        control.last_h = h
+        control.succeeded(h, t_target - state["t"], error)
         taken += 1
         smallest = min(smallest, h)
         last = chunk
@@ -453,6 +483,10 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             t1 = time.perf_counter()
             pending = None  # a failed step of a whole chunk: redone with cut steps
             if control.whole_chunks:
+                if control.last_h != settings.dt:  # back to dt after cut steps
+                    _restart(model, state)
+                    control.restarts += 1
+                    control.last_h = settings.dt
                 n = min(call_steps, total - steps)
                 chunk, info, detail = integrator.advance(state, n)
                 elapsed = time.perf_counter() - t1
@@ -512,6 +546,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
         model.counters["factorizations"] += factorizations
         model.counters["jacobian_evaluations"] += jacobians
         for name, count in (("step_cuts", control.cuts), ("steps_rejected", control.rejected),
+                            ("step_restarts", control.restarts),
                             ("steps_taken", control.taken),
                             ("newton_floor_accepts", integrator.floor_accepts)):
             model.counters[name] = model.counters.get(name, 0) + int(count)
