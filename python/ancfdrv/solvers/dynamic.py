@@ -358,6 +358,31 @@ def _snapshot(state: dict) -> dict:
             for k in _STATE_KEYS}
 
 
+#: a warning when the energy balance rises above this fraction of the energy scale
+ENERGY_CREATED_WARNING = 0.05
+
+
+class EnergyWatch:
+    """The energy balance over a run (ENERGY_NAMES: total - total(0) - the works of drives,
+    frames, contact damping, friction, material damping): the most energy the integrator
+    created, relative to the largest kinetic energy or change of potential energy. The
+    methods dissipate (rho_inf < 1) or conserve it to their order; a rise is instability."""
+
+    def __init__(self, first: np.ndarray) -> None:
+        self.first = first.copy()
+        self.most, self.scale = 0.0, 0.0
+
+    def add(self, energy: np.ndarray) -> None:
+        balance = energy[:, 4] - self.first[4] - energy[:, [5, 6, 8, 9, 10]].sum(axis=1)
+        potential = energy[:, 1:4].sum(axis=1) - self.first[1:4].sum()
+        self.most = max(self.most, float(balance.max()))
+        self.scale = max(self.scale, float(np.abs(energy[:, 0]).max()),
+                         float(np.abs(potential).max()))
+
+    def created(self) -> float:
+        return self.most / self.scale if self.scale > 0 else 0.0
+
+
 def _restart(model: Model, state: dict) -> None:
     """A restart of the method at a change of the step: the acceleration and the
     multipliers consistent with the state (:func:`initial_acceleration`), the
@@ -475,6 +500,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     if settings.step not in ("fixed", "adaptive"):
         raise SolverError(f"solver.step = {settings.step!r} must be 'fixed' or 'adaptive'")
     control = StepControl(settings)
+    energy_watch = EnergyWatch(first.energy[0])
     failed = np.zeros(3, dtype=np.int64)  # work of failed tries before a row's interval
     carried_cut = False  # a whole chunk's step failed and was cut: its row counts the cut
     try:
@@ -525,6 +551,8 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             newton += int(chunk.stats[:, 0].sum())
             factorizations += int(chunk.stats[:, 1].sum())
             jacobians += int(chunk.stats[:, 2].sum())
+            if len(chunk.time):
+                energy_watch.add(chunk.energy)
             t1 = time.perf_counter()
             if sink and len(chunk.time):
                 sink(chunk)
@@ -554,6 +582,13 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             for name, count in zip(CONTACT_COUNTERS, state["counts"]):
                 model.counters[name] += int(count)
             model.contact_guesses = state["guesses"].copy()
+    created = energy_watch.created()
+    if created > ENERGY_CREATED_WARNING:
+        model.warnings.append(
+            f"the integrator created energy: the balance (total - total(0) - works) rose to "
+            f"{created:.1%} of the largest kinetic or potential-energy change, the method's "
+            "numerical instability (rho_inf = 1 on a nonlinear model at a coarse step): the "
+            "result is not reliable; lower solver.dt or take solver.rho_inf < 1")
     wall = time.perf_counter() - start
     timing["total"] = wall
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
