@@ -108,8 +108,11 @@ def residual_floor(model: Model, e: np.ndarray, k_values: np.ndarray, scale: flo
     return float(np.finfo(float).eps * np.linalg.norm(magnitude) / max(scale, 1e-300))
 
 
-#: iterations in a row without a new smallest residual: the static Newton has stalled
-STALL_ITERATIONS = 4
+#: iterations in a row without a new smallest residual: the static Newton has stalled, once
+#: its residual is small (below STALL_NEAR, or at the floor); far from the solution large
+#: rotations make the residual rise for a while before Newton converges (the elastica),
+#: so there only FAR_STALL_ITERATIONS without progress count as a stall
+STALL_ITERATIONS, FAR_STALL_ITERATIONS, STALL_NEAR = 4, 25, 1e-6
 
 
 def _stall_message(history: list[float], floor: float, tol: float, load_step: int,
@@ -118,7 +121,7 @@ def _stall_message(history: list[float], floor: float, tol: float, load_step: in
     divergence (the residual grew three times in a row to 1e3 times its minimum)."""
     last, smallest = history[-1], min(history)
     where = f"at load step {load_step} of {load_steps}"
-    if all(b > a for a, b in zip(history[-4:-1], history[-3:])) and last > 1e3 * smallest:
+    if all(b > a for a, b in zip(history[-4:-1], history[-3:])) and last > 1e6 * smallest:
         return (f"static Newton diverged {where}: the relative residual grew three times in a "
                 f"row to {last:.3e} (smallest {smallest:.3e}); raise solver.load_steps")
     if smallest <= floor:
@@ -126,8 +129,8 @@ def _stall_message(history: list[float], floor: float, tol: float, load_step: in
                 f"stays at {smallest:.3e} (estimated floor {floor:.3e}) above solver.tol = "
                 f"{tol:.3e}, which asks for more digits than double precision carries here; "
                 "raise solver.tol")
-    return (f"static Newton stalled {where}: {STALL_ITERATIONS} iterations without a smaller "
-            f"residual (smallest {smallest:.3e}, tolerance {tol:.3e}); raise solver.load_steps")
+    return (f"static Newton stalled {where}: no smaller residual in the last iterations "
+            f"(smallest {smallest:.3e}, tolerance {tol:.3e}); raise solver.load_steps")
 
 
 def _hessian_triplets(model: Model, e: np.ndarray):
@@ -215,14 +218,17 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                     if how:
                         break
                     # the stagnation and divergence test (issue 24 item 2): no new minimum
-                    # in STALL_ITERATIONS iterations, or growth to 1e3 times it
+                    # in STALL_ITERATIONS iterations near the solution (FAR_STALL_ITERATIONS
+                    # far from it), or three rises to 1e6 times it
                     step_history = history[len(history) - iteration:]
                     best = int(np.argmin(step_history))
+                    near = step_history[best] <= max(STALL_NEAR, floor)
                     growing = (iteration >= 4 and all(
                         b > a for a, b in zip(step_history[-4:-1], step_history[-3:]))
-                        and force_res > 1e3 * step_history[best])
-                    if iteration - 1 - best >= STALL_ITERATIONS or growing \
-                            or not np.isfinite(force_res):
+                        and force_res > 1e6 * step_history[best])
+                    since = iteration - 1 - best
+                    if since >= (STALL_ITERATIONS if near else FAR_STALL_ITERATIONS) \
+                            or growing or not np.isfinite(force_res):
                         raise SolverError(_stall_message(step_history, floor, tol, load_step,
                                                          load_steps))
                 else:
