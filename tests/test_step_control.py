@@ -6,7 +6,7 @@ References:
   (tests/reference/mechanisms.py, written without ancfdrv);
 * the flexible double pendulum (benchmarks/_stability_models.py) at a step ten times finer
   (a converged reference in time: at dt = 1e-3 it is within 6.6e-5 m of one at 1e-4,
-  benchmarks/results/stability_after.md);
+  benchmarks/results/stability_after_double.md);
 * invariants: the energy balance of generalized-alpha at rho_inf = 1 (no numerical damping),
   the user's time grid, the counts in /dynamic and /counters;
 * the boom statics by the split iteration (seed 000, a different method) and by Newton's
