@@ -168,7 +168,8 @@ def test_newton_failure_exit_3_keeps_finished_chunks(capsys, tmp_path):
     # one Newton correction per step suffices at rest, not once the drive accelerates
     code = main(["run", str(LUFFING), "-o", str(out), "--set", "beam.nodes=4",
                  "--set", "solver.max_newton=1", "--set", "solver.newton_tol=1e-7",
-                 "--set", "output.chunk_steps=50"])
+                 "--set", "output.chunk_steps=50",
+                 "--set", "solver.dt_min=1e-3"])  # = dt: no step cuts (they would rescue it)
     assert code == 3
     err = capsys.readouterr().err
     assert "time step from t = " in err and "did not converge within 1 iterations" in err

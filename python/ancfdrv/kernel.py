@@ -644,12 +644,17 @@ class KernelSystem:
         factorized at another state): a run from a new initial state is reproducible."""
         self._check(_kernel.system_reset_stepper(self.handle), "reset_stepper")
 
-    def advance(self, nsteps: int, settings, state: dict, store_q: bool):
-        """Advance nsteps steps (time_integrator) from state (t, e, v, a, accel, lam, work,
-        powers, guesses, counts; updated in place); returns the raw outputs and status."""
+    def advance(self, nsteps: int, settings, state: dict, store_q: bool,
+                h: float | None = None):
+        """Advance nsteps steps of size h (default settings.dt; time_integrator) from state
+        (t, e, v, a, accel, lam, work, powers, guesses, counts; updated in place); returns
+        the raw outputs and status [steps done, info, detail, steps converged at the
+        round-off floor]; a failed step's statistics are the column after the last
+        completed step."""
         nq = nsteps if store_q else 1
         out = _kernel.system_advance(
-            self.handle, self.ncon, self.nprobe, self.npoint, nsteps, nq, settings.dt,
+            self.handle, self.ncon, self.nprobe, self.npoint, nsteps, nq,
+            settings.dt if h is None else h,
             settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f, settings.tol,
             settings.length_scale, settings.max_newton, settings.jacobian_code,
             settings.contraction, state["t"], _f(state["e"]), _f(state["v"]), _f(state["a"]),

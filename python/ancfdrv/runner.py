@@ -181,7 +181,9 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
     solver, output = scene["solver"], scene["output"]
     common = dict(tol=solver["newton_tol"], max_newton=solver["max_newton"],
                   chunk_steps=output["chunk_steps"], store_q=output["q"],
-                  jacobian=solver["jacobian"], contraction=solver["contraction"])
+                  jacobian=solver["jacobian"], contraction=solver["contraction"],
+                  dt_min=solver.get("dt_min", 0.0), step=solver.get("step", "fixed"),
+                  tolerance=solver.get("tolerance", 1e-6))
     if solver["integrator"] == "generalized_alpha":
         return DynamicSettings.generalized_alpha(solver["dt"], solver["t_end"],
                                                  solver["rho_inf"], **common)
@@ -379,7 +381,11 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
         **attrs, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
         "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,
         "jacobian_policy": "constant" if model.constant_policy else settings.jacobian,
-        "wall_time_s": dyn.wall_time_s, "status": "ok"}, stages)
+        "wall_time_s": dyn.wall_time_s, "status": "ok",
+        "step_control": settings.step, "dt_min": settings.smallest_step,
+        "step_cuts": dyn.step_cuts, "steps_rejected": dyn.steps_rejected,
+        "steps_taken": dyn.steps_taken, "smallest_step": dyn.smallest_step,
+        "newton_floor_accepts": dyn.floor_accepts}, stages)
     return dyn, stages
 
 

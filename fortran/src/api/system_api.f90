@@ -694,8 +694,9 @@ end subroutine system_output_row
 !> Advances nsteps steps of the generalized-alpha method (time_integrator), one output row
 !> per step. The state (t, e, v, a, accel, lam, work, the powers at the state, contact
 !> guesses and counters) is updated in place: calls may split a run anywhere without
-!> changing its result. status = [steps done, info, detail]; stats(:, step) = Newton
-!> corrections, factorizations, Jacobian evaluations. jacobian: 1 per step, 2 per
+!> changing its result. status = [steps done, info, detail, steps converged at the
+!> round-off floor]; stats(:, step) = Newton corrections, factorizations, Jacobian
+!> evaluations (of a failed step too: the column after the last completed one). jacobian: 1 per step, 2 per
 !> iteration, 3 reused across steps (time_integrator).
 subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, beta, gamma, alpha_m, &
                           alpha_f, tol, length_scale, max_newton, jacobian, contraction, t, e, v, &
@@ -718,7 +719,7 @@ subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, bet
   real(dp), intent(out) :: out_lambda(max(1, ncon), nsteps), out_energy(11, nsteps)
   real(dp), intent(out) :: out_constraint(nsteps), out_contact(6, max(1, npoint), nsteps)
   real(dp), intent(out) :: out_q(ndof, nq)
-  integer, intent(out) :: out_stats(3, nsteps), status(3)
+  integer, intent(out) :: out_stats(3, nsteps), status(4)
   real(dp), intent(out) :: last_correction
   type(system_model), pointer :: sys
   type(integrator_settings) :: cfg
@@ -762,7 +763,7 @@ subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, bet
                         out_probe(:, 1:nprobe, :), out_deflection(:, 1:nprobe, :), &
                         out_lambda(1:ncon, :), out_energy, out_constraint, out_stats, &
                         out_contact(:, 1:npoint, :), nq == nsteps, out_q, status(1), status(2), &
-                        status(3), last_correction)
+                        status(3), last_correction, status(4))
   guesses = state%guesses
   counts = state%counts
 end subroutine system_advance

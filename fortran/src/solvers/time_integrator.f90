@@ -59,6 +59,29 @@ module time_integrator
   !> per-step statistics: Newton corrections, factorizations, Jacobian evaluations
   integer, parameter, public :: stat_corrections = 1, stat_factorizations = 2, &
                                 stat_jacobians = 3, stat_count = 3
+  !> why a step's Newton iteration ended without meeting the tolerance (the detail of
+  !> info = 1): the iteration limit; a stall at the round-off floor of the corrections (the
+  !> tolerance asks for more digits than the arithmetic carries); a stall above it; growth
+  !> (divergence)
+  integer, parameter, public :: newton_limit = 0, newton_floor_stall = 1, newton_stall = 2, &
+                                newton_diverged = 3
+  !> corrections that set no new minimum in this many iterations in a row: a stall
+  integer, parameter :: stall_iterations = 4
+  !> the round-off floor of a correction, in ulps of the largest coordinate (or the length
+  !> scale): a correction there is the solve of a residual that is round-off noise
+  real(dp), parameter :: floor_ulps = 1000.0_dp
+  !> the smallest newton_tol that double precision resolves: a stall at the floor with a
+  !> tolerance at least this is converged (counted); below it the tolerance cannot be met
+  real(dp), parameter :: resolvable_tol = 100.0_dp * epsilon(1.0_dp)
+
+  !> The stagnation and divergence test of a step's Newton iteration (reset at each try).
+  type :: newton_monitor
+    real(dp) :: smallest = huge(1.0_dp)  ! the smallest correction so far
+    integer :: since_smallest = 0        ! corrections since it, none smaller
+    integer :: growing = 0               ! corrections in a row larger than the previous
+    integer :: outcome = newton_limit    ! why the iteration ended unconverged
+    logical :: at_floor = .false.        ! converged at the round-off floor (counted)
+  end type newton_monitor
 
   type :: integrator_settings
     real(dp) :: h, beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
@@ -117,7 +140,7 @@ contains
                               out_time, &
                               out_probe, out_deflection, out_lambda, out_energy, out_constraint, &
                               out_stats, out_contact, store_q, out_q, steps_done, info, detail, &
-                              last_correction)
+                              last_correction, floor_accepts)
     type(system_model), intent(inout) :: sys
     type(integrator_settings), intent(in) :: cfg
     integer, intent(in) :: nsteps
@@ -132,6 +155,8 @@ contains
     real(dp), intent(out) :: out_q(:, :)
     integer, intent(out) :: steps_done, info, detail
     real(dp), intent(out) :: last_correction  ! max |de| of the last Newton correction
+    integer, intent(out) :: floor_accepts  ! steps converged at the round-off floor
+    type(newton_monitor) :: monitor
     real(dp) :: e_new(sys%ndof), a_new(sys%ndof), accel_new(sys%ndof), v_new(sys%ndof)
     real(dp) :: lam_new(sys%ncon), predicted_internal(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
@@ -143,6 +168,7 @@ contains
     detail = 0
     steps_done = 0
     last_correction = 0.0_dp
+    floor_accepts = 0
     out_stats = 0
     h = cfg%h
     beta_prime = (1.0_dp - cfg%alpha_m) / (cfg%beta * h * h * (1.0_dp - cfg%alpha_f))
@@ -171,7 +197,7 @@ contains
         end if
         call newton(sys, cfg, t + h, rotations, rates, beta_prime, velocity_factor, e_new, &
                     v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, info, detail)
+                    stats, done, last_correction, monitor, info, detail)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
         ! refreshed the matrix on the way) gets one retry from its start with a fresh one
@@ -179,9 +205,13 @@ contains
             .or. fresh_matrix) exit
       end do
       if (.not. done) then
+        ! the failed step's work is reported in its row (not a completed step)
+        out_stats(:, step) = stats
         info = 1
+        detail = monitor%outcome
         return
       end if
+      if (monitor%at_floor) floor_accepts = floor_accepts + 1
       if (started_old) call update_reuse_backoff(sys, stats(stat_factorizations) > 0)
       ! accept the step
       a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
@@ -281,7 +311,7 @@ contains
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, t_new, rotations, rates, beta_prime, velocity_factor, e_new, v_new, &
                     accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, info, detail)
+                    stats, done, last_correction, monitor, info, detail)
     type(system_model), intent(inout) :: sys
     type(integrator_settings), intent(in) :: cfg
     real(dp), intent(in) :: t_new, rotations(:, :, 0:), rates(0:), beta_prime, velocity_factor
@@ -292,13 +322,14 @@ contains
     integer, intent(inout) :: stats(stat_count)
     logical, intent(out) :: done
     real(dp), intent(inout) :: last_correction
+    type(newton_monitor), intent(out) :: monitor
     integer, intent(out) :: info, detail
     real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof)
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
     real(dp) :: w(3 * size(sys%block_first), sys%ncon), schur(sys%ncon, sys%ncon)
     real(dp) :: dlam(sys%ncon, 1), strain, previous_correction, step_cap, step_theta
     integer :: it, ipiv(sys%ncon), lapack_info, active
-    logical :: use_known, refresh
+    logical :: use_known, refresh, capped, halt
     info = 0
     detail = 0
     done = .false.
@@ -351,12 +382,14 @@ contains
                              .false., correction)
         correction = correction - direction
       end if
+      capped = .false.
       if (sys%npoint > 0) then
         ! damped Newton with contact: no correction moves a coordinate by more than half a
         ! leaf thickness (a contact that is open at the linearization point has no stiffness
         ! there, and a full step would jump far through the other leaf)
         step_cap = contact_step_cap(sys)
         if (maxval(abs(correction)) > step_cap) then
+          capped = .true.
           dlam = dlam * (step_cap / maxval(abs(correction)))
           correction = correction * (step_cap / maxval(abs(correction)))
         end if
@@ -383,6 +416,15 @@ contains
           done = .true.
         end if
         if (done) return
+      end if
+      ! (a correction cut to the contact cap says nothing about convergence)
+      if (.not. capped) then
+        call stagnated(monitor, cfg, it, last_correction, previous_correction, &
+                       maxval(abs(e_new)), halt)
+        if (halt) then
+          done = monitor%at_floor
+          return
+        end if
       end if
       if (sys%policy == policy_constant .or. it >= cfg%max_newton) then
         previous_correction = last_correction
@@ -419,6 +461,51 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> The stagnation and divergence test after correction it of size last (the one before:
+  !> previous; coordinate_size: the largest |e|); halt: the iteration must stop:
+  !> * a stall: stall_iterations corrections in a row set no new minimum. At the round-off
+  !>   floor (the smallest correction within floor_ulps ulps of the largest coordinate or
+  !>   the length scale) the state is as converged as double precision resolves: accepted
+  !>   (at_floor) when newton_tol is itself resolvable (>= resolvable_tol), otherwise the
+  !>   tolerance cannot be met (newton_floor_stall); above the floor: newton_stall;
+  !> * divergence: three corrections in a row each larger than the one before and ten times
+  !>   the smallest, or one correction larger than the length scale (newton_diverged).
+  pure subroutine stagnated(monitor, cfg, it, last, previous, coordinate_size, halt)
+    type(newton_monitor), intent(inout) :: monitor
+    type(integrator_settings), intent(in) :: cfg
+    integer, intent(in) :: it
+    real(dp), intent(in) :: last, previous, coordinate_size
+    logical, intent(out) :: halt
+    real(dp) :: floor
+    halt = .false.
+    if (last < monitor%smallest) then
+      monitor%smallest = last
+      monitor%since_smallest = 0
+    else
+      monitor%since_smallest = monitor%since_smallest + 1
+    end if
+    if (it > 1 .and. last > previous) then
+      monitor%growing = monitor%growing + 1
+    else
+      monitor%growing = 0
+    end if
+    if (monitor%since_smallest >= stall_iterations) then
+      floor = floor_ulps * epsilon(1.0_dp) * max(coordinate_size, cfg%length_scale)
+      halt = .true.
+      if (monitor%smallest > floor) then
+        monitor%outcome = newton_stall
+      else if (cfg%tol >= resolvable_tol) then
+        monitor%at_floor = .true.
+      else
+        monitor%outcome = newton_floor_stall
+      end if
+    else if ((monitor%growing >= 3 .and. last > 10.0_dp * monitor%smallest) .or. &
+             last > cfg%length_scale) then
+      halt = .true.
+      monitor%outcome = newton_diverged
+    end if
+  end subroutine stagnated
 
   !> Half the thinnest leaf of any contact pair: no Newton correction moves a coordinate
   !> further.

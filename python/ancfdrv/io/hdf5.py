@@ -483,6 +483,13 @@ class DynamicWriter:
             series("newton_iterations", "count", dtype="i8")
             series("factorizations", "count", dtype="i8")
             series("jacobian_evaluations", "count", dtype="i8")
+            # step control (issue 26): which step reached each row, how many steps and cuts
+            series("step_size", "s")
+            series("substeps", "count", dtype="i8")
+            series("step_cuts", "count", dtype="i8")
+            group["step_size"].attrs["description"] = (
+                "the smallest step taken to reach the row (0 for the initial row); the rows "
+                "stay on the grid t0 + k dt, steps land on it exactly")
             if self.npoints:  # per contact point: penetration, forces, slip, projection
                 for name in CONTACT_FIELDS:
                     series(f"contact/{name}", CONTACT_UNITS.get(name, "1"), (self.npoints,))
@@ -558,6 +565,7 @@ class DynamicWriter:
         append("newton_iterations", np.rint(chunk.stats[:, 0]).astype(np.int64))
         append("factorizations", np.rint(chunk.stats[:, 1]).astype(np.int64))
         append("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64))
+        self._append_steps(group, chunk)
         if self.store_q and chunk.q is not None:
             if self.write_q:
                 append("q", chunk.q)
@@ -566,6 +574,26 @@ class DynamicWriter:
             if self.nnodes:
                 self._append_frames(group, chunk.q)
         self.rows += n
+
+    def _append_steps(self, group: h5py.Group, chunk) -> None:
+        """step_size, substeps, step_cuts of the chunk's rows (a chunk without them: one
+        step each, of the rows' time difference; the initial row 0)."""
+        n = len(chunk.time)
+        size = getattr(chunk, "step_size", None)
+        if size is None:
+            before = group["time"][self.rows - 1] if self.rows else None
+            previous = np.concatenate([[chunk.time[0] if before is None else before],
+                                       chunk.time[:-1]]) if n else np.zeros(0)
+            size = chunk.time - previous
+        substeps = getattr(chunk, "substeps", None)
+        if substeps is None:
+            substeps = (np.asarray(size) > 0).astype(np.int64)
+        cuts = getattr(chunk, "cuts", None)
+        if cuts is None:
+            cuts = np.zeros(n, dtype=np.int64)
+        _append_rows(group.id, "step_size", self.rows, np.asarray(size, dtype=float))
+        _append_rows(group.id, "substeps", self.rows, np.asarray(substeps, dtype=np.int64))
+        _append_rows(group.id, "step_cuts", self.rows, np.asarray(cuts, dtype=np.int64))
 
     def _append_frames(self, group: h5py.Group, q: np.ndarray) -> None:
         """The points' positions at the chunk's frame rows (every stride-th and the last)."""

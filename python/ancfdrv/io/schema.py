@@ -274,6 +274,17 @@ SCHEMA: dict[str, dict[str, Key]] = {
                              "linear joint equations: eliminated (q = B e + q0, seed 003) or "
                              "kept with multipliers (seed 000); 'auto' eliminates when the "
                              "system has rigid bodies"),
+        "dt_min": Key("float", 0.0, non_negative,
+                      "smallest step (s) a failed step is cut to (halved from dt, doubled "
+                      "back after 4 successes; 0: dt / 1024; dt_min = dt: no cuts); a step "
+                      "failing at dt_min ends the run (exit 3)"),
+        "step": Key("str", "fixed", one_of("fixed", "adaptive"),
+                    "'fixed': steps of dt, cut where one fails; 'adaptive': each step sized "
+                    "by the local error estimate (Zienkiewicz & Xie 1991) to "
+                    "solver.tolerance, at most dt (the output interval), at least dt_min"),
+        "tolerance": Key("float", 1e-6, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
+                         "step = 'adaptive': local position error allowed per step, relative "
+                         "to the model's length"),
     },
     "output": {
         "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),

@@ -17,6 +17,19 @@ and decides when to factorize the iteration matrix S = beta' M + K:
 
 Each chunk's outputs go to a ``sink`` (the HDF5 writer) before the next chunk starts, so an
 interrupted or failed run keeps every completed chunk.
+
+Step-size control (:class:`StepControl`, issue 26). The output stays on the user's grid
+t0 + k dt: every step lands on it exactly (no interpolation; a step is shortened to reach
+the next grid time). With ``step = 'fixed'`` the kernel steps whole chunks at dt; a step
+that fails (Newton diverges or stalls, the state turns non-finite, a linear solve or the
+contact search fails: a contact set that cycles shows as a Newton stall) is retried from its
+start with half the step, again and again down to ``dt_min``, and the step doubles back after
+GROW_AFTER successes in a row (at most to dt, where whole chunks resume). A failure at
+dt_min ends the run (SolverError, exit 3). A Newton stall at the round-off floor with a
+tolerance below what double precision resolves is not retried (a smaller step does not
+lower the floor). With ``step = 'adaptive'`` every step is sized by the local error
+estimate of Zienkiewicz & Xie (1991; see :func:`local_error`) to ``tolerance`` (bounded by
+dt and dt_min), and the same cuts apply to failed steps.
 """
 from __future__ import annotations
 
@@ -64,6 +77,17 @@ class DynamicSettings:
     jacobian: str = "step"
     contraction: float = 0.25
     length_scale: float = 1.0
+    #: the smallest step a failed step may be cut to (0: dt / 1024)
+    dt_min: float = 0.0
+    #: 'fixed' (dt, cut where a step fails) or 'adaptive' (sized by the local error estimate)
+    step: str = "fixed"
+    #: step = 'adaptive': the local error allowed per step, relative to the length scale
+    tolerance: float = 1e-6
+
+    @property
+    def smallest_step(self) -> float:
+        """dt_min, or dt / 1024 when it is 0 (the default)."""
+        return self.dt_min if self.dt_min > 0 else self.dt / 1024.0
 
     @classmethod
     def generalized_alpha(cls, dt: float, t_end: float, rho_inf: float,
@@ -106,6 +130,11 @@ class Chunk:
     stats: np.ndarray         # (nt, 3): STAT_NAMES (corrections, factorizations, jacobians)
     q: np.ndarray | None      # (nt, ndof) when stored
     contact: np.ndarray | None = None  # (nt, npoints, 6): CONTACT_FIELDS
+    #: per row: the smallest step taken to reach it (s; 0 for the initial row), the steps
+    #: taken and the step cuts in its interval (None: one step of the grid's size, no cut)
+    step_size: np.ndarray | None = None
+    substeps: np.ndarray | None = None
+    cuts: np.ndarray | None = None
 
     @property
     def newton(self) -> np.ndarray:
@@ -124,6 +153,14 @@ class DynamicResult:
     wall_time_s: float
     timing: dict[str, float] = field(default_factory=dict)
     jacobians: int = 0
+    #: step control (issue 26): failed steps retried with a smaller step, steps rejected by
+    #: the error estimate, steps taken (grid steps and their substeps), the smallest step,
+    #: steps whose Newton iteration converged at the round-off floor
+    step_cuts: int = 0
+    steps_rejected: int = 0
+    steps_taken: int = 0
+    smallest_step: float = 0.0
+    floor_accepts: int = 0
 
 
 def _saddle_solve(model: Model, matrix: sp.spmatrix, rhs_top: np.ndarray,
@@ -160,6 +197,8 @@ class TimeIntegrator:
         self.model, self.settings = model, settings
         settings.length_scale = model.length_scale
         self.last_correction = 0.0
+        self.floor_accepts = 0   # steps converged at the round-off floor (all calls)
+        self.failed_stats = np.zeros(3, dtype=np.int64)  # the last failed step's work
 
     def state(self, t: float, e: np.ndarray, v: np.ndarray, a: np.ndarray,
               lam: np.ndarray) -> dict:
@@ -171,12 +210,17 @@ class TimeIntegrator:
                     guesses=self.model.contact_guesses.copy(),
                     counts=np.zeros(6, dtype=np.int32))
 
-    def advance(self, state: dict, nsteps: int) -> tuple[Chunk, int, int]:
-        """Advance ``nsteps`` steps; ``state`` is updated in place. Returns the chunk of
-        completed steps, the kernel's info and detail codes."""
+    def advance(self, state: dict, nsteps: int, h: float | None = None
+                ) -> tuple[Chunk, int, int]:
+        """Advance ``nsteps`` steps of size h (default dt); ``state`` is updated in place.
+        Returns the chunk of completed steps, the kernel's info and detail codes (a failed
+        step's statistics go to ``failed_stats``)."""
         s, m = self.settings, self.model
-        out = m.kernel.advance(nsteps, s, state, s.store_q)
-        done, info, detail = out["status"]
+        out = m.kernel.advance(nsteps, s, state, s.store_q, h)
+        done, info, detail, floor = out["status"]
+        self.floor_accepts += floor
+        self.failed_stats = out["stats"][:, done].astype(np.int64) if info and done < nsteps \
+            else np.zeros(3, dtype=np.int64)
         self.last_correction = out["last_correction"]
         chunk = Chunk(time=out["time"][:done],
                       probes=np.transpose(out["probes"][:, :m.kernel.nprobe, :done], (2, 1, 0)),
@@ -189,15 +233,219 @@ class TimeIntegrator:
                       if m.contact_pairs else None)
         return chunk, info, detail
 
-    def failure_message(self, info: int, detail: int, t: float) -> str:
+    def failure_message(self, info: int, detail: int, t: float, h: float | None = None,
+                        cuts: int = 0) -> str:
         s = self.settings
+        h = s.dt if h is None else h
         reason = STEP_FAILURES.get(info, f"kernel code {info}").format(max_newton=s.max_newton,
                                                                        detail=detail)
         if info == 1:
+            reason = NEWTON_OUTCOMES.get(detail, reason).format(max_newton=s.max_newton)
             reason += (f" (last correction {self.last_correction:.3e} m, tolerance "
-                       f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length; raise "
-                       "solver.max_newton or lower solver.dt)")
-        return f"time step from t = {t:.6g} s to t = {t + s.dt:.6g} s failed: {reason}"
+                       f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length")
+            if detail == NEWTON_FLOOR_STALL:
+                reason += ("; the corrections cannot fall below the round-off of the "
+                           "coordinates: raise solver.newton_tol)")
+            else:
+                reason += "; raise solver.max_newton or lower solver.dt_min)"
+        if cuts:
+            reason += (f"; the step was cut {cuts} times, the last from {2 * h:.3g} s to "
+                       f"{h:.3g} s, and solver.dt_min = {s.smallest_step:.3g} s allows no "
+                       "smaller one")
+        return f"time step from t = {t:.6g} s to t = {t + h:.6g} s failed: {reason}"
+
+
+#: why a step's Newton iteration ended unconverged (time_integrator's newton_* codes)
+NEWTON_LIMIT, NEWTON_FLOOR_STALL, NEWTON_STALL, NEWTON_DIVERGED = 0, 1, 2, 3
+NEWTON_OUTCOMES = {
+    NEWTON_LIMIT: "Newton did not converge within {max_newton} iterations",
+    NEWTON_FLOOR_STALL: "Newton stalled at the round-off floor (the corrections stopped "
+                        "falling at the size double precision resolves, above a tolerance "
+                        "below it)",
+    NEWTON_STALL: "Newton stalled (four corrections in a row set no new minimum, above the "
+                  "round-off floor)",
+    NEWTON_DIVERGED: "Newton diverged (the corrections grew three times in a row, or one "
+                     "exceeded the length scale)",
+}
+#: kernel failures a smaller step may avoid (not: a constraint or drive that cannot be
+#: evaluated, a refused call)
+RETRYABLE = {1, 2, 3, 4, 6, 7, 8}
+#: successful steps in a row after which a cut step doubles again
+GROW_AFTER = 4
+
+
+def local_error(settings: DynamicSettings, h: float, accel_old: np.ndarray,
+                accel_new: np.ndarray) -> float:
+    """The local error estimate of Newmark's displacement update (Zienkiewicz & Xie 1991,
+    "A simple error estimator and adaptive time stepping procedure for dynamic analysis",
+    Earthquake Eng. Struct. Dyn. 20, 871-887): the Taylor remainder of
+    e_{n+1} = e_n + h e'_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}) against the exact motion
+    is (beta - 1/6) h^3 e^(3), with e^(3) ~ (a_{n+1} - a_n) / h:
+        eta = |beta - 1/6| h^2 max |a_{n+1} - a_n|,
+    here with the accelerations e'' (for generalized-alpha the same remainder with its beta).
+    Returned relative to tolerance x length scale: a step is accepted at <= 1."""
+    eta = abs(settings.beta - 1.0 / 6.0) * h * h * np.max(np.abs(accel_new - accel_old),
+                                                          initial=0.0)
+    return eta / (settings.tolerance * settings.length_scale)
+
+
+@dataclass
+class StepControl:
+    """The step-size control's state (issue 26), apart from the kernel's system: the
+    current step, the successes since the last cut, the counts of the run."""
+
+    settings: DynamicSettings
+    h: float = 0.0
+    successes: int = 0
+    cuts: int = 0
+    rejected: int = 0
+    taken: int = 0
+    smallest: float = np.inf
+    #: the size of the last step taken (a change restarts the method, :func:`_restart`)
+    last_h: float = 0.0
+    restarts: int = 0
+
+    def __post_init__(self) -> None:
+        self.h = self.last_h = self.settings.dt
+
+    @property
+    def whole_chunks(self) -> bool:
+        """Whether the kernel may step whole chunks at dt (fixed steps, no cut pending)."""
+        return self.settings.step == "fixed" and self.h >= self.settings.dt
+
+    def succeeded(self, h: float, remaining: float, error: float | None = None) -> None:
+        """A step of size h succeeded, ``remaining`` is left to the next grid time. Steps
+        are dt / 2^k: the step doubles after GROW_AFTER successes (adaptive: after a step
+        whose error estimate, ~h^3, stays below 1 at twice the step: error <= 0.9 / 8) where
+        the double step lands on the grid."""
+        self.taken += 1
+        self.smallest = min(self.smallest, h)
+        self.successes += 1
+        if error is not None:
+            grow = error <= 0.9 / 8.0
+        else:
+            grow = self.successes >= GROW_AFTER
+        double = 2.0 * self.h
+        aligned = remaining <= 0.0 or abs(remaining / double - round(remaining / double)) < 1e-6
+        if grow and self.h < self.settings.dt and aligned:
+            self.h = min(self.settings.dt, double)
+            self.successes = 0
+
+    def cut(self, h: float) -> bool:
+        """A step of size h failed: halve it; False when that falls below dt_min."""
+        self.successes = 0
+        if 0.5 * h < self.settings.smallest_step * (1.0 - 1e-12):
+            return False
+        self.cuts += 1
+        self.h = 0.5 * h
+        return True
+
+    def reject(self, h: float, error: float) -> None:
+        """The error estimate rejected a step of size h: halved until the estimate (~h^3)
+        would meet the tolerance (at least once, at most to dt_min)."""
+        self.rejected += 1
+        self.successes = 0
+        self.h = 0.5 * h
+        while error / 8.0 > 1.0 and 0.5 * self.h >= self.settings.smallest_step:
+            self.h *= 0.5
+            error /= 8.0
+        self.h = max(self.h, self.settings.smallest_step)
+
+
+_STATE_KEYS = ("t", "e", "v", "a", "accel", "lam", "work", "powers", "guesses", "counts")
+
+
+def _snapshot(state: dict) -> dict:
+    return {k: (state[k].copy() if isinstance(state[k], np.ndarray) else state[k])
+            for k in _STATE_KEYS}
+
+
+#: a warning when the energy balance rises above this fraction of the energy scale
+ENERGY_CREATED_WARNING = 0.05
+
+
+class EnergyWatch:
+    """The energy balance over a run (ENERGY_NAMES: total - total(0) - the works of drives,
+    frames, contact damping, friction, material damping): the most energy the integrator
+    created, relative to the largest kinetic energy or change of potential energy. The
+    methods dissipate (rho_inf < 1) or conserve it to their order; a rise is instability."""
+
+    def __init__(self, first: np.ndarray) -> None:
+        self.first = first.copy()
+        self.most, self.scale = 0.0, 0.0
+
+    def add(self, energy: np.ndarray) -> None:
+        balance = energy[:, 4] - self.first[4] - energy[:, [5, 6, 8, 9, 10]].sum(axis=1)
+        potential = energy[:, 1:4].sum(axis=1) - self.first[1:4].sum()
+        self.most = max(self.most, float(balance.max()))
+        self.scale = max(self.scale, float(np.abs(energy[:, 0]).max()),
+                         float(np.abs(potential).max()))
+
+    def created(self) -> float:
+        return self.most / self.scale if self.scale > 0 else 0.0
+
+
+def _restart(model: Model, state: dict) -> None:
+    """A restart of the method at a change of the step: the acceleration and the
+    multipliers consistent with the state (:func:`initial_acceleration`), the
+    generalized-alpha variable a = e''. At rho_inf = 1 the method leaves a period-2
+    oscillation of a - e'' and of the multipliers undamped forever (docs/theory.md section
+    14), and a change of the step turns it into an error of order (constraint violation) /
+    h^2 that is never damped either; the restart removes it (accuracy is kept: a and e''
+    differ by O(h^2) at rho_inf = 1)."""
+    accel, lam = initial_acceleration(model, state["e"], state["v"], state["t"])
+    state["a"], state["accel"], state["lam"] = accel.copy(), accel.copy(), lam.copy()
+
+
+def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
+              t_target: float, stats0: np.ndarray | None = None, cuts0: int = 0) -> Chunk:
+    """Steps of the controller's size from state["t"] to the grid time t_target (landed on
+    exactly); returns the row at t_target with the interval's statistics (failed tries
+    included). Raises SolverError when a step fails at dt_min."""
+    s = integrator.settings
+    stats = np.zeros(3, dtype=np.int64) if stats0 is None else stats0.copy()
+    cuts, taken, smallest, last = cuts0, 0, np.inf, None
+    adaptive = s.step == "adaptive"
+    while True:
+        remaining = t_target - state["t"]
+        if remaining <= 1e-9 * s.smallest_step:
+            break
+        h = control.h
+        if h >= remaining * (1.0 - 1e-9):
+            h = remaining
+        if abs(h - control.last_h) > 1e-9 * h:
+            _restart(integrator.model, state)
+            control.restarts += 1
+        before = _snapshot(state)
+        chunk, info, detail = integrator.advance(state, 1, h)
+        if info:
+            stats += integrator.failed_stats
+            retry = info in RETRYABLE and not (info == 1 and detail == NEWTON_FLOOR_STALL)
+            if not retry or not control.cut(h):
+                state.update(before)
+                raise SolverError(integrator.failure_message(info, detail, state["t"], h,
+                                                             cuts if retry else 0))
+            cuts += 1
+            state.update(before)
+            continue
+        stats += chunk.stats[0].astype(np.int64)
+        error = local_error(s, h, before["accel"], state["accel"]) if adaptive else None
+        if error is not None and error > 1.0 and h > s.smallest_step * (1.0 + 1e-12):
+            control.reject(h, error)
+            state.update(before)
+            continue
+        control.last_h = h
+        control.succeeded(h, t_target - state["t"], error)
+        taken += 1
+        smallest = min(smallest, h)
+        last = chunk
+    state["t"] = t_target
+    last.time = np.array([t_target])
+    last.stats = stats[None, :]
+    last.step_size = np.array([smallest])
+    last.substeps = np.array([taken], dtype=np.int64)
+    last.cuts = np.array([cuts], dtype=np.int64)
+    return last
 
 
 def initial_row(model: Model, state: dict) -> Chunk:
@@ -255,22 +503,63 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
                bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s [{elapsed}<{remaining}{postfix}]")
     steps = newton = factorizations = jacobians = 0
     call_steps = min(settings.chunk_steps, 10)  # the first call measures a step's cost
+    if settings.step not in ("fixed", "adaptive"):
+        raise SolverError(f"solver.step = {settings.step!r} must be 'fixed' or 'adaptive'")
+    control = StepControl(settings)
+    energy_watch = EnergyWatch(first.energy[0])
+    failed = np.zeros(3, dtype=np.int64)  # work of failed tries before a row's interval
+    carried_cut = False  # a whole chunk's step failed and was cut: its row counts the cut
     try:
         while steps < total:
-            n = min(call_steps, total - steps)
             t_before = state["t"]
             t1 = time.perf_counter()
-            chunk, info, detail = integrator.advance(state, n)
-            elapsed = time.perf_counter() - t1
-            timing["stepping"] += elapsed
-            if len(chunk.time):  # calls of at most ~0.25 s: a stop request waits no longer
-                call_steps = max(1, min(settings.chunk_steps,
-                                        int(0.25 * len(chunk.time) / max(elapsed, 1e-9))))
+            pending = None  # a failed step of a whole chunk: redone with cut steps
+            if control.whole_chunks:
+                if control.last_h != settings.dt:  # back to dt after cut steps
+                    _restart(model, state)
+                    control.restarts += 1
+                    control.last_h = settings.dt
+                n = min(call_steps, total - steps)
+                chunk, info, detail = integrator.advance(state, n)
+                elapsed = time.perf_counter() - t1
+                if len(chunk.time):  # calls of at most ~0.25 s: a stop request waits no longer
+                    call_steps = max(1, min(settings.chunk_steps,
+                                            int(0.25 * len(chunk.time) / max(elapsed, 1e-9))))
+                control.taken += len(chunk.time)
+                if len(chunk.time):
+                    control.smallest = min(control.smallest, settings.dt)
+                if info:
+                    failed += integrator.failed_stats
+                    retry = info in RETRYABLE and not (info == 1
+                                                       and detail == NEWTON_FLOOR_STALL)
+                    if not retry or not control.cut(settings.dt):
+                        pending = SolverError(integrator.failure_message(info, detail,
+                                                                         state["t"]))
+                    else:
+                        carried_cut = True
+            else:
+                # the grid time the kernel's whole chunks would reach (t + dt each step)
+                t_target = t0 + (steps + 1) * settings.dt if settings.step == "adaptive" \
+                    else state["t"] + settings.dt
+                try:
+                    chunk = _interval(integrator, control, state, t_target, failed,
+                                      int(carried_cut))
+                except SolverError as exc:
+                    pending = exc
+                    chunk = Chunk(time=np.zeros(0), probes=np.zeros((0, 0, 3)),
+                                  deflections=np.zeros((0, 0, 3)), lam=np.zeros((0, 0)),
+                                  energy=np.zeros((0, 11)), constraint=np.zeros(0),
+                                  stats=np.zeros((0, 3)), q=None)
+                failed = np.zeros(3, dtype=np.int64)
+                carried_cut = False
+            timing["stepping"] += time.perf_counter() - t1
             steps += len(chunk.time)
             newton += int(chunk.stats[:, 0].sum())
             factorizations += int(chunk.stats[:, 1].sum())
             jacobians += int(chunk.stats[:, 2].sum())
-            chunk, outside = _check_assumptions(model, chunk, state, info)
+            chunk, outside = _check_assumptions(model, chunk, state, pending is not None)
+            if len(chunk.time):
+                energy_watch.add(chunk.energy)
             t1 = time.perf_counter()
             if sink and len(chunk.time):
                 sink(chunk)
@@ -279,8 +568,11 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             bar.set_postfix(steps=steps, newton=newton)
             if outside:
                 raise SolverError(outside)
-            if info:
-                raise SolverError(integrator.failure_message(info, detail, state["t"]))
+            if isinstance(pending, SolverError):
+                newton += int(failed[0])
+                factorizations += int(failed[1])
+                jacobians += int(failed[2])
+                raise pending
             if should_stop is not None and should_stop():
                 raise Interrupted(f"stopped at t = {state['t']:.6g} s after {steps} steps")
     finally:  # the counters hold what was done, also when a step failed
@@ -290,18 +582,34 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
         model.counters["solves"] += newton
         model.counters["factorizations"] += factorizations
         model.counters["jacobian_evaluations"] += jacobians
+        for name, count in (("step_cuts", control.cuts), ("steps_rejected", control.rejected),
+                            ("step_restarts", control.restarts),
+                            ("steps_taken", control.taken),
+                            ("newton_floor_accepts", integrator.floor_accepts)):
+            model.counters[name] = model.counters.get(name, 0) + int(count)
         if model.contact_pairs:
             for name, count in zip(CONTACT_COUNTERS, state["counts"]):
                 model.counters[name] += int(count)
             model.contact_guesses = state["guesses"].copy()
+    created = energy_watch.created()
+    if created > ENERGY_CREATED_WARNING:
+        model.warnings.append(
+            f"the integrator created energy: the balance (total - total(0) - works) rose to "
+            f"{created:.1%} of the largest kinetic or potential-energy change, the method's "
+            "numerical instability (rho_inf = 1 on a nonlinear model at a coarse step): the "
+            "result is not reliable; lower solver.dt or take solver.rho_inf < 1")
     wall = time.perf_counter() - start
     timing["total"] = wall
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
-                         solves_setup=0, wall_time_s=wall, timing=timing, jacobians=jacobians)
+                         solves_setup=0, wall_time_s=wall, timing=timing, jacobians=jacobians,
+                         step_cuts=control.cuts, steps_rejected=control.rejected,
+                         steps_taken=control.taken,
+                         smallest_step=float(control.smallest) if control.taken else 0.0,
+                         floor_accepts=integrator.floor_accepts)
 
 
 def _check_assumptions(model: Model, chunk: Chunk, state: dict,
-                       info: int) -> tuple[Chunk, str]:
+                       info: bool) -> tuple[Chunk, str]:
     """(the rows to keep, why the run stops or ''): an 'ffr' beam that leaves its
     small-strain assumption (solvers.assumptions) stops the run at the first row that does
     when the chunk holds q (the rows after it dropped), else at the chunk's last state."""
@@ -329,4 +637,5 @@ def _outside(model: Model, e, t: float, how: str) -> str:
 
 
 __all__ = ["DynamicSettings", "Chunk", "DynamicResult", "TimeIntegrator", "integrate",
+           "StepControl", "local_error",
            "initial_acceleration", "initial_row", "ENERGY_NAMES", "CONTACT_FIELDS", "STAT_NAMES"]

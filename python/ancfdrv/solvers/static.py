@@ -47,7 +47,7 @@ class StaticResult:
 
 
 def converged(force_res: float, con_res: float, step: float, size: float, tol: float,
-              previous_res: float = np.inf) -> str:
+              previous_res: float = np.inf, floor: float = 0.0) -> str:
     """One test for both static solvers: '' while iterating, else why it stopped.
 
     'residual': relative force residual and constraint violation below tol.
@@ -59,11 +59,18 @@ def converged(force_res: float, con_res: float, step: float, size: float, tol: f
     iteration's change between passes goes to zero), or
     'floor': the residual no longer decreases (Newton's corrections are then solves of
     round-off noise, which do not shrink).
+    'roundoff' (Newton, issue 26): the residual is below its round-off floor ``floor``
+    (:func:`residual_floor`, above tol) and the correction that reached it was below
+    sqrt(tol) relative to the displacement: Newton's error after it is of the order of its
+    square, below tol, so the state is converged and another iteration would only solve
+    round-off noise.
     """
     if con_res > tol:
         return ""
     if force_res <= tol:
         return "residual"
+    if force_res <= floor and step <= np.sqrt(tol) * size:
+        return "roundoff"
     if force_res <= np.sqrt(tol):
         if step <= tol * size:
             return "step"
@@ -88,6 +95,44 @@ def residuals(model: Model, d: np.ndarray, lam: np.ndarray, internal: np.ndarray
                 scale_floor, 1e-300)
     return (np.linalg.norm(residual) / scale,
             np.max(np.abs(values), initial=0.0) / model.length_scale)
+
+
+def residual_floor(model: Model, e: np.ndarray, k_values: np.ndarray, scale: float) -> float:
+    """The round-off floor of the relative force residual at e: the forward error bound of
+    the internal force, eps |||K| |e||| / scale (Higham, Accuracy and Stability of Numerical
+    Algorithms, 2nd ed., section 3.5: a matrix-vector product's error is within gamma_n
+    |K| |e|), with |K| the tangent's absolute values. The absolute ANCF coordinates carry the
+    rigid configuration, so the elastic force is the small difference of large terms: on
+    the 28-node FFR boom the bound is 3.5e-9 where the measured floor is 3e-10 to 6e-10, and
+    both grow with the mesh."""
+    magnitude = sp.coo_matrix((np.abs(k_values), (model.pattern.rows, model.pattern.col_index)),
+                              shape=(model.ndof, model.ndof)) @ np.abs(e)
+    return float(np.finfo(float).eps * np.linalg.norm(magnitude) / max(scale, 1e-300))
+
+
+#: iterations in a row without a new smallest residual: the static Newton has stalled, once
+#: its residual is small (below STALL_NEAR, or at the floor); far from the solution large
+#: rotations make the residual rise for a while before Newton converges (the elastica),
+#: so there only FAR_STALL_ITERATIONS without progress count as a stall
+STALL_ITERATIONS, FAR_STALL_ITERATIONS, STALL_NEAR = 4, 25, 1e-6
+
+
+def _stall_message(history: list[float], floor: float, tol: float, load_step: int,
+                   load_steps: int) -> str:
+    """Why the static Newton stopped early: a stall at (or above) the round-off floor, or a
+    divergence (the residual grew three times in a row to 1e3 times its minimum)."""
+    last, smallest = history[-1], min(history)
+    where = f"at load step {load_step} of {load_steps}"
+    if all(b > a for a, b in zip(history[-4:-1], history[-3:])) and last > 1e6 * smallest:
+        return (f"static Newton diverged {where}: the relative residual grew three times in a "
+                f"row to {last:.3e} (smallest {smallest:.3e}); raise solver.load_steps")
+    if smallest <= floor:
+        return (f"static Newton stalled at the round-off floor {where}: the relative residual "
+                f"stays at {smallest:.3e} (estimated floor {floor:.3e}) above solver.tol = "
+                f"{tol:.3e}, which asks for more digits than double precision carries here; "
+                "raise solver.tol")
+    return (f"static Newton stalled {where}: no smaller residual in the last iterations "
+            f"(smallest {smallest:.3e}, tolerance {tol:.3e}); raise solver.load_steps")
 
 
 def _hessian_triplets(model: Model, e: np.ndarray):
@@ -174,10 +219,27 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                                                    force_scale)
                     previous = history[-1] if history and iteration > 1 else np.inf
                     history.append(force_res)
+                    scale = max(np.linalg.norm(external), np.linalg.norm(internal),
+                                force_scale)
+                    floor = residual_floor(model, model.e0 + d, k_values, scale)
                     how = converged(force_res, con_res, np.linalg.norm(step[:n]),
-                                    np.linalg.norm(d), tol, previous)
+                                    np.linalg.norm(d), tol, previous, floor)
                     if how:
                         break
+                    # the stagnation and divergence test (issue 24 item 2): no new minimum
+                    # in STALL_ITERATIONS iterations near the solution (FAR_STALL_ITERATIONS
+                    # far from it), or three rises to 1e6 times it
+                    step_history = history[len(history) - iteration:]
+                    best = int(np.argmin(step_history))
+                    near = step_history[best] <= max(STALL_NEAR, floor)
+                    growing = (iteration >= 4 and all(
+                        b > a for a, b in zip(step_history[-4:-1], step_history[-3:]))
+                        and force_res > 1e6 * step_history[best])
+                    since = iteration - 1 - best
+                    if since >= (STALL_ITERATIONS if near else FAR_STALL_ITERATIONS) \
+                            or growing or not np.isfinite(force_res):
+                        raise SolverError(_stall_message(step_history, floor, tol, load_step,
+                                                         load_steps))
                 else:
                     raise SolverError(
                         f"static Newton did not converge in {max_iter} iterations at load step "
