@@ -17,7 +17,7 @@ from .errors import InputError, SolverError
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
            "SparsePattern", "DirectSolver", "plate_shape", "plate_element_arrays",
-           "plate_reference", "plate_forces", "PlateReference", "StructuralBeam", "SectionData",
+           "plate_reference", "plate_forces", "PlateReference", "CubicBeam", "SectionData",
            "section_data"]
 
 
@@ -118,16 +118,16 @@ def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poi
                                          weights, youngs, poisson, int(want_tangent))
 
 
-class StructuralBeam:
+class CubicBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
     (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel)."""
 
     def __init__(self, reference, lengths, section: SectionData, youngs, poisson) -> None:
-        nterms = int(_kernel.beam_structural_size())
+        nterms = int(_kernel.beam_cubic_size())
         (self.forms, self.strain0, self.stiffness,
-         info) = _kernel.beam_structural_setup(nterms, _f(reference), _f(lengths), section.area,
-                                               section.inertia_y, section.inertia_z,
-                                               section.polar, youngs, poisson)
+         info) = _kernel.beam_cubic_setup(nterms, _f(reference), _f(lengths), section.area,
+                                           section.inertia_y, section.inertia_z,
+                                           section.polar, youngs, poisson)
         if info:
             element, code = divmod(info, 10)
             reason = {1: "unsupported quadrature",
@@ -136,8 +136,8 @@ class StructuralBeam:
 
     def forces(self, dofs, e, want_tangent: bool):
         """Elastic force, strain energy and element tangents (24, 24, nel) at e."""
-        return _kernel.beam_structural_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
-                                              self.strain0, self.stiffness, int(want_tangent))
+        return _kernel.beam_cubic_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
+                                         self.strain0, self.stiffness, int(want_tangent))
 
 
 PLATE_VARIANTS = {"plain": 0, "completed": 1}
@@ -442,12 +442,12 @@ class KernelSystem:
         self._check(info, "continuum beam set")
         return int(index)
 
-    def add_structural_set(self, dofs, scatter, forms, strain0, stiffness, frame: int,
-                           damping_time: float = 0.0) -> int:
-        index, info = _kernel.system_add_structural_set(
+    def add_cubic_set(self, dofs, scatter, forms, strain0, stiffness, frame: int,
+                      damping_time: float = 0.0) -> int:
+        index, info = _kernel.system_add_cubic_set(
             self.handle, _i(dofs + 1), _i(scatter), _f(forms), _f(strain0), _f(stiffness),
             frame, damping_time)
-        self._check(info, "structural beam set")
+        self._check(info, "cubic beam set")
         return int(index)
 
     def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,

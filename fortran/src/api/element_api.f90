@@ -127,18 +127,18 @@ subroutine beam_nonlinear_forces(ndof, nel, npts, nvolume, dofs, e, gradients, w
   energy = sum(element_energy)
 end subroutine beam_nonlinear_forces
 
-!> Number of strain terms per element of the structural ("cubic") beam.
-subroutine beam_structural_size(nterms)
+!> Number of strain terms per element of the 'cubic' bending beam.
+subroutine beam_cubic_size(nterms)
   use beam_structural, only: structural_terms
   implicit none
   integer, intent(out) :: nterms
   nterms = structural_terms
-end subroutine beam_structural_size
+end subroutine beam_cubic_size
 
-!> Strain forms, reference strains and stiffnesses of the structural ("cubic") beam per
+!> Strain forms, reference strains and stiffnesses of the 'cubic' bending beam per
 !> element, from the reference configuration and the section properties. info =
 !> 10*element + code.
-subroutine beam_structural_setup(nel, nterms, reference, lengths, area, inertia_y, inertia_z, &
+subroutine beam_cubic_setup(nel, nterms, reference, lengths, area, inertia_y, inertia_z, &
                                  polar, youngs, poisson, forms, strain0, stiffness, info)
   use ancf_kinds, only: dp
   use beam_structural, only: structural_setup
@@ -158,11 +158,11 @@ subroutine beam_structural_setup(nel, nterms, reference, lengths, area, inertia_
       return
     end if
   end do
-end subroutine beam_structural_setup
+end subroutine beam_cubic_setup
 
-!> Structural ("cubic") elastic force (global), strain energy and, when want_tangent /= 0,
+!> 'Cubic' bending elastic force (global), strain energy and, when want_tangent /= 0,
 !> the element tangents (24 x 24 x nel) of a beam mesh.
-subroutine beam_structural_forces(ndof, nel, nterms, dofs, e, forms, strain0, stiffness, &
+subroutine beam_cubic_forces(ndof, nel, nterms, dofs, e, forms, strain0, stiffness, &
                                   want_tangent, force, energy, tangent)
   use ancf_kinds, only: dp
   use beam_structural, only: structural_element
@@ -186,7 +186,7 @@ subroutine beam_structural_forces(ndof, nel, nterms, dofs, e, forms, strain0, st
     force(dofs(:, el)) = force(dofs(:, el)) + element_force(:, el)
   end do
   energy = sum(element_energy)
-end subroutine beam_structural_forces
+end subroutine beam_cubic_forces
 
 !> Shape functions and their parameter derivatives at npts material points.
 subroutine beam_shape_functions(npts, xi, y, z, lengths, shape, dshape_dx, dshape_dy, dshape_dz)

@@ -64,22 +64,29 @@ subroutine system_reset_stepper(handle, info)
   if (sys%policy /= policy_constant) sys%factorized = .false.
 end subroutine system_reset_stepper
 
+!> Element sets: one routine per family builds the family's set (element_sets: an
+!> extension of element_set in the family's module) from plain arrays and hands it to the
+!> one append path (mechanical_system append_set). Each checks the dofs (1..nfull) and the
+!> damping_time (the Kelvin-Voigt retardation time, s; 0: no material damping; negative:
+!> info = 2) and returns the set's 1-based index.
+
 !> ANCF-FFR beam elements: K0 and the rigid configuration (24, nel) in the floating frame
 !> `frame` (1-based index into the system's frames), the element dofs (full, 1-based) and
-!> the scatter map into the full pattern. damping_time: the Kelvin-Voigt retardation time
-!> (s; 0: no material damping). info = 2 also for a negative damping_time.
+!> the scatter map into the full pattern.
 subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference, frame, &
                               damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_ffr
+  use element_sets, only: element_set
+  use ffr_elastic, only: ffr_set
   use system_store, only: store_get
   implicit none
   integer, intent(in) :: handle, nel, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(ffr_set) :: built
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
@@ -88,26 +95,26 @@ subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference,
     info = 2
     return
   end if
-  set%kind = set_ffr
-  set%nel = nel
-  set%nde = 24
-  set%frame = frame
-  set%dofs = dofs
-  set%scatter = scatter
-  set%stiffness0 = stiffness0
-  set%reference = reference
-  set%damping_time = damping_time
+  built%nel = nel
+  built%nde = 24
+  built%frame = frame
+  built%dofs = dofs
+  built%scatter = scatter
+  built%stiffness0 = stiffness0
+  built%reference = reference
+  built%damping_time = damping_time
+  allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_ffr_set
 
 !> Large-deformation (continuum) beam elements: material gradients and weights at npts
-!> Gauss points of which the first nvolume are volume points (beam_nonlinear);
-!> damping_time as system_add_ffr_set.
+!> Gauss points of which the first nvolume are volume points (beam_nonlinear).
 subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, gradients, &
                                     weights, youngs, poisson, frame, damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_continuum
+  use element_sets, only: element_set
+  use beam_nonlinear, only: continuum_set
   use system_store, only: store_get
   implicit none
   integer, intent(in) :: handle, nel, npts, nvolume, dofs(24, nel), scatter(24, 24, nel), frame
@@ -115,7 +122,8 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(continuum_set) :: built
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
@@ -123,29 +131,30 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
     info = 2
     return
   end if
-  set%kind = set_continuum
-  set%nel = nel
-  set%nde = 24
-  set%frame = frame
-  set%dofs = dofs
-  set%scatter = scatter
-  set%volume_points = nvolume
-  set%gradients = gradients
-  set%weights = weights
-  set%youngs = youngs
-  set%poisson = poisson
-  set%damping_time = damping_time
+  built%nel = nel
+  built%nde = 24
+  built%frame = frame
+  built%dofs = dofs
+  built%scatter = scatter
+  built%volume_points = nvolume
+  built%gradients = gradients
+  built%weights = weights
+  built%youngs = youngs
+  built%poisson = poisson
+  built%damping_time = damping_time
+  built%force_cost = 1.2d0
+  built%tangent_cost = 15.0d0
+  allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_continuum_set
 
-!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural);
-!> damping_time as system_add_ffr_set.
-subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, strain0, &
-                                     stiffness, frame, damping_time, index, info)
+!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural).
+subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strain0, &
+                                stiffness, frame, damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_structural
-  use beam_structural, only: structural_pattern, structural_terms
+  use element_sets, only: element_set
+  use beam_structural, only: cubic_set, structural_pattern, structural_terms
   use system_store, only: store_get
   implicit none
   integer, intent(in) :: handle, nel, nterms, dofs(24, nel), scatter(24, 24, nel), frame
@@ -153,7 +162,8 @@ subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, 
   real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(cubic_set) :: built
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
@@ -162,28 +172,30 @@ subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, 
     info = 2
     return
   end if
-  set%kind = set_structural
-  set%nel = nel
-  set%nde = 24
-  set%frame = frame
-  set%dofs = dofs
-  set%scatter = scatter
-  set%forms = forms
-  set%strain0 = strain0
-  set%term_stiffness = stiffness
-  allocate (set%form_pairs(2, 64, nterms), set%form_npairs(nterms))
-  call structural_pattern(forms, set%form_pairs, set%form_npairs)
-  set%damping_time = damping_time
+  built%nel = nel
+  built%nde = 24
+  built%frame = frame
+  built%dofs = dofs
+  built%scatter = scatter
+  built%forms = forms
+  built%strain0 = strain0
+  built%term_stiffness = stiffness
+  allocate (built%form_pairs(2, 64, nterms), built%form_npairs(nterms))
+  call structural_pattern(forms, built%form_pairs, built%form_npairs)
+  built%damping_time = damping_time
+  built%force_cost = 1.2d0
+  built%tangent_cost = 3.0d0
+  allocate (set, source=built)
   call append_set(sys, set, index)
-end subroutine system_add_structural_set
+end subroutine system_add_cubic_set
 
-!> Thin plate elements (plate_element): reference data at npts Gauss points; damping_time
-!> as system_add_ffr_set.
+!> Thin plate elements (plate_element): reference data at npts Gauss points.
 subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_frame, curvature0, &
                                 weights, youngs, poisson, thickness, damping_time, index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_plate
+  use element_sets, only: element_set
+  use plate_element, only: plate_set
   use system_store, only: store_get
   implicit none
   integer, intent(in) :: handle, nel, npts, dofs(36, nel), scatter(36, 36, nel)
@@ -192,7 +204,8 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
   real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(plate_set) :: built
   index = 0
   call store_get(handle, sys, info)
   if (info /= 0) return
@@ -200,19 +213,21 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
     info = 2
     return
   end if
-  set%kind = set_plate
-  set%nel = nel
-  set%nde = 36
-  set%dofs = dofs
-  set%scatter = scatter
-  set%derivs = derivs
-  set%plate_frame = plate_frame
-  set%curvature0 = curvature0
-  set%weights = weights
-  set%youngs = youngs
-  set%poisson = poisson
-  set%thickness = thickness
-  set%damping_time = damping_time
+  built%nel = nel
+  built%nde = 36
+  built%dofs = dofs
+  built%scatter = scatter
+  built%derivs = derivs
+  built%plate_frame = plate_frame
+  built%curvature0 = curvature0
+  built%weights = weights
+  built%youngs = youngs
+  built%poisson = poisson
+  built%thickness = thickness
+  built%damping_time = damping_time
+  built%force_cost = 6.0d0
+  built%tangent_cost = 80.0d0
+  allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_plate_set
 

@@ -12,7 +12,7 @@
 !> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
 !> mechanics); with nu = 0 both coincide with the plain law.
 !>
-!> Kelvin-Voigt material damping (retardation time tau, nonlinear_element_damped):
+!> Kelvin-Voigt material damping (retardation time tau, nonlinear_element given the rates):
 !> S = D : (E + tau E'), with the strain rate E' = B(F) q' (the Voigt form of sym(F^T F'),
 !> F' = q' g^T), so the damping force is Q_d = int tau B^T D E' dV0 and the dissipated power
 !> int tau E'^T D E' dV0 >= 0; a rigid motion has E' = 0 (objective). Its derivatives:
@@ -23,9 +23,20 @@ module beam_nonlinear
   use quadrature, only: gauss_legendre
   use beam_element, only: beam_shape
   use matrix3, only: invert3
+  use element_sets, only: local_element_set
   implicit none
   private
-  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, nonlinear_element_damped
+  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, continuum_set
+
+  !> The family's element set (element_sets): material gradients (8, 3, npts, nel) and
+  !> weights (npts, nel) at the Gauss points, the first volume_points of them volume points.
+  type, extends(local_element_set) :: continuum_set
+    integer :: volume_points = 0
+    real(dp), allocatable :: gradients(:, :, :, :), weights(:, :)
+    real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp
+  contains
+    procedure :: element_forces => continuum_element_forces
+  end type continuum_set
 
   !> Gauss points along the axis; the section rule comes from beam_section.
   integer, parameter, public :: nonlinear_axial_points = 4
@@ -84,19 +95,29 @@ contains
   !> one element with nodal vectors q(3, 8).
   !> The first volume_points points integrate the Poisson-free law over the volume, the
   !> others (the neutral-axis points) the Poisson part.
+  !> With Kelvin-Voigt damping (the nodal rates q'(3, 8), damping_time tau > 0, rate_factor
+  !> and dissipation all present): the force includes the damping force, dissipation is its
+  !> power and the tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
   pure subroutine nonlinear_element(q, gradients, weights, volume_points, youngs, poisson, &
-                                    want_tangent, force, energy, tangent)
+                                    want_tangent, force, energy, tangent, rates, damping_time, &
+                                    rate_factor, dissipation)
     real(dp), intent(in) :: q(3, 8), gradients(:, :, :), weights(:)
     integer, intent(in) :: volume_points
     real(dp), intent(in) :: youngs, poisson
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
+    real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
+    real(dp), intent(out), optional :: dissipation
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
     real(dp) :: stress(6), b(6, 24), db(6, 24)
+    real(dp) :: b_rate(6, 24), deformation_rate(3, 3), strain_rate(6), damping_stress(6)
+    logical :: damped
     integer :: p
+    damped = present(rates)
     call split_laws(youngs, poisson, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
+    if (damped) dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
       if (p <= volume_points) then
@@ -109,61 +130,51 @@ contains
       call green_lagrange(deformation, strain)
       stress = matmul(law, strain)
       energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
+      if (damped) then
+        call deformation_gradient(rates, gradients(:, :, p), deformation_rate)
+        call green_lagrange_rate(deformation, deformation_rate, strain_rate)
+        damping_stress = damping_time * matmul(law, strain_rate)
+        dissipation = dissipation + weights(p) * dot_product(strain_rate, damping_stress)
+        stress = stress + damping_stress
+      end if
       call add_nodal_force(deformation, stress, gradients(:, :, p), weights(p), force)
       if (.not. want_tangent) cycle
       call strain_matrix(deformation, gradients(:, :, p), b)
-      db = matmul(law, b)
-      tangent = tangent + weights(p) * matmul(transpose(b), db)
+      if (damped) then
+        ! (1 + c tau) B^T D B + tau B^T D B(F') + the geometric term of the total stress
+        call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
+        tangent = tangent + weights(p) * matmul(transpose(b), &
+                  matmul(law, (1.0_dp + rate_factor * damping_time) * b + damping_time * b_rate))
+      else
+        db = matmul(law, b)
+        tangent = tangent + weights(p) * matmul(transpose(b), db)
+      end if
       call add_geometric_stiffness(stress, gradients(:, :, p), weights(p), tangent)
     end do
   end subroutine nonlinear_element
 
-  !> nonlinear_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
-  !> q'(3, 8): the force includes the damping force, dissipation is its power and the
-  !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
-  pure subroutine nonlinear_element_damped(q, rates, gradients, weights, volume_points, youngs, &
-                                           poisson, damping_time, rate_factor, want_tangent, &
-                                           force, energy, dissipation, tangent)
-    real(dp), intent(in) :: q(3, 8), rates(3, 8), gradients(:, :, :), weights(:)
-    integer, intent(in) :: volume_points
-    real(dp), intent(in) :: youngs, poisson, damping_time, rate_factor
+  !> The element_set element_forces of a continuum set: nonlinear_element of element el.
+  pure subroutine continuum_element_forces(set, el, coords, want_tangent, force, energy, &
+                                           tangent, info, rates, rate_factor, dissipation)
+    class(continuum_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords(:, :)
     logical, intent(in) :: want_tangent
-    real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
-    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
-    real(dp) :: stress(6), b(6, 24), b_rate(6, 24)
-    real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
-    integer :: p
-    call split_laws(youngs, poisson, law_free, law_poisson)
-    force = 0.0_dp
-    energy = 0.0_dp
-    dissipation = 0.0_dp
-    if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
-    do p = 1, size(weights)
-      if (p <= volume_points) then
-        law = law_free
-      else
-        law = law_poisson
-        if (all(law == 0.0_dp)) cycle
-      end if
-      call deformation_gradient(q, gradients(:, :, p), deformation)
-      call deformation_gradient(rates, gradients(:, :, p), deformation_rate)
-      call green_lagrange(deformation, strain)
-      call green_lagrange_rate(deformation, deformation_rate, strain_rate)
-      stress = matmul(law, strain)
-      damping_stress = damping_time * matmul(law, strain_rate)
-      energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
-      dissipation = dissipation + weights(p) * dot_product(strain_rate, damping_stress)
-      stress = stress + damping_stress
-      call add_nodal_force(deformation, stress, gradients(:, :, p), weights(p), force)
-      if (.not. want_tangent) cycle
-      call strain_matrix(deformation, gradients(:, :, p), b)
-      ! (1 + c tau) B^T D B + tau B^T D B(F') + the geometric term of the total stress
-      call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
-      tangent = tangent + weights(p) * matmul(transpose(b), &
-                matmul(law, (1.0_dp + rate_factor * damping_time) * b + damping_time * b_rate))
-      call add_geometric_stiffness(stress, gradients(:, :, p), weights(p), tangent)
-    end do
-  end subroutine nonlinear_element_damped
+    real(dp), intent(out) :: force(:), energy, tangent(:, :)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(:, :), rate_factor
+    real(dp), intent(out), optional :: dissipation
+    info = 0
+    if (present(rates)) then
+      call nonlinear_element(coords, set%gradients(:, :, :, el), set%weights(:, el), &
+                             set%volume_points, set%youngs, set%poisson, want_tangent, force, &
+                             energy, tangent, rates, set%damping_time, rate_factor, dissipation)
+    else
+      call nonlinear_element(coords, set%gradients(:, :, :, el), set%weights(:, el), &
+                             set%volume_points, set%youngs, set%poisson, want_tangent, force, &
+                             energy, tangent)
+    end if
+  end subroutine continuum_element_forces
 
   !> The rate of the Green-Lagrange strain (Voigt, engineering shears) at the deformation
   !> gradient F and its rate F': the Voigt form of sym(F^T F'), i.e. B(F) q'.

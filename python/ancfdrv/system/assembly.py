@@ -19,6 +19,7 @@ from ..errors import InputError
 from .bodies import Beam, Body, Ground, Leaf, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
 from .drives import Constant
+from .element_kinds import SetContext, register_body, register_set, set_builder
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation, orthonormality, planar_fixes, small_turn
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
@@ -187,12 +188,13 @@ def _element_sets(bodies, frames, beam_frame, act: _Active, active: set[str], co
                   warnings: list[str]) -> tuple[list[SetInfo], list[np.ndarray]]:
     sets, blocks = [], []
     for body in bodies:
-        if isinstance(body, Beam):
-            info = _beam_set(body, frames[beam_frame[body.name] - 1], beam_frame[body.name])
-        elif isinstance(body, Plate):
-            info = _plate_set(body, active, counters, warnings)
-        else:
+        build = set_builder(body)
+        if build is None:
             continue
+        frame_id = beam_frame.get(body.name, 0)
+        context = SetContext(frames[frame_id - 1] if frame_id else None, frame_id, active,
+                             counters, warnings)
+        info = build(body, context)
         counters["element_arrays"] += info.nel
         _damping(info, body, active, counters, warnings)
         sets.append(info)
@@ -217,7 +219,8 @@ def _damping(info: SetInfo, body: Body, active: set[str], counters: Counter,
         warnings.append(message)
 
 
-def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
+def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
+    frame, frame_id = context.frame, context.frame_id
     dofs = beam.element_dofs()
     local = dofs - beam.first
     q = beam.coordinates()
@@ -235,16 +238,16 @@ def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
                    mass_compact=mass_compact)
     if beam.formulation == "ffr":
         info.kind = "ffr"
-        if beam.bending == "cubic":  # K0: the structural tangent at the reference, in the frame
-            structural = kernel.StructuralBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
-                                               m.poisson_ratio)
-            *_, stiffness0 = structural.forces(local, frame_q, True)
+        if beam.bending == "cubic":  # K0: the cubic tangent at the reference, in the frame
+            cubic = kernel.CubicBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
+                                     m.poisson_ratio)
+            *_, stiffness0 = cubic.forces(local, frame_q, True)
         info.stiffness0 = np.asfortranarray(stiffness0)
         info.reference = np.asfortranarray(frame_q[local])
     elif beam.bending == "cubic":
-        info.kind = "structural"
-        info.structural = kernel.StructuralBeam(global_ref, beam.lengths, section,
-                                                m.youngs_modulus, m.poisson_ratio)
+        info.kind = "cubic"
+        info.cubic = kernel.CubicBeam(global_ref, beam.lengths, section, m.youngs_modulus,
+                                      m.poisson_ratio)
     else:
         info.kind = "continuum"
         info.gradients, info.weights, info.nvolume = kernel.beam_nonlinear_setup(
@@ -252,7 +255,8 @@ def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
     return info
 
 
-def _plate_set(plate: Plate, active: set[str], counters: Counter, warnings: list[str]) -> SetInfo:
+def _plate_set(plate: Plate, context: SetContext) -> SetInfo:
+    active, counters, warnings = context.active, context.counters, context.warnings
     mesh = plate.mesh
     dofs = plate.element_dofs()
     local = dofs - plate.first
@@ -270,6 +274,34 @@ def _plate_set(plate: Plate, active: set[str], counters: Counter, warnings: list
                                                   plate.material.density, np.zeros(3))
     return SetInfo(body=plate, kind="plate", dofs=dofs, nel=mesh.nel, frame=0,
                    mass_compact=mass_compact, plate_reference=ref)
+
+
+def _add_ffr(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame, s.damping_time)
+
+
+def _add_continuum(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
+                                s.body.material.youngs_modulus, s.body.material.poisson_ratio,
+                                s.frame, s.damping_time)
+
+
+def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_cubic_set(s.dofs, s.scatter, s.cubic.forms, s.cubic.strain0, s.cubic.stiffness,
+                            s.frame, s.damping_time)
+
+
+def _add_plate(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_plate_set(s.dofs, s.scatter, s.plate_reference, s.body.material.youngs_modulus,
+                            s.body.material.poisson_ratio, s.body.thickness, s.damping_time)
+
+
+register_body(Beam, _beam_set)
+register_body(Plate, _plate_set)
+register_set("ffr", _add_ffr)
+register_set("continuum", _add_continuum)
+register_set("cubic", _add_cubic)
+register_set("plate", _add_plate)
 
 
 # -- mass and loads --------------------------------------------------------------------------
