@@ -18,7 +18,7 @@ __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
            "SparsePattern", "DirectSolver", "plate_shape", "plate_element_arrays",
            "plate_reference", "plate_forces", "PlateReference", "CubicBeam", "SectionData",
-           "section_data"]
+           "section_data", "cable_element_arrays", "cable_shape", "cable_forces"]
 
 
 def _f(a, dtype=np.float64) -> np.ndarray:
@@ -138,6 +138,31 @@ class CubicBeam:
         """Elastic force, strain energy and element tangents (24, 24, nel) at e."""
         return _kernel.beam_cubic_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
                                          self.strain0, self.stiffness, int(want_tangent))
+
+
+def cable_element_arrays(lengths, mass_per_length: float, load) -> tuple[np.ndarray, np.ndarray]:
+    """Cable elements (cable_element): scalar element masses Mbar (4, 4, nel) (the element
+    mass is kron(Mbar, I3)) and the generalized forces (12, nel) of a uniform load per
+    length (3,)."""
+    return _kernel.cable_element_arrays(_f(np.atleast_1d(lengths)), float(mass_per_length),
+                                        _f(load))
+
+
+def cable_shape(xi: float, length: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cable shape rows (4,) at xi of an element: position, d/dx and d2/dx2."""
+    return _kernel.cable_shape_functions(float(xi), float(length))
+
+
+def cable_forces(dofs, e, lengths, axial_stiffness: float, bending_stiffness: float,
+                 want_tangent: bool):
+    """Cable elastic force dU/de (global), strain energy and element tangents (12, 12, nel)
+    at e; dofs (12, nel) 0-based."""
+    force, energy, tangent, info = _kernel.cable_forces(
+        _f(np.asarray(dofs) + 1, np.int32), _f(e), _f(np.atleast_1d(lengths)),
+        float(axial_stiffness), float(bending_stiffness), int(want_tangent))
+    if info:
+        raise SolverError(f"cable element {info}: r' vanished at a Gauss point")
+    return force, float(energy), tangent
 
 
 PLATE_VARIANTS = {"plain": 0, "completed": 1}
@@ -456,6 +481,14 @@ class KernelSystem:
             self.handle, _i(dofs + 1), _i(scatter), reference.derivs, reference.frame,
             reference.curvature0, reference.weights, youngs, poisson, thickness, damping_time)
         self._check(info, "plate set")
+        return int(index)
+
+    def add_cable_set(self, dofs, scatter, lengths, axial_stiffness: float,
+                      bending_stiffness: float, damping_time: float = 0.0) -> int:
+        index, info = _kernel.system_add_cable_set(
+            self.handle, _i(dofs + 1), _i(scatter), _f(lengths), axial_stiffness,
+            bending_stiffness, damping_time)
+        self._check(info, "cable set")
         return int(index)
 
     def set_frames(self, drives, axes, bases, pivots) -> None:

@@ -557,3 +557,60 @@ subroutine direct_destroy(handle, info)
   call solver_destroy(handle, info)
 end subroutine direct_destroy
 
+
+!> Cable elements (cable_element): the scalar element masses Mbar (4, 4, nel) (the element
+!> mass is kron(Mbar, I3)) for the mass per length, and the generalized forces (12, nel) of
+!> a uniform load per length (3).
+subroutine cable_element_arrays(nel, lengths, mass_per_length, load, mass, load_force)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_mass, cable_gravity
+  implicit none
+  integer, intent(in) :: nel
+  real(dp), intent(in) :: lengths(nel), mass_per_length, load(3)
+  real(dp), intent(out) :: mass(4, 4, nel), load_force(12, nel)
+  integer :: el
+  do el = 1, nel
+    call cable_mass(lengths(el), mass_per_length, mass(:, :, el))
+    call cable_gravity(lengths(el), load, load_force(:, el))
+  end do
+end subroutine cable_element_arrays
+
+!> Cable shape rows at xi (element of the given length): position, d/dx, d2/dx2 (4 each).
+subroutine cable_shape_functions(xi, length, shape, slope, second)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_shape
+  implicit none
+  real(dp), intent(in) :: xi, length
+  real(dp), intent(out) :: shape(4), slope(4), second(4)
+  call cable_shape(xi, length, shape, slope, second)
+end subroutine cable_shape_functions
+
+!> Cable elastic force (global), strain energy and, when want_tangent /= 0, the element
+!> tangents (12 x 12 x nel) of a cable mesh. info = element number whose r' vanished.
+subroutine cable_forces(ndof, nel, dofs, e, lengths, axial_stiffness, bending_stiffness, &
+                        want_tangent, force, energy, tangent, info)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_element_force
+  implicit none
+  integer, intent(in) :: ndof, nel, dofs(12, nel), want_tangent
+  real(dp), intent(in) :: e(ndof), lengths(nel), axial_stiffness, bending_stiffness
+  real(dp), intent(out) :: force(ndof), energy, tangent(12, 12, nel)
+  integer, intent(out) :: info
+  real(dp) :: element_force(12), element_energy
+  integer :: el, code
+  force = 0.0_dp
+  energy = 0.0_dp
+  tangent = 0.0_dp
+  info = 0
+  do el = 1, nel
+    call cable_element_force(reshape(e(dofs(:, el)), [3, 4]), lengths(el), axial_stiffness, &
+                             bending_stiffness, want_tangent /= 0, element_force, &
+                             element_energy, tangent(:, :, el), code)
+    if (code /= 0) then
+      info = el
+      return
+    end if
+    force(dofs(:, el)) = force(dofs(:, el)) + element_force
+    energy = energy + element_energy
+  end do
+end subroutine cable_forces

@@ -231,6 +231,43 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
   call append_set(sys, set, index)
 end subroutine system_add_plate_set
 
+!> ANCF cable elements (cable_element): element lengths and the section's EA and EI.
+!> damping_time must be 0 (the family has no material damping; info = 2 otherwise).
+subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiffness, &
+                                bending_stiffness, damping_time, index, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, append_set
+  use element_sets, only: element_set
+  use cable_element, only: cable_set
+  use system_store, only: store_get
+  implicit none
+  integer, intent(in) :: handle, nel, dofs(12, nel), scatter(12, 12, nel)
+  real(dp), intent(in) :: lengths(nel), axial_stiffness, bending_stiffness, damping_time
+  integer, intent(out) :: index, info
+  type(system_model), pointer :: sys
+  class(element_set), allocatable :: set
+  type(cable_set) :: built
+  index = 0
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. damping_time /= 0.0_dp .or. &
+      any(lengths <= 0.0_dp)) then
+    info = 2
+    return
+  end if
+  built%nel = nel
+  built%nde = 12
+  built%dofs = dofs
+  built%scatter = scatter
+  built%lengths = lengths
+  built%axial_stiffness = axial_stiffness
+  built%bending_stiffness = bending_stiffness
+  built%force_cost = 0.5d0
+  built%tangent_cost = 2.0d0
+  allocate (set, source=built)
+  call append_set(sys, set, index)
+end subroutine system_add_cable_set
+
 !> Floating frames A_f(t) = Rot(axis_f, phi_d(t)) base_f about pivot_f (drive 0: fixed).
 subroutine system_set_frames(handle, nframe, drives, axes, bases, pivots, info)
   use ancf_kinds, only: dp

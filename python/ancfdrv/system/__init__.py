@@ -7,11 +7,12 @@ container and its name checks), ``assembly`` (numbering, elimination of linear j
 patterns, the kernel handle), ``model`` (the assembled model).
 """
 from .bodies import Beam, Leaf, Material, Plate, RigidBody
+from .cable import Cable
 from .drives import Constant, Cycle, Drive, Luffing, Sine, SpinUp, Table
 from .model import Model
 from .sections import Box, Circle, Rectangle, Section, Tube
 from .system import System
 
-__all__ = ["System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Section",
+__all__ = ["System", "Model", "Material", "Beam", "Cable", "Plate", "Leaf", "RigidBody", "Section",
            "Rectangle", "Box", "Tube", "Circle", "Drive", "Constant", "Luffing", "SpinUp",
            "Cycle", "Sine", "Table"]

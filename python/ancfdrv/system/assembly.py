@@ -317,6 +317,9 @@ def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern
                 if isinstance(info.body, Beam):
                     compact[:, :, at.element] += kernel.beam_point_mass(
                         *at.local, info.body.lengths[at.element], pm.mass)
+                elif hasattr(info.body, "shape_row"):  # a family's own shape row (cable)
+                    shape = info.body.shape_row(at)
+                    compact[:, :, at.element] += pm.mass * np.outer(shape, shape)
                 else:
                     shape, _ = kernel.plate_shape(*at.local, info.body.mesh.a[at.element],
                                                   info.body.mesh.b[at.element])
@@ -355,6 +358,9 @@ def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counter
                                                body.material.density, g)
                 np.add.at(gravity, info.dofs.reshape(-1, order="F"),
                           elements.reshape(-1, order="F"))
+            elif hasattr(body, "gravity_forces"):  # a family's own (cable)
+                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
+                          body.gravity_forces(g).reshape(-1, order="F"))
             else:
                 _, elements = kernel.plate_element_arrays(
                     body.mesh.a, body.mesh.b, body.thickness, body.material.density,

@@ -111,6 +111,8 @@ def length_scale(bodies: list[Body]) -> float:
             sizes.append(body.length)
         elif isinstance(body, Plate):
             sizes.append(float(np.ptp(body.mesh.coords[:, :3], axis=0).max()))
+        elif body.flexible and hasattr(body, "length"):  # other families (cable)
+            sizes.append(float(body.length))
     if sizes:
         return max(sizes)
     centres = np.array([b.centre for b in bodies if isinstance(b, RigidBody)])
