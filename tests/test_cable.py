@@ -202,3 +202,31 @@ def test_cable_refusals():
     s.joint("root", "weld", "ground", "c", point=(0, 0, 0))
     with pytest.raises(InputError, match="cable 'c': material damping is not implemented"):
         s.assemble(effects=("damping",))
+
+
+SCENE = """&scene  title = 'cable elastica', analysis = 'static', effects = 'tip_force' /
+&material  name = 'steel', youngs_modulus = 2.1e11, density = 7850.0 /
+&cable  name = 'rope', material = 'steel', start = 0.0, 0.0, 0.0, end = 2.0, 0.0, 0.0,
+        nodes = 17, section = 'circle', diameter = 0.02 /
+&joint  name = 'clamp', type = 'weld', body1 = 'ground', body2 = 'rope', point = 0, 0, 0 /
+&load  name = 'tip force', type = 'force', body = 'rope', point = 2.0, 0.0, 0.0,
+       vector = 0.0, -{force!r}, 0.0, effect = 'tip_force' /
+&probe  name = 'tip', body = 'rope', point = 2.0, 0.0, 0.0 /
+&solver  static_method = 'newton', load_steps = 5 /
+"""
+
+
+def test_cable_from_a_namelist(tmp_path):
+    """The &cable group of a general scene builds the same cable: the elastica k = 1 from a
+    scene file, tip displacement in the result file (REFERENCES.md values)."""
+    import h5py
+
+    from ancfdrv.runner import run_scene
+    scene = tmp_path / "cable.nml"
+    scene.write_text(SCENE.format(force=E * INERTIA / 4.0))
+    run_scene(scene, output=tmp_path / "cable.h5", progress=False)
+    with h5py.File(tmp_path / "cable.h5") as h5:
+        tip = h5["static/deflection/tip"][()].ravel()
+        assert h5["model"].attrs["bodies"] == "rope: cable"
+    assert -tip[1] / 2.0 == pytest.approx(0.30172, abs=1e-5)
+    assert -tip[0] / 2.0 == pytest.approx(0.05643, abs=1e-5)

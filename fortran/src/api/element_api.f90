@@ -431,17 +431,6 @@ subroutine moment_generalized_force(director, axis, magnitude, force, jacobian, 
   call moment_force(director, axis, magnitude, force, jacobian, hessian, info)
 end subroutine moment_generalized_force
 
-!> Rotation of a section director about an axis from a reference direction; the dead
-!> moment's potential is -magnitude * angle.
-subroutine moment_rotation_angle(director, axis, reference, angle)
-  use ancf_kinds, only: dp
-  use section_moment, only: moment_angle
-  implicit none
-  real(dp), intent(in) :: director(3), axis(3), reference(3)
-  real(dp), intent(out) :: angle
-  angle = moment_angle(director, axis, reference)
-end subroutine moment_rotation_angle
-
 !> A drive's phi, phi', phi'' at nt times (params: its parameters, any length).
 subroutine drive_values(kind, nparams, params, nt, t, phi, dphi, ddphi, info)
   use ancf_kinds, only: dp

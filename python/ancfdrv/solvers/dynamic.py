@@ -118,7 +118,6 @@ class DynamicResult:
     steps: int
     newton_iterations: int
     factorizations: int
-    solves_setup: int
     wall_time_s: float
     timing: dict[str, float] = field(default_factory=dict)
     jacobians: int = 0
@@ -288,7 +287,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     wall = time.perf_counter() - start
     timing["total"] = wall
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
-                         solves_setup=0, wall_time_s=wall, timing=timing, jacobians=jacobians)
+                         wall_time_s=wall, timing=timing, jacobians=jacobians)
 
 
 __all__ = ["DynamicSettings", "Chunk", "DynamicResult", "TimeIntegrator", "integrate",
