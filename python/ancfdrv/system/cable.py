@@ -142,8 +142,10 @@ class Cable(Body):
 
     # -- what the assembly asks of a flexible body besides its set ---------------------------
     def gravity_forces(self, g: np.ndarray) -> np.ndarray:
-        """Generalized gravity forces per element (12, nel)."""
-        _, forces = kernel.cable_element_arrays(self.lengths, self.mass_per_length, g)
+        """Generalized gravity forces per element (12, nel) of the acceleration g (3,): the
+        uniform load rho A g per length."""
+        _, forces = kernel.cable_element_arrays(self.lengths, self.mass_per_length,
+                                                self.mass_per_length * np.asarray(g, float))
         return forces
 
     @property
