@@ -98,6 +98,9 @@ contains
   !> With Kelvin-Voigt damping (the nodal rates q'(3, 8), damping_time tau > 0, rate_factor
   !> and dissipation all present): the force includes the damping force, dissipation is its
   !> power and the tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
+  !> (The two point loops stay apart: one loop with the damping behind a flag let the
+  !> compiler inline the point helpers and made the undamped force 24 % dearer, measured
+  !> with callgrind.)
   pure subroutine nonlinear_element(q, gradients, weights, volume_points, youngs, poisson, &
                                     want_tangent, force, energy, tangent, rates, damping_time, &
                                     rate_factor, dissipation)
@@ -108,16 +111,32 @@ contains
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
     real(dp), intent(out), optional :: dissipation
+    if (present(rates)) then
+      call damped_points(q, rates, gradients, weights, volume_points, youngs, poisson, &
+                         damping_time, rate_factor, want_tangent, force, energy, dissipation, &
+                         tangent)
+    else
+      call elastic_points(q, gradients, weights, volume_points, youngs, poisson, want_tangent, &
+                          force, energy, tangent)
+    end if
+  end subroutine nonlinear_element
+
+  !> nonlinear_element without damping (its loop over the Gauss points). The first
+  !> volume_points points integrate the Poisson-free law over the volume, the
+  !> others (the neutral-axis points) the Poisson part.
+  pure subroutine elastic_points(q, gradients, weights, volume_points, youngs, poisson, &
+                                 want_tangent, force, energy, tangent)
+    real(dp), intent(in) :: q(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
+    real(dp), intent(in) :: youngs, poisson
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
     real(dp) :: stress(6), b(6, 24), db(6, 24)
-    real(dp) :: b_rate(6, 24), deformation_rate(3, 3), strain_rate(6), damping_stress(6)
-    logical :: damped
     integer :: p
-    damped = present(rates)
     call split_laws(youngs, poisson, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
-    if (damped) dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
       if (p <= volume_points) then
@@ -130,28 +149,61 @@ contains
       call green_lagrange(deformation, strain)
       stress = matmul(law, strain)
       energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
-      if (damped) then
-        call deformation_gradient(rates, gradients(:, :, p), deformation_rate)
-        call green_lagrange_rate(deformation, deformation_rate, strain_rate)
-        damping_stress = damping_time * matmul(law, strain_rate)
-        dissipation = dissipation + weights(p) * dot_product(strain_rate, damping_stress)
-        stress = stress + damping_stress
-      end if
       call add_nodal_force(deformation, stress, gradients(:, :, p), weights(p), force)
       if (.not. want_tangent) cycle
       call strain_matrix(deformation, gradients(:, :, p), b)
-      if (damped) then
-        ! (1 + c tau) B^T D B + tau B^T D B(F') + the geometric term of the total stress
-        call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
-        tangent = tangent + weights(p) * matmul(transpose(b), &
-                  matmul(law, (1.0_dp + rate_factor * damping_time) * b + damping_time * b_rate))
-      else
-        db = matmul(law, b)
-        tangent = tangent + weights(p) * matmul(transpose(b), db)
-      end if
+      db = matmul(law, b)
+      tangent = tangent + weights(p) * matmul(transpose(b), db)
       call add_geometric_stiffness(stress, gradients(:, :, p), weights(p), tangent)
     end do
-  end subroutine nonlinear_element
+  end subroutine elastic_points
+
+  !> nonlinear_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
+  !> q'(3, 8) (its loop over the Gauss points): the force includes the damping force, dissipation is its power and the
+  !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
+  pure subroutine damped_points(q, rates, gradients, weights, volume_points, youngs, &
+                                           poisson, damping_time, rate_factor, want_tangent, &
+                                           force, energy, dissipation, tangent)
+    real(dp), intent(in) :: q(3, 8), rates(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
+    real(dp), intent(in) :: youngs, poisson, damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
+    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: stress(6), b(6, 24), b_rate(6, 24)
+    real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
+    integer :: p
+    call split_laws(youngs, poisson, law_free, law_poisson)
+    force = 0.0_dp
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
+    do p = 1, size(weights)
+      if (p <= volume_points) then
+        law = law_free
+      else
+        law = law_poisson
+        if (all(law == 0.0_dp)) cycle
+      end if
+      call deformation_gradient(q, gradients(:, :, p), deformation)
+      call deformation_gradient(rates, gradients(:, :, p), deformation_rate)
+      call green_lagrange(deformation, strain)
+      call green_lagrange_rate(deformation, deformation_rate, strain_rate)
+      stress = matmul(law, strain)
+      damping_stress = damping_time * matmul(law, strain_rate)
+      energy = energy + 0.5_dp * weights(p) * dot_product(strain, stress)
+      dissipation = dissipation + weights(p) * dot_product(strain_rate, damping_stress)
+      stress = stress + damping_stress
+      call add_nodal_force(deformation, stress, gradients(:, :, p), weights(p), force)
+      if (.not. want_tangent) cycle
+      call strain_matrix(deformation, gradients(:, :, p), b)
+      ! (1 + c tau) B^T D B + tau B^T D B(F') + the geometric term of the total stress
+      call strain_matrix(deformation_rate, gradients(:, :, p), b_rate)
+      tangent = tangent + weights(p) * matmul(transpose(b), &
+                matmul(law, (1.0_dp + rate_factor * damping_time) * b + damping_time * b_rate))
+      call add_geometric_stiffness(stress, gradients(:, :, p), weights(p), tangent)
+    end do
+  end subroutine damped_points
 
   !> The element_set element_forces of a continuum set: nonlinear_element of element el.
   pure subroutine continuum_element_forces(set, el, coords, want_tangent, force, energy, &

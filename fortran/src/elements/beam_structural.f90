@@ -194,7 +194,8 @@ contains
   !> With Kelvin-Voigt damping (the nodal rates q'(3, 8), damping_time tau > 0, rate_factor
   !> and dissipation all present): the force includes the damping force, dissipation is its
   !> power and the tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric:
-  !> whole columns, and the gradients from the full forms).
+  !> whole columns, and the gradients from the full forms). (The two term loops stay apart,
+  !> as in beam_nonlinear: one loop behind a flag compiles to a slower undamped force.)
   pure subroutine structural_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
                                      tangent, pairs, npairs, rates, damping_time, rate_factor, &
                                      dissipation)
@@ -205,18 +206,32 @@ contains
     integer, intent(in), optional :: pairs(2, 64, structural_terms), npairs(structural_terms)
     real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
     real(dp), intent(out), optional :: dissipation
+    if (present(rates)) then
+      call damped_terms(q, rates, forms, strain0, stiffness, damping_time, rate_factor, &
+                        want_tangent, force, energy, dissipation, tangent)
+    else
+      call elastic_terms(q, forms, strain0, stiffness, want_tangent, force, energy, tangent, &
+                         pairs, npairs)
+    end if
+  end subroutine structural_element
+
+  !> structural_element without damping (its loop over the strain terms). With the set's pattern (structural_pattern)
+  !> the gradients C q run over the forms' nonzero entries only.
+  pure subroutine elastic_terms(q, forms, strain0, stiffness, want_tangent, force, energy, &
+                                tangent, pairs, npairs)
+    real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
+    real(dp), intent(in) :: stiffness(structural_terms)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, tangent(24, 24)
+    integer, intent(in), optional :: pairs(2, 64, structural_terms), npairs(structural_terms)
     real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
-    real(dp) :: rate_gradient(3, 8), strain_rate, total, row(24)
-    logical :: damped
     integer :: t, j, a, k
-    damped = present(rates)
     force = 0.0_dp
     energy = 0.0_dp
-    if (damped) dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     geometric = 0.0_dp
     do t = 1, structural_terms
-      if (present(pairs) .and. .not. damped) then
+      if (present(pairs)) then
         gradient = 0.0_dp
         do k = 1, npairs(t)
           gradient(:, pairs(2, k, t)) = gradient(:, pairs(2, k, t)) &
@@ -230,41 +245,67 @@ contains
       do a = 1, 8  ! the 3 x 8 gradient as 24 numbers, copied in place of a reshape
         flat(3 * a - 2:3 * a) = gradient(:, a)
       end do
-      if (damped) then
-        strain_rate = sum(rates * gradient)                 ! s' = q' . C q
-        total = strain + damping_time * strain_rate
-        dissipation = dissipation + damping_time * stiffness(t) * strain_rate**2
-      else
-        total = strain
-      end if
-      force = force + stiffness(t) * total * flat
+      force = force + stiffness(t) * strain * flat
       if (.not. want_tangent) cycle
-      if (damped) then
-        ! k g ((1 + c tau) g + tau C q')^T, whole columns
-        rate_gradient = matmul(rates, forms(:, :, t))
-        do a = 1, 8
-          row(3 * a - 2:3 * a) = stiffness(t) * ((1.0_dp + rate_factor * damping_time) &
-                                 * gradient(:, a) + damping_time * rate_gradient(:, a))
-        end do
-        do j = 1, 24
-          tangent(:, j) = tangent(:, j) + row(j) * flat
-        end do
-      else
-        do j = 1, 24
-          scaled = stiffness(t) * flat(j)
-          tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
-        end do
-      end if
-      geometric = geometric + stiffness(t) * total * forms(:, :, t)
+      do j = 1, 24
+        scaled = stiffness(t) * flat(j)
+        tangent(j:24, j) = tangent(j:24, j) + scaled * flat(j:24)
+      end do
+      geometric = geometric + stiffness(t) * strain * forms(:, :, t)
     end do
     if (.not. want_tangent) return
     call add_kron_identity(geometric, tangent)
-    if (damped) return
     ! the rank-one parts filled the lower triangle; the geometric part is symmetric
     do j = 2, 24
       tangent(1:j - 1, j) = tangent(j, 1:j - 1)
     end do
-  end subroutine structural_element
+  end subroutine elastic_terms
+
+  !> structural_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
+  !> q'(3, 8) (its loop over the strain terms): the force includes the damping force, dissipation is its power and the
+  !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
+  pure subroutine damped_terms(q, rates, forms, strain0, stiffness, damping_time, &
+                                            rate_factor, want_tangent, force, energy, &
+                                            dissipation, tangent)
+    real(dp), intent(in) :: q(3, 8), rates(3, 8), forms(8, 8, structural_terms)
+    real(dp), intent(in) :: strain0(structural_terms), stiffness(structural_terms)
+    real(dp), intent(in) :: damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
+    real(dp) :: gradient(3, 8), rate_gradient(3, 8), strain, strain_rate, total
+    real(dp) :: geometric(8, 8), row(24), column(24)
+    integer :: t, j, a
+    force = 0.0_dp
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
+    geometric = 0.0_dp
+    do t = 1, structural_terms
+      gradient = matmul(q, forms(:, :, t))
+      strain = 0.5_dp * sum(q * gradient) - strain0(t)
+      strain_rate = sum(rates * gradient)                 ! s' = q' . C q
+      total = strain + damping_time * strain_rate
+      energy = energy + 0.5_dp * stiffness(t) * strain**2
+      dissipation = dissipation + damping_time * stiffness(t) * strain_rate**2
+      do a = 1, 8  ! the 3 x 8 gradient as 24 numbers, copied in place of a reshape
+        column(3 * a - 2:3 * a) = gradient(:, a)
+      end do
+      force = force + stiffness(t) * total * column
+      if (.not. want_tangent) cycle
+      ! k g ((1 + c tau) g + tau C q')^T, whole columns
+      rate_gradient = matmul(rates, forms(:, :, t))
+      do a = 1, 8
+        row(3 * a - 2:3 * a) = stiffness(t) * ((1.0_dp + rate_factor * damping_time) &
+                               * gradient(:, a) + damping_time * rate_gradient(:, a))
+      end do
+      do j = 1, 24
+        tangent(:, j) = tangent(:, j) + row(j) * column
+      end do
+      geometric = geometric + stiffness(t) * total * forms(:, :, t)
+    end do
+    if (.not. want_tangent) return
+    call add_kron_identity(geometric, tangent)
+  end subroutine damped_terms
 
   !> The element_set element_forces of a cubic set: structural_element of element el.
   pure subroutine cubic_element_forces(set, el, coords, want_tangent, force, energy, tangent, &

@@ -332,7 +332,8 @@ contains
   !> With Kelvin-Voigt damping (the coordinate rates (3, 12), damping_time tau > 0,
   !> rate_factor and dissipation all present): the force includes the damping force,
   !> dissipation is its power and the tangent (when want_tangent) the combined dQ/dq +
-  !> rate_factor dQ/dq', both triangles (it is not symmetric).
+  !> rate_factor dQ/dq', both triangles (it is not symmetric). (The two point loops stay
+  !> apart, as in beam_nonlinear: one loop behind a flag compiles to a slower undamped force.)
   pure subroutine plate_forces(coords, derivs, frame, curvature0, weights, youngs, poisson, &
                                thickness, want_tangent, force, energy, tangent, info, rates, &
                                damping_time, rate_factor, dissipation)
@@ -345,43 +346,50 @@ contains
     integer, intent(out) :: info
     real(dp), intent(in), optional :: rates(3, plate_shapes), damping_time, rate_factor
     real(dp), intent(out), optional :: dissipation
+    if (present(rates)) then
+      call damped_points(coords, rates, derivs, frame, curvature0, weights, youngs, poisson, &
+                         thickness, damping_time, rate_factor, want_tangent, force, energy, &
+                         dissipation, tangent, info)
+    else
+      call elastic_points(coords, derivs, frame, curvature0, weights, youngs, poisson, &
+                          thickness, want_tangent, force, energy, tangent, info)
+    end if
+  end subroutine plate_forces
+
+  !> plate_forces without damping (its loop over the Gauss points).
+  pure subroutine elastic_points(coords, derivs, frame, curvature0, weights, youngs, poisson, &
+                                 thickness, want_tangent, force, energy, tangent, info)
+    real(dp), intent(in) :: coords(3, plate_shapes)
+    real(dp), intent(in) :: derivs(plate_shapes, plate_fields, plate_points)
+    real(dp), intent(in) :: frame(2, 2, plate_points), curvature0(3, plate_points)
+    real(dp), intent(in) :: weights(plate_points), youngs, poisson, thickness
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(plate_dofs), energy, tangent(plate_dofs, plate_dofs)
+    integer, intent(out) :: info
     real(dp) :: membrane_d(3, 3), bending_d(3, 3)
     real(dp) :: fields(3, plate_fields), point_w, gradient(3, plate_fields), hessian(15, 15)
     real(dp) :: nodal(3, plate_shapes), shape_d(plate_fields, plate_shapes)
-    real(dp) :: field_rates(3, plate_fields), point_power
-    logical :: damped
     integer :: p, row, col
     info = 0
-    damped = present(rates)
     call elastic_matrices(youngs, poisson, thickness, membrane_d, bending_d)
     energy = 0.0_dp
-    if (damped) dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp
     nodal = 0.0_dp
     do p = 1, plate_points
       shape_d = transpose(derivs(:, :, p))
       call interpolate(coords, shape_d, fields)
-      if (damped) call interpolate(rates, shape_d, field_rates)
       if (degenerate(fields)) then
         info = 2
         return
       end if
-      if (damped) then
-        call point_energy_damped(fields, field_rates, frame(:, :, p), curvature0(:, p), &
-                                 membrane_d, bending_d, damping_time, rate_factor, want_tangent, &
-                                 point_w, point_power, gradient, hessian)
-        dissipation = dissipation + weights(p) * point_power
-      else
-        call point_energy(fields, frame(:, :, p), curvature0(:, p), membrane_d, bending_d, &
-                          want_tangent, point_w, gradient, hessian)
-      end if
+      call point_energy(fields, frame(:, :, p), curvature0(:, p), membrane_d, bending_d, &
+                        want_tangent, point_w, gradient, hessian)
       energy = energy + weights(p) * point_w
       call add_nodal_force(weights(p) * gradient, shape_d, nodal)
-      ! undamped, H is symmetric: the upper triangle, mirrored at the end; damped, every entry
-      if (want_tangent) call add_point_tangent(hessian, shape_d, weights(p), .not. damped, &
-                                               tangent)
+      ! H is symmetric: the upper triangle, mirrored at the end
+      if (want_tangent) call add_point_tangent(hessian, shape_d, weights(p), .true., tangent)
     end do
-    if (want_tangent .and. .not. damped) then
+    if (want_tangent) then
       do col = 1, plate_dofs
         do row = col + 1, plate_dofs
           tangent(row, col) = tangent(col, row)
@@ -389,7 +397,54 @@ contains
       end do
     end if
     force = reshape(nodal, [plate_dofs])
-  end subroutine plate_forces
+  end subroutine elastic_points
+
+  !> plate_forces with Kelvin-Voigt damping (damping_time tau > 0) at the coordinate rates
+  !> (3, 12) (its loop over the Gauss points): the force includes the damping force, dissipation is its power and the tangent
+  !> (when want_tangent) the combined dQ/dq + rate_factor dQ/dq', both triangles (it is not
+  !> symmetric). info = 2: the normal vanished.
+  pure subroutine damped_points(coords, rates, derivs, frame, curvature0, weights, youngs, &
+                                      poisson, thickness, damping_time, rate_factor, &
+                                      want_tangent, force, energy, dissipation, tangent, info)
+    real(dp), intent(in) :: coords(3, plate_shapes), rates(3, plate_shapes)
+    real(dp), intent(in) :: derivs(plate_shapes, plate_fields, plate_points)
+    real(dp), intent(in) :: frame(2, 2, plate_points), curvature0(3, plate_points)
+    real(dp), intent(in) :: weights(plate_points), youngs, poisson, thickness
+    real(dp), intent(in) :: damping_time, rate_factor
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(plate_dofs), energy, dissipation
+    real(dp), intent(out) :: tangent(plate_dofs, plate_dofs)
+    integer, intent(out) :: info
+    real(dp) :: membrane_d(3, 3), bending_d(3, 3)
+    real(dp) :: fields(3, plate_fields), field_rates(3, plate_fields), point_w, point_power
+    real(dp) :: gradient(3, plate_fields), hessian(15, 15), nodal(3, plate_shapes)
+    real(dp) :: shape_d(plate_fields, plate_shapes)
+    integer :: p
+    info = 0
+    call elastic_matrices(youngs, poisson, thickness, membrane_d, bending_d)
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
+    nodal = 0.0_dp
+    do p = 1, plate_points
+      shape_d = transpose(derivs(:, :, p))
+      call interpolate(coords, shape_d, fields)
+      call interpolate(rates, shape_d, field_rates)
+      if (degenerate(fields)) then
+        info = 2
+        return
+      end if
+      call point_energy_damped(fields, field_rates, frame(:, :, p), curvature0(:, p), membrane_d, &
+                               bending_d, damping_time, rate_factor, want_tangent, point_w, &
+                               point_power, gradient, hessian)
+      energy = energy + weights(p) * point_w
+      dissipation = dissipation + weights(p) * point_power
+      call add_nodal_force(weights(p) * gradient, shape_d, nodal)
+      ! H is not symmetric: every entry
+      if (want_tangent) call add_point_tangent(hessian, shape_d, weights(p), .false., tangent)
+    end do
+    force = reshape(nodal, [plate_dofs])
+  end subroutine damped_points
 
   !> The element_set element_forces of a plate set: plate_forces of element el.
   pure subroutine plate_element_forces(set, el, coords, want_tangent, force, energy, tangent, &
