@@ -12,7 +12,7 @@ Python side calls (arrays prepared once in Fortran order, so no conversion is ti
 * ``nonlinear force + tangent``: the same with the element tangents (24 x 24 per element),
   ``want_tangent=1``;
 * ``cubic force`` and ``cubic force + tangent``: the same for ``beam.bending = 'cubic'``
-  (``_kernel.beam_structural_forces``: 21 strain forms per element, docs/theory.md
+  (``_kernel.beam_cubic_forces``: 21 strain forms per element, docs/theory.md
   section 12);
 * ``FFR force``: the floating-frame elastic force T K0 (T^T e - e0),
   ``_kernel.ffr_elastic_force``;
@@ -208,7 +208,7 @@ def beam_arrays(kernel: Any, nel: int, poisson: float) -> dict[str, Any]:
     e[:, 6:9] = np.column_stack([-np.sin(angle) + 0.01, np.cos(angle), 0.0 * s])
     e[:, 9:12] = [0.0, 0.0, 1.0]
     return {"npts": int(continuum.weights.shape[0]), "nvolume": continuum.nvolume,
-            "ndof": models["nonlinear"].ndof, "cubic": cubic.structural, "models": models,
+            "ndof": models["nonlinear"].ndof, "cubic": cubic.cubic, "models": models,
             "dofs": np.asfortranarray(continuum.dofs + 1, dtype=np.int32),
             "e": np.asfortranarray(e.ravel()), "reference": ffr.reference,
             "gradients": continuum.gradients, "weights": continuum.weights,
@@ -237,9 +237,9 @@ def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
     calls: dict[str, Callable[[], Any]] = {
         "nonlinear_force": nonlinear(0),
         "nonlinear_force_tangent": nonlinear(1),
-        "cubic_force": lambda: kernel.beam_structural_forces(
+        "cubic_force": lambda: kernel.beam_cubic_forces(
             a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 0),
-        "cubic_force_tangent": lambda: kernel.beam_structural_forces(
+        "cubic_force_tangent": lambda: kernel.beam_cubic_forces(
             a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 1),
         "ffr_force": lambda: kernel.ffr_elastic_force(a["dofs"], a["stiffness0"],
                                                       a["reference"], a["rotation"], a["e"]),

@@ -31,12 +31,6 @@ def layout(params: dict[str, int], names: list[str]) -> tuple[int, ...]:
     return tuple(params[n] for n in names)
 
 
-def test_element_set_kinds():
-    p = parameters("system/element_sets.f90")
-    assert (codes.SET_FFR, codes.SET_CONTINUUM, codes.SET_STRUCTURAL, codes.SET_PLATE) == \
-        layout(p, ["set_ffr", "set_continuum", "set_structural", "set_plate"])
-
-
 def test_constraint_kinds():
     p = parameters("system/constraints.f90")
     assert (codes.CONSTRAINT_COORDINATE, codes.CONSTRAINT_DISTANCE, codes.CONSTRAINT_CROSS,

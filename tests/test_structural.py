@@ -75,11 +75,11 @@ def test_system_force_over_the_nonzero_entries_is_the_dense_elements():
     model = beam("nonlinear", nodes=5, poisson=0.3)
     try:
         beam_set = model.sets[0]
-        assert beam_set.kind == "structural"
+        assert beam_set.kind == "cubic"
         rot = Rotation.from_euler("xyz", [2.1, -0.7, 0.4]).as_matrix()
         e = (model.e0.reshape(-1, 3) @ rot.T).ravel() + 1e-2 * RNG.standard_normal(model.ndof)
         system_force, system_energy = model.internal_force(e)[:2]
-        dense_force, dense_energy, _ = beam_set.structural.forces(beam_set.dofs, e, False)
+        dense_force, dense_energy, _ = beam_set.cubic.forces(beam_set.dofs, e, False)
         assert np.abs(system_force).max() > 0
         np.testing.assert_allclose(system_force, dense_force,
                                    atol=1e-13 * np.abs(dense_force).max())
@@ -115,7 +115,7 @@ def test_curved_reference_is_strain_free():
                          [np.cos(angle), np.sin(angle), 0.0],
                          [-np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
     reference = np.concatenate([arc(0.0), arc(length)]).T.reshape(3, 8, 1)
-    element = kernel.StructuralBeam(reference, [length], rect(0.02, 0.03), 2e11, 0.3)
+    element = kernel.CubicBeam(reference, [length], rect(0.02, 0.03), 2e11, 0.3)
     dofs = np.arange(24)[:, None]
     e0 = reference[:, :, 0].T.ravel()
     force, energy, _ = element.forces(dofs, e0, False)

@@ -23,14 +23,15 @@ _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 from ._version import __version__  # noqa: E402,F401
 
-from .system import (Beam, Box, Circle, Constant, Cycle, General, Leaf, Luffing, Material,  # noqa: E402
-                     Model, Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
+from .system import (Beam, Box, Cable, Circle, Constant, Cycle, General, Leaf, Luffing,  # noqa: E402
+                     Material, Model, Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, System,
+                     Table, Tube)
 
 from .results import Results, open_results  # noqa: E402  (gives System its analyses)
 
 #: ``ancfdrv.open(path)``: any result file as :class:`~ancfdrv.results.Results`
 open = open_results  # noqa: A001 - the package's own name, as SPEC section 10 spells it
 
-__all__ = ["open", "open_results", "Results", "System", "Model", "Material", "Beam", "Plate",
-           "Leaf", "RigidBody", "Rectangle", "Box", "Tube", "Circle", "General", "Constant",
-           "Luffing", "SpinUp", "Cycle", "Sine", "Table", "Ramp"]
+__all__ = ["open", "open_results", "Results", "System", "Model", "Material", "Beam", "Cable",
+           "Plate", "Leaf", "RigidBody", "Rectangle", "Box", "Tube", "Circle", "General",
+           "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table", "Ramp"]

@@ -5,9 +5,6 @@ Each value here mirrors an ``integer, parameter`` of a kernel module (named in t
 """
 from __future__ import annotations
 
-# fortran/src/system/element_sets.f90
-SET_FFR, SET_CONTINUUM, SET_STRUCTURAL, SET_PLATE = 1, 2, 3, 4
-
 # fortran/src/system/constraints.f90
 CONSTRAINT_COORDINATE, CONSTRAINT_DISTANCE, CONSTRAINT_CROSS, CONSTRAINT_DOT = 1, 2, 3, 4
 

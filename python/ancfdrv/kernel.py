@@ -17,8 +17,8 @@ from .errors import InputError, SolverError
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
            "SparsePattern", "DirectSolver", "plate_shape", "plate_element_arrays",
-           "plate_reference", "plate_forces", "PlateReference", "StructuralBeam", "SectionData",
-           "section_data"]
+           "plate_reference", "plate_forces", "PlateReference", "CubicBeam", "SectionData",
+           "section_data", "cable_element_arrays", "cable_shape", "cable_forces"]
 
 
 def _f(a, dtype=np.float64) -> np.ndarray:
@@ -125,7 +125,7 @@ def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poi
                                          int(want_tangent))
 
 
-class StructuralBeam:
+class CubicBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
     (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel);
     ``torsion`` the Saint-Venant constant J (default: the polar moment) and
@@ -133,13 +133,13 @@ class StructuralBeam:
 
     def __init__(self, reference, lengths, section: SectionData, youngs, poisson,
                  torsion: float | None = None, shear_factors=(1.0, 1.0)) -> None:
-        nterms = int(_kernel.beam_structural_size())
+        nterms = int(_kernel.beam_cubic_size())
         torsion = section.polar if torsion is None else torsion
         (self.forms, self.strain0, self.stiffness,
-         info) = _kernel.beam_structural_setup(nterms, _f(reference), _f(lengths), section.area,
-                                               section.inertia_y, section.inertia_z,
-                                               torsion, shear_factors[0], shear_factors[1],
-                                               youngs, poisson)
+         info) = _kernel.beam_cubic_setup(nterms, _f(reference), _f(lengths), section.area,
+                                          section.inertia_y, section.inertia_z,
+                                          torsion, shear_factors[0], shear_factors[1],
+                                          youngs, poisson)
         if info:
             element, code = divmod(info, 10)
             reason = {1: "unsupported quadrature",
@@ -148,8 +148,33 @@ class StructuralBeam:
 
     def forces(self, dofs, e, want_tangent: bool):
         """Elastic force, strain energy and element tangents (24, 24, nel) at e."""
-        return _kernel.beam_structural_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
-                                              self.strain0, self.stiffness, int(want_tangent))
+        return _kernel.beam_cubic_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
+                                         self.strain0, self.stiffness, int(want_tangent))
+
+
+def cable_element_arrays(lengths, mass_per_length: float, load) -> tuple[np.ndarray, np.ndarray]:
+    """Cable elements (cable_element): scalar element masses Mbar (4, 4, nel) (the element
+    mass is kron(Mbar, I3)) and the generalized forces (12, nel) of a uniform load per
+    length (3,)."""
+    return _kernel.cable_element_arrays(_f(np.atleast_1d(lengths)), float(mass_per_length),
+                                        _f(load))
+
+
+def cable_shape(xi: float, length: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cable shape rows (4,) at xi of an element: position, d/dx and d2/dx2."""
+    return _kernel.cable_shape_functions(float(xi), float(length))
+
+
+def cable_forces(dofs, e, lengths, axial_stiffness: float, bending_stiffness: float,
+                 want_tangent: bool):
+    """Cable elastic force dU/de (global), strain energy and element tangents (12, 12, nel)
+    at e; dofs (12, nel) 0-based."""
+    force, energy, tangent, info = _kernel.cable_forces(
+        _f(np.asarray(dofs) + 1, np.int32), _f(e), _f(np.atleast_1d(lengths)),
+        float(axial_stiffness), float(bending_stiffness), int(want_tangent))
+    if info:
+        raise SolverError(f"cable element {info}: r' vanished at a Gauss point")
+    return force, float(energy), tangent
 
 
 PLATE_VARIANTS = {"plain": 0, "completed": 1}
@@ -426,6 +451,13 @@ def _pad_last(a: np.ndarray, dtype=np.float64) -> np.ndarray:
     return np.asfortranarray(a)
 
 
+def _text(message: bytes | str) -> str:
+    """A kernel message buffer (f2py returns character(len=200) as bytes) as text."""
+    if isinstance(message, bytes):
+        message = message.decode("ascii", "replace")
+    return str(message).strip() or "no message"
+
+
 class KernelSystem:
     """A mechanical system held by the kernel (system_store): built once by the set-up
     methods (indices are 0-based here, 1-based in the kernel), then evaluated or stepped
@@ -433,72 +465,81 @@ class KernelSystem:
     :meth:`close`."""
 
     def __init__(self, ndof: int, nfull: int) -> None:
-        handle, info = _kernel.system_create(ndof, nfull)
+        handle, info, message = _kernel.system_create(ndof, nfull)
         if info:
-            raise SolverError("the kernel's system table is full (256 systems alive)")
+            raise SolverError(_text(message))
         self.handle, self.ndof, self.nfull = int(handle), ndof, nfull
         self.ncon = self.nprobe = self.npoint = 0
         self.nnz_pattern = 0
 
-    def _check(self, info: int, what: str) -> None:
+    def _check(self, info: int, what: str, message: bytes | str = b"") -> None:
+        """Raise with the kernel's own text (code 1: a stale handle, 2: sizes or indices
+        inconsistent with the system: a bug of the caller)."""
         if info:
-            raise SolverError(f"kernel system set-up ({what}): code {info} "
-                              f"({'stale handle' if info == 1 else 'inconsistent sizes'})")
+            raise SolverError(f"kernel system set-up ({what}), code {info}: {_text(message)}")
 
     # element sets: dofs 0-based (nde, nel), scatter 1-based (Pattern.scatter), frame: the
     # 1-based frame id (0: none); damping_time: the Kelvin-Voigt retardation time tau (s) of
     # the set's material damping (0: none, and none of its code runs)
     def add_ffr_set(self, dofs, scatter, stiffness0, reference, frame: int,
                     damping_time: float = 0.0) -> int:
-        index, info = _kernel.system_add_ffr_set(self.handle, _i(dofs + 1), _i(scatter),
+        index, info, message = _kernel.system_add_ffr_set(self.handle, _i(dofs + 1), _i(scatter),
                                                  _f(stiffness0), _f(reference), frame,
                                                  damping_time)
-        self._check(info, "FFR beam set")
+        self._check(info, "FFR beam set", message)
         return int(index)
 
     def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
                           poisson: float, frame: int, damping_time: float = 0.0,
                           shear_scales=(1.0, 0.0, 0.0)) -> int:
-        index, info = _kernel.system_add_continuum_set(
+        index, info, message = _kernel.system_add_continuum_set(
             self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights), youngs,
             poisson, _f(shear_scales), frame, damping_time)
-        self._check(info, "continuum beam set")
+        self._check(info, "continuum beam set", message)
         return int(index)
 
-    def add_structural_set(self, dofs, scatter, forms, strain0, stiffness, frame: int,
-                           damping_time: float = 0.0) -> int:
-        index, info = _kernel.system_add_structural_set(
+    def add_cubic_set(self, dofs, scatter, forms, strain0, stiffness, frame: int,
+                      damping_time: float = 0.0) -> int:
+        index, info, message = _kernel.system_add_cubic_set(
             self.handle, _i(dofs + 1), _i(scatter), _f(forms), _f(strain0), _f(stiffness),
             frame, damping_time)
-        self._check(info, "structural beam set")
+        self._check(info, "cubic beam set", message)
         return int(index)
 
     def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
                       poisson: float, thickness: float, damping_time: float = 0.0) -> int:
-        index, info = _kernel.system_add_plate_set(
+        index, info, message = _kernel.system_add_plate_set(
             self.handle, _i(dofs + 1), _i(scatter), reference.derivs, reference.frame,
             reference.curvature0, reference.weights, youngs, poisson, thickness, damping_time)
-        self._check(info, "plate set")
+        self._check(info, "plate set", message)
+        return int(index)
+
+    def add_cable_set(self, dofs, scatter, lengths, axial_stiffness: float,
+                      bending_stiffness: float, damping_time: float = 0.0) -> int:
+        index, info, message = _kernel.system_add_cable_set(
+            self.handle, _i(dofs + 1), _i(scatter), _f(lengths), axial_stiffness,
+            bending_stiffness, damping_time)
+        self._check(info, "cable set", message)
         return int(index)
 
     def set_frames(self, drives, axes, bases, pivots) -> None:
         """Frames: drive (0-based drive index, -1: fixed), axis, base (3, 3), pivot."""
         n = len(drives)
-        info = _kernel.system_set_frames(
+        info, message = _kernel.system_set_frames(
             self.handle, n, _pad_last(np.asarray(drives, dtype=np.int32) + 1, np.int32),
             _pad_last(np.asarray(axes, dtype=float).reshape(-1, 3).T),
             _pad_last(np.transpose(np.asarray(bases, dtype=float).reshape(-1, 3, 3), (1, 2, 0))),
             _pad_last(np.asarray(pivots, dtype=float).reshape(-1, 3).T))
-        self._check(info, "frames")
+        self._check(info, "frames", message)
 
     def set_drives(self, kinds, params: list) -> None:
         ptr = np.concatenate([[0], np.cumsum([len(p) for p in params])]).astype(np.int32) + 1
         data = np.concatenate([np.asarray(p, dtype=float) for p in params]) if params else \
             np.zeros(0)
-        info = _kernel.system_set_drives(self.handle, len(kinds), len(data),
+        info, message = _kernel.system_set_drives(self.handle, len(kinds), len(data),
                                          _pad_last(np.asarray(kinds, dtype=np.int32), np.int32),
                                          _i(ptr), _pad_last(data))
-        self._check(info, "drives")
+        self._check(info, "drives", message)
 
     def set_matrices(self, mass_csr, full_pattern, solver_handle: int, policy: int,
                      mass_pattern, vector_frame, block_first) -> None:
@@ -507,36 +548,36 @@ class KernelSystem:
         of each reduced 3-vector (0: global; frames 1-based here) and the blocks' first dofs."""
         full_row_ptr, full_col = full_pattern
         self.nnz_pattern = len(mass_pattern)
-        info = _kernel.system_set_matrices(
+        info, message = _kernel.system_set_matrices(
             self.handle, _i(mass_csr.indptr + 1), _i(mass_csr.indices + 1), _f(mass_csr.data),
             _i(np.asarray(full_row_ptr) + 1), _i(np.asarray(full_col) + 1), solver_handle,
             policy, _f(mass_pattern), len(vector_frame),
             _pad_last(np.asarray(vector_frame, dtype=np.int32), np.int32), len(block_first),
             _pad_last(np.asarray(block_first, dtype=np.int32) + 1, np.int32), ndof=self.ndof,
             nfull=self.nfull)
-        self._check(info, "matrices")
+        self._check(info, "matrices", message)
 
     def set_kron_mass(self, scalar_csr) -> None:
         """M = kron(Mbar, I3): Mbar's CSR on the 3-vectors replaces M in the products."""
-        info = _kernel.system_set_kron_mass(self.handle, _i(scalar_csr.indptr + 1),
+        info, message = _kernel.system_set_kron_mass(self.handle, _i(scalar_csr.indptr + 1),
                                             _i(scalar_csr.indices + 1), _f(scalar_csr.data))
-        self._check(info, "kron mass")
+        self._check(info, "kron mass", message)
 
     def set_reduction(self, b_csr, offset, plan_source, plan_target, plan_coef) -> None:
-        info = _kernel.system_set_reduction(
+        info, message = _kernel.system_set_reduction(
             self.handle, len(b_csr.data), _i(b_csr.indptr + 1),
             _pad_last(b_csr.indices + 1, np.int32), _pad_last(b_csr.data), _f(offset),
             len(plan_coef), _pad_last(np.asarray(plan_source) + 1, np.int32),
             _pad_last(np.asarray(plan_target) + 1, np.int32), _pad_last(plan_coef),
             nfull=self.nfull)
-        self._check(info, "reduction")
+        self._check(info, "reduction", message)
 
     def set_loads(self, constant_force, force_drives, force_vectors, moment_dofs, moment_axes,
                   magnitudes, moment_references) -> None:
         """Driven forces: 0-based drive indices and vectors (ndof, n); moments: full director
         dofs (n, 3, 0-based), axes, magnitudes, directors at t = 0."""
         nforce, nmoment = len(force_drives), len(magnitudes)
-        info = _kernel.system_set_loads(
+        info, message = _kernel.system_set_loads(
             self.handle, _f(constant_force), nforce,
             _pad_last(np.asarray(force_drives, dtype=np.int32) + 1, np.int32),
             _pad_last(np.asarray(force_vectors, dtype=float).reshape(self.ndof, nforce)), nmoment,
@@ -545,7 +586,7 @@ class KernelSystem:
             _pad_last(np.asarray(magnitudes, dtype=float)),
             _pad_last(np.asarray(moment_references, dtype=float).reshape(-1, 3).T),
             ndof=self.ndof)
-        self._check(info, "loads")
+        self._check(info, "loads", message)
 
     def set_vector_loads(self, loads) -> None:
         """Driven and follower point loads (model.VectorLoadInfo)."""
@@ -567,31 +608,31 @@ class KernelSystem:
 
     def set_constraints(self, layout: "ConstraintLayout") -> None:
         ncon, nterm = len(layout.kinds), len(layout.term_dof)
-        info = _kernel.system_set_constraints(
+        info, message = _kernel.system_set_constraints(
             self.handle, ncon, nterm, _pad_last(layout.kinds, np.int32),
             _pad_last(np.asarray(layout.drives) + 1, np.int32), _pad_last(layout.params),
             _pad_last(layout.operand_const), _i(np.asarray(layout.term_ptr) + 1),
             _pad_last(np.asarray(layout.term_dof) + 1, np.int32), _pad_last(layout.term_coef))
-        self._check(info, "constraints")
+        self._check(info, "constraints", message)
         self.ncon = ncon
 
     def add_contact_pair(self, dofs, sizes, grid, point_element, point_local, params) -> None:
-        info = _kernel.system_add_contact_pair(
+        info, message = _kernel.system_add_contact_pair(
             self.handle, _i(np.asarray(dofs) + 1), _f(sizes), _i(np.asarray(grid) + 1),
             _i(np.asarray(point_element) + 1), _f(point_local), _f(params))
-        self._check(info, "contact pair")
+        self._check(info, "contact pair", message)
         self.npoint += len(point_element)
 
     def set_probes(self, ptr, dofs, coefs, frames, reference) -> None:
         """Probe p = sum coef q[dof:dof+3] over terms ptr[p]:ptr[p+1] (0-based dofs),
         deflection frame (0: global, frames 1-based), rigid position in it (nprobe, 3)."""
         nprobe = len(ptr) - 1
-        info = _kernel.system_set_probes(
+        info, message = _kernel.system_set_probes(
             self.handle, len(dofs), _i(np.asarray(ptr) + 1),
             _pad_last(np.asarray(dofs, dtype=np.int32) + 1, np.int32), _pad_last(coefs),
             _pad_last(np.asarray(frames, dtype=np.int32), np.int32),
             _pad_last(np.asarray(reference, dtype=float).reshape(-1, 3).T))
-        self._check(info, "probes")
+        self._check(info, "probes", message)
         self.nprobe = nprobe
 
     def evaluate(self, t: float, e, v, guesses, counts, *, load_factor: float = 1.0,
@@ -603,9 +644,10 @@ class KernelSystem:
         out = _kernel.system_evaluate(self.handle, nnz, self.npoint, t, _f(e), _f(v), load_factor,
                                       velocity_factor, int(want_tangent), _f(guesses),
                                       _i(counts), ndof=self.ndof)
-        guesses, counts, internal, external, strain, potential, records, tangent, info = out
+        (guesses, counts, internal, external, strain, potential, records, tangent, info,
+         message) = out
         if info:
-            self._failure(info, "force evaluation")
+            self._failure(info, "force evaluation", message)
         return dict(internal=internal, external=external, strain=float(strain),
                     contact_potential=float(potential), records=records[:, :self.npoint],
                     tangent=tangent if want_tangent else None, guesses=guesses, counts=counts)
@@ -626,23 +668,25 @@ class KernelSystem:
             self.handle, self.ncon, self.nprobe, self.npoint, t, _f(e), _f(v),
             _f(lam) if len(lam) else np.zeros(1), _f(work), _f(guesses), _i(counts),
             ndof=self.ndof)
-        guesses, counts, probe, deflection, energy, violation, records, powers, info = out
+        (guesses, counts, probe, deflection, energy, violation, records, powers, info,
+         message) = out
         if info:
-            self._failure(info, "output row")
+            self._failure(info, "output row", message)
         return dict(probes=probe[:, :self.nprobe].T.copy(),
                     deflections=deflection[:, :self.nprobe].T.copy(), energy=energy,
                     violation=float(violation), records=records[:, :self.npoint],
                     guesses=guesses, counts=counts, powers=powers)
 
-    def _failure(self, info: int, what: str) -> None:
-        from .codes import STEP_FAILURES
-        reason = STEP_FAILURES.get(int(info), f"kernel code {info}")
-        raise SolverError(f"{what}: " + reason.format(max_newton="?", detail="?"))
+    def _failure(self, info: int, what: str, message: bytes | str) -> None:
+        """Raise with the kernel's text of the failure (a stale handle and inconsistent sizes
+        are named as such, not as a solver failure)."""
+        raise SolverError(f"{what}, kernel code {info}: {_text(message)}")
 
     def reset_stepper(self) -> None:
         """Forget the stepper's state of earlier runs (contraction estimate, a matrix
         factorized at another state): a run from a new initial state is reproducible."""
-        self._check(_kernel.system_reset_stepper(self.handle), "reset_stepper")
+        info, message = _kernel.system_reset_stepper(self.handle)
+        self._check(info, "reset_stepper", message)
 
     def advance(self, nsteps: int, settings, state: dict, store_q: bool,
                 h: float | None = None):

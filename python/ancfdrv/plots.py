@@ -640,8 +640,9 @@ def plot_static(h5_path: Path, png: str | Path | None = None) -> Path:
     with h5py.File(h5_path, "r") as h5:
         _require_static(h5, h5_path)
         s = h5["model/node_s"][()]
-        e0 = h5["model/e0"][()].reshape(-1, 12)
-        q = h5["static/q"][()].reshape(-1, 12)
+        stride = int(h5["model"].attrs.get("node_coordinates", 12))  # beams 12, cables 6
+        e0 = h5["model/e0"][()].reshape(-1, stride)
+        q = h5["static/q"][()].reshape(-1, stride)
         title = h5.attrs["title"]
         tip = h5["static/deflection/tip"][()]
         axis = e0[1, 0:3] - e0[0, 0:3]

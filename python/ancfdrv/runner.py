@@ -34,7 +34,7 @@ from .io import hdf5 as results
 from .io.general import locate_error
 from .io.lock import OutputLock, lock_path
 from .builders import build_model
-from .io.scene import PLATE_KINDS, Scene, load_scene
+from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
 from .solvers.static import StaticResult, solve_newton, solve_static
@@ -160,13 +160,6 @@ def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = Fa
             raise InputError("the output file exists and is not an HDF5 file; refusing to "
                              "overwrite it (remove it or choose another output file)",
                              file=str(out))
-
-
-def has_plates(scene: Scene) -> bool:
-    """Whether the scene's model has plates or leaves."""
-    if scene.kind == "general":
-        return any(group in ("plate", "leaf") for group, _ in scene.items)
-    return scene.kind in PLATE_KINDS
 
 
 def writes_xdmf(scene: Scene) -> bool:

@@ -132,20 +132,20 @@ subroutine beam_nonlinear_forces(ndof, nel, npts, nvolume, dofs, e, gradients, w
   energy = sum(element_energy)
 end subroutine beam_nonlinear_forces
 
-!> Number of strain terms per element of the structural ("cubic") beam.
-subroutine beam_structural_size(nterms)
+!> Number of strain terms per element of the 'cubic' bending beam.
+subroutine beam_cubic_size(nterms)
   use beam_structural, only: structural_terms
   implicit none
   integer, intent(out) :: nterms
   nterms = structural_terms
-end subroutine beam_structural_size
+end subroutine beam_cubic_size
 
-!> Strain forms, reference strains and stiffnesses of the structural ("cubic") beam per
+!> Strain forms, reference strains and stiffnesses of the 'cubic' bending beam per
 !> element, from the reference configuration and the section properties (torsion: the
 !> Saint-Venant constant J; shear_y, shear_z: the shear factors). info = 10*element + code.
-subroutine beam_structural_setup(nel, nterms, reference, lengths, area, inertia_y, inertia_z, &
-                                 torsion, shear_y, shear_z, youngs, poisson, forms, strain0, &
-                                 stiffness, info)
+subroutine beam_cubic_setup(nel, nterms, reference, lengths, area, inertia_y, inertia_z, &
+                            torsion, shear_y, shear_z, youngs, poisson, forms, strain0, &
+                            stiffness, info)
   use ancf_kinds, only: dp
   use beam_structural, only: structural_setup
   implicit none
@@ -165,11 +165,11 @@ subroutine beam_structural_setup(nel, nterms, reference, lengths, area, inertia_
       return
     end if
   end do
-end subroutine beam_structural_setup
+end subroutine beam_cubic_setup
 
-!> Structural ("cubic") elastic force (global), strain energy and, when want_tangent /= 0,
+!> 'Cubic' bending elastic force (global), strain energy and, when want_tangent /= 0,
 !> the element tangents (24 x 24 x nel) of a beam mesh.
-subroutine beam_structural_forces(ndof, nel, nterms, dofs, e, forms, strain0, stiffness, &
+subroutine beam_cubic_forces(ndof, nel, nterms, dofs, e, forms, strain0, stiffness, &
                                   want_tangent, force, energy, tangent)
   use ancf_kinds, only: dp
   use beam_structural, only: structural_element
@@ -193,7 +193,7 @@ subroutine beam_structural_forces(ndof, nel, nterms, dofs, e, forms, strain0, st
     force(dofs(:, el)) = force(dofs(:, el)) + element_force(:, el)
   end do
   energy = sum(element_energy)
-end subroutine beam_structural_forces
+end subroutine beam_cubic_forces
 
 !> Shape functions and their parameter derivatives at npts material points.
 subroutine beam_shape_functions(npts, xi, y, z, lengths, shape, dshape_dx, dshape_dy, dshape_dz)
@@ -438,17 +438,6 @@ subroutine moment_generalized_force(director, axis, magnitude, force, jacobian, 
   call moment_force(director, axis, magnitude, force, jacobian, hessian, info)
 end subroutine moment_generalized_force
 
-!> Rotation of a section director about an axis from a reference direction; the dead
-!> moment's potential is -magnitude * angle.
-subroutine moment_rotation_angle(director, axis, reference, angle)
-  use ancf_kinds, only: dp
-  use section_moment, only: moment_angle
-  implicit none
-  real(dp), intent(in) :: director(3), axis(3), reference(3)
-  real(dp), intent(out) :: angle
-  angle = moment_angle(director, axis, reference)
-end subroutine moment_rotation_angle
-
 !> A drive's phi, phi', phi'' at nt times (params: its parameters, any length).
 subroutine drive_values(kind, nparams, params, nt, t, phi, dphi, ddphi, info)
   use ancf_kinds, only: dp
@@ -576,3 +565,60 @@ subroutine vector_load_generalized_force(kind, vector, shares, a, b, force, jaco
   integer, intent(out) :: info
   call vector_load_force(kind, vector, shares, a, b, force, jacobian, info)
 end subroutine vector_load_generalized_force
+
+!> Cable elements (cable_element): the scalar element masses Mbar (4, 4, nel) (the element
+!> mass is kron(Mbar, I3)) for the mass per length, and the generalized forces (12, nel) of
+!> a uniform load per length (3).
+subroutine cable_element_arrays(nel, lengths, mass_per_length, load, mass, load_force)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_mass, cable_gravity
+  implicit none
+  integer, intent(in) :: nel
+  real(dp), intent(in) :: lengths(nel), mass_per_length, load(3)
+  real(dp), intent(out) :: mass(4, 4, nel), load_force(12, nel)
+  integer :: el
+  do el = 1, nel
+    call cable_mass(lengths(el), mass_per_length, mass(:, :, el))
+    call cable_gravity(lengths(el), load, load_force(:, el))
+  end do
+end subroutine cable_element_arrays
+
+!> Cable shape rows at xi (element of the given length): position, d/dx, d2/dx2 (4 each).
+subroutine cable_shape_functions(xi, length, shape, slope, second)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_shape
+  implicit none
+  real(dp), intent(in) :: xi, length
+  real(dp), intent(out) :: shape(4), slope(4), second(4)
+  call cable_shape(xi, length, shape, slope, second)
+end subroutine cable_shape_functions
+
+!> Cable elastic force (global), strain energy and, when want_tangent /= 0, the element
+!> tangents (12 x 12 x nel) of a cable mesh. info = element number whose r' vanished.
+subroutine cable_forces(ndof, nel, dofs, e, lengths, axial_stiffness, bending_stiffness, &
+                        want_tangent, force, energy, tangent, info)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_element_force
+  implicit none
+  integer, intent(in) :: ndof, nel, dofs(12, nel), want_tangent
+  real(dp), intent(in) :: e(ndof), lengths(nel), axial_stiffness, bending_stiffness
+  real(dp), intent(out) :: force(ndof), energy, tangent(12, 12, nel)
+  integer, intent(out) :: info
+  real(dp) :: element_force(12), element_energy
+  integer :: el, code
+  force = 0.0_dp
+  energy = 0.0_dp
+  tangent = 0.0_dp
+  info = 0
+  do el = 1, nel
+    call cable_element_force(reshape(e(dofs(:, el)), [3, 4]), lengths(el), axial_stiffness, &
+                             bending_stiffness, want_tangent /= 0, element_force, &
+                             element_energy, tangent(:, :, el), code)
+    if (code /= 0) then
+      info = el
+      return
+    end if
+    force(dofs(:, el)) = force(dofs(:, el)) + element_force
+    energy = energy + element_energy
+  end do
+end subroutine cable_forces

@@ -5,16 +5,21 @@
 !> handle; 2 sizes inconsistent with the system; other codes as documented per routine.
 
 !> A new, empty system of ndof independent and nfull full coordinates.
-subroutine system_create(ndof, nfull, handle, info)
+subroutine system_create(ndof, nfull, handle, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_create, store_get
   implicit none
   integer, intent(in) :: ndof, nfull
   integer, intent(out) :: handle, info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_create(handle, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = "the kernel's system table is full (256 systems alive)"
+    return
+  end if
   call store_get(handle, sys, info)
   sys%ndof = ndof
   sys%nfull = nfull
@@ -34,26 +39,36 @@ subroutine system_create(ndof, nfull, handle, info)
   allocate (sys%block_first(0), sys%flexibility(ndof, 0), sys%flexibility_cc(0, 0))
 end subroutine system_create
 
-subroutine system_destroy(handle, info)
+subroutine system_destroy(handle, info, message)
   use system_store, only: store_destroy
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  message = ' '
   call store_destroy(handle, info)
+  if (info /= 0) message = handle_text(handle)
 end subroutine system_destroy
 
 !> Forgets what the stepper learned in earlier runs (the contraction estimate; a matrix
 !> factorized at another state, except the constant policy's, which depends on the step
 !> alone): a run from a new initial state then gives the same result on any handle.
-subroutine system_reset_stepper(handle, info)
+subroutine system_reset_stepper(handle, info, message)
   use mechanical_system, only: system_model, policy_constant
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   sys%theta = -1.0d0
   sys%unconfirmed = 0
   sys%reuse_failures = 0
@@ -64,39 +79,54 @@ subroutine system_reset_stepper(handle, info)
   if (sys%policy /= policy_constant) sys%factorized = .false.
 end subroutine system_reset_stepper
 
+!> Element sets: one routine per family builds the family's set (element_sets: an
+!> extension of element_set in the family's module) from plain arrays and hands it to the
+!> one append path (mechanical_system append_set). Each checks the dofs (1..nfull) and the
+!> damping_time (the Kelvin-Voigt retardation time, s; 0: no material damping; negative:
+!> info = 2) and returns the set's 1-based index.
+
 !> ANCF-FFR beam elements: K0 and the rigid configuration (24, nel) in the floating frame
 !> `frame` (1-based index into the system's frames), the element dofs (full, 1-based) and
-!> the scatter map into the full pattern. damping_time: the Kelvin-Voigt retardation time
-!> (s; 0: no material damping). info = 2 also for a negative damping_time.
+!> the scatter map into the full pattern.
 subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference, frame, &
-                              damping_time, index, info)
+                              damping_time, index, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_ffr
+  use element_sets, only: element_set
+  use ffr_elastic, only: ffr_set
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nel, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), damping_time
   integer, intent(out) :: index, info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(ffr_set) :: built
   index = 0
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. frame < 1 .or. &
       .not. (damping_time >= 0.0_dp)) then
     info = 2
+    message = 'system_add_ffr_set: an element dof outside 1..nfull, a' // &
+              ' frame < 1 or a negative damping_time'
     return
   end if
-  set%kind = set_ffr
-  set%nel = nel
-  set%nde = 24
-  set%frame = frame
-  set%dofs = dofs
-  set%scatter = scatter
-  set%stiffness0 = stiffness0
-  set%reference = reference
-  set%damping_time = damping_time
+  built%nel = nel
+  built%nde = 24
+  built%frame = frame
+  built%dofs = dofs
+  built%scatter = scatter
+  built%stiffness0 = stiffness0
+  built%reference = reference
+  built%damping_time = damping_time
+  allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_ffr_set
 
@@ -106,138 +136,221 @@ end subroutine system_add_ffr_set
 !> correction [c, d_y, d_z].
 subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, gradients, &
                                     weights, youngs, poisson, shear_scales, frame, damping_time, &
-                                    index, info)
+                                    index, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_continuum
+  use element_sets, only: element_set
+  use beam_nonlinear, only: continuum_set
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nel, npts, nvolume, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
   real(dp), intent(in) :: shear_scales(3), damping_time
   integer, intent(out) :: index, info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(continuum_set) :: built
   index = 0
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
-  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
-    info = 2
+  if (info /= 0) then
+    message = handle_text(handle)
     return
   end if
-  set%kind = set_continuum
-  set%nel = nel
-  set%nde = 24
-  set%frame = frame
-  set%dofs = dofs
-  set%scatter = scatter
-  set%volume_points = nvolume
-  set%gradients = gradients
-  set%weights = weights
-  set%youngs = youngs
-  set%poisson = poisson
-  set%shear_scales = shear_scales
-  set%damping_time = damping_time
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
+    info = 2
+    message = 'system_add_continuum_set: an element dof outside 1..nfull or a negative damping_time'
+    return
+  end if
+  built%nel = nel
+  built%nde = 24
+  built%frame = frame
+  built%dofs = dofs
+  built%scatter = scatter
+  built%volume_points = nvolume
+  built%gradients = gradients
+  built%weights = weights
+  built%youngs = youngs
+  built%poisson = poisson
+  built%shear_scales = shear_scales
+  built%damping_time = damping_time
+  built%force_cost = 1.2d0
+  built%tangent_cost = 15.0d0
+  allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_continuum_set
 
-!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural);
-!> damping_time as system_add_ffr_set.
-subroutine system_add_structural_set(handle, nel, nterms, dofs, scatter, forms, strain0, &
-                                     stiffness, frame, damping_time, index, info)
+!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural).
+subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strain0, &
+                                stiffness, frame, damping_time, index, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_structural
-  use beam_structural, only: structural_pattern, structural_terms
+  use element_sets, only: element_set
+  use beam_structural, only: cubic_set, structural_pattern, structural_terms
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nel, nterms, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
   real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(cubic_set) :: built
   index = 0
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp) .or. &
       nterms /= structural_terms) then
     info = 2
+    message = 'system_add_cubic_set: an element dof outside 1..nfull, a' // &
+              ' negative damping_time or nterms wrong'
     return
   end if
-  set%kind = set_structural
-  set%nel = nel
-  set%nde = 24
-  set%frame = frame
-  set%dofs = dofs
-  set%scatter = scatter
-  set%forms = forms
-  set%strain0 = strain0
-  set%term_stiffness = stiffness
-  allocate (set%form_pairs(2, 64, nterms), set%form_npairs(nterms))
-  call structural_pattern(forms, set%form_pairs, set%form_npairs)
-  set%damping_time = damping_time
+  built%nel = nel
+  built%nde = 24
+  built%frame = frame
+  built%dofs = dofs
+  built%scatter = scatter
+  built%forms = forms
+  built%strain0 = strain0
+  built%term_stiffness = stiffness
+  allocate (built%form_pairs(2, 64, nterms), built%form_npairs(nterms))
+  call structural_pattern(forms, built%form_pairs, built%form_npairs)
+  built%damping_time = damping_time
+  built%force_cost = 1.2d0
+  built%tangent_cost = 3.0d0
+  allocate (set, source=built)
   call append_set(sys, set, index)
-end subroutine system_add_structural_set
+end subroutine system_add_cubic_set
 
-!> Thin plate elements (plate_element): reference data at npts Gauss points; damping_time
-!> as system_add_ffr_set.
+!> Thin plate elements (plate_element): reference data at npts Gauss points.
 subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_frame, curvature0, &
-                                weights, youngs, poisson, thickness, damping_time, index, info)
+                                weights, youngs, poisson, thickness, damping_time, index, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
-  use element_sets, only: element_set, set_plate
+  use element_sets, only: element_set
+  use plate_element, only: plate_set
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nel, npts, dofs(36, nel), scatter(36, 36, nel)
   real(dp), intent(in) :: derivs(12, 5, npts, nel), plate_frame(2, 2, npts, nel)
   real(dp), intent(in) :: curvature0(3, npts, nel), weights(npts, nel), youngs, poisson, thickness
   real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(element_set) :: set
+  class(element_set), allocatable :: set
+  type(plate_set) :: built
   index = 0
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
-  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
-    info = 2
+  if (info /= 0) then
+    message = handle_text(handle)
     return
   end if
-  set%kind = set_plate
-  set%nel = nel
-  set%nde = 36
-  set%dofs = dofs
-  set%scatter = scatter
-  set%derivs = derivs
-  set%plate_frame = plate_frame
-  set%curvature0 = curvature0
-  set%weights = weights
-  set%youngs = youngs
-  set%poisson = poisson
-  set%thickness = thickness
-  set%damping_time = damping_time
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
+    info = 2
+    message = 'system_add_plate_set: an element dof outside 1..nfull or a negative damping_time'
+    return
+  end if
+  built%nel = nel
+  built%nde = 36
+  built%dofs = dofs
+  built%scatter = scatter
+  built%derivs = derivs
+  built%plate_frame = plate_frame
+  built%curvature0 = curvature0
+  built%weights = weights
+  built%youngs = youngs
+  built%poisson = poisson
+  built%thickness = thickness
+  built%damping_time = damping_time
+  built%force_cost = 6.0d0
+  built%tangent_cost = 80.0d0
+  allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_plate_set
 
+!> ANCF cable elements (cable_element): element lengths and the section's EA and EI.
+!> damping_time must be 0 (the family has no material damping; info = 2 otherwise).
+subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiffness, &
+                                bending_stiffness, damping_time, index, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, append_set
+  use element_sets, only: element_set
+  use cable_element, only: cable_set
+  use system_store, only: store_get
+  use kernel_errors, only: handle_text
+  implicit none
+  integer, intent(in) :: handle, nel, dofs(12, nel), scatter(12, 12, nel)
+  real(dp), intent(in) :: lengths(nel), axial_stiffness, bending_stiffness, damping_time
+  integer, intent(out) :: index, info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  class(element_set), allocatable :: set
+  type(cable_set) :: built
+  index = 0
+  message = ' '
+  call store_get(handle, sys, info)
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. damping_time /= 0.0_dp .or. &
+      any(lengths <= 0.0_dp)) then
+    info = 2
+    message = 'system_add_cable_set: an element dof outside 1..nfull, a' // &
+              ' non-positive element length or a damping_time (cables have none)'
+    return
+  end if
+  built%nel = nel
+  built%nde = 12
+  built%dofs = dofs
+  built%scatter = scatter
+  built%lengths = lengths
+  built%axial_stiffness = axial_stiffness
+  built%bending_stiffness = bending_stiffness
+  built%force_cost = 0.5d0
+  built%tangent_cost = 2.0d0
+  allocate (set, source=built)
+  call append_set(sys, set, index)
+end subroutine system_add_cable_set
+
 !> Floating frames A_f(t) = Rot(axis_f, phi_d(t)) base_f about pivot_f (drive 0: fixed).
-subroutine system_set_frames(handle, nframe, drives, axes, bases, pivots, info)
+subroutine system_set_frames(handle, nframe, drives, axes, bases, pivots, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nframe, drives(max(1, nframe))
   real(dp), intent(in) :: axes(3, max(1, nframe)), bases(3, 3, max(1, nframe))
   real(dp), intent(in) :: pivots(3, max(1, nframe))
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   integer :: f
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   deallocate (sys%frames)
   allocate (sys%frames(nframe))
   do f = 1, nframe
     if (drives(f) /= 0 .and. norm2(axes(:, f)) == 0.0_dp) then
       info = 2
+      message = 'system_set_frames: a driven frame with a zero axis'
       return
     end if
     sys%frames(f)%drive = drives(f)
@@ -249,19 +362,26 @@ end subroutine system_set_frames
 
 !> Drives (drives module): kinds and the packed parameters of drive d at
 !> data(ptr(d):ptr(d+1)-1).
-subroutine system_set_drives(handle, ndrive, ndata, kinds, ptr, data, info)
+subroutine system_set_drives(handle, ndrive, ndata, kinds, ptr, data, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, ndrive, ndata, kinds(max(1, ndrive)), ptr(ndrive + 1)
   real(dp), intent(in) :: data(max(1, ndata))
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (ptr(1) /= 1 .or. ptr(ndrive + 1) /= ndata + 1) then
     info = 2
+    message = 'system_set_drives: drive pointers inconsistent with ndata'
     return
   end if
   sys%drive_kinds = kinds(1:ndrive)
@@ -277,10 +397,11 @@ end subroutine system_set_drives
 subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_values, &
                                nfull, nnz_full, full_row_ptr, full_col, solver_handle, policy, &
                                nnz_pattern, mass_pattern, nvec, vector_frame, nblock, block_first, &
-                               info)
+                               info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, ndof, nnz_mass, mass_row_ptr(ndof + 1), mass_col(nnz_mass)
   real(dp), intent(in) :: mass_values(nnz_mass)
@@ -289,11 +410,18 @@ subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, m
   real(dp), intent(in) :: mass_pattern(nnz_pattern)
   integer, intent(in) :: vector_frame(max(1, nvec)), block_first(max(1, nblock))
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (ndof /= sys%ndof .or. nfull /= sys%nfull) then
     info = 2
+    message = 'system_set_matrices: sizes inconsistent with the system' // &
+              ' (ndof, nfull) or the solver pattern'
     return
   end if
   sys%mass_row_ptr = mass_row_ptr
@@ -319,19 +447,26 @@ end subroutine system_set_matrices
 
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),
 !> replacing the CSR of system_set_matrices in products (a ninth of the entries).
-subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info)
+subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nvec, nnz, row_ptr(nvec + 1), col(nnz)
   real(dp), intent(in) :: values(nnz)
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (3 * nvec /= sys%ndof .or. any(col < 1) .or. any(col > nvec)) then
     info = 2
+    message = 'system_set_kron_mass: sizes inconsistent with the system (3 nvec /= ndof)'
     return
   end if
   sys%mass_row_ptr = row_ptr
@@ -343,21 +478,28 @@ end subroutine system_set_kron_mass
 !> q = B e + q0 (B CSR over nfull rows, 1-based) and the plan of B^T S B: values(target)
 !> += coef * full_values(source).
 subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, offset, nplan, &
-                                plan_source, plan_target, plan_coef, info)
+                                plan_source, plan_target, plan_coef, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nfull, nnz_b, b_ptr(nfull + 1), b_col(max(1, nnz_b)), nplan
   real(dp), intent(in) :: b_values(max(1, nnz_b)), offset(nfull)
   integer, intent(in) :: plan_source(max(1, nplan)), plan_target(max(1, nplan))
   real(dp), intent(in) :: plan_coef(max(1, nplan))
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (nfull /= sys%nfull) then
     info = 2
+    message = 'system_set_reduction: sizes inconsistent with the system (nfull)'
     return
   end if
   sys%reduced = .true.
@@ -375,10 +517,11 @@ end subroutine system_set_reduction
 !> t = 0 for the potential).
 subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, force_vectors, &
                             nmoment, moment_dofs, moment_axis, moment_magnitude, moment_reference, &
-                            info)
+                            info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, ndof, nforce, nmoment
   real(dp), intent(in) :: constant_force(ndof), force_vectors(ndof, max(1, nforce))
@@ -386,16 +529,25 @@ subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, f
   real(dp), intent(in) :: moment_axis(3, max(1, nmoment)), moment_magnitude(max(1, nmoment))
   real(dp), intent(in) :: moment_reference(3, max(1, nmoment))
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (ndof /= sys%ndof) then
     info = 2
+    message = 'system_set_loads: sizes inconsistent with the system (ndof)' // &
+              ' or a drive index out of range'
     return
   end if
   if (nmoment > 0) then
     if (any(moment_dofs(:, 1:nmoment) < 1) .or. any(moment_dofs(:, 1:nmoment) > sys%nfull)) then
       info = 2
+      message = 'system_set_loads: sizes inconsistent with the system (ndof)' // &
+                ' or a drive index out of range'
       return
     end if
   end if
@@ -456,10 +608,11 @@ end subroutine system_set_vector_loads
 !> Constraints with multipliers, in the constraints module's layout over the independent
 !> coordinates.
 subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, operand_const, &
-                                  term_ptr, term_dof, term_coef, info)
+                                  term_ptr, term_dof, term_coef, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, ncon, nterm
   integer, intent(in) :: kinds(max(1, ncon)), drives(max(1, ncon)), term_ptr(6 * ncon + 1)
@@ -467,16 +620,23 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
   real(dp), intent(in) :: params(8, max(1, ncon)), operand_const(6, max(1, ncon))
   real(dp), intent(in) :: term_coef(max(1, nterm))
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (term_ptr(6 * ncon + 1) /= nterm + 1) then
     info = 2
+    message = 'system_set_constraints: term pointers or dofs inconsistent with the system'
     return
   end if
   if (nterm > 0) then
     if (any(term_dof(1:nterm) < 1) .or. any(term_dof(1:nterm) > sys%ndof)) then
       info = 2
+      message = 'system_set_constraints: term pointers or dofs inconsistent with the system'
       return
     end if
   end if
@@ -494,23 +654,30 @@ end subroutine system_set_constraints
 !> sizes), the grid of the searched surface and the points (element column, local xi, eta),
 !> with the contact parameters.
 subroutine system_add_contact_pair(handle, nel, dofs, sizes, ngrid_l, ngrid_w, grid, npoint, &
-                                   point_element, point_local, params, info)
+                                   point_element, point_local, params, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_pair
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nel, dofs(36, nel), ngrid_l, ngrid_w, grid(ngrid_l, ngrid_w)
   integer, intent(in) :: npoint, point_element(npoint)
   real(dp), intent(in) :: sizes(2, nel), point_local(2, npoint), params(8)
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(contact_pair), allocatable :: grown(:)
   integer :: n
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. any(grid < 1) .or. any(grid > nel) .or. &
       any(point_element < 1) .or. any(point_element > nel)) then
     info = 2
+    message = 'system_add_contact_pair: dofs outside 1..nfull or inconsistent contact sizes'
     return
   end if
   n = size(sys%pairs)
@@ -531,27 +698,35 @@ end subroutine system_add_contact_pair
 
 !> Probes: positions sum_k coef_k q(dof_k:dof_k+2) over the terms ptr(p):ptr(p+1)-1, the
 !> frame their deflections are resolved in (0: global) and the rigid position in it.
-subroutine system_set_probes(handle, nprobe, nterm, ptr, dofs, coefs, frames, reference, info)
+subroutine system_set_probes(handle, nprobe, nterm, ptr, dofs, coefs, frames, reference, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
   integer, intent(in) :: handle, nprobe, nterm, ptr(nprobe + 1), dofs(max(1, nterm))
   integer, intent(in) :: frames(max(1, nprobe))
   real(dp), intent(in) :: coefs(max(1, nterm)), reference(3, max(1, nprobe))
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (nterm > 0) then
     if (any(dofs(1:nterm) < 1) .or. any(dofs(1:nterm) + 2 > sys%nfull)) then
       info = 2
+      message = 'system_set_probes: probe pointers, dofs or frames inconsistent with the system'
       return
     end if
   end if
   if (nprobe > 0) then
     if (any(frames(1:nprobe) < 0) .or. any(frames(1:nprobe) > size(sys%frames))) then
       info = 2
+      message = 'system_set_probes: probe pointers, dofs or frames inconsistent with the system'
       return
     end if
   end if
@@ -572,11 +747,12 @@ end subroutine system_set_probes
 !> stepper's (5 drive, 6 moment, 7 plate normal, 8 contact search).
 subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velocity_factor, &
                            want_tangent, guesses, counts, internal, external, strain, &
-                           contact_potential, records, tangent, info)
+                           contact_potential, records, tangent, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
                                external_forces
   use system_store, only: store_get
+  use kernel_errors, only: handle_text, failure_text
   implicit none
   integer, intent(in) :: handle, ndof, nnz, npoint, want_tangent
   real(dp), intent(in) :: t, e(ndof), v(ndof), load_factor, velocity_factor
@@ -586,20 +762,30 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velo
   real(dp), intent(out) :: internal(ndof), external(ndof), strain, contact_potential
   real(dp), intent(out) :: records(6, max(1, npoint)), tangent(nnz)
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(contact_state) :: state
   real(dp), allocatable :: rotations(:, :, :), rates(:)
   real(dp) :: powers(2)
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (ndof /= sys%ndof .or. npoint /= sys%npoint .or. (want_tangent /= 0 .and. &
       nnz /= size(sys%mass_pattern))) then
     info = 2
+    message = 'system_evaluate: sizes inconsistent with the system (ndof,' // &
+              ' npoint, or nnz of the tangent)'
     return
   end if
   allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)))
   call frame_rotations(sys, t, rotations, rates, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = failure_text(info)
+    return
+  end if
   state%guesses = guesses
   state%counts = counts
   records = 0.0_dp
@@ -612,7 +798,10 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velo
     call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
                          strain, contact_potential, powers, records, info, rates=rates)
   end if
-  if (info /= 0) return
+  if (info /= 0) then
+    message = failure_text(info)
+    return
+  end if
   call external_forces(sys, t, load_factor, external, info, e)
   guesses = state%guesses
   counts = state%counts
@@ -656,11 +845,12 @@ end subroutine system_full_forces
 !> One output row (probes, deflections, energies, constraint violation, contact records)
 !> of the state (t, e, e', lambda) with the accumulated works.
 subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, work, guesses, &
-                             counts, probe, deflection, energy, violation, records, powers, info)
+                             counts, probe, deflection, energy, violation, records, powers, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, power_count, energy_count
   use time_integrator, only: output_row
   use system_store, only: store_get
+  use kernel_errors, only: handle_text, failure_text
   implicit none
   integer, intent(in) :: handle, ndof, ncon, nprobe, npoint
   real(dp), intent(in) :: t, e(ndof), v(ndof), lam(max(1, ncon)), work(5)
@@ -670,14 +860,20 @@ subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, w
   real(dp), intent(out) :: probe(3, max(1, nprobe)), deflection(3, max(1, nprobe)), energy(11)
   real(dp), intent(out) :: violation, records(6, max(1, npoint)), powers(5)
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(contact_state) :: state
   powers = 0.0_dp
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. nprobe /= sys%nprobe .or. &
       npoint /= sys%npoint .or. power_count /= 5 .or. energy_count /= 11) then
     info = 2
+    message = 'system_output_row: sizes inconsistent with the system (ndof, ncon, nprobe, npoint)'
     return
   end if
   state%guesses = guesses
@@ -689,6 +885,7 @@ subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, w
                   deflection(:, 1:nprobe), energy, violation, records(:, 1:npoint), powers, info)
   guesses = state%guesses
   counts = state%counts
+  if (info /= 0) message = failure_text(info)
 end subroutine system_output_row
 
 !> Advances nsteps steps of the generalized-alpha method (time_integrator), one output row

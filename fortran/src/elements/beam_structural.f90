@@ -26,7 +26,7 @@
 !> with its torsion and shear correction, so the two options differ in the bending
 !> interpolation only.
 !>
-!> Kelvin-Voigt material damping (retardation time tau, structural_element_damped) acts on
+!> Kelvin-Voigt material damping (retardation time tau, structural_element given the rates) acts on
 !> every strain: s -> s + tau s' with s' = q' . C q, so Q_d = sum_terms k tau s' C q, the
 !> dissipated power sum k tau s'^2 >= 0 (a rigid motion leaves every s' at zero), and the
 !> tangent dQ/dq + c dQ/dq' = sum k ((1 + c tau) g g^T + tau g (C q')^T + (s + tau s') C x I3)
@@ -34,15 +34,26 @@
 module beam_structural
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
+  use element_sets, only: local_element_set
   implicit none
   private
-  public :: structural_setup, structural_element, structural_element_damped, structural_pattern
+  public :: structural_setup, structural_element, structural_pattern, cubic_set
 
   !> Axial points of the axial and bending strains, of the torsion.
   integer, parameter :: n_line = 3, n_axial = 3, n_torsion = 2
   !> Nodal terms per node: shear y, shear z, section yy, zz, yz.
   integer, parameter :: n_nodal = 5
   integer, parameter, public :: structural_terms = 2 * n_line + n_axial + n_torsion + 2 * n_nodal
+
+  !> The family's element set (element_sets): strain forms (8, 8, nterms, nel), reference
+  !> strains and stiffnesses (nterms, nel), and the forms' nonzero entries
+  !> (structural_pattern): (2, 64, nterms), (nterms).
+  type, extends(local_element_set) :: cubic_set
+    real(dp), allocatable :: forms(:, :, :, :), strain0(:, :), term_stiffness(:, :)
+    integer, allocatable :: form_pairs(:, :, :), form_npairs(:)
+  contains
+    procedure :: element_forces => cubic_element_forces
+  end type cubic_set
 
 contains
 
@@ -182,8 +193,34 @@ contains
   !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
   !> one element with nodal vectors q(3, 8). With the set's pattern (structural_pattern)
   !> the gradients C q run over the forms' nonzero entries only.
+  !> With Kelvin-Voigt damping (the nodal rates q'(3, 8), damping_time tau > 0, rate_factor
+  !> and dissipation all present): the force includes the damping force, dissipation is its
+  !> power and the tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric:
+  !> whole columns, and the gradients from the full forms). (The two term loops stay apart,
+  !> as in beam_nonlinear: one loop behind a flag compiles to a slower undamped force.)
   pure subroutine structural_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
-                                     tangent, pairs, npairs)
+                                     tangent, pairs, npairs, rates, damping_time, rate_factor, &
+                                     dissipation)
+    real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
+    real(dp), intent(in) :: stiffness(structural_terms)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), energy, tangent(24, 24)
+    integer, intent(in), optional :: pairs(2, 64, structural_terms), npairs(structural_terms)
+    real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
+    real(dp), intent(out), optional :: dissipation
+    if (present(rates)) then
+      call damped_terms(q, rates, forms, strain0, stiffness, damping_time, rate_factor, &
+                        want_tangent, force, energy, dissipation, tangent)
+    else
+      call elastic_terms(q, forms, strain0, stiffness, want_tangent, force, energy, tangent, &
+                         pairs, npairs)
+    end if
+  end subroutine structural_element
+
+  !> structural_element without damping (its loop over the strain terms). With the set's pattern (structural_pattern)
+  !> the gradients C q run over the forms' nonzero entries only.
+  pure subroutine elastic_terms(q, forms, strain0, stiffness, want_tangent, force, energy, &
+                                tangent, pairs, npairs)
     real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
     real(dp), intent(in) :: stiffness(structural_terms)
     logical, intent(in) :: want_tangent
@@ -224,12 +261,12 @@ contains
     do j = 2, 24
       tangent(1:j - 1, j) = tangent(j, 1:j - 1)
     end do
-  end subroutine structural_element
+  end subroutine elastic_terms
 
   !> structural_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
-  !> q'(3, 8): the force includes the damping force, dissipation is its power and the
+  !> q'(3, 8) (its loop over the strain terms): the force includes the damping force, dissipation is its power and the
   !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
-  pure subroutine structural_element_damped(q, rates, forms, strain0, stiffness, damping_time, &
+  pure subroutine damped_terms(q, rates, forms, strain0, stiffness, damping_time, &
                                             rate_factor, want_tangent, force, energy, &
                                             dissipation, tangent)
     real(dp), intent(in) :: q(3, 8), rates(3, 8), forms(8, 8, structural_terms)
@@ -270,7 +307,31 @@ contains
     end do
     if (.not. want_tangent) return
     call add_kron_identity(geometric, tangent)
-  end subroutine structural_element_damped
+  end subroutine damped_terms
+
+  !> The element_set element_forces of a cubic set: structural_element of element el.
+  pure subroutine cubic_element_forces(set, el, coords, want_tangent, force, energy, tangent, &
+                                       info, rates, rate_factor, dissipation)
+    class(cubic_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords(:, :)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), energy, tangent(:, :)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(:, :), rate_factor
+    real(dp), intent(out), optional :: dissipation
+    info = 0
+    if (present(rates)) then
+      call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
+                              set%term_stiffness(:, el), want_tangent, force, energy, tangent, &
+                              rates=rates, damping_time=set%damping_time, &
+                              rate_factor=rate_factor, dissipation=dissipation)
+    else
+      call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
+                              set%term_stiffness(:, el), want_tangent, force, energy, tangent, &
+                              set%form_pairs, set%form_npairs)
+    end if
+  end subroutine cubic_element_forces
 
   !> tangent += kron(geometric, I3): an (8, 8) form acting alike on the three components.
   pure subroutine add_kron_identity(geometric, tangent)

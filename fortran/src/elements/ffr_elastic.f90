@@ -15,11 +15,23 @@
 !> zero for a rigid motion. dQ_d/de' = tau T K0 T^T, dQ_d/de = -tau T K0 T^T [omega]x per
 !> vector (= -tau T K0 [omega_l]x T^T): the combined tangent block of a pair of nodal
 !> vectors is A K0_ab ((1 + c tau) I - tau [omega_l]x) A^T.
+!>
+!> ffr_set: the family's element set (element_sets), the elements of one body in its frame.
 module ffr_elastic
   use ancf_kinds, only: dp
+  use element_sets, only: element_set, frame_omega, scatter_add
   implicit none
   private
-  public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_damped_force, ffr_damped_stiffness
+  public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_set
+
+  !> ANCF-FFR beam elements: K0 (24, 24, nel) and the rigid configuration in the body's
+  !> floating frame (24, nel).
+  type, extends(element_set) :: ffr_set
+    real(dp), allocatable :: stiffness0(:, :, :), reference(:, :)
+  contains
+    procedure :: forces => ffr_set_forces
+    procedure :: energy_power => ffr_set_energy_power
+  end type ffr_set
 
 contains
 
@@ -58,46 +70,34 @@ contains
     end do
   end function frame_rate
 
-  !> Adds the global elastic plus Kelvin-Voigt damping force T K0 (u + tau x') to force and
-  !> returns the strain energy and the dissipated power tau x'^T K0 x' (v: the coordinate
-  !> rates, omega_local: the frame's angular velocity in the frame).
-  pure subroutine ffr_damped_force(nel, dofs, stiffness0, reference, rotation, omega_local, &
-                                   damping_time, e, v, force, energy, dissipation)
-    integer, intent(in) :: nel, dofs(24, nel)
-    real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), rotation(3, 3)
-    real(dp), intent(in) :: omega_local(3), damping_time, e(:), v(:)
-    real(dp), intent(inout) :: force(:)
-    real(dp), intent(out) :: energy, dissipation
-    real(dp) :: local_disp(24), local_rate(24), local_force(24), damping_force(24)
-    integer :: el
-    energy = 0.0_dp
-    dissipation = 0.0_dp
-    do el = 1, nel
-      local_disp = frame_displacement(rotation, e, dofs(:, el), reference(:, el))
-      local_rate = frame_rate(rotation, omega_local, e, v, dofs(:, el))
-      local_force = matmul(stiffness0(:, :, el), local_disp)
-      damping_force = damping_time * matmul(stiffness0(:, :, el), local_rate)
-      energy = energy + 0.5_dp * dot_product(local_disp, local_force)
-      dissipation = dissipation + dot_product(local_rate, damping_force)
-      local_force = local_force + damping_force
-      call add_global_force(rotation, local_force, dofs(:, el), force)
-    end do
-  end subroutine ffr_damped_force
-
   !> Adds the global elastic force to force and returns the strain energy; dofs(24, nel)
-  !> are 1-based indices into e and force.
-  pure subroutine ffr_force(nel, dofs, stiffness0, reference, rotation, e, force, energy)
+  !> are 1-based indices into e and force. With the coordinate rates v (and omega_local,
+  !> the frame's angular velocity in the frame, and damping_time tau > 0) the Kelvin-Voigt
+  !> damping force too: T K0 (u + tau x'), and dissipation returns tau x'^T K0 x'.
+  pure subroutine ffr_force(nel, dofs, stiffness0, reference, rotation, e, force, energy, v, &
+                            omega_local, damping_time, dissipation)
     integer, intent(in) :: nel, dofs(24, nel)
     real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), rotation(3, 3), e(:)
     real(dp), intent(inout) :: force(:)
     real(dp), intent(out) :: energy
-    real(dp) :: local_disp(24), local_force(24)
+    real(dp), intent(in), optional :: v(:), omega_local(3), damping_time
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: local_disp(24), local_force(24), local_rate(24), damping_force(24)
+    logical :: damped
     integer :: el
+    damped = present(v)
     energy = 0.0_dp
+    if (present(dissipation)) dissipation = 0.0_dp
     do el = 1, nel
       local_disp = frame_displacement(rotation, e, dofs(:, el), reference(:, el))
       local_force = matmul(stiffness0(:, :, el), local_disp)
       energy = energy + 0.5_dp * dot_product(local_disp, local_force)
+      if (damped) then
+        local_rate = frame_rate(rotation, omega_local, e, v, dofs(:, el))
+        damping_force = damping_time * matmul(stiffness0(:, :, el), local_rate)
+        dissipation = dissipation + dot_product(local_rate, damping_force)
+        local_force = local_force + damping_force
+      end if
       call add_global_force(rotation, local_force, dofs(:, el), force)
     end do
   end subroutine ffr_force
@@ -151,51 +151,40 @@ contains
     end do
   end subroutine ffr_energy_power
 
-  !> Combined element tangents dQ/de + c dQ/de' of the damped FFR elements in the frame
-  !> rotation: blocks A K0_ab ((1 + c tau) I - tau [omega_l]x) A^T (omega_l = 0: the
+  !> Element stiffness matrices in the global frame, T K0 T^T, block by block. Damped
+  !> (damping_time tau > 0 given, with omega_local and rate_factor c): the combined tangents
+  !> dQ/de + c dQ/de', blocks A K0_ab ((1 + c tau) I - tau [omega_l]x) A^T (omega_l = 0: the
   !> stiffness (1 + c tau) T K0 T^T alone).
-  pure subroutine ffr_damped_stiffness(nel, stiffness0, rotation, omega_local, rate_factor, &
-                                       damping_time, stiffness)
+  pure subroutine ffr_stiffness(nel, stiffness0, rotation, stiffness, omega_local, rate_factor, &
+                                damping_time)
     integer, intent(in) :: nel
-    real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3), omega_local(3)
-    real(dp), intent(in) :: rate_factor, damping_time
+    real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3)
     real(dp), intent(out) :: stiffness(24, 24, nel)
+    real(dp), intent(in), optional :: omega_local(3), rate_factor, damping_time
     real(dp) :: right(3, 3), turn(3, 3)
     integer :: el, a, b, i
-    ! right = ((1 + c tau) I - tau [omega_l]x) A^T
-    turn = 0.0_dp
-    turn(2, 1) = omega_local(3)
-    turn(3, 1) = -omega_local(2)
-    turn(1, 2) = -omega_local(3)
-    turn(3, 2) = omega_local(1)
-    turn(1, 3) = omega_local(2)
-    turn(2, 3) = -omega_local(1)
-    turn = -damping_time * turn
-    do i = 1, 3
-      turn(i, i) = turn(i, i) + 1.0_dp + rate_factor * damping_time
-    end do
-    right = matmul(turn, transpose(rotation))
+    if (present(damping_time)) then
+      ! right = ((1 + c tau) I - tau [omega_l]x) A^T
+      turn = 0.0_dp
+      turn(2, 1) = omega_local(3)
+      turn(3, 1) = -omega_local(2)
+      turn(1, 2) = -omega_local(3)
+      turn(3, 2) = omega_local(1)
+      turn(1, 3) = omega_local(2)
+      turn(2, 3) = -omega_local(1)
+      turn = -damping_time * turn
+      do i = 1, 3
+        turn(i, i) = turn(i, i) + 1.0_dp + rate_factor * damping_time
+      end do
+      right = matmul(turn, transpose(rotation))
+    else
+      right = transpose(rotation)
+    end if
     do el = 1, nel
       do b = 0, 7
         do a = 0, 7
           stiffness(3 * a + 1:3 * a + 3, 3 * b + 1:3 * b + 3, el) = matmul(rotation, &
             matmul(stiffness0(3 * a + 1:3 * a + 3, 3 * b + 1:3 * b + 3, el), right))
-        end do
-      end do
-    end do
-  end subroutine ffr_damped_stiffness
-
-  !> Element stiffness matrices in the global frame, T K0 T^T, block by block.
-  pure subroutine ffr_stiffness(nel, stiffness0, rotation, stiffness)
-    integer, intent(in) :: nel
-    real(dp), intent(in) :: stiffness0(24, 24, nel), rotation(3, 3)
-    real(dp), intent(out) :: stiffness(24, 24, nel)
-    integer :: el, a, b
-    do el = 1, nel
-      do b = 0, 7
-        do a = 0, 7
-          stiffness(3 * a + 1:3 * a + 3, 3 * b + 1:3 * b + 3, el) = matmul(rotation, &
-            matmul(stiffness0(3 * a + 1:3 * a + 3, 3 * b + 1:3 * b + 3, el), transpose(rotation)))
         end do
       end do
     end do
@@ -216,5 +205,76 @@ contains
       end do
     end do
   end subroutine add_global_force
+
+  !> The element_set forces of an FFR set: the frame rotation in the force, tangent_rotation
+  !> (default rotation) in the tangents T K0 T^T; damped, the frame's angular velocities.
+  subroutine ffr_set_forces(set, rotation, e, force, energy, info, tangent_values, &
+                            tangent_rotation, v, omega_local, rate_factor, dissipation, &
+                            tangent_omega)
+    class(ffr_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), intent(inout), optional :: tangent_values(:)
+    real(dp), intent(in), optional :: tangent_rotation(3, 3)
+    real(dp), intent(in), optional :: v(:), omega_local(3), rate_factor, tangent_omega(3)
+    real(dp), intent(out), optional :: dissipation
+    real(dp), allocatable :: stiffness(:, :, :)
+    real(dp) :: omega(3), omega_t(3), factor, power, turned(3, 3)
+    logical :: damped
+    info = 0
+    damped = present(v) .and. set%damping_time > 0.0_dp
+    power = 0.0_dp
+    if (damped) then
+      omega = 0.0_dp
+      if (present(omega_local)) omega = omega_local
+      omega_t = omega
+      if (present(tangent_omega)) omega_t = tangent_omega
+      factor = 0.0_dp
+      if (present(rate_factor)) factor = rate_factor
+      call ffr_force(set%nel, set%dofs, set%stiffness0, set%reference, rotation, e, force, &
+                     energy, v, omega, set%damping_time, power)
+    else
+      call ffr_force(set%nel, set%dofs, set%stiffness0, set%reference, rotation, e, force, &
+                     energy)
+    end if
+    if (present(tangent_values)) then
+      turned = rotation
+      if (present(tangent_rotation)) turned = tangent_rotation
+      allocate (stiffness(24, 24, set%nel))
+      if (damped) then
+        call ffr_stiffness(set%nel, set%stiffness0, turned, stiffness, omega_t, factor, &
+                           set%damping_time)
+      else
+        call ffr_stiffness(set%nel, set%stiffness0, turned, stiffness)
+      end if
+      call scatter_add(set, stiffness, tangent_values)
+    end if
+    if (present(dissipation)) dissipation = power
+  end subroutine ffr_set_forces
+
+  !> The element_set energy_power of an FFR set: ffr_energy_power (the frame's power).
+  subroutine ffr_set_energy_power(set, rotation, axis, rate, e, energy, power, info, v, &
+                                  dissipation)
+    class(ffr_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), axis(3), rate, e(:)
+    real(dp), intent(out) :: energy, power
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:)
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: power_lost
+    info = 0
+    power_lost = 0.0_dp
+    if (present(v) .and. set%damping_time > 0.0_dp) then
+      call ffr_energy_power(set%nel, set%dofs, set%stiffness0, set%reference, rotation, &
+                            axis, rate, e, energy, power, v, &
+                            frame_omega(rotation, axis, rate), set%damping_time, power_lost)
+    else
+      call ffr_energy_power(set%nel, set%dofs, set%stiffness0, set%reference, rotation, &
+                            axis, rate, e, energy, power)
+    end if
+    if (present(dissipation)) dissipation = power_lost
+  end subroutine ffr_set_energy_power
 
 end module ffr_elastic

@@ -27,7 +27,7 @@
 !> z = (r_x, r_y, r_xx, r_yy, r_xy); its gradient and Hessian with respect to z are
 !> analytic, and Q = sum_A dS_A^T dW/dz_A, K_t = sum_AB dS_A^T d2W/dz_A dz_B dS_B.
 !>
-!> Kelvin-Voigt material damping (retardation time tau, plate_forces_damped): the membrane
+!> Kelvin-Voigt material damping (retardation time tau, plate_forces given the rates): the membrane
 !> stress and the bending moment become D (eps + tau eps') and D (kappa + tau kappa'), with
 !> the rates eps' = (d eps/dz) z' and kappa' = (d kappa/dz) z' of the field rates z'
 !> (objective: a rigid motion leaves both at zero). Writing s = (eps, kappa) and J = ds/dz,
@@ -40,16 +40,27 @@ module plate_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
   use matrix3, only: cross, skew
+  use element_sets, only: local_element_set
   implicit none
   private
   public :: plate_shape, plate_mass, plate_surface_load, plate_setup, plate_forces, &
-            plate_curvatures, plate_forces_damped
+            plate_curvatures, plate_set
 
   integer, parameter, public :: plate_shapes = 12, plate_dofs = 36, plate_fields = 5
   integer, parameter, public :: plate_variant_plain = 0, plate_variant_completed = 1
   !> Gauss points per direction of the elastic, mass and load integrals.
   integer, parameter, public :: plate_gauss_1d = 4
   integer, parameter, public :: plate_points = plate_gauss_1d * plate_gauss_1d
+
+  !> The family's element set (element_sets): shape derivatives (12, 5, npts, nel), frame
+  !> maps (2, 2, npts, nel), reference curvatures (3, npts, nel), weights (npts, nel).
+  type, extends(local_element_set) :: plate_set
+    real(dp), allocatable :: derivs(:, :, :, :), plate_frame(:, :, :, :), curvature0(:, :, :)
+    real(dp), allocatable :: weights(:, :)
+    real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp, thickness = 0.0_dp
+  contains
+    procedure :: element_forces => plate_element_forces
+  end type plate_set
   !> Field indices of z: r_x, r_y, r_xx, r_yy, r_xy.
   integer, parameter :: f_x = 1, f_y = 2, f_xx = 3, f_yy = 4, f_xy = 5
 
@@ -318,8 +329,36 @@ contains
   !> Elastic force (36), strain energy and, on request, tangent (36 x 36) of one element at
   !> coordinates (3, 12), from the reference data of plate_setup. info = 2: the normal
   !> vanished (a degenerate configuration).
+  !> With Kelvin-Voigt damping (the coordinate rates (3, 12), damping_time tau > 0,
+  !> rate_factor and dissipation all present): the force includes the damping force,
+  !> dissipation is its power and the tangent (when want_tangent) the combined dQ/dq +
+  !> rate_factor dQ/dq', both triangles (it is not symmetric). (The two point loops stay
+  !> apart, as in beam_nonlinear: one loop behind a flag compiles to a slower undamped force.)
   pure subroutine plate_forces(coords, derivs, frame, curvature0, weights, youngs, poisson, &
-                               thickness, want_tangent, force, energy, tangent, info)
+                               thickness, want_tangent, force, energy, tangent, info, rates, &
+                               damping_time, rate_factor, dissipation)
+    real(dp), intent(in) :: coords(3, plate_shapes)
+    real(dp), intent(in) :: derivs(plate_shapes, plate_fields, plate_points)
+    real(dp), intent(in) :: frame(2, 2, plate_points), curvature0(3, plate_points)
+    real(dp), intent(in) :: weights(plate_points), youngs, poisson, thickness
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(plate_dofs), energy, tangent(plate_dofs, plate_dofs)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(3, plate_shapes), damping_time, rate_factor
+    real(dp), intent(out), optional :: dissipation
+    if (present(rates)) then
+      call damped_points(coords, rates, derivs, frame, curvature0, weights, youngs, poisson, &
+                         thickness, damping_time, rate_factor, want_tangent, force, energy, &
+                         dissipation, tangent, info)
+    else
+      call elastic_points(coords, derivs, frame, curvature0, weights, youngs, poisson, &
+                          thickness, want_tangent, force, energy, tangent, info)
+    end if
+  end subroutine plate_forces
+
+  !> plate_forces without damping (its loop over the Gauss points).
+  pure subroutine elastic_points(coords, derivs, frame, curvature0, weights, youngs, poisson, &
+                                 thickness, want_tangent, force, energy, tangent, info)
     real(dp), intent(in) :: coords(3, plate_shapes)
     real(dp), intent(in) :: derivs(plate_shapes, plate_fields, plate_points)
     real(dp), intent(in) :: frame(2, 2, plate_points), curvature0(3, plate_points)
@@ -358,13 +397,13 @@ contains
       end do
     end if
     force = reshape(nodal, [plate_dofs])
-  end subroutine plate_forces
+  end subroutine elastic_points
 
   !> plate_forces with Kelvin-Voigt damping (damping_time tau > 0) at the coordinate rates
-  !> (3, 12): the force includes the damping force, dissipation is its power and the tangent
+  !> (3, 12) (its loop over the Gauss points): the force includes the damping force, dissipation is its power and the tangent
   !> (when want_tangent) the combined dQ/dq + rate_factor dQ/dq', both triangles (it is not
   !> symmetric). info = 2: the normal vanished.
-  pure subroutine plate_forces_damped(coords, rates, derivs, frame, curvature0, weights, youngs, &
+  pure subroutine damped_points(coords, rates, derivs, frame, curvature0, weights, youngs, &
                                       poisson, thickness, damping_time, rate_factor, &
                                       want_tangent, force, energy, dissipation, tangent, info)
     real(dp), intent(in) :: coords(3, plate_shapes), rates(3, plate_shapes)
@@ -405,7 +444,30 @@ contains
       if (want_tangent) call add_point_tangent(hessian, shape_d, weights(p), .false., tangent)
     end do
     force = reshape(nodal, [plate_dofs])
-  end subroutine plate_forces_damped
+  end subroutine damped_points
+
+  !> The element_set element_forces of a plate set: plate_forces of element el.
+  pure subroutine plate_element_forces(set, el, coords, want_tangent, force, energy, tangent, &
+                                       info, rates, rate_factor, dissipation)
+    class(plate_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords(:, :)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), energy, tangent(:, :)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(:, :), rate_factor
+    real(dp), intent(out), optional :: dissipation
+    if (present(rates)) then
+      call plate_forces(coords, set%derivs(:, :, :, el), set%plate_frame(:, :, :, el), &
+                        set%curvature0(:, :, el), set%weights(:, el), set%youngs, set%poisson, &
+                        set%thickness, want_tangent, force, energy, tangent, info, rates, &
+                        set%damping_time, rate_factor, dissipation)
+    else
+      call plate_forces(coords, set%derivs(:, :, :, el), set%plate_frame(:, :, :, el), &
+                        set%curvature0(:, :, el), set%weights(:, el), set%youngs, set%poisson, &
+                        set%thickness, want_tangent, force, energy, tangent, info)
+    end if
+  end subroutine plate_element_forces
 
   !> point_energy with Kelvin-Voigt damping at the field rates z': the elastic energy
   !> density, the dissipated power density, the gradient of the total (elastic plus

@@ -32,7 +32,7 @@
 module mechanical_system
   use ancf_kinds, only: dp
   use constraints, only: constraint_eval, operand_values, drive_value
-  use element_sets, only: element_set, set_forces, set_energy_power, set_ffr, frame_omega
+  use element_sets, only: element_set, set_slot, frame_omega
   use section_moment, only: moment_force, moment_angle
   use vector_loads, only: vector_load_force
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record
@@ -82,7 +82,7 @@ module mechanical_system
 
   type :: system_model
     integer :: ndof = 0, nfull = 0
-    type(element_set), allocatable :: sets(:)
+    type(set_slot), allocatable :: sets(:)             ! element sets of any family
     type(frame_def), allocatable :: frames(:)
     integer, allocatable :: drive_kinds(:), drive_ptr(:)
     real(dp), allocatable :: drive_data(:)
@@ -151,15 +151,19 @@ module mechanical_system
 
 contains
 
-  !> Appends an element set; index: its 1-based position.
+  !> Appends an element set of any family (moved into the system: set is deallocated on
+  !> return); index: its 1-based position. The one append path of every set.
   subroutine append_set(sys, set, index)
     type(system_model), intent(inout) :: sys
-    type(element_set), intent(in) :: set
+    class(element_set), allocatable, intent(inout) :: set
     integer, intent(out) :: index
-    type(element_set), allocatable :: grown(:)
+    type(set_slot), allocatable :: grown(:)
+    integer :: s
     allocate (grown(size(sys%sets) + 1))
-    grown(1:size(sys%sets)) = sys%sets
-    grown(size(grown)) = set
+    do s = 1, size(sys%sets)
+      call move_alloc(sys%sets(s)%item, grown(s)%item)
+    end do
+    call move_alloc(set, grown(size(grown))%item)
     call move_alloc(grown, sys%sets)
     index = size(sys%sets)
   end subroutine append_set
@@ -233,7 +237,7 @@ contains
     integer :: s
     damped_sets = .false.
     do s = 1, size(sys%sets)
-      if (sys%sets(s)%damping_time > 0.0_dp) damped_sets = .true.
+      if (sys%sets(s)%item%damping_time > 0.0_dp) damped_sets = .true.
     end do
   end function damped_sets
 
@@ -368,27 +372,27 @@ contains
       call to_full(sys, v, .false., v_full)
     end if
     do s = 1, size(sys%sets)
-      f = sys%sets(s)%frame
-      if (sys%sets(s)%damping_time > 0.0_dp) then
+      f = sys%sets(s)%item%frame
+      if (sys%sets(s)%item%damping_time > 0.0_dp) then
         rate = 0.0_dp
         if (present(rates)) rate = rates(f)
         tangent_rate = rate
         if (present(tangent_rates)) tangent_rate = tangent_rates(f)
         if (want_tangent) then
-          call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info, &
+          call sys%sets(s)%item%forces(rotations(:, :, f), e_full, full_force, set_energy, info, &
                           values_full, tangent_rotation(:, :, f), v=v_full, &
                           omega_local=set_omega(sys, f, rotations(:, :, f), rate), &
                           rate_factor=velocity_factor, &
                           tangent_omega=set_omega(sys, f, tangent_rotation(:, :, f), tangent_rate))
         else
-          call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info, &
+          call sys%sets(s)%item%forces(rotations(:, :, f), e_full, full_force, set_energy, info, &
                           v=v_full, omega_local=set_omega(sys, f, rotations(:, :, f), rate))
         end if
       else if (want_tangent) then
-        call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info, &
+        call sys%sets(s)%item%forces(rotations(:, :, f), e_full, full_force, set_energy, info, &
                         values_full, tangent_rotation(:, :, f))
       else
-        call set_forces(sys%sets(s), rotations(:, :, f), e_full, full_force, set_energy, info)
+        call sys%sets(s)%item%forces(rotations(:, :, f), e_full, full_force, set_energy, info)
       end if
       if (info /= 0) return
       strain = strain + set_energy
@@ -824,15 +828,15 @@ contains
     end if
     strain = 0.0_dp
     do s = 1, size(sys%sets)
-      f = sys%sets(s)%frame
-      if (sys%sets(s)%damping_time > 0.0_dp) then
+      f = sys%sets(s)%item%frame
+      if (sys%sets(s)%item%damping_time > 0.0_dp) then
         ! the dissipated power is lost (a negative work); an FFR set's frame power includes
         ! that of its damping force
-        call set_energy_power(sys%sets(s), rotations(:, :, f), sys_axis(sys, f), rates(f), &
+        call sys%sets(s)%item%energy_power(rotations(:, :, f), sys_axis(sys, f), rates(f), &
                               e_full, set_energy, set_power, info, v_full, dissipation)
         powers(power_material_damping) = powers(power_material_damping) - dissipation
       else
-        call set_energy_power(sys%sets(s), rotations(:, :, f), sys_axis(sys, f), rates(f), &
+        call sys%sets(s)%item%energy_power(rotations(:, :, f), sys_axis(sys, f), rates(f), &
                               e_full, set_energy, set_power, info)
       end if
       if (info /= 0) return

@@ -34,7 +34,6 @@ def build_model(scene) -> Model:
     model.warnings[:0] = built.warnings
     if built.response is not None:
         model.response = built.response
-    model.kind = scene.kind
     check_ffr_validity(model, built.system)
     if scene.kind == "general":  # deflection relative to the supports' rigid motion
         from ..system.supports import support_frames

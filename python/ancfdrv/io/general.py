@@ -167,6 +167,9 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
                formulation=v["formulation"] or scene["scene"]["formulation"],
                bending=v["bending"], segments=v["segments"], frame_drive=v["frame_drive"],
                frame_axis=v["frame_axis"], frame_pivot=v["frame_pivot"])
+    elif group == "cable":
+        s.cable(v["name"], material=v["material"], start=v["start"], end=v["end"],
+                nodes=v["nodes"], section=_section(v))
     elif group == "plate":
         s.plate(v["name"], material=v["material"], thickness=v["thickness"], corner=v["corner"],
                 edge_x=v["edge_x"], edge_y=v["edge_y"], nx=v["nx"], ny=v["ny"],
@@ -199,7 +202,8 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
 
 
 _ITEM_WORDS = {"joint": "joint", "drive": "drive", "load": "load", "probe": "probe",
-               "contact": "contact", "beam": "beam", "plate": "plate", "leaf": "leaf",
+               "contact": "contact", "beam": "beam", "cable": "cable", "plate": "plate",
+               "leaf": "leaf",
                "rigid body": "rigid_body", "material": "material", "body": None}
 _ITEM_PREFIX = re.compile(r"^(%s) '([^']*)'" % "|".join(_ITEM_WORDS))
 
@@ -219,7 +223,7 @@ def locate_error(exc: InputError, scene) -> InputError:
         if match:
             word, name = match.group(1), re.sub(r" #\d+$", "", match.group(2))
             kinds = [_ITEM_WORDS[word]] if _ITEM_WORDS[word] else \
-                ["beam", "plate", "leaf", "rigid_body"]
+                ["beam", "cable", "plate", "leaf", "rigid_body"]
             group = next((f"{g}[{name}]" for g in kinds if (g, name) in names), None)
         else:
             head = re.sub(r" #\d+$", "", message.split(":", 1)[0])
@@ -232,7 +236,8 @@ def build_general(scene) -> BuiltSystem:
     s = System(scene["scene"]["title"], effects=scene.effects)
     # materials and drives first, then the bodies (numbered in file order), then what refers
     # to them: a scene may list its groups in any order
-    rank = {"material": 0, "drive": 1, "beam": 2, "plate": 2, "leaf": 2, "rigid_body": 2}
+    rank = {"material": 0, "drive": 1, "beam": 2, "cable": 2, "plate": 2, "leaf": 2,
+            "rigid_body": 2}
     order = sorted(scene.items, key=lambda item: rank.get(item[0], 3))
     for group, values in order:
         try:

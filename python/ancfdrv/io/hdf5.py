@@ -226,6 +226,12 @@ def create(path: Path, scene: Scene, model: Model) -> None:
             elements.attrs["description"] = "corner nodes of each element (0-based rows of nodes)"
         if len(beams) == 1:
             _dataset(group, "node_s", beams[0].stations, "m")
+        elif not beams:  # another line family alone (a cable: 6 coordinates per node)
+            lines = [b for b in model.bodies if b.flexible and hasattr(b, "stations")]
+            if len(lines) == 1:
+                _dataset(group, "node_s", lines[0].stations, "m")
+                group.attrs["node_coordinates"] = np.int64(lines[0].ncoordinates
+                                                           // len(lines[0].stations))
         _dataset(group, "e0", model.e0, COORDINATE_UNITS)
         group.attrs["constraint_names"] = "\n".join(model.constraints.names)
         group.attrs["bodies"] = "\n".join(f"{b.name}: {type(b).__name__.lower()}"

@@ -310,9 +310,9 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scen
     for group in GENERAL_SINGLE_GROUPS:
         if group not in values:
             values[group] = {k: s.default for k, s in SCHEMA[group].items()}
-    if not any(g in ("beam", "plate", "leaf", "rigid_body") for g, _ in items):
-        raise InputError("a general scene needs at least one body (&beam, &plate, &leaf or "
-                         "&rigid_body)", file=file)
+    if not any(g in ("beam", "cable", "plate", "leaf", "rigid_body") for g, _ in items):
+        raise InputError("a general scene needs at least one body (&beam, &cable, &plate, "
+                         "&leaf or &rigid_body)", file=file)
     listed = "effects" in nml.get("scene", {})
     buffer = io.StringIO()
     nml.write(buffer)

@@ -434,6 +434,21 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "frame_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the frame's turn"),
         "frame_pivot": Key("floats", None, vector3, "point of the frame's axis (default: start)"),
     },
+    "cable": {
+        "name": _name(),
+        "material": Key("str", doc="name of a &material"),
+        "start": Key("floats", check=vector3, doc="start of the axis (m)"),
+        "end": Key("floats", check=vector3, doc="end of the axis (m)"),
+        "nodes": Key("int", check=at_least(2), doc="nodes on the cable (>= 2)"),
+        "section": Key("str", "circle", one_of("rectangle", "box", "tube", "circle"),
+                       "cross-section (its area and bending inertia; I_y = I_z required): "
+                       "'circle' (diameter), 'tube' (diameter, wall), a square 'rectangle' "
+                       "or 'box'"),
+        "width": Key("float", None, positive, "section width (m)"),
+        "height": Key("float", None, positive, "section height (m)"),
+        "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
+        "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+    },
     "plate": {
         "name": _name(),
         "material": Key("str", doc="name of a &material"),
@@ -558,7 +573,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
 #: Groups of general scenes that occur once (shared with the template scenes).
 GENERAL_SINGLE_GROUPS = ("scene", "solver", "output")
 #: Groups only general scenes have.
-GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe")
+GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe", "cable")
 #: checks that take a list key's whole value (the others take each item)
 WHOLE_LIST_CHECKS = (vector3, points3, principal_positive)
 

@@ -445,6 +445,8 @@ def estimate_general(items: list[tuple[str, dict[str, Any]]]) -> Estimate:
         label = f"{group}[{v['name']}]"
         if group == "beam":
             parts.append(Part(label, "nodes", "beam", v["nodes"], 12))
+        elif group == "cable":  # half a beam node's coordinates, a beam's coupling
+            parts.append(Part(label, "nodes", "beam", v["nodes"], 6))
         elif group in ("plate", "leaf"):
             parts.append(Part(label, "nx", group, _grid(v["nx"], v["ny"]), 9))
         elif group == "rigid_body":

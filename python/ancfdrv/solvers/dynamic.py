@@ -149,7 +149,6 @@ class DynamicResult:
     steps: int
     newton_iterations: int
     factorizations: int
-    solves_setup: int
     wall_time_s: float
     timing: dict[str, float] = field(default_factory=dict)
     jacobians: int = 0
@@ -601,7 +600,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     wall = time.perf_counter() - start
     timing["total"] = wall
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
-                         solves_setup=0, wall_time_s=wall, timing=timing, jacobians=jacobians,
+                         wall_time_s=wall, timing=timing, jacobians=jacobians,
                          step_cuts=control.cuts, steps_rejected=control.rejected,
                          steps_taken=control.taken,
                          smallest_step=float(control.smallest) if control.taken else 0.0,

@@ -275,11 +275,6 @@ class Jet:
         n, m = self.grad.shape
         return np.hstack([self.value[:, None], self.grad, self.hess.reshape(n, m * m)])
 
-    @classmethod
-    def unstack(cls, columns: np.ndarray, m: int) -> "Jet":
-        n = columns.shape[0]
-        return cls(columns[:, 0], columns[:, 1:1 + m], columns[:, 1 + m:].reshape(n, m, m))
-
     def combine(self, a: float, other: "Jet", b: float) -> "Jet":
         return Jet(a * self.value + b * other.value, a * self.grad + b * other.grad,
                    a * self.hess + b * other.hess)

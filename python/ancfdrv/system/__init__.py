@@ -7,12 +7,13 @@ container and its name checks), ``assembly`` (numbering, elimination of linear j
 patterns, the kernel handle), ``model`` (the assembled model).
 """
 from .bodies import Beam, Leaf, Material, Plate, RigidBody
+from .cable import Cable
 from .drives import Constant, Cycle, Drive, Luffing, Ramp, Sine, SpinUp, Table
 from .model import Model
 from .sections import Box, Circle, General, Rectangle, Section, Tube
 from .system import System
 
-__all__ = ["System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Section",
+__all__ = ["System", "Model", "Material", "Beam", "Cable", "Plate", "Leaf", "RigidBody", "Section",
            "Rectangle", "Box", "Tube", "Circle", "General", "Drive", "Constant", "Luffing", "Ramp",
            "SpinUp",
            "Cycle", "Sine", "Table"]

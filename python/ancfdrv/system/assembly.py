@@ -19,6 +19,7 @@ from ..errors import InputError
 from .bodies import Beam, Body, Ground, Leaf, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
 from .drives import Constant
+from .element_kinds import SetContext, register_body, register_set, set_builder
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation, orthonormality, planar_fixes, small_turn
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
@@ -213,12 +214,13 @@ def _element_sets(bodies, frames, beam_frame, act: _Active, active: set[str], co
                   warnings: list[str]) -> tuple[list[SetInfo], list[np.ndarray]]:
     sets, blocks = [], []
     for body in bodies:
-        if isinstance(body, Beam):
-            info = _beam_set(body, frames[beam_frame[body.name] - 1], beam_frame[body.name])
-        elif isinstance(body, Plate):
-            info = _plate_set(body, active, counters, warnings)
-        else:
+        build = set_builder(body)
+        if build is None:
             continue
+        frame_id = beam_frame.get(body.name, 0)
+        context = SetContext(frames[frame_id - 1] if frame_id else None, frame_id, active,
+                             counters, warnings)
+        info = build(body, context)
         counters["element_arrays"] += info.nel
         _damping(info, body, active, counters, warnings)
         sets.append(info)
@@ -243,7 +245,8 @@ def _damping(info: SetInfo, body: Body, active: set[str], counters: Counter,
         warnings.append(message)
 
 
-def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
+def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
+    frame, frame_id = context.frame, context.frame_id
     dofs = beam.element_dofs()
     local = dofs - beam.first
     q = beam.coordinates()
@@ -270,17 +273,16 @@ def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
                    mass_compact=mass_compact)
     if beam.formulation == "ffr":
         info.kind = "ffr"
-        if beam.bending == "cubic":  # K0: the structural tangent at the reference, in the frame
-            structural = kernel.StructuralBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
-                                               m.poisson_ratio, torsion, shear_factors)
-            *_, stiffness0 = structural.forces(local, frame_q, True)
+        if beam.bending == "cubic":  # K0: the cubic tangent at the reference, in the frame
+            cubic = kernel.CubicBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
+                                     m.poisson_ratio, torsion, shear_factors)
+            *_, stiffness0 = cubic.forces(local, frame_q, True)
         info.stiffness0 = np.asfortranarray(stiffness0)
         info.reference = np.asfortranarray(frame_q[local])
     elif beam.bending == "cubic":
-        info.kind = "structural"
-        info.structural = kernel.StructuralBeam(global_ref, beam.lengths, section,
-                                                m.youngs_modulus, m.poisson_ratio, torsion,
-                                                shear_factors)
+        info.kind = "cubic"
+        info.cubic = kernel.CubicBeam(global_ref, beam.lengths, section, m.youngs_modulus,
+                                      m.poisson_ratio, torsion, shear_factors)
     else:
         info.kind = "continuum"
         info.gradients, info.weights, info.nvolume = kernel.beam_nonlinear_setup(
@@ -289,7 +291,8 @@ def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
     return info
 
 
-def _plate_set(plate: Plate, active: set[str], counters: Counter, warnings: list[str]) -> SetInfo:
+def _plate_set(plate: Plate, context: SetContext) -> SetInfo:
+    active, counters, warnings = context.active, context.counters, context.warnings
     mesh = plate.mesh
     dofs = plate.element_dofs()
     local = dofs - plate.first
@@ -309,6 +312,34 @@ def _plate_set(plate: Plate, active: set[str], counters: Counter, warnings: list
                    mass_compact=mass_compact, plate_reference=ref)
 
 
+def _add_ffr(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame, s.damping_time)
+
+
+def _add_continuum(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
+                                s.body.material.youngs_modulus, s.body.material.poisson_ratio,
+                                s.frame, s.damping_time, s.shear_scales)
+
+
+def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_cubic_set(s.dofs, s.scatter, s.cubic.forms, s.cubic.strain0, s.cubic.stiffness,
+                            s.frame, s.damping_time)
+
+
+def _add_plate(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_plate_set(s.dofs, s.scatter, s.plate_reference, s.body.material.youngs_modulus,
+                            s.body.material.poisson_ratio, s.body.thickness, s.damping_time)
+
+
+register_body(Beam, _beam_set)
+register_body(Plate, _plate_set)
+register_set("ffr", _add_ffr)
+register_set("continuum", _add_continuum)
+register_set("cubic", _add_cubic)
+register_set("plate", _add_plate)
+
+
 # -- mass and loads --------------------------------------------------------------------------
 def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern,
           counters: Counter) -> sp.csr_matrix:
@@ -322,6 +353,9 @@ def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern
                 if isinstance(info.body, Beam):
                     compact[:, :, at.element] += kernel.beam_point_mass(
                         *at.local, info.body.lengths[at.element], pm.mass)
+                elif hasattr(info.body, "shape_row"):  # a family's own shape row (cable)
+                    shape = info.body.shape_row(at)
+                    compact[:, :, at.element] += pm.mass * np.outer(shape, shape)
                 else:
                     shape, _ = kernel.plate_shape(*at.local, info.body.mesh.a[at.element],
                                                   info.body.mesh.b[at.element])
@@ -360,6 +394,9 @@ def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counter
                                                *body.section.mass_rule(body.material.density), g)
                 np.add.at(gravity, info.dofs.reshape(-1, order="F"),
                           elements.reshape(-1, order="F"))
+            elif hasattr(body, "gravity_forces"):  # a family's own (cable)
+                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
+                          body.gravity_forces(g).reshape(-1, order="F"))
             else:
                 _, elements = kernel.plate_element_arrays(
                     body.mesh.a, body.mesh.b, body.thickness, body.material.density,

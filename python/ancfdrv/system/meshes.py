@@ -15,14 +15,6 @@ import numpy as np
 from ..errors import InputError
 
 PLATE_NODE_DOFS = 9
-#: Offsets of a node's r, r_x, r_y within its 9 coordinates.
-P_R, P_RX, P_RY = 0, 3, 6
-
-
-def plate_node_dofs(node: int, part: int = P_R) -> list[int]:
-    """0-based global indices of the 3 coordinates of ``part`` of ``node``."""
-    start = PLATE_NODE_DOFS * node + part
-    return list(range(start, start + 3))
 
 
 @dataclass
@@ -48,14 +40,6 @@ class PlateMesh:
     @property
     def nel(self) -> int:
         return len(self.elements)
-
-    def element_at(self, xi_global: float, eta_global: float) -> tuple[int, float, float]:
-        """Element and local (xi, eta) in [0, 1]^2 of the point at fractions (xi_global,
-        eta_global) of the plate's length and width."""
-        nx, ny = self.grid.shape[0] - 1, self.grid.shape[1] - 1
-        i = min(int(xi_global * nx), nx - 1)
-        j = min(int(eta_global * ny), ny - 1)
-        return j * nx + i, xi_global * nx - i, eta_global * ny - j
 
 
 def _grid_mesh(stations_x: np.ndarray, stations_y: np.ndarray, node_vectors) -> PlateMesh:

@@ -20,6 +20,7 @@ from ..errors import InputError, SolverError
 from .bodies import Beam, Body, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
 from .drives import Drive
+from .element_kinds import add_to_kernel
 from .patterns import Pattern, Reduction
 
 
@@ -44,7 +45,7 @@ class SetInfo:
     """An element set as assembled (one per flexible body)."""
 
     body: Body
-    kind: str                 # 'ffr', 'continuum', 'structural', 'plate'
+    kind: str                 # 'ffr', 'continuum', 'cubic', 'plate', 'cable'
     dofs: np.ndarray          # (nde, nel) full coordinates, 0-based
     nel: int
     frame: int                # 1-based frame id (0: none)
@@ -57,7 +58,7 @@ class SetInfo:
     nvolume: int = 0
     #: the continuum beam's torsion and shear correction [c, d_y, d_z] (Section.shear_scales)
     shear_scales: tuple[float, float, float] = (1.0, 0.0, 0.0)
-    structural: kernel.StructuralBeam | None = None
+    cubic: kernel.CubicBeam | None = None
     plate_reference: kernel.PlateReference | None = None
     #: Kelvin-Voigt retardation time (s) handed to the kernel: the material's with the
     #: effect 'damping' listed, else 0 (no damping code runs)
@@ -132,6 +133,8 @@ def length_scale(bodies: list[Body]) -> float:
             sizes.append(body.length)
         elif isinstance(body, Plate):
             sizes.append(float(np.ptp(body.mesh.coords[:, :3], axis=0).max()))
+        elif body.flexible and hasattr(body, "length"):  # other families (cable)
+            sizes.append(float(body.length))
     if sizes:
         return max(sizes)
     centres = np.array([b.centre for b in bodies if isinstance(b, RigidBody)])
@@ -437,22 +440,8 @@ class Model:
     def build_kernel(self) -> None:
         """Hand the system to the kernel (once) and analyse the iteration matrix's pattern."""
         ks = kernel.KernelSystem(self.ndof, self.nfull)
-        for s in self.sets:
-            if s.kind == "ffr":
-                ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame,
-                               s.damping_time)
-            elif s.kind == "continuum":
-                ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
-                                     s.body.material.youngs_modulus,
-                                     s.body.material.poisson_ratio, s.frame, s.damping_time,
-                                     s.shear_scales)
-            elif s.kind == "structural":
-                ks.add_structural_set(s.dofs, s.scatter, s.structural.forms, s.structural.strain0,
-                                      s.structural.stiffness, s.frame, s.damping_time)
-            else:
-                ks.add_plate_set(s.dofs, s.scatter, s.plate_reference,
-                                 s.body.material.youngs_modulus, s.body.material.poisson_ratio,
-                                 s.body.thickness, s.damping_time)
+        for s in self.sets:  # each kind's adder (element_kinds; registered by its family)
+            add_to_kernel(ks, s)
         ks.set_frames([f.drive for f in self.frames], [f.axis for f in self.frames],
                       [f.base for f in self.frames], [f.pivot for f in self.frames])
         ks.set_drives([d.kind for d in self.drives], [d.params() for d in self.drives])

@@ -32,6 +32,7 @@ from ..io import validate
 from ..io.schema import (EFFECTS_AVAILABLE, check_call, coerce, plain_value, short_repr,
                          title_problem)
 from .bodies import Beam, Body, Ground, Leaf, Material, Plate, RigidBody
+from .cable import Cable
 from .contact import ContactPair
 from .drives import DRIVE_TYPES, Drive, Table
 from .joints import Joint
@@ -190,6 +191,14 @@ class System:
                                    bending=bending, segments=segments,
                                    frame_drive=self._drive(frame_drive, where),
                                    frame_axis=frame_axis, frame_pivot=frame_pivot))
+
+    @_api
+    def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
+              section: Section | None = None) -> Cable:
+        """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli)."""
+        name = self._body_name(name)
+        return self._add_body(Cable(name, self._material(material, f"cable {name!r}"), start,
+                                    end, nodes, section))
 
     @_api
     def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,

@@ -1,0 +1,219 @@
+!> The gradient-deficient ANCF cable element in 3D (Euler-Bernoulli): per node the position
+!> r and the slope r_x (6 coordinates), cubic Hermite interpolation along the element,
+!>   r(xi) = S1 r_1 + L S2 r_1,x + S3 r_2 + L S4 r_2,x,   xi = x / L in [0, 1],
+!>   S1 = 1 - 3 xi^2 + 2 xi^3, S2 = xi - 2 xi^2 + xi^3, S3 = 3 xi^2 - 2 xi^3, S4 = xi^3 - xi^2
+!> (Gerstmayr and Shabana, Nonlinear Dynamics 45 (2006) 109-130; Exudyn's ANCFCable2D and
+!> ANCFCable). Nodal vectors as q(3, 4) = [r_1, r_1,x, r_2, r_2,x]; the element shape rows
+!> below carry the factor L of the slopes.
+!>
+!> Strain energy of a straight, unstrained reference (x the reference arc length):
+!>   U = 1/2 int EA eps^2 dx + 1/2 int EI kappa^2 dx,
+!>   eps = (r' . r' - 1) / 2                          (axial Green strain),
+!>   kappa^2 = |r' x r''|^2 / |r'|^6 = ((r'.r')(r''.r'') - (r'.r'')^2) / (r'.r')^3
+!> (the exact curvature of the centre line, not the simplified r''.r'' of the small-strain
+!> cable). Both are invariant under rigid motions (a translation leaves r', r'' alone, a
+!> rotation turns them together), so rigid-body modes carry no strain energy at any angle.
+!> The cross-section's torsion and shear are not modelled (a cable has no section frame).
+!> Gauss points per element: 5 for the axial term (eps^2 is a polynomial of degree 8, exact)
+!> and 5 for the bending term (rational).
+!>
+!> The force is Q = dU/dq and the tangent its analytic derivative K = d^2U/dq^2 (symmetric),
+!> from the gradient and Hessian of the point energy w(a, b) in a = r', b = r'':
+!>   dw/da = EA eps a + EI/2 df/da,  dw/db = EI/2 df/db,  f = g / h,
+!>   g = (a.a)(b.b) - (a.b)^2,  h = (a.a)^3  (the quotient rule twice, below).
+!> Material damping is not implemented for this family (the Python side refuses it).
+module cable_element
+  use ancf_kinds, only: dp
+  use quadrature, only: gauss_legendre
+  use element_sets, only: local_element_set
+  implicit none
+  private
+  public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
+
+  !> Gauss points per element.
+  integer, parameter, public :: cable_points = 5
+  !> Coordinates per node and per element.
+  integer, parameter, public :: cable_node_dofs = 6, cable_dofs = 12
+
+  !> The family's element set (element_sets): element lengths and the section's axial and
+  !> bending stiffnesses EA, EI (one material and section per set).
+  type, extends(local_element_set) :: cable_set
+    real(dp), allocatable :: lengths(:)
+    real(dp) :: axial_stiffness = 0.0_dp, bending_stiffness = 0.0_dp
+  contains
+    procedure :: element_forces => cable_element_forces
+  end type cable_set
+
+contains
+
+  !> Shape rows at xi: the position (shape), the first and second derivatives with respect
+  !> to x (slope, second), each (4) acting on q(3, 4) = [r_1, r_1,x, r_2, r_2,x].
+  pure subroutine cable_shape(xi, length, shape, slope, second)
+    real(dp), intent(in) :: xi, length
+    real(dp), intent(out) :: shape(4), slope(4), second(4)
+    shape = [1.0_dp - 3.0_dp * xi**2 + 2.0_dp * xi**3, length * (xi - 2.0_dp * xi**2 + xi**3), &
+             3.0_dp * xi**2 - 2.0_dp * xi**3, length * (xi**3 - xi**2)]
+    slope = [(-6.0_dp * xi + 6.0_dp * xi**2) / length, 1.0_dp - 4.0_dp * xi + 3.0_dp * xi**2, &
+             (6.0_dp * xi - 6.0_dp * xi**2) / length, 3.0_dp * xi**2 - 2.0_dp * xi]
+    second = [(-6.0_dp + 12.0_dp * xi) / length**2, (-4.0_dp + 6.0_dp * xi) / length, &
+              (6.0_dp - 12.0_dp * xi) / length**2, (6.0_dp * xi - 2.0_dp) / length]
+  end subroutine cable_shape
+
+  !> The element mass of the scalar shapes, Mbar = rho A int S S^T dx (4 x 4; the element
+  !> mass is kron(Mbar, I3)), in closed form: rho A L / 420 [156, 22L, 54, -13L; ...].
+  pure subroutine cable_mass(length, mass_per_length, mass)
+    real(dp), intent(in) :: length, mass_per_length
+    real(dp), intent(out) :: mass(4, 4)
+    real(dp) :: l
+    l = length
+    mass = reshape([156.0_dp, 22.0_dp * l, 54.0_dp, -13.0_dp * l, &
+                    22.0_dp * l, 4.0_dp * l**2, 13.0_dp * l, -3.0_dp * l**2, &
+                    54.0_dp, 13.0_dp * l, 156.0_dp, -22.0_dp * l, &
+                    -13.0_dp * l, -3.0_dp * l**2, -22.0_dp * l, 4.0_dp * l**2], [4, 4])
+    mass = mass * mass_per_length * length / 420.0_dp
+  end subroutine cable_mass
+
+  !> Generalized force (3, 4) of a uniform load per length (3): load int S dx, in closed
+  !> form load [L/2, L^2/12, L/2, -L^2/12].
+  pure subroutine cable_gravity(length, load, force)
+    real(dp), intent(in) :: length, load(3)
+    real(dp), intent(out) :: force(3, 4)
+    force(:, 1) = 0.5_dp * length * load
+    force(:, 2) = length**2 / 12.0_dp * load
+    force(:, 3) = 0.5_dp * length * load
+    force(:, 4) = -length**2 / 12.0_dp * load
+  end subroutine cable_gravity
+
+  !> Elastic force dU/dq (12), strain energy and, when want_tangent, the tangent d^2U/dq^2
+  !> (12 x 12) of one element of length L at its nodal vectors q(3, 4). info = 2: r'
+  !> vanished at a Gauss point (the curvature is undefined).
+  pure subroutine cable_element_force(q, length, axial_stiffness, bending_stiffness, &
+                                      want_tangent, force, energy, tangent, info)
+    real(dp), intent(in) :: q(3, 4), length, axial_stiffness, bending_stiffness
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(cable_dofs), energy, tangent(cable_dofs, cable_dofs)
+    integer, intent(out) :: info
+    real(dp) :: xg(cable_points), wg(cable_points), shape(4), slope(4), second(4)
+    real(dp) :: a(3), b(3), grad_a(3), grad_b(3), hessian(6, 6), weight, point_energy
+    real(dp) :: rows(2, 4), block(3, 3)
+    integer :: p, i, j, m, n
+    call gauss_legendre(cable_points, xg, wg, info)
+    if (info /= 0) return
+    force = 0.0_dp
+    energy = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
+    do p = 1, cable_points
+      call cable_shape(0.5_dp * (xg(p) + 1.0_dp), length, shape, slope, second)
+      weight = 0.5_dp * wg(p) * length
+      a = matmul(q, slope)
+      b = matmul(q, second)
+      call point_derivatives(a, b, axial_stiffness, bending_stiffness, want_tangent, &
+                             point_energy, grad_a, grad_b, hessian, info)
+      if (info /= 0) return
+      energy = energy + weight * point_energy
+      do i = 1, 4
+        force(3 * i - 2:3 * i) = force(3 * i - 2:3 * i) &
+                                 + weight * (slope(i) * grad_a + second(i) * grad_b)
+      end do
+      if (.not. want_tangent) cycle
+      rows(1, :) = slope
+      rows(2, :) = second
+      do j = 1, 4
+        do i = 1, 4
+          block = 0.0_dp
+          do n = 1, 2
+            do m = 1, 2
+              block = block + rows(m, i) * rows(n, j) &
+                      * hessian(3 * m - 2:3 * m, 3 * n - 2:3 * n)
+            end do
+          end do
+          tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) = tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) &
+                                                      + weight * block
+        end do
+      end do
+    end do
+  end subroutine cable_element_force
+
+  !> The point energy w = EA/2 eps^2 + EI/2 kappa^2 at a = r', b = r'', its gradient
+  !> (dw/da, dw/db) and, when want_hessian, its Hessian (6 x 6, in (a, b)).
+  pure subroutine point_derivatives(a, b, axial_stiffness, bending_stiffness, want_hessian, &
+                                    energy, grad_a, grad_b, hessian, info)
+    real(dp), intent(in) :: a(3), b(3), axial_stiffness, bending_stiffness
+    logical, intent(in) :: want_hessian
+    real(dp), intent(out) :: energy, grad_a(3), grad_b(3), hessian(6, 6)
+    integer, intent(out) :: info
+    real(dp) :: aa, bb, ab, strain, g, h, f, dg(6), dh(6), df(6), hg(6, 6), hh(6, 6)
+    real(dp) :: identity(3, 3)
+    integer :: i
+    info = 0
+    aa = dot_product(a, a)
+    bb = dot_product(b, b)
+    ab = dot_product(a, b)
+    if (aa <= 0.0_dp) then
+      info = 2
+      return
+    end if
+    identity = 0.0_dp
+    do i = 1, 3
+      identity(i, i) = 1.0_dp
+    end do
+    strain = 0.5_dp * (aa - 1.0_dp)
+    g = aa * bb - ab**2                                  ! |a x b|^2
+    h = aa**3
+    f = g / h                                            ! kappa^2
+    energy = 0.5_dp * axial_stiffness * strain**2 + 0.5_dp * bending_stiffness * f
+    dg(1:3) = 2.0_dp * bb * a - 2.0_dp * ab * b
+    dg(4:6) = 2.0_dp * aa * b - 2.0_dp * ab * a
+    dh(1:3) = 6.0_dp * aa**2 * a
+    dh(4:6) = 0.0_dp
+    df = dg / h - g * dh / h**2
+    grad_a = axial_stiffness * strain * a + 0.5_dp * bending_stiffness * df(1:3)
+    grad_b = 0.5_dp * bending_stiffness * df(4:6)
+    if (.not. want_hessian) return
+    hg(1:3, 1:3) = 2.0_dp * bb * identity - 2.0_dp * outer(b, b)
+    hg(4:6, 4:6) = 2.0_dp * aa * identity - 2.0_dp * outer(a, a)
+    hg(1:3, 4:6) = 4.0_dp * outer(a, b) - 2.0_dp * outer(b, a) - 2.0_dp * ab * identity
+    hg(4:6, 1:3) = transpose(hg(1:3, 4:6))
+    hh = 0.0_dp
+    hh(1:3, 1:3) = 6.0_dp * aa**2 * identity + 24.0_dp * aa * outer(a, a)
+    hessian = 0.5_dp * bending_stiffness * (hg / h - (outer6(dg, dh) + outer6(dh, dg)) / h**2 &
+                                            - g * hh / h**2 + 2.0_dp * g * outer6(dh, dh) / h**3)
+    hessian(1:3, 1:3) = hessian(1:3, 1:3) + axial_stiffness * (outer(a, a) + strain * identity)
+  end subroutine point_derivatives
+
+  pure function outer(x, y) result(m)
+    real(dp), intent(in) :: x(3), y(3)
+    real(dp) :: m(3, 3)
+    integer :: j
+    do j = 1, 3
+      m(:, j) = x * y(j)
+    end do
+  end function outer
+
+  pure function outer6(x, y) result(m)
+    real(dp), intent(in) :: x(6), y(6)
+    real(dp) :: m(6, 6)
+    integer :: j
+    do j = 1, 6
+      m(:, j) = x * y(j)
+    end do
+  end function outer6
+
+  !> The element_set element_forces of a cable set (no damping: a damped call gets
+  !> dissipation 0 and the elastic force alone; the Python side refuses cable damping).
+  pure subroutine cable_element_forces(set, el, coords, want_tangent, force, energy, tangent, &
+                                       info, rates, rate_factor, dissipation)
+    class(cable_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords(:, :)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), energy, tangent(:, :)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(:, :), rate_factor
+    real(dp), intent(out), optional :: dissipation
+    if (present(dissipation)) dissipation = 0.0_dp
+    call cable_element_force(coords, set%lengths(el), set%axial_stiffness, &
+                             set%bending_stiffness, want_tangent, force, energy, tangent, info)
+  end subroutine cable_element_forces
+
+end module cable_element

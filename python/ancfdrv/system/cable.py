@@ -1,0 +1,174 @@
+"""The ANCF cable: a gradient-deficient Euler-Bernoulli beam element in 3D (kernel module
+``fortran/src/elements/cable_element.f90``; Gerstmayr and Shabana 2006, Exudyn's
+ANCFCable). Per node the position r and the slope r_x (6 coordinates, half a beam node's
+12): axial strain (r'.r' - 1)/2 and the exact curvature |r' x r''| / |r'|^3 with the
+section's EA and EI; no shear, no torsion, no section frame. The element family's whole
+Python side: the body, its set builder and kernel adder (registered in
+:mod:`.element_kinds`).
+
+Joints act on nodes: a 'weld' holds r and r_x (a clamp), 'spherical' the position, 'fix'
+one nodal vector ('r' or 'r_x'). Loads and probes act at any point of the axis. Material
+damping is not implemented for cables (refused when the effect 'damping' is listed).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import kernel
+from ..errors import InputError
+from .bodies import Attachment, Body, Material, _vec
+from .element_kinds import SetContext, register_body, register_set
+from .expressions import Vec3
+from .model import SetInfo
+from .sections import Rectangle, Section
+
+CABLE_NODE_DOFS = 6
+#: offsets of the nodal vectors within a node's coordinates
+CABLE_OFFSETS = {"r": 0, "r_x": 3}
+
+
+class Cable(Body):
+    """A straight ANCF cable from ``start`` to ``end`` with ``nodes`` equally spaced nodes
+    and the cross-section ``section`` (its area and bending inertia: a cable bends alike
+    about every axis, so the section must have I_y = I_z: circle, tube, square)."""
+
+    flexible = True
+
+    def __init__(self, name: str, material: Material, start, end, nodes: int,
+                 section: Section | None = None) -> None:
+        self.name = name
+        where = f"cable {name!r}"
+        self.material = material
+        self.start, self.end = _vec(start, "start", where), _vec(end, "end", where)
+        axis = self.end - self.start
+        self.length = float(np.linalg.norm(axis))
+        if self.length <= 0.0:
+            raise InputError(f"{where}: start and end coincide")
+        if not isinstance(nodes, (int, np.integer)) or nodes < 2:
+            raise InputError(f"{where}: nodes = {nodes!r} must be an integer >= 2")
+        self.nodes = int(nodes)
+        self.section = section if section is not None else Rectangle(0.1, 0.1)
+        data = self.section.data
+        if abs(data.inertia_y - data.inertia_z) > 1e-9 * max(data.inertia_y, data.inertia_z):
+            raise InputError(f"{where}: a cable has one bending stiffness; its section has "
+                             f"I_y = {data.inertia_y:g} and I_z = {data.inertia_z:g} m^4 (use "
+                             "a circle, a tube or a square)")
+        self.tangent = axis / self.length
+        self.stations = np.linspace(0.0, self.length, self.nodes)
+        self.lengths = np.diff(self.stations)
+
+    # -- geometry ---------------------------------------------------------------------------
+    @property
+    def nel(self) -> int:
+        return self.nodes - 1
+
+    @property
+    def ncoordinates(self) -> int:
+        return CABLE_NODE_DOFS * self.nodes
+
+    @property
+    def axial_stiffness(self) -> float:
+        return self.material.youngs_modulus * self.section.data.area
+
+    @property
+    def bending_stiffness(self) -> float:
+        return self.material.youngs_modulus * self.section.data.inertia_y
+
+    def node_positions(self) -> np.ndarray:
+        return self.start + np.outer(self.stations, self.tangent)
+
+    def coordinates(self) -> np.ndarray:
+        q = np.zeros((self.nodes, CABLE_NODE_DOFS))
+        q[:, 0:3] = self.node_positions()
+        q[:, 3:6] = self.tangent
+        return q.ravel()
+
+    def element_dofs(self) -> np.ndarray:
+        """(12, nel) full coordinates of every element (after numbering)."""
+        return self.first + np.array([np.arange(12) + CABLE_NODE_DOFS * el
+                                      for el in range(self.nel)]).T
+
+    def node_first(self, node: int, which: str = "r") -> int:
+        return self.first + CABLE_NODE_DOFS * node + CABLE_OFFSETS[which]
+
+    # -- attachments ------------------------------------------------------------------------
+    def locate(self, point, *, node: bool, what: str) -> Attachment:
+        p = _vec(point, "point", what)
+        rel = p - self.start
+        s = float(rel @ self.tangent)
+        tol = 1e-6 * self.length
+        if s < -tol or s > self.length + tol or np.linalg.norm(rel - s * self.tangent) > tol:
+            raise InputError(f"{what}: point {list(p)} is not on the axis of cable "
+                             f"{self.name!r} (from {list(self.start)} to {list(self.end)})")
+        nearest = int(np.argmin(np.abs(self.stations - s)))
+        at_node = abs(self.stations[nearest] - s) <= tol
+        if node and not at_node:
+            raise InputError(f"{what}: point {list(p)} is not a node of cable {self.name!r} "
+                             f"(nearest node at {list(self.node_positions()[nearest])}); "
+                             "joints act on nodes of cables")
+        s = min(max(s, 0.0), self.length)
+        element = min(int(np.searchsorted(self.stations, s, side="right")) - 1, self.nel - 1)
+        xi = (s - self.stations[element]) / self.lengths[element]
+        return Attachment(nearest if at_node else None, element, (xi,))
+
+    def shape_row(self, at: Attachment) -> np.ndarray:
+        """The position's shape row (4,) on the element's [r_1, r_1,x, r_2, r_2,x]."""
+        shape, _, _ = kernel.cable_shape(at.local[0], self.lengths[at.element])
+        return shape
+
+    def position(self, at: Attachment) -> Vec3:
+        if at.node is not None:
+            return Vec3.of(self.node_first(at.node))
+        shape = self.shape_row(at)
+        first = self.first + CABLE_NODE_DOFS * at.element
+        return Vec3({first + 3 * a: float(shape[a]) for a in range(4) if shape[a] != 0.0})
+
+    def vector(self, at: Attachment, which: str) -> Vec3:
+        if at.node is None:
+            raise InputError(f"cable {self.name!r}: nodal vectors exist at nodes only")
+        if which not in CABLE_OFFSETS:
+            raise InputError(f"cable {self.name!r}: a cable node has the vectors r and r_x, "
+                             f"not {which!r}")
+        return Vec3.of(self.node_first(at.node, which))
+
+    def basis(self, at: Attachment) -> list[Vec3]:
+        return [self.vector(at, "r_x")]
+
+    def held_vectors(self, at: Attachment) -> list[str]:
+        return ["r_x"]  # a clamp holds the slope (the cable has no section to hold)
+
+    def directors(self, at: Attachment) -> list[str]:
+        return []
+
+    # -- what the assembly asks of a flexible body besides its set ---------------------------
+    def gravity_forces(self, g: np.ndarray) -> np.ndarray:
+        """Generalized gravity forces per element (12, nel) of the acceleration g (3,): the
+        uniform load rho A g per length."""
+        _, forces = kernel.cable_element_arrays(self.lengths, self.mass_per_length,
+                                                self.mass_per_length * np.asarray(g, float))
+        return forces
+
+    @property
+    def mass_per_length(self) -> float:
+        return self.material.density * self.section.data.area
+
+
+def cable_set(cable: Cable, context: SetContext) -> SetInfo:
+    """The cable's element set: dofs, the scalar element masses (closed form) and the
+    kernel data (lengths, EA, EI)."""
+    if cable.material.damping_time > 0 and "damping" in context.active:
+        raise InputError(f"cable {cable.name!r}: material damping is not implemented for "
+                         f"cables (material {cable.material.name!r} has damping_time = "
+                         f"{cable.material.damping_time:g} s): drop the effect 'damping'")
+    mass, _ = kernel.cable_element_arrays(cable.lengths, cable.mass_per_length, np.zeros(3))
+    return SetInfo(body=cable, kind="cable", dofs=cable.element_dofs(), nel=cable.nel, frame=0,
+                   mass_compact=mass)
+
+
+def _add_cable(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_cable_set(s.dofs, s.scatter, s.body.lengths, s.body.axial_stiffness,
+                            s.body.bending_stiffness, s.damping_time)
+
+
+register_body(Cable, cable_set)
+register_set("cable", _add_cable)
