@@ -38,7 +38,7 @@ from ..errors import SolverError
 from ..kernel import DirectSolver
 from ..system.model import Model
 from .modal import DENSE_LIMIT, linearize, null_space
-from .static import StaticResult, solve_newton
+from .static import StaticResult
 
 
 @dataclass
@@ -101,17 +101,182 @@ def _sparse(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int, tol: f
     return theta[keep].real, z[:n, keep].real
 
 
+class LoadPath:
+    """Static states under F + P R (fixed loads F, reference loads R, load factor P) by
+    Newton with continuation from the last state. The loads enter linearly with the kernel's
+    load factor, so with ``model`` holding F + R and ``base_model`` F alone the residual is
+    r_model(e, P) + r_base(e, 1) - r_base(e, P) (the elastic parts cancel); without fixed
+    loads (``base_model is model``) it is r_model(e, P)."""
+
+    def __init__(self, model: Model, base_model: Model, *, tol: float, max_iter: int,
+                 load_steps: int) -> None:
+        self.model, self.base = model, base_model
+        self.tol, self.max_iter, self.load_steps = tol, max_iter, load_steps
+        self.e = model.e0.copy()
+        self.lam = np.zeros(len(model.constraints))
+        self.factor = 0.0
+        self.solves = 0
+        self.k0: sp.csr_matrix | None = None
+
+    def _terms(self, e, lam, factor):
+        parts = [(self.model, factor, 1.0)]
+        if self.base is not self.model:
+            parts += [(self.base, 1.0, 1.0), (self.base, factor, -1.0)]
+        residual = np.zeros(self.model.ndof)
+        stiffness = None
+        lin = None
+        for model, lf, sign in parts:
+            out = model.forces(e, load_factor=lf)
+            residual += sign * (out["internal"] - out["external"])
+            lin = linearize(model, e, lam if sign > 0 else np.zeros_like(lam), load_factor=lf)
+            stiffness = sign * lin.stiffness if stiffness is None else \
+                stiffness + sign * lin.stiffness
+        if self.base is not self.model:  # the constraint Hessian term once, not twice
+            lin_h = linearize(self.base, e, lam, load_factor=1.0)
+            lin_0 = linearize(self.base, e, np.zeros_like(lam), load_factor=1.0)
+            stiffness = stiffness - (lin_h.stiffness - lin_0.stiffness)
+        return residual, stiffness.tocsr(), lin.constraints
+
+    def tangent(self) -> sp.csr_matrix:
+        return self._terms(self.e, self.lam, self.factor)[1]
+
+    def constraints(self) -> sp.csr_matrix:
+        return self._terms(self.e, self.lam, self.factor)[2]
+
+    def solve(self, factor: float) -> None:
+        """Move the state to the load factor ``factor`` (in load_steps increments)."""
+        n = self.model.ndof
+        start = self.factor
+        for step in range(1, self.load_steps + 1):
+            target = start + (factor - start) * step / self.load_steps
+            e, lam = self.e.copy(), self.lam.copy()
+            for iteration in range(1, self.max_iter + 1):
+                residual, k, g = self._terms(e, lam, target)
+                phi = self.model.constraints.jacobian(e, n)[0] if g.shape[0] else np.zeros(0)
+                residual = residual - g.T @ lam
+                mat = sp.bmat([[k, -g.T], [-g, None]], format="csc") if g.shape[0] else \
+                    k.tocsc()
+                dz = spla.splu(mat).solve(np.concatenate([-residual, phi]))
+                e += dz[:n]
+                lam += dz[n:]
+                if not np.all(np.isfinite(dz)):
+                    break
+                if np.linalg.norm(dz[:n]) <= self.tol * self.model.length_scale:
+                    break
+            else:
+                raise SolverError(f"buckling: the static state at load factor {target:.6g} "
+                                  f"did not converge in {self.max_iter} Newton iterations "
+                                  "(raise buckling.load_steps)")
+            if not np.all(np.isfinite(e)):
+                raise SolverError(f"buckling: non-finite static state at load factor "
+                                  f"{target:.6g}")
+            self.e, self.lam, self.factor = e, lam, target
+            self.solves += 1
+
+
+def _pencil(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int, method: str,
+            eigen_tol: float):
+    if method == "dense":
+        return _dense(k0, kg, g, count)
+    return _sparse(k0, kg, g, count, eigen_tol)
+
+
+def _lowest(k: sp.spmatrix, m: sp.spmatrix, g: sp.spmatrix, method: str) -> float:
+    """The lowest omega^2 of (K, M) on the null space of G (the softest mode's stiffness:
+    it reaches 0 where the static state loses stability)."""
+    if method == "dense":
+        basis = null_space(g, k.shape[0])
+        kr, mr = basis.T @ (k @ basis), basis.T @ (m @ basis)
+        return float(la.eigh(0.5 * (kr + kr.T), 0.5 * (mr + mr.T), eigvals_only=True,
+                             subset_by_index=[0, 0])[0])
+    n, ncon = k.shape[0], g.shape[0]
+    scale = np.abs(k.diagonal()).max() / np.abs(m.diagonal()).max()
+    sigma = -1e-6 * scale
+    aug = sp.bmat([[k, g.T], [g, None]], format="csr")
+    b = sp.bmat([[m, None], [None, sp.csr_matrix((ncon, ncon))]], format="csr")
+    shifted = (aug - sigma * b).tocoo()
+    solver = DirectSolver(n + ncon, shifted.row, shifted.col, what="buckling softest mode")
+    try:
+        solver.factorize(shifted.data)
+        op = spla.LinearOperator((n + ncon, n + ncon), matvec=solver.solve, dtype=float)
+        v0 = solver.solve(b @ np.random.default_rng(1).standard_normal(n + ncon))
+        w = spla.eigsh(aug, k=1, M=b, sigma=sigma, OPinv=op, which="LM", v0=v0,
+                       return_eigenvectors=False)
+    finally:
+        solver.close()
+    return float(w.min())
+
+
+def _advance(path: "LoadPath", factor: float, tries: int = 6) -> None:
+    """Move the path to ``factor``; when Newton fails there, halve the step from the last
+    converged state (up to ``tries`` times)."""
+    last = (path.e.copy(), path.lam.copy(), path.factor)
+    for attempt in range(tries + 1):
+        try:
+            path.solve(factor)
+            return
+        except SolverError:
+            if attempt == tries:
+                raise
+            path.e, path.lam, path.factor = last[0].copy(), last[1].copy(), last[2]
+            factor = last[2] + 0.5 * (factor - last[2])
+
+
+def _root(history: list[tuple[float, float]], mu: float, factor: float) -> float:
+    """The load factor where omega^2(P) = w0 (1 - a P - b P^2), fitted through the last two
+    states (one: linear), vanishes; the pencil's factor ``mu`` when the fit has no root."""
+    w0 = history[0][1]
+    if len(history) < 3 or w0 <= 0:
+        p, w = history[-1]
+        slope = (w0 - w) / (p * w0) if w0 > 0 else 0.0
+        estimate = 1.0 / slope if slope > 0 else mu
+    else:
+        (p1, w1), (p2, w2) = history[-2:]
+        try:
+            a, b = np.linalg.solve(np.array([[p1, p1**2], [p2, p2**2]]),
+                                   [1 - w1 / w0, 1 - w2 / w0])
+        except np.linalg.LinAlgError:
+            a, b = (1 - w2 / w0) / p2, 0.0
+        if abs(b) <= 1e-14 * abs(a) * max(p1, p2):
+            estimate = 1.0 / a if a > 0 else mu
+        else:
+            disc = a * a + 4 * b
+            roots = [(-a + sg * np.sqrt(disc)) / (2 * b) for sg in (1.0, -1.0)] \
+                if disc >= 0 else []
+            roots = [r for r in roots if r > 0]
+            estimate = min(roots, key=lambda r: abs(r - factor)) if roots else mu
+    return float(estimate)
+
+
+def _smallest_positive(theta: np.ndarray) -> float:
+    scale = np.abs(theta).max(initial=0.0)
+    positive = theta[theta > 1e-12 * max(scale, 1e-300)]
+    if not len(positive):
+        raise SolverError("buckling: no positive load factor (the reference loads do not "
+                          "reduce the stiffness)")
+    return float(1.0 / positive.max())
+
+
 def buckling_analysis(model: Model, base_model: Model, count: int, *,
-                      fixed_loads: tuple[str, ...] = (), base: StaticResult | None = None,
-                      reference: StaticResult | None = None, solver: str = "auto",
-                      tol: float = 1e-10, max_iter: int = 50, load_steps: int = 1,
-                      reference_factor: float = 1.0, eigen_tol: float = 0.0) -> BucklingResult:
+                      fixed_loads: tuple[str, ...] = (), method: str = "nonlinear",
+                      solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,
+                      load_steps: int = 1, reference_factor: float = 1.0,
+                      rtol: float = 1e-6, max_updates: int = 30,
+                      eigen_tol: float = 0.0) -> BucklingResult:
     """The ``count`` lowest positive load factors of ``model``'s loads beyond those of
     ``base_model`` (the same system with the fixed loads alone; pass ``model`` itself
-    when nothing is fixed and no load is kept: then state 0 is the unloaded one, solved
-    with the load factor 0)."""
+    when no load is fixed).
+
+    ``method``: 'linear' solves (K_0 + mu K_g) phi = 0 once with K_g from the difference of
+    tangents at ``reference_factor``; 'nonlinear' (default) repeats it with K_g evaluated on
+    the static path at the latest estimate until the first load factor reproduces itself:
+    then the tangent on the static path is singular there (the stability limit of the
+    model, pre-buckling deformation included). See the module doc and docs/theory.md.
+    """
     if count < 1:
         raise SolverError(f"buckling: modes = {count} must be at least 1")
+    if method not in ("linear", "nonlinear"):
+        raise SolverError(f"buckling: method {method!r} must be 'linear' or 'nonlinear'")
     if model.ndof != base_model.ndof or not np.array_equal(model.e0, base_model.e0):
         raise SolverError("buckling: the model with and without the reference loads differ "
                           "in their coordinates")
@@ -119,47 +284,62 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         raise SolverError("buckling: every beam has the 'ffr' formulation, whose constant "
                           "small-strain stiffness has no geometric (initial-stress) part; "
                           "use formulation = 'nonlinear'")
+    if not reference_factor > 0:
+        raise SolverError(f"buckling: reference_factor = {reference_factor} must be positive")
     start = time.perf_counter()
     timing: dict[str, float] = {}
-    if base is None:
-        base = solve_newton(base_model, tol=tol, max_iter=max_iter, load_steps=load_steps,
-                            loads=0.0 if base_model is model else 1.0)
-    if reference is None:
-        reference = solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps,
-                                 loads=reference_factor) if base_model is not model or \
-            reference_factor != 1.0 else solve_newton(model, tol=tol, max_iter=max_iter,
-                                                      load_steps=load_steps)
-    timing["static"] = base.wall_time_s + reference.wall_time_s
-    t0 = time.perf_counter()
-    lf0 = 0.0 if base_model is model else 1.0
-    lin0 = linearize(base_model, base.e, base.lam, load_factor=lf0)
-    lin1 = linearize(model, reference.e, reference.lam, load_factor=reference_factor)
-    kg = ((lin1.stiffness - lin0.stiffness) / reference_factor).tocsr()
-    timing["assembly"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    free = model.ndof - lin0.constraints.shape[0]
-    method = solver if solver != "auto" else ("dense" if free <= DENSE_LIMIT else "sparse")
-    if method == "dense":
-        theta, vectors = _dense(lin0.stiffness, kg, lin0.constraints, count)
-    else:
-        theta, vectors = _sparse(lin0.stiffness, kg, lin0.constraints, count, eigen_tol)
-    timing["eigen"] = time.perf_counter() - t0
+    path = LoadPath(model, base_model, tol=tol, max_iter=max_iter, load_steps=load_steps)
+    path.solve(0.0)  # state 0: the fixed loads alone
+    base = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0, 0.0)
+    k0 = path.tangent()
+    g = path.constraints()
+    free = model.ndof - g.shape[0]
+    how = solver if solver != "auto" else ("dense" if free <= DENSE_LIMIT else "sparse")
+    mass = model.mass_matrix()
+    history = [(0.0, _lowest(k0, mass, g, how))]   # (P, lowest omega^2 of K_T(P) over M)
+    factor, previous = reference_factor, None
+    while True:
+        _advance(path, factor)
+        factor = path.factor
+        k_t = path.tangent()
+        kg = ((k_t - k0) / factor).tocsr()
+        theta, vectors = _pencil(k0, kg, g, count, how, eigen_tol)
+        mu = _smallest_positive(theta)
+        if method == "linear":
+            critical = mu
+            break
+        history.append((factor, _lowest(k_t, mass, g, how)))
+        critical = _root(history, mu, factor)
+        if previous is not None and abs(critical - previous) <= rtol * critical:
+            break
+        if len(history) > max_updates:
+            raise SolverError(f"buckling: the load factor did not settle in {max_updates} "
+                              f"updates (last estimates {previous:.6g}, {critical:.6g})")
+        previous = critical
+        # approach the estimate from below: the static state at the limit is singular
+        factor = float(np.clip(factor + 0.5 * (critical - factor), factor / 8, factor * 8))
+    timing["path"] = time.perf_counter() - start
+    reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
+                             0.0)
     scale = np.abs(theta).max(initial=0.0)
     positive = theta > 1e-12 * max(scale, 1e-300)
-    mu = 1.0 / theta[positive]
-    order = np.argsort(mu)[:count]
+    mus = 1.0 / theta[positive]
+    order = np.argsort(mus)[:count]
+    mus[order[0]] = critical  # the stability limit (nonlinear: the fitted root)
+    order = order[np.argsort(mus[order], kind="stable")]
     shapes = vectors[:, positive][:, order].T.copy()
     for i, x in enumerate(shapes):
         peak = x[np.argmax(np.abs(x))]
         shapes[i] = x / peak if peak else x
     negative = theta < -1e-12 * max(scale, 1e-300)
-    result = BucklingResult(mu[order], shapes, method, tuple(fixed_loads),
+    result = BucklingResult(mus[order], shapes, how, tuple(fixed_loads),
                             model.expand(shapes, with_offset=False), base, reference,
                             timing=timing,
-                            extra={"reference_factor": reference_factor,
+                            extra={"method": method, "updates": len(history),
+                                   "reference_factor": history[-1][0],
+                                   "static_solves": path.solves,
                                    "negative_load_factor": float(1.0 / theta[negative].min())
-                                   if negative.any() else 0.0,
-                                   "asymmetry": max(lin0.asymmetry, lin1.asymmetry)})
+                                   if negative.any() else 0.0})
     model.counters["buckling_analyses"] += 1
     result.wall_time_s = time.perf_counter() - start
     timing["total"] = result.wall_time_s
