@@ -21,8 +21,8 @@ _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 from ._version import __version__  # noqa: E402,F401
 
-from .system import (Beam, Box, Circle, Constant, Cycle, Leaf, Luffing, Material, Model,  # noqa: E402
-                     Plate, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
+from .system import (Beam, Box, Circle, Constant, Cycle, General, Leaf, Luffing, Material,  # noqa: E402
+                     Model, Plate, Rectangle, RigidBody, Sine, SpinUp, System, Table, Tube)
 
 __all__ = ["System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Rectangle",
-           "Box", "Tube", "Circle", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table"]
+           "Box", "Tube", "Circle", "General", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table"]

@@ -62,14 +62,17 @@ def section_data(kind: int, dims) -> SectionData:
                        float(iy), float(iz), float(polar))
 
 
-def beam_element_arrays(lengths, section: SectionData, density, youngs, poisson, reference):
+def beam_element_arrays(lengths, section: SectionData, density, youngs, poisson, reference,
+                        shear_scales=(1.0, 0.0, 0.0)):
     """Compact mass (8, 8, nel) and small-strain stiffness K0 (24, 24, nel) per element.
 
-    ``reference`` is (3, 8, nel): the element's nodal vectors in the floating frame.
+    ``reference`` is (3, 8, nel): the element's nodal vectors in the floating frame;
+    ``shear_scales`` the section's torsion and shear correction [c, d_y, d_z]
+    (Section.shear_scales; the default is the plain law).
     """
     mass, stiffness, info = _kernel.beam_element_arrays(
         _f(lengths), _f(section.y), _f(section.z), _f(section.weights), density, youngs, poisson,
-        _f(reference))
+        _f(shear_scales), _f(reference))
     if info:
         element, code = divmod(info, 10)
         reason = {1: "unsupported quadrature", 2: "degenerate reference geometry (det J0 <= 0)"}
@@ -112,22 +115,29 @@ def beam_nonlinear_setup(reference, lengths, section: SectionData):
 
 
 def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poisson,
-                          want_tangent: bool):
-    """Large-deformation elastic force, strain energy and element tangents (24, 24, nel)."""
+                          want_tangent: bool, shear_scales=(1.0, 0.0, 0.0)):
+    """Large-deformation elastic force, strain energy and element tangents (24, 24, nel);
+    ``shear_scales`` the section's torsion and shear correction (default: the plain law)."""
     return _kernel.beam_nonlinear_forces(nvolume, _f(dofs + 1, np.int32), _f(e), gradients,
-                                         weights, youngs, poisson, int(want_tangent))
+                                         weights, youngs, poisson, _f(shear_scales),
+                                         int(want_tangent))
 
 
 class StructuralBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
-    (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel)."""
+    (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel);
+    ``torsion`` the Saint-Venant constant J (default: the polar moment) and
+    ``shear_factors`` (k_y, k_z) (default 1)."""
 
-    def __init__(self, reference, lengths, section: SectionData, youngs, poisson) -> None:
+    def __init__(self, reference, lengths, section: SectionData, youngs, poisson,
+                 torsion: float | None = None, shear_factors=(1.0, 1.0)) -> None:
         nterms = int(_kernel.beam_structural_size())
+        torsion = section.polar if torsion is None else torsion
         (self.forms, self.strain0, self.stiffness,
          info) = _kernel.beam_structural_setup(nterms, _f(reference), _f(lengths), section.area,
                                                section.inertia_y, section.inertia_z,
-                                               section.polar, youngs, poisson)
+                                               torsion, shear_factors[0], shear_factors[1],
+                                               youngs, poisson)
         if info:
             element, code = divmod(info, 10)
             reason = {1: "unsupported quadrature",
@@ -435,10 +445,11 @@ class KernelSystem:
         return int(index)
 
     def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
-                          poisson: float, frame: int, damping_time: float = 0.0) -> int:
+                          poisson: float, frame: int, damping_time: float = 0.0,
+                          shear_scales=(1.0, 0.0, 0.0)) -> int:
         index, info = _kernel.system_add_continuum_set(
             self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights), youngs,
-            poisson, frame, damping_time)
+            poisson, _f(shear_scales), frame, damping_time)
         self._check(info, "continuum beam set")
         return int(index)
 

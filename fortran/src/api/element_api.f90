@@ -5,14 +5,16 @@
 
 !> Element arrays of a beam mesh: compact mass (8 x 8) and small-strain stiffness K0
 !> (24 x 24) per element, over a section rule (beam_section_rule). info = 10*element + code.
+!> shear_scales: the torsion and shear correction [c, d_y, d_z] (beam_linear_stiffness).
 subroutine beam_element_arrays(nel, nsec, lengths, section_y, section_z, section_w, density, &
-                               youngs, poisson, reference, mass_compact, stiffness, info)
+                               youngs, poisson, shear_scales, reference, mass_compact, &
+                               stiffness, info)
   use ancf_kinds, only: dp
   use beam_element, only: beam_mass_compact, beam_linear_stiffness
   implicit none
   integer, intent(in) :: nel, nsec
   real(dp), intent(in) :: lengths(nel), section_y(nsec), section_z(nsec), section_w(nsec)
-  real(dp), intent(in) :: density, youngs, poisson, reference(3, 8, nel)
+  real(dp), intent(in) :: density, youngs, poisson, shear_scales(3), reference(3, 8, nel)
   real(dp), intent(out) :: mass_compact(8, 8, nel), stiffness(24, 24, nel)
   integer, intent(out) :: info
   integer :: el, code
@@ -22,7 +24,7 @@ subroutine beam_element_arrays(nel, nsec, lengths, section_y, section_z, section
                            mass_compact(:, :, el), code)
     if (code == 0) call beam_linear_stiffness(reference(:, :, el), lengths(el), section_y, &
                                               section_z, section_w, youngs, poisson, &
-                                              stiffness(:, :, el), code)
+                                              shear_scales, stiffness(:, :, el), code)
     if (code /= 0) then
       info = 10 * el + code
       return
@@ -101,14 +103,16 @@ end subroutine beam_nonlinear_setup
 
 !> Large-deformation elastic force (global), strain energy and, when want_tangent /= 0,
 !> the element tangents (24 x 24 x nel) of a beam mesh; the first nvolume Gauss points of
-!> an element are its volume points.
+!> an element are its volume points; shear_scales the torsion and shear correction
+!> [c, d_y, d_z] (beam_nonlinear).
 subroutine beam_nonlinear_forces(ndof, nel, npts, nvolume, dofs, e, gradients, weights, youngs, &
-                                 poisson, want_tangent, force, energy, tangent)
+                                 poisson, shear_scales, want_tangent, force, energy, tangent)
   use ancf_kinds, only: dp
   use beam_nonlinear, only: nonlinear_element
   implicit none
   integer, intent(in) :: ndof, nel, npts, nvolume, dofs(24, nel), want_tangent
   real(dp), intent(in) :: e(ndof), gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
+  real(dp), intent(in) :: shear_scales(3)
   real(dp), intent(out) :: force(ndof), energy, tangent(24, 24, nel)
   real(dp) :: element_force(24, nel), element_energy(nel)
   integer :: el
@@ -117,7 +121,8 @@ subroutine beam_nonlinear_forces(ndof, nel, npts, nvolume, dofs, e, gradients, w
   !$omp parallel do schedule(static)
   do el = 1, nel
     call nonlinear_element(reshape(e(dofs(:, el)), [3, 8]), gradients(:, :, :, el), weights(:, el), &
-                           nvolume, youngs, poisson, want_tangent /= 0, element_force(:, el), &
+                           nvolume, youngs, poisson, shear_scales, want_tangent /= 0, &
+                           element_force(:, el), &
                            element_energy(el), tangent(:, :, el))
   end do
   !$omp end parallel do
@@ -136,23 +141,25 @@ subroutine beam_structural_size(nterms)
 end subroutine beam_structural_size
 
 !> Strain forms, reference strains and stiffnesses of the structural ("cubic") beam per
-!> element, from the reference configuration and the section properties. info =
-!> 10*element + code.
+!> element, from the reference configuration and the section properties (torsion: the
+!> Saint-Venant constant J; shear_y, shear_z: the shear factors). info = 10*element + code.
 subroutine beam_structural_setup(nel, nterms, reference, lengths, area, inertia_y, inertia_z, &
-                                 polar, youngs, poisson, forms, strain0, stiffness, info)
+                                 torsion, shear_y, shear_z, youngs, poisson, forms, strain0, &
+                                 stiffness, info)
   use ancf_kinds, only: dp
   use beam_structural, only: structural_setup
   implicit none
   integer, intent(in) :: nel, nterms
-  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), area, inertia_y, inertia_z, polar
-  real(dp), intent(in) :: youngs, poisson
+  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), area, inertia_y, inertia_z
+  real(dp), intent(in) :: torsion, shear_y, shear_z, youngs, poisson
   real(dp), intent(out) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
   integer, intent(out) :: info
   integer :: el, code
   info = 0
   do el = 1, nel
-    call structural_setup(reference(:, :, el), lengths(el), area, inertia_y, inertia_z, polar, &
-                          youngs, poisson, forms(:, :, :, el), strain0(:, el), stiffness(:, el), code)
+    call structural_setup(reference(:, :, el), lengths(el), area, inertia_y, inertia_z, torsion, &
+                          shear_y, shear_z, youngs, poisson, forms(:, :, :, el), strain0(:, el), &
+                          stiffness(:, el), code)
     if (code /= 0) then
       info = 10 * el + code
       return

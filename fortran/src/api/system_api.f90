@@ -102,9 +102,11 @@ end subroutine system_add_ffr_set
 
 !> Large-deformation (continuum) beam elements: material gradients and weights at npts
 !> Gauss points of which the first nvolume are volume points (beam_nonlinear);
-!> damping_time as system_add_ffr_set.
+!> damping_time as system_add_ffr_set; shear_scales the section's torsion and shear
+!> correction [c, d_y, d_z].
 subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, gradients, &
-                                    weights, youngs, poisson, frame, damping_time, index, info)
+                                    weights, youngs, poisson, shear_scales, frame, damping_time, &
+                                    index, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set, set_continuum
@@ -112,7 +114,7 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   implicit none
   integer, intent(in) :: handle, nel, npts, nvolume, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
-  real(dp), intent(in) :: damping_time
+  real(dp), intent(in) :: shear_scales(3), damping_time
   integer, intent(out) :: index, info
   type(system_model), pointer :: sys
   type(element_set) :: set
@@ -134,6 +136,7 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   set%weights = weights
   set%youngs = youngs
   set%poisson = poisson
+  set%shear_scales = shear_scales
   set%damping_time = damping_time
   call append_set(sys, set, index)
 end subroutine system_add_continuum_set

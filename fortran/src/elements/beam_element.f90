@@ -121,24 +121,40 @@ contains
   !> Strain eps = [e_xx, e_yy, e_zz, g_xy, g_yz, g_xz] of u = S (e - e0) with respect
   !> to the reference material coordinates X = r0(x, y, z); isotropic law (E, nu), which
   !> for nu = 0 is the paper's Q = diag(E, E, E, E/2, E/2, E/2) (eq. 18).
+  !> Torsion and shear of the section (shear_scales = [c, d_y, d_z], as beam_nonlinear):
+  !> G on g_xy, g_xz times c = J / I_p over the section, and G d_y, G d_z (d = k - c) on
+  !> the neutral axis, so the twist costs G J and a uniform shear k G A.
   !> info: 0 ok, 1 bad quadrature, 2 degenerate reference (det J0 <= 0).
   pure subroutine beam_linear_stiffness(reference, length, section_y, section_z, section_w, &
-                                        youngs, poisson, stiffness, info)
+                                        youngs, poisson, shear_scales, stiffness, info)
     real(dp), intent(in) :: reference(3, 8), length, section_y(:), section_z(:), section_w(:)
-    real(dp), intent(in) :: youngs, poisson
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
     real(dp), intent(out) :: stiffness(24, 24)
     integer, intent(out) :: info
     real(dp) :: xi(n_axial), weight(n_axial, size(section_w))
     real(dp) :: shape(8), dshape(8, 3), jacobian0(3, 3), inverse0(3, 3), det0
     real(dp) :: material_gradient(8, 3), strain_matrix(6, 24), elasticity(6, 6)
+    real(dp) :: axis_law(6, 6), shear
     integer :: i, s
     call volume_rule(length, section_w, xi, weight, info)
     call isotropic_elasticity(youngs, poisson, elasticity)
+    shear = elasticity(4, 4)
+    elasticity(4, 4) = shear_scales(1) * shear
+    elasticity(6, 6) = shear_scales(1) * shear
+    axis_law = 0.0_dp
+    axis_law(4, 4) = shear_scales(2) * shear
+    axis_law(6, 6) = shear_scales(3) * shear
     stiffness = 0.0_dp
-    do s = 1, size(section_w)
+    do s = 1, size(section_w) + 1
       do i = 1, n_axial
-        call beam_shape(xi(i), section_y(s), section_z(s), length, shape, dshape(:, 1), &
-                        dshape(:, 2), dshape(:, 3))
+        if (s <= size(section_w)) then
+          call beam_shape(xi(i), section_y(s), section_z(s), length, shape, dshape(:, 1), &
+                          dshape(:, 2), dshape(:, 3))
+        else
+          if (all(axis_law == 0.0_dp)) exit
+          call beam_shape(xi(i), 0.0_dp, 0.0_dp, length, shape, dshape(:, 1), dshape(:, 2), &
+                          dshape(:, 3))
+        end if
         jacobian0 = matmul(reference, dshape)
         call invert3(jacobian0, inverse0, det0)
         if (det0 <= 0.0_dp) then
@@ -147,8 +163,13 @@ contains
         end if
         material_gradient = matmul(dshape, inverse0)
         call small_strain_matrix(material_gradient, strain_matrix)
-        stiffness = stiffness + weight(i, s) * det0 * &
-                    matmul(transpose(strain_matrix), matmul(elasticity, strain_matrix))
+        if (s <= size(section_w)) then
+          stiffness = stiffness + weight(i, s) * det0 * &
+                      matmul(transpose(strain_matrix), matmul(elasticity, strain_matrix))
+        else
+          stiffness = stiffness + sum(weight(i, :)) * det0 * &
+                      matmul(transpose(strain_matrix), matmul(axis_law, strain_matrix))
+        end if
       end do
     end do
   end subroutine beam_linear_stiffness

@@ -12,6 +12,15 @@
 !> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
 !> mechanics); with nu = 0 both coincide with the plain law.
 !>
+!> Torsion and shear of the section (shear_scales = [c, d_y, d_z], docs/theory.md): the
+!> linear section field has no warping, so the shears 2E12, 2E13 at the volume points
+!> carry a twist tau with the polar moment, G I_p tau^2/2. Their modulus is scaled there by
+!> c = J / I_p (J the Saint-Venant torsion constant), and the neutral-axis points add
+!> G d_y, G d_z on 2E12, 2E13 with d = k - c (k the section's shear factor): the section
+!> strain 2E12 = a + y b + z t is linear in (y, z) for any F, so the section integrates to
+!>   c G (A a^2 + I_z b^2 + I_y t^2) + d_y G A a^2 = k_y G A a^2 + c G (I_z b^2 + I_y t^2):
+!> torsion G J, shear k G A, exactly (the rule is symmetric). [1, 0, 0]: the plain law.
+!>
 !> Kelvin-Voigt material damping (retardation time tau, nonlinear_element_damped):
 !> S = D : (E + tau E'), with the strain rate E' = B(F) q' (the Voigt form of sym(F^T F'),
 !> F' = q' g^T), so the damping force is Q_d = int tau B^T D E' dV0 and the dissipated power
@@ -85,16 +94,16 @@ contains
   !> The first volume_points points integrate the Poisson-free law over the volume, the
   !> others (the neutral-axis points) the Poisson part.
   pure subroutine nonlinear_element(q, gradients, weights, volume_points, youngs, poisson, &
-                                    want_tangent, force, energy, tangent)
+                                    shear_scales, want_tangent, force, energy, tangent)
     real(dp), intent(in) :: q(3, 8), gradients(:, :, :), weights(:)
     integer, intent(in) :: volume_points
-    real(dp), intent(in) :: youngs, poisson
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
     real(dp) :: stress(6), b(6, 24), db(6, 24)
     integer :: p
-    call split_laws(youngs, poisson, law_free, law_poisson)
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
@@ -122,18 +131,18 @@ contains
   !> q'(3, 8): the force includes the damping force, dissipation is its power and the
   !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
   pure subroutine nonlinear_element_damped(q, rates, gradients, weights, volume_points, youngs, &
-                                           poisson, damping_time, rate_factor, want_tangent, &
-                                           force, energy, dissipation, tangent)
+                                           poisson, shear_scales, damping_time, rate_factor, &
+                                           want_tangent, force, energy, dissipation, tangent)
     real(dp), intent(in) :: q(3, 8), rates(3, 8), gradients(:, :, :), weights(:)
     integer, intent(in) :: volume_points
-    real(dp), intent(in) :: youngs, poisson, damping_time, rate_factor
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3), damping_time, rate_factor
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
     real(dp) :: stress(6), b(6, 24), b_rate(6, 24)
     real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
     integer :: p
-    call split_laws(youngs, poisson, law_free, law_poisson)
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson)
     force = 0.0_dp
     energy = 0.0_dp
     dissipation = 0.0_dp
@@ -243,9 +252,11 @@ contains
     end do
   end subroutine strain_matrix
 
-  !> D0 = diag(E, E, E, G, G, G) and the Poisson part D - D0 of the isotropic law.
-  pure subroutine split_laws(youngs, poisson, law_free, law_poisson)
-    real(dp), intent(in) :: youngs, poisson
+  !> D0 = diag(E, E, E, G, G, G) and the Poisson part D - D0 of the isotropic law, with the
+  !> section's torsion and shear correction shear_scales = [c, d_y, d_z]: D0's G on 2E12
+  !> and 2E13 times c (volume points), G d_y and G d_z added to the neutral-axis law.
+  pure subroutine split_laws(youngs, poisson, shear_scales, law_free, law_poisson)
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
     real(dp), intent(out) :: law_free(6, 6), law_poisson(6, 6)
     real(dp) :: lame, shear
     integer :: i
@@ -259,6 +270,10 @@ contains
       law_free(i + 3, i + 3) = shear
       law_poisson(i, i) = lame + 2.0_dp * shear - youngs
     end do
+    law_free(4, 4) = shear_scales(1) * shear
+    law_free(6, 6) = shear_scales(1) * shear
+    law_poisson(4, 4) = shear_scales(2) * shear
+    law_poisson(6, 6) = shear_scales(3) * shear
   end subroutine split_laws
 
   !> tangent += w kron(G S G^T, I3): the geometric stiffness of the second Piola-Kirchhoff

@@ -21,8 +21,9 @@
 !>   s = 1/2 sum_ab C_ab q_a . q_b - s0,      U = 1/2 sum_terms k s^2,
 !> so dS/dq_a = sum_b C_ab q_b, the tangent is k (g g^T + s C x I3), rigid motions leave
 !> every s unchanged, and a curved reference is strain-free by s0. Stiffnesses: EA, EI_z,
-!> EI_y, G J with J = I_y + I_z and G A (k = 1) of the section (beam_section), as the
-!> continuum element with nu = 0 has, so the two options differ in the bending
+!> EI_y, G J with J the section's Saint-Venant torsion constant and k_y G A, k_z G A with
+!> its shear factors (python/ancfdrv/system/sections.py), as the continuum element has
+!> with its torsion and shear correction, so the two options differ in the bending
 !> interpolation only.
 !>
 !> Kelvin-Voigt material damping (retardation time tau, structural_element_damped) acts on
@@ -72,12 +73,13 @@ contains
   !> Quadratic forms C (8, 8, term), reference values s0 and stiffnesses k (material times
   !> line element |r0_x| L dxi) of one element. info = 1: quadrature unavailable; 2: the
   !> reference tangent r0_x vanishes somewhere.
-  !> Section data (beam_section): area, I_y = int z^2 dA, I_z = int y^2 dA, the torsion
-  !> constant (the polar moment).
-  pure subroutine structural_setup(reference, length, area, inertia_y, inertia_z, polar, youngs, &
-                                   poisson, forms, strain0, stiffness, info)
-    real(dp), intent(in) :: reference(3, 8), length, area, inertia_y, inertia_z, polar
-    real(dp), intent(in) :: youngs, poisson
+  !> Section data: area, I_y = int z^2 dA, I_z = int y^2 dA, the Saint-Venant torsion
+  !> constant J (torsion) and the shear factors k_y (shear along the height, 2E12) and k_z.
+  pure subroutine structural_setup(reference, length, area, inertia_y, inertia_z, torsion, &
+                                   shear_y, shear_z, youngs, poisson, forms, strain0, &
+                                   stiffness, info)
+    real(dp), intent(in) :: reference(3, 8), length, area, inertia_y, inertia_z, torsion
+    real(dp), intent(in) :: shear_y, shear_z, youngs, poisson
     real(dp), intent(out) :: forms(8, 8, structural_terms), strain0(structural_terms)
     real(dp), intent(out) :: stiffness(structural_terms)
     integer, intent(out) :: info
@@ -129,15 +131,15 @@ contains
       line = 0.5_dp * w2(i) * length * norm2(matmul(reference, slope))
       t = t + 1
       forms(:, :, t) = 0.5_dp * (product_form(dir_y_x, dir_z) - product_form(dir_z_x, dir_y))
-      stiffness(t) = shear * polar * line
+      stiffness(t) = shear * torsion * line
     end do
     do node = 0, 1
       call centreline_rows(real(node, dp), length, slope, second, dir_y, dir_z, dir_y_x, dir_z_x)
       line = 0.5_dp * length * norm2(matmul(reference, slope))
       forms(:, :, t + 1) = product_form(slope, dir_y)
-      stiffness(t + 1) = shear * area * line
+      stiffness(t + 1) = shear_y * shear * area * line
       forms(:, :, t + 2) = product_form(slope, dir_z)
-      stiffness(t + 2) = shear * area * line
+      stiffness(t + 2) = shear_z * shear * area * line
       forms(:, :, t + 3) = spread(dir_y, 2, 8) * spread(dir_y, 1, 8)
       stiffness(t + 3) = youngs * area * line
       forms(:, :, t + 4) = spread(dir_z, 2, 8) * spread(dir_z, 1, 8)

@@ -48,6 +48,8 @@ module element_sets
     ! points carry the Poisson-free law
     integer :: volume_points = 0
     real(dp), allocatable :: gradients(:, :, :, :), weights(:, :)
+    ! and the section's torsion and shear correction [c, d_y, d_z] (beam_nonlinear)
+    real(dp) :: shear_scales(3) = [1.0_dp, 0.0_dp, 0.0_dp]
     ! structural: forms (8, 8, nterms, nel), reference strains and stiffnesses (nterms, nel)
     real(dp), allocatable :: forms(:, :, :, :), strain0(:, :), term_stiffness(:, :)
     ! and the forms' nonzero entries (structural_pattern): (2, 64, nterms), (nterms)
@@ -260,7 +262,8 @@ contains
       case (set_continuum)
         call nonlinear_element_damped(coords, rates, set%gradients(:, :, :, el), &
                                       set%weights(:, el), set%volume_points, set%youngs, &
-                                      set%poisson, set%damping_time, rate_factor, want_tangent, &
+                                      set%poisson, set%shear_scales, set%damping_time, &
+                                      rate_factor, want_tangent, &
                                       force, energy, dissipation, tangent)
       case (set_structural)
         call structural_element_damped(coords, rates, set%forms(:, :, :, el), &
@@ -279,7 +282,8 @@ contains
     select case (set%kind)
     case (set_continuum)
       call nonlinear_element(coords, set%gradients(:, :, :, el), set%weights(:, el), &
-                             set%volume_points, set%youngs, set%poisson, want_tangent, force, &
+                             set%volume_points, set%youngs, set%poisson, set%shear_scales, &
+                             want_tangent, force, &
                              energy, tangent)
     case (set_structural)
       call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &

@@ -49,17 +49,30 @@ def effects_of(items: list[tuple[str, dict[str, Any]]]) -> set[str]:
     return out
 
 
+_SECTION_KEYS = {"rectangle": ("width", "height"), "box": ("width", "height", "wall"),
+                 "tube": ("diameter", "wall"), "circle": ("diameter",),
+                 "general": ("area", "iy", "iz", "torsion_constant", "shear_factor_y",
+                             "shear_factor_z")}
+_SECTION_OPTIONAL = {"general": ("mass_per_length", "rotary_inertia", "fibre_points")}
+
+
 def _section(v: dict[str, Any]):
     kind = v["section"]
-    keys = {"rectangle": ("width", "height"), "box": ("width", "height", "wall"),
-            "tube": ("diameter", "wall"), "circle": ("diameter",)}[kind]
-    missing = [k for k in keys if v[k] is None]
+    keys = _SECTION_KEYS[kind]
+    optional = _SECTION_OPTIONAL.get(kind, ())
+    missing = [k for k in keys if v.get(k) is None]
     if missing:
         raise InputError(f"section {kind!r} needs {', '.join(missing)}")
-    extra = [k for k in ("width", "height", "wall", "diameter") if k not in keys and
-             v[k] is not None]
+    every = {k for ks in _SECTION_KEYS.values() for k in ks} | \
+        {k for ks in _SECTION_OPTIONAL.values() for k in ks}
+    extra = sorted(k for k in every if k not in keys and k not in optional and
+                   v.get(k) is not None)
     if extra:
         raise InputError(f"section {kind!r} does not take {', '.join(extra)}")
+    if kind == "general":
+        return SECTIONS[kind](*(v[k] for k in keys), mass_per_length=v.get("mass_per_length"),
+                              rotary_inertia=v.get("rotary_inertia"),
+                              fibre_points=v.get("fibre_points"))
     return SECTIONS[kind](*(v[k] for k in keys))
 
 

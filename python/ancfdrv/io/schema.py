@@ -353,13 +353,36 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "nodes": Key("int", check=at_least(2), doc="nodes on the beam (>= 2)"),
         "segments": Key("floats", None, doc="segment lengths (m) each split equally (keeps "
                         "their ends as nodes); default: one segment"),
-        "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle"),
+        "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle",
+                                                  "general"),
                        "cross-section: 'rectangle' (width, height), 'box' (width, height, wall), "
-                       "'tube' (diameter, wall), 'circle' (diameter)"),
+                       "'tube' (diameter, wall), 'circle' (diameter), 'general' (area, iy, iz, "
+                       "torsion_constant, shear_factor_y, shear_factor_z; optional "
+                       "mass_per_length, rotary_inertia, fibre_points)"),
         "width": Key("float", None, positive, "section width along r_z (m)"),
         "height": Key("float", None, positive, "section height along r_y (m)"),
         "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
         "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+        "area": Key("float", None, positive, "'general': cross-section area A (m^2)"),
+        "iy": Key("float", None, positive, "'general': I_y = int z^2 dA, bending along the "
+                  "width r_z (m^4)"),
+        "iz": Key("float", None, positive, "'general': I_z = int y^2 dA, bending along the "
+                  "height r_y (m^4)"),
+        "torsion_constant": Key("float", None, positive, "'general': Saint-Venant torsion "
+                                "constant J (m^4)"),
+        "shear_factor_y": Key("float", None, positive, "'general': shear factor k_y (shear "
+                              "stiffness k_y G A along the height)"),
+        "shear_factor_z": Key("float", None, positive, "'general': shear factor k_z (along the "
+                              "width)"),
+        "mass_per_length": Key("float", None, positive, "'general', optional: mass per unit "
+                               "length (kg/m; default density * area)"),
+        "rotary_inertia": Key("floats", None, vector3, "'general', optional: r_x, r_y, r_z, "
+                              "rotary inertia per unit length about the axis, the height and "
+                              "the width axes (kg m; r_x = r_y + r_z; default density * (iy + "
+                              "iz, iy, iz))"),
+        "fibre_points": Key("floats", None, doc="'general', optional: outer-fibre points y1, "
+                            "z1, y2, z2, ... in the section (m) for stresses (default: the "
+                            "corners of the rectangle of the same A, I_y, I_z)"),
         "height_axis": Key("floats", None, vector3, "direction of the section height "
                            "(default: global z, or y for a beam along z)"),
         "formulation": Key("str", None, one_of("ffr", "nonlinear"),

@@ -9,9 +9,9 @@ patterns, the kernel handle), ``model`` (the assembled model).
 from .bodies import Beam, Leaf, Material, Plate, RigidBody
 from .drives import Constant, Cycle, Drive, Luffing, Sine, SpinUp, Table
 from .model import Model
-from .sections import Box, Circle, Rectangle, Section, Tube
+from .sections import Box, Circle, General, Rectangle, Section, Tube
 from .system import System
 
 __all__ = ["System", "Model", "Material", "Beam", "Plate", "Leaf", "RigidBody", "Section",
-           "Rectangle", "Box", "Tube", "Circle", "Drive", "Constant", "Luffing", "SpinUp",
+           "Rectangle", "Box", "Tube", "Circle", "General", "Drive", "Constant", "Luffing", "SpinUp",
            "Cycle", "Sine", "Table"]

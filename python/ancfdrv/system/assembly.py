@@ -229,26 +229,37 @@ def _beam_set(beam: Beam, frame: FrameInfo, frame_id: int) -> SetInfo:
     m = beam.material
     frame_ref = frame_q[local].reshape(3, 8, beam.nel, order="F")
     global_ref = q[local].reshape(3, 8, beam.nel, order="F")
+    # torsion constant J and shear factors of the section (docs/theory.md, "Sections")
+    shear_scales = beam.section.shear_scales(m.poisson_ratio)
+    torsion = beam.section.torsion_constant
+    shear_factors = beam.section.shear_factors(m.poisson_ratio)
     mass_compact, stiffness0 = kernel.beam_element_arrays(
-        beam.lengths, section, m.density, m.youngs_modulus, m.poisson_ratio, frame_ref)
+        beam.lengths, section, m.density, m.youngs_modulus, m.poisson_ratio, frame_ref,
+        shear_scales)
+    mass_rule, mass_density = beam.section.mass_rule(m.density)
+    if mass_rule is not section:   # a general section's own mass and rotary inertia
+        mass_compact, _ = kernel.beam_element_arrays(
+            beam.lengths, mass_rule, mass_density, m.youngs_modulus, m.poisson_ratio, frame_ref)
     info = SetInfo(body=beam, kind="", dofs=dofs, nel=beam.nel, frame=frame_id,
                    mass_compact=mass_compact)
     if beam.formulation == "ffr":
         info.kind = "ffr"
         if beam.bending == "cubic":  # K0: the structural tangent at the reference, in the frame
             structural = kernel.StructuralBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
-                                               m.poisson_ratio)
+                                               m.poisson_ratio, torsion, shear_factors)
             *_, stiffness0 = structural.forces(local, frame_q, True)
         info.stiffness0 = np.asfortranarray(stiffness0)
         info.reference = np.asfortranarray(frame_q[local])
     elif beam.bending == "cubic":
         info.kind = "structural"
         info.structural = kernel.StructuralBeam(global_ref, beam.lengths, section,
-                                                m.youngs_modulus, m.poisson_ratio)
+                                                m.youngs_modulus, m.poisson_ratio, torsion,
+                                                shear_factors)
     else:
         info.kind = "continuum"
         info.gradients, info.weights, info.nvolume = kernel.beam_nonlinear_setup(
             global_ref, beam.lengths, section)
+        info.shear_scales = shear_scales
     return info
 
 
@@ -319,8 +330,8 @@ def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counter
         for info in sets:
             body = info.body
             if isinstance(body, Beam):
-                elements = kernel.beam_gravity(body.lengths, body.section.data,
-                                               body.material.density, g)
+                elements = kernel.beam_gravity(body.lengths,
+                                               *body.section.mass_rule(body.material.density), g)
                 np.add.at(gravity, info.dofs.reshape(-1, order="F"),
                           elements.reshape(-1, order="F"))
             else:

@@ -55,6 +55,8 @@ class SetInfo:
     gradients: np.ndarray | None = None
     weights: np.ndarray | None = None
     nvolume: int = 0
+    #: the continuum beam's torsion and shear correction [c, d_y, d_z] (Section.shear_scales)
+    shear_scales: tuple[float, float, float] = (1.0, 0.0, 0.0)
     structural: kernel.StructuralBeam | None = None
     plate_reference: kernel.PlateReference | None = None
     #: Kelvin-Voigt retardation time (s) handed to the kernel: the material's with the
@@ -384,7 +386,8 @@ class Model:
             elif s.kind == "continuum":
                 ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
                                      s.body.material.youngs_modulus,
-                                     s.body.material.poisson_ratio, s.frame, s.damping_time)
+                                     s.body.material.poisson_ratio, s.frame, s.damping_time,
+                                     s.shear_scales)
             elif s.kind == "structural":
                 ks.add_structural_set(s.dofs, s.scatter, s.structural.forms, s.structural.strain0,
                                       s.structural.stiffness, s.frame, s.damping_time)
