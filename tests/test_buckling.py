@@ -49,25 +49,30 @@ def column(case, *, bending="cubic", nodes=9, length=2.0, side=0.02, load=1000.0
 
 @pytest.mark.parametrize("case", K_FACTOR)
 def test_euler_columns(case):
-    """8 'cubic' elements: within 0.05% of pi^2 EI/(KL)^2 (measured -0.006% to -0.03%),
-    each critical load twice (the two bending planes of the square section)."""
+    """8 'cubic' elements: within 0.05% of pi^2 EI/(KL)^2 with the shear correction
+    1 / (1 + P / (k G A)) (Timoshenko & Gere sec. 2.17; Cowper's k of the section, the
+    beam's shear; 0.01% to 0.08% here), each critical load twice (the two bending planes
+    of the square section)."""
     model = column(case).assemble()
     result = buckling_analysis(model, model, 2)
-    reference = np.pi**2 * E * 0.02**4 / 12 / (K_FACTOR[case] * 2.0) ** 2
+    euler = np.pi**2 * E * 0.02**4 / 12 / (K_FACTOR[case] * 2.0) ** 2
+    shear = Rectangle(0.02, 0.02).shear_factors(0.0)[0] * E / 2 * 0.02**2
+    reference = euler / (1 + euler / shear)
     error = result.load_factor * 1000.0 / reference - 1
     print(f"\n{case}: relative errors {error}")
     assert np.all(np.abs(error) < 5e-4)
 
 
 def test_continuum_column_and_sparse_solver():
-    """The 'continuum' bending option (Timoshenko with shear factor 1: P_cr / (1 + P_cr /
-    GA), 0.04% below Euler here) on 32 elements, solved by the sparse solver (ARPACK
-    on the multiplier form) and the dense one: both within 1% and equal."""
+    """The 'continuum' bending option (Timoshenko with Cowper's shear factor: P_cr / (1 +
+    P_cr / (k G A)), 0.05% below Euler here) on 32 elements, solved by the sparse solver
+    (ARPACK on the multiplier form) and the dense one: both within 1% and equal."""
     model = column("pinned-pinned", bending="continuum", nodes=33).assemble()
     dense = buckling_analysis(model, model, 2, solver="dense")
     sparse = buckling_analysis(model, model, 2, solver="sparse")
     euler = np.pi**2 * E * 0.02**4 / 12 / 2.0**2
-    reference = euler / (1 + euler / (E / 2 * 0.02**2))
+    shear = Rectangle(0.02, 0.02).shear_factors(0.0)[0] * E / 2 * 0.02**2
+    reference = euler / (1 + euler / shear)
     np.testing.assert_allclose(sparse.load_factor, dense.load_factor, rtol=1e-8)
     error = dense.load_factor * 1000.0 / reference - 1
     print(f"\ncontinuum pinned-pinned: relative errors {error}")
@@ -98,29 +103,31 @@ def test_ffr_is_refused():
 
 
 def test_lateral_torsional_buckling_of_a_cantilever_strip():
-    """A strip 2 m x 60 mm (height, along y) x 6 mm, clamped, a vertical tip force at the
-    centroid: P_cr = 4.013 sqrt(E I_z G J) / L^2 with I_z = h b^3 / 12 (weak axis) and J the
-    model's torsion constant. The 'cubic' option uses today J = I_y + I_z (the polar moment;
-    the Saint-Venant value is the branch i20-sections' work): the closed form is evaluated
-    with that J, a valid closed form for the model as it is. The closed form neglects the
-    in-plane pre-buckling deflection; its effect ~ I_z / I_y = 1%: the strip's modes are
-    compared with the correction factor 1 / sqrt(1 - I_z / I_y) (Kirby & Nethercot), within
-    1%."""
+    """A strip 2 m x 60 mm (height, along y) x 6 mm, clamped, a vertical dead force at the
+    tip's centroid: P_cr = 4.013 sqrt(E I_z G J) / L^2 (Prandtl) with I_z = h b^3 / 12 (weak
+    axis) and J the Saint-Venant constant of the rectangle (series; branch i20-sections),
+    times the pre-buckling deflection factor 1 / sqrt((1 - E I_z / E I_y)(1 - G J / E I_y))
+    (Kirby & Nethercot 1979; Trahair, Flexural-Torsional Buckling of Structures, 1993,
+    sec. 3.9): 0.8% above Prandtl here. The stability limit on the static path ('nonlinear',
+    the default) within 1%; the classical linear eigenproblem in ANCF coordinates is far off
+    for this case (docs/theory.md), which is why it is not the default."""
     length, height, width, nu = 2.0, 0.06, 0.006, 0.3
+    section = Rectangle(width, height)
     s = System("strip")
     s.material("steel", youngs_modulus=E, density=RHO, poisson_ratio=nu)
     s.beam("strip", material="steel", start=(0, 0, 0), end=(length, 0, 0), nodes=17,
-           section=Rectangle(width, height), height_axis=(0, 1, 0), formulation="nonlinear",
-           bending="cubic")
+           section=section, height_axis=(0, 1, 0), formulation="nonlinear", bending="cubic")
     s.joint("root", "weld", "ground", "strip", point=(0, 0, 0))
     s.load("P", "force", body="strip", point=(length, 0, 0), vector=(0, -10.0, 0))
     model = s.assemble()
     result = buckling_analysis(model, model, 1)
     i_z, i_y = height * width**3 / 12, width * height**3 / 12
-    polar = i_y + i_z
+    j = section.torsion_constant
+    assert j == pytest.approx(width**3 * height / 3 * (1 - 0.630 * width / height), rel=2e-3)
     g = E / (2 * (1 + nu))
-    prandtl = 4.013 * np.sqrt(E * i_z * g * polar) / length**2
-    corrected = prandtl / np.sqrt(1 - i_z / i_y)
+    prandtl = 4.013 * np.sqrt(E * i_z * g * j) / length**2
+    corrected = prandtl / np.sqrt((1 - i_z / i_y) * (1 - g * j / (E * i_y)))
     critical = result.load_factor[0] * 10.0
-    print(f"\nLTB: P_cr {critical:.3f} N, Prandtl {prandtl:.3f} N, corrected {corrected:.3f} N")
+    print(f"\nLTB: P_cr {critical:.3f} N, Prandtl {prandtl:.3f} N, corrected {corrected:.3f} N, "
+          f"{result.extra}")
     assert critical == pytest.approx(corrected, rel=1e-2)
