@@ -181,30 +181,33 @@ def _pencil(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int, method
     return _sparse(k0, kg, g, count, eigen_tol)
 
 
-def _lowest(k: sp.spmatrix, m: sp.spmatrix, g: sp.spmatrix, method: str) -> float:
-    """The lowest omega^2 of (K, M) on the null space of G (the softest mode's stiffness:
-    it reaches 0 where the static state loses stability)."""
-    if method == "dense":
-        basis = null_space(g, k.shape[0])
-        kr, mr = basis.T @ (k @ basis), basis.T @ (m @ basis)
-        return float(la.eigh(0.5 * (kr + kr.T), 0.5 * (mr + mr.T), eigvals_only=True,
-                             subset_by_index=[0, 0])[0])
+def _lowest(k: sp.spmatrix, m: sp.spmatrix, g: sp.spmatrix, method: str,
+            count: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """The ``count`` lowest omega^2 of (K, M) on the null space of G and their vectors
+    (columns): the softest modes' stiffness, which reaches 0 where the static state loses
+    stability."""
     n, ncon = k.shape[0], g.shape[0]
+    if method == "dense":
+        basis = null_space(g, n)
+        kr, mr = basis.T @ (k @ basis), basis.T @ (m @ basis)
+        count = min(count, kr.shape[0])
+        w, y = la.eigh(0.5 * (kr + kr.T), 0.5 * (mr + mr.T), subset_by_index=[0, count - 1])
+        return w, basis @ y
     scale = np.abs(k.diagonal()).max() / np.abs(m.diagonal()).max()
-    sigma = -1e-6 * scale
+    sigma = -1e-8 * scale
     aug = sp.bmat([[k, g.T], [g, None]], format="csr")
     b = sp.bmat([[m, None], [None, sp.csr_matrix((ncon, ncon))]], format="csr")
     shifted = (aug - sigma * b).tocoo()
-    solver = DirectSolver(n + ncon, shifted.row, shifted.col, what="buckling softest mode")
+    solver = DirectSolver(n + ncon, shifted.row, shifted.col, what="buckling softest modes")
     try:
         solver.factorize(shifted.data)
         op = spla.LinearOperator((n + ncon, n + ncon), matvec=solver.solve, dtype=float)
         v0 = solver.solve(b @ np.random.default_rng(1).standard_normal(n + ncon))
-        w = spla.eigsh(aug, k=1, M=b, sigma=sigma, OPinv=op, which="LM", v0=v0,
-                       return_eigenvectors=False)
+        w, z = spla.eigsh(aug, k=count, M=b, sigma=sigma, OPinv=op, which="LM", v0=v0)
     finally:
         solver.close()
-    return float(w.min())
+    order = np.argsort(w)
+    return w[order], z[:n, order]
 
 
 def _advance(path: "LoadPath", factor: float, tries: int = 6) -> None:
@@ -222,30 +225,27 @@ def _advance(path: "LoadPath", factor: float, tries: int = 6) -> None:
             factor = last[2] + 0.5 * (factor - last[2])
 
 
-def _root(history: list[tuple[float, float]], mu: float, factor: float) -> float:
-    """The load factor where omega^2(P) = w0 (1 - a P - b P^2), fitted through the last two
-    states (one: linear), vanishes; the pencil's factor ``mu`` when the fit has no root."""
+def _root(history: list[tuple[float, float]]) -> float | None:
+    """The load factor where omega^2(P) = w0 (1 - a P - b P^2), fitted through (0, w0) and
+    the last two states (one: linear), vanishes; None while the stiffness does not
+    decrease with the load (no limit in sight)."""
     w0 = history[0][1]
-    if len(history) < 3 or w0 <= 0:
-        p, w = history[-1]
-        slope = (w0 - w) / (p * w0) if w0 > 0 else 0.0
-        estimate = 1.0 / slope if slope > 0 else mu
-    else:
-        (p1, w1), (p2, w2) = history[-2:]
-        try:
-            a, b = np.linalg.solve(np.array([[p1, p1**2], [p2, p2**2]]),
-                                   [1 - w1 / w0, 1 - w2 / w0])
-        except np.linalg.LinAlgError:
-            a, b = (1 - w2 / w0) / p2, 0.0
-        if abs(b) <= 1e-14 * abs(a) * max(p1, p2):
-            estimate = 1.0 / a if a > 0 else mu
-        else:
-            disc = a * a + 4 * b
-            roots = [(-a + sg * np.sqrt(disc)) / (2 * b) for sg in (1.0, -1.0)] \
-                if disc >= 0 else []
-            roots = [r for r in roots if r > 0]
-            estimate = min(roots, key=lambda r: abs(r - factor)) if roots else mu
-    return float(estimate)
+    p2, w2 = history[-1]
+    if w0 <= 0 or w2 >= w0 * (1 - 1e-9):
+        return None
+    if len(history) < 3:
+        return p2 / (1 - w2 / w0)
+    p1, w1 = history[-2]
+    try:
+        a, b = np.linalg.solve(np.array([[p1, p1**2], [p2, p2**2]]), [1 - w1 / w0, 1 - w2 / w0])
+    except np.linalg.LinAlgError:
+        return p2 / (1 - w2 / w0)
+    if abs(b) <= 1e-14 * abs(a) * max(p1, p2):
+        return 1.0 / a if a > 0 else None
+    disc = a * a + 4 * b
+    roots = [(-a + sg * np.sqrt(disc)) / (2 * b) for sg in (1.0, -1.0)] if disc >= 0 else []
+    roots = [r for r in roots if r > 0]
+    return float(min(roots, key=lambda r: abs(r - p2))) if roots else None
 
 
 def _smallest_positive(theta: np.ndarray) -> float:
@@ -296,50 +296,67 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     free = model.ndof - g.shape[0]
     how = solver if solver != "auto" else ("dense" if free <= DENSE_LIMIT else "sparse")
     mass = model.mass_matrix()
-    history = [(0.0, _lowest(k0, mass, g, how))]   # (P, lowest omega^2 of K_T(P) over M)
-    factor, previous = reference_factor, None
+    track = max(count, 1)
+    w0, _ = _lowest(k0, mass, g, how, track)
+    history = [(0.0, w0)]   # (P, the lowest omega^2 of K_T(P) over M)
+    factor, previous, critical = reference_factor, None, None
     while True:
         _advance(path, factor)
         factor = path.factor
         k_t = path.tangent()
-        kg = ((k_t - k0) / factor).tocsr()
-        theta, vectors = _pencil(k0, kg, g, count, how, eigen_tol)
-        mu = _smallest_positive(theta)
         if method == "linear":
-            critical = mu
+            kg = ((k_t - k0) / factor).tocsr()
+            theta, vectors = _pencil(k0, kg, g, count, how, eigen_tol)
             break
-        history.append((factor, _lowest(k_t, mass, g, how)))
-        critical = _root(history, mu, factor)
-        if previous is not None and abs(critical - previous) <= rtol * critical:
+        w, vectors = _lowest(k_t, mass, g, how, track)
+        history.append((factor, w))
+        critical = _root([(p, x[0]) for p, x in history])
+        if critical is not None and previous is not None and \
+                abs(critical - previous) <= rtol * critical:
             break
         if len(history) > max_updates:
-            raise SolverError(f"buckling: the load factor did not settle in {max_updates} "
-                              f"updates (last estimates {previous:.6g}, {critical:.6g})")
+            raise SolverError(
+                f"buckling: no stability limit found up to {factor:.6g} times the reference "
+                "loads (the lowest stiffness does not decrease toward zero)" if critical is None
+                else f"buckling: the load factor did not settle in {max_updates} updates "
+                     f"(last estimates {previous:.6g}, {critical:.6g})")
         previous = critical
-        # approach the estimate from below: the static state at the limit is singular
-        factor = float(np.clip(factor + 0.5 * (critical - factor), factor / 8, factor * 8))
+        if critical is None:  # no softening yet: load further
+            factor *= 4.0
+        else:  # approach the estimate from below: the state at the limit is singular
+            factor = float(np.clip(factor + 0.5 * (critical - factor), factor / 8, factor * 8))
     timing["path"] = time.perf_counter() - start
     reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
                              0.0)
-    scale = np.abs(theta).max(initial=0.0)
-    positive = theta > 1e-12 * max(scale, 1e-300)
-    mus = 1.0 / theta[positive]
-    order = np.argsort(mus)[:count]
-    mus[order[0]] = critical  # the stability limit (nonlinear: the fitted root)
-    order = order[np.argsort(mus[order], kind="stable")]
-    shapes = vectors[:, positive][:, order].T.copy()
+    if method == "linear":
+        scale = np.abs(theta).max(initial=0.0)
+        positive = theta > 1e-12 * max(scale, 1e-300)
+        mus = 1.0 / theta[positive]
+        order = np.argsort(mus)[:count]
+        factors, shapes = mus[order], vectors[:, positive][:, order].T.copy()
+        negative = theta < -1e-12 * max(scale, 1e-300)
+        negative_factor = float(1.0 / theta[negative].min()) if negative.any() else 0.0
+    else:
+        # the first: the limit; the others: each mode's omega^2(P) extrapolated likewise
+        factors = [critical]
+        for i in range(1, min(count, len(history[-1][1]))):
+            root = _root([(p, x[i]) for p, x in history])
+            if root is not None:
+                factors.append(root)
+        keep = np.argsort(factors, kind="stable")
+        factors = np.asarray(factors)[keep]
+        shapes = vectors[:, keep].T.copy()
+        negative_factor = 0.0
     for i, x in enumerate(shapes):
         peak = x[np.argmax(np.abs(x))]
         shapes[i] = x / peak if peak else x
-    negative = theta < -1e-12 * max(scale, 1e-300)
-    result = BucklingResult(mus[order], shapes, how, tuple(fixed_loads),
+    result = BucklingResult(np.asarray(factors, dtype=float), shapes, how, tuple(fixed_loads),
                             model.expand(shapes, with_offset=False), base, reference,
                             timing=timing,
                             extra={"method": method, "updates": len(history),
                                    "reference_factor": history[-1][0],
                                    "static_solves": path.solves,
-                                   "negative_load_factor": float(1.0 / theta[negative].min())
-                                   if negative.any() else 0.0})
+                                   "negative_load_factor": negative_factor})
     model.counters["buckling_analyses"] += 1
     result.wall_time_s = time.perf_counter() - start
     timing["total"] = result.wall_time_s
