@@ -261,7 +261,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                       fixed_loads: tuple[str, ...] = (), method: str = "nonlinear",
                       solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,
                       load_steps: int = 1, reference_factor: float = 1.0,
-                      rtol: float = 1e-6, max_updates: int = 30,
+                      rtol: float = 1e-6, max_updates: int = 40,
                       eigen_tol: float = 0.0) -> BucklingResult:
     """The ``count`` lowest positive load factors of ``model``'s loads beyond those of
     ``base_model`` (the same system with the fixed loads alone; pass ``model`` itself
@@ -309,6 +309,15 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
             theta, vectors = _pencil(k0, kg, g, count, how, eigen_tol)
             break
         w, vectors = _lowest(k_t, mass, g, how, track)
+        if len(history) >= 2 and factor > history[-1][0] and \
+                0 < history[-1][1][0] < history[0][1][0] and w[0] > history[-1][1][0]:
+            raise SolverError(
+                f"buckling: no stability limit on the static path: the lowest stiffness fell "
+                f"to {history[-1][1][0] / history[0][1][0]:.3g} of its start at "
+                f"{history[-1][0]:.6g} times the reference loads and rises again at "
+                f"{factor:.6g} (an imperfect structure: the fixed loads bend what the "
+                "reference loads compress); buckling.method = 'linear' gives the classical "
+                "estimate, docs/theory.md says when it holds")
         history.append((factor, w))
         critical = _root([(p, x[0]) for p, x in history])
         if critical is not None and previous is not None and \
@@ -324,7 +333,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         if critical is None:  # no softening yet: load further
             factor *= 4.0
         else:  # approach the estimate from below: the state at the limit is singular
-            factor = float(np.clip(factor + 0.5 * (critical - factor), factor / 8, factor * 8))
+            factor = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
     timing["path"] = time.perf_counter() - start
     reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
                              0.0)
