@@ -504,7 +504,7 @@ SCHEMA["modal"] = {
     "solver": Key("str", "auto", one_of("auto", "dense", "sparse"),
                   "eigensolver: 'dense' (null space of the constraints, LAPACK), 'sparse' "
                   "(shift-invert Lanczos on the multiplier form, MUMPS + ARPACK), 'auto' (dense "
-                  "up to 400 free coordinates)"),
+                  "up to 150 free coordinates)"),
     "rigid_tol": Key("float", 1e-9, lambda v: None if 0 < v < 1e-3 else
                      "must lie in (0, 1e-3)", "modes with |omega^2| below rigid_tol times "
                      "max diag K / max diag M are rigid-body modes, reported at 0 Hz"),

@@ -48,7 +48,7 @@ from ..system.model import Model
 from .static import StaticResult, solve_newton
 
 #: largest number of coordinates minus constraints solved densely by ``solver='auto'``
-DENSE_LIMIT = 400
+DENSE_LIMIT = 150
 
 
 @dataclass
