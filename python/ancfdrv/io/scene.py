@@ -383,7 +383,7 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str, kind: str) 
         raise InputError("the boom needs three segments A1-A2, A2-A3, A3-A4", file=file,
                          group="beam", key="segments")
     boom = values.get("boom")
-    if boom and scene["analysis"] != "static" and boom["omega"] > 0:
+    if boom and scene["analysis"] in ("dynamic", "static+dynamic") and boom["omega"] > 0:
         sweep = math.radians(boom["angle_end_deg"] - boom["angle_deg"])
         if sweep <= 0:
             raise InputError("luffing needs angle_end_deg > angle_deg (or omega = 0 to hold "

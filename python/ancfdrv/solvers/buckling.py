@@ -261,7 +261,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                       fixed_loads: tuple[str, ...] = (), method: str = "nonlinear",
                       solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,
                       load_steps: int = 1, reference_factor: float = 1.0,
-                      rtol: float = 1e-6, max_updates: int = 40,
+                      rtol: float = 1e-6, max_updates: int = 40, max_factor: float = 1e6,
                       eigen_tol: float = 0.0) -> BucklingResult:
     """The ``count`` lowest positive load factors of ``model``'s loads beyond those of
     ``base_model`` (the same system with the fixed loads alone; pass ``model`` itself
@@ -334,6 +334,11 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                      f"(last estimates {previous:.6g}, {critical:.6g})")
         previous = critical
         if critical is None:  # no softening yet: load further
+            if factor * 4.0 > max_factor:
+                raise SolverError(
+                    f"buckling: no stability limit up to {factor:.6g} times the reference "
+                    "loads (the lowest stiffness does not fall as they grow: e.g. a square "
+                    "section bent in a plane of symmetry has no lateral-torsional buckling)")
             factor *= 4.0
         else:  # approach the estimate from below: the state at the limit is singular
             factor = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
