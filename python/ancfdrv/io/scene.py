@@ -463,9 +463,9 @@ def _check_spring(values: dict[str, dict[str, Any]], file: str) -> None:
         if leaf[key] is None:
             raise InputError("required key is missing", file=file, group="leaf", key=key)
     if scene["analysis"] not in ("dynamic", "modal"):
-        raise InputError("the leaf spring runs dynamics or modal analysis only (use a slow "
-                         "'load_cycle' for quasi-static loading)", file=file, group="scene",
-                         key="analysis")
+        raise InputError("the leaf spring runs dynamics only, or analysis = 'modal' (use a "
+                         "slow 'load_cycle' for quasi-static loading)", file=file,
+                         group="scene", key="analysis")
     if leaf["prestress"]:
         if "prestress" not in effects:
             raise InputError("leaf.prestress = .true. needs the effect 'prestress' in "

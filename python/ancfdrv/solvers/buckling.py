@@ -312,7 +312,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         # a rise after a fall that stopped well above zero (near the limit, omega^2 ~ 0 is
         # round-off and may rise by noise)
         if len(history) >= 2 and factor > history[-1][0] and \
-                1e-3 * history[0][1][0] < history[-1][1][0] < history[0][1][0] and \
+                1e-3 * history[0][1][0] < history[-1][1][0] < 0.99 * history[0][1][0] and \
                 w[0] > history[-1][1][0]:
             raise SolverError(
                 f"buckling: no stability limit on the static path: the lowest stiffness fell "
