@@ -446,7 +446,8 @@ def run_eigen(scene: Scene, model: Model, out: Path, timing: dict[str, Any]) -> 
                                        solver=settings["solver"], tol=solver["tol"],
                                        max_iter=solver["max_iter"],
                                        load_steps=settings["load_steps"],
-                                       rtol=settings["rtol"])
+                                       rtol=settings["rtol"],
+                                       reference_factor=settings["reference_factor"])
         finally:
             if base is not model:
                 base.close()

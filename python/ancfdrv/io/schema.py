@@ -528,6 +528,9 @@ SCHEMA["buckling"] = {
                 "method 'nonlinear': relative change of the load factor that ends the updates"),
     "load_steps": Key("int", 1, positive, "Newton load increments between states on the "
                       "static path"),
+    "reference_factor": Key("float", 1.0, positive, "the first state on the path: this "
+                            "multiple of the reference loads (nearer the limit when the "
+                            "scene's loads are far below it)"),
 }
 #: &modal and &buckling occur once in general scenes too
 GENERAL_SINGLE_GROUPS = GENERAL_SINGLE_GROUPS + ("modal", "buckling")
