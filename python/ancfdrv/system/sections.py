@@ -263,23 +263,33 @@ def _positive_number(value, key: str, where: str) -> float:
     return number
 
 
+def _four_point_rule(area: float, iy: float, iz: float) -> kernel.SectionData:
+    """Points (y, z) = (+-sqrt(iz/area), +-sqrt(iy/area)) with weights area/4: they integrate
+    1, y^2, z^2 to area, iz, iy (and every odd moment to 0)."""
+    half_y, half_z = math.sqrt(iz / area), math.sqrt(iy / area)
+    y = np.array([-half_y, half_y, -half_y, half_y])
+    z = np.array([-half_z, -half_z, half_z, half_z])
+    return kernel.SectionData(SECTION_RECTANGLE, (2.0 * half_z, 2.0 * half_y, 0.0), y, z,
+                              np.full(4, 0.25 * area), area, iy, iz, iy + iz)
+
+
 class General(Section):
     """A section given by its properties, as a section table or a benchmark lists them:
     area A, I_y = int z^2 dA, I_z = int y^2 dA, the torsion constant J and the shear factors
     k_y, k_z (the shear stiffnesses are k G A; a benchmark's G A_s gives k = G A_s / (G A)).
-    Optional: ``mass_per_length`` (kg/m; default density times A) and ``rotary_inertia``
-    = (r_x, r_y, r_z) (kg m per unit length, about the axis, the width-normal y... see below;
-    default density times (I_y + I_z, I_y, I_z)), and ``fibre_points`` ((y, z) pairs for
-    the stresses; default the corners of the equivalent rectangle).
+    Optional: ``mass_per_length`` (kg/m; default density times A), ``rotary_inertia`` =
+    (r_x, r_y, r_z) (kg m, per unit length; default density times (I_y + I_z, I_y, I_z)) and
+    ``fibre_points`` ((y, z) pairs for the stresses; default the corners of the rectangle
+    with the same I_y/A and I_z/A).
 
     ``rotary_inertia`` = (r_x, r_y, r_z): r_x = int rho (y^2 + z^2) dA about the beam's axis,
     r_y = int rho z^2 dA (turning about the height axis), r_z = int rho y^2 dA. The beam's
     section field is linear (its directors r_y, r_z carry the rotary inertia), so r_x =
     r_y + r_z is required.
 
-    The elements integrate the section with the 2 x 2 rule of the equivalent rectangle,
-    height sqrt(12 I_z / A) and width sqrt(12 I_y / A) (the same A, I_y, I_z), and the mass
-    with that of the rectangle of the given mass and rotary inertias.
+    The elements integrate the section with four points (+-sqrt(I_z/A), +-sqrt(I_y/A)) of
+    weight A/4 (the same A, I_y, I_z), and the mass with four points (+-sqrt(r_z/m),
+    +-sqrt(r_y/m)) of weight m/4 (m the mass per length).
     """
 
     kind = SECTION_RECTANGLE
@@ -324,7 +334,14 @@ class General(Section):
 
     @property
     def dims(self) -> tuple[float, ...]:
+        """Width and height of the rectangle with the same I_y / A and I_z / A."""
         return (math.sqrt(12.0 * self._iy / self._area), math.sqrt(12.0 * self._iz / self._area))
+
+    @cached_property
+    def data(self) -> kernel.SectionData:
+        """Four points (+-sqrt(I_z/A), +-sqrt(I_y/A)) of weight A/4: the 2 x 2 Gauss rule of
+        the rectangle with the same I_y/A and I_z/A, its weights scaled to the area A."""
+        return _four_point_rule(self._area, self._iy, self._iz)
 
     @property
     def extent(self) -> tuple[float, float]:
@@ -375,9 +392,7 @@ class General(Section):
             _, ry, rz = self.rotary_inertia
         else:
             ry, rz = density * self._iy, density * self._iz
-        width, height = math.sqrt(12.0 * ry / mass), math.sqrt(12.0 * rz / mass)
-        rule = kernel.section_data(SECTION_RECTANGLE, (width, height))
-        return rule, mass / rule.area
+        return _four_point_rule(mass, ry, rz), 1.0   # weights carry the mass: density 1
 
     def __repr__(self) -> str:
         return (f"General(area={self._area!r}, iy={self._iy!r}, iz={self._iz!r}, "
