@@ -300,6 +300,8 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     w0, _ = _lowest(k0, mass, g, how, track)
     history = [(0.0, w0)]   # (P, the lowest omega^2 of K_T(P) over M)
     factor, previous, critical = reference_factor, None, None
+    saved: dict[float, tuple[np.ndarray, np.ndarray]] = {}  # states on the path
+    ceiling = np.inf  # a factor known to lie past a fall and rise of the stiffness
     while True:
         _advance(path, factor)
         factor = path.factor
@@ -310,10 +312,19 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
             break
         w, vectors = _lowest(k_t, mass, g, how, track)
         # a rise after a fall that stopped well above zero (near the limit, omega^2 ~ 0 is
-        # round-off and may rise by noise)
+        # round-off and may rise by noise): either the step passed over a limit or the path
+        # has none; step back to the fallen state and halve the interval (geometrically)
+        # until it is narrower than 5%, then refuse
         if len(history) >= 2 and factor > history[-1][0] and \
                 1e-3 * history[0][1][0] < history[-1][1][0] < 0.99 * history[0][1][0] and \
                 w[0] > history[-1][1][0]:
+            low = history[-1][0]
+            if factor / low > 1.05 and len(history) <= max_updates:
+                ceiling = factor
+                path.e, path.lam = saved[low][0].copy(), saved[low][1].copy()
+                path.factor = low
+                factor = float(np.sqrt(low * ceiling))
+                continue
             raise SolverError(
                 f"buckling: no stability limit on the static path: the lowest stiffness fell "
                 f"to {history[-1][1][0] / history[0][1][0]:.3g} of its start at "
@@ -321,6 +332,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                 f"{factor:.6g} (an imperfect structure: the fixed loads bend what the "
                 "reference loads compress); buckling.method = 'linear' gives the classical "
                 "estimate, docs/theory.md says when it holds")
+        saved[factor] = (path.e.copy(), path.lam.copy())
         history.append((factor, w))
         critical = _root([(p, x[0]) for p, x in history])
         if critical is not None and previous is not None and \
@@ -339,9 +351,11 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                     f"buckling: no stability limit up to {factor:.6g} times the reference "
                     "loads (the lowest stiffness does not fall as they grow: e.g. a square "
                     "section bent in a plane of symmetry has no lateral-torsional buckling)")
-            factor *= 4.0
+            factor = min(factor * 4.0, float(np.sqrt(factor * ceiling)))
         else:  # approach the estimate from below: the state at the limit is singular
             factor = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
+            if factor >= ceiling:
+                factor = float(np.sqrt(path.factor * ceiling))
     timing["path"] = time.perf_counter() - start
     reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
                              0.0)
