@@ -171,12 +171,14 @@ def test_rigid_rotation_at_high_speed_carries_no_strain(formulation):
 
 def test_newton_failure_scene(capsys, tmp_path):
     """g. inputs/hard/newton_failure.nml: exit 3, a message with time and reason, every
-    completed step flushed, no NaN."""
+    completed step flushed, no NaN. (The failing step is a knife edge, the last correction
+    within 3e-4 of the tolerance: with the Saint-Venant J in K0's torsion entries, which the
+    planar boom does not load, round-off moved it from t = 0.949 s to 0.950 s.)"""
     from ancfdrv.cli import main
     out = tmp_path / "nf.h5"
     assert main(["run", str(INPUTS / "hard" / "newton_failure.nml"), "-o", str(out)]) == 3
     err = capsys.readouterr().err
-    assert "time step from t = 0.949 s" in err and "did not converge" in err
+    assert "time step from t = 0.95 s" in err and "did not converge" in err
     t, tip = read(out, "dynamic/time", "dynamic/deflection/tip")
-    assert t[-1] == pytest.approx(0.949) and len(t) == 950
+    assert t[-1] == pytest.approx(0.950) and len(t) == 951
     assert np.all(np.isfinite(tip))

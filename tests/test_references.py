@@ -51,12 +51,15 @@ def _cantilever(
 def test_section_helpers_match_hand_formulas():
     r = fr.rectangle(0.2, 0.3)
     assert (r.A, r.Iy, r.Iz) == pytest.approx((0.06, 0.2 * 0.3**3 / 12, 0.3 * 0.2**3 / 12), rel=1e-14)
-    assert r.J == pytest.approx(r.Iy + r.Iz, rel=1e-14) and r.shear_area == r.A
+    # Saint-Venant: beta(h/b = 1.5) = 0.196 (Timoshenko & Goodier's table)
+    assert r.J == pytest.approx(0.196 * 0.2**3 * 0.3, rel=2e-3) and r.shear_area == r.A
+    assert r.Ip == pytest.approx(r.Iy + r.Iz, rel=1e-14)
     b = fr.box(0.2, 0.3, 0.01)  # outer minus inner 0.18 x 0.28
     assert b.A == pytest.approx(0.06 - 0.18 * 0.28, rel=1e-13)
     assert b.Iy == pytest.approx((0.2 * 0.3**3 - 0.18 * 0.28**3) / 12, rel=1e-13)
     assert b.Iz == pytest.approx((0.3 * 0.2**3 - 0.28 * 0.18**3) / 12, rel=1e-13)
-    assert b.J == pytest.approx(b.Iy + b.Iz, rel=1e-14)
+    # Bredt-Batho on the midline 0.19 x 0.29 (plus the walls' share p t^3 / 3)
+    assert b.J == pytest.approx(4 * (0.19 * 0.29)**2 * 0.01 / 0.96 + 0.96 * 1e-6 / 3, rel=1e-12)
     t = fr.tube(0.1, 0.005)
     assert t.A == pytest.approx(math.pi * (0.1**2 - 0.09**2) / 4, rel=1e-14)
     assert t.Iy == t.Iz == pytest.approx(math.pi * (0.1**4 - 0.09**4) / 64, rel=1e-14)

@@ -406,8 +406,8 @@ def test_gravity_on_every_body_kind():
 @pytest.mark.parametrize("kind", KINDS)
 def test_dead_torque_twist(kind, formulation, bending):
     """A dead moment T = 10 N m about the axis of a 2 m cantilever (4 elements): the tip
-    section twists by T L / (G J), J = I_h + I_w (the project's torsion constant, the polar
-    moment), read from both directors (r_y turns towards z, r_z towards -y: the section
+    section twists by T L / (G J), J the Saint-Venant constant (before issue 20 the polar
+    moment I_h + I_w), read from both directors (r_y turns towards z, r_z towards -y: the section
     turns without shearing). Tolerance 1e-7 (the twist is below 1e-4 rad). A torque applied
     to one director only sheared the section at the loaded node, an error that grew with the
     mesh (2.6e-4 on 2 elements, 1e-3 on 8)."""
@@ -426,4 +426,5 @@ def test_dead_torque_twist(kind, formulation, bending):
         model.close()
     tip = q[12 * 4: 12 * 5].reshape(4, 3)
     twist = [np.arctan2(tip[2, 2], tip[2, 1]), np.arctan2(-tip[3, 1], tip[3, 2])]
-    np.testing.assert_allclose(twist, torque * length / (G * (i_h + i_w)), rtol=1e-7)
+    np.testing.assert_allclose(twist, torque * length / (G * section.torsion_constant),
+                               rtol=1e-7)

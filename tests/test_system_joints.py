@@ -95,14 +95,15 @@ def test_l_frame_weld_closed_form_and_frames(force):
     """L-frame: column H = 1.5 m clamped at its base, arm L = 2 m welded at the corner at 90
     degrees, tip load. FFR 'cubic' on 2 and 4 elements per member against the unit-load
     closed forms (beam_formulas.l_frame_tip_displacement: M, N and V of both members;
-    l_grillage_tip_deflection: bending of both and torsion G J of the column, J = I_h + I_w)
+    l_grillage_tip_deflection: bending of both and torsion G J of the column, J the
+    Saint-Venant constant of the 50 x 100 mm rectangle)
     and frames.py, to 1e-9. The weld passes the moment through the sections, so the result
     does not depend on the mesh (a weld to the column's sheared tangent did: 0.1 % on 2
     elements, 1.4 % on 16)."""
     fx, fy, fz = force
     dx, dy = bf.l_frame_tip_displacement(1.5, 2.0, fx, fy, E * AREA, E * I_H, E * AREA, E * I_H,
                                          G * AREA, G * AREA)
-    dz = bf.l_grillage_tip_deflection(fz, 1.5, 2.0, E * I_W, G * (I_H + I_W), E * I_W,
+    dz = bf.l_grillage_tip_deflection(fz, 1.5, 2.0, E * I_W, G * REF.J, E * I_W,
                                       G * AREA, G * AREA)
     closed = np.array([dx, dy, dz])
     reference = _knee_frame(0.0, force)
@@ -231,7 +232,7 @@ def test_rigid_body_welded_to_ffr_tip_closed_form(case, nodes, body_first):
     there, or a torque of 20 kN m about the axis (a couple of forces on the body).
     Displacements of the beam's tip, of the body's point 1 m beyond it and of a body point
     0.5 m off the axis against the Timoshenko closed forms (beam_formulas: tip force plus
-    the moment P * 1 m; N L / (E A); twist T L / (G J), J = I_h + I_w) on 2, 8 and 16
+    the moment P * 1 m; N L / (E A); twist T L / (G J), J the Saint-Venant constant) on 2, 8 and 16
     elements, whichever body the weld names first.
 
     Tolerance 1e-9 of the largest displacement: FFR 'cubic' is linear and exact for end
@@ -242,7 +243,7 @@ def test_rigid_body_welded_to_ffr_tip_closed_form(case, nodes, body_first):
     2.2e-3 on 2 elements, 2.8e-4 on 16 in the transverse case (tip turn 2e-3 rad), 9.4e-2 on
     2 elements in the torque case (twist 1e-2 rad)."""
     length, ref = BOOM["length"], BOOM["ref"]
-    ei, ea, ga, gj = E * ref.Iy, E * ref.A, G * ref.A, G * (ref.Iy + ref.Iz)
+    ei, ea, ga, gj = E * ref.Iy, E * ref.A, G * ref.A, G * ref.J
     arm, side = np.array([length + 1.0, 0.0, 0.0]), np.array([length, 0.5, 0.0])
     probes = {"tip": ("beam", (length, 0.0, 0.0)), "arm": ("body", arm), "side": ("body", side)}
     expected = {name: np.zeros(3) for name in probes}
@@ -468,7 +469,7 @@ def test_spherical_joint_between_two_cantilevers():
     50 N m) at A's end, the joint: displacements of A's midpoint and of the joint and the
     twist of A's end against frames.py (add_hinge without an axis) to 1e-9 (FFR 'cubic';
     the twist is 1e-4 rad, so second-order terms stay below 1e-8), and A alone twists:
-    T a / (G J) with J = I_h + I_w."""
+    T a / (G J) with J the Saint-Venant constant."""
     a, b = 1.5, 2.0
     force, torque = np.array([60.0, -900.0, 400.0]), 50.0
     s = System("spherical")
@@ -502,7 +503,7 @@ def test_spherical_joint_between_two_cantilevers():
     np.testing.assert_allclose(node(1)[0] - (a / 2, 0, 0), u[na[1], :3], atol=1e-9 * scale, rtol=0)
     np.testing.assert_allclose(node(2)[0] - (a, 0, 0), u[na[2], :3], atol=1e-9 * scale, rtol=0)
     np.testing.assert_allclose(twist, u[na[2], 3], rtol=1e-7)
-    assert twist[0] == pytest.approx(torque * a / (G * (I_H + I_W)), rel=1e-7)
+    assert twist[0] == pytest.approx(torque * a / (G * SECTION.torsion_constant), rel=1e-7)
 
 
 def _simply_supported(length: float, nodes: int) -> dict[str, np.ndarray]:

@@ -102,7 +102,8 @@ def beam_point_mass(xi, y, z, length, mass) -> np.ndarray:
 def beam_nonlinear_setup(reference, lengths, section: SectionData):
     """Material gradients (8, 3, npts, nel), weights (npts, nel) and the number of volume
     points of the large-deformation beam's Gauss rule, from the reference configuration
-    (3, 8, nel); the remaining points are on the neutral axis."""
+    (3, 8, nel); the remaining points are on the neutral axis and the section's twist
+    points (beam_nonlinear)."""
     nsec = len(section.weights)
     npts = int(_kernel.beam_nonlinear_points(nsec))
     gradients, weights, info = _kernel.beam_nonlinear_setup(
@@ -111,7 +112,8 @@ def beam_nonlinear_setup(reference, lengths, section: SectionData):
         element, code = divmod(info, 10)
         raise InputError(f"beam element {element}: degenerate reference geometry "
                          f"(det J0 <= 0, code {code})")
-    return gradients, weights, npts - npts // (nsec + 1)
+    naxial = (npts - 8) // (nsec + 1)        # 4 axial points; 4 x 2 twist points
+    return gradients, weights, nsec * naxial  # the volume points come first
 
 
 def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poisson,

@@ -32,10 +32,11 @@ properties (see the helpers ``rectangle``, ``box``, ``tube``, ``circle``):
   width). In a planar frame with the default height axis (global z), the in-plane
   bending stiffness is therefore E * Iz; give an in-plane ``height_axis`` (normal to
   the element) to bend with E * Iy instead.
-* ``J = Iy + Iz``, the *polar* second moment, is used for the torsional stiffness G J
-  of every section, consistently (exact for circles and tubes; for rectangles and
-  boxes it overestimates the Saint-Venant torsion constant). The torsional mass rho J
-  is the exact polar mass moment per length for any section.
+* ``J`` is the Saint-Venant torsion constant used for the torsional stiffness G J:
+  rectangles by the series solution (Timoshenko & Goodier, ch. 10), boxes by Bredt-Batho
+  on the wall's midline plus the walls' own share p t^3 / 3, circles and tubes the polar
+  moment (exact). The torsional mass rho Ip uses the polar moment ``Ip = Iy + Iz``, the
+  exact polar mass moment per length for any section.
 * The Timoshenko shear area is ``k A`` in both planes, with the shear coefficient
   ``k`` given per element (default 1.0, i.e. shear area = A, the project's choice).
 
@@ -48,7 +49,7 @@ polynomial integrands). Nodal displacements are exact (to rounding) for point lo
 nodes and uniform distributed loads, for both theories. Translational consistent mass
 rho A; rotary inertia (rho Iy, rho Iz in bending) is included for Timoshenko elements and
 left out for Euler-Bernoulli ones by default (``rotary_inertia`` overrides); torsional
-mass rho J always.
+mass rho Ip always.
 
 Other members
 -------------
@@ -107,9 +108,9 @@ class Section:
     """Cross-section properties [m^2, m^4].
 
     ``Iy = integral z^2 dA`` (z along the height), ``Iz = integral y^2 dA`` (y along the
-    width), ``J = Iy + Iz`` (polar moment, used for torsion everywhere). The Timoshenko
-    shear area is ``shear_area = A`` (shear coefficient 1); an element may scale it with
-    its own shear coefficient.
+    width), ``J`` the Saint-Venant torsion constant, ``Ip = Iy + Iz`` the polar moment
+    (torsional mass). The Timoshenko shear area is ``shear_area = A`` (shear coefficient
+    1); an element may scale it with its own shear coefficient.
     """
 
     A: float
@@ -118,28 +119,46 @@ class Section:
     J: float
 
     @property
+    def Ip(self) -> float:
+        """Polar second moment Iy + Iz (the torsional mass per length is rho Ip)."""
+        return self.Iy + self.Iz
+
+    @property
     def shear_area(self) -> float:
         """Timoshenko shear area with coefficient 1: the full area A."""
         return self.A
 
 
+def _rectangle_torsion(width: float, height: float) -> float:
+    """Saint-Venant J of a solid rectangle, t <= s its sides: the series of Timoshenko &
+    Goodier (Theory of Elasticity, ch. 10), J = t^3 s (1/3 - (64 t / (pi^5 s))
+    sum_{k >= 0} tanh((2k+1) pi s / (2t)) / (2k+1)^5), 60 terms."""
+    t, s = sorted((width, height))
+    total = sum(np.tanh((2 * k + 1) * np.pi * s / (2 * t)) / (2 * k + 1) ** 5 for k in range(60))
+    return t**3 * s * (1.0 / 3.0 - 64.0 * t / (np.pi**5 * s) * total)
+
+
 def rectangle(width: float, height: float) -> Section:
-    """Solid rectangle: A = w h, Iy = w h^3/12, Iz = h w^3/12, J = Iy + Iz."""
+    """Solid rectangle: A = w h, Iy = w h^3/12, Iz = h w^3/12, J by the series."""
     _positive(width=width, height=height)
     iy, iz = width * height**3 / 12.0, height * width**3 / 12.0
-    return Section(width * height, iy, iz, iy + iz)
+    return Section(width * height, iy, iz, _rectangle_torsion(width, height))
 
 
 def box(width: float, height: float, wall: float) -> Section:
     """Thin- or thick-walled rectangular box (outer width x height, uniform wall):
-    outer rectangle minus the inner (w - 2t) x (h - 2t) one; J = Iy + Iz."""
+    outer rectangle minus the inner (w - 2t) x (h - 2t) one; J by Bredt-Batho on the
+    midline, 4 A_m^2 t / p, plus the walls' open-section share p t^3 / 3."""
     _positive(width=width, height=height, wall=wall)
     if 2.0 * wall >= min(width, height):
         raise ValueError(
             f"box wall {wall} must be less than half of min(width, height) = {min(width, height)}"
         )
     outer, inner = rectangle(width, height), rectangle(width - 2 * wall, height - 2 * wall)
-    return Section(outer.A - inner.A, outer.Iy - inner.Iy, outer.Iz - inner.Iz, outer.J - inner.J)
+    perimeter = 2.0 * (width - wall + height - wall)
+    mid_area = (width - wall) * (height - wall)
+    j = 4.0 * mid_area**2 * wall / perimeter + perimeter * wall**3 / 3.0
+    return Section(outer.A - inner.A, outer.Iy - inner.Iy, outer.Iz - inner.Iz, j)
 
 
 def tube(diameter: float, wall: float) -> Section:
@@ -265,7 +284,8 @@ def beam_local_matrices(L, E, G, A, Iy, Iz, J, rho, timoshenko, rotary_inertia, 
     Q = np.zeros((ne, 12, 3))
     two = np.array([[1.0, -1.0], [-1.0, 1.0]])
     lumped = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
-    for idx, stiff, mass in ((_AXIAL, E * A, rho * A), (_TORSION, G * J, rho * J)):
+    Ip = Iy + Iz
+    for idx, stiff, mass in ((_AXIAL, E * A, rho * A), (_TORSION, G * J, rho * Ip)):
         K[:, idx[:, None], idx[None, :]] = (stiff / L)[:, None, None] * two
         M[:, idx[:, None], idx[None, :]] = (mass * L)[:, None, None] * lumped
     Q[:, _AXIAL, 0] = 0.5 * L[:, None]

@@ -122,8 +122,9 @@ contains
   !> to the reference material coordinates X = r0(x, y, z); isotropic law (E, nu), which
   !> for nu = 0 is the paper's Q = diag(E, E, E, E/2, E/2, E/2) (eq. 18).
   !> Torsion and shear of the section (shear_scales = [c, d_y, d_z], as beam_nonlinear):
-  !> G on g_xy, g_xz times c = J / I_p over the section, and G d_y, G d_z (d = k - c) on
-  !> the neutral axis, so the twist costs G J and a uniform shear k G A.
+  !> E/2 on g_xy, g_xz over the section, G d_y, G d_z on the neutral axis, and c G - E/2 on
+  !> g_xy at the twist points (0, +-sqrt(I_y/A)), on g_xz at (+-sqrt(I_z/A), 0) (weights
+  !> A/2), so the twist costs G J (c = J / I_p) and a uniform shear k G A (d = k - c).
   !> info: 0 ok, 1 bad quadrature, 2 degenerate reference (det J0 <= 0).
   pure subroutine beam_linear_stiffness(reference, length, section_y, section_z, section_w, &
                                         youngs, poisson, shear_scales, stiffness, info)
@@ -134,26 +135,49 @@ contains
     real(dp) :: xi(n_axial), weight(n_axial, size(section_w))
     real(dp) :: shape(8), dshape(8, 3), jacobian0(3, 3), inverse0(3, 3), det0
     real(dp) :: material_gradient(8, 3), strain_matrix(6, 24), elasticity(6, 6)
-    real(dp) :: axis_law(6, 6), shear
-    integer :: i, s
+    real(dp) :: laws(6, 6, 3), shear, area, point_y(5), point_z(5), point_w(5), law(6, 6)
+    real(dp) :: pt(2), wt(2), xi_point, weight_point
+    integer :: i, s, nsection, extra, naxial
     call volume_rule(length, section_w, xi, weight, info)
+    if (info == 0) call gauss_legendre(2, pt, wt, info)   ! the twist points' axial rule
     call isotropic_elasticity(youngs, poisson, elasticity)
     shear = elasticity(4, 4)
-    elasticity(4, 4) = shear_scales(1) * shear
-    elasticity(6, 6) = shear_scales(1) * shear
-    axis_law = 0.0_dp
-    axis_law(4, 4) = shear_scales(2) * shear
-    axis_law(6, 6) = shear_scales(3) * shear
+    elasticity(4, 4) = 0.5_dp * youngs                       ! as beam_nonlinear's volume law
+    elasticity(6, 6) = 0.5_dp * youngs
+    laws = 0.0_dp
+    laws(4, 4, 1) = shear_scales(2) * shear                  ! neutral axis
+    laws(6, 6, 1) = shear_scales(3) * shear
+    laws(4, 4, 2) = shear_scales(1) * shear - 0.5_dp * youngs   ! twist points (0, +-z0)
+    laws(6, 6, 3) = shear_scales(1) * shear - 0.5_dp * youngs   ! twist points (+-y0, 0)
+    nsection = size(section_w)
+    area = sum(section_w)
+    point_y = [0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, -1.0_dp] * sqrt(sum(section_w * section_y**2) / area)
+    point_z = [0.0_dp, 1.0_dp, -1.0_dp, 0.0_dp, 0.0_dp] * sqrt(sum(section_w * section_z**2) / area)
+    point_w = [1.0_dp, 0.5_dp, 0.5_dp, 0.5_dp, 0.5_dp]       ! times the area
     stiffness = 0.0_dp
-    do s = 1, size(section_w) + 1
-      do i = 1, n_axial
-        if (s <= size(section_w)) then
+    do s = 1, nsection + 5
+      extra = s - nsection
+      if (extra >= 1) then
+        law = laws(:, :, min(extra, 1) + merge(1, 0, extra >= 2) + merge(1, 0, extra >= 4))
+        if (all(law == 0.0_dp)) cycle
+      else
+        law = elasticity
+      end if
+      naxial = merge(2, n_axial, extra >= 2)
+      do i = 1, naxial
+        if (extra >= 2) then          ! twist points: 2 Gauss points, as beam_nonlinear
+          xi_point = 0.5_dp * (pt(i) + 1.0_dp)
+          weight_point = 0.5_dp * wt(i) * length * area
+        else
+          xi_point = xi(i)
+          weight_point = sum(weight(i, :))
+        end if
+        if (extra < 1) then
           call beam_shape(xi(i), section_y(s), section_z(s), length, shape, dshape(:, 1), &
                           dshape(:, 2), dshape(:, 3))
         else
-          if (all(axis_law == 0.0_dp)) exit
-          call beam_shape(xi(i), 0.0_dp, 0.0_dp, length, shape, dshape(:, 1), dshape(:, 2), &
-                          dshape(:, 3))
+          call beam_shape(xi_point, point_y(extra), point_z(extra), length, shape, &
+                          dshape(:, 1), dshape(:, 2), dshape(:, 3))
         end if
         jacobian0 = matmul(reference, dshape)
         call invert3(jacobian0, inverse0, det0)
@@ -163,12 +187,12 @@ contains
         end if
         material_gradient = matmul(dshape, inverse0)
         call small_strain_matrix(material_gradient, strain_matrix)
-        if (s <= size(section_w)) then
+        if (extra < 1) then
           stiffness = stiffness + weight(i, s) * det0 * &
-                      matmul(transpose(strain_matrix), matmul(elasticity, strain_matrix))
+                      matmul(transpose(strain_matrix), matmul(law, strain_matrix))
         else
-          stiffness = stiffness + sum(weight(i, :)) * det0 * &
-                      matmul(transpose(strain_matrix), matmul(axis_law, strain_matrix))
+          stiffness = stiffness + point_w(extra) * weight_point * det0 * &
+                      matmul(transpose(strain_matrix), matmul(law, strain_matrix))
         end if
       end do
     end do

@@ -8,18 +8,22 @@
 !> At the reference (F = I, S = 0) the tangent equals the small-strain K0 of the FFR model.
 !>
 !> Poisson locking (the section fields are linear in y, z): D is split into the Poisson-free
-!> part D0 = diag(E, E, E, G, G, G), integrated over the whole section, and the Poisson
-!> part D - D0, integrated on the neutral axis only (the splitting of enhanced continuum
-!> mechanics); with nu = 0 both coincide with the plain law.
+!> part D0 = diag(E, E, E, E/2, G, E/2), integrated over the whole section, and the Poisson
+!> part D - D0 (its normal block), integrated on the neutral axis only (the splitting of
+!> enhanced continuum mechanics); the shears' G enters through the twist and axis points
+!> below. With nu = 0 all coincide with the plain law.
 !>
-!> Torsion and shear of the section (shear_scales = [c, d_y, d_z], docs/theory.md): the
-!> linear section field has no warping, so the shears 2E12, 2E13 at the volume points
-!> carry a twist tau with the polar moment, G I_p tau^2/2. Their modulus is scaled there by
-!> c = J / I_p (J the Saint-Venant torsion constant), and the neutral-axis points add
-!> G d_y, G d_z on 2E12, 2E13 with d = k - c (k the section's shear factor): the section
-!> strain 2E12 = a + y b + z t is linear in (y, z) for any F, so the section integrates to
-!>   c G (A a^2 + I_z b^2 + I_y t^2) + d_y G A a^2 = k_y G A a^2 + c G (I_z b^2 + I_y t^2):
-!> torsion G J, shear k G A, exactly (the rule is symmetric). [1, 0, 0]: the plain law.
+!> Torsion and shear of the section (shear_scales = [c, d_y, d_z], docs/theory.md section
+!> 17): the linear section field has no warping; the shears 2E12 = a_y + y b_y + z t_y,
+!> 2E13 = a_z + y t_z + z b_z are linear in y, z for any F (a the transverse shears, t the
+!> twist, b the axial gradients of the section's stretch). Over the volume they take E/2
+!> (D0 is the Poisson-free law: with G there the b terms tied a spinning rod's deflection to
+!> nu); twist points, at each axial station a pair (0, +-z0), z0 = sqrt(I_y/A), weights A/2,
+!> with c G - E/2 on 2E12 only, and a pair (+-y0, 0), y0 = sqrt(I_z/A), with c G - E/2 on
+!> 2E13 only (2 Gauss points along the element, the others 4); the neutral-axis points add
+!> d G on 2E12, 2E13. With c = J / I_p and
+!> d = k - c the twist costs G J tau^2 and a uniform shear k G A, exactly (the pairs are
+!> symmetric), and b keeps E/2. Twist and axis points whose law vanishes are skipped.
 !>
 !> Kelvin-Voigt material damping (retardation time tau, nonlinear_element_damped):
 !> S = D : (E + tau E'), with the strain rate E' = B(F) q' (the Voigt form of sym(F^T F'),
@@ -36,47 +40,69 @@ module beam_nonlinear
   private
   public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, nonlinear_element_damped
 
-  !> Gauss points along the axis; the section rule comes from beam_section.
+  !> Gauss points along the axis; the section rule comes from beam_section. The twist
+  !> points use 2 (t^2 is quadratic along the element: exact).
   integer, parameter, public :: nonlinear_axial_points = 4
+  integer, parameter :: twist_axial_points = 2
 
 contains
 
-  !> Points per element for a section rule of nsection points: the volume points, then the
-  !> neutral-axis points.
+  !> Points per element for a section rule of nsection points: the volume points, the
+  !> neutral-axis points, the twist points (0, +-z0) and (+-y0, 0).
   pure integer function nonlinear_rule_size(nsection)
     integer, intent(in) :: nsection
-    nonlinear_rule_size = nonlinear_axial_points * (nsection + 1)
+    nonlinear_rule_size = nonlinear_axial_points * (nsection + 1) + 4 * twist_axial_points
   end function nonlinear_rule_size
 
   !> Material gradients g_a (8, 3, point) and weights (volume element det J0 included) of
   !> one element: first the axial x section volume points (section point outer), then the
-  !> neutral-axis points whose weights carry the section area. info = 2 for det J0 <= 0.
+  !> neutral-axis points whose weights carry the section area, then the twist points (0, z0),
+  !> (0, -z0), (y0, 0), (-y0, 0) of weight A/2. info = 2 for det J0 <= 0.
   pure subroutine nonlinear_setup(reference, length, section_y, section_z, section_w, &
                                   gradients, weights, info)
     real(dp), intent(in) :: reference(3, 8), length, section_y(:), section_z(:), section_w(:)
     real(dp), intent(out) :: gradients(:, :, :), weights(:)   ! (8, 3, npts), (npts)
     integer, intent(out) :: info
     real(dp) :: pa(nonlinear_axial_points), wa(nonlinear_axial_points)
+    real(dp) :: pt(twist_axial_points), wt(twist_axial_points), xi, axial_weight
     real(dp) :: shape(8), dshape(8, 3), jac0(3, 3), inv0(3, 3), det0, y, z
-    integer :: i, s, p, nsection
+    real(dp) :: area, twist_y(4), twist_z(4), twist_w(4)
+    integer :: i, s, p, nsection, naxial
     nsection = size(section_w)
     call gauss_legendre(nonlinear_axial_points, pa, wa, info)
     if (info /= 0) return
+    call gauss_legendre(twist_axial_points, pt, wt, info)
+    if (info /= 0) return
+    area = sum(section_w)
+    twist_y = [0.0_dp, 0.0_dp, 1.0_dp, -1.0_dp] * sqrt(sum(section_w * section_y**2) / area)
+    twist_z = [1.0_dp, -1.0_dp, 0.0_dp, 0.0_dp] * sqrt(sum(section_w * section_z**2) / area)
+    twist_w = 0.5_dp * area
     p = 0
-    do s = 1, nsection + 1
-      do i = 1, nonlinear_axial_points
+    do s = 1, nsection + 5
+      naxial = merge(nonlinear_axial_points, twist_axial_points, s <= nsection + 1)
+      do i = 1, naxial
         p = p + 1
+        if (s <= nsection + 1) then
+          xi = 0.5_dp * (pa(i) + 1.0_dp)
+          axial_weight = 0.5_dp * wa(i) * length
+        else
+          xi = 0.5_dp * (pt(i) + 1.0_dp)
+          axial_weight = 0.5_dp * wt(i) * length
+        end if
         if (s <= nsection) then
           y = section_y(s)
           z = section_z(s)
-          weights(p) = 0.5_dp * wa(i) * length * section_w(s)
-        else
+          weights(p) = axial_weight * section_w(s)
+        else if (s == nsection + 1) then
           y = 0.0_dp
           z = 0.0_dp
-          weights(p) = 0.5_dp * wa(i) * length * sum(section_w)
+          weights(p) = axial_weight * area
+        else
+          y = twist_y(s - nsection - 1)
+          z = twist_z(s - nsection - 1)
+          weights(p) = axial_weight * twist_w(s - nsection - 1)
         end if
-        call beam_shape(0.5_dp * (pa(i) + 1.0_dp), y, z, length, shape, dshape(:, 1), &
-                        dshape(:, 2), dshape(:, 3))
+        call beam_shape(xi, y, z, length, shape, dshape(:, 1), dshape(:, 2), dshape(:, 3))
         jac0 = matmul(reference, dshape)
         call invert3(jac0, inv0, det0)
         if (det0 <= 0.0_dp) then
@@ -101,19 +127,17 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: law_twist_y(6, 6), law_twist_z(6, 6)
     real(dp) :: stress(6), b(6, 24), db(6, 24)
     integer :: p
-    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson)
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson, law_twist_y, &
+                    law_twist_z)
     force = 0.0_dp
     energy = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
-      if (p <= volume_points) then
-        law = law_free
-      else
-        law = law_poisson
-        if (all(law == 0.0_dp)) cycle
-      end if
+      law = point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z)
+      if (p > volume_points .and. all(law == 0.0_dp)) cycle
       call deformation_gradient(q, gradients(:, :, p), deformation)
       call green_lagrange(deformation, strain)
       stress = matmul(law, strain)
@@ -139,21 +163,19 @@ contains
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
     real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3), strain(6)
+    real(dp) :: law_twist_y(6, 6), law_twist_z(6, 6)
     real(dp) :: stress(6), b(6, 24), b_rate(6, 24)
     real(dp) :: deformation_rate(3, 3), strain_rate(6), damping_stress(6)
     integer :: p
-    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson)
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson, law_twist_y, &
+                    law_twist_z)
     force = 0.0_dp
     energy = 0.0_dp
     dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     do p = 1, size(weights)
-      if (p <= volume_points) then
-        law = law_free
-      else
-        law = law_poisson
-        if (all(law == 0.0_dp)) cycle
-      end if
+      law = point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z)
+      if (p > volume_points .and. all(law == 0.0_dp)) cycle
       call deformation_gradient(q, gradients(:, :, p), deformation)
       call deformation_gradient(rates, gradients(:, :, p), deformation_rate)
       call green_lagrange(deformation, strain)
@@ -253,11 +275,14 @@ contains
   end subroutine strain_matrix
 
   !> D0 = diag(E, E, E, G, G, G) and the Poisson part D - D0 of the isotropic law, with the
-  !> section's torsion and shear correction shear_scales = [c, d_y, d_z]: D0's G on 2E12
-  !> and 2E13 times c (volume points), G d_y and G d_z added to the neutral-axis law.
-  pure subroutine split_laws(youngs, poisson, shear_scales, law_free, law_poisson)
+  !> section's torsion and shear correction shear_scales = [c, d_y, d_z]: G d_y and G d_z
+  !> on 2E12, 2E13 added to the neutral-axis law, (c - 1) G on 2E12 at the twist points
+  !> (0, +-z0) and on 2E13 at (+-y0, 0).
+  pure subroutine split_laws(youngs, poisson, shear_scales, law_free, law_poisson, &
+                             law_twist_y, law_twist_z)
     real(dp), intent(in) :: youngs, poisson, shear_scales(3)
     real(dp), intent(out) :: law_free(6, 6), law_poisson(6, 6)
+    real(dp), intent(out) :: law_twist_y(6, 6), law_twist_z(6, 6)
     real(dp) :: lame, shear
     integer :: i
     lame = youngs * poisson / ((1.0_dp + poisson) * (1.0_dp - 2.0_dp * poisson))
@@ -270,11 +295,39 @@ contains
       law_free(i + 3, i + 3) = shear
       law_poisson(i, i) = lame + 2.0_dp * shear - youngs
     end do
-    law_free(4, 4) = shear_scales(1) * shear
-    law_free(6, 6) = shear_scales(1) * shear
+    ! the shears that vary over the section (2E12, 2E13) take E/2, the Poisson-free law's
+    ! modulus, over the volume (docs/theory.md section 17: with G there, their y b_y and z b_z
+    ! parts tied the deflection of a spinning rod to nu); the twist points make the twist
+    ! c G I_p = G J and the neutral axis the uniform shear k G A
+    law_free(4, 4) = 0.5_dp * youngs
+    law_free(6, 6) = 0.5_dp * youngs
     law_poisson(4, 4) = shear_scales(2) * shear
     law_poisson(6, 6) = shear_scales(3) * shear
+    law_twist_y = 0.0_dp
+    law_twist_z = 0.0_dp
+    law_twist_y(4, 4) = shear_scales(1) * shear - 0.5_dp * youngs
+    law_twist_z(6, 6) = shear_scales(1) * shear - 0.5_dp * youngs
   end subroutine split_laws
+
+  !> The law of point p: volume points, then the neutral-axis points (nonlinear_axial_points
+  !> of them), the twist points (0, +-z0) and (+-y0, 0) (twist_axial_points of each;
+  !> nonlinear_setup's order).
+  pure function point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z) &
+      result(law)
+    integer, intent(in) :: p, volume_points
+    real(dp), intent(in) :: law_free(6, 6), law_poisson(6, 6), law_twist_y(6, 6)
+    real(dp), intent(in) :: law_twist_z(6, 6)
+    real(dp) :: law(6, 6)
+    if (p <= volume_points) then
+      law = law_free
+    else if (p <= volume_points + nonlinear_axial_points) then
+      law = law_poisson
+    else if (p <= volume_points + nonlinear_axial_points + 2 * twist_axial_points) then
+      law = law_twist_y
+    else
+      law = law_twist_z
+    end if
+  end function point_law
 
   !> tangent += w kron(G S G^T, I3): the geometric stiffness of the second Piola-Kirchhoff
   !> stress S (Voigt) with the material gradients G (8, 3) of the shape functions.

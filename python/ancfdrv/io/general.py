@@ -70,10 +70,13 @@ def _section(v: dict[str, Any]):
     if extra:
         raise InputError(f"section {kind!r} does not take {', '.join(extra)}")
     if kind == "general":
+        if v.get("shear") is not None:
+            raise InputError("section 'general' does not take shear (give shear_factor_y, "
+                             "shear_factor_z)")
         return SECTIONS[kind](*(v[k] for k in keys), mass_per_length=v.get("mass_per_length"),
                               rotary_inertia=v.get("rotary_inertia"),
                               fibre_points=v.get("fibre_points"))
-    return SECTIONS[kind](*(v[k] for k in keys))
+    return SECTIONS[kind](*(v[k] for k in keys), shear=v.get("shear") or "unit")
 
 
 def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:

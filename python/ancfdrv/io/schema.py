@@ -365,6 +365,9 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "height": Key("float", None, positive, "section height along r_y (m)"),
         "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
         "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+        "shear": Key("str", None, one_of("unit", "cowper"), "shear factors of 'rectangle', "
+                     "'box', 'tube', 'circle': 'unit' (k = 1, the default) or 'cowper' "
+                     "(Cowper 1966, from the section and nu)"),
         "area": Key("float", None, positive, "'general': cross-section area A (m^2)"),
         "iy": Key("float", None, positive, "'general': I_y = int z^2 dA, bending along the "
                   "width r_z (m^4)"),

@@ -11,7 +11,8 @@ The public properties every section has (docs/theory.md, "Sections"): ``area``, 
 (int z^2 dA, bending about the height axis y), ``iz`` (int y^2 dA), ``torsion_constant``
 (Saint-Venant J: rectangle by the series of Timoshenko & Goodier, box by Bredt-Batho on the
 wall's midline plus the walls' own open-section share, tube and circle exact, J = I_p),
-:meth:`Section.shear_factors` (Cowper 1966, which depend on Poisson's ratio) and
+:meth:`Section.shear_factors` (1 by default, as before issue 20; ``shear='cowper'``:
+Cowper 1966, which depend on Poisson's ratio) and
 :meth:`Section.fibre_points` (the outer-fibre points (y, z) at which stresses peak).
 """
 from __future__ import annotations
@@ -112,9 +113,23 @@ class Section:
         """Saint-Venant torsion constant J (m^4): G J is the torsional stiffness."""
         raise NotImplementedError
 
+    #: 'unit' (k = 1, the default: the elements' behaviour before issue 20, which the
+    #: shipped scenes and their references keep) or 'cowper' (Cowper 1966)
+    shear: str = "unit"
+
     def shear_factors(self, poisson: float) -> tuple[float, float]:
-        """Shear factors (k_y, k_z) for shear along the height and the width (Cowper 1966):
-        the shear stiffnesses are k G A."""
+        """Shear factors (k_y, k_z) for shear along the height and the width, the shear
+        stiffnesses being k G A: 1 unless the section was made with shear='cowper'
+        (then :meth:`cowper_shear_factors`)."""
+        if self.shear == "cowper":
+            return self.cowper_shear_factors(poisson)
+        if self.shear != "unit":
+            raise InputError(f"{type(self).__name__.lower()} section: shear = {self.shear!r} "
+                             "must be 'unit' or 'cowper'")
+        return (1.0, 1.0)
+
+    def cowper_shear_factors(self, poisson: float) -> tuple[float, float]:
+        """Cowper's (1966) shear factors (k_y, k_z) of the section at Poisson's ratio."""
         raise NotImplementedError
 
     def fibre_points(self) -> np.ndarray:
@@ -142,6 +157,7 @@ class Rectangle(Section):
 
     width: float
     height: float
+    shear: str = "unit"
     kind = SECTION_RECTANGLE
 
     @property
@@ -156,7 +172,7 @@ class Rectangle(Section):
     def torsion_constant(self) -> float:
         return rectangle_torsion_constant(self.width, self.height)
 
-    def shear_factors(self, poisson: float) -> tuple[float, float]:
+    def cowper_shear_factors(self, poisson: float) -> tuple[float, float]:
         k = 10.0 * (1.0 + poisson) / (12.0 + 11.0 * poisson)
         return (k, k)
 
@@ -172,6 +188,7 @@ class Box(Section):
     width: float
     height: float
     wall: float
+    shear: str = "unit"
     kind = SECTION_BOX
 
     @property
@@ -186,7 +203,7 @@ class Box(Section):
     def torsion_constant(self) -> float:
         return box_torsion_constant(self.width, self.height, self.wall)
 
-    def shear_factors(self, poisson: float) -> tuple[float, float]:
+    def cowper_shear_factors(self, poisson: float) -> tuple[float, float]:
         web, flange = self.height - self.wall, self.width - self.wall
         return (_cowper_box(web, flange, self.wall, poisson),
                 _cowper_box(flange, web, self.wall, poisson))
@@ -202,6 +219,7 @@ class Tube(Section):
 
     diameter: float
     wall: float
+    shear: str = "unit"
     kind = SECTION_TUBE
 
     @property
@@ -216,7 +234,7 @@ class Tube(Section):
     def torsion_constant(self) -> float:
         return self.polar   # exact: a tube does not warp
 
-    def shear_factors(self, poisson: float) -> tuple[float, float]:
+    def cowper_shear_factors(self, poisson: float) -> tuple[float, float]:
         m = (0.5 * self.diameter - self.wall) / (0.5 * self.diameter)   # r_i / r_o
         nu, a = poisson, (1.0 + m * m) ** 2
         k = 6.0 * (1.0 + nu) * a / ((7.0 + 6.0 * nu) * a + (20.0 + 12.0 * nu) * m * m)
@@ -231,6 +249,7 @@ class Circle(Section):
     """Solid circle: diameter (m)."""
 
     diameter: float
+    shear: str = "unit"
     kind = SECTION_CIRCLE
 
     @property
@@ -245,7 +264,7 @@ class Circle(Section):
     def torsion_constant(self) -> float:
         return self.polar   # exact: a circle does not warp
 
-    def shear_factors(self, poisson: float) -> tuple[float, float]:
+    def cowper_shear_factors(self, poisson: float) -> tuple[float, float]:
         k = 6.0 * (1.0 + poisson) / (7.0 + 6.0 * poisson)
         return (k, k)
 
