@@ -50,8 +50,8 @@ def column(case, *, bending="cubic", nodes=9, length=2.0, side=0.02, load=1000.0
 @pytest.mark.parametrize("case", K_FACTOR)
 def test_euler_columns(case):
     """8 'cubic' elements: within 0.05% of pi^2 EI/(KL)^2 with the shear correction
-    1 / (1 + P / (k G A)) (Timoshenko & Gere sec. 2.17; Cowper's k of the section, the
-    beam's shear; 0.01% to 0.08% here), each critical load twice (the two bending planes
+    1 / (1 + P / (k G A)) (Timoshenko & Gere sec. 2.17; k the section's shear factor, as the
+    beam uses it; 0.01% to 0.08% here), each critical load twice (the two bending planes
     of the square section)."""
     model = column(case).assemble()
     result = buckling_analysis(model, model, 2)
@@ -64,8 +64,8 @@ def test_euler_columns(case):
 
 
 def test_continuum_column_and_sparse_solver():
-    """The 'continuum' bending option (Timoshenko with Cowper's shear factor: P_cr / (1 +
-    P_cr / (k G A)), 0.05% below Euler here) on 16 elements, solved by the sparse solver
+    """The 'continuum' bending option (Timoshenko with the section's shear factor: P_cr /
+    (1 + P_cr / (k G A)), 0.05% below Euler here) on 16 elements, solved by the sparse solver
     (ARPACK on the multiplier form) and the dense one: both within 1% and equal."""
     model = column("pinned-pinned", bending="continuum", nodes=17).assemble()
     dense = buckling_analysis(model, model, 2, solver="dense")
