@@ -44,14 +44,16 @@ def cantilever(length, width, height, nodes, *, formulation="nonlinear", bending
 
 def in_plane(model, modes, axis: int) -> np.ndarray:
     """Indices of the modes whose nodal displacements r lie (90%) along global ``axis``:
-    bending in one plane, apart from torsion and axial modes."""
+    bending in one plane, apart from torsion and axial modes (a torsion mode barely moves
+    r: its direction is round-off and is skipped)."""
     full = modes.full_shapes
     picked = []
     for i, x in enumerate(full):
         r = np.concatenate([x[b.first:b.first + b.ncoordinates].reshape(-1, 12)[:, :3]
                             for b in model.bodies if hasattr(b, "nodes")])
         share = np.sum(r[:, axis] ** 2) / max(np.sum(r**2), 1e-300)
-        if share > 0.9:
+        moves = np.sqrt(np.sum(r**2)) > 1e-3 * np.linalg.norm(x)
+        if share > 0.9 and moves:
             picked.append(i)
     return np.array(picked, dtype=int)
 
