@@ -30,6 +30,10 @@ def plot_result(h5_path: str | Path, png: str | Path | None = None) -> Path:
     :data:`EXTRA_PLOTS` whose group the file holds are written beside it."""
     h5_path = Path(h5_path)
     with h5py.File(h5_path, "r") as h5:
+        eigen = [g for g in ("modal", "buckling") if g in h5 and "mesh_shapes" in h5[g]]
+    if eigen:
+        return plot_modes(h5_path, png, eigen[0])
+    with h5py.File(h5_path, "r") as h5:
         dynamic = "dynamic" in h5 and "time" in h5["dynamic"] and len(h5["dynamic/time"]) > 1
         plate = "nodes" in h5["model"]
         kind = _text(h5.attrs.get("kind", ""))
@@ -859,3 +863,68 @@ def plot_sections(h5_path: str | Path, png: str | Path | None = None) -> Path | 
     fig.savefig(out, dpi=110)
     plt.close(fig)
     return out
+
+
+def _mesh_segments(h5: h5py.File) -> list[np.ndarray]:
+    """Point index lists to draw: each line and each closed quadrilateral of /model/mesh."""
+    group = h5["model/mesh"]
+    kind = _text(group.attrs["topology_type"])
+    topology = group["topology"][()]
+    if kind == "Polyline":
+        return [row for row in topology]
+    if kind == "Quadrilateral":
+        return [np.append(row, row[0]) for row in topology]
+    out, k = [], 0
+    while k < len(topology):
+        if topology[k] == 5:
+            out.append(np.append(topology[k + 1:k + 5], topology[k + 1]))
+            k += 5
+        else:
+            out.append(topology[k + 2:k + 4])
+            k += 4
+    return out
+
+
+def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal",
+               count: int = 4) -> Path:
+    """The first mode shapes of a modal or buckling analysis: the mesh at the static state
+    (grey) and displaced by each shape (scaled to a tenth of the model's size), seen in the
+    plane of the model's largest extent and the shape's largest displacement."""
+    png = Path(png) if png else h5_path.with_suffix(".png")
+    with h5py.File(h5_path, "r") as h5:
+        static = h5[f"{group}/mesh_static"][()]
+        shapes = h5[f"{group}/mesh_shapes"][:count]
+        key = "frequency" if group == "modal" else "load_factor"
+        values = h5[f"{group}/{key}"][:count]
+        damping = h5[f"{group}/damping_ratio"][:count] if "damping_ratio" in h5[group] else None
+        segments = _mesh_segments(h5)
+        title = _text(h5.attrs.get("title", ""))
+    extent = np.ptp(static, axis=0)
+    size = max(float(extent.max()), 1e-12)
+    n = len(shapes)
+    fig, axes = plt.subplots(1, max(n, 1), figsize=(3.2 * max(n, 1), 3.2),
+                             constrained_layout=True, squeeze=False)
+    for k, ax in enumerate(axes[0]):
+        if k >= n:
+            ax.axis("off")
+            continue
+        along = int(np.argmax(extent))
+        moved = int(np.argmax(np.abs(shapes[k]).max(axis=0) + (np.arange(3) == along) * -1e9))
+        deformed = static + 0.1 * size * shapes[k]
+        for seg in segments:
+            ax.plot(static[seg, along], static[seg, moved], color="0.75", lw=0.8)
+            ax.plot(deformed[seg, along], deformed[seg, moved], color="C0", lw=1.2)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel(f"{'xyz'[along]} (m)")
+        ax.set_ylabel(f"{'xyz'[moved]} (m)")
+        if group == "modal":
+            label = f"mode {k + 1}: {values[k]:.4g} Hz"
+            if damping is not None:
+                label += f", zeta {damping[k]:.3g}"
+        else:
+            label = f"mode {k + 1}: load factor {values[k]:.4g}"
+        ax.set_title(label, fontsize=9)
+    fig.suptitle(f"{title} ({group})", fontsize=10)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return png

@@ -491,6 +491,9 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
             stop.check()
         if analysis in ("dynamic", "static+dynamic"):
             dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop)
+        if analysis in ("modal", "buckling"):
+            with stop.immediate():
+                run_eigen(scene, model, out, timing)
     except Interrupted as exc:
         signum = stop.signum or exc.signum
         finish("interrupted", f"interrupted by {signal_name(signum)}")
@@ -516,3 +519,74 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
         model.close()
     finish("ok", after_error=False)
     return RunOutcome(scene, out, static, dynamic, model.warnings, stages)
+
+
+# -- modal analysis and linear buckling (SPEC section 10) ---------------------------------
+def eigen_settings(scene: Scene, group: str) -> dict[str, Any]:
+    """The &modal or &buckling values of a scene, with the schema's defaults for a group
+    the scene does not give."""
+    from .io.schema import SCHEMA
+    given = scene.values.get(group) or {}
+    return {k: given.get(k, spec.default) for k, spec in SCHEMA[group].items()}
+
+
+def fixed_load_model(scene: Scene, fixed: list[str]) -> Model:
+    """The scene's model with only the loads named in ``fixed`` (load names or effects);
+    an unknown name is an InputError naming buckling.fixed_loads."""
+    from .builders import build_system
+    built = build_system(scene)
+    system = built.system
+    known = set(system.loads) | {load.effect for load in system.loads.values()}
+    unknown = [name for name in fixed if name not in known]
+    if unknown:
+        raise InputError(f"unknown load or effect {', '.join(map(repr, unknown))} (loads: "
+                         f"{', '.join(system.loads) or 'none'})", file=str(scene.path),
+                         group="buckling", key="fixed_loads")
+    system.loads = {name: load for name, load in system.loads.items()
+                    if name in fixed or load.effect in fixed}
+    model = system.assemble(effects=scene.effects,
+                            linear_joints=scene["solver"].get("linear_joints", "auto"))
+    model.kind = scene.kind
+    return model
+
+
+def run_eigen(scene: Scene, model: Model, out: Path, timing: dict[str, Any]) -> None:
+    """analysis = 'modal' (about the static equilibrium) or 'buckling'; writes /modal or
+    /buckling, /static, and the XDMF of the shapes."""
+    from .io.xdmf import MeshLayout, write_mode_xdmf
+    from .solvers.buckling import buckling_analysis
+    from .solvers.modal import modal_analysis
+    solver = scene["solver"]
+    analysis = scene["scene"]["analysis"]
+    t0 = time.perf_counter()
+    if analysis == "modal":
+        settings = eigen_settings(scene, "modal")
+        result = modal_analysis(model, settings["modes"], solver=settings["solver"],
+                                tol=solver["tol"], max_iter=solver["max_iter"],
+                                load_steps=solver["load_steps"],
+                                rigid_tol=settings["rigid_tol"],
+                                spin_rate=settings["spin_rate"],
+                                spin_axis=settings["spin_axis"],
+                                spin_centre=settings["spin_centre"])
+        results.write_modal(out, model, result)
+    else:
+        settings = eigen_settings(scene, "buckling")
+        fixed = list(settings["fixed_loads"])
+        base = fixed_load_model(scene, fixed) if fixed else model
+        try:
+            result = buckling_analysis(model, base, settings["modes"],
+                                       fixed_loads=tuple(fixed), method=settings["method"],
+                                       solver=settings["solver"], tol=solver["tol"],
+                                       max_iter=solver["max_iter"],
+                                       load_steps=settings["load_steps"],
+                                       rtol=settings["rtol"],
+                                       reference_factor=settings["reference_factor"])
+        finally:
+            if base is not model:
+                base.close()
+        results.write_buckling(out, model, result)
+    timing[f"{analysis}_total"] = time.perf_counter() - t0
+    for phase, seconds in result.timing.items():
+        timing[f"{analysis}_{phase}"] = seconds
+    if scene["output"].get("xdmf", True) and MeshLayout.from_model(model) is not None:
+        write_mode_xdmf(out, analysis)

@@ -22,7 +22,7 @@ def build(scene) -> BuiltSystem:
     steel = material(s, scene)
     phi = np.radians(boom["angle_deg"])
     height_h = boom["pivot_offset"]
-    if scene["scene"]["analysis"] != "static" and boom["omega"] > 0:
+    if scene["scene"]["analysis"] in ("dynamic", "static+dynamic") and boom["omega"] > 0:
         sweep = np.radians(boom["angle_end_deg"] - boom["angle_deg"])
         drive = s.drive("luffing", "luffing", omega=boom["omega"] * np.sign(sweep),
                         t_start=boom["t_start"], t_brake=boom["t_brake"], sweep=sweep, start=phi)

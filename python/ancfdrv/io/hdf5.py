@@ -367,6 +367,7 @@ def read_summary(path: Path) -> dict[str, Any]:
                     series = dynamic["deflection_support"][name]
                     if len(series):
                         out[f"dynamic.deflection_support.{name}.final"] = series[-1]
+        out.update(eigen_summary(h5))
         if "timing" in h5:
             out.update({f"timing.{k}": v for k, v in h5["timing"].attrs.items()})
         if "counters" in h5:
@@ -816,3 +817,94 @@ def _stress_points(h5: h5py.File, group: h5py.Group, recorder) -> None:
     if "mesh_von_mises_max" in group:
         del group["mesh_von_mises_max"]
     _dataset(group, "mesh_von_mises_max", values, "Pa")
+# -- modal analysis and linear buckling (SPEC section 10) -----------------------------------
+#: how many of the first frequencies / load factors ``ancf info`` prints
+INFO_EIGEN_COUNT = 6
+
+
+def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
+                 full_shapes: np.ndarray, state: np.ndarray, series: dict[str, tuple],
+                 attrs: dict[str, Any]) -> None:
+    """/<name>: the eigenvalue series (name -> (values, units)), shapes[N, ndof] (solver
+    coordinates, as solved), full_shapes[N, nfull], the state the analysis linearized about
+    (static_q), and for XDMF and plots the mesh points at that state (mesh_static) with
+    each shape on them (mesh_shapes[N, npoints, 3], scaled to a largest displacement of 1)."""
+    from .xdmf import MeshLayout, write_layout
+    with _open_write(path) as h5:
+        if name in h5:
+            del h5[name]
+        group = h5.create_group(name)
+        for key, (values, units) in series.items():
+            _dataset(group, key, np.asarray(values), units)
+        data = _dataset(group, "shapes", shapes, COORDINATE_UNITS)
+        data.attrs["description"] = "mode shapes (rows) in the solver coordinates e"
+        _dataset(group, "full_shapes", full_shapes, COORDINATE_UNITS)
+        _dataset(group, "static_q", state, COORDINATE_UNITS)
+        _attrs(group.attrs, attrs)
+        layout = MeshLayout.from_model(model)
+        if layout is not None:
+            if "model/mesh" not in h5:
+                write_layout(h5, layout)
+            static = layout.positions(model, state[None, :])[0]
+            mesh = (layout.map @ np.atleast_2d(full_shapes).T).T.reshape(
+                len(full_shapes), layout.npoints, 3)
+            peak = np.abs(mesh).reshape(len(mesh), -1).max(axis=1, initial=0.0)
+            mesh = mesh / np.where(peak > 0, peak, 1.0)[:, None, None]
+            _dataset(group, "mesh_static", static, "m")
+            shapes_ds = _dataset(group, "mesh_shapes", mesh, "1")
+            shapes_ds.attrs["description"] = ("each shape at the mesh points, scaled to a "
+                                              "largest displacement of 1")
+            for k in range(len(mesh)):  # plain datasets for the XDMF attributes
+                _dataset(group, f"xdmf/mode_{k + 1}", mesh[k], "1")
+
+
+def write_modal(path: Path, model: Model, result) -> None:
+    """/modal from a :class:`~ancfdrv.solvers.modal.ModalResult`: frequency[N] (Hz,
+    ascending, rigid-body modes 0), damping_ratio[N] and damped_frequency[N] when damping
+    (or a steady spin) is on, omega_squared[N], rigid[N], shapes[N, ndof]."""
+    series: dict[str, tuple] = {"frequency": (result.frequency, "Hz"),
+                                "omega_squared": (result.omega_squared, "rad^2/s^2"),
+                                "rigid": (result.rigid.astype(np.int8), "1")}
+    if result.damping_ratio is not None:
+        series["damping_ratio"] = (result.damping_ratio, "1")
+        series["damped_frequency"] = (result.damped_frequency, "Hz")
+    attrs = {"method": result.method, "modes": len(result.frequency),
+             "wall_time_s": result.wall_time_s,
+             **{f"time_{k}_s": v for k, v in result.timing.items()},
+             **{k: v for k, v in result.extra.items() if np.isscalar(v)}}
+    _write_eigen(path, model, "modal", result.shapes, result.full_shapes, result.static.e,
+                 series, attrs)
+    write_static(path, model, result.static)
+
+
+def write_buckling(path: Path, model: Model, result) -> None:
+    """/buckling from a :class:`~ancfdrv.solvers.buckling.BucklingResult`:
+    load_factor[N] (multiples of the reference loads; ascending, positive) and shapes[N, ndof]
+    (largest component 1); /static holds the state under the fixed loads alone."""
+    attrs = {"method": result.extra.get("method", ""), "solver": result.method,
+             "fixed_loads": ",".join(result.fixed_loads), "modes": len(result.load_factor),
+             "wall_time_s": result.wall_time_s,
+             **{f"time_{k}_s": v for k, v in result.timing.items()},
+             **{k: v for k, v in result.extra.items() if np.isscalar(v)}}
+    state = result.reference.e if result.reference is not None else model.e0
+    _write_eigen(path, model, "buckling", result.shapes, result.full_shapes, state,
+                 {"load_factor": (result.load_factor, "1")}, attrs)
+    if result.base is not None:
+        write_static(path, model, result.base)
+
+
+def eigen_summary(h5: h5py.File) -> dict[str, Any]:
+    """The headline figures of /modal and /buckling for ``ancf info``: the first
+    frequencies (and damping ratios), the first load factors, and the attributes."""
+    out: dict[str, Any] = {}
+    for name, key in (("modal", "frequency"), ("buckling", "load_factor")):
+        if name not in h5 or key not in h5[name]:
+            continue
+        group = h5[name]
+        out.update({f"{name}.{k}": _text(v) for k, v in group.attrs.items()})
+        out[f"{name}.{key}"] = group[key][:INFO_EIGEN_COUNT]
+        if "damping_ratio" in group:
+            out[f"{name}.damping_ratio"] = group["damping_ratio"][:INFO_EIGEN_COUNT]
+        if len(group[key]):
+            out[f"{name}.first_{key}"] = float(group[key][0])
+    return out

@@ -352,7 +352,7 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str, kind: str) 
             raise InputError(f"unknown effect {effect!r}; known effects: "
                              f"{', '.join(EFFECTS_AVAILABLE)}", file=file, group="scene",
                              key="effects")
-    if scene["formulation"] == "nonlinear" and scene["analysis"] != "dynamic":
+    if scene["formulation"] == "nonlinear" and scene["analysis"] in ("static", "static+dynamic"):
         if values["solver"]["static_method"] != "newton":
             raise InputError("formulation 'nonlinear' needs static_method = 'newton' (the split "
                              "iteration relies on the constant FFR stiffness)", file=file,
@@ -383,7 +383,7 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str, kind: str) 
         raise InputError("the boom needs three segments A1-A2, A2-A3, A3-A4", file=file,
                          group="beam", key="segments")
     boom = values.get("boom")
-    if boom and scene["analysis"] != "static" and boom["omega"] > 0:
+    if boom and scene["analysis"] in ("dynamic", "static+dynamic") and boom["omega"] > 0:
         sweep = math.radians(boom["angle_end_deg"] - boom["angle_deg"])
         if sweep <= 0:
             raise InputError("luffing needs angle_end_deg > angle_deg (or omega = 0 to hold "
@@ -462,9 +462,10 @@ def _check_spring(values: dict[str, dict[str, Any]], file: str) -> None:
     for key in ("width", "thickness"):
         if leaf[key] is None:
             raise InputError("required key is missing", file=file, group="leaf", key=key)
-    if scene["analysis"] != "dynamic":
-        raise InputError("the leaf spring runs dynamics only (use a slow 'load_cycle' for "
-                         "quasi-static loading)", file=file, group="scene", key="analysis")
+    if scene["analysis"] not in ("dynamic", "modal"):
+        raise InputError("the leaf spring runs dynamics only, or analysis = 'modal' (use a "
+                         "slow 'load_cycle' for quasi-static loading)", file=file,
+                         group="scene", key="analysis")
     if leaf["prestress"]:
         if "prestress" not in effects:
             raise InputError("leaf.prestress = .true. needs the effect 'prestress' in "

@@ -83,8 +83,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "scene": {
         "title": Key("str", check=lambda v: title_problem(v), doc="a line describing the "
                      "scene (at most 1000 characters)"),
-        "analysis": Key("str", "static", one_of("static", "dynamic", "static+dynamic"),
-                        "which analysis runs"),
+        "analysis": Key("str", "static", one_of("static", "dynamic", "static+dynamic", "modal",
+                                                "buckling"),
+                        "which analysis runs ('modal' and 'buckling': about the static state, "
+                        "settings in &modal and &buckling)"),
         "formulation": Key("str", "ffr", one_of("ffr", "nonlinear"), "elastic model"),
         "effects": Key("strs", [], doc="force effects to compute; nothing else is computed "
                        "(general scenes: default every effect their items belong to)"),
@@ -572,6 +574,43 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
 }
 #: Groups of general scenes that occur once (shared with the template scenes).
 GENERAL_SINGLE_GROUPS = ("scene", "solver", "output")
+#: Modal analysis and linear buckling (SPEC section 10; solvers/modal.py, buckling.py): groups
+#: of both kinds of scene, read when scene.analysis is 'modal' or 'buckling'.
+SCHEMA["modal"] = {
+    "modes": Key("int", 10, at_least(1), "number of modes (lowest frequencies first)"),
+    "solver": Key("str", "auto", one_of("auto", "dense", "sparse"),
+                  "eigensolver: 'dense' (null space of the constraints, LAPACK), 'sparse' "
+                  "(shift-invert Lanczos on the multiplier form, MUMPS + ARPACK), 'auto' (dense "
+                  "up to 150 free coordinates)"),
+    "rigid_tol": Key("float", 1e-9, lambda v: None if 0 < v < 1e-3 else
+                     "must lie in (0, 1e-3)", "modes with |omega^2| below rigid_tol times "
+                     "max diag K / max diag M are rigid-body modes, reported at 0 Hz"),
+    "spin_rate": Key("float", 0.0, doc="modes in a frame turning steadily at this rate "
+                     "(rad/s) about spin_axis through spin_centre, with the centrifugal and "
+                     "Coriolis forces (0: no rotation)"),
+    "spin_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the steady rotation"),
+    "spin_centre": Key("floats", [0.0, 0.0, 0.0], vector3, "a point of the rotation axis (m)"),
+}
+SCHEMA["buckling"] = {
+    "modes": Key("int", 3, at_least(1), "number of load factors (lowest positive first)"),
+    "fixed_loads": Key("strs", [], doc="loads (by name) or effects (e.g. 'gravity') kept at "
+                       "their value; the others are the reference loads the factor multiplies"),
+    "method": Key("str", "nonlinear", one_of("nonlinear", "linear"),
+                  "'nonlinear': the stability limit on the static path (K_g re-evaluated until "
+                  "the factor reproduces itself); 'linear': (K_0 + mu K_g) phi = 0 once, K_g "
+                  "from the tangents at the scene's loads and at the fixed loads"),
+    "solver": Key("str", "auto", one_of("auto", "dense", "sparse"),
+                  "eigensolver, as modal.solver"),
+    "rtol": Key("float", 1e-6, lambda v: None if 0 < v < 0.1 else "must lie in (0, 0.1)",
+                "method 'nonlinear': relative change of the load factor that ends the updates"),
+    "load_steps": Key("int", 1, positive, "Newton load increments between states on the "
+                      "static path"),
+    "reference_factor": Key("float", 1.0, positive, "the first state on the path: this "
+                            "multiple of the reference loads (nearer the limit when the "
+                            "scene's loads are far below it)"),
+}
+#: &modal and &buckling occur once in general scenes too
+GENERAL_SINGLE_GROUPS = GENERAL_SINGLE_GROUPS + ("modal", "buckling")
 #: Groups only general scenes have.
 GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe", "cable")
 #: checks that take a list key's whole value (the others take each item)

@@ -269,3 +269,38 @@ def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
     write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
                                                             xml_declaration=True))
     return out
+
+
+def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path:
+    """An XDMF file beside the HDF5 result of a modal or buckling analysis: one grid (the
+    mesh at the static state the analysis linearized about, ``/<group>/mesh_static``) with
+    one vector attribute per mode, ``mode_1``, ``mode_2``, ... (``/<group>/xdmf/mode_<k>``,
+    each scaled to a largest displacement of 1): in ParaView, Warp By Vector with a mode
+    shows its shape."""
+    path = Path(path)
+    name = Path(as_name) if as_name is not None else path
+    if ":" in name.name:
+        raise InputError("the file name must not contain ':' (XDMF cannot name it)",
+                         file=str(name))
+    with h5py.File(path, "r") as h5:
+        kind, dims, topology, ncells, npoints = _topology_of(h5)
+        modes = sorted((k for k in h5[f"{group}/xdmf"]), key=lambda k: int(k.split("_")[1]))
+    h5_name = name.name
+    root = ET.Element("Xdmf", Version="3.0")
+    domain = ET.SubElement(root, "Domain")
+    grid = ET.SubElement(domain, "Grid", Name=f"{group} shapes", GridType="Uniform")
+    topo = ET.SubElement(grid, "Topology", TopologyType=kind, NumberOfElements=str(ncells))
+    if kind == "Polyline":
+        topo.set("NodesPerElement", "2")
+    _item(topo, dims, h5_name, topology, "Int")
+    geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
+    _item(geometry, (npoints, 3), h5_name, f"/{group}/mesh_static")
+    for mode in modes:
+        attribute = ET.SubElement(grid, "Attribute", Name=mode, AttributeType="Vector",
+                                  Center="Node")
+        _item(attribute, (npoints, 3), h5_name, f"/{group}/xdmf/{mode}")
+    out = name.with_suffix(".xdmf")
+    partial = out.with_name(out.name + ".partial")
+    ET.ElementTree(root).write(partial, encoding="utf-8", xml_declaration=True)
+    os.replace(partial, out)
+    return out

@@ -547,6 +547,53 @@ class System:
         ``.probes[name]`` of shape (nt, 3), ``.energy``)."""
         return self._analysis("simulate")(self, t_end, dt, from_static=from_static, **options)
 
+    # -- modal analysis and linear buckling (SPEC section 10) ----------------------------
+    def modes(self, n: int = 10, *, effects: Iterable[str] | None = None,
+              linear_joints: str = "auto", **options):
+        """The ``n`` lowest modes about the static equilibrium of the system's loads
+        (:func:`ancfdrv.solvers.modal.modal_analysis`; ``options`` are its keywords:
+        solver, tol, load_steps, rigid_tol, spin_rate, spin_axis, spin_centre, ...).
+        Returns a :class:`~ancfdrv.solvers.modal.ModalResult` (frequency in Hz ascending,
+        rigid-body modes at 0; mass-normalized shapes; damping_ratio with damping on)."""
+        from ..solvers.modal import modal_analysis
+        model = self.assemble(effects=effects, linear_joints=linear_joints)
+        try:
+            return modal_analysis(model, n, **options)
+        finally:
+            model.close()
+
+    def buckling(self, n: int = 3, *, fixed_loads: Iterable[str] = (),
+                 effects: Iterable[str] | None = None, linear_joints: str = "auto",
+                 **options):
+        """The ``n`` lowest positive load factors of the system's loads about their static
+        state (:func:`ancfdrv.solvers.buckling.buckling_analysis`): the loads (by name, or
+        all loads of an effect) in ``fixed_loads`` keep their value, the others are
+        multiplied. ``options``: method ('nonlinear' | 'linear'), solver, tol, load_steps,
+        rtol, ... Returns a :class:`~ancfdrv.solvers.buckling.BucklingResult`."""
+        from ..solvers.buckling import buckling_analysis
+        fixed = tuple(fixed_loads)
+        known = set(self.loads) | {load.effect for load in self.loads.values()}
+        unknown = [name for name in fixed if name not in known]
+        if unknown:
+            raise InputError(f"buckling: fixed_loads names unknown load(s) or effect(s) "
+                             f"{', '.join(map(repr, unknown))} (loads: "
+                             f"{', '.join(self.loads) or 'none'})")
+        model = self.assemble(effects=effects, linear_joints=linear_joints)
+        base = model
+        if fixed:
+            every = self.loads
+            try:
+                self.loads = {k: v for k, v in every.items() if k in fixed or v.effect in fixed}
+                base = self.assemble(effects=effects, linear_joints=linear_joints)
+            finally:
+                self.loads = every
+        try:
+            return buckling_analysis(model, base, n, fixed_loads=fixed, **options)
+        finally:
+            model.close()
+            if base is not model:
+                base.close()
+
 
 
 #: drive parameters of the API per type (keyword -> schema key of &drive checked against)
