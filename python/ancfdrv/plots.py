@@ -148,7 +148,7 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
                      transform=axes[0].transAxes)
     axes[-1].set_xlabel("time (s)")
     axes[0].set_title(f"{title} ({status})\nprobe deflection: {label}", fontsize=9)
-    fig.savefig(png, dpi=110)
+    save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png
 
@@ -184,7 +184,7 @@ def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
         ax.text(0.5, 0.5, "no probes in this file", ha="center", transform=ax.transAxes)
     ax.set_ylabel("deflection (mm)")
     ax.set_title(f"{title} ({method})\nprobe deflection: {label}", fontsize=9)
-    fig.savefig(png, dpi=110)
+    save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png
 
@@ -860,7 +860,7 @@ def plot_sections(h5_path: str | Path, png: str | Path | None = None) -> Path | 
     fig.suptitle(f"{title}: section forces and stresses along the beams")
     fig.tight_layout()
     out = Path(png) if png else h5_path.with_name(h5_path.stem + "_sections.png")
-    fig.savefig(out, dpi=110)
+    save_figure(fig, out, dpi=110)
     plt.close(fig)
     return out
 
@@ -925,6 +925,6 @@ def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal
             label = f"mode {k + 1}: load factor {values[k]:.4g}"
         ax.set_title(label, fontsize=9)
     fig.suptitle(f"{title} ({group})", fontsize=10)
-    fig.savefig(png, dpi=110)
+    save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png

@@ -287,13 +287,15 @@ class Results:
         XDMF description (dynamic runs with output.xdmf) and the plot (``plot``) beside it
         as ``ancf run`` writes them. A plot that fails is a warning, never an error.
         Refuses (InputError) what ``ancf run`` refuses: a directory, a non-HDF5 file, ..."""
+        from .io.safe_write import write_with
         from .runner import check_output_path
         target = Path(path)
         if target.exists() and target.resolve() == self.path.resolve():
             raise InputError("save: the target is this result's own file", file=str(target))
         check_output_path(target)
         target.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(self.path, target)
+        # atomically and never through a link planted at the target (io.safe_write)
+        write_with(target, lambda temp: shutil.copyfile(self.path, temp))
         if self.path.with_suffix(".xdmf").exists():
             from .io.xdmf import write_xdmf
             write_xdmf(target)

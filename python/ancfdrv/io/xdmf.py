@@ -300,7 +300,6 @@ def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path
                                   Center="Node")
         _item(attribute, (npoints, 3), h5_name, f"/{group}/xdmf/{mode}")
     out = name.with_suffix(".xdmf")
-    partial = out.with_name(out.name + ".partial")
-    ET.ElementTree(root).write(partial, encoding="utf-8", xml_declaration=True)
-    os.replace(partial, out)
+    write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
+                                                            xml_declaration=True))
     return out
