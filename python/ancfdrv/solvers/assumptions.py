@@ -22,21 +22,45 @@ FFR_LIMIT = 0.1
 def ffr_departures(model, e: np.ndarray, t: float) -> list[tuple[str, float]]:
     """(beam, largest change of a section vector in its frame) of every 'ffr' beam of the
     model at the state e and time t."""
+    return [(name, float(change[0]))
+            for name, change in ffr_departure_rows(model, np.atleast_2d(e), np.atleast_1d(t))]
+
+
+def ffr_departure_rows(model, rows: np.ndarray, times: np.ndarray) -> list[tuple[str, np.ndarray]]:
+    """(beam, largest change of a section vector in its frame at each row) of every 'ffr'
+    beam for the states rows (n, ndof) at the times (n,): a run's chunk at once (the frame
+    rotations from the drive's vectorized values, no loop over the rows)."""
     sets = [s for s in model.sets if s.kind == "ffr"]
     if not sets:
         return []
-    q = model.expand(e)
+    q = np.atleast_2d(model.expand(rows))
+    times = np.asarray(times, dtype=float)
     out = []
+    directions = [1, 2, 3, 5, 6, 7]   # r_x, r_y, r_z of both nodes
     for info in sets:
         frame = model.frames[info.frame - 1]
-        rotation = frame.rotation(t)
-        current = q[info.dofs].reshape(3, 8, info.nel, order="F")      # (xyz, vector, el)
+        rotations = _frame_rotations(frame, times)                      # (n, 3, 3)
+        current = q[:, info.dofs.reshape(-1, order="F")].reshape(
+            len(q), info.nel, 8, 3)[:, :, directions]                   # (n, el, vector, xyz)
         reference = np.asarray(info.reference).reshape(3, 8, info.nel, order="F")
-        directions = [1, 2, 3, 5, 6, 7]   # r_x, r_y, r_z of both nodes
-        local = np.einsum("ji,jvn->ivn", rotation, current[:, directions])
-        change = np.linalg.norm(local - reference[:, directions], axis=0)
-        out.append((info.body.name, float(np.max(change, initial=0.0))))
+        reference = reference[:, directions].transpose(2, 1, 0)          # (el, vector, xyz)
+        local = np.einsum("nji,nevj->nevi", rotations, current)
+        change = np.linalg.norm(local - reference[None], axis=-1)
+        out.append((info.body.name, change.reshape(len(q), -1).max(axis=1, initial=0.0)))
     return out
+
+
+def _frame_rotations(frame, times: np.ndarray) -> np.ndarray:
+    """A floating frame's rotations A(t) (n, 3, 3) at the times (Rodrigues, vectorized)."""
+    base = np.asarray(frame.base, dtype=float)
+    if frame.drive_obj is None:
+        return np.broadcast_to(base, (len(times), 3, 3))
+    angle = frame.drive_obj.values(times)[0]
+    k = np.asarray(frame.axis, dtype=float) / np.linalg.norm(frame.axis)
+    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    turn = (np.eye(3)[None] + np.sin(angle)[:, None, None] * skew
+            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew))
+    return turn @ base
 
 
 def check_ffr(model, e: np.ndarray, t: float, *, when: str) -> None:

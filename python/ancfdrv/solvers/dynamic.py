@@ -48,7 +48,7 @@ from ..errors import Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver
 from ..system.model import Model
-from .assumptions import check_ffr
+from .assumptions import FFR_LIMIT, check_ffr, ffr_departure_rows
 
 #: what a contact record (per point and step) holds
 CONTACT_FIELDS = CONTACT_RECORD
@@ -614,13 +614,16 @@ def _check_assumptions(model: Model, chunk: Chunk, state: dict,
     when the chunk holds q (the rows after it dropped), else at the chunk's last state."""
     if not any(s.kind == "ffr" for s in model.sets) or not len(chunk.time):
         return chunk, ""
-    if chunk.q is not None:
-        for row, (t, e) in enumerate(zip(chunk.time, chunk.q)):
-            why = _outside(model, e, float(t), "at")
-            if why:
-                return Chunk(**{k: (None if v is None else v[:row + 1])
-                                for k, v in vars(chunk).items()}), why
-        return chunk, ""
+    if chunk.q is not None:  # every row at once; the first row outside ends the run
+        outside = np.zeros(len(chunk.time), dtype=bool)
+        for _, change in ffr_departure_rows(model, chunk.q, chunk.time):
+            outside |= ~(change <= FFR_LIMIT)      # beyond the limit, or not finite
+        if not outside.any():
+            return chunk, ""
+        row = int(np.argmax(outside))
+        why = _outside(model, chunk.q[row], float(chunk.time[row]), "at")
+        return Chunk(**{k: (None if v is None else v[:row + 1])
+                        for k, v in vars(chunk).items()}), why
     if info:
         return chunk, ""
     return chunk, _outside(model, state["e"], float(state["t"]), "by")
