@@ -190,7 +190,7 @@ contains
     real(dp), intent(in) :: params(:), t
     real(dp), intent(out) :: phi, dphi, ddphi
     integer, intent(out) :: info
-    integer :: n, lo, hi, mid
+    integer :: n, lo, hi
     info = 0
     phi = 0.0_dp
     dphi = 0.0_dp
@@ -208,16 +208,8 @@ contains
       phi = params(2 * n)
       return
     end if
-    lo = 1
-    hi = n
-    do while (hi - lo > 1)
-      mid = (lo + hi) / 2
-      if (params(mid) <= t) then
-        lo = mid
-      else
-        hi = mid
-      end if
-    end do
+    lo = table_interval(params(1:n), t)
+    hi = lo + 1
     if (params(hi) <= params(lo)) then
       info = 2
       return
@@ -262,7 +254,7 @@ contains
     real(dp), intent(in) :: params(:), t
     real(dp), intent(out) :: phi, dphi, ddphi
     integer, intent(out) :: info
-    integer :: n, lo, hi, mid
+    integer :: n, lo, hi
     real(dp) :: h, u, v0, v1, s0, s1
     info = 0
     phi = 0.0_dp
@@ -281,16 +273,8 @@ contains
       phi = params(2 * n)
       return
     end if
-    lo = 1
-    hi = n
-    do while (hi - lo > 1)
-      mid = (lo + hi) / 2
-      if (params(mid) <= t) then
-        lo = mid
-      else
-        hi = mid
-      end if
-    end do
+    lo = table_interval(params(1:n), t)
+    hi = lo + 1
     h = params(hi) - params(lo)
     if (h <= 0.0_dp) then
       info = 2
@@ -308,5 +292,21 @@ contains
     ddphi = ((12.0_dp * u - 6.0_dp) * (v0 - v1) / h + (6.0_dp * u - 4.0_dp) * s0 &
              + (6.0_dp * u - 2.0_dp) * s1) / h
   end subroutine hermite_table
+
+  !> The interval [times(lo), times(lo + 1)] holding t (times(1) < t < times(n), bisection).
+  pure integer function table_interval(times, t) result(lo)
+    real(dp), intent(in) :: times(:), t
+    integer :: hi, mid
+    lo = 1
+    hi = size(times)
+    do while (hi - lo > 1)
+      mid = (lo + hi) / 2
+      if (times(mid) <= t) then
+        lo = mid
+      else
+        hi = mid
+      end if
+    end do
+  end function table_interval
 
 end module drives

@@ -516,32 +516,12 @@ contains
     real(dp), intent(in) :: t, e_full(:), load_factor
     real(dp), intent(inout) :: full_force(:)
     integer, intent(out) :: info
-    real(dp) :: phi, dphi, ddphi, x(3, 3), force(3, 3), jacobian(3, 3, 3, 2)
+    real(dp) :: force(3, 3), jacobian(3, 3, 3, 2)
     integer :: l, s, k, dof
     info = 0
     do l = 1, sys%nvload
-      phi = 1.0_dp
-      if (sys%vload_drive(l) > 0) then
-        call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
-                         t, phi, dphi, ddphi, info)
-        if (info /= 0) then
-          info = 5
-          return
-        end if
-      end if
-      x = 0.0_dp
-      do s = 1, 2
-        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
-          dof = sys%vload_dof(k)
-          x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(dof:dof + 2)
-        end do
-      end do
-      call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
-                             sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
-      if (info /= 0) then
-        info = 6
-        return
-      end if
+      call vector_load_at(sys, l, t, e_full, load_factor, force, jacobian, info)
+      if (info /= 0) return
       do s = 1, 3
         do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
           dof = sys%vload_dof(k)
@@ -560,31 +540,12 @@ contains
     real(dp), intent(in) :: t, e_full(:), load_factor
     real(dp), intent(inout) :: values_full(:)
     integer, intent(out) :: info
-    real(dp) :: phi, dphi, ddphi, x(3, 3), force(3, 3), jacobian(3, 3, 3, 2)
+    real(dp) :: force(3, 3), jacobian(3, 3, 3, 2)
     integer :: l, s, w, k, m, i, j, row, col, pos, base
     info = 0
     do l = 1, sys%nvload
-      phi = 1.0_dp
-      if (sys%vload_drive(l) > 0) then
-        call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
-                         t, phi, dphi, ddphi, info)
-        if (info /= 0) then
-          info = 5
-          return
-        end if
-      end if
-      x = 0.0_dp
-      do s = 1, 2
-        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
-          x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(sys%vload_dof(k):sys%vload_dof(k) + 2)
-        end do
-      end do
-      call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
-                             sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
-      if (info /= 0) then
-        info = 6
-        return
-      end if
+      call vector_load_at(sys, l, t, e_full, load_factor, force, jacobian, info)
+      if (info /= 0) return
       do s = 1, 3
         do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
           do w = 1, 2
@@ -605,6 +566,39 @@ contains
       end do
     end do
   end subroutine vector_load_tangent
+
+  !> Load l of the driven and follower point loads at (e_full, t), times load_factor: its
+  !> generalized forces on its slots (a, b, p) and their Jacobian (vector_loads). info = 5
+  !> when its drive fails, 6 for a malformed load.
+  subroutine vector_load_at(sys, l, t, e_full, load_factor, force, jacobian, info)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: l
+    real(dp), intent(in) :: t, e_full(:), load_factor
+    real(dp), intent(out) :: force(3, 3), jacobian(3, 3, 3, 2)
+    integer, intent(out) :: info
+    real(dp) :: phi, dphi, ddphi, x(3, 2)
+    integer :: s, k, dof
+    info = 0
+    phi = 1.0_dp
+    if (sys%vload_drive(l) > 0) then
+      call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+                       t, phi, dphi, ddphi, info)
+      if (info /= 0) then
+        info = 5
+        return
+      end if
+    end if
+    x = 0.0_dp
+    do s = 1, 2
+      do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
+        dof = sys%vload_dof(k)
+        x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(dof:dof + 2)
+      end do
+    end do
+    call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
+                           sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
+    if (info /= 0) info = 6
+  end subroutine vector_load_at
 
   !> Position of (row, col) in the full pattern, 0 when absent.
   pure integer function pattern_position(sys, row, col) result(pos)
