@@ -140,7 +140,7 @@ def drive_parameters() -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
 
 
 def _type_table(title: str, parameters: dict, meaning: dict, extra: str = "") -> list[str]:
-    lines = [f"### {title}", "", f"| type | required | optional | meaning |",
+    lines = [f"### {title}", "", "| type | required | optional | meaning |",
              "|---|---|---|---|"]
     for kind, (required, optional) in parameters.items():
         lines.append(f"| `{kind}` | {_cell(', '.join(required)) or '-'} | "

@@ -53,17 +53,15 @@ def ignore_file_size_signal() -> None:
 
 
 @contextmanager
-def replace_atomically(path: str | Path, mode: str = "w", **open_kwargs: Any) -> Iterator[IO]:
-    """A file object to write ``path``'s new content to; on success the content replaces
-    ``path`` in one rename (a symbolic link at ``path`` is replaced, not followed), on
-    failure the temporary file is removed and ``path`` is left as it was."""
+def _swap_in(path: str | Path) -> Iterator[tuple[int, Path]]:
+    """A temporary file beside ``path`` (its open descriptor and name) that replaces
+    ``path`` in one rename when the block ends normally (a symbolic link at ``path`` is
+    replaced, not followed), and is removed otherwise, leaving ``path`` as it was."""
     path = Path(path)
     fd, temp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
                                 dir=str(path.parent) if str(path.parent) else ".")
     try:
-        with os.fdopen(fd, mode, **open_kwargs) as fh:
-            yield fh
-            fh.flush()
+        yield fd, Path(temp)
         os.chmod(temp, 0o644 & ~_umask())
         os.replace(temp, path)
     except BaseException:
@@ -72,6 +70,16 @@ def replace_atomically(path: str | Path, mode: str = "w", **open_kwargs: Any) ->
         except OSError:
             pass
         raise
+
+
+@contextmanager
+def replace_atomically(path: str | Path, mode: str = "w", **open_kwargs: Any) -> Iterator[IO]:
+    """A file object to write ``path``'s new content to; on success the content replaces
+    ``path`` in one rename (a symbolic link at ``path`` is replaced, not followed), on
+    failure the temporary file is removed and ``path`` is left as it was."""
+    with _swap_in(path) as (fd, _), os.fdopen(fd, mode, **open_kwargs) as fh:
+        yield fh
+        fh.flush()
 
 
 def _umask() -> int:
@@ -103,20 +111,9 @@ def save_figure(fig: Any, path: str | Path, **kwargs: Any) -> None:
 
 def write_with(path: str | Path, writer: Callable[[Path], None]) -> None:
     """Let ``writer`` write a temporary file (given its path), then move it onto ``path``."""
-    path = Path(path)
-    fd, temp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
-                                dir=str(path.parent) if str(path.parent) else ".")
-    os.close(fd)
-    try:
-        writer(Path(temp))
-        os.chmod(temp, 0o644 & ~_umask())
-        os.replace(temp, path)
-    except BaseException:
-        try:
-            os.unlink(temp)
-        except OSError:
-            pass
-        raise
+    with _swap_in(path) as (fd, temp):
+        os.close(fd)
+        writer(temp)
 
 
 def create_fresh(path: str | Path) -> None:

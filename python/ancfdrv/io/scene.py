@@ -20,7 +20,7 @@ from ..errors import InputError
 from . import validate
 from .schema import (COMMON_GROUPS, EFFECTS_AVAILABLE, EFFECTS_PLANNED, GENERAL_ONLY_GROUPS,
                      GENERAL_SCHEMA, GENERAL_SINGLE_GROUPS, MODEL_GROUPS, PLATE_KINDS, REQUIRED,
-                     SCHEMA, WHOLE_LIST_CHECKS, Key, coerce, short_repr)
+                     SCHEMA, Key, checked_value)
 
 __all__ = ["Scene", "load_scene", "parse_address", "is_general", "SCHEMA", "GENERAL_SCHEMA",
            "EFFECTS_AVAILABLE", "MODEL_GROUPS", "PLATE_KINDS"]
@@ -177,18 +177,7 @@ def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str) -
         where = dict(file=file, group=label, key=key)
         if key not in schema:
             raise InputError(f"unknown key; known keys of &{group}: {', '.join(schema)}", **where)
-        spec = schema[key]
-        value = coerce(spec.kind, raw, where)
-        if spec.size is not None and len(value) != spec.size:
-            raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
-        if spec.check is not None:
-            whole = spec.check in WHOLE_LIST_CHECKS
-            items = [value] if whole or spec.kind != "floats" else value
-            for item in items:
-                message = spec.check(item)
-                if message:
-                    raise InputError(f"{short_repr(value)} {message}", **where)
-        typed[key] = value
+        typed[key] = checked_value(schema[key], raw, where)
     for key, spec in schema.items():
         if key not in typed:
             if spec.default is REQUIRED:

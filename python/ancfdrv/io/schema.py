@@ -617,6 +617,22 @@ GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe
 WHOLE_LIST_CHECKS = (vector3, points3, principal_positive)
 
 
+def checked_value(spec: Key, raw: Any, where: dict[str, Any]) -> Any:
+    """A key's value typed (:func:`coerce`), of its size and passing its check, else an
+    InputError at ``where`` (the namelist's and the Python API's one rule)."""
+    value = coerce(spec.kind, raw, where)
+    if spec.size is not None and len(value) != spec.size:
+        raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
+    if spec.check is not None:
+        whole = spec.check in WHOLE_LIST_CHECKS
+        items = [value] if whole or spec.kind != "floats" else value
+        for item in items:
+            message = spec.check(item)
+            if message:
+                raise InputError(f"{short_repr(value)} {message}", **where)
+    return value
+
+
 # -- the Python API's door: the same types, ranges and messages as the namelist -----------
 
 def plain_value(value: Any) -> Any:
@@ -663,15 +679,5 @@ def check_call(group: str, label: str, values: dict[str, Any]) -> dict[str, Any]
             raise InputError(f"expected a string, got {short_repr(raw)}", **where)
         if spec.kind == "floats" and not isinstance(raw, list):
             raw = [raw]
-        value = coerce(spec.kind, raw, where)
-        if spec.size is not None and len(value) != spec.size:
-            raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
-        if spec.check is not None:
-            whole = spec.check in WHOLE_LIST_CHECKS
-            items = [value] if whole or spec.kind != "floats" else value
-            for item in items:
-                message = spec.check(item)
-                if message:
-                    raise InputError(f"{short_repr(value)} {message}", **where)
-        out[key] = value
+        out[key] = checked_value(spec, raw, where)
     return out

@@ -568,7 +568,6 @@ def check_arguments(function: str, **values: Any) -> dict[str, Any]:
     out = {}
     for key, raw in values.items():
         value = _plain_number(raw)
-        where: dict = {}
         name = f"{function}: {key}"
         if key in ("max_iter", "load_steps", "max_newton", "chunk_steps", "max_inner"):
             if isinstance(value, bool) or not isinstance(value, int):
