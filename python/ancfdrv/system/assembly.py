@@ -587,7 +587,8 @@ def _linearized(system, warnings: list[str]) -> dict[str, str]:
                 for body, other in ((a, b), (b, a)):
                     if other.name in out and body.name not in out:
                         out[body.name], grown = out[other.name], True
-    for joint in (j for j in joints if j.type in ("weld", "revolute")):
+    for joint in (j for j in joints if j.type in ("weld", "revolute", "prismatic",
+                                                  "cylindrical", "universal")):
         for body, other in (joint.bodies, joint.bodies[::-1]):
             if body.name in out and other.flexible and not small_turn(other):
                 warnings.append(
@@ -718,7 +719,7 @@ def _constant_constraint(eq: Constraint, x: list[float], tol: float, notes: list
         elif eq.kind == CONSTRAINT_CROSS:
             value = float(p[:3] @ np.cross(x[:3], x[3:]))
         else:
-            value = float(x[:3] @ x[3:]) - p[0]
+            value = float(x[:3] @ x[3:]) - p[0] - p[1] * phi   # dot (p[1]: driven)
         if abs(value) > tol:
             if eq.drive is None:
                 raise InputError(f"{eq.name}: every coordinate of this equation is held by other "

@@ -1,0 +1,232 @@
+"""The joint types 'prismatic', 'cylindrical' and 'universal' (SPEC 8.1, issue 22).
+
+References, each independent of the code under test:
+
+* closed forms of rigid-body mechanics: a block on a frictionless incline slides by
+  g sin(theta) t^2 / 2 and the guide pushes with m g cos(theta) along the incline's normal;
+  a driven slide carries m (s'' - g . a) along the axis; an axisymmetric rotor on a
+  cylindrical joint gains the spin T P / (2 I_a) and the axial speed F P / (2 m) from a
+  force and a torque pulse amplitude (1 - cos(2 pi t / P)) / 2 and keeps both afterwards
+  (no torque about, no force along the axis: invariants), while the joint carries its weight
+  and the weight's moment about the joint's point;
+* the Cardan joint's speed ratio w2 / w1 = cos(beta) / (1 - sin^2(beta) sin^2(theta1))
+  (theta1 from the input yoke normal to the shafts' plane; derived from the cross's
+  condition u1 . v2 = 0, i.e. tan(theta2) = tan(theta1) / cos(beta));
+* central differences of the joint equations (values -> Jacobian -> Hessian) at a state with
+  large rotations of every body;
+* global equilibrium of a beam held at a point between its nodes (reaction = weight, moment
+  = weight times its lever arm) and Newton's second law for its centre of mass.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ancfdrv import Rectangle, System
+from ancfdrv.errors import InputError
+from ancfdrv.solvers.dynamic import DynamicSettings, integrate
+from ancfdrv.solvers.static import solve_newton
+from ancfdrv.system.bodies import RigidBody
+
+G = 9.81
+
+
+# ------------------------------------------------------------------------- prismatic
+@pytest.mark.parametrize("ground_first", [True, False], ids=["ground-block", "block-ground"])
+def test_block_slides_down_a_frictionless_incline(ground_first):
+    """A 3 kg block on a prismatic guide inclined 30 degrees, gravity -z, from rest: its
+    displacement along the guide is g sin(theta) t^2 / 2 (1e-12 m over 1 s), the guide's
+    reaction on the block is m g cos(theta) along the incline's normal with no moment about
+    the block's centre (1e-9 relative); named the other way round (block, ground) the
+    reaction is what the block exerts on the ground: the opposite."""
+    theta, m = np.radians(30.0), 3.0
+    axis = np.array([np.cos(theta), 0.0, -np.sin(theta)])
+    normal = np.array([np.sin(theta), 0.0, np.cos(theta)])
+    s = System("incline")
+    s.rigid_body("block", mass=m, inertia=(0.1, 0.2, 0.3, 0, 0, 0), position=(1, 0, 2))
+    bodies = ("ground", "block") if ground_first else ("block", "ground")
+    s.joint("guide", "prismatic", *bodies, point=(1, 0, 2), axis=axis)
+    s.load("g", "gravity", vector=(0, 0, -G))
+    s.probe("c", "block", (1, 0, 2))
+    res = s.simulate(t_end=1.0, dt=0.01)
+    assert res.status == "ok"
+    t, p = res.time, res.probes["c"]
+    slide = (p - p[0]) @ axis
+    np.testing.assert_allclose(slide, G * np.sin(theta) * t**2 / 2, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(p - p[0] - np.outer(slide, axis), 0.0, atol=1e-12)
+    sign = 1.0 if ground_first else -1.0
+    reaction = res.reactions["guide"]
+    np.testing.assert_allclose(reaction["force"], sign * m * G * np.cos(theta) * np.tile(
+        normal, (len(t), 1)), rtol=0, atol=1e-9 * m * G)
+    np.testing.assert_allclose(reaction["moment"], 0.0, atol=1e-9 * m * G)
+
+
+def test_driven_prismatic_follows_its_drive_and_carries_the_actuator_force():
+    """A prismatic actuator along a 30 degree incline moves the block by
+    s(t) = A (1 - cos(2 pi f t)) (a 'sine' drive with offset A, phase -pi/2: at rest at
+    t = 0): the block's displacement along the axis equals s(t) - s(0) (1e-12 m), and the
+    reaction is m g cos(theta) along the normal (1e-12 relative) plus the actuator's force
+    m (s'' - g . a) along the axis: within 1.5e-4 of its amplitude m A (2 pi f)^2 at
+    dt = 2 ms (the trapezoidal rule's accelerations of a prescribed motion alternate about
+    the exact ones: measured 1.03e-4, and 2.6e-5 at dt = 1 ms, second order)."""
+    theta, m, amp, freq = np.radians(30.0), 2.0, 0.2, 1.5
+    axis = np.array([np.cos(theta), 0.0, -np.sin(theta)])
+    normal = np.array([np.sin(theta), 0.0, np.cos(theta)])
+    s = System("actuator")
+    s.drive("stroke", "sine", amplitude=amp, frequency=freq, phase=-np.pi / 2, offset=amp)
+    s.rigid_body("block", mass=m, inertia=(0.1, 0.1, 0.1, 0, 0, 0), position=(0, 0, 0))
+    s.joint("ram", "prismatic", "ground", "block", point=(0, 0, 0), axis=axis, drive="stroke")
+    s.load("g", "gravity", vector=(0, 0, -G))
+    s.probe("c", "block", (0, 0, 0))
+    res = s.simulate(t_end=1.0, dt=0.002)
+    assert res.status == "ok"
+    t, p = res.time, res.probes["c"]
+    stroke = amp * (1 - np.cos(2 * np.pi * freq * t))
+    np.testing.assert_allclose(p @ axis, stroke, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(p - np.outer(p @ axis, axis), 0.0, atol=1e-12)
+    accel = amp * (2 * np.pi * freq)**2 * np.cos(2 * np.pi * freq * t)
+    gravity_along = np.array([0.0, 0.0, -G]) @ axis
+    expected = np.outer(m * (accel - gravity_along), axis) + m * G * np.cos(theta) * normal
+    error = res.reactions["ram"]["force"] - expected
+    np.testing.assert_allclose(error @ normal, 0.0, atol=1e-12 * m * G)
+    np.testing.assert_allclose(error - np.outer(error @ axis, axis), 0.0, atol=1e-12 * m * G)
+    assert np.abs(error @ axis).max() <= 1.5e-4 * m * amp * (2 * np.pi * freq)**2
+
+
+def test_contradictory_driven_slides_are_refused_and_consistent_ones_dropped():
+    """A driven prismatic and a 'prescribed' translation of the same point along the same
+    axis: with two different drives the model is refused naming both joints (the redundancy
+    check of SPEC 8.1), with the same drive the repeated equation is dropped and noted."""
+    def build(second: str) -> System:
+        s = System("two actuators")
+        s.drive("a", "sine", amplitude=0.1, frequency=1.0)
+        s.drive("b", "sine", amplitude=0.2, frequency=1.0)
+        s.rigid_body("block", mass=1.0, inertia=(0.1, 0.1, 0.1, 0, 0, 0), position=(0, 0, 0))
+        s.joint("ram", "prismatic", "ground", "block", point=(0, 0, 0), axis=(1, 0, 0),
+                drive="a")
+        s.joint("push", "prescribed", "ground", "block", point=(0, 0, 0), axis=(1, 0, 0),
+                drive=second)
+        return s
+    with pytest.raises(InputError, match="contradicts") as info:
+        build("b").assemble()
+    assert "push" in str(info.value) and "ram" in str(info.value)
+    model = build("a").assemble()
+    try:
+        assert any("push: x(t) (implied by the others)" in n for n in model.notes), model.notes
+    finally:
+        model.close()
+
+
+# ----------------------------------------------------------------------- cylindrical
+def test_cylindrical_rotor_keeps_spin_and_axial_momentum_and_carries_its_weight():
+    """A rotor (m = 4 kg, I_a = 0.05, I_t = 0.3 kg m^2) on a cylindrical joint along x whose
+    point lies d = 0.3 m from its centre along the axis, gravity -z, a force F = 8 N along
+    and a torque T = 2 N m about the axis as a pulse of P = 0.2 s (integral P / 2).
+
+    * After the pulse the axial speed is F P / (2 m) = 0.2 m/s (1e-12: a force along a
+      translation integrates exactly) and stays (the centre's x is linear in t to 1e-12 m);
+    * the spin rate (from a rim point's angle) is T P / (2 I_a) = 4 rad/s within 5e-5
+      (trapezoidal rule on rotating vectors: 5.3e-4 at dt = 5 ms, 1.33e-4 at 2.5 ms, second
+      order) and stays constant to 1e-9 (the invariant; 4e-11 measured with the Newton
+      tolerance 1e-13 used here, 4e-7 with the default 1e-10, which ends a step's
+      iteration before the spin has converged to that level);
+    * the centre never leaves the axis, and the joint's reaction is the weight m g up and,
+      about the joint's point, the weight's moment m g d along +y (1e-9)."""
+    m, ia, it, t0, f0, period, d = 4.0, 0.05, 0.3, 2.0, 8.0, 0.2, 0.3
+    s = System("spin and slide")
+    s.drive("pulse", "cycle", amplitude=1.0, period=period, t0=0.0)
+    s.rigid_body("rotor", mass=m, inertia=(ia, it, it, 0, 0, 0), position=(0, 0, 1))
+    s.joint("sleeve", "cylindrical", "ground", "rotor", point=(d, 0, 1), axis=(1, 0, 0))
+    s.load("g", "gravity", vector=(0, 0, -G))
+    s.load("torque", "moment", body="rotor", point=(0, 0, 1), vector=(t0, 0, 0), drive="pulse")
+    s.load("push", "force", body="rotor", point=(0, 0, 1), vector=(f0, 0, 0), drive="pulse")
+    s.probe("c", "rotor", (0, 0, 1))
+    s.probe("rim", "rotor", (0, 0.1, 1))
+    dt = 0.0025
+    res = s.simulate(t_end=0.6, dt=dt, newton_tol=1e-13)
+    assert res.status == "ok"
+    t, c = res.time, res.probes["c"]
+    rim = res.probes["rim"] - c
+    after = t >= period + 0.5 * dt
+    np.testing.assert_allclose(c[:, 1:] - c[0, 1:], 0.0, rtol=0, atol=1e-12)
+    speed = np.diff(c[after, 0]) / np.diff(t[after])
+    np.testing.assert_allclose(speed, f0 * period / (2 * m), rtol=1e-12)
+    angle = np.unwrap(np.arctan2(rim[:, 2], rim[:, 1]))
+    spin = np.diff(angle[after]) / np.diff(t[after])
+    expected = t0 * period / (2 * ia)
+    assert np.abs(spin - expected).max() <= 5e-5 * expected
+    assert np.ptp(spin) <= 1e-9 * expected
+    reaction = res.reactions["sleeve"]
+    np.testing.assert_allclose(reaction["force"], np.tile([0, 0, m * G], (len(t), 1)),
+                               rtol=0, atol=1e-9 * m * G)
+    np.testing.assert_allclose(reaction["moment"], np.tile([0, m * G * d, 0], (len(t), 1)),
+                               rtol=0, atol=1e-9 * m * G)
+
+
+# ------------------------------------------------------------------------- universal
+def _omega(body: RigidBody, q: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
+    """A rigid body's angular velocity from its axes J and their rates: J' = [w]x J, so
+    w = 1/2 sum_i J_i x J'_i."""
+    f = body.first
+    return 0.5 * sum(np.cross(q[f + 3 * k:f + 3 * k + 3], q_dot[f + 3 * k:f + 3 * k + 3])
+                     for k in (1, 2, 3))
+
+
+@pytest.mark.parametrize("beta_deg", [20.0, 45.0])
+def test_cardan_joint_speed_ratio_against_the_closed_form(beta_deg):
+    """Input shaft along x turned by a 'hub' drive (ramp to 2 pi rad/s over 0.2 s, 1.1 turns
+    in 1.2 s), output shaft in a bearing along (cos beta, sin beta, 0), a 'universal' joint
+    between them with the input yoke along z and the output yoke in the shafts' plane. At
+    every step of the dynamic run the velocities that satisfy the joint equations
+    (Phi_e v = -Phi_t) give w2 / w1 = cos(beta) / (1 - sin^2(beta) sin^2(theta1)) to 1e-12,
+    theta1 the drive's angle."""
+    beta = np.radians(beta_deg)
+    a2 = np.array([np.cos(beta), np.sin(beta), 0.0])
+    s = System("cardan")
+    s.drive("spin", "ramp", rate=2 * np.pi, t_ramp=0.2)
+    s.rigid_body("in", mass=1.0, inertia=(0.01, 0.02, 0.02, 0, 0, 0), position=(0, 0, 0))
+    s.rigid_body("out", mass=1.0, inertia=(0.01, 0.02, 0.02, 0, 0, 0), position=0.5 * a2)
+    s.joint("motor", "hub", "ground", "in", point=(0, 0, 0), pivot=(0, 0, 0), axis=(1, 0, 0),
+            drive="spin")
+    s.joint("bearing", "revolute", "ground", "out", point=0.5 * a2, axis=a2)
+    s.joint("cross", "universal", "in", "out", point=(0, 0, 0), axis=(0, 0, 1),
+            axis2=(-np.sin(beta), np.cos(beta), 0))
+    model = s.assemble()
+    rows = []
+    try:
+        settings = DynamicSettings.generalized_alpha(0.01, 1.2, 0.9, tol=1e-10, max_newton=30)
+        settings.store_q = True
+        integrate(model, settings, model.e0, sink=rows.append, progress=False)
+        states = np.concatenate([r.q for r in rows])
+        times = np.concatenate([r.time for r in rows])
+        cs = model.constraints
+        assert len(cs) == model.ndof   # the input drives everything: no free coordinate
+        ratios, expected = [], []
+        for e, t in zip(states, times):
+            phi_t = cs.evaluate(e, t)[3]
+            v = np.linalg.solve(cs.gradient_rows(e, model.ndof, t), -phi_t)
+            q, q_dot = model.expand(e), model.expand(v, with_offset=False)
+            w1 = _omega(s.bodies["in"], q, q_dot) @ np.array([1.0, 0.0, 0.0])
+            w2 = _omega(s.bodies["out"], q, q_dot) @ a2
+            if t > 0.0:
+                theta1 = s.drives["spin"].value(t)
+                ratios.append(w2 / w1)
+                expected.append(np.cos(beta) / (1 - np.sin(beta)**2 * np.sin(theta1)**2))
+        assert times[-1] == pytest.approx(1.2) and s.drives["spin"].value(1.2) > 2 * np.pi
+        np.testing.assert_allclose(ratios, expected, rtol=1e-12)
+        assert max(expected) / min(expected) > 1.0 / np.cos(beta)**2 - 1e-6  # the full swing
+    finally:
+        model.close()
+
+
+def test_universal_refuses_axes_that_are_not_normal():
+    s = System("bad cross")
+    s.rigid_body("a", mass=1.0, inertia=(1, 1, 1, 0, 0, 0), position=(0, 0, 0))
+    with pytest.raises(InputError, match="normal to each other"):
+        s.joint("x", "universal", "ground", "a", point=(0, 0, 0), axis=(0, 0, 1),
+                axis2=(0, 1, 1))
+    with pytest.raises(InputError, match="axis2"):
+        s.joint("y", "universal", "ground", "a", point=(0, 0, 0), axis=(0, 0, 1))
+    with pytest.raises(InputError, match="axis2 applies"):
+        s.joint("z", "revolute", "ground", "a", point=(0, 0, 0), axis=(0, 0, 1),
+                axis2=(1, 0, 0))
