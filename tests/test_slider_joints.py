@@ -230,3 +230,265 @@ def test_universal_refuses_axes_that_are_not_normal():
     with pytest.raises(InputError, match="axis2 applies"):
         s.joint("z", "revolute", "ground", "a", point=(0, 0, 0), axis=(0, 0, 1),
                 axis2=(1, 0, 0))
+
+
+# --------------------------------------------- the joint equations at large rotations
+SECTION = Rectangle(0.05, 0.1)
+AXIS, AXIS2 = np.array([0.6, 0.8, 0.0]), np.array([0.0, 0.0, 1.0])
+#: body pairs (body1, body2, point): beams 'a' along x (nodes at 0, 0.5, 1) and 'b' along
+#: y from (0.6, 0, 0); rigid bodies 'r', 'r2'; points between nodes and off a beam's axis
+PAIRS = {
+    "rigid-rigid": ("r", "r2", (2.5, 0.5, 0.3)),
+    "ground-rigid": ("ground", "r", (2.1, 0.4, 0.3)),
+    "beam-rigid (between nodes)": ("a", "r", (0.37, 0.0, 0.0)),
+    "rigid-beam (off the axis)": ("r", "a", (0.37, 0.02, 0.01)),
+    "ground-beam (between nodes)": ("ground", "a", (0.37, 0.0, 0.0)),
+    "beam-beam": ("a", "b", (0.6, 0.0, 0.0)),
+}
+TYPES = {
+    "prismatic": dict(axis=AXIS),
+    "prismatic driven": dict(axis=AXIS, drive="stroke"),
+    "cylindrical": dict(axis=AXIS),
+    "universal": dict(axis=AXIS2, axis2=np.array([0.8, -0.6, 0.0])),
+}
+
+
+def _pair_system(kind: str, pair: str, formulation: str = "nonlinear") -> System:
+    body1, body2, point = PAIRS[pair]
+    s = System(f"{kind} {pair}")
+    s.material("steel", youngs_modulus=2.1e11, density=7850.0)
+    s.drive("stroke", "spinup", omega=2.0, period=0.5, start=0.1)
+    s.beam("a", material="steel", start=(0, 0, 0), end=(1, 0, 0), nodes=3, section=SECTION,
+           height_axis=(0, 1, 0), formulation=formulation, bending="cubic")
+    s.beam("b", material="steel", start=(0.6, 0, 0), end=(0.6, 1, 0), nodes=3,
+           section=SECTION, height_axis=(-1, 0, 0), formulation=formulation, bending="cubic")
+    s.rigid_body("r", mass=2.0, inertia=(0.2, 0.25, 0.3, 0.01, 0.0, 0.02),
+                 position=(2, 0.5, 0.3))
+    s.rigid_body("r2", mass=1.0, inertia=(0.1, 0.1, 0.1, 0, 0, 0), position=(3, 0.5, 0.3))
+    s.joint("j", kind.split()[0], body1, body2, point=point, **TYPES[kind])
+    return s
+
+
+def _moved(model, motions: dict[str, tuple[np.ndarray, np.ndarray]], q: np.ndarray
+           ) -> np.ndarray:
+    """q with each named body's nodal vectors moved rigidly: positions x -> R x + c,
+    directions d -> R d (motions: name -> (R, c))."""
+    q = q.copy()
+    for body in model.bodies:
+        if body.name not in motions or body.ncoordinates == 0:
+            continue
+        rotation, shift = motions[body.name]
+        block = q[body.first:body.first + body.ncoordinates].reshape(-1, 4, 3)
+        block[:] = block @ rotation.T
+        block[:, 0, :] += shift
+        q[body.first:body.first + body.ncoordinates] = block.ravel()
+    return q
+
+
+def _rotation(axis, angle: float) -> np.ndarray:
+    from ancfdrv.system.bodies import rotation_about
+    return rotation_about(np.asarray(axis, dtype=float), angle)
+
+
+def _about(rotation: np.ndarray, point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(R, c) of the rotation R about a point: x -> R (x - point) + point."""
+    return rotation, point - rotation @ point
+
+
+def _compose(outer, inner):
+    """(R, c) of x -> outer(inner(x))."""
+    return outer[0] @ inner[0], outer[0] @ inner[1] + outer[1]
+
+
+@pytest.mark.parametrize("pair", sorted(PAIRS))
+@pytest.mark.parametrize("kind", sorted(TYPES))
+def test_joint_equations_jacobian_and_hessian_at_large_rotations(kind, pair):
+    """Each new joint between each pair of bodies, kept with multipliers:
+
+    * its equations vanish at t = 0, after a common rigid motion of both bodies by a large
+      rotation (2.2 rad about an oblique axis: 1e-12; none when body1 is the ground), and after the relative motion the
+      joint allows (prismatic: a slide along the carried axis; cylindrical: a slide and a
+      1.3 rad turn about it; universal: turns about both cross axes) on top of it, while a
+      motion it forbids violates them;
+    * at a state of large rotations (each body 1.0-2.5 rad about its own axis, plus noise
+      0.02) the Jacobian equals central differences of the values and each Hessian (the
+      matrices the static Newton iteration and the tangent use: hessian_triplets) central
+      differences of the Jacobian rows (step 1e-6; the equations are quadratic, so the
+      differences are exact to rounding: 1e-7 relative); for the driven prismatic Phi_t and
+      Phi_tt equal differences in time."""
+    s = _pair_system(kind, pair)
+    model = s.assemble(linear_joints="multipliers")
+    try:
+        cs = model.constraints
+        rows = [i for i, n in enumerate(cs.names) if n.startswith("j")]
+        assert rows
+
+        def values(e, t=0.0):
+            return cs.evaluate(e, t)[0][rows]
+        assert np.abs(values(model.e0)).max() <= 1e-12
+        body1, body2, point = PAIRS[pair]
+        point = np.asarray(point, dtype=float)
+        common = _about(_rotation((1.0, -2.0, 0.5), 2.2), point)
+        common = (common[0], common[1] + np.array([0.3, -0.2, 0.5]))
+        if body1 == "ground":   # the ground does not move: the relative motions from rest
+            common = (np.eye(3), np.zeros(3))
+        both = {body1: common, body2: common}
+        q_common = _moved(model, both, model.q0)
+        assert np.abs(values(q_common)).max() <= 1e-12
+        turn, moved_point = common[0], common[0] @ point + common[1]
+        if kind.startswith("prismatic"):
+            allowed = (np.eye(3), 0.35 * turn @ AXIS)
+        elif kind == "cylindrical":
+            allowed = _about(_rotation(turn @ AXIS, 1.3), moved_point)
+            allowed = (allowed[0], allowed[1] + 0.35 * turn @ AXIS)
+        else:
+            allowed = _compose(_about(_rotation(turn @ AXIS2, 0.9), moved_point),
+                               _about(_rotation(turn @ TYPES[kind]["axis2"], 1.1),
+                                      moved_point))
+        if body2 != "ground":
+            q_allowed = _moved(model, {body1: common, body2: _compose(allowed, common)},
+                               model.q0)
+            forbidden = _about(_rotation(turn @ np.cross(AXIS, AXIS2) if kind != "universal"
+                                         else turn @ np.cross(AXIS2, TYPES[kind]["axis2"]),
+                                         0.5), moved_point)
+            q_forbidden = _moved(model, {body1: common, body2: _compose(forbidden, common)},
+                                 model.q0)
+            if kind == "prismatic driven":   # the slide is the drive's: not free at t = 0
+                assert abs(values(q_allowed)).max() > 1e-3
+            else:
+                assert np.abs(values(q_allowed)).max() <= 1e-12
+            assert np.abs(values(q_forbidden)).max() > 1e-3
+        rng = np.random.default_rng(7)
+        motions = {}
+        for k, name in enumerate((body1, body2)):
+            centre = point + rng.standard_normal(3) * 0.2
+            motions[name] = _about(_rotation(rng.standard_normal(3), 1.0 + 1.5 * k), centre)
+        e = _moved(model, motions, model.q0) + 0.02 * rng.standard_normal(model.ndof)
+        t, h = 0.37, 1e-6
+        jac = cs.gradient_rows(e, model.ndof, t)[rows]
+        fd = np.zeros_like(jac)
+        hess = np.zeros((len(cs), model.ndof, model.ndof))
+        con, r_, c_, v_ = cs.hessian_triplets(e)
+        np.add.at(hess, (con, r_, c_), v_)
+        hess_fd = np.zeros_like(hess)
+        for k in range(model.ndof):
+            step = np.zeros(model.ndof)
+            step[k] = h
+            fd[:, k] = (values(e + step, t) - values(e - step, t)) / (2 * h)
+            hess_fd[:, :, k] = (cs.gradient_rows(e + step, model.ndof, t)
+                                - cs.gradient_rows(e - step, model.ndof, t)) / (2 * h)
+        scale = max(np.abs(jac).max(), 1.0)
+        assert np.abs(jac - fd).max() <= 1e-7 * scale
+        assert np.abs(hess[rows] - hess_fd[rows]).max() <= 1e-7 * max(np.abs(hess).max(), 1.0)
+        if body1 != "ground":   # quadratic equations (with the ground they are linear)
+            assert np.abs(hess[rows]).max() > 0.5
+        if "driven" in kind:
+            _, _, _, phi_t, phi_tt, _ = cs.evaluate(e, t)
+            dt = 1e-4
+            np.testing.assert_allclose(phi_t[rows], (values(e, t + dt) - values(e, t - dt))
+                                       / (2 * dt), rtol=0, atol=1e-7)
+            np.testing.assert_allclose(phi_tt[rows], (values(e, t + dt) - 2 * values(e, t)
+                                                      + values(e, t - dt)) / dt**2,
+                                       rtol=0, atol=1e-4)
+            assert np.abs(phi_t[rows]).max() > 0.1
+    finally:
+        model.close()
+
+
+# ------------------------------------------------ a beam on a guide between its nodes
+BEAM_L, BEAM_RHO, BEAM_W, BEAM_H = 2.0, 7850.0, 0.04, 0.06
+
+
+def _guided_beam(formulation: str, axis, point, bodies=("ground", "rod"), drive=None
+                 ) -> System:
+    """A 2 m steel beam (40 x 60 mm, 4 nodes: at 0, 2/3, 4/3, 2 m) from the origin along
+    ``axis`` on a prismatic guide at ``point`` (between nodes), gravity -z."""
+    axis = np.asarray(axis, dtype=float)
+    height = np.cross(axis, (0.0, 1.0, 0.0))
+    s = System("beam on a guide")
+    s.material("steel", youngs_modulus=2.1e11, density=BEAM_RHO)
+    s.drive("hold", "constant", value=0.0)
+    s.beam("rod", material="steel", start=(0, 0, 0), end=BEAM_L * axis, nodes=4,
+           section=Rectangle(BEAM_W, BEAM_H), height_axis=height, formulation=formulation)
+    s.joint("guide", "prismatic", *bodies, point=point, axis=axis, drive=drive)
+    s.load("g", "gravity", vector=(0, 0, -G))
+    s.probe("p", "rod", point)
+    return s
+
+
+@pytest.mark.parametrize("formulation", ["ffr", "nonlinear"])
+def test_beam_held_by_a_locked_guide_between_nodes_carries_its_weight(formulation):
+    """Statics: the horizontal beam on a guide along x at x = 0.5 m, 1 cm above its axis
+    (between nodes, off the axis), the slide locked by a constant drive; named (rod, ground)
+    the reaction is what the beam exerts on the ground: its weight m g down and, about the
+    guide's point, the weight's moment (c - p) x W with c the centre of mass (global
+    equilibrium): FFR 1e-9 relative, 'nonlinear' 1e-6 (the deflected beam's lever arm:
+    5e-8 measured)."""
+    point = np.array([0.5, 0.0, 0.01])
+    s = _guided_beam(formulation, (1, 0, 0), point, bodies=("rod", "ground"), drive="hold")
+    res = s.static()
+    assert res.status == "ok"
+    weight = np.array([0.0, 0.0, -BEAM_RHO * BEAM_W * BEAM_H * BEAM_L * G])
+    moment = np.cross(np.array([BEAM_L / 2, 0, 0]) - point, weight)
+    tol = (1e-9 if formulation == "ffr" else 1e-6) * np.linalg.norm(weight)
+    np.testing.assert_allclose(res.reactions["guide"]["force"], weight, rtol=0, atol=tol)
+    np.testing.assert_allclose(res.reactions["guide"]["moment"], moment, rtol=0, atol=tol)
+
+
+@pytest.mark.parametrize("formulation", ["ffr", "nonlinear"])
+def test_beam_slides_on_a_guide_between_its_nodes(formulation):
+    """Dynamics: the beam along a 30 degree incline on a frictionless guide at 0.5 m
+    (between nodes): the guide's point stays on its line (1e-12 m) and slides by
+    g sin(theta) t^2 / 2 (Newton's law for the centre of mass: the guide takes no force
+    along it), FFR to 1e-12 m; the 'nonlinear' beam's bending vibration shortens it
+    axially by second-order amounts: 1.0e-7 m measured over 0.22 m, 1e-6 relative allowed."""
+    theta = np.radians(30.0)
+    axis = np.array([np.cos(theta), 0.0, -np.sin(theta)])
+    s = _guided_beam(formulation, axis, 0.5 * axis)
+    res = s.simulate(t_end=0.3, dt=0.001)
+    assert res.status == "ok"
+    t, p = res.time, res.probes["p"]
+    slide = (p - p[0]) @ axis
+    expected = G * np.sin(theta) * t**2 / 2
+    np.testing.assert_allclose(p - p[0] - np.outer(slide, axis), 0.0, rtol=0, atol=1e-12)
+    tol = 1e-12 if formulation == "ffr" else 1e-6 * expected[-1]
+    np.testing.assert_allclose(slide, expected, rtol=0, atol=tol)
+
+
+# ----------------------------------------------------- the shipped double Cardan shaft
+def test_double_cardan_scene_is_homokinetic_and_its_tube_fluctuates(tmp_path):
+    """inputs/general/cardan_shaft.nml (namelist keys axis / axis2 as in Python), run for
+    0.5 s (0.75 turn): with the tube's yokes in phase the output turns with the input
+    (rigid shafts: exactly; here within 1e-3 rad, the flexible tube's twist under the
+    flywheel's start-up torque, T L / (G J) = 1e-4 rad, and its vibration: 2.4e-4 measured),
+    and the tube's angle obeys the single joint's closed form tan(theta_tube) =
+    cos(beta) tan(theta_in) (5e-4 rad; 1.1e-4 measured) and its speed ratio cos(beta) /
+    (1 - sin^2(beta) sin^2(theta_in)) after the ramp (1e-4, from central differences of the
+    probe angles: (w dt)^2 / 6 = 3e-5; 1.0e-5 measured)."""
+    from ancfdrv import open as open_results
+    from ancfdrv.runner import run_scene
+    from conftest import INPUTS
+    out = tmp_path / "cardan.h5"
+    run_scene(INPUTS / "general" / "cardan_shaft.nml", ["solver.t_end=0.5"], out,
+              progress=False)
+    res = open_results(out)
+    assert res.status == "ok"
+    beta = np.radians(20.0)
+    tube_axis, x, z = np.array([np.cos(beta), np.sin(beta), 0.0]), np.eye(3)[0], np.eye(3)[2]
+
+    def angle(v, axis):   # the turn about axis of a vector that was along +z
+        return np.unwrap(np.arctan2(v @ np.cross(axis, z), v @ z))
+    p = res.probes
+    t = res.time
+    theta_in = angle(p["input yoke"] - p["input yoke"][0] + (0, 0, 0.1), x)
+    theta_out = angle(p["output yoke"] - p["output yoke"][0] + (0, 0, 0.1), x)
+    theta_tube = angle(p["tube yoke"] - p["tube mid"], tube_axis)
+    assert theta_in[-1] > 0.7 * 2 * np.pi
+    assert np.abs(theta_out - theta_in).max() < 1e-3
+    closed = np.unwrap(np.arctan2(np.cos(beta) * np.sin(theta_in), np.cos(theta_in)))
+    assert np.abs(theta_tube - closed).max() < 5e-4
+    steady = t > 0.3
+    ratio = np.gradient(theta_tube, t)[steady] / np.gradient(theta_in, t)[steady]
+    expected = np.cos(beta) / (1 - np.sin(beta)**2 * np.sin(theta_in[steady])**2)
+    assert np.abs(ratio - expected).max() < 1e-4
+    assert expected.max() - expected.min() > 0.1   # the fluctuation is there to be seen
