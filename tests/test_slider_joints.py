@@ -61,33 +61,43 @@ def test_block_slides_down_a_frictionless_incline(ground_first):
     np.testing.assert_allclose(reaction["moment"], 0.0, atol=1e-9 * m * G)
 
 
-def test_driven_prismatic_follows_its_drive_and_carries_the_actuator_force():
+@pytest.mark.parametrize("ground_first", [True, False], ids=["ground-block", "block-ground"])
+def test_driven_prismatic_follows_its_drive_and_carries_the_actuator_force(ground_first):
     """A prismatic actuator along a 30 degree incline moves the block by
     s(t) = A (1 - cos(2 pi f t)) (a 'sine' drive with offset A, phase -pi/2: at rest at
     t = 0): the block's displacement along the axis equals s(t) - s(0) (1e-12 m), and the
     reaction is m g cos(theta) along the normal (1e-12 relative) plus the actuator's force
     m (s'' - g . a) along the axis: within 1.5e-4 of its amplitude m A (2 pi f)^2 at
     dt = 2 ms (the trapezoidal rule's accelerations of a prescribed motion alternate about
-    the exact ones: measured 1.03e-4, and 2.6e-5 at dt = 1 ms, second order)."""
+    the exact ones: measured 1.03e-4, and 2.6e-5 at dt = 1 ms, second order). The
+    multiplier of 'ram: slide(t)' is that force along the axis. Named (block, ground) the
+    drive moves p2 - p1 = ground - block: the block moves by -s(t), and the reaction is what
+    the block exerts on the ground."""
     theta, m, amp, freq = np.radians(30.0), 2.0, 0.2, 1.5
     axis = np.array([np.cos(theta), 0.0, -np.sin(theta)])
     normal = np.array([np.sin(theta), 0.0, np.cos(theta)])
     s = System("actuator")
     s.drive("stroke", "sine", amplitude=amp, frequency=freq, phase=-np.pi / 2, offset=amp)
     s.rigid_body("block", mass=m, inertia=(0.1, 0.1, 0.1, 0, 0, 0), position=(0, 0, 0))
-    s.joint("ram", "prismatic", "ground", "block", point=(0, 0, 0), axis=axis, drive="stroke")
+    bodies = ("ground", "block") if ground_first else ("block", "ground")
+    sign = 1.0 if ground_first else -1.0
+    s.joint("ram", "prismatic", *bodies, point=(0, 0, 0), axis=axis, drive="stroke")
     s.load("g", "gravity", vector=(0, 0, -G))
     s.probe("c", "block", (0, 0, 0))
     res = s.simulate(t_end=1.0, dt=0.002)
     assert res.status == "ok"
     t, p = res.time, res.probes["c"]
-    stroke = amp * (1 - np.cos(2 * np.pi * freq * t))
+    stroke = sign * amp * (1 - np.cos(2 * np.pi * freq * t))
     np.testing.assert_allclose(p @ axis, stroke, rtol=0, atol=1e-12)
     np.testing.assert_allclose(p - np.outer(p @ axis, axis), 0.0, atol=1e-12)
-    accel = amp * (2 * np.pi * freq)**2 * np.cos(2 * np.pi * freq * t)
+    accel = sign * amp * (2 * np.pi * freq)**2 * np.cos(2 * np.pi * freq * t)
     gravity_along = np.array([0.0, 0.0, -G]) @ axis
-    expected = np.outer(m * (accel - gravity_along), axis) + m * G * np.cos(theta) * normal
+    expected = sign * (np.outer(m * (accel - gravity_along), axis)
+                       + m * G * np.cos(theta) * normal)
     error = res.reactions["ram"]["force"] - expected
+    actuator = res.multiplier("ram: slide(t)")   # the force on the block along the axis
+    np.testing.assert_allclose(actuator, m * (accel - gravity_along), rtol=0,
+                               atol=1.5e-4 * m * amp * (2 * np.pi * freq)**2)
     np.testing.assert_allclose(error @ normal, 0.0, atol=1e-12 * m * G)
     np.testing.assert_allclose(error - np.outer(error @ axis, axis), 0.0, atol=1e-12 * m * G)
     assert np.abs(error @ axis).max() <= 1.5e-4 * m * amp * (2 * np.pi * freq)**2
