@@ -502,3 +502,39 @@ def test_double_cardan_scene_is_homokinetic_and_its_tube_fluctuates(tmp_path):
     expected = np.cos(beta) / (1 - np.sin(beta)**2 * np.sin(theta_in[steady])**2)
     assert np.abs(ratio - expected).max() < 1e-4
     assert expected.max() - expected.min() > 0.1   # the fluctuation is there to be seen
+
+
+@pytest.mark.parametrize("formulation", ["ffr", "nonlinear"])
+@pytest.mark.parametrize("order", [("beam", "tip"), ("tip", "beam")], ids=["beam-body",
+                                                                          "body-beam"])
+def test_locked_prismatic_is_a_weld(formulation, order):
+    """A prismatic joint whose slide a constant drive holds is a weld: a rigid body on the
+    tip of a 2 m cantilever (FFR, whose section turn carries the body's axes linearly, or
+    nonlinear), a force and a moment on the body: the body's displacement is the welded
+    model's to 1e-10 (measured 2e-12), whichever body is named first; with FFR the note
+    names the prismatic joint that linearizes the body's axes."""
+    tips = []
+    for kind in ("weld", "prismatic"):
+        s = System(kind)
+        s.material("steel", youngs_modulus=2.1e11, density=7850.0)
+        s.drive("hold", "constant", value=0.0)
+        s.beam("beam", material="steel", start=(0, 0, 0), end=(2, 0, 0), nodes=3,
+               section=Rectangle(0.05, 0.1), height_axis=(0, 1, 0), formulation=formulation)
+        s.rigid_body("tip", mass=10.0, inertia=(0.1, 0.2, 0.3, 0, 0, 0),
+                     position=(2.2, 0, 0.1))
+        s.joint("clamp", "weld", "ground", "beam", point=(0, 0, 0))
+        extra = dict(axis=(0.6, 0.8, 0), drive="hold") if kind == "prismatic" else {}
+        s.joint("j", kind, *order, point=(2.0, 0, 0), **extra)
+        s.load("F", "force", body="tip", point=(2.4, 0.05, 0.1), vector=(300.0, -500.0, 200.0))
+        s.load("M", "moment", body="tip", point=(2.4, 0.05, 0.1), vector=(50.0, 20.0, -30.0))
+        s.probe("p", "tip", (2.4, 0.05, 0.1))
+        model = s.assemble()
+        try:
+            e = solve_newton(model, tol=1e-12).e
+            tips.append(model.probe_positions(e)["p"] - model.probe_positions(model.e0)["p"])
+            if formulation == "ffr":
+                assert any(f"({kind} 'j'), linearized" in n for n in model.notes), model.notes
+        finally:
+            model.close()
+    assert np.abs(tips[0]).max() > 1e-3
+    np.testing.assert_allclose(tips[1], tips[0], rtol=0, atol=1e-10 * np.abs(tips[0]).max())
