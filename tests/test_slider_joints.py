@@ -316,8 +316,8 @@ def test_joint_equations_jacobian_and_hessian_at_large_rotations(kind, pair):
     """Each new joint between each pair of bodies, kept with multipliers:
 
     * its equations vanish at t = 0, after a common rigid motion of both bodies by a large
-      rotation (2.2 rad about an oblique axis: 1e-12; none when body1 is the ground), and after the relative motion the
-      joint allows (prismatic: a slide along the carried axis; cylindrical: a slide and a
+      rotation (2.2 rad about an oblique axis: 1e-12; none when body1 is the ground), and
+      after the relative motion the joint allows (prismatic: a slide along the carried axis; cylindrical: a slide and a
       1.3 rad turn about it; universal: turns about both cross axes) on top of it, while a
       motion it forbids violates them;
     * at a state of large rotations (each body 1.0-2.5 rad about its own axis, plus noise
