@@ -229,6 +229,39 @@ def test_cardan_joint_speed_ratio_against_the_closed_form(beta_deg):
         model.close()
 
 
+def test_cardan_cross_carries_the_output_shafts_inertia_torque():
+    """The same Cardan joint (beta = 30 deg) run by System.simulate: the reaction of the
+    'universal' on the output shaft, about the shaft's axis a2, is the torque that speeds
+    the shaft up and down, I_22 alpha_2 with alpha_2 = d/dt [w1 cos(beta) / (1 - sin^2(beta)
+    sin^2(theta1))] from the drive's angle, rate and acceleration (the bearing takes no
+    moment about a2); within 4e-3 of its peak at dt = 2.5 ms (the trapezoidal rule's
+    accelerations: 9.2e-3 at 5 ms, 2.5e-3 at 2.5 ms, second order). The cross's and the
+    bearing's forces on the shaft add up to zero (its centre does not move: 1e-12)."""
+    beta = np.radians(30.0)
+    a2 = np.array([np.cos(beta), np.sin(beta), 0.0])
+    inertia = (0.01, 0.02, 0.02, 0, 0, 0)
+    s = System("cardan")
+    s.drive("spin", "ramp", rate=2 * np.pi, t_ramp=0.2)
+    s.rigid_body("in", mass=1.0, inertia=inertia, position=(0, 0, 0))
+    s.rigid_body("out", mass=1.0, inertia=inertia, position=0.5 * a2)
+    s.joint("motor", "hub", "ground", "in", point=(0, 0, 0), pivot=(0, 0, 0), axis=(1, 0, 0),
+            drive="spin")
+    s.joint("bearing", "revolute", "ground", "out", point=0.5 * a2, axis=a2)
+    s.joint("cross", "universal", "in", "out", point=(0, 0, 0), axis=(0, 0, 1),
+            axis2=(-np.sin(beta), np.cos(beta), 0))
+    res = s.simulate(t_end=1.2, dt=0.0025)
+    assert res.status == "ok"
+    theta, w1, a1 = s.drives["spin"].values(res.time)
+    sb2 = np.sin(beta)**2
+    den = 1 - sb2 * np.sin(theta)**2
+    alpha2 = a1 * np.cos(beta) / den + w1**2 * np.cos(beta) * sb2 * np.sin(2 * theta) / den**2
+    torque = (a2 @ np.diag(inertia[:3]) @ a2) * alpha2
+    moment = res.reactions["cross"]["moment"] @ a2
+    assert np.abs(moment - torque).max() <= 4e-3 * np.abs(torque).max()
+    total = res.reactions["cross"]["force"] + res.reactions["bearing"]["force"]
+    np.testing.assert_allclose(total, 0.0, atol=1e-12)
+
+
 def test_universal_refuses_axes_that_are_not_normal():
     s = System("bad cross")
     s.rigid_body("a", mass=1.0, inertia=(1, 1, 1, 0, 0, 0), position=(0, 0, 0))
