@@ -36,6 +36,10 @@ Types (SPEC section 8, plus what the template scenes need):
 - ``universal``: positions coincide and ``axis`` (carried by body1) stays normal to
   ``axis2`` (carried by body2; normal to ``axis`` at t = 0): a Cardan joint's cross.
 
+The guide of 'prismatic' and 'cylindrical' is the line body1's section carries at the
+joint's point (a rigid guide fixed there) and p2 one material point of body2: a carriage on
+a flexible rail does not follow the rail's deflection along its length.
+
 The new types reuse the equations of the old ones (:meth:`Joint._orientation` of the weld,
 :meth:`Joint._axis_tie` of the revolute) and add dot products of carried directions
 (:func:`_product`), each linear when one factor is constant (the ground's) and a kernel
