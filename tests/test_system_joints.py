@@ -586,6 +586,15 @@ JOINTS = {
                                   axis=(0, 0, 1), drive="angle"),
     "hub body": lambda s: s.joint("j", "hub", "ground", "r", point=(2, 0.5, 0.3),
                                   pivot=(0, 0, 0), axis=(0, 0, 1), drive="angle"),
+    # issue 22 (tests/test_slider_joints.py checks them at large rotations)
+    "prismatic beam-body": lambda s: s.joint("j", "prismatic", "b", "r", point=(1, 0.4, 0),
+                                             axis=(0.6, 0.8, 0)),
+    "prismatic driven": lambda s: s.joint("j", "prismatic", "ground", "a", point=(0.3, 0, 0),
+                                          axis=(1, 0, 0), drive="length"),
+    "cylindrical beams": lambda s: s.joint("j", "cylindrical", "a", "b", point=(1, 0, 0),
+                                           axis=(0, 1, 0)),
+    "universal body-beam": lambda s: s.joint("j", "universal", "r", "a", point=(0.7, 0, 0),
+                                             axis=(0, 0, 1), axis2=(0, 1, 0)),
 }
 
 

@@ -31,6 +31,9 @@ JOINT_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "fix": (("point",), ("vector", "axis")),
     "arm": (("point", "axis", "pivot"), ()),
     "hub": (("point", "axis", "pivot", "drive"), ()),
+    "prismatic": (("point", "axis"), ("drive",)),
+    "cylindrical": (("point", "axis"), ()),
+    "universal": (("point", "axis", "axis2"), ()),
 }
 JOINT_MEANING = {
     "weld": "positions coincide; body2's section or axes follow body1's at the point",
@@ -43,6 +46,13 @@ JOINT_MEANING = {
            "component along axis (body1: ground)",
     "arm": "the boom's support: the node on a massless arm hinged at pivot about axis",
     "hub": "a driven clamp: node and section turn with the drive about axis through pivot",
+    "prismatic": "no relative rotation; body2's point slides along axis (carried by body1) "
+                 "through point; with drive, the slide (p2 - p1) . axis follows the drive's "
+                 "value minus its value at t = 0 (an actuator)",
+    "cylindrical": "body2's point slides along axis through point and turns about it (axis "
+                   "carried by body1)",
+    "universal": "positions coincide; axis (on body1) stays normal to axis2 (on body2): a "
+                 "Cardan joint's cross",
 }
 DRIVE_MEANING = {
     "constant": "phi = value",

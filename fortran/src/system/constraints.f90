@@ -8,7 +8,8 @@
 !>   kind 2  distance    |x(1:3) - x(4:6)|^2 - (p1 + p2 phi)^2 = 0  (a driven length with p2 = 1)
 !>   kind 3  cross       k . (x(1:3) x x(4:6)) = 0,  k = p(1:3): a vector parallel to a
 !>                       position vector in the plane normal to k
-!>   kind 4  dot         x(1:3) . x(4:6) - p1 = 0
+!>   kind 4  dot         x(1:3) . x(4:6) - (p1 + p2 phi) = 0  (with p2 /= 0 and a drive: a driven
+!>                       relative translation, e.g. a prismatic joint's actuator)
 !> phi is the value of the constraint's drive (drives module; no drive: phi = 0).
 !> Layout: kinds(n), drives(n), params(8, n), operand_const(6, n), and the terms of operand
 !> s of constraint c at term_ptr(6 (c - 1) + s) ... term_ptr(6 (c - 1) + s + 1) - 1 of
@@ -152,6 +153,7 @@ contains
         hessians(4:6, 1:3, c) = transpose(hessians(1:3, 4:6, c))
       case (constraint_kind_dot)
         values(c) = dot_product(x(1:3), x(4:6)) - params(1, c)
+        if (drives(c) /= 0) values(c) = values(c) - params(2, c) * phi
         gradients(1:3, c) = x(4:6)
         gradients(4:6, c) = x(1:3)
         if (.not. second) cycle
@@ -159,6 +161,10 @@ contains
           hessians(m, m + 3, c) = 1.0_dp
           hessians(m + 3, m, c) = 1.0_dp
         end do
+        if (drives(c) /= 0) then
+          phi_t(c) = -params(2, c) * dphi
+          phi_tt(c) = -params(2, c) * ddphi
+        end if
       case default
         info = c
         return

@@ -186,7 +186,7 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
     elif group == "joint":
         s.joint(v["name"], v["type"], v["body1"], v["body2"], point=v["point"], axis=v["axis"],
                 drive=v["drive"], point1=v["point1"], point2=v["point2"], pivot=v["pivot"],
-                vector=v["vector"], edge=v["edge"], box=v["box"])
+                vector=v["vector"], edge=v["edge"], box=v["box"], axis2=v["axis2"])
     elif group == "load":
         s.load(v["name"], v["type"], body=v["body"], point=v["point"], vector=v["vector"],
                mass=v["mass"], value=v["value"], drive=v["drive"], effect=v["effect"],

@@ -489,13 +489,18 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
     "joint": {
         "name": _name(),
         "type": Key("str", check=one_of("weld", "revolute", "spherical", "distance", "prescribed",
-                                        "fix", "arm", "hub"), doc="joint type (SPEC section 8)"),
+                                        "fix", "arm", "hub", "prismatic", "cylindrical",
+                                        "universal"), doc="joint type (SPEC section 8)"),
         "body1": Key("str", "ground", doc="first body (or 'ground')"),
         "body2": Key("str", doc="second body"),
         "point": Key("floats", None, points3, "joint point(s): any material points of the bodies "
                      "(between nodes, off a beam's axis)"),
-        "axis": Key("floats", None, vector3, "hinge axis / direction"),
-        "drive": Key("str", None, doc="drive of 'distance', 'prescribed', 'hub'"),
+        "axis": Key("floats", None, vector3, "hinge axis / direction ('prismatic', "
+                    "'cylindrical': the slide axis; 'universal': the cross's axis on body1)"),
+        "axis2": Key("floats", None, vector3, "'universal': the cross's axis on body2 (normal "
+                     "to axis at t = 0)"),
+        "drive": Key("str", None, doc="drive of 'distance', 'prescribed', 'hub', 'prismatic' "
+                     "(its relative translation along axis, from the value at t = 0)"),
         "point1": Key("floats", None, vector3, "'distance': point on body1"),
         "point2": Key("floats", None, vector3, "'distance': point on body2"),
         "pivot": Key("floats", None, vector3, "'prescribed', 'arm', 'hub': centre of rotation"),

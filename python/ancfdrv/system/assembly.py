@@ -556,8 +556,9 @@ def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[
             if body.planar:
                 out += planar_fixes(body, q0)
             if body.name in linearized:
+                via = system.joints[linearized[body.name]].type
                 notes.append(f"rigid body {body.name!r}: its axes follow the small section turn "
-                             f"of an FFR beam (weld {linearized[body.name]!r}), linearized; "
+                             f"of an FFR beam ({via} {linearized[body.name]!r}), linearized; "
                              "orthonormality not imposed")
                 continue
             out += orthonormality(body)
@@ -567,7 +568,8 @@ def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[
 def _linearized(system, warnings: list[str]) -> dict[str, str]:
     """Rigid bodies whose axes are linear in the coordinates, name -> the weld that makes them
     so: welded to an FFR beam in a fixed frame (Joint.linearized_body), or to such a body
-    through welds between rigid bodies. Their axes are orthonormal to first order only, as
+    through welds between rigid bodies ('prismatic' joints count as welds: they tie the
+    orientation alike). Their axes are orthonormal to first order only, as
     the beam's kinematics: imposing J^T J = I would hold the turn at zero. A warning names
     the welds and revolutes that tie such axes to a body with finite rotations (a nonlinear
     beam, a plate or leaf, an FFR beam in a moving frame): its directions then follow them
@@ -583,11 +585,13 @@ def _linearized(system, warnings: list[str]) -> dict[str, str]:
         grown = False
         for joint in joints:
             a, b = joint.bodies
-            if joint.type == "weld" and isinstance(a, RigidBody) and isinstance(b, RigidBody):
+            if joint.type in ("weld", "prismatic") and isinstance(a, RigidBody) and \
+                    isinstance(b, RigidBody):   # a prismatic's orientation ties are a weld's
                 for body, other in ((a, b), (b, a)):
                     if other.name in out and body.name not in out:
                         out[body.name], grown = out[other.name], True
-    for joint in (j for j in joints if j.type in ("weld", "revolute")):
+    for joint in (j for j in joints if j.type in ("weld", "revolute", "prismatic",
+                                                  "cylindrical", "universal")):
         for body, other in (joint.bodies, joint.bodies[::-1]):
             if body.name in out and other.flexible and not small_turn(other):
                 warnings.append(
@@ -718,7 +722,7 @@ def _constant_constraint(eq: Constraint, x: list[float], tol: float, notes: list
         elif eq.kind == CONSTRAINT_CROSS:
             value = float(p[:3] @ np.cross(x[:3], x[3:]))
         else:
-            value = float(x[:3] @ x[3:]) - p[0]
+            value = float(x[:3] @ x[3:]) - p[0] - p[1] * phi   # dot (p[1]: driven)
         if abs(value) > tol:
             if eq.drive is None:
                 raise InputError(f"{eq.name}: every coordinate of this equation is held by other "

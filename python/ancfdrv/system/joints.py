@@ -26,7 +26,24 @@ Types (SPEC section 8, plus what the template scenes need):
   hinged at ``pivot`` about ``axis``: its distance to the pivot and its plane are kept and
   its section's height direction r_y stays along the arm;
 - ``hub``: a driven clamp: body2's node and section turn with the drive's angle about
-  ``axis`` through ``pivot`` (the spin-up beam's root).
+  ``axis`` through ``pivot`` (the spin-up beam's root);
+- ``prismatic``: body2's section or axes follow body1's directions (as a weld's) and its
+  point stays on the line through body1's point along ``axis`` (carried by body1): relative
+  translation along the axis only; with ``drive`` the translation (p2 - p1) . axis is the
+  drive's value minus its value at t = 0 (an actuator);
+- ``cylindrical``: the bodies' vectors along ``axis`` coincide (as a revolute's) and body2's
+  point stays on body1's line along the axis: translation along and rotation about it;
+- ``universal``: positions coincide and ``axis`` (carried by body1) stays normal to
+  ``axis2`` (carried by body2; normal to ``axis`` at t = 0): a Cardan joint's cross.
+
+The guide of 'prismatic' and 'cylindrical' is the line body1's section carries at the
+joint's point (a rigid guide fixed there) and p2 one material point of body2: a carriage on
+a flexible rail does not follow the rail's deflection along its length.
+
+The new types reuse the equations of the old ones (:meth:`Joint._orientation` of the weld,
+:meth:`Joint._axis_tie` of the revolute) and add dot products of carried directions
+(:func:`_product`), each linear when one factor is constant (the ground's) and a kernel
+'dot' constraint otherwise (its value x . y - p1 - p2 phi carries the prismatic drive).
 
 A joint's point may be any material point of a body (SPEC 8.1): between the nodes of a beam,
 plate or leaf its position and directions come from the element's shape functions, and off a
@@ -45,7 +62,8 @@ from .bodies import Attachment, Beam, Body, Ground, Plate, RigidBody, rotation_a
 from .drives import Drive
 from .expressions import Scalar, Vec3, combination
 
-JOINT_TYPES = ("weld", "revolute", "spherical", "distance", "prescribed", "fix", "arm", "hub")
+JOINT_TYPES = ("weld", "revolute", "spherical", "distance", "prescribed", "fix", "arm", "hub",
+               "prismatic", "cylindrical", "universal")
 #: plate and leaf edges a joint can hold whole: x0 / x1 the ends along edge_x (a leaf's arc),
 #: y0 / y1 the sides along edge_y
 EDGES = ("x0", "x1", "y0", "y1")
@@ -128,6 +146,8 @@ class Joint:
     edge: str | None = None
     #: a box (x0, y0, z0, x1, y1, z1) whose every node of the flexible body the joint holds
     box: np.ndarray | None = None
+    #: 'universal': the cross's second axis, carried by body2 (normal to ``axis`` at t = 0)
+    axis2: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         where = f"joint {self.name!r}"
@@ -156,6 +176,15 @@ class Joint:
         self.swapped = isinstance(self.body2, Ground)
         if isinstance(self.body2, Ground):  # the ground is always body1
             self.body1, self.body2 = self.body2, self.body1
+            if self.type == "universal":   # each axis stays with its body
+                self.axis, self.axis2 = self.axis2, self.axis
+        if self.axis2 is not None:
+            if self.type != "universal":
+                raise InputError(f"{where}: axis2 applies to type 'universal' only")
+            self.axis2 = np.asarray(self.axis2, dtype=float)
+            if self.axis2.shape != (3,) or np.linalg.norm(self.axis2) == 0.0:
+                raise InputError(f"{where}: axis2 must be a non-zero 3-vector")
+            self.axis2 = self.axis2 / np.linalg.norm(self.axis2)
         if self.axis is not None:
             self.axis = np.asarray(self.axis, dtype=float)
             if self.axis.shape != (3,) or np.linalg.norm(self.axis) == 0.0:
@@ -167,8 +196,16 @@ class Joint:
         if self.type == "distance" and (self.point1 is None or self.point2 is None):
             raise InputError(f"{where}: type 'distance' needs point1 (on body1) and point2 (on "
                              "body2)")
-        if self.type in ("revolute", "arm", "hub") and self.axis is None:
+        if self.type in ("revolute", "arm", "hub", "prismatic", "cylindrical",
+                         "universal") and self.axis is None:
             raise InputError(f"{where}: type {self.type!r} needs an axis")
+        if self.type == "universal":
+            if self.axis2 is None:
+                raise InputError(f"{where}: type 'universal' needs axis2 (the cross's axis on "
+                                 "body2, normal to axis)")
+            if abs(float(self.axis @ self.axis2)) > 1e-9:
+                raise InputError(f"{where}: axis and axis2 must be normal to each other at "
+                                 f"t = 0 (their cosine is {float(self.axis @ self.axis2):.3g})")
         if self.type in ("prescribed", "fix", "arm", "hub") and not isinstance(self.body1, Ground):
             raise InputError(f"{where}: type {self.type!r} acts between the ground and a body "
                              f"(body1 = {self.body1.name!r} is not the ground)")
@@ -181,9 +218,10 @@ class Joint:
             raise InputError(f"{where}: type {self.type!r} needs a pivot")
         if self.vector not in ("r", "r_x", "r_y", "r_z"):
             raise InputError(f"{where}: vector {self.vector!r} must be 'r', 'r_x', 'r_y' or 'r_z'")
-        if self.drive is not None and self.type not in ("distance", "prescribed", "hub"):
-            raise InputError(f"{where}: a drive applies to types 'distance', 'prescribed' and "
-                             "'hub'")
+        if self.drive is not None and self.type not in ("distance", "prescribed", "hub",
+                                                        "prismatic"):
+            raise InputError(f"{where}: a drive applies to types 'distance', 'prescribed', "
+                             "'hub' and 'prismatic'")
 
     def _selected_points(self, where: str) -> list[np.ndarray]:
         """The nodes of the joint's flexible body on its edge or in its box (at t = 0): a
@@ -241,7 +279,7 @@ class Joint:
         turn (:func:`_weld_roles`), else None. Its axes are then I + [w]x, orthonormal to
         first order only, like the beam's own kinematics: the assembly does not impose its
         orthonormality (it would hold w at zero)."""
-        if self.type != "weld":
+        if self.type not in ("weld", "prismatic"):
             return None
         base, held = self.body1, self.body2
         if isinstance(base, RigidBody):
@@ -251,7 +289,12 @@ class Joint:
         return None
 
     def _weld(self, at1, at2, q0, name) -> list[Equation]:
-        out = self._spherical(at1, at2, q0, name)
+        return self._spherical(at1, at2, q0, name) + self._orientation(at1, at2, q0, name)
+
+    def _orientation(self, at1, at2, q0, name) -> list[Equation]:
+        """A weld's orientation ties: body2's section or axes follow body1's directions at
+        the point (see :func:`_weld_roles`, :func:`_section_ties`)."""
+        out: list[Equation] = []
         base, at_b, held, at_h = _weld_roles(self.body1, at1, self.body2, at2)
         basis = base.basis(at_b)
         initial = [b.value(q0) for b in basis]
@@ -266,7 +309,11 @@ class Joint:
         return out
 
     def _revolute(self, at1, at2, q0, name) -> list[Equation]:
-        out = self._spherical(at1, at2, q0, name)
+        return self._spherical(at1, at2, q0, name) + self._axis_tie(at1, at2, q0, name)
+
+    def _axis_tie(self, at1, at2, q0, name) -> list[Equation]:
+        """A revolute's axis equations: the two bodies' vectors along ``axis`` coincide."""
+        out: list[Equation] = []
         axes = []
         for body, at in ((self.body1, at1), (self.body2, at2)):
             components, kept = _carried(body, at, self.axis, q0, name)
@@ -274,6 +321,42 @@ class Joint:
             out += kept
         return out + [LinearEquation(axes[1][i] - axes[0][i], f"{name}: axis [{'xyz'[i]}]",
                                      list(axes[1][i].terms)) for i in range(3)]
+
+    def _across(self, at1, at2, q0, name) -> list[Equation]:
+        """Body2's point stays on the line through body1's point along ``axis`` (carried by
+        body1): (p2 - p1) . n = 0 for two normals n of the axis as body1 carries them."""
+        gap = (self.body2.position(at2) - self.body1.position(at1))
+        normals, kept = _carried_all(self.body1, at1, _normals(self.axis), q0, name)
+        out: list[Equation] = []
+        for k, n in enumerate(normals):
+            prefer = _prefer(gap, n, q0)
+            out.append(_product(gap.components(), n, 0.0, f"{name}: across {k + 1}", prefer))
+        return out + kept
+
+    def _prismatic(self, at1, at2, q0, name) -> list[Equation]:
+        out = self._orientation(at1, at2, q0, name) + self._across(at1, at2, q0, name)
+        if self.drive is not None:
+            # the user's (p2 - p1) . axis follows phi(t) - phi(0); with the bodies swapped
+            # (the ground named as body2) the internal p2 - p1 is its opposite
+            sign = -1.0 if self.swapped else 1.0
+            gap = self.body2.position(at2) - self.body1.position(at1)
+            (along,), kept = _carried_all(self.body1, at1, [self.axis], q0, name)
+            phi0 = self.drive.value(0.0)
+            out.append(_product(gap.components(), along, -sign * phi0, f"{name}: slide(t)",
+                                _prefer(gap, along, q0), self.drive, sign))
+            out += kept
+        return _unique(out)
+
+    def _cylindrical(self, at1, at2, q0, name) -> list[Equation]:
+        return _unique(self._axis_tie(at1, at2, q0, name) + self._across(at1, at2, q0, name))
+
+    def _universal(self, at1, at2, q0, name) -> list[Equation]:
+        out = self._spherical(at1, at2, q0, name)
+        (a1,), kept1 = _carried_all(self.body1, at1, [self.axis], q0, name)
+        (a2,), kept2 = _carried_all(self.body2, at2, [self.axis2], q0, name)
+        prefer = [d for s in a2 for d in s.terms]
+        out.append(_product(a1, a2, 0.0, f"{name}: cross", prefer))
+        return _unique(out + kept1 + kept2)
 
     def _fix(self, at1, at2, q0, name) -> list[Equation]:
         v = self.body2.vector(at2, self.vector)
@@ -363,6 +446,61 @@ def _dot(u: Vec3, v: Vec3, q0: np.ndarray, name: str, prefer: list[int]) -> Cons
     """u . v kept at its initial value."""
     return Constraint(CONSTRAINT_DOT, u.components() + v.components(),
                       [float(u.value(q0) @ v.value(q0))], None, name, prefer)
+
+
+def _normals(axis: np.ndarray) -> list[np.ndarray]:
+    """Two unit vectors normal to the unit vector axis and to each other."""
+    trial = np.eye(3)[int(np.argmin(np.abs(axis)))]
+    b = np.cross(axis, trial)
+    b /= np.linalg.norm(b)
+    return [b, np.cross(axis, b)]
+
+
+def _carried_all(body: Body, at: Attachment, directions: list[np.ndarray], q0: np.ndarray,
+                 name: str) -> tuple[list[list[Scalar]], list[Equation]]:
+    """:func:`_carried` for several directions; their section-keeping equations once."""
+    out, kept = [], []
+    for k0 in directions:
+        components, more = _carried(body, at, k0, q0, name)
+        out.append(components)
+        kept += more
+    return out, _unique(kept)
+
+
+def _unique(equations: list[Equation]) -> list[Equation]:
+    """The equations without repeats of a name (a section kept rigid by two ties)."""
+    seen: set[str] = set()
+    out = []
+    for eq in equations:
+        if eq.name not in seen:
+            seen.add(eq.name)
+            out.append(eq)
+    return out
+
+
+def _prefer(v: Vec3, direction: list[Scalar], q0: np.ndarray) -> list[int]:
+    """v's coordinates along the direction's largest components (at t = 0) first."""
+    k = np.array([s.value(q0) for s in direction])
+    order = np.argsort(-np.abs(k), kind="stable")
+    return [d for i in order if abs(k[i]) > 1e-12 for d in _dofs(v, int(i))]
+
+
+def _product(u: list[Scalar], v: list[Scalar], value: float, name: str, prefer: list[int],
+             drive: Drive | None = None, rate: float = 0.0) -> Equation:
+    """u . v = value + rate phi(t) for affine 3-vectors u, v (components): linear when one
+    of them is constant (a :class:`LinearEquation`, or a driven 'coordinate' constraint),
+    else a 'dot' constraint (x . y - p1 - p2 phi = 0)."""
+    if all(not s.terms for s in u):
+        u, v = v, u
+    if all(not s.terms for s in v):
+        expr = Scalar({}, 0.0)
+        for a, b in zip(u, v):
+            expr = expr + a.scaled(b.const)
+        if drive is None:
+            return LinearEquation(expr - Scalar({}, value), name, prefer)
+        return Constraint(CONSTRAINT_COORDINATE, [expr], [value, 0.0, 0.0, rate], drive, name,
+                          prefer)
+    return Constraint(CONSTRAINT_DOT, list(u) + list(v), [value, rate], drive, name, prefer)
 
 
 def small_turn(body: Body) -> bool:

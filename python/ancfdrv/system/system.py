@@ -307,15 +307,17 @@ class System:
     @_api
     def joint(self, name: str, type: str, body1: str | Body, body2: str | Body, *, point=None,
               axis=None, drive: str | Drive | None = None, point1=None, point2=None,
-              pivot=None, vector: str = "r", edge: str | None = None, box=None) -> Joint:
+              pivot=None, vector: str = "r", edge: str | None = None, box=None,
+              axis2=None) -> Joint:
         """A joint (``ancfdrv.system.joints``); ``point`` may list several points (the joint
         then acts at each), any material points of the bodies (SPEC 8.1). Instead of points,
         ``edge`` ('x0', 'x1', 'y0', 'y1': a side of a plate or leaf) or ``box`` (x0, y0, z0,
-        x1, y1, z1) selects every node of the flexible body there, whatever the mesh."""
+        x1, y1, z1) selects every node of the flexible body there, whatever the mesh.
+        ``axis2``: a 'universal' joint's second cross axis, on body2 (``axis`` is on body1)."""
         name = self._new_name(name, self.joints, "joint")
         where = f"joint {name!r}"
         v = check_call("joint", f"joint[{name}]", dict(
-            point=point, axis=axis, point1=point1, point2=point2, pivot=pivot))
+            point=point, axis=axis, point1=point1, point2=point2, pivot=pivot, axis2=axis2))
         axis = v["axis"]
         try:
             points = [] if point is None else _points(point)
@@ -325,7 +327,8 @@ class System:
         except ValueError as exc:
             raise InputError(f"{where}: {exc}") from None
         joint = Joint(name, type, self.body(body1, used_by=where), self.body(body2, used_by=where),
-                      points, axis, self._drive(drive, where), p1, p2, pv, vector, edge, box)
+                      points, axis, self._drive(drive, where), p1, p2, pv, vector, edge, box,
+                      axis2=v["axis2"])
         self.joints[name] = joint
         return joint
 
