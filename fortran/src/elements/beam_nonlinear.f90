@@ -34,7 +34,7 @@
 module beam_nonlinear
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use beam_element, only: beam_shape
+  use beam_element, only: beam_shape, material_axes
   use matrix3, only: invert3
   use element_sets, only: local_element_set
   implicit none
@@ -122,7 +122,10 @@ contains
           info = 2
           return
         end if
-        gradients(:, :, p) = matmul(dshape, inv0)
+        ! strains in the section's material axes (axis, height, width): F R0 with R0 the
+        ! orthonormal frame of J0's columns (material_axes); F alone would give them in the
+        ! global axes, where the split laws below are not those of an isotropic material
+        gradients(:, :, p) = matmul(dshape, matmul(inv0, material_axes(jac0)))
         weights(p) = weights(p) * det0
       end do
     end do
