@@ -12,11 +12,10 @@ Reference: the cubic option on 17 nodes at the same step (converged: 33 nodes ch
 history by 1.8e-6 of the peak, 65 the peak by 5e-7; halving the step moves the peak by 5e-4
 for every model here, so the comparison is at equal steps). Measured against it (largest
 difference over the history / the reference peak): cubic 9 nodes 1.5e-5 at nu = 0 and 0.3;
-continuum 17 nodes 0.46% at nu = 0 (peak -0.36%; on 33 nodes -0.09%), and at nu = 0.3 1.4%
-(peak -0.21%; 33 nodes: 1.6%, peak +0.06%). Before issue 20 the continuum peak at nu = 0.3
-was +1.9% (9 nodes +0.7%, 33 nodes +2.2%): the section-stretch gradients in its shears took
-G; they take E/2 now (docs/theory.md section 17). The history still drifts after the peak
-at nu = 0.3, so that case stays an expected failure.
+continuum 17 nodes 0.46% at nu = 0 and at nu = 0.3 (peak -0.36%; on 33 nodes 0.11%). Before
+the continuum element took its strains in the section's material axes, the rod (inclined
+in space) saw its split law in the global axes, where it is not isotropic at nu > 0: 1.4%
+at nu = 0.3 (docs/theory.md section 17).
 ``benchmarks/spatial_mechanism.py`` runs the full table (JSON).
 """
 from __future__ import annotations
@@ -133,3 +132,36 @@ def test_continuum_energy_independent_of_placement(section, poisson):
     assert energy0 > 0
     assert energy == pytest.approx(energy0, rel=1e-12)
     np.testing.assert_allclose(force, force0 @ rotation.T, atol=1e-10 * np.abs(force0).max())
+
+
+@pytest.mark.parametrize("poisson", [0.0, 0.3])
+def test_continuum_reference_tangent_independent_of_placement(poisson):
+    """The FFR element's K0 takes its strains in the same material axes: for a rectangle
+    (c = J / I_p != 1) turned by a rotation R in space, K0 is R K0 R^T (per nodal 3-vector)
+    to round-off, and at nu = 0 it equals the large-deformation element's tangent at the
+    reference (the continuum element's split puts the Poisson part on the axis, K0 over
+    the section, so they differ at nu > 0)."""
+    length, section = 0.1, Rectangle(0.01, 0.03)
+    reference = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1],
+                          [length, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float).T
+    scales = section.shear_scales(poisson)
+    rng = np.random.default_rng(11)
+    rotation = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    rotation *= np.linalg.det(rotation)
+    turn = np.kron(np.eye(8), rotation)
+
+    def k0(r):
+        return kernel.beam_element_arrays(np.array([length]), section.data, 7850.0, 2.1e11,
+                                          poisson, (r @ reference)[:, :, None], scales)[1][:, :, 0]
+
+    stiffness0 = k0(np.eye(3))
+    np.testing.assert_allclose(k0(rotation), turn @ stiffness0 @ turn.T,
+                               atol=1e-12 * np.abs(stiffness0).max())
+    if poisson == 0.0:
+        gradients, weights, nvolume = kernel.beam_nonlinear_setup(
+            (rotation @ reference)[:, :, None], np.array([length]), section.data)
+        _, _, tangent = kernel.beam_nonlinear_forces(
+            np.arange(24)[:, None], (rotation @ reference).T.ravel(), gradients, weights,
+            nvolume, 2.1e11, poisson, True, scales)
+        np.testing.assert_allclose(tangent[:, :, 0], k0(rotation),
+                                   atol=1e-10 * np.abs(stiffness0).max())
