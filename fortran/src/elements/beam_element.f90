@@ -17,7 +17,7 @@ module beam_element
   implicit none
   private
   public :: beam_shape, beam_mass_compact, beam_gravity_compact, &
-            beam_linear_stiffness, beam_point_mass_compact
+            beam_linear_stiffness, beam_point_mass_compact, material_axes
 
   !> Gauss points along the axis: exact for the mass (degree 6 in xi) and the linear
   !> stiffness (degree 4 in xi); the section rules come from beam_section.
@@ -136,8 +136,8 @@ contains
     real(dp) :: shape(8), dshape(8, 3), jacobian0(3, 3), inverse0(3, 3), det0
     real(dp) :: material_gradient(8, 3), strain_matrix(6, 24), elasticity(6, 6)
     real(dp) :: laws(6, 6, 3), shear, area, point_y(5), point_z(5), point_w(5), law(6, 6)
-    real(dp) :: pt(2), wt(2), xi_point, weight_point
-    integer :: i, s, nsection, extra, naxial
+    real(dp) :: pt(2), wt(2), xi_point, weight_point, axes(3, 3)
+    integer :: i, s, nsection, extra, naxial, a
     call volume_rule(length, section_w, xi, weight, info)
     if (info == 0) call gauss_legendre(2, pt, wt, info)   ! the twist points' axial rule
     call isotropic_elasticity(youngs, poisson, elasticity)
@@ -185,8 +185,15 @@ contains
           info = 2
           return
         end if
-        material_gradient = matmul(dshape, inverse0)
+        ! strains in the section's material axes R0 (as beam_nonlinear): the gradients
+        ! with respect to them, and the displacements' components along them, R0^T u_a
+        axes = material_axes(jacobian0)
+        material_gradient = matmul(dshape, matmul(inverse0, axes))
         call small_strain_matrix(material_gradient, strain_matrix)
+        do a = 1, 8
+          strain_matrix(:, 3 * a - 2:3 * a) = matmul(strain_matrix(:, 3 * a - 2:3 * a), &
+                                                     transpose(axes))
+        end do
         if (extra < 1) then
           stiffness = stiffness + weight(i, s) * det0 * &
                       matmul(transpose(strain_matrix), matmul(law, strain_matrix))
@@ -197,6 +204,20 @@ contains
       end do
     end do
   end subroutine beam_linear_stiffness
+
+  !> The orthonormal material axes at a point of the reference: the columns of J0 = d r0 /
+  !> d(x, y, z) made orthonormal from the first (the axis, then the height, then their
+  !> cross product). The identity for an element along x with its height along y.
+  pure function material_axes(jac0) result(axes)
+    real(dp), intent(in) :: jac0(3, 3)
+    real(dp) :: axes(3, 3)
+    axes(:, 1) = jac0(:, 1) / norm2(jac0(:, 1))
+    axes(:, 2) = jac0(:, 2) - dot_product(axes(:, 1), jac0(:, 2)) * axes(:, 1)
+    axes(:, 2) = axes(:, 2) / norm2(axes(:, 2))
+    axes(:, 3) = [axes(2, 1) * axes(3, 2) - axes(3, 1) * axes(2, 2), &
+                  axes(3, 1) * axes(1, 2) - axes(1, 1) * axes(3, 2), &
+                  axes(1, 1) * axes(2, 2) - axes(2, 1) * axes(1, 2)]
+  end function material_axes
 
   !> B(6, 24) with eps = B u for u = sum_a N_a u_a, given dN_a/dX_j = gradient(a, j).
   pure subroutine small_strain_matrix(gradient, strain_matrix)

@@ -6,6 +6,9 @@
 !>   F = sum_a q_a g_a^T,  E = (F^T F - I)/2,  S = D : E,
 !>   Q_a = int F S g_a dV0,  K_ab = int B_a^T D B_b dV0 + int (g_a^T S g_b) I3 dV0.
 !> At the reference (F = I, S = 0) the tangent equals the small-strain K0 of the FFR model.
+!> F and E are taken in the section's material axes R0 (beam_element's material_axes: the
+!> axis, the height, the width): g_a = R0^T J0^{-T} grad N_a. The laws below are not
+!> isotropic, so in the global axes an inclined element's energy depended on its direction.
 !>
 !> Poisson locking (the section fields are linear in y, z): D is split into the Poisson-free
 !> part D0 = diag(E, E, E, E/2, G, E/2), integrated over the whole section, and the Poisson
@@ -34,7 +37,7 @@
 module beam_nonlinear
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use beam_element, only: beam_shape
+  use beam_element, only: beam_shape, material_axes
   use matrix3, only: invert3
   use element_sets, only: local_element_set
   implicit none
@@ -122,7 +125,10 @@ contains
           info = 2
           return
         end if
-        gradients(:, :, p) = matmul(dshape, inv0)
+        ! strains in the section's material axes (axis, height, width): F R0 with R0 the
+        ! orthonormal frame of J0's columns (material_axes); F alone would give them in the
+        ! global axes, where the split laws below are not those of an isotropic material
+        gradients(:, :, p) = matmul(dshape, matmul(inv0, material_axes(jac0)))
         weights(p) = weights(p) * det0
       end do
     end do
