@@ -62,21 +62,51 @@ def _central_tangent(q, length, ea, ei, tension_only=True, h=1e-7):
     return numeric
 
 
+def _bending_energy(q: np.ndarray, length: float, ei: float) -> float:
+    """The rope's bending energy EI/2 int |r' x r''|^2 dx by a 6-point Gauss rule on the
+    kernel's shape rows (exact: the integrand is a polynomial of degree 6)."""
+    x, w = np.polynomial.legendre.leggauss(6)
+    nodal = q.reshape(4, 3).T
+    energy = 0.0
+    for xi, wi in zip(0.5 * (x + 1.0), 0.5 * w * length):
+        _, slope, second = kernel.cable_shape(xi, length)
+        energy += wi * 0.5 * ei * float(np.sum(np.cross(nodal @ slope, nodal @ second) ** 2))
+    return energy
+
+
 def test_rope_law_taut_like_the_cable_compressed_without_axial_force():
-    """Where every Gauss point is stretched the rope's force, energy and tangent are the
-    cable's (to rounding); where every one is compressed they are those of the cable with
-    EA = 0 (bending alone): the rope carries no compression."""
+    """The axial part: where every Gauss point is stretched the rope's force, energy and
+    tangent are the cable's (EI = 0 in both; to rounding), where every one is compressed
+    they vanish: the rope carries no compression. The bending part is the linear
+    EI/2 r''.r'' (defined where r' = 0): force and energy against a Gauss integration of
+    the shape rows, taut and slack alike."""
     length, ea, ei = 0.6, 50.0, 0.3
     taut = _element(length, 1.02, 1.03, bend=0.1)
     slack = _element(length, 0.97, 0.95, bend=0.1, seed=1)
     assert _gauss_strains(taut, length).min() > 1e-3
     assert _gauss_strains(slack, length).max() < -1e-3
-    for q, reference in ((taut, (ea, ei)), (slack, (0.0, ei))):
-        f_rope, u_rope, k_rope = kernel.cable_forces(DOFS, q, [length], ea, ei, True, True)
-        f_ref, u_ref, k_ref = kernel.cable_forces(DOFS, q, [length], *reference, True)
-        assert np.abs(f_rope - f_ref).max() <= 1e-13 * np.abs(f_ref).max()
-        assert u_rope == pytest.approx(u_ref, rel=1e-13)
-        assert np.abs(k_rope - k_ref).max() <= 1e-13 * np.abs(k_ref).max()
+    f_rope, u_rope, k_rope = kernel.cable_forces(DOFS, taut, [length], ea, 0.0, True, True)
+    f_ref, u_ref, k_ref = kernel.cable_forces(DOFS, taut, [length], ea, 0.0, True)
+    assert np.abs(f_rope - f_ref).max() <= 1e-13 * np.abs(f_ref).max()
+    assert u_rope == pytest.approx(u_ref, rel=1e-13)
+    assert np.abs(k_rope - k_ref).max() <= 1e-13 * np.abs(k_ref).max()
+    f_slack, u_slack, k_slack = kernel.cable_forces(DOFS, slack, [length], ea, 0.0, True, True)
+    assert u_slack == 0.0 and not f_slack.any() and not k_slack.any()
+    h = 1e-6
+    for q in (taut, slack):
+        f_bend, u_bend, _ = kernel.cable_forces(DOFS, q, [length], 0.0, ei, True, True)
+        assert u_bend == pytest.approx(_bending_energy(q, length, ei), rel=1e-12)
+        gradient = np.array([(_bending_energy(q + h * np.eye(12)[j], length, ei)
+                              - _bending_energy(q - h * np.eye(12)[j], length, ei)) / (2 * h)
+                             for j in range(12)])
+        assert np.abs(f_bend - gradient).max() <= 1e-7 * np.abs(f_bend).max()
+    # a straight rope stretched unevenly (r'' along r') has no bending force
+    uneven = np.concatenate([[0, 0, 0], [1.0, 0, 0], [0.65, 0, 0], [1.2, 0, 0]])
+    f_line, u_line, _ = kernel.cable_forces(DOFS, uneven, [length], 0.0, ei, False, True)
+    assert abs(u_line) <= 1e-14 * ei and np.abs(f_line).max() <= 1e-13 * ei  # rounding
+    # r' = 0 at a Gauss point (a folded rope): defined, the plain cable refuses it
+    folded = np.concatenate([[0, 0, 0], [0.0, 0.3, 0], [0, 0, 0], [0.0, -0.3, 0]])
+    kernel.cable_forces(DOFS, folded, [length], ea, ei, True, True)
 
 
 @pytest.mark.parametrize("case", ["taut", "slack", "partly slack"])
@@ -101,7 +131,7 @@ def test_rope_tangent_matches_central_differences(case):
 @pytest.mark.parametrize("angle", [0.0, 2.3])
 def test_rope_rigid_motions_and_reference_stiffness(angle):
     """A straight, unstrained rope translated and turned by up to 2.3 rad has no energy and
-    no force (to rounding), and its tangent there is the cable's: the reference, unstrained
+    no force (to rounding), and its axial tangent there is the cable's: the reference, unstrained
     to rounding, keeps the axial stiffness EA a a^T (the taut side's, module header), so a
     static Newton step from it is regular."""
     length, ea, ei = 0.5, 7.0e6, 2.0
@@ -111,8 +141,9 @@ def test_rope_rigid_motions_and_reference_stiffness(angle):
     force, energy, tangent = kernel.cable_forces(DOFS, q.ravel(), [length], ea, ei, True, True)
     assert abs(energy) <= 1e-13 * ea * length
     assert np.abs(force).max() <= 1e-9 * ea
-    _, _, cable = kernel.cable_forces(DOFS, q.ravel(), [length], ea, ei, True, False)
-    assert np.abs(tangent - cable).max() <= 1e-9 * np.abs(cable).max()
+    _, _, cable = kernel.cable_forces(DOFS, q.ravel(), [length], ea, 0.0, True, False)
+    _, _, bending = kernel.cable_forces(DOFS, q.ravel(), [length], 0.0, ei, True, True)
+    assert np.abs(tangent - bending - cable).max() <= 1e-9 * np.abs(cable).max()
     # a uniform stretch u (r' grows by u along the axis everywhere): u^T K u = EA L
     axis = rot @ np.array([1.0, 0.0, 0.0])
     stretch = np.concatenate([0 * axis, axis, length * axis, axis])

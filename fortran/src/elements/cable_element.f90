@@ -29,8 +29,11 @@
 !> The tangent is the exact one of each side; only in the band -slack_band < eps <= 0 (a
 !> state unstrained to rounding, e.g. the straight reference) it keeps the taut side's
 !> EA a a^T, the one-sided derivative at eps = 0+, so that a rope at rest in its reference
-!> still has its axial stiffness in a static Newton step. The bending term is unchanged (a
-!> rope's bending stiffness is a model parameter; it keeps the slack rope's tangent regular).
+!> still has its axial stiffness in a static Newton step. A rope's bending energy is
+!> EI/2 |r' x r''|^2 = EI/2 kappa^2 |r'|^6 (kappa^2 to within the strain's size; EI a small
+!> model parameter): the exact curvature above is singular where r' vanishes, and a slack
+!> rope folding onto itself passes r' = 0; |r' x r''|^2 is a polynomial, zero for any
+!> straight state (stretched unevenly or not) and unchanged by rigid motions.
 !>
 !> Kelvin-Voigt damping (damping_time tau > 0, the nodal rates given): the axial force
 !> adds N_d = EA tau eps', eps' = a . a' (the bending is not damped). For a rope only in
@@ -244,9 +247,12 @@ contains
     real(dp) :: aa, bb, ab, strain, g, h, f, dg(6), dh(6), df(6), hg(6, 6), hh(6, 6)
     real(dp) :: identity(3, 3)
     integer :: i
-    logical :: taut_tangent
     info = 0
-    taut_tangent = .true.
+    if (tension_only) then
+      call rope_point_derivatives(a, b, axial_stiffness, bending_stiffness, want_hessian, &
+                                  energy, grad_a, grad_b, hessian)
+      return
+    end if
     aa = dot_product(a, a)
     bb = dot_product(b, b)
     ab = dot_product(a, b)
@@ -262,10 +268,6 @@ contains
     g = aa * bb - ab**2                                  ! |a x b|^2
     h = aa**3
     f = g / h                                            ! kappa^2
-    if (tension_only) then
-      taut_tangent = strain > -slack_band
-      strain = max(strain, 0.0_dp)                       ! slack: no axial force, no energy
-    end if
     energy = 0.5_dp * axial_stiffness * strain**2 + 0.5_dp * bending_stiffness * f
     dg(1:3) = 2.0_dp * bb * a - 2.0_dp * ab * b
     dg(4:6) = 2.0_dp * aa * b - 2.0_dp * ab * a
@@ -283,9 +285,42 @@ contains
     hh(1:3, 1:3) = 6.0_dp * aa**2 * identity + 24.0_dp * aa * outer(a, a)
     hessian = 0.5_dp * bending_stiffness * (hg / h - (outer6(dg, dh) + outer6(dh, dg)) / h**2 &
                                             - g * hh / h**2 + 2.0_dp * g * outer6(dh, dh) / h**3)
-    if (tension_only .and. .not. taut_tangent) return   ! slack: bending alone
     hessian(1:3, 1:3) = hessian(1:3, 1:3) + axial_stiffness * (outer(a, a) + strain * identity)
   end subroutine point_derivatives
+
+  !> The rope's point energy w = EA/2 max(eps, 0)^2 + EI/2 |r' x r''|^2 at a = r', b = r'',
+  !> its gradient and, when want_hessian, its Hessian (module header): a polynomial in the
+  !> bending part, defined for every a, including a = 0 (a slack rope folding onto itself).
+  pure subroutine rope_point_derivatives(a, b, axial_stiffness, bending_stiffness, &
+                                         want_hessian, energy, grad_a, grad_b, hessian)
+    real(dp), intent(in) :: a(3), b(3), axial_stiffness, bending_stiffness
+    logical, intent(in) :: want_hessian
+    real(dp), intent(out) :: energy, grad_a(3), grad_b(3), hessian(6, 6)
+    real(dp) :: aa, bb, ab, strain, identity(3, 3)
+    logical :: taut_tangent
+    integer :: i
+    aa = dot_product(a, a)
+    bb = dot_product(b, b)
+    ab = dot_product(a, b)
+    strain = 0.5_dp * (aa - 1.0_dp)
+    taut_tangent = strain > -slack_band
+    strain = max(strain, 0.0_dp)                         ! slack: no axial force, no energy
+    ! bending: EI/2 g with g = |a x b|^2 = (a.a)(b.b) - (a.b)^2
+    energy = 0.5_dp * axial_stiffness * strain**2 + 0.5_dp * bending_stiffness * (aa * bb - ab**2)
+    grad_a = axial_stiffness * strain * a + bending_stiffness * (bb * a - ab * b)
+    grad_b = bending_stiffness * (aa * b - ab * a)
+    if (.not. want_hessian) return
+    identity = 0.0_dp
+    do i = 1, 3
+      identity(i, i) = 1.0_dp
+    end do
+    hessian(1:3, 1:3) = bending_stiffness * (bb * identity - outer(b, b))
+    hessian(4:6, 4:6) = bending_stiffness * (aa * identity - outer(a, a))
+    hessian(1:3, 4:6) = bending_stiffness * (2.0_dp * outer(a, b) - outer(b, a) - ab * identity)
+    hessian(4:6, 1:3) = transpose(hessian(1:3, 4:6))
+    if (.not. taut_tangent) return                       ! slack: bending alone
+    hessian(1:3, 1:3) = hessian(1:3, 1:3) + axial_stiffness * (outer(a, a) + strain * identity)
+  end subroutine rope_point_derivatives
 
   pure function outer(x, y) result(m)
     real(dp), intent(in) :: x(3), y(3)
