@@ -122,46 +122,6 @@ class Cable(Body):
         force = strain if not self.tension_only else np.maximum(strain, 0.0)
         return self.axial_stiffness * force * np.sqrt(1.0 + 2.0 * strain)
 
-    # -- geometry ---------------------------------------------------------------------------
-    @property
-    def nel(self) -> int:
-        return self.nodes - 1
-
-    @property
-    def ncoordinates(self) -> int:
-        return CABLE_NODE_DOFS * self.nodes
-
-    @property
-    def axial_stiffness(self) -> float:
-        return self.material.youngs_modulus * self.section.data.area
-
-    @property
-    def bending_stiffness(self) -> float:
-        """EI (N m^2): the given ``bending_stiffness``, else E times the section's I."""
-        if self._bending_stiffness is not None:
-            return self._bending_stiffness
-        return self.material.youngs_modulus * self.section.data.inertia_y
-
-    def axial_forces(self, e) -> np.ndarray:
-        """The axial force (N, tension positive) at every element's Gauss points (nel, 5),
-        from the full coordinates e (one state (ndof,) or a history (nt, ndof): then
-        (nt, nel, 5)): T = EA eps |r'| with eps = (r'.r' - 1)/2 (the force dw/dr' of the
-        element's law, its magnitude along r'); a rope's is EA max(eps, 0) |r'|."""
-        e = np.asarray(e, dtype=float)
-        q = e[..., self.element_dofs()]                            # (..., 12, nel)
-        q = np.moveaxis(q.reshape(*q.shape[:-2], 4, 3, self.nel), -1, -3)  # (..., nel, 4, 3)
-        xg, _ = np.polynomial.legendre.leggauss(5)
-        out = np.empty((*q.shape[:-2], 5))
-        for k, x in enumerate(0.5 * (xg + 1.0)):
-            slopes = np.array([kernel.cable_shape(x, length)[1] for length in self.lengths])
-            a = np.einsum("ij,...ijk->...ik", slopes, q)               # r' (..., nel, 3)
-            aa = np.einsum("...k,...k->...", a, a)
-            strain = 0.5 * (aa - 1.0)
-            if self.tension_only:
-                strain = np.maximum(strain, 0.0)
-            out[..., k] = self.axial_stiffness * strain * np.sqrt(aa)
-        return out
-
     def node_positions(self) -> np.ndarray:
         return self.start + np.outer(self.stations, self.tangent)
 
