@@ -379,3 +379,51 @@ def test_knuckle_crane_rope_example_and_its_scene(tmp_path):
         hook = h5["static/probes/hook"][()].ravel()
     with h5py.File(r.files[0]) as h5:
         assert np.allclose(hook, h5["static/probes/hook"][()].ravel(), rtol=0, atol=1e-9)
+
+
+def test_rope_damping_decay_and_energy_balance():
+    """Axial Kelvin-Voigt damping of a rope (material damping_time tau = 2 ms, effect
+    'damping'): 100 kg hanging on the nylon rope of the throw above (k = EA / L = 49.1 kN/m),
+    pulled down by 0.5 m g in the static start and released: it stays taut and its
+    oscillation decays with the damping ratio zeta = omega tau / 2 of the stiffness-
+    proportional damping c = tau k (omega = sqrt(k / m)): the ratio of successive swings
+    (peak to trough) exp(-2 pi zeta / sqrt(1 - zeta^2)) = 0.8700 within 2e-3 (measured
+    0.8694: the rope's 0.18 kg, the Green strain's nonlinearity); and thrown (pulled by 3 m g, slack in between) the energy lost equals
+    the damping's work (the balance total - works moves by < 1e-4 of the work; measured
+    2.7e-5 of 17.0 J)."""
+    length, mass, tau, dt = 2.0, 100.0, 2e-3, 1e-3
+
+    def system(pull: float):
+        s = System("damped rope")
+        nylon = s.material("nylon", youngs_modulus=1.25e9, density=1140.0, damping_time=tau)
+        s.cable("rope", material=nylon, start=(0, 0, 0), end=(0, -length, 0), nodes=2,
+                section=Circle(0.01), tension_only=True, bending_stiffness=0.1)
+        s.joint("top", "spherical", "ground", "rope", point=(0, 0, 0))
+        s.load("g", "gravity", vector=(0, -GRAVITY, 0))
+        s.load("payload", "point_mass", body="rope", point=(0, -length, 0), mass=mass)
+        s.probe("hook", "rope", (0, -length, 0))
+        s.drive("release", "table", times=(0.0, dt), values=(1.0, 0.0))
+        s.load("pull", "force", body="rope", point=(0, -length, 0),
+               vector=(0, -pull * mass * GRAVITY, 0), drive="release")
+        return s
+    res = system(0.5).simulate(1.0, dt, from_static=True, tol=1e-12, newton_tol=1e-10,
+                               xdmf=False)
+    assert res.counters["damping"] > 0
+    y = res.probes["hook"][:, 1]
+    peaks = [k for k in range(1, len(y) - 1) if y[k] > y[k - 1] and y[k] >= y[k + 1]]
+    troughs = [k for k in range(1, len(y) - 1) if y[k] < y[k - 1] and y[k] <= y[k + 1]]
+    swings = np.array([y[p] - y[min(q for q in troughs if q > p)] for p in peaks
+                       if any(q > p for q in troughs)])      # peak to the next trough
+    ratios = swings[1:] / swings[:-1]
+    k_rope = 1.25e9 * np.pi * 0.01**2 / 4.0 / length
+    zeta = np.sqrt(k_rope / mass) * tau / 2.0
+    expected = np.exp(-2.0 * np.pi * zeta / np.sqrt(1.0 - zeta**2))
+    assert len(ratios) >= 2
+    assert ratios == pytest.approx(expected, rel=2e-3)
+    thrown = system(3.0).simulate(0.45, 2e-4, from_static=True, tol=1e-12, newton_tol=1e-10,
+                                  xdmf=False)
+    keep = thrown.time > 1.5 * dt      # after the release
+    work = thrown.energy["material_damping_work"][keep]
+    balance = thrown.energy["balance"][keep]
+    assert -work[-1] > 10.0       # J: the rope dissipates while taut
+    assert np.ptp(balance) < 1e-4 * abs(work[-1])
