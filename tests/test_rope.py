@@ -201,7 +201,8 @@ def test_hanging_payload_stretch_and_top_tension():
     EA (lambda^2 - 1) lambda / 2 = m g + rho A g s (the tension at s above the end; Green
     strain, lambda the stretch), within 1e-9 (measured 2e-12); the linear estimate
     (m g + rho A g L / 2) L / (E A) differs from it by 1.9e-4 (the strain's own size) and
-    is not met at that tolerance. The top joint's reaction is the weight m g + rho A g L (equilibrium), 1e-10."""
+    is not met at that tolerance. The top joint's reaction is the weight m g + rho A g L
+    (equilibrium), 1e-10."""
     length, mass, d = 2.0, 100.0, 0.01
     area = np.pi * d**2 / 4.0
     ea, w = STEEL_E * area, STEEL_RHO * area * GRAVITY
@@ -272,7 +273,8 @@ def test_thrown_payload_flies_free_while_the_rope_is_slack():
     its acceleration that of the system without rope forces, M^-1 Q_gravity with the top
     held (1e-7: Newton's tolerance over h^2; measured 5e-13), which is -g to 1.1e-4
     (measured 3.0e-5: the consistent mass couples the end to the held top; rope mass
-    0.18 kg, 1.8e-3 of the payload's). The rope is compressed (strain down to < -1e-2) and still carries
+    0.18 kg, 1.8e-3 of the payload's). The rope is compressed (strain down to < -1e-2)
+    and still carries
     no compression (axial force >= 0 at every Gauss point). (The top joint's reaction is
     not the rope's tension: it also carries the inertia the consistent mass couples to the
     held node, and dips to -38 N when the rope snaps taut, against 220 N of tension.)"""
@@ -388,7 +390,8 @@ def test_rope_damping_decay_and_energy_balance():
     oscillation decays with the damping ratio zeta = omega tau / 2 of the stiffness-
     proportional damping c = tau k (omega = sqrt(k / m)): the ratio of successive swings
     (peak to trough) exp(-2 pi zeta / sqrt(1 - zeta^2)) = 0.8700 within 2e-3 (measured
-    0.8694: the rope's 0.18 kg, the Green strain's nonlinearity); and thrown (pulled by 3 m g, slack in between) the energy lost equals
+    0.8694: the rope's 0.18 kg, the Green strain's nonlinearity); and thrown (pulled by
+    3 m g, slack in between) the energy lost equals
     the damping's work (the balance total - works moves by < 1e-4 of the work; measured
     2.7e-5 of 17.0 J)."""
     length, mass, tau, dt = 2.0, 100.0, 2e-3, 1e-3
