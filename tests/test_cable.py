@@ -190,18 +190,21 @@ def test_cantilever_frequencies():
 
 
 def test_cable_refusals():
-    """Bad input names the item: a section with I_y != I_z, and material damping (not
-    implemented for cables) with the effect 'damping' listed."""
+    """Bad input names the item: a section with I_y != I_z, a negative bending stiffness
+    and a tension_only flag that is not a bool. (Material damping, refused before the rope,
+    is now the axial Kelvin-Voigt damping: tests/test_rope.py.)"""
     from ancfdrv import Rectangle
     s = System("bad")
     steel = s.material("steel", youngs_modulus=E, density=RHO, damping_time=1e-3)
     with pytest.raises(InputError, match="cable 'flat'.*one bending stiffness"):
         s.cable("flat", material=steel, start=(0, 0, 0), end=(1, 0, 0), nodes=3,
                 section=Rectangle(0.02, 0.01))
-    s.cable("c", material=steel, start=(0, 0, 0), end=(1, 0, 0), nodes=3, section=Circle(D))
-    s.joint("root", "weld", "ground", "c", point=(0, 0, 0))
-    with pytest.raises(InputError, match="cable 'c': material damping is not implemented"):
-        s.assemble(effects=("damping",))
+    with pytest.raises(InputError, match="cable 'soft'.*bending_stiffness = -1"):
+        s.cable("soft", material=steel, start=(0, 0, 0), end=(1, 0, 0), nodes=3,
+                section=Circle(D), bending_stiffness=-1.0)
+    with pytest.raises(InputError, match="cable 'r'.*tension_only = 'yes'"):
+        s.cable("r", material=steel, start=(0, 0, 0), end=(1, 0, 0), nodes=3,
+                section=Circle(D), tension_only="yes")
 
 
 SCENE = """&scene  title = 'cable elastica', analysis = 'static', effects = 'tip_force' /

@@ -18,7 +18,8 @@ __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
            "SparsePattern", "DirectSolver", "plate_shape", "plate_element_arrays",
            "plate_reference", "plate_forces", "PlateReference", "CubicBeam", "SectionData",
-           "section_data", "cable_element_arrays", "cable_shape", "cable_forces"]
+           "section_data", "cable_element_arrays", "cable_shape", "cable_forces",
+           "cable_damped_forces"]
 
 
 def _f(a, dtype=np.float64) -> np.ndarray:
@@ -166,15 +167,29 @@ def cable_shape(xi: float, length: float) -> tuple[np.ndarray, np.ndarray, np.nd
 
 
 def cable_forces(dofs, e, lengths, axial_stiffness: float, bending_stiffness: float,
-                 want_tangent: bool):
+                 want_tangent: bool, tension_only: bool = False):
     """Cable elastic force dU/de (global), strain energy and element tangents (12, 12, nel)
-    at e; dofs (12, nel) 0-based."""
+    at e; dofs (12, nel) 0-based; tension_only: a rope's axial law (no compression)."""
     force, energy, tangent, info = _kernel.cable_forces(
         _f(np.asarray(dofs) + 1, np.int32), _f(e), _f(np.atleast_1d(lengths)),
-        float(axial_stiffness), float(bending_stiffness), int(want_tangent))
+        float(axial_stiffness), float(bending_stiffness), int(want_tangent), int(tension_only))
     if info:
         raise SolverError(f"cable element {info}: r' vanished at a Gauss point")
     return force, float(energy), tangent
+
+
+def cable_damped_forces(dofs, e, v, lengths, axial_stiffness: float, bending_stiffness: float,
+                        tension_only: bool, damping_time: float, rate_factor: float):
+    """Cable force with the axial Kelvin-Voigt damping at the rates v: force (global), strain
+    energy, element tangents dQ/de + rate_factor dQ/de' (12, 12, nel) and the dissipated
+    power."""
+    force, energy, tangent, dissipation, info = _kernel.cable_damped_forces(
+        _f(np.asarray(dofs) + 1, np.int32), _f(e), _f(v), _f(np.atleast_1d(lengths)),
+        float(axial_stiffness), float(bending_stiffness), int(tension_only),
+        float(damping_time), float(rate_factor))
+    if info:
+        raise SolverError(f"cable element {info}: r' vanished at a Gauss point")
+    return force, float(energy), tangent, float(dissipation)
 
 
 PLATE_VARIANTS = {"plain": 0, "completed": 1}
@@ -515,10 +530,11 @@ class KernelSystem:
         return int(index)
 
     def add_cable_set(self, dofs, scatter, lengths, axial_stiffness: float,
-                      bending_stiffness: float, damping_time: float = 0.0) -> int:
+                      bending_stiffness: float, damping_time: float = 0.0,
+                      tension_only: bool = False) -> int:
         index, info, message = _kernel.system_add_cable_set(
             self.handle, _i(dofs + 1), _i(scatter), _f(lengths), axial_stiffness,
-            bending_stiffness, damping_time)
+            bending_stiffness, damping_time, int(tension_only))
         self._check(info, "cable set", message)
         return int(index)
 

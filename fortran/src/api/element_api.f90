@@ -594,13 +594,14 @@ subroutine cable_shape_functions(xi, length, shape, slope, second)
 end subroutine cable_shape_functions
 
 !> Cable elastic force (global), strain energy and, when want_tangent /= 0, the element
-!> tangents (12 x 12 x nel) of a cable mesh. info = element number whose r' vanished.
+!> tangents (12 x 12 x nel) of a cable mesh; tension_only /= 0: a rope's axial law. info =
+!> element number whose r' vanished.
 subroutine cable_forces(ndof, nel, dofs, e, lengths, axial_stiffness, bending_stiffness, &
-                        want_tangent, force, energy, tangent, info)
+                        want_tangent, tension_only, force, energy, tangent, info)
   use ancf_kinds, only: dp
   use cable_element, only: cable_element_force
   implicit none
-  integer, intent(in) :: ndof, nel, dofs(12, nel), want_tangent
+  integer, intent(in) :: ndof, nel, dofs(12, nel), want_tangent, tension_only
   real(dp), intent(in) :: e(ndof), lengths(nel), axial_stiffness, bending_stiffness
   real(dp), intent(out) :: force(ndof), energy, tangent(12, 12, nel)
   integer, intent(out) :: info
@@ -613,7 +614,7 @@ subroutine cable_forces(ndof, nel, dofs, e, lengths, axial_stiffness, bending_st
   do el = 1, nel
     call cable_element_force(reshape(e(dofs(:, el)), [3, 4]), lengths(el), axial_stiffness, &
                              bending_stiffness, want_tangent /= 0, element_force, &
-                             element_energy, tangent(:, :, el), code)
+                             element_energy, tangent(:, :, el), code, tension_only /= 0)
     if (code /= 0) then
       info = el
       return
@@ -622,3 +623,40 @@ subroutine cable_forces(ndof, nel, dofs, e, lengths, axial_stiffness, bending_st
     energy = energy + element_energy
   end do
 end subroutine cable_forces
+
+!> cable_forces with the axial Kelvin-Voigt damping (damping_time) at the rates v: the force
+!> includes the damping force, the tangents are dQ/de + rate_factor dQ/de' and dissipation
+!> the damping's power.
+subroutine cable_damped_forces(ndof, nel, dofs, e, v, lengths, axial_stiffness, &
+                               bending_stiffness, tension_only, damping_time, rate_factor, &
+                               force, energy, tangent, dissipation, info)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_damped_element_force
+  implicit none
+  integer, intent(in) :: ndof, nel, dofs(12, nel), tension_only
+  real(dp), intent(in) :: e(ndof), v(ndof), lengths(nel), axial_stiffness, bending_stiffness
+  real(dp), intent(in) :: damping_time, rate_factor
+  real(dp), intent(out) :: force(ndof), energy, tangent(12, 12, nel), dissipation
+  integer, intent(out) :: info
+  real(dp) :: element_force(12), element_energy, element_power
+  integer :: el, code
+  force = 0.0_dp
+  energy = 0.0_dp
+  dissipation = 0.0_dp
+  tangent = 0.0_dp
+  info = 0
+  do el = 1, nel
+    call cable_damped_element_force(reshape(e(dofs(:, el)), [3, 4]), &
+                                    reshape(v(dofs(:, el)), [3, 4]), lengths(el), &
+                                    axial_stiffness, bending_stiffness, tension_only /= 0, &
+                                    damping_time, rate_factor, .true., element_force, &
+                                    element_energy, tangent(:, :, el), element_power, code)
+    if (code /= 0) then
+      info = el
+      return
+    end if
+    force(dofs(:, el)) = force(dofs(:, el)) + element_force
+    energy = energy + element_energy
+    dissipation = dissipation + element_power
+  end do
+end subroutine cable_damped_forces

@@ -280,10 +280,11 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
   call append_set(sys, set, index)
 end subroutine system_add_plate_set
 
-!> ANCF cable elements (cable_element): element lengths and the section's EA and EI.
-!> damping_time must be 0 (the family has no material damping; info = 2 otherwise).
+!> ANCF cable elements (cable_element): element lengths and the section's EA and EI;
+!> tension_only /= 0: a rope (no compression); damping_time: the axial Kelvin-Voigt time.
 subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiffness, &
-                                bending_stiffness, damping_time, index, info, message)
+                                bending_stiffness, damping_time, tension_only, index, info, &
+                                message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
@@ -291,7 +292,7 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
   use system_store, only: store_get
   use kernel_errors, only: handle_text
   implicit none
-  integer, intent(in) :: handle, nel, dofs(12, nel), scatter(12, 12, nel)
+  integer, intent(in) :: handle, nel, dofs(12, nel), scatter(12, 12, nel), tension_only
   real(dp), intent(in) :: lengths(nel), axial_stiffness, bending_stiffness, damping_time
   integer, intent(out) :: index, info
   character(len=200), intent(out) :: message
@@ -305,11 +306,11 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
     message = handle_text(handle)
     return
   end if
-  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. damping_time /= 0.0_dp .or. &
-      any(lengths <= 0.0_dp)) then
+  if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. damping_time < 0.0_dp .or. &
+      any(lengths <= 0.0_dp) .or. bending_stiffness < 0.0_dp) then
     info = 2
     message = 'system_add_cable_set: an element dof outside 1..nfull, a' // &
-              ' non-positive element length or a damping_time (cables have none)'
+              ' non-positive element length, a negative damping_time or bending stiffness'
     return
   end if
   built%nel = nel
@@ -319,6 +320,8 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
   built%lengths = lengths
   built%axial_stiffness = axial_stiffness
   built%bending_stiffness = bending_stiffness
+  built%tension_only = tension_only /= 0
+  built%damping_time = damping_time
   built%force_cost = 0.5d0
   built%tangent_cost = 2.0d0
   allocate (set, source=built)

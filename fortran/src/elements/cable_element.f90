@@ -21,7 +21,26 @@
 !> from the gradient and Hessian of the point energy w(a, b) in a = r', b = r'':
 !>   dw/da = EA eps a + EI/2 df/da,  dw/db = EI/2 df/db,  f = g / h,
 !>   g = (a.a)(b.b) - (a.b)^2,  h = (a.a)^3  (the quotient rule twice, below).
-!> Material damping is not implemented for this family (the Python side refuses it).
+!>
+!> Rope (tension_only): the axial law carries no compression, point by point,
+!>   w_axial = EA/2 max(eps, 0)^2,   N = EA max(eps, 0)   (the force dw/da = N a),
+!> exact and piecewise: the energy is C1 (the force is continuous, zero at eps = 0) and the
+!> tangent jumps there, from EA (a a^T + eps I) on the taut side to 0 on the slack side.
+!> The tangent is the exact one of each side; only in the band -slack_band < eps <= 0 (a
+!> state unstrained to rounding, e.g. the straight reference) it keeps the taut side's
+!> EA a a^T, the one-sided derivative at eps = 0+, so that a rope at rest in its reference
+!> still has its axial stiffness in a static Newton step. A rope's bending energy is
+!> EI/2 |r' x r''|^2 = EI/2 kappa^2 |r'|^6 (kappa^2 to within the strain's size; EI a small
+!> model parameter): the exact curvature above is singular where r' vanishes, and a slack
+!> rope folding onto itself passes r' = 0; |r' x r''|^2 is a polynomial, zero for any
+!> straight state (stretched unevenly or not) and unchanged by rigid motions.
+!>
+!> Kelvin-Voigt damping (damping_time tau > 0, the nodal rates given): the axial force
+!> adds N_d = EA tau eps', eps' = a . a' (the bending is not damped). For a rope only in
+!> tension (eps > 0) and clipped so that the total EA eps + N_d never goes below zero (a
+!> rope that unloads faster than its damping allows goes slack, it never pushes). The
+!> dissipation is sum w N_d eps' >= 0; the tangent dQ/dq + rate_factor dQ/dq' of the
+!> damping force, EA tau (a a'^T + eps' I + rate_factor a a^T), is not symmetric.
 module cable_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
@@ -29,17 +48,22 @@ module cable_element
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
+  public :: cable_damped_element_force
 
   !> Gauss points per element.
   integer, parameter, public :: cable_points = 5
   !> Coordinates per node and per element.
   integer, parameter, public :: cable_node_dofs = 6, cable_dofs = 12
+  !> A rope's Green strain above -slack_band counts as taut for the tangent (not for the
+  !> force): the reference, unstrained to rounding, keeps its axial stiffness.
+  real(dp), parameter, public :: slack_band = 1.0e-12_dp
 
   !> The family's element set (element_sets): element lengths and the section's axial and
-  !> bending stiffnesses EA, EI (one material and section per set).
+  !> bending stiffnesses EA, EI (one material and section per set); tension_only: a rope.
   type, extends(local_element_set) :: cable_set
     real(dp), allocatable :: lengths(:)
     real(dp) :: axial_stiffness = 0.0_dp, bending_stiffness = 0.0_dp
+    logical :: tension_only = .false.
   contains
     procedure :: element_forces => cable_element_forces
   end type cable_set
@@ -85,18 +109,22 @@ contains
   end subroutine cable_gravity
 
   !> Elastic force dU/dq (12), strain energy and, when want_tangent, the tangent d^2U/dq^2
-  !> (12 x 12) of one element of length L at its nodal vectors q(3, 4). info = 2: r'
-  !> vanished at a Gauss point (the curvature is undefined).
+  !> (12 x 12) of one element of length L at its nodal vectors q(3, 4); tension_only
+  !> (default .false.): the rope's axial law. info = 2: r' vanished at a Gauss point (the
+  !> curvature is undefined).
   pure subroutine cable_element_force(q, length, axial_stiffness, bending_stiffness, &
-                                      want_tangent, force, energy, tangent, info)
+                                      want_tangent, force, energy, tangent, info, tension_only)
     real(dp), intent(in) :: q(3, 4), length, axial_stiffness, bending_stiffness
     logical, intent(in) :: want_tangent
+    logical, intent(in), optional :: tension_only
     real(dp), intent(out) :: force(cable_dofs), energy, tangent(cable_dofs, cable_dofs)
     integer, intent(out) :: info
     real(dp) :: xg(cable_points), wg(cable_points), shape(4), slope(4), second(4)
     real(dp) :: a(3), b(3), grad_a(3), grad_b(3), hessian(6, 6), weight, point_energy
-    real(dp) :: rows(2, 4), block(3, 3)
-    integer :: p, i, j, m, n
+    integer :: p
+    logical :: rope
+    rope = .false.
+    if (present(tension_only)) rope = tension_only
     call gauss_legendre(cable_points, xg, wg, info)
     if (info /= 0) return
     force = 0.0_dp
@@ -108,44 +136,123 @@ contains
       a = matmul(q, slope)
       b = matmul(q, second)
       call point_derivatives(a, b, axial_stiffness, bending_stiffness, want_tangent, &
-                             point_energy, grad_a, grad_b, hessian, info)
+                             point_energy, grad_a, grad_b, hessian, info, rope)
       if (info /= 0) return
       energy = energy + weight * point_energy
-      do i = 1, 4
-        force(3 * i - 2:3 * i) = force(3 * i - 2:3 * i) &
-                                 + weight * (slope(i) * grad_a + second(i) * grad_b)
-      end do
-      if (.not. want_tangent) cycle
-      rows(1, :) = slope
-      rows(2, :) = second
-      do j = 1, 4
-        do i = 1, 4
-          block = 0.0_dp
-          do n = 1, 2
-            do m = 1, 2
-              block = block + rows(m, i) * rows(n, j) &
-                      * hessian(3 * m - 2:3 * m, 3 * n - 2:3 * n)
-            end do
-          end do
-          tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) = tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) &
-                                                      + weight * block
-        end do
-      end do
+      call add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, force, &
+                     tangent)
     end do
   end subroutine cable_element_force
 
+  !> Adds one Gauss point's force (the gradients in a = r', b = r'') and, when want_tangent,
+  !> its tangent (the 6 x 6 matrix in (a, b)) to the element's.
+  pure subroutine add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, &
+                            force, tangent)
+    real(dp), intent(in) :: slope(4), second(4), weight, grad_a(3), grad_b(3), hessian(6, 6)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(inout) :: force(cable_dofs), tangent(cable_dofs, cable_dofs)
+    real(dp) :: rows(2, 4), block(3, 3)
+    integer :: i, j, m, n
+    do i = 1, 4
+      force(3 * i - 2:3 * i) = force(3 * i - 2:3 * i) &
+                               + weight * (slope(i) * grad_a + second(i) * grad_b)
+    end do
+    if (.not. want_tangent) return
+    rows(1, :) = slope
+    rows(2, :) = second
+    do j = 1, 4
+      do i = 1, 4
+        block = 0.0_dp
+        do n = 1, 2
+          do m = 1, 2
+            block = block + rows(m, i) * rows(n, j) &
+                    * hessian(3 * m - 2:3 * m, 3 * n - 2:3 * n)
+          end do
+        end do
+        tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) = tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) &
+                                                    + weight * block
+      end do
+    end do
+  end subroutine add_point
+
+  !> cable_element_force with Kelvin-Voigt damping of the axial strain (damping_time tau > 0)
+  !> at the nodal rates q'(3, 4): the force includes the damping force, dissipation is its
+  !> power and the tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (module header).
+  pure subroutine cable_damped_element_force(q, rates, length, axial_stiffness, &
+                                             bending_stiffness, tension_only, damping_time, &
+                                             rate_factor, want_tangent, force, energy, &
+                                             tangent, dissipation, info)
+    real(dp), intent(in) :: q(3, 4), rates(3, 4), length, axial_stiffness, bending_stiffness
+    logical, intent(in) :: tension_only, want_tangent
+    real(dp), intent(in) :: damping_time, rate_factor
+    real(dp), intent(out) :: force(cable_dofs), energy, tangent(cable_dofs, cable_dofs)
+    real(dp), intent(out) :: dissipation
+    integer, intent(out) :: info
+    real(dp) :: xg(cable_points), wg(cable_points), shape(4), slope(4), second(4)
+    real(dp) :: a(3), b(3), a_rate(3), grad_a(3), grad_b(3), hessian(6, 6), weight
+    real(dp) :: point_energy, strain, strain_rate, damping_force, viscous
+    real(dp) :: identity(3, 3)
+    integer :: p, i
+    identity = 0.0_dp
+    do i = 1, 3
+      identity(i, i) = 1.0_dp
+    end do
+    call gauss_legendre(cable_points, xg, wg, info)
+    if (info /= 0) return
+    force = 0.0_dp
+    energy = 0.0_dp
+    dissipation = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
+    viscous = axial_stiffness * damping_time
+    do p = 1, cable_points
+      call cable_shape(0.5_dp * (xg(p) + 1.0_dp), length, shape, slope, second)
+      weight = 0.5_dp * wg(p) * length
+      a = matmul(q, slope)
+      b = matmul(q, second)
+      a_rate = matmul(rates, slope)
+      call point_derivatives(a, b, axial_stiffness, bending_stiffness, want_tangent, &
+                             point_energy, grad_a, grad_b, hessian, info, tension_only)
+      if (info /= 0) return
+      energy = energy + weight * point_energy
+      strain = 0.5_dp * (dot_product(a, a) - 1.0_dp)
+      strain_rate = dot_product(a, a_rate)
+      if (tension_only .and. strain <= 0.0_dp) then
+        damping_force = 0.0_dp                              ! slack: no damping either
+      else if (tension_only .and. axial_stiffness * strain + viscous * strain_rate < 0.0_dp) then
+        damping_force = -axial_stiffness * strain           ! clipped: the total is zero
+        grad_a = grad_a + damping_force * a
+        if (want_tangent) hessian(1:3, 1:3) = hessian(1:3, 1:3) &
+          - axial_stiffness * (outer(a, a) + strain * identity)
+      else
+        damping_force = viscous * strain_rate
+        grad_a = grad_a + damping_force * a
+        if (want_tangent) hessian(1:3, 1:3) = hessian(1:3, 1:3) &
+          + viscous * (outer(a, a_rate) + strain_rate * identity + rate_factor * outer(a, a))
+      end if
+      dissipation = dissipation + weight * damping_force * strain_rate
+      call add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, force, &
+                     tangent)
+    end do
+  end subroutine cable_damped_element_force
+
   !> The point energy w = EA/2 eps^2 + EI/2 kappa^2 at a = r', b = r'', its gradient
-  !> (dw/da, dw/db) and, when want_hessian, its Hessian (6 x 6, in (a, b)).
+  !> (dw/da, dw/db) and, when want_hessian, its Hessian (6 x 6, in (a, b)); tension_only:
+  !> the rope's axial law EA/2 max(eps, 0)^2 (module header).
   pure subroutine point_derivatives(a, b, axial_stiffness, bending_stiffness, want_hessian, &
-                                    energy, grad_a, grad_b, hessian, info)
+                                    energy, grad_a, grad_b, hessian, info, tension_only)
     real(dp), intent(in) :: a(3), b(3), axial_stiffness, bending_stiffness
-    logical, intent(in) :: want_hessian
+    logical, intent(in) :: want_hessian, tension_only
     real(dp), intent(out) :: energy, grad_a(3), grad_b(3), hessian(6, 6)
     integer, intent(out) :: info
     real(dp) :: aa, bb, ab, strain, g, h, f, dg(6), dh(6), df(6), hg(6, 6), hh(6, 6)
     real(dp) :: identity(3, 3)
     integer :: i
     info = 0
+    if (tension_only) then
+      call rope_point_derivatives(a, b, axial_stiffness, bending_stiffness, want_hessian, &
+                                  energy, grad_a, grad_b, hessian)
+      return
+    end if
     aa = dot_product(a, a)
     bb = dot_product(b, b)
     ab = dot_product(a, b)
@@ -181,6 +288,40 @@ contains
     hessian(1:3, 1:3) = hessian(1:3, 1:3) + axial_stiffness * (outer(a, a) + strain * identity)
   end subroutine point_derivatives
 
+  !> The rope's point energy w = EA/2 max(eps, 0)^2 + EI/2 |r' x r''|^2 at a = r', b = r'',
+  !> its gradient and, when want_hessian, its Hessian (module header): a polynomial in the
+  !> bending part, defined for every a, including a = 0 (a slack rope folding onto itself).
+  pure subroutine rope_point_derivatives(a, b, axial_stiffness, bending_stiffness, &
+                                         want_hessian, energy, grad_a, grad_b, hessian)
+    real(dp), intent(in) :: a(3), b(3), axial_stiffness, bending_stiffness
+    logical, intent(in) :: want_hessian
+    real(dp), intent(out) :: energy, grad_a(3), grad_b(3), hessian(6, 6)
+    real(dp) :: aa, bb, ab, strain, identity(3, 3)
+    logical :: taut_tangent
+    integer :: i
+    aa = dot_product(a, a)
+    bb = dot_product(b, b)
+    ab = dot_product(a, b)
+    strain = 0.5_dp * (aa - 1.0_dp)
+    taut_tangent = strain > -slack_band
+    strain = max(strain, 0.0_dp)                         ! slack: no axial force, no energy
+    ! bending: EI/2 g with g = |a x b|^2 = (a.a)(b.b) - (a.b)^2
+    energy = 0.5_dp * axial_stiffness * strain**2 + 0.5_dp * bending_stiffness * (aa * bb - ab**2)
+    grad_a = axial_stiffness * strain * a + bending_stiffness * (bb * a - ab * b)
+    grad_b = bending_stiffness * (aa * b - ab * a)
+    if (.not. want_hessian) return
+    identity = 0.0_dp
+    do i = 1, 3
+      identity(i, i) = 1.0_dp
+    end do
+    hessian(1:3, 1:3) = bending_stiffness * (bb * identity - outer(b, b))
+    hessian(4:6, 4:6) = bending_stiffness * (aa * identity - outer(a, a))
+    hessian(1:3, 4:6) = bending_stiffness * (2.0_dp * outer(a, b) - outer(b, a) - ab * identity)
+    hessian(4:6, 1:3) = transpose(hessian(1:3, 4:6))
+    if (.not. taut_tangent) return                       ! slack: bending alone
+    hessian(1:3, 1:3) = hessian(1:3, 1:3) + axial_stiffness * (outer(a, a) + strain * identity)
+  end subroutine rope_point_derivatives
+
   pure function outer(x, y) result(m)
     real(dp), intent(in) :: x(3), y(3)
     real(dp) :: m(3, 3)
@@ -199,8 +340,8 @@ contains
     end do
   end function outer6
 
-  !> The element_set element_forces of a cable set (no damping: a damped call gets
-  !> dissipation 0 and the elastic force alone; the Python side refuses cable damping).
+  !> The element_set element_forces of a cable set: with rates (a damped set) the axial
+  !> Kelvin-Voigt damping, else the elastic force alone.
   pure subroutine cable_element_forces(set, el, coords, want_tangent, force, energy, tangent, &
                                        info, rates, rate_factor, dissipation)
     class(cable_set), intent(in) :: set
@@ -211,9 +352,21 @@ contains
     integer, intent(out) :: info
     real(dp), intent(in), optional :: rates(:, :), rate_factor
     real(dp), intent(out), optional :: dissipation
+    real(dp) :: factor, power
+    if (present(rates)) then
+      factor = 0.0_dp
+      if (present(rate_factor)) factor = rate_factor
+      call cable_damped_element_force(coords, rates, set%lengths(el), set%axial_stiffness, &
+                                      set%bending_stiffness, set%tension_only, &
+                                      set%damping_time, factor, want_tangent, force, energy, &
+                                      tangent, power, info)
+      if (present(dissipation)) dissipation = power
+      return
+    end if
     if (present(dissipation)) dissipation = 0.0_dp
     call cable_element_force(coords, set%lengths(el), set%axial_stiffness, &
-                             set%bending_stiffness, want_tangent, force, energy, tangent, info)
+                             set%bending_stiffness, want_tangent, force, energy, tangent, info, &
+                             set%tension_only)
   end subroutine cable_element_forces
 
 end module cable_element

@@ -450,6 +450,12 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "height": Key("float", None, positive, "section height (m)"),
         "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
         "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+        "tension_only": Key("bool", False, doc="a rope: the axial force is never "
+                            "compressive (the cable goes slack); with the effect 'damping' "
+                            "its axial damping acts in tension only"),
+        "bending_stiffness": Key("float", None, non_negative, "EI (N m^2) in place of E "
+                                 "times the section's I (a rope's effective bending "
+                                 "stiffness; 0 only in dynamics)"),
     },
     "plate": {
         "name": _name(),

@@ -52,6 +52,7 @@ import scipy.sparse.linalg as spla
 
 from ..codes import CONSTRAINT_COORDINATE
 from .bodies import Beam, Plate, RigidBody
+from .cable import Cable
 from .constraint_set import ConstraintSet
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation
@@ -275,6 +276,8 @@ def _vector_blocks(body) -> tuple[int, int]:
         return 12, body.nodes
     if isinstance(body, Plate):
         return 9, body.mesh.nnodes
+    if isinstance(body, Cable):  # r and r_x per node
+        return 6, body.nodes
     return 0, 0
 
 

@@ -8,7 +8,15 @@ Python side: the body, its set builder and kernel adder (registered in
 
 Joints act on nodes: a 'weld' holds r and r_x (a clamp), 'spherical' the position, 'fix'
 one nodal vector ('r' or 'r_x'). Loads and probes act at any point of the axis. Material
-damping is not implemented for cables (refused when the effect 'damping' is listed).
+damping (the material's damping_time with the effect 'damping') is Kelvin-Voigt damping of
+the axial strain only.
+
+A rope is a cable with ``tension_only=True``: its axial law carries no compression (EA
+max(eps, 0) at every Gauss point, exact and piecewise; the kernel module's header says how
+the kink is treated), its axial damping acts only in tension and never makes the force
+compressive, and its bending stiffness is usually given apart (``bending_stiffness``, N m^2:
+a wire rope bends far more easily than a solid bar of its diameter; it keeps a slack rope's
+Newton matrix regular and may be 0 in dynamics, where the mass does that).
 """
 from __future__ import annotations
 
@@ -30,12 +38,17 @@ CABLE_OFFSETS = {"r": 0, "r_x": 3}
 class Cable(Body):
     """A straight ANCF cable from ``start`` to ``end`` with ``nodes`` equally spaced nodes
     and the cross-section ``section`` (its area and bending inertia: a cable bends alike
-    about every axis, so the section must have I_y = I_z: circle, tube, square)."""
+    about every axis, so the section must have I_y = I_z: circle, tube, square).
+
+    ``tension_only``: a rope (the axial force is never compressive: it goes slack).
+    ``bending_stiffness`` (N m^2, >= 0): EI given directly instead of E times the section's
+    I (a rope's effective bending stiffness)."""
 
     flexible = True
 
     def __init__(self, name: str, material: Material, start, end, nodes: int,
-                 section: Section | None = None) -> None:
+                 section: Section | None = None, *, tension_only: bool = False,
+                 bending_stiffness: float | None = None) -> None:
         self.name = name
         where = f"cable {name!r}"
         self.material = material
@@ -53,6 +66,15 @@ class Cable(Body):
             raise InputError(f"{where}: a cable has one bending stiffness; its section has "
                              f"I_y = {data.inertia_y:g} and I_z = {data.inertia_z:g} m^4 (use "
                              "a circle, a tube or a square)")
+        if not isinstance(tension_only, (bool, np.bool_)):
+            raise InputError(f"{where}: tension_only = {tension_only!r} must be True or False")
+        self.tension_only = bool(tension_only)
+        if bending_stiffness is not None and not (
+                isinstance(bending_stiffness, (int, float, np.floating))
+                and np.isfinite(bending_stiffness) and bending_stiffness >= 0.0):
+            raise InputError(f"{where}: bending_stiffness = {bending_stiffness!r} must be a "
+                             "finite number >= 0 (N m^2)")
+        self._bending_stiffness = None if bending_stiffness is None else float(bending_stiffness)
         self.tangent = axis / self.length
         self.stations = np.linspace(0.0, self.length, self.nodes)
         self.lengths = np.diff(self.stations)
@@ -72,7 +94,33 @@ class Cable(Body):
 
     @property
     def bending_stiffness(self) -> float:
+        """EI (N m^2): the given ``bending_stiffness``, else E times the section's I."""
+        if self._bending_stiffness is not None:
+            return self._bending_stiffness
         return self.material.youngs_modulus * self.section.data.inertia_y
+
+    def strains(self, e) -> np.ndarray:
+        """The axial Green strain eps = (r'.r' - 1)/2 at every element's 5 Gauss points
+        (nel, 5), from the full coordinates e (one state (ndof,) or a history (nt, ndof):
+        then (nt, nel, 5)); signed (negative: compressed, for a rope: slack)."""
+        e = np.asarray(e, dtype=float)
+        q = e[..., self.element_dofs()]                            # (..., 12, nel)
+        q = np.moveaxis(q.reshape(*q.shape[:-2], 4, 3, self.nel), -1, -3)  # (..., nel, 4, 3)
+        xg, _ = np.polynomial.legendre.leggauss(5)
+        out = np.empty((*q.shape[:-2], 5))
+        for k, x in enumerate(0.5 * (xg + 1.0)):
+            slopes = np.array([kernel.cable_shape(x, length)[1] for length in self.lengths])
+            a = np.einsum("ij,...ijk->...ik", slopes, q)               # r' (..., nel, 3)
+            out[..., k] = 0.5 * (np.einsum("...k,...k->...", a, a) - 1.0)
+        return out
+
+    def axial_forces(self, e) -> np.ndarray:
+        """The axial force (N, tension positive) at the Gauss points of :meth:`strains`:
+        T = EA eps |r'| (the force dw/dr' of the element's law, its magnitude along r'); a
+        rope's is EA max(eps, 0) |r'| (never compressive)."""
+        strain = self.strains(e)
+        force = strain if not self.tension_only else np.maximum(strain, 0.0)
+        return self.axial_stiffness * force * np.sqrt(1.0 + 2.0 * strain)
 
     def node_positions(self) -> np.ndarray:
         return self.start + np.outer(self.stations, self.tangent)
@@ -155,11 +203,7 @@ class Cable(Body):
 
 def cable_set(cable: Cable, context: SetContext) -> SetInfo:
     """The cable's element set: dofs, the scalar element masses (closed form) and the
-    kernel data (lengths, EA, EI)."""
-    if cable.material.damping_time > 0 and "damping" in context.active:
-        raise InputError(f"cable {cable.name!r}: material damping is not implemented for "
-                         f"cables (material {cable.material.name!r} has damping_time = "
-                         f"{cable.material.damping_time:g} s): drop the effect 'damping'")
+    kernel data (lengths, EA, EI, the rope's tension-only law)."""
     mass, _ = kernel.cable_element_arrays(cable.lengths, cable.mass_per_length, np.zeros(3))
     return SetInfo(body=cable, kind="cable", dofs=cable.element_dofs(), nel=cable.nel, frame=0,
                    mass_compact=mass)
@@ -167,7 +211,7 @@ def cable_set(cable: Cable, context: SetContext) -> SetInfo:
 
 def _add_cable(ks: kernel.KernelSystem, s: SetInfo) -> int:
     return ks.add_cable_set(s.dofs, s.scatter, s.body.lengths, s.body.axial_stiffness,
-                            s.body.bending_stiffness, s.damping_time)
+                            s.body.bending_stiffness, s.damping_time, s.body.tension_only)
 
 
 register_body(Cable, cable_set)

@@ -194,11 +194,15 @@ class System:
 
     @_api
     def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
-              section: Section | None = None) -> Cable:
-        """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli)."""
+              section: Section | None = None, tension_only: bool = False,
+              bending_stiffness: float | None = None) -> Cable:
+        """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli).
+        ``tension_only=True`` makes it a rope that goes slack instead of carrying
+        compression; ``bending_stiffness`` (N m^2) replaces E times the section's I."""
         name = self._body_name(name)
         return self._add_body(Cable(name, self._material(material, f"cable {name!r}"), start,
-                                    end, nodes, section))
+                                    end, nodes, section, tension_only=tension_only,
+                                    bending_stiffness=bending_stiffness))
 
     @_api
     def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,
