@@ -489,6 +489,14 @@ class KernelSystem:
         self._check(info, "FFR beam set", message)
         return int(index)
 
+    def ffr_second_order(self, index: int, axial_rigidity, axis, length, slope_gram) -> None:
+        """Turn on the geometric stiffness (P-delta) of FFR set ``index`` (1-based):
+        per element EA, the unit axis in the frame (3, nel), the length and the centre-line
+        slope Gram matrix (8, 8, nel) (ffr_elastic module doc)."""
+        info, message = _kernel.system_ffr_second_order(self.handle, index, _f(axial_rigidity),
+                                                        _f(axis), _f(length), _f(slope_gram))
+        self._check(info, "FFR geometric stiffness", message)
+
     def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
                           poisson: float, frame: int, damping_time: float = 0.0,
                           shear_scales=(1.0, 0.0, 0.0)) -> int:

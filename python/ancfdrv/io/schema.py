@@ -112,6 +112,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "'continuum': the paper's element (curvature constant per element); "
                        "'cubic': curvature from the cubic centre line r_xx, higher accuracy "
                        "(docs/theory.md section 12)"),
+        "geometric_stiffness": Key("bool", False, doc="'ffr' beams: add the geometric stiffness of the current axial force (P-delta: the mean Green strain of each element's centre line, docs/theory.md section 24); off: the paper's linear model; ignored by 'nonlinear' beams, which have it"),
     },
     "material": {
         "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
@@ -431,6 +432,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "formulation": Key("str", None, one_of("ffr", "nonlinear"),
                            "'ffr' or 'nonlinear' (default: the scene's)"),
         "bending": Key("str", "continuum", one_of("continuum", "cubic"), "bending option"),
+        "geometric_stiffness": Key("bool", False, doc="'ffr' beams: add the geometric stiffness of the current axial force (P-delta: the mean Green strain of each element's centre line, docs/theory.md section 24); off: the paper's linear model; ignored by 'nonlinear' beams, which have it"),
         "frame_drive": Key("str", None, doc="drive turning the beam's frame (FFR: the "
                            "floating frame; both: the frame of the probe deflections)"),
         "frame_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the frame's turn"),
