@@ -1,5 +1,5 @@
 """The FFR geometric stiffness (P-delta), `beam.geometric_stiffness` (issue 23, item 2;
-docs/theory.md section 24).
+docs/theory.md, 'FFR geometric stiffness').
 
 References: the Euler-Bernoulli beam-column in closed form (a cantilever under an axial end
 force P and a transverse end force Q: tip deflection Q (tan u - u) / (P k) in compression,

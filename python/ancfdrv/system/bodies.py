@@ -171,7 +171,7 @@ class Beam(Body):
     t = 0, turned by ``frame_drive`` about ``frame_axis`` through ``frame_pivot`` (default:
     the start) when given: for 'ffr' the elastic model lives in it, for either formulation
     probe deflections are resolved in it. ``geometric_stiffness`` (for 'ffr'): the
-    geometric stiffness of the current axial force (P-delta, docs/theory.md section 24)."""
+    geometric stiffness of the current axial force (P-delta, docs/theory.md, 'FFR geometric stiffness')."""
 
     flexible = True
 
