@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as la
 
+from .. import kernel
 from ..errors import SolverError
 from ..system.drives import Drive
 from ..system.model import Model
@@ -223,10 +224,12 @@ def _pdelta_terms(model: Model, reduced: ReducedFFR, x_star: np.ndarray) -> None
 
 
 def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25,
-             gamma: float = 0.5, tol: float = 1e-12, max_newton: int = 10
-             ) -> dict[str, np.ndarray]:
+             gamma: float = 0.5, tol: float = 1e-12, max_newton: int = 10,
+             engine: str = "kernel") -> dict[str, np.ndarray]:
     """Newmark (beta, gamma) from the static state at rest; returns 'time', 'eta' and each
-    probe's deflection in the frame (name -> (steps + 1, 3))."""
+    probe's deflection in the frame (name -> (steps + 1, 3)). engine 'kernel': the Fortran
+    loop (kernel.reduced_ffr_newmark); 'python': the same steps in numpy (the reference of
+    the test)."""
     t0 = time.perf_counter()
     steps = int(round(t_end / dt))
     times = np.arange(steps + 1) * dt
@@ -239,6 +242,12 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
              - np.sin(psi)[:, None] * reduced.gravity_sin
              + (1.0 - np.cos(psi))[:, None] * reduced.gravity_cos)
     pd_lin, pd_quad = reduced.pdelta_linear, reduced.pdelta_quadratic
+    if engine == "kernel":
+        eta = kernel.reduced_ffr_newmark(dt, beta, gamma, reduced.omega_squared, gam, c2,
+                                         pd_lin, pd_quad, force, rate, accel, tol, max_newton)
+        return _finish(reduced, times, eta, t0)
+    if engine != "python":
+        raise SolverError(f"simulate: engine {engine!r} must be 'kernel' or 'python'")
     eta, vel, acc = np.zeros((steps + 1, r)), np.zeros(r), np.zeros(r)
     a_fac, v_fac = 1.0 / (beta * dt * dt), gamma / (beta * dt)
     eye = np.eye(r)
@@ -267,6 +276,11 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
         acc = (x - base) * a_fac
         vel = vbase + dt * gamma * acc
         eta[n + 1] = x
+    return _finish(reduced, times, eta, t0)
+
+
+def _finish(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, t0: float
+            ) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {"time": times, "eta": eta}
     for name, value in reduced.probe_static.items():
         out[name] = value + eta @ reduced.probe_basis[name].T
