@@ -79,6 +79,6 @@ def test_kernel_stepper_matches_the_python_steps(extra):
     # 8e-14 m (P-delta, converged to 1e-12)
     model, static = model_and_static(*extra)
     reduced = reduce_ffr(model, static, 3)
-    fast = simulate(reduced, 3.0, 1e-3)
-    slow = simulate(reduced, 3.0, 1e-3, engine="python")
+    fast = simulate(reduced, 3.0, 1e-3, tol=1e-12)
+    slow = simulate(reduced, 3.0, 1e-3, tol=1e-12, engine="python")
     assert np.max(np.abs(fast["tip"] - slow["tip"])) < 1e-11
