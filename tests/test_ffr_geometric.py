@@ -116,13 +116,16 @@ def test_spinup_above_the_first_frequency_stays_bounded(tmp_path):
     # (max |tip deflection| 0.5747 m against the nonlinear model's 0.5701 m; the largest
     # difference of the histories 9.1e-3 m, 1.6% of the range; measured)
     spin = INPUTS / "hard" / "spinup.nml"
-    histories = {}
+    histories, warnings = {}, {}
     for name, extra in (("ffr", ["scene.formulation=ffr", "beam.geometric_stiffness=true"]),
                         ("nonlinear", [])):
         out = tmp_path / f"{name}.h5"
         run_scene(spin, ["spinup.omega=6", "output.xdmf=false", *extra], out, progress=False)
         with h5py.File(out) as h5:
             histories[name] = h5["dynamic/deflection/tip"][()][:, 1]
+            warnings[name] = str(h5.attrs.get("warnings", ""))
+    assert "from the P-delta option" in warnings["ffr"]
+    assert "no geometric (centrifugal) stiffening" not in warnings["ffr"]
     ffr, reference = histories["ffr"], histories["nonlinear"]
     assert len(ffr) == len(reference)
     assert np.abs(ffr).max() == pytest.approx(np.abs(reference).max(), rel=0.02)
