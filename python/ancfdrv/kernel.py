@@ -274,6 +274,25 @@ def moment_force(director, axis, magnitude):
     return force, jacobian, hessian
 
 
+def reduced_ffr_newmark(dt: float, beta: float, gamma: float, omega2, gyroscopic,
+                        centrifugal, pdelta_linear, pdelta_quadratic, load, rate, accel,
+                        tol: float, max_newton: int) -> np.ndarray:
+    """Newmark stepping of a modally reduced FFR model (fortran reduced_ffr_stepper;
+    ancfdrv.solvers.ffr_reduced): eta (steps + 1, r) from rest; load (steps + 1, r), rate
+    and accel (steps + 1,); pdelta_linear None: no P-delta remainder."""
+    r = len(omega2)
+    pdelta = pdelta_linear is not None
+    lin = _f(pdelta_linear) if pdelta else np.zeros((r, r), order="F")
+    quad = _f(pdelta_quadratic) if pdelta else np.zeros((r, r, r), order="F")
+    eta, info, step = _kernel.reduced_ffr_newmark(
+        dt, beta, gamma, _f(omega2), _f(gyroscopic), _f(centrifugal), int(pdelta), lin, quad,
+        _f(np.asarray(load).T), _f(rate), _f(accel), tol, max_newton)
+    if info:
+        what = "Newton did not converge" if info == 1 else "singular iteration matrix"
+        raise SolverError(f"reduced FFR stepper: {what} at step {step}")
+    return eta.T
+
+
 def drive_values(kind: int, params, t):
     """phi, phi', phi'' of a drive at the times t (params: its parameters, any length)."""
     p = np.asarray(params, dtype=float).ravel()
@@ -503,6 +522,14 @@ class KernelSystem:
                                                  damping_time)
         self._check(info, "FFR beam set", message)
         return int(index)
+
+    def ffr_second_order(self, index: int, axial_rigidity, axis, length, slope_gram) -> None:
+        """Turn on the geometric stiffness (P-delta) of FFR set ``index`` (1-based):
+        per element EA, the unit axis in the frame (3, nel), the length and the centre-line
+        slope Gram matrix (8, 8, nel) (ffr_elastic module doc)."""
+        info, message = _kernel.system_ffr_second_order(self.handle, index, _f(axial_rigidity),
+                                                        _f(axis), _f(length), _f(slope_gram))
+        self._check(info, "FFR geometric stiffness", message)
 
     def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
                           poisson: float, frame: int, damping_time: float = 0.0,

@@ -660,3 +660,24 @@ subroutine cable_damped_forces(ndof, nel, dofs, e, v, lengths, axial_stiffness, 
     dissipation = dissipation + element_power
   end do
 end subroutine cable_damped_forces
+
+!> Newmark stepping of a modally reduced FFR model (reduced_ffr_stepper; python
+!> ancfdrv.solvers.ffr_reduced): eta(r, steps + 1) from rest at 0. pdelta = 0: no P-delta
+!> remainder (pdelta_linear, pdelta_quadratic unused). info = 1: Newton failed at
+!> failed_step; 2: singular iteration matrix.
+subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
+                               pdelta, pdelta_linear, pdelta_quadratic, load, rate, accel, &
+                               tol, max_newton, eta, info, failed_step)
+  use ancf_kinds, only: dp
+  use reduced_ffr_stepper, only: reduced_newmark
+  implicit none
+  integer, intent(in) :: r, steps, pdelta, max_newton
+  real(dp), intent(in) :: dt, beta, gamma, omega2(r), gyroscopic(r, r), centrifugal(r, r)
+  real(dp), intent(in) :: pdelta_linear(r, r), pdelta_quadratic(r, r, r)
+  real(dp), intent(in) :: load(r, steps + 1), rate(steps + 1), accel(steps + 1), tol
+  real(dp), intent(out) :: eta(r, steps + 1)
+  integer, intent(out) :: info, failed_step
+  call reduced_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
+                       pdelta /= 0, pdelta_linear, pdelta_quadratic, load, rate, accel, tol, &
+                       max_newton, eta, info, failed_step)
+end subroutine reduced_ffr_newmark

@@ -130,6 +130,39 @@ subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference,
   call append_set(sys, set, index)
 end subroutine system_add_ffr_set
 
+!> Turns on the geometric stiffness (P-delta) of the FFR set `index` (ffr_elastic's
+!> second_order): per element the axial rigidity EA, the unit axis in the frame, the length
+!> and the centre-line slope Gram matrix G_ab = int S_a' S_b' dx (8, 8). info = 2: the
+!> index is not an FFR set of this system or a length is not positive.
+subroutine system_ffr_second_order(handle, index, nel, axial_rigidity, axis, length, &
+                                   slope_gram, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use ffr_elastic, only: ffr_enable_second_order
+  use system_store, only: store_get
+  use kernel_errors, only: handle_text
+  implicit none
+  integer, intent(in) :: handle, index, nel
+  real(dp), intent(in) :: axial_rigidity(nel), axis(3, nel), length(nel), slope_gram(8, 8, nel)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  message = ' '
+  call store_get(handle, sys, info)
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
+  info = 2
+  message = 'system_ffr_second_order: set index is not an FFR set of this size, or a' // &
+            ' length is not positive'
+  if (index < 1 .or. index > size(sys%sets)) return
+  if (.not. all(length > 0.0_dp)) return
+  call ffr_enable_second_order(sys%sets(index)%item, axial_rigidity, axis, length, &
+                               slope_gram, info)
+  if (info == 0) message = ' '
+end subroutine system_ffr_second_order
+
 !> Large-deformation (continuum) beam elements: material gradients and weights at npts
 !> Gauss points of which the first nvolume are volume points (beam_nonlinear);
 !> damping_time as system_add_ffr_set; shear_scales the section's torsion and shear

@@ -36,7 +36,7 @@ def build(scene) -> BuiltSystem:
                section=rectangle(scene), height_axis=height,
                formulation=scene["scene"]["formulation"], bending=beam["bending"],
                segments=beam["segments"], frame_drive=drive, frame_axis=(0.0, 0.0, 1.0),
-               frame_pivot=(0.0, 0.0, 0.0))
+               frame_pivot=(0.0, 0.0, 0.0), geometric_stiffness=beam["geometric_stiffness"])
     s.joint("A1", "arm", "ground", "boom", point=a1, pivot=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0))
     a2 = a1 + beam["segments"][0] * tangent
     s.joint("A2", "prescribed", "ground", "boom", point=a2, pivot=(0.0, 0.0, 0.0),

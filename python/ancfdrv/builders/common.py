@@ -76,7 +76,14 @@ def check_ffr_validity(model, system: System) -> None:
         params = drive.params()
         rate = {DRIVE_LUFFING: abs(params[0]), DRIVE_SPINUP: abs(params[0])}.get(drive.kind, 0.0)
         omega1 = first_bending_frequency(beam)
-        if rate > 0.3 * omega1:
+        if rate > 0.3 * omega1 and beam.geometric_stiffness:
+            model.warnings.append(
+                f"formulation 'ffr' outside its assumptions: the frame of beam {beam.name!r} "
+                f"turns at {rate:.3g} rad/s, {rate / omega1:.2f} of its first bending frequency "
+                f"{omega1:.3g} rad/s; its centrifugal stiffening comes from the P-delta option "
+                "(geometric_stiffness), linear in the frame - compare with formulation = "
+                "'nonlinear'")
+        elif rate > 0.3 * omega1:
             model.warnings.append(
                 f"formulation 'ffr' outside its assumptions: the frame of beam {beam.name!r} "
                 f"turns at {rate:.3g} rad/s, {rate / omega1:.2f} of its first bending frequency "

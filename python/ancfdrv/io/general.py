@@ -166,7 +166,8 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
                nodes=v["nodes"], section=_section(v), height_axis=v["height_axis"],
                formulation=v["formulation"] or scene["scene"]["formulation"],
                bending=v["bending"], segments=v["segments"], frame_drive=v["frame_drive"],
-               frame_axis=v["frame_axis"], frame_pivot=v["frame_pivot"])
+               frame_axis=v["frame_axis"], frame_pivot=v["frame_pivot"],
+               geometric_stiffness=v["geometric_stiffness"])
     elif group == "cable":
         s.cable(v["name"], material=v["material"], start=v["start"], end=v["end"],
                 nodes=v["nodes"], section=_section(v), tension_only=v["tension_only"],

@@ -33,6 +33,13 @@ DAMPING_TIME_DOC = ("Kelvin-Voigt retardation time tau (s): stress D (strain + t
                     "modal damping ratio tau omega / 2; needs the effect 'damping'")
 
 #: Effects a scene may list in ``&scene effects``; what is not listed is never computed.
+#: the FFR P-delta option of &beam (template and general scenes)
+GEOMETRIC_STIFFNESS_DOC = (
+    "'ffr' beams: add the geometric stiffness of the current axial force (P-delta: each "
+    "element's axial force N = EA eps from its frame displacement, force N int u' . du' dx; "
+    "docs/theory.md, 'FFR geometric stiffness'); needs solver.static_method = 'newton' for a "
+    "static start; off (default): the paper's linear model; 'nonlinear' beams have it anyway "
+    "and ignore the key")
 EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
                      "point_loads", "pressure", "prestress", "contact", "friction", "load_cycle",
                      "damping")
@@ -112,6 +119,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "'continuum': the paper's element (curvature constant per element); "
                        "'cubic': curvature from the cubic centre line r_xx, higher accuracy "
                        "(docs/theory.md section 12)"),
+        "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),
     },
     "material": {
         "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
@@ -431,6 +439,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "formulation": Key("str", None, one_of("ffr", "nonlinear"),
                            "'ffr' or 'nonlinear' (default: the scene's)"),
         "bending": Key("str", "continuum", one_of("continuum", "cubic"), "bending option"),
+        "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),
         "frame_drive": Key("str", None, doc="drive turning the beam's frame (FFR: the "
                            "floating frame; both: the frame of the probe deflections)"),
         "frame_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the frame's turn"),

@@ -341,6 +341,10 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
         raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
                           "formulation (every body) without contact; use "
                           "solver.static_method = 'newton'")
+    if any(s.second_order is not None for s in model.sets):
+        raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
+                          "formulation; beam.geometric_stiffness makes it depend on the axial "
+                          "force: use solver.static_method = 'newton'")
     if model.vector_loads:
         raise SolverError("the split iteration takes dead loads only; driven moments and "
                           "follower loads need solver.static_method = 'newton'")

@@ -279,6 +279,9 @@ def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
             *_, stiffness0 = cubic.forces(local, frame_q, True)
         info.stiffness0 = np.asfortranarray(stiffness0)
         info.reference = np.asfortranarray(frame_q[local])
+        if beam.geometric_stiffness:
+            info.second_order = ffr_second_order_data(frame_ref, beam.lengths,
+                                                      m.youngs_modulus * beam.section.area)
     elif beam.bending == "cubic":
         info.kind = "cubic"
         info.cubic = kernel.CubicBeam(global_ref, beam.lengths, section, m.youngs_modulus,
@@ -312,8 +315,36 @@ def _plate_set(plate: Plate, context: SetContext) -> SetInfo:
                    mass_compact=mass_compact, plate_reference=ref)
 
 
+def ffr_second_order_data(frame_ref: np.ndarray, lengths: np.ndarray, axial_rigidity: float
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The per-element data of the FFR geometric stiffness (ffr_elastic module doc): EA,
+    the unit axis in the frame (from the reference r_A to r_B, frame_ref (3, 8, nel)), the
+    length and G_ab = int S_a' S_b' dx over the centre-line shape functions (N1, L N2, N3,
+    L N4 on the slots r_A, r_xA, r_B, r_xB; 3-point Gauss, exact for the degree-4 integrand)."""
+    nel = len(lengths)
+    chord = frame_ref[:, 4, :] - frame_ref[:, 0, :]
+    axis = chord / np.linalg.norm(chord, axis=0)
+    points, weights = np.polynomial.legendre.leggauss(3)
+    xi, w = 0.5 * (points + 1.0), 0.5 * weights
+    # d/dxi of N1, N2, N3, N4 (cubic Hermite)
+    dn = np.array([-6 * xi + 6 * xi**2, 1 - 4 * xi + 3 * xi**2, 6 * xi - 6 * xi**2,
+                   3 * xi**2 - 2 * xi])
+    gram = np.zeros((8, 8, nel))
+    for el, length in enumerate(lengths):
+        ds = np.zeros((8, len(xi)))
+        ds[[0, 1, 4, 5]] = dn * np.array([1.0, length, 1.0, length])[:, None]
+        # int_0^L (dS_a/dx)(dS_b/dx) dx = (1/L) int_0^1 (dS_a/dxi)(dS_b/dxi) dxi
+        gram[:, :, el] = (ds * w) @ ds.T / length
+    return (np.full(nel, float(axial_rigidity)), np.asfortranarray(axis),
+            np.asarray(lengths, dtype=float), np.asfortranarray(gram))
+
+
 def _add_ffr(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    return ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame, s.damping_time)
+    index = ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame,
+                           s.damping_time)
+    if s.second_order is not None:
+        ks.ffr_second_order(index, *s.second_order)
+    return index
 
 
 def _add_continuum(ks: kernel.KernelSystem, s: SetInfo) -> int:

@@ -170,15 +170,18 @@ class Beam(Body):
     'continuum' or 'cubic'. Its frame is the body frame (axis, height, width directions) at
     t = 0, turned by ``frame_drive`` about ``frame_axis`` through ``frame_pivot`` (default:
     the start) when given: for 'ffr' the elastic model lives in it, for either formulation
-    probe deflections are resolved in it."""
+    probe deflections are resolved in it. ``geometric_stiffness`` (for 'ffr'): the
+    geometric stiffness of the current axial force (P-delta, docs/theory.md, 'FFR geometric stiffness')."""
 
     flexible = True
 
     def __init__(self, name: str, material: Material, start, end, nodes: int,
                  section: Section | None = None, *, height_axis=None, formulation: str = "ffr",
                  bending: str = "continuum", segments=None, frame_drive=None,
-                 frame_axis=(0.0, 0.0, 1.0), frame_pivot=None) -> None:
+                 frame_axis=(0.0, 0.0, 1.0), frame_pivot=None,
+                 geometric_stiffness: bool = False) -> None:
         self.name = name
+        self.geometric_stiffness = bool(geometric_stiffness)
         where = f"beam {name!r}"
         self.material = material
         self.start, self.end = _vec(start, "start", where), _vec(end, "end", where)

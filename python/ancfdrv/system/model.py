@@ -63,6 +63,9 @@ class SetInfo:
     #: Kelvin-Voigt retardation time (s) handed to the kernel: the material's with the
     #: effect 'damping' listed, else 0 (no damping code runs)
     damping_time: float = 0.0
+    #: 'ffr' with geometric stiffness (P-delta): per element EA (nel,), the unit axis in
+    #: the frame (3, nel), the length (nel,), the slope Gram matrix (8, 8, nel); else None
+    second_order: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
 
 @dataclass

@@ -1,0 +1,160 @@
+!> Newmark stepping of a modally reduced FFR model in one prescribed frame (python
+!> ancfdrv.solvers.ffr_reduced, module doc there):
+!>   eta'' + 2 psi' Gam eta' + (Lam + psi'' Gam + psi'^2 C2) eta + R(eta) = g(t),
+!>   R(eta) = C eta + T(eta, eta)   (the P-delta remainder; absent without it),
+!> with constant r x r matrices and the frame's rate psi', acceleration psi'' and the load
+!> g given at every output time. The iteration matrix a I + v 2 psi' Gam + Lam + psi'' Gam +
+!> psi'^2 C2 (+ C) is factorized (LU with partial pivoting) only when psi' or psi'' changed; the linear
+!> model takes one exact solve per step, with P-delta simplified Newton on that matrix.
+module reduced_ffr_stepper
+  use ancf_kinds, only: dp
+  implicit none
+  private
+  public :: reduced_newmark
+
+contains
+
+  !> steps Newmark steps of size dt from rest at eta = 0; eta(:, 1) = 0 on entry is the
+  !> start, eta(:, n + 1) the state at step n. info = 0; 1: Newton did not converge within
+  !> max_newton corrections (failed_step: the step); 2: a singular iteration matrix.
+  subroutine reduced_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
+                             pdelta, pdelta_linear, pdelta_quadratic, load, rate, accel, tol, &
+                             max_newton, eta, info, failed_step)
+    integer, intent(in) :: r, steps, max_newton
+    real(dp), intent(in) :: dt, beta, gamma, omega2(r), gyroscopic(r, r), centrifugal(r, r)
+    logical, intent(in) :: pdelta
+    real(dp), intent(in) :: pdelta_linear(r, r), pdelta_quadratic(r, r, r)
+    real(dp), intent(in) :: load(r, steps + 1), rate(steps + 1), accel(steps + 1), tol
+    real(dp), intent(out) :: eta(r, steps + 1)
+    integer, intent(out) :: info, failed_step
+    real(dp) :: vel(r), acc(r), base(r), vbase(r), x(r), a_new(r), v_new(r), res(r)
+    real(dp) :: stiff(r, r), damp(r, r), jac(r, r), contracted(r, r)
+    real(dp) :: a_fac, v_fac, last_rate, last_accel
+    integer :: n, it, i, k, ipiv(r), lapack_info
+    logical :: converged, fresh
+    info = 0
+    failed_step = 0
+    a_fac = 1.0_dp / (beta * dt * dt)
+    v_fac = gamma / (beta * dt)
+    eta = 0.0_dp
+    vel = 0.0_dp
+    acc = 0.0_dp
+    fresh = .true.
+    last_rate = 0.0_dp
+    last_accel = 0.0_dp
+    do n = 1, steps
+      ! the iteration matrix a_fac I + v_fac damp + stiff (+ C): factorized again only when
+      ! the frame's rate or acceleration changed (constant in the luffing and free stages)
+      if (fresh .or. rate(n + 1) /= last_rate .or. accel(n + 1) /= last_accel) then
+        stiff = accel(n + 1) * gyroscopic + rate(n + 1)**2 * centrifugal
+        do i = 1, r
+          stiff(i, i) = stiff(i, i) + omega2(i)
+        end do
+        damp = 2.0_dp * rate(n + 1) * gyroscopic
+        jac = v_fac * damp + stiff
+        do i = 1, r
+          jac(i, i) = jac(i, i) + a_fac
+        end do
+        if (pdelta) jac = jac + pdelta_linear
+        ! (r is small: an inline LU beats LAPACK's call overhead by a factor of 20)
+        call small_lu(r, jac, ipiv, lapack_info)
+        if (lapack_info /= 0) then
+          info = 2
+          failed_step = n
+          return
+        end if
+        fresh = .false.
+        last_rate = rate(n + 1)
+        last_accel = accel(n + 1)
+      end if
+      base = eta(:, n) + dt * vel + dt * dt * (0.5_dp - beta) * acc
+      vbase = vel + dt * (1.0_dp - gamma) * acc
+      x = base + dt * dt * beta * acc
+      converged = .false.
+      do it = 1, max_newton
+        a_new = (x - base) * a_fac
+        v_new = vbase + dt * gamma * a_new
+        res = a_new + matmul(damp, v_new) + matmul(stiff, x) - load(:, n + 1)
+        if (pdelta) then
+          ! contracted(i, j) = sum_k T(i, j, k) x_k; R = C x + contracted x
+          contracted = 0.0_dp
+          do k = 1, r
+            contracted = contracted + pdelta_quadratic(:, :, k) * x(k)
+          end do
+          res = res + matmul(pdelta_linear, x) + matmul(contracted, x)
+        end if
+        res = -res
+        call small_lu_solve(r, jac, ipiv, res)
+        x = x + res
+        ! linear: the one correction solves the step exactly (the matrix is its Jacobian)
+        if (.not. pdelta) then
+          converged = .true.
+          exit
+        end if
+        ! P-delta: simplified Newton with the linear part's matrix (the quadratic
+        ! remainder is small against a_fac I)
+        if (maxval(abs(res)) <= tol * max(1.0_dp, maxval(abs(x)))) then
+          converged = .true.
+          exit
+        end if
+      end do
+      if (.not. converged) then
+        info = 1
+        failed_step = n
+        return
+      end if
+      acc = (x - base) * a_fac
+      vel = vbase + dt * gamma * acc
+      eta(:, n + 1) = x
+    end do
+  end subroutine reduced_newmark
+
+  !> In-place LU factorization with partial pivoting of a (n, n): info = 1 for a zero pivot.
+  pure subroutine small_lu(n, a, pivots, info)
+    integer, intent(in) :: n
+    real(dp), intent(inout) :: a(n, n)
+    integer, intent(out) :: pivots(n), info
+    real(dp) :: row(n)
+    integer :: j, p, i
+    info = 0
+    do j = 1, n
+      p = j - 1 + maxloc(abs(a(j:n, j)), 1)
+      pivots(j) = p
+      if (a(p, j) == 0.0_dp) then
+        info = 1
+        return
+      end if
+      if (p /= j) then
+        row = a(j, :)
+        a(j, :) = a(p, :)
+        a(p, :) = row
+      end if
+      a(j + 1:n, j) = a(j + 1:n, j) / a(j, j)
+      do i = j + 1, n
+        a(j + 1:n, i) = a(j + 1:n, i) - a(j + 1:n, j) * a(j, i)
+      end do
+    end do
+  end subroutine small_lu
+
+  !> b := a^-1 b with the factors of small_lu.
+  pure subroutine small_lu_solve(n, a, pivots, b)
+    integer, intent(in) :: n, pivots(n)
+    real(dp), intent(in) :: a(n, n)
+    real(dp), intent(inout) :: b(n)
+    real(dp) :: swap
+    integer :: j
+    do j = 1, n
+      if (pivots(j) /= j) then
+        swap = b(j)
+        b(j) = b(pivots(j))
+        b(pivots(j)) = swap
+      end if
+      b(j + 1:n) = b(j + 1:n) - a(j + 1:n, j) * b(j)
+    end do
+    do j = n, 1, -1
+      b(j) = b(j) / a(j, j)
+      b(1:j - 1) = b(1:j - 1) - a(1:j - 1, j) * b(j)
+    end do
+  end subroutine small_lu_solve
+
+end module reduced_ffr_stepper
