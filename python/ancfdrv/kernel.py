@@ -11,7 +11,8 @@ import numpy as np
 from dataclasses import dataclass
 
 from . import _kernel
-from .codes import DRIVE_TABLE, SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
+from .codes import (CONTACT_RECORD, DRIVE_TABLE, ENERGY_NAMES, POWER_NAMES, SECTION_BOX,
+                    SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE)
 from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
@@ -449,6 +450,409 @@ def _pad_last(a: np.ndarray, dtype=np.float64) -> np.ndarray:
     if a.shape[-1] == 0:
         a = np.zeros(a.shape[:-1] + (1,), dtype=dtype)
     return np.asfortranarray(a)
+
+
+#: the lengths of the energies of an output row and of the works and powers of the state
+ENERGY_COUNT, POWER_COUNT = len(ENERGY_NAMES), len(POWER_NAMES)
+
+
+def _text(message: bytes | str) -> str:
+    """A kernel message buffer (f2py returns character(len=200) as bytes) as text."""
+    if isinstance(message, bytes):
+        message = message.decode("ascii", "replace")
+    return str(message).strip() or "no message"
+
+
+class KernelSystem:
+    """A mechanical system held by the kernel (system_store): built once by the set-up
+    methods (indices are 0-based here, 1-based in the kernel), then evaluated or stepped
+    chunk by chunk without sending its arrays again. Use as a context manager or call
+    :meth:`close`."""
+
+    def __init__(self, ndof: int, nfull: int) -> None:
+        handle, info, message = _kernel.system_create(ndof, nfull)
+        if info:
+            raise SolverError(_text(message))
+        self.handle, self.ndof, self.nfull = int(handle), ndof, nfull
+        self.ncon = self.nprobe = self.npoint = 0
+        self.nnz_pattern = 0
+
+    def _check(self, info: int, what: str, message: bytes | str = b"") -> None:
+        """Raise with the kernel's own text (code 1: a stale handle, 2: sizes or indices
+        inconsistent with the system: a bug of the caller)."""
+        if info:
+            raise SolverError(f"kernel system set-up ({what}), code {info}: {_text(message)}")
+
+    # element sets: dofs 0-based (nde, nel), scatter 1-based (Pattern.scatter), frame: the
+    # 1-based frame id (0: none); damping_time: the Kelvin-Voigt retardation time tau (s) of
+    # the set's material damping (0: none, and none of its code runs)
+    def add_ffr_set(self, dofs, scatter, stiffness0, reference, frame: int,
+                    damping_time: float = 0.0) -> int:
+        index, info, message = _kernel.system_add_ffr_set(self.handle, _i(dofs + 1), _i(scatter),
+                                                 _f(stiffness0), _f(reference), frame,
+                                                 damping_time)
+        self._check(info, "FFR beam set", message)
+        return int(index)
+
+    def add_continuum_set(self, dofs, scatter, gradients, weights, nvolume: int, youngs: float,
+                          poisson: float, frame: int, damping_time: float = 0.0,
+                          shear_scales=(1.0, 0.0, 0.0)) -> int:
+        index, info, message = _kernel.system_add_continuum_set(
+            self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights), youngs,
+            poisson, _f(shear_scales), frame, damping_time)
+        self._check(info, "continuum beam set", message)
+        return int(index)
+
+    def add_cubic_set(self, dofs, scatter, forms, strain0, stiffness, frame: int,
+                      damping_time: float = 0.0) -> int:
+        index, info, message = _kernel.system_add_cubic_set(
+            self.handle, _i(dofs + 1), _i(scatter), _f(forms), _f(strain0), _f(stiffness),
+            frame, damping_time)
+        self._check(info, "cubic beam set", message)
+        return int(index)
+
+    def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
+                      poisson: float, thickness: float, damping_time: float = 0.0) -> int:
+        index, info, message = _kernel.system_add_plate_set(
+            self.handle, _i(dofs + 1), _i(scatter), reference.derivs, reference.frame,
+            reference.curvature0, reference.weights, youngs, poisson, thickness, damping_time)
+        self._check(info, "plate set", message)
+        return int(index)
+
+    def add_cable_set(self, dofs, scatter, lengths, axial_stiffness: float,
+                      bending_stiffness: float, damping_time: float = 0.0) -> int:
+        index, info, message = _kernel.system_add_cable_set(
+            self.handle, _i(dofs + 1), _i(scatter), _f(lengths), axial_stiffness,
+            bending_stiffness, damping_time)
+        self._check(info, "cable set", message)
+        return int(index)
+
+    def set_frames(self, drives, axes, bases, pivots) -> None:
+        """Frames: drive (0-based drive index, -1: fixed), axis, base (3, 3), pivot."""
+        n = len(drives)
+        info, message = _kernel.system_set_frames(
+            self.handle, n, _pad_last(np.asarray(drives, dtype=np.int32) + 1, np.int32),
+            _pad_last(np.asarray(axes, dtype=float).reshape(-1, 3).T),
+            _pad_last(np.transpose(np.asarray(bases, dtype=float).reshape(-1, 3, 3), (1, 2, 0))),
+            _pad_last(np.asarray(pivots, dtype=float).reshape(-1, 3).T))
+        self._check(info, "frames", message)
+
+    def set_drives(self, kinds, params: list) -> None:
+        ptr = np.concatenate([[0], np.cumsum([len(p) for p in params])]).astype(np.int32) + 1
+        data = np.concatenate([np.asarray(p, dtype=float) for p in params]) if params else \
+            np.zeros(0)
+        info, message = _kernel.system_set_drives(self.handle, len(kinds), len(data),
+                                         _pad_last(np.asarray(kinds, dtype=np.int32), np.int32),
+                                         _i(ptr), _pad_last(data))
+        self._check(info, "drives", message)
+
+    def set_matrices(self, mass_csr, full_pattern, solver_handle: int, policy: int,
+                     mass_pattern, vector_frame, block_first) -> None:
+        """M (scipy CSR on the independent coordinates), the full pattern (row_ptr,
+        col_index, 0-based), the solver and its policy, M on the solver's pattern, the frame
+        of each reduced 3-vector (0: global; frames 1-based here) and the blocks' first dofs."""
+        full_row_ptr, full_col = full_pattern
+        self.nnz_pattern = len(mass_pattern)
+        info, message = _kernel.system_set_matrices(
+            self.handle, _i(mass_csr.indptr + 1), _i(mass_csr.indices + 1), _f(mass_csr.data),
+            _i(np.asarray(full_row_ptr) + 1), _i(np.asarray(full_col) + 1), solver_handle,
+            policy, _f(mass_pattern), len(vector_frame),
+            _pad_last(np.asarray(vector_frame, dtype=np.int32), np.int32), len(block_first),
+            _pad_last(np.asarray(block_first, dtype=np.int32) + 1, np.int32), ndof=self.ndof,
+            nfull=self.nfull)
+        self._check(info, "matrices", message)
+
+    def set_kron_mass(self, scalar_csr) -> None:
+        """M = kron(Mbar, I3): Mbar's CSR on the 3-vectors replaces M in the products."""
+        info, message = _kernel.system_set_kron_mass(self.handle, _i(scalar_csr.indptr + 1),
+                                            _i(scalar_csr.indices + 1), _f(scalar_csr.data))
+        self._check(info, "kron mass", message)
+
+    def set_reduction(self, b_csr, offset, plan_source, plan_target, plan_coef) -> None:
+        info, message = _kernel.system_set_reduction(
+            self.handle, len(b_csr.data), _i(b_csr.indptr + 1),
+            _pad_last(b_csr.indices + 1, np.int32), _pad_last(b_csr.data), _f(offset),
+            len(plan_coef), _pad_last(np.asarray(plan_source) + 1, np.int32),
+            _pad_last(np.asarray(plan_target) + 1, np.int32), _pad_last(plan_coef),
+            nfull=self.nfull)
+        self._check(info, "reduction", message)
+
+    def set_loads(self, constant_force, force_drives, force_vectors, moment_dofs, moment_axes,
+                  magnitudes, moment_references) -> None:
+        """Driven forces: 0-based drive indices and vectors (ndof, n); moments: full director
+        dofs (n, 3, 0-based), axes, magnitudes, directors at t = 0."""
+        nforce, nmoment = len(force_drives), len(magnitudes)
+        info, message = _kernel.system_set_loads(
+            self.handle, _f(constant_force), nforce,
+            _pad_last(np.asarray(force_drives, dtype=np.int32) + 1, np.int32),
+            _pad_last(np.asarray(force_vectors, dtype=float).reshape(self.ndof, nforce)), nmoment,
+            _pad_last(np.asarray(moment_dofs, dtype=np.int32).reshape(-1, 3).T + 1, np.int32),
+            _pad_last(np.asarray(moment_axes, dtype=float).reshape(-1, 3).T),
+            _pad_last(np.asarray(magnitudes, dtype=float)),
+            _pad_last(np.asarray(moment_references, dtype=float).reshape(-1, 3).T),
+            ndof=self.ndof)
+        self._check(info, "loads", message)
+
+    def set_vector_loads(self, loads) -> None:
+        """Driven and follower point loads (model.VectorLoadInfo)."""
+        ptr, dofs, coefs = [0], [], []
+        for load in loads:
+            for slot in load.slots:
+                dofs += [d for d, _ in slot]
+                coefs += [c for _, c in slot]
+                ptr.append(len(dofs))
+        info = _kernel.system_set_vector_loads(
+            self.handle, len(loads), len(dofs),
+            _pad_last(np.array([x.kind for x in loads], dtype=np.int32), np.int32),
+            _pad_last(np.array([x.drive + 1 for x in loads], dtype=np.int32), np.int32),
+            _pad_last(np.array([x.vector for x in loads], dtype=float).reshape(-1, 3).T),
+            _pad_last(np.array([x.shares for x in loads], dtype=float).reshape(-1, 2).T),
+            _i(np.array(ptr) + 1), _pad_last(np.array(dofs, dtype=np.int32) + 1, np.int32),
+            _pad_last(np.array(coefs, dtype=float)))
+        self._check(info, "vector loads")
+
+    def set_constraints(self, layout: "ConstraintLayout") -> None:
+        ncon, nterm = len(layout.kinds), len(layout.term_dof)
+        info, message = _kernel.system_set_constraints(
+            self.handle, ncon, nterm, _pad_last(layout.kinds, np.int32),
+            _pad_last(np.asarray(layout.drives) + 1, np.int32), _pad_last(layout.params),
+            _pad_last(layout.operand_const), _i(np.asarray(layout.term_ptr) + 1),
+            _pad_last(np.asarray(layout.term_dof) + 1, np.int32), _pad_last(layout.term_coef))
+        self._check(info, "constraints", message)
+        self.ncon = ncon
+
+    def add_contact_pair(self, dofs, sizes, grid, point_element, point_local, params) -> None:
+        info, message = _kernel.system_add_contact_pair(
+            self.handle, _i(np.asarray(dofs) + 1), _f(sizes), _i(np.asarray(grid) + 1),
+            _i(np.asarray(point_element) + 1), _f(point_local), _f(params))
+        self._check(info, "contact pair", message)
+        self.npoint += len(point_element)
+
+    def set_probes(self, ptr, dofs, coefs, frames, reference) -> None:
+        """Probe p = sum coef q[dof:dof+3] over terms ptr[p]:ptr[p+1] (0-based dofs),
+        deflection frame (0: global, frames 1-based), rigid position in it (nprobe, 3)."""
+        nprobe = len(ptr) - 1
+        info, message = _kernel.system_set_probes(
+            self.handle, len(dofs), _i(np.asarray(ptr) + 1),
+            _pad_last(np.asarray(dofs, dtype=np.int32) + 1, np.int32), _pad_last(coefs),
+            _pad_last(np.asarray(frames, dtype=np.int32), np.int32),
+            _pad_last(np.asarray(reference, dtype=float).reshape(-1, 3).T))
+        self._check(info, "probes", message)
+        self.nprobe = nprobe
+
+    def evaluate(self, t: float, e, v, guesses, counts, *, load_factor: float = 1.0,
+                 velocity_factor: float = 0.0, want_tangent: bool = False) -> dict:
+        """Internal forces B^T (Q_el - Q_c - lf Q_M), external lf Q(t), strain energy, contact
+        potential and records, and on request the tangent on the solver's pattern; the
+        contact guesses and counters are updated (returned)."""
+        nnz = self.nnz_pattern if want_tangent else 1
+        out = _kernel.system_evaluate(self.handle, nnz, self.npoint, t, _f(e), _f(v), load_factor,
+                                      velocity_factor, int(want_tangent), _f(guesses),
+                                      _i(counts), ndof=self.ndof)
+        (guesses, counts, internal, external, strain, potential, records, tangent, info,
+         message) = out
+        if info:
+            self._failure(info, "force evaluation", message)
+        return dict(internal=internal, external=external, strain=float(strain),
+                    contact_potential=float(potential), records=records[:, :self.npoint],
+                    tangent=tangent if want_tangent else None, guesses=guesses, counts=counts)
+
+    def full_forces(self, t: float, e, v, guesses, *, load_factor: float = 1.0) -> np.ndarray:
+        """Q_el - Q_c - lf Q_M at (t, e, e') in the full coordinates q (before B^T): what
+        the joint reactions of eliminated linear joints are recovered from. The caller's
+        contact guesses are not changed."""
+        full, info = _kernel.system_full_forces(self.handle, self.nfull, self.npoint, t, _f(e),
+                                                _f(v), load_factor, _f(np.array(guesses)),
+                                                ndof=self.ndof)
+        if info:
+            self._failure(info, "full force evaluation")
+        return full
+
+    def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
+        out = _kernel.system_output_row(
+            self.handle, self.ncon, self.nprobe, self.npoint, t, _f(e), _f(v),
+            _f(lam) if len(lam) else np.zeros(1), _f(work), _f(guesses), _i(counts),
+            ndof=self.ndof)
+        (guesses, counts, probe, deflection, energy, violation, records, powers, info,
+         message) = out
+        if info:
+            self._failure(info, "output row", message)
+        return dict(probes=probe[:, :self.nprobe].T.copy(),
+                    deflections=deflection[:, :self.nprobe].T.copy(), energy=energy,
+                    violation=float(violation), records=records[:, :self.npoint],
+                    guesses=guesses, counts=counts, powers=powers)
+
+    def _failure(self, info: int, what: str, message: bytes | str) -> None:
+        """Raise with the kernel's text of the failure (a stale handle and inconsistent sizes
+        are named as such, not as a solver failure)."""
+        raise SolverError(f"{what}, kernel code {info}: {_text(message)}")
+
+    def stepper_setup(self, settings) -> None:
+        """Start a run of the kernel's stepper (``fortran/src/solvers/stepper.f90``) with the
+        run's settings (a :class:`~ancfdrv.solvers.dynamic.DynamicSettings`: beta, gamma,
+        alpha_m, alpha_f, tol, length_scale, max_newton, the Jacobian policy, contraction),
+        sent once per run, not with every chunk. What the stepper learned in earlier runs
+        (contraction estimate, a matrix factorized at another state) is forgotten: a run
+        from a new initial state is reproducible."""
+        info, message = _kernel.system_stepper_setup(
+            self.handle, settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f,
+            settings.tol, settings.length_scale, settings.max_newton, settings.jacobian_code,
+            settings.contraction)
+        self._check(info, "stepper_setup", message)
+
+    def state_size(self) -> int:
+        """The length of the packed stepper state (stepper.f90 ``state_size``)."""
+        return 1 + 4 * self.ndof + self.ncon + 2 * POWER_COUNT + 2 * self.npoint
+
+    def row_size(self, store_q: bool) -> int:
+        """The length of one output row of :meth:`advance` (stepper.f90 ``row_size``)."""
+        return (1 + 6 * self.nprobe + self.ncon + ENERGY_COUNT + 1
+                + len(CONTACT_RECORD) * self.npoint + (self.ndof if store_q else 0))
+
+    def advance(self, nsteps: int, h: float, state: dict, store_q: bool) -> dict:
+        """Advance nsteps steps of size h (time_integrator, with the run's settings of
+        :meth:`stepper_setup`) from state (t, e, v, a, accel, lam, work, powers, guesses,
+        counts; its entries are replaced by the new state's). Returns the outputs (time,
+        probes (3, nprobe, nsteps), deflections, lam, energy, constraint, stats, contact,
+        q), status [steps done, info, detail, steps converged at the round-off floor], the
+        kernel's text of a failure (``message``) and the last Newton correction; a failed
+        step's statistics are the column after the last completed step. A refused call (a
+        stale handle, no run set up, sizes inconsistent with the system) raises
+        SolverError with the kernel's text."""
+        n, nc, npt, npr = self.ndof, self.ncon, self.npoint, self.nprobe
+        guesses = np.asarray(state["guesses"], dtype=np.float64)
+        packed = np.concatenate([[state["t"]], state["e"], state["v"], state["a"],
+                                 state["accel"], np.asarray(state["lam"])[:nc], state["work"],
+                                 state["powers"], guesses[:, :npt].ravel(order="F")])
+        packed, counts, rows, stats, status, last_correction, message = _kernel.system_advance(
+            self.handle, nsteps, h, packed, _i(state["counts"]),
+            self.row_size(store_q))
+        status = [int(x) for x in status]
+        if status[1] == 9:
+            self._failure(9, "system_advance", message)
+        k = 1 + 4 * n + nc + 2 * POWER_COUNT
+        guesses = guesses.copy()
+        guesses[:, :npt] = packed[k:k + 2 * npt].reshape((2, npt), order="F")
+        k = 1 + 4 * n
+        state.update(t=float(packed[0]), e=packed[1:1 + n], v=packed[1 + n:1 + 2 * n],
+                     a=packed[1 + 2 * n:1 + 3 * n], accel=packed[1 + 3 * n:k],
+                     lam=packed[k:k + nc], work=packed[k + nc:k + nc + POWER_COUNT],
+                     powers=packed[k + nc + POWER_COUNT:k + nc + 2 * POWER_COUNT],
+                     guesses=guesses, counts=counts)
+        k = 1 + 6 * npr + nc
+        out = dict(time=rows[0],
+                   probes=rows[1:1 + 3 * npr].reshape((3, npr, nsteps), order="F"),
+                   deflections=rows[1 + 3 * npr:1 + 6 * npr].reshape((3, npr, nsteps),
+                                                                     order="F"),
+                   lam=rows[1 + 6 * npr:k], energy=rows[k:k + ENERGY_COUNT],
+                   constraint=rows[k + ENERGY_COUNT])
+        k += ENERGY_COUNT + 1
+        nrec = len(CONTACT_RECORD)
+        out.update(contact=rows[k:k + nrec * npt].reshape((nrec, npt, nsteps), order="F"),
+                   q=rows[k + nrec * npt:] if store_q else np.zeros((n, 1)), stats=stats,
+                   status=status, message=_text(message) if status[1] else "",
+                   last_correction=float(last_correction))
+        return out
+
+    def close(self) -> None:
+        if getattr(self, "handle", 0):
+            _kernel.direct_destroy(self.handle)
+            self.handle = 0
+
+    def __enter__(self) -> "DirectSolver":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+# -- rigid bodies and leaf contact (seed 003, eqs. 17-32) ---------------------------------
+def reference_node_mass(mass: float, centre, inertia) -> np.ndarray:
+    """12 x 12 mass matrix of an ANCF reference node (eq. 32), coordinates [r, r_x, r_y, r_z]."""
+    matrix, info = _kernel.reference_node_mass(mass, _f(centre), _f(inertia))
+    if info == 1:
+        raise InputError(f"rigid body mass {mass} must be positive")
+    if info == 2:
+        raise InputError("rigid body inertia tensor is not symmetric or not physical (its "
+                         "principal moments violate the triangle inequality)")
+    return matrix
+
+
+def contact_params(stiffness: float, damping: float, friction: float, slip_velocity: float,
+                   upper_thickness: float, lower_thickness: float, friction_on: bool) -> np.ndarray:
+    return np.array([stiffness, damping, friction, slip_velocity, upper_thickness,
+                     lower_thickness, 1.0 if friction_on else 0.0, 0.0])
+
+
+def contact_pair(upper, upper_rates, a_u, b_u, xi_q, eta_q, lower, lower_rates, a_l, b_l, xi_p,
+                 eta_p, params, velocity_factor: float = 0.0) -> dict:
+    """One contact pair: element coordinates (3, 12) and rates; forces on the upper and lower
+    element, Jacobian of minus the forces (72 x 72), record (penetration, F_n, |F_t|, slip),
+    penalty potential and powers (damping, friction)."""
+    (fu, fl, jac, record, potential, powers, active, info) = _kernel.contact_pair(
+        _f(upper), _f(upper_rates), a_u, b_u, xi_q, eta_q, _f(lower), _f(lower_rates), a_l, b_l,
+        xi_p, eta_p, _f(params), velocity_factor)
+    if info:
+        raise SolverError("contact pair: a mid-surface normal vanished")
+    return dict(force_upper=fu, force_lower=fl, jacobian=jac, record=record,
+                potential=float(potential), powers=powers, active=bool(active))
+
+
+def contact_projection(e, dofs, sizes, grid, point, guess) -> tuple[np.ndarray, int, int]:
+    """Closest point (leaf-level coordinates) of the upper mid-surface grid to ``point``;
+    returns it with the Newton iterations and fallback sweeps used."""
+    guess, counts, info = _kernel.contact_projection(
+        _f(e), _f(np.asarray(dofs) + 1, np.int32), _f(sizes), _f(np.asarray(grid) + 1, np.int32),
+        _f(point), _f(guess))
+    if info:
+        raise SolverError("contact search: no closest point found")
+    return guess, int(counts[0]), int(counts[1])
+
+
+def contact_evaluate(e, rates, dofs, sizes, grid, point_element, point_local, params, guesses,
+                     counts, velocity_factor: float = 0.0, pattern: "SparsePattern | None" = None):
+    """All contact points (see leaf_contact%contact_assemble): force (full), records
+    (6, npoints), potential, powers, updated guesses and counters, and the Jacobian's CSR
+    values on ``pattern`` when given."""
+    n = len(e)
+    if pattern is None:
+        row_ptr, col, want = np.ones(n + 1, np.int32), np.ones(1, np.int32), 0
+    else:
+        row_ptr, col, want = pattern.row_ptr + 1, pattern.col_index + 1, 1
+    (guesses, counts, force, records, potential, powers, values, info) = _kernel.contact_evaluate(
+        _f(e), _f(rates), _f(np.asarray(dofs) + 1, np.int32), _f(sizes),
+        _f(np.asarray(grid) + 1, np.int32), _f(np.asarray(point_element) + 1, np.int32),
+        _f(point_local), _f(params), velocity_factor, want, _f(row_ptr, np.int32),
+        _f(col, np.int32), _f(guesses), _f(counts, np.int32))
+    if info == 8:
+        raise SolverError("contact search: no closest point found on the upper leaf")
+    if info:
+        raise SolverError("contact: a mid-surface normal vanished")
+    return dict(force=force, records=records, potential=float(potential), powers=powers,
+                guesses=guesses, counts=counts, values=values if pattern is not None else None)
+
+
+# -- a mechanical system behind a kernel handle (fortran/src/api/system_api.f90) ----------
+def _i(a) -> np.ndarray:
+    return np.asfortranarray(a, dtype=np.int32)
+
+
+def _pad_last(a: np.ndarray, dtype=np.float64) -> np.ndarray:
+    """f2py refuses zero-size arrays: one unused entry along the last axis."""
+    a = np.asarray(a, dtype=dtype)
+    if a.shape[-1] == 0:
+        a = np.zeros(a.shape[:-1] + (1,), dtype=dtype)
+    return np.asfortranarray(a)
+
+
+#: the lengths of the energies of an output row and of the works and powers of the state
+ENERGY_COUNT, POWER_COUNT = len(ENERGY_NAMES), len(POWER_NAMES)
 
 
 def _text(message: bytes | str) -> str:
