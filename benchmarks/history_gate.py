@@ -2,8 +2,13 @@
 inputs/hard/) for a short t_end with each Jacobian policy and step control, on two builds,
 and compare the HDF5 histories bitwise.
 
-    python benchmarks/history_gate.py run  <repo> <outdir>     # run with <repo>/.venv/bin/ancf
+    python benchmarks/history_gate.py run <outdir> [<site>]   # this python, ancfdrv from <site>
     python benchmarks/history_gate.py diff <outdir_a> <outdir_b>
+
+A baseline build goes beside the working one, e.g.
+    git archive <commit> | tar -x -C /tmp/base && cd /tmp/base &&
+    pip install --no-build-isolation --no-deps --target /tmp/base_site .
+(the scenes are read from this checkout's inputs/ in both runs).
 
 Every dataset outside /timing is compared byte for byte (values, dtype and shape), and the
 counters and the root attributes status and message; wall times, dates, commits and paths
@@ -49,20 +54,24 @@ def name_of(scene: str, variant: str) -> str:
     return scene.replace("inputs/", "").replace("/", "_").replace(".nml", "") + f"-{variant}"
 
 
-def run(repo: Path, out: Path) -> None:
+def run(out: Path, site: str | None) -> None:
     out.mkdir(parents=True, exist_ok=True)
-    ancf = repo / ".venv" / "bin" / "ancf"
+    repo = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    if site:
+        env["PYTHONPATH"] = site
     for scene, t_end in SCENES:
         for variant, sets in VARIANTS:
             if variant not in EVERY and scene not in EXTRA_ON:
                 continue
             target = out / (name_of(scene, variant) + ".h5")
-            args = [str(ancf), "run", scene, "--set", f"solver.t_end={t_end}",
+            args = [sys.executable, "-c", "import sys; from ancfdrv.cli import main; "
+                    "sys.exit(main())", "run", scene, "--set", f"solver.t_end={t_end}",
                     "--set", "output.q=.true.", "--set", "output.xdmf=.false."]
             for s in sets:
                 args += ["--set", s]
             done = subprocess.run(args + ["-o", str(target)], cwd=repo, capture_output=True,
-                                  text=True, env={**os.environ, "MPLBACKEND": "Agg"})
+                                  text=True, env=env)
             (out / (name_of(scene, variant) + ".rc")).write_text(
                 f"{done.returncode}\n{done.stderr[-2000:]}")
             print(f"{name_of(scene, variant)}: exit {done.returncode}", flush=True)
@@ -116,6 +125,6 @@ def diff(a: Path, b: Path) -> int:
 
 if __name__ == "__main__":
     if sys.argv[1] == "run":
-        run(Path(sys.argv[2]).resolve(), Path(sys.argv[3]).resolve())
+        run(Path(sys.argv[2]).resolve(), sys.argv[3] if len(sys.argv) > 3 else None)
     else:
         sys.exit(diff(Path(sys.argv[2]), Path(sys.argv[3])))
