@@ -3,6 +3,7 @@ inputs/hard/) for a short t_end with each Jacobian policy and step control, on t
 and compare the HDF5 histories bitwise.
 
     python benchmarks/history_gate.py run <outdir> [<site>]   # this python, ancfdrv from <site>
+    python benchmarks/history_gate.py examples <outdir> [<site>]   # examples/ --quick
     python benchmarks/history_gate.py diff <outdir_a> <outdir_b>
 
 A baseline build goes beside the working one, e.g.
@@ -77,6 +78,27 @@ def run(out: Path, site: str | None) -> None:
             print(f"{name_of(scene, variant)}: exit {done.returncode}", flush=True)
 
 
+EXAMPLES = {"aerial_platform": [], "knuckle_boom": [], "slider_crank": [],
+            "sweep_from_python": [], "three_leaf_spring": [],
+            "road_transmissibility": ["--jobs", "1", "--keep-runs"]}
+
+
+def examples(out: Path, site: str | None) -> None:
+    """Each example with --quick, its result files in out/examples/<name>/."""
+    repo = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    if site:
+        env["PYTHONPATH"] = site
+    for name, extra in EXAMPLES.items():
+        target = out / "examples" / name
+        target.mkdir(parents=True, exist_ok=True)
+        done = subprocess.run([sys.executable, str(repo / "examples" / f"{name}.py"), "--quick",
+                               "--out", str(target), *extra], cwd=repo, capture_output=True,
+                              text=True, env=env)
+        (target / "exit.rc").write_text(f"{done.returncode}\n{done.stderr[-2000:]}")
+        print(f"{name}: exit {done.returncode}", flush=True)
+
+
 def _datasets(f: h5py.File) -> dict:
     found = {}
 
@@ -89,12 +111,15 @@ def _datasets(f: h5py.File) -> dict:
 
 def diff(a: Path, b: Path) -> int:
     bad = 0
-    files = sorted(p.name for p in a.glob("*.h5"))
+    files = sorted(str(p.relative_to(a)) for p in a.rglob("*.h5"))
     for name in files:
-        rc_a = (a / name.replace(".h5", ".rc")).read_text().split("\n")[0]
-        rc_b = (b / name.replace(".h5", ".rc")).read_text().split("\n")[0] \
-            if (b / name.replace(".h5", ".rc")).exists() else "missing"
+        rc = name.replace(".h5", ".rc")
+        if not (a / rc).exists():   # an example's file: its folder's exit.rc
+            rc = str(Path(name).parent / "exit.rc")
+        rc_a = (a / rc).read_text().split("\n")[0]
+        rc_b = (b / rc).read_text().split("\n")[0] if (b / rc).exists() else "missing"
         problems = [] if rc_a == rc_b else [f"exit {rc_a} vs {rc_b}"]
+        rows = 0
         if not (b / name).exists():
             problems.append("no file")
         else:
@@ -124,7 +149,8 @@ def diff(a: Path, b: Path) -> int:
 
 
 if __name__ == "__main__":
-    if sys.argv[1] == "run":
-        run(Path(sys.argv[2]).resolve(), sys.argv[3] if len(sys.argv) > 3 else None)
+    if sys.argv[1] in ("run", "examples"):
+        (run if sys.argv[1] == "run" else examples)(Path(sys.argv[2]).resolve(),
+                                                     sys.argv[3] if len(sys.argv) > 3 else None)
     else:
         sys.exit(diff(Path(sys.argv[2]), Path(sys.argv[3])))

@@ -23,6 +23,8 @@ def test_stale_handle_is_named():
     with pytest.raises(SolverError, match="force evaluation, kernel code 1: .*stale handle") as err:
         stale.evaluate(0.0, np.zeros(6), np.zeros(6), np.zeros((2, 1)), np.zeros(6, np.int32))
     assert "Newton" not in str(err.value) and "non-finite" not in str(err.value)
+    with pytest.raises(SolverError, match="full force evaluation, kernel code 1: .*stale handle"):
+        stale.full_forces(0.0, np.zeros(6), np.zeros(6), np.zeros((2, 1)))
     stale.handle = 0
     info, message = _kernel.system_destroy(handle)
     assert info == 1 and b"stale handle" in message

@@ -661,11 +661,11 @@ class KernelSystem:
         """Q_el - Q_c - lf Q_M at (t, e, e') in the full coordinates q (before B^T): what
         the joint reactions of eliminated linear joints are recovered from. The caller's
         contact guesses are not changed."""
-        full, info = _kernel.system_full_forces(self.handle, self.nfull, self.npoint, t, _f(e),
-                                                _f(v), load_factor, _f(np.array(guesses)),
-                                                ndof=self.ndof)
+        full, info, message = _kernel.system_full_forces(
+            self.handle, self.nfull, self.npoint, t, _f(e), _f(v), load_factor,
+            _f(np.array(guesses)), ndof=self.ndof)
         if info:
-            self._failure(info, "full force evaluation")
+            self._failure(info, "full force evaluation", message)
         return full
 
     def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:

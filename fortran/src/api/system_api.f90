@@ -833,34 +833,45 @@ end subroutine system_evaluate
 !> are recovered from them (python/ancfdrv/system/answers.py). The contact guesses and
 !> counters are used and returned unchanged in the caller's copy.
 subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor, guesses, &
-                              full_force, info)
+                              full_force, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces
   use system_store, only: store_get
+  use kernel_errors, only: handle_text, failure_text
   implicit none
   integer, intent(in) :: handle, ndof, nfull, npoint
   real(dp), intent(in) :: t, e(ndof), v(ndof), load_factor
   real(dp), intent(in) :: guesses(2, max(1, npoint))
   real(dp), intent(out) :: full_force(nfull)
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(contact_state) :: state
   real(dp), allocatable :: rotations(:, :, :), rates(:), reduced(:)
   real(dp) :: strain, potential, powers(2), records(6, max(1, npoint))
   full_force = 0.0_dp
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (ndof /= sys%ndof .or. nfull /= sys%nfull .or. npoint /= sys%npoint) then
     info = 2
+    message = 'system_full_forces: sizes inconsistent with the system (ndof, nfull, npoint)'
     return
   end if
   allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)), reduced(ndof))
   call frame_rotations(sys, t, rotations, rates, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = failure_text(info)
+    return
+  end if
   state%guesses = guesses
   state%counts = 0
   call internal_forces(sys, rotations, e, v, load_factor, 0.0_dp, state, reduced, strain, &
                        potential, powers, records, info, rates=rates, full_out=full_force)
+  if (info /= 0) message = failure_text(info)
 end subroutine system_full_forces
 
 !> One output row (probes, deflections, energies, constraint violation, contact records)

@@ -133,11 +133,9 @@ contains
   !> completed steps; the state is that of the last completed step; last_correction is the
   !> size of the last Newton correction (why a step failed to converge).
   subroutine integrator_chunk(sys, cfg, learned, h, nsteps, t, e, v, a, accel, lam, work, &
-                              powers, state, &
-                              out_time, &
-                              out_probe, out_deflection, out_lambda, out_energy, out_constraint, &
-                              out_stats, out_contact, store_q, out_q, steps_done, info, detail, &
-                              last_correction, floor_accepts)
+                              powers, state, out_time, out_probe, out_deflection, out_lambda, &
+                              out_energy, out_constraint, out_stats, out_contact, store_q, &
+                              out_q, steps_done, info, detail, last_correction, floor_accepts)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -193,8 +191,7 @@ contains
           started_old = sys%policy /= policy_constant
         end if
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
-                    e_new, &
-                    v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
+                    e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, monitor, info, detail)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it

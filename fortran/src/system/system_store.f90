@@ -1,8 +1,8 @@
 !> The table of mechanical systems behind integer handles: Python builds a system once,
 !> piece by piece (ancf_api's system_* routines), and steps it chunk by chunk without
-!> sending its arrays again. Beside each system its stepper (stepper.f90: the run's settings
-!> and what the stepper learned), apart from the system type. Besides sparse_direct's solver table, this is the kernel's only
-!> module state.
+!> sending its arrays again. Beside each system its stepper (stepper.f90: the run's
+!> settings and what the stepper learned), apart from the system type. Besides
+!> sparse_direct's solver table, this is the kernel's only module state.
 module system_store
   use mechanical_system, only: system_model
   use stepper, only: stepper_run
