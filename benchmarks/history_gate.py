@@ -114,8 +114,9 @@ def diff(a: Path, b: Path) -> int:
     files = sorted(str(p.relative_to(a)) for p in a.rglob("*.h5"))
     for name in files:
         rc = name.replace(".h5", ".rc")
-        if not (a / rc).exists():   # an example's file: its folder's exit.rc
-            rc = str(Path(name).parent / "exit.rc")
+        parent = Path(name).parent
+        while not (a / rc).exists() and parent != Path("."):   # an example's: its exit.rc
+            rc, parent = str(parent / "exit.rc"), parent.parent
         rc_a = (a / rc).read_text().split("\n")[0]
         rc_b = (b / rc).read_text().split("\n")[0] if (b / rc).exists() else "missing"
         problems = [] if rc_a == rc_b else [f"exit {rc_a} vs {rc_b}"]

@@ -108,9 +108,12 @@ def test_advance_errors_carry_the_kernels_text():
         settings = DynamicSettings(dt=1e-3, t_end=1.0, max_newton=1)
         integrator = TimeIntegrator(model, settings)
         run = integrator.state(0.0, model.e0, v0, a0, lam0)
-        wrong = dict(run, e=np.zeros(model.ndof + 3))
+        kernel.ndof += 3    # the caller's bug: a state of another system's size
+        wrong = {k: np.zeros(model.ndof + 3) if k in ("e", "v", "a", "accel") else v
+                 for k, v in run.items()}
         with pytest.raises(SolverError, match="system_advance: sizes inconsistent"):
             kernel.advance(1, 1e-3, wrong, False)
+        kernel.ndof -= 3
         chunk, info, detail = integrator.advance(run, 1)
         assert (info, detail, len(chunk.time)) == (1, 0, 0)
         assert integrator.failure_text == "Newton did not converge within 1 iterations"

@@ -454,6 +454,8 @@ def _pad_last(a: np.ndarray, dtype=np.float64) -> np.ndarray:
 
 #: the lengths of the energies of an output row and of the works and powers of the state
 ENERGY_COUNT, POWER_COUNT = len(ENERGY_NAMES), len(POWER_NAMES)
+#: the arrays of the packed stepper state after t, in order (stepper.f90 state_size)
+_PACKED_ARRAYS = ("e", "v", "a", "accel", "lam", "work", "powers")
 
 
 def _text(message: bytes | str) -> str:
@@ -700,14 +702,30 @@ class KernelSystem:
             settings.contraction)
         self._check(info, "stepper_setup", message)
 
+    def _layout(self, store_q: bool) -> tuple[list[slice], list[slice]]:
+        """The slices of the packed state (t, e, v, a, accel, lam, work, powers, guesses) and
+        of an output row (time, probes, deflections, lam, energy, constraint, contact, q):
+        stepper.f90 ``state_size`` and ``row_size``; computed once per system and store_q."""
+        key = (self.ndof, self.ncon, self.npoint, self.nprobe, store_q)
+        if getattr(self, "_layout_key", None) != key:
+            n, nc, npt, npr = key[:4]
+
+            def cut(lengths):
+                edges = np.cumsum([0, *lengths]).tolist()
+                return [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
+            self._layouts = (cut([1, n, n, n, n, nc, POWER_COUNT, POWER_COUNT, 2 * npt]),
+                             cut([1, 3 * npr, 3 * npr, nc, ENERGY_COUNT, 1,
+                                  len(CONTACT_RECORD) * npt, n if store_q else 0]))
+            self._layout_key = key
+        return self._layouts
+
     def state_size(self) -> int:
         """The length of the packed stepper state (stepper.f90 ``state_size``)."""
-        return 1 + 4 * self.ndof + self.ncon + 2 * POWER_COUNT + 2 * self.npoint
+        return self._layout(False)[0][-1].stop
 
     def row_size(self, store_q: bool) -> int:
         """The length of one output row of :meth:`advance` (stepper.f90 ``row_size``)."""
-        return (1 + 6 * self.nprobe + self.ncon + ENERGY_COUNT + 1
-                + len(CONTACT_RECORD) * self.npoint + (self.ndof if store_q else 0))
+        return self._layout(store_q)[1][-1].stop
 
     def advance(self, nsteps: int, h: float, state: dict, store_q: bool) -> dict:
         """Advance nsteps steps of size h (time_integrator, with the run's settings of
@@ -719,40 +737,36 @@ class KernelSystem:
         step's statistics are the column after the last completed step. A refused call (a
         stale handle, no run set up, sizes inconsistent with the system) raises
         SolverError with the kernel's text."""
-        n, nc, npt, npr = self.ndof, self.ncon, self.npoint, self.nprobe
-        guesses = np.asarray(state["guesses"], dtype=np.float64)
-        packed = np.concatenate([[state["t"]], state["e"], state["v"], state["a"],
-                                 state["accel"], np.asarray(state["lam"])[:nc], state["work"],
-                                 state["powers"], guesses[:, :npt].ravel(order="F")])
+        cuts, rows_cut = self._layout(store_q)
+        npt = self.npoint
+        packed = np.empty(cuts[-1].stop)
+        packed[0] = state["t"]
+        for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
+            packed[part] = state[key]
+        if npt:
+            packed[cuts[8]] = np.asarray(state["guesses"])[:, :npt].ravel(order="F")
         packed, counts, rows, stats, status, last_correction, message = _kernel.system_advance(
-            self.handle, nsteps, h, packed, _i(state["counts"]),
-            self.row_size(store_q))
+            self.handle, nsteps, h, packed, _i(state["counts"]), rows_cut[-1].stop)
         status = [int(x) for x in status]
         if status[1] == 9:
             self._failure(9, "system_advance", message)
-        k = 1 + 4 * n + nc + 2 * POWER_COUNT
-        guesses = guesses.copy()
-        guesses[:, :npt] = packed[k:k + 2 * npt].reshape((2, npt), order="F")
-        k = 1 + 4 * n
-        state.update(t=float(packed[0]), e=packed[1:1 + n], v=packed[1 + n:1 + 2 * n],
-                     a=packed[1 + 2 * n:1 + 3 * n], accel=packed[1 + 3 * n:k],
-                     lam=packed[k:k + nc], work=packed[k + nc:k + nc + POWER_COUNT],
-                     powers=packed[k + nc + POWER_COUNT:k + nc + 2 * POWER_COUNT],
-                     guesses=guesses, counts=counts)
-        k = 1 + 6 * npr + nc
-        out = dict(time=rows[0],
-                   probes=rows[1:1 + 3 * npr].reshape((3, npr, nsteps), order="F"),
-                   deflections=rows[1 + 3 * npr:1 + 6 * npr].reshape((3, npr, nsteps),
-                                                                     order="F"),
-                   lam=rows[1 + 6 * npr:k], energy=rows[k:k + ENERGY_COUNT],
-                   constraint=rows[k + ENERGY_COUNT])
-        k += ENERGY_COUNT + 1
-        nrec = len(CONTACT_RECORD)
-        out.update(contact=rows[k:k + nrec * npt].reshape((nrec, npt, nsteps), order="F"),
-                   q=rows[k + nrec * npt:] if store_q else np.zeros((n, 1)), stats=stats,
-                   status=status, message=_text(message) if status[1] else "",
-                   last_correction=float(last_correction))
-        return out
+        state["t"] = float(packed[0])
+        for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
+            state[key] = packed[part]
+        state["counts"] = counts
+        if npt:  # (without contact the guesses are one unused column, left as they are)
+            guesses = np.array(state["guesses"], dtype=np.float64)
+            guesses[:, :npt] = packed[cuts[8]].reshape((2, npt), order="F")
+            state["guesses"] = guesses
+        time, probes, deflections, lam, energy, constraint, contact, q = rows_cut
+        return dict(time=rows[0], probes=rows[probes].reshape((3, -1, nsteps), order="F"),
+                    deflections=rows[deflections].reshape((3, -1, nsteps), order="F"),
+                    lam=rows[lam], energy=rows[energy], constraint=rows[constraint.start],
+                    contact=rows[contact].reshape((len(CONTACT_RECORD), npt, nsteps),
+                                                  order="F"),
+                    q=rows[q] if store_q else np.zeros((self.ndof, 1)), stats=stats,
+                    status=status, message=_text(message) if status[1] else "",
+                    last_correction=float(last_correction))
 
     def close(self) -> None:
         if getattr(self, "handle", 0):
