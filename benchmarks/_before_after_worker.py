@@ -125,7 +125,10 @@ def dispatch(scene_path: str, steps: int, repeats: int, overrides: list[str]) ->
             if name == "raw_calls_of_1":
                 kernel = model.kernel
                 for _ in range(calls):
-                    out = kernel.advance(1, settings, s, False)
+                    # (the settings go to the kernel once per run since issue 25)
+                    out = kernel.advance(1, settings.dt, s, False) \
+                        if hasattr(kernel, "stepper_setup") else \
+                        kernel.advance(1, settings, s, False)
                     if out["status"][1]:
                         raise RuntimeError(f"kernel step failed: {out['status']}")
             else:

@@ -8,6 +8,7 @@ import pytest
 
 from ancfdrv import _kernel, kernel
 from ancfdrv.errors import SolverError
+from ancfdrv.solvers.dynamic import DynamicSettings
 
 
 def test_stale_handle_is_named():
@@ -18,10 +19,12 @@ def test_stale_handle_is_named():
     stale = kernel.KernelSystem.__new__(kernel.KernelSystem)
     stale.handle, stale.ndof, stale.nfull, stale.npoint, stale.nnz_pattern = handle, 6, 6, 0, 0
     with pytest.raises(SolverError, match=f"handle {handle} is not a live system.*stale handle"):
-        stale.reset_stepper()
+        stale.stepper_setup(DynamicSettings(dt=1e-3, t_end=1.0))
     with pytest.raises(SolverError, match="force evaluation, kernel code 1: .*stale handle") as err:
         stale.evaluate(0.0, np.zeros(6), np.zeros(6), np.zeros((2, 1)), np.zeros(6, np.int32))
     assert "Newton" not in str(err.value) and "non-finite" not in str(err.value)
+    with pytest.raises(SolverError, match="full force evaluation, kernel code 1: .*stale handle"):
+        stale.full_forces(0.0, np.zeros(6), np.zeros(6), np.zeros((2, 1)))
     stale.handle = 0
     info, message = _kernel.system_destroy(handle)
     assert info == 1 and b"stale handle" in message

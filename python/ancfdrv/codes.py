@@ -39,18 +39,3 @@ CONTACT_COUNTERS = ("contact_points", "contact_active", "friction_evaluations",
 CONTACT_PARAMS = ("stiffness", "damping", "friction", "slip_velocity", "upper_thickness",
                   "lower_thickness", "friction_on")
 
-#: failure codes of time_integrator.integrator_chunk (status(2) of system_advance)
-STEP_FAILURES = {
-    1: "Newton did not converge within {max_newton} iterations",
-    2: "the state became non-finite (NaN or overflow)",
-    3: "the linear solve failed (solver code {detail}: -10 = singular matrix)",
-    4: "the multipliers' Schur complement is singular (dgesv info {detail}): the "
-       "constraints are redundant or lost rank",
-    5: "a constraint or drive could not be evaluated",
-    6: "a bending moment's section director became parallel to its axis",
-    7: "a plate element's mid-surface normal vanished (r_x parallel to r_y: the element "
-       "folded onto a line)",
-    8: "the contact search found no closest point on the upper surface (the projection "
-       "diverged even from the sampled restart)",
-    9: "the kernel refused the call (a stale handle or inconsistent sizes: a bug)",
-}

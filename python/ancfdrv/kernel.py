@@ -11,7 +11,8 @@ import numpy as np
 from dataclasses import dataclass
 
 from . import _kernel
-from .codes import DRIVE_TABLE, SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
+from .codes import (CONTACT_RECORD, DRIVE_TABLE, ENERGY_NAMES, POWER_NAMES, SECTION_BOX,
+                    SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE)
 from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
@@ -485,6 +486,12 @@ def _pad_last(a: np.ndarray, dtype=np.float64) -> np.ndarray:
     return np.asfortranarray(a)
 
 
+#: the lengths of the energies of an output row and of the works and powers of the state
+ENERGY_COUNT, POWER_COUNT = len(ENERGY_NAMES), len(POWER_NAMES)
+#: the arrays of the packed stepper state after t, in order (stepper.f90 state_size)
+_PACKED_ARRAYS = ("e", "v", "a", "accel", "lam", "work", "powers")
+
+
 def _text(message: bytes | str) -> str:
     """A kernel message buffer (f2py returns character(len=200) as bytes) as text."""
     if isinstance(message, bytes):
@@ -699,11 +706,11 @@ class KernelSystem:
         """Q_el - Q_c - lf Q_M at (t, e, e') in the full coordinates q (before B^T): what
         the joint reactions of eliminated linear joints are recovered from. The caller's
         contact guesses are not changed."""
-        full, info = _kernel.system_full_forces(self.handle, self.nfull, self.npoint, t, _f(e),
-                                                _f(v), load_factor, _f(np.array(guesses)),
-                                                ndof=self.ndof)
+        full, info, message = _kernel.system_full_forces(
+            self.handle, self.nfull, self.npoint, t, _f(e), _f(v), load_factor,
+            _f(np.array(guesses)), ndof=self.ndof)
         if info:
-            self._failure(info, "full force evaluation")
+            self._failure(info, "full force evaluation", message)
         return full
 
     def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
@@ -725,36 +732,84 @@ class KernelSystem:
         are named as such, not as a solver failure)."""
         raise SolverError(f"{what}, kernel code {info}: {_text(message)}")
 
-    def reset_stepper(self) -> None:
-        """Forget the stepper's state of earlier runs (contraction estimate, a matrix
-        factorized at another state): a run from a new initial state is reproducible."""
-        info, message = _kernel.system_reset_stepper(self.handle)
-        self._check(info, "reset_stepper", message)
+    def stepper_setup(self, settings) -> None:
+        """Start a run of the kernel's stepper (``fortran/src/solvers/stepper.f90``) with the
+        run's settings (a :class:`~ancfdrv.solvers.dynamic.DynamicSettings`: beta, gamma,
+        alpha_m, alpha_f, tol, length_scale, max_newton, the Jacobian policy, contraction),
+        sent once per run, not with every chunk. What the stepper learned in earlier runs
+        (contraction estimate, a matrix factorized at another state) is forgotten: a run
+        from a new initial state is reproducible."""
+        info, message = _kernel.system_stepper_setup(
+            self.handle, settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f,
+            settings.tol, settings.length_scale, settings.max_newton, settings.jacobian_code,
+            settings.contraction)
+        self._check(info, "stepper_setup", message)
 
-    def advance(self, nsteps: int, settings, state: dict, store_q: bool,
-                h: float | None = None):
-        """Advance nsteps steps of size h (default settings.dt; time_integrator) from state
-        (t, e, v, a, accel, lam, work, powers, guesses, counts; updated in place); returns
-        the raw outputs and status [steps done, info, detail, steps converged at the
-        round-off floor]; a failed step's statistics are the column after the last
-        completed step."""
-        nq = nsteps if store_q else 1
-        out = _kernel.system_advance(
-            self.handle, self.ncon, self.nprobe, self.npoint, nsteps, nq,
-            settings.dt if h is None else h,
-            settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f, settings.tol,
-            settings.length_scale, settings.max_newton, settings.jacobian_code,
-            settings.contraction, state["t"], _f(state["e"]), _f(state["v"]), _f(state["a"]),
-            _f(state["accel"]), _f(state["lam"]) if len(state["lam"]) else np.zeros(1),
-            _f(state["work"]), _f(state["powers"]), _f(state["guesses"]), _i(state["counts"]),
-            ndof=self.ndof)
-        (t, e, v, a, accel, lam, work, powers, guesses, counts, o_time, o_probe, o_defl, o_lam,
-         o_energy, o_con, o_stats, o_contact, o_q, status, last_correction) = out
-        state.update(t=float(t), e=e, v=v, a=a, accel=accel, lam=lam[:self.ncon], work=work,
-                     powers=powers, guesses=guesses, counts=counts)
-        return dict(time=o_time, probes=o_probe, deflections=o_defl, lam=o_lam, energy=o_energy,
-                    constraint=o_con, stats=o_stats, contact=o_contact, q=o_q,
-                    status=[int(s) for s in status], last_correction=float(last_correction))
+    def _layout(self, store_q: bool) -> tuple[list[slice], list[slice]]:
+        """The slices of the packed state (t, e, v, a, accel, lam, work, powers, guesses) and
+        of an output row (time, probes, deflections, lam, energy, constraint, contact, q):
+        stepper.f90 ``state_size`` and ``row_size``; computed once per system and store_q."""
+        key = (self.ndof, self.ncon, self.npoint, self.nprobe, store_q)
+        if getattr(self, "_layout_key", None) != key:
+            n, nc, npt, npr = key[:4]
+
+            def cut(lengths):
+                edges = np.cumsum([0, *lengths]).tolist()
+                return [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
+            self._layouts = (cut([1, n, n, n, n, nc, POWER_COUNT, POWER_COUNT, 2 * npt]),
+                             cut([1, 3 * npr, 3 * npr, nc, ENERGY_COUNT, 1,
+                                  len(CONTACT_RECORD) * npt, n if store_q else 0]))
+            self._layout_key = key
+        return self._layouts
+
+    def state_size(self) -> int:
+        """The length of the packed stepper state (stepper.f90 ``state_size``)."""
+        return self._layout(False)[0][-1].stop
+
+    def row_size(self, store_q: bool) -> int:
+        """The length of one output row of :meth:`advance` (stepper.f90 ``row_size``)."""
+        return self._layout(store_q)[1][-1].stop
+
+    def advance(self, nsteps: int, h: float, state: dict, store_q: bool) -> dict:
+        """Advance nsteps steps of size h (time_integrator, with the run's settings of
+        :meth:`stepper_setup`) from state (t, e, v, a, accel, lam, work, powers, guesses,
+        counts; its entries are replaced by the new state's). Returns the outputs (time,
+        probes (3, nprobe, nsteps), deflections, lam, energy, constraint, stats, contact,
+        q), status [steps done, info, detail, steps converged at the round-off floor], the
+        kernel's text of a failure (``message``) and the last Newton correction; a failed
+        step's statistics are the column after the last completed step. A refused call (a
+        stale handle, no run set up, sizes inconsistent with the system) raises
+        SolverError with the kernel's text."""
+        cuts, rows_cut = self._layout(store_q)
+        npt = self.npoint
+        packed = np.empty(cuts[-1].stop)
+        packed[0] = state["t"]
+        for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
+            packed[part] = state[key]
+        if npt:
+            packed[cuts[8]] = np.asarray(state["guesses"])[:, :npt].ravel(order="F")
+        packed, counts, rows, stats, status, last_correction, message = _kernel.system_advance(
+            self.handle, nsteps, h, packed, _i(state["counts"]), rows_cut[-1].stop)
+        status = [int(x) for x in status]
+        if status[1] == 9:
+            self._failure(9, "system_advance", message)
+        state["t"] = float(packed[0])
+        for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
+            state[key] = packed[part]
+        state["counts"] = counts
+        if npt:  # (without contact the guesses are one unused column, left as they are)
+            guesses = np.array(state["guesses"], dtype=np.float64)
+            guesses[:, :npt] = packed[cuts[8]].reshape((2, npt), order="F")
+            state["guesses"] = guesses
+        time, probes, deflections, lam, energy, constraint, contact, q = rows_cut
+        return dict(time=rows[0], probes=rows[probes].reshape((3, -1, nsteps), order="F"),
+                    deflections=rows[deflections].reshape((3, -1, nsteps), order="F"),
+                    lam=rows[lam], energy=rows[energy], constraint=rows[constraint.start],
+                    contact=rows[contact].reshape((len(CONTACT_RECORD), npt, nsteps),
+                                                  order="F"),
+                    q=rows[q] if store_q else np.zeros((self.ndof, 1)), stats=stats,
+                    status=status, message=_text(message) if status[1] else "",
+                    last_correction=float(last_correction))
 
     def close(self) -> None:
         if getattr(self, "handle", 0):

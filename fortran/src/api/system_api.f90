@@ -51,33 +51,54 @@ subroutine system_destroy(handle, info, message)
   if (info /= 0) message = handle_text(handle)
 end subroutine system_destroy
 
-!> Forgets what the stepper learned in earlier runs (the contraction estimate; a matrix
-!> factorized at another state, except the constant policy's, which depends on the step
-!> alone): a run from a new initial state then gives the same result on any handle.
-subroutine system_reset_stepper(handle, info, message)
+!> Starts a run of the stepper (stepper.f90) with its settings, set once per run: the
+!> method's beta, gamma, alpha_m, alpha_f (Newmark: alpha_m = alpha_f = 0), the Newton
+!> tolerance (max |de| <= tol * length_scale) and iteration limit, the Jacobian policy
+!> (1 per step, 2 per iteration, 3 reused across steps) and the reuse policy's contraction
+!> limit. What the stepper learned in earlier runs is forgotten (the contraction estimate;
+!> a matrix factorized at another state, except the constant policy's, which depends on the
+!> step alone): a run from a new initial state then gives the same result on any handle.
+!> info: 1 not a live handle; 2 a setting out of its range.
+subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, length_scale, &
+                                max_newton, jacobian, contraction, info, message)
+  use ancf_kinds, only: dp
   use mechanical_system, only: system_model, policy_constant
+  use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, jacobian_reuse
   use system_store, only: store_get
   use kernel_errors, only: handle_text
   implicit none
-  integer, intent(in) :: handle
+  integer, intent(in) :: handle, max_newton, jacobian
+  real(dp), intent(in) :: beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  type(stepper_run), pointer :: run
   message = ' '
-  call store_get(handle, sys, info)
+  call store_get(handle, sys, info, run)
   if (info /= 0) then
     message = handle_text(handle)
     return
   end if
-  sys%theta = -1.0d0
-  sys%unconfirmed = 0
-  sys%reuse_failures = 0
-  sys%reuse_backoff = 0
-  sys%reuse_skip = 0
-  if (allocated(sys%accel_before)) deallocate (sys%accel_before)
-  sys%predict_from_before = .false.
+  if (.not. (beta > 0.0_dp .and. gamma > 0.0_dp .and. alpha_m < 1.0_dp .and. &
+             alpha_f < 1.0_dp .and. tol > 0.0_dp .and. length_scale > 0.0_dp .and. &
+             contraction > 0.0_dp .and. contraction < 1.0_dp)) then
+    info = 2
+    message = 'system_stepper_setup: a setting out of its range (beta, gamma, tol, ' // &
+              'length_scale > 0; alpha_m, alpha_f < 1; 0 < contraction < 1)'
+    return
+  end if
+  if (max_newton < 1 .or. jacobian < jacobian_step .or. jacobian > jacobian_reuse) then
+    info = 2
+    message = 'system_stepper_setup: max_newton < 1 or a Jacobian policy outside 1..3'
+    return
+  end if
+  call stepper_start(run, stepper_settings(beta=beta, gamma=gamma, alpha_m=alpha_m, &
+                                           alpha_f=alpha_f, tol=tol, &
+                                           length_scale=length_scale, &
+                                           max_newton=max_newton, jacobian=jacobian, &
+                                           contraction=contraction))
   if (sys%policy /= policy_constant) sys%factorized = .false.
-end subroutine system_reset_stepper
+end subroutine system_stepper_setup
 
 !> Element sets: one routine per family builds the family's set (element_sets: an
 !> extension of element_set in the family's module) from plain arrays and hands it to the
@@ -848,34 +869,45 @@ end subroutine system_evaluate
 !> are recovered from them (python/ancfdrv/system/answers.py). The contact guesses and
 !> counters are used and returned unchanged in the caller's copy.
 subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor, guesses, &
-                              full_force, info)
+                              full_force, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces
   use system_store, only: store_get
+  use kernel_errors, only: handle_text, failure_text
   implicit none
   integer, intent(in) :: handle, ndof, nfull, npoint
   real(dp), intent(in) :: t, e(ndof), v(ndof), load_factor
   real(dp), intent(in) :: guesses(2, max(1, npoint))
   real(dp), intent(out) :: full_force(nfull)
   integer, intent(out) :: info
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(contact_state) :: state
   real(dp), allocatable :: rotations(:, :, :), rates(:), reduced(:)
   real(dp) :: strain, potential, powers(2), records(6, max(1, npoint))
   full_force = 0.0_dp
+  message = ' '
   call store_get(handle, sys, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
   if (ndof /= sys%ndof .or. nfull /= sys%nfull .or. npoint /= sys%npoint) then
     info = 2
+    message = 'system_full_forces: sizes inconsistent with the system (ndof, nfull, npoint)'
     return
   end if
   allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)), reduced(ndof))
   call frame_rotations(sys, t, rotations, rates, info)
-  if (info /= 0) return
+  if (info /= 0) then
+    message = failure_text(info)
+    return
+  end if
   state%guesses = guesses
   state%counts = 0
   call internal_forces(sys, rotations, e, v, load_factor, 0.0_dp, state, reduced, strain, &
                        potential, powers, records, info, rates=rates, full_out=full_force)
+  if (info /= 0) message = failure_text(info)
 end subroutine system_full_forces
 
 !> One output row (probes, deflections, energies, constraint violation, contact records)
@@ -924,40 +956,96 @@ subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, w
   if (info /= 0) message = failure_text(info)
 end subroutine system_output_row
 
-!> Advances nsteps steps of the generalized-alpha method (time_integrator), one output row
-!> per step. The state (t, e, v, a, accel, lam, work, the powers at the state, contact
-!> guesses and counters) is updated in place: calls may split a run anywhere without
-!> changing its result. status = [steps done, info, detail, steps converged at the
-!> round-off floor]; stats(:, step) = Newton corrections, factorizations, Jacobian
-!> evaluations (of a failed step too: the column after the last completed one). jacobian: 1 per step, 2 per
-!> iteration, 3 reused across steps (time_integrator).
-subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, beta, gamma, alpha_m, &
-                          alpha_f, tol, length_scale, max_newton, jacobian, contraction, t, e, v, &
-                          a, accel, lam, work, powers, guesses, counts, out_time, out_probe, &
-                          out_deflection, out_lambda, out_energy, out_constraint, out_stats, &
-                          out_contact, out_q, status, last_correction)
+!> Advances nsteps steps of size h of the generalized-alpha method (time_integrator) with
+!> the settings of the run (system_stepper_setup), one output row per step. state (packed,
+!> stepper.f90 state_size: t, e, e', a, e'', lambda, works, the powers at the state,
+!> contact guesses) and the contact counters are updated in place: calls may split a run
+!> anywhere without changing its result. rows(:, step) (stepper.f90 row_size: time,
+!> probes, deflections, lambda, energies, constraint violation, contact records, and e when
+!> nrow has room for it). stats(:, step) = Newton corrections, factorizations, Jacobian
+!> evaluations (of a failed step too: the column after the last completed one). status =
+!> [steps done, info, detail, steps converged at the round-off floor]; info: the codes of
+!> integrator_chunk (1 .. 8), 9 a refused call (not a live handle, no run set up, sizes
+!> inconsistent with the system); message: the failure's text. last_correction: the size
+!> of the last Newton correction.
+subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, stats, status, &
+                          last_correction, message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, contact_state, power_count, energy_count
-  use time_integrator, only: integrator_settings, integrator_chunk, stat_count
+  use mechanical_system, only: system_model, contact_state, power_count, energy_count, &
+                               contact_record
+  use stepper, only: stepper_run, state_size, row_size
+  use time_integrator, only: integrator_chunk, stat_count, step_failure_text
   use system_store, only: store_get
+  use kernel_errors, only: handle_text
   implicit none
-  integer, intent(in) :: handle, ndof, ncon, nprobe, npoint, nsteps, nq, max_newton, jacobian
-  real(dp), intent(in) :: h, beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
-  real(dp), intent(inout) :: t, e(ndof), v(ndof), a(ndof), accel(ndof), lam(max(1, ncon)), work(5)
-  real(dp), intent(inout) :: powers(5), guesses(2, max(1, npoint))
+  integer, intent(in) :: handle, nsteps, nstate, nrow
+  real(dp), intent(in) :: h
+  real(dp), intent(inout) :: state(nstate)
   integer, intent(inout) :: counts(6)
-  !f2py intent(in,out) :: t, e, v, a, accel, lam, work, powers, guesses, counts
-  real(dp), intent(out) :: out_time(nsteps), out_probe(3, max(1, nprobe), nsteps)
-  real(dp), intent(out) :: out_deflection(3, max(1, nprobe), nsteps)
-  real(dp), intent(out) :: out_lambda(max(1, ncon), nsteps), out_energy(11, nsteps)
-  real(dp), intent(out) :: out_constraint(nsteps), out_contact(6, max(1, npoint), nsteps)
-  real(dp), intent(out) :: out_q(ndof, nq)
-  integer, intent(out) :: out_stats(3, nsteps), status(4)
-  real(dp), intent(out) :: last_correction
+  !f2py intent(in,out) :: state, counts
+  real(dp), intent(out) :: rows(nrow, nsteps), last_correction
+  integer, intent(out) :: stats(3, nsteps), status(4)
+  character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(integrator_settings) :: cfg
-  type(contact_state) :: state
-  integer :: info
+  type(stepper_run), pointer :: run
+  type(contact_state) :: contact
+  real(dp), allocatable :: e(:), v(:), a(:), accel(:), lam(:), out_time(:), out_probe(:, :, :)
+  real(dp), allocatable :: out_deflection(:, :, :), out_lambda(:, :), out_energy(:, :)
+  real(dp), allocatable :: out_constraint(:), out_contact(:, :, :), out_q(:, :)
+  real(dp) :: t, work(power_count), powers(power_count)
+  integer :: info, ndof, ncon, nprobe, npoint, step, k
+  logical :: store_q
+  rows = 0.0_dp
+  stats = 0
+  status = 0
+  last_correction = 0.0_dp
+  message = ' '
+  call store_get(handle, sys, info, run)
+  if (info /= 0) then
+    status(2) = 9
+    message = handle_text(handle)
+    return
+  end if
+  if (.not. run%ready) then
+    status(2) = 9
+    message = 'system_advance: no run set up (call system_stepper_setup first)'
+    return
+  end if
+  ndof = sys%ndof
+  ncon = sys%ncon
+  nprobe = sys%nprobe
+  npoint = sys%npoint
+  store_q = nrow == row_size(ndof, ncon, nprobe, npoint, .true.)
+  if (nstate /= state_size(ndof, ncon, npoint) .or. (.not. store_q .and. &
+      nrow /= row_size(ndof, ncon, nprobe, npoint, .false.)) .or. nsteps < 1 .or. &
+      .not. h > 0.0_dp .or. power_count /= 5 .or. stat_count /= 3) then
+    status(2) = 9
+    message = 'system_advance: sizes inconsistent with the system (the packed state or ' // &
+              'row length, nsteps < 1) or a step h <= 0'
+    return
+  end if
+  ! the packed state (stepper.f90 state_size)
+  t = state(1)
+  k = 1
+  e = state(k + 1:k + ndof)
+  k = k + ndof
+  v = state(k + 1:k + ndof)
+  k = k + ndof
+  a = state(k + 1:k + ndof)
+  k = k + ndof
+  accel = state(k + 1:k + ndof)
+  k = k + ndof
+  lam = state(k + 1:k + ncon)
+  k = k + ncon
+  work = state(k + 1:k + power_count)
+  k = k + power_count
+  powers = state(k + 1:k + power_count)
+  k = k + power_count
+  contact%guesses = reshape(state(k + 1:k + 2 * npoint), [2, npoint])
+  contact%counts = counts
+  allocate (out_time(nsteps), out_probe(3, nprobe, nsteps), out_deflection(3, nprobe, nsteps), &
+            out_lambda(ncon, nsteps), out_energy(energy_count, nsteps), out_constraint(nsteps), &
+            out_contact(contact_record, npoint, nsteps), out_q(ndof, merge(nsteps, 0, store_q)))
   out_time = 0.0_dp
   out_probe = 0.0_dp
   out_deflection = 0.0_dp
@@ -966,37 +1054,30 @@ subroutine system_advance(handle, ndof, ncon, nprobe, npoint, nsteps, nq, h, bet
   out_constraint = 0.0_dp
   out_contact = 0.0_dp
   out_q = 0.0_dp
-  out_stats = 0
-  last_correction = 0.0_dp
-  status = 0
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    status(2) = 9
-    return
-  end if
-  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. nprobe /= sys%nprobe .or. &
-      npoint /= sys%npoint .or. power_count /= 5 .or. energy_count /= 11 .or. stat_count /= 3) then
-    status(2) = 9
-    return
-  end if
-  cfg%h = h
-  cfg%beta = beta
-  cfg%gamma = gamma
-  cfg%alpha_m = alpha_m
-  cfg%alpha_f = alpha_f
-  cfg%tol = tol
-  cfg%length_scale = length_scale
-  cfg%max_newton = max_newton
-  cfg%jacobian = jacobian
-  cfg%contraction = contraction
-  state%guesses = guesses
-  state%counts = counts
-  call integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam(1:ncon), work, powers, state, &
-                        out_time, &
-                        out_probe(:, 1:nprobe, :), out_deflection(:, 1:nprobe, :), &
-                        out_lambda(1:ncon, :), out_energy, out_constraint, out_stats, &
-                        out_contact(:, 1:npoint, :), nq == nsteps, out_q, status(1), status(2), &
-                        status(3), last_correction, status(4))
-  guesses = state%guesses
-  counts = state%counts
+  call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, work, &
+                        powers, contact, out_time, out_probe, out_deflection, out_lambda, &
+                        out_energy, out_constraint, stats, out_contact, store_q, out_q, &
+                        status(1), status(2), status(3), last_correction, status(4))
+  if (status(2) /= 0) message = step_failure_text(status(2), status(3), run%settings%max_newton)
+  state = [t, e, v, a, accel, lam, work, powers, reshape(contact%guesses, [2 * npoint])]
+  counts = contact%counts
+  ! the output rows (stepper.f90 row_size)
+  do step = 1, nsteps
+    rows(1, step) = out_time(step)
+    k = 1
+    rows(k + 1:k + 3 * nprobe, step) = reshape(out_probe(:, :, step), [3 * nprobe])
+    k = k + 3 * nprobe
+    rows(k + 1:k + 3 * nprobe, step) = reshape(out_deflection(:, :, step), [3 * nprobe])
+    k = k + 3 * nprobe
+    rows(k + 1:k + ncon, step) = out_lambda(:, step)
+    k = k + ncon
+    rows(k + 1:k + energy_count, step) = out_energy(:, step)
+    k = k + energy_count
+    rows(k + 1, step) = out_constraint(step)
+    k = k + 1
+    rows(k + 1:k + contact_record * npoint, step) = reshape(out_contact(:, :, step), &
+                                                            [contact_record * npoint])
+    k = k + contact_record * npoint
+    if (store_q) rows(k + 1:k + ndof, step) = out_q(:, step)
+  end do
 end subroutine system_advance

@@ -14,7 +14,12 @@
 !> out of S; the residual is exact. A correction with max |de| <= tol * length_scale ends
 !> the step.
 !>
-!> When S is factorized (the Jacobian policy of integrator_settings):
+!> The run's settings and what the stepper learns from step to step (contraction estimate,
+!> reuse back-off, predictor) live apart from the system, in stepper.f90's stepper_run; the
+!> system keeps its iteration matrix (the factorization, its beta' and active contact
+!> points) and answers the stepper's one contact question, contact_step_limit.
+!>
+!> When S is factorized (the Jacobian policy of the stepper's settings):
 !> * the system's policy 'constant' (pure FFR in prescribed frames): once, in the solver
 !>   frame, for the whole run (every 3 x 3 block of M is a scalar times I3, so
 !>   beta' M + T K0 T^T = T (beta' M + K0) T^T for any frame rotation);
@@ -46,16 +51,14 @@ module time_integrator
                                internal_forces, external_forces, evaluate_constraints, &
                                constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
                                frame_gradients, energies, probe_output, policy_constant, &
-                               power_count, energy_count
-  use leaf_contact, only: contact_record, cp_upper_thickness, cp_lower_thickness
+                               power_count, energy_count, contact_record, contact_step_limit
+  use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
+                     jacobian_reuse, update_reuse_backoff
+  use kernel_errors, only: failure_text, message_length
   use sparse_direct, only: solver_solve
   implicit none
   private
-  public :: integrator_settings, integrator_chunk, output_row
-
-  integer, parameter, public :: jacobian_step = 1, jacobian_iteration = 2, jacobian_reuse = 3
-  !> the most steps jacobian_reuse starts with a fresh matrix before trying an old one again
-  integer, parameter :: max_reuse_backoff = 64
+  public :: integrator_chunk, output_row, step_failure_text
   !> per-step statistics: Newton corrections, factorizations, Jacobian evaluations
   integer, parameter, public :: stat_corrections = 1, stat_factorizations = 2, &
                                 stat_jacobians = 3, stat_count = 3
@@ -82,14 +85,6 @@ module time_integrator
     integer :: outcome = newton_limit    ! why the iteration ended unconverged
     logical :: at_floor = .false.        ! converged at the round-off floor (counted)
   end type newton_monitor
-
-  type :: integrator_settings
-    real(dp) :: h, beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
-    real(dp) :: tol = 1e-10_dp, length_scale = 1.0_dp
-    integer :: max_newton = 10
-    integer :: jacobian = jacobian_step
-    real(dp) :: contraction = 0.25_dp
-  end type integrator_settings
 
 contains
 
@@ -127,7 +122,8 @@ contains
     call constraint_reaction(sys, gradients, lam, r)
   end subroutine residual
 
-  !> Advances nsteps steps from (t, e, e' = v, a, e'' = accel, lambda), writing one output
+  !> Advances nsteps steps of size h from (t, e, e' = v, a, e'' = accel, lambda) with the
+  !> run's settings cfg and the learned state of the run's earlier steps, writing one output
   !> row per step; a is the generalized-alpha acceleration-like variable (= e'' for
   !> Newmark). work(power_count) accumulates the works of the drives, the moving frames,
   !> contact damping and friction. info: 0 ok; 1 Newton did not converge; 2 non-finite
@@ -136,13 +132,14 @@ contains
   !> plate element's normal vanished; 8 contact search failed. steps_done counts the
   !> completed steps; the state is that of the last completed step; last_correction is the
   !> size of the last Newton correction (why a step failed to converge).
-  subroutine integrator_chunk(sys, cfg, nsteps, t, e, v, a, accel, lam, work, powers, state, &
-                              out_time, &
-                              out_probe, out_deflection, out_lambda, out_energy, out_constraint, &
-                              out_stats, out_contact, store_q, out_q, steps_done, info, detail, &
-                              last_correction, floor_accepts)
+  subroutine integrator_chunk(sys, cfg, learned, h, nsteps, t, e, v, a, accel, lam, work, &
+                              powers, state, out_time, out_probe, out_deflection, out_lambda, &
+                              out_energy, out_constraint, out_stats, out_contact, store_q, &
+                              out_q, steps_done, info, detail, last_correction, floor_accepts)
     type(system_model), intent(inout) :: sys
-    type(integrator_settings), intent(in) :: cfg
+    type(stepper_settings), intent(in) :: cfg
+    type(stepper_state), intent(inout) :: learned
+    real(dp), intent(in) :: h
     integer, intent(in) :: nsteps
     real(dp), intent(inout) :: t, e(:), v(:), a(:), accel(:), lam(:), work(power_count)
     real(dp), intent(inout) :: powers(power_count)  ! the powers at the current state
@@ -161,7 +158,7 @@ contains
     real(dp) :: lam_new(sys%ncon), predicted_internal(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
-    real(dp) :: contact_potential, h, beta_prime, velocity_factor
+    real(dp) :: contact_potential, beta_prime, velocity_factor
     integer :: step, attempt, stats(stat_count)
     logical :: done, fresh_matrix, start_fresh, started_old
     info = 0
@@ -170,24 +167,22 @@ contains
     last_correction = 0.0_dp
     floor_accepts = 0
     out_stats = 0
-    h = cfg%h
     beta_prime = (1.0_dp - cfg%alpha_m) / (cfg%beta * h * h * (1.0_dp - cfg%alpha_f))
     velocity_factor = cfg%gamma / (cfg%beta * h)
     do step = 1, nsteps
       stats = 0
       call frame_rotations(sys, t + h, rotations, rates, info)
       if (info /= 0) return
-      start_fresh = sys%reuse_skip > 0
-      if (start_fresh) sys%reuse_skip = sys%reuse_skip - 1
+      start_fresh = learned%reuse_skip > 0
+      if (start_fresh) learned%reuse_skip = learned%reuse_skip - 1
       started_old = .false.
       do attempt = 1, 2
-        call predict(sys, cfg, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
+        call predict(sys, cfg, learned, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
         lam_new = lam
         fresh_matrix = .false.
         if (needs_factorization(sys, cfg, beta_prime, attempt) .or. start_fresh) then
-          call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                           predicted_internal, strain, sys%factor_active, info, detail, rates, &
-                           t + h)
+          call factorize(sys, learned, beta_prime, velocity_factor, rotations, e_new, v_new, &
+                         state, predicted_internal, strain, info, detail, rates, t + h)
           if (info /= 0) return
           stats(stat_factorizations) = stats(stat_factorizations) + 1
           stats(stat_jacobians) = stats(stat_jacobians) + 1
@@ -195,8 +190,8 @@ contains
         else if (attempt == 1) then
           started_old = sys%policy /= policy_constant
         end if
-        call newton(sys, cfg, t + h, rotations, rates, beta_prime, velocity_factor, e_new, &
-                    v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
+        call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
+                    e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, monitor, info, detail)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
@@ -212,7 +207,7 @@ contains
         return
       end if
       if (monitor%at_floor) floor_accepts = floor_accepts + 1
-      if (started_old) call update_reuse_backoff(sys, stats(stat_factorizations) > 0)
+      if (started_old) call update_reuse_backoff(learned, stats(stat_factorizations) > 0)
       ! accept the step
       a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
               / (1.0_dp - cfg%alpha_m)
@@ -222,13 +217,13 @@ contains
       ! the predictor of the next step: the one of e''_n and e''_{n-1} nearer e''_{n+1}
       ! (refactorized systems without contact only: the others never use it)
       if (sys%npoint == 0 .and. sys%policy /= policy_constant) then
-        if (allocated(sys%accel_before)) then
-          sys%predict_from_before = &
-            maxval(abs(accel_new - sys%accel_before)) < maxval(abs(accel_new - accel))
+        if (allocated(learned%accel_before)) then
+          learned%predict_from_before = &
+            maxval(abs(accel_new - learned%accel_before)) < maxval(abs(accel_new - accel))
         else
-          allocate (sys%accel_before(sys%ndof))
+          allocate (learned%accel_before(sys%ndof))
         end if
-        sys%accel_before = accel
+        learned%accel_before = accel
       end if
       accel = accel_new
       lam = lam_new
@@ -251,14 +246,15 @@ contains
 
   !> The predictor: e''_{n+1} = e''_n (or e''_{n-1}, see the module's notes); with penalty
   !> contact e_{n+1} = e_n.
-  pure subroutine predict(sys, cfg, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
+  pure subroutine predict(sys, cfg, learned, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
     type(system_model), intent(in) :: sys
-    type(integrator_settings), intent(in) :: cfg
+    type(stepper_settings), intent(in) :: cfg
+    type(stepper_state), intent(in) :: learned
     real(dp), intent(in) :: h, e(:), v(:), a(:), accel(:)
     real(dp), intent(out) :: e_new(:), v_new(:), a_new(:), accel_new(:)
     if (sys%npoint == 0) then
-      if (sys%predict_from_before) then
-        accel_new = sys%accel_before
+      if (learned%predict_from_before) then
+        accel_new = learned%accel_before
       else
         accel_new = accel
       end if
@@ -266,7 +262,7 @@ contains
               / (1.0_dp - cfg%alpha_m)
       e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
     else
-      if (maxval(abs(h * v)) <= contact_step_cap(sys)) then
+      if (maxval(abs(h * v)) <= contact_step_limit(sys)) then
         e_new = e + h * v
         a_new = -((0.5_dp - cfg%beta) * a) / cfg%beta
       else
@@ -279,27 +275,30 @@ contains
     v_new = v + h * ((1.0_dp - cfg%gamma) * a + cfg%gamma * a_new)
   end subroutine predict
 
-  !> jacobian_reuse's back-off after a step that started with a matrix of an earlier step:
-  !> refreshed, it had to refresh that matrix (or retry with a fresh one).
-  pure subroutine update_reuse_backoff(sys, refreshed)
+  !> refactorize (mechanical_system) at (e, e'), the factorization's active contact points
+  !> kept by the system; a new factorization (even one whose flexibility solve then failed)
+  !> has its contraction rate still to measure.
+  subroutine factorize(sys, learned, beta_prime, velocity_factor, rotations, e, v, state, &
+                       force, strain, info, detail, rates, t)
     type(system_model), intent(inout) :: sys
-    logical, intent(in) :: refreshed
-    if (refreshed) then
-      sys%reuse_failures = sys%reuse_failures + 1
-      if (sys%reuse_failures >= 2) then
-        sys%reuse_backoff = min(max(1, 2 * sys%reuse_backoff), max_reuse_backoff)
-        sys%reuse_skip = sys%reuse_backoff
-      end if
-    else
-      sys%reuse_failures = 0
-      sys%reuse_backoff = sys%reuse_backoff / 2
+    type(stepper_state), intent(inout) :: learned
+    real(dp), intent(in) :: beta_prime, velocity_factor, rotations(:, :, 0:), e(:), v(:)
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: force(:), strain
+    integer, intent(out) :: info, detail
+    real(dp), intent(in) :: rates(0:), t
+    call refactorize(sys, beta_prime, velocity_factor, rotations, e, v, state, force, strain, &
+                     sys%factor_active, info, detail, rates, t)
+    if (info == 0 .or. (info == 3 .and. sys%factorized)) then
+      learned%theta = -1.0_dp
+      learned%unconfirmed = 0
     end if
-  end subroutine update_reuse_backoff
+  end subroutine factorize
 
   !> Whether the step starts with a new factorization.
   pure logical function needs_factorization(sys, cfg, beta_prime, attempt)
     type(system_model), intent(in) :: sys
-    type(integrator_settings), intent(in) :: cfg
+    type(stepper_settings), intent(in) :: cfg
     real(dp), intent(in) :: beta_prime
     integer, intent(in) :: attempt
     needs_factorization = .not. sys%factorized .or. sys%factor_beta_prime /= beta_prime
@@ -309,11 +308,12 @@ contains
 
   !> Newton iterations of one step from the predicted state (updated in place). done: the
   !> last correction met the tolerance.
-  subroutine newton(sys, cfg, t_new, rotations, rates, beta_prime, velocity_factor, e_new, v_new, &
-                    accel_new, lam_new, state, predicted_internal, fresh_matrix, &
+  subroutine newton(sys, cfg, learned, t_new, rotations, rates, beta_prime, velocity_factor, &
+                    e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, monitor, info, detail)
     type(system_model), intent(inout) :: sys
-    type(integrator_settings), intent(in) :: cfg
+    type(stepper_settings), intent(in) :: cfg
+    type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: t_new, rotations(:, :, 0:), rates(0:), beta_prime, velocity_factor
     real(dp), intent(inout) :: e_new(:), v_new(:), accel_new(:), lam_new(:)
     type(contact_state), intent(inout) :: state
@@ -387,7 +387,7 @@ contains
         ! damped Newton with contact: no correction moves a coordinate by more than half a
         ! leaf thickness (a contact that is open at the linearization point has no stiffness
         ! there, and a full step would jump far through the other leaf)
-        step_cap = contact_step_cap(sys)
+        step_cap = contact_step_limit(sys)
         if (maxval(abs(correction)) > step_cap) then
           capped = .true.
           dlam = dlam * (step_cap / maxval(abs(correction)))
@@ -404,7 +404,7 @@ contains
         return
       end if
       last_correction = maxval(abs(correction))
-      if (converged(sys, cfg, it, last_correction, previous_correction, step_theta)) then
+      if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -451,9 +451,8 @@ contains
   contains
 
     subroutine refresh_matrix()
-      call refactorize(sys, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
-                       predicted_internal, strain, sys%factor_active, info, detail, rates, &
-                       t_new)
+      call factorize(sys, learned, beta_prime, velocity_factor, rotations, e_new, v_new, state, &
+                     predicted_internal, strain, info, detail, rates, t_new)
       if (info /= 0) return
       stats(stat_factorizations) = stats(stat_factorizations) + 1
       stats(stat_jacobians) = stats(stat_jacobians) + 1
@@ -473,7 +472,7 @@ contains
   !>   the smallest, or one correction larger than the length scale (newton_diverged).
   pure subroutine stagnated(monitor, cfg, it, last, previous, coordinate_size, halt)
     type(newton_monitor), intent(inout) :: monitor
-    type(integrator_settings), intent(in) :: cfg
+    type(stepper_settings), intent(in) :: cfg
     integer, intent(in) :: it
     real(dp), intent(in) :: last, previous, coordinate_size
     logical, intent(out) :: halt
@@ -507,18 +506,6 @@ contains
     end if
   end subroutine stagnated
 
-  !> Half the thinnest leaf of any contact pair: no Newton correction moves a coordinate
-  !> further.
-  pure real(dp) function contact_step_cap(sys) result(cap)
-    type(system_model), intent(in) :: sys
-    integer :: pair
-    cap = huge(1.0_dp)
-    do pair = 1, size(sys%pairs)
-      cap = min(cap, 0.5_dp * sys%pairs(pair)%params(cp_upper_thickness), &
-                0.5_dp * sys%pairs(pair)%params(cp_lower_thickness))
-    end do
-  end function contact_step_cap
-
   !> Whether the Newton iteration of a step has converged after correction it of size
   !> last (the one before: previous). jacobian_step and _iteration: last <= tol L. The
   !> simplified Newton of the policy constant and of jacobian_reuse (Hairer & Wanner's
@@ -527,9 +514,10 @@ contains
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
   !> it every confirm_every accepted steps; reuse measures it in every step (the matrix ages).
-  logical function converged(sys, cfg, it, last, previous, step_theta) result(ok)
-    type(system_model), intent(inout) :: sys
-    type(integrator_settings), intent(in) :: cfg
+  logical function converged(sys, cfg, learned, it, last, previous, step_theta) result(ok)
+    type(system_model), intent(in) :: sys
+    type(stepper_settings), intent(in) :: cfg
+    type(stepper_state), intent(inout) :: learned
     integer, intent(in) :: it
     real(dp), intent(in) :: last, previous
     real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
@@ -540,19 +528,19 @@ contains
     if (sys%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
     if (it == 1) then
       ! (reuse: the matrix ages, its contraction with it: measured in every step)
-      if (ok .or. sys%theta < 0.0_dp .or. sys%unconfirmed >= confirm_every .or. &
+      if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every .or. &
           sys%policy /= policy_constant) then
-        if (ok) sys%unconfirmed = sys%unconfirmed + 1
+        if (ok) learned%unconfirmed = learned%unconfirmed + 1
         return
       end if
-      theta = min(0.9_dp, 2.0_dp * sys%theta)
+      theta = min(0.9_dp, 2.0_dp * learned%theta)
       ok = theta / (1.0_dp - theta) * last <= limit
-      if (ok) sys%unconfirmed = sys%unconfirmed + 1
+      if (ok) learned%unconfirmed = learned%unconfirmed + 1
       return
     end if
     theta = last / previous
-    sys%theta = theta
-    sys%unconfirmed = 0
+    learned%theta = theta
+    learned%unconfirmed = 0
     ! the largest contraction of the step: a contact point that moves, sticks or slips
     ! makes the corrections fall irregularly, and a small ratio after a large one is no
     ! evidence that the next would be as small
@@ -586,5 +574,38 @@ contains
     call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, probe, deflection, &
                       energy, info)
   end subroutine output_row
+
+  !> The text of a failure of integrator_chunk (info, with its detail; max_newton: the
+  !> iteration limit of the run) for the message of system_advance.
+  pure function step_failure_text(info, detail, max_newton) result(text)
+    integer, intent(in) :: info, detail, max_newton
+    character(len=message_length) :: text
+    select case (info)
+    case (1)
+      select case (detail)
+      case (newton_floor_stall)
+        text = 'Newton stalled at the round-off floor (the corrections stopped falling at ' // &
+               'the size double precision resolves, above a tolerance below it)'
+      case (newton_stall)
+        text = 'Newton stalled (four corrections in a row set no new minimum, above the ' // &
+               'round-off floor)'
+      case (newton_diverged)
+        text = 'Newton diverged (the corrections grew three times in a row, or one ' // &
+               'exceeded the length scale)'
+      case default
+        write (text, '(a, i0, a)') 'Newton did not converge within ', max_newton, ' iterations'
+      end select
+    case (2)
+      text = 'the state became non-finite (NaN or overflow)'
+    case (3)
+      write (text, '(a, i0, a)') 'the linear solve failed (solver code ', detail, &
+        ': -10 = singular matrix)'
+    case (4)
+      write (text, '(a, i0, a)') "the multipliers' Schur complement is singular (dgesv info ", &
+        detail, '): the constraints are redundant or lost rank'
+    case default
+      text = failure_text(info)
+    end select
+  end function step_failure_text
 
 end module time_integrator

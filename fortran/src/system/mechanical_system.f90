@@ -35,7 +35,8 @@ module mechanical_system
   use element_sets, only: element_set, set_slot, frame_omega
   use section_moment, only: moment_force, moment_angle
   use vector_loads, only: vector_load_force
-  use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record
+  use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
+                          cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
   implicit none
   private
@@ -45,6 +46,8 @@ module mechanical_system
             evaluate_constraints, constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set, &
             tangent_frame_rates, damped_sets
+  ! what the stepper asks of the system's contact (it uses no contact module itself)
+  public :: contact_record, contact_step_limit
 
   integer, parameter, public :: policy_constant = 0, policy_refactor = 1
   !> energy(:) layout of an output row
@@ -133,19 +136,7 @@ module mechanical_system
     logical :: factorized = .false.
     real(dp) :: factor_beta_prime = 0.0_dp
     integer :: factor_active = -1                      ! active contact points at it
-    ! the simplified-Newton contraction rate measured with it (-1: not yet) and the steps
-    ! accepted since without measuring it again
-    real(dp) :: theta = -1.0_dp
-    integer :: unconfirmed = 0
-    ! jacobian_reuse back-off: steps that started with a matrix of an earlier step and had
-    ! to refresh it (in a row), the current back-off and the steps still to start with a
-    ! fresh matrix
-    integer :: reuse_failures = 0, reuse_backoff = 0, reuse_skip = 0
-    ! the stepper's predictor of refactorized systems without contact: e'' of the step
-    ! before the last (allocated once a step is done) and whether it predicted the last
-    ! step better than e''_n did
-    real(dp), allocatable :: accel_before(:)
-    logical :: predict_from_before = .false.
+    ! (what the stepper learns from step to step lives apart: stepper.f90)
     real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
   end type system_model
 
@@ -771,8 +762,6 @@ contains
     end if
     sys%factorized = .true.
     sys%factor_beta_prime = beta_prime
-    sys%theta = -1.0_dp
-    sys%unconfirmed = 0
     if (size(sys%block_first) == 0) return
     sys%flexibility = 0.0_dp
     do b = 1, size(sys%block_first)
@@ -902,5 +891,20 @@ contains
     energy(work_friction) = work(power_friction)
     energy(work_material_damping) = work(power_material_damping)
   end subroutine probe_output
+
+  !> The contact step limit: half the thinnest leaf of any contact pair (huge without
+  !> contact). No Newton correction of the stepper moves a coordinate further (a contact
+  !> open at the linearization point has no stiffness there, and a full step would jump far
+  !> through the other leaf), and the predictor of a contact system moves on at constant
+  !> velocity only while no coordinate moves further in the step.
+  pure real(dp) function contact_step_limit(sys) result(limit)
+    type(system_model), intent(in) :: sys
+    integer :: pair
+    limit = huge(1.0_dp)
+    do pair = 1, size(sys%pairs)
+      limit = min(limit, 0.5_dp * sys%pairs(pair)%params(cp_upper_thickness), &
+                  0.5_dp * sys%pairs(pair)%params(cp_lower_thickness))
+    end do
+  end function contact_step_limit
 
 end module mechanical_system

@@ -1,9 +1,11 @@
 !> The table of mechanical systems behind integer handles: Python builds a system once,
 !> piece by piece (ancf_api's system_* routines), and steps it chunk by chunk without
-!> sending its arrays again. Besides sparse_direct's solver table, this is the kernel's only
-!> module state.
+!> sending its arrays again. Beside each system its stepper (stepper.f90: the run's
+!> settings and what the stepper learned), apart from the system type. Besides
+!> sparse_direct's solver table, this is the kernel's only module state.
 module system_store
   use mechanical_system, only: system_model
+  use stepper, only: stepper_run
   implicit none
   private
   public :: store_create, store_destroy, store_get
@@ -12,6 +14,7 @@ module system_store
 
   type :: system_slot
     type(system_model) :: model
+    type(stepper_run) :: stepper
     logical :: in_use = .false.
   end type system_slot
 
@@ -29,6 +32,7 @@ contains
       if (.not. slots(h)%in_use) then
         slots(h)%in_use = .true.
         slots(h)%model = system_model()
+        slots(h)%stepper = stepper_run()
         handle = h
         info = 0
         return
@@ -44,20 +48,25 @@ contains
     if (handle < 1 .or. handle > max_systems) return
     if (.not. slots(handle)%in_use) return
     slots(handle)%model = system_model()
+    slots(handle)%stepper = stepper_run()
     slots(handle)%in_use = .false.
     info = 0
   end subroutine store_destroy
 
-  !> The system behind a handle. info = 1: not a live handle (model then unassociated).
-  subroutine store_get(handle, model, info)
+  !> The system behind a handle, and on request its stepper. info = 1: not a live handle
+  !> (model and run then unassociated).
+  subroutine store_get(handle, model, info, run)
     integer, intent(in) :: handle
     type(system_model), pointer, intent(out) :: model
     integer, intent(out) :: info
+    type(stepper_run), pointer, intent(out), optional :: run
     model => null()
+    if (present(run)) run => null()
     info = 1
     if (handle < 1 .or. handle > max_systems) return
     if (.not. slots(handle)%in_use) return
     model => slots(handle)%model
+    if (present(run)) run => slots(handle)%stepper
     info = 0
   end subroutine store_get
 

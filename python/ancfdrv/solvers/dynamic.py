@@ -43,7 +43,7 @@ import scipy.sparse as sp
 from tqdm import tqdm
 
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
-                     JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES, STEP_FAILURES)
+                     JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES)
 from ..errors import Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver
@@ -61,8 +61,10 @@ class DynamicSettings:
     """Integrator settings (``&solver`` and ``&output`` of a scene). Newmark is
     alpha_m = alpha_f = 0; :meth:`generalized_alpha` sets all four from rho_inf.
     ``jacobian``: when a refactorized model's iteration matrix is refreshed ('step',
-    'iteration', 'reuse'); ``contraction``: the reuse policy's limit on the ratio of
-    successive corrections."""
+    'iteration', 'reuse'; default 'reuse', the default of scenes and of ``ancf run``);
+    ``contraction``: the reuse policy's limit on the ratio of successive corrections. The
+    kernel's stepper takes these settings once per run (:meth:`TimeIntegrator.state`);
+    change them between runs, not between chunks."""
 
     dt: float
     t_end: float
@@ -74,7 +76,7 @@ class DynamicSettings:
     max_newton: int = 10
     chunk_steps: int = 1000
     store_q: bool = False
-    jacobian: str = "step"
+    jacobian: str = "reuse"
     contraction: float = 0.25
     length_scale: float = 1.0
     #: the smallest step a failed step may be cut to (0: dt / 1024)
@@ -198,12 +200,14 @@ class TimeIntegrator:
         self.last_correction = 0.0
         self.floor_accepts = 0   # steps converged at the round-off floor (all calls)
         self.failed_stats = np.zeros(3, dtype=np.int64)  # the last failed step's work
+        self.failure_text = ""   # the kernel's text of the last failed step
 
     def state(self, t: float, e: np.ndarray, v: np.ndarray, a: np.ndarray,
               lam: np.ndarray) -> dict:
-        """A stepper state at t with q'' = a (the generalized-alpha variable starts at a);
-        the kernel forgets what it learned in earlier runs, so runs are reproducible."""
-        self.model.kernel.reset_stepper()
+        """A stepper state at t with q'' = a (the generalized-alpha variable starts at a):
+        the start of a run. The kernel's stepper gets the run's settings and forgets what it
+        learned in earlier runs, so runs are reproducible."""
+        self.model.kernel.stepper_setup(self.settings)
         return dict(t=t, e=e.copy(), v=v.copy(), a=a.copy(), accel=a.copy(), lam=lam.copy(),
                     work=np.zeros(5), powers=np.zeros(5),
                     guesses=self.model.contact_guesses.copy(),
@@ -215,8 +219,9 @@ class TimeIntegrator:
         Returns the chunk of completed steps, the kernel's info and detail codes (a failed
         step's statistics go to ``failed_stats``)."""
         s, m = self.settings, self.model
-        out = m.kernel.advance(nsteps, s, state, s.store_q, h)
+        out = m.kernel.advance(nsteps, s.dt if h is None else h, state, s.store_q)
         done, info, detail, floor = out["status"]
+        self.failure_text = out["message"]
         self.floor_accepts += floor
         self.failed_stats = out["stats"][:, done].astype(np.int64) if info and done < nsteps \
             else np.zeros(3, dtype=np.int64)
@@ -236,10 +241,10 @@ class TimeIntegrator:
                         cuts: int = 0) -> str:
         s = self.settings
         h = s.dt if h is None else h
-        reason = STEP_FAILURES.get(info, f"kernel code {info}").format(max_newton=s.max_newton,
-                                                                       detail=detail)
+        # what failed, in the kernel's words (time_integrator step_failure_text); the
+        # scene keys that help, here
+        reason = self.failure_text or f"kernel code {info} (detail {detail})"
         if info == 1:
-            reason = NEWTON_OUTCOMES.get(detail, reason).format(max_newton=s.max_newton)
             reason += (f" (last correction {self.last_correction:.3e} m, tolerance "
                        f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length")
             if detail == NEWTON_FLOOR_STALL:
@@ -254,18 +259,9 @@ class TimeIntegrator:
         return f"time step from t = {t:.6g} s to t = {t + h:.6g} s failed: {reason}"
 
 
-#: why a step's Newton iteration ended unconverged (time_integrator's newton_* codes)
+#: why a step's Newton iteration ended unconverged (time_integrator's newton_* codes; the
+#: kernel's message says it in words)
 NEWTON_LIMIT, NEWTON_FLOOR_STALL, NEWTON_STALL, NEWTON_DIVERGED = 0, 1, 2, 3
-NEWTON_OUTCOMES = {
-    NEWTON_LIMIT: "Newton did not converge within {max_newton} iterations",
-    NEWTON_FLOOR_STALL: "Newton stalled at the round-off floor (the corrections stopped "
-                        "falling at the size double precision resolves, above a tolerance "
-                        "below it)",
-    NEWTON_STALL: "Newton stalled (four corrections in a row set no new minimum, above the "
-                  "round-off floor)",
-    NEWTON_DIVERGED: "Newton diverged (the corrections grew three times in a row, or one "
-                     "exceeded the length scale)",
-}
 #: kernel failures a smaller step may avoid (not: a constraint or drive that cannot be
 #: evaluated, a refused call)
 RETRYABLE = {1, 2, 3, 4, 6, 7, 8}

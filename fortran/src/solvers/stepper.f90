@@ -1,0 +1,111 @@
+!> The stepper's own data, apart from the mechanical system it steps (issue 25): the
+!> settings of a run (set once per run through system_stepper_setup, not re-sent with every
+!> chunk) and what the stepper learns from step to step (the contraction estimate of the
+!> simplified Newton, the back-off of jacobian_reuse, the predictor's choice). The system
+!> (mechanical_system) keeps what belongs to the model and its iteration matrix (the
+!> factorization, its beta' and its active contact points); a new stepper policy edits
+!> this module and time_integrator, not the system type. system_store holds one
+!> stepper_run beside each system; time_integrator reads and updates it.
+!>
+!> The packed arrays of system_advance (one state vector in and out, one output row per
+!> step) are laid out here, in one place: state_size, row_size and the offsets below.
+module stepper
+  use ancf_kinds, only: dp
+  use mechanical_system, only: power_count, energy_count, contact_record
+  implicit none
+  private
+  public :: stepper_settings, stepper_state, stepper_run, stepper_start, update_reuse_backoff, &
+            state_size, row_size
+
+  !> when a refactorized system's iteration matrix is refreshed (time_integrator)
+  integer, parameter, public :: jacobian_step = 1, jacobian_iteration = 2, jacobian_reuse = 3
+  !> the most steps jacobian_reuse starts with a fresh matrix before trying an old one again
+  integer, parameter :: max_reuse_backoff = 64
+
+  !> The settings of a run: the method's parameters (Newmark: alpha_m = alpha_f = 0), the
+  !> Newton tolerance (max |de| <= tol * length_scale), the iteration limit, the Jacobian
+  !> policy and jacobian_reuse's limit on the ratio of successive corrections. The step h
+  !> is not a setting: each chunk gives its own (step control cuts and grows it).
+  type :: stepper_settings
+    real(dp) :: beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
+    real(dp) :: tol = 1e-10_dp, length_scale = 1.0_dp
+    integer :: max_newton = 10
+    integer :: jacobian = jacobian_reuse
+    real(dp) :: contraction = 0.25_dp
+  end type stepper_settings
+
+  !> What the stepper learns while it steps (forgotten at the start of each run).
+  type :: stepper_state
+    ! the simplified-Newton contraction rate measured with the current factorization (-1:
+    ! not yet) and the steps accepted since without measuring it again
+    real(dp) :: theta = -1.0_dp
+    integer :: unconfirmed = 0
+    ! jacobian_reuse back-off: steps that started with a matrix of an earlier step and had
+    ! to refresh it (in a row), the current back-off and the steps still to start with a
+    ! fresh matrix
+    integer :: reuse_failures = 0, reuse_backoff = 0, reuse_skip = 0
+    ! the predictor of refactorized systems without contact: e'' of the step before the
+    ! last (allocated once a step is done) and whether it predicted the last step better
+    ! than e''_n did
+    real(dp), allocatable :: accel_before(:)
+    logical :: predict_from_before = .false.
+  end type stepper_state
+
+  !> A system's stepper: its run's settings, its learned state, whether a run was set up.
+  type :: stepper_run
+    type(stepper_settings) :: settings
+    type(stepper_state) :: state
+    logical :: ready = .false.
+  end type stepper_run
+
+contains
+
+  !> A new run with these settings: what earlier runs learned is forgotten (a run from a new
+  !> initial state then gives the same result on any handle).
+  pure subroutine stepper_start(run, settings)
+    type(stepper_run), intent(inout) :: run
+    type(stepper_settings), intent(in) :: settings
+    run%settings = settings
+    run%state = stepper_state()
+    run%ready = .true.
+  end subroutine stepper_start
+
+  !> The length of system_advance's packed state, in this order: t; e, e', a, e'' (ndof
+  !> each); lambda (ncon); the accumulated works and the powers at the state (power_count
+  !> each); the contact guesses (2, npoint).
+  pure integer function state_size(ndof, ncon, npoint)
+    integer, intent(in) :: ndof, ncon, npoint
+    state_size = 1 + 4 * ndof + ncon + 2 * power_count + 2 * npoint
+  end function state_size
+
+  !> The length of one output row of system_advance, in this order: the time; the probe
+  !> positions and their deflections (3, nprobe each); lambda (ncon); the energies
+  !> (energy_count); the constraint violation max |Phi|; the contact records
+  !> (contact_record, npoint); and, when the coordinates are stored, e (ndof).
+  pure integer function row_size(ndof, ncon, nprobe, npoint, store_q)
+    integer, intent(in) :: ndof, ncon, nprobe, npoint
+    logical, intent(in) :: store_q
+    row_size = 1 + 6 * nprobe + ncon + energy_count + 1 + contact_record * npoint
+    if (store_q) row_size = row_size + ndof
+  end function row_size
+
+  !> jacobian_reuse's back-off after a step that started with a matrix of an earlier step:
+  !> refreshed, it had to refresh that matrix (or retry with a fresh one). Two such steps in
+  !> a row double the back-off (1, 2, 4 .. max_reuse_backoff steps start fresh); a step that
+  !> succeeds with the old matrix halves it.
+  pure subroutine update_reuse_backoff(learned, refreshed)
+    type(stepper_state), intent(inout) :: learned
+    logical, intent(in) :: refreshed
+    if (refreshed) then
+      learned%reuse_failures = learned%reuse_failures + 1
+      if (learned%reuse_failures >= 2) then
+        learned%reuse_backoff = min(max(1, 2 * learned%reuse_backoff), max_reuse_backoff)
+        learned%reuse_skip = learned%reuse_backoff
+      end if
+    else
+      learned%reuse_failures = 0
+      learned%reuse_backoff = learned%reuse_backoff / 2
+    end if
+  end subroutine update_reuse_backoff
+
+end module stepper
