@@ -34,7 +34,7 @@ import numpy as np
 
 from example_utils import arguments, write_table
 
-from ancfdrv.io.hdf5 import read_summary
+from ancfdrv.results.hdf5 import read_summary
 from ancfdrv.reference.analytic import elastica_tip_load
 from ancfdrv.runner import run_scene
 

@@ -17,11 +17,10 @@ A run never loses or mislabels data:
 """
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any, Callable
 
 import h5py
 import numpy as np
@@ -30,18 +29,15 @@ from .errors import AncfError, InputError, Interrupted, SolverError
 from .io.safe_write import disk_full
 from .history import luffing_stage_bounds, stage_summary
 from .interrupt import StopRequest, signal_name
-from .io import hdf5 as results
-from .io.general import locate_error
-from .io.lock import OutputLock, lock_path
+from .results import hdf5 as results
+from .builders.general import locate_error
+from .results.lock import OutputLock
+from .results.output_path import check_output_path
 from .builders import build_model
 from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
 from .solvers.static import StaticResult, solve_newton, solve_static
-
-#: files written beside the result (suffix): the plot of ``ancf run``, the XDMF of plates
-DERIVED_SUFFIXES = {".png": "the plot", ".xdmf": "the XDMF description"}
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 @dataclass
@@ -75,91 +71,6 @@ def input_files(scene: Scene) -> list[Path]:
     """The files a scene reads: the scene file and any file it names
     (``Scene.input_files`` when the scene layer lists some)."""
     return [Path(scene.path), *(Path(p) for p in getattr(scene, "input_files", ()) or ())]
-
-
-def _same_file(a: Path, b: Path) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return a.resolve() == b.resolve()
-
-
-def _is_hdf5(path: Path) -> bool:
-    """HDF5's signature at offset 0, 512, 1024, ... (where a superblock may start)."""
-    size = path.stat().st_size
-    with open(path, "rb") as f:
-        offset = 0
-        while offset + len(_HDF5_SIGNATURE) <= size:
-            f.seek(offset)
-            if f.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE:
-                return True
-            offset = 512 if offset == 0 else 2 * offset
-    return False
-
-
-def _writable_parent(out: Path) -> None:
-    """The output's directory exists and is writable, or can be created."""
-    parent = out.parent if str(out.parent) else Path(".")
-    existing = parent
-    while not existing.exists() and existing.parent != existing:
-        if existing.is_symlink():
-            raise InputError(f"cannot create the output directory: {existing} is a broken "
-                             "symbolic link", file=str(out))
-        existing = existing.parent
-    if not existing.is_dir():
-        raise InputError(f"cannot create the output directory: {existing} is not a directory",
-                         file=str(out))
-    if not os.access(existing, os.W_OK | os.X_OK):
-        what = "directory" if existing == parent else "parent directory"
-        raise InputError(f"the output {what} {existing} is not writable", file=str(out))
-
-
-def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = False) -> None:
-    """Refuse, before anything is computed, an output that cannot be written or whose
-    writing would destroy something: raises InputError naming the path.
-
-    Refused: a directory; a path below a regular file; a directory without write
-    permission; an input file (compared as files: same inode, symbolic links followed),
-    also through the plot or XDMF written beside the result; an existing file that is
-    neither empty nor HDF5 (never overwritten); when the run writes XDMF (``xdmf``) a ':'
-    in the file name, which XDMF cannot express.
-    """
-    out = Path(out)
-    if out.name in ("", ".", ".."):
-        raise InputError("the output must name a file, e.g. results/run.h5", file=str(out))
-    if out.is_dir():
-        raise InputError("the output is a directory; give a file name such as "
-                         f"{out / 'run.h5'}", file=str(out))
-    for suffix, what in DERIVED_SUFFIXES.items():
-        if out.with_suffix(suffix) == out:
-            raise InputError(f"the output must not end in {suffix}: {what} is written beside "
-                             "the result under that name (use .h5)", file=str(out))
-    if xdmf and ":" in out.name:
-        raise InputError("the file name must not contain ':' (the XDMF description cannot "
-                         "name such a file; or set output.xdmf = .false.)", file=str(out))
-    derived = {out: "the output", out.with_suffix(".png"): "the plot written beside it",
-               out.with_suffix(".xdmf"): "the XDMF written beside it",
-               lock_path(out): "its lock file"}
-    for source in inputs:
-        for path, what in derived.items():
-            if path.exists() and source.exists() and _same_file(path, source):
-                if path == out:
-                    raise InputError(f"the output is the input file {source}; choose another "
-                                     "output file", file=str(out))
-                raise InputError(f"{what} ({path}) would overwrite the input file {source}; "
-                                 "choose another output file", file=str(out))
-    _writable_parent(out)
-    if out.exists() or out.is_symlink():
-        if not out.exists():
-            raise InputError("the output is a broken symbolic link", file=str(out))
-        if not out.is_file():
-            raise InputError("the output exists and is not a regular file", file=str(out))
-        if not os.access(out, os.W_OK):
-            raise InputError("the output file exists and is not writable", file=str(out))
-        if out.stat().st_size and not _is_hdf5(out):
-            raise InputError("the output file exists and is not an HDF5 file; refusing to "
-                             "overwrite it (remove it or choose another output file)",
-                             file=str(out))
 
 
 def writes_xdmf(scene: Scene) -> bool:
@@ -553,7 +464,7 @@ def fixed_load_model(scene: Scene, fixed: list[str]) -> Model:
 def run_eigen(scene: Scene, model: Model, out: Path, timing: dict[str, Any]) -> None:
     """analysis = 'modal' (about the static equilibrium) or 'buckling'; writes /modal or
     /buckling, /static, and the XDMF of the shapes."""
-    from .io.xdmf import MeshLayout, write_mode_xdmf
+    from .results.xdmf import MeshLayout, write_mode_xdmf
     from .solvers.buckling import buckling_analysis
     from .solvers.modal import modal_analysis
     solver = scene["solver"]

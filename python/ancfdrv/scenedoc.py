@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .io.general import _DRIVE_KEYS, _REQUIRED_DRIVE
+from .builders.general import _DRIVE_KEYS, _REQUIRED_DRIVE
 from .io.schema import GENERAL_SCHEMA, MODEL_GROUPS, REQUIRED, SCHEMA, Key
 from .system.drives import DRIVE_TYPES
 from .system.joints import JOINT_TYPES

@@ -1,13 +1,14 @@
 """Template scenes as thin builders over the System API (one module per template): each
 turns a validated template scene into a :class:`~ancfdrv.system.System`, and
 :func:`build_model` assembles it with the scene's effects. General scenes (SPEC section 8)
-are read by :mod:`ancfdrv.io.general` into the same API."""
+are built by :mod:`ancfdrv.builders.general` into the same API."""
 from __future__ import annotations
 
 from ..errors import InputError
 from ..system import Model, System
 from . import boom, cantilever, leaf, plate, spinup, spring
 from .common import BuiltSystem, check_ffr_validity
+from .general import build_general
 
 BUILDERS = {"boom": boom.build, "cantilever": cantilever.build, "spinup": spinup.build,
             "plate": plate.build, "leaf": leaf.build, "spring": spring.build}
@@ -15,9 +16,9 @@ BUILDERS = {"boom": boom.build, "cantilever": cantilever.build, "spinup": spinup
 
 def build_system(scene) -> BuiltSystem:
     """The System a template scene describes (with the builder's response and warnings)."""
-    if scene.kind == "general":
-        from ..io.general import build_general
-        return build_general(scene)
+    if scene.kind == "general":  # the System load_scene built (once), else a new one
+        built, scene.built = scene.built, None
+        return built if built is not None else build_general(scene)
     if scene.kind not in BUILDERS:
         raise InputError(f"no builder for scene kind {scene.kind!r}")
     return BUILDERS[scene.kind](scene)

@@ -36,8 +36,8 @@ from .._version import __version__
 from ..errors import InputError
 from ..system.bodies import Beam
 from ..system.model import Model
-from .safe_write import check_room, create_fresh
-from .scene import Scene
+from ..io.safe_write import check_room, create_fresh
+from ..io.scene import Scene
 from ..solvers.static import StaticResult
 
 #: the statuses a result file can carry (root attribute and /dynamic attribute)

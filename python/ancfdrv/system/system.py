@@ -512,12 +512,12 @@ class System:
         return model
 
     # -- analyses (SPEC section 10, "Python") ------------------------------------------------
-    #: the analyses, registered by :mod:`ancfdrv.results` (which sits above this layer: it
+    #: the analyses, registered by :mod:`ancfdrv.analyses` (which sits above this layer: it
     #: runs the solvers and writes the result file)
     _ANALYSES: dict[str, Callable[..., Any]] = {}
 
     def _analysis(self, name: str) -> Callable[..., Any]:
-        if name not in self._ANALYSES:  # only when ancfdrv.results was never imported
+        if name not in self._ANALYSES:  # only when ancfdrv.analyses was never imported
             raise RuntimeError("import ancfdrv (the package) to run analyses")
         return self._ANALYSES[name]
 
@@ -555,12 +555,8 @@ class System:
         solver, tol, load_steps, rigid_tol, spin_rate, spin_axis, spin_centre, ...).
         Returns a :class:`~ancfdrv.solvers.modal.ModalResult` (frequency in Hz ascending,
         rigid-body modes at 0; mass-normalized shapes; damping_ratio with damping on)."""
-        from ..solvers.modal import modal_analysis
-        model = self.assemble(effects=effects, linear_joints=linear_joints)
-        try:
-            return modal_analysis(model, n, **options)
-        finally:
-            model.close()
+        return self._analysis("modes")(self, n, effects=effects, linear_joints=linear_joints,
+                                       **options)
 
     def buckling(self, n: int = 3, *, fixed_loads: Iterable[str] = (),
                  effects: Iterable[str] | None = None, linear_joints: str = "auto",
@@ -570,30 +566,8 @@ class System:
         all loads of an effect) in ``fixed_loads`` keep their value, the others are
         multiplied. ``options``: method ('nonlinear' | 'linear'), solver, tol, load_steps,
         rtol, ... Returns a :class:`~ancfdrv.solvers.buckling.BucklingResult`."""
-        from ..solvers.buckling import buckling_analysis
-        fixed = tuple(fixed_loads)
-        known = set(self.loads) | {load.effect for load in self.loads.values()}
-        unknown = [name for name in fixed if name not in known]
-        if unknown:
-            raise InputError(f"buckling: fixed_loads names unknown load(s) or effect(s) "
-                             f"{', '.join(map(repr, unknown))} (loads: "
-                             f"{', '.join(self.loads) or 'none'})")
-        model = self.assemble(effects=effects, linear_joints=linear_joints)
-        base = model
-        if fixed:
-            every = self.loads
-            try:
-                self.loads = {k: v for k, v in every.items() if k in fixed or v.effect in fixed}
-                base = self.assemble(effects=effects, linear_joints=linear_joints)
-            finally:
-                self.loads = every
-        try:
-            return buckling_analysis(model, base, n, fixed_loads=fixed, **options)
-        finally:
-            model.close()
-            if base is not model:
-                base.close()
-
+        return self._analysis("buckling")(self, n, fixed_loads=fixed_loads, effects=effects,
+                                          linear_joints=linear_joints, **options)
 
 
 #: drive parameters of the API per type (keyword -> schema key of &drive checked against)
