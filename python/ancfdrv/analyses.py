@@ -30,7 +30,6 @@ from typing import Any
 
 import numpy as np
 
-from .builders.common import check_ffr_validity
 from .errors import InputError
 from .io import validate
 from .io.scene import Scene, _typed
@@ -39,7 +38,6 @@ from .results.reader import Results, open_results
 from .runner import run_loaded
 from .solvers.buckling import buckling_analysis
 from .solvers.modal import modal_analysis
-from .system.supports import support_frames
 from .system.system import System
 
 #: the analyses a System runs from Python (scene.analysis)
@@ -105,16 +103,13 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
     validate.check_time(solver, analysis, where)
     chosen = effects if effects is not None else system.effects
     model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
-                            linear_joints=solver["linear_joints"])
-    model.kind = "general"
-    model.support_frames = support_frames(system)
+                            linear_joints=solver["linear_joints"], supports=True)
     if "static_method" not in options and (any(s.kind != "ffr" for s in model.sets)
                                            or model.contact_pairs):
         # the CLI's default 'split' needs every body 'ffr' and no contact: where it cannot
         # run (it would fail with that message), Newton is the only static method
         solver["static_method"] = "newton"
     try:
-        check_ffr_validity(model, system)
         formulations = sorted({getattr(b, "formulation", "") for b in system.bodies.values()
                                if getattr(b, "formulation", "")})
         path, text = _script_text(system)

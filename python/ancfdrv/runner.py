@@ -27,13 +27,13 @@ import numpy as np
 
 from .errors import AncfError, InputError, Interrupted, SolverError
 from .io.safe_write import disk_full
-from .history import luffing_stage_bounds, stage_summary
+from .history import stage_summary
 from .interrupt import StopRequest, signal_name
 from .results import hdf5 as results
 from .builders.general import locate_error
 from .results.lock import OutputLock
 from .results.output_path import check_output_path
-from .builders import build_model
+from .builders import build_model, settle_mode, stage_bounds
 from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
@@ -93,28 +93,6 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
                                                  solver["rho_inf"], **common)
     return DynamicSettings(dt=solver["dt"], t_end=solver["t_end"], beta=solver["beta"],
                            gamma=solver["gamma"], **common)
-
-
-def boom_stages(scene: Scene) -> dict[str, tuple[float, float]] | None:
-    """Stage bounds of a luffing boom scene (None when the boom does not luff)."""
-    if scene.kind != "boom" or scene["boom"]["omega"] <= 0:
-        return None
-    boom = scene["boom"]
-    sweep = np.radians(boom["angle_end_deg"] - boom["angle_deg"])
-    return luffing_stage_bounds(boom["omega"], boom["t_start"], boom["t_brake"], sweep,
-                                scene["solver"]["t_end"])
-
-
-def settle_mode(scene: Scene) -> str:
-    """How a dynamic run starts: 'none' (from the assembled configuration), 'unloaded'
-    (at rest in the equilibrium of the internal forces alone: prestress carried by
-    contact, the external loads off) or 'loaded' (at rest in the static equilibrium under
-    every load). The spring's ``spring.settle`` ('none' | 'prestress' | 'gravity') names
-    the last two after what they settle."""
-    if scene.kind == "spring":
-        return {"none": "none", "prestress": "unloaded",
-                "gravity": "loaded"}[scene["spring"]["settle"]]
-    return scene["solver"]["settle"]
 
 
 def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str, Any],
@@ -275,7 +253,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                 f"formulation 'ffr' outside its assumptions: the tip deflects by {ratio:.2%} of "
                 "the length (small deformation assumed); compare with formulation = "
                 "'nonlinear'")
-    bounds = boom_stages(scene)
+    bounds = stage_bounds(scene)
     if bounds:
         with h5py.File(out, "r") as h5:
             t = h5["dynamic/time"][()]
@@ -457,7 +435,6 @@ def fixed_load_model(scene: Scene, fixed: list[str]) -> Model:
                     if name in fixed or load.effect in fixed}
     model = system.assemble(effects=scene.effects,
                             linear_joints=scene["solver"].get("linear_joints", "auto"))
-    model.kind = scene.kind
     return model
 
 

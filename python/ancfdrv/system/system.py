@@ -35,6 +35,7 @@ from .bodies import Beam, Body, Ground, Leaf, Material, Plate, RigidBody
 from .cable import Cable
 from .contact import ContactPair
 from .drives import DRIVE_TYPES, Drive, Table
+from .ffr_checks import ffr_speed_warnings
 from .joints import Joint
 from .loads import LOAD_TYPES, Load
 from .probes import Probe
@@ -469,7 +470,8 @@ class System:
     @_api
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
                  check_frames: bool = True, unused_effects: str | None = None,
-                 bounds: str | None = None):
+                 bounds: str | None = None, warnings: Iterable[str] = (),
+                 response: tuple[str, int] | None = None, supports: bool = False):
         """The model of this system (``ancfdrv.system.assembly.assemble``): only the effects
         listed (default: the system's own list, else all it uses) are computed. An 'ffr'
         beam whose floating frame nothing holds is refused (InputError); with
@@ -481,7 +483,12 @@ class System:
         (``System(effects=...)``) gets 'warn', a list given here 'allow' (a caller switching
         effects of a built system). Drives and loads beyond the physical
         bounds are refused (:meth:`check_bounds`) unless ``bounds='off'`` (default: the
-        system's own setting)."""
+        system's own setting). The model is complete when it is returned: ``warnings``
+        (a builder's) come first in ``model.warnings``, then the assembly's, then the check
+        of 'ffr' frames turning near a bending frequency; ``response`` is the (probe,
+        component) a sweep compares (default: the first probe's); ``supports`` records the
+        rigid motion of each beam's supports (``model.support_frames``: general scenes and
+        Systems run from Python report deflections relative to it)."""
         from .assembly import assemble
         if effects is not None:
             effects = check_effects(effects)
@@ -504,11 +511,13 @@ class System:
         validate.check_resources(validate.Estimate(self._parts(), contact_points=sum(
             2 * c.points for c in self.contacts.values())), None, None, "static")
         model = assemble(self, tuple(chosen) if chosen is not None else None,
-                         linear_joints=linear_joints, check_frames=check_frames)
+                         linear_joints=linear_joints, check_frames=check_frames,
+                         warnings=warnings, response=response, supports=supports)
         if unused_note:  # not silent: the run prints it, a script sees a UserWarning
-            import warnings
+            import warnings as _warnings
             model.warnings.append(unused_note)
-            warnings.warn(unused_note, UserWarning, stacklevel=3)
+            _warnings.warn(unused_note, UserWarning, stacklevel=3)
+        model.warnings.extend(ffr_speed_warnings(self))
         return model
 
     # -- analyses (SPEC section 10, "Python") ------------------------------------------------
