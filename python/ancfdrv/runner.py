@@ -8,7 +8,7 @@ A run never loses or mislabels data:
 
 * the output path is checked before anything is computed (:func:`check_output_path`:
   not a directory, not below a regular file, writable, never an input file);
-* the run holds an exclusive lock on the output (:class:`~ancfdrv.io.lock.OutputLock`):
+* the run holds an exclusive lock on the output (:class:`~ancfdrv.results.lock.OutputLock`):
   a second run writing the same file is refused, naming the first one;
 * SIGINT and SIGTERM stop the run at the next step boundary (:mod:`ancfdrv.interrupt`):
   what was computed is flushed and the file says status = 'interrupted';

@@ -124,7 +124,7 @@ def group_table(name: str, keys: dict[str, Key], suffix: str = "") -> list[str]:
 
 def drive_parameters() -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
     """(required, optional) parameters of each drive type, as the namelist reader
-    (:mod:`ancfdrv.io.general`) checks them."""
+    (:mod:`ancfdrv.builders.general`) checks them."""
     out = {}
     for kind in DRIVE_TYPES:
         required = tuple(_REQUIRED_DRIVE.get(kind, ()))
