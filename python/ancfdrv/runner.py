@@ -115,7 +115,7 @@ def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str
 
 def _write_static_supports(out: Path, model: Model, static: StaticResult) -> None:
     """/static/deflection_support of a general scene (:mod:`ancfdrv.system.supports`)."""
-    frames = getattr(model, "support_frames", None)
+    frames = model.support_frames
     if not frames:
         return
     from .system.supports import (DISPLACEMENT_REFERENCE, SUPPORT_REFERENCE,
@@ -137,7 +137,7 @@ class SupportRecorder:
 
     @classmethod
     def of(cls, model: Model) -> "SupportRecorder | None":
-        frames = getattr(model, "support_frames", None)
+        frames = model.support_frames
         if not frames or not any(p.body in frames for p in model.probes.values()):
             return None
         return cls(model, frames)
