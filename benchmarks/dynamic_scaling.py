@@ -6,7 +6,7 @@ For every node count (3k+1) of the boom of ``inputs/boom_luffing.nml`` this prep
 as :func:`ancfdrv.runner.run_scene` does for this scene (``build_model``, static start with
 ``solve_split``, :class:`ancfdrv.solvers.dynamic.TimeIntegrator`, consistent initial
 acceleration, the initial output row), integrates through the smooth start to the
-beginning of the luffing stage (:func:`ancfdrv.runner.boom_stages`, t = 1 s) and measures
+beginning of the luffing stage (:func:`ancfdrv.builders.stage_bounds`, t = 1 s) and measures
 there, with ``time.perf_counter``:
 
 * the wall time per Newmark step: ``integrator.advance(state, nsteps)`` from a copy of the
@@ -71,7 +71,8 @@ import numpy as np
 from _common import load_average, machine_info, print_table, write_report
 from ancfdrv.builders import build_model
 from ancfdrv.io.scene import Scene, load_scene
-from ancfdrv.runner import boom_stages, dynamic_settings, run_scene
+from ancfdrv.builders import stage_bounds
+from ancfdrv.runner import dynamic_settings, run_scene
 from ancfdrv.solvers.dynamic import (DynamicSettings, TimeIntegrator, initial_acceleration,
                                      initial_row)
 from ancfdrv.solvers.static import solve_split
@@ -163,7 +164,7 @@ def prepare(nodes: int) -> Prepared:
     timing each phase once."""
     setup: dict[str, Any] = {}
     scene = load_scene(SCENE, [f"beam.nodes={nodes}"])
-    stages = boom_stages(scene)
+    stages = stage_bounds(scene)
     if stages is None:
         raise RuntimeError(f"{SCENE} does not luff: no {WINDOW_STAGE} stage to measure")
     t_first, t_last = (float(x) for x in stages[WINDOW_STAGE])

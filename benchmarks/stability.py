@@ -258,7 +258,8 @@ def case_spring(quick: bool) -> dict:
 def _spring(quick: bool) -> dict:
     scene = load_scene(ROOT / "inputs/leaf_spring.nml",
                        [f"solver.t_end={0.2 if quick else 60.0}"])
-    from ancfdrv.runner import dynamic_settings, settle_mode
+    from ancfdrv.builders import settle_mode
+    from ancfdrv.runner import dynamic_settings
     model = build_model(scene)
     try:
         e0 = model.e0

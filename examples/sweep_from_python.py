@@ -3,7 +3,7 @@
 The shipped general scene ``inputs/general/cantilever.nml`` (a cantilever with a tip force)
 is run through :func:`ancfdrv.runner.run_scene` with ``--set``-style overrides, exactly as
 ``ancf run`` would: each case writes its own HDF5 file, which is read back with
-:func:`ancfdrv.io.hdf5.read_summary`. The overrides turn it into the large-deflection
+:func:`ancfdrv.results.hdf5.read_summary`. The overrides turn it into the large-deflection
 benchmark of the elastica: a slender steel beam (1 m, 5 x 5 mm), formulation
 'nonlinear', under a dead tip load P = k EI / L^2 with k = 10 (the tip drops by 0.81 L),
 solved by Newton in 10 load steps.
@@ -34,7 +34,7 @@ import numpy as np
 
 from example_utils import arguments, write_table
 
-from ancfdrv.io.hdf5 import read_summary
+from ancfdrv.results.hdf5 import read_summary
 from ancfdrv.reference.analytic import elastica_tip_load
 from ancfdrv.runner import run_scene
 

@@ -475,7 +475,7 @@ def test_run_writes_the_answers_by_name(tmp_path):
         points = h5["dynamic/mesh_von_mises_max"][()]
         assert points.max() == pytest.approx(env.attrs["max"])
     assert "von_mises_max" in out.with_suffix(".xdmf").read_text()
-    from ancfdrv.io.hdf5 import answer_headlines
+    from ancfdrv.results.hdf5 import answer_headlines
     from ancfdrv.plots import plot_sections
     lines = answer_headlines(out)
     assert any(line.startswith("static.largest_reaction") and "'A2'" in line for line in lines)
@@ -552,7 +552,7 @@ def test_ffr_linear_strain_matrix_and_element_path_agree(monkeypatch):
 def test_static_answers_bundle_the_three(tmp_path):
     """static_answers gives the same records as the three functions, and the file written
     from it holds them under the joint's and the beam's names."""
-    from ancfdrv.io import hdf5
+    from ancfdrv.results import hdf5
     from ancfdrv.system.answers import static_answers
     s = System("c")
     steel = s.material("steel", **STEEL)

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from ancfdrv.io.hdf5 import read_summary
+from ancfdrv.results.hdf5 import read_summary
 
 from reference import frames, leaf_reference, mechanisms
 

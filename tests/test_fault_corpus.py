@@ -30,7 +30,7 @@ import pytest
 from conftest import INPUTS
 from ancfdrv import System
 from ancfdrv.errors import AncfError, InputError
-from ancfdrv.io.lock import OutputLock
+from ancfdrv.results.lock import OutputLock
 from ancfdrv.io.validate import PHYSICAL_BOUNDS
 
 GUARD_S = 60  # a bound against hanging, not a measurement

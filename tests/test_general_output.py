@@ -153,7 +153,7 @@ def test_renamed_probe_and_failing_plot_are_not_failures(tmp_path, capsys, monke
 def test_failing_xdmf_is_a_warning(tmp_path, capsys, monkeypatch):
     """The XDMF description is an optional output too: when it cannot be written the run
     still exits 0 with its result complete (status 'ok') and says why on stderr."""
-    from ancfdrv.io import xdmf
+    from ancfdrv.results import xdmf
 
     def broken(*_args, **_kwargs):
         raise OSError("disk full")

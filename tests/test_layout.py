@@ -4,7 +4,12 @@ is read from the sources: every import between the package's own modules, functi
 ones included (a deferred import is still a dependency); `from . import name` of a name
 that is no module is an import of the package itself. The compiled extension
 `ancfdrv._kernel` (no .py file; it imports nothing of the package) is a leaf that only
-the thin binding `ancfdrv.kernel` imports."""
+the thin binding `ancfdrv.kernel` imports.
+
+Issue 25: the same graph read at package level (a subpackage is one node, a top-level
+module another) must follow one order of layers, each importing only layers below it, so
+no arrow runs back up and no two packages import each other, function-local imports
+included. The reader and checker of scenes (`io`) is a leaf over `errors`."""
 from __future__ import annotations
 
 import ast
@@ -63,6 +68,8 @@ def test_graph_is_read():
     assert "ancfdrv.system.assembly" in graph["ancfdrv.system"] or \
         "ancfdrv.system.system" in graph["ancfdrv.system"]
     assert "ancfdrv.system.model" in graph["ancfdrv.system.assembly"]
+    # a function-local import is read too (results/hdf5.py imports xdmf inside functions)
+    assert "ancfdrv.results.xdmf" in graph["ancfdrv.results.hdf5"]
 
 
 def test_no_import_cycles():
@@ -83,3 +90,75 @@ def test_no_module_imports_the_package_itself():
 
 def test_cycle_detection_finds_a_cycle():
     assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == [["a", "b", "c", "a"]]
+
+
+#: the package's layers, bottom first (SPEC section 9; the order read off the imports):
+#: a node may import only nodes of a lower layer (or itself). A subpackage is one node;
+#: a top-level module another; `ancfdrv` is the package's __init__ (the public API).
+LAYERS = [
+    {"_version", "errors", "_kernel", "history", "reference"},
+    {"codes", "interrupt"},
+    {"kernel"},                     # the typed binding over the compiled kernel
+    {"io"},                         # schema, namelist reader, validation, safe writes
+    {"sweep_keys"},
+    {"plots"},                      # reads result files with h5py alone
+    {"system"},                     # bodies, joints, loads, drives, assembly, Model
+    {"solvers"},                    # static, dynamic, modal, buckling
+    {"results"},                    # HDF5, XDMF, locks, output paths, the result object
+    {"builders"},                   # templates and the general namelist form: Scene -> System
+    {"runner"},                     # one scene start to finish
+    {"analyses", "sweep_exec"},     # System.static/simulate/modes/buckling; sweep workers
+    {"sweep", "scenedoc"},
+    {"cli"},
+    {"ancfdrv"},
+]
+
+
+def node_of(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else parts[0]
+
+
+def package_graph() -> dict[str, set[str]]:
+    out: dict[str, set[str]] = {}
+    for name, targets in module_graph().items():
+        here = node_of(name)
+        out.setdefault(here, set()).update(node_of(t) for t in targets if node_of(t) != here)
+    return out
+
+
+def upward_arrows(graph: dict[str, set[str]], layers: list[set[str]]) -> list[str]:
+    rank = {node: i for i, layer in enumerate(layers) for node in layer}
+    return sorted(f"{a} -> {b}" for a, targets in graph.items() for b in targets
+                  if rank[b] >= rank[a])
+
+
+def test_every_package_has_a_layer():
+    """A new subpackage or top-level module must be placed in LAYERS."""
+    placed = set().union(*LAYERS)
+    assert set(package_graph()) - placed == set()
+
+
+def test_packages_import_only_layers_below():
+    """No package imports one of its own layer or above (issue 25: builders <-> io,
+    io <-> solvers, io <-> system and solvers <-> system were cycles through
+    function-local imports)."""
+    assert upward_arrows(package_graph(), LAYERS) == []
+
+
+def test_no_package_cycles():
+    assert cycles(package_graph()) == []
+
+
+def test_io_is_a_leaf():
+    """Parsing and validation import nothing of the package but its errors (the general
+    scene's builder is registered by builders.general, not imported)."""
+    assert package_graph()["io"] <= {"errors"}
+
+
+def test_package_checks_can_fail():
+    """The checks see a back arrow and an unplaced edge (the old io -> builders one)."""
+    layers = [{"errors"}, {"io"}, {"builders"}]
+    assert upward_arrows({"io": {"builders", "errors"}, "builders": {"io"}}, layers) == \
+        ["io -> builders"]
+    assert cycles({"io": {"builders"}, "builders": {"io"}}) == [["builders", "io", "builders"]]

@@ -280,7 +280,7 @@ def test_curved_completed_leaf_stays_where_it_is(tmp_path):
     root = ET.parse(out.output.with_suffix(".xdmf")).getroot()
     grids = root.findall("./Domain/Grid/Grid")
     assert len(grids) == 501
-    # (per-step virtual datasets: row 500 of /dynamic/mesh_nodes, see io/xdmf.py)
+    # (per-step virtual datasets: row 500 of /dynamic/mesh_nodes, see results/xdmf.py)
     assert "leaf.h5:/dynamic/xdmf/position/500" in ET.tostring(grids[-1], encoding="unicode")
 
 

@@ -61,7 +61,7 @@ def refused(capsys, args: list[str], *fragments: str) -> str:
 
 def rows_written(path: Path) -> int:
     """Output rows on disk now (0 until the file exists and holds /dynamic)."""
-    from ancfdrv.io.hdf5 import open_result
+    from ancfdrv.results.hdf5 import open_result
     if not path.exists() or not h5py.is_hdf5(path):
         return 0
     try:
@@ -174,7 +174,7 @@ def test_read_only_directory_message(scene, tmp_path, monkeypatch, capsys):
     locked = tmp_path / "ro"
     locked.mkdir()
     real = os.access
-    monkeypatch.setattr(runner.os, "access", lambda path, mode, *a, **k:
+    monkeypatch.setattr(os, "access", lambda path, mode, *a, **k:
                         False if Path(path) == locked and mode & os.W_OK else
                         real(path, mode, *a, **k))
     refused(capsys, ["run", str(scene), "-o", str(locked / "x.h5"), *TINY],

@@ -8,7 +8,7 @@ import dataclasses
 from pathlib import Path
 
 from ancfdrv import scenedoc
-from ancfdrv.io.general import _DRIVE_KEYS
+from ancfdrv.builders.general import _DRIVE_KEYS
 from ancfdrv.io.schema import GENERAL_SCHEMA, SCHEMA
 from ancfdrv.system.drives import DRIVE_TYPES
 from ancfdrv.system.joints import JOINT_TYPES

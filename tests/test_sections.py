@@ -88,7 +88,7 @@ def test_cowper_shear_factor_reaches_the_deflection(bending, nodes, tolerance):
     """A stubby cantilever (L = 0.3 m, 50 x 100 mm, height along the load) under a tip force:
     Timoshenko's P L^3 / (3 E I) + P L / (k G A) with Cowper's k (the shear term is 11% of
     the deflection here). The cubic element reproduces the Timoshenko cantilever exactly on
-    one element (test_structural), the continuum one converges at second order."""
+    one element (test_cubic_beam), the continuum one converges at second order."""
     length, force = 0.3, 1000.0
     section = Rectangle(0.05, 0.1, shear="cowper")
     s = System("shear")

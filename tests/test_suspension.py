@@ -20,7 +20,7 @@ import h5py
 import numpy as np
 import pytest
 
-from ancfdrv.io.hdf5 import read_summary
+from ancfdrv.results.hdf5 import read_summary
 from ancfdrv.runner import run_scene
 
 from conftest import INPUTS, ROOT

@@ -27,7 +27,7 @@ import pytest
 from ancfdrv import runner
 from ancfdrv.cli import main
 from ancfdrv.errors import SolverError
-from ancfdrv.io.hdf5 import read_summary
+from ancfdrv.results.hdf5 import read_summary
 from ancfdrv.sweep import (MAX_NAME_CHARS, case_names, check_sweep_ids, read_sweep_id,
                            run_sweep)
 from conftest import INPUTS

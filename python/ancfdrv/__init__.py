@@ -1,11 +1,11 @@
 """ancfdrv: flexible multibody dynamics with the Absolute Nodal Coordinate Formulation.
 
 Compose a system in Python (``from ancfdrv import System``, :mod:`ancfdrv.system`) or in a
-namelist scene (:mod:`ancfdrv.io.scene`; template scenes are built by
-:mod:`ancfdrv.builders` over the same API), solve it (:mod:`ancfdrv.solvers`: static and
-dynamic) and store the results in HDF5 (:mod:`ancfdrv.io.hdf5`); :mod:`ancfdrv.runner` ties
-these together and :mod:`ancfdrv.cli` is the ``ancf`` command. From Python,
-``System.static()`` and ``System.simulate()`` run the same path and return
+namelist scene (read and checked by :mod:`ancfdrv.io`; template and general scenes are
+built by :mod:`ancfdrv.builders` over the same API), solve it (:mod:`ancfdrv.solvers`) and
+store the results in HDF5 (:mod:`ancfdrv.results`); :mod:`ancfdrv.runner` ties these
+together and :mod:`ancfdrv.cli` is the ``ancf`` command. From Python, ``System.static()``
+and ``System.simulate()`` run the same path (:mod:`ancfdrv.analyses`) and return
 :class:`~ancfdrv.results.Results`; ``ancfdrv.open(path)`` reads any result file.
 """
 import os as _os
@@ -27,7 +27,8 @@ from .system import (Beam, Box, Cable, Circle, Constant, Cycle, General, Leaf, L
                      Material, Model, Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, System,
                      Table, Tube)
 
-from .results import Results, open_results  # noqa: E402  (gives System its analyses)
+from .results import Results, open_results  # noqa: E402
+from . import analyses as _analyses  # noqa: E402,F401  (gives System its analyses)
 
 #: ``ancfdrv.open(path)``: any result file as :class:`~ancfdrv.results.Results`
 open = open_results  # noqa: A001 - the package's own name, as SPEC section 10 spells it

@@ -46,7 +46,7 @@ EXIT_CODES = """exit status:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from .io.hdf5 import read_summary
+    from .results.hdf5 import read_summary
     from .runner import run_scene
     if args.force:
         args.set = [*args.set, "scene.bounds=off"]
@@ -147,7 +147,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 def _cmd_info(args: argparse.Namespace) -> int:
     """The verdict on the first line (ok, failed, interrupted, running, abandoned), then
     the main figures."""
-    from .io.hdf5 import read_summary, verdict
+    from .results.hdf5 import read_summary, verdict
     path = Path(args.file)
     try:
         summary = read_summary(path)  # InputError (exit 2) when missing, not HDF5, not ours
@@ -166,7 +166,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
         if isinstance(value, np.ndarray):
             value = np.array2string(value, precision=6)
         print(f"{key:32s} {value}")
-    from .io.hdf5 import answer_headlines
+    from .results.hdf5 import answer_headlines
     try:
         for line in answer_headlines(path):
             print(line)

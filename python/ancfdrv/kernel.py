@@ -129,7 +129,7 @@ def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poi
 
 class CubicBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
-    (beam_structural.structural_setup) for a mesh with reference nodal vectors (3, 8, nel);
+    (beam_cubic.cubic_setup) for a mesh with reference nodal vectors (3, 8, nel);
     ``torsion`` the Saint-Venant constant J (default: the polar moment) and
     ``shear_factors`` (k_y, k_z) (default 1)."""
 

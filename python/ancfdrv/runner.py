@@ -8,7 +8,7 @@ A run never loses or mislabels data:
 
 * the output path is checked before anything is computed (:func:`check_output_path`:
   not a directory, not below a regular file, writable, never an input file);
-* the run holds an exclusive lock on the output (:class:`~ancfdrv.io.lock.OutputLock`):
+* the run holds an exclusive lock on the output (:class:`~ancfdrv.results.lock.OutputLock`):
   a second run writing the same file is refused, naming the first one;
 * SIGINT and SIGTERM stop the run at the next step boundary (:mod:`ancfdrv.interrupt`):
   what was computed is flushed and the file says status = 'interrupted';
@@ -17,31 +17,27 @@ A run never loses or mislabels data:
 """
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any, Callable
 
 import h5py
 import numpy as np
 
 from .errors import AncfError, InputError, Interrupted, SolverError
 from .io.safe_write import disk_full
-from .history import luffing_stage_bounds, stage_summary
+from .history import stage_summary
 from .interrupt import StopRequest, signal_name
-from .io import hdf5 as results
-from .io.general import locate_error
-from .io.lock import OutputLock, lock_path
-from .builders import build_model
+from .results import hdf5 as results
+from .builders.general import locate_error
+from .results.lock import OutputLock
+from .results.output_path import check_output_path
+from .builders import build_model, settle_mode, stage_bounds
 from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
 from .solvers.static import StaticResult, solve_newton, solve_static
-
-#: files written beside the result (suffix): the plot of ``ancf run``, the XDMF of plates
-DERIVED_SUFFIXES = {".png": "the plot", ".xdmf": "the XDMF description"}
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 @dataclass
@@ -77,91 +73,6 @@ def input_files(scene: Scene) -> list[Path]:
     return [Path(scene.path), *(Path(p) for p in getattr(scene, "input_files", ()) or ())]
 
 
-def _same_file(a: Path, b: Path) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return a.resolve() == b.resolve()
-
-
-def _is_hdf5(path: Path) -> bool:
-    """HDF5's signature at offset 0, 512, 1024, ... (where a superblock may start)."""
-    size = path.stat().st_size
-    with open(path, "rb") as f:
-        offset = 0
-        while offset + len(_HDF5_SIGNATURE) <= size:
-            f.seek(offset)
-            if f.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE:
-                return True
-            offset = 512 if offset == 0 else 2 * offset
-    return False
-
-
-def _writable_parent(out: Path) -> None:
-    """The output's directory exists and is writable, or can be created."""
-    parent = out.parent if str(out.parent) else Path(".")
-    existing = parent
-    while not existing.exists() and existing.parent != existing:
-        if existing.is_symlink():
-            raise InputError(f"cannot create the output directory: {existing} is a broken "
-                             "symbolic link", file=str(out))
-        existing = existing.parent
-    if not existing.is_dir():
-        raise InputError(f"cannot create the output directory: {existing} is not a directory",
-                         file=str(out))
-    if not os.access(existing, os.W_OK | os.X_OK):
-        what = "directory" if existing == parent else "parent directory"
-        raise InputError(f"the output {what} {existing} is not writable", file=str(out))
-
-
-def check_output_path(out: Path, inputs: Iterable[Path] = (), *, xdmf: bool = False) -> None:
-    """Refuse, before anything is computed, an output that cannot be written or whose
-    writing would destroy something: raises InputError naming the path.
-
-    Refused: a directory; a path below a regular file; a directory without write
-    permission; an input file (compared as files: same inode, symbolic links followed),
-    also through the plot or XDMF written beside the result; an existing file that is
-    neither empty nor HDF5 (never overwritten); when the run writes XDMF (``xdmf``) a ':'
-    in the file name, which XDMF cannot express.
-    """
-    out = Path(out)
-    if out.name in ("", ".", ".."):
-        raise InputError("the output must name a file, e.g. results/run.h5", file=str(out))
-    if out.is_dir():
-        raise InputError("the output is a directory; give a file name such as "
-                         f"{out / 'run.h5'}", file=str(out))
-    for suffix, what in DERIVED_SUFFIXES.items():
-        if out.with_suffix(suffix) == out:
-            raise InputError(f"the output must not end in {suffix}: {what} is written beside "
-                             "the result under that name (use .h5)", file=str(out))
-    if xdmf and ":" in out.name:
-        raise InputError("the file name must not contain ':' (the XDMF description cannot "
-                         "name such a file; or set output.xdmf = .false.)", file=str(out))
-    derived = {out: "the output", out.with_suffix(".png"): "the plot written beside it",
-               out.with_suffix(".xdmf"): "the XDMF written beside it",
-               lock_path(out): "its lock file"}
-    for source in inputs:
-        for path, what in derived.items():
-            if path.exists() and source.exists() and _same_file(path, source):
-                if path == out:
-                    raise InputError(f"the output is the input file {source}; choose another "
-                                     "output file", file=str(out))
-                raise InputError(f"{what} ({path}) would overwrite the input file {source}; "
-                                 "choose another output file", file=str(out))
-    _writable_parent(out)
-    if out.exists() or out.is_symlink():
-        if not out.exists():
-            raise InputError("the output is a broken symbolic link", file=str(out))
-        if not out.is_file():
-            raise InputError("the output exists and is not a regular file", file=str(out))
-        if not os.access(out, os.W_OK):
-            raise InputError("the output file exists and is not writable", file=str(out))
-        if out.stat().st_size and not _is_hdf5(out):
-            raise InputError("the output file exists and is not an HDF5 file; refusing to "
-                             "overwrite it (remove it or choose another output file)",
-                             file=str(out))
-
-
 def writes_xdmf(scene: Scene) -> bool:
     """Whether a run of the scene writes the XDMF description (dynamic runs with
     output.xdmf, the default)."""
@@ -184,28 +95,6 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
                            gamma=solver["gamma"], **common)
 
 
-def boom_stages(scene: Scene) -> dict[str, tuple[float, float]] | None:
-    """Stage bounds of a luffing boom scene (None when the boom does not luff)."""
-    if scene.kind != "boom" or scene["boom"]["omega"] <= 0:
-        return None
-    boom = scene["boom"]
-    sweep = np.radians(boom["angle_end_deg"] - boom["angle_deg"])
-    return luffing_stage_bounds(boom["omega"], boom["t_start"], boom["t_brake"], sweep,
-                                scene["solver"]["t_end"])
-
-
-def settle_mode(scene: Scene) -> str:
-    """How a dynamic run starts: 'none' (from the assembled configuration), 'unloaded'
-    (at rest in the equilibrium of the internal forces alone: prestress carried by
-    contact, the external loads off) or 'loaded' (at rest in the static equilibrium under
-    every load). The spring's ``spring.settle`` ('none' | 'prestress' | 'gravity') names
-    the last two after what they settle."""
-    if scene.kind == "spring":
-        return {"none": "none", "prestress": "unloaded",
-                "gravity": "loaded"}[scene["spring"]["settle"]]
-    return scene["solver"]["settle"]
-
-
 def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str, Any],
             stop: StopRequest) -> StaticResult:
     """The static equilibrium a settled dynamic run starts from (Newton, loads scaled by
@@ -226,7 +115,7 @@ def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str
 
 def _write_static_supports(out: Path, model: Model, static: StaticResult) -> None:
     """/static/deflection_support of a general scene (:mod:`ancfdrv.system.supports`)."""
-    frames = getattr(model, "support_frames", None)
+    frames = model.support_frames
     if not frames:
         return
     from .system.supports import (DISPLACEMENT_REFERENCE, SUPPORT_REFERENCE,
@@ -248,7 +137,7 @@ class SupportRecorder:
 
     @classmethod
     def of(cls, model: Model) -> "SupportRecorder | None":
-        frames = getattr(model, "support_frames", None)
+        frames = model.support_frames
         if not frames or not any(p.body in frames for p in model.probes.values()):
             return None
         return cls(model, frames)
@@ -364,7 +253,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                 f"formulation 'ffr' outside its assumptions: the tip deflects by {ratio:.2%} of "
                 "the length (small deformation assumed); compare with formulation = "
                 "'nonlinear'")
-    bounds = boom_stages(scene)
+    bounds = stage_bounds(scene)
     if bounds:
         with h5py.File(out, "r") as h5:
             t = h5["dynamic/time"][()]
@@ -546,14 +435,13 @@ def fixed_load_model(scene: Scene, fixed: list[str]) -> Model:
                     if name in fixed or load.effect in fixed}
     model = system.assemble(effects=scene.effects,
                             linear_joints=scene["solver"].get("linear_joints", "auto"))
-    model.kind = scene.kind
     return model
 
 
 def run_eigen(scene: Scene, model: Model, out: Path, timing: dict[str, Any]) -> None:
     """analysis = 'modal' (about the static equilibrium) or 'buckling'; writes /modal or
     /buckling, /static, and the XDMF of the shapes."""
-    from .io.xdmf import MeshLayout, write_mode_xdmf
+    from .results.xdmf import MeshLayout, write_mode_xdmf
     from .solvers.buckling import buckling_analysis
     from .solvers.modal import modal_analysis
     solver = scene["solver"]

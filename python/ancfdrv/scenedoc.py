@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .io.general import _DRIVE_KEYS, _REQUIRED_DRIVE
+from .builders.general import _DRIVE_KEYS, _REQUIRED_DRIVE
 from .io.schema import GENERAL_SCHEMA, MODEL_GROUPS, REQUIRED, SCHEMA, Key
 from .system.drives import DRIVE_TYPES
 from .system.joints import JOINT_TYPES
@@ -134,7 +134,7 @@ def group_table(name: str, keys: dict[str, Key], suffix: str = "") -> list[str]:
 
 def drive_parameters() -> dict[str, tuple[tuple[str, ...], tuple[str, ...]]]:
     """(required, optional) parameters of each drive type, as the namelist reader
-    (:mod:`ancfdrv.io.general`) checks them."""
+    (:mod:`ancfdrv.builders.general`) checks them."""
     out = {}
     for kind in DRIVE_TYPES:
         required = tuple(_REQUIRED_DRIVE.get(kind, ()))

@@ -33,7 +33,7 @@ import numpy as np
 from tqdm import tqdm
 
 from .errors import InputError
-from .io.lock import OutputLock
+from .results.lock import OutputLock
 from .io.safe_write import replace_atomically, write_bytes, write_text
 from .sweep_keys import is_resolution, resolution_sense, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
@@ -485,7 +485,7 @@ def store_case_file(case: Case, sweep_id: str, data: bytes | None = None, *,
         return ""
     remove_quietly(stale)
     if motion:  # written for the final name before the file appears there
-        from .io.xdmf import write_xdmf
+        from .results.xdmf import write_xdmf
         write_xdmf(case.part, as_name=case.output)
     os.replace(case.part, case.output)
     return str(case.output)

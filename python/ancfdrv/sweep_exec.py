@@ -99,7 +99,7 @@ def run_case(scene_file: str, params: dict[str, str], overrides: list[str],
 
 def _result_fields(outcome: Any, output: Path) -> dict:
     """What a sweep tabulates from a finished run."""
-    from .io.hdf5 import read_summary
+    from .results.hdf5 import read_summary
     summary = read_summary(output)
     row: dict[str, Any] = dict(status="ok", message="", exit_code=0,
                                total_time_s=summary["timing.total"], ndof=summary["model.ndof"])

@@ -134,10 +134,10 @@ end subroutine beam_nonlinear_forces
 
 !> Number of strain terms per element of the 'cubic' bending beam.
 subroutine beam_cubic_size(nterms)
-  use beam_structural, only: structural_terms
+  use beam_cubic, only: cubic_terms
   implicit none
   integer, intent(out) :: nterms
-  nterms = structural_terms
+  nterms = cubic_terms
 end subroutine beam_cubic_size
 
 !> Strain forms, reference strains and stiffnesses of the 'cubic' bending beam per
@@ -147,7 +147,7 @@ subroutine beam_cubic_setup(nel, nterms, reference, lengths, area, inertia_y, in
                             torsion, shear_y, shear_z, youngs, poisson, forms, strain0, &
                             stiffness, info)
   use ancf_kinds, only: dp
-  use beam_structural, only: structural_setup
+  use beam_cubic, only: cubic_setup
   implicit none
   integer, intent(in) :: nel, nterms
   real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), area, inertia_y, inertia_z
@@ -157,7 +157,7 @@ subroutine beam_cubic_setup(nel, nterms, reference, lengths, area, inertia_y, in
   integer :: el, code
   info = 0
   do el = 1, nel
-    call structural_setup(reference(:, :, el), lengths(el), area, inertia_y, inertia_z, torsion, &
+    call cubic_setup(reference(:, :, el), lengths(el), area, inertia_y, inertia_z, torsion, &
                           shear_y, shear_z, youngs, poisson, forms(:, :, :, el), strain0(:, el), &
                           stiffness(:, el), code)
     if (code /= 0) then
@@ -172,7 +172,7 @@ end subroutine beam_cubic_setup
 subroutine beam_cubic_forces(ndof, nel, nterms, dofs, e, forms, strain0, stiffness, &
                                   want_tangent, force, energy, tangent)
   use ancf_kinds, only: dp
-  use beam_structural, only: structural_element
+  use beam_cubic, only: cubic_element
   implicit none
   integer, intent(in) :: ndof, nel, nterms, dofs(24, nel), want_tangent
   real(dp), intent(in) :: e(ndof), forms(8, 8, nterms, nel), strain0(nterms, nel)
@@ -184,7 +184,7 @@ subroutine beam_cubic_forces(ndof, nel, nterms, dofs, e, forms, strain0, stiffne
   tangent = 0.0_dp
   !$omp parallel do schedule(static)
   do el = 1, nel
-    call structural_element(reshape(e(dofs(:, el)), [3, 8]), forms(:, :, :, el), strain0(:, el), &
+    call cubic_element(reshape(e(dofs(:, el)), [3, 8]), forms(:, :, :, el), strain0(:, el), &
                             stiffness(:, el), want_tangent /= 0, element_force(:, el), &
                             element_energy(el), tangent(:, :, el))
   end do

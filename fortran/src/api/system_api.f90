@@ -236,13 +236,13 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   call append_set(sys, set, index)
 end subroutine system_add_continuum_set
 
-!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_structural).
+!> Large-deformation beam elements with 'cubic' bending: strain forms (beam_cubic).
 subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strain0, &
                                 stiffness, frame, damping_time, index, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
-  use beam_structural, only: cubic_set, structural_pattern, structural_terms
+  use beam_cubic, only: cubic_set, cubic_pattern, cubic_terms
   use system_store, only: store_get
   use kernel_errors, only: handle_text
   implicit none
@@ -262,7 +262,7 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
     return
   end if
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp) .or. &
-      nterms /= structural_terms) then
+      nterms /= cubic_terms) then
     info = 2
     message = 'system_add_cubic_set: an element dof outside 1..nfull, a' // &
               ' negative damping_time or nterms wrong'
@@ -277,7 +277,7 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   built%strain0 = strain0
   built%term_stiffness = stiffness
   allocate (built%form_pairs(2, 64, nterms), built%form_npairs(nterms))
-  call structural_pattern(forms, built%form_pairs, built%form_npairs)
+  call cubic_pattern(forms, built%form_pairs, built%form_npairs)
   built%damping_time = damping_time
   built%force_cost = 1.2d0
   built%tangent_cost = 3.0d0

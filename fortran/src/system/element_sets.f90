@@ -13,7 +13,7 @@
 !>   set_slot           a holder of any set (an array of polymorphic sets).
 !>
 !> The families extend these types in their own modules: ffr_elastic (ffr_set), beam_nonlinear
-!> (continuum_set), beam_structural (cubic_set), plate_element (plate_set), cable_element
+!> (continuum_set), beam_cubic (cubic_set), plate_element (plate_set), cable_element
 !> (cable_set); system_api constructs them and hands them to mechanical_system's append_set.
 !> Element dofs index the FULL coordinate vector (before the elimination of linear
 !> constraints); scatter(:, :, el) holds each element-matrix entry's position in the values

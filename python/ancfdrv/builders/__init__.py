@@ -1,23 +1,28 @@
 """Template scenes as thin builders over the System API (one module per template): each
 turns a validated template scene into a :class:`~ancfdrv.system.System`, and
 :func:`build_model` assembles it with the scene's effects. General scenes (SPEC section 8)
-are read by :mod:`ancfdrv.io.general` into the same API."""
+are built by :mod:`ancfdrv.builders.general` into the same API."""
 from __future__ import annotations
 
 from ..errors import InputError
 from ..system import Model, System
 from . import boom, cantilever, leaf, plate, spinup, spring
-from .common import BuiltSystem, check_ffr_validity
+from .common import BuiltSystem
+from .general import build_general
 
 BUILDERS = {"boom": boom.build, "cantilever": cantilever.build, "spinup": spinup.build,
             "plate": plate.build, "leaf": leaf.build, "spring": spring.build}
+#: what a template adds to a run (the runner knows no template): hook name -> function of
+#: the scene, by scene kind; a kind without the hook takes the default below
+RUN_HOOKS = {"boom": {"stage_bounds": boom.stage_bounds},
+             "spring": {"settle_mode": spring.settle_mode}}
 
 
 def build_system(scene) -> BuiltSystem:
     """The System a template scene describes (with the builder's response and warnings)."""
-    if scene.kind == "general":
-        from ..io.general import build_general
-        return build_general(scene)
+    if scene.kind == "general":  # the System load_scene built (once), else a new one
+        built, scene.built = scene.built, None
+        return built if built is not None else build_general(scene)
     if scene.kind not in BUILDERS:
         raise InputError(f"no builder for scene kind {scene.kind!r}")
     return BUILDERS[scene.kind](scene)
@@ -26,19 +31,31 @@ def build_system(scene) -> BuiltSystem:
 def build_model(scene) -> Model:
     """The assembled model of a scene: only the scene's effects are computed."""
     built = build_system(scene)
-    model = built.system.assemble(effects=scene.effects,
-                                  linear_joints=scene["solver"].get("linear_joints", "auto"),
-                                  unused_effects="warn" if scene.kind == "general"
-                                  else "allow",
-                                  bounds=scene["scene"].get("bounds", "check"))
-    model.warnings[:0] = built.warnings
-    if built.response is not None:
-        model.response = built.response
-    check_ffr_validity(model, built.system)
-    if scene.kind == "general":  # deflection relative to the supports' rigid motion
-        from ..system.supports import support_frames
-        model.support_frames = support_frames(built.system)
-    return model
+    return built.system.assemble(effects=scene.effects,
+                                 linear_joints=scene["solver"].get("linear_joints", "auto"),
+                                 unused_effects="warn" if scene.kind == "general"
+                                 else "allow",
+                                 bounds=scene["scene"].get("bounds", "check"),
+                                 warnings=built.warnings, response=built.response,
+                                 # deflection relative to the supports' rigid motion
+                                 supports=scene.kind == "general")
 
 
-__all__ = ["build_system", "build_model", "BuiltSystem", "System"]
+def stage_bounds(scene) -> dict[str, tuple[float, float]] | None:
+    """The stages over which a dynamic run summarizes the response (the luffing boom's:
+    :func:`ancfdrv.builders.boom.stage_bounds`), None for other scenes."""
+    hook = RUN_HOOKS.get(scene.kind, {}).get("stage_bounds")
+    return hook(scene) if hook else None
+
+
+def settle_mode(scene) -> str:
+    """How a dynamic run starts: 'none' (from the assembled configuration), 'unloaded'
+    (at rest in the equilibrium of the internal forces alone: prestress carried by
+    contact, the external loads off) or 'loaded' (at rest in the static equilibrium under
+    every load): ``solver.settle``, or the template's own key (the spring's
+    ``spring.settle``)."""
+    hook = RUN_HOOKS.get(scene.kind, {}).get("settle_mode")
+    return hook(scene) if hook else scene["solver"]["settle"]
+
+
+__all__ = ["build_system", "build_model", "stage_bounds", "settle_mode", "BuiltSystem", "System"]

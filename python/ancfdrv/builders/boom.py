@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..history import luffing_stage_bounds
 from ..system import System
 from ..system.bodies import rotation_about
 from .common import BuiltSystem, beam_loads, material, rectangle
@@ -46,3 +47,15 @@ def build(scene) -> BuiltSystem:
         s.load("moment", "moment", body="boom", point=a2, vector=(0.0, 0.0, loads["moment"]),
                effect="bending_moment")
     return built
+
+
+def stage_bounds(scene) -> dict[str, tuple[float, float]] | None:
+    """The run hook of the boom: the bounds of the luffing stages (acceleration, constant
+    speed, braking, after), over which the run summarizes the tip's transverse deflection
+    (None when the boom does not luff)."""
+    boom = scene["boom"]
+    if boom["omega"] <= 0:
+        return None
+    sweep = np.radians(boom["angle_end_deg"] - boom["angle_deg"])
+    return luffing_stage_bounds(boom["omega"], boom["t_start"], boom["t_brake"], sweep,
+                                scene["solver"]["t_end"])

@@ -103,3 +103,11 @@ def road_drive(s: System, spring, scene) -> str | None:
     else:
         s.drive("road", "table", file=scene.resolve(spring["road_file"]))
     return "road"
+
+
+def settle_mode(scene) -> str:
+    """The run hook of the spring: ``spring.settle`` ('none' | 'prestress' | 'gravity')
+    names the start of a dynamic run after what it settles ('none', 'unloaded',
+    'loaded'; :func:`ancfdrv.builders.settle_mode`)."""
+    return {"none": "none", "prestress": "unloaded",
+            "gravity": "loaded"}[scene["spring"]["settle"]]

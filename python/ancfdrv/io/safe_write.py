@@ -128,12 +128,6 @@ def create_fresh(path: str | Path) -> None:
         pass
 
 
-def open_nofollow(path: str | Path, flags: int, mode: int = 0o644) -> int:
-    """``os.open`` with O_NOFOLLOW (and O_CLOEXEC): a symbolic link at ``path`` raises
-    OSError (ELOOP) instead of being followed."""
-    return os.open(path, flags | getattr(os, "O_NOFOLLOW", 0) | os.O_CLOEXEC, mode)
-
-
 #: what a write must leave free besides its own bytes: HDF5's metadata and the final status
 #: written after a refused write (a write that fails inside HDF5 can crash the library when
 #: the file is closed, so the room is checked before writing instead)

@@ -36,6 +36,10 @@ class Scene:
     overrides: list[str] = field(default_factory=list)
     #: general scenes: the named groups in file order (group, typed values)
     items: list[tuple[str, dict[str, Any]]] | None = None
+    #: general scenes: what the builder returned when :func:`load_scene` checked the scene
+    #: (a :class:`~ancfdrv.builders.common.BuiltSystem`), taken by the first
+    #: :func:`ancfdrv.builders.build_system` so that a scene is built once
+    built: Any = field(default=None, repr=False, compare=False)
 
     @property
     def kind(self) -> str:
@@ -77,6 +81,13 @@ class Scene:
     def output_file(self) -> Path:
         name = self.values.get("output", {}).get("file")
         return Path(name) if name else Path("results") / (self.path.stem + ".h5")
+
+
+#: the builder of general scenes: ``effects_of(items)`` (the effects the items belong to)
+#: and ``build(scene)`` (the System, built dry: every name, reference and value checked).
+#: :mod:`ancfdrv.builders.general` registers them; it sits above this reader, which imports
+#: nothing of the layers above it (``import ancfdrv`` always loads the builders).
+GENERAL_BUILDER: dict[str, Callable[..., Any]] = {}
 
 
 def _parse_override_value(kind: str, text: str, where: dict) -> Any:
@@ -307,14 +318,16 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scen
     nml.write(buffer)
     scene = Scene(path=path, values=values, text=buffer.getvalue(), overrides=applied,
                   items=items)
-    from .general import build_general, effects_of
+    if not GENERAL_BUILDER:
+        raise RuntimeError("import ancfdrv (the package) to read general scenes")
+    effects_of = GENERAL_BUILDER["effects_of"]
     if not listed:
         values["scene"]["effects"] = sorted(effects_of(items))
     _check_general(values, file, {e for e in effects_of(items)})
     validate.check_time(values["solver"], values["scene"]["analysis"], file)
     validate.check_resources(validate.estimate_general(items), file, values["solver"],
                              values["scene"]["analysis"])
-    build_general(scene)  # every name, reference and value checked, no kernel work
+    scene.built = GENERAL_BUILDER["build"](scene)  # every name, reference and value checked
     return scene
 
 

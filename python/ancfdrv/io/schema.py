@@ -4,7 +4,7 @@ physical range and a one-line meaning.
 Template scenes (SPEC section 3) use :data:`SCHEMA`: one model group (``&boom``,
 ``&cantilever``, ``&spinup``, ``&plate``, ``&leaf``, ``&spring``) and the common groups. General
 scenes (SPEC section 8) use the repeatable, named groups of :data:`GENERAL_SCHEMA` (each
-one call of the System API, :mod:`ancfdrv.io.general`) with ``&scene``, ``&solver`` and
+one call of the System API, :mod:`ancfdrv.builders.general`) with ``&scene``, ``&solver`` and
 ``&output``.
 """
 from __future__ import annotations

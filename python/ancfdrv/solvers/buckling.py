@@ -248,15 +248,6 @@ def _root(history: list[tuple[float, float]]) -> float | None:
     return float(min(roots, key=lambda r: abs(r - p2))) if roots else None
 
 
-def _smallest_positive(theta: np.ndarray) -> float:
-    scale = np.abs(theta).max(initial=0.0)
-    positive = theta[theta > 1e-12 * max(scale, 1e-300)]
-    if not len(positive):
-        raise SolverError("buckling: no positive load factor (the reference loads do not "
-                          "reduce the stiffness)")
-    return float(1.0 / positive.max())
-
-
 def buckling_analysis(model: Model, base_model: Model, count: int, *,
                       fixed_loads: tuple[str, ...] = (), method: str = "nonlinear",
                       solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,

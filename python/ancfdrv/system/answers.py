@@ -20,7 +20,7 @@ Reactions
 
 Section forces
     At ``stations`` points per element (equally spaced, both ends included) from the
-    element's own strain measures (``fortran/src/elements/beam_structural.f90``) and the
+    element's own strain measures (``fortran/src/elements/beam_cubic.f90``) and the
     section's stiffness, relative to the reference configuration: axial Green strain
     (r_x . r_x - 1)/2, bending strains b_y = -r_y,x . r_x (+ r_xx . r_y - mean(r_xx . r_y)
     with 'cubic' bending), b_z likewise with r_z, twist 1/2 (r_y,x . r_z - r_z,x . r_y)
@@ -363,7 +363,7 @@ def reactions(model: Model, e: np.ndarray, lam: np.ndarray, *, t: float = 0.0,
 # -- section forces --------------------------------------------------------------------------
 def _rows(xi: np.ndarray, length: float):
     """Coefficient rows (n, 8) of r_x, r_xx, r_y, r_z, r_y,x, r_z,x on the element's eight
-    nodal vectors [r1, r1_x, r1_y, r1_z, r2, ...] (beam_structural.centreline_rows)."""
+    nodal vectors [r1, r1_x, r1_y, r1_z, r2, ...] (beam_cubic.centreline_rows)."""
     z = np.zeros_like(xi)
     o = np.ones_like(xi)
     slope = np.column_stack([(-6 * xi + 6 * xi**2) / length, 1 - 4 * xi + 3 * xi**2, z, z,
@@ -391,7 +391,7 @@ class _Tables:
             return [np.stack([rows[k] for rows in per])[index] for k in range(6)]
         self.at, self.gauss, self.ends = table(self.xi), table(gauss), table(np.array([0.0, 1.0]))
         # the axial strain at the element's three axial Gauss points (the element's own
-        # sampling, beam_structural n_axial = 3), and the quadratic through them at the
+        # sampling, beam_cubic n_axial = 3), and the quadratic through them at the
         # stations: the Green strain between them carries the spurious share of the
         # bending slopes (v'^2/2 is quartic where u' is quadratic: membrane locking)
         axial = 0.5 + np.array([-1.0, 0.0, 1.0]) * np.sqrt(0.15)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass
+from typing import Iterable
 
 import numpy as np
 import scipy.sparse as sp
@@ -26,6 +27,7 @@ from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
 from .model import (VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_FORCE, VLOAD_FOLLOWER_MOMENT, FrameInfo,
                     MomentInfo, Model, ProbeInfo, SetInfo, VectorLoadInfo)
 from .patterns import Elimination, Pattern, eliminate, reduction_plan
+from .supports import support_frames
 
 #: effects every model reports (a zero count proves an effect was not computed)
 EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
@@ -47,10 +49,13 @@ class _Active:
 
 
 def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "auto",
-             check_frames: bool = True) -> Model:
+             check_frames: bool = True, warnings: Iterable[str] = (),
+             response: tuple[str, int] | None = None, supports: bool = False) -> Model:
     """The model of ``system`` with the listed effects (None: every effect it uses).
     ``check_frames=False`` assembles an 'ffr' beam whose frame nothing holds (for checks of
-    joint equations alone); the solvers refuse to run such a model."""
+    joint equations alone); the solvers refuse to run such a model. ``warnings``,
+    ``response``, ``supports``: see :meth:`~ancfdrv.system.System.assemble`."""
+    prefix = list(warnings)
     if linear_joints not in LINEAR_JOINTS:
         raise InputError(f"linear_joints {linear_joints!r} must be one of {LINEAR_JOINTS}")
     if not any(b.flexible or isinstance(b, RigidBody) for b in system.bodies.values()):
@@ -59,7 +64,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     counters: Counter = Counter({name: 0 for name in EFFECTS_AVAILABLE + CONTACT_COUNTERS})
     for name in active_effects:
         counters[name] += 0
-    warnings: list[str] = []
+    warnings: list[str] = prefix
     notes: list[str] = []
     act = _select(system, active_effects, warnings)
 
@@ -133,7 +138,8 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         driven_forces=[(i, reduce(v)) for i, v in driven],
         moments=moments, constraints=constraints, contact_pairs=contact_pairs, probes=probes,
         point_masses=[(m.body.name, m.point, m.mass) for m in act.masses],
-        linear_joints=mode)
+        linear_joints=mode, response=response,
+        support_frames=support_frames(system) if supports else None)
     model.vector_loads = vector_loads
     model.frame_problems = frame_problems
     _answer_inputs(model, system, equations, elimination, reduction, mass_full,

@@ -158,7 +158,9 @@ class Model:
                  reduction: Reduction | None, full_pattern: Pattern, pattern: Pattern,
                  mass: sp.csr_matrix, constant_force: np.ndarray, driven_forces: list,
                  moments: list[MomentInfo], constraints: ConstraintSet, contact_pairs: list[dict],
-                 probes: dict[str, ProbeInfo], point_masses: list, linear_joints: str) -> None:
+                 probes: dict[str, ProbeInfo], point_masses: list, linear_joints: str,
+                 response: tuple[str, int] | None = None,
+                 support_frames: dict | None = None) -> None:
         self.title, self.effects, self.counters = title, effects, counters
         self.warnings, self.notes = warnings, notes
         self.bodies, self.sets, self.frames, self.drives = bodies, sets, frames, drives
@@ -180,9 +182,12 @@ class Model:
         self.length_scale = length_scale(bodies)
         #: why the model must not be run (assembled with check_frames=False)
         self.frame_problems: list[str] = []
-        #: the probe and component sweeps compare (builders may set it)
-        self.response: tuple[str, int] | None = None
-        if probes:
+        #: the probe and component sweeps compare (a builder's choice, else the first probe's)
+        self.response: tuple[str, int] | None = response
+        #: the rigid motion of each beam's supports (general scenes and Python runs:
+        #: deflections relative to it, :mod:`ancfdrv.system.supports`), else None
+        self.support_frames = support_frames
+        if probes and response is None:
             first = next(iter(probes.values()))
             body = next(b for b in bodies if b.name == first.body)
             self.response = (first.name, 1 if isinstance(body, Beam) else 2)

@@ -35,6 +35,7 @@ from .bodies import Beam, Body, Ground, Leaf, Material, Plate, RigidBody
 from .cable import Cable
 from .contact import ContactPair
 from .drives import DRIVE_TYPES, Drive, Table
+from .ffr_checks import ffr_speed_warnings
 from .joints import Joint
 from .loads import LOAD_TYPES, Load
 from .probes import Probe
@@ -479,7 +480,8 @@ class System:
     @_api
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
                  check_frames: bool = True, unused_effects: str | None = None,
-                 bounds: str | None = None):
+                 bounds: str | None = None, warnings: Iterable[str] = (),
+                 response: tuple[str, int] | None = None, supports: bool = False):
         """The model of this system (``ancfdrv.system.assembly.assemble``): only the effects
         listed (default: the system's own list, else all it uses) are computed. An 'ffr'
         beam whose floating frame nothing holds is refused (InputError); with
@@ -491,7 +493,12 @@ class System:
         (``System(effects=...)``) gets 'warn', a list given here 'allow' (a caller switching
         effects of a built system). Drives and loads beyond the physical
         bounds are refused (:meth:`check_bounds`) unless ``bounds='off'`` (default: the
-        system's own setting)."""
+        system's own setting). The model is complete when it is returned: ``warnings``
+        (a builder's) come first in ``model.warnings``, then the assembly's, then the check
+        of 'ffr' frames turning near a bending frequency; ``response`` is the (probe,
+        component) a sweep compares (default: the first probe's); ``supports`` records the
+        rigid motion of each beam's supports (``model.support_frames``: general scenes and
+        Systems run from Python report deflections relative to it)."""
         from .assembly import assemble
         if effects is not None:
             effects = check_effects(effects)
@@ -514,20 +521,22 @@ class System:
         validate.check_resources(validate.Estimate(self._parts(), contact_points=sum(
             2 * c.points for c in self.contacts.values())), None, None, "static")
         model = assemble(self, tuple(chosen) if chosen is not None else None,
-                         linear_joints=linear_joints, check_frames=check_frames)
+                         linear_joints=linear_joints, check_frames=check_frames,
+                         warnings=warnings, response=response, supports=supports)
         if unused_note:  # not silent: the run prints it, a script sees a UserWarning
-            import warnings
+            import warnings as _warnings
             model.warnings.append(unused_note)
-            warnings.warn(unused_note, UserWarning, stacklevel=3)
+            _warnings.warn(unused_note, UserWarning, stacklevel=3)
+        model.warnings.extend(ffr_speed_warnings(self))
         return model
 
     # -- analyses (SPEC section 10, "Python") ------------------------------------------------
-    #: the analyses, registered by :mod:`ancfdrv.results` (which sits above this layer: it
+    #: the analyses, registered by :mod:`ancfdrv.analyses` (which sits above this layer: it
     #: runs the solvers and writes the result file)
     _ANALYSES: dict[str, Callable[..., Any]] = {}
 
     def _analysis(self, name: str) -> Callable[..., Any]:
-        if name not in self._ANALYSES:  # only when ancfdrv.results was never imported
+        if name not in self._ANALYSES:  # only when ancfdrv.analyses was never imported
             raise RuntimeError("import ancfdrv (the package) to run analyses")
         return self._ANALYSES[name]
 
@@ -565,12 +574,8 @@ class System:
         solver, tol, load_steps, rigid_tol, spin_rate, spin_axis, spin_centre, ...).
         Returns a :class:`~ancfdrv.solvers.modal.ModalResult` (frequency in Hz ascending,
         rigid-body modes at 0; mass-normalized shapes; damping_ratio with damping on)."""
-        from ..solvers.modal import modal_analysis
-        model = self.assemble(effects=effects, linear_joints=linear_joints)
-        try:
-            return modal_analysis(model, n, **options)
-        finally:
-            model.close()
+        return self._analysis("modes")(self, n, effects=effects, linear_joints=linear_joints,
+                                       **options)
 
     def buckling(self, n: int = 3, *, fixed_loads: Iterable[str] = (),
                  effects: Iterable[str] | None = None, linear_joints: str = "auto",
@@ -580,30 +585,8 @@ class System:
         all loads of an effect) in ``fixed_loads`` keep their value, the others are
         multiplied. ``options``: method ('nonlinear' | 'linear'), solver, tol, load_steps,
         rtol, ... Returns a :class:`~ancfdrv.solvers.buckling.BucklingResult`."""
-        from ..solvers.buckling import buckling_analysis
-        fixed = tuple(fixed_loads)
-        known = set(self.loads) | {load.effect for load in self.loads.values()}
-        unknown = [name for name in fixed if name not in known]
-        if unknown:
-            raise InputError(f"buckling: fixed_loads names unknown load(s) or effect(s) "
-                             f"{', '.join(map(repr, unknown))} (loads: "
-                             f"{', '.join(self.loads) or 'none'})")
-        model = self.assemble(effects=effects, linear_joints=linear_joints)
-        base = model
-        if fixed:
-            every = self.loads
-            try:
-                self.loads = {k: v for k, v in every.items() if k in fixed or v.effect in fixed}
-                base = self.assemble(effects=effects, linear_joints=linear_joints)
-            finally:
-                self.loads = every
-        try:
-            return buckling_analysis(model, base, n, fixed_loads=fixed, **options)
-        finally:
-            model.close()
-            if base is not model:
-                base.close()
-
+        return self._analysis("buckling")(self, n, fixed_loads=fixed_loads, effects=effects,
+                                          linear_joints=linear_joints, **options)
 
 
 #: drive parameters of the API per type (keyword -> schema key of &drive checked against)

@@ -40,7 +40,7 @@ import scipy.sparse as sp
 from h5py import h5a, h5d, h5p, h5s, h5t
 
 from ..errors import InputError
-from .safe_write import write_with
+from ..io.safe_write import write_with
 from ..system.bodies import Beam, Plate, RigidBody
 
 _STEPS_GROUP = "dynamic/xdmf"

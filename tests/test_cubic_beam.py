@@ -1,4 +1,4 @@
-"""The 'cubic' bending option (fortran/src/beam_structural.f90, docs/theory.md section 12)
+"""The 'cubic' bending option (fortran/src/beam_cubic.f90, docs/theory.md section 12)
 for both formulations.
 
 References: the kernel's own central differences, rigid motions (zero strain), the
@@ -69,7 +69,7 @@ def test_rigid_motions_carry_no_strain(angle_deg):
 
 
 def test_system_force_over_the_nonzero_entries_is_the_dense_elements():
-    """The system sums each strain form over its nonzero entries only (structural_pattern);
+    """The system sums each strain form over its nonzero entries only (cubic_pattern);
     the element entry point multiplies the dense 8 x 8 forms. At a rotated, perturbed state
     of a straight beam both give the same force and energy to round-off."""
     model = beam("nonlinear", nodes=5, poisson=0.3)

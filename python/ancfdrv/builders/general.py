@@ -12,8 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from ..builders.common import BuiltSystem
+from .common import BuiltSystem
 from ..errors import InputError
+from ..io.scene import GENERAL_BUILDER
 from ..system import System
 from ..system.sections import SECTIONS
 from ..system.system import LOAD_EFFECTS
@@ -262,3 +263,6 @@ def build_general(scene) -> BuiltSystem:
                              group="scene", key="response")
         response = (name, scene["scene"]["response_component"])
     return BuiltSystem(s, response)
+
+
+GENERAL_BUILDER.update(effects_of=effects_of, build=build_general)  # for io.scene.load_scene

@@ -13,7 +13,7 @@
 !> n + 1 tying conditions for n + 1 section rotations, so it cannot lock, and a constant
 !> shear is integrated exactly. Small strain: kappa = theta' + v'' - mean(v''), gamma =
 !> v' - theta; the element reproduces the Timoshenko beam under end loads and uniform load
-!> exactly with one element (tests/test_structural.py). Torsion 1/2 (r_y,x . r_z -
+!> exactly with one element (tests/test_cubic_beam.py). Torsion 1/2 (r_y,x . r_z -
 !> r_z,x . r_y); axial Green strain (r_x . r_x - 1)/2; section strains (r_y . r_y - 1)/2,
 !> (r_z . r_z - 1)/2, r_y . r_z at the nodes.
 !>
@@ -26,28 +26,28 @@
 !> with its torsion and shear correction, so the two options differ in the bending
 !> interpolation only.
 !>
-!> Kelvin-Voigt material damping (retardation time tau, structural_element given the rates) acts on
+!> Kelvin-Voigt material damping (retardation time tau, cubic_element given the rates) acts on
 !> every strain: s -> s + tau s' with s' = q' . C q, so Q_d = sum_terms k tau s' C q, the
 !> dissipated power sum k tau s'^2 >= 0 (a rigid motion leaves every s' at zero), and the
 !> tangent dQ/dq + c dQ/dq' = sum k ((1 + c tau) g g^T + tau g (C q')^T + (s + tau s') C x I3)
 !> (g = C q), not symmetric.
-module beam_structural
+module beam_cubic
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
   use element_sets, only: local_element_set
   implicit none
   private
-  public :: structural_setup, structural_element, structural_pattern, cubic_set
+  public :: cubic_setup, cubic_element, cubic_pattern, cubic_set
 
   !> Axial points of the axial and bending strains, of the torsion.
   integer, parameter :: n_line = 3, n_axial = 3, n_torsion = 2
   !> Nodal terms per node: shear y, shear z, section yy, zz, yz.
   integer, parameter :: n_nodal = 5
-  integer, parameter, public :: structural_terms = 2 * n_line + n_axial + n_torsion + 2 * n_nodal
+  integer, parameter, public :: cubic_terms = 2 * n_line + n_axial + n_torsion + 2 * n_nodal
 
   !> The family's element set (element_sets): strain forms (8, 8, nterms, nel), reference
   !> strains and stiffnesses (nterms, nel), and the forms' nonzero entries
-  !> (structural_pattern): (2, 64, nterms), (nterms).
+  !> (cubic_pattern): (2, 64, nterms), (nterms).
   type, extends(local_element_set) :: cubic_set
     real(dp), allocatable :: forms(:, :, :, :), strain0(:, :), term_stiffness(:, :)
     integer, allocatable :: form_pairs(:, :, :), form_npairs(:)
@@ -86,13 +86,13 @@ contains
   !> reference tangent r0_x vanishes somewhere.
   !> Section data: area, I_y = int z^2 dA, I_z = int y^2 dA, the Saint-Venant torsion
   !> constant J (torsion) and the shear factors k_y (shear along the height, 2E12) and k_z.
-  pure subroutine structural_setup(reference, length, area, inertia_y, inertia_z, torsion, &
+  pure subroutine cubic_setup(reference, length, area, inertia_y, inertia_z, torsion, &
                                    shear_y, shear_z, youngs, poisson, forms, strain0, &
                                    stiffness, info)
     real(dp), intent(in) :: reference(3, 8), length, area, inertia_y, inertia_z, torsion
     real(dp), intent(in) :: shear_y, shear_z, youngs, poisson
-    real(dp), intent(out) :: forms(8, 8, structural_terms), strain0(structural_terms)
-    real(dp), intent(out) :: stiffness(structural_terms)
+    real(dp), intent(out) :: forms(8, 8, cubic_terms), strain0(cubic_terms)
+    real(dp), intent(out) :: stiffness(cubic_terms)
     integer, intent(out) :: info
     real(dp) :: points(n_line), weights(n_line), p2(n_torsion), w2(n_torsion)
     real(dp) :: pa(n_axial), wa(n_axial)
@@ -164,22 +164,22 @@ contains
       info = 2
       return
     end if
-    do t = 1, structural_terms
+    do t = 1, cubic_terms
       strain0(t) = 0.5_dp * sum(reference * matmul(reference, forms(:, :, t)))
     end do
-  end subroutine structural_setup
+  end subroutine cubic_setup
 
   !> The nonzero entries (a, b) of each term's form in any element of a set (forms (8, 8,
-  !> structural_terms, nel)): a term couples few of the eight nodal vectors (an axial
+  !> cubic_terms, nel)): a term couples few of the eight nodal vectors (an axial
   !> strain the four of the centre line, a nodal shear two), so the force over these
   !> pairs costs about a third of the dense product.
-  pure subroutine structural_pattern(forms, pairs, npairs)
+  pure subroutine cubic_pattern(forms, pairs, npairs)
     real(dp), intent(in) :: forms(:, :, :, :)
-    integer, intent(out) :: pairs(2, 64, structural_terms), npairs(structural_terms)
+    integer, intent(out) :: pairs(2, 64, cubic_terms), npairs(cubic_terms)
     integer :: t, a, b
     pairs = 0
     npairs = 0
-    do t = 1, structural_terms
+    do t = 1, cubic_terms
       do b = 1, 8
         do a = 1, 8
           if (all(forms(a, b, t, :) == 0.0_dp)) cycle
@@ -188,24 +188,24 @@ contains
         end do
       end do
     end do
-  end subroutine structural_pattern
+  end subroutine cubic_pattern
 
   !> Internal force (24), strain energy and, when want_tangent, the tangent (24 x 24) of
-  !> one element with nodal vectors q(3, 8). With the set's pattern (structural_pattern)
+  !> one element with nodal vectors q(3, 8). With the set's pattern (cubic_pattern)
   !> the gradients C q run over the forms' nonzero entries only.
   !> With Kelvin-Voigt damping (the nodal rates q'(3, 8), damping_time tau > 0, rate_factor
   !> and dissipation all present): the force includes the damping force, dissipation is its
   !> power and the tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric:
   !> whole columns, and the gradients from the full forms). (The two term loops stay apart,
   !> as in beam_nonlinear: one loop behind a flag compiles to a slower undamped force.)
-  pure subroutine structural_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
+  pure subroutine cubic_element(q, forms, strain0, stiffness, want_tangent, force, energy, &
                                      tangent, pairs, npairs, rates, damping_time, rate_factor, &
                                      dissipation)
-    real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
-    real(dp), intent(in) :: stiffness(structural_terms)
+    real(dp), intent(in) :: q(3, 8), forms(8, 8, cubic_terms), strain0(cubic_terms)
+    real(dp), intent(in) :: stiffness(cubic_terms)
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
-    integer, intent(in), optional :: pairs(2, 64, structural_terms), npairs(structural_terms)
+    integer, intent(in), optional :: pairs(2, 64, cubic_terms), npairs(cubic_terms)
     real(dp), intent(in), optional :: rates(3, 8), damping_time, rate_factor
     real(dp), intent(out), optional :: dissipation
     if (present(rates)) then
@@ -215,24 +215,24 @@ contains
       call elastic_terms(q, forms, strain0, stiffness, want_tangent, force, energy, tangent, &
                          pairs, npairs)
     end if
-  end subroutine structural_element
+  end subroutine cubic_element
 
-  !> structural_element without damping (its loop over the strain terms). With the set's pattern (structural_pattern)
+  !> cubic_element without damping (its loop over the strain terms). With the set's pattern (cubic_pattern)
   !> the gradients C q run over the forms' nonzero entries only.
   pure subroutine elastic_terms(q, forms, strain0, stiffness, want_tangent, force, energy, &
                                 tangent, pairs, npairs)
-    real(dp), intent(in) :: q(3, 8), forms(8, 8, structural_terms), strain0(structural_terms)
-    real(dp), intent(in) :: stiffness(structural_terms)
+    real(dp), intent(in) :: q(3, 8), forms(8, 8, cubic_terms), strain0(cubic_terms)
+    real(dp), intent(in) :: stiffness(cubic_terms)
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, tangent(24, 24)
-    integer, intent(in), optional :: pairs(2, 64, structural_terms), npairs(structural_terms)
+    integer, intent(in), optional :: pairs(2, 64, cubic_terms), npairs(cubic_terms)
     real(dp) :: gradient(3, 8), flat(24), strain, geometric(8, 8), scaled
     integer :: t, j, a, k
     force = 0.0_dp
     energy = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     geometric = 0.0_dp
-    do t = 1, structural_terms
+    do t = 1, cubic_terms
       if (present(pairs)) then
         gradient = 0.0_dp
         do k = 1, npairs(t)
@@ -263,14 +263,14 @@ contains
     end do
   end subroutine elastic_terms
 
-  !> structural_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
+  !> cubic_element with Kelvin-Voigt damping (damping_time tau > 0) at the nodal rates
   !> q'(3, 8) (its loop over the strain terms): the force includes the damping force, dissipation is its power and the
   !> tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (not symmetric).
   pure subroutine damped_terms(q, rates, forms, strain0, stiffness, damping_time, &
                                             rate_factor, want_tangent, force, energy, &
                                             dissipation, tangent)
-    real(dp), intent(in) :: q(3, 8), rates(3, 8), forms(8, 8, structural_terms)
-    real(dp), intent(in) :: strain0(structural_terms), stiffness(structural_terms)
+    real(dp), intent(in) :: q(3, 8), rates(3, 8), forms(8, 8, cubic_terms)
+    real(dp), intent(in) :: strain0(cubic_terms), stiffness(cubic_terms)
     real(dp), intent(in) :: damping_time, rate_factor
     logical, intent(in) :: want_tangent
     real(dp), intent(out) :: force(24), energy, dissipation, tangent(24, 24)
@@ -282,7 +282,7 @@ contains
     dissipation = 0.0_dp
     if (want_tangent) tangent = 0.0_dp  ! (a force-only call leaves it alone, as the plate does)
     geometric = 0.0_dp
-    do t = 1, structural_terms
+    do t = 1, cubic_terms
       gradient = matmul(q, forms(:, :, t))
       strain = 0.5_dp * sum(q * gradient) - strain0(t)
       strain_rate = sum(rates * gradient)                 ! s' = q' . C q
@@ -309,7 +309,7 @@ contains
     call add_kron_identity(geometric, tangent)
   end subroutine damped_terms
 
-  !> The element_set element_forces of a cubic set: structural_element of element el.
+  !> The element_set element_forces of a cubic set: cubic_element of element el.
   pure subroutine cubic_element_forces(set, el, coords, want_tangent, force, energy, tangent, &
                                        info, rates, rate_factor, dissipation)
     class(cubic_set), intent(in) :: set
@@ -322,12 +322,12 @@ contains
     real(dp), intent(out), optional :: dissipation
     info = 0
     if (present(rates)) then
-      call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
+      call cubic_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
                               set%term_stiffness(:, el), want_tangent, force, energy, tangent, &
                               rates=rates, damping_time=set%damping_time, &
                               rate_factor=rate_factor, dissipation=dissipation)
     else
-      call structural_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
+      call cubic_element(coords, set%forms(:, :, :, el), set%strain0(:, el), &
                               set%term_stiffness(:, el), want_tangent, force, energy, tangent, &
                               set%form_pairs, set%form_npairs)
     end if
@@ -348,4 +348,4 @@ contains
     end do
   end subroutine add_kron_identity
 
-end module beam_structural
+end module beam_cubic

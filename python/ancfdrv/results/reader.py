@@ -1,5 +1,5 @@
-"""From a :class:`~ancfdrv.system.System` to results in one call, and any result file back
-(SPEC section 10, "Python").
+"""The result object: any result file read back (SPEC section 10, "Python"); the runs from
+Python that produce one are :mod:`ancfdrv.analyses`.
 
     from ancfdrv import System, Rectangle, open
     s = System("cantilever")
@@ -9,13 +9,9 @@
     res.save("results/cantilever.h5")        # the file `ancf run` writes (plot, XDMF beside)
     again = open("results/cantilever.h5")    # the same object from any result file
 
-A run from Python goes through the very path of ``ancf run`` (:func:`ancfdrv.runner.run_loaded`:
-the same solvers, settings, writer and status handling), with the CLI's defaults: every key
-of the scene groups ``&solver`` and ``&output`` is a keyword with the schema's default
-(``docs/scenes.md``), e.g. ``jacobian='reuse'``, ``integrator='newmark'``,
-``static_method='split'``. The run writes its HDF5 file to a temporary directory (or to
-``output=``); the :class:`Results` object is read back from that file, so an object from a
-run and one from :func:`open_results` (``ancfdrv.open``) are the same by construction.
+A run from Python writes its HDF5 file as ``ancf run`` does, and the :class:`Results`
+object is read back from that file, so an object from a run and one from
+:func:`open_results` (``ancfdrv.open``) are the same by construction.
 
 Result groups other modules add (``reactions``, ``sections``, ``stress`` under /static and
 /dynamic, and the root groups ``modal`` and ``buckling``) are read generically: every group
@@ -25,23 +21,14 @@ becomes a :class:`Record` (a dict of arrays and sub-records with the HDF5 attrib
 from __future__ import annotations
 
 import shutil
-import sys
-import tempfile
-import weakref
 from pathlib import Path
 from typing import Any
 
 import h5py
 import numpy as np
 
-from .errors import InputError
-from .io import hdf5
-from .io.scene import Scene, _typed
-from .io.schema import SCHEMA
-from .io import validate
-
-#: the analyses a System runs from Python (scene.analysis)
-ANALYSES = ("static", "dynamic", "static+dynamic")
+from ..errors import InputError
+from . import hdf5
 
 
 class Record(dict):
@@ -287,8 +274,8 @@ class Results:
         XDMF description (dynamic runs with output.xdmf) and the plot (``plot``) beside it
         as ``ancf run`` writes them. A plot that fails is a warning, never an error.
         Refuses (InputError) what ``ancf run`` refuses: a directory, a non-HDF5 file, ..."""
-        from .io.safe_write import write_with
-        from .runner import check_output_path
+        from ..io.safe_write import write_with
+        from .output_path import check_output_path
         target = Path(path)
         if target.exists() and target.resolve() == self.path.resolve():
             raise InputError("save: the target is this result's own file", file=str(target))
@@ -297,11 +284,11 @@ class Results:
         # atomically and never through a link planted at the target (io.safe_write)
         write_with(target, lambda temp: shutil.copyfile(self.path, temp))
         if self.path.with_suffix(".xdmf").exists():
-            from .io.xdmf import write_xdmf
+            from .xdmf import write_xdmf
             write_xdmf(target)
         if plot:
             import warnings
-            from .plots import plot_result
+            from ..plots import plot_result
             try:
                 plot_result(target)
             except Exception as exc:  # noqa: BLE001 - an optional output never fails a save
@@ -329,130 +316,3 @@ def open_results(path: str | Path) -> Results:
             raise InputError("not an ancfdrv result file (no /model group)", file=str(path))
         record = _read_group(h5)
     return Results(path, record)
-
-
-# -- runs from Python -----------------------------------------------------------------------
-def _settings(options: dict[str, Any], where: str) -> tuple[dict, dict]:
-    """The &solver and &output values of a run from Python: the schema's defaults (the
-    CLI's) with the keyword options; unknown keys and bad values raise InputError."""
-    solver_keys, output_keys = set(SCHEMA["solver"]), set(SCHEMA["output"]) - {"file"}
-    unknown = sorted(set(options) - solver_keys - output_keys)
-    if unknown:
-        raise InputError(f"{where}: unknown option {', '.join(map(repr, unknown))}; options: "
-                         f"the &solver keys ({', '.join(sorted(solver_keys))}) and the "
-                         f"&output keys ({', '.join(sorted(output_keys))}), see docs/scenes.md")
-    solver = {k: v for k, v in options.items() if k in solver_keys}
-    output = {k: v for k, v in options.items() if k in output_keys}
-    for key, value in list(solver.items()) + list(output.items()):
-        if isinstance(value, (tuple, list, np.ndarray)):
-            raise InputError(f"{where}: option {key!r} takes one value, got {value!r}")
-    if "dt" in solver and isinstance(solver["dt"], int) and not isinstance(solver["dt"], bool):
-        solver["dt"] = float(solver["dt"])
-    for key in ("t_end", "tol", "newton_tol", "split_p", "rho_inf", "beta", "gamma",
-                "contraction"):
-        if isinstance(solver.get(key), int) and not isinstance(solver[key], bool):
-            solver[key] = float(solver[key])
-    return (_typed("solver", "solver", solver, SCHEMA["solver"], where),
-            _typed("output", "output", output, SCHEMA["output"], where))
-
-
-def _script_text(system) -> tuple[Path, str]:
-    """What the file's 'scene' attribute holds for a System built in Python: the running
-    script's text when there is one, else a listing of the system's items."""
-    main = sys.modules.get("__main__")
-    script = Path(getattr(main, "__file__", "") or "")
-    if script.suffix == ".py" and script.is_file() and "site-packages" not in script.parts:
-        try:
-            return script.resolve(), script.read_text()
-        except (OSError, UnicodeDecodeError):
-            pass
-    lines = [f"# ancfdrv System {system.title!r} built in Python"]
-    for kind in ("materials", "bodies", "drives", "joints", "loads", "contacts", "probes"):
-        items = getattr(system, kind, {})
-        if items:
-            lines.append(f"# {kind}: {', '.join(items)}")
-    return Path("<python>"), "\n".join(lines) + "\n"
-
-
-def run_system(system, analysis: str, *, output: str | Path | None = None,
-               effects=None, progress: bool | None = None, **options: Any) -> Results:
-    """Run a System the way ``ancf run`` runs a scene and return its :class:`Results`.
-
-    ``analysis``: 'static', 'dynamic' or 'static+dynamic'; ``options``: any key of the
-    scene groups &solver and &output (docs/scenes.md), with their defaults; ``output``:
-    the HDF5 file to write (default: a temporary file that lives as long as the results;
-    :meth:`Results.save` copies it); ``effects``: the effects to compute (default: the
-    system's list, else every effect its items belong to). Raises InputError (bad input,
-    exit 2 in the CLI) or SolverError (the file keeps the rows computed)."""
-    from .builders.common import check_ffr_validity
-    from .runner import run_loaded
-    where = f"System {system.title!r}"
-    if analysis not in ANALYSES:
-        raise InputError(f"{where}: analysis {analysis!r} must be one of {', '.join(ANALYSES)}")
-    solver, out_values = _settings(options, where)
-    validate.check_time(solver, analysis, where)
-    chosen = effects if effects is not None else system.effects
-    model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
-                            linear_joints=solver["linear_joints"])
-    model.kind = "general"
-    from .system.supports import support_frames
-    model.support_frames = support_frames(system)
-    if "static_method" not in options and (any(s.kind != "ffr" for s in model.sets)
-                                           or model.contact_pairs):
-        # the CLI's default 'split' needs every body 'ffr' and no contact: where it cannot
-        # run (it would fail with that message), Newton is the only static method
-        solver["static_method"] = "newton"
-    try:
-        check_ffr_validity(model, system)
-        formulations = sorted({getattr(b, "formulation", "") for b in system.bodies.values()
-                               if getattr(b, "formulation", "")})
-        path, text = _script_text(system)
-        values = {"scene": {"title": system.title or "System", "analysis": analysis,
-                            "formulation": ",".join(formulations) or "rigid",
-                            "effects": list(model.effects), "response": None,
-                            "response_component": 2},
-                  "solver": solver, "output": out_values}
-        scene = Scene(path=path, values=values, text=text, items=[])
-    except BaseException:
-        model.close()
-        raise
-    owner = None
-    if output is None:
-        owner = tempfile.TemporaryDirectory(prefix="ancfdrv-")
-        weakref.finalize(owner, owner.cleanup)
-        target = Path(owner.name) / "result.h5"
-    else:
-        target = Path(output)
-    run_loaded(scene, target, progress=progress, model=model)
-    result = open_results(target)
-    result._owner = owner
-    return result
-
-
-def static(system, *, output: str | Path | None = None, effects=None,
-           progress: bool | None = None, **options: Any) -> Results:
-    """:meth:`System.static`: the static equilibrium (``ancf run`` of an 'static' scene)."""
-    return run_system(system, "static", output=output, effects=effects, progress=progress,
-                      **options)
-
-
-def simulate(system, t_end: float, dt: float | None = None, *, from_static: bool = False,
-             output: str | Path | None = None, effects=None, progress: bool | None = None,
-             **options: Any) -> Results:
-    """:meth:`System.simulate`: dynamics to ``t_end`` with step ``dt`` (default: the
-    CLI's, 1e-3 s), from rest in the assembled configuration, or from the static
-    equilibrium (``from_static``: analysis 'static+dynamic')."""
-    if dt is not None:
-        options["dt"] = dt
-    options["t_end"] = t_end
-    return run_system(system, "static+dynamic" if from_static else "dynamic", output=output,
-                      effects=effects, progress=progress, **options)
-
-
-def _register() -> None:
-    """Give System its analyses (the system layer sits below this module)."""
-    from .system.system import System
-    System._ANALYSES.update(static=static, simulate=simulate)
-
-
-_register()

@@ -10,7 +10,7 @@ Conventions:
 * the root attribute ``status`` is 'running' while the run writes, then 'ok', 'failed'
   (with ``message``) or 'interrupted' (SIGINT/SIGTERM: every step computed before the
   signal is in the file); /dynamic has the same ``status``. A file that still says
-  'running' while no process holds its lock (:mod:`ancfdrv.io.lock`) was abandoned:
+  'running' while no process holds its lock (:mod:`ancfdrv.results.lock`) was abandoned:
   its writer was killed (every flushed chunk is kept);
 * the root attributes carry the provenance: package version, git commit (when run from
   a checkout), library versions, compiler, platform, thread settings, command line.
@@ -36,8 +36,8 @@ from .._version import __version__
 from ..errors import InputError
 from ..system.bodies import Beam
 from ..system.model import Model
-from .safe_write import check_room, create_fresh
-from .scene import Scene
+from ..io.safe_write import check_room, create_fresh
+from ..io.scene import Scene
 from ..solvers.static import StaticResult
 
 #: the statuses a result file can carry (root attribute and /dynamic attribute)
@@ -177,7 +177,7 @@ def open_result(path: str | Path, attempts: int = 50) -> h5py.File:
 def _open_write(path: Path, mode: str = "a") -> h5py.File:
     """Open for writing. A reader holding HDF5's lock (``ancf info``, a viewer) delays a
     write by at most about a second; after that the writer goes on without HDF5's lock
-    (the run's own lock, :mod:`ancfdrv.io.lock`, already excludes other writers), so a
+    (the run's own lock, :mod:`ancfdrv.results.lock`, already excludes other writers), so a
     reader never makes a run fail."""
     for _ in range(50):
         try:
