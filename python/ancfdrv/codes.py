@@ -53,4 +53,6 @@ STEP_FAILURES = {
     8: "the contact search found no closest point on the upper surface (the projection "
        "diverged even from the sampled restart)",
     9: "the kernel refused the call (a stale handle or inconsistent sizes: a bug)",
+    10: "a force element's two points coincide (its line of action is undefined) or its "
+        "force table could not be evaluated",
 }
