@@ -194,10 +194,12 @@ def test_period_and_energy_of_the_undamped_oscillator():
     z = np.asarray(res.probes["c"])[:, 2] + 0.9
     crossings = _zero_crossings(t, z)
     period = 2 * np.mean(np.diff(crossings))
-    assert period == pytest.approx(2 * np.pi * np.sqrt(M / K), rel=2e-4)
+    # the trapezoidal rule lengthens the period by (omega h)^2 / 12 (measured 3.332e-5)
+    elongation = period / (2 * np.pi * np.sqrt(M / K)) - 1
+    assert elongation == pytest.approx((OMEGA * 1e-3)**2 / 12, rel=1e-2)
     energy = np.asarray(res.energy["kinetic"]) + np.asarray(res.energy["strain"])
     assert energy[0] == pytest.approx(0.5 * K * 0.1**2, rel=1e-12)
-    assert np.abs(energy - energy[0]).max() <= 1e-8 * energy[0]
+    assert np.abs(energy - energy[0]).max() <= 1e-12 * energy[0]   # measured 1.5e-14
 
 
 def test_damping_ratio_and_dissipated_work():
@@ -214,12 +216,12 @@ def test_damping_ratio_and_dissipated_work():
              and z[i] > 0]
     ratio = np.log(z[peaks[0]] / z[peaks[2]]) / 2   # two periods
     measured = ratio / np.sqrt(4 * np.pi**2 + ratio**2)
-    assert measured == pytest.approx(zeta, rel=2e-3)
+    assert measured == pytest.approx(zeta, rel=2e-4)                  # measured 2.8e-5
     lost = -np.asarray(res.energy["material_damping_work"])
     v = np.gradient(z, t)
     integral = np.concatenate([[0], np.cumsum(0.5 * (c * v[1:]**2 + c * v[:-1]**2)
                                               * np.diff(t))])
-    assert lost[-1] == pytest.approx(integral[-1], rel=2e-3)
+    assert lost[-1] == pytest.approx(integral[-1], rel=5e-4)          # measured 5.1e-5
     # kinetic + spring + lost work: constant up to the trapezoidal rule the stepper
     # integrates the power with (c (v_n^2 + v_n+1^2) / 2 against the scheme's own
     # c ((v_n + v_n+1) / 2)^2: O((omega h)^2)); halving h quarters the drift
@@ -235,6 +237,15 @@ def test_damping_ratio_and_dissipated_work():
     axial = np.asarray(res.reactions["spring"]["axial"])
     assert axial.shape == t.shape
     assert np.abs(axial - (K * (-z) + c * (-v))).max() <= 1e-3 * K * 0.1
+
+
+def test_modal_frequency_and_damping_ratio():
+    """Modal analysis about the equilibrium: sqrt(k/m) / 2 pi and zeta = c / (2 sqrt(k m))
+    (the damper enters C = dQ/de')."""
+    c = 2 * 0.05 * np.sqrt(K * M)
+    modes = guided_mass(damping=c, free_length=0.9, start=-1.0).modes(1)
+    assert modes.frequency[0] == pytest.approx(OMEGA / (2 * np.pi), rel=1e-12)
+    assert modes.damping_ratio[0] == pytest.approx(0.05, rel=1e-12)
 
 
 # -- the system tangent and the rigid-rotation invariant ----------------------------------------
@@ -345,15 +356,15 @@ def test_cylinder_quasi_static_force_and_rigid_limit():
     weight = 50.0 * 9.81
     late = t > 0.45
     axial = np.asarray(res.reactions["cyl"]["axial"])[late]
-    assert np.allclose(axial, -weight, rtol=2e-3)
+    assert np.allclose(axial, -weight, rtol=1e-5)                      # measured 3.7e-7
     # L - l = -m g / k (the drive at the same times: ramp of 0.1 m/s)
     from ancfdrv.system.drives import Ramp
     length = np.array([Ramp("r", start=1.0, rate=0.1, t_ramp=0.2, t0=0.0).value(x) for x in t])
-    assert np.allclose(z[late] - length[late], -weight / 2e5, rtol=2e-3)
+    assert np.allclose(z[late] - length[late], -weight / 2e5, rtol=1e-5)  # measured 6.8e-7
     stiff = _lifted("cylinder", stiffness=1e9, damping=1e5).simulate(t_end=0.4, dt=2e-3)
     rigid = _lifted("distance").simulate(t_end=0.4, dt=2e-3)
     gap = np.asarray(stiff.probes["c"])[:, 2] - np.asarray(rigid.probes["c"])[:, 2]
-    assert np.abs(gap[len(gap) // 2:] + weight / 1e9).max() <= 0.05 * weight / 1e9
+    assert np.abs(gap[len(gap) // 2:] + weight / 1e9).max() <= 1e-3 * weight / 1e9  # 8.4e-5
 
 
 # -- the two doors -----------------------------------------------------------------------------
@@ -403,3 +414,27 @@ def test_bad_input_names_the_item(call, message):
     with pytest.raises(InputError, match=message) as exc:
         s.force_element("fe", body1="ground", body2="box", **call)
     assert "fe" in str(exc.value)
+
+
+# -- the example --------------------------------------------------------------------------------
+def test_boom_mounts_example_matches_the_rigid_moment_balance(tmp_path):
+    """examples/boom_mounts.py --quick: the static strut forces within 0.2 % of the rigid
+    moment balance about the hinge (the rest: the boom's bending), the cylinder force during
+    the constant-rate lift within 1 % of the balance at the angle and rate reached (the
+    rest: the start's vibration), the oil column's compression the force over its
+    stiffness, and the energy balance closed to 1e-6 of the drive's work."""
+    import sys
+    from pathlib import Path
+    folder = str(Path(__file__).resolve().parents[1] / "examples")
+    if folder not in sys.path:   # as tests/test_examples.py imports the scripts
+        sys.path.insert(0, folder)
+    import boom_mounts
+    out = boom_mounts.run(True, tmp_path)
+    assert out["cylinder"] == pytest.approx(out["rigid_cylinder"], rel=2e-3)
+    assert out["gas"] == pytest.approx(out["rigid_gas"], rel=2e-3)
+    assert out["end_force"] == pytest.approx(out["rigid_end"], rel=1e-2)
+    assert out["column"] == pytest.approx(out["end_force"] / out["boom"].oil_stiffness,
+                                          rel=2e-3)
+    energy = out["lift"].energy
+    assert abs(np.asarray(energy["balance"])[-1]) <= 1e-6 * np.asarray(energy["drive_work"])[-1]
+    assert (tmp_path / "boom_mounts_lift.h5").is_file()

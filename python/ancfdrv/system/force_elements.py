@@ -110,6 +110,12 @@ class ForceElementInfo:
     table: np.ndarray
     slots: list[Vec3]
 
+    @property
+    def damped(self) -> bool:
+        """Whether it has a damper (its force depends on the rates)."""
+        damping = self.params[6:12] if self.kind == FE_BUSHING else self.params[1:2]
+        return bool(np.any(damping != 0.0))
+
     def dofs(self) -> np.ndarray:
         """Every full coordinate its slots touch (one block of the sparse pattern)."""
         firsts = sorted({d for slot in self.slots for d in slot.terms})
