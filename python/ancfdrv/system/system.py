@@ -490,8 +490,15 @@ class System:
             p1 = p2 = _points(given["point"])[0]
         else:
             p1, p2 = _points(given["point1"])[0], _points(given["point2"])[0]
-        first.locate(p1, node=False, what=where)   # material points of the bodies
-        second.locate(p2, node=False, what=where)
+        at1 = first.locate(p1, node=False, what=where)   # material points of the bodies
+        at2 = second.locate(p2, node=False, what=where)
+        if type == "bushing":
+            for body, at in ((first, at1), (second, at2)):
+                if len(body.basis(at)) != 3:
+                    raise InputError(f"{where}: a bushing needs three direction vectors at "
+                                     f"its point; {body.__class__.__name__.lower()} "
+                                     f"{body.name!r} carries {len(body.basis(at))} (use a "
+                                     "beam, a rigid body or the ground)")
         fe = ForceElement(name, type, first, second, p1, p2, values("stiffness"),
                           values("damping"), values("rotational_stiffness"),
                           values("rotational_damping"), given["free_length"],
