@@ -179,6 +179,31 @@ def test_static_equilibrium_with_preload_and_free_length():
     assert res.counters["force_elements"] == 1
 
 
+@pytest.mark.parametrize("interpolation", ["linear", "pchip"])
+def test_table_spring_hangs_where_its_table_says(interpolation):
+    """A hardening force-deflection table (-10, 0, 10, 40 mm -> -8, 0, 8, 60 N; a table
+    spans the deflections the element sees: beyond its ends its stiffness is 0, and at the
+    first point Newton's start would have none): the 19.62 N weight
+    hangs at the deflection where the table reaches it: between the points linear
+    interpolation 10 + 30 (19.62 - 8) / 52 mm, and the monotone PCHIP curve's inverse (by
+    bisection on the drive's own values)."""
+    table = ((-0.01, 0.0, 0.01, 0.04), (-8.0, 0.0, 8.0, 60.0), interpolation)
+    s = guided_mass(table=table, free_length=0.9, start=-0.9, gravity=9.81)
+    res = s.static(static_method="newton")
+    weight = M * 9.81
+    if interpolation == "linear":
+        expected = 0.01 + 0.03 * (weight - 8.0) / 52.0
+    else:
+        curve = Table("t", table[0], table[1], interpolation)
+        lo, hi = 0.01, 0.04
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if curve.value(mid) < weight else (lo, mid)
+        expected = 0.5 * (lo + hi)
+    assert -res.probes["c"][2] - 0.9 == pytest.approx(expected, rel=1e-9)
+    assert float(res.reactions["spring"]["axial"]) == pytest.approx(weight, rel=1e-9)
+
+
 def _zero_crossings(t, y):
     idx = np.nonzero(np.diff(np.sign(y)) != 0)[0]
     return t[idx] - y[idx] * (t[idx + 1] - t[idx]) / (y[idx + 1] - y[idx])

@@ -1,6 +1,6 @@
 """The :class:`System`: a user's structure composed of named materials, bodies, drives,
-joints, loads, contact pairs and probes, in a Python script or from a namelist (each group
-one call). Names are unique per kind of item; the body name 'ground' is reserved. A joint,
+joints, loads, contact pairs, force elements (spring-dampers, bushings, compliant
+cylinders) and probes, in a Python script or from a namelist (each group one call). Names are unique per kind of item; the body name 'ground' is reserved. A joint,
 load, contact or probe naming an unknown body (or drive, or material) is an
 :class:`~ancfdrv.errors.InputError` naming the item. :meth:`System.assemble` turns it into
 the model the solvers run (``ancfdrv.system.assembly``).
