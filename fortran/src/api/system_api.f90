@@ -616,7 +616,7 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm,
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
-  use force_elements, only: force_element_slots
+  use force_elements, only: force_element_slots, force_element_parameters
   implicit none
   integer, intent(in) :: handle, nfel, nparam, ntable, nslot, nterm
   integer, intent(in) :: kinds(max(1, nfel)), drives(max(1, nfel)), table_kinds(max(1, nfel))
@@ -637,6 +637,7 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm,
   end if
   do l = 1, nfel
     if (force_element_slots(kinds(l)) == 0) return
+    if (param_ptr(l + 1) - param_ptr(l) < force_element_parameters(kinds(l))) return
     if (slot_first(l) < 1 .or. slot_first(l) + force_element_slots(kinds(l)) - 1 > nslot) return
     if (drives(l) < 0 .or. drives(l) > size(sys%drive_kinds)) return
   end do
