@@ -640,7 +640,9 @@ class KernelSystem:
             _pad_last(np.asarray(layout["slot_const"], dtype=float).T),
             _i(np.array(layout["term_ptr"]) + 1),
             _pad_last(np.array(layout["term_dof"], dtype=np.int32) + 1, np.int32),
-            _pad_last(np.array(layout["term_coef"], dtype=float)))
+            _pad_last(np.array(layout["term_coef"], dtype=float)),
+            len(layout["positions"]), _i(np.asarray(layout["position_ptr"]) + 1),
+            _pad_last(np.asarray(layout["positions"]) + 1, np.int32))
         self._check(info, "force elements")
         self.nfel = nfel
 

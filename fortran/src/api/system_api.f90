@@ -612,7 +612,8 @@ end subroutine system_set_vector_loads
 !> 3-vector, term_coef).
 subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm, kinds, &
                                      drives, table_kinds, param_ptr, params, table_ptr, table, &
-                                     slot_first, slot_const, term_ptr, term_dof, term_coef, info)
+                                     slot_first, slot_const, term_ptr, term_dof, term_coef, &
+                                     npos, position_ptr, positions, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_store, only: store_get
@@ -624,6 +625,9 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm,
   integer, intent(in) :: term_ptr(nslot + 1), term_dof(max(1, nterm))
   real(dp), intent(in) :: params(max(1, nparam)), table(max(1, ntable))
   real(dp), intent(in) :: slot_const(3, max(1, nslot)), term_coef(max(1, nterm))
+  !> the tangent's positions in the full pattern's values (0: absent), element l's from
+  !> position_ptr(l), in force_element_forces' loop order (npos 0: searched instead)
+  integer, intent(in) :: npos, position_ptr(nfel + 1), positions(max(1, npos))
   integer, intent(out) :: info
   type(system_model), pointer :: sys
   integer :: l
@@ -631,7 +635,10 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm,
   if (info /= 0) return
   info = 2
   if (param_ptr(nfel + 1) /= nparam + 1 .or. table_ptr(nfel + 1) /= ntable + 1 .or. &
-      term_ptr(nslot + 1) /= nterm + 1) return
+      term_ptr(nslot + 1) /= nterm + 1 .or. position_ptr(nfel + 1) /= npos + 1) return
+  if (npos > 0) then
+    if (any(positions(1:npos) < 0)) return
+  end if
   if (nterm > 0) then
     if (any(term_dof(1:nterm) < 1) .or. any(term_dof(1:nterm) + 2 > sys%nfull)) return
   end if
@@ -655,6 +662,8 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm,
   sys%fel_term_ptr = term_ptr
   sys%fel_term_dof = term_dof(1:nterm)
   sys%fel_term_coef = term_coef(1:nterm)
+  sys%fel_pos_ptr = position_ptr
+  sys%fel_pos = positions(1:npos)
 end subroutine system_set_force_elements
 
 !> The reactions (7, nfel) of the force elements at (t, e, e'): force and moment body1

@@ -187,26 +187,32 @@ contains
     call accumulate(grad, hess, xd, total, k, c, force, stiffness, damping)
   end subroutine elastic
 
-  !> Adds one measure's force total * dm/dx and its derivatives (module documentation).
+  !> Adds one measure's force total * dm/dx and its derivatives (module documentation);
+  !> explicit loops (spread temporaries made the 8-slot bushing 10 times slower).
   pure subroutine accumulate(grad, hess, xd, total, slope, c, force, stiffness, damping)
     real(dp), intent(in) :: grad(:, :), hess(:, :, :, :), xd(:, :), total, slope, c
     real(dp), intent(inout) :: force(:, :), stiffness(:, :, :, :), damping(:, :, :, :)
-    real(dp) :: rate_gradient(3, size(grad, 2))
-    integer :: ns, s, w, i
+    real(dp) :: column(3, size(grad, 2))
+    integer :: ns, s, w, i, j
     ns = size(grad, 2)
     force = force + total * grad
-    do w = 1, ns            ! d m' / d x_w = sum_s H(s, w)^T xd_s
-      do i = 1, 3
-        rate_gradient(i, w) = sum(hess(:, :, i, w) * xd)
+    stiffness = stiffness + total * hess
+    ! d f / d x_w = slope dm/dx_w + c d m'/d x_w, with d m'/d x_w = sum_s H(s, w)^T xd_s
+    do w = 1, ns
+      do j = 1, 3
+        column(j, w) = slope * grad(j, w)
+        if (c /= 0.0_dp) column(j, w) = column(j, w) + c * sum(hess(:, :, j, w) * xd)
       end do
     end do
-    stiffness = stiffness + total * hess
     do w = 1, ns
-      do s = 1, ns
-        stiffness(:, s, :, w) = stiffness(:, s, :, w) + spread(grad(:, s), 2, 3) &
-          * spread(slope * grad(:, w) + c * rate_gradient(:, w), 1, 3)
-        damping(:, s, :, w) = damping(:, s, :, w) + c * spread(grad(:, s), 2, 3) &
-          * spread(grad(:, w), 1, 3)
+      do j = 1, 3
+        if (column(j, w) == 0.0_dp .and. (c == 0.0_dp .or. grad(j, w) == 0.0_dp)) cycle
+        do s = 1, ns
+          do i = 1, 3
+            stiffness(i, s, j, w) = stiffness(i, s, j, w) + grad(i, s) * column(j, w)
+            damping(i, s, j, w) = damping(i, s, j, w) + c * grad(i, s) * grad(j, w)
+          end do
+        end do
       end do
     end do
   end subroutine accumulate

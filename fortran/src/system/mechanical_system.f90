@@ -121,6 +121,9 @@ module mechanical_system
     integer, allocatable :: fel_kind(:), fel_drive(:), fel_table_kind(:), fel_param_ptr(:), &
                             fel_table_ptr(:), fel_slot_first(:), fel_term_ptr(:), fel_term_dof(:)
     real(dp), allocatable :: fel_params(:), fel_table(:), fel_slot_const(:, :), fel_term_coef(:)
+    ! the tangent's positions in the full pattern's values (0: absent) in the loop order of
+    ! force_element_forces, element l's from fel_pos_ptr(l); none given: searched
+    integer, allocatable :: fel_pos_ptr(:), fel_pos(:)
     ! constraints with multipliers (constraints module layout)
     integer :: ncon = 0
     integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
@@ -648,7 +651,8 @@ contains
     real(dp), intent(inout), optional :: values_full(:)
     real(dp), allocatable :: force(:, :), stiffness(:, :, :, :), damping(:, :, :, :)
     real(dp) :: el_energy, el_dissipation, el_power, reaction(fe_reaction_count)
-    integer :: l, ns, s, w, k, m, i, j, row, col, pos, slot_s, slot_w
+    integer :: l, ns, s, w, k, m, i, j, row, col, pos, slot_s, slot_w, next
+    logical :: known
     energy = 0.0_dp
     powers = 0.0_dp
     info = 0
@@ -669,6 +673,10 @@ contains
       end do
       if (present(values_full)) then
         stiffness = stiffness + velocity_factor * damping
+        known = .false.
+        if (allocated(sys%fel_pos_ptr)) known = sys%fel_pos_ptr(l + 1) > sys%fel_pos_ptr(l)
+        next = 0
+        if (known) next = sys%fel_pos_ptr(l)
         do s = 1, ns
           slot_s = sys%fel_slot_first(l) + s - 1
           do w = 1, ns
@@ -678,8 +686,13 @@ contains
                 do i = 1, 3
                   row = sys%fel_term_dof(k) + i - 1
                   do j = 1, 3
-                    col = sys%fel_term_dof(m) + j - 1
-                    pos = pattern_position(sys, row, col)
+                    if (known) then
+                      pos = sys%fel_pos(next)
+                      next = next + 1
+                    else
+                      col = sys%fel_term_dof(m) + j - 1
+                      pos = pattern_position(sys, row, col)
+                    end if
                     if (pos > 0) values_full(pos) = values_full(pos) + sys%fel_term_coef(k) &
                                                     * sys%fel_term_coef(m) * stiffness(i, s, j, w)
                   end do

@@ -183,8 +183,30 @@ def assemble_force_elements(items, q0: np.ndarray, drive_index: dict, counters: 
     return out, [info.dofs() for info in out if len(info.dofs())]
 
 
-def kernel_layout(infos: list[ForceElementInfo]) -> dict:
-    """The packed arrays of system_set_force_elements (0-based; kernel.py adds 1)."""
+def tangent_positions(info: ForceElementInfo, pattern) -> np.ndarray:
+    """The positions (0-based; -1: absent) in the full pattern's values of the element's
+    tangent entries, in the kernel's loop order: slot s, slot w, term k of s, term m of w,
+    component i, component j (row: k's coordinate + i, column: m's + j)."""
+    terms = [sorted(slot.terms.items()) for slot in info.slots]
+    rows, cols = [], []
+    offsets = np.arange(3)
+    for first in terms:
+        for second in terms:
+            if not first or not second:
+                continue
+            a = np.array([d for d, _ in first])[:, None, None, None] + offsets[None, None, :, None]
+            b = np.array([d for d, _ in second])[None, :, None, None] + offsets[None, None, None, :]
+            a, b = np.broadcast_arrays(a, b)
+            rows.append(a.ravel())
+            cols.append(b.ravel())
+    if not rows:
+        return np.zeros(0, dtype=np.int64)
+    return pattern.positions(np.concatenate(rows), np.concatenate(cols))
+
+
+def kernel_layout(infos: list[ForceElementInfo], pattern=None) -> dict:
+    """The packed arrays of system_set_force_elements (0-based; kernel.py adds 1), with the
+    tangent's positions in the full ``pattern`` (Pattern) when given."""
     param_ptr, table_ptr, slot_first, term_ptr = [0], [0], [], [0]
     params, table, consts, dofs, coefs = [], [], [], [], []
     for info in infos:
@@ -199,7 +221,12 @@ def kernel_layout(infos: list[ForceElementInfo]) -> dict:
                 dofs.append(d)
                 coefs.append(c)
             term_ptr.append(len(dofs))
-    return dict(kinds=[i.kind for i in infos], drives=[i.drive for i in infos],
+    positions = [tangent_positions(info, pattern) if pattern is not None
+                 else np.zeros(0, dtype=np.int64) for info in infos]
+    position_ptr = np.concatenate([[0], np.cumsum([len(x) for x in positions])])
+    return dict(positions=np.concatenate(positions) if positions else np.zeros(0, np.int64),
+                position_ptr=position_ptr,
+                kinds=[i.kind for i in infos], drives=[i.drive for i in infos],
                 table_kinds=[i.table_kind for i in infos], param_ptr=param_ptr,
                 params=params, table_ptr=table_ptr, table=table, slot_first=slot_first,
                 slot_const=np.array(consts, dtype=float).reshape(-1, 3), term_ptr=term_ptr,

@@ -473,7 +473,7 @@ class Model:
             ks.set_vector_loads(self.vector_loads)
         if self.force_elements:
             from .force_elements import kernel_layout
-            ks.set_force_elements(kernel_layout(self.force_elements))
+            ks.set_force_elements(kernel_layout(self.force_elements, self.full_pattern))
         ks.set_constraints(self.constraints.layout())
         for pair in self.contact_pairs:
             ks.add_contact_pair(pair["dofs"], pair["sizes"], pair["grid"], pair["point_element"],
