@@ -265,6 +265,26 @@ def vector_load_force(kind: int, vector, shares, a, b):
     return force, jacobian
 
 
+def force_element(kind: int, params, table_kind: int, table, x, xd, length: float = 0.0,
+                  length_rate: float = 0.0) -> dict:
+    """One force element (force_elements.f90) at its slot values x (3, ns) and rates xd:
+    force (3, ns), stiffness and damping (3, ns, 3, ns) (derivatives of the force by x and
+    xd), energy, dissipation, drive_power and reaction (7: force, moment, axial)."""
+    params = np.asarray(params, dtype=float)
+    table = np.asarray(table, dtype=float)
+    force, stiffness, damping, energy, dissipation, power, reaction, info = \
+        _kernel.force_element_generalized(kind, len(params), _pad_last(params), table_kind,
+                                          len(table), _pad_last(table), _f(x), _f(xd), length,
+                                          length_rate)
+    if info:
+        raise SolverError({1: f"force element of unknown kind {kind} or wrong sizes",
+                           2: "force element: its two points coincide",
+                           3: "force element: its table cannot be evaluated"}.get(
+                               info, f"force element: code {info}"))
+    return dict(force=force, stiffness=stiffness, damping=damping, energy=energy,
+                dissipation=dissipation, drive_power=power, reaction=reaction)
+
+
 def moment_force(director, axis, magnitude):
     """Dead moment on a section director: force (3,), Jacobian (3, 3), Hessian (3, 3, 3)."""
     force, jacobian, hessian, info = _kernel.moment_generalized_force(_f(director), _f(axis),
@@ -655,6 +675,36 @@ class KernelSystem:
             _i(np.array(ptr) + 1), _pad_last(np.array(dofs, dtype=np.int32) + 1, np.int32),
             _pad_last(np.array(coefs, dtype=float)))
         self._check(info, "vector loads")
+
+    def set_force_elements(self, layout: dict) -> None:
+        """Force elements (system/force_elements.kernel_layout: 0-based indices)."""
+        nfel, nslot = len(layout["kinds"]), len(layout["term_ptr"]) - 1
+        info = _kernel.system_set_force_elements(
+            self.handle, nfel, len(layout["params"]), len(layout["table"]), nslot,
+            len(layout["term_dof"]), _pad_last(np.array(layout["kinds"]), np.int32),
+            _pad_last(np.array(layout["drives"]) + 1, np.int32),
+            _pad_last(np.array(layout["table_kinds"]), np.int32),
+            _i(np.array(layout["param_ptr"]) + 1), _pad_last(np.array(layout["params"])),
+            _i(np.array(layout["table_ptr"]) + 1), _pad_last(np.array(layout["table"])),
+            _pad_last(np.array(layout["slot_first"]) + 1, np.int32),
+            _pad_last(np.asarray(layout["slot_const"], dtype=float).T),
+            _i(np.array(layout["term_ptr"]) + 1),
+            _pad_last(np.array(layout["term_dof"], dtype=np.int32) + 1, np.int32),
+            _pad_last(np.array(layout["term_coef"], dtype=float)),
+            len(layout["positions"]), _i(np.asarray(layout["position_ptr"]) + 1),
+            _pad_last(np.asarray(layout["positions"]) + 1, np.int32))
+        self._check(info, "force elements")
+        self.nfel = nfel
+
+    def force_element_reactions(self, t: float, e, v) -> np.ndarray:
+        """(7, nfel): per force element the force and moment body1 exerts on body2
+        (global) and the axial force (tension positive) at (t, e, e')."""
+        nfel = getattr(self, "nfel", 0)
+        out, info, message = _kernel.system_force_element_reactions(
+            self.handle, nfel, t, _f(e), _f(v), ndof=self.ndof)
+        if info:
+            raise SolverError(f"force element reactions: {_text(message)}")
+        return out[:, :nfel]
 
     def set_constraints(self, layout: "ConstraintLayout") -> None:
         ncon, nterm = len(layout.kinds), len(layout.term_dof)

@@ -178,13 +178,14 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     from .system.bodies import Beam
     if not scene["output"].get("answers", True):
         return None
-    if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies):
+    if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies) \
+            and not model.force_elements:
         return None
     recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
                               alpha_m=settings.alpha_m, alpha_f=settings.alpha_f,
                               stations=scene["output"].get("stations", 3),
                               keep_sections=bool(scene["output"].get("sections", False)))
-    if recorder.need_acceleration:
+    if recorder.need_acceleration or recorder.need_velocity:
         v0 = np.zeros(model.ndof)
         a0, _ = initial_acceleration(model, e_start, v0, 0.0)
         recorder.initial = (v0, a0)

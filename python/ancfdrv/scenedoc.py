@@ -17,6 +17,7 @@ from typing import Any
 from .builders.general import _DRIVE_KEYS, _REQUIRED_DRIVE
 from .io.schema import GENERAL_SCHEMA, MODEL_GROUPS, REQUIRED, SCHEMA, Key
 from .system.drives import DRIVE_TYPES
+from .system.force_elements import FORCE_ELEMENT_MEANING, FORCE_ELEMENT_PARAMETERS
 from .system.joints import JOINT_TYPES
 from .system.system import LOAD_EFFECTS, LOAD_PARAMETERS
 
@@ -180,7 +181,8 @@ def render() -> str:
         "A scene without a template group is a general scene: `&scene`, `&solver`, "
         "`&output` once each, and any number of the named groups below, each one call of "
         "the Python `System` API (`System.material`, `.beam`, `.plate`, `.leaf`, "
-        "`.rigid_body`, `.drive`, `.joint`, `.load`, `.contact`, `.probe`) with the same "
+        "`.rigid_body`, `.drive`, `.joint`, `.load`, `.contact`, `.probe`, `.force_element`) "
+        "with the same "
         "parameters.",
         "",
     ]
@@ -198,6 +200,13 @@ def render() -> str:
              for kind, needs in LOAD_PARAMETERS.items()}
     effects = {kind: f"effect default: '{LOAD_EFFECTS[kind]}'" for kind in LOAD_PARAMETERS}
     lines += _type_table("Loads (`&load type = ...`; optional `effect`)", loads, effects)
+    lines += _type_table("Force elements (`&force_element type = ...`; besides body1, body2; "
+                         "`System.force_element`)", FORCE_ELEMENT_PARAMETERS,
+                         FORCE_ELEMENT_MEANING,
+                         "A `spring_damper` takes `stiffness` (with `preload`) or the table "
+                         "`deflections`, `forces` (with `interpolation`). Reactions are "
+                         "stored under the element's name with the joints': force and moment "
+                         "body1 exerts on body2, `axial` (tension positive).")
     lines += ["## Template scenes (SPEC section 3)", "",
               "A template scene has exactly one model group (" +
               ", ".join(f"`&{g}`" for g in MODEL_GROUPS) + ") and the common groups "

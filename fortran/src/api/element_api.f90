@@ -566,6 +566,26 @@ subroutine vector_load_generalized_force(kind, vector, shares, a, b, force, jaco
   call vector_load_force(kind, vector, shares, a, b, force, jacobian, info)
 end subroutine vector_load_generalized_force
 
+!> One force element (force_elements) at its ns slot values x and rates xd: the generalized
+!> force, its derivatives by x and xd, the energy, dissipated and drive powers, the reaction
+!> (force, moment, axial). nparam, ntable: sizes (ntable 0: no table, table_kind 0).
+subroutine force_element_generalized(kind, nparam, params, table_kind, ntable, table, ns, x, &
+                                     xd, length, length_rate, force, stiffness, damping, &
+                                     energy, dissipation, drive_power, reaction, info)
+  use ancf_kinds, only: dp
+  use force_elements, only: force_element_eval
+  implicit none
+  integer, intent(in) :: kind, nparam, table_kind, ntable, ns
+  real(dp), intent(in) :: params(max(1, nparam)), table(max(1, ntable)), x(3, ns), xd(3, ns)
+  real(dp), intent(in) :: length, length_rate
+  real(dp), intent(out) :: force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns)
+  real(dp), intent(out) :: energy, dissipation, drive_power, reaction(7)
+  integer, intent(out) :: info
+  call force_element_eval(kind, params(1:nparam), table_kind, table(1:ntable), x, xd, length, &
+                          length_rate, force, stiffness, damping, energy, dissipation, &
+                          drive_power, reaction, info)
+end subroutine force_element_generalized
+
 !> Cable elements (cable_element): the scalar element masses Mbar (4, 4, nel) (the element
 !> mass is kron(Mbar, I3)) for the mass per length, and the generalized forces (12, nel) of
 !> a uniform load per length (3).

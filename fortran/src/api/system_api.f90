@@ -662,6 +662,99 @@ subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors,
   sys%vload_coef = coefs(1:nterm)
 end subroutine system_set_vector_loads
 
+!> Force elements (force_elements): nfel elements of kinds(nfel), drives (0: none), their
+!> parameters params(param_ptr(l) .. param_ptr(l + 1) - 1), tables likewise (table_kinds:
+!> 0 none), first slots slot_first(nfel) of nslot slots with constants slot_const(3, nslot)
+!> and terms term_ptr(slot) .. term_ptr(slot + 1) - 1 (term_dof: first full coordinate of a
+!> 3-vector, term_coef).
+subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm, kinds, &
+                                     drives, table_kinds, param_ptr, params, table_ptr, table, &
+                                     slot_first, slot_const, term_ptr, term_dof, term_coef, &
+                                     npos, position_ptr, positions, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  use force_elements, only: force_element_slots, force_element_parameters
+  implicit none
+  integer, intent(in) :: handle, nfel, nparam, ntable, nslot, nterm
+  integer, intent(in) :: kinds(max(1, nfel)), drives(max(1, nfel)), table_kinds(max(1, nfel))
+  integer, intent(in) :: param_ptr(nfel + 1), table_ptr(nfel + 1), slot_first(max(1, nfel))
+  integer, intent(in) :: term_ptr(nslot + 1), term_dof(max(1, nterm))
+  real(dp), intent(in) :: params(max(1, nparam)), table(max(1, ntable))
+  real(dp), intent(in) :: slot_const(3, max(1, nslot)), term_coef(max(1, nterm))
+  !> the tangent's positions in the full pattern's values (0: absent), element l's from
+  !> position_ptr(l), in force_element_forces' loop order (npos 0: searched instead)
+  integer, intent(in) :: npos, position_ptr(nfel + 1), positions(max(1, npos))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  integer :: l
+  call store_get(handle, sys, info)
+  if (info /= 0) return
+  info = 2
+  if (param_ptr(nfel + 1) /= nparam + 1 .or. table_ptr(nfel + 1) /= ntable + 1 .or. &
+      term_ptr(nslot + 1) /= nterm + 1 .or. position_ptr(nfel + 1) /= npos + 1) return
+  if (npos > 0) then
+    if (any(positions(1:npos) < 0)) return
+  end if
+  if (nterm > 0) then
+    if (any(term_dof(1:nterm) < 1) .or. any(term_dof(1:nterm) + 2 > sys%nfull)) return
+  end if
+  do l = 1, nfel
+    if (force_element_slots(kinds(l)) == 0) return
+    if (param_ptr(l + 1) - param_ptr(l) < force_element_parameters(kinds(l))) return
+    if (slot_first(l) < 1 .or. slot_first(l) + force_element_slots(kinds(l)) - 1 > nslot) return
+    if (drives(l) < 0 .or. drives(l) > size(sys%drive_kinds)) return
+  end do
+  info = 0
+  sys%nfel = nfel
+  sys%fel_kind = kinds(1:nfel)
+  sys%fel_drive = drives(1:nfel)
+  sys%fel_table_kind = table_kinds(1:nfel)
+  sys%fel_param_ptr = param_ptr
+  sys%fel_params = params(1:nparam)
+  sys%fel_table_ptr = table_ptr
+  sys%fel_table = table(1:ntable)
+  sys%fel_slot_first = slot_first(1:nfel)
+  sys%fel_slot_const = slot_const(:, 1:nslot)
+  sys%fel_term_ptr = term_ptr
+  sys%fel_term_dof = term_dof(1:nterm)
+  sys%fel_term_coef = term_coef(1:nterm)
+  sys%fel_pos_ptr = position_ptr
+  sys%fel_pos = positions(1:npos)
+end subroutine system_set_force_elements
+
+!> The reactions (7, nfel) of the force elements at (t, e, e'): force and moment body1
+!> exerts on body2 (global), axial force (tension positive). info: 5 (a drive failed) or
+!> 10 (an element's points coincide), with its text in message.
+subroutine system_force_element_reactions(handle, ndof, nfel, t, e, v, reactions, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, force_element_reactions
+  use system_store, only: store_get
+  use kernel_errors, only: handle_text, failure_text
+  implicit none
+  integer, intent(in) :: handle, ndof, nfel
+  real(dp), intent(in) :: t, e(ndof), v(ndof)
+  real(dp), intent(out) :: reactions(7, max(1, nfel))
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  message = ' '
+  reactions = 0.0_dp
+  call store_get(handle, sys, info)
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
+  if (ndof /= sys%ndof .or. nfel /= sys%nfel) then
+    info = 2
+    message = 'system_force_element_reactions: sizes inconsistent with the system'
+    return
+  end if
+  if (nfel == 0) return
+  call force_element_reactions(sys, t, e, v, reactions(:, 1:nfel), info)
+  if (info /= 0) message = failure_text(info)
+end subroutine system_force_element_reactions
+
 !> Constraints with multipliers, in the constraints module's layout over the independent
 !> coordinates.
 subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, operand_const, &
@@ -850,10 +943,11 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velo
   if (want_tangent /= 0) then  ! the tangent in global coordinates
     call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
                          strain, contact_potential, powers, records, info, rotations, tangent, &
-                         rates)
+                         rates, force_time=t)
   else
     call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
-                         strain, contact_potential, powers, records, info, rates=rates)
+                         strain, contact_potential, powers, records, info, rates=rates, &
+                         force_time=t)
   end if
   if (info /= 0) then
     message = failure_text(info)
@@ -906,7 +1000,8 @@ subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor,
   state%guesses = guesses
   state%counts = 0
   call internal_forces(sys, rotations, e, v, load_factor, 0.0_dp, state, reduced, strain, &
-                       potential, powers, records, info, rates=rates, full_out=full_force)
+                       potential, powers, records, info, rates=rates, full_out=full_force, &
+                       force_time=t)
   if (info /= 0) message = failure_text(info)
 end subroutine system_full_forces
 

@@ -28,6 +28,9 @@ contains
     case (8)
       text = 'the contact search found no closest point on the upper surface (the ' // &
              'projection diverged even from the sampled restart)'
+    case (10)
+      text = "a force element's two points coincide (its line of action is undefined) " // &
+             'or its force table could not be evaluated'
     case default
       write (text, '(a, i0)') 'kernel failure code ', code
     end select

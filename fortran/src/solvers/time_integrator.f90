@@ -109,7 +109,7 @@ contains
       internal = known_internal
     else
       call internal_forces(sys, rotations, e, v, 1.0_dp, 0.0_dp, state, internal, strain, &
-                           potential, powers, records, info, rates=rates)
+                           potential, powers, records, info, rates=rates, force_time=t)
       if (info /= 0) return
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if

@@ -35,6 +35,7 @@ module mechanical_system
   use element_sets, only: element_set, set_slot, frame_omega
   use section_moment, only: moment_force, moment_angle
   use vector_loads, only: vector_load_force
+  use force_elements, only: force_element_eval, force_element_slots, fe_reaction_count
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
                           cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
@@ -45,7 +46,7 @@ module mechanical_system
             external_forces, &
             evaluate_constraints, constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set, &
-            tangent_frame_rates, damped_sets
+            tangent_frame_rates, damped_sets, force_element_reactions
   ! what the stepper asks of the system's contact (it uses no contact module itself)
   public :: contact_record, contact_step_limit
 
@@ -115,6 +116,17 @@ module mechanical_system
     integer :: nvload = 0
     integer, allocatable :: vload_kind(:), vload_drive(:), vload_ptr(:), vload_dof(:)
     real(dp), allocatable :: vload_vector(:, :), vload_shares(:, :), vload_coef(:)
+    ! force elements (force_elements): per element a kind, a drive (0: none; the cylinder's
+    ! length), its parameters (fel_param_ptr), a force-deflection table (fel_table_ptr; kind
+    ! 0: none), its first slot (fel_slot_first); per slot a constant and the terms
+    ! fel_term_ptr(slot) .. fel_term_ptr(slot + 1) - 1 on full coordinates
+    integer :: nfel = 0
+    integer, allocatable :: fel_kind(:), fel_drive(:), fel_table_kind(:), fel_param_ptr(:), &
+                            fel_table_ptr(:), fel_slot_first(:), fel_term_ptr(:), fel_term_dof(:)
+    real(dp), allocatable :: fel_params(:), fel_table(:), fel_slot_const(:, :), fel_term_coef(:)
+    ! the tangent's positions in the full pattern's values (0: absent) in the loop order of
+    ! force_element_forces, element l's from fel_pos_ptr(l); none given: searched
+    integer, allocatable :: fel_pos_ptr(:), fel_pos(:)
     ! constraints with multipliers (constraints module layout)
     integer :: ncon = 0
     integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
@@ -332,7 +344,8 @@ contains
   !> info = 6 (moment undefined), 7 (a plate normal vanished), 8 (contact search failed).
   subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
                              strain, contact_potential, contact_powers, records, info, &
-                             tangent_rotation, tangent_values, rates, tangent_rates, full_out, t)
+                             tangent_rotation, tangent_values, rates, tangent_rates, full_out, t, &
+                             force_time)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
     type(contact_state), intent(inout) :: state
@@ -345,8 +358,11 @@ contains
     !> the same forces in the full coordinates q (before B^T), for the joint reactions
     real(dp), intent(out), optional :: full_out(:)
     real(dp), intent(in), optional :: t  ! with the tangent: the point loads' Jacobian at t
+    !> the time of the force elements' drives (every caller passes it; 0 when absent)
+    real(dp), intent(in), optional :: force_time
     real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
     real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3), rate, tangent_rate
+    real(dp) :: fel_powers(2)
     logical :: want_tangent
     integer :: s, m, k, f
     want_tangent = present(tangent_values)
@@ -358,9 +374,20 @@ contains
       allocate (values_full(size(sys%full_col)))
       values_full = 0.0_dp
     end if
-    if (sys%npoint > 0 .or. damped_sets(sys)) then
+    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys, v, .false., v_full)
+    end if
+    if (sys%nfel > 0) then
+      if (want_tangent) then
+        call force_element_forces(sys, merge_time(force_time), e_full, v_full, velocity_factor, &
+                                  full_force, set_energy, fel_powers, info, values_full)
+      else
+        call force_element_forces(sys, merge_time(force_time), e_full, v_full, velocity_factor, &
+                                  full_force, set_energy, fel_powers, info)
+      end if
+      if (info /= 0) return
+      strain = strain + set_energy
     end if
     do s = 1, size(sys%sets)
       f = sys%sets(s)%item%frame
@@ -591,6 +618,153 @@ contains
     if (info /= 0) info = 6
   end subroutine vector_load_at
 
+  !> The time an internal-force evaluation hands the force elements (0 when not given:
+  !> only systems without driven force elements are evaluated so).
+  pure real(dp) function merge_time(time)
+    real(dp), intent(in), optional :: time
+    merge_time = 0.0_dp
+    if (present(time)) merge_time = time
+  end function merge_time
+
+  !> The force elements at (e_full, v_full, t): their generalized forces added to full_force
+  !> (the residual's internal sign), the potential energy, powers(1) the dissipated power
+  !> and powers(2) the cylinders' drive power into the system; with values_full the tangent
+  !> dF/dq + velocity_factor dF/dq' added on the full pattern (entries outside it: none,
+  !> the assembly adds each element's coordinates as one block). info = 5 (a drive failed)
+  !> or 10 (an element's points coincide or its table fails).
+  subroutine force_element_forces(sys, t, e_full, v_full, velocity_factor, full_force, &
+                                  energy, powers, info, values_full)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, e_full(:), v_full(:), velocity_factor
+    real(dp), intent(inout) :: full_force(:)
+    real(dp), intent(out) :: energy, powers(2)
+    integer, intent(out) :: info
+    real(dp), intent(inout), optional :: values_full(:)
+    real(dp), allocatable :: force(:, :), stiffness(:, :, :, :), damping(:, :, :, :)
+    real(dp) :: el_energy, el_dissipation, el_power, reaction(fe_reaction_count)
+    integer :: l, ns, s, w, k, m, i, j, row, col, pos, slot_s, slot_w, next
+    logical :: known
+    energy = 0.0_dp
+    powers = 0.0_dp
+    info = 0
+    do l = 1, sys%nfel
+      ns = force_element_slots(sys%fel_kind(l))
+      allocate (force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns))
+      call force_element_at(sys, l, t, e_full, v_full, force, stiffness, damping, el_energy, &
+                            el_dissipation, el_power, reaction, info)
+      if (info /= 0) return
+      energy = energy + el_energy
+      powers = powers + [el_dissipation, el_power]
+      do s = 1, ns
+        slot_s = sys%fel_slot_first(l) + s - 1
+        do k = sys%fel_term_ptr(slot_s), sys%fel_term_ptr(slot_s + 1) - 1
+          row = sys%fel_term_dof(k)
+          full_force(row:row + 2) = full_force(row:row + 2) + sys%fel_term_coef(k) * force(:, s)
+        end do
+      end do
+      if (present(values_full)) then
+        stiffness = stiffness + velocity_factor * damping
+        known = .false.
+        if (allocated(sys%fel_pos_ptr)) known = sys%fel_pos_ptr(l + 1) > sys%fel_pos_ptr(l)
+        next = 0
+        if (known) next = sys%fel_pos_ptr(l)
+        do s = 1, ns
+          slot_s = sys%fel_slot_first(l) + s - 1
+          do w = 1, ns
+            slot_w = sys%fel_slot_first(l) + w - 1
+            do k = sys%fel_term_ptr(slot_s), sys%fel_term_ptr(slot_s + 1) - 1
+              do m = sys%fel_term_ptr(slot_w), sys%fel_term_ptr(slot_w + 1) - 1
+                do i = 1, 3
+                  row = sys%fel_term_dof(k) + i - 1
+                  do j = 1, 3
+                    if (known) then
+                      pos = sys%fel_pos(next)
+                      next = next + 1
+                    else
+                      col = sys%fel_term_dof(m) + j - 1
+                      pos = pattern_position(sys, row, col)
+                    end if
+                    if (pos > 0) values_full(pos) = values_full(pos) + sys%fel_term_coef(k) &
+                                                    * sys%fel_term_coef(m) * stiffness(i, s, j, w)
+                  end do
+                end do
+              end do
+            end do
+          end do
+        end do
+      end if
+      deallocate (force, stiffness, damping)
+    end do
+  end subroutine force_element_forces
+
+  !> Force element l at (e_full, v_full, t): its slots gathered, its drive evaluated (the
+  !> cylinder's nominal length), force_elements' evaluation. info = 5 (drive) or 10.
+  subroutine force_element_at(sys, l, t, e_full, v_full, force, stiffness, damping, energy, &
+                              dissipation, drive_power, reaction, info)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: l
+    real(dp), intent(in) :: t, e_full(:), v_full(:)
+    real(dp), intent(out) :: force(:, :), stiffness(:, :, :, :), damping(:, :, :, :)
+    real(dp), intent(out) :: energy, dissipation, drive_power, reaction(:)
+    integer, intent(out) :: info
+    real(dp) :: x(3, size(force, 2)), xd(3, size(force, 2)), length, length_rate, ddl
+    integer :: s, k, slot, dof
+    info = 0
+    length = 0.0_dp
+    length_rate = 0.0_dp
+    if (sys%fel_drive(l) > 0) then
+      call drive_value(sys%fel_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+                       length, length_rate, ddl, info)
+      if (info /= 0) then
+        info = 5
+        return
+      end if
+    end if
+    do s = 1, size(force, 2)
+      slot = sys%fel_slot_first(l) + s - 1
+      x(:, s) = sys%fel_slot_const(:, slot)
+      xd(:, s) = 0.0_dp
+      do k = sys%fel_term_ptr(slot), sys%fel_term_ptr(slot + 1) - 1
+        dof = sys%fel_term_dof(k)
+        x(:, s) = x(:, s) + sys%fel_term_coef(k) * e_full(dof:dof + 2)
+        xd(:, s) = xd(:, s) + sys%fel_term_coef(k) * v_full(dof:dof + 2)
+      end do
+    end do
+    call force_element_eval(sys%fel_kind(l), &
+                            sys%fel_params(sys%fel_param_ptr(l):sys%fel_param_ptr(l + 1) - 1), &
+                            sys%fel_table_kind(l), &
+                            sys%fel_table(sys%fel_table_ptr(l):sys%fel_table_ptr(l + 1) - 1), &
+                            x, xd, length, length_rate, force, stiffness, damping, energy, &
+                            dissipation, drive_power, reaction, info)
+    if (info /= 0) info = 10
+  end subroutine force_element_at
+
+  !> The reactions of every force element at (e, e', t) (reduced coordinates): per element
+  !> the force and moment body1 exerts on body2 (global) and the axial force (tension
+  !> positive), force_elements' layout (7, nfel). info = 5 or 10 (force_element_at).
+  subroutine force_element_reactions(sys, t, e, v, reactions, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, e(:), v(:)
+    real(dp), intent(out) :: reactions(:, :)
+    integer, intent(out) :: info
+    real(dp), allocatable :: e_full(:), v_full(:), force(:, :), stiffness(:, :, :, :), &
+                             damping(:, :, :, :)
+    real(dp) :: energy, dissipation, power
+    integer :: l, ns
+    info = 0
+    allocate (e_full(sys%nfull), v_full(sys%nfull))
+    call to_full(sys, e, .true., e_full)
+    call to_full(sys, v, .false., v_full)
+    do l = 1, sys%nfel
+      ns = force_element_slots(sys%fel_kind(l))
+      allocate (force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns))
+      call force_element_at(sys, l, t, e_full, v_full, force, stiffness, damping, energy, &
+                            dissipation, power, reactions(:, l), info)
+      if (info /= 0) return
+      deallocate (force, stiffness, damping)
+    end do
+  end subroutine force_element_reactions
+
   !> Position of (row, col) in the full pattern, 0 when absent.
   pure integer function pattern_position(sys, row, col) result(pos)
     type(system_model), intent(in) :: sys
@@ -748,7 +922,8 @@ contains
     if (present(rates)) frame_rates = rates
     call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
                          potential, powers, records, info, tangent_rotations(sys, rotations), &
-                         values, frame_rates, tangent_frame_rates(sys, frame_rates), t=t)
+                         values, frame_rates, tangent_frame_rates(sys, frame_rates), t=t, &
+                         force_time=t)
     if (info /= 0) return
     active = 0
     if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
@@ -795,6 +970,7 @@ contains
     real(dp), intent(out) :: records(:, :)
     integer, intent(out) :: info
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), set_energy, set_power, dissipation
+    real(dp) :: fel_powers(2)
     real(dp), allocatable :: e_full(:), v_full(:), unused(:), values_unused(:)
     integer :: s, f
     call evaluate_constraints(sys, e, t, phi, gradients, info)
@@ -805,11 +981,22 @@ contains
     powers(power_drive) = dot_product(lam, gradient_dot(sys, gradients, v))
     allocate (e_full(sys%nfull))
     call to_full(sys, e, .true., e_full)
-    if (sys%npoint > 0 .or. damped_sets(sys)) then
+    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys, v, .false., v_full)
     end if
     strain = 0.0_dp
+    if (sys%nfel > 0) then  ! potential, dissipation (a lost work) and the cylinders' drives
+      allocate (unused(sys%nfull))
+      unused = 0.0_dp
+      call force_element_forces(sys, t, e_full, v_full, 0.0_dp, unused, set_energy, &
+                                fel_powers, info)
+      if (info /= 0) return
+      deallocate (unused)
+      strain = strain + set_energy
+      powers(power_material_damping) = powers(power_material_damping) - fel_powers(1)
+      powers(power_drive) = powers(power_drive) + fel_powers(2)
+    end if
     do s = 1, size(sys%sets)
       f = sys%sets(s)%item%frame
       if (sys%sets(s)%item%damping_time > 0.0_dp) then

@@ -200,13 +200,21 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
                   points=v["points"])
     elif group == "probe":
         s.probe(v["name"], v["body"], v["point"])
+    elif group == "force_element":
+        s.force_element(v["name"], v["type"], v["body1"], v["body2"], point1=v["point1"],
+                        point2=v["point2"], point=v["point"], stiffness=v["stiffness"],
+                        damping=v["damping"], rotational_stiffness=v["rotational_stiffness"],
+                        rotational_damping=v["rotational_damping"],
+                        free_length=v["free_length"], preload=v["preload"],
+                        deflections=v["deflections"], forces=v["forces"],
+                        interpolation=v["interpolation"], drive=v["drive"])
     else:  # the schema admits no other group
         raise AssertionError(group)
 
 
 _ITEM_WORDS = {"joint": "joint", "drive": "drive", "load": "load", "probe": "probe",
                "contact": "contact", "beam": "beam", "cable": "cable", "plate": "plate",
-               "leaf": "leaf",
+               "leaf": "leaf", "force element": "force_element",
                "rigid body": "rigid_body", "material": "material", "body": None}
 _ITEM_PREFIX = re.compile(r"^(%s) '([^']*)'" % "|".join(_ITEM_WORDS))
 

@@ -586,6 +586,39 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "slip_speed": Key("float", 0.08, positive, "critical slip speed V_t (m/s)"),
         "points": Key("int", 3, at_least(2), "contact points per end edge"),
     },
+    "force_element": {
+        "name": _name(),
+        "type": Key("str", check=one_of("spring_damper", "bushing", "cylinder"),
+                    doc="'spring_damper' (along the line point1-point2), 'bushing' (6 diagonal "
+                    "stiffnesses and dampings at point), 'cylinder' (a driven length with "
+                    "oil-column stiffness and damping in series)"),
+        "body1": Key("str", "ground", doc="first body (or 'ground')"),
+        "body2": Key("str", doc="second body (or 'ground')"),
+        "point1": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body1 (m)"),
+        "point2": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body2 (m)"),
+        "point": Key("floats", None, vector3, "'bushing': the point on both bodies (m)"),
+        "stiffness": Key("floats", None, non_negative, "stiffness (N/m): one value; a "
+                         "'bushing' three, along body1's axes at the point"),
+        "damping": Key("floats", None, non_negative, "damping (N s/m): one value; a 'bushing' "
+                       "three (default 0)"),
+        "rotational_stiffness": Key("floats", None, non_negative, "'bushing': stiffness about "
+                                    "body1's three axes (N m/rad; default 0)"),
+        "rotational_damping": Key("floats", None, non_negative, "'bushing': damping about "
+                                  "body1's three axes (N m s/rad; default 0)"),
+        "free_length": Key("float", None, positive, "'spring_damper': length at which the "
+                           "force is the preload (m; default: the distance at t = 0)"),
+        "preload": Key("float", None, doc="'spring_damper': force at the free length (N, "
+                       "tension positive; default 0)"),
+        "deflections": Key("floats", None, doc="'spring_damper' instead of stiffness and "
+                           "preload: a force-deflection table's deflections L - free_length "
+                           "(m, increasing)"),
+        "forces": Key("floats", None, doc="'spring_damper': the table's forces (N, tension "
+                      "positive; constant beyond the ends)"),
+        "interpolation": Key("str", None, one_of("linear", "cubic", "pchip"),
+                             "'spring_damper': the table's interpolation, as a drive table's "
+                             "(default 'linear')"),
+        "drive": Key("str", None, doc="'cylinder': the drive of the nominal length l(t) (m)"),
+    },
     "probe": {
         "name": _name(),
         "body": Key("str", doc="the body"),
@@ -632,7 +665,8 @@ SCHEMA["buckling"] = {
 #: &modal and &buckling occur once in general scenes too
 GENERAL_SINGLE_GROUPS = GENERAL_SINGLE_GROUPS + ("modal", "buckling")
 #: Groups only general scenes have.
-GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe", "cable")
+GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe", "cable",
+                       "force_element")
 #: checks that take a list key's whole value (the others take each item)
 WHOLE_LIST_CHECKS = (vector3, points3, principal_positive)
 

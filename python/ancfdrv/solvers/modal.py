@@ -5,7 +5,7 @@ linearized about a static state (e*, lambda*) of the scene's loads:
 
     M x'' + C x' + K x - G^T mu = 0,   G x = 0,
     K = dQ_int/de - dQ_M/de - sum_k lambda*_k Phi_k,ee   (the static Newton matrix's block),
-    C = dQ_int/de' (material damping),  G = Phi_e(e*),
+    C = dQ_int/de' (material damping, force elements' dampers),  G = Phi_e(e*),
 
 so K holds the elastic tangent at the loaded state (for the large-deformation beams, plates
 and leaves its initial-stress part is the geometric stiffness of that state), the dead
@@ -57,7 +57,7 @@ class Linearization:
 
     stiffness: sp.csr_matrix      # K (symmetrized; see ``asymmetry``)
     mass: sp.csr_matrix           # M
-    damping: sp.csr_matrix | None  # C (material damping), None without damping
+    damping: sp.csr_matrix | None  # C (material damping, force elements' dampers), None without damping
     constraints: sp.csr_matrix    # G = Phi_e (ncon x ndof)
     asymmetry: float = 0.0        # |K - K^T|_max / |K|_max before symmetrizing
 
@@ -111,7 +111,7 @@ def linearize(model: Model, e: np.ndarray, lam: np.ndarray, t: float = 0.0,
     asymmetry = float(abs(stiffness - stiffness.T).max() / scale) if stiffness.nnz else 0.0
     stiffness = ((stiffness + stiffness.T) * 0.5).tocsr()
     damping = None
-    if model.damped:
+    if model.damped or any(f.damped for f in model.force_elements):  # C = dQ/de'
         rate = model.forces(e, t, want_tangent=True, velocity_factor=1.0,
                             load_factor=load_factor)["tangent"]
         damping = model.pattern.to_scipy(rate - out["tangent"])

@@ -348,6 +348,10 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     if model.vector_loads:
         raise SolverError("the split iteration takes dead loads only; driven moments and "
                           "follower loads need solver.static_method = 'newton'")
+    if model.force_elements:
+        raise SolverError("the split iteration needs a constant stiffness; force elements "
+                          "(spring-dampers, bushings, cylinders) need solver.static_method = "
+                          "'newton'")
     model.require_runnable()
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}

@@ -357,7 +357,25 @@ def reactions(model: Model, e: np.ndarray, lam: np.ndarray, *, t: float = 0.0,
         lf = model.load_factor if load_factor is None else load_factor
         v = np.zeros(model.ndof) if v is None else v
         residual = rm.residual(np.asarray(e, dtype=float), v, a, t, lf)
-    return rm.reactions(q, np.asarray(lam, dtype=float), t, residual)
+    out = rm.reactions(q, np.asarray(lam, dtype=float), t, residual)
+    out.update(force_element_reactions(model, e, v, t))
+    return out
+
+
+def force_element_reactions(model: Model, e: np.ndarray, v: np.ndarray | None = None,
+                            t: float = 0.0) -> dict[str, Reaction]:
+    """Per force element (``ancfdrv.system.force_elements``) the force and moment body1
+    exerts on body2 (global axes; the moment about the element's point on body2) and the
+    axial force (tension positive; 0 for a bushing) at (e, e', t), from the kernel."""
+    items = list(getattr(model, "force_elements", ()))
+    if not items:
+        return {}
+    v = np.zeros(model.ndof) if v is None else np.asarray(v, dtype=float)
+    rows = model.kernel.force_element_reactions(float(t), np.asarray(e, dtype=float), v)
+    q = model.expand(e)
+    return {info.name: Reaction(rows[0:3, i].copy(), rows[3:6, i].copy(),
+                                info.slots[1].value(q), float(rows[6, i]))
+            for i, info in enumerate(items)}
 
 
 # -- section forces --------------------------------------------------------------------------
@@ -714,6 +732,11 @@ class DynamicAnswers:
         self.time: list[float] = []
         #: per joint, per chunk: (force (nt, 3), moment (nt, 3), axial (nt,) or None)
         self.reactions: dict[str, list[tuple]] = {name: [] for name in self.map.joints}
+        #: force elements: their reactions need e' at every row (rebuilt as e'' is)
+        self.force_elements = list(getattr(model, "force_elements", ()))
+        for info in self.force_elements:
+            self.reactions[info.name] = []
+        self.need_velocity = bool(self.force_elements)
         self.sections: dict[str, list[SectionForces]] = {}
         self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
@@ -743,16 +766,29 @@ class DynamicAnswers:
         e_rows = np.asarray(chunk.q, dtype=float)
         q_rows = self.model.expand(e_rows)
         residual = None
+        velocities = np.zeros_like(e_rows)
         if self.need_acceleration:
             lf = self.model.load_factor
             residual = np.empty_like(q_rows)
             for row, t in enumerate(times):
                 v, accel = self._kinematics(float(t), e_rows[row])
+                velocities[row] = v
                 guesses = None
                 if getattr(chunk, "contact", None) is not None:   # xi, eta of each point
                     guesses = np.ascontiguousarray(chunk.contact[row, :, 4:6].T)
                 residual[row] = self.map.residual(e_rows[row], v, accel, float(t), lf,
                                                   guesses)
+        elif self.need_velocity:
+            for row, t in enumerate(times):
+                velocities[row], _ = self._kinematics(float(t), e_rows[row])
+        if self.force_elements:
+            found_fe = [force_element_reactions(self.model, e_rows[row], velocities[row],
+                                                float(t)) for row, t in enumerate(times)]
+            for info in self.force_elements:
+                rows = [f[info.name] for f in found_fe]
+                self.reactions[info.name].append((np.array([r.force for r in rows]),
+                                                  np.array([r.moment for r in rows]),
+                                                  np.array([r.axial for r in rows])))
         if self.map.joints:
             found = self.map.reaction_rows(q_rows, np.asarray(chunk.lam, dtype=float), times,
                                            residual)
@@ -777,7 +813,8 @@ class DynamicAnswers:
                 when[higher] = times[row][higher]
 
 
-__all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions", "section_forces",
+__all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions",
+           "section_forces", "force_element_reactions",
            "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
            "DEFAULT_STATIONS",
            "DynamicAnswers", "constraint_joints"]

@@ -22,6 +22,7 @@ from .constraint_set import ConstraintSet
 from .drives import Constant
 from .element_kinds import SetContext, register_body, register_set, set_builder
 from .expressions import Scalar
+from .force_elements import assemble_force_elements
 from .joints import Constraint, LinearEquation, orthonormality, planar_fixes, small_turn
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
 from .model import (VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_FORCE, VLOAD_FOLLOWER_MOMENT, FrameInfo,
@@ -87,7 +88,10 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     contact_pairs, contact_blocks = _contact(act.contacts, q0, active_effects, counters)
     rigid_blocks = [np.arange(b.first, b.first + b.ncoordinates) for b in bodies
                     if isinstance(b, RigidBody)]
-    full_pattern = Pattern.from_blocks(nfull, set_blocks + rigid_blocks + contact_blocks)
+    force_elements, force_blocks = assemble_force_elements(
+        getattr(system, "force_elements", {}).values(), q0, drive_index, counters)
+    full_pattern = Pattern.from_blocks(nfull, set_blocks + rigid_blocks + contact_blocks
+                                       + force_blocks)
     for info in sets:
         info.scatter = full_pattern.scatter(info.dofs)
 
@@ -141,6 +145,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         linear_joints=mode, response=response,
         support_frames=support_frames(system) if supports else None)
     model.vector_loads = vector_loads
+    model.force_elements = force_elements
     model.frame_problems = frame_problems
     _answer_inputs(model, system, equations, elimination, reduction, mass_full,
                    constant + gravity, driven)
@@ -939,6 +944,8 @@ def _policy(model: Model) -> None:
     the solver-frame assembly is exact (checked numerically); else 'refactor'."""
     model.policy, model.vector_frame = POLICY_REFACTOR, np.zeros(0, dtype=np.int64)
     if model.contact_pairs or any(s.kind != "ffr" for s in model.sets):
+        return
+    if model.force_elements:  # their tangent changes with the configuration
         return
     moving = [i + 1 for i, f in enumerate(model.frames) if f.drive >= 0]
     if not moving:

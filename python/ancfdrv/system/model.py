@@ -151,6 +151,8 @@ class Model:
 
     #: driven and follower point loads (set by the assembly; empty: none)
     vector_loads: tuple | list = ()
+    #: force elements (system/force_elements.ForceElementInfo; set by the assembly)
+    force_elements: tuple | list = ()
 
     def __init__(self, *, title: str, effects: tuple[str, ...], counters: Counter,
                  warnings: list[str], notes: list[str], bodies: list[Body], sets: list[SetInfo],
@@ -443,6 +445,8 @@ class Model:
             return False
         if self.vector_loads and self.policy != POLICY_CONSTANT:
             return False
+        if self.force_elements:  # a damper's tangent is unsymmetric (c dm/dq (d2m/dq2 q')^T)
+            return False
         return not self.contact_pairs and self.pattern.bandwidth() <= max(64, self.ndof // 4)
 
     def build_kernel(self) -> None:
@@ -475,6 +479,9 @@ class Model:
                      [m.magnitude for m in self.moments], [m.reference for m in self.moments])
         if self.vector_loads:
             ks.set_vector_loads(self.vector_loads)
+        if self.force_elements:
+            from .force_elements import kernel_layout
+            ks.set_force_elements(kernel_layout(self.force_elements, self.full_pattern))
         ks.set_constraints(self.constraints.layout())
         for pair in self.contact_pairs:
             ks.add_contact_pair(pair["dofs"], pair["sizes"], pair["grid"], pair["point_element"],

@@ -1,6 +1,6 @@
 """The :class:`System`: a user's structure composed of named materials, bodies, drives,
-joints, loads, contact pairs and probes, in a Python script or from a namelist (each group
-one call). Names are unique per kind of item; the body name 'ground' is reserved. A joint,
+joints, loads, contact pairs, force elements (spring-dampers, bushings, compliant
+cylinders) and probes, in a Python script or from a namelist (each group one call). Names are unique per kind of item; the body name 'ground' is reserved. A joint,
 load, contact or probe naming an unknown body (or drive, or material) is an
 :class:`~ancfdrv.errors.InputError` naming the item. :meth:`System.assemble` turns it into
 the model the solvers run (``ancfdrv.system.assembly``).
@@ -36,6 +36,7 @@ from .cable import Cable
 from .contact import ContactPair
 from .drives import DRIVE_TYPES, Drive, Table
 from .ffr_checks import ffr_speed_warnings
+from .force_elements import FORCE_ELEMENT_PARAMETERS, ForceElement
 from .joints import Joint
 from .loads import LOAD_TYPES, Load
 from .probes import Probe
@@ -107,6 +108,7 @@ class System:
         self.loads: dict[str, Load] = {}
         self.contacts: dict[str, ContactPair] = {}
         self.probes: dict[str, Probe] = {}
+        self.force_elements: dict[str, ForceElement] = {}
         self.ground = Ground()
         self.notes: list[str] = []
 
@@ -324,6 +326,9 @@ class System:
         ``axis2``: a 'universal' joint's second cross axis, on body2 (``axis`` is on body1)."""
         name = self._new_name(name, self.joints, "joint")
         where = f"joint {name!r}"
+        if name in getattr(self, "force_elements", {}):
+            raise InputError(f"{where}: a force element has that name (reactions are stored "
+                             "by name)")
         v = check_call("joint", f"joint[{name}]", dict(
             point=point, axis=axis, point1=point1, point2=point2, pivot=pivot, axis2=axis2))
         axis = v["axis"]
@@ -410,6 +415,108 @@ class System:
                            stiffness, damping, friction, slip_speed, points)
         self.contacts[name] = pair
         return pair
+
+    @_api
+    def force_element(self, name: str, type: str, body1: str | Body = "ground",
+                      body2: str | Body | None = None, *, point1=None, point2=None,
+                      point=None, stiffness=None, damping=None, rotational_stiffness=None,
+                      rotational_damping=None, free_length: float | None = None,
+                      preload: float | None = None, deflections=None, forces=None,
+                      interpolation: str | None = None,
+                      drive: str | Drive | None = None) -> ForceElement:
+        """A force element between body1 and body2 (either may be 'ground'; points are any
+        material points of the bodies), ``ancfdrv.system.force_elements``:
+
+        - ``'spring_damper'``: point1, point2; stiffness (N/m), damping (N s/m), free_length
+          (m; default the distance at t = 0), preload (N at the free length, tension
+          positive); or instead of stiffness and preload a force-deflection table
+          ``deflections`` (m, increasing), ``forces`` (N) with ``interpolation`` 'linear'
+          (default), 'cubic' or 'pchip'.
+        - ``'bushing'``: point; stiffness and damping (3 each: along body1's axes at the
+          point), rotational_stiffness and rotational_damping (3 each: about them).
+        - ``'cylinder'``: point1, point2, drive (the nominal length l(t), m), stiffness and
+          damping of the oil column in series: f = k (L - l) + c (L' - l').
+
+        Its reaction (force, moment, axial) is recorded under its name with the joints'."""
+        name = self._new_name(name, self.force_elements, "force element")
+        where = f"force element {name!r}"
+        if name in self.joints:
+            raise InputError(f"{where}: a joint has that name (reactions are stored by name)")
+        if not isinstance(type, str) or type not in FORCE_ELEMENT_PARAMETERS:
+            raise InputError(f"{where}: type {short_repr(type)} must be one of "
+                             f"{', '.join(FORCE_ELEMENT_PARAMETERS)}")
+        if body2 is None:
+            raise InputError(f"{where}: body2 is required")
+        v = check_call("force_element", f"force_element[{name}]", dict(
+            point1=point1, point2=point2, point=point, stiffness=stiffness, damping=damping,
+            rotational_stiffness=rotational_stiffness, rotational_damping=rotational_damping,
+            free_length=free_length, preload=preload, deflections=deflections, forces=forces,
+            interpolation=interpolation))
+        required, optional = FORCE_ELEMENT_PARAMETERS[type]
+        given = {k: v[k] for k in ("point1", "point2", "point", "stiffness", "damping",
+                                   "rotational_stiffness", "rotational_damping",
+                                   "free_length", "preload", "deflections", "forces",
+                                   "interpolation")}
+        given["drive"] = drive
+        missing = [k for k in required if given[k] is None]
+        if type == "spring_damper" and given["stiffness"] is None and given["forces"] is None:
+            missing.append("stiffness (or deflections and forces)")
+        if missing:
+            raise InputError(f"{where}: type {type!r} needs {', '.join(missing)}")
+        extra = [k for k, x in given.items() if x is not None and k not in required + optional]
+        if extra:
+            raise InputError(f"{where}: type {type!r} does not take {', '.join(extra)}")
+        size = 3 if type == "bushing" else 1
+
+        def values(key: str) -> np.ndarray:
+            x = given.get(key)
+            if x is None:
+                return np.zeros(size)
+            x = np.asarray(x, dtype=float).ravel()
+            if x.size != size:
+                raise InputError(f"{where}: {key} takes {size} value{'s' * (size > 1)} for "
+                                 f"type {type!r}, got {x.size}")
+            return x
+        first, second = self.body(body1, used_by=where), self.body(body2, used_by=where)
+        if first is second:
+            raise InputError(f"{where}: body1 and body2 are the same body")
+        table = None
+        if given["deflections"] is not None or given["forces"] is not None:
+            if given["stiffness"] is not None or given["preload"] is not None:
+                raise InputError(f"{where}: a force-deflection table replaces stiffness and "
+                                 "preload: give one or the other")
+            if given["deflections"] is None or given["forces"] is None:
+                raise InputError(f"{where}: a force-deflection table needs deflections and "
+                                 "forces")
+            table = Table(f"{name} (force table)", tuple(given["deflections"]),
+                          tuple(given["forces"]), interpolation or "linear")
+            try:
+                table.check()
+            except InputError as exc:
+                raise InputError(f"{where}: {str(exc).split(': ', 1)[-1]}".replace(
+                    "times", "deflections")) from None
+        elif interpolation is not None:
+            raise InputError(f"{where}: interpolation applies to a force-deflection table")
+        if type == "bushing":
+            p1 = p2 = _points(given["point"])[0]
+        else:
+            p1, p2 = _points(given["point1"])[0], _points(given["point2"])[0]
+        at1 = first.locate(p1, node=False, what=where)   # material points of the bodies
+        at2 = second.locate(p2, node=False, what=where)
+        if type == "bushing":
+            for body, at in ((first, at1), (second, at2)):
+                if len(body.basis(at)) != 3:
+                    raise InputError(f"{where}: a bushing needs three direction vectors at "
+                                     f"its point; {body.__class__.__name__.lower()} "
+                                     f"{body.name!r} carries {len(body.basis(at))} (use a "
+                                     "beam, a rigid body or the ground)")
+        fe = ForceElement(name, type, first, second, p1, p2, values("stiffness"),
+                          values("damping"), values("rotational_stiffness"),
+                          values("rotational_damping"), given["free_length"],
+                          float(given["preload"] or 0.0), table,
+                          self._drive(drive, where) if type == "cylinder" else None)
+        self.force_elements[name] = fe
+        return fe
 
     @_api
     def probe(self, name: str, body: str | Body, point) -> Probe:

@@ -1,0 +1,252 @@
+"""Force elements between two bodies (SPEC 8.1; kernel module
+``fortran/src/elements/force_elements.f90``): a spring-damper, a bushing and a compliant
+hydraulic cylinder. The family's whole Python side: the items a :class:`~.system.System`
+holds, their assembly into slots (material points and direction vectors of the two bodies,
+affine in the full coordinates, the ground's as constants) and their reactions.
+
+``spring_damper``  body1, point1, body2, point2; force along the line p2 - p1, tension
+                   positive: f = preload + stiffness (L - free_length) + damping L', or
+                   f = table(L - free_length) + damping L' (a force-deflection table through
+                   (deflections, forces), interpolated 'linear', 'cubic' or 'pchip' as the
+                   drive tables are, constant beyond its ends). free_length defaults to the
+                   distance at t = 0. Potential: preload d + stiffness d^2 / 2 (d = L - L0),
+                   or the table's integral from 0 to d.
+``bushing``        body1, body2 and one point on both; diagonal stiffness and damping: three
+                   translational (stiffness, damping: N/m, N s/m) along body1's direction
+                   vectors at the point and three rotational (rotational_stiffness,
+                   rotational_damping: N m/rad, N m s/rad) about them. Direction vectors: a
+                   rigid body's axes r_x, r_y, r_z (the global axes at t = 0), a beam's slope
+                   r_x and section directors r_y, r_z at the point, the ground's global axes
+                   (plates and cables carry fewer than three: refused). The rotation measure:
+                   theta_i = (g_k . h_j - g_j . h_k) / 2 for (i, j, k) cyclic, with g body1's
+                   vectors and h body2's mapped so that h = g at t = 0: the relative rotation
+                   vector's components on body1's axes to first order (small relative
+                   rotations), exactly zero when both bodies turn together by any angle.
+``cylinder``       body1, point1, body2, point2 and a drive: the nominal length l(t) of a rigid
+                   actuator in series with the oil column's stiffness and damping, f = k (L -
+                   l(t)) + c (L' - l'(t)) along the line (tension positive); the rigid,
+                   massless cylinder is the 'distance' joint with a drive.
+
+Energy: the potentials enter the strain energy; the dissipated power c m'^2 is a lost work
+counted with the material damping's (energy row ``work_material_damping``), and a
+cylinder's drive puts in the power -f l' (``work_drive``, with the driven joints').
+Reactions (``/static/reactions/<name>``, ``/dynamic/reactions/<name>``): the force and
+moment body1 exerts on body2 (global axes) and ``axial`` (the line's tension; 0 for a
+bushing). A system without force elements hands the kernel none and computes what it did
+before.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import kernel
+from ..errors import InputError
+from .bodies import Body
+from .drives import Drive, Table
+from .expressions import Vec3, combination
+
+#: kinds of the kernel module force_elements (fe_*)
+FE_SPRING_DAMPER, FE_BUSHING, FE_CYLINDER = 1, 2, 3
+FORCE_ELEMENT_KINDS = {"spring_damper": FE_SPRING_DAMPER, "bushing": FE_BUSHING,
+                       "cylinder": FE_CYLINDER}
+#: the parameters each type takes besides name, type, body1, body2: (required, optional)
+#: (a spring_damper needs stiffness or the table deflections and forces)
+FORCE_ELEMENT_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "spring_damper": (("point1", "point2"), ("stiffness", "damping", "free_length", "preload",
+                                             "deflections", "forces", "interpolation")),
+    "bushing": (("point", "stiffness"), ("damping", "rotational_stiffness",
+                                         "rotational_damping")),
+    "cylinder": (("point1", "point2", "drive", "stiffness"), ("damping",)),
+}
+FORCE_ELEMENT_MEANING = {
+    "spring_damper": "along the line point1-point2, tension positive: preload + stiffness "
+                     "(L - free_length) + damping L', or the table's force of L - free_length "
+                     "+ damping L'",
+    "bushing": "at point: stiffness/damping along and rotational_* about body1's three axes "
+               "(small relative rotations)",
+    "cylinder": "a rigid actuator of driven length l(t) in series with the oil column: "
+                "stiffness (L - l) + damping (L' - l')",
+}
+
+
+@dataclass
+class ForceElement:
+    """A force element as the user gave it (see the module documentation); vector
+    parameters of a bushing have 3 entries, the others 1."""
+
+    name: str
+    type: str
+    body1: Body
+    body2: Body
+    point1: np.ndarray
+    point2: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    rotational_stiffness: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    rotational_damping: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    free_length: float | None = None
+    preload: float = 0.0
+    table: Table | None = None
+    drive: Drive | None = None
+
+    @property
+    def kind(self) -> int:
+        return FORCE_ELEMENT_KINDS[self.type]
+
+
+@dataclass
+class ForceElementInfo:
+    """A force element as assembled: kernel kind, 0-based drive (-1: none), parameters,
+    table (kind 0: none), and its slots (Vec3 on the full coordinates)."""
+
+    name: str
+    kind: int
+    drive: int
+    params: np.ndarray
+    table_kind: int
+    table: np.ndarray
+    slots: list[Vec3]
+
+    @property
+    def damped(self) -> bool:
+        """Whether it has a damper (its force depends on the rates)."""
+        damping = self.params[6:12] if self.kind == FE_BUSHING else self.params[1:2]
+        return bool(np.any(damping != 0.0))
+
+    def dofs(self) -> np.ndarray:
+        """Every full coordinate its slots touch (one block of the sparse pattern)."""
+        firsts = sorted({d for slot in self.slots for d in slot.terms})
+        return np.array([d + i for d in firsts for i in range(3)], dtype=np.int64)
+
+
+def _where(fe: ForceElement) -> str:
+    return f"force element {fe.name!r}"
+
+
+def _directions(body: Body, at, what: str) -> list[Vec3]:
+    basis = body.basis(at)
+    if len(basis) != 3:
+        raise InputError(f"{what}: a bushing needs three direction vectors at its point; "
+                         f"{type(body).__name__.lower()} {body.name!r} carries {len(basis)} "
+                         "(use a beam, a rigid body or the ground)")
+    return basis
+
+
+def assemble_force_element(fe: ForceElement, q0: np.ndarray, drive_index: dict) -> \
+        ForceElementInfo:
+    """The kernel's data of one force element at the configuration q0 of t = 0."""
+    what = _where(fe)
+    at1 = fe.body1.locate(fe.point1, node=False, what=what)
+    at2 = fe.body2.locate(fe.point2, node=False, what=what)
+    p1, p2 = fe.body1.position(at1), fe.body2.position(at2)
+    slots = [p1, p2]
+    table_kind, table = 0, np.zeros(0)
+    drive = -1
+    if fe.type == "bushing":
+        g, b = _directions(fe.body1, at1, what), _directions(fe.body2, at2, what)
+        d1 = np.column_stack([v.value(q0) for v in g])
+        d2 = np.column_stack([v.value(q0) for v in b])
+        if abs(np.linalg.det(d2)) < 1e-9 * np.prod(np.linalg.norm(d2, axis=0)):
+            raise InputError(f"{what}: the direction vectors of {fe.body2.name!r} at the point "
+                             "are not independent")
+        mapping = np.linalg.solve(d2, d1)       # h_i = sum_j b_j R_ji equals g_i at t = 0
+        h = [combination(b, mapping[:, i]) for i in range(3)]
+        slots += list(g) + h
+        params = np.concatenate([fe.stiffness, fe.rotational_stiffness, fe.damping,
+                                 fe.rotational_damping])
+    else:
+        length0 = float(np.linalg.norm(p2.value(q0) - p1.value(q0)))
+        if length0 <= 1e-12 * max(1.0, float(np.abs(p1.value(q0)).max())):
+            raise InputError(f"{what}: point1 and point2 coincide (the line of action is "
+                             "undefined)")
+        if fe.type == "spring_damper":
+            free = length0 if fe.free_length is None else fe.free_length
+            params = np.array([fe.stiffness[0], fe.damping[0], free, fe.preload])
+            if fe.table is not None:
+                table_kind, table = fe.table.kind, np.array(fe.table.params(), dtype=float)
+        else:
+            params = np.array([fe.stiffness[0], fe.damping[0]])
+            drive = drive_index[id(fe.drive)]
+    return ForceElementInfo(fe.name, fe.kind, drive, params.astype(float), table_kind, table,
+                            slots)
+
+
+def assemble_force_elements(items, q0: np.ndarray, drive_index: dict, counters: Counter) -> \
+        tuple[list[ForceElementInfo], list[np.ndarray]]:
+    """The force elements' kernel data and their pattern blocks (one per element)."""
+    out = [assemble_force_element(fe, q0, drive_index) for fe in items]
+    if out:
+        counters["force_elements"] += len(out)
+    return out, [info.dofs() for info in out if len(info.dofs())]
+
+
+def tangent_positions(info: ForceElementInfo, pattern) -> np.ndarray:
+    """The positions (0-based; -1: absent) in the full pattern's values of the element's
+    tangent entries, in the kernel's loop order: slot s, slot w, term k of s, term m of w,
+    component i, component j (row: k's coordinate + i, column: m's + j)."""
+    terms = [sorted(slot.terms.items()) for slot in info.slots]
+    rows, cols = [], []
+    offsets = np.arange(3)
+    for first in terms:
+        for second in terms:
+            if not first or not second:
+                continue
+            a = np.array([d for d, _ in first])[:, None, None, None] + offsets[None, None, :, None]
+            b = np.array([d for d, _ in second])[None, :, None, None] + offsets[None, None, None, :]
+            a, b = np.broadcast_arrays(a, b)
+            rows.append(a.ravel())
+            cols.append(b.ravel())
+    if not rows:
+        return np.zeros(0, dtype=np.int64)
+    return pattern.positions(np.concatenate(rows), np.concatenate(cols))
+
+
+def kernel_layout(infos: list[ForceElementInfo], pattern=None) -> dict:
+    """The packed arrays of system_set_force_elements (0-based; kernel.py adds 1), with the
+    tangent's positions in the full ``pattern`` (Pattern) when given."""
+    param_ptr, table_ptr, slot_first, term_ptr = [0], [0], [], [0]
+    params, table, consts, dofs, coefs = [], [], [], [], []
+    for info in infos:
+        params += info.params.tolist()
+        table += info.table.tolist()
+        param_ptr.append(len(params))
+        table_ptr.append(len(table))
+        slot_first.append(len(consts))
+        for slot in info.slots:
+            consts.append(np.asarray(slot.const, dtype=float))
+            for d, c in sorted(slot.terms.items()):
+                dofs.append(d)
+                coefs.append(c)
+            term_ptr.append(len(dofs))
+    positions = [tangent_positions(info, pattern) if pattern is not None
+                 else np.zeros(0, dtype=np.int64) for info in infos]
+    position_ptr = np.concatenate([[0], np.cumsum([len(x) for x in positions])])
+    return dict(positions=np.concatenate(positions) if positions else np.zeros(0, np.int64),
+                position_ptr=position_ptr,
+                kinds=[i.kind for i in infos], drives=[i.drive for i in infos],
+                table_kinds=[i.table_kind for i in infos], param_ptr=param_ptr,
+                params=params, table_ptr=table_ptr, table=table, slot_first=slot_first,
+                slot_const=np.array(consts, dtype=float).reshape(-1, 3), term_ptr=term_ptr,
+                term_dof=dofs, term_coef=coefs)
+
+
+def slot_values(info: ForceElementInfo, q_full: np.ndarray) -> np.ndarray:
+    """The element's slot vectors (3, ns) at the full coordinates (tests, checks)."""
+    return np.column_stack([s.value(q_full) for s in info.slots])
+
+
+def evaluate(info: ForceElementInfo, x: np.ndarray, xd: np.ndarray | None = None,
+             length: float = 0.0, length_rate: float = 0.0) -> dict:
+    """One element at slot values x (3, ns) and rates xd through the kernel
+    (force_elements.force_element_eval): force (3, ns), stiffness and damping (3, ns, 3, ns),
+    energy, dissipation, drive_power, reaction (7)."""
+    return kernel.force_element(info.kind, info.params, info.table_kind, info.table, x,
+                                np.zeros_like(x) if xd is None else xd, length, length_rate)
+
+
+__all__ = ["ForceElement", "ForceElementInfo", "FORCE_ELEMENT_KINDS", "FORCE_ELEMENT_PARAMETERS",
+           "FORCE_ELEMENT_MEANING",
+           "assemble_force_elements", "kernel_layout", "slot_values", "evaluate"]
