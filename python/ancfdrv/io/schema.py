@@ -96,6 +96,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
                       "'check': drives and loads must stay within physical bounds "
                       "(ancfdrv.io.validate.PHYSICAL_BOUNDS, e.g. a rate of at most 1e4 rad/s); "
                       "'off' accepts any finite value (also: ancf run --force)"),
+        "planar": Key("str", "off", one_of("off", "auto", "xy", "yz", "zx"),
+                      "planar reduction (docs/theory.md, system/planar.py): 'xy', 'yz', 'zx' "
+                      "declare that the motion stays in planes parallel to that one (data "
+                      "leaving it are refused) and solve only the in-plane coordinates (a "
+                      "beam node 7 of 12, a cable node 4 of 6); 'auto' reduces when every "
+                      "body, joint and load keeps the motion in a coordinate plane; 'off' "
+                      "solves every coordinate"),
         "response_component": Key("int", 2, within(0, 2), "general scenes: the component of the "
                                   "response probe's deflection compared (0, 1, 2 = x, y, z; beams "
                                   "in their frame)"),

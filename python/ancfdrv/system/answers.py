@@ -125,7 +125,9 @@ class ReactionMap:
         eliminated = getattr(model, "eliminated", [])
         self.linear_owner = [owner.get(eq.name) for eq in eliminated]
         self.factor = None
-        if eliminated:
+        # rows no joint owns (a planar reduction's fixes, system/planar.py) need no mu: their
+        # force is on no joint, so without owned rows the residual is not formed at all
+        if eliminated and any(o is not None for o in self.linear_owner):
             rows, cols, vals = [], [], []
             for i, eq in enumerate(eliminated):
                 for d, a in eq.expr.terms.items():

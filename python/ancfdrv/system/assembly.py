@@ -26,6 +26,10 @@ from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
 from .model import (VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_FORCE, VLOAD_FOLLOWER_MOMENT, FrameInfo,
                     MomentInfo, Model, ProbeInfo, SetInfo, VectorLoadInfo)
 from .patterns import Elimination, Pattern, eliminate, reduction_plan
+from .planar import planar_equations
+from .planar import resolve as resolve_planar
+
+PLANE_NAMES = {2: "xy", 0: "yz", 1: "zx"}
 
 #: effects every model reports (a zero count proves an effect was not computed)
 EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
@@ -96,10 +100,19 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     has_rigid = any(isinstance(b, RigidBody) for b in bodies)
     mode = linear_joints if linear_joints != "auto" else ("eliminate" if has_rigid else
                                                           "multipliers")
+    plane, planar_eqs = _planar(system, act, q0, notes)
     equations = _equations(system, bodies, q0, notes, warnings)
     linear = [eq for eq in equations if isinstance(eq, LinearEquation)]
     reduction = None
-    if mode == "eliminate" and linear:
+    if planar_eqs:  # the planar fixes are eliminated whatever the joints' mode (planar.py)
+        elimination = eliminate(planar_eqs + (linear if mode == "eliminate" else []), q0)
+        notes += [f"redundant joint equation dropped: {name}" for name in elimination.redundant
+                  if ": planar" not in name]
+        reduction = reduction_plan(nfull, elimination, q0, full_pattern)
+        constraints_eq = [eq for eq in equations if isinstance(eq, Constraint)] \
+            if mode == "eliminate" else \
+            [_as_constraint(eq) if isinstance(eq, LinearEquation) else eq for eq in equations]
+    elif mode == "eliminate" and linear:
         elimination = eliminate(linear, q0)
         notes += [f"redundant joint equation dropped: {name}" for name in elimination.redundant]
         reduction = reduction_plan(nfull, elimination, q0, full_pattern)
@@ -138,6 +151,11 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     model.frame_problems = frame_problems
     _answer_inputs(model, system, equations, elimination, reduction, mass_full,
                    constant + gravity, driven)
+    if planar_eqs:  # the rows eliminated are the planar fixes (+ the linear joints)
+        kept = planar_eqs + (linear if mode == "eliminate" else [])
+        model.eliminated = [eq for eq in kept if eq.name not in set(elimination.redundant)]
+    model.planar = "" if plane is None else PLANE_NAMES[plane]
+    model.nplanar_fixed = sum(eq.name not in set(elimination.redundant) for eq in planar_eqs)
     _policy(model)
     model.build_kernel()
     return model
@@ -562,6 +580,20 @@ def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[
                 continue
             out += orthonormality(body)
     return out
+
+
+def _planar(system, act: _Active, q0: np.ndarray, notes: list[str]
+            ) -> tuple[int | None, list[LinearEquation]]:
+    """The planar reduction's plane (normal axis, None: off) and the coordinates it fixes
+    (:mod:`.planar`), checked against the bodies, joints and the loads of the listed
+    effects."""
+    setting = getattr(system, "planar", "off")
+    if setting == "off":
+        return None, []
+    loads = act.gravity + act.forces + act.moments + act.masses + act.pressures
+    plane, planar_notes = resolve_planar(system, setting, loads)
+    notes += planar_notes
+    return plane, ([] if plane is None else planar_equations(system, plane, q0))
 
 
 def _linearized(system, warnings: list[str]) -> dict[str, str]:

@@ -38,6 +38,7 @@ from .drives import DRIVE_TYPES, Drive, Table
 from .joints import Joint
 from .loads import LOAD_TYPES, Load
 from .probes import Probe
+from .planar import check_setting as check_planar
 from .sections import Section
 
 #: effects an item may belong to, with the default of each load type (SPEC section 8)
@@ -85,7 +86,7 @@ class System:
     """A mechanical system under construction (see the module documentation)."""
 
     def __init__(self, title: str = "", *, effects: Iterable[str] | None = None,
-                 bounds: str = "check") -> None:
+                 bounds: str = "check", planar: str = "off") -> None:
         if not isinstance(title, str):
             raise InputError(f"the title must be a string, got {short_repr(title)}",
                              group="scene", key="title")
@@ -99,6 +100,8 @@ class System:
                              group="scene", key="bounds")
         #: 'check': drives and loads within validate.PHYSICAL_BOUNDS at assembly; 'off'
         self.bounds = bounds
+        #: planar reduction ('off', 'auto', 'xy', 'yz', 'zx'; :mod:`.planar`)
+        self.planar = check_planar(planar)
         self.materials: dict[str, Material] = {}
         self.bodies: dict[str, Body] = {}
         self.drives: dict[str, Drive] = {}

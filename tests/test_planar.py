@@ -1,0 +1,134 @@
+"""Planar reduction (issue 23, python/ancfdrv/system/planar.py): a scene whose motion stays in
+a coordinate plane solves only the in-plane coordinates, eliminated like fixed coordinates.
+
+The reference of every comparison is the same scene unreduced (planar = 'off'): by the
+mirror symmetry about the plane the unreduced solution keeps the eliminated coordinates at
+their initial values, so the two histories agree to the Newton tolerance (runs at
+newton_tol = 1e-12 agree to ~1e-14 of the probe's range; the bound is 1e-8). The counts of
+unknowns are closed forms: a beam node keeps 12 - 5 = 7 coordinates, a cable node 6 - 2 = 4,
+a planar rigid body 12 - 6 = 6.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from ancfdrv import Circle, System
+from ancfdrv.errors import InputError
+from ancfdrv.runner import run_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _tip(path: Path) -> tuple[np.ndarray, dict]:
+    with h5py.File(path) as f:
+        return f["dynamic/probes/tip"][()], dict(f["model"].attrs)
+
+
+def _compare(tmp_path: Path, scene: str, overrides: list[str]) -> tuple[dict, dict, float]:
+    rows, attrs = {}, {}
+    for planar in ("off", "xy"):
+        out = tmp_path / f"{planar}.h5"
+        run_scene(ROOT / scene, overrides + [f"scene.planar={planar}", "solver.newton_tol=1e-12",
+                                             "output.xdmf=.false."], out, progress=False)
+        rows[planar], attrs[planar] = _tip(out)
+    diff = np.abs(rows["off"] - rows["xy"]).max() / np.ptp(rows["off"], axis=0).max()
+    return attrs["off"], attrs["xy"], float(diff)
+
+
+@pytest.mark.parametrize("bending", ["cubic", "continuum"])
+def test_boom_luffing_reduced_equals_unreduced(tmp_path, bending):
+    """The nonlinear boom luffing (4 nodes, the first 1.2 s: start and luffing stages) with
+    the tip mass and the moment at A2, reduced to the r1-r2 plane."""
+    off, xy, diff = _compare(tmp_path, "inputs/boom_luffing.nml", [
+        "scene.formulation=nonlinear", f"beam.bending={bending}", "beam.nodes=4",
+        "solver.static_method=newton", "solver.t_end=1.2"])
+    assert diff < 1e-8
+    assert (off["ndof"], off["nplanar_fixed"], off["planar"]) == (48, 0, "")
+    assert (xy["ndof"], xy["nplanar_fixed"], xy["planar"]) == (4 * 7, 4 * 5, "xy")
+    # the arm's plane and A2's r3 are held by the fixes: their multipliers are gone
+    assert xy["nunknowns"] == xy["ndof"] + xy["nconstraints"] < off["nunknowns"]
+    assert xy["nconstraints"] == off["nconstraints"] - 3
+
+
+def test_flexible_pendulum_reduced_equals_unreduced(tmp_path):
+    """The flexible pendulum (inputs/hard/pendulum.nml, 5 nodes, 0.3 s of its swing)."""
+    off, xy, diff = _compare(tmp_path, "inputs/hard/pendulum.nml", [
+        "beam.nodes=5", "solver.t_end=0.3", "solver.dt=1e-3"])
+    assert diff < 1e-8
+    assert (off["ndof"], xy["ndof"]) == (60, 35)
+
+
+def test_general_boom_with_rigid_arm(tmp_path):
+    """The boom's general twin (rigid arm, weld, linear joints eliminated) nonlinear: the
+    scene's own planar fixes and the rigid arm's (6 of its 12 coordinates) are eliminated."""
+    off, xy, diff = _compare(tmp_path, "inputs/general/boom_luffing.nml", [
+        "scene.formulation=nonlinear", "beam[boom].nodes=4", "beam[boom].bending=cubic",
+        "solver.static_method=newton", "solver.t_end=1.2"])
+    assert diff < 1e-8
+    assert xy["nplanar_fixed"] == 4 * 5 + 6
+    assert xy["ndof"] < off["ndof"]
+
+
+def _cable_pendulum(planar: str) -> System:
+    s = System("cable pendulum", planar=planar)
+    steel = s.material("steel", youngs_modulus=2.1e11, density=7850.0)
+    s.cable("rope", material=steel, start=(0, 0, 0), end=(1.0, 0, 0), nodes=5,
+            section=Circle(0.05))
+    s.joint("pin", "spherical", "ground", "rope", point=(0, 0, 0))
+    s.load("g", "gravity", vector=(0, -9.81, 0))
+    s.probe("tip", "rope", (1.0, 0, 0))
+    return s
+
+
+def test_cable_keeps_four_unknowns_per_node():
+    """A pinned cable swinging in the x-y plane: 4 unknowns per node (Exudyn's 2D cable's
+    count), the same swing as the unreduced cable."""
+    runs = {}
+    for planar in ("off", "auto"):
+        s = _cable_pendulum(planar)
+        model = s.assemble()
+        runs[planar] = (model.ndof, s.simulate(0.2, 2e-3, newton_tol=1e-12, xdmf=False)
+                        .probes["tip"])
+        model.close()
+    assert runs["off"][0] == 30 and runs["auto"][0] == 5 * 4
+    a, b = runs["off"][1], runs["auto"][1]
+    assert np.abs(a - b).max() < 1e-8 * np.ptp(a, axis=0).max()
+
+
+def test_declared_plane_refuses_data_that_leave_it():
+    """Each item that would take the motion out of the declared plane is named."""
+    s = _cable_pendulum("xy")
+    s.load("push", "force", body="rope", point=(1.0, 0, 0), vector=(0, 0, 1.0))
+    with pytest.raises(InputError, match="load 'push'.*component along z"):
+        s.assemble()
+    s = _cable_pendulum("zx")   # gravity along -y lies along the normal of the z-x plane
+    with pytest.raises(InputError, match="planar = 'zx'.*load 'g'"):
+        s.assemble()
+    s = _cable_pendulum("xy")
+    s.rigid_body("bob", mass=1.0, inertia=(1, 1, 1, 0, 0, 0.1), position=(2, 0, 0))
+    with pytest.raises(InputError, match="body 'bob'.*products of inertia"):
+        s.assemble()
+    s = _cable_pendulum("xy")
+    s.rigid_body("bob", mass=1.0, inertia=(1, 1, 1, 0, 0, 0), position=(2, 0, 0))
+    s.joint("hinge", "revolute", "ground", "bob", point=(2.0, 0, 0), axis=(0, 1, 0))
+    with pytest.raises(InputError, match="joint 'hinge'.*not along z"):
+        s.assemble()
+    with pytest.raises(InputError, match="planar"):
+        System("x", planar="xz-plane")
+
+
+def test_auto_keeps_a_spatial_scene_unreduced():
+    """'auto' on a cable pushed out of every coordinate plane solves every coordinate and
+    says why; 'off' adds no fixes."""
+    s = _cable_pendulum("auto")
+    s.load("push", "force", body="rope", point=(1.0, 0, 0), vector=(1.0, 0, 1.0))
+    model = s.assemble(effects=("gravity", "point_loads"))
+    try:
+        assert model.ndof == 30 and model.nplanar_fixed == 0 and model.planar == ""
+        assert any("no plane found" in n for n in model.notes)
+    finally:
+        model.close()
