@@ -115,10 +115,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
                      doc="total nodes on the beam"),
         "segments": Key("floats", None, doc="segment lengths between fixed nodes (m); "
                         "each is split into equal elements"),
-        "bending": Key("str", "continuum", one_of("continuum", "cubic"),
+        "bending": Key("str", "continuum", one_of("continuum", "cubic", "cable"),
                        "'continuum': the paper's element (curvature constant per element); "
                        "'cubic': curvature from the cubic centre line r_xx, higher accuracy "
-                       "(docs/theory.md section 12)"),
+                       "(docs/theory.md section 12); 'cable' (boom scenes, formulation "
+                       "'nonlinear'): the ANCF cable, r and r_x per node, Euler-Bernoulli"),
     },
     "material": {
         "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),

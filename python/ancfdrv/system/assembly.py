@@ -215,8 +215,8 @@ def _frames(bodies: list[Body], drive_index: dict) -> tuple[list[FrameInfo], dic
     """One frame per beam (its body frame, turned by its frame drive): 1-based ids."""
     frames, beam_frame = [], {}
     for body in bodies:
-        if not isinstance(body, Beam):
-            continue
+        if not isinstance(body, Beam) and getattr(body, "frame_drive", None) is None:
+            continue  # (a cable may carry a frame for its probes' deflection: builders/boom.py)
         drive = body.frame_drive
         base = body.orientation
         if drive is not None:
@@ -499,7 +499,9 @@ def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
     out = []
     firsts = {which: next(iter(body.vector(at, which).terms))
               for which in body.directors(at)}
-    if isinstance(body, RigidBody):
+    if not firsts and hasattr(body, "node_first"):  # a cable: no section, the slope turns
+        firsts = {"r_x": _slope_for_moment(body, at, load, axis, q0)}
+    if isinstance(body, RigidBody) or len(firsts) == 1:
         best = None
         for which, first in firsts.items():
             d = q0[first:first + 3]
@@ -523,6 +525,19 @@ def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
         out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
                               q0[first:first + 3].copy()))
     return out
+
+
+def _slope_for_moment(body: Body, at, load, axis: np.ndarray, q0: np.ndarray) -> int:
+    """A dead moment on a cable node acts on its slope r_x (Euler-Bernoulli: the section
+    turns with the axis; seed 000 eq. 26 with the director r_x, the rotation about the
+    moment's fixed axis measured on it). A cable has no torsion: the moment must be normal
+    to the slope at t = 0 (InputError naming the load otherwise)."""
+    first = next(iter(body.vector(at, "r_x").terms))
+    slope = q0[first:first + 3] / np.linalg.norm(q0[first:first + 3])
+    if abs(float(slope @ axis)) > 1e-9:
+        raise InputError(f"load {load.name!r}: a cable carries no torsion; its moment must be "
+                         f"normal to the cable's axis {list(np.round(slope, 12))} at the point")
+    return first
 
 
 def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,

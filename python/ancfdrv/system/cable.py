@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import kernel
 from ..errors import InputError
-from .bodies import Attachment, Body, Material, _vec
+from .bodies import Attachment, Beam, Body, Material, _vec
 from .element_kinds import SetContext, register_body, register_set
 from .expressions import Vec3
 from .model import SetInfo
@@ -35,7 +35,7 @@ class Cable(Body):
     flexible = True
 
     def __init__(self, name: str, material: Material, start, end, nodes: int,
-                 section: Section | None = None) -> None:
+                 section: Section | None = None, segments=None) -> None:
         self.name = name
         where = f"cable {name!r}"
         self.material = material
@@ -54,7 +54,9 @@ class Cable(Body):
                              f"I_y = {data.inertia_y:g} and I_z = {data.inertia_z:g} m^4 (use "
                              "a circle, a tube or a square)")
         self.tangent = axis / self.length
-        self.stations = np.linspace(0.0, self.length, self.nodes)
+        # segments: lengths between fixed nodes, each split equally (as a beam's)
+        self.stations = np.linspace(0.0, self.length, self.nodes) if segments is None else \
+            Beam._stations(self, segments, where)
         self.lengths = np.diff(self.stations)
 
     # -- geometry ---------------------------------------------------------------------------

@@ -197,11 +197,12 @@ class System:
 
     @_api
     def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
-              section: Section | None = None) -> Cable:
-        """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli)."""
+              section: Section | None = None, segments=None) -> Cable:
+        """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli);
+        ``segments``: lengths between fixed nodes, each split equally (as a beam's)."""
         name = self._body_name(name)
         return self._add_body(Cable(name, self._material(material, f"cable {name!r}"), start,
-                                    end, nodes, section))
+                                    end, nodes, section, segments=segments))
 
     @_api
     def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,
