@@ -934,7 +934,7 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
 
     pe_args = argparse.Namespace(min_time=args.hard_min_time, max_repeats=args.repeats,
                                  breakdown=False, kernel_min_time=0.05, svk_check=False,
-                                 bending=["cubic"], exudyn_symbolic_drive=True)
+                                 bending=[args.hard_bending], exudyn_symbolic_drive=True)
     record = pe.compare_problem(problem, exu, workdir, pe_args)
     if problem.name.startswith("spinup"):
         try:
@@ -943,7 +943,8 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
         except (ImportError, AttributeError) as exc:  # ancfdrv's drive API may move
             record["spinup_angle_vs_ancfdrv_drive_max_abs"] = f"unavailable: {exc}"
     summary: dict[str, Any] = {"overrides": list(problem.overrides)}
-    for key, dom in record.get("dominance", {}).get("cubic", {}).items():
+    summary["ancfdrv_bending"] = args.hard_bending
+    for key, dom in record.get("dominance", {}).get(args.hard_bending, {}).items():
         ratios = [p["time_ratio_ancfdrv_over_exudyn"] for p in dom["for_each_exudyn_run"]
                   if p["time_ratio_ancfdrv_over_exudyn"] is not None]
         summary[key] = {"ancfdrv_dominates": dom["ancfdrv_dominates"],
@@ -1234,7 +1235,8 @@ def _hard_md(problems: dict[str, Any]) -> list[str]:
         if not rec:
             continue
         if not out:
-            out = ["## spinup, pendulum: error against time (peer_exudyn.py, ancfdrv cubic)", ""]
+            out = ["## spinup, pendulum: error against time (peer_exudyn.py, ancfdrv "
+                   f"{problems[name]['summary'].get('ancfdrv_bending', 'cubic')})", ""]
         refs = rec["references"]
         out.append(f"**{name}** ({rec['problem']['quantity']}, overrides "
                    f"{rec['summary']['overrides']}): ancfdrv reference {refs['ancfdrv']} "
@@ -1530,6 +1532,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--hard-min-time", type=float, default=1.0,
                         help="spinup/pendulum: repeat a run until it took this long in all, at "
                              "most --repeats times (peer_exudyn.py's rule; default 1 s)")
+    parser.add_argument("--hard-bending", choices=("cubic", "cubic-planar"),
+                        default="cubic-planar",
+                        help="spinup/pendulum: ancfdrv's option (default 'cubic-planar': the "
+                             "cubic option with scene.planar = 'xy', issue 23)")
     parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
     parser.add_argument("--exudyn-fast", action="store_true",
                         help="load Exudyn's exudynCPPfast build (no range checks)")
