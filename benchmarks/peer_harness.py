@@ -1444,25 +1444,42 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
                              runs[c.label].history, common.history) / sag_range)
                          if runs[c.label].ok and common.ok else math.nan}
                 for family, c in ref_cfg.items()}
-        table = []
-        for level in LEVELS:
-            entry: dict[str, Any] = {"level_percent": level}
-            for key in ("own", "common"):
-                best = {}
-                for code in ("ancfdrv", "exudyn"):
-                    ok = [r for r in rows if r["code"] == code and r["ok"]
-                          and r[f"error_{key}_percent"] <= level]
-                    pick = min(ok, key=lambda r: r["solve_s"]) if ok else None
-                    best[code] = None if pick is None else {
-                        "label": pick["label"], "solve_s": pick["solve_s"],
-                        "error_percent": pick[f"error_{key}_percent"]}
-                entry[key] = {**best, "exudyn_over_ancfdrv": (
-                    best["exudyn"]["solve_s"] / best["ancfdrv"]["solve_s"]
-                    if best["ancfdrv"] and best["exudyn"] else None)}
-            table.append(entry)
         out["masses"][f"{mass:g}"] = {"sag_range_m": sag_range, "references": refs,
-                                      "runs": rows, "levels": table}
+                                      "runs": rows, "levels": level_table(rows)}
     return out
+
+
+def _before(row: dict[str, Any]) -> bool:
+    """A configuration that existed before issue 23's knobs (no cable, no planar)."""
+    return row["code"] == "ancfdrv" and row["family"] != "cable" and "planar" not in row["label"]
+
+
+def level_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per level and error kind ('own', 'common'): the fastest run of each code within the
+    level, the ratio, and ancfdrv's fastest among the configurations before issue 23
+    ('ancfdrv_before': FFR and the unreduced cubic option, timed in the same rounds)."""
+    table = []
+    for level in LEVELS:
+        entry: dict[str, Any] = {"level_percent": level}
+        for key in ("own", "common"):
+            best = {}
+            for code, pred in (("ancfdrv", lambda r: r["code"] == "ancfdrv"),
+                               ("exudyn", lambda r: r["code"] == "exudyn"),
+                               ("ancfdrv_before", _before)):
+                ok = [r for r in rows if pred(r) and r["ok"]
+                      and r[f"error_{key}_percent"] <= level]
+                pick = min(ok, key=lambda r: r["solve_s"]) if ok else None
+                best[code] = None if pick is None else {
+                    "label": pick["label"], "solve_s": pick["solve_s"],
+                    "error_percent": pick[f"error_{key}_percent"]}
+            x = best["exudyn"]
+            entry[key] = {**best, "exudyn_over_ancfdrv": (
+                x["solve_s"] / best["ancfdrv"]["solve_s"] if best["ancfdrv"] and x else None),
+                "exudyn_over_ancfdrv_before": (
+                    x["solve_s"] / best["ancfdrv_before"]["solve_s"]
+                    if best["ancfdrv_before"] and x else None)}
+        table.append(entry)
+    return table
 
 
 def levels_markdown(rec: dict[str, Any]) -> list[str]:
@@ -1474,11 +1491,14 @@ def levels_markdown(rec: dict[str, Any]) -> list[str]:
            "ancfdrv's finest cable (the Euler-Bernoulli model both cables converge to). "
            "Time: the dynamic solve (ancfdrv: `/dynamic` `wall_time_s`, with its HDF5 output "
            "and answers, no XDMF; Exudyn: `SolveDynamic`), best of the interleaved rounds. "
-           "Ratio: Exudyn's time / ancfdrv's (> 1: ancfdrv faster).", ""]
+           "Ratio: Exudyn's time / ancfdrv's (> 1: ancfdrv faster). 'before': ancfdrv's "
+           "fastest among the configurations that existed before issue 23 (FFR, the unreduced "
+           "cubic option at 4 and 10 nodes), timed in the same rounds.", ""]
     for mass, m in rec["masses"].items():
         out += [f"### tip mass {mass} kg (sag range {m['sag_range_m']:.4f} m)", "",
                 "| level | against | ancfdrv fastest | s | error % | Exudyn fastest | s | "
-                "error % | Exudyn / ancfdrv |", "|---|---|---|---:|---:|---|---:|---:|---:|"]
+                "error % | Exudyn / ancfdrv | before: ancfdrv fastest | Exudyn / before |",
+                "|---|---|---|---:|---:|---|---:|---:|---:|---|---:|"]
         for entry in m["levels"]:
             for key in ("own", "common"):
                 e = entry[key]
@@ -1488,7 +1508,9 @@ def levels_markdown(rec: dict[str, Any]) -> list[str]:
                     f"{a['label'] if a else 'none'} | {_f(a['solve_s']) if a else '-'} | "
                     f"{_f(a['error_percent']) if a else '-'} | {x['label'] if x else 'none'} | "
                     f"{_f(x['solve_s']) if x else '-'} | {_f(x['error_percent']) if x else '-'} "
-                    f"| {_f(e['exudyn_over_ancfdrv'], '.2f') if e['exudyn_over_ancfdrv'] else '-'} |")
+                    f"| {_f(e['exudyn_over_ancfdrv'], '.2f') if e['exudyn_over_ancfdrv'] else '-'} "
+                    f"| {e['ancfdrv_before']['label'] if e.get('ancfdrv_before') else 'none'} | "
+                    f"{_f(e['exudyn_over_ancfdrv_before'], '.2f') if e.get('exudyn_over_ancfdrv_before') else '-'} |")
         out += ["", "| code | run | solve s | stepping s | steps | Newton | factorizations | "
                 "unknowns | error own % | error common % |",
                 "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
