@@ -169,7 +169,7 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
                frame_axis=v["frame_axis"], frame_pivot=v["frame_pivot"])
     elif group == "cable":
         s.cable(v["name"], material=v["material"], start=v["start"], end=v["end"],
-                nodes=v["nodes"], section=_section(v))
+                nodes=v["nodes"], section=_section(v), segments=v.get("segments"))
     elif group == "plate":
         s.plate(v["name"], material=v["material"], thickness=v["thickness"], corner=v["corner"],
                 edge_x=v["edge_x"], edge_y=v["edge_y"], nx=v["nx"], ny=v["ny"],

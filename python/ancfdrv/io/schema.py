@@ -450,6 +450,9 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "start": Key("floats", check=vector3, doc="start of the axis (m)"),
         "end": Key("floats", check=vector3, doc="end of the axis (m)"),
         "nodes": Key("int", check=at_least(2), doc="nodes on the cable (>= 2)"),
+        "segments": Key("floats", None, doc="segment lengths between fixed nodes (m), each "
+                        "split into equal elements (as a beam's; nodes = k j + 1 for k "
+                        "segments)"),
         "section": Key("str", "circle", one_of("rectangle", "box", "tube", "circle"),
                        "cross-section (its area and bending inertia; I_y = I_z required): "
                        "'circle' (diameter), 'tube' (diameter, wall), a square 'rectangle' "
