@@ -220,3 +220,16 @@ def test_general_cable_boom_matches_the_template(tmp_path):
     # 4 unknowns per cable node; the weld makes the planar arm's 6 coordinates dependent
     assert attrs["planar"] == "xy" and attrs["ndof"] == 4 * 4
     assert np.abs(a - b).max() < 2e-4 * 0.12
+
+
+def test_ffr_beams_are_not_reduced(tmp_path):
+    """An FFR beam keeps its constant iteration matrix by turning whole nodal 3-vectors with
+    its frame: a declared plane is refused naming the beam, 'auto' leaves the scene
+    unreduced (the shipped FFR boom: 28 x 12 coordinates)."""
+    with pytest.raises(InputError, match="body 'boom'.*'ffr'"):
+        run_scene(ROOT / "inputs/boom_static.nml", ["scene.planar=xy"], tmp_path / "a.h5",
+                  progress=False)
+    run_scene(ROOT / "inputs/boom_static.nml", ["scene.planar=auto"], tmp_path / "b.h5",
+              progress=False)
+    with h5py.File(tmp_path / "b.h5") as f:
+        assert (f["model"].attrs["ndof"], f["model"].attrs["nplanar_fixed"]) == (28 * 12, 0)
