@@ -237,7 +237,8 @@ def import_ancfdrv() -> None:
 
 def ancfdrv_overrides(problem: Problem, nodes: int, dt: float, bending: str) -> list[str]:
     """``bending``: 'cubic' or 'continuum', with '-planar' the scene reduced to its plane
-    (``scene.planar = 'xy'``, issue 23)."""
+    (``scene.planar = 'xy'``, issue 23); 'cable-planar': the pendulum as an ANCF cable
+    (bending about the plane's normal), reduced."""
     option, _, planar = bending.partition("-")
     return [*problem.overrides, f"beam.nodes={nodes}", f"solver.dt={dt!r}",
             f"solver.t_end={problem.t_end!r}", f"beam.bending={option}"] + \
@@ -810,7 +811,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="the spin-up's hub drive in Exudyn as a symbolic user function "
                              "(evaluated in C++) instead of a Python one")
     parser.add_argument("--bending", nargs="+", choices=("cubic", "continuum", "cubic-planar",
-                                                          "continuum-planar"),
+                                                          "continuum-planar", "cable-planar"),
                         default=None,
                         help="ancfdrv's beam.bending options to run, one curve each; the "
                              "first one's finest run is the common reference (default both; "

@@ -932,9 +932,10 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
     """peer_exudyn's comparison of one problem with ancfdrv's cubic option."""
     import peer_exudyn as pe
 
+    bending = args.pendulum_bending if problem.name == "pendulum" else args.hard_bending
     pe_args = argparse.Namespace(min_time=args.hard_min_time, max_repeats=args.repeats,
                                  breakdown=False, kernel_min_time=0.05, svk_check=False,
-                                 bending=[args.hard_bending], exudyn_symbolic_drive=True)
+                                 bending=[bending], exudyn_symbolic_drive=True)
     record = pe.compare_problem(problem, exu, workdir, pe_args)
     if problem.name.startswith("spinup"):
         try:
@@ -943,8 +944,8 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
         except (ImportError, AttributeError) as exc:  # ancfdrv's drive API may move
             record["spinup_angle_vs_ancfdrv_drive_max_abs"] = f"unavailable: {exc}"
     summary: dict[str, Any] = {"overrides": list(problem.overrides)}
-    summary["ancfdrv_bending"] = args.hard_bending
-    for key, dom in record.get("dominance", {}).get(args.hard_bending, {}).items():
+    summary["ancfdrv_bending"] = bending
+    for key, dom in record.get("dominance", {}).get(bending, {}).items():
         ratios = [p["time_ratio_ancfdrv_over_exudyn"] for p in dom["for_each_exudyn_run"]
                   if p["time_ratio_ancfdrv_over_exudyn"] is not None]
         summary[key] = {"ancfdrv_dominates": dom["ancfdrv_dominates"],
@@ -1235,8 +1236,8 @@ def _hard_md(problems: dict[str, Any]) -> list[str]:
         if not rec:
             continue
         if not out:
-            out = ["## spinup, pendulum: error against time (peer_exudyn.py, ancfdrv "
-                   f"{problems[name]['summary'].get('ancfdrv_bending', 'cubic')})", ""]
+            out = ["## spinup, pendulum: error against time (peer_exudyn.py; ancfdrv's option "
+                   "in each problem's runs table)", ""]
         refs = rec["references"]
         out.append(f"**{name}** ({rec['problem']['quantity']}, overrides "
                    f"{rec['summary']['overrides']}): ancfdrv reference {refs['ancfdrv']} "
@@ -1558,6 +1559,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         default="cubic-planar",
                         help="spinup/pendulum: ancfdrv's option (default 'cubic-planar': the "
                              "cubic option with scene.planar = 'xy', issue 23)")
+    parser.add_argument("--pendulum-bending", choices=("cubic", "cubic-planar", "cable-planar"),
+                        default="cable-planar",
+                        help="pendulum: ancfdrv's option (default 'cable-planar': the ANCF "
+                             "cable reduced to its plane, issue 23)")
     parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
     parser.add_argument("--exudyn-fast", action="store_true",
                         help="load Exudyn's exudynCPPfast build (no range checks)")

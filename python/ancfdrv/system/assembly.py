@@ -603,10 +603,16 @@ def _planar(system, act: _Active, q0: np.ndarray, notes: list[str]
     (:mod:`.planar`), checked against the bodies, joints and the loads of the listed
     effects."""
     setting = getattr(system, "planar", "off")
+    plane, planar_notes = (None, []) if setting == "off" else resolve_planar(
+        system, setting, act.gravity + act.forces + act.moments + act.masses + act.pressures)
+    for body in system.bodies.values():
+        if getattr(body, "planar_bending", False) and plane is None:
+            raise InputError(f"cable {body.name!r}: its section bends with two stiffnesses and "
+                             "it was given the one of a single plane (bending_inertia): the "
+                             "system must keep it in that plane (scene.planar, System(planar="
+                             "...))", group="scene", key="planar")
     if setting == "off":
         return None, []
-    loads = act.gravity + act.forces + act.moments + act.masses + act.pressures
-    plane, planar_notes = resolve_planar(system, setting, loads)
     notes += planar_notes
     return plane, ([] if plane is None else planar_equations(system, plane, q0))
 

@@ -35,7 +35,8 @@ class Cable(Body):
     flexible = True
 
     def __init__(self, name: str, material: Material, start, end, nodes: int,
-                 section: Section | None = None, segments=None) -> None:
+                 section: Section | None = None, segments=None,
+                 bending_inertia: float | None = None) -> None:
         self.name = name
         where = f"cable {name!r}"
         self.material = material
@@ -49,10 +50,21 @@ class Cable(Body):
         self.nodes = int(nodes)
         self.section = section if section is not None else Rectangle(0.1, 0.1)
         data = self.section.data
-        if abs(data.inertia_y - data.inertia_z) > 1e-9 * max(data.inertia_y, data.inertia_z):
+        unequal = abs(data.inertia_y - data.inertia_z) > 1e-9 * max(data.inertia_y,
+                                                                     data.inertia_z)
+        if unequal and bending_inertia is None:
             raise InputError(f"{where}: a cable has one bending stiffness; its section has "
                              f"I_y = {data.inertia_y:g} and I_z = {data.inertia_z:g} m^4 (use "
-                             "a circle, a tube or a square)")
+                             "a circle, a tube or a square, or give bending_inertia for a "
+                             "cable kept in a plane)")
+        if bending_inertia is not None and not (np.isfinite(bending_inertia)
+                                                and bending_inertia > 0):
+            raise InputError(f"{where}: bending_inertia {bending_inertia!r} must be positive")
+        #: the bending inertia used (None: the section's, I_y = I_z); a cable given one for
+        #: an unequal section bends in one plane only: the assembly then requires the
+        #: system's planar reduction (system/planar.py), which keeps it in that plane
+        self.bending_inertia = None if bending_inertia is None else float(bending_inertia)
+        self.planar_bending = bool(unequal)
         self.tangent = axis / self.length
         # segments: lengths between fixed nodes, each split equally (as a beam's)
         self.stations = np.linspace(0.0, self.length, self.nodes) if segments is None else \
@@ -74,7 +86,9 @@ class Cable(Body):
 
     @property
     def bending_stiffness(self) -> float:
-        return self.material.youngs_modulus * self.section.data.inertia_y
+        inertia = self.section.data.inertia_y if self.bending_inertia is None else \
+            self.bending_inertia
+        return self.material.youngs_modulus * inertia
 
     def node_positions(self) -> np.ndarray:
         return self.start + np.outer(self.stations, self.tangent)

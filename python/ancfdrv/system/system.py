@@ -197,12 +197,16 @@ class System:
 
     @_api
     def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
-              section: Section | None = None, segments=None) -> Cable:
+              section: Section | None = None, segments=None,
+              bending_inertia: float | None = None) -> Cable:
         """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli);
-        ``segments``: lengths between fixed nodes, each split equally (as a beam's)."""
+        ``segments``: lengths between fixed nodes, each split equally (as a beam's);
+        ``bending_inertia`` (m^4): the inertia of a section with I_y != I_z about the axis a
+        cable kept in a plane bends about (the system must then be planar)."""
         name = self._body_name(name)
         return self._add_body(Cable(name, self._material(material, f"cable {name!r}"), start,
-                                    end, nodes, section, segments=segments))
+                                    end, nodes, section, segments=segments,
+                                    bending_inertia=bending_inertia))
 
     @_api
     def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,
