@@ -212,6 +212,18 @@ class ReactionMap:
             raise ValueError(f"constraint evaluation failed (code {out[-1]})")
         return out[1]
 
+    def _gradient_rows(self, q_rows: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """:meth:`_gradients` at every row of q_rows (nt, nfull) and times (nt,), in one
+        kernel call: (6, ncon, nt)."""
+        if not hasattr(self, "_args"):
+            self._gradients(q_rows[0], float(times[0]))   # builds the layout arrays
+        out = self._kernel.constraint_gradient_rows(
+            *self._args, np.asfortranarray(np.asarray(q_rows, dtype=float).T),
+            np.asarray(times, dtype=float))
+        if out[-1]:
+            raise ValueError(f"constraint evaluation failed (code {out[-1]})")
+        return out[0]
+
     def generalized_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
                          residual_rows: np.ndarray | None) -> dict[str, np.ndarray]:
         """Each joint's constraint force on body2's coordinates, (nt, body2.ncoordinates),
@@ -222,9 +234,8 @@ class ReactionMap:
         nterm = len(self.t_coef)
         contrib = np.zeros((nt, nterm))
         if len(self.full) and nterm:
-            for row in range(nt):
-                gradients = self._gradients(q_rows[row], float(times[row]))
-                contrib[row] = gradients[self.t_slot, self.t_con]
+            gradients = self._gradient_rows(q_rows, times)   # (6, ncon, nt): one kernel call
+            contrib[:] = gradients[self.t_slot, self.t_con, :].T
             contrib *= self.t_coef * lam_rows[:, self.t_con]
         mu = None
         if self.factor is not None and residual_rows is not None:
