@@ -236,8 +236,13 @@ def import_ancfdrv() -> None:
 
 
 def ancfdrv_overrides(problem: Problem, nodes: int, dt: float, bending: str) -> list[str]:
+    """``bending``: 'cubic' or 'continuum', with '-planar' the scene reduced to its plane
+    (``scene.planar = 'xy'``, issue 23); 'cable-planar': the pendulum as an ANCF cable
+    (bending about the plane's normal), reduced."""
+    option, _, planar = bending.partition("-")
     return [*problem.overrides, f"beam.nodes={nodes}", f"solver.dt={dt!r}",
-            f"solver.t_end={problem.t_end!r}", f"beam.bending={bending}"]
+            f"solver.t_end={problem.t_end!r}", f"beam.bending={option}"] + \
+        (["scene.planar=xy"] if planar == "planar" else [])
 
 
 def tip_history(problem: Problem, path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -805,7 +810,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--exudyn-symbolic-drive", action="store_true",
                         help="the spin-up's hub drive in Exudyn as a symbolic user function "
                              "(evaluated in C++) instead of a Python one")
-    parser.add_argument("--bending", nargs="+", choices=("cubic", "continuum"),
+    parser.add_argument("--bending", nargs="+", choices=("cubic", "continuum", "cubic-planar",
+                                                          "continuum-planar", "cable-planar"),
                         default=None,
                         help="ancfdrv's beam.bending options to run, one curve each; the "
                              "first one's finest run is the common reference (default both; "

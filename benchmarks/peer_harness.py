@@ -104,7 +104,8 @@ from _peer import (exudyn_build, exudyn_version, import_exudyn, quiet_settings,
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
-PROBLEM_NAMES = ("boom_ffr", "boom_nonlinear", "plate", "spinup", "pendulum", "leaf")
+PROBLEM_NAMES = ("boom_ffr", "boom_nonlinear", "plate", "spinup", "pendulum", "leaf",
+                 "levels")
 
 #: The figures of issue 13 and of the README, reported next to the measured ones; never
 #: used in a ratio.
@@ -931,9 +932,10 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
     """peer_exudyn's comparison of one problem with ancfdrv's cubic option."""
     import peer_exudyn as pe
 
+    bending = args.pendulum_bending if problem.name == "pendulum" else args.hard_bending
     pe_args = argparse.Namespace(min_time=args.hard_min_time, max_repeats=args.repeats,
                                  breakdown=False, kernel_min_time=0.05, svk_check=False,
-                                 bending=["cubic"], exudyn_symbolic_drive=True)
+                                 bending=[bending], exudyn_symbolic_drive=True)
     record = pe.compare_problem(problem, exu, workdir, pe_args)
     if problem.name.startswith("spinup"):
         try:
@@ -942,7 +944,8 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
         except (ImportError, AttributeError) as exc:  # ancfdrv's drive API may move
             record["spinup_angle_vs_ancfdrv_drive_max_abs"] = f"unavailable: {exc}"
     summary: dict[str, Any] = {"overrides": list(problem.overrides)}
-    for key, dom in record.get("dominance", {}).get("cubic", {}).items():
+    summary["ancfdrv_bending"] = bending
+    for key, dom in record.get("dominance", {}).get(bending, {}).items():
         ratios = [p["time_ratio_ancfdrv_over_exudyn"] for p in dom["for_each_exudyn_run"]
                   if p["time_ratio_ancfdrv_over_exudyn"] is not None]
         summary[key] = {"ancfdrv_dominates": dom["ancfdrv_dominates"],
@@ -1233,7 +1236,8 @@ def _hard_md(problems: dict[str, Any]) -> list[str]:
         if not rec:
             continue
         if not out:
-            out = ["## spinup, pendulum: error against time (peer_exudyn.py, ancfdrv cubic)", ""]
+            out = ["## spinup, pendulum: error against time (peer_exudyn.py; ancfdrv's option "
+                   "in each problem's runs table)", ""]
         refs = rec["references"]
         out.append(f"**{name}** ({rec['problem']['quantity']}, overrides "
                    f"{rec['summary']['overrides']}): ancfdrv reference {refs['ancfdrv']} "
@@ -1294,6 +1298,238 @@ def _leaf_md(rec: dict[str, Any] | None) -> list[str]:
     return out + [""]
 
 
+# -- accuracy levels (issue 23) -----------------------------------------------------------------
+#: the accuracy levels: error in % of the reference's sag range
+LEVELS = (3.0, 1.0, 0.3, 0.1, 0.03)
+
+
+@dataclass(frozen=True)
+class LevelConfig:
+    """One configuration of the level study: code, label, element family, the ancfdrv
+    overrides or the Exudyn elements per segment."""
+
+    code: str
+    label: str
+    family: str                      # 'ffr', 'cubic', 'cable' (ancfdrv) or 'exudyn'
+    overrides: tuple[str, ...] = ()
+    per_segment: int = 0
+
+
+def level_configs(quick: bool) -> tuple[list[LevelConfig], dict[str, LevelConfig]]:
+    """The timed configurations and the converged references (family -> config)."""
+    nl = ("scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.")
+
+    def a(family: str, nodes: int, planar: str) -> LevelConfig:
+        if family == "ffr":
+            return LevelConfig("ancfdrv", f"FFR {nodes} nodes", "ffr",
+                               (f"beam.nodes={nodes}", "output.xdmf=.false."))
+        tag = "" if planar == "off" else ", planar xy"
+        return LevelConfig("ancfdrv", f"{family} {nodes} nodes{tag}", family,
+                           nl + (f"beam.bending={family}", f"beam.nodes={nodes}",
+                                 f"scene.planar={planar}"))
+
+    def e(per_segment: int) -> LevelConfig:
+        return LevelConfig("exudyn", f"{3 * per_segment} el", "exudyn", (), per_segment)
+
+    if quick:
+        timed = [a("cubic", 4, "xy"), a("cable", 4, "xy"), a("cable", 7, "xy"), e(1), e(2)]
+        refs = {"cubic": a("cubic", 10, "xy"), "cable": a("cable", 16, "xy"), "exudyn": e(6)}
+    else:
+        timed = [a("ffr", 28, "off"), a("cubic", 4, "off"), a("cubic", 10, "off"),
+                 a("cubic", 4, "xy"), a("cubic", 7, "xy"), a("cubic", 10, "xy"),
+                 a("cable", 4, "off"), a("cable", 4, "xy"), a("cable", 7, "xy"),
+                 a("cable", 10, "xy"), a("cable", 16, "xy"),
+                 e(1), e(2), e(3), e(6), e(9)]
+        refs = {"cubic": a("cubic", 28, "xy"), "cable": a("cable", 55, "xy"), "exudyn": e(18)}
+    refs["ffr"] = refs["cubic"]   # the FFR model is judged against the converged nonlinear one
+    return timed, refs
+
+
+def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarray,
+                exu: Any, out: Path) -> Callable[[], tuple[float, float, dict[str, Any]]]:
+    """One timed run of a configuration (solve s, whole s, payload with 'values')."""
+    if config.code == "exudyn":
+        def once() -> tuple[float, float, dict[str, Any]]:
+            t = run_exudyn_boom(exu, boom, config.per_segment, True, False, grid, 1, 0.0)
+            if not t.ok:
+                raise RuntimeError(t.message)
+            return t.solve_s, t.whole_s, {"counts": t.counts, "values": t.values}
+        return once
+    from ancfdrv.runner import run_scene
+    read = boom_reader(boom, grid)
+
+    def once() -> tuple[float, float, dict[str, Any]]:
+        t0 = time.perf_counter()
+        run_scene(REPO / "inputs/boom_luffing.nml", base + list(config.overrides), out,
+                  progress=False)
+        whole = time.perf_counter() - t0
+        with h5py.File(out, "r") as h5:
+            attrs, model = h5["dynamic"].attrs, h5["model"].attrs
+            counts = {k: int(attrs[k]) for k in ("steps", "newton_iterations", "factorizations")}
+            counts.update({k: int(model[k]) for k in ("ndof", "nconstraints", "nunknowns",
+                                                     "nplanar_fixed") if k in model})
+            payload = read(h5)
+            stepping = float(h5["timing"].attrs.get("dynamic_stepping", math.nan))
+            solve = float(attrs["wall_time_s"])
+        return solve, whole, {"counts": counts, "values": payload["values"],
+                              "stepping_s": stepping}
+    return once
+
+
+def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -> dict[str, Any]:
+    """Each accuracy level's fastest configuration of each code on the luffing boom (m = 50
+    and 0 kg), against each code's own converged model and against a common reference
+    (ancfdrv's finest cable: the Euler-Bernoulli model that both codes' cables converge
+    to). Timed runs are interleaved (every configuration once per round, ``--repeats``
+    rounds, the best kept) so that a change of the machine's load hits all alike."""
+    timed_cfg, ref_cfg = level_configs(args.quick)
+    if exu is None:
+        timed_cfg = [c for c in timed_cfg if c.code != "exudyn"]
+        ref_cfg = {k: v for k, v in ref_cfg.items() if v.code != "exudyn"}
+    out: dict[str, Any] = {"levels_percent": list(LEVELS), "masses": {}}
+    masses = (50.0,) if args.quick else (50.0, 0.0)
+    for mass in masses:
+        base = ([f"solver.t_end={plan.boom_t_end!r}"] if plan.boom_t_end else []) + \
+            [f"loads.tip_mass={mass!r}"]
+        boom = boom_from_scene("inputs/boom_luffing.nml", base)
+        grid = uniform_grid(boom.t_end, boom.dt)
+        runs: dict[str, Timed] = {}
+        onces: dict[str, Callable] = {}
+        for k, c in enumerate(timed_cfg + list({id(v): v for v in ref_cfg.values()}.values())):
+            if c.label in runs:
+                continue
+            runs[c.label] = Timed(c.code, c.label, asdict(c))
+            onces[c.label] = _level_once(c, boom, base, grid, exu, workdir / f"level_{k}.h5")
+        errors = (RuntimeError, ValueError) + ancfdrv_errors()
+        references = {c.label for c in ref_cfg.values()} - {c.label for c in timed_cfg}
+        for round_ in range(args.repeats):
+            for label, once in onces.items():
+                run = runs[label]
+                if (round_ and label in references) or (run.message and not run.ok):
+                    continue
+                try:
+                    solve_s, whole_s, payload = once()
+                except errors as exc:
+                    run.message = f"{type(exc).__name__}: {exc}"
+                    continue
+                run.solve_samples.append(solve_s)
+                run.whole_samples.append(whole_s)
+                run.ok, run.solve_s, run.whole_s = True, min(run.solve_samples), \
+                    min(run.whole_samples)
+                run.counts = payload["counts"]
+                run.values = payload["values"]
+                if "stepping_s" in payload:
+                    run.extra["stepping_s"] = min(run.extra.get("stepping_s", math.inf),
+                                                  payload["stepping_s"])
+                if round_ == args.repeats - 1 or label in references:
+                    progress(f"levels m={mass:g}", run)
+        common = runs[ref_cfg["cable"].label]
+        sag_range = float(np.ptp(common.history)) if common.ok else math.nan
+        rows = []
+        for c in timed_cfg:
+            run = runs[c.label]
+            own = runs[ref_cfg[c.family].label]
+            row = {"code": c.code, "label": c.label, "family": c.family, "ok": run.ok,
+                   "message": run.message, "solve_s": run.solve_s, "whole_s": run.whole_s,
+                   "stepping_s": run.extra.get("stepping_s"), "repeats": len(run.solve_samples),
+                   "counts": run.counts, "own_reference": own.label}
+            for key, ref in (("own", own), ("common", common)):
+                ok = run.ok and ref.ok
+                rows_range = float(np.ptp(ref.history)) if ref.ok else math.nan
+                row[f"error_{key}_percent"] = (100.0 * max_difference(run.history, ref.history)
+                                               / rows_range) if ok else math.nan
+            rows.append(row)
+        refs = {family: {"label": c.label, "ok": runs[c.label].ok,
+                         "solve_s": runs[c.label].solve_s,
+                         "error_common_percent": (100.0 * max_difference(
+                             runs[c.label].history, common.history) / sag_range)
+                         if runs[c.label].ok and common.ok else math.nan}
+                for family, c in ref_cfg.items()}
+        out["masses"][f"{mass:g}"] = {"sag_range_m": sag_range, "references": refs,
+                                      "runs": rows, "levels": level_table(rows)}
+    return out
+
+
+def _before(row: dict[str, Any]) -> bool:
+    """A configuration that existed before issue 23's knobs (no cable, no planar)."""
+    return row["code"] == "ancfdrv" and row["family"] != "cable" and "planar" not in row["label"]
+
+
+def level_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per level and error kind ('own', 'common'): the fastest run of each code within the
+    level, the ratio, and ancfdrv's fastest among the configurations before issue 23
+    ('ancfdrv_before': FFR and the unreduced cubic option, timed in the same rounds)."""
+    table = []
+    for level in LEVELS:
+        entry: dict[str, Any] = {"level_percent": level}
+        for key in ("own", "common"):
+            best = {}
+            for code, pred in (("ancfdrv", lambda r: r["code"] == "ancfdrv"),
+                               ("exudyn", lambda r: r["code"] == "exudyn"),
+                               ("ancfdrv_before", _before)):
+                ok = [r for r in rows if pred(r) and r["ok"]
+                      and r[f"error_{key}_percent"] <= level]
+                pick = min(ok, key=lambda r: r["solve_s"]) if ok else None
+                best[code] = None if pick is None else {
+                    "label": pick["label"], "solve_s": pick["solve_s"],
+                    "error_percent": pick[f"error_{key}_percent"]}
+            x = best["exudyn"]
+            entry[key] = {**best, "exudyn_over_ancfdrv": (
+                x["solve_s"] / best["ancfdrv"]["solve_s"] if best["ancfdrv"] and x else None),
+                "exudyn_over_ancfdrv_before": (
+                    x["solve_s"] / best["ancfdrv_before"]["solve_s"]
+                    if best["ancfdrv_before"] and x else None)}
+        table.append(entry)
+    return table
+
+
+def levels_markdown(rec: dict[str, Any]) -> list[str]:
+    out = ["## levels: each accuracy level's fastest configuration (luffing boom, 10 s)", "",
+           "Error: max |sag - sag_ref| over the history in % of the reference's sag range. "
+           "'own': each run against its own code's converged model (ancfdrv: the finest run "
+           "of the same element family, cubic 28 nodes for the FFR and cubic runs, cable 55 "
+           "nodes for the cable; Exudyn: its finest cable); 'common': every run against "
+           "ancfdrv's finest cable (the Euler-Bernoulli model both cables converge to). "
+           "Time: the dynamic solve (ancfdrv: `/dynamic` `wall_time_s`, with its HDF5 output "
+           "and answers, no XDMF; Exudyn: `SolveDynamic`), best of the interleaved rounds. "
+           "Ratio: Exudyn's time / ancfdrv's (> 1: ancfdrv faster). 'before': ancfdrv's "
+           "fastest among the configurations that existed before issue 23 (FFR, the unreduced "
+           "cubic option at 4 and 10 nodes), timed in the same rounds.", ""]
+    for mass, m in rec["masses"].items():
+        out += [f"### tip mass {mass} kg (sag range {m['sag_range_m']:.4f} m)", "",
+                "| level | against | ancfdrv fastest | s | error % | Exudyn fastest | s | "
+                "error % | Exudyn / ancfdrv | before: ancfdrv fastest | Exudyn / before |",
+                "|---|---|---|---:|---:|---|---:|---:|---:|---|---:|"]
+        for entry in m["levels"]:
+            for key in ("own", "common"):
+                e = entry[key]
+                a, x = e["ancfdrv"], e["exudyn"]
+                out.append(
+                    f"| {entry['level_percent']:g} % | {key} | "
+                    f"{a['label'] if a else 'none'} | {_f(a['solve_s']) if a else '-'} | "
+                    f"{_f(a['error_percent']) if a else '-'} | {x['label'] if x else 'none'} | "
+                    f"{_f(x['solve_s']) if x else '-'} | {_f(x['error_percent']) if x else '-'} "
+                    f"| {_f(e['exudyn_over_ancfdrv'], '.2f') if e['exudyn_over_ancfdrv'] else '-'} "
+                    f"| {e['ancfdrv_before']['label'] if e.get('ancfdrv_before') else 'none'} | "
+                    f"{_f(e['exudyn_over_ancfdrv_before'], '.2f') if e.get('exudyn_over_ancfdrv_before') else '-'} |")
+        out += ["", "| code | run | solve s | stepping s | steps | Newton | factorizations | "
+                "unknowns | error own % | error common % |",
+                "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for r in m["runs"]:
+            c = r["counts"]
+            unknowns = c.get("nunknowns", "-")
+            out.append(f"| {r['code']} | {r['label']} | {_f(r['solve_s'])} | "
+                       f"{_f(r['stepping_s']) if r['stepping_s'] else '-'} | "
+                       f"{c.get('steps', '-')} | {c.get('newton_iterations', '-')} | "
+                       f"{c.get('factorizations', c.get('jacobians', '-'))} | {unknowns} | "
+                       f"{_f(r['error_own_percent'], '.4f')} | "
+                       f"{_f(r['error_common_percent'], '.4f')} |")
+        refs = "; ".join(f"{fam}: {r['label']} ({_f(r['error_common_percent'], '.4f')} % from "
+                         "the common reference)" for fam, r in m["references"].items())
+        out += ["", f"References: {refs}.", ""]
+    return out
+
+
 # -- command line ------------------------------------------------------------------------------
 def parse_only(text: str) -> list[str]:
     names = [n.strip() for n in text.split(",") if n.strip()]
@@ -1319,6 +1555,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--hard-min-time", type=float, default=1.0,
                         help="spinup/pendulum: repeat a run until it took this long in all, at "
                              "most --repeats times (peer_exudyn.py's rule; default 1 s)")
+    parser.add_argument("--hard-bending", choices=("cubic", "cubic-planar"),
+                        default="cubic-planar",
+                        help="spinup/pendulum: ancfdrv's option (default 'cubic-planar': the "
+                             "cubic option with scene.planar = 'xy', issue 23)")
+    parser.add_argument("--pendulum-bending", choices=("cubic", "cubic-planar", "cable-planar"),
+                        default="cable-planar",
+                        help="pendulum: ancfdrv's option (default 'cable-planar': the ANCF "
+                             "cable reduced to its plane, issue 23)")
     parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
     parser.add_argument("--exudyn-fast", action="store_true",
                         help="load Exudyn's exudynCPPfast build (no range checks)")
@@ -1385,6 +1629,8 @@ def main(argv: list[str] | None = None) -> int:
                     problems[key] = compare_hard(problem, exu, workdir, args)
             elif name == "leaf":
                 problems[name] = compare_leaf(plan, workdir, args, previous)
+            elif name == "levels":
+                problems[name] = boom_levels(plan, exu, workdir, args)
     machine["load_average_at_end"] = load_average()
     machine["load_average_per_problem"] = load_per_problem
     reinstalled = kernel_file.stat().st_mtime != kernel_mtime
@@ -1406,6 +1652,8 @@ def main(argv: list[str] | None = None) -> int:
     report["ratios"] = ratio_rows(problems)
     report["wall_time_s"] = time.perf_counter() - start
     text = markdown(report)
+    if "levels" in problems:
+        text += "\n".join(levels_markdown(problems["levels"])) + "\n"
     if reinstalled:
         text += ("\nWARNING: ancfdrv's kernel module changed during the run (a reinstall): the "
                  "runs may mix two builds.\n")

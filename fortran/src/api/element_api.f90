@@ -701,3 +701,35 @@ subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, ce
                        pdelta /= 0, pdelta_linear, pdelta_quadratic, load, rate, accel, tol, &
                        max_newton, eta, info, failed_step)
 end subroutine reduced_ffr_newmark
+
+!> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r); the
+!> velocities zero): gradients(:, :, r) as constraint_evaluate returns them. One call for
+!> a chunk of output rows (the reactions of every step, python/ancfdrv/system/answers.py).
+subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
+                                    params, operand_const, term_ptr, term_dof, term_coef, &
+                                    drive_kinds, drive_ptr, drive_data, q_rows, times, &
+                                    gradients, info)
+  use ancf_kinds, only: dp
+  use constraints, only: constraint_eval
+  implicit none
+  integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata, nrow
+  integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
+  integer, intent(in) :: drive_kinds(ndrive), drive_ptr(ndrive + 1)
+  real(dp), intent(in) :: params(8, ncon), operand_const(6, ncon), term_coef(nterm)
+  real(dp), intent(in) :: drive_data(ndata), q_rows(ndof, nrow), times(nrow)
+  real(dp), intent(out) :: gradients(6, ncon, nrow)
+  integer, intent(out) :: info
+  real(dp) :: values(ncon), hessians(6, 6, ncon), phi_t(ncon), phi_tt(ncon), gamma(ncon)
+  real(dp) :: velocity(ndof)
+  integer :: row
+  velocity = 0.0_dp
+  gradients = 0.0_dp
+  info = 0
+  do row = 1, nrow
+    call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
+                         term_coef, drive_kinds, drive_ptr, drive_data, q_rows(:, row), &
+                         velocity, times(row), values, gradients(:, :, row), hessians, phi_t, &
+                         phi_tt, gamma, info)
+    if (info /= 0) return
+  end do
+end subroutine constraint_gradient_rows

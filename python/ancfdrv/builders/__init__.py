@@ -31,6 +31,7 @@ def build_system(scene) -> BuiltSystem:
 def build_model(scene) -> Model:
     """The assembled model of a scene: only the scene's effects are computed."""
     built = build_system(scene)
+    built.system.planar = scene["scene"].get("planar", "off")  # system/planar.py
     return built.system.assemble(effects=scene.effects,
                                  linear_joints=scene["solver"].get("linear_joints", "auto"),
                                  unused_effects="warn" if scene.kind == "general"

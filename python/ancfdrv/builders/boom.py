@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..history import luffing_stage_bounds
+from ..errors import InputError
 from ..system import System
 from ..system.bodies import rotation_about
 from .common import BuiltSystem, beam_loads, material, rectangle
@@ -33,6 +34,8 @@ def build(scene) -> BuiltSystem:
     a1 = turn @ np.array([0.0, height_h, 0.0])
     tangent, height = turn @ np.array([1.0, 0.0, 0.0]), turn @ np.array([0.0, 1.0, 0.0])
     tip = a1 + beam["length"] * tangent
+    if beam["bending"] == "cable":
+        return _cable_boom(scene, built, steel, drive, a1, tangent, height, tip)
     b = s.beam("boom", material=steel, start=a1, end=tip, nodes=beam["nodes"],
                section=rectangle(scene), height_axis=height,
                formulation=scene["scene"]["formulation"], bending=beam["bending"],
@@ -59,3 +62,30 @@ def stage_bounds(scene) -> dict[str, tuple[float, float]] | None:
     sweep = np.radians(boom["angle_end_deg"] - boom["angle_deg"])
     return luffing_stage_bounds(boom["omega"], boom["t_start"], boom["t_brake"], sweep,
                                 scene["solver"]["t_end"])
+
+
+def _cable_boom(scene, built: BuiltSystem, steel, drive, a1, tangent, height, tip
+                ) -> BuiltSystem:
+    """``beam.bending = 'cable'`` (issue 23): the boom as an ANCF cable (r and r_x per node,
+    Euler-Bernoulli, EA and EI = E w h^3 / 12 of the section; ``system/cable.py``), the
+    'nonlinear' formulation only. A1 hangs on the arm with the slope r_x normal to it (the
+    section along the arm), A2 is driven on its circle, the moment M_B acts on the slope at
+    A2 (the section turns with the axis). The cable carries the boom's frame R(phi(t)) for
+    its probe's deflection, as the beam does."""
+    s, beam, loads, effects = built.system, scene["beam"], scene["loads"], scene.effects
+    if scene["scene"]["formulation"] != "nonlinear":
+        raise InputError("bending = 'cable' is a large-deformation element: it needs "
+                         "scene.formulation = 'nonlinear'", group="beam", key="bending")
+    c = s.cable("boom", material=steel, start=a1, end=tip, nodes=beam["nodes"],
+                section=rectangle(scene), segments=beam["segments"])
+    c.frame_drive, c.frame_axis, c.frame_pivot = drive, np.array([0.0, 0.0, 1.0]), np.zeros(3)
+    c.orientation = np.column_stack([tangent, height, np.cross(tangent, height)])
+    s.joint("A1", "arm", "ground", "boom", point=a1, pivot=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0))
+    a2 = a1 + beam["segments"][0] * tangent
+    s.joint("A2", "prescribed", "ground", "boom", point=a2, pivot=(0.0, 0.0, 0.0),
+            axis=(0.0, 0.0, 1.0), drive=drive)
+    beam_loads(built, scene, c, tip)
+    if "bending_moment" in effects and loads["moment"] != 0.0:
+        s.load("moment", "moment", body="boom", point=a2, vector=(0.0, 0.0, loads["moment"]),
+               effect="bending_moment")
+    return built

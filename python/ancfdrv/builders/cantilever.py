@@ -2,6 +2,7 @@
 'section' holds r, r_y, r_z; 'full' also r_x; 'pin' r and r_z, a hinge about r3); frame A = I."""
 from __future__ import annotations
 
+from ..errors import InputError
 from ..system import System
 from .common import BuiltSystem, beam_loads, material, rectangle
 
@@ -13,6 +14,8 @@ def build(scene) -> BuiltSystem:
     s = System(scene["scene"]["title"], effects=scene.effects)
     built = BuiltSystem(s, ("tip", 1))
     tip = (beam["length"], 0.0, 0.0)
+    if beam["bending"] == "cable":
+        return _cable(scene, built, tip)
     b = s.beam("beam", material=material(s, scene), start=(0.0, 0.0, 0.0), end=tip,
                nodes=beam["nodes"], section=rectangle(scene), height_axis=(0.0, 1.0, 0.0),
                formulation=scene["scene"]["formulation"], bending=beam["bending"],
@@ -20,4 +23,31 @@ def build(scene) -> BuiltSystem:
     for vector in CLAMPS[scene["cantilever"]["clamp"]]:
         s.joint(f"clamp {vector}", "fix", "ground", "beam", point=(0.0, 0.0, 0.0), vector=vector)
     beam_loads(built, scene, b, tip)
+    return built
+
+
+def _cable(scene, built: BuiltSystem, tip) -> BuiltSystem:
+    """``beam.bending = 'cable'`` (issue 23; formulation 'nonlinear'): the beam as an ANCF
+    cable (r, r_x per node, Euler-Bernoulli). Clamps: 'pin' holds r (a spherical joint:
+    with the planar reduction, the hinge about r3), 'section' and 'full' hold r and r_x (a
+    weld). A section with I_y != I_z bends in the r1-r2 plane with I_z = int y^2 dA, and
+    needs ``scene.planar = 'xy'``."""
+    s, beam = built.system, scene["beam"]
+    if scene["scene"]["formulation"] != "nonlinear":
+        raise InputError("bending = 'cable' is a large-deformation element: it needs "
+                         "scene.formulation = 'nonlinear'", group="beam", key="bending")
+    section = rectangle(scene)
+    square = abs(section.iy - section.iz) <= 1e-9 * max(section.iy, section.iz)
+    if not square and scene["scene"].get("planar", "off") != "xy":
+        raise InputError("bending = 'cable' with a section of two bending stiffnesses "
+                         f"(I_y = {section.iy:g}, I_z = {section.iz:g} m^4) bends in the r1-r2 "
+                         "plane only: it needs scene.planar = 'xy'", group="beam",
+                         key="bending")
+    c = s.cable("beam", material=material(s, scene), start=(0.0, 0.0, 0.0), end=tip,
+                nodes=beam["nodes"], section=section, segments=beam["segments"],
+                bending_inertia=None if square else section.iz)
+    clamp = scene["cantilever"]["clamp"]
+    s.joint(f"clamp {clamp}", "spherical" if clamp == "pin" else "weld", "ground", "beam",
+            point=(0.0, 0.0, 0.0))
+    beam_loads(built, scene, c, tip)
     return built

@@ -172,7 +172,7 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
     elif group == "cable":
         s.cable(v["name"], material=v["material"], start=v["start"], end=v["end"],
                 nodes=v["nodes"], section=_section(v), tension_only=v["tension_only"],
-                bending_stiffness=v["bending_stiffness"])
+                bending_stiffness=v["bending_stiffness"], segments=v.get("segments"))
     elif group == "plate":
         s.plate(v["name"], material=v["material"], thickness=v["thickness"], corner=v["corner"],
                 edge_x=v["edge_x"], edge_y=v["edge_y"], nx=v["nx"], ny=v["ny"],

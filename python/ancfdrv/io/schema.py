@@ -103,6 +103,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
                       "'check': drives and loads must stay within physical bounds "
                       "(ancfdrv.io.validate.PHYSICAL_BOUNDS, e.g. a rate of at most 1e4 rad/s); "
                       "'off' accepts any finite value (also: ancf run --force)"),
+        "planar": Key("str", "off", one_of("off", "auto", "xy", "yz", "zx"),
+                      "planar reduction (docs/theory.md, system/planar.py): 'xy', 'yz', 'zx' "
+                      "declare that the motion stays in planes parallel to that one (data "
+                      "leaving it are refused) and solve only the in-plane coordinates (a "
+                      "beam node 7 of 12, a cable node 4 of 6); 'auto' reduces when every "
+                      "body, joint and load keeps the motion in a coordinate plane; 'off' "
+                      "solves every coordinate"),
         "response_component": Key("int", 2, within(0, 2), "general scenes: the component of the "
                                   "response probe's deflection compared (0, 1, 2 = x, y, z; beams "
                                   "in their frame)"),
@@ -115,10 +122,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
                      doc="total nodes on the beam"),
         "segments": Key("floats", None, doc="segment lengths between fixed nodes (m); "
                         "each is split into equal elements"),
-        "bending": Key("str", "continuum", one_of("continuum", "cubic"),
+        "bending": Key("str", "continuum", one_of("continuum", "cubic", "cable"),
                        "'continuum': the paper's element (curvature constant per element); "
                        "'cubic': curvature from the cubic centre line r_xx, higher accuracy "
-                       "(docs/theory.md section 12)"),
+                       "(docs/theory.md section 12); 'cable' (boom and cantilever scenes, formulation "
+                       "'nonlinear'): the ANCF cable, r and r_x per node, Euler-Bernoulli "
+                       "(a section with I_y != I_z bends about r3 and needs scene.planar = "
+                       "'xy')"),
         "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),
     },
     "material": {
@@ -451,6 +461,9 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "start": Key("floats", check=vector3, doc="start of the axis (m)"),
         "end": Key("floats", check=vector3, doc="end of the axis (m)"),
         "nodes": Key("int", check=at_least(2), doc="nodes on the cable (>= 2)"),
+        "segments": Key("floats", None, doc="segment lengths between fixed nodes (m), each "
+                        "split into equal elements (as a beam's; nodes = k j + 1 for k "
+                        "segments)"),
         "section": Key("str", "circle", one_of("rectangle", "box", "tube", "circle"),
                        "cross-section (its area and bending inertia; I_y = I_z required): "
                        "'circle' (diameter), 'tube' (diameter, wall), a square 'rectangle' "

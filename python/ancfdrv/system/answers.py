@@ -126,7 +126,9 @@ class ReactionMap:
         eliminated = getattr(model, "eliminated", [])
         self.linear_owner = [owner.get(eq.name) for eq in eliminated]
         self.factor = None
-        if eliminated:
+        # rows no joint owns (a planar reduction's fixes, system/planar.py) need no mu: their
+        # force is on no joint, so without owned rows the residual is not formed at all
+        if eliminated and any(o is not None for o in self.linear_owner):
             rows, cols, vals = [], [], []
             for i, eq in enumerate(eliminated):
                 for d, a in eq.expr.terms.items():
@@ -211,6 +213,18 @@ class ReactionMap:
             raise ValueError(f"constraint evaluation failed (code {out[-1]})")
         return out[1]
 
+    def _gradient_rows(self, q_rows: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """:meth:`_gradients` at every row of q_rows (nt, nfull) and times (nt,), in one
+        kernel call: (6, ncon, nt)."""
+        if not hasattr(self, "_args"):
+            self._gradients(q_rows[0], float(times[0]))   # builds the layout arrays
+        out = self._kernel.constraint_gradient_rows(
+            *self._args, np.asfortranarray(np.asarray(q_rows, dtype=float).T),
+            np.asarray(times, dtype=float))
+        if out[-1]:
+            raise ValueError(f"constraint evaluation failed (code {out[-1]})")
+        return out[0]
+
     def generalized_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
                          residual_rows: np.ndarray | None) -> dict[str, np.ndarray]:
         """Each joint's constraint force on body2's coordinates, (nt, body2.ncoordinates),
@@ -221,9 +235,8 @@ class ReactionMap:
         nterm = len(self.t_coef)
         contrib = np.zeros((nt, nterm))
         if len(self.full) and nterm:
-            for row in range(nt):
-                gradients = self._gradients(q_rows[row], float(times[row]))
-                contrib[row] = gradients[self.t_slot, self.t_con]
+            gradients = self._gradient_rows(q_rows, times)   # (6, ncon, nt): one kernel call
+            contrib[:] = gradients[self.t_slot, self.t_con, :].T
             contrib *= self.t_coef * lam_rows[:, self.t_con]
         mu = None
         if self.factor is not None and residual_rows is not None:

@@ -29,6 +29,10 @@ from .model import (VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_FORCE, VLOAD_FOLLOWER_MOME
                     MomentInfo, Model, ProbeInfo, SetInfo, VectorLoadInfo)
 from .patterns import Elimination, Pattern, eliminate, reduction_plan
 from .supports import support_frames
+from .planar import planar_equations
+from .planar import resolve as resolve_planar
+
+PLANE_NAMES = {2: "xy", 0: "yz", 1: "zx"}
 
 #: effects every model reports (a zero count proves an effect was not computed)
 EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
@@ -105,10 +109,19 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     has_rigid = any(isinstance(b, RigidBody) for b in bodies)
     mode = linear_joints if linear_joints != "auto" else ("eliminate" if has_rigid else
                                                           "multipliers")
+    plane, planar_eqs = _planar(system, act, q0, notes)
     equations = _equations(system, bodies, q0, notes, warnings)
     linear = [eq for eq in equations if isinstance(eq, LinearEquation)]
     reduction = None
-    if mode == "eliminate" and linear:
+    if planar_eqs:  # the planar fixes are eliminated whatever the joints' mode (planar.py)
+        elimination = eliminate(planar_eqs + (linear if mode == "eliminate" else []), q0)
+        notes += [f"redundant joint equation dropped: {name}" for name in elimination.redundant
+                  if ": planar" not in name]
+        reduction = reduction_plan(nfull, elimination, q0, full_pattern)
+        constraints_eq = [eq for eq in equations if isinstance(eq, Constraint)] \
+            if mode == "eliminate" else \
+            [_as_constraint(eq) if isinstance(eq, LinearEquation) else eq for eq in equations]
+    elif mode == "eliminate" and linear:
         elimination = eliminate(linear, q0)
         notes += [f"redundant joint equation dropped: {name}" for name in elimination.redundant]
         reduction = reduction_plan(nfull, elimination, q0, full_pattern)
@@ -149,6 +162,11 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     model.frame_problems = frame_problems
     _answer_inputs(model, system, equations, elimination, reduction, mass_full,
                    constant + gravity, driven)
+    if planar_eqs:  # the rows eliminated are the planar fixes (+ the linear joints)
+        kept = planar_eqs + (linear if mode == "eliminate" else [])
+        model.eliminated = [eq for eq in kept if eq.name not in set(elimination.redundant)]
+    model.planar = "" if plane is None else PLANE_NAMES[plane]
+    model.nplanar_fixed = sum(eq.name not in set(elimination.redundant) for eq in planar_eqs)
     _policy(model)
     model.build_kernel()
     return model
@@ -208,8 +226,8 @@ def _frames(bodies: list[Body], drive_index: dict) -> tuple[list[FrameInfo], dic
     """One frame per beam (its body frame, turned by its frame drive): 1-based ids."""
     frames, beam_frame = [], {}
     for body in bodies:
-        if not isinstance(body, Beam):
-            continue
+        if not isinstance(body, Beam) and getattr(body, "frame_drive", None) is None:
+            continue  # (a cable may carry a frame for its probes' deflection: builders/boom.py)
         drive = body.frame_drive
         base = body.orientation
         if drive is not None:
@@ -523,7 +541,9 @@ def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
     out = []
     firsts = {which: next(iter(body.vector(at, which).terms))
               for which in body.directors(at)}
-    if isinstance(body, RigidBody):
+    if not firsts and hasattr(body, "node_first"):  # a cable: no section, the slope turns
+        firsts = {"r_x": _slope_for_moment(body, at, load, axis, q0)}
+    if isinstance(body, RigidBody) or len(firsts) == 1:
         best = None
         for which, first in firsts.items():
             d = q0[first:first + 3]
@@ -547,6 +567,19 @@ def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
         out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
                               q0[first:first + 3].copy()))
     return out
+
+
+def _slope_for_moment(body: Body, at, load, axis: np.ndarray, q0: np.ndarray) -> int:
+    """A dead moment on a cable node acts on its slope r_x (Euler-Bernoulli: the section
+    turns with the axis; seed 000 eq. 26 with the director r_x, the rotation about the
+    moment's fixed axis measured on it). A cable has no torsion: the moment must be normal
+    to the slope at t = 0 (InputError naming the load otherwise)."""
+    first = next(iter(body.vector(at, "r_x").terms))
+    slope = q0[first:first + 3] / np.linalg.norm(q0[first:first + 3])
+    if abs(float(slope @ axis)) > 1e-9:
+        raise InputError(f"load {load.name!r}: a cable carries no torsion; its moment must be "
+                         f"normal to the cable's axis {list(np.round(slope, 12))} at the point")
+    return first
 
 
 def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
@@ -605,6 +638,26 @@ def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[
                 continue
             out += orthonormality(body)
     return out
+
+
+def _planar(system, act: _Active, q0: np.ndarray, notes: list[str]
+            ) -> tuple[int | None, list[LinearEquation]]:
+    """The planar reduction's plane (normal axis, None: off) and the coordinates it fixes
+    (:mod:`.planar`), checked against the bodies, joints and the loads of the listed
+    effects."""
+    setting = getattr(system, "planar", "off")
+    plane, planar_notes = (None, []) if setting == "off" else resolve_planar(
+        system, setting, act.gravity + act.forces + act.moments + act.masses + act.pressures)
+    for body in system.bodies.values():
+        if getattr(body, "planar_bending", False) and plane is None:
+            raise InputError(f"cable {body.name!r}: its section bends with two stiffnesses and "
+                             "it was given the one of a single plane (bending_inertia): the "
+                             "system must keep it in that plane (scene.planar, System(planar="
+                             "...))", group="scene", key="planar")
+    if setting == "off":
+        return None, []
+    notes += planar_notes
+    return plane, ([] if plane is None else planar_equations(system, plane, q0))
 
 
 def _linearized(system, warnings: list[str]) -> dict[str, str]:

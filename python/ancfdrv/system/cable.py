@@ -24,7 +24,7 @@ import numpy as np
 
 from .. import kernel
 from ..errors import InputError
-from .bodies import Attachment, Body, Material, _vec
+from .bodies import Attachment, Beam, Body, Material, _vec
 from .element_kinds import SetContext, register_body, register_set
 from .expressions import Vec3
 from .model import SetInfo
@@ -47,8 +47,9 @@ class Cable(Body):
     flexible = True
 
     def __init__(self, name: str, material: Material, start, end, nodes: int,
-                 section: Section | None = None, *, tension_only: bool = False,
-                 bending_stiffness: float | None = None) -> None:
+                 section: Section | None = None, segments=None, *,
+                 tension_only: bool = False, bending_stiffness: float | None = None,
+                 bending_inertia: float | None = None) -> None:
         self.name = name
         where = f"cable {name!r}"
         self.material = material
@@ -62,10 +63,21 @@ class Cable(Body):
         self.nodes = int(nodes)
         self.section = section if section is not None else Rectangle(0.1, 0.1)
         data = self.section.data
-        if abs(data.inertia_y - data.inertia_z) > 1e-9 * max(data.inertia_y, data.inertia_z):
+        unequal = abs(data.inertia_y - data.inertia_z) > 1e-9 * max(data.inertia_y,
+                                                                     data.inertia_z)
+        if unequal and bending_inertia is None:
             raise InputError(f"{where}: a cable has one bending stiffness; its section has "
                              f"I_y = {data.inertia_y:g} and I_z = {data.inertia_z:g} m^4 (use "
-                             "a circle, a tube or a square)")
+                             "a circle, a tube or a square, or give bending_inertia for a "
+                             "cable kept in a plane)")
+        if bending_inertia is not None and not (np.isfinite(bending_inertia)
+                                                and bending_inertia > 0):
+            raise InputError(f"{where}: bending_inertia {bending_inertia!r} must be positive")
+        #: the bending inertia used (None: the section's, I_y = I_z); a cable given one for
+        #: an unequal section bends in one plane only: the assembly then requires the
+        #: system's planar reduction (system/planar.py), which keeps it in that plane
+        self.bending_inertia = None if bending_inertia is None else float(bending_inertia)
+        self.planar_bending = bool(unequal)
         if not isinstance(tension_only, (bool, np.bool_)):
             raise InputError(f"{where}: tension_only = {tension_only!r} must be True or False")
         self.tension_only = bool(tension_only)
@@ -76,7 +88,9 @@ class Cable(Body):
                              "finite number >= 0 (N m^2)")
         self._bending_stiffness = None if bending_stiffness is None else float(bending_stiffness)
         self.tangent = axis / self.length
-        self.stations = np.linspace(0.0, self.length, self.nodes)
+        # segments: lengths between fixed nodes, each split equally (as a beam's)
+        self.stations = np.linspace(0.0, self.length, self.nodes) if segments is None else \
+            Beam._stations(self, segments, where)
         self.lengths = np.diff(self.stations)
 
     # -- geometry ---------------------------------------------------------------------------
@@ -94,10 +108,13 @@ class Cable(Body):
 
     @property
     def bending_stiffness(self) -> float:
-        """EI (N m^2): the given ``bending_stiffness``, else E times the section's I."""
+        """EI (N m^2): the given ``bending_stiffness``, else E times the section's I (or the
+        given ``bending_inertia``)."""
         if self._bending_stiffness is not None:
             return self._bending_stiffness
-        return self.material.youngs_modulus * self.section.data.inertia_y
+        inertia = self.section.data.inertia_y if self.bending_inertia is None else \
+            self.bending_inertia
+        return self.material.youngs_modulus * inertia
 
     def strains(self, e) -> np.ndarray:
         """The axial Green strain eps = (r'.r' - 1)/2 at every element's 5 Gauss points

@@ -401,6 +401,8 @@ class Joint:
         """Seed 000 eqs. 30-33 for an arm about axis k through pivot O holding node p."""
         k, pivot = self.axis, self.pivot
         p = self.body2.position(at2)
+        if "r_y" not in self.body2.held_vectors(at2):
+            return self._arm_on_slope(at2, q0, name)
         director = self.body2.vector(at2, "r_y")
         arm = p - Vec3.constant(pivot)
         length = float(np.linalg.norm(arm.value(q0)))
@@ -421,6 +423,35 @@ class Joint:
             LinearEquation(arm.along(k), f"{name}: in the plane", _dofs(p, axial)),
             LinearEquation(director.along(k), f"{name}: section in the plane",
                            _dofs(director, axial)),
+        ]
+
+    def _arm_on_slope(self, at2, q0, name) -> list[Equation]:
+        """The arm holding a node of a body without a section (a cable: r and r_x): as
+        :meth:`_arm`, with the section's r_y along the arm written as the slope r_x normal
+        to it (Euler-Bernoulli: the section stays normal to the axis), r_x . (p - O) = 0."""
+        k, pivot = self.axis, self.pivot
+        p = self.body2.position(at2)
+        slope = self.body2.vector(at2, "r_x")
+        arm = p - Vec3.constant(pivot)
+        length = float(np.linalg.norm(arm.value(q0)))
+        if length == 0.0:
+            raise InputError(f"joint {name!r}: the node lies on the pivot (the arm has no length)")
+        if abs(k @ arm.value(q0)) > 1e-9 * length or \
+                abs(float(slope.value(q0) @ arm.value(q0))) > 1e-9 * length * float(
+                    np.linalg.norm(slope.value(q0))):
+            raise InputError(f"joint {name!r}: the node is not in the plane through the pivot "
+                             "normal to the axis, or its slope is not normal to the arm")
+        order = np.argsort(np.abs(k), kind="stable")
+        plane, axial = [int(i) for i in order[:2]], int(order[2])
+        const = Scalar({}, 0.0)
+        return [
+            Constraint(CONSTRAINT_DOT, arm.components() + slope.components(), [0.0], None,
+                       f"{name}: r_x normal to the arm", _dofs(p, plane[0])),
+            Constraint(CONSTRAINT_DISTANCE, p.components() + [const + Scalar({}, float(c))
+                                                              for c in pivot], [length, 0.0],
+                       None, f"{name}: arm length", _dofs(p, plane[1])),
+            LinearEquation(arm.along(k), f"{name}: in the plane", _dofs(p, axial)),
+            LinearEquation(slope.along(k), f"{name}: slope in the plane", _dofs(slope, axial)),
         ]
 
     def _distance(self, q0) -> list[Equation]:

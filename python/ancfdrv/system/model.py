@@ -214,7 +214,7 @@ class Model:
     def contact_point_names(self) -> list[str]:
         return [n for p in self.contact_pairs for n in p["point_names"]]
 
-    def summary(self) -> dict[str, int]:
+    def summary(self) -> dict[str, int | str]:
         """The /model attributes of a result file."""
         beams = [b for b in self.bodies if isinstance(b, Beam)]
         plates = [b for b in self.bodies if isinstance(b, Plate)]
@@ -226,7 +226,12 @@ class Model:
                 "nconstraints": len(self.constraints),
                 "nlinear_eliminated": 0 if self.reduction is None else
                     len(self.reduction.relations),
-                "ncontact_points": self.npoint}
+                "ncontact_points": self.npoint,
+                # planar reduction (system/planar.py): the plane ('' off), the coordinates
+                # it fixed, and the unknowns solved (coordinates + multipliers)
+                "planar": getattr(self, "planar", ""),
+                "nplanar_fixed": getattr(self, "nplanar_fixed", 0),
+                "nunknowns": self.ndof + len(self.constraints)}
 
     # -- coordinates --------------------------------------------------------------------------
     def expand(self, e: np.ndarray, with_offset: bool = True) -> np.ndarray:

@@ -40,6 +40,7 @@ from .force_elements import FORCE_ELEMENT_PARAMETERS, ForceElement
 from .joints import Joint
 from .loads import LOAD_TYPES, Load
 from .probes import Probe
+from .planar import check_setting as check_planar
 from .sections import Section
 
 #: effects an item may belong to, with the default of each load type (SPEC section 8)
@@ -87,7 +88,7 @@ class System:
     """A mechanical system under construction (see the module documentation)."""
 
     def __init__(self, title: str = "", *, effects: Iterable[str] | None = None,
-                 bounds: str = "check") -> None:
+                 bounds: str = "check", planar: str = "off") -> None:
         if not isinstance(title, str):
             raise InputError(f"the title must be a string, got {short_repr(title)}",
                              group="scene", key="title")
@@ -101,6 +102,8 @@ class System:
                              group="scene", key="bounds")
         #: 'check': drives and loads within validate.PHYSICAL_BOUNDS at assembly; 'off'
         self.bounds = bounds
+        #: planar reduction ('off', 'auto', 'xy', 'yz', 'zx'; :mod:`.planar`)
+        self.planar = check_planar(planar)
         self.materials: dict[str, Material] = {}
         self.bodies: dict[str, Body] = {}
         self.drives: dict[str, Drive] = {}
@@ -201,14 +204,19 @@ class System:
     @_api
     def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
               section: Section | None = None, tension_only: bool = False,
-              bending_stiffness: float | None = None) -> Cable:
+              bending_stiffness: float | None = None, segments=None,
+              bending_inertia: float | None = None) -> Cable:
         """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli).
         ``tension_only=True`` makes it a rope that goes slack instead of carrying
-        compression; ``bending_stiffness`` (N m^2) replaces E times the section's I."""
+        compression; ``bending_stiffness`` (N m^2) replaces E times the section's I;
+        ``segments``: lengths between fixed nodes, each split equally (as a beam's);
+        ``bending_inertia`` (m^4): the inertia of a section with I_y != I_z about the axis a
+        cable kept in a plane bends about (the system must then be planar)."""
         name = self._body_name(name)
         return self._add_body(Cable(name, self._material(material, f"cable {name!r}"), start,
                                     end, nodes, section, tension_only=tension_only,
-                                    bending_stiffness=bending_stiffness))
+                                    bending_stiffness=bending_stiffness, segments=segments,
+                                    bending_inertia=bending_inertia))
 
     @_api
     def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,
