@@ -423,7 +423,7 @@ def test_namelist_and_python_give_the_same_model(tmp_path):
     path = tmp_path / "spring.nml"
     path.write_text(text)
     from ancfdrv.io.scene import load_scene
-    from ancfdrv.io.general import build_general
+    from ancfdrv.builders.general import build_general
     built = build_general(load_scene(path))
     fe = built.system.force_elements["spring"]
     python = guided_mass(free_length=0.9, preload=5.0, gravity=9.81)
