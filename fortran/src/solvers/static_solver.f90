@@ -422,29 +422,45 @@ contains
     write (where, '(a, i0, a, i0)') 'at load step ', load_step, ' of ', load_steps
     select case (info)
     case (static_limit)
-      write (text, '(a, i0, 3a, es10.3, a, es10.3, a)') 'static Newton did not converge in ', &
-        max_iter, ' iterations ', trim(where), ' (relative residual ', last, &
-        ', constraint ', con_res, '); raise solver.load_steps or max_iter'
+      write (text, '(a, i0, 7a)') 'static Newton did not converge in ', max_iter, &
+        ' iterations ', trim(where), ' (relative residual ', sci(last), ', constraint ', &
+        sci(con_res), '); raise solver.load_steps or max_iter'
     case (static_diverged)
-      write (text, '(3a, es10.3, a, es10.3, a)') 'static Newton diverged ', trim(where), &
-        ': the relative residual grew three times in a row to ', last, ' (smallest ', &
-        smallest, '); raise solver.load_steps'
+      text = 'static Newton diverged ' // trim(where) // ': the relative residual grew ' // &
+             'three times in a row to ' // sci(last) // ' (smallest ' // sci(smallest) // &
+             '); raise solver.load_steps'
     case (static_floor_stall)
-      write (text, '(3a, es10.3, a, es10.3, a)') 'static Newton stalled at the round-off ' // &
-        'floor ', trim(where), ': residual ', smallest, ' above solver.tol = ', tol, &
-        ', more digits than double precision carries here; raise solver.tol'
+      text = 'static Newton stalled at the round-off floor ' // trim(where) // &
+             ': the relative residual stays at ' // sci(smallest) // ' above solver.tol = ' // &
+             sci(tol) // ', more digits than double precision carries here; raise solver.tol'
     case (static_stall)
-      write (text, '(3a, es10.3, a, es10.3, a)') 'static Newton stalled ', trim(where), &
-        ': no smaller residual in the last iterations (smallest ', smallest, ', tolerance ', &
-        tol, '); raise solver.load_steps'
+      text = 'static Newton stalled ' // trim(where) // ': no smaller residual in the last ' // &
+             'iterations (smallest ' // sci(smallest) // ', tolerance ' // sci(tol) // &
+             '); raise solver.load_steps'
     case (static_nonfinite)
-      write (text, '(2a)') 'static Newton: non-finite step ', trim(where)
+      text = 'static Newton: non-finite step ' // trim(where)
     case (static_solve_failed)
       write (text, '(3a, i0, a)') 'static Newton: the saddle-point solve failed ', &
         trim(where), ' (solver code ', detail, ': -10 = singular matrix)'
     case default
       text = 'static Newton ' // trim(where) // ': ' // trim(failure_text(info))
     end select
+
+  contains
+
+    !> x as Python's '{:.3e}' writes it
+    pure function sci(x) result(out)
+      real(dp), intent(in) :: x
+      character(len=:), allocatable :: out
+      character(len=16) :: buffer
+      integer :: p
+      write (buffer, '(es12.3)') x
+      buffer = adjustl(buffer)
+      p = index(buffer, 'E')
+      if (p > 0) buffer(p:p) = 'e'
+      out = trim(buffer)
+    end function sci
+
   end function static_failure_text
 
 end module static_solver

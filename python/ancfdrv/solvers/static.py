@@ -3,7 +3,10 @@
 Two solvers share one convergence test (:func:`residuals`):
 
 * :func:`solve_newton` - Newton-Raphson on the symmetric saddle-point system
-  [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] with MUMPS (pattern analysed once).
+  [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] with MUMPS, in the kernel
+  (fortran/src/solvers/static_solver.f90: the stepper's residual with the inertia off, one
+  call per load step, the load factor an argument); :func:`solve_newton_python` is the
+  same Newton assembled in Python, kept as the reference it is tested against.
 * :func:`solve_split` - the split iteration of seed 000 (eqs. 40-57) as implemented in
   docs/theory.md: coordinates split into dependent ones e_D (one per constraint, N1) and
   the rest e_R (N2); the fixed-point iteration
@@ -282,8 +285,9 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     check_arguments("solve_newton", tol=tol, max_iter=max_iter, load_steps=load_steps,
                     loads=loads)
     model.require_runnable()
+    model.check_alive()
     start = time.perf_counter()
-    n, ncon = model.ndof, len(model.constraints)
+    ncon = len(model.constraints)
     e, lam = model.e0.copy(), np.zeros(ncon)
     history: list[float] = []
     total, factorizations, force_scale = 0, 0, -1.0
