@@ -752,6 +752,32 @@ class KernelSystem:
                     contact_potential=float(potential), records=records[:, :self.npoint],
                     tangent=tangent if want_tangent else None, guesses=guesses, counts=counts)
 
+    def static_solve(self, *, t: float, load_factor: float, e0, rows, cols, e, lam, guesses,
+                     counts, tol: float, length_scale: float, max_iter: int, check_start: bool,
+                     force_scale: float, load_step: int, load_steps: int) -> dict:
+        """One load step of the kernel's static Newton (``fortran/src/solvers/
+        static_solver.f90``): equilibrium at ``load_factor`` from (e, lam), the tangent's
+        pattern ``rows``, ``cols`` (0-based). ``force_scale`` < 0 is set from the start and
+        returned. Returns e, lam, the contact guesses and counters, force_scale, iterations,
+        the relative residual history, the last residual and constraint violation,
+        converged_by (static_solver's by_* code) and factorizations, with info and the
+        kernel's message (0 and '' when converged)."""
+        ncon = len(lam)
+        out = _kernel.system_static_solve(
+            self.handle, ncon, self.npoint, t, load_factor, _f(e0),
+            _i(np.asarray(rows) + 1), _i(np.asarray(cols) + 1), _f(np.array(e, dtype=float)),
+            _f(np.array(lam, dtype=float)) if ncon else np.zeros(1),
+            _f(np.array(guesses, dtype=float)), _i(np.array(counts)),
+            tol, length_scale, max_iter, int(check_start), force_scale, load_step, load_steps)
+        (e, lam_out, guesses, counts, force_scale, iterations, history, force_res, con_res,
+         converged_by, factorizations, info, message) = out
+        return dict(e=e, lam=lam_out[:ncon], guesses=guesses, counts=counts,
+                    force_scale=float(force_scale), iterations=int(iterations),
+                    history=history[:int(iterations)].copy(), force_res=float(force_res),
+                    con_res=float(con_res), converged_by=int(converged_by),
+                    factorizations=int(factorizations), info=int(info),
+                    message=_text(message) if info else "")
+
     def full_forces(self, t: float, e, v, guesses, *, load_factor: float = 1.0) -> np.ndarray:
         """Q_el - Q_c - lf Q_M at (t, e, e') in the full coordinates q (before B^T): what
         the joint reactions of eliminated linear joints are recovered from. The caller's

@@ -1176,3 +1176,71 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
     if (store_q) rows(k + 1:k + ndof, step) = out_q(:, step)
   end do
 end subroutine system_advance
+
+!> One load step of the static Newton in the kernel (static_solver): equilibrium of the
+!> system at load factor load_factor and time t from (e, lam) (updated in place; e0 the
+!> reference configuration), the tangent's reduced pattern rows, cols (1-based, the
+!> solvers' pattern). force_scale: the residual's scale floor (< 0: set from the start and
+!> returned); check_start /= 0: a start that is already the equilibrium ends with 0
+!> iterations. Returns the iterations, the relative residual after each (history), the
+!> last relative residual and constraint violation, why it converged (static_solver's
+!> by_* codes) and the factorizations; info /= 0 with the text in message (load_step of
+!> load_steps name the step in it).
+subroutine system_static_solve(handle, ndof, ncon, npoint, nnz, t, load_factor, e0, rows, cols, &
+                               e, lam, guesses, counts, tol, length_scale, max_iter, check_start, &
+                               force_scale, load_step, load_steps, iterations, history, &
+                               force_res, con_res, converged_by, factorizations, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state
+  use static_solver, only: static_newton, static_failure_text
+  use system_store, only: store_get
+  use kernel_errors, only: handle_text
+  implicit none
+  integer, intent(in) :: handle, ndof, ncon, npoint, nnz, max_iter, check_start
+  integer, intent(in) :: rows(nnz), cols(nnz), load_step, load_steps
+  real(dp), intent(in) :: t, load_factor, e0(ndof), tol, length_scale
+  real(dp), intent(inout) :: e(ndof), lam(max(1, ncon)), force_scale
+  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  integer, intent(inout) :: counts(6)
+  !f2py intent(in,out) :: e, lam, guesses, counts, force_scale
+  integer, intent(out) :: iterations, converged_by, factorizations, info
+  real(dp), intent(out) :: history(max_iter), force_res, con_res
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  type(contact_state) :: state
+  integer :: detail
+  message = ' '
+  iterations = 0
+  converged_by = 0
+  factorizations = 0
+  history = 0.0_dp
+  force_res = 0.0_dp
+  con_res = 0.0_dp
+  call store_get(handle, sys, info)
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
+  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. npoint /= sys%npoint .or. &
+      nnz /= size(sys%mass_pattern) .or. max_iter < 1) then
+    info = 4
+    message = 'system_static_solve: sizes inconsistent with the system (ndof, ncon, npoint,' // &
+              ' nnz of the pattern) or max_iter < 1'
+    return
+  end if
+  if (any(rows < 1) .or. any(rows > ndof) .or. any(cols < 1) .or. any(cols > ndof)) then
+    info = 4
+    message = 'system_static_solve: a pattern entry outside 1..ndof'
+    return
+  end if
+  state%guesses = guesses
+  state%counts = counts
+  call static_newton(sys, t, load_factor, e0, rows, cols, e, lam(1:ncon), state, tol, &
+                     length_scale, max_iter, check_start /= 0, force_scale, iterations, &
+                     history, force_res, con_res, converged_by, factorizations, info, detail)
+  guesses = state%guesses
+  counts = state%counts
+  if (info /= 0) message = static_failure_text(info, detail, load_step, load_steps, max_iter, &
+                                               minval(history(1:max(1, iterations))), force_res, &
+                                               con_res, tol)
+end subroutine system_static_solve

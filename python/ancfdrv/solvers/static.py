@@ -3,7 +3,10 @@
 Two solvers share one convergence test (:func:`residuals`):
 
 * :func:`solve_newton` - Newton-Raphson on the symmetric saddle-point system
-  [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] with MUMPS (pattern analysed once).
+  [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] with MUMPS, in the kernel
+  (fortran/src/solvers/static_solver.f90: the stepper's residual with the inertia off, one
+  call per load step, the load factor an argument); :func:`solve_newton_python` is the
+  same Newton assembled in Python, kept as the reference it is tested against.
 * :func:`solve_split` - the split iteration of seed 000 (eqs. 40-57) as implemented in
   docs/theory.md: coordinates split into dependent ones e_D (one per constraint, N1) and
   the rest e_R (N2); the fixed-point iteration
@@ -140,19 +143,25 @@ def _hessian_triplets(model: Model, e: np.ndarray):
     return model.constraints.hessian_triplets(e)
 
 
-def _forces(model: Model, d: np.ndarray, want_tangent: bool, t: float = 0.0):
-    """(internal, external, tangent values or None) at e0 + d from the kernel."""
-    out = model.forces(model.e0 + d, t, want_tangent=want_tangent)
+def _forces(model: Model, d: np.ndarray, want_tangent: bool, load_factor: float = 1.0,
+            t: float = 0.0):
+    """(internal, external, tangent values or None) at e0 + d and the load factor from the
+    kernel."""
+    out = model.forces(model.e0 + d, t, want_tangent=want_tangent, load_factor=load_factor)
     return out["internal"], out["external"], out["tangent"]
 
 
-def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
-                 load_steps: int = 1, loads: float = 1.0) -> StaticResult:
+def solve_newton_python(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
+                        load_steps: int = 1, loads: float = 1.0) -> StaticResult:
     """Full Newton-Raphson on (e, lambda) from the rigid configuration; the loads are
     applied in ``load_steps`` equal increments (large deformation), each solved to tol.
     ``loads`` scales the external loads (gravity, forces, moments, pressure) of the last
     increment: 0 gives the equilibrium of the internal forces alone (prestress carried by
-    contact), the start of a settled run."""
+    contact), the start of a settled run.
+
+    The Python implementation of the static Newton, kept as the reference the kernel's
+    (:func:`solve_newton`) is tested against: the same residual, saddle-point matrix and
+    convergence test, assembled here from the kernel's force evaluations."""
     check_arguments("solve_newton", tol=tol, max_iter=max_iter, load_steps=load_steps,
                     loads=loads)
     model.require_runnable()
@@ -163,11 +172,11 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     t0 = time.perf_counter()
     h_con, h_rows, h_cols, h_vals = _hessian_triplets(model, model.e0)
     _, j_rows, j_cols, _ = model.constraints.jacobian(model.e0, n)
-    moment_cols = [cols for cols, *_ in model.moment_terms(model.e0)]
+    moment_cols = [cols for cols, *_ in model.moment_terms(model.e0, load_factor=1.0)]
     m_rows = [np.repeat(cols, len(cols)) for cols in moment_cols]
     m_cols = [np.tile(cols, len(cols)) for cols in moment_cols]
     # driven and follower point loads: their (non-symmetric) Jacobian, with the moments'
-    load_cols = [cols for cols, *_ in model.vector_load_terms(model.e0)]
+    load_cols = [cols for cols, *_ in model.vector_load_terms(model.e0, load_factor=1.0)]
     m_rows += [np.repeat(cols, len(cols)) for cols in load_cols]
     m_cols += [np.tile(cols, len(cols)) for cols in load_cols]
     rows = np.concatenate([model.pattern.rows, h_rows, *m_rows, n + j_rows, j_cols])
@@ -178,16 +187,17 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     with DirectSolver(n + ncon, rows, cols, what="static Newton saddle-point matrix") as solver:
         try:
             for load_step in range(1, load_steps + 1):
-                model.load_factor = loads * load_step / load_steps
+                factor = loads * load_step / load_steps
                 for iteration in range(1, max_iter + 1):
                     t0 = time.perf_counter()
                     e = model.e0 + d
                     phi, _, _, grads = model.constraints.jacobian(e, n)
                     reaction = np.zeros(n)
                     np.add.at(reaction, j_cols, grads * lam[j_rows])
-                    moments = model.moment_terms(e)
-                    moments += [(c, f, j, None) for c, f, j in model.vector_load_terms(e)]
-                    internal, external, k_values = _forces(model, d, True)
+                    moments = model.moment_terms(e, load_factor=factor)
+                    moments += [(c, f, j, None) for c, f, j in
+                                model.vector_load_terms(e, load_factor=factor)]
+                    internal, external, k_values = _forces(model, d, True, factor)
                     residual = internal - external - reaction
                     if load_step == 1 and iteration == 1:  # the start: loads and prestress
                         force_scale = max(np.linalg.norm(internal), np.linalg.norm(external))
@@ -214,7 +224,7 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                                           f"{iteration} of load step {load_step}")
                     d += step[:n]
                     lam += step[n:]
-                    internal, external, _ = _forces(model, d, False)
+                    internal, external, _ = _forces(model, d, False, factor)
                     force_res, con_res = residuals(model, d, lam, internal, external,
                                                    force_scale)
                     previous = history[-1] if history and iteration > 1 else np.inf
@@ -247,7 +257,6 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                         f"constraint {con_res:.3e}); raise solver.load_steps or max_iter")
                 total += iteration
         finally:
-            model.load_factor = 1.0
             model.counters["factorizations"] += solver.factorizations
             model.counters["solves"] += solver.solves
     check_ffr(model, model.e0 + d, 0.0, when="in the static equilibrium")
@@ -256,6 +265,65 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     return StaticResult(model.e0 + d, lam, "newton", total, force_res, con_res, wall, history,
                         timing, extra={"converged_by": how, "load_steps": load_steps,
                                        "load_factor": loads})
+
+
+#: static_solver.f90's converged_by codes
+_CONVERGED_BY = {1: "residual", 2: "roundoff", 3: "step", 4: "floor", 5: "unloaded start"}
+
+
+def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
+                 load_steps: int = 1, loads: float = 1.0) -> StaticResult:
+    """Full Newton-Raphson on (e, lambda) from the rigid configuration, in the kernel
+    (``fortran/src/solvers/static_solver.f90``, issue 25 item 4): the stepper's residual with
+    the inertia terms off, the saddle-point matrix [[K - dQ/de - sum lambda_k H_k,
+    -Phi_e^T], [-Phi_e, 0]] factorized by MUMPS, the convergence test of :func:`converged`
+    and :func:`residual_floor`. The loads are applied in ``load_steps`` equal increments
+    (large deformation), each solved to tol by one kernel call with its load factor as an
+    argument. ``loads`` scales the external loads (gravity, forces, moments, pressure) of
+    the last increment: 0 gives the equilibrium of the internal forces alone (prestress
+    carried by contact), the start of a settled run."""
+    check_arguments("solve_newton", tol=tol, max_iter=max_iter, load_steps=load_steps,
+                    loads=loads)
+    model.require_runnable()
+    model.check_alive()
+    start = time.perf_counter()
+    ncon = len(model.constraints)
+    e, lam = model.e0.copy(), np.zeros(ncon)
+    history: list[float] = []
+    total, factorizations, force_scale = 0, 0, -1.0
+    how, force_res, con_res = "", np.inf, np.inf
+    try:
+        for load_step in range(1, load_steps + 1):
+            out = model.kernel.static_solve(
+                t=0.0, load_factor=loads * load_step / load_steps, e0=model.e0,
+                rows=model.pattern.rows, cols=model.pattern.col_index, e=e, lam=lam,
+                guesses=model.contact_guesses, counts=model.contact_counts, tol=tol,
+                length_scale=model.length_scale, max_iter=max_iter,
+                check_start=load_step == 1 and load_steps == 1, force_scale=force_scale,
+                load_step=load_step, load_steps=load_steps)
+            model.contact_guesses, model.contact_counts = out["guesses"], out["counts"]
+            factorizations += out["factorizations"]
+            evaluations = out["iterations"] + 1
+            model.counters["elastic_force"] += 2 * evaluations
+            model.counters["stiffness_assembly"] += evaluations
+            for item in (*model.moments, *model.vector_loads):
+                model.counters[item.effect] += evaluations
+            if out["info"]:
+                raise SolverError(out["message"])
+            e, lam, force_scale = out["e"], out["lam"], out["force_scale"]
+            history += out["history"].tolist()
+            total += out["iterations"]
+            how, force_res, con_res = (_CONVERGED_BY[out["converged_by"]], out["force_res"],
+                                       out["con_res"])
+    finally:
+        model.counters["factorizations"] += factorizations
+        model.counters["solves"] += factorizations
+    check_ffr(model, e, 0.0, when="in the static equilibrium")
+    wall = time.perf_counter() - start
+    return StaticResult(e, lam, "newton", total, force_res, con_res, wall, history,
+                        {"assembly": 0.0, "factorization": 0.0, "solve": wall, "total": wall},
+                        extra={"converged_by": how, "load_steps": load_steps,
+                               "load_factor": loads})
 
 
 class Jet:

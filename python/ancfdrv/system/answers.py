@@ -367,7 +367,7 @@ def reactions(model: Model, e: np.ndarray, lam: np.ndarray, *, t: float = 0.0,
     q = model.expand(e)
     residual = None
     if rm.factor is not None:
-        lf = model.load_factor if load_factor is None else load_factor
+        lf = 1.0 if load_factor is None else load_factor
         v = np.zeros(model.ndof) if v is None else v
         residual = rm.residual(np.asarray(e, dtype=float), v, a, t, lf)
     out = rm.reactions(q, np.asarray(lam, dtype=float), t, residual)
@@ -781,7 +781,7 @@ class DynamicAnswers:
         residual = None
         velocities = np.zeros_like(e_rows)
         if self.need_acceleration:
-            lf = self.model.load_factor
+            lf = 1.0
             residual = np.empty_like(q_rows)
             for row, t in enumerate(times):
                 v, accel = self._kinematics(float(t), e_rows[row])

@@ -174,7 +174,6 @@ class Model:
         self.linear_joints = linear_joints
         self.policy = POLICY_REFACTOR
         self.vector_frame = np.zeros(0, dtype=np.int64)
-        self.load_factor = 1.0
         self.ndof, self.nfull = len(e0), len(q0)
         self.kernel: kernel.KernelSystem | None = None
         self.solver: kernel.DirectSolver | None = None
@@ -265,7 +264,7 @@ class Model:
         """From the kernel: internal = B^T (Q_el - Q_contact - lf Q_M), external = lf Q(t),
         strain energy, contact potential and records, and on request the tangent (sets plus
         velocity_factor times the contact Jacobian) on :attr:`pattern`."""
-        lf = self.load_factor if load_factor is None else load_factor
+        lf = 1.0 if load_factor is None else load_factor
         out = self.kernel.evaluate(t, e, np.zeros(self.ndof) if v is None else v,
                                    self.contact_guesses, self.contact_counts, load_factor=lf,
                                    velocity_factor=velocity_factor, want_tangent=want_tangent)
@@ -286,17 +285,17 @@ class Model:
         return out["internal"], out["strain"], out["tangent"]
 
     def constant_force(self) -> np.ndarray:
-        """Configuration-independent loads of the listed effects (at t = 0), times the load
-        factor."""
+        """Configuration-independent loads of the listed effects (at t = 0) at load factor 1
+        (the static Newton passes its load factors to the kernel as arguments)."""
         force = self.constant_force_vector.copy()
         for index, vector in self.driven_forces:
             force += self.drives[index].value(0.0) * vector
-        return self.load_factor * force
+        return force
 
     def moment_terms(self, e: np.ndarray, load_factor: float | None = None):
         """Per dead moment: (coordinates, force, Jacobian, Hessian) over the coordinates its
         director depends on (through B when reduced)."""
-        lf = self.load_factor if load_factor is None else load_factor
+        lf = 1.0 if load_factor is None else load_factor
         q = self.expand(e)
         out = []
         for m in self.moments:
@@ -312,7 +311,7 @@ class Model:
         Jacobian d force / d e) over the coordinates its directions and point depend on
         (through B when reduced); the force is external (it enters the residual with a
         minus sign)."""
-        lf = self.load_factor if load_factor is None else load_factor
+        lf = 1.0 if load_factor is None else load_factor
         q = self.expand(e)
         out = []
         for load in self.vector_loads:

@@ -1,0 +1,466 @@
+!> The static Newton in the kernel (issue 25 item 4): equilibrium at a load factor lf,
+!>   r(e, lambda) = B^T (Q_el - Q_c - lf Q_M)(e) - lf Q(e, t) - Phi_e^T lambda = 0,
+!>   Phi(e, t) = 0,
+!> the residual of the time stepper (time_integrator) with the inertia terms off: the same
+!> internal_forces (element sets, force elements, contact, dead moments, through q = B e + q0
+!> when linear constraints are eliminated), the same external_forces (constant, driven,
+!> driven and follower point loads) and the same constraints. Newton-Raphson on the
+!> symmetric saddle-point system
+!>   [[K - dQ/de - sum_k lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] [de; dlambda] = [-r; Phi]
+!> (K: the tangent of internal_forces with the point loads' Jacobian; dQ/de: the dead
+!> moments' Jacobian; H_k: the constraint Hessians), factorized by sequential MUMPS
+!> (sparse_direct: the pattern analysed once per call) - the stepper's iteration matrix
+!> beta' M + K regularizes the rigid modes, the static one has the multipliers for them.
+!> The convergence test is the one of python/ancfdrv/solvers/static.py (converged,
+!> residual_floor): the relative force residual and the constraint violation below tol,
+!> or, on fine meshes whose residual has a round-off floor, the correction or the residual
+!> stopped falling there; the stagnation and divergence test watches the residuals (the
+!> static Newton has no step size to cut: the load stepping in Python does).
+!> One call solves one load step; the load stepping and its reporting stay in Python.
+!> No I/O; failures return codes with their text (static_failure_text).
+module static_solver
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
+                               external_forces, constraint_reaction, contact_record
+  use constraints, only: constraint_eval
+  use section_moment, only: moment_force
+  use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
+                           solver_destroy
+  use kernel_errors, only: failure_text, message_length
+  implicit none
+  private
+  public :: static_newton, static_failure_text
+
+  !> why the iteration stopped (converged_by): the relative residual; the round-off floor
+  !> with a correction below sqrt(tol); the correction below tol; the residual stopped
+  !> falling below sqrt(tol); the start is the equilibrium (nothing loads the structure)
+  integer, parameter, public :: by_residual = 1, by_roundoff = 2, by_step = 3, by_floor = 4, &
+                                by_unloaded_start = 5
+  !> failures (info): iteration limit, divergence, stall at the round-off floor, stall,
+  !> non-finite step, linear solve failed (detail: the solver code); 5..10: internal_forces
+  integer, parameter, public :: static_limit = 1, static_diverged = 11, &
+                                static_floor_stall = 12, static_stall = 13, &
+                                static_nonfinite = 2, static_solve_failed = 3
+  !> iterations in a row without a new smallest residual: a stall once the residual is
+  !> small (below stall_near or at the floor); far from it, far_stall_iterations
+  integer, parameter :: stall_iterations = 4, far_stall_iterations = 25
+  real(dp), parameter :: stall_near = 1.0e-6_dp
+
+contains
+
+  !> One load step of the static Newton from (e, lambda) (updated in place) at load factor
+  !> load_factor and time t. e0: the reference configuration (the corrections' size is
+  !> measured against |e - e0|); rows, cols: the tangent's reduced pattern (1-based, the
+  !> order of internal_forces' tangent values); force_scale: the residual's scale floor (the
+  !> forces at the start; < 0 on entry: set from the first iterate); check_start: a start
+  !> that is already the equilibrium (nothing loads the structure) ends the call with 0
+  !> iterations. history(1:iterations): the relative residual after each correction.
+  subroutine static_newton(sys, t, load_factor, e0, rows, cols, e, lam, state, tol, &
+                           length_scale, max_iter, check_start, force_scale, iterations, &
+                           history, force_res, con_res, converged_by, factorizations, info, &
+                           detail)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, load_factor, e0(:), tol, length_scale
+    integer, intent(in) :: rows(:), cols(:), max_iter
+    logical, intent(in) :: check_start
+    real(dp), intent(inout) :: e(:), lam(:), force_scale
+    type(contact_state), intent(inout) :: state
+    integer, intent(out) :: iterations, converged_by, factorizations, info, detail
+    real(dp), intent(out) :: history(:), force_res, con_res
+    integer :: n, ncon, nnz, nhess, nmom, ngrad, total, handle, it, c, s1, s2, k1, k2, k, m
+    integer :: i, j, a, b, best, since, destroy_info
+    integer, allocatable :: srows(:), scols(:)
+    real(dp), allocatable :: values(:), tangent(:), rhs(:, :)
+    real(dp) :: internal(size(e)), loads(size(e)), reaction(size(e)), residual(size(e))
+    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), hessians(6, 6, sys%ncon)
+    real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
+    real(dp) :: step_size, size_now, scale, floor, previous, stiff, moment(3)
+    real(dp) :: jacobian(3, 3), hessian(3, 3, 3)
+    logical :: near, growing
+    n = size(e)
+    ncon = sys%ncon
+    nnz = size(rows)
+    iterations = 0
+    converged_by = 0
+    factorizations = 0
+    force_res = huge(1.0_dp)
+    con_res = huge(1.0_dp)
+    history = 0.0_dp
+    detail = 0
+    call frame_rotations(sys, t, rotations, rates, info)
+    if (info /= 0) return
+    ! the saddle-point pattern: tangent, constraint Hessians, moment Jacobians, gradients
+    nhess = 0
+    ngrad = 0
+    do c = 1, ncon
+      do s1 = 1, 6
+        ngrad = ngrad + slot_terms(c, s1)
+        do s2 = 1, 6
+          nhess = nhess + slot_terms(c, s1) * slot_terms(c, s2)
+        end do
+      end do
+    end do
+    nmom = 0
+    do m = 1, size(sys%moment_magnitude)
+      do i = 1, 3
+        do j = 1, 3
+          nmom = nmom + row_terms(sys%moment_dofs(i, m)) * row_terms(sys%moment_dofs(j, m))
+        end do
+      end do
+    end do
+    total = nnz + nhess + nmom + 2 * ngrad
+    allocate (srows(total), scols(total), values(total), tangent(nnz), rhs(n + ncon, 1))
+    srows(1:nnz) = rows
+    scols(1:nnz) = cols
+    k = nnz
+    do c = 1, ncon
+      do s1 = 1, 6
+        do s2 = 1, 6
+          do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
+            do k2 = first_term(c, s2), first_term(c, s2) + slot_terms(c, s2) - 1
+              k = k + 1
+              srows(k) = sys%term_dof(k1)
+              scols(k) = sys%term_dof(k2)
+            end do
+          end do
+        end do
+      end do
+    end do
+    do m = 1, size(sys%moment_magnitude)
+      do i = 1, 3
+        do j = 1, 3
+          do a = 1, row_terms(sys%moment_dofs(i, m))
+            do b = 1, row_terms(sys%moment_dofs(j, m))
+              k = k + 1
+              srows(k) = reduced_col(sys%moment_dofs(i, m), a)
+              scols(k) = reduced_col(sys%moment_dofs(j, m), b)
+            end do
+          end do
+        end do
+      end do
+    end do
+    do c = 1, ncon
+      do s1 = 1, 6
+        do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
+          srows(k + 1) = sys%term_dof(k1)
+          scols(k + 1) = n + c
+          srows(k + 2) = n + c
+          scols(k + 2) = sys%term_dof(k1)
+          k = k + 2
+        end do
+      end do
+    end do
+    call solver_create(0, handle, info, detail)
+    if (info /= 0) then
+      detail = info
+      info = static_solve_failed
+      return
+    end if
+    call solver_analyse(handle, n + ncon, total, srows, scols, info, detail)
+    if (info /= 0) then
+      detail = info
+      info = static_solve_failed
+      call solver_destroy(handle, destroy_info)
+      return
+    end if
+    do it = 1, max_iter
+      call evaluate(.true.)
+      if (info /= 0) exit
+      residual = internal - loads - reaction
+      if (force_scale < 0.0_dp) force_scale = max(norm2(internal), norm2(loads))
+      if (check_start .and. it == 1) then
+        stiff = 0.0_dp
+        if (nnz > 0) stiff = maxval(abs(tangent)) * length_scale
+        if (norm2(residual) <= 1.0e-13_dp * stiff .and. max_abs(phi) <= tol * length_scale) then
+          converged_by = by_unloaded_start
+          force_res = 0.0_dp
+          con_res = 0.0_dp
+          exit
+        end if
+      end if
+      ! the saddle-point values in the pattern's order
+      values(1:nnz) = tangent
+      k = nnz
+      do c = 1, ncon
+        do s1 = 1, 6
+          do s2 = 1, 6
+            do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
+              do k2 = first_term(c, s2), first_term(c, s2) + slot_terms(c, s2) - 1
+                k = k + 1
+                values(k) = -lam(c) * hessians(s1, s2, c) * sys%term_coef(k1) * sys%term_coef(k2)
+              end do
+            end do
+          end do
+        end do
+      end do
+      do m = 1, size(sys%moment_magnitude)
+        call moment_force(full_at(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
+                          load_factor * sys%moment_magnitude(m), moment, jacobian, hessian, info)
+        if (info /= 0) then
+          info = 6
+          exit
+        end if
+        do i = 1, 3
+          do j = 1, 3
+            do a = 1, row_terms(sys%moment_dofs(i, m))
+              do b = 1, row_terms(sys%moment_dofs(j, m))
+                k = k + 1
+                values(k) = -jacobian(i, j) * reduced_coef(sys%moment_dofs(i, m), a) &
+                            * reduced_coef(sys%moment_dofs(j, m), b)
+              end do
+            end do
+          end do
+        end do
+      end do
+      if (info /= 0) exit
+      do c = 1, ncon
+        do s1 = 1, 6
+          do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
+            values(k + 1) = -gradients(s1, c) * sys%term_coef(k1)
+            values(k + 2) = values(k + 1)
+            k = k + 2
+          end do
+        end do
+      end do
+      call solver_factorize(handle, total, values, info, detail)
+      factorizations = factorizations + 1
+      if (info == 0) then
+        rhs(1:n, 1) = -residual
+        rhs(n + 1:, 1) = phi
+        call solver_solve(handle, n + ncon, 1, rhs, info, detail)
+      end if
+      if (info /= 0) then
+        detail = info
+        info = static_solve_failed
+        exit
+      end if
+      iterations = it
+      if (.not. all(abs(rhs(:, 1)) < huge(1.0_dp))) then
+        info = static_nonfinite
+        exit
+      end if
+      e = e + rhs(1:n, 1)
+      lam = lam + rhs(n + 1:, 1)
+      call evaluate(.false.)
+      if (info /= 0) exit
+      scale = max(norm2(loads), norm2(reaction), norm2(internal), force_scale, 1.0e-300_dp)
+      force_res = norm2(internal - loads - reaction) / scale
+      con_res = 0.0_dp
+      con_res = max_abs(phi) / length_scale
+      previous = huge(1.0_dp)
+      if (it > 1) previous = history(it - 1)
+      history(it) = force_res
+      scale = max(norm2(loads), norm2(internal), force_scale)
+      floor = residual_floor(scale)
+      step_size = norm2(rhs(1:n, 1))
+      size_now = norm2(e - e0)
+      converged_by = converged(force_res, con_res, step_size, size_now, previous, floor)
+      if (converged_by /= 0) exit
+      best = minloc(history(1:it), dim=1)
+      near = history(best) <= max(stall_near, floor)
+      growing = it >= 4 .and. rising(history(1:it)) .and. force_res > 1.0e6_dp * history(best)
+      since = it - best
+      if ((near .and. since >= stall_iterations) .or. since >= far_stall_iterations .or. &
+          growing .or. .not. (force_res < huge(1.0_dp))) then
+        ! as static.py's message: divergence, a stall at the floor, or a stall above it
+        detail = 0
+        if (it >= 4 .and. rising(history(max(1, it - 3):it)) .and. &
+            force_res > 1.0e6_dp * history(best)) then
+          info = static_diverged
+        else if (history(best) <= floor) then
+          info = static_floor_stall
+        else
+          info = static_stall
+        end if
+        exit
+      end if
+    end do
+    if (info == 0 .and. converged_by == 0) info = static_limit
+    call solver_destroy(handle, destroy_info)
+
+  contains
+
+    !> internal (with the tangent on request), loads, constraints and reaction at e
+    subroutine evaluate(with_tangent)
+      logical, intent(in) :: with_tangent
+      real(dp) :: strain, potential, powers(2), records(contact_record, max(1, sys%npoint))
+      real(dp) :: zero_rates(size(e)), phi_t(ncon), phi_tt(ncon), gamma(ncon)
+      zero_rates = 0.0_dp
+      if (with_tangent) then
+        call internal_forces(sys, rotations, e, zero_rates, load_factor, 0.0_dp, state, &
+                             internal, strain, potential, powers, records, info, rotations, &
+                             tangent, rates, t=t, force_time=t)
+      else
+        call internal_forces(sys, rotations, e, zero_rates, load_factor, 0.0_dp, state, &
+                             internal, strain, potential, powers, records, info, rates=rates, &
+                             force_time=t)
+      end if
+      if (info /= 0) return
+      call external_forces(sys, t, load_factor, loads, info, e)
+      if (info /= 0) return
+      if (ncon > 0) then
+        call constraint_eval(ncon, sys%con_kind, sys%con_drive, sys%con_params, &
+                             sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
+                             sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, zero_rates, t, &
+                             phi, gradients, hessians, phi_t, phi_tt, gamma, info, &
+                             first_order_only=.not. with_tangent)
+        if (info /= 0) then
+          info = 5
+          return
+        end if
+      end if
+      reaction = 0.0_dp
+      call constraint_reaction(sys, gradients, lam, reaction)
+      reaction = -reaction
+    end subroutine evaluate
+
+    !> eps || |K| |e| || / scale (static.py residual_floor)
+    real(dp) function residual_floor(scale) result(level)
+      real(dp), intent(in) :: scale
+      real(dp) :: magnitude(size(e))
+      integer :: p
+      magnitude = 0.0_dp
+      do p = 1, nnz
+        magnitude(rows(p)) = magnitude(rows(p)) + abs(tangent(p)) * abs(e(cols(p)))
+      end do
+      level = epsilon(1.0_dp) * norm2(magnitude) / max(scale, 1.0e-300_dp)
+    end function residual_floor
+
+    !> static.py converged: 0 while iterating, else by_residual .. by_floor
+    integer function converged(force, violation, step, size_d, before, level) result(how)
+      real(dp), intent(in) :: force, violation, step, size_d, before, level
+      how = 0
+      if (violation > tol) return
+      if (force <= tol) then
+        how = by_residual
+      else if (force <= level .and. step <= sqrt(tol) * size_d) then
+        how = by_roundoff
+      else if (force <= sqrt(tol)) then
+        if (step <= tol * size_d) then
+          how = by_step
+        else if (force >= 0.5_dp * before) then
+          how = by_floor
+        end if
+      end if
+    end function converged
+
+    !> max |x| (0 for an empty x)
+    pure real(dp) function max_abs(x)
+      real(dp), intent(in) :: x(:)
+      max_abs = 0.0_dp
+      if (size(x) > 0) max_abs = maxval(abs(x))
+    end function max_abs
+
+    !> the last (up to) three residuals each larger than the one before
+    pure logical function rising(h)
+      real(dp), intent(in) :: h(:)
+      integer :: p
+      rising = .true.
+      do p = max(2, size(h) - 2), size(h)
+        rising = rising .and. h(p) > h(p - 1)
+      end do
+    end function rising
+
+    !> the number of terms and the first term of slot s of constraint c
+    integer function slot_terms(c, s)
+      integer, intent(in) :: c, s
+      slot_terms = sys%term_ptr(6 * (c - 1) + s + 1) - sys%term_ptr(6 * (c - 1) + s)
+    end function slot_terms
+
+    integer function first_term(c, s)
+      integer, intent(in) :: c, s
+      first_term = sys%term_ptr(6 * (c - 1) + s)
+    end function first_term
+
+    !> the coordinates e the full coordinate q(i) depends on (q = B e + q0), their number,
+    !> the a-th of them and its coefficient
+    integer function row_terms(i)
+      integer, intent(in) :: i
+      row_terms = 1
+      if (sys%reduced) row_terms = sys%reduction_ptr(i + 1) - sys%reduction_ptr(i)
+    end function row_terms
+
+    integer function reduced_col(i, a)
+      integer, intent(in) :: i, a
+      reduced_col = i
+      if (sys%reduced) reduced_col = sys%reduction_col(sys%reduction_ptr(i) + a - 1)
+    end function reduced_col
+
+    real(dp) function reduced_coef(i, a)
+      integer, intent(in) :: i, a
+      reduced_coef = 1.0_dp
+      if (sys%reduced) reduced_coef = sys%reduction_values(sys%reduction_ptr(i) + a - 1)
+    end function reduced_coef
+
+    !> the full coordinates q(dofs) at e
+    function full_at(dofs) result(q)
+      integer, intent(in) :: dofs(:)
+      real(dp) :: q(size(dofs))
+      integer :: p, a2
+      do p = 1, size(dofs)
+        if (.not. sys%reduced) then
+          q(p) = e(dofs(p))
+        else
+          q(p) = sys%reduction_offset(dofs(p))
+          do a2 = 1, row_terms(dofs(p))
+            q(p) = q(p) + reduced_coef(dofs(p), a2) * e(reduced_col(dofs(p), a2))
+          end do
+        end if
+      end do
+    end function full_at
+
+  end subroutine static_newton
+
+  !> The text of a failure of static_newton (info, detail) at load step load_step of
+  !> load_steps, with the smallest and last residuals and the iteration limit.
+  pure function static_failure_text(info, detail, load_step, load_steps, max_iter, smallest, &
+                                    last, con_res, tol) result(text)
+    integer, intent(in) :: info, detail, load_step, load_steps, max_iter
+    real(dp), intent(in) :: smallest, last, con_res, tol
+    character(len=message_length) :: text
+    character(len=40) :: where
+    write (where, '(a, i0, a, i0)') 'at load step ', load_step, ' of ', load_steps
+    select case (info)
+    case (static_limit)
+      write (text, '(a, i0, 7a)') 'static Newton did not converge in ', max_iter, &
+        ' iterations ', trim(where), ' (relative residual ', sci(last), ', constraint ', &
+        sci(con_res), '); raise solver.load_steps or max_iter'
+    case (static_diverged)
+      text = 'static Newton diverged ' // trim(where) // ': the relative residual grew ' // &
+             'three times in a row to ' // sci(last) // ' (smallest ' // sci(smallest) // &
+             '); raise solver.load_steps'
+    case (static_floor_stall)
+      text = 'static Newton stalled at the round-off floor ' // trim(where) // &
+             ': the relative residual stays at ' // sci(smallest) // ' above solver.tol = ' // &
+             sci(tol) // ', more digits than double precision carries here; raise solver.tol'
+    case (static_stall)
+      text = 'static Newton stalled ' // trim(where) // ': no smaller residual in the last ' // &
+             'iterations (smallest ' // sci(smallest) // ', tolerance ' // sci(tol) // &
+             '); raise solver.load_steps'
+    case (static_nonfinite)
+      text = 'static Newton: non-finite step ' // trim(where)
+    case (static_solve_failed)
+      write (text, '(3a, i0, a)') 'static Newton: the saddle-point solve failed ', &
+        trim(where), ' (solver code ', detail, ': -10 = singular matrix)'
+    case default
+      text = 'static Newton ' // trim(where) // ': ' // trim(failure_text(info))
+    end select
+
+  contains
+
+    !> x as Python's '{:.3e}' writes it
+    pure function sci(x) result(out)
+      real(dp), intent(in) :: x
+      character(len=:), allocatable :: out
+      character(len=16) :: buffer
+      integer :: p
+      write (buffer, '(es12.3)') x
+      buffer = adjustl(buffer)
+      p = index(buffer, 'E')
+      if (p > 0) buffer(p:p) = 'e'
+      out = trim(buffer)
+    end function sci
+
+  end function static_failure_text
+
+end module static_solver
