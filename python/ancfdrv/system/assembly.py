@@ -584,7 +584,8 @@ def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
     and every dead moment on a rigid body (its components on the body's current
     orthonormal directors give exactly the fixed moment at any rotation; the director
     potential of :func:`_moments` drops the component along the director it measures and
-    scales the rest when that director leaves the plane normal to the axis). Each acts through the two directions a, b of the body at its point (beam: r_y, r_z;
+    scales the rest when that director leaves the plane normal to the axis). Each acts
+    through the two directions a, b of the body at its point (beam: r_y, r_z;
     plate, leaf, rigid body: r_x, r_y; interpolated between nodes) and its position p; a
     follower's vector is kept as its components on (a, b, a x b) at t = 0."""
     out = []
