@@ -181,3 +181,46 @@ def test_rigid_body_dead_moment_tangent_and_exerted_moment():
         assert np.abs(jac - numeric).max() < 1e-8 * np.abs(jac).max()
     finally:
         model.close()
+
+
+def test_modal_stiffness_carries_the_rigid_body_moment_load_stiffness():
+    """Modal analysis linearizes about the static state with the dead moment's exact load
+    stiffness (kernel vector_loads): a rigid body on a bushing (400 N m/rad about each axis)
+    turned 0.125 rad by M = (30, 0, 40) N m. The stiffness modal.linearize returns equals
+    the central differences of the residual internal - external - Phi_e^T lambda there (the
+    rigid body's own constraints, lambda held), symmetrized (the load stiffness is
+    unsymmetric; the modal problem takes its symmetric part); without the moment's load
+    stiffness the two differ by the order of M."""
+    import scipy.sparse as sp
+
+    from ancfdrv.solvers.modal import linearize
+    s = System("mounted")
+    s.rigid_body("body", mass=2.0, inertia=(1.0, 1.0, 1.0, 0, 0, 0), position=(0, 0, 0))
+    s.force_element("mount", "bushing", "ground", "body", point=(0, 0, 0),
+                    stiffness=[1e6, 1e6, 1e6], rotational_stiffness=[400.0, 400.0, 400.0])
+    s.load("m", "moment", body="body", point=(0, 0, 0), vector=(30.0, 0.0, 40.0))
+    model = s.assemble()
+    try:
+        static = solve_newton(model)
+        e, lam, n = static.e, static.lam, model.ndof
+        stiffness = linearize(model, e, lam).stiffness.toarray()
+
+        def residual(x):
+            out = model.forces(x, 0.0)
+            _, rows, cols, grads = model.constraints.jacobian(x, n, 0.0)
+            g = sp.csr_matrix((grads, (rows, cols)), shape=(len(model.constraints), n))
+            return out["internal"] - out["external"] - g.T @ lam
+        numeric = np.zeros((n, n))
+        h = 1e-7
+        for j in range(n):
+            plus, minus = e.copy(), e.copy()
+            plus[j] += h
+            minus[j] -= h
+            numeric[:, j] = (residual(plus) - residual(minus)) / (2 * h)
+        numeric = 0.5 * (numeric + numeric.T)
+        assert np.abs(residual(e)).max() < 1e-6
+        (cols, _, jac), = model.vector_load_terms(e)
+        assert np.abs(jac).max() > 10.0     # the load stiffness is of the order of M
+        assert np.abs(stiffness - numeric).max() < 1e-4 * np.abs(jac).max()
+    finally:
+        model.close()
