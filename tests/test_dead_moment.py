@@ -224,3 +224,19 @@ def test_modal_stiffness_carries_the_rigid_body_moment_load_stiffness():
         assert np.abs(stiffness - numeric).max() < 1e-4 * np.abs(jac).max()
     finally:
         model.close()
+
+
+def test_static_rigid_body_moment_runs_with_the_python_default():
+    """System.static() with its default method picks Newton for a rigid body's moment (the
+    split iteration takes no configuration-dependent load) and turns a body on a bushing
+    (k_r = 400 N m/rad about z; its measure theta = sin(phi), potential k_r theta^2 / 2)
+    until k_r sin(phi) cos(phi) = M: phi = asin(2 M / k_r) / 2 for M = 40 N m."""
+    s = System("turned")
+    s.rigid_body("body", mass=2.0, inertia=(1.0, 1.0, 1.0, 0, 0, 0), position=(0, 0, 0))
+    s.force_element("mount", "bushing", "ground", "body", point=(0, 0, 0),
+                    stiffness=[1e6, 1e6, 1e6], rotational_stiffness=[400.0, 400.0, 400.0])
+    s.load("m", "moment", body="body", point=(0, 0, 0), vector=(0.0, 0.0, 40.0))
+    s.probe("x", "body", (1.0, 0.0, 0.0))
+    res = s.static()
+    x = np.asarray(res.probes["x"]).ravel()
+    assert np.arctan2(x[1], x[0]) == pytest.approx(0.5 * np.arcsin(2 * 40.0 / 400.0), rel=1e-9)
