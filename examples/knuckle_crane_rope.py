@@ -8,9 +8,17 @@ The model (planar layout in the x-y plane, gravity along -y; steel box girders):
   and held by the main cylinder, a 'distance' joint of constant length between a ground
   lug and the boom (s = 1.5 m);
 * the jib (3 m at -10 deg, box 200 x 250 x 8 mm) is hinged to the boom tip (the knuckle)
-  and lifted by the jib cylinder, a 'distance' joint whose length follows a 'luffing'
-  drive (boom s = 2.5 m to jib s = 0.75 m: a rigid, massless cylinder until the compliant
-  one is merged);
+  and lifted by the jib cylinder (boom s = 2.5 m to jib s = 0.75 m), a compliant 'cylinder'
+  force element: a rigid actuator whose length l(t) follows a 'luffing' drive, in series
+  with its oil column, f = k (L - l) + c (L' - l'). The column's stiffness is
+  k = A^2 K / V = A K / l_oil for the bore's area A (80 mm: A = 5.03e-3 m^2), the oil's
+  bulk modulus K = 1.5e9 Pa (mineral oil without air; hoses and entrained air make a real
+  column softer) and an oil column of l_oil = 0.8 m (the piston side at this extension plus
+  the dead volume up to the holding valve): k = 9.42e6 N/m. Its damping c = 8e4 N s/m is a
+  viscous stand-in for the valve and seal losses, sized for about 5 % of critical for the
+  payload's bounce on the column (2.4 Hz: the payload and jib turning about the knuckle on
+  k a^2, a = 0.42 m the cylinder's lever arm; the measured decay of the cylinder's force
+  gives the ratio, see the table);
 * the rope: an ANCF cable with ``tension_only=True`` (a rope: it goes slack instead of
   carrying compression), 2.5 m of 16 mm wire rope (E = 100 GPa and 5000 kg/m^3 on the
   circle's area, bending stiffness 5 N m^2), 5 elements, hung from the jib tip by a
@@ -21,12 +29,16 @@ What it computes and prints:
 
 1. statics: the rope's tension at the top (the 'rope top' joint's reaction) against the
    weight it carries, m g + rho A g L, and the hook's depth below the jib tip against the
-   rope's length stretched by that load;
+   rope's length stretched by that load; the jib cylinder's force (its ``axial``, negative:
+   it pushes) against the moment balance of the jib about the knuckle (its weight and the
+   rope's pull against the cylinder, a rigid jib turned to the static state's chord), and
+   the oil column's compression l - L against |f| / k;
 2. the lift: from the static equilibrium the jib cylinder extends by 0.05 m (a cosine start
    and stop of 0.3 s each, 0.1 m/s between) and holds; the payload swings. It tabulates
-   the swing amplitude and period (against the pendulum 2 pi sqrt(L / g) corrected for the
-   rope's mass), the rope's tension range over all its Gauss points and steps, whether it
-   went slack, and the step counts; it plots the swing, the tension and the paths
+   the swing amplitude and period (a least-squares sinusoid, against the pendulum
+   2 pi sqrt(L / g) corrected for the rope's mass), the jib cylinder's force range, the
+   rope's tension range over all its Gauss points and steps, whether it went slack, and the
+   step counts; it plots the swing, the tension and the paths
    (``knuckle_crane_rope.png``).
 
 Files in results/examples/: knuckle_crane_rope.{md,csv,png,h5}.
@@ -78,6 +90,16 @@ class KnuckleCrane:
     stroke: float = 0.05              # the jib cylinder's extension [m]
     stroke_rate: float = 0.1          # m/s
     stroke_ramp: float = 0.3          # s, the cosine start and stop each
+    bore: float = 0.080               # the jib cylinder's bore [m]
+    oil_bulk_modulus: float = 1.5e9   # Pa, mineral oil
+    oil_column: float = 0.8           # m, the oil column's length (piston side + dead volume)
+    oil_damping: float = 8e4          # N s/m: ~5 % of critical for the payload's bounce
+
+    @property
+    def oil_stiffness(self) -> float:
+        """k = A^2 K / V with V = A l_oil: the oil column's axial stiffness, N/m."""
+        area = np.pi * self.bore**2 / 4.0
+        return area * self.oil_bulk_modulus / self.oil_column
 
     def points(self) -> dict[str, np.ndarray]:
         """Pivot O, knuckle B, the lugs, the jib tip T and the hook H at t = 0."""
@@ -120,15 +142,18 @@ def build(p: KnuckleCrane, rope_nodes: int = 6) -> System:
     s.joint("column pin", "revolute", "ground", "boom", point=pts["O"], axis=(0, 0, 1))
     s.joint("main cylinder", "distance", "ground", "boom", point1=pts["G"], point2=pts["P1"])
     s.joint("knuckle", "revolute", "boom", "jib", point=pts["B"], axis=(0, 0, 1))
-    # cylinder: swap to the compliant cylinder force element (&force_element
-    # type='cylinder') when merged
-    s.joint("jib cylinder", "distance", "boom", "jib", point1=pts["P"], point2=pts["Q"],
-            drive="jib stroke")
+    # the jib cylinder: its drive's length in series with the compliant oil column
+    s.force_element("jib cylinder", "cylinder", "boom", "jib", point1=pts["P"],
+                    point2=pts["Q"], drive="jib stroke", stiffness=p.oil_stiffness,
+                    damping=p.oil_damping)
     s.joint("rope top", "spherical", "jib", "rope", point=pts["T"])
     s.load("g", "gravity", vector=(0.0, -GRAVITY, 0.0))
     s.load("payload", "point_mass", body="rope", point=pts["H"], mass=p.payload)
     s.probe("jib tip", "jib", pts["T"])
     s.probe("hook", "rope", pts["H"])
+    s.probe("knuckle", "jib", pts["B"])
+    s.probe("jib lug", "jib", pts["Q"])
+    s.probe("boom lug", "boom", pts["P"])
     return s
 
 
@@ -140,6 +165,11 @@ class Run:
     weight: float                  # m g + rho A g L, N
     depth_static: float            # hook below the jib tip, m
     depth_expected: float          # L (1 + (m g + rho A g L / 2) / EA), m
+    cylinder_static: float         # the jib cylinder's axial force (tension +), N
+    cylinder_balance: float        # the same from the jib's moment balance about the knuckle
+    compression_static: float      # the oil column's l - L, m
+    compression_expected: float    # |f| / k, m
+    cylinder_range: tuple          # least and largest axial force in the run, N
     time: np.ndarray
     swing: np.ndarray              # the rope chord's angle from the vertical, rad
     tension: np.ndarray            # (nt, 2): least and largest axial force over the rope
@@ -153,6 +183,36 @@ class Run:
     factorizations: int
     stop: float                    # the cylinder stops [s]
     files: list[Path]
+
+
+def _jib_balance(p: KnuckleCrane, stat, rope_top: np.ndarray) -> float:
+    """The jib cylinder's axial force (tension positive) from the jib's moment balance about
+    the knuckle B in the static state, the jib taken rigid and turned from its t = 0 line to
+    the chord from B to its tip: its weight at the middle, the rope's pull at the tip (minus
+    what the jib exerts on the rope) and the cylinder's force along the lug line Q - P."""
+    b, tip = (np.asarray(stat.probes[k]) for k in ("knuckle", "jib tip"))
+    q, lug = (np.asarray(stat.probes[k]) for k in ("jib lug", "boom lug"))
+    jib_mass = 7850.0 * p.jib_section.data.area * p.jib_length
+    middle = b + 0.5 * (tip - b)        # the rigid jib's centre of mass
+    weight = np.array([0.0, -jib_mass * GRAVITY, 0.0])
+    n = (q - lug) / np.linalg.norm(q - lug)
+
+    def moment(arm: np.ndarray, force: np.ndarray) -> float:
+        return float(arm[0] * force[1] - arm[1] * force[0])
+    # tension f pulls the jib lug towards the boom lug: force -f n on the jib
+    return (moment(middle - b, weight) + moment(tip - b, -rope_top)) / moment(q - b, n)
+
+
+def _fitted_period(t: np.ndarray, x: np.ndarray, start: float) -> float:
+    """The period of the sinusoid a sin(w t) + b cos(w t) + c nearest x (least squares)."""
+    from scipy.optimize import curve_fit
+
+    def sine(tt, a, b, w, c):
+        return a * np.sin(w * tt) + b * np.cos(w * tt) + c
+    w0 = 2.0 * np.pi / start
+    amplitude = 0.5 * float(np.ptp(x))
+    fit, _ = curve_fit(sine, t, x, p0=[amplitude * np.sin(0.0), amplitude, w0, float(x.mean())])
+    return float(2.0 * np.pi / abs(fit[2]))
 
 
 def _crossings(t: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -177,6 +237,13 @@ def run(quick: bool, out: Path) -> Run:
     ea = p.rope_modulus * p.rope_area
     depth = float(stat.probes["jib tip"][1] - stat.probes["hook"][1])
     expected = p.rope_length * (1.0 + (p.payload + p.rope_mass / 2.0) * GRAVITY / ea)
+    cylinder = float(np.asarray(stat.reactions["jib cylinder"]["axial"]))
+    balance = _jib_balance(p, stat, top)
+    pts = p.points()
+    stroke0 = float(np.linalg.norm(pts["Q"] - pts["P"]))   # l(0): the drive's start
+    length = float(np.linalg.norm(np.asarray(stat.probes["jib lug"])
+                                  - np.asarray(stat.probes["boom lug"])))
+    axial_t = np.asarray(res.dynamic.reactions["jib cylinder"]["axial"]).ravel()
 
     t = res.time
     chord = res.probes["hook"] - res.probes["jib tip"]
@@ -185,15 +252,21 @@ def run(quick: bool, out: Path) -> Run:
     tension = np.stack([forces.min(axis=1), forces.max(axis=1)], axis=1)
     stop = p.stroke / p.stroke_rate + p.stroke_ramp
     after = t > stop
-    # the swing about its mean after the stop; the period from its mean crossings
+    # the swing about its mean after the stop; the period from a least-squares sinusoid
+    # (started from the mean crossings): the payload's bounce on the oil column (2.4 Hz,
+    # decaying) rides on the swing and shifts single crossings, not the fitted period
     centred = swing[after] - 0.5 * (swing[after].max() + swing[after].min())
     crossings = _crossings(t[after], centred)
     period = float(2.0 * np.mean(np.diff(crossings))) if len(crossings) > 1 else np.nan
+    if np.isfinite(period):
+        period = _fitted_period(t[after], swing[after], period)
     # pendulum of the stretched rope with its own mass (a straight rope: m_r L^2 / 3)
     mu = p.rope_mass / p.payload
     pendulum = 2.0 * np.pi * np.sqrt(expected / GRAVITY * (1 + mu / 3) / (1 + mu / 2))
     attrs = res.dynamic.attrs
-    run_ = Run(float(top[1]), weight, depth, expected, t, swing, tension,
+    run_ = Run(float(top[1]), weight, depth, expected, cylinder, balance,
+               stroke0 - length, abs(cylinder) / p.oil_stiffness,
+               (float(axial_t.min()), float(axial_t.max())), t, swing, tension,
                float(0.5 * np.ptp(swing[after])), period, float(pendulum),
                int(np.sum(forces.min(axis=1) == 0.0)), int(np.sum(forces.max(axis=1) == 0.0)),
                int(attrs["steps"]), int(attrs["newton_iterations"]),
@@ -201,6 +274,12 @@ def run(quick: bool, out: Path) -> Run:
     rows = [
         ["rope tension at the top, static [N]", run_.top_tension_static, weight],
         ["hook below the jib tip, static [m]", depth, expected],
+        ["jib cylinder's force, static [N] (moment balance about the knuckle)", cylinder,
+         balance],
+        ["oil column's compression l - L, static [mm] (|f| / k)", 1e3 * (stroke0 - length),
+         1e3 * abs(cylinder) / p.oil_stiffness],
+        ["jib cylinder's force, least and largest in the run [kN]",
+         f"{axial_t.min() / 1e3:.2f} / {axial_t.max() / 1e3:.2f}", ""],
         ["swing amplitude after the stop [deg]", np.degrees(run_.swing_amplitude), np.nan],
         ["swing period [s]", period, pendulum],
         ["rope tension, least over the rope and run [N]", tension[:, 0].min(), np.nan],
@@ -213,7 +292,10 @@ def run(quick: bool, out: Path) -> Run:
     print(write_table(out / "knuckle_crane_rope", ["quantity", "model", "reference"], rows,
                       "Knuckle crane with a hoist rope",
                       "References: the weight m g + rho A g L; the rope stretched by its "
-                      "mean load (linear); the pendulum 2 pi sqrt(L / g) with the rope's "
+                      "mean load (linear); the cylinder's force from the jib's moment "
+                      "balance about the knuckle (rigid jib on the static chord), the oil "
+                      f"column's compression |f| / k (k = A K / l_oil = "
+                      f"{p.oil_stiffness:.3g} N/m); the pendulum 2 pi sqrt(L / g) with the rope's "
                       "mass (a straight rope). The tension is T = EA max(eps, 0) |r'| at the "
                       "rope's Gauss points."))
     plot(p, run_, res, out / "knuckle_crane_rope.png")

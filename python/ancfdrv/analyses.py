@@ -105,9 +105,10 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
     model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
                             linear_joints=solver["linear_joints"], supports=True)
     if "static_method" not in options and (any(s.kind != "ffr" for s in model.sets)
-                                           or model.contact_pairs):
-        # the CLI's default 'split' needs every body 'ffr' and no contact: where it cannot
-        # run (it would fail with that message), Newton is the only static method
+                                           or model.contact_pairs or model.vector_loads):
+        # the CLI's default 'split' needs every body 'ffr', no contact and dead loads only
+        # (no driven or follower load, no rigid body's moment): where it cannot run (it
+        # would fail with that message), Newton is the only static method
         solver["static_method"] = "newton"
     try:
         formulations = sorted({getattr(b, "formulation", "") for b in system.bodies.values()

@@ -981,11 +981,20 @@ contains
     powers(power_drive) = dot_product(lam, gradient_dot(sys, gradients, v))
     allocate (e_full(sys%nfull))
     call to_full(sys, e, .true., e_full)
-    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0) then
+    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0 .or. sys%nvload > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys, v, .false., v_full)
     end if
     strain = 0.0_dp
+    if (sys%nvload > 0) then  ! the driven and follower point loads and a rigid body's dead
+      ! moments have no potential: their power Q . q' is a work (of the drives)
+      allocate (unused(sys%nfull))
+      unused = 0.0_dp
+      call vector_load_forces(sys, t, e_full, 1.0_dp, unused, info)
+      if (info /= 0) return
+      powers(power_drive) = powers(power_drive) + dot_product(unused, v_full)
+      deallocate (unused)
+    end if
     if (sys%nfel > 0) then  ! potential, dissipation (a lost work) and the cylinders' drives
       allocate (unused(sys%nfull))
       unused = 0.0_dp

@@ -90,13 +90,19 @@ class ModalResult:
 def linearize(model: Model, e: np.ndarray, lam: np.ndarray, t: float = 0.0,
               load_factor: float | None = None) -> Linearization:
     """K, M, C and G at the state (e, lambda); K is the static Newton matrix's block
-    (elastic and contact tangent, minus the dead moments' Jacobians, minus the constraint
-    Hessians times the multipliers)."""
+    (elastic and contact tangent, minus the dead moments' and point loads' Jacobians, minus
+    the constraint Hessians times the multipliers)."""
     n = model.ndof
     out = model.forces(e, t, want_tangent=True, load_factor=load_factor)
     k = model.pattern.to_scipy(out["tangent"]).tocoo()
     rows, cols, vals = [k.row], [k.col], [k.data]
     for dofs, _, jac, _ in model.moment_terms(e, load_factor=load_factor):
+        rows.append(np.repeat(dofs, len(dofs)))
+        cols.append(np.tile(dofs, len(dofs)))
+        vals.append(-np.asarray(jac).ravel())
+    # the driven and follower point loads and a rigid body's dead moments (vector_loads):
+    # their exact, unsymmetric load stiffness
+    for dofs, _, jac in model.vector_load_terms(e, t, load_factor=load_factor):
         rows.append(np.repeat(dofs, len(dofs)))
         cols.append(np.tile(dofs, len(dofs)))
         vals.append(-np.asarray(jac).ravel())

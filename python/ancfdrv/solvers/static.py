@@ -414,8 +414,9 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
                           "formulation; beam.geometric_stiffness makes it depend on the axial "
                           "force: use solver.static_method = 'newton'")
     if model.vector_loads:
-        raise SolverError("the split iteration takes dead loads only; driven moments and "
-                          "follower loads need solver.static_method = 'newton'")
+        raise SolverError("the split iteration takes dead loads only; driven moments, "
+                          "follower loads and a rigid body's moments need "
+                          "solver.static_method = 'newton'")
     if model.force_elements:
         raise SolverError("the split iteration needs a constant stiffness; force elements "
                           "(spring-dampers, bushings, cylinders) need solver.static_method = "

@@ -500,7 +500,8 @@ def _add_point_vector(target: np.ndarray, body: Body, point, vector, name: str) 
 def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list[MomentInfo]:
     """A dead moment acts on the nodal directors that measure the rotation about its axis.
 
-    A rigid body: the director least parallel to the axis. A beam or plate section with
+    A rigid body's dead moments do not come here (:func:`_vector_loads`: exact at any
+    rotation). A beam or plate section with
     the two directors d1, d2 (beam r_y, r_z; plate r_x, r_y) and the normal n = d1 x d2 at
     t = 0: the moment's components about d1 and d2 act on d2 and d1, its component about n
     on both, in the shares that turn the section without shearing it (Beam.torsion_shares;
@@ -543,14 +544,8 @@ def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
               for which in body.directors(at)}
     if not firsts and hasattr(body, "node_first"):  # a cable: no section, the slope turns
         firsts = {"r_x": _slope_for_moment(body, at, load, axis, q0)}
-    if isinstance(body, RigidBody) or len(firsts) == 1:
-        best = None
-        for which, first in firsts.items():
-            d = q0[first:first + 3]
-            score = np.linalg.norm(np.cross(d, axis)) / np.linalg.norm(d)
-            if best is None or score > best[0] + 1e-12:
-                best = (score, first)
-        parts = [(best[1], axis, magnitude)]
+    if len(firsts) == 1:  # a cable's slope (normal to the axis: _slope_for_moment)
+        parts = [(next(iter(firsts.values())), axis, magnitude)]
     else:
         f1, f2 = firsts.values()
         u1 = q0[f1:f1 + 3] / np.linalg.norm(q0[f1:f1 + 3])
@@ -585,15 +580,21 @@ def _slope_for_moment(body: Body, at, load, axis: np.ndarray, q0: np.ndarray) ->
 def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
                   counters: Counter) -> list[VectorLoadInfo]:
     """The driven and follower point loads (kernel module vector_loads), taken out of the
-    dead forces and moments: a follower force, a moment with a drive or a follower moment.
-    Each acts through the two directions a, b of the body at its point (beam: r_y, r_z;
+    dead forces and moments: a follower force, a moment with a drive or a follower moment,
+    and every dead moment on a rigid body (its components on the body's current
+    orthonormal directors give exactly the fixed moment at any rotation; the director
+    potential of :func:`_moments` drops the component along the director it measures and
+    scales the rest when that director leaves the plane normal to the axis). Each acts
+    through the two directions a, b of the body at its point (beam: r_y, r_z;
     plate, leaf, rigid body: r_x, r_y; interpolated between nodes) and its position p; a
     follower's vector is kept as its components on (a, b, a x b) at t = 0."""
     out = []
-    chosen = [x for x in act.forces if x.follower] + \
-        [x for x in act.moments if x.follower or x.drive is not None]
+    def vector(x) -> bool:
+        return x.follower or x.drive is not None or isinstance(x.body, RigidBody)
+
+    chosen = [x for x in act.forces if x.follower] + [x for x in act.moments if vector(x)]
     act.forces[:] = [x for x in act.forces if not x.follower]
-    act.moments[:] = [x for x in act.moments if not (x.follower or x.drive is not None)]
+    act.moments[:] = [x for x in act.moments if not vector(x)]
     for load in chosen:
         body = load.body
         at = body.locate(load.point, node=False, what=f"load {load.name!r}")
