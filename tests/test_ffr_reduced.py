@@ -82,3 +82,76 @@ def test_kernel_stepper_matches_the_python_steps(extra):
     fast = simulate(reduced, 3.0, 1e-3, tol=1e-12)
     slow = simulate(reduced, 3.0, 1e-3, tol=1e-12, engine="python")
     assert np.max(np.abs(fast["tip"] - slow["tip"])) < 1e-11
+
+
+# -- the scene path: &beam modes = N (runner, System.simulate; issue 23 items 2 and 5) ------
+def scene_run(tmp_path, name: str, *extra: str) -> h5py.File:
+    out = tmp_path / f"{name}.h5"
+    run_scene(BOOM, [*BASE, *extra], out, progress=False)
+    return h5py.File(out)
+
+
+def test_scene_path_equals_the_prototype(tmp_path):
+    # the file of `ancf run --set beam.modes=3` against ffr_reduced.simulate of the same
+    # model and static state (the runner's static solve, repeated): the expansion to the
+    # full coordinates and the kernel's output row give back the reduced deflection
+    from ancfdrv.solvers.static import solve_static
+    scene = load_scene(BOOM, [*BASE, "beam.modes=3"])
+    model = build_model(scene)
+    solver = scene["solver"]
+    static = solve_static(model, solver["static_method"], tol=solver["tol"],
+                          max_iter=solver["max_iter"], p=solver["split_p"],
+                          load_steps=solver["load_steps"])
+    ref = simulate(reduce_ffr(model, static, 3), 3.0, 1e-3, tol=solver["newton_tol"])
+    with scene_run(tmp_path, "reduced", "beam.modes=3") as h5:
+        dyn = h5["dynamic"]
+        assert dyn.attrs["reduction"] == "modal" and dyn.attrs["modes"] == 3
+        assert "lambda" in dyn.attrs["not_provided"]
+        assert np.all(np.isnan(dyn["lambda"][()]))
+        assert np.allclose(dyn["time"][()], ref["time"])
+        assert np.max(np.abs(dyn["deflection/tip"][()] - ref["tip"])) < 1e-12
+        # the expanded state keeps the constraints to the linearization's order (m)
+        assert np.max(dyn["constraint_violation"][()]) < 1e-6
+        # kinetic energy starts at 0 (at rest) and is positive while luffing
+        kinetic = dyn["energy/kinetic"][()]
+        assert kinetic[0] == pytest.approx(0.0, abs=1e-12) and kinetic.max() > 0
+        assert h5.attrs["status"] == "ok"
+        assert h5["counters"].attrs["reduced_coordinates"] == dyn.attrs["reduced_coordinates"]
+
+
+def test_scene_path_converges_to_the_full_ffr_run(tmp_path):
+    # m = 50 kg, 10 nodes, 3 s: error of the reduced run's tip sag (from the file) against the
+    # full FFR run's, as a fraction of its sag range; falls with the modes (the morning's
+    # prototype: 2.7e-4 at 1 mode, 3.8e-6 at 4 modes on this case)
+    with scene_run(tmp_path, "full") as h5:
+        full = h5["dynamic/deflection/tip"][()][:, 1]
+    errors = []
+    for modes in (1, 2, 4):
+        with scene_run(tmp_path, f"m{modes}", f"beam.modes={modes}") as h5:
+            sag = h5["dynamic/deflection/tip"][()][:, 1]
+        errors.append(np.max(np.abs(sag - full)) / np.ptp(full))
+    print("\nerrors (fraction of the sag range), modes 1, 2, 4:", errors)
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[0] < 1e-3 and errors[2] < 1e-5
+
+
+def test_refused_models_name_the_beam(tmp_path):
+    from ancfdrv.errors import InputError
+    with pytest.raises(InputError, match="beam 'boom': modes = 2: reduce_ffr: every element "
+                       "set must be 'ffr'"):
+        run_scene(BOOM, [*BASE, "beam.modes=2", "scene.formulation=nonlinear"],
+                  tmp_path / "a.h5", progress=False)
+    with pytest.raises(InputError, match="beam 'boom': modes = 2: .*static\\+dynamic"):
+        run_scene(BOOM, [*BASE, "beam.modes=2", "scene.analysis=dynamic"],
+                  tmp_path / "b.h5", progress=False)
+    with pytest.raises(InputError, match="beam 'boom': modes = 2: .*Newmark"):
+        run_scene(BOOM, [*BASE, "beam.modes=2", "solver.integrator=generalized_alpha"],
+                  tmp_path / "c.h5", progress=False)
+    assert not (tmp_path / "a.h5").exists()
+
+
+def test_modes_zero_is_the_full_run_bitwise(tmp_path):
+    # modes = 0 (the default) must leave the full run untouched
+    with scene_run(tmp_path, "default") as a, scene_run(tmp_path, "zero", "beam.modes=0") as b:
+        assert np.array_equal(a["dynamic/deflection/tip"][()], b["dynamic/deflection/tip"][()])
+        assert "reduction" not in b["dynamic"].attrs

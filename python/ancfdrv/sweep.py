@@ -35,7 +35,7 @@ from tqdm import tqdm
 from .errors import InputError
 from .results.lock import OutputLock
 from .io.safe_write import replace_atomically, write_bytes, write_text
-from .sweep_keys import is_resolution, resolution_sense, static_value
+from .sweep_keys import is_resolution, resolution_rank, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
 from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
                          remove_quietly, response_of, run_dask, run_inline, run_processes,
@@ -276,8 +276,7 @@ def _reference_groups(rows: list[dict], varied: list[str]):
         groups.setdefault(tuple(row[k] for k in others), []).append(row)
 
     def rank(row: dict) -> tuple:
-        return tuple((-1 if resolution_sense(k) is max else 1) * float(row[k])
-                     for k in resolution)
+        return tuple(resolution_rank(k, row[k]) for k in resolution)
     for members in groups.values():
         ok = [r for r in members if r["status"] == "ok"]
         if not ok:
