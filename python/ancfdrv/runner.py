@@ -246,14 +246,14 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
     settings = dynamic_settings(scene)
     xdmf = scene["output"].get("xdmf", True)
     write_q = settings.store_q
-    settings.store_q = True  # the expanded coordinates are in every chunk
+    settings.store_q = bool(xdmf or write_q)  # the chunks carry the expanded coordinates
     try:
         with stop.immediate():
             reduced = reduce_ffr(model, static, beam.modes)
     except SolverError as exc:  # e.g. more modes than the constrained model has
         raise _reduction_error(scene, beam, str(exc)) from None
     writer = results.DynamicWriter(
-        out, model, True, settings.chunk_steps, xdmf=xdmf,
+        out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
         frames=scene["output"]["xdmf_frames"], write_q=write_q)
     attrs: dict[str, Any] = {

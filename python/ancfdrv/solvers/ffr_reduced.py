@@ -324,10 +324,12 @@ def check_scope(model: Model, static: StaticResult) -> None:
 def _turn(vectors: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Rot(axis, angle[i]) applied to every 3-vector of row i of vectors (nt, n)."""
     y = vectors.reshape(len(vectors), -1, 3)
-    wy = np.cross(axis, y)
-    wwy = np.cross(axis, wy)
-    return (y + np.sin(angle)[:, None, None] * wy
-            + (1.0 - np.cos(angle))[:, None, None] * wwy).reshape(vectors.shape)
+    skew = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
+                     [-axis[1], axis[0], 0.0]])
+    # Rodrigues per row: I + sin W + (1 - cos) W^2, applied to every 3-vector at once
+    turn = (np.eye(3)[None] + np.sin(angle)[:, None, None] * skew[None]
+            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew)[None])
+    return np.matmul(y, np.transpose(turn, (0, 2, 1))).reshape(vectors.shape)
 
 
 def expand(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray
@@ -341,7 +343,8 @@ def expand(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, velocity: np
                 k, psi)
     e = reduced.pivot_vector[None, :] + arm
     v = _turn(velocity @ reduced.basis.T, k, psi)
-    v += rate[:, None] * np.cross(k, arm.reshape(len(arm), -1, 3)).reshape(arm.shape)
+    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    v += rate[:, None] * (arm.reshape(len(arm), -1, 3) @ skew.T).reshape(arm.shape)
     return e, v
 
 
@@ -352,7 +355,9 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
     gamma, tol, max_newton), then, per output chunk of settings.chunk_steps rows, the full
     coordinates (:func:`expand`) and each row's probes, deflections, energies and
     constraint violation from the kernel's output row (the full run's definitions), sent to
-    ``sink`` as :class:`~.dynamic.Chunk`. The frame's work is the trapezoidal integral of
+    ``sink`` as :class:`~.dynamic.Chunk` (with q when settings.store_q: the XDMF frames,
+    output.q; the small-strain check then looks at every row, else at each chunk's last
+    state, as the full run does). The frame's work is the trapezoidal integral of
     its power (as the kernel's stepper integrates it); lambda, the drive's work and the
     energy balance are NaN (:data:`NOT_PROVIDED`). Returns a
     :class:`~.dynamic.DynamicResult`; an 'ffr' beam leaving its small-strain assumption
@@ -400,8 +405,10 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
             energy[:, 5] = np.nan
             chunk = Chunk(time=times[rows].copy(), probes=probes, deflections=deflections,
                           lam=np.full((n, ncon), np.nan), energy=energy, constraint=violation,
-                          stats=stats[rows].copy(), q=e)
-            chunk, outside = _check_assumptions(model, chunk, {}, False)
+                          stats=stats[rows].copy(), q=e if settings.store_q else None)
+            chunk, outside = _check_assumptions(model, chunk,
+                                                {"e": e[-1], "t": float(times[rows][-1])},
+                                                False)
             if sink is not None and len(chunk.time):
                 sink(chunk)
             rows_done += len(chunk.time)
