@@ -155,3 +155,55 @@ def test_modes_zero_is_the_full_run_bitwise(tmp_path):
     with scene_run(tmp_path, "default") as a, scene_run(tmp_path, "zero", "beam.modes=0") as b:
         assert np.array_equal(a["dynamic/deflection/tip"][()], b["dynamic/deflection/tip"][()])
         assert "reduction" not in b["dynamic"].attrs
+
+
+def test_system_simulate_runs_the_reduced_model():
+    # System.simulate takes the same path: the tip history equals the scene run's prototype
+    # (simulate of the same model and static state) to 1e-12 m
+    from ancfdrv.builders import build_system
+    scene = load_scene(BOOM, ["beam.nodes=10", "beam.modes=3"])
+    system = build_system(scene).system
+    res = system.simulate(1.0, 1e-3, from_static=True, static_method="newton", xdmf=False)
+    assert res.status == "ok" and res.dynamic.attrs["reduction"] == "modal"
+    model = build_model(load_scene(BOOM, ["beam.nodes=10", "solver.static_method=newton"]))
+    static = solve_newton(model, tol=scene["solver"]["tol"],
+                          max_iter=scene["solver"]["max_iter"])
+    ref = simulate(reduce_ffr(model, static, 3), 1.0, 1e-3,
+                   tol=scene["solver"]["newton_tol"])
+    assert np.max(np.abs(res.deflection["tip"] - ref["tip"])) < 1e-12
+
+
+def test_general_scene_refusal_names_the_beam(tmp_path):
+    # the general twin has the rigid arm besides the beam: outside the reduction's scope
+    from ancfdrv.errors import InputError
+    with pytest.raises(InputError, match=r"&beam\[boom\] modes: beam 'boom': modes = 2: .*"
+                       "only body.*arm"):
+        run_scene(INPUTS / "general" / "boom_luffing.nml",
+                  ["beam[boom].modes=2", "solver.t_end=0.1"], tmp_path / "g.h5",
+                  progress=False)
+
+
+def test_sweep_over_modes_with_a_reference(tmp_path):
+    # ancf sweep --vary beam.modes=0,1,4 --reference FULL.h5: modes = 0 (the full model) is
+    # the finest case; err vs reference recomputed here from the files
+    from ancfdrv.sweep import run_sweep
+    base = ["beam.nodes=7", "solver.t_end=0.5", "solver.static_method=newton",
+            "output.xdmf=false"]
+    reference = tmp_path / "full.h5"
+    run_scene(BOOM, base, reference, progress=False)
+    rows = run_sweep(str(BOOM), ["beam.modes=0,1,4"], tmp_path / "sweep", base=base,
+                     workers=1, progress=False, reference=reference)
+    with h5py.File(reference) as h5:
+        y_ref = h5["dynamic/deflection/tip"][()][:, 1]
+    by_modes = {r["beam.modes"]: r for r in rows}
+    assert all(r["status"] == "ok" for r in rows)
+    assert all(r["err_reference"] == by_modes["0"]["case"] for r in rows)
+    assert by_modes["0"]["err_vs_reference"] == 0.0   # the same run, bitwise
+    for modes in ("1", "4"):
+        with h5py.File(by_modes[modes]["file"]) as h5:
+            y = h5["dynamic/deflection/tip"][()][:, 1]
+        assert by_modes[modes]["err_vs_reference"] == pytest.approx(
+            np.max(np.abs(y - y_ref)) / np.ptp(y_ref), rel=1e-9)
+    assert by_modes["4"]["err_vs_reference"] < by_modes["1"]["err_vs_reference"]
+    assert "err vs reference" in (tmp_path / "sweep" / "summary.md").read_text()
+    assert (tmp_path / "sweep" / "error_vs_time.png").exists()
