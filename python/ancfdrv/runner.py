@@ -192,6 +192,19 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     return recorder
 
 
+def _warn_large_ffr_deflection(model: Model, out: Path) -> None:
+    """The warning of an 'ffr' run whose tip deflects by more than 5% of the length."""
+    if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
+        with h5py.File(out, "r") as h5:
+            deflection = h5["dynamic/deflection/tip"][()]
+        ratio = np.abs(deflection).max() / model.length_scale
+        if ratio > 0.05:
+            model.warnings.append(
+                f"formulation 'ffr' outside its assumptions: the tip deflects by {ratio:.2%} of "
+                "the length (small deformation assumed); compare with formulation = "
+                "'nonlinear'")
+
+
 # -- FFR modal reduction (&beam modes = N; solvers/ffr_reduced.py) --------------------------
 def modal_beam(model: Model):
     """The beam whose ``modes`` asks for the modal reduction (None: the full model)."""
@@ -246,7 +259,9 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
     settings = dynamic_settings(scene)
     xdmf = scene["output"].get("xdmf", True)
     write_q = settings.store_q
-    settings.store_q = bool(xdmf or write_q)  # the chunks carry the expanded coordinates
+    supports = SupportRecorder.of(model)  # general scenes: deflections from q, as the full run
+    # the chunks carry the expanded coordinates
+    settings.store_q = bool(xdmf or write_q or supports is not None)
     try:
         with stop.immediate():
             reduced = reduce_ffr(model, static, beam.modes)
@@ -263,14 +278,18 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
         "reduced_beam": beam.name, "reduced_coordinates": reduced.size,
         "kept_frequencies_hz": np.sqrt(np.abs(reduced.kept_omega_squared)) / (2 * np.pi),
         "not_provided": NOT_PROVIDED}
+    sink = writer if supports is None else supports.wrap(writer)
     try:
-        dyn = integrate_reduced(model, reduced, settings, sink=writer, progress=progress,
+        dyn = integrate_reduced(model, reduced, settings, sink=sink, progress=progress,
                                 should_stop=stop)
     finally:
         writer.flush()
+        if supports is not None:
+            supports.write(out, writer.rows)
         results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
+    _warn_large_ffr_deflection(model, out)
     bounds = stage_bounds(scene)
     stages: dict[str, float] = {}
     if bounds:
@@ -343,15 +362,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     stages: dict[str, float] = {}
-    if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
-        with h5py.File(out, "r") as h5:
-            deflection = h5["dynamic/deflection/tip"][()]
-        ratio = np.abs(deflection).max() / model.length_scale
-        if ratio > 0.05:
-            model.warnings.append(
-                f"formulation 'ffr' outside its assumptions: the tip deflects by {ratio:.2%} of "
-                "the length (small deformation assumed); compare with formulation = "
-                "'nonlinear'")
+    _warn_large_ffr_deflection(model, out)
     bounds = stage_bounds(scene)
     if bounds:
         with h5py.File(out, "r") as h5:
