@@ -127,7 +127,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         args.set = [*args.set, "scene.bounds=off"]
     try:
         rows = run_sweep(args.scene, args.vary, out, base=args.set, workers=args.workers,
-                         scheduler=args.scheduler)
+                         scheduler=args.scheduler, reference=args.reference)
     except SweepInterrupted as stop:
         done = sum(r["status"] in ("ok", "failed") for r in stop.rows)
         by = f" (stopped by {signal.Signals(stop.signum).name})" if stop.signum else ""
@@ -245,6 +245,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, help="parallel processes (default: all cores; "
                    "at most one per core, per case and per 150 MB of available memory)")
     p.add_argument("--scheduler", help="address of a Dask distributed scheduler")
+    p.add_argument("--reference", metavar="REF.h5", help="a result file every case is also "
+                   "compared with (column 'err vs reference'; the error-against-time chart "
+                   "shows it): e.g. a converged model of another formulation")
     p.set_defaults(func=_cmd_sweep)
     p = sub.add_parser("info", help="summarize a result file; the first line says whether "
                        "the run finished (ok), failed, was interrupted, is running or was "

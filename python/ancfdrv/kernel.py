@@ -297,21 +297,24 @@ def moment_force(director, axis, magnitude):
 
 def reduced_ffr_newmark(dt: float, beta: float, gamma: float, omega2, gyroscopic,
                         centrifugal, pdelta_linear, pdelta_quadratic, load, rate, accel,
-                        tol: float, max_newton: int) -> np.ndarray:
+                        tol: float, max_newton: int) -> dict[str, np.ndarray]:
     """Newmark stepping of a modally reduced FFR model (fortran reduced_ffr_stepper;
-    ancfdrv.solvers.ffr_reduced): eta (steps + 1, r) from rest; load (steps + 1, r), rate
-    and accel (steps + 1,); pdelta_linear None: no P-delta remainder."""
+    ancfdrv.solvers.ffr_reduced) from rest, the start's acceleration load[0]: 'eta' and
+    'velocity' (steps + 1, r), per step 'corrections' (Newton) and 'factorized' (0 or 1);
+    load (steps + 1, r), rate and accel (steps + 1,); pdelta_linear None: no P-delta
+    remainder."""
     r = len(omega2)
     pdelta = pdelta_linear is not None
     lin = _f(pdelta_linear) if pdelta else np.zeros((r, r), order="F")
     quad = _f(pdelta_quadratic) if pdelta else np.zeros((r, r, r), order="F")
-    eta, info, step = _kernel.reduced_ffr_newmark(
+    eta, velocity, corrections, factorized, info, step = _kernel.reduced_ffr_newmark(
         dt, beta, gamma, _f(omega2), _f(gyroscopic), _f(centrifugal), int(pdelta), lin, quad,
         _f(np.asarray(load).T), _f(rate), _f(accel), tol, max_newton)
     if info:
         what = "Newton did not converge" if info == 1 else "singular iteration matrix"
         raise SolverError(f"reduced FFR stepper: {what} at step {step}")
-    return eta.T
+    return {"eta": eta.T, "velocity": velocity.T, "corrections": corrections.astype(np.int64),
+            "factorized": factorized.astype(np.int64)}
 
 
 def drive_values(kind: int, params, t):

@@ -711,9 +711,19 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
         save_figure(fig, path, dpi=120)
         plt.close(fig)
         out.append(path)
-    err_key = "err_vs_closed_form" if any("err_vs_closed_form" in r for r in ok) else "err_vs_finest"
+    if any("err_vs_reference" in r for r in ok):
+        err_key = "err_vs_reference"
+    elif any("err_vs_closed_form" in r for r in ok):
+        err_key = "err_vs_closed_form"
+    else:
+        err_key = "err_vs_finest"
     pts = [r for r in ok if r.get(err_key, 0) > 0]
-    if pts:
+    if pts and others:  # one series per family (the values of the non-refining keys)
+        path = pareto_chart(pts, lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in others),
+                            lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in mesh_keys),
+                            err_key, outdir / "error_vs_time.png")
+        out.append(path)
+    elif pts:
         fig, ax = plt.subplots(figsize=(6, 4.2), constrained_layout=True)
         groups = sorted({r.get(nodes_key, "") for r in pts}, key=_num)
         markers = {dt: m for dt, m in zip(sorted({r.get("solver.dt", "") for r in pts},
@@ -738,6 +748,41 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
         plt.close(fig)
         out.append(path)
     return out
+
+
+def _short(key: str) -> str:
+    return key.rpartition(".")[2]
+
+
+def pareto_chart(rows: list[dict], family, point_label, err_key: str, path: Path, *,
+                 time_key: str = "total_time_s", title: str = "what accuracy costs in time"
+                 ) -> Path:
+    """Error against wall time, one line per family (``family(row)``: its label; points
+    joined in the order of time, each annotated with ``point_label(row)``, e.g. the node
+    count or the modes). Used by ``ancf sweep`` (families: the values of the non-refining
+    keys) and benchmarks/accuracy_chart.py (several sweeps in one chart)."""
+    fig, ax = plt.subplots(figsize=(8.5, 5.6), constrained_layout=True)
+    families: dict[str, list[dict]] = {}
+    for row in rows:
+        families.setdefault(family(row), []).append(row)
+    markers = "osD^v<>p*hX"
+    for i, (name, members) in enumerate(families.items()):
+        members = sorted(members, key=lambda r: float(r[time_key]))
+        x = [float(r[time_key]) for r in members]
+        y = [float(r[err_key]) for r in members]
+        ax.loglog(x, y, "-" + markers[i % len(markers)], ms=5, lw=1, color=f"C{i % 10}",
+                  label=name)
+        for r, xi, yi in zip(members, x, y):
+            ax.annotate(point_label(r), (xi, yi), textcoords="offset points", xytext=(3, 3),
+                        fontsize=6, color=f"C{i % 10}")
+    ax.set_xlabel(time_key.replace("_s", " (s)").replace("_", " "))
+    ax.set_ylabel(err_key.replace("_", " "))
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, loc="best")
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+    return path
 
 
 def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:

@@ -192,9 +192,126 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     return recorder
 
 
-def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
+def _warn_large_ffr_deflection(model: Model, out: Path) -> None:
+    """The warning of an 'ffr' run whose tip deflects by more than 5% of the length."""
+    if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
+        with h5py.File(out, "r") as h5:
+            deflection = h5["dynamic/deflection/tip"][()]
+        ratio = np.abs(deflection).max() / model.length_scale
+        if ratio > 0.05:
+            model.warnings.append(
+                f"formulation 'ffr' outside its assumptions: the tip deflects by {ratio:.2%} of "
+                "the length (small deformation assumed); compare with formulation = "
+                "'nonlinear'")
+
+
+# -- FFR modal reduction (&beam modes = N; solvers/ffr_reduced.py) --------------------------
+def modal_beam(model: Model):
+    """The beam whose ``modes`` asks for the modal reduction (None: the full model)."""
+    from .system.bodies import Beam
+    beams = [b for b in model.bodies if isinstance(b, Beam) and getattr(b, "modes", 0)]
+    return beams[0] if beams else None
+
+
+def _reduction_error(scene: Scene, beam, message: str) -> InputError:
+    group = "beam" if scene.kind != "general" else f"beam[{beam.name}]"
+    return InputError(f"beam {beam.name!r}: modes = {beam.modes}: {message}",
+                      file=str(scene.path), group=group, key="modes")
+
+
+def check_reduction(scene: Scene, model: Model) -> None:
+    """Refuse, before anything is computed, a reduced run outside the reduction's scope
+    (InputError naming the beam; the scope messages are ffr_reduced's)."""
+    beam = modal_beam(model)
+    if beam is None:
+        return
+    from types import SimpleNamespace
+    from .builders import settle_mode
+    from .solvers.ffr_reduced import check_scope
+    analysis = scene["scene"]["analysis"]
+    if analysis not in ("static+dynamic", "dynamic") or (
+            analysis == "dynamic" and settle_mode(scene) == "none"):
+        raise _reduction_error(scene, beam, "the modal reduction is of a dynamic run from the "
+                               "static equilibrium at t = 0 (scene.analysis = "
+                               "'static+dynamic')")
+    solver = scene["solver"]
+    if solver["integrator"] != "newmark" or solver.get("step", "fixed") != "fixed":
+        raise _reduction_error(scene, beam, "the reduced stepper is Newmark with fixed steps "
+                               "(solver.integrator = 'newmark', solver.step = 'fixed')")
+    others = [b.name for b in model.bodies if b is not beam]
+    if others:
+        raise _reduction_error(scene, beam, "the beam must be the model's only body (also "
+                               f"found: {', '.join(others)})")
+    try:
+        check_scope(model, SimpleNamespace(e=model.e0))
+    except SolverError as exc:
+        raise _reduction_error(scene, beam, str(exc)) from None
+
+
+def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
+    """The dynamic run of the modally reduced model (&beam modes = N): the layout of the
+    full run's /dynamic, the full coordinates expanded from the reduced ones; /dynamic
+    attributes reduction, modes, reduced_coordinates, kept_frequencies_hz, not_provided."""
+    from .solvers.ffr_reduced import NOT_PROVIDED, integrate_reduced, reduce_ffr
+    beam = modal_beam(model)
+    settings = dynamic_settings(scene)
+    xdmf = scene["output"].get("xdmf", True)
+    write_q = settings.store_q
+    supports = SupportRecorder.of(model)  # general scenes: deflections from q, as the full run
+    # the chunks carry the expanded coordinates
+    settings.store_q = bool(xdmf or write_q or supports is not None)
+    try:
+        with stop.immediate():
+            reduced = reduce_ffr(model, static, beam.modes)
+    except SolverError as exc:  # e.g. more modes than the constrained model has
+        raise _reduction_error(scene, beam, str(exc)) from None
+    writer = results.DynamicWriter(
+        out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
+        total_rows=int(round(settings.t_end / settings.dt)) + 1,
+        frames=scene["output"]["xdmf_frames"], write_q=write_q)
+    attrs: dict[str, Any] = {
+        "integrator": "newmark", "dt": settings.dt, "beta": settings.beta,
+        "gamma": settings.gamma, "alpha_m": 0.0, "alpha_f": 0.0, "rho_inf": 1.0,
+        "t_end": settings.t_end, "reduction": "modal", "modes": beam.modes,
+        "reduced_beam": beam.name, "reduced_coordinates": reduced.size,
+        "kept_frequencies_hz": np.sqrt(np.abs(reduced.kept_omega_squared)) / (2 * np.pi),
+        "not_provided": NOT_PROVIDED}
+    sink = writer if supports is None else supports.wrap(writer)
+    try:
+        dyn = integrate_reduced(model, reduced, settings, sink=sink, progress=progress,
+                                should_stop=stop)
+    finally:
+        writer.flush()
+        if supports is not None:
+            supports.write(out, writer.rows)
+        results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
+    for phase, seconds in dyn.timing.items():
+        timing[f"dynamic_{phase}"] = seconds
+    _warn_large_ffr_deflection(model, out)
+    bounds = stage_bounds(scene)
+    stages: dict[str, float] = {}
+    if bounds:
+        with h5py.File(out, "r") as h5:
+            stages = stage_summary(h5["dynamic/time"][()], h5["dynamic/deflection/tip"][:, 1],
+                                   bounds)
+    results.write_dynamic_attrs(out, {
+        **attrs, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
+        "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,
+        "jacobian_policy": "constant", "wall_time_s": dyn.wall_time_s, "status": "ok",
+        "step_control": "fixed", "dt_min": settings.dt, "step_cuts": 0,
+        "steps_rejected": 0, "steps_taken": dyn.steps_taken,
+        "smallest_step": dyn.smallest_step, "newton_floor_accepts": 0}, stages)
+    return dyn, stages
+
+
+def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
+                 timing: dict[str, Any], progress: bool | None,
+                 stop: StopRequest, static: StaticResult | None = None
+                 ) -> tuple[DynamicResult, dict]:
+    if modal_beam(model) is not None:
+        return _run_reduced(scene, model, out, static, timing, progress, stop)
     settings = dynamic_settings(scene)
     xdmf = scene["output"].get("xdmf", True)
     write_q = settings.store_q  # output.q: /dynamic/q at every step
@@ -245,15 +362,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     stages: dict[str, float] = {}
-    if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
-        with h5py.File(out, "r") as h5:
-            deflection = h5["dynamic/deflection/tip"][()]
-        ratio = np.abs(deflection).max() / model.length_scale
-        if ratio > 0.05:
-            model.warnings.append(
-                f"formulation 'ffr' outside its assumptions: the tip deflects by {ratio:.2%} of "
-                "the length (small deformation assumed); compare with formulation = "
-                "'nonlinear'")
+    _warn_large_ffr_deflection(model, out)
     bounds = stage_bounds(scene)
     if bounds:
         with h5py.File(out, "r") as h5:
@@ -345,6 +454,11 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
     except InputError as exc:  # found while assembling: name the scene file and the item
         raise locate_error(exc, scene) from None
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
+    try:
+        check_reduction(scene, model)
+    except InputError:
+        model.close()
+        raise
     static = dynamic = None
     stages: dict[str, float] = {}
 
@@ -380,7 +494,8 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
             e_start = static.e
             stop.check()
         if analysis in ("dynamic", "static+dynamic"):
-            dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop)
+            dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop,
+                                           static)
         if analysis in ("modal", "buckling"):
             with stop.immediate():
                 run_eigen(scene, model, out, timing)

@@ -35,7 +35,7 @@ from tqdm import tqdm
 from .errors import InputError
 from .results.lock import OutputLock
 from .io.safe_write import replace_atomically, write_bytes, write_text
-from .sweep_keys import is_resolution, resolution_sense, static_value
+from .sweep_keys import is_resolution, resolution_rank, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
 from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
                          remove_quietly, response_of, run_dask, run_inline, run_processes,
@@ -276,8 +276,7 @@ def _reference_groups(rows: list[dict], varied: list[str]):
         groups.setdefault(tuple(row[k] for k in others), []).append(row)
 
     def rank(row: dict) -> tuple:
-        return tuple((-1 if resolution_sense(k) is max else 1) * float(row[k])
-                     for k in resolution)
+        return tuple(resolution_rank(k, row[k]) for k in resolution)
     for members in groups.values():
         ok = [r for r in members if r["status"] == "ok"]
         if not ok:
@@ -317,6 +316,33 @@ def add_formulation_difference(rows: list[dict], varied: list[str]) -> None:
                 abs(static_value(ref)), 1e-300)
 
 
+def add_reference_errors(rows: list[dict], reference: str | Path) -> None:
+    """err_vs_reference per successful row against a given result file: dynamic cases
+    max |y(t) - y_ref(t)| over the reference's times within the case's / the range of y_ref
+    (the tip sag's range for beams: the measure of benchmarks/peer_harness.py); static
+    cases |y - y_ref| / |y_ref|. The file is named in err_reference_file."""
+    with h5py.File(reference, "r") as h5:
+        dynamic = "dynamic" in h5
+        if not dynamic:
+            probe, component = response_of(h5.attrs)
+            y_static = float(h5[f"static/deflection/{probe}"][component])
+    if dynamic:
+        t_ref, y_ref = _tip_history(str(reference))
+        scale = max(float(np.ptp(y_ref)), 1e-300)
+    for row in rows:
+        if row["status"] != "ok":
+            continue
+        row["err_reference_file"] = str(reference)
+        if dynamic and row.get("dynamic"):
+            t, y = _tip_history(row["file"])
+            common = t_ref <= t[-1] + 1e-12
+            row["err_vs_reference"] = float(np.abs(np.interp(t_ref[common], t, y)
+                                                   - y_ref[common]).max()) / scale
+        elif not dynamic and not row.get("dynamic"):
+            row["err_vs_reference"] = abs(static_value(row) - y_static) / max(abs(y_static),
+                                                                               1e-300)
+
+
 def add_errors(rows: list[dict], varied: list[str]) -> None:
     """err_vs_finest per row: against the finest resolution with the other keys equal."""
     if any(r.get("dynamic") for r in rows):
@@ -333,7 +359,8 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
               base: list[str] | None = None, workers: int | None = None,
               scheduler: str | None = None, progress: bool | None = None,
               start_method: str | None = None,
-              connect_timeout: float = CONNECT_TIMEOUT_S) -> list[dict]:
+              connect_timeout: float = CONNECT_TIMEOUT_S,
+              reference: str | Path | None = None) -> list[dict]:
     """Run every combination and write the report into ``outdir``. Returns the rows, one per
     case in the order of the combinations, each with a 'status' ('ok' or 'failed'), a
     'message' and an 'exit_code'. Bad input raises InputError before any case runs. Ctrl-C
@@ -342,8 +369,13 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
     ``workers``: local processes (default: all cores; 1 runs the cases in this process);
     ``scheduler``: the address of a Dask distributed scheduler instead (no shared
     filesystem needed); ``start_method``: multiprocessing start method of the local
-    workers (default: the platform's); ``connect_timeout``: seconds to reach the scheduler."""
+    workers (default: the platform's); ``connect_timeout``: seconds to reach the scheduler.
+    ``reference``: a result file (e.g. a converged model of another formulation) each case
+    is also compared with: column err_vs_reference (:func:`add_reference_errors`), which
+    the error-against-time chart then shows."""
     base = base or []
+    if reference is not None and not Path(reference).is_file():
+        raise InputError("--reference: no such result file", file=str(reference))
     if workers is not None and workers < 1:
         raise InputError(f"--workers {workers}: needs at least 1")
     scene = load_scene(scene_file, base)  # fail early on a bad scene or override
@@ -375,7 +407,7 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
                                            progress=progress, scene_text=scene.text)
             signals.armed = False  # the report is written whatever comes now
             check_sweep_ids(rows, sweep_id)
-            report(rows, keys, outdir, scene_file, base)
+            report(rows, keys, outdir, scene_file, base, reference)
     finally:
         if client is not None:
             client.close()
@@ -516,9 +548,11 @@ def check_sweep_ids(rows: list[dict], sweep_id: str) -> None:
 
 
 def report(rows: list[dict], keys: list[str], outdir: Path, scene_file: str,
-           base: list[str]) -> None:
+           base: list[str], reference: str | Path | None = None) -> None:
     """Errors, closed-form comparisons, summary.csv, summary.md and the plots."""
     add_errors(rows, keys)
+    if reference is not None:
+        add_reference_errors(rows, reference)
     add_formulation_difference(rows, keys)
     for row in rows:
         if row["status"] == "ok" and not row.get("dynamic"):
@@ -542,6 +576,7 @@ COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
            ("err_vs_closed_form", "err vs closed form", 1.0, "{:.2e}"),
            ("err_vs_finest", "err vs finest", 1.0, "{:.2e}"),
            ("err_abs_vs_finest", "err vs finest (mm)", 1e3, "{:.3e}"),
+           ("err_vs_reference", "err vs reference", 1.0, "{:.2e}"),
            ("phase_err_deg", "phase err (deg)", 1.0, "{:+.2f}"),
            ("diff_vs_nonlinear", "diff vs nonlinear", 1.0, "{:.2e}"),
            ("vibration_frequency_hz", "f vib (Hz)", 1.0, "{:.4f}"),

@@ -5,9 +5,17 @@ from __future__ import annotations
 
 from .io.scene import parse_address
 
+
+
+def full_model_first(values):
+    """The sense of ``beam.modes``: 0 (the full FFR model) is the finest, then the most
+    modes."""
+    return max(values, key=lambda v: float("inf") if float(v) == 0 else float(v))
+
+
 #: Parameters that refine a model; the finest value is the reference of the others.
 RESOLUTION_KEYS = {"beam.nodes": max, "solver.dt": min, "plate.nx": max, "plate.ny": max,
-                   "leaf.nx": max, "leaf.ny": max}
+                   "leaf.nx": max, "leaf.ny": max, "beam.modes": full_model_first}
 
 
 def _plain_key(part: str) -> str:
@@ -24,6 +32,14 @@ def is_resolution(key: str) -> bool:
 def resolution_sense(key: str):
     """max or min: the sense in which the key (the first of tied keys) refines."""
     return RESOLUTION_KEYS[_plain_key(key.split("+")[0])]
+
+
+def resolution_rank(key: str, value) -> float:
+    """Orders a refining key's values finest first (smallest rank)."""
+    sense = resolution_sense(key)
+    if sense is full_model_first:
+        return -float("inf") if float(value) == 0 else -float(value)
+    return (-1 if sense is max else 1) * float(value)
 
 
 def static_value(row: dict) -> float:

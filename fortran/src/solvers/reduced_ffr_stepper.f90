@@ -14,18 +14,24 @@ module reduced_ffr_stepper
 
 contains
 
-  !> steps Newmark steps of size dt from rest at eta = 0; eta(:, 1) = 0 on entry is the
-  !> start, eta(:, n + 1) the state at step n. info = 0; 1: Newton did not converge within
-  !> max_newton corrections (failed_step: the step); 2: a singular iteration matrix.
+  !> steps Newmark steps of size dt from rest at eta = 0; eta(:, 1) = 0 is the start,
+  !> eta(:, n + 1) the state at step n, velocity(:, n + 1) its rate eta'. The start's
+  !> acceleration is the consistent one at rest, eta''(0) = load(:, 1) (zero stiffness and
+  !> gyroscopic terms at eta = eta' = 0). Per step n + 1: corrections(n + 1) Newton
+  !> corrections, factorized(n + 1) = 1 when the iteration matrix was factorized (row 1:
+  !> 0, the start). info = 0; 1: Newton did not converge within max_newton corrections
+  !> (failed_step: the step); 2: a singular iteration matrix.
   subroutine reduced_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
                              pdelta, pdelta_linear, pdelta_quadratic, load, rate, accel, tol, &
-                             max_newton, eta, info, failed_step)
+                             max_newton, eta, velocity, corrections, factorized, info, &
+                             failed_step)
     integer, intent(in) :: r, steps, max_newton
     real(dp), intent(in) :: dt, beta, gamma, omega2(r), gyroscopic(r, r), centrifugal(r, r)
     logical, intent(in) :: pdelta
     real(dp), intent(in) :: pdelta_linear(r, r), pdelta_quadratic(r, r, r)
     real(dp), intent(in) :: load(r, steps + 1), rate(steps + 1), accel(steps + 1), tol
-    real(dp), intent(out) :: eta(r, steps + 1)
+    real(dp), intent(out) :: eta(r, steps + 1), velocity(r, steps + 1)
+    integer, intent(out) :: corrections(steps + 1), factorized(steps + 1)
     integer, intent(out) :: info, failed_step
     real(dp) :: vel(r), acc(r), base(r), vbase(r), x(r), a_new(r), v_new(r), res(r)
     real(dp) :: stiff(r, r), damp(r, r), jac(r, r), contracted(r, r)
@@ -37,8 +43,11 @@ contains
     a_fac = 1.0_dp / (beta * dt * dt)
     v_fac = gamma / (beta * dt)
     eta = 0.0_dp
+    velocity = 0.0_dp
+    corrections = 0
+    factorized = 0
     vel = 0.0_dp
-    acc = 0.0_dp
+    acc = load(:, 1)
     fresh = .true.
     last_rate = 0.0_dp
     last_accel = 0.0_dp
@@ -64,6 +73,7 @@ contains
           return
         end if
         fresh = .false.
+        factorized(n + 1) = 1
         last_rate = rate(n + 1)
         last_accel = accel(n + 1)
       end if
@@ -86,6 +96,7 @@ contains
         res = -res
         call small_lu_solve(r, jac, ipiv, res)
         x = x + res
+        corrections(n + 1) = it
         ! linear: the one correction solves the step exactly (the matrix is its Jacobian)
         if (.not. pdelta) then
           converged = .true.
@@ -106,6 +117,7 @@ contains
       acc = (x - base) * a_fac
       vel = vbase + dt * gamma * acc
       eta(:, n + 1) = x
+      velocity(:, n + 1) = vel
     end do
   end subroutine reduced_newmark
 

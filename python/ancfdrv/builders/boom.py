@@ -35,12 +35,18 @@ def build(scene) -> BuiltSystem:
     tangent, height = turn @ np.array([1.0, 0.0, 0.0]), turn @ np.array([0.0, 1.0, 0.0])
     tip = a1 + beam["length"] * tangent
     if beam["bending"] == "cable":
+        if beam["modes"]:
+            raise InputError("beam 'boom': modes = {} reduces an 'ffr' beam; the cable "
+                             "(bending = 'cable') is a large-deformation body".format(
+                                 beam["modes"]), file=str(scene.path), group="beam",
+                             key="modes")
         return _cable_boom(scene, built, steel, drive, a1, tangent, height, tip)
     b = s.beam("boom", material=steel, start=a1, end=tip, nodes=beam["nodes"],
                section=rectangle(scene), height_axis=height,
                formulation=scene["scene"]["formulation"], bending=beam["bending"],
                segments=beam["segments"], frame_drive=drive, frame_axis=(0.0, 0.0, 1.0),
-               frame_pivot=(0.0, 0.0, 0.0), geometric_stiffness=beam["geometric_stiffness"])
+               frame_pivot=(0.0, 0.0, 0.0), geometric_stiffness=beam["geometric_stiffness"],
+               modes=beam["modes"])
     s.joint("A1", "arm", "ground", "boom", point=a1, pivot=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0))
     a2 = a1 + beam["segments"][0] * tangent
     s.joint("A2", "prescribed", "ground", "boom", point=a2, pivot=(0.0, 0.0, 0.0),

@@ -19,7 +19,8 @@ def build(scene) -> BuiltSystem:
     b = s.beam("beam", material=material(s, scene), start=(0.0, 0.0, 0.0), end=tip,
                nodes=beam["nodes"], section=rectangle(scene), height_axis=(0.0, 1.0, 0.0),
                formulation=scene["scene"]["formulation"], bending=beam["bending"],
-               segments=beam["segments"], geometric_stiffness=beam["geometric_stiffness"])
+               segments=beam["segments"], geometric_stiffness=beam["geometric_stiffness"],
+               modes=beam["modes"])
     for vector in CLAMPS[scene["cantilever"]["clamp"]]:
         s.joint(f"clamp {vector}", "fix", "ground", "beam", point=(0.0, 0.0, 0.0), vector=vector)
     beam_loads(built, scene, b, tip)

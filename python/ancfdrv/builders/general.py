@@ -168,7 +168,7 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
                formulation=v["formulation"] or scene["scene"]["formulation"],
                bending=v["bending"], segments=v["segments"], frame_drive=v["frame_drive"],
                frame_axis=v["frame_axis"], frame_pivot=v["frame_pivot"],
-               geometric_stiffness=v["geometric_stiffness"])
+               geometric_stiffness=v["geometric_stiffness"], modes=v["modes"])
     elif group == "cable":
         s.cable(v["name"], material=v["material"], start=v["start"], end=v["end"],
                 nodes=v["nodes"], section=_section(v), tension_only=v["tension_only"],

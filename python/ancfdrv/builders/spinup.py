@@ -17,7 +17,8 @@ def build(scene) -> BuiltSystem:
                nodes=beam["nodes"], section=rectangle(scene), height_axis=(0.0, 1.0, 0.0),
                formulation=scene["scene"]["formulation"], bending=beam["bending"],
                segments=beam["segments"], frame_drive=drive, frame_axis=(0.0, 0.0, 1.0),
-               frame_pivot=(0.0, 0.0, 0.0), geometric_stiffness=beam["geometric_stiffness"])
+               frame_pivot=(0.0, 0.0, 0.0), geometric_stiffness=beam["geometric_stiffness"],
+               modes=beam["modes"])
     s.joint("hub", "hub", "ground", "beam", point=(0.0, 0.0, 0.0), pivot=(0.0, 0.0, 0.0),
             axis=(0.0, 0.0, 1.0), drive=drive)
     beam_loads(built, scene, b, tip)

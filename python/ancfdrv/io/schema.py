@@ -40,6 +40,14 @@ GEOMETRIC_STIFFNESS_DOC = (
     "docs/theory.md, 'FFR geometric stiffness'); needs solver.static_method = 'newton' for a "
     "static start; off (default): the paper's linear model; 'nonlinear' beams have it anyway "
     "and ignore the key")
+#: the FFR modal reduction of &beam (template and general scenes)
+MODES_DOC = (
+    "'ffr' beams, dynamic runs from the static start: 0 (default) integrates every "
+    "coordinate; N > 0 integrates the modally reduced model (the N lowest constrained modes "
+    "about the static state plus static corrections, constant matrices; docs/theory.md, "
+    "'Modal reduction of FFR bodies') and writes the full coordinates back (lambda, the "
+    "drive's work and reactions are not provided). Needs the beam the model's only "
+    "flexible body, in a frame turned by a drive, Newmark with fixed steps")
 EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_moment",
                      "point_loads", "pressure", "prestress", "contact", "friction", "load_cycle",
                      "damping")
@@ -130,6 +138,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "(a section with I_y != I_z bends about r3 and needs scene.planar = "
                        "'xy')"),
         "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),
+        "modes": Key("int", 0, non_negative, MODES_DOC),
     },
     "material": {
         "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
@@ -450,6 +459,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
                            "'ffr' or 'nonlinear' (default: the scene's)"),
         "bending": Key("str", "continuum", one_of("continuum", "cubic"), "bending option"),
         "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),
+        "modes": Key("int", 0, non_negative, MODES_DOC),
         "frame_drive": Key("str", None, doc="drive turning the beam's frame (FFR: the "
                            "floating frame; both: the frame of the probe deflections)"),
         "frame_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the frame's turn"),

@@ -71,6 +71,11 @@ class ReducedFFR:
     pdelta_quadratic: np.ndarray | None = None  # T (r, r, r)
     modes: int = 0
     timing: dict[str, float] = field(default_factory=dict)
+    #: the expansion back to the full coordinates (:func:`expand`): x*, the pivot on the
+    #: position slots p^, the frame's unit axis k
+    static_state: np.ndarray | None = None
+    pivot_vector: np.ndarray | None = None
+    axis: np.ndarray | None = None
 
     @property
     def size(self) -> int:
@@ -131,7 +136,8 @@ def reduce_ffr(model: Model, static: StaticResult, modes: int, *,
         euler_load=basis.T @ euler, centrifugal_load=basis.T @ centrifugal,
         gravity_sin=basis.T @ w_load, gravity_cos=basis.T @ w2_load,
         drive=frame.drive_obj, start_angle=frame.drive_obj.value(0.0),
-        probe_static={}, probe_basis={}, modes=modes)
+        probe_static={}, probe_basis={}, modes=modes, static_state=x_star.copy(),
+        pivot_vector=pivot, axis=k)
     static_defl = model.deflections_at(x_star, 0.0)
     for name, value in static_defl.items():
         reduced.probe_static[name] = value
@@ -226,8 +232,10 @@ def _pdelta_terms(model: Model, reduced: ReducedFFR, x_star: np.ndarray) -> None
 def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25,
              gamma: float = 0.5, tol: float = 1e-9, max_newton: int = 10,
              engine: str = "kernel") -> dict[str, np.ndarray]:
-    """Newmark (beta, gamma) from the static state at rest; returns 'time', 'eta' and each
-    probe's deflection in the frame (name -> (steps + 1, 3)). engine 'kernel': the Fortran
+    """Newmark (beta, gamma) from the static state at rest (the start's acceleration the
+    consistent one, eta''(0) = g(0)); returns 'time', 'eta', 'velocity' (eta'), each
+    probe's deflection in the frame (name -> (steps + 1, 3)) and, from the kernel, per step
+    'corrections' (Newton) and 'factorized' (0 or 1). engine 'kernel': the Fortran
     loop (kernel.reduced_ffr_newmark); 'python': the same steps in numpy with full Newton
     (the reference of the test). tol: P-delta's Newton ends on a correction below tol times
     max(1, max |eta|) (the linear model's one solve is exact); on the boom 1e-9 moves the
@@ -245,12 +253,15 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
              + (1.0 - np.cos(psi))[:, None] * reduced.gravity_cos)
     pd_lin, pd_quad = reduced.pdelta_linear, reduced.pdelta_quadratic
     if engine == "kernel":
-        eta = kernel.reduced_ffr_newmark(dt, beta, gamma, reduced.omega_squared, gam, c2,
-                                         pd_lin, pd_quad, force, rate, accel, tol, max_newton)
-        return _finish(reduced, times, eta, t0)
+        steps_out = kernel.reduced_ffr_newmark(dt, beta, gamma, reduced.omega_squared, gam,
+                                               c2, pd_lin, pd_quad, force, rate, accel, tol,
+                                               max_newton)
+        return _finish(reduced, times, steps_out["eta"], t0, steps_out)
     if engine != "python":
         raise SolverError(f"simulate: engine {engine!r} must be 'kernel' or 'python'")
-    eta, vel, acc = np.zeros((steps + 1, r)), np.zeros(r), np.zeros(r)
+    # at rest in the static state: eta'' = g(0) (the kernel's start too)
+    eta, vel, acc = np.zeros((steps + 1, r)), np.zeros(r), force[0].copy()
+    velocity = np.zeros((steps + 1, r))
     a_fac, v_fac = 1.0 / (beta * dt * dt), gamma / (beta * dt)
     eye = np.eye(r)
     for n in range(steps):
@@ -278,13 +289,148 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
         acc = (x - base) * a_fac
         vel = vbase + dt * gamma * acc
         eta[n + 1] = x
-    return _finish(reduced, times, eta, t0)
+        velocity[n + 1] = vel
+    return _finish(reduced, times, eta, t0, {"velocity": velocity})
 
 
-def _finish(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, t0: float
-            ) -> dict[str, np.ndarray]:
+def _finish(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, t0: float,
+            extra: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {"time": times, "eta": eta}
+    for key in ("velocity", "corrections", "factorized"):
+        if extra is not None and key in extra:
+            out[key] = extra[key]
     for name, value in reduced.probe_static.items():
         out[name] = value + eta @ reduced.probe_basis[name].T
     reduced.timing["simulate"] = time.perf_counter() - t0
     return out
+
+
+# -- the scene path: &beam modes = N (runner, System.simulate) -------------------------------
+#: what a reduced run's file cannot hold (the reduced model has no multipliers): the
+#: /dynamic attribute ``not_provided`` and the README say so
+NOT_PROVIDED = ("lambda (NaN: the reduced model has no multipliers), energy/drive_work and "
+                "energy/balance (NaN: the drive's power needs the multipliers), reactions, "
+                "section forces and stresses (/dynamic/reactions, sections, stress not "
+                "written)")
+
+
+def check_scope(model: Model, static: StaticResult) -> None:
+    """The prototype's scope checks (SolverError with its messages) on a state the
+    constraints hold at t = 0 (the static start, or the assembled configuration before the
+    static solve)."""
+    _check_scope(model, static)
+
+
+def _turn(vectors: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Rot(axis, angle[i]) applied to every 3-vector of row i of vectors (nt, n)."""
+    y = vectors.reshape(len(vectors), -1, 3)
+    skew = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
+                     [-axis[1], axis[0], 0.0]])
+    # Rodrigues per row: I + sin W + (1 - cos) W^2, applied to every 3-vector at once
+    turn = (np.eye(3)[None] + np.sin(angle)[:, None, None] * skew[None]
+            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew)[None])
+    return np.matmul(y, np.transpose(turn, (0, 2, 1))).reshape(vectors.shape)
+
+
+def expand(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """The full coordinates and their rates of reduced states (rows of eta, eta'):
+    e = p^ + U(psi) (x* + Psi eta - p^), e' = psi' k x (e - p^) + U(psi) Psi eta'."""
+    phi, rate, _ = reduced.drive.values(times)
+    psi = phi - reduced.start_angle
+    k = reduced.axis
+    arm = _turn((reduced.static_state - reduced.pivot_vector)[None, :] + eta @ reduced.basis.T,
+                k, psi)
+    e = reduced.pivot_vector[None, :] + arm
+    v = _turn(velocity @ reduced.basis.T, k, psi)
+    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    v += rate[:, None] * (arm.reshape(len(arm), -1, 3) @ skew.T).reshape(arm.shape)
+    return e, v
+
+
+def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
+                      progress: bool | None = None, should_stop=None):
+    """A dynamic run of the reduced model with the output of the full one: the reduced
+    history from the kernel's stepper (:func:`simulate`, Newmark with settings' beta,
+    gamma, tol, max_newton), then, per output chunk of settings.chunk_steps rows, the full
+    coordinates (:func:`expand`) and each row's probes, deflections, energies and
+    constraint violation from the kernel's output row (the full run's definitions), sent to
+    ``sink`` as :class:`~.dynamic.Chunk` (with q when settings.store_q: the XDMF frames,
+    output.q; the small-strain check then looks at every row, else at each chunk's last
+    state, as the full run does). The frame's work is the trapezoidal integral of
+    its power (as the kernel's stepper integrates it); lambda, the drive's work and the
+    energy balance are NaN (:data:`NOT_PROVIDED`). Returns a
+    :class:`~.dynamic.DynamicResult`; an 'ffr' beam leaving its small-strain assumption
+    ends the run as the full one does."""
+    from ..errors import Interrupted
+    from .dynamic import Chunk, DynamicResult, _check_assumptions
+    start = time.perf_counter()
+    timing = {"setup": reduced.timing.get("reduce", 0.0), "stepping": 0.0, "output": 0.0}
+    out = simulate(reduced, settings.t_end, settings.dt, beta=settings.beta,
+                   gamma=settings.gamma, tol=settings.tol, max_newton=settings.max_newton)
+    timing["stepping"] = reduced.timing["simulate"]
+    times, eta, velocity = out["time"], out["eta"], out["velocity"]
+    stats = np.column_stack([out["corrections"], out["factorized"], out["factorized"]])
+    ncon, nrows = len(model.constraints), len(times)
+    no_work = np.zeros(5)
+    guesses = model.contact_guesses.copy()
+    counts = np.zeros(6, dtype=np.int32)
+    frame_work, last_power = 0.0, None
+    rows_done = 0
+    step = max(1, int(settings.chunk_steps))
+    try:
+        for first in range(0, nrows, step):
+            t1 = time.perf_counter()
+            rows = slice(first, min(first + step, nrows))
+            e, v = expand(reduced, times[rows], eta[rows], velocity[rows])
+            n = len(e)
+            probes = np.zeros((n, model.kernel.nprobe, 3))
+            deflections = np.zeros_like(probes)
+            energy = np.zeros((n, 11))
+            violation, power = np.zeros(n), np.zeros(n)
+            for i in range(n):
+                row = model.kernel.output_row(float(times[first + i]), e[i], v[i],
+                                              np.zeros(ncon), no_work, guesses, counts)
+                probes[i], deflections[i] = row["probes"], row["deflections"]
+                energy[i], violation[i] = row["energy"], row["violation"]
+                power[i] = row["powers"][1]
+            # frame work: the trapezoidal rule over the rows (the stepper's rule)
+            previous = power[0] if last_power is None else last_power
+            increments = 0.5 * settings.dt * (np.concatenate([[previous], power[:-1]]) + power)
+            if last_power is None:
+                increments[0] = 0.0
+            work = frame_work + np.cumsum(increments)
+            frame_work, last_power = float(work[-1]), float(power[-1])
+            energy[:, 6] = work
+            energy[:, 5] = np.nan
+            chunk = Chunk(time=times[rows].copy(), probes=probes, deflections=deflections,
+                          lam=np.full((n, ncon), np.nan), energy=energy, constraint=violation,
+                          stats=stats[rows].copy(), q=e if settings.store_q else None)
+            chunk, outside = _check_assumptions(model, chunk,
+                                                {"e": e[-1], "t": float(times[rows][-1])},
+                                                False)
+            if sink is not None and len(chunk.time):
+                sink(chunk)
+            rows_done += len(chunk.time)
+            timing["output"] += time.perf_counter() - t1
+            if outside:
+                raise SolverError(outside)
+            if should_stop is not None and should_stop() and rows_done < nrows:
+                raise Interrupted(f"stopped at t = {times[rows_done - 1]:.6g} s after "
+                                  f"{rows_done - 1} steps")
+    finally:
+        steps = max(rows_done - 1, 0)
+        newton = int(stats[:rows_done, 0].sum())
+        factorizations = int(stats[:rows_done, 1].sum())
+        model.counters["time_steps"] += steps
+        model.counters["newton_iterations"] += newton
+        model.counters["solves"] += newton
+        model.counters["factorizations"] += factorizations
+        model.counters["jacobian_evaluations"] += factorizations
+        model.counters["steps_taken"] = model.counters.get("steps_taken", 0) + steps
+        model.counters["reduced_coordinates"] = reduced.size
+    wall = time.perf_counter() - start
+    timing["total"] = wall
+    return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
+                         wall_time_s=wall, timing=timing, jacobians=factorizations,
+                         steps_taken=steps, smallest_step=settings.dt if steps else 0.0)

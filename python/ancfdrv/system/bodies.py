@@ -171,7 +171,9 @@ class Beam(Body):
     t = 0, turned by ``frame_drive`` about ``frame_axis`` through ``frame_pivot`` (default:
     the start) when given: for 'ffr' the elastic model lives in it, for either formulation
     probe deflections are resolved in it. ``geometric_stiffness`` (for 'ffr'): the
-    geometric stiffness of the current axial force (P-delta, docs/theory.md, 'FFR geometric stiffness')."""
+    geometric stiffness of the current axial force (P-delta, docs/theory.md, 'FFR geometric stiffness').
+    ``modes`` (for 'ffr', dynamic runs): 0 integrates every coordinate, N > 0 the modal
+    reduction with N modes (:mod:`ancfdrv.solvers.ffr_reduced`)."""
 
     flexible = True
 
@@ -179,9 +181,12 @@ class Beam(Body):
                  section: Section | None = None, *, height_axis=None, formulation: str = "ffr",
                  bending: str = "continuum", segments=None, frame_drive=None,
                  frame_axis=(0.0, 0.0, 1.0), frame_pivot=None,
-                 geometric_stiffness: bool = False) -> None:
+                 geometric_stiffness: bool = False, modes: int = 0) -> None:
         self.name = name
         self.geometric_stiffness = bool(geometric_stiffness)
+        if not isinstance(modes, (int, np.integer)) or isinstance(modes, bool) or modes < 0:
+            raise InputError(f"beam {name!r}: modes = {modes!r} must be an integer >= 0")
+        self.modes = int(modes)
         where = f"beam {name!r}"
         self.material = material
         self.start, self.end = _vec(start, "start", where), _vec(end, "end", where)

@@ -183,15 +183,16 @@ class System:
              section: Section | None = None, height_axis=None, formulation: str = "ffr",
              bending: str = "continuum", segments=None, frame_drive: str | Drive | None = None,
              frame_axis=(0.0, 0.0, 1.0), frame_pivot=None,
-             geometric_stiffness: bool = False) -> Beam:
+             geometric_stiffness: bool = False, modes: int = 0) -> Beam:
         """An ANCF beam (:class:`~.bodies.Beam`); ``geometric_stiffness=True`` gives an 'ffr'
-        beam the geometric stiffness of its current axial force (P-delta)."""
+        beam the geometric stiffness of its current axial force (P-delta); ``modes=N`` (N > 0)
+        runs its dynamics as the modal reduction with N modes (``&beam modes``)."""
         name = self._body_name(name)
         where = f"beam {name!r}"
         v = check_call("beam", f"beam[{name}]", dict(
             start=start, end=end, nodes=nodes, segments=segments, height_axis=height_axis,
             formulation=formulation, bending=bending, frame_axis=frame_axis,
-            frame_pivot=frame_pivot, geometric_stiffness=geometric_stiffness))
+            frame_pivot=frame_pivot, geometric_stiffness=geometric_stiffness, modes=modes))
         nodes = v["nodes"]
         self._check_size(validate.Part(f"beam[{name}]", "nodes", "beam", nodes, 12))
         return self._add_body(Beam(name, self._material(material, where), start, end, nodes,
@@ -199,7 +200,8 @@ class System:
                                    bending=bending, segments=segments,
                                    frame_drive=self._drive(frame_drive, where),
                                    frame_axis=frame_axis, frame_pivot=frame_pivot,
-                                   geometric_stiffness=v["geometric_stiffness"]))
+                                   geometric_stiffness=v["geometric_stiffness"],
+                                   modes=v["modes"]))
 
     @_api
     def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
