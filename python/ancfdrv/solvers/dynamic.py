@@ -208,10 +208,11 @@ class TimeIntegrator:
         the start of a run. The kernel's stepper gets the run's settings and forgets what it
         learned in earlier runs, so runs are reproducible."""
         self.model.kernel.stepper_setup(self.settings)
-        return dict(t=t, e=e.copy(), v=v.copy(), a=a.copy(), accel=a.copy(), lam=lam.copy(),
-                    work=np.zeros(5), powers=np.zeros(5),
-                    guesses=self.model.contact_guesses.copy(),
-                    counts=np.zeros(6, dtype=np.int32))
+        # one packed buffer the kernel steps in place (kernel.PackedState): its arrays are
+        # views, changed by the next call
+        return self.model.kernel.packed_state(dict(
+            t=t, e=e, v=v, a=a, accel=a, lam=lam, work=np.zeros(5), powers=np.zeros(5),
+            guesses=self.model.contact_guesses.copy(), counts=np.zeros(6, dtype=np.int32)))
 
     def advance(self, state: dict, nsteps: int, h: float | None = None
                 ) -> tuple[Chunk, int, int]:
@@ -446,8 +447,11 @@ def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
 def initial_row(model: Model, state: dict) -> Chunk:
     """The output row of the initial state, with the kernel's energy definitions; the state
     gets the powers there (the start of the works the stepper integrates)."""
+    # (a copy of the guesses: output_row updates them in place, and the state's are the
+    # stepper's packed buffer; the contact counters count the row's evaluations, as before)
     row = model.kernel.output_row(state["t"], state["e"], state["v"], state["lam"],
-                                  state["work"], state["guesses"], state["counts"])
+                                  state["work"], np.array(state["guesses"], order="F"),
+                                  state["counts"])
     state["powers"] = row["powers"]
     # copies: the kernel updates the state's arrays in place as it steps on
     return Chunk(time=np.array([state["t"]]), probes=row["probes"][None],
