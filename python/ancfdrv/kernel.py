@@ -874,16 +874,10 @@ class KernelSystem:
         values["counts"] = _i(values["counts"]).copy()
         return PackedState(self._layout(False)[0], self.npoint, values)
 
-    def advance(self, nsteps: int, h: float, state: dict, store_q: bool) -> dict:
-        """Advance nsteps steps of size h (time_integrator, with the run's settings of
-        :meth:`stepper_setup`) from state (t, e, v, a, accel, lam, work, powers, guesses,
-        counts; its entries are replaced by the new state's). Returns the outputs (time,
-        probes (3, nprobe, nsteps), deflections, lam, energy, constraint, stats, contact,
-        q), status [steps done, info, detail, steps converged at the round-off floor], the
-        kernel's text of a failure (``message``) and the last Newton correction; a failed
-        step's statistics are the column after the last completed step. A refused call (a
-        stale handle, no run set up, sizes inconsistent with the system) raises
-        SolverError with the kernel's text."""
+    def advance_rows(self, nsteps: int, h: float, state: dict, store_q: bool) -> tuple:
+        """:meth:`advance` without unpacking the rows: (rows (row_size, nsteps) in the
+        layout of :meth:`row_slices`, stats, status, last correction, message), for the
+        stepper's own loop (single steps under step control: every numpy call counts)."""
         cuts, rows_cut = self._layout(store_q)
         npt = self.npoint
         if isinstance(state, PackedState) and len(state.packed) == cuts[-1].stop:
@@ -915,6 +909,27 @@ class KernelSystem:
                 guesses = np.array(state["guesses"], dtype=np.float64)
                 guesses[:, :npt] = packed[cuts[8]].reshape((2, npt), order="F")
                 state["guesses"] = guesses
+        return rows, stats, status, last_correction, message
+
+    def row_slices(self, store_q: bool) -> list[slice]:
+        """The slices of an output row (time, probes, deflections, lam, energy, constraint,
+        contact, q): stepper.f90 ``row_size``."""
+        return self._layout(store_q)[1]
+
+    def advance(self, nsteps: int, h: float, state: dict, store_q: bool) -> dict:
+        """Advance nsteps steps of size h (time_integrator, with the run's settings of
+        :meth:`stepper_setup`) from state (t, e, v, a, accel, lam, work, powers, guesses,
+        counts; its entries are replaced by the new state's). Returns the outputs (time,
+        probes (3, nprobe, nsteps), deflections, lam, energy, constraint, stats, contact,
+        q), status [steps done, info, detail, steps converged at the round-off floor], the
+        kernel's text of a failure (``message``) and the last Newton correction; a failed
+        step's statistics are the column after the last completed step. A refused call (a
+        stale handle, no run set up, sizes inconsistent with the system) raises
+        SolverError with the kernel's text."""
+        rows, stats, status, last_correction, message = self.advance_rows(nsteps, h, state,
+                                                                           store_q)
+        npt = self.npoint
+        rows_cut = self._layout(store_q)[1]
         time, probes, deflections, lam, energy, constraint, contact, q = rows_cut
         return dict(time=rows[0], probes=rows[probes].reshape((3, -1, nsteps), order="F"),
                     deflections=rows[deflections].reshape((3, -1, nsteps), order="F"),
