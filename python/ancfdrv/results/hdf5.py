@@ -420,11 +420,12 @@ def _append_rows(group_id: h5py.h5g.GroupID, name: str, start: int,
 class DynamicWriter:
     """Appends the chunks of a dynamic run to /dynamic (SPEC section 4).
 
-    Chunks are buffered and written together, with the file closed after each write,
-    whenever ``flush_rows`` rows are waiting or FLUSH_SECONDS have passed since the
-    last write (the initial row is written at once); :meth:`flush` writes the rest. So
-    the file on disk lags the computation by at most one output chunk or about a
-    second, and a run that stops (failure, SIGINT, SIGTERM) flushes everything.
+    Chunks are buffered and written together (merged: one write per series), with the
+    file closed after each write, whenever ``flush_rows`` rows are waiting or
+    FLUSH_SECONDS have passed since the last write (the initial row is written at once);
+    :meth:`flush` writes the rest. So the file on disk lags the computation by at most
+    ``flush_rows`` rows or about a second (the runner sizes ``flush_rows`` to ~16 MB),
+    and a run that stops (failure, SIGINT, SIGTERM) flushes everything.
     """
 
     def __init__(self, path: Path, model: Model, store_q: bool,
