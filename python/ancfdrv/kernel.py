@@ -515,6 +515,53 @@ ENERGY_COUNT, POWER_COUNT = len(ENERGY_NAMES), len(POWER_NAMES)
 _PACKED_ARRAYS = ("e", "v", "a", "accel", "lam", "work", "powers")
 
 
+class PackedState(dict):
+    """A stepper state (t, e, v, a, accel, lam, work, powers, guesses, counts) whose arrays
+    are views of one packed buffer in the layout of stepper.f90 ``state_size``: the kernel
+    steps the buffer in place (:meth:`KernelSystem.advance`), so a call packs and unpacks
+    nothing (issue 25: the packing cost ~31,000 instructions per single-step call). Reading
+    a key gives its view (changed by the next call: copy what must stay); assigning a key
+    (or :meth:`update`) copies the value into the buffer. ``t`` reads as a float. A plain
+    dict of the same keys is accepted by :meth:`KernelSystem.advance` too (packed per
+    call)."""
+
+    def __init__(self, cuts: list[slice], npoint: int, values: dict) -> None:
+        super().__init__()
+        self.packed = np.zeros(cuts[-1].stop)
+        self.npoint = npoint
+        views = {key: self.packed[part] for key, part in zip(_PACKED_ARRAYS, cuts[1:8])}
+        if npoint:   # (2, npoint) in Fortran order: a view of the packed guesses
+            views["guesses"] = self.packed[cuts[8]].reshape((2, npoint), order="F")
+        self._views = views
+        for key, value in values.items():
+            self[key] = value
+
+    def __setitem__(self, key: str, value) -> None:
+        if key == "t":
+            self.packed[0] = value
+            dict.__setitem__(self, "t", float(value))
+            return
+        view = self._views.get(key)
+        if view is None:
+            dict.__setitem__(self, key, value)
+            return
+        if view is not value:
+            view[...] = np.asarray(value)[:, :self.npoint] if key == "guesses" else value
+        dict.__setitem__(self, key, view)
+
+    def update(self, other=(), **kwargs) -> None:  # type: ignore[override]
+        for key, value in dict(other, **kwargs).items():
+            self[key] = value
+
+    def stepped(self, packed: np.ndarray, counts: np.ndarray) -> None:
+        """Take the kernel's state after a call (in place unless f2py had to copy)."""
+        if packed is not self.packed:
+            self.packed[...] = packed
+        dict.__setitem__(self, "t", float(self.packed[0]))
+        if counts is not dict.__getitem__(self, "counts"):
+            dict.__setitem__(self, "counts", counts)
+
+
 def _text(message: bytes | str) -> str:
     """A kernel message buffer (f2py returns character(len=200) as bytes) as text."""
     if isinstance(message, bytes):
@@ -849,6 +896,55 @@ class KernelSystem:
         """The length of one output row of :meth:`advance` (stepper.f90 ``row_size``)."""
         return self._layout(store_q)[1][-1].stop
 
+    def packed_state(self, values: dict) -> PackedState:
+        """A :class:`PackedState` of this system holding ``values`` (copied)."""
+        values = dict(values)
+        values.setdefault("counts", np.zeros(6, dtype=np.int32))
+        values["counts"] = _i(values["counts"]).copy()
+        return PackedState(self._layout(False)[0], self.npoint, values)
+
+    def advance_rows(self, nsteps: int, h: float, state: dict, store_q: bool) -> tuple:
+        """:meth:`advance` without unpacking the rows: (rows (row_size, nsteps) in the
+        layout of :meth:`row_slices`, stats, status, last correction, message), for the
+        stepper's own loop (single steps under step control: every numpy call counts)."""
+        cuts, rows_cut = self._layout(store_q)
+        npt = self.npoint
+        if isinstance(state, PackedState) and len(state.packed) == cuts[-1].stop:
+            packed, counts, rows, stats, status, last_correction, message = \
+                _kernel.system_advance(self.handle, nsteps, h, state.packed, state["counts"],
+                                       rows_cut[-1].stop)
+            state.stepped(packed, counts)
+            status = status.tolist()
+            if status[1] == 9:
+                self._failure(9, "system_advance", message)
+        else:  # a plain dict: packed and unpacked on every call
+            packed = np.empty(cuts[-1].stop)
+            packed[0] = state["t"]
+            for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
+                packed[part] = state[key]
+            if npt:
+                packed[cuts[8]] = np.asarray(state["guesses"])[:, :npt].ravel(order="F")
+            packed, counts, rows, stats, status, last_correction, message = \
+                _kernel.system_advance(self.handle, nsteps, h, packed, _i(state["counts"]),
+                                       rows_cut[-1].stop)
+            status = [int(x) for x in status]
+            if status[1] == 9:
+                self._failure(9, "system_advance", message)
+            state["t"] = float(packed[0])
+            for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
+                state[key] = packed[part]
+            state["counts"] = counts
+            if npt:  # (without contact the guesses are one unused column, left as they are)
+                guesses = np.array(state["guesses"], dtype=np.float64)
+                guesses[:, :npt] = packed[cuts[8]].reshape((2, npt), order="F")
+                state["guesses"] = guesses
+        return rows, stats, status, last_correction, message
+
+    def row_slices(self, store_q: bool) -> list[slice]:
+        """The slices of an output row (time, probes, deflections, lam, energy, constraint,
+        contact, q): stepper.f90 ``row_size``."""
+        return self._layout(store_q)[1]
+
     def advance(self, nsteps: int, h: float, state: dict, store_q: bool) -> dict:
         """Advance nsteps steps of size h (time_integrator, with the run's settings of
         :meth:`stepper_setup`) from state (t, e, v, a, accel, lam, work, powers, guesses,
@@ -859,27 +955,10 @@ class KernelSystem:
         step's statistics are the column after the last completed step. A refused call (a
         stale handle, no run set up, sizes inconsistent with the system) raises
         SolverError with the kernel's text."""
-        cuts, rows_cut = self._layout(store_q)
+        rows, stats, status, last_correction, message = self.advance_rows(nsteps, h, state,
+                                                                           store_q)
         npt = self.npoint
-        packed = np.empty(cuts[-1].stop)
-        packed[0] = state["t"]
-        for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
-            packed[part] = state[key]
-        if npt:
-            packed[cuts[8]] = np.asarray(state["guesses"])[:, :npt].ravel(order="F")
-        packed, counts, rows, stats, status, last_correction, message = _kernel.system_advance(
-            self.handle, nsteps, h, packed, _i(state["counts"]), rows_cut[-1].stop)
-        status = [int(x) for x in status]
-        if status[1] == 9:
-            self._failure(9, "system_advance", message)
-        state["t"] = float(packed[0])
-        for key, part in zip(_PACKED_ARRAYS, cuts[1:8]):
-            state[key] = packed[part]
-        state["counts"] = counts
-        if npt:  # (without contact the guesses are one unused column, left as they are)
-            guesses = np.array(state["guesses"], dtype=np.float64)
-            guesses[:, :npt] = packed[cuts[8]].reshape((2, npt), order="F")
-            state["guesses"] = guesses
+        rows_cut = self._layout(store_q)[1]
         time, probes, deflections, lam, energy, constraint, contact, q = rows_cut
         return dict(time=rows[0], probes=rows[probes].reshape((3, -1, nsteps), order="F"),
                     deflections=rows[deflections].reshape((3, -1, nsteps), order="F"),

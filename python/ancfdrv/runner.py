@@ -326,8 +326,14 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     recorder = _answers_recorder(scene, model, settings, e_start)
     if recorder is not None:
         settings.store_q = True  # the answers need every step's coordinates (not written)
+    # rows are written at least once a second (FLUSH_SECONDS) and whenever ~16 MB wait:
+    # each write of a series costs ~0.2 ms whatever its rows, so writing every kernel call
+    # (chunk_steps rows) took a third of a small model's run
+    row_bytes = 8 * (16 + 6 * len(model.probes) + len(model.constraints)
+                     + 6 * model.npoint + (model.ndof if settings.store_q else 0))
     writer = results.DynamicWriter(
-        out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
+        out, model, settings.store_q, max(settings.chunk_steps, (16 << 20) // row_bytes),
+        xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
         frames=scene["output"]["xdmf_frames"], write_q=write_q)
     base_sink = writer if supports is None else supports.wrap(writer)

@@ -319,7 +319,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),
         "q": Key("bool", False, doc="store the coordinates q at every step"),
         "chunk_steps": Key("int", 1000, positive,
-                           "steps per kernel call; each chunk is flushed to the file"),
+                           "steps per kernel call at most; the rows reach the file at least "
+                           "once a second"),
         "xdmf": Key("bool", True, doc="dynamic runs: write OUT.xdmf beside the result, the "
                     "motion of every body for ParaView (plates as quadrilaterals, beams as "
                     "polylines, rigid bodies as their centre and axes); stores q"),

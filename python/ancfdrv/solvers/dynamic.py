@@ -47,6 +47,7 @@ from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_IT
 from ..errors import Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver
+from ..kernel import _text as kernel_text
 from ..system.model import Model
 from .assumptions import FFR_LIMIT, check_ffr, ffr_departure_rows
 
@@ -208,10 +209,11 @@ class TimeIntegrator:
         the start of a run. The kernel's stepper gets the run's settings and forgets what it
         learned in earlier runs, so runs are reproducible."""
         self.model.kernel.stepper_setup(self.settings)
-        return dict(t=t, e=e.copy(), v=v.copy(), a=a.copy(), accel=a.copy(), lam=lam.copy(),
-                    work=np.zeros(5), powers=np.zeros(5),
-                    guesses=self.model.contact_guesses.copy(),
-                    counts=np.zeros(6, dtype=np.int32))
+        # one packed buffer the kernel steps in place (kernel.PackedState): its arrays are
+        # views, changed by the next call
+        return self.model.kernel.packed_state(dict(
+            t=t, e=e, v=v, a=a, accel=a, lam=lam, work=np.zeros(5), powers=np.zeros(5),
+            guesses=self.model.contact_guesses.copy(), counts=np.zeros(6, dtype=np.int32)))
 
     def advance(self, state: dict, nsteps: int, h: float | None = None
                 ) -> tuple[Chunk, int, int]:
@@ -219,21 +221,26 @@ class TimeIntegrator:
         Returns the chunk of completed steps, the kernel's info and detail codes (a failed
         step's statistics go to ``failed_stats``)."""
         s, m = self.settings, self.model
-        out = m.kernel.advance(nsteps, s.dt if h is None else h, state, s.store_q)
-        done, info, detail, floor = out["status"]
-        self.failure_text = out["message"]
+        kernel = m.kernel
+        # the raw rows, sliced here: a single step under step control costs ~60 us, so the
+        # numpy calls of an intermediate unpacking would show
+        rows, stats, status, self.last_correction, message = kernel.advance_rows(
+            nsteps, s.dt if h is None else h, state, s.store_q)
+        done, info, detail, floor = status
+        self.failure_text = kernel_text(message) if info else ""
         self.floor_accepts += floor
-        self.failed_stats = out["stats"][:, done].astype(np.int64) if info and done < nsteps \
-            else np.zeros(3, dtype=np.int64)
-        self.last_correction = out["last_correction"]
-        chunk = Chunk(time=out["time"][:done],
-                      probes=np.transpose(out["probes"][:, :m.kernel.nprobe, :done], (2, 1, 0)),
-                      deflections=np.transpose(out["deflections"][:, :m.kernel.nprobe, :done],
-                                               (2, 1, 0)),
-                      lam=out["lam"][:len(m.constraints), :done].T, energy=out["energy"][:, :done].T,
-                      constraint=out["constraint"][:done], stats=out["stats"][:, :done].T,
-                      q=out["q"][:, :done].T if s.store_q else None,
-                      contact=np.transpose(out["contact"][:, :m.npoint, :done], (2, 1, 0))
+        self.failed_stats = stats[:, done].astype(np.int64) if info and done < nsteps \
+            else _NO_STATS
+        _, probes, deflections, lam, energy, constraint, contact, q = kernel.row_slices(
+            s.store_q)
+        cols = rows.T[:done]     # (done, row_size): one row per step
+        chunk = Chunk(time=cols[:, 0],
+                      probes=cols[:, probes].reshape(done, kernel.nprobe, 3),
+                      deflections=cols[:, deflections].reshape(done, kernel.nprobe, 3),
+                      lam=cols[:, lam], energy=cols[:, energy],
+                      constraint=cols[:, constraint.start], stats=stats[:, :done].T,
+                      q=cols[:, q] if s.store_q else None,
+                      contact=cols[:, contact].reshape(done, m.npoint, len(CONTACT_RECORD))
                       if m.contact_pairs else None)
         return chunk, info, detail
 
@@ -258,6 +265,10 @@ class TimeIntegrator:
                        "smaller one")
         return f"time step from t = {t:.6g} s to t = {t + h:.6g} s failed: {reason}"
 
+
+#: a call's failed-step statistics when no step failed (shared, never written)
+_NO_STATS = np.zeros(3, dtype=np.int64)
+_NO_STATS.flags.writeable = False
 
 #: why a step's Newton iteration ended unconverged (time_integrator's newton_* codes; the
 #: kernel's message says it in words)
@@ -457,8 +468,11 @@ def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
 def initial_row(model: Model, state: dict) -> Chunk:
     """The output row of the initial state, with the kernel's energy definitions; the state
     gets the powers there (the start of the works the stepper integrates)."""
+    # (a copy of the guesses: output_row updates them in place, and the state's are the
+    # stepper's packed buffer; the contact counters count the row's evaluations, as before)
     row = model.kernel.output_row(state["t"], state["e"], state["v"], state["lam"],
-                                  state["work"], state["guesses"], state["counts"])
+                                  state["work"], np.array(state["guesses"], order="F"),
+                                  state["counts"])
     state["powers"] = row["powers"]
     # copies: the kernel updates the state's arrays in place as it steps on
     return Chunk(time=np.array([state["t"]]), probes=row["probes"][None],
