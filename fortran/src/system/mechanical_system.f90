@@ -647,10 +647,14 @@ contains
     energy = 0.0_dp
     powers = 0.0_dp
     info = 0
+    if (sys%nfel == 0) return
+    ! one work space for every element, sized for the kind with the most slots
+    ns = maxval([(force_element_slots(sys%fel_kind(l)), l = 1, sys%nfel)])
+    allocate (force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns))
     do l = 1, sys%nfel
       ns = force_element_slots(sys%fel_kind(l))
-      allocate (force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns))
-      call force_element_at(sys, l, t, e_full, v_full, force, stiffness, damping, el_energy, &
+      call force_element_at(sys, l, t, e_full, v_full, force(:, 1:ns), &
+                            stiffness(:, 1:ns, :, 1:ns), damping(:, 1:ns, :, 1:ns), el_energy, &
                             el_dissipation, el_power, reaction, info)
       if (info /= 0) return
       energy = energy + el_energy
@@ -663,7 +667,8 @@ contains
         end do
       end do
       if (present(values_full)) then
-        stiffness = stiffness + velocity_factor * damping
+        stiffness(:, 1:ns, :, 1:ns) = stiffness(:, 1:ns, :, 1:ns) &
+                                      + velocity_factor * damping(:, 1:ns, :, 1:ns)
         known = .false.
         if (allocated(sys%fel_pos_ptr)) known = sys%fel_pos_ptr(l + 1) > sys%fel_pos_ptr(l)
         next = 0
@@ -693,7 +698,6 @@ contains
           end do
         end do
       end if
-      deallocate (force, stiffness, damping)
     end do
   end subroutine force_element_forces
 
