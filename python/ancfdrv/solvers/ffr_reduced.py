@@ -179,6 +179,23 @@ def _check_scope(model: Model, static: StaticResult) -> None:
                               f"at t = {t})")
 
 
+def _pdelta_elements(model: Model, x_star: np.ndarray, basis: np.ndarray):
+    """Per element of the sets with second_order: its coordinates, the frame displacement
+    u* = A0^T x* - reference, the basis columns in the frame P = A0^T basis, G (x) I3 and
+    the axial force per column dN = EA (chord . P) / L."""
+    rotation = model.frames[0].rotation(0.0)
+    for s in model.sets:
+        if s.second_order is None:
+            continue
+        rigidity, axis, length, gram = s.second_order
+        for el in range(s.nel):
+            dofs = s.dofs[:, el]
+            u_star = _blocks(x_star[dofs], rotation.T) - s.reference[:, el]
+            p = _blocks(basis[dofs], rotation.T)
+            d_n = rigidity[el] * (axis[:, el] @ (p[12:15] - p[0:3])) / length[el]
+            yield dofs, u_star, p, np.kron(gram[:, :, el], np.eye(3)), d_n
+
+
 def _pdelta_patterns(model: Model, x_star: np.ndarray, responses: np.ndarray
                      ) -> np.ndarray | None:
     """Per response column delta: the P-delta force of its axial forces on the static
@@ -186,18 +203,9 @@ def _pdelta_patterns(model: Model, x_star: np.ndarray, responses: np.ndarray
     rotation = model.frames[0].rotation(0.0)
     out = np.zeros((model.ndof, responses.shape[1]))
     found = False
-    for s in model.sets:
-        if s.second_order is None:
-            continue
+    for dofs, u_star, _, g24, d_n in _pdelta_elements(model, x_star, responses):
         found = True
-        rigidity, axis, length, gram = s.second_order
-        for el in range(s.nel):
-            dofs = s.dofs[:, el]
-            u_star = _blocks(x_star[dofs], rotation.T) - s.reference[:, el]
-            p = _blocks(responses[dofs], rotation.T)
-            slope = _blocks(np.kron(gram[:, :, el], np.eye(3)) @ u_star, rotation)
-            d_n = rigidity[el] * (axis[:, el] @ (p[12:15] - p[0:3])) / length[el]
-            np.add.at(out, dofs, np.outer(slope, d_n))
+        np.add.at(out, dofs, np.outer(_blocks(g24 @ u_star, rotation), d_n))
     return out if found else None
 
 
@@ -206,25 +214,10 @@ def _pdelta_terms(model: Model, reduced: ReducedFFR, x_star: np.ndarray) -> None
     r = reduced.size
     linear, quadratic = np.zeros((r, r)), np.zeros((r, r, r))
     found = False
-    rotation = model.frames[0].rotation(0.0)
-    for s in model.sets:
-        if s.second_order is None:
-            continue
+    for _, u_star, p, g24, d in _pdelta_elements(model, x_star, reduced.basis):
         found = True
-        rigidity, axis, length, gram = s.second_order
-        for el in range(s.nel):
-            dofs = s.dofs[:, el]
-            # frame displacement of the element u = A0^T x - reference, and its basis P
-            u_star = _blocks(x_star[dofs], rotation.T) - s.reference[:, el]
-            p = _blocks(reduced.basis[dofs], rotation.T)
-            g24 = np.kron(gram[:, :, el], np.eye(3))
-            chord = np.zeros(24)
-            chord[0:3], chord[12:15] = -axis[:, el], axis[:, el]
-            d = rigidity[el] * (chord @ p) / length[el]
-            c = p.T @ g24 @ u_star
-            b = p.T @ g24 @ p
-            linear += np.outer(c, d)
-            quadratic += b[:, :, None] * d[None, None, :]
+        linear += np.outer(p.T @ g24 @ u_star, d)
+        quadratic += (p.T @ g24 @ p)[:, :, None] * d[None, None, :]
     if found:
         reduced.pdelta_linear, reduced.pdelta_quadratic = linear, quadratic
 
