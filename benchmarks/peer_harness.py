@@ -1555,10 +1555,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--hard-min-time", type=float, default=1.0,
                         help="spinup/pendulum: repeat a run until it took this long in all, at "
                              "most --repeats times (peer_exudyn.py's rule; default 1 s)")
-    parser.add_argument("--hard-bending", choices=("cubic", "cubic-planar"),
+    parser.add_argument("--hard-bending", choices=("cubic", "cubic-planar", "cable-planar"),
                         default="cubic-planar",
-                        help="spinup/pendulum: ancfdrv's option (default 'cubic-planar': the "
-                             "cubic option with scene.planar = 'xy', issue 23)")
+                        help="spinup: ancfdrv's option (default 'cubic-planar': the cubic "
+                             "option with scene.planar = 'xy', issue 23; 'cable-planar': the "
+                             "ANCF cable reduced to its plane, clamped to the hub by r and r_x, "
+                             "as Exudyn's ANCFCable2D)")
     parser.add_argument("--pendulum-bending", choices=("cubic", "cubic-planar", "cable-planar"),
                         default="cable-planar",
                         help="pendulum: ancfdrv's option (default 'cable-planar': the ANCF "
