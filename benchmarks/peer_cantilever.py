@@ -362,7 +362,8 @@ def markdown(report: dict[str, Any]) -> str:
         f"CPUs, Python {m['python']}; load average {m['load_average_at_start']} at the start, "
         f"{m.get('load_average_at_end')} at the end (a shared machine: other processes "
         f"distort the times; the ratios come from interleaved runs). Exudyn "
-        f"{report['exudyn']['version']}, 1 thread; ancfdrv 1 OpenMP thread.",
+        f"{report['exudyn']['version']}, 1 thread; ancfdrv 1 OpenMP thread "
+        f"({report.get('ancfdrv', {}).get('package', '?')}).",
         "",
         f"Problem: `{s['scene']}` (1 m steel strip, 1 mm x 1 mm, clamped, released under "
         f"gravity; q L^3/EI = 4.4), 0 ... {s['t_end']:g} s, dt = {s['dt']:g} s, "
@@ -385,8 +386,10 @@ def markdown(report: dict[str, Any]) -> str:
                 f"{_f(run['whole_s'])} | {run['newton_iterations'] / run['steps']:.2f} | "
                 f"{run['factorizations']} | "
                 f"{_f(row['ratios'].get(code), '.2f') if code != 'exudyn' else ''} |")
-    lines += ["", "Peak memory (fresh interpreter per run, ru_maxrss, MB): peak; after the "
-              "imports; increment = peak - after imports. Ratio: ours / Exudyn's (target <= 1.5).", "",
+    lines += ["", "Peak memory (fresh interpreter per run; VmHWM, the peak resident set that "
+              "ru_maxrss reports, without the parent's peak Linux carries over an exec; MB): "
+              "after the imports, after the build, at the end (peak); increment = peak - "
+              "after imports. Ratio: ours / Exudyn's (target <= 1.5).", "",
               "| elements | code | after imports | after build | peak | increment | "
               "peak / Exudyn's | increment / Exudyn's |", "|---:|---|---:|---:|---:|---:|---:|---:|"]
     for row in report["rows"]:
@@ -430,7 +433,8 @@ def main(argv: list[str] | None = None) -> int:
     import numpy as np
 
     sys.path.insert(0, str(REPO / "benchmarks"))
-    import ancfdrv.runner  # noqa: F401  (import time stays out of the first measurement)
+    import ancfdrv
+    import ancfdrv.runner  # import time stays out of the first measurement
     from _common import load_average, machine_info, write_report
     from _peer import exudyn_version, import_exudyn
 
@@ -523,6 +527,8 @@ def main(argv: list[str] | None = None) -> int:
                  "Exudyn time / ancfdrv time, ancfdrv memory / Exudyn memory",
         "machine": machine,
         "physics": data,
+        "ancfdrv": {"package": str(Path(ancfdrv.runner.__file__).parent),
+                    "version": getattr(ancfdrv, "__version__", None)},
         "exudyn": {"available": exu is not None, "skipped_because": note,
                    "version": exudyn_version(exu) if exu is not None else None},
         "rows": rows,
