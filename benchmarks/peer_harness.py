@@ -45,7 +45,9 @@ codes solve the same model):
     corner probe (0.3, 0.3, 0): distance between the codes' histories and to ancfdrv's
     finer reference mesh.
 ``spinup``, ``pendulum``
-    ``peer_exudyn.py``'s error-against-time curves with ancfdrv's cubic bending option:
+    ``peer_exudyn.py``'s error-against-time curves with ancfdrv's option of
+    ``--hard-bending`` (spin-up; 'cubic-planar' by default, 'cable-planar' the ANCF cable
+    clamped to the hub by r and r_x) and ``--pendulum-bending`` ('cable-planar'):
     the spin-up at W = 4 rad/s and at the scene's W = 6 rad/s, the flexible pendulum; for
     each, whether ancfdrv's curve dominates Exudyn's (for every Exudyn run an ancfdrv run
     at least as accurate in no more time), judged against each code's own finest run and
