@@ -237,8 +237,9 @@ def import_ancfdrv() -> None:
 
 def ancfdrv_overrides(problem: Problem, nodes: int, dt: float, bending: str) -> list[str]:
     """``bending``: 'cubic' or 'continuum', with '-planar' the scene reduced to its plane
-    (``scene.planar = 'xy'``, issue 23); 'cable-planar': the pendulum as an ANCF cable
-    (bending about the plane's normal), reduced."""
+    (``scene.planar = 'xy'``, issue 23); 'cable-planar': the pendulum or the spin-up as an
+    ANCF cable (bending about the plane's normal; the spin-up's hub holds r and r_x),
+    reduced."""
     option, _, planar = bending.partition("-")
     return [*problem.overrides, f"beam.nodes={nodes}", f"solver.dt={dt!r}",
             f"solver.t_end={problem.t_end!r}", f"beam.bending={option}"] + \

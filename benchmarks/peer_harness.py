@@ -45,7 +45,9 @@ codes solve the same model):
     corner probe (0.3, 0.3, 0): distance between the codes' histories and to ancfdrv's
     finer reference mesh.
 ``spinup``, ``pendulum``
-    ``peer_exudyn.py``'s error-against-time curves with ancfdrv's cubic bending option:
+    ``peer_exudyn.py``'s error-against-time curves with ancfdrv's option of
+    ``--hard-bending`` (spin-up; 'cubic-planar' by default, 'cable-planar' the ANCF cable
+    clamped to the hub by r and r_x) and ``--pendulum-bending`` ('cable-planar'):
     the spin-up at W = 4 rad/s and at the scene's W = 6 rad/s, the flexible pendulum; for
     each, whether ancfdrv's curve dominates Exudyn's (for every Exudyn run an ancfdrv run
     at least as accurate in no more time), judged against each code's own finest run and
@@ -1555,10 +1557,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--hard-min-time", type=float, default=1.0,
                         help="spinup/pendulum: repeat a run until it took this long in all, at "
                              "most --repeats times (peer_exudyn.py's rule; default 1 s)")
-    parser.add_argument("--hard-bending", choices=("cubic", "cubic-planar"),
+    parser.add_argument("--hard-bending", choices=("cubic", "cubic-planar", "cable-planar"),
                         default="cubic-planar",
-                        help="spinup/pendulum: ancfdrv's option (default 'cubic-planar': the "
-                             "cubic option with scene.planar = 'xy', issue 23)")
+                        help="spinup: ancfdrv's option (default 'cubic-planar': the cubic "
+                             "option with scene.planar = 'xy', issue 23; 'cable-planar': the "
+                             "ANCF cable reduced to its plane, clamped to the hub by r and r_x, "
+                             "as Exudyn's ANCFCable2D)")
     parser.add_argument("--pendulum-bending", choices=("cubic", "cubic-planar", "cable-planar"),
                         default="cable-planar",
                         help="pendulum: ancfdrv's option (default 'cable-planar': the ANCF "

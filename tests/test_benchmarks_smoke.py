@@ -95,3 +95,34 @@ def test_before_after_same_version(tmp_path):
         assert all(v == 0.0 for v in d["final_state_max_difference"].values())
     table = out.with_suffix(".md").read_text()
     assert "| boom_static |" in table and "| pendulum |" in table
+
+
+def test_peer_cantilever_smoke(tmp_path):
+    """benchmarks/peer_cantilever.py on 4 elements, 5 steps, one repeat: the JSON's shape,
+    the unknowns of both codes (4 per node), the step counts, a memory record per code
+    (fresh interpreters) and the two codes' tip histories agreeing (same physics)."""
+    import pytest
+    pytest.importorskip("exudyn")
+    out = tmp_path / "cantilever.json"
+    run_script("peer_cantilever.py", "--elements", "4", "--options", "cable", "--t-end",
+               "0.005", "--sample-dt", "0.001", "--repeats", "1", "--output", str(out))
+    report = json.loads(out.read_text())
+    assert report["benchmark"] == "peer_cantilever" and report["exudyn"]["available"]
+    (row,) = report["rows"]
+    assert row["elements"] == 4 and set(row["runs"]) == {"ancfdrv/cable", "exudyn"}
+    for code, run in row["runs"].items():
+        assert run["ok"], run
+        assert run["unknowns"] == 4 * 5 and run["steps"] == 5
+        assert positive(run["per_step_ms"]) and run["newton_iterations"] >= 5
+        memory = row["memory"][code]
+        assert memory["ok"], memory
+        marks = memory["marks_mb"]
+        assert marks["start"] <= marks["after_imports"] <= marks["after_build"] \
+            <= marks["after_solve"] == memory["peak_mb"]
+    assert positive(row["ratios"]["ancfdrv/cable"])
+    assert positive(row["memory_ratios"]["ancfdrv/cable"]["peak"])
+    # 5 steps of the drop: the tip has fallen g t^2 / 2 ~ 1.2e-4 m; the codes agree far closer
+    same = row["comparison"]["cable_vs_exudyn"]
+    assert 5e-5 < same["tip_y_range_m"] < 5e-4
+    assert same["max_abs_dy_m"] < 1e-3 * same["tip_y_range_m"]
+    assert out.with_suffix(".md").read_text().startswith("# Nonlinear cantilever")

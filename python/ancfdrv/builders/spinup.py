@@ -1,8 +1,13 @@
 """The spin-up beam of Simo & Vu-Quoc (REFERENCES.md): the root section clamped to a hub
 turning about r3 with the prescribed angle phi(t) (joint 'hub'); the beam's frame is the
-hub's, A(t) = R(phi(t)), in which the probe deflections are resolved."""
+hub's, A(t) = R(phi(t)), in which the probe deflections are resolved. ``beam.bending =
+'cable'`` (formulation 'nonlinear'; issue 23) builds the beam as an ANCF cable whose root
+position and slope r_x turn with the hub (Exudyn's clamp of ANCFCable2D to a hub)."""
 from __future__ import annotations
 
+import numpy as np
+
+from ..errors import InputError
 from ..system import System
 from .common import BuiltSystem, beam_loads, material, rectangle
 
@@ -13,6 +18,8 @@ def build(scene) -> BuiltSystem:
     built = BuiltSystem(s, ("tip", 1))
     drive = s.drive("hub", "spinup", omega=spin["omega"], period=spin["period"], start=0.0)
     tip = (beam["length"], 0.0, 0.0)
+    if beam["bending"] == "cable":
+        return _cable(scene, built, drive, tip)
     b = s.beam("beam", material=material(s, scene), start=(0.0, 0.0, 0.0), end=tip,
                nodes=beam["nodes"], section=rectangle(scene), height_axis=(0.0, 1.0, 0.0),
                formulation=scene["scene"]["formulation"], bending=beam["bending"],
@@ -22,4 +29,31 @@ def build(scene) -> BuiltSystem:
     s.joint("hub", "hub", "ground", "beam", point=(0.0, 0.0, 0.0), pivot=(0.0, 0.0, 0.0),
             axis=(0.0, 0.0, 1.0), drive=drive)
     beam_loads(built, scene, b, tip)
+    return built
+
+
+def _cable(scene, built: BuiltSystem, drive, tip) -> BuiltSystem:
+    """The spin-up beam as an ANCF cable (r, r_x per node, Euler-Bernoulli; the section
+    must have I_y = I_z unless the scene is planar 'xy', where it bends with I_z): the hub
+    joint holds the root's r and r_x on the turning hub, the cable carries the hub's frame
+    R(phi(t)) for its probe's deflection."""
+    s, beam = built.system, scene["beam"]
+    if scene["scene"]["formulation"] != "nonlinear":
+        raise InputError("bending = 'cable' is a large-deformation element: it needs "
+                         "scene.formulation = 'nonlinear'", group="beam", key="bending")
+    section = rectangle(scene)
+    square = abs(section.iy - section.iz) <= 1e-9 * max(section.iy, section.iz)
+    if not square and scene["scene"].get("planar", "off") != "xy":
+        raise InputError("bending = 'cable' with a section of two bending stiffnesses "
+                         f"(I_y = {section.iy:g}, I_z = {section.iz:g} m^4) bends in the r1-r2 "
+                         "plane only: it needs scene.planar = 'xy'", group="beam",
+                         key="bending")
+    c = s.cable("beam", material=material(s, scene), start=(0.0, 0.0, 0.0), end=tip,
+                nodes=beam["nodes"], section=section, segments=beam["segments"],
+                bending_inertia=None if square else section.iz)
+    c.frame_drive, c.frame_axis, c.frame_pivot = drive, np.array([0.0, 0.0, 1.0]), np.zeros(3)
+    c.orientation = np.eye(3)   # the frame's axes at phi = 0: along the cable, r2, r3
+    s.joint("hub", "hub", "ground", "beam", point=(0.0, 0.0, 0.0), pivot=(0.0, 0.0, 0.0),
+            axis=(0.0, 0.0, 1.0), drive=drive)
+    beam_loads(built, scene, c, tip)
     return built

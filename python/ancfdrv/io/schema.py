@@ -133,8 +133,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "bending": Key("str", "continuum", one_of("continuum", "cubic", "cable"),
                        "'continuum': the paper's element (curvature constant per element); "
                        "'cubic': curvature from the cubic centre line r_xx, higher accuracy "
-                       "(docs/theory.md section 12); 'cable' (boom and cantilever scenes, formulation "
-                       "'nonlinear'): the ANCF cable, r and r_x per node, Euler-Bernoulli "
+                       "(docs/theory.md section 12); 'cable' (boom, cantilever and spin-up "
+                       "scenes, formulation 'nonlinear'): the ANCF cable, r and r_x per node, "
+                       "Euler-Bernoulli "
                        "(a section with I_y != I_z bends about r3 and needs scene.planar = "
                        "'xy')"),
         "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),

@@ -519,11 +519,38 @@ class DynamicWriter:
                     "the row of /dynamic/time of each row of mesh_nodes (XDMF frames)")
 
     def __call__(self, chunk) -> None:
+        if self.store_q and not self.write_q and getattr(chunk, "q", None) is not None:
+            chunk = self._thinned(chunk)
         self._pending.append(chunk)
         self._pending_rows += len(chunk.time)
         if (self.rows == 0 or self._pending_rows >= self.flush_rows
                 or time.monotonic() - self._last_write >= FLUSH_SECONDS):
             self.flush()
+
+    #: the fields of a chunk besides q that are written (copied by :meth:`_thinned`)
+    _ROW_FIELDS = ("time", "probes", "deflections", "lam", "energy", "constraint", "stats",
+                   "contact", "step_size", "substeps", "cuts")
+
+    def _thinned(self, chunk):
+        """The chunk as it waits for the next flush when /dynamic/q is not written: the
+        XDMF frames' points of its frame rows (computed now, row by row as the flush would)
+        and the last row's q (for q_last) instead of q at every step, the other fields
+        copied. The kernel's row buffer, mostly q, is then released at once instead of
+        waiting up to FLUSH_SECONDS (issue 23: at 2052 unknowns ~16 kB per step waited,
+        and the flush's merge copied it again). The file is the same."""
+        from types import SimpleNamespace
+        out = SimpleNamespace(**{f: None if getattr(chunk, f, None) is None
+                                 else np.array(getattr(chunk, f)) for f in self._ROW_FIELDS})
+        out.q = None
+        n = len(chunk.time)
+        out.q_last = np.array(chunk.q[-1]) if n else None
+        out.frames = None
+        if self.nnodes and n:
+            rows = self.rows + self._pending_rows + np.arange(n)
+            pick = (rows % self.stride == 0) | (rows == self.last_row)
+            if pick.any():
+                out.frames = (rows[pick], self.layout.positions(self.model, chunk.q[pick]))
+        return out
 
     def flush(self) -> None:
         """Write every buffered chunk (one open of the file)."""
@@ -534,6 +561,7 @@ class DynamicWriter:
         pending = sum(sum(getattr(getattr(chunk, f, None), "nbytes", 0)
                           for f in ("time", "probes", "deflections", "lam", "energy",
                                     "constraint", "stats", "q", "contact"))
+                      + (chunk.frames[1].nbytes if getattr(chunk, "frames", None) else 0)
                       for chunk in self._pending)
         check_room(self.path, 2 * pending + self.chunk_bytes)
         with _open_write(self.path) as h5:
@@ -572,6 +600,12 @@ class DynamicWriter:
             "contact")})
         merged.step_size, merged.substeps, merged.cuts = (
             np.concatenate([s[k] for s in steps]) for k in range(3))
+        if any(hasattr(c, "q_last") for c in chunks):   # thinned chunks (:meth:`_thinned`)
+            lasts = [c.q_last for c in chunks if getattr(c, "q_last", None) is not None]
+            merged.q_last = lasts[-1] if lasts else None
+            frames = [c.frames for c in chunks if getattr(c, "frames", None) is not None]
+            merged.frames = (np.concatenate([f[0] for f in frames]),
+                             np.concatenate([f[1] for f in frames])) if frames else None
         return merged
 
     def _append(self, group: h5py.Group, chunk) -> None:
@@ -600,7 +634,11 @@ class DynamicWriter:
         append("factorizations", np.rint(chunk.stats[:, 1]).astype(np.int64))
         append("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64))
         self._append_steps(group, chunk)
-        if self.store_q and chunk.q is not None:
+        if self.store_q and getattr(chunk, "q_last", None) is not None:   # thinned
+            group["q_last"][...] = chunk.q_last
+            if chunk.frames is not None:
+                self._write_frames(group, *chunk.frames)
+        elif self.store_q and chunk.q is not None:
             if self.write_q:
                 append("q", chunk.q)
             elif n:
@@ -645,10 +683,13 @@ class DynamicWriter:
         pick = (rows % self.stride == 0) | (rows == self.last_row)
         if not pick.any():
             return
-        nodes = self.layout.positions(self.model, q[pick])
+        self._write_frames(group, rows[pick], self.layout.positions(self.model, q[pick]))
+
+    def _write_frames(self, group: h5py.Group, rows: np.ndarray, nodes: np.ndarray) -> None:
+        """Append frames: the rows of /dynamic/time they show and their points."""
         for name, values in (("mesh_nodes", nodes),
                              ("mesh_displacement", nodes - self.layout.points[None, :, :]),
-                             ("mesh_rows", rows[pick])):
+                             ("mesh_rows", rows)):
             _append_rows(group.id, name, self.frames, values)
         self.frames += len(nodes)
 

@@ -30,15 +30,18 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as la
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..errors import SolverError
 from ..kernel import DirectSolver
 from ..system.model import Model
 from .modal import DENSE_LIMIT, linearize, null_space
 from .static import StaticResult
+from .._lazy import LazyModule
+
+# imported on first use (ancfdrv._lazy): ~10 MB most runs never need
+la = LazyModule("scipy.linalg")
+spla = LazyModule("scipy.sparse.linalg")
 
 
 @dataclass

@@ -40,7 +40,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as la
 
 from .. import kernel
 from ..errors import SolverError
@@ -48,6 +47,10 @@ from ..system.drives import Drive
 from ..system.model import Model
 from .modal import linearize, null_space
 from .static import StaticResult
+from .._lazy import LazyModule
+
+# imported on first use (ancfdrv._lazy): ~10 MB most runs never need
+la = LazyModule("scipy.linalg")
 
 
 @dataclass

@@ -38,14 +38,17 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as la
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..errors import SolverError
 from ..kernel import DirectSolver
 from ..system.model import Model
 from .static import StaticResult, solve_newton
+from .._lazy import LazyModule
+
+# imported on first use (ancfdrv._lazy): ~10 MB most runs never need
+la = LazyModule("scipy.linalg")
+spla = LazyModule("scipy.sparse.linalg")
 
 #: largest number of coordinates minus constraints solved densely by ``solver='auto'``
 DENSE_LIMIT = 150

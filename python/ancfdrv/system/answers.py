@@ -48,7 +48,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..codes import CONSTRAINT_COORDINATE
 from .bodies import Beam, Plate, RigidBody
@@ -58,6 +57,10 @@ from .expressions import Scalar
 from .joints import Constraint, LinearEquation
 from .model import Model
 from .sections import Box, Circle, Rectangle, Tube
+from .._lazy import LazyModule
+
+# imported on first use (ancfdrv._lazy): ~10 MB most runs never need
+spla = LazyModule("scipy.sparse.linalg")
 
 #: output.stations default: points per element where section forces are evaluated
 DEFAULT_STATIONS = 3
