@@ -9,7 +9,11 @@ large-deformation model (``scene.formulation=nonlinear``, ``beam.bending=cubic``
 ``--reference-nodes`` (28; 40 differs from it by 6e-5 / 2e-4 of the sag range at m = 50 / 0,
 printed with ``--check-reference``). Errors: max |sag - sag_ref| over the history (the
 transverse tip deflection in the rotating frame, ``/dynamic/deflection/tip`` component y),
-in % of the reference's sag range max - min (the measure of peer_harness.py). Also printed:
+in % of the reference's sag range max - min (the measure of peer_harness.py). Each FFR run
+is also judged against the large-deformation model with its own bending option on its own
+mesh ('same mesh': what the FFR approximation and P-delta cost, apart from the mesh's error),
+and ``--mesh-check N`` runs that model on N nodes too ('mesh error': how far the 28-node
+mesh of each bending option is from a finer one). Also printed:
 the solve time (``/dynamic`` wall_time_s; the machine's load is not controlled: compare
 within one run), Newton corrections per step and factorizations. JSON to ``-o``.
 
@@ -58,6 +62,9 @@ def main() -> None:
     parser.add_argument("--check-reference", type=int, default=0,
                         help="also run the reference at this many nodes and print the gap")
     parser.add_argument("--t-end", type=float, default=None)
+    parser.add_argument("--mesh-check", type=int, default=0,
+                        help="also run the large-deformation model of each bending option on "
+                             "this many nodes and print its gap to the --nodes mesh")
     args = parser.parse_args()
     common = [f"beam.nodes={args.nodes}"] + ([f"solver.t_end={args.t_end}"] if args.t_end else [])
     record: dict = {"scene": str(SCENE.relative_to(REPO)), "nodes": args.nodes,
@@ -77,15 +84,33 @@ def main() -> None:
                 case["reference_gap_percent"] = 100.0 * gap / sag_range
                 print(f"m = {mass:g}: reference {args.reference_nodes} vs "
                       f"{args.check_reference} nodes: {case['reference_gap_percent']:.4f}%")
+            same: dict[str, dict] = {}
+            for bending in ("continuum", "cubic"):
+                nonlinear = ["scene.formulation=nonlinear", "solver.static_method=newton",
+                             f"beam.bending={bending}"]
+                same[bending] = run([*base, *common, *nonlinear], work)
+                if args.mesh_check:
+                    fine = run([*base, *nonlinear, f"beam.nodes={args.mesh_check}"], work)
+                    gap = float(np.max(np.abs(np.interp(fine["t"], same[bending]["t"],
+                                                        same[bending]["sag"]) - fine["sag"])))
+                    case.setdefault("mesh_error_percent", {})[bending] = \
+                        100.0 * gap / float(np.ptp(fine["sag"]))
+                    print(f"m = {mass:g}: nonlinear {bending} {args.nodes} vs {args.mesh_check} "
+                          f"nodes: {case['mesh_error_percent'][bending]:.4f}%")
             for label, overrides in CONFIGS.items():
                 r = run([*base, *common, *overrides], work)
                 err = float(np.max(np.abs(np.interp(ref["t"], r["t"], r["sag"]) - ref["sag"])))
+                own = same["cubic" if "cubic" in label else "continuum"]
+                err_same = float(np.max(np.abs(np.interp(own["t"], r["t"], r["sag"])
+                                               - own["sag"])))
                 row = {"error_m": err, "error_percent": 100.0 * err / sag_range,
+                       "error_same_mesh_percent": 100.0 * err_same / float(np.ptp(own["sag"])),
                        **{k: r[k] for k in ("solve_s", "corrections_per_step",
                                             "factorizations")}}
                 case["runs"][label] = row
                 print(f"m = {mass:4g} kg  {label:26s} error {row['error_percent']:7.3f}% of "
-                      f"{sag_range:.4f} m   solve {row['solve_s']:.3f} s   "
+                      f"{sag_range:.4f} m, {row['error_same_mesh_percent']:6.3f}% against the "
+                      f"same element and mesh   solve {row['solve_s']:.3f} s   "
                       f"{row['corrections_per_step']:.2f} corrections/step", flush=True)
             record["cases"].append(case)
     if args.output:

@@ -473,13 +473,25 @@ def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
     data = beam.section.data
     xi = tables.xi
 
+    # the rows' vectors side by side: (nel, 8, rows * 3), so each table costs one product
+    # per element instead of one per element and row (numpy's batched matmul calls BLAS
+    # once per (np, 8) @ (8, 3) block: 0.8 ms per output row of a 40-element beam)
+    lead = vectors.shape[:-3]
+    rows = int(np.prod(lead)) if lead else 1
+    side = np.moveaxis(vectors.reshape(rows, *vectors.shape[-3:]), 0, -2)
+    side = side.reshape(*side.shape[:-2], rows * 3)
+
+    def product(t: np.ndarray) -> np.ndarray:   # (nel, np, 8) @ (..., nel, 8, 3)
+        out = np.matmul(t, side).reshape(*t.shape[:-1], rows, 3)
+        return np.moveaxis(out, -2, 0).reshape(*lead, *t.shape[:-1], 3)
+
     def fields(table: list[np.ndarray]) -> list[np.ndarray]:
-        return [np.matmul(t, vectors) for t in table]   # (nel, np, 8) @ (..., nel, 8, 3)
+        return [product(t) for t in table]
 
     def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return (a * b).sum(axis=-1)
     rx, rxx, ry, rz, ryx, rzx = fields(tables.at)
-    slope = np.matmul(tables.axial[0], vectors)
+    slope = product(tables.axial[0])
     eps = 0.5 * (dot(slope, slope) - 1.0) @ tables.axial_fit.T
     b_y = -dot(ryx, rx)
     b_z = -dot(rzx, rx)
