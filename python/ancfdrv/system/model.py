@@ -445,20 +445,20 @@ class Model:
             if (np.any(np.diff(b.indptr) != 1) or np.any(b.data != 1.0)
                     or np.any(np.bincount(b.indices, minlength=self.nfull) > 1)):
                 return None
-        from .cable import Cable   # (cable imports the model layer's bodies)
         first, weight, position = [], [], []
         for body in self.bodies:
-            if isinstance(body, (Beam, RigidBody)):
-                per_node, nodes = 4, 1 if isinstance(body, RigidBody) else body.nodes
-            elif isinstance(body, Plate):
-                per_node, nodes = 3, body.mesh.nnodes
-            elif isinstance(body, Cable):
-                per_node, nodes = 2, body.nodes
-            elif body.ncoordinates == 0:
+            if body.ncoordinates == 0:   # the ground
                 continue
+            if isinstance(body, RigidBody):
+                nodes = 1
+            elif isinstance(body, Plate):
+                nodes = body.mesh.nnodes
+            elif hasattr(body, "nodes"):   # beams and cables: r and its gradients per node
+                nodes = body.nodes
             else:
                 return None
-            if body.ncoordinates != 3 * per_node * nodes:
+            per_node, rest = divmod(body.ncoordinates, 3 * nodes)
+            if rest or per_node not in (2, 3, 4):
                 return None
             for node in range(nodes):
                 for k in range(per_node):
