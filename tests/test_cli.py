@@ -213,6 +213,8 @@ def test_sweep_compares_formulations_side_by_side(tmp_path):
     rows = {r["scene.formulation"]: r for r in csv.DictReader(open(out / "summary.csv"))}
     assert float(rows["nonlinear"]["diff_vs_nonlinear"]) == 0.0
     assert 1e-4 < float(rows["ffr"]["diff_vs_nonlinear"]) < 0.2
-    # refactorized, but reused across steps (jacobian = 'reuse'; 'step' made 1000)
-    assert 1 < int(rows["nonlinear"]["factorizations"]) < 500
+    # refactorizable, but reused across steps (jacobian = 'reuse'; 'step' made 1000) and
+    # carried with the boom's luffing turn (solver.carry: one matrix serves the run; 13
+    # without the carry)
+    assert 1 <= int(rows["nonlinear"]["factorizations"]) < 50
     assert int(rows["ffr"]["factorizations"]) == 1  # one per run

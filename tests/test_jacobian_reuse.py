@@ -94,8 +94,10 @@ def test_reuse_backs_off_where_old_matrices_do_not_serve(tmp_path):
     start fresh) it costs no more factorizations than 'step' and at most 25 % more
     corrections (measured 3527 and 9351 against 4000 and 8731), and keeps its gain while
     the beam turns slowly (the first 2.5 s: under 0.25 factorizations per step, measured
-    0.10). The answer is unchanged (full Newton's, 1e-6)."""
-    overrides = ["spinup.omega=6"]
+    0.10). The answer is unchanged (full Newton's, 1e-6). This is the back-off of a matrix
+    reused unturned (solver.carry = 'off'); the default carries the matrix with the beam's
+    rotation instead (tests/test_carry.py: a few factorizations for the whole run)."""
+    overrides = ["spinup.omega=6", "solver.carry=off"]
     base = INPUTS / "hard" / "spinup.nml"
     histories = {}
     for jacobian in ("reuse", "step"):

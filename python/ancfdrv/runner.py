@@ -87,7 +87,8 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
                   chunk_steps=output["chunk_steps"], store_q=output["q"],
                   jacobian=solver["jacobian"], contraction=solver["contraction"],
                   dt_min=solver.get("dt_min", 0.0), step=solver.get("step", "fixed"),
-                  tolerance=solver.get("tolerance", 1e-6))
+                  tolerance=solver.get("tolerance", 1e-6),
+                  carry=solver.get("carry", "rotation"))
     if solver["integrator"] == "generalized_alpha":
         return DynamicSettings.generalized_alpha(solver["dt"], solver["t_end"],
                                                  solver["rho_inf"], **common)

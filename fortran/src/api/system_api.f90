@@ -502,6 +502,65 @@ subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, m
   sys%factorized = .false.
 end subroutine system_set_matrices
 
+!> The 3-vectors jacobian_reuse carries the iteration matrix with (carried_rotation): the
+!> first full dof of each (1-based), its weight in the rotation fit and whether it is a
+!> position (1) or a gradient or director (0); nvec = 0: the matrix is not carried. The
+!> model layer decides where the carry is exact (every full coordinate a 3-vector, the
+!> reduction a selection). info: 1 not a live handle; 2 a dof outside 1..nfull - 2 or a
+!> negative weight.
+subroutine system_set_carry(handle, nvec, first, weight, position, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use system_store, only: store_get
+  use kernel_errors, only: handle_text
+  implicit none
+  integer, intent(in) :: handle, nvec, first(max(1, nvec)), position(max(1, nvec))
+  real(dp), intent(in) :: weight(max(1, nvec))
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  integer :: i, k
+  message = ' '
+  call store_get(handle, sys, info)
+  if (info /= 0) then
+    message = handle_text(handle)
+    return
+  end if
+  if (nvec > 0) then
+    if (any(first(1:nvec) < 1 .or. first(1:nvec) > sys%nfull - 2) .or. &
+        any(weight(1:nvec) < 0.0_dp) .or. mod(sys%nfull, 3) /= 0) then
+      info = 2
+      message = 'system_set_carry: a carried vector outside the full coordinates, a ' // &
+                'negative weight, or full coordinates that are not 3-vectors'
+      return
+    end if
+  end if
+  sys%carry_first = first(1:max(0, nvec))
+  sys%carry_weight = weight(1:max(0, nvec))
+  sys%carry_position = position(1:max(0, nvec)) /= 0
+  if (allocated(sys%carry_map)) deallocate (sys%carry_map)
+  if (nvec == 0) return
+  allocate (sys%carry_map(3, sys%nfull / 3))
+  if (.not. sys%reduced) then
+    sys%carry_map = reshape([(i, i = 1, sys%nfull)], [3, sys%nfull / 3])
+    return
+  end if
+  sys%carry_map = 0
+  do i = 1, sys%nfull  ! a selection: at most one unit entry per row of B
+    k = sys%reduction_ptr(i)
+    if (sys%reduction_ptr(i + 1) - k /= 1) cycle
+    if (sys%reduction_values(k) /= 1.0_dp) cycle
+    sys%carry_map(mod(i - 1, 3) + 1, (i - 1) / 3 + 1) = sys%reduction_col(k)
+  end do
+  if (count(sys%carry_map > 0) /= sys%ndof .or. any(sys%reduction_ptr(2:) - &
+      sys%reduction_ptr(:sys%nfull) > 1)) then
+    info = 2
+    message = 'system_set_carry: the reduction is not a selection of coordinates'
+    deallocate (sys%carry_first, sys%carry_weight, sys%carry_position, sys%carry_map)
+    allocate (sys%carry_first(0), sys%carry_weight(0), sys%carry_position(0))
+  end if
+end subroutine system_set_carry
+
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),
 !> replacing the CSR of system_set_matrices in products (a ninth of the entries).
 subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, message)

@@ -49,6 +49,13 @@ module stepper
     ! than e''_n did
     real(dp), allocatable :: accel_before(:)
     logical :: predict_from_before = .false.
+    ! the matrix carried with the system's rotation (carried_rotation): the carried vectors
+    ! at the factorization (3, nvec), the turn from them to the current step's predicted
+    ! state and whether the step uses it (a turn above carry_threshold)
+    real(dp), allocatable :: carry_reference(:, :)
+    real(dp) :: carry_turn(3, 3) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, &
+                                            0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
+    logical :: carry_on = .false.
   end type stepper_state
 
   !> A system's stepper: its run's settings, its learned state, whether a run was set up.

@@ -56,6 +56,8 @@ module time_integrator
                      jacobian_reuse, update_reuse_backoff
   use kernel_errors, only: failure_text, message_length
   use sparse_direct, only: solver_solve
+  use carried_rotation, only: carry_enabled, carry_vectors, carry_turn, carry_apply, &
+                              carry_gradients
   implicit none
   private
   public :: integrator_chunk, output_row, step_failure_text
@@ -76,6 +78,9 @@ module time_integrator
   !> the smallest newton_tol that double precision resolves: a stall at the floor with a
   !> tolerance at least this is converged (counted); below it the tolerance cannot be met
   real(dp), parameter :: resolvable_tol = 100.0_dp * epsilon(1.0_dp)
+  !> the smallest turn (rad) since the factorization that jacobian_reuse carries the matrix
+  !> through (carried_rotation); below it the unturned matrix is as good
+  real(dp), parameter :: carry_threshold = 1e-3_dp
 
   !> The stagnation and divergence test of a step's Newton iteration (reset at each try).
   type :: newton_monitor
@@ -190,6 +195,7 @@ contains
         else if (attempt == 1) then
           started_old = sys%policy /= policy_constant
         end if
+        call carry_step(sys, cfg, learned, fresh_matrix, e_new)
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     stats, done, last_correction, monitor, info, detail)
@@ -293,7 +299,34 @@ contains
       learned%theta = -1.0_dp
       learned%unconfirmed = 0
     end if
+    learned%carry_on = .false.
+    if (info == 0 .and. carry_enabled(sys)) then
+      if (.not. allocated(learned%carry_reference)) &
+        allocate (learned%carry_reference(3, size(sys%carry_first)))
+      call carry_vectors(sys, e, learned%carry_reference)
+    end if
   end subroutine factorize
+
+  !> jacobian_reuse with a carried matrix: the turn of the system from the factorization to
+  !> the step's predicted state e (carried_rotation), used by the step's corrections when it
+  !> exceeds carry_threshold; off with a fresh matrix (factorized at e itself).
+  subroutine carry_step(sys, cfg, learned, fresh_matrix, e)
+    type(system_model), intent(in) :: sys
+    type(stepper_settings), intent(in) :: cfg
+    type(stepper_state), intent(inout) :: learned
+    logical, intent(in) :: fresh_matrix
+    real(dp), intent(in) :: e(:)
+    real(dp), allocatable :: current(:, :)
+    real(dp) :: angle
+    integer :: svd_info
+    learned%carry_on = .false.
+    if (fresh_matrix .or. cfg%jacobian /= jacobian_reuse .or. .not. carry_enabled(sys) .or. &
+        .not. sys%factorized .or. .not. allocated(learned%carry_reference)) return
+    allocate (current(3, size(sys%carry_first)))
+    call carry_vectors(sys, e, current)
+    call carry_turn(sys, learned%carry_reference, current, learned%carry_turn, angle, svd_info)
+    learned%carry_on = svd_info == 0 .and. angle > carry_threshold
+  end subroutine carry_step
 
   !> Whether the step starts with a new factorization.
   pure logical function needs_factorization(sys, cfg, beta_prime, attempt)
@@ -330,10 +363,14 @@ contains
     real(dp) :: dlam(sys%ncon, 1), strain, previous_correction, step_cap, step_theta
     integer :: it, ipiv(sys%ncon), lapack_info, active
     logical :: use_known, refresh, capped, halt
+    ! the carried matrix's Schur complement, built at the step's first carried correction
+    real(dp), allocatable :: carry_flexibility(:, :), carry_lu(:, :)
+    logical :: carry_ready
     info = 0
     detail = 0
     done = .false.
     use_known = fresh_matrix
+    carry_ready = .false.
     previous_correction = huge(1.0_dp)
     step_theta = 0.0_dp
     active = sys%factor_active
@@ -356,18 +393,30 @@ contains
                       phi, gradients, strain, active, info, predicted_internal)
         if (info /= 0) return
       end if
-      ! z = U S^{-1} U^T r
-      call to_solver_frame(sys, rotations, r, .true., z(:, 1))
+      ! z = U S^{-1} U^T r (carried: T S^{-1} T^T r)
+      if (learned%carry_on) then
+        call carry_apply(sys, learned%carry_turn, r, .true., z(:, 1))
+      else
+        call to_solver_frame(sys, rotations, r, .true., z(:, 1))
+      end if
       call solver_solve(sys%solver_handle, sys%ndof, 1, z, info, detail)
       if (info /= 0) then
         detail = info
         info = 3
         return
       end if
-      call to_solver_frame(sys, rotations, z(:, 1), .false., direction)
+      if (learned%carry_on) then
+        call carry_apply(sys, learned%carry_turn, z(:, 1), .false., direction)
+      else
+        call to_solver_frame(sys, rotations, z(:, 1), .false., direction)
+      end if
       correction = -direction
       dlam = 0.0_dp
-      if (sys%ncon > 0) then
+      if (sys%ncon > 0 .and. learned%carry_on) then
+        ! the Schur complement with the carried matrix: C = G^T S^{-1} G, G = T^T Phi_e^T
+        call carry_schur()
+        if (info /= 0) return
+      else if (sys%ncon > 0) then
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
         call frame_gradients(sys, rotations, gradients, w)
         schur = matmul(transpose(w), matmul(sys%flexibility_cc, w))
@@ -449,6 +498,72 @@ contains
     end do
 
   contains
+
+    !> dlam and the correction of a carried matrix: F = S^{-1} G (G = T^T Phi_e^T) by one
+    !> solve of ncon right-hand sides and the LU factors of C = G^T F, both at the step's
+    !> first carried correction and kept for its others (the gradients move little within a
+    !> step; the residual and Phi stay exact, so the converged state does not depend on
+    !> them); then C dlam = Phi_e z - Phi, correction = T F dlam - z.
+    subroutine carry_schur()
+      real(dp) :: columns(sys%ndof, sys%ncon), turned(sys%ndof)
+      if (.not. carry_ready) then
+        if (.not. allocated(carry_flexibility)) &
+          allocate (carry_flexibility(sys%ndof, sys%ncon), carry_lu(sys%ncon, sys%ncon))
+        call carry_gradients(sys, learned%carry_turn, gradients, columns)
+        if (gather_blocks(columns, w)) then
+          ! within the factorization's flexibility S^{-1} E_c (the model's touched blocks
+          ! hold each constrained vector whole): no solve
+          carry_flexibility = matmul(sys%flexibility, w)
+          carry_lu = matmul(transpose(w), matmul(sys%flexibility_cc, w))
+        else
+          carry_flexibility = columns
+          call solver_solve(sys%solver_handle, sys%ndof, sys%ncon, carry_flexibility, info, &
+                            detail)
+          if (info /= 0) then
+            detail = info
+            info = 3
+            return
+          end if
+          carry_lu = matmul(transpose(columns), carry_flexibility)
+        end if
+        call dgetrf(sys%ncon, sys%ncon, carry_lu, sys%ncon, ipiv, lapack_info)
+        if (lapack_info /= 0) then
+          info = 4
+          detail = lapack_info
+          return
+        end if
+        carry_ready = .true.
+      end if
+      dlam(:, 1) = gradient_dot(sys, gradients, direction) - phi
+      call dgetrs('N', sys%ncon, 1, carry_lu, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
+      call carry_apply(sys, learned%carry_turn, matmul(carry_flexibility, dlam(:, 1)), .false., &
+                       turned)
+      correction = turned - direction
+    end subroutine carry_schur
+
+    !> w = E_c^T columns (the rows of the touched blocks; a dof in two blocks: the first)
+    !> when every nonzero of columns lies in a touched block; .false. otherwise.
+    logical function gather_blocks(columns, w) result(inside)
+      real(dp), intent(in) :: columns(:, :)
+      real(dp), intent(out) :: w(:, :)
+      integer :: row_of(sys%ndof), b, j, dof
+      row_of = 0
+      do b = size(sys%block_first), 1, -1
+        do j = 0, 2
+          row_of(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
+        end do
+      end do
+      w = 0.0_dp
+      inside = .true.
+      do dof = 1, sys%ndof
+        if (row_of(dof) > 0) then
+          w(row_of(dof), :) = columns(dof, :)
+        else if (any(columns(dof, :) /= 0.0_dp)) then
+          inside = .false.
+          return
+        end if
+      end do
+    end function gather_blocks
 
     subroutine refresh_matrix()
       call factorize(sys, learned, beta_prime, velocity_factor, rotations, e_new, v_new, state, &

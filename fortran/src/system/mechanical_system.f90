@@ -150,6 +150,15 @@ module mechanical_system
     integer :: factor_active = -1                      ! active contact points at it
     ! (what the stepper learns from step to step lives apart: stepper.f90)
     real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
+    ! the matrix carried with the system's rotation (carried_rotation): the first full dof of
+    ! each carried 3-vector, its weight in the rotation fit, whether it is a position (fitted
+    ! about the centroid) or a gradient or director; none: not carried
+    integer, allocatable :: carry_first(:)
+    real(dp), allocatable :: carry_weight(:)
+    logical, allocatable :: carry_position(:)
+    ! the reduced coordinate of each component of every full 3-vector (0: fixed by the
+    ! reduction), (3, nfull / 3)
+    integer, allocatable :: carry_map(:, :)
   end type system_model
 
 contains

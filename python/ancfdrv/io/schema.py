@@ -295,6 +295,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
                            "jacobian = 'reuse': refresh when a correction exceeds this fraction "
                            "of the previous one (0.25: an old matrix that contracts more slowly "
                            "costs more corrections than a new one costs to factorize)"),
+        "carry": Key("str", "rotation", one_of("rotation", "off"),
+                     "jacobian = 'reuse': 'rotation' turns the kept iteration matrix with the "
+                     "system's rotation since it was factorized (absolute-coordinate models "
+                     "without contact; docs/theory.md section 28), so a spinning or swinging "
+                     "body keeps its matrix; 'off' reuses it unturned"),
         "settle": Key("str", "none", one_of("none", "unloaded", "loaded"),
                       "dynamic runs start at rest from: 'none' the assembled configuration; "
                       "'unloaded' the equilibrium of the internal forces alone (prestress "

@@ -86,6 +86,9 @@ class DynamicSettings:
     step: str = "fixed"
     #: step = 'adaptive': the local error allowed per step, relative to the length scale
     tolerance: float = 1e-6
+    #: jacobian = 'reuse': 'rotation' carries the iteration matrix with the system's
+    #: rotation where that is exact (Model.carry_vectors), 'off' reuses it unturned
+    carry: str = "rotation"
 
     @property
     def smallest_step(self) -> float:
@@ -208,6 +211,10 @@ class TimeIntegrator:
         """A stepper state at t with q'' = a (the generalized-alpha variable starts at a):
         the start of a run. The kernel's stepper gets the run's settings and forgets what it
         learned in earlier runs, so runs are reproducible."""
+        if self.settings.carry not in ("rotation", "off"):
+            raise SolverError(f"carry {self.settings.carry!r} must be 'rotation' or 'off'")
+        self.model.kernel.set_carry(self.model.carry_vectors()
+                                    if self.settings.carry == "rotation" else None)
         self.model.kernel.stepper_setup(self.settings)
         # one packed buffer the kernel steps in place (kernel.PackedState): its arrays are
         # views, changed by the next call

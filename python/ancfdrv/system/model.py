@@ -427,12 +427,66 @@ class Model:
         ok_m = abs(mass - u @ mass @ u.T).max() <= 1e-12 * max(abs(mass).max(), 1e-300)
         return bool(ok_k and ok_m)
 
+    def carry_vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The 3-vectors the stepper fits the system's rotation to when it carries its
+        iteration matrix under rotation (``solver.carry``, docs/theory.md "The iteration
+        matrix carried with the rotation"): (first full coordinate of each vector, weight,
+        1 for a position / 0 for a gradient or director), or None where turning the matrix
+        does not follow the system: FFR sets (their frames already carry theirs), contact,
+        bodies whose coordinates are not all global 3-vectors, a reduction that does more
+        than select coordinates (eliminated joints). Positions weigh 1, the unit-size
+        gradients and directors the model's length squared, so both shares compare."""
+        if self.policy != POLICY_REFACTOR or self.contact_pairs or self.nfull % 3:
+            return None
+        if any(s.kind == "ffr" for s in self.sets):   # (other kinds ignore their frame)
+            return None
+        if self.reduction is not None:
+            b = self.reduction.matrix.tocsc()
+            if (np.any(np.diff(b.indptr) != 1) or np.any(b.data != 1.0)
+                    or np.any(np.bincount(b.indices, minlength=self.nfull) > 1)):
+                return None
+        first, weight, position = [], [], []
+        for body in self.bodies:
+            if body.ncoordinates == 0:   # the ground
+                continue
+            if isinstance(body, RigidBody):
+                nodes = 1
+            elif isinstance(body, Plate):
+                nodes = body.mesh.nnodes
+            elif hasattr(body, "nodes"):   # beams and cables: r and its gradients per node
+                nodes = body.nodes
+            else:
+                return None
+            per_node, rest = divmod(body.ncoordinates, 3 * nodes)
+            if rest or per_node not in (2, 3, 4):
+                return None
+            for node in range(nodes):
+                for k in range(per_node):
+                    first.append(body.first + 3 * (per_node * node + k))
+                    position.append(1 if k == 0 else 0)
+                    weight.append(1.0 if k == 0 else self.length_scale**2)
+        if not first:
+            return None
+        return (np.array(first, dtype=np.int64), np.array(weight),
+                np.array(position, dtype=np.int64))
+
     def touched_blocks(self) -> np.ndarray:
         """First coordinates (0-based) of the 3-vector blocks holding every constrained
         coordinate (the last block kept inside the vector)."""
         used = self.constraints.touched()
         if not len(used):
             return np.zeros(0, dtype=np.int64)
+        if self.carry_vectors() is not None:
+            # a carried matrix turns each constrained 3-vector whole (carried_rotation): its
+            # other reduced components join the blocks, so the turned gradients stay within
+            # the factorization's flexibility (no solves per step)
+            index = self.reduction.independent if self.reduction is not None else \
+                np.arange(self.nfull)
+            reduced_of = np.full(self.nfull, -1)
+            reduced_of[index] = np.arange(len(index))
+            full = index[used]
+            partners = reduced_of[(full - full % 3)[:, None] + np.arange(3)].ravel()
+            used = np.union1d(used, partners[partners >= 0])
         return np.unique(np.minimum(used - used % 3, self.ndof - 3))
 
     def banded(self) -> bool:

@@ -1,0 +1,237 @@
+!> The iteration matrix carried with the system's rotation (issue 23, item 3).
+!>
+!> Every coordinate of an absolute-coordinate system (ANCF positions and gradients, a rigid
+!> body's position and directors) is a 3-vector in the global axes, the mass matrix is
+!> kron(Mbar, I3) and the elastic forces are objective. Turning a configuration q rigidly by
+!> R turns its iteration matrix with it: S(T q) = T S(q) T^T with T = blockdiag(R, R, ..)
+!> (the mass term because every 3 x 3 block of M is a scalar times I3, the stiffness
+!> because the strain energy does not change under a rigid turn). A matrix factorized at
+!> q_f therefore serves at a state q that is q_f turned by R, plus a deformation, as
+!> S(q)^{-1} ~ T S(q_f)^{-1} T^T, where reusing it unturned would see its stiff directions
+!> (axial, in-plane) misaligned by the whole turn: modified Newton then stops contracting
+!> and the stepper refactorizes in every step of a spinning or swinging body.
+!>
+!> R is fitted to the system's carried 3-vectors (weighted orthogonal Procrustes, the Kabsch
+!> algorithm: positions about their weighted centroid, gradients and directors as they are):
+!> the rotation that best maps the vectors at the factorization onto the current ones. A
+!> small multiple of the identity added to their correlation keeps directions the vectors
+!> do not determine (a straight cable's own axis) unturned. On reduced coordinates
+!> e (q = B e + q0) the turn is T_e = B^T T B, exact where B selects coordinates and the turn
+!> keeps the selection (the planar reduction, turned about the plane's normal); the model
+!> layer enables the carry only then (python/ancfdrv/system/model.py, carry_vectors).
+!>
+!> The turned matrix is a preconditioner of the simplified Newton iteration: the residual
+!> and the constraints are exact, so the converged state does not depend on it; only the
+!> number of corrections (and of refactorizations) does. No I/O; the 3 x 3 polar factor by
+!> Newton iterations, LAPACK dgesvd where they do not settle.
+module carried_rotation
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  implicit none
+  private
+  public :: carry_enabled, carry_vectors, carry_turn, carry_apply, carry_gradients
+
+  !> the identity's share of the fitted correlation (relative to its Frobenius norm)
+  real(dp), parameter :: identity_share = 1e-6_dp
+
+contains
+
+  !> Whether the system carries its matrix (carried vectors were given).
+  pure logical function carry_enabled(sys)
+    type(system_model), intent(in) :: sys
+    carry_enabled = .false.
+    if (allocated(sys%carry_first)) carry_enabled = size(sys%carry_first) > 0
+  end function carry_enabled
+
+  !> The carried 3-vectors (3, nvec) of the system at the reduced coordinates e.
+  pure subroutine carry_vectors(sys, e, vectors)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: e(:)
+    real(dp), intent(out) :: vectors(:, :)
+    integer :: k, i, dof, b
+    do k = 1, size(sys%carry_first)
+      b = (sys%carry_first(k) - 1) / 3 + 1
+      do i = 1, 3
+        if (sys%carry_map(i, b) > 0) then
+          vectors(i, k) = e(sys%carry_map(i, b))
+        else  ! a coordinate the reduction fixes
+          dof = sys%carry_first(k) + i - 1
+          vectors(i, k) = sys%reduction_offset(dof)
+        end if
+      end do
+    end do
+  end subroutine carry_vectors
+
+  !> The rotation turn (3, 3) that best maps the reference vectors onto the current ones
+  !> (weighted; positions about their centroids) and its angle (rad). info = 1: the SVD
+  !> failed (turn = identity).
+  subroutine carry_turn(sys, reference, current, turn, angle, info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: reference(:, :), current(:, :)
+    real(dp), intent(out) :: turn(3, 3), angle
+    integer, intent(out) :: info
+    real(dp) :: correlation(3, 3), centre_ref(3), centre_now(3), weight_sum, scale
+    real(dp) :: a(3), b(3)
+    integer :: k, i, j
+    logical :: settled
+    centre_ref = 0.0_dp
+    centre_now = 0.0_dp
+    weight_sum = 0.0_dp
+    do k = 1, size(sys%carry_first)
+      if (.not. sys%carry_position(k)) cycle
+      centre_ref = centre_ref + sys%carry_weight(k) * reference(:, k)
+      centre_now = centre_now + sys%carry_weight(k) * current(:, k)
+      weight_sum = weight_sum + sys%carry_weight(k)
+    end do
+    if (weight_sum > 0.0_dp) then
+      centre_ref = centre_ref / weight_sum
+      centre_now = centre_now / weight_sum
+    end if
+    correlation = 0.0_dp  ! sum w b a^T (b: reference, a: current)
+    do k = 1, size(sys%carry_first)
+      if (sys%carry_position(k)) then
+        b = sys%carry_weight(k) * (reference(:, k) - centre_ref)
+        a = current(:, k) - centre_now
+      else
+        b = sys%carry_weight(k) * reference(:, k)
+        a = current(:, k)
+      end if
+      do j = 1, 3
+        correlation(:, j) = correlation(:, j) + b * a(j)
+      end do
+    end do
+    scale = identity_share * sqrt(sum(correlation**2))
+    do i = 1, 3
+      correlation(i, i) = correlation(i, i) + scale
+    end do
+    ! the orthogonal polar factor of correlation^T = V S U^T is V U^T: scaled Newton
+    ! iterations X <- (g X + X^{-T} / g) / 2 (Higham 1986), a few hundred flops; the SVD
+    ! where they do not settle on a rotation
+    angle = 0.0_dp
+    call polar_factor(transpose(correlation), turn, settled)
+    if (settled) then
+      info = 0
+    else
+      call svd_rotation(correlation, turn, info)
+      if (info /= 0) return
+    end if
+    angle = acos(max(-1.0_dp, min(1.0_dp, 0.5_dp * (turn(1, 1) + turn(2, 2) + turn(3, 3) &
+                                                     - 1.0_dp))))
+  end subroutine carry_turn
+
+  !> The rotation V diag(1, 1, d) U^T of correlation = U S V^T (d = det(V U^T)); info = 1:
+  !> the SVD failed (turn = identity).
+  subroutine svd_rotation(correlation, turn, info)
+    real(dp), intent(in) :: correlation(3, 3)
+    real(dp), intent(out) :: turn(3, 3)
+    integer, intent(out) :: info
+    real(dp) :: work_matrix(3, 3), left(3, 3), right_t(3, 3), singular(3), work(64)
+    real(dp) :: flip(3, 3)
+    integer :: i
+    work_matrix = correlation
+    call dgesvd('A', 'A', 3, 3, work_matrix, 3, singular, left, 3, right_t, 3, work, &
+                size(work), info)
+    turn = 0.0_dp
+    do i = 1, 3
+      turn(i, i) = 1.0_dp
+    end do
+    if (info /= 0) then
+      info = 1
+      return
+    end if
+    flip = turn
+    turn = matmul(transpose(right_t), transpose(left))
+    if (determinant(turn) < 0.0_dp) then
+      flip(3, 3) = -1.0_dp
+      turn = matmul(transpose(right_t), matmul(flip, transpose(left)))
+    end if
+  end subroutine svd_rotation
+
+  !> The orthogonal factor of the polar decomposition of x (scaled Newton iterations);
+  !> ok = .false. where x is singular, the iterations do not settle within 40, or the factor is
+  !> a reflection (then the SVD decides).
+  pure subroutine polar_factor(x, factor, ok)
+    real(dp), intent(in) :: x(3, 3)
+    real(dp), intent(out) :: factor(3, 3)
+    logical, intent(out) :: ok
+    real(dp) :: inverse_t(3, 3), next(3, 3), det, gamma
+    integer :: k
+    ok = .false.
+    factor = x
+    do k = 1, 40
+      det = determinant(factor)
+      if (.not. abs(det) > tiny(1.0_dp)) return
+      ! the inverse transposed: the cofactor matrix over the determinant
+      inverse_t(1, :) = [factor(2, 2) * factor(3, 3) - factor(2, 3) * factor(3, 2), &
+                         factor(2, 3) * factor(3, 1) - factor(2, 1) * factor(3, 3), &
+                         factor(2, 1) * factor(3, 2) - factor(2, 2) * factor(3, 1)] / det
+      inverse_t(2, :) = [factor(1, 3) * factor(3, 2) - factor(1, 2) * factor(3, 3), &
+                         factor(1, 1) * factor(3, 3) - factor(1, 3) * factor(3, 1), &
+                         factor(1, 2) * factor(3, 1) - factor(1, 1) * factor(3, 2)] / det
+      inverse_t(3, :) = [factor(1, 2) * factor(2, 3) - factor(1, 3) * factor(2, 2), &
+                         factor(1, 3) * factor(2, 1) - factor(1, 1) * factor(2, 3), &
+                         factor(1, 1) * factor(2, 2) - factor(1, 2) * factor(2, 1)] / det
+      gamma = sqrt(sqrt(sum(inverse_t**2) / sum(factor**2)))
+      next = 0.5_dp * (gamma * factor + inverse_t / gamma)
+      if (sum((next - factor)**2) <= (1e-13_dp)**2 * sum(next**2)) then
+        factor = next
+        ok = determinant(factor) > 0.0_dp
+        return
+      end if
+      factor = next
+    end do
+  end subroutine polar_factor
+
+  pure real(dp) function determinant(a)
+    real(dp), intent(in) :: a(3, 3)
+    determinant = a(1, 1) * (a(2, 2) * a(3, 3) - a(3, 2) * a(2, 3)) &
+                  - a(1, 2) * (a(2, 1) * a(3, 3) - a(3, 1) * a(2, 3)) &
+                  + a(1, 3) * (a(2, 1) * a(3, 2) - a(3, 1) * a(2, 2))
+  end function determinant
+
+  !> y = T_e x (back = .false.: from the factorization's axes to the current ones) or
+  !> y = T_e^T x (.true.), T_e = B^T blockdiag(turn) B on the reduced coordinates: every full
+  !> 3-vector turned, its fixed components (the reduction's) taken as zero (carry_map: the
+  !> reduced coordinate of each full component, 0 where fixed; B selects, so each reduced
+  !> coordinate is one full component).
+  pure subroutine carry_apply(sys, turn, x, back, y)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: turn(3, 3), x(:)
+    logical, intent(in) :: back
+    real(dp), intent(out) :: y(:)
+    real(dp) :: rotation(3, 3), v(3), w(3)
+    integer :: b, i
+    rotation = turn
+    if (back) rotation = transpose(turn)
+    do b = 1, size(sys%carry_map, 2)
+      do i = 1, 3
+        v(i) = 0.0_dp
+        if (sys%carry_map(i, b) > 0) v(i) = x(sys%carry_map(i, b))
+      end do
+      w = rotation(:, 1) * v(1) + rotation(:, 2) * v(2) + rotation(:, 3) * v(3)
+      do i = 1, 3
+        if (sys%carry_map(i, b) > 0) y(sys%carry_map(i, b)) = w(i)
+      end do
+    end do
+  end subroutine carry_apply
+
+  !> columns (ndof, ncon): T_e^T Phi_e^T, the constraint gradients turned back to the
+  !> factorization's axes (the right-hand sides of the Schur complement's flexibility).
+  pure subroutine carry_gradients(sys, turn, gradients, columns)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: turn(3, 3), gradients(:, :)
+    real(dp), intent(out) :: columns(:, :)
+    real(dp) :: column(sys%ndof)
+    integer :: c, s, k
+    do c = 1, sys%ncon
+      column = 0.0_dp
+      do s = 1, 6
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          column(sys%term_dof(k)) = column(sys%term_dof(k)) + gradients(s, c) * sys%term_coef(k)
+        end do
+      end do
+      call carry_apply(sys, turn, column, .true., columns(:, c))
+    end do
+  end subroutine carry_gradients
+
+end module carried_rotation

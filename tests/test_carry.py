@@ -1,0 +1,133 @@
+"""The iteration matrix carried with the system's rotation (``solver.carry = 'rotation'``,
+``fortran/src/solvers/carried_rotation.f90``, docs/theory.md section 28; issue 23 item 3).
+
+The carry rests on one property of absolute-coordinate elements: turning a configuration
+rigidly by R turns its tangent with it, K(T e) = T K(e) T^T (T = blockdiag(R) on every
+3-vector), because the strain energy does not change under a rigid turn; the mass matrix
+is kron(Mbar, I3) and commutes with T. That identity is checked first, on the tangents the
+kernel assembles (the cubic beam, the cable, both planar-reduced), against the unturned
+tangent turned by hand. The carried matrix only preconditions the simplified Newton
+iteration, so the stepper's answer must still be full Newton's within the Newton tolerance
+(the reference of tests/test_jacobian_reuse.py), while the spinning beam keeps its matrix
+instead of refactorizing in nearly every step.
+"""
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+
+from ancfdrv.builders import build_model
+from ancfdrv.io.scene import load_scene
+from ancfdrv.runner import run_scene
+
+from conftest import INPUTS
+
+SPINUP = INPUTS / "hard" / "spinup.nml"
+
+
+def turn_z(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def turned_state(model, e: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """The reduced coordinates of the configuration e turned rigidly by rotation about the
+    origin (every full 3-vector turned: positions and gradients alike)."""
+    q = model.expand(e)
+    q_turned = (q.reshape(-1, 3) @ rotation.T).reshape(-1)
+    return q_turned[model.reduction.independent] if model.reduction is not None else q_turned
+
+
+def turn_matrix(model, rotation: np.ndarray) -> np.ndarray:
+    """T_e = B^T blockdiag(R) B on the reduced coordinates (B a selection)."""
+    full = np.kron(np.eye(model.nfull // 3), rotation)
+    if model.reduction is None:
+        return full
+    b = model.reduction.matrix.toarray()
+    return b.T @ full @ b
+
+
+def test_the_tangent_turns_with_the_body():
+    """K(T e) = T K(e) T^T to round-off at a deformed state (the spin-up's cubic beam,
+    planar, perturbed, turned by 1.1 rad about the plane's normal): the property that makes
+    a matrix factorized before a turn serve after it."""
+    scene = load_scene(SPINUP, ["beam.bending=cubic", "beam.nodes=5", "scene.planar=xy"])
+    model = build_model(scene)
+    e = model.e0.copy()
+    rng = np.random.default_rng(3)
+    e = e + 1e-3 * rng.standard_normal(e.shape)   # a deformed state
+    rotation = turn_z(1.1)
+    t_e = turn_matrix(model, rotation)
+    k_here = model.pattern.to_scipy(model.stiffness_values(0.0, e)).toarray()
+    k_turned = model.pattern.to_scipy(
+        model.stiffness_values(0.0, turned_state(model, e, rotation))).toarray()
+    scale = np.abs(k_here).max()
+    assert np.abs(k_turned - t_e @ k_here @ t_e.T).max() <= 1e-9 * scale
+    # and turning matters: the unturned tangent is far off
+    assert np.abs(k_turned - k_here).max() > 1e-2 * scale
+    assert model.carry_vectors() is not None
+
+
+def test_the_cable_tangent_turns_with_the_body():
+    """The same identity for the planar ANCF cable (the flexible pendulum's model)."""
+    model = build_model(load_scene(INPUTS / "hard" / "pendulum.nml",
+                                   ["beam.nodes=5", "beam.bending=cable", "scene.planar=xy"]))
+    rng = np.random.default_rng(5)
+    e = model.e0 + 1e-2 * rng.standard_normal(model.e0.shape)
+    rotation = turn_z(-0.7)
+    t_e = turn_matrix(model, rotation)
+    k_here = model.pattern.to_scipy(model.stiffness_values(0.0, e)).toarray()
+    k_turned = model.pattern.to_scipy(
+        model.stiffness_values(0.0, turned_state(model, e, rotation))).toarray()
+    scale = np.abs(k_here).max()
+    assert np.abs(k_turned - t_e @ k_here @ t_e.T).max() <= 1e-9 * scale
+    assert np.abs(k_turned - k_here).max() > 1e-2 * scale
+
+
+def run(tmp_path, name: str, overrides: list[str]):
+    out = tmp_path / f"{name}.h5"
+    run_scene(SPINUP, ["spinup.omega=6", "solver.t_end=8", "beam.nodes=6", "solver.dt=1e-2",
+                       "scene.planar=xy", "output.xdmf=.false.", *overrides], out)
+    with h5py.File(out) as h5:
+        return (h5["dynamic/deflection/tip"][()], int(h5["dynamic"].attrs["factorizations"]),
+                int(h5["dynamic"].attrs["steps"]))
+
+
+def test_a_spinning_beam_keeps_its_matrix_and_full_newtons_answer(tmp_path):
+    """The spin-up (Simo & Vu-Quoc) to 8 s, when the hub has turned 25 rad: unturned, the
+    kept matrix stops contracting within a step or two of the hub's turn and 'reuse'
+    refactorizes in most steps; carried, a few matrices serve the run. Both answers are
+    full Newton's within the Newton tolerance (ten times closer at a 1e-4 times tighter
+    tolerance, as tests/test_jacobian_reuse.py demands of reuse)."""
+    off, fact_off, steps = run(tmp_path, "off", ["solver.carry=off", "solver.newton_tol=1e-8"])
+    on, fact_on, _ = run(tmp_path, "on", ["solver.carry=rotation", "solver.newton_tol=1e-8"])
+    full, *_ = run(tmp_path, "full", ["solver.jacobian=iteration", "solver.newton_tol=1e-8"])
+    on_tight, *_ = run(tmp_path, "on_tight", ["solver.newton_tol=1e-12"])
+    full_tight, *_ = run(tmp_path, "full_tight", ["solver.jacobian=iteration",
+                                                  "solver.newton_tol=1e-12"])
+    span = np.ptp(full, axis=0).max()
+    d_loose = np.abs(on - full).max() / span
+    d_tight = np.abs(on_tight - full_tight).max() / span
+    print(f"\nfactorizations: carried {fact_on}, unturned {fact_off}, {steps} steps; "
+          f"carried - full Newton {d_loose:.2e} (1e-8), {d_tight:.2e} (1e-12)")
+    assert fact_off > 0.5 * steps
+    assert fact_on < 0.05 * steps
+    assert d_loose < 1e-5
+    assert d_tight < max(d_loose / 10, 1e-11)
+    assert np.abs(off - full).max() / span < 1e-5
+
+
+def test_the_carry_is_refused_where_turning_is_not_exact():
+    """FFR bodies (their frames carry their matrix already), contact (its tangent is not
+    objective in the leaves' gap) and eliminated joints (a reduction that mixes
+    coordinates) are never carried."""
+    ffr = build_model(load_scene(INPUTS / "boom_luffing.nml", []))
+    assert ffr.carry_vectors() is None
+    spring = build_model(load_scene(INPUTS / "leaf_spring.nml", []))
+    assert spring.carry_vectors() is None
+    spin = build_model(load_scene(SPINUP, ["beam.bending=cubic", "scene.planar=xy"]))
+    first, weight, position = spin.carry_vectors()
+    # a beam node's four vectors: its position (weight 1) and three gradients (L^2)
+    assert len(first) == 4 * 11 and position[::4].all() and not position[1::4].any()
+    assert np.allclose(weight[1::4], spin.length_scale**2)
