@@ -135,3 +135,175 @@ def test_ffr_departure_rows_is_the_per_element_measure():
     assert name == "arm"
     assert change.tobytes() == plain.max(axis=1).tobytes()
     model.close()
+
+
+# -- the modally reduced FFR run's rows in bulk (solvers/ffr_reduced.RowMaps) ----------------
+from conftest import INPUTS  # noqa: E402
+
+BOOM = INPUTS / "boom_luffing.nml"
+SMALL = ["beam.nodes=10", "solver.t_end=3.0", "solver.static_method=newton"]
+
+
+def _reduced(*extra: str, modes: int = 3):
+    from ancfdrv.builders import build_model
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.solvers.ffr_reduced import reduce_ffr, simulate
+    from ancfdrv.solvers.static import solve_newton
+    model = build_model(load_scene(BOOM, [*SMALL, *extra]))
+    static = solve_newton(model, tol=1e-12, max_iter=50)
+    reduced = reduce_ffr(model, static, modes)
+    return model, reduced, simulate(reduced, 3.0, 1e-3)
+
+
+def _long_double_set_terms(model, reduced, t, eta):
+    """Strain energy and frame power of the FFR sets (ffr_elastic: ffr_energy_power and
+    add_second_order_power) at one reduced state, in long double from the expansion."""
+    ld = np.longdouble
+    frame = model.frames[0]
+    k = (frame.axis / np.linalg.norm(frame.axis)).astype(ld)
+    phi, rate, _ = (float(v[0]) for v in reduced.drive.values(np.array([t])))
+    psi = ld(phi) - ld(reduced.start_angle)
+    w = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]], dtype=ld)
+    turn = np.eye(3, dtype=ld) + np.sin(psi) * w + (1 - np.cos(psi)) * (w @ w)
+    y = (reduced.static_state - reduced.pivot_vector).astype(ld) \
+        + reduced.basis.astype(ld) @ eta.astype(ld)
+    e = reduced.pivot_vector.astype(ld) + (y.reshape(-1, 3) @ turn.T).reshape(-1)
+    rotation = turn @ frame.rotation(0.0).astype(ld)
+    energy = power = ld(0)
+    for info in model.sets:
+        for el in range(info.nel):
+            ref = info.reference[:, el].astype(ld)
+            local = (e[info.dofs[:, el]].reshape(8, 3) @ rotation).reshape(-1) - ref
+            force = info.stiffness0[:, :, el].astype(ld) @ local
+            if info.second_order is not None:
+                rigidity, axis, length, gram = info.second_order
+                axial = ld(rigidity[el]) * (axis[:, el].astype(ld) @ (local[12:15] - local[0:3])) \
+                    / ld(length[el])
+                extra = axial * (np.kron(gram[:, :, el], np.eye(3)).astype(ld) @ local)
+                energy += ld(0.5) * local @ extra
+                force = force + extra
+            energy += ld(0.5) * local @ (info.stiffness0[:, :, el].astype(ld) @ local)
+            x = (local + ref).reshape(8, 3)
+            power -= ld(rate) * np.sum(force.reshape(8, 3) * np.cross(k, x))
+    return energy, power
+
+
+@pytest.mark.parametrize("extra", [[], ["beam.geometric_stiffness=true", "beam.bending=cubic"]],
+                         ids=["linear", "pdelta"])
+def test_reduced_rows_are_the_kernel_output_row(extra):
+    """RowMaps.rows (quadratic and cubic forms of the reduced state) against the kernel's
+    output row of the expanded state: probes, deflections, kinetic, loads' and moment
+    energies to 1e-12 of their largest value, the constraint violation to the expansion's
+    rounding; the strain energy and frame power, whose kernel sums cancel by 3-4 orders
+    of magnitude, against the same formulas in long double (1e-11 and 1e-9 of the
+    largest; measured on the 28-node boom: the kernel itself 4e-12 and 7e-10 off)."""
+    from ancfdrv.solvers.ffr_reduced import RowMaps, expand
+    model, reduced, out = _reduced(*extra)
+    assert RowMaps.supported(model)
+    rows = np.arange(0, len(out["time"]), 150)
+    times, eta, vel = out["time"][rows], out["eta"][rows], out["velocity"][rows]
+    found = RowMaps(model, reduced).rows(times, eta, vel)
+    e, v = expand(reduced, times, eta, vel)
+    ncon = len(model.constraints)
+    kernel = [model.kernel.output_row(float(t), e[i], v[i], np.zeros(ncon), np.zeros(5),
+                                      model.contact_guesses.copy(), np.zeros(6, dtype=np.int32))
+              for i, t in enumerate(times)]
+    for key, name in (("probes", "probes"), ("deflections", "deflections")):
+        plain = np.array([row[key] for row in kernel])
+        assert np.abs(found[name] - plain).max() <= 1e-12 * np.abs(plain).max()
+    energy = np.array([row["energy"] for row in kernel])
+    for column in (0, 2, 3):     # kinetic, loads, moment
+        scale = np.abs(energy[:, column]).max()
+        assert scale > 0
+        assert np.abs(found["energy"][:, column] - energy[:, column]).max() <= 1e-12 * scale
+    violation = np.array([row["violation"] for row in kernel])
+    assert np.abs(found["violation"] - violation).max() <= 4e-16 * model.length_scale
+    exact = np.array([_long_double_set_terms(model, reduced, t, eta[i])
+                      for i, t in enumerate(times)], dtype=np.longdouble)
+    strain, power = exact[:, 0], exact[:, 1]
+    assert float(np.abs(found["energy"][:, 1] - strain).max()) <= 1e-11 * float(
+        np.abs(strain).max())
+    assert float(np.abs(found["power"] - power).max()) <= 1e-9 * float(np.abs(power).max())
+    total = found["energy"][:, :4].sum(axis=1)
+    assert np.abs(found["energy"][:, 4] - total).max() <= 1e-12 * np.abs(total).max()
+    model.close()
+
+
+def test_expanded_rows_expand_only_what_is_asked():
+    """ExpandedRows gives expand()'s rows: the last row, a mask's rows, a slice, and every
+    row through np.asarray (bit for bit: the same arithmetic)."""
+    from ancfdrv.solvers.ffr_reduced import ExpandedRows, expand
+    model, reduced, out = _reduced()
+    times, eta = out["time"][:40], out["eta"][:40]
+    plain, _ = expand(reduced, times, eta, np.zeros_like(eta))
+    lazy = ExpandedRows(reduced, times, eta)
+    assert len(lazy) == 40 and lazy.shape == plain.shape
+    mask = np.arange(40) % 7 == 0
+    assert np.allclose(lazy[mask], plain[mask], rtol=0, atol=1e-15)
+    assert np.allclose(lazy[-1], plain[-1], rtol=0, atol=1e-15)
+    assert np.allclose(lazy[3:9], plain[3:9], rtol=0, atol=1e-15)
+    assert np.asarray(lazy).tobytes() == plain.tobytes()
+    model.close()
+
+
+def test_reduced_small_strain_check_bound_and_stop():
+    """The bound c + n . |eta| is >= the section vectors' change at reduced states, small
+    and far beyond the limit; a history driven past the limit stops at the first row the
+    full check (every row expanded) finds outside, the rows after it dropped."""
+    from ancfdrv.solvers.assumptions import FFR_LIMIT
+    from ancfdrv.solvers.ffr_reduced import (ExpandedRows, _departure_bound,
+                                             _reduced_assumptions, expand)
+    model, reduced, out = _reduced()
+    c, n = _departure_bound(model, reduced)
+    rng = np.random.default_rng(9)
+    eta = rng.normal(size=(30, reduced.size)) * np.logspace(-3, 1, 30)[:, None]
+    times = np.linspace(0.0, 3.0, 30)
+    e, _ = expand(reduced, times, eta, np.zeros_like(eta))
+    (_, change), = ffr_departure_rows(model, e, times)
+    assert np.all(c + np.abs(eta) @ n >= change)
+    ramp = np.linspace(0.0, 1.0, 30)[:, None] * eta[-1]        # crosses the limit once
+    e, _ = expand(reduced, times, ramp, np.zeros_like(ramp))
+    (_, change), = ffr_departure_rows(model, e, times)
+    first = int(np.argmax(change > FFR_LIMIT))
+    assert 0 < first < 29
+    from ancfdrv.solvers import dynamic
+    chunk = dynamic.Chunk(time=times, probes=np.zeros((30, 1, 3)),
+                          deflections=np.zeros((30, 1, 3)), lam=np.zeros((30, 0)),
+                          energy=np.zeros((30, 11)), constraint=np.zeros(30),
+                          stats=np.zeros((30, 3)), q=ExpandedRows(reduced, times, ramp))
+    kept, why = _reduced_assumptions(model, reduced, chunk, ramp, True)
+    assert len(kept.time) == first + 1 and "small-strain" in why
+    assert len(kept.q) == first + 1
+    model.close()
+
+
+def test_reduced_run_file_keeps_every_dataset(tmp_path, monkeypatch):
+    """A reduced run with the rows in bulk writes the datasets and attributes the row by
+    row path writes (XDMF frames included), with the same values (1e-12 of each dataset's
+    largest; strain and frame work to the kernel's own rounding, 1e-9)."""
+    import h5py
+    from ancfdrv.runner import run_scene
+    from ancfdrv.solvers import ffr_reduced
+    over = ["beam.nodes=10", "solver.static_method=newton", "beam.modes=2", "solver.t_end=1.0",
+            "output.xdmf_frames=20"]
+    bulk, plain = tmp_path / "bulk.h5", tmp_path / "plain.h5"
+    run_scene(BOOM, over, bulk, progress=False)
+    monkeypatch.setattr(ffr_reduced.RowMaps, "supported", staticmethod(lambda model: False))
+    run_scene(BOOM, over, plain, progress=False)
+    with h5py.File(bulk) as a, h5py.File(plain) as b:
+        names_a, names_b = [], []
+        a["dynamic"].visit(names_a.append)
+        b["dynamic"].visit(names_b.append)
+        assert names_a == names_b
+        assert a["dynamic"].attrs["not_provided"] == b["dynamic"].attrs["not_provided"]
+        for name in names_a:
+            x, y = a["dynamic"][name], b["dynamic"][name]
+            if not isinstance(x, h5py.Dataset) or x.dtype.kind != "f":
+                continue
+            x, y = x[()], y[()]
+            assert np.array_equal(np.isnan(x), np.isnan(y)), name
+            scale = np.nanmax(np.abs(y)) if np.isfinite(y).any() else 0.0
+            loose = name in ("energy/strain", "energy/frame_work", "energy/total",
+                             "energy/balance")
+            tol = (1e-9 if loose else 1e-12) * scale + 1e-300
+            assert np.nanmax(np.abs(x - y), initial=0.0) <= tol, name

@@ -500,7 +500,21 @@ class RowMaps:
 
     def rows(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
         """Probes (n, nprobe, 3), deflections, energy (n, 11) without the works, the
-        constraint violation (n,) and the frame's power (n,) at the rows."""
+        constraint violation (n,) and the frame's power (n,) at the rows: in blocks of
+        ROW_BLOCK rows, whose temporaries (~100 kB each) stay in the cache and are reused
+        by the allocator (blocks of 10,000 rows page-faulted a fresh mapping for each)."""
+        n = len(times)
+        out = dict(probes=np.zeros((n, len(self.probes), 3)),
+                   deflections=np.zeros((n, len(self.probes), 3)), energy=np.zeros((n, 11)),
+                   violation=np.zeros(n), power=np.zeros(n))
+        for a in range(0, n, ROW_BLOCK):
+            b = slice(a, a + ROW_BLOCK)
+            for key, value in self._block(times[b], eta[b], velocity[b]).items():
+                out[key][b] = value
+        return out
+
+    def _block(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
+        """:meth:`rows` of one block."""
         phi, rate, _ = self.reduced.drive.values(times)
         psi = phi - self.reduced.start_angle
         n = len(times)
@@ -532,14 +546,10 @@ class RowMaps:
         energy[:, 1] = np.einsum("ti,ti->t", c @ self.strain, c)
         power = rate * np.einsum("ti,ti->t", c @ self.power, c)
         if self.cubic is not None:
-            used, pairs, third, table = self.cubic
-            for a in range(0, n, 4096):      # blocks: the monomials stay in the cache
-                b = slice(a, a + 4096)
-                cu = c[b][:, used]
-                square = cu[:, pairs[0]] * cu[:, pairs[1]]
-                both = (square[:, third[0]] * cu[:, third[1]]) @ table        # (rows, 2)
-                energy[b, 1] += both[:, 0]
-                power[b] += rate[b] * both[:, 1]
+            used, table = self.cubic
+            both = _cubic_values(c[:, used], table)
+            energy[:, 1] += both[:, 0]
+            power += rate * both[:, 1]
         ones = np.column_stack([np.ones(n), eta])
         energy[:, 2] = self.load_constant + (
             ones @ self.load_linear[0] + sin * (ones @ self.load_linear[1])
@@ -563,7 +573,8 @@ def _cubic_table(energy: np.ndarray, power: np.ndarray):
     """sum_ijk c_i c_j c_k T_ijk of the two tensors as sums over the monomials
     c_i c_j c_k, i <= j <= k, of the coefficients summed over the index permutations;
     coefficients of c_i that are zero in every term (sin and 1 - cos with the pivot on the
-    frame axis) left out: (used, pairs (i <= j), (pair, k) of each monomial, (nmono, 2))."""
+    frame axis) left out. The pairs (i <= j) ordered by j, the monomials by k: those of a
+    given j or k are a prefix (:func:`_cubic_values`). Returns (used, (nmono, 2) table)."""
     import itertools
     weight = sum(np.abs(t).sum(axis=tuple(a for a in range(3) if a != axis))
                  for t in (energy, power) for axis in range(3))
@@ -571,15 +582,29 @@ def _cubic_table(energy: np.ndarray, power: np.ndarray):
     m = len(used)
     sub = [t[np.ix_(used, used, used)] for t in (energy, power)]
     full = [sum(t.transpose(p) for p in itertools.permutations(range(3))) for t in sub]
-    pairs = np.triu_indices(m)
-    pair_of = {(int(i), int(j)): q for q, (i, j) in enumerate(zip(*pairs))}
-    mono = [(i, j, k) for i in range(m) for j in range(i, m) for k in range(j, m)]
-    third = (np.array([pair_of[(i, j)] for i, j, _ in mono], dtype=np.int64),
-             np.array([k for _, _, k in mono], dtype=np.int64))
+    pairs = [(i, j) for j in range(m) for i in range(j + 1)]
+    mono = [(i, j, k) for k in range(m) for i, j in pairs if j <= k]
     repeats = np.array([6 // len(set(itertools.permutations(t))) for t in mono], dtype=float)
     index = tuple(np.array(mono).T)
-    table = np.column_stack([f[index] / repeats for f in full])
-    return used, pairs, third, table
+    return used, np.column_stack([f[index] / repeats for f in full])
+
+
+def _cubic_values(c: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """(rows, 2): the monomials c_i c_j c_k (i <= j <= k, :func:`_cubic_table`'s order)
+    of the rows of c, built from prefixes (no gathers), times the table."""
+    rows, m = c.shape
+    square = np.empty((rows, m * (m + 1) // 2))
+    mono = np.empty((rows, len(table)))
+    at = 0
+    for j in range(m):
+        square[:, at:at + j + 1] = c[:, :j + 1] * c[:, j:j + 1]
+        at += j + 1
+    at = 0
+    for k in range(m):
+        width = (k + 1) * (k + 2) // 2
+        np.multiply(square[:, :width], c[:, k:k + 1], out=mono[:, at:at + width])
+        at += width
+    return mono @ table
 
 
 def _moment_angle(director: np.ndarray, axis: np.ndarray, reference: np.ndarray) -> np.ndarray:
@@ -593,6 +618,8 @@ def _moment_angle(director: np.ndarray, axis: np.ndarray, reference: np.ndarray)
 
 #: rows per output chunk of a reduced run computed in bulk (one write of the file each)
 BULK_ROWS = 65536
+#: rows per block of RowMaps.rows
+ROW_BLOCK = 1024
 
 
 def _departure_bound(model: Model, reduced: ReducedFFR) -> tuple[float, np.ndarray]:
