@@ -436,8 +436,7 @@ class RowMaps:
 
         def per_vector(matrix: np.ndarray, v: np.ndarray) -> np.ndarray:
             """matrix applied to every 3-vector of v (nel, 24, ...)."""
-            shaped = v.reshape(v.shape[0], 8, 3, -1)
-            return np.einsum("ij,ebjk->ebik", matrix, shaped).reshape(v.shape)
+            return np.matmul(matrix, v.reshape(v.shape[0], 8, 3, -1)).reshape(v.shape)
         for info in model.sets:
             dofs = info.dofs.T                                   # (nel, 24)
             ref = info.reference.T                               # (nel, 24)
@@ -449,21 +448,25 @@ class RowMaps:
                 per_vector(a_t, per_vector(skew @ skew, p_el)),
                 per_vector(a_t, basis[dofs])], axis=2)           # (nel, 24, 3 + r)
             forced = np.matmul(info.stiffness0.transpose(2, 0, 1), lin)      # K0 u per c
-            self.strain += 0.5 * np.einsum("eam,ean->mn", lin, forced)
+            width = lin.shape[2]
+            self.strain += 0.5 * lin.reshape(-1, width).T @ forced.reshape(-1, width)
             x = lin.copy()
             x[:, :, 0] += ref
             kx = per_vector(k_frame, x)                          # k x (u + u_ref)
-            self.power -= np.einsum("eam,ean->mn", forced, kx)
+            self.power -= forced.reshape(-1, width).T @ kx.reshape(-1, width)
             if info.second_order is not None:   # ffr_elastic.ffr_second_order
                 rigidity, axis, length, gram = info.second_order
                 chord = np.zeros((info.nel, 24))
                 chord[:, 12:15], chord[:, 0:3] = axis.T, -axis.T
-                axial = rigidity[:, None] * np.einsum("ea,eam->em", chord, lin) \
+                axial = rigidity[:, None] * np.matmul(chord[:, None, :], lin)[:, 0] \
                     / length[:, None]                            # N = axial . c
                 g24 = np.einsum("abe,ij->eaibj", gram, np.eye(3)).reshape(info.nel, 24, 24)
                 bent = np.matmul(g24, lin)                       # (G x I3) u per c
-                cubic_energy += np.einsum("eam,ean,ek->mnk", lin, 0.5 * bent, axial)
-                cubic_power -= np.einsum("eam,ean,ek->mnk", bent, kx, axial)
+                for tensor, left, right, factor in ((cubic_energy, lin, bent, 0.5),
+                                                    (cubic_power, bent, kx, -1.0)):
+                    pair = np.matmul(left.transpose(0, 2, 1), right)     # (nel, m, m)
+                    tensor += factor * (pair.reshape(info.nel, -1).T @ axial).reshape(
+                        tensor.shape)
         if any(info.second_order is not None for info in model.sets):
             self.cubic = _cubic_table(cubic_energy, cubic_power)
         # loads' potential: -Q . (p^ + y + sin W y + (1 - cos) W^2 y)
@@ -521,8 +524,8 @@ class RowMaps:
         sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
         k = self.reduced.axis
         # e at the needed coordinates, as expand() computes every coordinate
-        sub = self.sub_pivot[None, :] + _turn(self.sub_a0[None, :] + eta @ self.sub_basis.T,
-                                              k, psi)
+        sub = np.zeros((n, 0)) if not len(self.slots) else \
+            self.sub_pivot[None, :] + _turn(self.sub_a0[None, :] + eta @ self.sub_basis.T, k, psi)
         probes = np.zeros((n, len(self.probes), 3))
         deflections = np.zeros_like(probes)
         turn = None
@@ -583,10 +586,10 @@ def _cubic_table(energy: np.ndarray, power: np.ndarray):
     sub = [t[np.ix_(used, used, used)] for t in (energy, power)]
     full = [sum(t.transpose(p) for p in itertools.permutations(range(3))) for t in sub]
     pairs = [(i, j) for j in range(m) for i in range(j + 1)]
-    mono = [(i, j, k) for k in range(m) for i, j in pairs if j <= k]
-    repeats = np.array([6 // len(set(itertools.permutations(t))) for t in mono], dtype=float)
-    index = tuple(np.array(mono).T)
-    return used, np.column_stack([f[index] / repeats for f in full])
+    i, j, k = np.array([(i, j, k) for k in range(m) for i, j in pairs if j <= k]).T
+    # the distinct orderings of (i, j, k) each appear 6 / repeats times in the full sum
+    repeats = np.where(i == k, 6.0, np.where((i == j) | (j == k), 2.0, 1.0))
+    return used, np.column_stack([f[i, j, k] / repeats for f in full])
 
 
 def _cubic_values(c: np.ndarray, table: np.ndarray) -> np.ndarray:
