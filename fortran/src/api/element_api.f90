@@ -706,8 +706,9 @@ subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, ce
 end subroutine reduced_ffr_newmark
 
 !> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r); the
-!> velocities zero): gradients(:, :, r) as constraint_evaluate returns them. One call for
-!> a chunk of output rows (the reactions of every step, python/ancfdrv/system/answers.py).
+!> velocities zero): gradients(:, :, r) as constraint_evaluate returns them (first order
+!> only: no Hessians, Phi_t, gamma). One call for a chunk of output rows (the reactions of
+!> every step, python/ancfdrv/system/answers.py).
 subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
                                     params, operand_const, term_ptr, term_dof, term_coef, &
                                     drive_kinds, drive_ptr, drive_data, q_rows, times, &
@@ -732,7 +733,7 @@ subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kind
     call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
                          term_coef, drive_kinds, drive_ptr, drive_data, q_rows(:, row), &
                          velocity, times(row), values, gradients(:, :, row), hessians, phi_t, &
-                         phi_tt, gamma, info)
+                         phi_tt, gamma, info, first_order_only=.true.)
     if (info /= 0) return
   end do
 end subroutine constraint_gradient_rows

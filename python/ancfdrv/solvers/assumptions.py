@@ -33,7 +33,9 @@ def ffr_departure_rows(model, rows: np.ndarray, times: np.ndarray) -> list[tuple
     sets = [s for s in model.sets if s.kind == "ffr"]
     if not sets:
         return []
-    q = np.atleast_2d(model.expand(rows))
+    # read only: without eliminated joints q is e (no copy of every row)
+    q = np.atleast_2d(np.asarray(rows, dtype=float) if model.reduction is None
+                      else model.expand(rows))
     times = np.asarray(times, dtype=float)
     out = []
     for info in sets:

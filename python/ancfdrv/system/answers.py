@@ -970,7 +970,8 @@ class DynamicAnswers:
         if not len(times):
             return
         e_rows = np.asarray(chunk.q, dtype=float)
-        q_rows = self.model.expand(e_rows)
+        # read only: without eliminated joints q is e (no copy of every row)
+        q_rows = e_rows if self.model.reduction is None else self.model.expand(e_rows)
         residual = None
         velocities = np.zeros_like(e_rows)
         if self.need_acceleration:
