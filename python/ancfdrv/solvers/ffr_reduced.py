@@ -76,6 +76,8 @@ class ReducedFFR:
     static_state: np.ndarray | None = None
     pivot_vector: np.ndarray | None = None
     axis: np.ndarray | None = None
+    #: the constant maps of the output rows (:class:`RowMaps`; None: the row by row path)
+    row_maps: "RowMaps | None" = None
 
     @property
     def size(self) -> int:
@@ -145,6 +147,8 @@ def reduce_ffr(model: Model, static: StaticResult, modes: int, *,
             model.deflections_at(x_star + basis[:, i], 0.0)[name] - value
             for i in range(basis.shape[1])])
     _pdelta_terms(model, reduced, x_star)
+    if RowMaps.supported(model):   # constants of the reduced model, like probe_basis
+        reduced.row_maps = RowMaps(model, reduced)
     reduced.timing["reduce"] = time.perf_counter() - t0
     return reduced
 
@@ -713,7 +717,9 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
     counts = np.zeros(6, dtype=np.int32)
     frame_work, last_power = 0.0, None
     rows_done = 0
-    maps = RowMaps(model, reduced) if RowMaps.supported(model) else None
+    maps = reduced.row_maps
+    if maps is None and RowMaps.supported(model):
+        maps = reduced.row_maps = RowMaps(model, reduced)
     step = max(1, int(settings.chunk_steps))
     if maps is not None:   # the rows in bulk: chunks of up to BULK_ROWS rows (one write each)
         step = max(step, BULK_ROWS)
