@@ -532,18 +532,20 @@ class RowMaps:
             self.sub_pivot[None, :] + _turn(self.sub_a0[None, :] + eta @ self.sub_basis.T, k, psi)
         probes = np.zeros((n, len(self.probes), 3))
         deflections = np.zeros_like(probes)
-        turn = None
         for i, (_, p) in enumerate(self.probes):
             for d, coef in p.terms:
                 j = self.slot_of[int(d)]
                 probes[:, i, :] += coef * sub[:, j:j + 3]
-            if p.frame:
-                if turn is None:   # A(t) = Rot(k, phi(t)) base, per row
-                    from .assumptions import _frame_rotations
-                    turn = _frame_rotations(self.model.frames[p.frame - 1], times)
-                pivot = self.model.frames[p.frame - 1].pivot
-                deflections[:, i, :] = np.einsum("tji,tj->ti", turn, probes[:, i, :] - pivot) \
-                    - p.reference
+            if p.frame:   # A(t)^T v, A = Rot(k, phi) base: base^T (v - sin W v + (1 - cos) W^2 v)
+                info = self.model.frames[p.frame - 1]
+                angle = phi if info.drive_obj is self.reduced.drive else \
+                    info.drive_obj.values(times)[0]
+                axis = info.axis / np.linalg.norm(info.axis)
+                w = _skew(axis)
+                v = probes[:, i, :] - info.pivot
+                v = v - np.sin(angle)[:, None] * (v @ w.T) \
+                    + (1.0 - np.cos(angle))[:, None] * (v @ (w @ w).T)
+                deflections[:, i, :] = v @ info.base - p.reference
             else:
                 deflections[:, i, :] = probes[:, i, :] - p.reference
         energy = np.zeros((n, 11))
@@ -616,11 +618,12 @@ def _cubic_values(c: np.ndarray, table: np.ndarray) -> np.ndarray:
 
 def _moment_angle(director: np.ndarray, axis: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """section_moment.moment_angle at rows of directors (n, 3): the angle about the axis
-    from the reference to the director's projection."""
+    from the reference to the director's projection, atan2(k . (q x p), q . p) with
+    k . (q x p) = p . (k x q)."""
     k = axis / np.linalg.norm(axis)
     p = director - (director @ k)[:, None] * k
     q = reference - (k @ reference) * k
-    return np.arctan2(np.cross(q, p) @ k, p @ q)
+    return np.arctan2(p @ (_skew(k) @ q), p @ q)
 
 
 #: rows per output chunk of a reduced run computed in bulk (one write of the file each)
