@@ -18,7 +18,7 @@ A run never loses or mislabels data:
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -366,6 +366,9 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
         "rho_inf": scene["solver"]["rho_inf"] if scene["solver"]["integrator"] ==
         "generalized_alpha" else 1.0, "t_end": settings.t_end}
     sink = base_sink
+    # q carried for the answers only: the writer keeps its last row (/dynamic/q_last), so
+    # it gets that row alone (not 27 MB of rows to merge per flush on the 28-node FFR boom)
+    last_q_only = not write_q and not xdmf and supports is None
     if recorder is not None:
         def sink(chunk) -> None:
             nonlocal recorder
@@ -378,6 +381,8 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                     model.warnings.append(f"dynamic reactions, section forces and stresses "
                                           f"not recorded: {exc}")
                     recorder = None
+            if last_q_only and chunk.q is not None and len(chunk.q) > 1:
+                chunk = replace(chunk, q=chunk.q[-1:])
             base_sink(chunk)
     try:
         dyn = integrate(model, settings, e_start, sink=sink, progress=progress,

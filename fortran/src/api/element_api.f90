@@ -706,8 +706,9 @@ subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, ce
 end subroutine reduced_ffr_newmark
 
 !> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r); the
-!> velocities zero): gradients(:, :, r) as constraint_evaluate returns them. One call for
-!> a chunk of output rows (the reactions of every step, python/ancfdrv/system/answers.py).
+!> velocities zero): gradients(:, :, r) as constraint_evaluate returns them (first order
+!> only: no Hessians, Phi_t, gamma). One call for a chunk of output rows (the reactions of
+!> every step, python/ancfdrv/system/answers.py).
 subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
                                     params, operand_const, term_ptr, term_dof, term_coef, &
                                     drive_kinds, drive_ptr, drive_data, q_rows, times, &
@@ -732,7 +733,40 @@ subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kind
     call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
                          term_coef, drive_kinds, drive_ptr, drive_data, q_rows(:, row), &
                          velocity, times(row), values, gradients(:, :, row), hessians, phi_t, &
-                         phi_tt, gamma, info)
+                         phi_tt, gamma, info, first_order_only=.true.)
     if (info /= 0) return
   end do
 end subroutine constraint_gradient_rows
+
+!> The constraint violation max |Phi| at each of nrow states (q_rows(:, r), times(r)), as the
+!> system's output row computes it (constraint_eval, first order only): one call for the
+!> rows of a modally reduced FFR run (python/ancfdrv/solvers/ffr_reduced.py), whose states
+!> need only the constrained coordinates filled in.
+subroutine constraint_violation_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
+                                     params, operand_const, term_ptr, term_dof, term_coef, &
+                                     drive_kinds, drive_ptr, drive_data, q_rows, times, &
+                                     violation, info)
+  use ancf_kinds, only: dp
+  use constraints, only: constraint_eval
+  implicit none
+  integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata, nrow
+  integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
+  integer, intent(in) :: drive_kinds(ndrive), drive_ptr(ndrive + 1)
+  real(dp), intent(in) :: params(8, ncon), operand_const(6, ncon), term_coef(nterm)
+  real(dp), intent(in) :: drive_data(ndata), q_rows(ndof, nrow), times(nrow)
+  real(dp), intent(out) :: violation(nrow)
+  integer, intent(out) :: info
+  real(dp) :: values(ncon), gradients(6, ncon), hessians(6, 6, ncon), phi_t(ncon)
+  real(dp) :: phi_tt(ncon), gamma(ncon)
+  integer :: row
+  violation = 0.0_dp
+  info = 0
+  do row = 1, nrow
+    call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
+                         term_coef, drive_kinds, drive_ptr, drive_data, q_rows(:, row), &
+                         q_rows(:, row), times(row), values, gradients, hessians, phi_t, &
+                         phi_tt, gamma, info, first_order_only=.true.)
+    if (info /= 0) return
+    if (ncon > 0) violation(row) = maxval(abs(values))
+  end do
+end subroutine constraint_violation_rows

@@ -79,6 +79,8 @@ class ReducedFFR:
     static_state: np.ndarray | None = None
     pivot_vector: np.ndarray | None = None
     axis: np.ndarray | None = None
+    #: the constant maps of the output rows (:class:`RowMaps`; None: the row by row path)
+    row_maps: "RowMaps | None" = None
 
     @property
     def size(self) -> int:
@@ -148,6 +150,8 @@ def reduce_ffr(model: Model, static: StaticResult, modes: int, *,
             model.deflections_at(x_star + basis[:, i], 0.0)[name] - value
             for i in range(basis.shape[1])])
     _pdelta_terms(model, reduced, x_star)
+    if RowMaps.supported(model):   # constants of the reduced model, like probe_basis
+        reduced.row_maps = RowMaps(model, reduced)
     reduced.timing["reduce"] = time.perf_counter() - t0
     return reduced
 
@@ -344,6 +348,352 @@ def expand(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, velocity: np
     return e, v
 
 
+def _skew(k: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+
+
+def _vector_slots(dofs) -> np.ndarray:
+    """The full coordinates of the 3-vectors holding ``dofs`` (sorted, each vector once)."""
+    first = np.unique(np.asarray(dofs, dtype=np.int64) // 3) * 3
+    return (first[:, None] + np.arange(3)).reshape(-1)
+
+
+class ExpandedRows:
+    """The full coordinates of rows of a reduced history (:func:`expand`), expanded only
+    for the rows asked for: ``rows[-1]``, ``rows[mask]``, ``rows[a:b]`` expand those rows;
+    anything else (``np.asarray``) expands all. What the writer needs of a reduced run's q
+    (the XDMF frames, every stride-th row, and the last row) costs a few rows, not 10,000
+    (the expansion of every row was a third of the 20 ms the 10 s boom may cost)."""
+
+    def __init__(self, reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray) -> None:
+        self.reduced, self.times, self.eta = reduced, times, eta
+        self.shape = (len(times), reduced.basis.shape[0])
+        self.ndim, self.dtype = 2, np.dtype(float)
+        self.nbytes = self.times.nbytes + self.eta.nbytes
+
+    def __len__(self) -> int:
+        return len(self.times)
+
+    def __getitem__(self, index):
+        if isinstance(index, tuple):   # rows and columns: every row expanded
+            return np.asarray(self)[index]
+        rows = np.arange(len(self.times))[index]
+        single = np.ndim(rows) == 0
+        rows = np.atleast_1d(rows)
+        e, _ = expand(self.reduced, self.times[rows], self.eta[rows],
+                      np.zeros_like(self.eta[rows]))
+        return e[0] if single else e
+
+    def __array__(self, dtype=None, copy=None):
+        e = self[:]
+        return e if dtype is None else e.astype(dtype)
+
+
+class RowMaps:
+    """Constant maps from the reduced states (eta, eta') at the frame angle psi to a full
+    run's output row (:meth:`rows`), built once per run (docs/theory.md, modal reduction):
+    with y = x* - p^ + Psi eta in the frame at t = 0, e = p^ + U(psi) y and
+    e' = U(psi) (psi' W y + Psi eta') (U = Rot(k, psi) on every 3-vector, W = [k x]):
+
+    - probes, moment directors, constrained coordinates: e at those coordinates only,
+      expanded as :func:`expand` expands every coordinate, then the kernel's formulas;
+    - kinetic energy 1/2 e'^T M e' = 1/2 z^T M z (U^T M U = M) with z linear in
+      c = (psi', psi' eta, eta'): a Gram matrix of size 1 + 2r;
+    - strain energy and the frame's power (the kernel's FFR sets: u = A^T e - u_ref per
+      element, 1/2 u^T K0 u and -psi' sum (K0 u) . (k x (u + u_ref))), A = U(psi) A0: u is
+      linear in (1, sin psi, 1 - cos psi, eta), so each is a quadratic form of size 3 + r;
+    - the loads' potential -Q . e: linear in (1, sin psi, 1 - cos psi) x (1, eta).
+    """
+
+    def __init__(self, model: Model, reduced: ReducedFFR) -> None:
+        self.model, self.reduced = model, reduced
+        basis, n = reduced.basis, reduced.basis.shape[0]
+        r = basis.shape[1]
+        k = reduced.axis
+        skew = _skew(k)
+        pivot = reduced.pivot_vector
+        a0 = reduced.static_state - pivot
+        frame = model.frames[0]
+        self.base0 = frame.rotation(0.0)            # A0: the frame at t = 0 (psi = 0)
+        # coordinates whose values the output needs one by one
+        self.probes = list(model.probes.items())
+        probe_dofs = [d + j for _, p in self.probes for d, _ in p.terms for j in range(3)]
+        moment_dofs = [d for m in model.moments for d in m.dofs]
+        lay = model.constraints.layout()
+        constraint_dofs = list(lay.term_dof)
+        self.slots = _vector_slots(probe_dofs + moment_dofs + constraint_dofs) \
+            if probe_dofs + moment_dofs + constraint_dofs else np.zeros(0, dtype=np.int64)
+        self.slot_of = {int(d): i for i, d in enumerate(self.slots)}
+        self.sub_a0, self.sub_basis = a0[self.slots], basis[self.slots]
+        self.sub_pivot = pivot[self.slots]
+        # kinetic energy: z = psi' W a0 + psi' W Psi eta + Psi eta'
+        z = np.column_stack([_blocks(a0, skew), _blocks(basis, skew), basis])
+        self.kinetic = z.T @ (model.mass @ z)
+        # strain energy and frame power of the FFR sets: per element u = L c,
+        # c = (1, sin, 1 - cos, eta); x = u + u_ref = X c
+        self.strain = np.zeros((3 + r, 3 + r))
+        self.power = np.zeros((3 + r, 3 + r))
+        # P-delta (sets with second_order): per element N = n . c and the energy
+        # N c^T Q c, the power psi' N c^T P c: cubic forms, summed into tensors over c
+        cubic_energy = np.zeros((3 + r, 3 + r, 3 + r))
+        cubic_power = np.zeros((3 + r, 3 + r, 3 + r))
+        self.cubic = None
+        a_t = self.base0.T
+        k_frame = _skew(frame.axis / np.linalg.norm(frame.axis))
+
+        def per_vector(matrix: np.ndarray, v: np.ndarray) -> np.ndarray:
+            """matrix applied to every 3-vector of v (nel, 24, ...)."""
+            return np.matmul(matrix, v.reshape(v.shape[0], 8, 3, -1)).reshape(v.shape)
+        for info in model.sets:
+            dofs = info.dofs.T                                   # (nel, 24)
+            ref = info.reference.T                               # (nel, 24)
+            # A^T p^ = A0^T U^T p^ = A0^T (p^ - sin W p^ + (1 - cos) W^2 p^)
+            p_el = pivot[dofs][:, :, None]
+            lin = np.concatenate([
+                per_vector(a_t, p_el + a0[dofs][:, :, None]) - ref[:, :, None],
+                -per_vector(a_t, per_vector(skew, p_el)),
+                per_vector(a_t, per_vector(skew @ skew, p_el)),
+                per_vector(a_t, basis[dofs])], axis=2)           # (nel, 24, 3 + r)
+            forced = np.matmul(info.stiffness0.transpose(2, 0, 1), lin)      # K0 u per c
+            width = lin.shape[2]
+            self.strain += 0.5 * lin.reshape(-1, width).T @ forced.reshape(-1, width)
+            x = lin.copy()
+            x[:, :, 0] += ref
+            kx = per_vector(k_frame, x)                          # k x (u + u_ref)
+            self.power -= forced.reshape(-1, width).T @ kx.reshape(-1, width)
+            if info.second_order is not None:   # ffr_elastic.ffr_second_order
+                rigidity, axis, length, gram = info.second_order
+                chord = np.zeros((info.nel, 24))
+                chord[:, 12:15], chord[:, 0:3] = axis.T, -axis.T
+                axial = rigidity[:, None] * np.matmul(chord[:, None, :], lin)[:, 0] \
+                    / length[:, None]                            # N = axial . c
+                g24 = np.einsum("abe,ij->eaibj", gram, np.eye(3)).reshape(info.nel, 24, 24)
+                bent = np.matmul(g24, lin)                       # (G x I3) u per c
+                for tensor, left, right, factor in ((cubic_energy, lin, bent, 0.5),
+                                                    (cubic_power, bent, kx, -1.0)):
+                    pair = np.matmul(left.transpose(0, 2, 1), right)     # (nel, m, m)
+                    tensor += factor * (pair.reshape(info.nel, -1).T @ axial).reshape(
+                        tensor.shape)
+        if any(info.second_order is not None for info in model.sets):
+            self.cubic = _cubic_table(cubic_energy, cubic_power)
+        # loads' potential: -Q . (p^ + y + sin W y + (1 - cos) W^2 y)
+        load = model.constant_force()
+        self.load_constant = -float(load @ pivot)
+        rows = np.vstack([load, -_blocks(load, skew), _blocks(load, skew @ skew)])  # W^T = -W
+        self.load_linear = -np.column_stack([rows @ a0, rows @ basis])       # (3, 1 + r)
+        # the constraints on the coordinates self.slots (the kernel's layout, renumbered)
+        self.ncon = len(model.constraints)
+        if self.ncon:
+            from ..kernel import _f, _kernel
+            cs = model.constraints
+            ptr = np.concatenate([[0], np.cumsum([len(q) for q in cs.drive_params])]) + 1
+            data = np.concatenate([np.asarray(q, dtype=float) for q in cs.drive_params]) \
+                if cs.drive_params else np.zeros(1)
+            kinds = np.array(cs.drive_kinds or [0], dtype=np.int32)
+            local = np.array([self.slot_of[int(d)] for d in lay.term_dof], dtype=np.int64)
+            self._kernel = _kernel
+            self._constraint_args = (
+                _f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
+                _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
+                _f(local + 1 if len(local) else np.ones(1), np.int32),
+                _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
+                _f(ptr if len(cs.drive_kinds) else np.ones(2), np.int32), _f(data))
+
+    @staticmethod
+    def supported(model: Model) -> bool:
+        """Whether the maps hold every term of the kernel's output row (else: the row by
+        row path): FFR sets (P-delta included) without damping, no force elements, no
+        contact, no eliminated joints."""
+        return (all(s.kind == "ffr" and s.damping_time == 0.0 for s in model.sets)
+                and not getattr(model, "force_elements", ()) and not model.contact_pairs
+                and not model.vector_loads and model.reduction is None)
+
+    def rows(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
+        """Probes (n, nprobe, 3), deflections, energy (n, 11) without the works, the
+        constraint violation (n,) and the frame's power (n,) at the rows: in blocks of
+        ROW_BLOCK rows, whose temporaries (~100 kB each) stay in the cache and are reused
+        by the allocator (blocks of 10,000 rows page-faulted a fresh mapping for each)."""
+        n = len(times)
+        out = dict(probes=np.zeros((n, len(self.probes), 3)),
+                   deflections=np.zeros((n, len(self.probes), 3)), energy=np.zeros((n, 11)),
+                   violation=np.zeros(n), power=np.zeros(n))
+        for a in range(0, n, ROW_BLOCK):
+            b = slice(a, a + ROW_BLOCK)
+            for key, value in self._block(times[b], eta[b], velocity[b]).items():
+                out[key][b] = value
+        return out
+
+    def _block(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
+        """:meth:`rows` of one block."""
+        phi, rate, _ = self.reduced.drive.values(times)
+        psi = phi - self.reduced.start_angle
+        n = len(times)
+        sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
+        k = self.reduced.axis
+        # e at the needed coordinates, as expand() computes every coordinate
+        sub = np.zeros((n, 0)) if not len(self.slots) else \
+            self.sub_pivot[None, :] + _turn(self.sub_a0[None, :] + eta @ self.sub_basis.T, k, psi)
+        probes = np.zeros((n, len(self.probes), 3))
+        deflections = np.zeros_like(probes)
+        for i, (_, p) in enumerate(self.probes):
+            for d, coef in p.terms:
+                j = self.slot_of[int(d)]
+                probes[:, i, :] += coef * sub[:, j:j + 3]
+            if p.frame:   # A(t)^T v, A = Rot(k, phi) base: base^T (v - sin W v + (1 - cos) W^2 v)
+                info = self.model.frames[p.frame - 1]
+                angle = phi if info.drive_obj is self.reduced.drive else \
+                    info.drive_obj.values(times)[0]
+                axis = info.axis / np.linalg.norm(info.axis)
+                w = _skew(axis)
+                v = probes[:, i, :] - info.pivot
+                v = v - np.sin(angle)[:, None] * (v @ w.T) \
+                    + (1.0 - np.cos(angle))[:, None] * (v @ (w @ w).T)
+                deflections[:, i, :] = v @ info.base - p.reference
+            else:
+                deflections[:, i, :] = probes[:, i, :] - p.reference
+        energy = np.zeros((n, 11))
+        c = np.column_stack([rate, rate[:, None] * eta, velocity])
+        energy[:, 0] = 0.5 * np.einsum("ti,ti->t", c @ self.kinetic, c)
+        c = np.column_stack([np.ones(n), sin, cos1, eta])
+        energy[:, 1] = np.einsum("ti,ti->t", c @ self.strain, c)
+        power = rate * np.einsum("ti,ti->t", c @ self.power, c)
+        if self.cubic is not None:
+            used, table = self.cubic
+            both = _cubic_values(c[:, used], table)
+            energy[:, 1] += both[:, 0]
+            power += rate * both[:, 1]
+        ones = np.column_stack([np.ones(n), eta])
+        energy[:, 2] = self.load_constant + (
+            ones @ self.load_linear[0] + sin * (ones @ self.load_linear[1])
+            + cos1 * (ones @ self.load_linear[2]))
+        for m in self.model.moments:
+            director = sub[:, [self.slot_of[int(d)] for d in m.dofs]]
+            energy[:, 3] -= m.magnitude * _moment_angle(director, m.axis, m.reference)
+        energy[:, 4] = energy[:, 0] + energy[:, 1] + energy[:, 2] + energy[:, 3] + energy[:, 7]
+        violation = np.zeros(n)
+        if self.ncon:
+            out = self._kernel.constraint_violation_rows(
+                *self._constraint_args, np.asfortranarray(sub.T), np.asarray(times, float))
+            if out[-1]:
+                raise SolverError(f"constraint evaluation failed (code {out[-1]})")
+            violation = out[0]
+        return dict(probes=probes, deflections=deflections, energy=energy,
+                    violation=violation, power=power)
+
+
+def _cubic_table(energy: np.ndarray, power: np.ndarray):
+    """sum_ijk c_i c_j c_k T_ijk of the two tensors as sums over the monomials
+    c_i c_j c_k, i <= j <= k, of the coefficients summed over the index permutations;
+    coefficients of c_i that are zero in every term (sin and 1 - cos with the pivot on the
+    frame axis) left out. The pairs (i <= j) ordered by j, the monomials by k: those of a
+    given j or k are a prefix (:func:`_cubic_values`). Returns (used, (nmono, 2) table)."""
+    import itertools
+    weight = sum(np.abs(t).sum(axis=tuple(a for a in range(3) if a != axis))
+                 for t in (energy, power) for axis in range(3))
+    used = np.flatnonzero(weight > 0)
+    m = len(used)
+    sub = [t[np.ix_(used, used, used)] for t in (energy, power)]
+    full = [sum(t.transpose(p) for p in itertools.permutations(range(3))) for t in sub]
+    pairs = [(i, j) for j in range(m) for i in range(j + 1)]
+    i, j, k = np.array([(i, j, k) for k in range(m) for i, j in pairs if j <= k]).T
+    # the distinct orderings of (i, j, k) each appear 6 / repeats times in the full sum
+    repeats = np.where(i == k, 6.0, np.where((i == j) | (j == k), 2.0, 1.0))
+    return used, np.column_stack([f[i, j, k] / repeats for f in full])
+
+
+def _cubic_values(c: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """(rows, 2): the monomials c_i c_j c_k (i <= j <= k, :func:`_cubic_table`'s order)
+    of the rows of c, built from prefixes (no gathers), times the table."""
+    rows, m = c.shape
+    square = np.empty((rows, m * (m + 1) // 2))
+    mono = np.empty((rows, len(table)))
+    at = 0
+    for j in range(m):
+        square[:, at:at + j + 1] = c[:, :j + 1] * c[:, j:j + 1]
+        at += j + 1
+    at = 0
+    for k in range(m):
+        width = (k + 1) * (k + 2) // 2
+        np.multiply(square[:, :width], c[:, k:k + 1], out=mono[:, at:at + width])
+        at += width
+    return mono @ table
+
+
+def _moment_angle(director: np.ndarray, axis: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """section_moment.moment_angle at rows of directors (n, 3): the angle about the axis
+    from the reference to the director's projection, atan2(k . (q x p), q . p) with
+    k . (q x p) = p . (k x q)."""
+    k = axis / np.linalg.norm(axis)
+    p = director - (director @ k)[:, None] * k
+    q = reference - (k @ reference) * k
+    return np.arctan2(p @ (_skew(k) @ q), p @ q)
+
+
+#: rows per output chunk of a reduced run computed in bulk (one write of the file each)
+BULK_ROWS = 65536
+#: rows per block of RowMaps.rows
+ROW_BLOCK = 1024
+
+
+def _departure_bound(model: Model, reduced: ReducedFFR) -> tuple[float, np.ndarray]:
+    """(c, n) with c + n . |eta| >= the small-strain measure of every 'ffr' beam at a
+    reduced state (solvers.assumptions): a section vector's change in the frame is
+    A0^T (x* + Psi eta)_v - r_v0 (the pivot sits on positions only; A = U(psi) A0), at most
+    |A0^T x*_v - r_v0| + sum_j |Psi_vj| |eta_j|; c and n_j the largest over the vectors."""
+    from .assumptions import _section_vectors
+    a0t = model.frames[0].rotation(0.0).T
+    c, n = 0.0, np.zeros(reduced.size)
+    for info in model.sets:
+        if info.kind != "ffr":
+            continue
+        first, reference = _section_vectors(info)
+        index = first[:, None] + np.arange(3)
+        static = reduced.static_state[index] @ a0t.T - reference
+        c = max(c, float(np.linalg.norm(static, axis=1).max(initial=0.0)))
+        columns = np.linalg.norm(reduced.basis[index], axis=1)          # (m, r)
+        n = np.maximum(n, columns.max(axis=0, initial=0.0))
+    return c, n
+
+
+def _reduced_assumptions(model: Model, reduced: ReducedFFR, chunk, eta: np.ndarray,
+                         every_row: bool):
+    """dynamic._check_assumptions for a chunk of a reduced run: with every_row (the chunk
+    carries q), the first row whose 'ffr' beam leaves its small-strain range ends the run
+    (the rows after it dropped), else the chunk's last state is checked; rows whose bound
+    (:func:`_departure_bound`) stays below the limit are not expanded."""
+    from .assumptions import FFR_LIMIT, ffr_departure_rows
+    from .dynamic import Chunk, _outside
+    times = chunk.time
+    if not every_row:
+        e, _ = expand(reduced, times[-1:], eta[-1:], np.zeros_like(eta[-1:]))
+        return chunk, _outside(model, e[0], float(times[-1]), "by")
+    if not hasattr(reduced, "_departure_bound"):
+        reduced._departure_bound = _departure_bound(model, reduced)
+    c, n = reduced._departure_bound
+    bound = (c + np.abs(eta) @ n) * (1.0 + 1e-9)
+    suspect = np.flatnonzero(~(bound <= FFR_LIMIT))          # also not a number
+    if not len(suspect):
+        return chunk, ""
+    e, _ = expand(reduced, times[suspect], eta[suspect], np.zeros_like(eta[suspect]))
+    outside = np.zeros(len(suspect), dtype=bool)
+    for _, change in ffr_departure_rows(model, e, times[suspect]):
+        outside |= ~(change <= FFR_LIMIT)
+    if not outside.any():
+        return chunk, ""
+    k = int(np.argmax(outside))
+    row = int(suspect[k])
+    why = _outside(model, e[k], float(times[row]), "at")
+    kept = {}
+    for key, value in vars(chunk).items():
+        if value is None:
+            kept[key] = None
+        elif isinstance(value, ExpandedRows):
+            kept[key] = ExpandedRows(reduced, value.times[:row + 1], value.eta[:row + 1])
+        else:
+            kept[key] = value[:row + 1]
+    return Chunk(**kept), why
+
+
 def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
                       progress: bool | None = None, should_stop=None):
     """A dynamic run of the reduced model with the output of the full one: the reduced
@@ -373,23 +723,35 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
     counts = np.zeros(6, dtype=np.int32)
     frame_work, last_power = 0.0, None
     rows_done = 0
+    maps = reduced.row_maps
+    if maps is None and RowMaps.supported(model):
+        maps = reduced.row_maps = RowMaps(model, reduced)
     step = max(1, int(settings.chunk_steps))
+    if maps is not None:   # the rows in bulk: chunks of up to BULK_ROWS rows (one write each)
+        step = max(step, BULK_ROWS)
     try:
         for first in range(0, nrows, step):
             t1 = time.perf_counter()
             rows = slice(first, min(first + step, nrows))
-            e, v = expand(reduced, times[rows], eta[rows], velocity[rows])
-            n = len(e)
-            probes = np.zeros((n, model.kernel.nprobe, 3))
-            deflections = np.zeros_like(probes)
-            energy = np.zeros((n, 11))
-            violation, power = np.zeros(n), np.zeros(n)
-            for i in range(n):
-                row = model.kernel.output_row(float(times[first + i]), e[i], v[i],
-                                              np.zeros(ncon), no_work, guesses, counts)
-                probes[i], deflections[i] = row["probes"], row["deflections"]
-                energy[i], violation[i] = row["energy"], row["violation"]
-                power[i] = row["powers"][1]
+            if maps is not None:
+                found = maps.rows(times[rows], eta[rows], velocity[rows])
+                probes, deflections = found["probes"], found["deflections"]
+                energy, violation, power = found["energy"], found["violation"], found["power"]
+                e = ExpandedRows(reduced, times[rows], eta[rows])
+                n = len(e)
+            else:
+                e, v = expand(reduced, times[rows], eta[rows], velocity[rows])
+                n = len(e)
+                probes = np.zeros((n, model.kernel.nprobe, 3))
+                deflections = np.zeros_like(probes)
+                energy = np.zeros((n, 11))
+                violation, power = np.zeros(n), np.zeros(n)
+                for i in range(n):
+                    row = model.kernel.output_row(float(times[first + i]), e[i], v[i],
+                                                  np.zeros(ncon), no_work, guesses, counts)
+                    probes[i], deflections[i] = row["probes"], row["deflections"]
+                    energy[i], violation[i] = row["energy"], row["violation"]
+                    power[i] = row["powers"][1]
             # frame work: the trapezoidal rule over the rows (the stepper's rule)
             previous = power[0] if last_power is None else last_power
             increments = 0.5 * settings.dt * (np.concatenate([[previous], power[:-1]]) + power)
@@ -402,9 +764,13 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
             chunk = Chunk(time=times[rows].copy(), probes=probes, deflections=deflections,
                           lam=np.full((n, ncon), np.nan), energy=energy, constraint=violation,
                           stats=stats[rows].copy(), q=e if settings.store_q else None)
-            chunk, outside = _check_assumptions(model, chunk,
-                                                {"e": e[-1], "t": float(times[rows][-1])},
-                                                False)
+            if maps is not None:
+                chunk, outside = _reduced_assumptions(model, reduced, chunk, eta[rows],
+                                                      settings.store_q)
+            else:
+                chunk, outside = _check_assumptions(model, chunk,
+                                                    {"e": e[-1], "t": float(times[rows][-1])},
+                                                    False)
             if sink is not None and len(chunk.time):
                 sink(chunk)
             rows_done += len(chunk.time)

@@ -189,7 +189,13 @@ class ReactionMap:
                 entries = np.flatnonzero(owner_of_row[self.a_coo.row] == name)
                 cols = self.a_coo.col[entries]
                 entries = entries[(cols >= first) & (cols < first + size)]
-            self.selection[name] = (terms, entries, first, size)
+            # the 3-vectors of body2 the joint's force acts on (the rest are exactly zero):
+            # the force and moment sum over these only
+            touched = self.t_dof[terms] - first
+            if len(entries):
+                touched = np.concatenate([touched, self.a_coo.col[entries] - first])
+            slots = np.unique(touched // 3)
+            self.selection[name] = (terms, entries, first, size, slots)
 
     def _gradients(self, q_full: np.ndarray, t: float) -> np.ndarray:
         """The multiplier constraints' operand gradients (6, ncon) at (q, t) from the kernel
@@ -251,13 +257,18 @@ class ReactionMap:
             rhs = self.a @ (residual_rows - total).T
             mu = np.atleast_2d(self.factor.solve(rhs).T.reshape(nt, -1))
         out = {}
-        for name, (terms, entries, first, size) in self.selection.items():
-            vec = contrib[:, terms] @ _scatter(self.t_dof[terms] - first, size)
+        for name, (terms, entries, first, size, slots) in self.selection.items():
+            # on the touched 3-vectors only (slots): column 3 k + j is component j of slot k
+            compact = 3 * len(slots)
+
+            def column(dofs: np.ndarray) -> np.ndarray:
+                return 3 * np.searchsorted(slots, dofs // 3) + dofs % 3
+            vec = contrib[:, terms] @ _scatter(column(self.t_dof[terms] - first), compact)
             if mu is not None and len(entries):
                 a = self.a_coo
                 vec = vec + (mu[:, a.row[entries]] * a.data[entries]) @ \
-                    _scatter(a.col[entries] - first, size)
-            out[name] = vec
+                    _scatter(column(a.col[entries] - first), compact)
+            out[name] = (vec, slots)
         return out
 
     def reaction_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
@@ -265,7 +276,7 @@ class ReactionMap:
         """Per joint (force (nt, 3), moment (nt, 3), point (nt, 3), axial (nt,) or None)
         for rows of full coordinates and multipliers."""
         gen = self.generalized_rows(q_rows, lam_rows, times, residual_rows)
-        return {name: _reduce_rows(joint, gen[name], q_rows, self.points[name])
+        return {name: _reduce_rows(joint, *gen[name], q_rows, self.points[name])
                 for name, joint in self.joints.items()}
 
     def reactions(self, q_full: np.ndarray, lam: np.ndarray, t: float = 0.0,
@@ -325,21 +336,26 @@ def _vec_rows(expr, q_rows: np.ndarray) -> np.ndarray:
     return out
 
 
-def _reduce_rows(joint, generalized: np.ndarray, q_rows: np.ndarray, points: tuple):
+def _reduce_rows(joint, generalized: np.ndarray, slots: np.ndarray, q_rows: np.ndarray,
+                 points: tuple):
     """Force and moment about the joint's point of the generalized forces on body2 (nt
-    rows), the point and a distance joint's axial force."""
+    rows; on the 3-vectors ``slots`` of body2's coordinates, column 3 k + j component j of
+    slots[k]: every other vector carries no force), the point and a distance joint's axial
+    force."""
     body = joint.body2
     per, nodes = _vector_blocks(body)
     p2, p1 = points
     point = _vec_rows(p2, q_rows)
     nt = len(q_rows)
     force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
-    if per:
-        block = generalized.reshape(nt, nodes, per // 3, 3)
-        values = q_rows[:, body.first:body.first + per * nodes].reshape(nt, nodes, per // 3, 3)
-        force = block[:, :, 0, :].sum(axis=1)
-        moment = _cross(values[:, :, 0, :] - point[:, None, :], block[:, :, 0, :]).sum(axis=1)
-        moment += _cross(values[:, :, 1:, :], block[:, :, 1:, :]).sum(axis=(1, 2))
+    if per and len(slots):
+        block = generalized.reshape(nt, len(slots), 3)
+        index = (body.first + 3 * slots[:, None] + np.arange(3)).ravel()
+        values = q_rows[:, index].reshape(nt, len(slots), 3)
+        position = slots % (per // 3) == 0          # a node's first vector: its position
+        force = block[:, position].sum(axis=1)
+        moment = _cross(values[:, position] - point[:, None, :], block[:, position]).sum(axis=1)
+        moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
     swapped = getattr(joint, "swapped", False)
     if swapped:
         force, moment = -force, -moment
@@ -442,6 +458,7 @@ class _Tables:
         local[:, 0, :] -= beam.frame_pivot @ beam.orientation
         self.local_reference = local
         self._linear: np.ndarray | None = None
+        self._element: np.ndarray | None = None
 
     def linear_strain(self, beam: Beam) -> np.ndarray:
         """(ncoordinates, nel * nxi * 8): the strains' linear part about the reference in
@@ -456,6 +473,20 @@ class _Tables:
                 minus = _strains(beam, _beam_vectors(beam, base - unit, 0), self)
             self._linear = (0.5 * (plus - minus)).reshape(n, -1)
         return self._linear
+
+    def element_strain(self, beam: Beam) -> np.ndarray:
+        """(nel, 24, nxi * 6): per element the rows of :meth:`linear_strain` that act on its
+        own 24 coordinates (nodes e and e + 1; every other entry of the matrix is exactly
+        zero: an element's strains depend on its coordinates only), for the six measures
+        the section forces use (eps, b_y, b_z, twist, gamma_y, gamma_z), for one stacked
+        product per chunk of rows (:func:`_element_strains`)."""
+        if self._element is None:
+            nxi = len(self.xi)
+            full = self.linear_strain(beam).reshape(beam.ncoordinates, beam.nel, nxi, 8)
+            self._element = np.ascontiguousarray(np.stack([
+                full[12 * e:12 * e + 24, e, :, :6].reshape(24, nxi * 6)
+                for e in range(beam.nel)]))
+        return self._element
 
 
 def _tables(beam: Beam, stations: int) -> _Tables:
@@ -515,6 +546,24 @@ def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
     return np.stack([eps, b_y, b_z, twist, gamma_y, gamma_z, c_y, c_z], axis=-1)
 
 
+def _element_strains(blocks: np.ndarray, d_nodal: np.ndarray, nxi: int) -> np.ndarray:
+    """The six linear strain measures (..., nel, nxi, 6) of displacements d_nodal (..., n)
+    in the frame: per element its (24, nxi * 6) block on its own 24 coordinates (windows
+    of the rows, 12 coordinates apart), all elements and rows in one stacked matrix
+    product (a dense (n, nel * nxi * 8) product spent 13 times the work on zeros: on the
+    28-node boom 2.2e9 multiply-adds per 10,000 rows). A view (the element axis leads in
+    memory)."""
+    from numpy.lib.stride_tricks import as_strided
+    nel = len(blocks)
+    lead = d_nodal.shape[:-1]
+    rows = np.ascontiguousarray(d_nodal.reshape(-1, d_nodal.shape[-1]))    # (rows, n)
+    step, width = rows.strides
+    windows = as_strided(rows, shape=(nel, len(rows), 24), strides=(12 * width, step, width),
+                         writeable=False)
+    out = np.matmul(windows, blocks)                                  # (nel, rows, nxi * 6)
+    return np.moveaxis(out.reshape(nel, *lead, nxi, 6), 0, -3)
+
+
 def _beam_vectors(beam: Beam, q_full: np.ndarray, first: int | None = None) -> np.ndarray:
     """The elements' nodal vectors (..., nel, 8, 3) from coordinates (..., n) holding the
     beam's from ``first`` (default: the beam's first coordinate)."""
@@ -537,10 +586,10 @@ def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_
     if stations < 2:
         raise ValueError("stations must be at least 2 (both ends of each element)")
     tables = _tables(beam, stations)
-    current = _beam_vectors(beam, np.asarray(q_full, dtype=float))
+    q_full = np.asarray(q_full, dtype=float)
     if beam.formulation == "ffr":
         rotation = beam.orientation if frame is None else np.asarray(frame, dtype=float)
-        nodal = np.asarray(q_full, dtype=float)[..., beam.first:beam.first + beam.ncoordinates]
+        nodal = q_full[..., beam.first:beam.first + beam.ncoordinates]
         nodal = nodal.reshape(*nodal.shape[:-1], beam.nodes, 4, 3)
         if rotation.ndim == 3:   # per row: R^T v for every vector
             local = np.matmul(nodal.reshape(len(rotation), -1, 3), rotation)
@@ -550,36 +599,41 @@ def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_
             local = nodal @ rotation
             shift = beam.frame_pivot @ rotation
         local[..., 0, :] -= shift
-        d = local - tables.local_reference
+        local -= tables.local_reference
+        d_nodal = local.reshape(*local.shape[:-3], -1)
         if beam.ncoordinates * beam.nel * len(tables.xi) * 8 <= LINEAR_MATRIX_LIMIT:
-            d_nodal = d.reshape(*local.shape[:-3], -1)
-            change = (d_nodal @ tables.linear_strain(beam)).reshape(
-                *d_nodal.shape[:-1], beam.nel, len(tables.xi), 8)
+            change = _element_strains(tables.element_strain(beam), d_nodal, len(tables.xi))
         else:   # a long beam: the same linear part, element by element
             x0 = _beam_vectors(beam, tables.local_reference.reshape(-1), 0)
-            dv = _beam_vectors(beam, d.reshape(*local.shape[:-3], -1), 0)
+            dv = _beam_vectors(beam, d_nodal, 0)
             with np.errstate(invalid="ignore", divide="ignore"):
                 change = 0.5 * (_strains(beam, x0 + dv, tables) - _strains(beam, x0 - dv, tables))
     else:
-        now = _strains(beam, current, tables)
+        now = _strains(beam, _beam_vectors(beam, q_full), tables)
         change = now - tables.strain0
-    d = change.reshape(*change.shape[:-3], -1, 8)
+    # each measure (..., nel, nxi) times its modulus, written C-ordered: (..., ns) by reshape
+    lead = change.shape[:-3]
+    ns = change.shape[-3] * change.shape[-2]
     data, section, mat = beam.section.data, beam.section, beam.material
     e_mod = mat.youngs_modulus
     g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
     k_y, k_z = section.shear_factors(mat.poisson_ratio)
-    axial = e_mod * data.area * d[..., 0]
+
+    def scaled(factor: float, k: int) -> np.ndarray:
+        return np.multiply(factor, change[..., k], order="C").reshape(*lead, ns)
+    axial = scaled(e_mod * data.area, 0)
     if beam.formulation != "ffr":   # large deformation: the bending strains' axial share
-        rates = now[..., 6:].reshape(*d.shape[:-1], 2)
-        axial = axial + e_mod * (data.inertia_z * d[..., 1] * rates[..., 0]
-                                 + data.inertia_y * d[..., 2] * rates[..., 1])
-    return SectionForces(
-        s=tables.s, N=axial,
-        T=g_mod * section.torsion_constant * d[..., 3],
-        Q=np.stack([k_y * g_mod * data.area * d[..., 4], k_z * g_mod * data.area * d[..., 5]],
-                   axis=-1),
-        M=np.stack([-e_mod * data.inertia_y * d[..., 2], e_mod * data.inertia_z * d[..., 1]],
-                   axis=-1))
+        axial = axial + (e_mod * (data.inertia_z * change[..., 1] * now[..., 6]
+                                  + data.inertia_y * change[..., 2] * now[..., 7])
+                         ).reshape(*lead, ns)
+    pairs = np.empty((2, *change.shape[:-1], 2))     # Q and M: (..., nel, nxi, 2) each
+    for which, j, k, factor in ((0, 0, 4, k_y * g_mod * data.area),
+                                (0, 1, 5, k_z * g_mod * data.area),
+                                (1, 0, 2, -e_mod * data.inertia_y),
+                                (1, 1, 1, e_mod * data.inertia_z)):
+        np.multiply(factor, change[..., k], out=pairs[which][..., j])
+    return SectionForces(s=tables.s, N=axial, T=scaled(g_mod * section.torsion_constant, 3),
+                         Q=pairs[0].reshape(*lead, ns, 2), M=pairs[1].reshape(*lead, ns, 2))
 
 
 def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS, *,
@@ -587,7 +641,16 @@ def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS
     """Section forces of every beam of the model by name at the state e (time t: where an
     'ffr' beam's frame is); e may hold rows of states (nt, ndof) at the times t (nt,):
     the arrays then have a leading time axis."""
-    q = model.expand(e)
+    return _section_forces_full(model, model.expand(e), stations, t)
+
+
+#: rows per block of :class:`DynamicAnswers`' section forces and stress envelope
+SECTION_BLOCK = 256
+
+
+def _section_forces_full(model: Model, q: np.ndarray, stations: int,
+                         t: float | np.ndarray) -> dict[str, SectionForces]:
+    """:func:`section_forces` from the full coordinates q (nfull,) or (nt, nfull)."""
     frame_of = {s.body.name: s.frame for s in model.sets}
     out = {}
     for b in model.bodies:
@@ -741,6 +804,103 @@ def _von_mises_block(section, forces: SectionForces) -> np.ndarray:
     return np.sqrt(sigma.max(axis=-1))
 
 
+def _stress_bounds(section) -> tuple[np.ndarray, np.ndarray]:
+    """(normal, shear): per-unit coefficients with |sigma| <= normal . |(N, M_width,
+    M_height)| and tau <= shear . |(T, Q_height, Q_width)| at every fibre point of
+    :func:`fibre_stresses` (sigma is linear in N and the moments, tau linear in |T| and the
+    |Q| with coefficients >= 0 for every section kind): the largest magnitude of each
+    force's stress per unit force over the fibres, so von Mises <= sqrt(bound)."""
+    cache = section.__dict__.setdefault("_stress_bounds", None) \
+        if hasattr(section, "__dict__") else None
+    if cache is not None:
+        return cache
+    unit = np.eye(6)
+    forces = SectionForces(s=np.zeros(6), N=unit[0], T=unit[1],
+                           Q=np.column_stack([unit[2], unit[3]]),
+                           M=np.column_stack([unit[4], unit[5]]))
+    sigma, tau = fibre_stresses(section, forces)          # (6 unit cases, npoints)
+    normal = np.abs(sigma).max(axis=-1)[[0, 5, 4]]         # N, M_width, M_height
+    shear = np.abs(tau).max(axis=-1)[[1, 2, 3]]            # T, Q_height, Q_width
+    found = (normal, shear)
+    if hasattr(section, "__dict__"):
+        section.__dict__["_stress_bounds"] = found
+    return found
+
+
+#: the bound's safety margin against rounding (it and the stresses are computed apart)
+BOUND_MARGIN = 1e-9
+
+
+def peak_rows(section, forces: SectionForces, floor: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """(row, peak) per station of rows of section forces (nt, ns): the first row of the
+    largest von Mises stress and that stress, as ``argmax`` of :func:`von_mises_peak`
+    gives them (every value computed by the same operations: bitwise the same), without
+    evaluating the fibres of rows that cannot hold the peak: a bound from
+    :func:`_stress_bounds` (a few operations per row and station, against 16 fibres)
+    skips every row below the stress found at the row of the largest bound, or below
+    ``floor`` (ns,) (the envelope of earlier rows: a station whose rows all stay below it
+    may return any row with peak <= floor, -inf when a bound over all rows, from each
+    force's largest magnitude, lies below the floor)."""
+    nt, ns = forces.N.shape
+    normal, shear = _stress_bounds(section)
+    if floor is not None and nt > 1:
+        # the block's bound per station from each force's largest magnitude over the rows
+        # (reductions, no temporaries): stations that stay below the floor are done
+        def most(x: np.ndarray) -> np.ndarray:
+            return np.maximum(x.max(axis=0), -x.min(axis=0))
+        top_sig = (most(forces.N) * normal[0] + most(forces.M[..., 1]) * normal[1]
+                   + most(forces.M[..., 0]) * normal[2])
+        top_tau = (most(forces.T) * shear[0] + most(forces.Q[..., 0]) * shear[1]
+                   + most(forces.Q[..., 1]) * shear[2])
+        live = ~(np.sqrt(top_sig**2 + 3.0 * top_tau**2) * (1.0 + BOUND_MARGIN) < floor)
+        if not live.all():
+            row, peak = np.zeros(ns, dtype=np.int64), np.full(ns, -np.inf)
+            if live.any():
+                row[live], peak[live] = peak_rows(section, SectionForces(
+                    s=forces.s[live], N=forces.N[:, live], T=forces.T[:, live],
+                    Q=forces.Q[:, live], M=forces.M[:, live]), floor[live])
+            return row, peak
+    sig = np.abs(forces.N) * normal[0]
+    sig += np.abs(forces.M[..., 1]) * normal[1]
+    sig += np.abs(forces.M[..., 0]) * normal[2]
+    tau = np.abs(forces.T) * shear[0]
+    tau += np.abs(forces.Q[..., 0]) * shear[1]
+    tau += np.abs(forces.Q[..., 1]) * shear[2]
+    np.square(sig, out=sig)
+    np.square(tau, out=tau)
+    tau *= 3.0
+    sig += tau
+    bound = np.sqrt(sig, out=sig)
+    bound *= 1.0 + BOUND_MARGIN
+    if not np.isfinite(bound).all():   # not a number somewhere: every fibre, as before
+        vm = von_mises_peak(section, forces)
+        row = np.argmax(vm, axis=0)
+        return row, vm[row, np.arange(ns)]
+    stations = np.arange(ns)
+
+    def exact(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        return _von_mises_block(section, SectionForces(
+            s=forces.s, N=forces.N[rows, cols], T=forces.T[rows, cols],
+            Q=forces.Q[rows, cols], M=forces.M[rows, cols]))
+    top = np.argmax(bound, axis=0)
+    found = exact(top, stations)                 # a lower bound of each station's peak
+    level = found if floor is None else np.maximum(found, floor)
+    cols, rows = np.nonzero((bound >= level).T)  # by station, rows ascending
+    row, peak = top.copy(), found.copy()
+    if len(rows):
+        values = exact(rows, cols)
+        starts = np.flatnonzero(np.r_[True, cols[1:] != cols[:-1]])
+        best = np.maximum.reduceat(values, starts)
+        owner = cols[starts]
+        hit = values == np.repeat(best, np.diff(np.r_[starts, len(cols)]))
+        first = np.flatnonzero(hit)
+        station_of_first, at = np.unique(cols[first], return_index=True)
+        row[station_of_first] = rows[first[at]]
+        peak[owner] = best
+    return row, peak
+
+
 def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress]:
     """Stresses of every beam by name from its section forces."""
     beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
@@ -825,7 +985,8 @@ class DynamicAnswers:
         if not len(times):
             return
         e_rows = np.asarray(chunk.q, dtype=float)
-        q_rows = self.model.expand(e_rows)
+        # read only: without eliminated joints q is e (no copy of every row)
+        q_rows = e_rows if self.model.reduction is None else self.model.expand(e_rows)
         residual = None
         velocities = np.zeros_like(e_rows)
         if self.need_acceleration:
@@ -858,20 +1019,28 @@ class DynamicAnswers:
         self.time.extend(times.tolist())
         if not self.beams:
             return
-        forces = section_forces(self.model, np.asarray(chunk.q), self.stations, t=times)
-        for name, f in forces.items():
-            if self.keep_sections:
-                self.sections.setdefault(name, []).append(f)
-            vm = von_mises_peak(self.beams[name].section, f)   # (nt, ns)
-            row = np.argmax(vm, axis=0)
-            peak = vm[row, np.arange(vm.shape[1])]
-            if name not in self.envelope:
-                self.envelope[name] = (f.s, peak.copy(), times[row].copy())
-            else:
-                _, best, when = self.envelope[name]
-                higher = peak > best
-                best[higher] = peak[higher]
-                when[higher] = times[row][higher]
+        # blocks of rows whose temporaries stay in the cache (the stations' forces of
+        # 1000 rows of the 28-node boom are 4 MB)
+        for a in range(0, len(times), SECTION_BLOCK):
+            block = slice(a, a + SECTION_BLOCK)
+            forces = _section_forces_full(self.model, q_rows[block], self.stations,
+                                          times[block])
+            for name, f in forces.items():
+                self._record_sections(name, f, times[block])
+
+    def _record_sections(self, name: str, f: SectionForces, times: np.ndarray) -> None:
+        """Keep a block's section forces (output.sections) and lift the envelope."""
+        if self.keep_sections:
+            self.sections.setdefault(name, []).append(f)
+        floor = self.envelope[name][1] if name in self.envelope else None
+        row, peak = peak_rows(self.beams[name].section, f, floor)   # (ns,) each
+        if name not in self.envelope:
+            self.envelope[name] = (f.s, peak.copy(), times[row].copy())
+        else:
+            _, best, when = self.envelope[name]
+            higher = peak > best
+            best[higher] = peak[higher]
+            when[higher] = times[row][higher]
 
 
 __all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions",
