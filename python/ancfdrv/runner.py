@@ -355,27 +355,37 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
                                           f"not recorded: {exc}")
                     recorder = None
             base_sink(chunk)
+    done = False  # the attributes are written once: the full set after a completed run
     try:
         with results.released(out):  # the file is closed between the writes of the run
             dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
                             should_stop=stop)
-    finally:  # also after a failure or an interrupt: every computed step goes to the file
         writer.flush()
         if supports is not None:
             supports.write(out, writer.rows)
         if recorder is not None:
             results.write_dynamic_answers(out, recorder)
-        results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
-    for phase, seconds in dyn.timing.items():
-        timing[f"dynamic_{phase}"] = seconds
-    stages: dict[str, float] = {}
-    _warn_large_ffr_deflection(model, out)
-    bounds = stage_bounds(scene)
-    if bounds:
-        with results.reading(out) as h5:
-            t = h5["dynamic/time"][()]
-            transverse = h5["dynamic/deflection/tip"][:, 1]
-        stages = stage_summary(t, transverse, bounds)
+        for phase, seconds in dyn.timing.items():
+            timing[f"dynamic_{phase}"] = seconds
+        stages: dict[str, float] = {}
+        _warn_large_ffr_deflection(model, out)
+        bounds = stage_bounds(scene)
+        if bounds:
+            with results.reading(out) as h5:
+                t = h5["dynamic/time"][()]
+                transverse = h5["dynamic/deflection/tip"][:, 1]
+            stages = stage_summary(t, transverse, bounds)
+        done = True
+    finally:  # also after a failure or an interrupt: every computed step goes to the file
+        if not done:
+            results.drop(out)  # the held file may be in any state after an error
+            writer.flush()
+            if supports is not None:
+                supports.write(out, writer.rows)
+            if recorder is not None:
+                results.write_dynamic_answers(out, recorder)
+            results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)},
+                                        {})
     results.write_dynamic_attrs(out, {
         **attrs, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
         "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,

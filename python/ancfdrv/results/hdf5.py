@@ -602,7 +602,8 @@ class DynamicWriter:
 
     Chunks are buffered and written together (merged: one write per series), with the
     file closed after each write, whenever ``flush_rows`` rows are waiting or
-    FLUSH_SECONDS have passed since the last write (the initial row is written at once);
+    FLUSH_SECONDS have passed since the last write (or since the writer was made: the
+    initial row waits for the rows after it, one write instead of two in a short run);
     :meth:`flush` writes the rest. So the file on disk lags the computation by at most
     ``flush_rows`` rows or about a second (the runner sizes ``flush_rows`` to ~16 MB),
     and a run that stops (failure, SIGINT, SIGTERM) flushes everything.
@@ -648,15 +649,24 @@ class DynamicWriter:
             group = h5.create_group("dynamic")
             _attrs(group.attrs, {"status": "running", "rows": np.int64(0)})
 
+            # the row series are made by the first flush, with its rows (one HDF5 call per
+            # series instead of two: a short run writes once); ``series`` records them
+            self._series: dict[str, tuple] = {}
+            self._made: set[str] = set()
+            self._group_attrs: dict[str, dict[str, Any]] = {}
+
             def series(name: str, units: str, width: tuple[int, ...] = (),
-                       dtype: str = "f8") -> None:
+                       dtype: str = "f8", attrs: dict[str, Any] | None = None,
+                       now: bool = False) -> None:
                 # a model without constraints has lambda[nt, 0]: HDF5 chunks must be
                 # positive, so that axis gets a free maximum
                 chunk = tuple(max(1, w) for w in width)
                 limit = tuple(w if w else None for w in width)
-                _new_dataset(group, name, shape=(0, *width), maxshape=(None, *limit),
-                             dtype=dtype, chunks=(1024, *chunk)
-                             if width != (ndof,) else (16, ndof), units=units)
+                self._series[name] = (units, width, np.dtype(dtype), (None, *limit),
+                                      (1024, *chunk) if width != (ndof,) else (16, ndof),
+                                      attrs or {})
+                if now:
+                    self._make(group, name, None)
             series("time", "s")
             for name in self.names:
                 series(f"probes/{name}", "m", (3,))
@@ -670,16 +680,16 @@ class DynamicWriter:
             series("factorizations", "count", dtype="i8")
             series("jacobian_evaluations", "count", dtype="i8")
             # step control (issue 26): which step reached each row, how many steps and cuts
-            series("step_size", "s")
+            series("step_size", "s", attrs={"description": (
+                "the smallest step taken to reach the row (0 for the initial row); the rows "
+                "stay on the grid t0 + k dt, steps land on it exactly")})
             series("substeps", "count", dtype="i8")
             series("step_cuts", "count", dtype="i8")
-            group["step_size"].attrs["description"] = (
-                "the smallest step taken to reach the row (0 for the initial row); the rows "
-                "stay on the grid t0 + k dt, steps land on it exactly")
             if self.npoints:  # per contact point: penetration, forces, slip, projection
                 for name in CONTACT_FIELDS:
                     series(f"contact/{name}", CONTACT_UNITS.get(name, "1"), (self.npoints,))
-                group["contact"].attrs["points"] = "\n".join(model.contact_point_names)
+                self._group_attrs["contact"] = {
+                    "points": "\n".join(model.contact_point_names)}
             if self.write_q:
                 series("q", COORDINATE_UNITS, (ndof,))
             elif store_q:  # where a run that stops between XDMF frames ends
@@ -692,20 +702,50 @@ class DynamicWriter:
                                                 maxshape=(None, self.nnodes, 3), dtype="f8",
                                                 chunks=(16, self.nnodes, 3))
                     data.attrs["units"] = "m"
-                series("mesh_rows", "index", dtype="i8")
-                group["mesh_rows"].attrs["description"] = (
-                    "the row of /dynamic/time of each row of mesh_nodes (XDMF frames)")
+                series("mesh_rows", "index", dtype="i8", now=True, attrs={"description": (
+                    "the row of /dynamic/time of each row of mesh_nodes (XDMF frames)")})
+
+    def _make(self, group: h5py.Group, name: str, values: np.ndarray | None) -> None:
+        """Series ``name`` of /dynamic, holding ``values`` (None: no rows)."""
+        units, width, dtype, limit, chunks, attrs = self._series[name]
+        if values is None:
+            values = np.zeros((0, *width), dtype=dtype)
+        values = np.ascontiguousarray(values, dtype=dtype)
+        dataset = _new_dataset(group, name, values, maxshape=limit, chunks=chunks, units=units)
+        if attrs:
+            _attrs(h5py.AttributeManager(h5py.Dataset(dataset)), attrs)
+        self._made.add(name)
+        head = name.rpartition("/")[0]
+        if head in self._group_attrs:
+            _attrs(group[head].attrs, self._group_attrs.pop(head))
+
+    def _put(self, group: h5py.Group, name: str, values: np.ndarray) -> None:
+        """Rows self.rows.. of series ``name``: appended, or the series made with them."""
+        if name in self._made:
+            _append_rows(group.id, name, self.rows, values)
+        else:
+            self._make(group, name, values)
+
+    def _make_rest(self, group: h5py.Group) -> None:
+        """The series no flush has written yet, without rows (every series exists once
+        the run has written; a chunk without contact data leaves those empty)."""
+        for name in self._series:
+            if name not in self._made:
+                self._make(group, name, None)
 
     def __call__(self, chunk) -> None:
         self._pending.append(chunk)
         self._pending_rows += len(chunk.time)
-        if (self.rows == 0 or self._pending_rows >= self.flush_rows
+        if (self._pending_rows >= self.flush_rows
                 or time.monotonic() - self._last_write >= FLUSH_SECONDS):
             self.flush()
 
     def flush(self) -> None:
         """Write every buffered chunk (one open of the file)."""
         if not self._pending:
+            if len(self._made) < len(self._series):  # no row at all: the empty series
+                with _open_write(self.path) as h5:
+                    self._make_rest(h5["dynamic"])
             return
         # a full disk or file-size limit: refused before HDF5 writes (a write failing
         # inside HDF5 can crash it), the rows written before stay readable
@@ -721,6 +761,8 @@ class DynamicWriter:
             # costs ~0.2 ms, whatever its rows)
             self._append(group, self._merged(group) if len(self._pending) > 1
                          else self._pending[0])
+            if len(self._made) < len(self._series):
+                self._make_rest(group)
             group.attrs["rows"] = np.int64(self.rows)
             if self.nnodes:  # the per-frame views the XDMF description names
                 from .xdmf import add_step_views
@@ -756,7 +798,7 @@ class DynamicWriter:
         n = len(chunk.time)
 
         def append(name: str, values: np.ndarray) -> None:
-            _append_rows(group.id, name, self.rows, values)
+            self._put(group, name, values)
         append("time", chunk.time)
         for p, name in enumerate(self.names):
             append(f"probes/{name}", chunk.probes[:, p, :])
@@ -793,9 +835,9 @@ class DynamicWriter:
         size = getattr(chunk, "step_size", None)
         before = group["time"][self.rows - 1] if self.rows and size is None else None
         size, substeps, cuts = self._steps(chunk, before)
-        _append_rows(group.id, "step_size", self.rows, np.asarray(size, dtype=float))
-        _append_rows(group.id, "substeps", self.rows, np.asarray(substeps, dtype=np.int64))
-        _append_rows(group.id, "step_cuts", self.rows, np.asarray(cuts, dtype=np.int64))
+        self._put(group, "step_size", np.asarray(size, dtype=float))
+        self._put(group, "substeps", np.asarray(substeps, dtype=np.int64))
+        self._put(group, "step_cuts", np.asarray(cuts, dtype=np.int64))
 
     @staticmethod
     def _steps(chunk, before) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
