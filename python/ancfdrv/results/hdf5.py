@@ -80,11 +80,17 @@ def _attr_array(value: Any) -> np.ndarray | None:
     return None
 
 
-def _attrs(target: h5py.AttributeManager, values: dict[str, Any]) -> None:
+#: the dataspace of scalar attributes (made once; h5py's ``create_simple(())`` is scalar)
+_SCALAR = h5py.h5s.create(h5py.h5s.SCALAR)
+
+
+def _attrs(target: h5py.AttributeManager, values: dict[str, Any], *,
+           fresh: bool = False) -> None:
     """Write attributes (bool and int as int64). The common kinds go through h5py's
     low-level API with the types made once (the same HDF5 types and values as
     ``attrs[key] = value``, a quarter of its cost: a run writes ~160 attributes); any
-    other value through h5py's high-level API."""
+    other value through h5py's high-level API. ``fresh``: none of the names exists yet
+    (a new object), so none is looked up to be replaced."""
     oid = target._id
     for key, value in values.items():
         data = _attr_array(value)
@@ -92,10 +98,11 @@ def _attrs(target: h5py.AttributeManager, values: dict[str, Any]) -> None:
             target[key] = value
             continue
         name = key.encode("utf-8")
-        if h5py.h5a.exists(oid, name):
+        if not fresh and h5py.h5a.exists(oid, name):
             h5py.h5a.delete(oid, name)
         file_type, memory_type = _types(data.dtype)
-        attr = h5py.h5a.create(oid, name, file_type, h5py.h5s.create_simple(data.shape))
+        space = h5py.h5s.create_simple(data.shape) if data.ndim else _SCALAR
+        attr = h5py.h5a.create(oid, name, file_type, space)
         try:
             attr.write(data, mtype=memory_type)
         finally:
@@ -138,8 +145,7 @@ def _new_dataset(group: h5py.Group, name: str, data: np.ndarray | None = None, *
     if data is not None:
         dataset.write(h5py.h5s.ALL, h5py.h5s.ALL, data)
     if units is not None:
-        attr = h5py.h5a.create(dataset, b"units", _types(_TEXT)[0],
-                               h5py.h5s.create_simple(()))
+        attr = h5py.h5a.create(dataset, b"units", _types(_TEXT)[0], _SCALAR)
         try:
             attr.write(np.array(units, dtype=_TEXT), mtype=_types(_TEXT)[1])
         finally:
@@ -371,6 +377,7 @@ def create(path: Path, scene: Scene, model: Model) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     create_fresh(path)  # never write through a symbolic link planted at the name
     check_room(path, 16 * model.ndof * 8)  # a full disk: refused before HDF5 writes
+    beams = [b for b in model.bodies if isinstance(b, Beam)]
     with _open_write(path, "w-") as h5:
         _attrs(h5.attrs, {
             **provenance(),
@@ -390,10 +397,9 @@ def create(path: Path, scene: Scene, model: Model) -> None:
             "response_component": np.int64((model.response or ("", 0))[1]),
             "linear_joints": model.linear_joints,
             "iteration_matrix": "constant" if model.constant_policy else "refactorized",
-        })
-        beams = [b for b in model.bodies if isinstance(b, Beam)]
-        if beams:  # 'continuum' or 'cubic' (beam.bending) of the first beam
-            _attrs(h5.attrs, {"bending": beams[0].bending})
+            # 'continuum' or 'cubic' (beam.bending) of the first beam
+            **({"bending": beams[0].bending} if beams else {}),
+        }, fresh=True)
         group = h5.create_group("model")
         model_attrs = dict(model.summary())
         geometry = model.plate_geometry()
@@ -415,7 +421,7 @@ def create(path: Path, scene: Scene, model: Model) -> None:
                                           for b in model.bodies)
         if model.notes:
             model_attrs["notes"] = "\n".join(model.notes)
-        _attrs(group.attrs, model_attrs)
+        _attrs(group.attrs, model_attrs, fresh=True)
 
 
 def write_static(path: Path, model: Model, result: StaticResult) -> None:
@@ -436,7 +442,7 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
         _attrs(group.attrs, {"method": result.method, "iterations": result.iterations,
                              "residual_norm": result.residual_norm,
                              "constraint_norm": result.constraint_norm,
-                             "wall_time_s": result.wall_time_s, **result.extra})
+                             "wall_time_s": result.wall_time_s, **result.extra}, fresh=True)
 
 
 def finish(path: Path, model: Model, timing: dict[str, float], status: str,
@@ -451,19 +457,19 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
         counters = h5.create_group("counters")
         _attrs(counters.attrs, {**{k: int(v) for k, v in sorted(model.counters.items())},
                                 "constraint_evaluations": np.int64(
-                                    model.constraints.evaluations)})
+                                    model.constraints.evaluations)}, fresh=True)
         group = h5.create_group("timing")
-        _attrs(group.attrs, {k: float(v) for k, v in timing.items()})
-        # the phases SPEC section 4 names, summed over the analyses (dynamic stepping counts
-        # as solve: the kernel's factorization-free steps are substitutions and residuals)
-        _attrs(group.attrs, {
+        # every timing, then the phases SPEC section 4 names (which replace a timing of the
+        # same name), summed over the analyses (dynamic stepping counts as solve: the
+        # kernel's factorization-free steps are substitutions and residuals)
+        _attrs(group.attrs, {**{k: float(v) for k, v in timing.items()},
             "assembly": float(timing.get("static_assembly", 0.0) + timing.get("model", 0.0)),
             "factorization": float(timing.get("static_factorization", 0.0)
                                    + timing.get("dynamic_setup", 0.0)),
             "solve": float(timing.get("static_solve", 0.0) + timing.get("dynamic_stepping", 0.0)),
             "contact": 0.0,
             "output": float(timing.get("output", 0.0) + timing.get("dynamic_output", 0.0)),
-            "total": float(timing.get("total", 0.0))})
+            "total": float(timing.get("total", 0.0))}, fresh=True)
         _attrs(h5.attrs, {
             "status": status, "message": message,
             "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
@@ -647,7 +653,7 @@ class DynamicWriter:
             if "dynamic" in h5:
                 del h5["dynamic"]
             group = h5.create_group("dynamic")
-            _attrs(group.attrs, {"status": "running", "rows": np.int64(0)})
+            _attrs(group.attrs, {"status": "running", "rows": np.int64(0)}, fresh=True)
 
             # the row series are made by the first flush, with its rows (one HDF5 call per
             # series instead of two: a short run writes once); ``series`` records them
@@ -713,11 +719,11 @@ class DynamicWriter:
         values = np.ascontiguousarray(values, dtype=dtype)
         dataset = _new_dataset(group, name, values, maxshape=limit, chunks=chunks, units=units)
         if attrs:
-            _attrs(h5py.AttributeManager(h5py.Dataset(dataset)), attrs)
+            _attrs(h5py.AttributeManager(h5py.Dataset(dataset)), attrs, fresh=True)
         self._made.add(name)
         head = name.rpartition("/")[0]
         if head in self._group_attrs:
-            _attrs(group[head].attrs, self._group_attrs.pop(head))
+            _attrs(group[head].attrs, self._group_attrs.pop(head), fresh=True)
 
     def _put(self, group: h5py.Group, name: str, values: np.ndarray) -> None:
         """Rows self.rows.. of series ``name``: appended, or the series made with them."""
