@@ -119,21 +119,30 @@ def _dataset_plist(chunks: tuple[int, ...] | None) -> h5py.h5p.PropDCID:
     return plist
 
 
-def _parent(group: h5py.Group, name: str) -> tuple[h5py.Group, bytes]:
+def _parent(group: h5py.Group, name: str,
+            groups: dict[str, h5py.Group] | None = None) -> tuple[h5py.Group, bytes]:
     """The group that holds ``name`` (its intermediate groups created as h5py does) and
-    the last part of the name."""
+    the last part of the name; ``groups``: the subgroups of ``group`` found so far."""
     head, _, tail = name.rpartition("/")
-    return (group.require_group(head) if head else group), tail.encode("utf-8")
+    if not head:
+        return group, tail.encode("utf-8")
+    if groups is None:
+        return group.require_group(head), tail.encode("utf-8")
+    if head not in groups:
+        groups[head] = group.require_group(head)
+    return groups[head], tail.encode("utf-8")
 
 
 def _new_dataset(group: h5py.Group, name: str, data: np.ndarray | None = None, *,
                  shape: tuple[int, ...] | None = None, dtype: Any = None,
                  maxshape: tuple[int | None, ...] | None = None,
                  chunks: tuple[int, ...] | None = None,
-                 units: str | None = None) -> h5py.h5d.DatasetID:
+                 units: str | None = None,
+                 groups: dict[str, h5py.Group] | None = None) -> h5py.h5d.DatasetID:
     """A new dataset through h5py's low-level API (what ``create_dataset`` stores, at a
-    fifth of its cost), with its ``units`` attribute; ``data`` written when given."""
-    parent, leaf = _parent(group, name)
+    fifth of its cost), with its ``units`` attribute; ``data`` written when given;
+    ``groups``: see :func:`_parent`."""
+    parent, leaf = _parent(group, name, groups)
     if data is not None:
         shape, dtype = data.shape, data.dtype
     dtype = np.dtype(dtype)
@@ -660,6 +669,7 @@ class DynamicWriter:
             self._series: dict[str, tuple] = {}
             self._made: set[str] = set()
             self._group_attrs: dict[str, dict[str, Any]] = {}
+            self._groups: dict[str, h5py.Group] = {}  # /dynamic's subgroups (one opening)
 
             def series(name: str, units: str, width: tuple[int, ...] = (),
                        dtype: str = "f8", attrs: dict[str, Any] | None = None,
@@ -717,13 +727,14 @@ class DynamicWriter:
         if values is None:
             values = np.zeros((0, *width), dtype=dtype)
         values = np.ascontiguousarray(values, dtype=dtype)
-        dataset = _new_dataset(group, name, values, maxshape=limit, chunks=chunks, units=units)
+        dataset = _new_dataset(group, name, values, maxshape=limit, chunks=chunks, units=units,
+                               groups=self._groups)
         if attrs:
             _attrs(h5py.AttributeManager(h5py.Dataset(dataset)), attrs, fresh=True)
         self._made.add(name)
         head = name.rpartition("/")[0]
         if head in self._group_attrs:
-            _attrs(group[head].attrs, self._group_attrs.pop(head), fresh=True)
+            _attrs(self._groups[head].attrs, self._group_attrs.pop(head), fresh=True)
 
     def _put(self, group: h5py.Group, name: str, values: np.ndarray) -> None:
         """Rows self.rows.. of series ``name``: appended, or the series made with them."""
@@ -751,6 +762,7 @@ class DynamicWriter:
         if not self._pending:
             if len(self._made) < len(self._series):  # no row at all: the empty series
                 with _open_write(self.path) as h5:
+                    self._groups = {}
                     self._make_rest(h5["dynamic"])
             return
         # a full disk or file-size limit: refused before HDF5 writes (a write failing
@@ -762,6 +774,7 @@ class DynamicWriter:
         check_room(self.path, 2 * pending + self.chunk_bytes)
         with _open_write(self.path) as h5:
             group = h5["dynamic"]
+            self._groups = {}  # the subgroups found in this opening of the file
             first = self.frames
             # the waiting chunks as one: one HDF5 write per series and flush (each write
             # costs ~0.2 ms, whatever its rows)
