@@ -654,9 +654,12 @@ class DynamicWriter:
         self._pending_rows = 0
         self._last_write = time.monotonic()
         ncon, ndof = len(model.constraints), model.ndof
+        self.total_rows = total_rows
         # what a flush may allocate besides its rows: one HDF5 chunk of every series
-        self.chunk_bytes = 8 * (1024 * (4 + 6 * len(self.names) + max(ncon, 1) + 16
-                                        + 8 * self.npoints) + 16 * (ndof + 6 * self.nnodes))
+        self.chunk_bytes = 8 * (self._chunk_rows(1) * (4 + 16) + self._chunk_rows(3)
+                                * 6 * len(self.names) + self._chunk_rows(max(ncon, 1))
+                                * max(ncon, 1) + self._chunk_rows(max(self.npoints, 1))
+                                * 8 * self.npoints + 16 * (ndof + 6 * self.nnodes))
         check_room(path, self.chunk_bytes)
         with _open_write(path) as h5:
             if "dynamic" in h5:
@@ -673,14 +676,15 @@ class DynamicWriter:
 
             def series(name: str, units: str, width: tuple[int, ...] = (),
                        dtype: str = "f8", attrs: dict[str, Any] | None = None,
-                       now: bool = False) -> None:
+                       now: bool = False, rows: int | None = None) -> None:
                 # a model without constraints has lambda[nt, 0]: HDF5 chunks must be
                 # positive, so that axis gets a free maximum
                 chunk = tuple(max(1, w) for w in width)
                 limit = tuple(w if w else None for w in width)
                 self._series[name] = (units, width, np.dtype(dtype), (None, *limit),
-                                      (1024, *chunk) if width != (ndof,) else (16, ndof),
-                                      attrs or {})
+                                      (rows or self._chunk_rows(int(np.prod(chunk))),
+                                       *chunk)
+                                      if width != (ndof,) else (16, ndof), attrs or {})
                 if now:
                     self._make(group, name, None)
             series("time", "s")
@@ -718,8 +722,20 @@ class DynamicWriter:
                                                 maxshape=(None, self.nnodes, 3), dtype="f8",
                                                 chunks=(16, self.nnodes, 3))
                     data.attrs["units"] = "m"
-                series("mesh_rows", "index", dtype="i8", now=True, attrs={"description": (
-                    "the row of /dynamic/time of each row of mesh_nodes (XDMF frames)")})
+                series("mesh_rows", "index", dtype="i8", now=True, rows=1024, attrs={
+                    "description": "the row of /dynamic/time of each row of mesh_nodes "
+                                   "(XDMF frames)"})
+
+    #: the rows of a series' HDF5 chunk: the run's rows when known (one chunk: a run
+    #: written at its end writes each series in one piece, 2 ms less for 10000 rows), at
+    #: most CHUNK_BYTES per chunk, at least 1024 rows
+    CHUNK_BYTES = 256 * 1024
+
+    def _chunk_rows(self, width: int) -> int:
+        """Rows per HDF5 chunk of a series with ``width`` numbers per row."""
+        if self.total_rows <= 0:
+            return 1024
+        return min(self.total_rows, max(1024, self.CHUNK_BYTES // (8 * max(width, 1))))
 
     def _make(self, group: h5py.Group, name: str, values: np.ndarray | None) -> None:
         """Series ``name`` of /dynamic, holding ``values`` (None: no rows)."""
