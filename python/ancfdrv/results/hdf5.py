@@ -109,9 +109,11 @@ def _attrs(target: h5py.AttributeManager, values: dict[str, Any], *,
             attr.close()
 
 
+@functools.lru_cache(maxsize=64)
 def _dataset_plist(chunks: tuple[int, ...] | None) -> h5py.h5p.PropDCID:
     """A dataset creation property list as h5py's ``create_dataset`` makes it (no times
-    tracked; chunked when ``chunks``)."""
+    tracked; chunked when ``chunks``); made once per chunk shape (HDF5 copies it into
+    each dataset it creates)."""
     plist = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
     if chunks is not None:
         plist.set_chunk(chunks)
@@ -798,7 +800,7 @@ class DynamicWriter:
                          else self._pending[0])
             if len(self._made) < len(self._series):
                 self._make_rest(group)
-            group.attrs["rows"] = np.int64(self.rows)
+            _attrs(group.attrs, {"rows": np.int64(self.rows)})
             if self.nnodes:  # the per-frame views the XDMF description names
                 from .xdmf import add_step_views
                 add_step_views(h5, first, self.frames)
@@ -949,8 +951,9 @@ def _reaction_group(group: h5py.Group, name: str, force, moment, axial) -> None:
     _dataset(sub, "moment", np.asarray(moment, dtype=float), "N m")
     if axial is not None:
         _dataset(sub, "axial", np.asarray(axial, dtype=float), "N")
-    sub.attrs["description"] = ("what body1 exerts on body2, global axes; moment about the "
-                                "joint's point on body2; axial: tension positive")
+    _attrs(sub.attrs, {"description": "what body1 exerts on body2, global axes; moment "
+                                      "about the joint's point on body2; axial: tension "
+                                      "positive"}, fresh=True)
 
 
 def _section_group(group: h5py.Group, name: str, forces) -> None:
