@@ -198,3 +198,42 @@ def test_lock_record_replaces_a_stale_one(tmp_path):
         assert text.endswith("\n") and text.count("\n") == 1
         assert json.loads(text)["pid"] == os.getpid()
     assert not lock.exists()
+
+
+def test_a_full_disk_keeps_the_initial_row(tmp_path, monkeypatch):
+    """The initial row waits for the rows after it; when their write is refused (disk or
+    file-size limit), the initial row alone is written if it fits, every series is made,
+    the error is raised and the other rows still wait."""
+    import errno
+    from test_lean_output import _chunks, cantilever
+    from ancfdrv.results.hdf5 import DynamicWriter
+    from ancfdrv.solvers.dynamic import DynamicSettings
+    model = cantilever().assemble()
+    try:
+        chunks = _chunks(model, DynamicSettings(dt=1e-3, t_end=0.02, store_q=True), [10, 10])
+        path = tmp_path / "full.h5"
+        with h5py.File(path, "w"):
+            pass
+        writer = DynamicWriter(path, model, True, 10**6, xdmf=False, total_rows=21)
+        small = writer.chunk_bytes + 2 * sum(
+            getattr(chunks[0], f).nbytes for f in ("time", "probes", "deflections", "lam",
+                                                  "energy", "constraint", "stats", "q"))
+
+        def room(target, nbytes):
+            if nbytes > small:
+                raise OSError(errno.ENOSPC, "No space left on device")
+        monkeypatch.setattr(results, "check_room", room)
+        monkeypatch.setattr(results, "FLUSH_SECONDS", 1e9)  # every row waits for flush()
+        for chunk in chunks:
+            writer(chunk)
+        with pytest.raises(OSError):
+            writer.flush()
+        assert writer.rows == 1 and writer._pending_rows == 20
+        with h5py.File(path, "r") as h5:
+            lengths = set()
+            h5["dynamic"].visititems(lambda n, o: lengths.add(o.shape[0])
+                                     if isinstance(o, h5py.Dataset) else None)
+            assert lengths == {1} and h5["dynamic"].attrs["rows"] == 1
+            assert h5["dynamic/time"][0] == 0.0 and "step_size" in h5["dynamic"]
+    finally:
+        model.close()

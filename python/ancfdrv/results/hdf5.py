@@ -487,7 +487,8 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
             "warnings": "\n".join(model.warnings)})
         if "dynamic" in h5:
             _attrs(h5["dynamic"].attrs, {"status": status})
-        has_motion = "dynamic/mesh_nodes" in h5 and len(h5["dynamic/time"]) > 0
+        has_motion = ("dynamic/mesh_nodes" in h5 and "dynamic/time" in h5
+                      and len(h5["dynamic/time"]) > 0)
         if has_motion:
             _last_frame(h5, model)
     if has_motion:
@@ -789,7 +790,18 @@ class DynamicWriter:
                           for f in ("time", "probes", "deflections", "lam", "energy",
                                     "constraint", "stats", "q", "contact"))
                       for chunk in self._pending)
-        check_room(self.path, 2 * pending + self.chunk_bytes)
+        try:
+            check_room(self.path, 2 * pending + self.chunk_bytes)
+        except OSError:
+            rest = self._pending[1:]
+            if self.rows == 0 and rest:  # the run's initial row alone, if it fits, is kept
+                self._pending = self._pending[:1]
+                try:
+                    self.flush()
+                finally:  # the other rows still wait (a later flush meets the error again)
+                    self._pending = self._pending + rest
+                    self._pending_rows = sum(len(chunk.time) for chunk in self._pending)
+            raise
         with _open_write(self.path) as h5:
             group = h5["dynamic"]
             self._groups = {}  # the subgroups found in this opening of the file
