@@ -22,7 +22,6 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
 
-import h5py
 import numpy as np
 
 from .errors import AncfError, InputError, Interrupted, SolverError
@@ -101,7 +100,7 @@ def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str
     """The static equilibrium a settled dynamic run starts from (Newton, loads scaled by
     0 or 1), written to /static with the attribute settle."""
     solver = scene["solver"]
-    with stop.immediate():
+    with results.released(out), stop.immediate():
         result = solve_newton(model, tol=solver["tol"], max_iter=solver["max_iter"],
                               load_steps=solver["load_steps"],
                               loads=0.0 if settle == "unloaded" else 1.0)
@@ -218,7 +217,7 @@ def _row_blocks(chunk, nfull: int):
 def _warn_large_ffr_deflection(model: Model, out: Path) -> None:
     """The warning of an 'ffr' run whose tip deflects by more than 5% of the length."""
     if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
-        with h5py.File(out, "r") as h5:
+        with results.reading(out) as h5:
             deflection = h5["dynamic/deflection/tip"][()]
         ratio = np.abs(deflection).max() / model.length_scale
         if ratio > 0.05:
@@ -286,7 +285,7 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
     # the chunks carry the expanded coordinates
     settings.store_q = bool(xdmf or write_q or supports is not None)
     try:
-        with stop.immediate():
+        with results.released(out), stop.immediate():
             reduced = reduce_ffr(model, static, beam.modes)
     except SolverError as exc:  # e.g. more modes than the constrained model has
         raise _reduction_error(scene, beam, str(exc)) from None
@@ -303,8 +302,9 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
         "not_provided": NOT_PROVIDED}
     sink = writer if supports is None else supports.wrap(writer)
     try:
-        dyn = integrate_reduced(model, reduced, settings, sink=sink, progress=progress,
-                                should_stop=stop)
+        with results.released(out):  # the file is closed between the writes of the run
+            dyn = integrate_reduced(model, reduced, settings, sink=sink, progress=progress,
+                                    should_stop=stop)
     finally:
         writer.flush()
         if supports is not None:
@@ -316,7 +316,7 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
     bounds = stage_bounds(scene)
     stages: dict[str, float] = {}
     if bounds:
-        with h5py.File(out, "r") as h5:
+        with results.reading(out) as h5:
             stages = stage_summary(h5["dynamic/time"][()], h5["dynamic/deflection/tip"][:, 1],
                                    bounds)
     results.write_dynamic_attrs(out, {
@@ -384,26 +384,37 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
             if last_q_only and chunk.q is not None and len(chunk.q) > 1:
                 chunk = replace(chunk, q=chunk.q[-1:])
             base_sink(chunk)
+    done = False  # the attributes are written once: the full set after a completed run
     try:
-        dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
-                        should_stop=stop)
-    finally:  # also after a failure or an interrupt: every computed step goes to the file
+        with results.released(out):  # the file is closed between the writes of the run
+            dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
+                            should_stop=stop)
         writer.flush()
         if supports is not None:
             supports.write(out, writer.rows)
         if recorder is not None:
             results.write_dynamic_answers(out, recorder)
-        results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
-    for phase, seconds in dyn.timing.items():
-        timing[f"dynamic_{phase}"] = seconds
-    stages: dict[str, float] = {}
-    _warn_large_ffr_deflection(model, out)
-    bounds = stage_bounds(scene)
-    if bounds:
-        with h5py.File(out, "r") as h5:
-            t = h5["dynamic/time"][()]
-            transverse = h5["dynamic/deflection/tip"][:, 1]
-        stages = stage_summary(t, transverse, bounds)
+        for phase, seconds in dyn.timing.items():
+            timing[f"dynamic_{phase}"] = seconds
+        stages: dict[str, float] = {}
+        _warn_large_ffr_deflection(model, out)
+        bounds = stage_bounds(scene)
+        if bounds:
+            with results.reading(out) as h5:
+                t = h5["dynamic/time"][()]
+                transverse = h5["dynamic/deflection/tip"][:, 1]
+            stages = stage_summary(t, transverse, bounds)
+        done = True
+    finally:  # also after a failure or an interrupt: every computed step goes to the file
+        if not done:
+            results.drop(out)  # the held file may be in any state after an error
+            writer.flush()
+            if supports is not None:
+                supports.write(out, writer.rows)
+            if recorder is not None:
+                results.write_dynamic_answers(out, recorder)
+            results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)},
+                                        {})
     results.write_dynamic_attrs(out, {
         **attrs, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
         "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,
@@ -499,65 +510,75 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
 
     def finish(status: str, message: str = "", *, after_error: bool = True) -> None:
         timing["total"] = time.perf_counter() - start
+        if after_error:  # the held file may be in any state: reopened for the final status
+            results.drop(out)
         try:
             results.finish(out, model, timing, status, message)
         except OSError:
             if not after_error:
                 raise  # after an error, the error being raised matters more
-    try:
-        results.create(out, scene, model)
-        e_start = model.e0
-        if analysis in ("static", "static+dynamic"):
-            solver = scene["solver"]
-            with stop.immediate():  # the static solvers write nothing while they iterate
-                static = solve_static(model, solver["static_method"], tol=solver["tol"],
-                                      max_iter=solver["max_iter"], p=solver["split_p"],
-                                      load_steps=solver["load_steps"])
-            for phase, seconds in static.timing.items():
-                timing[f"static_{phase}"] = seconds
-            t0 = time.perf_counter()
-            results.write_static(out, model, static)
-            _write_static_supports(out, model, static)
-            _write_static_answers(scene, model, out, static)
-            timing["output"] = time.perf_counter() - t0
-            e_start = static.e
-            if analysis == "static+dynamic":
+        finally:
+            if after_error:  # closed before anything reads it (the interrupt message)
+                results.drop(out)
+    # the file stays open between the writes that follow each other without computing
+    # (create and the dynamic writer's set-up; the last rows, answers, attributes and
+    # status): closed in the solves and the stepping (results.released)
+    with results.holding(out):
+        try:
+            results.create(out, scene, model)
+            e_start = model.e0
+            if analysis in ("static", "static+dynamic"):
+                solver = scene["solver"]
+                # the static solvers write nothing while they iterate
+                with results.released(out), stop.immediate():
+                    static = solve_static(model, solver["static_method"], tol=solver["tol"],
+                                          max_iter=solver["max_iter"], p=solver["split_p"],
+                                          load_steps=solver["load_steps"])
+                for phase, seconds in static.timing.items():
+                    timing[f"static_{phase}"] = seconds
+                t0 = time.perf_counter()
+                results.write_static(out, model, static)
+                _write_static_supports(out, model, static)
+                _write_static_answers(scene, model, out, static)
+                timing["output"] = time.perf_counter() - t0
+                e_start = static.e
+                if analysis == "static+dynamic":
+                    stop.check()
+            settle = settle_mode(scene)
+            if analysis == "dynamic" and settle != "none":
+                static = _settle(scene, model, out, settle, timing, stop)
+                e_start = static.e
                 stop.check()
-        settle = settle_mode(scene)
-        if analysis == "dynamic" and settle != "none":
-            static = _settle(scene, model, out, settle, timing, stop)
-            e_start = static.e
-            stop.check()
-        if analysis in ("dynamic", "static+dynamic"):
-            dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop,
-                                           static)
-        if analysis in ("modal", "buckling"):
-            with stop.immediate():
-                run_eigen(scene, model, out, timing)
-    except Interrupted as exc:
-        signum = stop.signum or exc.signum
-        finish("interrupted", f"interrupted by {signal_name(signum)}")
-        raise Interrupted(_interrupt_message(out, signum), signum=signum) from None
-    except KeyboardInterrupt:  # no handler installed (not the main thread)
-        finish("interrupted", "interrupted (KeyboardInterrupt)")
-        raise
-    except AncfError as exc:
-        finish("failed", str(exc))
-        raise
-    except OSError as exc:
-        if not disk_full(exc):
+            if analysis in ("dynamic", "static+dynamic"):
+                dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop,
+                                               static)
+            if analysis in ("modal", "buckling"):
+                with results.released(out), stop.immediate():
+                    run_eigen(scene, model, out, timing)
+        except Interrupted as exc:
+            signum = stop.signum or exc.signum
+            finish("interrupted", f"interrupted by {signal_name(signum)}")
+            raise Interrupted(_interrupt_message(out, signum), signum=signum) from None
+        except KeyboardInterrupt:  # no handler installed (not the main thread)
+            finish("interrupted", "interrupted (KeyboardInterrupt)")
+            raise
+        except AncfError as exc:
+            finish("failed", str(exc))
+            raise
+        except OSError as exc:
+            if not disk_full(exc):
+                finish("failed", f"internal error: {type(exc).__name__}: {exc}")
+                raise
+            message = (f"cannot write {out}: the disk or the file-size limit is full "
+                       f"({str(exc).splitlines()[0][:200]}); the rows written before are kept")
+            finish("failed", message)
+            raise SolverError(message) from None
+        except BaseException as exc:  # a bug: the file must not claim to be running
             finish("failed", f"internal error: {type(exc).__name__}: {exc}")
             raise
-        message = (f"cannot write {out}: the disk or the file-size limit is full "
-                   f"({str(exc).splitlines()[0][:200]}); the rows written before are kept")
-        finish("failed", message)
-        raise SolverError(message) from None
-    except BaseException as exc:  # a bug: the file must not claim to be running
-        finish("failed", f"internal error: {type(exc).__name__}: {exc}")
-        raise
-    finally:
-        model.close()
-    finish("ok", after_error=False)
+        finally:
+            model.close()
+        finish("ok", after_error=False)
     return RunOutcome(scene, out, static, dynamic, model.warnings, stages)
 
 

@@ -132,8 +132,11 @@ class OutputLock:
         record = {"pid": os.getpid(), "host": socket.gethostname(),
                   "since": _dt.datetime.now().astimezone().isoformat(timespec="seconds"),
                   "command": shlex.join(sys.argv)}
-        os.ftruncate(fd, 0)
-        os.write(fd, (json.dumps(record) + "\n").encode())
+        text = (json.dumps(record) + "\n").encode()
+        # written over a stale record, then cut to its length: a truncation to 0 bytes
+        # makes ext4 (auto_da_alloc) write the file out when it is closed, ~4 ms a run
+        os.pwrite(fd, text, 0)
+        os.ftruncate(fd, len(text))
         self._fd = fd
 
     def release(self) -> None:
