@@ -205,8 +205,10 @@ def test_a_previous_result_survives_a_refused_run(scene, tmp_path, capsys):
 
 def test_second_writer_is_refused_naming_the_first(scene, tmp_path, capsys):
     out = tmp_path / "shared.h5"
+    # (30 s of luffing: rows reach the file once a second, so the run must outlast the first
+    # flush by a margin; 10 s ran in about one second once the matrix was carried)
     first = ancf("run", str(scene), "-o", str(out), *LONG[2:-4], "--set", "beam.nodes=10",
-                 "--set", "solver.t_end=10")
+                 "--set", "solver.t_end=30")
     wait_for_rows(out, first, 2)
     # the first run is held (SIGSTOP) while the second tries: it still writes then, however
     # fast the kernel has become
@@ -225,7 +227,7 @@ def test_second_writer_is_refused_naming_the_first(scene, tmp_path, capsys):
     with h5py.File(out, "r") as h5:  # the first run's scene and data, complete
         assert h5.attrs["status"] == "ok"
         assert "nodes = 10" in h5.attrs["scene"] and h5["model"].attrs["nnodes"] == 10
-        assert len(h5["dynamic/time"]) == 10001
+        assert len(h5["dynamic/time"]) == 30001
     assert_consistent_dynamic(out, 1e-3)
     assert not Path(str(out) + ".lock").exists()
 
