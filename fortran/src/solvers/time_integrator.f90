@@ -49,7 +49,8 @@ module time_integrator
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
                                internal_forces, external_forces, evaluate_constraints, &
-                               constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
+                               constraint_reaction, gradient_product, refactorize, &
+                               to_solver_frame, &
                                frame_gradients, energies, probe_output, policy_constant, &
                                power_count, energy_count, contact_record, contact_step_limit
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
@@ -86,13 +87,36 @@ module time_integrator
     logical :: at_floor = .false.        ! converged at the round-off floor (counted)
   end type newton_monitor
 
+  !> The work arrays of a chunk's Newton iterations and residuals, allocated once per chunk
+  !> (automatic arrays and matmul temporaries were heap allocations in every step).
+  type :: step_work
+    real(dp), allocatable :: r(:), z(:, :), direction(:), correction(:), back(:)
+    real(dp), allocatable :: phi(:), gradients(:, :), w(:, :), flex_w(:, :), w_dlam(:)
+    real(dp), allocatable :: schur(:, :), dlam(:, :), internal(:), loads(:), records(:, :)
+    integer, allocatable :: ipiv(:)
+  end type step_work
+
 contains
+
+  !> The work arrays of sys's steps.
+  pure subroutine allocate_work(sys, work)
+    type(system_model), intent(in) :: sys
+    type(step_work), intent(out) :: work
+    integer :: nb
+    nb = 3 * size(sys%block_first)
+    allocate (work%r(sys%ndof), work%z(sys%ndof, 1), work%direction(sys%ndof), &
+              work%correction(sys%ndof), work%back(sys%ndof), work%phi(sys%ncon), &
+              work%gradients(6, sys%ncon), work%w(nb, sys%ncon), work%flex_w(nb, sys%ncon), &
+              work%w_dlam(nb), work%schur(sys%ncon, sys%ncon), work%dlam(sys%ncon, 1), &
+              work%internal(sys%ndof), work%loads(sys%ndof), &
+              work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon))
+  end subroutine allocate_work
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
   !> constraint values and gradients, the strain energy and the number of active contact
   !> points; known_internal: B^T (Q_el - Q_c - Q_M) already computed (by refactorize).
   subroutine residual(sys, t, rotations, rates, e, v, acceleration, lam, state, r, phi, &
-                      gradients, strain, active, info, known_internal)
+                      gradients, strain, active, work, info, known_internal)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: t, rotations(:, :, 0:), rates(0:), e(:), v(:), acceleration(:)
     real(dp), intent(in) :: lam(:)
@@ -100,11 +124,12 @@ contains
     real(dp), intent(inout) :: strain  ! out; in with known_internal
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :)
     integer, intent(inout) :: active   ! out; in with known_internal
+    type(step_work), intent(inout) :: work  ! its internal, loads and records
     integer, intent(out) :: info
     real(dp), intent(in), optional :: known_internal(:)
-    real(dp) :: internal(sys%ndof), loads(sys%ndof), potential, powers(2)
-    real(dp) :: records(contact_record, max(1, sys%npoint))
+    real(dp) :: potential, powers(2)
     info = 0
+    associate (internal => work%internal, loads => work%loads, records => work%records)
     if (present(known_internal)) then
       internal = known_internal
     else
@@ -120,6 +145,7 @@ contains
     call evaluate_constraints(sys, e, t, phi, gradients, info)
     if (info /= 0) return
     call constraint_reaction(sys, gradients, lam, r)
+    end associate
   end subroutine residual
 
   !> Advances nsteps steps of size h from (t, e, e' = v, a, e'' = accel, lambda) with the
@@ -161,6 +187,8 @@ contains
     real(dp) :: contact_potential, beta_prime, velocity_factor
     integer :: step, attempt, stats(stat_count)
     logical :: done, fresh_matrix, start_fresh, started_old
+    type(step_work) :: scratch
+    call allocate_work(sys, scratch)
     info = 0
     detail = 0
     steps_done = 0
@@ -192,7 +220,7 @@ contains
         end if
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, info, detail)
+                    stats, done, last_correction, monitor, scratch, info, detail)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
         ! refreshed the matrix on the way) gets one retry from its start with a fresh one
@@ -310,7 +338,7 @@ contains
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, learned, t_new, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, info, detail)
+                    stats, done, last_correction, monitor, work, info, detail)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -323,13 +351,14 @@ contains
     logical, intent(out) :: done
     real(dp), intent(inout) :: last_correction
     type(newton_monitor), intent(out) :: monitor
+    type(step_work), intent(inout) :: work
     integer, intent(out) :: info, detail
-    real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof)
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
-    real(dp) :: w(3 * size(sys%block_first), sys%ncon), schur(sys%ncon, sys%ncon)
-    real(dp) :: dlam(sys%ncon, 1), strain, previous_correction, step_cap, step_theta
-    integer :: it, ipiv(sys%ncon), lapack_info, active
+    real(dp) :: strain, previous_correction, step_cap, step_theta
+    integer :: it, lapack_info, active
     logical :: use_known, refresh, capped, halt
+    associate (r => work%r, z => work%z, direction => work%direction, &
+               correction => work%correction, phi => work%phi, gradients => work%gradients, &
+               w => work%w, schur => work%schur, dlam => work%dlam, ipiv => work%ipiv)
     info = 0
     detail = 0
     done = .false.
@@ -340,10 +369,10 @@ contains
     do it = 1, cfg%max_newton
       if (use_known) then
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
-                      phi, gradients, strain, active, info, predicted_internal)
+                      phi, gradients, strain, active, work, info, predicted_internal)
       else
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
-                      phi, gradients, strain, active, info)
+                      phi, gradients, strain, active, work, info)
       end if
       if (info /= 0) return
       use_known = .false.
@@ -353,7 +382,7 @@ contains
         call refresh_matrix()
         if (info /= 0) return
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
-                      phi, gradients, strain, active, info, predicted_internal)
+                      phi, gradients, strain, active, work, info, predicted_internal)
         if (info /= 0) return
       end if
       ! z = U S^{-1} U^T r
@@ -370,16 +399,19 @@ contains
       if (sys%ncon > 0) then
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
         call frame_gradients(sys, rotations, gradients, w)
-        schur = matmul(transpose(w), matmul(sys%flexibility_cc, w))
-        dlam(:, 1) = gradient_dot(sys, gradients, direction) - phi
+        work%flex_w = matmul(sys%flexibility_cc, w)
+        schur = matmul(transpose(w), work%flex_w)
+        call gradient_product(sys, gradients, direction, dlam(:, 1))
+        dlam(:, 1) = dlam(:, 1) - phi
         call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
           return
         end if
-        call to_solver_frame(sys, rotations, matmul(sys%flexibility, matmul(w, dlam(:, 1))), &
-                             .false., correction)
+        work%w_dlam = matmul(w, dlam(:, 1))
+        work%back = matmul(sys%flexibility, work%w_dlam)
+        call to_solver_frame(sys, rotations, work%back, .false., correction)
         correction = correction - direction
       end if
       capped = .false.
@@ -447,6 +479,7 @@ contains
       end if
       previous_correction = last_correction
     end do
+    end associate
 
   contains
 

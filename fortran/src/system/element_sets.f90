@@ -269,7 +269,9 @@ contains
         energy = 0.0_dp
         return
       end if
-      force(set%dofs(:, el)) = force(set%dofs(:, el)) + element_force(1:nde)
+      do a = 1, nde  ! (a loop: the vector-subscripted statement made a heap temporary)
+        force(set%dofs(a, el)) = force(set%dofs(a, el)) + element_force(a)
+      end do
       energy = energy + element_energy
       if (.not. want_tangent) cycle
       do b = 1, nde

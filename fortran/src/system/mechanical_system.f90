@@ -44,7 +44,8 @@ module mechanical_system
   public :: system_model, frame_def, contact_pair, contact_state
   public :: frame_rotations, to_full, to_reduced, csr_matvec, mass_product, internal_forces, &
             external_forces, &
-            evaluate_constraints, constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
+            evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
+            refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set, &
             tangent_frame_rates, damped_sets, force_element_reactions
   ! what the stepper asks of the system's contact (it uses no contact module itself)
@@ -790,7 +791,8 @@ contains
     real(dp), intent(in) :: e(:), t
     real(dp), intent(out) :: phi(:), gradients(:, :)
     integer, intent(out) :: info
-    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    ! (unused by a first-order evaluation: fixed dummies, no heap arrays per call)
+    real(dp) :: hessians(6, 6, 1), phi_t(1), phi_tt(1), gamma(1)
     call constraint_eval(sys%ncon, sys%con_kind, sys%con_drive, sys%con_params, &
                          sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
                          sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, e, t, phi, gradients, &
@@ -818,6 +820,14 @@ contains
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: gradients(:, :), x(:)
     real(dp) :: y(sys%ncon)
+    call gradient_product(sys, gradients, x, y)
+  end function gradient_dot
+
+  !> y = Phi_e x for every constraint (gradient_dot into a given array).
+  pure subroutine gradient_product(sys, gradients, x, y)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: gradients(:, :), x(:)
+    real(dp), intent(out) :: y(:)
     integer :: c, s, k
     y = 0.0_dp
     do c = 1, sys%ncon
@@ -827,7 +837,7 @@ contains
         end do
       end do
     end do
-  end function gradient_dot
+  end subroutine gradient_product
 
   !> The solver frame: policy constant rotates each reduced 3-vector of a moving frame's
   !> bodies into that frame (U^T x, transpose_first) or back (U x); otherwise a copy.
