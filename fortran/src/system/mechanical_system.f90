@@ -33,7 +33,7 @@ module mechanical_system
   use ancf_kinds, only: dp
   use constraints, only: constraint_eval, operand_values, drive_value
   use element_sets, only: element_set, set_slot, frame_omega
-  use section_moment, only: moment_force, moment_angle
+  use section_moment, only: moment_force_only, moment_angle
   use vector_loads, only: vector_load_force
   use force_elements, only: force_element_eval, force_element_slots, fe_reaction_count
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
@@ -362,7 +362,7 @@ contains
     !> the time of the force elements' drives (every caller passes it; 0 when absent)
     real(dp), intent(in), optional :: force_time
     real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
-    real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3), rate, tangent_rate
+    real(dp) :: set_energy, moment(3), director(3), rate, tangent_rate
     real(dp) :: fel_powers(2)
     logical :: want_tangent
     integer :: s, m, k, f
@@ -424,13 +424,20 @@ contains
       if (info /= 0) return
     end if
     do m = 1, size(sys%moment_magnitude)
-      call moment_force(e_full(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
-                        load_factor * sys%moment_magnitude(m), moment, jacobian, hessian, info)
+      ! (the director gathered and the force scattered by loops: vector subscripts made heap
+      ! temporaries; the force alone: the moment's Jacobian is not part of the tangent)
+      do k = 1, 3
+        director(k) = e_full(sys%moment_dofs(k, m))
+      end do
+      call moment_force_only(director, sys%moment_axis(:, m), &
+                             load_factor * sys%moment_magnitude(m), moment, info)
       if (info /= 0) then
         info = 6
         return
       end if
-      full_force(sys%moment_dofs(:, m)) = full_force(sys%moment_dofs(:, m)) - moment
+      do k = 1, 3
+        full_force(sys%moment_dofs(k, m)) = full_force(sys%moment_dofs(k, m)) - moment(k)
+      end do
     end do
     if (present(full_out)) full_out = full_force
     call to_reduced(sys, full_force, force)
