@@ -93,6 +93,7 @@ module time_integrator
     real(dp), allocatable :: r(:), z(:, :), direction(:), correction(:), back(:)
     real(dp), allocatable :: phi(:), gradients(:, :), w(:, :), flex_w(:, :), w_dlam(:)
     real(dp), allocatable :: schur(:, :), dlam(:, :), internal(:), loads(:), records(:, :)
+    real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:, :)
     integer, allocatable :: ipiv(:)
   end type step_work
 
@@ -109,7 +110,9 @@ contains
               work%gradients(6, sys%ncon), work%w(nb, sys%ncon), work%flex_w(nb, sys%ncon), &
               work%w_dlam(nb), work%schur(sys%ncon, sys%ncon), work%dlam(sys%ncon, 1), &
               work%internal(sys%ndof), work%loads(sys%ndof), &
-              work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon))
+              work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
+              work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
+              work%row_ndof(sys%ndof, 2))
   end subroutine allocate_work
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
@@ -257,7 +260,8 @@ contains
       lam = lam_new
       t = t + h
       call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
-                    contact_potential, out_constraint(step), out_contact(:, :, step), info)
+                    contact_potential, out_constraint(step), out_contact(:, :, step), info, &
+                    scratch%full, scratch%row_phi, scratch%row_gradients)
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers + powers_new)
       powers = powers_new
@@ -266,7 +270,8 @@ contains
       out_stats(:, step) = stats
       out_lambda(:, step) = lam
       call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, &
-                        out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info)
+                        out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info, &
+                        scratch%full, scratch%row_ndof)
       if (info /= 0) return
       if (store_q) out_q(:, step) = e
     end do

@@ -982,25 +982,43 @@ contains
   !> Strain energy, the load potentials and the powers of the moving frames (FFR sets) and
   !> of the constraints (lambda . Phi_e e') at (e, e', t); contact potential, powers and
   !> records; the constraint violation max |Phi|.
+  !> full_work (optional, nfull; with phi_work (ncon) and gradients_work (6, ncon)): work
+  !> arrays of the caller, full_work returning the full coordinates q of e (for
+  !> probe_output) - no heap arrays per output row.
   subroutine energies(sys, rotations, rates, e, v, lam, t, state, strain, powers, &
-                      contact_potential, violation, records, info)
+                      contact_potential, violation, records, info, full_work, phi_work, &
+                      gradients_work)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), rates(0:), e(:), v(:), lam(:), t
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: strain, powers(power_count), contact_potential, violation
     real(dp), intent(out) :: records(:, :)
     integer, intent(out) :: info
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), set_energy, set_power, dissipation
+    real(dp), intent(out), optional, target :: full_work(:), phi_work(:), gradients_work(:, :)
+    real(dp) :: set_energy, set_power, dissipation
     real(dp) :: fel_powers(2)
-    real(dp), allocatable :: e_full(:), v_full(:), unused(:), values_unused(:)
+    real(dp), allocatable, target :: own_full(:), own_phi(:), own_gradients(:, :)
+    real(dp), allocatable :: v_full(:), unused(:), values_unused(:)
+    real(dp), pointer :: e_full(:), phi(:), gradients(:, :)
     integer :: s, f
+    if (present(full_work)) then
+      e_full => full_work
+      phi => phi_work
+      gradients => gradients_work
+    else
+      allocate (own_full(sys%nfull), own_phi(sys%ncon), own_gradients(6, sys%ncon))
+      e_full => own_full
+      phi => own_phi
+      gradients => own_gradients
+    end if
     call evaluate_constraints(sys, e, t, phi, gradients, info)
     if (info /= 0) return
     violation = 0.0_dp
     if (sys%ncon > 0) violation = maxval(abs(phi))
     powers = 0.0_dp
-    powers(power_drive) = dot_product(lam, gradient_dot(sys, gradients, v))
-    allocate (e_full(sys%nfull))
+    ! (Phi_e e' into phi, no longer needed: no function-result temporary)
+    call gradient_product(sys, gradients, v, phi)
+    powers(power_drive) = dot_product(lam, phi)
     call to_full(sys, e, .true., e_full)
     if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0 .or. sys%nvload > 0) then
       allocate (v_full(sys%nfull))
@@ -1063,19 +1081,33 @@ contains
 
   !> One output row's probes (positions), deflections (A_f^T (p - pivot_f) - reference) and
   !> energies (kinetic, strain, loads, moments, total, works, contact).
+  !> known_full (optional): the full coordinates q of e (energies' full_work), with
+  !> ndof_work (ndof, 2) work arrays of the caller - no heap arrays per output row.
   subroutine probe_output(sys, rotations, e, v, t, work, strain, contact_potential, probe, &
-                          deflection, energy, info)
+                          deflection, energy, info, known_full, ndof_work)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), t, work(:), strain
     real(dp), intent(in) :: contact_potential
     real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:)
     integer, intent(out) :: info
-    real(dp), allocatable :: e_full(:), mv(:), loads(:)
-    real(dp) :: pivot(3)
+    real(dp), intent(in), optional, target :: known_full(:)
+    real(dp), intent(out), optional, target :: ndof_work(:, :)
+    real(dp), allocatable, target :: own_full(:), own_ndof(:, :)
+    real(dp), pointer :: e_full(:), mv(:), loads(:)
+    real(dp) :: pivot(3), director(3)
     integer :: p, k, f, m
     info = 0
-    allocate (e_full(sys%nfull), mv(sys%ndof), loads(sys%ndof))
-    call to_full(sys, e, .true., e_full)
+    if (present(known_full)) then
+      e_full => known_full
+      mv => ndof_work(:, 1)
+      loads => ndof_work(:, 2)
+    else
+      allocate (own_full(sys%nfull), own_ndof(sys%ndof, 2))
+      call to_full(sys, e, .true., own_full)
+      e_full => own_full
+      mv => own_ndof(:, 1)
+      loads => own_ndof(:, 2)
+    end if
     do p = 1, sys%nprobe
       probe(:, p) = 0.0_dp
       do k = sys%probe_ptr(p), sys%probe_ptr(p + 1) - 1
@@ -1096,9 +1128,11 @@ contains
     if (info /= 0) return
     energy(energy_loads) = -dot_product(loads, e)
     do m = 1, size(sys%moment_magnitude)
+      do k = 1, 3  ! (gathered by a loop: a vector subscript made a heap temporary)
+        director(k) = e_full(sys%moment_dofs(k, m))
+      end do
       energy(energy_moment) = energy(energy_moment) - sys%moment_magnitude(m) * &
-        moment_angle(e_full(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
-                     sys%moment_reference(:, m))
+        moment_angle(director, sys%moment_axis(:, m), sys%moment_reference(:, m))
     end do
     energy(energy_contact) = contact_potential
     energy(energy_total) = sum(energy(energy_kinetic:energy_moment)) + contact_potential
