@@ -94,6 +94,7 @@ module time_integrator
     real(dp), allocatable :: phi(:), gradients(:, :), w(:, :), flex_w(:, :), w_dlam(:)
     real(dp), allocatable :: schur(:, :), dlam(:, :), internal(:), loads(:), records(:, :)
     real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:, :)
+    real(dp), allocatable :: full_pair(:, :)
     integer, allocatable :: ipiv(:)
   end type step_work
 
@@ -112,7 +113,7 @@ contains
               work%internal(sys%ndof), work%loads(sys%ndof), &
               work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
               work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
-              work%row_ndof(sys%ndof, 2))
+              work%row_ndof(sys%ndof, 2), work%full_pair(sys%nfull, 2))
   end subroutine allocate_work
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
@@ -137,7 +138,8 @@ contains
       internal = known_internal
     else
       call internal_forces(sys, rotations, e, v, 1.0_dp, 0.0_dp, state, internal, strain, &
-                           potential, powers, records, info, rates=rates, force_time=t)
+                           potential, powers, records, info, rates=rates, force_time=t, &
+                           full_work=work%full_pair)
       if (info /= 0) return
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if

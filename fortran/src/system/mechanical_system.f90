@@ -346,7 +346,7 @@ contains
   subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
                              strain, contact_potential, contact_powers, records, info, &
                              tangent_rotation, tangent_values, rates, tangent_rates, full_out, t, &
-                             force_time)
+                             force_time, full_work)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
     type(contact_state), intent(inout) :: state
@@ -361,13 +361,24 @@ contains
     real(dp), intent(in), optional :: t  ! with the tangent: the point loads' Jacobian at t
     !> the time of the force elements' drives (every caller passes it; 0 when absent)
     real(dp), intent(in), optional :: force_time
-    real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
+    !> work arrays of the caller (nfull, 2) for q and the full force: no heap arrays per call
+    real(dp), intent(out), optional, target :: full_work(:, :)
+    real(dp), allocatable, target :: own_full(:, :)
+    real(dp), pointer :: e_full(:), full_force(:)
+    real(dp), allocatable :: v_full(:), values_full(:)
     real(dp) :: set_energy, moment(3), director(3), rate, tangent_rate
     real(dp) :: fel_powers(2)
     logical :: want_tangent
     integer :: s, m, k, f
     want_tangent = present(tangent_values)
-    allocate (e_full(sys%nfull), full_force(sys%nfull))
+    if (present(full_work)) then
+      e_full => full_work(:, 1)
+      full_force => full_work(:, 2)
+    else
+      allocate (own_full(sys%nfull, 2))
+      e_full => own_full(:, 1)
+      full_force => own_full(:, 2)
+    end if
     call to_full(sys, e, .true., e_full)
     full_force = 0.0_dp
     strain = 0.0_dp
