@@ -361,10 +361,6 @@ contains
       info = 2
       return
     end if
-    identity = 0.0_dp
-    do i = 1, 3
-      identity(i, i) = 1.0_dp
-    end do
     strain = 0.5_dp * (aa - 1.0_dp)
     g = aa * bb - ab**2                                  ! |a x b|^2
     h = aa**3
@@ -378,6 +374,10 @@ contains
     grad_a = axial_stiffness * strain * a + 0.5_dp * bending_stiffness * df(1:3)
     grad_b = 0.5_dp * bending_stiffness * df(4:6)
     if (.not. want_hessian) return
+    identity = 0.0_dp
+    do i = 1, 3
+      identity(i, i) = 1.0_dp
+    end do
     hg(1:3, 1:3) = 2.0_dp * bb * identity - 2.0_dp * outer(b, b)
     hg(4:6, 4:6) = 2.0_dp * aa * identity - 2.0_dp * outer(a, a)
     hg(1:3, 4:6) = 4.0_dp * outer(a, b) - 2.0_dp * outer(b, a) - 2.0_dp * ab * identity
