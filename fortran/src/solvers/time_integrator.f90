@@ -406,8 +406,7 @@ contains
       if (sys%ncon > 0) then
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
         call frame_gradients(sys, rotations, gradients, w)
-        work%flex_w = matmul(sys%flexibility_cc, w)
-        schur = matmul(transpose(w), work%flex_w)
+        call schur_complement(sys%flexibility_cc, w, work%flex_w, schur)
         call gradient_product(sys, gradients, direction, dlam(:, 1))
         dlam(:, 1) = dlam(:, 1) - phi
         call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
@@ -417,7 +416,7 @@ contains
           return
         end if
         work%w_dlam = matmul(w, dlam(:, 1))
-        work%back = matmul(sys%flexibility, work%w_dlam)
+        call sparse_columns_product(sys%flexibility, work%w_dlam, work%back)
         call to_solver_frame(sys, rotations, work%back, .false., correction)
         correction = correction - direction
       end if
@@ -500,6 +499,49 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> The Schur complement C = W^T F W of the multipliers (F = E_c^T S^{-1} E_c, W the
+  !> solver-frame gradients at the touched blocks), with flex_w = F W: matmul's sums (each
+  !> entry summed over the inner index in increasing order, from 0) without the products
+  !> by the zero entries of W (a constraint touches a block or two): the same numbers.
+  pure subroutine schur_complement(flexibility_cc, w, flex_w, schur)
+    real(dp), intent(in) :: flexibility_cc(:, :), w(:, :)
+    real(dp), intent(out) :: flex_w(:, :), schur(:, :)
+    integer :: i, j, r
+    real(dp) :: total
+    do j = 1, size(w, 2)
+      flex_w(:, j) = 0.0_dp
+      do r = 1, size(w, 1)
+        if (w(r, j) == 0.0_dp) cycle
+        do i = 1, size(flex_w, 1)
+          flex_w(i, j) = flex_w(i, j) + flexibility_cc(i, r) * w(r, j)
+        end do
+      end do
+    end do
+    do j = 1, size(w, 2)
+      do i = 1, size(w, 2)
+        total = 0.0_dp
+        do r = 1, size(w, 1)
+          if (w(r, i) == 0.0_dp) cycle
+          total = total + w(r, i) * flex_w(r, j)
+        end do
+        schur(i, j) = total
+      end do
+    end do
+  end subroutine schur_complement
+
+  !> y = A x (matmul's sums over the columns in increasing order, from 0) without the
+  !> columns whose x is zero: the same numbers.
+  pure subroutine sparse_columns_product(a, x, y)
+    real(dp), intent(in) :: a(:, :), x(:)
+    real(dp), intent(out) :: y(:)
+    integer :: r
+    y = 0.0_dp
+    do r = 1, size(x)
+      if (x(r) == 0.0_dp) cycle
+      y = y + a(:, r) * x(r)
+    end do
+  end subroutine sparse_columns_product
 
   !> The stagnation and divergence test after correction it of size last (the one before:
   !> previous; coordinate_size: the largest |e|); halt: the iteration must stop:
