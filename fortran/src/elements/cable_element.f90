@@ -203,12 +203,8 @@ contains
                              point_energy, grad_a, grad_b, hessian, info, rope)
       if (info /= 0) return
       energy = energy + weight * point_energy
-      if (want_tangent) then
-        call add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, force, &
-                       tangent)
-      else
-        call add_point_force(slope, second, weight, grad_a, grad_b, force)
-      end if
+      call add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, force, &
+                     tangent)
     end do
   end subroutine rule_element_force
 
@@ -258,7 +254,10 @@ contains
     real(dp), intent(inout) :: force(cable_dofs), tangent(cable_dofs, cable_dofs)
     real(dp) :: rows(2, 4), block(3, 3)
     integer :: i, j, m, n
-    call add_point_force(slope, second, weight, grad_a, grad_b, force)
+    do i = 1, 4
+      force(3 * i - 2:3 * i) = force(3 * i - 2:3 * i) &
+                               + weight * (slope(i) * grad_a + second(i) * grad_b)
+    end do
     if (.not. want_tangent) return
     rows(1, :) = slope
     rows(2, :) = second
@@ -276,17 +275,6 @@ contains
       end do
     end do
   end subroutine add_point
-
-  !> The force part of add_point (apart: small enough to be inlined in the force pass).
-  pure subroutine add_point_force(slope, second, weight, grad_a, grad_b, force)
-    real(dp), intent(in) :: slope(4), second(4), weight, grad_a(3), grad_b(3)
-    real(dp), intent(inout) :: force(cable_dofs)
-    integer :: i
-    do i = 1, 4
-      force(3 * i - 2:3 * i) = force(3 * i - 2:3 * i) &
-                               + weight * (slope(i) * grad_a + second(i) * grad_b)
-    end do
-  end subroutine add_point_force
 
   !> cable_element_force with Kelvin-Voigt damping of the axial strain (damping_time tau > 0)
   !> at the nodal rates q'(3, 4): the force includes the damping force, dissipation is its
