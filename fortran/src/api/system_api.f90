@@ -342,7 +342,7 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
-  use cable_element, only: cable_set
+  use cable_element, only: cable_set, cable_rule
   use system_store, only: store_get
   use kernel_errors, only: handle_text
   implicit none
@@ -378,6 +378,12 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
   built%damping_time = damping_time
   built%force_cost = 0.5d0
   built%tangent_cost = 2.0d0
+  call cable_rule(built%rule, info)
+  if (info /= 0) then
+    info = 2
+    message = 'system_add_cable_set: the Gauss rule of the elements is not available'
+    return
+  end if
   allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_cable_set

@@ -49,7 +49,8 @@ module time_integrator
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
                                internal_forces, external_forces, evaluate_constraints, &
-                               constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
+                               constraint_reaction, gradient_product, refactorize, &
+                               to_solver_frame, &
                                frame_gradients, energies, probe_output, policy_constant, &
                                power_count, energy_count, contact_record, contact_step_limit
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
@@ -91,13 +92,40 @@ module time_integrator
     logical :: at_floor = .false.        ! converged at the round-off floor (counted)
   end type newton_monitor
 
+  !> The work arrays of a chunk's Newton iterations and residuals, allocated once per chunk
+  !> (automatic arrays and matmul temporaries were heap allocations in every step).
+  type :: step_work
+    real(dp), allocatable :: r(:), z(:, :), direction(:), correction(:), back(:)
+    real(dp), allocatable :: phi(:), gradients(:, :), w(:, :), flex_w(:, :), w_dlam(:)
+    real(dp), allocatable :: schur(:, :), dlam(:, :), internal(:), loads(:), records(:, :)
+    real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:, :)
+    real(dp), allocatable :: full_pair(:, :)
+    integer, allocatable :: ipiv(:)
+  end type step_work
+
 contains
+
+  !> The work arrays of sys's steps.
+  pure subroutine allocate_work(sys, work)
+    type(system_model), intent(in) :: sys
+    type(step_work), intent(out) :: work
+    integer :: nb
+    nb = 3 * size(sys%block_first)
+    allocate (work%r(sys%ndof), work%z(sys%ndof, 1), work%direction(sys%ndof), &
+              work%correction(sys%ndof), work%back(sys%ndof), work%phi(sys%ncon), &
+              work%gradients(6, sys%ncon), work%w(nb, sys%ncon), work%flex_w(nb, sys%ncon), &
+              work%w_dlam(nb), work%schur(sys%ncon, sys%ncon), work%dlam(sys%ncon, 1), &
+              work%internal(sys%ndof), work%loads(sys%ndof), &
+              work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
+              work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
+              work%row_ndof(sys%ndof, 2), work%full_pair(sys%nfull, 2))
+  end subroutine allocate_work
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
   !> constraint values and gradients, the strain energy and the number of active contact
   !> points; known_internal: B^T (Q_el - Q_c - Q_M) already computed (by refactorize).
   subroutine residual(sys, t, rotations, rates, e, v, acceleration, lam, state, r, phi, &
-                      gradients, strain, active, info, known_internal)
+                      gradients, strain, active, work, info, known_internal)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: t, rotations(:, :, 0:), rates(0:), e(:), v(:), acceleration(:)
     real(dp), intent(in) :: lam(:)
@@ -105,16 +133,18 @@ contains
     real(dp), intent(inout) :: strain  ! out; in with known_internal
     real(dp), intent(out) :: r(:), phi(:), gradients(:, :)
     integer, intent(inout) :: active   ! out; in with known_internal
+    type(step_work), intent(inout) :: work  ! its internal, loads and records
     integer, intent(out) :: info
     real(dp), intent(in), optional :: known_internal(:)
-    real(dp) :: internal(sys%ndof), loads(sys%ndof), potential, powers(2)
-    real(dp) :: records(contact_record, max(1, sys%npoint))
+    real(dp) :: potential, powers(2)
     info = 0
+    associate (internal => work%internal, loads => work%loads, records => work%records)
     if (present(known_internal)) then
       internal = known_internal
     else
       call internal_forces(sys, rotations, e, v, 1.0_dp, 0.0_dp, state, internal, strain, &
-                           potential, powers, records, info, rates=rates, force_time=t)
+                           potential, powers, records, info, rates=rates, force_time=t, &
+                           full_work=work%full_pair)
       if (info /= 0) return
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if
@@ -125,6 +155,7 @@ contains
     call evaluate_constraints(sys, e, t, phi, gradients, info)
     if (info /= 0) return
     call constraint_reaction(sys, gradients, lam, r)
+    end associate
   end subroutine residual
 
   !> Advances nsteps steps of size h from (t, e, e' = v, a, e'' = accel, lambda) with the
@@ -166,6 +197,8 @@ contains
     real(dp) :: contact_potential, beta_prime, velocity_factor
     integer :: step, attempt, stats(stat_count)
     logical :: done, fresh_matrix, start_fresh, started_old
+    type(step_work) :: scratch
+    call allocate_work(sys, scratch)
     info = 0
     detail = 0
     steps_done = 0
@@ -198,7 +231,7 @@ contains
         call carry_step(sys, cfg, learned, fresh_matrix, e_new)
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, info, detail)
+                    stats, done, last_correction, monitor, scratch, info, detail)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
         ! refreshed the matrix on the way) gets one retry from its start with a fresh one
@@ -235,7 +268,8 @@ contains
       lam = lam_new
       t = t + h
       call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
-                    contact_potential, out_constraint(step), out_contact(:, :, step), info)
+                    contact_potential, out_constraint(step), out_contact(:, :, step), info, &
+                    scratch%full, scratch%row_phi, scratch%row_gradients)
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers + powers_new)
       powers = powers_new
@@ -244,7 +278,8 @@ contains
       out_stats(:, step) = stats
       out_lambda(:, step) = lam
       call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, &
-                        out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info)
+                        out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info, &
+                        scratch%full, scratch%row_ndof)
       if (info /= 0) return
       if (store_q) out_q(:, step) = e
     end do
@@ -343,7 +378,7 @@ contains
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, learned, t_new, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, info, detail)
+                    stats, done, last_correction, monitor, work, info, detail)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -356,16 +391,17 @@ contains
     logical, intent(out) :: done
     real(dp), intent(inout) :: last_correction
     type(newton_monitor), intent(out) :: monitor
+    type(step_work), intent(inout) :: work
     integer, intent(out) :: info, detail
-    real(dp) :: r(sys%ndof), z(sys%ndof, 1), direction(sys%ndof), correction(sys%ndof)
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon)
-    real(dp) :: w(3 * size(sys%block_first), sys%ncon), schur(sys%ncon, sys%ncon)
-    real(dp) :: dlam(sys%ncon, 1), strain, previous_correction, step_cap, step_theta
-    integer :: it, ipiv(sys%ncon), lapack_info, active
+    real(dp) :: strain, previous_correction, step_cap, step_theta
+    integer :: it, lapack_info, active
     logical :: use_known, refresh, capped, halt
     ! the carried matrix's Schur complement, built at the step's first carried correction
     real(dp), allocatable :: carry_flexibility(:, :), carry_lu(:, :)
     logical :: carry_ready
+    associate (r => work%r, z => work%z, direction => work%direction, &
+               correction => work%correction, phi => work%phi, gradients => work%gradients, &
+               w => work%w, schur => work%schur, dlam => work%dlam, ipiv => work%ipiv)
     info = 0
     detail = 0
     done = .false.
@@ -377,10 +413,10 @@ contains
     do it = 1, cfg%max_newton
       if (use_known) then
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
-                      phi, gradients, strain, active, info, predicted_internal)
+                      phi, gradients, strain, active, work, info, predicted_internal)
       else
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
-                      phi, gradients, strain, active, info)
+                      phi, gradients, strain, active, work, info)
       end if
       if (info /= 0) return
       use_known = .false.
@@ -390,7 +426,7 @@ contains
         call refresh_matrix()
         if (info /= 0) return
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
-                      phi, gradients, strain, active, info, predicted_internal)
+                      phi, gradients, strain, active, work, info, predicted_internal)
         if (info /= 0) return
       end if
       ! z = U S^{-1} U^T r (carried: T S^{-1} T^T r)
@@ -419,16 +455,18 @@ contains
       else if (sys%ncon > 0) then
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
         call frame_gradients(sys, rotations, gradients, w)
-        schur = matmul(transpose(w), matmul(sys%flexibility_cc, w))
-        dlam(:, 1) = gradient_dot(sys, gradients, direction) - phi
+        call schur_complement(sys%flexibility_cc, w, work%flex_w, schur)
+        call gradient_product(sys, gradients, direction, dlam(:, 1))
+        dlam(:, 1) = dlam(:, 1) - phi
         call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
           return
         end if
-        call to_solver_frame(sys, rotations, matmul(sys%flexibility, matmul(w, dlam(:, 1))), &
-                             .false., correction)
+        work%w_dlam = matmul(w, dlam(:, 1))
+        call sparse_columns_product(sys%flexibility, work%w_dlam, work%back)
+        call to_solver_frame(sys, rotations, work%back, .false., correction)
         correction = correction - direction
       end if
       capped = .false.
@@ -496,6 +534,7 @@ contains
       end if
       previous_correction = last_correction
     end do
+    end associate
 
   contains
 
@@ -505,16 +544,17 @@ contains
     !> step; the residual and Phi stay exact, so the converged state does not depend on
     !> them); then C dlam = Phi_e z - Phi, correction = T F dlam - z.
     subroutine carry_schur()
+      ! (the newton's associate names are not visible here: the work arrays by name)
       real(dp) :: columns(sys%ndof, sys%ncon), turned(sys%ndof)
       if (.not. carry_ready) then
         if (.not. allocated(carry_flexibility)) &
           allocate (carry_flexibility(sys%ndof, sys%ncon), carry_lu(sys%ncon, sys%ncon))
-        call carry_gradients(sys, learned%carry_turn, gradients, columns)
-        if (gather_blocks(columns, w)) then
+        call carry_gradients(sys, learned%carry_turn, work%gradients, columns)
+        if (gather_blocks(columns, work%w)) then
           ! within the factorization's flexibility S^{-1} E_c (the model's touched blocks
           ! hold each constrained vector whole): no solve
-          carry_flexibility = matmul(sys%flexibility, w)
-          carry_lu = matmul(transpose(w), matmul(sys%flexibility_cc, w))
+          carry_flexibility = matmul(sys%flexibility, work%w)
+          carry_lu = matmul(transpose(work%w), matmul(sys%flexibility_cc, work%w))
         else
           carry_flexibility = columns
           call solver_solve(sys%solver_handle, sys%ndof, sys%ncon, carry_flexibility, info, &
@@ -526,7 +566,7 @@ contains
           end if
           carry_lu = matmul(transpose(columns), carry_flexibility)
         end if
-        call dgetrf(sys%ncon, sys%ncon, carry_lu, sys%ncon, ipiv, lapack_info)
+        call dgetrf(sys%ncon, sys%ncon, carry_lu, sys%ncon, work%ipiv, lapack_info)
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -534,11 +574,13 @@ contains
         end if
         carry_ready = .true.
       end if
-      dlam(:, 1) = gradient_dot(sys, gradients, direction) - phi
-      call dgetrs('N', sys%ncon, 1, carry_lu, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
-      call carry_apply(sys, learned%carry_turn, matmul(carry_flexibility, dlam(:, 1)), .false., &
-                       turned)
-      correction = turned - direction
+      call gradient_product(sys, work%gradients, work%direction, work%dlam(:, 1))
+      work%dlam(:, 1) = work%dlam(:, 1) - work%phi
+      call dgetrs('N', sys%ncon, 1, carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
+                  lapack_info)
+      call carry_apply(sys, learned%carry_turn, matmul(carry_flexibility, work%dlam(:, 1)), &
+                       .false., turned)
+      work%correction = turned - work%direction
     end subroutine carry_schur
 
     !> w = E_c^T columns (the rows of the touched blocks; a dof in two blocks: the first)
@@ -575,6 +617,49 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> The Schur complement C = W^T F W of the multipliers (F = E_c^T S^{-1} E_c, W the
+  !> solver-frame gradients at the touched blocks), with flex_w = F W: matmul's sums (each
+  !> entry summed over the inner index in increasing order, from 0) without the products
+  !> by the zero entries of W (a constraint touches a block or two): the same numbers.
+  pure subroutine schur_complement(flexibility_cc, w, flex_w, schur)
+    real(dp), intent(in) :: flexibility_cc(:, :), w(:, :)
+    real(dp), intent(out) :: flex_w(:, :), schur(:, :)
+    integer :: i, j, r
+    real(dp) :: total
+    do j = 1, size(w, 2)
+      flex_w(:, j) = 0.0_dp
+      do r = 1, size(w, 1)
+        if (w(r, j) == 0.0_dp) cycle
+        do i = 1, size(flex_w, 1)
+          flex_w(i, j) = flex_w(i, j) + flexibility_cc(i, r) * w(r, j)
+        end do
+      end do
+    end do
+    do j = 1, size(w, 2)
+      do i = 1, size(w, 2)
+        total = 0.0_dp
+        do r = 1, size(w, 1)
+          if (w(r, i) == 0.0_dp) cycle
+          total = total + w(r, i) * flex_w(r, j)
+        end do
+        schur(i, j) = total
+      end do
+    end do
+  end subroutine schur_complement
+
+  !> y = A x (matmul's sums over the columns in increasing order, from 0) without the
+  !> columns whose x is zero: the same numbers.
+  pure subroutine sparse_columns_product(a, x, y)
+    real(dp), intent(in) :: a(:, :), x(:)
+    real(dp), intent(out) :: y(:)
+    integer :: r
+    y = 0.0_dp
+    do r = 1, size(x)
+      if (x(r) == 0.0_dp) cycle
+      y = y + a(:, r) * x(r)
+    end do
+  end subroutine sparse_columns_product
 
   !> The stagnation and divergence test after correction it of size last (the one before:
   !> previous; coordinate_size: the largest |e|); halt: the iteration must stop:

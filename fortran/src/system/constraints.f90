@@ -83,7 +83,7 @@ contains
     !> stepper's residual needs no more
     logical, intent(in), optional :: first_order_only
     integer :: c, m, drive_info
-    real(dp) :: phi, dphi, ddphi, x(6), v(6), a(3), k(3), length
+    real(dp) :: phi, dphi, ddphi, x(6), v(6), a(3), k(3), length, cos_phi, sin_phi
     logical :: second
     second = .true.
     if (present(first_order_only)) second = .not. first_order_only
@@ -119,7 +119,14 @@ contains
           info = c  ! no coordinate in the first operand
           return
         end if
-        values(c) = x(1) - (params(1, c) + params(2, c) * cos(phi) + params(3, c) * sin(phi) &
+        ! (without a drive phi = 0: cos 0 = 1 and sin 0 = 0 exactly, without the calls)
+        cos_phi = 1.0_dp
+        sin_phi = 0.0_dp
+        if (drives(c) /= 0) then
+          cos_phi = cos(phi)
+          sin_phi = sin(phi)
+        end if
+        values(c) = x(1) - (params(1, c) + params(2, c) * cos_phi + params(3, c) * sin_phi &
                             + params(4, c) * phi)
         gradients(1, c) = 1.0_dp
         if (.not. second) cycle

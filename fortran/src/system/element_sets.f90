@@ -33,6 +33,11 @@ module element_sets
   !> whatever OMP_NUM_THREADS says: waking the sleeping team (OMP_WAIT_POLICY passive) costs
   !> more than it saves (2 threads made the 4-node cubic boom 5.6 times slower)
   real(dp), parameter :: threaded_work = 200.0_dp
+  !> The largest element (dofs) the serial loop holds in fixed work arrays (plates: 36);
+  !> below the threading threshold a set's loop runs without an OpenMP region and without
+  !> heap arrays: each element's force, energy and tangent are added as it is computed, in
+  !> the element order of the threaded loop's assembly (the same sums, bitwise)
+  integer, parameter :: serial_max_dofs = 36
 
   type, abstract :: element_set
     integer :: nel = 0
@@ -81,6 +86,8 @@ module element_sets
   contains
     procedure(element_forces_interface), deferred :: element_forces
     procedure :: forces => local_set_forces
+    procedure :: energy_power => local_energy_power
+    procedure :: element_energy => local_element_energy
   end type local_element_set
 
   abstract interface
@@ -165,7 +172,8 @@ contains
     real(dp), allocatable :: element_power(:)
     real(dp) :: factor, power
     logical :: want_tangent, damped
-    integer :: el, element_info(set%nel)
+    integer, allocatable :: element_info(:)
+    integer :: el
     info = 0
     want_tangent = present(tangent_values)
     damped = present(v) .and. set%damping_time > 0.0_dp
@@ -174,7 +182,16 @@ contains
       factor = 0.0_dp
       if (present(rate_factor)) factor = rate_factor
     end if
-    allocate (element_force(set%nde, set%nel), element_energy(set%nel))
+    if (loop_work(set, want_tangent) < threaded_work .and. set%nde <= serial_max_dofs) then
+      if (damped) then
+        call serial_set_forces(set, e, force, energy, info, tangent_values, v, factor, power)
+      else
+        call serial_set_forces(set, e, force, energy, info, tangent_values)
+      end if
+      if (present(dissipation)) dissipation = power
+      return
+    end if
+    allocate (element_force(set%nde, set%nel), element_energy(set%nel), element_info(set%nel))
     if (want_tangent) then
       allocate (tangents(set%nde, set%nde, set%nel))
     else
@@ -212,6 +229,133 @@ contains
     if (want_tangent) call scatter_add(set, tangents, tangent_values)
   end subroutine local_set_forces
 
+  !> local_set_forces of a small set on this thread (below the threading threshold): each
+  !> element's force, energy, dissipation and tangent added as it is computed, in element
+  !> order (the threaded loop's assembly order: the same sums), with fixed work arrays. With
+  !> v (a damped set) rate_factor and dissipation are present. On an element's failure
+  !> (info = 7) force holds the elements before it.
+  subroutine serial_set_forces(set, e, force, energy, info, tangent_values, v, rate_factor, &
+                               dissipation)
+    class(local_element_set), intent(in) :: set
+    real(dp), intent(in) :: e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), intent(inout), optional :: tangent_values(:)
+    real(dp), intent(in), optional :: v(:), rate_factor
+    real(dp), intent(out), optional :: dissipation
+    real(dp), target :: tangent_work(serial_max_dofs * serial_max_dofs)
+    real(dp) :: element_force(serial_max_dofs), element_energy, element_power
+    real(dp), pointer :: tangent(:, :)
+    logical :: want_tangent
+    integer :: el, a, b, nde, element_info
+    info = 0
+    nde = set%nde
+    want_tangent = present(tangent_values)
+    tangent(1:nde, 1:nde) => tangent_work(1:nde * nde)
+    energy = 0.0_dp
+    if (present(dissipation)) dissipation = 0.0_dp
+    do el = 1, set%nel
+      if (present(v)) then
+        call gathered_forces(set, el, e, want_tangent, element_force(1:nde), element_energy, &
+                             tangent, element_info, v, rate_factor, element_power)
+        dissipation = dissipation + element_power
+      else
+        call gathered_forces(set, el, e, want_tangent, element_force(1:nde), element_energy, &
+                             tangent, element_info)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      do a = 1, nde  ! (a loop: the vector-subscripted statement made a heap temporary)
+        force(set%dofs(a, el)) = force(set%dofs(a, el)) + element_force(a)
+      end do
+      energy = energy + element_energy
+      if (.not. want_tangent) cycle
+      do b = 1, nde
+        do a = 1, nde
+          if (set%scatter(a, b, el) > 0) tangent_values(set%scatter(a, b, el)) = &
+            tangent_values(set%scatter(a, b, el)) + tangent(a, b)
+        end do
+      end do
+    end do
+  end subroutine serial_set_forces
+
+  !> The energy_power of a local set: the strain energy element by element through
+  !> element_energy (no force assembly, no heap arrays), summed in element order as the
+  !> force pass sums it; with v (a damped set) the dissipated power too. No frame: power 0.
+  subroutine local_energy_power(set, rotation, axis, rate, e, energy, power, info, v, &
+                                dissipation)
+    class(local_element_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), axis(3), rate, e(:)
+    real(dp), intent(out) :: energy, power
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:)
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: coords(3, serial_max_dofs / 3), rates(3, serial_max_dofs / 3)
+    real(dp) :: element_energy, element_power, power_lost
+    logical :: damped
+    integer :: el, node, nodes, element_info
+    if (set%nde > serial_max_dofs) then
+      call set_energy_power(set, rotation, axis, rate, e, energy, power, info, v, dissipation)
+      return
+    end if
+    info = 0
+    power = 0.0_dp
+    energy = 0.0_dp
+    power_lost = 0.0_dp
+    damped = present(v) .and. set%damping_time > 0.0_dp
+    nodes = set%nde / 3
+    do el = 1, set%nel
+      do node = 1, nodes
+        coords(:, node) = e(set%dofs(3 * node - 2:3 * node, el))
+      end do
+      if (damped) then
+        do node = 1, nodes
+          rates(:, node) = v(set%dofs(3 * node - 2:3 * node, el))
+        end do
+        call set%element_energy(el, coords(:, 1:nodes), element_energy, element_info, &
+                                rates(:, 1:nodes), element_power)
+        power_lost = power_lost + element_power
+      else
+        call set%element_energy(el, coords(:, 1:nodes), element_energy, element_info)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      energy = energy + element_energy
+    end do
+    if (present(dissipation)) dissipation = power_lost
+  end subroutine local_energy_power
+
+  !> One element's strain energy at its nodal vectors coords (3, nde / 3) and, with rates,
+  !> its dissipated power: by default through element_forces (a family with a cheaper
+  !> energy-only path overrides this; it must return the same numbers). Only for elements
+  !> of at most serial_max_dofs dofs (local_energy_power).
+  pure subroutine local_element_energy(set, el, coords, energy, info, rates, dissipation)
+    class(local_element_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords(:, :)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(:, :)
+    real(dp), intent(out), optional :: dissipation
+    real(dp), target :: tangent_work(serial_max_dofs * serial_max_dofs)
+    real(dp) :: force(serial_max_dofs)
+    real(dp), pointer :: tangent(:, :)
+    tangent(1:set%nde, 1:set%nde) => tangent_work(1:set%nde * set%nde)
+    if (present(rates)) then
+      call set%element_forces(el, coords, .false., force(1:set%nde), energy, tangent, info, &
+                              rates, 0.0_dp, dissipation)
+    else
+      call set%element_forces(el, coords, .false., force(1:set%nde), energy, tangent, info)
+    end if
+  end subroutine local_element_energy
+
   !> Estimated work of one pass over a set's elements, microseconds on one thread.
   pure real(dp) function loop_work(set, want_tangent)
     class(local_element_set), intent(in) :: set
@@ -231,9 +375,43 @@ contains
     integer, intent(out) :: info
     real(dp), intent(in), optional :: v(:), rate_factor
     real(dp), intent(out), optional :: dissipation
+    ! (fixed work arrays: no heap allocation per element)
+    real(dp) :: coords(3, serial_max_dofs / 3), rates(3, serial_max_dofs / 3)
+    integer :: node, nodes
+    if (set%nde > serial_max_dofs) then
+      call gathered_large_forces(set, el, e, want_tangent, force, energy, tangent, info, v, &
+                                 rate_factor, dissipation)
+      return
+    end if
+    nodes = set%nde / 3
+    ! the element's coordinates as (3, shapes), copied in place of a reshape temporary
+    do node = 1, nodes
+      coords(:, node) = e(set%dofs(3 * node - 2:3 * node, el))
+    end do
+    if (present(v)) then
+      do node = 1, nodes
+        rates(:, node) = v(set%dofs(3 * node - 2:3 * node, el))
+      end do
+      call set%element_forces(el, coords(:, 1:nodes), want_tangent, force, energy, tangent, &
+                              info, rates(:, 1:nodes), rate_factor, dissipation)
+      return
+    end if
+    call set%element_forces(el, coords(:, 1:nodes), want_tangent, force, energy, tangent, info)
+  end subroutine gathered_forces
+
+  !> gathered_forces of an element with more than serial_max_dofs dofs.
+  pure subroutine gathered_large_forces(set, el, e, want_tangent, force, energy, tangent, info, &
+                                        v, rate_factor, dissipation)
+    class(local_element_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: e(:)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), energy, tangent(:, :)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:), rate_factor
+    real(dp), intent(out), optional :: dissipation
     real(dp) :: coords(3, set%nde / 3), rates(3, set%nde / 3)
     integer :: node
-    ! the element's coordinates as (3, shapes), copied in place of a reshape temporary
     do node = 1, set%nde / 3
       coords(:, node) = e(set%dofs(3 * node - 2:3 * node, el))
     end do
@@ -246,7 +424,7 @@ contains
       return
     end if
     call set%element_forces(el, coords, want_tangent, force, energy, tangent, info)
-  end subroutine gathered_forces
+  end subroutine gathered_large_forces
 
   !> Adds the element matrices (nde, nde, nel) to the full pattern's values.
   pure subroutine scatter_add(set, matrices, values)

@@ -33,7 +33,7 @@ module mechanical_system
   use ancf_kinds, only: dp
   use constraints, only: constraint_eval, operand_values, drive_value
   use element_sets, only: element_set, set_slot, frame_omega
-  use section_moment, only: moment_force, moment_angle
+  use section_moment, only: moment_force_only, moment_angle
   use vector_loads, only: vector_load_force
   use force_elements, only: force_element_eval, force_element_slots, fe_reaction_count
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
@@ -44,7 +44,8 @@ module mechanical_system
   public :: system_model, frame_def, contact_pair, contact_state
   public :: frame_rotations, to_full, to_reduced, csr_matvec, mass_product, internal_forces, &
             external_forces, &
-            evaluate_constraints, constraint_reaction, gradient_dot, refactorize, to_solver_frame, &
+            evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
+            refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set, &
             tangent_frame_rates, damped_sets, force_element_reactions
   ! what the stepper asks of the system's contact (it uses no contact module itself)
@@ -310,16 +311,19 @@ contains
     logical, intent(in) :: with_offset
     real(dp), intent(out) :: full(:)
     integer :: i, k
+    real(dp) :: total
     if (.not. sys%reduced) then
       full = x
       return
     end if
+    ! (a scalar accumulator per row, from the offset or 0: the same sums, in a register)
     do i = 1, sys%nfull
-      full(i) = 0.0_dp
-      if (with_offset) full(i) = sys%reduction_offset(i)
+      total = 0.0_dp
+      if (with_offset) total = sys%reduction_offset(i)
       do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
-        full(i) = full(i) + sys%reduction_values(k) * x(sys%reduction_col(k))
+        total = total + sys%reduction_values(k) * x(sys%reduction_col(k))
       end do
+      full(i) = total
     end do
   end subroutine to_full
 
@@ -354,7 +358,7 @@ contains
   subroutine internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, force, &
                              strain, contact_potential, contact_powers, records, info, &
                              tangent_rotation, tangent_values, rates, tangent_rates, full_out, t, &
-                             force_time)
+                             force_time, full_work)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), load_factor, velocity_factor
     type(contact_state), intent(inout) :: state
@@ -369,13 +373,24 @@ contains
     real(dp), intent(in), optional :: t  ! with the tangent: the point loads' Jacobian at t
     !> the time of the force elements' drives (every caller passes it; 0 when absent)
     real(dp), intent(in), optional :: force_time
-    real(dp), allocatable :: e_full(:), v_full(:), full_force(:), values_full(:)
-    real(dp) :: set_energy, moment(3), jacobian(3, 3), hessian(3, 3, 3), rate, tangent_rate
+    !> work arrays of the caller (nfull, 2) for q and the full force: no heap arrays per call
+    real(dp), intent(out), optional, target :: full_work(:, :)
+    real(dp), allocatable, target :: own_full(:, :)
+    real(dp), pointer :: e_full(:), full_force(:)
+    real(dp), allocatable :: v_full(:), values_full(:)
+    real(dp) :: set_energy, moment(3), director(3), rate, tangent_rate
     real(dp) :: fel_powers(2)
     logical :: want_tangent
     integer :: s, m, k, f
     want_tangent = present(tangent_values)
-    allocate (e_full(sys%nfull), full_force(sys%nfull))
+    if (present(full_work)) then
+      e_full => full_work(:, 1)
+      full_force => full_work(:, 2)
+    else
+      allocate (own_full(sys%nfull, 2))
+      e_full => own_full(:, 1)
+      full_force => own_full(:, 2)
+    end if
     call to_full(sys, e, .true., e_full)
     full_force = 0.0_dp
     strain = 0.0_dp
@@ -432,13 +447,20 @@ contains
       if (info /= 0) return
     end if
     do m = 1, size(sys%moment_magnitude)
-      call moment_force(e_full(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
-                        load_factor * sys%moment_magnitude(m), moment, jacobian, hessian, info)
+      ! (the director gathered and the force scattered by loops: vector subscripts made heap
+      ! temporaries; the force alone: the moment's Jacobian is not part of the tangent)
+      do k = 1, 3
+        director(k) = e_full(sys%moment_dofs(k, m))
+      end do
+      call moment_force_only(director, sys%moment_axis(:, m), &
+                             load_factor * sys%moment_magnitude(m), moment, info)
       if (info /= 0) then
         info = 6
         return
       end if
-      full_force(sys%moment_dofs(:, m)) = full_force(sys%moment_dofs(:, m)) - moment
+      do k = 1, 3
+        full_force(sys%moment_dofs(k, m)) = full_force(sys%moment_dofs(k, m)) - moment(k)
+      end do
     end do
     if (present(full_out)) full_out = full_force
     call to_reduced(sys, full_force, force)
@@ -799,7 +821,8 @@ contains
     real(dp), intent(in) :: e(:), t
     real(dp), intent(out) :: phi(:), gradients(:, :)
     integer, intent(out) :: info
-    real(dp) :: hessians(6, 6, sys%ncon), phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    ! (unused by a first-order evaluation: fixed dummies, no heap arrays per call)
+    real(dp) :: hessians(6, 6, 1), phi_t(1), phi_tt(1), gamma(1)
     call constraint_eval(sys%ncon, sys%con_kind, sys%con_drive, sys%con_params, &
                          sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
                          sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, e, t, phi, gradients, &
@@ -827,6 +850,14 @@ contains
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: gradients(:, :), x(:)
     real(dp) :: y(sys%ncon)
+    call gradient_product(sys, gradients, x, y)
+  end function gradient_dot
+
+  !> y = Phi_e x for every constraint (gradient_dot into a given array).
+  pure subroutine gradient_product(sys, gradients, x, y)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: gradients(:, :), x(:)
+    real(dp), intent(out) :: y(:)
     integer :: c, s, k
     y = 0.0_dp
     do c = 1, sys%ncon
@@ -836,7 +867,7 @@ contains
         end do
       end do
     end do
-  end function gradient_dot
+  end subroutine gradient_product
 
   !> The solver frame: policy constant rotates each reduced 3-vector of a moving frame's
   !> bodies into that frame (U^T x, transpose_first) or back (U x); otherwise a copy.
@@ -893,7 +924,7 @@ contains
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), gradients(:, :)
     real(dp), intent(out) :: w(:, :)
-    integer :: c, s, k, dof, b, comp, f
+    integer :: c, s, k, dof, b, comp, f, i
     real(dp) :: g
     w = 0.0_dp
     do c = 1, sys%ncon
@@ -906,7 +937,9 @@ contains
           end do
           comp = dof - sys%block_first(b) + 1
           f = dof_frame(sys, dof)
-          w(3 * (b - 1) + 1:3 * b, c) = w(3 * (b - 1) + 1:3 * b, c) + rotations(comp, :, f) * g
+          do i = 1, 3  ! (written out: the strided row slice cost a third of the Schur set-up)
+            w(3 * (b - 1) + i, c) = w(3 * (b - 1) + i, c) + rotations(comp, i, f) * g
+          end do
         end do
       end do
     end do
@@ -974,25 +1007,43 @@ contains
   !> Strain energy, the load potentials and the powers of the moving frames (FFR sets) and
   !> of the constraints (lambda . Phi_e e') at (e, e', t); contact potential, powers and
   !> records; the constraint violation max |Phi|.
+  !> full_work (optional, nfull; with phi_work (ncon) and gradients_work (6, ncon)): work
+  !> arrays of the caller, full_work returning the full coordinates q of e (for
+  !> probe_output) - no heap arrays per output row.
   subroutine energies(sys, rotations, rates, e, v, lam, t, state, strain, powers, &
-                      contact_potential, violation, records, info)
+                      contact_potential, violation, records, info, full_work, phi_work, &
+                      gradients_work)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), rates(0:), e(:), v(:), lam(:), t
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: strain, powers(power_count), contact_potential, violation
     real(dp), intent(out) :: records(:, :)
     integer, intent(out) :: info
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), set_energy, set_power, dissipation
+    real(dp), intent(out), optional, target :: full_work(:), phi_work(:), gradients_work(:, :)
+    real(dp) :: set_energy, set_power, dissipation
     real(dp) :: fel_powers(2)
-    real(dp), allocatable :: e_full(:), v_full(:), unused(:), values_unused(:)
+    real(dp), allocatable, target :: own_full(:), own_phi(:), own_gradients(:, :)
+    real(dp), allocatable :: v_full(:), unused(:), values_unused(:)
+    real(dp), pointer :: e_full(:), phi(:), gradients(:, :)
     integer :: s, f
+    if (present(full_work)) then
+      e_full => full_work
+      phi => phi_work
+      gradients => gradients_work
+    else
+      allocate (own_full(sys%nfull), own_phi(sys%ncon), own_gradients(6, sys%ncon))
+      e_full => own_full
+      phi => own_phi
+      gradients => own_gradients
+    end if
     call evaluate_constraints(sys, e, t, phi, gradients, info)
     if (info /= 0) return
     violation = 0.0_dp
     if (sys%ncon > 0) violation = maxval(abs(phi))
     powers = 0.0_dp
-    powers(power_drive) = dot_product(lam, gradient_dot(sys, gradients, v))
-    allocate (e_full(sys%nfull))
+    ! (Phi_e e' into phi, no longer needed: no function-result temporary)
+    call gradient_product(sys, gradients, v, phi)
+    powers(power_drive) = dot_product(lam, phi)
     call to_full(sys, e, .true., e_full)
     if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0 .or. sys%nvload > 0) then
       allocate (v_full(sys%nfull))
@@ -1055,19 +1106,33 @@ contains
 
   !> One output row's probes (positions), deflections (A_f^T (p - pivot_f) - reference) and
   !> energies (kinetic, strain, loads, moments, total, works, contact).
+  !> known_full (optional): the full coordinates q of e (energies' full_work), with
+  !> ndof_work (ndof, 2) work arrays of the caller - no heap arrays per output row.
   subroutine probe_output(sys, rotations, e, v, t, work, strain, contact_potential, probe, &
-                          deflection, energy, info)
+                          deflection, energy, info, known_full, ndof_work)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), e(:), v(:), t, work(:), strain
     real(dp), intent(in) :: contact_potential
     real(dp), intent(out) :: probe(:, :), deflection(:, :), energy(:)
     integer, intent(out) :: info
-    real(dp), allocatable :: e_full(:), mv(:), loads(:)
-    real(dp) :: pivot(3)
+    real(dp), intent(in), optional, target :: known_full(:)
+    real(dp), intent(out), optional, target :: ndof_work(:, :)
+    real(dp), allocatable, target :: own_full(:), own_ndof(:, :)
+    real(dp), pointer :: e_full(:), mv(:), loads(:)
+    real(dp) :: pivot(3), director(3)
     integer :: p, k, f, m
     info = 0
-    allocate (e_full(sys%nfull), mv(sys%ndof), loads(sys%ndof))
-    call to_full(sys, e, .true., e_full)
+    if (present(known_full)) then
+      e_full => known_full
+      mv => ndof_work(:, 1)
+      loads => ndof_work(:, 2)
+    else
+      allocate (own_full(sys%nfull), own_ndof(sys%ndof, 2))
+      call to_full(sys, e, .true., own_full)
+      e_full => own_full
+      mv => own_ndof(:, 1)
+      loads => own_ndof(:, 2)
+    end if
     do p = 1, sys%nprobe
       probe(:, p) = 0.0_dp
       do k = sys%probe_ptr(p), sys%probe_ptr(p + 1) - 1
@@ -1088,9 +1153,11 @@ contains
     if (info /= 0) return
     energy(energy_loads) = -dot_product(loads, e)
     do m = 1, size(sys%moment_magnitude)
+      do k = 1, 3  ! (gathered by a loop: a vector subscript made a heap temporary)
+        director(k) = e_full(sys%moment_dofs(k, m))
+      end do
       energy(energy_moment) = energy(energy_moment) - sys%moment_magnitude(m) * &
-        moment_angle(e_full(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
-                     sys%moment_reference(:, m))
+        moment_angle(director, sys%moment_axis(:, m), sys%moment_reference(:, m))
     end do
     energy(energy_contact) = contact_potential
     energy(energy_total) = sum(energy(energy_kinetic:energy_moment)) + contact_potential

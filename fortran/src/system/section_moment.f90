@@ -11,7 +11,7 @@ module section_moment
   use ancf_kinds, only: dp
   implicit none
   private
-  public :: moment_force, moment_angle
+  public :: moment_force, moment_force_only, moment_angle
 
 contains
 
@@ -56,6 +56,29 @@ contains
       end do
     end do
   end subroutine moment_force
+
+  !> The force(3) = Q of moment_force alone (the same arithmetic, no Jacobian or Hessian):
+  !> the residual's dead moments. info = 1 when the director is parallel to k.
+  pure subroutine moment_force_only(director, axis, magnitude, force, info)
+    real(dp), intent(in) :: director(3), axis(3), magnitude
+    real(dp), intent(out) :: force(3)
+    integer, intent(out) :: info
+    real(dp) :: k(3), p(3), kp(3), skew(3, 3), s
+    k = axis / norm2(axis)
+    p = director - dot_product(k, director) * k
+    s = dot_product(p, p)
+    force = 0.0_dp
+    info = 0
+    if (s <= epsilon(1.0_dp) * dot_product(director, director)) then
+      info = 1
+      return
+    end if
+    skew(:, 1) = [0.0_dp, k(3), -k(2)]
+    skew(:, 2) = [-k(3), 0.0_dp, k(1)]
+    skew(:, 3) = [k(2), -k(1), 0.0_dp]
+    kp = matmul(skew, p)
+    force = magnitude * kp / s
+  end subroutine moment_force_only
 
   !> Rotation angle of the director about the axis, measured from a reference direction
   !> (both projected on the plane normal to the axis), in (-pi, pi]. The potential of the
