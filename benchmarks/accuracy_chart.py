@@ -55,6 +55,18 @@ FAMILIES = [
 ]
 
 
+def draw(rows: list[dict], chart: Path) -> None:
+    """The chart of the rows (the machine's load average over the runs in its title)."""
+    loads = [r["load_average"] for r in rows]
+    pareto_chart(rows, lambda r: r["family"],
+                 lambda r: ("full" if r["knob"] == "beam.modes" and r["value"] == "0" else
+                            f"{r['value']}{' m' if r['knob'] == 'beam.modes' else ''}"),
+                 "err_vs_reference", chart,
+                 title="luffing boom, 10 s, 50 kg: error against the nonlinear cubic 28-node "
+                       "model vs wall time per case\n(labels: nodes, or modes 'm'; 2-core "
+                       f"machine at load average {min(loads):.1f}-{max(loads):.1f})")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("-o", "--output", type=Path, default=REPO / "benchmarks" / "results"
@@ -92,13 +104,7 @@ def main() -> None:
                 h5.unlink()
     (work / "rows.json").write_text(json.dumps(rows, indent=1) + "\n")
     args.chart.parent.mkdir(parents=True, exist_ok=True)
-    pareto_chart(rows, lambda r: r["family"],
-                 lambda r: ("full" if r["knob"] == "beam.modes" and r["value"] == "0" else
-                            f"{r['value']}{' m' if r['knob'] == 'beam.modes' else ''}"),
-                 "err_vs_reference", args.chart,
-                 title="luffing boom, 10 s, 50 kg: error against the nonlinear cubic 28-node "
-                       "model vs wall time per case\n(labels: nodes, or modes 'm'; loaded "
-                       "2-core machine)")
+    draw(rows, args.chart)
     lines = ["| family | knob | error vs reference (% of sag range) | case time (s) | "
              "dynamics (s) |", "|---|---|---|---|---|"]
     for r in rows:
