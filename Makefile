@@ -52,6 +52,11 @@ $(PY): | system-packages
 	$(PY) -m pip install -q --upgrade pip
 
 $(STAMP): $(SOURCES) | system-packages $(PY)
+	@# an extension module left in the source tree (a copied or in-place build) would be
+	@# installed over the fresh build by meson's install_subdir: refuse, naming it
+	@stale="$$(ls python/ancfdrv/_kernel*.so 2>/dev/null)"; if [ -n "$$stale" ]; then \
+	    echo "error: $$stale is a kernel build inside the source tree; meson would install it" \
+	         "over the fresh build. Remove it: rm $$stale" >&2; exit 2; fi
 	$(PY) -m pip install -q meson-python meson ninja numpy
 	PATH="$(abspath $(VENV))/bin:$$PATH" $(PY) -m pip install -q --no-build-isolation '.[test]'
 	touch $(STAMP)
