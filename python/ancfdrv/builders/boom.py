@@ -13,7 +13,7 @@ from ..history import luffing_stage_bounds
 from ..errors import InputError
 from ..system import System
 from ..system.bodies import rotation_about
-from .common import BuiltSystem, beam_loads, material, rectangle
+from .common import BuiltSystem, beam_loads, material, rectangle, template_cable
 
 
 def build(scene) -> BuiltSystem:
@@ -79,11 +79,7 @@ def _cable_boom(scene, built: BuiltSystem, steel, drive, a1, tangent, height, ti
     A2 (the section turns with the axis). The cable carries the boom's frame R(phi(t)) for
     its probe's deflection, as the beam does."""
     s, beam, loads, effects = built.system, scene["beam"], scene["loads"], scene.effects
-    if scene["scene"]["formulation"] != "nonlinear":
-        raise InputError("bending = 'cable' is a large-deformation element: it needs "
-                         "scene.formulation = 'nonlinear'", group="beam", key="bending")
-    c = s.cable("boom", material=steel, start=a1, end=tip, nodes=beam["nodes"],
-                section=rectangle(scene), segments=beam["segments"])
+    c = template_cable(scene, s, "boom", steel, a1, tip)
     c.frame_drive, c.frame_axis, c.frame_pivot = drive, np.array([0.0, 0.0, 1.0]), np.zeros(3)
     c.orientation = np.column_stack([tangent, height, np.cross(tangent, height)])
     s.joint("A1", "arm", "ground", "boom", point=a1, pivot=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0))

@@ -2,9 +2,8 @@
 'section' holds r, r_y, r_z; 'full' also r_x; 'pin' r and r_z, a hinge about r3); frame A = I."""
 from __future__ import annotations
 
-from ..errors import InputError
 from ..system import System
-from .common import BuiltSystem, beam_loads, material, rectangle
+from .common import BuiltSystem, beam_loads, material, rectangle, template_cable
 
 CLAMPS = {"section": ("r", "r_y", "r_z"), "full": ("r", "r_x", "r_y", "r_z"), "pin": ("r", "r_z")}
 
@@ -33,20 +32,8 @@ def _cable(scene, built: BuiltSystem, tip) -> BuiltSystem:
     with the planar reduction, the hinge about r3), 'section' and 'full' hold r and r_x (a
     weld). A section with I_y != I_z bends in the r1-r2 plane with I_z = int y^2 dA, and
     needs ``scene.planar = 'xy'``."""
-    s, beam = built.system, scene["beam"]
-    if scene["scene"]["formulation"] != "nonlinear":
-        raise InputError("bending = 'cable' is a large-deformation element: it needs "
-                         "scene.formulation = 'nonlinear'", group="beam", key="bending")
-    section = rectangle(scene)
-    square = abs(section.iy - section.iz) <= 1e-9 * max(section.iy, section.iz)
-    if not square and scene["scene"].get("planar", "off") != "xy":
-        raise InputError("bending = 'cable' with a section of two bending stiffnesses "
-                         f"(I_y = {section.iy:g}, I_z = {section.iz:g} m^4) bends in the r1-r2 "
-                         "plane only: it needs scene.planar = 'xy'", group="beam",
-                         key="bending")
-    c = s.cable("beam", material=material(s, scene), start=(0.0, 0.0, 0.0), end=tip,
-                nodes=beam["nodes"], section=section, segments=beam["segments"],
-                bending_inertia=None if square else section.iz)
+    s = built.system
+    c = template_cable(scene, s, "beam", material(s, scene), (0.0, 0.0, 0.0), tip)
     clamp = scene["cantilever"]["clamp"]
     s.joint(f"clamp {clamp}", "spherical" if clamp == "pin" else "weld", "ground", "beam",
             point=(0.0, 0.0, 0.0))

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import InputError
 from ..system import Beam, System
 from ..system.sections import Rectangle
 
@@ -27,6 +28,27 @@ def material(system: System, scene, name: str = "material"):
 
 def rectangle(scene) -> Rectangle:
     return Rectangle(scene["beam"]["width"], scene["beam"]["height"])
+
+
+def template_cable(scene, system: System, name: str, material_, start, end):
+    """``beam.bending = 'cable'`` in a beam template (issue 23): the beam as an ANCF cable
+    (r and r_x per node, Euler-Bernoulli, ``system/cable.py``), the 'nonlinear' formulation
+    only. A section with I_y != I_z bends in the r1-r2 plane with I_z = int y^2 dA and needs
+    ``scene.planar = 'xy'``."""
+    if scene["scene"]["formulation"] != "nonlinear":
+        raise InputError("bending = 'cable' is a large-deformation element: it needs "
+                         "scene.formulation = 'nonlinear'", group="beam", key="bending")
+    section = rectangle(scene)
+    square = abs(section.iy - section.iz) <= 1e-9 * max(section.iy, section.iz)
+    if not square and scene["scene"].get("planar", "off") != "xy":
+        raise InputError("bending = 'cable' with a section of two bending stiffnesses "
+                         f"(I_y = {section.iy:g}, I_z = {section.iz:g} m^4) bends in the r1-r2 "
+                         "plane only: it needs scene.planar = 'xy'", group="beam",
+                         key="bending")
+    beam = scene["beam"]
+    return system.cable(name, material=material_, start=start, end=end, nodes=beam["nodes"],
+                        section=section, segments=beam["segments"],
+                        bending_inertia=None if square else section.iz)
 
 
 def beam_loads(built: BuiltSystem, scene, beam: Beam, tip) -> None:

@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
 from ..system import System
-from .common import BuiltSystem, beam_loads, material, rectangle
+from .common import BuiltSystem, beam_loads, material, rectangle, template_cable
 
 
 def build(scene) -> BuiltSystem:
@@ -37,20 +36,8 @@ def _cable(scene, built: BuiltSystem, drive, tip) -> BuiltSystem:
     must have I_y = I_z unless the scene is planar 'xy', where it bends with I_z): the hub
     joint holds the root's r and r_x on the turning hub, the cable carries the hub's frame
     R(phi(t)) for its probe's deflection."""
-    s, beam = built.system, scene["beam"]
-    if scene["scene"]["formulation"] != "nonlinear":
-        raise InputError("bending = 'cable' is a large-deformation element: it needs "
-                         "scene.formulation = 'nonlinear'", group="beam", key="bending")
-    section = rectangle(scene)
-    square = abs(section.iy - section.iz) <= 1e-9 * max(section.iy, section.iz)
-    if not square and scene["scene"].get("planar", "off") != "xy":
-        raise InputError("bending = 'cable' with a section of two bending stiffnesses "
-                         f"(I_y = {section.iy:g}, I_z = {section.iz:g} m^4) bends in the r1-r2 "
-                         "plane only: it needs scene.planar = 'xy'", group="beam",
-                         key="bending")
-    c = s.cable("beam", material=material(s, scene), start=(0.0, 0.0, 0.0), end=tip,
-                nodes=beam["nodes"], section=section, segments=beam["segments"],
-                bending_inertia=None if square else section.iz)
+    s = built.system
+    c = template_cable(scene, s, "beam", material(s, scene), (0.0, 0.0, 0.0), tip)
     c.frame_drive, c.frame_axis, c.frame_pivot = drive, np.array([0.0, 0.0, 1.0]), np.zeros(3)
     c.orientation = np.eye(3)   # the frame's axes at phi = 0: along the cable, r2, r3
     s.joint("hub", "hub", "ground", "beam", point=(0.0, 0.0, 0.0), pivot=(0.0, 0.0, 0.0),
