@@ -15,6 +15,29 @@ module section_moment
 
 contains
 
+  !> What force and Jacobian share: the unit axis k, the director's part p normal to it,
+  !> s = |p|^2, skew = [k x] and the force Q = magnitude (k x p) / s. info = 1 (force 0)
+  !> when the director is parallel to k (rotation undefined).
+  pure subroutine section_plane(director, axis, magnitude, k, p, s, skew, force, info)
+    real(dp), intent(in) :: director(3), axis(3), magnitude
+    real(dp), intent(out) :: k(3), p(3), s, skew(3, 3), force(3)
+    integer, intent(out) :: info
+    k = axis / norm2(axis)
+    p = director - dot_product(k, director) * k
+    s = dot_product(p, p)
+    force = 0.0_dp
+    skew = 0.0_dp
+    info = 0
+    if (s <= epsilon(1.0_dp) * dot_product(director, director)) then
+      info = 1
+      return
+    end if
+    skew(:, 1) = [0.0_dp, k(3), -k(2)]
+    skew(:, 2) = [-k(3), 0.0_dp, k(1)]
+    skew(:, 3) = [k(2), -k(1), 0.0_dp]
+    force = magnitude * matmul(skew, p) / s
+  end subroutine section_plane
+
   !> force(3) = Q, jacobian(3,3) = dQ/dd, hessian(3,3,3) = d2Q_i/dd_j dd_l.
   !> info = 1 when the director is parallel to k (rotation undefined).
   pure subroutine moment_force(director, axis, magnitude, force, jacobian, hessian, info)
@@ -23,24 +46,15 @@ contains
     integer, intent(out) :: info
     real(dp) :: k(3), p(3), kp(3), skew(3, 3), projector(3, 3), s
     integer :: i, j, l
-    k = axis / norm2(axis)
-    p = director - dot_product(k, director) * k
-    s = dot_product(p, p)
-    force = 0.0_dp
     jacobian = 0.0_dp
     hessian = 0.0_dp
-    info = 0
-    if (s <= epsilon(1.0_dp) * dot_product(director, director)) then
-      info = 1
-      return
-    end if
-    skew = reshape([0.0_dp, k(3), -k(2), -k(3), 0.0_dp, k(1), k(2), -k(1), 0.0_dp], [3, 3])
+    call section_plane(director, axis, magnitude, k, p, s, skew, force, info)
+    if (info /= 0) return
     projector = -spread(k, 2, 3) * spread(k, 1, 3)
     do i = 1, 3
       projector(i, i) = projector(i, i) + 1.0_dp
     end do
     kp = matmul(skew, p)
-    force = magnitude * kp / s
     do j = 1, 3
       do i = 1, 3
         jacobian(i, j) = magnitude * (skew(i, j) / s - 2.0_dp * kp(i) * p(j) / s**2)
@@ -57,27 +71,14 @@ contains
     end do
   end subroutine moment_force
 
-  !> The force(3) = Q of moment_force alone (the same arithmetic, no Jacobian or Hessian):
-  !> the residual's dead moments. info = 1 when the director is parallel to k.
+  !> The force(3) = Q of moment_force alone (no Jacobian or Hessian): the residual's dead
+  !> moments. info = 1 when the director is parallel to k.
   pure subroutine moment_force_only(director, axis, magnitude, force, info)
     real(dp), intent(in) :: director(3), axis(3), magnitude
     real(dp), intent(out) :: force(3)
     integer, intent(out) :: info
-    real(dp) :: k(3), p(3), kp(3), skew(3, 3), s
-    k = axis / norm2(axis)
-    p = director - dot_product(k, director) * k
-    s = dot_product(p, p)
-    force = 0.0_dp
-    info = 0
-    if (s <= epsilon(1.0_dp) * dot_product(director, director)) then
-      info = 1
-      return
-    end if
-    skew(:, 1) = [0.0_dp, k(3), -k(2)]
-    skew(:, 2) = [-k(3), 0.0_dp, k(1)]
-    skew(:, 3) = [k(2), -k(1), 0.0_dp]
-    kp = matmul(skew, p)
-    force = magnitude * kp / s
+    real(dp) :: k(3), p(3), skew(3, 3), s
+    call section_plane(director, axis, magnitude, k, p, s, skew, force, info)
   end subroutine moment_force_only
 
   !> Rotation angle of the director about the axis, measured from a reference direction
