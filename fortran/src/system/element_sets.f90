@@ -297,7 +297,7 @@ contains
     real(dp) :: coords(3, serial_max_dofs / 3), rates(3, serial_max_dofs / 3)
     real(dp) :: element_energy, element_power, power_lost
     logical :: damped
-    integer :: el, node, nodes, element_info
+    integer :: el, nodes, element_info
     if (set%nde > serial_max_dofs) then
       call set_energy_power(set, rotation, axis, rate, e, energy, power, info, v, dissipation)
       return
@@ -309,13 +309,9 @@ contains
     damped = present(v) .and. set%damping_time > 0.0_dp
     nodes = set%nde / 3
     do el = 1, set%nel
-      do node = 1, nodes
-        coords(:, node) = e(set%dofs(3 * node - 2:3 * node, el))
-      end do
+      call gather_element(set, el, e, coords(:, 1:nodes))
       if (damped) then
-        do node = 1, nodes
-          rates(:, node) = v(set%dofs(3 * node - 2:3 * node, el))
-        end do
+        call gather_element(set, el, v, rates(:, 1:nodes))
         call set%element_energy(el, coords(:, 1:nodes), element_energy, element_info, &
                                 rates(:, 1:nodes), element_power)
         power_lost = power_lost + element_power
@@ -377,7 +373,7 @@ contains
     real(dp), intent(out), optional :: dissipation
     ! (fixed work arrays: no heap allocation per element)
     real(dp) :: coords(3, serial_max_dofs / 3), rates(3, serial_max_dofs / 3)
-    integer :: node, nodes
+    integer :: nodes
     if (set%nde > serial_max_dofs) then
       call gathered_large_forces(set, el, e, want_tangent, force, energy, tangent, info, v, &
                                  rate_factor, dissipation)
@@ -385,13 +381,9 @@ contains
     end if
     nodes = set%nde / 3
     ! the element's coordinates as (3, shapes), copied in place of a reshape temporary
-    do node = 1, nodes
-      coords(:, node) = e(set%dofs(3 * node - 2:3 * node, el))
-    end do
+    call gather_element(set, el, e, coords(:, 1:nodes))
     if (present(v)) then
-      do node = 1, nodes
-        rates(:, node) = v(set%dofs(3 * node - 2:3 * node, el))
-      end do
+      call gather_element(set, el, v, rates(:, 1:nodes))
       call set%element_forces(el, coords(:, 1:nodes), want_tangent, force, energy, tangent, &
                               info, rates(:, 1:nodes), rate_factor, dissipation)
       return
@@ -411,20 +403,27 @@ contains
     real(dp), intent(in), optional :: v(:), rate_factor
     real(dp), intent(out), optional :: dissipation
     real(dp) :: coords(3, set%nde / 3), rates(3, set%nde / 3)
-    integer :: node
-    do node = 1, set%nde / 3
-      coords(:, node) = e(set%dofs(3 * node - 2:3 * node, el))
-    end do
+    call gather_element(set, el, e, coords)
     if (present(v)) then
-      do node = 1, set%nde / 3
-        rates(:, node) = v(set%dofs(3 * node - 2:3 * node, el))
-      end do
+      call gather_element(set, el, v, rates)
       call set%element_forces(el, coords, want_tangent, force, energy, tangent, info, rates, &
                               rate_factor, dissipation)
       return
     end if
     call set%element_forces(el, coords, want_tangent, force, energy, tangent, info)
   end subroutine gathered_large_forces
+
+  !> Element el's nodal 3-vectors (3, nde / 3) gathered from the full vector x.
+  pure subroutine gather_element(set, el, x, nodal)
+    class(local_element_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: x(:)
+    real(dp), intent(out) :: nodal(:, :)
+    integer :: node
+    do node = 1, set%nde / 3
+      nodal(:, node) = x(set%dofs(3 * node - 2:3 * node, el))
+    end do
+  end subroutine gather_element
 
   !> Adds the element matrices (nde, nde, nel) to the full pattern's values.
   pure subroutine scatter_add(set, matrices, values)
