@@ -50,9 +50,9 @@ module stepper
     real(dp), allocatable :: accel_before(:)
     logical :: predict_from_before = .false.
     ! the matrix carried with the system's rotation (carried_rotation): the carried vectors
-    ! at the factorization (3, nvec), the turn from them to the current step's predicted
+    ! at the factorization and at the current step (3, nvec), the turn from them to the current step's predicted
     ! state and whether the step uses it (a turn above carry_threshold)
-    real(dp), allocatable :: carry_reference(:, :)
+    real(dp), allocatable :: carry_reference(:, :), carry_current(:, :)
     real(dp) :: carry_turn(3, 3) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, &
                                             0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
     logical :: carry_on = .false.

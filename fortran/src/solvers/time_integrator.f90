@@ -101,6 +101,9 @@ module time_integrator
     real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:, :)
     real(dp), allocatable :: full_pair(:, :)
     integer, allocatable :: ipiv(:)
+    ! the carried matrix's Schur complement (carried_rotation): T^T Phi_e^T, S^{-1} of it and
+    ! the LU factors of C, built at a step's first carried correction
+    real(dp), allocatable :: carry_columns(:, :), carry_flexibility(:, :), carry_lu(:, :)
   end type step_work
 
 contains
@@ -119,6 +122,9 @@ contains
               work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
               work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
               work%row_ndof(sys%ndof, 2), work%full_pair(sys%nfull, 2))
+    if (carry_enabled(sys)) allocate (work%carry_columns(sys%ndof, sys%ncon), &
+                                      work%carry_flexibility(sys%ndof, sys%ncon), &
+                                      work%carry_lu(sys%ncon, sys%ncon))
   end subroutine allocate_work
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
@@ -337,7 +343,8 @@ contains
     learned%carry_on = .false.
     if (info == 0 .and. carry_enabled(sys)) then
       if (.not. allocated(learned%carry_reference)) &
-        allocate (learned%carry_reference(3, size(sys%carry_first)))
+        allocate (learned%carry_reference(3, size(sys%carry_first)), &
+                  learned%carry_current(3, size(sys%carry_first)))
       call carry_vectors(sys, e, learned%carry_reference)
     end if
   end subroutine factorize
@@ -351,15 +358,14 @@ contains
     type(stepper_state), intent(inout) :: learned
     logical, intent(in) :: fresh_matrix
     real(dp), intent(in) :: e(:)
-    real(dp), allocatable :: current(:, :)
     real(dp) :: angle
     integer :: svd_info
     learned%carry_on = .false.
     if (fresh_matrix .or. cfg%jacobian /= jacobian_reuse .or. .not. carry_enabled(sys) .or. &
         .not. sys%factorized .or. .not. allocated(learned%carry_reference)) return
-    allocate (current(3, size(sys%carry_first)))
-    call carry_vectors(sys, e, current)
-    call carry_turn(sys, learned%carry_reference, current, learned%carry_turn, angle, svd_info)
+    call carry_vectors(sys, e, learned%carry_current)
+    call carry_turn(sys, learned%carry_reference, learned%carry_current, learned%carry_turn, &
+                    angle, svd_info)
     learned%carry_on = svd_info == 0 .and. angle > carry_threshold
   end subroutine carry_step
 
@@ -396,9 +402,7 @@ contains
     real(dp) :: strain, previous_correction, step_cap, step_theta
     integer :: it, lapack_info, active
     logical :: use_known, refresh, capped, halt
-    ! the carried matrix's Schur complement, built at the step's first carried correction
-    real(dp), allocatable :: carry_flexibility(:, :), carry_lu(:, :)
-    logical :: carry_ready
+    logical :: carry_ready  ! the carried Schur complement is built for this step
     associate (r => work%r, z => work%z, direction => work%direction, &
                correction => work%correction, phi => work%phi, gradients => work%gradients, &
                w => work%w, schur => work%schur, dlam => work%dlam, ipiv => work%ipiv)
@@ -545,28 +549,25 @@ contains
     !> them); then C dlam = Phi_e z - Phi, correction = T F dlam - z.
     subroutine carry_schur()
       ! (the newton's associate names are not visible here: the work arrays by name)
-      real(dp) :: columns(sys%ndof, sys%ncon), turned(sys%ndof)
       if (.not. carry_ready) then
-        if (.not. allocated(carry_flexibility)) &
-          allocate (carry_flexibility(sys%ndof, sys%ncon), carry_lu(sys%ncon, sys%ncon))
-        call carry_gradients(sys, learned%carry_turn, work%gradients, columns)
-        if (gather_blocks(columns, work%w)) then
+        call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns)
+        if (gather_blocks(work%carry_columns, work%w)) then
           ! within the factorization's flexibility S^{-1} E_c (the model's touched blocks
           ! hold each constrained vector whole): no solve
-          carry_flexibility = matmul(sys%flexibility, work%w)
-          carry_lu = matmul(transpose(work%w), matmul(sys%flexibility_cc, work%w))
+          work%carry_flexibility = matmul(sys%flexibility, work%w)
+          work%carry_lu = matmul(transpose(work%w), matmul(sys%flexibility_cc, work%w))
         else
-          carry_flexibility = columns
-          call solver_solve(sys%solver_handle, sys%ndof, sys%ncon, carry_flexibility, info, &
+          work%carry_flexibility = work%carry_columns
+          call solver_solve(sys%solver_handle, sys%ndof, sys%ncon, work%carry_flexibility, info, &
                             detail)
           if (info /= 0) then
             detail = info
             info = 3
             return
           end if
-          carry_lu = matmul(transpose(columns), carry_flexibility)
+          work%carry_lu = matmul(transpose(work%carry_columns), work%carry_flexibility)
         end if
-        call dgetrf(sys%ncon, sys%ncon, carry_lu, sys%ncon, work%ipiv, lapack_info)
+        call dgetrf(sys%ncon, sys%ncon, work%carry_lu, sys%ncon, work%ipiv, lapack_info)
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -576,11 +577,11 @@ contains
       end if
       call gradient_product(sys, work%gradients, work%direction, work%dlam(:, 1))
       work%dlam(:, 1) = work%dlam(:, 1) - work%phi
-      call dgetrs('N', sys%ncon, 1, carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
+      call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
                   lapack_info)
-      call carry_apply(sys, learned%carry_turn, matmul(carry_flexibility, work%dlam(:, 1)), &
-                       .false., turned)
-      work%correction = turned - work%direction
+      work%back = matmul(work%carry_flexibility, work%dlam(:, 1))
+      call carry_apply(sys, learned%carry_turn, work%back, .false., work%correction)
+      work%correction = work%correction - work%direction
     end subroutine carry_schur
 
     !> w = E_c^T columns (the rows of the touched blocks; a dof in two blocks: the first)
