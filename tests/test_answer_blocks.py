@@ -1,5 +1,5 @@
 """The dynamic answers (reactions, section forces, stress envelope) are recorded over a
-chunk's rows in blocks (runner._row_blocks, issue 23: the recorder's work arrays held ~5
+chunk's rows in blocks (DynamicAnswers' ANSWER_BLOCK_BYTES, issue 23: the recorder's work arrays held ~5
 copies of a chunk's full coordinates): any block size gives the same answers, also where the reactions need the accelerations rebuilt row by row across blocks (the
 knuckle crane's eliminated joints). The matrix products of a block of one row and of
 many rows may round differently (BLAS gemv against gemm): the answers agree to 1e-12 of
@@ -12,6 +12,7 @@ import h5py
 import numpy as np
 
 from ancfdrv import runner
+from ancfdrv.system import answers
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,16 +32,20 @@ def test_row_blocks_give_the_same_answers(tmp_path, monkeypatch):
     scene = ROOT / "inputs/knuckle_crane_rope.nml"
     overrides = ["solver.t_end=0.1"]
     runner.run_scene(scene, overrides, tmp_path / "whole.h5", progress=False)
-    monkeypatch.setattr(runner, "ANSWER_BLOCK_BYTES", 1)   # one row per block
+    monkeypatch.setattr(answers, "ANSWER_BLOCK_BYTES", 1)   # one row per block
     calls = []
-    original = runner._row_blocks
+    call, record = answers.DynamicAnswers.__call__, answers.DynamicAnswers._record
 
-    def counting(chunk, nfull):
-        parts = list(original(chunk, nfull))
-        calls.append((len(chunk.time), len(parts)))
-        return iter(parts)
+    def counting(self, chunk):
+        calls.append([len(chunk.time), 0])
+        call(self, chunk)
 
-    monkeypatch.setattr(runner, "_row_blocks", counting)
+    def counting_blocks(self, chunk):
+        calls[-1][1] += 1
+        record(self, chunk)
+
+    monkeypatch.setattr(answers.DynamicAnswers, "__call__", counting)
+    monkeypatch.setattr(answers.DynamicAnswers, "_record", counting_blocks)
     runner.run_scene(scene, overrides, tmp_path / "rows.h5", progress=False)
     assert any(rows > 1 and parts == rows for rows, parts in calls)
     whole, rows = _answers(tmp_path / "whole.h5"), _answers(tmp_path / "rows.h5")

@@ -192,28 +192,6 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     return recorder
 
 
-#: the answers recorder takes a chunk's rows in blocks of about this many bytes of full
-#: coordinates: its work arrays hold ~5 copies of them (at 3078 coordinates and a chunk of
-#: 60 steps, 7 MB at once; issue 23: a run's peak memory)
-ANSWER_BLOCK_BYTES = 1 << 18
-
-
-def _row_blocks(chunk, nfull: int):
-    """The chunk itself, or views of consecutive row blocks of it (the fields the answers
-    recorder reads) when it has more rows than one block holds."""
-    rows = max(1, ANSWER_BLOCK_BYTES // (8 * max(nfull, 1)))
-    n = len(chunk.time)
-    if n <= rows:
-        yield chunk
-        return
-    from types import SimpleNamespace
-    for start in range(0, n, rows):
-        block = slice(start, min(start + rows, n))
-        yield SimpleNamespace(time=chunk.time[block], q=chunk.q[block], lam=chunk.lam[block],
-                              contact=None if getattr(chunk, "contact", None) is None
-                              else chunk.contact[block])
-
-
 def _warn_large_ffr_deflection(model: Model, out: Path) -> None:
     """The warning of an 'ffr' run whose tip deflects by more than 5% of the length."""
     if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
@@ -374,8 +352,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
             nonlocal recorder
             if recorder is not None:
                 try:
-                    for part in _row_blocks(chunk, model.nfull):
-                        recorder(part)
+                    recorder(chunk)
                 except (AncfError, ValueError, FloatingPointError) as exc:
                     # the answers never fail a run: the file keeps everything else
                     model.warnings.append(f"dynamic reactions, section forces and stresses "

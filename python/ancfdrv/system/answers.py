@@ -45,6 +45,7 @@ Stresses
 from __future__ import annotations
 
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
@@ -646,6 +647,10 @@ def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS
 
 #: rows per block of :class:`DynamicAnswers`' section forces and stress envelope
 SECTION_BLOCK = 256
+#: :class:`DynamicAnswers` takes a chunk's rows in blocks of about this many bytes of full
+#: coordinates: its work arrays hold ~5 copies of them (at 3078 coordinates and a chunk of
+#: 60 steps, 7 MB at once; issue 23: a run's peak memory)
+ANSWER_BLOCK_BYTES = 1 << 18
 
 
 def _section_forces_full(model: Model, q: np.ndarray, stations: int,
@@ -979,8 +984,24 @@ class DynamicAnswers:
         return v1, accel1
 
     def __call__(self, chunk) -> None:
+        """Record a chunk of rows, in blocks of about ANSWER_BLOCK_BYTES of full coordinates
+        (the work arrays hold ~5 copies of a block's: bounded whatever the chunk's length)."""
         if chunk.q is None:
             raise ValueError("DynamicAnswers needs the coordinates of every step (store_q)")
+        rows = max(1, ANSWER_BLOCK_BYTES // (8 * max(self.model.nfull, 1)))
+        n = len(chunk.time)
+        if n <= rows:
+            self._record(chunk)
+            return
+        contact = getattr(chunk, "contact", None)
+        for start in range(0, n, rows):
+            block = slice(start, min(start + rows, n))
+            self._record(SimpleNamespace(time=chunk.time[block], q=chunk.q[block],
+                                         lam=chunk.lam[block],
+                                         contact=None if contact is None else contact[block]))
+
+    def _record(self, chunk) -> None:
+        """Record one block of rows (every row after the previous block's)."""
         times = np.asarray(chunk.time, dtype=float)
         if not len(times):
             return
