@@ -39,9 +39,9 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-import scipy.sparse as sp
 from tqdm import tqdm
 
+from ..csr import Csr
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
                      JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES)
 from ..errors import Interrupted, SolverError
@@ -168,15 +168,14 @@ class DynamicResult:
     floor_accepts: int = 0
 
 
-def _saddle_solve(model: Model, matrix: sp.spmatrix, rhs_top: np.ndarray,
+def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
                   rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str):
     """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]."""
     n, ncon = model.ndof, len(model.constraints)
     _, rows, cols, grads = model.constraints.jacobian(e, n, t)
-    coo = matrix.tocoo()
-    r = np.concatenate([coo.row, cols, n + rows])
-    c = np.concatenate([coo.col, n + rows, cols])
-    v = np.concatenate([coo.data, -grads, -grads])
+    r = np.concatenate([matrix.row_index(), cols, n + rows])
+    c = np.concatenate([matrix.indices, n + rows, cols])
+    v = np.concatenate([matrix.data, -grads, -grads])
     with DirectSolver(n + ncon, r, c, what=what) as solver:
         solver.factorize(v)
         x = solver.solve(np.concatenate([rhs_top, rhs_bottom]))
@@ -187,7 +186,7 @@ def initial_acceleration(model: Model, e: np.ndarray, v: np.ndarray, t: float):
     """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma."""
     *_, gamma = model.constraints.evaluate(e, t, v)
     forces = model.forces(e, t, v)
-    return _saddle_solve(model, model.mass_matrix(), forces["external"] - forces["internal"],
+    return _saddle_solve(model, model.mass, forces["external"] - forces["internal"],
                          -gamma, e, t, "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]")
 
 
