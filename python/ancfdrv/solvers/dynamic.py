@@ -39,7 +39,6 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-from tqdm import tqdm
 
 from ..csr import Csr
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
@@ -166,6 +165,28 @@ class DynamicResult:
     steps_taken: int = 0
     smallest_step: float = 0.0
     floor_accepts: int = 0
+
+
+class _NoBar:
+    """The progress bar of a run that shows none (tqdm and its imports, ~4 MB, not loaded)."""
+
+    def update(self, _n: float) -> None:
+        pass
+
+    def set_postfix(self, **_values) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+def _progress_bar(show: bool, total: float):
+    """tqdm's bar over the simulated time when shown, else a bar that does nothing."""
+    if not show:
+        return _NoBar()
+    from tqdm import tqdm
+    return tqdm(total=total, unit="s", desc="dynamics",
+                bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s [{elapsed}<{remaining}{postfix}]")
 
 
 def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
@@ -525,8 +546,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     timing["output"] += time.perf_counter() - t1
     total = int(round((settings.t_end - t0) / settings.dt))
     show = sys.stderr.isatty() if progress is None else progress
-    bar = tqdm(total=round(settings.t_end - t0, 9), unit="s", disable=not show, desc="dynamics",
-               bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s [{elapsed}<{remaining}{postfix}]")
+    bar = _progress_bar(show, round(settings.t_end - t0, 9))
     steps = newton = factorizations = jacobians = 0
     call_steps = min(settings.chunk_steps, 10)  # the first call measures a step's cost
     if settings.step not in ("fixed", "adaptive"):
