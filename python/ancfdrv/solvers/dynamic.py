@@ -40,9 +40,9 @@ from typing import Callable
 
 import numpy as np
 
-from ..csr import Csr
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
                      JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES)
+from ..csr import Csr
 from ..errors import Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver
@@ -168,7 +168,7 @@ class DynamicResult:
 
 
 class _NoBar:
-    """The progress bar of a run that shows none (tqdm and its imports, ~4 MB, not loaded)."""
+    """The progress bar of a run that shows none (tqdm and its imports not loaded: ~1 MB)."""
 
     def update(self, _n: float) -> None:
         pass
