@@ -663,7 +663,8 @@ class KernelSystem:
 
     def set_matrices(self, mass_csr, full_pattern, solver_handle: int, policy: int,
                      mass_pattern, vector_frame, block_first) -> None:
-        """M (scipy CSR on the independent coordinates), the full pattern (row_ptr,
+        """M (CSR arrays indptr, indices, data on the independent coordinates: an
+        ancfdrv.csr.Csr or a scipy matrix), the full pattern (row_ptr,
         col_index, 0-based), the solver and its policy, M on the solver's pattern, the frame
         of each reduced 3-vector (0: global; frames 1-based here) and the blocks' first dofs."""
         full_row_ptr, full_col = full_pattern

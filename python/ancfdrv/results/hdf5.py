@@ -239,11 +239,30 @@ def _mumps() -> str:
     return name
 
 
+def _scipy_version() -> str:
+    """scipy's version without importing scipy, which a dynamic run never needs (issue 23:
+    a run's memory): its ``version.py`` read as text (importlib.metadata would cost ~4 MB)."""
+    if "scipy" in sys.modules:
+        return sys.modules["scipy"].__version__
+    import importlib.util
+    spec = importlib.util.find_spec("scipy")
+    try:
+        text = (Path(spec.origin).parent / "version.py").read_text()
+    except (AttributeError, TypeError, OSError):
+        text = ""
+    for line in text.splitlines():
+        name, _, value = line.partition("=")
+        value = value.strip()
+        if name.strip() == "version" and value[:1] in ("'", '"'):
+            return value.strip("'\"")
+    import scipy
+    return scipy.__version__
+
+
 @functools.lru_cache(maxsize=1)
 def _static_provenance() -> dict[str, str]:
-    import scipy
     return {"git_commit": _git_commit(), "numpy_version": np.__version__,
-            "scipy_version": scipy.__version__, "h5py_version": h5py.__version__,
+            "scipy_version": _scipy_version(), "h5py_version": h5py.__version__,
             "hdf5_version": h5py.version.hdf5_version, "mumps": _mumps(),
             "compiler": _compiler(), "python_version": platform.python_version(),
             "platform": platform.platform()}

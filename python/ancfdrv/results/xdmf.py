@@ -36,9 +36,9 @@ from pathlib import Path
 
 import h5py
 import numpy as np
-import scipy.sparse as sp
 from h5py import h5a, h5d, h5p, h5s, h5t
 
+from ..csr import Csr
 from ..errors import InputError
 from ..io.safe_write import write_with
 from ..system.bodies import Beam, Plate, RigidBody
@@ -56,7 +56,7 @@ class MeshLayout:
     points: np.ndarray        # (npoints, 3) initial positions
     quads: np.ndarray         # (nquad, 4) point indices
     lines: np.ndarray         # (nline, 2) point indices
-    map: sp.csr_matrix        # (3 npoints, nfull): positions = map @ q_full
+    map: Csr                  # (3 npoints, nfull): positions = map @ q_full
     bodies: list[str]         # 'name: kind, points a..b' per body shown
 
     @classmethod
@@ -107,7 +107,7 @@ class MeshLayout:
                 bodies.append(f"{body.name}: {word}, points {start}..{count - 1}")
         if count == 0:
             return None
-        matrix = sp.csr_matrix((coefs, (rows, cols)), shape=(3 * count, model.nfull))
+        matrix = Csr.from_coo(rows, cols, coefs, (3 * count, model.nfull))
         points = (matrix @ model.q0).reshape(count, 3)
         return cls(points, _stack(quads, 4), _stack(lines, 2), matrix, bodies)
 

@@ -30,7 +30,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..errors import SolverError
 from ..kernel import DirectSolver
@@ -39,7 +38,9 @@ from .modal import DENSE_LIMIT, linearize, null_space
 from .static import StaticResult
 from .._lazy import LazyModule
 
-# imported on first use (ancfdrv._lazy): ~10 MB most runs never need
+# imported on first use (ancfdrv._lazy): ~10 MB most runs never need; scipy.sparse (~19 MB
+# with its import chain) too: a dynamic run imports this module but never solves here
+sp = LazyModule("scipy.sparse")
 la = LazyModule("scipy.linalg")
 spla = LazyModule("scipy.sparse.linalg")
 

@@ -39,11 +39,10 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-import scipy.sparse as sp
-from tqdm import tqdm
 
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
                      JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES)
+from ..csr import Csr
 from ..errors import Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver
@@ -168,15 +167,36 @@ class DynamicResult:
     floor_accepts: int = 0
 
 
-def _saddle_solve(model: Model, matrix: sp.spmatrix, rhs_top: np.ndarray,
+class _NoBar:
+    """The progress bar of a run that shows none (tqdm and its imports not loaded: ~1 MB)."""
+
+    def update(self, _n: float) -> None:
+        pass
+
+    def set_postfix(self, **_values) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+def _progress_bar(show: bool, total: float):
+    """tqdm's bar over the simulated time when shown, else a bar that does nothing."""
+    if not show:
+        return _NoBar()
+    from tqdm import tqdm
+    return tqdm(total=total, unit="s", desc="dynamics",
+                bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s [{elapsed}<{remaining}{postfix}]")
+
+
+def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
                   rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str):
     """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]."""
     n, ncon = model.ndof, len(model.constraints)
     _, rows, cols, grads = model.constraints.jacobian(e, n, t)
-    coo = matrix.tocoo()
-    r = np.concatenate([coo.row, cols, n + rows])
-    c = np.concatenate([coo.col, n + rows, cols])
-    v = np.concatenate([coo.data, -grads, -grads])
+    r = np.concatenate([matrix.row_index(), cols, n + rows])
+    c = np.concatenate([matrix.indices, n + rows, cols])
+    v = np.concatenate([matrix.data, -grads, -grads])
     with DirectSolver(n + ncon, r, c, what=what) as solver:
         solver.factorize(v)
         x = solver.solve(np.concatenate([rhs_top, rhs_bottom]))
@@ -187,7 +207,7 @@ def initial_acceleration(model: Model, e: np.ndarray, v: np.ndarray, t: float):
     """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma."""
     *_, gamma = model.constraints.evaluate(e, t, v)
     forces = model.forces(e, t, v)
-    return _saddle_solve(model, model.mass_matrix(), forces["external"] - forces["internal"],
+    return _saddle_solve(model, model.mass, forces["external"] - forces["internal"],
                          -gamma, e, t, "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]")
 
 
@@ -526,8 +546,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     timing["output"] += time.perf_counter() - t1
     total = int(round((settings.t_end - t0) / settings.dt))
     show = sys.stderr.isatty() if progress is None else progress
-    bar = tqdm(total=round(settings.t_end - t0, 9), unit="s", disable=not show, desc="dynamics",
-               bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s [{elapsed}<{remaining}{postfix}]")
+    bar = _progress_bar(show, round(settings.t_end - t0, 9))
     steps = newton = factorizations = jacobians = 0
     call_steps = min(settings.chunk_steps, 10)  # the first call measures a step's cost
     if settings.step not in ("fixed", "adaptive"):

@@ -38,7 +38,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..errors import SolverError
 from ..kernel import DirectSolver
@@ -46,7 +45,9 @@ from ..system.model import Model
 from .static import StaticResult, solve_newton
 from .._lazy import LazyModule
 
-# imported on first use (ancfdrv._lazy): ~10 MB most runs never need
+# imported on first use (ancfdrv._lazy): ~10 MB most runs never need; scipy.sparse (~19 MB
+# with its import chain) too: a dynamic run imports this module but never solves here
+sp = LazyModule("scipy.sparse")
 la = LazyModule("scipy.linalg")
 spla = LazyModule("scipy.sparse.linalg")
 
@@ -248,11 +249,12 @@ def steady_rotation_matrices(model: Model, rate: float, axis) -> tuple[sp.csr_ma
     from ..system.model import kron_scalar
     a = np.asarray(axis, dtype=float)
     a = a / np.linalg.norm(a)
-    mbar = kron_scalar(model.mass_matrix())
+    mbar = kron_scalar(model.mass)
     if mbar is None:
         raise SolverError("modal analysis about a steady rotation needs a mass matrix of "
                           "3 x 3 blocks c I3 (the coordinates of every body are position "
                           "vectors); this model's is not")
+    mbar = mbar.to_scipy()
     proj = np.eye(3) - np.outer(a, a)
     skew = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
     return (sp.kron(mbar, rate**2 * proj, format="csr"),

@@ -24,7 +24,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..errors import SolverError
 from ..io.validate import check_arguments
@@ -108,8 +107,7 @@ def residual_floor(model: Model, e: np.ndarray, k_values: np.ndarray, scale: flo
     rigid configuration, so the elastic force is the small difference of large terms: on
     the 28-node FFR boom the bound is 3.5e-9 where the measured floor is 3e-10 to 6e-10, and
     both grow with the mesh."""
-    magnitude = sp.coo_matrix((np.abs(k_values), (model.pattern.rows, model.pattern.col_index)),
-                              shape=(model.ndof, model.ndof)) @ np.abs(e)
+    magnitude = model.pattern.to_csr(np.abs(k_values)) @ np.abs(e)
     return float(np.finfo(float).eps * np.linalg.norm(magnitude) / max(scale, 1e-300))
 
 
@@ -437,14 +435,15 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     rel = np.concatenate([nonlinear, dep])
     nl = len(nonlinear)
     t0 = time.perf_counter()
-    stiffness = model.stiffness_matrix()
-    k_r = stiffness[rest]
-    k_rr, k_rd = k_r[:, rest].tocoo(), k_r[:, dep].toarray()
-    k_d = stiffness[dep]
-    k_dr, k_dd = k_d[:, rest], k_d[:, dep].toarray()
+    stiffness = model.pattern.to_csr(model.stiffness_values(0.0))   # (ancfdrv.csr: no scipy)
+    k_r = stiffness.take_rows(rest)
+    k_rr, k_rd = k_r.take_columns(rest), k_r.take_columns(dep).toarray()
+    k_d = stiffness.take_rows(dep)
+    k_dr, k_dd = k_d.take_columns(rest), k_d.take_columns(dep).toarray()
     constant = model.constant_force()
     timing["assembly"] += time.perf_counter() - t0
-    with DirectSolver(len(rest), k_rr.row, k_rr.col, what="split iteration K_RR") as solver:
+    with DirectSolver(len(rest), k_rr.row_index(), k_rr.indices,
+                      what="split iteration K_RR") as solver:
         try:
             t0 = time.perf_counter()
             solver.factorize(k_rr.data)

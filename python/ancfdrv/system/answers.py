@@ -48,7 +48,6 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..codes import CONSTRAINT_COORDINATE
 from .bodies import Beam, Plate, RigidBody
@@ -60,7 +59,9 @@ from .model import Model
 from .sections import Box, Circle, Rectangle, Tube
 from .._lazy import LazyModule
 
-# imported on first use (ancfdrv._lazy): ~10 MB most runs never need
+# imported on first use (ancfdrv._lazy): ~10 MB most runs never need; scipy.sparse (~19 MB)
+# only for the eliminated joints' reactions
+sp = LazyModule("scipy.sparse")
 spla = LazyModule("scipy.sparse.linalg")
 
 #: output.stations default: points per element where section forces are evaluated

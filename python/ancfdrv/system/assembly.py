@@ -11,11 +11,11 @@ from dataclasses import dataclass
 from typing import Iterable
 
 import numpy as np
-import scipy.sparse as sp
 
 from .. import kernel
 from ..codes import (CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE,
                      CONTACT_COUNTERS, POLICY_CONSTANT, POLICY_REFACTOR)
+from ..csr import Csr
 from ..errors import InputError
 from .bodies import Beam, Body, Ground, Leaf, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
@@ -140,8 +140,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     if reduction is None:
         mass = mass_full
     else:
-        b = reduction.matrix
-        mass = (b.T @ mass_full @ b).tocsr()
+        mass = reduction.matrix.congruence(mass_full)   # B^T M B, scipy's arithmetic
     mass.sort_indices()
 
     def reduce(v: np.ndarray) -> np.ndarray:
@@ -173,7 +172,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
 
 
 def _answer_inputs(model: Model, system, equations: list, elimination: Elimination,
-                   reduction, mass_full: sp.csr_matrix, constant_full: np.ndarray,
+                   reduction, mass_full: Csr, constant_full: np.ndarray,
                    driven_full: list) -> None:
     """What the joint reactions need besides the solution (``ancfdrv.system.answers``):
     the joints and the owner of every joint equation (by its name), the equations in the
@@ -402,7 +401,7 @@ register_set("plate", _add_plate)
 
 # -- mass and loads --------------------------------------------------------------------------
 def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern,
-          counters: Counter) -> sp.csr_matrix:
+          counters: Counter) -> Csr:
     """M in full coordinates: element masses, rigid bodies, point masses."""
     values = np.zeros(pattern.nnz)
     for info in sets:
@@ -437,7 +436,7 @@ def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern
         np.add.at(values, pattern.positions(rows.ravel(), cols.ravel()), block.ravel())
     for pm in masses:
         counters[pm.effect] += 1
-    return pattern.to_scipy(values)
+    return pattern.to_csr(values)
 
 
 def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counters: Counter,

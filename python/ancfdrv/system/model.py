@@ -12,10 +12,10 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from .. import kernel
 from ..codes import POLICY_CONSTANT, POLICY_REFACTOR
+from ..csr import Csr, unique_keys
 from ..errors import InputError, SolverError
 from .bodies import Beam, Body, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
@@ -112,18 +112,46 @@ class ProbeInfo:
     attachment: object = None
 
 
-def kron_scalar(mass: sp.csr_matrix) -> sp.csr_matrix | None:
+def kron_scalar(mass) -> Csr | None:
     """Mbar when M = kron(Mbar, I3) exactly (every 3 x 3 block a scalar times I3 over whole
-    3-vectors), else None."""
-    if mass.shape[0] % 3:
+    3-vectors), else None. ``mass``: a :class:`~ancfdrv.csr.Csr` or scipy sparse matrix;
+    Mbar without stored zeros, columns sorted."""
+    m = mass if isinstance(mass, Csr) else Csr.from_scipy(mass)
+    n = m.shape[0]
+    if n % 3:
         return None
-    scalar = sp.csr_matrix(mass[0::3, 0::3])
-    difference = sp.kron(scalar, sp.identity(3), format="csr") - mass
-    if difference.nnz and abs(difference).max() != 0.0:
+    rows, cols, vals = m.row_index(), m.indices, m.data
+    keep = vals != 0
+    rows, cols, vals = rows[keep], cols[keep], vals[keep]
+    corner = (rows % 3 == 0) & (cols % 3 == 0)
+    scalar = Csr.from_coo(rows[corner] // 3, cols[corner] // 3, vals[corner], (n // 3, n // 3))
+    # kron(Mbar, I3)'s nonzeros against M's: the same entries with the same values
+    s_rows, s_cols = scalar.row_index(), scalar.indices
+    kron_keys = ((3 * s_rows[:, None] + np.arange(3)) * n
+                 + 3 * s_cols[:, None] + np.arange(3)).ravel()
+    kron_vals = np.repeat(scalar.data, 3)
+    order = np.argsort(kron_keys, kind="stable")
+    keys = rows * n + cols
+    key_order = np.argsort(keys, kind="stable")
+    if len(keys) != len(kron_keys) or np.any(keys[key_order] != kron_keys[order]) \
+            or np.any(vals[key_order] != kron_vals[order]):
         return None
-    scalar.eliminate_zeros()
-    scalar.sort_indices()
     return scalar
+
+
+def _turned_difference(a: Csr, b: Csr, u: np.ndarray) -> float:
+    """max |A - U B U^T| for U block-diagonal with the 3 x 3 blocks u (one per 3-vector),
+    over the 3 x 3 blocks of A and B."""
+    nvec = len(u)
+    rows = np.concatenate([a.row_index(), b.row_index()])
+    cols = np.concatenate([a.indices, b.indices])
+    keys, _, block = unique_keys(rows // 3 * nvec + cols // 3)
+    part = np.repeat([0, 1], [a.nnz, b.nnz])
+    flat = ((part * len(keys) + block) * 3 + rows % 3) * 3 + cols % 3
+    dense = np.bincount(flat, weights=np.concatenate([a.data, b.data]),
+                        minlength=2 * 9 * len(keys)).reshape(2, len(keys), 3, 3)
+    turned = u[keys // nvec] @ dense[1] @ u[keys % nvec].transpose(0, 2, 1)
+    return float(np.abs(dense[0] - turned).max(initial=0.0))
 
 
 def length_scale(bodies: list[Body]) -> float:
@@ -158,7 +186,7 @@ class Model:
                  warnings: list[str], notes: list[str], bodies: list[Body], sets: list[SetInfo],
                  frames: list[FrameInfo], drives: list[Drive], q0: np.ndarray, e0: np.ndarray,
                  reduction: Reduction | None, full_pattern: Pattern, pattern: Pattern,
-                 mass: sp.csr_matrix, constant_force: np.ndarray, driven_forces: list,
+                 mass: Csr, constant_force: np.ndarray, driven_forces: list,
                  moments: list[MomentInfo], constraints: ConstraintSet, contact_pairs: list[dict],
                  probes: dict[str, ProbeInfo], point_masses: list, linear_joints: str,
                  response: tuple[str, int] | None = None,
@@ -243,8 +271,10 @@ class Model:
         return full if self.reduction is None else self.reduction.reduce(full)
 
     # -- matrices ---------------------------------------------------------------------------
-    def mass_matrix(self) -> sp.csr_matrix:
-        return self.mass.copy()
+    def mass_matrix(self):
+        """M on the independent coordinates, a scipy CSR matrix (a copy; imports
+        scipy.sparse; the run itself uses :attr:`mass`, a :class:`~ancfdrv.csr.Csr`)."""
+        return self.mass.to_scipy()
 
     def mass_values(self) -> np.ndarray:
         """M on the solvers' pattern."""
@@ -254,7 +284,8 @@ class Model:
         """The tangent (global coordinates) on the pattern at e (default e0) and t."""
         return self.forces(self.e0 if e is None else e, t, want_tangent=True)["tangent"]
 
-    def stiffness_matrix(self, t: float = 0.0) -> sp.csr_matrix:
+    def stiffness_matrix(self, t: float = 0.0):
+        """The tangent at e0 and t, a scipy CSR matrix (imports scipy.sparse)."""
         return self.pattern.to_scipy(self.stiffness_values(t))
 
     # -- forces -----------------------------------------------------------------------------
@@ -340,10 +371,10 @@ class Model:
         """Coordinates e the full coordinates q[dofs] depend on, and dq[dofs]/de there."""
         if self.reduction is None:
             return np.asarray(dofs), np.eye(len(dofs))
-        rows = self.reduction.matrix[dofs].tocoo()
-        cols = np.unique(rows.col)
+        rows = self.reduction.matrix.take_rows(dofs)
+        cols = np.unique(rows.indices)
         b = np.zeros((len(dofs), len(cols)))
-        b[rows.row, np.searchsorted(cols, rows.col)] = rows.data
+        b[rows.row_index(), np.searchsorted(cols, rows.indices)] = rows.data
         return cols, b
 
     # -- probes -----------------------------------------------------------------------------
@@ -398,11 +429,11 @@ class Model:
     def solver_frame_exact(self) -> bool:
         """Whether S in the solver frame is constant: B^T (M + K(phi)) B = U (B^T (M + K_c) B)
         U^T for a test turn of every moving frame (U: each reduced 3-vector's frame)."""
-        def reduced(values_full: np.ndarray) -> sp.csr_matrix:
-            m = self.full_pattern.to_scipy(values_full)
+        def reduced(values_full: np.ndarray) -> Csr:
+            m = self.full_pattern.to_csr(values_full)
             if self.reduction is not None:
-                m = self.reduction.matrix.T @ m @ self.reduction.matrix
-            return sp.csr_matrix(m)
+                m = self.reduction.matrix.congruence(m)
+            return m
 
         def stiffness(turn: float) -> np.ndarray:
             values = np.zeros(self.full_pattern.nnz)
@@ -417,14 +448,15 @@ class Model:
             return values
         turn = 0.9
         k_c, k_t = reduced(stiffness(0.0)), reduced(stiffness(turn))
-        blocks = [np.eye(3) if f == 0 else
-                  rotation_about(self.frames[f - 1].axis, turn) @ self.frames[f - 1].base
-                  for f in self.vector_frame]
-        u = sp.block_diag(blocks, format="csr")
-        scale = max(abs(k_c).max(), 1e-300)
+        turned = {f: rotation_about(self.frames[f - 1].axis, turn) @ self.frames[f - 1].base
+                  for f in set(self.vector_frame.tolist()) - {0}}
+        rotations = np.array([np.eye(3)] + [turned.get(f, np.eye(3))
+                                            for f in range(1, len(self.frames) + 1)])
+        u = rotations[self.vector_frame]          # (nvectors, 3, 3): U's diagonal blocks
+        scale = max(k_c.max_abs(), 1e-300)
         mass = self.mass
-        ok_k = abs(k_t - u @ k_c @ u.T).max() <= 1e-9 * scale
-        ok_m = abs(mass - u @ mass @ u.T).max() <= 1e-12 * max(abs(mass).max(), 1e-300)
+        ok_k = _turned_difference(k_t, k_c, u) <= 1e-9 * scale
+        ok_m = _turned_difference(mass, mass, u) <= 1e-12 * max(mass.max_abs(), 1e-300)
         return bool(ok_k and ok_m)
 
     def carry_vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -441,9 +473,7 @@ class Model:
         if any(s.kind == "ffr" for s in self.sets):   # (other kinds ignore their frame)
             return None
         if self.reduction is not None:
-            b = self.reduction.matrix.tocsc()
-            if (np.any(np.diff(b.indptr) != 1) or np.any(b.data != 1.0)
-                    or np.any(np.bincount(b.indices, minlength=self.nfull) > 1)):
+            if self.reduction.matrix.selection_columns() is None:
                 return None
         first, weight, position = [], [], []
         for body in self.bodies:

@@ -6,15 +6,17 @@ dofs, rigid bodies, contact pairs) with the scatter map of element matrices into
 34-37), choosing a dependent coordinate per equation after substituting the earlier ones, so
 chains and closed loops need no special case and an equation the others already imply is
 recognised as redundant. :func:`reduction_plan` forms the plan of B^T S B on the reduced
-pattern, which the kernel applies to every assembled matrix.
+pattern, which the kernel applies to every assembled matrix. Sparse matrices here are
+:class:`~ancfdrv.csr.Csr` (numpy arrays, scipy's arithmetic): a dynamic run never imports
+scipy.sparse (issue 23, a run's memory).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
+from ..csr import Csr
 from ..errors import InputError
 from .expressions import Scalar
 
@@ -43,11 +45,8 @@ class Pattern:
             k = b.shape[0]
             rows.append(np.repeat(b, k, axis=0).T.ravel())
             cols.append(np.tile(b, (k, 1)).T.ravel())
-        r, c = np.concatenate(rows), np.concatenate(cols)
-        matrix = sp.csr_matrix((np.ones(len(r), dtype=np.int8), (r, c)), shape=(n, n))
-        matrix.sum_duplicates()
-        matrix.sort_indices()
-        return cls(n, matrix.indptr, matrix.indices)
+        structure = Csr.structure(n, np.concatenate(rows), np.concatenate(cols))
+        return cls(n, structure.indptr, structure.indices)
 
     def positions(self, rows, cols) -> np.ndarray:
         """Positions of entries (rows, cols) in the values array (-1 when absent)."""
@@ -66,13 +65,20 @@ class Pattern:
             raise AssertionError("an element entry is missing from the pattern")
         return pos + 1
 
-    def values_of(self, matrix: sp.spmatrix) -> np.ndarray:
-        """Values of ``matrix`` on this pattern (entries outside it must be zero)."""
-        m = sp.csr_matrix(matrix)
-        return np.asarray(m[self.rows, self.col_index]).ravel()
+    def values_of(self, matrix) -> np.ndarray:
+        """Values of ``matrix`` (a :class:`~ancfdrv.csr.Csr` or scipy sparse matrix) on this
+        pattern (entries outside it must be zero)."""
+        m = matrix if isinstance(matrix, Csr) else Csr.from_scipy(matrix)
+        return m.values_at(self.rows, self.col_index)
 
-    def to_scipy(self, values: np.ndarray) -> sp.csr_matrix:
-        """A scipy CSR matrix with its own copy of the pattern."""
+    def to_csr(self, values: np.ndarray) -> Csr:
+        """The matrix of ``values`` on this pattern, with its own copy of the pattern."""
+        return Csr(np.array(values, dtype=float), self.col_index.copy(), self.row_ptr.copy(),
+                   (self.n, self.n))
+
+    def to_scipy(self, values: np.ndarray):
+        """A scipy CSR matrix with its own copy of the pattern (imports scipy.sparse)."""
+        import scipy.sparse as sp
         return sp.csr_matrix((np.array(values, dtype=float), self.col_index.copy(),
                               self.row_ptr.copy()), shape=(self.n, self.n))
 
@@ -85,7 +91,7 @@ class Reduction:
     """q = B e + q0 and the plan of B^T S B (source: full-pattern positions, target: reduced
     pattern positions, coefficient)."""
 
-    matrix: sp.csr_matrix          # B (nfull x nred)
+    matrix: Csr                    # B (nfull x nred; .to_scipy() for a scipy matrix)
     offset: np.ndarray             # q0 (nfull)
     independent: np.ndarray        # full index of each reduced coordinate
     pattern: Pattern               # of B^T S B
@@ -97,12 +103,12 @@ class Reduction:
     def expand(self, x: np.ndarray, with_offset: bool = True) -> np.ndarray:
         """Full coordinates (or, without the offset, velocities) from reduced ones; x may be
         (nred,) or (nt, nred)."""
-        full = (self.matrix @ np.asarray(x).T).T
+        full = self.matrix.matvec(np.asarray(x).T).T
         return full + self.offset if with_offset else full
 
     def reduce(self, full: np.ndarray) -> np.ndarray:
         """B^T Q (eq. 37)."""
-        return self.matrix.T @ full
+        return self.matrix.rmatvec(full)
 
 
 @dataclass
@@ -169,6 +175,20 @@ def eliminate(equations, q0: np.ndarray) -> Elimination:
     return result
 
 
+def _entry_pairs(entries: np.ndarray, f_rows: np.ndarray, f_cols: np.ndarray, ptr: np.ndarray,
+                 counts: np.ndarray, cols: np.ndarray, vals: np.ndarray):
+    """For the full entries (i, j) = (f_rows[k], f_cols[k]), k in ``entries`` (in that order):
+    every pair of a B entry (a) in row i and one (c) in row j, a-major, as (k, column of a,
+    column of c, B_ia B_jc); B's rows given by ptr, counts, cols, vals."""
+    per = counts[f_rows[entries]] * counts[f_cols[entries]]
+    source = np.repeat(entries, per)
+    local = np.arange(len(source)) - np.repeat(np.cumsum(per) - per, per)
+    width = counts[f_cols[source]]
+    at_a = ptr[f_rows[source]] + local // np.maximum(width, 1)
+    at_c = ptr[f_cols[source]] + local % np.maximum(width, 1)
+    return source, cols[at_a], cols[at_c], vals[at_a] * vals[at_c]
+
+
 def reduction_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
                    full_pattern: Pattern) -> Reduction:
     """B, q0 (checked against the initial configuration), the reduced pattern (structure of
@@ -190,36 +210,33 @@ def reduction_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
             rows.append(i)
             cols.append(column[i])
             vals.append(1.0)
-    b = sp.csr_matrix((vals, (rows, cols)), shape=(nfull, len(independent)))
-    b.sort_indices()
+    b = Csr.from_coo(rows, cols, vals, (nfull, len(independent)))
     mismatch = np.abs(b @ q0[independent] + offset - q0)
     if mismatch.max(initial=0.0) > 1e-9 * max(1.0, np.abs(q0).max(initial=0.0)):
         raise AssertionError(f"the reduction misses the initial configuration by "
                              f"{mismatch.max():.3e}")
-    p = sp.csr_matrix((np.ones(full_pattern.nnz), full_pattern.col_index, full_pattern.row_ptr),
-                      shape=(nfull, nfull))
-    babs = abs(b)
-    reduced = (babs.T @ p @ babs + sp.identity(b.shape[1])).tocsr()
-    reduced.sort_indices()
-    pattern = Pattern(b.shape[1], reduced.indptr, reduced.indices)
-    # plan: every full entry (i, j) and every pair of B entries in rows i and j
-    counts = np.diff(b.indptr)
+    # the reduced pattern: the structure of |B|^T P |B| (every pair of B's nonzeros in rows
+    # i and j of a full entry (i, j)) plus the diagonal
     f_rows, f_cols = full_pattern.rows, full_pattern.col_index
+    nonzero = b.data != 0
+    nz_counts = np.bincount(b.row_index()[nonzero], minlength=nfull)
+    _, pair_a, pair_c, _ = _entry_pairs(np.arange(full_pattern.nnz), f_rows, f_cols,
+                                        np.concatenate([[0], np.cumsum(nz_counts)]), nz_counts,
+                                        b.indices[nonzero], b.data[nonzero])
+    nred = len(independent)
+    diagonal = np.arange(nred)
+    reduced = Csr.structure(nred, np.concatenate([pair_a, diagonal]),
+                            np.concatenate([pair_c, diagonal]))
+    pattern = Pattern(nred, reduced.indptr, reduced.indices)
+    # plan: every full entry (i, j) and every pair of B entries in rows i and j; the entries
+    # whose rows hold one B entry each first, then the others (the order the kernel sums in)
+    counts = np.diff(b.indptr)
     simple = (counts[f_rows] == 1) & (counts[f_cols] == 1)
-    k = np.nonzero(simple)[0]
-    sources, targets, coefs = [k], [pattern.positions(b.indices[b.indptr[f_rows[k]]],
-                                                      b.indices[b.indptr[f_cols[k]]])], \
-        [b.data[b.indptr[f_rows[k]]] * b.data[b.indptr[f_cols[k]]]]
-    for kk in np.nonzero(~simple & (counts[f_rows] > 0) & (counts[f_cols] > 0))[0]:
-        ra = slice(b.indptr[f_rows[kk]], b.indptr[f_rows[kk] + 1])
-        rc = slice(b.indptr[f_cols[kk]], b.indptr[f_cols[kk] + 1])
-        a_cols, a_vals = b.indices[ra], b.data[ra]
-        c_cols, c_vals = b.indices[rc], b.data[rc]
-        sources.append(np.full(len(a_cols) * len(c_cols), kk))
-        targets.append(pattern.positions(np.repeat(a_cols, len(c_cols)),
-                                         np.tile(c_cols, len(a_cols))))
-        coefs.append(np.outer(a_vals, c_vals).ravel())
-    source, target, coef = np.concatenate(sources), np.concatenate(targets), np.concatenate(coefs)
+    order = np.concatenate([np.nonzero(simple)[0],
+                            np.nonzero(~simple & (counts[f_rows] > 0) & (counts[f_cols] > 0))[0]])
+    source, pair_a, pair_c, coef = _entry_pairs(order, f_rows, f_cols, b.indptr, counts,
+                                                b.indices, b.data)
+    target = pattern.positions(pair_a, pair_c)
     if (target < 0).any():
         raise AssertionError("reduced pattern misses an entry of B^T S B")
     return Reduction(b, offset, independent, pattern, source, target, coef, relations)
