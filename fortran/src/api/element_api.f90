@@ -739,15 +739,16 @@ subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kind
 end subroutine constraint_gradient_rows
 
 !> The constraint violation max |Phi| at each of nrow states (q_rows(:, r), times(r)), as the
-!> system's output row computes it (constraint_eval, first order only): one call for the
-!> rows of a modally reduced FFR run (python/ancfdrv/solvers/ffr_reduced.py), whose states
+!> system's output row computes it (the values of constraint_eval, through
+!> constraints' constraint_values: the layout checked once, each drive evaluated once a
+!> row): one call for the rows of a modally reduced FFR run (python/ancfdrv/solvers/ffr_reduced.py), whose states
 !> need only the constrained coordinates filled in.
 subroutine constraint_violation_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
                                      params, operand_const, term_ptr, term_dof, term_coef, &
                                      drive_kinds, drive_ptr, drive_data, q_rows, times, &
                                      violation, info)
   use ancf_kinds, only: dp
-  use constraints, only: constraint_eval
+  use constraints, only: constraint_values
   implicit none
   integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata, nrow
   integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
@@ -756,17 +757,15 @@ subroutine constraint_violation_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kin
   real(dp), intent(in) :: drive_data(ndata), q_rows(ndof, nrow), times(nrow)
   real(dp), intent(out) :: violation(nrow)
   integer, intent(out) :: info
-  real(dp) :: values(ncon), gradients(6, ncon), hessians(6, 6, ncon), phi_t(ncon)
-  real(dp) :: phi_tt(ncon), gamma(ncon)
+  real(dp), allocatable :: values(:, :)
   integer :: row
   violation = 0.0_dp
-  info = 0
+  allocate(values(ncon, nrow))
+  call constraint_values(ncon, nrow, kinds, drives, params, operand_const, term_ptr, &
+                         term_dof, term_coef, drive_kinds, drive_ptr, drive_data, q_rows, &
+                         times, values, info)
+  if (info /= 0 .or. ncon == 0) return
   do row = 1, nrow
-    call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
-                         term_coef, drive_kinds, drive_ptr, drive_data, q_rows(:, row), &
-                         q_rows(:, row), times(row), values, gradients, hessians, phi_t, &
-                         phi_tt, gamma, info, first_order_only=.true.)
-    if (info /= 0) return
-    if (ncon > 0) violation(row) = maxval(abs(values))
+    violation(row) = maxval(abs(values(:, row)))
   end do
 end subroutine constraint_violation_rows
