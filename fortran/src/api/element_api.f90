@@ -705,6 +705,30 @@ subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, ce
                        max_newton, eta, velocity, corrections, factorized, info, failed_step)
 end subroutine reduced_ffr_newmark
 
+!> The energies and the frame's power of a modally reduced FFR run's output rows
+!> (reduced_ffr_rows; python ancfdrv.solvers.ffr_reduced.RowMaps): kinetic, strain (with
+!> the P-delta cubic form when nused > 0), the frame's power and the loads' potential at
+!> nrow rows. used: 1-based indices into c = (1, sin psi, 1 - cos psi, eta).
+subroutine reduced_ffr_energy_rows(r, nrow, nused, nmono, rate, sin_psi, one_minus_cos, eta, &
+                                   velocity, kinetic_form, strain_form, power_form, used, &
+                                   table, load_constant, load_linear, kinetic, strain, power, &
+                                   load)
+  use ancf_kinds, only: dp
+  use reduced_ffr_rows, only: reduced_energy_rows
+  implicit none
+  integer, intent(in) :: r, nrow, nused, nmono
+  real(dp), intent(in) :: rate(nrow), sin_psi(nrow), one_minus_cos(nrow)
+  real(dp), intent(in) :: eta(r, nrow), velocity(r, nrow)
+  real(dp), intent(in) :: kinetic_form(1 + 2 * r, 1 + 2 * r)
+  real(dp), intent(in) :: strain_form(3 + r, 3 + r), power_form(3 + r, 3 + r)
+  integer, intent(in) :: used(nused)
+  real(dp), intent(in) :: table(nmono, 2), load_constant, load_linear(1 + r, 3)
+  real(dp), intent(out) :: kinetic(nrow), strain(nrow), power(nrow), load(nrow)
+  call reduced_energy_rows(r, nrow, nused, nmono, rate, sin_psi, one_minus_cos, eta, velocity, &
+                           kinetic_form, strain_form, power_form, used, table, load_constant, &
+                           load_linear, kinetic, strain, power, load)
+end subroutine reduced_ffr_energy_rows
+
 !> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r); the
 !> velocities zero): gradients(:, :, r) as constraint_evaluate returns them (first order
 !> only: no Hessians, Phi_t, gamma). One call for a chunk of output rows (the reactions of
