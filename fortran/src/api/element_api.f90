@@ -683,26 +683,29 @@ end subroutine cable_damped_forces
 
 !> Newmark stepping of a modally reduced FFR model (reduced_ffr_stepper; python
 !> ancfdrv.solvers.ffr_reduced): eta and its rate (r, steps + 1) from rest at 0, Newton
-!> corrections and factorizations per step. pdelta = 0: no P-delta remainder (pdelta_linear,
+!> corrections and factorizations per step; the load from its four patterns (columns of
+!> load_patterns) and the frame's psi'', psi'^2, sin psi, 1 - cos psi at each time. pdelta = 0: no P-delta remainder (pdelta_linear,
 !> pdelta_quadratic unused). info = 1: Newton failed at failed_step; 2: singular iteration
 !> matrix.
 subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
-                               pdelta, pdelta_linear, pdelta_quadratic, load, rate, accel, &
-                               tol, max_newton, eta, velocity, corrections, factorized, info, &
-                               failed_step)
+                               pdelta, pdelta_linear, pdelta_quadratic, load_patterns, rate, &
+                               accel, sin_psi, one_minus_cos, tol, max_newton, eta, velocity, &
+                               corrections, factorized, info, failed_step)
   use ancf_kinds, only: dp
   use reduced_ffr_stepper, only: reduced_newmark
   implicit none
   integer, intent(in) :: r, steps, pdelta, max_newton
   real(dp), intent(in) :: dt, beta, gamma, omega2(r), gyroscopic(r, r), centrifugal(r, r)
   real(dp), intent(in) :: pdelta_linear(r, r), pdelta_quadratic(r, r, r)
-  real(dp), intent(in) :: load(r, steps + 1), rate(steps + 1), accel(steps + 1), tol
+  real(dp), intent(in) :: load_patterns(r, 4), rate(steps + 1), accel(steps + 1), tol
+  real(dp), intent(in) :: sin_psi(steps + 1), one_minus_cos(steps + 1)
   real(dp), intent(out) :: eta(r, steps + 1), velocity(r, steps + 1)
   integer, intent(out) :: corrections(steps + 1), factorized(steps + 1)
   integer, intent(out) :: info, failed_step
   call reduced_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
-                       pdelta /= 0, pdelta_linear, pdelta_quadratic, load, rate, accel, tol, &
-                       max_newton, eta, velocity, corrections, factorized, info, failed_step)
+                       pdelta /= 0, pdelta_linear, pdelta_quadratic, load_patterns, rate, accel, &
+                       sin_psi, one_minus_cos, tol, max_newton, eta, velocity, corrections, &
+                       factorized, info, failed_step)
 end subroutine reduced_ffr_newmark
 
 !> The energies and the frame's power of a modally reduced FFR run's output rows

@@ -38,10 +38,10 @@ contains
     integer, parameter :: rows_per_block = 64
     real(dp) :: z(rows_per_block, 1 + 2 * r), c(rows_per_block, 3 + r)
     real(dp) :: pair(rows_per_block, max(nused * (nused + 1) / 2, 1))
-    real(dp) :: monomial(rows_per_block)
+    real(dp) :: monomial
     real(dp) :: cubic_strain(rows_per_block), cubic_power(rows_per_block)
     real(dp) :: linear(rows_per_block, 3), form(rows_per_block)
-    integer :: first, last, nb, i, j, k, at
+    integer :: first, last, nb, i, j, k, at, row
     do first = 1, nrow, rows_per_block
       last = min(nrow, first + rows_per_block - 1)
       nb = last - first + 1
@@ -75,9 +75,11 @@ contains
         do k = 1, nused
           do j = 1, k * (k + 1) / 2
             at = at + 1
-            monomial(1:nb) = pair(1:nb, j) * c(1:nb, used(k))
-            cubic_strain(1:nb) = cubic_strain(1:nb) + monomial(1:nb) * table(at, 1)
-            cubic_power(1:nb) = cubic_power(1:nb) + monomial(1:nb) * table(at, 2)
+            do row = 1, nb   ! one pass per monomial (no monomial array)
+              monomial = pair(row, j) * c(row, used(k))
+              cubic_strain(row) = cubic_strain(row) + monomial * table(at, 1)
+              cubic_power(row) = cubic_power(row) + monomial * table(at, 2)
+            end do
           end do
         end do
         strain(first:last) = strain(first:last) + cubic_strain(1:nb)

@@ -248,17 +248,19 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
     r = reduced.size
     lam = np.diag(reduced.omega_squared)
     gam, c2 = reduced.gyroscopic, reduced.centrifugal
-    force = (-accel[:, None] * reduced.euler_load - rate[:, None] ** 2 * reduced.centrifugal_load
-             - np.sin(psi)[:, None] * reduced.gravity_sin
-             + (1.0 - np.cos(psi))[:, None] * reduced.gravity_cos)
+    sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
     pd_lin, pd_quad = reduced.pdelta_linear, reduced.pdelta_quadratic
-    if engine == "kernel":
+    if engine == "kernel":   # the load formed in the stepper, step by step, as below
+        patterns = np.column_stack([reduced.euler_load, reduced.centrifugal_load,
+                                    reduced.gravity_sin, reduced.gravity_cos])
         steps_out = kernel.reduced_ffr_newmark(dt, beta, gamma, reduced.omega_squared, gam,
-                                               c2, pd_lin, pd_quad, force, rate, accel, tol,
-                                               max_newton)
+                                               c2, pd_lin, pd_quad, patterns, rate, accel,
+                                               sin, cos1, tol, max_newton)
         return _finish(reduced, times, steps_out["eta"], t0, steps_out)
     if engine != "python":
         raise SolverError(f"simulate: engine {engine!r} must be 'kernel' or 'python'")
+    force = (-accel[:, None] * reduced.euler_load - rate[:, None] ** 2 * reduced.centrifugal_load
+             - sin[:, None] * reduced.gravity_sin + cos1[:, None] * reduced.gravity_cos)
     # at rest in the static state: eta'' = g(0) (the kernel's start too)
     eta, vel, acc = np.zeros((steps + 1, r)), np.zeros(r), force[0].copy()
     velocity = np.zeros((steps + 1, r))
