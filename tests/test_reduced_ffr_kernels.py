@@ -200,3 +200,28 @@ def test_stepper_refuses_a_load_that_is_not_a_number():
     sin[7] = 0.5
     out = run()
     assert np.all(np.isfinite(out["eta"])) and 1 <= out["corrections"][1:].max() <= 3
+
+
+# -- the rows reuse the stepper's frame values ---------------------------------------------------
+def test_rows_with_the_simulated_frame_values_are_the_same_rows():
+    """RowMaps.rows given simulate's frame values (angle, rate, sin and 1 - cos of psi)
+    equals the rows that evaluate the drive themselves, bit for bit, across blocks."""
+    from conftest import INPUTS
+    from ancfdrv.builders import build_model
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.solvers import ffr_reduced
+    from ancfdrv.solvers.static import solve_newton
+    model = build_model(load_scene(INPUTS / "boom_luffing.nml", [
+        "beam.nodes=6", "solver.static_method=newton", "beam.geometric_stiffness=true"]))
+    reduced = ffr_reduced.reduce_ffr(model, solve_newton(model, tol=1e-12, max_iter=50), 2)
+    frame: dict = {}
+    out = ffr_reduced.simulate(reduced, 2.5, 1e-3, frame=frame)
+    assert set(frame) == {"angle", "rate", "sin", "one_minus_cos"}
+    assert np.ptp(frame["rate"]) > 0                  # the frame turns in these 2.5 s
+    rows = slice(3, 2503)                             # two blocks and a part
+    given = reduced.row_maps.rows(out["time"][rows], out["eta"][rows], out["velocity"][rows],
+                                  {k: v[rows] for k, v in frame.items()})
+    plain = reduced.row_maps.rows(out["time"][rows], out["eta"][rows], out["velocity"][rows])
+    for key, value in plain.items():
+        assert value.tobytes() == given[key].tobytes(), key
+    model.close()

@@ -231,7 +231,7 @@ def _pdelta_terms(model: Model, reduced: ReducedFFR, x_star: np.ndarray) -> None
 
 def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25,
              gamma: float = 0.5, tol: float = 1e-9, max_newton: int = 10,
-             engine: str = "kernel") -> dict[str, np.ndarray]:
+             engine: str = "kernel", frame: dict | None = None) -> dict[str, np.ndarray]:
     """Newmark (beta, gamma) from the static state at rest (the start's acceleration the
     consistent one, eta''(0) = g(0)); returns 'time', 'eta', 'velocity' (eta'), each
     probe's deflection in the frame (name -> (steps + 1, 3)) and, from the kernel, per step
@@ -239,7 +239,9 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
     loop (kernel.reduced_ffr_newmark); 'python': the same steps in numpy with full Newton
     (the reference of the test). tol: P-delta's Newton ends on a correction below tol times
     max(1, max |eta|) (the linear model's one solve is exact); on the boom 1e-9 moves the
-    tip by 4e-12 m from 1e-14, 1e-6 by 1.1e-9 m (measured)."""
+    tip by 4e-12 m from 1e-14, 1e-6 by 1.1e-9 m (measured). ``frame``: a dict that
+    receives the frame's values at the times, 'angle' (phi), 'rate', 'sin' and
+    'one_minus_cos' (of psi = phi - phi(0)), for the output rows (RowMaps.rows)."""
     t0 = time.perf_counter()
     steps = int(round(t_end / dt))
     times = np.arange(steps + 1) * dt
@@ -249,6 +251,8 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
     lam = np.diag(reduced.omega_squared)
     gam, c2 = reduced.gyroscopic, reduced.centrifugal
     sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
+    if frame is not None:
+        frame.update(angle=phi, rate=rate, sin=sin, one_minus_cos=cos1)
     pd_lin, pd_quad = reduced.pdelta_linear, reduced.pdelta_quadratic
     if engine == "kernel":   # the load formed in the stepper, step by step, as below
         patterns = np.column_stack([reduced.euler_load, reduced.centrifugal_load,
@@ -526,27 +530,36 @@ class RowMaps:
                 and not getattr(model, "force_elements", ()) and not model.contact_pairs
                 and not model.vector_loads and model.reduction is None)
 
-    def rows(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
+    def rows(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray,
+             frame: dict | None = None) -> dict:
         """Probes (n, nprobe, 3), deflections, energy (n, 11) without the works, the
         constraint violation (n,) and the frame's power (n,) at the rows: in blocks of
         ROW_BLOCK rows, whose temporaries (~250 kB at most) stay in the cache and are reused
-        by the allocator (blocks of 10,000 rows page-faulted a fresh mapping for each)."""
+        by the allocator (blocks of 10,000 rows page-faulted a fresh mapping for each).
+        ``frame``: the frame's values at these times as :func:`simulate` gives them
+        ('angle', 'rate', 'sin', 'one_minus_cos'; None: evaluated here, the same values)."""
         n = len(times)
         out = dict(probes=np.zeros((n, len(self.probes), 3)),
                    deflections=np.zeros((n, len(self.probes), 3)), energy=np.zeros((n, 11)),
                    violation=np.zeros(n), power=np.zeros(n))
         for a in range(0, n, ROW_BLOCK):
             b = slice(a, a + ROW_BLOCK)
-            for key, value in self._block(times[b], eta[b], velocity[b]).items():
+            part = None if frame is None else {k: v[b] for k, v in frame.items()}
+            for key, value in self._block(times[b], eta[b], velocity[b], part).items():
                 out[key][b] = value
         return out
 
-    def _block(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
+    def _block(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray,
+               frame: dict | None = None) -> dict:
         """:meth:`rows` of one block."""
-        phi, rate, _ = self.reduced.drive.values(times)
-        psi = phi - self.reduced.start_angle
+        if frame is None:
+            phi, rate, _ = self.reduced.drive.values(times)
+            psi = phi - self.reduced.start_angle
+            sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
+        else:
+            phi, rate = frame["angle"], frame["rate"]
+            sin, cos1 = frame["sin"], frame["one_minus_cos"]
         n = len(times)
-        sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
         # e at the needed coordinates, as expand() computes every coordinate
         if len(self.slots):
             sub = self.sub_pivot[None, :] + _turned(self.sub_a0[None, :] + eta @ self.sub_basis.T,
@@ -707,8 +720,10 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
     from .dynamic import Chunk, DynamicResult, _check_assumptions
     start = time.perf_counter()
     timing = {"setup": reduced.timing.get("reduce", 0.0), "stepping": 0.0, "output": 0.0}
+    frame: dict[str, np.ndarray] = {}
     out = simulate(reduced, settings.t_end, settings.dt, beta=settings.beta,
-                   gamma=settings.gamma, tol=settings.tol, max_newton=settings.max_newton)
+                   gamma=settings.gamma, tol=settings.tol, max_newton=settings.max_newton,
+                   frame=frame)
     timing["stepping"] = reduced.timing["simulate"]
     times, eta, velocity = out["time"], out["eta"], out["velocity"]
     stats = np.column_stack([out["corrections"], out["factorized"], out["factorized"]])
@@ -729,7 +744,8 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
             t1 = time.perf_counter()
             rows = slice(first, min(first + step, nrows))
             if maps is not None:
-                found = maps.rows(times[rows], eta[rows], velocity[rows])
+                found = maps.rows(times[rows], eta[rows], velocity[rows],
+                                  {k: v[rows] for k, v in frame.items()})
                 probes, deflections = found["probes"], found["deflections"]
                 energy, violation, power = found["energy"], found["violation"], found["power"]
                 e = ExpandedRows(reduced, times[rows], eta[rows])
