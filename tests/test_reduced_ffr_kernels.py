@@ -212,7 +212,7 @@ def test_rows_with_the_simulated_frame_values_are_the_same_rows():
     from ancfdrv.solvers import ffr_reduced
     from ancfdrv.solvers.static import solve_newton
     model = build_model(load_scene(INPUTS / "boom_luffing.nml", [
-        "beam.nodes=6", "solver.static_method=newton", "beam.geometric_stiffness=true"]))
+        "beam.nodes=7", "solver.static_method=newton", "beam.geometric_stiffness=true"]))
     reduced = ffr_reduced.reduce_ffr(model, solve_newton(model, tol=1e-12, max_iter=50), 2)
     frame: dict = {}
     out = ffr_reduced.simulate(reduced, 2.5, 1e-3, frame=frame)
