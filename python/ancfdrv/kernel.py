@@ -296,20 +296,23 @@ def moment_force(director, axis, magnitude):
 
 
 def reduced_ffr_newmark(dt: float, beta: float, gamma: float, omega2, gyroscopic,
-                        centrifugal, pdelta_linear, pdelta_quadratic, load, rate, accel,
-                        tol: float, max_newton: int) -> dict[str, np.ndarray]:
+                        centrifugal, pdelta_linear, pdelta_quadratic, load_patterns, rate,
+                        accel, sin_psi, one_minus_cos, tol: float,
+                        max_newton: int) -> dict[str, np.ndarray]:
     """Newmark stepping of a modally reduced FFR model (fortran reduced_ffr_stepper;
-    ancfdrv.solvers.ffr_reduced) from rest, the start's acceleration load[0]: 'eta' and
-    'velocity' (steps + 1, r), per step 'corrections' (Newton) and 'factorized' (0 or 1);
-    load (steps + 1, r), rate and accel (steps + 1,); pdelta_linear None: no P-delta
-    remainder."""
+    ancfdrv.solvers.ffr_reduced) from rest: 'eta' and 'velocity' (steps + 1, r), per step
+    'corrections' (Newton) and 'factorized' (0 or 1). The load at each time, formed in the
+    stepper as simulate forms it, is -accel l_e - rate^2 l_c - sin_psi l_s + one_minus_cos
+    l_k with load_patterns (r, 4) = (l_e, l_c, l_s, l_k); rate, accel, sin_psi and
+    one_minus_cos (steps + 1,); pdelta_linear None: no P-delta remainder."""
     r = len(omega2)
     pdelta = pdelta_linear is not None
     lin = _f(pdelta_linear) if pdelta else np.zeros((r, r), order="F")
     quad = _f(pdelta_quadratic) if pdelta else np.zeros((r, r, r), order="F")
     eta, velocity, corrections, factorized, info, step = _kernel.reduced_ffr_newmark(
         dt, beta, gamma, _f(omega2), _f(gyroscopic), _f(centrifugal), int(pdelta), lin, quad,
-        _f(np.asarray(load).T), _f(rate), _f(accel), tol, max_newton)
+        _f(load_patterns), _f(rate), _f(accel), _f(sin_psi), _f(one_minus_cos), tol,
+        max_newton)
     if info:
         what = "Newton did not converge" if info == 1 else "singular iteration matrix"
         raise SolverError(f"reduced FFR stepper: {what} at step {step}")

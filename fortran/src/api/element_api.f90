@@ -683,27 +683,54 @@ end subroutine cable_damped_forces
 
 !> Newmark stepping of a modally reduced FFR model (reduced_ffr_stepper; python
 !> ancfdrv.solvers.ffr_reduced): eta and its rate (r, steps + 1) from rest at 0, Newton
-!> corrections and factorizations per step. pdelta = 0: no P-delta remainder (pdelta_linear,
+!> corrections and factorizations per step; the load from its four patterns (columns of
+!> load_patterns) and the frame's psi'', psi'^2, sin psi, 1 - cos psi at each time. pdelta = 0: no P-delta remainder (pdelta_linear,
 !> pdelta_quadratic unused). info = 1: Newton failed at failed_step; 2: singular iteration
 !> matrix.
 subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
-                               pdelta, pdelta_linear, pdelta_quadratic, load, rate, accel, &
-                               tol, max_newton, eta, velocity, corrections, factorized, info, &
-                               failed_step)
+                               pdelta, pdelta_linear, pdelta_quadratic, load_patterns, rate, &
+                               accel, sin_psi, one_minus_cos, tol, max_newton, eta, velocity, &
+                               corrections, factorized, info, failed_step)
   use ancf_kinds, only: dp
   use reduced_ffr_stepper, only: reduced_newmark
   implicit none
   integer, intent(in) :: r, steps, pdelta, max_newton
   real(dp), intent(in) :: dt, beta, gamma, omega2(r), gyroscopic(r, r), centrifugal(r, r)
   real(dp), intent(in) :: pdelta_linear(r, r), pdelta_quadratic(r, r, r)
-  real(dp), intent(in) :: load(r, steps + 1), rate(steps + 1), accel(steps + 1), tol
+  real(dp), intent(in) :: load_patterns(r, 4), rate(steps + 1), accel(steps + 1), tol
+  real(dp), intent(in) :: sin_psi(steps + 1), one_minus_cos(steps + 1)
   real(dp), intent(out) :: eta(r, steps + 1), velocity(r, steps + 1)
   integer, intent(out) :: corrections(steps + 1), factorized(steps + 1)
   integer, intent(out) :: info, failed_step
   call reduced_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
-                       pdelta /= 0, pdelta_linear, pdelta_quadratic, load, rate, accel, tol, &
-                       max_newton, eta, velocity, corrections, factorized, info, failed_step)
+                       pdelta /= 0, pdelta_linear, pdelta_quadratic, load_patterns, rate, accel, &
+                       sin_psi, one_minus_cos, tol, max_newton, eta, velocity, corrections, &
+                       factorized, info, failed_step)
 end subroutine reduced_ffr_newmark
+
+!> The energies and the frame's power of a modally reduced FFR run's output rows
+!> (reduced_ffr_rows; python ancfdrv.solvers.ffr_reduced.RowMaps): kinetic, strain (with
+!> the P-delta cubic form when nused > 0), the frame's power and the loads' potential at
+!> nrow rows. used: 1-based indices into c = (1, sin psi, 1 - cos psi, eta).
+subroutine reduced_ffr_energy_rows(r, nrow, nused, nmono, rate, sin_psi, one_minus_cos, eta, &
+                                   velocity, kinetic_form, strain_form, power_form, used, &
+                                   table, load_constant, load_linear, kinetic, strain, power, &
+                                   load)
+  use ancf_kinds, only: dp
+  use reduced_ffr_rows, only: reduced_energy_rows
+  implicit none
+  integer, intent(in) :: r, nrow, nused, nmono
+  real(dp), intent(in) :: rate(nrow), sin_psi(nrow), one_minus_cos(nrow)
+  real(dp), intent(in) :: eta(r, nrow), velocity(r, nrow)
+  real(dp), intent(in) :: kinetic_form(1 + 2 * r, 1 + 2 * r)
+  real(dp), intent(in) :: strain_form(3 + r, 3 + r), power_form(3 + r, 3 + r)
+  integer, intent(in) :: used(nused)
+  real(dp), intent(in) :: table(nmono, 2), load_constant, load_linear(1 + r, 3)
+  real(dp), intent(out) :: kinetic(nrow), strain(nrow), power(nrow), load(nrow)
+  call reduced_energy_rows(r, nrow, nused, nmono, rate, sin_psi, one_minus_cos, eta, velocity, &
+                           kinetic_form, strain_form, power_form, used, table, load_constant, &
+                           load_linear, kinetic, strain, power, load)
+end subroutine reduced_ffr_energy_rows
 
 !> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r); the
 !> velocities zero): gradients(:, :, r) as constraint_evaluate returns them (first order
@@ -739,15 +766,16 @@ subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kind
 end subroutine constraint_gradient_rows
 
 !> The constraint violation max |Phi| at each of nrow states (q_rows(:, r), times(r)), as the
-!> system's output row computes it (constraint_eval, first order only): one call for the
-!> rows of a modally reduced FFR run (python/ancfdrv/solvers/ffr_reduced.py), whose states
+!> system's output row computes it (the values of constraint_eval, through
+!> constraints' constraint_values: the layout checked once, each drive evaluated once a
+!> row): one call for the rows of a modally reduced FFR run (python/ancfdrv/solvers/ffr_reduced.py), whose states
 !> need only the constrained coordinates filled in.
 subroutine constraint_violation_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
                                      params, operand_const, term_ptr, term_dof, term_coef, &
                                      drive_kinds, drive_ptr, drive_data, q_rows, times, &
                                      violation, info)
   use ancf_kinds, only: dp
-  use constraints, only: constraint_eval
+  use constraints, only: constraint_values
   implicit none
   integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata, nrow
   integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
@@ -756,17 +784,15 @@ subroutine constraint_violation_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kin
   real(dp), intent(in) :: drive_data(ndata), q_rows(ndof, nrow), times(nrow)
   real(dp), intent(out) :: violation(nrow)
   integer, intent(out) :: info
-  real(dp) :: values(ncon), gradients(6, ncon), hessians(6, 6, ncon), phi_t(ncon)
-  real(dp) :: phi_tt(ncon), gamma(ncon)
+  real(dp), allocatable :: values(:, :)
   integer :: row
   violation = 0.0_dp
-  info = 0
+  allocate(values(ncon, nrow))
+  call constraint_values(ncon, nrow, kinds, drives, params, operand_const, term_ptr, &
+                         term_dof, term_coef, drive_kinds, drive_ptr, drive_data, q_rows, &
+                         times, values, info)
+  if (info /= 0 .or. ncon == 0) return
   do row = 1, nrow
-    call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
-                         term_coef, drive_kinds, drive_ptr, drive_data, q_rows(:, row), &
-                         q_rows(:, row), times(row), values, gradients, hessians, phi_t, &
-                         phi_tt, gamma, info, first_order_only=.true.)
-    if (info /= 0) return
-    if (ncon > 0) violation(row) = maxval(abs(values))
+    violation(row) = maxval(abs(values(:, row)))
   end do
 end subroutine constraint_violation_rows

@@ -21,7 +21,7 @@ module constraints
   use matrix3, only: cross
   implicit none
   private
-  public :: constraint_eval, operand_values, drive_value
+  public :: constraint_eval, constraint_values, operand_values, drive_value
 
   integer, parameter, public :: constraint_kind_coordinate = 1, constraint_kind_distance = 2, &
                                 constraint_kind_cross = 3, constraint_kind_dot = 4
@@ -120,14 +120,15 @@ contains
           return
         end if
         ! (without a drive phi = 0: cos 0 = 1 and sin 0 = 0 exactly, without the calls)
+        ! (without a drive phi = 0: cos 0 = 1 and sin 0 = 0 exactly, without the calls)
         cos_phi = 1.0_dp
         sin_phi = 0.0_dp
         if (drives(c) /= 0) then
           cos_phi = cos(phi)
           sin_phi = sin(phi)
         end if
-        values(c) = x(1) - (params(1, c) + params(2, c) * cos_phi + params(3, c) * sin_phi &
-                            + params(4, c) * phi)
+        values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, cos_phi, &
+                                     sin_phi)
         gradients(1, c) = 1.0_dp
         if (.not. second) cycle
         phi_t(c) = -(-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * dphi
@@ -136,7 +137,8 @@ contains
       case (constraint_kind_distance)
         a = x(1:3) - x(4:6)
         length = params(1, c) + params(2, c) * phi
-        values(c) = dot_product(a, a) - length**2
+        values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, 1.0_dp, &
+                                     0.0_dp)
         gradients(1:3, c) = 2.0_dp * a
         gradients(4:6, c) = -2.0_dp * a
         if (.not. second) cycle
@@ -150,7 +152,8 @@ contains
         phi_tt(c) = -2.0_dp * (params(2, c) * dphi)**2 - 2.0_dp * length * params(2, c) * ddphi
       case (constraint_kind_cross)
         k = params(1:3, c)
-        values(c) = dot_product(k, cross(x(1:3), x(4:6)))
+        values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, 1.0_dp, &
+                                     0.0_dp)
         gradients(1:3, c) = cross(x(4:6), k)
         gradients(4:6, c) = cross(k, x(1:3))
         if (.not. second) cycle
@@ -159,8 +162,8 @@ contains
                                           -k(2), k(1), 0.0_dp], [3, 3])
         hessians(4:6, 1:3, c) = transpose(hessians(1:3, 4:6, c))
       case (constraint_kind_dot)
-        values(c) = dot_product(x(1:3), x(4:6)) - params(1, c)
-        if (drives(c) /= 0) values(c) = values(c) - params(2, c) * phi
+        values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, 1.0_dp, &
+                                     0.0_dp)
         gradients(1:3, c) = x(4:6)
         gradients(4:6, c) = x(1:3)
         if (.not. second) cycle
@@ -179,5 +182,116 @@ contains
       gamma(c) = -dot_product(v, matmul(hessians(:, :, c), v)) - phi_tt(c)
     end do
   end subroutine constraint_eval
+
+  !> The value of one constraint of kind ``kind`` (module doc) at its operands x and its
+  !> drive's value phi (driven: the constraint has a drive; without one phi = 0), with
+  !> cos_phi = cos(phi) and sin_phi = sin(phi) for the coordinate kind (1 and 0 exactly
+  !> without a drive; the callers evaluate them, once per drive where they can). The one
+  !> formula of constraint_eval and constraint_values; an unknown kind gives 0 (the callers
+  !> refuse it).
+  pure function constraint_value(kind, driven, p, x, phi, cos_phi, sin_phi) result(value)
+    integer, intent(in) :: kind
+    logical, intent(in) :: driven
+    real(dp), intent(in) :: p(:), x(6), phi, cos_phi, sin_phi
+    real(dp) :: value
+    real(dp) :: a(3), length
+    select case (kind)
+    case (constraint_kind_coordinate)
+      value = x(1) - (p(1) + p(2) * cos_phi + p(3) * sin_phi + p(4) * phi)
+    case (constraint_kind_distance)
+      a = x(1:3) - x(4:6)
+      length = p(1) + p(2) * phi
+      value = dot_product(a, a) - length**2
+    case (constraint_kind_cross)
+      value = dot_product(p(1:3), cross(x(1:3), x(4:6)))
+    case (constraint_kind_dot)
+      value = dot_product(x(1:3), x(4:6)) - p(1)
+      if (driven) value = value - p(2) * phi
+    case default
+      value = 0.0_dp
+    end select
+  end function constraint_value
+
+  !> The values Phi(e, t) alone at nrow states (e_rows(:, row), times(row)): what
+  !> constraint_eval returns as values, with the same arithmetic (constraint_value), for
+  !> the output rows' constraint check. The layout is checked once, each drive evaluated
+  !> once a row (its cos and sin too). info as constraint_eval's (at the first failing row).
+  pure subroutine constraint_values(ncon, nrow, kinds, drives, params, operand_const, &
+                                    term_ptr, term_dof, term_coef, drive_kinds, drive_ptr, &
+                                    drive_data, e_rows, times, values, info)
+    integer, intent(in) :: ncon, nrow, kinds(:), drives(:), term_ptr(:), term_dof(:)
+    integer, intent(in) :: drive_kinds(:), drive_ptr(:)
+    real(dp), intent(in) :: params(:, :), operand_const(:, :), term_coef(:), drive_data(:)
+    real(dp), intent(in) :: e_rows(:, :), times(:)
+    real(dp), intent(out) :: values(ncon, nrow)
+    integer, intent(out) :: info
+    real(dp) :: x(6), phi(size(drive_kinds)), cos_phi(size(drive_kinds))
+    real(dp) :: sin_phi(size(drive_kinds)), phi_c, cos_c, sin_c, unused_rate, unused_accel
+    logical :: evaluated(size(drive_kinds)), turned(size(drive_kinds))
+    integer :: c, d, row, s, k, drive_info
+    values = 0.0_dp
+    info = 0
+    if (ncon == 0) return
+    if (any(term_dof(1:term_ptr(6 * ncon + 1) - 1) < 1) .or. &
+        any(term_dof(1:term_ptr(6 * ncon + 1) - 1) > size(e_rows, 1))) then
+      info = 1
+      return
+    end if
+    do c = 1, ncon
+      if (kinds(c) < constraint_kind_coordinate .or. kinds(c) > constraint_kind_dot) then
+        info = c
+        return
+      end if
+      if (kinds(c) == constraint_kind_coordinate .and. &
+          term_ptr(6 * (c - 1) + 2) == term_ptr(6 * (c - 1) + 1)) then
+        info = c  ! no coordinate in the first operand
+        return
+      end if
+      if (drives(c) < 0 .or. drives(c) > size(drive_kinds)) then
+        info = c
+        return
+      end if
+    end do
+    do row = 1, nrow
+      evaluated = .false.
+      turned = .false.
+      do c = 1, ncon
+        d = drives(c)
+        phi_c = 0.0_dp
+        cos_c = 1.0_dp
+        sin_c = 0.0_dp
+        if (d /= 0) then
+          if (.not. evaluated(d)) then
+            call drive_value(d, drive_kinds, drive_ptr, drive_data, times(row), phi(d), &
+                             unused_rate, unused_accel, drive_info)
+            if (drive_info /= 0) then
+              info = -c
+              return
+            end if
+            evaluated(d) = .true.
+          end if
+          phi_c = phi(d)
+          if (kinds(c) == constraint_kind_coordinate) then
+            if (.not. turned(d)) then
+              cos_phi(d) = cos(phi(d))
+              sin_phi(d) = sin(phi(d))
+              turned(d) = .true.
+            end if
+            cos_c = cos_phi(d)
+            sin_c = sin_phi(d)
+          end if
+        end if
+        ! the operands, as operand_values sums them
+        do s = 1, 6
+          x(s) = operand_const(s, c)
+          do k = term_ptr(6 * (c - 1) + s), term_ptr(6 * (c - 1) + s + 1) - 1
+            x(s) = x(s) + term_coef(k) * e_rows(term_dof(k), row)
+          end do
+        end do
+        values(c, row) = constraint_value(kinds(c), d /= 0, params(:, c), x, phi_c, cos_c, &
+                                          sin_c)
+      end do
+    end do
+  end subroutine constraint_values
 
 end module constraints

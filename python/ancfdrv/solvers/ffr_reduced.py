@@ -231,7 +231,7 @@ def _pdelta_terms(model: Model, reduced: ReducedFFR, x_star: np.ndarray) -> None
 
 def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25,
              gamma: float = 0.5, tol: float = 1e-9, max_newton: int = 10,
-             engine: str = "kernel") -> dict[str, np.ndarray]:
+             engine: str = "kernel", frame: dict | None = None) -> dict[str, np.ndarray]:
     """Newmark (beta, gamma) from the static state at rest (the start's acceleration the
     consistent one, eta''(0) = g(0)); returns 'time', 'eta', 'velocity' (eta'), each
     probe's deflection in the frame (name -> (steps + 1, 3)) and, from the kernel, per step
@@ -239,7 +239,9 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
     loop (kernel.reduced_ffr_newmark); 'python': the same steps in numpy with full Newton
     (the reference of the test). tol: P-delta's Newton ends on a correction below tol times
     max(1, max |eta|) (the linear model's one solve is exact); on the boom 1e-9 moves the
-    tip by 4e-12 m from 1e-14, 1e-6 by 1.1e-9 m (measured)."""
+    tip by 4e-12 m from 1e-14, 1e-6 by 1.1e-9 m (measured). ``frame``: a dict that
+    receives the frame's values at the times, 'angle' (phi), 'rate', 'sin' and
+    'one_minus_cos' (of psi = phi - phi(0)), for the output rows (RowMaps.rows)."""
     t0 = time.perf_counter()
     steps = int(round(t_end / dt))
     times = np.arange(steps + 1) * dt
@@ -248,17 +250,21 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
     r = reduced.size
     lam = np.diag(reduced.omega_squared)
     gam, c2 = reduced.gyroscopic, reduced.centrifugal
-    force = (-accel[:, None] * reduced.euler_load - rate[:, None] ** 2 * reduced.centrifugal_load
-             - np.sin(psi)[:, None] * reduced.gravity_sin
-             + (1.0 - np.cos(psi))[:, None] * reduced.gravity_cos)
+    sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
+    if frame is not None:
+        frame.update(angle=phi, rate=rate, sin=sin, one_minus_cos=cos1)
     pd_lin, pd_quad = reduced.pdelta_linear, reduced.pdelta_quadratic
-    if engine == "kernel":
+    if engine == "kernel":   # the load formed in the stepper, step by step, as below
+        patterns = np.column_stack([reduced.euler_load, reduced.centrifugal_load,
+                                    reduced.gravity_sin, reduced.gravity_cos])
         steps_out = kernel.reduced_ffr_newmark(dt, beta, gamma, reduced.omega_squared, gam,
-                                               c2, pd_lin, pd_quad, force, rate, accel, tol,
-                                               max_newton)
+                                               c2, pd_lin, pd_quad, patterns, rate, accel,
+                                               sin, cos1, tol, max_newton)
         return _finish(reduced, times, steps_out["eta"], t0, steps_out)
     if engine != "python":
         raise SolverError(f"simulate: engine {engine!r} must be 'kernel' or 'python'")
+    force = (-accel[:, None] * reduced.euler_load - rate[:, None] ** 2 * reduced.centrifugal_load
+             - sin[:, None] * reduced.gravity_sin + cos1[:, None] * reduced.gravity_cos)
     # at rest in the static state: eta'' = g(0) (the kernel's start too)
     eta, vel, acc = np.zeros((steps + 1, r)), np.zeros(r), force[0].copy()
     velocity = np.zeros((steps + 1, r))
@@ -323,13 +329,20 @@ def check_scope(model: Model, static: StaticResult) -> None:
 
 def _turn(vectors: np.ndarray, axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     """Rot(axis, angle[i]) applied to every 3-vector of row i of vectors (nt, n)."""
-    y = vectors.reshape(len(vectors), -1, 3)
-    skew = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
-                     [-axis[1], axis[0], 0.0]])
-    # Rodrigues per row: I + sin W + (1 - cos) W^2, applied to every 3-vector at once
-    turn = (np.eye(3)[None] + np.sin(angle)[:, None, None] * skew[None]
-            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew)[None])
-    return np.matmul(y, np.transpose(turn, (0, 2, 1))).reshape(vectors.shape)
+    skew = _skew(axis)
+    return _turned(vectors, np.sin(angle), 1.0 - np.cos(angle), skew.T, (skew @ skew).T)
+
+
+def _turned(vectors: np.ndarray, sin: np.ndarray, one_minus_cos: np.ndarray,
+            skew_t: np.ndarray, skew2_t: np.ndarray) -> np.ndarray:
+    """Rodrigues per row, (I + sin W + (1 - cos) W^2) v = v + sin W v + (1 - cos) W^2 v on
+    every 3-vector v of row i of vectors (nt, n): W^T and (W^2)^T each applied to all the
+    rows' vectors in one product (a 3 x 3 product per row cost ~3,500 instructions each).
+    The one arithmetic of expand() and RowMaps' needed coordinates."""
+    nt = len(vectors)
+    flat = vectors.reshape(-1, 3)
+    return vectors + ((flat @ skew_t).reshape(nt, -1) * sin[:, None]
+                      + (flat @ skew2_t).reshape(nt, -1) * one_minus_cos[:, None])
 
 
 def expand(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray
@@ -481,17 +494,26 @@ class RowMaps:
         self.load_constant = -float(load @ pivot)
         rows = np.vstack([load, -_blocks(load, skew), _blocks(load, skew @ skew)])  # W^T = -W
         self.load_linear = -np.column_stack([rows @ a0, rows @ basis])       # (3, 1 + r)
+        # the turn of the needed coordinates (_block): W^T and (W^2)^T
+        self.skew_t, self.skew2_t = skew.T.copy(), (skew @ skew).T.copy()
+        # the kernel's reduced_ffr_energy_rows: the forms, Fortran ordered, once
+        from ..kernel import _f, _kernel
+        used, table = self.cubic if self.cubic is not None else \
+            (np.zeros(0, dtype=np.int64), np.zeros((1, 2)))
+        self._kernel = _kernel
+        self._energy_args = (
+            _f(self.kinetic), _f(self.strain), _f(self.power),
+            _f(np.asarray(used) + 1, np.int32) if len(used) else np.zeros(0, np.int32),
+            _f(table), float(self.load_constant), _f(self.load_linear.T))
         # the constraints on the coordinates self.slots (the kernel's layout, renumbered)
         self.ncon = len(model.constraints)
         if self.ncon:
-            from ..kernel import _f, _kernel
             cs = model.constraints
             ptr = np.concatenate([[0], np.cumsum([len(q) for q in cs.drive_params])]) + 1
             data = np.concatenate([np.asarray(q, dtype=float) for q in cs.drive_params]) \
                 if cs.drive_params else np.zeros(1)
             kinds = np.array(cs.drive_kinds or [0], dtype=np.int32)
             local = np.array([self.slot_of[int(d)] for d in lay.term_dof], dtype=np.int64)
-            self._kernel = _kernel
             self._constraint_args = (
                 _f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
                 _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
@@ -508,31 +530,42 @@ class RowMaps:
                 and not getattr(model, "force_elements", ()) and not model.contact_pairs
                 and not model.vector_loads and model.reduction is None)
 
-    def rows(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
+    def rows(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray,
+             frame: dict | None = None) -> dict:
         """Probes (n, nprobe, 3), deflections, energy (n, 11) without the works, the
         constraint violation (n,) and the frame's power (n,) at the rows: in blocks of
-        ROW_BLOCK rows, whose temporaries (~100 kB each) stay in the cache and are reused
-        by the allocator (blocks of 10,000 rows page-faulted a fresh mapping for each)."""
+        ROW_BLOCK rows, whose temporaries (~250 kB at most) stay in the cache and are reused
+        by the allocator (blocks of 10,000 rows page-faulted a fresh mapping for each).
+        ``frame``: the frame's values at these times as :func:`simulate` gives them
+        ('angle', 'rate', 'sin', 'one_minus_cos'; None: evaluated here, the same values)."""
         n = len(times)
         out = dict(probes=np.zeros((n, len(self.probes), 3)),
                    deflections=np.zeros((n, len(self.probes), 3)), energy=np.zeros((n, 11)),
                    violation=np.zeros(n), power=np.zeros(n))
         for a in range(0, n, ROW_BLOCK):
             b = slice(a, a + ROW_BLOCK)
-            for key, value in self._block(times[b], eta[b], velocity[b]).items():
+            part = None if frame is None else {k: v[b] for k, v in frame.items()}
+            for key, value in self._block(times[b], eta[b], velocity[b], part).items():
                 out[key][b] = value
         return out
 
-    def _block(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray) -> dict:
+    def _block(self, times: np.ndarray, eta: np.ndarray, velocity: np.ndarray,
+               frame: dict | None = None) -> dict:
         """:meth:`rows` of one block."""
-        phi, rate, _ = self.reduced.drive.values(times)
-        psi = phi - self.reduced.start_angle
+        if frame is None:
+            phi, rate, _ = self.reduced.drive.values(times)
+            psi = phi - self.reduced.start_angle
+            sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
+        else:
+            phi, rate = frame["angle"], frame["rate"]
+            sin, cos1 = frame["sin"], frame["one_minus_cos"]
         n = len(times)
-        sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
-        k = self.reduced.axis
         # e at the needed coordinates, as expand() computes every coordinate
-        sub = np.zeros((n, 0)) if not len(self.slots) else \
-            self.sub_pivot[None, :] + _turn(self.sub_a0[None, :] + eta @ self.sub_basis.T, k, psi)
+        if len(self.slots):
+            sub = self.sub_pivot[None, :] + _turned(self.sub_a0[None, :] + eta @ self.sub_basis.T,
+                                                    sin, cos1, self.skew_t, self.skew2_t)
+        else:
+            sub = np.zeros((n, 0))
         probes = np.zeros((n, len(self.probes), 3))
         deflections = np.zeros_like(probes)
         for i, (_, p) in enumerate(self.probes):
@@ -551,21 +584,12 @@ class RowMaps:
                 deflections[:, i, :] = v @ info.base - p.reference
             else:
                 deflections[:, i, :] = probes[:, i, :] - p.reference
+        # kinetic, strain (+ P-delta's cubic form), the frame's power and the loads'
+        # potential: the kernel's reduced_ffr_energy_rows, one pass over the rows
         energy = np.zeros((n, 11))
-        c = np.column_stack([rate, rate[:, None] * eta, velocity])
-        energy[:, 0] = 0.5 * np.einsum("ti,ti->t", c @ self.kinetic, c)
-        c = np.column_stack([np.ones(n), sin, cos1, eta])
-        energy[:, 1] = np.einsum("ti,ti->t", c @ self.strain, c)
-        power = rate * np.einsum("ti,ti->t", c @ self.power, c)
-        if self.cubic is not None:
-            used, table = self.cubic
-            both = _cubic_values(c[:, used], table)
-            energy[:, 1] += both[:, 0]
-            power += rate * both[:, 1]
-        ones = np.column_stack([np.ones(n), eta])
-        energy[:, 2] = self.load_constant + (
-            ones @ self.load_linear[0] + sin * (ones @ self.load_linear[1])
-            + cos1 * (ones @ self.load_linear[2]))
+        kinetic, strain, power, load = self._kernel.reduced_ffr_energy_rows(
+            np.asarray(rate, float), sin, cos1, eta.T, velocity.T, *self._energy_args)
+        energy[:, 0], energy[:, 1], energy[:, 2] = kinetic, strain, load
         for m in self.model.moments:
             director = sub[:, [self.slot_of[int(d)] for d in m.dofs]]
             energy[:, 3] -= m.magnitude * _moment_angle(director, m.axis, m.reference)
@@ -586,7 +610,8 @@ def _cubic_table(energy: np.ndarray, power: np.ndarray):
     c_i c_j c_k, i <= j <= k, of the coefficients summed over the index permutations;
     coefficients of c_i that are zero in every term (sin and 1 - cos with the pivot on the
     frame axis) left out. The pairs (i <= j) ordered by j, the monomials by k: those of a
-    given j or k are a prefix (:func:`_cubic_values`). Returns (used, (nmono, 2) table)."""
+    given j or k are a prefix (the order the kernel's reduced_ffr_energy_rows walks them).
+    Returns (used, (nmono, 2) table)."""
     import itertools
     weight = sum(np.abs(t).sum(axis=tuple(a for a in range(3) if a != axis))
                  for t in (energy, power) for axis in range(3))
@@ -601,24 +626,6 @@ def _cubic_table(energy: np.ndarray, power: np.ndarray):
     return used, np.column_stack([f[i, j, k] / repeats for f in full])
 
 
-def _cubic_values(c: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """(rows, 2): the monomials c_i c_j c_k (i <= j <= k, :func:`_cubic_table`'s order)
-    of the rows of c, built from prefixes (no gathers), times the table."""
-    rows, m = c.shape
-    square = np.empty((rows, m * (m + 1) // 2))
-    mono = np.empty((rows, len(table)))
-    at = 0
-    for j in range(m):
-        square[:, at:at + j + 1] = c[:, :j + 1] * c[:, j:j + 1]
-        at += j + 1
-    at = 0
-    for k in range(m):
-        width = (k + 1) * (k + 2) // 2
-        np.multiply(square[:, :width], c[:, k:k + 1], out=mono[:, at:at + width])
-        at += width
-    return mono @ table
-
-
 def _moment_angle(director: np.ndarray, axis: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """section_moment.moment_angle at rows of directors (n, 3): the angle about the axis
     from the reference to the director's projection, atan2(k . (q x p), q . p) with
@@ -631,8 +638,9 @@ def _moment_angle(director: np.ndarray, axis: np.ndarray, reference: np.ndarray)
 
 #: rows per output chunk of a reduced run computed in bulk (one write of the file each)
 BULK_ROWS = 65536
-#: rows per block of RowMaps.rows
-ROW_BLOCK = 1024
+#: rows per block of RowMaps.rows (2048: 6.1 ms for the 10 s boom's rows, 1024: 6.5, one
+#: block of 10,001: 10.7, its temporaries page-faulted afresh)
+ROW_BLOCK = 2048
 
 
 def _departure_bound(model: Model, reduced: ReducedFFR) -> tuple[float, np.ndarray]:
@@ -712,8 +720,10 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
     from .dynamic import Chunk, DynamicResult, _check_assumptions
     start = time.perf_counter()
     timing = {"setup": reduced.timing.get("reduce", 0.0), "stepping": 0.0, "output": 0.0}
+    frame: dict[str, np.ndarray] = {}
     out = simulate(reduced, settings.t_end, settings.dt, beta=settings.beta,
-                   gamma=settings.gamma, tol=settings.tol, max_newton=settings.max_newton)
+                   gamma=settings.gamma, tol=settings.tol, max_newton=settings.max_newton,
+                   frame=frame)
     timing["stepping"] = reduced.timing["simulate"]
     times, eta, velocity = out["time"], out["eta"], out["velocity"]
     stats = np.column_stack([out["corrections"], out["factorized"], out["factorized"]])
@@ -734,7 +744,8 @@ def integrate_reduced(model: Model, reduced: ReducedFFR, settings, *, sink=None,
             t1 = time.perf_counter()
             rows = slice(first, min(first + step, nrows))
             if maps is not None:
-                found = maps.rows(times[rows], eta[rows], velocity[rows])
+                found = maps.rows(times[rows], eta[rows], velocity[rows],
+                                  {k: v[rows] for k, v in frame.items()})
                 probes, deflections = found["probes"], found["deflections"]
                 energy, violation, power = found["energy"], found["violation"], found["power"]
                 e = ExpandedRows(reduced, times[rows], eta[rows])
