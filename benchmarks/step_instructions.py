@@ -37,6 +37,11 @@ CASES = {
     "boom7": BOOM + ["beam.nodes=7", "loads.tip_mass=50"],
     "pend5": PENDULUM + ["beam.nodes=5"],
     "pend17": PENDULUM + ["beam.nodes=17"],
+    # the peer harness's levels in full (issue 23: the pendulum 1 s, the spin-up W = 4 20 s)
+    "pend5full": PENDULUM[:-1] + ["beam.nodes=5", "solver.t_end=1.0"],
+    "pend17full": PENDULUM[:-1] + ["beam.nodes=17", "solver.t_end=1.0"],
+    "spin11": ["inputs/hard/spinup.nml", "spinup.omega=4", "beam.bending=cable",
+               "scene.planar=xy", "beam.nodes=11", "solver.dt=5e-3", "output.xdmf=.false."],
 }
 RUN = ("import sys; from ancfdrv.runner import run_scene; "
        "run_scene(sys.argv[1], sys.argv[3:], sys.argv[2], progress=False)")
