@@ -562,7 +562,7 @@ contains
           detail = lapack_info
           return
         end if
-        work%w_dlam = matmul(w, dlam(:, 1))
+        call sparse_columns_product(w, dlam(:, 1), work%w_dlam)
         call sparse_columns_product(sys%flexibility, work%w_dlam, work%back)
         call to_solver_frame(sys, rotations, work%back, .false., correction)
         correction = correction - direction
@@ -649,14 +649,20 @@ contains
     !> step; the residual and Phi stay exact, so the converged state does not depend on
     !> them); then C dlam = Phi_e z - Phi, correction = T F dlam - z.
     subroutine carry_schur()
+      integer :: c
       ! (the newton's associate names are not visible here: the work arrays by name)
       if (.not. carry_ready) then
         call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns)
         if (gather_blocks(work%carry_columns, work%w)) then
           ! within the factorization's flexibility S^{-1} E_c (the model's touched blocks
           ! hold each constrained vector whole): no solve
-          work%carry_flexibility = matmul(sys%flexibility, work%w)
-          work%carry_lu = matmul(transpose(work%w), matmul(sys%flexibility_cc, work%w))
+          ! (matmul's sums by the loops of sparse_columns_product and schur_complement:
+          ! the same numbers without the library calls and the temporary)
+          do c = 1, sys%ncon
+            call sparse_columns_product(sys%flexibility, work%w(:, c), &
+                                        work%carry_flexibility(:, c))
+          end do
+          call schur_complement(sys%flexibility_cc, work%w, work%flex_w, work%carry_lu)
         else
           work%carry_flexibility = work%carry_columns
           call solver_solve(sys%solver_handle, sys%ndof, sys%ncon, work%carry_flexibility, info, &
@@ -680,7 +686,7 @@ contains
       work%dlam(:, 1) = work%dlam(:, 1) - work%phi
       call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
                   lapack_info)
-      work%back = matmul(work%carry_flexibility, work%dlam(:, 1))
+      call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
       call carry_apply(sys, learned%carry_turn, work%back, .false., work%correction)
       work%correction = work%correction - work%direction
     end subroutine carry_schur
