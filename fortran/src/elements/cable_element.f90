@@ -48,7 +48,7 @@ module cable_element
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
-  public :: cable_damped_element_force, cable_rule
+  public :: cable_damped_element_force, cable_rule, cable_element_rows
 
   !> Gauss points per element.
   integer, parameter, public :: cable_points = 5
@@ -75,6 +75,10 @@ module cable_element
     real(dp) :: axial_stiffness = 0.0_dp, bending_stiffness = 0.0_dp
     logical :: tension_only = .false.
     type(cable_point_rule) :: rule
+    ! each element's shape rows at the rule's points (rule_rows: slope, second) and its
+    ! point weights (half_weight L), computed once per set (cable_element_rows): the same
+    ! numbers as in every call, without their eight divisions a point
+    real(dp), allocatable :: slope_rows(:, :, :), second_rows(:, :, :), weights(:, :)
   contains
     procedure :: element_forces => cable_element_forces
     procedure :: element_energy => cable_element_energy
@@ -113,6 +117,22 @@ contains
       rule%half_weight(p) = 0.5_dp * wg(p)
     end do
   end subroutine cable_rule
+
+  !> The set's per-element rows and weights (cable_set: slope_rows, second_rows (4, points,
+  !> nel), weights (points, nel)) from its rule and lengths.
+  pure subroutine cable_element_rows(set)
+    type(cable_set), intent(inout) :: set
+    integer :: el, p
+    allocate (set%slope_rows(4, cable_points, set%nel), set%second_rows(4, cable_points, set%nel), &
+              set%weights(cable_points, set%nel))
+    do el = 1, set%nel
+      do p = 1, cable_points
+        call rule_rows(set%rule, p, set%lengths(el), set%slope_rows(:, p, el), &
+                       set%second_rows(:, p, el))
+        set%weights(p, el) = set%rule%half_weight(p) * set%lengths(el)
+      end do
+    end do
+  end subroutine cable_element_rows
 
   !> The slope and second rows of cable_shape at the rule's point p for length L (the same
   !> numbers: the same numerators divided by the same powers of L).
@@ -477,10 +497,13 @@ contains
       return
     end if
     if (present(dissipation)) dissipation = 0.0_dp
-    if (.not. want_tangent .and. .not. set%tension_only .and. all(coords(3, :) == 0.0_dp)) then
-      call plane_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
-                               set%bending_stiffness, force, energy, info)
-      return
+    if (.not. want_tangent .and. .not. set%tension_only .and. allocated(set%weights)) then
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                 set%weights(:, el), set%axial_stiffness, &
+                                 set%bending_stiffness, force, energy, info)
+        return
+      end if
     end if
     call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
                             set%bending_stiffness, want_tangent, force, energy, tangent, info, &
@@ -492,10 +515,10 @@ contains
   !> components of the same expressions in the same order, the z components (+0 there:
   !> the z terms of the sums are +0) left out; the same numbers as rule_element_force, in
   !> two thirds of its vector arithmetic (issue 23: the planar cable's Newton corrections).
-  pure subroutine plane_element_force(q, length, rule, axial_stiffness, bending_stiffness, &
-                                      force, energy, info)
-    real(dp), intent(in) :: q(3, 4), length, axial_stiffness, bending_stiffness
-    type(cable_point_rule), intent(in) :: rule
+  pure subroutine plane_element_force(q, slope_rows, second_rows, weights, axial_stiffness, &
+                                      bending_stiffness, force, energy, info)
+    real(dp), intent(in) :: q(3, 4), slope_rows(4, cable_points), second_rows(4, cable_points)
+    real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
     real(dp), intent(out) :: force(:), energy
     integer, intent(out) :: info
     real(dp) :: slope(4), second(4), a(2), b(2), grad_a(2), grad_b(2), dg(4), dh(2), df(4)
@@ -505,8 +528,9 @@ contains
     force = 0.0_dp
     energy = 0.0_dp
     do p = 1, cable_points
-      call rule_rows(rule, p, length, slope, second)
-      weight = rule%half_weight(p) * length
+      slope = slope_rows(:, p)
+      second = second_rows(:, p)
+      weight = weights(p)
       a = matmul(q(1:2, :), slope)
       b = matmul(q(1:2, :), second)
       aa = dot_product(a, a)

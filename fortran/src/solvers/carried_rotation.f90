@@ -226,10 +226,21 @@ contains
     logical, intent(in) :: back
     real(dp), intent(out) :: y(:)
     real(dp) :: rotation(3, 3), v(3), w(3)
-    integer :: b, i
+    integer :: b, i, first, second
     rotation = turn
     if (back) rotation = transpose(turn)
     do b = 1, size(sys%carry_map, 2)
+      first = sys%carry_map(1, b)
+      second = sys%carry_map(2, b)
+      if (first > 0 .and. second > 0 .and. sys%carry_map(3, b) == 0) then
+        ! a vector of the xy plane (a planar reduction): the same sums with v(3) = 0,
+        ! without the general path's branches
+        v(1) = x(first)
+        v(2) = x(second)
+        y(first) = rotation(1, 1) * v(1) + rotation(1, 2) * v(2) + rotation(1, 3) * 0.0_dp
+        y(second) = rotation(2, 1) * v(1) + rotation(2, 2) * v(2) + rotation(2, 3) * 0.0_dp
+        cycle
+      end if
       do i = 1, 3
         v(i) = 0.0_dp
         if (sys%carry_map(i, b) > 0) v(i) = x(sys%carry_map(i, b))
