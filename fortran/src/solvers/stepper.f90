@@ -48,7 +48,7 @@ module stepper
     ! predict_accel): e'' of the two steps before the last (allocated once a step is done),
     ! the number of steps of size predict_step behind them (the extrapolations need equal
     ! steps) and the extrapolation that predicted the last step best
-    real(dp), allocatable :: accel_before(:), accel_before2(:)
+    real(dp), allocatable :: accel_before(:), accel_before2(:), accel_before3(:)
     real(dp) :: predict_step = 0.0_dp
     integer :: predict_history = 0
     integer :: predictor = 0
