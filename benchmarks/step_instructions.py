@@ -1,7 +1,9 @@
 """Instructions per time step of the kernel's stepping (callgrind; exact and independent of
 the machine's load), with the Newton corrections per step, for the small systems of
 issue 23 items 3-4: the luffing boom with the planar ANCF cable (4 and 7 nodes, 50 kg) and
-the flexible pendulum with the planar cable (5 and 17 nodes, dt = 1e-3).
+the flexible pendulum with the planar cable (5 and 17 nodes, dt = 1e-3), and the peer
+harness's levels in full (pend5full, pend17full: the pendulum's 1 s; spin11: the W = 4
+cable spin-up, 11 nodes, dt = 5e-3, 20 s).
 
     python benchmarks/step_instructions.py [--site DIR] [--cases boom4,pend5] [--output F]
 
