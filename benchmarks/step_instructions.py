@@ -1,7 +1,9 @@
 """Instructions per time step of the kernel's stepping (callgrind; exact and independent of
 the machine's load), with the Newton corrections per step, for the small systems of
 issue 23 items 3-4: the luffing boom with the planar ANCF cable (4 and 7 nodes, 50 kg) and
-the flexible pendulum with the planar cable (5 and 17 nodes, dt = 1e-3).
+the flexible pendulum with the planar cable (5 and 17 nodes, dt = 1e-3), and the peer
+harness's levels in full (pend5full, pend17full: the pendulum's 1 s; spin11: the W = 4
+cable spin-up, 11 nodes, dt = 5e-3, 20 s).
 
     python benchmarks/step_instructions.py [--site DIR] [--cases boom4,pend5] [--output F]
 
@@ -37,6 +39,11 @@ CASES = {
     "boom7": BOOM + ["beam.nodes=7", "loads.tip_mass=50"],
     "pend5": PENDULUM + ["beam.nodes=5"],
     "pend17": PENDULUM + ["beam.nodes=17"],
+    # the peer harness's levels in full (issue 23: the pendulum 1 s, the spin-up W = 4 20 s)
+    "pend5full": PENDULUM[:-1] + ["beam.nodes=5", "solver.t_end=1.0"],
+    "pend17full": PENDULUM[:-1] + ["beam.nodes=17", "solver.t_end=1.0"],
+    "spin11": ["inputs/hard/spinup.nml", "spinup.omega=4", "beam.bending=cable",
+               "scene.planar=xy", "beam.nodes=11", "solver.dt=5e-3", "output.xdmf=.false."],
 }
 RUN = ("import sys; from ancfdrv.runner import run_scene; "
        "run_scene(sys.argv[1], sys.argv[3:], sys.argv[2], progress=False)")

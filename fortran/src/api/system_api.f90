@@ -342,7 +342,7 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
-  use cable_element, only: cable_set, cable_rule
+  use cable_element, only: cable_set, cable_rule, cable_element_rows
   use system_store, only: store_get
   use kernel_errors, only: handle_text
   implicit none
@@ -384,6 +384,7 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
     message = 'system_add_cable_set: the Gauss rule of the elements is not available'
     return
   end if
+  call cable_element_rows(built)
   allocate (set, source=built)
   call append_set(sys, set, index)
 end subroutine system_add_cable_set
@@ -613,6 +614,7 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  integer :: i
   message = ' '
   call store_get(handle, sys, info)
   if (info /= 0) then

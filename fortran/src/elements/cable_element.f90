@@ -48,7 +48,7 @@ module cable_element
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
-  public :: cable_damped_element_force, cable_rule
+  public :: cable_damped_element_force, cable_rule, cable_element_rows
 
   !> Gauss points per element.
   integer, parameter, public :: cable_points = 5
@@ -75,6 +75,10 @@ module cable_element
     real(dp) :: axial_stiffness = 0.0_dp, bending_stiffness = 0.0_dp
     logical :: tension_only = .false.
     type(cable_point_rule) :: rule
+    ! each element's shape rows at the rule's points (rule_rows: slope, second) and its
+    ! point weights (half_weight L), computed once per set (cable_element_rows): the same
+    ! numbers as in every call, without their eight divisions a point
+    real(dp), allocatable :: slope_rows(:, :, :), second_rows(:, :, :), weights(:, :)
   contains
     procedure :: element_forces => cable_element_forces
     procedure :: element_energy => cable_element_energy
@@ -113,6 +117,22 @@ contains
       rule%half_weight(p) = 0.5_dp * wg(p)
     end do
   end subroutine cable_rule
+
+  !> The set's per-element rows and weights (cable_set: slope_rows, second_rows (4, points,
+  !> nel), weights (points, nel)) from its rule and lengths.
+  pure subroutine cable_element_rows(set)
+    type(cable_set), intent(inout) :: set
+    integer :: el, p
+    allocate (set%slope_rows(4, cable_points, set%nel), set%second_rows(4, cable_points, set%nel), &
+              set%weights(cable_points, set%nel))
+    do el = 1, set%nel
+      do p = 1, cable_points
+        call rule_rows(set%rule, p, set%lengths(el), set%slope_rows(:, p, el), &
+                       set%second_rows(:, p, el))
+        set%weights(p, el) = set%rule%half_weight(p) * set%lengths(el)
+      end do
+    end do
+  end subroutine cable_element_rows
 
   !> The slope and second rows of cable_shape at the rule's point p for length L (the same
   !> numbers: the same numerators divided by the same powers of L).
@@ -218,17 +238,29 @@ contains
     real(dp), intent(out) :: energy
     integer, intent(out) :: info
     real(dp) :: slope(4), second(4), a(3), b(3), weight, aa, bb, ab, strain
+    logical :: plane
     integer :: p
     info = 0
     energy = 0.0_dp
+    ! (in the plane z = 0 the z terms of the sums are +0: the x and y terms alone, the same
+    ! numbers)
+    plane = all(q(3, :) == 0.0_dp)
     do p = 1, cable_points
       call rule_rows(rule, p, length, slope, second)
       weight = rule%half_weight(p) * length
-      a = matmul(q, slope)
-      b = matmul(q, second)
-      aa = dot_product(a, a)
-      bb = dot_product(b, b)
-      ab = dot_product(a, b)
+      if (plane) then
+        a(1:2) = matmul(q(1:2, :), slope)
+        b(1:2) = matmul(q(1:2, :), second)
+        aa = dot_product(a(1:2), a(1:2))
+        bb = dot_product(b(1:2), b(1:2))
+        ab = dot_product(a(1:2), b(1:2))
+      else
+        a = matmul(q, slope)
+        b = matmul(q, second)
+        aa = dot_product(a, a)
+        bb = dot_product(b, b)
+        ab = dot_product(a, b)
+      end if
       strain = 0.5_dp * (aa - 1.0_dp)
       if (rope) then  ! (rope_point_derivatives' energy)
         strain = max(strain, 0.0_dp)
@@ -465,10 +497,70 @@ contains
       return
     end if
     if (present(dissipation)) dissipation = 0.0_dp
+    if (.not. want_tangent .and. .not. set%tension_only .and. allocated(set%weights)) then
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                 set%weights(:, el), set%axial_stiffness, &
+                                 set%bending_stiffness, force, energy, info)
+        return
+      end if
+    end if
     call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
                             set%bending_stiffness, want_tangent, force, energy, tangent, info, &
                             set%tension_only)
   end subroutine cable_element_forces
+
+  !> rule_element_force's force and energy (no tangent, not a rope) of an element in the
+  !> plane z = 0 (q(3, :) = 0, as in a scene reduced to the xy plane): the x and y
+  !> components of the same expressions in the same order, the z components (+0 there:
+  !> the z terms of the sums are +0) left out; the same numbers as rule_element_force, in
+  !> two thirds of its vector arithmetic (issue 23: the planar cable's Newton corrections).
+  pure subroutine plane_element_force(q, slope_rows, second_rows, weights, axial_stiffness, &
+                                      bending_stiffness, force, energy, info)
+    real(dp), intent(in) :: q(3, 4), slope_rows(4, cable_points), second_rows(4, cable_points)
+    real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
+    real(dp), intent(out) :: force(:), energy
+    integer, intent(out) :: info
+    real(dp) :: slope(4), second(4), a(2), b(2), grad_a(2), grad_b(2), dg(4), dh(2), df(4)
+    real(dp) :: weight, aa, bb, ab, strain, g, h, f, point_energy
+    integer :: p, i
+    info = 0
+    force = 0.0_dp
+    energy = 0.0_dp
+    do p = 1, cable_points
+      slope = slope_rows(:, p)
+      second = second_rows(:, p)
+      weight = weights(p)
+      a = matmul(q(1:2, :), slope)
+      b = matmul(q(1:2, :), second)
+      aa = dot_product(a, a)
+      bb = dot_product(b, b)
+      ab = dot_product(a, b)
+      if (aa <= 0.0_dp) then
+        info = 2
+        return
+      end if
+      ! (point_derivatives' expressions, component by component)
+      strain = 0.5_dp * (aa - 1.0_dp)
+      g = aa * bb - ab**2
+      h = aa**3
+      f = g / h
+      point_energy = 0.5_dp * axial_stiffness * strain**2 + 0.5_dp * bending_stiffness * f
+      dg(1:2) = 2.0_dp * bb * a - 2.0_dp * ab * b
+      dg(3:4) = 2.0_dp * aa * b - 2.0_dp * ab * a
+      dh = 6.0_dp * aa**2 * a
+      df(1:2) = dg(1:2) / h - g * dh / h**2
+      df(3:4) = dg(3:4) / h - g * 0.0_dp / h**2
+      grad_a = axial_stiffness * strain * a + 0.5_dp * bending_stiffness * df(1:2)
+      grad_b = 0.5_dp * bending_stiffness * df(3:4)
+      energy = energy + weight * point_energy
+      ! (add_point's force)
+      do i = 1, 4
+        force(3 * i - 2:3 * i - 1) = force(3 * i - 2:3 * i - 1) &
+                                     + weight * (slope(i) * grad_a + second(i) * grad_b)
+      end do
+    end do
+  end subroutine plane_element_force
 
   !> The element_set element_energy of a cable set: the energy-only pass (the damped set,
   !> given rates, through its force for the dissipation).

@@ -108,16 +108,42 @@ contains
     ! iterations X <- (g X + X^{-T} / g) / 2 (Higham 1986), a few hundred flops; the SVD
     ! where they do not settle on a rotation
     angle = 0.0_dp
-    call polar_factor(transpose(correlation), turn, settled)
-    if (settled) then
+    if (all([correlation(1, 3), correlation(2, 3), correlation(3, 1), correlation(3, 2)] &
+            == 0.0_dp)) then
+      ! vectors in the xy plane (a scene reduced to it): the rotation about z that
+      ! maximizes trace(R^T correlation^T), closed form (the polar iterations do not
+      ! settle on the nearly rank-one correlation of a straight beam, the SVD costs
+      ! ~4000 instructions a step)
+      call plane_rotation(correlation, turn)
       info = 0
     else
-      call svd_rotation(correlation, turn, info)
-      if (info /= 0) return
+      call polar_factor(transpose(correlation), turn, settled)
+      if (settled) then
+        info = 0
+      else
+        call svd_rotation(correlation, turn, info)
+        if (info /= 0) return
+      end if
     end if
     angle = acos(max(-1.0_dp, min(1.0_dp, 0.5_dp * (turn(1, 1) + turn(2, 2) + turn(3, 3) &
                                                      - 1.0_dp))))
   end subroutine carry_turn
+
+  !> The rotation about z, turn = [c -s 0; s c 0; 0 0 1], that maximizes
+  !> trace(turn^T correlation^T) = c (C11 + C22) + s (C12 - C21): the angle
+  !> atan2(C12 - C21, C11 + C22) (C = correlation, its z row and column zero but C33).
+  pure subroutine plane_rotation(correlation, turn)
+    real(dp), intent(in) :: correlation(3, 3)
+    real(dp), intent(out) :: turn(3, 3)
+    real(dp) :: theta
+    theta = atan2(correlation(1, 2) - correlation(2, 1), correlation(1, 1) + correlation(2, 2))
+    turn = 0.0_dp
+    turn(1, 1) = cos(theta)
+    turn(2, 1) = sin(theta)
+    turn(1, 2) = -turn(2, 1)
+    turn(2, 2) = turn(1, 1)
+    turn(3, 3) = 1.0_dp
+  end subroutine plane_rotation
 
   !> The rotation V diag(1, 1, d) U^T of correlation = U S V^T (d = det(V U^T)); info = 1:
   !> the SVD failed (turn = identity).
@@ -200,10 +226,21 @@ contains
     logical, intent(in) :: back
     real(dp), intent(out) :: y(:)
     real(dp) :: rotation(3, 3), v(3), w(3)
-    integer :: b, i
+    integer :: b, i, first, second
     rotation = turn
     if (back) rotation = transpose(turn)
     do b = 1, size(sys%carry_map, 2)
+      first = sys%carry_map(1, b)
+      second = sys%carry_map(2, b)
+      if (first > 0 .and. second > 0 .and. sys%carry_map(3, b) == 0) then
+        ! a vector of the xy plane (a planar reduction): the same sums with v(3) = 0,
+        ! without the general path's branches
+        v(1) = x(first)
+        v(2) = x(second)
+        y(first) = rotation(1, 1) * v(1) + rotation(1, 2) * v(2) + rotation(1, 3) * 0.0_dp
+        y(second) = rotation(2, 1) * v(1) + rotation(2, 2) * v(2) + rotation(2, 3) * 0.0_dp
+        cycle
+      end if
       do i = 1, 3
         v(i) = 0.0_dp
         if (sys%carry_map(i, b) > 0) v(i) = x(sys%carry_map(i, b))

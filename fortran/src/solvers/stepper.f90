@@ -44,11 +44,14 @@ module stepper
     ! to refresh it (in a row), the current back-off and the steps still to start with a
     ! fresh matrix
     integer :: reuse_failures = 0, reuse_backoff = 0, reuse_skip = 0
-    ! the predictor of refactorized systems without contact: e'' of the step before the
-    ! last (allocated once a step is done) and whether it predicted the last step better
-    ! than e''_n did
-    real(dp), allocatable :: accel_before(:)
-    logical :: predict_from_before = .false.
+    ! the predictor of refactorized systems without contact (time_integrator's
+    ! predict_accel): e'' of the two steps before the last (allocated once a step is done),
+    ! the number of steps of size predict_step behind them (the extrapolations need equal
+    ! steps) and the extrapolation that predicted the last step best
+    real(dp), allocatable :: accel_before(:), accel_before2(:), accel_before3(:)
+    real(dp) :: predict_step = 0.0_dp
+    integer :: predict_history = 0
+    integer :: predictor = 0
     ! the matrix carried with the system's rotation (carried_rotation): the carried vectors
     ! at the factorization and at the current step (3, nvec), the turn from them to the current step's predicted
     ! state and whether the step uses it (a turn above carry_threshold)

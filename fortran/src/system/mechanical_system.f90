@@ -102,6 +102,9 @@ module mechanical_system
     logical :: reduced = .false.
     integer, allocatable :: reduction_ptr(:), reduction_col(:)
     real(dp), allocatable :: reduction_values(:), reduction_offset(:)
+    ! a reduction that selects (each row of B empty or one entry 1): the column of each
+    ! full coordinate (0: fixed), for to_full and to_reduced; unallocated otherwise
+    integer, allocatable :: reduction_select(:)
     integer, allocatable :: plan_source(:), plan_target(:)
     real(dp), allocatable :: plan_coef(:)
     ! loads: constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
@@ -316,6 +319,17 @@ contains
       full = x
       return
     end if
+    if (allocated(sys%reduction_select)) then
+      ! a selection: the same sums (offset or 0, plus 1 x) without the row pointers
+      do i = 1, sys%nfull
+        total = 0.0_dp
+        if (with_offset) total = sys%reduction_offset(i)
+        k = sys%reduction_select(i)
+        if (k > 0) total = total + x(k)
+        full(i) = total
+      end do
+      return
+    end if
     ! (a scalar accumulator per row, from the offset or 0: the same sums, in a register)
     do i = 1, sys%nfull
       total = 0.0_dp
@@ -338,6 +352,14 @@ contains
       return
     end if
     x = 0.0_dp
+    if (allocated(sys%reduction_select)) then
+      ! a selection: the same sums (0 plus 1 full(i)) without the row pointers
+      do i = 1, sys%nfull
+        k = sys%reduction_select(i)
+        if (k > 0) x(k) = x(k) + full(i)
+      end do
+      return
+    end if
     do i = 1, sys%nfull
       do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
         x(sys%reduction_col(k)) = x(sys%reduction_col(k)) + sys%reduction_values(k) * full(i)

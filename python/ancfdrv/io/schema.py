@@ -294,7 +294,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "contraction": Key("float", 0.25, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                            "jacobian = 'reuse': refresh when a correction exceeds this fraction "
                            "of the previous one (0.25: an old matrix that contracts more slowly "
-                           "costs more corrections than a new one costs to factorize)"),
+                           "costs more corrections than a new one costs to factorize); from a "
+                           "step's third correction on the smaller of this and 0.1"),
         "carry": Key("str", "rotation", one_of("rotation", "off"),
                      "jacobian = 'reuse': 'rotation' turns the kept iteration matrix with the "
                      "system's rotation since it was factorized (absolute-coordinate models "
