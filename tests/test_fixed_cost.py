@@ -193,3 +193,110 @@ def test_a_full_disk_keeps_the_initial_row(tmp_path, monkeypatch):
             assert h5["dynamic/time"][0] == 0.0 and "step_size" in h5["dynamic"]
     finally:
         model.close()
+
+
+def _series(path):
+    """{name: (values, dtype, attributes, layout, maxshape)} of every /dynamic dataset."""
+    found = {}
+    with h5py.File(path, "r") as h5:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                found[name] = (obj[()], obj.dtype, dict(obj.attrs),
+                               obj.id.get_create_plist().get_layout(), obj.maxshape)
+        h5["dynamic"].visititems(visit)
+        found["@rows"] = h5["dynamic"].attrs["rows"]
+    return found
+
+
+@pytest.mark.parametrize("flush_rows", [10**6, 4])
+def test_last_flush_writes_what_extendable_series_hold(tmp_path, flush_rows):
+    """The writer's last flush (a run that ended) makes the series it writes not
+    extendable (compact when small, else contiguous), with the values, types, units and
+    row count of the extendable series a plain flush writes (the reference: the same
+    chunks through ``flush``; /dynamic/q, 51 rows of 48 numbers, is larger than
+    COMPACT_BYTES). With flush_rows = 4 the series are made by earlier flushes
+    during the run: they stay extendable (chunked) and the last flush appends to them."""
+    from test_lean_output import _chunks, cantilever
+    from ancfdrv.results.hdf5 import COMPACT_BYTES, DynamicWriter
+    from ancfdrv.solvers.dynamic import DynamicSettings
+    model = cantilever().assemble()
+    try:
+        chunks = _chunks(model, DynamicSettings(dt=1e-3, t_end=0.05, store_q=True),
+                         [3, 17, 30])
+        files = {}
+        for label in ("plain", "last"):
+            path = files[label] = tmp_path / f"{label}.h5"
+            with h5py.File(path, "w"):
+                pass
+            writer = DynamicWriter(path, model, True, flush_rows, xdmf=False, total_rows=51)
+            for chunk in chunks:
+                writer(chunk)
+            writer.flush() if label == "plain" else writer.flush_last()
+        plain, last = _series(files["plain"]), _series(files["last"])
+        assert plain.keys() == last.keys() and len(plain) > 15
+        assert int(last.pop("@rows")) == int(plain.pop("@rows")) == 51
+        layouts = set()
+        for name, (values, dtype, attrs, layout, maxshape) in last.items():
+            ref = plain[name]
+            assert values.shape == ref[0].shape and values.tobytes() == ref[0].tobytes(), name
+            assert dtype == ref[1] and attrs == ref[2], name
+            assert ref[3] == h5py.h5d.CHUNKED and ref[4][0] is None
+            if flush_rows < 51:   # made while the run went on: extendable, appended to
+                assert layout == h5py.h5d.CHUNKED and maxshape[0] is None, name
+            else:
+                assert maxshape == values.shape, name
+                assert layout == (h5py.h5d.COMPACT if values.nbytes <= COMPACT_BYTES
+                                  else h5py.h5d.CONTIGUOUS), name
+            layouts.add(layout)
+        assert layouts == ({h5py.h5d.CHUNKED} if flush_rows < 51 else
+                           {h5py.h5d.COMPACT, h5py.h5d.CONTIGUOUS})
+    finally:
+        model.close()
+
+
+def test_a_short_run_is_complete_after_its_one_flush(tmp_path):
+    """A run shorter than its first flush deadline writes its rows once, at its end: the
+    file is complete (status ok, every row of every series, the rows attribute, the
+    reactions), and the same as the file of a run whose writer flushes at every chunk
+    (FLUSH_SECONDS = 0: extendable series appended to), values bitwise."""
+    out = {}
+    for label, seconds in (("short", None), ("every_chunk", 0.0)):
+        path = out[label] = tmp_path / f"{label}.h5"
+        with pytest.MonkeyPatch.context() as patch:
+            if seconds is not None:
+                patch.setattr(results, "FLUSH_SECONDS", seconds)
+            runner.run_scene(INPUTS / "boom_luffing.nml", TINY, path, progress=False)
+    short, every = _series(out["short"]), _series(out["every_chunk"])
+    assert short.keys() == every.keys()
+    for name in short:
+        if name == "@rows":
+            assert int(short[name]) == int(every[name]) == 51
+            continue
+        assert short[name][0].tobytes() == every[name][0].tobytes(), name
+        assert short[name][2] == every[name][2], name
+        if name in ("time", "probes/tip", "lambda", "energy/total"):
+            assert short[name][3] != h5py.h5d.CHUNKED and every[name][3] == h5py.h5d.CHUNKED
+    with h5py.File(out["short"], "r") as h5:
+        assert h5.attrs["status"] == "ok" and h5["dynamic"].attrs["status"] == "ok"
+        assert len(h5["dynamic/time"]) == 51 and h5["dynamic/time"][-1] == pytest.approx(0.05)
+        assert len(h5["dynamic/reactions/A1/force"]) == 51
+
+
+def test_subgroup_is_the_group_h5py_makes(tmp_path):
+    """_subgroup (low-level) makes the group h5py's create_group makes: the same times
+    tracking, creation order not tracked, an ASCII link; an existing group is returned as
+    is."""
+    path = tmp_path / "g.h5"
+    with h5py.File(path, "w") as h5:
+        ours = results._subgroup(h5, "ours")
+        theirs = h5.create_group("theirs")
+        assert results._subgroup(h5, "ours") == ours
+        results._subgroup(ours, "inner")
+        assert results._has(h5, "ours") and not results._has(h5, "none")
+        assert results._has(ours, "inner")
+        made = [(p.get_obj_track_times(), p.get_link_creation_order(),
+                 p.get_attr_creation_order())
+                for p in (ours.id.get_create_plist(), theirs.id.get_create_plist())]
+        assert made[0] == made[1] and made[0][1:] == (0, 0)
+        info = {name: h5.id.links.get_info(name.encode()).cset for name in ("ours", "theirs")}
+        assert info["ours"] == info["theirs"] == h5py.h5t.CSET_ASCII
