@@ -23,7 +23,9 @@ two warm-up calls (collection switched on and off around them by callgrind's cli
 request, from a tiny C helper compiled with the system's ``cc``): per call the total, the
 kernel's stepping (``system_advance_``, inclusive) and the rest ("non-stepping"); needs
 valgrind and its headers. A call here is what ``benchmarks/peer_exudyn.py`` times: the
-run, then the tip history read back. Caveat: callgrind counts every iteration of a
+run, then the tip history read back. ``FLUSH_SECONDS`` is raised in the counted process (a
+run lasts ~50 times longer under valgrind and would flush by the clock where a quiet
+machine's run ends before its first flush deadline). Caveat: callgrind counts every iteration of a
 ``rep stos`` as an instruction, so large ``memset``s (HDF5 zeroes its caches) weigh more
 than their time.
 
@@ -82,6 +84,10 @@ def counted_calls(case: str, helper: str) -> None:
     """The child of :func:`instructions`: warm-up calls, then INSTRUCTION_CALLS calls with
     callgrind's collection on."""
     import ctypes
+    import ancfdrv.results.hdf5 as h5
+    # under valgrind a run lasts ~50 times longer and its writer would flush by the clock
+    # (FLUSH_SECONDS) where a quiet machine's run ends first: the rows wait for the end
+    h5.FLUSH_SECONDS = 1e9
     toggle = ctypes.CDLL(helper).callgrind_toggle
     out = Path(tempfile.mkdtemp()) / "run.h5"
     for _ in range(2):

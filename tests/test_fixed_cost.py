@@ -300,3 +300,51 @@ def test_subgroup_is_the_group_h5py_makes(tmp_path):
         assert made[0] == made[1] and made[0][1:] == (0, 0)
         info = {name: h5.id.links.get_info(name.encode()).cset for name in ("ours", "theirs")}
         assert info["ours"] == info["theirs"] == h5py.h5t.CSET_ASCII
+
+
+def test_a_short_chunk_waits_for_the_next_one():
+    """The answers recorder records a chunk of 2..WAIT_ROWS rows with the next chunk (one
+    pass instead of two) and a chunk still waiting when the answers are read
+    (``complete``): the reactions, section forces and stress envelope are bitwise those
+    of a recorder that records every chunk at once (WAIT_ROWS = 0), for a run that ends
+    after a long chunk and for one that ends with a short chunk still waiting."""
+    from test_lean_output import _chunks, cantilever
+    from ancfdrv.solvers.dynamic import DynamicSettings
+    from ancfdrv.system.answers import DynamicAnswers
+    model = cantilever().assemble()
+    try:
+        settings = DynamicSettings(dt=1e-3, t_end=0.05, store_q=True)
+        for sizes in ([10, 30], [10, 30, 5]):
+            chunks = _chunks(model, settings, sizes)
+            recorded = {}
+            for label, wait in (("waiting", DynamicAnswers.WAIT_ROWS), ("each", 0)):
+                recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
+                                          alpha_m=0.0, alpha_f=0.0, keep_sections=True)
+                recorder.WAIT_ROWS = wait
+                passes = []
+                real = recorder._record
+                recorder._record = lambda chunk: (passes.append(len(chunk.time)),
+                                                  real(chunk))
+                for chunk in chunks:
+                    recorder(chunk)
+                recorder.complete()
+                recorded[label] = (recorder, passes)
+            (ours, ours_passes), (each, each_passes) = recorded["waiting"], recorded["each"]
+            assert each_passes == [1, *sizes]
+            assert ours_passes == [1, 40] + ([5] if len(sizes) == 3 else [])
+            assert ours.time == each.time and len(ours.time) == 1 + sum(sizes)
+            for name in each.reactions:
+                a = [np.concatenate([c[k] for c in ours.reactions[name]]) for k in (0, 1)]
+                b = [np.concatenate([c[k] for c in each.reactions[name]]) for k in (0, 1)]
+                assert all(x.tobytes() == y.tobytes() for x, y in zip(a, b))
+            for name in each.sections:
+                for key in ("N", "T", "Q", "M"):
+                    x = np.concatenate([getattr(c, key) for c in ours.sections[name]])
+                    y = np.concatenate([getattr(c, key) for c in each.sections[name]])
+                    assert x.tobytes() == y.tobytes()
+            for name, (s, best, when) in each.envelope.items():
+                s2, best2, when2 = ours.envelope[name]
+                assert best2.tobytes() == best.tobytes() and when2.tobytes() == when.tobytes()
+            assert each.reactions and each.envelope
+    finally:
+        model.close()

@@ -1132,7 +1132,19 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
 def write_dynamic_answers(path: Path, recorder) -> None:
     """/dynamic/reactions/<joint> (leading time axis), /dynamic/sections/<beam> (when the
     recorder keeps them) and the stress envelope /dynamic/stress/<beam> (von_mises_max,
-    t_max per station; attributes max, s_max, t_max) of a DynamicAnswers recorder."""
+    t_max per station; attributes max, s_max, t_max) of a DynamicAnswers recorder (a
+    chunk still waiting in it recorded first: ``recorder.complete()``; when that fails,
+    as when a chunk fails in the runner's sink, the answers are not written and the
+    model's warnings say why)."""
+    complete = getattr(recorder, "complete", None)
+    if complete is not None:
+        from ..errors import AncfError
+        try:
+            complete()
+        except (AncfError, ValueError, FloatingPointError) as exc:
+            recorder.model.warnings.append(f"dynamic reactions, section forces and stresses "
+                                           f"not recorded: {exc}")
+            return
     if not recorder.time:
         return
     with _open_write(path) as h5:
