@@ -348,3 +348,28 @@ def test_a_short_chunk_waits_for_the_next_one():
             assert each.reactions and each.envelope
     finally:
         model.close()
+
+
+def test_a_last_flush_without_rows_makes_every_series(tmp_path):
+    """A run that stops before any row (its last flush has nothing to write) still gets
+    every series, empty, with the types and units a plain flush gives them."""
+    from test_lean_output import cantilever
+    from ancfdrv.results.hdf5 import DynamicWriter
+    model = cantilever().assemble()
+    try:
+        found = {}
+        for label in ("plain", "last"):
+            path = tmp_path / f"{label}.h5"
+            with h5py.File(path, "w"):
+                pass
+            writer = DynamicWriter(path, model, True, 10**6, xdmf=False, total_rows=21)
+            writer.flush() if label == "plain" else writer.flush_last()
+            found[label] = _series(path)
+        assert found["plain"].keys() == found["last"].keys() and len(found["last"]) > 15
+        assert int(found["last"].pop("@rows")) == int(found["plain"].pop("@rows")) == 0
+        for name, (values, dtype, attrs, _, _) in found["last"].items():
+            ref = found["plain"][name]
+            assert len(values) == 0 and values.shape == ref[0].shape, name
+            assert dtype == ref[1] and attrs == ref[2], name
+    finally:
+        model.close()
