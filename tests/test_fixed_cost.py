@@ -373,3 +373,34 @@ def test_a_last_flush_without_rows_makes_every_series(tmp_path):
             assert dtype == ref[1] and attrs == ref[2], name
     finally:
         model.close()
+
+
+@pytest.mark.parametrize("sizes", [[], [3], [3, 17]], ids=["no rows", "one flush", "two"])
+def test_q_last_holds_the_last_row(tmp_path, sizes):
+    """/dynamic/q_last (the coordinates carried, not written as /dynamic/q): made by the
+    first flush with the last row's q and rewritten by each later one; a writer without
+    rows still makes it (zeros, as before: it was made empty by the writer's set-up)."""
+    from test_lean_output import _chunks, cantilever
+    from ancfdrv.results.hdf5 import DynamicWriter
+    from ancfdrv.solvers.dynamic import DynamicSettings
+    model = cantilever().assemble()
+    try:
+        chunks = _chunks(model, DynamicSettings(dt=1e-3, t_end=0.02, store_q=True),
+                         sizes) if sizes else []
+        path = tmp_path / "q.h5"
+        with h5py.File(path, "w"):
+            pass
+        writer = DynamicWriter(path, model, True, 4, xdmf=False, total_rows=21,
+                               write_q=False)
+        expected = np.zeros(model.ndof) if not chunks else np.array(chunks[-1].q[-1])
+        for chunk in chunks:
+            writer(chunk)
+        writer.flush_last()
+        with h5py.File(path, "r") as h5:
+            assert "q" not in h5["dynamic"]
+            q_last = h5["dynamic/q_last"]
+            assert q_last.attrs["units"] == results.COORDINATE_UNITS
+            assert q_last[()].tobytes() == expected.tobytes()
+            assert len(h5["dynamic/time"]) == (1 + sum(sizes) if sizes else 0)
+    finally:
+        model.close()

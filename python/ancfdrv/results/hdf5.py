@@ -702,6 +702,9 @@ class DynamicWriter:
         self.frames = 0
         self.energy_names = ENERGY_NAMES
         self.rows = 0
+        self.ndof = model.ndof
+        self._q_last = bool(store_q and not self.write_q)   # /dynamic/q_last is written
+        self._q_last_made = False
         self._pending: list[Any] = []
         self._pending_rows = 0
         self._last_write = time.monotonic()
@@ -764,9 +767,9 @@ class DynamicWriter:
                     "points": "\n".join(model.contact_point_names)}
             if self.write_q:
                 series("q", COORDINATE_UNITS, (ndof,))
-            elif store_q:  # where a run that stops between XDMF frames ends
-                _new_dataset(group, "q_last", shape=(ndof,), dtype="f8",
-                             units=COORDINATE_UNITS)
+            # q_last (store_q without write_q): where a run that stops between XDMF frames
+            # ends; made by the first flush with its value, as the series (not made here
+            # and reopened by every flush: ~0.2 ms of a short run)
             if self.nnodes:  # points of every body per frame, for ParaView (XDMF)
                 write_layout(h5, self.layout)
                 for name in ("mesh_nodes", "mesh_displacement"):
@@ -819,10 +822,32 @@ class DynamicWriter:
 
     def _make_rest(self, group: h5py.Group) -> None:
         """The series no flush has written yet, without rows (every series exists once
-        the run has written; a chunk without contact data leaves those empty)."""
+        the run has written; a chunk without contact data leaves those empty), and
+        q_last (zeros) when no row gave it."""
         for name in self._series:
             if name not in self._made:
                 self._make(group, name, None)
+        if self._q_last and not self._q_last_made:
+            self._put_q_last(group, None)
+
+    def _put_q_last(self, group: h5py.Group, values: np.ndarray | None) -> None:
+        """/dynamic/q_last := values (None: made without a value, it reads zeros); made
+        by its first write (compact up to COMPACT_BYTES, else contiguous: never
+        extended), written in place after."""
+        if values is not None:
+            values = np.ascontiguousarray(values, dtype=np.float64)
+        if not self._q_last_made:
+            _new_dataset(group, "q_last", values, shape=(self.ndof,), dtype="f8",
+                         units=COORDINATE_UNITS,
+                         compact=8 * self.ndof <= COMPACT_BYTES)
+            self._q_last_made = True
+        elif values is not None:
+            h5py.h5d.open(group.id, b"q_last").write(h5py.h5s.ALL, h5py.h5s.ALL, values)
+
+    def _unmade(self) -> bool:
+        """Some series (or q_last) is not in the file yet."""
+        return len(self._made) < len(self._series) or (self._q_last
+                                                       and not self._q_last_made)
 
     def __call__(self, chunk) -> None:
         if self.store_q and not self.write_q and getattr(chunk, "q", None) is not None:
@@ -875,7 +900,7 @@ class DynamicWriter:
     def flush(self) -> None:
         """Write every buffered chunk (one open of the file)."""
         if not self._pending:
-            if len(self._made) < len(self._series):  # no row at all: the empty series
+            if self._unmade():  # no row at all: the empty series
                 with _open_write(self.path) as h5:
                     self._groups = {}
                     self._make_rest(h5["dynamic"])
@@ -909,7 +934,7 @@ class DynamicWriter:
             # costs ~0.2 ms, whatever its rows)
             self._append(group, self._merged(group) if len(self._pending) > 1
                          else self._pending[0])
-            if len(self._made) < len(self._series):
+            if self._unmade():
                 self._make_rest(group)
             _attrs(group.attrs, {"rows": np.int64(self.rows)})
             if self.nnodes:  # the per-frame views the XDMF description names
@@ -975,14 +1000,14 @@ class DynamicWriter:
         append("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64))
         self._append_steps(group, chunk)
         if self.store_q and getattr(chunk, "q_last", None) is not None:   # thinned
-            group["q_last"][...] = chunk.q_last
+            self._put_q_last(group, chunk.q_last)
             if chunk.frames is not None:
                 self._write_frames(group, *chunk.frames)
         elif self.store_q and chunk.q is not None:
             if self.write_q:
                 append("q", chunk.q)
             elif n:
-                group["q_last"][...] = chunk.q[-1]
+                self._put_q_last(group, chunk.q[-1])
             if self.nnodes:
                 self._append_frames(group, chunk.q)
         self.rows += n
