@@ -25,7 +25,9 @@ kernel's stepping (``system_advance_``, inclusive) and the rest ("non-stepping")
 valgrind and its headers. A call here is what ``benchmarks/peer_exudyn.py`` times: the
 run, then the tip history read back. ``FLUSH_SECONDS`` is raised in the counted process (a
 run lasts ~50 times longer under valgrind and would flush by the clock where a quiet
-machine's run ends before its first flush deadline). Caveat: callgrind counts every iteration of a
+machine's run ends before its first flush deadline), and the stepper's clock there
+advances 1 us per reading (it sizes the kernel calls by their elapsed time: the chunks of
+a quiet machine, the same in every count). Caveat: callgrind counts every iteration of a
 ``rep stos`` as an instruction, so large ``memset``s (HDF5 zeroes its caches) weigh more
 than their time.
 
@@ -84,10 +86,19 @@ def counted_calls(case: str, helper: str) -> None:
     """The child of :func:`instructions`: warm-up calls, then INSTRUCTION_CALLS calls with
     callgrind's collection on."""
     import ctypes
+    import types
     import ancfdrv.results.hdf5 as h5
+    import ancfdrv.solvers.dynamic as dynamic
     # under valgrind a run lasts ~50 times longer and its writer would flush by the clock
     # (FLUSH_SECONDS) where a quiet machine's run ends first: the rows wait for the end
     h5.FLUSH_SECONDS = 1e9
+    # the stepper sizes its kernel calls by the elapsed time of the first (~0.25 s each):
+    # a clock that advances 1 us per reading sizes them as a quiet machine does (up to
+    # output.chunk_steps), the same in every count (valgrind's slow and load-dependent
+    # clock gave other chunks, other answers passes: +-30 M instructions on the boom)
+    ticks = iter(range(1, 1 << 62))
+    dynamic.time = types.SimpleNamespace(perf_counter=lambda: 1e-6 * next(ticks),
+                                         monotonic=time.monotonic, time=time.time)
     toggle = ctypes.CDLL(helper).callgrind_toggle
     out = Path(tempfile.mkdtemp()) / "run.h5"
     for _ in range(2):
