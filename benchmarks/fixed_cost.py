@@ -17,6 +17,20 @@ holding ``ancfdrv/``, e.g. ``git archive <commit> python/ancfdrv`` unpacked, wit
 built ``_kernel*.so`` copied in) in a subprocess, interleaved case by case, so both are
 measured under the same load.
 
+``--instructions``: also count, with valgrind's callgrind (exact and independent of the
+machine's load), the instructions of ``INSTRUCTION_CALLS`` whole calls of each case after
+two warm-up calls (collection switched on and off around them by callgrind's client
+request, from a tiny C helper compiled with the system's ``cc``): per call the total, the
+kernel's stepping (``system_advance_``, inclusive) and the rest ("non-stepping"); needs
+valgrind and its headers. A call here is what ``benchmarks/peer_exudyn.py`` times: the
+run, then the tip history read back. ``FLUSH_SECONDS`` is raised in the counted process (a
+run lasts ~50 times longer under valgrind and would flush by the clock where a quiet
+machine's run ends before its first flush deadline), and the stepper's clock there
+advances 1 us per reading (it sizes the kernel calls by their elapsed time: the chunks of
+a quiet machine, the same in every count). Caveat: callgrind counts every iteration of a
+``rep stos`` as an instruction, so large ``memset``s (HDF5 zeroes its caches) weigh more
+than their time.
+
 Output: ``benchmarks/results/fixed_cost.json`` (``--quick``: ``fixed_cost_quick.json``,
 ignored by git). Run from the repository root::
 
@@ -51,6 +65,77 @@ CASES: dict[str, tuple[str, list[str]]] = {
         "beam.bending=cable", "beam.nodes=7", "scene.planar=xy"]),
 }
 QUICK = {"pendulum_cable_5": CASES["pendulum_cable_5"]}
+#: the whole calls counted per case by ``--instructions`` (after two warm-up calls)
+INSTRUCTION_CALLS = 2
+_TOGGLE_C = ("#include <valgrind/callgrind.h>\n"
+             "void callgrind_toggle(void) { CALLGRIND_TOGGLE_COLLECT; }\n")
+
+
+def _call(case: str, out: Path) -> None:
+    """One whole call as the peer harness makes it: run, then read the tip history."""
+    import h5py
+    import ancfdrv.runner as runner
+    scene, overrides = CASES[case]
+    runner.run_scene(REPO / scene, overrides, out, progress=False)
+    with h5py.File(out, "r") as h5:
+        h5["dynamic/time"][()]
+        h5["dynamic/probes/tip"][()]
+
+
+def counted_calls(case: str, helper: str) -> None:
+    """The child of :func:`instructions`: warm-up calls, then INSTRUCTION_CALLS calls with
+    callgrind's collection on."""
+    import ctypes
+    import types
+    import ancfdrv.results.hdf5 as h5
+    import ancfdrv.solvers.dynamic as dynamic
+    # under valgrind a run lasts ~50 times longer and its writer would flush by the clock
+    # (FLUSH_SECONDS) where a quiet machine's run ends first: the rows wait for the end
+    h5.FLUSH_SECONDS = 1e9
+    # the stepper sizes its kernel calls by the elapsed time of the first (~0.25 s each):
+    # a clock that advances 1 us per reading sizes them as a quiet machine does (up to
+    # output.chunk_steps), the same in every count (valgrind's slow and load-dependent
+    # clock gave other chunks, other answers passes: +-30 M instructions on the boom)
+    ticks = iter(range(1, 1 << 62))
+    dynamic.time = types.SimpleNamespace(perf_counter=lambda: 1e-6 * next(ticks),
+                                         monotonic=time.monotonic, time=time.time)
+    toggle = ctypes.CDLL(helper).callgrind_toggle
+    out = Path(tempfile.mkdtemp()) / "run.h5"
+    for _ in range(2):
+        _call(case, out)
+    toggle()
+    for _ in range(INSTRUCTION_CALLS):
+        _call(case, out)
+    toggle()
+
+
+def instructions(case: str, work: Path) -> dict[str, Any]:
+    """Instructions per whole call of ``case`` (total, stepping, non-stepping; callgrind)."""
+    import re
+    helper = work / "callgrind_toggle.so"
+    if not helper.exists():
+        source = work / "callgrind_toggle.c"
+        source.write_text(_TOGGLE_C)
+        subprocess.run(["cc", "-O1", "-shared", "-fPIC", "-o", str(helper), str(source)],
+                       check=True)
+    profile = work / f"{case}.callgrind"
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
+    subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
+                    f"--callgrind-out-file={profile}", sys.executable, __file__,
+                    "--counted", case, "--helper", str(helper)], env=env, check=True,
+                   capture_output=True)
+    text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100",
+                           str(profile)], capture_output=True, text=True, check=True).stdout
+
+    def count(pattern: str) -> int:
+        found = re.search(r"^\s*([\d,]+)\s+(?:\([^)]*\)\s+)?" + pattern, text, re.M)
+        return int(found.group(1).replace(",", "")) if found else 0
+    total = count(r"PROGRAM TOTALS")
+    stepping = count(r"\S*:system_advance_ ")
+    return {"calls": INSTRUCTION_CALLS,
+            "whole_per_call": total / INSTRUCTION_CALLS,
+            "stepping_per_call": stepping / INSTRUCTION_CALLS,
+            "non_stepping_per_call": (total - stepping) / INSTRUCTION_CALLS}
 
 
 def measure(case: str, repeats: int) -> dict[str, Any]:
@@ -113,10 +198,17 @@ def main() -> int:
     parser.add_argument("--repeats", type=int, default=15)
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--compare", help="directory holding another ancfdrv package")
+    parser.add_argument("--instructions", action="store_true",
+                        help="also count instructions per call with callgrind")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a subprocess: one case, JSON out
+    parser.add_argument("--counted", help=argparse.SUPPRESS)  # under callgrind
+    parser.add_argument("--helper", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.one:
         print(json.dumps(measure(args.one, args.repeats)))
+        return 0
+    if args.counted:
+        counted_calls(args.counted, args.helper)
         return 0
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from _common import load_average, machine_info
@@ -137,6 +229,24 @@ def main() -> int:
             print(f"{case:18s} {label:8s} whole {result['whole_wall_best_ms']:7.1f} ms wall; "
                   f"stepping {phases.get('kernel stepping', 0):6.1f}, non-stepping "
                   f"{phases['non-stepping (thread CPU)']:6.1f} ms thread CPU")
+            if args.instructions:
+                with tempfile.TemporaryDirectory() as tmp:
+                    if path:
+                        env_path = os.environ.get("PYTHONPATH")
+                        os.environ["PYTHONPATH"] = str(Path(path).resolve())
+                    try:
+                        counts = instructions(case, Path(tmp))
+                    finally:
+                        if path:
+                            if env_path is None:
+                                os.environ.pop("PYTHONPATH", None)
+                            else:
+                                os.environ["PYTHONPATH"] = env_path
+                result["instructions"] = counts
+                print(f"{'':27s} instructions per call: whole "
+                      f"{counts['whole_per_call'] / 1e6:7.2f} M, stepping "
+                      f"{counts['stepping_per_call'] / 1e6:7.2f} M, non-stepping "
+                      f"{counts['non_stepping_per_call'] / 1e6:7.2f} M")
     record["load_average_at_end"] = load_average()
     name = "fixed_cost_quick.json" if args.quick else "fixed_cost.json"
     target = REPO / "benchmarks" / "results" / name

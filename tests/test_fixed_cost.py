@@ -193,3 +193,214 @@ def test_a_full_disk_keeps_the_initial_row(tmp_path, monkeypatch):
             assert h5["dynamic/time"][0] == 0.0 and "step_size" in h5["dynamic"]
     finally:
         model.close()
+
+
+def _series(path):
+    """{name: (values, dtype, attributes, layout, maxshape)} of every /dynamic dataset."""
+    found = {}
+    with h5py.File(path, "r") as h5:
+        def visit(name, obj):
+            if isinstance(obj, h5py.Dataset):
+                found[name] = (obj[()], obj.dtype, dict(obj.attrs),
+                               obj.id.get_create_plist().get_layout(), obj.maxshape)
+        h5["dynamic"].visititems(visit)
+        found["@rows"] = h5["dynamic"].attrs["rows"]
+    return found
+
+
+@pytest.mark.parametrize("flush_rows", [10**6, 4])
+def test_last_flush_writes_what_extendable_series_hold(tmp_path, flush_rows):
+    """The writer's last flush (a run that ended) makes the series it writes not
+    extendable (compact when small, else contiguous), with the values, types, units and
+    row count of the extendable series a plain flush writes (the reference: the same
+    chunks through ``flush``; /dynamic/q, 51 rows of 48 numbers, is larger than
+    COMPACT_BYTES). With flush_rows = 4 the series are made by earlier flushes
+    during the run: they stay extendable (chunked) and the last flush appends to them."""
+    from test_lean_output import _chunks, cantilever
+    from ancfdrv.results.hdf5 import COMPACT_BYTES, DynamicWriter
+    from ancfdrv.solvers.dynamic import DynamicSettings
+    model = cantilever().assemble()
+    try:
+        chunks = _chunks(model, DynamicSettings(dt=1e-3, t_end=0.05, store_q=True),
+                         [3, 17, 30])
+        files = {}
+        for label in ("plain", "last"):
+            path = files[label] = tmp_path / f"{label}.h5"
+            with h5py.File(path, "w"):
+                pass
+            writer = DynamicWriter(path, model, True, flush_rows, xdmf=False, total_rows=51)
+            for chunk in chunks:
+                writer(chunk)
+            writer.flush() if label == "plain" else writer.flush_last()
+        plain, last = _series(files["plain"]), _series(files["last"])
+        assert plain.keys() == last.keys() and len(plain) > 15
+        assert int(last.pop("@rows")) == int(plain.pop("@rows")) == 51
+        layouts = set()
+        for name, (values, dtype, attrs, layout, maxshape) in last.items():
+            ref = plain[name]
+            assert values.shape == ref[0].shape and values.tobytes() == ref[0].tobytes(), name
+            assert dtype == ref[1] and attrs == ref[2], name
+            assert ref[3] == h5py.h5d.CHUNKED and ref[4][0] is None
+            if flush_rows < 51:   # made while the run went on: extendable, appended to
+                assert layout == h5py.h5d.CHUNKED and maxshape[0] is None, name
+            else:
+                assert maxshape == values.shape, name
+                assert layout == (h5py.h5d.COMPACT if values.nbytes <= COMPACT_BYTES
+                                  else h5py.h5d.CONTIGUOUS), name
+            layouts.add(layout)
+        assert layouts == ({h5py.h5d.CHUNKED} if flush_rows < 51 else
+                           {h5py.h5d.COMPACT, h5py.h5d.CONTIGUOUS})
+    finally:
+        model.close()
+
+
+def test_a_short_run_is_complete_after_its_one_flush(tmp_path):
+    """A run shorter than its first flush deadline writes its rows once, at its end: the
+    file is complete (status ok, every row of every series, the rows attribute, the
+    reactions), and the same as the file of a run whose writer flushes at every chunk
+    (FLUSH_SECONDS = 0: extendable series appended to), values bitwise."""
+    out = {}
+    for label, seconds in (("short", None), ("every_chunk", 0.0)):
+        path = out[label] = tmp_path / f"{label}.h5"
+        with pytest.MonkeyPatch.context() as patch:
+            if seconds is not None:
+                patch.setattr(results, "FLUSH_SECONDS", seconds)
+            runner.run_scene(INPUTS / "boom_luffing.nml", TINY, path, progress=False)
+    short, every = _series(out["short"]), _series(out["every_chunk"])
+    assert short.keys() == every.keys()
+    for name in short:
+        if name == "@rows":
+            assert int(short[name]) == int(every[name]) == 51
+            continue
+        assert short[name][0].tobytes() == every[name][0].tobytes(), name
+        assert short[name][2] == every[name][2], name
+        if name in ("time", "probes/tip", "lambda", "energy/total"):
+            assert short[name][3] != h5py.h5d.CHUNKED and every[name][3] == h5py.h5d.CHUNKED
+    with h5py.File(out["short"], "r") as h5:
+        assert h5.attrs["status"] == "ok" and h5["dynamic"].attrs["status"] == "ok"
+        assert len(h5["dynamic/time"]) == 51 and h5["dynamic/time"][-1] == pytest.approx(0.05)
+        assert len(h5["dynamic/reactions/A1/force"]) == 51
+
+
+def test_subgroup_is_the_group_h5py_makes(tmp_path):
+    """_subgroup (low-level) makes the group h5py's create_group makes: the same times
+    tracking, creation order not tracked, an ASCII link; an existing group is returned as
+    is."""
+    path = tmp_path / "g.h5"
+    with h5py.File(path, "w") as h5:
+        ours = results._subgroup(h5, "ours")
+        theirs = h5.create_group("theirs")
+        assert results._subgroup(h5, "ours") == ours
+        results._subgroup(ours, "inner")
+        assert results._has(h5, "ours") and not results._has(h5, "none")
+        assert results._has(ours, "inner")
+        made = [(p.get_obj_track_times(), p.get_link_creation_order(),
+                 p.get_attr_creation_order())
+                for p in (ours.id.get_create_plist(), theirs.id.get_create_plist())]
+        assert made[0] == made[1] and made[0][1:] == (0, 0)
+        info = {name: h5.id.links.get_info(name.encode()).cset for name in ("ours", "theirs")}
+        assert info["ours"] == info["theirs"] == h5py.h5t.CSET_ASCII
+
+
+def test_a_short_chunk_waits_for_the_next_one():
+    """The answers recorder records a chunk of 2..WAIT_ROWS rows with the next chunk (one
+    pass instead of two) and a chunk still waiting when the answers are read
+    (``complete``): the reactions, section forces and stress envelope are bitwise those
+    of a recorder that records every chunk at once (WAIT_ROWS = 0), for a run that ends
+    after a long chunk and for one that ends with a short chunk still waiting."""
+    from test_lean_output import _chunks, cantilever
+    from ancfdrv.solvers.dynamic import DynamicSettings
+    from ancfdrv.system.answers import DynamicAnswers
+    model = cantilever().assemble()
+    try:
+        settings = DynamicSettings(dt=1e-3, t_end=0.05, store_q=True)
+        for sizes in ([10, 30], [10, 30, 5]):
+            chunks = _chunks(model, settings, sizes)
+            recorded = {}
+            for label, wait in (("waiting", DynamicAnswers.WAIT_ROWS), ("each", 0)):
+                recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
+                                          alpha_m=0.0, alpha_f=0.0, keep_sections=True)
+                recorder.WAIT_ROWS = wait
+                passes = []
+                real = recorder._record
+                recorder._record = lambda chunk: (passes.append(len(chunk.time)),
+                                                  real(chunk))
+                for chunk in chunks:
+                    recorder(chunk)
+                recorder.complete()
+                recorded[label] = (recorder, passes)
+            (ours, ours_passes), (each, each_passes) = recorded["waiting"], recorded["each"]
+            assert each_passes == [1, *sizes]
+            assert ours_passes == [1, 40] + ([5] if len(sizes) == 3 else [])
+            assert ours.time == each.time and len(ours.time) == 1 + sum(sizes)
+            for name in each.reactions:
+                a = [np.concatenate([c[k] for c in ours.reactions[name]]) for k in (0, 1)]
+                b = [np.concatenate([c[k] for c in each.reactions[name]]) for k in (0, 1)]
+                assert all(x.tobytes() == y.tobytes() for x, y in zip(a, b))
+            for name in each.sections:
+                for key in ("N", "T", "Q", "M"):
+                    x = np.concatenate([getattr(c, key) for c in ours.sections[name]])
+                    y = np.concatenate([getattr(c, key) for c in each.sections[name]])
+                    assert x.tobytes() == y.tobytes()
+            for name, (s, best, when) in each.envelope.items():
+                s2, best2, when2 = ours.envelope[name]
+                assert best2.tobytes() == best.tobytes() and when2.tobytes() == when.tobytes()
+            assert each.reactions and each.envelope
+    finally:
+        model.close()
+
+
+def test_a_last_flush_without_rows_makes_every_series(tmp_path):
+    """A run that stops before any row (its last flush has nothing to write) still gets
+    every series, empty, with the types and units a plain flush gives them."""
+    from test_lean_output import cantilever
+    from ancfdrv.results.hdf5 import DynamicWriter
+    model = cantilever().assemble()
+    try:
+        found = {}
+        for label in ("plain", "last"):
+            path = tmp_path / f"{label}.h5"
+            with h5py.File(path, "w"):
+                pass
+            writer = DynamicWriter(path, model, True, 10**6, xdmf=False, total_rows=21)
+            writer.flush() if label == "plain" else writer.flush_last()
+            found[label] = _series(path)
+        assert found["plain"].keys() == found["last"].keys() and len(found["last"]) > 15
+        assert int(found["last"].pop("@rows")) == int(found["plain"].pop("@rows")) == 0
+        for name, (values, dtype, attrs, _, _) in found["last"].items():
+            ref = found["plain"][name]
+            assert len(values) == 0 and values.shape == ref[0].shape, name
+            assert dtype == ref[1] and attrs == ref[2], name
+    finally:
+        model.close()
+
+
+@pytest.mark.parametrize("sizes", [[], [3], [3, 17]], ids=["no rows", "one flush", "two"])
+def test_q_last_holds_the_last_row(tmp_path, sizes):
+    """/dynamic/q_last (the coordinates carried, not written as /dynamic/q): made by the
+    first flush with the last row's q and rewritten by each later one; a writer without
+    rows still makes it (zeros, as before: it was made empty by the writer's set-up)."""
+    from test_lean_output import _chunks, cantilever
+    from ancfdrv.results.hdf5 import DynamicWriter
+    from ancfdrv.solvers.dynamic import DynamicSettings
+    model = cantilever().assemble()
+    try:
+        chunks = _chunks(model, DynamicSettings(dt=1e-3, t_end=0.02, store_q=True),
+                         sizes) if sizes else []
+        path = tmp_path / "q.h5"
+        with h5py.File(path, "w"):
+            pass
+        writer = DynamicWriter(path, model, True, 4, xdmf=False, total_rows=21,
+                               write_q=False)
+        expected = np.zeros(model.ndof) if not chunks else np.array(chunks[-1].q[-1])
+        for chunk in chunks:
+            writer(chunk)
+        writer.flush_last()
+        with h5py.File(path, "r") as h5:
+            assert "q" not in h5["dynamic"]
+            q_last = h5["dynamic/q_last"]
+            assert q_last.attrs["units"] == results.COORDINATE_UNITS
+            assert q_last[()].tobytes() == expected.tobytes()
+            assert len(h5["dynamic/time"]) == (1 + sum(sizes) if sizes else 0)
+    finally:
+        model.close()

@@ -284,7 +284,7 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
             dyn = integrate_reduced(model, reduced, settings, sink=sink, progress=progress,
                                     should_stop=stop)
     finally:
-        writer.flush()
+        writer.flush_last()
         if supports is not None:
             supports.write(out, writer.rows)
         results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
@@ -366,7 +366,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
         with results.released(out):  # the file is closed between the writes of the run
             dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
                             should_stop=stop)
-        writer.flush()
+        writer.flush_last()
         if supports is not None:
             supports.write(out, writer.rows)
         if recorder is not None:
@@ -385,7 +385,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     finally:  # also after a failure or an interrupt: every computed step goes to the file
         if not done:
             results.drop(out)  # the held file may be in any state after an error
-            writer.flush()
+            writer.flush_last()
             if supports is not None:
                 supports.write(out, writer.rows)
             if recorder is not None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 import math
+import re
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -88,6 +89,101 @@ class Scene:
 #: :mod:`ancfdrv.builders.general` registers them; it sits above this reader, which imports
 #: nothing of the layers above it (``import ancfdrv`` always loads the builders).
 GENERAL_BUILDER: dict[str, Callable[..., Any]] = {}
+
+
+#: the tokens of the namelists :func:`fast_reads` reads (anything else: f90nml)
+_FAST_TOKEN = re.compile(r"""
+    (?P<space>\s+)
+  | (?P<comment>![^\n]*)
+  | (?P<string>'(?:[^'\n]|'')*'|"(?:[^"\n]|"")*")
+  | (?P<group>&[A-Za-z_]\w*)
+  | (?P<end>/)
+  | (?P<key>[A-Za-z_]\w*)[ \t]*=(?!=)
+  | (?P<comma>,)
+  | (?P<word>[^\s'"!/&$=,()*%]+)
+  | (?P<other>.)
+""", re.VERBOSE | re.DOTALL)
+_FAST_INT = re.compile(r"[+-]?\d+\Z")
+_FAST_FLOAT = re.compile(r"[+-]?(?:\d+\.\d*|\.\d+|\d+(?=[eEdD]))(?:[eEdD][+-]?\d+)?\Z")
+_FAST_LOGICAL = {".true.": True, ".t.": True, ".false.": False, ".f.": False}
+
+
+def _fast_value(kind: str, token: str) -> Any:
+    """A value token as f90nml's parser converts it (int, float, logical, string); a
+    token outside these plain forms raises ValueError."""
+    if kind == "string":
+        return token[1:-1].replace(token[0] * 2, token[0])
+    if _FAST_INT.match(token):
+        return int(token)
+    if _FAST_FLOAT.match(token):
+        return float(token.lower().replace("d", "e"))
+    logical = _FAST_LOGICAL.get(token.lower())
+    if logical is None:
+        raise ValueError(token)
+    return logical
+
+
+def fast_reads(text: str) -> f90nml.Namelist | None:
+    """The namelist ``f90nml.reads(text)`` returns, for the plain namelists scenes are
+    written in (groups ``&name ... /``; ``key = value`` or ``key = v1, v2, ...`` with
+    integer, real, logical and quoted string values; comments), built with f90nml's own
+    Namelist the way its parser builds it, in a single regular-expression pass (f90nml's
+    parser took ~0.4 ms of each scene load). None for anything else (indexed or derived
+    keys, repeat counts, complex or null values, unquoted strings, a key given twice,
+    text outside the groups, ...): the caller then reads the text with f90nml."""
+    nml = f90nml.Namelist()
+    group: f90nml.Namelist | None = None
+    name = key = None
+    values: list[Any] = []
+    after_value = False   # the last token was a value (a comma may follow)
+
+    def close_key() -> bool:
+        if key is None:
+            return True
+        if not values or key.lower() in group:
+            return False
+        group[key] = values[0] if len(values) == 1 else list(values)
+        return True
+    for match in _FAST_TOKEN.finditer(text):
+        kind = match.lastgroup
+        if kind == "space" or kind == "comment":
+            continue
+        token = match.group()
+        if group is None:
+            if kind != "group":
+                return None
+            name, group = token[1:], f90nml.Namelist()
+            if name.lower() == "end":
+                return None
+            key, values, after_value = None, [], False
+            continue
+        if kind == "key":   # (null values, 'a = 1, , b = 2', end at the comma branch)
+            if not close_key():
+                return None
+            key, values, after_value = match.group("key"), [], False
+        elif kind == "end":
+            if (key is not None and not after_value) or not close_key():
+                return None
+            if name in nml:
+                nml.add_cogroup(name, group)
+            else:
+                nml[name] = group
+            group = key = None
+        elif kind == "comma":
+            if not after_value:
+                return None
+            after_value = False
+        elif kind in ("string", "word"):
+            if key is None or after_value:
+                return None
+            try:
+                values.append(_fast_value(kind, token))
+            except ValueError:
+                return None
+            after_value = True
+        else:
+            return None
+    return nml if group is None else None
 
 
 def _parse_override_value(kind: str, text: str, where: dict) -> Any:
@@ -233,7 +329,9 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     file = str(path)
     text = _read_text(path, file)
     try:
-        nml = f90nml.reads(text)
+        nml = fast_reads(text)
+        if nml is None:  # not one of the plain forms fast_reads reads
+            nml = f90nml.reads(text)
     except Exception as exc:  # f90nml raises several types
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None

@@ -110,15 +110,62 @@ def _attrs(target: h5py.AttributeManager, values: dict[str, Any], *,
 
 
 @functools.lru_cache(maxsize=64)
-def _dataset_plist(chunks: tuple[int, ...] | None) -> h5py.h5p.PropDCID:
+def _dataset_plist(chunks: tuple[int, ...] | None,
+                   compact: bool = False) -> h5py.h5p.PropDCID:
     """A dataset creation property list as h5py's ``create_dataset`` makes it (no times
-    tracked; chunked when ``chunks``); made once per chunk shape (HDF5 copies it into
+    tracked; chunked when ``chunks``; the compact layout, the values kept in the dataset's
+    object header, when ``compact``); made once per chunk shape (HDF5 copies it into
     each dataset it creates)."""
     plist = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
     if chunks is not None:
         plist.set_chunk(chunks)
+    elif compact:
+        plist.set_layout(h5py.h5d.COMPACT)
     plist.set_obj_track_times(False)
     return plist
+
+
+#: the largest series written in the compact layout by the last flush (the values in the
+#: object header: no separate block to allocate and index; HDF5 allows < 64 kB)
+COMPACT_BYTES = 16 * 1024
+
+
+@functools.lru_cache(maxsize=1)
+def _group_plists() -> tuple[h5py.h5p.PropGCID, h5py.h5p.PropLCID]:
+    """The group and link creation property lists h5py's ``create_group`` uses for an
+    ASCII name (no times tracked, creation order not tracked, intermediate groups
+    created)."""
+    from h5py._hl.base import dlcpl
+    gcpl = h5py.h5p.create(h5py.h5p.GROUP_CREATE)
+    gcpl.set_obj_track_times(False)
+    lcpl = dlcpl.copy()
+    lcpl.set_char_encoding(h5py.h5t.CSET_ASCII)
+    return gcpl, lcpl
+
+
+def _subgroup(group: h5py.Group, name: str) -> h5py.Group:
+    """``group.require_group(name)`` for a plain ASCII name, through h5py's low-level API
+    (the group h5py makes, a fifth of the calls)."""
+    if "/" in name or not name.isascii() or h5py.get_config().track_order:
+        return group.require_group(name)
+    key = name.encode("ascii")
+    if group.id.links.exists(key):
+        return group.require_group(name)   # an existing member: h5py's checks
+    gcpl, lcpl = _group_plists()
+    return h5py.Group(h5py.h5g.create(group.id, key, lcpl=lcpl, gcpl=gcpl))
+
+
+def _has(group: h5py.Group, name: str) -> bool:
+    """``name in group`` for a plain ASCII name (one low-level call)."""
+    if "/" in name or not name.isascii():
+        return name in group
+    return group.id.links.exists(name.encode("ascii"))
+
+
+@functools.lru_cache(maxsize=256)
+def _text_array(text: str) -> np.ndarray:
+    """The array a text attribute stores (made once per text: units repeat)."""
+    return np.array(text, dtype=_TEXT)
 
 
 def _parent(group: h5py.Group, name: str,
@@ -129,9 +176,9 @@ def _parent(group: h5py.Group, name: str,
     if not head:
         return group, tail.encode("utf-8")
     if groups is None:
-        return group.require_group(head), tail.encode("utf-8")
+        return _subgroup(group, head), tail.encode("utf-8")
     if head not in groups:
-        groups[head] = group.require_group(head)
+        groups[head] = _subgroup(group, head)
     return groups[head], tail.encode("utf-8")
 
 
@@ -140,7 +187,8 @@ def _new_dataset(group: h5py.Group, name: str, data: np.ndarray | None = None, *
                  maxshape: tuple[int | None, ...] | None = None,
                  chunks: tuple[int, ...] | None = None,
                  units: str | None = None,
-                 groups: dict[str, h5py.Group] | None = None) -> h5py.h5d.DatasetID:
+                 groups: dict[str, h5py.Group] | None = None,
+                 compact: bool = False) -> h5py.h5d.DatasetID:
     """A new dataset through h5py's low-level API (what ``create_dataset`` stores, at a
     fifth of its cost), with its ``units`` attribute; ``data`` written when given;
     ``groups``: see :func:`_parent`."""
@@ -152,13 +200,14 @@ def _new_dataset(group: h5py.Group, name: str, data: np.ndarray | None = None, *
                                                 for m in maxshape)
     space = h5py.h5s.create_simple(shape, limit)
     dataset = h5py.h5d.create(parent.id, leaf, _types(dtype)[0], space,
-                              dcpl=_dataset_plist(chunks))
+                              dcpl=_dataset_plist(chunks, compact))
     if data is not None:
         dataset.write(h5py.h5s.ALL, h5py.h5s.ALL, data)
     if units is not None:
-        attr = h5py.h5a.create(dataset, b"units", _types(_TEXT)[0], _SCALAR)
+        file_type, memory_type = _types(_TEXT)
+        attr = h5py.h5a.create(dataset, b"units", file_type, _SCALAR)
         try:
-            attr.write(np.array(units, dtype=_TEXT), mtype=_types(_TEXT)[1])
+            attr.write(_text_array(units), mtype=memory_type)
         finally:
             attr.close()
     return dataset
@@ -430,7 +479,7 @@ def create(path: Path, scene: Scene, model: Model) -> None:
             # 'continuum' or 'cubic' (beam.bending) of the first beam
             **({"bending": beams[0].bending} if beams else {}),
         }, fresh=True)
-        group = h5.create_group("model")
+        group = _subgroup(h5, "model")
         model_attrs = dict(model.summary())
         geometry = model.plate_geometry()
         if geometry is not None:  # plates and leaves: initial node positions, connectivity
@@ -457,9 +506,9 @@ def create(path: Path, scene: Scene, model: Model) -> None:
 def write_static(path: Path, model: Model, result: StaticResult) -> None:
     """The /static group: q, lambda, probes, deflections and solver statistics."""
     with _open_write(path) as h5:
-        if "static" in h5:
+        if _has(h5, "static"):
             del h5["static"]
-        group = h5.create_group("static")
+        group = _subgroup(h5, "static")
         _dataset(group, "q", result.e, COORDINATE_UNITS)
         _dataset(group, "lambda", result.lam, MULTIPLIER_UNITS)
         history = _dataset(group, "residual_history", np.asarray(result.history, dtype=float),
@@ -482,13 +531,13 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
         raise ValueError(f"unknown status {status!r}")
     with _open_write(path) as h5:
         for name in ("counters", "timing"):
-            if name in h5:
+            if _has(h5, name):
                 del h5[name]
-        counters = h5.create_group("counters")
+        counters = _subgroup(h5, "counters")
         _attrs(counters.attrs, {**{k: int(v) for k, v in sorted(model.counters.items())},
                                 "constraint_evaluations": np.int64(
                                     model.constraints.evaluations)}, fresh=True)
-        group = h5.create_group("timing")
+        group = _subgroup(h5, "timing")
         # every timing, then the phases SPEC section 4 names (which replace a timing of the
         # same name), summed over the analyses (dynamic stepping counts as solve: the
         # kernel's factorization-free steps are substitutions and residuals)
@@ -504,7 +553,7 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
             "status": status, "message": message,
             "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             "warnings": "\n".join(model.warnings)})
-        if "dynamic" in h5:
+        if _has(h5, "dynamic"):
             _attrs(h5["dynamic"].attrs, {"status": status})
         has_motion = ("dynamic/mesh_nodes" in h5 and "dynamic/time" in h5
                       and len(h5["dynamic/time"]) > 0)
@@ -672,6 +721,9 @@ class DynamicWriter:
         self.frames = 0
         self.energy_names = ENERGY_NAMES
         self.rows = 0
+        self.ndof = model.ndof
+        self._q_last = bool(store_q and not self.write_q)   # /dynamic/q_last is written
+        self._q_last_made = False
         self._pending: list[Any] = []
         self._pending_rows = 0
         self._last_write = time.monotonic()
@@ -684,9 +736,9 @@ class DynamicWriter:
                                 * 8 * self.npoints + 16 * (ndof + 6 * self.nnodes))
         check_room(path, self.chunk_bytes)
         with _open_write(path) as h5:
-            if "dynamic" in h5:
+            if _has(h5, "dynamic"):
                 del h5["dynamic"]
-            group = h5.create_group("dynamic")
+            group = _subgroup(h5, "dynamic")
             _attrs(group.attrs, {"status": "running", "rows": np.int64(0)}, fresh=True)
 
             # the row series are made by the first flush, with its rows (one HDF5 call per
@@ -734,9 +786,9 @@ class DynamicWriter:
                     "points": "\n".join(model.contact_point_names)}
             if self.write_q:
                 series("q", COORDINATE_UNITS, (ndof,))
-            elif store_q:  # where a run that stops between XDMF frames ends
-                _new_dataset(group, "q_last", shape=(ndof,), dtype="f8",
-                             units=COORDINATE_UNITS)
+            # q_last (store_q without write_q): where a run that stops between XDMF frames
+            # ends; made by the first flush with its value, as the series (not made here
+            # and reopened by every flush: ~0.2 ms of a short run)
             if self.nnodes:  # points of every body per frame, for ParaView (XDMF)
                 write_layout(h5, self.layout)
                 for name in ("mesh_nodes", "mesh_displacement"):
@@ -760,13 +812,19 @@ class DynamicWriter:
         return min(self.total_rows, max(1024, self.CHUNK_BYTES // (8 * max(width, 1))))
 
     def _make(self, group: h5py.Group, name: str, values: np.ndarray | None) -> None:
-        """Series ``name`` of /dynamic, holding ``values`` (None: no rows)."""
+        """Series ``name`` of /dynamic, holding ``values`` (None: no rows); made by the
+        last flush (:meth:`flush_last`) not extendable: compact up to COMPACT_BYTES,
+        else contiguous."""
         units, width, dtype, limit, chunks, attrs = self._series[name]
         if values is None:
             values = np.zeros((0, *width), dtype=dtype)
         values = np.ascontiguousarray(values, dtype=dtype)
+        compact = False
+        if self._last:
+            limit = chunks = None
+            compact = values.nbytes <= COMPACT_BYTES
         dataset = _new_dataset(group, name, values, maxshape=limit, chunks=chunks, units=units,
-                               groups=self._groups)
+                               groups=self._groups, compact=compact)
         if attrs:
             _attrs(h5py.AttributeManager(h5py.Dataset(dataset)), attrs, fresh=True)
         self._made.add(name)
@@ -783,10 +841,32 @@ class DynamicWriter:
 
     def _make_rest(self, group: h5py.Group) -> None:
         """The series no flush has written yet, without rows (every series exists once
-        the run has written; a chunk without contact data leaves those empty)."""
+        the run has written; a chunk without contact data leaves those empty), and
+        q_last (zeros) when no row gave it."""
         for name in self._series:
             if name not in self._made:
                 self._make(group, name, None)
+        if self._q_last and not self._q_last_made:
+            self._put_q_last(group, None)
+
+    def _put_q_last(self, group: h5py.Group, values: np.ndarray | None) -> None:
+        """/dynamic/q_last := values (None: made without a value, it reads zeros); made
+        by its first write (compact up to COMPACT_BYTES, else contiguous: never
+        extended), written in place after."""
+        if values is not None:
+            values = np.ascontiguousarray(values, dtype=np.float64)
+        if not self._q_last_made:
+            _new_dataset(group, "q_last", values, shape=(self.ndof,), dtype="f8",
+                         units=COORDINATE_UNITS,
+                         compact=8 * self.ndof <= COMPACT_BYTES)
+            self._q_last_made = True
+        elif values is not None:
+            h5py.h5d.open(group.id, b"q_last").write(h5py.h5s.ALL, h5py.h5s.ALL, values)
+
+    def _unmade(self) -> bool:
+        """Some series (or q_last) is not in the file yet."""
+        return len(self._made) < len(self._series) or (self._q_last
+                                                       and not self._q_last_made)
 
     def __call__(self, chunk) -> None:
         if self.store_q and not self.write_q and getattr(chunk, "q", None) is not None:
@@ -822,10 +902,24 @@ class DynamicWriter:
                 out.frames = (rows[pick], self.layout.positions(self.model, chunk.q[pick]))
         return out
 
+    #: set by :meth:`flush_last` while it flushes: no rows follow
+    _last = False
+
+    def flush_last(self) -> None:
+        """The run has ended: :meth:`flush` the rest, no rows follow. The series this
+        flush makes (all of them in a run that ends before its first flush deadline, e.g.
+        any run shorter than FLUSH_SECONDS) are not extendable: compact up to
+        COMPACT_BYTES, else contiguous (less to allocate and index than a chunked one)."""
+        self._last = True
+        try:
+            self.flush()
+        finally:
+            self._last = False
+
     def flush(self) -> None:
         """Write every buffered chunk (one open of the file)."""
         if not self._pending:
-            if len(self._made) < len(self._series):  # no row at all: the empty series
+            if self._unmade():  # no row at all: the empty series
                 with _open_write(self.path) as h5:
                     self._groups = {}
                     self._make_rest(h5["dynamic"])
@@ -843,9 +937,11 @@ class DynamicWriter:
             rest = self._pending[1:]
             if self.rows == 0 and rest:  # the run's initial row alone, if it fits, is kept
                 self._pending = self._pending[:1]
+                last, self._last = self._last, False   # rows follow: extendable series
                 try:
                     self.flush()
                 finally:  # the other rows still wait (a later flush meets the error again)
+                    self._last = last
                     self._pending = self._pending + rest
                     self._pending_rows = sum(len(chunk.time) for chunk in self._pending)
             raise
@@ -857,7 +953,7 @@ class DynamicWriter:
             # costs ~0.2 ms, whatever its rows)
             self._append(group, self._merged(group) if len(self._pending) > 1
                          else self._pending[0])
-            if len(self._made) < len(self._series):
+            if self._unmade():
                 self._make_rest(group)
             _attrs(group.attrs, {"rows": np.int64(self.rows)})
             if self.nnodes:  # the per-frame views the XDMF description names
@@ -923,14 +1019,14 @@ class DynamicWriter:
         append("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64))
         self._append_steps(group, chunk)
         if self.store_q and getattr(chunk, "q_last", None) is not None:   # thinned
-            group["q_last"][...] = chunk.q_last
+            self._put_q_last(group, chunk.q_last)
             if chunk.frames is not None:
                 self._write_frames(group, *chunk.frames)
         elif self.store_q and chunk.q is not None:
             if self.write_q:
                 append("q", chunk.q)
             elif n:
-                group["q_last"][...] = chunk.q[-1]
+                self._put_q_last(group, chunk.q[-1])
             if self.nnodes:
                 self._append_frames(group, chunk.q)
         self.rows += n
@@ -1007,7 +1103,7 @@ def write_support_deflections(path: Path, analysis: str, deflections: dict[str, 
             return
         if "deflection_support" in group:
             del group["deflection_support"]
-        support = group.create_group("deflection_support")
+        support = _subgroup(group, "deflection_support")
         support.attrs["reference"] = reference
         for name, values in deflections.items():
             data = _dataset(support, name, values, "m")
@@ -1018,7 +1114,7 @@ def write_support_deflections(path: Path, analysis: str, deflections: dict[str, 
 
 # -- engineering answers (SPEC section 10) -----------------------------------------------------
 def _reaction_group(group: h5py.Group, name: str, force, moment, axial) -> None:
-    sub = group.create_group(name)
+    sub = _subgroup(group, name)
     _dataset(sub, "force", np.asarray(force, dtype=float), "N")
     _dataset(sub, "moment", np.asarray(moment, dtype=float), "N m")
     if axial is not None:
@@ -1029,7 +1125,7 @@ def _reaction_group(group: h5py.Group, name: str, force, moment, axial) -> None:
 
 
 def _section_group(group: h5py.Group, name: str, forces) -> None:
-    sub = group.create_group(name)
+    sub = _subgroup(group, name)
     _dataset(sub, "s", forces.s, "m")
     for key, units in (("N", "N"), ("T", "N m"), ("Q", "N"), ("M", "N m")):
         _dataset(sub, key, getattr(forces, key), units)
@@ -1046,20 +1142,20 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
     answers = static_answers(model, e, lam, stations)
     found, forces, stress = answers.reactions, answers.sections, answers.stress
     with _open_write(path) as h5:
-        group = h5.require_group("static")
+        group = _subgroup(h5, "static")
         for key in ("reactions", "sections", "stress"):
-            if key in group:
+            if _has(group, key):
                 del group[key]
         if found:
-            reactions_group = group.create_group("reactions")
+            reactions_group = _subgroup(group, "reactions")
             for name, r in found.items():
                 _reaction_group(reactions_group, name, r.force, r.moment, r.axial)
         if forces:
-            sections_group = group.create_group("sections")
-            stress_group = group.create_group("stress")
+            sections_group = _subgroup(group, "sections")
+            stress_group = _subgroup(group, "stress")
             for name, f in forces.items():
                 _section_group(sections_group, name, f)
-                sub = stress_group.create_group(name)
+                sub = _subgroup(stress_group, name)
                 _dataset(sub, "s", f.s, "m")
                 _dataset(sub, "sigma_x", stress[name].sigma_x, "Pa")
                 _dataset(sub, "von_mises", stress[name].von_mises, "Pa")
@@ -1080,16 +1176,28 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
 def write_dynamic_answers(path: Path, recorder) -> None:
     """/dynamic/reactions/<joint> (leading time axis), /dynamic/sections/<beam> (when the
     recorder keeps them) and the stress envelope /dynamic/stress/<beam> (von_mises_max,
-    t_max per station; attributes max, s_max, t_max) of a DynamicAnswers recorder."""
+    t_max per station; attributes max, s_max, t_max) of a DynamicAnswers recorder (a
+    chunk still waiting in it recorded first: ``recorder.complete()``; when that fails,
+    as when a chunk fails in the runner's sink, the answers are not written and the
+    model's warnings say why)."""
+    complete = getattr(recorder, "complete", None)
+    if complete is not None:
+        from ..errors import AncfError
+        try:
+            complete()
+        except (AncfError, ValueError, FloatingPointError) as exc:
+            recorder.model.warnings.append(f"dynamic reactions, section forces and stresses "
+                                           f"not recorded: {exc}")
+            return
     if not recorder.time:
         return
     with _open_write(path) as h5:
-        group = h5.require_group("dynamic")
+        group = _subgroup(h5, "dynamic")
         for key in ("reactions", "sections", "stress"):
-            if key in group:
+            if _has(group, key):
                 del group[key]
         if recorder.reactions:
-            reactions_group = group.create_group("reactions")
+            reactions_group = _subgroup(group, "reactions")
             for name, chunks in recorder.reactions.items():
                 if not chunks:
                     continue
@@ -1097,16 +1205,16 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 _reaction_group(reactions_group, name, np.concatenate([c[0] for c in chunks]),
                                 np.concatenate([c[1] for c in chunks]), axial)
         if recorder.sections:
-            sections_group = group.create_group("sections")
+            sections_group = _subgroup(group, "sections")
             for name, chunks in recorder.sections.items():
-                sub = sections_group.create_group(name)
+                sub = _subgroup(sections_group, name)
                 _dataset(sub, "s", chunks[0].s, "m")
                 for key, units in (("N", "N"), ("T", "N m"), ("Q", "N"), ("M", "N m")):
                     _dataset(sub, key, np.concatenate([getattr(c, key) for c in chunks]), units)
         if recorder.envelope:
-            stress_group = group.create_group("stress")
+            stress_group = _subgroup(group, "stress")
             for name, (s, best, when) in recorder.envelope.items():
-                sub = stress_group.create_group(name)
+                sub = _subgroup(stress_group, name)
                 _dataset(sub, "s", s, "m")
                 _dataset(sub, "von_mises_max", best, "Pa")
                 _dataset(sub, "t_max", when, "s")
@@ -1200,7 +1308,7 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
     with _open_write(path) as h5:
         if name in h5:
             del h5[name]
-        group = h5.create_group(name)
+        group = _subgroup(h5, name)
         for key, (values, units) in series.items():
             _dataset(group, key, np.asarray(values), units)
         data = _dataset(group, "shapes", shapes, COORDINATE_UNITS)

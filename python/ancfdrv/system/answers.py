@@ -984,12 +984,49 @@ class DynamicAnswers:
         self.state = (t, e.copy(), v1, a1, accel1)
         return v1, accel1
 
+    #: a chunk of 2 to WAIT_ROWS rows (the stepper's first call, which measures a step's
+    #: cost: 10 steps), fewer than a block holds, waits and is recorded with the next
+    #: chunk: one pass over the rows instead of two (a pass costs ~0.1-0.3 ms on a tiny
+    #: system); single rows (the initial row, the intervals of adaptive steps) do not
+    #: wait. :meth:`complete` records a chunk still waiting.
+    WAIT_ROWS = 16
+
+    _waiting = None
+
+    def complete(self) -> None:
+        """Record the chunk still waiting (:data:`WAIT_ROWS`): before the answers are read."""
+        waiting, self._waiting = self._waiting, None
+        if waiting is not None:
+            self._blocks(waiting)
+
     def __call__(self, chunk) -> None:
         """Record a chunk of rows, in blocks of about ANSWER_BLOCK_BYTES of full coordinates
-        (the work arrays hold ~5 copies of a block's: bounded whatever the chunk's length)."""
+        (the work arrays hold ~5 copies of a block's: bounded whatever the chunk's length);
+        a short chunk waits for the next one (:data:`WAIT_ROWS`)."""
         if chunk.q is None:
             raise ValueError("DynamicAnswers needs the coordinates of every step (store_q)")
-        rows = max(1, ANSWER_BLOCK_BYTES // (8 * max(self.model.nfull, 1)))
+        contact = getattr(chunk, "contact", None)
+        if self._waiting is not None:
+            held, self._waiting = self._waiting, None
+            chunk = SimpleNamespace(
+                time=np.concatenate([held.time, chunk.time]),
+                q=np.concatenate([held.q, chunk.q]), lam=np.concatenate([held.lam, chunk.lam]),
+                contact=None if contact is None or held.contact is None
+                else np.concatenate([held.contact, contact]))
+        elif 1 < len(chunk.time) <= self.WAIT_ROWS and len(chunk.time) < self._block_rows():
+            self._waiting = SimpleNamespace(   # copies: the chunk's arrays may be reused
+                time=np.array(chunk.time), q=np.array(chunk.q), lam=np.array(chunk.lam),
+                contact=None if contact is None else np.array(contact))
+            return
+        self._blocks(chunk)
+
+    def _block_rows(self) -> int:
+        """The rows of a block (about ANSWER_BLOCK_BYTES of full coordinates)."""
+        return max(1, ANSWER_BLOCK_BYTES // (8 * max(self.model.nfull, 1)))
+
+    def _blocks(self, chunk) -> None:
+        """Record a chunk in blocks of about ANSWER_BLOCK_BYTES of full coordinates."""
+        rows = self._block_rows()
         n = len(chunk.time)
         if n <= rows:
             self._record(chunk)
