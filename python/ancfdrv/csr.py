@@ -44,13 +44,14 @@ class Csr:
     0-based, int64 indices. Column order within a row is whatever the producing operation
     left (sorted after :meth:`from_coo`, :meth:`transpose` and :meth:`sort_indices`)."""
 
-    __slots__ = ("shape", "indptr", "indices", "data")
+    __slots__ = ("shape", "indptr", "indices", "data", "_term_plan")
 
     def __init__(self, data, indices, indptr, shape: tuple[int, int]) -> None:
         self.data = np.asarray(data, dtype=float)
         self.indices = np.asarray(indices, dtype=np.int64)
         self.indptr = np.asarray(indptr, dtype=np.int64)
         self.shape = (int(shape[0]), int(shape[1]))
+        self._term_plan: tuple | None = None
         if len(self.indptr) != self.shape[0] + 1 or len(self.indices) != len(self.data) \
                 or (len(self.indptr) and self.indptr[-1] != len(self.data)):
             raise ValueError(f"inconsistent CSR arrays for shape {self.shape}: indptr "
@@ -204,16 +205,30 @@ class Csr:
             raise ValueError(f"dimension mismatch: {self.shape} @ {x.shape}")
         dtype = np.result_type(self.data, x)
         out = np.zeros((self.shape[0],) + x.shape[1:], dtype=dtype)
-        counts = np.diff(self.indptr)
         if not self.nnz:
             return out
         products = (self.data.reshape((-1,) + (1,) * (x.ndim - 1)) * x[self.indices])
-        rows = self.row_index()
-        local = np.arange(self.nnz) - self.indptr[rows]
-        for k in range(int(counts.max())):   # the k-th term of every row that has one
-            at = np.nonzero(local == k)[0] if k else self.indptr[:-1][counts > 0]
+        rows, order, bounds = self.term_plan()
+        for k in range(len(bounds) - 1):   # the k-th term of every row that has one
+            at = order[bounds[k]:bounds[k + 1]]
             out[rows[at]] += products[at]
         return out
+
+    def term_plan(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(row of every entry, entries grouped by their place k in their row, where each k's
+        group starts): the order in which :meth:`matvec` adds the terms, so each row's sum is
+        formed in storage order in O(nnz) work. Kept while the structure arrays are the same
+        objects (every method that changes the structure assigns new arrays)."""
+        plan = self._term_plan
+        if plan is not None and plan[0] is self.indptr and plan[1] is self.indices:
+            return plan[2]
+        rows = self.row_index()
+        local = np.arange(self.nnz) - self.indptr[rows]
+        order = np.argsort(local, kind="stable")
+        bounds = np.zeros(int(local.max(initial=-1)) + 2, dtype=np.int64)
+        np.cumsum(np.bincount(local, minlength=len(bounds) - 1), out=bounds[1:])
+        self._term_plan = (self.indptr, self.indices, (rows, order, bounds))
+        return rows, order, bounds
 
     def rmatvec(self, x) -> np.ndarray:
         """A^T x for x (nrow,) or (nrow, k): scipy's ``A.T @ x`` (csc_matvec: rows of A in

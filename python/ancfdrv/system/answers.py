@@ -160,8 +160,18 @@ class ReactionMap:
             external += m.drives[index].value(t) * vector
         r = internal - load_factor * external
         if a is not None:
-            r += m.mass_full @ m.expand(a, with_offset=False)
+            r += self._mass_full() @ m.expand(a, with_offset=False)
         return r
+
+    def _mass_full(self):
+        """The full mass matrix for the residual's M q'': scipy's compiled product where the
+        eliminated joints' factorization has imported scipy anyway (the residual is formed on
+        every row there), else the model's numpy CSR; the two are bitwise equal."""
+        if self.factor is None:
+            return self.model.mass_full
+        if not hasattr(self, "_mass_full_scipy"):
+            self._mass_full_scipy = self.model.mass_full.to_scipy()
+        return self._mass_full_scipy
 
     def _term_arrays(self) -> None:
         """Flat arrays of the multiplier constraints' terms (constraint, operand slot, dof,
