@@ -307,38 +307,46 @@ contains
   end subroutine integrator_chunk
 
   !> e''_{n+1} by the extrapolation kind from accel = e''_n and the learned e''_{n-1},
-  !> e''_{n-2} (predict_hold .. predict_alternate_linear; the module's notes).
+  !> e''_{n-2} (predict_hold .. predict_fitted; the module's notes).
   pure subroutine extrapolate(kind, accel, learned, accel_new)
     integer, intent(in) :: kind
     real(dp), intent(in) :: accel(:)
     type(stepper_state), intent(in) :: learned
     real(dp), intent(out) :: accel_new(:)
-    select case (kind)
-    case (predict_alternate)
-      accel_new = learned%accel_before
-    case (predict_linear)
-      accel_new = 2.0_dp * accel - learned%accel_before
-    case (predict_quadratic)
-      accel_new = 3.0_dp * (accel - learned%accel_before) + learned%accel_before2
-    case (predict_alternate_linear)
-      accel_new = (accel + learned%accel_before) - learned%accel_before2
-    case (predict_fitted)
-      call fitted_extrapolation(accel, learned, accel_new)
-    case default
+    real(dp) :: alpha, beta
+    if (kind == predict_hold) then   ! (no history needed: none may be learned yet)
       accel_new = accel
-    end select
+      return
+    end if
+    alpha = 0.0_dp
+    beta = 0.0_dp
+    if (kind == predict_fitted) call fit_recurrence(accel, learned, alpha, beta)
+    accel_new = extrapolated(kind, accel, learned%accel_before, learned%accel_before2, &
+                             alpha, beta)
   end subroutine extrapolate
 
-  !> e''_{n+1} = e''_n + alpha d_n + beta d_{n-1} (d_k = e''_k - e''_{k-1}; fit_recurrence).
-  pure subroutine fitted_extrapolation(accel, learned, accel_new)
-    real(dp), intent(in) :: accel(:)
-    type(stepper_state), intent(in) :: learned
-    real(dp), intent(out) :: accel_new(:)
-    real(dp) :: alpha, beta
-    call fit_recurrence(accel, learned, alpha, beta)
-    accel_new = accel + alpha * (accel - learned%accel_before) &
-                + beta * (learned%accel_before - learned%accel_before2)
-  end subroutine fitted_extrapolation
+  !> One coordinate of e''_{n+1} by the extrapolation kind from now = e''_n, before =
+  !> e''_{n-1}, before2 = e''_{n-2} (alpha, beta: fit_recurrence's, for predict_fitted): the
+  !> one expression of each kind, for the predictor (extrapolate) and for judging the kinds
+  !> after a step (learn_predictor).
+  elemental real(dp) function extrapolated(kind, now, before, before2, alpha, beta)
+    integer, intent(in) :: kind
+    real(dp), intent(in) :: now, before, before2, alpha, beta
+    select case (kind)
+    case (predict_alternate)
+      extrapolated = before
+    case (predict_linear)
+      extrapolated = 2.0_dp * now - before
+    case (predict_quadratic)
+      extrapolated = 3.0_dp * (now - before) + before2
+    case (predict_alternate_linear)
+      extrapolated = (now + before) - before2
+    case (predict_fitted)
+      extrapolated = now + alpha * (now - before) + beta * (before - before2)
+    case default
+      extrapolated = now
+    end select
+  end function extrapolated
 
   !> alpha, beta: the least-squares fit of d_n = alpha d_{n-1} + beta d_{n-2} over the
   !> coordinates (d_k = e''_k - e''_{k-1}, e''_n = accel): the recurrence of one dominant
@@ -414,17 +422,19 @@ contains
   pure subroutine learn_predictor(learned, h, accel, accel_new)
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: h, accel(:), accel_new(:)
-    real(dp) :: misses(0:predict_fitted), alpha, beta, target, now, before, before2
+    real(dp) :: misses(0:predict_fitted), alpha, beta
     logical :: usable(0:predict_fitted)
     integer :: kind, i
     if (.not. allocated(learned%accel_before)) then
       allocate (learned%accel_before(size(accel)), learned%accel_before2(size(accel)), &
                 learned%accel_before3(size(accel)))
+      learned%accel_before2 = 0.0_dp   ! (read, unused, by the kinds that do not need them)
+      learned%accel_before3 = 0.0_dp
       learned%predictor = predict_hold
       learned%predict_history = 0
     else
       ! the candidates as this step would have used them (its own size h), their misses in
-      ! one pass over the coordinates (extrapolate's expressions)
+      ! one pass over the coordinates
       do kind = 0, predict_fitted
         usable(kind) = usable_predictor(learned, h, kind) == kind
       end do
@@ -433,21 +443,11 @@ contains
       if (usable(predict_fitted)) call fit_recurrence(accel, learned, alpha, beta)
       misses = 0.0_dp
       do i = 1, size(accel)
-        target = accel_new(i)
-        now = accel(i)
-        before = learned%accel_before(i)
-        misses(predict_hold) = max(misses(predict_hold), abs(target - now))
-        misses(predict_alternate) = max(misses(predict_alternate), abs(target - before))
-        misses(predict_linear) = max(misses(predict_linear), &
-                                     abs(target - (2.0_dp * now - before)))
-        if (.not. usable(predict_quadratic)) cycle
-        before2 = learned%accel_before2(i)
-        misses(predict_quadratic) = max(misses(predict_quadratic), &
-                                        abs(target - (3.0_dp * (now - before) + before2)))
-        misses(predict_alternate_linear) = max(misses(predict_alternate_linear), &
-                                               abs(target - ((now + before) - before2)))
-        misses(predict_fitted) = max(misses(predict_fitted), &
-          abs(target - (now + alpha * (now - before) + beta * (before - before2))))
+        do kind = predict_hold, predict_fitted
+          if (usable(kind)) misses(kind) = max(misses(kind), abs(accel_new(i) - &
+            extrapolated(kind, accel(i), learned%accel_before(i), learned%accel_before2(i), &
+                         alpha, beta)))
+        end do
       end do
       learned%predictor = predict_hold
       do kind = predict_alternate, predict_fitted
