@@ -76,7 +76,9 @@ def _assert_series_equal_file(sim, path: Path) -> int:
             if isinstance(obj, h5py.Dataset) and obj.ndim and len(obj) == len(h5["dynamic/time"]):
                 names.append(name)
         h5["dynamic"].visititems(visit)
-        rows = [n for n in names if not n.startswith(("reactions", "sections", "mesh_"))]
+        # the answers, support deflections and XDMF frames are not row series of the writer
+        rows = [n for n in names if not n.startswith(("reactions/", "sections/", "mesh_",
+                                                      "deflection_support/"))]
         assert sorted(rows) == sim.names
         for name in rows:
             expected, got = h5["dynamic"][name][()], sim.series(name)
@@ -156,6 +158,21 @@ def test_general_scene_with_force_element_answers(tmp_path):
     with h5py.File(path, "r") as h5:
         assert sim.reaction("cylinder")["axial"].tobytes() == \
             h5["dynamic/reactions/cylinder/axial"][()].tobytes()
+    _assert_same_files(path, saved)
+
+
+def test_general_scene_support_deflections(tmp_path):
+    sim, _, path, saved = _run_both(tmp_path, INPUTS / "general" / "boom_luffing.nml",
+                                    ["solver.t_end=0.05"])
+    _assert_series_equal_file(sim, path)
+    with h5py.File(path, "r") as h5:
+        names = sorted(h5["dynamic/deflection_support"])
+        assert names
+        for name in names:
+            assert sim.deflection_support(name).tobytes() == \
+                h5["dynamic/deflection_support"][name][()].tobytes()
+            assert sim.deflection_support(name, "static").tobytes() == \
+                h5["static/deflection_support"][name][()].tobytes()
     _assert_same_files(path, saved)
 
 
