@@ -67,6 +67,13 @@ class Simulation:
         self.timing: dict[str, float] = dict(output.timing)
         self.attrs: dict[str, Any] = dict(output.dynamic_attrs)
 
+    @property
+    def summary(self) -> dict[str, int | str]:
+        """The model's figures (the file's /model attributes: ndof, nnodes, nelements,
+        nconstraints, ...)."""
+        model = self._output.model
+        return {} if model is None else dict(model.summary())
+
     # -- the dynamic series -------------------------------------------------------------------
     @property
     def names(self) -> list[str]:
