@@ -474,6 +474,7 @@ def run_in_memory(scene: Scene, output: MemoryOutput, *, start: float | None = N
     what was computed before a failure or an interrupt stays in ``output``, its status
     'failed' or 'interrupted'. :func:`ancfdrv.simulate` is the public door."""
     start = time.perf_counter() if start is None else start
+    output.input_files, output.writes_xdmf = input_files(scene), writes_xdmf(scene)
     with StopRequest() as stop:
         outcome = _run_locked(scene, output, start, progress, stop, model)
     if stop.signum is not None:  # after the last step: the results are complete

@@ -181,6 +181,10 @@ class MemoryOutput:
         self.journal: list[tuple[str, Any, tuple, dict]] = []
         self.scene = None
         self.model = None
+        #: the files the scene reads (never overwritten by save) and whether its run writes
+        #: the XDMF description (set by the runner: :func:`ancfdrv.runner.run_in_memory`)
+        self.input_files: list[Path] = []
+        self.writes_xdmf = False
         self.static = None              # StaticResult (static, settled or modal start)
         self.static_answers = None      # ancfdrv.system.answers.Answers of the static state
         self.support: dict[str, dict[str, np.ndarray]] = {}   # analysis -> probe -> values
@@ -333,8 +337,7 @@ class MemoryOutput:
             from ..errors import InputError
             raise InputError("nothing to save: the run stopped before its model was built",
                              file=str(path))
-        from ..runner import input_files, writes_xdmf
-        check_output_path(path, input_files(self.scene), xdmf=writes_xdmf(self.scene))
+        check_output_path(path, self.input_files, xdmf=self.writes_xdmf)
         if path.exists() or path.is_symlink():
             if not replace:
                 from ..errors import InputError
