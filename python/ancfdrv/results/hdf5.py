@@ -703,7 +703,6 @@ def _steps(chunk, before) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             np.asarray(cuts, dtype=np.int64))
 
 
-
 def row_series(chunk, probe_names: list[str], npoints: int, total0: float,
                before: float | None) -> list[tuple[str, np.ndarray]]:
     """The rows of a chunk as /dynamic stores them: (series name, values) in the order the
