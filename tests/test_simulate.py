@@ -232,17 +232,22 @@ def test_save_refuses_an_existing_file_and_input_files(tmp_path):
 
 def test_in_memory_run_writes_no_file(tmp_path):
     """No file anywhere: not the scene's default output (results/<scene>.h5), nothing in
-    the working directory."""
+    the working directory. ``import ancfdrv`` does not import the in-memory module (it is
+    loaded on first use of ``ancfdrv.simulate``), and the run imports no scipy, as a
+    dynamic run_scene (tests/test_lazy_imports.py)."""
     scene, sets = PENDULUM
     code = textwrap.dedent(f"""
+        import sys
         import ancfdrv
+        print("ancfdrv.simulation" in sys.modules)
         sim = ancfdrv.simulate({str(scene)!r}, {sets!r}, progress=False)
+        print(sorted(m for m in sys.modules if m == "scipy" or m.startswith("scipy.")))
         print(len(sim.time))
     """)
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           cwd=tmp_path, timeout=120)
     assert done.returncode == 0, done.stderr[-2000:]
-    assert done.stdout.split()[-1] == "51"
+    assert done.stdout.split("\n")[:3] == ["False", "[]", "51"]
     assert list(tmp_path.iterdir()) == []
 
 
