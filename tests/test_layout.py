@@ -107,7 +107,8 @@ LAYERS = [
     {"results"},                    # HDF5, XDMF, locks, output paths, the result object
     {"builders"},                   # templates and the general namelist form: Scene -> System
     {"runner"},                     # one scene start to finish
-    {"analyses", "sweep_exec"},     # System.static/simulate/modes/buckling; sweep workers
+    {"analyses", "sweep_exec",      # System.static/simulate/modes/buckling; sweep workers;
+     "simulation"},                 # ancfdrv.simulate: a scene run kept in memory
     {"sweep", "scenedoc"},
     {"cli"},
     {"ancfdrv"},

@@ -7,6 +7,8 @@ store the results in HDF5 (:mod:`ancfdrv.results`); :mod:`ancfdrv.runner` ties t
 together and :mod:`ancfdrv.cli` is the ``ancf`` command. From Python, ``System.static()``
 and ``System.simulate()`` run the same path (:mod:`ancfdrv.analyses`) and return
 :class:`~ancfdrv.results.Results`; ``ancfdrv.open(path)`` reads any result file.
+``ancfdrv.simulate(scene, overrides)`` runs a scene file as ``ancf run`` does and keeps the
+results in memory (:class:`~ancfdrv.simulation.Simulation`, no file unless ``save(path)``).
 """
 import os as _os
 
@@ -33,6 +35,17 @@ from . import analyses as _analyses  # noqa: E402,F401  (gives System its analys
 #: ``ancfdrv.open(path)``: any result file as :class:`~ancfdrv.results.Results`
 open = open_results  # noqa: A001 - the package's own name, as SPEC section 10 spells it
 
-__all__ = ["open", "open_results", "Results", "System", "Model", "Material", "Beam", "Cable",
+
+
+def __getattr__(name: str):
+    """``ancfdrv.simulate`` and ``ancfdrv.Simulation`` (:mod:`ancfdrv.simulation`: a scene
+    run with its results kept in memory), imported on first use."""
+    if name in ("simulate", "Simulation"):
+        from . import simulation
+        return getattr(simulation, name)
+    raise AttributeError(f"module 'ancfdrv' has no attribute {name!r}")
+
+
+__all__ = ["simulate", "Simulation", "open", "open_results", "Results", "System", "Model", "Material", "Beam", "Cable",
            "Plate", "Leaf", "RigidBody", "Rectangle", "Box", "Tube", "Circle", "General",
            "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table", "Ramp"]

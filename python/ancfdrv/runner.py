@@ -14,13 +14,17 @@ A run never loses or mislabels data:
   what was computed is flushed and the file says status = 'interrupted';
 * whatever ends the run (success, bad input found late, solver failure, interrupt,
   unexpected exception), the file's final status says so.
+
+:func:`run_in_memory` runs the same path with the output kept in memory (a
+:class:`~ancfdrv.results.memory.MemoryOutput` stands where the file is: it takes the same
+writer calls and replays them into a file when asked): :func:`ancfdrv.simulate`.
 """
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
@@ -38,13 +42,27 @@ from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
 from .solvers.static import StaticResult, solve_newton, solve_static
 
+if TYPE_CHECKING:
+    from .results.memory import MemoryOutput
+
+
+def _io(out: "Path | MemoryOutput") -> Any:
+    """Where a run's output goes: the HDF5 writer (:mod:`ancfdrv.results.hdf5`) for a file,
+    or, for a run kept in memory (:func:`run_in_memory`), its
+    :class:`~ancfdrv.results.memory.MemoryOutput`, which takes the same calls (the path
+    argument being itself), keeps what they carry and replays them into a file on
+    ``save``."""
+    return results if isinstance(out, Path) else out
+
 
 @dataclass
 class RunOutcome:
-    """What a run produced: the output file and the results of each analysis."""
+    """What a run produced: the output file (or the
+    :class:`~ancfdrv.results.memory.MemoryOutput` of a run kept in memory) and the results
+    of each analysis."""
 
     scene: Scene
-    output: Path
+    output: "Path | MemoryOutput"
     static: StaticResult | None
     dynamic: DynamicResult | None
     warnings: list[str]
@@ -95,25 +113,25 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
                            gamma=solver["gamma"], **common)
 
 
-def _settle(scene: Scene, model: Model, out: Path, settle: str, timing: dict[str, Any],
-            stop: StopRequest) -> StaticResult:
+def _settle(scene: Scene, model: Model, out: Path | MemoryOutput, settle: str,
+            timing: dict[str, Any], stop: StopRequest) -> StaticResult:
     """The static equilibrium a settled dynamic run starts from (Newton, loads scaled by
     0 or 1), written to /static with the attribute settle."""
     solver = scene["solver"]
-    with results.released(out), stop.immediate():
+    with _io(out).released(out), stop.immediate():
         result = solve_newton(model, tol=solver["tol"], max_iter=solver["max_iter"],
                               load_steps=solver["load_steps"],
                               loads=0.0 if settle == "unloaded" else 1.0)
     result.extra["settle"] = settle
     for phase, seconds in result.timing.items():
         timing[f"settle_{phase}"] = seconds
-    results.write_static(out, model, result)
+    _io(out).write_static(out, model, result)
     _write_static_supports(out, model, result)
     _write_static_answers(scene, model, out, result)
     return result
 
 
-def _write_static_supports(out: Path, model: Model, static: StaticResult) -> None:
+def _write_static_supports(out: Path | MemoryOutput, model: Model, static: StaticResult) -> None:
     """/static/deflection_support of a general scene (:mod:`ancfdrv.system.supports`)."""
     frames = model.support_frames
     if not frames:
@@ -122,7 +140,7 @@ def _write_static_supports(out: Path, model: Model, static: StaticResult) -> Non
                                   support_deflections)
     values = {k: v[0] for k, v in support_deflections(model, frames,
                                                       model.expand(static.e)).items()}
-    results.write_support_deflections(
+    _io(out).write_support_deflections(
         out, "static", values, {n: frames[model.probes[n].body].describe() for n in values},
         SUPPORT_REFERENCE, DISPLACEMENT_REFERENCE)
 
@@ -151,22 +169,23 @@ class SupportRecorder:
             writer(chunk)
         return sink
 
-    def write(self, out: Path, rows: int) -> None:
+    def write(self, out: Path | MemoryOutput, rows: int) -> None:
         from .system.supports import DISPLACEMENT_REFERENCE, SUPPORT_REFERENCE
         if not self.rows:
             return
         values = {name: np.concatenate([r[name] for r in self.rows])[:rows]
                   for name in self.rows[0]}
-        results.write_support_deflections(
+        _io(out).write_support_deflections(
             out, "dynamic", values,
             {n: self.frames[self.model.probes[n].body].describe() for n in values},
             SUPPORT_REFERENCE, DISPLACEMENT_REFERENCE)
 
 
-def _write_static_answers(scene: Scene, model: Model, out: Path, result: StaticResult) -> None:
+def _write_static_answers(scene: Scene, model: Model, out: Path | MemoryOutput,
+                          result: StaticResult) -> None:
     """Reactions, section forces and stresses of the static state (SPEC section 10)."""
-    results.write_static_answers(out, model, result.e, result.lam,
-                                 scene["output"].get("stations", 3))
+    _io(out).write_static_answers(out, model, result.e, result.lam,
+                                  scene["output"].get("stations", 3))
 
 
 def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
@@ -192,10 +211,10 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     return recorder
 
 
-def _warn_large_ffr_deflection(model: Model, out: Path) -> None:
+def _warn_large_ffr_deflection(model: Model, out: Path | MemoryOutput) -> None:
     """The warning of an 'ffr' run whose tip deflects by more than 5% of the length."""
     if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
-        with results.reading(out) as h5:
+        with _io(out).reading(out) as h5:
             deflection = h5["dynamic/deflection/tip"][()]
         ratio = np.abs(deflection).max() / model.length_scale
         if ratio > 0.05:
@@ -248,7 +267,7 @@ def check_reduction(scene: Scene, model: Model) -> None:
         raise _reduction_error(scene, beam, str(exc)) from None
 
 
-def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
+def _run_reduced(scene: Scene, model: Model, out: Path | MemoryOutput, static: StaticResult,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
     """The dynamic run of the modally reduced model (&beam modes = N): the layout of the
@@ -263,11 +282,11 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
     # the chunks carry the expanded coordinates
     settings.store_q = bool(xdmf or write_q or supports is not None)
     try:
-        with results.released(out), stop.immediate():
+        with _io(out).released(out), stop.immediate():
             reduced = reduce_ffr(model, static, beam.modes)
     except SolverError as exc:  # e.g. more modes than the constrained model has
         raise _reduction_error(scene, beam, str(exc)) from None
-    writer = results.DynamicWriter(
+    writer = _io(out).DynamicWriter(
         out, model, settings.store_q, settings.chunk_steps, xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
         frames=scene["output"]["xdmf_frames"], write_q=write_q)
@@ -280,24 +299,24 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
         "not_provided": NOT_PROVIDED}
     sink = writer if supports is None else supports.wrap(writer)
     try:
-        with results.released(out):  # the file is closed between the writes of the run
+        with _io(out).released(out):  # the file is closed between the writes of the run
             dyn = integrate_reduced(model, reduced, settings, sink=sink, progress=progress,
                                     should_stop=stop)
     finally:
         writer.flush_last()
         if supports is not None:
             supports.write(out, writer.rows)
-        results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
+        _io(out).write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)}, {})
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     _warn_large_ffr_deflection(model, out)
     bounds = stage_bounds(scene)
     stages: dict[str, float] = {}
     if bounds:
-        with results.reading(out) as h5:
+        with _io(out).reading(out) as h5:
             stages = stage_summary(h5["dynamic/time"][()], h5["dynamic/deflection/tip"][:, 1],
                                    bounds)
-    results.write_dynamic_attrs(out, {
+    _io(out).write_dynamic_attrs(out, {
         **attrs, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
         "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,
         "jacobian_policy": "constant", "wall_time_s": dyn.wall_time_s, "status": "ok",
@@ -307,7 +326,7 @@ def _run_reduced(scene: Scene, model: Model, out: Path, static: StaticResult,
     return dyn, stages
 
 
-def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
+def _run_dynamic(scene: Scene, model: Model, out: Path | MemoryOutput, e_start: np.ndarray,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest, static: StaticResult | None = None
                  ) -> tuple[DynamicResult, dict]:
@@ -332,7 +351,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
     # (chunk_steps rows) took a third of a small model's run
     row_bytes = 8 * (16 + 6 * len(model.probes) + len(model.constraints)
                      + 6 * model.npoint + (model.ndof if settings.store_q else 0))
-    writer = results.DynamicWriter(
+    writer = _io(out).DynamicWriter(
         out, model, settings.store_q, max(settings.chunk_steps, (16 << 20) // row_bytes),
         xdmf=xdmf,
         total_rows=int(round(settings.t_end / settings.dt)) + 1,
@@ -363,36 +382,36 @@ def _run_dynamic(scene: Scene, model: Model, out: Path, e_start: np.ndarray,
             base_sink(chunk)
     done = False  # the attributes are written once: the full set after a completed run
     try:
-        with results.released(out):  # the file is closed between the writes of the run
+        with _io(out).released(out):  # the file is closed between the writes of the run
             dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
                             should_stop=stop)
         writer.flush_last()
         if supports is not None:
             supports.write(out, writer.rows)
         if recorder is not None:
-            results.write_dynamic_answers(out, recorder)
+            _io(out).write_dynamic_answers(out, recorder)
         for phase, seconds in dyn.timing.items():
             timing[f"dynamic_{phase}"] = seconds
         stages: dict[str, float] = {}
         _warn_large_ffr_deflection(model, out)
         bounds = stage_bounds(scene)
         if bounds:
-            with results.reading(out) as h5:
+            with _io(out).reading(out) as h5:
                 t = h5["dynamic/time"][()]
                 transverse = h5["dynamic/deflection/tip"][:, 1]
             stages = stage_summary(t, transverse, bounds)
         done = True
     finally:  # also after a failure or an interrupt: every computed step goes to the file
         if not done:
-            results.drop(out)  # the held file may be in any state after an error
+            _io(out).drop(out)  # the held file may be in any state after an error
             writer.flush_last()
             if supports is not None:
                 supports.write(out, writer.rows)
             if recorder is not None:
-                results.write_dynamic_answers(out, recorder)
-            results.write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)},
+                _io(out).write_dynamic_answers(out, recorder)
+            _io(out).write_dynamic_attrs(out, {**attrs, "steps": max(writer.rows - 1, 0)},
                                         {})
-    results.write_dynamic_attrs(out, {
+    _io(out).write_dynamic_attrs(out, {
         **attrs, "steps": dyn.steps, "newton_iterations": dyn.newton_iterations,
         "factorizations": dyn.factorizations, "jacobian_evaluations": dyn.jacobians,
         "jacobian_policy": "constant" if model.constant_policy else settings.jacobian,
@@ -447,11 +466,28 @@ def run_loaded(scene: Scene, output: str | Path | None = None, *,
     return outcome
 
 
-def _interrupt_message(out: Path, signum: int | None) -> str:
+def run_in_memory(scene: Scene, output: MemoryOutput, *, start: float | None = None,
+                  progress: bool | None = None, model: Model | None = None) -> RunOutcome:
+    """Run a loaded scene as :func:`run_loaded` does (the same model, solvers, settings and
+    status handling) with its output kept in ``output`` instead of a file: no output path,
+    no lock, no file. Raises as :func:`run_loaded` (InputError, SolverError, Interrupted);
+    what was computed before a failure or an interrupt stays in ``output``, its status
+    'failed' or 'interrupted'. :func:`ancfdrv.simulate` is the public door."""
+    start = time.perf_counter() if start is None else start
+    output.input_files, output.writes_xdmf = input_files(scene), writes_xdmf(scene)
+    with StopRequest() as stop:
+        outcome = _run_locked(scene, output, start, progress, stop, model)
+    if stop.signum is not None:  # after the last step: the results are complete
+        raise Interrupted(f"interrupted by {signal_name(stop.signum)} after the run completed; "
+                          f"{output} are complete (status 'ok')", signum=stop.signum)
+    return outcome
+
+
+def _interrupt_message(out: Path | MemoryOutput, signum: int | None) -> str:
     """What an interrupted run left in its output file, in one line."""
     what = f"interrupted by {signal_name(signum)}"
     try:
-        summary = results.read_summary(out)
+        summary = _io(out).read_summary(out)
     except AncfError:
         return f"{what}; see {out}"
     if "dynamic.t_reached" in summary:
@@ -464,7 +500,7 @@ def _interrupt_message(out: Path, signum: int | None) -> str:
     return f"{what}{kept} (status 'interrupted')"
 
 
-def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
+def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: bool | None,
                 stop: StopRequest, model: Model | None = None) -> RunOutcome:
     analysis = scene["scene"]["analysis"]
     t0 = time.perf_counter()
@@ -488,33 +524,33 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
     def finish(status: str, message: str = "", *, after_error: bool = True) -> None:
         timing["total"] = time.perf_counter() - start
         if after_error:  # the held file may be in any state: reopened for the final status
-            results.drop(out)
+            _io(out).drop(out)
         try:
-            results.finish(out, model, timing, status, message)
+            _io(out).finish(out, model, timing, status, message)
         except OSError:
             if not after_error:
                 raise  # after an error, the error being raised matters more
         finally:
             if after_error:  # closed before anything reads it (the interrupt message)
-                results.drop(out)
+                _io(out).drop(out)
     # the file stays open between the writes that follow each other without computing
     # (create and the dynamic writer's set-up; the last rows, answers, attributes and
     # status): closed in the solves and the stepping (results.released)
-    with results.holding(out):
+    with _io(out).holding(out):
         try:
-            results.create(out, scene, model)
+            _io(out).create(out, scene, model)
             e_start = model.e0
             if analysis in ("static", "static+dynamic"):
                 solver = scene["solver"]
                 # the static solvers write nothing while they iterate
-                with results.released(out), stop.immediate():
+                with _io(out).released(out), stop.immediate():
                     static = solve_static(model, solver["static_method"], tol=solver["tol"],
                                           max_iter=solver["max_iter"], p=solver["split_p"],
                                           load_steps=solver["load_steps"])
                 for phase, seconds in static.timing.items():
                     timing[f"static_{phase}"] = seconds
                 t0 = time.perf_counter()
-                results.write_static(out, model, static)
+                _io(out).write_static(out, model, static)
                 _write_static_supports(out, model, static)
                 _write_static_answers(scene, model, out, static)
                 timing["output"] = time.perf_counter() - t0
@@ -530,7 +566,7 @@ def _run_locked(scene: Scene, out: Path, start: float, progress: bool | None,
                 dynamic, stages = _run_dynamic(scene, model, out, e_start, timing, progress, stop,
                                                static)
             if analysis in ("modal", "buckling"):
-                with results.released(out), stop.immediate():
+                with _io(out).released(out), stop.immediate():
                     run_eigen(scene, model, out, timing)
         except Interrupted as exc:
             signum = stop.signum or exc.signum
@@ -587,7 +623,7 @@ def fixed_load_model(scene: Scene, fixed: list[str]) -> Model:
     return model
 
 
-def run_eigen(scene: Scene, model: Model, out: Path, timing: dict[str, Any]) -> None:
+def run_eigen(scene: Scene, model: Model, out: Path | MemoryOutput, timing: dict[str, Any]) -> None:
     """analysis = 'modal' (about the static equilibrium) or 'buckling'; writes /modal or
     /buckling, /static, and the XDMF of the shapes."""
     from .results.xdmf import MeshLayout, write_mode_xdmf
@@ -605,7 +641,7 @@ def run_eigen(scene: Scene, model: Model, out: Path, timing: dict[str, Any]) -> 
                                 spin_rate=settings["spin_rate"],
                                 spin_axis=settings["spin_axis"],
                                 spin_centre=settings["spin_centre"])
-        results.write_modal(out, model, result)
+        _io(out).write_modal(out, model, result)
     else:
         settings = eigen_settings(scene, "buckling")
         fixed = list(settings["fixed_loads"])
@@ -621,9 +657,12 @@ def run_eigen(scene: Scene, model: Model, out: Path, timing: dict[str, Any]) -> 
         finally:
             if base is not model:
                 base.close()
-        results.write_buckling(out, model, result)
+        _io(out).write_buckling(out, model, result)
     timing[f"{analysis}_total"] = time.perf_counter() - t0
     for phase, seconds in result.timing.items():
         timing[f"{analysis}_{phase}"] = seconds
     if scene["output"].get("xdmf", True) and MeshLayout.from_model(model) is not None:
-        write_mode_xdmf(out, analysis)
+        if isinstance(out, Path):
+            write_mode_xdmf(out, analysis)
+        else:  # a run kept in memory: written by its save()
+            out.write_mode_xdmf(out, analysis)

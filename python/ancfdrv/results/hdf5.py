@@ -683,6 +683,60 @@ def _append_rows(group_id: h5py.h5g.GroupID, name: str, start: int,
     data.write(h5py.h5s.create_simple(values.shape), space, values)
 
 
+def _steps(chunk, before) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(step_size, substeps, step_cuts) of a chunk's rows; a chunk without them: one
+    step each, of the rows' time difference (``before``: the time of the row before
+    the chunk, None for the initial row, whose step is 0)."""
+    n = len(chunk.time)
+    size = getattr(chunk, "step_size", None)
+    if size is None:
+        previous = np.concatenate([[chunk.time[0] if before is None else before],
+                                   chunk.time[:-1]]) if n else np.zeros(0)
+        size = chunk.time - previous
+    substeps = getattr(chunk, "substeps", None)
+    if substeps is None:
+        substeps = (np.asarray(size) > 0).astype(np.int64)
+    cuts = getattr(chunk, "cuts", None)
+    if cuts is None:
+        cuts = np.zeros(n, dtype=np.int64)
+    return (np.asarray(size, dtype=float), np.asarray(substeps, dtype=np.int64),
+            np.asarray(cuts, dtype=np.int64))
+
+
+def row_series(chunk, probe_names: list[str], npoints: int, total0: float,
+               before: float | None) -> list[tuple[str, np.ndarray]]:
+    """The rows of a chunk as /dynamic stores them: (series name, values) in the order the
+    writer writes them (time, probes, deflection, lambda, energy with its balance, contact,
+    constraint_violation, the step statistics, step_size, substeps, step_cuts), q apart.
+    ``total0``: the total energy of the run's first row; ``before``: the time of the row
+    before the chunk (None for a chunk that starts the run or carries its step sizes).
+    The one place these values are made: the file's writer and a run kept in memory
+    (:mod:`ancfdrv.results.memory`) both use it."""
+    from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
+    out: list[tuple[str, np.ndarray]] = [("time", chunk.time)]
+    for p, name in enumerate(probe_names):
+        out.append((f"probes/{name}", chunk.probes[:, p, :]))
+        out.append((f"deflection/{name}", chunk.deflections[:, p, :]))
+    out.append(("lambda", chunk.lam))
+    for k, name in enumerate(ENERGY_NAMES):
+        out.append((f"energy/{name}", chunk.energy[:, k]))
+    # total - total(0) - work of drives, moving frames, contact damping, friction and
+    # material damping
+    out.append(("energy/balance", chunk.energy[:, 4] - total0 - chunk.energy[:, 5]
+                - chunk.energy[:, 6] - chunk.energy[:, 8] - chunk.energy[:, 9]
+                - chunk.energy[:, 10]))
+    if npoints and chunk.contact is not None:
+        for k, name in enumerate(CONTACT_FIELDS):
+            out.append((f"contact/{name}", chunk.contact[:, :, k]))
+    out.append(("constraint_violation", chunk.constraint))
+    out.append(("newton_iterations", np.rint(chunk.stats[:, 0]).astype(np.int64)))
+    out.append(("factorizations", np.rint(chunk.stats[:, 1]).astype(np.int64)))
+    out.append(("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64)))
+    size, substeps, cuts = _steps(chunk, before)
+    out += [("step_size", size), ("substeps", substeps), ("step_cuts", cuts)]
+    return out
+
+
 class DynamicWriter:
     """Appends the chunks of a dynamic run to /dynamic (SPEC section 4).
 
@@ -964,13 +1018,13 @@ class DynamicWriter:
 
     def _merged(self, group: h5py.Group):
         """The waiting chunks as one chunk (their rows in order; the step sizes, substeps
-        and cuts of chunks without them as :meth:`_steps` gives them)."""
+        and cuts of chunks without them as :func:`_steps` gives them)."""
         from types import SimpleNamespace
         chunks = self._pending
         before = group["time"][self.rows - 1] if self.rows else None
         steps = []
         for chunk in chunks:
-            steps.append(self._steps(chunk, before))
+            steps.append(_steps(chunk, before))
             if len(chunk.time):
                 before = chunk.time[-1]
 
@@ -994,72 +1048,23 @@ class DynamicWriter:
 
     def _append(self, group: h5py.Group, chunk) -> None:
         n = len(chunk.time)
-
-        def append(name: str, values: np.ndarray) -> None:
-            self._put(group, name, values)
-        append("time", chunk.time)
-        for p, name in enumerate(self.names):
-            append(f"probes/{name}", chunk.probes[:, p, :])
-            append(f"deflection/{name}", chunk.deflections[:, p, :])
-        append("lambda", chunk.lam)
-        for k, name in enumerate(self.energy_names):
-            append(f"energy/{name}", chunk.energy[:, k])
         total0 = group["energy/total"][0] if self.rows else chunk.energy[0, 4]
-        # total - total(0) - work of drives, moving frames, contact damping, friction and
-        # material damping
-        append("energy/balance", chunk.energy[:, 4] - total0 - chunk.energy[:, 5]
-               - chunk.energy[:, 6] - chunk.energy[:, 8] - chunk.energy[:, 9]
-               - chunk.energy[:, 10])
-        if self.npoints and chunk.contact is not None:
-            for k, name in enumerate(self.contact_fields):
-                append(f"contact/{name}", chunk.contact[:, :, k])
-        append("constraint_violation", chunk.constraint)
-        append("newton_iterations", np.rint(chunk.stats[:, 0]).astype(np.int64))
-        append("factorizations", np.rint(chunk.stats[:, 1]).astype(np.int64))
-        append("jacobian_evaluations", np.rint(chunk.stats[:, 2]).astype(np.int64))
-        self._append_steps(group, chunk)
+        before = group["time"][self.rows - 1] \
+            if self.rows and getattr(chunk, "step_size", None) is None else None
+        for name, values in row_series(chunk, self.names, self.npoints, total0, before):
+            self._put(group, name, values)
         if self.store_q and getattr(chunk, "q_last", None) is not None:   # thinned
             self._put_q_last(group, chunk.q_last)
             if chunk.frames is not None:
                 self._write_frames(group, *chunk.frames)
         elif self.store_q and chunk.q is not None:
             if self.write_q:
-                append("q", chunk.q)
+                self._put(group, "q", chunk.q)
             elif n:
                 self._put_q_last(group, chunk.q[-1])
             if self.nnodes:
                 self._append_frames(group, chunk.q)
         self.rows += n
-
-    def _append_steps(self, group: h5py.Group, chunk) -> None:
-        """step_size, substeps, step_cuts of the chunk's rows (a chunk without them: one
-        step each, of the rows' time difference; the initial row 0)."""
-        size = getattr(chunk, "step_size", None)
-        before = group["time"][self.rows - 1] if self.rows and size is None else None
-        size, substeps, cuts = self._steps(chunk, before)
-        self._put(group, "step_size", np.asarray(size, dtype=float))
-        self._put(group, "substeps", np.asarray(substeps, dtype=np.int64))
-        self._put(group, "step_cuts", np.asarray(cuts, dtype=np.int64))
-
-    @staticmethod
-    def _steps(chunk, before) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(step_size, substeps, step_cuts) of a chunk's rows; a chunk without them: one
-        step each, of the rows' time difference (``before``: the time of the row before
-        the chunk, None for the initial row, whose step is 0)."""
-        n = len(chunk.time)
-        size = getattr(chunk, "step_size", None)
-        if size is None:
-            previous = np.concatenate([[chunk.time[0] if before is None else before],
-                                       chunk.time[:-1]]) if n else np.zeros(0)
-            size = chunk.time - previous
-        substeps = getattr(chunk, "substeps", None)
-        if substeps is None:
-            substeps = (np.asarray(size) > 0).astype(np.int64)
-        cuts = getattr(chunk, "cuts", None)
-        if cuts is None:
-            cuts = np.zeros(n, dtype=np.int64)
-        return (np.asarray(size, dtype=float), np.asarray(substeps, dtype=np.int64),
-                np.asarray(cuts, dtype=np.int64))
 
     def _append_frames(self, group: h5py.Group, q: np.ndarray) -> None:
         """The points' positions at the chunk's frame rows (every stride-th and the last)."""
@@ -1134,12 +1139,15 @@ def _section_group(group: h5py.Group, name: str, forces) -> None:
 
 
 def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarray,
-                         stations: int = 3) -> None:
+                         stations: int = 3, answers=None) -> None:
     """/static/reactions/<joint>, /static/sections/<beam>, /static/stress/<beam> of the
     static state (ancfdrv.system.answers), and /model/constraint_joints (the joint of each
-    row of lambda)."""
+    row of lambda). ``answers``: the state's :func:`~ancfdrv.system.answers.static_answers`
+    when already computed (a run kept in memory, saved after its model's kernel was
+    released), else computed here."""
     from ..system.answers import constraint_joints, static_answers
-    answers = static_answers(model, e, lam, stations)
+    if answers is None:
+        answers = static_answers(model, e, lam, stations)
     found, forces, stress = answers.reactions, answers.sections, answers.stress
     with _open_write(path) as h5:
         group = _subgroup(h5, "static")
