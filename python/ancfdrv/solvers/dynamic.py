@@ -197,10 +197,36 @@ def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
     r = np.concatenate([matrix.row_index(), cols, n + rows])
     c = np.concatenate([matrix.indices, n + rows, cols])
     v = np.concatenate([matrix.data, -grads, -grads])
-    with DirectSolver(n + ncon, r, c, what=what) as solver:
+    rhs = np.concatenate([rhs_top, rhs_bottom])
+    if n + ncon > SADDLE_REUSE_MAX:
+        with DirectSolver(n + ncon, r, c, what=what) as solver:
+            solver.factorize(v)
+            x = solver.solve(rhs)
+        return x[:n], x[n:]
+    solver = _SADDLE_SOLVERS.pop() if _SADDLE_SOLVERS else None
+    try:
+        if solver is None:
+            solver = DirectSolver(n + ncon, r, c, what=what)
+        else:
+            solver.what = what
+            solver.analyse(n + ncon, r, c)
         solver.factorize(v)
-        x = solver.solve(np.concatenate([rhs_top, rhs_bottom]))
+        x = solver.solve(rhs)
+    except BaseException:
+        if solver is not None:   # after a failure: released, not reused
+            solver.close()
+        raise
+    _SADDLE_SOLVERS.append(solver)
     return x[:n], x[n:]
+
+
+#: saddle systems of at most this many unknowns share MUMPS instances (a free list of
+#: :data:`_SADDLE_SOLVERS`), analysed anew for each system: an instance's creation and
+#: release were half of a small model's initial acceleration (~1 M instructions, mostly
+#: MUMPS's set-up). A larger system gets its own instance, released after the solve (so
+#: no large factors stay in memory).
+SADDLE_REUSE_MAX = 4096
+_SADDLE_SOLVERS: list[DirectSolver] = []
 
 
 def initial_acceleration(model: Model, e: np.ndarray, v: np.ndarray, t: float):
@@ -514,10 +540,13 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
               v0: np.ndarray | None = None, t0: float = 0.0, *,
               sink: Callable[[Chunk], None] | None = None,
               progress: bool | None = None,
-              should_stop: Callable[[], bool] | None = None) -> DynamicResult:
+              should_stop: Callable[[], bool] | None = None,
+              initial: tuple[np.ndarray, np.ndarray] | None = None) -> DynamicResult:
     """Integrate from (t0, e0, v0) to settings.t_end. Each chunk goes to ``sink`` as soon
     as it is computed (the first one holds the initial state). A failed step raises
-    SolverError after the completed steps have gone to the sink.
+    SolverError after the completed steps have gone to the sink. ``initial``: the
+    consistent (a0, lambda0) of :func:`initial_acceleration` at (t0, e0, v0) when the
+    caller computed them already (not solved again).
 
     A kernel call takes at most about 0.25 s of wall time (the first call's time per step
     caps the following ones, never more than settings.chunk_steps), and ``should_stop`` is
@@ -534,7 +563,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
         raise SolverError(f"t_end = {settings.t_end} lies before the start time {t0}")
     v0 = np.zeros(model.ndof) if v0 is None else v0
     integrator = TimeIntegrator(model, settings)
-    a0, lam0 = initial_acceleration(model, e0, v0, t0)
+    a0, lam0 = initial_acceleration(model, e0, v0, t0) if initial is None else initial
     state = integrator.state(t0, e0, v0, a0, lam0)
     timing["setup"] = time.perf_counter() - start
     t1 = time.perf_counter()
