@@ -249,3 +249,55 @@ def test_repeated_group_still_found_without_the_scan(tmp_path, monkeypatch):
     with pytest.raises(InputError, match=r"group given twice \(lines \d+ and \d+\)") as err:
         load_scene(path)
     assert err.value.group == "beam" and scans == [1]
+
+
+# -- the constraint set's kernel arguments (system/constraint_set.py) ------------------------
+def _copy_of(cs):
+    """A new set with the same lists (no cached arguments)."""
+    from ancfdrv.system.constraint_set import ConstraintSet
+    import copy
+    return ConstraintSet(kinds=list(cs.kinds), drives=list(cs.drives),
+                         params=copy.deepcopy(cs.params),
+                         operand_const=copy.deepcopy(cs.operand_const),
+                         terms=copy.deepcopy(cs.terms), names=list(cs.names),
+                         drive_kinds=list(cs.drive_kinds),
+                         drive_params=copy.deepcopy(cs.drive_params))
+
+
+def _same_evaluation(a, b, e, t):
+    return all(np.array_equal(x, y) for x, y in zip(a.evaluate(e, t, e), b.evaluate(e, t, e)))
+
+
+def test_constraint_arguments_follow_every_change():
+    """The kernel arguments a constraint set keeps between evaluations are made again
+    after any change of its lists (a constraint added, a parameter, an operand's term or
+    constant, a drive's parameters changed in place): every evaluation equals that of a
+    new set holding the same lists."""
+    from ancfdrv.codes import CONSTRAINT_COORDINATE
+    model = _model("boom_luffing.nml", ["solver.t_end=0.05"])
+    try:
+        cs = model.constraints
+        e = model.e0 * (1 + 1e-3)
+        t = 0.7
+        assert _same_evaluation(cs, _copy_of(cs), e, t)
+        first = cs._kernel_inputs()
+        assert cs._kernel_inputs() is first          # unchanged: kept
+        cs.params[0][0] += 0.25
+        assert _same_evaluation(cs, _copy_of(cs), e, t)
+        d, a = cs.terms[0][0][0]
+        cs.terms[0][0][0] = (d, 2 * a)
+        assert _same_evaluation(cs, _copy_of(cs), e, t)
+        cs.operand_const[-1][0] -= 0.5
+        assert _same_evaluation(cs, _copy_of(cs), e, t)
+        driven = [c for c in range(len(cs)) if cs.drives[c] >= 0]
+        assert driven, "the boom's luffing drive"
+        params = cs.drive_params[cs.drives[driven[0]]]
+        params[0] = float(params[0]) + 0.1
+        assert _same_evaluation(cs, _copy_of(cs), e, t)
+        cs.add(CONSTRAINT_COORDINATE, [({1: 1.0}, 0.0)], [0.5], -1, "added")
+        values, *_ = cs.evaluate(e, t)
+        assert len(values) == len(cs) and values[-1] == e[1] - 0.5
+        assert _same_evaluation(cs, _copy_of(cs), e, t)
+        assert not any(a.flags.writeable for a in cs._kernel_inputs())
+    finally:
+        model.close()
