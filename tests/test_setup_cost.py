@@ -301,3 +301,86 @@ def test_constraint_arguments_follow_every_change():
         assert not any(a.flags.writeable for a in cs._kernel_inputs())
     finally:
         model.close()
+
+
+def test_energy_watch_sums_as_numpy_does():
+    """The energy watch's column sums give numpy's row sums bitwise (the figures of the
+    warning of created energy), for chunks of every size the stepper hands it."""
+    rng = np.random.default_rng(5)
+    for rows in (1, 2, 7, 16, 17, 990, 1001):
+        energy = rng.standard_normal((rows, 11)) * np.exp(rng.uniform(-25, 25, (rows, 11)))
+        works = energy[:, [5, 6, 8, 9, 10]]
+        columns = energy.T
+        assert np.array_equal(works.sum(axis=1), columns[5] + columns[6] + columns[8]
+                              + columns[9] + columns[10])
+        assert np.array_equal(energy[:, 1:4].sum(axis=1), columns[1] + columns[2] + columns[3])
+        first = energy[0]
+        watch = dynamic.EnergyWatch(first)
+        watch.add(energy)
+        balance = energy[:, 4] - first[4] - works.sum(axis=1)
+        potential = energy[:, 1:4].sum(axis=1) - first[1:4].sum()
+        assert watch.most == max(0.0, float(balance.max()))
+        assert watch.scale == max(float(np.abs(energy[:, 0]).max()),
+                                  float(np.abs(potential).max()),
+                                  float(np.abs(energy[:, 0] + energy[:, 1]).max()),
+                                  float(np.abs(works).max()))
+
+
+# -- the planar reduction's plan (system/patterns.py) -----------------------------------------
+@pytest.mark.parametrize("scene,overrides", [
+    ("hard/pendulum.nml", PENDULUM),
+    ("hard/pendulum.nml", ["beam.nodes=9", "scene.planar=xy"]),
+    ("boom_luffing.nml", ["scene.formulation=nonlinear", "solver.static_method=newton",
+                          "beam.bending=cable", "beam.nodes=4", "scene.planar=xy"]),
+    ("boom_luffing.nml", ["scene.formulation=nonlinear", "solver.static_method=newton",
+                          "beam.nodes=4", "scene.planar=xy"]),
+    ("hard/spinup.nml", ["scene.planar=xy"]),
+])
+def test_selection_plan_is_the_general_plan(scene, overrides, monkeypatch):
+    """A reduction that only fixes coordinates (the planar fixes) gets from the direct
+    construction exactly the arrays of the general one (B, q0, the coordinates kept, the
+    reduced pattern, the plan of B^T S B), and the model built with it is the same."""
+    from ancfdrv.system import assembly, patterns
+    seen = []
+    real = patterns.reduction_plan
+
+    def spy(*args):
+        seen.append(args)
+        return real(*args)
+    monkeypatch.setattr(assembly, "reduction_plan", spy)
+    model = _model(scene, overrides)
+    model.close()
+    assert seen
+    for args in seen:
+        nfull, elimination, q0, full_pattern = args
+        if any(r.terms for r in elimination.relations.values()):
+            continue   # eliminated joints: the general plan
+        fast = patterns._selection_plan(*args)
+        general = patterns._general_plan(*args)
+        for name in ("offset", "independent", "plan_source", "plan_target", "plan_coef"):
+            a, b = getattr(fast, name), getattr(general, name)
+            assert a.dtype == b.dtype and np.array_equal(a, b), name
+        for name in ("data", "indices", "indptr"):
+            a, b = getattr(fast.matrix, name), getattr(general.matrix, name)
+            assert a.dtype == b.dtype and np.array_equal(a, b), name
+        assert fast.matrix.shape == general.matrix.shape
+        assert fast.pattern.n == general.pattern.n
+        assert np.array_equal(fast.pattern.row_ptr, general.pattern.row_ptr)
+        assert np.array_equal(fast.pattern.col_index, general.pattern.col_index)
+        break
+    else:
+        pytest.fail("no planar reduction without eliminated joints")
+
+
+def test_selection_plan_refuses_a_missed_configuration():
+    """A fixed coordinate whose constant misses the initial configuration is refused as by
+    the general construction."""
+    from ancfdrv.system.expressions import Scalar
+    from ancfdrv.system.patterns import Elimination, Pattern, reduction_plan
+    q0 = np.array([0.0, 1.0, 2.0, 3.0])
+    pattern = Pattern.from_blocks(4, [np.arange(4)])
+    ok = reduction_plan(4, Elimination({1: Scalar({}, 1.0)}, []), q0, pattern)
+    assert np.array_equal(ok.independent, [0, 2, 3])
+    assert np.array_equal(ok.expand(np.array([5.0, 6.0, 7.0])), [5.0, 1.0, 6.0, 7.0])
+    with pytest.raises(AssertionError, match="misses the initial configuration"):
+        reduction_plan(4, Elimination({1: Scalar({}, 1.5)}, []), q0, pattern)

@@ -441,15 +441,22 @@ class EnergyWatch:
         self.first = first.copy()
         self.most, self.scale = 0.0, 0.0
 
+    #: the works among ENERGY_NAMES (drives, frames, contact damping, friction, damping)
+    WORKS = (5, 6, 8, 9, 10)
+
     def add(self, energy: np.ndarray) -> None:
-        works = energy[:, [5, 6, 8, 9, 10]]
-        balance = energy[:, 4] - self.first[4] - works.sum(axis=1)
-        potential = energy[:, 1:4].sum(axis=1) - self.first[1:4].sum()
+        # column by column (no copy of the works' columns): the sums in numpy's order of
+        # a row sum over a few columns (left to right), so the figures are bitwise those
+        # of works.sum(axis=1) and energy[:, 1:4].sum(axis=1)
+        columns = energy.T
+        works = columns[5] + columns[6] + columns[8] + columns[9] + columns[10]
+        balance = columns[4] - self.first[4] - works
+        potential = columns[1] + columns[2] + columns[3] - self.first[1:4].sum()
         self.most = max(self.most, float(balance.max()))
-        self.scale = max(self.scale, float(np.abs(energy[:, 0]).max()),
+        self.scale = max(self.scale, float(np.abs(columns[0]).max()),
                          float(np.abs(potential).max()),
-                         float(np.abs(energy[:, 0] + energy[:, 1]).max()),
-                         float(np.abs(works).max()))
+                         float(np.abs(columns[0] + columns[1]).max()),
+                         float(np.array([np.abs(columns[k]).max() for k in self.WORKS]).max()))
 
     def created(self) -> float:
         return self.most / self.scale if self.scale > 0 else 0.0

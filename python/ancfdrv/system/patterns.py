@@ -193,6 +193,51 @@ def reduction_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
                    full_pattern: Pattern) -> Reduction:
     """B, q0 (checked against the initial configuration), the reduced pattern (structure of
     B^T P B plus the diagonal) and the plan forming B^T S B on it."""
+    if all(not relation.terms for relation in elimination.relations.values()):
+        return _selection_plan(nfull, elimination, q0, full_pattern)
+    return _general_plan(nfull, elimination, q0, full_pattern)
+
+
+def _selection_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
+                    full_pattern: Pattern) -> Reduction:
+    """:func:`_general_plan` where every relation is a constant (the planar fixes: B
+    selects the independent coordinates), its arrays made directly: B's one 1 per
+    independent row, the full pattern's entries between independent coordinates (each
+    one pair of B entries, coefficient 1) in the full pattern's order."""
+    relations = elimination.relations
+    dependent = np.zeros(nfull, dtype=bool)
+    dependent[list(relations)] = True
+    independent = np.flatnonzero(~dependent).astype(np.int64)
+    nred = len(independent)
+    column = -np.ones(nfull, dtype=np.int64)
+    column[independent] = np.arange(nred)
+    offset = np.zeros(nfull)
+    fixed = np.array(list(relations), dtype=np.int64)
+    offset[fixed] = [relations[int(i)].const for i in fixed]
+    indptr = np.zeros(nfull + 1, dtype=np.int64)
+    np.cumsum(~dependent, out=indptr[1:])
+    b = Csr(np.ones(nred), np.arange(nred), indptr, (nfull, nred))
+    mismatch = np.abs(offset[fixed] - q0[fixed])
+    if mismatch.max(initial=0.0) > 1e-9 * max(1.0, np.abs(q0).max(initial=0.0)):
+        raise AssertionError(f"the reduction misses the initial configuration by "
+                             f"{mismatch.max():.3e}")
+    f_rows, f_cols = full_pattern.rows, full_pattern.col_index
+    source = np.flatnonzero(~dependent[f_rows] & ~dependent[f_cols]).astype(np.int64)
+    pair_a, pair_c = column[f_rows[source]], column[f_cols[source]]
+    diagonal = np.arange(nred)
+    reduced = Csr.structure(nred, np.concatenate([pair_a, diagonal]),
+                            np.concatenate([pair_c, diagonal]))
+    pattern = Pattern(nred, reduced.indptr, reduced.indices)
+    target = pattern.positions(pair_a, pair_c)
+    if (target < 0).any():
+        raise AssertionError("reduced pattern misses an entry of B^T S B")
+    return Reduction(b, offset, independent, pattern, source, target, np.ones(len(source)),
+                     relations)
+
+
+def _general_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
+                  full_pattern: Pattern) -> Reduction:
+    """:func:`reduction_plan` for any relations."""
     relations = elimination.relations
     independent = np.array([i for i in range(nfull) if i not in relations], dtype=np.int64)
     column = -np.ones(nfull, dtype=np.int64)
