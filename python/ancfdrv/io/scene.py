@@ -106,6 +106,7 @@ _FAST_TOKEN = re.compile(r"""
 _FAST_INT = re.compile(r"[+-]?\d+\Z")
 _FAST_FLOAT = re.compile(r"[+-]?(?:\d+\.\d*|\.\d+|\d+(?=[eEdD]))(?:[eEdD][+-]?\d+)?\Z")
 _FAST_LOGICAL = {".true.": True, ".t.": True, ".false.": False, ".f.": False}
+_DICT_CONTAINS, _DICT_SET = OrderedDict.__contains__, OrderedDict.__setitem__
 
 
 def _fast_value(kind: str, token: str) -> Any:
@@ -140,9 +141,13 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
     def close_key() -> bool:
         if key is None:
             return True
-        if not values or key.lower() in group:
+        lower = key.lower()
+        # f90nml's `lower in group` and `group[key] = value` for a group's plain values
+        # (no cogroups inside a group; a scalar or a list of scalars is stored as it is,
+        # under the lower-case key), without their per-call type checks
+        if not values or _DICT_CONTAINS(group, lower):
             return False
-        group[key] = values[0] if len(values) == 1 else list(values)
+        _DICT_SET(group, lower, values[0] if len(values) == 1 else list(values))
         return True
     for match in _FAST_TOKEN.finditer(text):
         kind = match.lastgroup
