@@ -391,7 +391,10 @@ def _reduce_rows(joint, generalized: np.ndarray, slots: np.ndarray, q_rows: np.n
         position = slots % (per // 3) == 0          # a node's first vector: its position
         force = block[:, position].sum(axis=1)
         moment = _cross(values[:, position] - point[:, None, :], block[:, position]).sum(axis=1)
-        moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
+        if position.all():   # no other vector: the sum over none, +0.0 each
+            moment += 0.0
+        else:
+            moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
     swapped = getattr(joint, "swapped", False)
     if swapped:
         force, moment = -force, -moment

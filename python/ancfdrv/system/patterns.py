@@ -99,10 +99,24 @@ class Reduction:
     plan_target: np.ndarray
     plan_coef: np.ndarray
     relations: dict[int, Scalar] = field(default_factory=dict)
+    #: the full index of each reduced coordinate when B only selects them (every relation
+    #: a constant: :func:`_selection_plan`), else None
+    selects: np.ndarray | None = None
 
     def expand(self, x: np.ndarray, with_offset: bool = True) -> np.ndarray:
         """Full coordinates (or, without the offset, velocities) from reduced ones; x may be
         (nred,) or (nt, nred)."""
+        if self.selects is not None:
+            # B x placed directly: each selected row's sum 0 + 1 x (as the product forms
+            # it: a -0.0 becomes 0.0), the others 0, then the offset
+            x = np.asarray(x)
+            if x.shape[-1] != len(self.selects):
+                raise ValueError(f"dimension mismatch: {self.matrix.shape} @ {x.T.shape}")
+            full = np.zeros(x.shape[:-1] + (len(self.offset),),
+                            dtype=np.result_type(self.matrix.data, x))
+            full[..., self.selects] = x
+            full += self.offset if with_offset else 0.0
+            return full
         full = self.matrix.matvec(np.asarray(x).T).T
         return full + self.offset if with_offset else full
 
@@ -232,7 +246,7 @@ def _selection_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
     if (target < 0).any():
         raise AssertionError("reduced pattern misses an entry of B^T S B")
     return Reduction(b, offset, independent, pattern, source, target, np.ones(len(source)),
-                     relations)
+                     relations, selects=independent)
 
 
 def _general_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
