@@ -412,3 +412,16 @@ def test_selection_expand_is_the_product():
         assert model.carry_vectors() is not None
     finally:
         model.close()
+
+
+def test_gradients_of_an_evaluation_with_velocities():
+    """Phi_e from an evaluation that had the velocities (the initial acceleration's) is
+    Phi_e of an evaluation without them (the operand gradients do not depend on e')."""
+    model = _model("boom_luffing.nml", ["solver.t_end=0.05"])
+    try:
+        cs, e = model.constraints, model.e0 * (1 + 1e-3)
+        v = np.linspace(-1.0, 1.0, model.ndof)
+        with_v = cs.gradient_rows(e, model.ndof, 0.3, cs.evaluate(e, 0.3, v))
+        assert np.array_equal(with_v, cs.gradient_rows(e, model.ndof, 0.3))
+    finally:
+        model.close()

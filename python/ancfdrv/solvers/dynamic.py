@@ -190,10 +190,12 @@ def _progress_bar(show: bool, total: float):
 
 
 def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
-                  rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str):
-    """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]."""
+                  rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str,
+                  evaluated: tuple | None = None):
+    """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]
+    (``evaluated``: the constraints' evaluation at (e, t) when the caller has it)."""
     n, ncon = model.ndof, len(model.constraints)
-    _, rows, cols, grads = model.constraints.jacobian(e, n, t)
+    _, rows, cols, grads = model.constraints.jacobian(e, n, t, evaluated)
     r = np.concatenate([matrix.row_index(), cols, n + rows])
     c = np.concatenate([matrix.indices, n + rows, cols])
     v = np.concatenate([matrix.data, -grads, -grads])
@@ -231,10 +233,11 @@ _SADDLE_SOLVERS: list[DirectSolver] = []
 
 def initial_acceleration(model: Model, e: np.ndarray, v: np.ndarray, t: float):
     """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma."""
-    *_, gamma = model.constraints.evaluate(e, t, v)
+    evaluated = model.constraints.evaluate(e, t, v)   # (its gradients do not depend on v)
     forces = model.forces(e, t, v)
     return _saddle_solve(model, model.mass, forces["external"] - forces["internal"],
-                         -gamma, e, t, "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]")
+                         -evaluated[-1], e, t,
+                         "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]", evaluated)
 
 
 class TimeIntegrator:

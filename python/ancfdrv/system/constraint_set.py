@@ -137,9 +137,11 @@ class ConstraintSet:
         self.__dict__["_inputs"] = (snapshot, args)
         return args
 
-    def jacobian(self, e: np.ndarray, ndof: int | None = None, t: float = 0.0):
-        """Values and Phi_e as COO triplets (rows, cols, values; duplicates add up)."""
-        values, gradients, *_ = self.evaluate(e, t)
+    def jacobian(self, e: np.ndarray, ndof: int | None = None, t: float = 0.0,
+                 evaluated: tuple | None = None):
+        """Values and Phi_e as COO triplets (rows, cols, values; duplicates add up).
+        ``evaluated``: what :meth:`evaluate` returned at (e, t), when the caller has it."""
+        values, gradients, *_ = self.evaluate(e, t) if evaluated is None else evaluated
         rows, cols, vals = [], [], []
         for c, per in enumerate(self.terms):
             for s, terms in enumerate(per):
@@ -150,9 +152,10 @@ class ConstraintSet:
         return (values, np.array(rows, dtype=np.int64), np.array(cols, dtype=np.int64),
                 np.array(vals, dtype=float))
 
-    def gradient_rows(self, e: np.ndarray, ndof: int, t: float = 0.0) -> np.ndarray:
-        """Dense Phi_e (ncon, ndof)."""
-        _, rows, cols, vals = self.jacobian(e, ndof, t)
+    def gradient_rows(self, e: np.ndarray, ndof: int, t: float = 0.0,
+                      evaluated: tuple | None = None) -> np.ndarray:
+        """Dense Phi_e (ncon, ndof) (``evaluated``: see :meth:`jacobian`)."""
+        _, rows, cols, vals = self.jacobian(e, ndof, t, evaluated)
         out = np.zeros((len(self), ndof))
         np.add.at(out, (rows, cols), vals)
         return out
