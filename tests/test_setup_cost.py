@@ -425,3 +425,28 @@ def test_gradients_of_an_evaluation_with_velocities():
         assert np.array_equal(with_v, cs.gradient_rows(e, model.ndof, 0.3))
     finally:
         model.close()
+
+
+@pytest.mark.parametrize("scene", ["hard/pendulum.nml", "boom_luffing.nml", "leaf_spring.nml"])
+def test_kept_analysis_gives_a_fresh_solvers_answer(scene):
+    """Consecutive initial accelerations of one model (the same saddle pattern: the
+    reused instance keeps its analysis and only refactorizes) at different states are
+    bitwise those of instances made for each."""
+    model = _model(scene)
+    try:
+        def solve(k: int):
+            v = np.full(model.ndof, 0.01 * k)
+            return dynamic.initial_acceleration(model, model.e0 * (1 + 1e-4 * k), v, 0.1 * k)
+        kept = [solve(k) for k in range(3)]
+        assert dynamic._SADDLE_SOLVERS[-1].saddle_pattern is not None
+        size = dynamic.SADDLE_REUSE_MAX
+        try:
+            dynamic.SADDLE_REUSE_MAX = -1
+            fresh = [solve(k) for k in range(3)]
+        finally:
+            dynamic.SADDLE_REUSE_MAX = size
+        for (a, lam), (b, mu) in zip(kept, fresh):
+            assert np.array_equal(a, b) and np.array_equal(lam, mu)
+        assert not np.array_equal(kept[0][0], kept[2][0])   # the states differ
+    finally:
+        model.close()

@@ -211,7 +211,14 @@ def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
             solver = DirectSolver(n + ncon, r, c, what=what)
         else:
             solver.what = what
-            solver.analyse(n + ncon, r, c)
+            last = getattr(solver, "saddle_pattern", None)
+            # the pattern it analysed last (MUMPS analyses the structure, its values 0):
+            # the analysis is kept for the same pattern, as for any refactorization
+            if last is None or last[0] != n + ncon or not (
+                    np.array_equal(last[1], r) and np.array_equal(last[2], c)):
+                solver.saddle_pattern = None
+                solver.analyse(n + ncon, r, c)
+        solver.saddle_pattern = (n + ncon, r, c)
         solver.factorize(v)
         x = solver.solve(rhs)
     except BaseException:
