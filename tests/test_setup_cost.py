@@ -450,3 +450,42 @@ def test_kept_analysis_gives_a_fresh_solvers_answer(scene):
         assert not np.array_equal(kept[0][0], kept[2][0])   # the states differ
     finally:
         model.close()
+
+
+@pytest.mark.parametrize("scene,overrides", [
+    ("hard/pendulum.nml", ["beam.nodes=17", "beam.bending=cable", "scene.planar=xy"]),
+    ("hard/spinup.nml", ["scene.planar=xy"]),
+    ("boom_luffing.nml", ["scene.formulation=nonlinear", "solver.static_method=newton",
+                          "scene.planar=xy", "solver.linear_joints='eliminate'"]),
+])
+def test_single_term_elimination_is_the_general_one(scene, overrides, monkeypatch):
+    """The planar fixes (one coordinate each) eliminated directly give the relations the
+    general substitution gives (the same equations with a zero term added, which the
+    substitution drops, take the general way): keys, terms and constants bitwise."""
+    import copy
+    from ancfdrv.system import assembly, patterns
+    seen = []
+    real = patterns.eliminate
+
+    def spy(equations, q0):
+        seen.append((copy.deepcopy(equations), q0.copy()))
+        return real(equations, q0)
+    monkeypatch.setattr(assembly, "eliminate", spy)
+    _model(scene, overrides).close()
+    assert seen
+    for equations, q0 in seen:
+        singles = [eq for eq in equations if len(eq.expr.terms) == 1]
+        assert singles, "planar fixes"
+        general = copy.deepcopy(equations)
+        spare = len(q0) - 1
+        for eq in general:
+            eq.expr.terms = {**eq.expr.terms, spare: 0.0} if spare not in eq.expr.terms \
+                else {**eq.expr.terms, 0: 0.0}
+        fast, slow = real(equations, q0), real(general, q0)
+        assert fast.redundant == slow.redundant
+        assert list(fast.relations) == list(slow.relations)
+        for dof, relation in fast.relations.items():
+            other = slow.relations[dof]
+            assert relation.terms == other.terms
+            assert np.array_equal(np.float64(relation.const), np.float64(other.const))
+            assert np.signbit(relation.const) == np.signbit(other.const)

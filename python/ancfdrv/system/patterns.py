@@ -12,6 +12,8 @@ scipy.sparse (issue 23, a run's memory).
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -157,6 +159,15 @@ def eliminate(equations, q0: np.ndarray) -> Elimination:
         if abs(violation) > 1e-9 * scale:
             raise InputError(f"{eq.name}: the initial configuration violates this joint "
                              f"equation by {violation:.3e} (check the points and bodies)")
+        if len(eq.expr.terms) == 1:
+            # a · q_d + c = 0 (a planar fix) on a coordinate still independent that no
+            # relation uses: the steps below give q_d = -(c + 0) / a (the substitution
+            # adds c to 0), made directly
+            (dof, a), = eq.expr.terms.items()
+            if dof not in result.relations and dof not in users and a != 0.0 \
+                    and math.isfinite(a):
+                result.relations[dof] = Scalar({}, -(eq.expr.const + 0.0) / a)
+                continue
         s = result.substitute(eq.expr)
         big = max((abs(c) for c in s.terms.values()), default=0.0)
         s = Scalar({d: c for d, c in s.terms.items() if abs(c) > 1e-12 * big}, s.const)
