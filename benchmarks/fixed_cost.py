@@ -31,11 +31,21 @@ a quiet machine, the same in every count). Caveat: callgrind counts every iterat
 ``rep stos`` as an instruction, so large ``memset``s (HDF5 zeroes its caches) weigh more
 than their time.
 
+``--phases``: per case (the four above and ``PHASE_CASES``: the pendulum's 9 nodes, the
+hard spin-up, a general scene) the instructions of one whole call (after a warm-up call)
+split by phase: callgrind dumps at the entries and exits of the ``PHASES`` functions
+(scene load, model build and its parts, lock and path checks, answers, initial
+acceleration, dynamic set-up, static solves, HDF5, the kernel's stepping), each interval
+counted to the innermost phase running, the rest "glue"; and the best wall time of
+``--repeats`` whole calls (``--one``). ``--cases a,b`` selects cases; ``--compare`` as
+above. Output ``benchmarks/results/fixed_cost_phases.json``.
+
 Output: ``benchmarks/results/fixed_cost.json`` (``--quick``: ``fixed_cost_quick.json``,
 ignored by git). Run from the repository root::
 
     python benchmarks/fixed_cost.py                   # ~1 minute
     python benchmarks/fixed_cost.py --compare /tmp/old --repeats 20
+    python benchmarks/fixed_cost.py --phases --compare /tmp/old   # ~15 minutes
 """
 from __future__ import annotations
 
