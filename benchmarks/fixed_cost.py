@@ -31,11 +31,21 @@ a quiet machine, the same in every count). Caveat: callgrind counts every iterat
 ``rep stos`` as an instruction, so large ``memset``s (HDF5 zeroes its caches) weigh more
 than their time.
 
+``--phases``: per case (the four above and ``PHASE_CASES``: the pendulum's 9 nodes, the
+hard spin-up, a general scene) the instructions of one whole call (after a warm-up call)
+split by phase: callgrind dumps at the entries and exits of the ``PHASES`` functions
+(scene load, model build and its parts, lock and path checks, answers, initial
+acceleration, dynamic set-up, static solves, HDF5, the kernel's stepping), each interval
+counted to the innermost phase running, the rest "glue"; and the best wall time of
+``--repeats`` whole calls (``--one``). ``--cases a,b`` selects cases; ``--compare`` as
+above. Output ``benchmarks/results/fixed_cost_phases.json``.
+
 Output: ``benchmarks/results/fixed_cost.json`` (``--quick``: ``fixed_cost_quick.json``,
 ignored by git). Run from the repository root::
 
     python benchmarks/fixed_cost.py                   # ~1 minute
     python benchmarks/fixed_cost.py --compare /tmp/old --repeats 20
+    python benchmarks/fixed_cost.py --phases --compare /tmp/old   # ~15 minutes
 """
 from __future__ import annotations
 
@@ -64,22 +74,70 @@ CASES: dict[str, tuple[str, list[str]]] = {
         "scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.",
         "beam.bending=cable", "beam.nodes=7", "scene.planar=xy"]),
 }
+#: further cases of ``--phases`` (with the ones above): the pendulum's middle mesh, the
+#: hard spin-up (2 s of its 20) and a general scene (the cardan shaft, 0.2 s)
+PHASE_CASES: dict[str, tuple[str, list[str]]] = {
+    "pendulum_cable_9": ("inputs/hard/pendulum.nml", [
+        "beam.nodes=9", "solver.dt=1e-3", "beam.bending=cable", "scene.planar=xy"]),
+    "spinup_2s": ("inputs/hard/spinup.nml", ["solver.t_end=2.0", "output.xdmf=.false."]),
+    "general_cardan_shaft": ("inputs/general/cardan_shaft.nml", [
+        "solver.t_end=0.2", "output.xdmf=.false."]),
+}
 QUICK = {"pendulum_cable_5": CASES["pendulum_cable_5"]}
 #: the whole calls counted per case by ``--instructions`` (after two warm-up calls)
 INSTRUCTION_CALLS = 2
 _TOGGLE_C = ("#include <valgrind/callgrind.h>\n"
-             "void callgrind_toggle(void) { CALLGRIND_TOGGLE_COLLECT; }\n")
+             "void callgrind_toggle(void) { CALLGRIND_TOGGLE_COLLECT; }\n"
+             "void callgrind_dump(const char *label) { CALLGRIND_DUMP_STATS_AT(label); }\n")
+#: ``--phases``: the functions whose instructions are counted apart (module, owner, name,
+#: phase); the instructions between two of their entries and exits go to the innermost
+#: phase running, "glue" outside all (the runner, the stepper's Python side, checks)
+PHASES = (
+    ("ancfdrv.runner", None, "load_scene", "scene"),
+    ("ancfdrv.runner", None, "build_model", "model"),
+    ("ancfdrv.builders", None, "build_system", "model: build_system"),
+    ("ancfdrv.system.system", "System", "assemble", "model: assemble"),
+    ("ancfdrv.system.model", "Model", "build_kernel", "model: build_kernel"),
+    ("ancfdrv.runner", None, "check_output_path", "lock and path checks"),
+    ("ancfdrv.runner", "OutputLock", "__enter__", "lock and path checks"),
+    ("ancfdrv.runner", "OutputLock", "__exit__", "lock and path checks"),
+    ("ancfdrv.runner", None, "solve_static", "static solve"),
+    ("ancfdrv.runner", None, "solve_newton", "static solve"),
+    ("ancfdrv.runner", None, "_answers_recorder", "answers"),
+    ("ancfdrv.system.answers", "DynamicAnswers", "__call__", "answers"),
+    ("ancfdrv.system.answers", "DynamicAnswers", "complete", "answers"),
+    ("ancfdrv.solvers.dynamic", None, "initial_acceleration", "initial acceleration"),
+    ("ancfdrv.solvers.dynamic", "TimeIntegrator", "__init__", "dynamic set-up"),
+    ("ancfdrv.solvers.dynamic", "TimeIntegrator", "state", "dynamic set-up"),
+    ("ancfdrv.solvers.dynamic", None, "initial_row", "dynamic set-up"),
+    ("ancfdrv.results.hdf5", None, "create", "HDF5"),
+    ("ancfdrv.results.hdf5", None, "write_static", "HDF5"),
+    ("ancfdrv.results.hdf5", None, "write_static_answers", "HDF5 (with the static answers)"),
+    ("ancfdrv.results.hdf5", None, "write_support_deflections", "HDF5"),
+    ("ancfdrv.results.hdf5", None, "write_dynamic_attrs", "HDF5"),
+    ("ancfdrv.results.hdf5", None, "write_dynamic_answers", "HDF5"),
+    ("ancfdrv.results.hdf5", None, "finish", "HDF5"),
+    ("ancfdrv.results.hdf5", None, "drop", "HDF5"),
+    ("ancfdrv.results.hdf5", None, "reading", "HDF5"),
+    ("ancfdrv.results.hdf5", "DynamicWriter", "__init__", "HDF5"),
+    ("ancfdrv.results.hdf5", "DynamicWriter", "__call__", "HDF5"),
+    ("ancfdrv.results.hdf5", "DynamicWriter", "flush", "HDF5"),
+    ("ancfdrv.results.hdf5", "DynamicWriter", "flush_last", "HDF5"),
+)
+#: context managers of the HDF5 layer (their entries and exits are HDF5's)
+PHASE_CONTEXTS = (("ancfdrv.results.hdf5", "holding"), ("ancfdrv.results.hdf5", "released"))
 
 
 def _call(case: str, out: Path) -> None:
     """One whole call as the peer harness makes it: run, then read the tip history."""
     import h5py
     import ancfdrv.runner as runner
-    scene, overrides = CASES[case]
+    scene, overrides = {**CASES, **PHASE_CASES}[case]
     runner.run_scene(REPO / scene, overrides, out, progress=False)
     with h5py.File(out, "r") as h5:
         h5["dynamic/time"][()]
-        h5["dynamic/probes/tip"][()]
+        probes = h5["dynamic/probes"]
+        probes["tip" if "tip" in probes else next(iter(probes))][()]
 
 
 def counted_calls(case: str, helper: str) -> None:
@@ -109,15 +167,154 @@ def counted_calls(case: str, helper: str) -> None:
     toggle()
 
 
-def instructions(case: str, work: Path) -> dict[str, Any]:
-    """Instructions per whole call of ``case`` (total, stepping, non-stepping; callgrind)."""
+def _quiet_clock() -> None:
+    """The counted processes' settings (no flush by the clock, a stepper clock of 1 us per
+    reading: see :func:`counted_calls`)."""
+    import types
+    import ancfdrv.results.hdf5 as h5
+    import ancfdrv.solvers.dynamic as dynamic
+    h5.FLUSH_SECONDS = 1e9
+    ticks = iter(range(1, 1 << 62))
+    dynamic.time = types.SimpleNamespace(perf_counter=lambda: 1e-6 * next(ticks),
+                                         monotonic=time.monotonic, time=time.time)
+
+
+def phase_calls(case: str, helper: str) -> None:
+    """The child of :func:`phase_instructions`: one warm-up call, then one counted call
+    with a callgrind dump at every entry and exit of a :data:`PHASES` function (each dump
+    named after the phase whose instructions it holds)."""
+    import contextlib
+    import ctypes
+    import importlib
+    _quiet_clock()
+    lib = ctypes.CDLL(helper)
+    stack, on = ["glue"], [False]
+
+    def boundary() -> None:
+        if on[0]:
+            lib.callgrind_dump(stack[-1].encode())
+
+    def enter(label: str) -> None:
+        boundary()
+        stack.append(label)
+
+    def leave() -> None:
+        boundary()
+        stack.pop()
+
+    def wrap(owner: Any, name: str, label: str) -> None:
+        real = getattr(owner, name)
+
+        @functools.wraps(real)
+        def counted(*args: Any, **kwargs: Any) -> Any:
+            enter(label)
+            try:
+                return real(*args, **kwargs)
+            finally:
+                leave()
+        setattr(owner, name, counted)
+
+    def wrap_context(owner: Any, name: str) -> None:
+        real = getattr(owner, name)
+
+        @contextlib.contextmanager
+        def counted(*args: Any, **kwargs: Any):
+            enter("HDF5")
+            try:
+                manager = real(*args, **kwargs)
+                manager.__enter__()
+            finally:
+                leave()
+            try:
+                yield
+            except BaseException as exc:
+                enter("HDF5")
+                try:
+                    if not manager.__exit__(type(exc), exc, exc.__traceback__):
+                        raise
+                finally:
+                    leave()
+            else:
+                enter("HDF5")
+                try:
+                    manager.__exit__(None, None, None)
+                finally:
+                    leave()
+        setattr(owner, name, counted)
+    for module, owner, name, label in PHASES:
+        target = importlib.import_module(module)
+        wrap(target if owner is None else getattr(target, owner), name, label)
+    for module, name in PHASE_CONTEXTS:
+        wrap_context(importlib.import_module(module), name)
+    import ancfdrv.kernel as kernel
+    for value in vars(kernel).values():
+        if isinstance(value, type) and "advance_rows" in vars(value):
+            wrap(value, "advance_rows", "stepping")
+    import ancfdrv.runner as runner
+
+    def call(out: Path) -> None:   # _call, its read-back of the tip history as HDF5's
+        import h5py
+        scene, overrides = {**CASES, **PHASE_CASES}[case]
+        runner.run_scene(REPO / scene, overrides, out, progress=False)
+        enter("HDF5 (the read-back)")
+        try:
+            with h5py.File(out, "r") as h5:
+                h5["dynamic/time"][()]
+                probes = h5["dynamic/probes"]
+                probes["tip" if "tip" in probes else next(iter(probes))][()]
+        finally:
+            leave()
+    out = Path(tempfile.mkdtemp()) / "run.h5"
+    call(out)
+    lib.callgrind_toggle()
+    on[0] = True
+    call(out)
+    boundary()
+    on[0] = False
+    lib.callgrind_toggle()
+
+
+def phase_instructions(case: str, work: Path) -> dict[str, float]:
+    """Instructions of one whole call of ``case`` per phase (callgrind; after a warm-up
+    call, so imports and reused MUMPS instances are those of a process's later calls)."""
     import re
+    helper = _helper(work)
+    target = work / case
+    target.mkdir(parents=True, exist_ok=True)
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
+    subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
+                    f"--callgrind-out-file={target / 'cg'}", sys.executable, __file__,
+                    "--phase-counted", case, "--helper", str(helper)], env=env, check=True,
+                   capture_output=True)
+    found: dict[str, float] = {}
+    for dump in target.glob("cg*"):
+        text = dump.read_text(errors="replace")
+        label = re.search(r"^desc: Trigger: Client Request: (.+)$", text, re.M)
+        total = re.search(r"^(?:summary|totals): (\d+)", text, re.M)
+        if label and total:
+            found[label.group(1)] = found.get(label.group(1), 0) + int(total.group(1))
+    found["outside HDF5, the stepping and static solves"] = sum(
+        v for k, v in found.items() if k not in ("stepping", "static solve")
+        and not k.startswith("HDF5"))
+    return found
+
+
+def _helper(work: Path) -> Path:
+    """The callgrind client-request helper (compiled once per work directory)."""
     helper = work / "callgrind_toggle.so"
     if not helper.exists():
         source = work / "callgrind_toggle.c"
         source.write_text(_TOGGLE_C)
         subprocess.run(["cc", "-O1", "-shared", "-fPIC", "-o", str(helper), str(source)],
                        check=True)
+    return helper
+
+
+def instructions(case: str, work: Path) -> dict[str, Any]:
+
+    """Instructions per whole call of ``case`` (total, stepping, non-stepping; callgrind)."""
+    import re
+    helper = _helper(work)
     profile = work / f"{case}.callgrind"
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
     subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
@@ -172,7 +369,7 @@ def measure(case: str, repeats: int) -> dict[str, Any]:
     for value in vars(kernel).values():
         if isinstance(value, type) and "advance_rows" in vars(value):
             wrap(value, "advance_rows", "kernel stepping")
-    scene, overrides = CASES[case]
+    scene, overrides = {**CASES, **PHASE_CASES}[case]
     out = Path(tempfile.mkdtemp()) / "run.h5"
     runner.run_scene(REPO / scene, overrides, out, progress=False)
     rows, walls = [], []
@@ -193,6 +390,46 @@ def measure(case: str, repeats: int) -> dict[str, Any]:
             "repeats": repeats}
 
 
+def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) -> int:
+    """``--phases``: per case and version, the instructions of one whole call per phase
+    and the best wall time of ``--repeats`` whole calls (interleaved case by case)."""
+    every = {**CASES, **PHASE_CASES}
+    cases = [c for c in (args.cases.split(",") if args.cases else every)]
+    record: dict[str, Any] = {"machine": machine_info(), "load_average_at_start":
+                              load_average(), "cases": {}}
+    for case in cases:
+        versions = {"this": None, **({"compared": args.compare} if args.compare else {})}
+        for label, path in versions.items():
+            env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
+            saved = os.environ.get("PYTHONPATH")
+            if path:
+                env["PYTHONPATH"] = os.environ["PYTHONPATH"] = str(Path(path).resolve())
+            try:
+                with tempfile.TemporaryDirectory() as tmp:
+                    counts = phase_instructions(case, Path(tmp))
+            finally:
+                if path:
+                    if saved is None:
+                        os.environ.pop("PYTHONPATH", None)
+                    else:
+                        os.environ["PYTHONPATH"] = saved
+            done = subprocess.run([sys.executable, __file__, "--one", case, "--repeats",
+                                   str(args.repeats)], env=env, capture_output=True,
+                                  text=True, check=True)
+            timed = json.loads(done.stdout.strip().splitlines()[-1])
+            record["cases"].setdefault(case, {})[label] = {
+                "instructions_per_phase": counts, "load_average": load_average(), **timed}
+            mine = counts["outside HDF5, the stepping and static solves"]
+            print(f"{case:22s} {label:8s} outside HDF5/stepping {mine / 1e6:7.2f} M Ir, "
+                  f"stepping {counts.get('stepping', 0) / 1e6:8.2f} M Ir, whole call best "
+                  f"{timed['whole_wall_best_ms']:7.1f} ms wall", flush=True)
+    record["load_average_at_end"] = load_average()
+    target = REPO / "benchmarks" / "results" / "fixed_cost_phases.json"
+    target.write_text(json.dumps(record, indent=1) + "\n")
+    print(f"wrote {target}")
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeats", type=int, default=15)
@@ -200,8 +437,13 @@ def main() -> int:
     parser.add_argument("--compare", help="directory holding another ancfdrv package")
     parser.add_argument("--instructions", action="store_true",
                         help="also count instructions per call with callgrind")
+    parser.add_argument("--phases", action="store_true",
+                        help="instructions per phase (callgrind) and best wall times of "
+                             "CASES and PHASE_CASES: results/fixed_cost_phases.json")
+    parser.add_argument("--cases", help="--phases: these cases only (comma-separated)")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a subprocess: one case, JSON out
     parser.add_argument("--counted", help=argparse.SUPPRESS)  # under callgrind
+    parser.add_argument("--phase-counted", help=argparse.SUPPRESS)  # under callgrind
     parser.add_argument("--helper", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.one:
@@ -210,8 +452,13 @@ def main() -> int:
     if args.counted:
         counted_calls(args.counted, args.helper)
         return 0
+    if args.phase_counted:
+        phase_calls(args.phase_counted, args.helper)
+        return 0
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from _common import load_average, machine_info
+    if args.phases:
+        return phases_main(args, load_average, machine_info)
     cases = QUICK if args.quick else CASES
     record: dict[str, Any] = {"machine": machine_info(), "cases": {}}
     for case in cases:

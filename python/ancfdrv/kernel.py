@@ -392,6 +392,14 @@ class DirectSolver:
                                               _f(np.asarray(cols) + 1, np.int32))
         self._check(info, detail, "analyse")
 
+    def analyse(self, n: int, rows: np.ndarray, cols: np.ndarray) -> None:
+        """Another pattern on the same solver (MUMPS analyses it anew; no new instance),
+        to be factorized next."""
+        info, detail = _kernel.direct_analyse(self.handle, n, _f(np.asarray(rows) + 1, np.int32),
+                                              _f(np.asarray(cols) + 1, np.int32))
+        self._check(info, detail, "analyse")
+        self.n, self.nnz = n, len(rows)
+
     def _check(self, info: int, detail: int, step: str) -> None:
         if info == 0:
             return

@@ -206,8 +206,12 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
                               keep_sections=bool(scene["output"].get("sections", False)))
     if recorder.need_acceleration or recorder.need_velocity:
         v0 = np.zeros(model.ndof)
-        a0, _ = initial_acceleration(model, e_start, v0, 0.0)
+        a0, lam0 = initial_acceleration(model, e_start, v0, 0.0)
         recorder.initial = (v0, a0)
+        if not model.contact_pairs:  # integrate's start too (not solved twice); with
+            # contact the solve moves the model's contact projections, from which
+            # integrate's own solve starts
+            recorder.initial_solution = (a0, lam0)
     return recorder
 
 
@@ -384,7 +388,8 @@ def _run_dynamic(scene: Scene, model: Model, out: Path | MemoryOutput, e_start: 
     try:
         with _io(out).released(out):  # the file is closed between the writes of the run
             dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
-                            should_stop=stop)
+                            should_stop=stop,
+                            initial=getattr(recorder, "initial_solution", None))
         writer.flush_last()
         if supports is not None:
             supports.write(out, writer.rows)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import io
 import math
 import re
-from collections import Counter
+from collections import Counter, OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -106,6 +106,7 @@ _FAST_TOKEN = re.compile(r"""
 _FAST_INT = re.compile(r"[+-]?\d+\Z")
 _FAST_FLOAT = re.compile(r"[+-]?(?:\d+\.\d*|\.\d+|\d+(?=[eEdD]))(?:[eEdD][+-]?\d+)?\Z")
 _FAST_LOGICAL = {".true.": True, ".t.": True, ".false.": False, ".f.": False}
+_DICT_CONTAINS, _DICT_SET = OrderedDict.__contains__, OrderedDict.__setitem__
 
 
 def _fast_value(kind: str, token: str) -> Any:
@@ -140,9 +141,13 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
     def close_key() -> bool:
         if key is None:
             return True
-        if not values or key.lower() in group:
+        lower = key.lower()
+        # f90nml's `lower in group` and `group[key] = value` for a group's plain values
+        # (no cogroups inside a group; a scalar or a list of scalars is stored as it is,
+        # under the lower-case key), without their per-call type checks
+        if not values or _DICT_CONTAINS(group, lower):
             return False
-        group[key] = values[0] if len(values) == 1 else list(values)
+        _DICT_SET(group, lower, values[0] if len(values) == 1 else list(values))
         return True
     for match in _FAST_TOKEN.finditer(text):
         kind = match.lastgroup
@@ -184,6 +189,65 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
         else:
             return None
     return nml if group is None else None
+
+
+#: f90nml's output settings that :func:`namelist_text` reproduces (its defaults)
+_PLAIN_OUTPUT = dict(_column_width=72, _indent="    ", _end_comma=False, _uppercase=False,
+                     _float_format="", _index_spacing=False, _assign_spacing=True,
+                     _repeat_counter=False, _split_strings=False)
+_PLAIN_LOGICAL = {False: ".false.", True: ".true."}
+
+
+def _plain_text(nml: f90nml.Namelist) -> str | None:
+    """What ``nml.write`` writes, for namelists of plain groups (scalars and one-line
+    lists of logicals, integers, reals and strings; f90nml's default output settings),
+    built directly (f90nml's writer took a quarter of a scene load); None otherwise."""
+    if any(getattr(nml, k, v) != v for k, v in _PLAIN_OUTPUT.items()) or \
+            nml.logical_repr != _PLAIN_LOGICAL or nml.default_start_index is not None:
+        return None
+    lines: list[str] = []
+    for key, group in OrderedDict.items(nml):
+        if not isinstance(group, f90nml.Namelist) or group.start_index:
+            return None
+        if lines:
+            lines.append("")
+        lines.append("&" + _cogroup_name(key))
+        for name, value in OrderedDict.items(group):
+            values = value if type(value) is list else (value,)
+            texts = []
+            for item in values:
+                kind = type(item)
+                if kind is bool:
+                    texts.append(_PLAIN_LOGICAL[item])
+                elif kind is int or kind is float:
+                    texts.append(str(item))    # f90nml: str() and format(x, '')
+                elif kind is str:
+                    texts.append(f90nml.Namelist._f90str(nml, item))
+                else:
+                    return None
+            if not texts:
+                return None
+            line = "    " + name + " = " + ", ".join(texts)
+            if len(texts) > 1 and len(line) >= 72:   # f90nml wraps such a list
+                return None
+            lines.append(line.rstrip())
+        lines.append("/")
+    return "\n".join(lines) + "\n" if lines else ""
+
+
+def _cogroup_name(key: str) -> str:
+    """A group's name from f90nml's key (a repeated group's keys are _grp_<name>_<i>)."""
+    return key[5:].rsplit("_", 1)[0] if key.startswith("_grp_") else key
+
+
+def namelist_text(nml: f90nml.Namelist) -> str:
+    """The namelist as f90nml writes it (:func:`_plain_text` where it applies)."""
+    text = _plain_text(nml)
+    if text is None:
+        buffer = io.StringIO()
+        nml.write(buffer)
+        text = buffer.getvalue()
+    return text
 
 
 def _parse_override_value(kind: str, text: str, where: dict) -> Any:
@@ -329,15 +393,19 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     file = str(path)
     text = _read_text(path, file)
     try:
-        nml = fast_reads(text)
+        nml = plain = fast_reads(text)
         if nml is None:  # not one of the plain forms fast_reads reads
             nml = f90nml.reads(text)
     except Exception as exc:  # f90nml raises several types
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
     general = is_general(nml)
-    validate.check_repeats(file, validate.scan_groups(text),
-                           GENERAL_SCHEMA if general else ())
+    repeatable = GENERAL_SCHEMA if general else ()
+    # a plain namelist (fast_reads) has no key twice in a group (fast_reads refuses that):
+    # the text is scanned for its lines only when a group that may not repeat does
+    if plain is None or any(count > 1 and name not in repeatable for name, count in
+                            Counter(map(_cogroup_name, OrderedDict.keys(nml))).items()):
+        validate.check_repeats(file, validate.scan_groups(text), repeatable)
     _override_addresses(overrides or [], file)
     seen: Counter = Counter()
     for group, _ in nml.items():  # a repeated group comes once per occurrence
@@ -380,9 +448,7 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     validate.check_time(values["solver"], values["scene"]["analysis"], file)
     validate.check_resources(validate.estimate_template(values, kind), file, values["solver"],
                              values["scene"]["analysis"])
-    buffer = io.StringIO()
-    nml.write(buffer)
-    return Scene(path=path, values=values, text=buffer.getvalue(), overrides=applied)
+    return Scene(path=path, values=values, text=namelist_text(nml), overrides=applied)
 
 
 def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scene:
@@ -412,9 +478,7 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scen
         raise InputError("a general scene needs at least one body (&beam, &cable, &plate, "
                          "&leaf or &rigid_body)", file=file)
     listed = "effects" in nml.get("scene", {})
-    buffer = io.StringIO()
-    nml.write(buffer)
-    scene = Scene(path=path, values=values, text=buffer.getvalue(), overrides=applied,
+    scene = Scene(path=path, values=values, text=namelist_text(nml), overrides=applied,
                   items=items)
     if not GENERAL_BUILDER:
         raise RuntimeError("import ancfdrv (the package) to read general scenes")

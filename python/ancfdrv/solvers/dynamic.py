@@ -190,25 +190,61 @@ def _progress_bar(show: bool, total: float):
 
 
 def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
-                  rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str):
-    """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]."""
+                  rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str,
+                  evaluated: tuple | None = None):
+    """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]
+    (``evaluated``: the constraints' evaluation at (e, t) when the caller has it)."""
     n, ncon = model.ndof, len(model.constraints)
-    _, rows, cols, grads = model.constraints.jacobian(e, n, t)
+    _, rows, cols, grads = model.constraints.jacobian(e, n, t, evaluated)
     r = np.concatenate([matrix.row_index(), cols, n + rows])
     c = np.concatenate([matrix.indices, n + rows, cols])
     v = np.concatenate([matrix.data, -grads, -grads])
-    with DirectSolver(n + ncon, r, c, what=what) as solver:
+    rhs = np.concatenate([rhs_top, rhs_bottom])
+    if n + ncon > SADDLE_REUSE_MAX:
+        with DirectSolver(n + ncon, r, c, what=what) as solver:
+            solver.factorize(v)
+            x = solver.solve(rhs)
+        return x[:n], x[n:]
+    solver = _SADDLE_SOLVERS.pop() if _SADDLE_SOLVERS else None
+    try:
+        if solver is None:
+            solver = DirectSolver(n + ncon, r, c, what=what)
+        else:
+            solver.what = what
+            last = getattr(solver, "saddle_pattern", None)
+            # the pattern it analysed last (MUMPS analyses the structure, its values 0):
+            # the analysis is kept for the same pattern, as for any refactorization
+            if last is None or last[0] != n + ncon or not (
+                    np.array_equal(last[1], r) and np.array_equal(last[2], c)):
+                solver.saddle_pattern = None
+                solver.analyse(n + ncon, r, c)
+        solver.saddle_pattern = (n + ncon, r, c)
         solver.factorize(v)
-        x = solver.solve(np.concatenate([rhs_top, rhs_bottom]))
+        x = solver.solve(rhs)
+    except BaseException:
+        if solver is not None:   # after a failure: released, not reused
+            solver.close()
+        raise
+    _SADDLE_SOLVERS.append(solver)
     return x[:n], x[n:]
+
+
+#: saddle systems of at most this many unknowns share MUMPS instances (a free list of
+#: :data:`_SADDLE_SOLVERS`), analysed anew for each system: an instance's creation and
+#: release were half of a small model's initial acceleration (~1 M instructions, mostly
+#: MUMPS's set-up). A larger system gets its own instance, released after the solve (so
+#: no large factors stay in memory).
+SADDLE_REUSE_MAX = 4096
+_SADDLE_SOLVERS: list[DirectSolver] = []
 
 
 def initial_acceleration(model: Model, e: np.ndarray, v: np.ndarray, t: float):
     """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma."""
-    *_, gamma = model.constraints.evaluate(e, t, v)
+    evaluated = model.constraints.evaluate(e, t, v)   # (its gradients do not depend on v)
     forces = model.forces(e, t, v)
     return _saddle_solve(model, model.mass, forces["external"] - forces["internal"],
-                         -gamma, e, t, "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]")
+                         -evaluated[-1], e, t,
+                         "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]", evaluated)
 
 
 class TimeIntegrator:
@@ -415,15 +451,22 @@ class EnergyWatch:
         self.first = first.copy()
         self.most, self.scale = 0.0, 0.0
 
+    #: the works among ENERGY_NAMES (drives, frames, contact damping, friction, damping)
+    WORKS = (5, 6, 8, 9, 10)
+
     def add(self, energy: np.ndarray) -> None:
-        works = energy[:, [5, 6, 8, 9, 10]]
-        balance = energy[:, 4] - self.first[4] - works.sum(axis=1)
-        potential = energy[:, 1:4].sum(axis=1) - self.first[1:4].sum()
+        # column by column (no copy of the works' columns): the sums in numpy's order of
+        # a row sum over a few columns (left to right), so the figures are bitwise those
+        # of works.sum(axis=1) and energy[:, 1:4].sum(axis=1)
+        columns = energy.T
+        works = columns[5] + columns[6] + columns[8] + columns[9] + columns[10]
+        balance = columns[4] - self.first[4] - works
+        potential = columns[1] + columns[2] + columns[3] - self.first[1:4].sum()
         self.most = max(self.most, float(balance.max()))
-        self.scale = max(self.scale, float(np.abs(energy[:, 0]).max()),
+        self.scale = max(self.scale, float(np.abs(columns[0]).max()),
                          float(np.abs(potential).max()),
-                         float(np.abs(energy[:, 0] + energy[:, 1]).max()),
-                         float(np.abs(works).max()))
+                         float(np.abs(columns[0] + columns[1]).max()),
+                         float(np.array([np.abs(columns[k]).max() for k in self.WORKS]).max()))
 
     def created(self) -> float:
         return self.most / self.scale if self.scale > 0 else 0.0
@@ -514,10 +557,13 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
               v0: np.ndarray | None = None, t0: float = 0.0, *,
               sink: Callable[[Chunk], None] | None = None,
               progress: bool | None = None,
-              should_stop: Callable[[], bool] | None = None) -> DynamicResult:
+              should_stop: Callable[[], bool] | None = None,
+              initial: tuple[np.ndarray, np.ndarray] | None = None) -> DynamicResult:
     """Integrate from (t0, e0, v0) to settings.t_end. Each chunk goes to ``sink`` as soon
     as it is computed (the first one holds the initial state). A failed step raises
-    SolverError after the completed steps have gone to the sink.
+    SolverError after the completed steps have gone to the sink. ``initial``: the
+    consistent (a0, lambda0) of :func:`initial_acceleration` at (t0, e0, v0) when the
+    caller computed them already (not solved again).
 
     A kernel call takes at most about 0.25 s of wall time (the first call's time per step
     caps the following ones, never more than settings.chunk_steps), and ``should_stop`` is
@@ -534,7 +580,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
         raise SolverError(f"t_end = {settings.t_end} lies before the start time {t0}")
     v0 = np.zeros(model.ndof) if v0 is None else v0
     integrator = TimeIntegrator(model, settings)
-    a0, lam0 = initial_acceleration(model, e0, v0, t0)
+    a0, lam0 = initial_acceleration(model, e0, v0, t0) if initial is None else initial
     state = integrator.state(t0, e0, v0, a0, lam0)
     timing["setup"] = time.perf_counter() - start
     t1 = time.perf_counter()

@@ -246,6 +246,23 @@ class ReactionMap:
             raise ValueError(f"constraint evaluation failed (code {out[-1]})")
         return out[0]
 
+    def constant_gradients(self) -> np.ndarray | None:
+        """The operand gradients (6, ncon) when they are the same at every state: every
+        multiplier constraint of the coordinate kind (x_1 - value), without a drive and
+        with a coordinate in its first operand (what the kernel's evaluation checks), so
+        that the kernel (constraints.f90: gradients(1, c) = 1 exactly) returns e_1 per
+        constraint whatever q and t. None otherwise (the kernel evaluates every row)."""
+        if not hasattr(self, "_constant_gradients"):
+            full, constant = self.full, None
+            if len(full) and all(
+                    kind == CONSTRAINT_COORDINATE and drive < 0 and terms[0]
+                    and all(0 <= d < self.model.nfull for per in terms for d, _ in per)
+                    for kind, drive, terms in zip(full.kinds, full.drives, full.terms)):
+                constant = np.zeros((6, len(full)))
+                constant[0] = 1.0
+            self._constant_gradients = constant
+        return self._constant_gradients
+
     def generalized_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
                          residual_rows: np.ndarray | None) -> dict[str, np.ndarray]:
         """Each joint's constraint force on body2's coordinates, (nt, body2.ncoordinates),
@@ -254,8 +271,15 @@ class ReactionMap:
             self._term_arrays()
         nt = len(q_rows)
         nterm = len(self.t_coef)
-        contrib = np.zeros((nt, nterm))
-        if len(self.full) and nterm:
+        constant = self.constant_gradients() if len(self.full) and nterm else None
+        if constant is not None:
+            # the kernel's gradients without the kernel (the same values and products:
+            # g * (coef * lambda), bitwise what the rows' evaluation gives)
+            contrib = (self.t_coef * lam_rows[:, self.t_con]) * constant[self.t_slot,
+                                                                         self.t_con]
+        else:
+            contrib = np.zeros((nt, nterm))
+        if len(self.full) and nterm and constant is None:
             gradients = self._gradient_rows(q_rows, times)   # (6, ncon, nt): one kernel call
             contrib[:] = gradients[self.t_slot, self.t_con, :].T
             contrib *= self.t_coef * lam_rows[:, self.t_con]
@@ -367,7 +391,10 @@ def _reduce_rows(joint, generalized: np.ndarray, slots: np.ndarray, q_rows: np.n
         position = slots % (per // 3) == 0          # a node's first vector: its position
         force = block[:, position].sum(axis=1)
         moment = _cross(values[:, position] - point[:, None, :], block[:, position]).sum(axis=1)
-        moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
+        if position.all():   # no other vector: the sum over none, +0.0 each
+            moment += 0.0
+        else:
+            moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
     swapped = getattr(joint, "swapped", False)
     if swapped:
         force, moment = -force, -moment
@@ -1057,13 +1084,16 @@ class DynamicAnswers:
         # read only: without eliminated joints q is e (no copy of every row)
         q_rows = e_rows if self.model.reduction is None else self.model.expand(e_rows)
         residual = None
-        velocities = np.zeros_like(e_rows)
+        # e' at the rows: for the force elements' reactions only
+        velocities = np.zeros_like(e_rows) if self.force_elements else \
+            np.empty((len(e_rows), 0))
         if self.need_acceleration:
             lf = 1.0
             residual = np.empty_like(q_rows)
             for row, t in enumerate(times):
                 v, accel = self._kinematics(float(t), e_rows[row])
-                velocities[row] = v
+                if self.force_elements:
+                    velocities[row] = v
                 guesses = None
                 if getattr(chunk, "contact", None) is not None:   # xi, eta of each point
                     guesses = np.ascontiguousarray(chunk.contact[row, :, 4:6].T)

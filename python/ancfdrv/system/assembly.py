@@ -733,9 +733,10 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
         prefer.append([int(column[d]) for d in eq.prefer if column[d] >= 0])
     if not len(out):
         return out
-    values, *_ = out.evaluate(e0, 0.0)
+    evaluated = out.evaluate(e0, 0.0)
+    values = evaluated[0]
     keep, basis = [], []
-    gradients = out.gradient_rows(e0, ndof)
+    gradients = out.gradient_rows(e0, ndof, 0.0, evaluated)   # (the same evaluation)
     for c in range(len(out)):
         name = out.names[c]
         if abs(values[c]) > 1e-8 * scale ** 2:

@@ -98,18 +98,7 @@ class ConstraintSet:
             empty = np.zeros(0)
             return empty, np.zeros((6, 0)), np.zeros((6, 6, 0)), empty, empty, empty
         e_dot = np.zeros_like(e) if e_dot is None else e_dot
-        lay = self.layout()
-        ptr = np.concatenate([[0], np.cumsum([len(p) for p in self.drive_params])]) + 1
-        data = np.concatenate([np.asarray(p, dtype=float) for p in self.drive_params]) \
-            if self.drive_params else np.zeros(1)
-        kinds = np.array(self.drive_kinds or [0], dtype=np.int32)
-        out = _kernel.constraint_evaluate(
-            _f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
-            _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
-            _f(lay.term_dof + 1 if len(lay.term_dof) else np.ones(1), np.int32),
-            _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
-            _f(ptr if len(self.drive_kinds) else np.ones(2), np.int32), _f(data), _f(e),
-            _f(e_dot), t)
+        out = _kernel.constraint_evaluate(*self._kernel_inputs(), _f(e), _f(e_dot), t)
         values, gradients, hessians, phi_t, phi_tt, gamma, info = out
         if info > 0:
             raise InputError(f"constraint {self.names[info - 1]!r} is malformed")
@@ -117,9 +106,42 @@ class ConstraintSet:
             raise InputError(f"the drive of constraint {self.names[-info - 1]!r} failed")
         return values, gradients, hessians, phi_t, phi_tt, gamma
 
-    def jacobian(self, e: np.ndarray, ndof: int | None = None, t: float = 0.0):
-        """Values and Phi_e as COO triplets (rows, cols, values; duplicates add up)."""
-        values, gradients, *_ = self.evaluate(e, t)
+    def _snapshot(self) -> tuple:
+        """Everything the kernel's layout is made of, copied (compared with ==)."""
+        return (list(self.kinds), list(self.drives), [list(p) for p in self.params],
+                [list(c) for c in self.operand_const],
+                [[list(t) for t in per] for per in self.terms], list(self.drive_kinds),
+                [[float(x) for x in p] for p in self.drive_params])
+
+    def _kernel_inputs(self) -> tuple:
+        """The kernel's arguments of the set (its layout and drives as Fortran arrays),
+        made once and made again whenever any of the set's lists changed (their contents
+        are compared with a copy taken when the arguments were made, so a changed set never
+        gets old arguments)."""
+        snapshot = self._snapshot()
+        cached = self.__dict__.get("_inputs")
+        if cached is not None and cached[0] == snapshot:
+            return cached[1]
+        lay = self.layout()
+        ptr = np.concatenate([[0], np.cumsum([len(p) for p in self.drive_params])]) + 1
+        data = np.concatenate([np.asarray(p, dtype=float) for p in self.drive_params]) \
+            if self.drive_params else np.zeros(1)
+        kinds = np.array(self.drive_kinds or [0], dtype=np.int32)
+        args = (_f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
+                _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
+                _f(lay.term_dof + 1 if len(lay.term_dof) else np.ones(1), np.int32),
+                _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
+                _f(ptr if len(self.drive_kinds) else np.ones(2), np.int32), _f(data))
+        for array in args:   # shared by the calls: read only
+            array.flags.writeable = False
+        self.__dict__["_inputs"] = (snapshot, args)
+        return args
+
+    def jacobian(self, e: np.ndarray, ndof: int | None = None, t: float = 0.0,
+                 evaluated: tuple | None = None):
+        """Values and Phi_e as COO triplets (rows, cols, values; duplicates add up).
+        ``evaluated``: what :meth:`evaluate` returned at (e, t), when the caller has it."""
+        values, gradients, *_ = self.evaluate(e, t) if evaluated is None else evaluated
         rows, cols, vals = [], [], []
         for c, per in enumerate(self.terms):
             for s, terms in enumerate(per):
@@ -130,9 +152,10 @@ class ConstraintSet:
         return (values, np.array(rows, dtype=np.int64), np.array(cols, dtype=np.int64),
                 np.array(vals, dtype=float))
 
-    def gradient_rows(self, e: np.ndarray, ndof: int, t: float = 0.0) -> np.ndarray:
-        """Dense Phi_e (ncon, ndof)."""
-        _, rows, cols, vals = self.jacobian(e, ndof, t)
+    def gradient_rows(self, e: np.ndarray, ndof: int, t: float = 0.0,
+                      evaluated: tuple | None = None) -> np.ndarray:
+        """Dense Phi_e (ncon, ndof) (``evaluated``: see :meth:`jacobian`)."""
+        _, rows, cols, vals = self.jacobian(e, ndof, t, evaluated)
         out = np.zeros((len(self), ndof))
         np.add.at(out, (rows, cols), vals)
         return out

@@ -472,7 +472,7 @@ class Model:
             return None
         if any(s.kind == "ffr" for s in self.sets):   # (other kinds ignore their frame)
             return None
-        if self.reduction is not None:
+        if self.reduction is not None and self.reduction.selects is None:
             if self.reduction.matrix.selection_columns() is None:
                 return None
         first, weight, position = [], [], []

@@ -12,6 +12,8 @@ scipy.sparse (issue 23, a run's memory).
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -99,10 +101,24 @@ class Reduction:
     plan_target: np.ndarray
     plan_coef: np.ndarray
     relations: dict[int, Scalar] = field(default_factory=dict)
+    #: the full index of each reduced coordinate when B only selects them (every relation
+    #: a constant: :func:`_selection_plan`), else None
+    selects: np.ndarray | None = None
 
     def expand(self, x: np.ndarray, with_offset: bool = True) -> np.ndarray:
         """Full coordinates (or, without the offset, velocities) from reduced ones; x may be
         (nred,) or (nt, nred)."""
+        if self.selects is not None:
+            # B x placed directly: each selected row's sum 0 + 1 x (as the product forms
+            # it: a -0.0 becomes 0.0), the others 0, then the offset
+            x = np.asarray(x)
+            if x.shape[-1] != len(self.selects):
+                raise ValueError(f"dimension mismatch: {self.matrix.shape} @ {x.T.shape}")
+            full = np.zeros(x.shape[:-1] + (len(self.offset),),
+                            dtype=np.result_type(self.matrix.data, x))
+            full[..., self.selects] = x
+            full += self.offset if with_offset else 0.0
+            return full
         full = self.matrix.matvec(np.asarray(x).T).T
         return full + self.offset if with_offset else full
 
@@ -143,6 +159,15 @@ def eliminate(equations, q0: np.ndarray) -> Elimination:
         if abs(violation) > 1e-9 * scale:
             raise InputError(f"{eq.name}: the initial configuration violates this joint "
                              f"equation by {violation:.3e} (check the points and bodies)")
+        if len(eq.expr.terms) == 1:
+            # a · q_d + c = 0 (a planar fix) on a coordinate still independent that no
+            # relation uses: the steps below give q_d = -(c + 0) / a (the substitution
+            # adds c to 0), made directly
+            (dof, a), = eq.expr.terms.items()
+            if dof not in result.relations and dof not in users and a != 0.0 \
+                    and math.isfinite(a):
+                result.relations[dof] = Scalar({}, -(eq.expr.const + 0.0) / a)
+                continue
         s = result.substitute(eq.expr)
         big = max((abs(c) for c in s.terms.values()), default=0.0)
         s = Scalar({d: c for d, c in s.terms.items() if abs(c) > 1e-12 * big}, s.const)
@@ -193,6 +218,51 @@ def reduction_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
                    full_pattern: Pattern) -> Reduction:
     """B, q0 (checked against the initial configuration), the reduced pattern (structure of
     B^T P B plus the diagonal) and the plan forming B^T S B on it."""
+    if all(not relation.terms for relation in elimination.relations.values()):
+        return _selection_plan(nfull, elimination, q0, full_pattern)
+    return _general_plan(nfull, elimination, q0, full_pattern)
+
+
+def _selection_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
+                    full_pattern: Pattern) -> Reduction:
+    """:func:`_general_plan` where every relation is a constant (the planar fixes: B
+    selects the independent coordinates), its arrays made directly: B's one 1 per
+    independent row, the full pattern's entries between independent coordinates (each
+    one pair of B entries, coefficient 1) in the full pattern's order."""
+    relations = elimination.relations
+    dependent = np.zeros(nfull, dtype=bool)
+    dependent[list(relations)] = True
+    independent = np.flatnonzero(~dependent).astype(np.int64)
+    nred = len(independent)
+    column = -np.ones(nfull, dtype=np.int64)
+    column[independent] = np.arange(nred)
+    offset = np.zeros(nfull)
+    fixed = np.array(list(relations), dtype=np.int64)
+    offset[fixed] = [relations[int(i)].const for i in fixed]
+    indptr = np.zeros(nfull + 1, dtype=np.int64)
+    np.cumsum(~dependent, out=indptr[1:])
+    b = Csr(np.ones(nred), np.arange(nred), indptr, (nfull, nred))
+    mismatch = np.abs(offset[fixed] - q0[fixed])
+    if mismatch.max(initial=0.0) > 1e-9 * max(1.0, np.abs(q0).max(initial=0.0)):
+        raise AssertionError(f"the reduction misses the initial configuration by "
+                             f"{mismatch.max():.3e}")
+    f_rows, f_cols = full_pattern.rows, full_pattern.col_index
+    source = np.flatnonzero(~dependent[f_rows] & ~dependent[f_cols]).astype(np.int64)
+    pair_a, pair_c = column[f_rows[source]], column[f_cols[source]]
+    diagonal = np.arange(nred)
+    reduced = Csr.structure(nred, np.concatenate([pair_a, diagonal]),
+                            np.concatenate([pair_c, diagonal]))
+    pattern = Pattern(nred, reduced.indptr, reduced.indices)
+    target = pattern.positions(pair_a, pair_c)
+    if (target < 0).any():
+        raise AssertionError("reduced pattern misses an entry of B^T S B")
+    return Reduction(b, offset, independent, pattern, source, target, np.ones(len(source)),
+                     relations, selects=independent)
+
+
+def _general_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
+                  full_pattern: Pattern) -> Reduction:
+    """:func:`reduction_plan` for any relations."""
     relations = elimination.relations
     independent = np.array([i for i in range(nfull) if i not in relations], dtype=np.int64)
     column = -np.ones(nfull, dtype=np.int64)
