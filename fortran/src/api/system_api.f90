@@ -634,6 +634,16 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
   sys%plan_source = plan_source(1:nplan)
   sys%plan_target = plan_target(1:nplan)
   sys%plan_coef = plan_coef(1:nplan)
+  ! a selection (each row of B empty or one entry 1): to_full and to_reduced by its columns
+  ! (offset or 0, plus 1 x: the same sums without the row pointers and the products by 1)
+  if (allocated(sys%reduction_select)) deallocate (sys%reduction_select)
+  if (all(b_ptr(2:) - b_ptr(:nfull) <= 1) .and. all(b_values(1:nnz_b) == 1.0_dp)) then
+    allocate (sys%reduction_select(nfull))
+    do i = 1, nfull
+      sys%reduction_select(i) = 0
+      if (b_ptr(i + 1) > b_ptr(i)) sys%reduction_select(i) = b_col(b_ptr(i))
+    end do
+  end if
 end subroutine system_set_reduction
 
 !> Loads: the constant force (independent coordinates), driven forces phi_d(t) f_d, dead

@@ -31,7 +31,10 @@
 !> No I/O; failures return codes.
 module mechanical_system
   use ancf_kinds, only: dp
-  use constraints, only: constraint_eval, operand_values, drive_value
+  use constraints, only: constraint_eval, operand_values, drive_value, constraint_value, &
+                         constraint_kind_coordinate, constraint_kind_distance, &
+                         constraint_kind_cross, constraint_kind_dot
+  use matrix3, only: cross
   use element_sets, only: element_set, set_slot, frame_omega
   use section_moment, only: moment_force_only, moment_angle
   use vector_loads, only: vector_load_force
@@ -837,19 +840,74 @@ contains
   end function pattern_position
 
   !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
-  !> drive cannot be evaluated.
+  !> drive cannot be evaluated. constraint_eval's first-order results with the same
+  !> arithmetic (constraint_value, the operands summed as operand_values sums them), without
+  !> its argument descriptors, and a coordinate constraint's first operand alone (the only
+  !> one its value and gradient use): the Newton corrections of small systems evaluate it
+  !> in every correction.
   subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: e(:), t
     real(dp), intent(out) :: phi(:), gradients(:, :)
     integer, intent(out) :: info
-    ! (unused by a first-order evaluation: fixed dummies, no heap arrays per call)
-    real(dp) :: hessians(6, 6, 1), phi_t(1), phi_tt(1), gamma(1)
-    call constraint_eval(sys%ncon, sys%con_kind, sys%con_drive, sys%con_params, &
-                         sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
-                         sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, e, t, phi, gradients, &
-                         hessians, phi_t, phi_tt, gamma, info, first_order_only=.true.)
-    if (info /= 0) info = 5
+    real(dp) :: x(6), drive_phi, dphi, ddphi, cos_phi, sin_phi
+    integer :: c, s, k, last_operand, drive_info
+    info = 0
+    if (sys%ncon == 0) return
+    do k = 1, sys%term_ptr(6 * sys%ncon + 1) - 1
+      if (sys%term_dof(k) < 1 .or. sys%term_dof(k) > size(e)) then
+        info = 5
+        return
+      end if
+    end do
+    do c = 1, sys%ncon
+      call drive_value(sys%con_drive(c), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+                       drive_phi, dphi, ddphi, drive_info)
+      if (drive_info /= 0) then
+        info = 5
+        return
+      end if
+      last_operand = 6
+      if (sys%con_kind(c) == constraint_kind_coordinate) then
+        if (sys%term_ptr(6 * (c - 1) + 2) == sys%term_ptr(6 * (c - 1) + 1)) then
+          info = 5  ! no coordinate in the first operand
+          return
+        end if
+        last_operand = 1
+      else if (sys%con_kind(c) < constraint_kind_coordinate .or. sys%con_kind(c) > constraint_kind_dot) then
+        info = 5
+        return
+      end if
+      x = 0.0_dp
+      do s = 1, last_operand
+        x(s) = sys%operand_const(s, c)
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          x(s) = x(s) + sys%term_coef(k) * e(sys%term_dof(k))
+        end do
+      end do
+      cos_phi = 1.0_dp
+      sin_phi = 0.0_dp
+      if (sys%con_kind(c) == constraint_kind_coordinate .and. sys%con_drive(c) /= 0) then
+        cos_phi = cos(drive_phi)
+        sin_phi = sin(drive_phi)
+      end if
+      phi(c) = constraint_value(sys%con_kind(c), sys%con_drive(c) /= 0, sys%con_params(:, c), &
+                                x, drive_phi, cos_phi, sin_phi)
+      gradients(:, c) = 0.0_dp
+      select case (sys%con_kind(c))
+      case (constraint_kind_coordinate)
+        gradients(1, c) = 1.0_dp
+      case (constraint_kind_distance)
+        gradients(1:3, c) = 2.0_dp * (x(1:3) - x(4:6))
+        gradients(4:6, c) = -2.0_dp * (x(1:3) - x(4:6))
+      case (constraint_kind_cross)
+        gradients(1:3, c) = cross(x(4:6), sys%con_params(1:3, c))
+        gradients(4:6, c) = cross(sys%con_params(1:3, c), x(1:3))
+      case default  ! constraint_kind_dot
+        gradients(1:3, c) = x(4:6)
+        gradients(4:6, c) = x(1:3)
+      end select
+    end do
   end subroutine evaluate_constraints
 
   !> r = r - Phi_e^T lambda.
