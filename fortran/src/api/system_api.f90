@@ -546,6 +546,7 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   sys%carry_weight = weight(1:max(0, nvec))
   sys%carry_position = position(1:max(0, nvec)) /= 0
   if (allocated(sys%carry_map)) deallocate (sys%carry_map)
+  if (allocated(sys%carry_plane)) deallocate (sys%carry_plane)
   if (nvec == 0) return
   allocate (sys%carry_map(3, sys%nfull / 3))
   if (.not. sys%reduced) then
@@ -565,6 +566,19 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
     message = 'system_set_carry: the reduction is not a selection of coordinates'
     deallocate (sys%carry_first, sys%carry_weight, sys%carry_position, sys%carry_map)
     allocate (sys%carry_first(0), sys%carry_weight(0), sys%carry_position(0))
+    return
+  end if
+  ! every vector of the xy plane or fixed (a planar reduction): carry_apply by the pairs
+  if (all((sys%carry_map(1, :) > 0 .and. sys%carry_map(2, :) > 0 .and. &
+           sys%carry_map(3, :) == 0) .or. all(sys%carry_map == 0, dim=1))) then
+    k = count(sys%carry_map(1, :) > 0)
+    allocate (sys%carry_plane(2, k))
+    k = 0
+    do i = 1, size(sys%carry_map, 2)
+      if (sys%carry_map(1, i) == 0) cycle
+      k = k + 1
+      sys%carry_plane(:, k) = sys%carry_map(1:2, i)
+    end do
   end if
 end subroutine system_set_carry
 

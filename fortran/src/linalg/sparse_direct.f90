@@ -54,7 +54,6 @@ contains
         first = max(1, j - kd)
         offset = kd + 1 - j
         total = rhs(j, k)
-        !GCC$ unroll 4
         do i = first, j - 1
           total = total - band(offset + i, j) * rhs(i, k)
         end do
@@ -65,7 +64,6 @@ contains
         rhs(j, k) = x
         first = max(1, j - kd)
         offset = kd + 1 - j
-        !GCC$ unroll 4
         do i = first, j - 1
           rhs(i, k) = rhs(i, k) - x * band(offset + i, j)
         end do

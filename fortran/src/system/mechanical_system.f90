@@ -166,6 +166,10 @@ module mechanical_system
     ! the reduced coordinate of each component of every full 3-vector (0: fixed by the
     ! reduction), (3, nfull / 3)
     integer, allocatable :: carry_map(:, :)
+    ! when every 3-vector of carry_map is a vector of the xy plane (its x and y reduced, z
+    ! fixed) or wholly fixed: the reduced coordinates (x, y) of the plane vectors, (2, n);
+    ! unallocated otherwise
+    integer, allocatable :: carry_plane(:, :)
   end type system_model
 
 contains
