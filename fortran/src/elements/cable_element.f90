@@ -44,7 +44,7 @@
 module cable_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use element_sets, only: local_element_set
+  use element_sets, only: local_element_set, loop_work, threaded_work, local_set_forces
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
@@ -80,6 +80,7 @@ module cable_element
     ! numbers as in every call, without their eight divisions a point
     real(dp), allocatable :: slope_rows(:, :, :), second_rows(:, :, :), weights(:, :)
   contains
+    procedure :: forces => cable_set_forces
     procedure :: element_forces => cable_element_forces
     procedure :: element_energy => cable_element_energy
   end type cable_set
@@ -562,6 +563,66 @@ contains
     end do
   end subroutine plane_element_force
 
+  !> The element_set forces of a cable set. The force alone of an undamped elastic cable
+  !> set below the threading threshold (the Newton corrections of small systems): the loop
+  !> of local_set_forces' serial path (element by element, each element's force added as
+  !> it is computed, in element order) without its dispatch through gathered_forces and
+  !> cable_element_forces, an element of the plane z = 0 by plane_element_force: the same
+  !> numbers. Everything else: local_set_forces.
+  subroutine cable_set_forces(set, rotation, e, force, energy, info, tangent_values, &
+                              tangent_rotation, v, omega_local, rate_factor, dissipation, &
+                              tangent_omega)
+    class(cable_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), intent(inout), optional :: tangent_values(:)
+    real(dp), intent(in), optional :: tangent_rotation(3, 3)
+    real(dp), intent(in), optional :: v(:), omega_local(3), rate_factor, tangent_omega(3)
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: coords(3, 4), element_force(cable_dofs), element_energy
+    real(dp) :: unused_tangent(cable_dofs, cable_dofs)
+    integer :: el, a, node, element_info
+    if (present(tangent_values) .or. set%tension_only .or. .not. allocated(set%weights) .or. &
+        set%nde /= cable_dofs .or. loop_work(set, .false.) >= threaded_work .or. &
+        (present(v) .and. set%damping_time > 0.0_dp)) then
+      call local_set_forces(set, rotation, e, force, energy, info, tangent_values, &
+                            tangent_rotation, v, omega_local, rate_factor, dissipation, &
+                            tangent_omega)
+      return
+    end if
+    info = 0
+    energy = 0.0_dp
+    if (present(dissipation)) dissipation = 0.0_dp
+    do el = 1, set%nel
+      do node = 1, 4
+        coords(1, node) = e(set%dofs(3 * node - 2, el))
+        coords(2, node) = e(set%dofs(3 * node - 1, el))
+        coords(3, node) = e(set%dofs(3 * node, el))
+      end do
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                 set%weights(:, el), set%axial_stiffness, &
+                                 set%bending_stiffness, element_force, element_energy, &
+                                 element_info)
+      else
+        call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
+                                set%bending_stiffness, .false., element_force, element_energy, &
+                                unused_tangent, element_info, .false.)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      do a = 1, cable_dofs
+        force(set%dofs(a, el)) = force(set%dofs(a, el)) + element_force(a)
+      end do
+      energy = energy + element_energy
+    end do
+  end subroutine cable_set_forces
+
   !> The element_set element_energy of a cable set: the energy-only pass (the damped set,
   !> given rates, through its force for the dissipation).
   pure subroutine cable_element_energy(set, el, coords, energy, info, rates, dissipation)
@@ -578,8 +639,45 @@ contains
                                 0.0_dp, dissipation)
       return
     end if
+    if (.not. set%tension_only .and. allocated(set%weights)) then
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_energy(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                  set%weights(:, el), set%axial_stiffness, &
+                                  set%bending_stiffness, energy, info)
+        return
+      end if
+    end if
     call rule_element_energy(coords, set%lengths(el), set%rule, set%axial_stiffness, &
                              set%bending_stiffness, energy, info, set%tension_only)
   end subroutine cable_element_energy
+
+  !> rule_element_energy of an element in the plane z = 0 (not a rope) with the set's
+  !> shape rows and weights (cable_element_rows: the numbers rule_rows and half_weight L
+  !> give): the same sums, without the eight divisions a point.
+  pure subroutine plane_element_energy(q, slope_rows, second_rows, weights, axial_stiffness, &
+                                       bending_stiffness, energy, info)
+    real(dp), intent(in) :: q(3, 4), slope_rows(4, cable_points), second_rows(4, cable_points)
+    real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp) :: a(2), b(2), aa, bb, ab, strain
+    integer :: p
+    info = 0
+    energy = 0.0_dp
+    do p = 1, cable_points
+      a = matmul(q(1:2, :), slope_rows(:, p))
+      b = matmul(q(1:2, :), second_rows(:, p))
+      aa = dot_product(a, a)
+      bb = dot_product(b, b)
+      ab = dot_product(a, b)
+      strain = 0.5_dp * (aa - 1.0_dp)
+      if (aa <= 0.0_dp) then
+        info = 2
+        return
+      end if
+      energy = energy + weights(p) * (0.5_dp * axial_stiffness * strain**2 &
+                                      + 0.5_dp * bending_stiffness * ((aa * bb - ab**2) / aa**3))
+    end do
+  end subroutine plane_element_energy
 
 end module cable_element

@@ -27,12 +27,13 @@ module element_sets
   use ancf_kinds, only: dp
   implicit none
   private
-  public :: element_set, local_element_set, set_slot, frame_omega, scatter_add
+  public :: element_set, local_element_set, set_slot, frame_omega, scatter_add, loop_work, &
+            local_set_forces
 
   !> Work of an element loop (microseconds on one thread) below which it runs on one thread
   !> whatever OMP_NUM_THREADS says: waking the sleeping team (OMP_WAIT_POLICY passive) costs
   !> more than it saves (2 threads made the 4-node cubic boom 5.6 times slower)
-  real(dp), parameter :: threaded_work = 200.0_dp
+  real(dp), parameter, public :: threaded_work = 200.0_dp
   !> The largest element (dofs) the serial loop holds in fixed work arrays (plates: 36);
   !> below the threading threshold a set's loop runs without an OpenMP region and without
   !> heap arrays: each element's force, energy and tangent are added as it is computed, in
