@@ -520,14 +520,15 @@ contains
                                       bending_stiffness, force, energy, info)
     real(dp), intent(in) :: q(3, 4), slope_rows(4, cable_points), second_rows(4, cable_points)
     real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
-    real(dp), intent(out) :: force(:), energy
+    real(dp), intent(out) :: force(cable_dofs), energy
     integer, intent(out) :: info
     real(dp) :: slope(4), second(4), a(2), b(2), grad_a(2), grad_b(2), dg(4), dh(2), df(4)
-    real(dp) :: weight, aa, bb, ab, strain, g, h, f, point_energy
+    real(dp) :: weight, aa, bb, ab, strain, g, h, f, point_energy, planar(2, 4)
     integer :: p, i
     info = 0
-    force = 0.0_dp
     energy = 0.0_dp
+    ! (the x and y components summed in a (2, 4) array from 0, as in force, then stored)
+    planar = 0.0_dp
     do p = 1, cable_points
       slope = slope_rows(:, p)
       second = second_rows(:, p)
@@ -538,6 +539,7 @@ contains
       bb = dot_product(b, b)
       ab = dot_product(a, b)
       if (aa <= 0.0_dp) then
+        force = 0.0_dp
         info = 2
         return
       end if
@@ -557,9 +559,12 @@ contains
       energy = energy + weight * point_energy
       ! (add_point's force)
       do i = 1, 4
-        force(3 * i - 2:3 * i - 1) = force(3 * i - 2:3 * i - 1) &
-                                     + weight * (slope(i) * grad_a + second(i) * grad_b)
+        planar(:, i) = planar(:, i) + weight * (slope(i) * grad_a + second(i) * grad_b)
       end do
+    end do
+    do i = 1, 4
+      force(3 * i - 2:3 * i - 1) = planar(:, i)
+      force(3 * i) = 0.0_dp
     end do
   end subroutine plane_element_force
 
