@@ -407,8 +407,9 @@ contains
     type(step_work), intent(inout) :: work
     integer, intent(out) :: info, detail
     real(dp) :: strain, previous_correction, step_cap, step_theta
-    integer :: it, lapack_info, active
-    logical :: use_known, refresh, capped, halt
+    integer :: it, lapack_info, active, i
+    logical :: use_known, refresh, capped, halt, finite
+    real(dp) :: largest_correction, largest_coordinate, step_part
     logical :: carry_ready  ! the carried Schur complement is built for this step
     associate (r => work%r, z => work%z, direction => work%direction, &
                correction => work%correction, phi => work%phi, gradients => work%gradients, &
@@ -493,16 +494,27 @@ contains
           correction = correction * (step_cap / maxval(abs(correction)))
         end if
       end if
-      e_new = e_new + correction
-      accel_new = accel_new + beta_prime * correction
-      v_new = v_new + velocity_factor * correction
+      ! (one pass over the coordinates: the same elementwise updates, the finiteness test,
+      ! and the largest |correction| and |e_new| as maxval takes them; max is exact)
+      finite = .true.
+      largest_correction = 0.0_dp
+      largest_coordinate = 0.0_dp
+      do i = 1, sys%ndof
+        step_part = correction(i)
+        if (.not. abs(step_part) < huge(1.0_dp)) finite = .false.
+        e_new(i) = e_new(i) + step_part
+        accel_new(i) = accel_new(i) + beta_prime * step_part
+        v_new(i) = v_new(i) + velocity_factor * step_part
+        largest_correction = max(largest_correction, abs(step_part))
+        largest_coordinate = max(largest_coordinate, abs(e_new(i)))
+      end do
       lam_new = lam_new + dlam(:, 1)
       stats(stat_corrections) = stats(stat_corrections) + 1
-      if (.not. (all(abs(correction) < huge(1.0_dp)) .and. all(abs(lam_new) < huge(1.0_dp)))) then
+      if (.not. (finite .and. all(abs(lam_new) < huge(1.0_dp)))) then
         info = 2
         return
       end if
-      last_correction = maxval(abs(correction))
+      last_correction = largest_correction
       if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
@@ -519,7 +531,7 @@ contains
       ! (a correction cut to the contact cap says nothing about convergence)
       if (.not. capped) then
         call stagnated(monitor, cfg, it, last_correction, previous_correction, &
-                       maxval(abs(e_new)), halt)
+                       largest_coordinate, halt)
         if (halt) then
           done = monitor%at_floor
           return
