@@ -470,8 +470,7 @@ contains
         call schur_complement(sys%flexibility_cc, w, work%flex_w, schur)
         call gradient_product(sys, gradients, direction, dlam(:, 1))
         dlam(:, 1) = dlam(:, 1) - phi
-        call small_lu_factor(schur, ipiv, lapack_info)
-        if (lapack_info == 0) call small_lu_solve(schur, ipiv, dlam(:, 1))
+        call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -600,7 +599,7 @@ contains
           end if
           work%carry_lu = matmul(transpose(work%carry_columns), work%carry_flexibility)
         end if
-        call small_lu_factor(work%carry_lu, work%ipiv, lapack_info)
+        call dgetrf(sys%ncon, sys%ncon, work%carry_lu, sys%ncon, work%ipiv, lapack_info)
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -610,7 +609,8 @@ contains
       end if
       call gradient_product(sys, work%gradients, work%direction, work%dlam(:, 1))
       work%dlam(:, 1) = work%dlam(:, 1) - work%phi
-      call small_lu_solve(work%carry_lu, work%ipiv, work%dlam(:, 1))
+      call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
+                  lapack_info)
       call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
       call carry_apply(sys, learned%carry_turn, work%back, .false., work%correction)
       work%correction = work%correction - work%direction
@@ -680,80 +680,6 @@ contains
       end do
     end do
   end subroutine schur_complement
-
-  !> LU factors with partial pivoting of the small dense matrix a (n x n, the multipliers'
-  !> Schur complement): LAPACK dgetf2's algorithm (the pivot: the first largest |a(i, j)|;
-  !> the column below it scaled by its reciprocal; the rank-one update of the rest) without
-  !> the library calls, whose set-up cost more than the arithmetic of a few constraints.
-  !> info = j > 0: a(j, j) is exactly zero (singular), as dgetrf's.
-  pure subroutine small_lu_factor(a, ipiv, info)
-    real(dp), intent(inout) :: a(:, :)
-    integer, intent(out) :: ipiv(:), info
-    integer :: n, i, j, k, p
-    real(dp) :: largest, swap, reciprocal
-    n = size(a, 1)
-    info = 0
-    do j = 1, n
-      p = j
-      largest = abs(a(j, j))
-      do i = j + 1, n
-        if (abs(a(i, j)) > largest) then
-          p = i
-          largest = abs(a(i, j))
-        end if
-      end do
-      ipiv(j) = p
-      if (a(p, j) == 0.0_dp) then
-        if (info == 0) info = j
-        cycle
-      end if
-      if (p /= j) then
-        do k = 1, n
-          swap = a(j, k)
-          a(j, k) = a(p, k)
-          a(p, k) = swap
-        end do
-      end if
-      reciprocal = 1.0_dp / a(j, j)
-      do i = j + 1, n
-        a(i, j) = a(i, j) * reciprocal
-      end do
-      do k = j + 1, n
-        do i = j + 1, n
-          a(i, k) = a(i, k) - a(i, j) * a(j, k)
-        end do
-      end do
-    end do
-  end subroutine small_lu_factor
-
-  !> Solves A x = b (b overwritten) with small_lu_factor's factors: the row interchanges,
-  !> then L (unit) and U by columns, as LAPACK's dgetrs does.
-  pure subroutine small_lu_solve(a, ipiv, b)
-    real(dp), intent(in) :: a(:, :)
-    integer, intent(in) :: ipiv(:)
-    real(dp), intent(inout) :: b(:)
-    integer :: n, i, j
-    real(dp) :: swap
-    n = size(a, 1)
-    do j = 1, n
-      if (ipiv(j) /= j) then
-        swap = b(j)
-        b(j) = b(ipiv(j))
-        b(ipiv(j)) = swap
-      end if
-    end do
-    do j = 1, n
-      do i = j + 1, n
-        b(i) = b(i) - b(j) * a(i, j)
-      end do
-    end do
-    do j = n, 1, -1
-      b(j) = b(j) / a(j, j)
-      do i = 1, j - 1
-        b(i) = b(i) - b(j) * a(i, j)
-      end do
-    end do
-  end subroutine small_lu_solve
 
   !> y = A x (matmul's sums over the columns in increasing order, from 0) without the
   !> columns whose x is zero: the same numbers.
