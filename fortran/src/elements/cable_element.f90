@@ -522,7 +522,7 @@ contains
     real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
     real(dp), intent(out) :: force(cable_dofs), energy
     integer, intent(out) :: info
-    real(dp) :: slope(4), second(4), a(2), b(2), grad_a(2), grad_b(2), dg(4), dh(2), df(4)
+    real(dp) :: a(2), b(2), grad_a(2), grad_b(2), dg(4), dh(2), df(4)
     real(dp) :: weight, aa, bb, ab, strain, g, h, f, point_energy, planar(2, 4)
     integer :: p, i
     info = 0
@@ -530,11 +530,9 @@ contains
     ! (the x and y components summed in a (2, 4) array from 0, as in force, then stored)
     planar = 0.0_dp
     do p = 1, cable_points
-      slope = slope_rows(:, p)
-      second = second_rows(:, p)
       weight = weights(p)
-      a = matmul(q(1:2, :), slope)
-      b = matmul(q(1:2, :), second)
+      a = matmul(q(1:2, :), slope_rows(:, p))
+      b = matmul(q(1:2, :), second_rows(:, p))
       aa = dot_product(a, a)
       bb = dot_product(b, b)
       ab = dot_product(a, b)
@@ -559,7 +557,8 @@ contains
       energy = energy + weight * point_energy
       ! (add_point's force)
       do i = 1, 4
-        planar(:, i) = planar(:, i) + weight * (slope(i) * grad_a + second(i) * grad_b)
+        planar(:, i) = planar(:, i) + weight * (slope_rows(i, p) * grad_a &
+                                                + second_rows(i, p) * grad_b)
       end do
     end do
     do i = 1, 4
