@@ -522,43 +522,70 @@ contains
     real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
     real(dp), intent(out) :: force(cable_dofs), energy
     integer, intent(out) :: info
-    real(dp) :: a(2), b(2), grad_a(2), grad_b(2), dg(4), dh(2), df(4)
-    real(dp) :: weight, aa, bb, ab, strain, g, h, f, point_energy, planar(2, 4)
-    integer :: p, i
+    real(dp), dimension(cable_points) :: ax, ay, bx, by, aa, bb, ab, strain, g, h, f
+    real(dp), dimension(cable_points) :: point_energy, dg1, dg2, dg3, dg4, dh1, dh2
+    real(dp), dimension(cable_points) :: df1, df2, df3, df4, grad_ax, grad_ay, grad_bx, grad_by
+    real(dp) :: planar(2, 4)
+    integer :: p, i, k
     info = 0
     energy = 0.0_dp
-    ! (the x and y components summed in a (2, 4) array from 0, as in force, then stored)
+    ! (the points side by side, each with its point's expressions of the one-point form:
+    ! a = matmul(q(1:2, :), slope) sums from 0 over the four shapes in order, the dot
+    ! products from 0 over x then y; the x and y components summed in a (2, 4) array from
+    ! 0, as in force, then stored)
+    ax = 0.0_dp
+    ay = 0.0_dp
+    bx = 0.0_dp
+    by = 0.0_dp
+    do k = 1, 4
+      do p = 1, cable_points
+        ax(p) = ax(p) + q(1, k) * slope_rows(k, p)
+        ay(p) = ay(p) + q(2, k) * slope_rows(k, p)
+        bx(p) = bx(p) + q(1, k) * second_rows(k, p)
+        by(p) = by(p) + q(2, k) * second_rows(k, p)
+      end do
+    end do
+    do p = 1, cable_points
+      aa(p) = 0.0_dp + ax(p) * ax(p) + ay(p) * ay(p)
+      bb(p) = 0.0_dp + bx(p) * bx(p) + by(p) * by(p)
+      ab(p) = 0.0_dp + ax(p) * bx(p) + ay(p) * by(p)
+    end do
+    if (any(aa <= 0.0_dp)) then
+      force = 0.0_dp
+      info = 2
+      return
+    end if
+    ! (point_derivatives' expressions, component by component)
+    do p = 1, cable_points
+      strain(p) = 0.5_dp * (aa(p) - 1.0_dp)
+      g(p) = aa(p) * bb(p) - ab(p)**2
+      h(p) = aa(p)**3
+      f(p) = g(p) / h(p)
+      point_energy(p) = 0.5_dp * axial_stiffness * strain(p)**2 + 0.5_dp * bending_stiffness * f(p)
+      dg1(p) = 2.0_dp * bb(p) * ax(p) - 2.0_dp * ab(p) * bx(p)
+      dg2(p) = 2.0_dp * bb(p) * ay(p) - 2.0_dp * ab(p) * by(p)
+      dg3(p) = 2.0_dp * aa(p) * bx(p) - 2.0_dp * ab(p) * ax(p)
+      dg4(p) = 2.0_dp * aa(p) * by(p) - 2.0_dp * ab(p) * ay(p)
+      dh1(p) = 6.0_dp * aa(p)**2 * ax(p)
+      dh2(p) = 6.0_dp * aa(p)**2 * ay(p)
+      df1(p) = dg1(p) / h(p) - g(p) * dh1(p) / h(p)**2
+      df2(p) = dg2(p) / h(p) - g(p) * dh2(p) / h(p)**2
+      df3(p) = dg3(p) / h(p) - g(p) * 0.0_dp / h(p)**2
+      df4(p) = dg4(p) / h(p) - g(p) * 0.0_dp / h(p)**2
+      grad_ax(p) = axial_stiffness * strain(p) * ax(p) + 0.5_dp * bending_stiffness * df1(p)
+      grad_ay(p) = axial_stiffness * strain(p) * ay(p) + 0.5_dp * bending_stiffness * df2(p)
+      grad_bx(p) = 0.5_dp * bending_stiffness * df3(p)
+      grad_by(p) = 0.5_dp * bending_stiffness * df4(p)
+    end do
     planar = 0.0_dp
     do p = 1, cable_points
-      weight = weights(p)
-      a = matmul(q(1:2, :), slope_rows(:, p))
-      b = matmul(q(1:2, :), second_rows(:, p))
-      aa = dot_product(a, a)
-      bb = dot_product(b, b)
-      ab = dot_product(a, b)
-      if (aa <= 0.0_dp) then
-        force = 0.0_dp
-        info = 2
-        return
-      end if
-      ! (point_derivatives' expressions, component by component)
-      strain = 0.5_dp * (aa - 1.0_dp)
-      g = aa * bb - ab**2
-      h = aa**3
-      f = g / h
-      point_energy = 0.5_dp * axial_stiffness * strain**2 + 0.5_dp * bending_stiffness * f
-      dg(1:2) = 2.0_dp * bb * a - 2.0_dp * ab * b
-      dg(3:4) = 2.0_dp * aa * b - 2.0_dp * ab * a
-      dh = 6.0_dp * aa**2 * a
-      df(1:2) = dg(1:2) / h - g * dh / h**2
-      df(3:4) = dg(3:4) / h - g * 0.0_dp / h**2
-      grad_a = axial_stiffness * strain * a + 0.5_dp * bending_stiffness * df(1:2)
-      grad_b = 0.5_dp * bending_stiffness * df(3:4)
-      energy = energy + weight * point_energy
+      energy = energy + weights(p) * point_energy(p)
       ! (add_point's force)
       do i = 1, 4
-        planar(:, i) = planar(:, i) + weight * (slope_rows(i, p) * grad_a &
-                                                + second_rows(i, p) * grad_b)
+        planar(1, i) = planar(1, i) + weights(p) * (slope_rows(i, p) * grad_ax(p) &
+                                                    + second_rows(i, p) * grad_bx(p))
+        planar(2, i) = planar(2, i) + weights(p) * (slope_rows(i, p) * grad_ay(p) &
+                                                    + second_rows(i, p) * grad_by(p))
       end do
     end do
     do i = 1, 4
