@@ -691,23 +691,39 @@ contains
     real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
     real(dp), intent(out) :: energy
     integer, intent(out) :: info
-    real(dp) :: a(2), b(2), aa, bb, ab, strain
-    integer :: p
+    real(dp), dimension(cable_points) :: ax, ay, bx, by, aa, bb, ab, strain, point_energy
+    integer :: p, k
     info = 0
     energy = 0.0_dp
+    ! (the points side by side, as in plane_element_force)
+    ax = 0.0_dp
+    ay = 0.0_dp
+    bx = 0.0_dp
+    by = 0.0_dp
+    do k = 1, 4
+      do p = 1, cable_points
+        ax(p) = ax(p) + q(1, k) * slope_rows(k, p)
+        ay(p) = ay(p) + q(2, k) * slope_rows(k, p)
+        bx(p) = bx(p) + q(1, k) * second_rows(k, p)
+        by(p) = by(p) + q(2, k) * second_rows(k, p)
+      end do
+    end do
     do p = 1, cable_points
-      a = matmul(q(1:2, :), slope_rows(:, p))
-      b = matmul(q(1:2, :), second_rows(:, p))
-      aa = dot_product(a, a)
-      bb = dot_product(b, b)
-      ab = dot_product(a, b)
-      strain = 0.5_dp * (aa - 1.0_dp)
-      if (aa <= 0.0_dp) then
-        info = 2
-        return
-      end if
-      energy = energy + weights(p) * (0.5_dp * axial_stiffness * strain**2 &
-                                      + 0.5_dp * bending_stiffness * ((aa * bb - ab**2) / aa**3))
+      aa(p) = 0.0_dp + ax(p) * ax(p) + ay(p) * ay(p)
+      bb(p) = 0.0_dp + bx(p) * bx(p) + by(p) * by(p)
+      ab(p) = 0.0_dp + ax(p) * bx(p) + ay(p) * by(p)
+    end do
+    if (any(aa <= 0.0_dp)) then
+      info = 2
+      return
+    end if
+    do p = 1, cable_points
+      strain(p) = 0.5_dp * (aa(p) - 1.0_dp)
+      point_energy(p) = 0.5_dp * axial_stiffness * strain(p)**2 &
+                        + 0.5_dp * bending_stiffness * ((aa(p) * bb(p) - ab(p)**2) / aa(p)**3)
+    end do
+    do p = 1, cable_points
+      energy = energy + weights(p) * point_energy(p)
     end do
   end subroutine plane_element_energy
 
