@@ -637,6 +637,21 @@ contains
                                  set%weights(:, el), set%axial_stiffness, &
                                  set%bending_stiffness, element_force, element_energy, &
                                  element_info)
+        if (element_info /= 0) then
+          info = 7
+          energy = 0.0_dp
+          return
+        end if
+        ! (the z components are +0: adding them to the sums, which start at +0 and so are
+        ! never -0, changes nothing)
+        do node = 1, 4
+          force(set%dofs(3 * node - 2, el)) = force(set%dofs(3 * node - 2, el)) &
+                                              + element_force(3 * node - 2)
+          force(set%dofs(3 * node - 1, el)) = force(set%dofs(3 * node - 1, el)) &
+                                              + element_force(3 * node - 1)
+        end do
+        energy = energy + element_energy
+        cycle
       else
         call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
                                 set%bending_stiffness, .false., element_force, element_energy, &

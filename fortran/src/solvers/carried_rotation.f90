@@ -222,9 +222,9 @@ contains
   !> coordinate is one full component).
   pure subroutine carry_apply(sys, turn, x, back, y)
     type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: turn(3, 3), x(:)
+    real(dp), intent(in) :: turn(3, 3), x(sys%ndof)
     logical, intent(in) :: back
-    real(dp), intent(out) :: y(:)
+    real(dp), intent(out) :: y(sys%ndof)
     real(dp) :: rotation(3, 3), v(3), w(3), r11, r12, r13, r21, r22, r23
     integer :: b, i, first, second
     rotation = turn

@@ -865,11 +865,14 @@ contains
       end if
     end do
     do c = 1, sys%ncon
-      call drive_value(sys%con_drive(c), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
-                       drive_phi, dphi, ddphi, drive_info)
-      if (drive_info /= 0) then
-        info = 5
-        return
+      drive_phi = 0.0_dp  ! (drive_value's value without a drive)
+      if (sys%con_drive(c) /= 0) then
+        call drive_value(sys%con_drive(c), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+                         drive_phi, dphi, ddphi, drive_info)
+        if (drive_info /= 0) then
+          info = 5
+          return
+        end if
       end if
       last_operand = 6
       if (sys%con_kind(c) == constraint_kind_coordinate) then
@@ -882,7 +885,9 @@ contains
         info = 5
         return
       end if
-      x = 0.0_dp
+      do s = 1, 6
+        x(s) = 0.0_dp
+      end do
       do s = 1, last_operand
         x(s) = sys%operand_const(s, c)
         do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
@@ -897,7 +902,9 @@ contains
       end if
       phi(c) = constraint_value(sys%con_kind(c), sys%con_drive(c) /= 0, sys%con_params(:, c), &
                                 x, drive_phi, cos_phi, sin_phi)
-      gradients(:, c) = 0.0_dp
+      do s = 1, 6
+        gradients(s, c) = 0.0_dp
+      end do
       select case (sys%con_kind(c))
       case (constraint_kind_coordinate)
         gradients(1, c) = 1.0_dp
