@@ -62,7 +62,7 @@ end subroutine system_destroy
 subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, length_scale, &
                                 max_newton, jacobian, contraction, info, message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, policy_constant
+  use mechanical_system, only: system_model, policy_constant, plane_mass_setup
   use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, jacobian_reuse
   use system_store, only: store_get
   use kernel_errors, only: handle_text
@@ -98,6 +98,7 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
                                            max_newton=max_newton, jacobian=jacobian, &
                                            contraction=contraction))
   if (sys%policy /= policy_constant) sys%factorized = .false.
+  call plane_mass_setup(sys)
 end subroutine system_stepper_setup
 
 !> Element sets: one routine per family builds the family's set (element_sets: an
@@ -491,6 +492,8 @@ subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, m
   sys%mass_row_ptr = mass_row_ptr
   sys%mass_col = mass_col
   sys%mass_values = mass_values
+  if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
+                                                sys%mass_pair_row, sys%mass_pair_values)
   sys%full_row_ptr = full_row_ptr
   sys%full_col = full_col
   sys%solver_handle = solver_handle
@@ -610,6 +613,8 @@ subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, m
   sys%mass_col = col
   sys%mass_values = values
   sys%mass_kron = .true.
+  if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
+                                                sys%mass_pair_row, sys%mass_pair_values)
 end subroutine system_set_kron_mass
 
 !> q = B e + q0 (B CSR over nfull rows, 1-based) and the plan of B^T S B: values(target)

@@ -31,6 +31,7 @@
 !> No I/O; failures return codes.
 module mechanical_system
   use ancf_kinds, only: dp
+  use iso_fortran_env, only: int64
   use constraints, only: constraint_eval, operand_values, drive_value, constraint_value, &
                          constraint_kind_coordinate, constraint_kind_distance, &
                          constraint_kind_cross, constraint_kind_dot
@@ -45,6 +46,7 @@ module mechanical_system
   implicit none
   private
   public :: system_model, frame_def, contact_pair, contact_state
+  public :: plane_mass_setup
   public :: frame_rotations, to_full, to_reduced, csr_matvec, mass_product, internal_forces, &
             external_forces, &
             evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
@@ -100,6 +102,11 @@ module mechanical_system
     integer, allocatable :: mass_row_ptr(:), mass_col(:)
     real(dp), allocatable :: mass_values(:)
     logical :: mass_kron = .false.
+    ! the CSR mass of a planar reduction as kron(Mbar, I2) over the plane's (x, y) pairs
+    ! (plane_mass_setup; unallocated otherwise): Mbar's rows by pair, each entry's column the
+    ! x coordinate of its pair (y: x + 1), and each pair's x coordinate
+    integer, allocatable :: mass_pair_ptr(:), mass_pair_col(:), mass_pair_row(:)
+    real(dp), allocatable :: mass_pair_values(:)
     ! full pattern of the tangents; q = B e + q0 and the plan of B^T S B
     integer, allocatable :: full_row_ptr(:), full_col(:)
     logical :: reduced = .false.
@@ -281,6 +288,22 @@ contains
     real(dp), intent(out) :: y(:)
     integer :: i, k, j
     real(dp) :: total(3), m
+    if (allocated(sys%mass_pair_ptr)) then
+      ! kron(Mbar, I2) over the plane's pairs: each row's sums as csr_matvec takes them
+      do i = 1, size(sys%mass_pair_ptr) - 1
+        total(1:2) = 0.0_dp
+        do k = sys%mass_pair_ptr(i), sys%mass_pair_ptr(i + 1) - 1
+          j = sys%mass_pair_col(k)
+          m = sys%mass_pair_values(k)
+          total(1) = total(1) + m * x(j)
+          total(2) = total(2) + m * x(j + 1)
+        end do
+        j = sys%mass_pair_row(i)
+        y(j) = total(1)
+        y(j + 1) = total(2)
+      end do
+      return
+    end if
     if (.not. sys%mass_kron) then
       call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, x, y)
       return
@@ -297,6 +320,61 @@ contains
       y(3 * i - 2:3 * i) = total
     end do
   end subroutine mass_product
+
+  !> The mass product of a planar reduction by pairs (mass_pair_*): when every reduced
+  !> coordinate is the x or y of a plane vector (carry_plane, y = x + 1) and the CSR mass's
+  !> y row of each pair is its x row moved to the partner columns with the same values
+  !> (bit for bit) in the same order, Mbar's rows by pair, so that mass_product takes the
+  !> same sums with half the index work; otherwise nothing (the CSR stays in use).
+  subroutine plane_mass_setup(sys)
+    type(system_model), intent(inout) :: sys
+    integer, allocatable :: pair_of(:)
+    integer :: npair, p, k, row_x, row_y, kx, ky, count_x, nnz
+    if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
+                                                  sys%mass_pair_row, sys%mass_pair_values)
+    if (sys%mass_kron .or. .not. allocated(sys%carry_plane) .or. &
+        .not. allocated(sys%mass_row_ptr)) return
+    npair = size(sys%carry_plane, 2)
+    if (2 * npair /= sys%ndof .or. size(sys%mass_row_ptr) /= sys%ndof + 1) return
+    allocate (pair_of(sys%ndof))
+    pair_of = 0
+    do p = 1, npair
+      row_x = sys%carry_plane(1, p)
+      if (sys%carry_plane(2, p) /= row_x + 1) return
+      if (pair_of(row_x) /= 0 .or. pair_of(row_x + 1) /= 0) return
+      pair_of(row_x) = p
+      pair_of(row_x + 1) = -p
+    end do
+    nnz = 0
+    do p = 1, npair
+      row_x = sys%carry_plane(1, p)
+      row_y = row_x + 1
+      count_x = sys%mass_row_ptr(row_x + 1) - sys%mass_row_ptr(row_x)
+      if (sys%mass_row_ptr(row_y + 1) - sys%mass_row_ptr(row_y) /= count_x) return
+      do k = 0, count_x - 1
+        kx = sys%mass_row_ptr(row_x) + k
+        ky = sys%mass_row_ptr(row_y) + k
+        if (pair_of(sys%mass_col(kx)) <= 0 .or. sys%mass_col(ky) /= sys%mass_col(kx) + 1) return
+        if (transfer(sys%mass_values(kx), 1_int64) /= transfer(sys%mass_values(ky), 1_int64)) &
+          return
+      end do
+      nnz = nnz + count_x
+    end do
+    allocate (sys%mass_pair_ptr(npair + 1), sys%mass_pair_col(nnz), sys%mass_pair_row(npair), &
+              sys%mass_pair_values(nnz))
+    sys%mass_pair_ptr(1) = 1
+    do p = 1, npair
+      row_x = sys%carry_plane(1, p)
+      sys%mass_pair_row(p) = row_x
+      count_x = sys%mass_row_ptr(row_x + 1) - sys%mass_row_ptr(row_x)
+      kx = sys%mass_row_ptr(row_x)
+      sys%mass_pair_col(sys%mass_pair_ptr(p):sys%mass_pair_ptr(p) + count_x - 1) = &
+        sys%mass_col(kx:kx + count_x - 1)
+      sys%mass_pair_values(sys%mass_pair_ptr(p):sys%mass_pair_ptr(p) + count_x - 1) = &
+        sys%mass_values(kx:kx + count_x - 1)
+      sys%mass_pair_ptr(p + 1) = sys%mass_pair_ptr(p) + count_x
+    end do
+  end subroutine plane_mass_setup
 
   !> y = M x for a CSR matrix (1-based).
   pure subroutine csr_matvec(row_ptr, col, values, x, y)
