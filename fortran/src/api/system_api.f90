@@ -655,13 +655,17 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
   sys%plan_coef = plan_coef(1:nplan)
   ! a selection (each row of B empty or one entry 1): to_full and to_reduced by its columns
   ! (offset or 0, plus 1 x: the same sums without the row pointers and the products by 1)
-  if (allocated(sys%reduction_select)) deallocate (sys%reduction_select)
+  if (allocated(sys%reduction_select)) deallocate (sys%reduction_select, sys%select_full, &
+                                                    sys%select_column, sys%select_fixed)
   if (all(b_ptr(2:) - b_ptr(:nfull) <= 1) .and. all(b_values(1:nnz_b) == 1.0_dp)) then
     allocate (sys%reduction_select(nfull))
     do i = 1, nfull
       sys%reduction_select(i) = 0
       if (b_ptr(i + 1) > b_ptr(i)) sys%reduction_select(i) = b_col(b_ptr(i))
     end do
+    sys%select_full = pack([(i, i = 1, nfull)], sys%reduction_select > 0)
+    sys%select_column = pack(sys%reduction_select, sys%reduction_select > 0)
+    sys%select_fixed = pack([(i, i = 1, nfull)], sys%reduction_select == 0)
   end if
 end subroutine system_set_reduction
 
@@ -1184,7 +1188,7 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   real(dp), allocatable :: out_deflection(:, :, :), out_lambda(:, :), out_energy(:, :)
   real(dp), allocatable :: out_constraint(:), out_contact(:, :, :), out_q(:, :)
   real(dp) :: t, work(power_count), powers(power_count)
-  integer :: info, ndof, ncon, nprobe, npoint, step, k
+  integer :: info, ndof, ncon, nprobe, npoint, step, k, j
   logical :: store_q
   rows = 0.0_dp
   stats = 0
@@ -1253,12 +1257,17 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   state = [t, e, v, a, accel, lam, work, powers, reshape(contact%guesses, [2 * npoint])]
   counts = contact%counts
   ! the output rows (stepper.f90 row_size)
+  ! (the probes' and deflections' columns copied by loops: reshape was a library call a step)
   do step = 1, nsteps
     rows(1, step) = out_time(step)
     k = 1
-    rows(k + 1:k + 3 * nprobe, step) = reshape(out_probe(:, :, step), [3 * nprobe])
+    do j = 1, nprobe
+      rows(k + 3 * j - 2:k + 3 * j, step) = out_probe(:, j, step)
+    end do
     k = k + 3 * nprobe
-    rows(k + 1:k + 3 * nprobe, step) = reshape(out_deflection(:, :, step), [3 * nprobe])
+    do j = 1, nprobe
+      rows(k + 3 * j - 2:k + 3 * j, step) = out_deflection(:, j, step)
+    end do
     k = k + 3 * nprobe
     rows(k + 1:k + ncon, step) = out_lambda(:, step)
     k = k + ncon
@@ -1266,8 +1275,9 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
     k = k + energy_count
     rows(k + 1, step) = out_constraint(step)
     k = k + 1
-    rows(k + 1:k + contact_record * npoint, step) = reshape(out_contact(:, :, step), &
-                                                            [contact_record * npoint])
+    do j = 1, npoint
+      rows(k + contact_record * (j - 1) + 1:k + contact_record * j, step) = out_contact(:, j, step)
+    end do
     k = k + contact_record * npoint
     if (store_q) rows(k + 1:k + ndof, step) = out_q(:, step)
   end do

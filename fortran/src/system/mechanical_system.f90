@@ -115,6 +115,9 @@ module mechanical_system
     ! a reduction that selects (each row of B empty or one entry 1): the column of each
     ! full coordinate (0: fixed), for to_full and to_reduced; unallocated otherwise
     integer, allocatable :: reduction_select(:)
+    ! the same selection as lists: the selected full coordinates (increasing) with their
+    ! columns, and the fixed ones
+    integer, allocatable :: select_full(:), select_column(:), select_fixed(:)
     integer, allocatable :: plan_source(:), plan_target(:)
     real(dp), allocatable :: plan_coef(:)
     ! loads: constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
@@ -405,14 +408,24 @@ contains
       return
     end if
     if (allocated(sys%reduction_select)) then
-      ! a selection: the same sums (offset or 0, plus 1 x) without the row pointers
-      do i = 1, sys%nfull
-        total = 0.0_dp
-        if (with_offset) total = sys%reduction_offset(i)
-        k = sys%reduction_select(i)
-        if (k > 0) total = total + x(k)
-        full(i) = total
-      end do
+      ! a selection: the same sums (offset or 0, plus 1 x) without the row pointers, by the
+      ! lists of selected and fixed coordinates
+      if (with_offset) then
+        do k = 1, size(sys%select_fixed)
+          full(sys%select_fixed(k)) = sys%reduction_offset(sys%select_fixed(k))
+        end do
+        do k = 1, size(sys%select_full)
+          i = sys%select_full(k)
+          full(i) = sys%reduction_offset(i) + x(sys%select_column(k))
+        end do
+      else
+        do k = 1, size(sys%select_fixed)
+          full(sys%select_fixed(k)) = 0.0_dp
+        end do
+        do k = 1, size(sys%select_full)
+          full(sys%select_full(k)) = 0.0_dp + x(sys%select_column(k))
+        end do
+      end if
       return
     end if
     ! (a scalar accumulator per row, from the offset or 0: the same sums, in a register)
@@ -438,10 +451,10 @@ contains
     end if
     x = 0.0_dp
     if (allocated(sys%reduction_select)) then
-      ! a selection: the same sums (0 plus 1 full(i)) without the row pointers
-      do i = 1, sys%nfull
-        k = sys%reduction_select(i)
-        if (k > 0) x(k) = x(k) + full(i)
+      ! a selection: the same sums (0 plus 1 full(i), in increasing i) without the row
+      ! pointers
+      do k = 1, size(sys%select_full)
+        x(sys%select_column(k)) = x(sys%select_column(k)) + full(sys%select_full(k))
       end do
       return
     end if
