@@ -51,23 +51,30 @@ contains
     integer, intent(in) :: n, kd, nrhs
     real(dp), intent(in) :: band(kd + 1, n), lower(kd + 1, n)
     real(dp), intent(inout) :: rhs(n, nrhs)
-    integer :: i, j, k, first, last
+    integer :: i, j, k, m, first, last
     real(dp) :: x
     do k = 1, nrhs
       ! U^T y = b by the columns of U^T (the rows of U, contiguous in lower): each rhs(j)
       ! loses U(i, j) y(i) for i = j - kd .. j - 1 in increasing i, then is divided by
       ! U(j, j), the sums of the dot-product form, in array operations the compiler vectorizes
+      ! (scalar loops: a band of a few entries is shorter than the vector code's set-up)
       do i = 1, n
         x = rhs(i, k) / lower(1, i)
         rhs(i, k) = x
         last = min(kd, n - i)
-        rhs(i + 1:i + last, k) = rhs(i + 1:i + last, k) - lower(2:last + 1, i) * x
+        !GCC$ novector
+        do m = 1, last
+          rhs(i + m, k) = rhs(i + m, k) - lower(1 + m, i) * x
+        end do
       end do
       do j = n, 1, -1  ! U x = y
         x = rhs(j, k) / band(kd + 1, j)
         rhs(j, k) = x
         first = max(1, j - kd)
-        rhs(first:j - 1, k) = rhs(first:j - 1, k) - x * band(kd + 1 - j + first:kd, j)
+        !GCC$ novector
+        do i = first, j - 1
+          rhs(i, k) = rhs(i, k) - x * band(kd + 1 - j + i, j)
+        end do
       end do
     end do
   end subroutine cholesky_band_solve
