@@ -285,8 +285,8 @@ contains
     real(dp), intent(in) :: slope(4), second(4), weight, grad_a(3), grad_b(3), hessian(6, 6)
     logical, intent(in) :: want_tangent
     real(dp), intent(inout) :: force(cable_dofs), tangent(cable_dofs, cable_dofs)
-    real(dp) :: rows(2, 4), block(3, 3)
-    integer :: i, j, m, n
+    real(dp) :: rows(2, 4), s11, s21, s12, s22
+    integer :: i, j, r, c
     do i = 1, 4
       force(3 * i - 2:3 * i) = force(3 * i - 2:3 * i) &
                                + weight * (slope(i) * grad_a + second(i) * grad_b)
@@ -294,17 +294,21 @@ contains
     if (.not. want_tangent) return
     rows(1, :) = slope
     rows(2, :) = second
+    ! block (i, j) = sum over n, then m (1, 2) of rows(m, i) rows(n, j) H_mn (H_mn the
+    ! (m, n) 3 x 3 block of the hessian), from 0, entry by entry; tangent += weight block
     do j = 1, 4
       do i = 1, 4
-        block = 0.0_dp
-        do n = 1, 2
-          do m = 1, 2
-            block = block + rows(m, i) * rows(n, j) &
-                    * hessian(3 * m - 2:3 * m, 3 * n - 2:3 * n)
+        s11 = rows(1, i) * rows(1, j)
+        s21 = rows(2, i) * rows(1, j)
+        s12 = rows(1, i) * rows(2, j)
+        s22 = rows(2, i) * rows(2, j)
+        do c = 1, 3
+          do r = 1, 3
+            tangent(3 * i - 3 + r, 3 * j - 3 + c) = tangent(3 * i - 3 + r, 3 * j - 3 + c) &
+              + weight * ((((0.0_dp + s11 * hessian(r, c)) + s21 * hessian(3 + r, c)) &
+                           + s12 * hessian(r, 3 + c)) + s22 * hessian(3 + r, 3 + c))
           end do
         end do
-        tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) = tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) &
-                                                    + weight * block
       end do
     end do
   end subroutine add_point
