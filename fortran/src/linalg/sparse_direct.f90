@@ -57,24 +57,26 @@ contains
       ! U^T y = b by the columns of U^T (the rows of U, contiguous in lower): each rhs(j)
       ! loses U(i, j) y(i) for i = j - kd .. j - 1 in increasing i, then is divided by
       ! U(j, j), the sums of the dot-product form, in array operations the compiler vectorizes
-      ! (scalar loops: a band of a few entries is shorter than the vector code's set-up)
-      do i = 1, n
-        x = rhs(i, k) / lower(1, i)
-        rhs(i, k) = x
-        last = min(kd, n - i)
-        !GCC$ novector
-        do m = 1, last
-          rhs(i + m, k) = rhs(i + m, k) - lower(1 + m, i) * x
-        end do
-      end do
-      do j = n, 1, -1  ! U x = y
-        x = rhs(j, k) / band(kd + 1, j)
-        rhs(j, k) = x
+      ! (scalar loops: a band of a few entries is shorter than the vector code's set-up;
+      ! both sweeps as running sums in a register, each rhs(j) losing its terms in the
+      ! order of the column forms: U^T y = b in increasing i, U x = y in decreasing j)
+      do j = 1, n  ! U^T y = b
         first = max(1, j - kd)
+        x = rhs(j, k)
         !GCC$ novector
         do i = first, j - 1
-          rhs(i, k) = rhs(i, k) - x * band(kd + 1 - j + i, j)
+          x = x - band(kd + 1 - j + i, j) * rhs(i, k)
         end do
+        rhs(j, k) = x / band(kd + 1, j)
+      end do
+      do i = n, 1, -1  ! U x = y: x(i) loses U(i, j) x(j) for j = i + kd .. i + 1
+        last = min(kd, n - i)
+        x = rhs(i, k)
+        !GCC$ novector
+        do m = last, 1, -1
+          x = x - rhs(i + m, k) * lower(1 + m, i)
+        end do
+        rhs(i, k) = x / lower(1, i)
       end do
     end do
   end subroutine cholesky_band_solve

@@ -991,8 +991,14 @@ contains
         cos_phi = cos(drive_phi)
         sin_phi = sin(drive_phi)
       end if
-      phi(c) = constraint_value(sys%con_kind(c), sys%con_drive(c) /= 0, sys%con_params(:, c), &
-                                x, drive_phi, cos_phi, sin_phi)
+      if (sys%con_kind(c) == constraint_kind_coordinate) then
+        ! (constraint_value's formula of the kind, written in place of the call)
+        phi(c) = x(1) - (sys%con_params(1, c) + sys%con_params(2, c) * cos_phi &
+                         + sys%con_params(3, c) * sin_phi + sys%con_params(4, c) * drive_phi)
+      else
+        phi(c) = constraint_value(sys%con_kind(c), sys%con_drive(c) /= 0, &
+                                  sys%con_params(:, c), x, drive_phi, cos_phi, sin_phi)
+      end if
       do s = 1, 6
         gradients(s, c) = 0.0_dp
       end do
