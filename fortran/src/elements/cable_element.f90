@@ -44,7 +44,8 @@
 module cable_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use element_sets, only: local_element_set, loop_work, threaded_work, local_set_forces
+  use element_sets, only: local_element_set, loop_work, threaded_work, local_set_forces, &
+                          local_energy_power
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
@@ -81,6 +82,7 @@ module cable_element
     real(dp), allocatable :: slope_rows(:, :, :), second_rows(:, :, :), weights(:, :)
   contains
     procedure :: forces => cable_set_forces
+    procedure :: energy_power => cable_set_energy_power
     procedure :: element_forces => cable_element_forces
     procedure :: element_energy => cable_element_energy
   end type cable_set
@@ -672,6 +674,52 @@ contains
       energy = energy + element_energy
     end do
   end subroutine cable_set_forces
+
+  !> The element_set energy_power of a cable set. An undamped elastic cable set (or one
+  !> given no rates): local_energy_power's loop (each element's strain energy summed in
+  !> element order; no frame: power 0) without its dispatch through element_energy, a plane
+  !> element by plane_element_energy: the same numbers. Everything else: local_energy_power.
+  subroutine cable_set_energy_power(set, rotation, axis, rate, e, energy, power, info, v, &
+                                    dissipation)
+    class(cable_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), axis(3), rate, e(:)
+    real(dp), intent(out) :: energy, power
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:)
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: coords(3, 4), element_energy
+    integer :: el, node, element_info
+    if (set%tension_only .or. .not. allocated(set%weights) .or. set%nde /= cable_dofs .or. &
+        (present(v) .and. set%damping_time > 0.0_dp)) then
+      call local_energy_power(set, rotation, axis, rate, e, energy, power, info, v, dissipation)
+      return
+    end if
+    info = 0
+    power = 0.0_dp
+    energy = 0.0_dp
+    do el = 1, set%nel
+      do node = 1, 4
+        coords(1, node) = e(set%dofs(3 * node - 2, el))
+        coords(2, node) = e(set%dofs(3 * node - 1, el))
+        coords(3, node) = e(set%dofs(3 * node, el))
+      end do
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_energy(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                  set%weights(:, el), set%axial_stiffness, &
+                                  set%bending_stiffness, element_energy, element_info)
+      else
+        call rule_element_energy(coords, set%lengths(el), set%rule, set%axial_stiffness, &
+                                 set%bending_stiffness, element_energy, element_info, .false.)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      energy = energy + element_energy
+    end do
+    if (present(dissipation)) dissipation = 0.0_dp
+  end subroutine cable_set_energy_power
 
   !> The element_set element_energy of a cable set: the energy-only pass (the damped set,
   !> given rates, through its force for the dissipation).

@@ -28,7 +28,7 @@ module element_sets
   implicit none
   private
   public :: element_set, local_element_set, set_slot, frame_omega, scatter_add, loop_work, &
-            local_set_forces
+            local_set_forces, local_energy_power
 
   !> Work of an element loop (microseconds on one thread) below which it runs on one thread
   !> whatever OMP_NUM_THREADS says: waking the sleeping team (OMP_WAIT_POLICY passive) costs
