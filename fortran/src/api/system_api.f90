@@ -657,6 +657,7 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
   ! (offset or 0, plus 1 x: the same sums without the row pointers and the products by 1)
   if (allocated(sys%reduction_select)) deallocate (sys%reduction_select, sys%select_full, &
                                                     sys%select_column, sys%select_fixed)
+  sys%select_one_to_one = .false.
   if (all(b_ptr(2:) - b_ptr(:nfull) <= 1) .and. all(b_values(1:nnz_b) == 1.0_dp)) then
     allocate (sys%reduction_select(nfull))
     do i = 1, nfull
@@ -666,6 +667,11 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
     sys%select_full = pack([(i, i = 1, nfull)], sys%reduction_select > 0)
     sys%select_column = pack(sys%reduction_select, sys%reduction_select > 0)
     sys%select_fixed = pack([(i, i = 1, nfull)], sys%reduction_select == 0)
+    sys%select_one_to_one = .true.
+    do i = 1, size(sys%select_column) - 1
+      if (any(sys%select_column(i + 1:) == sys%select_column(i))) &
+        sys%select_one_to_one = .false.
+    end do
   end if
 end subroutine system_set_reduction
 

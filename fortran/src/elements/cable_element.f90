@@ -82,6 +82,7 @@ module cable_element
     real(dp), allocatable :: slope_rows(:, :, :), second_rows(:, :, :), weights(:, :)
   contains
     procedure :: forces => cable_set_forces
+    procedure :: selected_forces => cable_selected_forces
     procedure :: energy_power => cable_set_energy_power
     procedure :: element_forces => cable_element_forces
     procedure :: element_energy => cable_element_energy
@@ -674,6 +675,63 @@ contains
       energy = energy + element_energy
     end do
   end subroutine cable_set_forces
+
+  !> The element_set selected_forces of a cable set: cable_set_forces' lean pass (an
+  !> undamped elastic set below the threading threshold; done = .false. otherwise) on the
+  !> independent coordinates of a selection: each element's coordinates as to_full gives
+  !> them (q0 + e, or q0 where fixed), its force added to the reduced force of each selected
+  !> coordinate in element order (each full coordinate's sum of cable_set_forces, from +0,
+  !> which to_reduced then adds to 0: the same numbers, the selection being one to one).
+  subroutine cable_selected_forces(set, select, offset, e, force, energy, info, done)
+    class(cable_set), intent(in) :: set
+    integer, intent(in) :: select(:)
+    real(dp), intent(in) :: offset(:), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    logical, intent(out) :: done
+    real(dp) :: coords(3, 4), element_force(cable_dofs), element_energy
+    real(dp) :: unused_tangent(cable_dofs, cable_dofs)
+    integer :: el, a, i, k, element_info
+    energy = 0.0_dp
+    info = 0
+    done = .not. (set%tension_only .or. .not. allocated(set%weights) .or. &
+                  set%nde /= cable_dofs .or. loop_work(set, .false.) >= threaded_work .or. &
+                  set%damping_time > 0.0_dp)
+    if (.not. done) return
+    do el = 1, set%nel
+      do a = 1, cable_dofs
+        i = set%dofs(a, el)
+        k = select(i)
+        if (k > 0) then
+          coords(mod(a - 1, 3) + 1, (a - 1) / 3 + 1) = offset(i) + e(k)
+        else
+          coords(mod(a - 1, 3) + 1, (a - 1) / 3 + 1) = offset(i)
+        end if
+      end do
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                 set%weights(:, el), set%axial_stiffness, &
+                                 set%bending_stiffness, element_force, element_energy, &
+                                 element_info)
+      else
+        call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
+                                set%bending_stiffness, .false., element_force, element_energy, &
+                                unused_tangent, element_info, .false.)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      ! (a z component of a plane element is +0: added or not, the same sums)
+      do a = 1, cable_dofs
+        k = select(set%dofs(a, el))
+        if (k > 0) force(k) = force(k) + element_force(a)
+      end do
+      energy = energy + element_energy
+    end do
+  end subroutine cable_selected_forces
 
   !> The element_set energy_power of a cable set. An undamped elastic cable set (or one
   !> given no rates): local_energy_power's loop (each element's strain energy summed in

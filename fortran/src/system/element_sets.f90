@@ -50,6 +50,7 @@ module element_sets
   contains
     procedure(set_forces_interface), deferred :: forces
     procedure :: energy_power => set_energy_power
+    procedure :: selected_forces => no_selected_forces
   end type element_set
 
   abstract interface
@@ -117,6 +118,24 @@ module element_sets
   end type set_slot
 
 contains
+
+  !> The force pass of an undamped set on the independent coordinates of a selection
+  !> (q = B e + q0 with each row of B empty or one 1, no column twice: select(i) the column
+  !> of full coordinate i, 0 where fixed, offset = q0): the set's force added to the reduced
+  !> force as to_full, forces and to_reduced would give it, bit for bit; done = .false.
+  !> where the family has no such pass (the default): nothing is computed.
+  subroutine no_selected_forces(set, select, offset, e, force, energy, info, done)
+    class(element_set), intent(in) :: set
+    integer, intent(in) :: select(:)
+    real(dp), intent(in) :: offset(:), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    logical, intent(out) :: done
+    energy = 0.0_dp
+    info = 0
+    done = .false.
+  end subroutine no_selected_forces
 
   !> Strain energy at e and the power of the frame's motion at fixed e (a set in a moving
   !> frame; unit axis, rate phi'; 0 here: the families that have one override this). A damped
