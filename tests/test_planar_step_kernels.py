@@ -3,7 +3,8 @@ cost per Newton correction): each lean path must give the numbers of the general
 replaces, to the last bit, and keep the element's invariants.
 
 * cable_set_forces (fortran/src/elements/cable_element.f90): a small cable set's force pass
-  without the generic dispatch, a plane element (z = 0) by plane_element_force (the five
+  without the generic dispatch (on a planar reduction's one-to-one selection straight on the
+  independent coordinates: cable_selected_forces), a plane element (z = 0) by plane_element_force (the five
   Gauss points side by side), the output rows' energy by plane_element_energy: against the
   element routine of the element API (rule_element_force, the general 3D expressions),
   bit for bit, in the plane and out of it; the plane force against central differences of
@@ -52,12 +53,13 @@ def _bent(z_amplitude: float = 0.0) -> np.ndarray:
     return np.array(e)
 
 
-def _element_reference(model, e: np.ndarray) -> tuple[np.ndarray, float]:
+def _element_reference(model, e: np.ndarray, lengths_from=None) -> tuple[np.ndarray, float]:
     """The element API's force and energy (rule_element_force per element, summed in
-    element order from 0, as the system's set loop sums them), with the model's element
-    lengths (its nodes' distances in the reference)."""
+    element order from 0, as the system's set loop sums them) at the full coordinates e,
+    with the model's element lengths (its nodes' distances in the reference, the full
+    reference lengths_from, default the model's e0)."""
     dofs = np.array([np.arange(6 * k, 6 * k + 12) for k in range(NODES - 1)]).T
-    lengths = np.diff(model.e0[0::6])
+    lengths = np.diff((model.e0 if lengths_from is None else lengths_from)[0::6])
     force, energy, _ = kernel.cable_forces(dofs, e, lengths, E * AREA, E * INERTIA, False)
     return force, energy
 
@@ -75,6 +77,35 @@ def test_set_force_pass_is_the_element_routine_bit_for_bit(z_amplitude):
         force, energy = _element_reference(model, e)
         assert np.abs(force).max() > 1.0 and energy > 1.0
         assert out["internal"].tobytes() == force.tobytes()
+        assert out["strain"] == energy
+    finally:
+        model.close()
+
+
+def test_force_on_the_planar_selection_is_the_element_routine_bit_for_bit():
+    """A pinned cable reduced to the x-y plane (a one-to-one selection of the full
+    coordinates): the internal force on the independent coordinates (the sets straight on
+    them, selected_forces) is the element API's full force at q = B e + q0, taken at the
+    selected coordinates, to the last bit, and the strain energy the same."""
+    s = System("selection", planar="xy")
+    steel = s.material("steel", youngs_modulus=E, density=RHO)
+    s.cable("c", material=steel, start=(0, 0, 0), end=(LENGTH, 0, 0), nodes=NODES,
+            section=Circle(D))
+    s.joint("pin", "spherical", "ground", "c", point=(0, 0, 0))
+    model = s.assemble()
+    try:
+        independent = model.reduction.independent
+        # B selects, one to one: column k is the unit vector of full coordinate independent[k]
+        unit = model.expand(np.eye(model.ndof), with_offset=False)
+        np.testing.assert_array_equal(unit, np.eye(model.nfull)[:, independent].T)
+        bent = _bent()
+        bent[:3] = 0.0   # the pinned root
+        e = bent[independent]
+        q = model.expand(e)
+        np.testing.assert_array_equal(q, bent)
+        out = model.forces(e)
+        force, energy = _element_reference(model, q, lengths_from=model.q0)
+        assert out["internal"].tobytes() == force[independent].tobytes()
         assert out["strain"] == energy
     finally:
         model.close()
