@@ -878,6 +878,7 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  integer :: c, s
   message = ' '
   call store_get(handle, sys, info)
   if (info /= 0) then
@@ -904,6 +905,14 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
   sys%term_ptr = term_ptr
   sys%term_dof = term_dof(1:nterm)
   sys%term_coef = term_coef(1:nterm)
+  if (allocated(sys%con_operands)) deallocate (sys%con_operands)
+  allocate (sys%con_operands(ncon))
+  do c = 1, ncon
+    sys%con_operands(c) = 0
+    do s = 1, 6
+      if (term_ptr(6 * (c - 1) + s + 1) > term_ptr(6 * (c - 1) + s)) sys%con_operands(c) = s
+    end do
+  end do
 end subroutine system_set_constraints
 
 !> A contact pair (leaf_contact): the pair's element columns (dofs into the full vector,

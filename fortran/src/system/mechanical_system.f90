@@ -149,6 +149,8 @@ module mechanical_system
     ! constraints with multipliers (constraints module layout)
     integer :: ncon = 0
     integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
+    ! each constraint's last operand with terms (0: none), set with the constraints
+    integer, allocatable :: con_operands(:)
     real(dp), allocatable :: con_params(:, :), operand_const(:, :), term_coef(:)
     ! contact
     integer :: npoint = 0
@@ -1050,7 +1052,7 @@ contains
     real(dp), intent(inout) :: r(:)
     integer :: c, s, k
     do c = 1, sys%ncon
-      do s = 1, 6
+      do s = 1, operand_count(sys, c)
         do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
           r(sys%term_dof(k)) = r(sys%term_dof(k)) - gradients(s, c) * sys%term_coef(k) * lam(c)
         end do
@@ -1074,13 +1076,23 @@ contains
     integer :: c, s, k
     y = 0.0_dp
     do c = 1, sys%ncon
-      do s = 1, 6
+      do s = 1, operand_count(sys, c)
         do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
           y(c) = y(c) + gradients(s, c) * sys%term_coef(k) * x(sys%term_dof(k))
         end do
       end do
     end do
   end subroutine gradient_product
+
+  !> The operands of constraint c up to the last with terms (con_operands, set with the
+  !> constraints; 6 without it): the loops over the operands' terms skip the empty rest
+  !> (a coordinate constraint's five unused operands).
+  pure integer function operand_count(sys, c) result(count_c)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: c
+    count_c = 6
+    if (allocated(sys%con_operands)) count_c = sys%con_operands(c)
+  end function operand_count
 
   !> The solver frame: policy constant rotates each reduced 3-vector of a moving frame's
   !> bodies into that frame (U^T x, transpose_first) or back (U x); otherwise a copy.
