@@ -2,7 +2,7 @@
 the machine's load), with the Newton corrections per step, for the small systems of
 issue 23 items 3-4: the luffing boom with the planar ANCF cable (4 and 7 nodes, 50 kg) and
 the flexible pendulum with the planar cable (5 and 17 nodes, dt = 1e-3), and the peer
-harness's levels in full (pend5full, pend17full: the pendulum's 1 s; spin11: the W = 4
+harness's levels in full (pend5full, pend9full, pend17full: the pendulum's 1 s; spin11: the W = 4
 cable spin-up, 11 nodes, dt = 5e-3, 20 s).
 
     python benchmarks/step_instructions.py [--site DIR] [--cases boom4,pend5] [--output F]
@@ -41,6 +41,7 @@ CASES = {
     "pend17": PENDULUM + ["beam.nodes=17"],
     # the peer harness's levels in full (issue 23: the pendulum 1 s, the spin-up W = 4 20 s)
     "pend5full": PENDULUM[:-1] + ["beam.nodes=5", "solver.t_end=1.0"],
+    "pend9full": PENDULUM[:-1] + ["beam.nodes=9", "solver.t_end=1.0"],
     "pend17full": PENDULUM[:-1] + ["beam.nodes=17", "solver.t_end=1.0"],
     "spin11": ["inputs/hard/spinup.nml", "spinup.omega=4", "beam.bending=cable",
                "scene.planar=xy", "beam.nodes=11", "solver.dt=5e-3", "output.xdmf=.false."],

@@ -62,7 +62,7 @@ end subroutine system_destroy
 subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, length_scale, &
                                 max_newton, jacobian, contraction, info, message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, policy_constant
+  use mechanical_system, only: system_model, policy_constant, plane_mass_setup
   use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, jacobian_reuse
   use system_store, only: store_get
   use kernel_errors, only: handle_text
@@ -98,6 +98,7 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
                                            max_newton=max_newton, jacobian=jacobian, &
                                            contraction=contraction))
   if (sys%policy /= policy_constant) sys%factorized = .false.
+  call plane_mass_setup(sys)
 end subroutine system_stepper_setup
 
 !> Element sets: one routine per family builds the family's set (element_sets: an
@@ -491,6 +492,8 @@ subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, m
   sys%mass_row_ptr = mass_row_ptr
   sys%mass_col = mass_col
   sys%mass_values = mass_values
+  if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
+                                                sys%mass_pair_row, sys%mass_pair_values)
   sys%full_row_ptr = full_row_ptr
   sys%full_col = full_col
   sys%solver_handle = solver_handle
@@ -546,6 +549,7 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   sys%carry_weight = weight(1:max(0, nvec))
   sys%carry_position = position(1:max(0, nvec)) /= 0
   if (allocated(sys%carry_map)) deallocate (sys%carry_map)
+  if (allocated(sys%carry_plane)) deallocate (sys%carry_plane)
   if (nvec == 0) return
   allocate (sys%carry_map(3, sys%nfull / 3))
   if (.not. sys%reduced) then
@@ -565,6 +569,19 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
     message = 'system_set_carry: the reduction is not a selection of coordinates'
     deallocate (sys%carry_first, sys%carry_weight, sys%carry_position, sys%carry_map)
     allocate (sys%carry_first(0), sys%carry_weight(0), sys%carry_position(0))
+    return
+  end if
+  ! every vector of the xy plane or fixed (a planar reduction): carry_apply by the pairs
+  if (all((sys%carry_map(1, :) > 0 .and. sys%carry_map(2, :) > 0 .and. &
+           sys%carry_map(3, :) == 0) .or. all(sys%carry_map == 0, dim=1))) then
+    k = count(sys%carry_map(1, :) > 0)
+    allocate (sys%carry_plane(2, k))
+    k = 0
+    do i = 1, size(sys%carry_map, 2)
+      if (sys%carry_map(1, i) == 0) cycle
+      k = k + 1
+      sys%carry_plane(:, k) = sys%carry_map(1:2, i)
+    end do
   end if
 end subroutine system_set_carry
 
@@ -596,6 +613,8 @@ subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, m
   sys%mass_col = col
   sys%mass_values = values
   sys%mass_kron = .true.
+  if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
+                                                sys%mass_pair_row, sys%mass_pair_values)
 end subroutine system_set_kron_mass
 
 !> q = B e + q0 (B CSR over nfull rows, 1-based) and the plan of B^T S B: values(target)
@@ -634,6 +653,26 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
   sys%plan_source = plan_source(1:nplan)
   sys%plan_target = plan_target(1:nplan)
   sys%plan_coef = plan_coef(1:nplan)
+  ! a selection (each row of B empty or one entry 1): to_full and to_reduced by its columns
+  ! (offset or 0, plus 1 x: the same sums without the row pointers and the products by 1)
+  if (allocated(sys%reduction_select)) deallocate (sys%reduction_select, sys%select_full, &
+                                                    sys%select_column, sys%select_fixed)
+  sys%select_one_to_one = .false.
+  if (all(b_ptr(2:) - b_ptr(:nfull) <= 1) .and. all(b_values(1:nnz_b) == 1.0_dp)) then
+    allocate (sys%reduction_select(nfull))
+    do i = 1, nfull
+      sys%reduction_select(i) = 0
+      if (b_ptr(i + 1) > b_ptr(i)) sys%reduction_select(i) = b_col(b_ptr(i))
+    end do
+    sys%select_full = pack([(i, i = 1, nfull)], sys%reduction_select > 0)
+    sys%select_column = pack(sys%reduction_select, sys%reduction_select > 0)
+    sys%select_fixed = pack([(i, i = 1, nfull)], sys%reduction_select == 0)
+    sys%select_one_to_one = .true.
+    do i = 1, size(sys%select_column) - 1
+      if (any(sys%select_column(i + 1:) == sys%select_column(i))) &
+        sys%select_one_to_one = .false.
+    end do
+  end if
 end subroutine system_set_reduction
 
 !> Loads: the constant force (independent coordinates), driven forces phi_d(t) f_d, dead
@@ -839,6 +878,7 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
+  integer :: c, s
   message = ' '
   call store_get(handle, sys, info)
   if (info /= 0) then
@@ -865,6 +905,14 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
   sys%term_ptr = term_ptr
   sys%term_dof = term_dof(1:nterm)
   sys%term_coef = term_coef(1:nterm)
+  if (allocated(sys%con_operands)) deallocate (sys%con_operands)
+  allocate (sys%con_operands(ncon))
+  do c = 1, ncon
+    sys%con_operands(c) = 0
+    do s = 1, 6
+      if (term_ptr(6 * (c - 1) + s + 1) > term_ptr(6 * (c - 1) + s)) sys%con_operands(c) = s
+    end do
+  end do
 end subroutine system_set_constraints
 
 !> A contact pair (leaf_contact): the pair's element columns (dofs into the full vector,
@@ -1155,7 +1203,7 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   real(dp), allocatable :: out_deflection(:, :, :), out_lambda(:, :), out_energy(:, :)
   real(dp), allocatable :: out_constraint(:), out_contact(:, :, :), out_q(:, :)
   real(dp) :: t, work(power_count), powers(power_count)
-  integer :: info, ndof, ncon, nprobe, npoint, step, k
+  integer :: info, ndof, ncon, nprobe, npoint, step, k, j
   logical :: store_q
   rows = 0.0_dp
   stats = 0
@@ -1224,12 +1272,17 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   state = [t, e, v, a, accel, lam, work, powers, reshape(contact%guesses, [2 * npoint])]
   counts = contact%counts
   ! the output rows (stepper.f90 row_size)
+  ! (the probes' and deflections' columns copied by loops: reshape was a library call a step)
   do step = 1, nsteps
     rows(1, step) = out_time(step)
     k = 1
-    rows(k + 1:k + 3 * nprobe, step) = reshape(out_probe(:, :, step), [3 * nprobe])
+    do j = 1, nprobe
+      rows(k + 3 * j - 2:k + 3 * j, step) = out_probe(:, j, step)
+    end do
     k = k + 3 * nprobe
-    rows(k + 1:k + 3 * nprobe, step) = reshape(out_deflection(:, :, step), [3 * nprobe])
+    do j = 1, nprobe
+      rows(k + 3 * j - 2:k + 3 * j, step) = out_deflection(:, j, step)
+    end do
     k = k + 3 * nprobe
     rows(k + 1:k + ncon, step) = out_lambda(:, step)
     k = k + ncon
@@ -1237,8 +1290,9 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
     k = k + energy_count
     rows(k + 1, step) = out_constraint(step)
     k = k + 1
-    rows(k + 1:k + contact_record * npoint, step) = reshape(out_contact(:, :, step), &
-                                                            [contact_record * npoint])
+    do j = 1, npoint
+      rows(k + contact_record * (j - 1) + 1:k + contact_record * j, step) = out_contact(:, j, step)
+    end do
     k = k + contact_record * npoint
     if (store_q) rows(k + 1:k + ndof, step) = out_q(:, step)
   end do

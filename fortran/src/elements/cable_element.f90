@@ -44,7 +44,8 @@
 module cable_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use element_sets, only: local_element_set
+  use element_sets, only: local_element_set, loop_work, threaded_work, local_set_forces, &
+                          local_energy_power
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
@@ -80,6 +81,9 @@ module cable_element
     ! numbers as in every call, without their eight divisions a point
     real(dp), allocatable :: slope_rows(:, :, :), second_rows(:, :, :), weights(:, :)
   contains
+    procedure :: forces => cable_set_forces
+    procedure :: selected_forces => cable_selected_forces
+    procedure :: energy_power => cable_set_energy_power
     procedure :: element_forces => cable_element_forces
     procedure :: element_energy => cable_element_energy
   end type cable_set
@@ -284,8 +288,8 @@ contains
     real(dp), intent(in) :: slope(4), second(4), weight, grad_a(3), grad_b(3), hessian(6, 6)
     logical, intent(in) :: want_tangent
     real(dp), intent(inout) :: force(cable_dofs), tangent(cable_dofs, cable_dofs)
-    real(dp) :: rows(2, 4), block(3, 3)
-    integer :: i, j, m, n
+    real(dp) :: rows(2, 4), s11, s21, s12, s22
+    integer :: i, j, r, c
     do i = 1, 4
       force(3 * i - 2:3 * i) = force(3 * i - 2:3 * i) &
                                + weight * (slope(i) * grad_a + second(i) * grad_b)
@@ -293,17 +297,21 @@ contains
     if (.not. want_tangent) return
     rows(1, :) = slope
     rows(2, :) = second
+    ! block (i, j) = sum over n, then m (1, 2) of rows(m, i) rows(n, j) H_mn (H_mn the
+    ! (m, n) 3 x 3 block of the hessian), from 0, entry by entry; tangent += weight block
     do j = 1, 4
       do i = 1, 4
-        block = 0.0_dp
-        do n = 1, 2
-          do m = 1, 2
-            block = block + rows(m, i) * rows(n, j) &
-                    * hessian(3 * m - 2:3 * m, 3 * n - 2:3 * n)
+        s11 = rows(1, i) * rows(1, j)
+        s21 = rows(2, i) * rows(1, j)
+        s12 = rows(1, i) * rows(2, j)
+        s22 = rows(2, i) * rows(2, j)
+        do c = 1, 3
+          do r = 1, 3
+            tangent(3 * i - 3 + r, 3 * j - 3 + c) = tangent(3 * i - 3 + r, 3 * j - 3 + c) &
+              + weight * ((((0.0_dp + s11 * hessian(r, c)) + s21 * hessian(3 + r, c)) &
+                           + s12 * hessian(r, 3 + c)) + s22 * hessian(3 + r, 3 + c))
           end do
         end do
-        tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) = tangent(3 * i - 2:3 * i, 3 * j - 2:3 * j) &
-                                                    + weight * block
       end do
     end do
   end subroutine add_point
@@ -519,48 +527,257 @@ contains
                                       bending_stiffness, force, energy, info)
     real(dp), intent(in) :: q(3, 4), slope_rows(4, cable_points), second_rows(4, cable_points)
     real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
-    real(dp), intent(out) :: force(:), energy
+    real(dp), intent(out) :: force(cable_dofs), energy
     integer, intent(out) :: info
-    real(dp) :: slope(4), second(4), a(2), b(2), grad_a(2), grad_b(2), dg(4), dh(2), df(4)
-    real(dp) :: weight, aa, bb, ab, strain, g, h, f, point_energy
-    integer :: p, i
+    real(dp), dimension(cable_points) :: ax, ay, bx, by, aa, bb, ab, strain, g, h, f
+    real(dp), dimension(cable_points) :: point_energy, dg1, dg2, dg3, dg4, dh1, dh2
+    real(dp), dimension(cable_points) :: df1, df2, df3, df4, grad_ax, grad_ay, grad_bx, grad_by
+    real(dp) :: planar(2, 4)
+    integer :: p, i, k
     info = 0
-    force = 0.0_dp
     energy = 0.0_dp
-    do p = 1, cable_points
-      slope = slope_rows(:, p)
-      second = second_rows(:, p)
-      weight = weights(p)
-      a = matmul(q(1:2, :), slope)
-      b = matmul(q(1:2, :), second)
-      aa = dot_product(a, a)
-      bb = dot_product(b, b)
-      ab = dot_product(a, b)
-      if (aa <= 0.0_dp) then
-        info = 2
-        return
-      end if
-      ! (point_derivatives' expressions, component by component)
-      strain = 0.5_dp * (aa - 1.0_dp)
-      g = aa * bb - ab**2
-      h = aa**3
-      f = g / h
-      point_energy = 0.5_dp * axial_stiffness * strain**2 + 0.5_dp * bending_stiffness * f
-      dg(1:2) = 2.0_dp * bb * a - 2.0_dp * ab * b
-      dg(3:4) = 2.0_dp * aa * b - 2.0_dp * ab * a
-      dh = 6.0_dp * aa**2 * a
-      df(1:2) = dg(1:2) / h - g * dh / h**2
-      df(3:4) = dg(3:4) / h - g * 0.0_dp / h**2
-      grad_a = axial_stiffness * strain * a + 0.5_dp * bending_stiffness * df(1:2)
-      grad_b = 0.5_dp * bending_stiffness * df(3:4)
-      energy = energy + weight * point_energy
-      ! (add_point's force)
-      do i = 1, 4
-        force(3 * i - 2:3 * i - 1) = force(3 * i - 2:3 * i - 1) &
-                                     + weight * (slope(i) * grad_a + second(i) * grad_b)
+    ! (the points side by side, each with its point's expressions of the one-point form:
+    ! a = matmul(q(1:2, :), slope) sums from 0 over the four shapes in order, the dot
+    ! products from 0 over x then y; the x and y components summed in a (2, 4) array from
+    ! 0, as in force, then stored)
+    ax = 0.0_dp
+    ay = 0.0_dp
+    bx = 0.0_dp
+    by = 0.0_dp
+    do k = 1, 4
+      do p = 1, cable_points
+        ax(p) = ax(p) + q(1, k) * slope_rows(k, p)
+        ay(p) = ay(p) + q(2, k) * slope_rows(k, p)
+        bx(p) = bx(p) + q(1, k) * second_rows(k, p)
+        by(p) = by(p) + q(2, k) * second_rows(k, p)
       end do
     end do
+    do p = 1, cable_points
+      aa(p) = 0.0_dp + ax(p) * ax(p) + ay(p) * ay(p)
+      bb(p) = 0.0_dp + bx(p) * bx(p) + by(p) * by(p)
+      ab(p) = 0.0_dp + ax(p) * bx(p) + ay(p) * by(p)
+    end do
+    if (any(aa <= 0.0_dp)) then
+      force = 0.0_dp
+      info = 2
+      return
+    end if
+    ! (point_derivatives' expressions, component by component)
+    do p = 1, cable_points
+      strain(p) = 0.5_dp * (aa(p) - 1.0_dp)
+      g(p) = aa(p) * bb(p) - ab(p)**2
+      h(p) = aa(p)**3
+      f(p) = g(p) / h(p)
+      point_energy(p) = 0.5_dp * axial_stiffness * strain(p)**2 + 0.5_dp * bending_stiffness * f(p)
+      dg1(p) = 2.0_dp * bb(p) * ax(p) - 2.0_dp * ab(p) * bx(p)
+      dg2(p) = 2.0_dp * bb(p) * ay(p) - 2.0_dp * ab(p) * by(p)
+      dg3(p) = 2.0_dp * aa(p) * bx(p) - 2.0_dp * ab(p) * ax(p)
+      dg4(p) = 2.0_dp * aa(p) * by(p) - 2.0_dp * ab(p) * ay(p)
+      dh1(p) = 6.0_dp * aa(p)**2 * ax(p)
+      dh2(p) = 6.0_dp * aa(p)**2 * ay(p)
+      df1(p) = dg1(p) / h(p) - g(p) * dh1(p) / h(p)**2
+      df2(p) = dg2(p) / h(p) - g(p) * dh2(p) / h(p)**2
+      df3(p) = dg3(p) / h(p) - g(p) * 0.0_dp / h(p)**2
+      df4(p) = dg4(p) / h(p) - g(p) * 0.0_dp / h(p)**2
+      grad_ax(p) = axial_stiffness * strain(p) * ax(p) + 0.5_dp * bending_stiffness * df1(p)
+      grad_ay(p) = axial_stiffness * strain(p) * ay(p) + 0.5_dp * bending_stiffness * df2(p)
+      grad_bx(p) = 0.5_dp * bending_stiffness * df3(p)
+      grad_by(p) = 0.5_dp * bending_stiffness * df4(p)
+    end do
+    planar = 0.0_dp
+    do p = 1, cable_points
+      energy = energy + weights(p) * point_energy(p)
+      ! (add_point's force)
+      do i = 1, 4
+        planar(1, i) = planar(1, i) + weights(p) * (slope_rows(i, p) * grad_ax(p) &
+                                                    + second_rows(i, p) * grad_bx(p))
+        planar(2, i) = planar(2, i) + weights(p) * (slope_rows(i, p) * grad_ay(p) &
+                                                    + second_rows(i, p) * grad_by(p))
+      end do
+    end do
+    do i = 1, 4
+      force(3 * i - 2:3 * i - 1) = planar(:, i)
+      force(3 * i) = 0.0_dp
+    end do
   end subroutine plane_element_force
+
+  !> The element_set forces of a cable set. The force alone of an undamped elastic cable
+  !> set below the threading threshold (the Newton corrections of small systems): the loop
+  !> of local_set_forces' serial path (element by element, each element's force added as
+  !> it is computed, in element order) without its dispatch through gathered_forces and
+  !> cable_element_forces, an element of the plane z = 0 by plane_element_force: the same
+  !> numbers. Everything else: local_set_forces.
+  subroutine cable_set_forces(set, rotation, e, force, energy, info, tangent_values, &
+                              tangent_rotation, v, omega_local, rate_factor, dissipation, &
+                              tangent_omega)
+    class(cable_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), intent(inout), optional :: tangent_values(:)
+    real(dp), intent(in), optional :: tangent_rotation(3, 3)
+    real(dp), intent(in), optional :: v(:), omega_local(3), rate_factor, tangent_omega(3)
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: coords(3, 4), element_force(cable_dofs), element_energy
+    real(dp) :: unused_tangent(cable_dofs, cable_dofs)
+    integer :: el, a, node, element_info
+    if (present(tangent_values) .or. set%tension_only .or. .not. allocated(set%weights) .or. &
+        set%nde /= cable_dofs .or. loop_work(set, .false.) >= threaded_work .or. &
+        (present(v) .and. set%damping_time > 0.0_dp)) then
+      call local_set_forces(set, rotation, e, force, energy, info, tangent_values, &
+                            tangent_rotation, v, omega_local, rate_factor, dissipation, &
+                            tangent_omega)
+      return
+    end if
+    info = 0
+    energy = 0.0_dp
+    if (present(dissipation)) dissipation = 0.0_dp
+    do el = 1, set%nel
+      do node = 1, 4
+        coords(1, node) = e(set%dofs(3 * node - 2, el))
+        coords(2, node) = e(set%dofs(3 * node - 1, el))
+        coords(3, node) = e(set%dofs(3 * node, el))
+      end do
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                 set%weights(:, el), set%axial_stiffness, &
+                                 set%bending_stiffness, element_force, element_energy, &
+                                 element_info)
+        if (element_info /= 0) then
+          info = 7
+          energy = 0.0_dp
+          return
+        end if
+        ! (the z components are +0: adding them to the sums, which start at +0 and so are
+        ! never -0, changes nothing)
+        do node = 1, 4
+          force(set%dofs(3 * node - 2, el)) = force(set%dofs(3 * node - 2, el)) &
+                                              + element_force(3 * node - 2)
+          force(set%dofs(3 * node - 1, el)) = force(set%dofs(3 * node - 1, el)) &
+                                              + element_force(3 * node - 1)
+        end do
+        energy = energy + element_energy
+        cycle
+      else
+        call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
+                                set%bending_stiffness, .false., element_force, element_energy, &
+                                unused_tangent, element_info, .false.)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      do a = 1, cable_dofs
+        force(set%dofs(a, el)) = force(set%dofs(a, el)) + element_force(a)
+      end do
+      energy = energy + element_energy
+    end do
+  end subroutine cable_set_forces
+
+  !> The element_set selected_forces of a cable set: cable_set_forces' lean pass (an
+  !> undamped elastic set below the threading threshold; done = .false. otherwise) on the
+  !> independent coordinates of a selection: each element's coordinates as to_full gives
+  !> them (q0 + e, or q0 where fixed), its force added to the reduced force of each selected
+  !> coordinate in element order (each full coordinate's sum of cable_set_forces, from +0,
+  !> which to_reduced then adds to 0: the same numbers, the selection being one to one).
+  subroutine cable_selected_forces(set, select, offset, e, force, energy, info, done)
+    class(cable_set), intent(in) :: set
+    integer, intent(in) :: select(:)
+    real(dp), intent(in) :: offset(:), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    logical, intent(out) :: done
+    real(dp) :: coords(3, 4), element_force(cable_dofs), element_energy
+    real(dp) :: unused_tangent(cable_dofs, cable_dofs)
+    integer :: el, a, i, k, element_info
+    energy = 0.0_dp
+    info = 0
+    done = .not. (set%tension_only .or. .not. allocated(set%weights) .or. &
+                  set%nde /= cable_dofs .or. loop_work(set, .false.) >= threaded_work .or. &
+                  set%damping_time > 0.0_dp)
+    if (.not. done) return
+    do el = 1, set%nel
+      do a = 1, cable_dofs
+        i = set%dofs(a, el)
+        k = select(i)
+        if (k > 0) then
+          coords(mod(a - 1, 3) + 1, (a - 1) / 3 + 1) = offset(i) + e(k)
+        else
+          coords(mod(a - 1, 3) + 1, (a - 1) / 3 + 1) = offset(i)
+        end if
+      end do
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                 set%weights(:, el), set%axial_stiffness, &
+                                 set%bending_stiffness, element_force, element_energy, &
+                                 element_info)
+      else
+        call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
+                                set%bending_stiffness, .false., element_force, element_energy, &
+                                unused_tangent, element_info, .false.)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      ! (a z component of a plane element is +0: added or not, the same sums)
+      do a = 1, cable_dofs
+        k = select(set%dofs(a, el))
+        if (k > 0) force(k) = force(k) + element_force(a)
+      end do
+      energy = energy + element_energy
+    end do
+  end subroutine cable_selected_forces
+
+  !> The element_set energy_power of a cable set. An undamped elastic cable set (or one
+  !> given no rates): local_energy_power's loop (each element's strain energy summed in
+  !> element order; no frame: power 0) without its dispatch through element_energy, a plane
+  !> element by plane_element_energy: the same numbers. Everything else: local_energy_power.
+  subroutine cable_set_energy_power(set, rotation, axis, rate, e, energy, power, info, v, &
+                                    dissipation)
+    class(cable_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), axis(3), rate, e(:)
+    real(dp), intent(out) :: energy, power
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:)
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: coords(3, 4), element_energy
+    integer :: el, node, element_info
+    if (set%tension_only .or. .not. allocated(set%weights) .or. set%nde /= cable_dofs .or. &
+        (present(v) .and. set%damping_time > 0.0_dp)) then
+      call local_energy_power(set, rotation, axis, rate, e, energy, power, info, v, dissipation)
+      return
+    end if
+    info = 0
+    power = 0.0_dp
+    energy = 0.0_dp
+    do el = 1, set%nel
+      do node = 1, 4
+        coords(1, node) = e(set%dofs(3 * node - 2, el))
+        coords(2, node) = e(set%dofs(3 * node - 1, el))
+        coords(3, node) = e(set%dofs(3 * node, el))
+      end do
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_energy(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                  set%weights(:, el), set%axial_stiffness, &
+                                  set%bending_stiffness, element_energy, element_info)
+      else
+        call rule_element_energy(coords, set%lengths(el), set%rule, set%axial_stiffness, &
+                                 set%bending_stiffness, element_energy, element_info, .false.)
+      end if
+      if (element_info /= 0) then
+        info = 7
+        energy = 0.0_dp
+        return
+      end if
+      energy = energy + element_energy
+    end do
+    if (present(dissipation)) dissipation = 0.0_dp
+  end subroutine cable_set_energy_power
 
   !> The element_set element_energy of a cable set: the energy-only pass (the damped set,
   !> given rates, through its force for the dissipation).
@@ -578,8 +795,61 @@ contains
                                 0.0_dp, dissipation)
       return
     end if
+    if (.not. set%tension_only .and. allocated(set%weights)) then
+      if (all(coords(3, :) == 0.0_dp)) then
+        call plane_element_energy(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
+                                  set%weights(:, el), set%axial_stiffness, &
+                                  set%bending_stiffness, energy, info)
+        return
+      end if
+    end if
     call rule_element_energy(coords, set%lengths(el), set%rule, set%axial_stiffness, &
                              set%bending_stiffness, energy, info, set%tension_only)
   end subroutine cable_element_energy
+
+  !> rule_element_energy of an element in the plane z = 0 (not a rope) with the set's
+  !> shape rows and weights (cable_element_rows: the numbers rule_rows and half_weight L
+  !> give): the same sums, without the eight divisions a point.
+  pure subroutine plane_element_energy(q, slope_rows, second_rows, weights, axial_stiffness, &
+                                       bending_stiffness, energy, info)
+    real(dp), intent(in) :: q(3, 4), slope_rows(4, cable_points), second_rows(4, cable_points)
+    real(dp), intent(in) :: weights(cable_points), axial_stiffness, bending_stiffness
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), dimension(cable_points) :: ax, ay, bx, by, aa, bb, ab, strain, point_energy
+    integer :: p, k
+    info = 0
+    energy = 0.0_dp
+    ! (the points side by side, as in plane_element_force)
+    ax = 0.0_dp
+    ay = 0.0_dp
+    bx = 0.0_dp
+    by = 0.0_dp
+    do k = 1, 4
+      do p = 1, cable_points
+        ax(p) = ax(p) + q(1, k) * slope_rows(k, p)
+        ay(p) = ay(p) + q(2, k) * slope_rows(k, p)
+        bx(p) = bx(p) + q(1, k) * second_rows(k, p)
+        by(p) = by(p) + q(2, k) * second_rows(k, p)
+      end do
+    end do
+    do p = 1, cable_points
+      aa(p) = 0.0_dp + ax(p) * ax(p) + ay(p) * ay(p)
+      bb(p) = 0.0_dp + bx(p) * bx(p) + by(p) * by(p)
+      ab(p) = 0.0_dp + ax(p) * bx(p) + ay(p) * by(p)
+    end do
+    if (any(aa <= 0.0_dp)) then
+      info = 2
+      return
+    end if
+    do p = 1, cable_points
+      strain(p) = 0.5_dp * (aa(p) - 1.0_dp)
+      point_energy(p) = 0.5_dp * axial_stiffness * strain(p)**2 &
+                        + 0.5_dp * bending_stiffness * ((aa(p) * bb(p) - ab(p)**2) / aa(p)**3)
+    end do
+    do p = 1, cable_points
+      energy = energy + weights(p) * point_energy(p)
+    end do
+  end subroutine plane_element_energy
 
 end module cable_element

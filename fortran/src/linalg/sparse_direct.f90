@@ -27,6 +27,9 @@ module sparse_direct
     integer :: n = 0, bandwidth = 0
     integer, allocatable :: rows(:), cols(:), pivots(:)
     real(dp), allocatable :: band(:, :), general_band(:, :)
+    ! the Cholesky factor's rows (lower(1 + m, i) = U(i, i + m), m = 0 .. kd: the band
+    ! transposed), for the forward substitution by contiguous columns of U^T
+    real(dp), allocatable :: lower(:, :)
     logical :: pivoted_lu = .false.
     logical :: in_use = .false.
     logical :: analysed = .false.
@@ -40,33 +43,40 @@ module sparse_direct
 contains
 
   !> Solves U^T U x = b for the banded Cholesky factor U in LAPACK's upper band storage
-  !> (band(kd + 1 + i - j, j) = U(i, j)): the forward and backward substitutions written
-  !> out over the band's contiguous columns (the same arithmetic as dpbtrs, without its
-  !> per-column BLAS calls, which dominated a narrow band's solve).
-  pure subroutine cholesky_band_solve(n, kd, nrhs, band, rhs)
+  !> (band(kd + 1 + i - j, j) = U(i, j)) and its rows (lower, the band transposed): the
+  !> forward and backward substitutions written out over contiguous columns of U^T and U
+  !> (the same arithmetic as dpbtrs, without its per-column BLAS calls, which dominated a
+  !> narrow band's solve).
+  pure subroutine cholesky_band_solve(n, kd, nrhs, band, lower, rhs)
     integer, intent(in) :: n, kd, nrhs
-    real(dp), intent(in) :: band(kd + 1, n)
+    real(dp), intent(in) :: band(kd + 1, n), lower(kd + 1, n)
     real(dp), intent(inout) :: rhs(n, nrhs)
-    integer :: i, j, k, first, offset
-    real(dp) :: total, x
+    integer :: i, j, k, m, first, last
+    real(dp) :: x
     do k = 1, nrhs
+      ! U^T y = b by the columns of U^T (the rows of U, contiguous in lower): each rhs(j)
+      ! loses U(i, j) y(i) for i = j - kd .. j - 1 in increasing i, then is divided by
+      ! U(j, j), the sums of the dot-product form, in array operations the compiler vectorizes
+      ! (scalar loops: a band of a few entries is shorter than the vector code's set-up;
+      ! both sweeps as running sums in a register, each rhs(j) losing its terms in the
+      ! order of the column forms: U^T y = b in increasing i, U x = y in decreasing j)
       do j = 1, n  ! U^T y = b
         first = max(1, j - kd)
-        offset = kd + 1 - j
-        total = rhs(j, k)
+        x = rhs(j, k)
+        !GCC$ novector
         do i = first, j - 1
-          total = total - band(offset + i, j) * rhs(i, k)
+          x = x - band(kd + 1 - j + i, j) * rhs(i, k)
         end do
-        rhs(j, k) = total / band(kd + 1, j)
+        rhs(j, k) = x / band(kd + 1, j)
       end do
-      do j = n, 1, -1  ! U x = y
-        x = rhs(j, k) / band(kd + 1, j)
-        rhs(j, k) = x
-        first = max(1, j - kd)
-        offset = kd + 1 - j
-        do i = first, j - 1
-          rhs(i, k) = rhs(i, k) - x * band(offset + i, j)
+      do i = n, 1, -1  ! U x = y: x(i) loses U(i, j) x(j) for j = i + kd .. i + 1
+        last = min(kd, n - i)
+        x = rhs(i, k)
+        !GCC$ novector
+        do m = last, 1, -1
+          x = x - rhs(i + m, k) * lower(1 + m, i)
         end do
+        rhs(i, k) = x / lower(1, i)
       end do
     end do
   end subroutine cholesky_band_solve
@@ -231,7 +241,7 @@ contains
           call dgbtrs('N', n, slot%bandwidth, slot%bandwidth, nrhs, slot%general_band, &
                       3 * slot%bandwidth + 1, slot%pivots, rhs, n, info_detail)
         else
-          call cholesky_band_solve(n, slot%bandwidth, nrhs, slot%band, rhs)
+          call cholesky_band_solve(n, slot%bandwidth, nrhs, slot%band, slot%lower, rhs)
         end if
       end associate
       info = merge(0, 3, info_detail == 0)
@@ -268,6 +278,7 @@ contains
     if (slots(handle)%banded) then
       if (allocated(slots(handle)%band)) deallocate (slots(handle)%band)
       if (allocated(slots(handle)%general_band)) deallocate (slots(handle)%general_band)
+      if (allocated(slots(handle)%lower)) deallocate (slots(handle)%lower)
       if (allocated(slots(handle)%pivots)) deallocate (slots(handle)%pivots)
       if (allocated(slots(handle)%rows)) deallocate (slots(handle)%rows, slots(handle)%cols)
       slots(handle)%in_use = .false.
@@ -296,7 +307,7 @@ contains
     integer, intent(in) :: nnz
     real(dp), intent(in) :: values(nnz)
     integer, intent(out) :: info, info_detail
-    integer :: k, kd, row_in_band
+    integer :: k, kd, row_in_band, j
     info_detail = 0
     if (size(slot%rows) /= nnz) then
       info = 3
@@ -311,7 +322,20 @@ contains
     call dpbtrf('U', slot%n, kd, slot%band, kd + 1, info_detail)
     slot%pivoted_lu = info_detail /= 0
     info = 0
-    if (.not. slot%pivoted_lu) return
+    if (.not. slot%pivoted_lu) then
+      if (allocated(slot%lower)) then
+        if (size(slot%lower, 1) /= kd + 1 .or. size(slot%lower, 2) /= slot%n) &
+          deallocate (slot%lower)
+      end if
+      if (.not. allocated(slot%lower)) allocate (slot%lower(kd + 1, slot%n))
+      slot%lower = 0.0_dp
+      do j = 1, slot%n
+        do k = 0, min(kd, slot%n - j)
+          slot%lower(1 + k, j) = slot%band(kd + 1 - k, j + k)
+        end do
+      end do
+      return
+    end if
     ! not positive definite: general band storage, kl = ku = kd, with room for the fill-in
     if (.not. allocated(slot%general_band)) then
       allocate (slot%general_band(3 * kd + 1, slot%n), slot%pivots(slot%n))

@@ -138,7 +138,7 @@ contains
   pure subroutine learn_predictor(learned, h, accel, accel_new)
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: h, accel(:), accel_new(:)
-    real(dp) :: misses(0:predict_fitted), alpha, beta
+    real(dp) :: misses(0:predict_fitted), alpha, beta, now, before, before2
     logical :: usable(0:predict_fitted)
     integer :: kind, i
     if (.not. allocated(learned%accel_before)) then
@@ -157,12 +157,16 @@ contains
       alpha = 0.0_dp
       beta = 0.0_dp
       if (usable(predict_fitted)) call fit_recurrence(accel, learned, alpha, beta)
+      ! (every kind's miss in the same pass, each by its one expression (extrapolated) with
+      ! the kind fixed: no selection per coordinate; an unusable kind's miss is not read)
       misses = 0.0_dp
       do i = 1, size(accel)
+        now = accel(i)
+        before = learned%accel_before(i)
+        before2 = learned%accel_before2(i)
         do kind = predict_hold, predict_fitted
-          if (usable(kind)) misses(kind) = max(misses(kind), abs(accel_new(i) - &
-            extrapolated(kind, accel(i), learned%accel_before(i), learned%accel_before2(i), &
-                         alpha, beta)))
+          misses(kind) = max(misses(kind), abs(accel_new(i) - &
+                                               extrapolated(kind, now, before, before2, alpha, beta)))
         end do
       end do
       learned%predictor = predict_hold

@@ -222,13 +222,31 @@ contains
   !> coordinate is one full component).
   pure subroutine carry_apply(sys, turn, x, back, y)
     type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: turn(3, 3), x(:)
+    real(dp), intent(in) :: turn(3, 3), x(sys%ndof)
     logical, intent(in) :: back
-    real(dp), intent(out) :: y(:)
-    real(dp) :: rotation(3, 3), v(3), w(3)
+    real(dp), intent(out) :: y(sys%ndof)
+    real(dp) :: rotation(3, 3), v(3), w(3), r11, r12, r13, r21, r22, r23
     integer :: b, i, first, second
     rotation = turn
     if (back) rotation = transpose(turn)
+    if (allocated(sys%carry_plane)) then
+      ! every vector of the xy plane (or fixed): the plane path below by the list of pairs
+      r11 = rotation(1, 1)
+      r12 = rotation(1, 2)
+      r13 = rotation(1, 3) * 0.0_dp
+      r21 = rotation(2, 1)
+      r22 = rotation(2, 2)
+      r23 = rotation(2, 3) * 0.0_dp
+      do b = 1, size(sys%carry_plane, 2)
+        first = sys%carry_plane(1, b)
+        second = sys%carry_plane(2, b)
+        v(1) = x(first)
+        v(2) = x(second)
+        y(first) = r11 * v(1) + r12 * v(2) + r13
+        y(second) = r21 * v(1) + r22 * v(2) + r23
+      end do
+      return
+    end if
     do b = 1, size(sys%carry_map, 2)
       first = sys%carry_map(1, b)
       second = sys%carry_map(2, b)

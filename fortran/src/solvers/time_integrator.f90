@@ -118,6 +118,9 @@ module time_integrator
     real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:, :)
     real(dp), allocatable :: full_pair(:, :)
     integer, allocatable :: ipiv(:)
+    ! loads holds the external loads at loads_time (residual)
+    logical :: loads_ready = .false.
+    real(dp) :: loads_time = 0.0_dp
     ! the carried matrix's Schur complement (carried_rotation): T^T Phi_e^T, S^{-1} of it and
     ! the LU factors of C, built at a step's first carried correction
     real(dp), allocatable :: carry_columns(:, :), carry_flexibility(:, :), carry_lu(:, :)
@@ -172,8 +175,15 @@ contains
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if
     call mass_product(sys, acceleration, r)
-    call external_forces(sys, t, 1.0_dp, loads, info, e)
-    if (info /= 0) return
+    ! (loads of t alone, without point loads that follow e: once per time, kept for the
+    ! step's later corrections)
+    if (sys%nvload > 0 .or. .not. work%loads_ready .or. work%loads_time /= t) then
+      work%loads_ready = .false.
+      call external_forces(sys, t, 1.0_dp, loads, info, e)
+      if (info /= 0) return
+      work%loads_ready = .true.
+      work%loads_time = t
+    end if
     r = r + internal - loads
     call evaluate_constraints(sys, e, t, phi, gradients, info)
     if (info /= 0) return
@@ -407,8 +417,9 @@ contains
     type(step_work), intent(inout) :: work
     integer, intent(out) :: info, detail
     real(dp) :: strain, previous_correction, step_cap, step_theta
-    integer :: it, lapack_info, active
-    logical :: use_known, refresh, capped, halt
+    integer :: it, lapack_info, active, i
+    logical :: use_known, refresh, capped, halt, finite
+    real(dp) :: largest_correction, largest_coordinate, step_part
     logical :: carry_ready  ! the carried Schur complement is built for this step
     associate (r => work%r, z => work%z, direction => work%direction, &
                correction => work%correction, phi => work%phi, gradients => work%gradients, &
@@ -457,7 +468,8 @@ contains
       else
         call to_solver_frame(sys, rotations, z(:, 1), .false., direction)
       end if
-      correction = -direction
+      ! (with constraints both paths below overwrite the correction)
+      if (sys%ncon == 0) correction = -direction
       dlam = 0.0_dp
       if (sys%ncon > 0 .and. learned%carry_on) then
         ! the Schur complement with the carried matrix: C = G^T S^{-1} G, G = T^T Phi_e^T
@@ -492,16 +504,27 @@ contains
           correction = correction * (step_cap / maxval(abs(correction)))
         end if
       end if
-      e_new = e_new + correction
-      accel_new = accel_new + beta_prime * correction
-      v_new = v_new + velocity_factor * correction
+      ! (one pass over the coordinates: the same elementwise updates, the finiteness test,
+      ! and the largest |correction| and |e_new| as maxval takes them; max is exact)
+      finite = .true.
+      largest_correction = 0.0_dp
+      largest_coordinate = 0.0_dp
+      do i = 1, sys%ndof
+        step_part = correction(i)
+        if (.not. abs(step_part) < huge(1.0_dp)) finite = .false.
+        e_new(i) = e_new(i) + step_part
+        accel_new(i) = accel_new(i) + beta_prime * step_part
+        v_new(i) = v_new(i) + velocity_factor * step_part
+        largest_correction = max(largest_correction, abs(step_part))
+        largest_coordinate = max(largest_coordinate, abs(e_new(i)))
+      end do
       lam_new = lam_new + dlam(:, 1)
       stats(stat_corrections) = stats(stat_corrections) + 1
-      if (.not. (all(abs(correction) < huge(1.0_dp)) .and. all(abs(lam_new) < huge(1.0_dp)))) then
+      if (.not. (finite .and. all(abs(lam_new) < huge(1.0_dp)))) then
         info = 2
         return
       end if
-      last_correction = maxval(abs(correction))
+      last_correction = largest_correction
       if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
@@ -518,7 +541,7 @@ contains
       ! (a correction cut to the contact cap says nothing about convergence)
       if (.not. capped) then
         call stagnated(monitor, cfg, it, last_correction, previous_correction, &
-                       maxval(abs(e_new)), halt)
+                       largest_coordinate, halt)
         if (halt) then
           done = monitor%at_floor
           return
@@ -599,6 +622,12 @@ contains
       work%dlam(:, 1) = work%dlam(:, 1) - work%phi
       call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
                   lapack_info)
+      if (allocated(sys%carry_plane)) then
+        call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
+                                      work%carry_flexibility, work%dlam(:, 1), work%direction, &
+                                      work%correction)
+        return
+      end if
       call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
       call carry_apply(sys, learned%carry_turn, work%back, .false., work%correction)
       work%correction = work%correction - work%direction
@@ -668,6 +697,34 @@ contains
       end do
     end do
   end subroutine schur_complement
+
+  !> The carried correction T F dlam - z of a planar reduction (pairs: carry_plane, every
+  !> reduced coordinate in one) in one pass over the pairs: each pair's F dlam as
+  !> sparse_columns_product sums it, turned as carry_apply turns a plane vector, less z:
+  !> the same numbers.
+  pure subroutine plane_carried_correction(pairs, turn, flexibility, dlam, direction, &
+                                           correction)
+    integer, intent(in) :: pairs(:, :)
+    real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
+    real(dp), intent(out) :: correction(:)
+    real(dp) :: back_x, back_y, r13, r23
+    integer :: p, c, first, second
+    r13 = turn(1, 3) * 0.0_dp
+    r23 = turn(2, 3) * 0.0_dp
+    do p = 1, size(pairs, 2)
+      first = pairs(1, p)
+      second = pairs(2, p)
+      back_x = 0.0_dp
+      back_y = 0.0_dp
+      do c = 1, size(dlam)
+        if (dlam(c) == 0.0_dp) cycle
+        back_x = back_x + flexibility(first, c) * dlam(c)
+        back_y = back_y + flexibility(second, c) * dlam(c)
+      end do
+      correction(first) = (turn(1, 1) * back_x + turn(1, 2) * back_y + r13) - direction(first)
+      correction(second) = (turn(2, 1) * back_x + turn(2, 2) * back_y + r23) - direction(second)
+    end do
+  end subroutine plane_carried_correction
 
   !> y = A x (matmul's sums over the columns in increasing order, from 0) without the
   !> columns whose x is zero: the same numbers.

@@ -21,7 +21,7 @@ module constraints
   use matrix3, only: cross
   implicit none
   private
-  public :: constraint_eval, constraint_values, operand_values, drive_value
+  public :: constraint_eval, constraint_values, operand_values, drive_value, constraint_value
 
   integer, parameter, public :: constraint_kind_coordinate = 1, constraint_kind_distance = 2, &
                                 constraint_kind_cross = 3, constraint_kind_dot = 4

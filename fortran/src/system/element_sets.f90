@@ -27,12 +27,13 @@ module element_sets
   use ancf_kinds, only: dp
   implicit none
   private
-  public :: element_set, local_element_set, set_slot, frame_omega, scatter_add
+  public :: element_set, local_element_set, set_slot, frame_omega, scatter_add, loop_work, &
+            local_set_forces, local_energy_power
 
   !> Work of an element loop (microseconds on one thread) below which it runs on one thread
   !> whatever OMP_NUM_THREADS says: waking the sleeping team (OMP_WAIT_POLICY passive) costs
   !> more than it saves (2 threads made the 4-node cubic boom 5.6 times slower)
-  real(dp), parameter :: threaded_work = 200.0_dp
+  real(dp), parameter, public :: threaded_work = 200.0_dp
   !> The largest element (dofs) the serial loop holds in fixed work arrays (plates: 36);
   !> below the threading threshold a set's loop runs without an OpenMP region and without
   !> heap arrays: each element's force, energy and tangent are added as it is computed, in
@@ -49,6 +50,7 @@ module element_sets
   contains
     procedure(set_forces_interface), deferred :: forces
     procedure :: energy_power => set_energy_power
+    procedure :: selected_forces => no_selected_forces
   end type element_set
 
   abstract interface
@@ -116,6 +118,24 @@ module element_sets
   end type set_slot
 
 contains
+
+  !> The force pass of an undamped set on the independent coordinates of a selection
+  !> (q = B e + q0 with each row of B empty or one 1, no column twice: select(i) the column
+  !> of full coordinate i, 0 where fixed, offset = q0): the set's force added to the reduced
+  !> force as to_full, forces and to_reduced would give it, bit for bit; done = .false.
+  !> where the family has no such pass (the default): nothing is computed.
+  subroutine no_selected_forces(set, select, offset, e, force, energy, info, done)
+    class(element_set), intent(in) :: set
+    integer, intent(in) :: select(:)
+    real(dp), intent(in) :: offset(:), e(:)
+    real(dp), intent(inout) :: force(:)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    logical, intent(out) :: done
+    energy = 0.0_dp
+    info = 0
+    done = .false.
+  end subroutine no_selected_forces
 
   !> Strain energy at e and the power of the frame's motion at fixed e (a set in a moving
   !> frame; unit axis, rate phi'; 0 here: the families that have one override this). A damped

@@ -31,7 +31,11 @@
 !> No I/O; failures return codes.
 module mechanical_system
   use ancf_kinds, only: dp
-  use constraints, only: constraint_eval, operand_values, drive_value
+  use iso_fortran_env, only: int64
+  use constraints, only: constraint_eval, operand_values, drive_value, constraint_value, &
+                         constraint_kind_coordinate, constraint_kind_distance, &
+                         constraint_kind_cross, constraint_kind_dot
+  use matrix3, only: cross
   use element_sets, only: element_set, set_slot, frame_omega
   use section_moment, only: moment_force_only, moment_angle
   use vector_loads, only: vector_load_force
@@ -42,6 +46,7 @@ module mechanical_system
   implicit none
   private
   public :: system_model, frame_def, contact_pair, contact_state
+  public :: plane_mass_setup
   public :: frame_rotations, to_full, to_reduced, csr_matvec, mass_product, internal_forces, &
             external_forces, &
             evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
@@ -97,6 +102,11 @@ module mechanical_system
     integer, allocatable :: mass_row_ptr(:), mass_col(:)
     real(dp), allocatable :: mass_values(:)
     logical :: mass_kron = .false.
+    ! the CSR mass of a planar reduction as kron(Mbar, I2) over the plane's (x, y) pairs
+    ! (plane_mass_setup; unallocated otherwise): Mbar's rows by pair, each entry's column the
+    ! x coordinate of its pair (y: x + 1), and each pair's x coordinate
+    integer, allocatable :: mass_pair_ptr(:), mass_pair_col(:), mass_pair_row(:)
+    real(dp), allocatable :: mass_pair_values(:)
     ! full pattern of the tangents; q = B e + q0 and the plan of B^T S B
     integer, allocatable :: full_row_ptr(:), full_col(:)
     logical :: reduced = .false.
@@ -105,6 +115,11 @@ module mechanical_system
     ! a reduction that selects (each row of B empty or one entry 1): the column of each
     ! full coordinate (0: fixed), for to_full and to_reduced; unallocated otherwise
     integer, allocatable :: reduction_select(:)
+    ! the same selection as lists: the selected full coordinates (increasing) with their
+    ! columns, and the fixed ones
+    integer, allocatable :: select_full(:), select_column(:), select_fixed(:)
+    ! the selection takes no column twice (each reduced coordinate one full one)
+    logical :: select_one_to_one = .false.
     integer, allocatable :: plan_source(:), plan_target(:)
     real(dp), allocatable :: plan_coef(:)
     ! loads: constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
@@ -134,6 +149,8 @@ module mechanical_system
     ! constraints with multipliers (constraints module layout)
     integer :: ncon = 0
     integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
+    ! each constraint's last operand with terms (0: none), set with the constraints
+    integer, allocatable :: con_operands(:)
     real(dp), allocatable :: con_params(:, :), operand_const(:, :), term_coef(:)
     ! contact
     integer :: npoint = 0
@@ -163,6 +180,10 @@ module mechanical_system
     ! the reduced coordinate of each component of every full 3-vector (0: fixed by the
     ! reduction), (3, nfull / 3)
     integer, allocatable :: carry_map(:, :)
+    ! when every 3-vector of carry_map is a vector of the xy plane (its x and y reduced, z
+    ! fixed) or wholly fixed: the reduced coordinates (x, y) of the plane vectors, (2, n);
+    ! unallocated otherwise
+    integer, allocatable :: carry_plane(:, :)
   end type system_model
 
 contains
@@ -274,6 +295,22 @@ contains
     real(dp), intent(out) :: y(:)
     integer :: i, k, j
     real(dp) :: total(3), m
+    if (allocated(sys%mass_pair_ptr)) then
+      ! kron(Mbar, I2) over the plane's pairs: each row's sums as csr_matvec takes them
+      do i = 1, size(sys%mass_pair_ptr) - 1
+        total(1:2) = 0.0_dp
+        do k = sys%mass_pair_ptr(i), sys%mass_pair_ptr(i + 1) - 1
+          j = sys%mass_pair_col(k)
+          m = sys%mass_pair_values(k)
+          total(1) = total(1) + m * x(j)
+          total(2) = total(2) + m * x(j + 1)
+        end do
+        j = sys%mass_pair_row(i)
+        y(j) = total(1)
+        y(j + 1) = total(2)
+      end do
+      return
+    end if
     if (.not. sys%mass_kron) then
       call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, x, y)
       return
@@ -290,6 +327,61 @@ contains
       y(3 * i - 2:3 * i) = total
     end do
   end subroutine mass_product
+
+  !> The mass product of a planar reduction by pairs (mass_pair_*): when every reduced
+  !> coordinate is the x or y of a plane vector (carry_plane, y = x + 1) and the CSR mass's
+  !> y row of each pair is its x row moved to the partner columns with the same values
+  !> (bit for bit) in the same order, Mbar's rows by pair, so that mass_product takes the
+  !> same sums with half the index work; otherwise nothing (the CSR stays in use).
+  subroutine plane_mass_setup(sys)
+    type(system_model), intent(inout) :: sys
+    integer, allocatable :: pair_of(:)
+    integer :: npair, p, k, row_x, row_y, kx, ky, count_x, nnz
+    if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
+                                                  sys%mass_pair_row, sys%mass_pair_values)
+    if (sys%mass_kron .or. .not. allocated(sys%carry_plane) .or. &
+        .not. allocated(sys%mass_row_ptr)) return
+    npair = size(sys%carry_plane, 2)
+    if (2 * npair /= sys%ndof .or. size(sys%mass_row_ptr) /= sys%ndof + 1) return
+    allocate (pair_of(sys%ndof))
+    pair_of = 0
+    do p = 1, npair
+      row_x = sys%carry_plane(1, p)
+      if (sys%carry_plane(2, p) /= row_x + 1) return
+      if (pair_of(row_x) /= 0 .or. pair_of(row_x + 1) /= 0) return
+      pair_of(row_x) = p
+      pair_of(row_x + 1) = -p
+    end do
+    nnz = 0
+    do p = 1, npair
+      row_x = sys%carry_plane(1, p)
+      row_y = row_x + 1
+      count_x = sys%mass_row_ptr(row_x + 1) - sys%mass_row_ptr(row_x)
+      if (sys%mass_row_ptr(row_y + 1) - sys%mass_row_ptr(row_y) /= count_x) return
+      do k = 0, count_x - 1
+        kx = sys%mass_row_ptr(row_x) + k
+        ky = sys%mass_row_ptr(row_y) + k
+        if (pair_of(sys%mass_col(kx)) <= 0 .or. sys%mass_col(ky) /= sys%mass_col(kx) + 1) return
+        if (transfer(sys%mass_values(kx), 1_int64) /= transfer(sys%mass_values(ky), 1_int64)) &
+          return
+      end do
+      nnz = nnz + count_x
+    end do
+    allocate (sys%mass_pair_ptr(npair + 1), sys%mass_pair_col(nnz), sys%mass_pair_row(npair), &
+              sys%mass_pair_values(nnz))
+    sys%mass_pair_ptr(1) = 1
+    do p = 1, npair
+      row_x = sys%carry_plane(1, p)
+      sys%mass_pair_row(p) = row_x
+      count_x = sys%mass_row_ptr(row_x + 1) - sys%mass_row_ptr(row_x)
+      kx = sys%mass_row_ptr(row_x)
+      sys%mass_pair_col(sys%mass_pair_ptr(p):sys%mass_pair_ptr(p) + count_x - 1) = &
+        sys%mass_col(kx:kx + count_x - 1)
+      sys%mass_pair_values(sys%mass_pair_ptr(p):sys%mass_pair_ptr(p) + count_x - 1) = &
+        sys%mass_values(kx:kx + count_x - 1)
+      sys%mass_pair_ptr(p + 1) = sys%mass_pair_ptr(p) + count_x
+    end do
+  end subroutine plane_mass_setup
 
   !> y = M x for a CSR matrix (1-based).
   pure subroutine csr_matvec(row_ptr, col, values, x, y)
@@ -320,14 +412,24 @@ contains
       return
     end if
     if (allocated(sys%reduction_select)) then
-      ! a selection: the same sums (offset or 0, plus 1 x) without the row pointers
-      do i = 1, sys%nfull
-        total = 0.0_dp
-        if (with_offset) total = sys%reduction_offset(i)
-        k = sys%reduction_select(i)
-        if (k > 0) total = total + x(k)
-        full(i) = total
-      end do
+      ! a selection: the same sums (offset or 0, plus 1 x) without the row pointers, by the
+      ! lists of selected and fixed coordinates
+      if (with_offset) then
+        do k = 1, size(sys%select_fixed)
+          full(sys%select_fixed(k)) = sys%reduction_offset(sys%select_fixed(k))
+        end do
+        do k = 1, size(sys%select_full)
+          i = sys%select_full(k)
+          full(i) = sys%reduction_offset(i) + x(sys%select_column(k))
+        end do
+      else
+        do k = 1, size(sys%select_fixed)
+          full(sys%select_fixed(k)) = 0.0_dp
+        end do
+        do k = 1, size(sys%select_full)
+          full(sys%select_full(k)) = 0.0_dp + x(sys%select_column(k))
+        end do
+      end if
       return
     end if
     ! (a scalar accumulator per row, from the offset or 0: the same sums, in a register)
@@ -353,10 +455,10 @@ contains
     end if
     x = 0.0_dp
     if (allocated(sys%reduction_select)) then
-      ! a selection: the same sums (0 plus 1 full(i)) without the row pointers
-      do i = 1, sys%nfull
-        k = sys%reduction_select(i)
-        if (k > 0) x(k) = x(k) + full(i)
+      ! a selection: the same sums (0 plus 1 full(i), in increasing i) without the row
+      ! pointers
+      do k = 1, size(sys%select_full)
+        x(sys%select_column(k)) = x(sys%select_column(k)) + full(sys%select_full(k))
       end do
       return
     end if
@@ -402,9 +504,32 @@ contains
     real(dp), allocatable :: v_full(:), values_full(:)
     real(dp) :: set_energy, moment(3), director(3), rate, tangent_rate
     real(dp) :: fel_powers(2)
-    logical :: want_tangent
+    logical :: want_tangent, done
     integer :: s, m, k, f
     want_tangent = present(tangent_values)
+    ! the force alone of undamped sets on a one-to-one selection, nothing else acting: each
+    ! set straight on the independent coordinates (selected_forces), without q, the full
+    ! force and B^T (the same numbers)
+    done = .not. want_tangent .and. sys%select_one_to_one .and. sys%npoint == 0 .and. &
+           sys%nfel == 0 .and. .not. present(full_out)
+    if (done .and. allocated(sys%moment_magnitude)) done = size(sys%moment_magnitude) == 0
+    if (done) then
+      force = 0.0_dp
+      strain = 0.0_dp
+      do s = 1, size(sys%sets)
+        call sys%sets(s)%item%selected_forces(sys%reduction_select, sys%reduction_offset, e, &
+                                              force, set_energy, info, done)
+        if (.not. done .or. info /= 0) exit
+        strain = strain + set_energy
+      end do
+      if (done .and. info /= 0) return
+      if (done) then
+        contact_potential = 0.0_dp
+        contact_powers = 0.0_dp
+        return
+      end if
+      info = 0   ! (a set without the pass: the general path below, from the start)
+    end if
     if (present(full_work)) then
       e_full => full_work(:, 1)
       full_force => full_work(:, 2)
@@ -837,19 +962,87 @@ contains
   end function pattern_position
 
   !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
-  !> drive cannot be evaluated.
+  !> drive cannot be evaluated. constraint_eval's first-order results with the same
+  !> arithmetic (constraint_value, the operands summed as operand_values sums them), without
+  !> its argument descriptors, and a coordinate constraint's first operand alone (the only
+  !> one its value and gradient use): the Newton corrections of small systems evaluate it
+  !> in every correction.
   subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: e(:), t
     real(dp), intent(out) :: phi(:), gradients(:, :)
     integer, intent(out) :: info
-    ! (unused by a first-order evaluation: fixed dummies, no heap arrays per call)
-    real(dp) :: hessians(6, 6, 1), phi_t(1), phi_tt(1), gamma(1)
-    call constraint_eval(sys%ncon, sys%con_kind, sys%con_drive, sys%con_params, &
-                         sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
-                         sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, e, t, phi, gradients, &
-                         hessians, phi_t, phi_tt, gamma, info, first_order_only=.true.)
-    if (info /= 0) info = 5
+    real(dp) :: x(6), drive_phi, dphi, ddphi, cos_phi, sin_phi
+    integer :: c, s, k, last_operand, drive_info
+    info = 0
+    if (sys%ncon == 0) return
+    do k = 1, sys%term_ptr(6 * sys%ncon + 1) - 1
+      if (sys%term_dof(k) < 1 .or. sys%term_dof(k) > size(e)) then
+        info = 5
+        return
+      end if
+    end do
+    do c = 1, sys%ncon
+      drive_phi = 0.0_dp  ! (drive_value's value without a drive)
+      if (sys%con_drive(c) /= 0) then
+        call drive_value(sys%con_drive(c), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+                         drive_phi, dphi, ddphi, drive_info)
+        if (drive_info /= 0) then
+          info = 5
+          return
+        end if
+      end if
+      last_operand = 6
+      if (sys%con_kind(c) == constraint_kind_coordinate) then
+        if (sys%term_ptr(6 * (c - 1) + 2) == sys%term_ptr(6 * (c - 1) + 1)) then
+          info = 5  ! no coordinate in the first operand
+          return
+        end if
+        last_operand = 1
+      else if (sys%con_kind(c) < constraint_kind_coordinate .or. sys%con_kind(c) > constraint_kind_dot) then
+        info = 5
+        return
+      end if
+      do s = 1, 6
+        x(s) = 0.0_dp
+      end do
+      do s = 1, last_operand
+        x(s) = sys%operand_const(s, c)
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          x(s) = x(s) + sys%term_coef(k) * e(sys%term_dof(k))
+        end do
+      end do
+      cos_phi = 1.0_dp
+      sin_phi = 0.0_dp
+      if (sys%con_kind(c) == constraint_kind_coordinate .and. sys%con_drive(c) /= 0) then
+        cos_phi = cos(drive_phi)
+        sin_phi = sin(drive_phi)
+      end if
+      if (sys%con_kind(c) == constraint_kind_coordinate) then
+        ! (constraint_value's formula of the kind, written in place of the call)
+        phi(c) = x(1) - (sys%con_params(1, c) + sys%con_params(2, c) * cos_phi &
+                         + sys%con_params(3, c) * sin_phi + sys%con_params(4, c) * drive_phi)
+      else
+        phi(c) = constraint_value(sys%con_kind(c), sys%con_drive(c) /= 0, &
+                                  sys%con_params(:, c), x, drive_phi, cos_phi, sin_phi)
+      end if
+      do s = 1, 6
+        gradients(s, c) = 0.0_dp
+      end do
+      select case (sys%con_kind(c))
+      case (constraint_kind_coordinate)
+        gradients(1, c) = 1.0_dp
+      case (constraint_kind_distance)
+        gradients(1:3, c) = 2.0_dp * (x(1:3) - x(4:6))
+        gradients(4:6, c) = -2.0_dp * (x(1:3) - x(4:6))
+      case (constraint_kind_cross)
+        gradients(1:3, c) = cross(x(4:6), sys%con_params(1:3, c))
+        gradients(4:6, c) = cross(sys%con_params(1:3, c), x(1:3))
+      case default  ! constraint_kind_dot
+        gradients(1:3, c) = x(4:6)
+        gradients(4:6, c) = x(1:3)
+      end select
+    end do
   end subroutine evaluate_constraints
 
   !> r = r - Phi_e^T lambda.
@@ -859,7 +1052,7 @@ contains
     real(dp), intent(inout) :: r(:)
     integer :: c, s, k
     do c = 1, sys%ncon
-      do s = 1, 6
+      do s = 1, operand_count(sys, c)
         do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
           r(sys%term_dof(k)) = r(sys%term_dof(k)) - gradients(s, c) * sys%term_coef(k) * lam(c)
         end do
@@ -883,13 +1076,23 @@ contains
     integer :: c, s, k
     y = 0.0_dp
     do c = 1, sys%ncon
-      do s = 1, 6
+      do s = 1, operand_count(sys, c)
         do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
           y(c) = y(c) + gradients(s, c) * sys%term_coef(k) * x(sys%term_dof(k))
         end do
       end do
     end do
   end subroutine gradient_product
+
+  !> The operands of constraint c up to the last with terms (con_operands, set with the
+  !> constraints; 6 without it): the loops over the operands' terms skip the empty rest
+  !> (a coordinate constraint's five unused operands).
+  pure integer function operand_count(sys, c) result(count_c)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: c
+    count_c = 6
+    if (allocated(sys%con_operands)) count_c = sys%con_operands(c)
+  end function operand_count
 
   !> The solver frame: policy constant rotates each reduced 3-vector of a moving frame's
   !> bodies into that frame (U^T x, transpose_first) or back (U x); otherwise a copy.
