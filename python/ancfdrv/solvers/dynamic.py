@@ -232,9 +232,11 @@ def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
 #: saddle systems of at most this many unknowns share MUMPS instances (a free list of
 #: :data:`_SADDLE_SOLVERS`), analysed anew for each system: an instance's creation and
 #: release were half of a small model's initial acceleration (~1 M instructions, mostly
-#: MUMPS's set-up). A larger system gets its own instance, released after the solve (so
-#: no large factors stay in memory).
-SADDLE_REUSE_MAX = 4096
+#: MUMPS's set-up). A larger system gets its own instance, released after the solve, so
+#: no factors worth counting stay in memory while the run steps (at 4096 the 512-element
+#: cantilever's kept instance raised its peak resident set by 3.6 MB, 1.43x -> 1.50x
+#: Exudyn's: `benchmarks/peer_cantilever.py`).
+SADDLE_REUSE_MAX = 256
 _SADDLE_SOLVERS: list[DirectSolver] = []
 
 
