@@ -101,3 +101,27 @@ def test_a_scene_load_takes_the_fast_pass(monkeypatch):
     slow = load_scene(path, overrides)
     assert len(calls) == 1
     assert fast.text == slow.text and fast.values == slow.values
+
+
+@pytest.mark.parametrize("name, overrides", [
+    ("inputs/hard/pendulum.nml", ["beam.nodes=7", "solver.dt=0.002"]),
+    ("inputs/general/cardan_shaft.nml", [])])
+def test_the_scene_text_is_written_at_its_first_read(name, overrides):
+    """load_scene hands the Scene its namelist's writer, run at the first read of
+    ``text`` (a run kept in memory that saves no file never writes it); the text is
+    f90nml's writing of f90nml's reading of the file with the overrides set, and the same
+    after a copy (dataclasses.replace) and a pickle."""
+    import dataclasses
+    import pickle
+    scene = load_scene(ROOT / name, overrides)
+    assert callable(scene.__dict__["_text"])            # not written yet
+    copied = pickle.loads(pickle.dumps(scene))
+    reference = f90nml.read(ROOT / name)
+    for item in overrides:
+        address, value = item.split("=")
+        group, key = address.split(".")
+        reference[group][key] = f90nml.reads(f"&x v = {value} /")["x"]["v"]
+    text = scene.text
+    assert text == _written(reference) and isinstance(scene.__dict__["_text"], str)
+    assert scene.text is text                            # written once
+    assert copied.text == text and dataclasses.replace(scene, overrides=[]).text == text

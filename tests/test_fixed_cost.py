@@ -303,18 +303,21 @@ def test_subgroup_is_the_group_h5py_makes(tmp_path):
 
 
 def test_a_short_chunk_waits_for_the_next_one():
-    """The answers recorder records a chunk of 2..WAIT_ROWS rows with the next chunk (one
-    pass instead of two) and a chunk still waiting when the answers are read
-    (``complete``): the reactions, section forces and stress envelope are bitwise those
-    of a recorder that records every chunk at once (WAIT_ROWS = 0), for a run that ends
-    after a long chunk and for one that ends with a short chunk still waiting."""
+    """The answers recorder records a chunk of 2..WAIT_ROWS rows with the next chunk, the
+    initial row with the stepper's first call and the chunk after it (one pass instead of
+    three), and a chunk still waiting when the answers are read (``complete``); single
+    rows after the initial one (adaptive steps) do not wait: the reactions, section forces
+    and stress envelope are bitwise those of a recorder that records every chunk at once
+    (WAIT_ROWS = 0), for a run that ends after a long chunk, one that ends with a short
+    chunk still waiting, one whose only chunk waits, and single-row chunks."""
     from test_lean_output import _chunks, cantilever
     from ancfdrv.solvers.dynamic import DynamicSettings
     from ancfdrv.system.answers import DynamicAnswers
     model = cantilever().assemble()
     try:
         settings = DynamicSettings(dt=1e-3, t_end=0.05, store_q=True)
-        for sizes in ([10, 30], [10, 30, 5]):
+        for sizes, expected in (([10, 30], [41]), ([10, 30, 5], [41, 5]), ([10], [11]),
+                                ([1, 1, 1], [1, 1, 1, 1]), ([1, 10, 30], [1, 1, 40])):
             chunks = _chunks(model, settings, sizes)
             recorded = {}
             for label, wait in (("waiting", DynamicAnswers.WAIT_ROWS), ("each", 0)):
@@ -331,7 +334,7 @@ def test_a_short_chunk_waits_for_the_next_one():
                 recorded[label] = (recorder, passes)
             (ours, ours_passes), (each, each_passes) = recorded["waiting"], recorded["each"]
             assert each_passes == [1, *sizes]
-            assert ours_passes == [1, 40] + ([5] if len(sizes) == 3 else [])
+            assert ours_passes == expected
             assert ours.time == each.time and len(ours.time) == 1 + sum(sizes)
             for name in each.reactions:
                 a = [np.concatenate([c[k] for c in ours.reactions[name]]) for k in (0, 1)]

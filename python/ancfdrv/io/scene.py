@@ -12,6 +12,7 @@ import math
 import re
 from collections import Counter, OrderedDict
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any, Callable
 
@@ -82,6 +83,25 @@ class Scene:
     def output_file(self) -> Path:
         name = self.values.get("output", {}).get("file")
         return Path(name) if name else Path("results") / (self.path.stem + ".h5")
+
+
+def _scene_text(scene: Scene) -> str:
+    """The namelist text (a str; given as a function of no arguments it is written at the
+    first read: :func:`load_scene` hands over its namelist's writer, so a run kept in
+    memory that never saves a file does not write the text, ~0.1 ms)."""
+    text = scene.__dict__["_text"]
+    if callable(text):
+        text = scene.__dict__["_text"] = text()
+    return text
+
+
+def _set_scene_text(scene: Scene, text: str | Callable[[], str]) -> None:
+    scene.__dict__["_text"] = text
+
+
+# the dataclass's field `text` read and set through the property (__init__, ==, repr and
+# dataclasses.replace all read the text)
+Scene.text = property(_scene_text, _set_scene_text)  # type: ignore[assignment]
 
 
 #: the builder of general scenes: ``effects_of(items)`` (the effects the items belong to)
@@ -448,7 +468,7 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     validate.check_time(values["solver"], values["scene"]["analysis"], file)
     validate.check_resources(validate.estimate_template(values, kind), file, values["solver"],
                              values["scene"]["analysis"])
-    return Scene(path=path, values=values, text=namelist_text(nml), overrides=applied)
+    return Scene(path=path, values=values, text=partial(namelist_text, nml), overrides=applied)
 
 
 def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scene:
@@ -478,8 +498,8 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scen
         raise InputError("a general scene needs at least one body (&beam, &cable, &plate, "
                          "&leaf or &rigid_body)", file=file)
     listed = "effects" in nml.get("scene", {})
-    scene = Scene(path=path, values=values, text=namelist_text(nml), overrides=applied,
-                  items=items)
+    scene = Scene(path=path, values=values, text=partial(namelist_text, nml),
+                  overrides=applied, items=items)
     if not GENERAL_BUILDER:
         raise RuntimeError("import ancfdrv (the package) to read general scenes")
     effects_of = GENERAL_BUILDER["effects_of"]

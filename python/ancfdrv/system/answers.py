@@ -1023,9 +1023,14 @@ class DynamicAnswers:
 
     #: a chunk of 2 to WAIT_ROWS rows (the stepper's first call, which measures a step's
     #: cost: 10 steps), fewer than a block holds, waits and is recorded with the next
-    #: chunk: one pass over the rows instead of two (a pass costs ~0.1-0.3 ms on a tiny
-    #: system); single rows (the initial row, the intervals of adaptive steps) do not
-    #: wait. :meth:`complete` records a chunk still waiting.
+    #: chunk; so does the initial row (a single row before anything is recorded), joined
+    #: with a next chunk that would wait itself: the initial row, the first call and the
+    #: rest are one pass over the rows instead of three (a pass costs ~0.1-0.3 ms on a
+    #: tiny system). Single rows after it (the intervals of adaptive steps) do not wait,
+    #: and the initial row followed by a single row is recorded on its own as before: rows
+    #: grouped otherwise are not always bitwise the same (the adaptive boom's stresses
+    #: batched 17 rows at a time moved by 7e-14). :meth:`complete` records a chunk still
+    #: waiting.
     WAIT_ROWS = 16
 
     _waiting = None
@@ -1043,14 +1048,24 @@ class DynamicAnswers:
         if chunk.q is None:
             raise ValueError("DynamicAnswers needs the coordinates of every step (store_q)")
         contact = getattr(chunk, "contact", None)
+        rows = len(chunk.time)
         if self._waiting is not None:
             held, self._waiting = self._waiting, None
+            if rows == 1 and len(held.time) == 1:   # the initial row, then a single row
+                self._blocks(held)
+                self._blocks(chunk)
+                return
             chunk = SimpleNamespace(
                 time=np.concatenate([held.time, chunk.time]),
                 q=np.concatenate([held.q, chunk.q]), lam=np.concatenate([held.lam, chunk.lam]),
                 contact=None if contact is None or held.contact is None
                 else np.concatenate([held.contact, contact]))
-        elif 1 < len(chunk.time) <= self.WAIT_ROWS and len(chunk.time) < self._block_rows():
+            if len(held.time) == 1 and 1 < rows and len(chunk.time) <= self.WAIT_ROWS \
+                    and len(chunk.time) < self._block_rows():
+                self._waiting = chunk   # the initial row and a short chunk: new arrays
+                return
+        elif (1 < rows or (rows == 1 and not self.time)) and rows <= self.WAIT_ROWS \
+                and rows < self._block_rows():
             self._waiting = SimpleNamespace(   # copies: the chunk's arrays may be reused
                 time=np.array(chunk.time), q=np.array(chunk.q), lam=np.array(chunk.lam),
                 contact=None if contact is None else np.array(contact))
