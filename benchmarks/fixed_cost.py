@@ -144,19 +144,7 @@ def counted_calls(case: str, helper: str) -> None:
     """The child of :func:`instructions`: warm-up calls, then INSTRUCTION_CALLS calls with
     callgrind's collection on."""
     import ctypes
-    import types
-    import ancfdrv.results.hdf5 as h5
-    import ancfdrv.solvers.dynamic as dynamic
-    # under valgrind a run lasts ~50 times longer and its writer would flush by the clock
-    # (FLUSH_SECONDS) where a quiet machine's run ends first: the rows wait for the end
-    h5.FLUSH_SECONDS = 1e9
-    # the stepper sizes its kernel calls by the elapsed time of the first (~0.25 s each):
-    # a clock that advances 1 us per reading sizes them as a quiet machine does (up to
-    # output.chunk_steps), the same in every count (valgrind's slow and load-dependent
-    # clock gave other chunks, other answers passes: +-30 M instructions on the boom)
-    ticks = iter(range(1, 1 << 62))
-    dynamic.time = types.SimpleNamespace(perf_counter=lambda: 1e-6 * next(ticks),
-                                         monotonic=time.monotonic, time=time.time)
+    quiet_clock()
     toggle = ctypes.CDLL(helper).callgrind_toggle
     out = Path(tempfile.mkdtemp()) / "run.h5"
     for _ in range(2):
@@ -167,9 +155,14 @@ def counted_calls(case: str, helper: str) -> None:
     toggle()
 
 
-def _quiet_clock() -> None:
-    """The counted processes' settings (no flush by the clock, a stepper clock of 1 us per
-    reading: see :func:`counted_calls`)."""
+def quiet_clock() -> None:
+    """The counted processes' settings (also ``in_memory_call.py``'s). Under valgrind a run
+    lasts ~50 times longer and its writer would flush by the clock (FLUSH_SECONDS) where a
+    quiet machine's run ends first: the rows wait for the end. The stepper sizes its kernel
+    calls by the elapsed time of the first (~0.25 s each): a clock that advances 1 us per
+    reading sizes them as a quiet machine does (up to output.chunk_steps), the same in
+    every count (valgrind's slow and load-dependent clock gave other chunks, other answers
+    passes: +-30 M instructions on the boom)."""
     import types
     import ancfdrv.results.hdf5 as h5
     import ancfdrv.solvers.dynamic as dynamic
@@ -186,7 +179,7 @@ def phase_calls(case: str, helper: str) -> None:
     import contextlib
     import ctypes
     import importlib
-    _quiet_clock()
+    quiet_clock()
     lib = ctypes.CDLL(helper)
     stack, on = ["glue"], [False]
 

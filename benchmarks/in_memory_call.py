@@ -35,7 +35,6 @@ import subprocess
 import sys
 import tempfile
 import time
-import types
 from pathlib import Path
 from typing import Any
 
@@ -94,14 +93,10 @@ def wall_times(nodes: int, repeats: int, out: Path) -> dict[str, Any]:
 
 def counted_calls(kind: str, nodes: int, helper: str) -> None:
     """The child of :func:`instructions`: two warm-up calls, then INSTRUCTION_CALLS calls
-    with callgrind's collection on."""
+    with callgrind's collection on (fixed_cost.py's quiet clock and flush settings)."""
     import ctypes
-    import ancfdrv.results.hdf5 as h5
-    import ancfdrv.solvers.dynamic as dynamic
-    h5.FLUSH_SECONDS = 1e9
-    ticks = iter(range(1, 1 << 62))
-    dynamic.time = types.SimpleNamespace(perf_counter=lambda: 1e-6 * next(ticks),
-                                         monotonic=time.monotonic, time=time.time)
+    from fixed_cost import quiet_clock
+    quiet_clock()
     toggle = ctypes.CDLL(helper).callgrind_toggle
     out = Path(tempfile.mkdtemp()) / "run.h5"
     for _ in range(2):
