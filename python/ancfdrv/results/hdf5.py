@@ -737,6 +737,48 @@ def row_series(chunk, probe_names: list[str], npoints: int, total0: float,
     return out
 
 
+#: the fields of a chunk besides q that the writer stores (copied by :func:`thinned_chunk`)
+ROW_FIELDS = ("time", "probes", "deflections", "lam", "energy", "constraint", "stats",
+              "contact", "step_size", "substeps", "cuts")
+
+
+def thinned_chunk(chunk, first_row: int, stride: int, last_row: int, frames: bool):
+    """A chunk without q, as a writer keeps it when /dynamic/q is not stored: the
+    :data:`ROW_FIELDS` copied, ``q_last`` (the last row's q) and ``q = None``; and its
+    frame rows (the XDMF frames' rows: every ``stride``-th row counted from the run's
+    first and ``last_row``; ``first_row`` is the chunk's first row in the run), as
+    (rows, q at those rows), or None when ``frames`` is False or no row is a frame row.
+    Used by the file's :class:`DynamicWriter` and by the in-memory writer alike."""
+    from types import SimpleNamespace
+    out = SimpleNamespace(**{f: None if getattr(chunk, f, None) is None
+                             else np.array(getattr(chunk, f)) for f in ROW_FIELDS})
+    out.q = None
+    n = len(chunk.time)
+    out.q_last = np.array(chunk.q[-1]) if n else None
+    if not (frames and n):
+        return out, None
+    rows = first_row + np.arange(n)
+    pick = (rows % stride == 0) | (rows == last_row)
+    return out, ((rows[pick], chunk.q[pick]) if pick.any() else None)
+
+
+def complete_answers(recorder) -> bool:
+    """Record the chunk still waiting in a DynamicAnswers recorder (``complete()``), before
+    its answers are written or kept. False when that fails (as when a chunk fails in the
+    runner's sink): the answers are then not written, and the model's warnings say why."""
+    complete = getattr(recorder, "complete", None)
+    if complete is None:
+        return True
+    from ..errors import AncfError
+    try:
+        complete()
+    except (AncfError, ValueError, FloatingPointError) as exc:
+        recorder.model.warnings.append(f"dynamic reactions, section forces and stresses "
+                                       f"not recorded: {exc}")
+        return False
+    return True
+
+
 class DynamicWriter:
     """Appends the chunks of a dynamic run to /dynamic (SPEC section 4).
 
@@ -931,29 +973,17 @@ class DynamicWriter:
                 or time.monotonic() - self._last_write >= FLUSH_SECONDS):
             self.flush()
 
-    #: the fields of a chunk besides q that are written (copied by :meth:`_thinned`)
-    _ROW_FIELDS = ("time", "probes", "deflections", "lam", "energy", "constraint", "stats",
-                   "contact", "step_size", "substeps", "cuts")
-
     def _thinned(self, chunk):
-        """The chunk as it waits for the next flush when /dynamic/q is not written: the
-        XDMF frames' points of its frame rows (computed now, row by row as the flush would)
-        and the last row's q (for q_last) instead of q at every step, the other fields
-        copied. The kernel's row buffer, mostly q, is then released at once instead of
-        waiting up to FLUSH_SECONDS (issue 23: at 2052 unknowns ~16 kB per step waited,
-        and the flush's merge copied it again). The file is the same."""
-        from types import SimpleNamespace
-        out = SimpleNamespace(**{f: None if getattr(chunk, f, None) is None
-                                 else np.array(getattr(chunk, f)) for f in self._ROW_FIELDS})
-        out.q = None
-        n = len(chunk.time)
-        out.q_last = np.array(chunk.q[-1]) if n else None
-        out.frames = None
-        if self.nnodes and n:
-            rows = self.rows + self._pending_rows + np.arange(n)
-            pick = (rows % self.stride == 0) | (rows == self.last_row)
-            if pick.any():
-                out.frames = (rows[pick], self.layout.positions(self.model, chunk.q[pick]))
+        """The chunk as it waits for the next flush when /dynamic/q is not written
+        (:func:`thinned_chunk`), its frame rows' q turned into the XDMF frames' points now
+        (row by row as the flush would). The kernel's row buffer, mostly q, is then
+        released at once instead of waiting up to FLUSH_SECONDS (issue 23: at 2052 unknowns
+        ~16 kB per step waited, and the flush's merge copied it again). The file is the
+        same."""
+        out, frame = thinned_chunk(chunk, self.rows + self._pending_rows, self.stride,
+                                   self.last_row, bool(self.nnodes))
+        out.frames = None if frame is None else (
+            frame[0], self.layout.positions(self.model, frame[1]))
         return out
 
     #: set by :meth:`flush_last` while it flushes: no rows follow
@@ -1188,16 +1218,7 @@ def write_dynamic_answers(path: Path, recorder) -> None:
     chunk still waiting in it recorded first: ``recorder.complete()``; when that fails,
     as when a chunk fails in the runner's sink, the answers are not written and the
     model's warnings say why)."""
-    complete = getattr(recorder, "complete", None)
-    if complete is not None:
-        from ..errors import AncfError
-        try:
-            complete()
-        except (AncfError, ValueError, FloatingPointError) as exc:
-            recorder.model.warnings.append(f"dynamic reactions, section forces and stresses "
-                                           f"not recorded: {exc}")
-            return
-    if not recorder.time:
+    if not complete_answers(recorder) or not recorder.time:
         return
     with _open_write(path) as h5:
         group = _subgroup(h5, "dynamic")

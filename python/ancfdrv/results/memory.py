@@ -31,9 +31,6 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-#: the fields of a chunk besides q (those the file's writer stores)
-ROW_FIELDS = ("time", "probes", "deflections", "lam", "energy", "constraint", "stats",
-              "contact", "step_size", "substeps", "cuts")
 
 
 class MemoryWriter:
@@ -73,17 +70,12 @@ class MemoryWriter:
         self.rows += len(chunk.time)
 
     def _thinned(self, chunk) -> SimpleNamespace:
-        out = SimpleNamespace(**{f: None if getattr(chunk, f, None) is None
-                                 else np.array(getattr(chunk, f)) for f in ROW_FIELDS})
-        out.q = None
-        n = len(chunk.time)
-        out.q_last = np.array(chunk.q[-1]) if n else None
-        out.frame_q = None
-        if self.keep_frames and n:
-            rows = self.rows + np.arange(n)
-            pick = (rows % self.stride == 0) | (rows == self.last_row)
-            if pick.any():
-                out.frame_q = (rows[pick], np.array(chunk.q[pick]))
+        """:func:`.hdf5.thinned_chunk`, its frame rows' q kept (``frame_q``: the points
+        are computed when the file is saved)."""
+        from .hdf5 import thinned_chunk
+        out, frame = thinned_chunk(chunk, self.rows, self.stride, self.last_row,
+                                   self.keep_frames)
+        out.frame_q = frame
         return out
 
     def flush_last(self) -> None:
@@ -136,7 +128,7 @@ class MemoryWriter:
         writer = hdf5.DynamicWriter(path, self.model, *self.arguments, **self.options)
         for chunk in self.chunks:
             if hasattr(chunk, "frame_q"):
-                thinned = SimpleNamespace(**{f: getattr(chunk, f) for f in ROW_FIELDS})
+                thinned = SimpleNamespace(**{f: getattr(chunk, f) for f in hdf5.ROW_FIELDS})
                 thinned.q, thinned.q_last, thinned.frames = None, chunk.q_last, None
                 if chunk.frame_q is not None and writer.nnodes:
                     rows, q = chunk.frame_q
@@ -242,15 +234,9 @@ class MemoryOutput:
     def write_dynamic_answers(self, path, recorder) -> None:
         """The recorder's waiting rows recorded now (as the file's writer does first; a
         failure there is a warning and no answers, as in the file)."""
-        complete = getattr(recorder, "complete", None)
-        if complete is not None:
-            from ..errors import AncfError
-            try:
-                complete()
-            except (AncfError, ValueError, FloatingPointError) as exc:
-                recorder.model.warnings.append(f"dynamic reactions, section forces and "
-                                               f"stresses not recorded: {exc}")
-                return
+        from .hdf5 import complete_answers
+        if not complete_answers(recorder):
+            return
         self.recorder = recorder
         self._record("write_dynamic_answers", (recorder,))
 
