@@ -976,12 +976,11 @@ contains
     integer :: c, s, k, last_operand, drive_info
     info = 0
     if (sys%ncon == 0) return
-    do k = 1, sys%term_ptr(6 * sys%ncon + 1) - 1
-      if (sys%term_dof(k) < 1 .or. sys%term_dof(k) > size(e)) then
-        info = 5
-        return
-      end if
-    end do
+    ! (every term's coordinate lies in 1..ndof: system_set_constraints checked it once)
+    if (size(e) < sys%ndof) then
+      info = 5
+      return
+    end if
     do c = 1, sys%ncon
       drive_phi = 0.0_dp  ! (drive_value's value without a drive)
       if (sys%con_drive(c) /= 0) then
