@@ -31,8 +31,14 @@ class Pattern:
         self.row_ptr = np.asarray(row_ptr, dtype=np.int64)
         self.col_index = np.asarray(col_index, dtype=np.int64)
         self.nnz = len(self.col_index)
-        self.rows = np.repeat(np.arange(n), np.diff(self.row_ptr))
-        self._keys = self.rows * n + self.col_index
+
+    @property
+    def rows(self) -> np.ndarray:
+        """The row of every entry. Formed on each use, as the sorted keys row * n + col of
+        :meth:`positions`: a model keeps its patterns for its whole life, and these two
+        arrays were 8 bytes per entry each (1.3 MB of the 512-element cantilever's peak
+        memory; issue 23), read only while a model is built and by a static solve."""
+        return np.repeat(np.arange(self.n), np.diff(self.row_ptr))
 
     @classmethod
     def from_blocks(cls, n: int, blocks: list[np.ndarray]) -> "Pattern":
@@ -53,8 +59,9 @@ class Pattern:
     def positions(self, rows, cols) -> np.ndarray:
         """Positions of entries (rows, cols) in the values array (-1 when absent)."""
         wanted = np.asarray(rows, dtype=np.int64) * self.n + np.asarray(cols, dtype=np.int64)
-        pos = np.minimum(np.searchsorted(self._keys, wanted), len(self._keys) - 1)
-        return np.where(self._keys[pos] == wanted, pos, -1)
+        keys = self.rows * self.n + self.col_index
+        pos = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+        return np.where(keys[pos] == wanted, pos, -1)
 
     def scatter(self, dofs: np.ndarray) -> np.ndarray:
         """(nde, nde, nel) positions of element-matrix entries (a, b) of elements with dofs
