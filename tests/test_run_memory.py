@@ -6,8 +6,8 @@ holds or loads must leave every number as it was.
   as one whose calls are only limited by time (reference: that run).
 * A cantilever run loads neither numpy.ma (numpy >= 2.3 imports it for a plain
   ``np.unique``) nor numpy's least squares (a weld to the ground: its axes are the
-  identity); the replacements give numpy's own results (references: ``np.unique``,
-  ``np.linalg.lstsq``).
+  identity), socket or csv; the replacements give numpy's own results (references:
+  ``np.unique``, ``np.linalg.lstsq``) and the host name socket.gethostname() gives.
 * A Pattern keeps no per-entry arrays besides its columns; its rows and the positions of
   entries are those of a dense enumeration of the pattern (reference: brute force).
 """
@@ -108,7 +108,8 @@ def test_call_rows_bounds_the_buffer_at_one_row_at_least():
 
 def test_cantilever_run_loads_neither_masked_arrays_nor_least_squares(tmp_path):
     """The clamped cantilever (a weld to the ground) and the planar cable pendulum, with
-    answers and XDMF, in a fresh interpreter whose np.linalg.lstsq raises."""
+    answers and XDMF, in a fresh interpreter whose np.linalg.lstsq raises; nor the socket
+    module (the output lock's host name is uname's) or csv (table drives only)."""
     runs = [("inputs/hard/cantilever_drop.nml", SETS),
             ("inputs/hard/pendulum.nml", ["beam.nodes=5", "beam.bending=cable",
                                           "scene.planar=xy", "solver.t_end=0.01"])]
@@ -124,7 +125,7 @@ def test_cantilever_run_loads_neither_masked_arrays_nor_least_squares(tmp_path):
         for i, (scene, sets) in enumerate({[(str(ROOT / s), o) for s, o in runs]!r}):
             run_scene(scene, sets, {str(tmp_path)!r} + f"/r{{i}}.h5", progress=False)
         print(sorted(m for m in sys.modules
-                     if m == "numpy.ma" or m.startswith("numpy.ma.")))
+                     if m in ("numpy.ma", "socket", "csv") or m.startswith("numpy.ma.")))
     """)
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=300)
@@ -151,6 +152,18 @@ def test_ground_axes_give_least_squares_coefficients_bit_for_bit():
     from ancfdrv.errors import InputError
     with pytest.raises(InputError, match="cannot be written"):
         _express([None] * 2, turned[:2], np.array([0.0, 0.0, 1.0]), "joint 'w'")
+
+
+def test_lock_records_the_host_name_socket_gives(tmp_path):
+    import json
+    import socket
+
+    from ancfdrv.results.lock import OutputLock, lock_path
+
+    out = tmp_path / "r.h5"
+    with OutputLock(out):
+        record = json.loads(lock_path(out).read_text())
+    assert record["host"] == socket.gethostname() and record["pid"] > 0
 
 
 def test_sorted_unique_is_numpys_unique():
