@@ -85,6 +85,50 @@ def test_kernel_calls_stay_within_the_row_buffer_and_write_the_same_file(tmp_pat
         assert free[name] == capped[name], name
 
 
+def test_wide_rows_wait_in_bounded_buffers_and_write_the_same_file(tmp_path, monkeypatch):
+    """/dynamic/q of every step (output.q): the file writer writes once FLUSH_BYTES of rows
+    wait (here: a few rows' worth, FLUSH_MIN_SECONDS = 0), and its file is the one a writer
+    that waits for the end of the run writes, bit for bit."""
+    from ancfdrv.results import hdf5
+
+    sets = SETS + ["output.q=.true."]
+    monkeypatch.setattr(hdf5, "FLUSH_SECONDS", 1e9)
+    run_scene(CANTILEVER, sets, tmp_path / "whole.h5", progress=False)
+
+    model = build_model(load_scene(CANTILEVER, sets))
+    try:
+        row_bytes = 8 * model.kernel.row_size(True)
+    finally:
+        model.close()
+    monkeypatch.setattr(dynamic, "ROW_BUFFER_BYTES", 3 * row_bytes)   # 3 steps a call
+    monkeypatch.setattr(hdf5, "FLUSH_BYTES", 7 * row_bytes)
+    monkeypatch.setattr(hdf5, "FLUSH_MIN_SECONDS", 0.0)
+    waiting: list[int] = []
+    flushes: list[int] = []
+    call, flush = hdf5.DynamicWriter.__call__, hdf5.DynamicWriter.flush
+
+    def called(self, chunk):
+        call(self, chunk)
+        assert self._pending_bytes == sum(hdf5._chunk_bytes(c) for c in self._pending)
+        waiting.append(self._pending_bytes)
+
+    def flushed(self):
+        flushes.append(self._pending_rows)
+        flush(self)
+
+    monkeypatch.setattr(hdf5.DynamicWriter, "__call__", called)
+    monkeypatch.setattr(hdf5.DynamicWriter, "flush", flushed)
+    run_scene(CANTILEVER, sets, tmp_path / "bounded.h5", progress=False)
+    assert len(waiting) == 21 and max(waiting) < 7 * row_bytes   # the initial row, 20 calls
+    assert len(flushes) >= 8 and max(flushes) <= 9
+
+    whole, bounded = _datasets(tmp_path / "whole.h5"), _datasets(tmp_path / "bounded.h5")
+    assert set(whole) == set(bounded) and "dynamic/q" in whole
+    assert whole["dynamic/q"][1] == (61, 68)
+    for name in whole:
+        assert whole[name] == bounded[name], name
+
+
 def test_call_rows_bounds_the_buffer_at_one_row_at_least():
     class Kernel:
         def __init__(self, size):
