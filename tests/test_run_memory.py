@@ -8,8 +8,9 @@ holds or loads must leave every number as it was.
   ``np.unique``) nor numpy's least squares (a weld to the ground: its axes are the
   identity), socket or csv; the replacements give numpy's own results (references:
   ``np.unique``, ``np.linalg.lstsq``) and the host name socket.gethostname() gives.
-* A Pattern keeps no per-entry arrays besides its columns; its rows and the positions of
-  entries are those of a dense enumeration of the pattern (reference: brute force).
+* A large Pattern keeps no per-entry arrays besides its columns; its rows and the
+  positions of entries are those of a dense enumeration of the pattern (reference: brute
+  force).
 """
 from __future__ import annotations
 
@@ -219,7 +220,13 @@ def test_sorted_unique_is_numpys_unique():
     assert sorted_unique(grid).tolist() == np.unique(grid).tolist()
 
 
-def test_pattern_keeps_only_its_columns_and_finds_every_entry():
+@pytest.mark.parametrize("keep", [0, Pattern.KEEP_ENTRIES], ids=["large", "small"])
+def test_pattern_finds_every_entry_and_keeps_per_entry_arrays_of_small_ones(keep,
+                                                                              monkeypatch):
+    """A pattern above KEEP_ENTRIES entries (here: every pattern, KEEP_ENTRIES = 0) keeps
+    no per-entry array besides its columns; a small one keeps its rows and keys once
+    formed. Either finds every entry where a dense enumeration has it."""
+    monkeypatch.setattr(Pattern, "KEEP_ENTRIES", keep)
     blocks = [np.array([0, 1, 2, 3]), np.array([2, 3, 4, 5]), np.array([[6, 7], [1, 8]])]
     pattern = Pattern.from_blocks(9, blocks)
     entries = {(r, c) for r in range(9) for c in (r,)}
@@ -233,6 +240,9 @@ def test_pattern_keeps_only_its_columns_and_finds_every_entry():
     assert pattern.col_index.tolist() == [c for _, c in ordered]
     rows = np.array([r for r, _ in ordered] + [0, 8])
     cols = np.array([c for _, c in ordered] + [5, 0])
-    assert pattern.positions(rows, cols).tolist() == list(range(len(ordered))) + [-1, -1]
+    for _ in range(2):   # the second time from the kept keys of a small pattern
+        assert pattern.positions(rows, cols).tolist() == list(range(len(ordered))) + [-1, -1]
+        assert pattern.rows.tolist() == [r for r, _ in ordered]
     held = {name for name, value in vars(pattern).items() if isinstance(value, np.ndarray)}
-    assert held == {"row_ptr", "col_index"}
+    assert held == ({"row_ptr", "col_index"} if keep == 0 else
+                    {"row_ptr", "col_index", "_rows", "_keys"})
