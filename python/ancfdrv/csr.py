@@ -31,8 +31,10 @@ def unique_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def sorted_unique(keys: np.ndarray) -> np.ndarray:
-    """np.unique(keys) by a stable sort."""
-    ordered = np.sort(np.asarray(keys, dtype=np.int64), kind="stable")
+    """np.unique(keys) of integers (flattened, as int64) by a stable sort. Also where speed
+    does not matter: numpy >= 2.3 imports numpy.ma for a plain ``np.unique(x)`` (to ask
+    whether x is masked), 1.3 MB of a run's peak memory (issue 23)."""
+    ordered = np.sort(np.asarray(keys, dtype=np.int64).ravel(), kind="stable")
     keep = np.empty(len(ordered), dtype=bool)
     keep[:1] = True
     np.not_equal(ordered[1:], ordered[:-1], out=keep[1:])

@@ -53,6 +53,21 @@ CONTACT_UNITS = {"penetration": "m", "normal_force": "N", "friction_force": "N",
                  "slip_speed": "m/s", "xi": "1", "eta": "1"}
 #: a buffered dynamic writer writes at least this often (and every chunk_steps rows)
 FLUSH_SECONDS = 1.0
+#: ... and when this many bytes of rows wait, once FLUSH_MIN_SECONDS have passed since its
+#: last write: wide rows (q of every step, /dynamic/q) wait in bounded buffers (the 512-
+#: element cantilever's 16 MB of q waited whole, and the merge of a flush copied them:
+#: 92 MB peak against 66 MB without q; issue 23), and a write's fixed cost (~0.2 ms a
+#: series) is paid at most a few times a second
+FLUSH_BYTES = 4 << 20
+FLUSH_MIN_SECONDS = 0.25
+
+
+def _chunk_bytes(chunk) -> int:
+    """The bytes a waiting chunk holds (its row arrays and its XDMF frames' points)."""
+    return (sum(getattr(getattr(chunk, f, None), "nbytes", 0)
+                for f in ("time", "probes", "deflections", "lam", "energy", "constraint",
+                          "stats", "q", "contact"))
+            + (chunk.frames[1].nbytes if getattr(chunk, "frames", None) else 0))
 
 
 #: the text type of string attributes (h5py's: variable-length UTF-8)
@@ -822,6 +837,8 @@ class DynamicWriter:
         self._q_last_made = False
         self._pending: list[Any] = []
         self._pending_rows = 0
+        self._pending_bytes = 0
+        self._row_bytes: int | None = None   # a waiting row's bytes (:meth:`_waiting_bytes`)
         self._last_write = time.monotonic()
         ncon, ndof = len(model.constraints), model.ndof
         self.total_rows = total_rows
@@ -969,9 +986,27 @@ class DynamicWriter:
             chunk = self._thinned(chunk)
         self._pending.append(chunk)
         self._pending_rows += len(chunk.time)
-        if (self._pending_rows >= self.flush_rows
-                or time.monotonic() - self._last_write >= FLUSH_SECONDS):
+        self._pending_bytes += self._waiting_bytes(chunk)
+        since = time.monotonic() - self._last_write
+        if (self._pending_rows >= self.flush_rows or since >= FLUSH_SECONDS
+                or (self._pending_bytes >= FLUSH_BYTES and since >= FLUSH_MIN_SECONDS)):
             self.flush()
+
+    def _waiting_bytes(self, chunk) -> int:
+        """About :func:`_chunk_bytes` of a waiting chunk: its rows times the bytes of a row
+        of the run's first chunk after the initial row (the stepper's rows have one layout;
+        an interval of cut or adaptive steps counts its steps in int64: 12 bytes a row
+        more), and its frames' points. A single step under step control is a chunk: the
+        ten attribute reads of :func:`_chunk_bytes` would cost ~1 us of its ~60."""
+        rows = len(chunk.time)
+        if self._row_bytes is None:
+            exact = _chunk_bytes(chunk)
+            if rows and self.rows + self._pending_rows > rows:   # not the initial row
+                frames = getattr(chunk, "frames", None)
+                self._row_bytes = (exact - (frames[1].nbytes if frames else 0)) // rows
+            return exact
+        frames = getattr(chunk, "frames", None)
+        return rows * self._row_bytes + (frames[1].nbytes if frames else 0)
 
     def _thinned(self, chunk):
         """The chunk as it waits for the next flush when /dynamic/q is not written
@@ -1010,11 +1045,7 @@ class DynamicWriter:
             return
         # a full disk or file-size limit: refused before HDF5 writes (a write failing
         # inside HDF5 can crash it), the rows written before stay readable
-        pending = sum(sum(getattr(getattr(chunk, f, None), "nbytes", 0)
-                          for f in ("time", "probes", "deflections", "lam", "energy",
-                                    "constraint", "stats", "q", "contact"))
-                      + (chunk.frames[1].nbytes if getattr(chunk, "frames", None) else 0)
-                      for chunk in self._pending)
+        pending = sum(_chunk_bytes(chunk) for chunk in self._pending)
         try:
             check_room(self.path, 2 * pending + self.chunk_bytes)
         except OSError:
@@ -1028,6 +1059,7 @@ class DynamicWriter:
                     self._last = last
                     self._pending = self._pending + rest
                     self._pending_rows = sum(len(chunk.time) for chunk in self._pending)
+                    self._pending_bytes = sum(_chunk_bytes(chunk) for chunk in self._pending)
             raise
         with _open_write(self.path) as h5:
             group = h5["dynamic"]
@@ -1043,7 +1075,7 @@ class DynamicWriter:
             if self.nnodes:  # the per-frame views the XDMF description names
                 from .xdmf import add_step_views
                 add_step_views(h5, first, self.frames)
-        self._pending, self._pending_rows = [], 0
+        self._pending, self._pending_rows, self._pending_bytes = [], 0, 0
         self._last_write = time.monotonic()
 
     def _merged(self, group: h5py.Group):

@@ -555,6 +555,20 @@ def initial_row(model: Model, state: dict) -> Chunk:
                  contact=row["records"].T[None] if model.contact_pairs else None)
 
 
+#: the most bytes of output rows one kernel call returns (:func:`call_rows`). The rows
+#: of a call are a fresh array, mostly q when the chunks carry it: 0.25 s of steps of the
+#: 512-element cantilever (2052 unknowns) were 3.5 MB, and the peak resident set rose with
+#: the speed of the machine (issue 23: a run's peak memory, 78 -> 71 MB there).
+ROW_BUFFER_BYTES = 1 << 19
+
+
+def call_rows(model: Model, settings: DynamicSettings) -> int:
+    """The most steps one kernel call takes: its rows within :data:`ROW_BUFFER_BYTES`
+    (at least one). The chunks' sizes do not change the results: the stepper carries
+    its whole state from call to call."""
+    return max(1, ROW_BUFFER_BYTES // (8 * model.kernel.row_size(settings.store_q)))
+
+
 def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
               v0: np.ndarray | None = None, t0: float = 0.0, *,
               sink: Callable[[Chunk], None] | None = None,
@@ -568,9 +582,10 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     caller computed them already (not solved again).
 
     A kernel call takes at most about 0.25 s of wall time (the first call's time per step
-    caps the following ones, never more than settings.chunk_steps), and ``should_stop`` is
-    asked after every chunk: when it says True, Interrupted is raised after the sink got
-    the chunk, so a stop request (SIGINT) is answered within about a second."""
+    caps the following ones, never more than settings.chunk_steps nor :func:`call_rows`
+    steps), and ``should_stop`` is asked after every chunk: when it says True,
+    Interrupted is raised after the sink got the chunk, so a stop request (SIGINT) is
+    answered within about a second."""
     check_arguments("integrate", dt=settings.dt, t_end=settings.t_end, tol=settings.tol,
                     max_newton=settings.max_newton, chunk_steps=settings.chunk_steps, t0=t0)
     e0 = check_state("integrate", "e0", e0, model.ndof)
@@ -596,7 +611,9 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     show = sys.stderr.isatty() if progress is None else progress
     bar = _progress_bar(show, round(settings.t_end - t0, 9))
     steps = newton = factorizations = jacobians = 0
-    call_steps = min(settings.chunk_steps, 10)  # the first call measures a step's cost
+    row_cap = call_rows(model, settings)
+    # the first call measures a step's cost
+    call_steps = min(settings.chunk_steps, 10, row_cap)
     if settings.step not in ("fixed", "adaptive"):
         raise SolverError(f"solver.step = {settings.step!r} must be 'fixed' or 'adaptive'")
     control = StepControl(settings)
@@ -617,7 +634,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
                 chunk, info, detail = integrator.advance(state, n)
                 elapsed = time.perf_counter() - t1
                 if len(chunk.time):  # calls of at most ~0.25 s: a stop request waits no longer
-                    call_steps = max(1, min(settings.chunk_steps,
+                    call_steps = max(1, min(settings.chunk_steps, row_cap,
                                             int(0.25 * len(chunk.time) / max(elapsed, 1e-9))))
                 control.taken += len(chunk.time)
                 if len(chunk.time):

@@ -50,6 +50,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from ..codes import CONSTRAINT_COORDINATE
+from ..csr import sorted_unique
 from .bodies import Beam, Plate, RigidBody
 from .cable import Cable
 from .constraint_set import ConstraintSet
@@ -206,7 +207,7 @@ class ReactionMap:
             touched = self.t_dof[terms] - first
             if len(entries):
                 touched = np.concatenate([touched, self.a_coo.col[entries] - first])
-            slots = np.unique(touched // 3)
+            slots = sorted_unique(touched // 3)
             self.selection[name] = (terms, entries, first, size, slots)
 
     def _gradients(self, q_full: np.ndarray, t: float) -> np.ndarray:

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..csr import sorted_unique
 from ..errors import InputError
 from ..kernel import _f, _kernel
 
@@ -181,7 +182,7 @@ class ConstraintSet:
 
     def touched(self) -> np.ndarray:
         """Every coordinate some constraint depends on."""
-        return np.unique(self.term_dof) if len(self) else np.zeros(0, dtype=np.int64)
+        return sorted_unique(self.term_dof) if len(self) else np.zeros(0, dtype=np.int64)
 
     def operand_map(self, c: int, coordinates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(6, len(coordinates)) d operands / d coordinates and the operand constants of

@@ -20,7 +20,6 @@ scale loads.
 """
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -248,6 +247,7 @@ class Table(Drive):
                  value_column: int = 1, interpolation: str = "linear") -> "Table":
         """A table from a CSV file of (time, value) rows; a first row that is not numeric is
         a header."""
+        import csv   # here: most runs read no table (issue 23: the modules a run loads)
         path = Path(path)
         if not path.is_file():
             raise InputError(f"drive {name!r}: table file {str(path)!r} not found")

@@ -110,12 +110,27 @@ def _express(basis: list[Vec3], initial: list[np.ndarray], target: np.ndarray, w
              ) -> np.ndarray:
     """Coefficients c with sum c_k basis_k(0) = target (exact, else InputError)."""
     matrix = np.column_stack(initial)
+    if matrix.shape == (3, 3) and (matrix == _IDENTITY).all():
+        # the axes of the ground (a weld to it): c = target, as least squares finds it bit
+        # for bit, without numpy's LAPACK call (its first call loads ~1 MB of BLAS code and
+        # work space; issue 23: a run's peak memory)
+        coef = np.array(target, dtype=float)
+    else:
+        coef = _least_squares(matrix, target, what)
+    coef[np.abs(coef) < 1e-14 * np.abs(coef).max(initial=1.0)] = 0.0
+    return coef
+
+
+_IDENTITY = np.eye(3)
+
+
+def _least_squares(matrix: np.ndarray, target: np.ndarray, what: str) -> np.ndarray:
+    """The exact coefficients of target in the columns of matrix (else InputError)."""
     coef, *_ = np.linalg.lstsq(matrix, target, rcond=None)
     if np.linalg.norm(matrix @ coef - target) > 1e-9 * max(1.0, np.linalg.norm(target)):
         raise InputError(f"{what}: the direction {list(np.round(target, 12))} cannot be written "
                          "in the body's nodal directions there (a plate or leaf holds directions "
                          "in its own plane only)")
-    coef[np.abs(coef) < 1e-14 * np.abs(coef).max(initial=1.0)] = 0.0
     return coef
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import kernel
 from ..codes import POLICY_CONSTANT, POLICY_REFACTOR
-from ..csr import Csr, unique_keys
+from ..csr import Csr, sorted_unique, unique_keys
 from ..errors import InputError, SolverError
 from .bodies import Beam, Body, Plate, RigidBody, rotation_about
 from .constraint_set import ConstraintSet
@@ -372,7 +372,7 @@ class Model:
         if self.reduction is None:
             return np.asarray(dofs), np.eye(len(dofs))
         rows = self.reduction.matrix.take_rows(dofs)
-        cols = np.unique(rows.indices)
+        cols = sorted_unique(rows.indices)
         b = np.zeros((len(dofs), len(cols)))
         b[rows.row_index(), np.searchsorted(cols, rows.indices)] = rows.data
         return cols, b
@@ -516,8 +516,8 @@ class Model:
             reduced_of[index] = np.arange(len(index))
             full = index[used]
             partners = reduced_of[(full - full % 3)[:, None] + np.arange(3)].ravel()
-            used = np.union1d(used, partners[partners >= 0])
-        return np.unique(np.minimum(used - used % 3, self.ndof - 3))
+            used = sorted_unique(np.concatenate([used, partners[partners >= 0]]))
+        return sorted_unique(np.minimum(used - used % 3, self.ndof - 3))
 
     def banded(self) -> bool:
         """The banded Cholesky (with LU fallback) for symmetric matrices with a narrow band:

@@ -26,13 +26,40 @@ from .expressions import Scalar
 class Pattern:
     """CSR pattern of an n x n matrix (0-based, sorted columns)."""
 
+    #: a pattern of at most this many entries keeps its entries' rows and sorted keys once
+    #: formed (a small model's build reads them several times: ~20 us of the 5-node
+    #: pendulum's 1.2 ms); a larger one forms them on each use. A model keeps its patterns
+    #: for its whole life, and these two arrays are 8 bytes per entry each (1.3 MB of the
+    #: 512-element cantilever's peak memory; issue 23), read only while the model is built
+    #: and by a static solve.
+    KEEP_ENTRIES = 4096
+
     def __init__(self, n: int, row_ptr: np.ndarray, col_index: np.ndarray) -> None:
         self.n = n
         self.row_ptr = np.asarray(row_ptr, dtype=np.int64)
         self.col_index = np.asarray(col_index, dtype=np.int64)
         self.nnz = len(self.col_index)
-        self.rows = np.repeat(np.arange(n), np.diff(self.row_ptr))
-        self._keys = self.rows * n + self.col_index
+        self._rows: np.ndarray | None = None
+        self._keys: np.ndarray | None = None
+
+    @property
+    def rows(self) -> np.ndarray:
+        """The row of every entry (see :data:`KEEP_ENTRIES`)."""
+        rows = self._rows
+        if rows is None:
+            rows = np.repeat(np.arange(self.n), np.diff(self.row_ptr))
+            if self.nnz <= self.KEEP_ENTRIES:
+                self._rows = rows
+        return rows
+
+    def _sorted_keys(self) -> np.ndarray:
+        """row * n + col of every entry, ascending (see :data:`KEEP_ENTRIES`)."""
+        keys = self._keys
+        if keys is None:
+            keys = self.rows * self.n + self.col_index
+            if self.nnz <= self.KEEP_ENTRIES:
+                self._keys = keys
+        return keys
 
     @classmethod
     def from_blocks(cls, n: int, blocks: list[np.ndarray]) -> "Pattern":
@@ -53,8 +80,9 @@ class Pattern:
     def positions(self, rows, cols) -> np.ndarray:
         """Positions of entries (rows, cols) in the values array (-1 when absent)."""
         wanted = np.asarray(rows, dtype=np.int64) * self.n + np.asarray(cols, dtype=np.int64)
-        pos = np.minimum(np.searchsorted(self._keys, wanted), len(self._keys) - 1)
-        return np.where(self._keys[pos] == wanted, pos, -1)
+        keys = self._sorted_keys()
+        pos = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+        return np.where(keys[pos] == wanted, pos, -1)
 
     def scatter(self, dofs: np.ndarray) -> np.ndarray:
         """(nde, nde, nel) positions of element-matrix entries (a, b) of elements with dofs
