@@ -720,10 +720,17 @@ def checked_value(spec: Key, raw: Any, where: dict[str, Any]) -> Any:
 
 # -- the Python API's door: the same types, ranges and messages as the namelist -----------
 
+#: the types plain_value returns unchanged at once (exactly these; subclasses such as numpy
+#: scalars take the general way)
+_PLAIN_TYPES = frozenset((int, float, str, bool, type(None)))
+
+
 def plain_value(value: Any) -> Any:
     """A value as plain Python for checks and messages: numpy scalars become int/float
     (messages print ``2.2``, not ``np.float64(2.2)``), arrays and tuples become lists;
     anything else is returned unchanged (and refused by the type check that follows)."""
+    if type(value) in _PLAIN_TYPES:   # (the namelist's values: returned at once)
+        return value
     import numpy as np
     if isinstance(value, np.generic):
         return value.item()

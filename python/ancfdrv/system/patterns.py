@@ -31,7 +31,7 @@ class Pattern:
         self.row_ptr = np.asarray(row_ptr, dtype=np.int64)
         self.col_index = np.asarray(col_index, dtype=np.int64)
         self.nnz = len(self.col_index)
-        self.rows = np.repeat(np.arange(n), np.diff(self.row_ptr))
+        self.rows = np.repeat(np.arange(n), self.row_ptr[1:] - self.row_ptr[:-1])
         self._keys = self.rows * n + self.col_index
 
     @classmethod
@@ -43,7 +43,7 @@ class Pattern:
             b = np.asarray(block)
             if b.ndim == 1:
                 b = b[:, None]
-            b = b[:, np.all(b >= 0, axis=0)] if b.size else b
+            b = b[:, (b >= 0).all(axis=0)] if b.size else b
             k = b.shape[0]
             rows.append(np.repeat(b, k, axis=0).T.ravel())
             cols.append(np.tile(b, (k, 1)).T.ravel())
