@@ -44,6 +44,7 @@ Stresses
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from types import SimpleNamespace
 
@@ -109,7 +110,10 @@ class ReactionMap:
     rows and the coordinates of their body2."""
 
     def __init__(self, model: Model) -> None:
-        self.model = model
+        # the model keeps its map (reaction_map): the map refers to it weakly, so the two
+        # make no reference cycle and a run's model is freed as soon as it is dropped (a
+        # cycle left each run's objects to the garbage collector: ~0.15 ms per small run)
+        self._model = weakref.ref(model)
         self.joints = getattr(model, "joint_items", {})
         owner = getattr(model, "equation_owner", {})
         equations = getattr(model, "full_equations", {})
@@ -145,6 +149,15 @@ class ReactionMap:
         self.wanted = any(o is not None for o in self.multiplier_owner + self.linear_owner)
         self.a_coo = self.a.tocoo() if self.factor is not None else None
         self.points = {name: _joint_points(joint) for name, joint in self.joints.items()}
+
+    @property
+    def model(self) -> Model:
+        """The model of these reactions (it holds the map; a map outlives it only when
+        kept apart, and then has no model: ReferenceError)."""
+        model = self._model()
+        if model is None:
+            raise ReferenceError("the model of this reaction map was released")
+        return model
 
     def residual(self, e: np.ndarray, v: np.ndarray, a: np.ndarray | None, t: float,
                  load_factor: float, guesses: np.ndarray | None = None) -> np.ndarray:
@@ -366,7 +379,8 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _vec_rows(expr, q_rows: np.ndarray) -> np.ndarray:
     """A Vec3 expression at rows of coordinates: (nt, 3)."""
-    out = np.tile(expr.const, (len(q_rows), 1))
+    out = np.empty((len(q_rows), 3))
+    out[:] = expr.const   # (np.tile's rows, without its overhead)
     for d, c in expr.terms.items():
         out += c * q_rows[:, d:d + 3]
     return out
@@ -993,7 +1007,8 @@ class DynamicAnswers:
         self.need_acceleration = self.map.factor is not None
         self.initial = initial
         self.state: tuple | None = None
-        self.time: list[float] = []
+        #: the times of the blocks recorded (arrays; :attr:`time` joins them)
+        self._time_blocks: list[np.ndarray] = []
         #: per joint, per chunk: (force (nt, 3), moment (nt, 3), axial (nt,) or None)
         self.reactions: dict[str, list[tuple]] = {name: [] for name in self.map.joints}
         #: force elements: their reactions need e' at every row (rebuilt as e'' is)
@@ -1004,6 +1019,11 @@ class DynamicAnswers:
         self.sections: dict[str, list[SectionForces]] = {}
         self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+
+    @property
+    def time(self) -> list[float]:
+        """The times (s) of the rows recorded, in order."""
+        return [t for block in self._time_blocks for t in block.tolist()]
 
     def _kinematics(self, t: float, e: np.ndarray):
         """(e', e'') at the row, rebuilt from the previous row."""
@@ -1064,7 +1084,7 @@ class DynamicAnswers:
                     and len(chunk.time) < self._block_rows():
                 self._waiting = chunk   # the initial row and a short chunk: new arrays
                 return
-        elif (1 < rows or (rows == 1 and not self.time)) and rows <= self.WAIT_ROWS \
+        elif (1 < rows or (rows == 1 and not self._time_blocks)) and rows <= self.WAIT_ROWS \
                 and rows < self._block_rows():
             self._waiting = SimpleNamespace(   # copies: the chunk's arrays may be reused
                 time=np.array(chunk.time), q=np.array(chunk.q), lam=np.array(chunk.lam),
@@ -1130,7 +1150,7 @@ class DynamicAnswers:
                                            residual)
             for name, (force, moment, _, axial) in found.items():
                 self.reactions[name].append((force, moment, axial))
-        self.time.extend(times.tolist())
+        self._time_blocks.append(np.array(times))   # (a list of floats made on request)
         if not self.beams:
             return
         # blocks of rows whose temporaries stay in the cache (the stations' forces of
