@@ -1,7 +1,7 @@
 """The dense solve of small saddle systems (the consistent initial acceleration of a model
 with at most ``dynamic.DENSE_SADDLE_MAX`` coordinates and multipliers, issue 23's fixed
-cost): LAPACK's LU of the dense matrix in the kernel (``kernel.dense_solve``) in place of
-MUMPS.
+cost; off by default, set to 160 here): LAPACK's LU of the dense matrix in the kernel
+(``kernel.dense_solve``) in place of MUMPS.
 
 References: MUMPS's solution of the same system (the path of larger systems, forced by
 ``DENSE_SADDLE_MAX = 0``), the equations of motion M a - Phi_e^T lambda = f and the
@@ -54,6 +54,7 @@ def test_dense_saddle_solve_equals_mumps(scene, overrides, monkeypatch):
     satisfy the equations of motion and the constraints' accelerations to round-off."""
     model = build_model(load_scene(INPUTS / scene, overrides))
     try:
+        monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 160)   # (off by default)
         n = model.ndof + len(model.constraints)
         assert n <= dynamic.DENSE_SADDLE_MAX   # the dense path is the one taken
         rng = np.random.default_rng(7)
@@ -110,6 +111,7 @@ def test_large_saddle_systems_keep_mumps(monkeypatch):
     model = build_model(load_scene(INPUTS / "hard/pendulum.nml",
                                    ["beam.nodes=5", "beam.bending=cable", "scene.planar=xy"]))
     try:
+        monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 160)   # (off by default)
         calls = []
         real = dynamic.dense_solve
         monkeypatch.setattr(dynamic, "dense_solve", lambda *a, **k: calls.append(1) or
