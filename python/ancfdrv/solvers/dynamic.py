@@ -469,12 +469,14 @@ class EnergyWatch:
 
     #: the works among ENERGY_NAMES (drives, frames, contact damping, friction, damping)
     WORKS = (5, 6, 8, 9, 10)
+    _WORK_ROWS = list(WORKS)
 
     def add(self, energy: np.ndarray) -> None:
-        # column by column (no copy of the works' columns): the sums in numpy's order of
-        # a row sum over a few columns (left to right), so the figures are bitwise those
-        # of works.sum(axis=1) and energy[:, 1:4].sum(axis=1)
-        columns = energy.T
+        # column by column: the sums in numpy's order of a row sum over a few columns (left
+        # to right), so the figures are bitwise those of works.sum(axis=1) and
+        # energy[:, 1:4].sum(axis=1); the columns copied contiguous once (the chunk's are
+        # strided views of the kernel's rows: each operation on them was a strided loop)
+        columns = np.ascontiguousarray(energy.T)
         works = columns[5] + columns[6] + columns[8] + columns[9] + columns[10]
         balance = columns[4] - self.first[4] - works
         potential = columns[1] + columns[2] + columns[3] - self.first[1:4].sum()
@@ -482,7 +484,7 @@ class EnergyWatch:
         self.scale = max(self.scale, float(np.abs(columns[0]).max()),
                          float(np.abs(potential).max()),
                          float(np.abs(columns[0] + columns[1]).max()),
-                         float(np.array([np.abs(columns[k]).max() for k in self.WORKS]).max()))
+                         float(np.abs(columns[self._WORK_ROWS]).max()))
 
     def created(self) -> float:
         return self.most / self.scale if self.scale > 0 else 0.0
