@@ -371,10 +371,17 @@ def _joint_points(joint) -> tuple:
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b along the last axis (broadcast), without np.cross's overhead."""
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    """a x b along the last axis (broadcast), without np.cross's overhead (arrays of one
+    shape: the components written into one array, without np.stack's)."""
+    if a.shape != b.shape:
+        return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                         a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                         a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    out = np.empty(a.shape, dtype=np.result_type(a, b))
+    np.subtract(a[..., 1] * b[..., 2], a[..., 2] * b[..., 1], out=out[..., 0])
+    np.subtract(a[..., 2] * b[..., 0], a[..., 0] * b[..., 2], out=out[..., 1])
+    np.subtract(a[..., 0] * b[..., 1], a[..., 1] * b[..., 0], out=out[..., 2])
+    return out
 
 
 def _vec_rows(expr, q_rows: np.ndarray) -> np.ndarray:
@@ -397,18 +404,25 @@ def _reduce_rows(joint, generalized: np.ndarray, slots: np.ndarray, q_rows: np.n
     p2, p1 = points
     point = _vec_rows(p2, q_rows)
     nt = len(q_rows)
-    force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
     if per and len(slots):
         block = generalized.reshape(nt, len(slots), 3)
         index = (body.first + 3 * slots[:, None] + np.arange(3)).ravel()
         values = q_rows[:, index].reshape(nt, len(slots), 3)
         position = slots % (per // 3) == 0          # a node's first vector: its position
-        force = block[:, position].sum(axis=1)
-        moment = _cross(values[:, position] - point[:, None, :], block[:, position]).sum(axis=1)
+        if position.all() and block.flags.c_contiguous:
+            # every slot a position (a joint at a node): the arrays themselves, as the
+            # copies of every slot hold them (the same layout: the same sums)
+            on_block, on_values = block, values
+        else:
+            on_block, on_values = block[:, position], values[:, position]
+        force = on_block.sum(axis=1)
+        moment = _cross(on_values - point[:, None, :], on_block).sum(axis=1)
         if position.all():   # no other vector: the sum over none, +0.0 each
             moment += 0.0
         else:
             moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
+    else:
+        force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
     swapped = getattr(joint, "swapped", False)
     if swapped:
         force, moment = -force, -moment
