@@ -73,10 +73,12 @@ def test_state_dependent_gradients_are_evaluated():
 
 @pytest.mark.parametrize("scene", ["hard/pendulum.nml", "boom_luffing.nml", "hard/spinup.nml",
                                    "plate_pendulum.nml"])
-def test_reused_saddle_solver_gives_a_fresh_solvers_answer(scene):
+def test_reused_saddle_solver_gives_a_fresh_solvers_answer(scene, monkeypatch):
     """The initial acceleration from a reused MUMPS instance (analysed anew after other
     models' systems) is bitwise that of an instance made for it, and it satisfies the
-    equations of motion and Phi_e a = gamma."""
+    equations of motion and Phi_e a = gamma (MUMPS for every size: the dense solve of
+    small systems is compared with it in test_dense_saddle.py)."""
+    monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 0)
     other = _model("hard/spinup.nml")
     model = _model(scene)
     try:
@@ -110,6 +112,7 @@ def test_reused_saddle_solver_gives_a_fresh_solvers_answer(scene):
 
 def test_a_failed_saddle_solve_releases_its_solver(monkeypatch):
     """A solve that fails does not return its (possibly broken) instance for reuse."""
+    monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 0)   # MUMPS for every size
     model = _model("hard/pendulum.nml", PENDULUM)
     try:
         dynamic.initial_acceleration(model, model.e0, np.zeros(model.ndof), 0.0)
@@ -428,10 +431,11 @@ def test_gradients_of_an_evaluation_with_velocities():
 
 
 @pytest.mark.parametrize("scene", ["hard/pendulum.nml", "boom_luffing.nml", "leaf_spring.nml"])
-def test_kept_analysis_gives_a_fresh_solvers_answer(scene):
+def test_kept_analysis_gives_a_fresh_solvers_answer(scene, monkeypatch):
     """Consecutive initial accelerations of one model (the same saddle pattern: the
     reused instance keeps its analysis and only refactorizes) at different states are
-    bitwise those of instances made for each."""
+    bitwise those of instances made for each (MUMPS for every size)."""
+    monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 0)
     model = _model(scene)
     try:
         def solve(k: int):

@@ -110,7 +110,8 @@ class Csr:
 
     def row_index(self) -> np.ndarray:
         """The row of every stored entry."""
-        return np.repeat(np.arange(self.shape[0], dtype=np.int64), np.diff(self.indptr))
+        indptr = self.indptr   # (indptr[1:] - indptr[:-1]: np.diff without its overhead)
+        return np.repeat(np.arange(self.shape[0], dtype=np.int64), indptr[1:] - indptr[:-1])
 
     def copy(self) -> "Csr":
         return Csr(self.data.copy(), self.indices.copy(), self.indptr.copy(), self.shape)
@@ -291,14 +292,16 @@ class Csr:
 
     def canonical(self) -> bool:
         """Columns strictly ascending within every row (sorted, no duplicates)."""
-        steps = np.diff(self.indices)
-        return bool(np.all(steps[np.diff(self.row_index()) == 0] > 0))
+        indices, rows = self.indices, self.row_index()
+        steps = indices[1:] - indices[:-1]
+        return bool((steps[rows[1:] == rows[:-1]] > 0).all())
 
     def selection_columns(self) -> np.ndarray | None:
         """When this matrix selects (every column one stored 1, every row at most one entry):
         the column of each row (-1: none); else None."""
-        if np.any(self.data != 1.0) or np.any(np.diff(self.indptr) > 1) \
-                or np.any(np.bincount(self.indices, minlength=self.shape[1]) != 1):
+        indptr = self.indptr
+        if (self.data != 1.0).any() or (indptr[1:] - indptr[:-1] > 1).any() \
+                or (np.bincount(self.indices, minlength=self.shape[1]) != 1).any():
             return None
         column = np.full(self.shape[0], -1, dtype=np.int64)
         column[self.row_index()] = self.indices

@@ -17,7 +17,7 @@ from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
-           "SparsePattern", "DirectSolver", "plate_shape", "plate_element_arrays",
+           "SparsePattern", "DirectSolver", "dense_solve", "plate_shape", "plate_element_arrays",
            "plate_reference", "plate_forces", "PlateReference", "CubicBeam", "SectionData",
            "section_data", "cable_element_arrays", "cable_shape", "cable_forces",
            "cable_damped_forces"]
@@ -439,6 +439,31 @@ class DirectSolver:
             self.close()
         except Exception:
             pass
+
+
+def dense_solve(n: int, rows: np.ndarray, cols: np.ndarray, values: np.ndarray,
+                rhs: np.ndarray, what: str = "system matrix") -> np.ndarray:
+    """Solution of A x = rhs for the small n x n matrix A of the coordinate triplets
+    (0-based; duplicates add up, as for :class:`DirectSolver`), formed densely and
+    factorized by LAPACK's LU with partial pivoting in the kernel
+    (``fortran/src/linalg/dense_direct.f90``): for a few dozen unknowns microseconds where
+    MUMPS's analysis and factorization take a quarter of a millisecond. rhs: (n,) or (n, k).
+    Raises SolverError naming ``what`` for a singular matrix (an exactly zero pivot) or a
+    solution that is not finite (a pivot so small that the solution overflows)."""
+    b = np.asarray(rhs, dtype=np.float64)
+    x = np.array(b.reshape(n, -1), dtype=np.float64, order="F")  # solved in place
+    if len(rows) == 0:   # (f2py takes no empty arrays) the zero matrix
+        raise SolverError(f"{what}: factorization failed: {_MUMPS_MESSAGES[-10]} (no entries)")
+    x, info = _kernel.dense_solve(_f(np.asarray(rows) + 1, np.int32),
+                                  _f(np.asarray(cols) + 1, np.int32), _f(values), x)
+    if info < 0:
+        raise SolverError(f"{what}: a coordinate index lies outside 0..{n - 1}")
+    if info > 0 or not np.isfinite(x).all():
+        raise SolverError(f"{what}: factorization failed: {_MUMPS_MESSAGES[-10]} (dense LU, "
+                          f"column {info})" if info > 0 else
+                          f"{what}: solve failed: {_MUMPS_MESSAGES[-10]} (dense LU: the "
+                          "solution is not finite)")
+    return x.reshape(b.shape)
 
 
 # -- rigid bodies and leaf contact (seed 003, eqs. 17-32) ---------------------------------

@@ -7,9 +7,12 @@ file, the group and the key (exit status 2 on the command line).
 """
 from __future__ import annotations
 
+import errno
 import io
 import math
+import os
 import re
+import stat
 from collections import Counter, OrderedDict
 from dataclasses import dataclass, field
 from functools import partial
@@ -112,16 +115,20 @@ GENERAL_BUILDER: dict[str, Callable[..., Any]] = {}
 
 
 #: the tokens of the namelists :func:`fast_reads` reads (anything else: f90nml)
+#: (spaces and comments before a token are skipped by the expression itself: one match,
+#: one turn of the reader's loop, per token; a match of them alone, at the end of the
+#: text, has no group)
 _FAST_TOKEN = re.compile(r"""
-    (?P<space>\s+)
-  | (?P<comment>![^\n]*)
-  | (?P<string>'(?:[^'\n]|'')*'|"(?:[^"\n]|"")*")
-  | (?P<group>&[A-Za-z_]\w*)
-  | (?P<end>/)
-  | (?P<key>[A-Za-z_]\w*)[ \t]*=(?!=)
-  | (?P<comma>,)
-  | (?P<word>[^\s'"!/&$=,()*%]+)
-  | (?P<other>.)
+    (?:\s+|![^\n]*)*
+    (?:
+        (?P<string>'(?:[^'\n]|'')*'|"(?:[^"\n]|"")*")
+      | (?P<group>&[A-Za-z_]\w*)
+      | (?P<end>/)
+      | (?P<key>[A-Za-z_]\w*)[ \t]*=(?!=)
+      | (?P<comma>,)
+      | (?P<word>[^\s'"!/&$=,()*%]+)
+      | (?P<other>.)
+    )?
 """, re.VERBOSE | re.DOTALL)
 _FAST_INT = re.compile(r"[+-]?\d+\Z")
 _FAST_FLOAT = re.compile(r"[+-]?(?:\d+\.\d*|\.\d+|\d+(?=[eEdD]))(?:[eEdD][+-]?\d+)?\Z")
@@ -171,9 +178,9 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
         return True
     for match in _FAST_TOKEN.finditer(text):
         kind = match.lastgroup
-        if kind == "space" or kind == "comment":
+        if kind is None:   # spaces and comments at the end of the text
             continue
-        token = match.group()
+        token = match.group(kind)
         if group is None:
             if kind != "group":
                 return None
@@ -377,10 +384,21 @@ def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str) -
     return typed
 
 
+#: the errors of os.stat that Path.exists and Path.is_file take for "no such file"
+_MISSING = (errno.ENOENT, errno.ENOTDIR, errno.EBADF, errno.ELOOP)
+
+
 def _read_text(path: Path, file: str) -> str:
-    if not path.exists():
-        raise InputError("scene file not found", file=file)
-    if not path.is_file():
+    # one stat (as Path.exists then Path.is_file decided: missing, then not regular)
+    try:
+        status = os.stat(path)
+    except OSError as exc:
+        if exc.errno not in _MISSING:
+            raise
+        raise InputError("scene file not found", file=file) from None
+    except ValueError:   # (an embedded null byte: Path.exists says False)
+        raise InputError("scene file not found", file=file) from None
+    if not stat.S_ISREG(status.st_mode):
         raise InputError("the scene is not a regular file", file=file)
     try:
         data = path.read_bytes()

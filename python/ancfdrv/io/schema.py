@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from ..errors import InputError
-from .validate import check_int32, check_magnitude, check_name
+from .validate import INT32_MAX, MAX_MAGNITUDE, check_int32, check_magnitude, check_name
 
 REQUIRED = object()
 #: the longest title accepted: it heads every plot (a 100 kB title took half a minute to
@@ -705,7 +705,19 @@ WHOLE_LIST_CHECKS = (vector3, points3, principal_positive)
 def checked_value(spec: Key, raw: Any, where: dict[str, Any]) -> Any:
     """A key's value typed (:func:`coerce`), of its size and passing its check, else an
     InputError at ``where`` (the namelist's and the Python API's one rule)."""
-    value = coerce(spec.kind, raw, where)
+    kind, plain = spec.kind, type(raw)
+    # a namelist's plain values that coerce would return as they are (a finite float of
+    # an accepted magnitude, a 32-bit int, a bool), or stripped (a string), at once
+    if kind == "float" and plain is float and abs(raw) <= MAX_MAGNITUDE:
+        value = raw
+    elif kind == "int" and plain is int and abs(raw) <= INT32_MAX:
+        value = raw
+    elif kind == "str" and plain is str:
+        value = raw.strip()
+    elif kind == "bool" and plain is bool:
+        value = raw
+    else:
+        value = coerce(kind, raw, where)
     if spec.size is not None and len(value) != spec.size:
         raise InputError(f"expected {spec.size} values, got {len(value)}", **where)
     if spec.check is not None:
@@ -720,10 +732,17 @@ def checked_value(spec: Key, raw: Any, where: dict[str, Any]) -> Any:
 
 # -- the Python API's door: the same types, ranges and messages as the namelist -----------
 
+#: the types plain_value returns unchanged at once (exactly these; subclasses such as numpy
+#: scalars take the general way)
+_PLAIN_TYPES = frozenset((int, float, str, bool, type(None)))
+
+
 def plain_value(value: Any) -> Any:
     """A value as plain Python for checks and messages: numpy scalars become int/float
     (messages print ``2.2``, not ``np.float64(2.2)``), arrays and tuples become lists;
     anything else is returned unchanged (and refused by the type check that follows)."""
+    if type(value) in _PLAIN_TYPES:   # (the namelist's values: returned at once)
+        return value
     import numpy as np
     if isinstance(value, np.generic):
         return value.item()

@@ -25,6 +25,7 @@ XDMF frames' point positions, the file's attributes) is made when the file is sa
 from __future__ import annotations
 
 import contextlib
+import weakref
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any, Callable, Iterator
@@ -47,7 +48,10 @@ class MemoryWriter:
     def __init__(self, output: "MemoryOutput", model, store_q: bool, flush_rows: int = 1, *,
                  xdmf: bool | None = None, total_rows: int = 0, frames: int = 1000,
                  write_q: bool | None = None) -> None:
-        self.output, self.model, self.store_q = output, model, store_q
+        # the output keeps its writer: the writer refers to it weakly (no reference cycle:
+        # a dropped result is freed at once, not left to the garbage collector)
+        self._output = weakref.ref(output)
+        self.model, self.store_q = model, store_q
         self.arguments = (store_q, flush_rows)
         self.options = dict(xdmf=xdmf, total_rows=total_rows, frames=frames, write_q=write_q)
         self.write_q = store_q if write_q is None else bool(write_q and store_q)
@@ -61,6 +65,13 @@ class MemoryWriter:
             self.stride, self.last_row = 1, -1
         self.rows = 0
         self.chunks: list[Any] = []
+
+    @property
+    def output(self) -> "MemoryOutput":
+        output = self._output()
+        if output is None:
+            raise ReferenceError("the output of this writer was released")
+        return output
 
     def __call__(self, chunk) -> None:
         q = getattr(chunk, "q", None)

@@ -45,7 +45,7 @@ from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_IT
 from ..csr import Csr
 from ..errors import Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
-from ..kernel import DirectSolver
+from ..kernel import DirectSolver, dense_solve
 from ..kernel import _text as kernel_text
 from ..system.model import Model
 from .assumptions import FFR_LIMIT, check_ffr, ffr_departure_rows
@@ -200,6 +200,9 @@ def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
     c = np.concatenate([matrix.indices, n + rows, cols])
     v = np.concatenate([matrix.data, -grads, -grads])
     rhs = np.concatenate([rhs_top, rhs_bottom])
+    if n + ncon <= DENSE_SADDLE_MAX:
+        x = dense_solve(n + ncon, r, c, v, rhs, what=what)
+        return x[:n], x[n:]
     if n + ncon > SADDLE_REUSE_MAX:
         with DirectSolver(n + ncon, r, c, what=what) as solver:
             solver.factorize(v)
@@ -237,6 +240,17 @@ def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
 #: cantilever's kept instance raised its peak resident set by 3.6 MB, 1.43x -> 1.50x
 #: Exudyn's: `benchmarks/peer_cantilever.py`).
 SADDLE_REUSE_MAX = 256
+#: saddle systems of at most this many unknowns are formed densely and solved by LAPACK's
+#: LU with partial pivoting in the kernel (:func:`ancfdrv.kernel.dense_solve`; at most
+#: 0.2 MB for the time of the solve at 160): on a warm cache 0.014 ms against MUMPS's
+#: 0.12 ms at 22 unknowns (the 5-node planar pendulum), 0.13 against 0.24 at 134, about
+#: equal at 200. OFF (0) by default: the two solutions agree to round-off (~1e-14 of the
+#: largest entry, `tests/test_dense_saddle.py`), but a start acceleration that differs
+#: in its last bits moves where the Newton iterations of later steps stop, so the
+#: histories move by up to the Newton tolerance (history_gate, 63 runs: 21 differ, by
+#: 1e-9 to 8e-7 of a dataset's largest value; the spin-up's corrections 616 -> 611), not
+#: bitwise nor within 1e-12. Set it to 160 where that is accepted.
+DENSE_SADDLE_MAX = 0
 _SADDLE_SOLVERS: list[DirectSolver] = []
 
 
@@ -455,12 +469,14 @@ class EnergyWatch:
 
     #: the works among ENERGY_NAMES (drives, frames, contact damping, friction, damping)
     WORKS = (5, 6, 8, 9, 10)
+    _WORK_ROWS = list(WORKS)
 
     def add(self, energy: np.ndarray) -> None:
-        # column by column (no copy of the works' columns): the sums in numpy's order of
-        # a row sum over a few columns (left to right), so the figures are bitwise those
-        # of works.sum(axis=1) and energy[:, 1:4].sum(axis=1)
-        columns = energy.T
+        # column by column: the sums in numpy's order of a row sum over a few columns (left
+        # to right), so the figures are bitwise those of works.sum(axis=1) and
+        # energy[:, 1:4].sum(axis=1); the columns copied contiguous once (the chunk's are
+        # strided views of the kernel's rows: each operation on them was a strided loop)
+        columns = np.ascontiguousarray(energy.T)
         works = columns[5] + columns[6] + columns[8] + columns[9] + columns[10]
         balance = columns[4] - self.first[4] - works
         potential = columns[1] + columns[2] + columns[3] - self.first[1:4].sum()
@@ -468,7 +484,7 @@ class EnergyWatch:
         self.scale = max(self.scale, float(np.abs(columns[0]).max()),
                          float(np.abs(potential).max()),
                          float(np.abs(columns[0] + columns[1]).max()),
-                         float(np.array([np.abs(columns[k]).max() for k in self.WORKS]).max()))
+                         float(np.abs(columns[self._WORK_ROWS]).max()))
 
     def created(self) -> float:
         return self.most / self.scale if self.scale > 0 else 0.0

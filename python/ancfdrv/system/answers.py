@@ -44,6 +44,7 @@ Stresses
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from types import SimpleNamespace
 
@@ -110,7 +111,10 @@ class ReactionMap:
     rows and the coordinates of their body2."""
 
     def __init__(self, model: Model) -> None:
-        self.model = model
+        # the model keeps its map (reaction_map): the map refers to it weakly, so the two
+        # make no reference cycle and a run's model is freed as soon as it is dropped (a
+        # cycle left each run's objects to the garbage collector: ~0.15 ms per small run)
+        self._model = weakref.ref(model)
         self.joints = getattr(model, "joint_items", {})
         owner = getattr(model, "equation_owner", {})
         equations = getattr(model, "full_equations", {})
@@ -146,6 +150,15 @@ class ReactionMap:
         self.wanted = any(o is not None for o in self.multiplier_owner + self.linear_owner)
         self.a_coo = self.a.tocoo() if self.factor is not None else None
         self.points = {name: _joint_points(joint) for name, joint in self.joints.items()}
+
+    @property
+    def model(self) -> Model:
+        """The model of these reactions (it holds the map; a map outlives it only when
+        kept apart, and then has no model: ReferenceError)."""
+        model = self._model()
+        if model is None:
+            raise ReferenceError("the model of this reaction map was released")
+        return model
 
     def residual(self, e: np.ndarray, v: np.ndarray, a: np.ndarray | None, t: float,
                  load_factor: float, guesses: np.ndarray | None = None) -> np.ndarray:
@@ -359,15 +372,23 @@ def _joint_points(joint) -> tuple:
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b along the last axis (broadcast), without np.cross's overhead."""
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    """a x b along the last axis (broadcast), without np.cross's overhead (arrays of one
+    shape: the components written into one array, without np.stack's)."""
+    if a.shape != b.shape:
+        return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                         a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                         a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+    out = np.empty(a.shape, dtype=np.result_type(a, b))
+    np.subtract(a[..., 1] * b[..., 2], a[..., 2] * b[..., 1], out=out[..., 0])
+    np.subtract(a[..., 2] * b[..., 0], a[..., 0] * b[..., 2], out=out[..., 1])
+    np.subtract(a[..., 0] * b[..., 1], a[..., 1] * b[..., 0], out=out[..., 2])
+    return out
 
 
 def _vec_rows(expr, q_rows: np.ndarray) -> np.ndarray:
     """A Vec3 expression at rows of coordinates: (nt, 3)."""
-    out = np.tile(expr.const, (len(q_rows), 1))
+    out = np.empty((len(q_rows), 3))
+    out[:] = expr.const   # (np.tile's rows, without its overhead)
     for d, c in expr.terms.items():
         out += c * q_rows[:, d:d + 3]
     return out
@@ -384,18 +405,25 @@ def _reduce_rows(joint, generalized: np.ndarray, slots: np.ndarray, q_rows: np.n
     p2, p1 = points
     point = _vec_rows(p2, q_rows)
     nt = len(q_rows)
-    force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
     if per and len(slots):
         block = generalized.reshape(nt, len(slots), 3)
         index = (body.first + 3 * slots[:, None] + np.arange(3)).ravel()
         values = q_rows[:, index].reshape(nt, len(slots), 3)
         position = slots % (per // 3) == 0          # a node's first vector: its position
-        force = block[:, position].sum(axis=1)
-        moment = _cross(values[:, position] - point[:, None, :], block[:, position]).sum(axis=1)
+        if position.all() and block.flags.c_contiguous:
+            # every slot a position (a joint at a node): the arrays themselves, as the
+            # copies of every slot hold them (the same layout: the same sums)
+            on_block, on_values = block, values
+        else:
+            on_block, on_values = block[:, position], values[:, position]
+        force = on_block.sum(axis=1)
+        moment = _cross(on_values - point[:, None, :], on_block).sum(axis=1)
         if position.all():   # no other vector: the sum over none, +0.0 each
             moment += 0.0
         else:
             moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
+    else:
+        force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
     swapped = getattr(joint, "swapped", False)
     if swapped:
         force, moment = -force, -moment
@@ -994,7 +1022,8 @@ class DynamicAnswers:
         self.need_acceleration = self.map.factor is not None
         self.initial = initial
         self.state: tuple | None = None
-        self.time: list[float] = []
+        #: the times of the blocks recorded (arrays; :attr:`time` joins them)
+        self._time_blocks: list[np.ndarray] = []
         #: per joint, per chunk: (force (nt, 3), moment (nt, 3), axial (nt,) or None)
         self.reactions: dict[str, list[tuple]] = {name: [] for name in self.map.joints}
         #: force elements: their reactions need e' at every row (rebuilt as e'' is)
@@ -1005,6 +1034,11 @@ class DynamicAnswers:
         self.sections: dict[str, list[SectionForces]] = {}
         self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+
+    @property
+    def time(self) -> list[float]:
+        """The times (s) of the rows recorded, in order."""
+        return [t for block in self._time_blocks for t in block.tolist()]
 
     def _kinematics(self, t: float, e: np.ndarray):
         """(e', e'') at the row, rebuilt from the previous row."""
@@ -1065,7 +1099,7 @@ class DynamicAnswers:
                     and len(chunk.time) < self._block_rows():
                 self._waiting = chunk   # the initial row and a short chunk: new arrays
                 return
-        elif (1 < rows or (rows == 1 and not self.time)) and rows <= self.WAIT_ROWS \
+        elif (1 < rows or (rows == 1 and not self._time_blocks)) and rows <= self.WAIT_ROWS \
                 and rows < self._block_rows():
             self._waiting = SimpleNamespace(   # copies: the chunk's arrays may be reused
                 time=np.array(chunk.time), q=np.array(chunk.q), lam=np.array(chunk.lam),
@@ -1131,7 +1165,7 @@ class DynamicAnswers:
                                            residual)
             for name, (force, moment, _, axial) in found.items():
                 self.reactions[name].append((force, moment, axial))
-        self.time.extend(times.tolist())
+        self._time_blocks.append(np.array(times))   # (a list of floats made on request)
         if not self.beams:
             return
         # blocks of rows whose temporaries stay in the cache (the stations' forces of

@@ -110,7 +110,8 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     mode = linear_joints if linear_joints != "auto" else ("eliminate" if has_rigid else
                                                           "multipliers")
     plane, planar_eqs = _planar(system, act, q0, notes)
-    equations = _equations(system, bodies, q0, notes, warnings)
+    owners: dict[str, str] = {}
+    equations = _equations(system, bodies, q0, notes, warnings, owners)
     linear = [eq for eq in equations if isinstance(eq, LinearEquation)]
     reduction = None
     if planar_eqs:  # the planar fixes are eliminated whatever the joints' mode (planar.py)
@@ -159,7 +160,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     model.vector_loads = vector_loads
     model.force_elements = force_elements
     model.frame_problems = frame_problems
-    _answer_inputs(model, system, equations, elimination, reduction, mass_full,
+    _answer_inputs(model, system, owners, equations, elimination, reduction, mass_full,
                    constant + gravity, driven)
     if planar_eqs:  # the rows eliminated are the planar fixes (+ the linear joints)
         kept = planar_eqs + (linear if mode == "eliminate" else [])
@@ -171,17 +172,14 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     return model
 
 
-def _answer_inputs(model: Model, system, equations: list, elimination: Elimination,
-                   reduction, mass_full: Csr, constant_full: np.ndarray,
-                   driven_full: list) -> None:
+def _answer_inputs(model: Model, system, owners: dict[str, str], equations: list,
+                   elimination: Elimination, reduction, mass_full: Csr,
+                   constant_full: np.ndarray, driven_full: list) -> None:
     """What the joint reactions need besides the solution (``ancfdrv.system.answers``):
-    the joints and the owner of every joint equation (by its name), the equations in the
-    full coordinates q, the eliminated linear equations kept (not redundant), and the mass
-    and loads in the full coordinates (the residual of the eliminated rows is formed there)."""
-    owners = {}
-    for joint in system.joints.values():
-        for eq in joint.equations(model.q0):
-            owners[eq.name] = joint.name
+    the joints and the owner of every joint equation (by its name: ``owners``, from
+    :func:`_equations`), the equations in the full coordinates q, the eliminated linear
+    equations kept (not redundant), and the mass and loads in the full coordinates (the
+    residual of the eliminated rows is formed there)."""
     model.joint_items = dict(system.joints)
     model.equation_owner = owners
     model.full_equations = {eq.name: eq for eq in equations}
@@ -619,12 +617,17 @@ def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
 
 
 # -- joints ----------------------------------------------------------------------------------
-def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[str]) -> list:
+def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[str],
+               owners: dict[str, str]) -> list:
     """Every joint's equations in the order of the joints, then each rigid body's planar
-    guide and orthonormality, except for linearized bodies (:func:`_linearized`: noted)."""
+    guide and orthonormality, except for linearized bodies (:func:`_linearized`: noted).
+    ``owners`` gets the joint of each joint equation (by its name; the answers' map)."""
     out = []
     for joint in system.joints.values():
-        out += joint.equations(q0)
+        joint_equations = joint.equations(q0)
+        for eq in joint_equations:
+            owners[eq.name] = joint.name
+        out += joint_equations
     linearized = _linearized(system, warnings)
     for body in bodies:
         if isinstance(body, RigidBody):

@@ -24,7 +24,7 @@ import numpy as np
 
 from .. import kernel
 from ..errors import InputError
-from .bodies import Attachment, Beam, Body, Material, _vec
+from .bodies import Attachment, Beam, Body, Material, _vec, linspace
 from .element_kinds import SetContext, register_body, register_set
 from .expressions import Vec3
 from .model import SetInfo
@@ -89,9 +89,9 @@ class Cable(Body):
         self._bending_stiffness = None if bending_stiffness is None else float(bending_stiffness)
         self.tangent = axis / self.length
         # segments: lengths between fixed nodes, each split equally (as a beam's)
-        self.stations = np.linspace(0.0, self.length, self.nodes) if segments is None else \
+        self.stations = linspace(0.0, self.length, self.nodes) if segments is None else \
             Beam._stations(self, segments, where)
-        self.lengths = np.diff(self.stations)
+        self.lengths = self.stations[1:] - self.stations[:-1]   # (np.diff's values)
 
     # -- geometry ---------------------------------------------------------------------------
     @property

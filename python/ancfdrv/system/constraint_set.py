@@ -48,8 +48,12 @@ class ConstraintSet:
         self.names.append(name)
 
     def select(self, keep: list[int]) -> "ConstraintSet":
-        """The constraints at the indices ``keep`` (same drives)."""
+        """The constraints at the indices ``keep`` (same drives). Keeping all of them in
+        order, the kernel arguments made for this set go with the copy (checked against its
+        lists at every use as any set's: :meth:`_kernel_inputs`)."""
         out = ConstraintSet(drive_kinds=self.drive_kinds, drive_params=self.drive_params)
+        if list(keep) == list(range(len(self))) and "_inputs" in self.__dict__:
+            out.__dict__["_inputs"] = self.__dict__["_inputs"]
         for c in keep:
             out.kinds.append(self.kinds[c])
             out.drives.append(self.drives[c])

@@ -47,7 +47,7 @@ class Pattern:
         """The row of every entry (see :data:`KEEP_ENTRIES`)."""
         rows = self._rows
         if rows is None:
-            rows = np.repeat(np.arange(self.n), np.diff(self.row_ptr))
+            rows = np.repeat(np.arange(self.n), self.row_ptr[1:] - self.row_ptr[:-1])
             if self.nnz <= self.KEEP_ENTRIES:
                 self._rows = rows
         return rows
@@ -70,7 +70,7 @@ class Pattern:
             b = np.asarray(block)
             if b.ndim == 1:
                 b = b[:, None]
-            b = b[:, np.all(b >= 0, axis=0)] if b.size else b
+            b = b[:, (b >= 0).all(axis=0)] if b.size else b
             k = b.shape[0]
             rows.append(np.repeat(b, k, axis=0).T.ravel())
             cols.append(np.tile(b, (k, 1)).T.ravel())
