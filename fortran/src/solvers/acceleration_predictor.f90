@@ -5,20 +5,24 @@
 !> predict_history, predictor).
 module acceleration_predictor
   use ancf_kinds, only: dp
-  use stepper, only: stepper_state
+  use stepper, only: stepper_state, recurrence_order, recurrence_window, recurrence_span
   implicit none
   private
   public :: extrapolate, usable_predictor, learn_predictor
   public :: predict_hold, predict_alternate, predict_linear, predict_quadratic, &
-            predict_alternate_linear, predict_fitted
+            predict_alternate_linear, predict_fitted, predict_recurrence
 
   !> the predictor's extrapolations of e''_{n+1} (learn_predictor): e''_n; e''_{n-1}; linear
   !> 2 e''_n - e''_{n-1}; quadratic 3 e''_n - 3 e''_{n-1} + e''_{n-2}; linear with the
   !> period-2 alternation e''_n + e''_{n-1} - e''_{n-2}; the fitted recurrence
-  !> e''_n + alpha d_n + beta d_{n-1} (fit_recurrence)
+  !> e''_n + alpha d_n + beta d_{n-1} (fit_recurrence); the recurrence of order
+  !> recurrence_order e''_n + sum_j c_j d_{n+1-j} (fit_modes: several modes at once)
   integer, parameter :: predict_hold = 0, predict_alternate = 1, predict_linear = 2, &
                         predict_quadratic = 3, predict_alternate_linear = 4, &
-                        predict_fitted = 5
+                        predict_fitted = 5, predict_recurrence = 6
+  !> fit_modes' regularization, relative to the scaled normal equations' unit diagonal (a
+  !> history with fewer modes than recurrence_order leaves them singular)
+  real(dp), parameter :: modes_ridge = 1e-12_dp
 
 contains
 
@@ -32,6 +36,10 @@ contains
     real(dp) :: alpha, beta
     if (kind == predict_hold) then   ! (no history needed: none may be learned yet)
       accel_new = accel
+      return
+    end if
+    if (kind == predict_recurrence) then
+      call recurrence_extrapolation(accel, learned, accel_new)
       return
     end if
     alpha = 0.0_dp
@@ -119,6 +127,12 @@ contains
       needed = 2
     case (predict_fitted)
       needed = 3
+    case (predict_recurrence)
+      needed = recurrence_span
+      if (.not. learned%recurrence_ready) then
+        usable = predict_hold
+        return
+      end if
     case default
       usable = predict_hold
       return
@@ -138,8 +152,9 @@ contains
   pure subroutine learn_predictor(learned, h, accel, accel_new)
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: h, accel(:), accel_new(:)
-    real(dp) :: misses(0:predict_fitted), alpha, beta, now, before, before2
-    logical :: usable(0:predict_fitted)
+    real(dp) :: misses(0:predict_recurrence), alpha, beta, now, before, before2
+    real(dp) :: modes_guess(size(accel))
+    logical :: usable(0:predict_recurrence)
     integer :: kind, i
     if (.not. allocated(learned%accel_before)) then
       allocate (learned%accel_before(size(accel)), learned%accel_before2(size(accel)), &
@@ -151,7 +166,7 @@ contains
     else
       ! the candidates as this step would have used them (its own size h), their misses in
       ! one pass over the coordinates
-      do kind = 0, predict_fitted
+      do kind = 0, predict_recurrence
         usable(kind) = usable_predictor(learned, h, kind) == kind
       end do
       alpha = 0.0_dp
@@ -169,8 +184,12 @@ contains
                                                extrapolated(kind, now, before, before2, alpha, beta)))
         end do
       end do
+      if (usable(predict_recurrence)) then
+        call recurrence_extrapolation(accel, learned, modes_guess)
+        misses(predict_recurrence) = maxval(abs(accel_new - modes_guess))
+      end if
       learned%predictor = predict_hold
-      do kind = predict_alternate, predict_fitted
+      do kind = predict_alternate, predict_recurrence
         if (usable(kind) .and. misses(kind) < misses(learned%predictor)) &
           learned%predictor = kind
       end do
@@ -178,12 +197,122 @@ contains
       learned%accel_before2 = learned%accel_before
     end if
     if (learned%predict_step == h) then
-      learned%predict_history = min(learned%predict_history + 1, 3)
+      learned%predict_history = min(learned%predict_history + 1, recurrence_span)
     else
       learned%predict_step = h
       learned%predict_history = 1
     end if
     learned%accel_before = accel
+    call learn_modes(learned, accel, accel_new)
   end subroutine learn_predictor
+
+  !> The ring column of the difference lag steps before the newest (lag 0: d_{n+1} after
+  !> learn_modes, the last step's).
+  pure integer function ring_column(learned, lag)
+    type(stepper_state), intent(in) :: learned
+    integer, intent(in) :: lag
+    ring_column = modulo(learned%recurrence_newest - 1 - lag, recurrence_span) + 1
+  end function ring_column
+
+  !> e''_{n+1} = e''_n + sum_j c_j d_{n+1-j} (j = 1 .. recurrence_order, d_n the newest
+  !> difference in the ring; c: the fitted coefficients): the recurrence predictor, as
+  !> extrapolate uses it and learn_predictor judges it.
+  pure subroutine recurrence_extrapolation(accel, learned, accel_new)
+    real(dp), intent(in) :: accel(:)
+    type(stepper_state), intent(in) :: learned
+    real(dp), intent(out) :: accel_new(:)
+    integer :: j, column
+    accel_new = accel
+    do j = 1, recurrence_order
+      column = ring_column(learned, j - 1)
+      accel_new = accel_new + learned%recurrence_coefficients(j) &
+                              * learned%recurrence_differences(:, column)
+    end do
+  end subroutine recurrence_extrapolation
+
+  !> After a step from e''_n = accel to e''_{n+1} = accel_new: d_{n+1} enters the ring
+  !> (with its dot products with the differences before it), and once recurrence_span
+  !> differences of equal steps are known the coefficients of the next step's recurrence
+  !> are fitted (fit_modes).
+  pure subroutine learn_modes(learned, accel, accel_new)
+    type(stepper_state), intent(inout) :: learned
+    real(dp), intent(in) :: accel(:), accel_new(:)
+    integer :: column, other
+    if (.not. allocated(learned%recurrence_differences)) then
+      allocate (learned%recurrence_differences(size(accel), recurrence_span))
+      learned%recurrence_differences = 0.0_dp
+      learned%recurrence_dots = 0.0_dp
+      learned%recurrence_newest = 0
+    end if
+    learned%recurrence_newest = modulo(learned%recurrence_newest, recurrence_span) + 1
+    column = learned%recurrence_newest
+    learned%recurrence_differences(:, column) = accel_new - accel
+    do other = 1, recurrence_span
+      learned%recurrence_dots(column, other) = &
+        dot_product(learned%recurrence_differences(:, column), &
+                    learned%recurrence_differences(:, other))
+      learned%recurrence_dots(other, column) = learned%recurrence_dots(column, other)
+    end do
+    learned%recurrence_ready = .false.
+    if (learned%predict_history >= recurrence_span) call fit_modes(learned)
+  end subroutine learn_modes
+
+  !> The coefficients c of d_m = sum_j c_j d_{m-j} (j = 1 .. recurrence_order), the least
+  !> squares fit over all coordinates of the recurrence_window newest differences d_m: the
+  !> recurrence that a few lightly damped modes of the last steps follow (a sum of k
+  !> sinusoids or exponentials satisfies one of order 2k). The normal equations from the
+  !> ring's dot products, scaled to a unit diagonal and regularized by modes_ridge, by
+  !> Cholesky; recurrence_ready stays .false. where a difference vanishes or a pivot is
+  !> not positive.
+  pure subroutine fit_modes(learned)
+    type(stepper_state), intent(inout) :: learned
+    real(dp) :: normal(recurrence_order, recurrence_order), rhs(recurrence_order)
+    real(dp) :: scale(recurrence_order), pivot
+    integer :: i, j, k
+    do j = 1, recurrence_order
+      rhs(j) = 0.0_dp
+      do i = 0, recurrence_window - 1
+        rhs(j) = rhs(j) + learned%recurrence_dots(ring_column(learned, i), &
+                                                  ring_column(learned, i + j))
+      end do
+      do k = 1, recurrence_order
+        normal(j, k) = 0.0_dp
+        do i = 0, recurrence_window - 1
+          normal(j, k) = normal(j, k) + learned%recurrence_dots(ring_column(learned, i + j), &
+                                                                ring_column(learned, i + k))
+        end do
+      end do
+    end do
+    do j = 1, recurrence_order
+      if (.not. normal(j, j) > 0.0_dp) return
+      scale(j) = sqrt(normal(j, j))
+    end do
+    do k = 1, recurrence_order
+      do j = 1, recurrence_order
+        normal(j, k) = normal(j, k) / (scale(j) * scale(k))
+      end do
+      normal(k, k) = normal(k, k) + modes_ridge
+      rhs(k) = rhs(k) / scale(k)
+    end do
+    ! Cholesky normal = L L^T in the lower triangle, then the two triangular solves
+    do k = 1, recurrence_order
+      pivot = normal(k, k) - sum(normal(k, 1:k - 1)**2)
+      if (.not. pivot > 0.0_dp) return
+      normal(k, k) = sqrt(pivot)
+      do i = k + 1, recurrence_order
+        normal(i, k) = (normal(i, k) - sum(normal(i, 1:k - 1) * normal(k, 1:k - 1))) &
+                       / normal(k, k)
+      end do
+    end do
+    do k = 1, recurrence_order
+      rhs(k) = (rhs(k) - sum(normal(k, 1:k - 1) * rhs(1:k - 1))) / normal(k, k)
+    end do
+    do k = recurrence_order, 1, -1
+      rhs(k) = (rhs(k) - sum(normal(k + 1:recurrence_order, k) * rhs(k + 1:recurrence_order))) &
+               / normal(k, k)
+    end do
+    learned%recurrence_coefficients = rhs / scale
+    learned%recurrence_ready = all(abs(learned%recurrence_coefficients) < huge(1.0_dp))
+  end subroutine fit_modes
 
 end module acceleration_predictor

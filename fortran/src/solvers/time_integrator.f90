@@ -356,6 +356,8 @@ contains
     if (info == 0 .or. (info == 3 .and. sys%factorized)) then
       learned%theta = -1.0_dp
       learned%unconfirmed = 0
+      learned%matrix_theta = -1.0_dp
+      learned%matrix_unconfirmed = 0
     end if
     learned%carry_on = .false.
     if (info == 0 .and. carry_enabled(sys)) then
@@ -418,6 +420,7 @@ contains
     integer, intent(out) :: info, detail
     real(dp) :: strain, previous_correction, step_cap, step_theta
     integer :: it, lapack_info, active, i
+    integer :: refreshed_at  ! the correction after which the matrix was last refreshed
     logical :: use_known, refresh, capped, halt, finite
     real(dp) :: largest_correction, largest_coordinate, step_part
     logical :: carry_ready  ! the carried Schur complement is built for this step
@@ -431,6 +434,7 @@ contains
     carry_ready = .false.
     previous_correction = huge(1.0_dp)
     step_theta = 0.0_dp
+    refreshed_at = 0
     active = sys%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
@@ -447,6 +451,7 @@ contains
           sys%npoint > 0 .and. active /= sys%factor_active .and. it < cfg%max_newton) then
         call refresh_matrix()
         if (info /= 0) return
+        refreshed_at = it - 1
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
                       phi, gradients, strain, active, work, info, predicted_internal)
         if (info /= 0) return
@@ -525,7 +530,8 @@ contains
         return
       end if
       last_correction = largest_correction
-      if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta)) then
+      if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta, &
+                    it - 1 > refreshed_at)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -572,6 +578,7 @@ contains
         call refresh_matrix()
         if (info /= 0) return
         use_known = .true.
+        refreshed_at = it
       end if
       previous_correction = last_correction
     end do
@@ -791,21 +798,41 @@ contains
   !> with the contraction theta = last / previous from the second correction on. With the
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
-  !> it every confirm_every accepted steps; reuse measures it in every step (the matrix ages).
-  logical function converged(sys, cfg, learned, it, last, previous, step_theta) result(ok)
+  !> it every confirm_every accepted steps.
+  !> jacobian_reuse measures the contraction in every step that reaches its third correction
+  !> (the first ratio, from the predictor's error, mostly measures its linear part): from the
+  !> third correction on with the step's largest ratio. The second correction is accepted on
+  !> the matrix's contraction bound learned from earlier steps (learned%matrix_theta: the
+  !> largest ratio from a third correction on, measured with the current factorization
+  !> (same_matrix: both corrections of the ratio made with it), each older measurement
+  !> forgotten by matrix_forget per new one) when
+  !>   theta2 / (1 - theta2) last <= tol L,  theta2 = max(last / previous, min(0.5, 2 matrix_theta)),
+  !> i.e. at twice the bound, and never below the step's own first ratio (a step whose
+  !> corrections fall more slowly than the bound says is not accepted on it). Never with
+  !> contact points (their corrections fall irregularly), never without a bound (a new
+  !> factorization forgets it: a refresh, a changed contact set or step, a retry), and
+  !> not after confirm_every steps in a row accepted on the bound: that step goes on to its
+  !> third correction and measures the contraction again (a drive, a large rotation or a
+  !> stiffening of the step shows there). The caller checks the constraints to the
+  !> tolerance whenever a step is accepted on an estimate (newton), and the stagnation and
+  !> divergence tests (stagnated) run on every correction not accepted.
+  logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix) &
+    result(ok)
     type(system_model), intent(in) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
     integer, intent(in) :: it
     real(dp), intent(in) :: last, previous
     real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
+    logical, intent(in) :: same_matrix     ! last and previous came from the same matrix
     integer, parameter :: confirm_every = 20
+    real(dp), parameter :: matrix_forget = 0.9_dp
     real(dp) :: limit, theta
     limit = cfg%tol * cfg%length_scale
     ok = last <= limit
     if (sys%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
     if (it == 1) then
-      ! (reuse: the matrix ages, its contraction with it: measured in every step)
+      ! (reuse: the first correction is never accepted on an estimate)
       if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every .or. &
           sys%policy /= policy_constant) then
         if (ok) learned%unconfirmed = learned%unconfirmed + 1
@@ -822,10 +849,22 @@ contains
     ! the largest contraction of the step: a contact point that moves, sticks or slips
     ! makes the corrections fall irregularly, and a small ratio after a large one is no
     ! evidence that the next would be as small
-    ! (and the first ratio, from the predictor's error, mostly measures the linear part)
     if (it == 2 .and. sys%policy /= policy_constant) then
       step_theta = theta
+      if (ok .or. sys%npoint > 0 .or. learned%matrix_theta < 0.0_dp .or. &
+          learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
+      theta = max(theta, min(0.5_dp, 2.0_dp * learned%matrix_theta))
+      ok = theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit
+      if (ok) learned%matrix_unconfirmed = learned%matrix_unconfirmed + 1
       return
+    end if
+    if (sys%policy /= policy_constant .and. same_matrix) then
+      if (learned%matrix_theta < 0.0_dp) then
+        learned%matrix_theta = theta
+      else
+        learned%matrix_theta = max(theta, matrix_forget * learned%matrix_theta)
+      end if
+      learned%matrix_unconfirmed = 0
     end if
     step_theta = max(step_theta, theta)
     ok = ok .or. (step_theta < 1.0_dp .and. step_theta / (1.0_dp - step_theta) * last <= limit)
