@@ -26,6 +26,8 @@ module stepper
   !> to (each over all coordinates); it needs recurrence_span differences of equal steps
   integer, parameter, public :: recurrence_order = 6, recurrence_window = 3, &
                                 recurrence_span = recurrence_order + recurrence_window
+  !> the steps whose measured contraction jacobian_reuse's bound remembers (their largest)
+  integer, parameter, public :: contraction_memory = 16
 
   !> The settings of a run: the method's parameters (Newmark: alpha_m = alpha_f = 0), the
   !> Newton tolerance (max |de| <= tol * length_scale), the iteration limit, the Jacobian
@@ -66,11 +68,13 @@ module stepper
     real(dp) :: recurrence_coefficients(recurrence_order) = 0.0_dp
     integer :: recurrence_newest = 0
     logical :: recurrence_ready = .false.
-    ! jacobian_reuse's contraction bound: the largest ratio of successive corrections
-    ! measured from a step's third correction on with the current factorization (-1: none
-    ! yet; converged() in time_integrator), the steps since one was measured and since
-    ! the bound was last met by a confirming correction
-    real(dp) :: matrix_theta = -1.0_dp
+    ! jacobian_reuse's contraction bound (converged() in time_integrator): the largest
+    ! ratio of successive corrections measured from a step's third correction on, in each
+    ! of the last contraction_memory steps that measured one with the current
+    ! factorization (a ring; matrix_measured: how many, 0 after a factorization), and the
+    ! steps accepted on the bound since the last measurement
+    real(dp) :: matrix_ratios(contraction_memory) = 0.0_dp
+    integer :: matrix_measured = 0
     integer :: matrix_unconfirmed = 0
     ! the matrix carried with the system's rotation (carried_rotation): the carried vectors
     ! at the factorization and at the current step (3, nvec), the turn from them to the current step's predicted

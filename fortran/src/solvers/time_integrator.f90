@@ -64,7 +64,7 @@ module time_integrator
                                frame_gradients, energies, probe_output, policy_constant, &
                                power_count, energy_count, contact_record, contact_step_limit
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
-                     jacobian_reuse, update_reuse_backoff
+                     jacobian_reuse, update_reuse_backoff, contraction_memory
   use kernel_errors, only: failure_text, message_length
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
@@ -356,7 +356,7 @@ contains
     if (info == 0 .or. (info == 3 .and. sys%factorized)) then
       learned%theta = -1.0_dp
       learned%unconfirmed = 0
-      learned%matrix_theta = -1.0_dp
+      learned%matrix_measured = 0
       learned%matrix_unconfirmed = 0
     end if
     learned%carry_on = .false.
@@ -421,6 +421,7 @@ contains
     real(dp) :: strain, previous_correction, step_cap, step_theta
     integer :: it, lapack_info, active, i
     integer :: refreshed_at  ! the correction after which the matrix was last refreshed
+    logical :: measured      ! the step's contraction entered the learned bound (converged)
     logical :: use_known, refresh, capped, halt, finite
     real(dp) :: largest_correction, largest_coordinate, step_part
     logical :: carry_ready  ! the carried Schur complement is built for this step
@@ -435,6 +436,7 @@ contains
     previous_correction = huge(1.0_dp)
     step_theta = 0.0_dp
     refreshed_at = 0
+    measured = .false.
     active = sys%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
@@ -531,7 +533,7 @@ contains
       end if
       last_correction = largest_correction
       if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta, &
-                    it - 1 > refreshed_at)) then
+                    it - 1 > refreshed_at, measured)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -799,25 +801,29 @@ contains
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
   !> it every confirm_every accepted steps.
-  !> jacobian_reuse measures the contraction in every step that reaches its third correction
-  !> (the first ratio, from the predictor's error, mostly measures its linear part): from the
-  !> third correction on with the step's largest ratio. The second correction is accepted on
-  !> the matrix's contraction bound learned from earlier steps (learned%matrix_theta: the
-  !> largest ratio from a third correction on, measured with the current factorization
-  !> (same_matrix: both corrections of the ratio made with it), each older measurement
-  !> forgotten by matrix_forget per new one) when
-  !>   theta2 / (1 - theta2) last <= tol L,  theta2 = max(last / previous, min(0.5, 2 matrix_theta)),
-  !> i.e. at twice the bound, and never below the step's own first ratio (a step whose
-  !> corrections fall more slowly than the bound says is not accepted on it). Never with
-  !> contact points (their corrections fall irregularly), never without a bound (a new
-  !> factorization forgets it: a refresh, a changed contact set or step, a retry), and
-  !> not after confirm_every steps in a row accepted on the bound: that step goes on to its
-  !> third correction and measures the contraction again (a drive, a large rotation or a
-  !> stiffening of the step shows there). The caller checks the constraints to the
-  !> tolerance whenever a step is accepted on an estimate (newton), and the stagnation and
-  !> divergence tests (stagnated) run on every correction not accepted.
-  logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix) &
-    result(ok)
+  !> jacobian_reuse measures the contraction in every step that reaches its third
+  !> correction and accepts from there on the step's largest ratio (the first ratio, from
+  !> the predictor's error, mostly measures its linear part). At the second correction it
+  !> accepts on the contraction bound learned from earlier steps: matrix_theta, the largest
+  !> of the ratios measured from a third correction on (both corrections of a ratio made
+  !> with the current factorization: same_matrix) in the last contraction_memory steps that
+  !> measured one since the factorization, when
+  !>   theta / (1 - theta) last <= tol L,  theta = max(last / previous, min(0.5, 2 matrix_theta)):
+  !> twice the bound, never below the step's own first ratio; and only while the contraction
+  !> is steady: at least steady_count measurements, the largest within steady_spread times
+  !> the smallest (the 5-node cable pendulum: spreads 1.2-8, median 2, and no ratio above
+  !> 1.7 times the bound before it; the driven luffing boom's ratios jump from 1e-3 to 0.3
+  !> from step to step, spreads 4-750, median 33: never accepted there). Not with contact points (their
+  !> corrections fall irregularly), not without a measured bound (a new factorization
+  !> forgets it: a refresh, a changed contact set or step, a retry), not when the matrix
+  !> was refreshed within the step, and not after confirm_every steps in a row accepted on
+  !> the bound: that step goes on to its third correction and measures the contraction
+  !> again (a drive, a large rotation or a stiffening shows there). The caller checks the
+  !> constraints to the tolerance whenever a step is accepted on an estimate (newton), and
+  !> the stagnation and divergence tests (stagnated) run on every correction not accepted.
+  !> measured: this step has its entry in the bound's ring (its largest ratio).
+  logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix, &
+                             measured) result(ok)
     type(system_model), intent(in) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -825,9 +831,14 @@ contains
     real(dp), intent(in) :: last, previous
     real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
     logical, intent(in) :: same_matrix     ! last and previous came from the same matrix
+    logical, intent(inout) :: measured
     integer, parameter :: confirm_every = 20
-    real(dp), parameter :: matrix_forget = 0.9_dp
-    real(dp) :: limit, theta
+    ! a steady contraction: at least steady_count measurements, the largest within
+    ! steady_spread times the smallest
+    integer, parameter :: steady_count = 8
+    real(dp), parameter :: steady_spread = 4.0_dp
+    real(dp) :: limit, theta, bound
+    integer :: slot
     limit = cfg%tol * cfg%length_scale
     ok = last <= limit
     if (sys%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
@@ -851,18 +862,26 @@ contains
     ! evidence that the next would be as small
     if (it == 2 .and. sys%policy /= policy_constant) then
       step_theta = theta
-      if (ok .or. sys%npoint > 0 .or. learned%matrix_theta < 0.0_dp .or. &
+      if (ok .or. sys%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
           learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
-      theta = max(theta, min(0.5_dp, 2.0_dp * learned%matrix_theta))
+      slot = min(learned%matrix_measured, contraction_memory)
+      bound = maxval(learned%matrix_ratios(1:slot))
+      if (.not. bound <= steady_spread * minval(learned%matrix_ratios(1:slot))) return
+      theta = max(theta, min(0.5_dp, 2.0_dp * bound))
       ok = theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit
       if (ok) learned%matrix_unconfirmed = learned%matrix_unconfirmed + 1
       return
     end if
     if (sys%policy /= policy_constant .and. same_matrix) then
-      if (learned%matrix_theta < 0.0_dp) then
-        learned%matrix_theta = theta
+      ! the step's entry in the ring: its largest ratio from the third correction on
+      if (.not. measured) then
+        learned%matrix_measured = learned%matrix_measured + 1
+        slot = modulo(learned%matrix_measured - 1, contraction_memory) + 1
+        learned%matrix_ratios(slot) = theta
+        measured = .true.
       else
-        learned%matrix_theta = max(theta, matrix_forget * learned%matrix_theta)
+        slot = modulo(learned%matrix_measured - 1, contraction_memory) + 1
+        learned%matrix_ratios(slot) = max(learned%matrix_ratios(slot), theta)
       end if
       learned%matrix_unconfirmed = 0
     end if
