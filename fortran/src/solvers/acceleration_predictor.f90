@@ -38,8 +38,8 @@ contains
       accel_new = accel
       return
     end if
-    if (kind == predict_recurrence) then
-      call recurrence_extrapolation(accel, learned, accel_new)
+    if (kind == predict_recurrence) then   ! (the difference predicted with the fit)
+      accel_new = accel + learned%recurrence_guess
       return
     end if
     alpha = 0.0_dp
@@ -153,7 +153,6 @@ contains
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: h, accel(:), accel_new(:)
     real(dp) :: misses(0:predict_recurrence), alpha, beta, now, before, before2
-    real(dp) :: modes_guess(size(accel))
     logical :: usable(0:predict_recurrence)
     integer :: kind, i
     if (.not. allocated(learned%accel_before)) then
@@ -184,10 +183,8 @@ contains
                                                extrapolated(kind, now, before, before2, alpha, beta)))
         end do
       end do
-      if (usable(predict_recurrence)) then
-        call recurrence_extrapolation(accel, learned, modes_guess)
-        misses(predict_recurrence) = maxval(abs(accel_new - modes_guess))
-      end if
+      if (usable(predict_recurrence)) &
+        misses(predict_recurrence) = maxval(abs(accel_new - (accel + learned%recurrence_guess)))
       learned%predictor = predict_hold
       do kind = predict_alternate, predict_recurrence
         if (usable(kind) .and. misses(kind) < misses(learned%predictor)) &
@@ -206,40 +203,28 @@ contains
     call learn_modes(learned, accel, accel_new)
   end subroutine learn_predictor
 
-  !> The ring column of the difference lag steps before the newest (lag 0: d_{n+1} after
-  !> learn_modes, the last step's).
-  pure integer function ring_column(learned, lag)
+  !> The ring columns of the differences by lag (lag 0: the newest, d_{n+1} after
+  !> learn_modes has taken the last step's).
+  pure function ring_columns(learned) result(columns)
     type(stepper_state), intent(in) :: learned
-    integer, intent(in) :: lag
-    ring_column = modulo(learned%recurrence_newest - 1 - lag, recurrence_span) + 1
-  end function ring_column
-
-  !> e''_{n+1} = e''_n + sum_j c_j d_{n+1-j} (j = 1 .. recurrence_order, d_n the newest
-  !> difference in the ring; c: the fitted coefficients): the recurrence predictor, as
-  !> extrapolate uses it and learn_predictor judges it.
-  pure subroutine recurrence_extrapolation(accel, learned, accel_new)
-    real(dp), intent(in) :: accel(:)
-    type(stepper_state), intent(in) :: learned
-    real(dp), intent(out) :: accel_new(:)
-    integer :: j, column
-    accel_new = accel
-    do j = 1, recurrence_order
-      column = ring_column(learned, j - 1)
-      accel_new = accel_new + learned%recurrence_coefficients(j) &
-                              * learned%recurrence_differences(:, column)
+    integer :: columns(0:recurrence_span - 1), lag
+    do lag = 0, recurrence_span - 1
+      columns(lag) = modulo(learned%recurrence_newest - 1 - lag, recurrence_span) + 1
     end do
-  end subroutine recurrence_extrapolation
+  end function ring_columns
 
   !> After a step from e''_n = accel to e''_{n+1} = accel_new: d_{n+1} enters the ring
-  !> (with its dot products with the differences before it), and once recurrence_span
-  !> differences of equal steps are known the coefficients of the next step's recurrence
-  !> are fitted (fit_modes).
+  !> (with its dot products with the differences before it); once recurrence_span
+  !> differences of equal steps are known the coefficients c of the recurrence are fitted
+  !> (fit_modes) and the next step's difference predicted by it (recurrence_guess):
+  !>   e''_{n+2} - e''_{n+1} = sum_j c_j d_{n+2-j}   (j = 1 .. recurrence_order).
   pure subroutine learn_modes(learned, accel, accel_new)
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: accel(:), accel_new(:)
-    integer :: column, other
+    integer :: column, other, j, columns(0:recurrence_span - 1)
     if (.not. allocated(learned%recurrence_differences)) then
-      allocate (learned%recurrence_differences(size(accel), recurrence_span))
+      allocate (learned%recurrence_differences(size(accel), recurrence_span), &
+                learned%recurrence_guess(size(accel)))
       learned%recurrence_differences = 0.0_dp
       learned%recurrence_dots = 0.0_dp
       learned%recurrence_newest = 0
@@ -254,47 +239,56 @@ contains
       learned%recurrence_dots(other, column) = learned%recurrence_dots(column, other)
     end do
     learned%recurrence_ready = .false.
-    if (learned%predict_history >= recurrence_span) call fit_modes(learned)
+    if (learned%predict_history < recurrence_span) return
+    columns = ring_columns(learned)
+    call fit_modes(learned, columns)
+    if (.not. learned%recurrence_ready) return
+    learned%recurrence_guess = 0.0_dp
+    do j = 1, recurrence_order
+      learned%recurrence_guess = learned%recurrence_guess + learned%recurrence_coefficients(j) &
+                                 * learned%recurrence_differences(:, columns(j - 1))
+    end do
   end subroutine learn_modes
 
   !> The coefficients c of d_m = sum_j c_j d_{m-j} (j = 1 .. recurrence_order), the least
   !> squares fit over all coordinates of the recurrence_window newest differences d_m: the
   !> recurrence that a few lightly damped modes of the last steps follow (a sum of k
   !> sinusoids or exponentials satisfies one of order 2k). The normal equations from the
-  !> ring's dot products, scaled to a unit diagonal and regularized by modes_ridge, by
-  !> Cholesky; recurrence_ready stays .false. where a difference vanishes or a pivot is
-  !> not positive.
-  pure subroutine fit_modes(learned)
+  !> ring's dot products (columns: the ring's columns by lag), scaled to a unit diagonal
+  !> and regularized by modes_ridge, by Cholesky; recurrence_ready stays .false. where a
+  !> difference vanishes or a pivot is not positive.
+  pure subroutine fit_modes(learned, columns)
     type(stepper_state), intent(inout) :: learned
+    integer, intent(in) :: columns(0:)
     real(dp) :: normal(recurrence_order, recurrence_order), rhs(recurrence_order)
     real(dp) :: scale(recurrence_order), pivot
     integer :: i, j, k
+    associate (dots => learned%recurrence_dots)
     do j = 1, recurrence_order
       rhs(j) = 0.0_dp
       do i = 0, recurrence_window - 1
-        rhs(j) = rhs(j) + learned%recurrence_dots(ring_column(learned, i), &
-                                                  ring_column(learned, i + j))
+        rhs(j) = rhs(j) + dots(columns(i), columns(i + j))
       end do
-      do k = 1, recurrence_order
-        normal(j, k) = 0.0_dp
+      do k = j, recurrence_order
+        normal(k, j) = 0.0_dp
         do i = 0, recurrence_window - 1
-          normal(j, k) = normal(j, k) + learned%recurrence_dots(ring_column(learned, i + j), &
-                                                                ring_column(learned, i + k))
+          normal(k, j) = normal(k, j) + dots(columns(i + k), columns(i + j))
         end do
       end do
     end do
+    end associate
     do j = 1, recurrence_order
       if (.not. normal(j, j) > 0.0_dp) return
       scale(j) = sqrt(normal(j, j))
     end do
-    do k = 1, recurrence_order
-      do j = 1, recurrence_order
-        normal(j, k) = normal(j, k) / (scale(j) * scale(k))
+    ! (the lower triangle only: scaled, then Cholesky normal = L L^T in place)
+    do j = 1, recurrence_order
+      do k = j + 1, recurrence_order
+        normal(k, j) = normal(k, j) / (scale(k) * scale(j))
       end do
-      normal(k, k) = normal(k, k) + modes_ridge
-      rhs(k) = rhs(k) / scale(k)
+      normal(j, j) = 1.0_dp + modes_ridge
+      rhs(j) = rhs(j) / scale(j)
     end do
-    ! Cholesky normal = L L^T in the lower triangle, then the two triangular solves
     do k = 1, recurrence_order
       pivot = normal(k, k) - sum(normal(k, 1:k - 1)**2)
       if (.not. pivot > 0.0_dp) return

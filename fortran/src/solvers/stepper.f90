@@ -62,8 +62,9 @@ module stepper
     ! the recurrence predictor (acceleration_predictor's predict_recurrence): the last
     ! differences d_k = e''_k - e''_{k-1} in a ring (ndof, recurrence_span; newest in column
     ! recurrence_newest), their dot products (recurrence_span, recurrence_span, by ring
-    ! column) and the coefficients fitted to them for the next step (recurrence_ready)
-    real(dp), allocatable :: recurrence_differences(:, :)
+    ! column), the coefficients fitted to them and the next step's difference they predict
+    ! (recurrence_guess; both valid when recurrence_ready)
+    real(dp), allocatable :: recurrence_differences(:, :), recurrence_guess(:)
     real(dp) :: recurrence_dots(recurrence_span, recurrence_span) = 0.0_dp
     real(dp) :: recurrence_coefficients(recurrence_order) = 0.0_dp
     integer :: recurrence_newest = 0

@@ -10,9 +10,10 @@
 !> (1 - alpha_f)). The multipliers enter through a Schur complement built from the
 !> flexibility S^{-1} E_c at the 3-vectors the constraints touch (E_c: their unit vectors in
 !> the solver frame), so a Newton correction costs one back-substitution plus small dense
-!> algebra (LAPACK dgesv). The Jacobians of the dead moments and of lambda . Phi_ee are left
-!> out of S; the residual is exact. A correction with max |de| <= tol * length_scale ends
-!> the step.
+!> algebra (small_lu; LAPACK dgesv for many multipliers). The Jacobians of the dead moments
+!> and of lambda . Phi_ee are left out of S; the residual is exact. A correction with
+!> max |de| <= tol * length_scale ends the step (jacobian_reuse and the constant policy: an
+!> error estimate below it, see converged).
 !>
 !> The run's settings and what the stepper learns from step to step (contraction estimate,
 !> reuse back-off, predictor) live apart from the system, in stepper.f90's stepper_run; the
@@ -99,6 +100,10 @@ module time_integrator
   !> the smallest turn (rad) since the factorization that jacobian_reuse carries the matrix
   !> through (carried_rotation); below it the unturned matrix is as good
   real(dp), parameter :: carry_threshold = 1e-3_dp
+  !> the most multipliers whose Schur complement is solved by small_lu (LAPACK's dgesv,
+  !> dgetrf and dgetrs above: for 2 multipliers they cost ~800 instructions a call, most of
+  !> it the library's dispatch and workspace)
+  integer, parameter :: small_dense_limit = 8
 
   !> The stagnation and divergence test of a step's Newton iteration (reset at each try).
   type :: newton_monitor
@@ -488,7 +493,12 @@ contains
         call schur_complement(sys%flexibility_cc, w, work%flex_w, schur)
         call gradient_product(sys, gradients, direction, dlam(:, 1))
         dlam(:, 1) = dlam(:, 1) - phi
-        call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
+        if (sys%ncon <= small_dense_limit) then
+          call small_lu(schur, ipiv, lapack_info)
+          if (lapack_info == 0) call small_lu_solve(schur, ipiv, dlam(:, 1))
+        else
+          call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
+        end if
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -619,7 +629,11 @@ contains
           end if
           work%carry_lu = matmul(transpose(work%carry_columns), work%carry_flexibility)
         end if
-        call dgetrf(sys%ncon, sys%ncon, work%carry_lu, sys%ncon, work%ipiv, lapack_info)
+        if (sys%ncon <= small_dense_limit) then
+          call small_lu(work%carry_lu, work%ipiv, lapack_info)
+        else
+          call dgetrf(sys%ncon, sys%ncon, work%carry_lu, sys%ncon, work%ipiv, lapack_info)
+        end if
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -629,8 +643,12 @@ contains
       end if
       call gradient_product(sys, work%gradients, work%direction, work%dlam(:, 1))
       work%dlam(:, 1) = work%dlam(:, 1) - work%phi
-      call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
-                  lapack_info)
+      if (sys%ncon <= small_dense_limit) then
+        call small_lu_solve(work%carry_lu, work%ipiv, work%dlam(:, 1))
+      else
+        call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
+                    lapack_info)
+      end if
       if (allocated(sys%carry_plane)) then
         call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
@@ -676,6 +694,61 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> LU factorization with partial pivoting P A = L U of a small dense matrix in place
+  !> (LAPACK dgetf2's algorithm: the first largest |entry| of each column as its pivot,
+  !> whole rows swapped; L below the diagonal with a unit diagonal, U on and above it);
+  !> info = k > 0: U(k, k) is exactly zero (as dgetrf's info).
+  pure subroutine small_lu(a, ipiv, info)
+    real(dp), intent(inout) :: a(:, :)
+    integer, intent(out) :: ipiv(:), info
+    integer :: n, j, k, p
+    real(dp) :: row(size(a, 2))
+    n = size(a, 1)
+    info = 0
+    do j = 1, n
+      p = j - 1 + maxloc(abs(a(j:n, j)), 1)
+      ipiv(j) = p
+      if (a(p, j) /= 0.0_dp) then
+        if (p /= j) then
+          row = a(j, :)
+          a(j, :) = a(p, :)
+          a(p, :) = row
+        end if
+        a(j + 1:n, j) = a(j + 1:n, j) / a(j, j)
+      else if (info == 0) then
+        info = j
+      end if
+      do k = j + 1, n
+        a(j + 1:n, k) = a(j + 1:n, k) - a(j + 1:n, j) * a(j, k)
+      end do
+    end do
+  end subroutine small_lu
+
+  !> Solves A x = b (b overwritten by x) with small_lu's factors of A: the row swaps, the
+  !> unit lower and the upper triangular solves (as dgetrs).
+  pure subroutine small_lu_solve(a, ipiv, b)
+    real(dp), intent(in) :: a(:, :)
+    integer, intent(in) :: ipiv(:)
+    real(dp), intent(inout) :: b(:)
+    integer :: n, j
+    real(dp) :: swap
+    n = size(a, 1)
+    do j = 1, n
+      if (ipiv(j) /= j) then
+        swap = b(j)
+        b(j) = b(ipiv(j))
+        b(ipiv(j)) = swap
+      end if
+    end do
+    do j = 1, n - 1
+      b(j + 1:n) = b(j + 1:n) - b(j) * a(j + 1:n, j)
+    end do
+    do j = n, 1, -1
+      b(j) = b(j) / a(j, j)
+      b(1:j - 1) = b(1:j - 1) - b(j) * a(1:j - 1, j)
+    end do
+  end subroutine small_lu_solve
 
   !> The Schur complement C = W^T F W of the multipliers (F = E_c^T S^{-1} E_c, W the
   !> solver-frame gradients at the touched blocks), with flex_w = F W: matmul's sums (each
