@@ -221,7 +221,9 @@ contains
   pure subroutine learn_modes(learned, accel, accel_new)
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: accel(:), accel_new(:)
-    integer :: column, other, j, columns(0:recurrence_span - 1)
+    integer :: columns(0:recurrence_span - 1)
+    real(dp) :: lagged(0:recurrence_span - 1, 0:recurrence_span - 1)
+    integer :: a, b
     if (.not. allocated(learned%recurrence_differences)) then
       allocate (learned%recurrence_differences(size(accel), recurrence_span), &
                 learned%recurrence_guess(size(accel)))
@@ -230,53 +232,82 @@ contains
       learned%recurrence_newest = 0
     end if
     learned%recurrence_newest = modulo(learned%recurrence_newest, recurrence_span) + 1
-    column = learned%recurrence_newest
-    learned%recurrence_differences(:, column) = accel_new - accel
-    do other = 1, recurrence_span
-      learned%recurrence_dots(column, other) = &
-        dot_product(learned%recurrence_differences(:, column), &
-                    learned%recurrence_differences(:, other))
-      learned%recurrence_dots(other, column) = learned%recurrence_dots(column, other)
-    end do
+    call push_difference(size(accel), accel, accel_new, learned%recurrence_newest, &
+                         learned%recurrence_differences, learned%recurrence_dots)
     learned%recurrence_ready = .false.
     if (learned%predict_history < recurrence_span) return
     columns = ring_columns(learned)
-    call fit_modes(learned, columns)
-    if (.not. learned%recurrence_ready) return
-    learned%recurrence_guess = 0.0_dp
-    do j = 1, recurrence_order
-      learned%recurrence_guess = learned%recurrence_guess + learned%recurrence_coefficients(j) &
-                                 * learned%recurrence_differences(:, columns(j - 1))
+    do b = 0, recurrence_span - 1
+      do a = 0, recurrence_span - 1
+        lagged(a, b) = learned%recurrence_dots(columns(a), columns(b))
+      end do
     end do
+    call fit_modes(lagged, learned%recurrence_coefficients, learned%recurrence_ready)
+    if (.not. learned%recurrence_ready) return
+    call predicted_difference(size(accel), learned%recurrence_differences, columns, &
+                              learned%recurrence_coefficients, learned%recurrence_guess)
   end subroutine learn_modes
+
+  !> d = accel_new - accel into ring column `column` of differences (n, recurrence_span) and
+  !> its dot products with every column into dots (symmetric).
+  pure subroutine push_difference(n, accel, accel_new, column, differences, dots)
+    integer, intent(in) :: n, column
+    real(dp), intent(in) :: accel(n), accel_new(n)
+    real(dp), intent(inout) :: differences(n, recurrence_span)
+    real(dp), intent(inout) :: dots(recurrence_span, recurrence_span)
+    integer :: other, i
+    real(dp) :: total
+    differences(:, column) = accel_new - accel
+    do other = 1, recurrence_span
+      total = 0.0_dp
+      do i = 1, n
+        total = total + differences(i, column) * differences(i, other)
+      end do
+      dots(column, other) = total
+      dots(other, column) = total
+    end do
+  end subroutine push_difference
+
+  !> guess = sum_j c_j d(lag j - 1) (j = 1 .. recurrence_order): the next difference.
+  pure subroutine predicted_difference(n, differences, columns, coefficients, guess)
+    integer, intent(in) :: n, columns(0:)
+    real(dp), intent(in) :: differences(n, recurrence_span), coefficients(recurrence_order)
+    real(dp), intent(out) :: guess(n)
+    integer :: j
+    guess = 0.0_dp
+    do j = 1, recurrence_order
+      guess = guess + coefficients(j) * differences(:, columns(j - 1))
+    end do
+  end subroutine predicted_difference
 
   !> The coefficients c of d_m = sum_j c_j d_{m-j} (j = 1 .. recurrence_order), the least
   !> squares fit over all coordinates of the recurrence_window newest differences d_m: the
   !> recurrence that a few lightly damped modes of the last steps follow (a sum of k
   !> sinusoids or exponentials satisfies one of order 2k). The normal equations from the
-  !> ring's dot products (columns: the ring's columns by lag), scaled to a unit diagonal
-  !> and regularized by modes_ridge, by Cholesky; recurrence_ready stays .false. where a
+  !> dot products of the differences by lag (lagged(a, b) = d_{n-a} . d_{n-b}), scaled to a
+  !> unit diagonal and regularized by modes_ridge, by Cholesky; ready = .false. where a
   !> difference vanishes or a pivot is not positive.
-  pure subroutine fit_modes(learned, columns)
-    type(stepper_state), intent(inout) :: learned
-    integer, intent(in) :: columns(0:)
+  pure subroutine fit_modes(lagged, coefficients, ready)
+    real(dp), intent(in) :: lagged(0:recurrence_span - 1, 0:recurrence_span - 1)
+    real(dp), intent(out) :: coefficients(recurrence_order)
+    logical, intent(out) :: ready
     real(dp) :: normal(recurrence_order, recurrence_order), rhs(recurrence_order)
     real(dp) :: scale(recurrence_order), pivot
     integer :: i, j, k
-    associate (dots => learned%recurrence_dots)
+    ready = .false.
+    coefficients = 0.0_dp
     do j = 1, recurrence_order
       rhs(j) = 0.0_dp
       do i = 0, recurrence_window - 1
-        rhs(j) = rhs(j) + dots(columns(i), columns(i + j))
+        rhs(j) = rhs(j) + lagged(i, i + j)
       end do
       do k = j, recurrence_order
         normal(k, j) = 0.0_dp
         do i = 0, recurrence_window - 1
-          normal(k, j) = normal(k, j) + dots(columns(i + k), columns(i + j))
+          normal(k, j) = normal(k, j) + lagged(i + k, i + j)
         end do
       end do
     end do
-    end associate
     do j = 1, recurrence_order
       if (.not. normal(j, j) > 0.0_dp) return
       scale(j) = sqrt(normal(j, j))
@@ -305,8 +336,8 @@ contains
       rhs(k) = (rhs(k) - sum(normal(k + 1:recurrence_order, k) * rhs(k + 1:recurrence_order))) &
                / normal(k, k)
     end do
-    learned%recurrence_coefficients = rhs / scale
-    learned%recurrence_ready = all(abs(learned%recurrence_coefficients) < huge(1.0_dp))
+    coefficients = rhs / scale
+    ready = all(abs(coefficients) < huge(1.0_dp))
   end subroutine fit_modes
 
 end module acceleration_predictor
