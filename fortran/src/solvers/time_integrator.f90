@@ -43,7 +43,10 @@
 !> with a period-2 alternation e''_n + e''_{n-1} - e''_{n-2}, or the fitted recurrence
 !> e''_n + alpha d_n + beta d_{n-1} (d_k = e''_k - e''_{k-1}; alpha, beta fitted to the last
 !> three differences over all coordinates: one dominant mode, e.g. the cable's ringing
-!> axial mode at rho_inf = 1) (the extrapolations only across steps of the same size). A
+!> axial mode at rho_inf = 1), or the recurrence of order 6 e''_n + sum_j c_j d_{n+1-j}
+!> fitted to the last nine differences (several modes at once: the 5-node cable pendulum's
+!> ringing e'' predicted ~75 times better, its first correction ~1e-7 m instead of ~1e-5)
+!> (the extrapolations only across steps of the same size). A
 !> smooth motion (the spin-up's rotating acceleration) is predicted to O(h^3) instead of
 !> O(h): the first correction of the W = 4 spin-up, 11 nodes, dt 5e-3, falls from ~6e-6 m,
 !> the step from 2.84 to 1.80 corrections; the 5-node cable pendulum 3.37 -> 2.82. The
@@ -877,24 +880,26 @@ contains
   !> jacobian_reuse measures the contraction in every step that reaches its third
   !> correction and accepts from there on the step's largest ratio (the first ratio, from
   !> the predictor's error, mostly measures its linear part). At the second correction it
-  !> accepts on the contraction bound learned from earlier steps: matrix_theta, the largest
-  !> of the ratios measured from a third correction on (both corrections of a ratio made
-  !> with the current factorization: same_matrix) in the last contraction_memory steps that
-  !> measured one since the factorization, when
-  !>   theta / (1 - theta) last <= tol L,  theta = max(last / previous, min(0.5, 2 matrix_theta)):
-  !> twice the bound, never below the step's own first ratio; and only while the contraction
-  !> is steady: at least steady_count measurements, the largest within steady_spread times
-  !> the smallest (the 5-node cable pendulum: spreads 1.2-8, median 2, and no ratio above
-  !> 1.7 times the bound before it; the driven luffing boom's ratios jump from 1e-3 to 0.3
-  !> from step to step, spreads 4-750, median 33: never accepted there). Not with contact points (their
-  !> corrections fall irregularly), not without a measured bound (a new factorization
+  !> accepts on the contraction bound theta_b learned from earlier steps (issue 26;
+  !> docs/theory.md section 14): the largest of the ratios measured from a third correction
+  !> on (both corrections of a ratio made with the current factorization: same_matrix), one
+  !> per measuring step (its largest), over the last contraction_memory measuring steps
+  !> since the factorization (learned%matrix_ratios), when
+  !>   theta / (1 - theta) last <= tol L,  theta = max(last / previous, min(0.5, 2 theta_b)):
+  !> twice the bound, never below the step's own first ratio; and only while the
+  !> contraction is steady: at least steady_count measurements, the largest within
+  !> steady_spread times the smallest (the 5-node cable pendulum: spreads 1.2-8, median 2,
+  !> no ratio above 1.7 times the bound before it; the driven luffing boom's ratios jump
+  !> between 1e-3 and 0.3 from step to step, spreads 4-750, median 33: not accepted
+  !> there, where a decayed maximum as the bound left up to 4.6 tol L). Not with contact
+  !> points (their corrections fall irregularly), not without a bound (a new factorization
   !> forgets it: a refresh, a changed contact set or step, a retry), not when the matrix
   !> was refreshed within the step, and not after confirm_every steps in a row accepted on
   !> the bound: that step goes on to its third correction and measures the contraction
   !> again (a drive, a large rotation or a stiffening shows there). The caller checks the
   !> constraints to the tolerance whenever a step is accepted on an estimate (newton), and
   !> the stagnation and divergence tests (stagnated) run on every correction not accepted.
-  !> measured: this step has its entry in the bound's ring (its largest ratio).
+  !> measured: this step has its entry in the bound's ring.
   logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix, &
                              measured) result(ok)
     type(system_model), intent(in) :: sys
