@@ -916,7 +916,7 @@ contains
     integer, parameter :: steady_count = 8
     real(dp), parameter :: steady_spread = 4.0_dp
     real(dp) :: limit, theta, bound
-    integer :: slot
+    integer :: slot, known  ! the ring's entry of this step; the entries measured
     limit = cfg%tol * cfg%length_scale
     ok = last <= limit
     if (sys%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
@@ -942,9 +942,9 @@ contains
       step_theta = theta
       if (ok .or. sys%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
           learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
-      slot = min(learned%matrix_measured, contraction_memory)
-      bound = maxval(learned%matrix_ratios(1:slot))
-      if (.not. bound <= steady_spread * minval(learned%matrix_ratios(1:slot))) return
+      known = min(learned%matrix_measured, contraction_memory)
+      bound = maxval(learned%matrix_ratios(1:known))
+      if (.not. bound <= steady_spread * minval(learned%matrix_ratios(1:known))) return
       theta = max(theta, min(0.5_dp, 2.0_dp * bound))
       ok = theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit
       if (ok) learned%matrix_unconfirmed = learned%matrix_unconfirmed + 1
