@@ -87,7 +87,7 @@ def test_accepted_steps_leave_less_than_the_tolerance(case):
     """Every step's true remaining error is below newton_tol x L, the steps the estimate
     ends after two corrections among them (measured, largest / (newton_tol L): pendulum
     0.40 (295 of 700 steps end after 2 corrections), the boom 0.39 (83 of 600), the
-    spin-up 0.45 (179 of 800)). It fails
+    spin-up 0.31 (149 of 800)). It fails
     where the bound does not hold: before the steadiness condition the boom's irregular
     contraction (ratios from 1e-3 to 0.3 between steps) left up to 4.6 x newton_tol L in 9
     steps accepted after two corrections on the bound."""
