@@ -153,6 +153,7 @@ contains
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: h, accel(:), accel_new(:)
     real(dp) :: misses(0:predict_recurrence), alpha, beta, now, before, before2
+    real(dp), allocatable :: spare(:)
     logical :: usable(0:predict_recurrence)
     integer :: kind, i
     if (.not. allocated(learned%accel_before)) then
@@ -190,8 +191,12 @@ contains
         if (usable(kind) .and. misses(kind) < misses(learned%predictor)) &
           learned%predictor = kind
       end do
-      learned%accel_before3 = learned%accel_before2
-      learned%accel_before2 = learned%accel_before
+      ! the history moves on by one step: the arrays change places (no copies), the
+      ! oldest one's storage takes e''_n below
+      call move_alloc(learned%accel_before3, spare)
+      call move_alloc(learned%accel_before2, learned%accel_before3)
+      call move_alloc(learned%accel_before, learned%accel_before2)
+      call move_alloc(spare, learned%accel_before)
     end if
     if (learned%predict_step == h) then
       learned%predict_history = min(learned%predict_history + 1, recurrence_span)
@@ -222,8 +227,6 @@ contains
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: accel(:), accel_new(:)
     integer :: columns(0:recurrence_span - 1)
-    real(dp) :: lagged(0:recurrence_span - 1, 0:recurrence_span - 1)
-    integer :: a, b
     if (.not. allocated(learned%recurrence_differences)) then
       allocate (learned%recurrence_differences(size(accel), recurrence_span), &
                 learned%recurrence_guess(size(accel)))
@@ -232,51 +235,61 @@ contains
       learned%recurrence_newest = 0
     end if
     learned%recurrence_newest = modulo(learned%recurrence_newest, recurrence_span) + 1
-    call push_difference(size(accel), accel, accel_new, learned%recurrence_newest, &
+    columns = ring_columns(learned)
+    call push_difference(size(accel), accel, accel_new, columns, &
                          learned%recurrence_differences, learned%recurrence_dots)
     learned%recurrence_ready = .false.
     if (learned%predict_history < recurrence_span) return
-    columns = ring_columns(learned)
-    do b = 0, recurrence_span - 1
-      do a = 0, recurrence_span - 1
-        lagged(a, b) = learned%recurrence_dots(columns(a), columns(b))
-      end do
-    end do
-    call fit_modes(lagged, learned%recurrence_coefficients, learned%recurrence_ready)
+    call fit_modes(learned%recurrence_dots, columns, learned%recurrence_coefficients, &
+                   learned%recurrence_ready)
     if (.not. learned%recurrence_ready) return
     call predicted_difference(size(accel), learned%recurrence_differences, columns, &
                               learned%recurrence_coefficients, learned%recurrence_guess)
   end subroutine learn_modes
 
-  !> d = accel_new - accel into ring column `column` of differences (n, recurrence_span) and
-  !> its dot products with every column into dots (symmetric).
-  pure subroutine push_difference(n, accel, accel_new, column, differences, dots)
-    integer, intent(in) :: n, column
+  !> d = accel_new - accel into ring column columns(0) of differences (n, recurrence_span)
+  !> and its dot products with the differences of lags 0 .. recurrence_order into dots
+  !> (symmetric, by ring column), in one pass over the coordinates (each product summed in
+  !> coordinate order, as dot_product would). fit_modes reads the products of lags a, b
+  !> with |a - b| <= recurrence_order only (its normal equations' a, b in 1 ..
+  !> recurrence_span - 1, |a - b| < recurrence_order; its right-hand side's
+  !> b - a = 1 .. recurrence_order): those of lags recurrence_order + 1 .. recurrence_span - 1 with
+  !> the newest are never read (their entries keep older products).
+  pure subroutine push_difference(n, accel, accel_new, columns, differences, dots)
+    integer, intent(in) :: n, columns(0:recurrence_span - 1)
     real(dp), intent(in) :: accel(n), accel_new(n)
     real(dp), intent(inout) :: differences(n, recurrence_span)
     real(dp), intent(inout) :: dots(recurrence_span, recurrence_span)
-    integer :: other, i
-    real(dp) :: total
-    differences(:, column) = accel_new - accel
-    do other = 1, recurrence_span
-      total = 0.0_dp
-      do i = 1, n
-        total = total + differences(i, column) * differences(i, other)
+    integer :: lag, i
+    real(dp) :: total(0:recurrence_order), d
+    total = 0.0_dp
+    do i = 1, n
+      d = accel_new(i) - accel(i)
+      differences(i, columns(0)) = d
+      do lag = 0, recurrence_order
+        total(lag) = total(lag) + d * differences(i, columns(lag))
       end do
-      dots(column, other) = total
-      dots(other, column) = total
+    end do
+    do lag = 0, recurrence_order
+      dots(columns(0), columns(lag)) = total(lag)
+      dots(columns(lag), columns(0)) = total(lag)
     end do
   end subroutine push_difference
 
-  !> guess = sum_j c_j d(lag j - 1) (j = 1 .. recurrence_order): the next difference.
+  !> guess = sum_j c_j d(lag j - 1) (j = 1 .. recurrence_order): the next difference (each
+  !> coordinate's sum in the order of j, from 0).
   pure subroutine predicted_difference(n, differences, columns, coefficients, guess)
     integer, intent(in) :: n, columns(0:)
     real(dp), intent(in) :: differences(n, recurrence_span), coefficients(recurrence_order)
     real(dp), intent(out) :: guess(n)
-    integer :: j
-    guess = 0.0_dp
-    do j = 1, recurrence_order
-      guess = guess + coefficients(j) * differences(:, columns(j - 1))
+    integer :: j, i
+    real(dp) :: total
+    do i = 1, n
+      total = 0.0_dp
+      do j = 1, recurrence_order
+        total = total + coefficients(j) * differences(i, columns(j - 1))
+      end do
+      guess(i) = total
     end do
   end subroutine predicted_difference
 
@@ -287,8 +300,9 @@ contains
   !> dot products of the differences by lag (lagged(a, b) = d_{n-a} . d_{n-b}), scaled to a
   !> unit diagonal and regularized by modes_ridge, by Cholesky; ready = .false. where a
   !> difference vanishes or a pivot is not positive.
-  pure subroutine fit_modes(lagged, coefficients, ready)
-    real(dp), intent(in) :: lagged(0:recurrence_span - 1, 0:recurrence_span - 1)
+  pure subroutine fit_modes(dots, columns, coefficients, ready)
+    real(dp), intent(in) :: dots(recurrence_span, recurrence_span)
+    integer, intent(in) :: columns(0:recurrence_span - 1)
     real(dp), intent(out) :: coefficients(recurrence_order)
     logical, intent(out) :: ready
     real(dp) :: normal(recurrence_order, recurrence_order), rhs(recurrence_order)
@@ -296,15 +310,16 @@ contains
     integer :: i, j, k
     ready = .false.
     coefficients = 0.0_dp
+    ! (lagged(a, b) = dots(columns(a), columns(b)), read in place)
     do j = 1, recurrence_order
       rhs(j) = 0.0_dp
       do i = 0, recurrence_window - 1
-        rhs(j) = rhs(j) + lagged(i, i + j)
+        rhs(j) = rhs(j) + dots(columns(i), columns(i + j))
       end do
       do k = j, recurrence_order
         normal(k, j) = 0.0_dp
         do i = 0, recurrence_window - 1
-          normal(k, j) = normal(k, j) + lagged(i + k, i + j)
+          normal(k, j) = normal(k, j) + dots(columns(i + k), columns(i + j))
         end do
       end do
     end do

@@ -1343,8 +1343,8 @@ contains
     real(dp), intent(out), optional, target :: ndof_work(:, :)
     real(dp), allocatable, target :: own_full(:), own_ndof(:, :)
     real(dp), pointer :: e_full(:), mv(:), loads(:)
-    real(dp) :: pivot(3), director(3)
-    integer :: p, k, f, m
+    real(dp) :: pivot(3), director(3), relative(3), total
+    integer :: p, k, f, m, j
     info = 0
     if (present(known_full)) then
       e_full => known_full
@@ -1366,16 +1366,30 @@ contains
       f = sys%probe_frame(p)
       pivot = 0.0_dp
       if (f > 0) pivot = sys%frames(f)%pivot
-      deflection(:, p) = matmul(transpose(rotations(:, :, f)), probe(:, p) - pivot) &
-                         - sys%probe_reference(:, p)
+      ! A_f^T (p - pivot) by its sums as matmul takes them (from 0, in the order of the
+      ! rows), without matmul's library call and temporaries
+      relative = probe(:, p) - pivot
+      do k = 1, 3
+        total = 0.0_dp
+        do j = 1, 3
+          total = total + rotations(j, k, f) * relative(j)
+        end do
+        deflection(k, p) = total - sys%probe_reference(k, p)
+      end do
     end do
     call mass_product(sys, v, mv)
     energy = 0.0_dp
     energy(energy_kinetic) = 0.5_dp * dot_product(v, mv)
     energy(energy_strain) = strain
-    call external_forces(sys, t, 1.0_dp, loads, info)
-    if (info /= 0) return
-    energy(energy_loads) = -dot_product(loads, e)
+    if (size(sys%force_drive) == 0) then
+      ! the constant loads alone: the external loads at load factor 1 are constant_force
+      ! (bit for bit)
+      energy(energy_loads) = -dot_product(sys%constant_force, e)
+    else
+      call external_forces(sys, t, 1.0_dp, loads, info)
+      if (info /= 0) return
+      energy(energy_loads) = -dot_product(loads, e)
+    end if
     do m = 1, size(sys%moment_magnitude)
       do k = 1, 3  ! (gathered by a loop: a vector subscript made a heap temporary)
         director(k) = e_full(sys%moment_dofs(k, m))
