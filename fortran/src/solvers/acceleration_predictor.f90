@@ -152,7 +152,7 @@ contains
   pure subroutine learn_predictor(learned, h, accel, accel_new)
     type(stepper_state), intent(inout) :: learned
     real(dp), intent(in) :: h, accel(:), accel_new(:)
-    real(dp) :: misses(0:predict_recurrence), alpha, beta, now, before, before2
+    real(dp) :: misses(0:predict_recurrence), alpha, beta, now, before, before2, target
     real(dp), allocatable :: spare(:)
     logical :: usable(0:predict_recurrence)
     integer :: kind, i
@@ -176,16 +176,26 @@ contains
       ! the kind fixed: no selection per coordinate; an unusable kind's miss is not read)
       misses = 0.0_dp
       do i = 1, size(accel)
+        target = accel_new(i)
         now = accel(i)
         before = learned%accel_before(i)
         before2 = learned%accel_before2(i)
-        do kind = predict_hold, predict_fitted
-          misses(kind) = max(misses(kind), abs(accel_new(i) - &
-                                               extrapolated(kind, now, before, before2, alpha, beta)))
-        end do
+        misses(predict_hold) = max(misses(predict_hold), abs(target - &
+          extrapolated(predict_hold, now, before, before2, alpha, beta)))
+        misses(predict_alternate) = max(misses(predict_alternate), abs(target - &
+          extrapolated(predict_alternate, now, before, before2, alpha, beta)))
+        misses(predict_linear) = max(misses(predict_linear), abs(target - &
+          extrapolated(predict_linear, now, before, before2, alpha, beta)))
+        misses(predict_quadratic) = max(misses(predict_quadratic), abs(target - &
+          extrapolated(predict_quadratic, now, before, before2, alpha, beta)))
+        misses(predict_alternate_linear) = max(misses(predict_alternate_linear), abs(target - &
+          extrapolated(predict_alternate_linear, now, before, before2, alpha, beta)))
+        misses(predict_fitted) = max(misses(predict_fitted), abs(target - &
+          extrapolated(predict_fitted, now, before, before2, alpha, beta)))
+        ! (the recurrence's guess is allocated and defined from the first step on)
+        misses(predict_recurrence) = max(misses(predict_recurrence), &
+                                         abs(target - (now + learned%recurrence_guess(i))))
       end do
-      if (usable(predict_recurrence)) &
-        misses(predict_recurrence) = maxval(abs(accel_new - (accel + learned%recurrence_guess)))
       learned%predictor = predict_hold
       do kind = predict_alternate, predict_recurrence
         if (usable(kind) .and. misses(kind) < misses(learned%predictor)) &
@@ -213,8 +223,10 @@ contains
   pure function ring_columns(learned) result(columns)
     type(stepper_state), intent(in) :: learned
     integer :: columns(0:recurrence_span - 1), lag
+    ! (modulo(newest - 1 - lag, recurrence_span) + 1, newest in 1 .. recurrence_span)
     do lag = 0, recurrence_span - 1
-      columns(lag) = modulo(learned%recurrence_newest - 1 - lag, recurrence_span) + 1
+      columns(lag) = learned%recurrence_newest - lag
+      if (columns(lag) < 1) columns(lag) = columns(lag) + recurrence_span
     end do
   end function ring_columns
 
@@ -231,6 +243,7 @@ contains
       allocate (learned%recurrence_differences(size(accel), recurrence_span), &
                 learned%recurrence_guess(size(accel)))
       learned%recurrence_differences = 0.0_dp
+      learned%recurrence_guess = 0.0_dp
       learned%recurrence_dots = 0.0_dp
       learned%recurrence_newest = 0
     end if
