@@ -5,6 +5,7 @@ and compare the HDF5 histories bitwise.
     python benchmarks/history_gate.py run <outdir> [<site>]   # this python, ancfdrv from <site>
     python benchmarks/history_gate.py examples <outdir> [<site>]   # examples/ --quick
     python benchmarks/history_gate.py diff <outdir_a> <outdir_b>
+    python benchmarks/history_gate.py change <outdir_a> <outdir_b>   # how far (not bitwise)
 
 A baseline build goes beside the working one, e.g.
     git archive <commit> | tar -x -C /tmp/base && cd /tmp/base &&
@@ -149,9 +150,56 @@ def diff(a: Path, b: Path) -> int:
     return 1 if bad else 0
 
 
+def change(a: Path, b: Path) -> int:
+    """How far each history of b moved from a's where they are not bitwise equal (a change
+    of the Newton iterates: issue 26): the largest change of the coordinates (/dynamic/q),
+    the probes and the deflections, each over its own range (the widest component; at
+    least 1e-6 of its magnitude and 1e-9), and the Newton corrections (totals). Rows compared up
+    to the shorter history."""
+    files = sorted(str(p.relative_to(a)) for p in a.rglob("*.h5"))
+    worst = 0.0
+    for name in files:
+        if not (b / name).exists():
+            print(f"{name}: no file in {b}")
+            continue
+        with h5py.File(a / name) as fa, h5py.File(b / name) as fb:
+            if "dynamic/time" not in fa or "dynamic/time" not in fb:
+                print(f"{name}: no dynamic history")
+                continue
+            parts = []
+            largest = 0.0
+            for group in ("q", "probes", "deflection"):
+                key = f"dynamic/{group}"
+                if key not in fa or key not in fb:
+                    continue
+                items = [(key, fa[key], fb[key])] if isinstance(fa[key], h5py.Dataset) else \
+                    [(f"{key}/{k}", fa[key][k], fb[key][k]) for k in fa[key] if k in fb[key]]
+                for label, x, y in items:
+                    x, y = np.asarray(x[()], dtype=float), np.asarray(y[()], dtype=float)
+                    rows = min(len(x), len(y))
+                    x, y = x[:rows].reshape(rows, -1), y[:rows].reshape(rows, -1)
+                    # (a history at rest has no range: then 1e-6 of its magnitude, at
+                    # least 1e-9)
+                    span = max(np.ptp(x, axis=0).max(), 1e-6 * np.abs(x).max(), 1e-9) \
+                        if rows else 0.0
+                    moved = np.abs(x - y).max() / span if span > 0 else 0.0
+                    largest = max(largest, moved)
+                    if group != "q":
+                        parts.append(f"{label.split('/', 1)[1]} {moved:.1e}")
+            newton = [int(np.asarray(f["dynamic/newton_iterations"][()]).sum())
+                      for f in (fa, fb)] if "dynamic/newton_iterations" in fa else [0, 0]
+            worst = max(worst, largest)
+            print(f"{name}: largest change {largest:.2e} of the range ({', '.join(parts)}); "
+                  f"corrections {newton[0]} -> {newton[1]}")
+    print(f"largest change over all histories: {worst:.2e} of the range")
+    return 0
+
+
 if __name__ == "__main__":
     if sys.argv[1] in ("run", "examples"):
         (run if sys.argv[1] == "run" else examples)(Path(sys.argv[2]).resolve(),
                                                      sys.argv[3] if len(sys.argv) > 3 else None)
+    elif sys.argv[1] == "change":
+        sys.exit(change(Path(sys.argv[2]), Path(sys.argv[3])))
     else:
         sys.exit(diff(Path(sys.argv[2]), Path(sys.argv[3])))

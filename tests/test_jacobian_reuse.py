@@ -69,14 +69,16 @@ def test_reuse_converges_to_full_newton(tmp_path, case):
 
 
 def test_failed_step_retries_with_a_fresh_matrix(tmp_path):
-    """With max_newton = 3 an old matrix cannot finish some spin-up steps within the
+    """With max_newton = 2 an old matrix cannot finish some spin-up steps within the
     budget; each such step starts again with a matrix at its predicted state (the step's
     count shows the corrections of both attempts and the fresh factorization) and the run
-    completes with full Newton's answer."""
+    completes with full Newton's answer. (The budget was 3 corrections until the
+    recurrence predictor of issue 26: its predictions leave every step of this run within
+    3 corrections, measured 0 retries at 3 and 2 at 2.)"""
     history, corrections, factorizations = run(tmp_path, "spinup", "reuse", 1e-10,
-                                               "solver.max_newton=3")
+                                               "solver.max_newton=2")
     reference, *_ = run(tmp_path, "spinup", "iteration", 1e-10)
-    retried = corrections > 3
+    retried = corrections > 2
     print(f"\n{retried.sum()} retried steps of {len(corrections) - 1}, "
           f"{factorizations.sum()} factorizations")
     assert retried.sum() >= 1

@@ -21,6 +21,13 @@ module stepper
   integer, parameter, public :: jacobian_step = 1, jacobian_iteration = 2, jacobian_reuse = 3
   !> the most steps jacobian_reuse starts with a fresh matrix before trying an old one again
   integer, parameter :: max_reuse_backoff = 64
+  !> the recurrence predictor's order (the differences of e'' each predicted difference
+  !> depends on: up to three oscillating modes) and the window of differences it is fitted
+  !> to (each over all coordinates); it needs recurrence_span differences of equal steps
+  integer, parameter, public :: recurrence_order = 6, recurrence_window = 3, &
+                                recurrence_span = recurrence_order + recurrence_window
+  !> the steps whose measured contraction jacobian_reuse's bound remembers (their largest)
+  integer, parameter, public :: contraction_memory = 16
 
   !> The settings of a run: the method's parameters (Newmark: alpha_m = alpha_f = 0), the
   !> Newton tolerance (max |de| <= tol * length_scale), the iteration limit, the Jacobian
@@ -52,6 +59,24 @@ module stepper
     real(dp) :: predict_step = 0.0_dp
     integer :: predict_history = 0
     integer :: predictor = 0
+    ! the recurrence predictor (acceleration_predictor's predict_recurrence): the last
+    ! differences d_k = e''_k - e''_{k-1} in a ring (ndof, recurrence_span; newest in column
+    ! recurrence_newest), their dot products (recurrence_span, recurrence_span, by ring
+    ! column), the coefficients fitted to them and the next step's difference they predict
+    ! (recurrence_guess; both valid when recurrence_ready)
+    real(dp), allocatable :: recurrence_differences(:, :), recurrence_guess(:)
+    real(dp) :: recurrence_dots(recurrence_span, recurrence_span) = 0.0_dp
+    real(dp) :: recurrence_coefficients(recurrence_order) = 0.0_dp
+    integer :: recurrence_newest = 0
+    logical :: recurrence_ready = .false.
+    ! jacobian_reuse's contraction bound (converged() in time_integrator): the largest
+    ! ratio of successive corrections measured from a step's third correction on, in each
+    ! of the last contraction_memory steps that measured one with the current
+    ! factorization (a ring; matrix_measured: how many, 0 after a factorization), and the
+    ! steps accepted on the bound since the last measurement
+    real(dp) :: matrix_ratios(contraction_memory) = 0.0_dp
+    integer :: matrix_measured = 0
+    integer :: matrix_unconfirmed = 0
     ! the matrix carried with the system's rotation (carried_rotation): the carried vectors
     ! at the factorization and at the current step (3, nvec), the turn from them to the current step's predicted
     ! state and whether the step uses it (a turn above carry_threshold)

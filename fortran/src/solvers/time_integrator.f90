@@ -10,9 +10,10 @@
 !> (1 - alpha_f)). The multipliers enter through a Schur complement built from the
 !> flexibility S^{-1} E_c at the 3-vectors the constraints touch (E_c: their unit vectors in
 !> the solver frame), so a Newton correction costs one back-substitution plus small dense
-!> algebra (LAPACK dgesv). The Jacobians of the dead moments and of lambda . Phi_ee are left
-!> out of S; the residual is exact. A correction with max |de| <= tol * length_scale ends
-!> the step.
+!> algebra (small_lu; LAPACK dgesv for many multipliers). The Jacobians of the dead moments
+!> and of lambda . Phi_ee are left out of S; the residual is exact. A correction with
+!> max |de| <= tol * length_scale ends the step (jacobian_reuse and the constant policy: an
+!> error estimate below it, see converged).
 !>
 !> The run's settings and what the stepper learns from step to step (contraction estimate,
 !> reuse back-off, predictor) live apart from the system, in stepper.f90's stepper_run; the
@@ -42,7 +43,10 @@
 !> with a period-2 alternation e''_n + e''_{n-1} - e''_{n-2}, or the fitted recurrence
 !> e''_n + alpha d_n + beta d_{n-1} (d_k = e''_k - e''_{k-1}; alpha, beta fitted to the last
 !> three differences over all coordinates: one dominant mode, e.g. the cable's ringing
-!> axial mode at rho_inf = 1) (the extrapolations only across steps of the same size). A
+!> axial mode at rho_inf = 1), or the recurrence of order 6 e''_n + sum_j c_j d_{n+1-j}
+!> fitted to the last nine differences (several modes at once: the 5-node cable pendulum's
+!> ringing e'' predicted ~75 times better, its first correction ~1e-7 m instead of ~1e-5)
+!> (the extrapolations only across steps of the same size). A
 !> smooth motion (the spin-up's rotating acceleration) is predicted to O(h^3) instead of
 !> O(h): the first correction of the W = 4 spin-up, 11 nodes, dt 5e-3, falls from ~6e-6 m,
 !> the step from 2.84 to 1.80 corrections; the 5-node cable pendulum 3.37 -> 2.82. The
@@ -64,7 +68,7 @@ module time_integrator
                                frame_gradients, energies, probe_output, policy_constant, &
                                power_count, energy_count, contact_record, contact_step_limit
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
-                     jacobian_reuse, update_reuse_backoff
+                     jacobian_reuse, update_reuse_backoff, contraction_memory
   use kernel_errors, only: failure_text, message_length
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
@@ -99,6 +103,10 @@ module time_integrator
   !> the smallest turn (rad) since the factorization that jacobian_reuse carries the matrix
   !> through (carried_rotation); below it the unturned matrix is as good
   real(dp), parameter :: carry_threshold = 1e-3_dp
+  !> the most multipliers whose Schur complement is solved by small_lu (LAPACK's dgesv,
+  !> dgetrf and dgetrs above: for 2 multipliers they cost ~800 instructions a call, most of
+  !> it the library's dispatch and workspace)
+  integer, parameter :: small_dense_limit = 8
 
   !> The stagnation and divergence test of a step's Newton iteration (reset at each try).
   type :: newton_monitor
@@ -356,6 +364,8 @@ contains
     if (info == 0 .or. (info == 3 .and. sys%factorized)) then
       learned%theta = -1.0_dp
       learned%unconfirmed = 0
+      learned%matrix_measured = 0
+      learned%matrix_unconfirmed = 0
     end if
     learned%carry_on = .false.
     if (info == 0 .and. carry_enabled(sys)) then
@@ -418,6 +428,8 @@ contains
     integer, intent(out) :: info, detail
     real(dp) :: strain, previous_correction, step_cap, step_theta
     integer :: it, lapack_info, active, i
+    integer :: refreshed_at  ! the correction after which the matrix was last refreshed
+    logical :: measured      ! the step's contraction entered the learned bound (converged)
     logical :: use_known, refresh, capped, halt, finite
     real(dp) :: largest_correction, largest_coordinate, step_part
     logical :: carry_ready  ! the carried Schur complement is built for this step
@@ -431,6 +443,8 @@ contains
     carry_ready = .false.
     previous_correction = huge(1.0_dp)
     step_theta = 0.0_dp
+    refreshed_at = 0
+    measured = .false.
     active = sys%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
@@ -447,6 +461,7 @@ contains
           sys%npoint > 0 .and. active /= sys%factor_active .and. it < cfg%max_newton) then
         call refresh_matrix()
         if (info /= 0) return
+        refreshed_at = it - 1
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
                       phi, gradients, strain, active, work, info, predicted_internal)
         if (info /= 0) return
@@ -481,7 +496,12 @@ contains
         call schur_complement(sys%flexibility_cc, w, work%flex_w, schur)
         call gradient_product(sys, gradients, direction, dlam(:, 1))
         dlam(:, 1) = dlam(:, 1) - phi
-        call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
+        if (sys%ncon <= small_dense_limit) then
+          call small_lu(schur, ipiv, lapack_info)
+          if (lapack_info == 0) call small_lu_solve(schur, ipiv, dlam(:, 1))
+        else
+          call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
+        end if
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -525,7 +545,8 @@ contains
         return
       end if
       last_correction = largest_correction
-      if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta)) then
+      if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta, &
+                    it - 1 > refreshed_at, measured)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -572,6 +593,7 @@ contains
         call refresh_matrix()
         if (info /= 0) return
         use_known = .true.
+        refreshed_at = it
       end if
       previous_correction = last_correction
     end do
@@ -610,7 +632,11 @@ contains
           end if
           work%carry_lu = matmul(transpose(work%carry_columns), work%carry_flexibility)
         end if
-        call dgetrf(sys%ncon, sys%ncon, work%carry_lu, sys%ncon, work%ipiv, lapack_info)
+        if (sys%ncon <= small_dense_limit) then
+          call small_lu(work%carry_lu, work%ipiv, lapack_info)
+        else
+          call dgetrf(sys%ncon, sys%ncon, work%carry_lu, sys%ncon, work%ipiv, lapack_info)
+        end if
         if (lapack_info /= 0) then
           info = 4
           detail = lapack_info
@@ -620,8 +646,12 @@ contains
       end if
       call gradient_product(sys, work%gradients, work%direction, work%dlam(:, 1))
       work%dlam(:, 1) = work%dlam(:, 1) - work%phi
-      call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
-                  lapack_info)
+      if (sys%ncon <= small_dense_limit) then
+        call small_lu_solve(work%carry_lu, work%ipiv, work%dlam(:, 1))
+      else
+        call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
+                    lapack_info)
+      end if
       if (allocated(sys%carry_plane)) then
         call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
@@ -667,6 +697,61 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> LU factorization with partial pivoting P A = L U of a small dense matrix in place
+  !> (LAPACK dgetf2's algorithm: the first largest |entry| of each column as its pivot,
+  !> whole rows swapped; L below the diagonal with a unit diagonal, U on and above it);
+  !> info = k > 0: U(k, k) is exactly zero (as dgetrf's info).
+  pure subroutine small_lu(a, ipiv, info)
+    real(dp), intent(inout) :: a(:, :)
+    integer, intent(out) :: ipiv(:), info
+    integer :: n, j, k, p
+    real(dp) :: row(size(a, 2))
+    n = size(a, 1)
+    info = 0
+    do j = 1, n
+      p = j - 1 + maxloc(abs(a(j:n, j)), 1)
+      ipiv(j) = p
+      if (a(p, j) /= 0.0_dp) then
+        if (p /= j) then
+          row = a(j, :)
+          a(j, :) = a(p, :)
+          a(p, :) = row
+        end if
+        a(j + 1:n, j) = a(j + 1:n, j) / a(j, j)
+      else if (info == 0) then
+        info = j
+      end if
+      do k = j + 1, n
+        a(j + 1:n, k) = a(j + 1:n, k) - a(j + 1:n, j) * a(j, k)
+      end do
+    end do
+  end subroutine small_lu
+
+  !> Solves A x = b (b overwritten by x) with small_lu's factors of A: the row swaps, the
+  !> unit lower and the upper triangular solves (as dgetrs).
+  pure subroutine small_lu_solve(a, ipiv, b)
+    real(dp), intent(in) :: a(:, :)
+    integer, intent(in) :: ipiv(:)
+    real(dp), intent(inout) :: b(:)
+    integer :: n, j
+    real(dp) :: swap
+    n = size(a, 1)
+    do j = 1, n
+      if (ipiv(j) /= j) then
+        swap = b(j)
+        b(j) = b(ipiv(j))
+        b(ipiv(j)) = swap
+      end if
+    end do
+    do j = 1, n - 1
+      b(j + 1:n) = b(j + 1:n) - b(j) * a(j + 1:n, j)
+    end do
+    do j = n, 1, -1
+      b(j) = b(j) / a(j, j)
+      b(1:j - 1) = b(1:j - 1) - b(j) * a(1:j - 1, j)
+    end do
+  end subroutine small_lu_solve
 
   !> The Schur complement C = W^T F W of the multipliers (F = E_c^T S^{-1} E_c, W the
   !> solver-frame gradients at the touched blocks), with flex_w = F W: matmul's sums (each
@@ -791,21 +876,52 @@ contains
   !> with the contraction theta = last / previous from the second correction on. With the
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
-  !> it every confirm_every accepted steps; reuse measures it in every step (the matrix ages).
-  logical function converged(sys, cfg, learned, it, last, previous, step_theta) result(ok)
+  !> it every confirm_every accepted steps.
+  !> jacobian_reuse measures the contraction in every step that reaches its third
+  !> correction and accepts from there on the step's largest ratio (the first ratio, from
+  !> the predictor's error, mostly measures its linear part). At the second correction it
+  !> accepts on the contraction bound theta_b learned from earlier steps (issue 26;
+  !> docs/theory.md section 14): the largest of the ratios measured from a third correction
+  !> on (both corrections of a ratio made with the current factorization: same_matrix), one
+  !> per measuring step (its largest), over the last contraction_memory measuring steps
+  !> since the factorization (learned%matrix_ratios), when
+  !>   theta / (1 - theta) last <= tol L,  theta = max(last / previous, min(0.5, 2 theta_b)):
+  !> twice the bound, never below the step's own first ratio; and only while the
+  !> contraction is steady: at least steady_count measurements, the largest within
+  !> steady_spread times the smallest (the 5-node cable pendulum: spreads 1.2-8, median 2,
+  !> no ratio above 1.7 times the bound before it; the driven luffing boom's ratios jump
+  !> between 1e-3 and 0.3 from step to step, spreads 4-750, median 33: not accepted
+  !> there, where a decayed maximum as the bound left up to 4.6 tol L). Not with contact
+  !> points (their corrections fall irregularly), not without a bound (a new factorization
+  !> forgets it: a refresh, a changed contact set or step, a retry), not when the matrix
+  !> was refreshed within the step, and not after confirm_every steps in a row accepted on
+  !> the bound: that step goes on to its third correction and measures the contraction
+  !> again (a drive, a large rotation or a stiffening shows there). The caller checks the
+  !> constraints to the tolerance whenever a step is accepted on an estimate (newton), and
+  !> the stagnation and divergence tests (stagnated) run on every correction not accepted.
+  !> measured: this step has its entry in the bound's ring.
+  logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix, &
+                             measured) result(ok)
     type(system_model), intent(in) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
     integer, intent(in) :: it
     real(dp), intent(in) :: last, previous
     real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
+    logical, intent(in) :: same_matrix     ! last and previous came from the same matrix
+    logical, intent(inout) :: measured
     integer, parameter :: confirm_every = 20
-    real(dp) :: limit, theta
+    ! a steady contraction: at least steady_count measurements, the largest within
+    ! steady_spread times the smallest
+    integer, parameter :: steady_count = 8
+    real(dp), parameter :: steady_spread = 4.0_dp
+    real(dp) :: limit, theta, bound
+    integer :: slot, known  ! the ring's entry of this step; the entries measured
     limit = cfg%tol * cfg%length_scale
     ok = last <= limit
     if (sys%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
     if (it == 1) then
-      ! (reuse: the matrix ages, its contraction with it: measured in every step)
+      ! (reuse: the first correction is never accepted on an estimate)
       if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every .or. &
           sys%policy /= policy_constant) then
         if (ok) learned%unconfirmed = learned%unconfirmed + 1
@@ -822,10 +938,30 @@ contains
     ! the largest contraction of the step: a contact point that moves, sticks or slips
     ! makes the corrections fall irregularly, and a small ratio after a large one is no
     ! evidence that the next would be as small
-    ! (and the first ratio, from the predictor's error, mostly measures the linear part)
     if (it == 2 .and. sys%policy /= policy_constant) then
       step_theta = theta
+      if (ok .or. sys%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
+          learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
+      known = min(learned%matrix_measured, contraction_memory)
+      bound = maxval(learned%matrix_ratios(1:known))
+      if (.not. bound <= steady_spread * minval(learned%matrix_ratios(1:known))) return
+      theta = max(theta, min(0.5_dp, 2.0_dp * bound))
+      ok = theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit
+      if (ok) learned%matrix_unconfirmed = learned%matrix_unconfirmed + 1
       return
+    end if
+    if (sys%policy /= policy_constant .and. same_matrix) then
+      ! the step's entry in the ring: its largest ratio from the third correction on
+      if (.not. measured) then
+        learned%matrix_measured = learned%matrix_measured + 1
+        slot = modulo(learned%matrix_measured - 1, contraction_memory) + 1
+        learned%matrix_ratios(slot) = theta
+        measured = .true.
+      else
+        slot = modulo(learned%matrix_measured - 1, contraction_memory) + 1
+        learned%matrix_ratios(slot) = max(learned%matrix_ratios(slot), theta)
+      end if
+      learned%matrix_unconfirmed = 0
     end if
     step_theta = max(step_theta, theta)
     ok = ok .or. (step_theta < 1.0_dp .and. step_theta / (1.0_dp - step_theta) * last <= limit)

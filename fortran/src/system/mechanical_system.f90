@@ -107,6 +107,8 @@ module mechanical_system
     ! x coordinate of its pair (y: x + 1), and each pair's x coordinate
     integer, allocatable :: mass_pair_ptr(:), mass_pair_col(:), mass_pair_row(:)
     real(dp), allocatable :: mass_pair_values(:)
+    ! the pairs' x coordinates are 1, 3, 5, .. in pair order (kinetic_energy's one pass)
+    logical :: mass_pairs_ordered = .false.
     ! full pattern of the tangents; q = B e + q0 and the plan of B^T S B
     integer, allocatable :: full_row_ptr(:), full_col(:)
     logical :: reduced = .false.
@@ -339,6 +341,7 @@ contains
     integer :: npair, p, k, row_x, row_y, kx, ky, count_x, nnz
     if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
                                                   sys%mass_pair_row, sys%mass_pair_values)
+    sys%mass_pairs_ordered = .false.
     if (sys%mass_kron .or. .not. allocated(sys%carry_plane) .or. &
         .not. allocated(sys%mass_row_ptr)) return
     npair = size(sys%carry_plane, 2)
@@ -381,7 +384,40 @@ contains
         sys%mass_values(kx:kx + count_x - 1)
       sys%mass_pair_ptr(p + 1) = sys%mass_pair_ptr(p) + count_x
     end do
+    sys%mass_pairs_ordered = all(sys%mass_pair_row == [(2 * p - 1, p = 1, npair)])
   end subroutine plane_mass_setup
+
+  !> kinetic: the kinetic energy 1/2 e'^T M e' (M: mass_product's). With the plane's pairs in
+  !> coordinate order, in one pass: each row's sums as mass_product takes them, and their
+  !> products with e' summed in coordinate order from 0, as dot_product(v, M v) sums them
+  !> (the same number, bit for bit, without M v in memory); otherwise by mass_product and
+  !> dot_product (mv: work, ndof).
+  pure subroutine kinetic_energy(sys, v, mv, kinetic)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: v(:)
+    real(dp), intent(out) :: mv(:), kinetic
+    integer :: i, k, j
+    real(dp) :: total, total_x, total_y, m
+    if (sys%mass_pairs_ordered .and. allocated(sys%mass_pair_ptr)) then
+      total = 0.0_dp
+      do i = 1, size(sys%mass_pair_ptr) - 1
+        total_x = 0.0_dp
+        total_y = 0.0_dp
+        do k = sys%mass_pair_ptr(i), sys%mass_pair_ptr(i + 1) - 1
+          j = sys%mass_pair_col(k)
+          m = sys%mass_pair_values(k)
+          total_x = total_x + m * v(j)
+          total_y = total_y + m * v(j + 1)
+        end do
+        total = total + v(2 * i - 1) * total_x
+        total = total + v(2 * i) * total_y
+      end do
+      kinetic = 0.5_dp * total
+      return
+    end if
+    call mass_product(sys, v, mv)
+    kinetic = 0.5_dp * dot_product(v, mv)
+  end subroutine kinetic_energy
 
   !> y = M x for a CSR matrix (1-based).
   pure subroutine csr_matvec(row_ptr, col, values, x, y)
@@ -1343,8 +1379,8 @@ contains
     real(dp), intent(out), optional, target :: ndof_work(:, :)
     real(dp), allocatable, target :: own_full(:), own_ndof(:, :)
     real(dp), pointer :: e_full(:), mv(:), loads(:)
-    real(dp) :: pivot(3), director(3)
-    integer :: p, k, f, m
+    real(dp) :: pivot(3), director(3), relative(3), total
+    integer :: p, k, f, m, j
     info = 0
     if (present(known_full)) then
       e_full => known_full
@@ -1366,16 +1402,29 @@ contains
       f = sys%probe_frame(p)
       pivot = 0.0_dp
       if (f > 0) pivot = sys%frames(f)%pivot
-      deflection(:, p) = matmul(transpose(rotations(:, :, f)), probe(:, p) - pivot) &
-                         - sys%probe_reference(:, p)
+      ! A_f^T (p - pivot) by its sums as matmul takes them (from 0, in the order of the
+      ! rows), without matmul's library call and temporaries
+      relative = probe(:, p) - pivot
+      do k = 1, 3
+        total = 0.0_dp
+        do j = 1, 3
+          total = total + rotations(j, k, f) * relative(j)
+        end do
+        deflection(k, p) = total - sys%probe_reference(k, p)
+      end do
     end do
-    call mass_product(sys, v, mv)
     energy = 0.0_dp
-    energy(energy_kinetic) = 0.5_dp * dot_product(v, mv)
+    call kinetic_energy(sys, v, mv, energy(energy_kinetic))
     energy(energy_strain) = strain
-    call external_forces(sys, t, 1.0_dp, loads, info)
-    if (info /= 0) return
-    energy(energy_loads) = -dot_product(loads, e)
+    if (size(sys%force_drive) == 0) then
+      ! the constant loads alone: the external loads at load factor 1 are constant_force
+      ! (bit for bit)
+      energy(energy_loads) = -dot_product(sys%constant_force, e)
+    else
+      call external_forces(sys, t, 1.0_dp, loads, info)
+      if (info /= 0) return
+      energy(energy_loads) = -dot_product(loads, e)
+    end if
     do m = 1, size(sys%moment_magnitude)
       do k = 1, 3  ! (gathered by a loop: a vector subscript made a heap temporary)
         director(k) = e_full(sys%moment_dofs(k, m))
