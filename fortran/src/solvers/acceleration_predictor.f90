@@ -253,7 +253,7 @@ contains
                          learned%recurrence_differences, learned%recurrence_dots)
     learned%recurrence_ready = .false.
     if (learned%predict_history < recurrence_span) return
-    call fit_modes(learned%recurrence_dots, columns, learned%recurrence_coefficients, &
+    call fit_modes(learned%recurrence_dots, learned%recurrence_coefficients, &
                    learned%recurrence_ready)
     if (.not. learned%recurrence_ready) return
     call predicted_difference(size(accel), learned%recurrence_differences, columns, &
@@ -261,19 +261,20 @@ contains
   end subroutine learn_modes
 
   !> d = accel_new - accel into ring column columns(0) of differences (n, recurrence_span)
-  !> and its dot products with the differences of lags 0 .. recurrence_order into dots
-  !> (symmetric, by ring column), in one pass over the coordinates (each product summed in
-  !> coordinate order, as dot_product would). fit_modes reads the products of lags a, b
-  !> with |a - b| <= recurrence_order only (its normal equations' a, b in 1 ..
-  !> recurrence_span - 1, |a - b| < recurrence_order; its right-hand side's
-  !> b - a = 1 .. recurrence_order): those of lags recurrence_order + 1 .. recurrence_span - 1 with
-  !> the newest are never read (their entries keep older products).
+  !> and its dot products with the differences of lags 0 .. recurrence_order into dots, the
+  !> products by lag (dots(a + 1, b + 1) = d(lag a) . d(lag b), a >= b: the lower triangle;
+  !> the older products move one lag on, the new ones in column 1), each summed over the
+  !> coordinates in their order, as dot_product would, in one pass. fit_modes reads the
+  !> products of lags a, b with |a - b| <= recurrence_order only (its normal equations' a, b
+  !> in 1 .. recurrence_span - 1, |a - b| < recurrence_order; its right-hand side's b - a = 1
+  !> .. recurrence_order): those of the newest with lags recurrence_order + 1 ..
+  !> recurrence_span - 1 are never read (their entries keep older products).
   pure subroutine push_difference(n, accel, accel_new, columns, differences, dots)
     integer, intent(in) :: n, columns(0:recurrence_span - 1)
     real(dp), intent(in) :: accel(n), accel_new(n)
     real(dp), intent(inout) :: differences(n, recurrence_span)
     real(dp), intent(inout) :: dots(recurrence_span, recurrence_span)
-    integer :: lag, i
+    integer :: lag, i, a, b
     real(dp) :: total(0:recurrence_order), d
     total = 0.0_dp
     do i = 1, n
@@ -283,9 +284,14 @@ contains
         total(lag) = total(lag) + d * differences(i, columns(lag))
       end do
     end do
+    ! (backwards: each entry is read before it is overwritten)
+    do b = recurrence_span, 2, -1
+      do a = recurrence_span, b, -1
+        dots(a, b) = dots(a - 1, b - 1)
+      end do
+    end do
     do lag = 0, recurrence_order
-      dots(columns(0), columns(lag)) = total(lag)
-      dots(columns(lag), columns(0)) = total(lag)
+      dots(lag + 1, 1) = total(lag)
     end do
   end subroutine push_difference
 
@@ -313,9 +319,8 @@ contains
   !> dot products of the differences by lag (lagged(a, b) = d_{n-a} . d_{n-b}), scaled to a
   !> unit diagonal and regularized by modes_ridge, by Cholesky; ready = .false. where a
   !> difference vanishes or a pivot is not positive.
-  pure subroutine fit_modes(dots, columns, coefficients, ready)
+  pure subroutine fit_modes(dots, coefficients, ready)
     real(dp), intent(in) :: dots(recurrence_span, recurrence_span)
-    integer, intent(in) :: columns(0:recurrence_span - 1)
     real(dp), intent(out) :: coefficients(recurrence_order)
     logical, intent(out) :: ready
     real(dp) :: normal(recurrence_order, recurrence_order), rhs(recurrence_order)
@@ -323,16 +328,16 @@ contains
     integer :: i, j, k
     ready = .false.
     coefficients = 0.0_dp
-    ! (lagged(a, b) = dots(columns(a), columns(b)), read in place)
+    ! (lagged(a, b) = dots(a + 1, b + 1) for a >= b, push_difference's lower triangle)
     do j = 1, recurrence_order
       rhs(j) = 0.0_dp
       do i = 0, recurrence_window - 1
-        rhs(j) = rhs(j) + dots(columns(i), columns(i + j))
+        rhs(j) = rhs(j) + dots(i + j + 1, i + 1)
       end do
       do k = j, recurrence_order
         normal(k, j) = 0.0_dp
         do i = 0, recurrence_window - 1
-          normal(k, j) = normal(k, j) + dots(columns(i + k), columns(i + j))
+          normal(k, j) = normal(k, j) + dots(i + k + 1, i + j + 1)
         end do
       end do
     end do

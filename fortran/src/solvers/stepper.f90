@@ -61,8 +61,8 @@ module stepper
     integer :: predictor = 0
     ! the recurrence predictor (acceleration_predictor's predict_recurrence): the last
     ! differences d_k = e''_k - e''_{k-1} in a ring (ndof, recurrence_span; newest in column
-    ! recurrence_newest), their dot products (recurrence_span, recurrence_span, by ring
-    ! column), the coefficients fitted to them and the next step's difference they predict
+    ! recurrence_newest), their dot products (recurrence_span, recurrence_span, by lag:
+    ! (a + 1, b + 1) for lags a >= b; acceleration_predictor's push_difference), the coefficients fitted to them and the next step's difference they predict
     ! (recurrence_guess; both valid when recurrence_ready)
     real(dp), allocatable :: recurrence_differences(:, :), recurrence_guess(:)
     real(dp) :: recurrence_dots(recurrence_span, recurrence_span) = 0.0_dp
