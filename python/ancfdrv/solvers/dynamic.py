@@ -33,6 +33,7 @@ dt and dt_min), and the same cuts apply to failed steps.
 """
 from __future__ import annotations
 
+import functools
 import sys
 import time
 from dataclasses import dataclass, field
@@ -140,6 +141,11 @@ class Chunk:
     step_size: np.ndarray | None = None
     substeps: np.ndarray | None = None
     cuts: np.ndarray | None = None
+    #: the kernel's rows the row fields are views of: (rows (nt, row_size), the number of
+    #: columns before q, the fields made from them {name: array}, a function making those
+    #: fields from any (nt, that number) array); a writer that keeps the fields without q
+    #: copies the rows' first columns once (hdf5.thinned_chunk) instead of each field
+    rows: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def newton(self) -> np.ndarray:
@@ -313,14 +319,13 @@ class TimeIntegrator:
         _, probes, deflections, lam, energy, constraint, contact, q = kernel.row_slices(
             s.store_q)
         cols = rows.T[:done]     # (done, row_size): one row per step
-        chunk = Chunk(time=cols[:, 0],
-                      probes=cols[:, probes].reshape(done, kernel.nprobe, 3),
-                      deflections=cols[:, deflections].reshape(done, kernel.nprobe, 3),
-                      lam=cols[:, lam], energy=cols[:, energy],
-                      constraint=cols[:, constraint.start], stats=stats[:, :done].T,
-                      q=cols[:, q] if s.store_q else None,
-                      contact=cols[:, contact].reshape(done, m.npoint, len(CONTACT_RECORD))
-                      if m.contact_pairs else None)
+        made = functools.partial(_row_fields, cuts=(probes, deflections, lam, energy,
+                                                    constraint, contact),
+                                 nprobe=kernel.nprobe,
+                                 npoint=m.npoint if m.contact_pairs else -1)
+        fields = made(cols)
+        chunk = Chunk(**fields, stats=stats[:, :done].T, q=cols[:, q] if s.store_q else None,
+                      rows=(cols, q.start, fields, made))
         return chunk, info, detail
 
     def failure_message(self, info: int, detail: int, t: float, h: float | None = None,
@@ -343,6 +348,19 @@ class TimeIntegrator:
                        f"{h:.3g} s, and solver.dt_min = {s.smallest_step:.3g} s allows no "
                        "smaller one")
         return f"time step from t = {t:.6g} s to t = {t + h:.6g} s failed: {reason}"
+
+
+def _row_fields(cols: np.ndarray, cuts: tuple, nprobe: int, npoint: int) -> dict:
+    """A chunk's row fields (time, probes, deflections, lam, energy, constraint, contact)
+    as views of rows ``cols`` (nt, at least up to q) cut at the layout's slices ``cuts``
+    (probes, deflections, lam, energy, constraint, contact); ``npoint`` < 0: no contact."""
+    probes, deflections, lam, energy, constraint, contact = cuts
+    done = len(cols)
+    return dict(time=cols[:, 0], probes=cols[:, probes].reshape(done, nprobe, 3),
+                deflections=cols[:, deflections].reshape(done, nprobe, 3),
+                lam=cols[:, lam], energy=cols[:, energy], constraint=cols[:, constraint.start],
+                contact=cols[:, contact].reshape(done, npoint, len(CONTACT_RECORD))
+                if npoint >= 0 else None)
 
 
 #: a call's failed-step statistics when no step failed (shared, never written)
@@ -751,7 +769,8 @@ def _check_assumptions(model: Model, chunk: Chunk, state: dict,
             return chunk, ""
         row = int(np.argmax(outside))
         why = _outside(model, chunk.q[row], float(chunk.time[row]), "at")
-        return Chunk(**{k: (None if v is None else v[:row + 1])
+        # (the rows' views: the fields cut here are no longer theirs)
+        return Chunk(**{k: (None if v is None or k == "rows" else v[:row + 1])
                         for k, v in vars(chunk).items()}), why
     if info:
         return chunk, ""
