@@ -80,3 +80,29 @@ def test_layouts_kept_per_key_are_the_layouts_made_anew():
     assert ks.row_size(True) - ks.row_size(False) == 20
     ks.ndof = 21   # another system's sizes: another layout
     assert ks.row_size(True) - ks.row_size(False) == 21
+
+
+@pytest.mark.parametrize("scene, overrides", [
+    ("hard/pendulum.nml", PENDULUM),
+    ("plate_pendulum.nml", ["solver.t_end=0.01"]),
+])
+def test_carry_vectors_kept_are_those_made_anew(scene, overrides):
+    """The kept carry vectors (read only) are those made anew, and a changed policy makes
+    them again."""
+    from ancfdrv.builders import build_model
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.system.model import POLICY_CONSTANT
+    model = build_model(load_scene(INPUTS / scene, overrides))
+    kept, made = model.carry_vectors(), model.made_carry_vectors()
+    assert kept is model.carry_vectors()
+    assert (kept is None) == (made is None)
+    if kept is not None:
+        for a, b in zip(kept, made):
+            assert a.dtype == b.dtype and np.array_equal(a, b) and not a.flags.writeable
+    policy, model.policy = model.policy, POLICY_CONSTANT
+    assert model.carry_vectors() is None and model.made_carry_vectors() is None
+    model.policy = policy
+    again = model.carry_vectors()
+    assert (again is None) == (made is None)
+    if again is not None:
+        assert all(np.array_equal(a, b) for a, b in zip(again, made))
