@@ -493,3 +493,40 @@ def test_single_term_elimination_is_the_general_one(scene, overrides, monkeypatc
             assert relation.terms == other.terms
             assert np.array_equal(np.float64(relation.const), np.float64(other.const))
             assert np.signbit(relation.const) == np.signbit(other.const)
+
+
+def test_energy_watch_waiting_chunks_measure_as_each_alone(monkeypatch):
+    """Chunks measured together after waiting (EnergyWatch.WAIT_ROWS) update the largest
+    balance and the scale as measuring each chunk on arrival did (the former add, written
+    out here), NaN rows and signed zeros included, whatever the chunks' sizes."""
+    rng = np.random.default_rng(9)
+
+    def alone(first, chunks):
+        most = scale = 0.0
+        for energy in chunks:
+            works = energy[:, [5, 6, 8, 9, 10]]
+            balance = energy[:, 4] - first[4] - works.sum(axis=1)
+            potential = energy[:, 1:4].sum(axis=1) - first[1:4].sum()
+            most = max(most, float(balance.max()))
+            scale = max(scale, float(np.abs(energy[:, 0]).max()),
+                        float(np.abs(potential).max()),
+                        float(np.abs(energy[:, 0] + energy[:, 1]).max()),
+                        float(np.abs(works).max()))
+        return most, scale
+    for trial in range(200):
+        sizes = rng.integers(1, 40, int(rng.integers(1, 12)))
+        chunks = [rng.standard_normal((int(n), 11)) * np.exp(rng.uniform(-20, 20, (int(n), 11)))
+                  for n in sizes]
+        for c in chunks:
+            c[rng.random(c.shape) < 0.05] = -0.0
+            if trial % 7 == 0:
+                c[rng.random(c.shape) < 0.02] = np.nan
+        first = chunks[0][0].copy()
+        monkeypatch.setattr(dynamic.EnergyWatch, "WAIT_ROWS", int(rng.integers(1, 100)))
+        watch = dynamic.EnergyWatch(first)
+        for c in chunks:
+            watch.add(c)
+        most, scale = alone(first, chunks)
+        assert (watch.most, watch.scale) == (most, scale)
+        expected = most / scale if scale > 0 else 0.0
+        assert watch.created() == expected

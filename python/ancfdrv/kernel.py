@@ -678,9 +678,18 @@ class KernelSystem:
         self._check(info, "cable set", message)
         return int(index)
 
+    #: the set-up calls that set nothing a new system does not hold already (no frames,
+    #: no drives: system_create's empty lists) are not made (~70,000 instructions of f2py
+    #: argument handling each); False: made (the tests compare the two)
+    SKIP_EMPTY_SETUP = True
+    _frames_set = _drives_set = False
+
     def set_frames(self, drives, axes, bases, pivots) -> None:
         """Frames: drive (0-based drive index, -1: fixed), axis, base (3, 3), pivot."""
         n = len(drives)
+        if n == 0 and not self._frames_set and self.SKIP_EMPTY_SETUP:
+            return   # system_create's frames(0)
+        self._frames_set = True
         info, message = _kernel.system_set_frames(
             self.handle, n, _pad_last(np.asarray(drives, dtype=np.int32) + 1, np.int32),
             _pad_last(np.asarray(axes, dtype=float).reshape(-1, 3).T),
@@ -689,6 +698,9 @@ class KernelSystem:
         self._check(info, "frames", message)
 
     def set_drives(self, kinds, params: list) -> None:
+        if not len(kinds) and not params and not self._drives_set and self.SKIP_EMPTY_SETUP:
+            return   # system_create's drive_kinds(0), drive_ptr = [1], drive_data(0)
+        self._drives_set = True
         ptr = np.concatenate([[0], np.cumsum([len(p) for p in params])]).astype(np.int32) + 1
         data = np.concatenate([np.asarray(p, dtype=float) for p in params]) if params else \
             np.zeros(0)
@@ -927,18 +939,24 @@ class KernelSystem:
         """The slices of the packed state (t, e, v, a, accel, lam, work, powers, guesses) and
         of an output row (time, probes, deflections, lam, energy, constraint, contact, q):
         stepper.f90 ``state_size`` and ``row_size``; computed once per system and store_q."""
+        # kept per key: a run asks for both (the packed state's without q, the rows' with
+        # it), and one kept layout was made again at each change (~9 us)
         key = (self.ndof, self.ncon, self.npoint, self.nprobe, store_q)
-        if getattr(self, "_layout_key", None) != key:
+        kept = self.__dict__.setdefault("_layouts", {})
+        found = kept.get(key)
+        if found is None:
             n, nc, npt, npr = key[:4]
 
             def cut(lengths):
-                edges = np.cumsum([0, *lengths]).tolist()
+                edges = [0]
+                for length in lengths:
+                    edges.append(edges[-1] + int(length))
                 return [slice(a, b) for a, b in zip(edges[:-1], edges[1:])]
-            self._layouts = (cut([1, n, n, n, n, nc, POWER_COUNT, POWER_COUNT, 2 * npt]),
-                             cut([1, 3 * npr, 3 * npr, nc, ENERGY_COUNT, 1,
-                                  len(CONTACT_RECORD) * npt, n if store_q else 0]))
-            self._layout_key = key
-        return self._layouts
+            found = kept[key] = (
+                cut([1, n, n, n, n, nc, POWER_COUNT, POWER_COUNT, 2 * npt]),
+                cut([1, 3 * npr, 3 * npr, nc, ENERGY_COUNT, 1, len(CONTACT_RECORD) * npt,
+                     n if store_q else 0]))
+        return found
 
     def state_size(self) -> int:
         """The length of the packed stepper state (stepper.f90 ``state_size``)."""

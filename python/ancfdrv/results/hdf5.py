@@ -757,6 +757,12 @@ ROW_FIELDS = ("time", "probes", "deflections", "lam", "energy", "constraint", "s
               "contact", "step_size", "substeps", "cuts")
 
 
+#: :func:`thinned_chunk` copies the columns of the kernel's rows before q once when the
+#: chunk's fields are views of them (``Chunk.rows``); False: each field copied (as before;
+#: the tests compare the two)
+ROWS_COPIED_ONCE = True
+
+
 def thinned_chunk(chunk, first_row: int, stride: int, last_row: int, frames: bool):
     """A chunk without q, as a writer keeps it when /dynamic/q is not stored: the
     :data:`ROW_FIELDS` copied, ``q_last`` (the last row's q) and ``q = None``; and its
@@ -765,16 +771,31 @@ def thinned_chunk(chunk, first_row: int, stride: int, last_row: int, frames: boo
     (rows, q at those rows), or None when ``frames`` is False or no row is a frame row.
     Used by the file's :class:`DynamicWriter` and by the in-memory writer alike."""
     from types import SimpleNamespace
-    out = SimpleNamespace(**{f: None if getattr(chunk, f, None) is None
+    copies = {}
+    made = getattr(chunk, "rows", None) if ROWS_COPIED_ONCE else None
+    if made is not None:
+        # the fields still the views of the kernel's rows they were made as: the rows'
+        # columns before q copied once and the same views made of the copy (one copy of
+        # nt rows instead of one strided copy per field; the same values)
+        rows, width, fields, make = made
+        fresh = make(np.array(rows[:, :width]))
+        copies = {f: fresh[f] for f, v in fields.items()
+                  if v is not None and getattr(chunk, f, None) is v}
+    out = SimpleNamespace(**{f: copies[f] if f in copies else None
+                             if getattr(chunk, f, None) is None
                              else np.array(getattr(chunk, f)) for f in ROW_FIELDS})
     out.q = None
     n = len(chunk.time)
     out.q_last = np.array(chunk.q[-1]) if n else None
     if not (frames and n):
         return out, None
-    rows = first_row + np.arange(n)
-    pick = (rows % stride == 0) | (rows == last_row)
-    return out, ((rows[pick], chunk.q[pick]) if pick.any() else None)
+    # the frame rows: every stride-th row of the run and last_row (ascending), picked
+    # by index (a mask over every row cost as much as the copy)
+    picked = np.arange((-first_row) % stride, n, stride)
+    if 0 <= last_row - first_row < n and last_row % stride:
+        at = last_row - first_row
+        picked = np.insert(picked, int(np.searchsorted(picked, at)), at)
+    return out, ((first_row + picked, chunk.q[picked]) if len(picked) else None)
 
 
 def complete_answers(recorder) -> bool:

@@ -33,6 +33,7 @@ dt and dt_min), and the same cuts apply to failed steps.
 """
 from __future__ import annotations
 
+import functools
 import sys
 import time
 from dataclasses import dataclass, field
@@ -140,6 +141,11 @@ class Chunk:
     step_size: np.ndarray | None = None
     substeps: np.ndarray | None = None
     cuts: np.ndarray | None = None
+    #: the kernel's rows the row fields are views of: (rows (nt, row_size), the number of
+    #: columns before q, the fields made from them {name: array}, a function making those
+    #: fields from any (nt, that number) array); a writer that keeps the fields without q
+    #: copies the rows' first columns once (hdf5.thinned_chunk) instead of each field
+    rows: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def newton(self) -> np.ndarray:
@@ -313,14 +319,13 @@ class TimeIntegrator:
         _, probes, deflections, lam, energy, constraint, contact, q = kernel.row_slices(
             s.store_q)
         cols = rows.T[:done]     # (done, row_size): one row per step
-        chunk = Chunk(time=cols[:, 0],
-                      probes=cols[:, probes].reshape(done, kernel.nprobe, 3),
-                      deflections=cols[:, deflections].reshape(done, kernel.nprobe, 3),
-                      lam=cols[:, lam], energy=cols[:, energy],
-                      constraint=cols[:, constraint.start], stats=stats[:, :done].T,
-                      q=cols[:, q] if s.store_q else None,
-                      contact=cols[:, contact].reshape(done, m.npoint, len(CONTACT_RECORD))
-                      if m.contact_pairs else None)
+        made = functools.partial(_row_fields, cuts=(probes, deflections, lam, energy,
+                                                    constraint, contact),
+                                 nprobe=kernel.nprobe,
+                                 npoint=m.npoint if m.contact_pairs else -1)
+        fields = made(cols)
+        chunk = Chunk(**fields, stats=stats[:, :done].T, q=cols[:, q] if s.store_q else None,
+                      rows=(cols, q.start, fields, made))
         return chunk, info, detail
 
     def failure_message(self, info: int, detail: int, t: float, h: float | None = None,
@@ -343,6 +348,19 @@ class TimeIntegrator:
                        f"{h:.3g} s, and solver.dt_min = {s.smallest_step:.3g} s allows no "
                        "smaller one")
         return f"time step from t = {t:.6g} s to t = {t + h:.6g} s failed: {reason}"
+
+
+def _row_fields(cols: np.ndarray, cuts: tuple, nprobe: int, npoint: int) -> dict:
+    """A chunk's row fields (time, probes, deflections, lam, energy, constraint, contact)
+    as views of rows ``cols`` (nt, at least up to q) cut at the layout's slices ``cuts``
+    (probes, deflections, lam, energy, constraint, contact); ``npoint`` < 0: no contact."""
+    probes, deflections, lam, energy, constraint, contact = cuts
+    done = len(cols)
+    return dict(time=cols[:, 0], probes=cols[:, probes].reshape(done, nprobe, 3),
+                deflections=cols[:, deflections].reshape(done, nprobe, 3),
+                lam=cols[:, lam], energy=cols[:, energy], constraint=cols[:, constraint.start],
+                contact=cols[:, contact].reshape(done, npoint, len(CONTACT_RECORD))
+                if npoint >= 0 else None)
 
 
 #: a call's failed-step statistics when no step failed (shared, never written)
@@ -465,29 +483,69 @@ class EnergyWatch:
 
     def __init__(self, first: np.ndarray) -> None:
         self.first = first.copy()
-        self.most, self.scale = 0.0, 0.0
+        self._most, self._scale = 0.0, 0.0
+        #: chunks' energy columns (11, rows) waiting to be measured together
+        self._waiting: list[np.ndarray] = []
+        self._waiting_rows = 0
 
     #: the works among ENERGY_NAMES (drives, frames, contact damping, friction, damping)
     WORKS = (5, 6, 8, 9, 10)
     _WORK_ROWS = list(WORKS)
+    #: chunks wait until this many rows (90 kB of energies) are there, or until
+    #: :meth:`created` is asked: the ~20 numpy calls of a measurement are then made once for
+    #: many chunks (a chunk of a single step under step control paid ~25 us for them)
+    WAIT_ROWS = 1024
 
     def add(self, energy: np.ndarray) -> None:
+        # the chunk's columns copied contiguous once (they are strided views of the
+        # kernel's rows: each operation on them was a strided loop)
+        self._waiting.append(np.ascontiguousarray(energy.T))
+        self._waiting_rows += len(energy)
+        if self._waiting_rows >= self.WAIT_ROWS:
+            self._measure()
+
+    def _measure(self) -> None:
+        """Measure the waiting chunks: per chunk, in order, what measuring it alone gave
+        (its maxima by np.maximum.reduceat over the chunks' rows: the same maxima, NaN
+        included, and the same updates of ``most`` and ``scale``, chunk after chunk)."""
+        waiting, self._waiting, self._waiting_rows = self._waiting, [], 0
+        if not waiting:
+            return
+        columns = waiting[0] if len(waiting) == 1 else np.concatenate(waiting, axis=1)
+        starts = np.zeros(len(waiting), dtype=np.intp)
+        if len(waiting) > 1:
+            np.cumsum([w.shape[1] for w in waiting[:-1]], out=starts[1:])
         # column by column: the sums in numpy's order of a row sum over a few columns (left
         # to right), so the figures are bitwise those of works.sum(axis=1) and
-        # energy[:, 1:4].sum(axis=1); the columns copied contiguous once (the chunk's are
-        # strided views of the kernel's rows: each operation on them was a strided loop)
-        columns = np.ascontiguousarray(energy.T)
+        # energy[:, 1:4].sum(axis=1)
         works = columns[5] + columns[6] + columns[8] + columns[9] + columns[10]
         balance = columns[4] - self.first[4] - works
         potential = columns[1] + columns[2] + columns[3] - self.first[1:4].sum()
-        self.most = max(self.most, float(balance.max()))
-        self.scale = max(self.scale, float(np.abs(columns[0]).max()),
-                         float(np.abs(potential).max()),
-                         float(np.abs(columns[0] + columns[1]).max()),
-                         float(np.abs(columns[self._WORK_ROWS]).max()))
+        most = np.maximum.reduceat(balance, starts)
+        scales = np.maximum.reduceat(
+            np.abs(np.stack([columns[0], potential, columns[0] + columns[1]])), starts, axis=1)
+        work = np.maximum.reduceat(np.abs(columns[self._WORK_ROWS]), starts, axis=1)
+        work = np.maximum.reduce(work, axis=0)
+        for k in range(len(waiting)):
+            self._most = max(self._most, float(most[k]))
+            self._scale = max(self._scale, float(scales[0, k]), float(scales[1, k]),
+                              float(scales[2, k]), float(work[k]))
+
+    @property
+    def most(self) -> float:
+        """The largest balance so far (J; the waiting chunks measured first)."""
+        self._measure()
+        return self._most
+
+    @property
+    def scale(self) -> float:
+        """The run's energy scale so far (J; the waiting chunks measured first)."""
+        self._measure()
+        return self._scale
 
     def created(self) -> float:
-        return self.most / self.scale if self.scale > 0 else 0.0
+        most, scale = self.most, self.scale
+        return most / scale if scale > 0 else 0.0
 
 
 def _restart(model: Model, state: dict) -> None:
@@ -751,7 +809,8 @@ def _check_assumptions(model: Model, chunk: Chunk, state: dict,
             return chunk, ""
         row = int(np.argmax(outside))
         why = _outside(model, chunk.q[row], float(chunk.time[row]), "at")
-        return Chunk(**{k: (None if v is None else v[:row + 1])
+        # (the rows' views: the fields cut here are no longer theirs)
+        return Chunk(**{k: (None if v is None or k == "rows" else v[:row + 1])
                         for k, v in vars(chunk).items()}), why
     if info:
         return chunk, ""

@@ -693,7 +693,7 @@ def _reduced_assumptions(model: Model, reduced: ReducedFFR, chunk, eta: np.ndarr
     why = _outside(model, e[k], float(times[row]), "at")
     kept = {}
     for key, value in vars(chunk).items():
-        if value is None:
+        if value is None or key == "rows":   # (the kernel's rows: not cut)
             kept[key] = None
         elif isinstance(value, ExpandedRows):
             kept[key] = ExpandedRows(reduced, value.times[:row + 1], value.eta[:row + 1])

@@ -460,6 +460,23 @@ class Model:
         return bool(ok_k and ok_m)
 
     def carry_vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`made_carry_vectors`, made once per state of what they depend on (the
+        policy, the length scale, the contact pairs, sets, bodies and reduction; read-only
+        arrays): the kernel's hand-over (:meth:`touched_blocks`) and each run's start ask
+        for them (~0.1 M instructions each on a 5-node cable)."""
+        key = (self.policy, self.length_scale, self.nfull, len(self.contact_pairs),
+               len(self.sets), len(self.bodies))
+        kept = self.__dict__.get("_carry_vectors")
+        if kept is not None and kept[0] == key and kept[1] is self.reduction:
+            return kept[2]
+        made = self.made_carry_vectors()
+        if made is not None:
+            for array in made:
+                array.flags.writeable = False
+        self.__dict__["_carry_vectors"] = (key, self.reduction, made)
+        return made
+
+    def made_carry_vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """The 3-vectors the stepper fits the system's rotation to when it carries its
         iteration matrix under rotation (``solver.carry``, docs/theory.md "The iteration
         matrix carried with the rotation"): (first full coordinate of each vector, weight,

@@ -150,6 +150,37 @@ class Reduction:
         full = self.matrix.matvec(np.asarray(x).T).T
         return full + self.offset if with_offset else full
 
+    def expand_columns(self, x: np.ndarray, columns: np.ndarray) -> np.ndarray:
+        """``expand(x)[..., columns]`` (with the offset) without forming the other full
+        coordinates: the same operations on the columns asked for, so bit for bit the same
+        values (the selected ones x + q0, the others 0 + q0; with a general B the rows
+        ``columns`` of B, each summed from 0 in storage order as :meth:`Csr.matvec` sums
+        it, plus q0), column-major. For readers of a few full coordinates at every row (the joints'
+        reactions): an expansion of every row costs ~15 instructions per entry."""
+        x = np.asarray(x)
+        columns = np.asarray(columns, dtype=np.int64)
+        if x.shape[-1] != self.matrix.shape[1]:
+            raise ValueError(f"dimension mismatch: {self.matrix.shape} @ {x.T.shape}")
+        if self.selects is not None:
+            where = np.full(len(self.offset), -1, dtype=np.int64)
+            where[self.selects] = np.arange(len(self.selects))
+            source = where[columns]
+            chosen = np.flatnonzero(source >= 0)
+            # column-major (its transpose contiguous: readers take whole columns)
+            out = np.zeros((len(columns),) + x.shape[:-1][::-1],
+                           dtype=np.result_type(self.matrix.data, x)).T
+            out[..., chosen] = x[..., source[chosen]]
+            out += self.offset[columns]
+            return out
+        b = self.matrix
+        starts, stops = b.indptr[columns], b.indptr[columns + 1]
+        counts = stops - starts
+        take = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts) \
+            + np.arange(int(counts.sum()))
+        indptr = np.concatenate([[0], np.cumsum(counts)])
+        rows = Csr(b.data[take], b.indices[take], indptr, (len(columns), b.shape[1]))
+        return rows.matvec(x.T).T + self.offset[columns]
+
     def reduce(self, full: np.ndarray) -> np.ndarray:
         """B^T Q (eq. 37)."""
         return self.matrix.rmatvec(full)
