@@ -1282,7 +1282,7 @@ def _hard_md(problems: dict[str, Any]) -> list[str]:
         out.append("mesh: ancfdrv nodes, Exudyn elements; * = reference; wall: the whole call "
                    "(ancfdrv's in memory, `ancfdrv.simulate`: the compared time, as Exudyn's "
                    "sensor keeps its data in memory); with file: ancfdrv's same call writing "
-                   "the SPEC HDF5 file (`run_scene`), timed in the same repeats, interleaved "
+                   "the SPEC HDF5 file (`run_scene`), repeated after the in-memory call's repeats "
                    "(not compared); error: against ancfdrv's reference; self error: against "
                    "the code's own.")
         out.append("")
