@@ -54,7 +54,7 @@ def linspace(start: float, stop: float, num: int) -> np.ndarray:
 
 def _vec(value, what: str, name: str) -> np.ndarray:
     v = np.asarray(value, dtype=float).ravel()
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
+    if v.shape != (3,) or not np.isfinite(v).all():
         raise InputError(f"{name}: {what} must be three finite numbers, got {value!r}")
     return v
 
@@ -253,7 +253,7 @@ class Beam(Body):
             raise InputError(f"{where}: nodes = {self.nodes}: with {k} segments the beam needs "
                              f"{k}j+1 nodes ({', '.join(str(k * j + 1) for j in range(1, 5))}, ...)")
         per = (self.nodes - 1) // k
-        edges = np.concatenate([[0.0], np.cumsum(segments)])
+        edges = np.concatenate([[0.0], np.asarray(segments).cumsum()])
         parts = [linspace(a, b, per + 1)[:-1] for a, b in zip(edges[:-1].tolist(),
                                                               edges[1:].tolist())]
         return np.concatenate(parts + [[edges[-1]]])

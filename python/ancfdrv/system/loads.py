@@ -25,7 +25,7 @@ from .drives import Drive
 
 def _vector(value, what: str) -> np.ndarray:
     v = np.asarray(value, dtype=float).ravel()
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
+    if v.shape != (3,) or not np.isfinite(v).all():
         raise InputError(f"{what}: expected three finite numbers, got {value!r}")
     return v
 
