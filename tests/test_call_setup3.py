@@ -159,3 +159,62 @@ def test_group_names_as_f90nml_s_keys_view(monkeypatch, path):
     fast = scene_module.is_general(nml)
     monkeypatch.setattr(scene_module, "FAST_ITEMS", False)
     assert scene_module.is_general(nml) == fast
+
+
+def test_plain_float_lists_checked_as_coerce_checks_them():
+    """checked_value takes a list of plain floats within the accepted magnitude at once:
+    the same list coerce returns (new, the same floats), and every other list (ints, NaN,
+    infinities, too large, numpy scalars, strings) still through coerce, with its
+    message."""
+    from ancfdrv.io import schema
+    from ancfdrv.io.validate import MAX_MAGNITUDE
+    spec = schema.Key("floats", [])
+    where = dict(group="g", key="k")
+    for raw in ([1.5, -2.0, 0.0], [], [MAX_MAGNITUDE, -MAX_MAGNITUDE], [1, 2.5],
+                [np.float64(3.0), 1.0]):
+        got = schema.checked_value(spec, raw, where)
+        expected = schema.coerce("floats", raw, where)
+        assert got == expected and got is not raw
+        assert [type(x) for x in got] == [type(x) for x in expected] == [float] * len(raw)
+    for raw in ([float("nan")], [1.0, float("inf")], [2 * MAX_MAGNITUDE], [1.0, "a"],
+                [True]):
+        with pytest.raises(InputError) as fast:
+            schema.checked_value(spec, raw, where)
+        with pytest.raises(InputError) as slow:
+            schema.coerce("floats", raw, where)
+        assert str(fast.value) == str(slow.value)
+
+
+def test_control_characters_in_names_as_before():
+    """A name with a character below 32 is refused, any other accepted (the rule
+    ``any(ord(c) < 32 for c in name)``), for every character up to U+3000."""
+    from ancfdrv.system.system import _CONTROL
+    for code in range(0x3000):
+        name = f"a{chr(code)}b"
+        assert (_CONTROL.search(name) is not None) == any(ord(c) < 32 for c in name)
+    s = ancfdrv.System()
+    with pytest.raises(InputError, match="control characters"):
+        s.material("st\teel", youngs_modulus=2e11, density=7850.0)
+
+
+@pytest.mark.parametrize("value", [(1.0, 2.0, 3.0), (1.0, float("nan"), 0.0),
+                                   (float("inf"), 0.0, 0.0), (1.0, 2.0), "abc"])
+def test_points_checked_as_before(value):
+    """A point or vector of three finite numbers is taken, anything else refused with the
+    same message (the finite check by math.isfinite on the values)."""
+    from ancfdrv.system.bodies import _vec
+    from ancfdrv.system.loads import _vector
+    try:
+        v = np.asarray(value, dtype=float).ravel()
+        ok = v.shape == (3,) and bool(np.all(np.isfinite(v)))
+    except ValueError:
+        ok = None
+    for check in (lambda: _vec(value, "point", "x"), lambda: _vector(value, "vector")):
+        if ok:
+            assert check().tobytes() == v.tobytes()
+        elif ok is None:
+            with pytest.raises(ValueError):
+                check()
+        else:
+            with pytest.raises(InputError, match="three finite numbers"):
+                check()

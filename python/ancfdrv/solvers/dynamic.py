@@ -740,9 +740,11 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
                 carried_cut = False
             timing["stepping"] += time.perf_counter() - t1
             steps += len(chunk.time)
-            newton += int(chunk.stats[:, 0].sum())
-            factorizations += int(chunk.stats[:, 1].sum())
-            jacobians += int(chunk.stats[:, 2].sum())
+            # (the three columns' sums in one reduction: integers, exact either way)
+            totals = np.add.reduce(chunk.stats, axis=0)
+            newton += int(totals[0])
+            factorizations += int(totals[1])
+            jacobians += int(totals[2])
             chunk, outside = _check_assumptions(model, chunk, state, pending is not None)
             if len(chunk.time):
                 energy_watch.add(chunk.energy)

@@ -14,6 +14,7 @@ body coordinates u is at r + J u; J = I at t = 0, the body axes are the global a
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,7 +55,7 @@ def linspace(start: float, stop: float, num: int) -> np.ndarray:
 
 def _vec(value, what: str, name: str) -> np.ndarray:
     v = np.asarray(value, dtype=float).ravel()
-    if v.shape != (3,) or not np.isfinite(v).all():
+    if v.shape != (3,) or not all(map(math.isfinite, v.tolist())):   # (np.isfinite(v).all())
         raise InputError(f"{name}: {what} must be three finite numbers, got {value!r}")
     return v
 
