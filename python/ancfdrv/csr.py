@@ -19,14 +19,14 @@ def unique_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """np.unique(keys, return_index=True, return_inverse=True) by one stable sort (numpy's
     default sort and np.unique measured 10-30x slower on the assembly's nearly sorted keys)."""
     keys = np.asarray(keys, dtype=np.int64)
-    perm = np.argsort(keys, kind="stable")
+    perm = keys.argsort(kind="stable")
     ordered = keys[perm]
     new = np.empty(len(keys), dtype=bool)
     new[:1] = True
     np.not_equal(ordered[1:], ordered[:-1], out=new[1:])
-    starts = np.flatnonzero(new)
+    starts = new.nonzero()[0]
     inverse = np.empty(len(keys), dtype=np.int64)
-    inverse[perm] = np.cumsum(new) - 1
+    inverse[perm] = new.cumsum() - 1
     return ordered[starts], perm[starts], inverse
 
 
@@ -34,7 +34,8 @@ def sorted_unique(keys: np.ndarray) -> np.ndarray:
     """np.unique(keys) of integers (flattened, as int64) by a stable sort. Also where speed
     does not matter: numpy >= 2.3 imports numpy.ma for a plain ``np.unique(x)`` (to ask
     whether x is masked), 1.3 MB of a run's peak memory (issue 23)."""
-    ordered = np.sort(np.asarray(keys, dtype=np.int64).ravel(), kind="stable")
+    ordered = np.asarray(keys, dtype=np.int64).ravel().copy()   # (np.sort: a copy, sorted)
+    ordered.sort(kind="stable")
     keep = np.empty(len(ordered), dtype=bool)
     keep[:1] = True
     np.not_equal(ordered[1:], ordered[:-1], out=keep[1:])
@@ -81,7 +82,7 @@ class Csr:
             data = np.zeros(len(unique))
             np.add.at(data, inverse, v)
         indptr = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(unique // m if m else unique, minlength=n), out=indptr[1:])
+        np.bincount(unique // m if m else unique, minlength=n).cumsum(out=indptr[1:])
         return cls(data, unique % m if m else unique, indptr, (n, m))
 
     @classmethod
@@ -91,7 +92,7 @@ class Csr:
         m = int(n)
         keys = sorted_unique(np.asarray(rows, dtype=np.int64) * m + np.asarray(cols, dtype=np.int64))
         indptr = np.zeros(m + 1, dtype=np.int64)
-        np.cumsum(np.bincount(keys // m, minlength=m), out=indptr[1:])
+        np.bincount(keys // m, minlength=m).cumsum(out=indptr[1:])
         return cls(np.ones(len(keys)), keys % m, indptr, (m, m))
 
     @classmethod
@@ -111,7 +112,7 @@ class Csr:
     def row_index(self) -> np.ndarray:
         """The row of every stored entry."""
         indptr = self.indptr   # (indptr[1:] - indptr[:-1]: np.diff without its overhead)
-        return np.repeat(np.arange(self.shape[0], dtype=np.int64), indptr[1:] - indptr[:-1])
+        return np.arange(self.shape[0], dtype=np.int64).repeat(indptr[1:] - indptr[:-1])
 
     def copy(self) -> "Csr":
         return Csr(self.data.copy(), self.indices.copy(), self.indptr.copy(), self.shape)
@@ -137,14 +138,14 @@ class Csr:
         if keep.all():
             return
         counts = np.bincount(self.row_index()[keep], minlength=self.shape[0])
-        self.indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        self.indptr = np.concatenate([[0], counts.cumsum()]).astype(np.int64)
         self.indices, self.data = self.indices[keep], self.data[keep]
 
     def sort_indices(self) -> None:
         """Columns ascending within each row (stable)."""
         keys = self.row_index() * self.shape[1] + self.indices
-        if np.any(keys[1:] < keys[:-1]):
-            order = np.argsort(keys, kind="stable")
+        if (keys[1:] < keys[:-1]).any():
+            order = keys.argsort(kind="stable")
             self.indices, self.data = self.indices[order], self.data[order]
 
     # -- selection ---------------------------------------------------------------------------
@@ -153,7 +154,7 @@ class Csr:
         rows = np.asarray(rows, dtype=np.int64)
         start, stop = self.indptr[rows], self.indptr[rows + 1]
         counts = stop - start
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        indptr = np.concatenate([[0], counts.cumsum()]).astype(np.int64)
         at = np.repeat(start - indptr[:-1], counts) + np.arange(indptr[-1])
         return Csr(self.data[at], self.indices[at], indptr, (len(rows), self.shape[1]))
 
@@ -168,7 +169,7 @@ class Csr:
         new = where[self.indices]
         keep = new >= 0
         counts = np.bincount(self.row_index()[keep], minlength=self.shape[0])
-        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        indptr = np.concatenate([[0], counts.cumsum()]).astype(np.int64)
         return Csr(self.data[keep], new[keep], indptr, (self.shape[0], len(cols)))
 
     def values_at(self, rows, cols) -> np.ndarray:
@@ -179,15 +180,15 @@ class Csr:
         wanted = np.asarray(rows, dtype=np.int64) * ncol + np.asarray(cols, dtype=np.int64)
         if not len(keys):
             return np.zeros(wanted.shape)
-        pos = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+        pos = np.minimum(keys.searchsorted(wanted), len(keys) - 1)
         return np.where(keys[pos] == wanted, self.data[pos], 0.0)
 
     # -- products (scipy's loops) ---------------------------------------------------------------
     def transpose(self) -> "Csr":
         """A^T in CSR: scipy's csr_tocsc (each column's entries in storage order)."""
-        order = np.argsort(self.indices, kind="stable")
+        order = self.indices.argsort(kind="stable")
         indptr = np.zeros(self.shape[1] + 1, dtype=np.int64)
-        np.cumsum(np.bincount(self.indices, minlength=self.shape[1]), out=indptr[1:])
+        np.bincount(self.indices, minlength=self.shape[1]).cumsum(out=indptr[1:])
         return Csr(self.data[order], self.row_index()[order], indptr,
                    (self.shape[1], self.shape[0]))
 
@@ -227,9 +228,9 @@ class Csr:
             return plan[2]
         rows = self.row_index()
         local = np.arange(self.nnz) - self.indptr[rows]
-        order = np.argsort(local, kind="stable")
+        order = local.argsort(kind="stable")
         bounds = np.zeros(int(local.max(initial=-1)) + 2, dtype=np.int64)
-        np.cumsum(np.bincount(local, minlength=len(bounds) - 1), out=bounds[1:])
+        np.bincount(local, minlength=len(bounds) - 1).cumsum(out=bounds[1:])
         self._term_plan = (self.indptr, self.indices, (rows, order, bounds))
         return rows, order, bounds
 
@@ -267,10 +268,10 @@ class Csr:
         np.add.at(sums, group, products)                      # sequential: scipy's order
         rows = unique // m
         # per row: the last touched column first (scipy's linked list); then drop zero sums
-        order = np.argsort(rows * (total + 1) + (total - first), kind="stable")
+        order = (rows * (total + 1) + (total - first)).argsort(kind="stable")
         order = order[sums[order] != 0]
         indptr = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(rows[order], minlength=n), out=indptr[1:])
+        np.bincount(rows[order], minlength=n).cumsum(out=indptr[1:])
         return Csr(sums[order], unique[order] % m, indptr, (n, m))
 
     def congruence(self, inner: "Csr") -> "Csr":

@@ -682,6 +682,11 @@ class KernelSystem:
     #: no drives: system_create's empty lists) are not made (~70,000 instructions of f2py
     #: argument handling each); False: made (the tests compare the two)
     SKIP_EMPTY_SETUP = True
+    #: advance_rows steps into rows and stats made by numpy.empty (system_advance_into):
+    #: f2py zero-filled system_advance's fresh output arrays (a memset of every row, ~0.34
+    #: MB per second of the 5-node pendulum) that the kernel then wrote again in full;
+    #: False: system_advance (the same rows, stats and state bit for bit)
+    ROWS_INTO = True
     _frames_set = _drives_set = False
 
     def set_frames(self, drives, axes, bases, pivots) -> None:
@@ -980,9 +985,16 @@ class KernelSystem:
         cuts, rows_cut = self._layout(store_q)
         npt = self.npoint
         if isinstance(state, PackedState) and len(state.packed) == cuts[-1].stop:
-            packed, counts, rows, stats, status, last_correction, message = \
-                _kernel.system_advance(self.handle, nsteps, h, state.packed, state["counts"],
-                                       rows_cut[-1].stop)
+            if self.ROWS_INTO:   # (system_advance_into: the same call, no zero-fill)
+                rows = np.empty((rows_cut[-1].stop, nsteps), order="F")
+                stats = np.empty((3, nsteps), dtype=np.int32, order="F")
+                packed, counts, status, last_correction, message = \
+                    _kernel.system_advance_into(self.handle, h, state.packed, state["counts"],
+                                                rows, stats, nsteps)
+            else:
+                packed, counts, rows, stats, status, last_correction, message = \
+                    _kernel.system_advance(self.handle, nsteps, h, state.packed,
+                                           state["counts"], rows_cut[-1].stop)
             state.stepped(packed, counts)
             status = status.tolist()
             if status[1] == 9:

@@ -73,6 +73,6 @@ def beam_loads(built: BuiltSystem, scene, beam: Beam, tip) -> None:
                               "not applied")
     for key, effect in (("tip_force", "tip_force"), ("end_moment", "end_moment"),
                         ("moment", "bending_moment")):
-        if effect not in effects and np.any(np.asarray(loads[key]) != 0):
+        if effect not in effects and (np.asarray(loads[key]) != 0).any():
             built.warnings.append(f"loads.{key} is set but {effect!r} is not in scene.effects: "
                                   "not applied")

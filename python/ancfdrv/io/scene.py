@@ -134,6 +134,35 @@ _FAST_INT = re.compile(r"[+-]?\d+\Z")
 _FAST_FLOAT = re.compile(r"[+-]?(?:\d+\.\d*|\.\d+|\d+(?=[eEdD]))(?:[eEdD][+-]?\d+)?\Z")
 _FAST_LOGICAL = {".true.": True, ".t.": True, ".false.": False, ".f.": False}
 _DICT_CONTAINS, _DICT_SET = OrderedDict.__contains__, OrderedDict.__setitem__
+#: a new f90nml Namelist's attributes (what its __init__ sets: output settings, cogroups,
+#: start indices), taken from one made at import
+_NAMELIST_STATE = dict(vars(f90nml.Namelist()))
+#: those of its attributes that are dicts (each Namelist has its own)
+_NAMELIST_DICTS = tuple(k for k, v in _NAMELIST_STATE.items() if type(v) is dict)
+#: fast_reads makes its Namelists by :func:`_new_namelist` (f90nml's __init__ costs ~2 us
+#: a Namelist: platform look-ups, property setters; a scene has one per group) and files
+#: its groups without Namelist.__contains__/__setitem__'s type checks; False: f90nml's
+#: ``Namelist()``, ``in`` and ``nml[name] = group`` (the tests compare the two)
+FAST_NAMELIST = True
+#: a template scene read by fast_reads has its groups and keys read as the Namelists'
+#: own dict items (load_scene, _typed), and every scene's group names are its keys'
+#: cogroup names (load_scene, is_general); False: f90nml's items and keys views (the
+#: tests compare)
+FAST_ITEMS = True
+
+
+def _new_namelist() -> f90nml.Namelist:
+    """An empty ``f90nml.Namelist()``: the same type and attributes (each dict of them a
+    new one, as __init__ makes them), without __init__'s work."""
+    if not FAST_NAMELIST:
+        return f90nml.Namelist()
+    nml = OrderedDict.__new__(f90nml.Namelist)
+    OrderedDict.__init__(nml)
+    state = nml.__dict__
+    state.update(_NAMELIST_STATE)
+    for key in _NAMELIST_DICTS:
+        state[key] = dict(_NAMELIST_STATE[key])
+    return nml
 
 
 def _fast_value(kind: str, token: str) -> Any:
@@ -159,7 +188,7 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
     parser took ~0.4 ms of each scene load). None for anything else (indexed or derived
     keys, repeat counts, complex or null values, unquoted strings, a key given twice,
     text outside the groups, ...): the caller then reads the text with f90nml."""
-    nml = f90nml.Namelist()
+    nml = _new_namelist()
     group: f90nml.Namelist | None = None
     name = key = None
     values: list[Any] = []
@@ -184,7 +213,7 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
         if group is None:
             if kind != "group":
                 return None
-            name, group = token[1:], f90nml.Namelist()
+            name, group = token[1:], _new_namelist()
             if name.lower() == "end":
                 return None
             key, values, after_value = None, [], False
@@ -196,10 +225,18 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
         elif kind == "end":
             if (key is not None and not after_value) or not close_key():
                 return None
-            if name in nml:
+            lower = name.lower()
+            if not FAST_NAMELIST:
+                if name in nml:
+                    nml.add_cogroup(name, group)
+                else:
+                    nml[name] = group
+            # f90nml's `name in nml` and `nml[name] = group` for a Namelist value (stored
+            # under the lower-case name), without their per-call type checks
+            elif _DICT_CONTAINS(nml, lower) or lower in nml._cogroups:
                 nml.add_cogroup(name, group)
             else:
-                nml[name] = group
+                _DICT_SET(nml, lower, group)
             group = key = None
         elif kind == "comma":
             if not after_value:
@@ -286,7 +323,8 @@ def _parse_override_value(kind: str, text: str, where: dict) -> Any:
 def is_general(nml: f90nml.Namelist) -> bool:
     """A general scene (SPEC section 8): no template model group; &beam, &plate, &leaf and
     &material then carry names."""
-    groups = set(nml.keys())
+    # (the names of f90nml's keys view: each key's cogroup name)
+    groups = set(map(_cogroup_name, OrderedDict.keys(nml))) if FAST_ITEMS else set(nml.keys())
     if groups & {"boom", "cantilever", "spinup", "spring", "loads"}:
         return False
     if groups & set(GENERAL_ONLY_GROUPS):
@@ -368,10 +406,14 @@ def _schema_of(group: str, general: bool) -> dict[str, Key] | None:
     return SCHEMA.get(group)
 
 
-def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str) -> dict[str, Any]:
-    """Coerce and check one group's entries against its schema; fill the defaults."""
+def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str,
+           plain: bool = False) -> dict[str, Any]:
+    """Coerce and check one group's entries against its schema; fill the defaults.
+    ``plain``: a group of a namelist :func:`fast_reads` read (lower-case keys that are no
+    cogroup keys): its items read as the dict's own (f90nml's items view makes an NmlKey
+    and calls Namelist.__getitem__ per key: the same keys as str, the same values)."""
     typed: dict[str, Any] = {}
-    for key, raw in entries.items():
+    for key, raw in (OrderedDict.items(entries) if plain else entries.items()):
         where = dict(file=file, group=label, key=key)
         if key not in schema:
             raise InputError(f"unknown key; known keys of &{group}: {', '.join(schema)}", **where)
@@ -401,7 +443,8 @@ def _read_text(path: Path, file: str) -> str:
     if not stat.S_ISREG(status.st_mode):
         raise InputError("the scene is not a regular file", file=file)
     try:
-        data = path.read_bytes()
+        with open(path, "rb") as handle:   # (Path.read_bytes without pathlib's layers)
+            data = handle.read()
     except OSError as exc:
         raise InputError(f"cannot read the scene file: {exc.strerror}", file=file) from None
     try:
@@ -446,7 +489,10 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
         validate.check_repeats(file, validate.scan_groups(text), repeatable)
     _override_addresses(overrides or [], file)
     seen: Counter = Counter()
-    for group, _ in nml.items():  # a repeated group comes once per occurrence
+    # a repeated group comes once per occurrence (f90nml's items view: each key's cogroup
+    # name)
+    for group in (map(_cogroup_name, OrderedDict.keys(nml)) if FAST_ITEMS
+                  else (g for g, _ in nml.items())):
         if _schema_of(group, general) is None:
             known = list(GENERAL_SCHEMA) + list(GENERAL_SINGLE_GROUPS) if general else SCHEMA
             raise InputError(f"unknown group in a {'general' if general else 'template'} scene; "
@@ -462,8 +508,10 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
         return _general_scene(path, nml, applied)
 
     values: dict[str, dict[str, Any]] = {}
-    for group, entries in nml.items():
-        values[group] = _typed(group, group, entries, SCHEMA[group], file)
+    # (no group repeats here: refused above; a plain namelist's groups read as its dict's)
+    fast = plain is not None and FAST_ITEMS
+    for group, entries in (OrderedDict.items(nml) if fast else nml.items()):
+        values[group] = _typed(group, group, entries, SCHEMA[group], file, fast)
 
     models = [g for g in MODEL_GROUPS if g in values]
     if "spring" in models and "leaf" in models:  # &leaf: the spring's leaf pack

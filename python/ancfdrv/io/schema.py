@@ -716,6 +716,9 @@ def checked_value(spec: Key, raw: Any, where: dict[str, Any]) -> Any:
         value = raw.strip()
     elif kind == "bool" and plain is bool:
         value = raw
+    elif kind == "floats" and plain is list and all(
+            type(x) is float and abs(x) <= MAX_MAGNITUDE for x in raw):
+        value = list(raw)   # (coerce's list: each float as it is)
     else:
         value = coerce(kind, raw, where)
     if spec.size is not None and len(value) != spec.size:

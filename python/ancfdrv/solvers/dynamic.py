@@ -516,7 +516,7 @@ class EnergyWatch:
         columns = waiting[0] if len(waiting) == 1 else np.concatenate(waiting, axis=1)
         starts = np.zeros(len(waiting), dtype=np.intp)
         if len(waiting) > 1:
-            np.cumsum([w.shape[1] for w in waiting[:-1]], out=starts[1:])
+            np.asarray([w.shape[1] for w in waiting[:-1]]).cumsum(out=starts[1:])
         # column by column: the sums in numpy's order of a row sum over a few columns (left
         # to right), so the figures are bitwise those of works.sum(axis=1) and
         # energy[:, 1:4].sum(axis=1)
@@ -525,7 +525,8 @@ class EnergyWatch:
         potential = columns[1] + columns[2] + columns[3] - self.first[1:4].sum()
         most = np.maximum.reduceat(balance, starts)
         scales = np.maximum.reduceat(
-            np.abs(np.stack([columns[0], potential, columns[0] + columns[1]])), starts, axis=1)
+            np.abs(np.concatenate([columns[0][None], potential[None],   # (np.stack)
+                                   (columns[0] + columns[1])[None]])), starts, axis=1)
         work = np.maximum.reduceat(np.abs(columns[self._WORK_ROWS]), starts, axis=1)
         work = np.maximum.reduce(work, axis=0)
         for k in range(len(waiting)):
@@ -741,9 +742,11 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
                 carried_cut = False
             timing["stepping"] += time.perf_counter() - t1
             steps += len(chunk.time)
-            newton += int(chunk.stats[:, 0].sum())
-            factorizations += int(chunk.stats[:, 1].sum())
-            jacobians += int(chunk.stats[:, 2].sum())
+            # (the three columns' sums in one reduction: integers, exact either way)
+            totals = np.add.reduce(chunk.stats, axis=0)
+            newton += int(totals[0])
+            factorizations += int(totals[1])
+            jacobians += int(totals[2])
             chunk, outside = _check_assumptions(model, chunk, state, pending is not None)
             if len(chunk.time):
                 energy_watch.add(chunk.energy)

@@ -53,6 +53,13 @@ class _Active:
     contacts: list
 
 
+def _norm(v: np.ndarray) -> np.floating:
+    """np.linalg.norm(v) of a float array, its own operations (sqrt of the dot product of
+    the array raveled in memory order) without its generic checks."""
+    x = v.ravel(order="K")
+    return np.sqrt(x.dot(x))
+
+
 def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "auto",
              check_frames: bool = True, warnings: Iterable[str] = (),
              response: tuple[str, int] | None = None, supports: bool = False) -> Model:
@@ -747,18 +754,18 @@ def _constraint_set(equations: list[Constraint], elimination: Elimination, colum
                              f"by {values[c]:.3e} (check the points, the bodies and the drives' "
                              "values at t = 0)")
         g = gradients[c]
-        norm = np.linalg.norm(g)
+        norm = _norm(g)
         if norm == 0.0 or not any(out.terms[c]):
             notes.append(f"redundant joint equation dropped: {name} (satisfied identically)")
             continue
         r = g.copy()
         for b in basis:
             r -= (b @ r) * b
-        if np.linalg.norm(r) <= 1e-8 * norm:
+        if _norm(r) <= 1e-8 * norm:
             _check_consistent(out, c, keep, gradients, e0, scale)
             notes.append(f"redundant joint equation dropped: {name} (implied by the others)")
             continue
-        basis.append(r / np.linalg.norm(r))
+        basis.append(r / _norm(r))
         keep.append(c)
     out = out.select(keep)
     taken: set[int] = set()

@@ -14,6 +14,7 @@ body coordinates u is at r + J u; J = I at t = 0, the body axes are the global a
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,7 +55,7 @@ def linspace(start: float, stop: float, num: int) -> np.ndarray:
 
 def _vec(value, what: str, name: str) -> np.ndarray:
     v = np.asarray(value, dtype=float).ravel()
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
+    if v.shape != (3,) or not all(map(math.isfinite, v.tolist())):   # (np.isfinite(v).all())
         raise InputError(f"{name}: {what} must be three finite numbers, got {value!r}")
     return v
 
@@ -253,7 +254,7 @@ class Beam(Body):
             raise InputError(f"{where}: nodes = {self.nodes}: with {k} segments the beam needs "
                              f"{k}j+1 nodes ({', '.join(str(k * j + 1) for j in range(1, 5))}, ...)")
         per = (self.nodes - 1) // k
-        edges = np.concatenate([[0.0], np.cumsum(segments)])
+        edges = np.concatenate([[0.0], np.asarray(segments).cumsum()])
         parts = [linspace(a, b, per + 1)[:-1] for a, b in zip(edges[:-1].tolist(),
                                                               edges[1:].tolist())]
         return np.concatenate(parts + [[edges[-1]]])

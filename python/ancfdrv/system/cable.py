@@ -55,7 +55,7 @@ class Cable(Body):
         self.material = material
         self.start, self.end = _vec(start, "start", where), _vec(end, "end", where)
         axis = self.end - self.start
-        self.length = float(np.linalg.norm(axis))
+        self.length = float(np.sqrt(axis.dot(axis)))   # (np.linalg.norm of a float vector)
         if self.length <= 0.0:
             raise InputError(f"{where}: start and end coincide")
         if not isinstance(nodes, (int, np.integer)) or nodes < 2:
@@ -140,7 +140,7 @@ class Cable(Body):
         return self.axial_stiffness * force * np.sqrt(1.0 + 2.0 * strain)
 
     def node_positions(self) -> np.ndarray:
-        return self.start + np.outer(self.stations, self.tangent)
+        return self.start + self.stations[:, None] * self.tangent[None, :]   # (np.outer)
 
     def coordinates(self) -> np.ndarray:
         q = np.zeros((self.nodes, CABLE_NODE_DOFS))
@@ -162,17 +162,18 @@ class Cable(Body):
         rel = p - self.start
         s = float(rel @ self.tangent)
         tol = 1e-6 * self.length
-        if s < -tol or s > self.length + tol or np.linalg.norm(rel - s * self.tangent) > tol:
+        off = rel - s * self.tangent   # (its np.linalg.norm: sqrt of its dot product)
+        if s < -tol or s > self.length + tol or np.sqrt(off.dot(off)) > tol:
             raise InputError(f"{what}: point {list(p)} is not on the axis of cable "
                              f"{self.name!r} (from {list(self.start)} to {list(self.end)})")
-        nearest = int(np.argmin(np.abs(self.stations - s)))
+        nearest = int(np.abs(self.stations - s).argmin())
         at_node = abs(self.stations[nearest] - s) <= tol
         if node and not at_node:
             raise InputError(f"{what}: point {list(p)} is not a node of cable {self.name!r} "
                              f"(nearest node at {list(self.node_positions()[nearest])}); "
                              "joints act on nodes of cables")
         s = min(max(s, 0.0), self.length)
-        element = min(int(np.searchsorted(self.stations, s, side="right")) - 1, self.nel - 1)
+        element = min(int(self.stations.searchsorted(s, side="right")) - 1, self.nel - 1)
         xi = (s - self.stations[element]) / self.lengths[element]
         return Attachment(nearest if at_node else None, element, (xi,))
 

@@ -69,7 +69,7 @@ class ConstraintSet:
     @property
     def term_ptr(self) -> np.ndarray:
         counts = [len(t) for per in self.terms for t in per]
-        return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        return np.concatenate([[0], np.asarray(counts).cumsum()]).astype(np.int64)
 
     @property
     def term_dof(self) -> np.ndarray:
@@ -128,7 +128,7 @@ class ConstraintSet:
         if cached is not None and cached[0] == snapshot:
             return cached[1]
         lay = self.layout()
-        ptr = np.concatenate([[0], np.cumsum([len(p) for p in self.drive_params])]) + 1
+        ptr = np.concatenate([[0], np.asarray([len(p) for p in self.drive_params]).cumsum()]) + 1
         data = np.concatenate([np.asarray(p, dtype=float) for p in self.drive_params]) \
             if self.drive_params else np.zeros(1)
         kinds = np.array(self.drive_kinds or [0], dtype=np.int32)

@@ -14,6 +14,7 @@
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,7 +26,7 @@ from .drives import Drive
 
 def _vector(value, what: str) -> np.ndarray:
     v = np.asarray(value, dtype=float).ravel()
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
+    if v.shape != (3,) or not all(map(math.isfinite, v.tolist())):   # (np.isfinite(v).all())
         raise InputError(f"{what}: expected three finite numbers, got {value!r}")
     return v
 

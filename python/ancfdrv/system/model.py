@@ -591,7 +591,8 @@ class Model:
         for pair in self.contact_pairs:
             ks.add_contact_pair(pair["dofs"], pair["sizes"], pair["grid"], pair["point_element"],
                                 pair["point_local"], pair["params"])
-        ptr = np.concatenate([[0], np.cumsum([len(p.terms) for p in self.probes.values()])])
+        ptr = np.concatenate([[0], np.asarray([len(p.terms) for p in self.probes.values()])
+                              .cumsum()])
         ks.set_probes(ptr, [d for p in self.probes.values() for d, _ in p.terms],
                       [c for p in self.probes.values() for _, c in p.terms],
                       [p.frame for p in self.probes.values()],

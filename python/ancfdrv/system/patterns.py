@@ -73,7 +73,7 @@ class Pattern:
             b = b[:, (b >= 0).all(axis=0)] if b.size else b
             k = b.shape[0]
             rows.append(np.repeat(b, k, axis=0).T.ravel())
-            cols.append(np.tile(b, (k, 1)).T.ravel())
+            cols.append(np.concatenate([b] * k).T.ravel())   # (np.tile(b, (k, 1)))
         structure = Csr.structure(n, np.concatenate(rows), np.concatenate(cols))
         return cls(n, structure.indptr, structure.indices)
 
@@ -81,15 +81,17 @@ class Pattern:
         """Positions of entries (rows, cols) in the values array (-1 when absent)."""
         wanted = np.asarray(rows, dtype=np.int64) * self.n + np.asarray(cols, dtype=np.int64)
         keys = self._sorted_keys()
-        pos = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+        pos = np.minimum(keys.searchsorted(wanted), len(keys) - 1)
         return np.where(keys[pos] == wanted, pos, -1)
 
     def scatter(self, dofs: np.ndarray) -> np.ndarray:
         """(nde, nde, nel) positions of element-matrix entries (a, b) of elements with dofs
         (nde, nel), 1-based (the kernel's layout; 0 = absent)."""
         nde, nel = dofs.shape
-        rows = np.broadcast_to(dofs[:, None, :], (nde, nde, nel))
-        cols = np.broadcast_to(dofs[None, :, :], (nde, nde, nel))
+        rows = np.empty((nde, nde, nel), dtype=dofs.dtype)   # (np.broadcast_to's values)
+        rows[...] = dofs[:, None, :]
+        cols = np.empty((nde, nde, nel), dtype=dofs.dtype)
+        cols[...] = dofs[None, :, :]
         pos = self.positions(rows.ravel(), cols.ravel()).reshape(nde, nde, nel)
         if (pos < 0).any():
             raise AssertionError("an element entry is missing from the pattern")
@@ -291,7 +293,7 @@ def _selection_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
     relations = elimination.relations
     dependent = np.zeros(nfull, dtype=bool)
     dependent[list(relations)] = True
-    independent = np.flatnonzero(~dependent).astype(np.int64)
+    independent = (~dependent).nonzero()[0].astype(np.int64)
     nred = len(independent)
     column = -np.ones(nfull, dtype=np.int64)
     column[independent] = np.arange(nred)
@@ -299,14 +301,14 @@ def _selection_plan(nfull: int, elimination: Elimination, q0: np.ndarray,
     fixed = np.array(list(relations), dtype=np.int64)
     offset[fixed] = [relations[int(i)].const for i in fixed]
     indptr = np.zeros(nfull + 1, dtype=np.int64)
-    np.cumsum(~dependent, out=indptr[1:])
+    (~dependent).cumsum(out=indptr[1:])
     b = Csr(np.ones(nred), np.arange(nred), indptr, (nfull, nred))
     mismatch = np.abs(offset[fixed] - q0[fixed])
     if mismatch.max(initial=0.0) > 1e-9 * max(1.0, np.abs(q0).max(initial=0.0)):
         raise AssertionError(f"the reduction misses the initial configuration by "
                              f"{mismatch.max():.3e}")
     f_rows, f_cols = full_pattern.rows, full_pattern.col_index
-    source = np.flatnonzero(~dependent[f_rows] & ~dependent[f_cols]).astype(np.int64)
+    source = (~dependent[f_rows] & ~dependent[f_cols]).nonzero()[0].astype(np.int64)
     pair_a, pair_c = column[f_rows[source]], column[f_cols[source]]
     diagonal = np.arange(nred)
     reduced = Csr.structure(nred, np.concatenate([pair_a, diagonal]),

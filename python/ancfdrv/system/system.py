@@ -23,6 +23,7 @@ Example (a cantilever with a tip mass)::
 """
 from __future__ import annotations
 
+import re
 from typing import Any, Callable, Iterable
 
 import numpy as np
@@ -51,6 +52,10 @@ LOAD_EFFECTS = {"gravity": "gravity", "force": "point_loads", "moment": "point_l
 LOAD_PARAMETERS = {"gravity": ("vector",), "force": ("body", "point", "vector"),
                    "moment": ("body", "point", "vector"), "point_mass": ("body", "point", "mass"),
                    "pressure": ("body", "value")}
+
+
+#: a control character (ord < 32) in a name
+_CONTROL = re.compile("[\x00-\x1f]")
 
 
 def _api(method):
@@ -124,8 +129,7 @@ class System:
         # probe names become HDF5 dataset names: the general scenes' name rule; other
         # items only must not hold control characters (builders use names like 'dw/dx')
         problem = validate.check_name(name) if what == "probe" else \
-            ("must not contain control characters" if any(ord(c) < 32 for c in name)
-             else None)
+            ("must not contain control characters" if _CONTROL.search(name) else None)
         if problem:
             raise InputError(f"{what} name {short_repr(name)} {problem}")
         if name in table:
