@@ -271,12 +271,12 @@ contains
   end subroutine carry_apply
 
   !> columns (ndof, ncon): T_e^T Phi_e^T, the constraint gradients turned back to the
-  !> factorization's axes (the right-hand sides of the Schur complement's flexibility).
-  pure subroutine carry_gradients(sys, turn, gradients, columns)
+  !> factorization's axes (the right-hand sides of the Schur complement's flexibility);
+  !> column (ndof): work (the caller's: an automatic array was a heap allocation a call).
+  pure subroutine carry_gradients(sys, turn, gradients, columns, column)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: turn(3, 3), gradients(:, :)
-    real(dp), intent(out) :: columns(:, :)
-    real(dp) :: column(sys%ndof)
+    real(dp), intent(out) :: columns(:, :), column(:)
     integer :: c, s, k
     do c = 1, sys%ncon
       column = 0.0_dp

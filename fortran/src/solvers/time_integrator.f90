@@ -132,6 +132,11 @@ module time_integrator
     ! the carried matrix's Schur complement (carried_rotation): T^T Phi_e^T, S^{-1} of it and
     ! the LU factors of C, built at a step's first carried correction
     real(dp), allocatable :: carry_columns(:, :), carry_flexibility(:, :), carry_lu(:, :)
+    ! carry_gradients' column of Phi_e^T (its work array), and the row of w (E_c^T) of each
+    ! reduced coordinate (0: in no touched block; a dof in two blocks: the first), made once
+    ! per chunk for gather_blocks (automatic arrays were heap allocations in every step)
+    real(dp), allocatable :: carry_column(:)
+    integer, allocatable :: block_row(:)
   end type step_work
 
 contains
@@ -140,7 +145,7 @@ contains
   pure subroutine allocate_work(sys, work)
     type(system_model), intent(in) :: sys
     type(step_work), intent(out) :: work
-    integer :: nb
+    integer :: nb, b, j
     nb = 3 * size(sys%block_first)
     allocate (work%r(sys%ndof), work%z(sys%ndof, 1), work%direction(sys%ndof), &
               work%correction(sys%ndof), work%back(sys%ndof), work%phi(sys%ncon), &
@@ -150,9 +155,17 @@ contains
               work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
               work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
               work%row_ndof(sys%ndof, 2), work%full_pair(sys%nfull, 2))
-    if (carry_enabled(sys)) allocate (work%carry_columns(sys%ndof, sys%ncon), &
-                                      work%carry_flexibility(sys%ndof, sys%ncon), &
-                                      work%carry_lu(sys%ncon, sys%ncon))
+    if (carry_enabled(sys)) then
+      allocate (work%carry_columns(sys%ndof, sys%ncon), &
+                work%carry_flexibility(sys%ndof, sys%ncon), work%carry_lu(sys%ncon, sys%ncon), &
+                work%carry_column(sys%ndof), work%block_row(sys%ndof))
+      work%block_row = 0
+      do b = size(sys%block_first), 1, -1
+        do j = 0, 2
+          work%block_row(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
+        end do
+      end do
+    end if
   end subroutine allocate_work
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
@@ -610,7 +623,8 @@ contains
       integer :: c
       ! (the newton's associate names are not visible here: the work arrays by name)
       if (.not. carry_ready) then
-        call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns)
+        call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
+                             work%carry_column)
         if (gather_blocks(work%carry_columns, work%w)) then
           ! within the factorization's flexibility S^{-1} E_c (the model's touched blocks
           ! hold each constrained vector whole): no solve
@@ -668,21 +682,22 @@ contains
     logical function gather_blocks(columns, w) result(inside)
       real(dp), intent(in) :: columns(:, :)
       real(dp), intent(out) :: w(:, :)
-      integer :: row_of(sys%ndof), b, j, dof
-      row_of = 0
-      do b = size(sys%block_first), 1, -1
-        do j = 0, 2
-          row_of(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
-        end do
-      end do
+      integer :: dof, c
+      ! (work%block_row: made once per chunk by allocate_work)
       w = 0.0_dp
       inside = .true.
       do dof = 1, sys%ndof
-        if (row_of(dof) > 0) then
-          w(row_of(dof), :) = columns(dof, :)
-        else if (any(columns(dof, :) /= 0.0_dp)) then
-          inside = .false.
-          return
+        if (work%block_row(dof) > 0) then
+          do c = 1, size(columns, 2)
+            w(work%block_row(dof), c) = columns(dof, c)
+          end do
+        else
+          do c = 1, size(columns, 2)
+            if (columns(dof, c) /= 0.0_dp) then
+              inside = .false.
+              return
+            end if
+          end do
         end if
       end do
     end function gather_blocks
@@ -706,7 +721,7 @@ contains
     real(dp), intent(inout) :: a(:, :)
     integer, intent(out) :: ipiv(:), info
     integer :: n, j, k, p
-    real(dp) :: row(size(a, 2))
+    real(dp) :: swap
     n = size(a, 1)
     info = 0
     do j = 1, n
@@ -714,9 +729,12 @@ contains
       ipiv(j) = p
       if (a(p, j) /= 0.0_dp) then
         if (p /= j) then
-          row = a(j, :)
-          a(j, :) = a(p, :)
-          a(p, :) = row
+          ! (entry by entry: a row temporary of unknown size was a heap allocation a call)
+          do k = 1, size(a, 2)
+            swap = a(j, k)
+            a(j, k) = a(p, k)
+            a(p, k) = swap
+          end do
         end if
         a(j + 1:n, j) = a(j + 1:n, j) / a(j, j)
       else if (info == 0) then
@@ -792,10 +810,51 @@ contains
     integer, intent(in) :: pairs(:, :)
     real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
     real(dp), intent(out) :: correction(:)
-    real(dp) :: back_x, back_y, r13, r23
-    integer :: p, c, first, second
+    real(dp) :: back_x, back_y, r11, r12, r13, r21, r22, r23, d1, d2
+    integer :: p, c, first, second, c1, c2, nonzero
+    r11 = turn(1, 1)
+    r12 = turn(1, 2)
     r13 = turn(1, 3) * 0.0_dp
+    r21 = turn(2, 1)
+    r22 = turn(2, 2)
     r23 = turn(2, 3) * 0.0_dp
+    ! one or two nonzero multiplier corrections (a pin in the plane): their sums written
+    ! out, the same terms in the same order as the loop below (zero ones skipped there too)
+    nonzero = count(dlam /= 0.0_dp)
+    if (nonzero >= 1 .and. nonzero <= 2) then
+      c1 = 0
+      c2 = 0
+      do c = 1, size(dlam)
+        if (dlam(c) == 0.0_dp) cycle
+        if (c1 == 0) then
+          c1 = c
+        else
+          c2 = c
+        end if
+      end do
+      d1 = dlam(c1)
+      if (nonzero == 1) then
+        do p = 1, size(pairs, 2)
+          first = pairs(1, p)
+          second = pairs(2, p)
+          back_x = 0.0_dp + flexibility(first, c1) * d1
+          back_y = 0.0_dp + flexibility(second, c1) * d1
+          correction(first) = (r11 * back_x + r12 * back_y + r13) - direction(first)
+          correction(second) = (r21 * back_x + r22 * back_y + r23) - direction(second)
+        end do
+        return
+      end if
+      d2 = dlam(c2)
+      do p = 1, size(pairs, 2)
+        first = pairs(1, p)
+        second = pairs(2, p)
+        back_x = 0.0_dp + flexibility(first, c1) * d1 + flexibility(first, c2) * d2
+        back_y = 0.0_dp + flexibility(second, c1) * d1 + flexibility(second, c2) * d2
+        correction(first) = (r11 * back_x + r12 * back_y + r13) - direction(first)
+        correction(second) = (r21 * back_x + r22 * back_y + r23) - direction(second)
+      end do
+      return
+    end if
     do p = 1, size(pairs, 2)
       first = pairs(1, p)
       second = pairs(2, p)
@@ -806,8 +865,8 @@ contains
         back_x = back_x + flexibility(first, c) * dlam(c)
         back_y = back_y + flexibility(second, c) * dlam(c)
       end do
-      correction(first) = (turn(1, 1) * back_x + turn(1, 2) * back_y + r13) - direction(first)
-      correction(second) = (turn(2, 1) * back_x + turn(2, 2) * back_y + r23) - direction(second)
+      correction(first) = (r11 * back_x + r12 * back_y + r13) - direction(first)
+      correction(second) = (r21 * back_x + r22 * back_y + r23) - direction(second)
     end do
   end subroutine plane_carried_correction
 
