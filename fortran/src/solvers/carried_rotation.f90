@@ -29,7 +29,8 @@ module carried_rotation
   use mechanical_system, only: system_model
   implicit none
   private
-  public :: carry_enabled, carry_vectors, carry_turn, carry_apply, carry_gradients
+  public :: carry_enabled, carry_vectors, carry_turn, carry_apply, carry_gradients, &
+            carry_plane_gradients
 
   !> the identity's share of the fitted correlation (relative to its Frobenius norm)
   real(dp), parameter :: identity_share = 1e-6_dp
@@ -288,5 +289,44 @@ contains
       call carry_apply(sys, turn, column, .true., columns(:, c))
     end do
   end subroutine carry_gradients
+
+  !> carry_gradients of a planar reduction (carry_plane) at the listed pairs only (pairs:
+  !> indices into carry_plane, holding every term dof of the constraints): columns at
+  !> those pairs' coordinates as carry_gradients gives them (the same scatter into a zeroed
+  !> column, the same turn as carry_apply's plane path), the other rows not written.
+  pure subroutine carry_plane_gradients(sys, turn, gradients, pairs, columns, column)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: turn(3, 3), gradients(:, :)
+    integer, intent(in) :: pairs(:)
+    real(dp), intent(inout) :: columns(:, :), column(:)
+    real(dp) :: r11, r12, r13, r21, r22, r23, v1, v2
+    integer :: c, s, k, p, first, second
+    ! (back: the transposed turn, as carry_apply(.., back = .true., ..))
+    r11 = turn(1, 1)
+    r12 = turn(2, 1)
+    r13 = turn(3, 1) * 0.0_dp
+    r21 = turn(1, 2)
+    r22 = turn(2, 2)
+    r23 = turn(3, 2) * 0.0_dp
+    do c = 1, sys%ncon
+      do p = 1, size(pairs)
+        column(sys%carry_plane(1, pairs(p))) = 0.0_dp
+        column(sys%carry_plane(2, pairs(p))) = 0.0_dp
+      end do
+      do s = 1, 6
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          column(sys%term_dof(k)) = column(sys%term_dof(k)) + gradients(s, c) * sys%term_coef(k)
+        end do
+      end do
+      do p = 1, size(pairs)
+        first = sys%carry_plane(1, pairs(p))
+        second = sys%carry_plane(2, pairs(p))
+        v1 = column(first)
+        v2 = column(second)
+        columns(first, c) = r11 * v1 + r12 * v2 + r13
+        columns(second, c) = r21 * v1 + r22 * v2 + r23
+      end do
+    end do
+  end subroutine carry_plane_gradients
 
 end module carried_rotation

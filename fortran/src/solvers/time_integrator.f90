@@ -73,7 +73,7 @@ module time_integrator
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
   use carried_rotation, only: carry_enabled, carry_vectors, carry_turn, carry_apply, &
-                              carry_gradients
+                              carry_gradients, carry_plane_gradients
   implicit none
   private
   public :: integrator_chunk, output_row, step_failure_text
@@ -137,6 +137,13 @@ module time_integrator
     ! per chunk for gather_blocks (automatic arrays were heap allocations in every step)
     real(dp), allocatable :: carry_column(:)
     integer, allocatable :: block_row(:)
+    ! the reduced coordinates in touched blocks (block_row > 0), and those outside them
+    ! that T^T Phi_e^T can make nonzero (scan_known: the list holds; else all are scanned)
+    integer, allocatable :: touched_dofs(:), scan_dofs(:)
+    logical :: scan_known = .false.
+    ! a planar reduction with scan_known: the pairs (carry_plane) holding a touched or a
+    ! scanned coordinate, the only rows of T^T Phi_e^T that gather_blocks reads
+    integer, allocatable :: carry_pairs(:)
   end type step_work
 
 contains
@@ -165,8 +172,55 @@ contains
           work%block_row(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
         end do
       end do
+      work%touched_dofs = pack([(j, j = 1, sys%ndof)], work%block_row > 0)
+      call carry_scan_setup(sys, work)
     end if
   end subroutine allocate_work
+
+  !> work%scan_dofs: the reduced coordinates outside the touched blocks (block_row = 0)
+  !> where carry_gradients' columns T^T Phi_e^T can be nonzero. Column c of Phi_e^T is
+  !> nonzero at the constraints' term dofs only, and T^T (carry_apply) turns each carried
+  !> 3-vector on its own: a vector without a term dof gets exactly +-0 from a finite turn
+  !> (r11 * 0 + r12 * 0 + r13 * 0), which gather_blocks' test (/= 0) passes. So with a finite
+  !> turn only the coordinates of vectors holding a term dof need the test. scan_known =
+  !> .false. (every coordinate tested, as before) unless each reduced coordinate is in
+  !> exactly one carried vector.
+  pure subroutine carry_scan_setup(sys, work)
+    type(system_model), intent(in) :: sys
+    type(step_work), intent(inout) :: work
+    integer :: vector_of(sys%ndof), b, i, k, dof
+    logical :: reached(sys%ndof)
+    work%scan_known = .false.
+    allocate (work%scan_dofs(0))
+    if (sys%ncon == 0) return
+    vector_of = 0
+    do b = 1, size(sys%carry_map, 2)
+      do i = 1, 3
+        dof = sys%carry_map(i, b)
+        if (dof <= 0) cycle
+        if (dof > sys%ndof) return
+        if (vector_of(dof) /= 0) return
+        vector_of(dof) = b
+      end do
+    end do
+    if (any(vector_of == 0)) return
+    reached = .false.
+    do k = sys%term_ptr(1), sys%term_ptr(6 * sys%ncon + 1) - 1
+      dof = sys%term_dof(k)
+      if (dof < 1 .or. dof > sys%ndof) return
+      b = vector_of(dof)
+      do i = 1, 3
+        if (sys%carry_map(i, b) > 0) reached(sys%carry_map(i, b)) = .true.
+      end do
+    end do
+    work%scan_dofs = pack([(dof, dof = 1, sys%ndof)], reached .and. work%block_row == 0)
+    work%scan_known = .true.
+    if (.not. allocated(sys%carry_plane)) return
+    ! (every term dof is reached: its pair is among them)
+    reached = reached .or. work%block_row > 0
+    work%carry_pairs = pack([(k, k = 1, size(sys%carry_plane, 2))], &
+                            reached(sys%carry_plane(1, :)) .or. reached(sys%carry_plane(2, :)))
+  end subroutine carry_scan_setup
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
   !> constraint values and gradients, the strain energy and the number of active contact
@@ -541,7 +595,6 @@ contains
       ! and the largest |correction| and |e_new| as maxval takes them; max is exact)
       finite = .true.
       largest_correction = 0.0_dp
-      largest_coordinate = 0.0_dp
       do i = 1, sys%ndof
         step_part = correction(i)
         if (.not. abs(step_part) < huge(1.0_dp)) finite = .false.
@@ -549,7 +602,6 @@ contains
         accel_new(i) = accel_new(i) + beta_prime * step_part
         v_new(i) = v_new(i) + velocity_factor * step_part
         largest_correction = max(largest_correction, abs(step_part))
-        largest_coordinate = max(largest_coordinate, abs(e_new(i)))
       end do
       lam_new = lam_new + dlam(:, 1)
       stats(stat_corrections) = stats(stat_corrections) + 1
@@ -574,6 +626,11 @@ contains
       end if
       ! (a correction cut to the contact cap says nothing about convergence)
       if (.not. capped) then
+        ! (the largest |e_new| only here, where it is read: e_new is finite, max is exact)
+        largest_coordinate = 0.0_dp
+        do i = 1, sys%ndof
+          largest_coordinate = max(largest_coordinate, abs(e_new(i)))
+        end do
         call stagnated(monitor, cfg, it, last_correction, previous_correction, &
                        largest_coordinate, halt)
         if (halt) then
@@ -621,11 +678,26 @@ contains
     !> them); then C dlam = Phi_e z - Phi, correction = T F dlam - z.
     subroutine carry_schur()
       integer :: c
+      logical :: partial, inside
       ! (the newton's associate names are not visible here: the work arrays by name)
       if (.not. carry_ready) then
-        call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
-                             work%carry_column)
-        if (gather_blocks(work%carry_columns, work%w)) then
+        ! a planar reduction whose rows outside the gathered pairs are known to be +-0 (a
+        ! finite turn, carry_scan_setup): T^T Phi_e^T at those pairs only; the whole
+        ! columns when the solve below needs them
+        partial = allocated(work%carry_pairs)
+        if (partial) partial = all(abs(learned%carry_turn) <= huge(1.0_dp))
+        if (partial) then
+          call carry_plane_gradients(sys, learned%carry_turn, work%gradients, &
+                                     work%carry_pairs, work%carry_columns, work%carry_column)
+        else
+          call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
+                               work%carry_column)
+        end if
+        inside = gather_blocks(work%carry_columns, work%w)
+        if (partial .and. .not. inside) &
+          call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
+                               work%carry_column)
+        if (inside) then
           ! within the factorization's flexibility S^{-1} E_c (the model's touched blocks
           ! hold each constrained vector whole): no solve
           ! (matmul's sums by the loops of sparse_columns_product and schur_complement:
@@ -682,10 +754,30 @@ contains
     logical function gather_blocks(columns, w) result(inside)
       real(dp), intent(in) :: columns(:, :)
       real(dp), intent(out) :: w(:, :)
-      integer :: dof, c
-      ! (work%block_row: made once per chunk by allocate_work)
+      integer :: dof, c, k
+      ! (work%block_row, touched_dofs and scan_dofs: made once per chunk by allocate_work;
+      ! with a finite turn only scan_dofs can hold a nonzero outside the blocks, see
+      ! carry_scan_setup; the same w and the same answer as the test of every coordinate)
       w = 0.0_dp
       inside = .true.
+      if (work%scan_known .and. all(abs(learned%carry_turn) <= huge(1.0_dp))) then
+        do k = 1, size(work%scan_dofs)
+          dof = work%scan_dofs(k)
+          do c = 1, size(columns, 2)
+            if (columns(dof, c) /= 0.0_dp) then
+              inside = .false.
+              return
+            end if
+          end do
+        end do
+        do k = 1, size(work%touched_dofs)
+          dof = work%touched_dofs(k)
+          do c = 1, size(columns, 2)
+            w(work%block_row(dof), c) = columns(dof, c)
+          end do
+        end do
+        return
+      end if
       do dof = 1, sys%ndof
         if (work%block_row(dof) > 0) then
           do c = 1, size(columns, 2)
