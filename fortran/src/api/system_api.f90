@@ -550,10 +550,12 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   sys%carry_position = position(1:max(0, nvec)) /= 0
   if (allocated(sys%carry_map)) deallocate (sys%carry_map)
   if (allocated(sys%carry_plane)) deallocate (sys%carry_plane)
+  if (allocated(sys%carry_source)) deallocate (sys%carry_source)
   if (nvec == 0) return
   allocate (sys%carry_map(3, sys%nfull / 3))
   if (.not. sys%reduced) then
     sys%carry_map = reshape([(i, i = 1, sys%nfull)], [3, sys%nfull / 3])
+    call carry_sources()
     return
   end if
   sys%carry_map = 0
@@ -571,6 +573,7 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
     allocate (sys%carry_first(0), sys%carry_weight(0), sys%carry_position(0))
     return
   end if
+  call carry_sources()
   ! every vector of the xy plane or fixed (a planar reduction): carry_apply by the pairs
   if (all((sys%carry_map(1, :) > 0 .and. sys%carry_map(2, :) > 0 .and. &
            sys%carry_map(3, :) == 0) .or. all(sys%carry_map == 0, dim=1))) then
@@ -583,6 +586,24 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
       sys%carry_plane(:, k) = sys%carry_map(1:2, i)
     end do
   end if
+
+contains
+
+  !> sys%carry_source from carry_first and carry_map (carry_vectors' reads).
+  subroutine carry_sources()
+    integer :: vec, component, b
+    allocate (sys%carry_source(3, nvec))
+    do vec = 1, nvec
+      b = (sys%carry_first(vec) - 1) / 3 + 1
+      do component = 1, 3
+        if (sys%carry_map(component, b) > 0) then
+          sys%carry_source(component, vec) = sys%carry_map(component, b)
+        else
+          sys%carry_source(component, vec) = -(sys%carry_first(vec) + component - 1)
+        end if
+      end do
+    end do
+  end subroutine carry_sources
 end subroutine system_set_carry
 
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),

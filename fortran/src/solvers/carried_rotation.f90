@@ -49,15 +49,16 @@ contains
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: e(:)
     real(dp), intent(out) :: vectors(:, :)
-    integer :: k, i, dof, b
+    integer :: k, i, source
+    ! (carry_source: carry_map's reduced coordinate or minus the fixed full dof, made once
+    ! by system_set_carry)
     do k = 1, size(sys%carry_first)
-      b = (sys%carry_first(k) - 1) / 3 + 1
       do i = 1, 3
-        if (sys%carry_map(i, b) > 0) then
-          vectors(i, k) = e(sys%carry_map(i, b))
+        source = sys%carry_source(i, k)
+        if (source > 0) then
+          vectors(i, k) = e(source)
         else  ! a coordinate the reduction fixes
-          dof = sys%carry_first(k) + i - 1
-          vectors(i, k) = sys%reduction_offset(dof)
+          vectors(i, k) = sys%reduction_offset(-source)
         end if
       end do
     end do

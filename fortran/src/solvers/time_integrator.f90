@@ -551,8 +551,8 @@ contains
         call to_solver_frame(sys, rotations, z(:, 1), .false., direction)
       end if
       ! (with constraints both paths below overwrite the correction)
+      ! (dlam: written whole by gradient_product in both paths below; empty without constraints)
       if (sys%ncon == 0) correction = -direction
-      dlam = 0.0_dp
       if (sys%ncon > 0 .and. learned%carry_on) then
         ! the Schur complement with the carried matrix: C = G^T S^{-1} G, G = T^T Phi_e^T
         call carry_schur()

@@ -186,6 +186,10 @@ module mechanical_system
     ! fixed) or wholly fixed: the reduced coordinates (x, y) of the plane vectors, (2, n);
     ! unallocated otherwise
     integer, allocatable :: carry_plane(:, :)
+    ! where carry_vectors reads each component of the carried vectors, (3, nvec): the
+    ! reduced coordinate (> 0) or minus the full dof whose reduction_offset it is (made by
+    ! system_set_carry with carry_map)
+    integer, allocatable :: carry_source(:, :)
   end type system_model
 
 contains
