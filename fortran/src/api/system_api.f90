@@ -1220,11 +1220,11 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   type(system_model), pointer :: sys
   type(stepper_run), pointer :: run
   type(contact_state) :: contact
-  real(dp), allocatable :: e(:), v(:), a(:), accel(:), lam(:), out_time(:), out_probe(:, :, :)
-  real(dp), allocatable :: out_deflection(:, :, :), out_lambda(:, :), out_energy(:, :)
-  real(dp), allocatable :: out_constraint(:), out_contact(:, :, :), out_q(:, :)
+  real(dp), allocatable :: e(:), v(:), a(:), accel(:), lam(:), out_probe(:, :, :)
+  real(dp), allocatable :: out_deflection(:, :, :), out_contact(:, :, :), no_q(:, :)
   real(dp) :: t, work(power_count), powers(power_count)
   integer :: info, ndof, ncon, nprobe, npoint, step, k, j
+  integer :: at_lambda, at_energy, at_constraint, at_q  ! the rows' offsets (row_size)
   logical :: store_q
   rows = 0.0_dp
   stats = 0
@@ -1274,28 +1274,41 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   k = k + power_count
   contact%guesses = reshape(state(k + 1:k + 2 * npoint), [2, npoint])
   contact%counts = counts
-  allocate (out_time(nsteps), out_probe(3, nprobe, nsteps), out_deflection(3, nprobe, nsteps), &
-            out_lambda(ncon, nsteps), out_energy(energy_count, nsteps), out_constraint(nsteps), &
-            out_contact(contact_record, npoint, nsteps), out_q(ndof, merge(nsteps, 0, store_q)))
-  out_time = 0.0_dp
+  ! (the stepper writes time, lam, energy, constraint violation and q straight into their
+  ! rows, zeroed above: what it leaves unwritten is zero, as the copies of zeroed arrays
+  ! were; the probes, deflections and contact records are copied below)
+  at_lambda = 1 + 6 * nprobe
+  at_energy = at_lambda + ncon
+  at_constraint = at_energy + energy_count
+  at_q = at_constraint + 1 + contact_record * npoint
+  allocate (out_probe(3, nprobe, nsteps), out_deflection(3, nprobe, nsteps), &
+            out_contact(contact_record, npoint, nsteps))
   out_probe = 0.0_dp
   out_deflection = 0.0_dp
-  out_lambda = 0.0_dp
-  out_energy = 0.0_dp
-  out_constraint = 0.0_dp
   out_contact = 0.0_dp
-  out_q = 0.0_dp
-  call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, work, &
-                        powers, contact, out_time, out_probe, out_deflection, out_lambda, &
-                        out_energy, out_constraint, stats, out_contact, store_q, out_q, &
-                        status(1), status(2), status(3), last_correction, status(4))
+  if (store_q) then
+    call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, &
+                          work, powers, contact, rows(1, :), out_probe, out_deflection, &
+                          rows(at_lambda + 1:at_lambda + ncon, :), &
+                          rows(at_energy + 1:at_energy + energy_count, :), &
+                          rows(at_constraint + 1, :), stats, out_contact, store_q, &
+                          rows(at_q + 1:at_q + ndof, :), status(1), status(2), status(3), &
+                          last_correction, status(4))
+  else
+    allocate (no_q(ndof, 0))
+    call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, &
+                          work, powers, contact, rows(1, :), out_probe, out_deflection, &
+                          rows(at_lambda + 1:at_lambda + ncon, :), &
+                          rows(at_energy + 1:at_energy + energy_count, :), &
+                          rows(at_constraint + 1, :), stats, out_contact, store_q, no_q, &
+                          status(1), status(2), status(3), last_correction, status(4))
+  end if
   if (status(2) /= 0) message = step_failure_text(status(2), status(3), run%settings%max_newton)
   state = [t, e, v, a, accel, lam, work, powers, reshape(contact%guesses, [2 * npoint])]
   counts = contact%counts
   ! the output rows (stepper.f90 row_size)
   ! (the probes' and deflections' columns copied by loops: reshape was a library call a step)
   do step = 1, nsteps
-    rows(1, step) = out_time(step)
     k = 1
     do j = 1, nprobe
       rows(k + 3 * j - 2:k + 3 * j, step) = out_probe(:, j, step)
@@ -1304,18 +1317,10 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
     do j = 1, nprobe
       rows(k + 3 * j - 2:k + 3 * j, step) = out_deflection(:, j, step)
     end do
-    k = k + 3 * nprobe
-    rows(k + 1:k + ncon, step) = out_lambda(:, step)
-    k = k + ncon
-    rows(k + 1:k + energy_count, step) = out_energy(:, step)
-    k = k + energy_count
-    rows(k + 1, step) = out_constraint(step)
-    k = k + 1
+    k = at_constraint + 1
     do j = 1, npoint
       rows(k + contact_record * (j - 1) + 1:k + contact_record * j, step) = out_contact(:, j, step)
     end do
-    k = k + contact_record * npoint
-    if (store_q) rows(k + 1:k + ndof, step) = out_q(:, step)
   end do
 end subroutine system_advance
 
