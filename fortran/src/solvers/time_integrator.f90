@@ -305,6 +305,7 @@ contains
     real(dp) :: contact_potential, beta_prime, velocity_factor
     integer :: step, attempt, stats(stat_count)
     logical :: done, fresh_matrix, start_fresh, started_old
+    logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
     type(step_work) :: scratch
     call allocate_work(sys, scratch)
     info = 0
@@ -339,7 +340,8 @@ contains
         call carry_step(sys, cfg, learned, fresh_matrix, e_new)
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, scratch, info, detail)
+                    stats, done, last_correction, monitor, scratch, info, detail, &
+                    constraints_checked)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
         ! refreshed the matrix on the way) gets one retry from its start with a fresh one
@@ -368,9 +370,17 @@ contains
       accel = accel_new
       lam = lam_new
       t = t + h
-      call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
-                    contact_potential, out_constraint(step), out_contact(:, :, step), info, &
-                    scratch%full, scratch%row_phi, scratch%row_gradients)
+      ! (a step accepted on the contraction estimate evaluated its constraints at e_new,
+      ! t + h: the energies read them instead of evaluating them again)
+      if (constraints_checked) then
+        call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
+                      contact_potential, out_constraint(step), out_contact(:, :, step), info, &
+                      scratch%full, scratch%phi, scratch%gradients, constraints_known=.true.)
+      else
+        call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
+                      contact_potential, out_constraint(step), out_contact(:, :, step), info, &
+                      scratch%full, scratch%row_phi, scratch%row_gradients)
+      end if
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers + powers_new)
       powers = powers_new
@@ -478,7 +488,8 @@ contains
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, learned, t_new, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, work, info, detail)
+                    stats, done, last_correction, monitor, work, info, detail, &
+                    constraints_checked)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -493,6 +504,8 @@ contains
     type(newton_monitor), intent(out) :: monitor
     type(step_work), intent(inout) :: work
     integer, intent(out) :: info, detail
+    !> done with work%phi and work%gradients evaluated at the final e_new and t_new
+    logical, intent(out) :: constraints_checked
     real(dp) :: strain, previous_correction, step_cap, step_theta
     integer :: it, lapack_info, active, i
     integer :: refreshed_at  ! the correction after which the matrix was last refreshed
@@ -506,6 +519,7 @@ contains
     info = 0
     detail = 0
     done = .false.
+    constraints_checked = .false.
     use_known = fresh_matrix
     carry_ready = .false.
     previous_correction = huge(1.0_dp)
@@ -619,6 +633,7 @@ contains
           call evaluate_constraints(sys, e_new, t_new, phi, gradients, info)
           if (info /= 0) return
           done = maxval(abs(phi)) <= cfg%tol * min(1.0_dp, cfg%length_scale)
+          constraints_checked = done
         else
           done = .true.
         end if
