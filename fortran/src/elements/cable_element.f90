@@ -694,6 +694,7 @@ contains
     real(dp) :: unused_tangent(cable_dofs, cable_dofs)
     integer :: el, a, i, k, node, component, element_info
     integer :: selected(cable_dofs)  ! the element's reduced coordinates (0: fixed)
+    logical :: plane
     energy = 0.0_dp
     info = 0
     done = .not. (set%tension_only .or. .not. allocated(set%weights) .or. &
@@ -717,7 +718,8 @@ contains
           end if
         end do
       end do
-      if (all(coords(3, :) == 0.0_dp)) then
+      plane = all(coords(3, :) == 0.0_dp)
+      if (plane) then
         call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
                                  set%weights(:, el), set%axial_stiffness, &
                                  set%bending_stiffness, element_force, element_energy, &
@@ -732,11 +734,21 @@ contains
         energy = 0.0_dp
         return
       end if
-      ! (a z component of a plane element is +0: added or not, the same sums)
-      do a = 1, cable_dofs
-        k = selected(a)
-        if (k > 0) force(k) = force(k) + element_force(a)
-      end do
+      ! (a z component of a plane element is +0: added or not, the same sums (force starts
+      ! at +0 and a sum is -0 only when both terms are, so no entry is ever -0 and adding +0
+      ! leaves it as it is): a plane element's z components are skipped)
+      if (plane) then
+        do a = 1, cable_dofs
+          if (mod(a, 3) == 0) cycle
+          k = selected(a)
+          if (k > 0) force(k) = force(k) + element_force(a)
+        end do
+      else
+        do a = 1, cable_dofs
+          k = selected(a)
+          if (k > 0) force(k) = force(k) + element_force(a)
+        end do
+      end if
       energy = energy + element_energy
     end do
   end subroutine cable_selected_forces

@@ -303,7 +303,7 @@ contains
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
     real(dp) :: contact_potential, beta_prime, velocity_factor
-    integer :: step, attempt, stats(stat_count)
+    integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
     logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
     type(step_work) :: scratch
@@ -358,11 +358,15 @@ contains
       if (monitor%at_floor) floor_accepts = floor_accepts + 1
       if (started_old) call update_reuse_backoff(learned, stats(stat_factorizations) > 0)
       ! accept the step
-      a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
-              / (1.0_dp - cfg%alpha_m)
-      v = v + h * ((1.0_dp - cfg%gamma) * a + cfg%gamma * a_new)
-      e = e_new
-      a = a_new
+      ! (one pass: each coordinate's a_new, v, e and a by the same expressions as the
+      ! array statements they replace, without their separate loops and copies)
+      do i = 1, sys%ndof
+        a_new(i) = (cfg%alpha_f * accel(i) + (1.0_dp - cfg%alpha_f) * accel_new(i) &
+                    - cfg%alpha_m * a(i)) / (1.0_dp - cfg%alpha_m)
+        v(i) = v(i) + h * ((1.0_dp - cfg%gamma) * a(i) + cfg%gamma * a_new(i))
+        e(i) = e_new(i)
+        a(i) = a_new(i)
+      end do
       ! the predictor of the next step: the extrapolation that came nearest e''_{n+1}
       ! (refactorized systems without contact only: the others never use it)
       if (sys%npoint == 0 .and. sys%policy /= policy_constant) &
@@ -404,12 +408,19 @@ contains
     type(stepper_state), intent(in) :: learned
     real(dp), intent(in) :: h, e(:), v(:), a(:), accel(:)
     real(dp), intent(out) :: e_new(:), v_new(:), a_new(:), accel_new(:)
+    integer :: i
     if (sys%npoint == 0) then
       call extrapolate(usable_predictor(learned, h, learned%predictor), accel, learned, &
                        accel_new)
-      a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
-              / (1.0_dp - cfg%alpha_m)
-      e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
+      ! (one pass: each coordinate's a_new, e_new and v_new by the expressions of the array
+      ! statements they replace)
+      do i = 1, size(e)
+        a_new(i) = (cfg%alpha_f * accel(i) + (1.0_dp - cfg%alpha_f) * accel_new(i) &
+                    - cfg%alpha_m * a(i)) / (1.0_dp - cfg%alpha_m)
+        e_new(i) = e(i) + h * v(i) + h * h * ((0.5_dp - cfg%beta) * a(i) + cfg%beta * a_new(i))
+        v_new(i) = v(i) + h * ((1.0_dp - cfg%gamma) * a(i) + cfg%gamma * a_new(i))
+      end do
+      return
     else
       if (maxval(abs(h * v)) <= contact_step_limit(sys)) then
         e_new = e + h * v
