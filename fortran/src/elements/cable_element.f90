@@ -738,10 +738,11 @@ contains
       ! at +0 and a sum is -0 only when both terms are, so no entry is ever -0 and adding +0
       ! leaves it as it is): a plane element's z components are skipped)
       if (plane) then
-        do a = 1, cable_dofs
-          if (mod(a, 3) == 0) cycle
-          k = selected(a)
-          if (k > 0) force(k) = force(k) + element_force(a)
+        do node = 1, 4
+          do a = 3 * node - 2, 3 * node - 1
+            k = selected(a)
+            if (k > 0) force(k) = force(k) + element_force(a)
+          end do
         end do
       else
         do a = 1, cable_dofs

@@ -301,7 +301,7 @@ contains
     integer, intent(in) :: pairs(:)
     real(dp), intent(inout) :: columns(:, :), column(:)
     real(dp) :: r11, r12, r13, r21, r22, r23, v1, v2
-    integer :: c, s, k, p, first, second
+    integer :: c, s, k, p, first, second, last
     ! (back: the transposed turn, as carry_apply(.., back = .true., ..))
     r11 = turn(1, 1)
     r12 = turn(2, 1)
@@ -314,7 +314,10 @@ contains
         column(sys%carry_plane(1, pairs(p))) = 0.0_dp
         column(sys%carry_plane(2, pairs(p))) = 0.0_dp
       end do
-      do s = 1, 6
+      ! (the operands up to the last with terms, con_operands: the rest are empty)
+      last = 6
+      if (allocated(sys%con_operands)) last = sys%con_operands(c)
+      do s = 1, last
         do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
           column(sys%term_dof(k)) = column(sys%term_dof(k)) + gradients(s, c) * sys%term_coef(k)
         end do

@@ -325,7 +325,9 @@ contains
       started_old = .false.
       do attempt = 1, 2
         call predict(sys, cfg, learned, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
-        lam_new = lam
+        do i = 1, sys%ncon  ! (the multipliers' copies by loops: a few entries, no memcpy call)
+          lam_new(i) = lam(i)
+        end do
         fresh_matrix = .false.
         if (needs_factorization(sys, cfg, beta_prime, attempt) .or. start_fresh) then
           call factorize(sys, learned, beta_prime, velocity_factor, rotations, e_new, v_new, &
@@ -372,7 +374,9 @@ contains
       if (sys%npoint == 0 .and. sys%policy /= policy_constant) &
         call learn_predictor(learned, h, accel, accel_new)
       accel = accel_new
-      lam = lam_new
+      do i = 1, sys%ncon
+        lam(i) = lam_new(i)
+      end do
       t = t + h
       ! (a step accepted on the contraction estimate evaluated its constraints at e_new,
       ! t + h: the energies read them instead of evaluating them again)
@@ -391,7 +395,9 @@ contains
       steps_done = step
       out_time(step) = t
       out_stats(:, step) = stats
-      out_lambda(:, step) = lam
+      do i = 1, sys%ncon
+        out_lambda(i, step) = lam(i)
+      end do
       call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, &
                         out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info, &
                         scratch%full, scratch%row_ndof)
