@@ -1391,3 +1391,21 @@ subroutine system_static_solve(handle, ndof, ncon, npoint, nnz, t, load_factor, 
                                                minval(history(1:max(1, iterations))), force_res, &
                                                con_res, tol)
 end subroutine system_static_solve
+
+!> Tests of the stepper's carried Schur complement (time_integrator's path_check_on):
+!> enable /= 0 turns the comparison of its fast paths with the routines they replaced on
+!> (counters reset), 0 off; checks and mismatches: the comparisons made and those that
+!> differed since the last reset.
+subroutine stepper_path_checks(enable, checks, mismatches)
+  use time_integrator, only: path_check_on, path_checks, path_mismatches
+  implicit none
+  integer, intent(in) :: enable
+  integer, intent(out) :: checks, mismatches
+  checks = path_checks
+  mismatches = path_mismatches
+  if (enable /= 0) then
+    path_checks = 0
+    path_mismatches = 0
+  end if
+  path_check_on = enable /= 0
+end subroutine stepper_path_checks

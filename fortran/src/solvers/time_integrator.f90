@@ -60,6 +60,7 @@
 !> next one, far through the other leaf).
 !> No I/O; failures return codes (see integrator_chunk).
 module time_integrator
+  use, intrinsic :: iso_fortran_env, only: int64
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
                                internal_forces, external_forces, evaluate_constraints, &
@@ -77,6 +78,13 @@ module time_integrator
   implicit none
   private
   public :: integrator_chunk, output_row, step_failure_text
+  !> tests (system_api's stepper_path_checks): while path_check_on, every carried Schur
+  !> complement's fast paths (carry_plane_gradients' partial columns, gather_blocks' scan
+  !> lists, plane_carried_correction's written-out sums) are compared bit for bit with the
+  !> routines they replaced, run alongside (check_carry_gather, check_plane_correction);
+  !> path_checks counts the comparisons, path_mismatches those that differed
+  logical, public, save :: path_check_on = .false.
+  integer, public, save :: path_checks = 0, path_mismatches = 0
   !> per-step statistics: Newton corrections, factorizations, Jacobian evaluations
   integer, parameter, public :: stat_corrections = 1, stat_factorizations = 2, &
                                 stat_jacobians = 3, stat_count = 3
@@ -726,6 +734,9 @@ contains
                                work%carry_column)
         end if
         inside = gather_blocks(work%carry_columns, work%w)
+        if (path_check_on) call check_carry_gather(sys, learned%carry_turn, work%gradients, &
+                                                   work%carry_columns, work%w, partial, &
+                                                   work%carry_pairs, inside)
         if (partial .and. .not. inside) &
           call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
                                work%carry_column)
@@ -774,6 +785,9 @@ contains
         call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
                                       work%correction)
+        if (path_check_on) call check_plane_correction(sys%carry_plane, learned%carry_turn, &
+                                                       work%carry_flexibility, work%dlam(:, 1), &
+                                                       work%direction, work%correction)
         return
       end if
       call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
@@ -836,6 +850,104 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
+
+  !> path_check_on: carry_schur's columns and gather against carry_gradients' whole columns
+  !> and the gather as it was before the scan lists (every coordinate tested, the row map
+  !> made anew; verbatim), bit for bit: the partial columns at the gathered pairs' rows,
+  !> the answer, and w where inside.
+  subroutine check_carry_gather(sys, turn, gradients, columns, w, partial, pairs, inside)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: turn(3, 3), gradients(:, :), columns(:, :), w(:, :)
+    logical, intent(in) :: partial, inside
+    integer, intent(in), allocatable :: pairs(:)
+    real(dp), allocatable :: whole(:, :), column(:), w_old(:, :)
+    integer, allocatable :: row_of(:)
+    integer :: b, j, dof, p, c, mismatches
+    logical :: inside_old
+    allocate (whole(sys%ndof, sys%ncon), column(sys%ndof), w_old(size(w, 1), size(w, 2)), &
+              row_of(sys%ndof))
+    call carry_gradients(sys, turn, gradients, whole, column)
+    mismatches = 0
+    if (partial) then
+      do p = 1, size(pairs)
+        do j = 1, 2
+          dof = sys%carry_plane(j, pairs(p))
+          do c = 1, sys%ncon
+            if (.not. same_bits(columns(dof, c), whole(dof, c))) mismatches = mismatches + 1
+          end do
+        end do
+      end do
+    else
+      do c = 1, sys%ncon
+        do dof = 1, sys%ndof
+          if (.not. same_bits(columns(dof, c), whole(dof, c))) mismatches = mismatches + 1
+        end do
+      end do
+    end if
+    ! (gather_blocks before the scan lists)
+    row_of = 0
+    do b = size(sys%block_first), 1, -1
+      do j = 0, 2
+        row_of(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
+      end do
+    end do
+    w_old = 0.0_dp
+    inside_old = .true.
+    do dof = 1, sys%ndof
+      if (row_of(dof) > 0) then
+        w_old(row_of(dof), :) = whole(dof, :)
+      else if (any(whole(dof, :) /= 0.0_dp)) then
+        inside_old = .false.
+        exit
+      end if
+    end do
+    if (inside_old .neqv. inside) mismatches = mismatches + 1
+    if (inside .and. inside_old) then
+      do c = 1, size(w, 2)
+        do j = 1, size(w, 1)
+          if (.not. same_bits(w(j, c), w_old(j, c))) mismatches = mismatches + 1
+        end do
+      end do
+    end if
+    path_checks = path_checks + 1
+    if (mismatches > 0) path_mismatches = path_mismatches + 1
+  end subroutine check_carry_gather
+
+  !> path_check_on: plane_carried_correction's correction against the routine as it was
+  !> before its written-out sums (the loop over the multipliers, verbatim), bit for bit.
+  subroutine check_plane_correction(pairs, turn, flexibility, dlam, direction, correction)
+    integer, intent(in) :: pairs(:, :)
+    real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
+    real(dp), intent(in) :: correction(:)
+    real(dp) :: back_x, back_y, r13, r23, old_x, old_y
+    integer :: p, c, first, second, mismatches
+    mismatches = 0
+    r13 = turn(1, 3) * 0.0_dp
+    r23 = turn(2, 3) * 0.0_dp
+    do p = 1, size(pairs, 2)
+      first = pairs(1, p)
+      second = pairs(2, p)
+      back_x = 0.0_dp
+      back_y = 0.0_dp
+      do c = 1, size(dlam)
+        if (dlam(c) == 0.0_dp) cycle
+        back_x = back_x + flexibility(first, c) * dlam(c)
+        back_y = back_y + flexibility(second, c) * dlam(c)
+      end do
+      old_x = (turn(1, 1) * back_x + turn(1, 2) * back_y + r13) - direction(first)
+      old_y = (turn(2, 1) * back_x + turn(2, 2) * back_y + r23) - direction(second)
+      if (.not. same_bits(old_x, correction(first))) mismatches = mismatches + 1
+      if (.not. same_bits(old_y, correction(second))) mismatches = mismatches + 1
+    end do
+    path_checks = path_checks + 1
+    if (mismatches > 0) path_mismatches = path_mismatches + 1
+  end subroutine check_plane_correction
+
+  !> Whether x and y are the same bits.
+  pure logical function same_bits(x, y)
+    real(dp), intent(in) :: x, y
+    same_bits = transfer(x, 1_int64) == transfer(y, 1_int64)
+  end function same_bits
 
   !> LU factorization with partial pivoting P A = L U of a small dense matrix in place
   !> (LAPACK dgetf2's algorithm: the first largest |entry| of each column as its pivot,
