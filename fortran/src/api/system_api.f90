@@ -550,10 +550,12 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   sys%carry_position = position(1:max(0, nvec)) /= 0
   if (allocated(sys%carry_map)) deallocate (sys%carry_map)
   if (allocated(sys%carry_plane)) deallocate (sys%carry_plane)
+  if (allocated(sys%carry_source)) deallocate (sys%carry_source)
   if (nvec == 0) return
   allocate (sys%carry_map(3, sys%nfull / 3))
   if (.not. sys%reduced) then
     sys%carry_map = reshape([(i, i = 1, sys%nfull)], [3, sys%nfull / 3])
+    call carry_sources()
     return
   end if
   sys%carry_map = 0
@@ -571,6 +573,7 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
     allocate (sys%carry_first(0), sys%carry_weight(0), sys%carry_position(0))
     return
   end if
+  call carry_sources()
   ! every vector of the xy plane or fixed (a planar reduction): carry_apply by the pairs
   if (all((sys%carry_map(1, :) > 0 .and. sys%carry_map(2, :) > 0 .and. &
            sys%carry_map(3, :) == 0) .or. all(sys%carry_map == 0, dim=1))) then
@@ -583,6 +586,24 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
       sys%carry_plane(:, k) = sys%carry_map(1:2, i)
     end do
   end if
+
+contains
+
+  !> sys%carry_source from carry_first and carry_map (carry_vectors' reads).
+  subroutine carry_sources()
+    integer :: vec, component, b
+    allocate (sys%carry_source(3, nvec))
+    do vec = 1, nvec
+      b = (sys%carry_first(vec) - 1) / 3 + 1
+      do component = 1, 3
+        if (sys%carry_map(component, b) > 0) then
+          sys%carry_source(component, vec) = sys%carry_map(component, b)
+        else
+          sys%carry_source(component, vec) = -(sys%carry_first(vec) + component - 1)
+        end if
+      end do
+    end do
+  end subroutine carry_sources
 end subroutine system_set_carry
 
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),
@@ -1199,11 +1220,11 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   type(system_model), pointer :: sys
   type(stepper_run), pointer :: run
   type(contact_state) :: contact
-  real(dp), allocatable :: e(:), v(:), a(:), accel(:), lam(:), out_time(:), out_probe(:, :, :)
-  real(dp), allocatable :: out_deflection(:, :, :), out_lambda(:, :), out_energy(:, :)
-  real(dp), allocatable :: out_constraint(:), out_contact(:, :, :), out_q(:, :)
+  real(dp), allocatable :: e(:), v(:), a(:), accel(:), lam(:), out_probe(:, :, :)
+  real(dp), allocatable :: out_deflection(:, :, :), out_contact(:, :, :), no_q(:, :)
   real(dp) :: t, work(power_count), powers(power_count)
   integer :: info, ndof, ncon, nprobe, npoint, step, k, j
+  integer :: at_lambda, at_energy, at_constraint, at_q  ! the rows' offsets (row_size)
   logical :: store_q
   rows = 0.0_dp
   stats = 0
@@ -1253,28 +1274,41 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   k = k + power_count
   contact%guesses = reshape(state(k + 1:k + 2 * npoint), [2, npoint])
   contact%counts = counts
-  allocate (out_time(nsteps), out_probe(3, nprobe, nsteps), out_deflection(3, nprobe, nsteps), &
-            out_lambda(ncon, nsteps), out_energy(energy_count, nsteps), out_constraint(nsteps), &
-            out_contact(contact_record, npoint, nsteps), out_q(ndof, merge(nsteps, 0, store_q)))
-  out_time = 0.0_dp
+  ! (the stepper writes time, lam, energy, constraint violation and q straight into their
+  ! rows, zeroed above: what it leaves unwritten is zero, as the copies of zeroed arrays
+  ! were; the probes, deflections and contact records are copied below)
+  at_lambda = 1 + 6 * nprobe
+  at_energy = at_lambda + ncon
+  at_constraint = at_energy + energy_count
+  at_q = at_constraint + 1 + contact_record * npoint
+  allocate (out_probe(3, nprobe, nsteps), out_deflection(3, nprobe, nsteps), &
+            out_contact(contact_record, npoint, nsteps))
   out_probe = 0.0_dp
   out_deflection = 0.0_dp
-  out_lambda = 0.0_dp
-  out_energy = 0.0_dp
-  out_constraint = 0.0_dp
   out_contact = 0.0_dp
-  out_q = 0.0_dp
-  call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, work, &
-                        powers, contact, out_time, out_probe, out_deflection, out_lambda, &
-                        out_energy, out_constraint, stats, out_contact, store_q, out_q, &
-                        status(1), status(2), status(3), last_correction, status(4))
+  if (store_q) then
+    call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, &
+                          work, powers, contact, rows(1, :), out_probe, out_deflection, &
+                          rows(at_lambda + 1:at_lambda + ncon, :), &
+                          rows(at_energy + 1:at_energy + energy_count, :), &
+                          rows(at_constraint + 1, :), stats, out_contact, store_q, &
+                          rows(at_q + 1:at_q + ndof, :), status(1), status(2), status(3), &
+                          last_correction, status(4))
+  else
+    allocate (no_q(ndof, 0))
+    call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, &
+                          work, powers, contact, rows(1, :), out_probe, out_deflection, &
+                          rows(at_lambda + 1:at_lambda + ncon, :), &
+                          rows(at_energy + 1:at_energy + energy_count, :), &
+                          rows(at_constraint + 1, :), stats, out_contact, store_q, no_q, &
+                          status(1), status(2), status(3), last_correction, status(4))
+  end if
   if (status(2) /= 0) message = step_failure_text(status(2), status(3), run%settings%max_newton)
   state = [t, e, v, a, accel, lam, work, powers, reshape(contact%guesses, [2 * npoint])]
   counts = contact%counts
   ! the output rows (stepper.f90 row_size)
   ! (the probes' and deflections' columns copied by loops: reshape was a library call a step)
   do step = 1, nsteps
-    rows(1, step) = out_time(step)
     k = 1
     do j = 1, nprobe
       rows(k + 3 * j - 2:k + 3 * j, step) = out_probe(:, j, step)
@@ -1283,18 +1317,10 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
     do j = 1, nprobe
       rows(k + 3 * j - 2:k + 3 * j, step) = out_deflection(:, j, step)
     end do
-    k = k + 3 * nprobe
-    rows(k + 1:k + ncon, step) = out_lambda(:, step)
-    k = k + ncon
-    rows(k + 1:k + energy_count, step) = out_energy(:, step)
-    k = k + energy_count
-    rows(k + 1, step) = out_constraint(step)
-    k = k + 1
+    k = at_constraint + 1
     do j = 1, npoint
       rows(k + contact_record * (j - 1) + 1:k + contact_record * j, step) = out_contact(:, j, step)
     end do
-    k = k + contact_record * npoint
-    if (store_q) rows(k + 1:k + ndof, step) = out_q(:, step)
   end do
 end subroutine system_advance
 
@@ -1388,3 +1414,21 @@ subroutine system_static_solve(handle, ndof, ncon, npoint, nnz, t, load_factor, 
                                                minval(history(1:max(1, iterations))), force_res, &
                                                con_res, tol)
 end subroutine system_static_solve
+
+!> Tests of the stepper's carried Schur complement (time_integrator's path_check_on):
+!> enable /= 0 turns the comparison of its fast paths with the routines they replaced on
+!> (counters reset), 0 off; checks and mismatches: the comparisons made and those that
+!> differed since the last reset.
+subroutine stepper_path_checks(enable, checks, mismatches)
+  use time_integrator, only: path_check_on, path_checks, path_mismatches
+  implicit none
+  integer, intent(in) :: enable
+  integer, intent(out) :: checks, mismatches
+  checks = path_checks
+  mismatches = path_mismatches
+  if (enable /= 0) then
+    path_checks = 0
+    path_mismatches = 0
+  end if
+  path_check_on = enable /= 0
+end subroutine stepper_path_checks

@@ -692,7 +692,9 @@ contains
     logical, intent(out) :: done
     real(dp) :: coords(3, 4), element_force(cable_dofs), element_energy
     real(dp) :: unused_tangent(cable_dofs, cable_dofs)
-    integer :: el, a, i, k, element_info
+    integer :: el, a, i, k, node, component, element_info
+    integer :: selected(cable_dofs)  ! the element's reduced coordinates (0: fixed)
+    logical :: plane
     energy = 0.0_dp
     info = 0
     done = .not. (set%tension_only .or. .not. allocated(set%weights) .or. &
@@ -700,16 +702,24 @@ contains
                   set%damping_time > 0.0_dp)
     if (.not. done) return
     do el = 1, set%nel
-      do a = 1, cable_dofs
-        i = set%dofs(a, el)
-        k = select(i)
-        if (k > 0) then
-          coords(mod(a - 1, 3) + 1, (a - 1) / 3 + 1) = offset(i) + e(k)
-        else
-          coords(mod(a - 1, 3) + 1, (a - 1) / 3 + 1) = offset(i)
-        end if
+      ! (each element dof's reduced coordinate looked up once, for the gather and the
+      ! scatter; coords by node and component, not by mod and division of a)
+      a = 0
+      do node = 1, 4
+        do component = 1, 3
+          a = a + 1
+          i = set%dofs(a, el)
+          k = select(i)
+          selected(a) = k
+          if (k > 0) then
+            coords(component, node) = offset(i) + e(k)
+          else
+            coords(component, node) = offset(i)
+          end if
+        end do
       end do
-      if (all(coords(3, :) == 0.0_dp)) then
+      plane = all(coords(3, :) == 0.0_dp)
+      if (plane) then
         call plane_element_force(coords, set%slope_rows(:, :, el), set%second_rows(:, :, el), &
                                  set%weights(:, el), set%axial_stiffness, &
                                  set%bending_stiffness, element_force, element_energy, &
@@ -724,11 +734,22 @@ contains
         energy = 0.0_dp
         return
       end if
-      ! (a z component of a plane element is +0: added or not, the same sums)
-      do a = 1, cable_dofs
-        k = select(set%dofs(a, el))
-        if (k > 0) force(k) = force(k) + element_force(a)
-      end do
+      ! (a z component of a plane element is +0: added or not, the same sums (force starts
+      ! at +0 and a sum is -0 only when both terms are, so no entry is ever -0 and adding +0
+      ! leaves it as it is): a plane element's z components are skipped)
+      if (plane) then
+        do node = 1, 4
+          do a = 3 * node - 2, 3 * node - 1
+            k = selected(a)
+            if (k > 0) force(k) = force(k) + element_force(a)
+          end do
+        end do
+      else
+        do a = 1, cable_dofs
+          k = selected(a)
+          if (k > 0) force(k) = force(k) + element_force(a)
+        end do
+      end if
       energy = energy + element_energy
     end do
   end subroutine cable_selected_forces

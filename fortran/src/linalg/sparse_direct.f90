@@ -64,6 +64,7 @@ contains
         first = max(1, j - kd)
         x = rhs(j, k)
         !GCC$ novector
+        !GCC$ unroll 4
         do i = first, j - 1
           x = x - band(kd + 1 - j + i, j) * rhs(i, k)
         end do
@@ -73,6 +74,7 @@ contains
         last = min(kd, n - i)
         x = rhs(i, k)
         !GCC$ novector
+        !GCC$ unroll 4
         do m = last, 1, -1
           x = x - rhs(i + m, k) * lower(1 + m, i)
         end do

@@ -29,7 +29,8 @@ module carried_rotation
   use mechanical_system, only: system_model
   implicit none
   private
-  public :: carry_enabled, carry_vectors, carry_turn, carry_apply, carry_gradients
+  public :: carry_enabled, carry_vectors, carry_turn, carry_apply, carry_gradients, &
+            carry_plane_gradients
 
   !> the identity's share of the fitted correlation (relative to its Frobenius norm)
   real(dp), parameter :: identity_share = 1e-6_dp
@@ -48,15 +49,16 @@ contains
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: e(:)
     real(dp), intent(out) :: vectors(:, :)
-    integer :: k, i, dof, b
+    integer :: k, i, source
+    ! (carry_source: carry_map's reduced coordinate or minus the fixed full dof, made once
+    ! by system_set_carry)
     do k = 1, size(sys%carry_first)
-      b = (sys%carry_first(k) - 1) / 3 + 1
       do i = 1, 3
-        if (sys%carry_map(i, b) > 0) then
-          vectors(i, k) = e(sys%carry_map(i, b))
+        source = sys%carry_source(i, k)
+        if (source > 0) then
+          vectors(i, k) = e(source)
         else  ! a coordinate the reduction fixes
-          dof = sys%carry_first(k) + i - 1
-          vectors(i, k) = sys%reduction_offset(dof)
+          vectors(i, k) = sys%reduction_offset(-source)
         end if
       end do
     end do
@@ -271,12 +273,12 @@ contains
   end subroutine carry_apply
 
   !> columns (ndof, ncon): T_e^T Phi_e^T, the constraint gradients turned back to the
-  !> factorization's axes (the right-hand sides of the Schur complement's flexibility).
-  pure subroutine carry_gradients(sys, turn, gradients, columns)
+  !> factorization's axes (the right-hand sides of the Schur complement's flexibility);
+  !> column (ndof): work (the caller's: an automatic array was a heap allocation a call).
+  pure subroutine carry_gradients(sys, turn, gradients, columns, column)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: turn(3, 3), gradients(:, :)
-    real(dp), intent(out) :: columns(:, :)
-    real(dp) :: column(sys%ndof)
+    real(dp), intent(out) :: columns(:, :), column(:)
     integer :: c, s, k
     do c = 1, sys%ncon
       column = 0.0_dp
@@ -288,5 +290,47 @@ contains
       call carry_apply(sys, turn, column, .true., columns(:, c))
     end do
   end subroutine carry_gradients
+
+  !> carry_gradients of a planar reduction (carry_plane) at the listed pairs only (pairs:
+  !> indices into carry_plane, holding every term dof of the constraints): columns at
+  !> those pairs' coordinates as carry_gradients gives them (the same scatter into a zeroed
+  !> column, the same turn as carry_apply's plane path), the other rows not written.
+  pure subroutine carry_plane_gradients(sys, turn, gradients, pairs, columns, column)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: turn(3, 3), gradients(:, :)
+    integer, intent(in) :: pairs(:)
+    real(dp), intent(inout) :: columns(:, :), column(:)
+    real(dp) :: r11, r12, r13, r21, r22, r23, v1, v2
+    integer :: c, s, k, p, first, second, last
+    ! (back: the transposed turn, as carry_apply(.., back = .true., ..))
+    r11 = turn(1, 1)
+    r12 = turn(2, 1)
+    r13 = turn(3, 1) * 0.0_dp
+    r21 = turn(1, 2)
+    r22 = turn(2, 2)
+    r23 = turn(3, 2) * 0.0_dp
+    do c = 1, sys%ncon
+      do p = 1, size(pairs)
+        column(sys%carry_plane(1, pairs(p))) = 0.0_dp
+        column(sys%carry_plane(2, pairs(p))) = 0.0_dp
+      end do
+      ! (the operands up to the last with terms, con_operands: the rest are empty)
+      last = 6
+      if (allocated(sys%con_operands)) last = sys%con_operands(c)
+      do s = 1, last
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          column(sys%term_dof(k)) = column(sys%term_dof(k)) + gradients(s, c) * sys%term_coef(k)
+        end do
+      end do
+      do p = 1, size(pairs)
+        first = sys%carry_plane(1, pairs(p))
+        second = sys%carry_plane(2, pairs(p))
+        v1 = column(first)
+        v2 = column(second)
+        columns(first, c) = r11 * v1 + r12 * v2 + r13
+        columns(second, c) = r21 * v1 + r22 * v2 + r23
+      end do
+    end do
+  end subroutine carry_plane_gradients
 
 end module carried_rotation

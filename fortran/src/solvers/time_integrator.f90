@@ -60,6 +60,7 @@
 !> next one, far through the other leaf).
 !> No I/O; failures return codes (see integrator_chunk).
 module time_integrator
+  use, intrinsic :: iso_fortran_env, only: int64
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
                                internal_forces, external_forces, evaluate_constraints, &
@@ -73,10 +74,17 @@ module time_integrator
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
   use carried_rotation, only: carry_enabled, carry_vectors, carry_turn, carry_apply, &
-                              carry_gradients
+                              carry_gradients, carry_plane_gradients
   implicit none
   private
   public :: integrator_chunk, output_row, step_failure_text
+  !> tests (system_api's stepper_path_checks): while path_check_on, every carried Schur
+  !> complement's fast paths (carry_plane_gradients' partial columns, gather_blocks' scan
+  !> lists, plane_carried_correction's written-out sums) are compared bit for bit with the
+  !> routines they replaced, run alongside (check_carry_gather, check_plane_correction);
+  !> path_checks counts the comparisons, path_mismatches those that differed
+  logical, public, save :: path_check_on = .false.
+  integer, public, save :: path_checks = 0, path_mismatches = 0
   !> per-step statistics: Newton corrections, factorizations, Jacobian evaluations
   integer, parameter, public :: stat_corrections = 1, stat_factorizations = 2, &
                                 stat_jacobians = 3, stat_count = 3
@@ -132,6 +140,18 @@ module time_integrator
     ! the carried matrix's Schur complement (carried_rotation): T^T Phi_e^T, S^{-1} of it and
     ! the LU factors of C, built at a step's first carried correction
     real(dp), allocatable :: carry_columns(:, :), carry_flexibility(:, :), carry_lu(:, :)
+    ! carry_gradients' column of Phi_e^T (its work array), and the row of w (E_c^T) of each
+    ! reduced coordinate (0: in no touched block; a dof in two blocks: the first), made once
+    ! per chunk for gather_blocks (automatic arrays were heap allocations in every step)
+    real(dp), allocatable :: carry_column(:)
+    integer, allocatable :: block_row(:)
+    ! the reduced coordinates in touched blocks (block_row > 0), and those outside them
+    ! that T^T Phi_e^T can make nonzero (scan_known: the list holds; else all are scanned)
+    integer, allocatable :: touched_dofs(:), scan_dofs(:)
+    logical :: scan_known = .false.
+    ! a planar reduction with scan_known: the pairs (carry_plane) holding a touched or a
+    ! scanned coordinate, the only rows of T^T Phi_e^T that gather_blocks reads
+    integer, allocatable :: carry_pairs(:)
   end type step_work
 
 contains
@@ -140,7 +160,7 @@ contains
   pure subroutine allocate_work(sys, work)
     type(system_model), intent(in) :: sys
     type(step_work), intent(out) :: work
-    integer :: nb
+    integer :: nb, b, j
     nb = 3 * size(sys%block_first)
     allocate (work%r(sys%ndof), work%z(sys%ndof, 1), work%direction(sys%ndof), &
               work%correction(sys%ndof), work%back(sys%ndof), work%phi(sys%ncon), &
@@ -150,10 +170,65 @@ contains
               work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
               work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
               work%row_ndof(sys%ndof, 2), work%full_pair(sys%nfull, 2))
-    if (carry_enabled(sys)) allocate (work%carry_columns(sys%ndof, sys%ncon), &
-                                      work%carry_flexibility(sys%ndof, sys%ncon), &
-                                      work%carry_lu(sys%ncon, sys%ncon))
+    if (carry_enabled(sys)) then
+      allocate (work%carry_columns(sys%ndof, sys%ncon), &
+                work%carry_flexibility(sys%ndof, sys%ncon), work%carry_lu(sys%ncon, sys%ncon), &
+                work%carry_column(sys%ndof), work%block_row(sys%ndof))
+      work%block_row = 0
+      do b = size(sys%block_first), 1, -1
+        do j = 0, 2
+          work%block_row(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
+        end do
+      end do
+      work%touched_dofs = pack([(j, j = 1, sys%ndof)], work%block_row > 0)
+      call carry_scan_setup(sys, work)
+    end if
   end subroutine allocate_work
+
+  !> work%scan_dofs: the reduced coordinates outside the touched blocks (block_row = 0)
+  !> where carry_gradients' columns T^T Phi_e^T can be nonzero. Column c of Phi_e^T is
+  !> nonzero at the constraints' term dofs only, and T^T (carry_apply) turns each carried
+  !> 3-vector on its own: a vector without a term dof gets exactly +-0 from a finite turn
+  !> (r11 * 0 + r12 * 0 + r13 * 0), which gather_blocks' test (/= 0) passes. So with a finite
+  !> turn only the coordinates of vectors holding a term dof need the test. scan_known =
+  !> .false. (every coordinate tested, as before) unless each reduced coordinate is in
+  !> exactly one carried vector.
+  pure subroutine carry_scan_setup(sys, work)
+    type(system_model), intent(in) :: sys
+    type(step_work), intent(inout) :: work
+    integer :: vector_of(sys%ndof), b, i, k, dof
+    logical :: reached(sys%ndof)
+    work%scan_known = .false.
+    allocate (work%scan_dofs(0))
+    if (sys%ncon == 0) return
+    vector_of = 0
+    do b = 1, size(sys%carry_map, 2)
+      do i = 1, 3
+        dof = sys%carry_map(i, b)
+        if (dof <= 0) cycle
+        if (dof > sys%ndof) return
+        if (vector_of(dof) /= 0) return
+        vector_of(dof) = b
+      end do
+    end do
+    if (any(vector_of == 0)) return
+    reached = .false.
+    do k = sys%term_ptr(1), sys%term_ptr(6 * sys%ncon + 1) - 1
+      dof = sys%term_dof(k)
+      if (dof < 1 .or. dof > sys%ndof) return
+      b = vector_of(dof)
+      do i = 1, 3
+        if (sys%carry_map(i, b) > 0) reached(sys%carry_map(i, b)) = .true.
+      end do
+    end do
+    work%scan_dofs = pack([(dof, dof = 1, sys%ndof)], reached .and. work%block_row == 0)
+    work%scan_known = .true.
+    if (.not. allocated(sys%carry_plane)) return
+    ! (every term dof is reached: its pair is among them)
+    reached = reached .or. work%block_row > 0
+    work%carry_pairs = pack([(k, k = 1, size(sys%carry_plane, 2))], &
+                            reached(sys%carry_plane(1, :)) .or. reached(sys%carry_plane(2, :)))
+  end subroutine carry_scan_setup
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
   !> constraint values and gradients, the strain energy and the number of active contact
@@ -184,8 +259,10 @@ contains
     end if
     call mass_product(sys, acceleration, r)
     ! (loads of t alone, without point loads that follow e: once per time, kept for the
-    ! step's later corrections)
-    if (sys%nvload > 0 .or. .not. work%loads_ready .or. work%loads_time /= t) then
+    ! step's later corrections; without driven loads (force_drive) they are constant_force
+    ! at every time: once per chunk)
+    if (sys%nvload > 0 .or. .not. work%loads_ready .or. &
+        (work%loads_time /= t .and. size(sys%force_drive) > 0)) then
       work%loads_ready = .false.
       call external_forces(sys, t, 1.0_dp, loads, info, e)
       if (info /= 0) return
@@ -236,8 +313,9 @@ contains
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
     real(dp) :: contact_potential, beta_prime, velocity_factor
-    integer :: step, attempt, stats(stat_count)
+    integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
+    logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
     type(step_work) :: scratch
     call allocate_work(sys, scratch)
     info = 0
@@ -257,7 +335,9 @@ contains
       started_old = .false.
       do attempt = 1, 2
         call predict(sys, cfg, learned, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
-        lam_new = lam
+        do i = 1, sys%ncon  ! (the multipliers' copies by loops: a few entries, no memcpy call)
+          lam_new(i) = lam(i)
+        end do
         fresh_matrix = .false.
         if (needs_factorization(sys, cfg, beta_prime, attempt) .or. start_fresh) then
           call factorize(sys, learned, beta_prime, velocity_factor, rotations, e_new, v_new, &
@@ -272,7 +352,8 @@ contains
         call carry_step(sys, cfg, learned, fresh_matrix, e_new)
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, scratch, info, detail)
+                    stats, done, last_correction, monitor, scratch, info, detail, &
+                    constraints_checked)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
         ! refreshed the matrix on the way) gets one retry from its start with a fresh one
@@ -289,28 +370,44 @@ contains
       if (monitor%at_floor) floor_accepts = floor_accepts + 1
       if (started_old) call update_reuse_backoff(learned, stats(stat_factorizations) > 0)
       ! accept the step
-      a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
-              / (1.0_dp - cfg%alpha_m)
-      v = v + h * ((1.0_dp - cfg%gamma) * a + cfg%gamma * a_new)
-      e = e_new
-      a = a_new
+      ! (one pass: each coordinate's a_new, v, e and a by the same expressions as the
+      ! array statements they replace, without their separate loops and copies)
+      do i = 1, sys%ndof
+        a_new(i) = (cfg%alpha_f * accel(i) + (1.0_dp - cfg%alpha_f) * accel_new(i) &
+                    - cfg%alpha_m * a(i)) / (1.0_dp - cfg%alpha_m)
+        v(i) = v(i) + h * ((1.0_dp - cfg%gamma) * a(i) + cfg%gamma * a_new(i))
+        e(i) = e_new(i)
+        a(i) = a_new(i)
+      end do
       ! the predictor of the next step: the extrapolation that came nearest e''_{n+1}
       ! (refactorized systems without contact only: the others never use it)
       if (sys%npoint == 0 .and. sys%policy /= policy_constant) &
         call learn_predictor(learned, h, accel, accel_new)
       accel = accel_new
-      lam = lam_new
+      do i = 1, sys%ncon
+        lam(i) = lam_new(i)
+      end do
       t = t + h
-      call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
-                    contact_potential, out_constraint(step), out_contact(:, :, step), info, &
-                    scratch%full, scratch%row_phi, scratch%row_gradients)
+      ! (a step accepted on the contraction estimate evaluated its constraints at e_new,
+      ! t + h: the energies read them instead of evaluating them again)
+      if (constraints_checked) then
+        call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
+                      contact_potential, out_constraint(step), out_contact(:, :, step), info, &
+                      scratch%full, scratch%phi, scratch%gradients, constraints_known=.true.)
+      else
+        call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers_new, &
+                      contact_potential, out_constraint(step), out_contact(:, :, step), info, &
+                      scratch%full, scratch%row_phi, scratch%row_gradients)
+      end if
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers + powers_new)
       powers = powers_new
       steps_done = step
       out_time(step) = t
       out_stats(:, step) = stats
-      out_lambda(:, step) = lam
+      do i = 1, sys%ncon
+        out_lambda(i, step) = lam(i)
+      end do
       call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, &
                         out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info, &
                         scratch%full, scratch%row_ndof)
@@ -327,12 +424,19 @@ contains
     type(stepper_state), intent(in) :: learned
     real(dp), intent(in) :: h, e(:), v(:), a(:), accel(:)
     real(dp), intent(out) :: e_new(:), v_new(:), a_new(:), accel_new(:)
+    integer :: i
     if (sys%npoint == 0) then
       call extrapolate(usable_predictor(learned, h, learned%predictor), accel, learned, &
                        accel_new)
-      a_new = (cfg%alpha_f * accel + (1.0_dp - cfg%alpha_f) * accel_new - cfg%alpha_m * a) &
-              / (1.0_dp - cfg%alpha_m)
-      e_new = e + h * v + h * h * ((0.5_dp - cfg%beta) * a + cfg%beta * a_new)
+      ! (one pass: each coordinate's a_new, e_new and v_new by the expressions of the array
+      ! statements they replace)
+      do i = 1, size(e)
+        a_new(i) = (cfg%alpha_f * accel(i) + (1.0_dp - cfg%alpha_f) * accel_new(i) &
+                    - cfg%alpha_m * a(i)) / (1.0_dp - cfg%alpha_m)
+        e_new(i) = e(i) + h * v(i) + h * h * ((0.5_dp - cfg%beta) * a(i) + cfg%beta * a_new(i))
+        v_new(i) = v(i) + h * ((1.0_dp - cfg%gamma) * a(i) + cfg%gamma * a_new(i))
+      end do
+      return
     else
       if (maxval(abs(h * v)) <= contact_step_limit(sys)) then
         e_new = e + h * v
@@ -411,7 +515,8 @@ contains
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, learned, t_new, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, work, info, detail)
+                    stats, done, last_correction, monitor, work, info, detail, &
+                    constraints_checked)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -426,6 +531,8 @@ contains
     type(newton_monitor), intent(out) :: monitor
     type(step_work), intent(inout) :: work
     integer, intent(out) :: info, detail
+    !> done with work%phi and work%gradients evaluated at the final e_new and t_new
+    logical, intent(out) :: constraints_checked
     real(dp) :: strain, previous_correction, step_cap, step_theta
     integer :: it, lapack_info, active, i
     integer :: refreshed_at  ! the correction after which the matrix was last refreshed
@@ -439,6 +546,7 @@ contains
     info = 0
     detail = 0
     done = .false.
+    constraints_checked = .false.
     use_known = fresh_matrix
     carry_ready = .false.
     previous_correction = huge(1.0_dp)
@@ -484,8 +592,8 @@ contains
         call to_solver_frame(sys, rotations, z(:, 1), .false., direction)
       end if
       ! (with constraints both paths below overwrite the correction)
+      ! (dlam: written whole by gradient_product in both paths below; empty without constraints)
       if (sys%ncon == 0) correction = -direction
-      dlam = 0.0_dp
       if (sys%ncon > 0 .and. learned%carry_on) then
         ! the Schur complement with the carried matrix: C = G^T S^{-1} G, G = T^T Phi_e^T
         call carry_schur()
@@ -528,7 +636,6 @@ contains
       ! and the largest |correction| and |e_new| as maxval takes them; max is exact)
       finite = .true.
       largest_correction = 0.0_dp
-      largest_coordinate = 0.0_dp
       do i = 1, sys%ndof
         step_part = correction(i)
         if (.not. abs(step_part) < huge(1.0_dp)) finite = .false.
@@ -536,7 +643,6 @@ contains
         accel_new(i) = accel_new(i) + beta_prime * step_part
         v_new(i) = v_new(i) + velocity_factor * step_part
         largest_correction = max(largest_correction, abs(step_part))
-        largest_coordinate = max(largest_coordinate, abs(e_new(i)))
       end do
       lam_new = lam_new + dlam(:, 1)
       stats(stat_corrections) = stats(stat_corrections) + 1
@@ -554,6 +660,7 @@ contains
           call evaluate_constraints(sys, e_new, t_new, phi, gradients, info)
           if (info /= 0) return
           done = maxval(abs(phi)) <= cfg%tol * min(1.0_dp, cfg%length_scale)
+          constraints_checked = done
         else
           done = .true.
         end if
@@ -561,6 +668,11 @@ contains
       end if
       ! (a correction cut to the contact cap says nothing about convergence)
       if (.not. capped) then
+        ! (the largest |e_new| only here, where it is read: e_new is finite, max is exact)
+        largest_coordinate = 0.0_dp
+        do i = 1, sys%ndof
+          largest_coordinate = max(largest_coordinate, abs(e_new(i)))
+        end do
         call stagnated(monitor, cfg, it, last_correction, previous_correction, &
                        largest_coordinate, halt)
         if (halt) then
@@ -608,10 +720,29 @@ contains
     !> them); then C dlam = Phi_e z - Phi, correction = T F dlam - z.
     subroutine carry_schur()
       integer :: c
+      logical :: partial, inside
       ! (the newton's associate names are not visible here: the work arrays by name)
       if (.not. carry_ready) then
-        call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns)
-        if (gather_blocks(work%carry_columns, work%w)) then
+        ! a planar reduction whose rows outside the gathered pairs are known to be +-0 (a
+        ! finite turn, carry_scan_setup): T^T Phi_e^T at those pairs only; the whole
+        ! columns when the solve below needs them
+        partial = allocated(work%carry_pairs)
+        if (partial) partial = all(abs(learned%carry_turn) <= huge(1.0_dp))
+        if (partial) then
+          call carry_plane_gradients(sys, learned%carry_turn, work%gradients, &
+                                     work%carry_pairs, work%carry_columns, work%carry_column)
+        else
+          call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
+                               work%carry_column)
+        end if
+        inside = gather_blocks(work%carry_columns, work%w)
+        if (path_check_on) call check_carry_gather(sys, learned%carry_turn, work%gradients, &
+                                                   work%carry_columns, work%w, partial, &
+                                                   work%carry_pairs, inside)
+        if (partial .and. .not. inside) &
+          call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
+                               work%carry_column)
+        if (inside) then
           ! within the factorization's flexibility S^{-1} E_c (the model's touched blocks
           ! hold each constrained vector whole): no solve
           ! (matmul's sums by the loops of sparse_columns_product and schur_complement:
@@ -656,6 +787,9 @@ contains
         call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
                                       work%correction)
+        if (path_check_on) call check_plane_correction(sys%carry_plane, learned%carry_turn, &
+                                                       work%carry_flexibility, work%dlam(:, 1), &
+                                                       work%direction, work%correction)
         return
       end if
       call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
@@ -668,21 +802,42 @@ contains
     logical function gather_blocks(columns, w) result(inside)
       real(dp), intent(in) :: columns(:, :)
       real(dp), intent(out) :: w(:, :)
-      integer :: row_of(sys%ndof), b, j, dof
-      row_of = 0
-      do b = size(sys%block_first), 1, -1
-        do j = 0, 2
-          row_of(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
-        end do
-      end do
+      integer :: dof, c, k
+      ! (work%block_row, touched_dofs and scan_dofs: made once per chunk by allocate_work;
+      ! with a finite turn only scan_dofs can hold a nonzero outside the blocks, see
+      ! carry_scan_setup; the same w and the same answer as the test of every coordinate)
       w = 0.0_dp
       inside = .true.
+      if (work%scan_known .and. all(abs(learned%carry_turn) <= huge(1.0_dp))) then
+        do k = 1, size(work%scan_dofs)
+          dof = work%scan_dofs(k)
+          do c = 1, size(columns, 2)
+            if (columns(dof, c) /= 0.0_dp) then
+              inside = .false.
+              return
+            end if
+          end do
+        end do
+        do k = 1, size(work%touched_dofs)
+          dof = work%touched_dofs(k)
+          do c = 1, size(columns, 2)
+            w(work%block_row(dof), c) = columns(dof, c)
+          end do
+        end do
+        return
+      end if
       do dof = 1, sys%ndof
-        if (row_of(dof) > 0) then
-          w(row_of(dof), :) = columns(dof, :)
-        else if (any(columns(dof, :) /= 0.0_dp)) then
-          inside = .false.
-          return
+        if (work%block_row(dof) > 0) then
+          do c = 1, size(columns, 2)
+            w(work%block_row(dof), c) = columns(dof, c)
+          end do
+        else
+          do c = 1, size(columns, 2)
+            if (columns(dof, c) /= 0.0_dp) then
+              inside = .false.
+              return
+            end if
+          end do
         end if
       end do
     end function gather_blocks
@@ -698,6 +853,104 @@ contains
 
   end subroutine newton
 
+  !> path_check_on: carry_schur's columns and gather against carry_gradients' whole columns
+  !> and the gather as it was before the scan lists (every coordinate tested, the row map
+  !> made anew; verbatim), bit for bit: the partial columns at the gathered pairs' rows,
+  !> the answer, and w where inside.
+  subroutine check_carry_gather(sys, turn, gradients, columns, w, partial, pairs, inside)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: turn(3, 3), gradients(:, :), columns(:, :), w(:, :)
+    logical, intent(in) :: partial, inside
+    integer, intent(in), allocatable :: pairs(:)
+    real(dp), allocatable :: whole(:, :), column(:), w_old(:, :)
+    integer, allocatable :: row_of(:)
+    integer :: b, j, dof, p, c, mismatches
+    logical :: inside_old
+    allocate (whole(sys%ndof, sys%ncon), column(sys%ndof), w_old(size(w, 1), size(w, 2)), &
+              row_of(sys%ndof))
+    call carry_gradients(sys, turn, gradients, whole, column)
+    mismatches = 0
+    if (partial) then
+      do p = 1, size(pairs)
+        do j = 1, 2
+          dof = sys%carry_plane(j, pairs(p))
+          do c = 1, sys%ncon
+            if (.not. same_bits(columns(dof, c), whole(dof, c))) mismatches = mismatches + 1
+          end do
+        end do
+      end do
+    else
+      do c = 1, sys%ncon
+        do dof = 1, sys%ndof
+          if (.not. same_bits(columns(dof, c), whole(dof, c))) mismatches = mismatches + 1
+        end do
+      end do
+    end if
+    ! (gather_blocks before the scan lists)
+    row_of = 0
+    do b = size(sys%block_first), 1, -1
+      do j = 0, 2
+        row_of(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
+      end do
+    end do
+    w_old = 0.0_dp
+    inside_old = .true.
+    do dof = 1, sys%ndof
+      if (row_of(dof) > 0) then
+        w_old(row_of(dof), :) = whole(dof, :)
+      else if (any(whole(dof, :) /= 0.0_dp)) then
+        inside_old = .false.
+        exit
+      end if
+    end do
+    if (inside_old .neqv. inside) mismatches = mismatches + 1
+    if (inside .and. inside_old) then
+      do c = 1, size(w, 2)
+        do j = 1, size(w, 1)
+          if (.not. same_bits(w(j, c), w_old(j, c))) mismatches = mismatches + 1
+        end do
+      end do
+    end if
+    path_checks = path_checks + 1
+    if (mismatches > 0) path_mismatches = path_mismatches + 1
+  end subroutine check_carry_gather
+
+  !> path_check_on: plane_carried_correction's correction against the routine as it was
+  !> before its written-out sums (the loop over the multipliers, verbatim), bit for bit.
+  subroutine check_plane_correction(pairs, turn, flexibility, dlam, direction, correction)
+    integer, intent(in) :: pairs(:, :)
+    real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
+    real(dp), intent(in) :: correction(:)
+    real(dp) :: back_x, back_y, r13, r23, old_x, old_y
+    integer :: p, c, first, second, mismatches
+    mismatches = 0
+    r13 = turn(1, 3) * 0.0_dp
+    r23 = turn(2, 3) * 0.0_dp
+    do p = 1, size(pairs, 2)
+      first = pairs(1, p)
+      second = pairs(2, p)
+      back_x = 0.0_dp
+      back_y = 0.0_dp
+      do c = 1, size(dlam)
+        if (dlam(c) == 0.0_dp) cycle
+        back_x = back_x + flexibility(first, c) * dlam(c)
+        back_y = back_y + flexibility(second, c) * dlam(c)
+      end do
+      old_x = (turn(1, 1) * back_x + turn(1, 2) * back_y + r13) - direction(first)
+      old_y = (turn(2, 1) * back_x + turn(2, 2) * back_y + r23) - direction(second)
+      if (.not. same_bits(old_x, correction(first))) mismatches = mismatches + 1
+      if (.not. same_bits(old_y, correction(second))) mismatches = mismatches + 1
+    end do
+    path_checks = path_checks + 1
+    if (mismatches > 0) path_mismatches = path_mismatches + 1
+  end subroutine check_plane_correction
+
+  !> Whether x and y are the same bits.
+  pure logical function same_bits(x, y)
+    real(dp), intent(in) :: x, y
+    same_bits = transfer(x, 1_int64) == transfer(y, 1_int64)
+  end function same_bits
+
   !> LU factorization with partial pivoting P A = L U of a small dense matrix in place
   !> (LAPACK dgetf2's algorithm: the first largest |entry| of each column as its pivot,
   !> whole rows swapped; L below the diagonal with a unit diagonal, U on and above it);
@@ -706,7 +959,7 @@ contains
     real(dp), intent(inout) :: a(:, :)
     integer, intent(out) :: ipiv(:), info
     integer :: n, j, k, p
-    real(dp) :: row(size(a, 2))
+    real(dp) :: swap
     n = size(a, 1)
     info = 0
     do j = 1, n
@@ -714,9 +967,12 @@ contains
       ipiv(j) = p
       if (a(p, j) /= 0.0_dp) then
         if (p /= j) then
-          row = a(j, :)
-          a(j, :) = a(p, :)
-          a(p, :) = row
+          ! (entry by entry: a row temporary of unknown size was a heap allocation a call)
+          do k = 1, size(a, 2)
+            swap = a(j, k)
+            a(j, k) = a(p, k)
+            a(p, k) = swap
+          end do
         end if
         a(j + 1:n, j) = a(j + 1:n, j) / a(j, j)
       else if (info == 0) then
@@ -792,10 +1048,51 @@ contains
     integer, intent(in) :: pairs(:, :)
     real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
     real(dp), intent(out) :: correction(:)
-    real(dp) :: back_x, back_y, r13, r23
-    integer :: p, c, first, second
+    real(dp) :: back_x, back_y, r11, r12, r13, r21, r22, r23, d1, d2
+    integer :: p, c, first, second, c1, c2, nonzero
+    r11 = turn(1, 1)
+    r12 = turn(1, 2)
     r13 = turn(1, 3) * 0.0_dp
+    r21 = turn(2, 1)
+    r22 = turn(2, 2)
     r23 = turn(2, 3) * 0.0_dp
+    ! one or two nonzero multiplier corrections (a pin in the plane): their sums written
+    ! out, the same terms in the same order as the loop below (zero ones skipped there too)
+    nonzero = count(dlam /= 0.0_dp)
+    if (nonzero >= 1 .and. nonzero <= 2) then
+      c1 = 0
+      c2 = 0
+      do c = 1, size(dlam)
+        if (dlam(c) == 0.0_dp) cycle
+        if (c1 == 0) then
+          c1 = c
+        else
+          c2 = c
+        end if
+      end do
+      d1 = dlam(c1)
+      if (nonzero == 1) then
+        do p = 1, size(pairs, 2)
+          first = pairs(1, p)
+          second = pairs(2, p)
+          back_x = 0.0_dp + flexibility(first, c1) * d1
+          back_y = 0.0_dp + flexibility(second, c1) * d1
+          correction(first) = (r11 * back_x + r12 * back_y + r13) - direction(first)
+          correction(second) = (r21 * back_x + r22 * back_y + r23) - direction(second)
+        end do
+        return
+      end if
+      d2 = dlam(c2)
+      do p = 1, size(pairs, 2)
+        first = pairs(1, p)
+        second = pairs(2, p)
+        back_x = 0.0_dp + flexibility(first, c1) * d1 + flexibility(first, c2) * d2
+        back_y = 0.0_dp + flexibility(second, c1) * d1 + flexibility(second, c2) * d2
+        correction(first) = (r11 * back_x + r12 * back_y + r13) - direction(first)
+        correction(second) = (r21 * back_x + r22 * back_y + r23) - direction(second)
+      end do
+      return
+    end if
     do p = 1, size(pairs, 2)
       first = pairs(1, p)
       second = pairs(2, p)
@@ -806,8 +1103,8 @@ contains
         back_x = back_x + flexibility(first, c) * dlam(c)
         back_y = back_y + flexibility(second, c) * dlam(c)
       end do
-      correction(first) = (turn(1, 1) * back_x + turn(1, 2) * back_y + r13) - direction(first)
-      correction(second) = (turn(2, 1) * back_x + turn(2, 2) * back_y + r23) - direction(second)
+      correction(first) = (r11 * back_x + r12 * back_y + r13) - direction(first)
+      correction(second) = (r21 * back_x + r22 * back_y + r23) - direction(second)
     end do
   end subroutine plane_carried_correction
 

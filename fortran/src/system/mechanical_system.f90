@@ -186,6 +186,10 @@ module mechanical_system
     ! fixed) or wholly fixed: the reduced coordinates (x, y) of the plane vectors, (2, n);
     ! unallocated otherwise
     integer, allocatable :: carry_plane(:, :)
+    ! where carry_vectors reads each component of the carried vectors, (3, nvec): the
+    ! reduced coordinate (> 0) or minus the full dof whose reduction_offset it is (made by
+    ! system_set_carry with carry_map)
+    integer, allocatable :: carry_source(:, :)
   end type system_model
 
 contains
@@ -1272,15 +1276,19 @@ contains
   !> probe_output) - no heap arrays per output row.
   subroutine energies(sys, rotations, rates, e, v, lam, t, state, strain, powers, &
                       contact_potential, violation, records, info, full_work, phi_work, &
-                      gradients_work)
+                      gradients_work, constraints_known)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: rotations(:, :, 0:), rates(0:), e(:), v(:), lam(:), t
     type(contact_state), intent(inout) :: state
     real(dp), intent(out) :: strain, powers(power_count), contact_potential, violation
     real(dp), intent(out) :: records(:, :)
     integer, intent(out) :: info
-    real(dp), intent(out), optional, target :: full_work(:), phi_work(:), gradients_work(:, :)
+    real(dp), intent(inout), optional, target :: full_work(:), phi_work(:), gradients_work(:, :)
+    !> .true.: phi_work and gradients_work hold evaluate_constraints(sys, e, t) already (the
+    !> stepper's check of an accepted state), not evaluated again
+    logical, intent(in), optional :: constraints_known
     real(dp) :: set_energy, set_power, dissipation
+    logical :: known
     real(dp) :: fel_powers(2)
     real(dp), allocatable, target :: own_full(:), own_phi(:), own_gradients(:, :)
     real(dp), allocatable :: v_full(:), unused(:), values_unused(:)
@@ -1296,8 +1304,14 @@ contains
       phi => own_phi
       gradients => own_gradients
     end if
-    call evaluate_constraints(sys, e, t, phi, gradients, info)
-    if (info /= 0) return
+    known = .false.
+    if (present(constraints_known) .and. present(full_work)) known = constraints_known
+    if (known) then
+      info = 0
+    else
+      call evaluate_constraints(sys, e, t, phi, gradients, info)
+      if (info /= 0) return
+    end if
     violation = 0.0_dp
     if (sys%ncon > 0) violation = maxval(abs(phi))
     powers = 0.0_dp
