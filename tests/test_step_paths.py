@@ -1,6 +1,6 @@
 """The stepper's leaner carried Schur complement (issue 26, w6-step2) against the routines
-it replaced, bit for bit, on real runs: while system_api's stepper_path_checks is on, every
-use of the fast paths in time_integrator's carry_schur is compared with the old routine run
+it replaced, bit for bit, on real runs: while system_api's stepper_path_checks is on for a
+run's handle (turned on right after the run's stepper set-up), every use of the fast paths in time_integrator's carry_schur is compared with the old routine run
 alongside (check_carry_gather, check_plane_correction):
 
 * T^T Phi_e^T made only at the gathered pairs of a planar reduction (carry_plane_gradients)
@@ -21,6 +21,7 @@ import pytest
 
 import ancfdrv
 from ancfdrv import _kernel
+from ancfdrv.kernel import KernelSystem
 
 INPUTS = Path(__file__).resolve().parents[1] / "inputs"
 
@@ -33,13 +34,27 @@ INPUTS = Path(__file__).resolve().parents[1] / "inputs"
     ("hard/spinup.nml", ["spinup.omega=6", "beam.nodes=6", "solver.dt=1e-2",
                          "solver.t_end=2"], False),
 ])
-def test_carried_fast_paths_are_the_replaced_routines(scene, overrides, plane):
-    _kernel.stepper_path_checks(1)
-    try:
-        sim = ancfdrv.simulate(INPUTS / scene, [*overrides, "output.xdmf=.false."],
-                               progress=False)
-    finally:
-        checks, mismatches = _kernel.stepper_path_checks(0)
+def test_carried_fast_paths_are_the_replaced_routines(scene, overrides, plane, monkeypatch):
+    counted: list[tuple[int, int]] = []
+    setup, close = KernelSystem.stepper_setup, KernelSystem.close
+
+    def setup_checked(self, settings) -> None:
+        setup(self, settings)
+        assert _kernel.stepper_path_checks(self.handle, 1)[2] == 0
+
+    def close_counted(self) -> None:
+        if getattr(self, "handle", 0):
+            checks, mismatches, info = _kernel.stepper_path_checks(self.handle, 0)
+            if info == 0:
+                counted.append((checks, mismatches))
+        close(self)
+
+    monkeypatch.setattr(KernelSystem, "stepper_setup", setup_checked)
+    monkeypatch.setattr(KernelSystem, "close", close_counted)
+    sim = ancfdrv.simulate(INPUTS / scene, [*overrides, "output.xdmf=.false."],
+                           progress=False)
+    checks = sum(c for c, _ in counted)
+    mismatches = sum(m for _, m in counted)
     steps = len(sim.time) - 1
     print(f"\n{scene}: {checks} comparisons in {steps} steps, {mismatches} differed")
     assert sim.status == "ok"

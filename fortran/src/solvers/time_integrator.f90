@@ -78,13 +78,6 @@ module time_integrator
   implicit none
   private
   public :: integrator_chunk, output_row, step_failure_text
-  !> tests (system_api's stepper_path_checks): while path_check_on, every carried Schur
-  !> complement's fast paths (carry_plane_gradients' partial columns, gather_blocks' scan
-  !> lists, plane_carried_correction's written-out sums) are compared bit for bit with the
-  !> routines they replaced, run alongside (check_carry_gather, check_plane_correction);
-  !> path_checks counts the comparisons, path_mismatches those that differed
-  logical, public, save :: path_check_on = .false.
-  integer, public, save :: path_checks = 0, path_mismatches = 0
   !> per-step statistics: Newton corrections, factorizations, Jacobian evaluations
   integer, parameter, public :: stat_corrections = 1, stat_factorizations = 2, &
                                 stat_jacobians = 3, stat_count = 3
@@ -736,9 +729,9 @@ contains
                                work%carry_column)
         end if
         inside = gather_blocks(work%carry_columns, work%w)
-        if (path_check_on) call check_carry_gather(sys, learned%carry_turn, work%gradients, &
-                                                   work%carry_columns, work%w, partial, &
-                                                   work%carry_pairs, inside)
+        if (learned%path_check) call check_carry_gather(sys, learned%carry_turn, work%gradients, &
+                                                        work%carry_columns, work%w, partial, &
+                                                        work%carry_pairs, inside, learned)
         if (partial .and. .not. inside) &
           call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
                                work%carry_column)
@@ -787,9 +780,9 @@ contains
         call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
                                       work%correction)
-        if (path_check_on) call check_plane_correction(sys%carry_plane, learned%carry_turn, &
-                                                       work%carry_flexibility, work%dlam(:, 1), &
-                                                       work%direction, work%correction)
+        if (learned%path_check) call check_plane_correction(sys%carry_plane, learned%carry_turn, &
+                                                            work%carry_flexibility, work%dlam(:, 1), &
+                                                            work%direction, work%correction, learned)
         return
       end if
       call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
@@ -853,15 +846,17 @@ contains
 
   end subroutine newton
 
-  !> path_check_on: carry_schur's columns and gather against carry_gradients' whole columns
+  !> learned%path_check (tests; system_api's stepper_path_checks): carry_schur's columns and
+  !> gather against carry_gradients' whole columns
   !> and the gather as it was before the scan lists (every coordinate tested, the row map
   !> made anew; verbatim), bit for bit: the partial columns at the gathered pairs' rows,
   !> the answer, and w where inside.
-  subroutine check_carry_gather(sys, turn, gradients, columns, w, partial, pairs, inside)
+  subroutine check_carry_gather(sys, turn, gradients, columns, w, partial, pairs, inside, learned)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: turn(3, 3), gradients(:, :), columns(:, :), w(:, :)
     logical, intent(in) :: partial, inside
     integer, intent(in), allocatable :: pairs(:)
+    type(stepper_state), intent(inout) :: learned   ! its path_checks, path_mismatches
     real(dp), allocatable :: whole(:, :), column(:), w_old(:, :)
     integer, allocatable :: row_of(:)
     integer :: b, j, dof, p, c, mismatches
@@ -911,16 +906,18 @@ contains
         end do
       end do
     end if
-    path_checks = path_checks + 1
-    if (mismatches > 0) path_mismatches = path_mismatches + 1
+    learned%path_checks = learned%path_checks + 1
+    if (mismatches > 0) learned%path_mismatches = learned%path_mismatches + 1
   end subroutine check_carry_gather
 
-  !> path_check_on: plane_carried_correction's correction against the routine as it was
-  !> before its written-out sums (the loop over the multipliers, verbatim), bit for bit.
-  subroutine check_plane_correction(pairs, turn, flexibility, dlam, direction, correction)
+  !> learned%path_check (tests): plane_carried_correction's correction against the routine
+  !> as it was before its written-out sums (the loop over the multipliers, verbatim), bit for bit.
+  subroutine check_plane_correction(pairs, turn, flexibility, dlam, direction, correction, &
+                                    learned)
     integer, intent(in) :: pairs(:, :)
     real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
     real(dp), intent(in) :: correction(:)
+    type(stepper_state), intent(inout) :: learned   ! its path_checks, path_mismatches
     real(dp) :: back_x, back_y, r13, r23, old_x, old_y
     integer :: p, c, first, second, mismatches
     mismatches = 0
@@ -941,8 +938,8 @@ contains
       if (.not. same_bits(old_x, correction(first))) mismatches = mismatches + 1
       if (.not. same_bits(old_y, correction(second))) mismatches = mismatches + 1
     end do
-    path_checks = path_checks + 1
-    if (mismatches > 0) path_mismatches = path_mismatches + 1
+    learned%path_checks = learned%path_checks + 1
+    if (mismatches > 0) learned%path_mismatches = learned%path_mismatches + 1
   end subroutine check_plane_correction
 
   !> Whether x and y are the same bits.
