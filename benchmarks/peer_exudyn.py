@@ -271,8 +271,8 @@ def run_ancfdrv(problem: Problem, nodes: int, dt: float, bending: str, workdir: 
     :func:`ancfdrv.runner.run_scene` call writing the HDF5 file (``wall_file_s``) repeated
     the same way; a SolverError is recorded, not raised. (Until the sixth wave the file call
     ran after each in-memory repeat: every in-memory repeat then started on the caches the
-    file's writer left, ~1.2 ms of the 5-node pendulum's call, a condition Exudyn's
-    back-to-back repeats never saw.)"""
+    file's writer left, a condition Exudyn's back-to-back repeats never saw; on the sixth
+    wave's code the difference measured within noise, benchmarks/README.md.)"""
     from ancfdrv.errors import AncfError
     from ancfdrv.runner import run_scene
     from ancfdrv.simulation import simulate
