@@ -1,17 +1,12 @@
-"""A writer's copies of a chunk's rows (issue 23, a small call's fixed cost): the kernel's
-rows before q copied once (``hdf5.ROWS_COPIED_ONCE``) and the XDMF frame rows picked by
-index give what the field-by-field copies and the mask over every row gave.
-
-References: a mask over every row (rows % stride == 0 or the last row, the former
-``thinned_chunk``), and whole runs kept in memory and saved with the field-by-field
-copies: every series, the saved file's every dataset (HDF5 bytes of the values)."""
+"""A writer's copies of a chunk's rows: the XDMF frame rows picked by index are those a
+mask over every row picks (rows % stride == 0 or the last row), and a kept chunk holds
+no view of the kernel's rows."""
 from __future__ import annotations
 
 from types import SimpleNamespace
 
 import h5py
 import numpy as np
-import pytest
 
 import ancfdrv
 from conftest import INPUTS
@@ -53,24 +48,6 @@ def _kept(scene: str, overrides: list[str], tmp_path, name: str):
                 found[key] = obj[()]
         h5.visititems(visit)
     return series, found
-
-
-@pytest.mark.parametrize("scene, overrides", [
-    ("hard/pendulum.nml", PENDULUM),                                 # frames, answers
-    ("hard/pendulum.nml", PENDULUM + ["solver.step='adaptive'"]),    # fields replaced
-    ("leaf_spring.nml", ["solver.t_end=0.02"]),                      # contact rows
-])
-def test_rows_copied_once_keep_what_each_fields_copy_kept(monkeypatch, tmp_path, scene,
-                                                          overrides):
-    once = _kept(scene, overrides, tmp_path, "once")
-    monkeypatch.setattr(hdf5, "ROWS_COPIED_ONCE", False)
-    each = _kept(scene, overrides, tmp_path, "each")
-    for mine, theirs in zip(once, each):
-        assert mine.keys() == theirs.keys()
-        for key in mine:
-            a, b = np.asarray(mine[key]), np.asarray(theirs[key])
-            assert a.dtype == b.dtype and a.shape == b.shape, key
-            assert np.ascontiguousarray(a).tobytes() == np.ascontiguousarray(b).tobytes(), key
 
 
 def test_a_kept_chunk_holds_no_view_of_the_kernels_rows(monkeypatch):

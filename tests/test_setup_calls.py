@@ -2,9 +2,8 @@
 without frames or drives is not sent the empty lists system_create made already, and the
 layouts of the packed state and of the rows are kept per key.
 
-References: whole runs with every call made (``KernelSystem.SKIP_EMPTY_SETUP = False``,
-every series bit for bit), the kernel's calls counted (a scene with drives and frames
-still sends them), the layouts made anew."""
+References: the kernel's calls counted (a scene with drives and frames still sends them),
+the layouts made anew."""
 from __future__ import annotations
 
 import numpy as np
@@ -22,32 +21,6 @@ def _series(scene, overrides):
     sim = ancfdrv.simulate(INPUTS / scene, overrides, progress=False)
     assert sim.status == "ok"
     return {k: np.asarray(sim.series(k)) for k in sim.names}
-
-
-@pytest.mark.parametrize("scene, overrides, sent", [
-    ("hard/pendulum.nml", PENDULUM, set()),                      # neither frames nor drives
-    ("boom_luffing.nml", ["solver.t_end=0.05", "output.xdmf=.false."], {"drives", "frames"}),
-    ("hard/spinup.nml", ["solver.t_end=0.05", "output.xdmf=.false."], {"drives", "frames"}),
-])
-def test_empty_setup_calls_skipped_the_same_run(monkeypatch, scene, overrides, sent):
-    made: list[str] = []
-    for name in ("frames", "drives"):
-        real = getattr(kernel._kernel, f"system_set_{name}")
-
-        def spy(*args, _real=real, _name=name):
-            made.append(_name)
-            return _real(*args)
-        monkeypatch.setattr(kernel._kernel, f"system_set_{name}", spy)
-    skipped = _series(scene, overrides)
-    assert set(made) == sent
-    made.clear()
-    monkeypatch.setattr(kernel.KernelSystem, "SKIP_EMPTY_SETUP", False)
-    every = _series(scene, overrides)
-    assert set(made) == {"frames", "drives"}
-    assert skipped.keys() == every.keys()
-    for key in skipped:
-        assert skipped[key].dtype == every[key].dtype and \
-            skipped[key].tobytes() == every[key].tobytes(), key
 
 
 def test_frames_set_once_are_cleared_by_an_empty_call(monkeypatch):

@@ -678,21 +678,14 @@ class KernelSystem:
         self._check(info, "cable set", message)
         return int(index)
 
-    #: the set-up calls that set nothing a new system does not hold already (no frames,
-    #: no drives: system_create's empty lists) are not made (~70,000 instructions of f2py
-    #: argument handling each); False: made (the tests compare the two)
-    SKIP_EMPTY_SETUP = True
-    #: advance_rows steps into rows and stats made by numpy.empty (system_advance_into):
-    #: f2py zero-filled system_advance's fresh output arrays (a memset of every row, ~0.34
-    #: MB per second of the 5-node pendulum) that the kernel then wrote again in full;
-    #: False: system_advance (the same rows, stats and state bit for bit)
-    ROWS_INTO = True
+    #: the set-up calls that set nothing a new system holds already (no frames, no drives:
+    #: system_create's empty lists) are not made
     _frames_set = _drives_set = False
 
     def set_frames(self, drives, axes, bases, pivots) -> None:
         """Frames: drive (0-based drive index, -1: fixed), axis, base (3, 3), pivot."""
         n = len(drives)
-        if n == 0 and not self._frames_set and self.SKIP_EMPTY_SETUP:
+        if n == 0 and not self._frames_set:
             return   # system_create's frames(0)
         self._frames_set = True
         info, message = _kernel.system_set_frames(
@@ -703,7 +696,7 @@ class KernelSystem:
         self._check(info, "frames", message)
 
     def set_drives(self, kinds, params: list) -> None:
-        if not len(kinds) and not params and not self._drives_set and self.SKIP_EMPTY_SETUP:
+        if not len(kinds) and not params and not self._drives_set:
             return   # system_create's drive_kinds(0), drive_ptr = [1], drive_data(0)
         self._drives_set = True
         ptr = np.concatenate([[0], np.cumsum([len(p) for p in params])]).astype(np.int32) + 1
@@ -985,16 +978,13 @@ class KernelSystem:
         cuts, rows_cut = self._layout(store_q)
         npt = self.npoint
         if isinstance(state, PackedState) and len(state.packed) == cuts[-1].stop:
-            if self.ROWS_INTO:   # (system_advance_into: the same call, no zero-fill)
-                rows = np.empty((rows_cut[-1].stop, nsteps), order="F")
-                stats = np.empty((3, nsteps), dtype=np.int32, order="F")
-                packed, counts, status, last_correction, message = \
-                    _kernel.system_advance_into(self.handle, h, state.packed, state["counts"],
-                                                rows, stats, nsteps)
-            else:
-                packed, counts, rows, stats, status, last_correction, message = \
-                    _kernel.system_advance(self.handle, nsteps, h, state.packed,
-                                           state["counts"], rows_cut[-1].stop)
+            # (system_advance_into: rows made by numpy.empty, which the kernel writes in
+            # full; f2py would zero-fill system_advance's fresh output arrays first)
+            rows = np.empty((rows_cut[-1].stop, nsteps), order="F")
+            stats = np.empty((3, nsteps), dtype=np.int32, order="F")
+            packed, counts, status, last_correction, message = \
+                _kernel.system_advance_into(self.handle, h, state.packed, state["counts"],
+                                            rows, stats, nsteps)
             state.stepped(packed, counts)
             status = status.tolist()
             if status[1] == 9:

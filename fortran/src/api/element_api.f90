@@ -813,37 +813,3 @@ subroutine dense_solve(n, nnz, rows, cols, values, nrhs, rhs, info)
   call dense_coo_solve(n, nnz, rows, cols, values, nrhs, rhs, info)
 end subroutine dense_solve
 
-!> The acceleration predictor's learning (acceleration_predictor's learn_predictor) over a
-!> sequence of accelerations of equal steps h, accels(:, 1 .. m) (e''_0 .. e''_{m-1}), from a
-!> fresh stepper state: the kind it chose for the next step, whether the recurrence of order
-!> 6 is fitted (ready = 1; -1: the kernel's recurrence order is not 6), its coefficients and
-!> the next difference it predicts (e''_m - e''_{m-1}). For tests of the recurrence's ring
-!> of differences and dot products against a fit from scratch.
-subroutine predictor_learn_sequence(n, m, h, accels, kind, ready, coefficients, guess)
-  use ancf_kinds, only: dp
-  use stepper, only: stepper_state, recurrence_order
-  use acceleration_predictor, only: learn_predictor
-  implicit none
-  integer, intent(in) :: n, m
-  real(dp), intent(in) :: h, accels(n, m)
-  integer, intent(out) :: kind, ready
-  real(dp), intent(out) :: coefficients(6), guess(n)
-  type(stepper_state) :: learned
-  integer :: step
-  kind = 0
-  ready = 0
-  coefficients = 0.0_dp
-  guess = 0.0_dp
-  if (recurrence_order /= 6) then
-    ready = -1
-    return
-  end if
-  do step = 2, m
-    call learn_predictor(learned, h, accels(:, step - 1), accels(:, step))
-  end do
-  kind = learned%predictor
-  if (.not. learned%recurrence_ready) return
-  ready = 1
-  coefficients = learned%recurrence_coefficients
-  guess = learned%recurrence_guess
-end subroutine predictor_learn_sequence

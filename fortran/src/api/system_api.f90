@@ -1415,29 +1415,3 @@ subroutine system_static_solve(handle, ndof, ncon, npoint, nnz, t, load_factor, 
                                                con_res, tol)
 end subroutine system_static_solve
 
-!> Tests of the stepper's carried Schur complement (stepper_state's path_check) of the run
-!> set up on handle (after system_stepper_setup, which starts a fresh state): enable /= 0
-!> turns the comparison of its fast paths with the routines they replaced on (counters
-!> reset), 0 off; checks and mismatches: the comparisons made and those that differed since
-!> the last reset. info /= 0: no such handle.
-subroutine stepper_path_checks(handle, enable, checks, mismatches, info)
-  use mechanical_system, only: system_model
-  use stepper, only: stepper_run
-  use system_store, only: store_get
-  implicit none
-  integer, intent(in) :: handle, enable
-  integer, intent(out) :: checks, mismatches, info
-  type(system_model), pointer :: sys
-  type(stepper_run), pointer :: run
-  checks = 0
-  mismatches = 0
-  call store_get(handle, sys, info, run)
-  if (info /= 0) return
-  checks = run%state%path_checks
-  mismatches = run%state%path_mismatches
-  if (enable /= 0) then
-    run%state%path_checks = 0
-    run%state%path_mismatches = 0
-  end if
-  run%state%path_check = enable /= 0
-end subroutine stepper_path_checks

@@ -84,14 +84,6 @@ module stepper
     real(dp) :: carry_turn(3, 3) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, &
                                             0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
     logical :: carry_on = .false.
-    ! tests (system_api's stepper_path_checks): while path_check, every use of the carried
-    ! Schur complement's fast paths (carry_plane_gradients' partial columns, gather_blocks'
-    ! scan lists, plane_carried_correction's written-out sums) is compared bit for bit with
-    ! the routines they replaced, run alongside (time_integrator's check_carry_gather,
-    ! check_plane_correction); path_checks counts the comparisons, path_mismatches those
-    ! that differed
-    logical :: path_check = .false.
-    integer :: path_checks = 0, path_mismatches = 0
   end type stepper_state
 
   !> A system's stepper: its run's settings, its learned state, whether a run was set up.

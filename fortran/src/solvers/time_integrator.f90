@@ -60,7 +60,6 @@
 !> next one, far through the other leaf).
 !> No I/O; failures return codes (see integrator_chunk).
 module time_integrator
-  use, intrinsic :: iso_fortran_env, only: int64
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
                                internal_forces, external_forces, evaluate_constraints, &
@@ -729,9 +728,6 @@ contains
                                work%carry_column)
         end if
         inside = gather_blocks(work%carry_columns, work%w)
-        if (learned%path_check) call check_carry_gather(sys, learned%carry_turn, work%gradients, &
-                                                        work%carry_columns, work%w, partial, &
-                                                        work%carry_pairs, inside, learned)
         if (partial .and. .not. inside) &
           call carry_gradients(sys, learned%carry_turn, work%gradients, work%carry_columns, &
                                work%carry_column)
@@ -780,9 +776,6 @@ contains
         call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
                                       work%correction)
-        if (learned%path_check) call check_plane_correction(sys%carry_plane, learned%carry_turn, &
-                                                            work%carry_flexibility, work%dlam(:, 1), &
-                                                            work%direction, work%correction, learned)
         return
       end if
       call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
@@ -845,108 +838,6 @@ contains
     end subroutine refresh_matrix
 
   end subroutine newton
-
-  !> learned%path_check (tests; system_api's stepper_path_checks): carry_schur's columns and
-  !> gather against carry_gradients' whole columns
-  !> and the gather as it was before the scan lists (every coordinate tested, the row map
-  !> made anew; verbatim), bit for bit: the partial columns at the gathered pairs' rows,
-  !> the answer, and w where inside.
-  subroutine check_carry_gather(sys, turn, gradients, columns, w, partial, pairs, inside, learned)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: turn(3, 3), gradients(:, :), columns(:, :), w(:, :)
-    logical, intent(in) :: partial, inside
-    integer, intent(in), allocatable :: pairs(:)
-    type(stepper_state), intent(inout) :: learned   ! its path_checks, path_mismatches
-    real(dp), allocatable :: whole(:, :), column(:), w_old(:, :)
-    integer, allocatable :: row_of(:)
-    integer :: b, j, dof, p, c, mismatches
-    logical :: inside_old
-    allocate (whole(sys%ndof, sys%ncon), column(sys%ndof), w_old(size(w, 1), size(w, 2)), &
-              row_of(sys%ndof))
-    call carry_gradients(sys, turn, gradients, whole, column)
-    mismatches = 0
-    if (partial) then
-      do p = 1, size(pairs)
-        do j = 1, 2
-          dof = sys%carry_plane(j, pairs(p))
-          do c = 1, sys%ncon
-            if (.not. same_bits(columns(dof, c), whole(dof, c))) mismatches = mismatches + 1
-          end do
-        end do
-      end do
-    else
-      do c = 1, sys%ncon
-        do dof = 1, sys%ndof
-          if (.not. same_bits(columns(dof, c), whole(dof, c))) mismatches = mismatches + 1
-        end do
-      end do
-    end if
-    ! (gather_blocks before the scan lists)
-    row_of = 0
-    do b = size(sys%block_first), 1, -1
-      do j = 0, 2
-        row_of(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
-      end do
-    end do
-    w_old = 0.0_dp
-    inside_old = .true.
-    do dof = 1, sys%ndof
-      if (row_of(dof) > 0) then
-        w_old(row_of(dof), :) = whole(dof, :)
-      else if (any(whole(dof, :) /= 0.0_dp)) then
-        inside_old = .false.
-        exit
-      end if
-    end do
-    if (inside_old .neqv. inside) mismatches = mismatches + 1
-    if (inside .and. inside_old) then
-      do c = 1, size(w, 2)
-        do j = 1, size(w, 1)
-          if (.not. same_bits(w(j, c), w_old(j, c))) mismatches = mismatches + 1
-        end do
-      end do
-    end if
-    learned%path_checks = learned%path_checks + 1
-    if (mismatches > 0) learned%path_mismatches = learned%path_mismatches + 1
-  end subroutine check_carry_gather
-
-  !> learned%path_check (tests): plane_carried_correction's correction against the routine
-  !> as it was before its written-out sums (the loop over the multipliers, verbatim), bit for bit.
-  subroutine check_plane_correction(pairs, turn, flexibility, dlam, direction, correction, &
-                                    learned)
-    integer, intent(in) :: pairs(:, :)
-    real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
-    real(dp), intent(in) :: correction(:)
-    type(stepper_state), intent(inout) :: learned   ! its path_checks, path_mismatches
-    real(dp) :: back_x, back_y, r13, r23, old_x, old_y
-    integer :: p, c, first, second, mismatches
-    mismatches = 0
-    r13 = turn(1, 3) * 0.0_dp
-    r23 = turn(2, 3) * 0.0_dp
-    do p = 1, size(pairs, 2)
-      first = pairs(1, p)
-      second = pairs(2, p)
-      back_x = 0.0_dp
-      back_y = 0.0_dp
-      do c = 1, size(dlam)
-        if (dlam(c) == 0.0_dp) cycle
-        back_x = back_x + flexibility(first, c) * dlam(c)
-        back_y = back_y + flexibility(second, c) * dlam(c)
-      end do
-      old_x = (turn(1, 1) * back_x + turn(1, 2) * back_y + r13) - direction(first)
-      old_y = (turn(2, 1) * back_x + turn(2, 2) * back_y + r23) - direction(second)
-      if (.not. same_bits(old_x, correction(first))) mismatches = mismatches + 1
-      if (.not. same_bits(old_y, correction(second))) mismatches = mismatches + 1
-    end do
-    learned%path_checks = learned%path_checks + 1
-    if (mismatches > 0) learned%path_mismatches = learned%path_mismatches + 1
-  end subroutine check_plane_correction
-
-  !> Whether x and y are the same bits.
-  pure logical function same_bits(x, y)
-    real(dp), intent(in) :: x, y
-    same_bits = transfer(x, 1_int64) == transfer(y, 1_int64)
-  end function same_bits
 
   !> LU factorization with partial pivoting P A = L U of a small dense matrix in place
   !> (LAPACK dgetf2's algorithm: the first largest |entry| of each column as its pivot,

@@ -139,23 +139,12 @@ _DICT_CONTAINS, _DICT_SET = OrderedDict.__contains__, OrderedDict.__setitem__
 _NAMELIST_STATE = dict(vars(f90nml.Namelist()))
 #: those of its attributes that are dicts (each Namelist has its own)
 _NAMELIST_DICTS = tuple(k for k, v in _NAMELIST_STATE.items() if type(v) is dict)
-#: fast_reads makes its Namelists by :func:`_new_namelist` (f90nml's __init__ costs ~2 us
-#: a Namelist: platform look-ups, property setters; a scene has one per group) and files
-#: its groups without Namelist.__contains__/__setitem__'s type checks; False: f90nml's
-#: ``Namelist()``, ``in`` and ``nml[name] = group`` (the tests compare the two)
-FAST_NAMELIST = True
-#: a template scene read by fast_reads has its groups and keys read as the Namelists'
-#: own dict items (load_scene, _typed), and every scene's group names are its keys'
-#: cogroup names (load_scene, is_general); False: f90nml's items and keys views (the
-#: tests compare)
-FAST_ITEMS = True
 
 
 def _new_namelist() -> f90nml.Namelist:
     """An empty ``f90nml.Namelist()``: the same type and attributes (each dict of them a
-    new one, as __init__ makes them), without __init__'s work."""
-    if not FAST_NAMELIST:
-        return f90nml.Namelist()
+    new one, as __init__ makes them), without __init__'s work (platform look-ups, property
+    setters; a scene has one Namelist per group)."""
     nml = OrderedDict.__new__(f90nml.Namelist)
     OrderedDict.__init__(nml)
     state = nml.__dict__
@@ -226,14 +215,9 @@ def fast_reads(text: str) -> f90nml.Namelist | None:
             if (key is not None and not after_value) or not close_key():
                 return None
             lower = name.lower()
-            if not FAST_NAMELIST:
-                if name in nml:
-                    nml.add_cogroup(name, group)
-                else:
-                    nml[name] = group
             # f90nml's `name in nml` and `nml[name] = group` for a Namelist value (stored
             # under the lower-case name), without their per-call type checks
-            elif _DICT_CONTAINS(nml, lower) or lower in nml._cogroups:
+            if _DICT_CONTAINS(nml, lower) or lower in nml._cogroups:
                 nml.add_cogroup(name, group)
             else:
                 _DICT_SET(nml, lower, group)
@@ -324,7 +308,7 @@ def is_general(nml: f90nml.Namelist) -> bool:
     """A general scene (SPEC section 8): no template model group; &beam, &plate, &leaf and
     &material then carry names."""
     # (the names of f90nml's keys view: each key's cogroup name)
-    groups = set(map(_cogroup_name, OrderedDict.keys(nml))) if FAST_ITEMS else set(nml.keys())
+    groups = set(map(_cogroup_name, OrderedDict.keys(nml)))
     if groups & {"boom", "cantilever", "spinup", "spring", "loads"}:
         return False
     if groups & set(GENERAL_ONLY_GROUPS):
@@ -491,8 +475,7 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     seen: Counter = Counter()
     # a repeated group comes once per occurrence (f90nml's items view: each key's cogroup
     # name)
-    for group in (map(_cogroup_name, OrderedDict.keys(nml)) if FAST_ITEMS
-                  else (g for g, _ in nml.items())):
+    for group in map(_cogroup_name, OrderedDict.keys(nml)):
         if _schema_of(group, general) is None:
             known = list(GENERAL_SCHEMA) + list(GENERAL_SINGLE_GROUPS) if general else SCHEMA
             raise InputError(f"unknown group in a {'general' if general else 'template'} scene; "
@@ -509,7 +492,7 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
 
     values: dict[str, dict[str, Any]] = {}
     # (no group repeats here: refused above; a plain namelist's groups read as its dict's)
-    fast = plain is not None and FAST_ITEMS
+    fast = plain is not None
     for group, entries in (OrderedDict.items(nml) if fast else nml.items()):
         values[group] = _typed(group, group, entries, SCHEMA[group], file, fast)
 

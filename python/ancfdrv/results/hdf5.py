@@ -757,12 +757,6 @@ ROW_FIELDS = ("time", "probes", "deflections", "lam", "energy", "constraint", "s
               "contact", "step_size", "substeps", "cuts")
 
 
-#: :func:`thinned_chunk` copies the columns of the kernel's rows before q once when the
-#: chunk's fields are views of them (``Chunk.rows``); False: each field copied (as before;
-#: the tests compare the two)
-ROWS_COPIED_ONCE = True
-
-
 def thinned_chunk(chunk, first_row: int, stride: int, last_row: int, frames: bool):
     """A chunk without q, as a writer keeps it when /dynamic/q is not stored: the
     :data:`ROW_FIELDS` copied, ``q_last`` (the last row's q) and ``q = None``; and its
@@ -772,7 +766,7 @@ def thinned_chunk(chunk, first_row: int, stride: int, last_row: int, frames: boo
     Used by the file's :class:`DynamicWriter` and by the in-memory writer alike."""
     from types import SimpleNamespace
     copies = {}
-    made = getattr(chunk, "rows", None) if ROWS_COPIED_ONCE else None
+    made = getattr(chunk, "rows", None)
     if made is not None:
         # the fields still the views of the kernel's rows they were made as: the rows'
         # columns before q copied once and the same views made of the copy (one copy of

@@ -336,8 +336,7 @@ class ReactionMap:
         if columns is not None:
             place = np.full(self.model.nfull, -1, dtype=np.int64)
             place[columns] = np.arange(len(columns))
-        reduce = _reduce_components if COMPONENT_MAJOR else _reduce_rows
-        return {name: reduce(joint, *gen[name], q_rows, self.points[name], place)
+        return {name: _reduce_components(joint, *gen[name], q_rows, self.points[name], place)
                 for name, joint in self.joints.items()}
 
     def row_columns(self) -> np.ndarray | None:
@@ -405,77 +404,10 @@ def _joint_points(joint) -> tuple:
     return p2, p1
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b along the last axis (broadcast), without np.cross's overhead (arrays of one
-    shape: the components written into one array, without np.stack's)."""
-    if a.shape != b.shape:
-        return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                         a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                         a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-    out = np.empty(a.shape, dtype=np.result_type(a, b))
-    np.subtract(a[..., 1] * b[..., 2], a[..., 2] * b[..., 1], out=out[..., 0])
-    np.subtract(a[..., 2] * b[..., 0], a[..., 0] * b[..., 2], out=out[..., 1])
-    np.subtract(a[..., 0] * b[..., 1], a[..., 1] * b[..., 0], out=out[..., 2])
-    return out
-
-
-def _vec_rows(expr, q_rows: np.ndarray, place: np.ndarray | None = None) -> np.ndarray:
-    """A Vec3 expression at rows of coordinates: (nt, 3). ``place``: the column of q_rows
-    holding each full coordinate (None: q_rows holds them all, in order)."""
-    out = np.empty((len(q_rows), 3))
-    out[:] = expr.const   # (np.tile's rows, without its overhead)
-    for d, c in expr.terms.items():
-        k = d if place is None else int(place[d])
-        out += c * q_rows[:, k:k + 3]
-    return out
-
-
-def _reduce_rows(joint, generalized: np.ndarray, slots: np.ndarray, q_rows: np.ndarray,
-                 points: tuple, place: np.ndarray | None = None):
-    """Force and moment about the joint's point of the generalized forces on body2 (nt
-    rows; on the 3-vectors ``slots`` of body2's coordinates, column 3 k + j component j of
-    slots[k]: every other vector carries no force), the point and a distance joint's axial
-    force. ``place``: as for :func:`_vec_rows`."""
-    body = joint.body2
-    per, nodes = _vector_blocks(body)
-    p2, p1 = points
-    point = _vec_rows(p2, q_rows, place)
-    nt = len(q_rows)
-    if per and len(slots):
-        block = generalized.reshape(nt, len(slots), 3)
-        index = (body.first + 3 * slots[:, None] + np.arange(3)).ravel()
-        if place is not None:
-            index = place[index]
-        values = q_rows[:, index].reshape(nt, len(slots), 3)
-        position = slots % (per // 3) == 0          # a node's first vector: its position
-        if position.all() and block.flags.c_contiguous:
-            # every slot a position (a joint at a node): the arrays themselves, as the
-            # copies of every slot hold them (the same layout: the same sums)
-            on_block, on_values = block, values
-        else:
-            on_block, on_values = block[:, position], values[:, position]
-        force = on_block.sum(axis=1)
-        moment = _cross(on_values - point[:, None, :], on_block).sum(axis=1)
-        if position.all():   # no other vector: the sum over none, +0.0 each
-            moment += 0.0
-        else:
-            moment += _cross(values[:, ~position], block[:, ~position]).sum(axis=1)
-    else:
-        force, moment = np.zeros((nt, 3)), np.zeros((nt, 3))
-    swapped = getattr(joint, "swapped", False)
-    if swapped:
-        force, moment = -force, -moment
-    axial = None
-    if p1 is not None:
-        u = point - _vec_rows(p1, q_rows, place)
-        u /= np.linalg.norm(u, axis=1, keepdims=True)
-        axial = np.einsum("ti,ti->t", force if swapped else -force, u)
-    return force, moment, point, axial
-
-
 def _vec_components(expr, q_rows: np.ndarray, place: np.ndarray | None = None) -> np.ndarray:
-    """:func:`_vec_rows` component-major: (3, nt), the same operations element by element
-    (so the same values), each over a row of nt values instead of nt rows of 3."""
+    """A Vec3 expression at rows of coordinates, component-major: (3, nt). ``place``: the
+    column of q_rows holding each full coordinate (None: q_rows holds them all, in
+    order)."""
     out = np.empty((3, len(q_rows)))
     out[:] = expr.const[:, None]
     columns = q_rows.T
@@ -487,11 +419,12 @@ def _vec_components(expr, q_rows: np.ndarray, place: np.ndarray | None = None) -
 
 def _reduce_components(joint, generalized: np.ndarray, slots: np.ndarray,
                        q_rows: np.ndarray, points: tuple, place: np.ndarray | None = None):
-    """:func:`_reduce_rows` with the arrays component-major ((3, slots, nt) instead of
-    (nt, slots, 3)): every operation the same element by element and each sum over the
-    slots taken slot after slot as there, so bit for bit the same force, moment, point
-    and axial force (tests), but each numpy operation runs over rows of nt values, not
-    nt rows of 3 (~100 instructions less per row and joint). Returns (nt, 3) views."""
+    """Force and moment about the joint's point of the generalized forces on body2 (nt
+    rows; on the 3-vectors ``slots`` of body2's coordinates, column 3 k + j component j of
+    slots[k]: every other vector carries no force), the point and a distance joint's axial
+    force (tension positive). ``place``: as for :func:`_vec_components`. The arrays are
+    component-major ((3, slots, nt)), so each numpy operation runs over rows of nt values.
+    Returns (nt, 3) views."""
     body = joint.body2
     per, nodes = _vector_blocks(body)
     p2, p1 = points
@@ -523,7 +456,7 @@ def _reduce_components(joint, generalized: np.ndarray, slots: np.ndarray,
         force, moment = -force, -moment
     axial = None
     rows = point.T
-    if p1 is not None:   # as _reduce_rows forms it (its norm and einsum on rows of 3)
+    if p1 is not None:
         rows = np.ascontiguousarray(rows)
         u = rows - np.ascontiguousarray(_vec_components(p1, q_rows, place).T)
         u /= np.linalg.norm(u, axis=1, keepdims=True)
@@ -533,19 +466,12 @@ def _reduce_components(joint, generalized: np.ndarray, slots: np.ndarray,
 
 
 def _cross_components(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a x b along the first axis (component-major arrays of one shape), as
-    :func:`_cross` forms each component."""
+    """a x b along the first axis (component-major arrays of one shape)."""
     out = np.empty(a.shape, dtype=np.result_type(a, b))
     np.subtract(a[1] * b[2], a[2] * b[1], out=out[0])
     np.subtract(a[2] * b[0], a[0] * b[2], out=out[1])
     np.subtract(a[0] * b[1], a[1] * b[0], out=out[2])
     return out
-
-
-#: :meth:`ReactionMap.reaction_rows` reduces the generalized forces component-major
-#: (:func:`_reduce_components`); False: row-major (:func:`_reduce_rows`, the reference
-#: the tests compare it with)
-COMPONENT_MAJOR = True
 
 
 def reaction_map(model: Model) -> ReactionMap:
@@ -831,10 +757,6 @@ SECTION_BLOCK = 256
 #: coordinates: its work arrays hold ~5 copies of them (at 3078 coordinates and a chunk of
 #: 60 steps, 7 MB at once; issue 23: a run's peak memory)
 ANSWER_BLOCK_BYTES = 1 << 18
-#: the dynamic answers expand only the full coordinates the joints' reactions read when
-#: nothing else needs them (:meth:`ReactionMap.row_columns`); False: every row expanded
-#: whole, as before (the tests compare the two)
-EXPAND_COLUMNS = True
 
 
 def _section_forces_full(model: Model, q: np.ndarray, stations: int,
@@ -1255,9 +1177,9 @@ class DynamicAnswers:
         columns = None
         if self.model.reduction is None:
             q_rows = e_rows
-        elif not self.beams and not self.map.joints and EXPAND_COLUMNS:
+        elif not self.beams and not self.map.joints:
             q_rows = None   # nothing here reads the full coordinates
-        elif not self.beams and self.map.joints and EXPAND_COLUMNS \
+        elif not self.beams and self.map.joints \
                 and (columns := self.map.row_columns()) is not None:
             q_rows = self.model.reduction.expand_columns(e_rows, columns)
         else:
