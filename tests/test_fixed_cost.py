@@ -302,12 +302,22 @@ def test_subgroup_is_the_group_h5py_makes(tmp_path):
         assert info["ours"] == info["theirs"] == h5py.h5t.CSET_ASCII
 
 
+def _close(x: np.ndarray, y: np.ndarray, floor: float = 0.0) -> bool:
+    """Equal shapes and values within 1e-12 of the series' magnitude plus ``floor``: a chunk
+    recorded with others runs its matrix products over more rows (BLAS gemm against gemv
+    kernels), which may round differently in the last bits; each value is a short sum of
+    terms of the series' scale. ``floor``: the rounding of a value that is a small
+    difference of large terms (the axial force EA (|r'| - 1))."""
+    scale = float(np.max(np.abs(y), initial=0.0))
+    return x.shape == y.shape and bool(np.all(np.abs(x - y) <= 1e-12 * scale + floor))
+
+
 def test_a_short_chunk_waits_for_the_next_one():
     """The answers recorder records a chunk of 2..WAIT_ROWS rows with the next chunk, the
     initial row with the stepper's first call and the chunk after it (one pass instead of
     three), and a chunk still waiting when the answers are read (``complete``); single
     rows after the initial one (adaptive steps) do not wait: the reactions, section forces
-    and stress envelope are bitwise those of a recorder that records every chunk at once
+    and stress envelope are those (to rounding) of a recorder that records every chunk at once
     (WAIT_ROWS = 0), for a run that ends after a long chunk, one that ends with a short
     chunk still waiting, one whose only chunk waits, and single-row chunks."""
     from test_lean_output import _chunks, cantilever
@@ -339,15 +349,17 @@ def test_a_short_chunk_waits_for_the_next_one():
             for name in each.reactions:
                 a = [np.concatenate([c[k] for c in ours.reactions[name]]) for k in (0, 1)]
                 b = [np.concatenate([c[k] for c in each.reactions[name]]) for k in (0, 1)]
-                assert all(x.tobytes() == y.tobytes() for x, y in zip(a, b))
+                assert all(_close(x, y) for x, y in zip(a, b))
+            # N = EA (|r'| - 1): the stretch's rounding, a few eps, times EA (1.05e9 N)
+            axial_floor = 16 * np.finfo(float).eps * 2.1e11 * 0.05 * 0.1
             for name in each.sections:
                 for key in ("N", "T", "Q", "M"):
                     x = np.concatenate([getattr(c, key) for c in ours.sections[name]])
                     y = np.concatenate([getattr(c, key) for c in each.sections[name]])
-                    assert x.tobytes() == y.tobytes()
+                    assert _close(x, y, axial_floor if key == "N" else 0.0), key
             for name, (s, best, when) in each.envelope.items():
                 s2, best2, when2 = ours.envelope[name]
-                assert best2.tobytes() == best.tobytes() and when2.tobytes() == when.tobytes()
+                assert _close(best2, best) and np.array_equal(when2, when)
             assert each.reactions and each.envelope
     finally:
         model.close()
