@@ -120,9 +120,9 @@ def test_error_texts():
     # (the words, not the digits: the residual a free beam stalls at is the rounding of a
     # singular solve, about 0.97, and moves with the machine's arithmetic)
     with pytest.raises(SolverError, match=r"static Newton stalled at the round-off floor at "
-                       r"load step 1 of 1: the relative residual stays at 9\.\d{3}e-01") as kernel:
+                       r"load step 1 of 1: the relative residual stays at \d\.\d{3}e[+-]\d{2}") as kernel:
         solve_newton(free)
-    with pytest.raises(SolverError, match=r"stays at 9\.\d{3}e-01") as python:
+    with pytest.raises(SolverError, match=r"stays at \d\.\d{3}e[+-]\d{2}") as python:
         solve_newton_python(free)
     assert str(kernel.value).split(" (")[0][:60] == str(python.value).split(" (")[0][:60]
     # sizes that do not fit the system are named as such
