@@ -817,9 +817,15 @@ def table_lines(rows: list[dict], keys: list[str]) -> list[str]:
 
 
 def undefined_notes(rows: list[dict]) -> list[str]:
-    """Why an error shows 'n/a': one line per case and column."""
-    return [f"n/a: {label} of {row.get('case', '?')}: {row[f'{key}_undefined']}"
-            for row in rows for key, label, _, _ in COLUMNS if f"{key}_undefined" in row]
+    """Why an error shows 'n/a': one line per column and reason, naming the cases."""
+    cases: dict[tuple[str, str], list[str]] = {}
+    for key, label, _, _ in COLUMNS:
+        for row in rows:
+            if f"{key}_undefined" in row:
+                cases.setdefault((label, row[f"{key}_undefined"]), []).append(
+                    str(row.get("case", "?")))
+    return [f"n/a: {label} of {', '.join(names)}: {why}"
+            for (label, why), names in cases.items()]
 
 
 def reference_notes(rows: list[dict], keys: list[str]) -> list[str]:

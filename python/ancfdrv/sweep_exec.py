@@ -109,14 +109,13 @@ def _result_fields(outcome: Any, output: Path) -> dict:
                    solve_time_s=static.wall_time_s)
         # general scenes: the deflection relative to the supports' rigid motion when the
         # file has it (ancfdrv.system.supports), not the mechanism's rigid motion
-        support = "static.deflection_support.tip"
-        if "static.deflection.tip" in summary:
-            axial, transverse, lateral = summary.get(support, summary["static.deflection.tip"])
+        probe, component = response_of(summary)
+        values = summary.get(f"static.deflection_support.{probe}",
+                             summary[f"static.deflection.{probe}"])
+        if (probe, component) == ("tip", 1):  # a beam's tip sag, with its other components
+            axial, transverse, lateral = values
             row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral)
-        else:
-            probe, component = response_of(summary)
-            values = summary.get(f"static.deflection_support.{probe}",
-                                 summary[f"static.deflection.{probe}"])
+        else:  # the scene's response probe (scene.response), not a probe that is called tip
             row["response"] = float(values[component])
     if dynamic is not None:
         row.update(dynamic=True, steps=dynamic.steps, newton_iterations=dynamic.newton_iterations,
