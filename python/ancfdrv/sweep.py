@@ -406,16 +406,15 @@ def _file_probes(h5: h5py.File) -> set[str]:
 
 
 def _expected_model(scene) -> tuple[list[str], list[str], tuple[str, int] | None]:
-    """What a run of ``scene`` records of its model: the bodies ('name: type'), the probe
-    names and the compared (probe, component)."""
+    """What a run of ``scene`` records of its model: the body names, the probe names and
+    the compared (probe, component)."""
     from .builders import build_system
     from .system.model import default_response
     built = build_system(scene)
     bodies = list(built.system.bodies.values())
     probes = built.system.probes
     response = built.response or default_response(probes, bodies)
-    return ([f"{b.name}: {type(b).__name__.lower()}" for b in bodies], list(probes),
-            response)
+    return [b.name for b in bodies], list(probes), response
 
 
 def load_reference(reference: str | Path, scene, families: set[str]) -> Reference:
@@ -426,12 +425,13 @@ def load_reference(reference: str | Path, scene, families: set[str]) -> Referenc
     - of the analysis the cases run ('static', 'dynamic' (or 'static+dynamic': a history),
       'modal' or 'buckling'), the same for every case;
     - of the same model. The rule: the same scene title, the same kind of scene (the
-      template, or 'general'), the same bodies (names and types), and for static and
-      dynamic sweeps the same probes and the same compared probe and component. What
-      resolves or approximates the model (nodes, modes, the formulation, dt, the solver)
-      may differ: that is what a reference is for. The physical values (lengths,
-      materials, loads) are not compared: a reference of the same scene run with other
-      values is the user's choice and is named in the report (err_reference_file)."""
+      template, or 'general'), the same bodies (by name), and for static and dynamic
+      sweeps the same probes and the same compared probe and component. What resolves or
+      approximates the model (nodes, modes, the formulation, the element kind of a body -
+      beam or cable -, dt, the solver) may differ: that is what a reference is for. The
+      physical values (lengths, materials, loads) are not compared: a reference of the
+      same scene run with other values is the user's choice and is named in the report
+      (err_reference_file)."""
     path = Path(reference)
     where = str(path)
     if not path.is_file():
@@ -485,7 +485,8 @@ def load_reference(reference: str | Path, scene, families: set[str]) -> Referenc
         mismatch.append(f"its title is {summary.get('title')!r}, the sweep's scene's {title!r}")
     if summary.get("kind") != scene.kind:
         mismatch.append(f"it is a {summary.get('kind')!r} scene, the sweep's a {scene.kind!r}")
-    theirs = [b for b in str(summary.get("model.bodies", "")).split("\n") if b]
+    theirs = [b.rpartition(":")[0] for b in str(summary.get("model.bodies", "")).split("\n")
+              if b]  # 'name: type' lines
     if sorted(theirs) != sorted(bodies):
         mismatch.append(f"its bodies are {', '.join(theirs) or 'none'}, the sweep's "
                         f"{', '.join(bodies)}")
