@@ -684,7 +684,7 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
     panel_keys = [k for k in others if k != x_key]
     panels = sorted({tuple(r[k] for k in panel_keys) for r in ok}, key=lambda t: [float(v) if
                     _isnum(v) else v for v in t])
-    if x_key and not any(r.get("dynamic") for r in ok):  # static sweeps: Figs. 4-5
+    if x_key and not any(r.get("dynamic") or "analysis" in r for r in ok):  # static: Figs. 4-5
         fig, axes = plt.subplots(1, len(panels), figsize=(5.5 * len(panels), 4), squeeze=False,
                                  constrained_layout=True)
         for ax, panel in zip(axes[0], panels):

@@ -25,6 +25,7 @@ import re
 import sys
 import uuid
 from collections import Counter
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -37,9 +38,9 @@ from .results.lock import OutputLock
 from .io.safe_write import replace_atomically, write_bytes, write_text
 from .sweep_keys import is_resolution, resolution_rank, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
-from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, failure,
-                         remove_quietly, response_of, run_dask, run_inline, run_processes,
-                         worker_cap)
+from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, eigen_values,
+                         failure, remove_quietly, response_of, run_dask, run_inline,
+                         run_processes, worker_cap)
 
 #: Case file names: these characters only, at most this long (before the hash suffix).
 _UNSAFE = re.compile(r"[^A-Za-z0-9._+-]")
@@ -189,25 +190,76 @@ def case_names(combos: list[dict[str, str]]) -> list[str]:
             else name for name, params in zip(names, combos)]
 
 
+def _history(h5: h5py.File) -> tuple[np.ndarray, np.ndarray]:
+    probe, component = response_of(h5.attrs)
+    name = f"dynamic/deflection_support/{probe}"  # general scenes (supports' motion off)
+    if name not in h5:
+        name = f"dynamic/deflection/{probe}"
+    return h5["dynamic/time"][()], h5[name][:, component]
+
+
 def _tip_history(path: str) -> tuple[np.ndarray, np.ndarray]:
     """Time and the compared history (the tip sag for beams)."""
     with h5py.File(path, "r") as h5:
-        probe, component = response_of(h5.attrs)
-        name = f"dynamic/deflection_support/{probe}"  # general scenes (supports' motion off)
-        if name not in h5:
-            name = f"dynamic/deflection/{probe}"
-        return h5["dynamic/time"][()], h5[name][:, component]
+        return _history(h5)
+
+
+def _static_deflection(h5: h5py.File, probe: str) -> np.ndarray:
+    """A probe's static deflection as a sweep row has it: relative to the supports' rigid
+    motion when the file has it (general scenes), else to the rigid frame."""
+    name = f"static/deflection_support/{probe}"
+    return h5[name][()] if name in h5 else h5[f"static/deflection/{probe}"][()]
+
+
+def _probe_and_size(path: str) -> tuple[str, float]:
+    """The compared probe of a result file and its model's size (m)."""
+    with h5py.File(path, "r") as h5:
+        return response_of(h5.attrs)[0], float(h5["model"].attrs.get("length_scale", 0.0))
+
+
+#: A deflection at most this fraction of the model's size is zero to the precision of a
+#: solve (a nanometre on a metre: the Newton tolerances are relative to the model's size)
+ZERO_DEFLECTION = 1e-9
+
+
+def relative_error(absolute: float, scale: float, size: float, probe: str) -> float | str:
+    """``absolute / scale``, the error relative to the reference's deflection; or, when
+    that deflection is zero to round-off (at most ZERO_DEFLECTION times the model's size
+    ``size``, m), the note saying why a relative error is undefined there (the absolute
+    error stays meaningful)."""
+    if scale == 0.0 or scale <= ZERO_DEFLECTION * size:
+        return (f"undefined: the reference deflection of probe {probe!r} is zero to "
+                f"round-off ({scale:.1e} m, model size {size:.3g} m); see the absolute error")
+    return absolute / scale
+
+
+def eigen_error(values: np.ndarray, reference: np.ndarray) -> float | str:
+    """The largest relative difference of the first frequencies (load factors) both runs
+    computed, in ascending order; a note when there are none to compare."""
+    n = min(len(values), len(reference))
+    if n == 0:
+        return "undefined: no elastic frequency or load factor to compare"
+    return float(np.max(np.abs(values[:n] - reference[:n]) / np.abs(reference[:n])))
+
+
+def _set_error(row: dict, key: str, err: float | str) -> None:
+    """row[key] = the error, or row[key + '_undefined'] = why there is none."""
+    if isinstance(err, str):
+        row[f"{key}_undefined"] = err
+    else:
+        row[key] = err
 
 
 def add_history_errors(rows: list[dict], varied: list[str]) -> None:
     """Dynamic cases: against the finest case with the same other keys, the amplitude
-    error max|y - y_ref| / max|y_ref| of the tip sag history, and the phase error
-    accumulated over the vibration stage, 360 (f - f_ref) T_vib in degrees, from
-    zero-crossing frequencies."""
+    error max|y - y_ref| / max|y_ref| of the tip sag history (undefined when y_ref is zero
+    to round-off), and the phase error accumulated over the vibration stage,
+    360 (f - f_ref) T_vib in degrees, from zero-crossing frequencies."""
     from .history import crossing_frequency
     for members, finest in _reference_groups(rows, varied):
         t_ref, y_ref = _tip_history(finest["file"])
-        scale = max(np.abs(y_ref).max(), 1e-300)
+        probe, size = _probe_and_size(finest["file"])
+        scale = float(np.abs(y_ref).max())
         t0, t1 = finest.get("stage_vibration_t0"), finest.get("stage_vibration_t1")
         f_ref = None
         if t0 is not None:
@@ -217,7 +269,7 @@ def add_history_errors(rows: list[dict], varied: list[str]) -> None:
             t, y = _tip_history(row["file"])
             common = t_ref <= t[-1]
             absolute = float(np.abs(np.interp(t_ref[common], t, y) - y_ref[common]).max())
-            row["err_vs_finest"] = absolute / scale
+            _set_error(row, "err_vs_finest", relative_error(absolute, scale, size, probe))
             row["err_abs_vs_finest"] = absolute  # m (the table shows mm)
             if f_ref is not None:
                 mask = t >= t0
@@ -294,7 +346,7 @@ def add_formulation_difference(rows: list[dict], varied: list[str]) -> None:
     """When scene.formulation is varied: each row's difference from the large-deformation
     ('nonlinear') case with the same other keys - what the FFR model's assumptions cost,
     next to what they save in time (static: relative tip sag; dynamic: max |sag(t) -
-    sag_nl(t)| / max |sag_nl|)."""
+    sag_nl(t)| / max |sag_nl|; modal and buckling: as err_vs_finest)."""
     key = "scene.formulation"
     if key not in varied:
         return
@@ -305,42 +357,179 @@ def add_formulation_difference(rows: list[dict], varied: list[str]) -> None:
         ref = reference.get(tuple(row[k] for k in others))
         if row["status"] != "ok" or ref is None:
             continue
-        if row.get("dynamic"):
+        if "analysis" in row:  # modal or buckling
+            diff = eigen_error(eigen_values(row["file"])[1], eigen_values(ref["file"])[1])
+        elif row.get("dynamic"):
             t_ref, y_ref = _tip_history(ref["file"])
             t, y = _tip_history(row["file"])
             common = t_ref <= t[-1]
-            row["diff_vs_nonlinear"] = float(np.abs(np.interp(t_ref[common], t, y) - y_ref[common])
-                                             .max() / max(np.abs(y_ref).max(), 1e-300))
+            diff = relative_error(float(np.abs(np.interp(t_ref[common], t, y)
+                                               - y_ref[common]).max()),
+                                  float(np.abs(y_ref).max()), *_probe_and_size(ref["file"])[::-1])
         else:
-            row["diff_vs_nonlinear"] = abs(static_value(row) - static_value(ref)) / max(
-                abs(static_value(ref)), 1e-300)
+            diff = relative_error(abs(static_value(row) - static_value(ref)),
+                                  abs(static_value(ref)), *_probe_and_size(ref["file"])[::-1])
+        _set_error(row, "diff_vs_nonlinear", diff)
 
 
-def add_reference_errors(rows: list[dict], reference: str | Path) -> None:
-    """err_vs_reference per successful row against a given result file: dynamic cases
+#: The analyses a sweep compares, by family: a static+dynamic case compares its history.
+ANALYSIS_FAMILY = {"static": "static", "dynamic": "dynamic", "static+dynamic": "dynamic",
+                   "modal": "modal", "buckling": "buckling"}
+
+
+@dataclass(frozen=True)
+class Reference:
+    """A result file every case of a sweep is compared with (``--reference``), read and
+    checked before the first case runs (:func:`load_reference`)."""
+
+    path: Path
+    family: str  # 'static', 'dynamic', 'modal' or 'buckling'
+    values: np.ndarray  # static: [value]; dynamic: the history; modal/buckling: eigenvalues
+    time: np.ndarray | None  # dynamic: the times of ``values``
+    probe: str  # the compared probe (static and dynamic)
+    length_scale: float  # the model's size (m)
+
+
+def _file_family(h5: h5py.File) -> str | None:
+    for group in ("modal", "buckling", "dynamic", "static"):
+        if group in h5:
+            return group
+    return None
+
+
+def _file_probes(h5: h5py.File) -> set[str]:
+    names: set[str] = set()
+    for group in ("static/deflection", "dynamic/deflection"):
+        if group in h5:
+            names.update(h5[group])
+    return names
+
+
+def _expected_model(scene) -> tuple[list[str], list[str], tuple[str, int] | None]:
+    """What a run of ``scene`` records of its model: the body names, the probe names and
+    the compared (probe, component)."""
+    from .builders import build_system
+    from .system.model import default_response
+    built = build_system(scene)
+    bodies = list(built.system.bodies.values())
+    probes = built.system.probes
+    response = built.response or default_response(probes, bodies)
+    return [b.name for b in bodies], list(probes), response
+
+
+def load_reference(reference: str | Path, scene, families: set[str]) -> Reference:
+    """Read ``--reference`` and check that it can stand for the sweep's cases; InputError
+    (exit 2) naming the file and the mismatch otherwise. It must be
+
+    - a readable ancfdrv result file of a run that finished (status 'ok');
+    - of the analysis the cases run ('static', 'dynamic' (or 'static+dynamic': a history),
+      'modal' or 'buckling'), the same for every case;
+    - of the same model. The rule: the same scene title, the same kind of scene (the
+      template, or 'general'), the same bodies (by name), and for static and dynamic
+      sweeps the same probes and the same compared probe and component. What resolves or
+      approximates the model (nodes, modes, the formulation, the element kind of a body -
+      beam or cable -, dt, the solver) may differ: that is what a reference is for. The
+      physical values (lengths, materials, loads) are not compared: a reference of the
+      same scene run with other values is the user's choice and is named in the report
+      (err_reference_file)."""
+    path = Path(reference)
+    where = str(path)
+    if not path.is_file():
+        raise InputError("--reference: no such result file", file=where)
+    from .results.hdf5 import read_summary
+    try:
+        summary = read_summary(path)
+    except InputError as exc:
+        raise InputError(f"--reference: {str(exc).removeprefix(where + ': ')}",
+                         file=where) from None
+    except Exception as exc:  # a damaged file (truncated HDF5, missing datasets)
+        raise InputError(f"--reference: cannot read it as an ancfdrv result file "
+                         f"({type(exc).__name__})", file=where) from None
+    status = summary.get("status", "")
+    if status != "ok":
+        message = str(summary.get("message", "")).splitlines()
+        raise InputError(f"--reference: the reference run did not succeed (status "
+                         f"{status!r}{': ' + message[0] if message else ''}); only a "
+                         "finished run can be a reference", file=where)
+    if len(families) > 1:
+        raise InputError(f"--reference: the sweep's cases run different analyses "
+                         f"({', '.join(sorted(families))}); one reference cannot stand for "
+                         "all of them", file=where)
+    family = next(iter(families))
+    try:
+        with h5py.File(path, "r") as h5:
+            found = _file_family(h5)
+            if found != family:
+                raise InputError(f"--reference: a {found or 'empty'} result, but the sweep's "
+                                 f"cases are {family} runs", file=where)
+            length = float(h5["model"].attrs.get("length_scale", 0.0))
+            probes = _file_probes(h5)
+            probe, component = response_of(h5.attrs)
+            time = None
+            if family == "static":
+                values = np.array([_static_deflection(h5, probe)[component]])
+            elif family == "dynamic":
+                time, values = _history(h5)
+            else:
+                values = eigen_values(path)[1]
+    except InputError:
+        raise
+    except Exception as exc:  # opened, but a dataset it needs is missing or damaged
+        raise InputError(f"--reference: cannot read its {family} results ({type(exc).__name__}"
+                         f"{': ' + str(exc).splitlines()[0] if str(exc) else ''})",
+                         file=where) from None
+    bodies, scene_probes, response = _expected_model(scene)
+    mismatch = []
+    title = scene["scene"]["title"]
+    if summary.get("title") != title:
+        mismatch.append(f"its title is {summary.get('title')!r}, the sweep's scene's {title!r}")
+    if summary.get("kind") != scene.kind:
+        mismatch.append(f"it is a {summary.get('kind')!r} scene, the sweep's a {scene.kind!r}")
+    theirs = [b.rpartition(":")[0] for b in str(summary.get("model.bodies", "")).split("\n")
+              if b]  # 'name: type' lines
+    if sorted(theirs) != sorted(bodies):
+        mismatch.append(f"its bodies are {', '.join(theirs) or 'none'}, the sweep's "
+                        f"{', '.join(bodies)}")
+    if family in ("static", "dynamic"):
+        if probes != set(scene_probes):
+            mismatch.append(f"its probes are {', '.join(sorted(probes)) or 'none'}, the "
+                            f"sweep's {', '.join(scene_probes) or 'none'}")
+        elif response is not None and (probe, component) != tuple(response):
+            mismatch.append(f"it compares probe {probe!r} component {component}, the sweep "
+                            f"probe {response[0]!r} component {response[1]}")
+    if mismatch:
+        raise InputError("--reference is a run of another model: " + "; ".join(mismatch),
+                         file=where)
+    return Reference(path, family, values, time, probe, length)
+
+
+def add_reference_errors(rows: list[dict], reference: Reference) -> None:
+    """err_vs_reference per successful row against the reference (checked by
+    :func:`load_reference` to be of the cases' analysis and model): dynamic cases
     max |y(t) - y_ref(t)| over the reference's times within the case's / the range of y_ref
     (the tip sag's range for beams: the measure of benchmarks/peer_harness.py); static
-    cases |y - y_ref| / |y_ref|. The file is named in err_reference_file."""
-    with h5py.File(reference, "r") as h5:
-        dynamic = "dynamic" in h5
-        if not dynamic:
-            probe, component = response_of(h5.attrs)
-            y_static = float(h5[f"static/deflection/{probe}"][component])
-    if dynamic:
-        t_ref, y_ref = _tip_history(str(reference))
-        scale = max(float(np.ptp(y_ref)), 1e-300)
+    cases |y - y_ref| / |y_ref|; modal and buckling cases the largest relative difference
+    of the frequencies (load factors) both computed. A reference value that is zero to
+    round-off leaves the error undefined (:func:`relative_error`). The file is named in
+    err_reference_file."""
     for row in rows:
         if row["status"] != "ok":
             continue
-        row["err_reference_file"] = str(reference)
-        if dynamic and row.get("dynamic"):
+        row["err_reference_file"] = str(reference.path)
+        if reference.family == "dynamic":
             t, y = _tip_history(row["file"])
-            common = t_ref <= t[-1] + 1e-12
-            row["err_vs_reference"] = float(np.abs(np.interp(t_ref[common], t, y)
-                                                   - y_ref[common]).max()) / scale
-        elif not dynamic and not row.get("dynamic"):
-            row["err_vs_reference"] = abs(static_value(row) - y_static) / max(abs(y_static),
-                                                                               1e-300)
+            common = reference.time <= t[-1] + 1e-12
+            absolute = float(np.abs(np.interp(reference.time[common], t, y)
+                                    - reference.values[common]).max())
+            err = relative_error(absolute, float(np.ptp(reference.values)),
+                                 reference.length_scale, reference.probe)
+        elif reference.family == "static":
+            err = relative_error(abs(static_value(row) - reference.values[0]),
+                                 abs(float(reference.values[0])), reference.length_scale,
+                                 reference.probe)
+        else:
+            err = eigen_error(eigen_values(row["file"])[1], reference.values)
+        _set_error(row, "err_vs_reference", err)
 
 
 def add_errors(rows: list[dict], varied: list[str]) -> None:
@@ -349,10 +538,18 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
         add_history_errors(rows, varied)
         return
     for members, finest in _reference_groups(rows, varied):
+        if "analysis" in finest:  # modal or buckling: the eigenvalues both computed
+            reference = eigen_values(finest["file"])[1]
+            for row in members:
+                _set_error(row, "err_vs_finest",
+                           eigen_error(eigen_values(row["file"])[1], reference))
+            continue
+        ref = static_value(finest)
+        probe, size = _probe_and_size(finest["file"])
         for row in members:
-            ref = static_value(finest)
-            row["err_vs_finest"] = abs(static_value(row) - ref) / max(abs(ref), 1e-300)
-            row["err_abs_vs_finest"] = abs(static_value(row) - ref)  # m (the table: mm)
+            absolute = abs(static_value(row) - ref)
+            _set_error(row, "err_vs_finest", relative_error(absolute, abs(ref), size, probe))
+            row["err_abs_vs_finest"] = absolute  # m (the table: mm)
 
 
 def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
@@ -374,16 +571,18 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
     is also compared with: column err_vs_reference (:func:`add_reference_errors`), which
     the error-against-time chart then shows."""
     base = base or []
-    if reference is not None and not Path(reference).is_file():
-        raise InputError("--reference: no such result file", file=str(reference))
     if workers is not None and workers < 1:
         raise InputError(f"--workers {workers}: needs at least 1")
     scene = load_scene(scene_file, base)  # fail early on a bad scene or override
     grid = parse_vary(vary, scene_file)
     keys = [k for k, _ in grid]
     combos = [dict(zip(keys, values)) for values in itertools.product(*[v for _, v in grid])]
+    families = set()
     for params in combos:  # validate every case before spending time on any
-        load_scene(scene_file, base + expand(params))
+        case_scene = load_scene(scene_file, base + expand(params))
+        families.add(ANALYSIS_FAMILY[case_scene["scene"]["analysis"]])
+    if reference is not None:  # read and checked before the first case runs
+        reference = load_reference(reference, scene, families)
     outdir = Path(outdir)
     check_sweep_dir(outdir, scene_file)
     sweep_id = uuid.uuid4().hex
@@ -548,14 +747,14 @@ def check_sweep_ids(rows: list[dict], sweep_id: str) -> None:
 
 
 def report(rows: list[dict], keys: list[str], outdir: Path, scene_file: str,
-           base: list[str], reference: str | Path | None = None) -> None:
+           base: list[str], reference: Reference | None = None) -> None:
     """Errors, closed-form comparisons, summary.csv, summary.md and the plots."""
     add_errors(rows, keys)
     if reference is not None:
         add_reference_errors(rows, reference)
     add_formulation_difference(rows, keys)
     for row in rows:
-        if row["status"] == "ok" and not row.get("dynamic"):
+        if row["status"] == "ok" and not row.get("dynamic") and "analysis" not in row:
             err = closed_form_error(scene_file, row, base)
             if err is not None:
                 row["err_vs_closed_form"] = err
@@ -573,6 +772,8 @@ COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
            ("response", "static response (mm)", 1e3, "{:.5f}"),
            ("response_closed_form", "closed form (mm)", 1e3, "{:.5f}"),
            ("tip_transverse_closed_form", "closed form (mm)", 1e3, "{:.4f}"),
+           ("first_frequency_hz", "f1 (Hz)", 1.0, "{:.5g}"),
+           ("first_load_factor", "load factor 1", 1.0, "{:.5g}"),
            ("err_vs_closed_form", "err vs closed form", 1.0, "{:.2e}"),
            ("err_vs_finest", "err vs finest", 1.0, "{:.2e}"),
            ("err_abs_vs_finest", "err vs finest (mm)", 1e3, "{:.3e}"),
@@ -586,6 +787,7 @@ COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
            ("newton_iterations", "Newton", 1, "{}"),
            ("factorizations", "factor.", 1, "{}"),
            ("dynamic_time_s", "dynamic (s)", 1.0, "{:.3f}"),
+           ("eigen_time_s", "eigen (s)", 1.0, "{:.3f}"),
            ("total_time_s", "case time (s)", 1.0, "{:.3f}"),
            ("status", "status", None, "{}")]
 
@@ -594,14 +796,16 @@ def table_lines(rows: list[dict], keys: list[str]) -> list[str]:
     """The Markdown table of a sweep (what `make demo` prints), followed by the note naming
     the reference of 'err vs finest'. An error against a reference that is not the finest
     case requested (it failed) is marked '*'."""
-    cols = [c for c in COLUMNS if any(c[0] in r for r in rows)]
+    cols = [c for c in COLUMNS if any(c[0] in r or f"{c[0]}_undefined" in r for r in rows)]
     header = keys + [c[1] for c in cols]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for row in rows:
         cells = [str(row[k]) for k in keys]
         for key, _, scale, fmt in cols:
             value = row.get(key)
-            if value is None or value == "":
+            if f"{key}_undefined" in row:
+                cells.append("n/a")
+            elif value is None or value == "":
                 cells.append("-")
             else:
                 cells.append(fmt.format(value * scale if scale not in (None, 1) else value))
@@ -609,8 +813,20 @@ def table_lines(rows: list[dict], keys: list[str]) -> list[str]:
                         not row.get("err_reference_is_finest", True):
                     cells[-1] += " *"
         lines.append("| " + " | ".join(cells) + " |")
-    notes = reference_notes(rows, keys)
+    notes = reference_notes(rows, keys) + undefined_notes(rows)
     return lines + ([""] + notes if notes else [])
+
+
+def undefined_notes(rows: list[dict]) -> list[str]:
+    """Why an error shows 'n/a': one line per column and reason, naming the cases."""
+    cases: dict[tuple[str, str], list[str]] = {}
+    for key, label, _, _ in COLUMNS:
+        for row in rows:
+            if f"{key}_undefined" in row:
+                cases.setdefault((label, row[f"{key}_undefined"]), []).append(
+                    str(row.get("case", "?")))
+    return [f"n/a: {label} of {', '.join(names)}: {why}"
+            for (label, why), names in cases.items()]
 
 
 def reference_notes(rows: list[dict], keys: list[str]) -> list[str]:
@@ -620,7 +836,7 @@ def reference_notes(rows: list[dict], keys: list[str]) -> list[str]:
         return []
     refs: dict[str, dict] = {}
     for row in rows:
-        if "err_vs_finest" in row:
+        if "err_reference" in row:
             refs.setdefault(row["err_reference"], row)
     if not refs:
         return []
@@ -649,17 +865,28 @@ def write_report(rows: list[dict], keys: list[str], outdir: Path) -> None:
             writer.writerow(row)
     counts = Counter(r["status"] for r in rows)
     dynamic = any(r.get("dynamic") for r in rows)
-    what = ("max |sag(t) - sag_ref(t)| / max |sag_ref| over the history; the phase error is "
-            "accumulated over the vibration stage" if dynamic else
-            "the relative difference of the tip sag")
+    eigen = {r["analysis"] for r in rows if "analysis" in r}
+    if dynamic:
+        what = ("max |sag(t) - sag_ref(t)| / max |sag_ref| over the history; the phase error "
+                "is accumulated over the vibration stage")
+    elif eigen:
+        what = ("the largest relative difference of the "
+                + " and ".join({"modal": "elastic frequencies (Hz; rigid-body modes left out)",
+                                "buckling": "load factors"}[a] for a in sorted(eigen))
+                + " both cases computed, in ascending order; the headline is the first")
+    else:
+        what = "the relative difference of the tip sag"
     status = ", ".join(f"{n} {s}" for s, n in counts.items() if s != "ok")
     lines = ["# Sweep summary", "", f"{len(rows)} cases, {counts['ok']} ok"
              f"{', ' + status if status else ''}. Error against "
-             f"the finest case: {what}, relative and in mm (beams: tip sag = transverse tip "
+             f"the finest case: {what}" + ("" if eigen and not dynamic else
+             ", relative and in mm (beams: tip sag = transverse tip "
              "deflection in the rigid frame; general scenes: the response probe's deflection "
              "relative to the rigid motion of its beam's supports, /deflection_support; plates "
-             "and leaves: the r3 displacement of the corner, centre or end probe). "
-             "Times are wall-clock seconds of this machine.", ""]
+             "and leaves: the r3 displacement of the corner, centre or end probe); a relative "
+             "error against a deflection that is zero to round-off (at most "
+             f"{ZERO_DEFLECTION:g} of the model's size) is n/a")
+             + ". Times are wall-clock seconds of this machine.", ""]
     lines += table_lines(rows, keys)
     noted = [r for r in rows if r.get("message")]
     if noted:

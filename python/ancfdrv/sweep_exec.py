@@ -109,20 +109,48 @@ def _result_fields(outcome: Any, output: Path) -> dict:
                    solve_time_s=static.wall_time_s)
         # general scenes: the deflection relative to the supports' rigid motion when the
         # file has it (ancfdrv.system.supports), not the mechanism's rigid motion
-        support = "static.deflection_support.tip"
-        if "static.deflection.tip" in summary:
-            axial, transverse, lateral = summary.get(support, summary["static.deflection.tip"])
+        probe, component = response_of(summary)
+        values = summary.get(f"static.deflection_support.{probe}",
+                             summary[f"static.deflection.{probe}"])
+        if (probe, component) == ("tip", 1):  # a beam's tip sag, with its other components
+            axial, transverse, lateral = values
             row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral)
-        else:
-            probe, component = response_of(summary)
-            values = summary.get(f"static.deflection_support.{probe}",
-                                 summary[f"static.deflection.{probe}"])
+        else:  # the scene's response probe (scene.response), not a probe that is called tip
             row["response"] = float(values[component])
     if dynamic is not None:
         row.update(dynamic=True, steps=dynamic.steps, newton_iterations=dynamic.newton_iterations,
                    factorizations=dynamic.factorizations, dynamic_time_s=dynamic.wall_time_s,
                    **{f"stage_{k}": v for k, v in outcome.stages.items()})
+    eigen = eigen_values(output)
+    if eigen is not None:  # modal or buckling: the headline is the case's response
+        analysis, values = eigen
+        row.update(analysis=analysis, eigen_count=len(values),
+                   eigen_time_s=summary[f"{analysis}.wall_time_s"])
+        if len(values):
+            row[EIGEN_HEADLINE[analysis]] = float(values[0])
     return row
+
+
+#: The row field of the headline of an eigenvalue analysis: the first elastic frequency (Hz)
+#: of a modal run, the first load factor of a buckling run.
+EIGEN_HEADLINE = {"modal": "first_frequency_hz", "buckling": "first_load_factor"}
+
+
+def eigen_values(path: str | Path) -> tuple[str, Any] | None:
+    """('modal', the elastic frequencies in Hz, ascending: the rigid-body modes, reported
+    at 0 Hz, left out) or ('buckling', the load factors, ascending) of a result file; None
+    for a file of another analysis."""
+    import h5py
+    import numpy as np
+    with h5py.File(path, "r") as h5:
+        if "modal" in h5:
+            frequency = h5["modal/frequency"][()]
+            rigid = h5["modal/rigid"][()].astype(bool) if "rigid" in h5["modal"] else \
+                np.zeros(len(frequency), dtype=bool)
+            return "modal", frequency[~rigid]
+        if "buckling" in h5:
+            return "buckling", h5["buckling/load_factor"][()]
+    return None
 
 
 def response_of(attrs: Any) -> tuple[str, int]:

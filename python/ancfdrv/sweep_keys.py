@@ -6,7 +6,6 @@ from __future__ import annotations
 from .io.scene import parse_address
 
 
-
 def full_model_first(values):
     """The sense of ``beam.modes``: 0 (the full FFR model) is the finest, then the most
     modes."""
@@ -43,5 +42,10 @@ def resolution_rank(key: str, value) -> float:
 
 
 def static_value(row: dict) -> float:
-    """The static quantity a sweep compares (tip sag for beams)."""
-    return row["tip_transverse"] if "tip_transverse" in row else row["response"]
+    """The quantity a sweep compares in a case without a history: the tip sag for beams,
+    the response probe's deflection otherwise, the headline of a modal or buckling case
+    (its first elastic frequency or first load factor)."""
+    for key in ("tip_transverse", "response", "first_frequency_hz", "first_load_factor"):
+        if key in row:
+            return row[key]
+    raise KeyError(f"case {row.get('case', '?')} has no compared quantity")

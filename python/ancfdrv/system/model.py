@@ -154,6 +154,18 @@ def _turned_difference(a: Csr, b: Csr, u: np.ndarray) -> float:
     return float(np.abs(dense[0] - turned).max(initial=0.0))
 
 
+def default_response(probes: dict, bodies: list[Body]) -> tuple[str, int] | None:
+    """The probe and component a sweep compares when the builder names none: the first
+    probe, its transverse component (1) on a beam, else r3 (2); None without probes.
+    ``probes``: the model's (each names its body) or a System's (each holds its body)."""
+    if not probes:
+        return None
+    first = next(iter(probes.values()))
+    name = getattr(first.body, "name", first.body)
+    body = next(b for b in bodies if b.name == name)
+    return first.name, 1 if isinstance(body, Beam) else 2
+
+
 def length_scale(bodies: list[Body]) -> float:
     """The length the Newton tolerances are relative to: the largest flexible body's size
     (a beam's length, the largest extent of a plate's or leaf's nodes along a coordinate
@@ -216,10 +228,8 @@ class Model:
         #: the rigid motion of each beam's supports (general scenes and Python runs:
         #: deflections relative to it, :mod:`ancfdrv.system.supports`), else None
         self.support_frames = support_frames
-        if probes and response is None:
-            first = next(iter(probes.values()))
-            body = next(b for b in bodies if b.name == first.body)
-            self.response = (first.name, 1 if isinstance(body, Beam) else 2)
+        if response is None:
+            self.response = default_response(probes, bodies)
 
     def require_runnable(self) -> None:
         """Refuse a model assembled for checks alone (an 'ffr' frame nothing holds)."""
@@ -241,7 +251,7 @@ class Model:
     def contact_point_names(self) -> list[str]:
         return [n for p in self.contact_pairs for n in p["point_names"]]
 
-    def summary(self) -> dict[str, int | str]:
+    def summary(self) -> dict[str, int | str | float]:
         """The /model attributes of a result file."""
         beams = [b for b in self.bodies if isinstance(b, Beam)]
         plates = [b for b in self.bodies if isinstance(b, Plate)]
@@ -258,7 +268,9 @@ class Model:
                 # it fixed, and the unknowns solved (coordinates + multipliers)
                 "planar": getattr(self, "planar", ""),
                 "nplanar_fixed": getattr(self, "nplanar_fixed", 0),
-                "nunknowns": self.ndof + len(self.constraints)}
+                "nunknowns": self.ndof + len(self.constraints),
+                # the model's size (m): what a deflection is small or zero against (sweeps)
+                "length_scale": float(self.length_scale)}
 
     # -- coordinates --------------------------------------------------------------------------
     def expand(self, e: np.ndarray, with_offset: bool = True) -> np.ndarray:
