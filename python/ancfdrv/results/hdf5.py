@@ -539,11 +539,18 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
                              "wall_time_s": result.wall_time_s, **result.extra}, fresh=True)
 
 
+#: what the final status may add to a file (counters, timing and status attributes: 8.8 kB
+#: on a new file); with less room left :func:`finish` writes nothing (OSError) rather than
+#: have HDF5 fail inside its write, which leaves a file no reader can open
+FINISH_BYTES = 64 * 1024
+
+
 def finish(path: Path, model: Model, timing: dict[str, float], status: str,
            message: str = "") -> None:
     """Counters, timing and the final status (also after a failure or an interrupt)."""
     if status not in STATUSES:
         raise ValueError(f"unknown status {status!r}")
+    check_room(path, FINISH_BYTES, margin=0)
     with _open_write(path) as h5:
         for name in ("counters", "timing"):
             if _has(h5, name):
@@ -1387,6 +1394,11 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
     (static_q), and for XDMF and plots the mesh points at that state (mesh_static) with
     each shape on them (mesh_shapes[N, npoints, 3], scaled to a largest displacement of 1)."""
     from .xdmf import MeshLayout, write_layout
+    layout = MeshLayout.from_model(model)
+    # a full disk or ``ulimit -f``: refused before HDF5 writes (a write that fails inside
+    # HDF5 left a file no reader could open: the model and the statics lost)
+    check_room(path, _eigen_bytes(model, layout, [shapes, full_shapes, state] +
+                                  [np.asarray(v) for v, _ in series.values()]))
     with _open_write(path) as h5:
         if name in h5:
             del h5[name]
@@ -1398,7 +1410,6 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
         _dataset(group, "full_shapes", full_shapes, COORDINATE_UNITS)
         _dataset(group, "static_q", state, COORDINATE_UNITS)
         _attrs(group.attrs, attrs)
-        layout = MeshLayout.from_model(model)
         if layout is not None:
             if "model/mesh" not in h5:
                 write_layout(h5, layout)
@@ -1415,6 +1426,26 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
                 _dataset(group, f"xdmf/mode_{k + 1}", mesh[k], "1")
 
 
+#: HDF5's own bytes per dataset (object header, attributes, link) counted by the room check
+#: of an eigen write on top of the data: an object header with a few attributes takes well
+#: under 1 kB, the rest is slack for the B-tree and heap entries of the groups
+DATASET_BYTES = 2048
+
+
+def _eigen_bytes(model: Model, layout, arrays: list[np.ndarray]) -> int:
+    """An upper estimate of what an eigen write adds to the file: its arrays, the mesh
+    datasets (the points at the state, each shape twice: mesh_shapes and xdmf/mode_k, the
+    layout when the file has none), and DATASET_BYTES per dataset."""
+    data = sum(np.asarray(a).nbytes for a in arrays)
+    datasets = len(arrays)
+    if layout is not None:
+        count = len(np.atleast_2d(arrays[1]))
+        data += 8 * 3 * layout.npoints * (2 * count + 1) + layout.points.nbytes + \
+            8 * (layout.quads.size + 3 * len(layout.quads) + 3 * layout.lines.size)
+        datasets += count + 4
+    return data + DATASET_BYTES * datasets
+
+
 def write_modal(path: Path, model: Model, result) -> None:
     """/modal from a :class:`~ancfdrv.solvers.modal.ModalResult`: frequency[N] (Hz,
     ascending, rigid-body modes 0), damping_ratio[N] and damped_frequency[N] when damping
@@ -1429,9 +1460,9 @@ def write_modal(path: Path, model: Model, result) -> None:
              "wall_time_s": result.wall_time_s,
              **{f"time_{k}_s": v for k, v in result.timing.items()},
              **{k: v for k, v in result.extra.items() if np.isscalar(v)}}
+    write_static(path, model, result.static)  # first: kept when /modal finds no room
     _write_eigen(path, model, "modal", result.shapes, result.full_shapes, result.static.e,
                  series, attrs)
-    write_static(path, model, result.static)
 
 
 def write_buckling(path: Path, model: Model, result) -> None:
@@ -1444,10 +1475,10 @@ def write_buckling(path: Path, model: Model, result) -> None:
              **{f"time_{k}_s": v for k, v in result.timing.items()},
              **{k: v for k, v in result.extra.items() if np.isscalar(v)}}
     state = result.reference.e if result.reference is not None else model.e0
+    if result.base is not None:  # first: kept when /buckling finds no room
+        write_static(path, model, result.base)
     _write_eigen(path, model, "buckling", result.shapes, result.full_shapes, state,
                  {"load_factor": (result.load_factor, "1")}, attrs)
-    if result.base is not None:
-        write_static(path, model, result.base)
 
 
 def eigen_summary(h5: h5py.File) -> dict[str, Any]:
