@@ -117,3 +117,51 @@ def test_the_floor_stall_text_is_whole_at_its_longest():
                               f"{big} of {big}: the relative residual stays at ")
     assert message.endswith("above solver.tol = 1.000e-300, beyond double precision; "
                             "raise solver.tol")
+
+
+# -- a write that fails leaves what the file held readable --------------------------------
+
+_LIMITED_RUN = """
+import resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[1]), resource.RLIM_INFINITY))
+from ancfdrv.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def _run_limited(limit: int, *argv: str):
+    import subprocess
+    import sys
+    return subprocess.run([sys.executable, "-c", _LIMITED_RUN, str(limit), *argv],
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_a_modal_result_beyond_the_file_size_limit_keeps_model_and_statics(tmp_path):
+    """``ulimit -f`` reached by the modal write (the limit leaves room for the model and
+    the statics, not for the 100 modes' 0.5 MB): exit 3 naming the limit, and the file
+    opens with /model, /static and status 'failed' (HDF5 failing inside its write left a
+    file no reader could open, or crashed the process)."""
+    import h5py
+    from ancfdrv.io.safe_write import ROOM_MARGIN_BYTES
+    out = tmp_path / "modes.h5"
+    ndof = 204   # the crane boom: 17 nodes of 12 coordinates
+    limit = ROOM_MARGIN_BYTES + 16 * ndof * 8 + 4096   # what the file's creation asks for
+    done = _run_limited(limit, "run", str(INPUTS / "crane_boom_modes.nml"), "-o", str(out),
+                        "--set", "modal.modes=100", "--set", "modal.solver=dense")
+    assert done.returncode == 3, done.stderr
+    assert "file-size limit" in done.stderr and "Traceback" not in done.stderr
+    with h5py.File(out, "r") as h5:
+        assert h5["model"].attrs["ndof"] == ndof
+        assert "static/q" in h5 and "modal" not in h5
+        assert h5.attrs["status"] == "failed" and "file-size limit" in h5.attrs["message"]
+    assert not list(tmp_path.glob("*.tmp"))
+
+
+def test_a_file_size_limit_below_any_result_leaves_no_unreadable_file(tmp_path):
+    """A limit below what even the final status needs: exit 3, and no file (the status
+    written into a new file beyond the limit left one that HDF5 could not open)."""
+    out = tmp_path / "modes.h5"
+    done = _run_limited(8000, "run", str(INPUTS / "crane_boom_modes.nml"), "-o", str(out))
+    assert done.returncode == 3 and "file-size limit" in done.stderr, done.stderr
+    assert not out.exists()
