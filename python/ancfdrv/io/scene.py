@@ -470,6 +470,7 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     """Read, override and validate a scene file (template or general). Raises InputError
     on any problem; every rule is applied before anything is built (the rules:
     :mod:`ancfdrv.io.validate`)."""
+    path = path if type(path) is str else validate.check_path(path, "scene")
     path = Path(path)
     file = str(path)
     text = _read_text(path, file)

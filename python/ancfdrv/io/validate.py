@@ -46,6 +46,7 @@ import math
 import os
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Iterable
 
 from ..errors import InputError
@@ -621,6 +622,31 @@ def check_arguments(function: str, **values: Any) -> dict[str, Any]:
         raise InputError(f"{function}: t_end / dt = {out['t_end'] / out['dt']:.3g} steps; at "
                          f"most {MAX_STEPS:.0e} steps are accepted")
     return out
+
+
+def check_path(value: Any, argument: str) -> Path:
+    """A file path given to the Python API (a scene, ``output=``, ``Results.save(path)``,
+    ``ancfdrv.open(path)``): a str or os.PathLike, else InputError naming the argument
+    and what it got (a number, None, bytes, an empty or NUL-bearing name)."""
+    from .schema import short_repr
+    expected = f"{argument}: expected a file path (a str or pathlib.Path), got"
+    if isinstance(value, (bytes, bytearray)):
+        raise InputError(f"{expected} bytes {short_repr(bytes(value))} (decode it: "
+                         "os.fsdecode(path))")
+    if not isinstance(value, (str, os.PathLike)):
+        raise InputError(f"{expected} "
+                         f"{'None' if value is None else type(value).__name__ + ' '}"
+                         f"{'' if value is None else short_repr(value)}")
+    try:
+        path = Path(value)
+    except TypeError:  # an os.PathLike whose __fspath__ gives bytes
+        raise InputError(f"{expected} {type(value).__name__} {short_repr(value)}") from None
+    if "\x00" in str(path):
+        raise InputError(f"{argument}: the file name {short_repr(str(path))} contains a NUL "
+                         "character")
+    if isinstance(value, str) and not value.strip():
+        raise InputError(f"{argument}: the file name is empty")
+    return path
 
 
 def check_state(function: str, key: str, value: Any, size: int):

@@ -346,15 +346,25 @@ def open_result(path: str | Path, attempts: int = 50) -> h5py.File:
     running run opens the file for each chunk it writes). Raises InputError when the
     file is missing or is not HDF5."""
     path = Path(path)
+    if path.is_dir():
+        raise InputError("a directory, not a result file", file=str(path))
     if not path.is_file():
         raise InputError("result file not found", file=str(path))
-    if not h5py.is_hdf5(path):
-        raise InputError("not an HDF5 file", file=str(path))
+    try:
+        if not h5py.is_hdf5(path):
+            raise InputError("not an HDF5 file", file=str(path))
+    except OSError as exc:  # unreadable (permissions, I/O error)
+        raise InputError(f"cannot read the file: {exc.strerror or exc}",
+                         file=str(path)) from None
     for attempt in range(attempts):
         try:
             return h5py.File(path, "r")
         except OSError as exc:
             if attempt == attempts - 1 or "lock" not in str(exc).lower():
+                if "truncated" in str(exc).lower():
+                    raise InputError("the HDF5 file is truncated (shorter than its own "
+                                     "header says: a copy or a write cut short)",
+                                     file=str(path)) from None
                 raise InputError(f"cannot read the HDF5 file ({exc})", file=str(path)) from None
             time.sleep(0.02)
     raise AssertionError("unreachable")
