@@ -495,7 +495,8 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     # repeat does)
     if plain is None or any(count > 1 and name not in repeatable for name, count in
                             Counter(map(_cogroup_name, OrderedDict.keys(nml))).items()):
-        validate.check_repeats(file, groups or validate.scan_groups(text), repeatable)
+        validate.check_repeats(file, groups if groups is not None else validate.scan_groups(text),
+                               repeatable)
     _override_addresses(overrides or [], file)
     seen: Counter = Counter()
     # a repeated group comes once per occurrence (f90nml's items view: each key's cogroup
