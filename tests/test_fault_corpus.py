@@ -164,6 +164,21 @@ API_MISUSE = {
                                             "expected a vector of the model's 36 coordinates"),
     "integrate with dt=0": (lambda: _integrate(dt=0.0), "dt"),
     "integrate with max_newton=0": (lambda: _integrate(max_newton=0), "max_newton"),
+    # issue 35: the eigen analyses and the file doors
+    "modes('3')": (lambda: arm().modes("3"), "&modal modes: expected an integer, got '3'"),
+    "modes(None)": (lambda: arm().modes(None), "&modal modes: expected an integer"),
+    "modes(3.5)": (lambda: arm().modes(3.5), "&modal modes: expected an integer, got 3.5"),
+    "modes unknown keyword": (lambda: arm().modes(2, shfit=1.0),
+                              "unknown keyword argument 'shfit'"),
+    "modes rigid_tol=-1": (lambda: arm().modes(2, rigid_tol=-1), "&modal rigid_tol: -1.0 must "
+                           "lie in (0, 1e-3)"),
+    "buckling rtol=0": (lambda: arm().buckling(1, rtol=0), "&buckling rtol: 0.0 must lie in"),
+    "buckling('3')": (lambda: arm().buckling("3"), "&buckling modes: expected an integer"),
+    "static(output=5)": (lambda: arm().static(output=5), "output: expected a file path"),
+    "open(bytes)": (lambda: __import__("ancfdrv").open(b"r.h5"),
+                    "open(path): expected a file path (a str or pathlib.Path), got bytes"),
+    "open(None)": (lambda: __import__("ancfdrv").open(None), "open(path): expected a file "
+                   "path (a str or pathlib.Path), got None"),
 }
 
 

@@ -33,11 +33,11 @@ import numpy as np
 from .errors import InputError
 from .io import validate
 from .io.scene import Scene, _typed
-from .io.schema import SCHEMA
+from .io.schema import SCHEMA, check_keywords
 from .results.reader import Results, open_results
 from .runner import run_loaded
-from .solvers.buckling import buckling_analysis
-from .solvers.modal import modal_analysis
+from .solvers.buckling import BUCKLING_KEYWORDS, buckling_analysis
+from .solvers.modal import MODAL_KEYWORDS, modal_analysis
 from .system.system import System
 
 #: the analyses a System runs from Python (scene.analysis)
@@ -101,6 +101,7 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
         raise InputError(f"{where}: analysis {analysis!r} must be one of {', '.join(ANALYSES)}")
     solver, out_values = _settings(options, where)
     validate.check_time(solver, analysis, where)
+    target = None if output is None else validate.check_path(output, f"{where}: output")
     chosen = effects if effects is not None else system.effects
     model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
                             linear_joints=solver["linear_joints"], supports=True)
@@ -124,12 +125,10 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
         model.close()
         raise
     owner = None
-    if output is None:
+    if target is None:
         owner = tempfile.TemporaryDirectory(prefix="ancfdrv-")
         weakref.finalize(owner, owner.cleanup)
         target = Path(owner.name) / "result.h5"
-    else:
-        target = Path(output)
     run_loaded(scene, target, progress=progress, model=model)
     result = open_results(target)
     result._owner = owner
@@ -156,9 +155,25 @@ def simulate(system, t_end: float, dt: float | None = None, *, from_static: bool
                       effects=effects, progress=progress, **options)
 
 
+def _eigen_door(system, call: str, keywords: dict[str, str], n: Any, linear_joints: Any,
+                options: dict[str, Any], **named: Any) -> tuple[int, str, dict[str, Any]]:
+    """The arguments of System.modes or System.buckling checked before anything is
+    assembled, with the rules and messages of their namelist keys (``n`` is &modal or
+    &buckling ``modes``, ``linear_joints`` &solver's, the options those of ``keywords``)."""
+    where = f"System {system.title!r}: {call}()"
+    options = check_keywords(where, options, {k: g for k, g in keywords.items()
+                                              if k != "modes" and k not in named})
+    first = check_keywords(where, {"modes": n, **named}, keywords)
+    joints = check_keywords(where, {"linear_joints": linear_joints},
+                            {"linear_joints": "solver"})["linear_joints"]
+    return first.pop("modes"), joints, {**options, **first}
+
+
 def modes(system, n: int = 10, *, effects=None, linear_joints: str = "auto", **options: Any):
     """:meth:`System.modes`: the ``n`` lowest modes about the static equilibrium of the
     system's loads (:func:`ancfdrv.solvers.modal.modal_analysis`)."""
+    n, linear_joints, options = _eigen_door(system, "modes", MODAL_KEYWORDS, n, linear_joints,
+                                            options)
     model = system.assemble(effects=effects, linear_joints=linear_joints)
     try:
         return modal_analysis(model, n, **options)
@@ -171,7 +186,9 @@ def buckling(system, n: int = 3, *, fixed_loads=(), effects=None,
     """:meth:`System.buckling`: the ``n`` lowest positive load factors of the system's
     loads about their static state (:func:`ancfdrv.solvers.buckling.buckling_analysis`),
     the loads named in ``fixed_loads`` (load names or effects) kept at their value."""
-    fixed = tuple(fixed_loads)
+    n, linear_joints, options = _eigen_door(system, "buckling", BUCKLING_KEYWORDS, n,
+                                            linear_joints, options, fixed_loads=fixed_loads)
+    fixed = tuple(options.pop("fixed_loads"))
     known = set(system.loads) | {load.effect for load in system.loads.values()}
     unknown = [name for name in fixed if name not in known]
     if unknown:

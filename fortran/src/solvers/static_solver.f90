@@ -412,7 +412,9 @@ contains
   end subroutine static_newton
 
   !> The text of a failure of static_newton (info, detail) at load step load_step of
-  !> load_steps, with the smallest and last residuals and the iteration limit.
+  !> load_steps, with the smallest and last residuals and the iteration limit. Every text
+  !> fits message_length (200) with 10-digit counts and 3-digit exponents: a longer one
+  !> is cut mid-word by the assignment (the floor stall's ended in 'raise solver.to').
   pure function static_failure_text(info, detail, load_step, load_steps, max_iter, smallest, &
                                     last, con_res, tol) result(text)
     integer, intent(in) :: info, detail, load_step, load_steps, max_iter
@@ -432,7 +434,7 @@ contains
     case (static_floor_stall)
       text = 'static Newton stalled at the round-off floor ' // trim(where) // &
              ': the relative residual stays at ' // sci(smallest) // ' above solver.tol = ' // &
-             sci(tol) // ', more digits than double precision carries here; raise solver.tol'
+             sci(tol) // ', beyond double precision; raise solver.tol'
     case (static_stall)
       text = 'static Newton stalled ' // trim(where) // ': no smaller residual in the last ' // &
              'iterations (smallest ' // sci(smallest) // ', tolerance ' // sci(tol) // &
@@ -448,13 +450,16 @@ contains
 
   contains
 
-    !> x as Python's '{:.3e}' writes it
+    !> x as Python's '{:.3e}' writes it (a 3-digit exponent too: es12.3 drops its 'E',
+    !> '1.000-300')
     pure function sci(x) result(out)
       real(dp), intent(in) :: x
       character(len=:), allocatable :: out
       character(len=16) :: buffer
       integer :: p
       write (buffer, '(es12.3)') x
+      if (index(buffer, 'E') == 0 .and. scan(buffer, '0123456789') > 0) &
+        write (buffer, '(es13.3e3)') x
       buffer = adjustl(buffer)
       p = index(buffer, 'E')
       if (p > 0) buffer(p:p) = 'e'

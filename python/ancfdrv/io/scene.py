@@ -454,23 +454,33 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     """Read, override and validate a scene file (template or general). Raises InputError
     on any problem; every rule is applied before anything is built (the rules:
     :mod:`ancfdrv.io.validate`)."""
+    path = path if type(path) is str else validate.check_path(path, "scene")
     path = Path(path)
     file = str(path)
     text = _read_text(path, file)
+    # a plain namelist (fast_reads) has every group ended before the next one starts and no
+    # key twice in a group (fast_reads declines both): any other text is scanned
+    groups = None
     try:
         nml = plain = fast_reads(text)
         if nml is None:  # not one of the plain forms fast_reads reads
+            groups = validate.scan_groups(text)
             nml = f90nml.reads(text)
     except Exception as exc:  # f90nml raises several types
+        if groups and all(g.ended for g in groups[:-1]) and not groups[-1].ended:
+            validate.check_ended(file, groups)  # the text ends inside its last group
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
+    if groups is not None:
+        validate.check_ended(file, groups)
     general = is_general(nml)
     repeatable = GENERAL_SCHEMA if general else ()
-    # a plain namelist (fast_reads) has no key twice in a group (fast_reads refuses that):
-    # the text is scanned for its lines only when a group that may not repeat does
+    # (in a plain namelist the text is scanned for its lines only when a group that may not
+    # repeat does)
     if plain is None or any(count > 1 and name not in repeatable for name, count in
                             Counter(map(_cogroup_name, OrderedDict.keys(nml))).items()):
-        validate.check_repeats(file, validate.scan_groups(text), repeatable)
+        validate.check_repeats(file, groups if groups is not None else validate.scan_groups(text),
+                               repeatable)
     _override_addresses(overrides or [], file)
     seen: Counter = Counter()
     # a repeated group comes once per occurrence (f90nml's items view: each key's cogroup

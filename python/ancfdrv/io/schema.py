@@ -788,3 +788,21 @@ def check_call(group: str, label: str, values: dict[str, Any]) -> dict[str, Any]
             raw = [raw]
         out[key] = checked_value(spec, raw, where)
     return out
+
+
+def check_keywords(function: str, values: dict[str, Any],
+                   keys: dict[str, str]) -> dict[str, Any]:
+    """Keyword arguments of a Python API function that stand for namelist keys, checked
+    with those keys' rules and messages: ``keys`` maps each argument to the group of
+    :data:`SCHEMA` whose key of the same name it is (``modes(): &modal rigid_tol: -1.0 must
+    lie in (0, 1e-3)``). An argument ``keys`` does not name is refused with the ones the
+    function takes. Returns the checked values (plain Python numbers, strings and lists)."""
+    unknown = sorted(set(values) - set(keys))
+    if unknown:
+        raise InputError(f"{function}: unknown keyword argument "
+                         f"{', '.join(map(repr, unknown))}; it takes "
+                         f"{', '.join(sorted(keys))} (the namelist keys of the same name, "
+                         "docs/scenes.md)")
+    return {name: checked_value(SCHEMA[keys[name]][name], plain_value(raw),
+                                dict(file=function, group=keys[name], key=name))
+            for name, raw in values.items()}

@@ -4,11 +4,15 @@
 :class:`~ancfdrv.errors.InputError` (exit status 2) naming the file, the group (``beam[boom]``
 for a named group of a general scene) and the key:
 
-1. **Repeats in the text** (:func:`check_repeats`). f90nml keeps the last of a repeated key
-   and merges repeated groups, so the text itself is scanned (a small tokenizer of group
-   and key names, :func:`scan_groups`): a key given twice in one group is an error (with
-   both line numbers), so is a group given twice, except the named, repeatable groups of
-   general scenes (``&beam``, ``&joint``, ...).
+1. **Groups and repeats in the text** (:func:`check_ended`, :func:`check_repeats`). f90nml
+   silently drops a group that starts before the previous one ended (a missing ``/``), keeps
+   the last of a repeated key and merges repeated groups, so the text itself is scanned (a
+   small tokenizer of group and key names, :func:`scan_groups`; strings and comments are
+   skipped, ``/``, ``&``, ``$``, ``&end`` and ``$end`` end a group as they do for f90nml): a
+   group that starts inside another is an error naming both groups and the line, so is a
+   group the text ends inside; a key given twice in one group is an error (with both line
+   numbers), so is a group given twice, except the named, repeatable groups of general
+   scenes (``&beam``, ``&joint``, ...).
 2. **Command-line values** (:func:`parse_value`): ``--set GROUP.KEY=VALUE`` and each value
    of ``--vary`` must be ONE value of the key's type, written as in a namelist: a number, an
    integer, ``.true.``/``.false.``, a string (quoted, or unquoted without quotes, ``&``,
@@ -42,6 +46,7 @@ import math
 import os
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Iterable
 
 from ..errors import InputError
@@ -93,6 +98,9 @@ class GroupText:
     line: int
     keys: list[KeyText] = field(default_factory=list)
     item: str | None = None
+    #: ended by '/', '&', '$', '&end' or '$end' (False: the next group or the end of the
+    #: text came first)
+    ended: bool = False
 
     @property
     def label(self) -> str:
@@ -140,9 +148,10 @@ def scan_groups(text: str) -> list[GroupText]:
                 groups.append(current)
             continue
         if kind == "end" or (kind == "group" and token[1:].lower() == "end"):
+            current.ended = True
             current, expect_name = None, False
             continue
-        if kind == "group":  # a new group without '/': f90nml reports the syntax
+        if kind == "group":  # a new group before the '/' of this one (check_ended)
             current = GroupText(token[1:].lower(), line)
             groups.append(current)
             continue
@@ -157,6 +166,22 @@ def scan_groups(text: str) -> list[GroupText]:
             current.item = _unquote(token) if kind == "string" else token
         expect_name = False
     return groups
+
+
+def check_ended(file: str, groups: list[GroupText]) -> None:
+    """A group that starts before the previous one ended (f90nml drops the later group
+    without a word), or a group the text ends inside, raises InputError naming the groups
+    and the lines."""
+    for group, after in zip(groups, groups[1:] + [None]):
+        if group.ended:
+            continue
+        if after is None:
+            raise InputError(f"line {group.line}: group &{group.name} has no '/' before the "
+                             "end of the file (missing '/')", file=file)
+        raise InputError(f"line {after.line}: group &{after.name} starts before group "
+                         f"&{group.name} (line {group.line}) ended (missing '/'): a namelist "
+                         f"reader would drop &{after.name} silently; end &{group.name} with "
+                         "'/'", file=file)
 
 
 def check_repeats(file: str, groups: list[GroupText], repeatable: Iterable[str]) -> None:
@@ -597,6 +622,31 @@ def check_arguments(function: str, **values: Any) -> dict[str, Any]:
         raise InputError(f"{function}: t_end / dt = {out['t_end'] / out['dt']:.3g} steps; at "
                          f"most {MAX_STEPS:.0e} steps are accepted")
     return out
+
+
+def check_path(value: Any, argument: str) -> Path:
+    """A file path given to the Python API (a scene, ``output=``, ``Results.save(path)``,
+    ``ancfdrv.open(path)``): a str or os.PathLike, else InputError naming the argument
+    and what it got (a number, None, bytes, an empty or NUL-bearing name)."""
+    from .schema import short_repr
+    expected = f"{argument}: expected a file path (a str or pathlib.Path), got"
+    if isinstance(value, (bytes, bytearray)):
+        raise InputError(f"{expected} bytes {short_repr(bytes(value))} (decode it: "
+                         "os.fsdecode(path))")
+    if not isinstance(value, (str, os.PathLike)):
+        raise InputError(f"{expected} "
+                         f"{'None' if value is None else type(value).__name__ + ' '}"
+                         f"{'' if value is None else short_repr(value)}")
+    try:
+        path = Path(value)
+    except TypeError:  # an os.PathLike whose __fspath__ gives bytes
+        raise InputError(f"{expected} {type(value).__name__} {short_repr(value)}") from None
+    if "\x00" in str(path):
+        raise InputError(f"{argument}: the file name {short_repr(str(path))} contains a NUL "
+                         "character")
+    if isinstance(value, str) and not value.strip():
+        raise InputError(f"{argument}: the file name is empty")
+    return path
 
 
 def check_state(function: str, key: str, value: Any, size: int):

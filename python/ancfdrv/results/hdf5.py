@@ -346,15 +346,25 @@ def open_result(path: str | Path, attempts: int = 50) -> h5py.File:
     running run opens the file for each chunk it writes). Raises InputError when the
     file is missing or is not HDF5."""
     path = Path(path)
+    if path.is_dir():
+        raise InputError("a directory, not a result file", file=str(path))
     if not path.is_file():
         raise InputError("result file not found", file=str(path))
-    if not h5py.is_hdf5(path):
-        raise InputError("not an HDF5 file", file=str(path))
+    try:
+        if not h5py.is_hdf5(path):
+            raise InputError("not an HDF5 file", file=str(path))
+    except OSError as exc:  # unreadable (permissions, I/O error)
+        raise InputError(f"cannot read the file: {exc.strerror or exc}",
+                         file=str(path)) from None
     for attempt in range(attempts):
         try:
             return h5py.File(path, "r")
         except OSError as exc:
             if attempt == attempts - 1 or "lock" not in str(exc).lower():
+                if "truncated" in str(exc).lower():
+                    raise InputError("the HDF5 file is truncated (shorter than its own "
+                                     "header says: a copy or a write cut short)",
+                                     file=str(path)) from None
                 raise InputError(f"cannot read the HDF5 file ({exc})", file=str(path)) from None
             time.sleep(0.02)
     raise AssertionError("unreachable")
@@ -539,11 +549,18 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
                              "wall_time_s": result.wall_time_s, **result.extra}, fresh=True)
 
 
+#: what the final status may add to a file (counters, timing and status attributes: 8.8 kB
+#: on a new file); with less room left :func:`finish` writes nothing (OSError) rather than
+#: have HDF5 fail inside its write, which leaves a file no reader can open
+FINISH_BYTES = 64 * 1024
+
+
 def finish(path: Path, model: Model, timing: dict[str, float], status: str,
            message: str = "") -> None:
     """Counters, timing and the final status (also after a failure or an interrupt)."""
     if status not in STATUSES:
         raise ValueError(f"unknown status {status!r}")
+    check_room(path, FINISH_BYTES, margin=0)
     with _open_write(path) as h5:
         for name in ("counters", "timing"):
             if _has(h5, name):
@@ -1381,6 +1398,11 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
     (static_q), and for XDMF and plots the mesh points at that state (mesh_static) with
     each shape on them (mesh_shapes[N, npoints, 3], scaled to a largest displacement of 1)."""
     from .xdmf import MeshLayout, write_layout
+    layout = MeshLayout.from_model(model)
+    # a full disk or ``ulimit -f``: refused before HDF5 writes (a write that fails inside
+    # HDF5 left a file no reader could open: the model and the statics lost)
+    check_room(path, _eigen_bytes(model, layout, [shapes, full_shapes, state] +
+                                  [np.asarray(v) for v, _ in series.values()]))
     with _open_write(path) as h5:
         if name in h5:
             del h5[name]
@@ -1392,7 +1414,6 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
         _dataset(group, "full_shapes", full_shapes, COORDINATE_UNITS)
         _dataset(group, "static_q", state, COORDINATE_UNITS)
         _attrs(group.attrs, attrs)
-        layout = MeshLayout.from_model(model)
         if layout is not None:
             if "model/mesh" not in h5:
                 write_layout(h5, layout)
@@ -1409,6 +1430,26 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
                 _dataset(group, f"xdmf/mode_{k + 1}", mesh[k], "1")
 
 
+#: HDF5's own bytes per dataset (object header, attributes, link) counted by the room check
+#: of an eigen write on top of the data: an object header with a few attributes takes well
+#: under 1 kB, the rest is slack for the B-tree and heap entries of the groups
+DATASET_BYTES = 2048
+
+
+def _eigen_bytes(model: Model, layout, arrays: list[np.ndarray]) -> int:
+    """An upper estimate of what an eigen write adds to the file: its arrays, the mesh
+    datasets (the points at the state, each shape twice: mesh_shapes and xdmf/mode_k, the
+    layout when the file has none), and DATASET_BYTES per dataset."""
+    data = sum(np.asarray(a).nbytes for a in arrays)
+    datasets = len(arrays)
+    if layout is not None:
+        count = len(np.atleast_2d(arrays[1]))
+        data += 8 * 3 * layout.npoints * (2 * count + 1) + layout.points.nbytes + \
+            8 * (layout.quads.size + 3 * len(layout.quads) + 3 * layout.lines.size)
+        datasets += count + 4
+    return data + DATASET_BYTES * datasets
+
+
 def write_modal(path: Path, model: Model, result) -> None:
     """/modal from a :class:`~ancfdrv.solvers.modal.ModalResult`: frequency[N] (Hz,
     ascending, rigid-body modes 0), damping_ratio[N] and damped_frequency[N] when damping
@@ -1423,9 +1464,9 @@ def write_modal(path: Path, model: Model, result) -> None:
              "wall_time_s": result.wall_time_s,
              **{f"time_{k}_s": v for k, v in result.timing.items()},
              **{k: v for k, v in result.extra.items() if np.isscalar(v)}}
+    write_static(path, model, result.static)  # first: kept when /modal finds no room
     _write_eigen(path, model, "modal", result.shapes, result.full_shapes, result.static.e,
                  series, attrs)
-    write_static(path, model, result.static)
 
 
 def write_buckling(path: Path, model: Model, result) -> None:
@@ -1438,10 +1479,10 @@ def write_buckling(path: Path, model: Model, result) -> None:
              **{f"time_{k}_s": v for k, v in result.timing.items()},
              **{k: v for k, v in result.extra.items() if np.isscalar(v)}}
     state = result.reference.e if result.reference is not None else model.e0
+    if result.base is not None:  # first: kept when /buckling finds no room
+        write_static(path, model, result.base)
     _write_eigen(path, model, "buckling", result.shapes, result.full_shapes, state,
                  {"load_factor": (result.load_factor, "1")}, attrs)
-    if result.base is not None:
-        write_static(path, model, result.base)
 
 
 def eigen_summary(h5: h5py.File) -> dict[str, Any]:

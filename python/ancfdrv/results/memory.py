@@ -327,9 +327,10 @@ class MemoryOutput:
         their order, into the HDF5 writer. The path is checked as a run's output is
         (never an input file, never through a symbolic link); an existing file is
         refused unless ``replace``."""
+        from ..io.validate import check_path
         from . import hdf5
         from .output_path import check_output_path
-        path = Path(path)
+        path = check_path(path, "Simulation.save(path)")
         if self.scene is None:
             from ..errors import InputError
             raise InputError("nothing to save: the run stopped before its model was built",

@@ -274,15 +274,27 @@ class Results:
         XDMF description (dynamic runs with output.xdmf) and the plot (``plot``) beside it
         as ``ancf run`` writes them. A plot that fails is a warning, never an error.
         Refuses (InputError) what ``ancf run`` refuses: a directory, a non-HDF5 file, ..."""
-        from ..io.safe_write import write_with
+        from ..errors import SolverError
+        from ..io.safe_write import disk_full, write_with
+        from ..io.validate import check_path
         from .output_path import check_output_path
-        target = Path(path)
+        target = check_path(path, "Results.save(path)")
         if target.exists() and target.resolve() == self.path.resolve():
             raise InputError("save: the target is this result's own file", file=str(target))
         check_output_path(target)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        # atomically and never through a link planted at the target (io.safe_write)
-        write_with(target, lambda temp: shutil.copyfile(self.path, temp))
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            # atomically and never through a link planted at the target (io.safe_write): a
+            # write that fails leaves what the target held
+            write_with(target, lambda temp: shutil.copyfile(self.path, temp))
+        except OSError as exc:
+            reason = exc.strerror or str(exc)
+            if disk_full(exc):
+                raise SolverError(f"save: cannot write {target}: the disk or the file-size "
+                                  f"limit is full ({reason}); {target} is left as it "
+                                  "was") from None
+            raise InputError(f"save: cannot write a file in {target.parent}: {reason}; "
+                             f"{target.name} is left as it was", file=str(target)) from None
         if self.path.with_suffix(".xdmf").exists():
             from .xdmf import write_xdmf
             write_xdmf(target)
@@ -310,7 +322,8 @@ def open_results(path: str | Path) -> Results:
     """Read any ancfdrv result file (from ``ancf run``, a sweep, :meth:`Results.save`)
     into a :class:`Results`. Raises InputError when the file is missing, not HDF5 or not
     an ancfdrv result."""
-    path = Path(path)
+    from ..io.validate import check_path
+    path = check_path(path, "open(path)")
     with hdf5.open_result(path) as h5:
         if not isinstance(h5.get("model"), h5py.Group):
             raise InputError("not an ancfdrv result file (no /model group)", file=str(path))

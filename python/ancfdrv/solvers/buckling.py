@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import SolverError
+from ..io.schema import check_keywords
 from ..kernel import DirectSolver
 from ..system.model import Model
 from .modal import DENSE_LIMIT, linearize, null_space
@@ -252,6 +253,14 @@ def _root(history: list[tuple[float, float]]) -> float | None:
     return float(min(roots, key=lambda r: abs(r - p2))) if roots else None
 
 
+#: the arguments of :func:`buckling_analysis` that are namelist keys (argument -> its
+#: group; ``modes`` is ``count``): checked with the namelist's rules, and the keywords
+#: ``System.buckling`` takes besides ``n``
+BUCKLING_KEYWORDS = {"modes": "buckling", "fixed_loads": "buckling", "method": "buckling",
+                     "solver": "buckling", "rtol": "buckling", "load_steps": "buckling",
+                     "reference_factor": "buckling", "tol": "solver", "max_iter": "solver"}
+
+
 def buckling_analysis(model: Model, base_model: Model, count: int, *,
                       fixed_loads: tuple[str, ...] = (), method: str = "nonlinear",
                       solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,
@@ -267,11 +276,18 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     the static path at the latest estimate until the first load factor reproduces itself:
     then the tangent on the static path is singular there (the stability limit of the
     model, pre-buckling deformation included). See the module doc and docs/theory.md.
+    The arguments of :data:`BUCKLING_KEYWORDS` pass the rules of their namelist keys
+    (InputError).
     """
-    if count < 1:
-        raise SolverError(f"buckling: modes = {count} must be at least 1")
-    if method not in ("linear", "nonlinear"):
-        raise SolverError(f"buckling: method {method!r} must be 'linear' or 'nonlinear'")
+    args = check_keywords("buckling", dict(
+        modes=count, fixed_loads=fixed_loads, method=method, solver=solver, rtol=rtol,
+        load_steps=load_steps, reference_factor=reference_factor, tol=tol,
+        max_iter=max_iter), BUCKLING_KEYWORDS)
+    count, fixed_loads, method, solver = (args["modes"], tuple(args["fixed_loads"]),
+                                          args["method"], args["solver"])
+    rtol, load_steps, reference_factor = (args["rtol"], args["load_steps"],
+                                          args["reference_factor"])
+    tol, max_iter = args["tol"], args["max_iter"]
     if model.ndof != base_model.ndof or not np.array_equal(model.e0, base_model.e0):
         raise SolverError("buckling: the model with and without the reference loads differ "
                           "in their coordinates")
@@ -279,8 +295,6 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         raise SolverError("buckling: every beam has the 'ffr' formulation, whose constant "
                           "small-strain stiffness has no geometric (initial-stress) part; "
                           "use formulation = 'nonlinear'")
-    if not reference_factor > 0:
-        raise SolverError(f"buckling: reference_factor = {reference_factor} must be positive")
     start = time.perf_counter()
     timing: dict[str, float] = {}
     path = LoadPath(model, base_model, tol=tol, max_iter=max_iter, load_steps=load_steps)

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import SolverError
+from ..io.schema import check_keywords
 from ..kernel import DirectSolver
 from ..system.model import Model
 from .static import StaticResult, solve_newton
@@ -261,6 +262,14 @@ def steady_rotation_matrices(model: Model, rate: float, axis) -> tuple[sp.csr_ma
             sp.kron(mbar, 2.0 * rate * skew, format="csr"))
 
 
+#: the arguments of :func:`modal_analysis` that are namelist keys (argument -> its group;
+#: ``modes`` is ``count``): checked with the namelist's rules, and the keywords
+#: ``System.modes`` takes besides ``n``
+MODAL_KEYWORDS = {"modes": "modal", "solver": "modal", "rigid_tol": "modal",
+                  "spin_rate": "modal", "spin_axis": "modal", "spin_centre": "modal",
+                  "tol": "solver", "max_iter": "solver", "load_steps": "solver"}
+
+
 def modal_analysis(model: Model, count: int, *, static: StaticResult | None = None,
                    solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,
                    load_steps: int = 1, rigid_tol: float = 1e-9, shift: float | None = None,
@@ -273,12 +282,17 @@ def modal_analysis(model: Model, count: int, *, static: StaticResult | None = No
     up to :data:`DENSE_LIMIT` free coordinates). ``spin_rate`` > 0: modes in a frame turning
     steadily about ``spin_axis`` through ``spin_centre`` (every body turning with it: the
     static state includes the centrifugal forces, K their softening, and the Coriolis
-    forces make the problem gyroscopic; see docs/theory.md).
+    forces make the problem gyroscopic; see docs/theory.md). The arguments of
+    :data:`MODAL_KEYWORDS` pass the rules of their namelist keys (InputError).
     """
-    if count < 1:
-        raise SolverError(f"modal analysis: modes = {count} must be at least 1")
-    if solver not in ("auto", "dense", "sparse"):
-        raise SolverError(f"modal analysis: solver {solver!r} must be auto, dense or sparse")
+    args = check_keywords("modal analysis", dict(
+        modes=count, solver=solver, rigid_tol=rigid_tol, spin_rate=spin_rate,
+        spin_axis=spin_axis, spin_centre=spin_centre, tol=tol, max_iter=max_iter,
+        load_steps=load_steps), MODAL_KEYWORDS)
+    count, solver, rigid_tol, spin_rate = (args["modes"], args["solver"], args["rigid_tol"],
+                                           args["spin_rate"])
+    spin_axis, spin_centre = args["spin_axis"], args["spin_centre"]
+    tol, max_iter, load_steps = args["tol"], args["max_iter"], args["load_steps"]
     start = time.perf_counter()
     timing: dict[str, float] = {}
     centrifugal = coriolis = None

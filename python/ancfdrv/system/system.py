@@ -691,8 +691,9 @@ class System:
     def modes(self, n: int = 10, *, effects: Iterable[str] | None = None,
               linear_joints: str = "auto", **options):
         """The ``n`` lowest modes about the static equilibrium of the system's loads
-        (:func:`ancfdrv.solvers.modal.modal_analysis`; ``options`` are its keywords:
-        solver, tol, load_steps, rigid_tol, spin_rate, spin_axis, spin_centre, ...).
+        (:func:`ancfdrv.solvers.modal.modal_analysis`; ``n`` is &modal modes, ``options``
+        the other keys of &modal (solver, rigid_tol, spin_rate, spin_axis, spin_centre) and
+        &solver's tol, max_iter, load_steps, each checked as in a scene: InputError).
         Returns a :class:`~ancfdrv.solvers.modal.ModalResult` (frequency in Hz ascending,
         rigid-body modes at 0; mass-normalized shapes; damping_ratio with damping on)."""
         return self._analysis("modes")(self, n, effects=effects, linear_joints=linear_joints,
@@ -704,8 +705,10 @@ class System:
         """The ``n`` lowest positive load factors of the system's loads about their static
         state (:func:`ancfdrv.solvers.buckling.buckling_analysis`): the loads (by name, or
         all loads of an effect) in ``fixed_loads`` keep their value, the others are
-        multiplied. ``options``: method ('nonlinear' | 'linear'), solver, tol, load_steps,
-        rtol, ... Returns a :class:`~ancfdrv.solvers.buckling.BucklingResult`."""
+        multiplied. ``n`` is &buckling modes, ``options`` the other keys of &buckling
+        (method 'nonlinear' | 'linear', solver, rtol, load_steps, reference_factor) and
+        &solver's tol, max_iter, each checked as in a scene (InputError). Returns a
+        :class:`~ancfdrv.solvers.buckling.BucklingResult`."""
         return self._analysis("buckling")(self, n, fixed_loads=fixed_loads, effects=effects,
                                           linear_joints=linear_joints, **options)
 
