@@ -52,14 +52,11 @@ def test_a_missing_slash_names_both_groups_and_the_line(tmp_path, group, after, 
     assert not (tmp_path / "out.h5").exists()
 
 
-@pytest.mark.parametrize("reader", ["fast", "f90nml", "f90nml-namelists"])
+@pytest.mark.parametrize("reader", ["fast", "f90nml"])
 def test_the_refusal_holds_on_every_reading_path(tmp_path, monkeypatch, reader):
-    """The same refusal whether the scene's own reader or f90nml parses the text, and with
-    f90nml's own Namelists (FAST_NAMELIST off)."""
+    """The same refusal whether the scene's own reader or f90nml parses the text."""
     if reader != "fast":
         monkeypatch.setattr(scene_module, "fast_reads", lambda text: None)
-    if reader == "f90nml-namelists":
-        monkeypatch.setattr(scene_module, "FAST_NAMELIST", False)
     path = tmp_path / "scene.nml"
     path.write_text(_without_end_of("loads"))
     with pytest.raises(InputError, match=r"line 25: group &solver starts before group &loads "

@@ -160,7 +160,7 @@ def test_truncated_reference_is_refused(tmp_path, capsys, modal_scene, good_moda
     cut = tmp_path / "cut.h5"
     data = good_modal.read_bytes()
     cut.write_bytes(data[:len(data) // 2])
-    refused(tmp_path, capsys, modal_scene, cut, "cannot read")
+    refused(tmp_path, capsys, modal_scene, cut, "--reference", "truncated")
 
 
 def test_reference_of_a_failed_run_is_refused(tmp_path, capsys, modal_scene, good_modal):
