@@ -25,6 +25,8 @@ class InputError(AncfError):
     def __init__(self, message: str, *, file: str | None = None, group: str | None = None,
                  key: str | None = None) -> None:
         self.file, self.group, self.key = file, group, key
+        #: the message without the place (file, group, key) it is prefixed with
+        self.reason = message
         where = []
         if file:
             where.append(str(file))
