@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import tempfile
 from pathlib import Path
 
 import h5py
@@ -242,3 +243,51 @@ def test_buckling_of_ffr_beams_refused_as_configuration(write_scene):
     code, err = run("run", str(scene), "-o", str(scene.with_suffix(".h5")))
     assert code == 2, err
     assert "&scene formulation" in err and "use formulation = 'nonlinear'" in err
+
+
+# --- a programming error is not bad input -------------------------------------------------
+
+def test_a_bug_in_the_assembly_is_an_internal_error(write_scene, monkeypatch, tmp_path):
+    """An exception the package did not raise on purpose, inside the assembly of a valid
+    scene, is reported as an internal error (exit 1, the trace in a file), not as bad
+    input: System.assemble has no door that would turn it into an InputError."""
+    from ancfdrv.system import assembly
+
+    def bug(*args, **kwargs):
+        raise AttributeError("'Plate' object has no attribute 'start'")
+    monkeypatch.setattr(assembly, "_planar", bug)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # where the trace goes
+    scene, out = locked_box(write_scene)
+    code, err = run("run", str(scene), "-o", str(out))
+    assert code == 1, err
+    assert "internal error: AttributeError" in err
+    assert f"full trace in {tmp_path}" in err
+    s = System("bug")
+    s.rigid_body("box", mass=1.0, inertia=(1, 1, 1, 0, 0, 0), position=(0, 0, 0))
+    with pytest.raises(AttributeError, match="no attribute 'start'"):
+        s.assemble()
+
+
+def test_a_section_that_is_not_one_is_refused():
+    """Once turned into an InputError by the API's catch-all of AttributeError (which also
+    hid bugs): now checked where it is given."""
+    from ancfdrv.errors import InputError
+    s = System("s")
+    s.material("steel", youngs_modulus=2.1e11, density=7850.0)
+    for call in ("beam", "cable"):
+        with pytest.raises(InputError, match=rf"&{call}\[b\] section: expected a section "
+                                             r"\(Rectangle, Box, Tube, Circle or General\), "
+                                             "got 5"):
+            getattr(s, call)("b", material="steel", start=(0, 0, 0), end=(1, 0, 0), nodes=3,
+                             section=5)
+
+
+@pytest.mark.parametrize("response", [("nope", 2), ("c", 3), 5])
+def test_assemble_refuses_a_response_of_no_probe(response):
+    from ancfdrv.errors import InputError
+    s = System("s")
+    s.rigid_body("box", mass=1.0, inertia=(1, 1, 1, 0, 0, 0), position=(0, 0, 0))
+    s.probe("c", "box", (0, 0, 0))
+    with pytest.raises(InputError, match=r"response must be \(probe name, component 0, 1 "
+                                         r"or 2\) of a probe of the system.*probes: c"):
+        s.assemble(response=response)

@@ -473,13 +473,14 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     path = Path(path)
     file = str(path)
     text = _read_text(path, file)
-    try:
-        nml = plain = fast_reads(text)
-        if nml is None:  # not one of the plain forms fast_reads reads
+    nml = plain = fast_reads(text)  # ours: None for what it does not read, never raises
+    if nml is None:  # not one of the plain forms fast_reads reads
+        try:
             nml = f90nml.reads(text)
-    except Exception as exc:  # f90nml raises several types
-        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
+        except Exception as exc:  # f90nml raises several types
+            message = str(exc).strip().splitlines()[0] if str(exc).strip() else \
+                type(exc).__name__
+            raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
     general = is_general(nml)
     repeatable = GENERAL_SCHEMA if general else ()
     # a plain namelist (fast_reads) has no key twice in a group (fast_reads refuses that):
