@@ -269,9 +269,11 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     model, pre-buckling deformation included). See the module doc and docs/theory.md.
     """
     if count < 1:
-        raise SolverError(f"buckling: modes = {count} must be at least 1")
+        raise InputError(f"buckling: modes = {count} must be at least 1", group="buckling",
+                         key="modes")
     if method not in ("linear", "nonlinear"):
-        raise SolverError(f"buckling: method {method!r} must be 'linear' or 'nonlinear'")
+        raise InputError(f"buckling: method {method!r} must be 'linear' or 'nonlinear'",
+                         group="buckling", key="method")
     if model.ndof != base_model.ndof or not np.array_equal(model.e0, base_model.e0):
         raise SolverError("buckling: the model with and without the reference loads differ "
                           "in their coordinates")
@@ -283,7 +285,8 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                          "small-strain stiffness has no geometric (initial-stress) part; "
                          "use formulation = 'nonlinear'", group="scene", key="formulation")
     if not reference_factor > 0:
-        raise SolverError(f"buckling: reference_factor = {reference_factor} must be positive")
+        raise InputError(f"buckling: reference_factor = {reference_factor} must be positive",
+                         group="buckling", key="reference_factor")
     start = time.perf_counter()
     timing: dict[str, float] = {}
     path = LoadPath(model, base_model, tol=tol, max_iter=max_iter, load_steps=load_steps)

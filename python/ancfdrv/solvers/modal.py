@@ -286,9 +286,11 @@ def modal_analysis(model: Model, count: int, *, static: StaticResult | None = No
     forces make the problem gyroscopic; see docs/theory.md).
     """
     if count < 1:
-        raise SolverError(f"modal analysis: modes = {count} must be at least 1")
+        raise InputError(f"modal analysis: modes = {count} must be at least 1", group="modal",
+                         key="modes")
     if solver not in ("auto", "dense", "sparse"):
-        raise SolverError(f"modal analysis: solver {solver!r} must be auto, dense or sparse")
+        raise InputError(f"modal analysis: solver {solver!r} must be auto, dense or sparse",
+                         group="modal", key="solver")
     start = time.perf_counter()
     timing: dict[str, float] = {}
     centrifugal = coriolis = None
