@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ancfdrv import System
-from ancfdrv.errors import SolverError
+from ancfdrv.errors import InputError
 from ancfdrv.solvers.buckling import buckling_analysis
 from ancfdrv.system.sections import Rectangle
 
@@ -99,7 +99,7 @@ def test_fixed_loads_stay_at_their_value():
 def test_ffr_is_refused():
     """The FFR beam's constant stiffness has no geometric part: refused, not a wrong 0."""
     model = column("fixed-free", formulation="ffr").assemble()
-    with pytest.raises(SolverError, match="ffr"):
+    with pytest.raises(InputError, match="&scene formulation: .*'ffr'"):
         buckling_analysis(model, model, 1)
 
 

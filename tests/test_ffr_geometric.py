@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 import pytest
 
-from ancfdrv.errors import SolverError
+from ancfdrv.errors import InputError
 from ancfdrv.runner import run_scene
 
 from conftest import INPUTS
@@ -60,7 +60,9 @@ def test_transverse_load_alone_is_unchanged(tmp_path):
 
 
 def test_split_iteration_refuses_it(tmp_path):
-    with pytest.raises(SolverError, match="static_method = 'newton'"):
+    """A configuration the split iteration cannot solve: bad input naming the key."""
+    with pytest.raises(InputError, match="&solver static_method: .*use "
+                                         "solver.static_method = 'newton'"):
         run_scene(INPUTS / "boom_luffing.nml", ["scene.analysis=static",
                   "beam.geometric_stiffness=true"], tmp_path / "b.h5", progress=False)
 

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ._version import __version__
-from .errors import AncfError, InputError, Interrupted
+from .errors import PROGRAMMING_ERRORS, AncfError, InputError, Interrupted
 
 EXIT_CODES = """exit status:
   0    success
@@ -152,7 +152,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     try:
         summary = read_summary(path)  # InputError (exit 2) when missing, not HDF5, not ours
         word, detail = verdict(path, summary)
-    except AncfError:
+    except (AncfError, *PROGRAMMING_ERRORS):
         raise
     except Exception as exc:  # noqa: BLE001 - a damaged file: exit 2 naming it
         raise corrupted(path, exc) from None
@@ -186,7 +186,7 @@ def _cmd_plot(args: argparse.Namespace) -> int:
             plot_results(paths, args.output)
     except (ValueError, KeyError, OSError) as exc:
         raise InputError(str(exc), file=", ".join(map(str, paths))) from None
-    except AncfError:
+    except (AncfError, *PROGRAMMING_ERRORS):
         raise
     except Exception as exc:  # noqa: BLE001 - a damaged file: exit 2 naming it
         raise corrupted(", ".join(map(str, paths)), exc) from None

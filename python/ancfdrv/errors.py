@@ -8,6 +8,13 @@ such as ``max_iter=0`` is an :class:`InputError` with the namelist's message."""
 from __future__ import annotations
 
 
+#: exceptions only a mistake in the package's own code raises, whatever the input: the doors
+#: that report a damaged file's exceptions (of any type) as bad input let these through, so
+#: a bug surfaces as an internal error (exit 1), not as a damaged file (exit 2)
+PROGRAMMING_ERRORS = (NameError, ImportError, AssertionError, NotImplementedError,
+                      SyntaxError)
+
+
 class AncfError(Exception):
     """Base class of every error ancfdrv raises on purpose."""
 
@@ -25,6 +32,8 @@ class InputError(AncfError):
     def __init__(self, message: str, *, file: str | None = None, group: str | None = None,
                  key: str | None = None) -> None:
         self.file, self.group, self.key = file, group, key
+        #: the message without the place (file, group, key) it is prefixed with
+        self.reason = message
         where = []
         if file:
             where.append(str(file))

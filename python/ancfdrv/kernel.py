@@ -11,8 +11,8 @@ import numpy as np
 from dataclasses import dataclass
 
 from . import _kernel
-from .codes import (CONTACT_RECORD, DRIVE_TABLE, ENERGY_NAMES, POWER_NAMES, SECTION_BOX,
-                    SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE)
+from .codes import (CONTACT_RECORD, DRIVE_HERMITE, DRIVE_TABLE, ENERGY_NAMES, POWER_NAMES,
+                    SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE)
 from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
@@ -323,7 +323,8 @@ def reduced_ffr_newmark(dt: float, beta: float, gamma: float, omega2, gyroscopic
 def drive_values(kind: int, params, t):
     """phi, phi', phi'' of a drive at the times t (params: its parameters, any length)."""
     p = np.asarray(params, dtype=float).ravel()
-    if kind != DRIVE_TABLE and p.size < 8:  # unused trailing parameters are zero
+    # unused trailing parameters of the fixed layouts are zero; a table's length is its data
+    if kind not in (DRIVE_TABLE, DRIVE_HERMITE) and p.size < 8:
         p = np.concatenate([p, np.zeros(8 - p.size)])
     if p.size == 0:
         p = np.zeros(1)

@@ -40,7 +40,7 @@ from .builders import build_model, settle_mode, stage_bounds
 from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
-from .solvers.static import StaticResult, solve_newton, solve_static
+from .solvers.static import StaticResult, check_split, solve_newton, solve_static
 
 if TYPE_CHECKING:
     from .results.memory import MemoryOutput
@@ -520,9 +520,12 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
     try:
         check_reduction(scene, model)
-    except InputError:
+        if analysis in ("static", "static+dynamic") and \
+                scene["solver"]["static_method"] == "split":
+            check_split(model)  # before the output is touched
+    except InputError as exc:
         model.close()
-        raise
+        raise locate_error(exc, scene) from None
     static = dynamic = None
     stages: dict[str, float] = {}
 
@@ -580,6 +583,10 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
         except KeyboardInterrupt:  # no handler installed (not the main thread)
             finish("interrupted", "interrupted (KeyboardInterrupt)")
             raise
+        except InputError as exc:  # found by a solver (e.g. a modal analysis of nothing)
+            located = locate_error(exc, scene)
+            finish("failed", str(located))
+            raise located from None
         except AncfError as exc:
             finish("failed", str(exc))
             raise

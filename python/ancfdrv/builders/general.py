@@ -226,6 +226,8 @@ def locate_error(exc: InputError, scene) -> InputError:
     ...`` or an equation name ``lift: position``, ``lift #2: ...``)."""
     if exc.file is not None:
         return exc
+    if exc.group is not None:  # placed by whoever raised it (e.g. &solver static_method)
+        return InputError(exc.reason, file=str(scene.path), group=exc.group, key=exc.key)
     message = str(exc)
     group = None
     if scene.kind == "general":

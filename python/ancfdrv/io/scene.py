@@ -461,17 +461,17 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     # a plain namelist (fast_reads) has every group ended before the next one starts and no
     # key twice in a group (fast_reads declines both): any other text is scanned
     groups = None
-    try:
-        nml = plain = fast_reads(text)
-        if nml is None:  # not one of the plain forms fast_reads reads
-            groups = validate.scan_groups(text)
+    nml = plain = fast_reads(text)  # ours: None for what it does not read, never raises
+    if nml is None:  # not one of the plain forms fast_reads reads
+        groups = validate.scan_groups(text)
+        try:
             nml = f90nml.reads(text)
-    except Exception as exc:  # f90nml raises several types
-        if groups and all(g.ended for g in groups[:-1]) and not groups[-1].ended:
-            validate.check_ended(file, groups)  # the text ends inside its last group
-        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
-    if groups is not None:
+        except Exception as exc:  # f90nml raises several types
+            if groups and all(g.ended for g in groups[:-1]) and not groups[-1].ended:
+                validate.check_ended(file, groups)  # the text ends inside its last group
+            message = str(exc).strip().splitlines()[0] if str(exc).strip() else \
+                type(exc).__name__
+            raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
         validate.check_ended(file, groups)
     general = is_general(nml)
     repeatable = GENERAL_SCHEMA if general else ()

@@ -31,11 +31,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SolverError
+from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
 from ..kernel import DirectSolver
 from ..system.model import Model
-from .modal import DENSE_LIMIT, linearize, null_space
+from .modal import DENSE_LIMIT, check_free, linearize, null_space
 from .static import StaticResult
 from .._lazy import LazyModule
 
@@ -291,10 +291,16 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     if model.ndof != base_model.ndof or not np.array_equal(model.e0, base_model.e0):
         raise SolverError("buckling: the model with and without the reference loads differ "
                           "in their coordinates")
+    if not model.sets:
+        raise InputError("buckling: the model has no flexible body (beam, cable, plate or "
+                         "leaf); rigid bodies do not buckle", group="scene", key="analysis")
     if all(s.kind == "ffr" for s in model.sets):
-        raise SolverError("buckling: every beam has the 'ffr' formulation, whose constant "
-                          "small-strain stiffness has no geometric (initial-stress) part; "
-                          "use formulation = 'nonlinear'")
+        raise InputError("buckling: every beam has the 'ffr' formulation, whose constant "
+                         "small-strain stiffness has no geometric (initial-stress) part; "
+                         "use formulation = 'nonlinear'", group="scene", key="formulation")
+    if not reference_factor > 0:
+        raise InputError(f"buckling: reference_factor = {reference_factor} must be positive",
+                         group="buckling", key="reference_factor")
     start = time.perf_counter()
     timing: dict[str, float] = {}
     path = LoadPath(model, base_model, tol=tol, max_iter=max_iter, load_steps=load_steps)
@@ -303,6 +309,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     k0 = path.tangent()
     g = path.constraints()
     free = model.ndof - g.shape[0]
+    check_free("buckling", free)
     how = solver if solver != "auto" else ("dense" if free <= DENSE_LIMIT else "sparse")
     mass = model.mass_matrix()
     track = max(count, 1)

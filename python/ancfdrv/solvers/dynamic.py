@@ -44,7 +44,7 @@ import numpy as np
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
                      JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES)
 from ..csr import Csr
-from ..errors import Interrupted, SolverError
+from ..errors import InputError, Interrupted, SolverError
 from ..io.validate import check_arguments, check_state
 from ..kernel import DirectSolver, dense_solve
 from ..kernel import _text as kernel_text
@@ -103,7 +103,8 @@ class DynamicSettings:
         alpha_f, beta = (1 - alpha_m + alpha_f)^2 / 4 (second order, unconditionally stable,
         high frequencies damped to rho_inf per step)."""
         if not 0.0 <= rho_inf <= 1.0:
-            raise SolverError(f"rho_inf = {rho_inf} outside [0, 1]")
+            raise InputError(f"rho_inf = {rho_inf} outside [0, 1]", group="solver",
+                             key="rho_inf")
         alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
         alpha_f = rho_inf / (rho_inf + 1.0)
         gamma = 0.5 - alpha_m + alpha_f
@@ -118,8 +119,8 @@ class DynamicSettings:
     @property
     def jacobian_code(self) -> int:
         if self.jacobian not in JACOBIAN_POLICIES:
-            raise SolverError(f"jacobian policy {self.jacobian!r} must be one of "
-                              f"{', '.join(JACOBIAN_POLICIES)}")
+            raise InputError(f"jacobian policy {self.jacobian!r} must be one of "
+                             f"{', '.join(JACOBIAN_POLICIES)}", group="solver", key="jacobian")
         return JACOBIAN_POLICIES[self.jacobian]
 
 
@@ -276,7 +277,8 @@ class TimeIntegrator:
 
     def __init__(self, model: Model, settings: DynamicSettings) -> None:
         if settings.dt <= 0:
-            raise SolverError(f"time step dt = {settings.dt} must be positive")
+            raise InputError(f"time step dt = {settings.dt} must be positive", group="solver",
+                             key="dt")
         model.check_alive()
         settings.jacobian_code  # validates the policy  # noqa: B018
         self.model, self.settings = model, settings
@@ -292,7 +294,8 @@ class TimeIntegrator:
         the start of a run. The kernel's stepper gets the run's settings and forgets what it
         learned in earlier runs, so runs are reproducible."""
         if self.settings.carry not in ("rotation", "off"):
-            raise SolverError(f"carry {self.settings.carry!r} must be 'rotation' or 'off'")
+            raise InputError(f"carry {self.settings.carry!r} must be 'rotation' or 'off'",
+                             group="solver", key="carry")
         self.model.kernel.set_carry(self.model.carry_vectors()
                                     if self.settings.carry == "rotation" else None)
         self.model.kernel.stepper_setup(self.settings)
@@ -671,7 +674,8 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     start = time.perf_counter()
     timing = {"setup": 0.0, "stepping": 0.0, "output": 0.0}
     if settings.t_end < t0:
-        raise SolverError(f"t_end = {settings.t_end} lies before the start time {t0}")
+        raise InputError(f"t_end = {settings.t_end} lies before the start time {t0}",
+                         group="solver", key="t_end")
     v0 = np.zeros(model.ndof) if v0 is None else v0
     integrator = TimeIntegrator(model, settings)
     a0, lam0 = initial_acceleration(model, e0, v0, t0) if initial is None else initial
@@ -692,7 +696,8 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     # the first call measures a step's cost
     call_steps = min(settings.chunk_steps, 10, row_cap)
     if settings.step not in ("fixed", "adaptive"):
-        raise SolverError(f"solver.step = {settings.step!r} must be 'fixed' or 'adaptive'")
+        raise InputError(f"step {settings.step!r} must be 'fixed' or 'adaptive'",
+                         group="solver", key="step")
     control = StepControl(settings)
     energy_watch = EnergyWatch(first.energy[0])
     failed = np.zeros(3, dtype=np.int64)  # work of failed tries before a row's interval

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SolverError
+from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
 from ..kernel import DirectSolver
 from ..system.model import Model
@@ -252,9 +252,9 @@ def steady_rotation_matrices(model: Model, rate: float, axis) -> tuple[sp.csr_ma
     a = a / np.linalg.norm(a)
     mbar = kron_scalar(model.mass)
     if mbar is None:
-        raise SolverError("modal analysis about a steady rotation needs a mass matrix of "
-                          "3 x 3 blocks c I3 (the coordinates of every body are position "
-                          "vectors); this model's is not")
+        raise InputError("modal analysis about a steady rotation needs a mass matrix of "
+                         "3 x 3 blocks c I3 (the coordinates of every body are position "
+                         "vectors); this model's is not", group="modal", key="spin_rate")
     mbar = mbar.to_scipy()
     proj = np.eye(3) - np.outer(a, a)
     skew = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
@@ -268,6 +268,16 @@ def steady_rotation_matrices(model: Model, rate: float, axis) -> tuple[sp.csr_ma
 MODAL_KEYWORDS = {"modes": "modal", "solver": "modal", "rigid_tol": "modal",
                   "spin_rate": "modal", "spin_axis": "modal", "spin_centre": "modal",
                   "tol": "solver", "max_iter": "solver", "load_steps": "solver"}
+
+
+def check_free(what: str, free: int) -> None:
+    """Refuse an eigenproblem without a free coordinate (the joints hold every one: no
+    mode), an InputError naming scene.analysis."""
+    if free < 1:
+        raise InputError(f"{what}: the joints hold every coordinate of the model, so nothing "
+                         "can move and there is no mode; analyse it statically "
+                         "(scene.analysis = 'static') for its reactions", group="scene",
+                         key="analysis")
 
 
 def modal_analysis(model: Model, count: int, *, static: StaticResult | None = None,
@@ -314,6 +324,11 @@ def modal_analysis(model: Model, count: int, *, static: StaticResult | None = No
     timing["assembly"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     free = model.ndof - lin.constraints.shape[0]
+    check_free("modal analysis", free)
+    if solver == "sparse" and free < 2:  # ARPACK finds at most free - 1 modes
+        raise InputError("modal analysis: the model has 1 free coordinate, too few for the "
+                         "sparse eigensolver (ARPACK); use solver = 'dense' (or 'auto')",
+                         group="modal", key="solver")
     method = solver if solver != "auto" else ("dense" if free <= DENSE_LIMIT else "sparse")
     scale = stiffness_scale(lin)
     quadratic = None

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import SolverError
+from ..errors import InputError, SolverError
 from ..io.validate import check_arguments
 from ..kernel import DirectSolver
 from ..system.model import Model
@@ -388,6 +388,30 @@ def _force_jet(model: Model, rel: np.ndarray, d: Jet, lam: np.ndarray, nd: int) 
     return out
 
 
+def check_split(model: Model) -> None:
+    """Refuse a model the split iteration cannot solve (InputError naming
+    solver.static_method: a configuration the user chose, not a failed solve)."""
+    def refuse(why: str) -> None:
+        raise InputError(f"the split iteration {why}; use solver.static_method = 'newton'",
+                         group="solver", key="static_method")
+    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
+        refuse("needs the constant stiffness of the 'ffr' formulation (every body) without "
+               "contact")
+    if any(s.second_order is not None for s in model.sets):
+        refuse("needs the constant stiffness of the 'ffr' formulation; "
+               "beam.geometric_stiffness makes it depend on the axial force")
+    if model.vector_loads:
+        refuse("takes dead loads only; driven moments, follower loads and a rigid body's "
+               "moments are not")
+    if model.force_elements:
+        refuse("needs a constant stiffness; force elements (spring-dampers, bushings, "
+               "cylinders) have none")
+    dep = np.asarray(model.constraints.dependent, dtype=int)
+    if len(set(dep.tolist())) != len(model.constraints):
+        refuse("needs a dependent coordinate of its own per constraint; two constraints of "
+               "this model share one")
+
+
 def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: float = 0.0,
                 inner_tol: float = 1e-13, max_inner: int = 200) -> StaticResult:
     """The split iteration of seed 000 with re-expansion until convergence (module doc).
@@ -402,30 +426,14 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     check_arguments("solve_split", tol=tol, max_iter=max_iter, p=p, inner_tol=inner_tol,
                     max_inner=max_inner)
     if not 0.0 <= p < 1.0:
-        raise SolverError(f"split iteration: p = {p} outside [0, 1)")
-    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
-        raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
-                          "formulation (every body) without contact; use "
-                          "solver.static_method = 'newton'")
-    if any(s.second_order is not None for s in model.sets):
-        raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
-                          "formulation; beam.geometric_stiffness makes it depend on the axial "
-                          "force: use solver.static_method = 'newton'")
-    if model.vector_loads:
-        raise SolverError("the split iteration takes dead loads only; driven moments, "
-                          "follower loads and a rigid body's moments need "
-                          "solver.static_method = 'newton'")
-    if model.force_elements:
-        raise SolverError("the split iteration needs a constant stiffness; force elements "
-                          "(spring-dampers, bushings, cylinders) need solver.static_method = "
-                          "'newton'")
+        raise InputError(f"split iteration: p = {p} outside [0, 1)", group="solver",
+                         key="split_p")
+    check_split(model)
     model.require_runnable()
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)
     dep = np.array(model.constraints.dependent, dtype=int)
-    if len(set(dep.tolist())) != ncon:
-        raise SolverError("split iteration: two constraints share a dependent coordinate")
     rest = np.setdiff1d(np.arange(n), dep)
     nd, m = len(dep), len(dep) + ncon
     touched = set(model.constraints.touched().tolist()) | {
@@ -442,22 +450,24 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     k_dr, k_dd = k_d.take_columns(rest), k_d.take_columns(dep).toarray()
     constant = model.constant_force()
     timing["assembly"] += time.perf_counter() - t0
-    with DirectSolver(len(rest), k_rr.row_index(), k_rr.indices,
-                      what="split iteration K_RR") as solver:
-        try:
-            t0 = time.perf_counter()
-            solver.factorize(k_rr.data)
-            timing["factorization"] += time.perf_counter() - t0
-            t0 = time.perf_counter()
-            columns = np.zeros((len(rest), 1 + nl + nd))
-            columns[:, 0] = constant[rest]
-            columns[local, 1 + np.arange(nl)] = 1.0
-            columns[:, 1 + nl:] = k_rd
-            solved = solver.solve(columns)
-            timing["solve"] += time.perf_counter() - t0
-        finally:
-            model.counters["factorizations"] += solver.factorizations
-            model.counters["solves"] += solver.solves
+    solved = np.zeros((0, 1 + nl + nd))  # the constraints hold every coordinate: no e_R
+    if len(rest):
+        with DirectSolver(len(rest), k_rr.row_index(), k_rr.indices,
+                          what="split iteration K_RR") as solver:
+            try:
+                t0 = time.perf_counter()
+                solver.factorize(k_rr.data)
+                timing["factorization"] += time.perf_counter() - t0
+                t0 = time.perf_counter()
+                columns = np.zeros((len(rest), 1 + nl + nd))
+                columns[:, 0] = constant[rest]
+                columns[local, 1 + np.arange(nl)] = 1.0
+                columns[:, 1 + nl:] = k_rd
+                solved = solver.solve(columns)
+                timing["solve"] += time.perf_counter() - t0
+            finally:
+                model.counters["factorizations"] += solver.factorizations
+                model.counters["solves"] += solver.solves
     u0, z, y = solved[:, 0], solved[:, 1:1 + nl], solved[:, 1 + nl:]
     kdr_u0, kdr_z, kdr_y = k_dr @ u0, k_dr @ z, k_dr @ y
     dd_grad = np.zeros((nd, m))
@@ -543,4 +553,5 @@ def solve_static(model: Model, method: str, *, tol: float, max_iter: int,
         return solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
     if method == "split":
         return solve_split(model, tol=tol, max_iter=max_iter, p=p)
-    raise SolverError(f"unknown static method {method!r}")
+    raise InputError(f"static_method {method!r} must be 'split' or 'newton'", group="solver",
+                     key="static_method")

@@ -120,24 +120,16 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     owners: dict[str, str] = {}
     equations = _equations(system, bodies, q0, notes, warnings, owners)
     linear = [eq for eq in equations if isinstance(eq, LinearEquation)]
-    reduction = None
-    if planar_eqs:  # the planar fixes are eliminated whatever the joints' mode (planar.py)
-        elimination = eliminate(planar_eqs + (linear if mode == "eliminate" else []), q0)
-        notes += [f"redundant joint equation dropped: {name}" for name in elimination.redundant
-                  if ": planar" not in name]
-        reduction = reduction_plan(nfull, elimination, q0, full_pattern)
-        constraints_eq = [eq for eq in equations if isinstance(eq, Constraint)] \
-            if mode == "eliminate" else \
-            [_as_constraint(eq) if isinstance(eq, LinearEquation) else eq for eq in equations]
-    elif mode == "eliminate" and linear:
-        elimination = eliminate(linear, q0)
-        notes += [f"redundant joint equation dropped: {name}" for name in elimination.redundant]
-        reduction = reduction_plan(nfull, elimination, q0, full_pattern)
-        constraints_eq = [eq for eq in equations if isinstance(eq, Constraint)]
-    else:
-        elimination = Elimination({}, [])
-        constraints_eq = [_as_constraint(eq) if isinstance(eq, LinearEquation) else eq
-                          for eq in equations]
+    elimination, reduction, constraints_eq, dropped = _linear_joints(
+        mode, equations, linear, planar_eqs, q0, full_pattern)
+    if reduction is not None and not len(reduction.independent) and mode == "eliminate":
+        # the joints hold every coordinate (a locked body): the kernel solves no system of
+        # size 0, so the linear joints are kept with multipliers (their reactions follow)
+        mode = "multipliers"
+        notes.append("the joints hold every coordinate: linear joints kept with multipliers")
+        elimination, reduction, constraints_eq, dropped = _linear_joints(
+            mode, equations, linear, planar_eqs, q0, full_pattern)
+    notes += dropped
     ndof = nfull if reduction is None else len(reduction.independent)
     column = np.arange(nfull) if reduction is None else _columns(nfull, reduction)
     e0 = q0 if reduction is None else q0[reduction.independent].copy()
@@ -717,6 +709,31 @@ def _columns(nfull: int, reduction) -> np.ndarray:
     column = -np.ones(nfull, dtype=np.int64)
     column[reduction.independent] = np.arange(len(reduction.independent))
     return column
+
+
+def _linear_joints(mode: str, equations: list, linear: list[LinearEquation],
+                   planar_eqs: list[LinearEquation], q0: np.ndarray, full_pattern: Pattern):
+    """The linear joint equations eliminated (mode 'eliminate') or kept as constraints
+    with multipliers, the planar fixes eliminated whatever the mode (planar.py): the
+    elimination, the reduction (None: nothing eliminated), the equations kept as
+    constraints and the notes of the redundant equations dropped."""
+    if planar_eqs:
+        elimination = eliminate(planar_eqs + (linear if mode == "eliminate" else []), q0)
+        notes = [f"redundant joint equation dropped: {name}" for name in elimination.redundant
+                 if ": planar" not in name]
+        reduction = reduction_plan(len(q0), elimination, q0, full_pattern)
+        kept = [eq for eq in equations if isinstance(eq, Constraint)] \
+            if mode == "eliminate" else \
+            [_as_constraint(eq) if isinstance(eq, LinearEquation) else eq for eq in equations]
+        return elimination, reduction, kept, notes
+    if mode == "eliminate" and linear:
+        elimination = eliminate(linear, q0)
+        notes = [f"redundant joint equation dropped: {name}" for name in elimination.redundant]
+        reduction = reduction_plan(len(q0), elimination, q0, full_pattern)
+        return elimination, reduction, [eq for eq in equations if isinstance(eq, Constraint)], \
+            notes
+    return Elimination({}, []), None, [_as_constraint(eq) if isinstance(eq, LinearEquation)
+                                       else eq for eq in equations], []
 
 
 def _constraint_set(equations: list[Constraint], elimination: Elimination, column: np.ndarray,

@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .bodies import Beam, Ground, RigidBody
+from .bodies import Beam, RigidBody
 from .expressions import Scalar
 from .joints import LinearEquation
 
@@ -85,12 +85,13 @@ def _normal_to(v: np.ndarray, j: int) -> bool:
 
 
 def body_plane(body, j: int) -> float | None:
-    """The j-coordinate of a body's plane (None: the ground, anything)."""
-    if isinstance(body, Ground):
-        return None
+    """The j-coordinate of a body's plane (None: the ground, anything; a plate or a leaf,
+    which is not reduced and refused as such by :func:`planar_problems`)."""
     if isinstance(body, RigidBody):
         return float(body.centre[j])
-    return float(body.start[j])
+    if isinstance(body, (Beam, _cable_type())):
+        return float(body.start[j])
+    return None
 
 
 def planar_problems(system, j: int, loads=None) -> list[str]:
@@ -131,8 +132,10 @@ def planar_problems(system, j: int, loads=None) -> list[str]:
                 out.append(f"{where}: it is planar with the normal {'xyz'[body.plane_axis]}, "
                            f"not {plane}")
         else:
-            out.append(f"{where}: planar reduction covers beams, cables and rigid bodies, not "
-                       f"a {type(body).__name__.lower()}")
+            kind = type(body).__name__.lower()
+            out.append(f"{where}: {'leaves' if kind == 'leaf' else kind + 's'} cannot be "
+                       "reduced to a plane (the planar reduction covers beams, cables and "
+                       f"rigid bodies): remove scene.planar or the {kind} {body.name!r}")
     for joint in system.joints.values():
         where = f"joint {joint.name!r}"
         turning = joint.type in ("revolute", "arm", "hub") or (

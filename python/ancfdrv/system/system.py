@@ -68,8 +68,8 @@ def _api(method):
     def call(self, *args, **kwargs):
         try:
             return method(self, *args, **kwargs)
-        except (TypeError, ValueError, AttributeError, KeyError, IndexError, ZeroDivisionError,
-                OverflowError, FloatingPointError) as exc:
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError,
+                FloatingPointError) as exc:
             item = args[0] if args and isinstance(args[0], str) else ""
             label = f"{method.__name__}[{item}]" if item else method.__name__
             text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
@@ -78,6 +78,14 @@ def _api(method):
             raise InputError("not enough memory to build this item: use a coarser mesh",
                              group=method.__name__) from None
     return call
+
+
+def _section(section, label: str) -> Section | None:
+    """The section of a beam or cable call (InputError naming the key for anything else)."""
+    if section is not None and not isinstance(section, Section):
+        raise InputError("expected a section (Rectangle, Box, Tube, Circle or General), got "
+                         f"{short_repr(section)}", group=label, key="section")
+    return section
 
 
 def _points(value) -> list[np.ndarray]:
@@ -200,7 +208,7 @@ class System:
         nodes = v["nodes"]
         self._check_size(validate.Part(f"beam[{name}]", "nodes", "beam", nodes, 12))
         return self._add_body(Beam(name, self._material(material, where), start, end, nodes,
-                                   section, height_axis=height_axis, formulation=formulation,
+                                   _section(section, f"beam[{name}]"), height_axis=height_axis, formulation=formulation,
                                    bending=bending, segments=segments,
                                    frame_drive=self._drive(frame_drive, where),
                                    frame_axis=frame_axis, frame_pivot=frame_pivot,
@@ -220,7 +228,8 @@ class System:
         cable kept in a plane bends about (the system must then be planar)."""
         name = self._body_name(name)
         return self._add_body(Cable(name, self._material(material, f"cable {name!r}"), start,
-                                    end, nodes, section, tension_only=tension_only,
+                                    end, nodes, _section(section, f"cable[{name}]"),
+                                    tension_only=tension_only,
                                     bending_stiffness=bending_stiffness, segments=segments,
                                     bending_inertia=bending_inertia))
 
@@ -598,7 +607,6 @@ class System:
             out.add("prestress")
         return out
 
-    @_api
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
                  check_frames: bool = True, unused_effects: str | None = None,
                  bounds: str | None = None, warnings: Iterable[str] = (),
@@ -637,13 +645,30 @@ class System:
                 if unused_effects == "refuse":
                     raise
                 unused_note = str(exc).split(": ", 1)[1]
+        if bounds not in (None, "check", "off"):
+            raise InputError(f"bounds must be 'check' or 'off', got {short_repr(bounds)}")
+        if isinstance(warnings, str) or not isinstance(warnings, Iterable) or \
+                not all(isinstance(w, str) for w in warnings):
+            raise InputError(f"warnings must be a list of texts, got {short_repr(warnings)}")
+        if response is not None and not (
+                isinstance(response, tuple) and len(response) == 2 and
+                response[0] in self.probes and response[1] in (0, 1, 2)):
+            raise InputError(f"response must be (probe name, component 0, 1 or 2) of a probe "
+                             f"of the system, got {short_repr(response)} (probes: "
+                             f"{', '.join(self.probes) or 'none'})")
         if (bounds or self.bounds) == "check":
             self.check_bounds()
         validate.check_resources(validate.Estimate(self._parts(), contact_points=sum(
             2 * c.points for c in self.contacts.values())), None, None, "static")
-        model = assemble(self, tuple(chosen) if chosen is not None else None,
-                         linear_joints=linear_joints, check_frames=check_frames,
-                         warnings=warnings, response=response, supports=supports)
+        # no door here: the items passed theirs, so an exception of the assembly other
+        # than the package's own is a bug and surfaces as one
+        try:
+            model = assemble(self, tuple(chosen) if chosen is not None else None,
+                             linear_joints=linear_joints, check_frames=check_frames,
+                             warnings=list(warnings), response=response, supports=supports)
+        except MemoryError:
+            raise InputError("not enough memory to assemble this model: use a coarser mesh",
+                             group="assemble") from None
         if unused_note:  # not silent: the run prints it, a script sees a UserWarning
             import warnings as _warnings
             model.warnings.append(unused_note)
