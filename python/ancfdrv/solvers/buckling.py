@@ -35,7 +35,7 @@ from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
 from ..kernel import DirectSolver
 from ..system.model import Model
-from .modal import DENSE_LIMIT, check_free, linearize, null_space
+from .modal import DENSE_LIMIT, arpack_start, check_free, linearize, null_space
 from .static import StaticResult
 from .._lazy import LazyModule
 
@@ -97,7 +97,7 @@ def _sparse(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int, tol: f
             return solver.solve(y)
         op = spla.LinearOperator((n + ncon, n + ncon), matvec=matvec, dtype=float)
         k = min(count + 4, n + ncon - 2)
-        theta, z = spla.eigs(op, k=k, which="LR", tol=tol)
+        theta, z = spla.eigs(op, k=k, which="LR", tol=tol, **arpack_start(matvec, n + ncon, 1))
     except spla.ArpackNoConvergence as exc:
         raise SolverError(f"buckling: ARPACK did not converge ({exc})") from None
     finally:
@@ -207,8 +207,8 @@ def _lowest(k: sp.spmatrix, m: sp.spmatrix, g: sp.spmatrix, method: str,
     try:
         solver.factorize(shifted.data)
         op = spla.LinearOperator((n + ncon, n + ncon), matvec=solver.solve, dtype=float)
-        v0 = solver.solve(b @ np.random.default_rng(1).standard_normal(n + ncon))
-        w, z = spla.eigsh(aug, k=count, M=b, sigma=sigma, OPinv=op, which="LM", v0=v0)
+        w, z = spla.eigsh(aug, k=count, M=b, sigma=sigma, OPinv=op, which="LM",
+                          **arpack_start(lambda r: solver.solve(b @ r), n + ncon, 1))
     finally:
         solver.close()
     order = np.argsort(w)

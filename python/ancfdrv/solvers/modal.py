@@ -34,7 +34,9 @@ limit) is reported as a negative frequency -sqrt(-omega^2) / 2 pi.
 """
 from __future__ import annotations
 
+import inspect
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -212,6 +214,22 @@ def _dense_modes(lin: Linearization, count: int, spin_gyro: sp.spmatrix | None):
     return result
 
 
+def arpack_start(apply: Callable[[np.ndarray], np.ndarray], size: int,
+                 seed: int) -> dict[str, object]:
+    """ARPACK's start, the same in every run: ``v0 = apply(r)`` for a normal vector r of a
+    generator seeded with ``seed`` (``apply`` the operator: v0 in its range, e.g. no
+    component along the multipliers' infinite eigenvalues; a random r is orthogonal to no
+    mode, unlike a vector of ones to a symmetric structure's antisymmetric modes), and that
+    generator for ARPACK's restarts. scipy >= 1.17 (ARPACK in C) takes it as ``rng`` and
+    without it draws both from OS entropy, so the eigenvalues differed in their last digits
+    from run to run; the Fortran ARPACK of older scipy restarts from its own fixed seed."""
+    rng = np.random.default_rng(seed)
+    start: dict[str, object] = {"v0": apply(rng.standard_normal(size))}
+    if "rng" in inspect.signature(spla.eigs).parameters:
+        start["rng"] = rng
+    return start
+
+
 def _sparse_modes(lin: Linearization, count: int, shift: float, tol: float):
     """Shift-invert Lanczos on the multiplier form (module doc)."""
     n, ncon = lin.stiffness.shape[0], lin.constraints.shape[0]
@@ -226,12 +244,8 @@ def _sparse_modes(lin: Linearization, count: int, shift: float, tol: float):
         op = spla.LinearOperator((n + ncon, n + ncon), matvec=lambda x: solver.solve(x),
                                  dtype=float)
         count = min(count, n - ncon - 1)  # ARPACK needs k below the free dimension
-        # a start vector in the range of the operator: no component along the
-        # infinite-eigenvalue (multiplier) directions
-        rng = np.random.default_rng(12345)
-        v0 = solver.solve(b @ rng.standard_normal(n + ncon))
         w2, z = spla.eigsh(a, k=count, M=b, sigma=shift, OPinv=op, which="LM", tol=tol,
-                           v0=v0)
+                           **arpack_start(lambda r: solver.solve(b @ r), n + ncon, 12345))
         factorizations = solver.factorizations
     except spla.ArpackNoConvergence as exc:
         raise SolverError(f"modal analysis: ARPACK did not converge ({exc})") from None
