@@ -12,7 +12,7 @@ A run from Python goes through the very path of ``ancf run`` (:func:`ancfdrv.run
 the same solvers, settings, writer and status handling), with the CLI's defaults: every key
 of the scene groups ``&solver`` and ``&output`` is a keyword with the schema's default
 (``docs/scenes.md``), e.g. ``jacobian='reuse'``, ``integrator='newmark'``,
-``static_method='split'``. The run writes its HDF5 file to a temporary directory (or to
+``static_method='auto'``. The run writes its HDF5 file to a temporary directory (or to
 ``output=``); the :class:`~ancfdrv.results.Results` object is read back from that file
 (:func:`ancfdrv.results.open_results`).
 
@@ -104,12 +104,6 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
     chosen = effects if effects is not None else system.effects
     model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
                             linear_joints=solver["linear_joints"], supports=True)
-    if "static_method" not in options and (any(s.kind != "ffr" for s in model.sets)
-                                           or model.contact_pairs or model.vector_loads):
-        # the CLI's default 'split' needs every body 'ffr', no contact and dead loads only
-        # (no driven or follower load, no rigid body's moment): where it cannot run (it
-        # would fail with that message), Newton is the only static method
-        solver["static_method"] = "newton"
     try:
         formulations = sorted({getattr(b, "formulation", "") for b in system.bodies.values()
                                if getattr(b, "formulation", "")})

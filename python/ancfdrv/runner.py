@@ -271,6 +271,21 @@ def check_reduction(scene: Scene, model: Model) -> None:
         raise _reduction_error(scene, beam, str(exc)) from None
 
 
+def check_static_method(scene: Scene, model: Model) -> None:
+    """Refuse, before anything is computed, ``solver.static_method = 'split'`` on a scene
+    the split iteration cannot solve (InputError naming the key and why; 'auto', the
+    default, takes Newton there)."""
+    if scene["scene"]["analysis"] not in ("static", "static+dynamic") \
+            or scene["solver"]["static_method"] != "split":
+        return
+    from .solvers.static import split_obstacle
+    why = split_obstacle(model)
+    if why is not None:
+        raise InputError(f"'split' cannot solve this scene: {why}; use 'newton' or 'auto' "
+                         "(the default: 'split' where it applies, else 'newton')",
+                         file=str(scene.path), group="solver", key="static_method")
+
+
 def _run_reduced(scene: Scene, model: Model, out: Path | MemoryOutput, static: StaticResult,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
@@ -520,6 +535,7 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
     try:
         check_reduction(scene, model)
+        check_static_method(scene, model)
     except InputError:
         model.close()
         raise

@@ -603,7 +603,7 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str, kind: str) 
                              f"{', '.join(EFFECTS_AVAILABLE)}", file=file, group="scene",
                              key="effects")
     if scene["formulation"] == "nonlinear" and scene["analysis"] in ("static", "static+dynamic"):
-        if values["solver"]["static_method"] != "newton":
+        if values["solver"]["static_method"] == "split":
             raise InputError("formulation 'nonlinear' needs static_method = 'newton' (the split "
                              "iteration relies on the constant FFR stiffness)", file=file,
                              group="solver", key="static_method")

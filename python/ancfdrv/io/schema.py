@@ -263,8 +263,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "pressure": Key("float", 0.0, doc="plate: dead pressure along -r3 (Pa)"),
     },
     "solver": {
-        "static_method": Key("str", "split", one_of("split", "newton"),
-                             "static solver: split iteration or Newton-Raphson"),
+        "static_method": Key("str", "auto", one_of("auto", "split", "newton"),
+                             "static solver: 'split' (the split iteration of seed 000: "
+                             "'ffr' bodies, dead loads, no force element, no contact), "
+                             "'newton' (Newton-Raphson, any scene), 'auto' (default: "
+                             "'split' where it applies, 'newton' otherwise; /static "
+                             "attributes method and method_setting record the choice)"),
         "tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                    "relative tolerance of the static solve"),
         "max_iter": Key("int", 50, positive, "iteration limit of the static solve"),

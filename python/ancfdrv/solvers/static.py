@@ -388,6 +388,25 @@ def _force_jet(model: Model, rel: np.ndarray, d: Jet, lam: np.ndarray, nd: int) 
     return out
 
 
+def split_obstacle(model: Model) -> str | None:
+    """Why the split iteration cannot solve ``model`` (it needs the constant FFR stiffness
+    and dead loads only), or None when it can: what ``static_method = 'auto'`` chooses by,
+    and why an explicit 'split' is refused."""
+    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
+        return ("the split iteration needs the constant stiffness of the 'ffr' formulation "
+                "(every body) without contact")
+    if any(s.second_order is not None for s in model.sets):
+        return ("the split iteration needs the constant stiffness of the 'ffr' formulation; "
+                "beam.geometric_stiffness makes it depend on the axial force")
+    if model.vector_loads:
+        return ("the split iteration takes dead loads only; driven moments, follower loads "
+                "and a rigid body's moments are not")
+    if model.force_elements:
+        return ("the split iteration needs a constant stiffness; force elements "
+                "(spring-dampers, bushings, cylinders) are not")
+    return None
+
+
 def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: float = 0.0,
                 inner_tol: float = 1e-13, max_inner: int = 200) -> StaticResult:
     """The split iteration of seed 000 with re-expansion until convergence (module doc).
@@ -403,22 +422,9 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
                     max_inner=max_inner)
     if not 0.0 <= p < 1.0:
         raise SolverError(f"split iteration: p = {p} outside [0, 1)")
-    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
-        raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
-                          "formulation (every body) without contact; use "
-                          "solver.static_method = 'newton'")
-    if any(s.second_order is not None for s in model.sets):
-        raise SolverError("the split iteration needs the constant stiffness of the 'ffr' "
-                          "formulation; beam.geometric_stiffness makes it depend on the axial "
-                          "force: use solver.static_method = 'newton'")
-    if model.vector_loads:
-        raise SolverError("the split iteration takes dead loads only; driven moments, "
-                          "follower loads and a rigid body's moments need "
-                          "solver.static_method = 'newton'")
-    if model.force_elements:
-        raise SolverError("the split iteration needs a constant stiffness; force elements "
-                          "(spring-dampers, bushings, cylinders) need solver.static_method = "
-                          "'newton'")
+    obstacle = split_obstacle(model)
+    if obstacle is not None:
+        raise SolverError(f"{obstacle}: use solver.static_method = 'newton'")
     model.require_runnable()
     start = time.perf_counter()
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
@@ -536,11 +542,28 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
                                        "converged_by": how, "nonlinear_coordinates": nl})
 
 
+#: the values of ``solver.static_method``: 'auto' (the default) takes the split iteration
+#: where it applies (:func:`split_obstacle`), Newton otherwise
+STATIC_METHODS = ("auto", "split", "newton")
+
+
+def static_method_for(model: Model, method: str) -> str:
+    """The static method a run uses: ``method`` itself, or for 'auto' the split iteration
+    where it applies (the boom's FFR scenes of seed 000) and Newton otherwise."""
+    if method == "auto":
+        return "split" if split_obstacle(model) is None else "newton"
+    return method
+
+
 def solve_static(model: Model, method: str, *, tol: float, max_iter: int,
                  p: float = 0.0, load_steps: int = 1) -> StaticResult:
-    """Dispatch on ``solver.static_method``."""
-    if method == "newton":
-        return solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
-    if method == "split":
-        return solve_split(model, tol=tol, max_iter=max_iter, p=p)
-    raise SolverError(f"unknown static method {method!r}")
+    """Dispatch on ``solver.static_method`` ('auto', 'split', 'newton'); the result's
+    ``method`` is the one used, ``extra['method_setting']`` the one asked for."""
+    if method not in STATIC_METHODS:
+        raise SolverError(f"unknown static method {method!r}")
+    if static_method_for(model, method) == "newton":
+        result = solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
+    else:
+        result = solve_split(model, tol=tol, max_iter=max_iter, p=p)
+    result.extra["method_setting"] = method
+    return result

@@ -664,8 +664,8 @@ class System:
     def static(self, **options: Any):
         """The static equilibrium, run exactly as ``ancf run`` runs a static scene, with
         the CLI's defaults. Keywords: any key of the scene groups &solver and &output
-        (``static_method='split'`` by default as in the CLI, 'newton' where the split
-        iteration cannot run: a body not 'ffr', or contact; ``tol``, ``max_iter``,
+        (``static_method='auto'`` by default as in the CLI: the split iteration where it
+        applies, 'newton' otherwise; ``tol``, ``max_iter``,
         ``load_steps``, ...; docs/scenes.md), ``effects`` (default: the system's list, else
         every effect its items belong to), ``output`` (an HDF5 path; default a temporary
         file, see :meth:`~ancfdrv.results.Results.save`), ``progress``.
