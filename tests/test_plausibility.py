@@ -5,11 +5,17 @@ eigen settings, sizes and output, with a result that is not finite or absurdly l
 never ending with status ok."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pytest
 
 from ancfdrv.cli import main
+from ancfdrv.errors import InputError
+from ancfdrv.io import validate
+
+from conftest import INPUTS
 
 # a box of 2 kg hanging on a spring (800 N/m, free length 0.9 m, preload 5 N) from the
 # origin, held to slide along z: tension m g = 5 + 800 (L - 0.9) at the spring length L
@@ -74,3 +80,134 @@ def test_boom_default_is_the_split_iteration_unchanged(write_scene, tmp_path):
         assert a["static"].attrs["method_setting"] == "auto"
         assert b["static"].attrs["method_setting"] == "split"
         assert np.array_equal(a["static/q"][()], b["static/q"][()])
+
+
+# -- item 5: a result strained beyond an elastic metal warns -------------------------------
+def run_cantilever(tmp_path, name: str, *sets: str) -> tuple[int, Path]:
+    """The shipped cantilever (2 m, 50 x 50 mm, 100 N at the tip), nonlinear so that a
+    soft material deflects without leaving the formulation, 4 nodes."""
+    out = tmp_path / f"{name}.h5"
+    code = main(["run", str(INPUTS / "cantilever.nml"), "-o", str(out),
+                 "--set", "scene.formulation=nonlinear", "--set", "beam.nodes=4",
+                 "--set", "solver.load_steps=10", *(x for s in sets for x in ("--set", s))])
+    return code, out
+
+
+def largest_strain(out: Path) -> float:
+    """The beam's largest von Mises stress in the file over the modulus the run used."""
+    with h5py.File(out) as h5:
+        stress = float(h5["static/stress/beam"].attrs["max"])
+        modulus = float(h5.attrs["scene"].split("youngs_modulus = ")[1].split()[0]
+                        .replace("d", "e"))
+    return stress / modulus
+
+
+def test_youngs_modulus_in_mpa_warns_in_file_and_on_stderr(tmp_path, capsys):
+    code, out = run_cantilever(tmp_path, "mpa", "material.youngs_modulus=2.1e5")
+    assert code == 0
+    err = capsys.readouterr().err
+    strain = largest_strain(out)
+    assert strain > 0.005   # the file's own stresses: beyond the elastic limit
+    with h5py.File(out) as h5:
+        warnings = h5.attrs["warnings"]
+        assert h5.attrs["status"] == "ok"
+        length = 2.0   # the undeformed beam's bounding box
+        moved = np.abs(h5["static/deflection/tip"][()]).max()
+    assert moved > length
+    for text in (warnings, err):
+        assert "beam 'beam' is strained by" in text
+        assert f"{strain:.3g}" in text    # the strain named is the file's
+        assert "probe 'tip' on beam 'beam' is displaced by" in text
+        assert "check the units" in text and "Young's modulus in Pa" in text
+        assert "scene.bounds = 'off' silences" in text
+    assert "warning: static result implausible" in err
+
+
+def test_youngs_modulus_in_pa_does_not_warn(tmp_path, capsys):
+    code, out = run_cantilever(tmp_path, "pa")
+    assert code == 0
+    assert "implausible" not in capsys.readouterr().err
+    assert largest_strain(out) < 0.005
+    with h5py.File(out) as h5:
+        assert "implausible" not in h5.attrs["warnings"]
+
+
+def test_bounds_off_silences_the_warning(tmp_path, capsys):
+    code, out = run_cantilever(tmp_path, "off", "material.youngs_modulus=2.1e5",
+                               "scene.bounds=off")
+    assert code == 0
+    assert "implausible" not in capsys.readouterr().err
+    assert largest_strain(out) > 0.005   # the same result, unwarned
+    with h5py.File(out) as h5:
+        assert "implausible" not in h5.attrs["warnings"]
+        assert h5.attrs["status"] == "ok"
+
+
+# -- physical bounds and results that are no results ----------------------------------------
+def test_a_spring_of_1e_300_is_refused_and_its_result_never_ok(write_scene, tmp_path, capsys):
+    scene = write_scene(SPRING.replace("stiffness = 800.0", "stiffness = 1e-300"))
+    out = tmp_path / "soft.h5"
+    assert main(["run", str(scene), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "&force_element[spring] stiffness" in err
+    assert "below the smallest physical stiffness" in err and "scene.bounds = 'off'" in err
+    assert not out.exists()
+    # bounds lifted: the box falls without end, a result no run vouches for (exit 3)
+    assert main(["run", str(scene), "-o", str(out), "--set", "scene.bounds=off"]) == 3
+    assert "the static result is not physical" in capsys.readouterr().err
+    with h5py.File(out) as h5:
+        assert h5.attrs["status"] == "failed"
+        assert "not physical" in h5.attrs["message"]
+        assert "static/q" in h5   # the rows computed are kept
+
+
+def test_a_stiffness_beyond_the_bound_is_refused(write_scene, tmp_path, capsys):
+    scene = write_scene(SPRING.replace("stiffness = 800.0", "stiffness = 1e15"))
+    assert main(["run", str(scene), "-o", str(tmp_path / "stiff.h5")]) == 2
+    err = capsys.readouterr().err
+    assert "&force_element[spring] stiffness" in err and "beyond the physical bound" in err
+
+
+def test_spin_rate_beyond_the_bound_is_refused(tmp_path, capsys):
+    code = main(["run", str(INPUTS / "crane_boom_modes.nml"), "-o", str(tmp_path / "m.h5"),
+                 "--set", "modal.spin_rate=1e9"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "&modal spin_rate" in err and "beyond the physical bound for angular rate" in err
+
+
+def test_a_1_nm_beam_is_refused_in_both_kinds_of_scene(write_scene, tmp_path, capsys):
+    code = main(["run", str(INPUTS / "cantilever.nml"), "-o", str(tmp_path / "a.h5"),
+                 "--set", "beam.length=1e-9"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "&beam length" in err and "below the smallest physical length" in err
+    general = (INPUTS / "general" / "cantilever.nml").read_text().replace("2.0, 0.0, 0.0",
+                                                                          "1e-9, 0.0, 0.0")
+    code = main(["run", str(write_scene(general)), "-o", str(tmp_path / "b.h5")])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "&beam[arm]" in err and "below the smallest physical length" in err
+
+
+def test_output_stations_beyond_memory_is_refused_before_allocating(tmp_path, capsys):
+    code = main(["run", str(INPUTS / "cantilever.nml"), "-o", str(tmp_path / "s.h5"),
+                 "--set", "output.stations=100000000"])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "&output stations" in err and "of memory for the section forces" in err
+    assert "use fewer stations" in err
+    assert not (tmp_path / "s.h5").exists()
+
+
+def test_output_memory_estimate_counts_elements_and_stations():
+    """The estimate is BYTES_PER_STATION per element and station (a 10-node beam: 9
+    elements), refused above half the memory available, named output.stations."""
+    estimate = validate.Estimate([validate.Part("beam", "nodes", "beam", 10, 12)])
+    output = {"stations": 1000}
+    assert validate.output_bytes(estimate, output, None, "static") == 4096 * 9 * 1000
+    room = 2 * (estimate.memory_bytes + 4096 * 9 * 1000)   # exactly the limit: accepted
+    validate.check_output_memory(estimate, output, "f.nml", None, "static", available=room)
+    with pytest.raises(InputError, match=r"&output stations: 1,000 stations per beam element"):
+        validate.check_output_memory(estimate, output, "f.nml", None, "static",
+                                     available=room - 4)

@@ -182,10 +182,33 @@ class SupportRecorder:
 
 
 def _write_static_answers(scene: Scene, model: Model, out: Path | MemoryOutput,
-                          result: StaticResult) -> None:
-    """Reactions, section forces and stresses of the static state (SPEC section 10)."""
-    _io(out).write_static_answers(out, model, result.e, result.lam,
-                                  scene["output"].get("stations", 3))
+                          result: StaticResult):
+    """Reactions, section forces and stresses of the static state (SPEC section 10),
+    written and returned (:class:`~ancfdrv.system.answers.Answers`)."""
+    from .system.answers import static_answers
+    stations = scene["output"].get("stations", 3)
+    answers = static_answers(model, result.e, result.lam, stations)
+    _io(out).write_static_answers(out, model, result.e, result.lam, stations, answers=answers)
+    return answers
+
+
+def warns_implausible(scene: Scene) -> bool:
+    """Whether implausible results are warned of (``scene.bounds = 'check'``, the
+    default; :mod:`ancfdrv.results.plausibility`)."""
+    return scene["scene"].get("bounds", "check") == "check"
+
+
+def _check_dynamic_plausibility(scene: Scene, model: Model, out: Path | MemoryOutput,
+                                envelope: dict) -> None:
+    """The plausibility of a completed dynamic run (its probes' deflections read back,
+    the answers' stress envelope): warnings in ``model.warnings``, SolverError for a
+    result that is not finite or absurdly displaced."""
+    from .results.plausibility import check_dynamic
+    with _io(out).reading(out) as h5:
+        deflection = {name: h5[f"dynamic/deflection/{name}"][()] for name in model.probes
+                      if f"dynamic/deflection/{name}" in h5}
+    model.warnings.extend(check_dynamic(model, deflection, envelope,
+                                        warn=warns_implausible(scene)))
 
 
 def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
@@ -329,6 +352,7 @@ def _run_reduced(scene: Scene, model: Model, out: Path | MemoryOutput, static: S
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     _warn_large_ffr_deflection(model, out)
+    _check_dynamic_plausibility(scene, model, out, {})
     bounds = stage_bounds(scene)
     stages: dict[str, float] = {}
     if bounds:
@@ -414,6 +438,8 @@ def _run_dynamic(scene: Scene, model: Model, out: Path | MemoryOutput, e_start: 
             timing[f"dynamic_{phase}"] = seconds
         stages: dict[str, float] = {}
         _warn_large_ffr_deflection(model, out)
+        _check_dynamic_plausibility(scene, model, out,
+                                    recorder.envelope if recorder is not None else {})
         bounds = stage_bounds(scene)
         if bounds:
             with _io(out).reading(out) as h5:
@@ -573,8 +599,11 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                 t0 = time.perf_counter()
                 _io(out).write_static(out, model, static)
                 _write_static_supports(out, model, static)
-                _write_static_answers(scene, model, out, static)
+                answers = _write_static_answers(scene, model, out, static)
                 timing["output"] = time.perf_counter() - t0
+                from .results.plausibility import check_static
+                model.warnings.extend(check_static(model, static.e, answers.stress,
+                                                   warn=warns_implausible(scene)))
                 e_start = static.e
                 if analysis == "static+dynamic":
                     stop.check()
