@@ -211,3 +211,43 @@ def test_output_memory_estimate_counts_elements_and_stations():
     with pytest.raises(InputError, match=r"&output stations: 1,000 stations per beam element"):
         validate.check_output_memory(estimate, output, "f.nml", None, "static",
                                      available=room - 4)
+
+
+def api_cantilever(modulus: float, bounds: str = "check"):
+    """The cantilever of run_cantilever built in Python."""
+    from ancfdrv import Rectangle, System
+    s = System("cantilever", bounds=bounds)
+    s.material("m", youngs_modulus=modulus, density=7850.0)
+    s.beam("b", material="m", start=(0, 0, 0), end=(2, 0, 0), nodes=4, formulation="nonlinear",
+           section=Rectangle(0.05, 0.05), height_axis=(0, 1, 0))
+    for vector in ("r", "r_y", "r_z"):
+        s.joint(f"clamp {vector}", "fix", "ground", "b", point=(0, 0, 0), vector=vector)
+    s.load("f", "force", body="b", point=(2, 0, 0), vector=(0, -100, 0))
+    s.probe("tip", "b", (2, 0, 0))
+    return s
+
+
+def test_python_runs_warn_alike_and_bounds_off_silences(recwarn):
+    with pytest.warns(UserWarning, match="static result implausible: beam 'b' is strained"):
+        api_cantilever(2.1e5).static(load_steps=10)
+    recwarn.clear()
+    result = api_cantilever(2.1e5, bounds="off").static(load_steps=10)
+    assert result.status == "ok"
+    assert not [w for w in recwarn if "implausible" in str(w.message)]
+
+
+def test_dynamic_result_strained_beyond_the_limit_warns_with_its_time(tmp_path, capsys):
+    """The dynamic run's stress envelope (/dynamic/stress) is what the warning reads."""
+    code, out = run_cantilever(tmp_path, "dyn", "material.youngs_modulus=2.1e5",
+                               "scene.analysis=dynamic", "solver.t_end=0.1", "solver.dt=1e-2",
+                               "output.xdmf=false")
+    assert code == 0
+    err = capsys.readouterr().err
+    with h5py.File(out) as h5:
+        envelope = h5["dynamic/stress/beam"].attrs
+        strain, when = float(envelope["max"]) / 2.1e5, float(envelope["t_max"])
+        warnings = h5.attrs["warnings"]
+    assert strain > 0.005
+    for text in (warnings, err):
+        assert f"dynamic result implausible: beam 'beam' is strained by {strain:.3g}" in text
+        assert f"at t = {when:.6g} s" in text

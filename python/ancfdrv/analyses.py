@@ -101,6 +101,8 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
         raise InputError(f"{where}: analysis {analysis!r} must be one of {', '.join(ANALYSES)}")
     solver, out_values = _settings(options, where)
     validate.check_time(solver, analysis, where)
+    validate.check_output_memory(validate.Estimate(system._parts()), out_values, where,
+                                 solver, analysis)
     chosen = effects if effects is not None else system.effects
     model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
                             linear_joints=solver["linear_joints"], supports=True)
@@ -111,7 +113,7 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
         values = {"scene": {"title": system.title or "System", "analysis": analysis,
                             "formulation": ",".join(formulations) or "rigid",
                             "effects": list(model.effects), "response": None,
-                            "response_component": 2},
+                            "response_component": 2, "bounds": system.bounds},
                   "solver": solver, "output": out_values}
         scene = Scene(path=path, values=values, text=text, items=[])
     except BaseException:
@@ -124,7 +126,12 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
         target = Path(owner.name) / "result.h5"
     else:
         target = Path(output)
-    run_loaded(scene, target, progress=progress, model=model)
+    outcome = run_loaded(scene, target, progress=progress, model=model)
+    from .results.plausibility import IMPLAUSIBLE
+    for note in outcome.warnings:   # a script sees them as the terminal does
+        if IMPLAUSIBLE in note:
+            import warnings
+            warnings.warn(note, UserWarning, stacklevel=3)
     result = open_results(target)
     result._owner = owner
     return result

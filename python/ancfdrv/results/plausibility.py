@@ -38,6 +38,8 @@ if TYPE_CHECKING:
 ELASTIC_STRAIN = 0.005
 #: a displacement above this multiple of the structure's size is no result (exit 3)
 ABSURD_FACTOR = 1e3
+#: the words every warning of this module carries ("static result implausible: ...")
+IMPLAUSIBLE = "result implausible"
 #: what every warning and failure suggests
 UNITS = ("check the units (SI: Young's modulus in Pa, e.g. 2.1e11 for steel, not 2.1e5 in "
          "MPa; lengths in m; forces in N; stiffnesses in N/m)")
@@ -88,7 +90,7 @@ def strain_warnings(model: "Model", peaks: dict[str, tuple[float, str]], when: s
         modulus = float(beam.material.youngs_modulus)
         strain = stress / modulus
         if strain > ELASTIC_STRAIN:
-            out.append(f"{when} result implausible: beam {name!r} is strained by {strain:.3g} "
+            out.append(f"{when} {IMPLAUSIBLE}: beam {name!r} is strained by {strain:.3g} "
                        f"({strain:.2%}; von Mises stress {stress:.4g} Pa over Young's modulus "
                        f"{modulus:.4g} Pa{where}), more than an elastic metal takes "
                        f"({ELASTIC_STRAIN:.1%}): {UNITS_HINT}")
@@ -100,8 +102,8 @@ def displacement_check(model: "Model", largest: dict[str, float], when: str, *,
     """The warnings of probes (their largest displacement component, m, by probe name)
     displaced by more than the structure's size (``warn``), after the failure of one
     displaced by more than :data:`ABSURD_FACTOR` times it (SolverError)."""
-    if not largest:
-        return []
+    if all(value <= model.length_scale for value in largest.values()):
+        return []   # (NaN compares False: checked below) within a size no structure is below
     size = structure_size(model)
     out = []
     for name, value in largest.items():
@@ -112,7 +114,7 @@ def displacement_check(model: "Model", largest: dict[str, float], when: str, *,
                               f"times the structure's size ({size:.3g} m): a stiffness, a load "
                               f"or a unit is off by orders of magnitude; {UNITS}")
         if warn and value > size:
-            out.append(f"{when} result implausible: probe {name!r} on {body} is displaced by "
+            out.append(f"{when} {IMPLAUSIBLE}: probe {name!r} on {body} is displaced by "
                        f"{value:.4g} m, more than the structure's size ({size:.4g} m, the "
                        f"diagonal of the undeformed model's bounding box): {UNITS_HINT}")
     return out
