@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import sys
 import tempfile
+import warnings
 import weakref
 from pathlib import Path
 from typing import Any
@@ -34,6 +35,7 @@ from .errors import InputError
 from .io import validate
 from .io.scene import Scene, _typed
 from .io.schema import SCHEMA
+from .results.plausibility import IMPLAUSIBLE
 from .results.reader import Results, open_results
 from .runner import run_loaded
 from .solvers.buckling import buckling_analysis
@@ -127,10 +129,8 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
     else:
         target = Path(output)
     outcome = run_loaded(scene, target, progress=progress, model=model)
-    from .results.plausibility import IMPLAUSIBLE
     for note in outcome.warnings:   # a script sees them as the terminal does
         if IMPLAUSIBLE in note:
-            import warnings
             warnings.warn(note, UserWarning, stacklevel=3)
     result = open_results(target)
     result._owner = owner

@@ -35,6 +35,7 @@ from .interrupt import StopRequest, signal_name
 from .results import hdf5 as results
 from .builders.general import locate_error
 from .results.lock import OutputLock
+from .results.plausibility import check_dynamic, check_static
 from .results.output_path import check_output_path
 from .builders import build_model, settle_mode, stage_bounds
 from .io.scene import Scene, load_scene
@@ -44,6 +45,7 @@ from .solvers.static import StaticResult, solve_newton, solve_static
 
 if TYPE_CHECKING:
     from .results.memory import MemoryOutput
+    from .system.answers import Answers
 
 
 def _io(out: "Path | MemoryOutput") -> Any:
@@ -182,7 +184,7 @@ class SupportRecorder:
 
 
 def _write_static_answers(scene: Scene, model: Model, out: Path | MemoryOutput,
-                          result: StaticResult):
+                          result: StaticResult) -> "Answers":
     """Reactions, section forces and stresses of the static state (SPEC section 10),
     written and returned (:class:`~ancfdrv.system.answers.Answers`)."""
     from .system.answers import static_answers
@@ -203,7 +205,6 @@ def _check_dynamic_plausibility(scene: Scene, model: Model, out: Path | MemoryOu
     """The plausibility of a completed dynamic run (its probes' deflections read back,
     the answers' stress envelope): warnings in ``model.warnings``, SolverError for a
     result that is not finite or absurdly displaced."""
-    from .results.plausibility import check_dynamic
     with _io(out).reading(out) as h5:
         deflection = {name: h5[f"dynamic/deflection/{name}"][()] for name in model.probes
                       if f"dynamic/deflection/{name}" in h5}
@@ -601,7 +602,6 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                 _write_static_supports(out, model, static)
                 answers = _write_static_answers(scene, model, out, static)
                 timing["output"] = time.perf_counter() - t0
-                from .results.plausibility import check_static
                 model.warnings.extend(check_static(model, static.e, answers.stress,
                                                    warn=warns_implausible(scene)))
                 e_start = static.e
