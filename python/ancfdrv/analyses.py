@@ -12,7 +12,7 @@ A run from Python goes through the very path of ``ancf run`` (:func:`ancfdrv.run
 the same solvers, settings, writer and status handling), with the CLI's defaults: every key
 of the scene groups ``&solver`` and ``&output`` is a keyword with the schema's default
 (``docs/scenes.md``), e.g. ``jacobian='reuse'``, ``integrator='newmark'``,
-``static_method='split'``. The run writes its HDF5 file to a temporary directory (or to
+``static_method='auto'``. The run writes its HDF5 file to a temporary directory (or to
 ``output=``); the :class:`~ancfdrv.results.Results` object is read back from that file
 (:func:`ancfdrv.results.open_results`).
 
@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import sys
 import tempfile
+import warnings
 import weakref
 from pathlib import Path
 from typing import Any
@@ -34,6 +35,7 @@ from .errors import InputError
 from .io import validate
 from .io.scene import Scene, _typed
 from .io.schema import SCHEMA, check_keywords
+from .results.plausibility import IMPLAUSIBLE
 from .results.reader import Results, open_results
 from .runner import run_loaded
 from .solvers.buckling import BUCKLING_KEYWORDS, buckling_analysis
@@ -102,15 +104,11 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
     solver, out_values = _settings(options, where)
     validate.check_time(solver, analysis, where)
     target = None if output is None else validate.check_path(output, f"{where}: output")
+    validate.check_output_memory(validate.Estimate(system._parts()), out_values, where,
+                                 solver, analysis)
     chosen = effects if effects is not None else system.effects
     model = system.assemble(effects=tuple(chosen) if chosen is not None else None,
                             linear_joints=solver["linear_joints"], supports=True)
-    if "static_method" not in options and (any(s.kind != "ffr" for s in model.sets)
-                                           or model.contact_pairs or model.vector_loads):
-        # the CLI's default 'split' needs every body 'ffr', no contact and dead loads only
-        # (no driven or follower load, no rigid body's moment): where it cannot run (it
-        # would fail with that message), Newton is the only static method
-        solver["static_method"] = "newton"
     try:
         formulations = sorted({getattr(b, "formulation", "") for b in system.bodies.values()
                                if getattr(b, "formulation", "")})
@@ -118,7 +116,7 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
         values = {"scene": {"title": system.title or "System", "analysis": analysis,
                             "formulation": ",".join(formulations) or "rigid",
                             "effects": list(model.effects), "response": None,
-                            "response_component": 2},
+                            "response_component": 2, "bounds": system.bounds},
                   "solver": solver, "output": out_values}
         scene = Scene(path=path, values=values, text=text, items=[])
     except BaseException:
@@ -129,7 +127,10 @@ def run_system(system, analysis: str, *, output: str | Path | None = None,
         owner = tempfile.TemporaryDirectory(prefix="ancfdrv-")
         weakref.finalize(owner, owner.cleanup)
         target = Path(owner.name) / "result.h5"
-    run_loaded(scene, target, progress=progress, model=model)
+    outcome = run_loaded(scene, target, progress=progress, model=model)
+    for note in outcome.warnings:   # a script sees them as the terminal does
+        if IMPLAUSIBLE in note:
+            warnings.warn(note, UserWarning, stacklevel=3)
     result = open_results(target)
     result._owner = owner
     return result

@@ -35,15 +35,17 @@ from .interrupt import StopRequest, signal_name
 from .results import hdf5 as results
 from .builders.general import locate_error
 from .results.lock import OutputLock
+from .results.plausibility import check_dynamic, check_static
 from .results.output_path import check_output_path
 from .builders import build_model, settle_mode, stage_bounds
 from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
-from .solvers.static import StaticResult, check_split, solve_newton, solve_static
+from .solvers.static import StaticResult, solve_newton, solve_static
 
 if TYPE_CHECKING:
     from .results.memory import MemoryOutput
+    from .system.answers import Answers
 
 
 def _io(out: "Path | MemoryOutput") -> Any:
@@ -182,10 +184,32 @@ class SupportRecorder:
 
 
 def _write_static_answers(scene: Scene, model: Model, out: Path | MemoryOutput,
-                          result: StaticResult) -> None:
-    """Reactions, section forces and stresses of the static state (SPEC section 10)."""
-    _io(out).write_static_answers(out, model, result.e, result.lam,
-                                  scene["output"].get("stations", 3))
+                          result: StaticResult) -> "Answers":
+    """Reactions, section forces and stresses of the static state (SPEC section 10),
+    written and returned (:class:`~ancfdrv.system.answers.Answers`)."""
+    from .system.answers import static_answers
+    stations = scene["output"].get("stations", 3)
+    answers = static_answers(model, result.e, result.lam, stations)
+    _io(out).write_static_answers(out, model, result.e, result.lam, stations, answers=answers)
+    return answers
+
+
+def warns_implausible(scene: Scene) -> bool:
+    """Whether implausible results are warned of (``scene.bounds = 'check'``, the
+    default; :mod:`ancfdrv.results.plausibility`)."""
+    return scene["scene"].get("bounds", "check") == "check"
+
+
+def _check_dynamic_plausibility(scene: Scene, model: Model, out: Path | MemoryOutput,
+                                envelope: dict) -> None:
+    """The plausibility of a completed dynamic run (its probes' deflections read back,
+    the answers' stress envelope): warnings in ``model.warnings``, SolverError for a
+    result that is not finite or absurdly displaced."""
+    with _io(out).reading(out) as h5:
+        deflection = {name: h5[f"dynamic/deflection/{name}"][()] for name in model.probes
+                      if f"dynamic/deflection/{name}" in h5}
+    model.warnings.extend(check_dynamic(model, deflection, envelope,
+                                        warn=warns_implausible(scene)))
 
 
 def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
@@ -271,6 +295,21 @@ def check_reduction(scene: Scene, model: Model) -> None:
         raise _reduction_error(scene, beam, str(exc)) from None
 
 
+def check_static_method(scene: Scene, model: Model) -> None:
+    """Refuse, before anything is computed, ``solver.static_method = 'split'`` on a scene
+    the split iteration cannot solve (InputError naming the key and why; 'auto', the
+    default, takes Newton there)."""
+    if scene["scene"]["analysis"] not in ("static", "static+dynamic") \
+            or scene["solver"]["static_method"] != "split":
+        return
+    from .solvers.static import split_obstacle
+    why = split_obstacle(model)
+    if why is not None:
+        raise InputError(f"'split' cannot solve this scene: {why}; use 'newton' or 'auto' "
+                         "(the default: 'split' where it applies, else 'newton')",
+                         file=str(scene.path), group="solver", key="static_method")
+
+
 def _run_reduced(scene: Scene, model: Model, out: Path | MemoryOutput, static: StaticResult,
                  timing: dict[str, Any], progress: bool | None,
                  stop: StopRequest) -> tuple[DynamicResult, dict]:
@@ -314,6 +353,7 @@ def _run_reduced(scene: Scene, model: Model, out: Path | MemoryOutput, static: S
     for phase, seconds in dyn.timing.items():
         timing[f"dynamic_{phase}"] = seconds
     _warn_large_ffr_deflection(model, out)
+    _check_dynamic_plausibility(scene, model, out, {})
     bounds = stage_bounds(scene)
     stages: dict[str, float] = {}
     if bounds:
@@ -399,6 +439,8 @@ def _run_dynamic(scene: Scene, model: Model, out: Path | MemoryOutput, e_start: 
             timing[f"dynamic_{phase}"] = seconds
         stages: dict[str, float] = {}
         _warn_large_ffr_deflection(model, out)
+        _check_dynamic_plausibility(scene, model, out,
+                                    recorder.envelope if recorder is not None else {})
         bounds = stage_bounds(scene)
         if bounds:
             with _io(out).reading(out) as h5:
@@ -520,9 +562,7 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
     timing: dict[str, Any] = {"model": time.perf_counter() - t0}
     try:
         check_reduction(scene, model)
-        if analysis in ("static", "static+dynamic") and \
-                scene["solver"]["static_method"] == "split":
-            check_split(model)  # before the output is touched
+        check_static_method(scene, model)
     except InputError as exc:
         model.close()
         raise locate_error(exc, scene) from None
@@ -560,8 +600,10 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                 t0 = time.perf_counter()
                 _io(out).write_static(out, model, static)
                 _write_static_supports(out, model, static)
-                _write_static_answers(scene, model, out, static)
+                answers = _write_static_answers(scene, model, out, static)
                 timing["output"] = time.perf_counter() - t0
+                model.warnings.extend(check_static(model, static.e, answers.stress,
+                                                   warn=warns_implausible(scene)))
                 e_start = static.e
                 if analysis == "static+dynamic":
                     stop.check()

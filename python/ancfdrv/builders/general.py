@@ -241,7 +241,8 @@ def locate_error(exc: InputError, scene) -> InputError:
         else:
             head = re.sub(r" #\d+$", "", message.split(":", 1)[0])
             group = next((f"{g}[{n}]" for g, n in sorted(names) if n == head), None)
-    return InputError(message, file=str(scene.path), group=group)
+    return InputError(message, file=str(scene.path), group=group,
+                      key=exc.key if group is not None and exc.group is None else None)
 
 
 def build_general(scene) -> BuiltSystem:

@@ -525,8 +525,12 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
             values[group] = {k: s.default for k, s in SCHEMA[group].items()}
     _check_consistency(values, file, kind)
     validate.check_time(values["solver"], values["scene"]["analysis"], file)
-    validate.check_resources(validate.estimate_template(values, kind), file, values["solver"],
-                             values["scene"]["analysis"])
+    _check_template_sizes(values, file)
+    estimate = validate.estimate_template(values, kind)
+    validate.check_resources(estimate, file, values["solver"], values["scene"]["analysis"])
+    validate.check_output_memory(estimate, values["output"], file, values["solver"],
+                                 values["scene"]["analysis"])
+    _check_eigen_bounds(values, file)
     return Scene(path=path, values=values, text=partial(namelist_text, nml), overrides=applied)
 
 
@@ -566,10 +570,48 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scen
         values["scene"]["effects"] = sorted(effects_of(items))
     _check_general(values, file, {e for e in effects_of(items)})
     validate.check_time(values["solver"], values["scene"]["analysis"], file)
-    validate.check_resources(validate.estimate_general(items), file, values["solver"],
-                             values["scene"]["analysis"])
+    estimate = validate.estimate_general(items)
+    validate.check_resources(estimate, file, values["solver"], values["scene"]["analysis"])
+    validate.check_output_memory(estimate, values["output"], file, values["solver"],
+                                 values["scene"]["analysis"])
+    _check_eigen_bounds(values, file)
     scene.built = GENERAL_BUILDER["build"](scene)  # every name, reference and value checked
     return scene
+
+
+#: the lengths of template scenes held to ``validate.PHYSICAL_MINIMA`` (group, key, quantity)
+TEMPLATE_SIZES = (("beam", "length", "length"), ("beam", "width", "section"),
+                  ("beam", "height", "section"), ("plate", "length_x", "length"),
+                  ("plate", "length_y", "length"), ("plate", "thickness", "section"),
+                  ("leaf", "arc_length", "length"), ("leaf", "width", "section"),
+                  ("leaf", "thickness", "section"))
+
+
+def _check_template_sizes(values: dict[str, dict[str, Any]], file: str) -> None:
+    """A template scene's lengths and sections above the physical minima
+    (``validate.PHYSICAL_MINIMA``; lifted by ``scene.bounds = 'off'``)."""
+    if values["scene"].get("bounds", "check") != "check":
+        return
+    for group, key, quantity in TEMPLATE_SIZES:
+        value = (values.get(group) or {}).get(key)
+        if value is None:
+            continue
+        try:
+            validate.check_minimum(quantity, value, key)
+        except InputError as exc:
+            raise InputError(str(exc), file=file, group=group, key=key) from None
+
+
+def _check_eigen_bounds(values: dict[str, dict[str, Any]], file: str) -> None:
+    """``modal.spin_rate`` within the physical bound of an angular rate
+    (``validate.PHYSICAL_BOUNDS``; lifted by ``scene.bounds = 'off'``)."""
+    if values["scene"].get("bounds", "check") != "check" or "modal" not in values:
+        return
+    try:
+        validate.check_bound("angular_rate", values["modal"].get("spin_rate", 0.0),
+                             "spin_rate")
+    except InputError as exc:
+        raise InputError(str(exc), file=file, group="modal", key="spin_rate") from None
 
 
 def _check_general(values: dict[str, dict[str, Any]], file: str, used: set[str]) -> None:
@@ -596,7 +638,7 @@ def _check_consistency(values: dict[str, dict[str, Any]], file: str, kind: str) 
                              f"{', '.join(EFFECTS_AVAILABLE)}", file=file, group="scene",
                              key="effects")
     if scene["formulation"] == "nonlinear" and scene["analysis"] in ("static", "static+dynamic"):
-        if values["solver"]["static_method"] != "newton":
+        if values["solver"]["static_method"] == "split":
             raise InputError("formulation 'nonlinear' needs static_method = 'newton' (the split "
                              "iteration relies on the constant FFR stiffness)", file=file,
                              group="solver", key="static_method")

@@ -108,9 +108,18 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "response": Key("str", None, doc="general scenes: the probe sweeps compare (default: "
                         "the first probe)"),
         "bounds": Key("str", "check", one_of("check", "off"),
-                      "'check': drives and loads must stay within physical bounds "
-                      "(ancfdrv.io.validate.PHYSICAL_BOUNDS, e.g. a rate of at most 1e4 rad/s); "
-                      "'off' accepts any finite value (also: ancf run --force)"),
+                      "'check': drives, loads, force elements and modal.spin_rate must stay "
+                      "within physical bounds (ancfdrv.io.validate.PHYSICAL_BOUNDS, e.g. a "
+                      "rate of at most 1e4 rad/s, a stiffness of at most 1e12 N/m), a nonzero "
+                      "stiffness and every body's length and section above physical minima "
+                      "(PHYSICAL_MINIMA: 1e-3 N/m, 1 mm, 10 micrometres: beyond them the input "
+                      "is a typo or a unit slip), and a static or dynamic result strained "
+                      "beyond 0.5 % (more than an elastic metal takes) or displaced by more "
+                      "than the structure's size warns, naming the body "
+                      "(ancfdrv.results.plausibility); 'off' accepts any finite value and "
+                      "silences the warning (also: ancf run --force). A result not finite or "
+                      "displaced by more than 1000 times the structure's size fails (exit 3) "
+                      "either way"),
         "planar": Key("str", "off", one_of("off", "auto", "xy", "yz", "zx"),
                       "planar reduction (docs/theory.md, system/planar.py): 'xy', 'yz', 'zx' "
                       "declare that the motion stays in planes parallel to that one (data "
@@ -263,8 +272,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "pressure": Key("float", 0.0, doc="plate: dead pressure along -r3 (Pa)"),
     },
     "solver": {
-        "static_method": Key("str", "split", one_of("split", "newton"),
-                             "static solver: split iteration or Newton-Raphson"),
+        "static_method": Key("str", "auto", one_of("auto", "split", "newton"),
+                             "static solver: 'split' (the split iteration of seed 000: "
+                             "'ffr' bodies, dead loads, no force element, no contact), "
+                             "'newton' (Newton-Raphson, any scene), 'auto' (default: "
+                             "'split' where it applies, 'newton' otherwise; /static "
+                             "attributes method and method_setting record the choice)"),
         "tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                    "relative tolerance of the static solve"),
         "max_iter": Key("int", 50, positive, "iteration limit of the static solve"),
@@ -335,7 +348,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                            "runs show every k-th step (and the last); each frame costs "
                            "about 0.4 ms of output"),
         "stations": Key("int", 3, at_least(2), "points per beam element where the section "
-                        "forces and stresses are evaluated (both ends included)"),
+                        "forces and stresses are evaluated (both ends included); their "
+                        "memory (about 4 kB per element and station, with sections = "
+                        ".true. 192 B more per dynamic row) is estimated before the run and "
+                        "refused above half the memory available"),
         "sections": Key("bool", False, doc="dynamic runs: store the section forces of every "
                         "beam at every step (/dynamic/sections); the stress envelope is kept "
                         "either way"),
@@ -629,13 +645,17 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "point2": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body2 (m)"),
         "point": Key("floats", None, vector3, "'bushing': the point on both bodies (m)"),
         "stiffness": Key("floats", None, non_negative, "stiffness (N/m): one value; a "
-                         "'bushing' three, along body1's axes at the point"),
+                         "'bushing' three, along body1's axes at the point; 0 or within "
+                         "[1e-3, 1e12] N/m (scene.bounds: a softer spring carries nothing a "
+                         "structure weighs, a stiffer one is a joint)"),
         "damping": Key("floats", None, non_negative, "damping (N s/m): one value; a 'bushing' "
-                       "three (default 0)"),
+                       "three (default 0; at most 1e10, scene.bounds)"),
         "rotational_stiffness": Key("floats", None, non_negative, "'bushing': stiffness about "
-                                    "body1's three axes (N m/rad; default 0)"),
+                                    "body1's three axes (N m/rad; default 0; 0 or within "
+                                    "[1e-6, 1e12], scene.bounds)"),
         "rotational_damping": Key("floats", None, non_negative, "'bushing': damping about "
-                                  "body1's three axes (N m s/rad; default 0)"),
+                                  "body1's three axes (N m s/rad; default 0; at most 1e10, "
+                                  "scene.bounds)"),
         "free_length": Key("float", None, positive, "'spring_damper': length at which the "
                            "force is the preload (m; default: the distance at t = 0)"),
         "preload": Key("float", None, doc="'spring_damper': force at the free length (N, "
@@ -671,7 +691,8 @@ SCHEMA["modal"] = {
                      "max diag K / max diag M are rigid-body modes, reported at 0 Hz"),
     "spin_rate": Key("float", 0.0, doc="modes in a frame turning steadily at this rate "
                      "(rad/s) about spin_axis through spin_centre, with the centrifugal and "
-                     "Coriolis forces (0: no rotation)"),
+                     "Coriolis forces (0: no rotation); at most 1e4 rad/s in magnitude "
+                     "(scene.bounds: about 95,000 rpm, beyond the fastest turbines)"),
     "spin_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the steady rotation"),
     "spin_centre": Key("floats", [0.0, 0.0, 0.0], vector3, "a point of the rotation axis (m)"),
 }

@@ -576,6 +576,54 @@ def check_resources(estimate: Estimate, file: str, solver: dict[str, Any] | None
             "mesh", file=file, group="solver", key="dt")
 
 
+#: memory of the section forces and stresses per beam element and output station (bytes):
+#: measured 1.2 to 2.4 kB at the peak of the static answers of a 9-element beam with 100
+#: and 1000 stations, either formulation (an 'ffr' beam's linear-strain matrix is capped
+#: at 16 MB by ancfdrv.system.answers.LINEAR_MATRIX_LIMIT), rounded up
+BYTES_PER_STATION = 4096
+#: memory of one dynamic row of output.sections per element and station: N, T, Q, M
+#: (12 doubles), kept until the run ends and joined once (twice that)
+BYTES_PER_SECTION_ROW = 2 * 12 * 8
+
+
+def output_bytes(estimate: Estimate, output: dict[str, Any], solver: dict[str, Any] | None,
+                 analysis: str) -> int:
+    """The memory the beams' section forces and stresses take (``output.stations`` points
+    per element, and with ``output.sections`` every row of a dynamic run): bytes."""
+    elements = sum(max(p.nodes - 1, 1) for p in estimate.parts if p.kind == "beam")
+    stations = int(output.get("stations", 3))
+    need = BYTES_PER_STATION * elements * stations
+    if (output.get("sections") and solver is not None
+            and analysis in ("dynamic", "static+dynamic")):
+        rows = steps_of(solver["dt"], solver["t_end"]) + 1
+        need += BYTES_PER_SECTION_ROW * elements * stations * rows
+    return need
+
+
+def check_output_memory(estimate: Estimate, output: dict[str, Any], file: str,
+                        solver: dict[str, Any] | None, analysis: str,
+                        available: int | None = None) -> None:
+    """Refuse, before anything is allocated, output whose memory (:func:`output_bytes`)
+    with the model's (:attr:`Estimate.memory_bytes`) exceeds MEMORY_FRACTION of the
+    available memory; the message names output.stations, the estimate and the limit."""
+    need = output_bytes(estimate, output, solver, analysis)
+    if not need:
+        return
+    available = available_memory() if available is None else available
+    limit = MEMORY_FRACTION * available
+    if need + estimate.memory_bytes > limit:
+        stations = int(output.get("stations", 3))
+        rows = (" and output.sections at every step" if output.get("sections")
+                and analysis in ("dynamic", "static+dynamic") else "")
+        raise InputError(
+            f"{stations:,} stations per beam element{rows} need about {_bytes(need)} of "
+            f"memory for the section forces and stresses (with the model's "
+            f"{_bytes(estimate.memory_bytes)}), the limit is {_bytes(limit)} "
+            f"({MEMORY_FRACTION:.0%} of the {_bytes(available)} available): use fewer "
+            "stations (3, the default, gives both ends and the middle of each element)",
+            file=file, group="output", key="stations")
+
+
 # -- 6. arguments of the solver functions (the Python API's door) -------------------------
 
 def _plain_number(value: Any) -> Any:
@@ -680,16 +728,43 @@ PHYSICAL_BOUNDS: dict[str, tuple[float, str, str]] = {
     "moment": (1e10, "N m", "a million tonnes on a 1 m arm"),
     "mass": (1e8, "kg", "a hundred thousand tonnes"),
     "pressure": (1e10, "Pa", "10 GPa, beyond the strength of any structural material"),
+    "stiffness": (1e12, "N/m", "a steel bar of 1 m^2 section 0.2 m long; stiffer is a joint"),
+    "rotational_stiffness": (1e12, "N m/rad", "a steel shaft of 1 m diameter 0.01 m long"),
+    "damping": (1e10, "N s/m", "a force of 10 GN at 1 m/s"),
+    "rotational_damping": (1e10, "N m s/rad", "a moment of 10 GN m at 1 rad/s"),
+}
+#: the smallest nonzero magnitude accepted for a quantity (SI units), with what it stands
+#: for: a spring softer than this carries nothing a structure weighs (a box of 2 kg on
+#: a spring of 1e-300 N/m hung 2e301 m down), a body smaller than this is not one the
+#: beam and plate models describe (a 1 nm beam's modes are 8e11 Hz); 0 stays allowed where
+#: the key allows it (no spring). Lifted with the other bounds (``scene.bounds = 'off'``).
+PHYSICAL_MINIMA: dict[str, tuple[float, str, str]] = {
+    "stiffness": (1e-3, "N/m", "1 mN per metre, softer than any spring that carries a load"),
+    "rotational_stiffness": (1e-6, "N m/rad", "1 micro-N m per radian"),
+    "length": (1e-3, "m", "1 mm; a shorter body's modes pass the frequency bound, 1e5 Hz"),
+    "section": (1e-5, "m", "10 micrometres, thinner than kitchen foil"),
 }
 #: how a bound is lifted (for the messages)
 BOUNDS_OVERRIDE = ("scene.bounds = 'off' (ancf run --force) or System(..., bounds='off')")
 
 
-def check_bound(quantity: str, value: float, what: str) -> None:
+def check_bound(quantity: str, value: float, what: str, key: str | None = None) -> None:
     """InputError naming ``what``, the value and the bound when |value| exceeds the
-    physical bound of ``quantity`` (:data:`PHYSICAL_BOUNDS`)."""
+    physical bound of ``quantity`` (:data:`PHYSICAL_BOUNDS`); ``key``: the key it is
+    given by."""
     limit, unit, meaning = PHYSICAL_BOUNDS[quantity]
     if abs(value) > limit:
         raise InputError(f"{what} = {value:g} {unit} is beyond the physical bound for "
                          f"{quantity.replace('_', ' ')}, {limit:g} {unit} ({meaning}); "
-                         f"if this is meant, lift the bounds: {BOUNDS_OVERRIDE}")
+                         f"if this is meant, lift the bounds: {BOUNDS_OVERRIDE}", key=key)
+
+
+def check_minimum(quantity: str, value: float, what: str, key: str | None = None) -> None:
+    """InputError naming ``what``, the value and the bound when 0 < |value| is below the
+    smallest physical magnitude of ``quantity`` (:data:`PHYSICAL_MINIMA`); ``key``: the
+    key it is given by."""
+    limit, unit, meaning = PHYSICAL_MINIMA[quantity]
+    if 0.0 < abs(value) < limit:
+        raise InputError(f"{what} = {value:g} {unit} is below the smallest physical "
+                         f"{quantity.replace('_', ' ')} accepted, {limit:g} {unit} ({meaning}); "
+                         f"if this is meant, lift the bounds: {BOUNDS_OVERRIDE}", key=key)

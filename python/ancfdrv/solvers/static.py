@@ -388,28 +388,36 @@ def _force_jet(model: Model, rel: np.ndarray, d: Jet, lam: np.ndarray, nd: int) 
     return out
 
 
+def split_obstacle(model: Model) -> str | None:
+    """Why the split iteration cannot solve ``model`` (it needs the constant FFR stiffness
+    and dead loads only), or None when it can: what ``static_method = 'auto'`` chooses by,
+    and why an explicit 'split' is refused."""
+    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
+        return ("the split iteration needs the constant stiffness of the 'ffr' formulation "
+                "(every body) without contact")
+    if any(s.second_order is not None for s in model.sets):
+        return ("the split iteration needs the constant stiffness of the 'ffr' formulation; "
+                "beam.geometric_stiffness makes it depend on the axial force")
+    if model.vector_loads:
+        return ("the split iteration takes dead loads only; driven moments, follower loads "
+                "and a rigid body's moments are not")
+    if model.force_elements:
+        return ("the split iteration needs a constant stiffness; force elements "
+                "(spring-dampers, bushings, cylinders) are not")
+    dep = np.asarray(model.constraints.dependent, dtype=int)
+    if len(set(dep.tolist())) != len(model.constraints):
+        return ("the split iteration needs a dependent coordinate of its own per constraint; "
+                "two constraints of this model share one")
+    return None
+
+
 def check_split(model: Model) -> None:
     """Refuse a model the split iteration cannot solve (InputError naming
     solver.static_method: a configuration the user chose, not a failed solve)."""
-    def refuse(why: str) -> None:
-        raise InputError(f"the split iteration {why}; use solver.static_method = 'newton'",
+    obstacle = split_obstacle(model)
+    if obstacle is not None:
+        raise InputError(f"{obstacle}; use solver.static_method = 'newton' or 'auto'",
                          group="solver", key="static_method")
-    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
-        refuse("needs the constant stiffness of the 'ffr' formulation (every body) without "
-               "contact")
-    if any(s.second_order is not None for s in model.sets):
-        refuse("needs the constant stiffness of the 'ffr' formulation; "
-               "beam.geometric_stiffness makes it depend on the axial force")
-    if model.vector_loads:
-        refuse("takes dead loads only; driven moments, follower loads and a rigid body's "
-               "moments are not")
-    if model.force_elements:
-        refuse("needs a constant stiffness; force elements (spring-dampers, bushings, "
-               "cylinders) have none")
-    dep = np.asarray(model.constraints.dependent, dtype=int)
-    if len(set(dep.tolist())) != len(model.constraints):
-        refuse("needs a dependent coordinate of its own per constraint; two constraints of "
-               "this model share one")
 
 
 def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: float = 0.0,
@@ -546,12 +554,29 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
                                        "converged_by": how, "nonlinear_coordinates": nl})
 
 
+#: the values of ``solver.static_method``: 'auto' (the default) takes the split iteration
+#: where it applies (:func:`split_obstacle`), Newton otherwise
+STATIC_METHODS = ("auto", "split", "newton")
+
+
+def static_method_for(model: Model, method: str) -> str:
+    """The static method a run uses: ``method`` itself, or for 'auto' the split iteration
+    where it applies (the boom's FFR scenes of seed 000) and Newton otherwise."""
+    if method == "auto":
+        return "split" if split_obstacle(model) is None else "newton"
+    return method
+
+
 def solve_static(model: Model, method: str, *, tol: float, max_iter: int,
                  p: float = 0.0, load_steps: int = 1) -> StaticResult:
-    """Dispatch on ``solver.static_method``."""
-    if method == "newton":
-        return solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
-    if method == "split":
-        return solve_split(model, tol=tol, max_iter=max_iter, p=p)
-    raise InputError(f"static_method {method!r} must be 'split' or 'newton'", group="solver",
-                     key="static_method")
+    """Dispatch on ``solver.static_method`` ('auto', 'split', 'newton'); the result's
+    ``method`` is the one used, ``extra['method_setting']`` the one asked for."""
+    if method not in STATIC_METHODS:
+        raise InputError(f"static_method {method!r} must be one of {', '.join(STATIC_METHODS)}",
+                         group="solver", key="static_method")
+    if static_method_for(model, method) == "newton":
+        result = solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
+    else:
+        result = solve_split(model, tol=tol, max_iter=max_iter, p=p)
+    result.extra["method_setting"] = method
+    return result

@@ -560,9 +560,12 @@ class System:
 
     # -- the model ------------------------------------------------------------------------
     def check_bounds(self) -> None:
-        """Every drive and load within the physical bounds (``validate.PHYSICAL_BOUNDS``:
-        rates, frequencies, accelerations, forces, moments, masses, pressures); InputError
-        naming the item, the value and the bound otherwise. Lifted by ``bounds='off'``."""
+        """Every drive, load and force element within the physical bounds
+        (``validate.PHYSICAL_BOUNDS``: rates, frequencies, accelerations, forces, moments,
+        masses, pressures, stiffnesses, dampings) and every nonzero stiffness and every
+        flexible body's size and section above the physical minima
+        (``validate.PHYSICAL_MINIMA``); InputError naming the item, the value and the
+        bound otherwise. Lifted by ``bounds='off'``."""
         for drive in self.drives.values():
             where = f"drive {drive.name!r}"
             omega = getattr(drive, "omega", None)
@@ -581,6 +584,34 @@ class System:
             magnitude = float(np.linalg.norm(value)) if np.ndim(value) else float(value)
             validate.check_bound(kind, magnitude, f"load {load.name!r}: |{attribute}|"
                                  if np.ndim(value) else f"load {load.name!r}: {attribute}")
+        for element in self.force_elements.values():
+            where = f"force element {element.name!r}"
+            for key in ("stiffness", "rotational_stiffness", "damping", "rotational_damping"):
+                for value in np.atleast_1d(getattr(element, key)).tolist():
+                    validate.check_bound(key, value, f"{where}: {key}", key=key)
+                    if key in validate.PHYSICAL_MINIMA:
+                        validate.check_minimum(key, value, f"{where}: {key}", key=key)
+        for body in self.bodies.values():
+            self._check_dimensions(body)
+
+    @staticmethod
+    def _check_dimensions(body: Body) -> None:
+        """A flexible body's size and section within the physical minima
+        (``validate.PHYSICAL_MINIMA``: 'length', 'section')."""
+        word = "plate" if isinstance(body, Plate) and not isinstance(body, Leaf) else \
+            type(body).__name__.lower()
+        where = f"{word} {body.name!r}"
+        if isinstance(body, (Beam, Cable)):
+            validate.check_minimum("length", body.length, f"{where}: length", key="end")
+            validate.check_minimum("section", float(np.sqrt(body.section.area)),
+                                   f"{where}: the side of a square of its section's area",
+                                   key="section")
+        elif isinstance(body, Plate):
+            extent = float(np.ptp(body.mesh.coords[:, :3], axis=0).max())
+            validate.check_minimum("length", extent, f"{where}: the largest extent",
+                                   key="edge_x" if word == "plate" else "arc_length")
+            validate.check_minimum("section", body.thickness, f"{where}: thickness",
+                                   key="thickness")
 
     def check_effects_used(self, effects: Iterable[str]) -> None:
         """Every effect listed is one an item of the system belongs to (an effect that
@@ -689,8 +720,8 @@ class System:
     def static(self, **options: Any):
         """The static equilibrium, run exactly as ``ancf run`` runs a static scene, with
         the CLI's defaults. Keywords: any key of the scene groups &solver and &output
-        (``static_method='split'`` by default as in the CLI, 'newton' where the split
-        iteration cannot run: a body not 'ffr', or contact; ``tol``, ``max_iter``,
+        (``static_method='auto'`` by default as in the CLI: the split iteration where it
+        applies, 'newton' otherwise; ``tol``, ``max_iter``,
         ``load_steps``, ...; docs/scenes.md), ``effects`` (default: the system's list, else
         every effect its items belong to), ``output`` (an HDF5 path; default a temporary
         file, see :meth:`~ancfdrv.results.Results.save`), ``progress``.
