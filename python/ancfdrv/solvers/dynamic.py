@@ -705,7 +705,8 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     Interrupted is raised after the sink got the chunk, so a stop request (SIGINT) is
     answered within about a second."""
     check_arguments("integrate", dt=settings.dt, t_end=settings.t_end, tol=settings.tol,
-                    max_newton=settings.max_newton, chunk_steps=settings.chunk_steps, t0=t0)
+                    max_newton=settings.max_newton, chunk_steps=settings.chunk_steps, t0=t0,
+                    dt_min=settings.dt_min)
     e0 = check_state("integrate", "e0", e0, model.ndof)
     v0 = None if v0 is None else check_state("integrate", "v0", v0, model.ndof)
     model.require_runnable()
