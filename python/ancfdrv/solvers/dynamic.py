@@ -29,7 +29,10 @@ dt_min ends the run (SolverError, exit 3). A Newton stall at the round-off floor
 tolerance below what double precision resolves is not retried (a smaller step does not
 lower the floor). With ``step = 'adaptive'`` every step is sized by the local error
 estimate of Zienkiewicz & Xie (1991; see :func:`local_error`) to ``tolerance`` (bounded by
-dt and dt_min), and the same cuts apply to failed steps.
+dt and dt_min), and the same cuts apply to failed steps; a step at dt_min (within
+:data:`STEP_RTOL`) whose estimate exceeds the tolerance ends the run (SolverError, exit 3).
+No loop of the control ends only by round-off: tries in a row without an accepted step are
+bounded, and ``should_stop`` is asked after each of them.
 """
 from __future__ import annotations
 
