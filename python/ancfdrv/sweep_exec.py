@@ -238,7 +238,10 @@ def end_with_parent() -> None:
     * a daemon thread looks for the parent every PARENT_POLL_S seconds and, once it is
       gone, sends this process SIGTERM until it ends: the first one stops a running case
       (also where PR_SET_PDEATHSIG does not exist), the next ends the worker that the
-      stopped case left waiting for work that will not come."""
+      stopped case left waiting for work that will not come.
+
+    (PR_SET_PDEATHSIG follows the thread that started the worker: start the pool's workers
+    from a thread that outlives them, e.g. the main thread, as both pools here do.)"""
     parent = os.getppid()
     _die_with_parent()
     signal.signal(signal.SIGTERM, _exit_on_sigterm)
