@@ -637,10 +637,10 @@ def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
                 allowed = s.tolerance * s.length_scale
                 raise SolverError(
                     f"time step from t = {state['t']:.6g} s to t = {state['t'] + h:.6g} s: "
-                    f"its local error estimate {error * allowed:.3g} m exceeds "
-                    f"solver.tolerance x length = {allowed:.3g} m at the smallest step, "
-                    f"solver.dt_min = {s.smallest_step:.3g} s: the tolerance cannot be "
-                    "met; raise solver.tolerance or lower solver.dt_min")
+                    f"its local error estimate exceeds solver.tolerance x length = "
+                    f"{allowed:.3g} m even at the smallest step, solver.dt_min = "
+                    f"{s.smallest_step:.3g} s: the tolerance cannot be met; raise "
+                    "solver.tolerance or lower solver.dt_min")
             control.reject(h, error)
             continue
         tries = 0
