@@ -74,6 +74,7 @@ from ancfdrv.builders import build_system
 from ancfdrv.io.scene import load_scene
 from ancfdrv.runner import run_scene
 from ancfdrv.solvers.static import solve_newton
+from ancfdrv.sweep_exec import end_with_parent
 from ancfdrv.system.bodies import RigidBody
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -263,7 +264,9 @@ def _progress(done: int, total: int, row: dict, started: float) -> None:
 
 def sweep(cases: list[Case], jobs: int, progress: bool = True) -> list[dict]:
     """Run the cases in ``jobs`` processes (spawned: each imports ancfdrv afresh), printing
-    a line per finished run when ``progress``; the rows come back in the cases' order."""
+    a line per finished run when ``progress``; the rows come back in the cases' order. The
+    workers end with this process, however it ends (a timeout's SIGTERM, SIGKILL):
+    :func:`ancfdrv.sweep_exec.end_with_parent`."""
     started = time.perf_counter()
     rows: list[dict | None] = [None] * len(cases)
     if jobs <= 1:
@@ -273,7 +276,8 @@ def sweep(cases: list[Case], jobs: int, progress: bool = True) -> list[dict]:
                 _progress(i + 1, len(cases), rows[i], started)
         return rows
     context = multiprocessing.get_context("spawn")
-    with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
+    with concurrent.futures.ProcessPoolExecutor(max_workers=jobs, mp_context=context,
+                                                initializer=end_with_parent) as pool:
         futures = {pool.submit(run_case, case): i for i, case in enumerate(cases)}
         for done, future in enumerate(concurrent.futures.as_completed(futures), start=1):
             rows[futures[future]] = future.result()

@@ -294,6 +294,8 @@ CASES: list[Case] = [
     run("dt-tiny-many-steps", edit("LUFFING", ("dt = 1e-3", "dt = 1e-300")), "&solver dt"),
     run("dt-longer-than-t-end", edit("LUFFING", ("dt = 1e-3", "dt = 0.5")), "&solver dt",
         "longer than t_end"),
+    run("dt-min-longer-than-dt", edit("LUFFING", ("dt = 1e-3", "dt = 1e-3, dt_min = 2e-3")),
+        "&solver dt_min", "is longer than dt =", "cannot exceed the step"),
     run("t-end-not-whole-steps", edit("LUFFING", ("dt = 1e-3", "dt = 3e-3")), "&solver t_end",
         "not a whole number of steps", "use t_end = 0.009 or 0.012 s"),
     run("t-end-not-whole-steps-general", edit("GENERAL", ("t_end = 0.005", "t_end = 0.0055")),

@@ -262,6 +262,83 @@ def test_signal_stops_the_run_and_keeps_every_step(scene, tmp_path, signum, code
     assert info.returncode == 0 and text.splitlines()[0].startswith(f"{out}: interrupted:")
 
 
+def wait_for_model(path: Path, proc: subprocess.Popen) -> None:
+    """Until the run's file holds its model (written before any solve)."""
+    from ancfdrv.results.hdf5 import open_result
+    deadline = time.monotonic() + HANG_GUARD_S
+    while True:
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, f"{path} never got its model"
+        try:
+            with open_result(path) as h5:
+                if "model" in h5:
+                    return
+        except Exception:  # noqa: BLE001 - not there or being created: look again
+            pass
+        time.sleep(0.05)
+
+
+def _stopped(proc: subprocess.Popen, signum: int) -> tuple[int, str]:
+    """Send signum and wait for the process: it must end within SIGNAL_GUARD_S (a bound
+    against a run that does not listen, not a measurement)."""
+    proc.send_signal(signum)
+    try:
+        _, err = proc.communicate(timeout=SIGNAL_GUARD_S)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        pytest.fail(f"the run did not stop within {SIGNAL_GUARD_S} s of {signum!r}")
+    return proc.returncode, err
+
+
+SIGNAL_GUARD_S = 20
+SIGNALS = [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")]
+
+
+@pytest.mark.parametrize("signum,code,name", SIGNALS)
+def test_signal_stops_an_adaptive_run_within_its_output_interval(tmp_path, signum, code,
+                                                                 name):
+    """Issue 35: under step = 'adaptive' the stop request is asked after every step tried,
+    not only at the output rows. The 5-node pendulum with rows 5 s apart and a tolerance
+    of 1e-12 (steps down to dt_min = 1e-9 s) spends minutes in its first interval (its
+    first second took 14.7 s when only the rows asked); signalled a second after its file
+    holds the model, it stops with exit 130 / 143, one line, and a file that opens with status
+    'interrupted' and the initial row."""
+    out = tmp_path / "adaptive.h5"
+    proc = ancf("run", str(INPUTS / "hard" / "pendulum.nml"), "-o", str(out), "--set",
+                "beam.nodes=5", "--set", "solver.dt=5.0", "--set", "solver.t_end=100",
+                "--set", "solver.step=adaptive", "--set", "solver.tolerance=1e-12",
+                "--set", "solver.dt_min=1e-9", "--set", "output.xdmf=.false.")
+    wait_for_model(out, proc)
+    time.sleep(1.0)  # into the first interval (the rows wait there: none is flushed yet)
+    returncode, err = _stopped(proc, signum)
+    assert returncode == code, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and f"interrupted by {name} at t = 0 s" in lines[0], err
+    with h5py.File(out, "r") as h5:
+        assert h5.attrs["status"] == "interrupted"
+        assert h5["dynamic/time"][()].tolist() == [0.0]
+
+
+@pytest.mark.parametrize("signum,code,name", SIGNALS)
+def test_signal_stops_a_static_run(tmp_path, signum, code, name):
+    """A long static run in a process (the 400-node elastica in 2000 load steps, one
+    kernel call each): signalled once its file holds the model, it stops with exit 130 /
+    143 and one line; the file opens, says 'interrupted' and keeps the model, no static
+    solution (none was complete)."""
+    out = tmp_path / "static.h5"
+    proc = ancf("run", str(INPUTS / "hard" / "elastica.nml"), "-o", str(out), "--set",
+                "beam.nodes=400", "--set", "solver.load_steps=2000")
+    wait_for_model(out, proc)
+    returncode, err = _stopped(proc, signum)
+    assert returncode == code, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and f"interrupted by {name} before any result" in lines[0], err
+    with h5py.File(out, "r") as h5:
+        assert h5.attrs["status"] == "interrupted"
+        assert h5["model"].attrs["nnodes"] == 400 and "static" not in h5
+
+
 def test_sigkill_leaves_an_abandoned_file_and_no_blocking_lock(scene, tmp_path, capsys):
     out = tmp_path / "killed.h5"
     proc = ancf("run", str(scene), "-o", str(out), *LONG)

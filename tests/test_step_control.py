@@ -186,3 +186,94 @@ def test_boom_statics_converge_without_the_round_off_iteration():
     finally:
         model.close()
     assert np.abs(newton.e - split.e).max() < 1e-9
+
+
+def test_adaptive_step_at_dt_min_ends_the_run_with_exit_3(tmp_path, capsys):
+    """Issue 35: a tolerance no step can meet (1e-15 of the length) on the 5-node pendulum.
+    The control halves the step down to dt_min; the sub-step that ends an interval there is
+    t_target - t and came out 1.9e-11 of a step longer than dt_min (the round-off of the
+    sum t), was rejected, cut back to the same remainder, forever (Ctrl-C could not stop
+    it). Now it is at dt_min: the run ends with exit 3 saying the tolerance cannot be met
+    at solver.dt_min, and the file keeps its rows (the initial one at least, on the grid)
+    with status 'failed'."""
+    out = tmp_path / "p.h5"
+    code = main(["run", str(INPUTS / "hard" / "pendulum.nml"), "--set", "beam.nodes=5",
+                 "--set", "solver.t_end=0.05", "--set", "solver.step=adaptive",
+                 "--set", "solver.tolerance=1e-15", "-o", str(out)])
+    err = capsys.readouterr().err
+    assert code == 3, err
+    assert "the tolerance cannot be met" in err and "solver.dt_min" in err
+    assert "raise solver.tolerance" in err
+    with h5py.File(out) as h5:
+        t = h5["dynamic/time"][()]
+        assert h5["dynamic"].attrs["status"] == "failed"
+    assert len(t) >= 1
+    np.testing.assert_allclose(t, np.arange(len(t)) * 5e-4, rtol=0, atol=1e-12)
+
+
+def test_a_step_within_round_off_of_dt_min_is_at_dt_min():
+    """The step the pendulum above was stuck on: dt_min = 5e-4 / 1024 and a last sub-step
+    1.9e-11 of it longer (9e-18 s, 1.3 ulp of t = 0.05 s) is at dt_min; twice dt_min is
+    not, unless the controller's own step is at dt_min already (a step stretched onto the
+    grid); the relative slack is STEP_RTOL = 1e-9."""
+    from ancfdrv.solvers.dynamic import STEP_RTOL, StepControl
+    settings = DynamicSettings(dt=5e-4, t_end=0.05, step="adaptive")
+    floor = settings.smallest_step
+    control = StepControl(settings)
+    control.h = 2 * floor
+    assert control.at_floor(floor * (1 + 1.9e-11))
+    assert not control.at_floor(2 * floor)
+    assert not control.at_floor(floor * (1 + 2 * STEP_RTOL))
+    control.h = floor
+    assert control.at_floor(floor * (1 + 1e-6))
+
+
+def test_a_step_control_that_makes_no_progress_is_stopped(monkeypatch):
+    """The guard on tries in a row without an accepted step: with a broken control whose
+    rejections leave the step as it was and never see dt_min, the run ends with a
+    SolverError naming the guard after 8 + log2(dt / dt_min) tries (18 at the default
+    dt_min = dt / 1024), not in an endless loop."""
+    from ancfdrv.solvers import dynamic
+    tries = []
+    advance = dynamic.TimeIntegrator.advance
+
+    def counted(self, state, nsteps, h=None):
+        tries.append(h)
+        return advance(self, state, nsteps, h)
+
+    monkeypatch.setattr(dynamic.TimeIntegrator, "advance", counted)
+    monkeypatch.setattr(dynamic.StepControl, "reject", lambda self, h, error: None)
+    monkeypatch.setattr(dynamic.StepControl, "at_floor", lambda self, h: False)
+    mass, length = 3.0, 1.2
+    s = System("pendulum")
+    s.rigid_body("rod", mass=mass, inertia=np.diag([1e-4, 1.0, 1.0]) * mass * length**2 / 12,
+                 position=(length / 2, 0, 0))
+    s.joint("pin", "revolute", "ground", "rod", point=(0, 0, 0), axis=(0, 0, 1))
+    s.load("g", "gravity", vector=(0, -G, 0))
+    model = s.assemble()
+    try:
+        with pytest.raises(SolverError, match="tries in a row") as raised:
+            integrate(model, DynamicSettings(dt=0.05, t_end=0.1, step="adaptive",
+                                             tolerance=1e-15), model.e0, progress=False)
+    finally:
+        model.close()
+    assert "without an accepted step" in str(raised.value)
+    assert len(tries) == 18
+
+
+def test_dt_min_longer_than_dt_is_refused_by_the_api():
+    """solver.dt_min > dt (accepted before issue 35): System.simulate and integrate refuse
+    it with an InputError naming both (the namelist's refusal: tests/test_bad_input.py)."""
+    from ancfdrv.errors import InputError
+    s = System("pendulum")
+    s.rigid_body("rod", mass=1.0, inertia=np.eye(3) * 0.1, position=(0.5, 0, 0))
+    s.joint("pin", "revolute", "ground", "rod", point=(0, 0, 0), axis=(0, 0, 1))
+    with pytest.raises(InputError, match="dt_min = .* is longer than dt ="):
+        s.simulate(0.01, 1e-3, dt_min=2e-3)
+    model = s.assemble()
+    try:
+        with pytest.raises(InputError, match="integrate: dt_min = .* is longer than dt ="):
+            integrate(model, DynamicSettings(dt=1e-3, t_end=0.01, dt_min=2e-3), model.e0,
+                      progress=False)
+    finally:
+        model.close()

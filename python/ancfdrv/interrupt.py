@@ -3,10 +3,12 @@
 While a :class:`StopRequest` is active (a ``with`` block in the main thread) the two
 signals do not kill the process: they are recorded, and the run stops at the next point
 where its output is consistent (after the chunk being computed, which the time
-integrator keeps below ~0.25 s of wall time), marks the file 'interrupted' and raises
-:class:`~ancfdrv.errors.Interrupted` (exit status 130 for SIGINT, 143 for SIGTERM).
-Phases that cannot look at the request (model building, a static solve) run inside
-:meth:`StopRequest.immediate`, where a signal raises at once: they write nothing.
+integrator keeps below ~0.25 s of wall time, or under step control after the step being
+tried), marks the file 'interrupted' and raises :class:`~ancfdrv.errors.Interrupted`
+(exit status 130 for SIGINT, 143 for SIGTERM). Phases that cannot look at the request
+(model building, a static solve) run inside :meth:`StopRequest.immediate`, where a signal
+raises at once: they write nothing. (A handler runs between two Python operations: a
+kernel call in progress, e.g. one load step of the static Newton solve, is finished first.)
 """
 from __future__ import annotations
 

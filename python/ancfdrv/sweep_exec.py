@@ -27,6 +27,7 @@ import os
 import signal
 import tempfile
 import threading
+import time
 import traceback
 from collections import deque
 from dataclasses import dataclass
@@ -246,6 +247,42 @@ def _die_with_parent() -> None:
         return
     if os.getppid() != parent:  # the parent died before the request was in place
         os._exit(128 + signal.SIGTERM)
+
+
+#: how often a pool worker started by :func:`end_with_parent` looks for its parent (s)
+PARENT_POLL_S = 0.25
+
+
+def end_with_parent() -> None:
+    """Make this process, a worker of a process pool (the ``initializer`` of a
+    ``concurrent.futures.ProcessPoolExecutor`` or a ``multiprocessing.Pool``), end with its
+    parent, however the parent ends (SIGTERM, SIGKILL, a crash): a parent stopped by a
+    timeout left its two workers running for 25 minutes (issue 35).
+
+    * Linux: the kernel sends SIGTERM when the parent dies (PR_SET_PDEATHSIG), so a case
+      being run stops at its next step boundary (:mod:`ancfdrv.interrupt`), its file says
+      'interrupted';
+    * SIGTERM outside a run ends the worker at once (an idle worker, blocked on its queue);
+    * a daemon thread looks for the parent every PARENT_POLL_S seconds and, once it is
+      gone, sends this process SIGTERM until it ends: the first one stops a running case
+      (also where PR_SET_PDEATHSIG does not exist), the next ends the worker that the
+      stopped case left waiting for work that will not come.
+
+    (PR_SET_PDEATHSIG follows the thread that started the worker: start the pool's workers
+    from a thread that outlives them, e.g. the main thread, as both pools here do.)"""
+    parent = os.getppid()
+    _die_with_parent()
+    signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    threading.Thread(target=_watch_parent, args=(parent,), name="ancf-parent-watch",
+                     daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_S)
+    while True:
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(PARENT_POLL_S)
 
 
 def worker_cap(requested: int, cases: int) -> int:

@@ -325,8 +325,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                              "system has rigid bodies"),
         "dt_min": Key("float", 0.0, non_negative,
                       "smallest step (s) a failed step is cut to (halved from dt, doubled "
-                      "back after 4 successes; 0: dt / 1024; dt_min = dt: no cuts); a step "
-                      "failing at dt_min ends the run (exit 3)"),
+                      "back after 4 successes; 0: dt / 1024; dt_min = dt: no cuts; at most "
+                      "dt); a step failing at dt_min, or whose error estimate exceeds "
+                      "solver.tolerance there (step = 'adaptive'), ends the run (exit 3)"),
         "step": Key("str", "fixed", one_of("fixed", "adaptive"),
                     "'fixed': steps of dt, cut where one fails; 'adaptive': each step sized "
                     "by the local error estimate (Zienkiewicz & Xie 1991) to "

@@ -369,9 +369,14 @@ def steps_of(dt: float, t_end: float) -> int:
     return int(round(t_end / dt))
 
 
+def _dt_min_problem(dt_min: float, dt: float) -> str:
+    return (f"dt_min = {_g(dt_min)} s is longer than dt = {_g(dt)} s: the smallest step a "
+            "step is cut to cannot exceed the step (dt_min = dt: no cuts; 0: dt / 1024)")
+
+
 def check_time(solver: dict[str, Any], analysis: str, file: str) -> None:
-    """t_end > 0, MIN_DT <= dt <= t_end, t_end a whole number of steps, at most MAX_STEPS
-    steps (dynamic analyses only)."""
+    """t_end > 0, MIN_DT <= dt <= t_end, dt_min <= dt, t_end a whole number of steps, at
+    most MAX_STEPS steps (dynamic analyses only)."""
     if analysis not in ("dynamic", "static+dynamic"):
         return
     dt, t_end = solver["dt"], solver["t_end"]
@@ -385,6 +390,8 @@ def check_time(solver: dict[str, Any], analysis: str, file: str) -> None:
     if dt > t_end:
         raise InputError(f"dt = {_g(dt)} s is longer than t_end = {_g(t_end)} s: the run "
                          "would make no step", **where, key="dt")
+    if solver.get("dt_min", 0.0) > dt:
+        raise InputError(_dt_min_problem(solver["dt_min"], dt), **where, key="dt_min")
     ratio = t_end / dt
     if ratio > MAX_STEPS:
         raise InputError(f"t_end / dt = {ratio:.3g} steps; at most {MAX_STEPS:.0e} steps are "
@@ -640,8 +647,9 @@ def check_arguments(function: str, **values: Any) -> dict[str, Any]:
     """The keyword arguments of a solver function checked at its entry (InputError naming
     the function and the argument): ``tol`` a finite number > 0, ``max_iter``,
     ``load_steps``, ``max_newton`` and ``chunk_steps`` integers >= 1 within 32 bits,
-    ``loads`` and ``p`` finite numbers, ``dt`` at least MIN_DT, ``t_end`` finite and > 0,
-    at most MAX_STEPS steps. Returns the values as plain Python numbers."""
+    ``loads`` and ``p`` finite numbers, ``dt`` at least MIN_DT, ``dt_min`` >= 0 and at most
+    ``dt``, ``t_end`` finite and > 0, at most MAX_STEPS steps. Returns the values as
+    plain Python numbers."""
     out = {}
     for key, raw in values.items():
         value = _plain_number(raw)
@@ -660,12 +668,16 @@ def check_arguments(function: str, **values: Any) -> dict[str, Any]:
                 raise InputError(f"{name}: expected a finite number, got {value!r}")
             if key in ("tol", "inner_tol") and value <= 0:
                 raise InputError(f"{name} = {value:g} must be positive")
+            if key == "dt_min" and value < 0:
+                raise InputError(f"{name} = {value:g} s must be 0 (dt / 1024) or positive")
             if key == "dt" and value < MIN_DT:
                 raise InputError(f"{function}: dt = {value:g} s is below the smallest step "
                                  f"accepted ({MIN_DT:g} s)")
             if key == "t_end" and value <= 0:
                 raise InputError(f"{function}: t_end = {value:g} s must be positive")
         out[key] = value
+    if "dt" in out and "dt_min" in out and out["dt_min"] > out["dt"]:
+        raise InputError(f"{function}: {_dt_min_problem(out['dt_min'], out['dt'])}")
     if "dt" in out and "t_end" in out and out["t_end"] / out["dt"] > MAX_STEPS:
         raise InputError(f"{function}: t_end / dt = {out['t_end'] / out['dt']:.3g} steps; at "
                          f"most {MAX_STEPS:.0e} steps are accepted")

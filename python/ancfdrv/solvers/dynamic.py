@@ -29,7 +29,10 @@ dt_min ends the run (SolverError, exit 3). A Newton stall at the round-off floor
 tolerance below what double precision resolves is not retried (a smaller step does not
 lower the floor). With ``step = 'adaptive'`` every step is sized by the local error
 estimate of Zienkiewicz & Xie (1991; see :func:`local_error`) to ``tolerance`` (bounded by
-dt and dt_min), and the same cuts apply to failed steps.
+dt and dt_min), and the same cuts apply to failed steps; a step at dt_min (within
+:data:`STEP_RTOL`) whose estimate exceeds the tolerance ends the run (SolverError, exit 3).
+No loop of the control ends only by round-off: tries in a row without an accepted step are
+bounded, and ``should_stop`` is asked after each of them.
 """
 from __future__ import annotations
 
@@ -380,6 +383,16 @@ NEWTON_LIMIT, NEWTON_FLOOR_STALL, NEWTON_STALL, NEWTON_DIVERGED = 0, 1, 2, 3
 RETRYABLE = {1, 2, 3, 4, 6, 7, 8}
 #: successful steps in a row after which a cut step doubles again
 GROW_AFTER = 4
+#: the relative slack within which two step sizes are one: a step that would end short of
+#: the next grid time by less is stretched onto it, and a step within it of dt_min is at
+#: dt_min (cannot be cut nor rejected). A sub-step that ends an interval is t_target - t,
+#: t the sum of the interval's earlier sub-steps, so it carries their round-off, a few ulps
+#: of t: 1.9e-11 of a 4.9e-7 s step at t = 0.05 s (9e-18 s, 1.3 ulp), which compared with
+#: dt_min at 1e-12 was rejected, cut back to that same remainder, forever (issue 35). 1e-9
+#: covers k ulps of t for k t / h up to ~4e6 (the k sub-steps of an interval, h >= dt_min),
+#: and is far below the factor 2 between the sizes the control chooses (dt / 2^k); beyond
+#: it the controller's own step, set to dt_min exactly, still says the floor is reached.
+STEP_RTOL = 1e-9
 
 
 def local_error(settings: DynamicSettings, h: float, accel_old: np.ndarray,
@@ -442,11 +455,17 @@ class StepControl:
     def cut(self, h: float) -> bool:
         """A step of size h failed: halve it; False when that falls below dt_min."""
         self.successes = 0
-        if 0.5 * h < self.settings.smallest_step * (1.0 - 1e-12):
+        if 0.5 * h < self.settings.smallest_step * (1.0 - STEP_RTOL):
             return False
         self.cuts += 1
         self.h = 0.5 * h
         return True
+
+    def at_floor(self, h: float) -> bool:
+        """Whether a step of size h is at dt_min (within STEP_RTOL): it, or the controller's
+        step it was stretched from to land on the grid, cannot be made smaller."""
+        floor = self.settings.smallest_step * (1.0 + STEP_RTOL)
+        return h <= floor or self.h <= floor
 
     def reject(self, h: float, error: float) -> None:
         """The error estimate rejected a step of size h: halved until the estimate (~h^3)
@@ -567,26 +586,42 @@ def _restart(model: Model, state: dict) -> None:
 
 
 def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
-              t_target: float, stats0: np.ndarray | None = None, cuts0: int = 0) -> Chunk:
+              t_target: float, stats0: np.ndarray | None = None, cuts0: int = 0,
+              should_stop: Callable[[], bool] | None = None) -> Chunk:
     """Steps of the controller's size from state["t"] to the grid time t_target (landed on
     exactly); returns the row at t_target with the interval's statistics (failed tries
-    included). Raises SolverError when a step fails at dt_min."""
+    included). Raises SolverError when a step fails at dt_min, or when its error estimate
+    exceeds the tolerance at dt_min, and Interrupted when ``should_stop`` says so after a
+    try (the interval's steps are then dropped: the state stays where it got to)."""
     s = integrator.settings
     stats = np.zeros(3, dtype=np.int64) if stats0 is None else stats0.copy()
     cuts, taken, smallest, last = cuts0, 0, np.inf, None
     adaptive = s.step == "adaptive"
+    # a guard: each cut or rejection at least halves the controller's step until dt_min,
+    # where the next one ends the run, so this many tries in a row cannot fail or be
+    # rejected unless the control is broken (it ends the run instead of looping)
+    max_tries = 8 + int(np.ceil(np.log2(max(s.dt / s.smallest_step, 1.0))))
+    tries = 0  # failed or rejected since the last accepted step
     while True:
         remaining = t_target - state["t"]
-        if remaining <= 1e-9 * s.smallest_step:
+        if remaining <= STEP_RTOL * s.smallest_step:
             break
+        if should_stop is not None and should_stop():
+            raise Interrupted(f"stopped at t = {state['t']:.6g} s, between two output rows")
+        if tries >= max_tries:
+            raise SolverError(f"step-size control: {tries} tries in a row from t = "
+                              f"{state['t']:.6g} s without an accepted step (halving dt = "
+                              f"{s.dt:.3g} s to solver.dt_min = {s.smallest_step:.3g} s takes "
+                              f"{max_tries - 8}); the run stops")
         h = control.h
-        if h >= remaining * (1.0 - 1e-9):
+        if h >= remaining * (1.0 - STEP_RTOL):
             h = remaining
-        if abs(h - control.last_h) > 1e-9 * h:
+        if abs(h - control.last_h) > STEP_RTOL * h:
             _restart(integrator.model, state)
             control.restarts += 1
         before = _snapshot(state)
         chunk, info, detail = integrator.advance(state, 1, h)
+        tries += 1
         if info:
             stats += integrator.failed_stats
             retry = info in RETRYABLE and not (info == 1 and detail == NEWTON_FLOOR_STALL)
@@ -599,10 +634,19 @@ def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
             continue
         stats += chunk.stats[0].astype(np.int64)
         error = local_error(s, h, before["accel"], state["accel"]) if adaptive else None
-        if error is not None and error > 1.0 and h > s.smallest_step * (1.0 + 1e-12):
-            control.reject(h, error)
+        if error is not None and error > 1.0:
             state.update(before)
+            if control.at_floor(h):
+                allowed = s.tolerance * s.length_scale
+                raise SolverError(
+                    f"time step from t = {state['t']:.6g} s to t = {state['t'] + h:.6g} s: "
+                    f"its local error estimate exceeds solver.tolerance x length = "
+                    f"{allowed:.3g} m even at the smallest step, solver.dt_min = "
+                    f"{s.smallest_step:.3g} s: the tolerance cannot be met; raise "
+                    "solver.tolerance or lower solver.dt_min")
+            control.reject(h, error)
             continue
+        tries = 0
         control.last_h = h
         control.succeeded(h, t_target - state["t"], error)
         taken += 1
@@ -667,7 +711,8 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     Interrupted is raised after the sink got the chunk, so a stop request (SIGINT) is
     answered within about a second."""
     check_arguments("integrate", dt=settings.dt, t_end=settings.t_end, tol=settings.tol,
-                    max_newton=settings.max_newton, chunk_steps=settings.chunk_steps, t0=t0)
+                    max_newton=settings.max_newton, chunk_steps=settings.chunk_steps, t0=t0,
+                    dt_min=settings.dt_min)
     e0 = check_state("integrate", "e0", e0, model.ndof)
     v0 = None if v0 is None else check_state("integrate", "v0", v0, model.ndof)
     model.require_runnable()
@@ -736,7 +781,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
                     else state["t"] + settings.dt
                 try:
                     chunk = _interval(integrator, control, state, t_target, failed,
-                                      int(carried_cut))
+                                      int(carried_cut), should_stop)
                 except SolverError as exc:
                     pending = exc
                     chunk = Chunk(time=np.zeros(0), probes=np.zeros((0, 0, 3)),
