@@ -688,7 +688,9 @@ def check_path(value: Any, argument: str) -> Path:
     """A file path given to the Python API (a scene, ``output=``, ``Results.save(path)``,
     ``ancfdrv.open(path)``): a str or os.PathLike, else InputError naming the argument
     and what it got (a number, None, bytes, an empty or NUL-bearing name)."""
-    from .schema import short_repr
+    def short_repr(thing: Any, limit: int = 60) -> str:   # (schema.short_repr's cut)
+        text = repr(thing)
+        return text if len(text) <= limit else text[:limit - 4] + "..." + text[-1]
     expected = f"{argument}: expected a file path (a str or pathlib.Path), got"
     if isinstance(value, (bytes, bytearray)):
         raise InputError(f"{expected} bytes {short_repr(bytes(value))} (decode it: "
