@@ -27,8 +27,10 @@ demo: $(STAMP)
 	@echo "== One luffing run, 28 nodes, 50 kg"
 	$(VENV)/bin/ancf run inputs/boom_luffing.nml -o results/boom_luffing.h5
 
+# one pytest worker per core (pytest-xdist), each test file on one worker (its module
+# fixtures computed once)
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --dist loadfile
 
 benchmark: $(STAMP)
 	$(PY) benchmarks/static_scaling.py
