@@ -3,6 +3,8 @@
 # the package and its Python dependencies, the Meson build.
 #   make demo   the crane-boom example of seed 000 (statics sweep), results in results/
 #   make test   the whole test suite (pytest)
+#   make bench  every benchmark, one report: results/bench/report.md (BENCH_FLAGS=--quick
+#               for the smoke settings, BENCH_FLAGS=--list for the plan; benchmarks/README.md)
 
 SHELL := /bin/bash
 PYTHON ?= python3
@@ -15,7 +17,7 @@ SOURCES := $(shell find fortran python -name '*.f90' -o -name '*.py' -o -name '.
 DEMO_STATIC := results/boom_static_sweep
 DEMO_LUFFING := results/boom_luffing_sweep
 
-.PHONY: demo test install system-packages clean benchmark
+.PHONY: demo test bench install system-packages clean
 
 demo: $(STAMP)
 	@echo "== Statics (seed 000, Figs. 4-5): 5 angles x 2 masses x 5 meshes, against the closed form"
@@ -32,8 +34,9 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q -n auto --dist loadfile
 
-benchmark: $(STAMP)
-	$(PY) benchmarks/static_scaling.py
+BENCH_FLAGS ?=
+bench: $(STAMP)
+	$(PY) benchmarks/run_all.py $(BENCH_FLAGS)
 
 install: $(STAMP)
 

@@ -3,7 +3,7 @@ tests/test_step_control.py.
 
 * the flexible double pendulum: two hinged beams 1 m, 0.02 x 0.02 m, E = 2e9 Pa,
   rho = 2700 kg/m^3 ('nonlinear' ANCF beams), released horizontal under gravity;
-* the flexible pendulum (Berzeri & Shabana 2000; ../shared/REFERENCES.md): inputs/hard/pendulum.nml.
+* the flexible pendulum (Berzeri & Shabana 2000): inputs/hard/pendulum.nml.
 """
 from __future__ import annotations
 

@@ -142,6 +142,8 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=10)
     parser.add_argument("--calls", type=int, default=20)
     parser.add_argument("--instructions", action="store_true")
+    parser.add_argument("--output", type=Path, default=RESULTS / "call_overhead.json",
+                        help="the JSON report; its Markdown table beside it (.md)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     parser.add_argument("--counted", help=argparse.SUPPRESS)
     parser.add_argument("--helper", help=argparse.SUPPRESS)
@@ -175,8 +177,8 @@ def main() -> None:
         with tempfile.TemporaryDirectory() as work:
             for label, site in copies.items():
                 report["copies"][label]["instructions"] = instructions(site, Path(work), label)
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "call_overhead.json").write_text(json.dumps(report, indent=1) + "\n")
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    args.output.write_text(json.dumps(report, indent=1) + "\n")
     lines = [f"# The fixed cost of a small in-memory call ({report['date']})", "",
              f"`ancfdrv.simulate({report['scene']}, {OVERRIDES})`: {args.rounds} rounds of "
              f"{args.calls} calls per copy, alternating; load average "
@@ -192,7 +194,7 @@ def main() -> None:
             f"| {s['outside_cpu_ms']['best']:.3f} / {s['outside_cpu_ms']['median']:.3f} "
             f"| {s['gc_collections']['mean']:.2f} | {s['gc_ms']['mean']:.3f} "
             f"| {'' if ins is None else f'{ins:.2f}'} |")
-    (RESULTS / "call_overhead.md").write_text("\n".join(lines) + "\n")
+    args.output.with_suffix(".md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

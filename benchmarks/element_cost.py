@@ -213,6 +213,7 @@ def beam_arrays(kernel: Any, nel: int, poisson: float) -> dict[str, Any]:
             "e": np.asfortranarray(e.ravel()), "reference": ffr.reference,
             "gradients": continuum.gradients, "weights": continuum.weights,
             "stiffness0": ffr.stiffness0, "rotation": np.asfortranarray(np.eye(3)),
+            "shear_scales": np.asarray(continuum.shear_scales, dtype=float),
             "youngs": YOUNGS, "poisson": poisson}
 
 
@@ -232,7 +233,7 @@ def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
     def nonlinear(want_tangent: int) -> Callable[[], Any]:
         return lambda: kernel.beam_nonlinear_forces(a["nvolume"], a["dofs"], a["e"],
                                                     a["gradients"], a["weights"], a["youngs"],
-                                                    a["poisson"], want_tangent)
+                                                    a["poisson"], a["shear_scales"], want_tangent)
 
     calls: dict[str, Callable[[], Any]] = {
         "nonlinear_force": nonlinear(0),

@@ -114,7 +114,8 @@ def contact_setup(points: int) -> dict[str, Any]:
     from ancfdrv import _kernel, kernel
     from ancfdrv.builders import build_model
     from ancfdrv.io.scene import load_scene
-    from ancfdrv.system.meshes import P_R, PLATE_NODE_DOFS
+    from ancfdrv.system.meshes import PLATE_NODE_DOFS
+    P_R = 0  # r is the first vector of a plate node's [r, r_x, r_y]
 
     scene = load_scene(SCENE, [f"spring.contact_points={points}"])
     model = build_model(scene)

@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """Accuracy against wall time: ancfdrv's large-deformation beam and Exudyn's ANCFCable2D on
-the two hard cases of ../shared/REFERENCES.md.
+the two hard cases of docs/hard-cases.md.
 
 Problems (the physical data are read from the ancfdrv scenes, so both codes solve the
 same beam):
@@ -32,7 +32,7 @@ and EI from the scene's section) and integrates with its generalized-alpha solve
 * spin-up: ancfdrv prescribes r = 0, r_y = (-sin phi, cos phi, 0), r_z = e3 at the root;
   Exudyn prescribes r = 0 and the slope r' = (cos phi, sin phi) (``CoordinateConstraint``
   with an offset user function), which also fixes the axial stretch of the root point
-  (strains there are ~3e-5: no visible effect). phi(t) is the profile of REFERENCES.md,
+  (strains there are ~3e-5: no visible effect). phi(t) is the profile of Simo & Vu-Quoc 1986,
   checked against ancfdrv's drive (``kernel.drive_values``).
 
 Each code runs a grid of meshes and steps; its finest run is its converged reference.
@@ -424,7 +424,7 @@ def beam_from_scene(problem: Problem) -> Beam:
 
 
 def spinup_angle(beam: Beam, t: float) -> float:
-    """Hub angle of REFERENCES.md: (W/T)[t^2/2 + (T/2pi)^2 (cos(2 pi t/T) - 1)] for t < T,
+    """Hub angle of Simo & Vu-Quoc 1986: (W/T)[t^2/2 + (T/2pi)^2 (cos(2 pi t/T) - 1)] for t < T,
     W t - W T/2 after."""
     w, period = beam.omega, beam.period
     if t < period:

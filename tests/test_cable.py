@@ -8,7 +8,7 @@ force in rigid motions (translation, a large rotation), the analytic tangent aga
 differences of the force (and the force against differences of the energy), objectivity
 under a large rotation of a deformed state. System checks through the System API: the tip
 deflection of a cantilever against Euler-Bernoulli P L^3 / (3 E I), the large-deflection
-elastica (REFERENCES.md: k = P L^2 / EI = 1 gives w/L = 0.30172, u/L = 0.05643) and the first
+elastica (Mattiasson 1981: k = P L^2 / EI = 1 gives w/L = 0.30172, u/L = 0.05643) and the first
 bending frequencies against the closed form beta_n L = 1.87510, 4.69409, 7.85476.
 """
 from __future__ import annotations
@@ -149,7 +149,7 @@ def test_cantilever_tip_deflection_euler_bernoulli():
 
 def test_cantilever_elastica():
     """k = P L^2 / (E I) = 1, 16 elements, 5 load steps: w/L = 0.30172, u/L = 0.05643
-    (REFERENCES.md, the elastica; Mattiasson 1981) to the 5 digits given."""
+    (the elastica; Mattiasson 1981) to the 5 digits given."""
     length = 2.0
     tip = _cantilever(17, E * INERTIA / length**2, length, load_steps=5)
     assert -tip[1] / length == pytest.approx(0.30172, abs=1e-5)
@@ -221,7 +221,7 @@ SCENE = """&scene  title = 'cable elastica', analysis = 'static', effects = 'tip
 
 def test_cable_from_a_namelist(tmp_path):
     """The &cable group of a general scene builds the same cable: the elastica k = 1 from a
-    scene file, tip displacement in the result file (REFERENCES.md values)."""
+    scene file, tip displacement in the result file (Mattiasson 1981's values)."""
     import h5py
 
     from ancfdrv.runner import run_scene

@@ -1,6 +1,6 @@
 """Beam element kernel: mass, gravity, stiffness, rigid motions, the T^T M T = M identity.
 
-References: REFERENCES.md (Chrono ChElementBeamANCF_3243 compact mass and gravity for a
+References: Chrono's unit tests (ChElementBeamANCF_3243 compact mass and gravity for a
 1 m, 0.1 x 0.1 m, rho = 7850 element: 13m/35, 11mL/210, 9m/70, -13mL/420; mg/2, mgL/12),
 closed-form volume and weight, and invariants (rigid motions carry no strain).
 """

@@ -193,7 +193,7 @@ def _strip(nx: int, poisson: float, force: float = 0.0, moment: float = 0.0) -> 
 
 @pytest.mark.parametrize("poisson", [0.0, 0.3])
 def test_clamped_strip_under_tip_force_and_moment_matches_kirchhoff(poisson):
-    """w = F L^3 / (3 D b) and w = M L^2 / (2 D b) (REFERENCES.md); a load giving w = L/1000
+    """w = F L^3 / (3 D b) and w = M L^2 / (2 D b) (Kirchhoff plate strip); a load giving w = L/1000
     keeps the geometric nonlinearity below 1e-6."""
     d_width = 2e11 * 0.01**3 / (12 * (1 - poisson**2)) * 0.1
     force = 3e-3 * d_width
@@ -218,7 +218,7 @@ def test_simply_supported_plate_under_pressure_converges_to_kirchhoff():
     from ancfdrv.reference.analytic import navier_plate_centre_deflection
     assert navier_plate_centre_deflection(1.0, 1.0, 1.0, 12 * (1 - 0.09), 0.3, 1.0) == \
         pytest.approx(navier, rel=1e-12)  # D = 1
-    assert navier == pytest.approx(0.00406, abs=5e-6)  # REFERENCES.md's 0.00406
+    assert navier == pytest.approx(0.00406, abs=5e-6)  # Navier's 0.00406 (Timoshenko)
     errors = []
     for n in (4, 8, 16):
         scene = load_scene(INPUTS / "plate_pressure.nml", [f"plate.nx={n}", f"plate.ny={n}"])

@@ -4,7 +4,7 @@ named by an edge or a box so that refining the mesh never leaves part of them fr
 
 References: the Euler-Bernoulli closed form of a propped cantilever with an overhang
 (superposition of cantilever deflections, below), the same model with a node at every
-point, and the plate-strip closed form w = q L^4 / (8 D) (REFERENCES.md; nu = 0, where the
+point, and the plate-strip closed form w = q L^4 / (8 D) (Kirchhoff; nu = 0, where the
 free-sided strip and the beam agree)."""
 from __future__ import annotations
 

@@ -251,18 +251,18 @@ def test_in_memory_run_writes_no_file(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_readme_example_runs_as_printed(tmp_path, monkeypatch):
-    """README's in-memory example, run in an empty directory (the scene's path made
-    absolute): it saves the one file it asks for, and the history it reports conserves
+def test_docs_example_runs_as_printed(tmp_path, monkeypatch):
+    """The in-memory example of docs/python-api.md, run in an empty directory (the scene's
+    path made absolute): it saves the one file it asks for, and the history it reports conserves
     energy (the pendulum has no damping: the balance total - total(0) - works stays
     below 1e-4 of the largest kinetic energy) while the tip falls from the horizontal."""
-    text = (ROOT / "README.md").read_text()
+    text = (ROOT / "docs" / "python-api.md").read_text()
     blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
     block = next(b for b in blocks if "ancfdrv.simulate(" in b)
     block = block.replace('"inputs/hard/pendulum.nml"', repr(str(PENDULUM[0])))
     monkeypatch.chdir(tmp_path)
     names: dict[str, object] = {}
-    exec(compile(block, "README.md", "exec"), names)
+    exec(compile(block, "docs/python-api.md", "exec"), names)
     sim = names["sim"]
     assert [p.name for p in tmp_path.rglob("*") if p.is_file()] == ["pendulum.h5"]
     assert np.abs(sim.energy("balance")).max() < 1e-4 * sim.energy("kinetic").max()

@@ -304,7 +304,8 @@ def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | No
 
 def _navier_error(scene, row: dict) -> float | None:
     """Simply supported plate under pressure alone: error of the centre deflection against
-    Navier's series (REFERENCES.md: 0.00406 q a^4 / D for the square plate)."""
+    Navier's series (Timoshenko, Theory of Plates and Shells: 0.00406 q a^4 / D for the
+    square plate)."""
     from .reference.analytic import navier_plate_centre_deflection
     plate, material = scene["plate"], scene["material"]
     if plate["support"] != "simply_supported" or set(scene.effects) != {"pressure"}:

@@ -7,7 +7,7 @@
 !>   r(x, y, z) = sum_a N_a q_a,   N = [N1, L N2, y (1 - xi), z (1 - xi), N3, L N4, y xi, z xi]
 !>
 !> with the cubic Hermite N1..N4 (eqs. 4-5, with f_yR = b a, f_zR = c a: the printed
-!> "b - a" is a misprint, see REFERENCES.md). Compact arrays (8 x 8, 3 x 8) act on the
+!> "b - a" is a misprint, docs/README.md "References"). Compact arrays (8 x 8, 3 x 8) act on the
 !> eight nodal 3-vectors q_a; the full 24 x 24 matrices are the compact ones times I3
 !> (mass) or are built per 3 x 3 block (stiffness).
 module beam_element

@@ -11,7 +11,7 @@
 !>   membrane  W_m = h/2 eps^T D eps,          eps = [E11, E22, 2 E12],  E = (F^T F - I)/2
 !>   bending   W_b = h^3/24 kappa^T D kappa,   kappa = [k11, k22, 2 k12]
 !> with the curvatures of eq. 6, c_ab = r_ab . g / |g|^3, g = r_x x r_y (the unnormalized
-!> normal: see REFERENCES.md on eq. 6 vs eq. 7).
+!> normal: docs/README.md "References" on eq. 6 vs eq. 7).
 !>  * plain:     F = [r_x r_y], k_ab = c_ab (a curved reference carries initial strain);
 !>  * completed: J = [r_x r_y n] J0^{-1}. Because n is a unit vector normal to r_x and r_y,
 !>    J^T J = blockdiag(A, 1) with A the in-plane metric, so eps_ZZ, eps_XZ, eps_YZ of eq. 10

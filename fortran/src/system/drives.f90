@@ -2,7 +2,7 @@
 !>   kind 0  constant:  phi = p(1)
 !>   kind 1  luffing profile of SPEC section 5 (smooth start, constant rate, smooth brake):
 !>           p = [omega, t_s, t_b, sweep, phi_start] (omega and sweep of one sign)
-!>   kind 2  spin-up of Simo & Vu-Quoc (REFERENCES.md): p = [W, T, phi_start],
+!>   kind 2  spin-up of Simo & Vu-Quoc (J. Appl. Mech. 53, 1986): p = [W, T, phi_start],
 !>           phi = (W/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)) for t < T, W t - W T/2 after
 !>   kind 3  load cycle: p = [amplitude, T, t_0]: phi = amplitude (1 - cos(2 pi (t - t_0)/T))/2
 !>           on [t_0, t_0 + T] (0 -> amplitude -> 0 with zero rate at both ends), 0 outside

@@ -1,4 +1,4 @@
-"""The spin-up beam of Simo & Vu-Quoc (REFERENCES.md): the root section clamped to a hub
+"""The spin-up beam of Simo & Vu-Quoc (J. Appl. Mech. 53, 1986): the root section clamped to a hub
 turning about r3 with the prescribed angle phi(t) (joint 'hub'); the beam's frame is the
 hub's, A(t) = R(phi(t)), in which the probe deflections are resolved. ``beam.bending =
 'cable'`` (formulation 'nonlinear'; issue 23) builds the beam as an ANCF cable whose root
