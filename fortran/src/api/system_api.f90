@@ -572,7 +572,7 @@ contains
 end subroutine system_set_carry
 
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),
-!> replacing the CSR of system_set_matrices in products (a ninth of the entries).
+!> replacing the CSR of system_set_mass in products (a ninth of the entries).
 subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
