@@ -5,18 +5,19 @@ and the wall time of a run with gravity only, with contact, and with contact and
 
 Part 1, cost per call. For ``spring.contact_points`` in ``--points`` (2 3 5 9 17 per end
 edge of the lower leaf, so 4 6 10 18 34 points in all) the scene's model is built
-(``load_scene`` with the override, ``build_model``) and ``kernel.contact_evaluate`` (the
+(``load_scene`` with the override, ``build_model``) and the contact forces of its kernel
+handle (``KernelSystem.contact_forces``, ``_kernel.system_contact_forces``: the
 search of each point's closest point on the main leaf, penalty normal force with damping,
 smooth Coulomb friction, and their assembly into the full force vector) is timed at one
 fixed state: the assembled configuration with the lower leaf raised by 0.5 mm along r3 (so
 every point penetrates by 0.49 mm) and moving along r1 at 0.02 m/s (every point slips, below
 the critical slip velocity V_t = 0.08 m/s: the smooth friction branch). Four calls:
 
-* ``wrapper``: ``ancfdrv.kernel.contact_evaluate`` as the Python side calls it (it converts
-  the index arrays to 1-based Fortran order on every call), without the Jacobian;
+* ``wrapper``: ``KernelSystem.contact_forces`` as the Python side calls it (it stacks the
+  coordinates and rates on every call), without the Jacobian;
 * ``wrapper + Jacobian``: the same with ``pattern=model.full_pattern`` (the contact
   Jacobian's values on the full pattern, 30744 entries, which the call zeroes and fills);
-* ``raw``, ``raw + Jacobian``: the f2py entry point ``_kernel.contact_evaluate`` with every
+* ``raw``, ``raw + Jacobian``: the f2py entry point ``_kernel.system_contact_forces`` with every
   array prepared once, what the Fortran stepper itself pays per evaluation (it calls the
   same ``contact_assemble``: once per Newton iteration with the Jacobian, once per step
   without it for the energies).
@@ -111,7 +112,7 @@ LABELS = {"wrapper": "wrapper", "wrapper_jacobian": "wrapper+J", "raw": "raw",
 # -- part 1: contact search and forces per call ------------------------------------------------
 def contact_setup(points: int) -> dict[str, Any]:
     """Model with ``points`` contact points per edge, the timed state and the four calls."""
-    from ancfdrv import _kernel, kernel
+    from ancfdrv import _kernel
     from ancfdrv.builders import build_model
     from ancfdrv.io.scene import load_scene
     from ancfdrv.system.meshes import PLATE_NODE_DOFS
@@ -119,7 +120,6 @@ def contact_setup(points: int) -> dict[str, Any]:
 
     scene = load_scene(SCENE, [f"spring.contact_points={points}"])
     model = build_model(scene)
-    model.close()  # only the assembled arrays are used here, not the kernel system
     pair = model.contact_pairs[0]
     lower = next(b for b in model.bodies if b.name == "lower")
     e = model.expand(model.e0).copy()   # contact works on the full coordinates
@@ -133,27 +133,18 @@ def contact_setup(points: int) -> dict[str, Any]:
     counts = np.zeros(6, np.int32)
     pattern = model.full_pattern
 
-    def wrapper(jacobian: bool) -> Callable[[], Any]:
-        return lambda: kernel.contact_evaluate(
-            e, rates, pair["dofs"], sizes, pair["grid"], pair["point_element"],
-            pair["point_local"], pair["params"], guesses, counts,
-            pattern=pattern if jacobian else None)
+    system = model.kernel   # its contact pair and the full pattern
 
-    f = np.asfortranarray
-    raw_args = dict(e=f(e), rates=f(rates), dofs=f(pair["dofs"] + 1, np.int32), sizes=sizes,
-                    grid=f(pair["grid"] + 1, np.int32),
-                    point_element=f(pair["point_element"] + 1, np.int32),
-                    point_local=f(pair["point_local"], np.float64),
-                    params=f(pair["params"], np.float64))
-    row_ptr, col = f(pattern.row_ptr + 1, np.int32), f(pattern.col_index + 1, np.int32)
-    dummy_ptr, dummy_col = np.ones(len(e) + 1, np.int32), np.ones(1, np.int32)
+    def wrapper(jacobian: bool) -> Callable[[], Any]:
+        return lambda: system.contact_forces(e, rates, guesses, counts, want_jacobian=jacobian)
+
+    state = np.asfortranarray(np.column_stack([e, rates]))
+    npoint = len(pair["point_element"])
 
     def raw(jacobian: bool) -> Callable[[], Any]:
-        a = raw_args
-        ptr, cols = (row_ptr, col) if jacobian else (dummy_ptr, dummy_col)
-        return lambda: _kernel.contact_evaluate(
-            a["e"], a["rates"], a["dofs"], a["sizes"], a["grid"], a["point_element"],
-            a["point_local"], a["params"], 0.0, int(jacobian), ptr, cols, guesses, counts)
+        nnz = len(pattern.col_index) if jacobian else 1
+        return lambda: _kernel.system_contact_forces(system.handle, nnz, npoint, state, 0.0,
+                                                     int(jacobian), guesses, counts)
 
     calls = {"wrapper": wrapper(False), "wrapper_jacobian": wrapper(True),
              "raw": raw(False), "raw_jacobian": raw(True)}

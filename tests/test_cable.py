@@ -74,7 +74,7 @@ def test_rigid_motions_have_no_strain_energy(angle):
     rot = _rotation([0.3, -1.0, 0.6], angle)
     q = _straight(length).reshape(4, 3) @ rot.T
     q[[0, 2]] += np.array([1.2, -0.4, 3.0])
-    force, energy, _ = kernel.cable_forces(DOFS, q.ravel(), [length], E * AREA, E * INERTIA,
+    force, energy, _, _ = kernel.cable_forces(DOFS, q.ravel(), [length], E * AREA, E * INERTIA,
                                            False)
     assert abs(energy) <= 1e-13 * E * INERTIA * length / 2.0
     assert np.abs(force).max() <= 1e-12 * E * INERTIA / length**2
@@ -87,14 +87,14 @@ def test_tangent_matches_central_differences():
     symmetric (a Hessian) to rounding. Stiffnesses of comparable size so both terms count."""
     length, ea, ei = 0.7, 3.0, 0.2
     q = _deformed(length)
-    force, _, tangent = kernel.cable_forces(DOFS, q, [length], ea, ei, True)
+    force, _, tangent, _ = kernel.cable_forces(DOFS, q, [length], ea, ei, True)
     h = 1e-6
     numeric, gradient = np.zeros((12, 12)), np.zeros(12)
     for j in range(12):
         dq = np.zeros(12)
         dq[j] = h
-        fp, up, _ = kernel.cable_forces(DOFS, q + dq, [length], ea, ei, False)
-        fm, um, _ = kernel.cable_forces(DOFS, q - dq, [length], ea, ei, False)
+        fp, up, _, _ = kernel.cable_forces(DOFS, q + dq, [length], ea, ei, False)
+        fm, um, _, _ = kernel.cable_forces(DOFS, q - dq, [length], ea, ei, False)
         numeric[:, j] = (fp - fm) / (2 * h)
         gradient[j] = (up - um) / (2 * h)
     assert np.abs(tangent[:, :, 0] - numeric).max() <= 1e-8 * np.abs(numeric).max()
@@ -109,8 +109,8 @@ def test_large_rotation_of_a_deformed_state_is_objective():
     q = _deformed(length, seed=7)
     rot = _rotation([1.0, 2.0, -0.5], 2.0)
     big = np.kron(np.eye(4), rot)
-    f0, u0, k0 = kernel.cable_forces(DOFS, q, [length], ea, ei, True)
-    f1, u1, k1 = kernel.cable_forces(DOFS, big @ q, [length], ea, ei, True)
+    f0, u0, k0, _ = kernel.cable_forces(DOFS, q, [length], ea, ei, True)
+    f1, u1, k1, _ = kernel.cable_forces(DOFS, big @ q, [length], ea, ei, True)
     assert u1 == pytest.approx(u0, rel=1e-12)
     assert np.abs(f1 - big @ f0).max() <= 1e-12 * np.abs(f0).max()
     assert np.abs(k1[:, :, 0] - big @ k0[:, :, 0] @ big.T).max() <= 1e-12 * np.abs(k0).max()
@@ -169,7 +169,7 @@ def test_cantilever_frequencies():
     q = np.zeros((nel + 1, 6))
     q[:, 0] = np.linspace(0.0, length, nel + 1)
     q[:, 3] = 1.0
-    _, _, tangents = kernel.cable_forces(dofs, q.ravel(), lengths, E * AREA, E * INERTIA, True)
+    _, _, tangents, _ = kernel.cable_forces(dofs, q.ravel(), lengths, E * AREA, E * INERTIA, True)
     mbar, _ = kernel.cable_element_arrays(lengths, RHO * AREA, np.zeros(3))
     stiffness, mass = np.zeros((n, n)), np.zeros((n, n))
     for el in range(nel):

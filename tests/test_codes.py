@@ -106,3 +106,42 @@ def test_every_step_failure_code_has_its_text(code):
     texts = texts[texts.index("function step_failure_text"):]
     texts += (SRC / "core" / "kernel_errors.f90").read_text()
     assert re.search(rf"case \({code}\)", texts), code
+
+
+@pytest.mark.parametrize("prefix", sorted(codes.KERNEL_LAYOUTS))
+def test_kernel_argument_layouts(prefix):
+    """Each grouped-argument layout of the f2py binding (api_support.f90 <prefix>_<name>,
+    <prefix>_count) has the Python names in the same order and the same length."""
+    p = parameters("api/api_support.f90")
+    names = codes.KERNEL_LAYOUTS[prefix]
+    assert layout(p, [f"{prefix}_{n}" for n in names]) == tuple(range(1, len(names) + 1))
+    assert p[f"{prefix}_count"] == len(names)
+    # no index of the prefix that Python does not name
+    assert {k for k in p if k.startswith(prefix + "_")} == \
+        {f"{prefix}_{n}" for n in names} | {f"{prefix}_count"}
+
+
+def test_binding_declares_each_layout_with_its_length():
+    """f2py cannot read a used module's parameters, so the binding declares a grouped array
+    with a literal length: each dummy whose elements a routine names with a layout's indices
+    (``name(<prefix>_...)``, or ``name(:, <prefix>_...)`` for a column layout) is declared
+    with a length (its first dimension, or its last for the columns) that holds every index
+    the routine uses and no more than the layout: the layout's length, or a leading part of
+    it (reduced_ffr_energy_rows takes the frame's motion without psi'')."""
+    p = parameters("api/api_support.f90")
+    checked = 0
+    for source in ("api/element_api.f90", "api/system_api.f90"):
+        text = (SRC / source).read_text()
+        for body in re.findall(r"\nsubroutine .*?\nend subroutine", text, re.S):
+            joined = re.sub(r"&\s*\n\s*", " ", body)
+            uses = re.findall(r"\b(\w+)\((?:[:\w ]+, )?([a-z]{2})_(\w+)\)", joined)
+            for name, prefix in {(n, x) for n, x, _ in uses if f"{x}_count" in p}:
+                used = max(p[f"{prefix}_{i}"] for n, x, i in uses if (n, x) == (name, prefix))
+                decl = re.search(rf"::[^\n]*\b{name}\(([^)]*)\)", joined)
+                assert decl, (source, name)
+                dims = [d.strip() for d in decl.group(1).split(",")]
+                lengths = [int(d) for d in (dims[0], dims[-1]) if d.isdigit()]
+                assert any(used <= n <= p[f"{prefix}_count"] for n in lengths), \
+                    (source, name, dims, prefix)
+                checked += 1
+    assert checked >= 20

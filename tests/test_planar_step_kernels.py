@@ -60,7 +60,7 @@ def _element_reference(model, e: np.ndarray, lengths_from=None) -> tuple[np.ndar
     reference lengths_from, default the model's e0)."""
     dofs = np.array([np.arange(6 * k, 6 * k + 12) for k in range(NODES - 1)]).T
     lengths = np.diff((model.e0 if lengths_from is None else lengths_from)[0::6])
-    force, energy, _ = kernel.cable_forces(dofs, e, lengths, E * AREA, E * INERTIA, False)
+    force, energy, _, _ = kernel.cable_forces(dofs, e, lengths, E * AREA, E * INERTIA, False)
     return force, energy
 
 

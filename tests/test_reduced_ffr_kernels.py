@@ -13,7 +13,7 @@ import pytest
 
 from ancfdrv import kernel
 from ancfdrv.errors import SolverError
-from ancfdrv.kernel import _f, _kernel
+from ancfdrv.kernel import _f, _kernel, _state
 from ancfdrv.system.drives import Sine
 
 # -- constraint values of every kind at many rows ---------------------------------------------
@@ -53,10 +53,8 @@ def _layout():
                 coef.append(a)
             ptr.append(len(dof) + 1)
     data = np.array(drive.params(), dtype=float)
-    args = (_f(kinds, np.int32), _f(drives, np.int32), _f(params), _f(const),
-            _f(np.array(ptr), np.int32), _f(np.array(dof), np.int32), _f(np.array(coef)),
-            _f(np.array([drive.kind]), np.int32), _f(np.array([1, 1 + len(data)]), np.int32),
-            _f(data))
+    args = (kinds, drives, params, const, np.array(ptr), np.array(dof), np.array(coef),
+            np.array([drive.kind]), np.array([1, 1 + len(data)]), data)
 
     def closed_form(e: np.ndarray, t: float) -> np.ndarray:
         phi = float(drive.values([t])[0][0])
@@ -87,11 +85,12 @@ def test_constraint_violation_rows_are_the_closed_forms_and_constraint_evaluate(
     rng = np.random.default_rng(23)
     e_rows = rng.normal(size=(NDOF, 40))
     times = np.linspace(0.0, 4.0, 40)
-    violation, info = _kernel.constraint_violation_rows(*args, _f(e_rows), _f(times))
+    packed = (*kernel.constraint_arrays(*args), len(args[0]))
+    violation, info = _kernel.constraint_violation_rows(*packed, _f(e_rows), _f(times))
     assert info == 0
     for row, t in enumerate(times):
         exact = closed_form(e_rows[:, row], t)
-        full = _kernel.constraint_evaluate(*args, _f(e_rows[:, row]), np.zeros(NDOF), t)
+        full = _kernel.constraint_evaluate(*packed, _state(e_rows[:, row], np.zeros(NDOF)), t)
         assert full[-1] == 0
         assert violation[row] == np.max(np.abs(full[0]))
         assert abs(violation[row] - np.max(np.abs(exact))) <= 1e-14 * (1.0 + np.max(
@@ -106,12 +105,14 @@ def test_constraint_violation_rows_refuse_a_bad_layout():
     args = list(_layout()[0])
     e_rows, times = np.zeros((NDOF, 3)), np.zeros(3)
     short = np.zeros((NDOF - 1, 3))          # the last coordinate (12) out of range
-    assert _kernel.constraint_violation_rows(*args, _f(short), _f(times))[1] == 1
+    packed = (*kernel.constraint_arrays(*args), len(args[0]))
+    assert _kernel.constraint_violation_rows(*packed, _f(short), _f(times))[1] == 1
     drives = np.array(args[1])
     drives[2] = 5
-    args[1] = _f(drives, np.int32)
-    assert _kernel.constraint_violation_rows(*args, _f(e_rows), _f(times))[1] == 3
-    full = _kernel.constraint_evaluate(*args, np.zeros(NDOF), np.zeros(NDOF), 0.0)
+    args[1] = drives
+    packed = (*kernel.constraint_arrays(*args), len(args[0]))
+    assert _kernel.constraint_violation_rows(*packed, _f(e_rows), _f(times))[1] == 3
+    full = _kernel.constraint_evaluate(*packed, _state(np.zeros(NDOF), np.zeros(NDOF)), 0.0)
     assert full[-1] == 3
 
 
@@ -147,10 +148,11 @@ def test_energy_rows_are_the_forms(cubic):
         assert list(used) == [0] + list(range(3, 3 + r))
         want_strain = want_strain + np.einsum("ti,tj,tk,ijk->t", c, c, c, tensors[0])
         want_power = want_power + rate * np.einsum("ti,tj,tk,ijk->t", c, c, c, tensors[1])
-    got = _kernel.reduced_ffr_energy_rows(
-        rate, sin, cos1, _f(eta.T), _f(vel.T), _f(kin), _f(strain), _f(power),
-        _f(np.asarray(used) + 1, np.int32) if len(used) else np.zeros(0, np.int32),
+    energies = _kernel.reduced_ffr_energy_rows(
+        _f(np.column_stack([rate, sin, cos1])), _f(eta.T), _f(vel.T), _f(kin), _f(strain),
+        _f(power), _f(np.asarray(used) + 1, np.int32) if len(used) else np.zeros(0, np.int32),
         _f(table), load_constant, _f(load_linear.T))
+    got = energies.T       # the columns kinetic, strain, power, load (KERNEL_LAYOUTS 're')
     for found, want in zip(got, (want_kin, want_strain, want_power, want_load)):
         assert np.abs(found - want).max() <= 1e-13 * np.abs(want).max()
 

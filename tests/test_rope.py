@@ -59,8 +59,8 @@ def _central_tangent(q, length, ea, ei, tension_only=True, h=1e-7):
     for j in range(12):
         dq = np.zeros(12)
         dq[j] = h
-        fp, _, _ = kernel.cable_forces(DOFS, q + dq, [length], ea, ei, False, tension_only)
-        fm, _, _ = kernel.cable_forces(DOFS, q - dq, [length], ea, ei, False, tension_only)
+        fp, _, _, _ = kernel.cable_forces(DOFS, q + dq, [length], ea, ei, False, tension_only)
+        fm, _, _, _ = kernel.cable_forces(DOFS, q - dq, [length], ea, ei, False, tension_only)
         numeric[:, j] = (fp - fm) / (2 * h)
     return numeric
 
@@ -88,16 +88,16 @@ def test_rope_law_taut_like_the_cable_compressed_without_axial_force():
     slack = _element(length, 0.97, 0.95, bend=0.1, seed=1)
     assert _gauss_strains(taut, length).min() > 1e-3
     assert _gauss_strains(slack, length).max() < -1e-3
-    f_rope, u_rope, k_rope = kernel.cable_forces(DOFS, taut, [length], ea, 0.0, True, True)
-    f_ref, u_ref, k_ref = kernel.cable_forces(DOFS, taut, [length], ea, 0.0, True)
+    f_rope, u_rope, k_rope, _ = kernel.cable_forces(DOFS, taut, [length], ea, 0.0, True, True)
+    f_ref, u_ref, k_ref, _ = kernel.cable_forces(DOFS, taut, [length], ea, 0.0, True)
     assert np.abs(f_rope - f_ref).max() <= 1e-13 * np.abs(f_ref).max()
     assert u_rope == pytest.approx(u_ref, rel=1e-13)
     assert np.abs(k_rope - k_ref).max() <= 1e-13 * np.abs(k_ref).max()
-    f_slack, u_slack, k_slack = kernel.cable_forces(DOFS, slack, [length], ea, 0.0, True, True)
+    f_slack, u_slack, k_slack, _ = kernel.cable_forces(DOFS, slack, [length], ea, 0.0, True, True)
     assert u_slack == 0.0 and not f_slack.any() and not k_slack.any()
     h = 1e-6
     for q in (taut, slack):
-        f_bend, u_bend, _ = kernel.cable_forces(DOFS, q, [length], 0.0, ei, True, True)
+        f_bend, u_bend, _, _ = kernel.cable_forces(DOFS, q, [length], 0.0, ei, True, True)
         assert u_bend == pytest.approx(_bending_energy(q, length, ei), rel=1e-12)
         gradient = np.array([(_bending_energy(q + h * np.eye(12)[j], length, ei)
                               - _bending_energy(q - h * np.eye(12)[j], length, ei)) / (2 * h)
@@ -105,7 +105,7 @@ def test_rope_law_taut_like_the_cable_compressed_without_axial_force():
         assert np.abs(f_bend - gradient).max() <= 1e-7 * np.abs(f_bend).max()
     # a straight rope stretched unevenly (r'' along r') has no bending force
     uneven = np.concatenate([[0, 0, 0], [1.0, 0, 0], [0.65, 0, 0], [1.2, 0, 0]])
-    f_line, u_line, _ = kernel.cable_forces(DOFS, uneven, [length], 0.0, ei, False, True)
+    f_line, u_line, _, _ = kernel.cable_forces(DOFS, uneven, [length], 0.0, ei, False, True)
     assert abs(u_line) <= 1e-14 * ei and np.abs(f_line).max() <= 1e-13 * ei  # rounding
     # r' = 0 at a Gauss point (a folded rope): defined, the plain cable refuses it
     folded = np.concatenate([[0, 0, 0], [0.0, 0.3, 0], [0, 0, 0], [0.0, -0.3, 0]])
@@ -125,7 +125,7 @@ def test_rope_tangent_matches_central_differences(case):
     assert np.abs(strains).min() > 1e-4
     if case == "partly slack":
         assert strains.min() < 0.0 < strains.max()
-    _, _, tangent = kernel.cable_forces(DOFS, q, [length], ea, ei, True, True)
+    _, _, tangent, _ = kernel.cable_forces(DOFS, q, [length], ea, ei, True, True)
     numeric = _central_tangent(q, length, ea, ei)
     assert np.abs(tangent[:, :, 0] - numeric).max() <= 1e-6 * np.abs(numeric).max()
     assert np.abs(tangent[:, :, 0] - tangent[:, :, 0].T).max() <= 1e-13 * np.abs(tangent).max()
@@ -141,11 +141,11 @@ def test_rope_rigid_motions_and_reference_stiffness(angle):
     rot = _rotation([0.3, -1.0, 0.6], angle)
     q = np.concatenate([[0, 0, 0], [1, 0, 0], [length, 0, 0], [1, 0, 0]]).reshape(4, 3) @ rot.T
     q[[0, 2]] += np.array([1.2, -0.4, 3.0])
-    force, energy, tangent = kernel.cable_forces(DOFS, q.ravel(), [length], ea, ei, True, True)
+    force, energy, tangent, _ = kernel.cable_forces(DOFS, q.ravel(), [length], ea, ei, True, True)
     assert abs(energy) <= 1e-13 * ea * length
     assert np.abs(force).max() <= 1e-9 * ea
-    _, _, cable = kernel.cable_forces(DOFS, q.ravel(), [length], ea, 0.0, True, False)
-    _, _, bending = kernel.cable_forces(DOFS, q.ravel(), [length], 0.0, ei, True, True)
+    _, _, cable, _ = kernel.cable_forces(DOFS, q.ravel(), [length], ea, 0.0, True, False)
+    _, _, bending, _ = kernel.cable_forces(DOFS, q.ravel(), [length], 0.0, ei, True, True)
     assert np.abs(tangent - bending - cable).max() <= 1e-9 * np.abs(cable).max()
     # a uniform stretch u (r' grows by u along the axis everywhere): u^T K u = EA L
     axis = rot @ np.array([1.0, 0.0, 0.0])
@@ -166,27 +166,31 @@ def test_rope_damping_tangent_power_and_clipping(case):
     v = 0.1 * rng.standard_normal(12)
     if case == "clipped":  # shorten fast: eps' ~ -3/s, tau eps' ~ -0.06 below -eps ~ -0.03
         v = v - 3.0 * np.concatenate([[0, 0, 0], [1, 0, 0], [length, 0, 0], [1, 0, 0]])
-    f, u, k, power = kernel.cable_damped_forces(DOFS, q, v, [length], ea, ei, True, tau, c)
-    f0, u0, _ = kernel.cable_forces(DOFS, q, [length], ea, ei, False, True)
+
+    def damped(q, v):
+        return kernel.cable_forces(DOFS, q, [length], ea, ei, True, True, rates=v,
+                                   damping_time=tau, rate_factor=c)
+    f, u, k, power = damped(q, v)
+    f0, u0, _, _ = kernel.cable_forces(DOFS, q, [length], ea, ei, False, True)
     assert u == pytest.approx(u0, rel=1e-14)
     assert power == pytest.approx((f - f0) @ v, rel=1e-12)
     assert power > 0.0
     if case == "clipped":
-        fb, _, _ = kernel.cable_forces(DOFS, q, [length], 0.0, ei, False, True)
+        fb, _, _, _ = kernel.cable_forces(DOFS, q, [length], 0.0, ei, False, True)
         assert np.abs(f - fb).max() <= 1e-13 * np.abs(f0).max()
     h = 1e-7
     numeric = np.zeros((12, 12))
     for j in range(12):
         dq = np.zeros(12)
         dq[j] = h
-        fp = kernel.cable_damped_forces(DOFS, q + dq, v, [length], ea, ei, True, tau, c)[0]
-        fm = kernel.cable_damped_forces(DOFS, q - dq, v, [length], ea, ei, True, tau, c)[0]
-        gp = kernel.cable_damped_forces(DOFS, q, v + dq, [length], ea, ei, True, tau, c)[0]
-        gm = kernel.cable_damped_forces(DOFS, q, v - dq, [length], ea, ei, True, tau, c)[0]
+        fp = damped(q + dq, v)[0]
+        fm = damped(q - dq, v)[0]
+        gp = damped(q, v + dq)[0]
+        gm = damped(q, v - dq)[0]
         numeric[:, j] = (fp - fm) / (2 * h) + c * (gp - gm) / (2 * h)
     assert np.abs(k[:, :, 0] - numeric).max() <= 1e-6 * np.abs(numeric).max()
     slack = _element(length, 0.97, 0.95, bend=0.1, seed=1)
-    fs, _, _, ps = kernel.cable_damped_forces(DOFS, slack, v, [length], ea, ei, True, tau, c)
+    fs, _, _, ps = damped(slack, v)
     assert ps == 0.0
     assert np.array_equal(fs, kernel.cable_forces(DOFS, slack, [length], ea, ei, False, True)[0])
 

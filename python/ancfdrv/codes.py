@@ -39,3 +39,38 @@ CONTACT_COUNTERS = ("contact_points", "contact_active", "friction_evaluations",
 CONTACT_PARAMS = ("stiffness", "damping", "friction", "slip_velocity", "upper_thickness",
                   "lower_thickness", "friction_on")
 
+
+# fortran/src/api/api_support.f90: the small arrays that group a kernel routine's related
+# scalars, by the prefix of their index names (<prefix>_<name> = 1-based position there,
+# <prefix>_count = the length); the f2py routines document which array has which layout
+KERNEL_LAYOUTS: dict[str, tuple[str, ...]] = {
+    "cs": ("area", "inertia_y", "inertia_z", "torsion", "shear_y", "shear_z", "youngs",
+           "poisson"),                                   # beam_cubic_setup's section
+    "bm": ("youngs", "poisson"),                         # a continuum beam set's material
+    "pm": ("youngs", "poisson", "thickness"),            # a plate's material
+    "cb": ("axial_stiffness", "bending_stiffness", "damping_time", "rate_factor"),  # cable
+    "fk": ("element", "table"),                          # a force element's kinds
+    "fg": ("length", "length_rate"),                     # a force element's length
+    "fe": ("energy", "dissipation", "drive_power"),      # a force element's energies
+    "fl": ("kind", "drive", "table_kind", "slot_first"),  # system force elements (rows)
+    "fp": ("param", "table", "position"),                # their pointers (columns)
+    "cl": ("ncon", "nterm", "ndrive"),                   # a packed constraint layout's header
+    "fm": ("rate", "sin_psi", "one_minus_cos", "accel"),  # a frame's motion (columns)
+    "rs": ("dt", "beta", "gamma", "tol"),                # the reduced FFR stepper's settings
+    "rc": ("pdelta", "max_newton"),                      # and controls
+    "rn": ("corrections", "factorized"),                 # its per-step counts (columns)
+    "rt": ("info", "failed_step"),                       # its status
+    "re": ("kinetic", "strain", "power", "load"),        # reduced energy rows (columns)
+    "sv": ("coordinates", "rates"),                      # a state (columns)
+    "ff": ("internal", "external"),                      # system_evaluate's forces (columns)
+    "ef": ("time", "load_factor", "velocity_factor"),    # system_evaluate's factors
+    "ee": ("strain", "contact_potential"),               # system_evaluate's energies
+    "ss": ("time", "load_factor", "tol", "length_scale"),  # a static load step's settings
+    "sc": ("check_start", "load_step", "load_steps"),    # its controls
+    "sr": ("force_scale", "force_res", "con_res"),       # its residual scales
+    "so": ("info", "iterations", "converged_by", "factorizations"),  # its outcome
+    "tp": ("rows", "cols"),                              # a pattern's coordinates (columns)
+    "sl": ("handle", "policy"),                          # a solver
+    "cg": ("a", "b", "xi", "eta"),                       # a contact pair's side
+    "ce": ("potential", "damping", "friction"),          # contact energies
+}

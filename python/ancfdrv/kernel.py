@@ -11,8 +11,8 @@ import numpy as np
 from dataclasses import dataclass
 
 from . import _kernel
-from .codes import (CONTACT_RECORD, DRIVE_HERMITE, DRIVE_TABLE, ENERGY_NAMES, POWER_NAMES,
-                    SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE)
+from .codes import (CONTACT_RECORD, DRIVE_HERMITE, DRIVE_TABLE, ENERGY_NAMES, KERNEL_LAYOUTS,
+                    POWER_NAMES, SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE)
 from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
@@ -20,11 +20,45 @@ __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass
            "SparsePattern", "DirectSolver", "dense_solve", "plate_shape", "plate_element_arrays",
            "plate_reference", "plate_forces", "PlateReference", "CubicBeam", "SectionData",
            "section_data", "cable_element_arrays", "cable_shape", "cable_forces",
-           "cable_damped_forces"]
+           "constraint_arrays"]
 
 
 def _f(a, dtype=np.float64) -> np.ndarray:
     return np.asfortranarray(a, dtype=dtype)
+
+
+def _pack(prefix: str, dtype=np.float64, **values) -> np.ndarray:
+    """The small array of a kernel routine's grouped scalars in the layout ``prefix``
+    (codes.KERNEL_LAYOUTS, fortran/src/api/api_support.f90), from its values by name."""
+    names = KERNEL_LAYOUTS[prefix]
+    if set(values) != set(names):
+        raise TypeError(f"layout {prefix!r} takes {names}, got {sorted(values)}")
+    return np.array([values[n] for n in names], dtype=dtype)
+
+
+def _at(prefix: str, name: str) -> int:
+    """The 0-based position of ``name`` in the layout ``prefix``."""
+    return KERNEL_LAYOUTS[prefix].index(name)
+
+
+def constraint_arrays(kinds, drives, params, operand_const, term_ptr, term_dof, term_coef,
+                      drive_kinds, drive_ptr, drive_data) -> tuple[np.ndarray, np.ndarray]:
+    """A constraint set's kernel arrays (1-based indices, the constraints module layout)
+    packed as the kernel's constraint routines take them (api_support unpack_constraints):
+    the integers [ncon, nterm, ndrive, kinds, drives, term_ptr, term_dof, drive_kinds,
+    drive_ptr] and the reals [params (8, ncon), operand_const (6, ncon), term_coef,
+    drive_data]."""
+    kinds, drives = np.ravel(kinds), np.ravel(drives)
+    term_dof, drive_kinds = np.ravel(term_dof), np.ravel(drive_kinds)
+    if len(np.ravel(term_coef)) != len(term_dof) or \
+            len(np.ravel(drive_ptr)) != len(drive_kinds) + 1:
+        raise ValueError("constraint arrays: term_coef and term_dof, or drive_ptr and "
+                         "drive_kinds, of inconsistent lengths")
+    ints = np.concatenate([[len(kinds), len(term_dof), len(drive_kinds)], kinds, drives,
+                           np.ravel(term_ptr), term_dof, drive_kinds, np.ravel(drive_ptr)])
+    reals = np.concatenate([np.ravel(params, order="F"), np.ravel(operand_const, order="F"),
+                            np.ravel(term_coef), np.ravel(drive_data)])
+    return _f(ints, np.int32), _f(reals if reals.size else np.zeros(1))
 
 
 @dataclass(frozen=True)
@@ -138,10 +172,11 @@ class CubicBeam:
         nterms = int(_kernel.beam_cubic_size())
         torsion = section.polar if torsion is None else torsion
         (self.forms, self.strain0, self.stiffness,
-         info) = _kernel.beam_cubic_setup(nterms, _f(reference), _f(lengths), section.area,
-                                          section.inertia_y, section.inertia_z,
-                                          torsion, shear_factors[0], shear_factors[1],
-                                          youngs, poisson)
+         info) = _kernel.beam_cubic_setup(
+             nterms, _f(reference), _f(lengths),
+             _pack("cs", area=section.area, inertia_y=section.inertia_y,
+                   inertia_z=section.inertia_z, torsion=torsion, shear_y=shear_factors[0],
+                   shear_z=shear_factors[1], youngs=youngs, poisson=poisson))
         if info:
             element, code = divmod(info, 10)
             reason = {1: "unsupported quadrature",
@@ -168,26 +203,23 @@ def cable_shape(xi: float, length: float) -> tuple[np.ndarray, np.ndarray, np.nd
 
 
 def cable_forces(dofs, e, lengths, axial_stiffness: float, bending_stiffness: float,
-                 want_tangent: bool, tension_only: bool = False):
-    """Cable elastic force dU/de (global), strain energy and element tangents (12, 12, nel)
-    at e; dofs (12, nel) 0-based; tension_only: a rope's axial law (no compression)."""
-    force, energy, tangent, info = _kernel.cable_forces(
-        _f(np.asarray(dofs) + 1, np.int32), _f(e), _f(np.atleast_1d(lengths)),
-        float(axial_stiffness), float(bending_stiffness), int(want_tangent), int(tension_only))
-    if info:
-        raise SolverError(f"cable element {info}: r' vanished at a Gauss point")
-    return force, float(energy), tangent
-
-
-def cable_damped_forces(dofs, e, v, lengths, axial_stiffness: float, bending_stiffness: float,
-                        tension_only: bool, damping_time: float, rate_factor: float):
-    """Cable force with the axial Kelvin-Voigt damping at the rates v: force (global), strain
-    energy, element tangents dQ/de + rate_factor dQ/de' (12, 12, nel) and the dissipated
-    power."""
-    force, energy, tangent, dissipation, info = _kernel.cable_damped_forces(
-        _f(np.asarray(dofs) + 1, np.int32), _f(e), _f(v), _f(np.atleast_1d(lengths)),
-        float(axial_stiffness), float(bending_stiffness), int(tension_only),
-        float(damping_time), float(rate_factor))
+                 want_tangent: bool, tension_only: bool = False, *, rates=None,
+                 damping_time: float = 0.0, rate_factor: float = 0.0):
+    """Cable force (global), strain energy, element tangents (12, 12, nel) and the dissipated
+    power at e; dofs (12, nel) 0-based; tension_only: a rope's axial law (no compression).
+    Without damping (damping_time 0) the force is the elastic dU/de and the power 0; with the
+    axial Kelvin-Voigt damping_time > 0 at the rates, the force includes the damping force
+    and the tangents are dQ/de + rate_factor dQ/de'."""
+    e = _f(e)
+    if damping_time > 0.0 and rates is None:
+        raise ValueError("cable_forces: a damping_time needs the rates")
+    properties = _pack("cb", axial_stiffness=axial_stiffness,
+                       bending_stiffness=bending_stiffness, damping_time=damping_time,
+                       rate_factor=rate_factor)
+    v = np.zeros_like(e) if rates is None else _f(rates)
+    force, energy, tangent, dissipation, info = _kernel.cable_forces(
+        _f(np.asarray(dofs) + 1, np.int32), e, v, _f(np.atleast_1d(lengths)), properties,
+        int(want_tangent), int(tension_only))
     if info:
         raise SolverError(f"cable element {info}: r' vanished at a Gauss point")
     return force, float(energy), tangent, float(dissipation)
@@ -235,7 +267,8 @@ def plate_forces(dofs, e, reference: PlateReference, youngs: float, poisson: flo
     """Plate elastic force (ndof,), strain energy and element tangents (36, 36, nel)."""
     force, energy, tangent, info = _kernel.plate_elastic_forces(
         _f(dofs + 1, np.int32), _f(e), reference.derivs, reference.frame, reference.curvature0,
-        reference.weights, youngs, poisson, thickness, int(want_tangent))
+        reference.weights, _pack("pm", youngs=youngs, poisson=poisson, thickness=thickness),
+        int(want_tangent))
     if info:
         element, code = divmod(info, 1000)
         raise SolverError(f"plate element {element}: the mid-surface normal vanished "
@@ -272,10 +305,12 @@ def force_element(kind: int, params, table_kind: int, table, x, xd, length: floa
     xd), energy, dissipation, drive_power and reaction (7: force, moment, axial)."""
     params = np.asarray(params, dtype=float)
     table = np.asarray(table, dtype=float)
-    force, stiffness, damping, energy, dissipation, power, reaction, info = \
-        _kernel.force_element_generalized(kind, len(params), _pad_last(params), table_kind,
-                                          len(table), _pad_last(table), _f(x), _f(xd), length,
-                                          length_rate)
+    force, stiffness, damping, energies, reaction, info = _kernel.force_element_generalized(
+        _pack("fk", np.int32, element=kind, table=table_kind), len(params), _pad_last(params),
+        len(table), _pad_last(table), _f(x), _f(xd),
+        _pack("fg", length=length, length_rate=length_rate))
+    energy, dissipation, power = (float(energies[_at("fe", n)])
+                                  for n in ("energy", "dissipation", "drive_power"))
     if info:
         raise SolverError({1: f"force element of unknown kind {kind} or wrong sizes",
                            2: "force element: its two points coincide",
@@ -309,10 +344,16 @@ def reduced_ffr_newmark(dt: float, beta: float, gamma: float, omega2, gyroscopic
     pdelta = pdelta_linear is not None
     lin = _f(pdelta_linear) if pdelta else np.zeros((r, r), order="F")
     quad = _f(pdelta_quadratic) if pdelta else np.zeros((r, r, r), order="F")
-    eta, velocity, corrections, factorized, info, step = _kernel.reduced_ffr_newmark(
-        dt, beta, gamma, _f(omega2), _f(gyroscopic), _f(centrifugal), int(pdelta), lin, quad,
-        _f(load_patterns), _f(rate), _f(accel), _f(sin_psi), _f(one_minus_cos), tol,
-        max_newton)
+    motion = dict(rate=rate, sin_psi=sin_psi, one_minus_cos=one_minus_cos, accel=accel)
+    frame = _f(np.column_stack([np.asarray(motion[n], dtype=float)
+                                for n in KERNEL_LAYOUTS["fm"]]))
+    eta, velocity, counts, status = _kernel.reduced_ffr_newmark(
+        _pack("rs", dt=dt, beta=beta, gamma=gamma, tol=tol),
+        _pack("rc", np.int32, pdelta=int(pdelta), max_newton=max_newton), _f(omega2),
+        _f(gyroscopic), _f(centrifugal), lin, quad, _f(load_patterns), frame)
+    corrections, factorized = counts[:, _at("rn", "corrections")], \
+        counts[:, _at("rn", "factorized")]
+    info, step = int(status[_at("rt", "info")]), int(status[_at("rt", "failed_step")])
     if info:
         what = "Newton did not converge" if info == 1 else "singular iteration matrix"
         raise SolverError(f"reduced FFR stepper: {what} at step {step}")
@@ -490,13 +531,17 @@ def contact_pair(upper, upper_rates, a_u, b_u, xi_q, eta_q, lower, lower_rates, 
     """One contact pair: element coordinates (3, 12) and rates; forces on the upper and lower
     element, Jacobian of minus the forces (72 x 72), record (penetration, F_n, |F_t|, slip),
     penalty potential and powers (damping, friction)."""
-    (fu, fl, jac, record, potential, powers, active, info) = _kernel.contact_pair(
-        _f(upper), _f(upper_rates), a_u, b_u, xi_q, eta_q, _f(lower), _f(lower_rates), a_l, b_l,
-        xi_p, eta_p, _f(params), velocity_factor)
+    geometry = _f(np.column_stack([_pack("cg", a=a_u, b=b_u, xi=xi_q, eta=eta_q),
+                                   _pack("cg", a=a_l, b=b_l, xi=xi_p, eta=eta_p)]))
+    (forces, jac, record, energies, active, info) = _kernel.contact_pair(
+        _f(upper), _f(upper_rates), _f(lower), _f(lower_rates), geometry, _f(params),
+        velocity_factor)
     if info:
         raise SolverError("contact pair: a mid-surface normal vanished")
-    return dict(force_upper=fu, force_lower=fl, jacobian=jac, record=record,
-                potential=float(potential), powers=powers, active=bool(active))
+    return dict(force_upper=forces[:, 0], force_lower=forces[:, 1], jacobian=jac, record=record,
+                potential=float(energies[_at("ce", "potential")]),
+                powers=energies[[_at("ce", "damping"), _at("ce", "friction")]],
+                active=bool(active))
 
 
 def contact_projection(e, dofs, sizes, grid, point, guess) -> tuple[np.ndarray, int, int]:
@@ -510,32 +555,16 @@ def contact_projection(e, dofs, sizes, grid, point, guess) -> tuple[np.ndarray, 
     return guess, int(counts[0]), int(counts[1])
 
 
-def contact_evaluate(e, rates, dofs, sizes, grid, point_element, point_local, params, guesses,
-                     counts, velocity_factor: float = 0.0, pattern: "SparsePattern | None" = None):
-    """All contact points (see leaf_contact%contact_assemble): force (full), records
-    (6, npoints), potential, powers, updated guesses and counters, and the Jacobian's CSR
-    values on ``pattern`` when given."""
-    n = len(e)
-    if pattern is None:
-        row_ptr, col, want = np.ones(n + 1, np.int32), np.ones(1, np.int32), 0
-    else:
-        row_ptr, col, want = pattern.row_ptr + 1, pattern.col_index + 1, 1
-    (guesses, counts, force, records, potential, powers, values, info) = _kernel.contact_evaluate(
-        _f(e), _f(rates), _f(np.asarray(dofs) + 1, np.int32), _f(sizes),
-        _f(np.asarray(grid) + 1, np.int32), _f(np.asarray(point_element) + 1, np.int32),
-        _f(point_local), _f(params), velocity_factor, want, _f(row_ptr, np.int32),
-        _f(col, np.int32), _f(guesses), _f(counts, np.int32))
-    if info == 8:
-        raise SolverError("contact search: no closest point found on the upper leaf")
-    if info:
-        raise SolverError("contact: a mid-surface normal vanished")
-    return dict(force=force, records=records, potential=float(potential), powers=powers,
-                guesses=guesses, counts=counts, values=values if pattern is not None else None)
-
-
 # -- a mechanical system behind a kernel handle (fortran/src/api/system_api.f90) ----------
 def _i(a) -> np.ndarray:
     return np.asfortranarray(a, dtype=np.int32)
+
+
+def _state(e, v) -> np.ndarray:
+    """(n, 2): coordinates and rates as the kernel's state columns (codes.KERNEL_LAYOUTS
+    'sv')."""
+    columns = dict(coordinates=np.asarray(e, dtype=float), rates=np.asarray(v, dtype=float))
+    return _f(np.column_stack([columns[n] for n in KERNEL_LAYOUTS["sv"]]))
 
 
 def _pad_last(a: np.ndarray, dtype=np.float64) -> np.ndarray:
@@ -649,8 +678,8 @@ class KernelSystem:
                           poisson: float, frame: int, damping_time: float = 0.0,
                           shear_scales=(1.0, 0.0, 0.0)) -> int:
         index, info, message = _kernel.system_add_continuum_set(
-            self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights), youngs,
-            poisson, _f(shear_scales), frame, damping_time)
+            self.handle, nvolume, _i(dofs + 1), _i(scatter), _f(gradients), _f(weights),
+            _pack("bm", youngs=youngs, poisson=poisson), _f(shear_scales), frame, damping_time)
         self._check(info, "continuum beam set", message)
         return int(index)
 
@@ -666,7 +695,8 @@ class KernelSystem:
                       poisson: float, thickness: float, damping_time: float = 0.0) -> int:
         index, info, message = _kernel.system_add_plate_set(
             self.handle, _i(dofs + 1), _i(scatter), reference.derivs, reference.frame,
-            reference.curvature0, reference.weights, youngs, poisson, thickness, damping_time)
+            reference.curvature0, reference.weights,
+            _pack("pm", youngs=youngs, poisson=poisson, thickness=thickness), damping_time)
         self._check(info, "plate set", message)
         return int(index)
 
@@ -716,13 +746,16 @@ class KernelSystem:
         of each reduced 3-vector (0: global; frames 1-based here) and the blocks' first dofs."""
         full_row_ptr, full_col = full_pattern
         self.nnz_pattern = len(mass_pattern)
-        info, message = _kernel.system_set_matrices(
+        self._full_col = full_col
+        info, message = _kernel.system_set_mass(
             self.handle, _i(mass_csr.indptr + 1), _i(mass_csr.indices + 1), _f(mass_csr.data),
-            _i(np.asarray(full_row_ptr) + 1), _i(np.asarray(full_col) + 1), solver_handle,
-            policy, _f(mass_pattern), len(vector_frame),
+            _f(mass_pattern), ndof=self.ndof)
+        self._check(info, "matrices", message)
+        info, message = _kernel.system_set_solver(
+            self.handle, _i(np.asarray(full_row_ptr) + 1), _i(np.asarray(full_col) + 1),
+            _pack("sl", np.int32, handle=solver_handle, policy=policy), len(vector_frame),
             _pad_last(np.asarray(vector_frame, dtype=np.int32), np.int32), len(block_first),
-            _pad_last(np.asarray(block_first, dtype=np.int32) + 1, np.int32), ndof=self.ndof,
-            nfull=self.nfull)
+            _pad_last(np.asarray(block_first, dtype=np.int32) + 1, np.int32), nfull=self.nfull)
         self._check(info, "matrices", message)
 
     def set_kron_mass(self, scalar_csr) -> None:
@@ -792,19 +825,24 @@ class KernelSystem:
     def set_force_elements(self, layout: dict) -> None:
         """Force elements (system/force_elements.kernel_layout: 0-based indices)."""
         nfel, nslot = len(layout["kinds"]), len(layout["term_ptr"]) - 1
-        info = _kernel.system_set_force_elements(
-            self.handle, nfel, len(layout["params"]), len(layout["table"]), nslot,
-            len(layout["term_dof"]), _pad_last(np.array(layout["kinds"]), np.int32),
-            _pad_last(np.array(layout["drives"]) + 1, np.int32),
-            _pad_last(np.array(layout["table_kinds"]), np.int32),
-            _i(np.array(layout["param_ptr"]) + 1), _pad_last(np.array(layout["params"])),
-            _i(np.array(layout["table_ptr"]) + 1), _pad_last(np.array(layout["table"])),
-            _pad_last(np.array(layout["slot_first"]) + 1, np.int32),
+        info = _kernel.system_set_force_slots(
+            self.handle, nslot, len(layout["term_dof"]),
             _pad_last(np.asarray(layout["slot_const"], dtype=float).T),
             _i(np.array(layout["term_ptr"]) + 1),
             _pad_last(np.array(layout["term_dof"], dtype=np.int32) + 1, np.int32),
-            _pad_last(np.array(layout["term_coef"], dtype=float)),
-            len(layout["positions"]), _i(np.asarray(layout["position_ptr"]) + 1),
+            _pad_last(np.array(layout["term_coef"], dtype=float)))
+        self._check(info, "force elements")
+        columns = dict(kind=np.array(layout["kinds"]), drive=np.array(layout["drives"]) + 1,
+                       table_kind=np.array(layout["table_kinds"]),
+                       slot_first=np.array(layout["slot_first"]) + 1)
+        elements = np.array([columns[n] for n in KERNEL_LAYOUTS["fl"]], dtype=np.int32)
+        pointers = dict(param=layout["param_ptr"], table=layout["table_ptr"],
+                        position=layout["position_ptr"])
+        info = _kernel.system_set_force_elements(
+            self.handle, nfel, len(layout["params"]), len(layout["table"]),
+            len(layout["positions"]), _pad_last(elements.reshape(len(elements), nfel), np.int32),
+            _i(np.column_stack([np.asarray(pointers[n]) + 1 for n in KERNEL_LAYOUTS["fp"]])),
+            _pad_last(np.array(layout["params"])), _pad_last(np.array(layout["table"])),
             _pad_last(np.asarray(layout["positions"]) + 1, np.int32))
         self._check(info, "force elements")
         self.nfel = nfel
@@ -854,15 +892,18 @@ class KernelSystem:
         potential and records, and on request the tangent on the solver's pattern; the
         contact guesses and counters are updated (returned)."""
         nnz = self.nnz_pattern if want_tangent else 1
-        out = _kernel.system_evaluate(self.handle, nnz, self.npoint, t, _f(e), _f(v), load_factor,
-                                      velocity_factor, int(want_tangent), _f(guesses),
-                                      _i(counts), ndof=self.ndof)
-        (guesses, counts, internal, external, strain, potential, records, tangent, info,
-         message) = out
+        out = _kernel.system_evaluate(
+            self.handle, nnz, self.npoint, _state(e, v),
+            _pack("ef", time=t, load_factor=load_factor, velocity_factor=velocity_factor),
+            int(want_tangent), _f(guesses), _i(counts), ndof=self.ndof)
+        (guesses, counts, forces, energies, records, tangent, info, message) = out
         if info:
             self._failure(info, "force evaluation", message)
-        return dict(internal=internal, external=external, strain=float(strain),
-                    contact_potential=float(potential), records=records[:, :self.npoint],
+        return dict(internal=forces[:, _at("ff", "internal")],
+                    external=forces[:, _at("ff", "external")],
+                    strain=float(energies[_at("ee", "strain")]),
+                    contact_potential=float(energies[_at("ee", "contact_potential")]),
+                    records=records[:, :self.npoint],
                     tangent=tangent if want_tangent else None, guesses=guesses, counts=counts)
 
     def static_solve(self, *, t: float, load_factor: float, e0, rows, cols, e, lam, guesses,
@@ -875,20 +916,28 @@ class KernelSystem:
         the relative residual history, the last residual and constraint violation,
         converged_by (static_solver's by_* code) and factorizations, with info and the
         kernel's message (0 and '' when converged)."""
-        ncon = len(lam)
+        e = np.asarray(e, dtype=float)
+        n, ncon = len(e), len(lam)
+        guesses = np.asarray(guesses, dtype=float)[:, :self.npoint]
+        state = np.concatenate([e, np.asarray(lam, dtype=float), guesses.ravel(order="F")])
+        scales = _pack("sr", force_scale=force_scale, force_res=0.0, con_res=0.0)
         out = _kernel.system_static_solve(
-            self.handle, ncon, self.npoint, t, load_factor, _f(e0),
-            _i(np.asarray(rows) + 1), _i(np.asarray(cols) + 1), _f(np.array(e, dtype=float)),
-            _f(np.array(lam, dtype=float)) if ncon else np.zeros(1),
-            _f(np.array(guesses, dtype=float)), _i(np.array(counts)),
-            tol, length_scale, max_iter, int(check_start), force_scale, load_step, load_steps)
-        (e, lam_out, guesses, counts, force_scale, iterations, history, force_res, con_res,
-         converged_by, factorizations, info, message) = out
-        return dict(e=e, lam=lam_out[:ncon], guesses=guesses, counts=counts,
-                    force_scale=float(force_scale), iterations=int(iterations),
-                    history=history[:int(iterations)].copy(), force_res=float(force_res),
-                    con_res=float(con_res), converged_by=int(converged_by),
-                    factorizations=int(factorizations), info=int(info),
+            self.handle, state, _i(np.array(counts)), _f(e0),
+            _i(np.column_stack([np.asarray(rows) + 1, np.asarray(cols) + 1])),
+            _pack("ss", time=t, load_factor=load_factor, tol=tol, length_scale=length_scale),
+            _pack("sc", np.int32, check_start=int(check_start), load_step=load_step,
+                  load_steps=load_steps), max_iter, scales)
+        state, counts, scales, history, outcome, message = out
+        info, iterations = int(outcome[_at("so", "info")]), int(outcome[_at("so", "iterations")])
+        guesses_out = np.zeros((2, max(1, self.npoint)), order="F")
+        guesses_out[:, :self.npoint] = state[n + ncon:].reshape(2, self.npoint, order="F")
+        return dict(e=state[:n].copy(), lam=state[n:n + ncon].copy(), guesses=guesses_out,
+                    counts=counts, force_scale=float(scales[_at("sr", "force_scale")]),
+                    iterations=iterations, history=history[:iterations].copy(),
+                    force_res=float(scales[_at("sr", "force_res")]),
+                    con_res=float(scales[_at("sr", "con_res")]),
+                    converged_by=int(outcome[_at("so", "converged_by")]),
+                    factorizations=int(outcome[_at("so", "factorizations")]), info=info,
                     message=_text(message) if info else "")
 
     def full_forces(self, t: float, e, v, guesses, *, load_factor: float = 1.0) -> np.ndarray:
@@ -903,18 +952,37 @@ class KernelSystem:
         return full
 
     def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
+        cut = self._layout(False)[1]
         out = _kernel.system_output_row(
-            self.handle, self.ncon, self.nprobe, self.npoint, t, _f(e), _f(v),
+            self.handle, self.ncon, self.npoint, cut[-1].start, t, _state(e, v),
             _f(lam) if len(lam) else np.zeros(1), _f(work), _f(guesses), _i(counts),
             ndof=self.ndof)
-        (guesses, counts, probe, deflection, energy, violation, records, powers, info,
-         message) = out
+        (guesses, counts, row, powers, info, message) = out
         if info:
             self._failure(info, "output row", message)
-        return dict(probes=probe[:, :self.nprobe].T.copy(),
-                    deflections=deflection[:, :self.nprobe].T.copy(), energy=energy,
-                    violation=float(violation), records=records[:, :self.npoint],
+        return dict(probes=row[cut[1]].reshape(self.nprobe, 3),
+                    deflections=row[cut[2]].reshape(self.nprobe, 3), energy=row[cut[4]].copy(),
+                    violation=float(row[cut[5]][0]),
+                    records=row[cut[6]].reshape(self.npoint, len(CONTACT_RECORD)).T,
                     guesses=guesses, counts=counts, powers=powers)
+
+    def contact_forces(self, e_full, rates_full, guesses, counts, *,
+                       velocity_factor: float = 0.0, want_jacobian: bool = False) -> dict:
+        """The contact forces of the system's contact pairs at the full coordinates and
+        rates (leaf_contact%contact_assemble): force (full), records (6, npoint), potential,
+        powers (damping, friction), the updated guesses and counters and, on request, the
+        Jacobian of minus the forces on the full pattern (its CSR values)."""
+        nnz = len(self._full_col) if want_jacobian else 1
+        (guesses, counts, force, records, energies, values, info,
+         message) = _kernel.system_contact_forces(
+            self.handle, nnz, self.npoint, _state(e_full, rates_full), velocity_factor,
+            int(want_jacobian), _f(guesses), _i(counts), nfull=self.nfull)
+        if info:
+            self._failure(info, "contact forces", message)
+        return dict(force=force, records=records[:, :self.npoint],
+                    potential=float(energies[_at("ce", "potential")]),
+                    powers=energies[[_at("ce", "damping"), _at("ce", "friction")]],
+                    guesses=guesses, counts=counts, values=values if want_jacobian else None)
 
     def _failure(self, info: int, what: str, message: bytes | str) -> None:
         """Raise with the kernel's text of the failure (a stale handle and inconsistent sizes

@@ -142,24 +142,27 @@ end subroutine beam_cubic_size
 
 !> Strain forms, reference strains and stiffnesses of the 'cubic' bending beam per
 !> element, from the reference configuration and the section properties (torsion: the
-!> Saint-Venant constant J; shear_y, shear_z: the shear factors). info = 10*element + code.
-subroutine beam_cubic_setup(nel, nterms, reference, lengths, area, inertia_y, inertia_z, &
-                            torsion, shear_y, shear_z, youngs, poisson, forms, strain0, &
+!> Saint-Venant constant J; shear_y, shear_z: the shear factors), all in section
+!> (api_support cs_*: area, inertia_y, inertia_z, torsion, shear_y, shear_z, youngs,
+!> poisson). info = 10*element + code.
+subroutine beam_cubic_setup(nel, nterms, reference, lengths, section, forms, strain0, &
                             stiffness, info)
   use ancf_kinds, only: dp
   use beam_cubic, only: cubic_setup
+  use api_support, only: cs_area, cs_inertia_y, cs_inertia_z, cs_torsion, cs_shear_y, &
+                         cs_shear_z, cs_youngs, cs_poisson
   implicit none
   integer, intent(in) :: nel, nterms
-  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), area, inertia_y, inertia_z
-  real(dp), intent(in) :: torsion, shear_y, shear_z, youngs, poisson
+  real(dp), intent(in) :: reference(3, 8, nel), lengths(nel), section(8)
   real(dp), intent(out) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
   integer, intent(out) :: info
   integer :: el, code
   info = 0
   do el = 1, nel
-    call cubic_setup(reference(:, :, el), lengths(el), area, inertia_y, inertia_z, torsion, &
-                          shear_y, shear_z, youngs, poisson, forms(:, :, :, el), strain0(:, el), &
-                          stiffness(:, el), code)
+    call cubic_setup(reference(:, :, el), lengths(el), section(cs_area), section(cs_inertia_y), &
+                     section(cs_inertia_z), section(cs_torsion), section(cs_shear_y), &
+                     section(cs_shear_z), section(cs_youngs), section(cs_poisson), &
+                     forms(:, :, :, el), strain0(:, el), stiffness(:, el), code)
     if (code /= 0) then
       info = 10 * el + code
       return
@@ -311,18 +314,19 @@ subroutine plate_reference(nel, npts, reference, a, b, variant, derivs, frame, c
   end do
 end subroutine plate_reference
 
-!> Elastic force (ndof), strain energy and element tangents (36, 36, nel) of a plate mesh.
+!> Elastic force (ndof), strain energy and element tangents (36, 36, nel) of a plate mesh;
+!> material (api_support pm_*): Young's modulus, Poisson's ratio, thickness.
 !> info = 2 + 1000 el: the normal vanished in element el.
 subroutine plate_elastic_forces(ndof, nel, npts, dofs, e, derivs, frame, curvature0, weights, &
-                                youngs, poisson, thickness, want_tangent, force, energy, &
-                                tangent, info)
+                                material, want_tangent, force, energy, tangent, info)
   use ancf_kinds, only: dp
   use plate_element, only: plate_forces
+  use api_support, only: pm_youngs, pm_poisson, pm_thickness
   implicit none
   integer, intent(in) :: ndof, nel, npts, dofs(36, nel), want_tangent
   real(dp), intent(in) :: e(ndof), derivs(12, 5, npts, nel), frame(2, 2, npts, nel)
   real(dp), intent(in) :: curvature0(3, npts, nel), weights(npts, nel)
-  real(dp), intent(in) :: youngs, poisson, thickness
+  real(dp), intent(in) :: material(3)
   real(dp), intent(out) :: force(ndof), energy, tangent(36, 36, nel)
   integer, intent(out) :: info
   real(dp) :: element_force(36, nel), element_energy(nel)
@@ -331,7 +335,8 @@ subroutine plate_elastic_forces(ndof, nel, npts, dofs, e, derivs, frame, curvatu
   !$omp parallel do schedule(static)
   do el = 1, nel
     call plate_forces(reshape(e(dofs(:, el)), [3, 12]), derivs(:, :, :, el), frame(:, :, :, el), &
-                      curvature0(:, :, el), weights(:, el), youngs, poisson, thickness, &
+                      curvature0(:, :, el), weights(:, el), material(pm_youngs), &
+                      material(pm_poisson), material(pm_thickness), &
                       want_tangent /= 0, element_force(:, el), element_energy(el), &
                       tangent(:, :, el), element_info(el))
   end do
@@ -358,24 +363,28 @@ subroutine reference_node_mass(mass, centre, inertia, mass_matrix, info)
   call rigid_body_mass(mass, centre, inertia, mass_matrix, info)
 end subroutine reference_node_mass
 
-!> One contact pair (leaf_contact%contact_point): upper element at local (xi_q, eta_q),
-!> lower-leaf point at (xi_p, eta_p).
-subroutine contact_pair(upper, upper_rates, a_u, b_u, xi_q, eta_q, lower, lower_rates, a_l, b_l, &
-                        xi_p, eta_p, params, velocity_factor, force_upper, force_lower, jacobian, &
-                        record, potential, powers, active, info)
+!> One contact pair (leaf_contact%contact_point): the upper element at its local point and
+!> the lower-leaf point; geometry(:, 1) upper, geometry(:, 2) lower (api_support cg_*:
+!> element sizes a, b and the local point xi, eta). forces(:, 1) on the upper element,
+!> forces(:, 2) on the lower; energies (ce_*): the penalty potential, the damping and
+!> friction powers.
+subroutine contact_pair(upper, upper_rates, lower, lower_rates, geometry, params, &
+                        velocity_factor, forces, jacobian, record, energies, active, info)
   use ancf_kinds, only: dp
   use leaf_contact, only: contact_point
+  use api_support, only: cg_a, cg_b, cg_xi, cg_eta, ce_potential, ce_damping, ce_friction
   implicit none
-  real(dp), intent(in) :: upper(3, 12), upper_rates(3, 12), a_u, b_u, xi_q, eta_q
-  real(dp), intent(in) :: lower(3, 12), lower_rates(3, 12), a_l, b_l, xi_p, eta_p
-  real(dp), intent(in) :: params(8), velocity_factor
-  real(dp), intent(out) :: force_upper(36), force_lower(36), jacobian(72, 72), record(4)
-  real(dp), intent(out) :: potential, powers(2)
+  real(dp), intent(in) :: upper(3, 12), upper_rates(3, 12), lower(3, 12), lower_rates(3, 12)
+  real(dp), intent(in) :: geometry(4, 2), params(8), velocity_factor
+  real(dp), intent(out) :: forces(36, 2), jacobian(72, 72), record(4), energies(3)
   integer, intent(out) :: active, info
   logical :: is_active
-  call contact_point(upper, upper_rates, a_u, b_u, xi_q, eta_q, lower, lower_rates, a_l, b_l, &
-                     xi_p, eta_p, params, velocity_factor, .true., force_upper, force_lower, &
-                     jacobian, record, potential, powers, is_active, info)
+  call contact_point(upper, upper_rates, geometry(cg_a, 1), geometry(cg_b, 1), &
+                     geometry(cg_xi, 1), geometry(cg_eta, 1), lower, lower_rates, &
+                     geometry(cg_a, 2), geometry(cg_b, 2), geometry(cg_xi, 2), &
+                     geometry(cg_eta, 2), params, velocity_factor, .true., forces(:, 1), &
+                     forces(:, 2), jacobian, record, energies(ce_potential), &
+                     energies(ce_damping:ce_friction), is_active, info)
   active = merge(1, 0, is_active)
 end subroutine contact_pair
 
@@ -394,37 +403,6 @@ subroutine contact_projection(nfull, nel, ngrid_l, ngrid_w, e, dofs, sizes, grid
   counts = 0
   call project_point(e, dofs, grid, sizes, p, guess, counts(1), counts(2), info)
 end subroutine contact_projection
-
-!> Contact forces of all points at (e, rates) (leaf_contact%contact_assemble), with the
-!> Jacobian on the CSR pattern (row_ptr, col) when want_jacobian /= 0.
-subroutine contact_evaluate(nfull, nel, ncontact, ngrid_l, ngrid_w, nnz, e, rates, dofs, sizes, &
-                            grid, point_element, point_local, params, velocity_factor, &
-                            want_jacobian, row_ptr, col, guesses, counts, force, records, &
-                            potential, powers, values, info)
-  use ancf_kinds, only: dp
-  use leaf_contact, only: contact_assemble
-  implicit none
-  integer, intent(in) :: nfull, nel, ncontact, ngrid_l, ngrid_w, nnz, want_jacobian
-  integer, intent(in) :: dofs(36, nel), grid(ngrid_l, ngrid_w), point_element(ncontact)
-  integer, intent(in) :: row_ptr(nfull + 1), col(nnz)
-  real(dp), intent(in) :: e(nfull), rates(nfull), sizes(2, nel), point_local(2, ncontact)
-  real(dp), intent(in) :: params(8), velocity_factor
-  real(dp), intent(inout) :: guesses(2, ncontact)
-  integer, intent(inout) :: counts(6)
-  !f2py intent(in,out) :: guesses, counts
-  real(dp), intent(out) :: force(nfull), records(6, ncontact), potential, powers(2), values(nnz)
-  integer, intent(out) :: info
-  force = 0.0_dp
-  values = 0.0_dp
-  if (want_jacobian /= 0) then
-    call contact_assemble(e, rates, dofs, sizes, grid, point_element, point_local, params, &
-                          velocity_factor, guesses, force, records, potential, powers, counts, &
-                          info, row_ptr, col, values)
-  else
-    call contact_assemble(e, rates, dofs, sizes, grid, point_element, point_local, params, &
-                          velocity_factor, guesses, force, records, potential, powers, counts, info)
-  end if
-end subroutine contact_evaluate
 
 !> Generalized force of a dead moment on a section director, with its first and
 !> second derivatives.
@@ -456,26 +434,33 @@ subroutine drive_values(kind, nparams, params, nt, t, phi, dphi, ddphi, info)
 end subroutine drive_values
 
 !> Constraint values, operand gradients (6, ncon), constant operand Hessians, Phi_t,
-!> Phi_tt and the acceleration right-hand side gamma at (e, e_dot, t) (constraints module
-!> layout).
-subroutine constraint_evaluate(ncon, ndof, nterm, ndrive, ndata, kinds, drives, params, &
-                               operand_const, term_ptr, term_dof, term_coef, drive_kinds, &
-                               drive_ptr, drive_data, e, e_dot, t, values, gradients, hessians, &
-                               phi_t, phi_tt, gamma, info)
+!> Phi_tt and the acceleration right-hand side gamma at (e, e_dot, t), state(:, sv_*) = (e,
+!> e_dot), of the packed constraint layout (ints, reals: api_support unpack_constraints).
+subroutine constraint_evaluate(nint, ints, nreal, reals, ncon, ndof, state, t, values, &
+                               gradients, hessians, phi_t, phi_tt, gamma, info)
   use ancf_kinds, only: dp
   use constraints, only: constraint_eval
+  use api_support, only: constraint_layout, unpack_constraints, sv_coordinates, sv_rates
   implicit none
-  integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata
-  integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
-  integer, intent(in) :: drive_kinds(ndrive), drive_ptr(ndrive + 1)
-  real(dp), intent(in) :: params(8, ncon), operand_const(6, ncon), term_coef(nterm)
-  real(dp), intent(in) :: drive_data(ndata), e(ndof), e_dot(ndof), t
+  integer, intent(in) :: nint, ints(nint), nreal, ncon, ndof
+  real(dp), intent(in) :: reals(nreal), state(ndof, 2), t
   real(dp), intent(out) :: values(ncon), gradients(6, ncon), hessians(6, 6, ncon)
   real(dp), intent(out) :: phi_t(ncon), phi_tt(ncon), gamma(ncon)
   integer, intent(out) :: info
-  call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, term_coef, &
-                       drive_kinds, drive_ptr, drive_data, e, e_dot, t, values, gradients, &
-                       hessians, phi_t, phi_tt, gamma, info)
+  type(constraint_layout) :: lay
+  values = 0.0_dp
+  gradients = 0.0_dp
+  hessians = 0.0_dp
+  phi_t = 0.0_dp
+  phi_tt = 0.0_dp
+  gamma = 0.0_dp
+  call unpack_constraints(ints, reals, ncon, lay, info)
+  if (info /= 0) return
+  call constraint_eval(ncon, lay%kinds, lay%drives, lay%params, lay%operand_const, &
+                       lay%term_ptr, lay%term_dof, lay%term_coef, lay%drive_kinds, &
+                       lay%drive_ptr, lay%drive_data, state(:, sv_coordinates), &
+                       state(:, sv_rates), t, values, gradients, hessians, phi_t, phi_tt, &
+                       gamma, info)
 end subroutine constraint_evaluate
 
 !> Pattern size of an n x n matrix coupled by element dof lists.
@@ -567,23 +552,27 @@ subroutine vector_load_generalized_force(kind, vector, shares, a, b, force, jaco
 end subroutine vector_load_generalized_force
 
 !> One force element (force_elements) at its ns slot values x and rates xd: the generalized
-!> force, its derivatives by x and xd, the energy, dissipated and drive powers, the reaction
-!> (force, moment, axial). nparam, ntable: sizes (ntable 0: no table, table_kind 0).
-subroutine force_element_generalized(kind, nparam, params, table_kind, ntable, table, ns, x, &
-                                     xd, length, length_rate, force, stiffness, damping, &
-                                     energy, dissipation, drive_power, reaction, info)
+!> force, its derivatives by x and xd, the energies (api_support fe_*: energy, dissipated
+!> and drive powers), the reaction (force, moment, axial). kinds (fk_*): the element's and
+!> its table's (0: no table); geometry (fg_*): its length and length rate; nparam, ntable:
+!> sizes (ntable 0: no table).
+subroutine force_element_generalized(kinds, nparam, params, ntable, table, ns, x, xd, geometry, &
+                                     force, stiffness, damping, energies, reaction, info)
   use ancf_kinds, only: dp
   use force_elements, only: force_element_eval
+  use api_support, only: fk_element, fk_table, fg_length, fg_length_rate, fe_energy, &
+                         fe_dissipation, fe_drive_power
   implicit none
-  integer, intent(in) :: kind, nparam, table_kind, ntable, ns
+  integer, intent(in) :: kinds(2), nparam, ntable, ns
   real(dp), intent(in) :: params(max(1, nparam)), table(max(1, ntable)), x(3, ns), xd(3, ns)
-  real(dp), intent(in) :: length, length_rate
+  real(dp), intent(in) :: geometry(2)
   real(dp), intent(out) :: force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns)
-  real(dp), intent(out) :: energy, dissipation, drive_power, reaction(7)
+  real(dp), intent(out) :: energies(3), reaction(7)
   integer, intent(out) :: info
-  call force_element_eval(kind, params(1:nparam), table_kind, table(1:ntable), x, xd, length, &
-                          length_rate, force, stiffness, damping, energy, dissipation, &
-                          drive_power, reaction, info)
+  call force_element_eval(kinds(fk_element), params(1:nparam), kinds(fk_table), &
+                          table(1:ntable), x, xd, geometry(fg_length), geometry(fg_length_rate), &
+                          force, stiffness, damping, energies(fe_energy), &
+                          energies(fe_dissipation), energies(fe_drive_power), reaction, info)
 end subroutine force_element_generalized
 
 !> Cable elements (cable_element): the scalar element masses Mbar (4, 4, nel) (the element
@@ -614,48 +603,20 @@ subroutine cable_shape_functions(xi, length, shape, slope, second)
 end subroutine cable_shape_functions
 
 !> Cable elastic force (global), strain energy and, when want_tangent /= 0, the element
-!> tangents (12 x 12 x nel) of a cable mesh; tension_only /= 0: a rope's axial law. info =
-!> element number whose r' vanished.
-subroutine cable_forces(ndof, nel, dofs, e, lengths, axial_stiffness, bending_stiffness, &
-                        want_tangent, tension_only, force, energy, tangent, info)
+!> tangents (12 x 12 x nel) of a cable mesh; tension_only /= 0: a rope's axial law.
+!> properties (api_support cb_*): EA, EI, the axial Kelvin-Voigt damping_time (0: none) and
+!> the rate_factor; with damping the force includes the damping force at the rates v, the
+!> tangents are dQ/de + rate_factor dQ/de' and dissipation is the damping's power (else 0).
+!> info = element number whose r' vanished.
+subroutine cable_forces(ndof, nel, dofs, e, v, lengths, properties, want_tangent, tension_only, &
+                        force, energy, tangent, dissipation, info)
   use ancf_kinds, only: dp
   use cable_element, only: cable_element_force
+  use api_support, only: cb_axial_stiffness, cb_bending_stiffness, cb_damping_time, &
+                         cb_rate_factor
   implicit none
   integer, intent(in) :: ndof, nel, dofs(12, nel), want_tangent, tension_only
-  real(dp), intent(in) :: e(ndof), lengths(nel), axial_stiffness, bending_stiffness
-  real(dp), intent(out) :: force(ndof), energy, tangent(12, 12, nel)
-  integer, intent(out) :: info
-  real(dp) :: element_force(12), element_energy
-  integer :: el, code
-  force = 0.0_dp
-  energy = 0.0_dp
-  tangent = 0.0_dp
-  info = 0
-  do el = 1, nel
-    call cable_element_force(reshape(e(dofs(:, el)), [3, 4]), lengths(el), axial_stiffness, &
-                             bending_stiffness, want_tangent /= 0, element_force, &
-                             element_energy, tangent(:, :, el), code, tension_only /= 0)
-    if (code /= 0) then
-      info = el
-      return
-    end if
-    force(dofs(:, el)) = force(dofs(:, el)) + element_force
-    energy = energy + element_energy
-  end do
-end subroutine cable_forces
-
-!> cable_forces with the axial Kelvin-Voigt damping (damping_time) at the rates v: the force
-!> includes the damping force, the tangents are dQ/de + rate_factor dQ/de' and dissipation
-!> the damping's power.
-subroutine cable_damped_forces(ndof, nel, dofs, e, v, lengths, axial_stiffness, &
-                               bending_stiffness, tension_only, damping_time, rate_factor, &
-                               force, energy, tangent, dissipation, info)
-  use ancf_kinds, only: dp
-  use cable_element, only: cable_damped_element_force
-  implicit none
-  integer, intent(in) :: ndof, nel, dofs(12, nel), tension_only
-  real(dp), intent(in) :: e(ndof), v(ndof), lengths(nel), axial_stiffness, bending_stiffness
-  real(dp), intent(in) :: damping_time, rate_factor
+  real(dp), intent(in) :: e(ndof), v(ndof), lengths(nel), properties(4)
   real(dp), intent(out) :: force(ndof), energy, tangent(12, 12, nel), dissipation
   integer, intent(out) :: info
   real(dp) :: element_force(12), element_energy, element_power
@@ -666,11 +627,20 @@ subroutine cable_damped_forces(ndof, nel, dofs, e, v, lengths, axial_stiffness, 
   tangent = 0.0_dp
   info = 0
   do el = 1, nel
-    call cable_damped_element_force(reshape(e(dofs(:, el)), [3, 4]), &
-                                    reshape(v(dofs(:, el)), [3, 4]), lengths(el), &
-                                    axial_stiffness, bending_stiffness, tension_only /= 0, &
-                                    damping_time, rate_factor, .true., element_force, &
-                                    element_energy, tangent(:, :, el), element_power, code)
+    if (properties(cb_damping_time) > 0.0_dp) then
+      call cable_element_force(reshape(e(dofs(:, el)), [3, 4]), lengths(el), &
+                               properties(cb_axial_stiffness), properties(cb_bending_stiffness), &
+                               want_tangent /= 0, element_force, element_energy, &
+                               tangent(:, :, el), code, tension_only /= 0, &
+                               reshape(v(dofs(:, el)), [3, 4]), properties(cb_damping_time), &
+                               properties(cb_rate_factor), element_power)
+    else
+      call cable_element_force(reshape(e(dofs(:, el)), [3, 4]), lengths(el), &
+                               properties(cb_axial_stiffness), properties(cb_bending_stiffness), &
+                               want_tangent /= 0, element_force, element_energy, &
+                               tangent(:, :, el), code, tension_only /= 0)
+      element_power = 0.0_dp
+    end if
     if (code /= 0) then
       info = el
       return
@@ -679,118 +649,126 @@ subroutine cable_damped_forces(ndof, nel, dofs, e, v, lengths, axial_stiffness, 
     energy = energy + element_energy
     dissipation = dissipation + element_power
   end do
-end subroutine cable_damped_forces
+end subroutine cable_forces
 
 !> Newmark stepping of a modally reduced FFR model (reduced_ffr_stepper; python
-!> ancfdrv.solvers.ffr_reduced): eta and its rate (r, steps + 1) from rest at 0, Newton
-!> corrections and factorizations per step; the load from its four patterns (columns of
-!> load_patterns) and the frame's psi'', psi'^2, sin psi, 1 - cos psi at each time. pdelta = 0: no P-delta remainder (pdelta_linear,
-!> pdelta_quadratic unused). info = 1: Newton failed at failed_step; 2: singular iteration
-!> matrix.
-subroutine reduced_ffr_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
-                               pdelta, pdelta_linear, pdelta_quadratic, load_patterns, rate, &
-                               accel, sin_psi, one_minus_cos, tol, max_newton, eta, velocity, &
-                               corrections, factorized, info, failed_step)
+!> ancfdrv.solvers.ffr_reduced): eta and its rate (r, steps + 1) from rest at 0, per step
+!> counts(:, rn_corrections) Newton corrections and counts(:, rn_factorized)
+!> factorizations; the load from its four patterns (columns of load_patterns) and the
+!> frame's motion at each time (api_support fm_* columns: psi', sin psi, 1 - cos psi,
+!> psi''). settings (rs_*): dt, beta, gamma, tol; controls (rc_*): pdelta (0: no P-delta
+!> remainder, pdelta_linear and pdelta_quadratic unused), max_newton. status (rt_*): info
+!> (1 Newton failed, 2 singular iteration matrix) and the failed step.
+subroutine reduced_ffr_newmark(r, steps, settings, controls, omega2, gyroscopic, centrifugal, &
+                               pdelta_linear, pdelta_quadratic, load_patterns, frame, eta, &
+                               velocity, counts, status)
   use ancf_kinds, only: dp
   use reduced_ffr_stepper, only: reduced_newmark
+  use api_support, only: rs_dt, rs_beta, rs_gamma, rs_tol, rc_pdelta, rc_max_newton, &
+                         fm_rate, fm_accel, fm_sin_psi, fm_one_minus_cos, rn_corrections, &
+                         rn_factorized, rt_info, rt_failed_step
   implicit none
-  integer, intent(in) :: r, steps, pdelta, max_newton
-  real(dp), intent(in) :: dt, beta, gamma, omega2(r), gyroscopic(r, r), centrifugal(r, r)
+  integer, intent(in) :: r, steps, controls(2)
+  real(dp), intent(in) :: settings(4), omega2(r), gyroscopic(r, r), centrifugal(r, r)
   real(dp), intent(in) :: pdelta_linear(r, r), pdelta_quadratic(r, r, r)
-  real(dp), intent(in) :: load_patterns(r, 4), rate(steps + 1), accel(steps + 1), tol
-  real(dp), intent(in) :: sin_psi(steps + 1), one_minus_cos(steps + 1)
+  real(dp), intent(in) :: load_patterns(r, 4), frame(steps + 1, 4)
   real(dp), intent(out) :: eta(r, steps + 1), velocity(r, steps + 1)
-  integer, intent(out) :: corrections(steps + 1), factorized(steps + 1)
-  integer, intent(out) :: info, failed_step
-  call reduced_newmark(r, steps, dt, beta, gamma, omega2, gyroscopic, centrifugal, &
-                       pdelta /= 0, pdelta_linear, pdelta_quadratic, load_patterns, rate, accel, &
-                       sin_psi, one_minus_cos, tol, max_newton, eta, velocity, corrections, &
-                       factorized, info, failed_step)
+  integer, intent(out) :: counts(steps + 1, 2), status(2)
+  call reduced_newmark(r, steps, settings(rs_dt), settings(rs_beta), settings(rs_gamma), &
+                       omega2, gyroscopic, centrifugal, controls(rc_pdelta) /= 0, &
+                       pdelta_linear, pdelta_quadratic, load_patterns, frame(:, fm_rate), &
+                       frame(:, fm_accel), frame(:, fm_sin_psi), frame(:, fm_one_minus_cos), &
+                       settings(rs_tol), controls(rc_max_newton), eta, velocity, &
+                       counts(:, rn_corrections), counts(:, rn_factorized), status(rt_info), &
+                       status(rt_failed_step))
 end subroutine reduced_ffr_newmark
 
 !> The energies and the frame's power of a modally reduced FFR run's output rows
-!> (reduced_ffr_rows; python ancfdrv.solvers.ffr_reduced.RowMaps): kinetic, strain (with
-!> the P-delta cubic form when nused > 0), the frame's power and the loads' potential at
-!> nrow rows. used: 1-based indices into c = (1, sin psi, 1 - cos psi, eta).
-subroutine reduced_ffr_energy_rows(r, nrow, nused, nmono, rate, sin_psi, one_minus_cos, eta, &
-                                   velocity, kinetic_form, strain_form, power_form, used, &
-                                   table, load_constant, load_linear, kinetic, strain, power, &
-                                   load)
+!> (reduced_ffr_rows; python ancfdrv.solvers.ffr_reduced.RowMaps): energies(:, re_*) the
+!> kinetic, strain (with the P-delta cubic form when nused > 0), the frame's power and the
+!> loads' potential at nrow rows of the frame's motion (api_support fm_* columns: psi',
+!> sin psi, 1 - cos psi). used: 1-based indices into c = (1, sin psi, 1 - cos psi, eta).
+subroutine reduced_ffr_energy_rows(r, nrow, nused, nmono, frame, eta, velocity, kinetic_form, &
+                                   strain_form, power_form, used, table, load_constant, &
+                                   load_linear, energies)
   use ancf_kinds, only: dp
   use reduced_ffr_rows, only: reduced_energy_rows
+  use api_support, only: fm_rate, fm_sin_psi, fm_one_minus_cos, re_kinetic, re_strain, &
+                         re_power, re_load
   implicit none
   integer, intent(in) :: r, nrow, nused, nmono
-  real(dp), intent(in) :: rate(nrow), sin_psi(nrow), one_minus_cos(nrow)
-  real(dp), intent(in) :: eta(r, nrow), velocity(r, nrow)
+  real(dp), intent(in) :: frame(nrow, 3), eta(r, nrow), velocity(r, nrow)
   real(dp), intent(in) :: kinetic_form(1 + 2 * r, 1 + 2 * r)
   real(dp), intent(in) :: strain_form(3 + r, 3 + r), power_form(3 + r, 3 + r)
   integer, intent(in) :: used(nused)
   real(dp), intent(in) :: table(nmono, 2), load_constant, load_linear(1 + r, 3)
-  real(dp), intent(out) :: kinetic(nrow), strain(nrow), power(nrow), load(nrow)
-  call reduced_energy_rows(r, nrow, nused, nmono, rate, sin_psi, one_minus_cos, eta, velocity, &
-                           kinetic_form, strain_form, power_form, used, table, load_constant, &
-                           load_linear, kinetic, strain, power, load)
+  real(dp), intent(out) :: energies(nrow, 4)
+  call reduced_energy_rows(r, nrow, nused, nmono, frame(:, fm_rate), frame(:, fm_sin_psi), &
+                           frame(:, fm_one_minus_cos), eta, velocity, kinetic_form, &
+                           strain_form, power_form, used, table, load_constant, load_linear, &
+                           energies(:, re_kinetic), energies(:, re_strain), &
+                           energies(:, re_power), energies(:, re_load))
 end subroutine reduced_ffr_energy_rows
 
 !> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r); the
 !> velocities zero): gradients(:, :, r) as constraint_evaluate returns them (first order
-!> only: no Hessians, Phi_t, gamma). One call for a chunk of output rows (the reactions of
+!> only: no Hessians, Phi_t, gamma), of the packed constraint layout (ints, reals:
+!> api_support unpack_constraints). One call for a chunk of output rows (the reactions of
 !> every step, python/ancfdrv/system/answers.py).
-subroutine constraint_gradient_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
-                                    params, operand_const, term_ptr, term_dof, term_coef, &
-                                    drive_kinds, drive_ptr, drive_data, q_rows, times, &
+subroutine constraint_gradient_rows(nint, ints, nreal, reals, ncon, ndof, nrow, q_rows, times, &
                                     gradients, info)
   use ancf_kinds, only: dp
   use constraints, only: constraint_eval
+  use api_support, only: constraint_layout, unpack_constraints
   implicit none
-  integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata, nrow
-  integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
-  integer, intent(in) :: drive_kinds(ndrive), drive_ptr(ndrive + 1)
-  real(dp), intent(in) :: params(8, ncon), operand_const(6, ncon), term_coef(nterm)
-  real(dp), intent(in) :: drive_data(ndata), q_rows(ndof, nrow), times(nrow)
+  integer, intent(in) :: nint, ints(nint), nreal, ncon, ndof, nrow
+  real(dp), intent(in) :: reals(nreal), q_rows(ndof, nrow), times(nrow)
   real(dp), intent(out) :: gradients(6, ncon, nrow)
   integer, intent(out) :: info
   real(dp) :: values(ncon), hessians(6, 6, ncon), phi_t(ncon), phi_tt(ncon), gamma(ncon)
   real(dp) :: velocity(ndof)
+  type(constraint_layout) :: lay
   integer :: row
   velocity = 0.0_dp
   gradients = 0.0_dp
-  info = 0
+  call unpack_constraints(ints, reals, ncon, lay, info)
+  if (info /= 0) return
   do row = 1, nrow
-    call constraint_eval(ncon, kinds, drives, params, operand_const, term_ptr, term_dof, &
-                         term_coef, drive_kinds, drive_ptr, drive_data, q_rows(:, row), &
-                         velocity, times(row), values, gradients(:, :, row), hessians, phi_t, &
-                         phi_tt, gamma, info, first_order_only=.true.)
+    call constraint_eval(ncon, lay%kinds, lay%drives, lay%params, lay%operand_const, &
+                         lay%term_ptr, lay%term_dof, lay%term_coef, lay%drive_kinds, &
+                         lay%drive_ptr, lay%drive_data, q_rows(:, row), velocity, times(row), &
+                         values, gradients(:, :, row), hessians, phi_t, phi_tt, gamma, info, &
+                         first_order_only=.true.)
     if (info /= 0) return
   end do
 end subroutine constraint_gradient_rows
 
-!> The constraint violation max |Phi| at each of nrow states (q_rows(:, r), times(r)), as the
-!> system's output row computes it (the values of constraint_eval, through
-!> constraints' constraint_values: the layout checked once, each drive evaluated once a
-!> row): one call for the rows of a modally reduced FFR run (python/ancfdrv/solvers/ffr_reduced.py), whose states
-!> need only the constrained coordinates filled in.
-subroutine constraint_violation_rows(ncon, ndof, nterm, ndrive, ndata, nrow, kinds, drives, &
-                                     params, operand_const, term_ptr, term_dof, term_coef, &
-                                     drive_kinds, drive_ptr, drive_data, q_rows, times, &
+!> The constraint violation max |Phi| at each of nrow states (q_rows(:, r), times(r)) of the
+!> packed constraint layout (ints, reals: api_support unpack_constraints), as the system's
+!> output row computes it (the values of constraint_eval, through constraints'
+!> constraint_values: the layout checked once, each drive evaluated once a row): one call
+!> for the rows of a modally reduced FFR run (python/ancfdrv/solvers/ffr_reduced.py), whose
+!> states need only the constrained coordinates filled in.
+subroutine constraint_violation_rows(nint, ints, nreal, reals, ncon, ndof, nrow, q_rows, times, &
                                      violation, info)
   use ancf_kinds, only: dp
   use constraints, only: constraint_values
+  use api_support, only: constraint_layout, unpack_constraints
   implicit none
-  integer, intent(in) :: ncon, ndof, nterm, ndrive, ndata, nrow
-  integer, intent(in) :: kinds(ncon), drives(ncon), term_ptr(6 * ncon + 1), term_dof(nterm)
-  integer, intent(in) :: drive_kinds(ndrive), drive_ptr(ndrive + 1)
-  real(dp), intent(in) :: params(8, ncon), operand_const(6, ncon), term_coef(nterm)
-  real(dp), intent(in) :: drive_data(ndata), q_rows(ndof, nrow), times(nrow)
+  integer, intent(in) :: nint, ints(nint), nreal, ncon, ndof, nrow
+  real(dp), intent(in) :: reals(nreal), q_rows(ndof, nrow), times(nrow)
   real(dp), intent(out) :: violation(nrow)
   integer, intent(out) :: info
   real(dp), allocatable :: values(:, :)
+  type(constraint_layout) :: lay
   integer :: row
   violation = 0.0_dp
+  call unpack_constraints(ints, reals, ncon, lay, info)
+  if (info /= 0) return
   allocate(values(ncon, nrow))
-  call constraint_values(ncon, nrow, kinds, drives, params, operand_const, term_ptr, &
-                         term_dof, term_coef, drive_kinds, drive_ptr, drive_data, q_rows, &
-                         times, values, info)
+  call constraint_values(ncon, nrow, lay%kinds, lay%drives, lay%params, lay%operand_const, &
+                         lay%term_ptr, lay%term_dof, lay%term_coef, lay%drive_kinds, &
+                         lay%drive_ptr, lay%drive_data, q_rows, times, values, info)
   if (info /= 0 .or. ncon == 0) return
   do row = 1, nrow
     violation(row) = maxval(abs(values(:, row)))

@@ -8,7 +8,8 @@
 subroutine system_create(ndof, nfull, handle, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_create, store_get
+  use system_store, only: store_create
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: ndof, nfull
   integer, intent(out) :: handle, info
@@ -20,7 +21,7 @@ subroutine system_create(ndof, nfull, handle, info, message)
     message = "the kernel's system table is full (256 systems alive)"
     return
   end if
-  call store_get(handle, sys, info)
+  call api_system(handle, sys, info)
   sys%ndof = ndof
   sys%nfull = nfull
   allocate (sys%sets(0), sys%frames(0), sys%pairs(0))
@@ -64,8 +65,7 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, policy_constant, plane_mass_setup
   use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, jacobian_reuse
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, max_newton, jacobian
   real(dp), intent(in) :: beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
@@ -73,12 +73,8 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(stepper_run), pointer :: run
-  message = ' '
-  call store_get(handle, sys, info, run)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message, run)
+  if (info /= 0) return
   if (.not. (beta > 0.0_dp .and. gamma > 0.0_dp .and. alpha_m < 1.0_dp .and. &
              alpha_f < 1.0_dp .and. tol > 0.0_dp .and. length_scale > 0.0_dp .and. &
              contraction > 0.0_dp .and. contraction < 1.0_dp)) then
@@ -116,8 +112,7 @@ subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference,
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
   use ffr_elastic, only: ffr_set
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nel, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: stiffness0(24, 24, nel), reference(24, nel), damping_time
@@ -127,12 +122,8 @@ subroutine system_add_ffr_set(handle, nel, dofs, scatter, stiffness0, reference,
   class(element_set), allocatable :: set
   type(ffr_set) :: built
   index = 0
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. frame < 1 .or. &
       .not. (damping_time >= 0.0_dp)) then
     info = 2
@@ -161,20 +152,15 @@ subroutine system_ffr_second_order(handle, index, nel, axial_rigidity, axis, len
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use ffr_elastic, only: ffr_enable_second_order
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, index, nel
   real(dp), intent(in) :: axial_rigidity(nel), axis(3, nel), length(nel), slope_gram(8, 8, nel)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   info = 2
   message = 'system_ffr_second_order: set index is not an FFR set of this size, or a' // &
             ' length is not positive'
@@ -188,19 +174,18 @@ end subroutine system_ffr_second_order
 !> Large-deformation (continuum) beam elements: material gradients and weights at npts
 !> Gauss points of which the first nvolume are volume points (beam_nonlinear);
 !> damping_time as system_add_ffr_set; shear_scales the section's torsion and shear
-!> correction [c, d_y, d_z].
+!> correction [c, d_y, d_z]; material (api_support bm_*): Young's modulus, Poisson's ratio.
 subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, gradients, &
-                                    weights, youngs, poisson, shear_scales, frame, damping_time, &
+                                    weights, material, shear_scales, frame, damping_time, &
                                     index, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
   use beam_nonlinear, only: continuum_set
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system, bm_youngs, bm_poisson
   implicit none
   integer, intent(in) :: handle, nel, npts, nvolume, dofs(24, nel), scatter(24, 24, nel), frame
-  real(dp), intent(in) :: gradients(8, 3, npts, nel), weights(npts, nel), youngs, poisson
+  real(dp), intent(in) :: gradients(8, 3, npts, nel), weights(npts, nel), material(2)
   real(dp), intent(in) :: shear_scales(3), damping_time
   integer, intent(out) :: index, info
   character(len=200), intent(out) :: message
@@ -208,12 +193,8 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   class(element_set), allocatable :: set
   type(continuum_set) :: built
   index = 0
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
     info = 2
     message = 'system_add_continuum_set: an element dof outside 1..nfull or a negative damping_time'
@@ -227,8 +208,8 @@ subroutine system_add_continuum_set(handle, nel, npts, nvolume, dofs, scatter, g
   built%volume_points = nvolume
   built%gradients = gradients
   built%weights = weights
-  built%youngs = youngs
-  built%poisson = poisson
+  built%youngs = material(bm_youngs)
+  built%poisson = material(bm_poisson)
   built%shear_scales = shear_scales
   built%damping_time = damping_time
   built%force_cost = 1.2d0
@@ -244,8 +225,7 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
   use beam_cubic, only: cubic_set, cubic_pattern, cubic_terms
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nel, nterms, dofs(24, nel), scatter(24, 24, nel), frame
   real(dp), intent(in) :: forms(8, 8, nterms, nel), strain0(nterms, nel), stiffness(nterms, nel)
@@ -256,12 +236,8 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   class(element_set), allocatable :: set
   type(cubic_set) :: built
   index = 0
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp) .or. &
       nterms /= cubic_terms) then
     info = 2
@@ -286,19 +262,19 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   call append_set(sys, set, index)
 end subroutine system_add_cubic_set
 
-!> Thin plate elements (plate_element): reference data at npts Gauss points.
+!> Thin plate elements (plate_element): reference data at npts Gauss points; material
+!> (api_support pm_*): Young's modulus, Poisson's ratio, thickness.
 subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_frame, curvature0, &
-                                weights, youngs, poisson, thickness, damping_time, index, info, message)
+                                weights, material, damping_time, index, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
   use plate_element, only: plate_set
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system, pm_youngs, pm_poisson, pm_thickness
   implicit none
   integer, intent(in) :: handle, nel, npts, dofs(36, nel), scatter(36, 36, nel)
   real(dp), intent(in) :: derivs(12, 5, npts, nel), plate_frame(2, 2, npts, nel)
-  real(dp), intent(in) :: curvature0(3, npts, nel), weights(npts, nel), youngs, poisson, thickness
+  real(dp), intent(in) :: curvature0(3, npts, nel), weights(npts, nel), material(3)
   real(dp), intent(in) :: damping_time
   integer, intent(out) :: index, info
   character(len=200), intent(out) :: message
@@ -306,12 +282,8 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
   class(element_set), allocatable :: set
   type(plate_set) :: built
   index = 0
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. .not. (damping_time >= 0.0_dp)) then
     info = 2
     message = 'system_add_plate_set: an element dof outside 1..nfull or a negative damping_time'
@@ -325,9 +297,9 @@ subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_
   built%plate_frame = plate_frame
   built%curvature0 = curvature0
   built%weights = weights
-  built%youngs = youngs
-  built%poisson = poisson
-  built%thickness = thickness
+  built%youngs = material(pm_youngs)
+  built%poisson = material(pm_poisson)
+  built%thickness = material(pm_thickness)
   built%damping_time = damping_time
   built%force_cost = 6.0d0
   built%tangent_cost = 80.0d0
@@ -344,8 +316,7 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
   use cable_element, only: cable_set, cable_rule, cable_element_rows
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nel, dofs(12, nel), scatter(12, 12, nel), tension_only
   real(dp), intent(in) :: lengths(nel), axial_stiffness, bending_stiffness, damping_time
@@ -355,12 +326,8 @@ subroutine system_add_cable_set(handle, nel, dofs, scatter, lengths, axial_stiff
   class(element_set), allocatable :: set
   type(cable_set) :: built
   index = 0
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. damping_time < 0.0_dp .or. &
       any(lengths <= 0.0_dp) .or. bending_stiffness < 0.0_dp) then
     info = 2
@@ -394,8 +361,7 @@ end subroutine system_add_cable_set
 subroutine system_set_frames(handle, nframe, drives, axes, bases, pivots, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nframe, drives(max(1, nframe))
   real(dp), intent(in) :: axes(3, max(1, nframe)), bases(3, 3, max(1, nframe))
@@ -404,12 +370,8 @@ subroutine system_set_frames(handle, nframe, drives, axes, bases, pivots, info, 
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   integer :: f
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   deallocate (sys%frames)
   allocate (sys%frames(nframe))
   do f = 1, nframe
@@ -430,20 +392,15 @@ end subroutine system_set_frames
 subroutine system_set_drives(handle, ndrive, ndata, kinds, ptr, data, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, ndrive, ndata, kinds(max(1, ndrive)), ptr(ndrive + 1)
   real(dp), intent(in) :: data(max(1, ndata))
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (ptr(1) /= 1 .or. ptr(ndrive + 1) /= ndata + 1) then
     info = 2
     message = 'system_set_drives: drive pointers inconsistent with ndata'
@@ -456,37 +413,25 @@ end subroutine system_set_drives
 
 !> The mass matrix on the independent coordinates (CSR, 1-based; zero entries may be left
 !> out) and on the solver's pattern (mass_pattern, aligned with the pattern analysed by the
-!> solver), the full pattern of the tangents, the solver handle and its policy
-!> (0 constant, 1 refactorized), the frame of every reduced 3-vector (policy constant; 0:
-!> global) and the first dofs of the 3-vector blocks the constraints touch.
-subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_values, &
-                               nfull, nnz_full, full_row_ptr, full_col, solver_handle, policy, &
-                               nnz_pattern, mass_pattern, nvec, vector_frame, nblock, block_first, &
-                               info, message)
+!> solver). system_set_solver sets the pattern and the solver.
+subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_values, &
+                           nnz_pattern, mass_pattern, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, ndof, nnz_mass, mass_row_ptr(ndof + 1), mass_col(nnz_mass)
   real(dp), intent(in) :: mass_values(nnz_mass)
-  integer, intent(in) :: nfull, nnz_full, full_row_ptr(nfull + 1), full_col(nnz_full)
-  integer, intent(in) :: solver_handle, policy, nnz_pattern, nvec, nblock
+  integer, intent(in) :: nnz_pattern
   real(dp), intent(in) :: mass_pattern(nnz_pattern)
-  integer, intent(in) :: vector_frame(max(1, nvec)), block_first(max(1, nblock))
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
-  if (ndof /= sys%ndof .or. nfull /= sys%nfull) then
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  if (ndof /= sys%ndof) then
     info = 2
-    message = 'system_set_matrices: sizes inconsistent with the system' // &
-              ' (ndof, nfull) or the solver pattern'
+    message = 'system_set_mass: sizes inconsistent with the system (ndof)'
     return
   end if
   sys%mass_row_ptr = mass_row_ptr
@@ -494,11 +439,36 @@ subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, m
   sys%mass_values = mass_values
   if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
                                                 sys%mass_pair_row, sys%mass_pair_values)
+  sys%mass_pattern = mass_pattern
+  sys%factorized = .false.
+end subroutine system_set_mass
+
+!> The full pattern of the tangents (CSR, 1-based), the solver (api_support sl_*: its
+!> handle, its policy: 0 constant, 1 refactorized), the frame of every reduced 3-vector
+!> (policy constant; 0: global) and the first dofs of the 3-vector blocks the constraints
+!> touch.
+subroutine system_set_solver(handle, nfull, nnz_full, full_row_ptr, full_col, solver, nvec, &
+                             vector_frame, nblock, block_first, info, message)
+  use mechanical_system, only: system_model
+  use api_support, only: api_system, sl_handle, sl_policy
+  implicit none
+  integer, intent(in) :: handle, nfull, nnz_full, full_row_ptr(nfull + 1), full_col(nnz_full)
+  integer, intent(in) :: solver(2), nvec, nblock
+  integer, intent(in) :: vector_frame(max(1, nvec)), block_first(max(1, nblock))
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  if (nfull /= sys%nfull) then
+    info = 2
+    message = 'system_set_solver: sizes inconsistent with the system (nfull)'
+    return
+  end if
   sys%full_row_ptr = full_row_ptr
   sys%full_col = full_col
-  sys%solver_handle = solver_handle
-  sys%policy = policy
-  sys%mass_pattern = mass_pattern
+  sys%solver_handle = solver(sl_handle)
+  sys%policy = solver(sl_policy)
   if (allocated(sys%vector_frame)) deallocate (sys%vector_frame)
   sys%single_frame = -1
   if (nvec > 0) then
@@ -508,9 +478,9 @@ subroutine system_set_matrices(handle, ndof, nnz_mass, mass_row_ptr, mass_col, m
   end if
   sys%block_first = block_first(1:nblock)
   deallocate (sys%flexibility, sys%flexibility_cc)
-  allocate (sys%flexibility(ndof, 3 * nblock), sys%flexibility_cc(3 * nblock, 3 * nblock))
+  allocate (sys%flexibility(sys%ndof, 3 * nblock), sys%flexibility_cc(3 * nblock, 3 * nblock))
   sys%factorized = .false.
-end subroutine system_set_matrices
+end subroutine system_set_solver
 
 !> The 3-vectors jacobian_reuse carries the iteration matrix with (carried_rotation): the
 !> first full dof of each (1-based), its weight in the rotation fit and whether it is a
@@ -521,8 +491,7 @@ end subroutine system_set_matrices
 subroutine system_set_carry(handle, nvec, first, weight, position, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nvec, first(max(1, nvec)), position(max(1, nvec))
   real(dp), intent(in) :: weight(max(1, nvec))
@@ -530,12 +499,8 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   integer :: i, k
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (nvec > 0) then
     if (any(first(1:nvec) < 1 .or. first(1:nvec) > sys%nfull - 2) .or. &
         any(weight(1:nvec) < 0.0_dp) .or. mod(sys%nfull, 3) /= 0) then
@@ -607,24 +572,19 @@ contains
 end subroutine system_set_carry
 
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),
-!> replacing the CSR of system_set_matrices in products (a ninth of the entries).
+!> replacing the CSR of system_set_mass in products (a ninth of the entries).
 subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nvec, nnz, row_ptr(nvec + 1), col(nnz)
   real(dp), intent(in) :: values(nnz)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (3 * nvec /= sys%ndof .or. any(col < 1) .or. any(col > nvec)) then
     info = 2
     message = 'system_set_kron_mass: sizes inconsistent with the system (3 nvec /= ndof)'
@@ -644,8 +604,7 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
                                 plan_source, plan_target, plan_coef, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nfull, nnz_b, b_ptr(nfull + 1), b_col(max(1, nnz_b)), nplan
   real(dp), intent(in) :: b_values(max(1, nnz_b)), offset(nfull)
@@ -655,12 +614,8 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   integer :: i
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (nfull /= sys%nfull) then
     info = 2
     message = 'system_set_reduction: sizes inconsistent with the system (nfull)'
@@ -704,8 +659,7 @@ subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, f
                             info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, ndof, nforce, nmoment
   real(dp), intent(in) :: constant_force(ndof), force_vectors(ndof, max(1, nforce))
@@ -715,12 +669,8 @@ subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, f
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (ndof /= sys%ndof) then
     info = 2
     message = 'system_set_loads: sizes inconsistent with the system (ndof)' // &
@@ -751,7 +701,7 @@ subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors,
                                    dofs, coefs, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nload, nterm
   integer, intent(in) :: kinds(max(1, nload)), drives(max(1, nload)), ptr(3 * nload + 1)
@@ -760,7 +710,7 @@ subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors,
   real(dp), intent(in) :: coefs(max(1, nterm))
   integer, intent(out) :: info
   type(system_model), pointer :: sys
-  call store_get(handle, sys, info)
+  call api_system(handle, sys, info)
   if (info /= 0) return
   if (ptr(3 * nload + 1) /= nterm + 1) then
     info = 2
@@ -789,64 +739,85 @@ subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors,
   sys%vload_coef = coefs(1:nterm)
 end subroutine system_set_vector_loads
 
-!> Force elements (force_elements): nfel elements of kinds(nfel), drives (0: none), their
-!> parameters params(param_ptr(l) .. param_ptr(l + 1) - 1), tables likewise (table_kinds:
-!> 0 none), first slots slot_first(nfel) of nslot slots with constants slot_const(3, nslot)
-!> and terms term_ptr(slot) .. term_ptr(slot + 1) - 1 (term_dof: first full coordinate of a
-!> 3-vector, term_coef).
-subroutine system_set_force_elements(handle, nfel, nparam, ntable, nslot, nterm, kinds, &
-                                     drives, table_kinds, param_ptr, params, table_ptr, table, &
-                                     slot_first, slot_const, term_ptr, term_dof, term_coef, &
-                                     npos, position_ptr, positions, info)
+!> The slots of the force elements (set before system_set_force_elements): nslot slots with
+!> constants slot_const(3, nslot) and terms term_ptr(slot) .. term_ptr(slot + 1) - 1
+!> (term_dof: first full coordinate of a 3-vector, term_coef). info: 1 not a live handle;
+!> 2 the pointers disagree with nterm or a term outside the full coordinates.
+subroutine system_set_force_slots(handle, nslot, nterm, slot_const, term_ptr, term_dof, &
+                                  term_coef, info)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use force_elements, only: force_element_slots, force_element_parameters
+  use api_support, only: api_system
   implicit none
-  integer, intent(in) :: handle, nfel, nparam, ntable, nslot, nterm
-  integer, intent(in) :: kinds(max(1, nfel)), drives(max(1, nfel)), table_kinds(max(1, nfel))
-  integer, intent(in) :: param_ptr(nfel + 1), table_ptr(nfel + 1), slot_first(max(1, nfel))
+  integer, intent(in) :: handle, nslot, nterm
   integer, intent(in) :: term_ptr(nslot + 1), term_dof(max(1, nterm))
-  real(dp), intent(in) :: params(max(1, nparam)), table(max(1, ntable))
   real(dp), intent(in) :: slot_const(3, max(1, nslot)), term_coef(max(1, nterm))
-  !> the tangent's positions in the full pattern's values (0: absent), element l's from
-  !> position_ptr(l), in force_element_forces' loop order (npos 0: searched instead)
-  integer, intent(in) :: npos, position_ptr(nfel + 1), positions(max(1, npos))
   integer, intent(out) :: info
   type(system_model), pointer :: sys
-  integer :: l
-  call store_get(handle, sys, info)
+  call api_system(handle, sys, info)
   if (info /= 0) return
   info = 2
-  if (param_ptr(nfel + 1) /= nparam + 1 .or. table_ptr(nfel + 1) /= ntable + 1 .or. &
-      term_ptr(nslot + 1) /= nterm + 1 .or. position_ptr(nfel + 1) /= npos + 1) return
-  if (npos > 0) then
-    if (any(positions(1:npos) < 0)) return
-  end if
+  if (term_ptr(nslot + 1) /= nterm + 1) return
   if (nterm > 0) then
     if (any(term_dof(1:nterm) < 1) .or. any(term_dof(1:nterm) + 2 > sys%nfull)) return
   end if
-  do l = 1, nfel
-    if (force_element_slots(kinds(l)) == 0) return
-    if (param_ptr(l + 1) - param_ptr(l) < force_element_parameters(kinds(l))) return
-    if (slot_first(l) < 1 .or. slot_first(l) + force_element_slots(kinds(l)) - 1 > nslot) return
-    if (drives(l) < 0 .or. drives(l) > size(sys%drive_kinds)) return
-  end do
   info = 0
-  sys%nfel = nfel
-  sys%fel_kind = kinds(1:nfel)
-  sys%fel_drive = drives(1:nfel)
-  sys%fel_table_kind = table_kinds(1:nfel)
-  sys%fel_param_ptr = param_ptr
-  sys%fel_params = params(1:nparam)
-  sys%fel_table_ptr = table_ptr
-  sys%fel_table = table(1:ntable)
-  sys%fel_slot_first = slot_first(1:nfel)
   sys%fel_slot_const = slot_const(:, 1:nslot)
   sys%fel_term_ptr = term_ptr
   sys%fel_term_dof = term_dof(1:nterm)
   sys%fel_term_coef = term_coef(1:nterm)
-  sys%fel_pos_ptr = position_ptr
+end subroutine system_set_force_slots
+
+!> Force elements (force_elements) on the slots of system_set_force_slots: per element l
+!> elements(:, l) (api_support fl_*: kind, drive (0: none), table kind (0: none), first
+!> slot), its parameters params(p(l) .. p(l + 1) - 1), p = pointers(:, fp_param), its table
+!> likewise (fp_table) and the tangent's positions in the full pattern's values (0: absent;
+!> fp_position; in force_element_forces' loop order; npos 0: searched instead). info: 1 not
+!> a live handle; 2 an inconsistent layout (no slots set, a kind, drive or slot out of range,
+!> too few parameters).
+subroutine system_set_force_elements(handle, nfel, nparam, ntable, npos, elements, pointers, &
+                                     params, table, positions, info)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use force_elements, only: force_element_slots, force_element_parameters
+  use api_support, only: api_system, fl_kind, fl_drive, fl_table_kind, &
+                         fl_slot_first, fp_param, fp_table, fp_position
+  implicit none
+  integer, intent(in) :: handle, nfel, nparam, ntable, npos
+  integer, intent(in) :: elements(4, max(1, nfel)), pointers(nfel + 1, 3)
+  real(dp), intent(in) :: params(max(1, nparam)), table(max(1, ntable))
+  integer, intent(in) :: positions(max(1, npos))
+  integer, intent(out) :: info
+  type(system_model), pointer :: sys
+  integer :: l, kind, first
+  call api_system(handle, sys, info)
+  if (info /= 0) return
+  info = 2
+  if (.not. allocated(sys%fel_slot_const)) return
+  if (pointers(nfel + 1, fp_param) /= nparam + 1 .or. pointers(nfel + 1, fp_table) /= ntable + 1 &
+      .or. pointers(nfel + 1, fp_position) /= npos + 1) return
+  if (npos > 0) then
+    if (any(positions(1:npos) < 0)) return
+  end if
+  do l = 1, nfel
+    kind = elements(fl_kind, l)
+    first = elements(fl_slot_first, l)
+    if (force_element_slots(kind) == 0) return
+    if (pointers(l + 1, fp_param) - pointers(l, fp_param) < force_element_parameters(kind)) return
+    if (first < 1 .or. first + force_element_slots(kind) - 1 > size(sys%fel_slot_const, 2)) return
+    if (elements(fl_drive, l) < 0 .or. elements(fl_drive, l) > size(sys%drive_kinds)) return
+  end do
+  info = 0
+  sys%nfel = nfel
+  sys%fel_kind = elements(fl_kind, 1:nfel)
+  sys%fel_drive = elements(fl_drive, 1:nfel)
+  sys%fel_table_kind = elements(fl_table_kind, 1:nfel)
+  sys%fel_param_ptr = pointers(:, fp_param)
+  sys%fel_params = params(1:nparam)
+  sys%fel_table_ptr = pointers(:, fp_table)
+  sys%fel_table = table(1:ntable)
+  sys%fel_slot_first = elements(fl_slot_first, 1:nfel)
+  sys%fel_pos_ptr = pointers(:, fp_position)
   sys%fel_pos = positions(1:npos)
 end subroutine system_set_force_elements
 
@@ -856,8 +827,8 @@ end subroutine system_set_force_elements
 subroutine system_force_element_reactions(handle, ndof, nfel, t, e, v, reactions, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, force_element_reactions
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text, failure_text
+  use api_support, only: api_system
+  use kernel_errors, only: failure_text
   implicit none
   integer, intent(in) :: handle, ndof, nfel
   real(dp), intent(in) :: t, e(ndof), v(ndof)
@@ -867,11 +838,8 @@ subroutine system_force_element_reactions(handle, ndof, nfel, t, e, v, reactions
   type(system_model), pointer :: sys
   message = ' '
   reactions = 0.0_dp
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (ndof /= sys%ndof .or. nfel /= sys%nfel) then
     info = 2
     message = 'system_force_element_reactions: sizes inconsistent with the system'
@@ -888,8 +856,7 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
                                   term_ptr, term_dof, term_coef, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, ncon, nterm
   integer, intent(in) :: kinds(max(1, ncon)), drives(max(1, ncon)), term_ptr(6 * ncon + 1)
@@ -900,12 +867,8 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   integer :: c, s
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (term_ptr(6 * ncon + 1) /= nterm + 1) then
     info = 2
     message = 'system_set_constraints: term pointers or dofs inconsistent with the system'
@@ -943,8 +906,7 @@ subroutine system_add_contact_pair(handle, nel, dofs, sizes, ngrid_l, ngrid_w, g
                                    point_element, point_local, params, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_pair
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nel, dofs(36, nel), ngrid_l, ngrid_w, grid(ngrid_l, ngrid_w)
   integer, intent(in) :: npoint, point_element(npoint)
@@ -954,12 +916,8 @@ subroutine system_add_contact_pair(handle, nel, dofs, sizes, ngrid_l, ngrid_w, g
   type(system_model), pointer :: sys
   type(contact_pair), allocatable :: grown(:)
   integer :: n
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (any(dofs < 1) .or. any(dofs > sys%nfull) .or. any(grid < 1) .or. any(grid > nel) .or. &
       any(point_element < 1) .or. any(point_element > nel)) then
     info = 2
@@ -987,8 +945,7 @@ end subroutine system_add_contact_pair
 subroutine system_set_probes(handle, nprobe, nterm, ptr, dofs, coefs, frames, reference, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nprobe, nterm, ptr(nprobe + 1), dofs(max(1, nterm))
   integer, intent(in) :: frames(max(1, nprobe))
@@ -996,12 +953,8 @@ subroutine system_set_probes(handle, nprobe, nterm, ptr, dofs, coefs, frames, re
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (nterm > 0) then
     if (any(dofs(1:nterm) < 1) .or. any(dofs(1:nterm) + 2 > sys%nfull)) then
       info = 2
@@ -1029,36 +982,37 @@ end subroutine system_set_probes
 !> records, and with want_tangent /= 0 the tangent (sets, plus velocity_factor times the
 !> contact Jacobian) on the solver's (reduced) pattern in global coordinates. Damped sets
 !> add their damping force at e' (with the frames' angular velocities at t) and their
-!> tangent is dQ/de + velocity_factor dQ/de'. Codes as the
-!> stepper's (5 drive, 6 moment, 7 plate normal, 8 contact search).
-subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velocity_factor, &
-                           want_tangent, guesses, counts, internal, external, strain, &
-                           contact_potential, records, tangent, info, message)
+!> tangent is dQ/de + velocity_factor dQ/de'. state(:, sv_coordinates) = e,
+!> state(:, sv_rates) = e'; factors (ef_*): t, load_factor, velocity_factor; forces(:, ff_*):
+!> internal, external; energies (ee_*): strain, contact potential. Codes as the stepper's
+!> (5 drive, 6 moment, 7 plate normal, 8 contact search).
+subroutine system_evaluate(handle, ndof, nnz, npoint, state, factors, want_tangent, guesses, &
+                           counts, forces, energies, records, tangent, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
                                external_forces
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text, failure_text
+  use kernel_errors, only: failure_text
+  use api_support, only: api_system, sv_coordinates, sv_rates, ef_time, &
+                         ef_load_factor, ef_velocity_factor, ff_internal, &
+                         ff_external, ee_strain, ee_contact_potential
   implicit none
   integer, intent(in) :: handle, ndof, nnz, npoint, want_tangent
-  real(dp), intent(in) :: t, e(ndof), v(ndof), load_factor, velocity_factor
+  real(dp), intent(in) :: state(ndof, 2), factors(3)
   real(dp), intent(inout) :: guesses(2, max(1, npoint))
   integer, intent(inout) :: counts(6)
   !f2py intent(in,out) :: guesses, counts
-  real(dp), intent(out) :: internal(ndof), external(ndof), strain, contact_potential
+  real(dp), intent(out) :: forces(ndof, 2), energies(2)
   real(dp), intent(out) :: records(6, max(1, npoint)), tangent(nnz)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(contact_state) :: state
+  type(contact_state) :: contact
   real(dp), allocatable :: rotations(:, :, :), rates(:)
-  real(dp) :: powers(2)
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  real(dp) :: powers(2), t, load_factor, velocity_factor
+  forces = 0.0_dp
+  energies = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (ndof /= sys%ndof .or. npoint /= sys%npoint .or. (want_tangent /= 0 .and. &
       nnz /= size(sys%mass_pattern))) then
     info = 2
@@ -1066,32 +1020,38 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, t, e, v, load_factor, velo
               ' npoint, or nnz of the tangent)'
     return
   end if
+  t = factors(ef_time)
+  load_factor = factors(ef_load_factor)
+  velocity_factor = factors(ef_velocity_factor)
   allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)))
   call frame_rotations(sys, t, rotations, rates, info)
   if (info /= 0) then
     message = failure_text(info)
     return
   end if
-  state%guesses = guesses
-  state%counts = counts
+  contact%guesses = guesses
+  contact%counts = counts
   records = 0.0_dp
   tangent = 0.0_dp
   if (want_tangent /= 0) then  ! the tangent in global coordinates
-    call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
-                         strain, contact_potential, powers, records, info, rotations, tangent, &
-                         rates, force_time=t)
+    call internal_forces(sys, rotations, state(:, sv_coordinates), state(:, sv_rates), &
+                         load_factor, velocity_factor, contact, forces(:, ff_internal), &
+                         energies(ee_strain), energies(ee_contact_potential), powers, records, &
+                         info, rotations, tangent, rates, force_time=t)
   else
-    call internal_forces(sys, rotations, e, v, load_factor, velocity_factor, state, internal, &
-                         strain, contact_potential, powers, records, info, rates=rates, &
-                         force_time=t)
+    call internal_forces(sys, rotations, state(:, sv_coordinates), state(:, sv_rates), &
+                         load_factor, velocity_factor, contact, forces(:, ff_internal), &
+                         energies(ee_strain), energies(ee_contact_potential), powers, records, &
+                         info, rates=rates, force_time=t)
   end if
   if (info /= 0) then
     message = failure_text(info)
     return
   end if
-  call external_forces(sys, t, load_factor, external, info, e)
-  guesses = state%guesses
-  counts = state%counts
+  call external_forces(sys, t, load_factor, forces(:, ff_external), info, &
+                       state(:, sv_coordinates))
+  guesses = contact%guesses
+  counts = contact%counts
 end subroutine system_evaluate
 
 !> The configuration-dependent forces Q_el - Q_c - lf Q_M at (t, e, e') in the full
@@ -1102,8 +1062,8 @@ subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor,
                               full_force, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text, failure_text
+  use api_support, only: api_system
+  use kernel_errors, only: failure_text
   implicit none
   integer, intent(in) :: handle, ndof, nfull, npoint
   real(dp), intent(in) :: t, e(ndof), v(ndof), load_factor
@@ -1116,12 +1076,8 @@ subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor,
   real(dp), allocatable :: rotations(:, :, :), rates(:), reduced(:)
   real(dp) :: strain, potential, powers(2), records(6, max(1, npoint))
   full_force = 0.0_dp
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
   if (ndof /= sys%ndof .or. nfull /= sys%nfull .or. npoint /= sys%npoint) then
     info = 2
     message = 'system_full_forces: sizes inconsistent with the system (ndof, nfull, npoint)'
@@ -1141,50 +1097,71 @@ subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor,
   if (info /= 0) message = failure_text(info)
 end subroutine system_full_forces
 
-!> One output row (probes, deflections, energies, constraint violation, contact records)
-!> of the state (t, e, e', lambda) with the accumulated works.
-subroutine system_output_row(handle, ndof, ncon, nprobe, npoint, t, e, v, lam, work, guesses, &
-                             counts, probe, deflection, energy, violation, records, powers, info, message)
+!> One output row of the state (t, e, e', lambda) with the accumulated works, in the layout
+!> of a row of system_advance without q (stepper.f90 row_size: time, probes, deflections,
+!> lambda, energies, constraint violation, contact records); state(:, sv_coordinates) = e,
+!> state(:, sv_rates) = e'. powers: the powers at the state.
+subroutine system_output_row(handle, ndof, ncon, npoint, nrow, t, state, lam, work, guesses, &
+                             counts, row, powers, info, message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, contact_state, power_count, energy_count
+  use mechanical_system, only: system_model, contact_state, power_count, energy_count, &
+                               contact_record
+  use stepper, only: row_size
   use time_integrator, only: output_row
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text, failure_text
+  use kernel_errors, only: failure_text
+  use api_support, only: api_system, sv_coordinates, sv_rates
   implicit none
-  integer, intent(in) :: handle, ndof, ncon, nprobe, npoint
-  real(dp), intent(in) :: t, e(ndof), v(ndof), lam(max(1, ncon)), work(5)
+  integer, intent(in) :: handle, ndof, ncon, npoint, nrow
+  real(dp), intent(in) :: t, state(ndof, 2), lam(max(1, ncon)), work(5)
   real(dp), intent(inout) :: guesses(2, max(1, npoint))
   integer, intent(inout) :: counts(6)
   !f2py intent(in,out) :: guesses, counts
-  real(dp), intent(out) :: probe(3, max(1, nprobe)), deflection(3, max(1, nprobe)), energy(11)
-  real(dp), intent(out) :: violation, records(6, max(1, npoint)), powers(5)
+  real(dp), intent(out) :: row(nrow), powers(5)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(contact_state) :: state
+  type(contact_state) :: contact
+  real(dp), allocatable :: probe(:, :), deflection(:, :), records(:, :)
+  real(dp) :: energy(energy_count), violation
+  integer :: nprobe, k
+  row = 0.0_dp
   powers = 0.0_dp
-  message = ' '
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
-  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. nprobe /= sys%nprobe .or. &
-      npoint /= sys%npoint .or. power_count /= 5 .or. energy_count /= 11) then
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  nprobe = sys%nprobe
+  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. npoint /= sys%npoint .or. &
+      nrow /= row_size(ndof, ncon, nprobe, npoint, .false.) .or. power_count /= 5) then
     info = 2
-    message = 'system_output_row: sizes inconsistent with the system (ndof, ncon, nprobe, npoint)'
+    message = 'system_output_row: sizes inconsistent with the system (ndof, ncon, npoint,' // &
+              ' the row length)'
     return
   end if
-  state%guesses = guesses
-  state%counts = counts
+  contact%guesses = guesses
+  contact%counts = counts
+  allocate (probe(3, nprobe), deflection(3, nprobe), records(contact_record, npoint))
   probe = 0.0_dp
   deflection = 0.0_dp
   records = 0.0_dp
-  call output_row(sys, t, e, v, lam(1:ncon), work, state, probe(:, 1:nprobe), &
-                  deflection(:, 1:nprobe), energy, violation, records(:, 1:npoint), powers, info)
-  guesses = state%guesses
-  counts = state%counts
-  if (info /= 0) message = failure_text(info)
+  call output_row(sys, t, state(:, sv_coordinates), state(:, sv_rates), lam(1:ncon), work, &
+                  contact, probe, deflection, energy, violation, records, powers, info)
+  guesses = contact%guesses
+  counts = contact%counts
+  if (info /= 0) then
+    message = failure_text(info)
+    return
+  end if
+  row(1) = t
+  k = 1
+  row(k + 1:k + 3 * nprobe) = reshape(probe, [3 * nprobe])
+  k = k + 3 * nprobe
+  row(k + 1:k + 3 * nprobe) = reshape(deflection, [3 * nprobe])
+  k = k + 3 * nprobe
+  row(k + 1:k + ncon) = lam(1:ncon)
+  k = k + ncon
+  row(k + 1:k + energy_count) = energy
+  k = k + energy_count
+  row(k + 1) = violation
+  row(k + 2:k + 1 + contact_record * npoint) = reshape(records, [contact_record * npoint])
 end subroutine system_output_row
 
 !> Advances nsteps steps of size h of the generalized-alpha method (time_integrator) with
@@ -1206,8 +1183,7 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
                                contact_record
   use stepper, only: stepper_run, state_size, row_size
   use time_integrator, only: integrator_chunk, stat_count, step_failure_text
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nsteps, nstate, nrow
   real(dp), intent(in) :: h
@@ -1230,11 +1206,9 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   stats = 0
   status = 0
   last_correction = 0.0_dp
-  message = ' '
-  call store_get(handle, sys, info, run)
+  call api_system(handle, sys, info, message, run)
   if (info /= 0) then
     status(2) = 9
-    message = handle_text(handle)
     return
   end if
   if (.not. run%ready) then
@@ -1348,70 +1322,135 @@ subroutine system_advance_into(handle, nsteps, h, nstate, state, counts, nrow, r
 end subroutine system_advance_into
 
 !> One load step of the static Newton in the kernel (static_solver): equilibrium of the
-!> system at load factor load_factor and time t from (e, lam) (updated in place; e0 the
-!> reference configuration), the tangent's reduced pattern rows, cols (1-based, the
-!> solvers' pattern). force_scale: the residual's scale floor (< 0: set from the start and
-!> returned); check_start /= 0: a start that is already the equilibrium ends with 0
-!> iterations. Returns the iterations, the relative residual after each (history), the
-!> last relative residual and constraint violation, why it converged (static_solver's
-!> by_* codes) and the factorizations; info /= 0 with the text in message (load_step of
-!> load_steps name the step in it).
-subroutine system_static_solve(handle, ndof, ncon, npoint, nnz, t, load_factor, e0, rows, cols, &
-                               e, lam, guesses, counts, tol, length_scale, max_iter, check_start, &
-                               force_scale, load_step, load_steps, iterations, history, &
-                               force_res, con_res, converged_by, factorizations, info, message)
+!> system at load factor and time from the packed state [e (ndof), lambda (ncon), contact
+!> guesses (2, npoint)] (updated in place; e0 the reference configuration), the tangent's
+!> reduced pattern (pattern(:, tp_rows), pattern(:, tp_cols), 1-based, the solvers' pattern).
+!> settings (ss_*): t, load_factor, tol, length_scale; controls (sc_*): check_start (/= 0: a
+!> start that is already the equilibrium ends with 0 iterations), load_step and load_steps
+!> (named in a failure's text). scales (sr_*): the residual's scale floor force_scale (< 0:
+!> set from the start and returned), the last relative residual and constraint violation
+!> (out). Returns the relative residual after each iteration (history) and outcome (so_*):
+!> info, the iterations, why it converged (static_solver's by_* codes), the factorizations;
+!> info /= 0 with the text in message.
+subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pattern, settings, &
+                               controls, max_iter, scales, history, outcome, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state
   use static_solver, only: static_newton, static_failure_text
-  use system_store, only: store_get
-  use kernel_errors, only: handle_text
+  use api_support, only: api_system, tp_rows, tp_cols, ss_time, &
+                         ss_load_factor, ss_tol, ss_length_scale, sc_check_start, &
+                         sc_load_step, sc_load_steps, sr_force_scale, sr_force_res, &
+                         sr_con_res, so_info, so_iterations, so_converged_by, &
+                         so_factorizations
   implicit none
-  integer, intent(in) :: handle, ndof, ncon, npoint, nnz, max_iter, check_start
-  integer, intent(in) :: rows(nnz), cols(nnz), load_step, load_steps
-  real(dp), intent(in) :: t, load_factor, e0(ndof), tol, length_scale
-  real(dp), intent(inout) :: e(ndof), lam(max(1, ncon)), force_scale
-  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  integer, intent(in) :: handle, nstate, ndof, nnz, max_iter
+  real(dp), intent(inout) :: state(nstate), scales(3)
   integer, intent(inout) :: counts(6)
-  !f2py intent(in,out) :: e, lam, guesses, counts, force_scale
-  integer, intent(out) :: iterations, converged_by, factorizations, info
-  real(dp), intent(out) :: history(max_iter), force_res, con_res
+  !f2py intent(in,out) :: state, counts, scales
+  real(dp), intent(in) :: e0(ndof), settings(4)
+  integer, intent(in) :: pattern(nnz, 2), controls(3)
+  real(dp), intent(out) :: history(max_iter)
+  integer, intent(out) :: outcome(4)
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  type(contact_state) :: state
-  integer :: detail
-  message = ' '
-  iterations = 0
-  converged_by = 0
-  factorizations = 0
+  type(contact_state) :: contact
+  real(dp), allocatable :: e(:), lam(:)
+  integer :: info, detail, ncon, npoint
+  outcome = 0
   history = 0.0_dp
-  force_res = 0.0_dp
-  con_res = 0.0_dp
-  call store_get(handle, sys, info)
-  if (info /= 0) then
-    message = handle_text(handle)
-    return
-  end if
-  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. npoint /= sys%npoint .or. &
+  call api_system(handle, sys, info, message)
+  outcome(so_info) = info
+  if (info /= 0) return
+  ncon = sys%ncon
+  npoint = sys%npoint
+  if (ndof /= sys%ndof .or. nstate /= ndof + ncon + 2 * npoint .or. &
       nnz /= size(sys%mass_pattern) .or. max_iter < 1) then
-    info = 4
-    message = 'system_static_solve: sizes inconsistent with the system (ndof, ncon, npoint,' // &
-              ' nnz of the pattern) or max_iter < 1'
+    outcome(so_info) = 4
+    message = 'system_static_solve: sizes inconsistent with the system (ndof, the packed' // &
+              ' state, nnz of the pattern) or max_iter < 1'
     return
   end if
-  if (any(rows < 1) .or. any(rows > ndof) .or. any(cols < 1) .or. any(cols > ndof)) then
-    info = 4
+  if (any(pattern < 1) .or. any(pattern > ndof)) then
+    outcome(so_info) = 4
     message = 'system_static_solve: a pattern entry outside 1..ndof'
     return
   end if
-  state%guesses = guesses
-  state%counts = counts
-  call static_newton(sys, t, load_factor, e0, rows, cols, e, lam(1:ncon), state, tol, &
-                     length_scale, max_iter, check_start /= 0, force_scale, iterations, &
-                     history, force_res, con_res, converged_by, factorizations, info, detail)
-  guesses = state%guesses
-  counts = state%counts
-  if (info /= 0) message = static_failure_text(info, detail, load_step, load_steps, max_iter, &
-                                               minval(history(1:max(1, iterations))), force_res, &
-                                               con_res, tol)
+  e = state(1:ndof)
+  lam = state(ndof + 1:ndof + ncon)
+  contact%guesses = reshape(state(ndof + ncon + 1:nstate), [2, npoint])
+  contact%counts = counts
+  call static_newton(sys, settings(ss_time), settings(ss_load_factor), e0, &
+                     pattern(:, tp_rows), pattern(:, tp_cols), e, lam, contact, &
+                     settings(ss_tol), settings(ss_length_scale), max_iter, &
+                     controls(sc_check_start) /= 0, scales(sr_force_scale), &
+                     outcome(so_iterations), history, scales(sr_force_res), scales(sr_con_res), &
+                     outcome(so_converged_by), outcome(so_factorizations), info, detail)
+  state = [e, lam, reshape(contact%guesses, [2 * npoint])]
+  counts = contact%counts
+  outcome(so_info) = info
+  if (info /= 0) message = static_failure_text(info, detail, controls(sc_load_step), &
+                                               controls(sc_load_steps), max_iter, &
+                                               minval(history(1:max(1, outcome(so_iterations)))), &
+                                               scales(sr_force_res), scales(sr_con_res), &
+                                               settings(ss_tol))
 end subroutine system_static_solve
 
+
+!> The contact forces of the system's contact pairs (system_add_contact_pair) at the full
+!> coordinates and rates state(:, sv_*) (leaf_contact%contact_assemble): force (full),
+!> records (6, npoint), energies (api_support ce_*: penalty potential, damping and
+!> friction powers), and when want_jacobian /= 0 the Jacobian of minus the forces on the
+!> full pattern (system_set_solver, nnz entries). The contact guesses and counters are
+!> updated. info: 1 not a live handle; 2 sizes inconsistent with the system; 7 a normal
+!> vanished; 8 the closest-point search failed.
+subroutine system_contact_forces(handle, nfull, nnz, npoint, state, velocity_factor, &
+                                 want_jacobian, guesses, counts, force, records, energies, &
+                                 values, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state, contact_forces
+  use kernel_errors, only: failure_text
+  use api_support, only: api_system, sv_coordinates, sv_rates, ce_potential, ce_damping, &
+                         ce_friction
+  implicit none
+  integer, intent(in) :: handle, nfull, nnz, npoint, want_jacobian
+  real(dp), intent(in) :: state(nfull, 2), velocity_factor
+  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  integer, intent(inout) :: counts(6)
+  !f2py intent(in,out) :: guesses, counts
+  real(dp), intent(out) :: force(nfull), records(6, max(1, npoint)), energies(3), values(nnz)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  type(contact_state) :: contact
+  real(dp), allocatable :: jacobian(:)
+  force = 0.0_dp
+  records = 0.0_dp
+  energies = 0.0_dp
+  values = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  if (nfull /= sys%nfull .or. npoint /= sys%npoint .or. (want_jacobian /= 0 .and. &
+      nnz /= size(sys%full_col))) then
+    info = 2
+    message = 'system_contact_forces: sizes inconsistent with the system (nfull, npoint,' // &
+              ' or nnz of the full pattern)'
+    return
+  end if
+  contact%guesses = guesses
+  contact%counts = counts
+  if (want_jacobian /= 0) then
+    allocate (jacobian(nnz))
+    jacobian = 0.0_dp
+  end if
+  call contact_forces(sys, state(:, sv_coordinates), state(:, sv_rates), velocity_factor, &
+                      contact, force, records(:, 1:npoint), energies(ce_potential), &
+                      energies(ce_damping:ce_friction), info, jacobian)
+  if (info /= 0) then
+    message = failure_text(info)
+    return
+  end if
+  force = -force   ! (contact_forces subtracts them: the residual carries elastic minus contact)
+  if (want_jacobian /= 0) values = jacobian
+  guesses = contact%guesses
+  counts = contact%counts
+end subroutine system_contact_forces

@@ -49,7 +49,7 @@ module cable_element
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
-  public :: cable_damped_element_force, cable_rule, cable_element_rows
+  public :: cable_rule, cable_element_rows
 
   !> Gauss points per element.
   integer, parameter, public :: cable_points = 5
@@ -184,15 +184,21 @@ contains
 
   !> Elastic force dU/dq (12), strain energy and, when want_tangent, the tangent d^2U/dq^2
   !> (12 x 12) of one element of length L at its nodal vectors q(3, 4); tension_only
-  !> (default .false.): the rope's axial law. info = 2: r' vanished at a Gauss point (the
-  !> curvature is undefined).
+  !> (default .false.): the rope's axial law. With the nodal rates q'(3, 4), damping_time
+  !> tau > 0, rate_factor and dissipation all present: the axial Kelvin-Voigt damping (module
+  !> header), the force includes the damping force, dissipation is its power and the tangent
+  !> is dQ/dq + rate_factor dQ/dq'. info = 2: r' vanished at a Gauss point (the curvature is
+  !> undefined).
   pure subroutine cable_element_force(q, length, axial_stiffness, bending_stiffness, &
-                                      want_tangent, force, energy, tangent, info, tension_only)
+                                      want_tangent, force, energy, tangent, info, tension_only, &
+                                      rates, damping_time, rate_factor, dissipation)
     real(dp), intent(in) :: q(3, 4), length, axial_stiffness, bending_stiffness
     logical, intent(in) :: want_tangent
     logical, intent(in), optional :: tension_only
     real(dp), intent(out) :: force(cable_dofs), energy, tangent(cable_dofs, cable_dofs)
     integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(3, 4), damping_time, rate_factor
+    real(dp), intent(out), optional :: dissipation
     type(cable_point_rule) :: rule
     logical :: rope
     rope = .false.
@@ -200,24 +206,41 @@ contains
     call cable_rule(rule, info)
     if (info /= 0) return
     call rule_element_force(q, length, rule, axial_stiffness, bending_stiffness, want_tangent, &
-                            force, energy, tangent, info, rope)
+                            force, energy, tangent, info, rope, rates, damping_time, &
+                            rate_factor, dissipation)
   end subroutine cable_element_force
 
-  !> cable_element_force with the element's rule given (cable_rule).
+  !> cable_element_force with the element's rule given (cable_rule); damped when the rates,
+  !> damping_time, rate_factor and dissipation are present.
   pure subroutine rule_element_force(q, length, rule, axial_stiffness, bending_stiffness, &
-                                     want_tangent, force, energy, tangent, info, rope)
+                                     want_tangent, force, energy, tangent, info, rope, rates, &
+                                     damping_time, rate_factor, dissipation)
     real(dp), intent(in) :: q(3, 4), length, axial_stiffness, bending_stiffness
     type(cable_point_rule), intent(in) :: rule
     logical, intent(in) :: want_tangent, rope
     real(dp), intent(out) :: force(cable_dofs), energy, tangent(cable_dofs, cable_dofs)
     integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(3, 4), damping_time, rate_factor
+    real(dp), intent(out), optional :: dissipation
     real(dp) :: slope(4), second(4)
     real(dp) :: a(3), b(3), grad_a(3), grad_b(3), hessian(6, 6), weight, point_energy
-    integer :: p
+    real(dp) :: a_rate(3), strain, strain_rate, damping_force, viscous, identity(3, 3)
+    logical :: damped
+    integer :: p, i
+    damped = present(rates) .and. present(damping_time) .and. present(rate_factor) .and. &
+             present(dissipation)
     info = 0
     force = 0.0_dp
     energy = 0.0_dp
     if (want_tangent) tangent = 0.0_dp
+    if (damped) then
+      dissipation = 0.0_dp
+      viscous = axial_stiffness * damping_time
+      identity = 0.0_dp
+      do i = 1, 3
+        identity(i, i) = 1.0_dp
+      end do
+    end if
     do p = 1, cable_points
       call rule_rows(rule, p, length, slope, second)
       weight = rule%half_weight(p) * length
@@ -227,6 +250,25 @@ contains
                              point_energy, grad_a, grad_b, hessian, info, rope)
       if (info /= 0) return
       energy = energy + weight * point_energy
+      if (damped) then
+        a_rate = matmul(rates, slope)
+        strain = 0.5_dp * (dot_product(a, a) - 1.0_dp)
+        strain_rate = dot_product(a, a_rate)
+        if (rope .and. strain <= 0.0_dp) then
+          damping_force = 0.0_dp                              ! slack: no damping either
+        else if (rope .and. axial_stiffness * strain + viscous * strain_rate < 0.0_dp) then
+          damping_force = -axial_stiffness * strain           ! clipped: the total is zero
+          grad_a = grad_a + damping_force * a
+          if (want_tangent) hessian(1:3, 1:3) = hessian(1:3, 1:3) &
+            - axial_stiffness * (outer(a, a) + strain * identity)
+        else
+          damping_force = viscous * strain_rate
+          grad_a = grad_a + damping_force * a
+          if (want_tangent) hessian(1:3, 1:3) = hessian(1:3, 1:3) &
+            + viscous * (outer(a, a_rate) + strain_rate * identity + rate_factor * outer(a, a))
+        end if
+        dissipation = dissipation + weight * damping_force * strain_rate
+      end if
       call add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, force, &
                      tangent)
     end do
@@ -315,66 +357,6 @@ contains
       end do
     end do
   end subroutine add_point
-
-  !> cable_element_force with Kelvin-Voigt damping of the axial strain (damping_time tau > 0)
-  !> at the nodal rates q'(3, 4): the force includes the damping force, dissipation is its
-  !> power and the tangent (when want_tangent) is dQ/dq + rate_factor dQ/dq' (module header).
-  pure subroutine cable_damped_element_force(q, rates, length, axial_stiffness, &
-                                             bending_stiffness, tension_only, damping_time, &
-                                             rate_factor, want_tangent, force, energy, &
-                                             tangent, dissipation, info)
-    real(dp), intent(in) :: q(3, 4), rates(3, 4), length, axial_stiffness, bending_stiffness
-    logical, intent(in) :: tension_only, want_tangent
-    real(dp), intent(in) :: damping_time, rate_factor
-    real(dp), intent(out) :: force(cable_dofs), energy, tangent(cable_dofs, cable_dofs)
-    real(dp), intent(out) :: dissipation
-    integer, intent(out) :: info
-    real(dp) :: xg(cable_points), wg(cable_points), shape(4), slope(4), second(4)
-    real(dp) :: a(3), b(3), a_rate(3), grad_a(3), grad_b(3), hessian(6, 6), weight
-    real(dp) :: point_energy, strain, strain_rate, damping_force, viscous
-    real(dp) :: identity(3, 3)
-    integer :: p, i
-    identity = 0.0_dp
-    do i = 1, 3
-      identity(i, i) = 1.0_dp
-    end do
-    call gauss_legendre(cable_points, xg, wg, info)
-    if (info /= 0) return
-    force = 0.0_dp
-    energy = 0.0_dp
-    dissipation = 0.0_dp
-    if (want_tangent) tangent = 0.0_dp
-    viscous = axial_stiffness * damping_time
-    do p = 1, cable_points
-      call cable_shape(0.5_dp * (xg(p) + 1.0_dp), length, shape, slope, second)
-      weight = 0.5_dp * wg(p) * length
-      a = matmul(q, slope)
-      b = matmul(q, second)
-      a_rate = matmul(rates, slope)
-      call point_derivatives(a, b, axial_stiffness, bending_stiffness, want_tangent, &
-                             point_energy, grad_a, grad_b, hessian, info, tension_only)
-      if (info /= 0) return
-      energy = energy + weight * point_energy
-      strain = 0.5_dp * (dot_product(a, a) - 1.0_dp)
-      strain_rate = dot_product(a, a_rate)
-      if (tension_only .and. strain <= 0.0_dp) then
-        damping_force = 0.0_dp                              ! slack: no damping either
-      else if (tension_only .and. axial_stiffness * strain + viscous * strain_rate < 0.0_dp) then
-        damping_force = -axial_stiffness * strain           ! clipped: the total is zero
-        grad_a = grad_a + damping_force * a
-        if (want_tangent) hessian(1:3, 1:3) = hessian(1:3, 1:3) &
-          - axial_stiffness * (outer(a, a) + strain * identity)
-      else
-        damping_force = viscous * strain_rate
-        grad_a = grad_a + damping_force * a
-        if (want_tangent) hessian(1:3, 1:3) = hessian(1:3, 1:3) &
-          + viscous * (outer(a, a_rate) + strain_rate * identity + rate_factor * outer(a, a))
-      end if
-      dissipation = dissipation + weight * damping_force * strain_rate
-      call add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, force, &
-                     tangent)
-    end do
-  end subroutine cable_damped_element_force
 
   !> The point energy w = EA/2 eps^2 + EI/2 kappa^2 at a = r', b = r'', its gradient
   !> (dw/da, dw/db) and, when want_hessian, its Hessian (6 x 6, in (a, b)); tension_only:
@@ -497,10 +479,9 @@ contains
     if (present(rates)) then
       factor = 0.0_dp
       if (present(rate_factor)) factor = rate_factor
-      call cable_damped_element_force(coords, rates, set%lengths(el), set%axial_stiffness, &
-                                      set%bending_stiffness, set%tension_only, &
-                                      set%damping_time, factor, want_tangent, force, energy, &
-                                      tangent, power, info)
+      call rule_element_force(coords, set%lengths(el), set%rule, set%axial_stiffness, &
+                              set%bending_stiffness, want_tangent, force, energy, tangent, &
+                              info, set%tension_only, rates, set%damping_time, factor, power)
       if (present(dissipation)) dissipation = power
       return
     end if

@@ -215,17 +215,52 @@ contains
 
   !> Energy density W(z) at one Gauss point, its gradient (3, 5) and, on request, its
   !> Hessian (15, 15) with respect to z = (r_x, r_y, r_xx, r_yy, r_xy).
+  !> With Kelvin-Voigt damping (the field rates z', tau, rate_factor and power all present):
+  !> the elastic energy density, the dissipated power density, the gradient of the total
+  !> (elastic plus damping) force and, on request, the combined Hessian d/dz + rate_factor
+  !> d/dz'. The bending part is the elastic one at the shifted reference curvature
+  !> c0 - tau c' (c' = (dc/dz) z'): its moment is then D (kappa + tau kappa'), which its
+  !> gradient and its geometric Hessian carry; the membrane damping stress, the rate
+  !> derivative c tau J^T D J and the rate terms tau J^T D (d2s/dz2 z') are added to them.
   pure subroutine point_energy(fields, frame, curvature0, membrane_d, bending_d, want_hessian, &
-                               energy, gradient, hessian)
+                               energy, gradient, hessian, field_rates, tau, rate_factor, power)
     real(dp), intent(in) :: fields(3, plate_fields), frame(2, 2), curvature0(3)
     real(dp), intent(in) :: membrane_d(3, 3), bending_d(3, 3)
     logical, intent(in) :: want_hessian
     real(dp), intent(out) :: energy, gradient(3, plate_fields), hessian(15, 15)
+    real(dp), intent(in), optional :: field_rates(3, plate_fields), tau, rate_factor
+    real(dp), intent(out), optional :: power
+    real(dp) :: reference(3), deformation_rate(3, 2), strain_rate(3), damping_stress(3)
+    real(dp) :: b_rate(3, 6), rate_map(3, 3), rate_dcurv(3, 15), curvature_rate(3)
+    real(dp) :: elastic_kappa(3), kappa_rate(3), rate_dkappa(3, 15), curvature_hessian_rate(3, 15)
+    real(dp) :: g_now(3), gnorm_now, c_now(3)
+    logical :: damped
     real(dp) :: deformation(3, 2), strain(3), stress(3), stress_tensor(2, 2), geometric(2, 2)
     real(dp) :: b_strain(3, 6), g(3), gnorm, u(3), v(3), c(3), to_local(3, 3), kappa(3)
     real(dp) :: moment(3), omega(3), dcurv(3, 15), dkappa(3, 15), w_eff(3), wg, h_eff(3)
     real(dp) :: hwg(3, 3), hgg(3, 3), gu(3, 3), gv(3, 3), k(2, 2)
     integer :: gamma, i, f, row, col
+    damped = present(field_rates) .and. present(tau) .and. present(rate_factor) .and. &
+             present(power)
+    reference = curvature0
+    if (damped) then  ! the curvatures' rates and the shifted reference curvature
+      g_now = cross(fields(:, f_x), fields(:, f_y))
+      gnorm_now = norm2(g_now)
+      c_now = [dot_product(fields(:, f_xx), g_now), dot_product(fields(:, f_yy), g_now), &
+               dot_product(fields(:, f_xy), g_now)] / gnorm_now**3
+      call curvature_map(frame, rate_map)
+      call curvature_gradients(fields, g_now, gnorm_now, rate_dcurv)
+      do i = 1, 3
+        curvature_rate(i) = 0.0_dp
+        do f = 1, plate_fields
+          curvature_rate(i) = curvature_rate(i) &
+                              + dot_product(rate_dcurv(i, 3 * f - 2:3 * f), field_rates(:, f))
+        end do
+      end do
+      elastic_kappa = matmul(rate_map, c_now - curvature0)
+      kappa_rate = matmul(rate_map, curvature_rate)
+      reference = curvature0 - tau * curvature_rate
+    end if
     k = frame
     u = fields(:, f_x)
     v = fields(:, f_y)
@@ -261,7 +296,7 @@ contains
     ! curvature in the reference's orthonormal frame, so c is rescaled by the reference
     ! |g0|^2 = 1 / det(K)^2 (1 for unit, orthogonal reference gradients and for plain)
     to_local = to_local / (k(1, 1) * k(2, 2) - k(1, 2) * k(2, 1))**2
-    kappa = matmul(to_local, c - curvature0)
+    kappa = matmul(to_local, c - reference)
     moment = matmul(bending_d, kappa)
     energy = energy + 0.5_dp * dot_product(kappa, moment)
     omega = matmul(moment, to_local)        ! dW/dc
@@ -279,6 +314,26 @@ contains
         gradient(:, f) = gradient(:, f) + omega(i) * dcurv(i, 3 * f - 2:3 * f)
       end do
     end do
+    if (damped) then
+      ! membrane: the damping stress tau D eps', eps' = B(F) z'
+      deformation_rate = matmul(field_rates(:, f_x:f_y), frame)
+      strain_rate = [dot_product(deformation(:, 1), deformation_rate(:, 1)), &
+                     dot_product(deformation(:, 2), deformation_rate(:, 2)), &
+                     dot_product(deformation(:, 1), deformation_rate(:, 2)) &
+                     + dot_product(deformation(:, 2), deformation_rate(:, 1))]
+      damping_stress = tau * matmul(membrane_d, strain_rate)
+      do gamma = 1, 2
+        do i = 1, 3
+          gradient(:, f_x + gamma - 1) = gradient(:, f_x + gamma - 1) &
+                                         + damping_stress(i) * b_strain(i, 3 * gamma - 2:3 * gamma)
+        end do
+      end do
+      ! the elastic energy (not the shifted one) and the dissipated power
+      energy = 0.5_dp * dot_product(strain, matmul(membrane_d, strain)) &
+               + 0.5_dp * dot_product(elastic_kappa, matmul(bending_d, elastic_kappa))
+      power = dot_product(strain_rate, damping_stress) &
+              + tau * dot_product(kappa_rate, matmul(bending_d, kappa_rate))
+    end if
     if (.not. want_hessian) return
     ! membrane: B^T D B + kron(K S K^T, I3)
     hessian = 0.0_dp
@@ -324,6 +379,27 @@ contains
       hessian(4:6, 3 * f - 2:3 * f) = hessian(4:6, 3 * f - 2:3 * f) &
                                       + omega(i) * transpose(matmul(hwg, gv))
     end do
+    if (.not. damped) return
+    ! membrane: geometric term of the damping stress, c tau B^T D B + tau B^T D B(F')
+    stress_tensor = reshape([damping_stress(1), damping_stress(3), damping_stress(3), &
+                             damping_stress(2)], [2, 2])
+    geometric = matmul(frame, matmul(stress_tensor, transpose(frame)))
+    do col = 1, 2
+      do row = 1, 2
+        do i = 1, 3
+          hessian(3 * row - 3 + i, 3 * col - 3 + i) = hessian(3 * row - 3 + i, 3 * col - 3 + i) &
+                                                      + geometric(row, col)
+        end do
+      end do
+    end do
+    call membrane_strain_matrix(frame, deformation_rate, b_rate)
+    hessian(1:6, 1:6) = hessian(1:6, 1:6) + matmul(transpose(b_strain), &
+      matmul(membrane_d, rate_factor * tau * b_strain + tau * b_rate))
+    ! bending: c tau dkappa^T D dkappa + tau dkappa^T D K-map((d2c/dz2) z')
+    rate_dkappa = matmul(rate_map, rate_dcurv)
+    call curvature_gradient_rate(fields, field_rates, g_now, gnorm_now, curvature_hessian_rate)
+    hessian = hessian + matmul(transpose(rate_dkappa), matmul(bending_d, &
+      rate_factor * tau * rate_dkappa + tau * matmul(rate_map, curvature_hessian_rate)))
   end subroutine point_energy
 
   !> Elastic force (36), strain energy and, on request, tangent (36 x 36) of one element at
@@ -434,9 +510,9 @@ contains
         info = 2
         return
       end if
-      call point_energy_damped(fields, field_rates, frame(:, :, p), curvature0(:, p), membrane_d, &
-                               bending_d, damping_time, rate_factor, want_tangent, point_w, &
-                               point_power, gradient, hessian)
+      call point_energy(fields, frame(:, :, p), curvature0(:, p), membrane_d, bending_d, &
+                        want_tangent, point_w, gradient, hessian, field_rates, damping_time, &
+                        rate_factor, point_power)
       energy = energy + weights(p) * point_w
       dissipation = dissipation + weights(p) * point_power
       call add_nodal_force(weights(p) * gradient, shape_d, nodal)
@@ -468,90 +544,6 @@ contains
                         set%thickness, want_tangent, force, energy, tangent, info)
     end if
   end subroutine plate_element_forces
-
-  !> point_energy with Kelvin-Voigt damping at the field rates z': the elastic energy
-  !> density, the dissipated power density, the gradient of the total (elastic plus
-  !> damping) force and, on request, the combined Hessian d/dz + rate_factor d/dz'.
-  !> The bending part is point_energy's at the shifted reference curvature c0 - tau c'
-  !> (c' = (dc/dz) z'): its moment is then D (kappa + tau kappa'), which its gradient and
-  !> its geometric Hessian carry; the membrane damping stress, the rate derivative
-  !> c tau J^T D J and the rate terms tau J^T D (d2s/dz2 z') are added here.
-  pure subroutine point_energy_damped(fields, field_rates, frame, curvature0, membrane_d, &
-                                      bending_d, tau, rate_factor, want_hessian, energy, &
-                                      power, gradient, hessian)
-    real(dp), intent(in) :: fields(3, plate_fields), field_rates(3, plate_fields), frame(2, 2)
-    real(dp), intent(in) :: curvature0(3), membrane_d(3, 3), bending_d(3, 3), tau, rate_factor
-    logical, intent(in) :: want_hessian
-    real(dp), intent(out) :: energy, power, gradient(3, plate_fields), hessian(15, 15)
-    real(dp) :: deformation(3, 2), deformation_rate(3, 2), strain(3), strain_rate(3)
-    real(dp) :: damping_stress(3), b_strain(3, 6), b_rate(3, 6), stress_tensor(2, 2)
-    real(dp) :: geometric(2, 2), g(3), gnorm, c(3), to_local(3, 3), kappa(3), kappa_rate(3)
-    real(dp) :: dcurv(3, 15), curvature_rate(3), dkappa(3, 15), curvature_hessian_rate(3, 15)
-    real(dp) :: shifted_energy
-    integer :: gamma, i, f, row, col
-    ! bending: curvatures, their gradients and rates
-    g = cross(fields(:, f_x), fields(:, f_y))
-    gnorm = norm2(g)
-    c = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
-         dot_product(fields(:, f_xy), g)] / gnorm**3
-    call curvature_map(frame, to_local)
-    call curvature_gradients(fields, g, gnorm, dcurv)
-    do i = 1, 3
-      curvature_rate(i) = 0.0_dp
-      do f = 1, plate_fields
-        curvature_rate(i) = curvature_rate(i) &
-                            + dot_product(dcurv(i, 3 * f - 2:3 * f), field_rates(:, f))
-      end do
-    end do
-    kappa = matmul(to_local, c - curvature0)
-    kappa_rate = matmul(to_local, curvature_rate)
-    call point_energy(fields, frame, curvature0 - tau * curvature_rate, membrane_d, bending_d, &
-                      want_hessian, shifted_energy, gradient, hessian)
-    ! membrane: the damping stress tau D eps', eps' = B(F) z'
-    deformation = matmul(fields(:, f_x:f_y), frame)
-    deformation_rate = matmul(field_rates(:, f_x:f_y), frame)
-    strain = [0.5_dp * (dot_product(deformation(:, 1), deformation(:, 1)) - 1.0_dp), &
-              0.5_dp * (dot_product(deformation(:, 2), deformation(:, 2)) - 1.0_dp), &
-              dot_product(deformation(:, 1), deformation(:, 2))]
-    strain_rate = [dot_product(deformation(:, 1), deformation_rate(:, 1)), &
-                   dot_product(deformation(:, 2), deformation_rate(:, 2)), &
-                   dot_product(deformation(:, 1), deformation_rate(:, 2)) &
-                   + dot_product(deformation(:, 2), deformation_rate(:, 1))]
-    damping_stress = tau * matmul(membrane_d, strain_rate)
-    call membrane_strain_matrix(frame, deformation, b_strain)
-    do gamma = 1, 2
-      do i = 1, 3
-        gradient(:, f_x + gamma - 1) = gradient(:, f_x + gamma - 1) &
-                                       + damping_stress(i) * b_strain(i, 3 * gamma - 2:3 * gamma)
-      end do
-    end do
-    ! the elastic energy (not the shifted one) and the dissipated power
-    energy = 0.5_dp * dot_product(strain, matmul(membrane_d, strain)) &
-             + 0.5_dp * dot_product(kappa, matmul(bending_d, kappa))
-    power = dot_product(strain_rate, damping_stress) &
-            + tau * dot_product(kappa_rate, matmul(bending_d, kappa_rate))
-    if (.not. want_hessian) return
-    ! membrane: geometric term of the damping stress, c tau B^T D B + tau B^T D B(F')
-    stress_tensor = reshape([damping_stress(1), damping_stress(3), damping_stress(3), &
-                             damping_stress(2)], [2, 2])
-    geometric = matmul(frame, matmul(stress_tensor, transpose(frame)))
-    do col = 1, 2
-      do row = 1, 2
-        do i = 1, 3
-          hessian(3 * row - 3 + i, 3 * col - 3 + i) = hessian(3 * row - 3 + i, 3 * col - 3 + i) &
-                                                      + geometric(row, col)
-        end do
-      end do
-    end do
-    call membrane_strain_matrix(frame, deformation_rate, b_rate)
-    hessian(1:6, 1:6) = hessian(1:6, 1:6) + matmul(transpose(b_strain), &
-      matmul(membrane_d, rate_factor * tau * b_strain + tau * b_rate))
-    ! bending: c tau dkappa^T D dkappa + tau dkappa^T D K-map((d2c/dz2) z')
-    dkappa = matmul(to_local, dcurv)
-    call curvature_gradient_rate(fields, field_rates, g, gnorm, curvature_hessian_rate)
-    hessian = hessian + matmul(transpose(dkappa), matmul(bending_d, &
-      rate_factor * tau * dkappa + tau * matmul(to_local, curvature_hessian_rate)))
-  end subroutine point_energy_damped
 
   !> B(3, 6) of the membrane strain with respect to (r_x, r_y) at F = [r_x r_y] K (or, with
   !> F' in place of F, the derivative of eps' = B(F) z' with respect to z).

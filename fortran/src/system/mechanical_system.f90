@@ -52,7 +52,7 @@ module mechanical_system
             evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
             refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set, &
-            tangent_frame_rates, damped_sets, force_element_reactions
+            tangent_frame_rates, damped_sets, force_element_reactions, contact_forces
   ! what the stepper asks of the system's contact (it uses no contact module itself)
   public :: contact_record, contact_step_limit
 

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import kernel
+from ..codes import KERNEL_LAYOUTS
 from ..errors import SolverError
 from ..system.drives import Drive
 from ..system.model import Model
@@ -497,7 +498,7 @@ class RowMaps:
         # the turn of the needed coordinates (_block): W^T and (W^2)^T
         self.skew_t, self.skew2_t = skew.T.copy(), (skew @ skew).T.copy()
         # the kernel's reduced_ffr_energy_rows: the forms, Fortran ordered, once
-        from ..kernel import _f, _kernel
+        from ..kernel import _f, _kernel, constraint_arrays
         used, table = self.cubic if self.cubic is not None else \
             (np.zeros(0, dtype=np.int64), np.zeros((1, 2)))
         self._kernel = _kernel
@@ -514,12 +515,11 @@ class RowMaps:
                 if cs.drive_params else np.zeros(1)
             kinds = np.array(cs.drive_kinds or [0], dtype=np.int32)
             local = np.array([self.slot_of[int(d)] for d in lay.term_dof], dtype=np.int64)
-            self._constraint_args = (
-                _f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
-                _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
-                _f(local + 1 if len(local) else np.ones(1), np.int32),
-                _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
-                _f(ptr if len(cs.drive_kinds) else np.ones(2), np.int32), _f(data))
+            self._constraint_args = (*constraint_arrays(
+                lay.kinds, lay.drives + 1, lay.params, lay.operand_const, lay.term_ptr + 1,
+                local + 1 if len(local) else np.ones(1),
+                lay.term_coef if len(lay.term_coef) else np.zeros(1), kinds,
+                ptr if len(cs.drive_kinds) else np.ones(2), data), len(lay.kinds))
 
     @staticmethod
     def supported(model: Model) -> bool:
@@ -587,8 +587,12 @@ class RowMaps:
         # kinetic, strain (+ P-delta's cubic form), the frame's power and the loads'
         # potential: the kernel's reduced_ffr_energy_rows, one pass over the rows
         energy = np.zeros((n, 11))
-        kinetic, strain, power, load = self._kernel.reduced_ffr_energy_rows(
-            np.asarray(rate, float), sin, cos1, eta.T, velocity.T, *self._energy_args)
+        motion = dict(rate=np.asarray(rate, float), sin_psi=sin, one_minus_cos=cos1)
+        frame = np.asfortranarray(np.column_stack([motion[k] for k in KERNEL_LAYOUTS["fm"][:3]]))
+        energies = self._kernel.reduced_ffr_energy_rows(frame, eta.T, velocity.T,
+                                                        *self._energy_args)
+        kinetic, strain, power, load = (energies[:, KERNEL_LAYOUTS["re"].index(k)]
+                                        for k in ("kinetic", "strain", "power", "load"))
         energy[:, 0], energy[:, 1], energy[:, 2] = kinetic, strain, load
         for m in self.model.moments:
             director = sub[:, [self.slot_of[int(d)] for d in m.dofs]]

@@ -227,7 +227,7 @@ class ReactionMap:
         """The multiplier constraints' operand gradients (6, ncon) at (q, t) from the kernel
         (ConstraintSet.evaluate with the layout arrays built once)."""
         if not hasattr(self, "_args"):
-            from ..kernel import _f, _kernel
+            from ..kernel import _kernel, _state, constraint_arrays
             full = self.full
             lay = full.layout()
             ptr = np.concatenate([[0], np.cumsum([len(p) for p in full.drive_params])]) + 1
@@ -235,15 +235,13 @@ class ReactionMap:
                 if full.drive_params else np.zeros(1)
             kinds = np.array(full.drive_kinds or [0], dtype=np.int32)
             self._kernel = _kernel
-            self._args = (
-                _f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
-                _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
-                _f(lay.term_dof + 1 if len(lay.term_dof) else np.ones(1), np.int32),
-                _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
-                _f(ptr if len(full.drive_kinds) else np.ones(2), np.int32), _f(data))
+            self._args = (*constraint_arrays(
+                lay.kinds, lay.drives + 1, lay.params, lay.operand_const, lay.term_ptr + 1,
+                lay.term_dof + 1 if len(lay.term_dof) else np.ones(1),
+                lay.term_coef if len(lay.term_coef) else np.zeros(1), kinds,
+                ptr if len(full.drive_kinds) else np.ones(2), data), len(lay.kinds))
             self._zero = np.zeros(len(q_full))
-        out = self._kernel.constraint_evaluate(*self._args, np.asfortranarray(q_full),
-                                               self._zero, t)
+        out = self._kernel.constraint_evaluate(*self._args, _state(q_full, self._zero), t)
         if out[-1]:
             raise ValueError(f"constraint evaluation failed (code {out[-1]})")
         return out[1]

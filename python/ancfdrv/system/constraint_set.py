@@ -14,7 +14,7 @@ import numpy as np
 
 from ..csr import sorted_unique
 from ..errors import InputError
-from ..kernel import _f, _kernel
+from ..kernel import _kernel, _state, constraint_arrays
 
 
 @dataclass
@@ -103,7 +103,7 @@ class ConstraintSet:
             empty = np.zeros(0)
             return empty, np.zeros((6, 0)), np.zeros((6, 6, 0)), empty, empty, empty
         e_dot = np.zeros_like(e) if e_dot is None else e_dot
-        out = _kernel.constraint_evaluate(*self._kernel_inputs(), _f(e), _f(e_dot), t)
+        out = _kernel.constraint_evaluate(*self._kernel_inputs(), _state(e, e_dot), t)
         values, gradients, hessians, phi_t, phi_tt, gamma, info = out
         if info > 0:
             raise InputError(f"constraint {self.names[info - 1]!r} is malformed")
@@ -132,13 +132,14 @@ class ConstraintSet:
         data = np.concatenate([np.asarray(p, dtype=float) for p in self.drive_params]) \
             if self.drive_params else np.zeros(1)
         kinds = np.array(self.drive_kinds or [0], dtype=np.int32)
-        args = (_f(lay.kinds, np.int32), _f(lay.drives + 1, np.int32), _f(lay.params),
-                _f(lay.operand_const), _f(lay.term_ptr + 1, np.int32),
-                _f(lay.term_dof + 1 if len(lay.term_dof) else np.ones(1), np.int32),
-                _f(lay.term_coef if len(lay.term_coef) else np.zeros(1)), _f(kinds, np.int32),
-                _f(ptr if len(self.drive_kinds) else np.ones(2), np.int32), _f(data))
-        for array in args:   # shared by the calls: read only
+        packed = constraint_arrays(
+            lay.kinds, lay.drives + 1, lay.params, lay.operand_const, lay.term_ptr + 1,
+            lay.term_dof + 1 if len(lay.term_dof) else np.ones(1),
+            lay.term_coef if len(lay.term_coef) else np.zeros(1),
+            kinds, ptr if len(self.drive_kinds) else np.ones(2), data)
+        for array in packed:   # shared by the calls: read only
             array.flags.writeable = False
+        args = (*packed, len(lay.kinds))
         self.__dict__["_inputs"] = (snapshot, args)
         return args
 

@@ -1,0 +1,142 @@
+!> What the f2py binding (element_api.f90, system_api.f90) shares and f2py does not wrap:
+!> the one handle check of the system routines and the layouts of the small arrays that
+!> group a routine's related scalars (so that no routine takes more than 15 arguments).
+!> Each layout is a set of 1-based indices <prefix>_<name> and its length <prefix>_count;
+!> python/ancfdrv/codes.py KERNEL_LAYOUTS mirrors every one (tests/test_codes.py checks).
+module api_support
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use stepper, only: stepper_run
+  use system_store, only: store_get
+  use kernel_errors, only: handle_text
+  implicit none
+  private
+  public :: api_system, unpack_constraints
+
+  !> The arrays of a constraint set (constraints module layout)
+  type, public :: constraint_layout
+    integer, allocatable :: kinds(:), drives(:), term_ptr(:), term_dof(:), drive_kinds(:), &
+                            drive_ptr(:)
+    real(dp), allocatable :: params(:, :), operand_const(:, :), term_coef(:), drive_data(:)
+  end type constraint_layout
+
+  !> beam_cubic_setup's section and material
+  integer, parameter, public :: cs_area = 1, cs_inertia_y = 2, cs_inertia_z = 3, &
+                                cs_torsion = 4, cs_shear_y = 5, cs_shear_z = 6, cs_youngs = 7, &
+                                cs_poisson = 8, cs_count = 8
+  !> a continuum beam set's material
+  integer, parameter, public :: bm_youngs = 1, bm_poisson = 2, bm_count = 2
+  !> a plate's material and thickness
+  integer, parameter, public :: pm_youngs = 1, pm_poisson = 2, pm_thickness = 3, pm_count = 3
+  !> a cable's section and its axial Kelvin-Voigt damping (damping_time 0: none)
+  integer, parameter, public :: cb_axial_stiffness = 1, cb_bending_stiffness = 2, &
+                                cb_damping_time = 3, cb_rate_factor = 4, cb_count = 4
+  !> one force element: its kinds, its length and rate, its energies
+  integer, parameter, public :: fk_element = 1, fk_table = 2, fk_count = 2
+  integer, parameter, public :: fg_length = 1, fg_length_rate = 2, fg_count = 2
+  integer, parameter, public :: fe_energy = 1, fe_dissipation = 2, fe_drive_power = 3, &
+                                fe_count = 3
+  !> a system's force elements (columns of elements(:, l)) and their pointers (columns)
+  integer, parameter, public :: fl_kind = 1, fl_drive = 2, fl_table_kind = 3, &
+                                fl_slot_first = 4, fl_count = 4
+  integer, parameter, public :: fp_param = 1, fp_table = 2, fp_position = 3, fp_count = 3
+  !> the header of a packed constraint layout (constraint_offsets)
+  integer, parameter, public :: cl_ncon = 1, cl_nterm = 2, cl_ndrive = 3, cl_count = 3
+  !> a reduced FFR run: the frame's motion at each time (columns), the stepper's settings
+  !> and controls, per-step counts (columns), its status, the energy rows (columns)
+  integer, parameter, public :: fm_rate = 1, fm_sin_psi = 2, fm_one_minus_cos = 3, &
+                                fm_accel = 4, fm_count = 4
+  integer, parameter, public :: rs_dt = 1, rs_beta = 2, rs_gamma = 3, rs_tol = 4, rs_count = 4
+  integer, parameter, public :: rc_pdelta = 1, rc_max_newton = 2, rc_count = 2
+  integer, parameter, public :: rn_corrections = 1, rn_factorized = 2, rn_count = 2
+  integer, parameter, public :: rt_info = 1, rt_failed_step = 2, rt_count = 2
+  integer, parameter, public :: re_kinetic = 1, re_strain = 2, re_power = 3, re_load = 4, &
+                                re_count = 4
+  !> a state's coordinates and rates (columns), the forces of system_evaluate (columns),
+  !> its factors and energies
+  integer, parameter, public :: sv_coordinates = 1, sv_rates = 2, sv_count = 2
+  integer, parameter, public :: ff_internal = 1, ff_external = 2, ff_count = 2
+  integer, parameter, public :: ef_time = 1, ef_load_factor = 2, ef_velocity_factor = 3, &
+                                ef_count = 3
+  integer, parameter, public :: ee_strain = 1, ee_contact_potential = 2, ee_count = 2
+  !> a static load step: settings, controls, the residual scales (in and out), outcome
+  integer, parameter, public :: ss_time = 1, ss_load_factor = 2, ss_tol = 3, &
+                                ss_length_scale = 4, ss_count = 4
+  integer, parameter, public :: sc_check_start = 1, sc_load_step = 2, sc_load_steps = 3, &
+                                sc_count = 3
+  integer, parameter, public :: sr_force_scale = 1, sr_force_res = 2, sr_con_res = 3, &
+                                sr_count = 3
+  integer, parameter, public :: so_info = 1, so_iterations = 2, so_converged_by = 3, &
+                                so_factorizations = 4, so_count = 4
+  !> the columns of a pattern's coordinates (rows, columns)
+  integer, parameter, public :: tp_rows = 1, tp_cols = 2, tp_count = 2
+  !> a solver: its handle (sparse_direct) and its policy (mechanical_system policy_*)
+  integer, parameter, public :: sl_handle = 1, sl_policy = 2, sl_count = 2
+  !> one contact pair: each side's element size and local point (columns upper, lower)
+  integer, parameter, public :: cg_a = 1, cg_b = 2, cg_xi = 3, cg_eta = 4, cg_count = 4
+  !> contact energies: the penalty potential, the damping and friction powers
+  integer, parameter, public :: ce_potential = 1, ce_damping = 2, ce_friction = 3, &
+                                ce_count = 3
+
+contains
+
+  !> The system (and on request its stepper run) behind handle; info = 1 with the text in
+  !> message when it is not a live handle, else info = 0 and message blank.
+  subroutine api_system(handle, sys, info, message, run)
+    integer, intent(in) :: handle
+    type(system_model), pointer, intent(out) :: sys
+    integer, intent(out) :: info
+    character(len=200), intent(out), optional :: message
+    type(stepper_run), pointer, intent(out), optional :: run
+    if (present(run)) then
+      call store_get(handle, sys, info, run)
+    else
+      call store_get(handle, sys, info)
+    end if
+    if (present(message)) then
+      message = ' '
+      if (info /= 0) message = handle_text(handle)
+    end if
+  end subroutine api_system
+
+  !> A packed constraint layout unpacked into the arrays of the constraints module,
+  !>   ints  = [ncon, nterm, ndrive, kinds(ncon), drives(ncon), term_ptr(6 ncon + 1),
+  !>            term_dof(nterm), drive_kinds(ndrive), drive_ptr(ndrive + 1)]
+  !>   reals = [params(8, ncon), operand_const(6, ncon), term_coef(nterm), drive_data(:)]
+  !> (drive_data to the end). info = ncon + 1 (no constraint's number): the lengths
+  !> disagree with the header or with ncon.
+  pure subroutine unpack_constraints(ints, reals, ncon, layout, info)
+    integer, intent(in) :: ints(:), ncon
+    real(dp), intent(in) :: reals(:)
+    type(constraint_layout), intent(out) :: layout
+    integer, intent(out) :: info
+    integer :: nterm, ndrive, at
+    info = ncon + 1
+    if (size(ints) < cl_count) return
+    nterm = ints(cl_nterm)
+    ndrive = ints(cl_ndrive)
+    if (ints(cl_ncon) /= ncon .or. nterm < 0 .or. ndrive < 0) return
+    if (size(ints) /= cl_count + 8 * ncon + 1 + nterm + 2 * ndrive + 1) return
+    if (size(reals) < 14 * ncon + nterm) return
+    at = cl_count
+    layout%kinds = ints(at + 1:at + ncon)
+    at = at + ncon
+    layout%drives = ints(at + 1:at + ncon)
+    at = at + ncon
+    layout%term_ptr = ints(at + 1:at + 6 * ncon + 1)
+    at = at + 6 * ncon + 1
+    layout%term_dof = ints(at + 1:at + nterm)
+    at = at + nterm
+    layout%drive_kinds = ints(at + 1:at + ndrive)
+    at = at + ndrive
+    layout%drive_ptr = ints(at + 1:at + ndrive + 1)
+    layout%params = reshape(reals(1:8 * ncon), [8, ncon])
+    at = 8 * ncon
+    layout%operand_const = reshape(reals(at + 1:at + 6 * ncon), [6, ncon])
+    at = at + 6 * ncon
+    layout%term_coef = reals(at + 1:at + nterm)
+    layout%drive_data = reals(at + nterm + 1:)
+    info = 0
+  end subroutine unpack_constraints
+
+end module api_support
