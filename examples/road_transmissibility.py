@@ -75,7 +75,7 @@ from ancfdrv.io.scene import load_scene
 from ancfdrv.runner import run_scene
 from ancfdrv.solvers.static import solve_newton
 from ancfdrv.sweep_exec import end_with_parent
-from ancfdrv.system.bodies import RigidBody
+from ancfdrv.system import RigidBody
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "inputs" / "leaf_spring_road.nml"

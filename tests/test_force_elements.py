@@ -1,4 +1,4 @@
-"""Force elements (SPEC 8.1, kernel module force_elements.f90, system/force_elements.py):
+"""Force elements (SPEC 8.1, kernel module force_elements.f90, system/kinds/force_element.py):
 spring-damper, bushing and compliant hydraulic cylinder. Every number is checked against an
 independent reference: the closed forms of a mass on a spring (equilibrium, period, damping
 ratio), central differences of the kernel's force and energy, invariants (energy balance,
@@ -11,7 +11,7 @@ import pytest
 
 from ancfdrv import System
 from ancfdrv.errors import InputError
-from ancfdrv.system.force_elements import (FE_BUSHING, FE_CYLINDER, FE_SPRING_DAMPER,
+from ancfdrv.system.kinds.force_element import (FE_BUSHING, FE_CYLINDER, FE_SPRING_DAMPER,
                                            ForceElementInfo, evaluate)
 from ancfdrv.system.drives import Table
 

@@ -1,5 +1,5 @@
 """The hoist rope: an ANCF cable with ``tension_only=True`` (fortran/src/elements/
-cable_element.f90, python/ancfdrv/system/cable.py) carrying a payload.
+cable_element.f90, python/ancfdrv/system/kinds/cable.py) carrying a payload.
 
 Element checks: the rope's law against the cable's (taut: the same force; compressed: no
 axial force at all, only bending), the analytic tangent against central differences on

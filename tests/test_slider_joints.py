@@ -26,7 +26,7 @@ from ancfdrv import Rectangle, System
 from ancfdrv.errors import InputError
 from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 from ancfdrv.solvers.static import solve_newton
-from ancfdrv.system.bodies import RigidBody
+from ancfdrv.system import RigidBody
 
 G = 9.81
 

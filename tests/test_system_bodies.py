@@ -26,7 +26,7 @@ import scipy.linalg
 
 from ancfdrv import Box, Circle, Rectangle, System, Tube
 from ancfdrv.solvers.static import solve_newton
-from ancfdrv.system.bodies import Beam, Plate, RigidBody
+from ancfdrv.system import Beam, Plate, RigidBody
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from reference import beam_formulas as bf  # noqa: E402  (tests/reference: never used by a run)

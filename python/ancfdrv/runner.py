@@ -218,7 +218,7 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     when the model has neither joints nor beams)."""
     from .solvers.dynamic import initial_acceleration
     from .system.answers import DynamicAnswers, reaction_map
-    from .system.bodies import Beam
+    from .system.kinds import Beam
     if not scene["output"].get("answers", True):
         return None
     if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies) \
@@ -255,7 +255,7 @@ def _warn_large_ffr_deflection(model: Model, out: Path | MemoryOutput) -> None:
 # -- FFR modal reduction (&beam modes = N; solvers/ffr_reduced.py) --------------------------
 def modal_beam(model: Model):
     """The beam whose ``modes`` asks for the modal reduction (None: the full model)."""
-    from .system.bodies import Beam
+    from .system.kinds import Beam
     beams = [b for b in model.bodies if isinstance(b, Beam) and getattr(b, "modes", 0)]
     return beams[0] if beams else None
 

@@ -73,7 +73,7 @@ def stage_bounds(scene) -> dict[str, tuple[float, float]] | None:
 def _cable_boom(scene, built: BuiltSystem, steel, drive, a1, tangent, height, tip
                 ) -> BuiltSystem:
     """``beam.bending = 'cable'`` (issue 23): the boom as an ANCF cable (r and r_x per node,
-    Euler-Bernoulli, EA and EI = E w h^3 / 12 of the section; ``system/cable.py``), the
+    Euler-Bernoulli, EA and EI = E w h^3 / 12 of the section; ``system/kinds/cable.py``), the
     'nonlinear' formulation only. A1 hangs on the arm with the slope r_x normal to it (the
     section along the arm), A2 is driven on its circle, the moment M_B acts on the slope at
     A2 (the section turns with the axis). The cable carries the boom's frame R(phi(t)) for

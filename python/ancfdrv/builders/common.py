@@ -32,7 +32,7 @@ def rectangle(scene) -> Rectangle:
 
 def template_cable(scene, system: System, name: str, material_, start, end):
     """``beam.bending = 'cable'`` in a beam template (issue 23): the beam as an ANCF cable
-    (r and r_x per node, Euler-Bernoulli, ``system/cable.py``), the 'nonlinear' formulation
+    (r and r_x per node, Euler-Bernoulli, ``system/kinds/cable.py``), the 'nonlinear' formulation
     only. A section with I_y != I_z bends in the r1-r2 plane with I_z = int y^2 dA and needs
     ``scene.planar = 'xy'``."""
     if scene["scene"]["formulation"] != "nonlinear":

@@ -1,5 +1,6 @@
 """General scenes (SPEC section 8): a thin reader over the System API. Every named group
-is one call, in file order: ``&material`` -> System.material, ``&beam`` -> System.beam, ...
+is one call, in file order: a kind's group (``&beam``, ``&cable``, ...; system/kinds/) ->
+``System.add(group, **values)``, ``&material`` -> System.material, ``&joint`` -> System.joint, ...
 Errors of a call (an unknown body in a joint, a non-physical value) are reported with the
 file and the group, e.g. ``scene.nml: &joint[lift]: unknown body 'jib'``.
 """
@@ -16,7 +17,7 @@ from .common import BuiltSystem
 from ..errors import InputError
 from ..io.scene import GENERAL_BUILDER
 from ..system import System
-from ..system.sections import SECTIONS
+from ..system.registry import kind, kinds
 from ..system.system import LOAD_EFFECTS
 
 #: drive parameters per type: namelist key -> API keyword (with a conversion)
@@ -50,36 +51,6 @@ def effects_of(items: list[tuple[str, dict[str, Any]]]) -> set[str]:
         elif group == "material" and v["damping_time"] > 0:
             out.add("damping")
     return out
-
-
-_SECTION_KEYS = {"rectangle": ("width", "height"), "box": ("width", "height", "wall"),
-                 "tube": ("diameter", "wall"), "circle": ("diameter",),
-                 "general": ("area", "iy", "iz", "torsion_constant", "shear_factor_y",
-                             "shear_factor_z")}
-_SECTION_OPTIONAL = {"general": ("mass_per_length", "rotary_inertia", "fibre_points")}
-
-
-def _section(v: dict[str, Any]):
-    kind = v["section"]
-    keys = _SECTION_KEYS[kind]
-    optional = _SECTION_OPTIONAL.get(kind, ())
-    missing = [k for k in keys if v.get(k) is None]
-    if missing:
-        raise InputError(f"section {kind!r} needs {', '.join(missing)}")
-    every = {k for ks in _SECTION_KEYS.values() for k in ks} | \
-        {k for ks in _SECTION_OPTIONAL.values() for k in ks}
-    extra = sorted(k for k in every if k not in keys and k not in optional and
-                   v.get(k) is not None)
-    if extra:
-        raise InputError(f"section {kind!r} does not take {', '.join(extra)}")
-    if kind == "general":
-        if v.get("shear") is not None:
-            raise InputError("section 'general' does not take shear (give shear_factor_y, "
-                             "shear_factor_z)")
-        return SECTIONS[kind](*(v[k] for k in keys), mass_per_length=v.get("mass_per_length"),
-                              rotary_inertia=v.get("rotary_inertia"),
-                              fibre_points=v.get("fibre_points"))
-    return SECTIONS[kind](*(v[k] for k in keys), shear=v.get("shear") or "unit")
 
 
 def _drive(s: System, v: dict[str, Any], scene_dir: Path) -> None:
@@ -159,31 +130,16 @@ def _check_joint_points(s: System, scene) -> None:
 
 def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> None:
     """One namelist group, one call of the System API."""
-    if group == "material":
+    found = kind(group)
+    if found is not None:   # a kind's group (system/kinds/): System.add
+        values = dict(v)
+        for key, scene_key in found.scene_defaults.items():
+            if values.get(key) is None:
+                values[key] = scene["scene"][scene_key]
+        s.add(group, **values)
+    elif group == "material":
         s.material(v["name"], youngs_modulus=v["youngs_modulus"], density=v["density"],
                    poisson_ratio=v["poisson_ratio"], damping_time=v["damping_time"])
-    elif group == "beam":
-        s.beam(v["name"], material=v["material"], start=v["start"], end=v["end"],
-               nodes=v["nodes"], section=_section(v), height_axis=v["height_axis"],
-               formulation=v["formulation"] or scene["scene"]["formulation"],
-               bending=v["bending"], segments=v["segments"], frame_drive=v["frame_drive"],
-               frame_axis=v["frame_axis"], frame_pivot=v["frame_pivot"],
-               geometric_stiffness=v["geometric_stiffness"], modes=v["modes"])
-    elif group == "cable":
-        s.cable(v["name"], material=v["material"], start=v["start"], end=v["end"],
-                nodes=v["nodes"], section=_section(v), tension_only=v["tension_only"],
-                bending_stiffness=v["bending_stiffness"], segments=v.get("segments"))
-    elif group == "plate":
-        s.plate(v["name"], material=v["material"], thickness=v["thickness"], corner=v["corner"],
-                edge_x=v["edge_x"], edge_y=v["edge_y"], nx=v["nx"], ny=v["ny"],
-                variant=v["variant"])
-    elif group == "leaf":
-        s.leaf(v["name"], material=v["material"], thickness=v["thickness"], width=v["width"],
-               arc_length=v["arc_length"], radius=v["radius"], centre=v["centre"], nx=v["nx"],
-               ny=v["ny"], variant=v["variant"], free_radius=v["free_radius"])
-    elif group == "rigid_body":
-        s.rigid_body(v["name"], mass=v["mass"], inertia=v["inertia"], position=v["position"],
-                     planar=v["planar"], plane_normal=v["plane_normal"])
     elif group == "drive":
         _drive(s, v, scene_dir)
     elif group == "joint":
@@ -200,14 +156,6 @@ def _call(s: System, group: str, v: dict[str, Any], scene, scene_dir: Path) -> N
                   points=v["points"])
     elif group == "probe":
         s.probe(v["name"], v["body"], v["point"])
-    elif group == "force_element":
-        s.force_element(v["name"], v["type"], v["body1"], v["body2"], point1=v["point1"],
-                        point2=v["point2"], point=v["point"], stiffness=v["stiffness"],
-                        damping=v["damping"], rotational_stiffness=v["rotational_stiffness"],
-                        rotational_damping=v["rotational_damping"],
-                        free_length=v["free_length"], preload=v["preload"],
-                        deflections=v["deflections"], forces=v["forces"],
-                        interpolation=v["interpolation"], drive=v["drive"])
     else:  # the schema admits no other group
         raise AssertionError(group)
 
@@ -235,9 +183,9 @@ def locate_error(exc: InputError, scene) -> InputError:
         match = _ITEM_PREFIX.match(message)
         if match:
             word, name = match.group(1), re.sub(r" #\d+$", "", match.group(2))
-            kinds = [_ITEM_WORDS[word]] if _ITEM_WORDS[word] else \
-                ["beam", "cable", "plate", "leaf", "rigid_body"]
-            group = next((f"{g}[{name}]" for g in kinds if (g, name) in names), None)
+            groups = [_ITEM_WORDS[word]] if _ITEM_WORDS[word] else \
+                [k.group for k in kinds() if k.table == "bodies"]
+            group = next((f"{g}[{name}]" for g in groups if (g, name) in names), None)
         else:
             head = re.sub(r" #\d+$", "", message.split(":", 1)[0])
             group = next((f"{g}[{n}]" for g, n in sorted(names) if n == head), None)
@@ -250,8 +198,7 @@ def build_general(scene) -> BuiltSystem:
     s = System(scene["scene"]["title"], effects=scene.effects)
     # materials and drives first, then the bodies (numbered in file order), then what refers
     # to them: a scene may list its groups in any order
-    rank = {"material": 0, "drive": 1, "beam": 2, "cable": 2, "plate": 2, "leaf": 2,
-            "rigid_body": 2}
+    rank = {"material": 0, "drive": 1, **{k.group: 2 for k in kinds() if k.table == "bodies"}}
     order = sorted(scene.items, key=lambda item: rank.get(item[0], 3))
     for group, values in order:
         try:

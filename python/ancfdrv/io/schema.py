@@ -419,7 +419,7 @@ def points3(v: Any) -> str | None:
         f"must be x, y, z (or several points: a multiple of 3 numbers), got {len(v)} numbers"
 
 
-def _name(doc: str = "a unique name of the item") -> Key:
+def name_key(doc: str = "a unique name of the item") -> Key:
     return Key("str", check=check_name, doc=doc)
 
 
@@ -428,129 +428,19 @@ def principal_positive(v: Any) -> str | None:
 
 
 #: Repeatable, named groups of general scenes (SPEC section 8); list kinds are checked as a
-#: whole (vector3, points3) rather than per item.
+#: whole (vector3, points3) rather than per item. The kinds' groups (&beam, &cable, &plate,
+#: &leaf, &rigid_body, &force_element) are declared by the kinds (system/kinds/) and added
+#: by :func:`register_group`.
 GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
     "material": {
-        "name": _name(),
+        "name": name_key(),
         "youngs_modulus": Key("float", check=positive, doc="E (Pa)"),
         "density": Key("float", check=positive, doc="rho (kg/m^3)"),
         "poisson_ratio": Key("float", 0.0, within(0.0, 0.5, open_hi=True), "nu"),
         "damping_time": Key("float", 0.0, non_negative, DAMPING_TIME_DOC),
     },
-    "beam": {
-        "name": _name(),
-        "material": Key("str", doc="name of a &material"),
-        "start": Key("floats", check=vector3, doc="start of the neutral axis (m)"),
-        "end": Key("floats", check=vector3, doc="end of the neutral axis (m)"),
-        "nodes": Key("int", check=at_least(2), doc="nodes on the beam (>= 2)"),
-        "segments": Key("floats", None, doc="segment lengths (m) each split equally (keeps "
-                        "their ends as nodes); default: one segment"),
-        "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle",
-                                                  "general"),
-                       "cross-section: 'rectangle' (width, height), 'box' (width, height, wall), "
-                       "'tube' (diameter, wall), 'circle' (diameter), 'general' (area, iy, iz, "
-                       "torsion_constant, shear_factor_y, shear_factor_z; optional "
-                       "mass_per_length, rotary_inertia, fibre_points)"),
-        "width": Key("float", None, positive, "section width along r_z (m)"),
-        "height": Key("float", None, positive, "section height along r_y (m)"),
-        "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
-        "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
-        "shear": Key("str", None, one_of("unit", "cowper"), "shear factors of 'rectangle', "
-                     "'box', 'tube', 'circle': 'unit' (k = 1, the default) or 'cowper' "
-                     "(Cowper 1966, from the section and nu)"),
-        "area": Key("float", None, positive, "'general': cross-section area A (m^2)"),
-        "iy": Key("float", None, positive, "'general': I_y = int z^2 dA, bending along the "
-                  "width r_z (m^4)"),
-        "iz": Key("float", None, positive, "'general': I_z = int y^2 dA, bending along the "
-                  "height r_y (m^4)"),
-        "torsion_constant": Key("float", None, positive, "'general': Saint-Venant torsion "
-                                "constant J (m^4)"),
-        "shear_factor_y": Key("float", None, positive, "'general': shear factor k_y (shear "
-                              "stiffness k_y G A along the height)"),
-        "shear_factor_z": Key("float", None, positive, "'general': shear factor k_z (along the "
-                              "width)"),
-        "mass_per_length": Key("float", None, positive, "'general', optional: mass per unit "
-                               "length (kg/m; default density * area)"),
-        "rotary_inertia": Key("floats", None, vector3, "'general', optional: r_x, r_y, r_z, "
-                              "rotary inertia per unit length about the axis, the height and "
-                              "the width axes (kg m; r_x = r_y + r_z; default density * (iy + "
-                              "iz, iy, iz))"),
-        "fibre_points": Key("floats", None, doc="'general', optional: outer-fibre points y1, "
-                            "z1, y2, z2, ... in the section (m) for stresses (default: the "
-                            "corners of the rectangle of the same A, I_y, I_z)"),
-        "height_axis": Key("floats", None, vector3, "direction of the section height "
-                           "(default: global z, or y for a beam along z)"),
-        "formulation": Key("str", None, one_of("ffr", "nonlinear"),
-                           "'ffr' or 'nonlinear' (default: the scene's)"),
-        "bending": Key("str", "continuum", one_of("continuum", "cubic"), "bending option"),
-        "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),
-        "modes": Key("int", 0, non_negative, MODES_DOC),
-        "frame_drive": Key("str", None, doc="drive turning the beam's frame (FFR: the "
-                           "floating frame; both: the frame of the probe deflections)"),
-        "frame_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the frame's turn"),
-        "frame_pivot": Key("floats", None, vector3, "point of the frame's axis (default: start)"),
-    },
-    "cable": {
-        "name": _name(),
-        "material": Key("str", doc="name of a &material"),
-        "start": Key("floats", check=vector3, doc="start of the axis (m)"),
-        "end": Key("floats", check=vector3, doc="end of the axis (m)"),
-        "nodes": Key("int", check=at_least(2), doc="nodes on the cable (>= 2)"),
-        "segments": Key("floats", None, doc="segment lengths between fixed nodes (m), each "
-                        "split into equal elements (as a beam's; nodes = k j + 1 for k "
-                        "segments)"),
-        "section": Key("str", "circle", one_of("rectangle", "box", "tube", "circle"),
-                       "cross-section (its area and bending inertia; I_y = I_z required): "
-                       "'circle' (diameter), 'tube' (diameter, wall), a square 'rectangle' "
-                       "or 'box'"),
-        "width": Key("float", None, positive, "section width (m)"),
-        "height": Key("float", None, positive, "section height (m)"),
-        "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
-        "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
-        "tension_only": Key("bool", False, doc="a rope: the axial force is never "
-                            "compressive (the cable goes slack); with the effect 'damping' "
-                            "its axial damping acts in tension only"),
-        "bending_stiffness": Key("float", None, non_negative, "EI (N m^2) in place of E "
-                                 "times the section's I (a rope's effective bending "
-                                 "stiffness; 0 only in dynamics)"),
-    },
-    "plate": {
-        "name": _name(),
-        "material": Key("str", doc="name of a &material"),
-        "thickness": Key("float", check=positive, doc="thickness (m)"),
-        "corner": Key("floats", check=vector3, doc="first corner (m)"),
-        "edge_x": Key("floats", check=vector3, doc="edge vector along the length (m)"),
-        "edge_y": Key("floats", check=vector3, doc="edge vector across, orthogonal (m)"),
-        "nx": Key("int", check=positive, doc="elements along edge_x"),
-        "ny": Key("int", check=positive, doc="elements along edge_y"),
-        "variant": Key("str", "completed", one_of("plain", "completed"), "thin plate variant"),
-    },
-    "leaf": {
-        "name": _name(),
-        "material": Key("str", doc="name of a &material"),
-        "thickness": Key("float", check=positive, doc="thickness (m)"),
-        "width": Key("float", check=positive, doc="width along r2 (m)"),
-        "arc_length": Key("float", check=positive, doc="mid-surface arc length (m)"),
-        "radius": Key("float", check=positive, doc="mid-surface radius, concave up (m)"),
-        "centre": Key("floats", check=vector3, doc="midpoint (lowest point) of the arc (m)"),
-        "nx": Key("int", check=positive, doc="elements along the arc (even)"),
-        "ny": Key("int", 1, positive, "elements across the width"),
-        "variant": Key("str", "completed", one_of("plain", "completed"), "thin plate variant"),
-        "free_radius": Key("float", None, positive, "stress-free radius (prestress; needs the "
-                           "effect 'prestress')"),
-    },
-    "rigid_body": {
-        "name": _name(),
-        "mass": Key("float", check=positive, doc="mass (kg)"),
-        "inertia": Key("floats", size=6, check=principal_positive, doc="Ixx, Iyy, Izz, Ixy, Iyz, Ixz about the centre of "
-                       "mass, global axes at t = 0 (kg m^2)"),
-        "position": Key("floats", check=vector3, doc="centre of mass at t = 0 (m)"),
-        "planar": Key("bool", False, doc="kept in the plane normal to plane_normal"),
-        "plane_normal": Key("floats", [0.0, 1.0, 0.0], vector3,
-                            "normal of the plane of a planar body (a coordinate axis)"),
-    },
     "joint": {
-        "name": _name(),
+        "name": name_key(),
         "type": Key("str", check=one_of("weld", "revolute", "spherical", "distance", "prescribed",
                                         "fix", "arm", "hub", "prismatic", "cylindrical",
                                         "universal"), doc="joint type (SPEC section 8)"),
@@ -575,7 +465,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
                    "in the box x0, y0, z0, x1, y1, z1 (m), whatever the mesh"),
     },
     "drive": {
-        "name": _name(),
+        "name": name_key(),
         "type": Key("str", check=one_of("constant", "luffing", "spinup", "cycle", "sine", "table",
                                         "ramp"),
                     doc="drive type"),
@@ -609,7 +499,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
                      "start_deg/end_deg; with start"),
     },
     "load": {
-        "name": _name(),
+        "name": name_key(),
         "type": Key("str", check=one_of("gravity", "force", "moment", "point_mass", "pressure"),
                     doc="load type"),
         "body": Key("str", None, doc="the loaded body"),
@@ -625,7 +515,7 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
                       "point_loads, point_loads, tip_mass, pressure)"),
     },
     "contact": {
-        "name": _name(),
+        "name": name_key(),
         "body1": Key("str", doc="the searched (upper) plate or leaf"),
         "body2": Key("str", doc="the plate or leaf whose end edges carry the points"),
         "stiffness": Key("float", check=positive, doc="penalty K (N/m)"),
@@ -634,49 +524,32 @@ GENERAL_SCHEMA: dict[str, dict[str, Key]] = {
         "slip_speed": Key("float", 0.08, positive, "critical slip speed V_t (m/s)"),
         "points": Key("int", 3, at_least(2), "contact points per end edge"),
     },
-    "force_element": {
-        "name": _name(),
-        "type": Key("str", check=one_of("spring_damper", "bushing", "cylinder"),
-                    doc="'spring_damper' (along the line point1-point2), 'bushing' (6 diagonal "
-                    "stiffnesses and dampings at point), 'cylinder' (a driven length with "
-                    "oil-column stiffness and damping in series)"),
-        "body1": Key("str", "ground", doc="first body (or 'ground')"),
-        "body2": Key("str", doc="second body (or 'ground')"),
-        "point1": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body1 (m)"),
-        "point2": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body2 (m)"),
-        "point": Key("floats", None, vector3, "'bushing': the point on both bodies (m)"),
-        "stiffness": Key("floats", None, non_negative, "stiffness (N/m): one value; a "
-                         "'bushing' three, along body1's axes at the point; 0 or within "
-                         "[1e-3, 1e12] N/m (scene.bounds: a softer spring carries nothing a "
-                         "structure weighs, a stiffer one is a joint)"),
-        "damping": Key("floats", None, non_negative, "damping (N s/m): one value; a 'bushing' "
-                       "three (default 0; at most 1e10, scene.bounds)"),
-        "rotational_stiffness": Key("floats", None, non_negative, "'bushing': stiffness about "
-                                    "body1's three axes (N m/rad; default 0; 0 or within "
-                                    "[1e-6, 1e12], scene.bounds)"),
-        "rotational_damping": Key("floats", None, non_negative, "'bushing': damping about "
-                                  "body1's three axes (N m s/rad; default 0; at most 1e10, "
-                                  "scene.bounds)"),
-        "free_length": Key("float", None, positive, "'spring_damper': length at which the "
-                           "force is the preload (m; default: the distance at t = 0)"),
-        "preload": Key("float", None, doc="'spring_damper': force at the free length (N, "
-                       "tension positive; default 0)"),
-        "deflections": Key("floats", None, doc="'spring_damper' instead of stiffness and "
-                           "preload: a force-deflection table's deflections L - free_length "
-                           "(m, increasing)"),
-        "forces": Key("floats", None, doc="'spring_damper': the table's forces (N, tension "
-                      "positive; constant beyond the ends)"),
-        "interpolation": Key("str", None, one_of("linear", "cubic", "pchip"),
-                             "'spring_damper': the table's interpolation, as a drive table's "
-                             "(default 'linear')"),
-        "drive": Key("str", None, doc="'cylinder': the drive of the nominal length l(t) (m)"),
-    },
     "probe": {
-        "name": _name(),
+        "name": name_key(),
         "body": Key("str", doc="the body"),
         "point": Key("floats", check=vector3, doc="material point (m)"),
     },
 }
+#: the groups of the kinds (system/registry.py), in registration order: GENERAL_SCHEMA lists
+#: them after &material, before the groups above that refer to them
+_KIND_GROUPS: list[str] = []
+
+
+def register_group(group: str, keys: dict[str, Key]) -> None:
+    """A kind's repeatable group of general scenes (``system.registry.register``: each kind
+    declares its keys once, in its own module); GENERAL_SCHEMA keeps its order: &material,
+    the kinds' groups, then the others."""
+    if group in GENERAL_SCHEMA:
+        raise ValueError(f"the general scene group {group!r} is declared twice")
+    _KIND_GROUPS.append(group)
+    others = {g: k for g, k in GENERAL_SCHEMA.items() if g != "material"}
+    material = GENERAL_SCHEMA.pop("material")
+    GENERAL_SCHEMA.clear()   # (in place: the modules that imported it see the kinds)
+    GENERAL_SCHEMA["material"] = material
+    GENERAL_SCHEMA.update({g: keys if g == group else others[g] for g in _KIND_GROUPS})
+    GENERAL_SCHEMA.update({g: k for g, k in others.items() if g not in _KIND_GROUPS})
+
+
 #: Groups of general scenes that occur once (shared with the template scenes).
 GENERAL_SINGLE_GROUPS = ("scene", "solver", "output")
 #: Modal analysis and linear buckling (SPEC section 10; solvers/modal.py, buckling.py): groups

@@ -35,7 +35,7 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
-from ..system.bodies import Beam
+from ..system.kinds import Beam
 from ..system.model import Model
 from ..io.safe_write import check_room, create_fresh
 from ..io.scene import Scene

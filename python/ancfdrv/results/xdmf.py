@@ -41,7 +41,7 @@ from h5py import h5a, h5d, h5p, h5s, h5t
 from ..csr import Csr
 from ..errors import InputError
 from ..io.safe_write import write_with
-from ..system.bodies import Beam, Plate, RigidBody
+from ..system.kinds import Beam, Plate, RigidBody
 
 _STEPS_GROUP = "dynamic/xdmf"
 #: XDMF cell codes of a Mixed topology

@@ -6,8 +6,8 @@
 container and its name checks), ``assembly`` (numbering, elimination of linear joints,
 patterns, the kernel handle), ``model`` (the assembled model).
 """
-from .bodies import Beam, Leaf, Material, Plate, RigidBody
-from .cable import Cable
+from .bodies import Material
+from .kinds import Beam, Cable, Leaf, Plate, RigidBody
 from .drives import Constant, Cycle, Drive, Luffing, Ramp, Sine, SpinUp, Table
 from .model import Model
 from .sections import Box, Circle, General, Rectangle, Section, Tube

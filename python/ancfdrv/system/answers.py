@@ -52,8 +52,7 @@ import numpy as np
 
 from ..codes import CONSTRAINT_COORDINATE
 from ..csr import sorted_unique
-from .bodies import Beam, Plate, RigidBody
-from .cable import Cable
+from .kinds import Beam, Cable, Plate, RigidBody
 from .constraint_set import ConstraintSet
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation
@@ -501,7 +500,7 @@ def reactions(model: Model, e: np.ndarray, lam: np.ndarray, *, t: float = 0.0,
 
 def force_element_reactions(model: Model, e: np.ndarray, v: np.ndarray | None = None,
                             t: float = 0.0) -> dict[str, Reaction]:
-    """Per force element (``ancfdrv.system.force_elements``) the force and moment body1
+    """Per force element (``ancfdrv.system.kinds.force_element``) the force and moment body1
     exerts on body2 (global axes; the moment about the element's point on body2) and the
     axial force (tension positive; 0 for a bushing) at (e, e', t), from the kernel."""
     items = list(getattr(model, "force_elements", ()))

@@ -17,12 +17,13 @@ from ..codes import (CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANC
                      CONTACT_COUNTERS, POLICY_CONSTANT, POLICY_REFACTOR)
 from ..csr import Csr
 from ..errors import InputError
-from .bodies import Beam, Body, Ground, Leaf, Plate, RigidBody, rotation_about
+from .bodies import Body, Ground, rotation_about
+from .kinds import Beam, RigidBody
 from .constraint_set import ConstraintSet
 from .drives import Constant
-from .element_kinds import SetContext, register_body, register_set, set_builder
+from .registry import SetContext, set_builder
 from .expressions import Scalar
-from .force_elements import assemble_force_elements
+from .kinds.force_element import assemble_force_elements
 from .joints import Constraint, LinearEquation, orthonormality, planar_fixes, small_turn
 from .loads import DeadMoment, Gravity, PointForce, PointMass, Pressure
 from .model import (VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_FORCE, VLOAD_FOLLOWER_MOMENT, FrameInfo,
@@ -268,132 +269,6 @@ def _damping(info: SetInfo, body: Body, active: set[str], counters: Counter,
                "'damping' is not listed: not applied")
     if message not in warnings:
         warnings.append(message)
-
-
-def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
-    frame, frame_id = context.frame, context.frame_id
-    dofs = beam.element_dofs()
-    local = dofs - beam.first
-    q = beam.coordinates()
-    rotation0 = frame.rotation(0.0)
-    frame_q = (q.reshape(-1, 3) @ rotation0).ravel()       # A0^T v for every 3-vector
-    positions = q.reshape(-1, 4, 3)[:, 0, :] - frame.pivot
-    frame_q.reshape(-1, 4, 3)[:, 0, :] = positions @ rotation0
-    section = beam.section.data
-    m = beam.material
-    frame_ref = frame_q[local].reshape(3, 8, beam.nel, order="F")
-    global_ref = q[local].reshape(3, 8, beam.nel, order="F")
-    # torsion constant J and shear factors of the section (docs/theory.md, "Sections")
-    shear_scales = beam.section.shear_scales(m.poisson_ratio)
-    torsion = beam.section.torsion_constant
-    shear_factors = beam.section.shear_factors(m.poisson_ratio)
-    mass_compact, stiffness0 = kernel.beam_element_arrays(
-        beam.lengths, section, m.density, m.youngs_modulus, m.poisson_ratio, frame_ref,
-        shear_scales)
-    mass_rule, mass_density = beam.section.mass_rule(m.density)
-    if mass_rule is not section:   # a general section's own mass and rotary inertia
-        mass_compact, _ = kernel.beam_element_arrays(
-            beam.lengths, mass_rule, mass_density, m.youngs_modulus, m.poisson_ratio, frame_ref)
-    info = SetInfo(body=beam, kind="", dofs=dofs, nel=beam.nel, frame=frame_id,
-                   mass_compact=mass_compact)
-    if beam.formulation == "ffr":
-        info.kind = "ffr"
-        if beam.bending == "cubic":  # K0: the cubic tangent at the reference, in the frame
-            cubic = kernel.CubicBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
-                                     m.poisson_ratio, torsion, shear_factors)
-            *_, stiffness0 = cubic.forces(local, frame_q, True)
-        info.stiffness0 = np.asfortranarray(stiffness0)
-        info.reference = np.asfortranarray(frame_q[local])
-        if beam.geometric_stiffness:
-            info.second_order = ffr_second_order_data(frame_ref, beam.lengths,
-                                                      m.youngs_modulus * beam.section.area)
-    elif beam.bending == "cubic":
-        info.kind = "cubic"
-        info.cubic = kernel.CubicBeam(global_ref, beam.lengths, section, m.youngs_modulus,
-                                      m.poisson_ratio, torsion, shear_factors)
-    else:
-        info.kind = "continuum"
-        info.gradients, info.weights, info.nvolume = kernel.beam_nonlinear_setup(
-            global_ref, beam.lengths, section)
-        info.shear_scales = shear_scales
-    return info
-
-
-def _plate_set(plate: Plate, context: SetContext) -> SetInfo:
-    active, counters, warnings = context.active, context.counters, context.warnings
-    mesh = plate.mesh
-    dofs = plate.element_dofs()
-    local = dofs - plate.first
-    reference = mesh.coords
-    if isinstance(plate, Leaf) and plate.prestressed:
-        if "prestress" in active:
-            reference = plate.reference_coords
-            counters["prestress"] += 1
-        else:
-            warnings.append(f"leaf {plate.name!r} has a free radius but the effect 'prestress' is "
-                            "not listed: it is stress-free as built")
-    ref = kernel.PlateReference(reference.ravel()[local].reshape(3, 12, mesh.nel, order="F"),
-                                mesh.a, mesh.b, plate.variant)
-    mass_compact, _ = kernel.plate_element_arrays(mesh.a, mesh.b, plate.thickness,
-                                                  plate.material.density, np.zeros(3))
-    return SetInfo(body=plate, kind="plate", dofs=dofs, nel=mesh.nel, frame=0,
-                   mass_compact=mass_compact, plate_reference=ref)
-
-
-def ffr_second_order_data(frame_ref: np.ndarray, lengths: np.ndarray, axial_rigidity: float
-                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The per-element data of the FFR geometric stiffness (ffr_elastic module doc): EA,
-    the unit axis in the frame (from the reference r_A to r_B, frame_ref (3, 8, nel)), the
-    length and G_ab = int S_a' S_b' dx over the centre-line shape functions (N1, L N2, N3,
-    L N4 on the slots r_A, r_xA, r_B, r_xB; 3-point Gauss, exact for the degree-4 integrand)."""
-    nel = len(lengths)
-    chord = frame_ref[:, 4, :] - frame_ref[:, 0, :]
-    axis = chord / np.linalg.norm(chord, axis=0)
-    points, weights = np.polynomial.legendre.leggauss(3)
-    xi, w = 0.5 * (points + 1.0), 0.5 * weights
-    # d/dxi of N1, N2, N3, N4 (cubic Hermite)
-    dn = np.array([-6 * xi + 6 * xi**2, 1 - 4 * xi + 3 * xi**2, 6 * xi - 6 * xi**2,
-                   3 * xi**2 - 2 * xi])
-    gram = np.zeros((8, 8, nel))
-    for el, length in enumerate(lengths):
-        ds = np.zeros((8, len(xi)))
-        ds[[0, 1, 4, 5]] = dn * np.array([1.0, length, 1.0, length])[:, None]
-        # int_0^L (dS_a/dx)(dS_b/dx) dx = (1/L) int_0^1 (dS_a/dxi)(dS_b/dxi) dxi
-        gram[:, :, el] = (ds * w) @ ds.T / length
-    return (np.full(nel, float(axial_rigidity)), np.asfortranarray(axis),
-            np.asarray(lengths, dtype=float), np.asfortranarray(gram))
-
-
-def _add_ffr(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    index = ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame,
-                           s.damping_time)
-    if s.second_order is not None:
-        ks.ffr_second_order(index, *s.second_order)
-    return index
-
-
-def _add_continuum(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    return ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
-                                s.body.material.youngs_modulus, s.body.material.poisson_ratio,
-                                s.frame, s.damping_time, s.shear_scales)
-
-
-def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    return ks.add_cubic_set(s.dofs, s.scatter, s.cubic.forms, s.cubic.strain0, s.cubic.stiffness,
-                            s.frame, s.damping_time)
-
-
-def _add_plate(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    return ks.add_plate_set(s.dofs, s.scatter, s.plate_reference, s.body.material.youngs_modulus,
-                            s.body.material.poisson_ratio, s.body.thickness, s.damping_time)
-
-
-register_body(Beam, _beam_set)
-register_body(Plate, _plate_set)
-register_set("ffr", _add_ffr)
-register_set("continuum", _add_continuum)
-register_set("cubic", _add_cubic)
-register_set("plate", _add_plate)
 
 
 # -- mass and loads --------------------------------------------------------------------------

@@ -12,14 +12,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .bodies import Plate
+from .bodies import Body
 
 
 @dataclass
 class ContactPair:
     name: str
-    body1: Plate            # the searched (upper) surface
-    body2: Plate            # the points' (lower) surface
+    body1: Body             # the searched (upper) surface (a plate or leaf)
+    body2: Body             # the points' (lower) surface
     stiffness: float
     damping: float = 0.0
     friction: float = 0.0
@@ -30,7 +30,7 @@ class ContactPair:
     def __post_init__(self) -> None:
         where = f"contact {self.name!r}"
         for body in (self.body1, self.body2):
-            if not isinstance(body, Plate):
+            if not body.surface:
                 raise InputError(f"{where}: {body.name!r} is not a plate or leaf surface")
         if self.body1 is self.body2:
             raise InputError(f"{where}: body1 and body2 are the same surface")

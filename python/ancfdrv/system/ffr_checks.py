@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..codes import DRIVE_LUFFING, DRIVE_SPINUP
-from .bodies import Beam
+from .kinds import Beam
 
 
 def first_bending_frequency(beam: Beam) -> float:

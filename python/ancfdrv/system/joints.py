@@ -58,7 +58,8 @@ import numpy as np
 
 from ..codes import CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE, CONSTRAINT_DOT
 from ..errors import InputError
-from .bodies import Attachment, Beam, Body, Ground, Plate, RigidBody, rotation_about
+from .bodies import Attachment, Body, Ground, rotation_about
+from .kinds import Beam, Plate, RigidBody
 from .drives import Drive
 from .expressions import Scalar, Vec3, combination
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .bodies import Body, Plate
+from .bodies import Body
 from .drives import Drive
 
 
@@ -118,7 +118,7 @@ class Pressure(Load):
     effect: str = "pressure"
 
     def __post_init__(self) -> None:
-        if not isinstance(self.body, Plate):
+        if not self.body.surface:
             raise InputError(f"load {self.name!r}: a pressure acts on a plate or leaf, not on "
                              f"{self.body.name!r}")
         if not np.isfinite(self.value):

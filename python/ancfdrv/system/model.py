@@ -17,10 +17,10 @@ from .. import kernel
 from ..codes import POLICY_CONSTANT, POLICY_REFACTOR
 from ..csr import Csr, sorted_unique, unique_keys
 from ..errors import InputError, SolverError
-from .bodies import Beam, Body, Plate, RigidBody, rotation_about
+from .bodies import Body, rotation_about
 from .constraint_set import ConstraintSet
 from .drives import Drive
-from .element_kinds import add_to_kernel
+from .registry import add_to_kernel
 from .patterns import Pattern, Reduction
 
 
@@ -163,24 +163,17 @@ def default_response(probes: dict, bodies: list[Body]) -> tuple[str, int] | None
     first = next(iter(probes.values()))
     name = getattr(first.body, "name", first.body)
     body = next(b for b in bodies if b.name == name)
-    return first.name, 1 if isinstance(body, Beam) else 2
+    return first.name, body.response_component
 
 
 def length_scale(bodies: list[Body]) -> float:
     """The length the Newton tolerances are relative to: the largest flexible body's size
     (a beam's length, the largest extent of a plate's or leaf's nodes along a coordinate
     axis), else the spread of the rigid bodies' centres (1 m when they coincide)."""
-    sizes = []
-    for body in bodies:
-        if isinstance(body, Beam):
-            sizes.append(body.length)
-        elif isinstance(body, Plate):
-            sizes.append(float(np.ptp(body.mesh.coords[:, :3], axis=0).max()))
-        elif body.flexible and hasattr(body, "length"):  # other families (cable)
-            sizes.append(float(body.length))
+    sizes = [body.extent for body in bodies if body.extent is not None]
     if sizes:
         return max(sizes)
-    centres = np.array([b.centre for b in bodies if isinstance(b, RigidBody)])
+    centres = np.array([b.centre for b in bodies if b.rigid])
     spread = float(np.linalg.norm(np.ptp(centres, axis=0))) if len(centres) else 0.0
     return spread if spread > 0 else 1.0
 
@@ -253,13 +246,11 @@ class Model:
 
     def summary(self) -> dict[str, int | str | float]:
         """The /model attributes of a result file."""
-        beams = [b for b in self.bodies if isinstance(b, Beam)]
-        plates = [b for b in self.bodies if isinstance(b, Plate)]
-        nodes = sum(b.nodes for b in beams) + sum(b.mesh.nnodes for b in plates)
+        nodes = sum(b.mesh_nodes for b in self.bodies)
         return {"ndof": self.ndof, "nfull": self.nfull, "nnodes": nodes,
                 "nelements": sum(s.nel for s in self.sets),
                 "nbodies": len(self.bodies), "nrigid_bodies":
-                    sum(isinstance(b, RigidBody) for b in self.bodies),
+                    sum(b.rigid for b in self.bodies),
                 "nconstraints": len(self.constraints),
                 "nlinear_eliminated": 0 if self.reduction is None else
                     len(self.reduction.relations),
@@ -412,8 +403,9 @@ class Model:
         return self.deflections_at(e, 0.0)
 
     # -- geometry for the result files ---------------------------------------------------------
-    def plate_bodies(self) -> list[Plate]:
-        return [b for b in self.bodies if isinstance(b, Plate)]
+    def plate_bodies(self) -> list[Body]:
+        """The bodies with a mid-surface mesh (plates and leaves)."""
+        return [b for b in self.bodies if b.surface]
 
     def node_positions(self, q_reduced: np.ndarray) -> np.ndarray:
         """Plate and leaf node positions (nt, nnodes, 3) from coordinates (nt, ndof)."""
@@ -508,13 +500,8 @@ class Model:
         for body in self.bodies:
             if body.ncoordinates == 0:   # the ground
                 continue
-            if isinstance(body, RigidBody):
-                nodes = 1
-            elif isinstance(body, Plate):
-                nodes = body.mesh.nnodes
-            elif hasattr(body, "nodes"):   # beams and cables: r and its gradients per node
-                nodes = body.nodes
-            else:
+            nodes = body.nnodes
+            if not nodes:
                 return None
             per_node, rest = divmod(body.ncoordinates, 3 * nodes)
             if rest or per_node not in (2, 3, 4):
@@ -569,7 +556,7 @@ class Model:
     def build_kernel(self) -> None:
         """Hand the system to the kernel (once) and analyse the iteration matrix's pattern."""
         ks = kernel.KernelSystem(self.ndof, self.nfull)
-        for s in self.sets:  # each kind's adder (element_kinds; registered by its family)
+        for s in self.sets:  # each kind's adder (the registry's; declared by its kind)
             add_to_kernel(ks, s)
         ks.set_frames([f.drive for f in self.frames], [f.axis for f in self.frames],
                       [f.base for f in self.frames], [f.pivot for f in self.frames])
@@ -597,7 +584,7 @@ class Model:
         if self.vector_loads:
             ks.set_vector_loads(self.vector_loads)
         if self.force_elements:
-            from .force_elements import kernel_layout
+            from .kinds.force_element import kernel_layout
             ks.set_force_elements(kernel_layout(self.force_elements, self.full_pattern))
         ks.set_constraints(self.constraints.layout())
         for pair in self.contact_pairs:

@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .bodies import Beam, RigidBody
+from .kinds import Beam, Cable, RigidBody
 from .expressions import Scalar
 from .joints import LinearEquation
 
@@ -68,11 +68,6 @@ def check_setting(value) -> str:
     return value
 
 
-def _cable_type():
-    from .cable import Cable
-    return Cable
-
-
 def _along(v: np.ndarray, j: int) -> bool:
     """v is parallel to e_j."""
     v = np.asarray(v, dtype=float)
@@ -89,7 +84,7 @@ def body_plane(body, j: int) -> float | None:
     which is not reduced and refused as such by :func:`planar_problems`)."""
     if isinstance(body, RigidBody):
         return float(body.centre[j])
-    if isinstance(body, (Beam, _cable_type())):
+    if isinstance(body, (Beam, Cable)):
         return float(body.start[j])
     return None
 
@@ -97,7 +92,6 @@ def body_plane(body, j: int) -> float | None:
 def planar_problems(system, j: int, loads=None) -> list[str]:
     """What in ``system`` leaves planes normal to e_j (empty: the motion stays in them).
     ``loads``: the loads to check (default: all of the system's)."""
-    cable = _cable_type()
     out: list[str] = []
     plane = "xyz"[j]
     scale = max([1.0] + [float(np.abs(b.coordinates()).max(initial=0.0))
@@ -112,7 +106,7 @@ def planar_problems(system, j: int, loads=None) -> list[str]:
 
     for body in system.bodies.values():
         where = f"body {body.name!r}"
-        if isinstance(body, (Beam, cable)):
+        if isinstance(body, (Beam, Cable)):
             if abs(float(body.start[j] - body.end[j])) > tol:
                 out.append(f"{where}: its axis leaves the plane normal to {plane}")
                 continue
@@ -204,7 +198,6 @@ def planar_equations(system, j: int, q0: np.ndarray) -> list[LinearEquation]:
     """The coordinates that stay at their initial values in planar motion with normal e_j
     (see the module documentation), as linear equations to eliminate."""
     from .joints import planar_fixes
-    cable = _cable_type()
     others = [k for k in range(3) if k != j]
     out: list[LinearEquation] = []
     for body in system.bodies.values():
@@ -218,7 +211,7 @@ def planar_equations(system, j: int, q0: np.ndarray) -> list[LinearEquation]:
                 for k in others:
                     out.append(_fix(body.node_first(node, normal_director) + k, q0,
                                     f"{tag} {normal_director}"))
-        elif isinstance(body, cable):
+        elif isinstance(body, Cable):
             for node in range(body.nodes):
                 tag = f"{body.name}: planar node {node + 1}"
                 for which in ("r", "r_x"):

@@ -26,6 +26,7 @@ import numpy as np
 from .. import kernel
 from ..codes import SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
 from ..errors import InputError
+from ..io.schema import short_repr
 
 
 def rectangle_torsion_constant(width: float, height: float, terms: int = 50) -> float:
@@ -422,3 +423,47 @@ class General(Section):
 
 SECTIONS = {"rectangle": Rectangle, "box": Box, "tube": Tube, "circle": Circle,
             "general": General}
+
+#: the namelist keys of each section shape (required; then optional ones)
+SECTION_KEYS = {"rectangle": ("width", "height"), "box": ("width", "height", "wall"),
+                "tube": ("diameter", "wall"), "circle": ("diameter",),
+                "general": ("area", "iy", "iz", "torsion_constant", "shear_factor_y",
+                            "shear_factor_z")}
+SECTION_OPTIONAL = {"general": ("mass_per_length", "rotary_inertia", "fibre_points")}
+
+
+def section_of(values: dict, label: str) -> Section | None:
+    """The section of a beam's or cable's values: a Section object as it is (the Python
+    API's; None: the body's default), or the namelist form, the shape's name under
+    ``section`` with its keys (``section='rectangle', width=..., height=...``)."""
+    kind = values.get("section")
+    every = {k for ks in SECTION_KEYS.values() for k in ks} | \
+        {k for ks in SECTION_OPTIONAL.values() for k in ks} | {"shear"}
+    if kind is None or isinstance(kind, Section):
+        given = sorted(k for k in every if values.get(k) is not None)
+        if given:
+            raise InputError(f"{', '.join(given)} describe a section by its keys: give "
+                             "section as its shape's name with them, or a Section object "
+                             "alone", group=label, key="section")
+        return kind
+    if not isinstance(kind, str) or kind not in SECTIONS:
+        raise InputError("expected a section (Rectangle, Box, Tube, Circle or General), got "
+                         f"{short_repr(kind)}", group=label, key="section")
+    keys = SECTION_KEYS[kind]
+    optional = SECTION_OPTIONAL.get(kind, ())
+    missing = [k for k in keys if values.get(k) is None]
+    if missing:
+        raise InputError(f"section {kind!r} needs {', '.join(missing)}")
+    extra = sorted(k for k in every - {"shear"} if k not in keys and k not in optional and
+                   values.get(k) is not None)
+    if extra:
+        raise InputError(f"section {kind!r} does not take {', '.join(extra)}")
+    if kind == "general":
+        if values.get("shear") is not None:
+            raise InputError("section 'general' does not take shear (give shear_factor_y, "
+                             "shear_factor_z)")
+        return SECTIONS[kind](*(values[k] for k in keys),
+                              mass_per_length=values.get("mass_per_length"),
+                              rotary_inertia=values.get("rotary_inertia"),
+                              fibre_points=values.get("fibre_points"))
+    return SECTIONS[kind](*(values[k] for k in keys), shear=values.get("shear") or "unit")

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bodies import Attachment, Beam
+from .bodies import Attachment
+from .kinds import Beam
 from .expressions import Vec3
 
 #: what the support deflection is (the HDF5 attribute 'reference' of deflection_support)

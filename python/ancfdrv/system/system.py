@@ -23,6 +23,7 @@ Example (a cantilever with a tip mass)::
 """
 from __future__ import annotations
 
+import copy
 import re
 from typing import Any, Callable, Iterable
 
@@ -30,18 +31,19 @@ import numpy as np
 
 from ..errors import InputError
 from ..io import validate
-from ..io.schema import (EFFECTS_AVAILABLE, check_call, coerce, plain_value, short_repr,
-                         title_problem)
-from .bodies import Beam, Body, Ground, Leaf, Material, Plate, RigidBody
-from .cable import Cable
+from ..io.schema import (EFFECTS_AVAILABLE, REQUIRED, check_call, plain_value,
+                         short_repr, title_problem)
+from . import kinds as _kinds  # noqa: F401  (registers the kinds)
+from .bodies import Body, Ground, Material, points_of
 from .contact import ContactPair
 from .drives import DRIVE_TYPES, Drive, Table
 from .ffr_checks import ffr_speed_warnings
-from .force_elements import FORCE_ELEMENT_PARAMETERS, ForceElement
+from .kinds.force_element import ForceElement
 from .joints import Joint
 from .loads import LOAD_TYPES, Load
 from .probes import Probe
 from .planar import check_setting as check_planar
+from .registry import kind, kind_of, kinds
 from .sections import Section
 
 #: effects an item may belong to, with the default of each load type (SPEC section 8)
@@ -78,23 +80,6 @@ def _api(method):
             raise InputError("not enough memory to build this item: use a coarser mesh",
                              group=method.__name__) from None
     return call
-
-
-def _section(section, label: str) -> Section | None:
-    """The section of a beam or cable call (InputError naming the key for anything else)."""
-    if section is not None and not isinstance(section, Section):
-        raise InputError("expected a section (Rectangle, Box, Tube, Circle or General), got "
-                         f"{short_repr(section)}", group=label, key="section")
-    return section
-
-
-def _points(value) -> list[np.ndarray]:
-    """One point (3 numbers) or several (a multiple of 3)."""
-    a = np.asarray(value, dtype=float).ravel()
-    if a.size == 0 or a.size % 3:
-        raise ValueError(f"expected x,y,z (or several points: a multiple of 3 numbers), got "
-                         f"{a.size} numbers")
-    return [a[i:i + 3].copy() for i in range(0, a.size, 3)]
 
 
 class System:
@@ -190,93 +175,96 @@ class System:
         self.bodies[body.name] = body
         return body
 
+    def add(self, group: str, **values: Any) -> Any:
+        """One item of a registered kind (:mod:`.registry`; 'beam', 'cable', 'plate',
+        'leaf', 'rigid_body', 'force_element'): the keys of its namelist group (docs/scenes.md,
+        the defaults of the omitted ones) checked with the namelist's rules and messages, the
+        item built and added. ``System.beam(...)`` is ``System.add('beam', ...)`` with the
+        section as a Section object or as the namelist's keys (``section='box', width=...``)."""
+        found = kind(group) if isinstance(group, str) else None
+        if found is None:
+            raise InputError(f"add: unknown group {short_repr(group)} (groups: "
+                             f"{', '.join(k.group for k in kinds())})")
+        name = values.get("name")
+        label = f"{found.api}[{name}]" if isinstance(name, str) and name else found.api
+        unknown = sorted(set(values) - set(found.keys) - set(found.api_keys))
+        if unknown:
+            raise InputError(f"unknown key {', '.join(map(repr, unknown))} (the keys of "
+                             f"&{group}: {', '.join(found.keys)})", group=label)
+        missing = [k for k, key in found.keys.items() if key.default is REQUIRED and
+                   values.get(k) is None and k not in found.scene_defaults]
+        if missing:
+            raise InputError(f"{', '.join(missing)} {'is' if len(missing) == 1 else 'are'} "
+                             "required", group=label)
+        # (a key the API may give as an object, e.g. a section, keeps the body's own default)
+        given = {k: copy.copy(key.default) for k, key in found.keys.items()
+                 if key.default is not REQUIRED and k not in found.objects}
+        given.update(values)
+        try:
+            return found.build(self, given)
+        except (TypeError, ValueError, ZeroDivisionError, OverflowError,
+                FloatingPointError) as exc:
+            text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise InputError(f"{text[:200]}", group=label) from None
+        except MemoryError:
+            raise InputError("not enough memory to build this item: use a coarser mesh",
+                             group=found.api) from None
+
     @_api
     def beam(self, name: str, *, material: str | Material, start, end, nodes: int,
              section: Section | None = None, height_axis=None, formulation: str = "ffr",
              bending: str = "continuum", segments=None, frame_drive: str | Drive | None = None,
              frame_axis=(0.0, 0.0, 1.0), frame_pivot=None,
-             geometric_stiffness: bool = False, modes: int = 0) -> Beam:
-        """An ANCF beam (:class:`~.bodies.Beam`); ``geometric_stiffness=True`` gives an 'ffr'
-        beam the geometric stiffness of its current axial force (P-delta); ``modes=N`` (N > 0)
-        runs its dynamics as the modal reduction with N modes (``&beam modes``)."""
-        name = self._body_name(name)
-        where = f"beam {name!r}"
-        v = check_call("beam", f"beam[{name}]", dict(
-            start=start, end=end, nodes=nodes, segments=segments, height_axis=height_axis,
-            formulation=formulation, bending=bending, frame_axis=frame_axis,
-            frame_pivot=frame_pivot, geometric_stiffness=geometric_stiffness, modes=modes))
-        nodes = v["nodes"]
-        self._check_size(validate.Part(f"beam[{name}]", "nodes", "beam", nodes, 12))
-        return self._add_body(Beam(name, self._material(material, where), start, end, nodes,
-                                   _section(section, f"beam[{name}]"), height_axis=height_axis, formulation=formulation,
-                                   bending=bending, segments=segments,
-                                   frame_drive=self._drive(frame_drive, where),
-                                   frame_axis=frame_axis, frame_pivot=frame_pivot,
-                                   geometric_stiffness=v["geometric_stiffness"],
-                                   modes=v["modes"]))
+             geometric_stiffness: bool = False, modes: int = 0) -> Body:
+        """An ANCF beam (:class:`~.kinds.beam.Beam`); ``geometric_stiffness=True`` gives an
+        'ffr' beam the geometric stiffness of its current axial force (P-delta); ``modes=N``
+        (N > 0) runs its dynamics as the modal reduction with N modes (``&beam modes``)."""
+        return self.add("beam", name=name, material=material, start=start, end=end,
+                        nodes=nodes, section=section, height_axis=height_axis,
+                        formulation=formulation, bending=bending, segments=segments,
+                        frame_drive=frame_drive, frame_axis=frame_axis,
+                        frame_pivot=frame_pivot, geometric_stiffness=geometric_stiffness,
+                        modes=modes)
 
     @_api
     def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
               section: Section | None = None, tension_only: bool = False,
               bending_stiffness: float | None = None, segments=None,
-              bending_inertia: float | None = None) -> Cable:
-        """An ANCF cable (:class:`~.cable.Cable`: r and r_x per node, Euler-Bernoulli).
+              bending_inertia: float | None = None) -> Body:
+        """An ANCF cable (:class:`~.kinds.cable.Cable`: r and r_x per node, Euler-Bernoulli).
         ``tension_only=True`` makes it a rope that goes slack instead of carrying
         compression; ``bending_stiffness`` (N m^2) replaces E times the section's I;
         ``segments``: lengths between fixed nodes, each split equally (as a beam's);
         ``bending_inertia`` (m^4): the inertia of a section with I_y != I_z about the axis a
         cable kept in a plane bends about (the system must then be planar)."""
-        name = self._body_name(name)
-        return self._add_body(Cable(name, self._material(material, f"cable {name!r}"), start,
-                                    end, nodes, _section(section, f"cable[{name}]"),
-                                    tension_only=tension_only,
-                                    bending_stiffness=bending_stiffness, segments=segments,
-                                    bending_inertia=bending_inertia))
+        return self.add("cable", name=name, material=material, start=start, end=end,
+                        nodes=nodes, section=section, tension_only=tension_only,
+                        bending_stiffness=bending_stiffness, segments=segments,
+                        bending_inertia=bending_inertia)
 
     @_api
     def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,
-              edge_y, nx: int, ny: int, variant: str = "completed") -> Plate:
-        """A flat thin plate (:class:`~.bodies.Plate`)."""
-        name = self._body_name(name)
-        v = check_call("plate", f"plate[{name}]", dict(
-            thickness=thickness, corner=corner, edge_x=edge_x, edge_y=edge_y, nx=nx, ny=ny,
-            variant=variant))
-        thickness, nx, ny = v["thickness"], v["nx"], v["ny"]
-        self._check_size(validate.Part(f"plate[{name}]", "nx", "plate", (nx + 1) * (ny + 1), 9))
-        return self._add_body(Plate(name, self._material(material, f"plate {name!r}"),
-                                    thickness, corner, edge_x, edge_y, nx, ny, variant=variant))
+              edge_y, nx: int, ny: int, variant: str = "completed") -> Body:
+        """A flat thin plate (:class:`~.kinds.plate.Plate`)."""
+        return self.add("plate", name=name, material=material, thickness=thickness,
+                        corner=corner, edge_x=edge_x, edge_y=edge_y, nx=nx, ny=ny,
+                        variant=variant)
 
     @_api
     def leaf(self, name: str, *, material: str | Material, thickness: float, width: float,
              arc_length: float, radius: float, centre, nx: int, ny: int,
-             variant: str = "completed", free_radius: float | None = None) -> Leaf:
-        """A curved leaf (:class:`~.bodies.Leaf`)."""
-        name = self._body_name(name)
-        v = check_call("leaf", f"leaf[{name}]", dict(
-            thickness=thickness, width=width, arc_length=arc_length, radius=radius,
-            centre=centre, nx=nx, ny=ny, variant=variant, free_radius=free_radius))
-        thickness, width, arc_length, radius = (v["thickness"], v["width"], v["arc_length"],
-                                                v["radius"])
-        nx, ny, free_radius = v["nx"], v["ny"], v["free_radius"]
-        self._check_size(validate.Part(f"leaf[{name}]", "nx", "leaf", (nx + 1) * (ny + 1), 9))
-        return self._add_body(Leaf(name, self._material(material, f"leaf {name!r}"), thickness,
-                                   width, arc_length, radius, centre, nx, ny, variant=variant,
-                                   free_radius=free_radius))
+             variant: str = "completed", free_radius: float | None = None) -> Body:
+        """A curved leaf (:class:`~.kinds.plate.Leaf`)."""
+        return self.add("leaf", name=name, material=material, thickness=thickness, width=width,
+                        arc_length=arc_length, radius=radius, centre=centre, nx=nx, ny=ny,
+                        variant=variant, free_radius=free_radius)
 
     @_api
     def rigid_body(self, name: str, *, mass: float, inertia, position, planar: bool = False,
-                   plane_normal=(0.0, 1.0, 0.0)) -> RigidBody:
-        """A rigid body as an ANCF reference node (:class:`~.bodies.RigidBody`)."""
-        name = self._body_name(name)
-        flat = plain_value(inertia)
-        v = check_call("rigid_body", f"rigid_body[{name}]", dict(
-            mass=mass, position=position, planar=planar, plane_normal=plane_normal,
-            inertia=inertia if not (isinstance(flat, list) and len(flat) == 9) else None))
-        if isinstance(flat, list) and len(flat) == 9:  # a 3 x 3 tensor: finite numbers
-            coerce("floats", flat, dict(group=f"rigid_body[{name}]", key="inertia"))
-        mass, planar = v["mass"], v["planar"]
-        return self._add_body(RigidBody(name, mass, inertia, position, planar=planar,
-                                        plane_normal=plane_normal))
+                   plane_normal=(0.0, 1.0, 0.0)) -> Body:
+        """A rigid body as an ANCF reference node (:class:`~.kinds.rigid_body.RigidBody`)."""
+        return self.add("rigid_body", name=name, mass=mass, inertia=inertia,
+                        position=position, planar=planar, plane_normal=plane_normal)
 
     def _body_name(self, name: str) -> str:
         if name == "ground":
@@ -290,18 +278,10 @@ class System:
                                  "static")
 
     def _parts(self) -> "list[validate.Part]":
-        parts = []
-        for body in self.bodies.values():
-            if isinstance(body, Beam):
-                parts.append(validate.Part(f"beam[{body.name}]", "nodes", "beam", body.nodes, 12))
-            elif isinstance(body, Plate):
-                kind = "leaf" if isinstance(body, Leaf) else "plate"
-                parts.append(validate.Part(f"{kind}[{body.name}]", "nx", kind,
-                                           body.mesh.nnodes, 9))
-            elif isinstance(body, RigidBody):
-                parts.append(validate.Part(f"rigid_body[{body.name}]", "mass", "rigid_body",
-                                           1, 12))
-        return parts
+        """The bodies' shares of the memory estimate (each kind's)."""
+        kinds_of = [(kind_of(body), body) for body in self.bodies.values()]
+        return [found.part(body) for found, body in kinds_of
+                if found is not None and found.part is not None]
 
     @_api
     def drive(self, name: str, type: str, **params) -> Drive:
@@ -356,10 +336,10 @@ class System:
             point=point, axis=axis, point1=point1, point2=point2, pivot=pivot, axis2=axis2))
         axis = v["axis"]
         try:
-            points = [] if point is None else _points(point)
-            p1 = None if point1 is None else _points(point1)[0]
-            p2 = None if point2 is None else _points(point2)[0]
-            pv = None if pivot is None else _points(pivot)[0]
+            points = [] if point is None else points_of(point)
+            p1 = None if point1 is None else points_of(point1)[0]
+            p2 = None if point2 is None else points_of(point2)[0]
+            pv = None if pivot is None else points_of(pivot)[0]
         except ValueError as exc:
             raise InputError(f"{where}: {exc}") from None
         joint = Joint(name, type, self.body(body1, used_by=where), self.body(body2, used_by=where),
@@ -448,7 +428,7 @@ class System:
                       interpolation: str | None = None,
                       drive: str | Drive | None = None) -> ForceElement:
         """A force element between body1 and body2 (either may be 'ground'; points are any
-        material points of the bodies), ``ancfdrv.system.force_elements``:
+        material points of the bodies), ``ancfdrv.system.kinds.force_element``:
 
         - ``'spring_damper'``: point1, point2; stiffness (N/m), damping (N s/m), free_length
           (m; default the distance at t = 0), preload (N at the free length, tension
@@ -461,85 +441,12 @@ class System:
           damping of the oil column in series: f = k (L - l) + c (L' - l').
 
         Its reaction (force, moment, axial) is recorded under its name with the joints'."""
-        name = self._new_name(name, self.force_elements, "force element")
-        where = f"force element {name!r}"
-        if name in self.joints:
-            raise InputError(f"{where}: a joint has that name (reactions are stored by name)")
-        if not isinstance(type, str) or type not in FORCE_ELEMENT_PARAMETERS:
-            raise InputError(f"{where}: type {short_repr(type)} must be one of "
-                             f"{', '.join(FORCE_ELEMENT_PARAMETERS)}")
-        if body2 is None:
-            raise InputError(f"{where}: body2 is required")
-        v = check_call("force_element", f"force_element[{name}]", dict(
-            point1=point1, point2=point2, point=point, stiffness=stiffness, damping=damping,
-            rotational_stiffness=rotational_stiffness, rotational_damping=rotational_damping,
-            free_length=free_length, preload=preload, deflections=deflections, forces=forces,
-            interpolation=interpolation))
-        required, optional = FORCE_ELEMENT_PARAMETERS[type]
-        given = {k: v[k] for k in ("point1", "point2", "point", "stiffness", "damping",
-                                   "rotational_stiffness", "rotational_damping",
-                                   "free_length", "preload", "deflections", "forces",
-                                   "interpolation")}
-        given["drive"] = drive
-        missing = [k for k in required if given[k] is None]
-        if type == "spring_damper" and given["stiffness"] is None and given["forces"] is None:
-            missing.append("stiffness (or deflections and forces)")
-        if missing:
-            raise InputError(f"{where}: type {type!r} needs {', '.join(missing)}")
-        extra = [k for k, x in given.items() if x is not None and k not in required + optional]
-        if extra:
-            raise InputError(f"{where}: type {type!r} does not take {', '.join(extra)}")
-        size = 3 if type == "bushing" else 1
-
-        def values(key: str) -> np.ndarray:
-            x = given.get(key)
-            if x is None:
-                return np.zeros(size)
-            x = np.asarray(x, dtype=float).ravel()
-            if x.size != size:
-                raise InputError(f"{where}: {key} takes {size} value{'s' * (size > 1)} for "
-                                 f"type {type!r}, got {x.size}")
-            return x
-        first, second = self.body(body1, used_by=where), self.body(body2, used_by=where)
-        if first is second:
-            raise InputError(f"{where}: body1 and body2 are the same body")
-        table = None
-        if given["deflections"] is not None or given["forces"] is not None:
-            if given["stiffness"] is not None or given["preload"] is not None:
-                raise InputError(f"{where}: a force-deflection table replaces stiffness and "
-                                 "preload: give one or the other")
-            if given["deflections"] is None or given["forces"] is None:
-                raise InputError(f"{where}: a force-deflection table needs deflections and "
-                                 "forces")
-            table = Table(f"{name} (force table)", tuple(given["deflections"]),
-                          tuple(given["forces"]), interpolation or "linear")
-            try:
-                table.check()
-            except InputError as exc:
-                raise InputError(f"{where}: {str(exc).split(': ', 1)[-1]}".replace(
-                    "times", "deflections")) from None
-        elif interpolation is not None:
-            raise InputError(f"{where}: interpolation applies to a force-deflection table")
-        if type == "bushing":
-            p1 = p2 = _points(given["point"])[0]
-        else:
-            p1, p2 = _points(given["point1"])[0], _points(given["point2"])[0]
-        at1 = first.locate(p1, node=False, what=where)   # material points of the bodies
-        at2 = second.locate(p2, node=False, what=where)
-        if type == "bushing":
-            for body, at in ((first, at1), (second, at2)):
-                if len(body.basis(at)) != 3:
-                    raise InputError(f"{where}: a bushing needs three direction vectors at "
-                                     f"its point; {body.__class__.__name__.lower()} "
-                                     f"{body.name!r} carries {len(body.basis(at))} (use a "
-                                     "beam, a rigid body or the ground)")
-        fe = ForceElement(name, type, first, second, p1, p2, values("stiffness"),
-                          values("damping"), values("rotational_stiffness"),
-                          values("rotational_damping"), given["free_length"],
-                          float(given["preload"] or 0.0), table,
-                          self._drive(drive, where) if type == "cylinder" else None)
-        self.force_elements[name] = fe
-        return fe
+        return self.add("force_element", name=name, type=type, body1=body1, body2=body2,
+                        point1=point1, point2=point2, point=point, stiffness=stiffness,
+                        damping=damping, rotational_stiffness=rotational_stiffness,
+                        rotational_damping=rotational_damping, free_length=free_length,
+                        preload=preload, deflections=deflections, forces=forces,
+                        interpolation=interpolation, drive=drive)
 
     @_api
     def probe(self, name: str, body: str | Body, point) -> Probe:
@@ -551,7 +458,7 @@ class System:
         if isinstance(target, Ground):
             raise InputError(f"{where}: the ground does not move")
         try:
-            p = _points(point)
+            p = points_of(point)
         except ValueError as exc:
             raise InputError(f"{where}: {exc}") from None
         target.locate(p[0], node=False, what=where)
@@ -597,21 +504,10 @@ class System:
     @staticmethod
     def _check_dimensions(body: Body) -> None:
         """A flexible body's size and section within the physical minima
-        (``validate.PHYSICAL_MINIMA``: 'length', 'section')."""
-        word = "plate" if isinstance(body, Plate) and not isinstance(body, Leaf) else \
-            type(body).__name__.lower()
-        where = f"{word} {body.name!r}"
-        if isinstance(body, (Beam, Cable)):
-            validate.check_minimum("length", body.length, f"{where}: length", key="end")
-            validate.check_minimum("section", float(np.sqrt(body.section.area)),
-                                   f"{where}: the side of a square of its section's area",
-                                   key="section")
-        elif isinstance(body, Plate):
-            extent = float(np.ptp(body.mesh.coords[:, :3], axis=0).max())
-            validate.check_minimum("length", extent, f"{where}: the largest extent",
-                                   key="edge_x" if word == "plate" else "arc_length")
-            validate.check_minimum("section", body.thickness, f"{where}: thickness",
-                                   key="thickness")
+        (``validate.PHYSICAL_MINIMA``: 'length', 'section'; each kind's check)."""
+        found = kind_of(body)
+        if found is not None and found.check_dimensions is not None:
+            found.check_dimensions(body)
 
     def check_effects_used(self, effects: Iterable[str]) -> None:
         """Every effect listed is one an item of the system belongs to (an effect that
@@ -634,8 +530,10 @@ class System:
             out.add("contact")
             if any(c.friction > 0 for c in self.contacts.values()):
                 out.add("friction")
-        if any(isinstance(b, Leaf) and b.prestressed for b in self.bodies.values()):
-            out.add("prestress")
+        for body in self.bodies.values():
+            found = kind_of(body)
+            if found is not None and found.effects is not None:
+                out |= found.effects(body)
         return out
 
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",

@@ -42,11 +42,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import kernel
-from ..errors import InputError
-from .bodies import Body
-from .drives import Drive, Table
-from .expressions import Vec3, combination
+from ... import kernel
+from ...errors import InputError
+from ...io.schema import Key, name_key, non_negative, one_of, positive, short_repr, vector3
+from ..bodies import Body, points_of
+from ..drives import Drive, Table
+from ..expressions import Vec3, combination
+from ..registry import Kind, checked_values, register
 
 #: kinds of the kernel module force_elements (fe_*)
 FE_SPRING_DAMPER, FE_BUSHING, FE_CYLINDER = 1, 2, 3
@@ -250,3 +252,128 @@ def evaluate(info: ForceElementInfo, x: np.ndarray, xd: np.ndarray | None = None
 __all__ = ["ForceElement", "ForceElementInfo", "FORCE_ELEMENT_KINDS", "FORCE_ELEMENT_PARAMETERS",
            "FORCE_ELEMENT_MEANING",
            "assemble_force_elements", "kernel_layout", "slot_values", "evaluate"]
+
+
+KEYS: dict[str, Key] = {
+    "name": name_key(),
+    "type": Key("str", check=one_of("spring_damper", "bushing", "cylinder"),
+                doc="'spring_damper' (along the line point1-point2), 'bushing' (6 diagonal "
+                "stiffnesses and dampings at point), 'cylinder' (a driven length with "
+                "oil-column stiffness and damping in series)"),
+    "body1": Key("str", "ground", doc="first body (or 'ground')"),
+    "body2": Key("str", doc="second body (or 'ground')"),
+    "point1": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body1 (m)"),
+    "point2": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body2 (m)"),
+    "point": Key("floats", None, vector3, "'bushing': the point on both bodies (m)"),
+    "stiffness": Key("floats", None, non_negative, "stiffness (N/m): one value; a "
+                     "'bushing' three, along body1's axes at the point; 0 or within "
+                     "[1e-3, 1e12] N/m (scene.bounds: a softer spring carries nothing a "
+                     "structure weighs, a stiffer one is a joint)"),
+    "damping": Key("floats", None, non_negative, "damping (N s/m): one value; a 'bushing' "
+                   "three (default 0; at most 1e10, scene.bounds)"),
+    "rotational_stiffness": Key("floats", None, non_negative, "'bushing': stiffness about "
+                                "body1's three axes (N m/rad; default 0; 0 or within "
+                                "[1e-6, 1e12], scene.bounds)"),
+    "rotational_damping": Key("floats", None, non_negative, "'bushing': damping about "
+                              "body1's three axes (N m s/rad; default 0; at most 1e10, "
+                              "scene.bounds)"),
+    "free_length": Key("float", None, positive, "'spring_damper': length at which the "
+                       "force is the preload (m; default: the distance at t = 0)"),
+    "preload": Key("float", None, doc="'spring_damper': force at the free length (N, "
+                   "tension positive; default 0)"),
+    "deflections": Key("floats", None, doc="'spring_damper' instead of stiffness and "
+                       "preload: a force-deflection table's deflections L - free_length "
+                       "(m, increasing)"),
+    "forces": Key("floats", None, doc="'spring_damper': the table's forces (N, tension "
+                  "positive; constant beyond the ends)"),
+    "interpolation": Key("str", None, one_of("linear", "cubic", "pchip"),
+                         "'spring_damper': the table's interpolation, as a drive table's "
+                         "(default 'linear')"),
+    "drive": Key("str", None, doc="'cylinder': the drive of the nominal length l(t) (m)"),
+}
+
+
+def build(system, v: dict) -> ForceElement:
+    """A force element from the values of ``System.add('force_element', ...)``."""
+    type = v["type"]
+    name = system._new_name(v["name"], system.force_elements, "force element")
+    where = f"force element {name!r}"
+    if name in system.joints:
+        raise InputError(f"{where}: a joint has that name (reactions are stored by name)")
+    if not isinstance(type, str) or type not in FORCE_ELEMENT_PARAMETERS:
+        raise InputError(f"{where}: type {short_repr(type)} must be one of "
+                         f"{', '.join(FORCE_ELEMENT_PARAMETERS)}")
+    if v["body2"] is None:
+        raise InputError(f"{where}: body2 is required")
+    v = checked_values(KIND, f"force_element[{name}]", v)
+    required, optional = FORCE_ELEMENT_PARAMETERS[type]
+    given = {k: v[k] for k in ("point1", "point2", "point", "stiffness", "damping",
+                               "rotational_stiffness", "rotational_damping",
+                               "free_length", "preload", "deflections", "forces",
+                               "interpolation")}
+    given["drive"] = v["drive"]
+    missing = [k for k in required if given[k] is None]
+    if type == "spring_damper" and given["stiffness"] is None and given["forces"] is None:
+        missing.append("stiffness (or deflections and forces)")
+    if missing:
+        raise InputError(f"{where}: type {type!r} needs {', '.join(missing)}")
+    extra = [k for k, x in given.items() if x is not None and k not in required + optional]
+    if extra:
+        raise InputError(f"{where}: type {type!r} does not take {', '.join(extra)}")
+    size = 3 if type == "bushing" else 1
+
+    def values(key: str) -> np.ndarray:
+        x = given.get(key)
+        if x is None:
+            return np.zeros(size)
+        x = np.asarray(x, dtype=float).ravel()
+        if x.size != size:
+            raise InputError(f"{where}: {key} takes {size} value{'s' * (size > 1)} for "
+                             f"type {type!r}, got {x.size}")
+        return x
+    first, second = system.body(v["body1"], used_by=where), system.body(v["body2"], used_by=where)
+    if first is second:
+        raise InputError(f"{where}: body1 and body2 are the same body")
+    table = None
+    if given["deflections"] is not None or given["forces"] is not None:
+        if given["stiffness"] is not None or given["preload"] is not None:
+            raise InputError(f"{where}: a force-deflection table replaces stiffness and "
+                             "preload: give one or the other")
+        if given["deflections"] is None or given["forces"] is None:
+            raise InputError(f"{where}: a force-deflection table needs deflections and "
+                             "forces")
+        table = Table(f"{name} (force table)", tuple(given["deflections"]),
+                      tuple(given["forces"]), v["interpolation"] or "linear")
+        try:
+            table.check()
+        except InputError as exc:
+            raise InputError(f"{where}: {str(exc).split(': ', 1)[-1]}".replace(
+                "times", "deflections")) from None
+    elif v["interpolation"] is not None:
+        raise InputError(f"{where}: interpolation applies to a force-deflection table")
+    if type == "bushing":
+        p1 = p2 = points_of(given["point"])[0]
+    else:
+        p1, p2 = points_of(given["point1"])[0], points_of(given["point2"])[0]
+    at1 = first.locate(p1, node=False, what=where)   # material points of the bodies
+    at2 = second.locate(p2, node=False, what=where)
+    if type == "bushing":
+        for body, at in ((first, at1), (second, at2)):
+            if len(body.basis(at)) != 3:
+                raise InputError(f"{where}: a bushing needs three direction vectors at "
+                                 f"its point; {body.__class__.__name__.lower()} "
+                                 f"{body.name!r} carries {len(body.basis(at))} (use a "
+                                 "beam, a rigid body or the ground)")
+    fe = ForceElement(name, type, first, second, p1, p2, values("stiffness"),
+                      values("damping"), values("rotational_stiffness"),
+                      values("rotational_damping"), given["free_length"],
+                      float(given["preload"] or 0.0), table,
+                      system._drive(v["drive"], where) if type == "cylinder" else None)
+    system.force_elements[name] = fe
+    return fe
+
+
+KIND = register(Kind(
+    group="force_element", body_class=ForceElement, keys=KEYS, build=build,
+    api="force_element", table="force_elements", word="force element",
+    objects=("body1", "body2", "drive")))

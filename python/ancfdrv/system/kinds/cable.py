@@ -4,7 +4,7 @@ ANCFCable). Per node the position r and the slope r_x (6 coordinates, half a bea
 12): axial strain (r'.r' - 1)/2 and the exact curvature |r' x r''| / |r'|^3 with the
 section's EA and EI; no shear, no torsion, no section frame. The element family's whole
 Python side: the body, its set builder and kernel adder (registered in
-:mod:`.element_kinds`).
+:mod:`..registry`).
 
 Joints act on nodes: a 'weld' holds r and r_x (a clamp), 'spherical' the position, 'fix'
 one nodal vector ('r' or 'r_x'). Loads and probes act at any point of the axis. Material
@@ -22,13 +22,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import kernel
-from ..errors import InputError
-from .bodies import Attachment, Beam, Body, Material, _vec, linspace
-from .element_kinds import SetContext, register_body, register_set
-from .expressions import Vec3
-from .model import SetInfo
-from .sections import Rectangle, Section
+from ... import kernel
+from ...errors import InputError
+from ...io.schema import Key, at_least, name_key, non_negative, one_of, positive, vector3
+from ..bodies import Attachment, Body, Material, _vec, axis_stations, check_axis_dimensions
+from ..expressions import Vec3
+from ..model import SetInfo
+from ..registry import Kind, SetContext, checked_values, register
+from ..sections import Rectangle, Section, section_of
 
 CABLE_NODE_DOFS = 6
 #: offsets of the nodal vectors within a node's coordinates
@@ -45,6 +46,14 @@ class Cable(Body):
     I (a rope's effective bending stiffness)."""
 
     flexible = True
+
+    @property
+    def nnodes(self) -> int:
+        return self.nodes
+
+    @property
+    def extent(self) -> float:
+        return self.length
 
     def __init__(self, name: str, material: Material, start, end, nodes: int,
                  section: Section | None = None, segments=None, *,
@@ -89,8 +98,7 @@ class Cable(Body):
         self._bending_stiffness = None if bending_stiffness is None else float(bending_stiffness)
         self.tangent = axis / self.length
         # segments: lengths between fixed nodes, each split equally (as a beam's)
-        self.stations = linspace(0.0, self.length, self.nodes) if segments is None else \
-            Beam._stations(self, segments, where)
+        self.stations = axis_stations(self.length, self.nodes, segments, where)
         self.lengths = self.stations[1:] - self.stations[:-1]   # (np.diff's values)
 
     # -- geometry ---------------------------------------------------------------------------
@@ -232,5 +240,48 @@ def _add_cable(ks: kernel.KernelSystem, s: SetInfo) -> int:
                             s.body.bending_stiffness, s.damping_time, s.body.tension_only)
 
 
-register_body(Cable, cable_set)
-register_set("cable", _add_cable)
+KEYS: dict[str, Key] = {
+    "name": name_key(),
+    "material": Key("str", doc="name of a &material"),
+    "start": Key("floats", check=vector3, doc="start of the axis (m)"),
+    "end": Key("floats", check=vector3, doc="end of the axis (m)"),
+    "nodes": Key("int", check=at_least(2), doc="nodes on the cable (>= 2)"),
+    "segments": Key("floats", None, doc="segment lengths between fixed nodes (m), each "
+                    "split into equal elements (as a beam's; nodes = k j + 1 for k "
+                    "segments)"),
+    "section": Key("str", "circle", one_of("rectangle", "box", "tube", "circle"),
+                   "cross-section (its area and bending inertia; I_y = I_z required): "
+                   "'circle' (diameter), 'tube' (diameter, wall), a square 'rectangle' "
+                   "or 'box'"),
+    "width": Key("float", None, positive, "section width (m)"),
+    "height": Key("float", None, positive, "section height (m)"),
+    "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
+    "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+    "tension_only": Key("bool", False, doc="a rope: the axial force is never "
+                        "compressive (the cable goes slack); with the effect 'damping' "
+                        "its axial damping acts in tension only"),
+    "bending_stiffness": Key("float", None, non_negative, "EI (N m^2) in place of E "
+                             "times the section's I (a rope's effective bending "
+                             "stiffness; 0 only in dynamics)"),
+}
+
+
+def build(system, v: dict) -> Cable:
+    """A cable from the values of ``System.add('cable', ...)`` (besides the namelist's
+    keys the API's ``bending_inertia``)."""
+    section = section_of(v, f"cable[{v['name']}]")
+    name = system._body_name(v["name"])
+    v = checked_values(KIND, f"cable[{name}]", v)
+    return system._add_body(Cable(name, system._material(v["material"], f"cable {name!r}"),
+                                  v["start"], v["end"], v["nodes"], section,
+                                  tension_only=v["tension_only"],
+                                  bending_stiffness=v["bending_stiffness"],
+                                  segments=v["segments"],
+                                  bending_inertia=v.get("bending_inertia")))
+
+
+KIND = register(Kind(
+    group="cable", body_class=Cable, keys=KEYS, build=build, api="cable", word="cable",
+    api_keys=("bending_inertia",), objects=("material", "section"), set_builder=cable_set,
+    adders={"cable": _add_cable},
+    check_dimensions=lambda body: check_axis_dimensions(body, "cable")))

@@ -1,0 +1,368 @@
+"""The beam kind: ANCF beams (floating-frame 'ffr' or large-deformation 'nonlinear',
+bending 'continuum' or 'cubic'), the namelist group &beam and ``System.beam``. The kind's
+whole Python side: the body, its keys, its element sets (kernel set kinds 'ffr',
+'continuum', 'cubic') and their kernel adders, its registration (:mod:`..registry`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ... import kernel
+from ...errors import InputError
+from ...io import validate
+from ...io.schema import (GEOMETRIC_STIFFNESS_DOC, MODES_DOC, Key, at_least, name_key,
+                          non_negative, one_of,
+                          positive, vector3)
+from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, axis_stations,
+                      check_axis_dimensions)
+from ..expressions import Vec3
+from ..model import SetInfo
+from ..registry import Kind, SetContext, checked_values, register
+from ..sections import Rectangle, Section, section_of
+
+BEAM_NODE_DOFS = 12
+FORMULATIONS = ("ffr", "nonlinear")
+BENDING = ("continuum", "cubic")
+
+
+class Beam(Body):
+    """A straight ANCF beam from ``start`` to ``end`` with ``nodes`` nodes (equally spaced, or
+    equally within each of ``segments``, whose lengths add up to the beam's), section
+    height along ``height_axis`` (default global z; y for a beam along z), formulation
+    'ffr' (small strain in a floating frame) or 'nonlinear' (large deformation), bending
+    'continuum' or 'cubic'. Its frame is the body frame (axis, height, width directions) at
+    t = 0, turned by ``frame_drive`` about ``frame_axis`` through ``frame_pivot`` (default:
+    the start) when given: for 'ffr' the elastic model lives in it, for either formulation
+    probe deflections are resolved in it. ``geometric_stiffness`` (for 'ffr'): the
+    geometric stiffness of the current axial force (P-delta, docs/theory.md, 'FFR geometric stiffness').
+    ``modes`` (for 'ffr', dynamic runs): 0 integrates every coordinate, N > 0 the modal
+    reduction with N modes (:mod:`ancfdrv.solvers.ffr_reduced`)."""
+
+    flexible = True
+    response_component = 1
+
+    @property
+    def nnodes(self) -> int:
+        return self.nodes
+
+    @property
+    def mesh_nodes(self) -> int:
+        return self.nodes
+
+    @property
+    def extent(self) -> float:
+        return self.length
+
+    def __init__(self, name: str, material: Material, start, end, nodes: int,
+                 section: Section | None = None, *, height_axis=None, formulation: str = "ffr",
+                 bending: str = "continuum", segments=None, frame_drive=None,
+                 frame_axis=(0.0, 0.0, 1.0), frame_pivot=None,
+                 geometric_stiffness: bool = False, modes: int = 0) -> None:
+        self.name = name
+        self.geometric_stiffness = bool(geometric_stiffness)
+        if not isinstance(modes, (int, np.integer)) or isinstance(modes, bool) or modes < 0:
+            raise InputError(f"beam {name!r}: modes = {modes!r} must be an integer >= 0")
+        self.modes = int(modes)
+        where = f"beam {name!r}"
+        self.material = material
+        self.start, self.end = _vec(start, "start", where), _vec(end, "end", where)
+        axis = self.end - self.start
+        self.length = float(np.linalg.norm(axis))
+        if self.length <= 0.0:
+            raise InputError(f"{where}: start and end coincide")
+        if not isinstance(nodes, (int, np.integer)) or nodes < 2:
+            raise InputError(f"{where}: nodes = {nodes!r} must be an integer >= 2")
+        if formulation not in FORMULATIONS:
+            raise InputError(f"{where}: formulation {formulation!r} must be one of {FORMULATIONS}")
+        if bending not in BENDING:
+            raise InputError(f"{where}: bending {bending!r} must be one of {BENDING}")
+        self.nodes, self.formulation, self.bending = int(nodes), formulation, bending
+        self.section = section if section is not None else Rectangle(0.1, 0.1)
+        self.section.data  # validates the dimensions now  # noqa: B018
+        tangent = axis / self.length
+        if height_axis is None:
+            height_axis = (0.0, 1.0, 0.0) if abs(tangent[2]) > 1.0 - 1e-12 else (0.0, 0.0, 1.0)
+        h = _vec(height_axis, "height_axis", where)
+        h = h - (h @ tangent) * tangent
+        if np.linalg.norm(h) < 1e-9:
+            raise InputError(f"{where}: height_axis is parallel to the beam axis")
+        h /= np.linalg.norm(h)
+        self.orientation = np.column_stack([tangent, h, np.cross(tangent, h)])
+        self.stations = axis_stations(self.length, self.nodes, segments, where)
+        self.lengths = self.stations[1:] - self.stations[:-1]   # (np.diff's values)
+        self.frame_drive = frame_drive
+        self.frame_axis = _vec(frame_axis, "frame_axis", where)
+        if np.linalg.norm(self.frame_axis) == 0.0:
+            raise InputError(f"{where}: frame_axis must not vanish")
+        self.frame_pivot = self.start.copy() if frame_pivot is None else \
+            _vec(frame_pivot, "frame_pivot", where)
+
+
+    # -- geometry ---------------------------------------------------------------------------
+    @property
+    def nel(self) -> int:
+        return self.nodes - 1
+
+    @property
+    def ncoordinates(self) -> int:
+        return BEAM_NODE_DOFS * self.nodes
+
+    def node_positions(self) -> np.ndarray:
+        return self.start + np.outer(self.stations, self.orientation[:, 0])
+
+    def coordinates(self) -> np.ndarray:
+        q = np.zeros((self.nodes, BEAM_NODE_DOFS))
+        q[:, 0:3] = self.node_positions()
+        q[:, 3:12] = self.orientation.T.ravel()
+        return q.ravel()
+
+    def element_dofs(self) -> np.ndarray:
+        """(24, nel) full coordinates of every element (after numbering)."""
+        return self.first + np.array([np.arange(24) + BEAM_NODE_DOFS * el
+                                      for el in range(self.nel)]).T
+
+    def node_first(self, node: int, which: str = "r") -> int:
+        return self.first + BEAM_NODE_DOFS * node + VECTOR_OFFSETS[which]
+
+    # -- attachments ------------------------------------------------------------------------
+    def locate(self, point, *, node: bool, what: str) -> Attachment:
+        p = _vec(point, "point", what)
+        rel = p - self.start
+        s = float(rel @ self.orientation[:, 0])
+        y = float(rel @ self.orientation[:, 1])
+        z = float(rel @ self.orientation[:, 2])
+        tol = 1e-6 * self.length
+        half_y, half_z = self.section.extent
+        if s < -tol or s > self.length + tol or abs(y) > half_y + tol or abs(z) > half_z + tol:
+            raise InputError(f"{what}: point {list(p)} is not a material point of beam "
+                             f"{self.name!r} (axis from {list(self.start)} to {list(self.end)})")
+        nearest = int(np.argmin(np.abs(self.stations - s)))
+        at_node = abs(self.stations[nearest] - s) <= tol and abs(y) <= tol and abs(z) <= tol
+        if node and not at_node:
+            raise InputError(f"{what}: point {list(p)} is not a node of beam {self.name!r} "
+                             f"(nearest node at {list(self.node_positions()[nearest])})")
+        s = min(max(s, 0.0), self.length)
+        element = min(int(np.searchsorted(self.stations, s, side="right")) - 1, self.nel - 1)
+        xi = (s - self.stations[element]) / self.lengths[element]
+        return Attachment(nearest if at_node else None, element, (xi, y, z))
+
+    def position(self, at: Attachment) -> Vec3:
+        if at.node is not None:
+            return Vec3.of(self.node_first(at.node))
+        xi, y, z = at.local
+        shape, *_ = kernel.beam_shape([xi], [y], [z], [self.lengths[at.element]])
+        first = self.first + BEAM_NODE_DOFS * at.element
+        return Vec3({first + 3 * a: float(shape[a, 0]) for a in range(8) if shape[a, 0] != 0.0})
+
+    def vector(self, at: Attachment, which: str) -> Vec3:
+        """A nodal vector at a node; between nodes or off the axis the same gradient of the
+        position field at the material point (through the shape functions: r_x = dr/dx,
+        r_y = dr/dy, r_z = dr/dz there; r_y and r_z interpolate the two nodes' directors)."""
+        if at.node is not None:
+            return Vec3.of(self.node_first(at.node, which))
+        if which == "r":
+            return self.position(at)
+        xi, y, z = at.local
+        derivs = kernel.beam_shape([xi], [y], [z], [self.lengths[at.element]])
+        weights = derivs[VECTOR_OFFSETS[which] // 3][:, 0]
+        first = self.first + BEAM_NODE_DOFS * at.element
+        return Vec3({first + 3 * a: float(weights[a]) for a in range(8) if weights[a] != 0.0})
+
+    def basis(self, at: Attachment) -> list[Vec3]:
+        return [self.vector(at, w) for w in ("r_x", "r_y", "r_z")]
+
+    def held_vectors(self, at: Attachment) -> list[str]:
+        return ["r_y", "r_z"]  # the cross-section (a section clamp); r_x may shear and stretch
+
+    def directors(self, at: Attachment) -> list[str]:
+        return ["r_y", "r_z"]
+
+    def torsion_shares(self) -> tuple[float, float]:
+        """How a torque about the axis divides between the directors r_y and r_z when the
+        section turns without shearing: halves with 'cubic' bending (its twist is
+        (r_y,x . r_z - r_z,x . r_y)/2); in the continuum element r_y's turn shears the fibres
+        at distance y (along the height) and r_z's those at distance z, so int y^2 dA / J
+        and int z^2 dA / J."""
+        if self.bending == "cubic":
+            return 0.5, 0.5
+        data = self.section.data
+        return data.inertia_z / data.polar, data.inertia_y / data.polar
+
+
+KEYS: dict[str, Key] = {
+    "name": name_key(),
+    "material": Key("str", doc="name of a &material"),
+    "start": Key("floats", check=vector3, doc="start of the neutral axis (m)"),
+    "end": Key("floats", check=vector3, doc="end of the neutral axis (m)"),
+    "nodes": Key("int", check=at_least(2), doc="nodes on the beam (>= 2)"),
+    "segments": Key("floats", None, doc="segment lengths (m) each split equally (keeps "
+                    "their ends as nodes); default: one segment"),
+    "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle",
+                                              "general"),
+                   "cross-section: 'rectangle' (width, height), 'box' (width, height, wall), "
+                   "'tube' (diameter, wall), 'circle' (diameter), 'general' (area, iy, iz, "
+                   "torsion_constant, shear_factor_y, shear_factor_z; optional "
+                   "mass_per_length, rotary_inertia, fibre_points)"),
+    "width": Key("float", None, positive, "section width along r_z (m)"),
+    "height": Key("float", None, positive, "section height along r_y (m)"),
+    "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
+    "diameter": Key("float", None, positive, "outer diameter of 'tube' and 'circle' (m)"),
+    "shear": Key("str", None, one_of("unit", "cowper"), "shear factors of 'rectangle', "
+                 "'box', 'tube', 'circle': 'unit' (k = 1, the default) or 'cowper' "
+                 "(Cowper 1966, from the section and nu)"),
+    "area": Key("float", None, positive, "'general': cross-section area A (m^2)"),
+    "iy": Key("float", None, positive, "'general': I_y = int z^2 dA, bending along the "
+              "width r_z (m^4)"),
+    "iz": Key("float", None, positive, "'general': I_z = int y^2 dA, bending along the "
+              "height r_y (m^4)"),
+    "torsion_constant": Key("float", None, positive, "'general': Saint-Venant torsion "
+                            "constant J (m^4)"),
+    "shear_factor_y": Key("float", None, positive, "'general': shear factor k_y (shear "
+                          "stiffness k_y G A along the height)"),
+    "shear_factor_z": Key("float", None, positive, "'general': shear factor k_z (along the "
+                          "width)"),
+    "mass_per_length": Key("float", None, positive, "'general', optional: mass per unit "
+                           "length (kg/m; default density * area)"),
+    "rotary_inertia": Key("floats", None, vector3, "'general', optional: r_x, r_y, r_z, "
+                          "rotary inertia per unit length about the axis, the height and "
+                          "the width axes (kg m; r_x = r_y + r_z; default density * (iy + "
+                          "iz, iy, iz))"),
+    "fibre_points": Key("floats", None, doc="'general', optional: outer-fibre points y1, "
+                        "z1, y2, z2, ... in the section (m) for stresses (default: the "
+                        "corners of the rectangle of the same A, I_y, I_z)"),
+    "height_axis": Key("floats", None, vector3, "direction of the section height "
+                       "(default: global z, or y for a beam along z)"),
+    "formulation": Key("str", None, one_of("ffr", "nonlinear"),
+                       "'ffr' or 'nonlinear' (default: the scene's)"),
+    "bending": Key("str", "continuum", one_of("continuum", "cubic"), "bending option"),
+    "geometric_stiffness": Key("bool", False, doc=GEOMETRIC_STIFFNESS_DOC),
+    "modes": Key("int", 0, non_negative, MODES_DOC),
+    "frame_drive": Key("str", None, doc="drive turning the beam's frame (FFR: the "
+                       "floating frame; both: the frame of the probe deflections)"),
+    "frame_axis": Key("floats", [0.0, 0.0, 1.0], vector3, "axis of the frame's turn"),
+    "frame_pivot": Key("floats", None, vector3, "point of the frame's axis (default: start)"),
+}
+
+
+def build(system, v: dict) -> Beam:
+    """A beam from the values of ``System.add('beam', ...)``."""
+    section = section_of(v, f"beam[{v['name']}]")
+    name = system._body_name(v["name"])
+    where = f"beam {name!r}"
+    v = checked_values(KIND, f"beam[{name}]", v)
+    system._check_size(part_of(name, v["nodes"]))
+    return system._add_body(Beam(
+        name, system._material(v["material"], where), v["start"], v["end"], v["nodes"],
+        section, height_axis=v.get("height_axis"), formulation=v.get("formulation") or "ffr",
+        bending=v.get("bending", "continuum"), segments=v.get("segments"),
+        frame_drive=system._drive(v.get("frame_drive"), where),
+        frame_axis=v.get("frame_axis", (0.0, 0.0, 1.0)), frame_pivot=v.get("frame_pivot"),
+        geometric_stiffness=v.get("geometric_stiffness", False), modes=v.get("modes", 0)))
+
+
+def part_of(name: str, nodes: int) -> validate.Part:
+    """A beam's share of the memory estimate."""
+    return validate.Part(f"beam[{name}]", "nodes", "beam", nodes, BEAM_NODE_DOFS)
+
+
+def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
+    frame, frame_id = context.frame, context.frame_id
+    dofs = beam.element_dofs()
+    local = dofs - beam.first
+    q = beam.coordinates()
+    rotation0 = frame.rotation(0.0)
+    frame_q = (q.reshape(-1, 3) @ rotation0).ravel()       # A0^T v for every 3-vector
+    positions = q.reshape(-1, 4, 3)[:, 0, :] - frame.pivot
+    frame_q.reshape(-1, 4, 3)[:, 0, :] = positions @ rotation0
+    section = beam.section.data
+    m = beam.material
+    frame_ref = frame_q[local].reshape(3, 8, beam.nel, order="F")
+    global_ref = q[local].reshape(3, 8, beam.nel, order="F")
+    # torsion constant J and shear factors of the section (docs/theory.md, "Sections")
+    shear_scales = beam.section.shear_scales(m.poisson_ratio)
+    torsion = beam.section.torsion_constant
+    shear_factors = beam.section.shear_factors(m.poisson_ratio)
+    mass_compact, stiffness0 = kernel.beam_element_arrays(
+        beam.lengths, section, m.density, m.youngs_modulus, m.poisson_ratio, frame_ref,
+        shear_scales)
+    mass_rule, mass_density = beam.section.mass_rule(m.density)
+    if mass_rule is not section:   # a general section's own mass and rotary inertia
+        mass_compact, _ = kernel.beam_element_arrays(
+            beam.lengths, mass_rule, mass_density, m.youngs_modulus, m.poisson_ratio, frame_ref)
+    info = SetInfo(body=beam, kind="", dofs=dofs, nel=beam.nel, frame=frame_id,
+                   mass_compact=mass_compact)
+    if beam.formulation == "ffr":
+        info.kind = "ffr"
+        if beam.bending == "cubic":  # K0: the cubic tangent at the reference, in the frame
+            cubic = kernel.CubicBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
+                                     m.poisson_ratio, torsion, shear_factors)
+            *_, stiffness0 = cubic.forces(local, frame_q, True)
+        info.stiffness0 = np.asfortranarray(stiffness0)
+        info.reference = np.asfortranarray(frame_q[local])
+        if beam.geometric_stiffness:
+            info.second_order = ffr_second_order_data(frame_ref, beam.lengths,
+                                                      m.youngs_modulus * beam.section.area)
+    elif beam.bending == "cubic":
+        info.kind = "cubic"
+        info.cubic = kernel.CubicBeam(global_ref, beam.lengths, section, m.youngs_modulus,
+                                      m.poisson_ratio, torsion, shear_factors)
+    else:
+        info.kind = "continuum"
+        info.gradients, info.weights, info.nvolume = kernel.beam_nonlinear_setup(
+            global_ref, beam.lengths, section)
+        info.shear_scales = shear_scales
+    return info
+
+
+
+def ffr_second_order_data(frame_ref: np.ndarray, lengths: np.ndarray, axial_rigidity: float
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The per-element data of the FFR geometric stiffness (ffr_elastic module doc): EA,
+    the unit axis in the frame (from the reference r_A to r_B, frame_ref (3, 8, nel)), the
+    length and G_ab = int S_a' S_b' dx over the centre-line shape functions (N1, L N2, N3,
+    L N4 on the slots r_A, r_xA, r_B, r_xB; 3-point Gauss, exact for the degree-4 integrand)."""
+    nel = len(lengths)
+    chord = frame_ref[:, 4, :] - frame_ref[:, 0, :]
+    axis = chord / np.linalg.norm(chord, axis=0)
+    points, weights = np.polynomial.legendre.leggauss(3)
+    xi, w = 0.5 * (points + 1.0), 0.5 * weights
+    # d/dxi of N1, N2, N3, N4 (cubic Hermite)
+    dn = np.array([-6 * xi + 6 * xi**2, 1 - 4 * xi + 3 * xi**2, 6 * xi - 6 * xi**2,
+                   3 * xi**2 - 2 * xi])
+    gram = np.zeros((8, 8, nel))
+    for el, length in enumerate(lengths):
+        ds = np.zeros((8, len(xi)))
+        ds[[0, 1, 4, 5]] = dn * np.array([1.0, length, 1.0, length])[:, None]
+        # int_0^L (dS_a/dx)(dS_b/dx) dx = (1/L) int_0^1 (dS_a/dxi)(dS_b/dxi) dxi
+        gram[:, :, el] = (ds * w) @ ds.T / length
+    return (np.full(nel, float(axial_rigidity)), np.asfortranarray(axis),
+            np.asarray(lengths, dtype=float), np.asfortranarray(gram))
+
+
+def _add_ffr(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    index = ks.add_ffr_set(s.dofs, s.scatter, s.stiffness0, s.reference, s.frame,
+                           s.damping_time)
+    if s.second_order is not None:
+        ks.ffr_second_order(index, *s.second_order)
+    return index
+
+
+def _add_continuum(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
+                                s.body.material.youngs_modulus, s.body.material.poisson_ratio,
+                                s.frame, s.damping_time, s.shear_scales)
+
+
+def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
+    return ks.add_cubic_set(s.dofs, s.scatter, s.cubic.forms, s.cubic.strain0, s.cubic.stiffness,
+                            s.frame, s.damping_time)
+
+
+
+KIND = register(Kind(
+    group="beam", body_class=Beam, keys=KEYS, build=build, api="beam", word="beam",
+    objects=("material", "section", "frame_drive"), scene_defaults={"formulation": "formulation"},
+    set_builder=_beam_set,
+    adders={"ffr": _add_ffr, "continuum": _add_continuum, "cubic": _add_cubic},
+    part=lambda body: part_of(body.name, body.nodes),
+    check_dimensions=lambda body: check_axis_dimensions(body, "beam")))
