@@ -33,7 +33,8 @@ module static_solver
 
   !> why the iteration stopped (converged_by): the relative residual; the round-off floor
   !> with a correction below sqrt(tol); the correction below tol; the residual stopped
-  !> falling below sqrt(tol); the start is the equilibrium (nothing loads the structure)
+  !> falling below sqrt(tol); the start is the equilibrium (no load at all, an unstressed
+  !> start)
   integer, parameter, public :: by_residual = 1, by_roundoff = 2, by_step = 3, by_floor = 4, &
                                 by_unloaded_start = 5
   !> failures (info): iteration limit, divergence, stall at the round-off floor, stall,
@@ -53,8 +54,10 @@ contains
   !> measured against |e - e0|); rows, cols: the tangent's reduced pattern (1-based, the
   !> order of internal_forces' tangent values); force_scale: the residual's scale floor (the
   !> forces at the start; < 0 on entry: set from the first iterate); check_start: a start
-  !> that is already the equilibrium (nothing loads the structure) ends the call with 0
-  !> iterations. history(1:iterations): the relative residual after each correction.
+  !> that is already the equilibrium ends the call with 0 iterations - only when no load
+  !> acts at all (external loads and dead moments exactly zero) and the internal forces
+  !> there are zero to their round-off, eps || |K| |e| || (an unstressed start).
+  !> history(1:iterations): the relative residual after each correction.
   subroutine static_newton(sys, t, load_factor, e0, rows, cols, e, lam, state, tol, &
                            length_scale, max_iter, check_start, force_scale, iterations, &
                            history, force_res, con_res, converged_by, factorizations, info, &
@@ -74,7 +77,7 @@ contains
     real(dp) :: internal(size(e)), loads(size(e)), reaction(size(e)), residual(size(e))
     real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), hessians(6, 6, sys%ncon)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
-    real(dp) :: step_size, size_now, scale, floor, previous, stiff, moment(3)
+    real(dp) :: step_size, size_now, scale, floor, previous, moment(3)
     real(dp) :: jacobian(3, 3), hessian(3, 3, 3)
     logical :: near, growing
     n = size(e)
@@ -169,9 +172,11 @@ contains
       residual = internal - loads - reaction
       if (force_scale < 0.0_dp) force_scale = max(norm2(internal), norm2(loads))
       if (check_start .and. it == 1) then
-        stiff = 0.0_dp
-        if (nnz > 0) stiff = maxval(abs(tangent)) * length_scale
-        if (norm2(residual) <= 1.0e-13_dp * stiff .and. max_abs(phi) <= tol * length_scale) then
+        ! no load at all and the internal forces zero to their own round-off: the start is
+        ! the equilibrium (a load, however small, is always solved for)
+        if (all(loads == 0.0_dp) .and. all(load_factor * sys%moment_magnitude == 0.0_dp) .and. &
+            norm2(residual) <= residual_floor(1.0_dp) .and. &
+            max_abs(phi) <= tol * length_scale) then
           converged_by = by_unloaded_start
           force_res = 0.0_dp
           con_res = 0.0_dp

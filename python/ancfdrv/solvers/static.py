@@ -199,10 +199,13 @@ def solve_newton_python(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                     residual = internal - external - reaction
                     if load_step == 1 and iteration == 1:  # the start: loads and prestress
                         force_scale = max(np.linalg.norm(internal), np.linalg.norm(external))
-                        # nothing loads the structure (e.g. settling a spring without
-                        # prestress and with the loads off): the start is the equilibrium
-                        stiff = np.abs(k_values).max(initial=0.0) * model.length_scale
-                        if (load_steps == 1 and np.linalg.norm(residual) <= 1e-13 * stiff
+                        # no load at all and the internal forces zero to their own round-off
+                        # (e.g. settling a spring without prestress and with the loads off):
+                        # the start is the equilibrium; a load, however small, is solved for
+                        unloaded = not np.any(external) and not any(
+                            np.any(f) for _, f, *_ in moments)
+                        if (load_steps == 1 and unloaded and np.linalg.norm(residual)
+                                <= residual_floor(model, e, k_values, 1.0)
                                 and np.abs(phi).max(initial=0.0) <= tol * model.length_scale):
                             how, force_res, con_res = "unloaded start", 0.0, 0.0
                             iteration = 0
