@@ -9,10 +9,11 @@ Conventions:
   'count' for counters, 'index' for connectivity); integer counters are stored as int64;
 * the root attribute ``status`` is 'running' while the run writes, then 'ok', 'failed'
   (with ``message``), 'unstable' (the energy grew beyond solver.energy_tolerance, with
-  ``message``: :class:`~ancfdrv.errors.UnstableError`) or 'interrupted' (SIGINT/SIGTERM: every step computed before the
-  signal is in the file); /dynamic has the same ``status``. A file that still says
-  'running' while no process holds its lock (:mod:`ancfdrv.results.lock`) was abandoned:
-  its writer was killed (every flushed chunk is kept);
+  ``message``: :class:`~ancfdrv.errors.UnstableError`) or 'interrupted' (SIGINT/SIGTERM:
+  every step computed before the signal is in the file); /dynamic has the same
+  ``status``. A file that still says 'running' while no process holds its lock
+  (:mod:`ancfdrv.results.lock`) was abandoned: its writer was killed (every flushed chunk
+  is kept);
 * the root attributes carry the provenance: package version, git commit (when run from
   a checkout), library versions, compiler, platform, thread settings, command line.
 """
