@@ -256,3 +256,22 @@ def test_eigen_headline_lists_every_value(tmp_path, capsys, analysis, extra, gro
     line = next(x for x in text.splitlines() if x.startswith(f"{group}.{key} "))
     assert line.endswith(f"... {len(values) - 8} more")
     np.testing.assert_allclose(numbers_after(blocks(text)[group], label), values, rtol=1e-5)
+
+
+def test_reaction_names_with_a_slash(tmp_path, capsys):
+    """The simply supported plate's joints 'support dw/dx' and 'support dw/dy' are nested
+    groups in HDF5: the table lists them by their names, with the file's values."""
+    out = tmp_path / "plate.h5"
+    assert main(["run", str(ROOT / "inputs" / "plate_pressure.nml"), "-o", str(out),
+                 "--set", "plate.nx=4", "--set", "plate.ny=4"]) == 0
+    rows = table_rows(blocks(capsys.readouterr().out)["static"])
+    with h5py.File(out) as h5:
+        found = {}
+        h5["static/reactions"].visititems(
+            lambda name, item: found.update({name: item}) if isinstance(item, h5py.Group)
+            and "force" in item else None)
+        assert {"support dw/dx", "support dw/dy"} <= set(rows) == set(found)
+        scale = max(np.abs(g["force"][()]).max() for g in found.values())
+        for name, (kind, values) in rows.items():
+            np.testing.assert_allclose(values[:3], found[name]["force"][()], rtol=0,
+                                       atol=1e-5 * scale)

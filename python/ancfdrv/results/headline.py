@@ -32,9 +32,23 @@ def _floats(values: Any) -> list[float]:
     return [float(v) for v in np.ravel(values)]
 
 
+def _reaction_groups(group: h5py.Group, prefix: str = "") -> list[tuple[str, h5py.Group]]:
+    """The reactions under /<phase>/reactions by name, in file order: a name with '/'
+    (a plate's 'support dw/dx') is a nested group in HDF5."""
+    out = []
+    for name, sub in group.items():
+        if not isinstance(sub, h5py.Group):
+            continue
+        if "force" in sub:
+            out.append((prefix + name, sub))
+        else:
+            out += _reaction_groups(sub, f"{prefix}{name}/")
+    return out
+
+
 def _static_reactions(group: h5py.Group) -> dict[str, dict[str, Any]]:
     out = {}
-    for name, sub in group.items():
+    for name, sub in _reaction_groups(group):
         out[name] = {"kind": _text(sub.attrs.get("kind", "joint")),
                      "force": _floats(sub["force"][()]), "moment": _floats(sub["moment"][()]),
                      "axial": float(sub["axial"][()]) if "axial" in sub else None}
@@ -50,7 +64,7 @@ def _peak(series: np.ndarray, time: np.ndarray) -> tuple[float, float]:
 
 def _dynamic_reactions(group: h5py.Group, time: np.ndarray) -> dict[str, dict[str, Any]]:
     out = {}
-    for name, sub in group.items():
+    for name, sub in _reaction_groups(group):
         force, when_force = _peak(sub["force"][()], time)
         moment, when_moment = _peak(sub["moment"][()], time)
         entry = {"kind": _text(sub.attrs.get("kind", "joint")), "force_max": force,
