@@ -19,7 +19,11 @@ Reactions
     the tension: minus the force on body2 along p2 - p1.
 
 Section forces
-    At ``stations`` points per element (equally spaced, both ends included) from the
+    At ``stations`` points per element (equally spaced, both ends included: a node appears
+    twice, left then right). A static state's (:func:`static_section_forces`, what
+    :func:`static_answers` returns) from each element's own equilibrium: exact where the
+    loads are, N and Q jump at the nodes that carry a load, a joint or a force element
+    (:func:`beam_equilibrium_forces`). A dynamic state's (:func:`section_forces`) from the
     element's own strain measures (``fortran/src/elements/beam_cubic.f90``) and the
     section's stiffness, relative to the reference configuration: axial Green strain
     (r_x . r_x - 1)/2, bending strains b_y = -r_y,x . r_x (+ r_xx . r_y - mean(r_xx . r_y)
@@ -57,7 +61,7 @@ from .kinds import Beam, Cable, Plate, RigidBody
 from .constraint_set import ConstraintSet
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation
-from .model import Model
+from .model import Model, SetInfo
 from .sections import Box, Circle, Rectangle, Tube
 from .._lazy import LazyModule
 
@@ -785,7 +789,7 @@ def _section_forces_full(model: Model, q: np.ndarray, stations: int,
 
 
 # -- section forces from the elements' equilibrium (static states) ----------------------------
-def _element_forces(model: Model, info, q: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+def _element_forces(info: SetInfo, q: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     """(nel, 8, 3) the elastic force of every element of a beam's set on its own eight
     nodal vectors at the full coordinates q (global axes), from the kernel's element
     routines: each element is handed its own 24 slots, so the kernel's sum over the
@@ -819,7 +823,7 @@ def _centreline(xi: np.ndarray, length: float) -> np.ndarray:
                             3 * xi**2 - 2 * xi**3, length * (xi**3 - xi**2), z, z])
 
 
-def beam_equilibrium_forces(model: Model, info, q: np.ndarray, gravity: np.ndarray,
+def beam_equilibrium_forces(model: Model, info: SetInfo, q: np.ndarray, gravity: np.ndarray,
                             stations: int = DEFAULT_STATIONS, t: float = 0.0) -> SectionForces:
     """Section forces of one beam at a static state from each element's own equilibrium
     (SPEC section 10), at ``stations`` points per element with both ends: at an element's
@@ -842,7 +846,7 @@ def beam_equilibrium_forces(model: Model, info, q: np.ndarray, gravity: np.ndarr
         raise ValueError("stations must be at least 2 (both ends of each element)")
     nel = info.nel
     rotation = model.frames[info.frame - 1].rotation(t) if info.frame else np.eye(3)
-    force = _element_forces(model, info, q, rotation)
+    force = _element_forces(info, q, rotation)
     mass_rule, density = beam.section.mass_rule(beam.material.density)
     load = np.moveaxis(np.asarray(kernel.beam_gravity(beam.lengths, mass_rule, density,
                                                       gravity)), -1, 0)
