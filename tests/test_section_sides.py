@@ -174,3 +174,33 @@ def test_peak_von_mises_at_a_welded_corner_is_n_over_a_plus_m_c_over_i(nodes):
     assert girder.N[0] == pytest.approx(load[0], rel=RTOL)
     assert girder.M[0, 1] == pytest.approx(-moment, rel=RTOL)
     model.close()
+
+
+@pytest.mark.parametrize("settle", ["unloaded", "loaded"])
+def test_settled_start_sections_balance_the_loads_it_carries(tmp_path, settle):
+    """A cantilever under gravity settled before a dynamic run: the 'loaded' static state
+    carries a section force of magnitude rho A g (L - s) (to 1e-9 of the weight: large
+    deformation, the sections turn by 1e-6 under the weight) and the moment
+    rho A g (L - s)^2 / 2 (to 1e-4: its lever shortens as the beam sags), the 'unloaded' one
+    (the loads off) none at all: its gravity is not subtracted."""
+    scene = tmp_path / "settle.nml"
+    scene.write_text(f"""&scene title = 'settled', analysis = 'dynamic', formulation = 'nonlinear',
+       effects = 'gravity' /
+&material name = 'steel', youngs_modulus = 2.1e11, density = 7850.0 /
+&beam name = 'bar', material = 'steel', start = 0.0, 0.0, 0.0, end = 2.0, 0.0, 0.0,
+      nodes = 3, section = 'rectangle', width = 0.05, height = 0.08, bending = 'cubic' /
+&joint name = 'root', type = 'weld', body1 = 'ground', body2 = 'bar', point = 0.0, 0.0, 0.0 /
+&load name = 'g', type = 'gravity', vector = 0.0, -9.81, 0.0 /
+&solver settle = '{settle}', dt = 1e-3, t_end = 2e-3 /
+""")
+    import ancfdrv
+    f = ancfdrv.simulate(scene, progress=False).static_answers.sections["bar"]
+    weight = STEEL["density"] * 0.05 * 0.08 * 9.81          # per length
+    share = 1.0 if settle == "loaded" else 0.0
+    magnitude = np.sqrt(f.N**2 + (f.Q**2).sum(axis=1))
+    assert magnitude == pytest.approx(share * weight * (2.0 - f.s), abs=RTOL * weight * 2.0)
+    # the load along -y: the height axis's moment (the height along z)
+    root = weight * 2.0**2 / 2
+    assert -f.M[:, 0] == pytest.approx(share * weight * (2.0 - f.s)**2 / 2, abs=1e-4 * root)
+    if settle == "unloaded":
+        assert np.abs(f.M).max() <= RTOL * root

@@ -897,15 +897,15 @@ def beam_equilibrium_forces(model: Model, info: SetInfo, q: np.ndarray, gravity:
         M=np.stack([along(moment_s, height), along(moment_s, width)], axis=-1).reshape(ns, 2))
 
 
-def static_section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS
-                          ) -> dict[str, SectionForces]:
+def static_section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS,
+                          load_factor: float = 1.0) -> dict[str, SectionForces]:
     """Section forces of every beam by name at a static state e (the solved equilibrium
-    of the scene's loads at load factor 1) from the elements' equilibrium
+    of the scene's loads scaled by ``load_factor``) from the elements' equilibrium
     (:func:`beam_equilibrium_forces`): exact where the loads are, with both sides of every
     node. :func:`section_forces` (the strains times the section's stiffness) serves the
     states that are not in static equilibrium (the rows of a dynamic run)."""
     q = model.expand(np.asarray(e, dtype=float))
-    gravity = np.asarray(model.gravity, dtype=float)
+    gravity = load_factor * np.asarray(model.gravity, dtype=float)
     return {info.body.name: beam_equilibrium_forces(model, info, q, gravity, stations)
             for info in model.sets if isinstance(info.body, Beam)}
 
@@ -1152,10 +1152,11 @@ class Answers:
 
 
 def static_answers(model: Model, e: np.ndarray, lam: np.ndarray,
-                   stations: int = DEFAULT_STATIONS) -> Answers:
-    """Reactions, section forces and stresses of a static state (e, lambda): what the
-    result writers store under /static and the results object exposes."""
-    forces = static_section_forces(model, e, stations)
+                   stations: int = DEFAULT_STATIONS, load_factor: float = 1.0) -> Answers:
+    """Reactions, section forces and stresses of a static state (e, lambda) of the loads
+    scaled by ``load_factor``: what the result writers store under /static and the results
+    object exposes."""
+    forces = static_section_forces(model, e, stations, load_factor)
     return Answers(reactions(model, e, lam), forces, stresses(model, forces))
 
 
