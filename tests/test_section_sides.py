@@ -13,7 +13,9 @@ and jump at the nodes that carry them; checked against the statics of the loads:
   results object (what /static/sections/<beam> stores) holds both sides of a loaded node;
 * the shipped knuckle crane's cylinder lugs: N, M on both sides and the largest normal
   stress N / A + M c / I from the statics of the reactions, at two meshes;
-* an 'unloaded' settle's static state carries no section forces, a 'loaded' one its weight.
+* an 'unloaded' settle's static state carries no section forces, a 'loaded' one its weight;
+* a column's P-delta root moment ('ffr' with geometric stiffness, large deformation) equals
+  its weld's reaction moment.
 """
 from __future__ import annotations
 
@@ -24,7 +26,7 @@ import pytest
 
 from ancfdrv import Rectangle, System
 from ancfdrv.solvers.static import solve_newton
-from ancfdrv.system.answers import static_section_forces, stresses
+from ancfdrv.system.answers import reactions, static_section_forces, stresses
 
 ROOT = Path(__file__).resolve().parents[1]
 STEEL = dict(youngs_modulus=2.1e11, density=7850.0)
@@ -284,4 +286,28 @@ def test_knuckle_crane_lug_stress_is_n_over_a_plus_m_c_over_i(nodes):
         stress = answers.stress[name]
         assert np.abs(stress.sigma_x[at]).max() == pytest.approx(hand, rel=1e-4)
         assert stress.von_mises[at].max() >= hand * (1 - 1e-4)
+    model.close()
+
+
+@pytest.mark.parametrize("formulation, geometric", [("ffr", True), ("nonlinear", False)])
+def test_p_delta_moment_at_the_root_is_the_reaction(formulation, geometric):
+    """A column under 10 kN of compression and 200 N sideways at its top (a third of its
+    Euler load): the root's section moment includes the P-delta share (about 40 % over
+    H L) and equals the weld's reaction moment (from its multipliers) to 1e-9; the top's
+    is zero."""
+    s = System("p-delta")
+    steel = s.material("steel", **STEEL)
+    extra = {"geometric_stiffness": True} if geometric else {}
+    s.beam("col", material=steel, start=(0, 0, 0), end=(3.0, 0, 0), nodes=7,
+           section=Rectangle(0.05, 0.05), height_axis=(0, 1, 0), formulation=formulation,
+           bending="cubic", **extra)
+    s.joint("root", "weld", "ground", "col", point=(0, 0, 0))
+    s.load("top", "force", body="col", point=(3.0, 0, 0), vector=(-1.0e4, 200.0, 0))
+    model = s.assemble()
+    result = solve_newton(model, tol=1e-9)
+    f = static_section_forces(model, result.e)["col"]
+    root = reactions(model, result.e, result.lam)["root"]
+    assert f.M[0, 1] > 1.3 * 200.0 * 3.0
+    assert f.M[0, 1] == pytest.approx(-root.moment[2], rel=RTOL)
+    assert abs(f.M[-1, 1]) <= RTOL * f.M[0, 1]
     model.close()

@@ -815,12 +815,15 @@ def _element_forces(info: SetInfo, q: np.ndarray, rotation: np.ndarray) -> np.nd
     return np.asarray(force).reshape(nel, 8, 3)
 
 
-def _centreline(xi: np.ndarray, length: float) -> np.ndarray:
-    """(n, 8) coefficients of the centre line r(xi) on the element's eight nodal vectors
-    (cubic Hermite on r1, r1_x, r2, r2_x)."""
+def _centreline(xi: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """(nel, n, 8) coefficients of the centre line r(xi) on each element's eight nodal
+    vectors (cubic Hermite on r1, r1_x, r2, r2_x; ``lengths`` (nel,))."""
     z = np.zeros_like(xi)
-    return np.column_stack([1 - 3 * xi**2 + 2 * xi**3, length * (xi - 2 * xi**2 + xi**3), z, z,
-                            3 * xi**2 - 2 * xi**3, length * (xi**3 - xi**2), z, z])
+    shape = np.stack([1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, z, z,
+                      3 * xi**2 - 2 * xi**3, xi**3 - xi**2, z, z], axis=-1)
+    slope_scale = np.ones((len(lengths), 1, 8))
+    slope_scale[:, 0, [1, 5]] = np.asarray(lengths)[:, None]
+    return shape[None] * slope_scale
 
 
 def beam_equilibrium_forces(model: Model, info: SetInfo, q: np.ndarray, gravity: np.ndarray,
@@ -865,19 +868,16 @@ def beam_equilibrium_forces(model: Model, info: SetInfo, q: np.ndarray, gravity:
     per_length = (load[:, 0] + load[:, 4]) / lengths[:, None]          # p (nel, 3)
     xi = np.linspace(0.0, 1.0, stations)
     points, weights = np.polynomial.legendre.leggauss(3)   # exact: r(x) is cubic
-    force_s = np.empty((nel, stations, 3))
-    moment_s = np.empty((nel, stations, 3))
-    for el in range(nel):
-        length, v = lengths[el], vectors[el]
-        r_s = _centreline(xi, length) @ v
-        # int_0^xi r dx per station (Gauss on [0, xi])
-        nodes = 0.5 * xi[:, None] * (points[None, :] + 1.0)
-        r_int = np.einsum("pq,pqk->pk", 0.5 * xi[:, None] * weights[None, :] * length,
-                          (_centreline(nodes.ravel(), length) @ v).reshape(stations, 3, 3))
-        run = (xi * length)[:, None]
-        force_s[el] = f_a[el] - run * per_length[el]
-        moment_s[el] = (m_a[el] + np.cross(v[0] - r_s, f_a[el])
-                        - np.cross(r_int - run * r_s, per_length[el]))
+    r_s = _centreline(xi, lengths) @ vectors                          # (nel, nxi, 3)
+    # int_0^xi r dx per station: Gauss on [0, xi]
+    nodes = (0.5 * xi[:, None] * (points[None, :] + 1.0)).ravel()
+    r_gauss = (_centreline(nodes, lengths) @ vectors).reshape(nel, stations, len(points), 3)
+    r_int = (0.5 * np.outer(lengths, xi))[:, :, None] * np.einsum("q,epqk->epk", weights,
+                                                                     r_gauss)
+    run = np.outer(lengths, xi)[:, :, None]                            # (nel, nxi, 1)
+    force_s = f_a[:, None] - run * per_length[:, None]
+    moment_s = (m_a[:, None] + np.cross(vectors[:, None, 0] - r_s, f_a[:, None])
+                - np.cross(r_int - run * r_s, per_length[:, None]))
     force_s[:, -1], moment_s[:, -1] = f_b, m_b   # the end from its own forces (the same
     #                                               up to round-off where the loads are gravity)
     dir_y = (1 - xi)[None, :, None] * vectors[:, None, 2] + xi[None, :, None] * vectors[:, None, 6]
@@ -1369,7 +1369,7 @@ class DynamicAnswers:
 
 
 __all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions",
-           "section_forces", "static_section_forces", "force_element_reactions",
+           "section_forces", "static_section_forces", "beam_equilibrium_forces", "force_element_reactions",
            "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
            "DEFAULT_STATIONS",
            "DynamicAnswers", "constraint_joints"]
