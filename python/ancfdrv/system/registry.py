@@ -91,6 +91,11 @@ class Kind:
     check_dimensions: Callable[[Any], None] | None = None
     #: ``effects(body) -> set``: the effects the body itself belongs to ('prestress')
     effects: Callable[[Any], set[str]] | None = None
+    #: ``end_forces(set_info, q, rotation) -> (forces, vectors)``: each element's elastic
+    #: force on its own nodal vectors and the vectors it acts at, both (nel, 8, 3), for the
+    #: static section forces from the elements' equilibrium (None: the kind has no beam
+    #: sections)
+    end_forces: Callable[[Any, Any, Any], tuple[Any, Any]] | None = None
 
 
 _KINDS: dict[str, Kind] = {}
