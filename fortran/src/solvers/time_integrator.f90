@@ -123,7 +123,7 @@ module time_integrator
     real(dp), allocatable :: r(:), z(:, :), direction(:), correction(:), back(:)
     real(dp), allocatable :: phi(:), gradients(:, :), w(:, :), flex_w(:, :), w_dlam(:)
     real(dp), allocatable :: schur(:, :), dlam(:, :), internal(:), loads(:), records(:, :)
-    real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:, :)
+    real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:)
     real(dp), allocatable :: full_pair(:, :)
     integer, allocatable :: ipiv(:)
     ! loads holds the external loads at loads_time (residual)
@@ -161,7 +161,7 @@ contains
               work%internal(sys%ndof), work%loads(sys%ndof), &
               work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
               work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
-              work%row_ndof(sys%ndof, 2), work%full_pair(sys%nfull, 2))
+              work%row_ndof(sys%ndof), work%full_pair(sys%nfull, 2))
     if (carry_enabled(sys)) then
       allocate (work%carry_columns(sys%ndof, sys%ncon), &
                 work%carry_flexibility(sys%ndof, sys%ncon), work%carry_lu(sys%ncon, sys%ncon), &
@@ -400,7 +400,7 @@ contains
       do i = 1, sys%ncon
         out_lambda(i, step) = lam(i)
       end do
-      call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, &
+      call probe_output(sys, rotations, e, v, work, strain, contact_potential, &
                         out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info, &
                         scratch%full, scratch%row_ndof)
       if (info /= 0) return
@@ -1170,7 +1170,7 @@ contains
     call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers, contact_potential, &
                   violation, contact, info)
     if (info /= 0) return
-    call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, probe, deflection, &
+    call probe_output(sys, rotations, e, v, work, strain, contact_potential, probe, deflection, &
                       energy, info)
   end subroutine output_row
 
