@@ -66,6 +66,7 @@ module time_integrator
                                constraint_reaction, gradient_product, refactorize, &
                                to_solver_frame, &
                                frame_gradients, energies, probe_output, policy_constant, &
+                               drive_step_work, power_drive, &
                                power_count, energy_count, contact_record, contact_step_limit
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
                      jacobian_reuse, update_reuse_backoff, contraction_memory
@@ -304,7 +305,7 @@ contains
     real(dp) :: lam_new(sys%ncon), predicted_internal(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
-    real(dp) :: contact_potential, beta_prime, velocity_factor
+    real(dp) :: contact_potential, beta_prime, velocity_factor, step_drive_work
     integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
     logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
@@ -361,6 +362,9 @@ contains
       end if
       if (monitor%at_floor) floor_accepts = floor_accepts + 1
       if (started_old) call update_reuse_backoff(learned, stats(stat_factorizations) > 0)
+      ! the drives' work over the step, from (t, e, lambda) to (t + h, e_new, lambda_new)
+      call drive_step_work(sys, t, t + h, e, e_new, lam, lam_new, step_drive_work, info)
+      if (info /= 0) return
       ! accept the step
       ! (one pass: each coordinate's a_new, v, e and a by the same expressions as the
       ! array statements they replace, without their separate loops and copies)
@@ -393,6 +397,7 @@ contains
       end if
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers + powers_new)
+      work(power_drive) = work(power_drive) + step_drive_work
       powers = powers_new
       steps_done = step
       out_time(step) = t

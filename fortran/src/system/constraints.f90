@@ -21,8 +21,7 @@ module constraints
   use matrix3, only: cross
   implicit none
   private
-  public :: constraint_eval, constraint_values, operand_values, drive_value, constraint_value, &
-            constraint_phi_t
+  public :: constraint_eval, constraint_values, operand_values, drive_value, constraint_value
 
   integer, parameter, public :: constraint_kind_coordinate = 1, constraint_kind_distance = 2, &
                                 constraint_kind_cross = 3, constraint_kind_dot = 4
@@ -132,7 +131,7 @@ contains
                                      sin_phi)
         gradients(1, c) = 1.0_dp
         if (.not. second) cycle
-        phi_t(c) = constraint_phi_t(kinds(c), params(:, c), phi, dphi)
+        phi_t(c) = -(-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * dphi
         phi_tt(c) = -((-params(2, c) * cos(phi) - params(3, c) * sin(phi)) * dphi**2 &
                       + (-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * ddphi)
       case (constraint_kind_distance)
@@ -149,7 +148,7 @@ contains
           hessians(m, m + 3, c) = -2.0_dp
           hessians(m + 3, m, c) = -2.0_dp
         end do
-        phi_t(c) = constraint_phi_t(kinds(c), params(:, c), phi, dphi)
+        phi_t(c) = -2.0_dp * length * params(2, c) * dphi
         phi_tt(c) = -2.0_dp * (params(2, c) * dphi)**2 - 2.0_dp * length * params(2, c) * ddphi
       case (constraint_kind_cross)
         k = params(1:3, c)
@@ -173,7 +172,7 @@ contains
           hessians(m + 3, m, c) = 1.0_dp
         end do
         if (drives(c) /= 0) then
-          phi_t(c) = constraint_phi_t(kinds(c), params(:, c), phi, dphi)
+          phi_t(c) = -params(2, c) * dphi
           phi_tt(c) = -params(2, c) * ddphi
         end if
       case default
@@ -183,25 +182,6 @@ contains
       gamma(c) = -dot_product(v, matmul(hessians(:, :, c), v)) - phi_tt(c)
     end do
   end subroutine constraint_eval
-
-  !> Phi_t of one constraint of kind ``kind`` (module doc) whose drive has the value phi and
-  !> the rate dphi (no drive: phi = dphi = 0, and Phi_t = 0). The one formula of
-  !> constraint_eval and of the drives' power (mechanical_system energies: -lambda Phi_t).
-  pure function constraint_phi_t(kind, p, phi, dphi) result(rate)
-    integer, intent(in) :: kind
-    real(dp), intent(in) :: p(:), phi, dphi
-    real(dp) :: rate
-    select case (kind)
-    case (constraint_kind_coordinate)
-      rate = -(-p(2) * sin(phi) + p(3) * cos(phi) + p(4)) * dphi
-    case (constraint_kind_distance)
-      rate = -2.0_dp * (p(1) + p(2) * phi) * p(2) * dphi
-    case (constraint_kind_dot)
-      rate = -p(2) * dphi
-    case default  ! (cross: no drive)
-      rate = 0.0_dp
-    end select
-  end function constraint_phi_t
 
   !> The value of one constraint of kind ``kind`` (module doc) at its operands x and its
   !> drive's value phi (driven: the constraint has a drive; without one phi = 0), with
