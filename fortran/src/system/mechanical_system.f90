@@ -1393,14 +1393,8 @@ contains
     origin = 0.0_dp
     do c = 1, sys%ncon
       if (sys%con_drive(c) == 0) cycle
-      call drive_value(sys%con_drive(c), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t0, &
-                       phi0, unused_rate, unused_accel, info)
-      if (info == 0) call drive_value(sys%con_drive(c), sys%drive_kinds, sys%drive_ptr, &
-                                      sys%drive_data, t1, phi1, unused_rate, unused_accel, info)
-      if (info /= 0) then
-        info = 5
-        return
-      end if
+      call drive_ends(sys%con_drive(c))
+      if (info /= 0) return
       before = constraint_value(sys%con_kind(c), .true., sys%con_params(:, c), origin, phi0, &
                                 cos(phi0), sin(phi0))
       after = constraint_value(sys%con_kind(c), .true., sys%con_params(:, c), origin, phi1, &
@@ -1408,18 +1402,22 @@ contains
       work = work - 0.5_dp * (lam0(c) + lam1(c)) * (after - before)
     end do
     do c = 1, size(sys%force_drive)
-      call drive_value(sys%force_drive(c), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t0, &
-                       phi0, unused_rate, unused_accel, info)
-      if (info == 0) call drive_value(sys%force_drive(c), sys%drive_kinds, sys%drive_ptr, &
-                                      sys%drive_data, t1, phi1, unused_rate, unused_accel, info)
-      if (info /= 0) then
-        info = 5
-        return
-      end if
+      call drive_ends(sys%force_drive(c))
+      if (info /= 0) return
       do k = 1, size(e0)  ! (a loop: e1 - e0 would make a temporary)
         work = work + 0.5_dp * (phi0 + phi1) * sys%force_vectors(k, c) * (e1(k) - e0(k))
       end do
     end do
+  contains
+    !> The drive's values at the step's ends, phi0 at t0 and phi1 at t1 (info 5: failed).
+    subroutine drive_ends(drive)
+      integer, intent(in) :: drive
+      call drive_value(drive, sys%drive_kinds, sys%drive_ptr, sys%drive_data, t0, phi0, &
+                       unused_rate, unused_accel, info)
+      if (info == 0) call drive_value(drive, sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+                                      t1, phi1, unused_rate, unused_accel, info)
+      if (info /= 0) info = 5
+    end subroutine drive_ends
   end subroutine drive_step_work
 
   pure function sys_axis(sys, f) result(axis)
