@@ -100,6 +100,12 @@ def _positive(value: float, what: str, name: str) -> float:
     return float(value)
 
 
+def along_axis(v, j: int, tol: float = 1e-9) -> bool:
+    """v is parallel to the coordinate axis e_j (within ``tol`` of its length, at least 1)."""
+    v = np.asarray(v, dtype=float)
+    return float(np.linalg.norm(np.delete(v, j))) <= tol * max(1.0, float(np.linalg.norm(v)))
+
+
 def rotation_about(axis, angle: float) -> np.ndarray:
     """Rodrigues' rotation matrix about a unit axis."""
     k = np.asarray(axis, dtype=float) / np.linalg.norm(axis)

@@ -20,11 +20,14 @@ A kind declares
   info) -> int``, the set's index); a body whose kind builds no set has no elements (a
   rigid body);
 - the size estimate of a body (``part``), its dimension check (``check_dimensions``) and the
-  effects a body belongs to by itself (``effects``).
+  effects a body belongs to by itself (``effects``);
+- its planar rule (:mod:`.planar`): the plane a body lies in (``plane``), what keeps it
+  from staying in a plane (``planar_problems``) and the coordinates a plane fixes
+  (``planar_fixed``); a kind without a rule is not reduced (a plate, a leaf).
 
 What a body answers about itself (its size, its nodes, its mid-surface, the probe component
-a sweep compares) is a property of its class (:class:`~.bodies.Body`). The planar rule, the
-mesh rows of the XDMF writer and the answers' per-kind tables still test concrete classes
+a sweep compares) is a property of its class (:class:`~.bodies.Body`). The mesh rows of the
+XDMF writer and the answers' per-kind tables still test concrete classes
 (tests/test_kinds_registry.py counts those checks and only lets the count go down).
 
 Each family of elements is one Fortran module (an extension of ``element_set`` in
@@ -91,6 +94,15 @@ class Kind:
     check_dimensions: Callable[[Any], None] | None = None
     #: ``effects(body) -> set``: the effects the body itself belongs to ('prestress')
     effects: Callable[[Any], set[str]] | None = None
+    #: ``plane(body, j) -> float | None``: the j-coordinate of the plane normal to e_j the
+    #: body lies in (None: any, or no planar rule)
+    plane: Callable[[Any, int], float | None] | None = None
+    #: ``planar_problems(body, j, tol) -> [text]``: what keeps the body from moving in planes
+    #: normal to e_j (each text after "body 'name': "); None: the kind is not reduced
+    planar_problems: Callable[[Any, int, float], list[str]] | None = None
+    #: ``planar_fixed(body, j, q0) -> [(dof, label)]``: the full coordinates that keep their
+    #: initial values in planar motion normal to e_j, each with its equation's label
+    planar_fixed: Callable[[Any, int, Any], list[tuple[int, str]]] | None = None
 
 
 _KINDS: dict[str, Kind] = {}

@@ -13,7 +13,7 @@ from ...io import validate
 from ...io.schema import (GEOMETRIC_STIFFNESS_DOC, MODES_DOC, Key, at_least, name_key,
                           non_negative, one_of,
                           positive, vector3)
-from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, axis_stations,
+from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, along_axis, axis_stations,
                       check_axis_dimensions)
 from ..expressions import Vec3
 from ..model import SetInfo
@@ -359,10 +359,45 @@ def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
 
 
 
+def _planar_problems(body: Beam, j: int, tol: float) -> list[str]:
+    """The planar rule (system/planar.py): the axis in a plane normal to e_j, a section axis
+    along e_j, and not 'ffr'."""
+    plane = "xyz"[j]
+    if abs(float(body.start[j] - body.end[j])) > tol:
+        return [f"its axis leaves the plane normal to {plane}"]
+    out = []
+    if body.formulation == "ffr":
+        out.append("formulation 'ffr' keeps its constant iteration matrix by turning whole "
+                   "nodal 3-vectors with the frame; it is not reduced (use 'nonlinear', or "
+                   "planar = 'off')")
+    if not (along_axis(body.orientation[:, 1], j) or along_axis(body.orientation[:, 2], j)):
+        out.append(f"no section axis (height or width) lies along {plane}")
+    return out
+
+
+def _planar_fixed(body: Beam, j: int, q0) -> list[tuple[int, str]]:
+    """In planar motion normal to e_j every node keeps r_j, r_x,j and the in-plane
+    director's j-component, and the normal director's two in-plane components."""
+    normal_director = "r_y" if along_axis(body.orientation[:, 1], j) else "r_z"
+    inplane_director = "r_z" if normal_director == "r_y" else "r_y"
+    out = []
+    for node in range(body.nodes):
+        tag = f"{body.name}: planar node {node + 1}"
+        for which in ("r", "r_x", inplane_director):
+            out.append((body.node_first(node, which) + j, f"{tag} {which}"))
+        for k in range(3):
+            if k != j:
+                out.append((body.node_first(node, normal_director) + k,
+                            f"{tag} {normal_director}"))
+    return out
+
+
 KIND = register(Kind(
     group="beam", body_class=Beam, keys=KEYS, build=build, api="beam", word="beam",
     objects=("material", "section", "frame_drive"), scene_defaults={"formulation": "formulation"},
     set_builder=_beam_set,
     adders={"ffr": _add_ffr, "continuum": _add_continuum, "cubic": _add_cubic},
     part=lambda body: part_of(body.name, body.nodes),
-    check_dimensions=lambda body: check_axis_dimensions(body, "beam")))
+    check_dimensions=lambda body: check_axis_dimensions(body, "beam"),
+    plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
+    planar_fixed=_planar_fixed))

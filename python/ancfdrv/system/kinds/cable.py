@@ -280,8 +280,23 @@ def build(system, v: dict) -> Cable:
                                   bending_inertia=v.get("bending_inertia")))
 
 
+def _planar_problems(body: Cable, j: int, tol: float) -> list[str]:
+    """The planar rule (system/planar.py): the axis in a plane normal to e_j."""
+    if abs(float(body.start[j] - body.end[j])) > tol:
+        return [f"its axis leaves the plane normal to {'xyz'[j]}"]
+    return []
+
+
+def _planar_fixed(body: Cable, j: int, q0) -> list[tuple[int, str]]:
+    """In planar motion normal to e_j every node keeps r_j and r_x,j."""
+    return [(body.node_first(node, which) + j, f"{body.name}: planar node {node + 1} {which}")
+            for node in range(body.nodes) for which in ("r", "r_x")]
+
+
 KIND = register(Kind(
     group="cable", body_class=Cable, keys=KEYS, build=build, api="cable", word="cable",
     api_keys=("bending_inertia",), objects=("material", "section"), set_builder=cable_set,
     adders={"cable": _add_cable},
-    check_dimensions=lambda body: check_axis_dimensions(body, "cable")))
+    check_dimensions=lambda body: check_axis_dimensions(body, "cable"),
+    plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
+    planar_fixed=_planar_fixed))

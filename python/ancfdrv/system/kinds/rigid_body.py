@@ -118,8 +118,36 @@ def build(system, v: dict) -> RigidBody:
                                       plane_normal=checked["plane_normal"]))
 
 
+def _planar_problems(body: RigidBody, j: int, tol: float) -> list[str]:
+    """The planar rule (system/planar.py): no product of inertia couples a turn about e_j
+    with the other two; a body already planar has the normal e_j."""
+    plane, out = "xyz"[j], []
+    coupling = np.delete(body.inertia[j], j)
+    if np.abs(coupling).max() > 1e-9 * np.abs(body.inertia).max():
+        out.append(f"its products of inertia couple a turn about {plane} with the other axes")
+    if body.planar and body.plane_axis != j:
+        out.append(f"it is planar with the normal {'xyz'[body.plane_axis]}, not {plane}")
+    return out
+
+
+def _planar_fixed(body: RigidBody, j: int, q0) -> list[tuple[int, str]]:
+    """In planar motion normal to e_j: its translation along j, its axis j (kept = e_j) and
+    the j-components of its other two axes (none when its own guide holds them)."""
+    if body.planar and body.plane_axis == j:
+        return []
+    out = [(body.vector_first("r") + j, f"{body.name}: planar (scene) r{j + 1}")]
+    for k, which in enumerate(("r_x", "r_y", "r_z")):
+        for comp in range(3):
+            if k == j or comp == j:
+                out.append((body.vector_first(which) + comp,
+                            f"{body.name}: planar (scene) {which}"))
+    return out
+
+
 KIND = register(Kind(
     group="rigid_body", body_class=RigidBody, keys=KEYS, build=build, api="rigid_body",
     word="rigid body",
     part=lambda body: validate.Part(f"rigid_body[{body.name}]", "mass", "rigid_body", 1,
-                                    RIGID_DOFS)))
+                                    RIGID_DOFS),
+    plane=lambda body, j: float(body.centre[j]), planar_problems=_planar_problems,
+    planar_fixed=_planar_fixed))
