@@ -13,8 +13,8 @@ from ...io import validate
 from ...io.schema import (GEOMETRIC_STIFFNESS_DOC, MODES_DOC, Key, at_least, name_key,
                           non_negative, one_of,
                           positive, vector3)
-from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, along_axis, axis_stations,
-                      check_axis_dimensions)
+from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, along_axis,
+                      axis_stations, check_axis_dimensions)
 from ..expressions import Vec3
 from ..model import SetInfo
 from ..registry import Kind, SetContext, checked_values, register
