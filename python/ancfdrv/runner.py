@@ -241,7 +241,7 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
 
 def _warn_large_ffr_deflection(model: Model, out: Path | MemoryOutput) -> None:
     """The warning of an 'ffr' run whose tip deflects by more than 5% of the length."""
-    if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
+    if any(s.floating for s in model.sets) and "tip" in model.probes:
         with _io(out).reading(out) as h5:
             deflection = h5["dynamic/deflection/tip"][()]
         ratio = np.abs(deflection).max() / model.length_scale

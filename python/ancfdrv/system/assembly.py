@@ -899,7 +899,7 @@ def _policy(model: Model) -> None:
     """'constant' (factorized once) when every element set is FFR, there is no contact and
     the solver-frame assembly is exact (checked numerically); else 'refactor'."""
     model.policy, model.vector_frame = POLICY_REFACTOR, np.zeros(0, dtype=np.int64)
-    if model.contact_pairs or any(s.kind != "ffr" for s in model.sets):
+    if model.contact_pairs or any(not s.floating for s in model.sets):
         return
     if model.force_elements:  # their tangent changes with the configuration
         return

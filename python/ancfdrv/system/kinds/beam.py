@@ -292,7 +292,7 @@ def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
     info = SetInfo(body=beam, kind="", dofs=dofs, nel=beam.nel, frame=frame_id,
                    mass_compact=mass_compact)
     if beam.formulation == "ffr":
-        info.kind = "ffr"
+        info.kind, info.floating = "ffr", True
         if beam.bending == "cubic":  # K0: the cubic tangent at the reference, in the frame
             cubic = kernel.CubicBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
                                      m.poisson_ratio, torsion, shear_factors)
