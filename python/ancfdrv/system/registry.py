@@ -23,11 +23,13 @@ A kind declares
   effects a body belongs to by itself (``effects``);
 - its planar rule (:mod:`.planar`): the plane a body lies in (``plane``), what keeps it
   from staying in a plane (``planar_problems``) and the coordinates a plane fixes
-  (``planar_fixed``); a kind without a rule is not reduced (a plate, a leaf).
+  (``planar_fixed``); a kind without a rule is not reduced (a plate, a leaf);
+- its mesh rows (``mesh``: the points and cells the XDMF writer shows for a body, through
+  the writer's row builder, ``mesh_order``: the kinds' order in the mesh).
 
 What a body answers about itself (its size, its nodes, its mid-surface, the probe component
-a sweep compares) is a property of its class (:class:`~.bodies.Body`). The mesh rows of the
-XDMF writer and the answers' per-kind tables still test concrete classes
+a sweep compares) is a property of its class (:class:`~.bodies.Body`). The answers'
+per-kind tables still test concrete classes
 (tests/test_kinds_registry.py counts those checks and only lets the count go down).
 
 Each family of elements is one Fortran module (an extension of ``element_set`` in
@@ -103,6 +105,13 @@ class Kind:
     #: ``planar_fixed(body, j, q0) -> [(dof, label)]``: the full coordinates that keep their
     #: initial values in planar motion normal to e_j, each with its equation's label
     planar_fixed: Callable[[Any, int, Any], list[tuple[int, str]]] | None = None
+    #: ``mesh(body, rows)``: adds the body's points and cells to the XDMF writer's row
+    #: builder (``rows.point(terms)``, ``rows.node_points(first, nnodes, stride)``,
+    #: ``rows.quads``, ``rows.lines``: results/xdmf.py); None: not shown
+    mesh: Callable[[Any, Any], None] | None = None
+    #: the kind's place in the mesh (bodies of lower order first, each kind in the model's
+    #: order)
+    mesh_order: int = 0
 
 
 _KINDS: dict[str, Kind] = {}

@@ -392,6 +392,12 @@ def _planar_fixed(body: Beam, j: int, q0) -> list[tuple[int, str]]:
     return out
 
 
+def _mesh(body: Beam, rows) -> None:
+    """XDMF: a 2-node line per element through the node positions r."""
+    nodes = rows.node_points(body.first, body.nodes, 12) + np.arange(body.nodes)
+    rows.lines.append(np.column_stack([nodes[:-1], nodes[1:]]))
+
+
 KIND = register(Kind(
     group="beam", body_class=Beam, keys=KEYS, build=build, api="beam", word="beam",
     objects=("material", "section", "frame_drive"), scene_defaults={"formulation": "formulation"},
@@ -400,4 +406,4 @@ KIND = register(Kind(
     part=lambda body: part_of(body.name, body.nodes),
     check_dimensions=lambda body: check_axis_dimensions(body, "beam"),
     plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
-    planar_fixed=_planar_fixed))
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1))

@@ -328,14 +328,20 @@ def _add_plate(ks: kernel.KernelSystem, s: SetInfo) -> int:
 
 
 
+def _mesh(body: Plate, rows) -> None:
+    """XDMF: the elements as quadrilaterals through the corner nodes."""
+    base = rows.node_points(body.first, body.mesh.nnodes, 9)
+    rows.quads.append(body.mesh.elements + base)
+
+
 PLATE = register(Kind(
     group="plate", body_class=Plate, keys=PLATE_KEYS, build=build_plate, api="plate",
     word="plate", objects=("material",), set_builder=_plate_set, adders={"plate": _add_plate},
     part=lambda body: part_of("plate", body.name, body.mesh.nnodes),
-    check_dimensions=lambda body: check_dimensions(body, "plate", "edge_x")))
+    check_dimensions=lambda body: check_dimensions(body, "plate", "edge_x"), mesh=_mesh))
 LEAF = register(Kind(
     group="leaf", body_class=Leaf, keys=LEAF_KEYS, build=build_leaf, api="leaf", word="leaf",
     objects=("material",), set_builder=_plate_set,
     part=lambda body: part_of("leaf", body.name, body.mesh.nnodes),
     check_dimensions=lambda body: check_dimensions(body, "leaf", "arc_length"),
-    effects=lambda body: {"prestress"} if body.prestressed else set()))
+    effects=lambda body: {"prestress"} if body.prestressed else set(), mesh=_mesh))

@@ -4,6 +4,8 @@ registration (:mod:`..registry`); it has no element set (its mass matrix is its 
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ... import kernel
@@ -144,10 +146,22 @@ def _planar_fixed(body: RigidBody, j: int, q0) -> list[tuple[int, str]]:
     return out
 
 
+def _mesh(body: RigidBody, rows) -> None:
+    """XDMF: its centre r and three lines along r_x, r_y, r_z as long as its radius of
+    gyration about the centre of mass, sqrt(tr(I) / 2m) (the root mean square distance of
+    the mass from the centre; 1 when 0)."""
+    size = math.sqrt(max(float(np.trace(body.inertia)), 0.0) / (2.0 * body.mass))
+    size = size if size > 0 else 1.0
+    centre = rows.point([(body.first, 1.0)])
+    for k in (1, 2, 3):  # r + size r_x, r + size r_y, r + size r_z
+        tip = rows.point([(body.first, 1.0), (body.first + 3 * k, size)])
+        rows.lines.append(np.array([[centre, tip]]))
+
+
 KIND = register(Kind(
     group="rigid_body", body_class=RigidBody, keys=KEYS, build=build, api="rigid_body",
     word="rigid body",
     part=lambda body: validate.Part(f"rigid_body[{body.name}]", "mass", "rigid_body", 1,
                                     RIGID_DOFS),
     plane=lambda body, j: float(body.centre[j]), planar_problems=_planar_problems,
-    planar_fixed=_planar_fixed))
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=2))
