@@ -218,10 +218,10 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     when the model has neither joints nor beams)."""
     from .solvers.dynamic import initial_acceleration
     from .system.answers import DynamicAnswers, reaction_map
-    from .system.kinds import Beam
+    from .system.registry import reports_sections
     if not scene["output"].get("answers", True):
         return None
-    if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies) \
+    if not reaction_map(model).joints and not any(reports_sections(b) for b in model.bodies) \
             and not model.force_elements:
         return None
     recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,

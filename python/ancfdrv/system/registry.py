@@ -24,12 +24,15 @@ A kind declares
 - its planar rule (:mod:`.planar`): the plane a body lies in (``plane``), what keeps it
   from staying in a plane (``planar_problems``) and the coordinates a plane fixes
   (``planar_fixed``); a kind without a rule is not reduced (a plate, a leaf);
+- whether its bodies report section forces and stresses at stations (``sections``: the
+  answers, :mod:`.answers`, and the dynamic run's recorder of them);
 - its mesh rows (``mesh``: the points and cells the XDMF writer shows for a body, through
   the writer's row builder, ``mesh_order``: the kinds' order in the mesh).
 
 What a body answers about itself (its size, its nodes, its mid-surface, the probe component
 a sweep compares) is a property of its class (:class:`~.bodies.Body`). The answers'
-per-kind tables still test concrete classes
+section forces are still re-derived for beams in numpy (:mod:`.answers`), and a few
+per-kind branches of the assembly and the joints still test concrete classes
 (tests/test_kinds_registry.py counts those checks and only lets the count go down).
 
 Each family of elements is one Fortran module (an extension of ``element_set`` in
@@ -45,7 +48,7 @@ from typing import Any, Callable
 from ..io.schema import Key, check_call, register_group
 
 __all__ = ["Kind", "SetContext", "register", "kinds", "kind", "kind_of", "checked_values",
-           "set_builder", "add_to_kernel"]
+           "set_builder", "add_to_kernel", "reports_sections"]
 
 
 @dataclass
@@ -112,6 +115,8 @@ class Kind:
     #: the kind's place in the mesh (bodies of lower order first, each kind in the model's
     #: order)
     mesh_order: int = 0
+    #: its bodies report section forces and stresses at stations (system/answers.py)
+    sections: bool = False
 
 
 _KINDS: dict[str, Kind] = {}
@@ -156,6 +161,12 @@ def checked_values(kind: Kind, label: str, values: dict[str, Any]) -> dict[str, 
     plain = {k: x for k, x in values.items() if k in kind.keys and
              (x is None or isinstance(x, str) or k not in kind.objects)}
     return {**values, **check_call(kind.group, label, plain)}
+
+
+def reports_sections(body) -> bool:
+    """Whether the body's kind reports section forces and stresses (``Kind.sections``)."""
+    found = kind_of(body)
+    return found is not None and found.sections
 
 
 def set_builder(body) -> Callable[[Any, SetContext], Any] | None:

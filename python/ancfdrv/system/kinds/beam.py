@@ -406,4 +406,4 @@ KIND = register(Kind(
     part=lambda body: part_of(body.name, body.nodes),
     check_dimensions=lambda body: check_axis_dimensions(body, "beam"),
     plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
-    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1))
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1, sections=True))
