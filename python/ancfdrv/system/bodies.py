@@ -210,6 +210,11 @@ class Body:
         """Nodal vectors a dead moment can act on (the rotation is measured on them)."""
         raise NotImplementedError
 
+    def torsion_shares(self) -> tuple[float, float]:
+        """How a moment about the normal of its two directors divides between them: halves
+        (a beam's section: by its shear and bending rule)."""
+        return 0.5, 0.5
+
 
 class Ground(Body):
     """The fixed world; its name 'ground' is reserved."""
