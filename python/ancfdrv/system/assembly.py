@@ -280,16 +280,7 @@ def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern
         for pm in masses:
             if pm.body is info.body:
                 at = pm.body.locate(pm.point, node=False, what=f"load {pm.name!r}")
-                if isinstance(info.body, Beam):
-                    compact[:, :, at.element] += kernel.beam_point_mass(
-                        *at.local, info.body.lengths[at.element], pm.mass)
-                elif hasattr(info.body, "shape_row"):  # a family's own shape row (cable)
-                    shape = info.body.shape_row(at)
-                    compact[:, :, at.element] += pm.mass * np.outer(shape, shape)
-                else:
-                    shape, _ = kernel.plate_shape(*at.local, info.body.mesh.a[at.element],
-                                                  info.body.mesh.b[at.element])
-                    compact[:, :, at.element] += pm.mass * np.outer(shape, shape)
+                compact[:, :, at.element] += info.body.point_mass(at, pm.mass)
         n = compact.shape[0]
         element = np.einsum("abe,ij->aibje", compact, np.eye(3)).reshape(3 * n, 3 * n, -1)
         np.add.at(values, info.scatter.ravel() - 1, element.ravel())
@@ -318,21 +309,8 @@ def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counter
     g = sum((load.vector for load in act.gravity), np.zeros(3))
     if act.gravity:
         for info in sets:
-            body = info.body
-            if isinstance(body, Beam):
-                elements = kernel.beam_gravity(body.lengths,
-                                               *body.section.mass_rule(body.material.density), g)
-                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
-                          elements.reshape(-1, order="F"))
-            elif hasattr(body, "gravity_forces"):  # a family's own (cable)
-                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
-                          body.gravity_forces(g).reshape(-1, order="F"))
-            else:
-                _, elements = kernel.plate_element_arrays(
-                    body.mesh.a, body.mesh.b, body.thickness, body.material.density,
-                    body.material.density * body.thickness * g)
-                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
-                          elements.reshape(-1, order="F"))
+            np.add.at(gravity, info.dofs.reshape(-1, order="F"),
+                      info.body.gravity_forces(g).reshape(-1, order="F"))
         for body in bodies:
             if body.rigid:
                 gravity[body.first:body.first + 3] += body.mass * g

@@ -210,6 +210,16 @@ class Body:
         """Nodal vectors a dead moment can act on (the rotation is measured on them)."""
         raise NotImplementedError
 
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A flexible body: a point mass's share of its element's compact mass matrix
+        (n, n) (the element at.element)."""
+        raise NotImplementedError
+
+    def gravity_forces(self, g: np.ndarray) -> np.ndarray:
+        """A flexible body: its generalized gravity forces per element (nde, nel) of the
+        acceleration g (3,)."""
+        raise NotImplementedError
+
     def torsion_shares(self) -> tuple[float, float]:
         """How a moment about the normal of its two directors divides between them: halves
         (a beam's section: by its shear and bending rule)."""

@@ -177,6 +177,16 @@ class Beam(Body):
     def directors(self, at: Attachment) -> list[str]:
         return ["r_y", "r_z"]
 
+    # -- what the assembly asks of a flexible body besides its set ---------------------------
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A point mass's share of its element's compact mass matrix."""
+        return kernel.beam_point_mass(*at.local, self.lengths[at.element], mass)
+
+    def gravity_forces(self, g: np.ndarray) -> np.ndarray:
+        """Generalized gravity forces per element (24, nel) of the acceleration g (3,)."""
+        return kernel.beam_gravity(self.lengths, *self.section.mass_rule(self.material.density),
+                                   g)
+
     def torsion_shares(self) -> tuple[float, float]:
         """How a torque about the axis divides between the directors r_y and r_z when the
         section turns without shearing: halves with 'cubic' bending (its twist is

@@ -215,6 +215,11 @@ class Cable(Body):
         return []
 
     # -- what the assembly asks of a flexible body besides its set ---------------------------
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A point mass's share (4, 4) of its element's compact mass matrix."""
+        shape = self.shape_row(at)
+        return mass * np.outer(shape, shape)
+
     def gravity_forces(self, g: np.ndarray) -> np.ndarray:
         """Generalized gravity forces per element (12, nel) of the acceleration g (3,): the
         uniform load rho A g per length."""

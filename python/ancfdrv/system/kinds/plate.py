@@ -169,6 +169,20 @@ class Plate(Body):
     def directors(self, at: Attachment) -> list[str]:
         return ["r_x", "r_y"]
 
+    # -- what the assembly asks of a flexible body besides its set ---------------------------
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A point mass's share of its element's compact mass matrix."""
+        shape, _ = kernel.plate_shape(*at.local, self.mesh.a[at.element],
+                                      self.mesh.b[at.element])
+        return mass * np.outer(shape, shape)
+
+    def gravity_forces(self, g: np.ndarray) -> np.ndarray:
+        """Generalized gravity forces per element of the acceleration g (3,)."""
+        _, elements = kernel.plate_element_arrays(
+            self.mesh.a, self.mesh.b, self.thickness, self.material.density,
+            self.material.density * self.thickness * g)
+        return elements
+
     def initial_normal(self, element: int) -> np.ndarray:
         """Unit normal r_x x r_y at the element's centre in the initial shape."""
         shape, derivs = kernel.plate_shape(0.5, 0.5, self.mesh.a[element], self.mesh.b[element])
