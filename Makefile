@@ -12,7 +12,8 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.ancfdrv-installed
 APT_PACKAGES := gfortran libmumps-seq-dev liblapack-dev libopenblas-dev pkg-config
-SOURCES := $(shell find fortran python -name '*.f90' -o -name '*.py' -o -name '.f2py_f2cmap') \
+SOURCES := $(shell find fortran python -name '*.f90' -o -name '*.py' -o -name '.f2py_f2cmap' \
+           -o -name meson.build) \
            meson.build pyproject.toml
 DEMO_STATIC := results/boom_static_sweep
 DEMO_LUFFING := results/boom_luffing_sweep
@@ -27,7 +28,7 @@ demo: $(STAMP)
 	$(VENV)/bin/ancf sweep inputs/boom_luffing.nml --vary loads.tip_mass=0,50 \
 	    --vary beam.nodes=4,10,16,22,28 --vary solver.dt=2e-3,1e-3 -o $(DEMO_LUFFING)
 	@echo "== One luffing run, 28 nodes, 50 kg"
-	$(VENV)/bin/ancf run inputs/boom_luffing.nml -o results/boom_luffing.h5
+	$(VENV)/bin/ancf run inputs/boom_luffing.nml -o results/boom_luffing.h5 --plot
 
 # one pytest worker per core (pytest-xdist), each test file on one worker (its module
 # fixtures computed once)

@@ -1,7 +1,7 @@
 """Regression gate of the kernel's static Newton (issue 25 item 4): every scene's static
 solve (analysis 'static', 'static+dynamic', settled starts, the modal analysis's static
 state) through the kernel's Newton (solvers/static.py solve_newton) and through the Python
-reference (solve_newton_python), compared: the largest difference of the coordinates
+reference (tests/reference/static_newton.py solve_newton_python), compared: the largest difference of the coordinates
 relative to the largest displacement |e - e0|, of the multipliers relative to the
 largest multiplier (counted when that is above 1e-9), and the iteration counts. The run stops after the (first) static
 solve; nothing is written but a temporary result file.
@@ -22,7 +22,10 @@ import ancfdrv.solvers.static as static
 from ancfdrv import cli
 
 ROOT = Path(__file__).resolve().parents[1]
-KERNEL, PYTHON = static.solve_newton, static.solve_newton_python
+sys.path.insert(0, str(ROOT / "tests"))
+from reference.static_newton import solve_newton_python  # noqa: E402  (the tests' reference)
+
+KERNEL, PYTHON = static.solve_newton, solve_newton_python
 INTEGRATE = runner.integrate
 
 

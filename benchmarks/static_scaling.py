@@ -73,7 +73,7 @@ from ancfdrv.errors import SolverError
 from ancfdrv.builders import build_model
 from ancfdrv.io.scene import load_scene
 from ancfdrv.kernel import DirectSolver
-from ancfdrv.solvers.static import StaticResult, _hessian_triplets, solve_newton, solve_split
+from ancfdrv.solvers.static import StaticResult, solve_newton, solve_split
 from ancfdrv.system.model import Model
 
 REPO = Path(__file__).resolve().parents[1]
@@ -187,7 +187,7 @@ def newton_saddle_system(model: Model) -> LinearSystem:
     n, ncon = model.ndof, len(model.constraints)
     e = model.e0
     lam = np.zeros(ncon)
-    h_con, h_rows, h_cols, h_vals = _hessian_triplets(model, e)
+    h_con, h_rows, h_cols, h_vals = model.constraints.hessian_triplets(e)
     phi, j_rows, j_cols, grads = model.constraints.jacobian(e, n)
     moments = model.moment_terms(e)
     m_rows = [np.repeat(cols, len(cols)) for cols, *_ in moments]

@@ -25,7 +25,8 @@ BOOM = """
 def test_run_writes_spec_layout_and_plot(boom_scene, tmp_path, capsys):
     out = tmp_path / "boom.h5"
     code = main(["run", str(boom_scene), "-o", str(out), "--set", "beam.nodes=10",
-                 "--set", "solver.static_method='newton'", "--set", "loads.tip_mass=50"])
+                 "--set", "solver.static_method='newton'", "--set", "loads.tip_mass=50",
+                 "--plot"])
     assert code == 0
     assert "tip" in capsys.readouterr().out
     with h5py.File(out) as h5:

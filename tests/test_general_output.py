@@ -28,8 +28,8 @@ SCENES = Path(__file__).resolve().parent / "scenes"
 GENERAL = Path(__file__).resolve().parents[1] / "inputs" / "general"
 
 
-def _run(scene: Path, out: Path, *sets: str) -> int:
-    args = ["run", str(scene), "-o", str(out)]
+def _run(scene: Path, out: Path, *sets: str, plot: bool = False) -> int:
+    args = ["run", str(scene), "-o", str(out), *(["--plot"] if plot else [])]
     for s in sets:
         args += ["--set", s]
     return main(args)
@@ -50,7 +50,8 @@ GIRDER = ("beam[girder].width=0.04", "beam[girder].height=0.04", "beam[girder].w
 def test_l_frame_static_two_beams_exit_0_plot_and_frame_formula(tmp_path, capsys):
     out = tmp_path / "l_frame.h5"
     code = _run(SCENES / "l_frame.nml", out, "scene.effects='point_loads'",
-                "beam[column].bending='cubic'", "beam[girder].bending='cubic'", *GIRDER)
+                "beam[column].bending='cubic'", "beam[girder].bending='cubic'", *GIRDER,
+                plot=True)
     assert code == 0, capsys.readouterr().err
     assert out.with_suffix(".png").stat().st_size > 1000
     with h5py.File(out) as h5:
@@ -90,7 +91,7 @@ def _four_bar_rocker_top(theta: np.ndarray) -> np.ndarray:
 
 def test_four_bar_dynamic_exit_0_plot_and_closed_form_kinematics(tmp_path, capsys):
     out = tmp_path / "four_bar.h5"
-    assert _run(SCENES / "four_bar.nml", out) == 0, capsys.readouterr().err
+    assert _run(SCENES / "four_bar.nml", out, plot=True) == 0, capsys.readouterr().err
     assert out.with_suffix(".png").stat().st_size > 1000
     with h5py.File(out) as h5:
         t = h5["dynamic/time"][()]
@@ -107,7 +108,7 @@ def test_four_bar_dynamic_exit_0_plot_and_closed_form_kinematics(tmp_path, capsy
 
 def test_knuckle_crane_static_dynamic_exit_0_plot_info(tmp_path, capsys):
     out = tmp_path / "crane.h5"
-    assert _run(SCENES / "knuckle_crane.nml", out, "solver.t_end=0.02") == 0, \
+    assert _run(SCENES / "knuckle_crane.nml", out, "solver.t_end=0.02", plot=True) == 0, \
         capsys.readouterr().err
     assert out.with_suffix(".png").stat().st_size > 1000
     capsys.readouterr()
@@ -123,7 +124,7 @@ def test_knuckle_crane_static_dynamic_exit_0_plot_info(tmp_path, capsys):
     ("leaf_spring", ("solver.t_end=0.01",))])
 def test_shipped_general_scenes_exit_0_with_plot(name, sets, tmp_path, capsys):
     out = tmp_path / f"{name}.h5"
-    assert _run(GENERAL / f"{name}.nml", out, *sets) == 0, capsys.readouterr().err
+    assert _run(GENERAL / f"{name}.nml", out, *sets, plot=True) == 0, capsys.readouterr().err
     assert out.with_suffix(".png").stat().st_size > 1000
     assert main(["plot", str(out), "-o", str(tmp_path / "p.png")]) == 0
 
@@ -135,7 +136,7 @@ def test_renamed_probe_and_failing_plot_are_not_failures(tmp_path, capsys, monke
     scene.write_text((GENERAL / "cantilever.nml").read_text().replace("name = 'tip'",
                                                                       "name = 'end point'"))
     out = tmp_path / "c.h5"
-    assert _run(scene, out) == 0
+    assert _run(scene, out, plot=True) == 0
     assert out.with_suffix(".png").exists()
     from ancfdrv import plots
 
@@ -143,7 +144,7 @@ def test_renamed_probe_and_failing_plot_are_not_failures(tmp_path, capsys, monke
         raise KeyError("node_s")
     monkeypatch.setattr(plots, "plot_result", broken)
     out2 = tmp_path / "c2.h5"
-    assert _run(scene, out2) == 0
+    assert _run(scene, out2, plot=True) == 0
     assert "warning: the plot" in capsys.readouterr().err
     with h5py.File(out2) as h5:
         assert h5.attrs["status"] == "ok"

@@ -387,7 +387,7 @@ def test_command_line_runs_and_plots_plate_scenes(tmp_path, capsys):
     from ancfdrv.cli import main
     out = tmp_path / "pressure.h5"
     assert main(["run", str(INPUTS / "plate_pressure.nml"), "-o", str(out),
-                 "--set", "plate.nx=4", "--set", "plate.ny=4"]) == 0
+                 "--set", "plate.nx=4", "--set", "plate.ny=4", "--plot"]) == 0
     printed = capsys.readouterr().out
     assert "centre" in printed and out.with_suffix(".png").exists()
     leaf = tmp_path / "leaf.h5"

@@ -1,5 +1,5 @@
 """The static Newton in the kernel (fortran/src/solvers/static_solver.f90, issue 25 item 4)
-against the Python static Newton it replaced (solvers/static.py solve_newton_python, which
+against the Python static Newton it replaced (tests/reference/static_newton.py, which
 assembles the moments' and point loads' Jacobians, the constraint Hessians and the
 convergence test from separate kernel calls and Python's constraint code), against closed
 forms, and its error texts.
@@ -17,10 +17,11 @@ import pytest
 from ancfdrv.builders import build_model
 from ancfdrv.errors import SolverError
 from ancfdrv.io.scene import load_scene
-from ancfdrv.solvers.static import residuals, solve_newton, solve_newton_python
+from ancfdrv.solvers.static import residuals, solve_newton
 
 from conftest import INPUTS
 from helpers import beam_model
+from reference.static_newton import solve_newton_python  # (tests/reference: never used by a run)
 
 SLENDER = ["beam.length=1", "beam.width=0.01", "beam.height=0.01",
            "scene.formulation=nonlinear"]

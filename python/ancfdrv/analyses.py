@@ -49,7 +49,9 @@ ANALYSES = ("static", "dynamic", "static+dynamic")
 def _settings(options: dict[str, Any], where: str) -> tuple[dict, dict]:
     """The &solver and &output values of a run from Python: the schema's defaults (the
     CLI's) with the keyword options; unknown keys and bad values raise InputError."""
-    solver_keys, output_keys = set(SCHEMA["solver"]), set(SCHEMA["output"]) - {"file"}
+    # output.plot is ancf run's (from Python: Results.save(path, plot=True))
+    solver_keys = set(SCHEMA["solver"])
+    output_keys = set(SCHEMA["output"]) - {"file", "plot"}
     unknown = sorted(set(options) - solver_keys - output_keys)
     if unknown:
         raise InputError(f"{where}: unknown option {', '.join(map(repr, unknown))}; options: "

@@ -1,9 +1,9 @@
 """The ``ancf`` command (SPEC section 2).
 
     ancf [--debug] [--version] COMMAND ...
-    ancf run SCENE.nml [-o OUT.h5] [--set GROUP.KEY=VALUE ...]
+    ancf run SCENE.nml [-o OUT.h5] [--set GROUP.KEY=VALUE ...] [--plot]
     ancf sweep SCENE.nml --vary GROUP.KEY=V1,V2,... [--vary ...] [-o DIR] [--workers N | --scheduler ADDR]
-    ancf info OUT.h5
+    ancf info OUT.h5 [--json]
     ancf plot OUT.h5 [OUT2.h5 ...] [-o PNG]   (several files: leaf spring runs overlaid)
 
 Exit status:
@@ -46,13 +46,19 @@ EXIT_CODES = """exit status:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    """Run a scene, print what it did and end with the headline of its answers
+    (:mod:`ancfdrv.results.headline`); the plot only with --plot or output.plot."""
     from .results.hdf5 import read_summary
+    from .results.headline import answer_lines, read_answers
     from .runner import run_scene
     if args.force:
         args.set = [*args.set, "scene.bounds=off"]
-    # the plot is written while the output is still locked (a second run is refused)
-    outcome = run_scene(args.scene, args.set, args.output,
-                        after=lambda done: optional_outputs(done.output))
+
+    def plot_if_asked(done) -> list[Path]:
+        # written while the output is still locked (a second run is refused meanwhile)
+        wanted = args.plot or bool(done.scene["output"].get("plot", False))
+        return optional_outputs(done.output) if wanted else []
+    outcome = run_scene(args.scene, args.set, args.output, after=plot_if_asked)
     for warning in outcome.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     summary = read_summary(outcome.output)
@@ -87,6 +93,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
             print(stage_table(outcome.stages))
     written = [str(outcome.output)] + [str(path) for path in (outcome.after or [])]
     print(f"  written      {', '.join(written)}")
+    print("\n".join(answer_lines(read_answers(outcome.output))))
     return 0
 
 
@@ -144,18 +151,61 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+#: ``ancf info`` prints at most this many values of an array figure, then "... N more"
+#: (the answers below the figures list every reaction, frequency and load factor)
+INFO_ARRAY_VALUES = 8
+
+
+def _info_value(value: object) -> object:
+    """An array figure as text, cut after INFO_ARRAY_VALUES values with a mark."""
+    if not isinstance(value, np.ndarray):
+        return value
+    flat = value.ravel()
+    if flat.size <= INFO_ARRAY_VALUES:
+        return np.array2string(value, precision=6, max_line_width=1 << 30)
+    shown = np.array2string(flat[:INFO_ARRAY_VALUES], precision=6, max_line_width=1 << 30)
+    return f"{shown[:-1]} ...] ... {flat.size - INFO_ARRAY_VALUES} more"
+
+
+def json_ready(value: object) -> object:
+    """A summary or answers value as plain JSON types (arrays as lists, whole)."""
+    if isinstance(value, dict):
+        return {str(k): json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_ready(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, bytes):
+        return value.decode()
+    return value
+
+
 def _cmd_info(args: argparse.Namespace) -> int:
     """The verdict on the first line (ok, failed, interrupted, running, abandoned), then
-    the main figures."""
+    the main figures and the answers (every reaction, frequency and load factor); with
+    --json one JSON object: file, verdict, detail, summary (every figure, arrays whole)
+    and answers."""
     from .results.hdf5 import read_summary, verdict
+    from .results.headline import answer_lines, read_answers
     path = Path(args.file)
     try:
         summary = read_summary(path)  # InputError (exit 2) when missing, not HDF5, not ours
         word, detail = verdict(path, summary)
+        try:
+            answers = read_answers(path)
+        except (OSError, KeyError, ValueError):
+            answers = {}  # a partial file (failed or interrupted): the figures are all
     except (AncfError, *PROGRAMMING_ERRORS):
         raise
     except Exception as exc:  # noqa: BLE001 - a damaged file: exit 2 naming it
         raise corrupted(path, exc) from None
+    if args.json:
+        import json
+        print(json.dumps(json_ready({"file": str(path), "verdict": word, "detail": detail,
+                                     "summary": summary, "answers": answers}), indent=1))
+        return 0
     print(f"{path}: {word}: {detail}")
     skip = {"scene", "status", "message"}
     for key, value in summary.items():
@@ -163,15 +213,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
             continue
         if isinstance(value, str) and "\n" in value:
             value = value.replace("\n", "; ")
-        if isinstance(value, np.ndarray):
-            value = np.array2string(value, precision=6)
-        print(f"{key:32s} {value}")
-    from .results.hdf5 import answer_headlines
-    try:
-        for line in answer_headlines(path):
-            print(line)
-    except (OSError, KeyError, ValueError):
-        pass  # an older or partial file: the summary above is what it has
+        print(f"{key:32s} {_info_value(value)}")
+    for line in answer_lines(answers):
+        print(line)
     return 0
 
 
@@ -234,6 +278,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="override a namelist value (repeatable)")
     p.add_argument("--force", action="store_true", help="accept drives and loads beyond "
                    "their physical bounds (the same as --set scene.bounds=off)")
+    p.add_argument("--plot", action="store_true", help="write the plot beside the result "
+                   "(OUT.png; the same as output.plot = .true.; ancf plot draws any result "
+                   "later)")
     p.set_defaults(func=_cmd_run)
     p = sub.add_parser("sweep", help="run every combination of --vary values")
     p.add_argument("scene")
@@ -253,6 +300,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "the run finished (ok), failed, was interrupted, is running or was "
                        "abandoned (its writer was killed)")
     p.add_argument("file")
+    p.add_argument("--json", action="store_true", help="write the figures and the answers "
+                   "as one JSON object (every reaction, frequency and load factor; arrays "
+                   "whole)")
     p.set_defaults(func=_cmd_info)
     p = sub.add_parser("plot", help="plot a result file (several: leaf spring runs overlaid)")
     p.add_argument("file", nargs="+", help="HDF5 result file; several only for leaf spring "

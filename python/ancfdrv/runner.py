@@ -189,7 +189,9 @@ def _write_static_answers(scene: Scene, model: Model, out: Path | MemoryOutput,
     written and returned (:class:`~ancfdrv.system.answers.Answers`)."""
     from .system.answers import static_answers
     stations = scene["output"].get("stations", 3)
-    answers = static_answers(model, result.e, result.lam, stations)
+    # the loads' scale the state balances (an 'unloaded' settle: 0)
+    answers = static_answers(model, result.e, result.lam, stations,
+                             result.extra.get("load_factor", 1.0))
     _io(out).write_static_answers(out, model, result.e, result.lam, stations, answers=answers)
     return answers
 

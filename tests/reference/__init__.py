@@ -1,7 +1,7 @@
 """Independent reference computations used by the tests only (never by a run).
 
-Written without looking at ancfdrv's implementation; pure numpy/scipy, SI units, every
-parameter passed explicitly. Their own correctness is checked against textbook closed
+Written without looking at ancfdrv's implementation (except the two solver references at
+the end, which say so); pure numpy/scipy, SI units, every parameter passed explicitly. Their own correctness is checked against textbook closed
 forms in ``tests/test_leaf_reference.py`` and ``tests/test_references.py``.
 
 Modules
@@ -38,4 +38,14 @@ Modules
     length, optional lift cylinder): jib angle, actuator force, hinge reactions, holding
     moment; and the small-deflection sag of the same boom made of flexible beams
     (superposition of cantilever and overhanging simply supported beam formulas).
+
+``static_newton``
+    The static Newton assembled in Python (``solve_newton_python``): the package's former
+    Newton, from separate kernel force evaluations and Python's constraint Jacobians and
+    Hessians; the reference of the kernel's static Newton (tests/test_static_kernel.py,
+    tests/test_static_small_loads.py, benchmarks/static_kernel_gate.py).
+
+``reduced_ffr_newmark``
+    The reduced FFR model's Newmark steps in numpy with full Newton (``newmark_python``):
+    the reference of the kernel's reduced stepper (tests/test_ffr_reduced.py).
 """

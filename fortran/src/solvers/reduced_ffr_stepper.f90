@@ -5,7 +5,7 @@
 !> with constant r x r matrices and the frame's rate psi', acceleration psi'' and angle psi
 !> given at every output time, the load
 !>   g = -psi'' l_euler - psi'^2 l_centrifugal - sin psi l_sin + (1 - cos psi) l_cos
-!> formed step by step from its four constant patterns (as ffr_reduced.simulate forms it). The iteration matrix a I + v 2 psi' Gam + Lam + psi'' Gam +
+!> formed step by step from its four constant patterns (as tests/reference/reduced_ffr_newmark.py forms it). The iteration matrix a I + v 2 psi' Gam + Lam + psi'' Gam +
 !> psi'^2 C2 (+ C) is factorized (LU with partial pivoting) only when psi' or psi'' changed; the linear
 !> model takes one exact solve per step, with P-delta simplified Newton on that matrix.
 module reduced_ffr_stepper
@@ -164,7 +164,7 @@ contains
   end subroutine reduced_newmark
 
   !> The load g of the module doc at one time, each entry in the order numpy forms it in
-  !> ffr_reduced.simulate: ((-psi'' l_e - psi'^2 l_c) - sin psi l_s) + (1 - cos psi) l_k.
+  !> tests/reference/reduced_ffr_newmark.py: ((-psi'' l_e - psi'^2 l_c) - sin psi l_s) + (1 - cos psi) l_k.
   pure subroutine step_load(r, patterns, rate, accel, sin_psi, one_minus_cos, load)
     integer, intent(in) :: r
     real(dp), intent(in) :: patterns(r, 4), rate, accel, sin_psi, one_minus_cos

@@ -11,11 +11,11 @@
 !> moments' Jacobian; H_k: the constraint Hessians), factorized by sequential MUMPS
 !> (sparse_direct: the pattern analysed once per call) - the stepper's iteration matrix
 !> beta' M + K regularizes the rigid modes, the static one has the multipliers for them.
-!> The convergence test is the one of python/ancfdrv/solvers/static.py (converged,
-!> residual_floor): the relative force residual and the constraint violation below tol,
-!> or, on fine meshes whose residual has a round-off floor, the correction or the residual
-!> stopped falling there; the stagnation and divergence test watches the residuals (the
-!> static Newton has no step size to cut: the load stepping in Python does).
+!> The convergence test is static.py's converged (its floor as tests/reference/
+!> static_newton.py's residual_floor): the relative force residual and the constraint
+!> violation below tol, or, on fine meshes whose residual has a round-off floor, the
+!> correction or the residual stopped falling there; the stagnation and divergence test
+!> watches the residuals (no step size to cut: the load stepping in Python does).
 !> One call solves one load step; the load stepping and its reporting stay in Python.
 !> No I/O; failures return codes with their text (static_failure_text).
 module static_solver
@@ -267,7 +267,7 @@ contains
       since = it - best
       if ((near .and. since >= stall_iterations) .or. since >= far_stall_iterations .or. &
           growing .or. .not. (force_res < huge(1.0_dp))) then
-        ! as static.py's message: divergence, a stall at the floor, or a stall above it
+        ! as tests/reference/static_newton.py's message: divergence, a stall at or above the floor
         detail = 0
         if (it >= 4 .and. rising(history(max(1, it - 3):it)) .and. &
             force_res > 1.0e6_dp * history(best)) then
@@ -319,7 +319,7 @@ contains
       reaction = -reaction
     end subroutine evaluate
 
-    !> eps || |K| |e| || / scale (static.py residual_floor)
+    !> eps || |K| |e| || / scale (tests/reference/static_newton.py residual_floor)
     real(dp) function residual_floor(scale) result(level)
       real(dp), intent(in) :: scale
       real(dp) :: magnitude(size(e))

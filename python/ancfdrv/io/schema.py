@@ -339,6 +339,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "output": {
         "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),
         "q": Key("bool", False, doc="store the coordinates q at every step"),
+        "plot": Key("bool", False, doc="ancf run: write the plot beside the result (OUT.png, "
+                    "as ancf run --plot does; ancf plot draws any result file later)"),
         "chunk_steps": Key("int", 1000, positive,
                            "steps per kernel call at most; the rows reach the file at least "
                            "once a second"),

@@ -1212,15 +1212,22 @@ def write_support_deflections(path: Path, analysis: str, deflections: dict[str, 
 
 
 # -- engineering answers (SPEC section 10) -----------------------------------------------------
-def _reaction_group(group: h5py.Group, name: str, force, moment, axial) -> None:
+def _reaction_group(group: h5py.Group, name: str, force, moment, axial, kind: str) -> None:
+    """/<phase>/reactions/<name>; ``kind``: 'joint' or 'force element' (what ``ancf info``
+    calls it)."""
     sub = _subgroup(group, name)
     _dataset(sub, "force", np.asarray(force, dtype=float), "N")
     _dataset(sub, "moment", np.asarray(moment, dtype=float), "N m")
     if axial is not None:
         _dataset(sub, "axial", np.asarray(axial, dtype=float), "N")
-    _attrs(sub.attrs, {"description": "what body1 exerts on body2, global axes; moment "
+    _attrs(sub.attrs, {"kind": kind,
+                       "description": "what body1 exerts on body2, global axes; moment "
                                       "about the joint's point on body2; axial: tension "
                                       "positive"}, fresh=True)
+
+
+def _reaction_kind(name: str, force_elements: set[str]) -> str:
+    return "force element" if name in force_elements else "joint"
 
 
 def _section_group(group: h5py.Group, name: str, forces) -> None:
@@ -1250,8 +1257,10 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
                 del group[key]
         if found:
             reactions_group = _subgroup(group, "reactions")
+            elements = {f.name for f in getattr(model, "force_elements", ())}
             for name, r in found.items():
-                _reaction_group(reactions_group, name, r.force, r.moment, r.axial)
+                _reaction_group(reactions_group, name, r.force, r.moment, r.axial,
+                                _reaction_kind(name, elements))
         if forces:
             sections_group = _subgroup(group, "sections")
             stress_group = _subgroup(group, "stress")
@@ -1291,12 +1300,14 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 del group[key]
         if recorder.reactions:
             reactions_group = _subgroup(group, "reactions")
+            elements = {f.name for f in recorder.force_elements}
             for name, chunks in recorder.reactions.items():
                 if not chunks:
                     continue
                 axial = None if chunks[0][2] is None else np.concatenate([c[2] for c in chunks])
                 _reaction_group(reactions_group, name, np.concatenate([c[0] for c in chunks]),
-                                np.concatenate([c[1] for c in chunks]), axial)
+                                np.concatenate([c[1] for c in chunks]), axial,
+                                _reaction_kind(name, elements))
         if recorder.sections:
             sections_group = _subgroup(group, "sections")
             for name, chunks in recorder.sections.items():
@@ -1315,46 +1326,6 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 _attrs(sub.attrs, {"max": float(best[k]), "s_max": float(s[k]),
                                    "t_max": float(when[k])})
             _stress_points(h5, group, recorder)
-
-
-def answer_headlines(path: Path) -> list[str]:
-    """The headline engineering figures of a result file (``ancf info``): the largest
-    reaction (static, and over the dynamic run with its time) and the largest von Mises
-    stress (static, and the dynamic envelope's, where and when). Empty when the file has
-    none of them."""
-    lines: list[str] = []
-    with open_result(path) as h5:
-        for phase in ("static", "dynamic"):
-            if phase not in h5:
-                continue
-            group = h5[phase]
-            if "reactions" in group:
-                best = None
-                for name, sub in group["reactions"].items():
-                    force = np.atleast_2d(sub["force"][()])
-                    size = np.linalg.norm(force, axis=1)
-                    k = int(np.argmax(size))
-                    if best is None or size[k] > best[1]:
-                        best = (name, float(size[k]), k, force[k])
-                if best is not None:
-                    when = ""
-                    if phase == "dynamic" and "time" in group:
-                        when = f" at t = {float(group['time'][best[2]]):.6g} s"
-                    force = ", ".join(f"{x:.6g}" for x in best[3])
-                    lines.append(f"{phase + '.largest_reaction':32s} joint {best[0]!r}: "
-                                 f"|F| = {best[1]:.6g} N ({force}){when}")
-            if "stress" in group:
-                best = None
-                for name, sub in group["stress"].items():
-                    peak = float(sub.attrs.get("max", 0.0))
-                    if best is None or peak > best[1]:
-                        best = (name, peak, float(sub.attrs.get("s_max", 0.0)),
-                                sub.attrs.get("t_max"))
-                if best is not None:
-                    when = "" if best[3] is None else f" at t = {float(best[3]):.6g} s"
-                    lines.append(f"{phase + '.largest_von_mises':32s} {best[1] / 1e6:.6g} MPa "
-                                 f"in beam {best[0]!r} at s = {best[2]:.6g} m{when}")
-    return lines
 
 
 def _stress_points(h5: h5py.File, group: h5py.Group, recorder) -> None:
@@ -1386,9 +1357,6 @@ def _stress_points(h5: h5py.File, group: h5py.Group, recorder) -> None:
         del group["mesh_von_mises_max"]
     _dataset(group, "mesh_von_mises_max", values, "Pa")
 # -- modal analysis and linear buckling (SPEC section 10) -----------------------------------
-#: how many of the first frequencies / load factors ``ancf info`` prints
-INFO_EIGEN_COUNT = 6
-
 
 def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
                  full_shapes: np.ndarray, state: np.ndarray, series: dict[str, tuple],
@@ -1486,17 +1454,17 @@ def write_buckling(path: Path, model: Model, result) -> None:
 
 
 def eigen_summary(h5: h5py.File) -> dict[str, Any]:
-    """The headline figures of /modal and /buckling for ``ancf info``: the first
-    frequencies (and damping ratios), the first load factors, and the attributes."""
+    """The figures of /modal and /buckling for ``ancf info``: every frequency (and damping
+    ratio), every load factor, the first of them, and the group's attributes."""
     out: dict[str, Any] = {}
     for name, key in (("modal", "frequency"), ("buckling", "load_factor")):
         if name not in h5 or key not in h5[name]:
             continue
         group = h5[name]
         out.update({f"{name}.{k}": _text(v) for k, v in group.attrs.items()})
-        out[f"{name}.{key}"] = group[key][:INFO_EIGEN_COUNT]
+        out[f"{name}.{key}"] = group[key][()]
         if "damping_ratio" in group:
-            out[f"{name}.damping_ratio"] = group["damping_ratio"][:INFO_EIGEN_COUNT]
+            out[f"{name}.damping_ratio"] = group["damping_ratio"][()]
         if len(group[key]):
             out[f"{name}.first_{key}"] = float(group[key][0])
     return out

@@ -232,15 +232,15 @@ def _pdelta_terms(model: Model, reduced: ReducedFFR, x_star: np.ndarray) -> None
 
 def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25,
              gamma: float = 0.5, tol: float = 1e-9, max_newton: int = 10,
-             engine: str = "kernel", frame: dict | None = None) -> dict[str, np.ndarray]:
+             frame: dict | None = None) -> dict[str, np.ndarray]:
     """Newmark (beta, gamma) from the static state at rest (the start's acceleration the
     consistent one, eta''(0) = g(0)); returns 'time', 'eta', 'velocity' (eta'), each
     probe's deflection in the frame (name -> (steps + 1, 3)) and, from the kernel, per step
-    'corrections' (Newton) and 'factorized' (0 or 1). engine 'kernel': the Fortran
-    loop (kernel.reduced_ffr_newmark); 'python': the same steps in numpy with full Newton
-    (the reference of the test). tol: P-delta's Newton ends on a correction below tol times
-    max(1, max |eta|) (the linear model's one solve is exact); on the boom 1e-9 moves the
-    tip by 4e-12 m from 1e-14, 1e-6 by 1.1e-9 m (measured). ``frame``: a dict that
+    'corrections' (Newton) and 'factorized' (0 or 1): the Fortran loop
+    (kernel.reduced_ffr_newmark; tests/reference/reduced_ffr_newmark.py takes the same steps
+    in numpy with full Newton, the reference of its test). tol: P-delta's Newton ends on a
+    correction below tol times max(1, max |eta|) (the linear model's one solve is exact); on
+    the boom 1e-9 moves the tip by 4e-12 m from 1e-14, 1e-6 by 1.1e-9 m (measured). ``frame``: a dict that
     receives the frame's values at the times, 'angle' (phi), 'rate', 'sin' and
     'one_minus_cos' (of psi = phi - phi(0)), for the output rows (RowMaps.rows)."""
     t0 = time.perf_counter()
@@ -248,56 +248,18 @@ def simulate(reduced: ReducedFFR, t_end: float, dt: float, *, beta: float = 0.25
     times = np.arange(steps + 1) * dt
     phi, rate, accel = reduced.drive.values(times)
     psi = phi - reduced.start_angle
-    r = reduced.size
-    lam = np.diag(reduced.omega_squared)
     gam, c2 = reduced.gyroscopic, reduced.centrifugal
     sin, cos1 = np.sin(psi), 1.0 - np.cos(psi)
     if frame is not None:
         frame.update(angle=phi, rate=rate, sin=sin, one_minus_cos=cos1)
     pd_lin, pd_quad = reduced.pdelta_linear, reduced.pdelta_quadratic
-    if engine == "kernel":   # the load formed in the stepper, step by step, as below
-        patterns = np.column_stack([reduced.euler_load, reduced.centrifugal_load,
-                                    reduced.gravity_sin, reduced.gravity_cos])
-        steps_out = kernel.reduced_ffr_newmark(dt, beta, gamma, reduced.omega_squared, gam,
-                                               c2, pd_lin, pd_quad, patterns, rate, accel,
-                                               sin, cos1, tol, max_newton)
-        return _finish(reduced, times, steps_out["eta"], t0, steps_out)
-    if engine != "python":
-        raise SolverError(f"simulate: engine {engine!r} must be 'kernel' or 'python'")
-    force = (-accel[:, None] * reduced.euler_load - rate[:, None] ** 2 * reduced.centrifugal_load
-             - sin[:, None] * reduced.gravity_sin + cos1[:, None] * reduced.gravity_cos)
-    # at rest in the static state: eta'' = g(0) (the kernel's start too)
-    eta, vel, acc = np.zeros((steps + 1, r)), np.zeros(r), force[0].copy()
-    velocity = np.zeros((steps + 1, r))
-    a_fac, v_fac = 1.0 / (beta * dt * dt), gamma / (beta * dt)
-    eye = np.eye(r)
-    for n in range(steps):
-        stiff = lam + accel[n + 1] * gam + rate[n + 1] ** 2 * c2
-        damp = 2.0 * rate[n + 1] * gam
-        base = eta[n] + dt * vel + dt * dt * (0.5 - beta) * acc
-        vbase = vel + dt * (1.0 - gamma) * acc
-        x = base + dt * dt * beta * acc  # predictor: the same acceleration
-        jac_lin = a_fac * eye + v_fac * damp + stiff
-        for _ in range(max_newton):
-            a_new = (x - base) * a_fac
-            v_new = vbase + dt * gamma * a_new
-            res = a_new + damp @ v_new + stiff @ x - force[n + 1]
-            jac = jac_lin
-            if pd_lin is not None:
-                tq = pd_quad @ x
-                res = res + pd_lin @ x + tq @ x
-                jac = jac_lin + pd_lin + tq + np.einsum("ijk,j->ik", pd_quad, x)
-            dx = np.linalg.solve(jac, -res)
-            x = x + dx
-            if np.max(np.abs(dx)) <= tol * max(1.0, np.max(np.abs(x))):
-                break
-        else:
-            raise SolverError(f"reduced FFR: Newton did not converge at t = {times[n + 1]:g}")
-        acc = (x - base) * a_fac
-        vel = vbase + dt * gamma * acc
-        eta[n + 1] = x
-        velocity[n + 1] = vel
-    return _finish(reduced, times, eta, t0, {"velocity": velocity})
+    # the load g(t) formed in the stepper, step by step, from its four constant patterns
+    patterns = np.column_stack([reduced.euler_load, reduced.centrifugal_load,
+                                reduced.gravity_sin, reduced.gravity_cos])
+    steps_out = kernel.reduced_ffr_newmark(dt, beta, gamma, reduced.omega_squared, gam,
+                                           c2, pd_lin, pd_quad, patterns, rate, accel,
+                                           sin, cos1, tol, max_newton)
+    return _finish(reduced, times, steps_out["eta"], t0, steps_out)
 
 
 def _finish(reduced: ReducedFFR, times: np.ndarray, eta: np.ndarray, t0: float,

@@ -19,7 +19,11 @@ Reactions
     the tension: minus the force on body2 along p2 - p1.
 
 Section forces
-    At ``stations`` points per element (equally spaced, both ends included) from the
+    At ``stations`` points per element (equally spaced, both ends included: a node appears
+    twice, left then right). A static state's (:func:`static_section_forces`, what
+    :func:`static_answers` returns) from each element's own equilibrium: exact where the
+    loads are, N and Q jump at the nodes that carry a load, a joint or a force element
+    (:func:`beam_equilibrium_forces`). A dynamic state's (:func:`section_forces`) from the
     element's own strain measures (``fortran/src/elements/beam_cubic.f90``) and the
     section's stiffness, relative to the reference configuration: axial Green strain
     (r_x . r_x - 1)/2, bending strains b_y = -r_y,x . r_x (+ r_xx . r_y - mean(r_xx . r_y)
@@ -50,13 +54,14 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from .. import kernel
 from ..codes import CONSTRAINT_COORDINATE
 from ..csr import sorted_unique
 from .kinds import Beam
 from .constraint_set import ConstraintSet
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation
-from .model import Model
+from .model import Model, SetInfo
 from .registry import reports_sections
 from .sections import Box, Circle, Rectangle, Tube
 from .._lazy import LazyModule
@@ -777,6 +782,128 @@ def _section_forces_full(model: Model, q: np.ndarray, stations: int,
     return out
 
 
+# -- section forces from the elements' equilibrium (static states) ----------------------------
+def _element_forces(info: SetInfo, q: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """(nel, 8, 3) the elastic force of every element of a beam's set on its own eight
+    nodal vectors at the full coordinates q (global axes), from the kernel's element
+    routines: each element is handed its own 24 slots, so the kernel's sum over the
+    elements leaves them apart."""
+    beam, nel = info.body, info.nel
+    own = np.arange(24 * nel).reshape(nel, 24).T
+    e = q[info.dofs].reshape(-1, order="F")
+    mat = beam.material
+    if info.kind == "cubic":
+        force = info.cubic.forces(own, e, False)[0]
+    elif info.kind == "continuum":
+        force = kernel.beam_nonlinear_forces(own, e, info.gradients, info.weights, info.nvolume,
+                                             mat.youngs_modulus, mat.poisson_ratio, False,
+                                             info.shear_scales)[0]
+    else:
+        force = kernel.ffr_force(own, info.stiffness0, rotation, e, info.reference)[0]
+        if info.second_order is not None:  # ffr_elastic: f_2 = N (G x I3) u in the frame
+            rigidity, axis, length, gram = info.second_order
+            u = (e.reshape(nel, 8, 3) @ rotation) - info.reference.T.reshape(nel, 8, 3)
+            n = rigidity * np.einsum("ke,ek->e", axis, u[:, 4] - u[:, 0]) / length
+            local = n[:, None, None] * np.einsum("abe,ebk->eak", gram, u)
+            force = force + (local @ rotation.T).reshape(-1)
+    return np.asarray(force).reshape(nel, 8, 3)
+
+
+def _centreline(xi: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """(nel, n, 8) coefficients of the centre line r(xi) on each element's eight nodal
+    vectors (cubic Hermite on r1, r1_x, r2, r2_x; ``lengths`` (nel,))."""
+    z = np.zeros_like(xi)
+    shape = np.stack([1 - 3 * xi**2 + 2 * xi**3, xi - 2 * xi**2 + xi**3, z, z,
+                      3 * xi**2 - 2 * xi**3, xi**3 - xi**2, z, z], axis=-1)
+    slope_scale = np.ones((len(lengths), 1, 8))
+    slope_scale[:, 0, [1, 5]] = np.asarray(lengths)[:, None]
+    return shape[None] * slope_scale
+
+
+def beam_equilibrium_forces(model: Model, info: SetInfo, q: np.ndarray, gravity: np.ndarray,
+                            stations: int = DEFAULT_STATIONS, t: float = 0.0) -> SectionForces:
+    """Section forces of one beam at a static state from each element's own equilibrium
+    (SPEC section 10), at ``stations`` points per element with both ends: at an element's
+    end the part of the structure beyond it exerts on the element its elastic force there
+    less its share of the element's distributed load (gravity), f_e - g_e, on the end's
+    four nodal vectors, reduced to a force F and a moment M = sum v x F_v about the end's
+    centre-line point (the virtual work of a rigid turn of the end's directors and slope);
+    at the start the same with the sign turned (what the element exerts on the part
+    before it). Between the ends the distributed load p is integrated from the start:
+    F(s) = F(A) - p (s - s_A), M(s) = M(A) + (r_A - r(s)) x F(A) - int_A^s (r - r(s)) x p.
+    The two elements at a node give its two sides (left, then right): they differ by the
+    load, joint or force element the node carries, and agree elsewhere. N, T are the
+    components along the section normal n = r_y x r_z, Q and M along the section's height
+    (r_y) and width (n x r_y) axes; sign convention as :func:`beam_section_forces`. An
+    'ffr' beam is in equilibrium on its reference geometry in the frame (small strain),
+    unless it has geometric stiffness: then, like the large-deformation beams, on its
+    current one. Loads and joints between nodes act through the element's nodal shares."""
+    beam = info.body
+    if stations < 2:
+        raise ValueError("stations must be at least 2 (both ends of each element)")
+    nel = info.nel
+    rotation = model.frames[info.frame - 1].rotation(t) if info.frame else np.eye(3)
+    force = _element_forces(info, q, rotation)
+    mass_rule, density = beam.section.mass_rule(beam.material.density)
+    load = np.moveaxis(np.asarray(kernel.beam_gravity(beam.lengths, mass_rule, density,
+                                                      gravity)), -1, 0)
+    load = np.swapaxes(load, 1, 2)                                     # (nel, 8, 3)
+    ends = force - load
+    if info.floating and info.second_order is None:   # the reference, turned
+        vectors = info.reference.T.reshape(nel, 8, 3) @ rotation.T
+    else:
+        vectors = q[info.dofs].T.reshape(nel, 8, 3)
+    # at the start (right side of node A) and the end (left side of node B)
+    f_a = -ends[:, 0]
+    m_a = -np.cross(vectors[:, 1:4], ends[:, 1:4]).sum(axis=1)
+    f_b = ends[:, 4]
+    m_b = np.cross(vectors[:, 5:8], ends[:, 5:8]).sum(axis=1)
+    lengths = np.asarray(beam.lengths, dtype=float)
+    per_length = (load[:, 0] + load[:, 4]) / lengths[:, None]          # p (nel, 3)
+    xi = np.linspace(0.0, 1.0, stations)
+    points, weights = np.polynomial.legendre.leggauss(3)   # exact: r(x) is cubic
+    r_s = _centreline(xi, lengths) @ vectors                          # (nel, nxi, 3)
+    # int_0^xi r dx per station: Gauss on [0, xi]
+    nodes = (0.5 * xi[:, None] * (points[None, :] + 1.0)).ravel()
+    r_gauss = (_centreline(nodes, lengths) @ vectors).reshape(nel, stations, len(points), 3)
+    r_int = (0.5 * np.outer(lengths, xi))[:, :, None] * np.einsum("q,epqk->epk", weights,
+                                                                     r_gauss)
+    run = np.outer(lengths, xi)[:, :, None]                            # (nel, nxi, 1)
+    force_s = f_a[:, None] - run * per_length[:, None]
+    moment_s = (m_a[:, None] + np.cross(vectors[:, None, 0] - r_s, f_a[:, None])
+                - np.cross(r_int - run * r_s, per_length[:, None]))
+    force_s[:, -1], moment_s[:, -1] = f_b, m_b   # the end from its own forces (the same
+    #                                               up to round-off where the loads are gravity)
+    dir_y = (1 - xi)[None, :, None] * vectors[:, None, 2] + xi[None, :, None] * vectors[:, None, 6]
+    dir_z = (1 - xi)[None, :, None] * vectors[:, None, 3] + xi[None, :, None] * vectors[:, None, 7]
+    normal = np.cross(dir_y, dir_z)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    height = dir_y / np.linalg.norm(dir_y, axis=-1, keepdims=True)
+    width = np.cross(normal, height)
+
+    def along(x: np.ndarray, axis: np.ndarray) -> np.ndarray:
+        return (x * axis).sum(axis=-1).reshape(-1)
+    ns = nel * stations
+    return SectionForces(
+        s=(beam.stations[:-1, None] + np.outer(lengths, xi)).ravel(),
+        N=along(force_s, normal), T=along(moment_s, normal),
+        Q=np.stack([along(force_s, height), along(force_s, width)], axis=-1).reshape(ns, 2),
+        M=np.stack([along(moment_s, height), along(moment_s, width)], axis=-1).reshape(ns, 2))
+
+
+def static_section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS,
+                          load_factor: float = 1.0) -> dict[str, SectionForces]:
+    """Section forces of every beam by name at a static state e (the solved equilibrium
+    of the scene's loads scaled by ``load_factor``) from the elements' equilibrium
+    (:func:`beam_equilibrium_forces`): exact where the loads are, with both sides of every
+    node. :func:`section_forces` (the strains times the section's stiffness) serves the
+    states that are not in static equilibrium (the rows of a dynamic run)."""
+    q = model.expand(np.asarray(e, dtype=float))
+    gravity = load_factor * np.asarray(model.gravity, dtype=float)
+    return {info.body.name: beam_equilibrium_forces(model, info, q, gravity, stations)
+            for info in model.sets if reports_sections(info.body)}
+
+
 # -- stresses --------------------------------------------------------------------------------
 def _rectangle_torsion(long: float, short: float) -> tuple[float, float]:
     """Saint-Venant torsion of a solid rectangle (Timoshenko & Goodier, Theory of
@@ -1019,10 +1146,11 @@ class Answers:
 
 
 def static_answers(model: Model, e: np.ndarray, lam: np.ndarray,
-                   stations: int = DEFAULT_STATIONS) -> Answers:
-    """Reactions, section forces and stresses of a static state (e, lambda): what the
-    result writers store under /static and the results object exposes."""
-    forces = section_forces(model, e, stations)
+                   stations: int = DEFAULT_STATIONS, load_factor: float = 1.0) -> Answers:
+    """Reactions, section forces and stresses of a static state (e, lambda) of the loads
+    scaled by ``load_factor``: what the result writers store under /static and the results
+    object exposes."""
+    forces = static_section_forces(model, e, stations, load_factor)
     return Answers(reactions(model, e, lam), forces, stresses(model, forces))
 
 
@@ -1235,7 +1363,7 @@ class DynamicAnswers:
 
 
 __all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions",
-           "section_forces", "force_element_reactions",
+           "section_forces", "static_section_forces", "beam_equilibrium_forces", "force_element_reactions",
            "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
            "DEFAULT_STATIONS",
            "DynamicAnswers", "constraint_joints"]

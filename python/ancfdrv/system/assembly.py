@@ -158,6 +158,8 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         support_frames=support_frames(system) if supports else None)
     model.vector_loads = vector_loads
     model.force_elements = force_elements
+    # the uniform gravity (m/s^2) the beams' section forces integrate between nodes
+    model.gravity = sum((load.vector for load in act.gravity), np.zeros(3))
     model.frame_problems = frame_problems
     _answer_inputs(model, system, owners, equations, elimination, reduction, mass_full,
                    constant + gravity, driven)

@@ -189,6 +189,8 @@ class Model:
     vector_loads: tuple | list = ()
     #: force elements (system/force_elements.ForceElementInfo; set by the assembly)
     force_elements: tuple | list = ()
+    #: the uniform gravity of the active gravity loads (m/s^2; set by the assembly)
+    gravity: tuple | np.ndarray = (0.0, 0.0, 0.0)
 
     def __init__(self, *, title: str, effects: tuple[str, ...], counters: Counter,
                  warnings: list[str], notes: list[str], bodies: list[Body], sets: list[SetInfo],
