@@ -498,8 +498,12 @@ def test_load_cycle_from_settled_state_does_not_ring(cycle_runs, case, tmp_path)
     assert runs["run"].chassis[0] == pytest.approx(runs["static"][0], abs=1e-6)  # settled
     if case == "on":
         from scipy.interpolate import CubicSpline
+        # the unsettled start's first step makes 261 J (9.8 times the run's energy scale)
+        # where the prestressed leaves engage: refused as 'unstable' by default (issue 39),
+        # run here with the tolerance opened to show the ringing it leaves
         run, summary = _cycle_run(tmp_path / "none.h5", ["spring.settle=none",
-                                                         "solver.t_end=1.0"])
+                                                         "solver.t_end=1.0",
+                                                         "solver.energy_tolerance=20"])
         released = run.chassis - CubicSpline(runs["forces"], runs["static"])(summary["force"])
         later = run.time >= 0.25   # after the release itself: the ringing it leaves
         assert np.abs(released[later]).max() > 10 * 0.005 * span

@@ -307,27 +307,71 @@ def test_constraint_arguments_follow_every_change():
         model.close()
 
 
+def _watch_reference(first, energy, times, tolerance):
+    """The energy watch's figures written out row by row: the largest balance, the scale
+    (the largest flow less the energy made by then, per row) and the first time the
+    balance exceeded tolerance x scale."""
+    works = energy[:, [5, 6, 8, 9, 10]]
+    balance = energy[:, 4] - first[4] - works.sum(axis=1)
+    potential = energy[:, 1:4].sum(axis=1) - first[1:4].sum()
+    most = scale = 0.0
+    for k in range(len(balance)):
+        flow = max(abs(energy[k, 0]), abs(potential[k]), abs(energy[k, 0] + energy[k, 1]),
+                   *np.abs(works[k]))
+        scale = max(scale, flow - max(balance[k], 0.0))
+        most = max(most, balance[k])
+    above = np.flatnonzero(balance > tolerance * scale)
+    return most, scale, (times[above[0]] if len(above) else None), balance
+
+
 def test_energy_watch_sums_as_numpy_does():
-    """The energy watch's column sums give numpy's row sums bitwise (the figures of the
-    warning of created energy), for chunks of every size the stepper hands it."""
+    """The energy watch's figures (the largest balance, the energy scale less the energy
+    made, the time the balance first exceeded the tolerance) are those of a row-by-row
+    reference, for chunks of every size the stepper hands it; its column sums are numpy's
+    row sums bitwise."""
     rng = np.random.default_rng(5)
     for rows in (1, 2, 7, 16, 17, 990, 1001):
-        energy = rng.standard_normal((rows, 11)) * np.exp(rng.uniform(-25, 25, (rows, 11)))
+        energy = rng.standard_normal((rows, 11)) * np.exp(rng.uniform(-5, 5, (rows, 11)))
+        times = np.arange(1, rows + 1) * 1e-3
         works = energy[:, [5, 6, 8, 9, 10]]
         columns = energy.T
         assert np.array_equal(works.sum(axis=1), columns[5] + columns[6] + columns[8]
                               + columns[9] + columns[10])
         assert np.array_equal(energy[:, 1:4].sum(axis=1), columns[1] + columns[2] + columns[3])
         first = energy[0]
-        watch = dynamic.EnergyWatch(first)
-        watch.add(energy)
-        balance = energy[:, 4] - first[4] - works.sum(axis=1)
-        potential = energy[:, 1:4].sum(axis=1) - first[1:4].sum()
-        assert watch.most == max(0.0, float(balance.max()))
-        assert watch.scale == max(float(np.abs(energy[:, 0]).max()),
-                                  float(np.abs(potential).max()),
-                                  float(np.abs(energy[:, 0] + energy[:, 1]).max()),
-                                  float(np.abs(works).max()))
+        watch = dynamic.EnergyWatch(first, tolerance=0.01)
+        watch.add(energy, times)
+        most, scale, onset, balance = _watch_reference(first, energy, times, 0.01)
+        assert watch.most == max(0.0, most)
+        assert watch.scale == scale
+        assert watch.unstable() == (max(0.0, most) > 0.01 * scale)
+        if onset is not None:   # the records keep each rise of 1 %: the time within it
+            found = watch.first_above(0.01 * scale)
+            assert onset <= found
+            before = balance[times < found]
+            assert not len(before) or before.max() <= 0.01 * scale * watch.RECORD_STEP
+
+
+def test_energy_watch_at_rest_and_blown_up():
+    """A run at rest (every energy round-off, 1e-26 J) is never unstable: the scale has
+    the integrator's floor. A run whose kinetic energy is mostly made energy is measured
+    against the flow less the energy made: 25 kJ made on a 70 J pendulum reads 357 times
+    the scale (the old measure, against the kinetic energy itself, read 1.0)."""
+    rest = np.zeros((50, 11))
+    rest[:, 0] = np.linspace(0.0, 2e-26, 50)
+    rest[:, 4] = rest[:, 0]
+    watch = dynamic.EnergyWatch(rest[0], tolerance=0.01, floor=1e-13)
+    watch.add(rest, np.arange(50) * 1e-3)
+    assert not watch.unstable() and watch.created() < 1e-12
+    blown = np.zeros((3, 11))
+    blown[:, 0] = [0.0, 70.0, 25070.0]       # kinetic: 70 J of physics, then 25 kJ made
+    blown[:, 2] = [0.0, -70.0, -70.0]        # gravity
+    blown[:, 4] = blown[:, 0] + blown[:, 2]  # total
+    watch = dynamic.EnergyWatch(blown[0], tolerance=0.01)
+    watch.add(blown, np.array([0.0, 1.0, 2.0]))
+    assert watch.scale == 70.0 and watch.created() == pytest.approx(25000.0 / 70.0)
+    assert watch.unstable() and watch.runaway()
+    assert watch.first_above(0.01 * 70.0) == 2.0
 
 
 # -- the planar reduction's plan (system/patterns.py) -----------------------------------------
@@ -497,23 +541,10 @@ def test_single_term_elimination_is_the_general_one(scene, overrides, monkeypatc
 
 
 def test_energy_watch_waiting_chunks_measure_as_each_alone(monkeypatch):
-    """Chunks measured together after waiting (EnergyWatch.WAIT_ROWS) update the largest
-    balance and the scale as measuring each chunk on arrival did (the former add, written
-    out here), NaN rows and signed zeros included, whatever the chunks' sizes."""
+    """Chunks measured together after waiting (EnergyWatch.WAIT_ROWS) give the largest
+    balance, the scale and the records of measuring each chunk on arrival (WAIT_ROWS = 1),
+    NaN rows and signed zeros included, whatever the chunks' sizes."""
     rng = np.random.default_rng(9)
-
-    def alone(first, chunks):
-        most = scale = 0.0
-        for energy in chunks:
-            works = energy[:, [5, 6, 8, 9, 10]]
-            balance = energy[:, 4] - first[4] - works.sum(axis=1)
-            potential = energy[:, 1:4].sum(axis=1) - first[1:4].sum()
-            most = max(most, float(balance.max()))
-            scale = max(scale, float(np.abs(energy[:, 0]).max()),
-                        float(np.abs(potential).max()),
-                        float(np.abs(energy[:, 0] + energy[:, 1]).max()),
-                        float(np.abs(works).max()))
-        return most, scale
     for trial in range(200):
         sizes = rng.integers(1, 40, int(rng.integers(1, 12)))
         chunks = [rng.standard_normal((int(n), 11)) * np.exp(rng.uniform(-20, 20, (int(n), 11)))
@@ -523,11 +554,16 @@ def test_energy_watch_waiting_chunks_measure_as_each_alone(monkeypatch):
             if trial % 7 == 0:
                 c[rng.random(c.shape) < 0.02] = np.nan
         first = chunks[0][0].copy()
-        monkeypatch.setattr(dynamic.EnergyWatch, "WAIT_ROWS", int(rng.integers(1, 100)))
-        watch = dynamic.EnergyWatch(first)
-        for c in chunks:
-            watch.add(c)
-        most, scale = alone(first, chunks)
-        assert (watch.most, watch.scale) == (most, scale)
-        expected = most / scale if scale > 0 else 0.0
-        assert watch.created() == expected
+        starts = np.concatenate([[0], np.cumsum(sizes)])
+        watches = []
+        for wait in (1, int(rng.integers(2, 100))):
+            monkeypatch.setattr(dynamic.EnergyWatch, "WAIT_ROWS", wait)
+            watch = dynamic.EnergyWatch(first)
+            for k, c in enumerate(chunks):
+                watch.add(c, np.arange(starts[k], starts[k + 1]) * 1e-3)
+            watches.append(watch)
+        alone, together = watches
+        assert (together.most, together.scale, together.created()) == \
+            (alone.most, alone.scale, alone.created())
+        for level in (0.0, 1.0, 1e3):
+            assert together.first_above(level) == alone.first_above(level)

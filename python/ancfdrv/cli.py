@@ -39,7 +39,8 @@ EXIT_CODES = """exit status:
   0    success
   1    internal error (a bug): one line, the full trace in a file it names (--debug prints it)
   2    bad input (scene, override, output path refused or in use, not a result file)
-  3    solver failure (the output file holds what was computed, status 'failed')
+  3    solver failure (the output file holds what was computed, status 'failed'; 'unstable'
+       when the energy grew beyond solver.energy_tolerance)
   130  interrupted by SIGINT (Ctrl-C), 143 by SIGTERM (the output file holds every step
        computed, status 'interrupted')
   141  the pipe our output went to was closed (e.g. ancf info F | head -1)"""
@@ -136,7 +137,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         rows = run_sweep(args.scene, args.vary, out, base=args.set, workers=args.workers,
                          scheduler=args.scheduler, reference=args.reference)
     except SweepInterrupted as stop:
-        done = sum(r["status"] in ("ok", "failed") for r in stop.rows)
+        done = sum(r["status"] in ("ok", "failed", "unstable") for r in stop.rows)
         by = f" (stopped by {signal.Signals(stop.signum).name})" if stop.signum else ""
         print(f"ancf sweep: interrupted: {done} of {len(stop.rows)} cases finished, the "
               f"others cancelled; report in {out}/summary.md{by}", file=sys.stderr)

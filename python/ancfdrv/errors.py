@@ -47,6 +47,15 @@ class SolverError(AncfError):
     """A solver failed: Newton did not converge, a matrix was singular, a kernel refused."""
 
     exit_code = 3
+    #: the output file's final status
+    status = "failed"
+
+
+class UnstableError(SolverError):
+    """The energy of a run grew beyond ``solver.energy_tolerance`` with no work to explain
+    it (the integrator's numerical instability): exit 3, status 'unstable', the rows kept."""
+
+    status = "unstable"
 
 
 class Interrupted(AncfError):

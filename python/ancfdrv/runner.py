@@ -107,7 +107,8 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
                   jacobian=solver["jacobian"], contraction=solver["contraction"],
                   dt_min=solver.get("dt_min", 0.0), step=solver.get("step", "fixed"),
                   tolerance=solver.get("tolerance", 1e-6),
-                  carry=solver.get("carry", "rotation"))
+                  carry=solver.get("carry", "rotation"),
+                  energy_tolerance=solver.get("energy_tolerance", 0.01))
     if solver["integrator"] == "generalized_alpha":
         return DynamicSettings.generalized_alpha(solver["dt"], solver["t_end"],
                                                  solver["rho_inf"], **common)
@@ -631,8 +632,8 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
             located = locate_error(exc, scene)
             finish("failed", str(located))
             raise located from None
-        except AncfError as exc:
-            finish("failed", str(exc))
+        except AncfError as exc:  # status 'failed', or 'unstable' (UnstableError)
+            finish(getattr(exc, "status", "failed"), str(exc))
             raise
         except OSError as exc:
             if not disk_full(exc):

@@ -20,8 +20,9 @@ only wall times, timings and the provenance's time stamps differ).
 Errors are those of ``run_scene``: InputError (bad input, naming the file, group and key),
 SolverError (a solve failed) and Interrupted (SIGINT/SIGTERM). Once the run has started
 computing, the exception carries what was computed until then as ``exc.simulation`` (a
-:class:`Simulation` whose ``status`` is 'failed' or 'interrupted', every completed step in
-its series; ``exc.simulation.save(path)`` writes the file ``run_scene`` would have left).
+:class:`Simulation` whose ``status`` is 'failed', 'unstable' or 'interrupted', every
+completed step in its series; ``exc.simulation.save(path)`` writes the file ``run_scene``
+would have left).
 """
 from __future__ import annotations
 
@@ -219,8 +220,8 @@ def simulate(scene: str | Path | Scene, overrides: list[str] | None = None, *,
 
     Raises InputError (bad input, naming the file, group and key), SolverError (a solve
     failed) or Interrupted (SIGINT/SIGTERM). Once the model is built, the exception
-    carries the results computed until then as ``exc.simulation`` (status 'failed' or
-    'interrupted')."""
+    carries the results computed until then as ``exc.simulation`` (status 'failed',
+    'unstable' or 'interrupted')."""
     from .runner import run_in_memory
     start = _time.perf_counter()
     if isinstance(scene, Scene):

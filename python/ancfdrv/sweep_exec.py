@@ -85,8 +85,8 @@ def run_case(scene_file: str, params: dict[str, str], overrides: list[str],
         outcome = runner.run_scene(scene_file, overrides, output, progress=False)
     except Interrupted as exc:  # SIGINT/SIGTERM reached this process during the case
         return failure(params, "interrupted", str(exc), exc.exit_code)
-    except AncfError as exc:
-        return failure(params, "failed", str(exc), exc.exit_code)
+    except AncfError as exc:  # 'failed', or 'unstable' (UnstableError)
+        return failure(params, getattr(exc, "status", "failed"), str(exc), exc.exit_code)
     except Exception as exc:  # a bug or an environment problem: still only this case's
         return failure(params, "failed", internal_error(exc), 1)
     if not Path(output).is_file():

@@ -66,6 +66,7 @@ module time_integrator
                                constraint_reaction, gradient_product, refactorize, &
                                to_solver_frame, &
                                frame_gradients, energies, probe_output, policy_constant, &
+                               drive_step_work, power_drive, &
                                power_count, energy_count, contact_record, contact_step_limit
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
                      jacobian_reuse, update_reuse_backoff, contraction_memory
@@ -123,7 +124,7 @@ module time_integrator
     real(dp), allocatable :: r(:), z(:, :), direction(:), correction(:), back(:)
     real(dp), allocatable :: phi(:), gradients(:, :), w(:, :), flex_w(:, :), w_dlam(:)
     real(dp), allocatable :: schur(:, :), dlam(:, :), internal(:), loads(:), records(:, :)
-    real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:, :)
+    real(dp), allocatable :: full(:), row_phi(:), row_gradients(:, :), row_ndof(:)
     real(dp), allocatable :: full_pair(:, :)
     integer, allocatable :: ipiv(:)
     ! loads holds the external loads at loads_time (residual)
@@ -161,7 +162,7 @@ contains
               work%internal(sys%ndof), work%loads(sys%ndof), &
               work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
               work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
-              work%row_ndof(sys%ndof, 2), work%full_pair(sys%nfull, 2))
+              work%row_ndof(sys%ndof), work%full_pair(sys%nfull, 2))
     if (carry_enabled(sys)) then
       allocate (work%carry_columns(sys%ndof, sys%ncon), &
                 work%carry_flexibility(sys%ndof, sys%ncon), work%carry_lu(sys%ncon, sys%ncon), &
@@ -304,7 +305,7 @@ contains
     real(dp) :: lam_new(sys%ncon), predicted_internal(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
-    real(dp) :: contact_potential, beta_prime, velocity_factor
+    real(dp) :: contact_potential, beta_prime, velocity_factor, step_drive_work
     integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
     logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
@@ -361,6 +362,9 @@ contains
       end if
       if (monitor%at_floor) floor_accepts = floor_accepts + 1
       if (started_old) call update_reuse_backoff(learned, stats(stat_factorizations) > 0)
+      ! the drives' work over the step, from (t, e, lambda) to (t + h, e_new, lambda_new)
+      call drive_step_work(sys, t, t + h, e, e_new, lam, lam_new, step_drive_work, info)
+      if (info /= 0) return
       ! accept the step
       ! (one pass: each coordinate's a_new, v, e and a by the same expressions as the
       ! array statements they replace, without their separate loops and copies)
@@ -393,6 +397,7 @@ contains
       end if
       if (info /= 0) return
       work = work + 0.5_dp * h * (powers + powers_new)
+      work(power_drive) = work(power_drive) + step_drive_work
       powers = powers_new
       steps_done = step
       out_time(step) = t
@@ -400,7 +405,7 @@ contains
       do i = 1, sys%ncon
         out_lambda(i, step) = lam(i)
       end do
-      call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, &
+      call probe_output(sys, rotations, e, v, work, strain, contact_potential, &
                         out_probe(:, :, step), out_deflection(:, :, step), out_energy(:, step), info, &
                         scratch%full, scratch%row_ndof)
       if (info /= 0) return
@@ -1170,7 +1175,7 @@ contains
     call energies(sys, rotations, rates, e, v, lam, t, state, strain, powers, contact_potential, &
                   violation, contact, info)
     if (info /= 0) return
-    call probe_output(sys, rotations, e, v, t, work, strain, contact_potential, probe, deflection, &
+    call probe_output(sys, rotations, e, v, work, strain, contact_potential, probe, deflection, &
                       energy, info)
   end subroutine output_row
 

@@ -335,6 +335,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "tolerance": Key("float", 1e-6, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                          "step = 'adaptive': local position error allowed per step, relative "
                          "to the model's length"),
+        "energy_tolerance": Key("float", 0.01, positive,
+                                "dynamic runs: the energy the integrator may make (the balance "
+                                "total - total(0) - works rising), relative to the run's energy "
+                                "scale (the largest kinetic, kinetic plus strain energy, "
+                                "potential-energy change or work so far); beyond it the run "
+                                "ends with exit 3, status 'unstable', the rows kept"),
     },
     "output": {
         "file": Key("str", None, doc="HDF5 result file (default results/<scene>.h5)"),

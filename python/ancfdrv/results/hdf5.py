@@ -8,10 +8,12 @@ Conventions:
 * every dataset has a ``units`` attribute (SI: m, s, N, J, ...; '1' for dimensionless,
   'count' for counters, 'index' for connectivity); integer counters are stored as int64;
 * the root attribute ``status`` is 'running' while the run writes, then 'ok', 'failed'
-  (with ``message``) or 'interrupted' (SIGINT/SIGTERM: every step computed before the
-  signal is in the file); /dynamic has the same ``status``. A file that still says
-  'running' while no process holds its lock (:mod:`ancfdrv.results.lock`) was abandoned:
-  its writer was killed (every flushed chunk is kept);
+  (with ``message``), 'unstable' (the energy grew beyond solver.energy_tolerance, with
+  ``message``: :class:`~ancfdrv.errors.UnstableError`) or 'interrupted' (SIGINT/SIGTERM:
+  every step computed before the signal is in the file); /dynamic has the same
+  ``status``. A file that still says 'running' while no process holds its lock
+  (:mod:`ancfdrv.results.lock`) was abandoned: its writer was killed (every flushed chunk
+  is kept);
 * the root attributes carry the provenance: package version, git commit (when run from
   a checkout), library versions, compiler, platform, thread settings, command line.
 """
@@ -42,7 +44,7 @@ from ..io.scene import Scene
 from ..solvers.static import StaticResult
 
 #: the statuses a result file can carry (root attribute and /dynamic attribute)
-STATUSES = ("running", "ok", "failed", "interrupted")
+STATUSES = ("running", "ok", "failed", "unstable", "interrupted")
 #: generalized coordinates: positions (m) and position gradients (dimensionless)
 COORDINATE_UNITS = "mixed (m for positions, 1 for gradients)"
 #: constraint multipliers: forces for position constraints, moments for gradient ones
@@ -674,8 +676,8 @@ def read_summary(path: Path) -> dict[str, Any]:
 
 
 def verdict(path: Path, summary: dict[str, Any] | None = None) -> tuple[str, str]:
-    """What became of the run that wrote a result file: ('ok' | 'failed' | 'interrupted'
-    | 'running' | 'abandoned' | 'unknown', one line saying why)."""
+    """What became of the run that wrote a result file: ('ok' | 'failed' | 'unstable' |
+    'interrupted' | 'running' | 'abandoned' | 'unknown', one line saying why)."""
     from .lock import holder
     summary = read_summary(path) if summary is None else summary
     status = str(summary.get("status", ""))
@@ -693,7 +695,7 @@ def verdict(path: Path, summary: dict[str, Any] | None = None) -> tuple[str, str
                              + (f" ({rows})" if rows else ""))
     if status == "ok":
         return "ok", "the run finished" + (f"; {rows}" if rows else "")
-    if status in ("failed", "interrupted"):
+    if status in ("failed", "unstable", "interrupted"):
         detail = message or status
         return status, detail + (f" ({rows})" if rows and rows not in detail else "")
     return "unknown", f"status attribute {status!r}"

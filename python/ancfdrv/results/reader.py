@@ -186,7 +186,7 @@ class Results:
 
     @property
     def status(self) -> str:
-        """'ok', 'failed', 'interrupted' or 'running' (root attribute)."""
+        """'ok', 'failed', 'unstable', 'interrupted' or 'running' (root attribute)."""
         return str(self.attrs.get("status", ""))
 
     @property

@@ -62,7 +62,7 @@ from .constraint_set import ConstraintSet
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation
 from .model import Model, SetInfo
-from .registry import reports_sections
+from .registry import kind_of, reports_sections
 from .sections import Box, Circle, Rectangle, Tube
 from .._lazy import LazyModule
 
@@ -783,32 +783,6 @@ def _section_forces_full(model: Model, q: np.ndarray, stations: int,
 
 
 # -- section forces from the elements' equilibrium (static states) ----------------------------
-def _element_forces(info: SetInfo, q: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """(nel, 8, 3) the elastic force of every element of a beam's set on its own eight
-    nodal vectors at the full coordinates q (global axes), from the kernel's element
-    routines: each element is handed its own 24 slots, so the kernel's sum over the
-    elements leaves them apart."""
-    beam, nel = info.body, info.nel
-    own = np.arange(24 * nel).reshape(nel, 24).T
-    e = q[info.dofs].reshape(-1, order="F")
-    mat = beam.material
-    if info.kind == "cubic":
-        force = info.cubic.forces(own, e, False)[0]
-    elif info.kind == "continuum":
-        force = kernel.beam_nonlinear_forces(own, e, info.gradients, info.weights, info.nvolume,
-                                             mat.youngs_modulus, mat.poisson_ratio, False,
-                                             info.shear_scales)[0]
-    else:
-        force = kernel.ffr_force(own, info.stiffness0, rotation, e, info.reference)[0]
-        if info.second_order is not None:  # ffr_elastic: f_2 = N (G x I3) u in the frame
-            rigidity, axis, length, gram = info.second_order
-            u = (e.reshape(nel, 8, 3) @ rotation) - info.reference.T.reshape(nel, 8, 3)
-            n = rigidity * np.einsum("ke,ek->e", axis, u[:, 4] - u[:, 0]) / length
-            local = n[:, None, None] * np.einsum("abe,ebk->eak", gram, u)
-            force = force + (local @ rotation.T).reshape(-1)
-    return np.asarray(force).reshape(nel, 8, 3)
-
-
 def _centreline(xi: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """(nel, n, 8) coefficients of the centre line r(xi) on each element's eight nodal
     vectors (cubic Hermite on r1, r1_x, r2, r2_x; ``lengths`` (nel,))."""
@@ -843,16 +817,12 @@ def beam_equilibrium_forces(model: Model, info: SetInfo, q: np.ndarray, gravity:
         raise ValueError("stations must be at least 2 (both ends of each element)")
     nel = info.nel
     rotation = model.frames[info.frame - 1].rotation(t) if info.frame else np.eye(3)
-    force = _element_forces(info, q, rotation)
+    force, vectors = kind_of(beam).end_forces(info, q, rotation)
     mass_rule, density = beam.section.mass_rule(beam.material.density)
     load = np.moveaxis(np.asarray(kernel.beam_gravity(beam.lengths, mass_rule, density,
                                                       gravity)), -1, 0)
     load = np.swapaxes(load, 1, 2)                                     # (nel, 8, 3)
     ends = force - load
-    if info.floating and info.second_order is None:   # the reference, turned
-        vectors = info.reference.T.reshape(nel, 8, 3) @ rotation.T
-    else:
-        vectors = q[info.dofs].T.reshape(nel, 8, 3)
     # at the start (right side of node A) and the end (left side of node B)
     f_a = -ends[:, 0]
     m_a = -np.cross(vectors[:, 1:4], ends[:, 1:4]).sum(axis=1)
@@ -901,7 +871,7 @@ def static_section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_S
     q = model.expand(np.asarray(e, dtype=float))
     gravity = load_factor * np.asarray(model.gravity, dtype=float)
     return {info.body.name: beam_equilibrium_forces(model, info, q, gravity, stations)
-            for info in model.sets if reports_sections(info.body)}
+            for info in model.sets if getattr(kind_of(info.body), "end_forces", None)}
 
 
 # -- stresses --------------------------------------------------------------------------------

@@ -26,12 +26,14 @@ A kind declares
   (``planar_fixed``); a kind without a rule is not reduced (a plate, a leaf);
 - whether its bodies report section forces and stresses at stations (``sections``: the
   answers, :mod:`.answers`, and the dynamic run's recorder of them);
+- its elements' end forces at a static state (``end_forces``: the section forces from the
+  elements' equilibrium, :mod:`.answers`);
 - its mesh rows (``mesh``: the points and cells the XDMF writer shows for a body, through
   the writer's row builder, ``mesh_order``: the kinds' order in the mesh).
 
 What a body answers about itself (its size, its nodes, its mid-surface, the probe component
-a sweep compares) is a property of its class (:class:`~.bodies.Body`). The answers'
-section forces are still re-derived for beams in numpy (:mod:`.answers`), and a few
+a sweep compares) is a property of its class (:class:`~.bodies.Body`). A dynamic
+state's section forces are still re-derived for beams in numpy (:mod:`.answers`), and a few
 per-kind branches of the assembly and the joints still test concrete classes
 (tests/test_kinds_registry.py counts those checks and only lets the count go down).
 
@@ -117,6 +119,11 @@ class Kind:
     mesh_order: int = 0
     #: its bodies report section forces and stresses at stations (system/answers.py)
     sections: bool = False
+    #: ``end_forces(set_info, q, rotation) -> (forces, vectors)``: each element's elastic
+    #: force on its own nodal vectors and the vectors it acts at, both (nel, 8, 3), for the
+    #: static section forces from the elements' equilibrium (None: the kind has no beam
+    #: sections)
+    end_forces: Callable[[Any, Any, Any], tuple[Any, Any]] | None = None
 
 
 _KINDS: dict[str, Kind] = {}

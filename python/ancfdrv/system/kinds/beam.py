@@ -408,6 +408,40 @@ def _mesh(body: Beam, rows) -> None:
     rows.lines.append(np.column_stack([nodes[:-1], nodes[1:]]))
 
 
+# -- section forces from the elements' equilibrium (static states: system/answers.py) ---
+def _end_forces(info: SetInfo, q: np.ndarray,
+                rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The beam kind's ``end_forces`` hook: (nel, 8, 3) the elastic force of every element of
+    a beam's set on its own eight nodal vectors at the full coordinates q (global axes),
+    from the kernel's element routines (each element is handed its own 24 slots, so the
+    kernel's sum over the elements leaves them apart), and (nel, 8, 3) the nodal vectors
+    the forces act at (an 'ffr' set without geometric stiffness: its reference, turned by
+    the frame's rotation; else the coordinates themselves)."""
+    beam, nel = info.body, info.nel
+    own = np.arange(24 * nel).reshape(nel, 24).T
+    e = q[info.dofs].reshape(-1, order="F")
+    mat = beam.material
+    if info.kind == "cubic":
+        force = info.cubic.forces(own, e, False)[0]
+    elif info.kind == "continuum":
+        force = kernel.beam_nonlinear_forces(own, e, info.gradients, info.weights, info.nvolume,
+                                             mat.youngs_modulus, mat.poisson_ratio, False,
+                                             info.shear_scales)[0]
+    else:
+        force = kernel.ffr_force(own, info.stiffness0, rotation, e, info.reference)[0]
+        if info.second_order is not None:  # ffr_elastic: f_2 = N (G x I3) u in the frame
+            rigidity, axis, length, gram = info.second_order
+            u = (e.reshape(nel, 8, 3) @ rotation) - info.reference.T.reshape(nel, 8, 3)
+            n = rigidity * np.einsum("ke,ek->e", axis, u[:, 4] - u[:, 0]) / length
+            local = n[:, None, None] * np.einsum("abe,ebk->eak", gram, u)
+            force = force + (local @ rotation.T).reshape(-1)
+    if info.kind == "ffr" and info.second_order is None:   # the reference, turned
+        vectors = info.reference.T.reshape(nel, 8, 3) @ rotation.T
+    else:
+        vectors = q[info.dofs].T.reshape(nel, 8, 3)
+    return np.asarray(force).reshape(nel, 8, 3), vectors
+
+
 KIND = register(Kind(
     group="beam", body_class=Beam, keys=KEYS, build=build, api="beam", word="beam",
     objects=("material", "section", "frame_drive"), scene_defaults={"formulation": "formulation"},
@@ -416,4 +450,5 @@ KIND = register(Kind(
     part=lambda body: part_of(body.name, body.nodes),
     check_dimensions=lambda body: check_axis_dimensions(body, "beam"),
     plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
-    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1, sections=True))
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1, sections=True,
+    end_forces=_end_forces))
