@@ -221,10 +221,10 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     when the model has neither joints nor beams)."""
     from .solvers.dynamic import initial_acceleration
     from .system.answers import DynamicAnswers, reaction_map
-    from .system.kinds import Beam
+    from .system.registry import reports_sections
     if not scene["output"].get("answers", True):
         return None
-    if not reaction_map(model).joints and not any(isinstance(b, Beam) for b in model.bodies) \
+    if not reaction_map(model).joints and not any(reports_sections(b) for b in model.bodies) \
             and not model.force_elements:
         return None
     recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
@@ -244,7 +244,7 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
 
 def _warn_large_ffr_deflection(model: Model, out: Path | MemoryOutput) -> None:
     """The warning of an 'ffr' run whose tip deflects by more than 5% of the length."""
-    if any(s.kind == "ffr" for s in model.sets) and "tip" in model.probes:
+    if any(s.floating for s in model.sets) and "tip" in model.probes:
         with _io(out).reading(out) as h5:
             deflection = h5["dynamic/deflection/tip"][()]
         ratio = np.abs(deflection).max() / model.length_scale

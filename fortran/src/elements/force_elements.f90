@@ -1,8 +1,8 @@
-!> Force elements between two bodies (SPEC 8.1): a spring-damper, a bushing and a compliant
-!> hydraulic cylinder. One element acts through "slots": 3-vectors affine in the full
-!> coordinates (material points and direction vectors of its two bodies, the ground's
-!> constants; the system gathers them), so that this module needs nothing but the slot
-!> values x(3, ns) and rates xd(3, ns).
+!> Force elements between two bodies (SPEC 8.1): a spring-damper, a bushing, a compliant
+!> hydraulic cylinder and a torsion spring. One element acts through "slots": 3-vectors
+!> affine in the full coordinates (material points and direction vectors of its two bodies,
+!> the ground's constants; the system gathers them), so that this module needs nothing but
+!> the slot values x(3, ns) and rates xd(3, ns).
 !>
 !> Every element is a sum of scalar measures m(x) with a force f(m, m'):
 !>   generalized force (the residual's internal sign)   F = sum f dm/dx
@@ -23,8 +23,13 @@
 !>                  rotation vector's components on body1's axes to first order, exactly
 !>                  zero when both bodies turn together; f_i = k_i u_i + c_i u_i' (and the
 !>                  rotational k_r, c_r with theta).
+!>   torsion        slots p1, p2 (the point on either body), g1, g2 (body1's unit vectors
+!>                  normal to the axis a = g1 x g2 at t = 0), h1 (body2's, equal to g1 at
+!>                  t = 0); the relative rotation about the axis theta = atan2(g2 . h1,
+!>                  g1 . h1) (exact for any angle in (-pi, pi) when the relative turn is
+!>                  about a); f = k_t theta + c_t theta'; the moment on body2 is -f a.
 !> Reaction (7): what body1 exerts on body2: force (3, global), moment (3, global), and the
-!> axial force (tension positive; 0 for the bushing).
+!> axial force (tension positive; 0 for the bushing and the torsion).
 module force_elements
   use ancf_kinds, only: dp
   use drives, only: drive_eval, drive_table, drive_hermite
@@ -32,7 +37,8 @@ module force_elements
   private
   public :: force_element_eval, force_element_slots, force_element_parameters
 
-  integer, parameter, public :: fe_spring_damper = 1, fe_bushing = 2, fe_cylinder = 3
+  integer, parameter, public :: fe_spring_damper = 1, fe_bushing = 2, fe_cylinder = 3, &
+                                fe_torsion = 4
   integer, parameter, public :: fe_reaction_count = 7
 
 contains
@@ -45,19 +51,21 @@ contains
       n = 2
     case (fe_bushing)
       n = 8
+    case (fe_torsion)
+      n = 5
     case default
       n = 0
     end select
   end function force_element_slots
 
   !> Number of parameters of a kind (spring: k, c, L0, F0; cylinder: k, c; bushing: k(3),
-  !> k_r(3), c(3), c_r(3)).
+  !> k_r(3), c(3), c_r(3); torsion: k_t, c_t).
   pure integer function force_element_parameters(kind) result(n)
     integer, intent(in) :: kind
     select case (kind)
     case (fe_spring_damper)
       n = 4
-    case (fe_cylinder)
+    case (fe_cylinder, fe_torsion)
       n = 2
     case (fe_bushing)
       n = 12
@@ -169,8 +177,58 @@ contains
         g_unit = x(:, 2 + i) / max(norm2(x(:, 2 + i)), tiny(1.0_dp))
         reaction(4:6) = reaction(4:6) - total * g_unit
       end do
+    case (fe_torsion)
+      call turn_measure(x, m, grad, hess, info)
+      if (info /= 0) return
+      call elastic(params(1), params(2), m, grad, hess, xd, force, stiffness, damping, &
+                   energy, dissipation, total)
+      g_unit = [x(2, 3) * x(3, 4) - x(3, 3) * x(2, 4), x(3, 3) * x(1, 4) - x(1, 3) * x(3, 4), &
+                x(1, 3) * x(2, 4) - x(2, 3) * x(1, 4)]
+      reaction(4:6) = -total * g_unit / max(norm2(g_unit), tiny(1.0_dp))
     end select
   end subroutine force_element_eval
+
+  !> The torsion's measure theta = atan2(s, c), s = g2 . h1, c = g1 . h1 (slots 3, 4, 5), its
+  !> gradient and Hessian: theta_c grad c + theta_s grad s, and theta_c H_c + theta_s H_s +
+  !> theta_cc gc gc^T + theta_ss gs gs^T + theta_cs (gc gs^T + gs gc^T) with theta_c = -s/r2,
+  !> theta_s = c/r2, theta_cc = 2cs/r2^2 = -theta_ss, theta_cs = (s^2 - c^2)/r2^2, r2 = c^2 + s^2.
+  !> info = 2: h1 is normal to the plane of g1, g2 (no angle).
+  pure subroutine turn_measure(x, m, grad, hess, info)
+    real(dp), intent(in) :: x(:, :)
+    real(dp), intent(out) :: m, grad(:, :), hess(:, :, :, :)
+    integer, intent(out) :: info
+    real(dp) :: gc(3, size(x, 2)), gs(3, size(x, 2)), hc(3, size(x, 2), 3, size(x, 2))
+    real(dp) :: hs(3, size(x, 2), 3, size(x, 2)), c, s, r2
+    integer :: a, b, i, j
+    info = 0
+    gc = 0.0_dp
+    gs = 0.0_dp
+    hc = 0.0_dp
+    hs = 0.0_dp
+    call bilinear(3, 5, 1.0_dp, x, gc, hc)
+    call bilinear(4, 5, 1.0_dp, x, gs, hs)
+    c = dot_product(x(:, 3), x(:, 5))
+    s = dot_product(x(:, 4), x(:, 5))
+    r2 = c**2 + s**2
+    if (r2 <= tiny(1.0_dp) * 1.0e10_dp) then
+      info = 2
+      return
+    end if
+    m = atan2(s, c)
+    grad = (c * gs - s * gc) / r2
+    hess = (c * hs - s * hc) / r2
+    do b = 1, size(x, 2)
+      do j = 1, 3
+        do a = 1, size(x, 2)
+          do i = 1, 3
+            hess(i, a, j, b) = hess(i, a, j, b) + (2.0_dp * c * s * (gc(i, a) * gc(j, b) - &
+              gs(i, a) * gs(j, b)) + (s**2 - c**2) * (gc(i, a) * gs(j, b) + gs(i, a) * &
+              gc(j, b))) / r2**2
+          end do
+        end do
+      end do
+    end do
+  end subroutine turn_measure
 
   !> A linear elastic measure m with stiffness k and damping c: f = k m + c m'.
   pure subroutine elastic(k, c, m, grad, hess, xd, force, stiffness, damping, energy, &

@@ -41,7 +41,7 @@ from h5py import h5a, h5d, h5p, h5s, h5t
 from ..csr import Csr
 from ..errors import InputError
 from ..io.safe_write import write_with
-from ..system.kinds import Beam, Plate, RigidBody
+from ..system.registry import kind_of
 
 _STEPS_GROUP = "dynamic/xdmf"
 #: XDMF cell codes of a Mixed topology
@@ -61,55 +61,21 @@ class MeshLayout:
 
     @classmethod
     def from_model(cls, model) -> "MeshLayout | None":
-        """The layout of every plate (first, in the order of ``model.plate_geometry``),
-        beam and rigid body of the model; None when it has none of them."""
-        rows: list[int] = []
-        cols: list[int] = []
-        coefs: list[float] = []
-        quads, lines, bodies = [], [], []
-        count = 0
-
-        def point(terms: list[tuple[int, float]]) -> int:
-            """A new point at sum coef * q[first + (0, 1, 2)]; returns its index."""
-            nonlocal count
-            for first, coef in terms:
-                for axis in range(3):
-                    rows.append(3 * count + axis)
-                    cols.append(first + axis)
-                    coefs.append(coef)
-            count += 1
-            return count - 1
-
-        def node_points(first: int, nnodes: int, stride: int) -> int:
-            start = count
-            for node in range(nnodes):
-                point([(first + stride * node, 1.0)])
-            return start
-
-        kinds = ((Plate, "plate"), (Beam, "beam"), (RigidBody, "rigid body"))
-        for body_type, word in kinds:
-            for body in [b for b in model.bodies if isinstance(b, body_type)]:
-                start = count
-                if isinstance(body, Plate):
-                    base = node_points(body.first, body.mesh.nnodes, 9)
-                    quads.append(body.mesh.elements + base)
-                    word = "leaf" if type(body).__name__ == "Leaf" else "plate"
-                elif isinstance(body, Beam):
-                    base = node_points(body.first, body.nodes, 12)
-                    nodes = base + np.arange(body.nodes)
-                    lines.append(np.column_stack([nodes[:-1], nodes[1:]]))
-                else:
-                    size = _display_length(body)
-                    centre = point([(body.first, 1.0)])
-                    for k in (1, 2, 3):  # r + size r_x, r + size r_y, r + size r_z
-                        tip = point([(body.first, 1.0), (body.first + 3 * k, size)])
-                        lines.append(np.array([[centre, tip]]))
-                bodies.append(f"{body.name}: {word}, points {start}..{count - 1}")
+        """The layout of every body whose kind shows a mesh (:class:`~..system.registry.Kind`
+        ``mesh``; plates first, in the order of ``model.plate_geometry``, then beams, then
+        rigid bodies); None when it has none of them."""
+        rows = _Rows()
+        shown = [(k, b) for b in model.bodies if (k := kind_of(b)) is not None and k.mesh]
+        for found, body in sorted(shown, key=lambda pair: pair[0].mesh_order):
+            start = rows.count
+            found.mesh(body, rows)
+            rows.bodies.append(f"{body.name}: {found.word}, points {start}..{rows.count - 1}")
+        count = rows.count
         if count == 0:
             return None
-        matrix = Csr.from_coo(rows, cols, coefs, (3 * count, model.nfull))
+        matrix = Csr.from_coo(rows.rows, rows.cols, rows.coefs, (3 * count, model.nfull))
         points = (matrix @ model.q0).reshape(count, 3)
-        return cls(points, _stack(quads, 4), _stack(lines, 2), matrix, bodies)
+        return cls(points, _stack(rows.quads, 4), _stack(rows.lines, 2), matrix, rows.bodies)
 
     @property
     def npoints(self) -> int:
@@ -138,11 +104,35 @@ def _stack(blocks: list[np.ndarray], width: int) -> np.ndarray:
     return np.vstack(blocks).astype(np.int64) if blocks else np.zeros((0, width), np.int64)
 
 
-def _display_length(body: RigidBody) -> float:
-    """The radius of gyration about the centre of mass, sqrt(tr(I) / 2m) (the root mean
-    square distance of the mass from the centre): the length of the axes shown."""
-    size = math.sqrt(max(float(np.trace(body.inertia)), 0.0) / (2.0 * body.mass))
-    return size if size > 0 else 1.0
+class _Rows:
+    """The row builder a kind's ``mesh`` hook fills: points (each a sum of coefficients
+    times 3-vectors of the full coordinates), quadrilaterals and lines."""
+
+    def __init__(self) -> None:
+        self.rows: list[int] = []
+        self.cols: list[int] = []
+        self.coefs: list[float] = []
+        self.quads: list[np.ndarray] = []
+        self.lines: list[np.ndarray] = []
+        self.bodies: list[str] = []
+        self.count = 0
+
+    def point(self, terms: list[tuple[int, float]]) -> int:
+        """A new point at sum coef * q[first + (0, 1, 2)]; returns its index."""
+        for first, coef in terms:
+            for axis in range(3):
+                self.rows.append(3 * self.count + axis)
+                self.cols.append(first + axis)
+                self.coefs.append(coef)
+        self.count += 1
+        return self.count - 1
+
+    def node_points(self, first: int, nnodes: int, stride: int) -> int:
+        """A point per node (positions at first + stride * node); the first one's index."""
+        start = self.count
+        for node in range(nnodes):
+            self.point([(first + stride * node, 1.0)])
+        return start
 
 
 def frame_rows(total_rows: int, frames: int) -> tuple[int, int]:

@@ -30,7 +30,7 @@ def ffr_departure_rows(model, rows: np.ndarray, times: np.ndarray) -> list[tuple
     """(beam, largest change of a section vector in its frame at each row) of every 'ffr'
     beam for the states rows (n, ndof) at the times (n,): a run's chunk at once (the frame
     rotations from the drive's vectorized values, no loop over the rows)."""
-    sets = [s for s in model.sets if s.kind == "ffr"]
+    sets = [s for s in model.sets if s.floating]
     if not sets:
         return []
     # read only: without eliminated joints q is e (no copy of every row)

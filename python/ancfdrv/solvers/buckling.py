@@ -294,7 +294,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     if not model.sets:
         raise InputError("buckling: the model has no flexible body (beam, cable, plate or "
                          "leaf); rigid bodies do not buckle", group="scene", key="analysis")
-    if all(s.kind == "ffr" for s in model.sets):
+    if all(s.floating for s in model.sets):
         raise InputError("buckling: every beam has the 'ffr' formulation, whose constant "
                          "small-strain stiffness has no geometric (initial-stress) part; "
                          "use formulation = 'nonlinear'", group="scene", key="formulation")

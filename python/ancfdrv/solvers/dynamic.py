@@ -915,7 +915,7 @@ def _check_assumptions(model: Model, chunk: Chunk, state: dict,
     """(the rows to keep, why the run stops or ''): an 'ffr' beam that leaves its
     small-strain assumption (solvers.assumptions) stops the run at the first row that does
     when the chunk holds q (the rows after it dropped), else at the chunk's last state."""
-    if not any(s.kind == "ffr" for s in model.sets) or not len(chunk.time):
+    if not any(s.floating for s in model.sets) or not len(chunk.time):
         return chunk, ""
     if chunk.q is not None:  # every row at once; the first row outside ends the run
         outside = np.zeros(len(chunk.time), dtype=bool)

@@ -160,7 +160,7 @@ def reduce_ffr(model: Model, static: StaticResult, modes: int, *,
 def _check_scope(model: Model, static: StaticResult) -> None:
     if len(model.frames) != 1 or model.frames[0].drive_obj is None:
         raise SolverError("reduce_ffr: the model needs exactly one frame, turned by a drive")
-    if any(s.kind != "ffr" or s.frame != 1 for s in model.sets):
+    if any(not s.floating or s.frame != 1 for s in model.sets):
         raise SolverError("reduce_ffr: every element set must be 'ffr' in the driven frame")
     if model.reduction is not None or model.damped or model.vector_loads or \
             model.contact_pairs or model.driven_forces:
@@ -488,7 +488,7 @@ class RowMaps:
         """Whether the maps hold every term of the kernel's output row (else: the row by
         row path): FFR sets (P-delta included) without damping, no force elements, no
         contact, no eliminated joints."""
-        return (all(s.kind == "ffr" and s.damping_time == 0.0 for s in model.sets)
+        return (all(s.floating and s.damping_time == 0.0 for s in model.sets)
                 and not getattr(model, "force_elements", ()) and not model.contact_pairs
                 and not model.vector_loads and model.reduction is None)
 
@@ -618,7 +618,7 @@ def _departure_bound(model: Model, reduced: ReducedFFR) -> tuple[float, np.ndarr
     a0t = model.frames[0].rotation(0.0).T
     c, n = 0.0, np.zeros(reduced.size)
     for info in model.sets:
-        if info.kind != "ffr":
+        if not info.floating:
             continue
         first, reference = _section_vectors(info)
         index = first[:, None] + np.arange(3)

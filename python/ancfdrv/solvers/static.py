@@ -227,7 +227,7 @@ def split_obstacle(model: Model) -> str | None:
     """Why the split iteration cannot solve ``model`` (it needs the constant FFR stiffness
     and dead loads only), or None when it can: what ``static_method = 'auto'`` chooses by,
     and why an explicit 'split' is refused."""
-    if any(s.kind != "ffr" for s in model.sets) or model.contact_pairs:
+    if any(not s.floating for s in model.sets) or model.contact_pairs:
         return ("the split iteration needs the constant stiffness of the 'ffr' formulation "
                 "(every body) without contact")
     if any(s.second_order is not None for s in model.sets):

@@ -57,12 +57,12 @@ import numpy as np
 from .. import kernel
 from ..codes import CONSTRAINT_COORDINATE
 from ..csr import sorted_unique
-from .kinds import Beam, Cable, Plate, RigidBody
+from .kinds import Beam
 from .constraint_set import ConstraintSet
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation
 from .model import Model, SetInfo
-from .registry import kind_of
+from .registry import kind_of, reports_sections
 from .sections import Box, Circle, Rectangle, Tube
 from .._lazy import LazyModule
 
@@ -383,15 +383,8 @@ def _scatter(index: np.ndarray, size: int) -> np.ndarray:
 def _vector_blocks(body) -> tuple[int, int]:
     """(coordinates per node, number of nodes) of a body's coordinates; the first vector
     of each node is its position."""
-    if isinstance(body, RigidBody):
-        return 12, 1
-    if isinstance(body, Beam):
-        return 12, body.nodes
-    if isinstance(body, Plate):
-        return 9, body.mesh.nnodes
-    if isinstance(body, Cable):  # r and r_x per node
-        return 6, body.nodes
-    return 0, 0
+    nodes = body.nnodes   # (a rigid body: one node of 12; the ground: none)
+    return (body.ncoordinates // nodes, nodes) if nodes else (0, 0)
 
 
 def _joint_points(joint) -> tuple:
@@ -768,7 +761,7 @@ def _section_forces_full(model: Model, q: np.ndarray, stations: int,
     frame_of = {s.body.name: s.frame for s in model.sets}
     out = {}
     for b in model.bodies:
-        if isinstance(b, Beam):
+        if reports_sections(b):
             f = frame_of.get(b.name, 0)
             rotation = None
             if f:
@@ -1109,7 +1102,7 @@ def peak_rows(section, forces: SectionForces, floor: np.ndarray | None = None
 
 def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress]:
     """Stresses of every beam by name from its section forces."""
-    beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+    beams = {b.name: b for b in model.bodies if reports_sections(b)}
     return {name: beam_stress(beams[name].section, f) for name, f in forces.items()}
 
 
@@ -1168,7 +1161,7 @@ class DynamicAnswers:
         self.need_velocity = bool(self.force_elements)
         self.sections: dict[str, list[SectionForces]] = {}
         self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        self.beams = {b.name: b for b in model.bodies if isinstance(b, Beam)}
+        self.beams = {b.name: b for b in model.bodies if reports_sections(b)}
 
     @property
     def time(self) -> list[float]:

@@ -18,7 +18,7 @@ from ..codes import (CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANC
 from ..csr import Csr
 from ..errors import InputError
 from .bodies import Body, Ground, rotation_about
-from .kinds import Beam, RigidBody
+from .kinds import Beam
 from .constraint_set import ConstraintSet
 from .drives import Constant
 from .registry import SetContext, set_builder
@@ -71,7 +71,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     prefix = list(warnings)
     if linear_joints not in LINEAR_JOINTS:
         raise InputError(f"linear_joints {linear_joints!r} must be one of {LINEAR_JOINTS}")
-    if not any(b.flexible or isinstance(b, RigidBody) for b in system.bodies.values()):
+    if not any(b.flexible or b.rigid for b in system.bodies.values()):
         raise InputError("the system has no body")
     active_effects = set(_effects_used(system) if effects is None else effects)
     counters: Counter = Counter({name: 0 for name in EFFECTS_AVAILABLE + CONTACT_COUNTERS})
@@ -98,8 +98,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     sets, set_blocks = _element_sets(bodies, frames, beam_frame, act, active_effects, counters,
                                      warnings)
     contact_pairs, contact_blocks = _contact(act.contacts, q0, active_effects, counters)
-    rigid_blocks = [np.arange(b.first, b.first + b.ncoordinates) for b in bodies
-                    if isinstance(b, RigidBody)]
+    rigid_blocks = [np.arange(b.first, b.first + b.ncoordinates) for b in bodies if b.rigid]
     force_elements, force_blocks = assemble_force_elements(
         getattr(system, "force_elements", {}).values(), q0, drive_index, counters)
     full_pattern = Pattern.from_blocks(nfull, set_blocks + rigid_blocks + contact_blocks
@@ -114,7 +113,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     moments = _moments(act.moments, q0, counters)
 
     # joints: eliminate or keep with multipliers
-    has_rigid = any(isinstance(b, RigidBody) for b in bodies)
+    has_rigid = any(b.rigid for b in bodies)
     mode = linear_joints if linear_joints != "auto" else ("eliminate" if has_rigid else
                                                           "multipliers")
     plane, planar_eqs = _planar(system, act, q0, notes)
@@ -283,21 +282,12 @@ def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern
         for pm in masses:
             if pm.body is info.body:
                 at = pm.body.locate(pm.point, node=False, what=f"load {pm.name!r}")
-                if isinstance(info.body, Beam):
-                    compact[:, :, at.element] += kernel.beam_point_mass(
-                        *at.local, info.body.lengths[at.element], pm.mass)
-                elif hasattr(info.body, "shape_row"):  # a family's own shape row (cable)
-                    shape = info.body.shape_row(at)
-                    compact[:, :, at.element] += pm.mass * np.outer(shape, shape)
-                else:
-                    shape, _ = kernel.plate_shape(*at.local, info.body.mesh.a[at.element],
-                                                  info.body.mesh.b[at.element])
-                    compact[:, :, at.element] += pm.mass * np.outer(shape, shape)
+                compact[:, :, at.element] += info.body.point_mass(at, pm.mass)
         n = compact.shape[0]
         element = np.einsum("abe,ij->aibje", compact, np.eye(3)).reshape(3 * n, 3 * n, -1)
         np.add.at(values, info.scatter.ravel() - 1, element.ravel())
     for body in bodies:
-        if not isinstance(body, RigidBody):
+        if not body.rigid:
             continue
         block = body.mass_matrix.copy()
         for pm in masses:
@@ -321,23 +311,10 @@ def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counter
     g = sum((load.vector for load in act.gravity), np.zeros(3))
     if act.gravity:
         for info in sets:
-            body = info.body
-            if isinstance(body, Beam):
-                elements = kernel.beam_gravity(body.lengths,
-                                               *body.section.mass_rule(body.material.density), g)
-                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
-                          elements.reshape(-1, order="F"))
-            elif hasattr(body, "gravity_forces"):  # a family's own (cable)
-                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
-                          body.gravity_forces(g).reshape(-1, order="F"))
-            else:
-                _, elements = kernel.plate_element_arrays(
-                    body.mesh.a, body.mesh.b, body.thickness, body.material.density,
-                    body.material.density * body.thickness * g)
-                np.add.at(gravity, info.dofs.reshape(-1, order="F"),
-                          elements.reshape(-1, order="F"))
+            np.add.at(gravity, info.dofs.reshape(-1, order="F"),
+                      info.body.gravity_forces(g).reshape(-1, order="F"))
         for body in bodies:
-            if isinstance(body, RigidBody):
+            if body.rigid:
                 gravity[body.first:body.first + 3] += body.mass * g
         for pm in act.masses:
             _add_point_vector(gravity, pm.body, pm.point, pm.mass * g, pm.name)
@@ -397,7 +374,7 @@ def _moment_nodes(body: Body, load) -> list[tuple]:
     interpolate them there (the virtual work of the moment on the interpolated section's
     turn); the point's offset from the axis does not matter for a moment."""
     what = f"load {load.name!r}"
-    if isinstance(body, RigidBody):
+    if body.rigid:
         return [(body.locate(load.point, node=False, what=what), 1.0)]
     if isinstance(body, Beam):
         at = body.locate(load.point, node=False, what=what)
@@ -426,7 +403,7 @@ def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
         normal = np.cross(u1, u2)
         normal /= np.linalg.norm(normal)
         m_n, m_1, m_2 = (float(magnitude * axis @ u) for u in (normal, u1, u2))
-        w1, w2 = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
+        w1, w2 = body.torsion_shares()
         parts = [(f1, normal, w1 * m_n), (f2, normal, w2 * m_n), (f2, u1, m_1),
                  (f1, u2, m_2)]
         parts = [(f, np.sign(m) * k, abs(m)) for f, k, m in parts
@@ -463,7 +440,7 @@ def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
     follower's vector is kept as its components on (a, b, a x b) at t = 0."""
     out = []
     def vector(x) -> bool:
-        return x.follower or x.drive is not None or isinstance(x.body, RigidBody)
+        return x.follower or x.drive is not None or x.body.rigid
 
     chosen = [x for x in act.forces if x.follower] + [x for x in act.moments if vector(x)]
     act.forces[:] = [x for x in act.forces if not x.follower]
@@ -482,7 +459,7 @@ def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
             vector = np.linalg.solve(frame, load.vector)
         else:
             kind, vector = VLOAD_DEAD_MOMENT, load.vector.copy()
-        shares = body.torsion_shares() if isinstance(body, Beam) else (0.5, 0.5)
+        shares = body.torsion_shares()
         slots = [sorted(a.terms.items()), sorted(b.terms.items()),
                  sorted(p.terms.items()) if force else []]
         drive = -1 if load.drive is None else drive_index[id(load.drive)]
@@ -506,7 +483,7 @@ def _equations(system, bodies, q0: np.ndarray, notes: list[str], warnings: list[
         out += joint_equations
     linearized = _linearized(system, warnings)
     for body in bodies:
-        if isinstance(body, RigidBody):
+        if body.rigid:
             if body.planar:
                 out += planar_fixes(body, q0)
             if body.name in linearized:
@@ -559,8 +536,8 @@ def _linearized(system, warnings: list[str]) -> dict[str, str]:
         grown = False
         for joint in joints:
             a, b = joint.bodies
-            if joint.type in ("weld", "prismatic") and isinstance(a, RigidBody) and \
-                    isinstance(b, RigidBody):   # a prismatic's orientation ties are a weld's
+            # (a prismatic's orientation ties are a weld's)
+            if joint.type in ("weld", "prismatic") and a.rigid and b.rigid:
                 for body, other in ((a, b), (b, a)):
                     if other.name in out and body.name not in out:
                         out[body.name], grown = out[other.name], True
@@ -901,7 +878,7 @@ def _policy(model: Model) -> None:
     """'constant' (factorized once) when every element set is FFR, there is no contact and
     the solver-frame assembly is exact (checked numerically); else 'refactor'."""
     model.policy, model.vector_frame = POLICY_REFACTOR, np.zeros(0, dtype=np.int64)
-    if model.contact_pairs or any(s.kind != "ffr" for s in model.sets):
+    if model.contact_pairs or any(not s.floating for s in model.sets):
         return
     if model.force_elements:  # their tangent changes with the configuration
         return

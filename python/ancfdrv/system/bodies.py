@@ -100,6 +100,12 @@ def _positive(value: float, what: str, name: str) -> float:
     return float(value)
 
 
+def along_axis(v, j: int, tol: float = 1e-9) -> bool:
+    """v is parallel to the coordinate axis e_j (within ``tol`` of its length, at least 1)."""
+    v = np.asarray(v, dtype=float)
+    return float(np.linalg.norm(np.delete(v, j))) <= tol * max(1.0, float(np.linalg.norm(v)))
+
+
 def rotation_about(axis, angle: float) -> np.ndarray:
     """Rodrigues' rotation matrix about a unit axis."""
     k = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
@@ -203,6 +209,21 @@ class Body:
     def directors(self, at: Attachment) -> list[str]:
         """Nodal vectors a dead moment can act on (the rotation is measured on them)."""
         raise NotImplementedError
+
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A flexible body: a point mass's share of its element's compact mass matrix
+        (n, n) (the element at.element)."""
+        raise NotImplementedError
+
+    def gravity_forces(self, g: np.ndarray) -> np.ndarray:
+        """A flexible body: its generalized gravity forces per element (nde, nel) of the
+        acceleration g (3,)."""
+        raise NotImplementedError
+
+    def torsion_shares(self) -> tuple[float, float]:
+        """How a moment about the normal of its two directors divides between them: halves
+        (a beam's section: by its shear and bending rule)."""
+        return 0.5, 0.5
 
 
 class Ground(Body):

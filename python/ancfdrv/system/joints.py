@@ -59,7 +59,7 @@ import numpy as np
 from ..codes import CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE, CONSTRAINT_DOT
 from ..errors import InputError
 from .bodies import Attachment, Body, Ground, rotation_about
-from .kinds import Beam, Plate, RigidBody
+from .kinds import Beam, RigidBody
 from .drives import Drive
 from .expressions import Scalar, Vec3, combination
 
@@ -247,7 +247,7 @@ class Joint:
             raise InputError(f"{where}: edge and box select nodes of a beam, plate or leaf; "
                              f"neither {self.body1.name!r} nor {self.body2.name!r} is one")
         if self.edge is not None:
-            if not isinstance(body, Plate):
+            if not body.surface:
                 raise InputError(f"{where}: edge selects a side of a plate or leaf, and "
                                  f"{body.name!r} is not one (use box)")
             grid = body.mesh.grid
@@ -255,7 +255,7 @@ class Joint:
                      "y1": grid[:, -1]}[self.edge]
             positions = body.mesh.coords[nodes, 0:3]
         else:
-            allnodes = body.mesh.coords[:, 0:3] if isinstance(body, Plate) else \
+            allnodes = body.mesh.coords[:, 0:3] if body.surface else \
                 body.node_positions()
             size = float(np.ptp(allnodes, axis=0).max())
             tol = 1e-9 * max(size, 1.0)
@@ -298,9 +298,9 @@ class Joint:
         if self.type not in ("weld", "prismatic"):
             return None
         base, held = self.body1, self.body2
-        if isinstance(base, RigidBody):
+        if base.rigid:
             base, held = held, base
-        if isinstance(held, RigidBody) and small_turn(base):
+        if held.rigid and small_turn(base):
             return held
         return None
 
@@ -580,9 +580,9 @@ def _weld_roles(body1: Body, at1: Attachment, body2: Body, at2: Attachment
       neither shear nor stretch). This includes an FFR beam in a moving frame, whose
       linear tie would have time-dependent coefficients: there the stiffening above remains.
     """
-    if isinstance(body2, RigidBody) and body1.flexible:
+    if body2.rigid and body1.flexible:
         body1, at1, body2, at2 = body2, at2, body1, at1
-    if isinstance(body1, RigidBody) and small_turn(body2):
+    if body1.rigid and small_turn(body2):
         body1, at1, body2, at2 = body2, at2, body1, at1
     return body1, at1, body2, at2
 

@@ -66,6 +66,9 @@ class SetInfo:
     #: 'ffr' with geometric stiffness (P-delta): per element EA (nel,), the unit axis in
     #: the frame (3, nel), the length (nel,), the slope Gram matrix (8, 8, nel); else None
     second_order: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+    #: the set's elastic forces are a constant stiffness (stiffness0) turned with its
+    #: floating frame (the ANCF-FFR set): what the FFR-only solvers and checks ask
+    floating: bool = False
 
 
 @dataclass
@@ -493,7 +496,7 @@ class Model:
         gradients and directors the model's length squared, so both shares compare."""
         if self.policy != POLICY_REFACTOR or self.contact_pairs or self.nfull % 3:
             return None
-        if any(s.kind == "ffr" for s in self.sets):   # (other kinds ignore their frame)
+        if any(s.floating for s in self.sets):   # (other kinds ignore their frame)
             return None
         if self.reduction is not None and self.reduction.selects is None:
             if self.reduction.matrix.selection_columns() is None:

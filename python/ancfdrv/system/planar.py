@@ -35,7 +35,8 @@ of the listed effects):
 
 By the mirror symmetry about the plane, such a system's solution has, at every node,
 r_j, r_x,j and the in-plane director's j-component at their initial values, and the normal
-director's two in-plane components zero (a rigid body: :func:`~.joints.planar_fixes`).
+director's two in-plane components zero (each kind's rule: the ``plane``, ``planar_problems``
+and ``planar_fixed`` of its :class:`~.registry.Kind`).
 These are linear equations that the assembly eliminates like fixed coordinates
 (q = B e + q0, :mod:`.patterns`): a beam node keeps 7 unknowns of 12, a cable node 4 of 6,
 a rigid body 6 of 12 (its orthonormality then drops the equations the fixes satisfy).
@@ -48,9 +49,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .kinds import Beam, Cable, RigidBody
+from .bodies import along_axis
 from .expressions import Scalar
 from .joints import LinearEquation
+from .registry import kind_of
 
 #: the settings and each declared plane's normal axis (0, 1, 2 = x, y, z)
 PLANES = {"xy": 2, "yz": 0, "zx": 1}
@@ -70,8 +72,7 @@ def check_setting(value) -> str:
 
 def _along(v: np.ndarray, j: int) -> bool:
     """v is parallel to e_j."""
-    v = np.asarray(v, dtype=float)
-    return float(np.linalg.norm(np.delete(v, j))) <= _TOL * max(1.0, float(np.linalg.norm(v)))
+    return along_axis(v, j, _TOL)
 
 
 def _normal_to(v: np.ndarray, j: int) -> bool:
@@ -80,13 +81,10 @@ def _normal_to(v: np.ndarray, j: int) -> bool:
 
 
 def body_plane(body, j: int) -> float | None:
-    """The j-coordinate of a body's plane (None: the ground, anything; a plate or a leaf,
-    which is not reduced and refused as such by :func:`planar_problems`)."""
-    if isinstance(body, RigidBody):
-        return float(body.centre[j])
-    if isinstance(body, (Beam, Cable)):
-        return float(body.start[j])
-    return None
+    """The j-coordinate of a body's plane (None: the ground, anything; a kind without a
+    planar rule, which is not reduced and refused as such by :func:`planar_problems`)."""
+    kind = kind_of(body)
+    return None if kind is None or kind.plane is None else kind.plane(body, j)
 
 
 def planar_problems(system, j: int, loads=None) -> list[str]:
@@ -106,30 +104,14 @@ def planar_problems(system, j: int, loads=None) -> list[str]:
 
     for body in system.bodies.values():
         where = f"body {body.name!r}"
-        if isinstance(body, (Beam, Cable)):
-            if abs(float(body.start[j] - body.end[j])) > tol:
-                out.append(f"{where}: its axis leaves the plane normal to {plane}")
-                continue
-            if isinstance(body, Beam):
-                if body.formulation == "ffr":
-                    out.append(f"{where}: formulation 'ffr' keeps its constant iteration "
-                               "matrix by turning whole nodal 3-vectors with the frame; it "
-                               "is not reduced (use 'nonlinear', or planar = 'off')")
-                if not (_along(body.orientation[:, 1], j) or _along(body.orientation[:, 2], j)):
-                    out.append(f"{where}: no section axis (height or width) lies along {plane}")
-        elif isinstance(body, RigidBody):
-            coupling = np.delete(body.inertia[j], j)
-            if np.abs(coupling).max() > _TOL * np.abs(body.inertia).max():
-                out.append(f"{where}: its products of inertia couple a turn about {plane} "
-                           "with the other axes")
-            if body.planar and body.plane_axis != j:
-                out.append(f"{where}: it is planar with the normal {'xyz'[body.plane_axis]}, "
-                           f"not {plane}")
-        else:
-            kind = type(body).__name__.lower()
-            out.append(f"{where}: {'leaves' if kind == 'leaf' else kind + 's'} cannot be "
+        kind = kind_of(body)
+        if kind is not None and kind.planar_problems is not None:
+            out += [f"{where}: {text}" for text in kind.planar_problems(body, j, tol)]
+        elif kind is not None:
+            word = kind.group
+            out.append(f"{where}: {'leaves' if word == 'leaf' else word + 's'} cannot be "
                        "reduced to a plane (the planar reduction covers beams, cables and "
-                       f"rigid bodies): remove scene.planar or the {kind} {body.name!r}")
+                       f"rigid bodies): remove scene.planar or the {word} {body.name!r}")
     for joint in system.joints.values():
         where = f"joint {joint.name!r}"
         turning = joint.type in ("revolute", "arm", "hub") or (
@@ -197,35 +179,11 @@ def _fix(dof: int, q0: np.ndarray, name: str) -> LinearEquation:
 def planar_equations(system, j: int, q0: np.ndarray) -> list[LinearEquation]:
     """The coordinates that stay at their initial values in planar motion with normal e_j
     (see the module documentation), as linear equations to eliminate."""
-    from .joints import planar_fixes
-    others = [k for k in range(3) if k != j]
     out: list[LinearEquation] = []
     for body in system.bodies.values():
-        if isinstance(body, Beam):
-            normal_director = "r_y" if _along(body.orientation[:, 1], j) else "r_z"
-            inplane_director = "r_z" if normal_director == "r_y" else "r_y"
-            for node in range(body.nodes):
-                tag = f"{body.name}: planar node {node + 1}"
-                for which in ("r", "r_x", inplane_director):
-                    out.append(_fix(body.node_first(node, which) + j, q0, f"{tag} {which}"))
-                for k in others:
-                    out.append(_fix(body.node_first(node, normal_director) + k, q0,
-                                    f"{tag} {normal_director}"))
-        elif isinstance(body, Cable):
-            for node in range(body.nodes):
-                tag = f"{body.name}: planar node {node + 1}"
-                for which in ("r", "r_x"):
-                    out.append(_fix(body.node_first(node, which) + j, q0, f"{tag} {which}"))
-        elif isinstance(body, RigidBody):
-            if body.planar and body.plane_axis == j:
-                continue  # its own guide holds the same coordinates
-            saved = body.plane_axis
-            body.plane_axis = j
-            try:
-                out += [LinearEquation(eq.expr, eq.name.replace(": planar", ": planar (scene)"),
-                                       eq.prefer) for eq in planar_fixes(body, q0)]
-            finally:
-                body.plane_axis = saved
+        kind = kind_of(body)
+        if kind is not None and kind.planar_fixed is not None:
+            out += [_fix(dof, q0, label) for dof, label in kind.planar_fixed(body, j, q0)]
     return out
 
 

@@ -20,11 +20,21 @@ A kind declares
   info) -> int``, the set's index); a body whose kind builds no set has no elements (a
   rigid body);
 - the size estimate of a body (``part``), its dimension check (``check_dimensions``) and the
-  effects a body belongs to by itself (``effects``).
+  effects a body belongs to by itself (``effects``);
+- its planar rule (:mod:`.planar`): the plane a body lies in (``plane``), what keeps it
+  from staying in a plane (``planar_problems``) and the coordinates a plane fixes
+  (``planar_fixed``); a kind without a rule is not reduced (a plate, a leaf);
+- whether its bodies report section forces and stresses at stations (``sections``: the
+  answers, :mod:`.answers`, and the dynamic run's recorder of them);
+- its elements' end forces at a static state (``end_forces``: the section forces from the
+  elements' equilibrium, :mod:`.answers`);
+- its mesh rows (``mesh``: the points and cells the XDMF writer shows for a body, through
+  the writer's row builder, ``mesh_order``: the kinds' order in the mesh).
 
 What a body answers about itself (its size, its nodes, its mid-surface, the probe component
-a sweep compares) is a property of its class (:class:`~.bodies.Body`). The planar rule, the
-mesh rows of the XDMF writer and the answers' per-kind tables still test concrete classes
+a sweep compares) is a property of its class (:class:`~.bodies.Body`). A dynamic
+state's section forces are still re-derived for beams in numpy (:mod:`.answers`), and a few
+per-kind branches of the assembly and the joints still test concrete classes
 (tests/test_kinds_registry.py counts those checks and only lets the count go down).
 
 Each family of elements is one Fortran module (an extension of ``element_set`` in
@@ -40,7 +50,7 @@ from typing import Any, Callable
 from ..io.schema import Key, check_call, register_group
 
 __all__ = ["Kind", "SetContext", "register", "kinds", "kind", "kind_of", "checked_values",
-           "set_builder", "add_to_kernel"]
+           "set_builder", "add_to_kernel", "reports_sections"]
 
 
 @dataclass
@@ -91,6 +101,24 @@ class Kind:
     check_dimensions: Callable[[Any], None] | None = None
     #: ``effects(body) -> set``: the effects the body itself belongs to ('prestress')
     effects: Callable[[Any], set[str]] | None = None
+    #: ``plane(body, j) -> float | None``: the j-coordinate of the plane normal to e_j the
+    #: body lies in (None: any, or no planar rule)
+    plane: Callable[[Any, int], float | None] | None = None
+    #: ``planar_problems(body, j, tol) -> [text]``: what keeps the body from moving in planes
+    #: normal to e_j (each text after "body 'name': "); None: the kind is not reduced
+    planar_problems: Callable[[Any, int, float], list[str]] | None = None
+    #: ``planar_fixed(body, j, q0) -> [(dof, label)]``: the full coordinates that keep their
+    #: initial values in planar motion normal to e_j, each with its equation's label
+    planar_fixed: Callable[[Any, int, Any], list[tuple[int, str]]] | None = None
+    #: ``mesh(body, rows)``: adds the body's points and cells to the XDMF writer's row
+    #: builder (``rows.point(terms)``, ``rows.node_points(first, nnodes, stride)``,
+    #: ``rows.quads``, ``rows.lines``: results/xdmf.py); None: not shown
+    mesh: Callable[[Any, Any], None] | None = None
+    #: the kind's place in the mesh (bodies of lower order first, each kind in the model's
+    #: order)
+    mesh_order: int = 0
+    #: its bodies report section forces and stresses at stations (system/answers.py)
+    sections: bool = False
     #: ``end_forces(set_info, q, rotation) -> (forces, vectors)``: each element's elastic
     #: force on its own nodal vectors and the vectors it acts at, both (nel, 8, 3), for the
     #: static section forces from the elements' equilibrium (None: the kind has no beam
@@ -140,6 +168,12 @@ def checked_values(kind: Kind, label: str, values: dict[str, Any]) -> dict[str, 
     plain = {k: x for k, x in values.items() if k in kind.keys and
              (x is None or isinstance(x, str) or k not in kind.objects)}
     return {**values, **check_call(kind.group, label, plain)}
+
+
+def reports_sections(body) -> bool:
+    """Whether the body's kind reports section forces and stresses (``Kind.sections``)."""
+    found = kind_of(body)
+    return found is not None and found.sections
 
 
 def set_builder(body) -> Callable[[Any, SetContext], Any] | None:

@@ -13,8 +13,8 @@ from ...io import validate
 from ...io.schema import (GEOMETRIC_STIFFNESS_DOC, MODES_DOC, Key, at_least, name_key,
                           non_negative, one_of,
                           positive, vector3)
-from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, axis_stations,
-                      check_axis_dimensions)
+from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, along_axis,
+                      axis_stations, check_axis_dimensions)
 from ..expressions import Vec3
 from ..model import SetInfo
 from ..registry import Kind, SetContext, checked_values, register
@@ -177,6 +177,16 @@ class Beam(Body):
     def directors(self, at: Attachment) -> list[str]:
         return ["r_y", "r_z"]
 
+    # -- what the assembly asks of a flexible body besides its set ---------------------------
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A point mass's share of its element's compact mass matrix."""
+        return kernel.beam_point_mass(*at.local, self.lengths[at.element], mass)
+
+    def gravity_forces(self, g: np.ndarray) -> np.ndarray:
+        """Generalized gravity forces per element (24, nel) of the acceleration g (3,)."""
+        return kernel.beam_gravity(self.lengths, *self.section.mass_rule(self.material.density),
+                                   g)
+
     def torsion_shares(self) -> tuple[float, float]:
         """How a torque about the axis divides between the directors r_y and r_z when the
         section turns without shearing: halves with 'cubic' bending (its twist is
@@ -292,7 +302,7 @@ def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
     info = SetInfo(body=beam, kind="", dofs=dofs, nel=beam.nel, frame=frame_id,
                    mass_compact=mass_compact)
     if beam.formulation == "ffr":
-        info.kind = "ffr"
+        info.kind, info.floating = "ffr", True
         if beam.bending == "cubic":  # K0: the cubic tangent at the reference, in the frame
             cubic = kernel.CubicBeam(frame_ref, beam.lengths, section, m.youngs_modulus,
                                      m.poisson_ratio, torsion, shear_factors)
@@ -359,6 +369,45 @@ def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
 
 
 
+def _planar_problems(body: Beam, j: int, tol: float) -> list[str]:
+    """The planar rule (system/planar.py): the axis in a plane normal to e_j, a section axis
+    along e_j, and not 'ffr'."""
+    plane = "xyz"[j]
+    if abs(float(body.start[j] - body.end[j])) > tol:
+        return [f"its axis leaves the plane normal to {plane}"]
+    out = []
+    if body.formulation == "ffr":
+        out.append("formulation 'ffr' keeps its constant iteration matrix by turning whole "
+                   "nodal 3-vectors with the frame; it is not reduced (use 'nonlinear', or "
+                   "planar = 'off')")
+    if not (along_axis(body.orientation[:, 1], j) or along_axis(body.orientation[:, 2], j)):
+        out.append(f"no section axis (height or width) lies along {plane}")
+    return out
+
+
+def _planar_fixed(body: Beam, j: int, q0) -> list[tuple[int, str]]:
+    """In planar motion normal to e_j every node keeps r_j, r_x,j and the in-plane
+    director's j-component, and the normal director's two in-plane components."""
+    normal_director = "r_y" if along_axis(body.orientation[:, 1], j) else "r_z"
+    inplane_director = "r_z" if normal_director == "r_y" else "r_y"
+    out = []
+    for node in range(body.nodes):
+        tag = f"{body.name}: planar node {node + 1}"
+        for which in ("r", "r_x", inplane_director):
+            out.append((body.node_first(node, which) + j, f"{tag} {which}"))
+        for k in range(3):
+            if k != j:
+                out.append((body.node_first(node, normal_director) + k,
+                            f"{tag} {normal_director}"))
+    return out
+
+
+def _mesh(body: Beam, rows) -> None:
+    """XDMF: a 2-node line per element through the node positions r."""
+    nodes = rows.node_points(body.first, body.nodes, 12) + np.arange(body.nodes)
+    rows.lines.append(np.column_stack([nodes[:-1], nodes[1:]]))
+
+
 # -- section forces from the elements' equilibrium (static states: system/answers.py) ---
 def _end_forces(info: SetInfo, q: np.ndarray,
                 rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -400,4 +449,6 @@ KIND = register(Kind(
     adders={"ffr": _add_ffr, "continuum": _add_continuum, "cubic": _add_cubic},
     part=lambda body: part_of(body.name, body.nodes),
     check_dimensions=lambda body: check_axis_dimensions(body, "beam"),
+    plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1, sections=True,
     end_forces=_end_forces))

@@ -215,6 +215,11 @@ class Cable(Body):
         return []
 
     # -- what the assembly asks of a flexible body besides its set ---------------------------
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A point mass's share (4, 4) of its element's compact mass matrix."""
+        shape = self.shape_row(at)
+        return mass * np.outer(shape, shape)
+
     def gravity_forces(self, g: np.ndarray) -> np.ndarray:
         """Generalized gravity forces per element (12, nel) of the acceleration g (3,): the
         uniform load rho A g per length."""
@@ -280,8 +285,23 @@ def build(system, v: dict) -> Cable:
                                   bending_inertia=v.get("bending_inertia")))
 
 
+def _planar_problems(body: Cable, j: int, tol: float) -> list[str]:
+    """The planar rule (system/planar.py): the axis in a plane normal to e_j."""
+    if abs(float(body.start[j] - body.end[j])) > tol:
+        return [f"its axis leaves the plane normal to {'xyz'[j]}"]
+    return []
+
+
+def _planar_fixed(body: Cable, j: int, q0) -> list[tuple[int, str]]:
+    """In planar motion normal to e_j every node keeps r_j and r_x,j."""
+    return [(body.node_first(node, which) + j, f"{body.name}: planar node {node + 1} {which}")
+            for node in range(body.nodes) for which in ("r", "r_x")]
+
+
 KIND = register(Kind(
     group="cable", body_class=Cable, keys=KEYS, build=build, api="cable", word="cable",
     api_keys=("bending_inertia",), objects=("material", "section"), set_builder=cable_set,
     adders={"cable": _add_cable},
-    check_dimensions=lambda body: check_axis_dimensions(body, "cable")))
+    check_dimensions=lambda body: check_axis_dimensions(body, "cable"),
+    plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
+    planar_fixed=_planar_fixed))

@@ -1,8 +1,9 @@
 """Force elements between two bodies (SPEC 8.1; kernel module
-``fortran/src/elements/force_elements.f90``): a spring-damper, a bushing and a compliant
-hydraulic cylinder. The family's whole Python side: the items a :class:`~.system.System`
-holds, their assembly into slots (material points and direction vectors of the two bodies,
-affine in the full coordinates, the ground's as constants) and their reactions.
+``fortran/src/elements/force_elements.f90``): a spring-damper, a bushing, a compliant
+hydraulic cylinder and a torsion spring. The family's whole Python side: the items a
+:class:`~.system.System` holds, their assembly into slots (material points and direction
+vectors of the two bodies, affine in the full coordinates, the ground's as constants) and
+their reactions.
 
 ``spring_damper``  body1, point1, body2, point2; force along the line p2 - p1, tension
                    positive: f = preload + stiffness (L - free_length) + damping L', or
@@ -26,6 +27,14 @@ affine in the full coordinates, the ground's as constants) and their reactions.
                    actuator in series with the oil column's stiffness and damping, f = k (L -
                    l(t)) + c (L' - l'(t)) along the line (tension positive); the rigid,
                    massless cylinder is the 'distance' joint with a drive.
+``torsion``        body1, body2, one point on both and an axis: a linear torsion spring, the
+                   moment -(rotational_stiffness theta + rotational_damping theta') about
+                   the axis on body2 (N m/rad, N m s/rad; one value each), theta the relative
+                   rotation of body2 about the axis carried by body1: atan2(g2 . h1, g1 . h1)
+                   with g1, g2 body1's unit vectors normal to the axis at t = 0 and h1 body2's
+                   equal to g1 at t = 0 (exact for any angle in (-pi, pi) while the relative
+                   turn is about the axis, e.g. on a revolute joint; theta = 0 at t = 0).
+                   Direction vectors as for the bushing.
 
 Energy: the potentials enter the strain energy; the dissipated power c m'^2 is a lost work
 counted with the material damping's (energy row ``work_material_damping``), and a
@@ -51,9 +60,9 @@ from ..expressions import Vec3, combination
 from ..registry import Kind, checked_values, register
 
 #: kinds of the kernel module force_elements (fe_*)
-FE_SPRING_DAMPER, FE_BUSHING, FE_CYLINDER = 1, 2, 3
+FE_SPRING_DAMPER, FE_BUSHING, FE_CYLINDER, FE_TORSION = 1, 2, 3, 4
 FORCE_ELEMENT_KINDS = {"spring_damper": FE_SPRING_DAMPER, "bushing": FE_BUSHING,
-                       "cylinder": FE_CYLINDER}
+                       "cylinder": FE_CYLINDER, "torsion": FE_TORSION}
 #: the parameters each type takes besides name, type, body1, body2: (required, optional)
 #: (a spring_damper needs stiffness or the table deflections and forces)
 FORCE_ELEMENT_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
@@ -62,6 +71,7 @@ FORCE_ELEMENT_PARAMETERS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "bushing": (("point", "stiffness"), ("damping", "rotational_stiffness",
                                          "rotational_damping")),
     "cylinder": (("point1", "point2", "drive", "stiffness"), ("damping",)),
+    "torsion": (("point", "axis", "rotational_stiffness"), ("rotational_damping",)),
 }
 FORCE_ELEMENT_MEANING = {
     "spring_damper": "along the line point1-point2, tension positive: preload + stiffness "
@@ -71,6 +81,8 @@ FORCE_ELEMENT_MEANING = {
                "(small relative rotations)",
     "cylinder": "a rigid actuator of driven length l(t) in series with the oil column: "
                 "stiffness (L - l) + damping (L' - l')",
+    "torsion": "at point: the moment -(rotational_stiffness theta + rotational_damping "
+               "theta') about axis, theta body2's turn about it relative to body1",
 }
 
 
@@ -93,6 +105,7 @@ class ForceElement:
     preload: float = 0.0
     table: Table | None = None
     drive: Drive | None = None
+    axis: np.ndarray | None = None
 
     @property
     def kind(self) -> int:
@@ -131,7 +144,8 @@ def _where(fe: ForceElement) -> str:
 def _directions(body: Body, at, what: str) -> list[Vec3]:
     basis = body.basis(at)
     if len(basis) != 3:
-        raise InputError(f"{what}: a bushing needs three direction vectors at its point; "
+        raise InputError(f"{what}: a bushing or a torsion needs three direction vectors at "
+                         "its point; "
                          f"{type(body).__name__.lower()} {body.name!r} carries {len(basis)} "
                          "(use a beam, a rigid body or the ground)")
     return basis
@@ -159,6 +173,22 @@ def assemble_force_element(fe: ForceElement, q0: np.ndarray, drive_index: dict) 
         slots += list(g) + h
         params = np.concatenate([fe.stiffness, fe.rotational_stiffness, fe.damping,
                                  fe.rotational_damping])
+    elif fe.type == "torsion":
+        g, b = _directions(fe.body1, at1, what), _directions(fe.body2, at2, what)
+        axis = fe.axis / np.linalg.norm(fe.axis)
+        u1 = np.cross(axis, np.eye(3)[int(np.argmin(np.abs(axis)))])
+        u1 /= np.linalg.norm(u1)
+        u2 = np.cross(axis, u1)                  # u1 x u2 = axis
+        d1 = np.column_stack([v.value(q0) for v in g])
+        d2 = np.column_stack([v.value(q0) for v in b])
+        for d, body in ((d1, fe.body1), (d2, fe.body2)):
+            if abs(np.linalg.det(d)) < 1e-9 * np.prod(np.linalg.norm(d, axis=0)):
+                raise InputError(f"{what}: the direction vectors of {body.name!r} at the "
+                                 "point are not independent")
+        # vectors carried by the bodies that equal u1, u2 (body1) and u1 (body2) at t = 0
+        slots += [combination(g, np.linalg.solve(d1, u1)),
+                  combination(g, np.linalg.solve(d1, u2)), combination(b, np.linalg.solve(d2, u1))]
+        params = np.array([fe.rotational_stiffness[0], fe.rotational_damping[0]])
     else:
         length0 = float(np.linalg.norm(p2.value(q0) - p1.value(q0)))
         if length0 <= 1e-12 * max(1.0, float(np.abs(p1.value(q0)).max())):
@@ -256,15 +286,19 @@ __all__ = ["ForceElement", "ForceElementInfo", "FORCE_ELEMENT_KINDS", "FORCE_ELE
 
 KEYS: dict[str, Key] = {
     "name": name_key(),
-    "type": Key("str", check=one_of("spring_damper", "bushing", "cylinder"),
+    "type": Key("str", check=one_of("spring_damper", "bushing", "cylinder", "torsion"),
                 doc="'spring_damper' (along the line point1-point2), 'bushing' (6 diagonal "
                 "stiffnesses and dampings at point), 'cylinder' (a driven length with "
-                "oil-column stiffness and damping in series)"),
+                "oil-column stiffness and damping in series), 'torsion' (a torsion spring "
+                "about axis at point)"),
     "body1": Key("str", "ground", doc="first body (or 'ground')"),
     "body2": Key("str", doc="second body (or 'ground')"),
     "point1": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body1 (m)"),
     "point2": Key("floats", None, vector3, "'spring_damper', 'cylinder': point on body2 (m)"),
-    "point": Key("floats", None, vector3, "'bushing': the point on both bodies (m)"),
+    "point": Key("floats", None, vector3, "'bushing', 'torsion': the point on both bodies "
+                 "(m)"),
+    "axis": Key("floats", None, vector3, "'torsion': the axis of the relative rotation "
+                "(any length; carried by body1)"),
     "stiffness": Key("floats", None, non_negative, "stiffness (N/m): one value; a "
                      "'bushing' three, along body1's axes at the point; 0 or within "
                      "[1e-3, 1e12] N/m (scene.bounds: a softer spring carries nothing a "
@@ -272,11 +306,11 @@ KEYS: dict[str, Key] = {
     "damping": Key("floats", None, non_negative, "damping (N s/m): one value; a 'bushing' "
                    "three (default 0; at most 1e10, scene.bounds)"),
     "rotational_stiffness": Key("floats", None, non_negative, "'bushing': stiffness about "
-                                "body1's three axes (N m/rad; default 0; 0 or within "
-                                "[1e-6, 1e12], scene.bounds)"),
+                                "body1's three axes; 'torsion': one, about axis (N m/rad; "
+                                "default 0; 0 or within [1e-6, 1e12], scene.bounds)"),
     "rotational_damping": Key("floats", None, non_negative, "'bushing': damping about "
-                              "body1's three axes (N m s/rad; default 0; at most 1e10, "
-                              "scene.bounds)"),
+                              "body1's three axes; 'torsion': one, about axis (N m s/rad; "
+                              "default 0; at most 1e10, scene.bounds)"),
     "free_length": Key("float", None, positive, "'spring_damper': length at which the "
                        "force is the preload (m; default: the distance at t = 0)"),
     "preload": Key("float", None, doc="'spring_damper': force at the free length (N, "
@@ -307,11 +341,11 @@ def build(system, v: dict) -> ForceElement:
         raise InputError(f"{where}: body2 is required")
     v = checked_values(KIND, f"force_element[{name}]", v)
     required, optional = FORCE_ELEMENT_PARAMETERS[type]
-    given = {k: v[k] for k in ("point1", "point2", "point", "stiffness", "damping",
+    given = {k: v.get(k) for k in ("point1", "point2", "point", "stiffness", "damping",
                                "rotational_stiffness", "rotational_damping",
                                "free_length", "preload", "deflections", "forces",
-                               "interpolation")}
-    given["drive"] = v["drive"]
+                               "interpolation", "axis")}
+    given["drive"] = v.get("drive")
     missing = [k for k in required if given[k] is None]
     if type == "spring_damper" and given["stiffness"] is None and given["forces"] is None:
         missing.append("stiffness (or deflections and forces)")
@@ -343,24 +377,29 @@ def build(system, v: dict) -> ForceElement:
             raise InputError(f"{where}: a force-deflection table needs deflections and "
                              "forces")
         table = Table(f"{name} (force table)", tuple(given["deflections"]),
-                      tuple(given["forces"]), v["interpolation"] or "linear")
+                      tuple(given["forces"]), given["interpolation"] or "linear")
         try:
             table.check()
         except InputError as exc:
             raise InputError(f"{where}: {str(exc).split(': ', 1)[-1]}".replace(
                 "times", "deflections")) from None
-    elif v["interpolation"] is not None:
+    elif v.get("interpolation") is not None:
         raise InputError(f"{where}: interpolation applies to a force-deflection table")
-    if type == "bushing":
+    axis = None
+    if type == "torsion":
+        axis = np.asarray(given["axis"], dtype=float).ravel()
+        if axis.size != 3 or not np.linalg.norm(axis) > 0.0:
+            raise InputError(f"{where}: axis must be a nonzero 3-vector")
+    if type in ("bushing", "torsion"):
         p1 = p2 = points_of(given["point"])[0]
     else:
         p1, p2 = points_of(given["point1"])[0], points_of(given["point2"])[0]
     at1 = first.locate(p1, node=False, what=where)   # material points of the bodies
     at2 = second.locate(p2, node=False, what=where)
-    if type == "bushing":
+    if type in ("bushing", "torsion"):
         for body, at in ((first, at1), (second, at2)):
             if len(body.basis(at)) != 3:
-                raise InputError(f"{where}: a bushing needs three direction vectors at "
+                raise InputError(f"{where}: a {type} needs three direction vectors at "
                                  f"its point; {body.__class__.__name__.lower()} "
                                  f"{body.name!r} carries {len(body.basis(at))} (use a "
                                  "beam, a rigid body or the ground)")
@@ -368,7 +407,7 @@ def build(system, v: dict) -> ForceElement:
                       values("damping"), values("rotational_stiffness"),
                       values("rotational_damping"), given["free_length"],
                       float(given["preload"] or 0.0), table,
-                      system._drive(v["drive"], where) if type == "cylinder" else None)
+                      system._drive(given["drive"], where) if type == "cylinder" else None, axis)
     system.force_elements[name] = fe
     return fe
 

@@ -169,6 +169,20 @@ class Plate(Body):
     def directors(self, at: Attachment) -> list[str]:
         return ["r_x", "r_y"]
 
+    # -- what the assembly asks of a flexible body besides its set ---------------------------
+    def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
+        """A point mass's share of its element's compact mass matrix."""
+        shape, _ = kernel.plate_shape(*at.local, self.mesh.a[at.element],
+                                      self.mesh.b[at.element])
+        return mass * np.outer(shape, shape)
+
+    def gravity_forces(self, g: np.ndarray) -> np.ndarray:
+        """Generalized gravity forces per element of the acceleration g (3,)."""
+        _, elements = kernel.plate_element_arrays(
+            self.mesh.a, self.mesh.b, self.thickness, self.material.density,
+            self.material.density * self.thickness * g)
+        return elements
+
     def initial_normal(self, element: int) -> np.ndarray:
         """Unit normal r_x x r_y at the element's centre in the initial shape."""
         shape, derivs = kernel.plate_shape(0.5, 0.5, self.mesh.a[element], self.mesh.b[element])
@@ -328,14 +342,20 @@ def _add_plate(ks: kernel.KernelSystem, s: SetInfo) -> int:
 
 
 
+def _mesh(body: Plate, rows) -> None:
+    """XDMF: the elements as quadrilaterals through the corner nodes."""
+    base = rows.node_points(body.first, body.mesh.nnodes, 9)
+    rows.quads.append(body.mesh.elements + base)
+
+
 PLATE = register(Kind(
     group="plate", body_class=Plate, keys=PLATE_KEYS, build=build_plate, api="plate",
     word="plate", objects=("material",), set_builder=_plate_set, adders={"plate": _add_plate},
     part=lambda body: part_of("plate", body.name, body.mesh.nnodes),
-    check_dimensions=lambda body: check_dimensions(body, "plate", "edge_x")))
+    check_dimensions=lambda body: check_dimensions(body, "plate", "edge_x"), mesh=_mesh))
 LEAF = register(Kind(
     group="leaf", body_class=Leaf, keys=LEAF_KEYS, build=build_leaf, api="leaf", word="leaf",
     objects=("material",), set_builder=_plate_set,
     part=lambda body: part_of("leaf", body.name, body.mesh.nnodes),
     check_dimensions=lambda body: check_dimensions(body, "leaf", "arc_length"),
-    effects=lambda body: {"prestress"} if body.prestressed else set()))
+    effects=lambda body: {"prestress"} if body.prestressed else set(), mesh=_mesh))

@@ -4,6 +4,8 @@ registration (:mod:`..registry`); it has no element set (its mass matrix is its 
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ... import kernel
@@ -118,8 +120,48 @@ def build(system, v: dict) -> RigidBody:
                                       plane_normal=checked["plane_normal"]))
 
 
+def _planar_problems(body: RigidBody, j: int, tol: float) -> list[str]:
+    """The planar rule (system/planar.py): no product of inertia couples a turn about e_j
+    with the other two; a body already planar has the normal e_j."""
+    plane, out = "xyz"[j], []
+    coupling = np.delete(body.inertia[j], j)
+    if np.abs(coupling).max() > 1e-9 * np.abs(body.inertia).max():
+        out.append(f"its products of inertia couple a turn about {plane} with the other axes")
+    if body.planar and body.plane_axis != j:
+        out.append(f"it is planar with the normal {'xyz'[body.plane_axis]}, not {plane}")
+    return out
+
+
+def _planar_fixed(body: RigidBody, j: int, q0) -> list[tuple[int, str]]:
+    """In planar motion normal to e_j: its translation along j, its axis j (kept = e_j) and
+    the j-components of its other two axes (none when its own guide holds them)."""
+    if body.planar and body.plane_axis == j:
+        return []
+    out = [(body.vector_first("r") + j, f"{body.name}: planar (scene) r{j + 1}")]
+    for k, which in enumerate(("r_x", "r_y", "r_z")):
+        for comp in range(3):
+            if k == j or comp == j:
+                out.append((body.vector_first(which) + comp,
+                            f"{body.name}: planar (scene) {which}"))
+    return out
+
+
+def _mesh(body: RigidBody, rows) -> None:
+    """XDMF: its centre r and three lines along r_x, r_y, r_z as long as its radius of
+    gyration about the centre of mass, sqrt(tr(I) / 2m) (the root mean square distance of
+    the mass from the centre; 1 when 0)."""
+    size = math.sqrt(max(float(np.trace(body.inertia)), 0.0) / (2.0 * body.mass))
+    size = size if size > 0 else 1.0
+    centre = rows.point([(body.first, 1.0)])
+    for k in (1, 2, 3):  # r + size r_x, r + size r_y, r + size r_z
+        tip = rows.point([(body.first, 1.0), (body.first + 3 * k, size)])
+        rows.lines.append(np.array([[centre, tip]]))
+
+
 KIND = register(Kind(
     group="rigid_body", body_class=RigidBody, keys=KEYS, build=build, api="rigid_body",
     word="rigid body",
     part=lambda body: validate.Part(f"rigid_body[{body.name}]", "mass", "rigid_body", 1,
-                                    RIGID_DOFS)))
+                                    RIGID_DOFS),
+    plane=lambda body, j: float(body.centre[j]), planar_problems=_planar_problems,
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=2))
