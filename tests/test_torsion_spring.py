@@ -78,25 +78,35 @@ def test_tangent_energy_and_angle_against_closed_forms():
     assert rest["energy"] <= 1e-28 and np.abs(rest["force"]).max() <= 1e-13 * KT
 
 
-def hinged_disc(*, moment: float = 0.0, damping: float = 0.0, axis=(0, 0, 1)) -> System:
+def hinged_disc(*, moment: float = 0.0, damping: float = 0.0, axis=(0, 0, 1),
+                typed: bool = False) -> System:
     """A rigid disc on a revolute joint about z at its centre, held to the ground by a
-    torsion spring about ``axis`` (a multiple of z), a dead moment about z."""
+    torsion spring about ``axis`` (a multiple of z), a dead moment about z; the spring
+    through ``System.add`` or (``typed``) the typed ``System.force_element``."""
     s = System("torsion")
     s.rigid_body("disc", mass=1.0, inertia=(0.05, 0.05, J, 0, 0, 0), position=(0, 0, 0))
     s.joint("hinge", "revolute", "ground", "disc", point=(0, 0, 0), axis=(0, 0, 1))
-    s.add("force_element", name="spring", type="torsion", body1="ground", body2="disc",
-          point=(0, 0, 0), axis=axis, rotational_stiffness=KT, rotational_damping=damping)
+    values = dict(point=(0, 0, 0), axis=axis, rotational_stiffness=KT,
+                  rotational_damping=damping)
+    if typed:
+        s.force_element("spring", "torsion", "ground", "disc", **values)
+    else:
+        s.add("force_element", name="spring", type="torsion", body1="ground", body2="disc",
+              **values)
     if moment:
         s.load("m", "moment", body="disc", point=(0, 0, 0), vector=(0, 0, moment))
     s.probe("x", "disc", (1, 0, 0))
     return s
 
 
+@pytest.mark.parametrize("typed", [False, True], ids=["add", "typed"])
 @pytest.mark.parametrize("moment", [0.8, 24.0])
-def test_static_twist_is_the_moment_over_the_stiffness(moment):
+def test_static_twist_is_the_moment_over_the_stiffness(moment, typed):
     """A moment M about the hinge: the disc turns by M / k_t (exact for any angle: the
-    measure is the angle itself; 0.02 and 0.6 rad), the spring's reaction is -M."""
-    res = hinged_disc(moment=moment, axis=(0, 0, 2.5)).static(static_method="newton")
+    measure is the angle itself; 0.02 and 0.6 rad), the spring's reaction is -M; the same
+    through System.add and the typed System.force_element."""
+    res = hinged_disc(moment=moment, axis=(0, 0, 2.5), typed=typed).static(
+        static_method="newton")
     x = np.asarray(res.probes["x"]).ravel()
     assert np.arctan2(x[1], x[0]) == pytest.approx(moment / KT, rel=1e-9)
     assert np.allclose(res.reactions["spring"]["moment"], [0, 0, -moment], rtol=1e-9,

@@ -426,7 +426,7 @@ class System:
                       rotational_damping=None, free_length: float | None = None,
                       preload: float | None = None, deflections=None, forces=None,
                       interpolation: str | None = None,
-                      drive: str | Drive | None = None) -> ForceElement:
+                      drive: str | Drive | None = None, axis=None) -> ForceElement:
         """A force element between body1 and body2 (either may be 'ground'; points are any
         material points of the bodies), ``ancfdrv.system.kinds.force_element``:
 
@@ -439,6 +439,8 @@ class System:
           point), rotational_stiffness and rotational_damping (3 each: about them).
         - ``'cylinder'``: point1, point2, drive (the nominal length l(t), m), stiffness and
           damping of the oil column in series: f = k (L - l) + c (L' - l').
+        - ``'torsion'``: point, axis; rotational_stiffness (N m/rad) and rotational_damping
+          (N m s/rad) about the axis: the moment on body2 is -(k theta + c theta').
 
         Its reaction (force, moment, axial) is recorded under its name with the joints'."""
         return self.add("force_element", name=name, type=type, body1=body1, body2=body2,
@@ -446,7 +448,7 @@ class System:
                         damping=damping, rotational_stiffness=rotational_stiffness,
                         rotational_damping=rotational_damping, free_length=free_length,
                         preload=preload, deflections=deflections, forces=forces,
-                        interpolation=interpolation, drive=drive)
+                        interpolation=interpolation, drive=drive, axis=axis)
 
     @_api
     def probe(self, name: str, body: str | Body, point) -> Probe:
