@@ -8,10 +8,14 @@ registry instead of naming concrete classes.
   and may only go down;
 - the registry lists every kind, each kind's keys are the general schema's group (each key
   spelled once), and ``System.add(group, **values)`` builds the same body as the typed
-  method (same coordinates, same mass matrix)."""
+  method (same coordinates, same mass matrix);
+- the typed methods (System.beam, ...) take exactly their kind's keys and API keywords (their
+  signatures and docstrings are made from the kind), accept a key the old hand-written
+  signatures missed and refuse an unknown one with the namelist's message."""
 from __future__ import annotations
 
 import ast
+import inspect
 from pathlib import Path
 
 import numpy as np
@@ -19,9 +23,10 @@ import pytest
 
 import ancfdrv
 from ancfdrv.errors import InputError
-from ancfdrv.io.schema import GENERAL_SCHEMA
-from ancfdrv.system import Rectangle, System
+from ancfdrv.io.schema import GENERAL_SCHEMA, REQUIRED, Key
+from ancfdrv.system import Box, Rectangle, System
 from ancfdrv.system.registry import kind, kind_of, kinds
+from ancfdrv.system.system import _typed
 
 PACKAGE = Path(ancfdrv.__file__).resolve().parent
 KINDS_DIR = PACKAGE / "system" / "kinds"
@@ -219,3 +224,83 @@ def test_add_refuses_an_unknown_group_and_key():
     # the namelist's check and message, through the Python door
     with pytest.raises(InputError, match=r"beam\[b\].*nodes.*must be at least 2"):
         s.add("beam", name="b", material="steel", start=(0, 0, 0), end=(1, 0, 0), nodes=1)
+
+
+# -- the typed methods: thin wrappers over System.add whose keywords are the kind's keys --
+
+@pytest.mark.parametrize("group", GROUPS)
+def test_the_typed_method_lists_exactly_the_kinds_keys(group):
+    found = kind(group)
+    method = getattr(System, found.api)
+    params = inspect.signature(method).parameters
+    assert list(params)[0] == "self"
+    assert not [p for p in params.values() if p.kind in (p.VAR_KEYWORD, p.VAR_POSITIONAL)]
+    assert set(params) - {"self"} == set(found.keys) | set(found.api_keys)
+    assert len(params) - 1 == len(found.keys) + len(found.api_keys)
+    # a required keyword has no default, an optional one shows one (a positional parameter
+    # keeps the API's: force_element's body2 follows body1 = 'ground'); help() names each key
+    for k, key in found.keys.items():
+        required = key.default is REQUIRED and k not in found.scene_defaults
+        if params[k].kind is params[k].KEYWORD_ONLY:
+            assert (params[k].default is inspect.Parameter.empty) == required, k
+        assert f"``{k}``" in method.__doc__, k
+
+
+def test_the_typed_methods_keep_their_positional_parameters():
+    positional = {found.api: [n for n, p in inspect.signature(
+        getattr(System, found.api)).parameters.items() if p.kind is p.POSITIONAL_OR_KEYWORD]
+        for found in kinds()}
+    assert positional == {"beam": ["self", "name"], "cable": ["self", "name"],
+                          "plate": ["self", "name"], "leaf": ["self", "name"],
+                          "rigid_body": ["self", "name"],
+                          "force_element": ["self", "name", "type", "body1", "body2"]}
+
+
+def test_a_key_added_to_a_kind_is_a_keyword_of_its_typed_method(monkeypatch):
+    monkeypatch.setitem(kind("plate").keys, "colour", Key("str", "grey", doc="its colour"))
+
+    def plate(self, name: str, **values):
+        """A plate."""
+
+    made = _typed("plate")(plate)
+    colour = inspect.signature(made).parameters["colour"]
+    assert colour.kind is colour.KEYWORD_ONLY and colour.default == "grey"
+    assert "``colour`` (str; default 'grey'): its colour" in made.__doc__
+
+
+def test_keys_absent_from_the_old_signatures_are_accepted():
+    """The old System.beam took a section only as a Section object and System.leaf required
+    ny: the kind's namelist form of the section and the default ny = 1 now pass."""
+    by_keys, by_object = System(), System()
+    for s in (by_keys, by_object):
+        s.material("steel", youngs_modulus=2.1e11, density=7850.0, poisson_ratio=0.3)
+    by_keys.beam("b", material="steel", start=(0, 0, 0), end=(2, 0, 0), nodes=4,
+                 section="box", width=0.05, height=0.1, wall=0.005, formulation="nonlinear")
+    by_object.beam("b", material="steel", start=(0, 0, 0), end=(2, 0, 0), nodes=4,
+                   section=Box(0.05, 0.1, 0.005), formulation="nonlinear")
+    assert by_keys.bodies["b"].section.area == pytest.approx(0.05 * 0.1 - 0.04 * 0.09,
+                                                             rel=1e-12)
+    leaf = dict(material="steel", thickness=0.01, width=0.06, arc_length=1.0, radius=2.0,
+                centre=(0, 0, 0), nx=4)
+    by_keys.leaf("l", **leaf)
+    by_object.leaf("l", **leaf, ny=1)
+    assert by_keys.bodies["l"].ny == 1
+    (q_keys, m_keys), (q_object, m_object) = _mass_and_q(by_keys), _mass_and_q(by_object)
+    _close(q_keys, q_object)
+    _close(m_keys, m_object)
+
+
+@pytest.mark.parametrize("api, args", [
+    ("beam", dict(material="steel", start=(0, 0, 0), end=(1, 0, 0), nodes=3)),
+    ("rigid_body", dict(mass=1.0, inertia=(1, 1, 1, 0, 0, 0), position=(0, 0, 0))),
+])
+def test_the_typed_method_refuses_an_unknown_keyword_naming_it(api, args):
+    s = System()
+    s.material("steel", youngs_modulus=2.1e11, density=7850.0)
+    with pytest.raises(InputError, match=rf"{api}\[b\].*unknown key 'lenght' \(the keys of "
+                                         rf"&{api}: name, "):
+        getattr(s, api)("b", **args, lenght=1.0)
+    assert "b" not in s.bodies
+    with pytest.raises(InputError, match=r"force_element\[f\].*unknown key 'stifness'"):
+        s.force_element("f", "spring_damper", "ground", "ground", point1=(0, 0, 0),
+                        point2=(1, 0, 0), stifness=1.0)

@@ -24,7 +24,9 @@ Example (a cantilever with a tip mass)::
 from __future__ import annotations
 
 import copy
+import inspect
 import re
+import textwrap
 from typing import Any, Callable, Iterable
 
 import numpy as np
@@ -80,6 +82,60 @@ def _api(method):
             raise InputError("not enough memory to build this item: use a coarser mesh",
                              group=method.__name__) from None
     return call
+
+
+#: the annotation of a namelist key's value in the typed methods' signatures, by Key.kind
+_KEY_ANNOTATIONS = {"float": "float", "int": "int", "str": "str", "bool": "bool",
+                    "floats": "float | Sequence[float]", "strs": "Sequence[str]"}
+#: what the Python API also takes, besides a name, for a key a kind lists in Kind.objects
+_OBJECT_ANNOTATIONS = {"material": "str | Material", "section": "str | Section",
+                       "drive": "str | Drive", "frame_drive": "str | Drive",
+                       "body1": "str | Body", "body2": "str | Body"}
+
+
+def _typed(group: str):
+    """Makes a System method the typed door of a registered kind: a thin wrapper over
+    ``System.add(group, ...)`` whose signature (``__signature__``: what ``help`` and IDEs
+    show) and docstring are made from the kind's keys and API keywords (``Kind.keys``,
+    ``Kind.api_keys``), so a key added to the kind is a keyword of its method. The method's
+    own parameters (those the API takes positionally) come first, as written; the other keys
+    follow as keyword-only, required where the key is, with the default the call gets (None
+    where the builder chooses: an object key's, a scene-default key's)."""
+    found = kind(group)
+    if found is None:
+        raise ValueError(f"no kind {group!r} is registered")
+
+    def make(method):
+        if method.__name__ != found.api:
+            raise ValueError(f"kind {group!r} names {found.api!r} as its API entry, not "
+                             f"{method.__name__!r}")
+        own = inspect.signature(method)
+        params = [p for p in own.parameters.values() if p.kind is not p.VAR_KEYWORD]
+        taken = {p.name for p in params}
+        lines = []
+        for k, key in found.keys.items():
+            text = _OBJECT_ANNOTATIONS.get(k, _KEY_ANNOTATIONS[key.kind]) \
+                if k in found.objects else _KEY_ANNOTATIONS[key.kind]
+            required = key.default is REQUIRED and k not in found.scene_defaults
+            default = inspect.Parameter.empty if required else \
+                None if k in found.objects or k in found.scene_defaults else key.default
+            if default is None:
+                text += " | None"
+            if k not in taken:
+                params.append(inspect.Parameter(k, inspect.Parameter.KEYWORD_ONLY,
+                                                default=default, annotation=text))
+            lines.append(f"- ``{k}`` ({text}; "
+                         f"{'required' if required else f'default {default!r}'}): {key.doc}")
+        for k in found.api_keys:
+            params.append(inspect.Parameter(k, inspect.Parameter.KEYWORD_ONLY, default=None))
+            lines.append(f"- ``{k}`` (default None): the Python API's own keyword (above)")
+        method.__signature__ = own.replace(parameters=params)
+        method.__doc__ = "\n".join([
+            inspect.cleandoc(method.__doc__ or ""), "",
+            f"Keywords (the keys of &{group}, docs/scenes.md; an unknown one is refused):", "",
+            *(textwrap.fill(line, 88, subsequent_indent="  ") for line in lines)])
+        return method
+    return make
 
 
 class System:
@@ -211,60 +267,48 @@ class System:
                              group=found.api) from None
 
     @_api
-    def beam(self, name: str, *, material: str | Material, start, end, nodes: int,
-             section: Section | None = None, height_axis=None, formulation: str = "ffr",
-             bending: str = "continuum", segments=None, frame_drive: str | Drive | None = None,
-             frame_axis=(0.0, 0.0, 1.0), frame_pivot=None,
-             geometric_stiffness: bool = False, modes: int = 0) -> Body:
-        """An ANCF beam (:class:`~.kinds.beam.Beam`); ``geometric_stiffness=True`` gives an
-        'ffr' beam the geometric stiffness of its current axial force (P-delta); ``modes=N``
-        (N > 0) runs its dynamics as the modal reduction with N modes (``&beam modes``)."""
-        return self.add("beam", name=name, material=material, start=start, end=end,
-                        nodes=nodes, section=section, height_axis=height_axis,
-                        formulation=formulation, bending=bending, segments=segments,
-                        frame_drive=frame_drive, frame_axis=frame_axis,
-                        frame_pivot=frame_pivot, geometric_stiffness=geometric_stiffness,
-                        modes=modes)
+    @_typed("beam")
+    def beam(self, name: str, **values: Any) -> Body:
+        """An ANCF beam (:class:`~.kinds.beam.Beam`): ``System.add('beam', name=name,
+        ...)``. The section is a Section object (default a 0.1 m square) or the namelist's
+        form (``section='box', width=..., height=..., wall=...``);
+        ``geometric_stiffness=True`` gives an 'ffr' beam the geometric stiffness of its
+        current axial force (P-delta); ``modes=N`` (N > 0) runs its dynamics as the modal
+        reduction with N modes; ``formulation`` defaults to 'ffr'."""
+        return self.add("beam", name=name, **values)
 
     @_api
-    def cable(self, name: str, *, material: str | Material, start, end, nodes: int,
-              section: Section | None = None, tension_only: bool = False,
-              bending_stiffness: float | None = None, segments=None,
-              bending_inertia: float | None = None) -> Body:
-        """An ANCF cable (:class:`~.kinds.cable.Cable`: r and r_x per node, Euler-Bernoulli).
-        ``tension_only=True`` makes it a rope that goes slack instead of carrying
-        compression; ``bending_stiffness`` (N m^2) replaces E times the section's I;
-        ``segments``: lengths between fixed nodes, each split equally (as a beam's);
-        ``bending_inertia`` (m^4): the inertia of a section with I_y != I_z about the axis a
-        cable kept in a plane bends about (the system must then be planar)."""
-        return self.add("cable", name=name, material=material, start=start, end=end,
-                        nodes=nodes, section=section, tension_only=tension_only,
-                        bending_stiffness=bending_stiffness, segments=segments,
-                        bending_inertia=bending_inertia)
+    @_typed("cable")
+    def cable(self, name: str, **values: Any) -> Body:
+        """An ANCF cable (:class:`~.kinds.cable.Cable`: r and r_x per node, Euler-Bernoulli):
+        ``System.add('cable', name=name, ...)``. ``tension_only=True`` makes it a rope that
+        goes slack instead of carrying compression; ``bending_stiffness`` (N m^2) replaces E
+        times the section's I; ``segments``: lengths between fixed nodes, each split equally
+        (as a beam's); ``bending_inertia`` (m^4, the Python API's own keyword): the inertia
+        of a section with I_y != I_z about the axis a cable kept in a plane bends about (the
+        system must then be planar)."""
+        return self.add("cable", name=name, **values)
 
     @_api
-    def plate(self, name: str, *, material: str | Material, thickness: float, corner, edge_x,
-              edge_y, nx: int, ny: int, variant: str = "completed") -> Body:
-        """A flat thin plate (:class:`~.kinds.plate.Plate`)."""
-        return self.add("plate", name=name, material=material, thickness=thickness,
-                        corner=corner, edge_x=edge_x, edge_y=edge_y, nx=nx, ny=ny,
-                        variant=variant)
+    @_typed("plate")
+    def plate(self, name: str, **values: Any) -> Body:
+        """A flat thin plate (:class:`~.kinds.plate.Plate`): ``System.add('plate',
+        name=name, ...)``."""
+        return self.add("plate", name=name, **values)
 
     @_api
-    def leaf(self, name: str, *, material: str | Material, thickness: float, width: float,
-             arc_length: float, radius: float, centre, nx: int, ny: int,
-             variant: str = "completed", free_radius: float | None = None) -> Body:
-        """A curved leaf (:class:`~.kinds.plate.Leaf`)."""
-        return self.add("leaf", name=name, material=material, thickness=thickness, width=width,
-                        arc_length=arc_length, radius=radius, centre=centre, nx=nx, ny=ny,
-                        variant=variant, free_radius=free_radius)
+    @_typed("leaf")
+    def leaf(self, name: str, **values: Any) -> Body:
+        """A curved leaf (:class:`~.kinds.plate.Leaf`): ``System.add('leaf', name=name,
+        ...)``."""
+        return self.add("leaf", name=name, **values)
 
     @_api
-    def rigid_body(self, name: str, *, mass: float, inertia, position, planar: bool = False,
-                   plane_normal=(0.0, 1.0, 0.0)) -> Body:
-        """A rigid body as an ANCF reference node (:class:`~.kinds.rigid_body.RigidBody`)."""
-        return self.add("rigid_body", name=name, mass=mass, inertia=inertia,
-                        position=position, planar=planar, plane_normal=plane_normal)
+    @_typed("rigid_body")
+    def rigid_body(self, name: str, **values: Any) -> Body:
+        """A rigid body as an ANCF reference node (:class:`~.kinds.rigid_body.RigidBody`):
+        ``System.add('rigid_body', name=name, ...)``."""
+        return self.add("rigid_body", name=name, **values)
 
     def _body_name(self, name: str) -> str:
         if name == "ground":
@@ -420,13 +464,9 @@ class System:
         return pair
 
     @_api
+    @_typed("force_element")
     def force_element(self, name: str, type: str, body1: str | Body = "ground",
-                      body2: str | Body | None = None, *, point1=None, point2=None,
-                      point=None, stiffness=None, damping=None, rotational_stiffness=None,
-                      rotational_damping=None, free_length: float | None = None,
-                      preload: float | None = None, deflections=None, forces=None,
-                      interpolation: str | None = None,
-                      drive: str | Drive | None = None, axis=None) -> ForceElement:
+                      body2: str | Body | None = None, **values: Any) -> ForceElement:
         """A force element between body1 and body2 (either may be 'ground'; points are any
         material points of the bodies), ``ancfdrv.system.kinds.force_element``:
 
@@ -444,11 +484,7 @@ class System:
 
         Its reaction (force, moment, axial) is recorded under its name with the joints'."""
         return self.add("force_element", name=name, type=type, body1=body1, body2=body2,
-                        point1=point1, point2=point2, point=point, stiffness=stiffness,
-                        damping=damping, rotational_stiffness=rotational_stiffness,
-                        rotational_damping=rotational_damping, free_length=free_length,
-                        preload=preload, deflections=deflections, forces=forces,
-                        interpolation=interpolation, drive=drive, axis=axis)
+                        **values)
 
     @_api
     def probe(self, name: str, body: str | Body, point) -> Probe:
