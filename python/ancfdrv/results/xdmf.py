@@ -58,6 +58,7 @@ class MeshLayout:
     lines: np.ndarray         # (nline, 2) point indices
     map: Csr                  # (3 npoints, nfull): positions = map @ q_full
     bodies: list[str]         # 'name: kind, points a..b' per body shown
+    spans: dict[str, range]   # the points of each body shown, by name
 
     @classmethod
     def from_model(cls, model) -> "MeshLayout | None":
@@ -70,12 +71,14 @@ class MeshLayout:
             start = rows.count
             found.mesh(body, rows)
             rows.bodies.append(f"{body.name}: {found.word}, points {start}..{rows.count - 1}")
+            rows.spans[body.name] = range(start, rows.count)
         count = rows.count
         if count == 0:
             return None
         matrix = Csr.from_coo(rows.rows, rows.cols, rows.coefs, (3 * count, model.nfull))
         points = (matrix @ model.q0).reshape(count, 3)
-        return cls(points, _stack(rows.quads, 4), _stack(rows.lines, 2), matrix, rows.bodies)
+        return cls(points, _stack(rows.quads, 4), _stack(rows.lines, 2), matrix, rows.bodies,
+                   rows.spans)
 
     @property
     def npoints(self) -> int:
@@ -115,6 +118,7 @@ class _Rows:
         self.quads: list[np.ndarray] = []
         self.lines: list[np.ndarray] = []
         self.bodies: list[str] = []
+        self.spans: dict[str, range] = {}
         self.count = 0
 
     def point(self, terms: list[tuple[int, float]]) -> int:
