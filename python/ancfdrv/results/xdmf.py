@@ -5,7 +5,8 @@ The XDMF 3 file beside ``OUT.h5`` is a temporal collection with one uniform grid
 always with the first and the last step). The grid shows
 
 * plates and leaves as quadrilaterals (the elements' corner nodes), as before;
-* beams as polylines: a 2-node line per element through the node positions r;
+* beams and cables (ropes) as polylines: a 2-node line per element through the node
+  positions r;
 * rigid bodies as their centre r with their body axes: three lines from the centre along
   r_x, r_y, r_z, as long as the body's radius of gyration sqrt(tr(I) / 2m). (A lone point
   is not used: in a ``Mixed`` topology VTK reads a Polyvertex with a node count and meshio
@@ -160,7 +161,7 @@ def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
     topology.attrs["description"] = (
         "XDMF connectivity (0-based rows of points): " + {
             "Quadrilateral": "the corner points of each plate element",
-            "Polyline": "2-point lines (beam elements, rigid body axes)",
+            "Polyline": "2-point lines (beam and cable elements, rigid body axes)",
             "Mixed": "per cell its XDMF code, then quad: 4 points; line: 2, 2 points"}[kind])
     group.attrs["topology_type"] = kind
     group.attrs["ncells"] = np.int64(ncells)
