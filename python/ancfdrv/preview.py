@@ -257,7 +257,7 @@ def figure(system: System, model: Model, title: str) -> Any:
                 setter(c - 0.5 * size - margin, c + 0.5 * size + margin)
             ax.set_box_aspect((1, 1, 1))
             ax.set_proj_type("ortho")
-            ax.view_init(elev=np.degrees(np.arctan(1 / np.sqrt(2))), azim=-135)
+            ax.view_init(elev=np.degrees(np.arctan(1 / np.sqrt(2))), azim=-45)
             ax.set_xlabel(f"{_AXIS[idx[0]]} (m)")
             ax.set_ylabel(f"{_AXIS[idx[1]]} (m)")
             ax.set_zlabel(f"{_AXIS[idx[2]]} (m)")
