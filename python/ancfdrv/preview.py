@@ -17,6 +17,7 @@ matplotlib is imported when a picture is drawn, never by importing this module.
 """
 from __future__ import annotations
 
+import os
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -65,7 +66,6 @@ def show_system(system: System, path: str | Path | None = None) -> Path:
     temporary file ``ancf-show-*.png`` when None; returns the PNG's path."""
     if path is None:
         handle, name = tempfile.mkstemp(prefix="ancf-show-", suffix=".png")
-        import os
         os.close(handle)
         path = name
     model = system.assemble()
@@ -96,9 +96,9 @@ def geometry(system: System, model: Model) -> dict[str, Any]:
         if layout is None or body.name not in layout.spans:
             continue
         span = layout.spans[body.name]
-        inside = lambda cells: cells[np.all((cells >= span.start) & (cells < span.stop), 1)]
-        edges = np.vstack([_segments(layout.points, inside(layout.lines)),
-                           _segments(layout.points, inside(layout.quads))])
+        edges = np.vstack([_segments(layout.points, cells[np.all(
+            (cells >= span.start) & (cells < span.stop), axis=1)])
+            for cells in (layout.lines, layout.quads)])
         nodes = layout.points[span.start:span.stop]
         box = None
         if not body.flexible:  # a rigid body: its centre and a box half its axes' length
@@ -133,10 +133,13 @@ def geometry(system: System, model: Model) -> dict[str, Any]:
 
 
 def bounding_box(shapes: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    """(low, high) corners of every point drawn but the arrows and labels."""
+    """(low, high) corners of every point drawn (rigid bodies' boxes included) but the
+    arrows and labels."""
     pts = [b["edges"] for b in shapes["bodies"].values()]
     pts += [b["nodes"] for b in shapes["bodies"].values() if b["nodes"] is not None]
     pts += [ends for _, ends, _ in shapes["lines"]]
+    pts += [np.array([centre - half, centre + half]) for b in shapes["bodies"].values()
+            if b["box"] is not None for centre, half in [b["box"]]]
     pts += [np.atleast_2d(p) for key in ("joints", "probes", "masses", "forces", "moments")
             for _, p, *_ in shapes[key]]
     every = np.vstack([np.asarray(p, float).reshape(-1, 3) for p in pts]) if pts else \
