@@ -106,7 +106,7 @@ LAYERS = [
     {"solvers"},                    # static, dynamic, modal, buckling
     {"results"},                    # HDF5, XDMF, locks, output paths, the result object
     {"builders"},                   # templates and the general namelist form: Scene -> System
-    {"runner"},                     # one scene start to finish
+    {"runner", "preview"},          # one scene start to finish; ancf show
     {"analyses", "sweep_exec",      # System.static/simulate/modes/buckling; sweep workers;
      "simulation"},                 # ancfdrv.simulate: a scene run kept in memory
     {"sweep", "scenedoc"},

@@ -215,10 +215,17 @@ def buckling(system, n: int = 3, *, fixed_loads=(), effects=None,
             base.close()
 
 
+def show(system: System, path=None):
+    """System.show: the preview of the undeformed model (:mod:`ancfdrv.preview`)."""
+    from .preview import show_system
+    return show_system(system, path)
+
+
 def _register() -> None:
     """Give System its analyses (the system layer sits below this module: it runs the
     solvers and writes the result file)."""
-    System._ANALYSES.update(static=static, simulate=simulate, modes=modes, buckling=buckling)
+    System._ANALYSES.update(static=static, simulate=simulate, modes=modes, buckling=buckling,
+                             show=show)
 
 
 _register()

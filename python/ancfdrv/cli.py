@@ -5,6 +5,7 @@
     ancf sweep SCENE.nml --vary GROUP.KEY=V1,V2,... [--vary ...] [-o DIR] [--workers N | --scheduler ADDR]
     ancf info OUT.h5 [--json]
     ancf plot OUT.h5 [OUT2.h5 ...] [-o PNG]   (several files: leaf spring runs overlaid)
+    ancf show SCENE.nml [-o PNG] [--set GROUP.KEY=VALUE ...]   (the model before any solve)
 
 Exit status:
     0    success
@@ -247,6 +248,15 @@ def _cmd_plot(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_show(args: argparse.Namespace) -> int:
+    """The preview of a scene's undeformed model (:mod:`ancfdrv.preview`): nothing is
+    solved, no result file is written."""
+    from .preview import show_scene
+    png = show_scene(args.scene, args.set, args.output)
+    print(f"written {png}")
+    return 0
+
+
 def corrupted(path: object, exc: BaseException) -> InputError:
     """A result file that opens but whose content is damaged or not what a run writes."""
     text = str(exc).splitlines()[0][:200] if str(exc) else ""
@@ -311,6 +321,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", help="PNG file (default: beside the (first) HDF5, "
                    "<first>_compare.png for several)")
     p.set_defaults(func=_cmd_plot)
+    p = sub.add_parser("show", help="draw the model of a scene before any solve: three "
+                       "views and an isometric one with the names of bodies, joints, loads "
+                       "and probes (nothing is solved)")
+    p.add_argument("scene")
+    p.add_argument("-o", "--output", help="PNG file (default: SCENE.png beside the scene)")
+    p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE",
+                   help="override a namelist value (repeatable)")
+    p.set_defaults(func=_cmd_show)
     return parser
 
 

@@ -5,7 +5,8 @@ The XDMF 3 file beside ``OUT.h5`` is a temporal collection with one uniform grid
 always with the first and the last step). The grid shows
 
 * plates and leaves as quadrilaterals (the elements' corner nodes), as before;
-* beams as polylines: a 2-node line per element through the node positions r;
+* beams and cables (ropes) as polylines: a 2-node line per element through the node
+  positions r;
 * rigid bodies as their centre r with their body axes: three lines from the centre along
   r_x, r_y, r_z, as long as the body's radius of gyration sqrt(tr(I) / 2m). (A lone point
   is not used: in a ``Mixed`` topology VTK reads a Polyvertex with a node count and meshio
@@ -58,6 +59,7 @@ class MeshLayout:
     lines: np.ndarray         # (nline, 2) point indices
     map: Csr                  # (3 npoints, nfull): positions = map @ q_full
     bodies: list[str]         # 'name: kind, points a..b' per body shown
+    spans: dict[str, range]   # the points of each body shown, by name
 
     @classmethod
     def from_model(cls, model) -> "MeshLayout | None":
@@ -70,12 +72,14 @@ class MeshLayout:
             start = rows.count
             found.mesh(body, rows)
             rows.bodies.append(f"{body.name}: {found.word}, points {start}..{rows.count - 1}")
+            rows.spans[body.name] = range(start, rows.count)
         count = rows.count
         if count == 0:
             return None
         matrix = Csr.from_coo(rows.rows, rows.cols, rows.coefs, (3 * count, model.nfull))
         points = (matrix @ model.q0).reshape(count, 3)
-        return cls(points, _stack(rows.quads, 4), _stack(rows.lines, 2), matrix, rows.bodies)
+        return cls(points, _stack(rows.quads, 4), _stack(rows.lines, 2), matrix, rows.bodies,
+                   rows.spans)
 
     @property
     def npoints(self) -> int:
@@ -115,6 +119,7 @@ class _Rows:
         self.quads: list[np.ndarray] = []
         self.lines: list[np.ndarray] = []
         self.bodies: list[str] = []
+        self.spans: dict[str, range] = {}
         self.count = 0
 
     def point(self, terms: list[tuple[int, float]]) -> int:
@@ -156,7 +161,7 @@ def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
     topology.attrs["description"] = (
         "XDMF connectivity (0-based rows of points): " + {
             "Quadrilateral": "the corner points of each plate element",
-            "Polyline": "2-point lines (beam elements, rigid body axes)",
+            "Polyline": "2-point lines (beam and cable elements, rigid body axes)",
             "Mixed": "per cell its XDMF code, then quad: 4 points; line: 2, 2 points"}[kind])
     group.attrs["topology_type"] = kind
     group.attrs["ncells"] = np.int64(ncells)

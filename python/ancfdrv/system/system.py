@@ -679,6 +679,13 @@ class System:
         ``.probes[name]`` of shape (nt, 3), ``.energy``)."""
         return self._analysis("simulate")(self, t_end, dt, from_static=from_static, **options)
 
+    def show(self, path=None):
+        """A picture of the undeformed model, nothing solved (``ancf show``,
+        :mod:`ancfdrv.preview`): three orthographic views and an isometric one with the
+        names of bodies, joints, loads and probes, written to ``path`` (a PNG; default a new
+        temporary file ``ancf-show-*.png``). Returns the PNG's path."""
+        return self._analysis("show")(self, path)
+
     # -- modal analysis and linear buckling (SPEC section 10) ----------------------------
     def modes(self, n: int = 10, *, effects: Iterable[str] | None = None,
               linear_joints: str = "auto", **options):

@@ -298,10 +298,16 @@ def _planar_fixed(body: Cable, j: int, q0) -> list[tuple[int, str]]:
             for node in range(body.nodes) for which in ("r", "r_x")]
 
 
+def _mesh(body: Cable, rows) -> None:
+    """XDMF: a 2-node line per element through the node positions r (a polyline)."""
+    nodes = rows.node_points(body.first, body.nodes, CABLE_NODE_DOFS) + np.arange(body.nodes)
+    rows.lines.append(np.column_stack([nodes[:-1], nodes[1:]]))
+
+
 KIND = register(Kind(
     group="cable", body_class=Cable, keys=KEYS, build=build, api="cable", word="cable",
     api_keys=("bending_inertia",), objects=("material", "section"), set_builder=cable_set,
     adders={"cable": _add_cable},
     check_dimensions=lambda body: check_axis_dimensions(body, "cable"),
     plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
-    planar_fixed=_planar_fixed))
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1))
