@@ -351,8 +351,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
                            "steps per kernel call at most; the rows reach the file at least "
                            "once a second"),
         "xdmf": Key("bool", True, doc="dynamic runs: write OUT.xdmf beside the result, the "
-                    "motion of every body for ParaView (plates as quadrilaterals, beams as "
-                    "polylines, rigid bodies as their centre and axes); stores q"),
+                    "motion of every body for ParaView (plates as quadrilaterals, beams and "
+                    "cables as polylines, rigid bodies as their centre and axes); stores q"),
         "xdmf_frames": Key("int", 250, at_least(2), "the most frames the XDMF holds: longer "
                            "runs show every k-th step (and the last); each frame costs "
                            "about 0.4 ms of output"),
