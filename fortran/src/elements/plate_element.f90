@@ -239,7 +239,7 @@ contains
     real(dp) :: b_strain(3, 6), g(3), gnorm, u(3), v(3), c(3), to_local(3, 3), kappa(3)
     real(dp) :: moment(3), omega(3), dcurv(3, 15), dkappa(3, 15), w_eff(3), wg, h_eff(3)
     real(dp) :: hwg(3, 3), hgg(3, 3), gu(3, 3), gv(3, 3), k(2, 2)
-    integer :: gamma, i, f, row, col
+    integer :: gamma, i, f
     damped = present(field_rates) .and. present(tau) .and. present(rate_factor) .and. &
              present(power)
     reference = curvature0
@@ -340,14 +340,7 @@ contains
     hessian(1:6, 1:6) = matmul(transpose(b_strain), matmul(membrane_d, b_strain))
     stress_tensor = reshape([stress(1), stress(3), stress(3), stress(2)], [2, 2])
     geometric = matmul(k, matmul(stress_tensor, transpose(k)))
-    do col = 1, 2
-      do row = 1, 2
-        do i = 1, 3
-          hessian(3 * row - 3 + i, 3 * col - 3 + i) = hessian(3 * row - 3 + i, 3 * col - 3 + i) &
-                                                      + geometric(row, col)
-        end do
-      end do
-    end do
+    call add_geometric_membrane(geometric, hessian)
     ! bending, material part
     dkappa = matmul(to_local, dcurv)
     hessian = hessian + matmul(transpose(dkappa), matmul(bending_d, dkappa))
@@ -384,14 +377,7 @@ contains
     stress_tensor = reshape([damping_stress(1), damping_stress(3), damping_stress(3), &
                              damping_stress(2)], [2, 2])
     geometric = matmul(frame, matmul(stress_tensor, transpose(frame)))
-    do col = 1, 2
-      do row = 1, 2
-        do i = 1, 3
-          hessian(3 * row - 3 + i, 3 * col - 3 + i) = hessian(3 * row - 3 + i, 3 * col - 3 + i) &
-                                                      + geometric(row, col)
-        end do
-      end do
-    end do
+    call add_geometric_membrane(geometric, hessian)
     call membrane_strain_matrix(frame, deformation_rate, b_rate)
     hessian(1:6, 1:6) = hessian(1:6, 1:6) + matmul(transpose(b_strain), &
       matmul(membrane_d, rate_factor * tau * b_strain + tau * b_rate))
@@ -544,6 +530,22 @@ contains
                         set%thickness, want_tangent, force, energy, tangent, info)
     end if
   end subroutine plate_element_forces
+
+  !> The geometric part of the membrane tangent, kron(G, I3) with G (2, 2) = K S K^T, added
+  !> to the (6, 6) block of a point's Hessian on the two in-plane gradients.
+  pure subroutine add_geometric_membrane(geometric, hessian)
+    real(dp), intent(in) :: geometric(2, 2)
+    real(dp), intent(inout) :: hessian(:, :)
+    integer :: row, col, i
+    do col = 1, 2
+      do row = 1, 2
+        do i = 1, 3
+          hessian(3 * row - 3 + i, 3 * col - 3 + i) = hessian(3 * row - 3 + i, 3 * col - 3 + i) &
+                                                      + geometric(row, col)
+        end do
+      end do
+    end do
+  end subroutine add_geometric_membrane
 
   !> B(3, 6) of the membrane strain with respect to (r_x, r_y) at F = [r_x r_y] K (or, with
   !> F' in place of F, the derivative of eps' = B(F) z' with respect to z).
