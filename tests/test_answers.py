@@ -532,26 +532,6 @@ def test_twisted_rectangle_saint_venant_shear(width, height, alpha):
     model.close()
 
 
-def test_ffr_linear_strain_matrix_and_element_path_agree(monkeypatch):
-    """An FFR beam's section forces come from its linear-strain matrix, or for long beams
-    (above LINEAR_MATRIX_LIMIT entries) element by element: the same numbers (1e-8)."""
-    import ancfdrv.system.answers as answers
-    s = System("c")
-    steel = s.material("steel", **STEEL)
-    s.beam("arm", material=steel, start=(0, 0, 0), end=(2, 0, 0), nodes=9,
-           section=Rectangle(0.05, 0.1), height_axis=(0, 1, 0), formulation="ffr",
-           bending="cubic")
-    s.joint("root", "weld", "ground", "arm", point=(0, 0, 0))
-    s.load("tip", "force", body="arm", point=(2, 0, 0), vector=(30.0, 100.0, -40.0))
-    model, result = _solve(s)
-    by_matrix = section_forces(model, result.e)["arm"]
-    monkeypatch.setattr(answers, "LINEAR_MATRIX_LIMIT", 0)
-    by_element = section_forces(model, result.e)["arm"]
-    for key in ("N", "T", "Q", "M"):
-        assert getattr(by_element, key) == pytest.approx(getattr(by_matrix, key), abs=1e-8 * 200)
-    model.close()
-
-
 def test_static_answers_bundle_the_three(tmp_path):
     """static_answers gives the same records as the three functions, and the file written
     from it holds them under the joint's and the beam's names."""

@@ -93,28 +93,6 @@ def _ffr_beam(nodes: int = 7):
     return s.assemble()
 
 
-def test_element_blocks_hold_the_whole_linear_strain_matrix():
-    """Every entry of the FFR linear-strain matrix outside the element's own 24 rows is
-    exactly zero, so the stacked per-element product is the dense product: the same
-    strain measures to rounding (1e-12 of the largest) on rows of random displacements."""
-    model = _ffr_beam()
-    beam = model.bodies[0]
-    tables = answers._tables(beam, 3)
-    dense = tables.linear_strain(beam).reshape(beam.ncoordinates, beam.nel, 3, 8)
-    for e in range(beam.nel):
-        outside = np.ones(beam.ncoordinates, dtype=bool)
-        outside[12 * e:12 * e + 24] = False
-        assert not dense[outside, e].any()
-    rng = np.random.default_rng(2)
-    d = rng.normal(size=(40, beam.ncoordinates)) * 1e-3
-    plain = (d @ tables.linear_strain(beam)).reshape(40, beam.nel, 3, 8)[..., :6]
-    stacked = answers._element_strains(tables.element_strain(beam), d, 3)
-    assert np.abs(stacked - plain).max() <= 1e-12 * np.abs(plain).max()
-    one = answers._element_strains(tables.element_strain(beam), d[4], 3)
-    assert np.abs(one - plain[4]).max() <= 1e-12 * np.abs(plain).max()
-    model.close()
-
-
 def test_ffr_departure_rows_is_the_per_element_measure():
     """The small-strain check on each node's section vectors once equals the measure
     element by element, |A^T r_i - r_i0| maximized over all elements' r_x, r_y, r_z, bit

@@ -648,6 +648,8 @@ class KernelSystem:
         self.handle, self.ndof, self.nfull = int(handle), ndof, nfull
         self.ncon = self.nprobe = self.npoint = 0
         self.nnz_pattern = 0
+        #: the elements of each beam set given section data (set_sections), by index
+        self._set_sizes: dict[int, int] = {}
 
     def _check(self, info: int, what: str, message: bytes | str = b"") -> None:
         """Raise with the kernel's own text (code 1: a stale handle, 2: sizes or indices
@@ -690,6 +692,33 @@ class KernelSystem:
             frame, damping_time)
         self._check(info, "cubic beam set", message)
         return int(index)
+
+    def set_sections(self, index: int, lengths, reference, cubic: bool, **section: float
+                     ) -> None:
+        """Give beam set ``index`` (1-based) the data of its section forces: the element
+        lengths (nel,), the reference nodal vectors (3, 8, nel) (an 'ffr' set's in its
+        frame), the bending option and the section (codes.KERNEL_LAYOUTS 'sk', by name)."""
+        info, message = _kernel.system_set_sections(self.handle, index, _f(lengths),
+                                                    _f(reference), _pack("sk", **section),
+                                                    int(cubic))
+        self._check(info, "beam section data", message)
+        self._set_sizes[index] = len(lengths)
+
+    def section_forces(self, index: int, times, e_rows, xi) -> np.ndarray:
+        """Section forces (6, nrows, ns nel) [N, T, Q_height, Q_width, M_height, M_width]
+        of beam set ``index`` at the stations xi (ns,) of every element for the states
+        e_rows (nrows, ndof) (independent coordinates) at the times (nrows,) (element_sets
+        section_forces; station i of element el at el ns + i, 0-based), in one call for all
+        rows. Each component's (nrows, ns nel) is C-contiguous."""
+        nel = self._set_sizes[index]
+        xi = np.asarray(xi, dtype=np.float64)
+        # the rows (nrows, ndof) in C order are the kernel's (ndof, nrows) columns
+        forces, info, message = _kernel.system_section_forces(
+            self.handle, index, len(xi) * nel, np.asarray(times, dtype=np.float64),
+            np.ascontiguousarray(e_rows, dtype=np.float64).T, xi)
+        if info:
+            raise SolverError(f"kernel section forces, code {info}: {_text(message)}")
+        return forces.T
 
     def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
                       poisson: float, thickness: float, damping_time: float = 0.0) -> int:

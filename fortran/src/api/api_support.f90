@@ -9,9 +9,14 @@ module api_support
   use stepper, only: stepper_run
   use system_store, only: store_get
   use kernel_errors, only: handle_text
+  use element_sets, only: element_set
+  use beam_stations, only: station_section
+  use ffr_elastic, only: ffr_set
+  use beam_nonlinear, only: continuum_set
+  use beam_cubic, only: cubic_set
   implicit none
   private
-  public :: api_system, unpack_constraints
+  public :: api_system, unpack_constraints, give_sections
 
   !> The arrays of a constraint set (constraints module layout)
   type, public :: constraint_layout
@@ -24,6 +29,11 @@ module api_support
   integer, parameter, public :: cs_area = 1, cs_inertia_y = 2, cs_inertia_z = 3, &
                                 cs_torsion = 4, cs_shear_y = 5, cs_shear_z = 6, cs_youngs = 7, &
                                 cs_poisson = 8, cs_count = 8
+  !> a beam set's section data for its section forces (beam_stations station_section):
+  !> EA, G J, k_y G A, k_z G A, the moments' factors -E I_y and E I_z, E, I_y, I_z, I_p
+  integer, parameter, public :: sk_axial = 1, sk_torsion = 2, sk_shear_y = 3, sk_shear_z = 4, &
+                                sk_moment_height = 5, sk_moment_width = 6, sk_youngs = 7, &
+                                sk_inertia_y = 8, sk_inertia_z = 9, sk_polar = 10, sk_count = 10
   !> a continuum beam set's material
   integer, parameter, public :: bm_youngs = 1, bm_poisson = 2, bm_count = 2
   !> a plate's material and thickness
@@ -98,6 +108,26 @@ contains
       if (info /= 0) message = handle_text(handle)
     end if
   end subroutine api_system
+
+  !> Hands a beam set (ffr, continuum or cubic) the data of its section forces
+  !> (system_set_sections; here, where f2py does not read the type selection). info = 2:
+  !> the set is of another family.
+  subroutine give_sections(set, sections, info)
+    class(element_set), intent(inout) :: set
+    type(station_section), intent(in) :: sections
+    integer, intent(out) :: info
+    info = 0
+    select type (set)
+    type is (ffr_set)
+      set%sections = sections
+    type is (continuum_set)
+      set%sections = sections
+    type is (cubic_set)
+      set%sections = sections
+    class default
+      info = 2
+    end select
+  end subroutine give_sections
 
   !> A packed constraint layout unpacked into the arrays of the constraints module,
   !>   ints  = [ncon, nterm, ndrive, kinds(ncon), drives(ncon), term_ptr(6 ncon + 1),

@@ -262,6 +262,101 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   call append_set(sys, set, index)
 end subroutine system_add_cubic_set
 
+!> Gives the beam set `index` (ffr, continuum or cubic) the data of its section forces
+!> (beam_stations): the element lengths (nel), the reference nodal vectors (3, 8, nel)
+!> (global; an FFR set's in its frame, as its reference), the section (api_support sk_*) and
+!> the bending option (cubic /= 0: 'cubic'). info = 2: index is not a beam set of nel
+!> elements, or a length or I_p is not positive.
+subroutine system_set_sections(handle, index, nel, lengths, reference, section, cubic, info, &
+                               message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use beam_stations, only: station_section
+  use api_support, only: api_system, give_sections, sk_axial, sk_torsion, sk_shear_y, sk_shear_z, &
+                         sk_moment_height, sk_moment_width, sk_youngs, sk_inertia_y, &
+                         sk_inertia_z, sk_polar
+  implicit none
+  integer, intent(in) :: handle, index, nel, cubic
+  real(dp), intent(in) :: lengths(nel), reference(3, 8, nel), section(10)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  type(station_section) :: built
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  info = 2
+  message = 'system_set_sections: index is not a beam set of nel elements, or a length' // &
+            ' or the polar moment is not positive'
+  if (index < 1 .or. index > size(sys%sets)) return
+  if (sys%sets(index)%item%nel /= nel .or. .not. all(lengths > 0.0_dp) .or. &
+      .not. (section(sk_polar) > 0.0_dp)) return
+  built%cubic = cubic /= 0
+  built%axial = section(sk_axial)
+  built%torsion = section(sk_torsion)
+  built%shear_y = section(sk_shear_y)
+  built%shear_z = section(sk_shear_z)
+  built%moment_height = section(sk_moment_height)
+  built%moment_width = section(sk_moment_width)
+  built%youngs = section(sk_youngs)
+  built%inertia_y = section(sk_inertia_y)
+  built%inertia_z = section(sk_inertia_z)
+  built%polar = section(sk_polar)
+  built%length = lengths
+  built%reference = reference
+  call give_sections(sys%sets(index)%item, built, info)
+  if (info == 0) message = ' '
+end subroutine system_set_sections
+
+!> Section forces of the beam set `index` at the stations xi (ns, in [0, 1] along every
+!> element) of the states e_rows (ndof, nrows) (the independent coordinates, expanded as
+!> to_full) at the times (nrows) (where the set's frame is): forces (ns nel, nrows, 6)
+!> [N, T, Q_height, Q_width, M_height, M_width], station i of element el in row
+!> i + ns (el - 1) (element_sets section_forces). info = 2: sizes inconsistent or a station
+!> outside [0, 1]; 3: the set reports no section forces; 5: a frame's drive failed.
+subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_rows, xi, &
+                                 forces, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, frame_rotations, to_full
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle, index, nrows, ndof, ns, nst
+  real(dp), intent(in) :: times(nrows), e_rows(ndof, nrows), xi(ns)
+  real(dp), intent(out) :: forces(nst, nrows, 6)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :)
+  integer :: row, frame
+  forces = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  info = 2
+  message = 'system_section_forces: set index, rows (ndof per row, one per time) or' // &
+            ' stations (ns nel, each in [0, 1]) inconsistent'
+  if (index < 1 .or. index > size(sys%sets)) return
+  if (ndof /= sys%ndof .or. ns < 1 .or. nst /= ns * sys%sets(index)%item%nel) return
+  if (any(xi < 0.0_dp) .or. any(xi > 1.0_dp)) return
+  frame = sys%sets(index)%item%frame
+  allocate (rotations(3, 3, nrows), frames(3, 3, 0:size(sys%frames)), &
+            rates(0:size(sys%frames)), q_rows(sys%nfull, nrows))
+  do row = 1, nrows
+    call frame_rotations(sys, times(row), frames, rates, info)
+    if (info /= 0) then
+      message = "system_section_forces: a frame's drive failed"
+      return
+    end if
+    rotations(:, :, row) = frames(:, :, frame)
+    call to_full(sys, e_rows(:, row), .true., q_rows(:, row))
+  end do
+  call sys%sets(index)%item%section_forces(rotations, q_rows, xi, forces, info)
+  if (info /= 0) then
+    info = 3
+    message = 'system_section_forces: the set reports no section forces'
+    return
+  end if
+  message = ' '
+end subroutine system_section_forces
+
 !> Thin plate elements (plate_element): reference data at npts Gauss points; material
 !> (api_support pm_*): Young's modulus, Poisson's ratio, thickness.
 subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_frame, curvature0, &

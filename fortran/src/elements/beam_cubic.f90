@@ -35,6 +35,7 @@ module beam_cubic
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
   use element_sets, only: local_element_set
+  use beam_stations, only: centreline_rows, station_section, set_station_forces
   implicit none
   private
   public :: cubic_setup, cubic_element, cubic_pattern, cubic_set
@@ -51,28 +52,14 @@ module beam_cubic
   type, extends(local_element_set) :: cubic_set
     real(dp), allocatable :: forms(:, :, :, :), strain0(:, :), term_stiffness(:, :)
     integer, allocatable :: form_pairs(:, :, :), form_npairs(:)
+    !> the section data of its section forces (beam_stations)
+    type(station_section) :: sections
   contains
     procedure :: element_forces => cubic_element_forces
+    procedure :: section_forces => cubic_section_forces
   end type cubic_set
 
 contains
-
-  !> Coefficient rows of the neutral-axis fields at xi: r_x = sum_a slope_a q_a, r_xx,
-  !> r_y, r_z and the (constant) r_y,x, r_z,x.
-  pure subroutine centreline_rows(xi, length, slope, second, dir_y, dir_z, dir_y_x, dir_z_x)
-    real(dp), intent(in) :: xi, length
-    real(dp), intent(out) :: slope(8), second(8), dir_y(8), dir_z(8), dir_y_x(8), dir_z_x(8)
-    slope = [(-6.0_dp * xi + 6.0_dp * xi**2) / length, 1.0_dp - 4.0_dp * xi + 3.0_dp * xi**2, &
-             0.0_dp, 0.0_dp, (6.0_dp * xi - 6.0_dp * xi**2) / length, 3.0_dp * xi**2 - 2.0_dp * xi, &
-             0.0_dp, 0.0_dp]
-    second = [(-6.0_dp + 12.0_dp * xi) / length**2, (-4.0_dp + 6.0_dp * xi) / length, 0.0_dp, &
-              0.0_dp, (6.0_dp - 12.0_dp * xi) / length**2, (6.0_dp * xi - 2.0_dp) / length, &
-              0.0_dp, 0.0_dp]
-    dir_y = [0.0_dp, 0.0_dp, 1.0_dp - xi, 0.0_dp, 0.0_dp, 0.0_dp, xi, 0.0_dp]
-    dir_z = [0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp - xi, 0.0_dp, 0.0_dp, 0.0_dp, xi]
-    dir_y_x = [0.0_dp, 0.0_dp, -1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp] / length
-    dir_z_x = [0.0_dp, 0.0_dp, 0.0_dp, -1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp] / length
-  end subroutine centreline_rows
 
   !> a b^T + b a^T: the form of the dot product (sum a_i q_i) . (sum b_j q_j).
   pure function product_form(a, b) result(form)
@@ -332,6 +319,15 @@ contains
                               set%form_pairs, set%form_npairs)
     end if
   end subroutine cubic_element_forces
+
+  !> The element_set section_forces of a cubic set (beam_stations, 'cubic' measures).
+  subroutine cubic_section_forces(set, rotations, q_rows, xi, forces, info)
+    class(cubic_set), intent(in) :: set
+    real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
+    real(dp), intent(out) :: forces(:, :, :)
+    integer, intent(out) :: info
+    call set_station_forces(set%sections, set%dofs, q_rows, xi, forces, info)
+  end subroutine cubic_section_forces
 
   !> tangent += kron(geometric, I3): an (8, 8) form acting alike on the three components.
   pure subroutine add_kron_identity(geometric, tangent)

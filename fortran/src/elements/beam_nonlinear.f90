@@ -40,6 +40,7 @@ module beam_nonlinear
   use beam_element, only: beam_shape, material_axes
   use matrix3, only: invert3
   use element_sets, only: local_element_set
+  use beam_stations, only: station_section, set_station_forces
   implicit none
   private
   public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, continuum_set
@@ -52,8 +53,11 @@ module beam_nonlinear
     real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp
     !> the section's torsion and shear correction [c, d_y, d_z] (docs/theory.md section 17)
     real(dp) :: shear_scales(3) = [1.0_dp, 0.0_dp, 0.0_dp]
+    !> the section data of its section forces (beam_stations)
+    type(station_section) :: sections
   contains
     procedure :: element_forces => continuum_element_forces
+    procedure :: section_forces => continuum_section_forces
   end type continuum_set
 
   !> Gauss points along the axis; the section rule comes from beam_section. The twist
@@ -421,5 +425,15 @@ contains
       end do
     end do
   end subroutine add_geometric_stiffness
+
+  !> The element_set section_forces of a continuum set (beam_stations; its bending option
+  !> in the section data: a nonlinear beam's 'cubic' bending is a cubic_set).
+  subroutine continuum_section_forces(set, rotations, q_rows, xi, forces, info)
+    class(continuum_set), intent(in) :: set
+    real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
+    real(dp), intent(out) :: forces(:, :, :)
+    integer, intent(out) :: info
+    call set_station_forces(set%sections, set%dofs, q_rows, xi, forces, info)
+  end subroutine continuum_section_forces
 
 end module beam_nonlinear

@@ -4,8 +4,10 @@
 !>
 !>   element_set        abstract: the set's dofs and scatter map, its floating frame and
 !>                      material damping; deferred `forces` (force, strain energy, on request
-!>                      the tangent, damped with the coordinate rates and a rate factor) and
-!>                      `energy_power` (strain energy, frame power, dissipation);
+!>                      the tangent, damped with the coordinate rates and a rate factor),
+!>                      `energy_power` (strain energy, frame power, dissipation) and
+!>                      `section_forces` (a beam family's N, T, Q, M at stations along its
+!>                      elements for rows of states; beam_stations; none by default);
 !>   local_element_set  abstract extension for families whose elements are independent of
 !>                      any frame (the large-deformation kinds): deferred `element_forces` of
 !>                      one element; the loop over elements (OpenMP), the assembly of forces
@@ -51,6 +53,7 @@ module element_sets
     procedure(set_forces_interface), deferred :: forces
     procedure :: energy_power => set_energy_power
     procedure :: selected_forces => no_selected_forces
+    procedure :: section_forces => no_section_forces
   end type element_set
 
   abstract interface
@@ -136,6 +139,20 @@ contains
     info = 0
     done = .false.
   end subroutine no_selected_forces
+
+  !> The section forces (ns nel, nrows, 6) [N, T, Q_height, Q_width, M_height, M_width] at
+  !> the stations xi (ns, in [0, 1] along each element; station i of element el in row
+  !> i + ns (el - 1)) of the states q_rows (nfull, nrows), the set's frame at each row
+  !> rotations (3, 3, nrows): a beam family's (beam_stations). info = 1 here: the family
+  !> reports no section forces (or its set was given no section data).
+  subroutine no_section_forces(set, rotations, q_rows, xi, forces, info)
+    class(element_set), intent(in) :: set
+    real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
+    real(dp), intent(out) :: forces(:, :, :)
+    integer, intent(out) :: info
+    forces = 0.0_dp
+    info = 1
+  end subroutine no_section_forces
 
   !> Strain energy at e and the power of the frame's motion at fixed e (a set in a moving
   !> frame; unit axis, rate phi'; 0 here: the families that have one override this). A damped

@@ -585,8 +585,7 @@ def check_resources(estimate: Estimate, file: str, solver: dict[str, Any] | None
 
 #: memory of the section forces and stresses per beam element and output station (bytes):
 #: measured 1.2 to 2.4 kB at the peak of the static answers of a 9-element beam with 100
-#: and 1000 stations, either formulation (an 'ffr' beam's linear-strain matrix is capped
-#: at 16 MB by ancfdrv.system.answers.LINEAR_MATRIX_LIMIT), rounded up
+#: and 1000 stations, either formulation, rounded up
 BYTES_PER_STATION = 4096
 #: memory of one dynamic row of output.sections per element and station: N, T, Q, M
 #: (12 doubles), kept until the run ends and joined once (twice that)

@@ -23,9 +23,11 @@ Section forces
     twice, left then right). A static state's (:func:`static_section_forces`, what
     :func:`static_answers` returns) from each element's own equilibrium: exact where the
     loads are, N and Q jump at the nodes that carry a load, a joint or a force element
-    (:func:`beam_equilibrium_forces`). A dynamic state's (:func:`section_forces`) from the
-    element's own strain measures (``fortran/src/elements/beam_cubic.f90``) and the
-    section's stiffness, relative to the reference configuration: axial Green strain
+    (:func:`beam_equilibrium_forces`). A dynamic state's (:func:`section_forces`) is what
+    the beam's element family reports through the kernel's element interface (its
+    section_forces: ``fortran/src/elements/beam_stations.f90``), for all rows of a chunk in
+    one call, from its own strain measures and the section's stiffness, relative to the
+    reference configuration (an 'ffr' beam: their linear part in its frame): axial Green strain
     (r_x . r_x - 1)/2, bending strains b_y = -r_y,x . r_x (+ r_xx . r_y - mean(r_xx . r_y)
     with 'cubic' bending), b_z likewise with r_z, twist 1/2 (r_y,x . r_z - r_z,x . r_y)
     ('cubic'; the continuum element's (I_z r_y,x . r_z - I_y r_z,x . r_y) / I_p), shear
@@ -73,8 +75,6 @@ spla = LazyModule("scipy.sparse.linalg")
 
 #: output.stations default: points per element where section forces are evaluated
 DEFAULT_STATIONS = 3
-#: the largest FFR linear-strain matrix kept per beam (entries; 16 MB)
-LINEAR_MATRIX_LIMIT = 2_000_000
 
 
 @dataclass
@@ -514,229 +514,27 @@ def force_element_reactions(model: Model, e: np.ndarray, v: np.ndarray | None = 
 
 
 # -- section forces --------------------------------------------------------------------------
-def _rows(xi: np.ndarray, length: float):
-    """Coefficient rows (n, 8) of r_x, r_xx, r_y, r_z, r_y,x, r_z,x on the element's eight
-    nodal vectors [r1, r1_x, r1_y, r1_z, r2, ...] (beam_cubic.centreline_rows)."""
-    z = np.zeros_like(xi)
-    o = np.ones_like(xi)
-    slope = np.column_stack([(-6 * xi + 6 * xi**2) / length, 1 - 4 * xi + 3 * xi**2, z, z,
-                             (6 * xi - 6 * xi**2) / length, 3 * xi**2 - 2 * xi, z, z])
-    second = np.column_stack([(-6 + 12 * xi) / length**2, (-4 + 6 * xi) / length, z, z,
-                              (6 - 12 * xi) / length**2, (6 * xi - 2) / length, z, z])
-    dir_y = np.column_stack([z, z, 1 - xi, z, z, z, xi, z])
-    dir_z = np.column_stack([z, z, z, 1 - xi, z, z, z, xi])
-    dir_y_x = np.column_stack([z, z, -o, z, z, z, o, z]) / length
-    dir_z_x = np.column_stack([z, z, z, -o, z, z, z, o]) / length
-    return slope, second, dir_y, dir_z, dir_y_x, dir_z_x
-
-
-class _Tables:
-    """A beam's coefficient rows at the stations, the Gauss points and the element ends
-    (per element: (nel, npoints, 8) for each of the six fields) and its reference strains."""
-
-    def __init__(self, beam: Beam, stations: int) -> None:
-        self.xi = np.linspace(0.0, 1.0, stations)
-        gauss = 0.5 + np.array([-0.5, 0.5]) / np.sqrt(3.0)
-        unique, index = np.unique(beam.lengths, return_inverse=True)
-
-        def table(points: np.ndarray) -> list[np.ndarray]:
-            per = [_rows(points, length) for length in unique]
-            return [np.stack([rows[k] for rows in per])[index] for k in range(6)]
-        self.at, self.gauss, self.ends = table(self.xi), table(gauss), table(np.array([0.0, 1.0]))
-        # the axial strain at the element's three axial Gauss points (the element's own
-        # sampling, beam_cubic n_axial = 3), and the quadratic through them at the
-        # stations: the Green strain between them carries the spurious share of the
-        # bending slopes (v'^2/2 is quartic where u' is quadratic: membrane locking)
-        axial = 0.5 + np.array([-1.0, 0.0, 1.0]) * np.sqrt(0.15)
-        self.axial = table(axial)
-        self.axial_fit = np.array([[np.prod([(x - axial[m]) / (axial[k] - axial[m])
-                                             for m in range(3) if m != k]) for k in range(3)]
-                                   for x in self.xi])   # (nxi, 3) Lagrange weights
-        self.s = (beam.stations[:-1, None] + np.outer(beam.lengths, self.xi)).ravel()
-        self.reference = _beam_vectors(beam, beam.coordinates(), 0)
-        self.strain0 = _strains(beam, self.reference, self)
-        # an FFR beam: the reference nodal vectors in its frame at t = 0 (positions from the
-        # frame's pivot), and the linear strains' matrix (built on first use)
-        local = beam.coordinates().reshape(beam.nodes, 4, 3) @ beam.orientation
-        local[:, 0, :] -= beam.frame_pivot @ beam.orientation
-        self.local_reference = local
-        self._linear: np.ndarray | None = None
-        self._element: np.ndarray | None = None
-
-    def linear_strain(self, beam: Beam) -> np.ndarray:
-        """(ncoordinates, nel * nxi * 8): the strains' linear part about the reference in
-        the frame, column by column (f(x0 + e_j) - f(x0 - e_j)) / 2, exact since every
-        measure is a quadratic form of the nodal vectors."""
-        if self._linear is None:
-            n = beam.ncoordinates
-            base = self.local_reference.reshape(-1)
-            unit = np.eye(n)
-            with np.errstate(invalid="ignore", divide="ignore"):  # (unused normals)
-                plus = _strains(beam, _beam_vectors(beam, base + unit, 0), self)
-                minus = _strains(beam, _beam_vectors(beam, base - unit, 0), self)
-            self._linear = (0.5 * (plus - minus)).reshape(n, -1)
-        return self._linear
-
-    def element_strain(self, beam: Beam) -> np.ndarray:
-        """(nel, 24, nxi * 6): per element the rows of :meth:`linear_strain` that act on its
-        own 24 coordinates (nodes e and e + 1; every other entry of the matrix is exactly
-        zero: an element's strains depend on its coordinates only), for the six measures
-        the section forces use (eps, b_y, b_z, twist, gamma_y, gamma_z), for one stacked
-        product per chunk of rows (:func:`_element_strains`)."""
-        if self._element is None:
-            nxi = len(self.xi)
-            full = self.linear_strain(beam).reshape(beam.ncoordinates, beam.nel, nxi, 8)
-            self._element = np.ascontiguousarray(np.stack([
-                full[12 * e:12 * e + 24, e, :, :6].reshape(24, nxi * 6)
-                for e in range(beam.nel)]))
-        return self._element
-
-
-def _tables(beam: Beam, stations: int) -> _Tables:
-    cache = beam.__dict__.setdefault("_answer_tables", {})
-    if stations not in cache:
-        cache[stations] = _Tables(beam, stations)
-    return cache[stations]
-
-
-def _strains(beam: Beam, vectors: np.ndarray, tables: _Tables) -> np.ndarray:
-    """(..., nel, nxi, 6) strain measures [eps, b_y, b_z, twist, gamma_y, gamma_z] of
-    every element at the stations, from the nodal vectors (..., nel, 8, 3) (vectorized over
-    the elements and any leading axes, e.g. time rows)."""
-    cubic = beam.bending == "cubic"
-    data = beam.section.data
-    xi = tables.xi
-
-    # the rows' vectors side by side: (nel, 8, rows * 3), so each table costs one product
-    # per element instead of one per element and row (numpy's batched matmul calls BLAS
-    # once per (np, 8) @ (8, 3) block: 0.8 ms per output row of a 40-element beam)
-    lead = vectors.shape[:-3]
-    rows = int(np.prod(lead)) if lead else 1
-    side = np.moveaxis(vectors.reshape(rows, *vectors.shape[-3:]), 0, -2)
-    side = side.reshape(*side.shape[:-2], rows * 3)
-
-    def product(t: np.ndarray) -> np.ndarray:   # (nel, np, 8) @ (..., nel, 8, 3)
-        out = np.matmul(t, side).reshape(*t.shape[:-1], rows, 3)
-        return np.moveaxis(out, -2, 0).reshape(*lead, *t.shape[:-1], 3)
-
-    def fields(table: list[np.ndarray]) -> list[np.ndarray]:
-        return [product(t) for t in table]
-
-    def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return (a * b).sum(axis=-1)
-    rx, rxx, ry, rz, ryx, rzx = fields(tables.at)
-    slope = product(tables.axial[0])
-    eps = 0.5 * (dot(slope, slope) - 1.0) @ tables.axial_fit.T
-    b_y = -dot(ryx, rx)
-    b_z = -dot(rzx, rx)
-    if cubic:
-        g = fields(tables.gauss)
-        b_y = b_y + dot(rxx, ry) - dot(g[1], g[2]).mean(axis=-1)[..., None]
-        b_z = b_z + dot(rxx, rz) - dot(g[1], g[3]).mean(axis=-1)[..., None]
-        twist = 0.5 * (dot(ryx, rz) - dot(rzx, ry))
-        nodal = fields(tables.ends)
-        shear_y, shear_z = dot(nodal[0], nodal[2]), dot(nodal[0], nodal[3])
-        gamma_y = shear_y[..., :1] * (1 - xi) + shear_y[..., 1:] * xi
-        gamma_z = shear_z[..., :1] * (1 - xi) + shear_z[..., 1:] * xi
-    else:
-        twist = (data.inertia_z * dot(ryx, rz) - data.inertia_y * dot(rzx, ry)) / data.polar
-        gamma_y, gamma_z = dot(rx, ry), dot(rx, rz)
-    # the directors' rates along the section normal n: the bending strains' share of the
-    # force on the section along n (their variation with r_x, -r_y,x . delta r_x)
-    normal = np.cross(ry, rz)
-    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
-    c_y, c_z = -dot(ryx, normal), -dot(rzx, normal)
-    return np.stack([eps, b_y, b_z, twist, gamma_y, gamma_z, c_y, c_z], axis=-1)
-
-
-def _element_strains(blocks: np.ndarray, d_nodal: np.ndarray, nxi: int) -> np.ndarray:
-    """The six linear strain measures (..., nel, nxi, 6) of displacements d_nodal (..., n)
-    in the frame: per element its (24, nxi * 6) block on its own 24 coordinates (windows
-    of the rows, 12 coordinates apart), all elements and rows in one stacked matrix
-    product (a dense (n, nel * nxi * 8) product spent 13 times the work on zeros: on the
-    28-node boom 2.2e9 multiply-adds per 10,000 rows). A view (the element axis leads in
-    memory)."""
-    from numpy.lib.stride_tricks import as_strided
-    nel = len(blocks)
-    lead = d_nodal.shape[:-1]
-    rows = np.ascontiguousarray(d_nodal.reshape(-1, d_nodal.shape[-1]))    # (rows, n)
-    step, width = rows.strides
-    windows = as_strided(rows, shape=(nel, len(rows), 24), strides=(12 * width, step, width),
-                         writeable=False)
-    out = np.matmul(windows, blocks)                                  # (nel, rows, nxi * 6)
-    return np.moveaxis(out.reshape(nel, *lead, nxi, 6), 0, -3)
-
-
-def _beam_vectors(beam: Beam, q_full: np.ndarray, first: int | None = None) -> np.ndarray:
-    """The elements' nodal vectors (..., nel, 8, 3) from coordinates (..., n) holding the
-    beam's from ``first`` (default: the beam's first coordinate)."""
-    first = beam.first if first is None else first
-    block = q_full[..., first:first + beam.ncoordinates]
-    nodal = block.reshape(*block.shape[:-1], beam.nodes, 4, 3)
-    return np.concatenate([nodal[..., :-1, :, :], nodal[..., 1:, :, :]], axis=-2)
-
-
-def beam_section_forces(beam: Beam, q_full: np.ndarray, stations: int = DEFAULT_STATIONS,
-                        frame: np.ndarray | None = None) -> SectionForces:
-    """Section forces of one beam at ``stations`` points per element (see the module
-    documentation for the strains and the sign convention) from the full coordinates
-    (nfull,) or rows of them (nt, nfull): the arrays then have a leading time axis. An
-    'ffr' beam's strains are the small-strain (linear) part in its frame, whose rotation
-    is ``frame`` ((3, 3) or (nt, 3, 3); default: the beam's frame at t = 0); every strain
-    measure is a quadratic form of the nodal vectors, so its linear part about the
-    reference x0 is exactly (f(x0 + d) - f(x0 - d)) / 2 with d the displacement in the
-    frame."""
+def _stations(beam: Beam, stations: int) -> tuple[np.ndarray, np.ndarray]:
+    """The stations' places xi in every element (both ends included) and their arc lengths
+    s (nel * stations,)."""
     if stations < 2:
         raise ValueError("stations must be at least 2 (both ends of each element)")
-    tables = _tables(beam, stations)
-    q_full = np.asarray(q_full, dtype=float)
-    if beam.formulation == "ffr":
-        rotation = beam.orientation if frame is None else np.asarray(frame, dtype=float)
-        nodal = q_full[..., beam.first:beam.first + beam.ncoordinates]
-        nodal = nodal.reshape(*nodal.shape[:-1], beam.nodes, 4, 3)
-        if rotation.ndim == 3:   # per row: R^T v for every vector
-            local = np.matmul(nodal.reshape(len(rotation), -1, 3), rotation)
-            local = local.reshape(nodal.shape)
-            shift = np.einsum("i,tij->tj", beam.frame_pivot, rotation)[:, None, :]
-        else:
-            local = nodal @ rotation
-            shift = beam.frame_pivot @ rotation
-        local[..., 0, :] -= shift
-        local -= tables.local_reference
-        d_nodal = local.reshape(*local.shape[:-3], -1)
-        if beam.ncoordinates * beam.nel * len(tables.xi) * 8 <= LINEAR_MATRIX_LIMIT:
-            change = _element_strains(tables.element_strain(beam), d_nodal, len(tables.xi))
-        else:   # a long beam: the same linear part, element by element
-            x0 = _beam_vectors(beam, tables.local_reference.reshape(-1), 0)
-            dv = _beam_vectors(beam, d_nodal, 0)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                change = 0.5 * (_strains(beam, x0 + dv, tables) - _strains(beam, x0 - dv, tables))
-    else:
-        now = _strains(beam, _beam_vectors(beam, q_full), tables)
-        change = now - tables.strain0
-    # each measure (..., nel, nxi) times its modulus, written C-ordered: (..., ns) by reshape
-    lead = change.shape[:-3]
-    ns = change.shape[-3] * change.shape[-2]
-    data, section, mat = beam.section.data, beam.section, beam.material
-    e_mod = mat.youngs_modulus
-    g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
-    k_y, k_z = section.shear_factors(mat.poisson_ratio)
+    xi = np.linspace(0.0, 1.0, stations)
+    return xi, (beam.stations[:-1, None] + np.outer(beam.lengths, xi)).ravel()
 
-    def scaled(factor: float, k: int) -> np.ndarray:
-        return np.multiply(factor, change[..., k], order="C").reshape(*lead, ns)
-    axial = scaled(e_mod * data.area, 0)
-    if beam.formulation != "ffr":   # large deformation: the bending strains' axial share
-        axial = axial + (e_mod * (data.inertia_z * change[..., 1] * now[..., 6]
-                                  + data.inertia_y * change[..., 2] * now[..., 7])
-                         ).reshape(*lead, ns)
-    pairs = np.empty((2, *change.shape[:-1], 2))     # Q and M: (..., nel, nxi, 2) each
-    for which, j, k, factor in ((0, 0, 4, k_y * g_mod * data.area),
-                                (0, 1, 5, k_z * g_mod * data.area),
-                                (1, 0, 2, -e_mod * data.inertia_y),
-                                (1, 1, 1, e_mod * data.inertia_z)):
-        np.multiply(factor, change[..., k], out=pairs[which][..., j])
-    return SectionForces(s=tables.s, N=axial, T=scaled(g_mod * section.torsion_constant, 3),
-                         Q=pairs[0].reshape(*lead, ns, 2), M=pairs[1].reshape(*lead, ns, 2))
+
+def beam_section_forces(model: Model, info: SetInfo, e_rows: np.ndarray, times: np.ndarray,
+                        stations: int = DEFAULT_STATIONS) -> SectionForces:
+    """Section forces of one beam (its element set ``info``) at ``stations`` points per
+    element for the states e_rows (nt, ndof) at the times (nt,) (where an 'ffr' beam's
+    frame is), each array with a leading time axis: what the beam's element family
+    reports from its own strain measures and the section's stiffness (the kernel's
+    element_sets section_forces, ``fortran/src/elements/beam_stations.f90``; the module
+    documentation gives the measures and the sign convention), all rows in one call."""
+    xi, s = _stations(info.body, stations)
+    f = model.kernel.section_forces(info.index, times, e_rows, xi)
+    return SectionForces(s=s, N=f[0], T=f[1], Q=np.stack([f[2], f[3]], axis=-1),
+                         M=np.stack([f[4], f[5]], axis=-1))
 
 
 def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS, *,
@@ -744,42 +542,23 @@ def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS
     """Section forces of every beam of the model by name at the state e (time t: where an
     'ffr' beam's frame is); e may hold rows of states (nt, ndof) at the times t (nt,):
     the arrays then have a leading time axis."""
-    return _section_forces_full(model, model.expand(e), stations, t)
-
-
-#: rows per block of :class:`DynamicAnswers`' section forces and stress envelope
-SECTION_BLOCK = 256
-#: :class:`DynamicAnswers` takes a chunk's rows in blocks of about this many bytes of full
-#: coordinates: its work arrays hold ~5 copies of them (at 3078 coordinates and a chunk of
-#: 60 steps, 7 MB at once; issue 23: a run's peak memory)
-ANSWER_BLOCK_BYTES = 1 << 18
-
-
-def _section_forces_full(model: Model, q: np.ndarray, stations: int,
-                         t: float | np.ndarray) -> dict[str, SectionForces]:
-    """:func:`section_forces` from the full coordinates q (nfull,) or (nt, nfull)."""
-    frame_of = {s.body.name: s.frame for s in model.sets}
+    e = np.asarray(e, dtype=float)
+    rows = np.atleast_2d(e)
+    times = np.broadcast_to(np.asarray(t, dtype=float), (len(rows),))
     out = {}
-    for b in model.bodies:
-        if reports_sections(b):
-            f = frame_of.get(b.name, 0)
-            rotation = None
-            if f:
-                info = model.frames[f - 1]
-                if not np.ndim(t):
-                    rotation = info.rotation(float(t))
-                elif info.drive_obj is None:
-                    rotation = np.broadcast_to(info.base, (len(t), 3, 3))
-                else:   # Rodrigues about the frame axis, all rows at once
-                    angle = info.drive_obj.values(np.asarray(t, dtype=float))[0]
-                    k = info.axis / np.linalg.norm(info.axis)
-                    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]],
-                                     [-k[1], k[0], 0.0]])
-                    turn = (np.eye(3) + np.sin(angle)[:, None, None] * skew
-                            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew))
-                    rotation = turn @ info.base
-            out[b.name] = beam_section_forces(b, q, stations, rotation)
+    for info in model.sets:
+        if reports_sections(info.body):
+            f = beam_section_forces(model, info, rows, times, stations)
+            if e.ndim == 1:
+                f = SectionForces(f.s, f.N[0], f.T[0], f.Q[0], f.M[0])
+            out[info.body.name] = f
     return out
+
+
+#: :class:`DynamicAnswers` takes a chunk's rows in blocks of about this many bytes of full
+#: coordinates for the reactions: their work arrays hold ~5 copies of them (at 3078
+#: coordinates and a chunk of 60 steps, 7 MB at once; issue 23: a run's peak memory)
+ANSWER_BLOCK_BYTES = 1 << 18
 
 
 # -- section forces from the elements' equilibrium (static states) ----------------------------
@@ -1162,6 +941,8 @@ class DynamicAnswers:
         self.sections: dict[str, list[SectionForces]] = {}
         self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.beams = {b.name: b for b in model.bodies if reports_sections(b)}
+        #: the beams' element sets (their section forces: the kernel's, per chunk)
+        self.section_sets = [info for info in model.sets if reports_sections(info.body)]
 
     @property
     def time(self) -> list[float]:
@@ -1240,18 +1021,25 @@ class DynamicAnswers:
         return max(1, ANSWER_BLOCK_BYTES // (8 * max(self.model.nfull, 1)))
 
     def _blocks(self, chunk) -> None:
-        """Record a chunk in blocks of about ANSWER_BLOCK_BYTES of full coordinates."""
+        """Record a chunk: its reactions in blocks of about ANSWER_BLOCK_BYTES of full
+        coordinates, its beams' section forces in one kernel call per beam."""
         rows = self._block_rows()
         n = len(chunk.time)
         if n <= rows:
             self._record(chunk)
+        else:
+            contact = getattr(chunk, "contact", None)
+            for start in range(0, n, rows):
+                block = slice(start, min(start + rows, n))
+                self._record(SimpleNamespace(time=chunk.time[block], q=chunk.q[block],
+                                             lam=chunk.lam[block],
+                                             contact=None if contact is None else contact[block]))
+        times = np.asarray(chunk.time, dtype=float)
+        if not len(times):
             return
-        contact = getattr(chunk, "contact", None)
-        for start in range(0, n, rows):
-            block = slice(start, min(start + rows, n))
-            self._record(SimpleNamespace(time=chunk.time[block], q=chunk.q[block],
-                                         lam=chunk.lam[block],
-                                         contact=None if contact is None else contact[block]))
+        for info in self.section_sets:
+            self._record_sections(info.body.name, beam_section_forces(
+                self.model, info, chunk.q, times, self.stations), times)
 
     def _record(self, chunk) -> None:
         """Record one block of rows (every row after the previous block's)."""
@@ -1260,16 +1048,15 @@ class DynamicAnswers:
             return
         e_rows = np.asarray(chunk.q, dtype=float)
         # read only: without eliminated joints q is e (no copy of every row); with them,
-        # when nothing here needs every full coordinate (no beam's section forces, no
-        # kernel gradients), only those the reactions read (the same values: the
-        # expansion's own operations on those columns)
+        # when the reactions need neither kernel gradients nor the full residual, only the
+        # full coordinates they read (the same values: the expansion's own operations on
+        # those columns)
         columns = None
         if self.model.reduction is None:
             q_rows = e_rows
-        elif not self.beams and not self.map.joints:
+        elif not self.map.joints:
             q_rows = None   # nothing here reads the full coordinates
-        elif not self.beams and self.map.joints \
-                and (columns := self.map.row_columns()) is not None:
+        elif not self.need_acceleration and (columns := self.map.row_columns()) is not None:
             q_rows = self.model.reduction.expand_columns(e_rows, columns)
         else:
             q_rows = self.model.expand(e_rows)
@@ -1306,16 +1093,6 @@ class DynamicAnswers:
             for name, (force, moment, _, axial) in found.items():
                 self.reactions[name].append((force, moment, axial))
         self._time_blocks.append(np.array(times))   # (a list of floats made on request)
-        if not self.beams:
-            return
-        # blocks of rows whose temporaries stay in the cache (the stations' forces of
-        # 1000 rows of the 28-node boom are 4 MB)
-        for a in range(0, len(times), SECTION_BLOCK):
-            block = slice(a, a + SECTION_BLOCK)
-            forces = _section_forces_full(self.model, q_rows[block], self.stations,
-                                          times[block])
-            for name, f in forces.items():
-                self._record_sections(name, f, times[block])
 
     def _record_sections(self, name: str, f: SectionForces, times: np.ndarray) -> None:
         """Keep a block's section forces (output.sections) and lift the envelope."""

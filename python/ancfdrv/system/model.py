@@ -69,6 +69,8 @@ class SetInfo:
     #: the set's elastic forces are a constant stiffness (stiffness0) turned with its
     #: floating frame (the ANCF-FFR set): what the FFR-only solvers and checks ask
     floating: bool = False
+    #: the set's 1-based index in the kernel's system (0 until handed to it)
+    index: int = 0
 
 
 @dataclass
@@ -562,7 +564,7 @@ class Model:
         """Hand the system to the kernel (once) and analyse the iteration matrix's pattern."""
         ks = kernel.KernelSystem(self.ndof, self.nfull)
         for s in self.sets:  # each kind's adder (the registry's; declared by its kind)
-            add_to_kernel(ks, s)
+            s.index = add_to_kernel(ks, s)
         ks.set_frames([f.drive for f in self.frames], [f.axis for f in self.frames],
                       [f.base for f in self.frames], [f.pivot for f in self.frames])
         ks.set_drives([d.kind for d in self.drives], [d.params() for d in self.drives])

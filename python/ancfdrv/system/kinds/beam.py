@@ -354,19 +354,41 @@ def _add_ffr(ks: kernel.KernelSystem, s: SetInfo) -> int:
                            s.damping_time)
     if s.second_order is not None:
         ks.ffr_second_order(index, *s.second_order)
+    _add_sections(ks, index, s, s.reference)   # (its reference is in its frame)
     return index
 
 
 def _add_continuum(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    return ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
-                                s.body.material.youngs_modulus, s.body.material.poisson_ratio,
-                                s.frame, s.damping_time, s.shear_scales)
+    index = ks.add_continuum_set(s.dofs, s.scatter, s.gradients, s.weights, s.nvolume,
+                                 s.body.material.youngs_modulus, s.body.material.poisson_ratio,
+                                 s.frame, s.damping_time, s.shear_scales)
+    _add_sections(ks, index, s, s.body.coordinates()[s.dofs - s.body.first])
+    return index
 
 
 def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    return ks.add_cubic_set(s.dofs, s.scatter, s.cubic.forms, s.cubic.strain0, s.cubic.stiffness,
-                            s.frame, s.damping_time)
+    index = ks.add_cubic_set(s.dofs, s.scatter, s.cubic.forms, s.cubic.strain0,
+                             s.cubic.stiffness, s.frame, s.damping_time)
+    _add_sections(ks, index, s, s.body.coordinates()[s.dofs - s.body.first])
+    return index
 
+
+def _add_sections(ks: kernel.KernelSystem, index: int, s: SetInfo, reference: np.ndarray
+                  ) -> None:
+    """The data of the set's section forces (fortran/src/elements/beam_stations.f90): the
+    reference nodal vectors (24, nel), the section's stiffnesses (E A, G J, k G A, the
+    moments' -E I_y and E I_z) and the bending option."""
+    beam = s.body
+    data, section, mat = beam.section.data, beam.section, beam.material
+    e_mod = mat.youngs_modulus
+    g_mod = e_mod / (2.0 * (1.0 + mat.poisson_ratio))
+    k_y, k_z = section.shear_factors(mat.poisson_ratio)
+    ks.set_sections(index, beam.lengths, np.reshape(reference, (3, 8, s.nel), order="F"),
+                    beam.bending == "cubic", axial=e_mod * data.area,
+                    torsion=g_mod * section.torsion_constant, shear_y=k_y * g_mod * data.area,
+                    shear_z=k_z * g_mod * data.area, moment_height=-e_mod * data.inertia_y,
+                    moment_width=e_mod * data.inertia_z, youngs=e_mod,
+                    inertia_y=data.inertia_y, inertia_z=data.inertia_z, polar=data.polar)
 
 
 def _planar_problems(body: Beam, j: int, tol: float) -> list[str]:
