@@ -200,3 +200,44 @@ def test_load_control_stalls_near_the_limit_and_names_arc_length():
     text = str(caught.value)
     assert "limit point" in text and "static_method = 'arc_length'" in text
     assert "; raise solver.load_steps" not in text
+
+
+TRUSS_SCENE = """
+&scene  title = 'von Mises truss', analysis = 'static', formulation = 'nonlinear',
+        planar = 'xy' /
+&material  name = 'm', youngs_modulus = 1.0e7, density = 1000.0, poisson_ratio = 0.0 /
+&beam  name = 'left', material = 'm', start = -1.0, 0.0, 0.0, end = 0.0, 0.1, 0.0, nodes = 2,
+       section = 'rectangle', width = 0.12, height = 0.12, height_axis = 0.0, 0.0, 1.0 /
+&beam  name = 'right', material = 'm', start = 1.0, 0.0, 0.0, end = 0.0, 0.1, 0.0, nodes = 2,
+       section = 'rectangle', width = 0.12, height = 0.12, height_axis = 0.0, 0.0, 1.0 /
+&joint  name = 'left_pin', type = 'fix', body1 = 'ground', body2 = 'left',
+        point = -1.0, 0.0, 0.0 /
+&joint  name = 'right_pin', type = 'fix', body1 = 'ground', body2 = 'right',
+        point = 1.0, 0.0, 0.0 /
+&joint  name = 'apex', type = 'spherical', body1 = 'left', body2 = 'right',
+        point = 0.0, 0.1, 0.0 /
+&load  name = 'P', type = 'force', body = 'left', point = 0.0, 0.1, 0.0,
+       vector = 0.0, -{load}, 0.0 /
+&probe  name = 'apex', body = 'left', point = 0.0, 0.1, 0.0 /
+&solver  static_method = 'arc_length', target_load_factor = 0.5, arc_length = 0.01,
+         control_probe = 'apex' /
+"""
+
+
+def test_scene_door_and_plot(tmp_path):
+    """The namelist door: ``ancf run`` of the truss with static_method = 'arc_length' up to
+    half of 1.5 P_limit (before the limit) exits 0 with the state there on the closed form;
+    ``ancf plot`` draws the path beside the static plot."""
+    from ancfdrv.cli import main
+    scene = tmp_path / "truss.nml"
+    scene.write_text(TRUSS_SCENE.format(load=1.5 * P_LIMIT))
+    out = tmp_path / "truss.h5"
+    assert main(["run", str(scene), "-o", str(out)]) == 0
+    path = read_path(out)
+    assert path["probe"] == "apex" and path["load_factor"][-1] == 0.5
+    y = RISE + path["displacement"][-1, 1]
+    assert EA * y * (RISE**2 - y**2) / L0**3 == pytest.approx(0.75 * P_LIMIT, rel=1e-9)
+    assert np.all(path["negative_eigenvalues"] == 0) and len(path["limit_points"]) == 0
+    png = tmp_path / "truss.png"
+    assert main(["plot", str(out), "-o", str(png)]) == 0
+    assert png.with_name("truss_path.png").is_file()
