@@ -149,11 +149,11 @@ def test_handed_initial_acceleration_gives_the_same_run(tmp_path, monkeypatch):
     try:
         settings = runner.dynamic_settings(scene)
         e0 = model.e0
-        static = runner.solve_static(model, scene["solver"]["static_method"],
-                                     tol=scene["solver"]["tol"],
-                                     max_iter=scene["solver"]["max_iter"],
-                                     p=scene["solver"]["split_p"],
-                                     load_steps=scene["solver"]["load_steps"]) \
+        static = runner.solve_static_path(model, scene["solver"]["static_method"],
+                                          tol=scene["solver"]["tol"],
+                                          max_iter=scene["solver"]["max_iter"],
+                                          p=scene["solver"]["split_p"],
+                                          load_steps=scene["solver"]["load_steps"]) \
             if scene["scene"]["analysis"] == "static+dynamic" else None
         if static is not None:
             e0 = static.e

@@ -44,7 +44,7 @@ def no_solver(monkeypatch, tmp_path):
     import ancfdrv.runner
     import ancfdrv.solvers.static
     import ancfdrv.solvers.dynamic
-    for module, name in ((ancfdrv.runner, "solve_static"), (ancfdrv.runner, "solve_newton"),
+    for module, name in ((ancfdrv.runner, "solve_static_path"), (ancfdrv.runner, "solve_newton"),
                          (ancfdrv.runner, "integrate"), (ancfdrv.solvers.static, "solve_static"),
                          (ancfdrv.solvers.static, "solve_newton"),
                          (ancfdrv.solvers.dynamic, "integrate")):

@@ -65,7 +65,51 @@ def plot_result(h5_path: str | Path, png: str | Path | None = None) -> Path:
         out = plot_general_static(h5_path, png)
     for name, function in extras:  # e.g. modes, buckling, reactions (other modules)
         function(h5_path, out.with_name(f"{out.stem}_{name}.png"))
+    with h5py.File(h5_path, "r") as h5:
+        has_path = "static/path" in h5
+    if has_path:
+        plot_path(h5_path, out.with_name(f"{out.stem}_path.png"))
     return out
+
+
+def plot_path(h5_path: str | Path, png: str | Path | None = None) -> Path:
+    """The arc-length path of /static/path: the load factor against the control probe's
+    displacement component that moves most, the limit points marked (triangles) and the
+    bifurcation points (squares), the points colored by their stability (negative
+    eigenvalues of the tangent: 0 stable)."""
+    h5_path = Path(h5_path)
+    png = Path(png) if png else h5_path.with_name(f"{h5_path.stem}_path.png")
+    with h5py.File(h5_path, "r") as h5:
+        group = h5["static/path"]
+        factor = group["load_factor"][()]
+        disp = group["displacement"][()].reshape(len(factor), -1)
+        count = group["negative_eigenvalues"][()]
+        attrs = {k: group.attrs[k] for k in ("probe", "limit_points", "bifurcation_points",
+                                              "limit_load_factors")}
+        title = _text(h5.attrs.get("title", h5_path.stem))
+    k = int(np.argmax(np.ptp(disp, axis=0)))
+    x = 1e3 * disp[:, k]
+    fig, ax = plt.subplots(figsize=(6.4, 4.4), constrained_layout=True)
+    ax.plot(x, factor, color="0.5", lw=1.0)
+    stable = count == 0
+    ax.plot(x[stable], factor[stable], "o", ms=3, color="tab:blue", label="stable")
+    ax.plot(x[~stable], factor[~stable], "o", ms=3, color="tab:red",
+            label="unstable (negative eigenvalues)")
+    limits = np.asarray(attrs["limit_points"], dtype=int)
+    for i, value in zip(limits, np.asarray(attrs["limit_load_factors"])):
+        ax.plot(x[i], factor[i], "^", ms=8, color="k")
+        ax.annotate(f"limit {value:.4g}", (x[i], factor[i]), textcoords="offset points",
+                    xytext=(6, 6), fontsize=8)
+    for i in np.asarray(attrs["bifurcation_points"], dtype=int):
+        ax.plot(x[i], factor[i], "s", ms=7, mfc="none", color="tab:green")
+    ax.axhline(0.0, color="0.8", lw=0.8)
+    ax.set_xlabel(f"u_{'xyz'[k]} of probe {_text(attrs['probe'])} (mm)")
+    ax.set_ylabel("load factor")
+    ax.set_title(f"{title}: static path (arc length)", fontsize=9)
+    ax.legend(fontsize=8)
+    save_figure(fig, png, dpi=110)
+    plt.close(fig)
+    return png
 
 
 #: plots of optional result groups: {root group name: function(h5_path, png) -> Path};

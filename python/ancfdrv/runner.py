@@ -41,7 +41,8 @@ from .builders import build_model, settle_mode, stage_bounds
 from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
-from .solvers.static import StaticResult, solve_newton, solve_static
+from .solvers.path import solve_static_path
+from .solvers.static import StaticResult, solve_newton
 
 if TYPE_CHECKING:
     from .results.memory import MemoryOutput
@@ -595,9 +596,13 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                 solver = scene["solver"]
                 # the static solvers write nothing while they iterate
                 with _io(out).released(out), stop.immediate():
-                    static = solve_static(model, solver["static_method"], tol=solver["tol"],
-                                          max_iter=solver["max_iter"], p=solver["split_p"],
-                                          load_steps=solver["load_steps"])
+                    static = solve_static_path(
+                        model, solver["static_method"], tol=solver["tol"],
+                        max_iter=solver["max_iter"], p=solver["split_p"],
+                        load_steps=solver["load_steps"], arc_length=solver["arc_length"],
+                        max_steps=solver["max_steps"],
+                        target_load_factor=solver["target_load_factor"],
+                        control_probe=solver["control_probe"])
                 for phase, seconds in static.timing.items():
                     timing[f"static_{phase}"] = seconds
                 t0 = time.perf_counter()
@@ -607,6 +612,8 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                 timing["output"] = time.perf_counter() - t0
                 model.warnings.extend(check_static(model, static.e, answers.stress,
                                                    warn=warns_implausible(scene)))
+                if static.path is not None and not static.path.reached:
+                    raise SolverError(static.path.message)   # the path and state written
                 e_start = static.e
                 if analysis == "static+dynamic":
                     stop.check()

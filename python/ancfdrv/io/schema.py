@@ -272,12 +272,30 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "pressure": Key("float", 0.0, doc="plate: dead pressure along -r3 (Pa)"),
     },
     "solver": {
-        "static_method": Key("str", "auto", one_of("auto", "split", "newton"),
+        "static_method": Key("str", "auto", one_of("auto", "split", "newton", "arc_length"),
                              "static solver: 'split' (the split iteration of seed 000: "
                              "'ffr' bodies, dead loads, no force element, no contact), "
                              "'newton' (Newton-Raphson, any scene), 'auto' (default: "
                              "'split' where it applies, 'newton' otherwise; /static "
-                             "attributes method and method_setting record the choice)"),
+                             "attributes method and method_setting record the choice), "
+                             "'arc_length' (path-following with the load factor an "
+                             "unknown: passes limit points and snap-backs, writes "
+                             "/static/path; keys arc_length, max_steps, target_load_factor, "
+                             "control_probe)"),
+        "arc_length": Key("float", 0.0, non_negative,
+                          "static_method = 'arc_length': the first step's length in the "
+                          "coordinates (m; adapted to the iteration count after; 0: a "
+                          "twentieth of the linear response to the target load)"),
+        "max_steps": Key("int", 200, positive,
+                         "static_method = 'arc_length': steps allowed before the path ends "
+                         "short of target_load_factor (exit 3, the path written)"),
+        "target_load_factor": Key("float", 1.0, lambda v: None if v != 0 else "must not be 0",
+                                  "static_method = 'arc_length': the load factor (multiple "
+                                  "of the scene's loads) where the path ends, at its first "
+                                  "crossing; the static result is the state there"),
+        "control_probe": Key("str", "", doc="static_method = 'arc_length': the probe whose "
+                             "displacement is the path's abscissa (/static/path/"
+                             "displacement; '': the scene's first probe)"),
         "tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
                    "relative tolerance of the static solve"),
         "max_iter": Key("int", 50, positive, "iteration limit of the static solve"),

@@ -30,7 +30,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Any, Iterator
+from typing import TYPE_CHECKING, Any, Iterator
 
 import h5py
 import numpy as np
@@ -42,6 +42,9 @@ from ..system.model import Model
 from ..io.safe_write import check_room, create_fresh
 from ..io.scene import Scene
 from ..solvers.static import StaticResult
+
+if TYPE_CHECKING:
+    from ..solvers.path import StaticPath
 
 #: the statuses a result file can carry (root attribute and /dynamic attribute)
 STATUSES = ("running", "ok", "failed", "unstable", "interrupted")
@@ -549,6 +552,27 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
                              "residual_norm": result.residual_norm,
                              "constraint_norm": result.constraint_norm,
                              "wall_time_s": result.wall_time_s, **result.extra}, fresh=True)
+        if result.path is not None:
+            _write_path(group, result.path)
+
+
+def _write_path(group: h5py.Group, path: StaticPath) -> None:
+    """/static/path of an arc-length run (solvers/path.StaticPath): the converged points'
+    load factors, the control probe's displacement and the tangent's negative eigenvalue
+    count, with the limit and bifurcation points as attributes."""
+    _dataset(group, "path/load_factor", path.load_factor, "1")
+    _dataset(group, "path/displacement", path.displacement, "m")
+    _dataset(group, "path/negative_eigenvalues", path.negative_eigenvalues, "1")
+    _attrs(group["path"].attrs, {
+        "probe": path.probe, "target_load_factor": path.target_load_factor,
+        "reached": path.reached, "message": path.message,
+        "limit_points": np.asarray(path.limit_points, dtype=np.int64),
+        "limit_load_factors": np.asarray(path.limit_load_factors, dtype=float),
+        "bifurcation_points": np.asarray(path.bifurcation_points, dtype=np.int64),
+        "description": "converged points of the arc-length path; limit_points and "
+                       "bifurcation_points index them (a limit: an extremum of the load "
+                       "factor, refined in limit_load_factors; a bifurcation: the count of "
+                       "negative eigenvalues changes with no extremum)"}, fresh=True)
 
 
 #: what the final status may add to a file (counters, timing and status attributes: 8.8 kB

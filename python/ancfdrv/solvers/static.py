@@ -47,6 +47,19 @@ class StaticResult:
     history: list[float] = field(default_factory=list)
     timing: dict[str, float] = field(default_factory=dict)
     extra: dict[str, float] = field(default_factory=dict)
+    #: the arc-length path (solvers/path.StaticPath) of static_method = 'arc_length'
+    path: object = None
+
+
+class LoadStepFailure(SolverError):
+    """A load step of :func:`solve_newton` did not converge: the kernel's text, with the
+    last converged state (``e``, ``lam`` at ``last_factor``) and the load factor
+    ``factor`` that failed, from which solvers/path.diagnose_stall tells a limit point."""
+
+    def __init__(self, message: str, *, e: np.ndarray, lam: np.ndarray, last_factor: float,
+                 factor: float) -> None:
+        super().__init__(message)
+        self.e, self.lam, self.last_factor, self.factor = e, lam, last_factor, factor
 
 
 def converged(force_res: float, con_res: float, step: float, size: float, tol: float,
@@ -142,7 +155,9 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
             for item in (*model.moments, *model.vector_loads):
                 model.counters[item.effect] += evaluations
             if out["info"]:
-                raise SolverError(out["message"])
+                raise LoadStepFailure(out["message"], e=e.copy(), lam=lam.copy(),
+                                      last_factor=loads * (load_step - 1) / load_steps,
+                                      factor=loads * load_step / load_steps)
             e, lam, force_scale = out["e"], out["lam"], out["force_scale"]
             history += out["history"].tolist()
             total += out["iterations"]

@@ -1,0 +1,380 @@
+"""Static path-following by arc length (SPEC section 8.2 "Static paths", issue 34 item 2).
+
+``solver.static_method = 'arc_length'``: the load factor P is an unknown beside the
+coordinates e and the multipliers lambda. With the residual R(e, lambda, P) = r(e, P) -
+Phi_e^T lambda, r = internal - external linear in P (the kernel's load factor), and the
+load vector q = -dr/dP, each step of the cylindrical arc-length method of Crisfield (1981)
+solves R = 0, Phi = 0 and ||Delta e|| = Delta l, where Delta e is the step's increment
+from the last converged point:
+
+* predictor: Delta P = +-Delta l / ||du_q|| along the tangent du_q = K_T^{-1} q, the sign
+  that keeps the direction of the previous increment (Feng's criterion: passes limit
+  points, where P turns, and snap-backs, where the displacement turns);
+* corrector: each Newton iteration solves the saddle-point system twice with one
+  factorization, du = du_r + dP du_q, and dP is the root of the quadratic constraint whose
+  new increment makes the smaller angle with the previous one (Crisfield's choice); no real
+  root, or no convergence in ``max_iter`` iterations, halves the arc from the last point;
+* the arc adapts to the iteration count: times sqrt(5 / iterations), within [1/2, 2] per
+  step and at most 4 times the first arc.
+
+At every converged point the number of negative eigenvalues of the tangent on the
+constrained coordinates (the stability index: 0 on a stable branch) is counted from the
+eigenvalues of N^T K_T N (N a basis of the constraints' null space) for small models, else
+from the lowest few of (K_T, M) by shift-invert. A point where P has an extremum is a limit
+point (its load factor refined by a parabola in the path length through the three points
+about it); a change of the count with no extremum of P is a bifurcation point.
+
+The path ends at the first crossing of ``target_load_factor`` (the state there solved by
+Newton at that load factor: the static result), or after ``max_steps`` steps (then the last
+point, with ``reached = False`` and a message: the run fails with exit 3 after writing it).
+
+:func:`diagnose_stall` reads a failed load-controlled Newton solve: cut back from the last
+converged load step, it tells a limit point (the tangent stiffness along the loads falls
+toward zero, or a negative eigenvalue appears) from other failures and says so, naming
+``static_method = 'arc_length'``.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, SolverError
+from ..system.model import Model
+from .._lazy import LazyModule
+from .buckling import _lowest
+from .modal import DENSE_LIMIT, linearize, null_space
+from .static import LoadStepFailure, StaticResult, converged, solve_static
+
+sp = LazyModule("scipy.sparse")
+spla = LazyModule("scipy.sparse.linalg")
+la = LazyModule("scipy.linalg")
+
+#: iterations per step the arc adapts to
+DESIRED_ITERATIONS = 5
+#: halvings of the arc from one point before the path is given up
+MAX_CUTS = 12
+
+
+@dataclass
+class StaticPath:
+    """The converged points of an arc-length path (HDF5: /static/path). ``displacement``
+    (npoints, 3): the control probe's displacement from the assembled configuration
+    (global axes);
+    ``negative_eigenvalues``: the stability index of the tangent at each point;
+    ``limit_points``/``bifurcation_points``: indices of the points, ``limit_load_factors``
+    the limit points' load factors refined between the points."""
+
+    load_factor: np.ndarray
+    displacement: np.ndarray
+    negative_eigenvalues: np.ndarray
+    probe: str
+    limit_points: list[int] = field(default_factory=list)
+    limit_load_factors: list[float] = field(default_factory=list)
+    bifurcation_points: list[int] = field(default_factory=list)
+    target_load_factor: float = 1.0
+    reached: bool = True
+    message: str = ""
+
+
+class _State:
+    """The residual, tangent, constraints and load vector at (e, lambda, P); the force
+    residual relative to the largest of the forces met and ``floor`` (the size of the
+    target loads: an unloaded start is not judged by its round-off alone)."""
+
+    def __init__(self, model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
+                 floor: float = 0.0) -> None:
+        n = model.ndof
+        lin = linearize(model, e, lam, load_factor=factor)
+        r0 = model.forces(e, load_factor=0.0)
+        r1 = model.forces(e, load_factor=1.0)
+        internal = r0["internal"] + factor * (r1["internal"] - r0["internal"])
+        external = r0["external"] + factor * (r1["external"] - r0["external"])
+        self.load = (r1["external"] - r0["external"]) - (r1["internal"] - r0["internal"])
+        self.stiffness, self.constraints = lin.stiffness, lin.constraints
+        reaction = self.constraints.T @ lam if len(lam) else np.zeros(n)
+        self.residual = internal - external - reaction
+        self.phi = model.constraints.jacobian(e, n)[0] if len(lam) else np.zeros(0)
+        scale = max(np.linalg.norm(external), np.linalg.norm(reaction),
+                    np.linalg.norm(internal), floor, 1e-300)
+        self.force_res = float(np.linalg.norm(self.residual) / scale)
+        self.con_res = float(np.max(np.abs(self.phi), initial=0.0) / model.length_scale)
+        self.n = n
+        g = self.constraints
+        mat = sp.bmat([[self.stiffness, -g.T], [-g, None]], format="csc") if g.shape[0] \
+            else self.stiffness.tocsc()
+        try:
+            self._lu = spla.splu(mat)
+        except RuntimeError:  # exactly singular
+            self._lu = None
+
+    def solve(self, residual_part: bool) -> tuple[np.ndarray, np.ndarray]:
+        """(du, dlam) of K du - G^T dlam = -R, -G du = Phi (``residual_part``), or of
+        K du - G^T dlam = q, G du = 0."""
+        if self._lu is None:
+            raise SolverError("arc length: the tangent is singular")
+        rhs = np.concatenate([-self.residual, self.phi]) if residual_part else \
+            np.concatenate([self.load, np.zeros(len(self.phi))])
+        x = self._lu.solve(rhs)
+        return x[:self.n], x[self.n:]
+
+
+def negative_eigenvalues(model: Model, state: _State) -> int:
+    """The number of negative eigenvalues of the tangent on the constraints' null space
+    (exact for models up to DENSE_LIMIT free coordinates; else among the lowest eight)."""
+    k, g = state.stiffness, state.constraints
+    free = model.ndof - g.shape[0]
+    if free <= DENSE_LIMIT:
+        basis = null_space(g, model.ndof)
+        reduced = basis.T @ (k @ basis)
+        w = la.eigvalsh(0.5 * (reduced + reduced.T))
+    else:
+        w, _ = _lowest(k, model.mass_matrix(), g, "sparse", min(8, free - 1))
+        w = np.asarray(w)
+    scale = max(np.abs(k.diagonal()).max(initial=0.0), 1e-300) if free > DENSE_LIMIT else \
+        max(np.abs(w).max(initial=0.0), 1e-300)
+    return int(np.sum(w < -1e-10 * scale))
+
+
+def _newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float, tol: float,
+               max_iter: int, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """Newton at the fixed load factor ``factor`` from (e, lam): (e, lam, iterations), or
+    None when it does not converge."""
+    previous = np.inf
+    for iteration in range(1, max_iter + 1):
+        state = _State(model, e, lam, factor, floor)
+        if iteration > 1 and converged(state.force_res, state.con_res, step, size, tol,
+                                       previous):
+            return e, lam, iteration - 1
+        previous = state.force_res
+        du, dl = state.solve(True)
+        if not np.all(np.isfinite(du)):
+            return None
+        e, lam = e + du, lam + dl
+        step, size = np.linalg.norm(du), np.linalg.norm(e - model.e0)
+    return None
+
+
+def _probe_displacement(model: Model, e: np.ndarray, probe: str) -> np.ndarray:
+    """The probe's displacement from the assembled configuration, global axes."""
+    return model.probe_positions(e)[probe] - model.probe_positions(model.e0)[probe]
+
+
+def _marks(factors: np.ndarray, counts: np.ndarray, lengths: np.ndarray):
+    """Limit points (extrema of P, refined by a parabola in the path length) and
+    bifurcation points (the count changes with no extremum of P next to it)."""
+    limits, refined, bifurcations = [], [], []
+    for i in range(1, len(factors) - 1):
+        if (factors[i] - factors[i - 1]) * (factors[i + 1] - factors[i]) < 0:
+            limits.append(i)
+            s = lengths[i - 1:i + 2] - lengths[i]
+            a, b, c = np.polyfit(s, factors[i - 1:i + 2], 2)
+            vertex = -b / (2 * a) if a != 0 else 0.0
+            refined.append(float(c - b * b / (4 * a)) if a != 0 and
+                           s[0] <= vertex <= s[2] else float(factors[i]))
+    for i in range(1, len(factors)):
+        if counts[i] != counts[i - 1] and not {i - 1, i} & set(limits):
+            bifurcations.append(i)
+    return limits, refined, bifurcations
+
+
+def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
+                     arc_length: float = 0.0, max_steps: int = 200,
+                     target_load_factor: float = 1.0, control_probe: str = "") -> StaticResult:
+    """The static path from the assembled configuration by cylindrical arc length (module
+    doc) up to ``target_load_factor``; the result is the state there (or the last point)
+    with ``path`` the :class:`StaticPath`. ``arc_length`` 0: a twentieth of the linear
+    response to the target load. ``control_probe`` '' : the model's response probe."""
+    model.require_runnable()
+    model.check_alive()
+    if not model.probes:
+        raise InputError("static_method = 'arc_length' records the path at a probe; the "
+                         "scene has none: add a &probe (solver.control_probe names it)",
+                         group="solver", key="control_probe")
+    probe = control_probe or (model.response[0] if model.response else next(iter(model.probes)))
+    if probe not in model.probes:
+        raise InputError(f"control_probe {probe!r} is no probe of the scene (probes: "
+                         f"{', '.join(model.probes)})", group="solver", key="control_probe")
+    if target_load_factor == 0.0:
+        raise InputError("target_load_factor must not be 0", group="solver",
+                         key="target_load_factor")
+    start = time.perf_counter()
+    e, lam, factor = model.e0.copy(), np.zeros(len(model.constraints)), 0.0
+    floor = abs(target_load_factor) * float(np.linalg.norm(
+        _State(model, e, lam, factor).load))
+    state = _State(model, e, lam, factor, floor)
+    if state.force_res > tol or state.con_res > tol:   # a prestressed start: settle it
+        settled = _newton_at(model, e, lam, 0.0, tol, max_iter, floor)
+        if settled is None:
+            raise SolverError("arc length: the state at load factor 0 did not converge")
+        e, lam = settled[0], settled[1]
+        state = _State(model, e, lam, factor, floor)
+    du_q, _ = state.solve(False)
+    direction = np.sign(target_load_factor)
+    arc = arc_length if arc_length > 0 else abs(target_load_factor) * np.linalg.norm(du_q) / 20
+    if not arc > 0:
+        raise InputError("arc length: the loads move nothing (zero load vector); nothing to "
+                         "follow", group="solver", key="static_method")
+    largest = 4.0 * arc
+    factors, disps, counts, lengths = [0.0], [_probe_displacement(model, e, probe)], \
+        [negative_eigenvalues(model, state)], [0.0]
+    previous: np.ndarray | None = None   # the last step's increment of e
+    iterations_total, history = 0, []
+    reached, message = False, ""
+    for _ in range(max_steps):
+        base_state = state
+        for cut in range(MAX_CUTS + 1):
+            step = _arc_step(model, e, lam, factor, base_state, arc, previous, direction, tol,
+                             max_iter, floor)
+            if step is not None:
+                break
+            arc *= 0.5
+        else:
+            message = (f"arc length: no step converged from load factor {factor:.6g} with the "
+                       f"arc cut {MAX_CUTS} times (to {arc:.3e}); the path ends there")
+            break
+        e_new, lam_new, factor_new, iterations, state = step
+        iterations_total += iterations
+        history.append(state.force_res)
+        crossed = (factor - target_load_factor) * (factor_new - target_load_factor) <= 0 \
+            and factor_new != factor
+        if crossed:
+            w = (target_load_factor - factor) / (factor_new - factor)
+            landed = _newton_at(model, e + w * (e_new - e), lam + w * (lam_new - lam),
+                                target_load_factor, tol, max_iter, floor)
+            if landed is None:   # too close to a limit: a shorter arc first
+                arc *= 0.5
+                state = base_state
+                continue
+            e_new, lam_new, factor_new = landed[0], landed[1], target_load_factor
+            state = _State(model, e_new, lam_new, factor_new, floor)
+            reached = True
+        previous = e_new - e
+        lengths.append(lengths[-1] + float(np.linalg.norm(previous)))
+        e, lam, factor = e_new, lam_new, factor_new
+        factors.append(factor)
+        disps.append(_probe_displacement(model, e, probe))
+        counts.append(negative_eigenvalues(model, state))
+        if reached:
+            break
+        arc = min(largest, arc * float(np.clip(np.sqrt(DESIRED_ITERATIONS / max(iterations, 1)),
+                                               0.5, 2.0)))
+    else:
+        message = (f"arc length: the path did not reach target_load_factor = "
+                   f"{target_load_factor:.6g} in max_steps = {max_steps} steps (last load "
+                   f"factor {factor:.6g}); raise solver.max_steps or solver.arc_length")
+    factors_a, counts_a = np.asarray(factors), np.asarray(counts, dtype=np.int64)
+    limits, refined, bifurcations = _marks(factors_a, counts_a, np.asarray(lengths))
+    path = StaticPath(factors_a, np.asarray(disps), counts_a, probe, limits, refined,
+                      bifurcations, float(target_load_factor), reached, message)
+    wall = time.perf_counter() - start
+    result = StaticResult(e, lam, "arc_length", iterations_total, state.force_res,
+                          state.con_res, wall, history,
+                          {"assembly": 0.0, "factorization": 0.0, "solve": wall, "total": wall},
+                          extra={"load_factor": factor, "path_points": len(factors),
+                                 "reached": reached})
+    result.path = path
+    return result
+
+
+def _arc_step(model: Model, e0: np.ndarray, lam0: np.ndarray, p0: float, state: _State,
+              arc: float, previous: np.ndarray | None, direction: float, tol: float,
+              max_iter: int, floor: float):
+    """One arc-length step of length ``arc`` from the converged (e0, lam0, p0) whose state
+    is ``state``: (e, lam, P, iterations, state) or None when it does not converge."""
+    du_q, dl_q = state.solve(False)
+    norm = np.linalg.norm(du_q)
+    if not norm > 0 or not np.all(np.isfinite(du_q)):
+        return None
+    sign = direction if previous is None else (1.0 if du_q @ previous >= 0 else -1.0)
+    dp = sign * arc / norm
+    de, dlam = dp * du_q, dp * dl_q
+    previous_res = np.inf
+    for iteration in range(1, max_iter + 1):
+        e, lam, factor = e0 + de, lam0 + dlam, p0 + dp
+        current = _State(model, e, lam, factor, floor)
+        if not np.isfinite(current.force_res):
+            return None
+        if iteration > 1 and converged(current.force_res, current.con_res, step_size,
+                                       np.linalg.norm(e - model.e0), tol, previous_res):
+            return e, lam, factor, iteration - 1, current
+        previous_res = current.force_res
+        du_r, dl_r = current.solve(True)
+        du_q, dl_q = current.solve(False)
+        base = de + du_r
+        a, b, c = du_q @ du_q, 2.0 * du_q @ base, base @ base - arc * arc
+        disc = b * b - 4 * a * c
+        if not a > 0 or disc < 0:
+            return None
+        roots = [(-b + s * np.sqrt(disc)) / (2 * a) for s in (1.0, -1.0)]
+        ddp = max(roots, key=lambda x: (base + x * du_q) @ de)
+        change = du_r + ddp * du_q
+        de, dlam, dp = de + change, dlam + dl_r + ddp * dl_q, dp + ddp
+        step_size = np.linalg.norm(change)
+        if not np.all(np.isfinite(de)):
+            return None
+    return None
+
+
+def diagnose_stall(model: Model, failure: LoadStepFailure, *, tol: float, max_iter: int,
+                   cuts: int = 10) -> SolverError:
+    """The error to report for a failed load-controlled Newton solve: cut the failing load
+    step back from its last converged state (halving up to ``cuts`` times) to the highest
+    load factor P* that converges; when there the tangent stiffness along the loads,
+    q^T (K_T^{-1} q) at the start over the same at P*, has fallen below 0.1 or the
+    tangent has a negative eigenvalue, the loads pass a maximum the structure cannot carry
+    under load control: say so and name arc_length. Otherwise the original failure."""
+    e, lam, reached, above = failure.e, failure.lam, failure.last_factor, failure.factor
+    for _ in range(cuts):
+        middle = 0.5 * (reached + above)
+        trial = _newton_at(model, e, lam, middle, tol, max_iter)
+        if trial is None:
+            above = middle
+        else:
+            e, lam, reached = trial[0], trial[1], middle
+    if _newton_at(model, e, lam, failure.factor, tol, max_iter) is not None:
+        return failure   # the whole step converges from closer: not a limit (load_steps helps)
+    start = _State(model, model.e0, np.zeros(len(model.constraints)), 0.0)
+    at = _State(model, e, lam, reached)
+    flex0 = start.load @ start.solve(False)[0] if start._lu is not None else np.nan
+    flex = at.load @ at.solve(False)[0] if at._lu is not None else np.inf
+    ratio = flex0 / flex if flex != 0 else 0.0
+    negative = negative_eigenvalues(model, at)
+    if not (ratio < 0.1 or negative > 0):
+        return failure
+    head = str(failure).split("; raise")[0]
+    return SolverError(
+        f"static Newton stalled near a limit point of the load path: the loads converge up "
+        f"to {reached:.6g} times their value, not beyond (the step was cut {cuts} times), and "
+        f"the tangent stiffness along the loads has fallen to {ratio:.3g} of its start"
+        f"{f' with {negative} negative eigenvalue(s)' if negative else ''}; load control "
+        f"cannot pass a maximum of the load: use solver.static_method = 'arc_length' "
+        f"(the load factor an unknown) to follow the path past it ({head})")
+
+
+#: the values of ``solver.static_method``
+STATIC_METHODS = ("auto", "split", "newton", "arc_length")
+
+
+def solve_static_path(model: Model, method: str, *, tol: float, max_iter: int,
+                      p: float = 0.0, load_steps: int = 1, arc_length: float = 0.0,
+                      max_steps: int = 200, target_load_factor: float = 1.0,
+                      control_probe: str = "") -> StaticResult:
+    """The static solve of a scene: 'arc_length' follows the path
+    (:func:`solve_arc_length`), the other methods are :func:`~.static.solve_static`'s; a
+    load-controlled Newton that fails is diagnosed (:func:`diagnose_stall`)."""
+    if method not in STATIC_METHODS:
+        raise InputError(f"static_method {method!r} must be one of {', '.join(STATIC_METHODS)}",
+                         group="solver", key="static_method")
+    if method == "arc_length":
+        result = solve_arc_length(model, tol=tol, max_iter=max_iter, arc_length=arc_length,
+                                  max_steps=max_steps, target_load_factor=target_load_factor,
+                                  control_probe=control_probe)
+        result.extra["method_setting"] = method
+        return result
+    try:
+        return solve_static(model, method, tol=tol, max_iter=max_iter, p=p,
+                            load_steps=load_steps)
+    except LoadStepFailure as failure:
+        raise diagnose_stall(model, failure, tol=tol, max_iter=max_iter) from None

@@ -1,0 +1,243 @@
+"""Static path-following by arc length (``solver.static_method = 'arc_length'``,
+solvers/path.py; SPEC section 8.2 "Static paths", issue 34 item 2).
+
+* The shallow von Mises truss (two pinned bars of half-span a and rise h, a vertical load P
+  at the apex): with the bars' Green-Lagrange axial strain (St. Venant-Kirchhoff, the
+  nonlinear beam's axial model; a straight pinned bar does not bend) the equilibrium path is
+  P(y) = EA y (h^2 - y^2) / L0^3 (y the apex height, L0 = sqrt(a^2 + h^2)): limit loads
+  +-2 EA h^3 / (3 sqrt(3) L0^3) at y = +-h / sqrt(3), unstable between them (one negative
+  eigenvalue), stable outside.
+* Lee's frame (Lee, Manuel & Rossow 1968; Schweizerhof & Wriggers 1986; Simo & Vu-Quoc
+  1986): column and beam of L = 120 cm, pinned at the column's foot and at the beam's far
+  end, rigid corner, a vertical load at 24 cm from the corner; E = 720 N/cm^2, A = 6 cm^2,
+  I = 2 cm^4 (here in SI: E = 7.2e6 Pa, section 3 cm x 2 cm in the plane). Published limit
+  load P L^2 / EI = 18.5-18.6 (18.56 taken, issue 34). The path snaps back: past the
+  limit the load point's vertical displacement turns back while the load keeps falling.
+  Reference path: tests/reference/lee_frame_path.json, the same model on 81 nodes per member
+  (benchmarks/lee_frame.py; its limit load 18.52, 0.24% below 18.56; the nodes 11, 21,
+  41 give 17.98, 18.38, 18.49: second-order convergence).
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from ancfdrv import System
+from ancfdrv.errors import SolverError
+from ancfdrv.plots import plot_result
+from ancfdrv.system.sections import Rectangle
+
+REFERENCE = Path(__file__).resolve().parent / "reference" / "lee_frame_path.json"
+
+# -- the von Mises truss -----------------------------------------------------------------
+A_HALF, RISE, E_TRUSS, SIDE = 1.0, 0.1, 1e7, 0.12
+EA = E_TRUSS * SIDE**2
+L0 = np.hypot(A_HALF, RISE)
+P_LIMIT = 2 * EA * RISE**3 / (3 * np.sqrt(3) * L0**3)
+
+
+def truss(load: float) -> System:
+    """Two one-element bars (the continuum option, nu = 0) pinned to the ground and to each
+    other at the apex, in the x-y plane; a probe at the apex."""
+    s = System("von Mises truss", planar="xy")
+    s.material("m", youngs_modulus=E_TRUSS, density=1000.0, poisson_ratio=0.0)
+    for name, x in (("left", -A_HALF), ("right", A_HALF)):
+        s.beam(name, material="m", start=(x, 0, 0), end=(0, RISE, 0), nodes=2,
+               section=Rectangle(SIDE, SIDE), height_axis=(0, 0, 1), formulation="nonlinear")
+        s.joint(f"{name}_pin", "fix", "ground", name, point=(x, 0, 0))
+    s.joint("apex", "spherical", "left", "right", point=(0, RISE, 0))
+    s.load("P", "force", body="left", point=(0, RISE, 0), vector=(0, -load, 0))
+    s.probe("apex", "left", (0, RISE, 0))
+    return s
+
+
+def read_path(h5_path: Path) -> dict:
+    with h5py.File(h5_path, "r") as h5:
+        group = h5["static/path"]
+        out = {k: group[k][()] for k in group}
+        out.update({k: group.attrs[k] for k in group.attrs})
+        out["status"] = h5.attrs.get("status", h5["/"].attrs.get("status"))
+    return out
+
+
+def test_von_mises_truss_follows_the_closed_form_through_both_limits(tmp_path):
+    """Loads 1.5 P_limit: the path passes the upper limit, the unstable branch and the lower
+    limit, and ends at the target on the far stable branch. Every point on the closed form
+    within 1e-9 P_limit; the limits (refined) within 1e-3 of +-2/3; the stability index 0, 1,
+    0 along the branches; the final state at load factor 1 with y < -h."""
+    load = 1.5 * P_LIMIT
+    result = truss(load).static(static_method="arc_length", output=tmp_path / "t.h5")
+    path = read_path(tmp_path / "t.h5")
+    y = RISE + path["displacement"][:, 1]
+    closed = EA * y * (RISE**2 - y**2) / L0**3
+    assert np.max(np.abs(path["load_factor"] * load - closed)) < 1e-9 * P_LIMIT
+    assert np.max(np.abs(path["displacement"][:, 0])) < 1e-9 * RISE
+    np.testing.assert_allclose(path["limit_load_factors"], [2 / 3, -2 / 3], atol=1e-3)
+    first, second = path["limit_points"]
+    assert y[first] == pytest.approx(RISE / np.sqrt(3), rel=0.05)
+    count = path["negative_eigenvalues"]
+    # the point of largest |P| next to a limit lies on either side of it
+    assert np.all(count[:first] == 0) and np.all(count[first + 1:second] == 1) \
+        and np.all(count[second + 1:] == 0) and {count[first], count[second]} <= {0, 1}
+    assert len(path["bifurcation_points"]) == 0 and path["reached"]
+    assert path["load_factor"][-1] == 1.0 and y[-1] < -RISE
+    assert (result.probes["apex"][1] - RISE) == pytest.approx(path["displacement"][-1, 1],
+                                                              abs=1e-12)
+
+
+def test_path_short_of_the_target_writes_it_and_fails(tmp_path):
+    """max_steps too few for the target: exit-3 SolverError naming max_steps, the path and
+    the last point written, status 'failed'."""
+    out = tmp_path / "short.h5"
+    with pytest.raises(SolverError, match=r"did not reach target_load_factor .* max_steps"):
+        truss(1.5 * P_LIMIT).static(static_method="arc_length", max_steps=4, output=out)
+    path = read_path(out)
+    assert len(path["load_factor"]) == 5 and not path["reached"]
+    assert 0 < path["load_factor"][-1] < 1
+
+
+# -- Lee's frame -------------------------------------------------------------------------
+L_FRAME, E_FRAME = 1.2, 7.2e6
+EI_FRAME = E_FRAME * 0.03 * 0.02**3 / 12          # 0.144 N m^2: EI / L^2 = 0.1 N
+P_UNIT = EI_FRAME / L_FRAME**2
+LIMIT_REFERENCE = 18.56                           # P L^2 / EI (issue 34; 18.5-18.6 published)
+
+
+def lee_frame(nodes: int, load: float) -> System:
+    """Lee's frame with the 'cubic' bending option, ``nodes`` per member, the load ``load``
+    (in EI / L^2) down at 0.2 L from the corner; a probe at the load point."""
+    s = System("Lee's frame", planar="xy")
+    s.material("m", youngs_modulus=E_FRAME, density=1000.0, poisson_ratio=0.3)
+    section = Rectangle(0.03, 0.02)       # 2 cm deep in the plane: I = 2 cm^4, A = 6 cm^2
+    s.beam("column", material="m", start=(0, 0, 0), end=(0, L_FRAME, 0), nodes=nodes,
+           section=section, height_axis=(1, 0, 0), formulation="nonlinear", bending="cubic")
+    s.beam("beam", material="m", start=(0, L_FRAME, 0), end=(L_FRAME, L_FRAME, 0),
+           nodes=nodes, section=section, height_axis=(0, 1, 0), formulation="nonlinear",
+           bending="cubic")
+    s.joint("foot", "fix", "ground", "column", point=(0, 0, 0))
+    s.joint("far_end", "fix", "ground", "beam", point=(L_FRAME, L_FRAME, 0))
+    s.joint("corner", "weld", "column", "beam", point=(0, L_FRAME, 0))
+    s.load("P", "force", body="beam", point=(0.2 * L_FRAME, L_FRAME, 0),
+           vector=(0, -load * P_UNIT, 0))
+    s.probe("load_point", "beam", (0.2 * L_FRAME, L_FRAME, 0))
+    return s
+
+
+def lee_path(nodes: int, tmp_path: Path) -> dict:
+    """The path under 20 EI / L^2 (beyond the limit: the target is met on the far branch)."""
+    out = tmp_path / f"lee{nodes}.h5"
+    lee_frame(nodes, 20.0).static(static_method="arc_length", output=out)
+    path = read_path(out)
+    path["png"] = plot_result(out)
+    return path
+
+
+def distance_to_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
+    """The distance of each point to the polyline through ``line`` (rows: vertices)."""
+    a, b = line[:-1], line[1:]
+    ab = b - a
+    out = []
+    for p in points:
+        t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
+        out.append(np.min(np.linalg.norm(a + t[:, None] * ab - p, axis=1)))
+    return np.asarray(out)
+
+
+@pytest.fixture(scope="module")
+def lee31(tmp_path_factory):
+    return lee_path(31, tmp_path_factory.mktemp("lee"))
+
+
+def test_lee_frame_limit_load_within_one_percent(lee31):
+    """31 nodes per member: the limit load within 1% of 18.56 EI / L^2 (measured -0.53%),
+    where the stability index turns from 0 to 1; past it the load point's vertical
+    displacement turns back (the snap-back) while the index stays 1."""
+    load = 20.0 * path_factor(lee31)
+    first = lee31["limit_points"][0]
+    limit = 20.0 * lee31["limit_load_factors"][0]
+    print(f"\nLee's frame, 31 nodes: limit {limit:.4f} EI/L^2 ({limit / LIMIT_REFERENCE - 1:+.3%})")
+    assert abs(limit / LIMIT_REFERENCE - 1) < 0.01
+    count = lee31["negative_eigenvalues"]
+    assert np.all(count[:first] == 0) and count[first + 1] == 1
+    down = -lee31["displacement"][:, 1]
+    turn = first + int(np.argmax(np.diff(down[first:]) < 0))   # where v first turns back
+    back = turn + int(np.argmax(np.diff(down[turn:]) > 0))      # and where it turns again
+    assert turn > first and count[turn] == 1 and down[back] < down[turn] - 0.05 * L_FRAME
+    assert load[turn + 1] < load[turn]          # the load still falls where v turns back
+    assert lee31["reached"] and lee31["load_factor"][-1] == 1.0
+    assert lee31["png"].is_file()
+
+
+def path_factor(path: dict) -> np.ndarray:
+    return np.asarray(path["load_factor"])
+
+
+def test_lee_frame_path_within_one_percent_of_the_reference(lee31):
+    """Every point of the 31-node path (u/L, v/L, P L^2 / (EI 18.56)) within 1% of the
+    81-node reference path's polyline, through the limit and the snap-back (measured)."""
+    reference = json.loads(REFERENCE.read_text())
+    line = np.column_stack([np.asarray(reference["u"]) / L_FRAME,
+                            np.asarray(reference["v"]) / L_FRAME,
+                            np.asarray(reference["load"]) / LIMIT_REFERENCE])
+    points = np.column_stack([lee31["displacement"][:, 0] / L_FRAME,
+                              lee31["displacement"][:, 1] / L_FRAME,
+                              20.0 * path_factor(lee31) / LIMIT_REFERENCE])
+    far = distance_to_polyline(points, line)
+    print(f"\nLee's frame, 31 nodes: largest distance to the 81-node path {far.max():.4f}")
+    assert far.max() < 0.01
+
+
+def test_load_control_stalls_near_the_limit_and_names_arc_length():
+    """Load control under 20 EI / L^2 (beyond the limit) in 10 steps: the solve fails near
+    the limit load and says so, naming static_method = 'arc_length' (not 'raise
+    solver.load_steps', which cannot help)."""
+    with pytest.raises(SolverError) as caught:
+        lee_frame(11, 20.0).static(static_method="newton", load_steps=10)
+    text = str(caught.value)
+    assert "limit point" in text and "static_method = 'arc_length'" in text
+    assert "; raise solver.load_steps" not in text
+
+
+TRUSS_SCENE = """
+&scene  title = 'von Mises truss', analysis = 'static', formulation = 'nonlinear',
+        planar = 'xy' /
+&material  name = 'm', youngs_modulus = 1.0e7, density = 1000.0, poisson_ratio = 0.0 /
+&beam  name = 'left', material = 'm', start = -1.0, 0.0, 0.0, end = 0.0, 0.1, 0.0, nodes = 2,
+       section = 'rectangle', width = 0.12, height = 0.12, height_axis = 0.0, 0.0, 1.0 /
+&beam  name = 'right', material = 'm', start = 1.0, 0.0, 0.0, end = 0.0, 0.1, 0.0, nodes = 2,
+       section = 'rectangle', width = 0.12, height = 0.12, height_axis = 0.0, 0.0, 1.0 /
+&joint  name = 'left_pin', type = 'fix', body1 = 'ground', body2 = 'left',
+        point = -1.0, 0.0, 0.0 /
+&joint  name = 'right_pin', type = 'fix', body1 = 'ground', body2 = 'right',
+        point = 1.0, 0.0, 0.0 /
+&joint  name = 'apex', type = 'spherical', body1 = 'left', body2 = 'right',
+        point = 0.0, 0.1, 0.0 /
+&load  name = 'P', type = 'force', body = 'left', point = 0.0, 0.1, 0.0,
+       vector = 0.0, -{load}, 0.0 /
+&probe  name = 'apex', body = 'left', point = 0.0, 0.1, 0.0 /
+&solver  static_method = 'arc_length', target_load_factor = 0.5, arc_length = 0.01,
+         control_probe = 'apex' /
+"""
+
+
+def test_scene_door_and_plot(tmp_path):
+    """The namelist door: ``ancf run`` of the truss with static_method = 'arc_length' up to
+    half of 1.5 P_limit (before the limit) exits 0 with the state there on the closed form;
+    ``ancf plot`` draws the path beside the static plot."""
+    from ancfdrv.cli import main
+    scene = tmp_path / "truss.nml"
+    scene.write_text(TRUSS_SCENE.format(load=1.5 * P_LIMIT))
+    out = tmp_path / "truss.h5"
+    assert main(["run", str(scene), "-o", str(out)]) == 0
+    path = read_path(out)
+    assert path["probe"] == "apex" and path["load_factor"][-1] == 0.5
+    y = RISE + path["displacement"][-1, 1]
+    assert EA * y * (RISE**2 - y**2) / L0**3 == pytest.approx(0.75 * P_LIMIT, rel=1e-9)
+    assert np.all(path["negative_eigenvalues"] == 0) and len(path["limit_points"]) == 0
+    png = tmp_path / "truss.png"
+    assert main(["plot", str(out), "-o", str(png)]) == 0
+    assert png.with_name("truss_path.png").is_file()
