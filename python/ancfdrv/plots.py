@@ -717,36 +717,18 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
         err_key = "err_vs_closed_form"
     else:
         err_key = "err_vs_finest"
-    pts = [r for r in ok if r.get(err_key, 0) > 0]
-    if pts and others:  # one series per family (the values of the non-refining keys)
-        path = pareto_chart(pts, lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in others),
-                            lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in mesh_keys),
-                            err_key, outdir / "error_vs_time.png")
-        out.append(path)
-    elif pts:
-        fig, ax = plt.subplots(figsize=(6, 4.2), constrained_layout=True)
-        groups = sorted({r.get(nodes_key, "") for r in pts}, key=_num)
-        markers = {dt: m for dt, m in zip(sorted({r.get("solver.dt", "") for r in pts},
-                                                 key=_num), "osD^v<>p*")}
-        for g in groups:
-            for dt, marker in markers.items():
-                sel = [r for r in pts if r.get(nodes_key, "") == g and r.get("solver.dt", "") == dt]
-                if not sel:
-                    continue
-                label = (_mesh_label(nodes_key, g) if nodes_key else "") + (
-                    f", dt {dt}" if len(markers) > 1 else "")
-                ax.loglog([r["total_time_s"] for r in sel], [r[err_key] for r in sel], marker,
-                          ms=5, color=f"C{groups.index(g) % 10}", label=label or None)
-        ax.set_xlabel("wall time per case (s)")
-        ax.set_ylabel(err_key.replace("_", " "))
-        ax.set_title("what accuracy costs in time")
-        ax.grid(alpha=0.3, which="both")
-        if nodes_key:
-            ax.legend(fontsize=8)
-        path = outdir / "error_vs_time.png"
-        save_figure(fig, path, dpi=120)
-        plt.close(fig)
-        out.append(path)
+    pts = [r for r in ok if r.get(err_key, 0) > 0 and r.get("compute_time_s", 0) > 0]
+    if pts:  # one series per family (the values of the non-refining keys)
+        def varies(key: str) -> bool:
+            return len({str(r.get(key)) for r in pts}) > 1
+        dt_keys = ["solver.dt"] if varies("solver.dt") else []
+        # a line per family (the values of the other keys that vary), a label per point
+        family_keys = [k for k in others if varies(k)] or dt_keys
+        point_keys = mesh_keys + [k for k in dt_keys if k not in family_keys]
+        out.append(pareto_chart(
+            pts, lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in family_keys) or "runs",
+            lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in point_keys), err_key,
+            outdir / "error_vs_time.png", common_reference=err_key == "err_vs_reference"))
     return out
 
 
@@ -754,30 +736,61 @@ def _short(key: str) -> str:
     return key.rpartition(".")[2]
 
 
+#: the time axis of an accuracy-versus-time chart (results/hdf5.py, phase_times)
+COMPUTE_LABEL = ("computing time (s): model, assembly, factorization, solve\n"
+                 "(the file's /timing; start-up, reading and writing excluded)")
+
+
+def pareto_front(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The points no other point beats in both time and error (x: time, y: error), in
+    the order of time: the cheapest run for each accuracy."""
+    front: list[tuple[float, float]] = []
+    for x, y in sorted(points):
+        if not front or y < front[-1][1]:
+            front.append((x, y))
+    return front
+
+
 def pareto_chart(rows: list[dict], family, point_label, err_key: str, path: Path, *,
-                 time_key: str = "total_time_s", title: str = "what accuracy costs in time"
-                 ) -> Path:
-    """Error against wall time, one line per family (``family(row)``: its label; points
-    joined in the order of time, each annotated with ``point_label(row)``, e.g. the node
-    count or the modes). Used by ``ancf sweep`` (families: the values of the non-refining
-    keys) and benchmarks/accuracy_chart.py (several sweeps in one chart)."""
+                 time_key: str = "compute_time_s", title: str = "what accuracy costs in time",
+                 common_reference: bool = False) -> Path:
+    """Error against computing time on logarithmic axes. One colour per family
+    (``family(row)``: its label); each point annotated with ``point_label(row)`` (e.g. the
+    node count and the step); each family's line joins its Pareto front (the cheapest of
+    its runs for each accuracy), its other runs are hollow. With ``common_reference`` (every
+    error measured against the same reference, so the families are alternatives for one
+    problem) the front over all the families is drawn beneath in grey. Used by ``ancf
+    sweep`` (families: the values of the other varied keys) and
+    benchmarks/accuracy_chart.py."""
     fig, ax = plt.subplots(figsize=(8.5, 5.6), constrained_layout=True)
     families: dict[str, list[dict]] = {}
     for row in rows:
         families.setdefault(family(row), []).append(row)
+    if common_reference:
+        front = pareto_front([(float(r[time_key]), float(r[err_key])) for r in rows])
+        ax.plot([p[0] for p in front], [p[1] for p in front], color="0.75", lw=6, alpha=0.7,
+                zorder=0, label="cheapest for its accuracy, over all")
     markers = "osD^v<>p*hX"
     for i, (name, members) in enumerate(families.items()):
-        members = sorted(members, key=lambda r: float(r[time_key]))
-        x = [float(r[time_key]) for r in members]
-        y = [float(r[err_key]) for r in members]
-        ax.loglog(x, y, "-" + markers[i % len(markers)], ms=5, lw=1, color=f"C{i % 10}",
-                  label=name)
-        for r, xi, yi in zip(members, x, y):
+        colour, marker = f"C{i % 10}", markers[i % len(markers)]
+        points = [(float(r[time_key]), float(r[err_key])) for r in members]
+        front = pareto_front(points)
+        ax.plot([p[0] for p in front], [p[1] for p in front], "-" + marker, ms=5, lw=1.2,
+                color=colour, label=name)
+        others = [p for p in points if p not in front]
+        if others:
+            ax.plot([p[0] for p in others], [p[1] for p in others], marker, ms=5,
+                    mfc="none", color=colour)
+        for r, (xi, yi) in zip(members, points):
             ax.annotate(point_label(r), (xi, yi), textcoords="offset points", xytext=(3, 3),
-                        fontsize=6, color=f"C{i % 10}")
-    ax.set_xlabel(time_key.replace("_s", " (s)").replace("_", " "))
+                        fontsize=6, color=colour)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(COMPUTE_LABEL if time_key == "compute_time_s"
+                  else time_key.replace("_s", " (s)").replace("_", " "))
     ax.set_ylabel(err_key.replace("_", " "))
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title + "\n(lines: each family's cheapest runs for their accuracy; "
+                 "hollow: beaten by a run of the same family)", fontsize=9)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7, loc="best")
     save_figure(fig, path, dpi=120)
