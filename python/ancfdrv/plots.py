@@ -3,6 +3,8 @@ histories and load-cycle loop (several runs overlaid), and a sweep's
 result-against-parameter curves and error-against-wall-time (Pareto) chart."""
 from __future__ import annotations
 
+import textwrap
+
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -159,7 +161,9 @@ def _components(support: bool) -> tuple[str, str, str]:
 
 
 def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
-    """Any static result: every probe's deflection components (mm) as grouped bars."""
+    """Any static result: the deformed structure over a grey ghost of the undeformed one
+    (scaled, the factor in the title) when the file has the mesh, and every probe's
+    deflection components (mm) as grouped bars."""
     h5_path = Path(h5_path)
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
@@ -169,9 +173,25 @@ def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
         title = _text(h5.attrs.get("title", h5_path.stem))
         method = _text(static.attrs.get("method", ""))
         label = _deflection_label(static)
+        shape = None
+        if "mesh_nodes" in static and "model/mesh" in h5:
+            ghost = h5["model/mesh/points"][()]
+            shape = (_mesh_segments(h5), ghost, static["mesh_nodes"][()] - ghost)
     names = list(probes)
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.2 * len(names) + 3), 3.8),
-                           constrained_layout=True)
+    width = max(6.0, 1.2 * len(names) + 3)
+    if shape is None:
+        fig, ax = plt.subplots(figsize=(width, 3.8), constrained_layout=True)
+    else:
+        fig, (ax_shape, ax) = plt.subplots(1, 2, figsize=(width + 5.0, 4.2),
+                                           constrained_layout=True,
+                                           gridspec_kw={"width_ratios": [1.2, 1.0]})
+        segments, ghost, displacement = shape
+        scale = shape_scale(ghost, displacement)
+        _draw_shape(ax_shape, segments, ghost, displacement, scale)
+        peak = 1e3 * float(np.linalg.norm(displacement, axis=1).max(initial=0.0))
+        ax_shape.set_title("deformed (blue) over undeformed (grey), displacements "
+                           + ("at true scale" if scale == 1.0 else f"x {scale:.3g}")
+                           + f"\nlargest displacement {peak:.4g} mm", fontsize=9)
     if names:
         d = 1e3 * np.array([probes[n] for n in names]).reshape(len(names), -1)
         x = np.arange(len(names))
@@ -183,7 +203,8 @@ def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
     else:
         ax.text(0.5, 0.5, "no probes in this file", ha="center", transform=ax.transAxes)
     ax.set_ylabel("deflection (mm)")
-    ax.set_title(f"{title} ({method})\nprobe deflection: {label}", fontsize=9)
+    ax.set_title(textwrap.fill(f"probe deflection: {label}", 70), fontsize=8)
+    fig.suptitle(f"{title} ({method})", fontsize=10)
     save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png
@@ -943,6 +964,33 @@ def _mesh_segments(h5: h5py.File) -> list[np.ndarray]:
     return out
 
 
+def _draw_shape(ax, segments: list[np.ndarray], base: np.ndarray, displacement: np.ndarray,
+                scale: float) -> None:
+    """The mesh at ``base`` (grey ghost) and displaced by ``scale`` x ``displacement``, seen
+    in the plane of the mesh's largest extent and the displacement's largest component."""
+    extent = np.ptp(base, axis=0)
+    along = int(np.argmax(extent))
+    moved = int(np.argmax(np.abs(displacement).max(axis=0, initial=0.0)
+                          + (np.arange(3) == along) * -1e9))
+    deformed = base + scale * displacement
+    for seg in segments:
+        ax.plot(base[seg, along], base[seg, moved], color="0.75", lw=0.8)
+        ax.plot(deformed[seg, along], deformed[seg, moved], color="C0", lw=1.2)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(f"{'xyz'[along]} (m)")
+    ax.set_ylabel(f"{'xyz'[moved]} (m)")
+
+
+def shape_scale(base: np.ndarray, displacement: np.ndarray) -> float:
+    """The factor that draws a displacement field visibly: its largest displacement shown
+    as a tenth of the mesh's size, or 1 (true scale) when it is already larger."""
+    size = max(float(np.ptp(base, axis=0).max(initial=0.0)), 1e-12)
+    peak = float(np.abs(displacement).max(initial=0.0))
+    if peak == 0.0 or peak >= 0.1 * size:
+        return 1.0
+    return 0.1 * size / peak
+
+
 def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal",
                count: int = 4) -> Path:
     """The first mode shapes of a modal or buckling analysis: the mesh at the static state
@@ -957,8 +1005,7 @@ def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal
         damping = h5[f"{group}/damping_ratio"][:count] if "damping_ratio" in h5[group] else None
         segments = _mesh_segments(h5)
         title = _text(h5.attrs.get("title", ""))
-    extent = np.ptp(static, axis=0)
-    size = max(float(extent.max()), 1e-12)
+    size = max(float(np.ptp(static, axis=0).max()), 1e-12)
     n = len(shapes)
     fig, axes = plt.subplots(1, max(n, 1), figsize=(3.2 * max(n, 1), 3.2),
                              constrained_layout=True, squeeze=False)
@@ -966,15 +1013,7 @@ def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal
         if k >= n:
             ax.axis("off")
             continue
-        along = int(np.argmax(extent))
-        moved = int(np.argmax(np.abs(shapes[k]).max(axis=0) + (np.arange(3) == along) * -1e9))
-        deformed = static + 0.1 * size * shapes[k]
-        for seg in segments:
-            ax.plot(static[seg, along], static[seg, moved], color="0.75", lw=0.8)
-            ax.plot(deformed[seg, along], deformed[seg, moved], color="C0", lw=1.2)
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel(f"{'xyz'[along]} (m)")
-        ax.set_ylabel(f"{'xyz'[moved]} (m)")
+        _draw_shape(ax, segments, static, shapes[k], 0.1 * size)
         if group == "modal":
             label = f"mode {k + 1}: {values[k]:.4g} Hz"
             if damping is not None:

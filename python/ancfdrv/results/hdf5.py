@@ -545,6 +545,12 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
             _dataset(group, f"probes/{name}", position, "m")
         for name, deflection in model.deflections(result.e).items():
             _dataset(group, f"deflection/{name}", deflection, "m")
+        from .xdmf import MeshLayout, write_layout
+        layout = MeshLayout.from_model(model)
+        if layout is not None:  # the deformed shape (ancf plot, the static XDMF)
+            if "model/mesh" not in h5:
+                write_layout(h5, layout)
+            _dataset(group, "mesh_nodes", layout.positions(model, result.e[None, :])[0], "m")
         _attrs(group.attrs, {"method": result.method, "iterations": result.iterations,
                              "residual_norm": result.residual_norm,
                              "constraint_norm": result.constraint_norm,
