@@ -107,10 +107,53 @@ def _deflection_label(group: h5py.Group) -> str:
 MAX_PROBE_PANELS = 6
 
 
+#: a probe or a component whose largest displacement is below this fraction of the model's
+#: size (round-off) does not move: not drawn (a probe so is named in the footnote); a
+#: reaction whose force changes by less than this fraction of the largest change neither
+STILL = 1e-9
+#: the reactions drawn by the default dynamic plot: those whose force changes most
+MAX_REACTION_CURVES = 4
+
+
+def _cable_swing(h5: h5py.File) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each cable's (rope's) swing over the mesh frames: (time, angle in degrees of its
+    chord, first to last point, from the chord's direction at t = 0)."""
+    if "dynamic/mesh_nodes" not in h5 or "model/mesh" not in h5:
+        return {}
+    out = {}
+    nodes = h5["dynamic/mesh_nodes"]
+    times = h5["dynamic/time"][()][h5["dynamic/mesh_rows"][()]]
+    for line in _text(h5["model/mesh"].attrs.get("bodies", "")).splitlines():
+        name, _, rest = line.partition(": ")
+        kind, _, points = rest.partition(", points ")
+        if kind != "cable" or ".." not in points:
+            continue
+        first, last = (int(v) for v in points.split(".."))
+        chord = nodes[:, last, :] - nodes[:, first, :]
+        chord /= np.maximum(np.linalg.norm(chord, axis=1, keepdims=True), 1e-300)
+        cosine = np.clip(chord @ chord[0], -1.0, 1.0)
+        out[name] = (times[:len(chord)], np.degrees(np.arccos(cosine)))
+    return out
+
+
+def _changing_reactions(dyn: h5py.Group) -> dict[str, np.ndarray]:
+    """The reactions whose force magnitude (kN) changes most over the run."""
+    if "reactions" not in dyn:
+        return {}
+    found = {name: np.linalg.norm(group["force"][()], axis=1) / 1e3
+             for name, group in dyn["reactions"].items() if "force" in group}
+    ranges = {name: float(np.ptp(v)) if len(v) else 0.0 for name, v in found.items()}
+    largest = max(ranges.values(), default=0.0)
+    ranked = sorted((n for n in found if ranges[n] > STILL * largest and largest > 0),
+                    key=lambda n: -ranges[n])
+    return {n: found[n] for n in ranked[:MAX_REACTION_CURVES]}
+
+
 def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
-    """Any dynamic result: each probe's deflection components (x, y, z in its frame) over
-    time (at most :data:`MAX_PROBE_PANELS` probes, then the largest-moving ones), and the
-    energies the file holds."""
+    """Any dynamic result, the quantities that move: each probe's deflection components
+    (in its frame, the basis named once in the title; probes and components that do not
+    move are left out and named below), each rope's swing angle, the reactions whose force
+    changes most, and the energies the file holds."""
     h5_path = Path(h5_path)
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
@@ -122,20 +165,40 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
         status = _text(h5.attrs.get("status", ""))
         label = _deflection_label(dyn)
         beam_frame = set(dyn.get("deflection_support", {}))
-    if len(probes) > MAX_PROBE_PANELS:
-        ranked = sorted(probes, key=lambda n: -float(np.abs(probes[n]).max(initial=0.0)))
-        probes = {n: probes[n] for n in ranked[:MAX_PROBE_PANELS]}
-    panels = len(probes) + (1 if energy else 0)
-    fig, axes = plt.subplots(max(panels, 1), 1, figsize=(9, 2.4 * max(panels, 1) + 0.6),
+        swing = _cable_swing(h5)
+        reactions = _changing_reactions(dyn)
+        size = float(h5["model"].attrs.get("length_scale", 1.0)) if "model" in h5 else 1.0
+    peaks = {n: float(np.abs(d).max(initial=0.0)) for n, d in probes.items()}
+    still = [n for n in probes if peaks[n] <= STILL * size]
+    moving = sorted((n for n in probes if n not in still), key=lambda n: -peaks[n])
+    left_out = [n for n in moving[MAX_PROBE_PANELS:]]
+    probes = {n: probes[n] for n in moving[:MAX_PROBE_PANELS]}
+    panels = len(probes) + (1 if swing else 0) + (1 if reactions else 0) + (1 if energy else 0)
+    fig, axes = plt.subplots(max(panels, 1), 1, figsize=(9, 2.2 * max(panels, 1) + 0.9),
                              sharex=True, constrained_layout=True, squeeze=False)
-    axes = axes[:, 0]
+    axes = list(axes[:, 0])
     for ax, (name, d) in zip(axes, probes.items()):
         for k, component in enumerate(_components(name in beam_frame)):
-            ax.plot(t, 1e3 * d[:, k], lw=1.0, label=component)
+            if np.abs(d[:, k]).max(initial=0.0) > STILL * size:
+                ax.plot(t, 1e3 * d[:, k], lw=1.0, label=component)
         ax.set_ylabel(f"{name} (mm)")
         ax.legend(fontsize=8, ncol=3, loc="upper left")
+    axes = axes[len(probes):]
+    if swing:
+        ax = axes.pop(0)
+        for name, (times, angle) in swing.items():
+            ax.plot(times, angle, lw=1.0, label=name)
+        ax.set_ylabel("rope swing (deg)")
+        ax.legend(fontsize=8, ncol=4, loc="upper left", title="chord from its direction at t = 0",
+                  title_fontsize=7)
+    if reactions:
+        ax = axes.pop(0)
+        for name, force in reactions.items():
+            ax.plot(t, force, lw=1.0, label=name)
+        ax.set_ylabel("reaction |F| (kN)")
+        ax.legend(fontsize=8, ncol=4, loc="upper left")
     if energy:
-        ax = axes[len(probes)]
+        ax = axes.pop(0)
         for key in ("kinetic", "strain", "gravity"):
             if key in energy:
                 ax.plot(t, energy[key], lw=1.0, label=key)
@@ -145,11 +208,18 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
             ax.plot(t, energy["drive_work"], ":", lw=1.0, label="drive work")
         ax.set_ylabel("energy (J)")
         ax.legend(fontsize=8, ncol=5, loc="upper left")
+    first, last = fig.axes[0], fig.axes[-1]
     if not panels:
-        axes[0].text(0.5, 0.5, "no probes and no energies in this file", ha="center",
-                     transform=axes[0].transAxes)
-    axes[-1].set_xlabel("time (s)")
-    axes[0].set_title(f"{title} ({status})\nprobe deflection: {label}", fontsize=9)
+        first.text(0.5, 0.5, "no probes and no energies in this file", ha="center",
+                   transform=first.transAxes)
+    last.set_xlabel("time (s)")
+    first.set_title(f"{title} ({status})\n" + textwrap.fill(f"probe deflection: {label}", 110),
+                    fontsize=9)
+    notes = ([f"not moving (not drawn): {', '.join(still)}"] if still else []) + \
+        ([f"not drawn (more than {MAX_PROBE_PANELS} probes): {', '.join(left_out)}"]
+         if left_out else [])
+    if notes:
+        fig.text(0.01, 0.002, "; ".join(notes), fontsize=7, color="0.4", va="bottom")
     save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png
