@@ -102,6 +102,7 @@ LAYERS = [
     {"io"},                         # schema, namelist reader, validation, safe writes
     {"sweep_keys"},
     {"plots"},                      # reads result files with h5py alone
+    {"animate"},                    # ancf animate: frames from a result file, drawn by plots
     {"system"},                     # bodies, joints, loads, drives, assembly, Model
     {"solvers"},                    # static, dynamic, modal, buckling
     {"results"},                    # HDF5, XDMF, locks, output paths, the result object

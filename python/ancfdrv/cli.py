@@ -6,6 +6,7 @@
     ancf info OUT.h5 [--json]
     ancf plot OUT.h5 [OUT2.h5 ...] [-o PNG]   (several files: leaf spring runs overlaid)
     ancf show SCENE.nml [-o PNG] [--set GROUP.KEY=VALUE ...]   (the model before any solve)
+    ancf animate OUT.h5 [-o MP4|GIF] [--mode N] [--view xy|yz|zx]
 
 Exit status:
     0    success
@@ -257,6 +258,20 @@ def _cmd_show(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_animate(args: argparse.Namespace) -> int:
+    """An animation of a dynamic run, or of a mode or buckling shape (:mod:`ancfdrv.animate`)."""
+    from .animate import animate
+    path = Path(args.file)
+    if not path.is_file():
+        raise InputError("result file not found", file=str(path))
+    try:
+        out = animate(path, args.output, mode=args.mode, view=args.view)
+    except (KeyError, OSError) as exc:
+        raise corrupted(path, exc) from None
+    print(f"written {out}")
+    return 0
+
+
 def corrupted(path: object, exc: BaseException) -> InputError:
     """A result file that opens but whose content is damaged or not what a run writes."""
     text = str(exc).splitlines()[0][:200] if str(exc) else ""
@@ -329,6 +344,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE",
                    help="override a namelist value (repeatable)")
     p.set_defaults(func=_cmd_show)
+    p = sub.add_parser("animate", help="animate a result: the whole mesh through a dynamic "
+                       "run, or a mode or buckling shape (--mode N) oscillating")
+    p.add_argument("file")
+    p.add_argument("-o", "--output", help="a .gif or .mp4 (default: beside the file; MP4 "
+                   "when ffmpeg is installed, else GIF)")
+    p.add_argument("--mode", type=int, help="animate mode N (1-based) of the file's modal or "
+                   "buckling analysis")
+    p.add_argument("--view", default="auto", choices=["auto", "xy", "yz", "zx"],
+                   help="the plane drawn (default: the mesh's two largest extents)")
+    p.set_defaults(func=_cmd_animate)
     return parser
 
 

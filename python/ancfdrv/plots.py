@@ -3,6 +3,8 @@ histories and load-cycle loop (several runs overlaid), and a sweep's
 result-against-parameter curves and error-against-wall-time (Pareto) chart."""
 from __future__ import annotations
 
+import textwrap
+
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -149,10 +151,53 @@ def _deflection_label(group: h5py.Group) -> str:
 MAX_PROBE_PANELS = 6
 
 
+#: a probe or a component whose largest displacement is below this fraction of the model's
+#: size (round-off) does not move: not drawn (a probe so is named in the footnote); a
+#: reaction whose force changes by less than this fraction of the largest change neither
+STILL = 1e-9
+#: the reactions drawn by the default dynamic plot: those whose force changes most
+MAX_REACTION_CURVES = 4
+
+
+def _cable_swing(h5: h5py.File) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each cable's (rope's) swing over the mesh frames: (time, angle in degrees of its
+    chord, first to last point, from the chord's direction at t = 0)."""
+    if "dynamic/mesh_nodes" not in h5 or "model/mesh" not in h5:
+        return {}
+    out = {}
+    nodes = h5["dynamic/mesh_nodes"]
+    times = h5["dynamic/time"][()][h5["dynamic/mesh_rows"][()]]
+    for line in _text(h5["model/mesh"].attrs.get("bodies", "")).splitlines():
+        name, _, rest = line.partition(": ")
+        kind, _, points = rest.partition(", points ")
+        if kind != "cable" or ".." not in points:
+            continue
+        first, last = (int(v) for v in points.split(".."))
+        chord = nodes[:, last, :] - nodes[:, first, :]
+        chord /= np.maximum(np.linalg.norm(chord, axis=1, keepdims=True), 1e-300)
+        cosine = np.clip(chord @ chord[0], -1.0, 1.0)
+        out[name] = (times[:len(chord)], np.degrees(np.arccos(cosine)))
+    return out
+
+
+def _changing_reactions(dyn: h5py.Group) -> dict[str, np.ndarray]:
+    """The reactions whose force magnitude (kN) changes most over the run."""
+    if "reactions" not in dyn:
+        return {}
+    found = {name: np.linalg.norm(group["force"][()], axis=1) / 1e3
+             for name, group in dyn["reactions"].items() if "force" in group}
+    ranges = {name: float(np.ptp(v)) if len(v) else 0.0 for name, v in found.items()}
+    largest = max(ranges.values(), default=0.0)
+    ranked = sorted((n for n in found if ranges[n] > STILL * largest and largest > 0),
+                    key=lambda n: -ranges[n])
+    return {n: found[n] for n in ranked[:MAX_REACTION_CURVES]}
+
+
 def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
-    """Any dynamic result: each probe's deflection components (x, y, z in its frame) over
-    time (at most :data:`MAX_PROBE_PANELS` probes, then the largest-moving ones), and the
-    energies the file holds."""
+    """Any dynamic result, the quantities that move: each probe's deflection components
+    (in its frame, the basis named once in the title; probes and components that do not
+    move are left out and named below), each rope's swing angle, the reactions whose force
+    changes most, and the energies the file holds."""
     h5_path = Path(h5_path)
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
@@ -164,20 +209,40 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
         status = _text(h5.attrs.get("status", ""))
         label = _deflection_label(dyn)
         beam_frame = set(dyn.get("deflection_support", {}))
-    if len(probes) > MAX_PROBE_PANELS:
-        ranked = sorted(probes, key=lambda n: -float(np.abs(probes[n]).max(initial=0.0)))
-        probes = {n: probes[n] for n in ranked[:MAX_PROBE_PANELS]}
-    panels = len(probes) + (1 if energy else 0)
-    fig, axes = plt.subplots(max(panels, 1), 1, figsize=(9, 2.4 * max(panels, 1) + 0.6),
+        swing = _cable_swing(h5)
+        reactions = _changing_reactions(dyn)
+        size = float(h5["model"].attrs.get("length_scale", 1.0)) if "model" in h5 else 1.0
+    peaks = {n: float(np.abs(d).max(initial=0.0)) for n, d in probes.items()}
+    still = [n for n in probes if peaks[n] <= STILL * size]
+    moving = sorted((n for n in probes if n not in still), key=lambda n: -peaks[n])
+    left_out = [n for n in moving[MAX_PROBE_PANELS:]]
+    probes = {n: probes[n] for n in moving[:MAX_PROBE_PANELS]}
+    panels = len(probes) + (1 if swing else 0) + (1 if reactions else 0) + (1 if energy else 0)
+    fig, axes = plt.subplots(max(panels, 1), 1, figsize=(9, 2.2 * max(panels, 1) + 0.9),
                              sharex=True, constrained_layout=True, squeeze=False)
-    axes = axes[:, 0]
+    axes = list(axes[:, 0])
     for ax, (name, d) in zip(axes, probes.items()):
         for k, component in enumerate(_components(name in beam_frame)):
-            ax.plot(t, 1e3 * d[:, k], lw=1.0, label=component)
+            if np.abs(d[:, k]).max(initial=0.0) > STILL * size:
+                ax.plot(t, 1e3 * d[:, k], lw=1.0, label=component)
         ax.set_ylabel(f"{name} (mm)")
         ax.legend(fontsize=8, ncol=3, loc="upper left")
+    axes = axes[len(probes):]
+    if swing:
+        ax = axes.pop(0)
+        for name, (times, angle) in swing.items():
+            ax.plot(times, angle, lw=1.0, label=name)
+        ax.set_ylabel("rope swing (deg)")
+        ax.legend(fontsize=8, ncol=4, loc="upper left", title="chord from its direction at t = 0",
+                  title_fontsize=7)
+    if reactions:
+        ax = axes.pop(0)
+        for name, force in reactions.items():
+            ax.plot(t, force, lw=1.0, label=name)
+        ax.set_ylabel("reaction |F| (kN)")
+        ax.legend(fontsize=8, ncol=4, loc="upper left")
     if energy:
-        ax = axes[len(probes)]
+        ax = axes.pop(0)
         for key in ("kinetic", "strain", "gravity"):
             if key in energy:
                 ax.plot(t, energy[key], lw=1.0, label=key)
@@ -187,11 +252,18 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
             ax.plot(t, energy["drive_work"], ":", lw=1.0, label="drive work")
         ax.set_ylabel("energy (J)")
         ax.legend(fontsize=8, ncol=5, loc="upper left")
+    first, last = fig.axes[0], fig.axes[-1]
     if not panels:
-        axes[0].text(0.5, 0.5, "no probes and no energies in this file", ha="center",
-                     transform=axes[0].transAxes)
-    axes[-1].set_xlabel("time (s)")
-    axes[0].set_title(f"{title} ({status})\nprobe deflection: {label}", fontsize=9)
+        first.text(0.5, 0.5, "no probes and no energies in this file", ha="center",
+                   transform=first.transAxes)
+    last.set_xlabel("time (s)")
+    first.set_title(f"{title} ({status})\n" + textwrap.fill(f"probe deflection: {label}", 110),
+                    fontsize=9)
+    notes = ([f"not moving (not drawn): {', '.join(still)}"] if still else []) + \
+        ([f"not drawn (more than {MAX_PROBE_PANELS} probes): {', '.join(left_out)}"]
+         if left_out else [])
+    if notes:
+        fig.text(0.01, 0.002, "; ".join(notes), fontsize=7, color="0.4", va="bottom")
     save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png
@@ -203,7 +275,9 @@ def _components(support: bool) -> tuple[str, str, str]:
 
 
 def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
-    """Any static result: every probe's deflection components (mm) as grouped bars."""
+    """Any static result: the deformed structure over a grey ghost of the undeformed one
+    (scaled, the factor in the title) when the file has the mesh, and every probe's
+    deflection components (mm) as grouped bars."""
     h5_path = Path(h5_path)
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
@@ -213,9 +287,25 @@ def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
         title = _text(h5.attrs.get("title", h5_path.stem))
         method = _text(static.attrs.get("method", ""))
         label = _deflection_label(static)
+        shape = None
+        if "mesh_nodes" in static and "model/mesh" in h5:
+            ghost = h5["model/mesh/points"][()]
+            shape = (_mesh_segments(h5), ghost, static["mesh_nodes"][()] - ghost)
     names = list(probes)
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.2 * len(names) + 3), 3.8),
-                           constrained_layout=True)
+    width = max(6.0, 1.2 * len(names) + 3)
+    if shape is None:
+        fig, ax = plt.subplots(figsize=(width, 3.8), constrained_layout=True)
+    else:
+        fig, (ax_shape, ax) = plt.subplots(1, 2, figsize=(width + 5.0, 4.2),
+                                           constrained_layout=True,
+                                           gridspec_kw={"width_ratios": [1.2, 1.0]})
+        segments, ghost, displacement = shape
+        scale = shape_scale(ghost, displacement)
+        _draw_shape(ax_shape, segments, ghost, displacement, scale)
+        peak = 1e3 * float(np.linalg.norm(displacement, axis=1).max(initial=0.0))
+        ax_shape.set_title("deformed (blue) over undeformed (grey), displacements "
+                           + ("at true scale" if scale == 1.0 else f"x {scale:.3g}")
+                           + f"\nlargest displacement {peak:.4g} mm", fontsize=9)
     if names:
         d = 1e3 * np.array([probes[n] for n in names]).reshape(len(names), -1)
         x = np.arange(len(names))
@@ -227,7 +317,8 @@ def plot_general_static(h5_path: Path, png: str | Path | None = None) -> Path:
     else:
         ax.text(0.5, 0.5, "no probes in this file", ha="center", transform=ax.transAxes)
     ax.set_ylabel("deflection (mm)")
-    ax.set_title(f"{title} ({method})\nprobe deflection: {label}", fontsize=9)
+    ax.set_title(textwrap.fill(f"probe deflection: {label}", 70), fontsize=8)
+    fig.suptitle(f"{title} ({method})", fontsize=10)
     save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png
@@ -761,36 +852,18 @@ def plot_sweep(rows: list[dict], keys: list[str], outdir: Path) -> list[Path]:
         err_key = "err_vs_closed_form"
     else:
         err_key = "err_vs_finest"
-    pts = [r for r in ok if r.get(err_key, 0) > 0]
-    if pts and others:  # one series per family (the values of the non-refining keys)
-        path = pareto_chart(pts, lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in others),
-                            lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in mesh_keys),
-                            err_key, outdir / "error_vs_time.png")
-        out.append(path)
-    elif pts:
-        fig, ax = plt.subplots(figsize=(6, 4.2), constrained_layout=True)
-        groups = sorted({r.get(nodes_key, "") for r in pts}, key=_num)
-        markers = {dt: m for dt, m in zip(sorted({r.get("solver.dt", "") for r in pts},
-                                                 key=_num), "osD^v<>p*")}
-        for g in groups:
-            for dt, marker in markers.items():
-                sel = [r for r in pts if r.get(nodes_key, "") == g and r.get("solver.dt", "") == dt]
-                if not sel:
-                    continue
-                label = (_mesh_label(nodes_key, g) if nodes_key else "") + (
-                    f", dt {dt}" if len(markers) > 1 else "")
-                ax.loglog([r["total_time_s"] for r in sel], [r[err_key] for r in sel], marker,
-                          ms=5, color=f"C{groups.index(g) % 10}", label=label or None)
-        ax.set_xlabel("wall time per case (s)")
-        ax.set_ylabel(err_key.replace("_", " "))
-        ax.set_title("what accuracy costs in time")
-        ax.grid(alpha=0.3, which="both")
-        if nodes_key:
-            ax.legend(fontsize=8)
-        path = outdir / "error_vs_time.png"
-        save_figure(fig, path, dpi=120)
-        plt.close(fig)
-        out.append(path)
+    pts = [r for r in ok if r.get(err_key, 0) > 0 and r.get("compute_time_s", 0) > 0]
+    if pts:  # one series per family (the values of the non-refining keys)
+        def varies(key: str) -> bool:
+            return len({str(r.get(key)) for r in pts}) > 1
+        dt_keys = ["solver.dt"] if varies("solver.dt") else []
+        # a line per family (the values of the other keys that vary), a label per point
+        family_keys = [k for k in others if varies(k)] or dt_keys
+        point_keys = mesh_keys + [k for k in dt_keys if k not in family_keys]
+        out.append(pareto_chart(
+            pts, lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in family_keys) or "runs",
+            lambda r: ", ".join(f"{_short(k)} {r[k]}" for k in point_keys), err_key,
+            outdir / "error_vs_time.png", common_reference=err_key == "err_vs_reference"))
     return out
 
 
@@ -798,30 +871,61 @@ def _short(key: str) -> str:
     return key.rpartition(".")[2]
 
 
+#: the time axis of an accuracy-versus-time chart (results/hdf5.py, phase_times)
+COMPUTE_LABEL = ("computing time (s): model, assembly, factorization, solve\n"
+                 "(the file's /timing; start-up, reading and writing excluded)")
+
+
+def pareto_front(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The points no other point beats in both time and error (x: time, y: error), in
+    the order of time: the cheapest run for each accuracy."""
+    front: list[tuple[float, float]] = []
+    for x, y in sorted(points):
+        if not front or y < front[-1][1]:
+            front.append((x, y))
+    return front
+
+
 def pareto_chart(rows: list[dict], family, point_label, err_key: str, path: Path, *,
-                 time_key: str = "total_time_s", title: str = "what accuracy costs in time"
-                 ) -> Path:
-    """Error against wall time, one line per family (``family(row)``: its label; points
-    joined in the order of time, each annotated with ``point_label(row)``, e.g. the node
-    count or the modes). Used by ``ancf sweep`` (families: the values of the non-refining
-    keys) and benchmarks/accuracy_chart.py (several sweeps in one chart)."""
+                 time_key: str = "compute_time_s", title: str = "what accuracy costs in time",
+                 common_reference: bool = False) -> Path:
+    """Error against computing time on logarithmic axes. One colour per family
+    (``family(row)``: its label); each point annotated with ``point_label(row)`` (e.g. the
+    node count and the step); each family's line joins its Pareto front (the cheapest of
+    its runs for each accuracy), its other runs are hollow. With ``common_reference`` (every
+    error measured against the same reference, so the families are alternatives for one
+    problem) the front over all the families is drawn beneath in grey. Used by ``ancf
+    sweep`` (families: the values of the other varied keys) and
+    benchmarks/accuracy_chart.py."""
     fig, ax = plt.subplots(figsize=(8.5, 5.6), constrained_layout=True)
     families: dict[str, list[dict]] = {}
     for row in rows:
         families.setdefault(family(row), []).append(row)
+    if common_reference:
+        front = pareto_front([(float(r[time_key]), float(r[err_key])) for r in rows])
+        ax.plot([p[0] for p in front], [p[1] for p in front], color="0.75", lw=6, alpha=0.7,
+                zorder=0, label="cheapest for its accuracy, over all")
     markers = "osD^v<>p*hX"
     for i, (name, members) in enumerate(families.items()):
-        members = sorted(members, key=lambda r: float(r[time_key]))
-        x = [float(r[time_key]) for r in members]
-        y = [float(r[err_key]) for r in members]
-        ax.loglog(x, y, "-" + markers[i % len(markers)], ms=5, lw=1, color=f"C{i % 10}",
-                  label=name)
-        for r, xi, yi in zip(members, x, y):
+        colour, marker = f"C{i % 10}", markers[i % len(markers)]
+        points = [(float(r[time_key]), float(r[err_key])) for r in members]
+        front = pareto_front(points)
+        ax.plot([p[0] for p in front], [p[1] for p in front], "-" + marker, ms=5, lw=1.2,
+                color=colour, label=name)
+        others = [p for p in points if p not in front]
+        if others:
+            ax.plot([p[0] for p in others], [p[1] for p in others], marker, ms=5,
+                    mfc="none", color=colour)
+        for r, (xi, yi) in zip(members, points):
             ax.annotate(point_label(r), (xi, yi), textcoords="offset points", xytext=(3, 3),
-                        fontsize=6, color=f"C{i % 10}")
-    ax.set_xlabel(time_key.replace("_s", " (s)").replace("_", " "))
+                        fontsize=6, color=colour)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(COMPUTE_LABEL if time_key == "compute_time_s"
+                  else time_key.replace("_s", " (s)").replace("_", " "))
     ax.set_ylabel(err_key.replace("_", " "))
-    ax.set_title(title, fontsize=10)
+    ax.set_title(title + "\n(lines: each family's cheapest runs for their accuracy; "
+                 "hollow: beaten by a run of the same family)", fontsize=9)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7, loc="best")
     save_figure(fig, path, dpi=120)
@@ -974,6 +1078,33 @@ def _mesh_segments(h5: h5py.File) -> list[np.ndarray]:
     return out
 
 
+def _draw_shape(ax, segments: list[np.ndarray], base: np.ndarray, displacement: np.ndarray,
+                scale: float) -> None:
+    """The mesh at ``base`` (grey ghost) and displaced by ``scale`` x ``displacement``, seen
+    in the plane of the mesh's largest extent and the displacement's largest component."""
+    extent = np.ptp(base, axis=0)
+    along = int(np.argmax(extent))
+    moved = int(np.argmax(np.abs(displacement).max(axis=0, initial=0.0)
+                          + (np.arange(3) == along) * -1e9))
+    deformed = base + scale * displacement
+    for seg in segments:
+        ax.plot(base[seg, along], base[seg, moved], color="0.75", lw=0.8)
+        ax.plot(deformed[seg, along], deformed[seg, moved], color="C0", lw=1.2)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel(f"{'xyz'[along]} (m)")
+    ax.set_ylabel(f"{'xyz'[moved]} (m)")
+
+
+def shape_scale(base: np.ndarray, displacement: np.ndarray) -> float:
+    """The factor that draws a displacement field visibly: its largest displacement shown
+    as a tenth of the mesh's size, or 1 (true scale) when it is already larger."""
+    size = max(float(np.ptp(base, axis=0).max(initial=0.0)), 1e-12)
+    peak = float(np.abs(displacement).max(initial=0.0))
+    if peak == 0.0 or peak >= 0.1 * size:
+        return 1.0
+    return 0.1 * size / peak
+
+
 def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal",
                count: int = 4) -> Path:
     """The first mode shapes of a modal or buckling analysis: the mesh at the static state
@@ -988,8 +1119,7 @@ def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal
         damping = h5[f"{group}/damping_ratio"][:count] if "damping_ratio" in h5[group] else None
         segments = _mesh_segments(h5)
         title = _text(h5.attrs.get("title", ""))
-    extent = np.ptp(static, axis=0)
-    size = max(float(extent.max()), 1e-12)
+    size = max(float(np.ptp(static, axis=0).max()), 1e-12)
     n = len(shapes)
     fig, axes = plt.subplots(1, max(n, 1), figsize=(3.2 * max(n, 1), 3.2),
                              constrained_layout=True, squeeze=False)
@@ -997,15 +1127,7 @@ def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal
         if k >= n:
             ax.axis("off")
             continue
-        along = int(np.argmax(extent))
-        moved = int(np.argmax(np.abs(shapes[k]).max(axis=0) + (np.arange(3) == along) * -1e9))
-        deformed = static + 0.1 * size * shapes[k]
-        for seg in segments:
-            ax.plot(static[seg, along], static[seg, moved], color="0.75", lw=0.8)
-            ax.plot(deformed[seg, along], deformed[seg, moved], color="C0", lw=1.2)
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel(f"{'xyz'[along]} (m)")
-        ax.set_ylabel(f"{'xyz'[moved]} (m)")
+        _draw_shape(ax, segments, static, shapes[k], 0.1 * size)
         if group == "modal":
             label = f"mode {k + 1}: {values[k]:.4g} Hz"
             if damping is not None:

@@ -789,6 +789,7 @@ COLUMNS = [("tip_transverse", "static sag (mm)", 1e3, "{:.4f}"),
            ("factorizations", "factor.", 1, "{}"),
            ("dynamic_time_s", "dynamic (s)", 1.0, "{:.3f}"),
            ("eigen_time_s", "eigen (s)", 1.0, "{:.3f}"),
+           ("compute_time_s", "compute (s)", 1.0, "{:.3f}"),
            ("total_time_s", "case time (s)", 1.0, "{:.3f}"),
            ("status", "status", None, "{}")]
 

@@ -103,7 +103,9 @@ def _result_fields(outcome: Any, output: Path) -> dict:
     from .results.hdf5 import read_summary
     summary = read_summary(output)
     row: dict[str, Any] = dict(status="ok", message="", exit_code=0,
-                               total_time_s=summary["timing.total"], ndof=summary["model.ndof"])
+                               total_time_s=summary["timing.total"],
+                               compute_time_s=summary["timing.compute"],
+                               ndof=summary["model.ndof"])
     static, dynamic = outcome.static, outcome.dynamic
     if static is not None:
         row.update(iterations=static.iterations, residual=static.residual_norm,

@@ -548,6 +548,12 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
             _dataset(group, f"probes/{name}", position, "m")
         for name, deflection in model.deflections(result.e).items():
             _dataset(group, f"deflection/{name}", deflection, "m")
+        from .xdmf import MeshLayout, write_layout
+        layout = MeshLayout.from_model(model)
+        if layout is not None:  # the deformed shape (ancf plot, the static XDMF)
+            if "model/mesh" not in h5:
+                write_layout(h5, layout)
+            _dataset(group, "mesh_nodes", layout.positions(model, result.e[None, :])[0], "m")
         _attrs(group.attrs, {"method": result.method, "iterations": result.iterations,
                              "residual_norm": result.residual_norm,
                              "constraint_norm": result.constraint_norm,
@@ -581,6 +587,28 @@ def _write_path(group: h5py.Group, path: StaticPath) -> None:
 FINISH_BYTES = 64 * 1024
 
 
+def phase_times(timing: dict[str, float]) -> dict[str, float]:
+    """The phases SPEC section 4 names, summed over every analysis of a run (the static
+    solve, the settling solve before a dynamic run, the stepping, the modal and buckling
+    analyses): model build and assembly, factorization, solve, contact, output, total, and
+    ``compute``, the first three together: what the run's numbers cost, without the
+    process's start-up, the scene's reading and the writing of results (the time axis of
+    a sweep's accuracy-versus-time chart)."""
+    def summed(*names: str) -> float:
+        return float(sum(timing.get(name, 0.0) for name in names))
+    phases = {
+        "assembly": summed("model", "static_assembly", "settle_assembly", "modal_assembly"),
+        "factorization": summed("static_factorization", "settle_factorization",
+                                "dynamic_setup"),
+        "solve": summed("static_solve", "settle_solve", "dynamic_stepping", "modal_static",
+                        "modal_eigen", "buckling_total"),
+        "contact": 0.0,
+        "output": summed("output", "dynamic_output"),
+        "total": summed("total")}
+    phases["compute"] = phases["assembly"] + phases["factorization"] + phases["solve"]
+    return phases
+
+
 def finish(path: Path, model: Model, timing: dict[str, float], status: str,
            message: str = "") -> None:
     """Counters, timing and the final status (also after a failure or an interrupt)."""
@@ -600,13 +628,7 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
         # same name), summed over the analyses (dynamic stepping counts as solve: the
         # kernel's factorization-free steps are substitutions and residuals)
         _attrs(group.attrs, {**{k: float(v) for k, v in timing.items()},
-            "assembly": float(timing.get("static_assembly", 0.0) + timing.get("model", 0.0)),
-            "factorization": float(timing.get("static_factorization", 0.0)
-                                   + timing.get("dynamic_setup", 0.0)),
-            "solve": float(timing.get("static_solve", 0.0) + timing.get("dynamic_stepping", 0.0)),
-            "contact": 0.0,
-            "output": float(timing.get("output", 0.0) + timing.get("dynamic_output", 0.0)),
-            "total": float(timing.get("total", 0.0))}, fresh=True)
+                             **phase_times(timing)}, fresh=True)
         _attrs(h5.attrs, {
             "status": status, "message": message,
             "finished": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
