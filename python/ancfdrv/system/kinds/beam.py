@@ -295,7 +295,7 @@ def build(system, v: dict) -> Beam:
 
 def part_of(name: str, nodes: int) -> validate.Part:
     """A beam's share of the memory estimate."""
-    return validate.Part(f"beam[{name}]", "nodes", "beam", nodes, BEAM_NODE_DOFS)
+    return validate.Part(f"beam[{name}]", "nodes", "beam", nodes, BEAM_NODE_DOFS, sections=True)
 
 
 def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
