@@ -203,7 +203,7 @@ def test_output_stations_beyond_memory_is_refused_before_allocating(tmp_path, ca
 def test_output_memory_estimate_counts_elements_and_stations():
     """The estimate is BYTES_PER_STATION per element and station (a 10-node beam: 9
     elements), refused above half the memory available, named output.stations."""
-    estimate = validate.Estimate([validate.Part("beam", "nodes", "beam", 10, 12)])
+    estimate = validate.Estimate([validate.Part("beam", "nodes", "beam", 10, 12, sections=True)])
     output = {"stations": 1000}
     assert validate.output_bytes(estimate, output, None, "static") == 4096 * 9 * 1000
     room = 2 * (estimate.memory_bytes + 4096 * 9 * 1000)   # exactly the limit: accepted

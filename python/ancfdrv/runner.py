@@ -259,8 +259,7 @@ def _warn_large_ffr_deflection(model: Model, out: Path | MemoryOutput) -> None:
 # -- FFR modal reduction (&beam modes = N; solvers/ffr_reduced.py) --------------------------
 def modal_beam(model: Model):
     """The beam whose ``modes`` asks for the modal reduction (None: the full model)."""
-    from .system.kinds import Beam
-    beams = [b for b in model.bodies if isinstance(b, Beam) and getattr(b, "modes", 0)]
+    beams = [b for b in model.bodies if b.modes]
     return beams[0] if beams else None
 
 

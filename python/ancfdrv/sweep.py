@@ -279,42 +279,14 @@ def add_history_errors(rows: list[dict], varied: list[str]) -> None:
 
 
 def closed_form_error(scene_file: str, row: dict, base: list[str]) -> float | None:
-    """Relative error of the tip sag against the boom's closed form (None if not a boom)."""
-    from .reference.analytic import boom_static_tip_deflection
+    """Relative error of a successful case's response against its template's closed form
+    (:func:`ancfdrv.builders.closed_form_error`; None if the template has none)."""
+    from .builders import closed_form_error as template_error
     params = expand({k: row[k] for k in row if "." in k})
     scene = load_scene(scene_file, base + params)
     if row.get("status") != "ok":
         return None
-    if scene.kind == "plate":
-        return _navier_error(scene, row)
-    if scene.kind != "boom":
-        return None
-    effects, loads = scene.effects, scene["loads"]
-    beam, material = scene["beam"], scene["material"]
-    _, reference = boom_static_tip_deflection(
-        scene["boom"]["angle_deg"], loads["tip_mass"] if "tip_mass" in effects else 0.0,
-        length=beam["length"], a=beam["segments"][0], H=scene["boom"]["pivot_offset"],
-        width=beam["width"], height=beam["height"], youngs=material["youngs_modulus"],
-        density=material["density"], poisson=material["poisson_ratio"],
-        gravity=loads["gravity"] if "gravity" in effects else 0.0,
-        moment=loads["moment"] if "bending_moment" in effects else 0.0, shear=True)
-    row["tip_transverse_closed_form"] = reference
-    return abs(row["tip_transverse"] - reference) / max(abs(reference), 1e-300)
-
-
-def _navier_error(scene, row: dict) -> float | None:
-    """Simply supported plate under pressure alone: error of the centre deflection against
-    Navier's series (Timoshenko, Theory of Plates and Shells: 0.00406 q a^4 / D for the
-    square plate)."""
-    from .reference.analytic import navier_plate_centre_deflection
-    plate, material = scene["plate"], scene["material"]
-    if plate["support"] != "simply_supported" or set(scene.effects) != {"pressure"}:
-        return None
-    reference = -navier_plate_centre_deflection(
-        scene["loads"]["pressure"], plate["length_x"], plate["length_y"],
-        material["youngs_modulus"], material["poisson_ratio"], plate["thickness"])
-    row["response_closed_form"] = reference
-    return abs(row["response"] - reference) / max(abs(reference), 1e-300)
+    return template_error(scene, row)
 
 
 def _reference_groups(rows: list[dict], varied: list[str]):

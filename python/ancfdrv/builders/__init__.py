@@ -12,9 +12,12 @@ from .general import build_general
 
 BUILDERS = {"boom": boom.build, "cantilever": cantilever.build, "spinup": spinup.build,
             "plate": plate.build, "leaf": leaf.build, "spring": spring.build}
-#: what a template adds to a run (the runner knows no template): hook name -> function of
-#: the scene, by scene kind; a kind without the hook takes the default below
-RUN_HOOKS = {"boom": {"stage_bounds": boom.stage_bounds},
+#: what a template adds to a run and to a sweep's report (the runner and the sweep know no
+#: template): hook name -> function of the scene, by scene kind; a kind without the hook
+#: takes the default below
+RUN_HOOKS = {"boom": {"stage_bounds": boom.stage_bounds,
+                      "closed_form_error": boom.closed_form_error},
+             "plate": {"closed_form_error": plate.closed_form_error},
              "spring": {"settle_mode": spring.settle_mode}}
 
 
@@ -59,4 +62,15 @@ def settle_mode(scene) -> str:
     return hook(scene) if hook else scene["solver"]["settle"]
 
 
-__all__ = ["build_system", "build_model", "stage_bounds", "settle_mode", "BuiltSystem", "System"]
+def closed_form_error(scene, row: dict) -> float | None:
+    """The relative error of a successful static case's response (a sweep's row) against
+    the template's closed form, which the hook records in the row (the boom's tip sag:
+    :func:`ancfdrv.builders.boom.closed_form_error`; the simply supported plate's centre
+    deflection: :func:`ancfdrv.builders.plate.closed_form_error`); None for a scene without
+    one."""
+    hook = RUN_HOOKS.get(scene.kind, {}).get("closed_form_error")
+    return hook(scene, row) if hook else None
+
+
+__all__ = ["build_system", "build_model", "stage_bounds", "settle_mode", "closed_form_error",
+           "BuiltSystem", "System"]

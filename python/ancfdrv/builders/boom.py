@@ -70,6 +70,24 @@ def stage_bounds(scene) -> dict[str, tuple[float, float]] | None:
                                 scene["solver"]["t_end"])
 
 
+def closed_form_error(scene, row: dict) -> float:
+    """The sweep hook of the boom: the relative error of a static case's tip sag
+    (``row['tip_transverse']``) against the boom's closed form (shear included), which it
+    records in ``row['tip_transverse_closed_form']``."""
+    from ..reference.analytic import boom_static_tip_deflection
+    effects, loads = scene.effects, scene["loads"]
+    beam, material = scene["beam"], scene["material"]
+    _, reference = boom_static_tip_deflection(
+        scene["boom"]["angle_deg"], loads["tip_mass"] if "tip_mass" in effects else 0.0,
+        length=beam["length"], a=beam["segments"][0], H=scene["boom"]["pivot_offset"],
+        width=beam["width"], height=beam["height"], youngs=material["youngs_modulus"],
+        density=material["density"], poisson=material["poisson_ratio"],
+        gravity=loads["gravity"] if "gravity" in effects else 0.0,
+        moment=loads["moment"] if "bending_moment" in effects else 0.0, shear=True)
+    row["tip_transverse_closed_form"] = reference
+    return abs(row["tip_transverse"] - reference) / max(abs(reference), 1e-300)
+
+
 def _cable_boom(scene, built: BuiltSystem, steel, drive, a1, tangent, height, tip
                 ) -> BuiltSystem:
     """``beam.bending = 'cable'`` (issue 23): the boom as an ANCF cable (r and r_x per node,

@@ -51,3 +51,20 @@ def build(scene) -> BuiltSystem:
     # sweeps compare the displacement along r3: of the corner (pendulum), else the centre
     response = ("corner", 2) if support == "corner_spherical" else ("centre", 2)
     return BuiltSystem(s, response)
+
+
+def closed_form_error(scene, row: dict) -> float | None:
+    """The sweep hook of the plate: a simply supported plate under pressure alone, the
+    relative error of a static case's centre deflection (``row['response']``) against
+    Navier's series (Timoshenko, Theory of Plates and Shells: 0.00406 q a^4 / D for the
+    square plate), which it records in ``row['response_closed_form']``; None for other
+    supports or loads."""
+    from ..reference.analytic import navier_plate_centre_deflection
+    plate, material = scene["plate"], scene["material"]
+    if plate["support"] != "simply_supported" or set(scene.effects) != {"pressure"}:
+        return None
+    reference = -navier_plate_centre_deflection(
+        scene["loads"]["pressure"], plate["length_x"], plate["length_y"],
+        material["youngs_modulus"], material["poisson_ratio"], plate["thickness"])
+    row["response_closed_form"] = reference
+    return abs(row["response"] - reference) / max(abs(reference), 1e-300)

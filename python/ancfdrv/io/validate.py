@@ -417,6 +417,9 @@ class Part:
     kind: str             # a key of NONZEROS_PER_COORDINATE
     nodes: int
     per_node: int         # coordinates per node
+    #: its elements keep section forces and stresses at output.stations (a beam's): the
+    #: output memory (:func:`output_bytes`)
+    sections: bool = False
 
 
 @dataclass
@@ -456,7 +459,7 @@ def _grid(nx: int, ny: int) -> int:
 def estimate_template(values: dict[str, dict[str, Any]], kind: str) -> Estimate:
     """The size of a template scene's model (after the schema checks)."""
     if kind in ("boom", "cantilever", "spinup"):
-        return Estimate([Part("beam", "nodes", "beam", values["beam"]["nodes"], 12)])
+        return Estimate([Part("beam", "nodes", "beam", values["beam"]["nodes"], 12, True)])
     if kind in ("plate", "leaf"):
         v = values[kind]
         return Estimate([Part(kind, "nx", "plate", _grid(v["nx"], v["ny"]), 9)])
@@ -476,9 +479,10 @@ def estimate_general(items: list[tuple[str, dict[str, Any]]]) -> Estimate:
     for group, v in items:
         label = f"{group}[{v['name']}]"
         if group == "beam":
-            parts.append(Part(label, "nodes", "beam", v["nodes"], 12))
-        elif group == "cable":  # half a beam node's coordinates, a beam's coupling
-            parts.append(Part(label, "nodes", "beam", v["nodes"], 6))
+            parts.append(Part(label, "nodes", "beam", v["nodes"], 12, True))
+        elif group == "cable":  # half a beam node's coordinates, a beam's coupling (and, as
+            # a beam's, its elements' share of the section output memory)
+            parts.append(Part(label, "nodes", "beam", v["nodes"], 6, True))
         elif group in ("plate", "leaf"):
             parts.append(Part(label, "nx", group, _grid(v["nx"], v["ny"]), 9))
         elif group == "rigid_body":
@@ -596,7 +600,7 @@ def output_bytes(estimate: Estimate, output: dict[str, Any], solver: dict[str, A
                  analysis: str) -> int:
     """The memory the beams' section forces and stresses take (``output.stations`` points
     per element, and with ``output.sections`` every row of a dynamic run): bytes."""
-    elements = sum(max(p.nodes - 1, 1) for p in estimate.parts if p.kind == "beam")
+    elements = sum(max(p.nodes - 1, 1) for p in estimate.parts if p.sections)
     stations = int(output.get("stations", 3))
     need = BYTES_PER_STATION * elements * stations
     if (output.get("sections") and solver is not None

@@ -37,7 +37,6 @@ import numpy as np
 
 from .._version import __version__
 from ..errors import InputError
-from ..system.kinds import Beam
 from ..system.model import Model
 from ..io.safe_write import check_room, create_fresh
 from ..io.scene import Scene
@@ -486,7 +485,7 @@ def create(path: Path, scene: Scene, model: Model) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     create_fresh(path)  # never write through a symbolic link planted at the name
     check_room(path, 16 * model.ndof * 8)  # a full disk: refused before HDF5 writes
-    beams = [b for b in model.bodies if isinstance(b, Beam)]
+    bending = next((b.bending for b in model.bodies if b.bending is not None), None)
     with _open_write(path, "w-") as h5:
         _attrs(h5.attrs, {
             **provenance(),
@@ -507,7 +506,7 @@ def create(path: Path, scene: Scene, model: Model) -> None:
             "linear_joints": model.linear_joints,
             "iteration_matrix": "constant" if model.constant_policy else "refactorized",
             # 'continuum' or 'cubic' (beam.bending) of the first beam
-            **({"bending": beams[0].bending} if beams else {}),
+            **({"bending": bending} if bending is not None else {}),
         }, fresh=True)
         group = _subgroup(h5, "model")
         model_attrs = dict(model.summary())
@@ -516,6 +515,7 @@ def create(path: Path, scene: Scene, model: Model) -> None:
             _dataset(group, "nodes", geometry[0], "m")
             elements = _dataset(group, "elements", geometry[1], "index")
             elements.attrs["description"] = "corner nodes of each element (0-based rows of nodes)"
+        beams = [b for b in model.bodies if b.section_directors]  # lines with a section
         if len(beams) == 1:
             _dataset(group, "node_s", beams[0].stations, "m")
         elif not beams:  # another line family alone (a cable: 6 coordinates per node)

@@ -18,7 +18,6 @@ from ..codes import (CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANC
 from ..csr import Csr
 from ..errors import InputError
 from .bodies import Body, Ground, rotation_about
-from .kinds import Beam
 from .constraint_set import ConstraintSet
 from .drives import Constant
 from .registry import SetContext, set_builder
@@ -221,10 +220,11 @@ def _select(system, active: set[str], warnings: list[str]) -> _Active:
 
 # -- frames and element sets -----------------------------------------------------------------
 def _frames(bodies: list[Body], drive_index: dict) -> tuple[list[FrameInfo], dict[str, int]]:
-    """One frame per beam (its body frame, turned by its frame drive): 1-based ids."""
+    """One frame per framed body (``Body.framed``: a beam's body frame, turned by its frame
+    drive): 1-based ids."""
     frames, beam_frame = [], {}
     for body in bodies:
-        if not isinstance(body, Beam) and getattr(body, "frame_drive", None) is None:
+        if not body.framed:
             continue  # (a cable may carry a frame for its probes' deflection: builders/boom.py)
         drive = body.frame_drive
         base = body.orientation
@@ -361,29 +361,11 @@ def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list
     for load in loads:
         body = load.body
         axis = load.vector / np.linalg.norm(load.vector)
-        for at, share in _moment_nodes(body, load):
+        for at, share in body.moment_attachments(load.point, f"load {load.name!r}"):
             out += _moment_parts(body, at, load, axis, share * float(np.linalg.norm(load.vector)),
                                  q0)
         counters[load.effect] += 1
     return out
-
-
-def _moment_nodes(body: Body, load) -> list[tuple]:
-    """Where a moment acts: (attachment, share) at a node, or on a beam between nodes the
-    two nodes of its element in the shares (1 - xi, xi) by which its directors r_y, r_z
-    interpolate them there (the virtual work of the moment on the interpolated section's
-    turn); the point's offset from the axis does not matter for a moment."""
-    what = f"load {load.name!r}"
-    if body.rigid:
-        return [(body.locate(load.point, node=False, what=what), 1.0)]
-    if isinstance(body, Beam):
-        at = body.locate(load.point, node=False, what=what)
-        if at.node is not None:
-            return [(at, 1.0)]
-        xi = at.local[0]
-        nodes = [(at.element, 1.0 - xi), (at.element + 1, xi)]
-        return [(type(at)(node, at.element, at.local), w) for node, w in nodes if w > 0.0]
-    return [(body.locate(load.point, node=True, what=what), 1.0)]
 
 
 def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
@@ -448,7 +430,7 @@ def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
     for load in chosen:
         body = load.body
         at = body.locate(load.point, node=False, what=f"load {load.name!r}")
-        names = ("r_y", "r_z") if isinstance(body, Beam) else ("r_x", "r_y")
+        names = body.section_directors or ("r_x", "r_y")
         a, b = (body.vector(at, w) for w in names)
         p = body.position(at)
         a0, b0 = a.value(q0), b.value(q0)
@@ -732,7 +714,7 @@ def _anchors(body: Body, joints) -> set:
     return out
 
 
-def _turned_by(beam: Beam, component: set, joints) -> str:
+def _turned_by(beam: Body, component: set, joints) -> str:
     """Why an 'ffr' beam in a fixed frame cannot stay in it ('' when it can): no weld, fixed
     hub or fixed section director clamps it to the ground, and a joint with a moving drive ('distance' as a
     cylinder, 'prescribed', 'hub', 'arm') acts in the assembly it belongs to, so the drive
@@ -767,7 +749,7 @@ def ffr_frame_problems(system) -> list[str]:
     joints = list(system.joints.values())
     problems = []
     for beam in system.bodies.values():
-        if not isinstance(beam, Beam) or beam.formulation != "ffr":
+        if not beam.floating:
             continue
         component, todo = {beam}, [beam]
         while todo:  # the bodies joined to the beam, directly or through others
@@ -900,7 +882,7 @@ def _policy(model: Model) -> None:
         if full[0] % 3 or np.any(np.diff(full) != 1):
             return  # a reduced 3-vector that is not one nodal vector
         body = owner[full[0]]
-        if isinstance(body, Beam):
+        if body.floating:  # an FFR beam: its own frame's
             f = frame_of_body[body.name]
             vector_frame[v] = f if model.frames[f - 1].drive >= 0 else 0
         elif len(moving) == 1:

@@ -158,6 +158,29 @@ class Body:
     surface = False
     #: the component of a probe's deflection a sweep compares by default (r3; a beam r2)
     response_component = 2
+    #: its elastic model lives in a floating frame, with small strain (an 'ffr' beam): the
+    #: FFR checks and solvers
+    floating = False
+    #: the drive turning its own frame about a fixed axis (None: the frame, if it has one,
+    #: keeps its t = 0 orientation): a beam's ``frame_drive``; a cable may carry one for its
+    #: probes' deflection (builders/boom.py)
+    frame_drive = None
+    #: the directors of its cross-section, a section that turns apart from the tangent r_x
+    #: (a beam's r_y, r_z; empty: none): welds and hinge axes hold the section, a moment
+    #: between nodes acts on the element's two sections, a beam with joints gets a support
+    #: frame (supports.py), a driven or follower load is resolved on them (others: r_x, r_y)
+    section_directors: tuple[str, ...] = ()
+    #: its elements' bending option ('continuum' or 'cubic' for a beam; None: no option)
+    bending: str | None = None
+    #: modes of the modal reduction of its coordinates (0: every coordinate integrated; a
+    #: beam's ``modes``, solvers/ffr_reduced.py)
+    modes = 0
+
+    @property
+    def framed(self) -> bool:
+        """It has a frame of its own (the assembly's FrameInfo): a body with a frame drive;
+        a beam always (its body frame)."""
+        return self.frame_drive is not None
 
     @property
     def nnodes(self) -> int:
@@ -224,6 +247,11 @@ class Body:
         """How a moment about the normal of its two directors divides between them: halves
         (a beam's section: by its shear and bending rule)."""
         return 0.5, 0.5
+
+    def moment_attachments(self, point, what: str) -> list[tuple[Attachment, float]]:
+        """Where a moment at the point acts, each attachment with its share of it: a rigid
+        body at the point, a flexible body at its node there (a beam also between nodes)."""
+        return [(self.locate(point, node=not self.rigid, what=what), 1.0)]
 
 
 class Ground(Body):

@@ -23,7 +23,7 @@ def ffr_speed_warnings(system) -> list[str]:
     bending frequency (FFR has no geometric, centrifugal, stiffening)."""
     out = []
     for beam in system.bodies.values():
-        if not isinstance(beam, Beam) or beam.formulation != "ffr" or beam.frame_drive is None:
+        if not beam.floating or beam.frame_drive is None:
             continue
         drive = beam.frame_drive
         params = drive.params()

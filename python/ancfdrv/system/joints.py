@@ -318,7 +318,7 @@ class Joint:
         for which in held.held_vectors(at_h):
             v = held.vector(at_h, which)
             ties.append((which, v, _express(basis, initial, v.value(q0), f"joint {name!r}")))
-        if isinstance(base, Beam) and any(coef[0] != 0.0 for *_, coef in ties):
+        if base.section_directors and any(coef[0] != 0.0 for *_, coef in ties):
             return out + _section_ties(base, at_b, held, at_h, ties, q0, name)
         for which, v, coef in ties:
             out += vector_equations(v, combination(basis, coef), f"{name}: {which}")
@@ -551,15 +551,10 @@ def _product(u: list[Scalar], v: list[Scalar], value: float, name: str, prefer: 
 
 
 def small_turn(body: Body) -> bool:
-    """Whether the body is a beam whose section turns are small and kinematics linear (FFR
-    in a fixed frame, :func:`_small_turn`)."""
-    return isinstance(body, Beam) and _small_turn(body)
-
-
-def _small_turn(beam: Beam) -> bool:
-    """Whether the beam's section turns are small and its kinematics linear (FFR, fixed
-    frame): then directions it carries are linear in its coordinates (:func:`_turned`)."""
-    return beam.formulation == "ffr" and beam.frame_drive is None
+    """Whether the body's section turns are small and its kinematics linear (a floating
+    body in a fixed frame: an FFR beam without a frame drive): then directions it carries
+    are linear in its coordinates (:func:`_turned`)."""
+    return body.floating and body.frame_drive is None
 
 
 def _weld_roles(body1: Body, at1: Attachment, body2: Body, at2: Attachment
@@ -568,7 +563,7 @@ def _weld_roles(body1: Body, at1: Attachment, body2: Body, at2: Attachment
     follow the base's directions. A rigid body welded to a flexible body, whatever the
     order the joint names them in:
 
-    * to an FFR beam in a fixed frame (:func:`_small_turn`): the beam is the base and the
+    * to an FFR beam in a fixed frame (:func:`small_turn`): the beam is the base and the
       body's axes follow its section's small turn v0 + w x v0 (:func:`_turned`, linear).
       Tying the beam's directors to the body's orthonormal axes instead would hold them at
       unit length through a finite turn: the FFR element's linear section strains would
@@ -594,7 +589,7 @@ def _turned(beam: Beam, at: Attachment, v0: np.ndarray) -> list[Scalar]:
     w_y = d_z . e_x, w_z = -d_y . e_x. Free of the section's stretch and shear, and of the
     centre line's slope r_x (which also turns with the shear strain)."""
     e = beam.orientation.T   # rows e_x, e_y, e_z
-    d_y, d_z = (beam.vector(at, w) for w in ("r_y", "r_z"))
+    d_y, d_z = (beam.vector(at, w) for w in beam.section_directors)
     s_y, s_z = beam.torsion_shares()
     rotation = [d_y.along(e[2]).scaled(s_y) - d_z.along(e[1]).scaled(s_z), d_z.along(e[0]),
                 d_y.along(e[0]).scaled(-1.0)]
@@ -628,13 +623,14 @@ def _carried(body: Body, at: Attachment, k0: np.ndarray, q0: np.ndarray, name: s
         return [Scalar({}, float(c)) for c in k0], []
     basis = body.basis(at)
     coef = _express(basis, [b.value(q0) for b in basis], k0, f"joint {name!r}")
-    if isinstance(body, Beam):
-        if _small_turn(body):
+    if body.section_directors:
+        if small_turn(body):
             return _turned(body, at, k0), []
         if coef[0] == 0.0:
-            directors = [body.vector(at, w) for w in ("r_y", "r_z")]
+            names = list(body.section_directors)
+            directors = [body.vector(at, w) for w in names]
             return combination(directors, coef[1:]).components(), \
-                _kept(body, at, ["r_y", "r_z"], q0, name)
+                _kept(body, at, names, q0, name)
     return combination(basis, coef).components(), []
 
 
@@ -656,14 +652,15 @@ def _section_ties(base: Beam, at_b: Attachment, held: Body, at_h: Attachment, ti
       these ties measure rotations only (a rigid connector at the joint).
     """
     out: list[Equation] = []
-    if _small_turn(base):
+    if small_turn(base):
         for which, v, _ in ties:
             turned = _turned(base, at_b, v.value(q0))
             out += [LinearEquation(v.component(i) - turned[i],
                                    f"{name}: {which} [{'xyz'[i]}] (section turn)", _dofs(v, i))
                     for i in range(3)]
         return out
-    directors = [base.vector(at_b, w) for w in ("r_y", "r_z")]
+    names = list(base.section_directors)
+    directors = [base.vector(at_b, w) for w in names]
     for which, v, coef in ties:
         if coef[0] == 0.0:
             out += vector_equations(v, combination(directors, coef[1:]), f"{name}: {which}")
@@ -671,8 +668,8 @@ def _section_ties(base: Beam, at_b: Attachment, held: Body, at_h: Attachment, ti
         w = v - combination(directors, coef[1:])
         prefer = [d for i in range(3) for d in _dofs(v, i)]
         out += [_dot(w, d, q0, f"{name}: {which} normal to {base.name}'s {dn}", prefer)
-                for d, dn in zip(directors, ("r_y", "r_z"))]
-    return out + _kept(base, at_b, ["r_y", "r_z"], q0, name) + \
+                for d, dn in zip(directors, names)]
+    return out + _kept(base, at_b, names, q0, name) + \
         _kept(held, at_h, held.held_vectors(at_h), q0, name)
 
 

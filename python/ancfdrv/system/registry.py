@@ -32,10 +32,12 @@ A kind declares
   the writer's row builder, ``mesh_order``: the kinds' order in the mesh).
 
 What a body answers about itself (its size, its nodes, its mid-surface, the probe component
-a sweep compares) is a property of its class (:class:`~.bodies.Body`). A dynamic
-state's section forces are still re-derived for beams in numpy (:mod:`.answers`), and a few
-per-kind branches of the assembly and the joints still test concrete classes
-(tests/test_kinds_registry.py counts those checks and only lets the count go down).
+a sweep compares, whether it floats in a frame and has a frame of its own, its section's
+directors, where a moment on it acts, its bending option and modal reduction) is a property
+of its class (:class:`~.bodies.Body`): the assembly, the joints, the supports and the writers
+ask it instead of testing its class. A dynamic state's section forces are still re-derived
+for beams in numpy (:mod:`.answers`, which still tests a beam's formulation:
+tests/test_kinds_registry.py counts those checks and only lets the count go down).
 
 Each family of elements is one Fortran module (an extension of ``element_set`` in
 ``fortran/src/system/element_sets.f90``, built by one ``system_add_<kind>_set`` routine)

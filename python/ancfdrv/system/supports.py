@@ -93,7 +93,7 @@ def support_frames(system) -> dict[str, SupportFrame]:
     must be numbered: call after ``System.assemble``)."""
     out = {}
     for beam in system.bodies.values():
-        if not isinstance(beam, Beam):
+        if not beam.section_directors:  # no section (not a beam) for the frame to follow
             continue
         points: list[tuple[str, np.ndarray]] = []
         for joint in system.joints.values():
@@ -112,7 +112,7 @@ def support_frames(system) -> dict[str, SupportFrame]:
         end = beam.position(beam.locate(far[1], node=False, what=where)) if has_end else None
         joints = (name_a, far[0]) if has_end and far[0] != name_a else (name_a,)
         out[beam.name] = SupportFrame(beam.name, joints, beam.position(at_a), end,
-                                      beam.vector(at_node, "r_y"), beam.vector(at_node, "r_z"))
+                                      *(beam.vector(at_node, w) for w in beam.section_directors))
     return out
 
 

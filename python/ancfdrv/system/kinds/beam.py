@@ -40,6 +40,17 @@ class Beam(Body):
 
     flexible = True
     response_component = 1
+    section_directors = ("r_y", "r_z")
+
+    @property
+    def floating(self) -> bool:
+        """Formulation 'ffr': small strain in its floating frame."""
+        return self.formulation == "ffr"
+
+    @property
+    def framed(self) -> bool:
+        """Always: its body frame (turned by ``frame_drive`` when given)."""
+        return True
 
     @property
     def nnodes(self) -> int:
@@ -175,7 +186,7 @@ class Beam(Body):
         return ["r_y", "r_z"]  # the cross-section (a section clamp); r_x may shear and stretch
 
     def directors(self, at: Attachment) -> list[str]:
-        return ["r_y", "r_z"]
+        return list(self.section_directors)
 
     # -- what the assembly asks of a flexible body besides its set ---------------------------
     def point_mass(self, at: Attachment, mass: float) -> np.ndarray:
@@ -197,6 +208,18 @@ class Beam(Body):
             return 0.5, 0.5
         data = self.section.data
         return data.inertia_z / data.polar, data.inertia_y / data.polar
+
+    def moment_attachments(self, point, what: str) -> list[tuple[Attachment, float]]:
+        """At a node, or between nodes the two nodes of its element in the shares
+        (1 - xi, xi) by which its directors r_y, r_z interpolate them there (the virtual
+        work of the moment on the interpolated section's turn); the point's offset from the
+        axis does not matter for a moment."""
+        at = self.locate(point, node=False, what=what)
+        if at.node is not None:
+            return [(at, 1.0)]
+        xi = at.local[0]
+        nodes = [(at.element, 1.0 - xi), (at.element + 1, xi)]
+        return [(Attachment(node, at.element, at.local), w) for node, w in nodes if w > 0.0]
 
 
 KEYS: dict[str, Key] = {
@@ -272,7 +295,7 @@ def build(system, v: dict) -> Beam:
 
 def part_of(name: str, nodes: int) -> validate.Part:
     """A beam's share of the memory estimate."""
-    return validate.Part(f"beam[{name}]", "nodes", "beam", nodes, BEAM_NODE_DOFS)
+    return validate.Part(f"beam[{name}]", "nodes", "beam", nodes, BEAM_NODE_DOFS, sections=True)
 
 
 def _beam_set(beam: Beam, context: SetContext) -> SetInfo:
