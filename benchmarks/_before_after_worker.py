@@ -104,7 +104,7 @@ def dispatch(scene_path: str, steps: int, repeats: int, overrides: list[str]) ->
     def advance(integrator, s: dict, n: int) -> None:
         chunk, info, detail = integrator.advance(s, n)
         if info:
-            raise RuntimeError(integrator.failure_message(info, detail, s["t"]))
+            raise RuntimeError(f"step failed at t = {s['t']}: kernel code {info} ({detail})")
 
     def release(model, integrator) -> None:
         close = getattr(model, "close", None) or getattr(integrator, "close", None)
@@ -126,7 +126,10 @@ def dispatch(scene_path: str, steps: int, repeats: int, overrides: list[str]) ->
                 kernel = model.kernel
                 for _ in range(calls):
                     # (the settings go to the kernel once per run since issue 25)
-                    out = kernel.advance(1, settings.dt, s, False) \
+                    # (the step-size control in the kernel since issue 36: rows, not h)
+                    out = kernel.advance(1, s, False) \
+                        if hasattr(kernel, "consistent_acceleration") else \
+                        kernel.advance(1, settings.dt, s, False) \
                         if hasattr(kernel, "stepper_setup") else \
                         kernel.advance(1, settings, s, False)
                     if out["status"][1]:

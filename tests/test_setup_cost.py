@@ -2,9 +2,9 @@
 result file): each shortcut must give what the general way gives.
 
 References: the kernel's constraint evaluation of every row (the reactions' constant
-operand gradients), a MUMPS instance made for the one solve (the reused saddle solvers),
-the initial acceleration solved by the integrator itself (an integrator handed it), and
-the equations of motion (the residual of the initial acceleration)."""
+operand gradients), the initial acceleration solved by the integrator itself (an
+integrator handed it), and the equations of motion (the residual of the initial
+acceleration)."""
 from __future__ import annotations
 
 import numpy as np
@@ -67,64 +67,6 @@ def test_state_dependent_gradients_are_evaluated():
     try:
         assert len(model.constraints)
         assert answers.reaction_map(model).constant_gradients() is None
-    finally:
-        model.close()
-
-
-@pytest.mark.parametrize("scene", ["hard/pendulum.nml", "boom_luffing.nml", "hard/spinup.nml",
-                                   "plate_pendulum.nml"])
-def test_reused_saddle_solver_gives_a_fresh_solvers_answer(scene, monkeypatch):
-    """The initial acceleration from a reused MUMPS instance (analysed anew after other
-    models' systems) is bitwise that of an instance made for it, and it satisfies the
-    equations of motion and Phi_e a = gamma (MUMPS for every size: the dense solve of
-    small systems is compared with it in test_dense_saddle.py)."""
-    monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 0)
-    other = _model("hard/spinup.nml")
-    model = _model(scene)
-    try:
-        v = np.zeros(model.ndof)
-        dynamic.initial_acceleration(other, other.e0, np.zeros(other.ndof), 0.0)
-        assert dynamic._SADDLE_SOLVERS   # an instance waits for reuse
-        reused = dynamic.initial_acceleration(model, model.e0, v, 0.0)
-        size = dynamic.SADDLE_REUSE_MAX
-        try:
-            dynamic.SADDLE_REUSE_MAX = -1   # every system gets its own instance
-            fresh = dynamic.initial_acceleration(model, model.e0, v, 0.0)
-        finally:
-            dynamic.SADDLE_REUSE_MAX = size
-        assert np.array_equal(reused[0], fresh[0]) and np.array_equal(reused[1], fresh[1])
-        a, lam = reused
-        forces = model.forces(model.e0, 0.0, v)
-        _, rows, cols, grads = model.constraints.jacobian(model.e0, model.ndof, 0.0)
-        phi_e = np.zeros((len(model.constraints), model.ndof))
-        np.add.at(phi_e, (rows, cols), grads)
-        residual = model.mass.toarray() @ a - phi_e.T @ lam - (forces["external"]
-                                                               - forces["internal"])
-        scale = np.abs(forces["external"] - forces["internal"]).max() + \
-            np.abs(phi_e.T @ lam).max()
-        assert np.abs(residual).max() <= 1e-9 * scale
-        *_, gamma = model.constraints.evaluate(model.e0, 0.0, v)
-        assert np.allclose(phi_e @ a, gamma, rtol=0, atol=1e-9 * (1 + np.abs(a).max()))
-    finally:
-        model.close()
-        other.close()
-
-
-def test_a_failed_saddle_solve_releases_its_solver(monkeypatch):
-    """A solve that fails does not return its (possibly broken) instance for reuse."""
-    monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 0)   # MUMPS for every size
-    model = _model("hard/pendulum.nml", PENDULUM)
-    try:
-        dynamic.initial_acceleration(model, model.e0, np.zeros(model.ndof), 0.0)
-        waiting = len(dynamic._SADDLE_SOLVERS)
-        assert waiting >= 1
-
-        def broken(self, values):
-            raise dynamic.SolverError("factorization failed (test)")
-        monkeypatch.setattr(dynamic.DirectSolver, "factorize", broken)
-        with pytest.raises(dynamic.SolverError):
-            dynamic.initial_acceleration(model, model.e0, np.zeros(model.ndof), 0.0)
-        assert len(dynamic._SADDLE_SOLVERS) == waiting - 1
     finally:
         model.close()
 
@@ -471,32 +413,6 @@ def test_gradients_of_an_evaluation_with_velocities():
         v = np.linspace(-1.0, 1.0, model.ndof)
         with_v = cs.gradient_rows(e, model.ndof, 0.3, cs.evaluate(e, 0.3, v))
         assert np.array_equal(with_v, cs.gradient_rows(e, model.ndof, 0.3))
-    finally:
-        model.close()
-
-
-@pytest.mark.parametrize("scene", ["hard/pendulum.nml", "boom_luffing.nml", "leaf_spring.nml"])
-def test_kept_analysis_gives_a_fresh_solvers_answer(scene, monkeypatch):
-    """Consecutive initial accelerations of one model (the same saddle pattern: the
-    reused instance keeps its analysis and only refactorizes) at different states are
-    bitwise those of instances made for each (MUMPS for every size)."""
-    monkeypatch.setattr(dynamic, "DENSE_SADDLE_MAX", 0)
-    model = _model(scene)
-    try:
-        def solve(k: int):
-            v = np.full(model.ndof, 0.01 * k)
-            return dynamic.initial_acceleration(model, model.e0 * (1 + 1e-4 * k), v, 0.1 * k)
-        kept = [solve(k) for k in range(3)]
-        assert dynamic._SADDLE_SOLVERS[-1].saddle_pattern is not None
-        size = dynamic.SADDLE_REUSE_MAX
-        try:
-            dynamic.SADDLE_REUSE_MAX = -1
-            fresh = [solve(k) for k in range(3)]
-        finally:
-            dynamic.SADDLE_REUSE_MAX = size
-        for (a, lam), (b, mu) in zip(kept, fresh):
-            assert np.array_equal(a, b) and np.array_equal(lam, mu)
-        assert not np.array_equal(kept[0][0], kept[2][0])   # the states differ
     finally:
         model.close()
 

@@ -101,23 +101,23 @@ def test_advance_errors_carry_the_kernels_text():
                  guesses=model.contact_guesses.copy(), counts=np.zeros(6, dtype=np.int32))
     try:
         with pytest.raises(SolverError, match="no run set up .call system_stepper_setup"):
-            kernel.advance(1, 1e-3, dict(state), False)
+            kernel.advance(1, dict(state), False)
         with pytest.raises(SolverError, match="stepper_setup.*code 2: system_stepper_setup: "
                                               "a setting out of its range"):
             kernel.stepper_setup(DynamicSettings(dt=1e-3, t_end=1.0, contraction=1.5))
-        settings = DynamicSettings(dt=1e-3, t_end=1.0, max_newton=1)
+        settings = DynamicSettings(dt=1e-3, t_end=1.0, max_newton=1, dt_min=1e-3)  # no cut
         integrator = TimeIntegrator(model, settings)
         run = integrator.state(0.0, model.e0, v0, a0, lam0)
         kernel.ndof += 3    # the caller's bug: a state of another system's size
         wrong = {k: np.zeros(model.ndof + 3) if k in ("e", "v", "a", "accel") else v
                  for k, v in run.items()}
         with pytest.raises(SolverError, match="system_advance: sizes inconsistent"):
-            kernel.advance(1, 1e-3, wrong, False)
+            kernel.advance(1, wrong, False)
         kernel.ndof -= 3
         chunk, info, detail = integrator.advance(run, 1)
         assert (info, detail, len(chunk.time)) == (1, 0, 0)
         assert integrator.failure_text == "Newton did not converge within 1 iterations"
-        message = integrator.failure_message(info, detail, 0.0)
+        message = integrator.failure_message(info, detail)
         assert message.startswith("time step from t = 0 s to t = 0.001 s failed: Newton did "
                                   "not converge within 1 iterations (last correction")
     finally:
@@ -126,6 +126,6 @@ def test_advance_errors_carry_the_kernels_text():
     kernel.handle = handle   # destroyed: a stale handle
     try:
         with pytest.raises(SolverError, match=f"handle {handle} is not a live system"):
-            kernel.advance(1, 1e-3, state, False)
+            kernel.advance(1, state, False)
     finally:
         kernel.handle = 0

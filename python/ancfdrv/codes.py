@@ -71,6 +71,12 @@ KERNEL_LAYOUTS: dict[str, tuple[str, ...]] = {
     "sc": ("check_start", "load_step", "load_steps"),    # its controls
     "sr": ("force_scale", "force_res", "con_res"),       # its residual scales
     "so": ("info", "iterations", "converged_by", "factorizations"),  # its outcome
+    "sk": ("dt", "dt_min", "adaptive", "tolerance"),     # the stepper's step-size control
+    "at": ("corrections", "factorizations", "jacobians", "substeps", "cuts"),  # rows' stats
+    "as": ("rows", "info", "detail", "floor_accepts", "tries", "failure_cuts",
+           "failure_tries", "failed_corrections", "failed_factorizations",
+           "failed_jacobians", "cuts", "rejected", "restarts", "taken"),  # an advance's status
+    "af": ("last_correction", "failure_t", "failure_h", "smallest"),  # and its figures
     "tp": ("rows", "cols"),                              # a pattern's coordinates (columns)
     "sl": ("handle", "policy"),                          # a solver
     "cg": ("a", "b", "xi", "eta"),                       # a contact pair's side

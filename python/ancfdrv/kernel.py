@@ -17,7 +17,7 @@ from .errors import InputError, SolverError
 
 __all__ = ["beam_element_arrays", "beam_gravity", "beam_shape", "beam_point_mass",
            "ffr_force", "ffr_element_stiffness", "moment_force", "drive_values",
-           "SparsePattern", "DirectSolver", "dense_solve", "plate_shape", "plate_element_arrays",
+           "SparsePattern", "DirectSolver", "plate_shape", "plate_element_arrays",
            "plate_reference", "plate_forces", "PlateReference", "CubicBeam", "SectionData",
            "section_data", "cable_element_arrays", "cable_shape", "cable_forces",
            "constraint_arrays"]
@@ -483,32 +483,6 @@ class DirectSolver:
             pass
 
 
-def dense_solve(n: int, rows: np.ndarray, cols: np.ndarray, values: np.ndarray,
-                rhs: np.ndarray, what: str = "system matrix") -> np.ndarray:
-    """Solution of A x = rhs for the small n x n matrix A of the coordinate triplets
-    (0-based; duplicates add up, as for :class:`DirectSolver`), formed densely and
-    factorized by LAPACK's LU with partial pivoting in the kernel
-    (``fortran/src/linalg/dense_direct.f90``): for a few dozen unknowns microseconds where
-    MUMPS's analysis and factorization take a quarter of a millisecond. rhs: (n,) or (n, k).
-    Raises SolverError naming ``what`` for a singular matrix (an exactly zero pivot) or a
-    solution that is not finite (a pivot so small that the solution overflows)."""
-    b = np.asarray(rhs, dtype=np.float64)
-    x = np.array(b.reshape(n, -1), dtype=np.float64, order="F")  # solved in place
-    if len(rows) == 0:   # (f2py takes no empty arrays) the zero matrix
-        raise SolverError(f"{what}: factorization failed: {_MUMPS_MESSAGES[-10]} (no entries)")
-    x, info = _kernel.dense_solve(_f(np.asarray(rows) + 1, np.int32),
-                                  _f(np.asarray(cols) + 1, np.int32), _f(values), x)
-    if info < 0:
-        raise SolverError(f"{what}: a coordinate index lies outside 0..{n - 1}")
-    if info > 0 or not np.isfinite(x).all():
-        raise SolverError(f"{what}: factorization failed: {_MUMPS_MESSAGES[-10]} (dense LU, "
-                          f"column {info})" if info > 0 else
-                          f"{what}: solve failed: {_MUMPS_MESSAGES[-10]} (dense LU: the "
-                          "solution is not finite)")
-    return x.reshape(b.shape)
-
-
-# -- rigid bodies and leaf contact (seed 003, eqs. 17-32) ---------------------------------
 def reference_node_mass(mass: float, centre, inertia) -> np.ndarray:
     """12 x 12 mass matrix of an ANCF reference node (eq. 32), coordinates [r, r_x, r_y, r_z]."""
     matrix, info = _kernel.reference_node_mass(mass, _f(centre), _f(inertia))
@@ -768,17 +742,20 @@ class KernelSystem:
         self._check(info, "drives", message)
 
     def set_matrices(self, mass_csr, full_pattern, solver_handle: int, policy: int,
-                     mass_pattern, vector_frame, block_first) -> None:
+                     mass_pattern, vector_frame, block_first, saddle_mass) -> None:
         """M (CSR arrays indptr, indices, data on the independent coordinates: an
         ancfdrv.csr.Csr or a scipy matrix), the full pattern (row_ptr,
         col_index, 0-based), the solver and its policy, M on the solver's pattern, the frame
-        of each reduced 3-vector (0: global; frames 1-based here) and the blocks' first dofs."""
+        of each reduced 3-vector (0: global; frames 1-based here), the blocks' first dofs and
+        M as the model assembled it (CSR, zero entries kept: the mass block of the kernel's
+        consistent acceleration, ``fortran/src/solvers/consistent_start.f90``)."""
         full_row_ptr, full_col = full_pattern
         self.nnz_pattern = len(mass_pattern)
         self._full_col = full_col
         info, message = _kernel.system_set_mass(
             self.handle, _i(mass_csr.indptr + 1), _i(mass_csr.indices + 1), _f(mass_csr.data),
-            _f(mass_pattern), ndof=self.ndof)
+            _f(mass_pattern), _i(saddle_mass.indptr + 1), _i(saddle_mass.indices + 1),
+            _f(saddle_mass.data), ndof=self.ndof)
         self._check(info, "matrices", message)
         info, message = _kernel.system_set_solver(
             self.handle, _i(np.asarray(full_row_ptr) + 1), _i(np.asarray(full_col) + 1),
@@ -1021,15 +998,29 @@ class KernelSystem:
     def stepper_setup(self, settings) -> None:
         """Start a run of the kernel's stepper (``fortran/src/solvers/stepper.f90``) with the
         run's settings (a :class:`~ancfdrv.solvers.dynamic.DynamicSettings`: beta, gamma,
-        alpha_m, alpha_f, tol, length_scale, max_newton, the Jacobian policy, contraction),
-        sent once per run, not with every chunk. What the stepper learned in earlier runs
-        (contraction estimate, a matrix factorized at another state) is forgotten: a run
-        from a new initial state is reproducible."""
+        alpha_m, alpha_f, tol, length_scale, max_newton, the Jacobian policy, contraction,
+        and the step-size control: dt, dt_min, step, tolerance), sent once per run, not with
+        every chunk. What the stepper learned in earlier runs (contraction estimate, a
+        matrix factorized at another state, the step-size control's state) is forgotten: a
+        run from a new initial state is reproducible."""
         info, message = _kernel.system_stepper_setup(
             self.handle, settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f,
             settings.tol, settings.length_scale, settings.max_newton, settings.jacobian_code,
-            settings.contraction)
+            settings.contraction,
+            _pack("sk", dt=settings.dt, dt_min=settings.dt_min,
+                  adaptive=float(settings.step == "adaptive"), tolerance=settings.tolerance))
         self._check(info, "stepper_setup", message)
+
+    def consistent_acceleration(self, t: float, e, v, guesses, counts) -> dict:
+        """The consistent acceleration e'' and multipliers lambda of the state (t, e, e')
+        (``fortran/src/solvers/consistent_start.f90``); the contact guesses and counters are
+        updated (returned). A failure raises SolverError with the kernel's text."""
+        guesses, counts, accel, lam, info, message = _kernel.system_consistent_acceleration(
+            self.handle, self.ncon, self.npoint, t, _state(e, v), _f(guesses), _i(counts),
+            ndof=self.ndof)
+        if info:
+            raise SolverError(_text(message))
+        return dict(accel=accel, lam=lam[:self.ncon], guesses=guesses, counts=counts)
 
     def _layout(self, store_q: bool) -> tuple[list[slice], list[slice]]:
         """The slices of the packed state (t, e, v, a, accel, lam, work, powers, guesses) and
@@ -1069,20 +1060,21 @@ class KernelSystem:
         values["counts"] = _i(values["counts"]).copy()
         return PackedState(self._layout(False)[0], self.npoint, values)
 
-    def advance_rows(self, nsteps: int, h: float, state: dict, store_q: bool) -> tuple:
-        """:meth:`advance` without unpacking the rows: (rows (row_size, nsteps) in the
-        layout of :meth:`row_slices`, stats, status, last correction, message), for the
-        stepper's own loop (single steps under step control: every numpy call counts)."""
+    def advance_rows(self, nrows: int, budget: int, state: dict, store_q: bool) -> tuple:
+        """:meth:`advance` without unpacking the rows: (rows (row_size, nrows) in the layout
+        of :meth:`row_slices`, stats (5, nrows), sizes (nrows,), status, figures, message),
+        for the stepper's own loop (every numpy call counts)."""
         cuts, rows_cut = self._layout(store_q)
         npt = self.npoint
         if isinstance(state, PackedState) and len(state.packed) == cuts[-1].stop:
             # (system_advance_into: rows made by numpy.empty, which the kernel writes in
             # full; f2py would zero-fill system_advance's fresh output arrays first)
-            rows = np.empty((rows_cut[-1].stop, nsteps), order="F")
-            stats = np.empty((3, nsteps), dtype=np.int32, order="F")
-            packed, counts, status, last_correction, message = \
-                _kernel.system_advance_into(self.handle, h, state.packed, state["counts"],
-                                            rows, stats, nsteps)
+            rows = np.empty((rows_cut[-1].stop, nrows), order="F")
+            stats = np.empty((5, nrows), dtype=np.int32, order="F")
+            sizes = np.empty(nrows)
+            packed, counts, status, figures, message = \
+                _kernel.system_advance_into(self.handle, budget, state.packed,
+                                            state["counts"], rows, stats, sizes)
             state.stepped(packed, counts)
             status = status.tolist()
             if status[1] == 9:
@@ -1094,9 +1086,9 @@ class KernelSystem:
                 packed[part] = state[key]
             if npt:
                 packed[cuts[8]] = np.asarray(state["guesses"])[:, :npt].ravel(order="F")
-            packed, counts, rows, stats, status, last_correction, message = \
-                _kernel.system_advance(self.handle, nsteps, h, packed, _i(state["counts"]),
-                                       rows_cut[-1].stop)
+            packed, counts, rows, stats, sizes, status, figures, message = \
+                _kernel.system_advance(self.handle, nrows, budget, packed,
+                                       _i(state["counts"]), rows_cut[-1].stop)
             status = [int(x) for x in status]
             if status[1] == 9:
                 self._failure(9, "system_advance", message)
@@ -1108,36 +1100,38 @@ class KernelSystem:
                 guesses = np.array(state["guesses"], dtype=np.float64)
                 guesses[:, :npt] = packed[cuts[8]].reshape((2, npt), order="F")
                 state["guesses"] = guesses
-        return rows, stats, status, last_correction, message
+        return rows, stats, sizes, status, figures, message
 
     def row_slices(self, store_q: bool) -> list[slice]:
         """The slices of an output row (time, probes, deflections, lam, energy, constraint,
         contact, q): stepper.f90 ``row_size``."""
         return self._layout(store_q)[1]
 
-    def advance(self, nsteps: int, h: float, state: dict, store_q: bool) -> dict:
-        """Advance nsteps steps of size h (time_integrator, with the run's settings of
-        :meth:`stepper_setup`) from state (t, e, v, a, accel, lam, work, powers, guesses,
-        counts; its entries are replaced by the new state's). Returns the outputs (time,
-        probes (3, nprobe, nsteps), deflections, lam, energy, constraint, stats, contact,
-        q), status [steps done, info, detail, steps converged at the round-off floor], the
-        kernel's text of a failure (``message``) and the last Newton correction; a failed
-        step's statistics are the column after the last completed step. A refused call (a
-        stale handle, no run set up, sizes inconsistent with the system) raises
-        SolverError with the kernel's text."""
-        rows, stats, status, last_correction, message = self.advance_rows(nsteps, h, state,
-                                                                           store_q)
+    def advance(self, nrows: int, state: dict, store_q: bool, budget: int | None = None) -> dict:
+        """Advance up to nrows output rows of the run set up by :meth:`stepper_setup`
+        (``fortran/src/solvers/step_control.f90``: whole chunks at dt, cut steps, restarts,
+        adaptive steps) with at most ``budget`` steps tried (default: 1024 per row) from
+        state (t, e, v, a, accel, lam, work, powers, guesses, counts; its entries are
+        replaced by the new state's). Returns the outputs (time, probes (3, nprobe, nrows),
+        deflections, lam, energy, constraint, contact, q, stats (5, nrows): corrections,
+        factorizations, jacobians, substeps, cuts; sizes: the smallest step to each row),
+        status and figures (codes.KERNEL_LAYOUTS 'as', 'af'), the kernel's text of a failure
+        (``message``). A refused call (a stale handle, no run set up, sizes inconsistent
+        with the system) raises SolverError with the kernel's text."""
+        budget = 1024 * nrows if budget is None else budget
+        rows, stats, sizes, status, figures, message = self.advance_rows(nrows, budget, state,
+                                                                         store_q)
         npt = self.npoint
         rows_cut = self._layout(store_q)[1]
         time, probes, deflections, lam, energy, constraint, contact, q = rows_cut
-        return dict(time=rows[0], probes=rows[probes].reshape((3, -1, nsteps), order="F"),
-                    deflections=rows[deflections].reshape((3, -1, nsteps), order="F"),
+        return dict(time=rows[0], probes=rows[probes].reshape((3, -1, nrows), order="F"),
+                    deflections=rows[deflections].reshape((3, -1, nrows), order="F"),
                     lam=rows[lam], energy=rows[energy], constraint=rows[constraint.start],
-                    contact=rows[contact].reshape((len(CONTACT_RECORD), npt, nsteps),
+                    contact=rows[contact].reshape((len(CONTACT_RECORD), npt, nrows),
                                                   order="F"),
                     q=rows[q] if store_q else np.zeros((self.ndof, 1)), stats=stats,
-                    status=status, message=_text(message) if status[1] else "",
-                    last_correction=float(last_correction))
+                    sizes=sizes, status=status, figures=figures,
+                    message=_text(message) if status[1] else "")
 
     def close(self) -> None:
         if getattr(self, "handle", 0):

@@ -78,6 +78,19 @@ module api_support
                                 sr_count = 3
   integer, parameter, public :: so_info = 1, so_iterations = 2, so_converged_by = 3, &
                                 so_factorizations = 4, so_count = 4
+  !> the stepper's step-size control (system_stepper_setup), a controlled advance's per-row
+  !> statistics (columns), its status and its figures (system_advance)
+  integer, parameter, public :: sk_dt = 1, sk_dt_min = 2, sk_adaptive = 3, sk_tolerance = 4, &
+                                sk_count = 4
+  integer, parameter, public :: at_corrections = 1, at_factorizations = 2, at_jacobians = 3, &
+                                at_substeps = 4, at_cuts = 5, at_count = 5
+  integer, parameter, public :: as_rows = 1, as_info = 2, as_detail = 3, as_floor_accepts = 4, &
+                                as_tries = 5, as_failure_cuts = 6, as_failure_tries = 7, &
+                                as_failed_corrections = 8, as_failed_factorizations = 9, &
+                                as_failed_jacobians = 10, as_cuts = 11, as_rejected = 12, &
+                                as_restarts = 13, as_taken = 14, as_count = 14
+  integer, parameter, public :: af_last_correction = 1, af_failure_t = 2, af_failure_h = 3, &
+                                af_smallest = 4, af_count = 4
   !> the columns of a pattern's coordinates (rows, columns)
   integer, parameter, public :: tp_rows = 1, tp_cols = 2, tp_count = 2
   !> a solver: its handle (sparse_direct) and its policy (mechanical_system policy_*)

@@ -775,19 +775,4 @@ subroutine constraint_violation_rows(nint, ints, nreal, reals, ncon, ndof, nrow,
   end do
 end subroutine constraint_violation_rows
 
-!> A small system A x = b from coordinate triplets (1-based, duplicates add up), formed
-!> densely and solved by LAPACK's dgesv (dense_direct). info: 0 ok; -1 an index outside
-!> 1..n; > 0 singular (the zero pivot's column).
-subroutine dense_solve(n, nnz, rows, cols, values, nrhs, rhs, info)
-  use ancf_kinds, only: dp
-  use dense_direct, only: dense_coo_solve
-  implicit none
-  integer, intent(in) :: n, nnz, nrhs
-  integer, intent(in) :: rows(nnz), cols(nnz)
-  real(dp), intent(in) :: values(nnz)
-  real(dp), intent(inout) :: rhs(n, nrhs)
-  !f2py intent(in,out) :: rhs
-  integer, intent(out) :: info
-  call dense_coo_solve(n, nnz, rows, cols, values, nrhs, rhs, info)
-end subroutine dense_solve
 

@@ -55,20 +55,24 @@ end subroutine system_destroy
 !> Starts a run of the stepper (stepper.f90) with its settings, set once per run: the
 !> method's beta, gamma, alpha_m, alpha_f (Newmark: alpha_m = alpha_f = 0), the Newton
 !> tolerance (max |de| <= tol * length_scale) and iteration limit, the Jacobian policy
-!> (1 per step, 2 per iteration, 3 reused across steps) and the reuse policy's contraction
-!> limit. What the stepper learned in earlier runs is forgotten (the contraction estimate;
-!> a matrix factorized at another state, except the constant policy's, which depends on the
-!> step alone): a run from a new initial state then gives the same result on any handle.
+!> (1 per step, 2 per iteration, 3 reused across steps), the reuse policy's contraction
+!> limit and the step-size control (control(sk_*): the output grid's dt, dt_min (0: dt /
+!> 1024), adaptive /= 0 for step = 'adaptive', the local error tolerance; step_control.f90).
+!> What the stepper learned in earlier runs is forgotten (the contraction estimate; a matrix
+!> factorized at another state, except the constant policy's, which depends on the step
+!> alone): a run from a new initial state then gives the same result on any handle.
 !> info: 1 not a live handle; 2 a setting out of its range.
 subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, length_scale, &
-                                max_newton, jacobian, contraction, info, message)
+                                max_newton, jacobian, contraction, control, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, policy_constant, plane_mass_setup
-  use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, jacobian_reuse
-  use api_support, only: api_system
+  use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, &
+                     jacobian_reuse, control_settings
+  use api_support, only: api_system, sk_dt, sk_dt_min, sk_adaptive, sk_tolerance
   implicit none
   integer, intent(in) :: handle, max_newton, jacobian
   real(dp), intent(in) :: beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
+  real(dp), intent(in) :: control(4)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
@@ -88,11 +92,21 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
     message = 'system_stepper_setup: max_newton < 1 or a Jacobian policy outside 1..3'
     return
   end if
+  if (.not. (control(sk_dt) > 0.0_dp .and. control(sk_dt_min) >= 0.0_dp .and. &
+             control(sk_tolerance) > 0.0_dp)) then
+    info = 2
+    message = 'system_stepper_setup: a step-size control setting out of its range ' // &
+              '(dt > 0, dt_min >= 0, tolerance > 0)'
+    return
+  end if
   call stepper_start(run, stepper_settings(beta=beta, gamma=gamma, alpha_m=alpha_m, &
                                            alpha_f=alpha_f, tol=tol, &
                                            length_scale=length_scale, &
                                            max_newton=max_newton, jacobian=jacobian, &
-                                           contraction=contraction))
+                                           contraction=contraction), &
+                     control_settings(dt=control(sk_dt), dt_min=control(sk_dt_min), &
+                                      tolerance=control(sk_tolerance), &
+                                      adaptive=control(sk_adaptive) /= 0.0_dp))
   if (sys%policy /= policy_constant) sys%factorized = .false.
   call plane_mass_setup(sys)
 end subroutine system_stepper_setup
@@ -507,10 +521,13 @@ subroutine system_set_drives(handle, ndrive, ndata, kinds, ptr, data, info, mess
 end subroutine system_set_drives
 
 !> The mass matrix on the independent coordinates (CSR, 1-based; zero entries may be left
-!> out) and on the solver's pattern (mass_pattern, aligned with the pattern analysed by the
-!> solver). system_set_solver sets the pattern and the solver.
+!> out), on the solver's pattern (mass_pattern, aligned with the pattern analysed by the
+!> solver) and as the model assembled it (saddle_*, CSR, 1-based, zero entries kept: the mass
+!> block of the consistent acceleration, consistent_start). system_set_solver sets the
+!> pattern and the solver.
 subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_values, &
-                           nnz_pattern, mass_pattern, info, message)
+                           nnz_pattern, mass_pattern, nnz_saddle, saddle_ptr, saddle_col, &
+                           saddle_values, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use api_support, only: api_system
@@ -519,6 +536,8 @@ subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_
   real(dp), intent(in) :: mass_values(nnz_mass)
   integer, intent(in) :: nnz_pattern
   real(dp), intent(in) :: mass_pattern(nnz_pattern)
+  integer, intent(in) :: nnz_saddle, saddle_ptr(ndof + 1), saddle_col(nnz_saddle)
+  real(dp), intent(in) :: saddle_values(nnz_saddle)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
@@ -534,7 +553,16 @@ subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_
   sys%mass_values = mass_values
   if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
                                                 sys%mass_pair_row, sys%mass_pair_values)
+  if (any(saddle_col < 1) .or. any(saddle_col > ndof) .or. saddle_ptr(1) /= 1 .or. &
+      saddle_ptr(ndof + 1) /= nnz_saddle + 1) then
+    info = 2
+    message = 'system_set_mass: the saddle mass is no CSR of ndof rows (1-based)'
+    return
+  end if
   sys%mass_pattern = mass_pattern
+  sys%saddle_mass_ptr = saddle_ptr
+  sys%saddle_mass_col = saddle_col
+  sys%saddle_mass_values = saddle_values
   sys%factorized = .false.
 end subroutine system_set_mass
 
@@ -1259,55 +1287,59 @@ subroutine system_output_row(handle, ndof, ncon, npoint, nrow, t, state, lam, wo
   row(k + 2:k + 1 + contact_record * npoint) = reshape(records, [contact_record * npoint])
 end subroutine system_output_row
 
-!> Advances nsteps steps of size h of the generalized-alpha method (time_integrator) with
-!> the settings of the run (system_stepper_setup), one output row per step. state (packed,
-!> stepper.f90 state_size: t, e, e', a, e'', lambda, works, the powers at the state,
-!> contact guesses) and the contact counters are updated in place: calls may split a run
-!> anywhere without changing its result. rows(:, step) (stepper.f90 row_size: time,
-!> probes, deflections, lambda, energies, constraint violation, contact records, and e when
-!> nrow has room for it). stats(:, step) = Newton corrections, factorizations, Jacobian
-!> evaluations (of a failed step too: the column after the last completed one). status =
-!> [steps done, info, detail, steps converged at the round-off floor]; info: the codes of
-!> integrator_chunk (1 .. 8), 9 a refused call (not a live handle, no run set up, sizes
-!> inconsistent with the system); message: the failure's text. last_correction: the size
-!> of the last Newton correction.
-subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, stats, status, &
-                          last_correction, message)
+!> Advances up to nrows output rows of the run set up by system_stepper_setup, with at most
+!> budget steps tried (step_control: whole chunks at dt, cut steps, restarts, adaptive
+!> steps; an output interval left unfinished is resumed by the next call). state (packed,
+!> stepper.f90 state_size: t, e, e', a, e'', lambda, works, the powers at the state, contact
+!> guesses) and the contact counters are updated in place: calls may split a run anywhere
+!> without changing its result. rows(:, k) (stepper.f90 row_size: time, probes,
+!> deflections, lambda, energies, constraint violation, contact records, and e when nrow
+!> has room for it); stats(at_*, k): Newton corrections, factorizations, Jacobian
+!> evaluations (failed tries included), steps taken, step cuts; sizes(k): the smallest step
+!> to the row. status(as_*): the rows done, info, detail, steps converged at the round-off
+!> floor, the steps tried; of a failure: the interval's cuts, the tries in a row, the work of
+!> failed tries the run counts; the run's cuts, rejections, restarts and steps taken so far.
+!> figures(af_*): the last Newton correction; a failure's time and step; the run's smallest
+!> step. info: integrator_chunk's codes (1 .. 8, 10), step_control's (11 .. 13), 9 a
+!> refused call (not a live handle, no run set up, sizes inconsistent with the system);
+!> message: the failure's text.
+subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, rows, stats, &
+                          sizes, status, figures, message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, contact_state, power_count, energy_count, &
-                               contact_record
+  use mechanical_system, only: system_model, power_count
   use stepper, only: stepper_run, state_size, row_size
-  use time_integrator, only: integrator_chunk, stat_count, step_failure_text
-  use api_support, only: api_system
+  use time_integrator, only: stat_count, step_failure_text
+  use step_control, only: stepper_point, controlled_rows, control_failure
+  use api_support, only: api_system, as_rows, as_info, as_detail, as_floor_accepts, as_tries, &
+                         as_failure_cuts, as_failure_tries, as_failed_corrections, &
+                         as_failed_jacobians, as_cuts, as_rejected, as_restarts, as_taken, &
+                         af_last_correction, af_failure_t, af_failure_h, af_smallest
   implicit none
-  integer, intent(in) :: handle, nsteps, nstate, nrow
-  real(dp), intent(in) :: h
+  integer, intent(in) :: handle, nrows, budget, nstate, nrow
   real(dp), intent(inout) :: state(nstate)
   integer, intent(inout) :: counts(6)
   !f2py intent(in,out) :: state, counts
-  real(dp), intent(out) :: rows(nrow, nsteps), last_correction
-  integer, intent(out) :: stats(3, nsteps), status(4)
+  real(dp), intent(out) :: rows(nrow, nrows), sizes(nrows), figures(4)
+  integer, intent(out) :: stats(5, nrows), status(14)
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(stepper_run), pointer :: run
-  type(contact_state) :: contact
-  real(dp), allocatable :: e(:), v(:), a(:), accel(:), lam(:), out_probe(:, :, :)
-  real(dp), allocatable :: out_deflection(:, :, :), out_contact(:, :, :), no_q(:, :)
-  real(dp) :: t, work(power_count), powers(power_count)
-  integer :: info, ndof, ncon, nprobe, npoint, step, k, j
-  integer :: at_lambda, at_energy, at_constraint, at_q  ! the rows' offsets (row_size)
+  type(stepper_point) :: p
+  type(control_failure) :: failure
+  integer :: info, ndof, ncon, nprobe, npoint, k
   logical :: store_q
   rows = 0.0_dp
   stats = 0
+  sizes = 0.0_dp
   status = 0
-  last_correction = 0.0_dp
+  figures = 0.0_dp
   call api_system(handle, sys, info, message, run)
   if (info /= 0) then
-    status(2) = 9
+    status(as_info) = 9
     return
   end if
   if (.not. run%ready) then
-    status(2) = 9
+    status(as_info) = 9
     message = 'system_advance: no run set up (call system_stepper_setup first)'
     return
   end if
@@ -1317,104 +1349,115 @@ subroutine system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, 
   npoint = sys%npoint
   store_q = nrow == row_size(ndof, ncon, nprobe, npoint, .true.)
   if (nstate /= state_size(ndof, ncon, npoint) .or. (.not. store_q .and. &
-      nrow /= row_size(ndof, ncon, nprobe, npoint, .false.)) .or. nsteps < 1 .or. &
-      .not. h > 0.0_dp .or. power_count /= 5 .or. stat_count /= 3) then
-    status(2) = 9
+      nrow /= row_size(ndof, ncon, nprobe, npoint, .false.)) .or. nrows < 1 .or. &
+      budget < 1 .or. power_count /= 5 .or. stat_count /= 3) then
+    status(as_info) = 9
     message = 'system_advance: sizes inconsistent with the system (the packed state or ' // &
-              'row length, nsteps < 1) or a step h <= 0'
+              'row length) or nrows, budget < 1'
     return
   end if
   ! the packed state (stepper.f90 state_size)
-  t = state(1)
+  p%t = state(1)
   k = 1
-  e = state(k + 1:k + ndof)
+  p%e = state(k + 1:k + ndof)
   k = k + ndof
-  v = state(k + 1:k + ndof)
+  p%v = state(k + 1:k + ndof)
   k = k + ndof
-  a = state(k + 1:k + ndof)
+  p%a = state(k + 1:k + ndof)
   k = k + ndof
-  accel = state(k + 1:k + ndof)
+  p%accel = state(k + 1:k + ndof)
   k = k + ndof
-  lam = state(k + 1:k + ncon)
+  p%lam = state(k + 1:k + ncon)
   k = k + ncon
-  work = state(k + 1:k + power_count)
+  p%work = state(k + 1:k + power_count)
   k = k + power_count
-  powers = state(k + 1:k + power_count)
+  p%powers = state(k + 1:k + power_count)
   k = k + power_count
-  contact%guesses = reshape(state(k + 1:k + 2 * npoint), [2, npoint])
-  contact%counts = counts
-  ! (the stepper writes time, lam, energy, constraint violation and q straight into their
-  ! rows, zeroed above: what it leaves unwritten is zero, as the copies of zeroed arrays
-  ! were; the probes, deflections and contact records are copied below)
-  at_lambda = 1 + 6 * nprobe
-  at_energy = at_lambda + ncon
-  at_constraint = at_energy + energy_count
-  at_q = at_constraint + 1 + contact_record * npoint
-  allocate (out_probe(3, nprobe, nsteps), out_deflection(3, nprobe, nsteps), &
-            out_contact(contact_record, npoint, nsteps))
-  out_probe = 0.0_dp
-  out_deflection = 0.0_dp
-  out_contact = 0.0_dp
-  if (store_q) then
-    call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, &
-                          work, powers, contact, rows(1, :), out_probe, out_deflection, &
-                          rows(at_lambda + 1:at_lambda + ncon, :), &
-                          rows(at_energy + 1:at_energy + energy_count, :), &
-                          rows(at_constraint + 1, :), stats, out_contact, store_q, &
-                          rows(at_q + 1:at_q + ndof, :), status(1), status(2), status(3), &
-                          last_correction, status(4))
-  else
-    allocate (no_q(ndof, 0))
-    call integrator_chunk(sys, run%settings, run%state, h, nsteps, t, e, v, a, accel, lam, &
-                          work, powers, contact, rows(1, :), out_probe, out_deflection, &
-                          rows(at_lambda + 1:at_lambda + ncon, :), &
-                          rows(at_energy + 1:at_energy + energy_count, :), &
-                          rows(at_constraint + 1, :), stats, out_contact, store_q, no_q, &
-                          status(1), status(2), status(3), last_correction, status(4))
+  p%contact%guesses = reshape(state(k + 1:k + 2 * npoint), [2, npoint])
+  p%contact%counts = counts
+  call controlled_rows(sys, run, p, nrows, budget, store_q, rows, stats, sizes, &
+                       status(as_rows), status(as_tries), status(as_info), status(as_detail), &
+                       figures(af_last_correction), status(as_floor_accepts), failure)
+  if (status(as_info) /= 0) then
+    message = failure%text
+    if (status(as_info) <= 10) &
+      message = step_failure_text(status(as_info), status(as_detail), run%settings%max_newton)
+    figures(af_failure_t) = failure%t
+    figures(af_failure_h) = failure%h
+    status(as_failure_cuts) = failure%cuts
+    status(as_failure_tries) = failure%tries
+    status(as_failed_corrections:as_failed_jacobians) = failure%work
   end if
-  if (status(2) /= 0) message = step_failure_text(status(2), status(3), run%settings%max_newton)
-  state = [t, e, v, a, accel, lam, work, powers, reshape(contact%guesses, [2 * npoint])]
-  counts = contact%counts
-  ! the output rows (stepper.f90 row_size)
-  ! (the probes' and deflections' columns copied by loops: reshape was a library call a step)
-  do step = 1, nsteps
-    k = 1
-    do j = 1, nprobe
-      rows(k + 3 * j - 2:k + 3 * j, step) = out_probe(:, j, step)
-    end do
-    k = k + 3 * nprobe
-    do j = 1, nprobe
-      rows(k + 3 * j - 2:k + 3 * j, step) = out_deflection(:, j, step)
-    end do
-    k = at_constraint + 1
-    do j = 1, npoint
-      rows(k + contact_record * (j - 1) + 1:k + contact_record * j, step) = out_contact(:, j, step)
-    end do
-  end do
+  status(as_cuts) = run%control%cuts
+  status(as_rejected) = run%control%rejected
+  status(as_restarts) = run%control%restarts
+  status(as_taken) = run%control%taken
+  figures(af_smallest) = run%control%smallest
+  state = [p%t, p%e, p%v, p%a, p%accel, p%lam, p%work, p%powers, &
+           reshape(p%contact%guesses, [2 * npoint])]
+  counts = p%contact%counts
 end subroutine system_advance
 
-!> system_advance into arrays the caller made (rows and stats, intent(inout)): the same
-!> call, whose every output it writes (rows and stats zeroed first, then every column of
-!> every step). f2py zero-filled the fresh output arrays of system_advance before the call
-!> (one memset of the rows, ~0.34 MB per second of the 5-node pendulum's steps) that the
-!> kernel overwrote; arrays from numpy.empty are handed over as they are.
-subroutine system_advance_into(handle, nsteps, h, nstate, state, counts, nrow, rows, stats, &
-                               status, last_correction, message)
+!> system_advance into arrays the caller made (rows, stats and sizes, intent(inout)): the
+!> same call, whose every output it writes. f2py zero-filled the fresh output arrays of
+!> system_advance before the call (one memset of the rows, ~0.34 MB per second of the
+!> 5-node pendulum's steps) that the kernel overwrote; arrays from numpy.empty are handed
+!> over as they are.
+subroutine system_advance_into(handle, nrows, budget, nstate, state, counts, nrow, rows, stats, &
+                               sizes, status, figures, message)
   use ancf_kinds, only: dp
   implicit none
-  integer, intent(in) :: handle, nsteps, nstate, nrow
-  real(dp), intent(in) :: h
+  integer, intent(in) :: handle, nrows, budget, nstate, nrow
   real(dp), intent(inout) :: state(nstate)
   integer, intent(inout) :: counts(6)
   !f2py intent(in,out) :: state, counts
-  real(dp), intent(inout) :: rows(nrow, nsteps)
-  integer, intent(inout) :: stats(3, nsteps)
-  real(dp), intent(out) :: last_correction
-  integer, intent(out) :: status(4)
+  real(dp), intent(inout) :: rows(nrow, nrows), sizes(nrows)
+  integer, intent(inout) :: stats(5, nrows)
+  real(dp), intent(out) :: figures(4)
+  integer, intent(out) :: status(14)
   character(len=200), intent(out) :: message
-  call system_advance(handle, nsteps, h, nstate, state, counts, nrow, rows, stats, status, &
-                      last_correction, message)
+  call system_advance(handle, nrows, budget, nstate, state, counts, nrow, rows, stats, sizes, &
+                      status, figures, message)
 end subroutine system_advance_into
+
+!> The consistent acceleration e'' and multipliers lambda of the state (t, e, e') (columns
+!> sv_*; consistent_start): the start of a run. The contact guesses and counters are used
+!> and updated. info /= 0: the failure, in words in message.
+subroutine system_consistent_acceleration(handle, ndof, ncon, npoint, t, state, guesses, &
+                                          counts, accel, lam, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state
+  use consistent_start, only: consistent_acceleration
+  use api_support, only: api_system, sv_coordinates, sv_rates
+  implicit none
+  integer, intent(in) :: handle, ndof, ncon, npoint
+  real(dp), intent(in) :: t, state(ndof, 2)
+  real(dp), intent(inout) :: guesses(2, max(1, npoint))
+  integer, intent(inout) :: counts(6)
+  !f2py intent(in,out) :: guesses, counts
+  real(dp), intent(out) :: accel(ndof), lam(max(1, ncon))
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  type(contact_state) :: contact
+  integer :: detail
+  accel = 0.0_dp
+  lam = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. npoint /= sys%npoint) then
+    info = 2
+    message = 'system_consistent_acceleration: sizes inconsistent with the system (ndof, ' // &
+              'ncon, npoint)'
+    return
+  end if
+  contact%guesses = guesses(:, 1:npoint)
+  contact%counts = counts
+  call consistent_acceleration(sys, t, state(:, sv_coordinates), state(:, sv_rates), contact, &
+                               accel, lam(1:ncon), info, detail, message)
+  guesses(:, 1:npoint) = contact%guesses
+  counts = contact%counts
+end subroutine system_consistent_acceleration
 
 !> One load step of the static Newton in the kernel (static_solver): equilibrium of the
 !> system at load factor and time from the packed state [e (ndof), lambda (ncon), contact

@@ -15,7 +15,7 @@ module stepper
   implicit none
   private
   public :: stepper_settings, stepper_state, stepper_run, stepper_start, update_reuse_backoff, &
-            state_size, row_size
+            state_size, row_size, control_settings, control_state
 
   !> when a refactorized system's iteration matrix is refreshed (time_integrator)
   integer, parameter, public :: jacobian_step = 1, jacobian_iteration = 2, jacobian_reuse = 3
@@ -86,10 +86,47 @@ module stepper
     logical :: carry_on = .false.
   end type stepper_state
 
-  !> A system's stepper: its run's settings, its learned state, whether a run was set up.
+  !> The step-size control of a run (step_control.f90): the output grid's step dt, the
+  !> smallest step a failed or rejected step may be cut to (dt_min, dt / 1024 when given as
+  !> 0), step = 'adaptive' (sized by the local error estimate) or 'fixed', and the local
+  !> error allowed per step relative to the length scale (adaptive).
+  type :: control_settings
+    real(dp) :: dt = 0.0_dp, dt_min = 0.0_dp, tolerance = 1e-6_dp
+    logical :: adaptive = .false.
+  end type control_settings
+
+  !> The step-size control's state, kept from call to call (forgotten at the start of each
+  !> run): the controller's step h, the successes since the last cut, the size of the last
+  !> step taken (a change restarts the method), the run's counts (cuts, rejections,
+  !> restarts, steps taken, the smallest step), and the output interval in progress when a
+  !> call's budget ran out inside it (its grid time, the statistics and the row of its last
+  !> accepted step so far, its tries since the last accepted step), and the contact guesses
+  !> the restarts' force evaluations start from and update.
+  type :: control_state
+    real(dp) :: h = 0.0_dp, last_h = 0.0_dp, smallest = huge(1.0_dp)
+    integer :: successes = 0, cuts = 0, rejected = 0, restarts = 0, taken = 0
+    logical :: started = .false.
+    ! the output interval in progress (open) and what it has done so far
+    logical :: open = .false.
+    real(dp) :: target = 0.0_dp, interval_smallest = huge(1.0_dp)
+    integer :: interval_stats(3) = 0, interval_cuts = 0, interval_taken = 0, tries = 0
+    real(dp), allocatable :: row(:)
+    ! a whole step at dt failed and was cut: the next interval starts with its work and cut
+    logical :: carried = .false.
+    integer :: carried_stats(3) = 0
+    ! the grid rows done in the run (adaptive: the grid times are t0 + k dt) and t0
+    integer :: rows = 0
+    real(dp) :: t0 = 0.0_dp
+    real(dp), allocatable :: restart_guesses(:, :)
+  end type control_state
+
+  !> A system's stepper: its run's settings, its learned state, its step-size control,
+  !> whether a run was set up.
   type :: stepper_run
     type(stepper_settings) :: settings
     type(stepper_state) :: state
+    type(control_settings) :: control_settings
+    type(control_state) :: control
     logical :: ready = .false.
   end type stepper_run
 
@@ -97,11 +134,17 @@ contains
 
   !> A new run with these settings: what earlier runs learned is forgotten (a run from a new
   !> initial state then gives the same result on any handle).
-  pure subroutine stepper_start(run, settings)
+  pure subroutine stepper_start(run, settings, control)
     type(stepper_run), intent(inout) :: run
     type(stepper_settings), intent(in) :: settings
+    type(control_settings), intent(in) :: control
     run%settings = settings
     run%state = stepper_state()
+    run%control_settings = control
+    if (run%control_settings%dt_min <= 0.0_dp) run%control_settings%dt_min = control%dt / 1024.0_dp
+    run%control = control_state()
+    run%control%h = control%dt
+    run%control%last_h = control%dt
     run%ready = .true.
   end subroutine stepper_start
 

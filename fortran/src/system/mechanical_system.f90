@@ -103,6 +103,10 @@ module mechanical_system
     integer, allocatable :: mass_row_ptr(:), mass_col(:)
     real(dp), allocatable :: mass_values(:)
     logical :: mass_kron = .false.
+    ! M as the model assembled it (CSR, 1-based, its zero entries kept): the mass block of
+    ! the consistent acceleration's saddle system (consistent_start)
+    integer, allocatable :: saddle_mass_ptr(:), saddle_mass_col(:)
+    real(dp), allocatable :: saddle_mass_values(:)
     ! the CSR mass of a planar reduction as kron(Mbar, I2) over the plane's (x, y) pairs
     ! (plane_mass_setup; unallocated otherwise): Mbar's rows by pair, each entry's column the
     ! x coordinate of its pair (y: x + 1), and each pair's x coordinate

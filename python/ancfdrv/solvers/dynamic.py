@@ -18,21 +18,19 @@ and decides when to factorize the iteration matrix S = beta' M + K:
 Each chunk's outputs go to a ``sink`` (the HDF5 writer) before the next chunk starts, so an
 interrupted or failed run keeps every completed chunk.
 
-Step-size control (:class:`StepControl`, issue 26). The output stays on the user's grid
-t0 + k dt: every step lands on it exactly (no interpolation; a step is shortened to reach
-the next grid time). With ``step = 'fixed'`` the kernel steps whole chunks at dt; a step
-that fails (Newton diverges or stalls, the state turns non-finite, a linear solve or the
-contact search fails: a contact set that cycles shows as a Newton stall) is retried from its
-start with half the step, again and again down to ``dt_min``, and the step doubles back after
-GROW_AFTER successes in a row (at most to dt, where whole chunks resume). A failure at
-dt_min ends the run (SolverError, exit 3). A Newton stall at the round-off floor with a
-tolerance below what double precision resolves is not retried (a smaller step does not
-lower the floor). With ``step = 'adaptive'`` every step is sized by the local error
-estimate of Zienkiewicz & Xie (1991; see :func:`local_error`) to ``tolerance`` (bounded by
-dt and dt_min), and the same cuts apply to failed steps; a step at dt_min (within
-:data:`STEP_RTOL`) whose estimate exceeds the tolerance ends the run (SolverError, exit 3).
-No loop of the control ends only by round-off: tries in a row without an accepted step are
-bounded, and ``should_stop`` is asked after each of them.
+Step-size control (issue 26) is the kernel's too (``fortran/src/solvers/step_control.f90``):
+the output stays on the user's grid t0 + k dt, every row landed on exactly. With
+``step = 'fixed'`` the kernel steps whole chunks at dt; a step that fails (Newton diverges or
+stalls, the state turns non-finite, a linear solve or the contact search fails) is retried
+from its start with half the step, down to ``dt_min``, and the step doubles back after four
+successes in a row; a failure at dt_min ends the run (SolverError, exit 3), and a Newton
+stall at the round-off floor with a tolerance below what double precision resolves is not
+retried. With ``step = 'adaptive'`` every step is sized by the local error estimate of
+Zienkiewicz & Xie (1991) to ``tolerance`` (bounded by dt and dt_min), with the same cuts;
+a step at dt_min whose estimate exceeds the tolerance ends the run (SolverError, exit 3).
+At each change of the step the method restarts from the consistent acceleration
+(:func:`initial_acceleration`'s kernel routine). A call tries a bounded number of steps, so
+``should_stop`` is asked at least every ~0.25 s, also inside an output interval.
 """
 from __future__ import annotations
 
@@ -45,11 +43,9 @@ from typing import Callable
 import numpy as np
 
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
-                     JACOBIAN_REUSE, JACOBIAN_STEP, STAT_NAMES)
-from ..csr import Csr
+                     JACOBIAN_REUSE, JACOBIAN_STEP, KERNEL_LAYOUTS, STAT_NAMES)
 from ..errors import InputError, Interrupted, SolverError, UnstableError
 from ..io.validate import check_arguments, check_state
-from ..kernel import DirectSolver, dense_solve
 from ..kernel import _text as kernel_text
 from ..system.model import Model
 from .assumptions import FFR_LIMIT, check_ffr, ffr_departure_rows
@@ -202,80 +198,15 @@ def _progress_bar(show: bool, total: float):
                 bar_format="{l_bar}{bar}| t={n:.3f}/{total:.3f} s [{elapsed}<{remaining}{postfix}]")
 
 
-def _saddle_solve(model: Model, matrix: Csr, rhs_top: np.ndarray,
-                  rhs_bottom: np.ndarray, e: np.ndarray, t: float, what: str,
-                  evaluated: tuple | None = None):
-    """Solve [[matrix, -Phi_e^T], [-Phi_e, 0]] [x; lam] = [rhs_top; rhs_bottom]
-    (``evaluated``: the constraints' evaluation at (e, t) when the caller has it)."""
-    n, ncon = model.ndof, len(model.constraints)
-    _, rows, cols, grads = model.constraints.jacobian(e, n, t, evaluated)
-    r = np.concatenate([matrix.row_index(), cols, n + rows])
-    c = np.concatenate([matrix.indices, n + rows, cols])
-    v = np.concatenate([matrix.data, -grads, -grads])
-    rhs = np.concatenate([rhs_top, rhs_bottom])
-    if n + ncon <= DENSE_SADDLE_MAX:
-        x = dense_solve(n + ncon, r, c, v, rhs, what=what)
-        return x[:n], x[n:]
-    if n + ncon > SADDLE_REUSE_MAX:
-        with DirectSolver(n + ncon, r, c, what=what) as solver:
-            solver.factorize(v)
-            x = solver.solve(rhs)
-        return x[:n], x[n:]
-    solver = _SADDLE_SOLVERS.pop() if _SADDLE_SOLVERS else None
-    try:
-        if solver is None:
-            solver = DirectSolver(n + ncon, r, c, what=what)
-        else:
-            solver.what = what
-            last = getattr(solver, "saddle_pattern", None)
-            # the pattern it analysed last (MUMPS analyses the structure, its values 0):
-            # the analysis is kept for the same pattern, as for any refactorization
-            if last is None or last[0] != n + ncon or not (
-                    np.array_equal(last[1], r) and np.array_equal(last[2], c)):
-                solver.saddle_pattern = None
-                solver.analyse(n + ncon, r, c)
-        solver.saddle_pattern = (n + ncon, r, c)
-        solver.factorize(v)
-        x = solver.solve(rhs)
-    except BaseException:
-        if solver is not None:   # after a failure: released, not reused
-            solver.close()
-        raise
-    _SADDLE_SOLVERS.append(solver)
-    return x[:n], x[n:]
-
-
-#: saddle systems of at most this many unknowns share MUMPS instances (a free list of
-#: :data:`_SADDLE_SOLVERS`), analysed anew for each system: an instance's creation and
-#: release were half of a small model's initial acceleration (~1 M instructions, mostly
-#: MUMPS's set-up). A larger system gets its own instance, released after the solve, so
-#: no factors worth counting stay in memory while the run steps (at 4096 the 512-element
-#: cantilever's kept instance raised its peak resident set by 3.6 MB, 1.43x -> 1.50x
-#: Exudyn's: `benchmarks/peer_cantilever.py`).
-SADDLE_REUSE_MAX = 256
-#: saddle systems of at most this many unknowns are formed densely and solved by LAPACK's
-#: LU with partial pivoting in the kernel (:func:`ancfdrv.kernel.dense_solve`; at most
-#: 0.2 MB for the time of the solve at 160): on a warm cache 0.014 ms against MUMPS's
-#: 0.12 ms at 22 unknowns (the 5-node planar pendulum), 0.13 against 0.24 at 134, about
-#: equal at 200. OFF (0) by default: the two solutions agree to round-off (~1e-14 of the
-#: largest entry, `tests/test_dense_saddle.py`), but a start acceleration that differs
-#: in its last bits moves where the Newton iterations of later steps stop, so the
-#: histories move by up to the Newton tolerance (history_gate, 63 runs: 21 differ, by
-#: 1e-9 to 8e-7 of a dataset's largest value; the spin-up's corrections 616 -> 611), not
-#: bitwise nor within 1e-12. Set it to 160 where that is accepted. (The thrown rope's energy
-#: test, `tests/test_rope.py`, is one history such last bits move far: its energy error at
-#: dt = 2e-4 went 1.4e-4 -> 2.1e-4, against its bound of 2e-4; see that test.)
-DENSE_SADDLE_MAX = 0
-_SADDLE_SOLVERS: list[DirectSolver] = []
-
-
 def initial_acceleration(model: Model, e: np.ndarray, v: np.ndarray, t: float):
-    """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma."""
-    evaluated = model.constraints.evaluate(e, t, v)   # (its gradients do not depend on v)
-    forces = model.forces(e, t, v)
-    return _saddle_solve(model, model.mass, forces["external"] - forces["internal"],
-                         -evaluated[-1], e, t,
-                         "initial acceleration [[M, -Phi_e^T], [-Phi_e, 0]]", evaluated)
+    """Consistent a(t) and lambda(t) from the equations of motion and Phi_e a = gamma: the
+    kernel's saddle solve (``fortran/src/solvers/consistent_start.f90``), the one the
+    stepper's restarts use. The contact guesses start from and update the model's."""
+    out = model.kernel.consistent_acceleration(t, e, v, model.contact_guesses,
+                                               model.contact_counts)
+    model.contact_guesses, model.contact_counts = out["guesses"], out["counts"]
+    model.count_consistent_accelerations(1)
+    return out["accel"], out["lam"]
 
 
 class TimeIntegrator:
@@ -287,12 +218,16 @@ class TimeIntegrator:
                              key="dt")
         model.check_alive()
         settings.jacobian_code  # validates the policy  # noqa: B018
+        if settings.step not in ("fixed", "adaptive"):
+            raise InputError(f"step {settings.step!r} must be 'fixed' or 'adaptive'",
+                             group="solver", key="step")
         self.model, self.settings = model, settings
         settings.length_scale = model.length_scale
-        self.last_correction = 0.0
         self.floor_accepts = 0   # steps converged at the round-off floor (all calls)
-        self.failed_stats = np.zeros(3, dtype=np.int64)  # the last failed step's work
         self.failure_text = ""   # the kernel's text of the last failed step
+        #: the last call's status and figures (codes.KERNEL_LAYOUTS 'as', 'af')
+        self.status = [0] * len(KERNEL_LAYOUTS["as"])
+        self.figures = np.zeros(len(KERNEL_LAYOUTS["af"]))
 
     def state(self, t: float, e: np.ndarray, v: np.ndarray, a: np.ndarray,
               lam: np.ndarray) -> dict:
@@ -311,49 +246,81 @@ class TimeIntegrator:
             t=t, e=e, v=v, a=a, accel=a, lam=lam, work=np.zeros(5), powers=np.zeros(5),
             guesses=self.model.contact_guesses.copy(), counts=np.zeros(6, dtype=np.int32)))
 
-    def advance(self, state: dict, nsteps: int, h: float | None = None
+    def advance(self, state: dict, nrows: int, budget: int | None = None
                 ) -> tuple[Chunk, int, int]:
-        """Advance ``nsteps`` steps of size h (default dt); ``state`` is updated in place.
-        Returns the chunk of completed steps, the kernel's info and detail codes (a failed
-        step's statistics go to ``failed_stats``)."""
+        """Advance up to ``nrows`` output rows with at most ``budget`` steps tried (default
+        1024 per row) under the kernel's step-size control
+        (``fortran/src/solvers/step_control.f90``); ``state`` is updated in place (an
+        output interval the budget ended inside is resumed by the next call). Returns the
+        chunk of completed rows, the kernel's info and detail codes (:meth:`failure_message`
+        says a failure in words; the kernel's status and figures are kept in ``status`` and
+        ``figures``)."""
         s, m = self.settings, self.model
         kernel = m.kernel
-        # the raw rows, sliced here: a single step under step control costs ~60 us, so the
-        # numpy calls of an intermediate unpacking would show
-        rows, stats, status, self.last_correction, message = kernel.advance_rows(
-            nsteps, s.dt if h is None else h, state, s.store_q)
-        done, info, detail, floor = status
+        rows, stats, sizes, self.status, self.figures, message = kernel.advance_rows(
+            nrows, 1024 * nrows if budget is None else budget, state, s.store_q)
+        done, info, detail = self.status[:3]
         self.failure_text = kernel_text(message) if info else ""
-        self.floor_accepts += floor
-        self.failed_stats = stats[:, done].astype(np.int64) if info and done < nsteps \
-            else _NO_STATS
+        self.floor_accepts += self.status[_STATUS["floor_accepts"]]
         _, probes, deflections, lam, energy, constraint, contact, q = kernel.row_slices(
             s.store_q)
-        cols = rows.T[:done]     # (done, row_size): one row per step
+        cols = rows.T[:done]     # (done, row_size): one row per output time
         made = functools.partial(_row_fields, cuts=(probes, deflections, lam, energy,
                                                     constraint, contact),
                                  nprobe=kernel.nprobe,
                                  npoint=m.npoint if m.contact_pairs else -1)
         fields = made(cols)
-        chunk = Chunk(**fields, stats=stats[:, :done].T, q=cols[:, q] if s.store_q else None,
-                      rows=(cols, q.start, fields, made))
+        counts = stats[:, :done].T
+        chunk = Chunk(**fields, stats=counts[:, :3], q=cols[:, q] if s.store_q else None,
+                      rows=(cols, q.start, fields, made), step_size=sizes[:done],
+                      substeps=counts[:, 3], cuts=counts[:, 4])
         return chunk, info, detail
 
-    def failure_message(self, info: int, detail: int, t: float, h: float | None = None,
-                        cuts: int = 0) -> str:
+    def control_counts(self) -> dict[str, int]:
+        """The run's step-size control so far (the last call's status): step cuts, steps
+        rejected by the error estimate, restarts, steps taken."""
+        return {name: int(self.status[_STATUS[name]])
+                for name in ("cuts", "rejected", "restarts", "taken")}
+
+    @property
+    def failed_work(self) -> np.ndarray:
+        """The work of a failed call's failed tries the run counts (corrections,
+        factorizations, Jacobian evaluations)."""
+        return np.array(self.status[_STATUS["failed_corrections"]:
+                                    _STATUS["failed_jacobians"] + 1], dtype=np.int64)
+
+    def failure_message(self, info: int, detail: int) -> str:
+        """The failure of the last call in words, with the scene keys that help."""
         s = self.settings
-        h = s.dt if h is None else h
+        t = float(self.figures[_FIGURES["failure_t"]])
+        h = float(self.figures[_FIGURES["failure_h"]])
+        if info == CONTROL_TRIES:
+            halvings = int(np.ceil(np.log2(max(s.dt / s.smallest_step, 1.0))))
+            return (f"step-size control: {self.status[_STATUS['failure_tries']]} tries in a "
+                    f"row from t = {t:.6g} s without an accepted step (halving dt = "
+                    f"{s.dt:.3g} s to solver.dt_min = {s.smallest_step:.3g} s takes "
+                    f"{halvings}); the run stops")
+        if info == CONTROL_TOLERANCE:
+            allowed = s.tolerance * s.length_scale
+            return (f"time step from t = {t:.6g} s to t = {t + h:.6g} s: its local error "
+                    f"estimate exceeds solver.tolerance x length = {allowed:.3g} m even at "
+                    f"the smallest step, solver.dt_min = {s.smallest_step:.3g} s: the "
+                    "tolerance cannot be met; raise solver.tolerance or lower solver.dt_min")
+        if info == CONTROL_RESTART:
+            return f"the restart of the method at t = {t:.6g} s failed: {self.failure_text}"
         # what failed, in the kernel's words (time_integrator step_failure_text); the
         # scene keys that help, here
         reason = self.failure_text or f"kernel code {info} (detail {detail})"
         if info == 1:
-            reason += (f" (last correction {self.last_correction:.3e} m, tolerance "
+            last = float(self.figures[_FIGURES["last_correction"]])
+            reason += (f" (last correction {last:.3e} m, tolerance "
                        f"{s.tol * self.model.length_scale:.3e} m = newton_tol x length")
             if detail == NEWTON_FLOOR_STALL:
                 reason += ("; the corrections cannot fall below the round-off of the "
                            "coordinates: raise solver.newton_tol)")
             else:
                 reason += "; raise solver.max_newton or lower solver.dt_min)"
+        cuts = self.status[_STATUS["failure_cuts"]]
         if cuts:
             reason += (f"; the step was cut {cuts} times, the last from {2 * h:.3g} s to "
                        f"{h:.3g} s, and solver.dt_min = {s.smallest_step:.3g} s allows no "
@@ -374,120 +341,15 @@ def _row_fields(cols: np.ndarray, cuts: tuple, nprobe: int, npoint: int) -> dict
                 if npoint >= 0 else None)
 
 
-#: a call's failed-step statistics when no step failed (shared, never written)
-_NO_STATS = np.zeros(3, dtype=np.int64)
-_NO_STATS.flags.writeable = False
-
 #: why a step's Newton iteration ended unconverged (time_integrator's newton_* codes; the
 #: kernel's message says it in words)
 NEWTON_LIMIT, NEWTON_FLOOR_STALL, NEWTON_STALL, NEWTON_DIVERGED = 0, 1, 2, 3
-#: kernel failures a smaller step may avoid (not: a constraint or drive that cannot be
-#: evaluated, a refused call)
-RETRYABLE = {1, 2, 3, 4, 6, 7, 8}
-#: successful steps in a row after which a cut step doubles again
-GROW_AFTER = 4
-#: the relative slack within which two step sizes are one: a step that would end short of
-#: the next grid time by less is stretched onto it, and a step within it of dt_min is at
-#: dt_min (cannot be cut nor rejected). A sub-step that ends an interval is t_target - t,
-#: t the sum of the interval's earlier sub-steps, so it carries their round-off, a few ulps
-#: of t: 1.9e-11 of a 4.9e-7 s step at t = 0.05 s (9e-18 s, 1.3 ulp), which compared with
-#: dt_min at 1e-12 was rejected, cut back to that same remainder, forever (issue 35). 1e-9
-#: covers k ulps of t for k t / h up to ~4e6 (the k sub-steps of an interval, h >= dt_min),
-#: and is far below the factor 2 between the sizes the control chooses (dt / 2^k); beyond
-#: it the controller's own step, set to dt_min exactly, still says the floor is reached.
-STEP_RTOL = 1e-9
-
-
-def local_error(settings: DynamicSettings, h: float, accel_old: np.ndarray,
-                accel_new: np.ndarray) -> float:
-    """The local error estimate of Newmark's displacement update (Zienkiewicz & Xie 1991,
-    "A simple error estimator and adaptive time stepping procedure for dynamic analysis",
-    Earthquake Eng. Struct. Dyn. 20, 871-887): the Taylor remainder of
-    e_{n+1} = e_n + h e'_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}) against the exact motion
-    is (beta - 1/6) h^3 e^(3), with e^(3) ~ (a_{n+1} - a_n) / h:
-        eta = |beta - 1/6| h^2 max |a_{n+1} - a_n|,
-    here with the accelerations e'' (for generalized-alpha the same remainder with its beta).
-    Returned relative to tolerance x length scale: a step is accepted at <= 1."""
-    eta = abs(settings.beta - 1.0 / 6.0) * h * h * np.max(np.abs(accel_new - accel_old),
-                                                          initial=0.0)
-    return eta / (settings.tolerance * settings.length_scale)
-
-
-@dataclass
-class StepControl:
-    """The step-size control's state (issue 26), apart from the kernel's system: the
-    current step, the successes since the last cut, the counts of the run."""
-
-    settings: DynamicSettings
-    h: float = 0.0
-    successes: int = 0
-    cuts: int = 0
-    rejected: int = 0
-    taken: int = 0
-    smallest: float = np.inf
-    #: the size of the last step taken (a change restarts the method, :func:`_restart`)
-    last_h: float = 0.0
-    restarts: int = 0
-
-    def __post_init__(self) -> None:
-        self.h = self.last_h = self.settings.dt
-
-    @property
-    def whole_chunks(self) -> bool:
-        """Whether the kernel may step whole chunks at dt (fixed steps, no cut pending)."""
-        return self.settings.step == "fixed" and self.h >= self.settings.dt
-
-    def succeeded(self, h: float, remaining: float, error: float | None = None) -> None:
-        """A step of size h succeeded, ``remaining`` is left to the next grid time. Steps
-        are dt / 2^k: the step doubles after GROW_AFTER successes (adaptive: after a step
-        whose error estimate, ~h^3, stays below 1 at twice the step: error <= 0.9 / 8) where
-        the double step lands on the grid."""
-        self.taken += 1
-        self.smallest = min(self.smallest, h)
-        self.successes += 1
-        if error is not None:
-            grow = error <= 0.9 / 8.0
-        else:
-            grow = self.successes >= GROW_AFTER
-        double = 2.0 * self.h
-        aligned = remaining <= 0.0 or abs(remaining / double - round(remaining / double)) < 1e-6
-        if grow and self.h < self.settings.dt and aligned:
-            self.h = min(self.settings.dt, double)
-            self.successes = 0
-
-    def cut(self, h: float) -> bool:
-        """A step of size h failed: halve it; False when that falls below dt_min."""
-        self.successes = 0
-        if 0.5 * h < self.settings.smallest_step * (1.0 - STEP_RTOL):
-            return False
-        self.cuts += 1
-        self.h = 0.5 * h
-        return True
-
-    def at_floor(self, h: float) -> bool:
-        """Whether a step of size h is at dt_min (within STEP_RTOL): it, or the controller's
-        step it was stretched from to land on the grid, cannot be made smaller."""
-        floor = self.settings.smallest_step * (1.0 + STEP_RTOL)
-        return h <= floor or self.h <= floor
-
-    def reject(self, h: float, error: float) -> None:
-        """The error estimate rejected a step of size h: halved until the estimate (~h^3)
-        would meet the tolerance (at least once, at most to dt_min)."""
-        self.rejected += 1
-        self.successes = 0
-        self.h = 0.5 * h
-        while error / 8.0 > 1.0 and 0.5 * self.h >= self.settings.smallest_step:
-            self.h *= 0.5
-            error /= 8.0
-        self.h = max(self.h, self.settings.smallest_step)
-
-
-_STATE_KEYS = ("t", "e", "v", "a", "accel", "lam", "work", "powers", "guesses", "counts")
-
-
-def _snapshot(state: dict) -> dict:
-    return {k: (state[k].copy() if isinstance(state[k], np.ndarray) else state[k])
-            for k in _STATE_KEYS}
+#: the step-size control's own failures (step_control.f90 control_*): tries in a row without
+#: an accepted step, the error estimate above the tolerance at dt_min, a failed restart
+CONTROL_TRIES, CONTROL_TOLERANCE, CONTROL_RESTART = 11, 12, 13
+#: the positions in a controlled advance's status and figures (system_advance)
+_STATUS = {name: i for i, name in enumerate(KERNEL_LAYOUTS["as"])}
+_FIGURES = {name: i for i, name in enumerate(KERNEL_LAYOUTS["af"])}
 
 
 class EnergyWatch:
@@ -637,94 +499,6 @@ def energy_floor(model: Model, settings: DynamicSettings) -> float:
     return 0.5 * trace * (settings.tol * model.length_scale / settings.dt) ** 2
 
 
-def _restart(model: Model, state: dict) -> None:
-    """A restart of the method at a change of the step: the acceleration and the
-    multipliers consistent with the state (:func:`initial_acceleration`), the
-    generalized-alpha variable a = e''. At rho_inf = 1 the method leaves a period-2
-    oscillation of a - e'' and of the multipliers undamped forever (docs/theory.md section
-    14), and a change of the step turns it into an error of order (constraint violation) /
-    h^2 that is never damped either; the restart removes it (accuracy is kept: a and e''
-    differ by O(h^2) at rho_inf = 1)."""
-    accel, lam = initial_acceleration(model, state["e"], state["v"], state["t"])
-    state["a"], state["accel"], state["lam"] = accel.copy(), accel.copy(), lam.copy()
-
-
-def _interval(integrator: "TimeIntegrator", control: StepControl, state: dict,
-              t_target: float, stats0: np.ndarray | None = None, cuts0: int = 0,
-              should_stop: Callable[[], bool] | None = None) -> Chunk:
-    """Steps of the controller's size from state["t"] to the grid time t_target (landed on
-    exactly); returns the row at t_target with the interval's statistics (failed tries
-    included). Raises SolverError when a step fails at dt_min, or when its error estimate
-    exceeds the tolerance at dt_min, and Interrupted when ``should_stop`` says so after a
-    try (the interval's steps are then dropped: the state stays where it got to)."""
-    s = integrator.settings
-    stats = np.zeros(3, dtype=np.int64) if stats0 is None else stats0.copy()
-    cuts, taken, smallest, last = cuts0, 0, np.inf, None
-    adaptive = s.step == "adaptive"
-    # a guard: each cut or rejection at least halves the controller's step until dt_min,
-    # where the next one ends the run, so this many tries in a row cannot fail or be
-    # rejected unless the control is broken (it ends the run instead of looping)
-    max_tries = 8 + int(np.ceil(np.log2(max(s.dt / s.smallest_step, 1.0))))
-    tries = 0  # failed or rejected since the last accepted step
-    while True:
-        remaining = t_target - state["t"]
-        if remaining <= STEP_RTOL * s.smallest_step:
-            break
-        if should_stop is not None and should_stop():
-            raise Interrupted(f"stopped at t = {state['t']:.6g} s, between two output rows")
-        if tries >= max_tries:
-            raise SolverError(f"step-size control: {tries} tries in a row from t = "
-                              f"{state['t']:.6g} s without an accepted step (halving dt = "
-                              f"{s.dt:.3g} s to solver.dt_min = {s.smallest_step:.3g} s takes "
-                              f"{max_tries - 8}); the run stops")
-        h = control.h
-        if h >= remaining * (1.0 - STEP_RTOL):
-            h = remaining
-        if abs(h - control.last_h) > STEP_RTOL * h:
-            _restart(integrator.model, state)
-            control.restarts += 1
-        before = _snapshot(state)
-        chunk, info, detail = integrator.advance(state, 1, h)
-        tries += 1
-        if info:
-            stats += integrator.failed_stats
-            retry = info in RETRYABLE and not (info == 1 and detail == NEWTON_FLOOR_STALL)
-            if not retry or not control.cut(h):
-                state.update(before)
-                raise SolverError(integrator.failure_message(info, detail, state["t"], h,
-                                                             cuts if retry else 0))
-            cuts += 1
-            state.update(before)
-            continue
-        stats += chunk.stats[0].astype(np.int64)
-        error = local_error(s, h, before["accel"], state["accel"]) if adaptive else None
-        if error is not None and error > 1.0:
-            state.update(before)
-            if control.at_floor(h):
-                allowed = s.tolerance * s.length_scale
-                raise SolverError(
-                    f"time step from t = {state['t']:.6g} s to t = {state['t'] + h:.6g} s: "
-                    f"its local error estimate exceeds solver.tolerance x length = "
-                    f"{allowed:.3g} m even at the smallest step, solver.dt_min = "
-                    f"{s.smallest_step:.3g} s: the tolerance cannot be met; raise "
-                    "solver.tolerance or lower solver.dt_min")
-            control.reject(h, error)
-            continue
-        tries = 0
-        control.last_h = h
-        control.succeeded(h, t_target - state["t"], error)
-        taken += 1
-        smallest = min(smallest, h)
-        last = chunk
-    state["t"] = t_target
-    last.time = np.array([t_target])
-    last.stats = stats[None, :]
-    last.step_size = np.array([smallest])
-    last.substeps = np.array([taken], dtype=np.int64)
-    last.cuts = np.array([cuts], dtype=np.int64)
-    return last
-
-
 def initial_row(model: Model, state: dict) -> Chunk:
     """The output row of the initial state, with the kernel's energy definitions; the state
     gets the powers there (the start of the works the stepper integrates)."""
@@ -804,58 +578,23 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     row_cap = call_rows(model, settings)
     # the first call measures a step's cost
     call_steps = min(settings.chunk_steps, 10, row_cap)
-    if settings.step not in ("fixed", "adaptive"):
-        raise InputError(f"step {settings.step!r} must be 'fixed' or 'adaptive'",
-                         group="solver", key="step")
-    control = StepControl(settings)
     energy_watch = EnergyWatch(first.energy[0], settings.energy_tolerance,
                                energy_floor(model, settings))
-    failed = np.zeros(3, dtype=np.int64)  # work of failed tries before a row's interval
-    carried_cut = False  # a whole chunk's step failed and was cut: its row counts the cut
     try:
         while steps < total:
             t_before = state["t"]
             t1 = time.perf_counter()
-            pending = None  # a failed step of a whole chunk: redone with cut steps
-            if control.whole_chunks:
-                if control.last_h != settings.dt:  # back to dt after cut steps
-                    _restart(model, state)
-                    control.restarts += 1
-                    control.last_h = settings.dt
-                n = min(call_steps, total - steps)
-                chunk, info, detail = integrator.advance(state, n)
-                elapsed = time.perf_counter() - t1
-                if len(chunk.time):  # calls of at most ~0.25 s: a stop request waits no longer
-                    call_steps = max(1, min(settings.chunk_steps, row_cap,
-                                            int(0.25 * len(chunk.time) / max(elapsed, 1e-9))))
-                control.taken += len(chunk.time)
-                if len(chunk.time):
-                    control.smallest = min(control.smallest, settings.dt)
-                if info:
-                    failed += integrator.failed_stats
-                    retry = info in RETRYABLE and not (info == 1
-                                                       and detail == NEWTON_FLOOR_STALL)
-                    if not retry or not control.cut(settings.dt):
-                        pending = SolverError(integrator.failure_message(info, detail,
-                                                                         state["t"]))
-                    else:
-                        carried_cut = True
-            else:
-                # the grid time the kernel's whole chunks would reach (t + dt each step)
-                t_target = t0 + (steps + 1) * settings.dt if settings.step == "adaptive" \
-                    else state["t"] + settings.dt
-                try:
-                    chunk = _interval(integrator, control, state, t_target, failed,
-                                      int(carried_cut), should_stop)
-                except SolverError as exc:
-                    pending = exc
-                    chunk = Chunk(time=np.zeros(0), probes=np.zeros((0, 0, 3)),
-                                  deflections=np.zeros((0, 0, 3)), lam=np.zeros((0, 0)),
-                                  energy=np.zeros((0, 11)), constraint=np.zeros(0),
-                                  stats=np.zeros((0, 3)), q=None)
-                failed = np.zeros(3, dtype=np.int64)
-                carried_cut = False
-            timing["stepping"] += time.perf_counter() - t1
+            # rows within the call's budget of steps tried (all of them at dt unless a step
+            # is cut or sized by the error estimate)
+            chunk, info, detail = integrator.advance(state, min(call_steps, total - steps),
+                                                     call_steps)
+            elapsed = time.perf_counter() - t1
+            tries = integrator.status[_STATUS["tries"]]
+            if tries:  # calls of at most ~0.25 s: a stop request waits no longer
+                call_steps = max(1, min(settings.chunk_steps, row_cap,
+                                        int(0.25 * tries / max(elapsed, 1e-9))))
+            pending = SolverError(integrator.failure_message(info, detail)) if info else None
+            timing["stepping"] += elapsed
             steps += len(chunk.time)
             # (the three columns' sums in one reduction: integers, exact either way)
             totals = np.add.reduce(chunk.stats, axis=0)
@@ -873,7 +612,8 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             bar.set_postfix(steps=steps, newton=newton)
             if outside:
                 raise SolverError(outside)
-            if isinstance(pending, SolverError):
+            if pending is not None:
+                failed = integrator.failed_work
                 newton += int(failed[0])
                 factorizations += int(failed[1])
                 jacobians += int(failed[2])
@@ -886,14 +626,18 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
             raise UnstableError(energy_watch.message())
     finally:  # the counters hold what was done, also when a step failed
         bar.close()
+        control = integrator.control_counts()
         model.counters["time_steps"] += steps
         model.counters["newton_iterations"] += newton
         model.counters["solves"] += newton
         model.counters["factorizations"] += factorizations
         model.counters["jacobian_evaluations"] += jacobians
-        for name, count in (("step_cuts", control.cuts), ("steps_rejected", control.rejected),
-                            ("step_restarts", control.restarts),
-                            ("steps_taken", control.taken),
+        # (each restart evaluated the forces and constraints for its consistent acceleration)
+        model.count_consistent_accelerations(control["restarts"])
+        for name, count in (("step_cuts", control["cuts"]),
+                            ("steps_rejected", control["rejected"]),
+                            ("step_restarts", control["restarts"]),
+                            ("steps_taken", control["taken"]),
                             ("newton_floor_accepts", integrator.floor_accepts)):
             model.counters[name] = model.counters.get(name, 0) + int(count)
         if model.contact_pairs:
@@ -904,9 +648,10 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
     timing["total"] = wall
     return DynamicResult(steps=steps, newton_iterations=newton, factorizations=factorizations,
                          wall_time_s=wall, timing=timing, jacobians=jacobians,
-                         step_cuts=control.cuts, steps_rejected=control.rejected,
-                         steps_taken=control.taken,
-                         smallest_step=float(control.smallest) if control.taken else 0.0,
+                         step_cuts=control["cuts"], steps_rejected=control["rejected"],
+                         steps_taken=control["taken"],
+                         smallest_step=float(integrator.figures[_FIGURES["smallest"]])
+                         if control["taken"] else 0.0,
                          floor_accepts=integrator.floor_accepts)
 
 
@@ -943,5 +688,4 @@ def _outside(model: Model, e, t: float, how: str) -> str:
 
 
 __all__ = ["DynamicSettings", "Chunk", "DynamicResult", "TimeIntegrator", "integrate",
-           "StepControl", "local_error",
            "initial_acceleration", "initial_row", "ENERGY_NAMES", "CONTACT_FIELDS", "STAT_NAMES"]

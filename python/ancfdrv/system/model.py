@@ -309,16 +309,25 @@ class Model:
         out = self.kernel.evaluate(t, e, np.zeros(self.ndof) if v is None else v,
                                    self.contact_guesses, self.contact_counts, load_factor=lf,
                                    velocity_factor=velocity_factor, want_tangent=want_tangent)
-        self.counters["elastic_force"] += 1
+        self._count_force_evaluations(1)
         if want_tangent:
             self.counters["stiffness_assembly"] += 1
-        if self.damped:
-            self.counters["damping"] += 1
-        if self.moments:
-            for m in self.moments:
-                self.counters[m.effect] += 1
         self.contact_guesses, self.contact_counts = out["guesses"], out["counts"]
         return out
+
+    def _count_force_evaluations(self, n: int) -> None:
+        """Count n evaluations of the forces in the kernel (elastic, damping, moments)."""
+        self.counters["elastic_force"] += n
+        if self.damped:
+            self.counters["damping"] += n
+        for m in self.moments or ():
+            self.counters[m.effect] += n
+
+    def count_consistent_accelerations(self, n: int) -> None:
+        """Count n consistent accelerations solved in the kernel (the start of a run and
+        its restarts: each evaluates the forces and the constraints once)."""
+        self._count_force_evaluations(n)
+        self.constraints.evaluations += n
 
     def internal_force(self, e: np.ndarray, t: float = 0.0, want_tangent: bool = False):
         """B^T (Q_el - Q_contact - Q_M), strain energy and (on request) the tangent values."""
@@ -577,7 +586,7 @@ class Model:
         mass.sort_indices()
         ks.set_matrices(mass, (self.full_pattern.row_ptr, self.full_pattern.col_index),
                         self.solver.handle, self.policy, self.mass_values(), self.vector_frame,
-                        self.touched_blocks())
+                        self.touched_blocks(), self.mass)
         scalar = kron_scalar(mass)
         if scalar is not None:
             ks.set_kron_mass(scalar)

@@ -1,0 +1,161 @@
+!> The consistent acceleration and multipliers of a state (t, e, e'): the start of a run and
+!> the restart of the method at a change of the step (step_control). With the equations of
+!> motion and the constraints differentiated twice (Phi_e e'' = gamma):
+!>   [[M, -Phi_e^T], [-Phi_e, 0]] [e''; lambda] = [Q(t) - B^T (Q_el - Q_c - Q_M); -gamma],
+!> solved by MUMPS (unsymmetric) on the coordinate list of M as the model assembled it (its
+!> zero entries kept: the saddle's pattern and its analysis do not depend on the values),
+!> then Phi_e^T's and Phi_e's entries, constraint by constraint, operand by operand, term by
+!> term. One MUMPS instance per solve, released after it. No I/O; failures return codes and
+!> text.
+module consistent_start
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
+                               external_forces, contact_record
+  use constraints, only: constraint_eval
+  use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
+                           solver_destroy
+  use kernel_errors, only: failure_text, message_length
+  implicit none
+  private
+  public :: consistent_acceleration
+
+contains
+
+  !> accel = e'' and lam = lambda consistent with (t, e, v); contact: the contact guesses the
+  !> force evaluation starts from (updated) and its counters. info /= 0: the failure, in
+  !> words in message (a force or constraint evaluation's code, or 3: the saddle system's
+  !> solve failed, detail the MUMPS code INFOG(1)).
+  subroutine consistent_acceleration(sys, t, e, v, contact, accel, lam, info, detail, message)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: t, e(:), v(:)
+    type(contact_state), intent(inout) :: contact
+    real(dp), intent(out) :: accel(:), lam(:)
+    integer, intent(out) :: info, detail
+    character(len=message_length), intent(out) :: message
+    real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
+    real(dp) :: internal(sys%ndof), external(sys%ndof), strain, potential, powers(2)
+    real(dp) :: records(contact_record, max(1, sys%npoint))
+    real(dp) :: values(sys%ncon), gradients(6, sys%ncon), hessians(6, 6, sys%ncon)
+    real(dp) :: phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    real(dp), allocatable :: entries(:), rhs(:, :)
+    integer, allocatable :: rows(:), cols(:)
+    integer :: n, ncon, nmass, nterm, k, c, s, i, row, handle, stage, ignored
+    character(len=*), parameter :: what = "the consistent acceleration's saddle system " // &
+                                           '[[M, -Phi_e^T], [-Phi_e, 0]]'
+    n = sys%ndof
+    ncon = sys%ncon
+    accel = 0.0_dp
+    lam = 0.0_dp
+    detail = 0
+    message = ''
+    call frame_rotations(sys, t, rotations, rates, info)
+    if (info == 0) call internal_forces(sys, rotations, e, v, 1.0_dp, 0.0_dp, contact, internal, &
+                                        strain, potential, powers, records, info, rates=rates, &
+                                        force_time=t)
+    if (info == 0) call external_forces(sys, t, 1.0_dp, external, info, e)
+    if (info /= 0) then
+      message = 'the force evaluation of the consistent acceleration failed: ' // &
+                failure_text(info)
+      return
+    end if
+    if (ncon > 0) then
+      call constraint_eval(ncon, sys%con_kind, sys%con_drive, sys%con_params, sys%operand_const, &
+                           sys%term_ptr, sys%term_dof, sys%term_coef, sys%drive_kinds, &
+                           sys%drive_ptr, sys%drive_data, e, v, t, values, gradients, hessians, &
+                           phi_t, phi_tt, gamma, info)
+      if (info /= 0) then
+        info = 5
+        message = 'the consistent acceleration: ' // failure_text(info)
+        return
+      end if
+    end if
+    ! the saddle's coordinate list: M's entries, Phi_e^T's (rows of e, columns of lambda),
+    ! Phi_e's (rows of lambda)
+    nmass = size(sys%saddle_mass_col)
+    nterm = 0
+    if (ncon > 0) nterm = sys%term_ptr(6 * ncon + 1) - sys%term_ptr(1)
+    allocate (rows(nmass + 2 * nterm), cols(nmass + 2 * nterm), entries(nmass + 2 * nterm))
+    do row = 1, n
+      do k = sys%saddle_mass_ptr(row), sys%saddle_mass_ptr(row + 1) - 1
+        rows(k) = row
+        cols(k) = sys%saddle_mass_col(k)
+        entries(k) = sys%saddle_mass_values(k)
+      end do
+    end do
+    i = nmass
+    do c = 1, ncon
+      do s = 1, 6
+        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+          i = i + 1
+          rows(i) = sys%term_dof(k)
+          cols(i) = n + c
+          entries(i) = -(sys%term_coef(k) * gradients(s, c))
+          rows(i + nterm) = n + c
+          cols(i + nterm) = sys%term_dof(k)
+          entries(i + nterm) = entries(i)
+        end do
+      end do
+    end do
+    allocate (rhs(n + ncon, 1))
+    rhs(1:n, 1) = external - internal
+    rhs(n + 1:n + ncon, 1) = -gamma
+    stage = 1
+    call solver_create(0, handle, info, detail)
+    if (info == 0) then
+      stage = 2
+      call solver_analyse(handle, n + ncon, size(rows), rows, cols, info, detail)
+      if (info == 0) then
+        stage = 3
+        call solver_factorize(handle, size(entries), entries, info, detail)
+      end if
+      if (info == 0) then
+        stage = 4
+        call solver_solve(handle, n + ncon, 1, rhs, info, detail)
+      end if
+      call solver_destroy(handle, ignored)
+    end if
+    if (info /= 0) then
+      detail = info
+      info = 3
+      message = what // ': ' // trim(stage_name(stage)) // ' failed (' // &
+                trim(mumps_text(detail)) // ')'
+      return
+    end if
+    accel = rhs(1:n, 1)
+    lam = rhs(n + 1:n + ncon, 1)
+  end subroutine consistent_acceleration
+
+  pure function stage_name(stage) result(name)
+    integer, intent(in) :: stage
+    character(len=16) :: name
+    select case (stage)
+    case (1)
+      name = 'creation'
+    case (2)
+      name = 'analysis'
+    case (3)
+      name = 'factorization'
+    case default
+      name = 'solve'
+    end select
+  end function stage_name
+
+  !> MUMPS's INFOG(1) in words (the sparse_direct wrapper's own codes 1 .. 3 too).
+  pure function mumps_text(code) result(text)
+    integer, intent(in) :: code
+    character(len=80) :: text
+    select case (code)
+    case (-10)
+      text = 'the matrix is numerically singular'
+    case (-6)
+      text = 'the matrix is structurally singular'
+    case (-5, -13)
+      text = 'MUMPS could not allocate memory'
+    case (-9)
+      text = 'MUMPS workspace too small'
+    case default
+      write (text, '(a, i0)') 'MUMPS error INFOG(1) = ', code
+    end select
+  end function mumps_text
+
+end module consistent_start
