@@ -459,11 +459,14 @@ class Standard(General):
                     shear_factor_y=self.shear_factor_y, shear_factor_z=self.shear_factor_z,
                     fibre_points=[float(v) for v in self.fibre_points().ravel()])
 
-    def label(self) -> str:
-        """The designation with its strong axis, for pictures and reports."""
+    def label(self, height_axis=None) -> str:
+        """The designation with its strong axis, for pictures and reports (``ancf show``):
+        the web runs along the height (``height_axis``, global when given)."""
         if self.iz == self.iy:
             return self.designation
-        return f"{self.designation}, strong axis: I_z (web along the height)"
+        where = "the height" if height_axis is None else \
+            "(" + ", ".join(f"{v:.3g}" for v in np.asarray(height_axis, float) + 0.0) + ")"
+        return f"{self.designation}, web along {where}: strong axis iz"
 
     def __repr__(self) -> str:
         return f"Standard({self.designation!r})"
