@@ -26,8 +26,8 @@ _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 from ._version import __version__  # noqa: E402,F401
 
 from .system import (Beam, Box, Cable, Circle, Constant, Cycle, General, Leaf, Luffing,  # noqa: E402
-                     Material, Model, Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, System,
-                     Table, Tube)
+                     Material, Model, Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, Standard,
+                     System, Table, Tube)
 
 from .results import Results, open_results  # noqa: E402
 from . import analyses as _analyses  # noqa: E402,F401  (gives System its analyses)
@@ -48,4 +48,4 @@ def __getattr__(name: str):
 
 __all__ = ["simulate", "Simulation", "open", "open_results", "Results", "System", "Model", "Material", "Beam", "Cable",
            "Plate", "Leaf", "RigidBody", "Rectangle", "Box", "Tube", "Circle", "General",
-           "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table", "Ramp"]
+           "Standard", "Constant", "Luffing", "SpinUp", "Cycle", "Sine", "Table", "Ramp"]

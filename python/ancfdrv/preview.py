@@ -105,9 +105,12 @@ def geometry(system: System, model: Model) -> dict[str, Any]:
             centre = np.asarray(body.centre, dtype=float)
             half = 0.5 * float(np.max(np.linalg.norm(nodes - centre, axis=1)))
             box = (centre, half)
+        word = kind_of(body).word
+        section_label = getattr(getattr(body, "section", None), "label", None)
+        if callable(section_label):  # a standard section: its name and strong axis
+            word += ", " + section_label(body.orientation[:, 1])
         bodies[body.name] = dict(edges=edges, nodes=nodes if body.flexible else None,
-                                 box=box, label=nodes.mean(axis=0),
-                                 word=kind_of(body).word)
+                                 box=box, label=nodes.mean(axis=0), word=word)
     joints, lines = [], []
     for joint in system.joints.values():
         support = isinstance(joint.body1, Ground) or isinstance(joint.body2, Ground)

@@ -10,10 +10,10 @@ from .bodies import Material
 from .kinds import Beam, Cable, Leaf, Plate, RigidBody
 from .drives import Constant, Cycle, Drive, Luffing, Ramp, Sine, SpinUp, Table
 from .model import Model
-from .sections import Box, Circle, General, Rectangle, Section, Tube
+from .sections import Box, Circle, General, Rectangle, Section, Standard, Tube
 from .system import System
 
 __all__ = ["System", "Model", "Material", "Beam", "Cable", "Plate", "Leaf", "RigidBody", "Section",
-           "Rectangle", "Box", "Tube", "Circle", "General", "Drive", "Constant", "Luffing", "Ramp",
+           "Rectangle", "Box", "Tube", "Circle", "General", "Standard", "Drive", "Constant", "Luffing", "Ramp",
            "SpinUp",
            "Cycle", "Sine", "Table"]

@@ -1,5 +1,7 @@
-"""Beam cross-sections: solid rectangle, box (hollow rectangle), tube, solid circle, and a
-general section given by its properties.
+"""Beam cross-sections: solid rectangle, box (hollow rectangle), tube, solid circle, a
+general section given by its properties, and the standard steel sections (IPE, HEA, HEB,
+RHS, SHS, CHS: :class:`Standard`, a general section with the numbers of
+:mod:`.section_tables`).
 
 Each section is integrated exactly over its area by a quadrature rule of the kernel
 (``fortran/src/elements/beam_section.f90``): the mass and small-strain stiffness need the
@@ -27,6 +29,7 @@ from .. import kernel
 from ..codes import SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
 from ..errors import InputError
 from ..io.schema import short_repr
+from . import section_tables
 
 
 def rectangle_torsion_constant(width: float, height: float, terms: int = 50) -> float:
@@ -421,6 +424,54 @@ class General(Section):
                 f"rotary_inertia={self.rotary_inertia!r})")
 
 
+class Standard(General):
+    """A standard steel section by its designation ('IPE200', 'HEB300', 'RHS200x100x8',
+    'SHS100x5', 'CHS168.3x8'; :mod:`.section_tables` holds the sizes, their source and
+    the formulas): exactly the :class:`General` section of the same numbers, A, I_y, I_z,
+    J, the shear factors k = A_v / A of EN 1993-1-1's shear areas and the outer fibres,
+    with the section's height along the web (the beam's ``height_axis``). So ``iz`` =
+    int y^2 dA is the strong axis's moment (EN's I_y, bending in the plane of the web) and
+    ``iy`` the weak one (EN's I_z). The mass comes from the material's density, as for
+    every section; :attr:`nominal_mass` is the standards' (7850 kg/m^3)."""
+
+    def __init__(self, designation: str, *, where: str | None = None) -> None:
+        try:
+            props = section_tables.lookup(designation)
+        except LookupError as exc:
+            raise InputError(str(exc)) from None
+        self.properties = props
+        self.designation = props.designation
+        super().__init__(props.area, props.i_minor, props.i_major, props.torsion_constant,
+                         props.shear_area_web / props.area,
+                         props.shear_area_flange / props.area,
+                         fibre_points=props.fibre_points,
+                         where=where or f"section {props.designation!r}")
+
+    @property
+    def nominal_mass(self) -> float:
+        """Mass per length at the standards' 7850 kg/m^3 (kg/m)."""
+        return self.properties.mass_per_length
+
+    def general_values(self) -> dict:
+        """The keys of the equal ``section = 'general'`` input."""
+        return dict(area=self.area, iy=self.iy, iz=self.iz,
+                    torsion_constant=self.torsion_constant,
+                    shear_factor_y=self.shear_factor_y, shear_factor_z=self.shear_factor_z,
+                    fibre_points=[float(v) for v in self.fibre_points().ravel()])
+
+    def label(self, height_axis=None) -> str:
+        """The designation with its strong axis, for pictures and reports (``ancf show``):
+        the web runs along the height (``height_axis``, global when given)."""
+        if self.iz == self.iy:
+            return self.designation
+        where = "the height" if height_axis is None else \
+            "(" + ", ".join(f"{v:.3g}" for v in np.asarray(height_axis, float) + 0.0) + ")"
+        return f"{self.designation}, web along {where}: strong axis iz"
+
+    def __repr__(self) -> str:
+        return f"Standard({self.designation!r})"
+
+
 SECTIONS = {"rectangle": Rectangle, "box": Box, "tube": Tube, "circle": Circle,
             "general": General}
 
@@ -432,10 +483,25 @@ SECTION_KEYS = {"rectangle": ("width", "height"), "box": ("width", "height", "wa
 SECTION_OPTIONAL = {"general": ("mass_per_length", "rotary_inertia", "fibre_points")}
 
 
+def section_name_problem(value) -> str | None:
+    """Why a namelist ``section`` is refused (the key's check), or None: a shape's name or
+    a standard designation (:mod:`.section_tables`) passes."""
+    if value in SECTIONS or section_tables.is_standard(value):
+        return None
+    if section_tables.looks_standard(value):
+        hint = section_tables.nearest(value)
+        return ("is not a standard section of this catalogue"
+                + (f"; nearest: {', '.join(repr(h) for h in hint)}" if hint else "")
+                + " (docs/modelling.md lists the sizes)")
+    return ("must be one of " + ", ".join(repr(k) for k in SECTIONS) + " or a standard "
+            "section such as 'IPE200', 'HEB300', 'RHS200x100x8', 'SHS100x5', 'CHS168.3x8'")
+
+
 def section_of(values: dict, label: str) -> Section | None:
     """The section of a beam's or cable's values: a Section object as it is (the Python
     API's; None: the body's default), or the namelist form, the shape's name under
-    ``section`` with its keys (``section='rectangle', width=..., height=...``)."""
+    ``section`` with its keys (``section='rectangle', width=..., height=...``), or a
+    standard designation alone (``section='IPE200'``)."""
     kind = values.get("section")
     every = {k for ks in SECTION_KEYS.values() for k in ks} | \
         {k for ks in SECTION_OPTIONAL.values() for k in ks} | {"shear"}
@@ -446,8 +512,19 @@ def section_of(values: dict, label: str) -> Section | None:
                              "section as its shape's name with them, or a Section object "
                              "alone", group=label, key="section")
         return kind
+    if isinstance(kind, str) and kind not in SECTIONS and section_tables.looks_standard(kind):
+        given = sorted(k for k in every if values.get(k) is not None)
+        if given:
+            raise InputError(f"section {kind!r} is a standard section: its properties come "
+                             f"from the standard, so {', '.join(given)} must not be given",
+                             group=label, key="section")
+        problem = section_name_problem(kind)
+        if problem:
+            raise InputError(f"section = {kind!r} {problem}", group=label, key="section")
+        return Standard(kind)
     if not isinstance(kind, str) or kind not in SECTIONS:
-        raise InputError("expected a section (Rectangle, Box, Tube, Circle or General), got "
+        raise InputError("expected a section (Rectangle, Box, Tube, Circle, General or a "
+                         "standard name such as 'IPE200'), got "
                          f"{short_repr(kind)}", group=label, key="section")
     keys = SECTION_KEYS[kind]
     optional = SECTION_OPTIONAL.get(kind, ())

@@ -18,7 +18,7 @@ from ..bodies import (VECTOR_OFFSETS, Attachment, Body, Material, _vec, along_ax
 from ..expressions import Vec3
 from ..model import SetInfo
 from ..registry import Kind, SetContext, checked_values, register
-from ..sections import Rectangle, Section, section_of
+from ..sections import Rectangle, Section, section_name_problem, section_of
 
 BEAM_NODE_DOFS = 12
 FORMULATIONS = ("ffr", "nonlinear")
@@ -230,12 +230,15 @@ KEYS: dict[str, Key] = {
     "nodes": Key("int", check=at_least(2), doc="nodes on the beam (>= 2)"),
     "segments": Key("floats", None, doc="segment lengths (m) each split equally (keeps "
                     "their ends as nodes); default: one segment"),
-    "section": Key("str", "rectangle", one_of("rectangle", "box", "tube", "circle",
-                                              "general"),
+    "section": Key("str", "rectangle", section_name_problem,
                    "cross-section: 'rectangle' (width, height), 'box' (width, height, wall), "
                    "'tube' (diameter, wall), 'circle' (diameter), 'general' (area, iy, iz, "
                    "torsion_constant, shear_factor_y, shear_factor_z; optional "
-                   "mass_per_length, rotary_inertia, fibre_points)"),
+                   "mass_per_length, rotary_inertia, fibre_points), or a standard steel "
+                   "section alone: 'IPE80'...'IPE600', 'HEA100'...'HEA600', "
+                   "'HEB100'...'HEB600' (EN 10365), 'RHS200x100x8', 'SHS100x5', "
+                   "'CHS168.3x8' (EN 10219-2; docs/modelling.md lists the sizes), its web "
+                   "along height_axis: iz (bending in the web's plane) is the strong axis"),
     "width": Key("float", None, positive, "section width along r_z (m)"),
     "height": Key("float", None, positive, "section height along r_y (m)"),
     "wall": Key("float", None, positive, "wall thickness of 'box' and 'tube' (m)"),
