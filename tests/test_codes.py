@@ -145,3 +145,19 @@ def test_binding_declares_each_layout_with_its_length():
                     (source, name, dims, prefix)
                 checked += 1
     assert checked >= 20
+
+
+def test_kernel_layout_prefixes_are_unique():
+    """Each layout prefix of codes.KERNEL_LAYOUTS names one layout: a dict literal keeps the
+    last of two equal keys silently (two branches once both chose 'sk', and the section
+    layout was packed as the step control's)."""
+    import ast
+    source = Path(codes.__file__).read_text()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.AnnAssign) and getattr(node.target, "id", "") == \
+                "KERNEL_LAYOUTS":
+            keys = [k.value for k in node.value.keys]
+            assert len(keys) == len(set(keys)), sorted(k for k in keys if keys.count(k) > 1)
+            break
+    else:
+        raise AssertionError("KERNEL_LAYOUTS not found in codes.py")

@@ -137,17 +137,30 @@ def negative_eigenvalues(model: Model, state: _State) -> int:
     return int(np.sum(w < -1e-10 * scale))
 
 
+#: iterations in a row without a new smallest residual after which a Newton solve of the
+#: path is abandoned (the kernel's static Newton stops after 4 near the floor, 25 far)
+STALL_ITERATIONS = 25
+
+
 def _newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float, tol: float,
                max_iter: int, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray, int] | None:
     """Newton at the fixed load factor ``factor`` from (e, lam): (e, lam, iterations), or
-    None when it does not converge."""
-    previous = np.inf
+    None when it does not converge: the iteration limit, a non-finite step, or
+    STALL_ITERATIONS without a new smallest residual (a user's tolerance beyond round-off
+    or an iteration limit of 1e8 must not keep the path or the diagnosis running)."""
+    previous, smallest, since = np.inf, np.inf, 0
     for iteration in range(1, max_iter + 1):
         state = _State(model, e, lam, factor, floor)
         if iteration > 1 and converged(state.force_res, state.con_res, step, size, tol,
                                        previous):
             return e, lam, iteration - 1
         previous = state.force_res
+        if state.force_res < smallest:
+            smallest, since = state.force_res, 0
+        else:
+            since += 1
+            if since >= STALL_ITERATIONS:
+                return None
         du, dl = state.solve(True)
         if not np.all(np.isfinite(du)):
             return None

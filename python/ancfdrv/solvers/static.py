@@ -51,6 +51,13 @@ class StaticResult:
     path: object = None
 
 
+#: the kernel's static failures (fortran/src/solvers/static_solver.f90, info) that say nothing
+#: about the load path: a stall at the round-off floor (the tolerance is beyond double
+#: precision), a non-finite step, a failed linear solve; these are reported as they are,
+#: never diagnosed as a limit point
+NOT_A_LOAD_FAILURE = (12, 2, 3)
+
+
 class LoadStepFailure(SolverError):
     """A load step of :func:`solve_newton` did not converge: the kernel's text, with the
     last converged state (``e``, ``lam`` at ``last_factor``) and the load factor
@@ -154,6 +161,8 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
             model.counters["stiffness_assembly"] += evaluations
             for item in (*model.moments, *model.vector_loads):
                 model.counters[item.effect] += evaluations
+            if out["info"] in NOT_A_LOAD_FAILURE:  # the tolerance or the numbers, not the path
+                raise SolverError(out["message"])
             if out["info"]:
                 raise LoadStepFailure(out["message"], e=e.copy(), lam=lam.copy(),
                                       last_factor=loads * (load_step - 1) / load_steps,
