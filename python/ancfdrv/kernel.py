@@ -673,7 +673,7 @@ class KernelSystem:
         lengths (nel,), the reference nodal vectors (3, 8, nel) (an 'ffr' set's in its
         frame), the bending option and the section (codes.KERNEL_LAYOUTS 'sk', by name)."""
         info, message = _kernel.system_set_sections(self.handle, index, _f(lengths),
-                                                    _f(reference), _pack("sk", **section),
+                                                    _f(reference), _pack("bs", **section),
                                                     int(cubic))
         self._check(info, "beam section data", message)
         self._set_sizes[index] = len(lengths)

@@ -278,7 +278,7 @@ end subroutine system_add_cubic_set
 
 !> Gives the beam set `index` (ffr, continuum or cubic) the data of its section forces
 !> (beam_stations): the element lengths (nel), the reference nodal vectors (3, 8, nel)
-!> (global; an FFR set's in its frame, as its reference), the section (api_support sk_*) and
+!> (global; an FFR set's in its frame, as its reference), the section (api_support bs_*) and
 !> the bending option (cubic /= 0: 'cubic'). info = 2: index is not a beam set of nel
 !> elements, or a length or I_p is not positive.
 subroutine system_set_sections(handle, index, nel, lengths, reference, section, cubic, info, &
@@ -286,9 +286,9 @@ subroutine system_set_sections(handle, index, nel, lengths, reference, section, 
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use beam_stations, only: station_section
-  use api_support, only: api_system, give_sections, sk_axial, sk_torsion, sk_shear_y, sk_shear_z, &
-                         sk_moment_height, sk_moment_width, sk_youngs, sk_inertia_y, &
-                         sk_inertia_z, sk_polar
+  use api_support, only: api_system, give_sections, bs_axial, bs_torsion, bs_shear_y, bs_shear_z, &
+                         bs_moment_height, bs_moment_width, bs_youngs, bs_inertia_y, &
+                         bs_inertia_z, bs_polar
   implicit none
   integer, intent(in) :: handle, index, nel, cubic
   real(dp), intent(in) :: lengths(nel), reference(3, 8, nel), section(10)
@@ -303,18 +303,18 @@ subroutine system_set_sections(handle, index, nel, lengths, reference, section, 
             ' or the polar moment is not positive'
   if (index < 1 .or. index > size(sys%sets)) return
   if (sys%sets(index)%item%nel /= nel .or. .not. all(lengths > 0.0_dp) .or. &
-      .not. (section(sk_polar) > 0.0_dp)) return
+      .not. (section(bs_polar) > 0.0_dp)) return
   built%cubic = cubic /= 0
-  built%axial = section(sk_axial)
-  built%torsion = section(sk_torsion)
-  built%shear_y = section(sk_shear_y)
-  built%shear_z = section(sk_shear_z)
-  built%moment_height = section(sk_moment_height)
-  built%moment_width = section(sk_moment_width)
-  built%youngs = section(sk_youngs)
-  built%inertia_y = section(sk_inertia_y)
-  built%inertia_z = section(sk_inertia_z)
-  built%polar = section(sk_polar)
+  built%axial = section(bs_axial)
+  built%torsion = section(bs_torsion)
+  built%shear_y = section(bs_shear_y)
+  built%shear_z = section(bs_shear_z)
+  built%moment_height = section(bs_moment_height)
+  built%moment_width = section(bs_moment_width)
+  built%youngs = section(bs_youngs)
+  built%inertia_y = section(bs_inertia_y)
+  built%inertia_z = section(bs_inertia_z)
+  built%polar = section(bs_polar)
   built%length = lengths
   built%reference = reference
   call give_sections(sys%sets(index)%item, built, info)
