@@ -66,3 +66,19 @@ def test_the_recorder_refuses_rows_without_their_answers():
             recorder(chunk)
     finally:
         model.close()
+
+
+def test_recording_the_answers_leaves_the_motion_alone(tmp_path):
+    """The answers are written by the stepper from the states it reaches: a run that records
+    them (a contact scene with joints) has the motion of one that does not, bit for bit
+    (the same computation; the recorder once solved the start's consistent acceleration
+    again, which moved the contact projections the run started from)."""
+    scene = ROOT / "inputs/leaf_spring_road.nml"
+    common = ["solver.t_end=0.01", "output.q=.true.", "output.xdmf=.false."]
+    runner.run_scene(scene, common, tmp_path / "with.h5", progress=False)
+    runner.run_scene(scene, common + ["output.answers=.false."], tmp_path / "without.h5",
+                     progress=False)
+    with h5py.File(tmp_path / "with.h5", "r") as a, h5py.File(tmp_path / "without.h5", "r") as b:
+        assert "dynamic/reactions" in a and "dynamic/reactions" not in b
+        for name in ("dynamic/q", "dynamic/lambda", "dynamic/contact/normal_force"):
+            assert np.array_equal(a[name][()], b[name][()]), name

@@ -379,6 +379,8 @@ class ReactionMap:
 
     def reactions(self, q_full: np.ndarray, lam: np.ndarray, t: float = 0.0,
                   residual: np.ndarray | None = None) -> dict[str, Reaction]:
+        """The reactions of one state (full coordinates, multipliers, time; ``residual``:
+        the residual at :attr:`columns`, needed with eliminated joints)."""
         rows = self.reaction_rows(q_full[None], np.asarray(lam, dtype=float)[None],
                                   np.array([t]), None if residual is None else residual[None])
         return {name: Reaction(f[0], m[0], p[0], None if a is None else float(a[0]))
