@@ -331,8 +331,7 @@ def test_a_short_chunk_waits_for_the_next_one():
             chunks = _chunks(model, settings, sizes)
             recorded = {}
             for label, wait in (("waiting", DynamicAnswers.WAIT_ROWS), ("each", 0)):
-                recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
-                                          alpha_m=0.0, alpha_f=0.0, keep_sections=True)
+                recorder = DynamicAnswers(model, keep_sections=True)
                 recorder.WAIT_ROWS = wait
                 passes = []
                 real = recorder._record

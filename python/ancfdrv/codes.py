@@ -46,7 +46,7 @@ CONTACT_PARAMS = ("stiffness", "damping", "friction", "slip_velocity", "upper_th
 KERNEL_LAYOUTS: dict[str, tuple[str, ...]] = {
     "cs": ("area", "inertia_y", "inertia_z", "torsion", "shear_y", "shear_z", "youngs",
            "poisson"),                                   # beam_cubic_setup's section
-    "sk": ("axial", "torsion", "shear_y", "shear_z", "moment_height", "moment_width", "youngs",
+    "bs": ("axial", "torsion", "shear_y", "shear_z", "moment_height", "moment_width", "youngs",
            "inertia_y", "inertia_z", "polar"),           # a beam set's section forces data
     "bm": ("youngs", "poisson"),                         # a continuum beam set's material
     "pm": ("youngs", "poisson", "thickness"),            # a plate's material

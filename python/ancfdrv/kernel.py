@@ -673,7 +673,7 @@ class KernelSystem:
         lengths (nel,), the reference nodal vectors (3, 8, nel) (an 'ffr' set's in its
         frame), the bending option and the section (codes.KERNEL_LAYOUTS 'sk', by name)."""
         info, message = _kernel.system_set_sections(self.handle, index, _f(lengths),
-                                                    _f(reference), _pack("sk", **section),
+                                                    _f(reference), _pack("bs", **section),
                                                     int(cubic))
         self._check(info, "beam section data", message)
         self._set_sizes[index] = len(lengths)
@@ -960,7 +960,7 @@ class KernelSystem:
     def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
         cut = self._layout(False)[1]
         out = _kernel.system_output_row(
-            self.handle, self.ncon, self.npoint, cut[-1].start, t, _state(e, v),
+            self.handle, self.ncon, self.npoint, cut[6].stop, t, _state(e, v),
             _f(lam) if len(lam) else np.zeros(1), _f(work), _f(guesses), _i(counts),
             ndof=self.ndof)
         (guesses, counts, row, powers, info, message) = out
@@ -1010,6 +1010,39 @@ class KernelSystem:
             _pack("sk", dt=settings.dt, dt_min=settings.dt_min,
                   adaptive=float(settings.step == "adaptive"), tolerance=settings.tolerance))
         self._check(info, "stepper_setup", message)
+        self.nanswer = 0   # (a new run's rows answer nothing until answer_setup)
+
+    def answer_setup(self, columns, mass_rows, constant, driven) -> None:
+        """Make the rows of the run set up by :meth:`stepper_setup` answer
+        (``fortran/src/solvers/row_answers.f90``): each force element's reactions (7 values)
+        and the residual of the equations of motion at the full coordinates ``columns``
+        (0-based), from the full mass's rows there (``mass_rows``: a scipy CSR matrix, one
+        row per column, over the full coordinates) and the loads there: ``constant`` (ncol,)
+        and ``driven`` (ncol, one column per force drive, in the order of
+        :meth:`set_loads`)."""
+        columns = np.asarray(columns, dtype=np.int32)
+        ncol, nnz = len(columns), int(mass_rows.nnz)
+        driven = np.asarray(driven, dtype=float)   # (ncol, ndrive)
+        info, message = _kernel.system_answer_setup(
+            self.handle, ncol, nnz, driven.shape[1], _pad_last(columns + 1, np.int32),
+            _i(np.asarray(mass_rows.indptr) + 1),
+            _pad_last(np.asarray(mass_rows.indices) + 1, np.int32),
+            _pad_last(np.asarray(mass_rows.data, dtype=float)),
+            _pad_last(np.asarray(constant, dtype=float)),
+            _f(driven if driven.size else np.zeros((max(ncol, 1), max(driven.shape[1], 1)))))
+        self._check(info, "answer_setup", message)
+        self.nanswer = 7 * getattr(self, "nfel", 0) + ncol
+
+    def answer_row(self, t: float, e, v, accel, guesses) -> np.ndarray:
+        """The answers of the state (t, e, e', e'') with the contact projections
+        ``guesses``, in the layout of the answers of a row of :meth:`advance` (the run's
+        initial row)."""
+        out, info, message = _kernel.system_answer_row(
+            self.handle, self.npoint, self.nanswer, t, _state(e, v), _f(accel),
+            _f(np.array(guesses)), ndof=self.ndof)
+        if info:
+            self._failure(info, "answer row", message)
+        return out[:self.nanswer]
 
     def consistent_acceleration(self, t: float, e, v, guesses, counts) -> dict:
         """The consistent acceleration e'' and multipliers lambda of the state (t, e, e')
@@ -1024,15 +1057,17 @@ class KernelSystem:
 
     def _layout(self, store_q: bool) -> tuple[list[slice], list[slice]]:
         """The slices of the packed state (t, e, v, a, accel, lam, work, powers, guesses) and
-        of an output row (time, probes, deflections, lam, energy, constraint, contact, q):
-        stepper.f90 ``state_size`` and ``row_size``; computed once per system and store_q."""
+        of an output row (time, probes, deflections, lam, energy, constraint, contact,
+        answers, q): stepper.f90 ``state_size`` and ``row_size``; computed once per system,
+        run answers (:meth:`answer_setup`) and store_q."""
         # kept per key: a run asks for both (the packed state's without q, the rows' with
         # it), and one kept layout was made again at each change (~9 us)
-        key = (self.ndof, self.ncon, self.npoint, self.nprobe, store_q)
+        key = (self.ndof, self.ncon, self.npoint, self.nprobe, getattr(self, "nanswer", 0),
+               store_q)
         kept = self.__dict__.setdefault("_layouts", {})
         found = kept.get(key)
         if found is None:
-            n, nc, npt, npr = key[:4]
+            n, nc, npt, npr, nanswer = key[:5]
 
             def cut(lengths):
                 edges = [0]
@@ -1042,7 +1077,7 @@ class KernelSystem:
             found = kept[key] = (
                 cut([1, n, n, n, n, nc, POWER_COUNT, POWER_COUNT, 2 * npt]),
                 cut([1, 3 * npr, 3 * npr, nc, ENERGY_COUNT, 1, len(CONTACT_RECORD) * npt,
-                     n if store_q else 0]))
+                     nanswer, n if store_q else 0]))
         return found
 
     def state_size(self) -> int:
@@ -1104,7 +1139,7 @@ class KernelSystem:
 
     def row_slices(self, store_q: bool) -> list[slice]:
         """The slices of an output row (time, probes, deflections, lam, energy, constraint,
-        contact, q): stepper.f90 ``row_size``."""
+        contact, answers, q): stepper.f90 ``row_size``."""
         return self._layout(store_q)[1]
 
     def advance(self, nrows: int, state: dict, store_q: bool, budget: int | None = None) -> dict:
@@ -1123,7 +1158,7 @@ class KernelSystem:
                                                                          store_q)
         npt = self.npoint
         rows_cut = self._layout(store_q)[1]
-        time, probes, deflections, lam, energy, constraint, contact, q = rows_cut
+        time, probes, deflections, lam, energy, constraint, contact, _, q = rows_cut
         return dict(time=rows[0], probes=rows[probes].reshape((3, -1, nrows), order="F"),
                     deflections=rows[deflections].reshape((3, -1, nrows), order="F"),
                     lam=rows[lam], energy=rows[energy], constraint=rows[constraint.start],

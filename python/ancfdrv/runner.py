@@ -216,11 +216,9 @@ def _check_dynamic_plausibility(scene: Scene, model: Model, out: Path | MemoryOu
                                         warn=warns_implausible(scene)))
 
 
-def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
-                      e_start: np.ndarray):
+def _answers_recorder(scene: Scene, model: Model):
     """The recorder of the dynamic reactions, section forces and stress envelope (None
     when the model has neither joints nor beams)."""
-    from .solvers.dynamic import initial_acceleration
     from .system.answers import DynamicAnswers, reaction_map
     from .system.registry import reports_sections
     if not scene["output"].get("answers", True):
@@ -228,19 +226,8 @@ def _answers_recorder(scene: Scene, model: Model, settings: DynamicSettings,
     if not reaction_map(model).joints and not any(reports_sections(b) for b in model.bodies) \
             and not model.force_elements:
         return None
-    recorder = DynamicAnswers(model, beta=settings.beta, gamma=settings.gamma,
-                              alpha_m=settings.alpha_m, alpha_f=settings.alpha_f,
-                              stations=scene["output"].get("stations", 3),
-                              keep_sections=bool(scene["output"].get("sections", False)))
-    if recorder.need_acceleration or recorder.need_velocity:
-        v0 = np.zeros(model.ndof)
-        a0, lam0 = initial_acceleration(model, e_start, v0, 0.0)
-        recorder.initial = (v0, a0)
-        if not model.contact_pairs:  # integrate's start too (not solved twice); with
-            # contact the solve moves the model's contact projections, from which
-            # integrate's own solve starts
-            recorder.initial_solution = (a0, lam0)
-    return recorder
+    return DynamicAnswers(model, stations=scene["output"].get("stations", 3),
+                          keep_sections=bool(scene["output"].get("sections", False)))
 
 
 def _warn_large_ffr_deflection(model: Model, out: Path | MemoryOutput) -> None:
@@ -390,9 +377,10 @@ def _run_dynamic(scene: Scene, model: Model, out: Path | MemoryOutput, e_start: 
     supports = SupportRecorder.of(model)
     if supports is not None:  # the support deflections come from q at every step
         settings.store_q = True
-    recorder = _answers_recorder(scene, model, settings, e_start)
+    recorder = _answers_recorder(scene, model)
     if recorder is not None:
         settings.store_q = True  # the answers need every step's coordinates (not written)
+        settings.answers = recorder.needs_answers   # and the kernel's part of each row's
     # rows are written at least once a second (FLUSH_SECONDS) and whenever ~16 MB wait:
     # each write of a series costs ~0.2 ms whatever its rows, so writing every kernel call
     # (chunk_steps rows) took a third of a small model's run
@@ -431,8 +419,7 @@ def _run_dynamic(scene: Scene, model: Model, out: Path | MemoryOutput, e_start: 
     try:
         with _io(out).released(out):  # the file is closed between the writes of the run
             dyn = integrate(model, settings, e_start, sink=sink, progress=progress,
-                            should_stop=stop,
-                            initial=getattr(recorder, "initial_solution", None))
+                            should_stop=stop)
         writer.flush_last()
         if supports is not None:
             supports.write(out, writer.rows)

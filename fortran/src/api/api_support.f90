@@ -31,9 +31,9 @@ module api_support
                                 cs_poisson = 8, cs_count = 8
   !> a beam set's section data for its section forces (beam_stations station_section):
   !> EA, G J, k_y G A, k_z G A, the moments' factors -E I_y and E I_z, E, I_y, I_z, I_p
-  integer, parameter, public :: sk_axial = 1, sk_torsion = 2, sk_shear_y = 3, sk_shear_z = 4, &
-                                sk_moment_height = 5, sk_moment_width = 6, sk_youngs = 7, &
-                                sk_inertia_y = 8, sk_inertia_z = 9, sk_polar = 10, sk_count = 10
+  integer, parameter, public :: bs_axial = 1, bs_torsion = 2, bs_shear_y = 3, bs_shear_z = 4, &
+                                bs_moment_height = 5, bs_moment_width = 6, bs_youngs = 7, &
+                                bs_inertia_y = 8, bs_inertia_z = 9, bs_polar = 10, bs_count = 10
   !> a continuum beam set's material
   integer, parameter, public :: bm_youngs = 1, bm_poisson = 2, bm_count = 2
   !> a plate's material and thickness

@@ -278,7 +278,7 @@ end subroutine system_add_cubic_set
 
 !> Gives the beam set `index` (ffr, continuum or cubic) the data of its section forces
 !> (beam_stations): the element lengths (nel), the reference nodal vectors (3, 8, nel)
-!> (global; an FFR set's in its frame, as its reference), the section (api_support sk_*) and
+!> (global; an FFR set's in its frame, as its reference), the section (api_support bs_*) and
 !> the bending option (cubic /= 0: 'cubic'). info = 2: index is not a beam set of nel
 !> elements, or a length or I_p is not positive.
 subroutine system_set_sections(handle, index, nel, lengths, reference, section, cubic, info, &
@@ -286,9 +286,9 @@ subroutine system_set_sections(handle, index, nel, lengths, reference, section, 
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use beam_stations, only: station_section
-  use api_support, only: api_system, give_sections, sk_axial, sk_torsion, sk_shear_y, sk_shear_z, &
-                         sk_moment_height, sk_moment_width, sk_youngs, sk_inertia_y, &
-                         sk_inertia_z, sk_polar
+  use api_support, only: api_system, give_sections, bs_axial, bs_torsion, bs_shear_y, bs_shear_z, &
+                         bs_moment_height, bs_moment_width, bs_youngs, bs_inertia_y, &
+                         bs_inertia_z, bs_polar
   implicit none
   integer, intent(in) :: handle, index, nel, cubic
   real(dp), intent(in) :: lengths(nel), reference(3, 8, nel), section(10)
@@ -303,18 +303,18 @@ subroutine system_set_sections(handle, index, nel, lengths, reference, section, 
             ' or the polar moment is not positive'
   if (index < 1 .or. index > size(sys%sets)) return
   if (sys%sets(index)%item%nel /= nel .or. .not. all(lengths > 0.0_dp) .or. &
-      .not. (section(sk_polar) > 0.0_dp)) return
+      .not. (section(bs_polar) > 0.0_dp)) return
   built%cubic = cubic /= 0
-  built%axial = section(sk_axial)
-  built%torsion = section(sk_torsion)
-  built%shear_y = section(sk_shear_y)
-  built%shear_z = section(sk_shear_z)
-  built%moment_height = section(sk_moment_height)
-  built%moment_width = section(sk_moment_width)
-  built%youngs = section(sk_youngs)
-  built%inertia_y = section(sk_inertia_y)
-  built%inertia_z = section(sk_inertia_z)
-  built%polar = section(sk_polar)
+  built%axial = section(bs_axial)
+  built%torsion = section(bs_torsion)
+  built%shear_y = section(bs_shear_y)
+  built%shear_z = section(bs_shear_z)
+  built%moment_height = section(bs_moment_height)
+  built%moment_width = section(bs_moment_width)
+  built%youngs = section(bs_youngs)
+  built%inertia_y = section(bs_inertia_y)
+  built%inertia_z = section(bs_inertia_z)
+  built%polar = section(bs_polar)
   built%length = lengths
   built%reference = reference
   call give_sections(sys%sets(index)%item, built, info)
@@ -1253,7 +1253,7 @@ subroutine system_output_row(handle, ndof, ncon, npoint, nrow, t, state, lam, wo
   if (info /= 0) return
   nprobe = sys%nprobe
   if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. npoint /= sys%npoint .or. &
-      nrow /= row_size(ndof, ncon, nprobe, npoint, .false.) .or. power_count /= 5) then
+      nrow /= row_size(ndof, ncon, nprobe, npoint, 0, .false.) .or. power_count /= 5) then
     info = 2
     message = 'system_output_row: sizes inconsistent with the system (ndof, ncon, npoint,' // &
               ' the row length)'
@@ -1287,14 +1287,99 @@ subroutine system_output_row(handle, ndof, ncon, npoint, nrow, t, state, lam, wo
   row(k + 2:k + 1 + contact_record * npoint) = reshape(records, [contact_record * npoint])
 end subroutine system_output_row
 
+!> Makes the rows of the run set up by system_stepper_setup answer (row_answers): per force
+!> element its reactions, and the residual of the equations of motion at the full
+!> coordinates columns(ncol) (1-based), from the full mass's rows there (CSR: mass_ptr(ncol +
+!> 1), mass_col(nnz) over the full coordinates, mass_values(nnz)) and the loads there:
+!> constant (gravity included) and driven(:, d) for the system's force drive d (ndrive of
+!> them). info = 2: sizes inconsistent with the system or an index outside it; 9 no run set up.
+subroutine system_answer_setup(handle, ncol, nnz, ndrive, columns, mass_ptr, mass_col, &
+                               mass_values, constant, driven, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use stepper, only: stepper_run
+  use row_answers, only: answer_data
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle, ncol, nnz, ndrive
+  integer, intent(in) :: columns(max(1, ncol)), mass_ptr(ncol + 1), mass_col(max(1, nnz))
+  real(dp), intent(in) :: mass_values(max(1, nnz)), constant(max(1, ncol))
+  real(dp), intent(in) :: driven(max(1, ncol), max(1, ndrive))
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  type(stepper_run), pointer :: run
+  call api_system(handle, sys, info, message, run)
+  if (info /= 0) return
+  if (.not. run%ready) then
+    info = 9
+    message = 'system_answer_setup: no run set up (call system_stepper_setup first)'
+    return
+  end if
+  info = 2
+  message = 'system_answer_setup: sizes inconsistent with the system (the force drives) ' // &
+            'or a column outside the full coordinates'
+  if (ncol < 0 .or. nnz < 0 .or. ndrive /= size(sys%force_drive)) return
+  if (mass_ptr(1) /= 1 .or. mass_ptr(ncol + 1) /= nnz + 1) return
+  if (ncol > 0) then
+    if (any(columns(1:ncol) < 1) .or. any(columns(1:ncol) > sys%nfull)) return
+  end if
+  if (nnz > 0) then
+    if (any(mass_col(1:nnz) < 1) .or. any(mass_col(1:nnz) > sys%nfull)) return
+  end if
+  info = 0
+  message = ' '
+  run%answers = answer_data(on=.true., columns=columns(1:ncol), mass_ptr=mass_ptr, &
+                            mass_col=mass_col(1:nnz), mass_values=mass_values(1:nnz), &
+                            constant=constant(1:ncol), driven=driven(1:ncol, 1:ndrive))
+end subroutine system_answer_setup
+
+!> The answers (row_answers, answer_row) of the state (t, e, e') (columns sv_*) with the
+!> accelerations e'' and the contact projections guesses, for the run's rows' layout:
+!> what a row of system_advance carries, for a state the stepper did not reach (the run's
+!> initial row). info = 2: nanswer is not the run's; else answer_row's code.
+subroutine system_answer_row(handle, ndof, npoint, nanswer, t, state, accel, guesses, &
+                             answers, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, contact_state
+  use stepper, only: stepper_run
+  use row_answers, only: answer_row, answer_count
+  use kernel_errors, only: failure_text
+  use api_support, only: api_system, sv_coordinates, sv_rates
+  implicit none
+  integer, intent(in) :: handle, ndof, npoint, nanswer
+  real(dp), intent(in) :: t, state(ndof, 2), accel(ndof), guesses(2, max(1, npoint))
+  real(dp), intent(out) :: answers(max(1, nanswer))
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  type(stepper_run), pointer :: run
+  type(contact_state) :: contact
+  answers = 0.0_dp
+  call api_system(handle, sys, info, message, run)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. npoint /= sys%npoint .or. &
+      nanswer /= answer_count(sys, run%answers)) then
+    info = 2
+    message = 'system_answer_row: sizes inconsistent with the system or its run (ndof, ' // &
+              'npoint, the answers)'
+    return
+  end if
+  if (nanswer == 0) return
+  contact%guesses = guesses(:, 1:npoint)
+  call answer_row(sys, run%answers, t, state(:, sv_coordinates), state(:, sv_rates), accel, &
+                  contact, answers(1:nanswer), info)
+  if (info /= 0) message = failure_text(info)
+end subroutine system_answer_row
+
 !> Advances up to nrows output rows of the run set up by system_stepper_setup, with at most
 !> budget steps tried (step_control: whole chunks at dt, cut steps, restarts, adaptive
 !> steps; an output interval left unfinished is resumed by the next call). state (packed,
 !> stepper.f90 state_size: t, e, e', a, e'', lambda, works, the powers at the state, contact
 !> guesses) and the contact counters are updated in place: calls may split a run anywhere
 !> without changing its result. rows(:, k) (stepper.f90 row_size: time, probes,
-!> deflections, lambda, energies, constraint violation, contact records, and e when nrow
-!> has room for it); stats(at_*, k): Newton corrections, factorizations, Jacobian
+!> deflections, lambda, energies, constraint violation, contact records, the answers of a
+!> run set up with system_answer_setup (row_answers), and e when nrow has room for it); stats(at_*, k): Newton corrections, factorizations, Jacobian
 !> evaluations (failed tries included), steps taken, step cuts; sizes(k): the smallest step
 !> to the row. status(as_*): the rows done, info, detail, steps converged at the round-off
 !> floor, the steps tried; of a failure: the interval's cuts, the tries in a row, the work of
@@ -1308,6 +1393,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, power_count
   use stepper, only: stepper_run, state_size, row_size
+  use row_answers, only: answer_count
   use time_integrator, only: stat_count, step_failure_text
   use step_control, only: stepper_point, controlled_rows, control_failure
   use api_support, only: api_system, as_rows, as_info, as_detail, as_floor_accepts, as_tries, &
@@ -1326,7 +1412,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   type(stepper_run), pointer :: run
   type(stepper_point) :: p
   type(control_failure) :: failure
-  integer :: info, ndof, ncon, nprobe, npoint, k
+  integer :: info, ndof, ncon, nprobe, npoint, nanswer, k
   logical :: store_q
   rows = 0.0_dp
   stats = 0
@@ -1347,9 +1433,10 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   ncon = sys%ncon
   nprobe = sys%nprobe
   npoint = sys%npoint
-  store_q = nrow == row_size(ndof, ncon, nprobe, npoint, .true.)
+  nanswer = answer_count(sys, run%answers)
+  store_q = nrow == row_size(ndof, ncon, nprobe, npoint, nanswer, .true.)
   if (nstate /= state_size(ndof, ncon, npoint) .or. (.not. store_q .and. &
-      nrow /= row_size(ndof, ncon, nprobe, npoint, .false.)) .or. nrows < 1 .or. &
+      nrow /= row_size(ndof, ncon, nprobe, npoint, nanswer, .false.)) .or. nrows < 1 .or. &
       budget < 1 .or. power_count /= 5 .or. stat_count /= 3) then
     status(as_info) = 9
     message = 'system_advance: sizes inconsistent with the system (the packed state or ' // &

@@ -26,6 +26,8 @@ module step_control
   use time_integrator, only: integrator_chunk, newton_floor_stall
   use consistent_start, only: consistent_acceleration
   use kernel_errors, only: message_length
+  use row_answers, only: answer_row, answer_count
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   implicit none
   private
   public :: stepper_point, controlled_rows, control_failure
@@ -288,7 +290,9 @@ contains
 
   !> n steps of size h from p (integrator_chunk) with their output rows in the row layout of
   !> stepper.f90 (row_size) and their statistics (a failed step's: the column after the
-  !> last completed one).
+  !> last completed one). A run whose rows answer (row_answers) takes the steps one by one
+  !> and writes each row's answers from the state it reached (e', e'' as the method has
+  !> them); answers that cannot be evaluated are written as NaN (the step stands).
   subroutine step_rows(sys, run, h, n, p, rows, stats, store_q, steps_done, info, detail, &
                        last_correction, floor_accepts)
     type(system_model), intent(inout) :: sys
@@ -303,39 +307,42 @@ contains
     real(dp), intent(out) :: last_correction
     real(dp), allocatable :: out_probe(:, :, :), out_deflection(:, :, :), out_contact(:, :, :)
     real(dp), allocatable :: no_q(:, :)
-    integer :: ndof, ncon, nprobe, npoint, step, k, j
-    integer :: at_lambda, at_energy, at_constraint, at_q  ! the rows' offsets (row_size)
+    integer :: ndof, ncon, nprobe, npoint, nanswer, step, k, j, floor, answer_info
+    integer :: at_lambda, at_energy, at_constraint, at_answers, at_q  ! (row_size)
     ndof = sys%ndof
     ncon = sys%ncon
     nprobe = sys%nprobe
     npoint = sys%npoint
+    nanswer = answer_count(sys, run%answers)
     ! (the stepper writes time, lam, energy, constraint violation and q straight into their
     ! rows, zeroed by the caller; the probes, deflections and contact records are copied)
     at_lambda = 1 + 6 * nprobe
     at_energy = at_lambda + ncon
     at_constraint = at_energy + energy_count
-    at_q = at_constraint + 1 + contact_record * npoint
+    at_answers = at_constraint + 1 + contact_record * npoint
+    at_q = at_answers + nanswer
     allocate (out_probe(3, nprobe, n), out_deflection(3, nprobe, n), &
               out_contact(contact_record, npoint, n))
     out_probe = 0.0_dp
     out_deflection = 0.0_dp
     out_contact = 0.0_dp
-    if (store_q) then
-      call integrator_chunk(sys, run%settings, run%state, h, n, p%t, p%e, p%v, p%a, p%accel, &
-                            p%lam, p%work, p%powers, p%contact, rows(1, :), out_probe, &
-                            out_deflection, rows(at_lambda + 1:at_lambda + ncon, :), &
-                            rows(at_energy + 1:at_energy + energy_count, :), &
-                            rows(at_constraint + 1, :), stats, out_contact, store_q, &
-                            rows(at_q + 1:at_q + ndof, :), steps_done, info, detail, &
-                            last_correction, floor_accepts)
+    if (.not. store_q) allocate (no_q(ndof, 0))
+    if (nanswer == 0) then
+      call steps(1, n, steps_done)
     else
-      allocate (no_q(ndof, 0))
-      call integrator_chunk(sys, run%settings, run%state, h, n, p%t, p%e, p%v, p%a, p%accel, &
-                            p%lam, p%work, p%powers, p%contact, rows(1, :), out_probe, &
-                            out_deflection, rows(at_lambda + 1:at_lambda + ncon, :), &
-                            rows(at_energy + 1:at_energy + energy_count, :), &
-                            rows(at_constraint + 1, :), stats, out_contact, store_q, no_q, &
-                            steps_done, info, detail, last_correction, floor_accepts)
+      steps_done = 0
+      floor_accepts = 0
+      do step = 1, n
+        call steps(step, 1, k)
+        floor_accepts = floor_accepts + floor
+        if (k < 1) exit
+        call answer_row(sys, run%answers, p%t, p%e, p%v, p%accel, p%contact, &
+                        rows(at_answers + 1:at_answers + nanswer, step), answer_info)
+        if (answer_info /= 0) rows(at_answers + 1:at_answers + nanswer, step) = &
+          ieee_value(0.0_dp, ieee_quiet_nan)
+        steps_done = step
+        if (info /= 0) exit
+      end do
     end if
     ! (the probes' and deflections' columns copied by loops: reshape was a library call a step)
     do step = 1, n
@@ -353,6 +360,37 @@ contains
           out_contact(:, j, step)
       end do
     end do
+
+  contains
+
+    !> m steps into the rows' columns first .. first + m - 1 (done: the steps completed).
+    subroutine steps(first, m, done)
+      integer, intent(in) :: first, m
+      integer, intent(out) :: done
+      integer :: last
+      last = first + m - 1
+      if (store_q) then
+        call integrator_chunk(sys, run%settings, run%state, h, m, p%t, p%e, p%v, p%a, &
+                              p%accel, p%lam, p%work, p%powers, p%contact, rows(1, first:last), &
+                              out_probe(:, :, first:last), out_deflection(:, :, first:last), &
+                              rows(at_lambda + 1:at_lambda + ncon, first:last), &
+                              rows(at_energy + 1:at_energy + energy_count, first:last), &
+                              rows(at_constraint + 1, first:last), stats(:, first:last), &
+                              out_contact(:, :, first:last), store_q, &
+                              rows(at_q + 1:at_q + ndof, first:last), done, info, detail, &
+                              last_correction, floor)
+      else
+        call integrator_chunk(sys, run%settings, run%state, h, m, p%t, p%e, p%v, p%a, &
+                              p%accel, p%lam, p%work, p%powers, p%contact, rows(1, first:last), &
+                              out_probe(:, :, first:last), out_deflection(:, :, first:last), &
+                              rows(at_lambda + 1:at_lambda + ncon, first:last), &
+                              rows(at_energy + 1:at_energy + energy_count, first:last), &
+                              rows(at_constraint + 1, first:last), stats(:, first:last), &
+                              out_contact(:, :, first:last), store_q, no_q, done, info, &
+                              detail, last_correction, floor)
+      end if
+      if (nanswer == 0) floor_accepts = floor
+    end subroutine steps
   end subroutine step_rows
 
   !> Kernel failures a smaller step may avoid (not: a constraint or drive that cannot be

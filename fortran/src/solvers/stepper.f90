@@ -12,6 +12,7 @@
 module stepper
   use ancf_kinds, only: dp
   use mechanical_system, only: power_count, energy_count, contact_record
+  use row_answers, only: answer_data
   implicit none
   private
   public :: stepper_settings, stepper_state, stepper_run, stepper_start, update_reuse_backoff, &
@@ -121,12 +122,13 @@ module stepper
   end type control_state
 
   !> A system's stepper: its run's settings, its learned state, its step-size control,
-  !> whether a run was set up.
+  !> whether a run was set up, what its rows answer (row_answers; none unless set up).
   type :: stepper_run
     type(stepper_settings) :: settings
     type(stepper_state) :: state
     type(control_settings) :: control_settings
     type(control_state) :: control
+    type(answer_data) :: answers
     logical :: ready = .false.
   end type stepper_run
 
@@ -143,6 +145,7 @@ contains
     run%control_settings = control
     if (run%control_settings%dt_min <= 0.0_dp) run%control_settings%dt_min = control%dt / 1024.0_dp
     run%control = control_state()
+    run%answers = answer_data()
     run%control%h = control%dt
     run%control%last_h = control%dt
     run%ready = .true.
@@ -159,11 +162,12 @@ contains
   !> The length of one output row of system_advance, in this order: the time; the probe
   !> positions and their deflections (3, nprobe each); lambda (ncon); the energies
   !> (energy_count); the constraint violation max |Phi|; the contact records
-  !> (contact_record, npoint); and, when the coordinates are stored, e (ndof).
-  pure integer function row_size(ndof, ncon, nprobe, npoint, store_q)
-    integer, intent(in) :: ndof, ncon, nprobe, npoint
+  !> (contact_record, npoint); the run's answers (nanswer: row_answers answer_count); and,
+  !> when the coordinates are stored, e (ndof).
+  pure integer function row_size(ndof, ncon, nprobe, npoint, nanswer, store_q)
+    integer, intent(in) :: ndof, ncon, nprobe, npoint, nanswer
     logical, intent(in) :: store_q
-    row_size = 1 + 6 * nprobe + ncon + energy_count + 1 + contact_record * npoint
+    row_size = 1 + 6 * nprobe + ncon + energy_count + 1 + contact_record * npoint + nanswer
     if (store_q) row_size = row_size + ndof
   end function row_size
 

@@ -91,6 +91,10 @@ class DynamicSettings:
     #: the energy the integrator may make, relative to the run's energy scale, before the
     #: run ends as unstable (:class:`EnergyWatch`)
     energy_tolerance: float = 0.01
+    #: the output rows carry the answers' kernel part (``fortran/src/solvers/
+    #: row_answers.f90``: the force elements' reactions, the residual at the eliminated
+    #: joints' coordinates) for :class:`~ancfdrv.system.answers.DynamicAnswers`
+    answers: bool = False
 
     @property
     def smallest_step(self) -> float:
@@ -139,6 +143,9 @@ class Chunk:
     stats: np.ndarray         # (nt, 3): STAT_NAMES (corrections, factorizations, jacobians)
     q: np.ndarray | None      # (nt, ndof) when stored
     contact: np.ndarray | None = None  # (nt, npoints, 6): CONTACT_FIELDS
+    #: (nt, nanswer) with DynamicSettings.answers: per force element its reactions (force,
+    #: moment, axial), then the residual at the eliminated joints' coordinates
+    answers: np.ndarray | None = None
     #: per row: the smallest step taken to reach it (s; 0 for the initial row), the steps
     #: taken and the step cuts in its interval (None: one step of the grid's size, no cut)
     step_size: np.ndarray | None = None
@@ -240,6 +247,9 @@ class TimeIntegrator:
         self.model.kernel.set_carry(self.model.carry_vectors()
                                     if self.settings.carry == "rotation" else None)
         self.model.kernel.stepper_setup(self.settings)
+        if self.settings.answers:
+            from ..system.answers import answer_inputs
+            self.model.kernel.answer_setup(*answer_inputs(self.model))
         # one packed buffer the kernel steps in place (kernel.PackedState): its arrays are
         # views, changed by the next call
         return self.model.kernel.packed_state(dict(
@@ -262,8 +272,8 @@ class TimeIntegrator:
         done, info, detail = self.status[:3]
         self.failure_text = kernel_text(message) if info else ""
         self.floor_accepts += self.status[_STATUS["floor_accepts"]]
-        _, probes, deflections, lam, energy, constraint, contact, q = kernel.row_slices(
-            s.store_q)
+        _, probes, deflections, lam, energy, constraint, contact, answers, q = \
+            kernel.row_slices(s.store_q)
         cols = rows.T[:done]     # (done, row_size): one row per output time
         made = functools.partial(_row_fields, cuts=(probes, deflections, lam, energy,
                                                     constraint, contact),
@@ -272,6 +282,7 @@ class TimeIntegrator:
         fields = made(cols)
         counts = stats[:, :done].T
         chunk = Chunk(**fields, stats=counts[:, :3], q=cols[:, q] if s.store_q else None,
+                      answers=cols[:, answers] if s.answers else None,
                       rows=(cols, q.start, fields, made), step_size=sizes[:done],
                       substeps=counts[:, 3], cuts=counts[:, 4])
         return chunk, info, detail
@@ -508,8 +519,12 @@ def initial_row(model: Model, state: dict) -> Chunk:
                                   state["work"], np.array(state["guesses"], order="F"),
                                   state["counts"])
     state["powers"] = row["powers"]
+    answers = None
+    if getattr(model.kernel, "nanswer", 0):   # the run's rows answer (DynamicSettings.answers)
+        answers = model.kernel.answer_row(state["t"], state["e"], state["v"], state["accel"],
+                                          state["guesses"])[None]
     # copies: the kernel updates the state's arrays in place as it steps on
-    return Chunk(time=np.array([state["t"]]), probes=row["probes"][None],
+    return Chunk(answers=answers, time=np.array([state["t"]]), probes=row["probes"][None],
                  deflections=row["deflections"][None], lam=state["lam"][None, :].copy(),
                  energy=row["energy"][None],
                  constraint=np.array([row["violation"]]), stats=np.zeros((1, 3), dtype=np.int64),

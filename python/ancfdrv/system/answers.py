@@ -152,6 +152,12 @@ class ReactionMap:
                     vals.append(a)
             self.a = sp.csr_matrix((vals, (rows, cols)), shape=(len(eliminated), model.nfull))
             self.factor = spla.splu(sp.csc_matrix(self.a @ self.a.T))
+            #: the full coordinates the eliminated rows touch: the residual is needed there
+            #: alone (the kernel's rows carry it there: row_answers.f90)
+            self.columns = sorted_unique(np.asarray(self.a.indices, dtype=np.int64))
+            self.a_columns = sp.csr_matrix(self.a[:, self.columns])
+        if self.factor is None:
+            self.columns = np.zeros(0, dtype=np.int64)
         self.wanted = any(o is not None for o in self.multiplier_owner + self.linear_owner)
         self.a_coo = self.a.tocoo() if self.factor is not None else None
         self.points = {name: _joint_points(joint) for name, joint in self.joints.items()}
@@ -283,7 +289,8 @@ class ReactionMap:
     def generalized_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
                          residual_rows: np.ndarray | None) -> dict[str, np.ndarray]:
         """Each joint's constraint force on body2's coordinates, (nt, body2.ncoordinates),
-        for rows of states."""
+        for rows of states; ``residual_rows`` (nt, len(columns)): the residual at
+        :attr:`columns`."""
         if not hasattr(self, "selection"):
             self._term_arrays()
         nt = len(q_rows)
@@ -302,12 +309,17 @@ class ReactionMap:
             contrib *= self.t_coef * lam_rows[:, self.t_con]
         mu = None
         if self.factor is not None and residual_rows is not None:
-            if not hasattr(self, "_scatter_all"):
-                self._scatter_all = sp.csr_matrix(
-                    (np.ones(nterm), (np.arange(nterm), self.t_dof)),
-                    shape=(nterm, self.model.nfull))
-            total = (self._scatter_all.T @ contrib.T).T
-            rhs = self.a @ (residual_rows - total).T
+            if not hasattr(self, "_scatter_columns"):
+                # the terms on the columns, each added into its column's place
+                place = np.searchsorted(self.columns, self.t_dof)
+                place = np.minimum(place, max(len(self.columns) - 1, 0))
+                on = self.columns[place] == self.t_dof if len(self.columns) else \
+                    np.zeros(nterm, dtype=bool)
+                self._scatter_columns = sp.csr_matrix(
+                    (np.ones(int(on.sum())), (np.flatnonzero(on), place[on])),
+                    shape=(nterm, len(self.columns)))
+            total = (self._scatter_columns.T @ contrib.T).T
+            rhs = self.a_columns @ (residual_rows - total).T
             mu = np.atleast_2d(self.factor.solve(rhs).T.reshape(nt, -1))
         out = {}
         for name, (terms, entries, first, size, slots) in self.selection.items():
@@ -367,6 +379,8 @@ class ReactionMap:
 
     def reactions(self, q_full: np.ndarray, lam: np.ndarray, t: float = 0.0,
                   residual: np.ndarray | None = None) -> dict[str, Reaction]:
+        """The reactions of one state (full coordinates, multipliers, time; ``residual``:
+        the residual at :attr:`columns`, needed with eliminated joints)."""
         rows = self.reaction_rows(q_full[None], np.asarray(lam, dtype=float)[None],
                                   np.array([t]), None if residual is None else residual[None])
         return {name: Reaction(f[0], m[0], p[0], None if a is None else float(a[0]))
@@ -491,7 +505,7 @@ def reactions(model: Model, e: np.ndarray, lam: np.ndarray, *, t: float = 0.0,
     if rm.factor is not None:
         lf = 1.0 if load_factor is None else load_factor
         v = np.zeros(model.ndof) if v is None else v
-        residual = rm.residual(np.asarray(e, dtype=float), v, a, t, lf)
+        residual = rm.residual(np.asarray(e, dtype=float), v, a, t, lf)[rm.columns]
     out = rm.reactions(q, np.asarray(lam, dtype=float), t, residual)
     out.update(force_element_reactions(model, e, v, t))
     return out
@@ -555,13 +569,6 @@ def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS
     return out
 
 
-#: :class:`DynamicAnswers` takes a chunk's rows in blocks of about this many bytes of full
-#: coordinates for the reactions: their work arrays hold ~5 copies of them (at 3078
-#: coordinates and a chunk of 60 steps, 7 MB at once; issue 23: a run's peak memory)
-ANSWER_BLOCK_BYTES = 1 << 18
-
-
-# -- section forces from the elements' equilibrium (static states) ----------------------------
 def _centreline(xi: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """(nel, n, 8) coefficients of the centre line r(xi) on each element's eight nodal
     vectors (cubic Hermite on r1, r1_x, r2, r2_x; ``lengths`` (nel,))."""
@@ -910,34 +917,44 @@ def constraint_joints(model: Model) -> list[str]:
     return [owner.get(name, "") for name in model.constraints.names]
 
 
+def answer_inputs(model: Model) -> tuple[np.ndarray, object, np.ndarray, np.ndarray]:
+    """What the kernel's rows need to answer (``Kernel.answer_setup``,
+    ``fortran/src/solvers/row_answers.f90``): the full coordinates the eliminated joints'
+    rows touch (:attr:`ReactionMap.columns`; none without eliminated joints a joint owns),
+    the full mass's rows there (scipy CSR), the constant loads (gravity included) and the
+    driven loads there (one column per driven load, in the order of the model's)."""
+    columns = reaction_map(model).columns
+    constant, driven = model.full_loads
+    mass_rows = model.mass_full.to_scipy()[columns] if len(columns) else \
+        sp.csr_matrix((0, model.nfull))
+    loads = np.column_stack([vector[columns] for _, vector in driven]) if driven else \
+        np.zeros((len(columns), 0))
+    return columns, mass_rows, np.asarray(constant, dtype=float)[columns], loads
+
+
 class DynamicAnswers:
-    """Reactions, section forces and the stress envelope of a dynamic run, row by row
-    from the chunks of the stepper (a sink: ``recorder(chunk)``; the chunks must carry q).
+    """Reactions, section forces and the stress envelope of a dynamic run, from the chunks
+    of the stepper (a sink: ``recorder(chunk)``; the chunks carry q and, when the model has
+    force elements or eliminated joints, the rows' answers: a run with
+    ``DynamicSettings.answers``). The kernel writes each row's force-element reactions and
+    the residual of the equations of motion at the eliminated joints' coordinates from the
+    state it reached (``fortran/src/solvers/row_answers.f90``); the joints' reactions and the
+    beams' section forces are formed over all rows of a chunk at once."""
 
-    The eliminated joints' reactions need the accelerations: they are rebuilt from the
-    coordinates of consecutive rows by the integrator's own relations (time_integrator:
-    e_{n+1} = e_n + h e'_n + h^2 ((1/2 - beta) a_n + beta a_{n+1}),
-    e'_{n+1} = e'_n + h ((1 - gamma) a_n + gamma a_{n+1}), (1 - alpha_m) a_{n+1} + alpha_m
-    a_n = (1 - alpha_f) e''_{n+1} + alpha_f e''_n) from the initial state (v0, a0)."""
-
-    def __init__(self, model: Model, *, beta: float, gamma: float, alpha_m: float,
-                 alpha_f: float, stations: int = DEFAULT_STATIONS, keep_sections: bool = False,
-                 initial: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+    def __init__(self, model: Model, *, stations: int = DEFAULT_STATIONS,
+                 keep_sections: bool = False) -> None:
         self.model, self.stations, self.keep_sections = model, stations, keep_sections
-        self.beta, self.gamma, self.alpha_m, self.alpha_f = beta, gamma, alpha_m, alpha_f
         self.map = reaction_map(model)
-        self.need_acceleration = self.map.factor is not None
-        self.initial = initial
-        self.state: tuple | None = None
-        #: the times of the blocks recorded (arrays; :attr:`time` joins them)
+        #: the eliminated joints' reactions need the residual at the rows (the rows' answers)
+        self.need_residual = self.map.factor is not None
+        #: the times of the chunks recorded (arrays; :attr:`time` joins them)
         self._time_blocks: list[np.ndarray] = []
         #: per joint, per chunk: (force (nt, 3), moment (nt, 3), axial (nt,) or None)
         self.reactions: dict[str, list[tuple]] = {name: [] for name in self.map.joints}
-        #: force elements: their reactions need e' at every row (rebuilt as e'' is)
+        #: force elements: their reactions are the rows' answers' first 7 values each
         self.force_elements = list(getattr(model, "force_elements", ()))
         for info in self.force_elements:
             self.reactions[info.name] = []
-        self.need_velocity = bool(self.force_elements)
         self.sections: dict[str, list[SectionForces]] = {}
         self.envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self.beams = {b.name: b for b in model.bodies if reports_sections(b)}
@@ -945,36 +962,24 @@ class DynamicAnswers:
         self.section_sets = [info for info in model.sets if reports_sections(info.body)]
 
     @property
+    def needs_answers(self) -> bool:
+        """Whether the chunks must carry the rows' answers (``DynamicSettings.answers``)."""
+        return self.need_residual or bool(self.force_elements)
+
+    @property
     def time(self) -> list[float]:
         """The times (s) of the rows recorded, in order."""
         return [t for block in self._time_blocks for t in block.tolist()]
 
-    def _kinematics(self, t: float, e: np.ndarray):
-        """(e', e'') at the row, rebuilt from the previous row."""
-        if self.state is None:
-            v, a = self.initial if self.initial is not None else \
-                (np.zeros_like(e), np.zeros_like(e))
-            self.state = (t, e.copy(), v.copy(), a.copy(), a.copy())
-            return v, a
-        t0, e0, v0, a0, accel0 = self.state
-        h = t - t0
-        b, g, am, af = self.beta, self.gamma, self.alpha_m, self.alpha_f
-        a1 = (e - e0 - h * v0 - h * h * (0.5 - b) * a0) / (b * h * h)
-        v1 = v0 + h * ((1.0 - g) * a0 + g * a1)
-        accel1 = ((1.0 - am) * a1 + am * a0 - af * accel0) / (1.0 - af)
-        self.state = (t, e.copy(), v1, a1, accel1)
-        return v1, accel1
-
     #: a chunk of 2 to WAIT_ROWS rows (the stepper's first call, which measures a step's
-    #: cost: 10 steps), fewer than a block holds, waits and is recorded with the next
-    #: chunk; so does the initial row (a single row before anything is recorded), joined
-    #: with a next chunk that would wait itself: the initial row, the first call and the
-    #: rest are one pass over the rows instead of three (a pass costs ~0.1-0.3 ms on a
-    #: tiny system). Single rows after it (the intervals of adaptive steps) do not wait,
-    #: and the initial row followed by a single row is recorded on its own as before: rows
-    #: grouped otherwise are not always bitwise the same (the adaptive boom's stresses
-    #: batched 17 rows at a time moved by 7e-14). :meth:`complete` records a chunk still
-    #: waiting.
+    #: cost: 10 steps) waits and is recorded with the next chunk; so does the initial row
+    #: (a single row before anything is recorded), joined with a next chunk that would wait
+    #: itself: the initial row, the first call and the rest are one pass over the rows
+    #: instead of three (a pass costs ~0.1-0.3 ms on a tiny system). Single rows after it
+    #: (the intervals of adaptive steps) do not wait, and the initial row followed by a
+    #: single row is recorded on its own as before: rows grouped otherwise are not always
+    #: bitwise the same (the adaptive boom's stresses batched 17 rows at a time moved by
+    #: 7e-14). :meth:`complete` records a chunk still waiting.
     WAIT_ROWS = 16
 
     _waiting = None
@@ -983,116 +988,72 @@ class DynamicAnswers:
         """Record the chunk still waiting (:data:`WAIT_ROWS`): before the answers are read."""
         waiting, self._waiting = self._waiting, None
         if waiting is not None:
-            self._blocks(waiting)
+            self._record(waiting)
 
     def __call__(self, chunk) -> None:
-        """Record a chunk of rows, in blocks of about ANSWER_BLOCK_BYTES of full coordinates
-        (the work arrays hold ~5 copies of a block's: bounded whatever the chunk's length);
-        a short chunk waits for the next one (:data:`WAIT_ROWS`)."""
+        """Record a chunk of rows (bounded by the kernel's row buffer: dynamic.py
+        ``call_rows``); a short chunk waits for the next one (:data:`WAIT_ROWS`)."""
         if chunk.q is None:
             raise ValueError("DynamicAnswers needs the coordinates of every step (store_q)")
-        contact = getattr(chunk, "contact", None)
+        answers = getattr(chunk, "answers", None) if self.needs_answers else None
+        if self.needs_answers and answers is None:
+            raise ValueError("DynamicAnswers needs the rows' answers (DynamicSettings.answers)")
         rows = len(chunk.time)
         if self._waiting is not None:
             held, self._waiting = self._waiting, None
             if rows == 1 and len(held.time) == 1:   # the initial row, then a single row
-                self._blocks(held)
-                self._blocks(chunk)
+                self._record(held)
+                self._record(chunk)
                 return
             chunk = SimpleNamespace(
                 time=np.concatenate([held.time, chunk.time]),
                 q=np.concatenate([held.q, chunk.q]), lam=np.concatenate([held.lam, chunk.lam]),
-                contact=None if contact is None or held.contact is None
-                else np.concatenate([held.contact, contact]))
-            if len(held.time) == 1 and 1 < rows and len(chunk.time) <= self.WAIT_ROWS \
-                    and len(chunk.time) < self._block_rows():
+                answers=None if answers is None else np.concatenate([held.answers, answers]))
+            if len(held.time) == 1 and 1 < rows and len(chunk.time) <= self.WAIT_ROWS:
                 self._waiting = chunk   # the initial row and a short chunk: new arrays
                 return
-        elif (1 < rows or (rows == 1 and not self._time_blocks)) and rows <= self.WAIT_ROWS \
-                and rows < self._block_rows():
+        elif (1 < rows or (rows == 1 and not self._time_blocks)) and rows <= self.WAIT_ROWS:
             self._waiting = SimpleNamespace(   # copies: the chunk's arrays may be reused
                 time=np.array(chunk.time), q=np.array(chunk.q), lam=np.array(chunk.lam),
-                contact=None if contact is None else np.array(contact))
+                answers=None if answers is None else np.array(answers))
             return
-        self._blocks(chunk)
-
-    def _block_rows(self) -> int:
-        """The rows of a block (about ANSWER_BLOCK_BYTES of full coordinates)."""
-        return max(1, ANSWER_BLOCK_BYTES // (8 * max(self.model.nfull, 1)))
-
-    def _blocks(self, chunk) -> None:
-        """Record a chunk: its reactions in blocks of about ANSWER_BLOCK_BYTES of full
-        coordinates, its beams' section forces in one kernel call per beam."""
-        rows = self._block_rows()
-        n = len(chunk.time)
-        if n <= rows:
-            self._record(chunk)
-        else:
-            contact = getattr(chunk, "contact", None)
-            for start in range(0, n, rows):
-                block = slice(start, min(start + rows, n))
-                self._record(SimpleNamespace(time=chunk.time[block], q=chunk.q[block],
-                                             lam=chunk.lam[block],
-                                             contact=None if contact is None else contact[block]))
-        times = np.asarray(chunk.time, dtype=float)
-        if not len(times):
-            return
-        for info in self.section_sets:
-            self._record_sections(info.body.name, beam_section_forces(
-                self.model, info, chunk.q, times, self.stations), times)
+        self._record(chunk)
 
     def _record(self, chunk) -> None:
-        """Record one block of rows (every row after the previous block's)."""
+        """Record a chunk's rows: the reactions from the rows' states and answers, the beams'
+        section forces in one kernel call per beam."""
         times = np.asarray(chunk.time, dtype=float)
         if not len(times):
             return
         e_rows = np.asarray(chunk.q, dtype=float)
-        # read only: without eliminated joints q is e (no copy of every row); with them,
-        # when the reactions need neither kernel gradients nor the full residual, only the
-        # full coordinates they read (the same values: the expansion's own operations on
-        # those columns)
-        columns = None
-        if self.model.reduction is None:
-            q_rows = e_rows
-        elif not self.map.joints:
-            q_rows = None   # nothing here reads the full coordinates
-        elif not self.need_acceleration and (columns := self.map.row_columns()) is not None:
-            q_rows = self.model.reduction.expand_columns(e_rows, columns)
-        else:
-            q_rows = self.model.expand(e_rows)
-        residual = None
-        # e' at the rows: for the force elements' reactions only
-        velocities = np.zeros_like(e_rows) if self.force_elements else \
-            np.empty((len(e_rows), 0))
-        if self.need_acceleration:
-            lf = 1.0
-            residual = np.empty_like(q_rows)
-            for row, t in enumerate(times):
-                v, accel = self._kinematics(float(t), e_rows[row])
-                if self.force_elements:
-                    velocities[row] = v
-                guesses = None
-                if getattr(chunk, "contact", None) is not None:   # xi, eta of each point
-                    guesses = np.ascontiguousarray(chunk.contact[row, :, 4:6].T)
-                residual[row] = self.map.residual(e_rows[row], v, accel, float(t), lf,
-                                                  guesses)
-        elif self.need_velocity:
-            for row, t in enumerate(times):
-                velocities[row], _ = self._kinematics(float(t), e_rows[row])
-        if self.force_elements:
-            found_fe = [force_element_reactions(self.model, e_rows[row], velocities[row],
-                                                float(t)) for row, t in enumerate(times)]
-            for info in self.force_elements:
-                rows = [f[info.name] for f in found_fe]
-                self.reactions[info.name].append((np.array([r.force for r in rows]),
-                                                  np.array([r.moment for r in rows]),
-                                                  np.array([r.axial for r in rows])))
+        answers = getattr(chunk, "answers", None) if self.needs_answers else None
+        if answers is not None and not np.all(np.isfinite(answers)):
+            raise ValueError("the kernel could not evaluate the forces of a row's reactions")
+        nfel = len(self.force_elements)
+        for i, info in enumerate(self.force_elements):
+            values = answers[:, 7 * i:7 * i + 7]
+            self.reactions[info.name].append((values[:, 0:3].copy(), values[:, 3:6].copy(),
+                                              values[:, 6].copy()))
         if self.map.joints:
+            # read only: without eliminated joints q is e (no copy of every row); with them,
+            # when the reactions need no kernel gradients, only the full coordinates they
+            # read (the same values: the expansion's own operations on those columns)
+            columns = None
+            if self.model.reduction is None:
+                q_rows = e_rows
+            elif (columns := self.map.row_columns()) is not None:
+                q_rows = self.model.reduction.expand_columns(e_rows, columns)
+            else:
+                q_rows = self.model.expand(e_rows)
+            residual = answers[:, 7 * nfel:] if self.need_residual else None
             found = self.map.reaction_rows(q_rows, np.asarray(chunk.lam, dtype=float), times,
                                            residual, columns=columns)
             for name, (force, moment, _, axial) in found.items():
                 self.reactions[name].append((force, moment, axial))
         self._time_blocks.append(np.array(times))   # (a list of floats made on request)
+        for info in self.section_sets:
+            self._record_sections(info.body.name, beam_section_forces(
+                self.model, info, e_rows, times, self.stations), times)
 
     def _record_sections(self, name: str, f: SectionForces, times: np.ndarray) -> None:
         """Keep a block's section forces (output.sections) and lift the envelope."""
@@ -1112,5 +1073,5 @@ class DynamicAnswers:
 __all__ = ["Answers", "static_answers", "Reaction", "SectionForces", "Stress", "reactions",
            "section_forces", "static_section_forces", "beam_equilibrium_forces", "force_element_reactions",
            "beam_section_forces", "stresses", "beam_stress", "fibre_stresses", "reaction_map",
-           "DEFAULT_STATIONS",
+           "DEFAULT_STATIONS", "answer_inputs",
            "DynamicAnswers", "constraint_joints"]
