@@ -604,9 +604,8 @@ GENERAL_SINGLE_GROUPS = GENERAL_SINGLE_GROUPS + ("modal", "buckling")
 #: repeat.
 DEFINITION_GROUPS = ("parameters", "point")
 POINT_SCHEMA: dict[str, Key] = {
-    "name": name_key("a unique name of the point; a point key of any group (start, end, "
-                     "point, point1, point2, pivot, frame_pivot, corner, centre, position, "
-                     "spin_centre) may give it instead of x, y, z"),
+    "name": name_key("a unique name of the point; the point keys of any group "
+                     "(ancfdrv.io.expressions.POINT_KEYS) may give it instead of x, y, z"),
     "at": Key("floats", check=vector3, doc="the point's coordinates x, y, z (m; numbers, "
               "expressions or an earlier point's name)"),
 }
