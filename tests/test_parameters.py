@@ -272,3 +272,25 @@ def test_expressions_degrees_against_radians():
         assert evaluate(f"cosd({deg})", {}) == pytest.approx(math.cos(rad), abs=1e-15)
         assert evaluate(f"cosd({deg})**2 + sind({deg})**2", {}) == pytest.approx(1.0,
                                                                                   abs=1e-15)
+
+
+TEMPLATE = """&parameters  L = 2.0, side = 0.05, P = 100.0 /
+&scene  title = 'cantilever', analysis = 'static', formulation = 'ffr', effects = 'tip_force' /
+&beam  length = '$L', width = '$side', height = '$side', nodes = 9 /
+&material  youngs_modulus = 2.1e11, density = 7850.0 /
+&cantilever  clamp = 'section' /
+&loads  tip_force = 0.0, '-$P', 0.0 /
+&solver  static_method = 'newton' /
+"""
+
+
+def test_a_template_scene_takes_parameters(tmp_path):
+    """Template scenes take &parameters too: the beam's length, section and the tip force
+    from the parameters, --set moving each."""
+    path = _scene(tmp_path, TEMPLATE, "template.nml")
+    scene = load_scene(path, ["parameters.L=3.0", "parameters.side=0.04"])
+    assert scene.kind == "cantilever"
+    assert (scene["beam"]["length"], scene["beam"]["width"], scene["beam"]["height"]) == \
+        (3.0, 0.04, 0.04)
+    assert scene["loads"]["tip_force"] == [0.0, -100.0, 0.0]
+    assert "beam.length = '$L' => 3.0" in scene.expressions
