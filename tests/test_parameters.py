@@ -13,7 +13,7 @@ import pytest
 import ancfdrv  # noqa: F401  (registers the general-scene builder)
 from ancfdrv.cli import main
 from ancfdrv.errors import InputError
-from ancfdrv.io.expressions import ExpressionError, evaluate, parameters_used
+from ancfdrv.io.parameters import ExpressionError, evaluate
 from ancfdrv.io.scene import load_scene
 from ancfdrv.runner import run_scene
 from ancfdrv.sweep import run_sweep
@@ -75,10 +75,6 @@ def test_expression_refusals(text, words):
     with pytest.raises(ExpressionError) as info:
         evaluate(text, {"h": 2.0})
     assert words in str(info.value)
-
-
-def test_parameters_used():
-    assert parameters_used("$h + $L*sind($Phi) + pi") == {"h", "l", "phi"}
 
 
 # -- 2. in a scene -----------------------------------------------------------------------------

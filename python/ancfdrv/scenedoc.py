@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from .builders.general import _DRIVE_KEYS, _REQUIRED_DRIVE
-from .io.expressions import FUNCTIONS, POINT_KEYS
+from .io.parameters import FUNCTIONS, POINT_KEYS
 from .io.schema import GENERAL_SCHEMA, MODEL_GROUPS, POINT_SCHEMA, REQUIRED, SCHEMA, Key
 from .system.drives import DRIVE_TYPES
 from .system.kinds.force_element import FORCE_ELEMENT_MEANING, FORCE_ELEMENT_PARAMETERS

@@ -23,7 +23,7 @@ import f90nml
 
 from ..errors import InputError
 from . import validate
-from .expressions import CONSTANTS, POINT_KEYS, Definitions, ExpressionError
+from .parameters import CONSTANTS, POINT_KEYS, Definitions, ExpressionError
 from .schema import (COMMON_GROUPS, DEFINITION_GROUPS, EFFECTS_AVAILABLE, EFFECTS_PLANNED,
                      GENERAL_ONLY_GROUPS, GENERAL_SCHEMA, GENERAL_SINGLE_GROUPS, MODEL_GROUPS,
                      PLATE_KINDS, POINT_SCHEMA, REQUIRED, SCHEMA, Key, checked_value)

@@ -21,8 +21,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-__all__ = ["ExpressionError", "FUNCTIONS", "POINT_KEYS", "Definitions", "evaluate",
-           "parameters_used"]
+__all__ = ["ExpressionError", "FUNCTIONS", "POINT_KEYS", "Definitions", "evaluate"]
 
 
 class ExpressionError(Exception):
@@ -218,11 +217,6 @@ def evaluate(text: str, parameters: dict[str, float]) -> float:
         raise ExpressionError("the value overflows") from None
 
 
-def parameters_used(text: str) -> set[str]:
-    """The parameters an expression names (lower case)."""
-    return {t.lower() for kind, t, _ in _tokens(text) if kind == "parameter"}
-
-
 def _written(value: Any) -> str:
     """A key's value as written in the namelist (strings quoted)."""
     items = value if isinstance(value, list) else [value]
@@ -235,8 +229,6 @@ class Definitions:
     them (what the result file stores)."""
 
     parameters: dict[str, float] = field(default_factory=dict)
-    #: the parameters as written (a number, or the expression text)
-    written: dict[str, Any] = field(default_factory=dict)
     points: dict[str, list[float]] = field(default_factory=dict)
     #: 'address = written => value' of each key given by an expression or a point name
     record: list[str] = field(default_factory=list)
