@@ -15,7 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from .builders.general import _DRIVE_KEYS, _REQUIRED_DRIVE
-from .io.schema import GENERAL_SCHEMA, MODEL_GROUPS, REQUIRED, SCHEMA, Key
+from .io.parameters import FUNCTIONS, POINT_KEYS
+from .io.schema import GENERAL_SCHEMA, MODEL_GROUPS, POINT_SCHEMA, REQUIRED, SCHEMA, Key
 from .system.drives import DRIVE_TYPES
 from .system.kinds.force_element import FORCE_ELEMENT_MEANING, FORCE_ELEMENT_PARAMETERS
 from .system.joints import JOINT_TYPES
@@ -159,6 +160,37 @@ def _type_table(title: str, parameters: dict, meaning: dict, extra: str = "") ->
     return lines + ([""] + [extra] if extra else []) + [""]
 
 
+def definitions() -> list[str]:
+    """The section on ``&parameters``, expressions and ``&point`` (any scene)."""
+    return [
+        "## Parameters, expressions and named points (SPEC section 8.2)",
+        "",
+        "Any scene may define named numbers in `&parameters` groups (several allowed; each "
+        "name once) and give any numeric key as a quoted expression over them: "
+        "`end = 0.0, '$h + $L*sind($phi)', 0.0`. A parameter is written `$name` "
+        "(case-insensitive) and may itself be an expression over the parameters defined "
+        "before it. Expressions know numbers, `+ - * /`, `**` (right-associative, binding "
+        "tighter than a unary minus on its left: `-2**2` is -4), parentheses, the constant "
+        "`pi` and the functions " + ", ".join(f"`{f}`" for f in FUNCTIONS) + " (`sin`, "
+        "`cos`, `tan` in radians, `sind`, `cosd`, `tand` in degrees). They are read by a "
+        "small parser, never evaluated as code: any other name or character, a division by "
+        "zero or a value that is not finite is an error (exit 2) naming file, group, key "
+        "and the expression. `--set parameters.NAME=VALUE` and `ancf sweep --vary "
+        "parameters.NAME=V1,V2,...` move every key that uses the parameter. The result "
+        "file's root attributes `parameters` and `expressions` record each parameter's "
+        "value and each key given by an expression or a point name, as written and as "
+        "evaluated.",
+        "",
+        "`&parameters  L = 4.0, phi = 40.0, tip_x = '$L*cosd($phi)' /`",
+        "",
+        "A `&point` names a point once; a point key (" +
+        ", ".join(f"`{k}`" for k in sorted(POINT_KEYS)) + ") of any group may give its "
+        "name instead of x, y, z: `point = 'lug1'` (a joint's `point` may list several).",
+        "",
+        *group_table("point", POINT_SCHEMA),
+    ]
+
+
 def render() -> str:
     """The text of docs/scenes.md."""
     lines = [
@@ -177,6 +209,7 @@ def render() -> str:
         "The `&solver` and `&output` keys are also the keywords of `System.static()` and "
         "`System.simulate()` in Python, with the same defaults.",
         "",
+        *definitions(),
         "## General scenes (SPEC section 8)",
         "",
         "A scene without a template group is a general scene: `&scene`, `&solver`, "

@@ -117,8 +117,9 @@ def expand(params: dict[str, str]) -> list[str]:
 def parse_vary(items: list[str], scene_file: str) -> list[tuple[str, list[str]]]:
     """``GROUP.KEY=V1,V2,...`` or ``GROUP[NAME].KEY=...`` (a named group of a general scene)
     -> (dotted key, values); keys are checked against the schema (every case is validated
-    with its scene before any runs). Keys joined by '+' vary together
-    (``plate.nx+plate.ny=2,4,8``: 2x2, 4x4, 8x8)."""
+    with its scene before any runs; ``parameters.NAME`` moves every key whose expression
+    uses the parameter). Keys joined by '+' vary together (``plate.nx+plate.ny=2,4,8``:
+    2x2, 4x4, 8x8)."""
     out = []
     for item in items:
         if "=" not in item or "." not in item.split("=", 1)[0]:
@@ -134,7 +135,8 @@ def parse_vary(items: list[str], scene_file: str) -> list[tuple[str, list[str]]]
                                  "GROUP[NAME].KEY", file=scene_file) from None
             schema = GENERAL_SCHEMA.get(group, {}) if name is not None else \
                 {**SCHEMA.get(group, {}), **GENERAL_SCHEMA.get(group, {})}
-            if key not in schema:
+            # (a scene's own parameters: checked when each case's scene is read)
+            if key not in schema and not (group == "parameters" and name is None):
                 raise InputError(f"--vary names an unknown key {part.strip()!r}",
                                  file=scene_file, group=group, key=key)
             parts.append(f"{group}.{key}" if name is None else f"{group}[{name}].{key}")

@@ -23,9 +23,10 @@ import f90nml
 
 from ..errors import InputError
 from . import validate
-from .schema import (COMMON_GROUPS, EFFECTS_AVAILABLE, EFFECTS_PLANNED, GENERAL_ONLY_GROUPS,
-                     GENERAL_SCHEMA, GENERAL_SINGLE_GROUPS, MODEL_GROUPS, PLATE_KINDS, REQUIRED,
-                     SCHEMA, Key, checked_value)
+from .parameters import CONSTANTS, POINT_KEYS, Definitions, ExpressionError
+from .schema import (COMMON_GROUPS, DEFINITION_GROUPS, EFFECTS_AVAILABLE, EFFECTS_PLANNED,
+                     GENERAL_ONLY_GROUPS, GENERAL_SCHEMA, GENERAL_SINGLE_GROUPS, MODEL_GROUPS,
+                     PLATE_KINDS, POINT_SCHEMA, REQUIRED, SCHEMA, Key, checked_value)
 
 __all__ = ["Scene", "load_scene", "parse_address", "is_general", "SCHEMA", "GENERAL_SCHEMA",
            "EFFECTS_AVAILABLE", "MODEL_GROUPS", "PLATE_KINDS"]
@@ -45,6 +46,10 @@ class Scene:
     #: (a :class:`~ancfdrv.builders.common.BuiltSystem`), taken by the first
     #: :func:`ancfdrv.builders.build_system` so that a scene is built once
     built: Any = field(default=None, repr=False, compare=False)
+    #: the &parameters' values (lower-case names), overrides applied
+    parameters: dict[str, float] = field(default_factory=dict)
+    #: each key given by an expression or a point name: 'address = as written => value'
+    expressions: list[str] = field(default_factory=list)
 
     @property
     def kind(self) -> str:
@@ -352,6 +357,9 @@ def _apply_override(nml: f90nml.Namelist, item: str, general: bool, file: str) -
         group, name, key = parse_address(dotted)
     except ValueError as exc:
         raise InputError(f"override {item!r}: {exc}", file=file) from None
+    if group == "parameters":
+        _override_parameter(nml, item, name, key, value, file)
+        return f"{dotted.strip()}={value.strip()}"
     schema = _schema_of(group, general)
     label = group if name is None else f"{group}[{name}]"
     where = dict(file=file, group=label, key=key)
@@ -382,6 +390,87 @@ def _apply_override(nml: f90nml.Namelist, item: str, general: bool, file: str) -
     return f"{dotted.strip()}={value.strip()}"
 
 
+def _override_parameter(nml: f90nml.Namelist, item: str, name: str | None, key: str,
+                        value: str, file: str) -> None:
+    """--set parameters.NAME=VALUE: the &parameters group that defines NAME takes the
+    number (every key whose expression uses it follows)."""
+    where = dict(file=file, group="parameters", key=key)
+    if name is not None:
+        raise InputError(f"override {item!r}: a parameter is addressed as parameters.NAME",
+                         **where)
+    parsed = validate.parse_value("float", value, where)
+    instances = _instances(nml, "parameters")
+    for instance in instances:
+        if key in instance:
+            instance[key] = parsed
+            return
+    known = ", ".join(k for i in instances for k in i) or "none"
+    raise InputError(f"override {item!r}: the scene defines no parameter {key!r} "
+                     f"(parameters: {known})", **where)
+
+
+def _definitions(nml: f90nml.Namelist, file: str) -> Definitions:
+    """The scene's &parameters (in file order: each a number or an expression over the
+    earlier ones) and named &point groups."""
+    defs = Definitions()
+    for instance in _instances(nml, "parameters"):
+        for key, raw in instance.items():
+            where = dict(file=file, group="parameters", key=key)
+            if key in defs.parameters:
+                raise InputError("the parameter is defined twice (each name once, in any "
+                                 "&parameters group)", **where)
+            if type(raw) is str:
+                try:
+                    value = defs.number(raw)
+                except ExpressionError as exc:
+                    raise InputError(f"expression {raw!r}: {exc}", **where) from None
+            else:
+                value = checked_value(Key("float"), raw, where)
+            defs.parameters[key] = value
+    for instance in _instances(nml, "point"):
+        name = str(instance.get("name", "")).strip()
+        label = f"point[{name}]" if name else "point"
+        typed = _typed("point", label, instance, POINT_SCHEMA, file, defs=defs)
+        if typed["name"] in defs.points:
+            raise InputError(f"the name {typed['name']!r} is used twice", file=file,
+                             group=label, key="name")
+        defs.points[typed["name"]] = typed["at"]
+    return defs
+
+
+#: the key kinds whose values may be expressions
+_NUMERIC_KINDS = frozenset(("float", "floats", "int"))
+#: a bare word: in a key that is not a point key not an expression but a wrong value (the
+#: type's message: 'expected a number')
+_WORD = re.compile(r"\s*([A-Za-z_]\w*)\s*\Z")
+
+
+def _resolved(defs: Definitions, spec: Key, label: str, key: str, raw: Any,
+              where: dict[str, Any]) -> Any:
+    """A numeric key's raw value with its expressions and point names replaced (the value
+    as it came where it holds neither)."""
+    if spec.kind not in _NUMERIC_KINDS:
+        return raw
+    if type(raw) is str:
+        word = _WORD.match(raw)
+        if word and key not in POINT_KEYS and word.group(1).lower() not in CONSTANTS:
+            return raw   # (refused by the type's check)
+    elif type(raw) is not list or str not in map(type, raw):
+        return raw
+    if key in POINT_KEYS:
+        for item in (raw if type(raw) is list else [raw]):
+            word = _WORD.match(item) if type(item) is str else None
+            if word and item.strip() not in defs.points and \
+                    word.group(1).lower() not in CONSTANTS:
+                known = ", ".join(map(repr, defs.points)) or "none"
+                raise InputError(f"unknown point {item.strip()!r} (named points: {known})",
+                                 **where)
+    try:
+        return defs.resolve(f"{label}.{key}", key, raw)
+    except ExpressionError as exc:
+        raise InputError(str(exc), **where) from None
+
+
 def _schema_of(group: str, general: bool) -> dict[str, Key] | None:
     if general:
         if group in GENERAL_SINGLE_GROUPS:
@@ -391,17 +480,22 @@ def _schema_of(group: str, general: bool) -> dict[str, Key] | None:
 
 
 def _typed(group: str, label: str, entries, schema: dict[str, Key], file: str,
-           plain: bool = False) -> dict[str, Any]:
+           plain: bool = False, defs: Definitions | None = None) -> dict[str, Any]:
     """Coerce and check one group's entries against its schema; fill the defaults.
     ``plain``: a group of a namelist :func:`fast_reads` read (lower-case keys that are no
     cogroup keys): its items read as the dict's own (f90nml's items view makes an NmlKey
-    and calls Namelist.__getitem__ per key: the same keys as str, the same values)."""
+    and calls Namelist.__getitem__ per key: the same keys as str, the same values).
+    ``defs``: the scene's parameters and points, which the numeric keys' expressions and
+    point names are evaluated with (recorded in ``defs.record``)."""
     typed: dict[str, Any] = {}
     for key, raw in (OrderedDict.items(entries) if plain else entries.items()):
         where = dict(file=file, group=label, key=key)
         if key not in schema:
             raise InputError(f"unknown key; known keys of &{group}: {', '.join(schema)}", **where)
-        typed[key] = checked_value(schema[key], raw, where)
+        spec = schema[key]
+        if defs is not None:
+            raw = _resolved(defs, spec, label, key, raw, where)
+        typed[key] = checked_value(spec, raw, where)
     for key, spec in schema.items():
         if key not in typed:
             if spec.default is REQUIRED:
@@ -474,7 +568,7 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
             raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
         validate.check_ended(file, groups)
     general = is_general(nml)
-    repeatable = GENERAL_SCHEMA if general else ()
+    repeatable = (*GENERAL_SCHEMA, *DEFINITION_GROUPS) if general else DEFINITION_GROUPS
     # (in a plain namelist the text is scanned for its lines only when a group that may not
     # repeat does)
     if plain is None or any(count > 1 and name not in repeatable for name, count in
@@ -486,8 +580,11 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     # a repeated group comes once per occurrence (f90nml's items view: each key's cogroup
     # name)
     for group in map(_cogroup_name, OrderedDict.keys(nml)):
+        if group in DEFINITION_GROUPS:
+            continue
         if _schema_of(group, general) is None:
-            known = list(GENERAL_SCHEMA) + list(GENERAL_SINGLE_GROUPS) if general else SCHEMA
+            known = [*GENERAL_SCHEMA, *GENERAL_SINGLE_GROUPS] if general else [*SCHEMA]
+            known += DEFINITION_GROUPS
             raise InputError(f"unknown group in a {'general' if general else 'template'} scene; "
                              f"known groups: {', '.join(known)}", file=file, group=group)
         seen[group] += 1
@@ -497,14 +594,18 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
                              group=group)
 
     applied = [_apply_override(nml, item, general, file) for item in overrides or []]
+    defs = _definitions(nml, file)
     if general:
-        return _general_scene(path, nml, applied)
+        return _general_scene(path, nml, applied, defs)
 
     values: dict[str, dict[str, Any]] = {}
-    # (no group repeats here: refused above; a plain namelist's groups read as its dict's)
+    # (no group repeats here but the definitions': refused above; a plain namelist's groups
+    # read as its dict's)
     fast = plain is not None
     for group, entries in (OrderedDict.items(nml) if fast else nml.items()):
-        values[group] = _typed(group, group, entries, SCHEMA[group], file, fast)
+        if _cogroup_name(group) in DEFINITION_GROUPS:
+            continue
+        values[group] = _typed(group, group, entries, SCHEMA[group], file, fast, defs)
 
     models = [g for g in MODEL_GROUPS if g in values]
     if "spring" in models and "leaf" in models:  # &leaf: the spring's leaf pack
@@ -531,24 +632,29 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
     validate.check_output_memory(estimate, values["output"], file, values["solver"],
                                  values["scene"]["analysis"])
     _check_eigen_bounds(values, file)
-    return Scene(path=path, values=values, text=partial(namelist_text, nml), overrides=applied)
+    return Scene(path=path, values=values, text=partial(namelist_text, nml), overrides=applied,
+                 parameters=defs.parameters, expressions=defs.record)
 
 
-def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scene:
-    """Validate a general scene: the single groups, then every named item in file order;
-    the System is built once (dry) so that every name and value is checked now."""
+def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str],
+                   defs: Definitions) -> Scene:
+    """Validate a general scene: the single groups, then every named item in file order
+    (their expressions and point names evaluated with ``defs``); the System is built once
+    (dry) so that every name and value is checked now."""
     file = str(path)
     values: dict[str, dict[str, Any]] = {}
     items: list[tuple[str, dict[str, Any]]] = []
     names: dict[str, set[str]] = {}
     for group, entries in nml.items():
+        if group in DEFINITION_GROUPS:
+            continue
         for instance in (entries if isinstance(entries, list) else [entries]):
             if group in GENERAL_SINGLE_GROUPS:
-                values[group] = _typed(group, group, instance, SCHEMA[group], file)
+                values[group] = _typed(group, group, instance, SCHEMA[group], file, defs=defs)
                 continue
             name = str(instance.get("name", "")).strip()
             label = f"{group}[{name}]" if name else group
-            typed = _typed(group, label, instance, GENERAL_SCHEMA[group], file)
+            typed = _typed(group, label, instance, GENERAL_SCHEMA[group], file, defs=defs)
             if typed["name"] in names.setdefault(group, set()):
                 raise InputError(f"the name {typed['name']!r} is used twice", file=file,
                                  group=label, key="name")
@@ -562,7 +668,8 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str]) -> Scen
                          "&leaf or &rigid_body)", file=file)
     listed = "effects" in nml.get("scene", {})
     scene = Scene(path=path, values=values, text=partial(namelist_text, nml),
-                  overrides=applied, items=items)
+                  overrides=applied, items=items, parameters=defs.parameters,
+                  expressions=defs.record)
     if not GENERAL_BUILDER:
         raise RuntimeError("import ancfdrv (the package) to read general scenes")
     effects_of = GENERAL_BUILDER["effects_of"]

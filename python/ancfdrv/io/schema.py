@@ -616,6 +616,17 @@ SCHEMA["buckling"] = {
 }
 #: &modal and &buckling occur once in general scenes too
 GENERAL_SINGLE_GROUPS = GENERAL_SINGLE_GROUPS + ("modal", "buckling")
+#: Groups of any scene that define names the other groups' values use (SPEC section 8.2;
+#: :mod:`ancfdrv.io.parameters`), read before them and never built: ``&parameters`` (any
+#: keys: each a named number or an expression over earlier ones) and ``&point``; both may
+#: repeat.
+DEFINITION_GROUPS = ("parameters", "point")
+POINT_SCHEMA: dict[str, Key] = {
+    "name": name_key("a unique name of the point; the point keys of any group "
+                     "(ancfdrv.io.parameters.POINT_KEYS) may give it instead of x, y, z"),
+    "at": Key("floats", check=vector3, doc="the point's coordinates x, y, z (m; numbers, "
+              "expressions or an earlier point's name)"),
+}
 #: Groups only general scenes have.
 GENERAL_ONLY_GROUPS = ("rigid_body", "joint", "drive", "load", "contact", "probe", "cable",
                        "force_element")

@@ -493,6 +493,10 @@ def create(path: Path, scene: Scene, model: Model) -> None:
             "scene": scene.text,
             "scene_file": str(scene.path),
             "overrides": "\n".join(scene.overrides),
+            # the &parameters' values and each key given by an expression or a point
+            # name ('address = as written => value'; SPEC section 8.2)
+            "parameters": "\n".join(f"{k} = {v!r}" for k, v in scene.parameters.items()),
+            "expressions": "\n".join(scene.expressions),
             "title": scene["scene"]["title"],
             "kind": scene.kind,
             "formulation": scene["scene"]["formulation"],
