@@ -291,6 +291,45 @@ BUCKLING_KEYWORDS = {"modes": "buckling", "fixed_loads": "buckling", "method": "
                      "reference_factor": "buckling", "tol": "solver", "max_iter": "solver"}
 
 
+#: 'linear' is confirmed where the tangent on the static path, at this fraction of its first
+#: factor, keeps less than CONFIRM_STIFFNESS of the lowest stiffness it had at the scene's
+#: loads (a linear softening leaves 1 - CONFIRM_AT P / (P - 1) of it: 0.02 P / (P - 1))
+CONFIRM_AT, CONFIRM_STIFFNESS = 0.98, 0.25
+
+
+def _confirm_linear(path: "LoadPath", factor: float, k1: sp.spmatrix, mass: sp.spmatrix,
+                    g: sp.spmatrix, how: str, basis: np.ndarray | None) -> None:
+    """Refuse a 'linear' factor the model contradicts. The classical estimate extrapolates
+    the change of the tangent between the scene's loads and a step beyond them; where the
+    pre-buckling deformation turns the structure (a mechanism's arm swinging about its pin,
+    a stiff-shear frame), that change holds the initial-displacement matrix as well as the
+    initial-stress one and the estimate can be far too low (docs/theory.md section 23).
+    The check loads the static path to CONFIRM_AT of the factor: a factor the model
+    confirms leaves the lowest stiffness near zero there; one that leaves more than
+    CONFIRM_STIFFNESS of it (or a path that cannot be followed that far) is refused, naming
+    'nonlinear' (SolverError, exit 3): never a wrong factor with status ok."""
+    if factor <= 1.0:
+        return
+    w1, _ = _lowest(k1, mass, g, how, 1, basis)
+    target = 1.0 + CONFIRM_AT * (factor - 1.0)
+    try:
+        _advance(path, target)
+    except SolverError as exc:
+        raise SolverError(
+            f"buckling: the 'linear' estimate {factor:.6g} is not confirmed: the static path "
+            f"could not be followed to {target:.6g} times the loads ({exc}); the structure "
+            "may have a limit below it: use buckling.method = 'nonlinear'") from None
+    w, _ = _lowest(path.tangent(), mass, g, how, 1, basis)
+    kept = float(w[0] / w1[0]) if w1[0] > 0 else 0.0
+    if kept > CONFIRM_STIFFNESS:
+        raise SolverError(
+            f"buckling: the 'linear' estimate {factor:.6g} is contradicted by the model: at "
+            f"{path.factor:.6g} times the loads the tangent keeps {kept:.2g} of its lowest "
+            "stiffness (a buckling load leaves ~0); the pre-buckling deformation turns the "
+            "structure, which the classical estimate misreads (docs/theory.md section 23): "
+            "use buckling.method = 'nonlinear'")
+
+
 def buckling_analysis(model: Model, base_model: Model, count: int, *,
                       fixed_loads: tuple[str, ...] = (), method: str = "nonlinear",
                       solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,
@@ -422,6 +461,8 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         factors, shapes = mus[order], vectors[:, positive][:, order].T.copy()
         negative = (theta < -1e-12 * max(scale, 1e-300)) & (theta > -1.0)
         negative_factor = float(1.0 + 1.0 / theta[negative].min()) if negative.any() else 0.0
+        if len(factors):
+            _confirm_linear(path, float(factors[0]), k1, mass, g, how, basis)
     else:
         # the first: the limit; the others: each mode's omega^2(P) extrapolated likewise
         factors = [critical]
