@@ -601,18 +601,19 @@ SCHEMA["buckling"] = {
     "fixed_loads": Key("strs", [], doc="loads (by name) or effects (e.g. 'gravity') kept at "
                        "their value; the others are the reference loads the factor multiplies"),
     "method": Key("str", "nonlinear", one_of("nonlinear", "linear"),
-                  "'nonlinear': the stability limit on the static path (K_g re-evaluated until "
-                  "the factor reproduces itself); 'linear': (K_0 + mu K_g) phi = 0 once, K_g "
-                  "from the tangents at the scene's loads and at the fixed loads"),
+                  "both start from the scene's static state (factor 1); 'nonlinear': the "
+                  "stability limit on the static path (the lowest stiffness followed until its "
+                  "zero reproduces itself); 'linear': (K_1 + nu K_g) phi = 0 once, factor "
+                  "1 + nu, K_g from the tangents at factors 1 and 1 + reference_factor"),
     "solver": Key("str", "auto", one_of("auto", "dense", "sparse"),
                   "eigensolver, as modal.solver"),
     "rtol": Key("float", 1e-6, lambda v: None if 0 < v < 0.1 else "must lie in (0, 0.1)",
                 "method 'nonlinear': relative change of the load factor that ends the updates"),
     "load_steps": Key("int", 1, positive, "Newton load increments between states on the "
                       "static path"),
-    "reference_factor": Key("float", 1.0, positive, "the first state on the path: this "
-                            "multiple of the reference loads (nearer the limit when the "
-                            "scene's loads are far below it)"),
+    "reference_factor": Key("float", 1.0, positive, "the first state on the path past "
+                            "the scene's own: its load factor is 1 + this (larger when the "
+                            "scene's loads are far below the limit)"),
 }
 #: &modal and &buckling occur once in general scenes too
 GENERAL_SINGLE_GROUPS = GENERAL_SINGLE_GROUPS + ("modal", "buckling")

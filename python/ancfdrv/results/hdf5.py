@@ -1492,7 +1492,7 @@ def write_modal(path: Path, model: Model, result) -> None:
 def write_buckling(path: Path, model: Model, result) -> None:
     """/buckling from a :class:`~ancfdrv.solvers.buckling.BucklingResult`:
     load_factor[N] (multiples of the reference loads; ascending, positive) and shapes[N, ndof]
-    (largest component 1); /static holds the state under the fixed loads alone."""
+    (largest component 1); /static holds the scene's static state (load factor 1)."""
     attrs = {"method": result.extra.get("method", ""), "solver": result.method,
              "fixed_loads": ",".join(result.fixed_loads), "modes": len(result.load_factor),
              "wall_time_s": result.wall_time_s,

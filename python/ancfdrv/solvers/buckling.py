@@ -1,28 +1,33 @@
-"""Linear buckling about a static state (SPEC section 10, docs/theory.md "Buckling").
+"""Buckling about the scene's static state (SPEC section 10, docs/theory.md "Buckling").
 
 The loads are split into fixed loads F (kept at their value, e.g. gravity) and the
-reference loads P (the others). Two static equilibria are solved: state 0 under F alone and
-state 1 under F + P. With K_T(state) the tangent of the linearized equations
+reference loads R (the others); the structure carries F + P R, P the load factor. Both
+methods start from the scene's own static state, P = 1 (solved as the scene's static
+solve does, :func:`~.static.solve_newton`), never from P = 0: a rope that hangs a payload,
+a mechanism held by its loads or a cylinder's preload has no stiffness without its loads.
+With K_T(P) the tangent of the linearized equations at the static state under F + P R
 (:func:`~.modal.linearize`: elastic tangent with its initial-stress part, the dead moments'
-load stiffness and the constraint Hessians times the multipliers), the eigenproblem is
+and follower loads' load stiffness and the constraint Hessians times the multipliers):
 
-    (K_0 + mu K_g) phi = 0  on  G_0 phi = 0,    K_0 = K_T(state 0),
-    K_g = (K_T(state 1) - K_T(state 0)) / s   (s = ``reference_factor``, default 1)
+* 'linear': K_g = (K_T(1 + s) - K_T(1)) / s (s = ``reference_factor``, default 1) and
 
-and mu is the load factor: the structure under F + mu P loses stability. K_g by this
-difference of tangents is the classical initial-stress (geometric) stiffness of the
-reference loads whenever the tangent is affine in the load factor, which holds for the
-initial-stress term (linear in the stress, itself linear in the load) as long as the
-pre-buckling displacements under s P are small (linear buckling's own assumption). What
-it neglects is the change of the tangent by the pre-buckling deformation's geometry
-(second order in the load), like every linear buckling analysis. ``reference_factor`` < 1
-evaluates the difference at a smaller load when the scene's loads are large.
+      (K_1 + nu K_g) phi = 0  on  G_1 phi = 0,    K_1 = K_T(1),    P = 1 + nu  (nu > 0);
 
-Solved in null-space form densely (K_0 positive definite on the null space of G:
-N^T (-K_g) N y = theta N^T K_0 N y, mu = 1 / theta for the largest positive theta), or for
-large models by ARPACK on the multiplier form with [[K_0, G^T], [G, 0]] factorized once by
-MUMPS. Only positive load factors are reported (a negative one means the reversed loads
-buckle the structure; attribute ``negative_load_factor`` gives the smallest in size).
+  the classical linear buckling about the static state: exact where K_T is affine in P
+  (small pre-buckling deformation).
+* 'nonlinear': the lowest omega^2 of (K_T(P), M) followed along the static path from P = 1
+  until its zero (fitted through the states) reproduces itself: the stability limit of
+  the model, pre-buckling deformation included.
+
+Directions with no stiffness at the static state (a mechanism's free motion, a rigid body's
+free rotation) are not buckling: both methods work on the constrained coordinates where
+K_1 is positive definite (the null space of G with K_1's zero-stiffness directions
+removed); a negative stiffness there means the scene's own state is unstable (refused).
+Solved densely (eigh on the reduced matrices) up to :data:`DENSE_LIMIT` free coordinates,
+else by ARPACK on the multiplier form with [[K_1, G^T], [G, 0]] factorized once by MUMPS
+(no zero-stiffness direction allowed there). Only factors above 1 are buckling (a factor
+below 1 belongs to unloading, e.g. a pendulum that loses its gravity stiffness); attribute
+``negative_load_factor`` gives the smallest reversed-load factor.
 """
 from __future__ import annotations
 
@@ -35,8 +40,8 @@ from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
 from ..kernel import DirectSolver
 from ..system.model import Model
-from .modal import DENSE_LIMIT, arpack_start, check_free, linearize, null_space
-from .static import StaticResult
+from .modal import arpack_start, check_free, linearize, null_space
+from .static import StaticResult, solve_newton
 from .._lazy import LazyModule
 
 # imported on first use (ancfdrv._lazy): ~10 MB most runs never need; scipy.sparse (~19 MB
@@ -44,6 +49,13 @@ from .._lazy import LazyModule
 sp = LazyModule("scipy.sparse")
 la = LazyModule("scipy.linalg")
 spla = LazyModule("scipy.sparse.linalg")
+
+#: free coordinates up to which the eigenproblems are solved densely (a 600 x 600 eigh takes
+#: some 0.1 s; the dense form removes zero-stiffness directions, the sparse one cannot)
+DENSE_LIMIT = 600
+#: eigenvalues of K_1 on the constrained coordinates below this fraction of the largest in
+#: size are zero-stiffness directions (mechanisms, free rotations), not structure
+ZERO_STIFFNESS = 1e-11
 
 
 @dataclass
@@ -67,19 +79,35 @@ class BucklingResult:
         return len(self.load_factor)
 
 
-def _dense(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int):
-    n = k0.shape[0]
+def elastic_basis(k1: sp.spmatrix, g: sp.spmatrix) -> np.ndarray:
+    """An orthonormal basis of the constrained coordinates (the null space of G) without the
+    directions in which K_1 has no stiffness (eigenvalues of N^T K_1 N below
+    :data:`ZERO_STIFFNESS` times the largest in size): a mechanism's or a free body's
+    motion, which no load factor buckles. SolverError when K_1 has a negative stiffness
+    there (the scene's own static state is unstable)."""
+    n = k1.shape[0]
     basis = null_space(g, n)
-    a = basis.T @ (k0 @ basis)
+    reduced = basis.T @ (k1 @ basis)
+    w, v = la.eigh(0.5 * (reduced + reduced.T))
+    floor = ZERO_STIFFNESS * max(np.abs(w).max(initial=0.0), 1e-300)
+    if np.any(w < -floor):
+        raise SolverError(
+            f"buckling: the scene's static state is unstable ({int(np.sum(w < -floor))} "
+            "negative eigenvalue(s) of the tangent on the constrained coordinates): it "
+            "buckles under the scene's own loads; lower them (or run the static path with "
+            "solver.static_method = 'arc_length' to see where it loses stability)")
+    keep = w > floor
+    if not keep.any():
+        raise SolverError("buckling: the structure has no stiffness at its static state "
+                          "(every constrained direction is a free motion)")
+    return basis @ v[:, keep]
+
+
+def _dense(basis: np.ndarray, k1: sp.spmatrix, kg: sp.spmatrix):
+    a = basis.T @ (k1 @ basis)
     b = basis.T @ (kg @ basis)
     a, b = 0.5 * (a + a.T), 0.5 * (b + b.T)
-    try:
-        theta, y = la.eigh(-b, a)
-    except la.LinAlgError:
-        raise SolverError("buckling: the stiffness under the fixed loads is not positive "
-                          "definite on the constrained coordinates (a rigid-body motion is "
-                          "free, or the fixed loads alone already buckle the structure)") \
-            from None
+    theta, y = la.eigh(-b, a)
     return theta, basis @ y
 
 
@@ -179,21 +207,21 @@ class LoadPath:
             self.solves += 1
 
 
-def _pencil(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int, method: str,
-            eigen_tol: float):
-    if method == "dense":
-        return _dense(k0, kg, g, count)
-    return _sparse(k0, kg, g, count, eigen_tol)
+def _pencil(basis: np.ndarray | None, k1: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix,
+            count: int, eigen_tol: float):
+    if basis is not None:
+        return _dense(basis, k1, kg)
+    return _sparse(k1, kg, g, count, eigen_tol)
 
 
 def _lowest(k: sp.spmatrix, m: sp.spmatrix, g: sp.spmatrix, method: str,
-            count: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """The ``count`` lowest omega^2 of (K, M) on the null space of G and their vectors
-    (columns): the softest modes' stiffness, which reaches 0 where the static state loses
-    stability."""
+            count: int = 1, basis: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The ``count`` lowest omega^2 of (K, M) on the null space of G (or on ``basis``, dense)
+    and their vectors (columns): the softest modes' stiffness, which reaches 0 where the
+    static state loses stability."""
     n, ncon = k.shape[0], g.shape[0]
     if method == "dense":
-        basis = null_space(g, n)
+        basis = null_space(g, n) if basis is None else basis
         kr, mr = basis.T @ (k @ basis), basis.T @ (m @ basis)
         count = min(count, kr.shape[0])
         w, y = la.eigh(0.5 * (kr + kr.T), 0.5 * (mr + mr.T), subset_by_index=[0, count - 1])
@@ -231,26 +259,28 @@ def _advance(path: "LoadPath", factor: float, tries: int = 6) -> None:
 
 
 def _root(history: list[tuple[float, float]]) -> float | None:
-    """The load factor where omega^2(P) = w0 (1 - a P - b P^2), fitted through (0, w0) and
-    the last two states (one: linear), vanishes; None while the stiffness does not
-    decrease with the load (no limit in sight)."""
-    w0 = history[0][1]
+    """The load factor where omega^2(P) = w0 (1 - a x - b x^2), x = P - P0, fitted through
+    the first state (P0, w0) and the last two (one: linear), vanishes; None while the
+    stiffness does not decrease with the load (no limit in sight)."""
+    p0, w0 = history[0]
     p2, w2 = history[-1]
     if w0 <= 0 or w2 >= w0 * (1 - 1e-9):
         return None
+    x2 = p2 - p0
     if len(history) < 3:
-        return p2 / (1 - w2 / w0)
+        return p0 + x2 / (1 - w2 / w0)
     p1, w1 = history[-2]
+    x1 = p1 - p0
     try:
-        a, b = np.linalg.solve(np.array([[p1, p1**2], [p2, p2**2]]), [1 - w1 / w0, 1 - w2 / w0])
+        a, b = np.linalg.solve(np.array([[x1, x1**2], [x2, x2**2]]), [1 - w1 / w0, 1 - w2 / w0])
     except np.linalg.LinAlgError:
-        return p2 / (1 - w2 / w0)
-    if abs(b) <= 1e-14 * abs(a) * max(p1, p2):
-        return 1.0 / a if a > 0 else None
+        return p0 + x2 / (1 - w2 / w0)
+    if abs(b) <= 1e-14 * abs(a) * max(x1, x2):
+        return p0 + 1.0 / a if a > 0 else None
     disc = a * a + 4 * b
     roots = [(-a + sg * np.sqrt(disc)) / (2 * b) for sg in (1.0, -1.0)] if disc >= 0 else []
     roots = [r for r in roots if r > 0]
-    return float(min(roots, key=lambda r: abs(r - p2))) if roots else None
+    return float(p0 + min(roots, key=lambda r: abs(r - x2))) if roots else None
 
 
 #: the arguments of :func:`buckling_analysis` that are namelist keys (argument -> its
@@ -259,6 +289,45 @@ def _root(history: list[tuple[float, float]]) -> float | None:
 BUCKLING_KEYWORDS = {"modes": "buckling", "fixed_loads": "buckling", "method": "buckling",
                      "solver": "buckling", "rtol": "buckling", "load_steps": "buckling",
                      "reference_factor": "buckling", "tol": "solver", "max_iter": "solver"}
+
+
+#: 'linear' is confirmed where the tangent on the static path, at this fraction of its first
+#: factor, keeps less than CONFIRM_STIFFNESS of the lowest stiffness it had at the scene's
+#: loads (a linear softening leaves 1 - CONFIRM_AT P / (P - 1) of it: 0.02 P / (P - 1))
+CONFIRM_AT, CONFIRM_STIFFNESS = 0.98, 0.25
+
+
+def _confirm_linear(path: "LoadPath", factor: float, k1: sp.spmatrix, mass: sp.spmatrix,
+                    g: sp.spmatrix, how: str, basis: np.ndarray | None) -> None:
+    """Refuse a 'linear' factor the model contradicts. The classical estimate extrapolates
+    the change of the tangent between the scene's loads and a step beyond them; where the
+    pre-buckling deformation turns the structure (a mechanism's arm swinging about its pin,
+    a stiff-shear frame), that change holds the initial-displacement matrix as well as the
+    initial-stress one and the estimate can be far too low (docs/theory.md section 23).
+    The check loads the static path to CONFIRM_AT of the factor: a factor the model
+    confirms leaves the lowest stiffness near zero there; one that leaves more than
+    CONFIRM_STIFFNESS of it (or a path that cannot be followed that far) is refused, naming
+    'nonlinear' (SolverError, exit 3): never a wrong factor with status ok."""
+    if factor <= 1.0:
+        return
+    w1, _ = _lowest(k1, mass, g, how, 1, basis)
+    target = 1.0 + CONFIRM_AT * (factor - 1.0)
+    try:
+        _advance(path, target)
+    except SolverError as exc:
+        raise SolverError(
+            f"buckling: the 'linear' estimate {factor:.6g} is not confirmed: the static path "
+            f"could not be followed to {target:.6g} times the loads ({exc}); the structure "
+            "may have a limit below it: use buckling.method = 'nonlinear'") from None
+    w, _ = _lowest(path.tangent(), mass, g, how, 1, basis)
+    kept = float(w[0] / w1[0]) if w1[0] > 0 else 0.0
+    if kept > CONFIRM_STIFFNESS:
+        raise SolverError(
+            f"buckling: the 'linear' estimate {factor:.6g} is contradicted by the model: at "
+            f"{path.factor:.6g} times the loads the tangent keeps {kept:.2g} of its lowest "
+            "stiffness (a buckling load leaves ~0); the pre-buckling deformation turns the "
+            "structure, which the classical estimate misreads (docs/theory.md section 23): "
+            "use buckling.method = 'nonlinear'")
 
 
 def buckling_analysis(model: Model, base_model: Model, count: int, *,
@@ -271,11 +340,11 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     ``base_model`` (the same system with the fixed loads alone; pass ``model`` itself
     when no load is fixed).
 
-    ``method``: 'linear' solves (K_0 + mu K_g) phi = 0 once with K_g from the difference of
-    tangents at ``reference_factor``; 'nonlinear' (default) repeats it with K_g evaluated on
-    the static path at the latest estimate until the first load factor reproduces itself:
-    then the tangent on the static path is singular there (the stability limit of the
-    model, pre-buckling deformation included). See the module doc and docs/theory.md.
+    Both start from the scene's static state (load factor 1). ``method``: 'linear' solves
+    (K_1 + nu K_g) phi = 0 once, P = 1 + nu, with K_g from the tangents at 1 and at
+    1 + ``reference_factor``; 'nonlinear' (default) follows the lowest stiffness along the
+    static path until its zero reproduces itself: there the tangent on the static path is
+    singular (the stability limit of the model, pre-buckling deformation included). See the module doc and docs/theory.md.
     The arguments of :data:`BUCKLING_KEYWORDS` pass the rules of their namelist keys
     (InputError).
     """
@@ -303,19 +372,25 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                          group="buckling", key="reference_factor")
     start = time.perf_counter()
     timing: dict[str, float] = {}
+    # the scene's own static state (P = 1), solved as the scene's static solve does
+    scene_state = solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
     path = LoadPath(model, base_model, tol=tol, max_iter=max_iter, load_steps=load_steps)
-    path.solve(0.0)  # state 0: the fixed loads alone
-    base = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0, 0.0)
-    k0 = path.tangent()
+    path.e, path.lam, path.factor = scene_state.e.copy(), scene_state.lam.copy(), 1.0
+    base = scene_state
+    k1 = path.tangent()
     g = path.constraints()
     free = model.ndof - g.shape[0]
     check_free("buckling", free)
     how = solver if solver != "auto" else ("dense" if free <= DENSE_LIMIT else "sparse")
+    basis = elastic_basis(k1, g) if how == "dense" else None
     mass = model.mass_matrix()
     track = max(count, 1)
-    w0, _ = _lowest(k0, mass, g, how, track)
-    history = [(0.0, w0)]   # (P, the lowest omega^2 of K_T(P) over M)
-    factor, previous, critical = reference_factor, None, None
+    if method == "nonlinear":
+        w1, _ = _lowest(k1, mass, g, how, track, basis)
+        history = [(1.0, w1)]   # (P, the lowest omega^2 of K_T(P) over M)
+    else:
+        history = [(1.0, None)]
+    factor, previous, critical = 1.0 + reference_factor, None, None
     saved: dict[float, tuple[np.ndarray, np.ndarray]] = {}  # states on the path
     ceiling = np.inf  # a factor known to lie past a fall and rise of the stiffness
     while True:
@@ -323,10 +398,11 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         factor = path.factor
         k_t = path.tangent()
         if method == "linear":
-            kg = ((k_t - k0) / factor).tocsr()
-            theta, vectors = _pencil(k0, kg, g, count, how, eigen_tol)
+            kg = ((k_t - k1) / (factor - 1.0)).tocsr()
+            theta, vectors = _pencil(basis, k1, kg, g, count, eigen_tol)
+            history.append((factor, None))
             break
-        w, vectors = _lowest(k_t, mass, g, how, track)
+        w, vectors = _lowest(k_t, mass, g, how, track, basis)
         # a rise after a fall that stopped well above zero (near the limit, omega^2 ~ 0 is
         # round-off and may rise by noise): either the step passed over a limit or the path
         # has none; step back to the fallen state and halve the interval (geometrically)
@@ -376,13 +452,17 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
                              0.0)
     if method == "linear":
+        # P = 1 + 1 / theta: theta > 0 buckles above the scene's loads; theta in (-1, 0)
+        # buckles the reversed loads (P < 0); theta <= -1 is unloading (0 <= P < 1)
         scale = np.abs(theta).max(initial=0.0)
         positive = theta > 1e-12 * max(scale, 1e-300)
-        mus = 1.0 / theta[positive]
+        mus = 1.0 + 1.0 / theta[positive]
         order = np.argsort(mus)[:count]
         factors, shapes = mus[order], vectors[:, positive][:, order].T.copy()
-        negative = theta < -1e-12 * max(scale, 1e-300)
-        negative_factor = float(1.0 / theta[negative].min()) if negative.any() else 0.0
+        negative = (theta < -1e-12 * max(scale, 1e-300)) & (theta > -1.0)
+        negative_factor = float(1.0 + 1.0 / theta[negative].min()) if negative.any() else 0.0
+        if len(factors):
+            _confirm_linear(path, float(factors[0]), k1, mass, g, how, basis)
     else:
         # the first: the limit; the others: each mode's omega^2(P) extrapolated likewise
         factors = [critical]
