@@ -425,3 +425,33 @@ def test_rigid_body_box_has_its_inertia_and_moves_rigidly():
         np.testing.assert_allclose(moved[1:4] - moved[0], gyration * rotation.T, atol=1e-12)
     finally:
         model.close()
+
+
+def test_static_run_writes_the_state_as_xdmf(tmp_path):
+    """A static run's XDMF: one grid at the static state with its displacement from the
+    undeformed mesh; the payload sits at the hook probe; output.xdmf = .false. writes none."""
+    out = tmp_path / "crane.h5"
+    run_scene(INPUTS / "knuckle_crane_rope.nml", ["scene.analysis=static"], out,
+              progress=False)
+    mesh = meshio.read(out.with_suffix(".xdmf"))
+    with h5py.File(out) as h5:
+        parts = mesh_parts(h5)
+        reference = h5["model/mesh/points"][()]
+        hook = h5["static/probes/hook"][()]
+        assert "dynamic" not in h5 and "modal" not in h5
+    (payload,) = parts["payload"][1]
+    np.testing.assert_allclose(mesh.points[payload], hook, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(mesh.points, reference + mesh.point_data["displacement"],
+                               rtol=0, atol=1e-14)
+    assert mesh.point_data["displacement"][payload][1] < -0.01  # it hangs lower
+    assert len(mesh.cells[0].data) == 8 + 12 + 5 + 2 + 4
+    # the same run kept in memory writes the same XDMF (naming its own file) on save
+    import ancfdrv
+    saved = ancfdrv.simulate(INPUTS / "knuckle_crane_rope.nml", ["scene.analysis=static"],
+                             progress=False).save(tmp_path / "memory.h5")
+    assert saved.with_suffix(".xdmf").read_text() == \
+        out.with_suffix(".xdmf").read_text().replace("crane.h5", "memory.h5")
+    quiet = tmp_path / "quiet.h5"
+    run_scene(INPUTS / "knuckle_crane_rope.nml", ["scene.analysis=static", "output.xdmf=.false."],
+              quiet, progress=False)
+    assert quiet.is_file() and not quiet.with_suffix(".xdmf").exists()

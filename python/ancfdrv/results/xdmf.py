@@ -1,5 +1,9 @@
 """XDMF descriptions of result files, for ParaView (and meshio): every body of the model.
 
+A static result has one grid at the static state (:func:`write_static_xdmf`), a modal or
+buckling result one grid with a vector attribute per shape (:func:`write_mode_xdmf`), a
+dynamic result the following time series (:func:`write_xdmf`), all on the same mesh.
+
 The XDMF 3 file beside ``OUT.h5`` is a temporal collection with one uniform grid per frame
 (an output step; long runs are thinned to at most ``output.xdmf_frames`` frames, evenly,
 always with the first and the last step). The grid shows
@@ -343,6 +347,24 @@ def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path
     one vector attribute per mode, ``mode_1``, ``mode_2``, ... (``/<group>/xdmf/mode_<k>``,
     each scaled to a largest displacement of 1): in ParaView, Warp By Vector with a mode
     shows its shape."""
+    with h5py.File(path, "r") as h5:
+        modes = sorted((k for k in h5[f"{group}/xdmf"]), key=lambda k: int(k.split("_")[1]))
+    return _one_grid(path, f"{group} shapes", f"/{group}/mesh_static",
+                     [(mode, f"/{group}/xdmf/{mode}") for mode in modes], as_name)
+
+
+def write_static_xdmf(path: Path, as_name: Path | None = None) -> Path:
+    """An XDMF file beside the HDF5 result of a static analysis: one grid, the mesh at the
+    static state (``/static/mesh_nodes``), with its ``displacement`` from the undeformed
+    mesh (``/static/mesh_displacement``)."""
+    return _one_grid(path, "static state", "/static/mesh_nodes",
+                     [("displacement", "/static/mesh_displacement")], as_name)
+
+
+def _one_grid(path: Path, title: str, geometry_data: str,
+              attributes: list[tuple[str, str]], as_name: Path | None) -> Path:
+    """An XDMF file of one uniform grid: the file's mesh at the points ``geometry_data``
+    with a vector attribute per (name, dataset)."""
     path = Path(path)
     name = Path(as_name) if as_name is not None else path
     if ":" in name.name:
@@ -350,21 +372,20 @@ def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path
                          file=str(name))
     with h5py.File(path, "r") as h5:
         kind, dims, topology, ncells, npoints = _topology_of(h5)
-        modes = sorted((k for k in h5[f"{group}/xdmf"]), key=lambda k: int(k.split("_")[1]))
     h5_name = name.name
     root = ET.Element("Xdmf", Version="3.0")
     domain = ET.SubElement(root, "Domain")
-    grid = ET.SubElement(domain, "Grid", Name=f"{group} shapes", GridType="Uniform")
+    grid = ET.SubElement(domain, "Grid", Name=title, GridType="Uniform")
     topo = ET.SubElement(grid, "Topology", TopologyType=kind, NumberOfElements=str(ncells))
     if kind == "Polyline":
         topo.set("NodesPerElement", "2")
     _item(topo, dims, h5_name, topology, "Int")
     geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
-    _item(geometry, (npoints, 3), h5_name, f"/{group}/mesh_static")
-    for mode in modes:
-        attribute = ET.SubElement(grid, "Attribute", Name=mode, AttributeType="Vector",
+    _item(geometry, (npoints, 3), h5_name, geometry_data)
+    for label, dataset in attributes:
+        attribute = ET.SubElement(grid, "Attribute", Name=label, AttributeType="Vector",
                                   Center="Node")
-        _item(attribute, (npoints, 3), h5_name, f"/{group}/xdmf/{mode}")
+        _item(attribute, (npoints, 3), h5_name, dataset)
     out = name.with_suffix(".xdmf")
     write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
                                                             xml_declaration=True))
