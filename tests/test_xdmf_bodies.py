@@ -451,7 +451,19 @@ def test_static_run_writes_the_state_as_xdmf(tmp_path):
                              progress=False).save(tmp_path / "memory.h5")
     assert saved.with_suffix(".xdmf").read_text() == \
         out.with_suffix(".xdmf").read_text().replace("crane.h5", "memory.h5")
+    # and Results.save writes it beside the copy, naming the copy
+    copy = ancfdrv.open(out).save(tmp_path / "copy.h5", plot=False)
+    assert copy.with_suffix(".xdmf").read_text() == \
+        out.with_suffix(".xdmf").read_text().replace("crane.h5", "copy.h5")
     quiet = tmp_path / "quiet.h5"
     run_scene(INPUTS / "knuckle_crane_rope.nml", ["scene.analysis=static", "output.xdmf=.false."],
               quiet, progress=False)
     assert quiet.is_file() and not quiet.with_suffix(".xdmf").exists()
+
+
+def test_saved_modal_result_keeps_its_shapes_xdmf(crane, tmp_path):
+    """Results.save of a modal result writes the shapes' XDMF beside the copy."""
+    import ancfdrv
+    copy = ancfdrv.open(crane).save(tmp_path / "copy.h5", plot=False)
+    assert copy.with_suffix(".xdmf").read_text() == \
+        crane.with_suffix(".xdmf").read_text().replace("crane.h5", "copy.h5")

@@ -361,6 +361,24 @@ def write_static_xdmf(path: Path, as_name: Path | None = None) -> Path:
                      [("displacement", "/static/mesh_displacement")], as_name)
 
 
+def write_any_xdmf(path: Path, as_name: Path | None = None) -> Path | None:
+    """The XDMF a result file's run writes, by what the file holds: the motion of a
+    dynamic run (:func:`write_xdmf`), else the shapes of a modal or buckling analysis
+    (:func:`write_mode_xdmf`), else the static state (:func:`write_static_xdmf`); None
+    when it holds none of them (no mesh)."""
+    with h5py.File(path, "r") as h5:
+        if "model/mesh" not in h5 and "model/elements" not in h5:
+            return None
+        motion = "dynamic/mesh_nodes" in h5 and "dynamic/time" in h5
+        eigen = next((g for g in ("modal", "buckling") if f"{g}/xdmf" in h5), None)
+        static = "static/mesh_displacement" in h5
+    if motion:
+        return write_xdmf(path, as_name)
+    if eigen is not None:
+        return write_mode_xdmf(path, eigen, as_name)
+    return write_static_xdmf(path, as_name) if static else None
+
+
 def _one_grid(path: Path, title: str, geometry_data: str,
               attributes: list[tuple[str, str]], as_name: Path | None) -> Path:
     """An XDMF file of one uniform grid: the file's mesh at the points ``geometry_data``
