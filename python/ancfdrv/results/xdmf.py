@@ -76,7 +76,6 @@ class MeshLayout:
     offset: np.ndarray        # (3 npoints,) the constant part (points on the ground)
     bodies: list[str]         # 'name: kind, points a..b' per item shown
     spans: dict[str, range]   # the points of each body (model.bodies) shown, by name
-    parts: list[tuple[str, str, range]]  # (name, kind word, points) of every item shown
 
     @classmethod
     def from_model(cls, model) -> "MeshLayout | None":
@@ -102,7 +101,7 @@ class MeshLayout:
         if rows.lone:
             lines = np.vstack([lines, np.repeat(np.array(rows.lone, np.int64)[:, None], 2, 1)])
         return cls(points, _stack(rows.quads, 4), lines, matrix, offset, rows.bodies,
-                   rows.spans, rows.parts)
+                   rows.spans)
 
     @property
     def npoints(self) -> int:
@@ -131,8 +130,8 @@ def _connections(model, rows: "_Rows") -> None:
     """The force elements (a line from the point on body1 to the point on body2; a
     bushing's or a torsion spring's two points coincide at t = 0), the point masses (a lone
     point at the material point of their body) and the joints (a 'distance' joint: a line
-    between its points; the others: a lone point per point, on body2, the body the joint
-    moves with the ground as body1)."""
+    between its points; the others: a lone point per joint point, carried by body2, as
+    the ground is always a joint's body1)."""
     for info in model.force_elements:
         start = rows.count
         ends = [rows.expression(slot) for slot in info.slots[:2]]
@@ -145,7 +144,7 @@ def _connections(model, rows: "_Rows") -> None:
         rows.lone.append(rows.expression(
             body.position(body.locate(point, node=False, what=f"load {name!r}"))))
         rows.part(name, "point mass", start)
-    for joint in getattr(model, "joint_items", {}).values():
+    for joint in model.joint_items.values():
         where = f"joint {joint.name!r}"
         start = rows.count
         if joint.type == "distance":
@@ -179,7 +178,6 @@ class _Rows:
         self.lone: list[int] = []
         self.bodies: list[str] = []
         self.spans: dict[str, range] = {}
-        self.parts: list[tuple[str, str, range]] = []
         self.count = 0
 
     def point(self, terms: list[tuple[int, float]], const=(0.0, 0.0, 0.0)) -> int:
@@ -208,7 +206,6 @@ class _Rows:
     def part(self, name: str, word: str, start: int) -> None:
         """Names the points from ``start`` to the last one made ('name: word, points a..b')."""
         self.bodies.append(f"{name}: {word}, points {start}..{self.count - 1}")
-        self.parts.append((name, word, range(start, self.count)))
 
 
 def frame_rows(total_rows: int, frames: int) -> tuple[int, int]:
