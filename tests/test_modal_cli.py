@@ -55,7 +55,7 @@ def test_modal_run_writes_frequencies_shapes_xdmf_info_and_plot(tmp_path, capsys
         assert h5["modal/shapes"].shape == (4, h5["model"].attrs["ndof"])
         assert "damping_ratio" not in h5["modal"]  # damping is off
         assert "static/q" in h5  # the state the modes are about
-        assert h5["modal/mesh_shapes"].shape == (4, 9, 3)
+        assert h5["modal/mesh_shapes"].shape == (4, 9 + 1, 3)  # the nodes, the weld's point
     python = python_twin().modes(4)
     np.testing.assert_allclose(frequency, python.frequency, rtol=1e-10)
     assert np.all(np.diff(frequency) >= 0)

@@ -128,8 +128,12 @@ def test_meshio_reads_the_xdmf(plate):
     with h5py.File(plate, "r") as h5:
         time = h5["dynamic/time"][()]
         nodes = h5["dynamic/mesh_nodes"][()]
-        reference = h5["model/nodes"][()]
+        reference = h5["model/mesh/points"][()]
         elements = h5["model/elements"][()]
+        # the plate's nodes, then the point of the joint that holds its corner
+        np.testing.assert_array_equal(reference[:-1], h5["model/nodes"][()])
+        assert h5["model/mesh"].attrs["bodies"].splitlines() == [
+            "plate: plate, points 0..8", "corner: joint, points 9..9"]
     with meshio.xdmf.TimeSeriesReader(plate.with_suffix(".xdmf")) as reader:
         points, cells = reader.read_points_cells()
         assert reader.num_steps == len(time)

@@ -284,7 +284,8 @@ def test_curved_completed_leaf_stays_where_it_is(tmp_path):
         assert np.abs(h5["dynamic/deflection/end"][()]).max() < 1e-12
         assert np.abs(h5["dynamic/energy/strain"][()]).max() < 1e-15
         assert h5["counters"].attrs["prestress"] == 0
-        assert h5["dynamic/mesh_nodes"].shape == (len(h5["dynamic/time"]), 18, 3)
+        # the leaf's 18 nodes and the middle clamp's points (2 nodes for r, 2 for r_x)
+        assert h5["dynamic/mesh_nodes"].shape == (len(h5["dynamic/time"]), 18 + 4, 3)
     # XDMF beside the HDF5: one grid per output row (up to xdmf_frames), pointing at the
     # datasets
     root = ET.parse(out.output.with_suffix(".xdmf")).getroot()

@@ -6,8 +6,9 @@ an empty working directory that must hold no result file afterwards. The PNG's p
 is read from its header. The drawn geometry of each body (the artists the preview tags
 ``body:<name>``) is compared with the body as the scene gives it: a straight beam or cable
 spans its start and end, a flat plate its corner and corner + edge_x + edge_y, a rigid body
-its centre and the tips of its axes at the radius of gyration sqrt(tr(I) / 2m) (the XDMF
-layout's, results/xdmf.py).
+its centre, the tips of its axes at the radius of gyration sqrt(tr(I) / 2m) and the corners
+of its inertia box, half-sizes a, b, c from Ixx = m (b^2 + c^2) / 3, ... (the XDMF layout's,
+results/xdmf.py).
 """
 from __future__ import annotations
 
@@ -101,8 +102,12 @@ def expected_boxes(scene: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
             ends = np.array([corner, corner + v["edge_x"] + np.asarray(v["edge_y"])])
         elif group == "rigid_body":
             centre = np.asarray(v["position"], float)
-            size = np.sqrt(sum(v["inertia"][:3]) / (2.0 * v["mass"]))
-            ends = np.vstack([centre, centre + size * np.eye(3)])
+            moments = np.asarray(v["inertia"][:3], float)
+            assert not any(v["inertia"][3:])  # principal axes along x, y, z
+            size = np.sqrt(moments.sum() / (2.0 * v["mass"]))
+            half = np.sqrt(3.0 * (moments.sum() - 2.0 * moments) / (2.0 * v["mass"]))
+            ends = np.vstack([centre, centre + size * np.eye(3), centre - half,
+                              centre + half])
         else:
             continue
         out[v["name"]] = (ends.min(axis=0), ends.max(axis=0))

@@ -1,7 +1,8 @@
 """Animations of a result file (``ancf animate``, SPEC section 2): the whole mesh the file
-holds (beams, plates, cables and ropes as /model/mesh draws them) moving through a dynamic
-run, or a mode or buckling shape oscillating about the static state it was computed at,
-with the time stamp (or the mode's frequency or load factor) on every frame.
+holds (every body, force element, point mass and joint as /model/mesh draws them) moving
+through a dynamic run, or a mode or buckling shape oscillating about the static state it
+was computed at, with the time stamp (or the mode's frequency or load factor) on every
+frame.
 
 Seen in one plane: the one of the mesh's two largest extents over the run, or the plane
 asked for (``view = 'xy' | 'yz' | 'zx'``). Written with matplotlib's writers: MP4 through
@@ -33,6 +34,11 @@ MAX_FRAMES = 100
 def _segments(h5: h5py.File) -> list[np.ndarray]:
     from .plots import _mesh_segments
     return _mesh_segments(h5)
+
+
+def _style(segment: np.ndarray) -> dict:
+    from .plots import mesh_style
+    return mesh_style(segment)
 
 
 def _plane(points: np.ndarray, view: str) -> tuple[int, int]:
@@ -122,8 +128,9 @@ def animate(h5_path: str | Path, output: str | Path | None = None, *, mode: int 
     ax.set_ylabel(f"{'xyz'[vertical]} (m)")
     ax.grid(alpha=0.3)
     for seg in segments:  # the first frame as a grey ghost
-        ax.plot(frames[0][seg, horizontal], frames[0][seg, vertical], color="0.8", lw=0.8)
-    lines = [ax.plot([], [], color="C0", lw=1.5)[0] for _ in segments]
+        ax.plot(frames[0][seg, horizontal], frames[0][seg, vertical], color="0.8", lw=0.8,
+                **_style(seg))
+    lines = [ax.plot([], [], color="C0", lw=1.5, **_style(seg))[0] for seg in segments]
     stamp = ax.set_title("", fontsize=9)
     fig.suptitle(title, fontsize=10)
 

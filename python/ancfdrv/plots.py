@@ -1059,23 +1059,31 @@ def plot_sections(h5_path: str | Path, png: str | Path | None = None) -> Path | 
 
 
 def _mesh_segments(h5: h5py.File) -> list[np.ndarray]:
-    """Point index lists to draw: each line and each closed quadrilateral of /model/mesh."""
+    """Point index lists to draw: each line and each closed quadrilateral of /model/mesh;
+    a line from a point to itself (a point mass, a joint) as that one point."""
     group = h5["model/mesh"]
     kind = _text(group.attrs["topology_type"])
     topology = group["topology"][()]
-    if kind == "Polyline":
-        return [row for row in topology]
     if kind == "Quadrilateral":
         return [np.append(row, row[0]) for row in topology]
-    out, k = [], 0
-    while k < len(topology):
-        if topology[k] == 5:
-            out.append(np.append(topology[k + 1:k + 5], topology[k + 1]))
-            k += 5
-        else:
-            out.append(topology[k + 2:k + 4])
-            k += 4
-    return out
+    if kind == "Polyline":
+        lines = list(topology)
+    else:
+        out, lines, k = [], [], 0
+        while k < len(topology):
+            if topology[k] == 5:
+                out.append(np.append(topology[k + 1:k + 5], topology[k + 1]))
+                k += 5
+            else:
+                lines.append(topology[k + 2:k + 4])
+                k += 4
+        return out + [line[:1] if line[0] == line[1] else line for line in lines]
+    return [line[:1] if line[0] == line[1] else line for line in lines]
+
+
+def mesh_style(segment: np.ndarray) -> dict:
+    """matplotlib's style of a mesh segment: a line, or a marker for a lone point."""
+    return dict(marker="o", ms=4) if len(segment) == 1 else {}
 
 
 def _draw_shape(ax, segments: list[np.ndarray], base: np.ndarray, displacement: np.ndarray,
@@ -1088,8 +1096,9 @@ def _draw_shape(ax, segments: list[np.ndarray], base: np.ndarray, displacement: 
                           + (np.arange(3) == along) * -1e9))
     deformed = base + scale * displacement
     for seg in segments:
-        ax.plot(base[seg, along], base[seg, moved], color="0.75", lw=0.8)
-        ax.plot(deformed[seg, along], deformed[seg, moved], color="C0", lw=1.2)
+        ax.plot(base[seg, along], base[seg, moved], color="0.75", lw=0.8, **mesh_style(seg))
+        ax.plot(deformed[seg, along], deformed[seg, moved], color="C0", lw=1.2,
+                **mesh_style(seg))
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"{'xyz'[along]} (m)")
     ax.set_ylabel(f"{'xyz'[moved]} (m)")

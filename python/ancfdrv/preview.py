@@ -5,8 +5,8 @@ solved. One PNG shows three orthographic views (x-y, x-z, y-z) and an isometric 
 
 * bodies as the points and cells their kind's ``mesh`` hook gives the XDMF writer
   (:class:`~ancfdrv.results.xdmf.MeshLayout`: beams and cables as centre lines through
-  their nodes, plates and leaves as their element edges, rigid bodies as their centre and
-  axes), flexible bodies' nodes marked, a rigid body with a small box about its centre;
+  their nodes, plates and leaves as their element edges, rigid bodies as their centre,
+  axes and inertia box), flexible bodies' nodes marked, a rigid body's centre marked;
 * joints as labelled points (joints to the ground, the supports, as triangles), distance
   joints and force elements as dashed lines between their points;
 * point masses as points, probes as labelled markers, forces and gravity as arrows
@@ -100,17 +100,13 @@ def geometry(system: System, model: Model) -> dict[str, Any]:
             (cells >= span.start) & (cells < span.stop), axis=1)])
             for cells in (layout.lines, layout.quads)])
         nodes = layout.points[span.start:span.stop]
-        box = None
-        if not body.flexible:  # a rigid body: its centre and a box half its axes' length
-            centre = np.asarray(body.centre, dtype=float)
-            half = 0.5 * float(np.max(np.linalg.norm(nodes - centre, axis=1)))
-            box = (centre, half)
+        centre = None if body.flexible else np.asarray(body.centre, dtype=float)
         word = kind_of(body).word
         section_label = getattr(getattr(body, "section", None), "label", None)
         if callable(section_label):  # a standard section: its name and strong axis
             word += ", " + section_label(body.orientation[:, 1])
         bodies[body.name] = dict(edges=edges, nodes=nodes if body.flexible else None,
-                                 box=box, label=nodes.mean(axis=0), word=word)
+                                 centre=centre, label=nodes.mean(axis=0), word=word)
     joints, lines = [], []
     for joint in system.joints.values():
         support = isinstance(joint.body1, Ground) or isinstance(joint.body2, Ground)
@@ -136,13 +132,10 @@ def geometry(system: System, model: Model) -> dict[str, Any]:
 
 
 def bounding_box(shapes: dict[str, Any]) -> tuple[np.ndarray, np.ndarray]:
-    """(low, high) corners of every point drawn (rigid bodies' boxes included) but the
-    arrows and labels."""
+    """(low, high) corners of every point drawn but the arrows and labels."""
     pts = [b["edges"] for b in shapes["bodies"].values()]
     pts += [b["nodes"] for b in shapes["bodies"].values() if b["nodes"] is not None]
     pts += [ends for _, ends, _ in shapes["lines"]]
-    pts += [np.array([centre - half, centre + half]) for b in shapes["bodies"].values()
-            if b["box"] is not None for centre, half in [b["box"]]]
     pts += [np.atleast_2d(p) for key in ("joints", "probes", "masses", "forces", "moments")
             for _, p, *_ in shapes[key]]
     every = np.vstack([np.asarray(p, float).reshape(-1, 3) for p in pts]) if pts else \
@@ -202,15 +195,8 @@ def figure(system: System, model: Model, title: str) -> Any:
             ax.plot(*coords(body["edges"]), "-", color=colour, lw=1.8, gid=f"body:{name}")
             if body["nodes"] is not None:
                 ax.plot(*coords(body["nodes"]), "o", color=colour, ms=3, gid=f"body:{name}")
-            if body["box"] is not None:
-                centre, half = body["box"]
-                ax.plot(*coords(centre), "s", color=colour, ms=6, gid=f"body:{name}")
-                corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1)
-                                    for sz in (-1, 1)]) * half + centre
-                for a in range(8):
-                    for b in range(a + 1, 8):
-                        if np.sum(np.abs(corners[a] - corners[b]) > 0) == 1:
-                            ax.plot(*coords(corners[[a, b]]), "-", color=colour, lw=0.8)
+            if body["centre"] is not None:
+                ax.plot(*coords(body["centre"]), "s", color=colour, ms=6, gid=f"body:{name}")
             if labels:
                 text(body["label"], f"{name} ({body['word']})", color=colour,
                      fontweight="bold")

@@ -94,10 +94,9 @@ def input_files(scene: Scene) -> list[Path]:
 
 
 def writes_xdmf(scene: Scene) -> bool:
-    """Whether a run of the scene writes the XDMF description (dynamic runs with
-    output.xdmf, the default)."""
-    return (scene["scene"]["analysis"] != "static"
-            and bool(scene["output"].get("xdmf", True)))
+    """Whether a run of the scene writes the XDMF description (output.xdmf, the default:
+    every analysis; a static one shows its state, a modal or buckling one its shapes)."""
+    return bool(scene["output"].get("xdmf", True))
 
 
 def dynamic_settings(scene: Scene) -> DynamicSettings:
@@ -595,6 +594,9 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                 _io(out).write_static(out, model, static)
                 _write_static_supports(out, model, static)
                 answers = _write_static_answers(scene, model, out, static)
+                if analysis == "static":
+                    with _io(out).released(out):
+                        _write_grid_xdmf(scene, model, out, "static")
                 timing["output"] = time.perf_counter() - t0
                 model.warnings.extend(check_static(model, static.e, answers.stress,
                                                    warn=warns_implausible(scene)))
@@ -676,7 +678,6 @@ def fixed_load_model(scene: Scene, fixed: list[str]) -> Model:
 def run_eigen(scene: Scene, model: Model, out: Path | MemoryOutput, timing: dict[str, Any]) -> None:
     """analysis = 'modal' (about the static equilibrium) or 'buckling'; writes /modal or
     /buckling, /static, and the XDMF of the shapes."""
-    from .results.xdmf import MeshLayout, write_mode_xdmf
     from .solvers.buckling import buckling_analysis
     from .solvers.modal import modal_analysis
     solver = scene["solver"]
@@ -711,8 +712,18 @@ def run_eigen(scene: Scene, model: Model, out: Path | MemoryOutput, timing: dict
     timing[f"{analysis}_total"] = time.perf_counter() - t0
     for phase, seconds in result.timing.items():
         timing[f"{analysis}_{phase}"] = seconds
-    if scene["output"].get("xdmf", True) and MeshLayout.from_model(model) is not None:
-        if isinstance(out, Path):
-            write_mode_xdmf(out, analysis)
-        else:  # a run kept in memory: written by its save()
-            out.write_mode_xdmf(out, analysis)
+    _write_grid_xdmf(scene, model, out, analysis)
+
+
+def _write_grid_xdmf(scene: Scene, model: Model, out: Path | MemoryOutput, group: str) -> None:
+    """The one-grid XDMF of a static state (``group`` 'static') or of the shapes of a
+    modal or buckling analysis, with output.xdmf (the default) and a mesh to show."""
+    from .results.xdmf import MeshLayout, write_mode_xdmf, write_static_xdmf
+    if not writes_xdmf(scene) or MeshLayout.from_model(model) is None:
+        return
+    if not isinstance(out, Path):  # a run kept in memory: written by its save()
+        out.write_grid_xdmf(out, group)
+    elif group == "static":
+        write_static_xdmf(out)
+    else:
+        write_mode_xdmf(out, group)

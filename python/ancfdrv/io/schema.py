@@ -368,9 +368,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "chunk_steps": Key("int", 1000, positive,
                            "steps per kernel call at most; the rows reach the file at least "
                            "once a second"),
-        "xdmf": Key("bool", True, doc="dynamic runs: write OUT.xdmf beside the result, the "
-                    "motion of every body for ParaView (plates as quadrilaterals, beams and "
-                    "cables as polylines, rigid bodies as their centre and axes); stores q"),
+        "xdmf": Key("bool", True, doc="write OUT.xdmf beside the result for ParaView: the "
+                    "motion of a dynamic run (stores q), the static state, or the modal or "
+                    "buckling shapes, with every body (plates as quadrilaterals, beams and "
+                    "cables as polylines, rigid bodies as their centre, axes and inertia "
+                    "box, force elements and distance joints as lines, point masses and "
+                    "joints as points)"),
         "xdmf_frames": Key("int", 250, at_least(2), "the most frames the XDMF holds: longer "
                            "runs show every k-th step (and the last); each frame costs "
                            "about 0.4 ms of output"),

@@ -538,7 +538,8 @@ def create(path: Path, scene: Scene, model: Model) -> None:
 
 
 def write_static(path: Path, model: Model, result: StaticResult) -> None:
-    """The /static group: q, lambda, probes, deflections and solver statistics."""
+    """The /static group: q, lambda, probes, deflections, solver statistics and the mesh
+    points at the state (``mesh_nodes``, ``mesh_displacement`` from /model/mesh/points)."""
     with _open_write(path) as h5:
         if _has(h5, "static"):
             del h5["static"]
@@ -557,7 +558,9 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
         if layout is not None:  # the deformed shape (ancf plot, the static XDMF)
             if "model/mesh" not in h5:
                 write_layout(h5, layout)
-            _dataset(group, "mesh_nodes", layout.positions(model, result.e[None, :])[0], "m")
+            nodes = layout.positions(model, result.e[None, :])[0]
+            _dataset(group, "mesh_nodes", nodes, "m")
+            _dataset(group, "mesh_displacement", nodes - layout.points, "m")
         _attrs(group.attrs, {"method": result.method, "iterations": result.iterations,
                              "residual_norm": result.residual_norm,
                              "constraint_norm": result.constraint_norm,

@@ -271,8 +271,10 @@ class MemoryOutput:
             self.static = result.base
         self._record("write_buckling", (model, result))
 
-    def write_mode_xdmf(self, path, analysis: str) -> None:
-        self._record("write_mode_xdmf", (analysis,))
+    def write_grid_xdmf(self, path, group: str) -> None:
+        """The XDMF of the static state ('static') or of a modal or buckling analysis's
+        shapes, written on save."""
+        self._record("write_grid_xdmf", (group,))
 
     # -- file handling: nothing to hold, release or drop ---------------------------------------
     def holding(self, path) -> contextlib.AbstractContextManager:
@@ -355,10 +357,13 @@ class MemoryOutput:
                     writers[id(target)] = target.replay(path)
                 elif call in ("flush_last", "flush"):
                     getattr(writers[id(target)], call)()
-                elif call == "write_mode_xdmf":
-                    from .xdmf import write_mode_xdmf
-                    hdf5.drop(path)   # write_mode_xdmf opens the file itself
-                    write_mode_xdmf(path, *args)
+                elif call == "write_grid_xdmf":
+                    from .xdmf import write_mode_xdmf, write_static_xdmf
+                    hdf5.drop(path)   # the XDMF writers open the file themselves
+                    if args[0] == "static":
+                        write_static_xdmf(path)
+                    else:
+                        write_mode_xdmf(path, *args)
                 else:
                     calls[call](path, *args, **kwargs)
         return path

@@ -49,8 +49,9 @@ UNITS_HINT = f"{UNITS}; scene.bounds = 'off' silences this warning"
 
 def structure_size(model: "Model") -> float:
     """The diagonal of the bounding box of the undeformed model (m): the points the result
-    files draw (plate and beam nodes, rigid bodies' frames) and the probes, at least the
-    model's length scale (a lone rigid body: 1 m)."""
+    files draw (plate and beam nodes, rigid bodies' frames and inertia boxes, the points of
+    force elements, point masses and joints) and the probes, at least the model's length
+    scale (a lone rigid body: 1 m)."""
     from .xdmf import MeshLayout
     points = [np.array(list(model.probe_positions(model.e0).values())).reshape(-1, 3)]
     layout = MeshLayout.from_model(model)

@@ -271,8 +271,8 @@ class Results:
     # -- files --------------------------------------------------------------------------------
     def save(self, path: str | Path, *, plot: bool = True) -> Path:
         """Write the result file ``ancf run`` writes, byte for byte the run's HDF5, with the
-        XDMF description (dynamic runs with output.xdmf) and the plot (``plot``) beside it
-        as ``ancf run`` writes them. A plot that fails is a warning, never an error.
+        XDMF description (when the run wrote one: output.xdmf) and the plot (``plot``)
+        beside it as ``ancf run`` writes them. A plot that fails is a warning, never an error.
         Refuses (InputError) what ``ancf run`` refuses: a directory, a non-HDF5 file, ..."""
         from ..errors import SolverError
         from ..io.safe_write import disk_full, write_with
@@ -296,8 +296,8 @@ class Results:
             raise InputError(f"save: cannot write a file in {target.parent}: {reason}; "
                              f"{target.name} is left as it was", file=str(target)) from None
         if self.path.with_suffix(".xdmf").exists():
-            from .xdmf import write_xdmf
-            write_xdmf(target)
+            from .xdmf import write_any_xdmf
+            write_any_xdmf(target)
         if plot:
             import warnings
             from ..plots import plot_result

@@ -1,5 +1,9 @@
 """XDMF descriptions of result files, for ParaView (and meshio): every body of the model.
 
+A static result has one grid at the static state (:func:`write_static_xdmf`), a modal or
+buckling result one grid with a vector attribute per shape (:func:`write_mode_xdmf`), a
+dynamic result the following time series (:func:`write_xdmf`), all on the same mesh.
+
 The XDMF 3 file beside ``OUT.h5`` is a temporal collection with one uniform grid per frame
 (an output step; long runs are thinned to at most ``output.xdmf_frames`` frames, evenly,
 always with the first and the last step). The grid shows
@@ -8,14 +12,25 @@ always with the first and the last step). The grid shows
 * beams and cables (ropes) as polylines: a 2-node line per element through the node
   positions r;
 * rigid bodies as their centre r with their body axes: three lines from the centre along
-  r_x, r_y, r_z, as long as the body's radius of gyration sqrt(tr(I) / 2m). (A lone point
-  is not used: in a ``Mixed`` topology VTK reads a Polyvertex with a node count and meshio
-  without one, so no vertex encoding works for both readers.)
+  r_x, r_y, r_z, as long as the body's radius of gyration sqrt(tr(I) / 2m), and the
+  wireframe (12 edges) of their inertia box, the uniform box of the same mass and
+  principal moments of inertia, each corner r + u1 r_x + u2 r_y + u3 r_z;
+* force elements and distance joints as a line between their two attachment points;
+* point masses and joints as lone points (a joint with several points, an edge or box
+  selection, as several), labelled by the ``bodies`` list.
+
+Every point is an affine function of the full coordinates q: a sum of coefficients times
+nodal 3-vectors plus a constant (a point on the ground). A lone point is written as a line
+from the point to itself (``2 2 a a`` in a ``Mixed`` topology): XDMF's own Polyvertex
+cannot be used, since in a ``Mixed`` topology VTK (ParaView) reads a Polyvertex with a
+node count and meshio without one, so no vertex encoding works for both readers; the plots
+draw such a line as a marker, ParaView shows it with the Points representation.
 
 With one kind of cell the topology is ``Quadrilateral`` or ``Polyline`` (2 nodes per line);
 with several it is ``Mixed`` (quad: 5 a b c d, line: 2 2 a b). The points' positions come
 from the stored coordinates: q of each step expanded to the full coordinates
-(:meth:`Model.expand`) and mapped by the sparse matrix of :class:`MeshLayout`.
+(:meth:`Model.expand`), mapped by the sparse matrix of :class:`MeshLayout` plus its
+constant offset.
 
 Every DataItem is a plain ``Format="HDF"`` item naming one dataset, which is what both
 ParaView's XDMF 3 reader and meshio's ``meshio.xdmf.TimeSeriesReader`` understand (meshio
@@ -51,34 +66,41 @@ _QUAD, _LINE = 5, 2
 
 @dataclass
 class MeshLayout:
-    """The points and cells XDMF shows for a model, and the map from full coordinates to
-    the points' positions."""
+    """The points and cells XDMF shows for a model, and the affine map from full
+    coordinates to the points' positions."""
 
     points: np.ndarray        # (npoints, 3) initial positions
     quads: np.ndarray         # (nquad, 4) point indices
-    lines: np.ndarray         # (nline, 2) point indices
-    map: Csr                  # (3 npoints, nfull): positions = map @ q_full
-    bodies: list[str]         # 'name: kind, points a..b' per body shown
-    spans: dict[str, range]   # the points of each body shown, by name
+    lines: np.ndarray         # (nline, 2) point indices (a lone point: a line [a, a])
+    map: Csr                  # (3 npoints, nfull): positions = map @ q_full + offset
+    offset: np.ndarray        # (3 npoints,) the constant part (points on the ground)
+    bodies: list[str]         # 'name: kind, points a..b' per item shown
+    spans: dict[str, range]   # the points of each body (model.bodies) shown, by name
 
     @classmethod
     def from_model(cls, model) -> "MeshLayout | None":
-        """The layout of every body whose kind shows a mesh (:class:`~..system.registry.Kind`
-        ``mesh``; plates first, in the order of ``model.plate_geometry``, then beams, then
-        rigid bodies); None when it has none of them."""
+        """The layout of every item the XDMF shows: the bodies whose kind shows a mesh
+        (:class:`~..system.registry.Kind` ``mesh``; plates first, in the order of
+        ``model.plate_geometry``, then beams and cables, then rigid bodies), then the force
+        elements, the point masses and the joints; None when it shows nothing."""
         rows = _Rows()
         shown = [(k, b) for b in model.bodies if (k := kind_of(b)) is not None and k.mesh]
         for found, body in sorted(shown, key=lambda pair: pair[0].mesh_order):
             start = rows.count
             found.mesh(body, rows)
-            rows.bodies.append(f"{body.name}: {found.word}, points {start}..{rows.count - 1}")
+            rows.part(body.name, found.word, start)
             rows.spans[body.name] = range(start, rows.count)
-        count = rows.count
-        if count == 0:
+        if rows.count == 0:
             return None
+        _connections(model, rows)
+        count = rows.count
         matrix = Csr.from_coo(rows.rows, rows.cols, rows.coefs, (3 * count, model.nfull))
-        points = (matrix @ model.q0).reshape(count, 3)
-        return cls(points, _stack(rows.quads, 4), _stack(rows.lines, 2), matrix, rows.bodies,
+        offset = np.array(rows.consts, dtype=float).reshape(3 * count)
+        points = (matrix @ model.q0 + offset).reshape(count, 3)
+        lines = _stack(rows.lines, 2)
+        if rows.lone:
+            lines = np.vstack([lines, np.repeat(np.array(rows.lone, np.int64)[:, None], 2, 1)])
+        return cls(points, _stack(rows.quads, 4), lines, matrix, offset, rows.bodies,
                    rows.spans)
 
     @property
@@ -88,7 +110,7 @@ class MeshLayout:
     def positions(self, model, e: np.ndarray) -> np.ndarray:
         """Point positions (nt, npoints, 3) from (reduced) coordinates e (nt, ndof)."""
         full = model.expand(np.atleast_2d(e))
-        return (self.map @ full.T).T.reshape(len(full), self.npoints, 3)
+        return ((self.map @ full.T).T + self.offset).reshape(len(full), self.npoints, 3)
 
     def topology(self) -> tuple[str, np.ndarray, int]:
         """(XDMF topology type, connectivity, number of cells): 'Quadrilateral' or
@@ -104,33 +126,75 @@ class MeshLayout:
         return "Mixed", flat, len(self.quads) + len(self.lines)
 
 
+def _connections(model, rows: "_Rows") -> None:
+    """The force elements (a line from the point on body1 to the point on body2; a
+    bushing's or a torsion spring's two points coincide at t = 0), the point masses (a lone
+    point at the material point of their body) and the joints (a 'distance' joint: a line
+    between its points; the others: a lone point per joint point, carried by body2, as
+    the ground is always a joint's body1)."""
+    for info in model.force_elements:
+        start = rows.count
+        ends = [rows.expression(slot) for slot in info.slots[:2]]
+        rows.lines.append(np.array([ends]))
+        rows.part(info.name, "force element", start)
+    bodies = {body.name: body for body in model.bodies}
+    for name, owner, point, _ in model.point_masses:
+        body = bodies[owner]
+        start = rows.count
+        rows.lone.append(rows.expression(
+            body.position(body.locate(point, node=False, what=f"load {name!r}"))))
+        rows.part(name, "point mass", start)
+    for joint in model.joint_items.values():
+        where = f"joint {joint.name!r}"
+        start = rows.count
+        if joint.type == "distance":
+            ends = [rows.expression(body.position(body.locate(p, node=False, what=where)))
+                    for body, p in ((joint.body1, joint.point1), (joint.body2, joint.point2))]
+            rows.lines.append(np.array([ends]))
+        else:
+            body = joint.body2
+            for point in joint.points:
+                rows.lone.append(rows.expression(
+                    body.position(body.locate(point, node=False, what=where))))
+        rows.part(joint.name, "joint", start)
+
+
 def _stack(blocks: list[np.ndarray], width: int) -> np.ndarray:
     return np.vstack(blocks).astype(np.int64) if blocks else np.zeros((0, width), np.int64)
 
 
 class _Rows:
     """The row builder a kind's ``mesh`` hook fills: points (each a sum of coefficients
-    times 3-vectors of the full coordinates), quadrilaterals and lines."""
+    times 3-vectors of the full coordinates, plus a constant), quadrilaterals, lines and
+    lone points."""
 
     def __init__(self) -> None:
         self.rows: list[int] = []
         self.cols: list[int] = []
         self.coefs: list[float] = []
+        self.consts: list[float] = []
         self.quads: list[np.ndarray] = []
         self.lines: list[np.ndarray] = []
+        self.lone: list[int] = []
         self.bodies: list[str] = []
         self.spans: dict[str, range] = {}
         self.count = 0
 
-    def point(self, terms: list[tuple[int, float]]) -> int:
-        """A new point at sum coef * q[first + (0, 1, 2)]; returns its index."""
+    def point(self, terms: list[tuple[int, float]], const=(0.0, 0.0, 0.0)) -> int:
+        """A new point at const + sum coef * q[first + (0, 1, 2)]; returns its index."""
         for first, coef in terms:
             for axis in range(3):
                 self.rows.append(3 * self.count + axis)
                 self.cols.append(first + axis)
                 self.coefs.append(coef)
+        self.consts.extend(float(c) for c in const)
         self.count += 1
         return self.count - 1
+
+    def expression(self, v) -> int:
+        """A new point at an affine expression of the full coordinates
+        (:class:`~..system.expressions.Vec3`); returns its index."""
+        return self.point(sorted(v.terms.items()), v.const)
 
     def node_points(self, first: int, nnodes: int, stride: int) -> int:
         """A point per node (positions at first + stride * node); the first one's index."""
@@ -138,6 +202,10 @@ class _Rows:
         for node in range(nnodes):
             self.point([(first + stride * node, 1.0)])
         return start
+
+    def part(self, name: str, word: str, start: int) -> None:
+        """Names the points from ``start`` to the last one made ('name: word, points a..b')."""
+        self.bodies.append(f"{name}: {word}, points {start}..{self.count - 1}")
 
 
 def frame_rows(total_rows: int, frames: int) -> tuple[int, int]:
@@ -161,8 +229,12 @@ def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
     topology.attrs["description"] = (
         "XDMF connectivity (0-based rows of points): " + {
             "Quadrilateral": "the corner points of each plate element",
-            "Polyline": "2-point lines (beam and cable elements, rigid body axes)",
-            "Mixed": "per cell its XDMF code, then quad: 4 points; line: 2, 2 points"}[kind])
+            "Polyline": "2-point lines (beam and cable elements, rigid body axes and "
+                        "boxes, force elements, distance joints; a line from a point to "
+                        "itself: a lone point, a point mass or a joint)",
+            "Mixed": "per cell its XDMF code, then quad: 4 points; line: 2, 2 points (a "
+                     "line from a point to itself: a lone point, a point mass or a "
+                     "joint)"}[kind])
     group.attrs["topology_type"] = kind
     group.attrs["ncells"] = np.int64(ncells)
     group.attrs["bodies"] = "\n".join(layout.bodies)
@@ -272,6 +344,42 @@ def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path
     one vector attribute per mode, ``mode_1``, ``mode_2``, ... (``/<group>/xdmf/mode_<k>``,
     each scaled to a largest displacement of 1): in ParaView, Warp By Vector with a mode
     shows its shape."""
+    with h5py.File(path, "r") as h5:
+        modes = sorted((k for k in h5[f"{group}/xdmf"]), key=lambda k: int(k.split("_")[1]))
+    return _one_grid(path, f"{group} shapes", f"/{group}/mesh_static",
+                     [(mode, f"/{group}/xdmf/{mode}") for mode in modes], as_name)
+
+
+def write_static_xdmf(path: Path, as_name: Path | None = None) -> Path:
+    """An XDMF file beside the HDF5 result of a static analysis: one grid, the mesh at the
+    static state (``/static/mesh_nodes``), with its ``displacement`` from the undeformed
+    mesh (``/static/mesh_displacement``)."""
+    return _one_grid(path, "static state", "/static/mesh_nodes",
+                     [("displacement", "/static/mesh_displacement")], as_name)
+
+
+def write_any_xdmf(path: Path, as_name: Path | None = None) -> Path | None:
+    """The XDMF a result file's run writes, by what the file holds: the motion of a
+    dynamic run (:func:`write_xdmf`), else the shapes of a modal or buckling analysis
+    (:func:`write_mode_xdmf`), else the static state (:func:`write_static_xdmf`); None
+    when it holds none of them (no mesh)."""
+    with h5py.File(path, "r") as h5:
+        if "model/mesh" not in h5 and "model/elements" not in h5:
+            return None
+        motion = "dynamic/mesh_nodes" in h5 and "dynamic/time" in h5
+        eigen = next((g for g in ("modal", "buckling") if f"{g}/xdmf" in h5), None)
+        static = "static/mesh_displacement" in h5
+    if motion:
+        return write_xdmf(path, as_name)
+    if eigen is not None:
+        return write_mode_xdmf(path, eigen, as_name)
+    return write_static_xdmf(path, as_name) if static else None
+
+
+def _one_grid(path: Path, title: str, geometry_data: str,
+              attributes: list[tuple[str, str]], as_name: Path | None) -> Path:
+    """An XDMF file of one uniform grid: the file's mesh at the points ``geometry_data``
+    with a vector attribute per (name, dataset)."""
     path = Path(path)
     name = Path(as_name) if as_name is not None else path
     if ":" in name.name:
@@ -279,21 +387,20 @@ def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path
                          file=str(name))
     with h5py.File(path, "r") as h5:
         kind, dims, topology, ncells, npoints = _topology_of(h5)
-        modes = sorted((k for k in h5[f"{group}/xdmf"]), key=lambda k: int(k.split("_")[1]))
     h5_name = name.name
     root = ET.Element("Xdmf", Version="3.0")
     domain = ET.SubElement(root, "Domain")
-    grid = ET.SubElement(domain, "Grid", Name=f"{group} shapes", GridType="Uniform")
+    grid = ET.SubElement(domain, "Grid", Name=title, GridType="Uniform")
     topo = ET.SubElement(grid, "Topology", TopologyType=kind, NumberOfElements=str(ncells))
     if kind == "Polyline":
         topo.set("NodesPerElement", "2")
     _item(topo, dims, h5_name, topology, "Int")
     geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
-    _item(geometry, (npoints, 3), h5_name, f"/{group}/mesh_static")
-    for mode in modes:
-        attribute = ET.SubElement(grid, "Attribute", Name=mode, AttributeType="Vector",
+    _item(geometry, (npoints, 3), h5_name, geometry_data)
+    for label, dataset in attributes:
+        attribute = ET.SubElement(grid, "Attribute", Name=label, AttributeType="Vector",
                                   Center="Node")
-        _item(attribute, (npoints, 3), h5_name, f"/{group}/xdmf/{mode}")
+        _item(attribute, (npoints, 3), h5_name, dataset)
     out = name.with_suffix(".xdmf")
     write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
                                                             xml_declaration=True))

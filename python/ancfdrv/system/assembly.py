@@ -152,7 +152,7 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         constant_force=reduce(constant + gravity),
         driven_forces=[(i, reduce(v)) for i, v in driven],
         moments=moments, constraints=constraints, contact_pairs=contact_pairs, probes=probes,
-        point_masses=[(m.body.name, m.point, m.mass) for m in act.masses],
+        point_masses=[(m.name, m.body.name, m.point, m.mass) for m in act.masses],
         linear_joints=mode, response=response,
         support_frames=support_frames(system) if supports else None)
     model.vector_loads = vector_loads

@@ -210,6 +210,7 @@ class Model:
         self.full_pattern, self.pattern, self.mass = full_pattern, pattern, mass
         self.constant_force_vector = constant_force
         self.driven_forces, self.moments, self.constraints = driven_forces, moments, constraints
+        #: the active point masses: (load name, body name, point at t = 0, mass) each
         self.contact_pairs, self.probes, self.point_masses = contact_pairs, probes, point_masses
         self.linear_joints = linear_joints
         self.policy = POLICY_REFACTOR

@@ -113,8 +113,9 @@ class Kind:
     #: initial values in planar motion normal to e_j, each with its equation's label
     planar_fixed: Callable[[Any, int, Any], list[tuple[int, str]]] | None = None
     #: ``mesh(body, rows)``: adds the body's points and cells to the XDMF writer's row
-    #: builder (``rows.point(terms)``, ``rows.node_points(first, nnodes, stride)``,
-    #: ``rows.quads``, ``rows.lines``: results/xdmf.py); None: not shown
+    #: builder (``rows.point(terms)``, ``rows.expression(vec3)`` for an affine expression
+    #: of q, ``rows.node_points(first, nnodes, stride)``, ``rows.quads``, ``rows.lines``:
+    #: results/xdmf.py); None: not shown
     mesh: Callable[[Any, Any], None] | None = None
     #: the kind's place in the mesh (bodies of lower order first, each kind in the model's
     #: order)

@@ -146,16 +146,39 @@ def _planar_fixed(body: RigidBody, j: int, q0) -> list[tuple[int, str]]:
     return out
 
 
+def inertia_box(body: RigidBody) -> tuple[np.ndarray, np.ndarray]:
+    """The uniform box of the body's mass and principal moments of inertia: (half-sizes
+    (a, b, c), the principal axes as columns, in the body's axes at t = 0). A box of
+    half-sizes a, b, c has I1 = m (b^2 + c^2) / 3 about its first axis, and so on, so
+    a^2 = 3 (I2 + I3 - I1) / 2m (0 when the moments do not meet the triangle inequality
+    strictly: a flat body)."""
+    moments, axes = np.linalg.eigh(body.inertia)
+    squares = 3.0 * (moments.sum() - 2.0 * moments) / (2.0 * body.mass)
+    return np.sqrt(np.maximum(squares, 0.0)), axes
+
+
+#: the 12 edges of a box between its corners k = 4 i + 2 j + l (signs (-1)^(1+i), ...)
+BOX_EDGES = np.array([[0, 1], [2, 3], [4, 5], [6, 7], [0, 2], [1, 3], [4, 6], [5, 7],
+                      [0, 4], [1, 5], [2, 6], [3, 7]])
+
+
 def _mesh(body: RigidBody, rows) -> None:
     """XDMF: its centre r and three lines along r_x, r_y, r_z as long as its radius of
     gyration about the centre of mass, sqrt(tr(I) / 2m) (the root mean square distance of
-    the mass from the centre; 1 when 0)."""
+    the mass from the centre; 1 when 0), then the 12 edges of its inertia box
+    (:func:`inertia_box`) between the corners r + u1 r_x + u2 r_y + u3 r_z, u = V (+-a,
+    +-b, +-c): 8 points, each affine in the body's coordinates, moving with it."""
     size = math.sqrt(max(float(np.trace(body.inertia)), 0.0) / (2.0 * body.mass))
     size = size if size > 0 else 1.0
     centre = rows.point([(body.first, 1.0)])
     for k in (1, 2, 3):  # r + size r_x, r + size r_y, r + size r_z
         tip = rows.point([(body.first, 1.0), (body.first + 3 * k, size)])
         rows.lines.append(np.array([[centre, tip]]))
+    half, axes = inertia_box(body)
+    first = rows.count
+    for signs in np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T:
+        rows.expression(body.position_of_offset(axes @ (signs * half)))
+    rows.lines.append(BOX_EDGES + first)
 
 
 KIND = register(Kind(
