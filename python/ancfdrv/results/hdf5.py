@@ -637,16 +637,25 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
             _attrs(h5["dynamic"].attrs, {"status": status})
         has_motion = ("dynamic/mesh_nodes" in h5 and "dynamic/time" in h5
                       and len(h5["dynamic/time"]) > 0)
+        series = None
         if has_motion:
             _last_frame(h5, model)
-    if has_motion:
-        from .xdmf import write_xdmf
-        drop(path)  # write_xdmf opens the file itself
+            from .xdmf import Series, xdmf_target, write_series
+            try:  # described in this opening of the file (its views made), written after
+                target = xdmf_target(path)
+                series = Series.of(h5)
+            except Exception as exc:  # noqa: BLE001 - an optional output never fails a run
+                _no_xdmf(model, path, exc)
+    if series is not None:
         try:
-            write_xdmf(path)
-        except Exception as exc:  # noqa: BLE001 - an optional output never fails a good run
-            model.warnings.append(f"the XDMF description of {path} was not written: "
-                                  f"{type(exc).__name__}: {exc}")
+            write_series(series, target)
+        except Exception as exc:  # noqa: BLE001 - an optional output never fails a run
+            _no_xdmf(model, path, exc)
+
+
+def _no_xdmf(model: Model, path: Path, exc: Exception) -> None:
+    model.warnings.append(f"the XDMF description of {path} was not written: "
+                          f"{type(exc).__name__}: {exc}")
 
 
 def _last_frame(h5: h5py.File, model: Model) -> None:

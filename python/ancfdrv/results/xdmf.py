@@ -19,19 +19,19 @@ from the stored coordinates: q of each step expanded to the full coordinates
 
 Every DataItem is a plain ``Format="HDF"`` item naming one dataset, which is what both
 ParaView's XDMF 3 reader and meshio's ``meshio.xdmf.TimeSeriesReader`` understand (meshio
-reads neither HyperSlab nor Function items). The per-frame items are HDF5 virtual datasets,
+reads neither HyperSlab nor Function items: its readers require ``Format`` on every
+DataItem). The per-frame items are HDF5 virtual datasets,
 ``/dynamic/xdmf/position/<k>`` and ``/dynamic/xdmf/displacement/<k>``, that map row k of
 ``/dynamic/mesh_nodes`` and ``/dynamic/mesh_displacement``: no data is copied (the dynamic
 writer adds them as frames are written, :func:`add_step_views`). meshio reads the geometry
 of the first frame only: the motion is in the ``displacement`` attribute of every frame.
-The XML is built with ElementTree, so any file name (``&``, ``<``, quotes) gives valid XML;
-a ``:`` in the HDF5 file name cannot be expressed in XDMF's ``file:/path`` notation and is
-refused.
+The XML is built as text with the file name escaped, so any file name (``&``, ``<``,
+quotes) gives valid XML; a ``:`` in the HDF5 file name cannot be expressed in XDMF's
+``file:/path`` notation and is refused.
 """
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,7 +41,7 @@ from h5py import h5a, h5d, h5p, h5s, h5t
 
 from ..csr import Csr
 from ..errors import InputError
-from ..io.safe_write import write_with
+from ..io.safe_write import write_text
 from ..system.registry import kind_of
 
 _STEPS_GROUP = "dynamic/xdmf"
@@ -168,28 +168,53 @@ def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
     group.attrs["bodies"] = "\n".join(layout.bodies)
 
 
-def _item(parent: ET.Element, dims: tuple[int, ...], h5_name: str, dataset: str,
-          number_type: str = "Float", precision: int = 8) -> ET.Element:
-    item = ET.SubElement(parent, "DataItem", Dimensions=" ".join(map(str, dims)),
-                         NumberType=number_type, Precision=str(precision), Format="HDF")
-    item.text = f"{h5_name}:{dataset}"
-    return item
+def _escape(text: str) -> str:
+    """``text`` as XML character data or a double-quoted attribute value."""
+    return (text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+            .replace('"', "&quot;"))
+
+
+def _item(dims: tuple[int, ...], h5_name: str, dataset: str, number_type: str = "Float",
+          precision: int = 8) -> str:
+    """A ``Format="HDF"`` DataItem naming ``dataset`` of ``h5_name`` (already escaped)."""
+    return (f'<DataItem Dimensions="{" ".join(map(str, dims))}" NumberType="{number_type}" '
+            f'Precision="{precision}" Format="HDF">{h5_name}:{_escape(dataset)}</DataItem>')
+
+
+def _topology_xml(kind: str, ncells: int, dims: tuple[int, ...], h5_name: str,
+                  dataset: str) -> str:
+    nodes = ' NodesPerElement="2"' if kind == "Polyline" else ""
+    return (f'<Topology TopologyType="{kind}" NumberOfElements="{ncells}"{nodes}>'
+            f'{_item(dims, h5_name, dataset, "Int")}</Topology>')
+
+
+def _document(grids: str) -> str:
+    return ('<?xml version="1.0" encoding="utf-8"?>\n<Xdmf Version="3.0"><Domain>'
+            f"{grids}</Domain></Xdmf>")
 
 
 def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = False) -> None:
     """Virtual datasets /dynamic/xdmf/position/<k> = /dynamic/mesh_nodes[k] and
     /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for frames
     first <= k < stop, each with its source's ``units``. The dynamic writer calls this at
-    each flush, so the cost (~0.2 ms per view) is spread over the run and a stopped run
-    does not wait for it. (h5py's low-level API: its high-level VirtualLayout took ~1 ms
-    per view.) ``existing``: some of the views may exist already (an older file)."""
+    each flush, so the cost (~0.15 ms of CPU per view, most of it inside HDF5) is spread
+    over the run and a stopped run does not wait for it. (h5py's low-level API: its
+    high-level VirtualLayout took ~1 ms per view.) ``existing``: some of the views may
+    exist already (an older file): their names are listed once, not looked up per view."""
     for source, name in (("dynamic/mesh_nodes", "position"),
                          ("dynamic/mesh_displacement", "displacement")):
         if source not in h5:
             continue
         data = h5[source]
         shape = data.shape
+        stop_here = min(stop, shape[0])
+        if stop_here <= first:
+            continue
         group = h5.require_group(f"{_STEPS_GROUP}/{name}")
+        made = set(group) if existing and len(group) else set()
+        todo = [k for k in range(first, stop_here) if str(k) not in made]
+        if not todo:
+            continue
         selection = h5s.create_simple(shape)
         view_space = h5s.create_simple(shape[1:])
         dtype = data.id.get_type()
@@ -198,12 +223,11 @@ def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = Fal
         scalar = h5s.create(h5s.SCALAR)
         units = np.array(data.attrs.get("units", "m"), dtype=text)
         count = (1, *shape[1:])
-        for k in range(first, min(stop, shape[0])):
-            if existing and str(k) in group:
-                continue
+        source_name = ("/" + source).encode()
+        for k in todo:
             selection.select_hyperslab((k,) + (0,) * (len(shape) - 1), count)
             plist = h5p.create(h5p.DATASET_CREATE)
-            plist.set_virtual(view_space, b".", ("/" + source).encode(), selection)
+            plist.set_virtual(view_space, b".", source_name, selection)
             view = h5d.create(group.id, str(k).encode(), dtype, view_space, dcpl=plist)
             h5a.create(view, b"units", text_type, scalar).write(units)
 
@@ -219,51 +243,84 @@ def _topology_of(h5: h5py.File) -> tuple[str, tuple[int, ...], str, int, int]:
     return "Quadrilateral", shape, "/model/elements", shape[0], len(h5["model/nodes"])
 
 
+@dataclass
+class Series:
+    """What the XDMF description of a dynamic run names: its frames (output rows and
+    times), its mesh and which per-point series the file holds."""
+
+    rows: np.ndarray          # the output row of each frame
+    times: np.ndarray         # (nframes,) s
+    topology: tuple[str, tuple[int, ...], str, int, int]   # see _topology_of
+    displacement: bool        # /dynamic/mesh_displacement (and its views)
+    stress_points: bool       # /dynamic/mesh_von_mises_max
+
+    @classmethod
+    def of(cls, h5: h5py.File) -> "Series":
+        """The series of an open result file, after making the per-frame views its
+        writer has not made (a run stopped between flushes, an older file)."""
+        times = h5["dynamic/time"]
+        nframes = h5["dynamic/mesh_nodes"].shape[0]
+        rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(nframes)
+        nframes = min(nframes, int(np.searchsorted(rows, len(times))))
+        rows = rows[:nframes]
+        add_step_views(h5, 0, nframes, existing=True)
+        return cls(rows, times[()][rows] if nframes else np.zeros(0), _topology_of(h5),
+                   "dynamic/mesh_displacement" in h5, "dynamic/mesh_von_mises_max" in h5)
+
+    def xml(self, h5_name: str) -> str:
+        """The XDMF 3 text: a temporal collection of one uniform grid per frame, built as
+        text (an ElementTree of the same grids took ~0.2 ms per frame to build and write).
+        ``h5_name``: the HDF5 file's name, already checked for ``:``."""
+        kind, dims, topology_data, ncells, npoints = self.topology
+        name = _escape(h5_name)
+        topology = _topology_xml(kind, ncells, dims, name, topology_data)
+        stress = ""
+        if self.stress_points:  # the run's von Mises envelope at the beam nodes (Pa)
+            stress = ('<Attribute Name="von_mises_max" AttributeType="Scalar" Center="Node">'
+                      f'{_item((npoints,), name, "/dynamic/mesh_von_mises_max")}</Attribute>')
+        grids = []
+        for k, (row, time) in enumerate(zip(self.rows, self.times)):
+            motion = ""
+            if self.displacement:
+                motion = ('<Attribute Name="displacement" AttributeType="Vector" '
+                          'Center="Node">'
+                          f'{_item((npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")}'
+                          "</Attribute>")
+            grids.append(
+                f'\n<Grid Name="step {row}" GridType="Uniform"><Time Value="{time:.17g}"/>'
+                f'{topology}<Geometry GeometryType="XYZ">'
+                f'{_item((npoints, 3), name, f"/{_STEPS_GROUP}/position/{k}")}</Geometry>'
+                f"{motion}{stress}</Grid>")
+        return _document('<Grid Name="motion" GridType="Collection" '
+                         f'CollectionType="Temporal">{"".join(grids)}\n</Grid>')
+
+
+def xdmf_target(path: Path, as_name: Path | None = None) -> Path:
+    """The HDF5 file name the XDMF beside ``path`` names (``as_name`` when the file is
+    about to be moved there); refused with ':' in it (XDMF's ``file:/path`` notation
+    cannot express it)."""
+    target = Path(as_name) if as_name is not None else Path(path)
+    if ":" in target.name:
+        raise InputError("XDMF cannot name an HDF5 file with ':' in its name", file=str(path))
+    return target
+
+
+def write_series(series: Series, target: Path) -> Path:
+    """The XDMF file of ``series`` beside ``target`` (the HDF5 file it names)."""
+    out = target.with_suffix(".xdmf")
+    write_text(out, series.xml(target.name))
+    return out
+
+
 def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
     """An XDMF file beside the HDF5 result of a dynamic run: one grid per frame at the
     points' positions of that step, with their displacement from t = 0; opens in ParaView
     as a time series. ``as_name``: the name the HDF5 file will have (it is about to be
     moved there); the XDMF is written beside that name and refers to it."""
-    path = Path(path)
-    target = Path(as_name) if as_name is not None else path
-    name = target.name
-    if ":" in name:
-        raise InputError("XDMF cannot name an HDF5 file with ':' in its name", file=str(path))
+    target = xdmf_target(path, as_name)
     with h5py.File(path, "a") as h5:
-        times = h5["dynamic/time"][()]
-        nframes = h5["dynamic/mesh_nodes"].shape[0]
-        rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(nframes)
-        nframes = min(nframes, int(np.searchsorted(rows, len(times))))
-        kind, dims, topology_data, ncells, npoints = _topology_of(h5)
-        add_step_views(h5, 0, nframes, existing=True)  # those the writer has not made
-        displacement = "dynamic/mesh_displacement" in h5
-        stress_points = "dynamic/mesh_von_mises_max" in h5
-    root = ET.Element("Xdmf", Version="3.0")
-    domain = ET.SubElement(root, "Domain")
-    series = ET.SubElement(domain, "Grid", Name="motion", GridType="Collection",
-                           CollectionType="Temporal")
-    for k in range(nframes):
-        grid = ET.SubElement(series, "Grid", Name=f"step {rows[k]}", GridType="Uniform")
-        ET.SubElement(grid, "Time", Value=f"{times[rows[k]]:.17g}")
-        topology = ET.SubElement(grid, "Topology", TopologyType=kind,
-                                 NumberOfElements=str(ncells))
-        if kind == "Polyline":
-            topology.set("NodesPerElement", "2")
-        _item(topology, dims, name, topology_data, "Int")
-        geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
-        _item(geometry, (npoints, 3), name, f"/{_STEPS_GROUP}/position/{k}")
-        if displacement:
-            attribute = ET.SubElement(grid, "Attribute", Name="displacement",
-                                      AttributeType="Vector", Center="Node")
-            _item(attribute, (npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
-        if stress_points:  # the run's von Mises envelope at the beam nodes (Pa)
-            attribute = ET.SubElement(grid, "Attribute", Name="von_mises_max",
-                                      AttributeType="Scalar", Center="Node")
-            _item(attribute, (npoints,), name, "/dynamic/mesh_von_mises_max")
-    out = target.with_suffix(".xdmf")
-    write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
-                                                            xml_declaration=True))
-    return out
+        series = Series.of(h5)
+    return write_series(series, target)
 
 
 def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path:
@@ -280,21 +337,15 @@ def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path
     with h5py.File(path, "r") as h5:
         kind, dims, topology, ncells, npoints = _topology_of(h5)
         modes = sorted((k for k in h5[f"{group}/xdmf"]), key=lambda k: int(k.split("_")[1]))
-    h5_name = name.name
-    root = ET.Element("Xdmf", Version="3.0")
-    domain = ET.SubElement(root, "Domain")
-    grid = ET.SubElement(domain, "Grid", Name=f"{group} shapes", GridType="Uniform")
-    topo = ET.SubElement(grid, "Topology", TopologyType=kind, NumberOfElements=str(ncells))
-    if kind == "Polyline":
-        topo.set("NodesPerElement", "2")
-    _item(topo, dims, h5_name, topology, "Int")
-    geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
-    _item(geometry, (npoints, 3), h5_name, f"/{group}/mesh_static")
+    h5_name = _escape(name.name)
+    parts = [f'<Grid Name="{_escape(group)} shapes" GridType="Uniform">',
+             _topology_xml(kind, ncells, dims, h5_name, topology),
+             '<Geometry GeometryType="XYZ">'
+             f'{_item((npoints, 3), h5_name, f"/{group}/mesh_static")}</Geometry>']
     for mode in modes:
-        attribute = ET.SubElement(grid, "Attribute", Name=mode, AttributeType="Vector",
-                                  Center="Node")
-        _item(attribute, (npoints, 3), h5_name, f"/{group}/xdmf/{mode}")
+        parts.append(f'<Attribute Name="{_escape(mode)}" AttributeType="Vector" Center="Node">'
+                     f'{_item((npoints, 3), h5_name, f"/{group}/xdmf/{mode}")}</Attribute>')
+    parts.append("</Grid>")
     out = name.with_suffix(".xdmf")
-    write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
-                                                            xml_declaration=True))
+    write_text(out, _document("\n".join(parts)))
     return out
