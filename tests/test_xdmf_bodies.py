@@ -224,3 +224,53 @@ def test_a_failed_run_ends_its_motion_at_the_last_step(tmp_path):
     _, _, frames = read_series(out.with_suffix(".xdmf"))
     assert frames[-1][0] == time[-1]
     np.testing.assert_allclose(reference[-1] + frames[-1][1][-1], tip, atol=1e-12)  # the tip
+
+
+def test_every_frame_names_its_row_of_the_stored_positions(beam):
+    """ParaView reads each frame's Geometry item, meshio the first frame's points and each
+    frame's displacement: both must give /dynamic/mesh_nodes of that frame, at its time."""
+    xdmf = beam.with_suffix(".xdmf")
+    grids = ET.parse(xdmf).getroot().findall("./Domain/Grid/Grid")
+    points, _, frames = read_series(xdmf)
+    with h5py.File(beam) as h5:
+        nodes = h5["dynamic/mesh_nodes"][()]
+        times = h5["dynamic/time"][()][h5["dynamic/mesh_rows"][()]]
+        reference = h5["model/mesh/points"][()]
+        assert len(grids) == len(frames) == len(nodes) == 11
+        for k in (0, len(grids) - 1):
+            item = grids[k].find("./Geometry/DataItem")
+            dataset = item.text.split(":", 1)[1]
+            assert item.get("Dimensions") == "4 3"
+            np.testing.assert_array_equal(h5[dataset][()], nodes[k])
+            assert float(grids[k].find("Time").get("Value")) == times[k]
+    np.testing.assert_array_equal(points, nodes[0])
+    assert [t for t, _ in frames] == list(times)
+    np.testing.assert_allclose(reference + frames[-1][1], nodes[-1], atol=1e-14)
+
+
+def test_rewriting_the_description_makes_only_the_missing_views(tmp_path):
+    """write_xdmf on a file whose views are partly missing (an older or stopped file)
+    makes the missing ones, each the row of its frame, and names all of them."""
+    from ancfdrv.results.xdmf import write_xdmf
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.05",
+                                            "output.xdmf_frames=6"], out, progress=False)
+    with h5py.File(out, "a") as h5:
+        for k in ("2", "5"):
+            del h5[f"dynamic/xdmf/position/{k}"]
+        del h5["dynamic/xdmf/displacement/0"]
+        assert len(h5["dynamic/xdmf/position"]) == 4
+    out.with_suffix(".xdmf").unlink()
+    write_xdmf(out)
+    points, _, frames = read_series(out.with_suffix(".xdmf"))
+    with h5py.File(out) as h5:
+        nodes = h5["dynamic/mesh_nodes"][()]
+        for name in ("position", "displacement"):
+            assert sorted(h5[f"dynamic/xdmf/{name}"], key=int) == [str(k) for k in range(6)]
+        for k in range(6):
+            np.testing.assert_array_equal(h5[f"dynamic/xdmf/position/{k}"][()], nodes[k])
+            assert h5[f"dynamic/xdmf/position/{k}"].attrs["units"] == "m"
+        np.testing.assert_array_equal(h5["dynamic/xdmf/displacement/0"][()],
+                                      h5["dynamic/mesh_displacement"][0])
+    assert len(frames) == 6
+    np.testing.assert_array_equal(points, nodes[0])
