@@ -17,14 +17,21 @@ with several it is ``Mixed`` (quad: 5 a b c d, line: 2 2 a b). The points' posit
 from the stored coordinates: q of each step expanded to the full coordinates
 (:meth:`Model.expand`) and mapped by the sparse matrix of :class:`MeshLayout`.
 
-Every DataItem is a plain ``Format="HDF"`` item naming one dataset, which is what both
-ParaView's XDMF 3 reader and meshio's ``meshio.xdmf.TimeSeriesReader`` understand (meshio
-reads neither HyperSlab nor Function items: its readers require ``Format`` on every
-DataItem). The per-frame items are HDF5 virtual datasets,
-``/dynamic/xdmf/position/<k>`` and ``/dynamic/xdmf/displacement/<k>``, that map row k of
-``/dynamic/mesh_nodes`` and ``/dynamic/mesh_displacement``: no data is copied (the dynamic
-writer adds them as frames are written, :func:`add_step_views`). meshio reads the geometry
-of the first frame only: the motion is in the ``displacement`` attribute of every frame.
+meshio's ``meshio.xdmf.TimeSeriesReader`` reads only plain ``Format="HDF"`` items naming
+one whole dataset (its readers require ``Format`` on every DataItem: no HyperSlab, no
+Function), and of the geometry only the first frame's; ParaView's XDMF 3 reader reads every
+frame's geometry and attributes, HyperSlab items included. So:
+
+* the first frame's geometry and every frame's ``displacement`` attribute are HDF5 virtual
+  datasets, ``/dynamic/xdmf/position/0`` and ``/dynamic/xdmf/displacement/<k>``, that map
+  row k of ``/dynamic/mesh_nodes`` and ``/dynamic/mesh_displacement``: no data is copied
+  (the dynamic writer adds them as frames are written, :func:`add_step_views`);
+* the geometry of frame k >= 1 is a HyperSlab item, row k of ``/dynamic/mesh_nodes``:
+  no HDF5 object per frame (each view costs ~0.15 ms of CPU to make and the file's close
+  more; this halves their number).
+
+meshio shows the motion through the ``displacement`` attribute of every frame, ParaView
+through the geometry too.
 The XML is built as text with the file name escaped, so any file name (``&``, ``<``,
 quotes) gives valid XML; a ``:`` in the HDF5 file name cannot be expressed in XDMF's
 ``file:/path`` notation and is refused.
@@ -194,20 +201,21 @@ def _document(grids: str) -> str:
 
 
 def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = False) -> None:
-    """Virtual datasets /dynamic/xdmf/position/<k> = /dynamic/mesh_nodes[k] and
-    /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for frames
-    first <= k < stop, each with its source's ``units``. The dynamic writer calls this at
-    each flush, so the cost (~0.15 ms of CPU per view, most of it inside HDF5) is spread
-    over the run and a stopped run does not wait for it. (h5py's low-level API: its
-    high-level VirtualLayout took ~1 ms per view.) ``existing``: some of the views may
-    exist already (an older file): their names are listed once, not looked up per view."""
-    for source, name in (("dynamic/mesh_nodes", "position"),
-                         ("dynamic/mesh_displacement", "displacement")):
+    """Virtual datasets /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for
+    frames first <= k < stop, and /dynamic/xdmf/position/0 = /dynamic/mesh_nodes[0] (the
+    geometry meshio reads) with the first frame, each with its source's ``units``. The
+    dynamic writer calls this at each flush, so the cost (~0.15 ms of CPU per view, most of
+    it inside HDF5) is spread over the run and a stopped run does not wait for it. (h5py's
+    low-level API: its high-level VirtualLayout took ~1 ms per view.) ``existing``: some of
+    the views may exist already (an older file): their names are listed once, not looked
+    up per view."""
+    for source, name, last in (("dynamic/mesh_nodes", "position", 1),
+                               ("dynamic/mesh_displacement", "displacement", stop)):
         if source not in h5:
             continue
         data = h5[source]
         shape = data.shape
-        stop_here = min(stop, shape[0])
+        stop_here = min(last, stop, shape[0])
         if stop_here <= first:
             continue
         group = h5.require_group(f"{_STEPS_GROUP}/{name}")
@@ -232,6 +240,13 @@ def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = Fal
             h5a.create(view, b"units", text_type, scalar).write(units)
 
 
+def _row_item(k: int, rows: int, npoints: int, h5_name: str, dataset: str) -> str:
+    """A HyperSlab item: row k of the (rows, npoints, 3) dataset (start, stride, count)."""
+    return (f'<DataItem ItemType="HyperSlab" Dimensions="1 {npoints} 3">'
+            f'<DataItem Dimensions="3 3" NumberType="Int" Format="XML">{k} 0 0 1 1 1 1 '
+            f'{npoints} 3</DataItem>{_item((rows, npoints, 3), h5_name, dataset)}</DataItem>')
+
+
 def _topology_of(h5: h5py.File) -> tuple[str, tuple[int, ...], str, int, int]:
     """(type, dims, dataset, ncells, npoints) of the file's mesh: /model/mesh, or for
     files written before it the plates' /model/elements and /model/nodes."""
@@ -250,6 +265,7 @@ class Series:
 
     rows: np.ndarray          # the output row of each frame
     times: np.ndarray         # (nframes,) s
+    stored: int               # the rows of /dynamic/mesh_nodes (>= the frames)
     topology: tuple[str, tuple[int, ...], str, int, int]   # see _topology_of
     displacement: bool        # /dynamic/mesh_displacement (and its views)
     stress_points: bool       # /dynamic/mesh_von_mises_max
@@ -264,7 +280,8 @@ class Series:
         nframes = min(nframes, int(np.searchsorted(rows, len(times))))
         rows = rows[:nframes]
         add_step_views(h5, 0, nframes, existing=True)
-        return cls(rows, times[()][rows] if nframes else np.zeros(0), _topology_of(h5),
+        return cls(rows, times[()][rows] if nframes else np.zeros(0),
+                   h5["dynamic/mesh_nodes"].shape[0], _topology_of(h5),
                    "dynamic/mesh_displacement" in h5, "dynamic/mesh_von_mises_max" in h5)
 
     def xml(self, h5_name: str) -> str:
@@ -286,10 +303,11 @@ class Series:
                           'Center="Node">'
                           f'{_item((npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")}'
                           "</Attribute>")
+            where = _item((npoints, 3), name, f"/{_STEPS_GROUP}/position/0") if k == 0 \
+                else _row_item(k, self.stored, npoints, name, "/dynamic/mesh_nodes")
             grids.append(
                 f'\n<Grid Name="step {row}" GridType="Uniform"><Time Value="{time:.17g}"/>'
-                f'{topology}<Geometry GeometryType="XYZ">'
-                f'{_item((npoints, 3), name, f"/{_STEPS_GROUP}/position/{k}")}</Geometry>'
+                f'{topology}<Geometry GeometryType="XYZ">{where}</Geometry>'
                 f"{motion}{stress}</Grid>")
         return _document('<Grid Name="motion" GridType="Collection" '
                          f'CollectionType="Temporal">{"".join(grids)}\n</Grid>')
