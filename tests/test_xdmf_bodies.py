@@ -227,51 +227,69 @@ def test_a_failed_run_ends_its_motion_at_the_last_step(tmp_path):
     np.testing.assert_allclose(reference[-1] + frames[-1][1][-1], tip, atol=1e-12)  # the tip
 
 
-def geometry(grid: ET.Element, h5: h5py.File) -> np.ndarray:
-    """The points of a frame's Geometry item as the XDMF model defines them (what
-    ParaView reads): a plain HDF item's dataset, or a HyperSlab's rows (its first child
+def values(item: ET.Element, h5: h5py.File) -> np.ndarray:
+    """A DataItem's values as the XDMF model defines them (what ParaView reads): inline
+    text (Format XML), a plain HDF item's dataset, or a HyperSlab's rows (its first child
     the start, stride and count per dimension, its second the dataset)."""
-    item = grid.find("./Geometry/DataItem")
-    if item.get("ItemType") != "HyperSlab":
-        assert item.get("Format") == "HDF"
-        return h5[item.text.split(":", 1)[1]][()]
-    slab, source = list(item)
-    assert slab.get("Format") == "XML" and source.get("Format") == "HDF"
-    start, stride, count = np.array(slab.text.split(), dtype=int).reshape(3, -1)
-    data = h5[source.text.split(":", 1)[1]]
-    assert list(data.shape) == [int(d) for d in source.get("Dimensions").split()]
-    index = tuple(slice(a, a + s * (n - 1) + 1, s) for a, s, n in zip(start, stride, count))
-    assert [int(d) for d in item.get("Dimensions").split()] == list(count)
-    return data[index].reshape(-1, 3)
+    dims = [int(d) for d in item.get("Dimensions").split()]
+    if item.get("ItemType") == "HyperSlab":
+        slab, source = list(item)
+        assert slab.get("Format") == "XML" and source.get("Format") == "HDF"
+        start, stride, count = np.array(slab.text.split(), dtype=int).reshape(3, -1)
+        data = values(source, h5)
+        assert dims == list(count)
+        return data[tuple(slice(a, a + s * (n - 1) + 1, s)
+                          for a, s, n in zip(start, stride, count))]
+    if item.get("Format") == "XML":
+        return np.array([float(v) for v in item.text.split()]).reshape(dims)
+    assert item.get("Format") == "HDF"
+    data = h5[item.text.split(":", 1)[1]][()]
+    assert list(data.shape) == dims
+    return data
 
 
-def test_every_frame_names_its_row_of_the_stored_positions(beam):
+@pytest.mark.parametrize("views", [False, True], ids=["inline", "views"])
+def test_every_frame_gives_its_row_of_the_stored_positions(views, tmp_path, monkeypatch):
     """ParaView reads each frame's Geometry item, meshio the first frame's points and each
-    frame's displacement: both must give /dynamic/mesh_nodes of that frame, at its time."""
-    xdmf = beam.with_suffix(".xdmf")
-    grids = ET.parse(xdmf).getroot().findall("./Domain/Grid/Grid")
-    points, _, frames = read_series(xdmf)
-    with h5py.File(beam) as h5:
+    frame's displacement: both must give /dynamic/mesh_nodes of that frame, at its time,
+    exactly. 11 frames of 4 points are carried inline; with the inline limit at 0 the
+    same series names one view per frame (the displacement meshio reads), not two."""
+    from ancfdrv.results import xdmf
+    if views:
+        monkeypatch.setattr(xdmf, "INLINE_VALUES", 0)
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.5",
+                                            "output.xdmf_frames=11"], out, progress=False)
+    grids = ET.parse(out.with_suffix(".xdmf")).getroot().findall("./Domain/Grid/Grid")
+    points, _, frames = read_series(out.with_suffix(".xdmf"))
+    with h5py.File(out) as h5:
         nodes = h5["dynamic/mesh_nodes"][()]
+        shifts = h5["dynamic/mesh_displacement"][()]
         times = h5["dynamic/time"][()][h5["dynamic/mesh_rows"][()]]
-        reference = h5["model/mesh/points"][()]
         assert len(grids) == len(frames) == len(nodes) == 11
         for k, grid in enumerate(grids):
-            np.testing.assert_array_equal(geometry(grid, h5), nodes[k])
+            np.testing.assert_array_equal(
+                values(grid.find("./Geometry/DataItem"), h5).reshape(-1, 3), nodes[k])
+            np.testing.assert_array_equal(
+                values(grid.find("./Attribute[@Name='displacement']/DataItem"), h5),
+                shifts[k])
             assert float(grid.find("Time").get("Value")) == times[k]
-        # one HDF5 object per frame (the displacement meshio reads), not two
-        assert list(h5["dynamic/xdmf/position"]) == ["0"]
-        assert len(h5["dynamic/xdmf/displacement"]) == 11
+        if views:
+            assert list(h5["dynamic/xdmf/position"]) == ["0"]
+            assert len(h5["dynamic/xdmf/displacement"]) == 11
+        else:
+            assert "xdmf" not in h5["dynamic"]
     np.testing.assert_array_equal(points, nodes[0])
     assert [t for t, _ in frames] == list(times)
     for k in range(len(frames)):
-        np.testing.assert_allclose(reference + frames[k][1], nodes[k], atol=1e-14)
+        np.testing.assert_array_equal(frames[k][1], shifts[k])
 
 
-def test_rewriting_the_description_makes_only_the_missing_views(tmp_path):
+def test_rewriting_the_description_makes_only_the_missing_views(tmp_path, monkeypatch):
     """write_xdmf on a file whose views are partly missing (an older or stopped file)
     makes the missing ones, each the row of its frame, and names all of them."""
-    from ancfdrv.results.xdmf import write_xdmf
+    from ancfdrv.results import xdmf
+    monkeypatch.setattr(xdmf, "INLINE_VALUES", 0)
     out = tmp_path / "boom.h5"
     run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.05",
                                             "output.xdmf_frames=6"], out, progress=False)
@@ -281,7 +299,7 @@ def test_rewriting_the_description_makes_only_the_missing_views(tmp_path):
         del h5["dynamic/xdmf/position/0"]
         assert len(h5["dynamic/xdmf/displacement"]) == 3
     out.with_suffix(".xdmf").unlink()
-    write_xdmf(out)
+    xdmf.write_xdmf(out)
     points, _, frames = read_series(out.with_suffix(".xdmf"))
     grids = ET.parse(out.with_suffix(".xdmf")).getroot().findall("./Domain/Grid/Grid")
     with h5py.File(out) as h5:
@@ -292,7 +310,8 @@ def test_rewriting_the_description_makes_only_the_missing_views(tmp_path):
         for k in range(6):
             np.testing.assert_array_equal(h5[f"dynamic/xdmf/displacement/{k}"][()], shifts[k])
             assert h5[f"dynamic/xdmf/displacement/{k}"].attrs["units"] == "m"
-            np.testing.assert_array_equal(geometry(grids[k], h5), nodes[k])
+            np.testing.assert_array_equal(
+                values(grids[k].find("./Geometry/DataItem"), h5).reshape(-1, 3), nodes[k])
         assert h5["dynamic/xdmf/position/0"].attrs["units"] == "m"
     assert len(frames) == 6
     np.testing.assert_array_equal(points, nodes[0])

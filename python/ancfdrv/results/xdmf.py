@@ -22,13 +22,16 @@ one whole dataset (its readers require ``Format`` on every DataItem: no HyperSla
 Function), and of the geometry only the first frame's; ParaView's XDMF 3 reader reads every
 frame's geometry and attributes, HyperSlab items included. So:
 
-* the first frame's geometry and every frame's ``displacement`` attribute are HDF5 virtual
-  datasets, ``/dynamic/xdmf/position/0`` and ``/dynamic/xdmf/displacement/<k>``, that map
-  row k of ``/dynamic/mesh_nodes`` and ``/dynamic/mesh_displacement``: no data is copied
-  (the dynamic writer adds them as frames are written, :func:`add_step_views`);
-* the geometry of frame k >= 1 is a HyperSlab item, row k of ``/dynamic/mesh_nodes``:
-  no HDF5 object per frame (each view costs ~0.15 ms of CPU to make and the file's close
-  more; this halves their number).
+* a small series (at most :data:`INLINE_VALUES` values of displacement over all frames: a
+  boom or a pendulum at the default 250 frames) carries the first frame's points and
+  every frame's displacement inline, as ``Format="XML"`` items (the shortest decimal text
+  that reads back as the same double), with no HDF5 object per frame;
+* a larger one names HDF5 virtual datasets, ``/dynamic/xdmf/position/0`` and
+  ``/dynamic/xdmf/displacement/<k>``, that map row k of ``/dynamic/mesh_nodes`` and
+  ``/dynamic/mesh_displacement``: no data is copied (the dynamic writer adds them as
+  frames are written, :func:`add_step_views`; each costs ~0.15 ms of CPU to make, plus
+  its share of the file's close);
+* the geometry of frame k >= 1 is a HyperSlab item, row k of ``/dynamic/mesh_nodes``.
 
 meshio shows the motion through the ``displacement`` attribute of every frame, ParaView
 through the geometry too.
@@ -52,6 +55,9 @@ from ..io.safe_write import write_text
 from ..system.registry import kind_of
 
 _STEPS_GROUP = "dynamic/xdmf"
+#: the most displacement values (3 per point and frame) a description carries inline
+#: (~20 bytes of text each: at most ~0.6 MB); larger series name per-frame views
+INLINE_VALUES = 30_000
 #: XDMF cell codes of a Mixed topology
 _QUAD, _LINE = 5, 2
 
@@ -155,6 +161,18 @@ def frame_rows(total_rows: int, frames: int) -> tuple[int, int]:
     return math.ceil((total_rows - 1) / (frames - 1)), total_rows - 1
 
 
+def frame_count(total_rows: int, frames: int) -> int:
+    """The frames :func:`frame_rows` shows of a run of ``total_rows`` rows."""
+    stride, last = frame_rows(total_rows, frames)
+    return last // stride + 1 + int(last % stride != 0)
+
+
+def inline(npoints: int, nframes: int) -> bool:
+    """Whether the description of ``nframes`` frames of ``npoints`` points carries the
+    points' data inline (:data:`INLINE_VALUES`) instead of naming per-frame views."""
+    return 3 * npoints * nframes <= INLINE_VALUES
+
+
 def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
     """/model/mesh: the initial points, the connectivity and what each point belongs to."""
     if "model/mesh" in h5:
@@ -203,9 +221,10 @@ def _document(grids: str) -> str:
 def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = False) -> None:
     """Virtual datasets /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for
     frames first <= k < stop, and /dynamic/xdmf/position/0 = /dynamic/mesh_nodes[0] (the
-    geometry meshio reads) with the first frame, each with its source's ``units``. The
-    dynamic writer calls this at each flush, so the cost (~0.15 ms of CPU per view, most of
-    it inside HDF5) is spread over the run and a stopped run does not wait for it. (h5py's
+    geometry meshio reads) with the first frame, each with its source's ``units``: the
+    items of a series too large to carry inline (:func:`inline`). The dynamic writer calls
+    this at each flush, so the cost (~0.15 ms of CPU per view, most of it inside HDF5) is
+    spread over the run and a stopped run does not wait for it. (h5py's
     low-level API: its high-level VirtualLayout took ~1 ms per view.) ``existing``: some of
     the views may exist already (an older file): their names are listed once, not looked
     up per view."""
@@ -240,6 +259,15 @@ def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = Fal
             h5a.create(view, b"units", text_type, scalar).write(units)
 
 
+def _values(values: np.ndarray) -> str:
+    """An inline ``Format="XML"`` item of float64 values: each the shortest decimal text
+    that reads back as the same double (meshio and ParaView parse it with strtod)."""
+    dims = " ".join(map(str, values.shape))
+    text = " ".join(map(repr, values.ravel().tolist()))
+    return (f'<DataItem Dimensions="{dims}" NumberType="Float" Precision="8" Format="XML">'
+            f"{text}</DataItem>")
+
+
 def _row_item(k: int, rows: int, npoints: int, h5_name: str, dataset: str) -> str:
     """A HyperSlab item: row k of the (rows, npoints, 3) dataset (start, stride, count)."""
     return (f'<DataItem ItemType="HyperSlab" Dimensions="1 {npoints} 3">'
@@ -267,22 +295,32 @@ class Series:
     times: np.ndarray         # (nframes,) s
     stored: int               # the rows of /dynamic/mesh_nodes (>= the frames)
     topology: tuple[str, tuple[int, ...], str, int, int]   # see _topology_of
-    displacement: bool        # /dynamic/mesh_displacement (and its views)
+    displacement: bool        # /dynamic/mesh_displacement
     stress_points: bool       # /dynamic/mesh_von_mises_max
+    #: a small series' first points (npoints, 3) and displacements (nframes, npoints, 3),
+    #: written inline (:func:`inline`); None: named as per-frame views
+    values: tuple[np.ndarray, np.ndarray | None] | None = None
 
     @classmethod
     def of(cls, h5: h5py.File) -> "Series":
-        """The series of an open result file, after making the per-frame views its
-        writer has not made (a run stopped between flushes, an older file)."""
+        """The series of an open result file: a small one with its values, a larger one
+        after making the per-frame views its writer has not made (a run stopped between
+        flushes, an older file)."""
         times = h5["dynamic/time"]
-        nframes = h5["dynamic/mesh_nodes"].shape[0]
-        rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(nframes)
-        nframes = min(nframes, int(np.searchsorted(rows, len(times))))
+        nodes = h5["dynamic/mesh_nodes"]
+        stored, npoints = nodes.shape[0], nodes.shape[1]
+        rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(stored)
+        nframes = min(stored, int(np.searchsorted(rows, len(times))))
         rows = rows[:nframes]
-        add_step_views(h5, 0, nframes, existing=True)
-        return cls(rows, times[()][rows] if nframes else np.zeros(0),
-                   h5["dynamic/mesh_nodes"].shape[0], _topology_of(h5),
-                   "dynamic/mesh_displacement" in h5, "dynamic/mesh_von_mises_max" in h5)
+        displacement = "dynamic/mesh_displacement" in h5
+        values = None
+        if inline(npoints, nframes):
+            values = (nodes[0] if nframes else np.zeros((npoints, 3)),
+                      h5["dynamic/mesh_displacement"][:nframes] if displacement else None)
+        else:
+            add_step_views(h5, 0, nframes, existing=True)
+        return cls(rows, times[()][rows] if nframes else np.zeros(0), stored, _topology_of(h5),
+                   displacement, "dynamic/mesh_von_mises_max" in h5, values)
 
     def xml(self, h5_name: str) -> str:
         """The XDMF 3 text: a temporal collection of one uniform grid per frame, built as
@@ -299,12 +337,16 @@ class Series:
         for k, (row, time) in enumerate(zip(self.rows, self.times)):
             motion = ""
             if self.displacement:
+                shift = _values(self.values[1][k]) if self.values is not None else \
+                    _item((npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
                 motion = ('<Attribute Name="displacement" AttributeType="Vector" '
-                          'Center="Node">'
-                          f'{_item((npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")}'
-                          "</Attribute>")
-            where = _item((npoints, 3), name, f"/{_STEPS_GROUP}/position/0") if k == 0 \
-                else _row_item(k, self.stored, npoints, name, "/dynamic/mesh_nodes")
+                          f'Center="Node">{shift}</Attribute>')
+            if k > 0:
+                where = _row_item(k, self.stored, npoints, name, "/dynamic/mesh_nodes")
+            elif self.values is not None:
+                where = _values(self.values[0])
+            else:
+                where = _item((npoints, 3), name, f"/{_STEPS_GROUP}/position/0")
             grids.append(
                 f'\n<Grid Name="step {row}" GridType="Uniform"><Time Value="{time:.17g}"/>'
                 f'{topology}<Geometry GeometryType="XYZ">{where}</Geometry>'
