@@ -315,3 +315,23 @@ def test_rewriting_the_description_makes_only_the_missing_views(tmp_path, monkey
         assert h5["dynamic/xdmf/position/0"].attrs["units"] == "m"
     assert len(frames) == 6
     np.testing.assert_array_equal(points, nodes[0])
+
+
+def test_a_run_with_its_description_opens_its_file_three_times(tmp_path, monkeypatch):
+    """The description is made in the run's last opening of its file (it was closed and
+    opened once more for it): create; static results and the dynamic set-up; the rows,
+    the status and the description (tests/test_fixed_cost.py counts the same without it)."""
+    opened = []
+    real = h5py.File
+
+    class Counted(real):
+        def __init__(self, name, mode="r", *args, **kwargs):
+            opened.append((Path(name).name, mode))
+            super().__init__(name, mode, *args, **kwargs)
+    monkeypatch.setattr(h5py, "File", Counted)
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.05"], out,
+              progress=False)
+    monkeypatch.undo()
+    assert opened == [("boom.h5", "w-"), ("boom.h5", "a"), ("boom.h5", "a")]
+    assert out.with_suffix(".xdmf").exists()
