@@ -158,7 +158,7 @@ def test_failing_xdmf_is_a_warning(tmp_path, capsys, monkeypatch):
 
     def broken(*_args, **_kwargs):
         raise OSError("disk full")
-    monkeypatch.setattr(xdmf, "write_xdmf", broken)
+    monkeypatch.setattr(xdmf, "write_series", broken)
     out = tmp_path / "fb.h5"
     assert _run(SCENES / "four_bar.nml", out, "solver.t_end=0.01") == 0
     assert "XDMF description" in capsys.readouterr().err

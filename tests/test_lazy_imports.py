@@ -3,13 +3,21 @@ scipy.sparse.linalg cost ~9 MB of the run's peak memory and scipy.sparse's impor
 (numpy.testing, unittest, numpy.f2py) ~19 MB (issue 23, benchmarks/peer_cantilever.py);
 only the static, modal, buckling and FFR-reduction analyses and eliminated joints'
 reactions use them. Nor does a run import matplotlib or the plots. The modules that import
-them lazily still reach them when they are needed."""
+them lazily still reach them when they are needed.
+
+Issue 38 (a command's start): ``ancf --help`` imports neither numpy, h5py nor the package's
+system (the package's names are imported on first use), and ``ancf run`` of a dynamic scene
+imports neither the Python analyses (ancfdrv.analyses, the Results reader), the modal and
+buckling solvers nor ElementTree (the XDMF is written as text); System's analyses still
+load on its first analysis, however System was imported."""
 from __future__ import annotations
 
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
+
+import pytest
 
 from ancfdrv._lazy import LazyModule
 
@@ -73,3 +81,67 @@ def test_lazy_module_imports_on_first_use():
         pass
     else:
         raise AssertionError("dunder lookups must not import")
+
+
+def _modules_after(code: str, cwd: Path = ROOT) -> list[str]:
+    done = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], capture_output=True,
+                          text=True, timeout=120, cwd=cwd)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return eval(done.stdout.strip().splitlines()[-1])  # noqa: S307 - our own list literal
+
+
+def test_help_imports_no_numpy_nor_the_system():
+    found = _modules_after("""
+        import sys
+        import ancfdrv.cli
+        for argv in (["--help"], ["run", "--help"]):
+            try:
+                ancfdrv.cli.main(argv)
+            except SystemExit as stop:
+                assert stop.code == 0, stop.code
+        print(sorted(m for m in sys.modules if m.split(".")[0] in ("numpy", "h5py", "scipy")
+                     or m.startswith(("ancfdrv.system", "ancfdrv.results", "ancfdrv.runner"))))
+    """)
+    assert found == []
+
+
+def test_a_command_line_run_imports_only_what_it_runs(tmp_path):
+    found = _modules_after(f"""
+        import sys
+        from ancfdrv.cli import main
+        assert main(["run", "inputs/boom_luffing.nml", "-o", {str(tmp_path / "b.h5")!r},
+                     "--set", "beam.nodes=4", "--set", "solver.t_end=0.05"]) == 0
+        assert "ancfdrv.runner" in sys.modules and "ancfdrv.results.xdmf" in sys.modules
+        print(sorted(m for m in sys.modules if m in (
+            "ancfdrv.analyses", "ancfdrv.results.reader", "ancfdrv.simulation",
+            "ancfdrv.solvers.modal", "ancfdrv.solvers.buckling", "xml.etree.ElementTree")))
+    """)
+    assert found == []
+    assert (tmp_path / "b.h5").exists() and (tmp_path / "b.xdmf").exists()
+
+
+def test_system_analyses_load_on_first_use():
+    """System imported from its own module (not through ``ancfdrv``): its first analysis
+    loads ancfdrv.analyses, and the static sag of a cantilever under its tip force is
+    P L^3 / 3 E I (Euler-Bernoulli, within 2e-3 as in tests/test_results_api.py: the
+    beam's shear flexibility adds ~1e-3)."""
+    found = _modules_after("""
+        import sys
+        from ancfdrv.system import Rectangle, System
+        assert "ancfdrv.analyses" not in sys.modules
+        s = System("cantilever")
+        steel = s.material("steel", youngs_modulus=2.1e11, density=7850.0)
+        s.beam("arm", material=steel, start=(0, 0, 0), end=(2.0, 0, 0), nodes=5,
+               section=Rectangle(0.05, 0.1), height_axis=(0, 1, 0), formulation="nonlinear",
+               bending="cubic")
+        s.joint("root", "weld", "ground", "arm", point=(0, 0, 0))
+        s.load("tip", "force", body="arm", point=(2.0, 0, 0), vector=(0, -100.0, 0))
+        s.probe("end", "arm", (2.0, 0, 0))
+        res = s.static()
+        import ancfdrv
+        assert ancfdrv.System is System and ancfdrv.open is ancfdrv.open_results
+        print([float(res.deflection["end"][1]), "ancfdrv.analyses" in sys.modules])
+    """)
+    sag = 100.0 * 2.0**3 / (3 * 2.1e11 * 0.05 * 0.1**3 / 12)
+    assert found[1] is True
+    assert found[0] == pytest.approx(-sag, rel=2e-3)

@@ -252,8 +252,11 @@ def test_pattern_finds_every_entry_and_keeps_per_entry_arrays_of_small_ones(keep
 def test_bounded_flushes_keep_the_xdmf_frames_and_file(tmp_path, monkeypatch):
     """The plate pendulum's XDMF frames (node positions at frame rows, per-frame views)
     waiting in buffers of ~4 rows and kernel calls of 3 steps give the file and the .xdmf
-    description of a run written at its end, bit for bit."""
-    from ancfdrv.results import hdf5
+    description of a run written at its end, bit for bit. (Its 21 frames of 9 points would
+    be carried inline: the inline limit is set to 0 so that the flushes make the views.)"""
+    from ancfdrv.results import hdf5, xdmf
+
+    monkeypatch.setattr(xdmf, "INLINE_VALUES", 0)
 
     scene, sets = ROOT / "inputs" / "plate_pendulum.nml", ["solver.t_end=0.02"]
     monkeypatch.setattr(hdf5, "FLUSH_SECONDS", 1e9)
@@ -278,6 +281,7 @@ def test_bounded_flushes_keep_the_xdmf_frames_and_file(tmp_path, monkeypatch):
     assert len(flushes) >= 5 and max(flushes) <= 6   # the bound and one call's rows
     whole, bounded = _datasets(tmp_path / "whole.h5"), _datasets(tmp_path / "bounded.h5")
     assert set(whole) == set(bounded) and "dynamic/mesh_nodes" in whole
+    assert "dynamic/xdmf/displacement/20" in whole
     assert whole["dynamic/mesh_nodes"][1][0] > 3
     for name in whole:
         assert whole[name] == bounded[name], name

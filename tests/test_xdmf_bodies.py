@@ -226,7 +226,8 @@ def test_sweep_cases_have_xdmf_naming_their_final_file(tmp_path):
     for row in rows:
         h5_path = Path(row["file"])
         root = ET.parse(h5_path.with_suffix(".xdmf")).getroot()
-        texts = {item.text.split(":")[0] for item in root.iter("DataItem")}
+        texts = {item.text.split(":")[0] for item in root.iter("DataItem")
+                 if item.get("Format") == "HDF"}
         assert texts == {h5_path.name}
         points, cells, frames = read_series(h5_path.with_suffix(".xdmf"))
         assert len(frames) == 11 and cells[0].type == "line"
@@ -467,3 +468,113 @@ def test_saved_modal_result_keeps_its_shapes_xdmf(crane, tmp_path):
     copy = ancfdrv.open(crane).save(tmp_path / "copy.h5", plot=False)
     assert copy.with_suffix(".xdmf").read_text() == \
         crane.with_suffix(".xdmf").read_text().replace("crane.h5", "copy.h5")
+
+
+def values(item: ET.Element, h5: h5py.File) -> np.ndarray:
+    """A DataItem's values as the XDMF model defines them (what ParaView reads): inline
+    text (Format XML), a plain HDF item's dataset, or a HyperSlab's rows (its first child
+    the start, stride and count per dimension, its second the dataset)."""
+    dims = [int(d) for d in item.get("Dimensions").split()]
+    if item.get("ItemType") == "HyperSlab":
+        slab, source = list(item)
+        assert slab.get("Format") == "XML" and source.get("Format") == "HDF"
+        start, stride, count = np.array(slab.text.split(), dtype=int).reshape(3, -1)
+        data = values(source, h5)
+        assert dims == list(count)
+        return data[tuple(slice(a, a + s * (n - 1) + 1, s)
+                          for a, s, n in zip(start, stride, count))]
+    if item.get("Format") == "XML":
+        return np.array([float(v) for v in item.text.split()]).reshape(dims)
+    assert item.get("Format") == "HDF"
+    data = h5[item.text.split(":", 1)[1]][()]
+    assert list(data.shape) == dims
+    return data
+
+
+@pytest.mark.parametrize("views", [False, True], ids=["inline", "views"])
+def test_every_frame_gives_its_row_of_the_stored_positions(views, tmp_path, monkeypatch):
+    """ParaView reads each frame's Geometry item, meshio the first frame's points and each
+    frame's displacement: both must give /dynamic/mesh_nodes of that frame, at its time,
+    exactly. 11 frames of 4 points are carried inline; with the inline limit at 0 the
+    same series names one view per frame (the displacement meshio reads), not two."""
+    from ancfdrv.results import xdmf
+    if views:
+        monkeypatch.setattr(xdmf, "INLINE_VALUES", 0)
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.5",
+                                            "output.xdmf_frames=11"], out, progress=False)
+    grids = ET.parse(out.with_suffix(".xdmf")).getroot().findall("./Domain/Grid/Grid")
+    points, _, frames = read_series(out.with_suffix(".xdmf"))
+    with h5py.File(out) as h5:
+        nodes = h5["dynamic/mesh_nodes"][()]
+        shifts = h5["dynamic/mesh_displacement"][()]
+        times = h5["dynamic/time"][()][h5["dynamic/mesh_rows"][()]]
+        assert len(grids) == len(frames) == len(nodes) == 11
+        for k, grid in enumerate(grids):
+            np.testing.assert_array_equal(
+                values(grid.find("./Geometry/DataItem"), h5).reshape(-1, 3), nodes[k])
+            np.testing.assert_array_equal(
+                values(grid.find("./Attribute[@Name='displacement']/DataItem"), h5),
+                shifts[k])
+            assert float(grid.find("Time").get("Value")) == times[k]
+        if views:
+            assert list(h5["dynamic/xdmf/position"]) == ["0"]
+            assert len(h5["dynamic/xdmf/displacement"]) == 11
+        else:
+            assert "xdmf" not in h5["dynamic"]
+    np.testing.assert_array_equal(points, nodes[0])
+    assert [t for t, _ in frames] == list(times)
+    for k in range(len(frames)):
+        np.testing.assert_array_equal(frames[k][1], shifts[k])
+
+
+def test_rewriting_the_description_makes_only_the_missing_views(tmp_path, monkeypatch):
+    """write_xdmf on a file whose views are partly missing (an older or stopped file)
+    makes the missing ones, each the row of its frame, and names all of them."""
+    from ancfdrv.results import xdmf
+    monkeypatch.setattr(xdmf, "INLINE_VALUES", 0)
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.05",
+                                            "output.xdmf_frames=6"], out, progress=False)
+    with h5py.File(out, "a") as h5:
+        for k in ("0", "2", "5"):
+            del h5[f"dynamic/xdmf/displacement/{k}"]
+        del h5["dynamic/xdmf/position/0"]
+        assert len(h5["dynamic/xdmf/displacement"]) == 3
+    out.with_suffix(".xdmf").unlink()
+    xdmf.write_xdmf(out)
+    points, _, frames = read_series(out.with_suffix(".xdmf"))
+    grids = ET.parse(out.with_suffix(".xdmf")).getroot().findall("./Domain/Grid/Grid")
+    with h5py.File(out) as h5:
+        nodes = h5["dynamic/mesh_nodes"][()]
+        shifts = h5["dynamic/mesh_displacement"][()]
+        assert list(h5["dynamic/xdmf/position"]) == ["0"]
+        assert sorted(h5["dynamic/xdmf/displacement"], key=int) == [str(k) for k in range(6)]
+        for k in range(6):
+            np.testing.assert_array_equal(h5[f"dynamic/xdmf/displacement/{k}"][()], shifts[k])
+            assert h5[f"dynamic/xdmf/displacement/{k}"].attrs["units"] == "m"
+            np.testing.assert_array_equal(
+                values(grids[k].find("./Geometry/DataItem"), h5).reshape(-1, 3), nodes[k])
+        assert h5["dynamic/xdmf/position/0"].attrs["units"] == "m"
+    assert len(frames) == 6
+    np.testing.assert_array_equal(points, nodes[0])
+
+
+def test_a_run_with_its_description_opens_its_file_three_times(tmp_path, monkeypatch):
+    """The description is made in the run's last opening of its file (it was closed and
+    opened once more for it): create; static results and the dynamic set-up; the rows,
+    the status and the description (tests/test_fixed_cost.py counts the same without it)."""
+    opened = []
+    real = h5py.File
+
+    class Counted(real):
+        def __init__(self, name, mode="r", *args, **kwargs):
+            opened.append((Path(name).name, mode))
+            super().__init__(name, mode, *args, **kwargs)
+    monkeypatch.setattr(h5py, "File", Counted)
+    out = tmp_path / "boom.h5"
+    run_scene(INPUTS / "boom_luffing.nml", ["beam.nodes=4", "solver.t_end=0.05"], out,
+              progress=False)
+    monkeypatch.undo()
+    assert opened == [("boom.h5", "w-"), ("boom.h5", "a"), ("boom.h5", "a")]
+    assert out.with_suffix(".xdmf").exists()

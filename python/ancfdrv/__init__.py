@@ -25,25 +25,43 @@ _os.environ.setdefault("OMP_WAIT_POLICY", "passive")
 
 from ._version import __version__  # noqa: E402,F401
 
-from .system import (Beam, Box, Cable, Circle, Constant, Cycle, General, Leaf, Luffing,  # noqa: E402
-                     Material, Model, Plate, Ramp, Rectangle, RigidBody, Sine, SpinUp, Standard,
-                     System, Table, Tube)
+import importlib as _importlib  # noqa: E402
 
-from .results import Results, open_results  # noqa: E402
-from . import analyses as _analyses  # noqa: E402,F401  (gives System its analyses)
+from . import _lazy  # noqa: E402
 
-#: ``ancfdrv.open(path)``: any result file as :class:`~ancfdrv.results.Results`
-open = open_results  # noqa: A001 - the package's own name, as SPEC section 10 spells it
+# System's analyses (System.static, simulate, modes, buckling) live in ancfdrv.analyses,
+# above the system layer: it is named here, at the top, and imported on the first analysis
+_lazy.provide("analyses", "ancfdrv.analyses")
 
+#: the public names, each imported from its module on first use (``ancf run --help`` and
+#: ``ancf info`` import neither the system nor the solvers)
+_EXPORTS = {
+    **{name: ".system" for name in (
+        "Beam", "Box", "Cable", "Circle", "Constant", "Cycle", "General", "Leaf", "Luffing",
+        "Material", "Model", "Plate", "Ramp", "Rectangle", "RigidBody", "Sine", "SpinUp",
+        "Standard", "System", "Table", "Tube")},
+    "Results": ".results", "open_results": ".results",
+    #: ``ancfdrv.open(path)``: any result file as :class:`~ancfdrv.results.Results`
+    "open": ".results",
+    "simulate": ".simulation", "Simulation": ".simulation",
+}
 
 
 def __getattr__(name: str):
-    """``ancfdrv.simulate`` and ``ancfdrv.Simulation`` (:mod:`ancfdrv.simulation`: a scene
-    run with its results kept in memory), imported on first use."""
-    if name in ("simulate", "Simulation"):
-        from . import simulation
-        return getattr(simulation, name)
-    raise AttributeError(f"module 'ancfdrv' has no attribute {name!r}")
+    """The public names of :data:`_EXPORTS`, imported on first use: the system API, the
+    result reader and ``ancfdrv.simulate`` / ``ancfdrv.Simulation``
+    (:mod:`ancfdrv.simulation`: a scene run with its results kept in memory)."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'ancfdrv' has no attribute {name!r}")
+    value = getattr(_importlib.import_module(module, __name__),
+                    "open_results" if name == "open" else name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})
 
 
 __all__ = ["simulate", "Simulation", "open", "open_results", "Results", "System", "Model", "Material", "Beam", "Cable",

@@ -18,7 +18,8 @@ of the scene groups ``&solver`` and ``&output`` is a keyword with the schema's d
 
 The system layer sits below the solvers and the writers, so :class:`System` does not import
 them: this module registers the analyses (``System.static``, ``simulate``, ``modes``,
-``buckling``) when the package is imported.
+``buckling``) when it is imported, which the first analysis of a System does (the package's
+``__init__`` names this module to it, :func:`ancfdrv._lazy.provide`).
 """
 from __future__ import annotations
 

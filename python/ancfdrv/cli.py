@@ -27,12 +27,9 @@ import datetime as _dt
 import os
 import signal
 import sys
-import tempfile
 import threading
 import traceback
 from pathlib import Path
-
-import numpy as np
 
 from ._version import __version__
 from .errors import PROGRAMMING_ERRORS, AncfError, InputError, Interrupted
@@ -161,6 +158,7 @@ INFO_ARRAY_VALUES = 8
 
 def _info_value(value: object) -> object:
     """An array figure as text, cut after INFO_ARRAY_VALUES values with a mark."""
+    import numpy as np
     if not isinstance(value, np.ndarray):
         return value
     flat = value.ravel()
@@ -172,6 +170,7 @@ def _info_value(value: object) -> object:
 
 def json_ready(value: object) -> object:
     """A summary or answers value as plain JSON types (arrays as lists, whole)."""
+    import numpy as np
     if isinstance(value, dict):
         return {str(k): json_ready(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -359,6 +358,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _trace_file(command: str) -> Path:
     """Write the current exception's trace to a new file in the temporary directory."""
+    import tempfile
     stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     fd, name = tempfile.mkstemp(prefix=f"ancf-{command}-{stamp}-", suffix=".trace.txt")
     with os.fdopen(fd, "w") as f:

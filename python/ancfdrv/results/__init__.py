@@ -6,6 +6,15 @@ result object of :meth:`System.static` / :meth:`System.simulate` and ``ancfdrv.o
 builders and the runner."""
 from __future__ import annotations
 
-from .reader import Analysis, Record, Results, open_results
+from typing import Any
 
 __all__ = ["Analysis", "Record", "Results", "open_results"]
+
+
+def __getattr__(name: str) -> Any:
+    """The result object's names from :mod:`.reader`, imported on first use (a run writes
+    its file with :mod:`.hdf5` and never reads it back as :class:`Results`)."""
+    if name in __all__:
+        from . import reader
+        return getattr(reader, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

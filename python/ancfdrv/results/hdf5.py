@@ -644,22 +644,31 @@ def finish(path: Path, model: Model, timing: dict[str, float], status: str,
             _attrs(h5["dynamic"].attrs, {"status": status})
         has_motion = ("dynamic/mesh_nodes" in h5 and "dynamic/time" in h5
                       and len(h5["dynamic/time"]) > 0)
+        series = None
         if has_motion:
             _last_frame(h5, model)
-    if has_motion:
-        from .xdmf import write_xdmf
-        drop(path)  # write_xdmf opens the file itself
+            from .xdmf import Series, xdmf_target, write_series
+            try:  # described in this opening of the file (its views made), written after
+                target = xdmf_target(path)
+                series = Series.of(h5)
+            except Exception as exc:  # noqa: BLE001 - an optional output never fails a run
+                _no_xdmf(model, path, exc)
+    if series is not None:
         try:
-            write_xdmf(path)
-        except Exception as exc:  # noqa: BLE001 - an optional output never fails a good run
-            model.warnings.append(f"the XDMF description of {path} was not written: "
-                                  f"{type(exc).__name__}: {exc}")
+            write_series(series, target)
+        except Exception as exc:  # noqa: BLE001 - an optional output never fails a run
+            _no_xdmf(model, path, exc)
+
+
+def _no_xdmf(model: Model, path: Path, exc: Exception) -> None:
+    model.warnings.append(f"the XDMF description of {path} was not written: "
+                          f"{type(exc).__name__}: {exc}")
 
 
 def _last_frame(h5: h5py.File, model: Model) -> None:
     """A run that stopped (failure, interrupt) between XDMF frames: its last row becomes
     a frame too (from the stored q or q_last), so the motion ends where the run ended."""
-    from .xdmf import MeshLayout, add_step_views
+    from .xdmf import MeshLayout
     group = h5["dynamic"]
     last = len(group["time"]) - 1
     if "q" in group and len(group["q"]) == last + 1:
@@ -681,8 +690,7 @@ def _last_frame(h5: h5py.File, model: Model) -> None:
     for name, values in (("mesh_nodes", nodes),
                          ("mesh_displacement", nodes - layout.points[None, :, :]),
                          ("mesh_rows", np.array([last]))):
-        _append_rows(group.id, name, k, values)
-    add_step_views(h5, k, k + 1)
+        _append_rows(group.id, name, k, values)   # (its view, if any: xdmf.Series.of)
 
 
 def _text(value: Any) -> Any:
@@ -903,7 +911,7 @@ class DynamicWriter:
         at most ``frames`` of the ``total_rows`` rows the run will write
         (:func:`~.xdmf.frame_rows`)."""
         from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
-        from .xdmf import MeshLayout, frame_rows, write_layout
+        from .xdmf import MeshLayout, frame_count, frame_rows, inline, write_layout
         self.path, self.names, self.store_q = path, list(model.probes), store_q
         self.write_q = store_q if write_q is None else bool(write_q and store_q)
         self.flush_rows = max(1, int(flush_rows))
@@ -916,6 +924,10 @@ class DynamicWriter:
         self.nnodes = self.layout.npoints if self.layout is not None else 0
         self.stride, self.last_row = frame_rows(total_rows, frames) if total_rows > 0 \
             else (1, -1)
+        # the per-frame views a larger series' XDMF description names, made at each flush
+        # (a small one carries its values inline: :func:`~.xdmf.inline`)
+        self.views = bool(self.nnodes) and (
+            total_rows <= 0 or not inline(self.nnodes, frame_count(total_rows, frames)))
         self.frames = 0
         self.energy_names = ENERGY_NAMES
         self.rows = 0
@@ -1159,7 +1171,7 @@ class DynamicWriter:
             if self._unmade():
                 self._make_rest(group)
             _attrs(group.attrs, {"rows": np.int64(self.rows)})
-            if self.nnodes:  # the per-frame views the XDMF description names
+            if self.views:
                 from .xdmf import add_step_views
                 add_step_views(h5, first, self.frames)
         self._pending, self._pending_rows, self._pending_bytes = [], 0, 0

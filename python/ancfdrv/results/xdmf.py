@@ -32,21 +32,31 @@ from the stored coordinates: q of each step expanded to the full coordinates
 (:meth:`Model.expand`), mapped by the sparse matrix of :class:`MeshLayout` plus its
 constant offset.
 
-Every DataItem is a plain ``Format="HDF"`` item naming one dataset, which is what both
-ParaView's XDMF 3 reader and meshio's ``meshio.xdmf.TimeSeriesReader`` understand (meshio
-reads neither HyperSlab nor Function items). The per-frame items are HDF5 virtual datasets,
-``/dynamic/xdmf/position/<k>`` and ``/dynamic/xdmf/displacement/<k>``, that map row k of
-``/dynamic/mesh_nodes`` and ``/dynamic/mesh_displacement``: no data is copied (the dynamic
-writer adds them as frames are written, :func:`add_step_views`). meshio reads the geometry
-of the first frame only: the motion is in the ``displacement`` attribute of every frame.
-The XML is built with ElementTree, so any file name (``&``, ``<``, quotes) gives valid XML;
-a ``:`` in the HDF5 file name cannot be expressed in XDMF's ``file:/path`` notation and is
-refused.
+meshio's ``meshio.xdmf.TimeSeriesReader`` reads only plain ``Format="HDF"`` items naming
+one whole dataset (its readers require ``Format`` on every DataItem: no HyperSlab, no
+Function), and of the geometry only the first frame's; ParaView's XDMF 3 reader reads every
+frame's geometry and attributes, HyperSlab items included. So:
+
+* a small series (at most :data:`INLINE_VALUES` values of displacement over all frames: a
+  boom or a pendulum at the default 250 frames) carries the first frame's points and
+  every frame's displacement inline, as ``Format="XML"`` items (the shortest decimal text
+  that reads back as the same double), with no HDF5 object per frame;
+* a larger one names HDF5 virtual datasets, ``/dynamic/xdmf/position/0`` and
+  ``/dynamic/xdmf/displacement/<k>``, that map row k of ``/dynamic/mesh_nodes`` and
+  ``/dynamic/mesh_displacement``: no data is copied (the dynamic writer adds them as
+  frames are written, :func:`add_step_views`; each costs ~0.15 ms of CPU to make, plus
+  its share of the file's close);
+* the geometry of frame k >= 1 is a HyperSlab item, row k of ``/dynamic/mesh_nodes``.
+
+meshio shows the motion through the ``displacement`` attribute of every frame, ParaView
+through the geometry too.
+The XML is built as text with the file name escaped, so any file name (``&``, ``<``,
+quotes) gives valid XML; a ``:`` in the HDF5 file name cannot be expressed in XDMF's
+``file:/path`` notation and is refused.
 """
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -56,10 +66,13 @@ from h5py import h5a, h5d, h5p, h5s, h5t
 
 from ..csr import Csr
 from ..errors import InputError
-from ..io.safe_write import write_with
+from ..io.safe_write import write_text
 from ..system.registry import kind_of
 
 _STEPS_GROUP = "dynamic/xdmf"
+#: the most displacement values (3 per point and frame) a description carries inline
+#: (~20 bytes of text each: at most ~0.6 MB); larger series name per-frame views
+INLINE_VALUES = 30_000
 #: XDMF cell codes of a Mixed topology
 _QUAD, _LINE = 5, 2
 
@@ -216,6 +229,18 @@ def frame_rows(total_rows: int, frames: int) -> tuple[int, int]:
     return math.ceil((total_rows - 1) / (frames - 1)), total_rows - 1
 
 
+def frame_count(total_rows: int, frames: int) -> int:
+    """The frames :func:`frame_rows` shows of a run of ``total_rows`` rows."""
+    stride, last = frame_rows(total_rows, frames)
+    return last // stride + 1 + int(last % stride != 0)
+
+
+def inline(npoints: int, nframes: int) -> bool:
+    """Whether the description of ``nframes`` frames of ``npoints`` points carries the
+    points' data inline (:data:`INLINE_VALUES`) instead of naming per-frame views."""
+    return 3 * npoints * nframes <= INLINE_VALUES
+
+
 def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
     """/model/mesh: the initial points, the connectivity and what each point belongs to."""
     if "model/mesh" in h5:
@@ -240,28 +265,55 @@ def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
     group.attrs["bodies"] = "\n".join(layout.bodies)
 
 
-def _item(parent: ET.Element, dims: tuple[int, ...], h5_name: str, dataset: str,
-          number_type: str = "Float", precision: int = 8) -> ET.Element:
-    item = ET.SubElement(parent, "DataItem", Dimensions=" ".join(map(str, dims)),
-                         NumberType=number_type, Precision=str(precision), Format="HDF")
-    item.text = f"{h5_name}:{dataset}"
-    return item
+def _escape(text: str) -> str:
+    """``text`` as XML character data or a double-quoted attribute value."""
+    return (text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+            .replace('"', "&quot;"))
+
+
+def _item(dims: tuple[int, ...], h5_name: str, dataset: str, number_type: str = "Float",
+          precision: int = 8) -> str:
+    """A ``Format="HDF"`` DataItem naming ``dataset`` of ``h5_name`` (already escaped)."""
+    return (f'<DataItem Dimensions="{" ".join(map(str, dims))}" NumberType="{number_type}" '
+            f'Precision="{precision}" Format="HDF">{h5_name}:{_escape(dataset)}</DataItem>')
+
+
+def _topology_xml(kind: str, ncells: int, dims: tuple[int, ...], h5_name: str,
+                  dataset: str) -> str:
+    nodes = ' NodesPerElement="2"' if kind == "Polyline" else ""
+    return (f'<Topology TopologyType="{kind}" NumberOfElements="{ncells}"{nodes}>'
+            f'{_item(dims, h5_name, dataset, "Int")}</Topology>')
+
+
+def _document(grids: str) -> str:
+    return ('<?xml version="1.0" encoding="utf-8"?>\n<Xdmf Version="3.0"><Domain>'
+            f"{grids}</Domain></Xdmf>")
 
 
 def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = False) -> None:
-    """Virtual datasets /dynamic/xdmf/position/<k> = /dynamic/mesh_nodes[k] and
-    /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for frames
-    first <= k < stop, each with its source's ``units``. The dynamic writer calls this at
-    each flush, so the cost (~0.2 ms per view) is spread over the run and a stopped run
-    does not wait for it. (h5py's low-level API: its high-level VirtualLayout took ~1 ms
-    per view.) ``existing``: some of the views may exist already (an older file)."""
-    for source, name in (("dynamic/mesh_nodes", "position"),
-                         ("dynamic/mesh_displacement", "displacement")):
+    """Virtual datasets /dynamic/xdmf/displacement/<k> = /dynamic/mesh_displacement[k] for
+    frames first <= k < stop, and /dynamic/xdmf/position/0 = /dynamic/mesh_nodes[0] (the
+    geometry meshio reads) with the first frame, each with its source's ``units``: the
+    items of a series too large to carry inline (:func:`inline`). The dynamic writer calls
+    this at each flush, so the cost (~0.15 ms of CPU per view, most of it inside HDF5) is
+    spread over the run and a stopped run does not wait for it. (h5py's
+    low-level API: its high-level VirtualLayout took ~1 ms per view.) ``existing``: some of
+    the views may exist already (an older file): their names are listed once, not looked
+    up per view."""
+    for source, name, last in (("dynamic/mesh_nodes", "position", 1),
+                               ("dynamic/mesh_displacement", "displacement", stop)):
         if source not in h5:
             continue
         data = h5[source]
         shape = data.shape
+        stop_here = min(last, stop, shape[0])
+        if stop_here <= first:
+            continue
         group = h5.require_group(f"{_STEPS_GROUP}/{name}")
+        made = set(group) if existing and len(group) else set()
+        todo = [k for k in range(first, stop_here) if str(k) not in made]
+        if not todo:
+            continue
         selection = h5s.create_simple(shape)
         view_space = h5s.create_simple(shape[1:])
         dtype = data.id.get_type()
@@ -270,14 +322,29 @@ def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = Fal
         scalar = h5s.create(h5s.SCALAR)
         units = np.array(data.attrs.get("units", "m"), dtype=text)
         count = (1, *shape[1:])
-        for k in range(first, min(stop, shape[0])):
-            if existing and str(k) in group:
-                continue
+        source_name = ("/" + source).encode()
+        for k in todo:
             selection.select_hyperslab((k,) + (0,) * (len(shape) - 1), count)
             plist = h5p.create(h5p.DATASET_CREATE)
-            plist.set_virtual(view_space, b".", ("/" + source).encode(), selection)
+            plist.set_virtual(view_space, b".", source_name, selection)
             view = h5d.create(group.id, str(k).encode(), dtype, view_space, dcpl=plist)
             h5a.create(view, b"units", text_type, scalar).write(units)
+
+
+def _values(values: np.ndarray) -> str:
+    """An inline ``Format="XML"`` item of float64 values: each the shortest decimal text
+    that reads back as the same double (meshio and ParaView parse it with strtod)."""
+    dims = " ".join(map(str, values.shape))
+    text = " ".join(map(repr, values.ravel().tolist()))
+    return (f'<DataItem Dimensions="{dims}" NumberType="Float" Precision="8" Format="XML">'
+            f"{text}</DataItem>")
+
+
+def _row_item(k: int, rows: int, npoints: int, h5_name: str, dataset: str) -> str:
+    """A HyperSlab item: row k of the (rows, npoints, 3) dataset (start, stride, count)."""
+    return (f'<DataItem ItemType="HyperSlab" Dimensions="1 {npoints} 3">'
+            f'<DataItem Dimensions="3 3" NumberType="Int" Format="XML">{k} 0 0 1 1 1 1 '
+            f'{npoints} 3</DataItem>{_item((rows, npoints, 3), h5_name, dataset)}</DataItem>')
 
 
 def _topology_of(h5: h5py.File) -> tuple[str, tuple[int, ...], str, int, int]:
@@ -291,51 +358,101 @@ def _topology_of(h5: h5py.File) -> tuple[str, tuple[int, ...], str, int, int]:
     return "Quadrilateral", shape, "/model/elements", shape[0], len(h5["model/nodes"])
 
 
+@dataclass
+class Series:
+    """What the XDMF description of a dynamic run names: its frames (output rows and
+    times), its mesh and which per-point series the file holds."""
+
+    rows: np.ndarray          # the output row of each frame
+    times: np.ndarray         # (nframes,) s
+    stored: int               # the rows of /dynamic/mesh_nodes (>= the frames)
+    topology: tuple[str, tuple[int, ...], str, int, int]   # see _topology_of
+    displacement: bool        # /dynamic/mesh_displacement
+    stress_points: bool       # /dynamic/mesh_von_mises_max
+    #: a small series' first points (npoints, 3) and displacements (nframes, npoints, 3),
+    #: written inline (:func:`inline`); None: named as per-frame views
+    values: tuple[np.ndarray, np.ndarray | None] | None = None
+
+    @classmethod
+    def of(cls, h5: h5py.File) -> "Series":
+        """The series of an open result file: a small one with its values, a larger one
+        after making the per-frame views its writer has not made (a run stopped between
+        flushes, an older file)."""
+        times = h5["dynamic/time"]
+        nodes = h5["dynamic/mesh_nodes"]
+        stored, npoints = nodes.shape[0], nodes.shape[1]
+        rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(stored)
+        nframes = min(stored, int(np.searchsorted(rows, len(times))))
+        rows = rows[:nframes]
+        displacement = "dynamic/mesh_displacement" in h5
+        values = None
+        if inline(npoints, nframes):
+            values = (nodes[0] if nframes else np.zeros((npoints, 3)),
+                      h5["dynamic/mesh_displacement"][:nframes] if displacement else None)
+        else:
+            add_step_views(h5, 0, nframes, existing=True)
+        return cls(rows, times[()][rows] if nframes else np.zeros(0), stored, _topology_of(h5),
+                   displacement, "dynamic/mesh_von_mises_max" in h5, values)
+
+    def xml(self, h5_name: str) -> str:
+        """The XDMF 3 text: a temporal collection of one uniform grid per frame, built as
+        text (an ElementTree of the same grids took ~0.2 ms per frame to build and write).
+        ``h5_name``: the HDF5 file's name, already checked for ``:``."""
+        kind, dims, topology_data, ncells, npoints = self.topology
+        name = _escape(h5_name)
+        topology = _topology_xml(kind, ncells, dims, name, topology_data)
+        stress = ""
+        if self.stress_points:  # the run's von Mises envelope at the beam nodes (Pa)
+            stress = ('<Attribute Name="von_mises_max" AttributeType="Scalar" Center="Node">'
+                      f'{_item((npoints,), name, "/dynamic/mesh_von_mises_max")}</Attribute>')
+        grids = []
+        for k, (row, time) in enumerate(zip(self.rows, self.times)):
+            motion = ""
+            if self.displacement:
+                shift = _values(self.values[1][k]) if self.values is not None else \
+                    _item((npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
+                motion = ('<Attribute Name="displacement" AttributeType="Vector" '
+                          f'Center="Node">{shift}</Attribute>')
+            if k > 0:
+                where = _row_item(k, self.stored, npoints, name, "/dynamic/mesh_nodes")
+            elif self.values is not None:
+                where = _values(self.values[0])
+            else:
+                where = _item((npoints, 3), name, f"/{_STEPS_GROUP}/position/0")
+            grids.append(
+                f'\n<Grid Name="step {row}" GridType="Uniform"><Time Value="{time:.17g}"/>'
+                f'{topology}<Geometry GeometryType="XYZ">{where}</Geometry>'
+                f"{motion}{stress}</Grid>")
+        return _document('<Grid Name="motion" GridType="Collection" '
+                         f'CollectionType="Temporal">{"".join(grids)}\n</Grid>')
+
+
+def xdmf_target(path: Path, as_name: Path | None = None) -> Path:
+    """The HDF5 file name the XDMF beside ``path`` names (``as_name`` when the file is
+    about to be moved there); refused with ':' in it (XDMF's ``file:/path`` notation
+    cannot express it)."""
+    target = Path(as_name) if as_name is not None else Path(path)
+    if ":" in target.name:
+        raise InputError("XDMF cannot name an HDF5 file with ':' in its name", file=str(path))
+    return target
+
+
+def write_series(series: Series, target: Path) -> Path:
+    """The XDMF file of ``series`` beside ``target`` (the HDF5 file it names)."""
+    out = target.with_suffix(".xdmf")
+    write_text(out, series.xml(target.name))
+    return out
+
+
 def write_xdmf(path: Path, as_name: Path | None = None) -> Path:
     """An XDMF file beside the HDF5 result of a dynamic run: one grid per frame at the
     points' positions of that step, with their displacement from t = 0; opens in ParaView
     as a time series. ``as_name``: the name the HDF5 file will have (it is about to be
     moved there); the XDMF is written beside that name and refers to it."""
-    path = Path(path)
-    target = Path(as_name) if as_name is not None else path
-    name = target.name
-    if ":" in name:
-        raise InputError("XDMF cannot name an HDF5 file with ':' in its name", file=str(path))
+    target = xdmf_target(path, as_name)
     with h5py.File(path, "a") as h5:
-        times = h5["dynamic/time"][()]
-        nframes = h5["dynamic/mesh_nodes"].shape[0]
-        rows = h5["dynamic/mesh_rows"][()] if "dynamic/mesh_rows" in h5 else np.arange(nframes)
-        nframes = min(nframes, int(np.searchsorted(rows, len(times))))
-        kind, dims, topology_data, ncells, npoints = _topology_of(h5)
-        add_step_views(h5, 0, nframes, existing=True)  # those the writer has not made
-        displacement = "dynamic/mesh_displacement" in h5
-        stress_points = "dynamic/mesh_von_mises_max" in h5
-    root = ET.Element("Xdmf", Version="3.0")
-    domain = ET.SubElement(root, "Domain")
-    series = ET.SubElement(domain, "Grid", Name="motion", GridType="Collection",
-                           CollectionType="Temporal")
-    for k in range(nframes):
-        grid = ET.SubElement(series, "Grid", Name=f"step {rows[k]}", GridType="Uniform")
-        ET.SubElement(grid, "Time", Value=f"{times[rows[k]]:.17g}")
-        topology = ET.SubElement(grid, "Topology", TopologyType=kind,
-                                 NumberOfElements=str(ncells))
-        if kind == "Polyline":
-            topology.set("NodesPerElement", "2")
-        _item(topology, dims, name, topology_data, "Int")
-        geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
-        _item(geometry, (npoints, 3), name, f"/{_STEPS_GROUP}/position/{k}")
-        if displacement:
-            attribute = ET.SubElement(grid, "Attribute", Name="displacement",
-                                      AttributeType="Vector", Center="Node")
-            _item(attribute, (npoints, 3), name, f"/{_STEPS_GROUP}/displacement/{k}")
-        if stress_points:  # the run's von Mises envelope at the beam nodes (Pa)
-            attribute = ET.SubElement(grid, "Attribute", Name="von_mises_max",
-                                      AttributeType="Scalar", Center="Node")
-            _item(attribute, (npoints,), name, "/dynamic/mesh_von_mises_max")
-    out = target.with_suffix(".xdmf")
-    write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
-                                                            xml_declaration=True))
-    return out
+        series = Series.of(h5)
+    return write_series(series, target)
 
 
 def write_mode_xdmf(path: Path, group: str, as_name: Path | None = None) -> Path:
@@ -387,21 +504,15 @@ def _one_grid(path: Path, title: str, geometry_data: str,
                          file=str(name))
     with h5py.File(path, "r") as h5:
         kind, dims, topology, ncells, npoints = _topology_of(h5)
-    h5_name = name.name
-    root = ET.Element("Xdmf", Version="3.0")
-    domain = ET.SubElement(root, "Domain")
-    grid = ET.SubElement(domain, "Grid", Name=title, GridType="Uniform")
-    topo = ET.SubElement(grid, "Topology", TopologyType=kind, NumberOfElements=str(ncells))
-    if kind == "Polyline":
-        topo.set("NodesPerElement", "2")
-    _item(topo, dims, h5_name, topology, "Int")
-    geometry = ET.SubElement(grid, "Geometry", GeometryType="XYZ")
-    _item(geometry, (npoints, 3), h5_name, geometry_data)
+    h5_name = _escape(name.name)
+    parts = [f'<Grid Name="{_escape(title)}" GridType="Uniform">',
+             _topology_xml(kind, ncells, dims, h5_name, topology),
+             '<Geometry GeometryType="XYZ">'
+             f'{_item((npoints, 3), h5_name, geometry_data)}</Geometry>']
     for label, dataset in attributes:
-        attribute = ET.SubElement(grid, "Attribute", Name=label, AttributeType="Vector",
-                                  Center="Node")
-        _item(attribute, (npoints, 3), h5_name, dataset)
+        parts.append(f'<Attribute Name="{_escape(label)}" AttributeType="Vector" Center="Node">'
+                     f'{_item((npoints, 3), h5_name, dataset)}</Attribute>')
+    parts.append("</Grid>")
     out = name.with_suffix(".xdmf")
-    write_with(out, lambda temp: ET.ElementTree(root).write(temp, encoding="utf-8",
-                                                            xml_declaration=True))
+    write_text(out, _document("\n".join(parts)))
     return out

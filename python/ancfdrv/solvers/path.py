@@ -43,8 +43,6 @@ import numpy as np
 from ..errors import InputError, SolverError
 from ..system.model import Model
 from .._lazy import LazyModule
-from .buckling import _lowest
-from .modal import DENSE_LIMIT, linearize, null_space
 from .static import LoadStepFailure, StaticResult, converged, solve_static
 
 sp = LazyModule("scipy.sparse")
@@ -85,6 +83,7 @@ class _State:
 
     def __init__(self, model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
                  floor: float = 0.0) -> None:
+        from .modal import linearize  # arc length only: a Newton solve imports no modal code
         n = model.ndof
         lin = linearize(model, e, lam, load_factor=factor)
         r0 = model.forces(e, load_factor=0.0)
@@ -123,6 +122,8 @@ class _State:
 def negative_eigenvalues(model: Model, state: _State) -> int:
     """The number of negative eigenvalues of the tangent on the constraints' null space
     (exact for models up to DENSE_LIMIT free coordinates; else among the lowest eight)."""
+    from .buckling import _lowest
+    from .modal import DENSE_LIMIT, null_space
     k, g = state.stiffness, state.constraints
     free = model.ndof - g.shape[0]
     if free <= DENSE_LIMIT:

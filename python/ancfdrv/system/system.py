@@ -31,6 +31,7 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
+from .. import _lazy
 from ..errors import InputError
 from ..io import validate
 from ..io.schema import (EFFECTS_AVAILABLE, REQUIRED, check_call, plain_value,
@@ -649,7 +650,7 @@ class System:
     _ANALYSES: dict[str, Callable[..., Any]] = {}
 
     def _analysis(self, name: str) -> Callable[..., Any]:
-        if name not in self._ANALYSES:  # only when ancfdrv.analyses was never imported
+        if name not in self._ANALYSES and not _lazy.load("analyses"):
             raise RuntimeError("import ancfdrv (the package) to run analyses")
         return self._ANALYSES[name]
 
