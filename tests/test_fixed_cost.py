@@ -38,7 +38,7 @@ def test_result_file_is_closed_while_the_run_computes(tmp_path, monkeypatch):
             seen[name] = _open_files()
             return real(*args, **kwargs)
         return call
-    monkeypatch.setattr(runner, "solve_static", watched("static", runner.solve_static))
+    monkeypatch.setattr(runner, "solve_static_path", watched("static", runner.solve_static_path))
     monkeypatch.setattr(runner, "integrate", watched("dynamic", runner.integrate))
     opens = []
     real_open = results._open_file

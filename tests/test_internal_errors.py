@@ -276,8 +276,8 @@ def test_a_section_that_is_not_one_is_refused():
     s.material("steel", youngs_modulus=2.1e11, density=7850.0)
     for call in ("beam", "cable"):
         with pytest.raises(InputError, match=rf"&{call}\[b\] section: expected a section "
-                                             r"\(Rectangle, Box, Tube, Circle or General\), "
-                                             "got 5"):
+                                             r"\(Rectangle, Box, Tube, Circle, General or a "
+                                             r"standard name such as 'IPE200'\), got 5"):
             getattr(s, call)("b", material="steel", start=(0, 0, 0), end=(1, 0, 0), nodes=3,
                              section=5)
 

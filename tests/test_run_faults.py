@@ -357,13 +357,13 @@ def test_sigkill_leaves_an_abandoned_file_and_no_blocking_lock(scene, tmp_path, 
 
 def test_interrupted_static_solve_is_marked(scene, tmp_path, monkeypatch, capsys):
     """SIGINT during a static solve (which cannot poll for it) ends it at once."""
-    real = runner.solve_static
+    real = runner.solve_static_path
 
     def signalled(*args, **kwargs):
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)  # the handler runs here and raises
         return real(*args, **kwargs)
-    monkeypatch.setattr(runner, "solve_static", signalled)
+    monkeypatch.setattr(runner, "solve_static_path", signalled)
     out = tmp_path / "static.h5"
     assert main(["run", str(scene), "-o", str(out), *TINY]) == 130
     err = capsys.readouterr().err
@@ -425,7 +425,7 @@ def test_info_verdicts_ok_and_failed(scene, tmp_path, capsys):
 def test_internal_error_is_one_line_with_a_trace_file(scene, tmp_path, monkeypatch, capsys):
     def broken(*args, **kwargs):
         raise RuntimeError("deliberate failure for the test")
-    monkeypatch.setattr(runner, "solve_static", broken)
+    monkeypatch.setattr(runner, "solve_static_path", broken)
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     out = tmp_path / "bug.h5"
     assert main(["run", str(scene), "-o", str(out), *TINY]) == 1
