@@ -22,7 +22,7 @@ module step_control
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, power_count, energy_count, &
                                contact_record
-  use stepper, only: stepper_run, control_settings, control_state
+  use stepper, only: stepper_run, stepper_settings, control_settings, control_state
   use time_integrator, only: integrator_chunk, newton_floor_stall
   use consistent_start, only: consistent_acceleration
   use kernel_errors, only: message_length
@@ -46,6 +46,9 @@ module step_control
   !> was rejected, cut back to that same remainder, forever). 1e-9 covers k ulps of t for
   !> k t / h up to ~4e6, far below the factor 2 between the sizes the control chooses.
   real(dp), parameter, public :: step_rtol = 1e-9_dp
+  !> a method without numerical damping (neutral_method) on a constrained system restarts
+  !> after this many whole steps at dt (see the module's notes)
+  integer, parameter, public :: neutral_restart_steps = 64
 
   !> A stepper state: t; e, e', a (the generalized-alpha variable), e''; lambda; the works
   !> and the powers at the state; the contact guesses and counters.
@@ -117,6 +120,13 @@ contains
           c%last_h = cs%dt
         end if
         n = min(nrows - done, budget - tries)
+        if (neutral_method(run%settings) .and. sys%ncon > 0) then
+          if (c%since_restart >= neutral_restart_steps) then
+            call restart(sys, run, p, info, failure)
+            if (info /= 0) return
+          end if
+          n = min(n, neutral_restart_steps - c%since_restart)
+        end if
         t_before = p%t
         call step_rows(sys, run, cs%dt, n, p, rows(:, done + 1:done + n), &
                        stats(1:3, done + 1:done + n), store_q, k, info, detail, last_correction, &
@@ -132,6 +142,7 @@ contains
           stats(4, done + j) = 1
         end do
         c%taken = c%taken + k
+        c%since_restart = c%since_restart + k
         if (k > 0) c%smallest = min(c%smallest, cs%dt)
         c%rows = c%rows + k
         done = done + k
@@ -286,6 +297,7 @@ contains
     run%control%restart_guesses = contact%guesses
     p%a = p%accel
     run%control%restarts = run%control%restarts + 1
+    run%control%since_restart = 0
   end subroutine restart
 
   !> n steps of size h from p (integrator_chunk) with their output rows in the row layout of
@@ -392,6 +404,15 @@ contains
       if (nanswer == 0) floor_accepts = floor
     end subroutine steps
   end subroutine step_rows
+
+  !> Whether the method leaves the infinite-frequency mode undamped (spectral radius 1 at
+  !> h omega -> infinity): generalized-alpha with alpha_m = alpha_f (rho_inf = 1) and
+  !> gamma = 1/2, Newmark's trapezoidal rule among them.
+  pure logical function neutral_method(cfg)
+    type(stepper_settings), intent(in) :: cfg
+    neutral_method = abs(cfg%alpha_m - cfg%alpha_f) <= 1e-12_dp .and. &
+                     abs(cfg%gamma - 0.5_dp) <= 1e-12_dp
+  end function neutral_method
 
   !> Kernel failures a smaller step may avoid (not: a constraint or drive that cannot be
   !> evaluated, a force element's, a refused call; not a Newton stall at the round-off floor).

@@ -106,6 +106,8 @@ module stepper
   type :: control_state
     real(dp) :: h = 0.0_dp, last_h = 0.0_dp, smallest = huge(1.0_dp)
     integer :: successes = 0, cuts = 0, rejected = 0, restarts = 0, taken = 0
+    ! whole steps at dt since the last restart (a neutral method's periodic restarts)
+    integer :: since_restart = 0
     logical :: started = .false.
     ! the output interval in progress (open) and what it has done so far
     logical :: open = .false.
