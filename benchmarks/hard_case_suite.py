@@ -13,7 +13,7 @@ Not yet in the grid (no shipped scene): the rope drop and throw and the driven c
 rope for 100 s of the issue.
 
 Writes benchmarks/results/hard_case_suite.json and prints the table of benchmarks/README.md.
-Usage: python benchmarks/hard_case_suite.py [--quick] [--only pendulum,double]
+Usage: python benchmarks/hard_case_suite.py [--quick] [--only pendulum,double] [--output JSON]
 """
 from __future__ import annotations
 
@@ -49,6 +49,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true")
     parser.add_argument("--only", default="pendulum,double")
+    parser.add_argument("--output", type=Path, default=HERE / "results" / "hard_case_suite.json")
     args = parser.parse_args()
     records = []
     references: dict = {}
@@ -64,8 +65,8 @@ def main() -> None:
                   f"{'-' if record['dissipated'] is None else format(record['dissipated'], '.1e')} | "
                   f"{record['corrections']} | {record['cuts']} | {record['wall_s']} |",
                   flush=True)
-    out = HERE / "results" / "hard_case_suite.json"
-    out.parent.mkdir(exist_ok=True)
+    out = args.output
+    out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(json_ready({"machine": machine_info(), "quick": args.quick,
                                           "runs": records}), indent=1))
     wrong = [r["case"] for r in records if r["class"] not in ("correct", "refused")]

@@ -75,6 +75,7 @@ BENCHES = [
           quick=("--cases", "boom4"), needs="valgrind"),
     Bench("stability", "long-run stability suite: completion, step cuts, energy balance",
           out=None, fixed=("stability.json", "stability.md")),
+    Bench("hard_case_suite", "hard cases of record: each run correct, refused or ok and wrong"),
     Bench("right_angle_cantilever", "right-angle cantilever (Simo & Vu-Quoc 1986), 0-30 s"),
     Bench("spatial_mechanism", "spatial slider-crank, both bending options, nu = 0 and 0.3"),
     Bench("flying_spaghetti", "3D flying spaghetti (Simo & Vu-Quoc 1988)", out="--out"),
