@@ -106,9 +106,6 @@ module stepper
   type :: control_state
     real(dp) :: h = 0.0_dp, last_h = 0.0_dp, smallest = huge(1.0_dp)
     integer :: successes = 0, cuts = 0, rejected = 0, restarts = 0, taken = 0
-    ! a neutral method's smallest alternation of the multipliers in a block of whole steps
-    ! since the last restart (step_control; -1: none measured yet)
-    real(dp) :: smallest_alternation = -1.0_dp
     logical :: started = .false.
     ! the output interval in progress (open) and what it has done so far
     logical :: open = .false.
