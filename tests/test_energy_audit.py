@@ -208,3 +208,20 @@ def test_a_well_posed_long_run_stays_ok(tmp_path):
     assert not [w for w in outcome.warnings if "energy" in w]
     with h5py.File(out) as h5:
         assert h5.attrs["status"] == "ok"
+
+
+def test_a_model_of_one_unknown_keeps_its_blocks_inside_it(tmp_path):
+    """The slide reduces to one unknown; the kernel's constraint blocks (3-vectors holding
+    every constrained coordinate) start at 0, not at ndof - 3 = -2: the factorization's
+    flexibility was written 16 bytes before its array and the heap was corrupted (a crash
+    one run in ten, in whichever test came next)."""
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.runner import build_model
+    scene = tmp_path / "slide.nml"
+    scene.write_text(SLIDE)
+    model = build_model(load_scene(scene))
+    try:
+        assert model.ndof == 1
+        assert model.touched_blocks().tolist() == [0]
+    finally:
+        model.close()

@@ -104,8 +104,7 @@ contains
     type(stepper_point) :: before
     real(dp) :: buffer(size(rows, 1), 1), t_before, h, remaining, error
     integer :: step_stats(3, 1), n, k, j, floor, max_tries, at_lambda
-    real(dp) :: swing
-    logical :: retry, finished, neutral
+    logical :: retry, finished, neutral, restart_now
     cs => run%control_settings
     c => run%control
     rows = 0.0_dp
@@ -130,10 +129,11 @@ contains
           call restart(sys, run, p, info, failure)
           if (info /= 0) return
           c%last_h = cs%dt
+          call block_reset(c)
         end if
         n = min(nrows - done, budget - tries)
         neutral = neutral_method(run%settings) .and. sys%ncon > 0
-        if (neutral) n = min(n, neutral_block_steps)
+        if (neutral) n = min(n, neutral_block_steps - c%block_steps)
         t_before = p%t
         call step_rows(sys, run, cs%dt, n, p, rows(:, done + 1:done + n), &
                        stats(1:3, done + 1:done + n), store_q, k, info, detail, last_correction, &
@@ -152,13 +152,18 @@ contains
         if (k > 0) c%smallest = min(c%smallest, cs%dt)
         c%rows = c%rows + k
         done = done + k
-        if (info == 0 .and. neutral .and. k >= 3) then
+        if (neutral) then
           at_lambda = 1 + 6 * sys%nprobe
-          swing = alternation(rows(at_lambda + 1:at_lambda + sys%ncon, done - k + 1:done))
-          if (swing > neutral_share * maxval(abs(rows(at_lambda + 1:at_lambda + sys%ncon, &
-                                                       done - k + 1:done)))) then
-            call restart(sys, run, p, info, failure)
-            if (info /= 0) return
+          call block_rows(c, rows(at_lambda + 1:at_lambda + sys%ncon, done - k + 1:done))
+          if (info /= 0) then
+            call block_reset(c)
+          else if (c%block_steps >= neutral_block_steps) then
+            restart_now = c%block_swing > neutral_share * c%block_peak
+            call block_reset(c)
+            if (restart_now) then
+              call restart(sys, run, p, info, failure)
+              if (info /= 0) return
+            end if
           end if
         end if
         if (info == 0) cycle
@@ -428,19 +433,37 @@ contains
                      abs(cfg%gamma - 0.5_dp) <= 1e-12_dp
   end function neutral_method
 
-  !> The amplitude of the period-2 part of the multipliers over consecutive rows (columns):
-  !> max |lambda_{n+1} - 2 lambda_n + lambda_{n-1}| / 4 (c (-1)^n gives c; a smooth history
-  !> ~h^2 lambda'').
-  pure real(dp) function alternation(lam) result(swing)
+  !> The block's record of whole-step rows (their multipliers, columns, in order): the
+  !> period-2 part of the multipliers, max |lambda_{n+1} - 2 lambda_n + lambda_{n-1}| / 4
+  !> (c (-1)^n gives c; a smooth history ~h^2 lambda''), over the block's consecutive rows
+  !> (those of earlier calls included), and the largest |lambda|.
+  pure subroutine block_rows(c, lam)
+    type(control_state), intent(inout) :: c
     real(dp), intent(in) :: lam(:, :)
-    integer :: n, i
-    swing = 0.0_dp
-    do n = 2, size(lam, 2) - 1
-      do i = 1, size(lam, 1)
-        swing = max(swing, abs(lam(i, n + 1) - 2.0_dp * lam(i, n) + lam(i, n - 1)) / 4.0_dp)
-      end do
+    integer :: n
+    if (.not. allocated(c%block_lambda)) then
+      allocate (c%block_lambda(size(lam, 1), 2))
+      c%block_lambda = 0.0_dp
+    end if
+    do n = 1, size(lam, 2)
+      if (c%block_held == 2) c%block_swing = max(c%block_swing, maxval(abs( &
+        lam(:, n) - 2.0_dp * c%block_lambda(:, 2) + c%block_lambda(:, 1))) / 4.0_dp)
+      c%block_peak = max(c%block_peak, maxval(abs(lam(:, n))))
+      c%block_lambda(:, 1) = c%block_lambda(:, 2)
+      c%block_lambda(:, 2) = lam(:, n)
+      c%block_held = min(c%block_held + 1, 2)
     end do
-  end function alternation
+    c%block_steps = c%block_steps + size(lam, 2)
+  end subroutine block_rows
+
+  !> A new block: after a full one, a failed step or a restart.
+  pure subroutine block_reset(c)
+    type(control_state), intent(inout) :: c
+    c%block_steps = 0
+    c%block_held = 0
+    c%block_swing = 0.0_dp
+    c%block_peak = 0.0_dp
+  end subroutine block_reset
 
   !> Kernel failures a smaller step may avoid (not: a constraint or drive that cannot be
   !> evaluated, a force element's, a refused call; not a Newton stall at the round-off floor).

@@ -169,7 +169,7 @@ contains
                 work%carry_column(sys%ndof), work%block_row(sys%ndof))
       work%block_row = 0
       do b = size(sys%block_first), 1, -1
-        do j = 0, 2
+        do j = 0, min(2, sys%ndof - sys%block_first(b))
           work%block_row(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
         end do
       end do

@@ -1255,7 +1255,7 @@ contains
     if (size(sys%block_first) == 0) return
     sys%flexibility = 0.0_dp
     do b = 1, size(sys%block_first)
-      do j = 1, 3
+      do j = 1, min(3, sys%ndof - sys%block_first(b) + 1)  ! (fewer than 3 unknowns left)
         sys%flexibility(sys%block_first(b) + j - 1, 3 * (b - 1) + j) = 1.0_dp
       end do
     end do
@@ -1266,8 +1266,9 @@ contains
       info = 3
       return
     end if
+    sys%flexibility_cc = 0.0_dp
     do b = 1, size(sys%block_first)
-      do j = 1, 3
+      do j = 1, min(3, sys%ndof - sys%block_first(b) + 1)
         sys%flexibility_cc(3 * (b - 1) + j, :) = sys%flexibility(sys%block_first(b) + j - 1, :)
       end do
     end do

@@ -550,7 +550,9 @@ class Model:
             full = index[used]
             partners = reduced_of[(full - full % 3)[:, None] + np.arange(3)].ravel()
             used = sorted_unique(np.concatenate([used, partners[partners >= 0]]))
-        return sorted_unique(np.minimum(used - used % 3, self.ndof - 3))
+        # (a model of fewer than 3 unknowns, e.g. a body on a slide: one block at 0, whose
+        # rows past the last unknown the kernel leaves out)
+        return sorted_unique(np.maximum(np.minimum(used - used % 3, self.ndof - 3), 0))
 
     def banded(self) -> bool:
         """The banded Cholesky (with LU fallback) for symmetric matrices with a narrow band:
