@@ -4,11 +4,10 @@
 At rho_inf = 1 (generalized-alpha with alpha_m = alpha_f, the trapezoidal rule) an error in
 the acceleration-like variable a is a period-2 oscillation of e'' and of the multipliers that
 nothing damps (a_{n+1} + a_n is what the positions see); on the flexible double pendulum at
-dt = 2.5e-4 it grew from 0.4 N to 164 N by t = 5.5 s and the run drowned in step cuts. The
-kernel's step control restarts such a method from the consistent acceleration when that
-oscillation exceeds 1 % of the multipliers over a block of 64 steps (step_control.f90),
-which removes it. Asserted here: the restarts are those blocks, none for a damped method, and a finer step costs no more Newton corrections per step than a coarser
-one. The long run that needs the restarts (10 s, 40000 steps) is benchmarks/hard_case_suite.py's.
+dt = 2.5e-4 it grew from 0.4 N to 164 N by t = 5.5 s and the run drowned in step cuts. A restart
+from the consistent acceleration removes it, but the restart tried (docs/hard-cases.md) was
+not landed. Asserted here, on a 6-node version over 0.3 s (before the growth, which takes
+~17,000 steps): a finer step costs no more Newton corrections per step than a coarser one.
 """
 from __future__ import annotations
 
@@ -17,11 +16,6 @@ import numpy as np
 from ancfdrv import Rectangle, System
 from ancfdrv.solvers.dynamic import DynamicSettings, integrate
 
-
-
-def _alternation(lam: np.ndarray) -> np.ndarray:
-    """The period-2 part of the multipliers at each row (step_control's alternation)."""
-    return np.abs(lam[2:] - 2.0 * lam[1:-1] + lam[:-2]).max(axis=1) / 4.0
 
 
 def double_pendulum(nodes: int = 3) -> System:
@@ -40,33 +34,23 @@ def double_pendulum(nodes: int = 3) -> System:
 
 
 def _run(dt: float, t_end: float, rho_inf: float = 1.0):
-    """The run's multipliers, Newton corrections per row and the step control's restarts."""
+    """The run's multipliers and Newton corrections per row."""
     model = double_pendulum().assemble()
     try:
         rows = []
         integrate(model, DynamicSettings.generalized_alpha(dt, t_end, rho_inf, tol=1e-10,
                                                            max_newton=20),
                   model.e0, sink=rows.append, progress=False)
-        restarts = int(model.counters["step_restarts"])
     finally:
         model.close()
     lam = np.concatenate([r.lam for r in rows])
     corrections = np.concatenate([r.stats for r in rows])[:, 0]
-    return lam, corrections, restarts
-
-
-def test_an_undamped_method_restarts_where_the_alternation_exceeds_1_percent():
-    # 0.2 s of the pendulum: 200 whole steps, measured in blocks of at most 64; its
-    # period-2 part exceeds 1 % of the multipliers, so it restarts, at most once a block
-    lam, _, restarts = _run(1e-3, 0.2)
-    assert _alternation(lam[1:]).max() > 0.01 * np.abs(lam).max()
-    assert 0 < restarts <= 200 // 3
-    assert _run(1e-3, 0.2, rho_inf=0.9)[2] == 0
+    return lam, corrections
 
 
 def test_a_finer_step_needs_no_more_corrections_per_step():
     t_end = 0.3
-    _, coarse, _ = _run(1e-3, t_end)
-    _, fine, _ = _run(2.5e-4, t_end)
+    _, coarse = _run(1e-3, t_end)
+    _, fine = _run(2.5e-4, t_end)
     # (row 0 is the initial state)
     assert fine[1:].mean() <= coarse[1:].mean()

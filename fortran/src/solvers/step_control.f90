@@ -15,12 +15,6 @@
 !> multipliers of the state (consistent_start): at rho_inf = 1 the method leaves a period-2
 !> oscillation of a - e'' and of the multipliers undamped, and a change of the step turns it
 !> into an error of order (constraint violation) / h^2 that is never damped either.
-!> A method without numerical damping (neutral_method: rho_inf = 1, the trapezoidal rule)
-!> on a constrained system also restarts when the period-2 oscillation of its multipliers
-!> exceeds neutral_share of them (issue 39: the nonlinear constraints of a turning hinge
-!> amplify it, ~0.3 % a step on the flexible double pendulum at dt = 2.5e-4, until the steps
-!> fail): measured over blocks of neutral_block_steps whole steps; the restart removes it
-!> without moving the positions (they see a_{n+1} + a_n only).
 !> A call does at most `budget` tries (steps tried), so the caller can answer a stop request
 !> between calls; an output interval left unfinished is resumed by the next call. Tries in a
 !> row without an accepted step are bounded (control_tries). No I/O; failures return codes.
@@ -28,7 +22,7 @@ module step_control
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, power_count, energy_count, &
                                contact_record
-  use stepper, only: stepper_run, stepper_settings, control_settings, control_state
+  use stepper, only: stepper_run, control_settings, control_state
   use time_integrator, only: integrator_chunk, newton_floor_stall
   use consistent_start, only: consistent_acceleration
   use kernel_errors, only: message_length
@@ -52,14 +46,6 @@ module step_control
   !> was rejected, cut back to that same remainder, forever). 1e-9 covers k ulps of t for
   !> k t / h up to ~4e6, far below the factor 2 between the sizes the control chooses.
   real(dp), parameter, public :: step_rtol = 1e-9_dp
-  !> a method without numerical damping (neutral_method) on a constrained system measures
-  !> the period-2 oscillation of its multipliers (alternation) over blocks of this many
-  !> whole steps at dt, and restarts after a block where it exceeds neutral_share of the
-  !> block's largest |lambda| (the module's notes; the luffing boom's stays below 1.1e-3 of
-  !> it, the double pendulum's 0.35 N is 1.5e-2 of its 20-40 N and grew to 164 N; a
-  !> restart only on a fourfold growth let it reach 301 N by 7.5 s)
-  integer, parameter, public :: neutral_block_steps = 64
-  real(dp), parameter, public :: neutral_share = 1e-2_dp
 
   !> A stepper state: t; e, e', a (the generalized-alpha variable), e''; lambda; the works
   !> and the powers at the state; the contact guesses and counters.
@@ -103,8 +89,8 @@ contains
     type(control_state), pointer :: c
     type(stepper_point) :: before
     real(dp) :: buffer(size(rows, 1), 1), t_before, h, remaining, error
-    integer :: step_stats(3, 1), n, k, j, floor, max_tries, at_lambda
-    logical :: retry, finished, neutral, restart_now
+    integer :: step_stats(3, 1), n, k, j, floor, max_tries
+    logical :: retry, finished
     cs => run%control_settings
     c => run%control
     rows = 0.0_dp
@@ -129,11 +115,8 @@ contains
           call restart(sys, run, p, info, failure)
           if (info /= 0) return
           c%last_h = cs%dt
-          call block_reset(c)
         end if
         n = min(nrows - done, budget - tries)
-        neutral = neutral_method(run%settings) .and. sys%ncon > 0
-        if (neutral) n = min(n, neutral_block_steps - c%block_steps)
         t_before = p%t
         call step_rows(sys, run, cs%dt, n, p, rows(:, done + 1:done + n), &
                        stats(1:3, done + 1:done + n), store_q, k, info, detail, last_correction, &
@@ -152,20 +135,6 @@ contains
         if (k > 0) c%smallest = min(c%smallest, cs%dt)
         c%rows = c%rows + k
         done = done + k
-        if (neutral) then
-          at_lambda = 1 + 6 * sys%nprobe
-          call block_rows(c, rows(at_lambda + 1:at_lambda + sys%ncon, done - k + 1:done))
-          if (info /= 0) then
-            call block_reset(c)
-          else if (c%block_steps >= neutral_block_steps) then
-            restart_now = c%block_swing > neutral_share * c%block_peak
-            call block_reset(c)
-            if (restart_now) then
-              call restart(sys, run, p, info, failure)
-              if (info /= 0) return
-            end if
-          end if
-        end if
         if (info == 0) cycle
         tries = tries + 1
         failure%work = 0
@@ -423,47 +392,6 @@ contains
       if (nanswer == 0) floor_accepts = floor
     end subroutine steps
   end subroutine step_rows
-
-  !> Whether the method leaves the infinite-frequency mode undamped (spectral radius 1 at
-  !> h omega -> infinity): generalized-alpha with alpha_m = alpha_f (rho_inf = 1) and
-  !> gamma = 1/2, Newmark's trapezoidal rule among them.
-  pure logical function neutral_method(cfg)
-    type(stepper_settings), intent(in) :: cfg
-    neutral_method = abs(cfg%alpha_m - cfg%alpha_f) <= 1e-12_dp .and. &
-                     abs(cfg%gamma - 0.5_dp) <= 1e-12_dp
-  end function neutral_method
-
-  !> The block's record of whole-step rows (their multipliers, columns, in order): the
-  !> period-2 part of the multipliers, max |lambda_{n+1} - 2 lambda_n + lambda_{n-1}| / 4
-  !> (c (-1)^n gives c; a smooth history ~h^2 lambda''), over the block's consecutive rows
-  !> (those of earlier calls included), and the largest |lambda|.
-  pure subroutine block_rows(c, lam)
-    type(control_state), intent(inout) :: c
-    real(dp), intent(in) :: lam(:, :)
-    integer :: n
-    if (.not. allocated(c%block_lambda)) then
-      allocate (c%block_lambda(size(lam, 1), 2))
-      c%block_lambda = 0.0_dp
-    end if
-    do n = 1, size(lam, 2)
-      if (c%block_held == 2) c%block_swing = max(c%block_swing, maxval(abs( &
-        lam(:, n) - 2.0_dp * c%block_lambda(:, 2) + c%block_lambda(:, 1))) / 4.0_dp)
-      c%block_peak = max(c%block_peak, maxval(abs(lam(:, n))))
-      c%block_lambda(:, 1) = c%block_lambda(:, 2)
-      c%block_lambda(:, 2) = lam(:, n)
-      c%block_held = min(c%block_held + 1, 2)
-    end do
-    c%block_steps = c%block_steps + size(lam, 2)
-  end subroutine block_rows
-
-  !> A new block: after a full one, a failed step or a restart.
-  pure subroutine block_reset(c)
-    type(control_state), intent(inout) :: c
-    c%block_steps = 0
-    c%block_held = 0
-    c%block_swing = 0.0_dp
-    c%block_peak = 0.0_dp
-  end subroutine block_reset
 
   !> Kernel failures a smaller step may avoid (not: a constraint or drive that cannot be
   !> evaluated, a force element's, a refused call; not a Newton stall at the round-off floor).
