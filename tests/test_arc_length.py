@@ -13,7 +13,12 @@ solvers/path.py; SPEC section 8.2 "Static paths", issue 34 item 2).
   I = 2 cm^4 (here in SI: E = 7.2e6 Pa, section 3 cm x 2 cm in the plane). Published limit
   load P L^2 / EI = 18.5-18.6 (18.56 taken, issue 34). The path snaps back: past the
   limit the load point's vertical displacement turns back while the load keeps falling.
-  Reference path: tests/reference/lee_frame_path.json, the same model on 81 nodes per member
+  Independent reference: tests/reference/lee_frame_displacement.json, the load point pulled
+  down by a stiff spring from a support moved in small increments, ordinary Newton at each
+  (benchmarks/lee_frame_displacement.py), from the start through the limit to where the
+  load point's vertical displacement turns back (31 nodes per member: limit 18.463; 81:
+  18.517). Mesh convergence through the snap-back, by arc length:
+  tests/reference/lee_frame_path.json, the same model on 81 nodes per member
   (benchmarks/lee_frame.py; its limit load 18.52, 0.24% below 18.56; the nodes 11, 21,
   41 give 17.98, 18.38, 18.49: second-order convergence).
 """
@@ -32,6 +37,7 @@ from ancfdrv.plots import plot_result
 from ancfdrv.system.sections import Rectangle
 
 REFERENCE = Path(__file__).resolve().parent / "reference" / "lee_frame_path.json"
+DISPLACEMENT_CONTROL = REFERENCE.with_name("lee_frame_displacement.json")
 
 # -- the von Mises truss -----------------------------------------------------------------
 A_HALF, RISE, E_TRUSS, SIDE = 1.0, 0.1, 1e7, 0.12
@@ -107,9 +113,9 @@ P_UNIT = EI_FRAME / L_FRAME**2
 LIMIT_REFERENCE = 18.56                           # P L^2 / EI (issue 34; 18.5-18.6 published)
 
 
-def lee_frame(nodes: int, load: float) -> System:
-    """Lee's frame with the 'cubic' bending option, ``nodes`` per member, the load ``load``
-    (in EI / L^2) down at 0.2 L from the corner; a probe at the load point."""
+def lee_members(nodes: int) -> System:
+    """Lee's frame unloaded: the 'cubic' bending option, ``nodes`` per member, a probe at the
+    load point (0.2 L from the corner)."""
     s = System("Lee's frame", planar="xy")
     s.material("m", youngs_modulus=E_FRAME, density=1000.0, poisson_ratio=0.3)
     section = Rectangle(0.03, 0.02)       # 2 cm deep in the plane: I = 2 cm^4, A = 6 cm^2
@@ -121,9 +127,16 @@ def lee_frame(nodes: int, load: float) -> System:
     s.joint("foot", "fix", "ground", "column", point=(0, 0, 0))
     s.joint("far_end", "fix", "ground", "beam", point=(L_FRAME, L_FRAME, 0))
     s.joint("corner", "weld", "column", "beam", point=(0, L_FRAME, 0))
+    s.probe("load_point", "beam", (0.2 * L_FRAME, L_FRAME, 0))
+    return s
+
+
+def lee_frame(nodes: int, load: float) -> System:
+    """Lee's frame (:func:`lee_members`) under the load ``load`` (in EI / L^2) down at the
+    load point."""
+    s = lee_members(nodes)
     s.load("P", "force", body="beam", point=(0.2 * L_FRAME, L_FRAME, 0),
            vector=(0, -load * P_UNIT, 0))
-    s.probe("load_point", "beam", (0.2 * L_FRAME, L_FRAME, 0))
     return s
 
 
@@ -177,8 +190,11 @@ def path_factor(path: dict) -> np.ndarray:
 
 
 def test_lee_frame_path_within_one_percent_of_the_reference(lee31):
-    """Every point of the 31-node path (u/L, v/L, P L^2 / (EI 18.56)) within 1% of the
-    81-node reference path's polyline, through the limit and the snap-back (measured)."""
+    """Mesh convergence (the same arc-length method; the independent check is
+    test_lee_frame_path_follows_displacement_control): every point of the 31-node path
+    (u/L, v/L, P L^2 / (EI 18.56)) within 1% of the 81-node arc-length path's polyline,
+    through the limit and the snap-back, past the displacement control's reach (measured
+    0.50%)."""
     reference = json.loads(REFERENCE.read_text())
     line = np.column_stack([np.asarray(reference["u"]) / L_FRAME,
                             np.asarray(reference["v"]) / L_FRAME,
@@ -189,6 +205,55 @@ def test_lee_frame_path_within_one_percent_of_the_reference(lee31):
     far = distance_to_polyline(points, line)
     print(f"\nLee's frame, 31 nodes: largest distance to the 81-node path {far.max():.4f}")
     assert far.max() < 0.01
+
+
+def test_lee_frame_path_follows_displacement_control(lee31):
+    """The independent reference: the same frame pulled down by a stiff spring from a support
+    moved in small increments, each solved by ordinary Newton (no arc length), the load the
+    spring's pull (tests/reference/lee_frame_displacement.json, written by
+    ``.venv/bin/python benchmarks/lee_frame_displacement.py``). It covers the path from the
+    start through the limit to where v turns back (the snap-back), v monotonic. Every point
+    of the 31-node arc-length path in that range: the load within 1% of 18.56 of the 31-node
+    reference's load at the same v (interpolated; measured 0.25%, where the path is nearly
+    vertical in P(v) just before the snap-back, elsewhere < 0.02%) and u within 1% of L
+    (measured 0.11%); within 1% of the 81-node reference's polyline in (u/L, v/L,
+    P/18.56) (mesh and method; measured 0.31%). The limit loads of both references within
+    1% of 18.56 (measured -0.52%, -0.23%), and the arc-length limit within 0.1% of the
+    31-node reference's (measured -0.003%). The spring's horizontal pull (its tilt, a load
+    the frame does not have) below 1e-4 of 18.56 (measured 4e-5)."""
+    reference = {nodes: {k: np.asarray(x) for k, x in path.items()} for nodes, path
+                 in json.loads(DISPLACEMENT_CONTROL.read_text())["paths"].items()}
+    limit = 20.0 * lee31["limit_load_factors"][0]
+    u, v = lee31["displacement"][:, 0], lee31["displacement"][:, 1]
+    load = 20.0 * path_factor(lee31)
+    for ref in reference.values():
+        assert np.all(np.diff(ref["v"]) < 0) and np.all(np.diff(ref["w"]) > 0)
+        assert np.max(np.abs(ref["horizontal"])) < 1e-4 * LIMIT_REFERENCE  # the spring's tilt
+        assert abs(ref["limit_load"] / LIMIT_REFERENCE - 1) < 0.01
+        peak = int(np.argmax(ref["load"]))
+        assert 0 < peak < len(ref["v"]) - 10 and ref["load"][-1] < 0.8 * ref["limit_load"]
+    coarse, fine = reference["31"], reference["81"]
+    # the arc-length path's first branch (v still growing downwards) inside the range
+    branch = int(np.argmax(np.diff(-v) < 0))
+    inside = np.arange(branch + 1)[-v[:branch + 1] <= -coarse["v"][-1]]
+    assert -v[inside[-1]] > -coarse["v"][np.argmax(coarse["load"])] + 0.05 * L_FRAME
+    down = np.r_[0.0, -coarse["v"]]
+    far_load = np.max(np.abs(load[inside] - np.interp(-v[inside], down,
+                                                      np.r_[0.0, coarse["load"]])))
+    far_u = np.max(np.abs(u[inside] - np.interp(-v[inside], down, np.r_[0.0, coarse["u"]])))
+    line = np.column_stack([np.r_[0.0, fine["u"]] / L_FRAME, np.r_[0.0, fine["v"]] / L_FRAME,
+                            np.r_[0.0, fine["load"]] / LIMIT_REFERENCE])
+    points = np.column_stack([u[inside] / L_FRAME, v[inside] / L_FRAME,
+                              load[inside] / LIMIT_REFERENCE])
+    far_fine = distance_to_polyline(points, line).max()
+    print(f"\nLee's frame, 31-node arc length, {len(inside)} points to v/L = "
+          f"{v[inside[-1]] / L_FRAME:.3f} against displacement control: 31 nodes, load "
+          f"within {far_load / LIMIT_REFERENCE:.4%} of 18.56, u within {far_u / L_FRAME:.4%} "
+          f"of L; 81 nodes, within {far_fine:.4%}; limits {limit:.4f}, "
+          f"{coarse['limit_load']:.4f} ({limit / coarse['limit_load'] - 1:+.4%}), "
+          f"{fine['limit_load']:.4f}")
+    assert far_load < 0.01 * LIMIT_REFERENCE and far_u < 0.01 * L_FRAME and far_fine < 0.01
+    assert abs(limit / coarse["limit_load"] - 1) < 1e-3
 
 
 def test_load_control_stalls_near_the_limit_and_names_arc_length():
