@@ -257,6 +257,11 @@ def test_error_against_a_zero_deflection_is_undefined_not_huge(tmp_path):
                     progress=False)
     assert [r["err_vs_finest"] > 0 for r in sag] == [True, True, False]
     assert all("err_vs_finest_undefined" not in r for r in sag)
+    # and the note names the probe and component that do move (the sag: component 1, by
+    # as much as the sag sweep's finest case reads), as the keys that would compare them
+    moving = f"probe 'tip' moves {1e3 * abs(sag[2]['tip_transverse']):.4g} mm along its component 1"
+    assert moving in rows[0]["err_vs_finest_undefined"]
+    assert "&scene response = 'tip', response_component = 1" in table
 
 
 def test_response_probe_is_the_scenes_not_a_probe_called_tip(tmp_path):

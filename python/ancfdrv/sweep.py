@@ -224,15 +224,47 @@ def _probe_and_size(path: str) -> tuple[str, float]:
 ZERO_DEFLECTION = 1e-9
 
 
-def relative_error(absolute: float, scale: float, size: float, probe: str) -> float | str:
+def relative_error(absolute: float, scale: float, size: float, probe: str,
+                   reference_file: str | None = None) -> float | str:
     """``absolute / scale``, the error relative to the reference's deflection; or, when
     that deflection is zero to round-off (at most ZERO_DEFLECTION times the model's size
     ``size``, m), the note saying why a relative error is undefined there (the absolute
-    error stays meaningful)."""
+    error stays meaningful) and, from ``reference_file``, which probe would serve
+    (:func:`moving_probe`)."""
     if scale == 0.0 or scale <= ZERO_DEFLECTION * size:
+        hint = moving_probe(reference_file, size) if reference_file else ""
         return (f"undefined: the reference deflection of probe {probe!r} is zero to "
-                f"round-off ({scale:.1e} m, model size {size:.3g} m); see the absolute error")
+                f"round-off ({scale:.1e} m, model size {size:.3g} m); see the absolute "
+                f"error{hint}")
     return absolute / scale
+
+
+def moving_probe(path: str, size: float) -> str:
+    """A hint naming the probe and component that move most in a result file (its static
+    deflections, or the largest over its dynamic ones; relative to the supports where the
+    file has that), as the scene keys that would compare it; '' when none moves beyond
+    round-off."""
+    best = (0.0, "", 0)
+    with h5py.File(path, "r") as h5:
+        for group in ("dynamic", "static"):
+            if group not in h5:
+                continue
+            for name in ("deflection_support", "deflection"):
+                if name not in h5[group]:
+                    continue
+                for probe, data in h5[f"{group}/{name}"].items():
+                    values = np.abs(np.asarray(data[()], dtype=float)).reshape(-1, 3)
+                    peak = values.max(axis=0, initial=0.0)
+                    k = int(np.argmax(peak))
+                    if peak[k] > best[0]:
+                        best = (float(peak[k]), probe, k)
+                break
+            break
+    if best[0] <= ZERO_DEFLECTION * size:
+        return ""
+    return (f"; probe {best[1]!r} moves {1e3 * best[0]:.4g} mm along its component "
+            f"{best[2]}: compare it with &scene response = {best[1]!r}, "
+            f"response_component = {best[2]}")
 
 
 def eigen_error(values: np.ndarray, reference: np.ndarray) -> float | str:
@@ -271,7 +303,8 @@ def add_history_errors(rows: list[dict], varied: list[str]) -> None:
             t, y = _tip_history(row["file"])
             common = t_ref <= t[-1]
             absolute = float(np.abs(np.interp(t_ref[common], t, y) - y_ref[common]).max())
-            _set_error(row, "err_vs_finest", relative_error(absolute, scale, size, probe))
+            _set_error(row, "err_vs_finest", relative_error(absolute, scale, size, probe,
+                                                            finest["file"]))
             row["err_abs_vs_finest"] = absolute  # m (the table shows mm)
             if f_ref is not None:
                 mask = t >= t0
@@ -497,11 +530,11 @@ def add_reference_errors(rows: list[dict], reference: Reference) -> None:
             absolute = float(np.abs(np.interp(reference.time[common], t, y)
                                     - reference.values[common]).max())
             err = relative_error(absolute, float(np.ptp(reference.values)),
-                                 reference.length_scale, reference.probe)
+                                 reference.length_scale, reference.probe, str(reference.path))
         elif reference.family == "static":
             err = relative_error(abs(static_value(row) - reference.values[0]),
                                  abs(float(reference.values[0])), reference.length_scale,
-                                 reference.probe)
+                                 reference.probe, str(reference.path))
         else:
             err = eigen_error(eigen_values(row["file"])[1], reference.values)
         _set_error(row, "err_vs_reference", err)
@@ -523,7 +556,8 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
         probe, size = _probe_and_size(finest["file"])
         for row in members:
             absolute = abs(static_value(row) - ref)
-            _set_error(row, "err_vs_finest", relative_error(absolute, abs(ref), size, probe))
+            _set_error(row, "err_vs_finest", relative_error(absolute, abs(ref), size, probe,
+                                                            finest["file"]))
             row["err_abs_vs_finest"] = absolute  # m (the table: mm)
 
 
