@@ -256,3 +256,41 @@ def test_portal_frame_stiff_shear_linear_estimate_is_refused():
     with pytest.raises(SolverError, match=r"'linear' estimate .* is contradicted by the "
                        r"model.*use buckling.method = 'nonlinear'"):
         _portal(1000.0).buckling(1, method="linear")
+
+
+#: Euler's clamped-free column of the test below: pi^2 E I / (4 L^2), I = 0.03 x 0.02^3 / 12
+EULER_COLUMN = np.pi**2 * 2.1e11 * 0.03 * 0.02**3 / 12 / (4 * 2.0**2)
+
+
+def test_buckling_shapes_are_drawn_on_the_scenes_state(tmp_path):
+    """The mode plot and the XDMF draw the buckling shapes on the scene's static state
+    (/static/mesh_nodes, load factor 1), not on the state near the limit the 'nonlinear'
+    method reached (there the knuckle crane was folded at 1429 times its loads); the
+    state the analysis linearized about stays in /buckling/static_q."""
+    import h5py
+
+    from ancfdrv.runner import run_scene
+    scene = tmp_path / "column.nml"
+    scene.write_text("""
+&scene  title = 'column', analysis = 'buckling', formulation = 'nonlinear' /
+&material  name = 'steel', youngs_modulus = 2.1e11, density = 7850.0 /
+&beam  name = 'arm', material = 'steel', start = 0, 0, 0, end = 2.0, 0, 0, nodes = 5,
+       section = 'rectangle', width = 0.02, height = 0.03, height_axis = 0, 1, 0,
+       bending = 'cubic' /
+&joint  name = 'root', type = 'weld', body1 = 'ground', body2 = 'arm', point = 0, 0, 0 /
+&load  name = 'push', type = 'force', body = 'arm', point = 2.0, 0, 0, vector = -100, 0, 0 /
+&probe  name = 'tip', body = 'arm', point = 2.0, 0, 0 /
+&buckling  modes = 1 /
+&solver  static_method = 'newton' /
+""")
+    out = tmp_path / "column.h5"
+    run_scene(scene, [], out, progress=False)
+    with h5py.File(out, "r") as h5:
+        drawn = h5["buckling/mesh_static"][()]
+        scene_state = h5["static/mesh_nodes"][()]
+        factor = h5["buckling/load_factor"][0]
+        at_limit = h5["buckling/static_q"][()]
+        scene_q = h5["static/q"][()]
+    assert factor == pytest.approx(EULER_COLUMN / 100.0, rel=1e-3)  # 25.9: far beyond 1
+    np.testing.assert_allclose(drawn, scene_state, rtol=0, atol=1e-12 * 2.0)
+    assert np.abs(at_limit - scene_q).max() > 1e3 * np.finfo(float).eps  # a different state

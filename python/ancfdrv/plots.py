@@ -1144,7 +1144,8 @@ def plot_modes(h5_path: Path, png: str | Path | None = None, group: str = "modal
         else:
             label = f"mode {k + 1}: load factor {values[k]:.4g}"
         ax.set_title(label, fontsize=9)
-    fig.suptitle(f"{title} ({group})", fontsize=10)
+    fig.suptitle(textwrap.fill(f"{title} ({group})", max(24, int(16 * max(n, 1)))),
+                 fontsize=10)
     save_figure(fig, png, dpi=110)
     plt.close(fig)
     return png

@@ -1427,11 +1427,12 @@ def _stress_points(h5: h5py.File, group: h5py.Group, recorder) -> None:
 
 def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
                  full_shapes: np.ndarray, state: np.ndarray, series: dict[str, tuple],
-                 attrs: dict[str, Any]) -> None:
+                 attrs: dict[str, Any], drawn_on: np.ndarray | None = None) -> None:
     """/<name>: the eigenvalue series (name -> (values, units)), shapes[N, ndof] (solver
     coordinates, as solved), full_shapes[N, nfull], the state the analysis linearized about
-    (static_q), and for XDMF and plots the mesh points at that state (mesh_static) with
-    each shape on them (mesh_shapes[N, npoints, 3], scaled to a largest displacement of 1)."""
+    (static_q), and for XDMF and plots the mesh points at ``drawn_on`` (default: that
+    state; mesh_static) with each shape on them (mesh_shapes[N, npoints, 3], scaled to a
+    largest displacement of 1)."""
     from .xdmf import MeshLayout, write_layout
     layout = MeshLayout.from_model(model)
     # a full disk or ``ulimit -f``: refused before HDF5 writes (a write that fails inside
@@ -1452,7 +1453,8 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
         if layout is not None:
             if "model/mesh" not in h5:
                 write_layout(h5, layout)
-            static = layout.positions(model, state[None, :])[0]
+            static = layout.positions(model, (state if drawn_on is None
+                                              else drawn_on)[None, :])[0]
             mesh = (layout.map @ np.atleast_2d(full_shapes).T).T.reshape(
                 len(full_shapes), layout.npoints, 3)
             peak = np.abs(mesh).reshape(len(mesh), -1).max(axis=1, initial=0.0)
@@ -1507,7 +1509,9 @@ def write_modal(path: Path, model: Model, result) -> None:
 def write_buckling(path: Path, model: Model, result) -> None:
     """/buckling from a :class:`~ancfdrv.solvers.buckling.BucklingResult`:
     load_factor[N] (multiples of the reference loads; ascending, positive) and shapes[N, ndof]
-    (largest component 1); /static holds the scene's static state (load factor 1)."""
+    (largest component 1); /static holds the scene's static state (load factor 1), on which
+    the shapes are drawn (mesh_static: the state at the limit, static_q, is folded far
+    beyond anything the structure carries, 1429 times the crane's loads)."""
     attrs = {"method": result.extra.get("method", ""), "solver": result.method,
              "fixed_loads": ",".join(result.fixed_loads), "modes": len(result.load_factor),
              "wall_time_s": result.wall_time_s,
@@ -1517,7 +1521,8 @@ def write_buckling(path: Path, model: Model, result) -> None:
     if result.base is not None:  # first: kept when /buckling finds no room
         write_static(path, model, result.base)
     _write_eigen(path, model, "buckling", result.shapes, result.full_shapes, state,
-                 {"load_factor": (result.load_factor, "1")}, attrs)
+                 {"load_factor": (result.load_factor, "1")}, attrs,
+                 drawn_on=result.base.e if result.base is not None else None)
 
 
 def eigen_summary(h5: h5py.File) -> dict[str, Any]:
