@@ -76,6 +76,9 @@ BENCHES = [
     Bench("stability", "long-run stability suite: completion, step cuts, energy balance",
           out=None, fixed=("stability.json", "stability.md")),
     Bench("hard_case_suite", "hard cases of record: each run correct, refused or ok and wrong"),
+    Bench("command_cost", "a small ancf command's cost beyond its computing: start-up, "
+          "imports, the XDMF", quick=("--repeats", "1"), out=None,
+          fixed=("command_cost.json",)),
     Bench("right_angle_cantilever", "right-angle cantilever (Simo & Vu-Quoc 1986), 0-30 s"),
     Bench("spatial_mechanism", "spatial slider-crank, both bending options, nu = 0 and 0.3"),
     Bench("flying_spaghetti", "3D flying spaghetti (Simo & Vu-Quoc 1988)", out="--out"),
@@ -92,6 +95,10 @@ BENCHES = [
     Bench("h5_compare", "", gate="compares two directories of result files"),
     Bench("static_kernel_gate", "", gate="compares the kernel's static Newton with the "
           "Python reference"),
+    Bench("lee_frame", "", gate="writes the reference path of tests/test_arc_length.py "
+          "(arc length, 81 nodes)"),
+    Bench("lee_frame_displacement", "", gate="writes the independent reference path of "
+          "tests/test_arc_length.py (displacement control through a stiff spring)"),
 ]
 
 

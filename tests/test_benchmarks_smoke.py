@@ -126,3 +126,15 @@ def test_peer_cantilever_smoke(tmp_path):
     assert 5e-5 < same["tip_y_range_m"] < 5e-4
     assert same["max_abs_dy_m"] < 1e-3 * same["tip_y_range_m"]
     assert out.with_suffix(".md").read_text().startswith("# Nonlinear cantilever")
+
+
+def test_make_bench_lists_every_benchmark_script(monkeypatch):
+    """`make bench` (benchmarks/run_all.py) runs every benchmark or says why not: each
+    script of benchmarks/ (not a helper module, _*.py) has its entry."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("run_all", BENCHMARKS / "run_all.py")
+    run_all = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, "run_all", run_all)  # (its dataclasses look it up)
+    spec.loader.exec_module(run_all)
+    scripts = {p.stem for p in BENCHMARKS.glob("*.py") if not p.stem.startswith("_")}
+    assert scripts - {"run_all"} == {b.name for b in run_all.BENCHES}
