@@ -22,6 +22,7 @@ import numpy as np  # noqa: E402
 from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter  # noqa: E402
 
 from .errors import InputError  # noqa: E402
+from .plots import _mesh_segments  # noqa: E402
 
 #: the planes a view may name, as (horizontal, vertical) coordinate indices
 VIEWS = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
@@ -29,11 +30,6 @@ VIEWS = {"xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
 MODE_FRAMES = 36
 #: the most frames of a dynamic run drawn (rows are skipped evenly beyond it)
 MAX_FRAMES = 100
-
-
-def _segments(h5: h5py.File) -> list[np.ndarray]:
-    from .plots import _mesh_segments
-    return _mesh_segments(h5)
 
 
 def _style(segment: np.ndarray) -> dict:
@@ -115,7 +111,7 @@ def animate(h5_path: str | Path, output: str | Path | None = None, *, mode: int 
                          "(apt install ffmpeg); ask for a .gif instead", key="output")
     with h5py.File(path, "r") as h5:
         frames, labels, title = _frames(h5, path, mode)
-        segments = _segments(h5)
+        segments = _mesh_segments(h5)
     horizontal, vertical = _plane(frames, view)
     fig, ax = plt.subplots(figsize=(6.4, 4.8), constrained_layout=True)
     flat = frames.reshape(-1, 3)

@@ -82,3 +82,18 @@ KERNEL_LAYOUTS: dict[str, tuple[str, ...]] = {
     "cg": ("a", "b", "xi", "eta"),                       # a contact pair's side
     "ce": ("potential", "damping", "friction"),          # contact energies
 }
+
+
+def mesh_parts(bodies: str) -> dict[str, tuple[str, range]]:
+    """The items of a result file's mesh from /model/mesh's ``bodies`` attribute (written
+    by results/xdmf.py, one 'name: kind, points a..b' line per item): {name: (kind, the
+    rows of /model/mesh/points)}. Read by the writer's own node fields and by the plots,
+    which read result files without the package's system."""
+    parts = {}
+    for line in bodies.splitlines():
+        name, _, rest = line.rpartition(": ")
+        kind, _, points = rest.partition(", points ")
+        if ".." in points:
+            first, last = (int(v) for v in points.split(".."))
+            parts[name] = (kind, range(first, last + 1))
+    return parts

@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .codes import mesh_parts  # noqa: E402
 from .io.safe_write import save_figure  # noqa: E402
 from .sweep_keys import is_resolution, static_value  # noqa: E402
 
@@ -167,13 +168,11 @@ def _cable_swing(h5: h5py.File) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     out = {}
     nodes = h5["dynamic/mesh_nodes"]
     times = h5["dynamic/time"][()][h5["dynamic/mesh_rows"][()]]
-    for line in _text(h5["model/mesh"].attrs.get("bodies", "")).splitlines():
-        name, _, rest = line.partition(": ")
-        kind, _, points = rest.partition(", points ")
-        if kind != "cable" or ".." not in points:
+    for name, (kind, points) in mesh_parts(_text(h5["model/mesh"].attrs.get("bodies",
+                                                                         ""))).items():
+        if kind != "cable":
             continue
-        first, last = (int(v) for v in points.split(".."))
-        chord = nodes[:, last, :] - nodes[:, first, :]
+        chord = nodes[:, points[-1], :] - nodes[:, points[0], :]
         chord /= np.maximum(np.linalg.norm(chord, axis=1, keepdims=True), 1e-300)
         cosine = np.clip(chord @ chord[0], -1.0, 1.0)
         out[name] = (times[:len(chord)], np.degrees(np.arccos(cosine)))

@@ -36,6 +36,7 @@ import h5py
 import numpy as np
 
 from .._version import __version__
+from ..codes import mesh_parts
 from ..errors import InputError
 from ..system.model import Model
 from ..io.safe_write import check_room, create_fresh
@@ -1403,12 +1404,8 @@ def _stress_points(h5: h5py.File, group: h5py.Group, recorder) -> None:
         return
     mesh = h5["model/mesh"]
     values = np.zeros(len(mesh["points"]))
-    ranges = {}
-    for line in str(mesh.attrs.get("bodies", "")).split("\n"):
-        name, _, rest = line.rpartition(": ")
-        if rest.startswith("beam, points "):
-            first, last = rest.removeprefix("beam, points ").split("..")
-            ranges[name] = (int(first), int(last))
+    ranges = {name: (points[0], points[-1]) for name, (kind, points)
+              in mesh_parts(str(mesh.attrs.get("bodies", ""))).items() if kind == "beam"}
     for name, (_, best, _) in recorder.envelope.items():
         if name not in ranges:
             continue
