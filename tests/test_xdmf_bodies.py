@@ -353,8 +353,8 @@ def test_crane_mode_plot_and_animation_show_the_payload(crane, tmp_path):
     mode shape."""
     from PIL import Image
 
-    from ancfdrv.animate import _frames, _segments
-    from ancfdrv.plots import plot_modes
+    from ancfdrv.animate import _frames
+    from ancfdrv.plots import _mesh_segments, plot_modes
     png = plot_modes(crane, tmp_path / "modes.png")
     with Image.open(png) as image:
         width, height = image.size
@@ -362,7 +362,7 @@ def test_crane_mode_plot_and_animation_show_the_payload(crane, tmp_path):
     assert (width, height) == (round(4 * 3.2 * 110), round(3.2 * 110))
     with h5py.File(crane) as h5:
         parts = mesh_parts(h5)
-        segments = _segments(h5)
+        segments = _mesh_segments(h5)
         frames, labels, _ = _frames(h5, crane, 2)
         static = h5["modal/mesh_static"][()]
         shape = h5["modal/mesh_shapes"][1]
