@@ -65,7 +65,8 @@ end subroutine system_destroy
 subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, length_scale, &
                                 max_newton, jacobian, contraction, control, info, message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, policy_constant, plane_mass_setup
+  use mechanical_system, only: system_model, policy_constant
+  use system_mass, only: plane_mass_setup
   use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, &
                      jacobian_reuse, control_settings
   use api_support, only: api_system, sk_dt, sk_dt_min, sk_adaptive, sk_tolerance
@@ -108,7 +109,7 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
                                       tolerance=control(sk_tolerance), &
                                       adaptive=control(sk_adaptive) /= 0.0_dp))
   if (sys%policy /= policy_constant) sys%factorized = .false.
-  call plane_mass_setup(sys)
+  call plane_mass_setup(sys%mass, sys%ndof, sys%carry_plane)
 end subroutine system_stepper_setup
 
 !> Element sets: one routine per family builds the family's set (element_sets: an
@@ -548,11 +549,11 @@ subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_
     message = 'system_set_mass: sizes inconsistent with the system (ndof)'
     return
   end if
-  sys%mass_row_ptr = mass_row_ptr
-  sys%mass_col = mass_col
-  sys%mass_values = mass_values
-  if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
-                                                sys%mass_pair_row, sys%mass_pair_values)
+  sys%mass%row_ptr = mass_row_ptr
+  sys%mass%col = mass_col
+  sys%mass%values = mass_values
+  if (allocated(sys%mass%pair_ptr)) deallocate (sys%mass%pair_ptr, sys%mass%pair_col, &
+                                                sys%mass%pair_row, sys%mass%pair_values)
   if (any(saddle_col < 1) .or. any(saddle_col > ndof) .or. saddle_ptr(1) /= 1 .or. &
       saddle_ptr(ndof + 1) /= nnz_saddle + 1) then
     info = 2
@@ -560,9 +561,9 @@ subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_
     return
   end if
   sys%mass_pattern = mass_pattern
-  sys%saddle_mass_ptr = saddle_ptr
-  sys%saddle_mass_col = saddle_col
-  sys%saddle_mass_values = saddle_values
+  sys%mass%saddle_ptr = saddle_ptr
+  sys%mass%saddle_col = saddle_col
+  sys%mass%saddle_values = saddle_values
   sys%factorized = .false.
 end subroutine system_set_mass
 
@@ -713,12 +714,12 @@ subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, m
     message = 'system_set_kron_mass: sizes inconsistent with the system (3 nvec /= ndof)'
     return
   end if
-  sys%mass_row_ptr = row_ptr
-  sys%mass_col = col
-  sys%mass_values = values
-  sys%mass_kron = .true.
-  if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
-                                                sys%mass_pair_row, sys%mass_pair_values)
+  sys%mass%row_ptr = row_ptr
+  sys%mass%col = col
+  sys%mass%values = values
+  sys%mass%kron = .true.
+  if (allocated(sys%mass%pair_ptr)) deallocate (sys%mass%pair_ptr, sys%mass%pair_col, &
+                                                sys%mass%pair_row, sys%mass%pair_values)
 end subroutine system_set_kron_mass
 
 !> q = B e + q0 (B CSR over nfull rows, 1-based) and the plan of B^T S B: values(target)

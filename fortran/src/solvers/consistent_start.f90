@@ -71,15 +71,15 @@ contains
     end if
     ! the saddle's coordinate list: M's entries, Phi_e^T's (rows of e, columns of lambda),
     ! Phi_e's (rows of lambda)
-    nmass = size(sys%saddle_mass_col)
+    nmass = size(sys%mass%saddle_col)
     nterm = 0
     if (ncon > 0) nterm = sys%term_ptr(6 * ncon + 1) - sys%term_ptr(1)
     allocate (rows(nmass + 2 * nterm), cols(nmass + 2 * nterm), entries(nmass + 2 * nterm))
     do row = 1, n
-      do k = sys%saddle_mass_ptr(row), sys%saddle_mass_ptr(row + 1) - 1
+      do k = sys%mass%saddle_ptr(row), sys%mass%saddle_ptr(row + 1) - 1
         rows(k) = row
-        cols(k) = sys%saddle_mass_col(k)
-        entries(k) = sys%saddle_mass_values(k)
+        cols(k) = sys%mass%saddle_col(k)
+        entries(k) = sys%mass%saddle_values(k)
       end do
     end do
     i = nmass

@@ -61,13 +61,14 @@
 !> No I/O; failures return codes (see integrator_chunk).
 module time_integrator
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
+  use mechanical_system, only: system_model, contact_state, frame_rotations, &
                                internal_forces, external_forces, evaluate_constraints, &
                                constraint_reaction, gradient_product, refactorize, &
                                to_solver_frame, &
                                frame_gradients, energies, probe_output, policy_constant, &
                                drive_step_work, power_drive, &
                                power_count, energy_count, contact_record, contact_step_limit
+  use system_mass, only: mass_product
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
                      jacobian_reuse, update_reuse_backoff, contraction_memory
   use kernel_errors, only: failure_text, message_length
@@ -250,7 +251,7 @@ contains
       if (info /= 0) return
       if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
     end if
-    call mass_product(sys, acceleration, r)
+    call mass_product(sys%mass, acceleration, r)
     ! (loads of t alone, without point loads that follow e: once per time, kept for the
     ! step's later corrections; without driven loads (force_drive) they are constant_force
     ! at every time: once per chunk)

@@ -31,7 +31,6 @@
 !> No I/O; failures return codes.
 module mechanical_system
   use ancf_kinds, only: dp
-  use iso_fortran_env, only: int64
   use constraints, only: constraint_eval, operand_values, drive_value, constraint_value, &
                          constraint_kind_coordinate, constraint_kind_distance, &
                          constraint_kind_cross, constraint_kind_dot
@@ -43,11 +42,11 @@ module mechanical_system
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
                           cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
+  use system_mass, only: mass_matrix, kinetic_energy
   implicit none
   private
   public :: system_model, frame_def, contact_pair, contact_state
-  public :: plane_mass_setup
-  public :: frame_rotations, to_full, to_reduced, csr_matvec, mass_product, internal_forces, &
+  public :: frame_rotations, to_full, to_reduced, internal_forces, &
             external_forces, &
             evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
             refactorize, to_solver_frame, &
@@ -97,23 +96,7 @@ module mechanical_system
     type(frame_def), allocatable :: frames(:)
     integer, allocatable :: drive_kinds(:), drive_ptr(:)
     real(dp), allocatable :: drive_data(:)
-    ! mass M (reduced, CSR, 1-based), used for M a and the kinetic energy; when M is
-    ! kron(Mbar, I3) over whole 3-vectors (beams, plates and rigid bodies all are), the CSR
-    ! of Mbar on the 3-vectors instead (a ninth of the entries)
-    integer, allocatable :: mass_row_ptr(:), mass_col(:)
-    real(dp), allocatable :: mass_values(:)
-    logical :: mass_kron = .false.
-    ! M as the model assembled it (CSR, 1-based, its zero entries kept): the mass block of
-    ! the consistent acceleration's saddle system (consistent_start)
-    integer, allocatable :: saddle_mass_ptr(:), saddle_mass_col(:)
-    real(dp), allocatable :: saddle_mass_values(:)
-    ! the CSR mass of a planar reduction as kron(Mbar, I2) over the plane's (x, y) pairs
-    ! (plane_mass_setup; unallocated otherwise): Mbar's rows by pair, each entry's column the
-    ! x coordinate of its pair (y: x + 1), and each pair's x coordinate
-    integer, allocatable :: mass_pair_ptr(:), mass_pair_col(:), mass_pair_row(:)
-    real(dp), allocatable :: mass_pair_values(:)
-    ! the pairs' x coordinates are 1, 3, 5, .. in pair order (kinetic_energy's one pass)
-    logical :: mass_pairs_ordered = .false.
+    type(mass_matrix) :: mass                         ! M and its forms (system_mass)
     ! full pattern of the tangents; q = B e + q0 and the plan of B^T S B
     integer, allocatable :: full_row_ptr(:), full_col(:)
     logical :: reduced = .false.
@@ -298,151 +281,6 @@ contains
     omega_local = 0.0_dp
     if (f > 0) omega_local = frame_omega(rotation, sys%frames(f)%axis, rate)
   end function set_omega
-
-  !> y = M x with the system's mass (CSR, or kron(Mbar, I3) with Mbar's CSR on 3-vectors).
-  pure subroutine mass_product(sys, x, y)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: x(:)
-    real(dp), intent(out) :: y(:)
-    integer :: i, k, j
-    real(dp) :: total(3), m
-    if (allocated(sys%mass_pair_ptr)) then
-      ! kron(Mbar, I2) over the plane's pairs: each row's sums as csr_matvec takes them
-      do i = 1, size(sys%mass_pair_ptr) - 1
-        total(1:2) = 0.0_dp
-        do k = sys%mass_pair_ptr(i), sys%mass_pair_ptr(i + 1) - 1
-          j = sys%mass_pair_col(k)
-          m = sys%mass_pair_values(k)
-          total(1) = total(1) + m * x(j)
-          total(2) = total(2) + m * x(j + 1)
-        end do
-        j = sys%mass_pair_row(i)
-        y(j) = total(1)
-        y(j + 1) = total(2)
-      end do
-      return
-    end if
-    if (.not. sys%mass_kron) then
-      call csr_matvec(sys%mass_row_ptr, sys%mass_col, sys%mass_values, x, y)
-      return
-    end if
-    do i = 1, size(sys%mass_row_ptr) - 1
-      total = 0.0_dp
-      do k = sys%mass_row_ptr(i), sys%mass_row_ptr(i + 1) - 1
-        j = 3 * (sys%mass_col(k) - 1)
-        m = sys%mass_values(k)
-        total(1) = total(1) + m * x(j + 1)
-        total(2) = total(2) + m * x(j + 2)
-        total(3) = total(3) + m * x(j + 3)
-      end do
-      y(3 * i - 2:3 * i) = total
-    end do
-  end subroutine mass_product
-
-  !> The mass product of a planar reduction by pairs (mass_pair_*): when every reduced
-  !> coordinate is the x or y of a plane vector (carry_plane, y = x + 1) and the CSR mass's
-  !> y row of each pair is its x row moved to the partner columns with the same values
-  !> (bit for bit) in the same order, Mbar's rows by pair, so that mass_product takes the
-  !> same sums with half the index work; otherwise nothing (the CSR stays in use).
-  subroutine plane_mass_setup(sys)
-    type(system_model), intent(inout) :: sys
-    integer, allocatable :: pair_of(:)
-    integer :: npair, p, k, row_x, row_y, kx, ky, count_x, nnz
-    if (allocated(sys%mass_pair_ptr)) deallocate (sys%mass_pair_ptr, sys%mass_pair_col, &
-                                                  sys%mass_pair_row, sys%mass_pair_values)
-    sys%mass_pairs_ordered = .false.
-    if (sys%mass_kron .or. .not. allocated(sys%carry_plane) .or. &
-        .not. allocated(sys%mass_row_ptr)) return
-    npair = size(sys%carry_plane, 2)
-    if (2 * npair /= sys%ndof .or. size(sys%mass_row_ptr) /= sys%ndof + 1) return
-    allocate (pair_of(sys%ndof))
-    pair_of = 0
-    do p = 1, npair
-      row_x = sys%carry_plane(1, p)
-      if (sys%carry_plane(2, p) /= row_x + 1) return
-      if (pair_of(row_x) /= 0 .or. pair_of(row_x + 1) /= 0) return
-      pair_of(row_x) = p
-      pair_of(row_x + 1) = -p
-    end do
-    nnz = 0
-    do p = 1, npair
-      row_x = sys%carry_plane(1, p)
-      row_y = row_x + 1
-      count_x = sys%mass_row_ptr(row_x + 1) - sys%mass_row_ptr(row_x)
-      if (sys%mass_row_ptr(row_y + 1) - sys%mass_row_ptr(row_y) /= count_x) return
-      do k = 0, count_x - 1
-        kx = sys%mass_row_ptr(row_x) + k
-        ky = sys%mass_row_ptr(row_y) + k
-        if (pair_of(sys%mass_col(kx)) <= 0 .or. sys%mass_col(ky) /= sys%mass_col(kx) + 1) return
-        if (transfer(sys%mass_values(kx), 1_int64) /= transfer(sys%mass_values(ky), 1_int64)) &
-          return
-      end do
-      nnz = nnz + count_x
-    end do
-    allocate (sys%mass_pair_ptr(npair + 1), sys%mass_pair_col(nnz), sys%mass_pair_row(npair), &
-              sys%mass_pair_values(nnz))
-    sys%mass_pair_ptr(1) = 1
-    do p = 1, npair
-      row_x = sys%carry_plane(1, p)
-      sys%mass_pair_row(p) = row_x
-      count_x = sys%mass_row_ptr(row_x + 1) - sys%mass_row_ptr(row_x)
-      kx = sys%mass_row_ptr(row_x)
-      sys%mass_pair_col(sys%mass_pair_ptr(p):sys%mass_pair_ptr(p) + count_x - 1) = &
-        sys%mass_col(kx:kx + count_x - 1)
-      sys%mass_pair_values(sys%mass_pair_ptr(p):sys%mass_pair_ptr(p) + count_x - 1) = &
-        sys%mass_values(kx:kx + count_x - 1)
-      sys%mass_pair_ptr(p + 1) = sys%mass_pair_ptr(p) + count_x
-    end do
-    sys%mass_pairs_ordered = all(sys%mass_pair_row == [(2 * p - 1, p = 1, npair)])
-  end subroutine plane_mass_setup
-
-  !> kinetic: the kinetic energy 1/2 e'^T M e' (M: mass_product's). With the plane's pairs in
-  !> coordinate order, in one pass: each row's sums as mass_product takes them, and their
-  !> products with e' summed in coordinate order from 0, as dot_product(v, M v) sums them
-  !> (the same number, bit for bit, without M v in memory); otherwise by mass_product and
-  !> dot_product (mv: work, ndof).
-  pure subroutine kinetic_energy(sys, v, mv, kinetic)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: v(:)
-    real(dp), intent(out) :: mv(:), kinetic
-    integer :: i, k, j
-    real(dp) :: total, total_x, total_y, m
-    if (sys%mass_pairs_ordered .and. allocated(sys%mass_pair_ptr)) then
-      total = 0.0_dp
-      do i = 1, size(sys%mass_pair_ptr) - 1
-        total_x = 0.0_dp
-        total_y = 0.0_dp
-        do k = sys%mass_pair_ptr(i), sys%mass_pair_ptr(i + 1) - 1
-          j = sys%mass_pair_col(k)
-          m = sys%mass_pair_values(k)
-          total_x = total_x + m * v(j)
-          total_y = total_y + m * v(j + 1)
-        end do
-        total = total + v(2 * i - 1) * total_x
-        total = total + v(2 * i) * total_y
-      end do
-      kinetic = 0.5_dp * total
-      return
-    end if
-    call mass_product(sys, v, mv)
-    kinetic = 0.5_dp * dot_product(v, mv)
-  end subroutine kinetic_energy
-
-  !> y = M x for a CSR matrix (1-based).
-  pure subroutine csr_matvec(row_ptr, col, values, x, y)
-    integer, intent(in) :: row_ptr(:), col(:)
-    real(dp), intent(in) :: values(:), x(:)
-    real(dp), intent(out) :: y(:)
-    integer :: i, k
-    real(dp) :: total
-    do i = 1, size(row_ptr) - 1
-      total = 0.0_dp
-      do k = row_ptr(i), row_ptr(i + 1) - 1
-        total = total + values(k) * x(col(k))
-      end do
-      y(i) = total
-    end do
-  end subroutine csr_matvec
 
   !> q = B e + q0 (with_offset; velocities without).
   pure subroutine to_full(sys, x, with_offset, full)
@@ -1484,7 +1322,7 @@ contains
       end do
     end do
     energy = 0.0_dp
-    call kinetic_energy(sys, v, mv, energy(energy_kinetic))
+    call kinetic_energy(sys%mass, v, mv, energy(energy_kinetic))
     energy(energy_strain) = strain
     energy(energy_loads) = -dot_product(sys%constant_force, e)
     do m = 1, size(sys%moment_magnitude)
