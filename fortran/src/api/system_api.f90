@@ -331,7 +331,8 @@ end subroutine system_set_sections
 subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_rows, xi, &
                                  forces, info, message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, frame_rotations, to_full
+  use mechanical_system, only: system_model, frame_rotations
+  use system_reduction, only: to_full
   use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, index, nrows, ndof, ns, nst
@@ -361,7 +362,7 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
       return
     end if
     rotations(:, :, row) = frames(:, :, frame)
-    call to_full(sys, e_rows(:, row), .true., q_rows(:, row))
+    call to_full(sys%reduction, e_rows(:, row), .true., q_rows(:, row))
   end do
   call sys%sets(index)%item%section_forces(rotations, q_rows, xi, forces, info)
   if (info /= 0) then
@@ -589,8 +590,8 @@ subroutine system_set_solver(handle, nfull, nnz_full, full_row_ptr, full_col, so
     message = 'system_set_solver: sizes inconsistent with the system (nfull)'
     return
   end if
-  sys%full_row_ptr = full_row_ptr
-  sys%full_col = full_col
+  sys%reduction%full_ptr = full_row_ptr
+  sys%reduction%full_col = full_col
   sys%solver_handle = solver(sl_handle)
   sys%policy = solver(sl_policy)
   if (allocated(sys%vector_frame)) deallocate (sys%vector_frame)
@@ -642,20 +643,20 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   if (allocated(sys%carry_source)) deallocate (sys%carry_source)
   if (nvec == 0) return
   allocate (sys%carry_map(3, sys%nfull / 3))
-  if (.not. sys%reduced) then
+  if (.not. sys%reduction%active) then
     sys%carry_map = reshape([(i, i = 1, sys%nfull)], [3, sys%nfull / 3])
     call carry_sources()
     return
   end if
   sys%carry_map = 0
   do i = 1, sys%nfull  ! a selection: at most one unit entry per row of B
-    k = sys%reduction_ptr(i)
-    if (sys%reduction_ptr(i + 1) - k /= 1) cycle
-    if (sys%reduction_values(k) /= 1.0_dp) cycle
-    sys%carry_map(mod(i - 1, 3) + 1, (i - 1) / 3 + 1) = sys%reduction_col(k)
+    k = sys%reduction%ptr(i)
+    if (sys%reduction%ptr(i + 1) - k /= 1) cycle
+    if (sys%reduction%values(k) /= 1.0_dp) cycle
+    sys%carry_map(mod(i - 1, 3) + 1, (i - 1) / 3 + 1) = sys%reduction%col(k)
   end do
-  if (count(sys%carry_map > 0) /= sys%ndof .or. any(sys%reduction_ptr(2:) - &
-      sys%reduction_ptr(:sys%nfull) > 1)) then
+  if (count(sys%carry_map > 0) /= sys%ndof .or. any(sys%reduction%ptr(2:) - &
+      sys%reduction%ptr(:sys%nfull) > 1)) then
     info = 2
     message = 'system_set_carry: the reduction is not a selection of coordinates'
     deallocate (sys%carry_first, sys%carry_weight, sys%carry_position, sys%carry_map)
@@ -728,6 +729,7 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
                                 plan_source, plan_target, plan_coef, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
+  use system_reduction, only: reduction_setup
   use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nfull, nnz_b, b_ptr(nfull + 1), b_col(max(1, nnz_b)), nplan
@@ -737,7 +739,6 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  integer :: i
   call api_system(handle, sys, info, message)
   if (info /= 0) return
   if (nfull /= sys%nfull) then
@@ -745,34 +746,8 @@ subroutine system_set_reduction(handle, nfull, nnz_b, b_ptr, b_col, b_values, of
     message = 'system_set_reduction: sizes inconsistent with the system (nfull)'
     return
   end if
-  sys%reduced = .true.
-  sys%reduction_ptr = b_ptr
-  sys%reduction_col = b_col(1:nnz_b)
-  sys%reduction_values = b_values(1:nnz_b)
-  sys%reduction_offset = offset
-  sys%plan_source = plan_source(1:nplan)
-  sys%plan_target = plan_target(1:nplan)
-  sys%plan_coef = plan_coef(1:nplan)
-  ! a selection (each row of B empty or one entry 1): to_full and to_reduced by its columns
-  ! (offset or 0, plus 1 x: the same sums without the row pointers and the products by 1)
-  if (allocated(sys%reduction_select)) deallocate (sys%reduction_select, sys%select_full, &
-                                                    sys%select_column, sys%select_fixed)
-  sys%select_one_to_one = .false.
-  if (all(b_ptr(2:) - b_ptr(:nfull) <= 1) .and. all(b_values(1:nnz_b) == 1.0_dp)) then
-    allocate (sys%reduction_select(nfull))
-    do i = 1, nfull
-      sys%reduction_select(i) = 0
-      if (b_ptr(i + 1) > b_ptr(i)) sys%reduction_select(i) = b_col(b_ptr(i))
-    end do
-    sys%select_full = pack([(i, i = 1, nfull)], sys%reduction_select > 0)
-    sys%select_column = pack(sys%reduction_select, sys%reduction_select > 0)
-    sys%select_fixed = pack([(i, i = 1, nfull)], sys%reduction_select == 0)
-    sys%select_one_to_one = .true.
-    do i = 1, size(sys%select_column) - 1
-      if (any(sys%select_column(i + 1:) == sys%select_column(i))) &
-        sys%select_one_to_one = .false.
-    end do
-  end if
+  call reduction_setup(sys%reduction, b_ptr, b_col(1:nnz_b), b_values(1:nnz_b), offset, &
+                       plan_source(1:nplan), plan_target(1:nplan), plan_coef(1:nplan))
 end subroutine system_set_reduction
 
 !> Loads: the constant force (independent coordinates), driven forces phi_d(t) f_d, dead
@@ -1656,7 +1631,7 @@ subroutine system_contact_forces(handle, nfull, nnz, npoint, state, velocity_fac
   call api_system(handle, sys, info, message)
   if (info /= 0) return
   if (nfull /= sys%nfull .or. npoint /= sys%npoint .or. (want_jacobian /= 0 .and. &
-      nnz /= size(sys%full_col))) then
+      nnz /= size(sys%reduction%full_col))) then
     info = 2
     message = 'system_contact_forces: sizes inconsistent with the system (nfull, npoint,' // &
               ' or nnz of the full pattern)'

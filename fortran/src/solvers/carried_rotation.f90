@@ -58,7 +58,7 @@ contains
         if (source > 0) then
           vectors(i, k) = e(source)
         else  ! a coordinate the reduction fixes
-          vectors(i, k) = sys%reduction_offset(-source)
+          vectors(i, k) = sys%reduction%offset(-source)
         end if
       end do
     end do

@@ -13,7 +13,8 @@
 module row_answers
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, contact_record, frame_rotations, &
-                               internal_forces, to_full, force_element_reactions
+                               internal_forces, force_element_reactions
+  use system_reduction, only: to_full
   use constraints, only: drive_value
   implicit none
   private
@@ -80,7 +81,7 @@ contains
                          potential, powers, records, info, rates=rates, full_out=full_force, &
                          force_time=t)
     if (info /= 0) return
-    call to_full(sys, accel, .false., accel_full)
+    call to_full(sys%reduction, accel, .false., accel_full)
     do d = 1, size(phi)
       call drive_value(sys%force_drive(d), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
                        phi(d), dphi, ddphi, info)

@@ -24,6 +24,7 @@ module static_solver
                                external_forces, constraint_reaction, contact_record
   use constraints, only: constraint_eval
   use section_moment, only: moment_force
+  use system_reduction, only: row_terms, reduced_col, reduced_coef, full_at
   use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
                            solver_destroy
   use kernel_errors, only: failure_text, message_length
@@ -107,7 +108,7 @@ contains
     do m = 1, size(sys%moment_magnitude)
       do i = 1, 3
         do j = 1, 3
-          nmom = nmom + row_terms(sys%moment_dofs(i, m)) * row_terms(sys%moment_dofs(j, m))
+          nmom = nmom + row_terms(sys%reduction, sys%moment_dofs(i, m)) * row_terms(sys%reduction, sys%moment_dofs(j, m))
         end do
       end do
     end do
@@ -132,11 +133,11 @@ contains
     do m = 1, size(sys%moment_magnitude)
       do i = 1, 3
         do j = 1, 3
-          do a = 1, row_terms(sys%moment_dofs(i, m))
-            do b = 1, row_terms(sys%moment_dofs(j, m))
+          do a = 1, row_terms(sys%reduction, sys%moment_dofs(i, m))
+            do b = 1, row_terms(sys%reduction, sys%moment_dofs(j, m))
               k = k + 1
-              srows(k) = reduced_col(sys%moment_dofs(i, m), a)
-              scols(k) = reduced_col(sys%moment_dofs(j, m), b)
+              srows(k) = reduced_col(sys%reduction, sys%moment_dofs(i, m), a)
+              scols(k) = reduced_col(sys%reduction, sys%moment_dofs(j, m), b)
             end do
           end do
         end do
@@ -199,7 +200,7 @@ contains
         end do
       end do
       do m = 1, size(sys%moment_magnitude)
-        call moment_force(full_at(sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
+        call moment_force(full_at(sys%reduction, e, sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
                           load_factor * sys%moment_magnitude(m), moment, jacobian, hessian, info)
         if (info /= 0) then
           info = 6
@@ -207,11 +208,12 @@ contains
         end if
         do i = 1, 3
           do j = 1, 3
-            do a = 1, row_terms(sys%moment_dofs(i, m))
-              do b = 1, row_terms(sys%moment_dofs(j, m))
+            do a = 1, row_terms(sys%reduction, sys%moment_dofs(i, m))
+              do b = 1, row_terms(sys%reduction, sys%moment_dofs(j, m))
                 k = k + 1
-                values(k) = -jacobian(i, j) * reduced_coef(sys%moment_dofs(i, m), a) &
-                            * reduced_coef(sys%moment_dofs(j, m), b)
+                values(k) = -jacobian(i, j) &
+                            * reduced_coef(sys%reduction, sys%moment_dofs(i, m), a) &
+                            * reduced_coef(sys%reduction, sys%moment_dofs(j, m), b)
               end do
             end do
           end do
@@ -376,43 +378,6 @@ contains
       integer, intent(in) :: c, s
       first_term = sys%term_ptr(6 * (c - 1) + s)
     end function first_term
-
-    !> the coordinates e the full coordinate q(i) depends on (q = B e + q0), their number,
-    !> the a-th of them and its coefficient
-    integer function row_terms(i)
-      integer, intent(in) :: i
-      row_terms = 1
-      if (sys%reduced) row_terms = sys%reduction_ptr(i + 1) - sys%reduction_ptr(i)
-    end function row_terms
-
-    integer function reduced_col(i, a)
-      integer, intent(in) :: i, a
-      reduced_col = i
-      if (sys%reduced) reduced_col = sys%reduction_col(sys%reduction_ptr(i) + a - 1)
-    end function reduced_col
-
-    real(dp) function reduced_coef(i, a)
-      integer, intent(in) :: i, a
-      reduced_coef = 1.0_dp
-      if (sys%reduced) reduced_coef = sys%reduction_values(sys%reduction_ptr(i) + a - 1)
-    end function reduced_coef
-
-    !> the full coordinates q(dofs) at e
-    function full_at(dofs) result(q)
-      integer, intent(in) :: dofs(:)
-      real(dp) :: q(size(dofs))
-      integer :: p, a2
-      do p = 1, size(dofs)
-        if (.not. sys%reduced) then
-          q(p) = e(dofs(p))
-        else
-          q(p) = sys%reduction_offset(dofs(p))
-          do a2 = 1, row_terms(dofs(p))
-            q(p) = q(p) + reduced_coef(dofs(p), a2) * e(reduced_col(dofs(p), a2))
-          end do
-        end if
-      end do
-    end function full_at
 
   end subroutine static_newton
 

@@ -43,10 +43,12 @@ module mechanical_system
                           cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
   use system_mass, only: mass_matrix, kinetic_energy
+  use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
+                              pattern_position
   implicit none
   private
   public :: system_model, frame_def, contact_pair, contact_state
-  public :: frame_rotations, to_full, to_reduced, internal_forces, &
+  public :: frame_rotations, internal_forces, &
             external_forces, &
             evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
             refactorize, to_solver_frame, &
@@ -97,21 +99,7 @@ module mechanical_system
     integer, allocatable :: drive_kinds(:), drive_ptr(:)
     real(dp), allocatable :: drive_data(:)
     type(mass_matrix) :: mass                         ! M and its forms (system_mass)
-    ! full pattern of the tangents; q = B e + q0 and the plan of B^T S B
-    integer, allocatable :: full_row_ptr(:), full_col(:)
-    logical :: reduced = .false.
-    integer, allocatable :: reduction_ptr(:), reduction_col(:)
-    real(dp), allocatable :: reduction_values(:), reduction_offset(:)
-    ! a reduction that selects (each row of B empty or one entry 1): the column of each
-    ! full coordinate (0: fixed), for to_full and to_reduced; unallocated otherwise
-    integer, allocatable :: reduction_select(:)
-    ! the same selection as lists: the selected full coordinates (increasing) with their
-    ! columns, and the fixed ones
-    integer, allocatable :: select_full(:), select_column(:), select_fixed(:)
-    ! the selection takes no column twice (each reduced coordinate one full one)
-    logical :: select_one_to_one = .false.
-    integer, allocatable :: plan_source(:), plan_target(:)
-    real(dp), allocatable :: plan_coef(:)
+    type(coordinate_reduction) :: reduction  ! q = B e + q0, the plan (system_reduction)
     ! loads: constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
     ! director coordinates
     real(dp), allocatable :: constant_force(:)
@@ -282,76 +270,6 @@ contains
     if (f > 0) omega_local = frame_omega(rotation, sys%frames(f)%axis, rate)
   end function set_omega
 
-  !> q = B e + q0 (with_offset; velocities without).
-  pure subroutine to_full(sys, x, with_offset, full)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: x(:)
-    logical, intent(in) :: with_offset
-    real(dp), intent(out) :: full(:)
-    integer :: i, k
-    real(dp) :: total
-    if (.not. sys%reduced) then
-      full = x
-      return
-    end if
-    if (allocated(sys%reduction_select)) then
-      ! a selection: the same sums (offset or 0, plus 1 x) without the row pointers, by the
-      ! lists of selected and fixed coordinates
-      if (with_offset) then
-        do k = 1, size(sys%select_fixed)
-          full(sys%select_fixed(k)) = sys%reduction_offset(sys%select_fixed(k))
-        end do
-        do k = 1, size(sys%select_full)
-          i = sys%select_full(k)
-          full(i) = sys%reduction_offset(i) + x(sys%select_column(k))
-        end do
-      else
-        do k = 1, size(sys%select_fixed)
-          full(sys%select_fixed(k)) = 0.0_dp
-        end do
-        do k = 1, size(sys%select_full)
-          full(sys%select_full(k)) = 0.0_dp + x(sys%select_column(k))
-        end do
-      end if
-      return
-    end if
-    ! (a scalar accumulator per row, from the offset or 0: the same sums, in a register)
-    do i = 1, sys%nfull
-      total = 0.0_dp
-      if (with_offset) total = sys%reduction_offset(i)
-      do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
-        total = total + sys%reduction_values(k) * x(sys%reduction_col(k))
-      end do
-      full(i) = total
-    end do
-  end subroutine to_full
-
-  !> x = B^T full (seed 003 eq. 37).
-  pure subroutine to_reduced(sys, full, x)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: full(:)
-    real(dp), intent(out) :: x(:)
-    integer :: i, k
-    if (.not. sys%reduced) then
-      x = full
-      return
-    end if
-    x = 0.0_dp
-    if (allocated(sys%reduction_select)) then
-      ! a selection: the same sums (0 plus 1 full(i), in increasing i) without the row
-      ! pointers
-      do k = 1, size(sys%select_full)
-        x(sys%select_column(k)) = x(sys%select_column(k)) + full(sys%select_full(k))
-      end do
-      return
-    end if
-    do i = 1, sys%nfull
-      do k = sys%reduction_ptr(i), sys%reduction_ptr(i + 1) - 1
-        x(sys%reduction_col(k)) = x(sys%reduction_col(k)) + sys%reduction_values(k) * full(i)
-      end do
-    end do
-  end subroutine to_reduced
-
   !> Elastic minus contact forces minus the dead moments (times load_factor), reduced: the
   !> configuration-dependent part of the residual at (e, e') and t; strain energy, contact
   !> potential, contact powers (damping, friction) and per-point records. With
@@ -393,14 +311,14 @@ contains
     ! the force alone of undamped sets on a one-to-one selection, nothing else acting: each
     ! set straight on the independent coordinates (selected_forces), without q, the full
     ! force and B^T (the same numbers)
-    done = .not. want_tangent .and. sys%select_one_to_one .and. sys%npoint == 0 .and. &
+    done = .not. want_tangent .and. sys%reduction%select_one_to_one .and. sys%npoint == 0 .and. &
            sys%nfel == 0 .and. .not. present(full_out)
     if (done .and. allocated(sys%moment_magnitude)) done = size(sys%moment_magnitude) == 0
     if (done) then
       force = 0.0_dp
       strain = 0.0_dp
       do s = 1, size(sys%sets)
-        call sys%sets(s)%item%selected_forces(sys%reduction_select, sys%reduction_offset, e, &
+        call sys%sets(s)%item%selected_forces(sys%reduction%select, sys%reduction%offset, e, &
                                               force, set_energy, info, done)
         if (.not. done .or. info /= 0) exit
         strain = strain + set_energy
@@ -421,16 +339,16 @@ contains
       e_full => own_full(:, 1)
       full_force => own_full(:, 2)
     end if
-    call to_full(sys, e, .true., e_full)
+    call to_full(sys%reduction, e, .true., e_full)
     full_force = 0.0_dp
     strain = 0.0_dp
     if (want_tangent) then
-      allocate (values_full(size(sys%full_col)))
+      allocate (values_full(size(sys%reduction%full_col)))
       values_full = 0.0_dp
     end if
     if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0) then
       allocate (v_full(sys%nfull))
-      call to_full(sys, v, .false., v_full)
+      call to_full(sys%reduction, v, .false., v_full)
     end if
     if (sys%nfel > 0) then
       if (want_tangent) then
@@ -493,21 +411,13 @@ contains
       end do
     end do
     if (present(full_out)) full_out = full_force
-    call to_reduced(sys, full_force, force)
+    call to_reduced(sys%reduction, full_force, force)
     if (.not. want_tangent) return
     if (present(t) .and. sys%nvload > 0) then
       call vector_load_tangent(sys, t, e_full, load_factor, values_full, info)
       if (info /= 0) return
     end if
-    if (sys%reduced) then  ! B^T S B by the plan
-      tangent_values = 0.0_dp
-      do k = 1, size(sys%plan_source)
-        tangent_values(sys%plan_target(k)) = tangent_values(sys%plan_target(k)) &
-                                             + sys%plan_coef(k) * values_full(sys%plan_source(k))
-      end do
-    else
-      tangent_values = values_full
-    end if
+    call reduce_tangent(sys%reduction, values_full, tangent_values)
   end subroutine internal_forces
 
   !> Contact forces of every pair subtracted from full_force (they are external: the
@@ -538,8 +448,8 @@ contains
                               sys%pairs(p)%grid, sys%pairs(p)%point_element, &
                               sys%pairs(p)%point_local, sys%pairs(p)%params, velocity_factor, &
                               state%guesses(:, first:last), pair_force, records(:, first:last), &
-                              pair_potential, pair_powers, state%counts, info, sys%full_row_ptr, &
-                              sys%full_col, values_full)
+                              pair_potential, pair_powers, state%counts, info, sys%reduction%full_ptr, &
+                              sys%reduction%full_col, values_full)
       else
         call contact_assemble(e_full, v_full, sys%pairs(p)%dofs, sys%pairs(p)%sizes, &
                               sys%pairs(p)%grid, sys%pairs(p)%point_element, &
@@ -570,11 +480,11 @@ contains
     force = load_factor * sys%constant_force
     if (present(e) .and. sys%nvload > 0) then
       allocate (e_full(sys%nfull), full_force(sys%nfull), reduced(sys%ndof))
-      call to_full(sys, e, .true., e_full)
+      call to_full(sys%reduction, e, .true., e_full)
       full_force = 0.0_dp
       call vector_load_forces(sys, t, e_full, load_factor, full_force, info)
       if (info /= 0) return
-      call to_reduced(sys, full_force, reduced)
+      call to_reduced(sys%reduction, full_force, reduced)
       force = force + reduced
     end if
     do d = 1, size(sys%force_drive)
@@ -634,7 +544,7 @@ contains
                 row = sys%vload_dof(k) + i - 1
                 do j = 1, 3
                   col = sys%vload_dof(m) + j - 1
-                  pos = pattern_position(sys, row, col)
+                  pos = pattern_position(sys%reduction, row, col)
                   if (pos > 0) values_full(pos) = values_full(pos) - sys%vload_coef(k) &
                                                   * sys%vload_coef(m) * jacobian(i, s, j, w)
                 end do
@@ -748,7 +658,7 @@ contains
                       next = next + 1
                     else
                       col = sys%fel_term_dof(m) + j - 1
-                      pos = pattern_position(sys, row, col)
+                      pos = pattern_position(sys%reduction, row, col)
                     end if
                     if (pos > 0) values_full(pos) = values_full(pos) + sys%fel_term_coef(k) &
                                                     * sys%fel_term_coef(m) * stiffness(i, s, j, w)
@@ -818,8 +728,8 @@ contains
     integer :: l, ns
     info = 0
     allocate (e_full(sys%nfull), v_full(sys%nfull))
-    call to_full(sys, e, .true., e_full)
-    call to_full(sys, v, .false., v_full)
+    call to_full(sys%reduction, e, .true., e_full)
+    call to_full(sys%reduction, v, .false., v_full)
     do l = 1, sys%nfel
       ns = force_element_slots(sys%fel_kind(l))
       allocate (force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns))
@@ -829,20 +739,6 @@ contains
       deallocate (force, stiffness, damping)
     end do
   end subroutine force_element_reactions
-
-  !> Position of (row, col) in the full pattern, 0 when absent.
-  pure integer function pattern_position(sys, row, col) result(pos)
-    type(system_model), intent(in) :: sys
-    integer, intent(in) :: row, col
-    integer :: k
-    pos = 0
-    do k = sys%full_row_ptr(row), sys%full_row_ptr(row + 1) - 1
-      if (sys%full_col(k) == col) then
-        pos = k
-        return
-      end if
-    end do
-  end function pattern_position
 
   !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
   !> drive cannot be evaluated. constraint_eval's first-order results with the same
@@ -1162,10 +1058,10 @@ contains
     powers = 0.0_dp
     ! the driven constraints and the driven forces phi_d(t) f_d do their work per step
     ! (drive_step_work, the integrator's own discrete identity), not here as powers
-    call to_full(sys, e, .true., e_full)
+    call to_full(sys%reduction, e, .true., e_full)
     if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0 .or. sys%nvload > 0) then
       allocate (v_full(sys%nfull))
-      call to_full(sys, v, .false., v_full)
+      call to_full(sys%reduction, v, .false., v_full)
     end if
     strain = 0.0_dp
     if (sys%nvload > 0) then  ! the driven and follower point loads and a rigid body's dead
@@ -1297,7 +1193,7 @@ contains
       mv => ndof_work
     else
       allocate (own_full(sys%nfull), own_ndof(sys%ndof))
-      call to_full(sys, e, .true., own_full)
+      call to_full(sys%reduction, e, .true., own_full)
       e_full => own_full
       mv => own_ndof
     end if
