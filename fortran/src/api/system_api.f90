@@ -25,8 +25,8 @@ subroutine system_create(ndof, nfull, handle, info, message)
   sys%ndof = ndof
   sys%nfull = nfull
   allocate (sys%sets(0), sys%frames(0), sys%pairs(0))
-  allocate (sys%drive_kinds(0), sys%drive_ptr(1), sys%drive_data(0))
-  sys%drive_ptr = 1
+  allocate (sys%drives%kinds(0), sys%drives%ptr(1), sys%drives%data(0))
+  sys%drives%ptr = 1
   allocate (sys%constant_force(ndof), sys%force_drive(0), sys%force_vectors(ndof, 0))
   sys%constant_force = 0.0_dp
   allocate (sys%moment_dofs(3, 0), sys%moment_axis(3, 0), sys%moment_magnitude(0), &
@@ -517,9 +517,9 @@ subroutine system_set_drives(handle, ndrive, ndata, kinds, ptr, data, info, mess
     message = 'system_set_drives: drive pointers inconsistent with ndata'
     return
   end if
-  sys%drive_kinds = kinds(1:ndrive)
-  sys%drive_ptr = ptr
-  sys%drive_data = data(1:ndata)
+  sys%drives%kinds = kinds(1:ndrive)
+  sys%drives%ptr = ptr
+  sys%drives%data = data(1:ndata)
 end subroutine system_set_drives
 
 !> The mass matrix on the independent coordinates (CSR, 1-based; zero entries may be left
@@ -823,7 +823,7 @@ subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors,
   end if
   if (nload > 0) then
     if (any(kinds(1:nload) < 1) .or. any(kinds(1:nload) > 3) .or. &
-        any(drives(1:nload) < 0) .or. any(drives(1:nload) > size(sys%drive_kinds))) then
+        any(drives(1:nload) < 0) .or. any(drives(1:nload) > size(sys%drives%kinds))) then
       info = 2
       return
     end if
@@ -904,7 +904,7 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, npos, element
     if (force_element_slots(kind) == 0) return
     if (pointers(l + 1, fp_param) - pointers(l, fp_param) < force_element_parameters(kind)) return
     if (first < 1 .or. first + force_element_slots(kind) - 1 > size(sys%fel_slot_const, 2)) return
-    if (elements(fl_drive, l) < 0 .or. elements(fl_drive, l) > size(sys%drive_kinds)) return
+    if (elements(fl_drive, l) < 0 .or. elements(fl_drive, l) > size(sys%drives%kinds)) return
   end do
   info = 0
   sys%nfel = nfel

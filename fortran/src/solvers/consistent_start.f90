@@ -60,8 +60,8 @@ contains
     end if
     if (ncon > 0) then
       call constraint_eval(ncon, sys%con_kind, sys%con_drive, sys%con_params, sys%operand_const, &
-                           sys%term_ptr, sys%term_dof, sys%term_coef, sys%drive_kinds, &
-                           sys%drive_ptr, sys%drive_data, e, v, t, values, gradients, hessians, &
+                           sys%term_ptr, sys%term_dof, sys%term_coef, sys%drives%kinds, &
+                           sys%drives%ptr, sys%drives%data, e, v, t, values, gradients, hessians, &
                            phi_t, phi_tt, gamma, info)
       if (info /= 0) then
         info = 5

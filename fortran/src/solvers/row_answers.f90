@@ -15,7 +15,7 @@ module row_answers
   use mechanical_system, only: system_model, contact_state, contact_record, frame_rotations, &
                                internal_forces, force_element_reactions
   use system_reduction, only: to_full
-  use constraints, only: drive_value
+  use system_drives, only: drive_at
   implicit none
   private
   public :: answer_data, answer_count, answer_row
@@ -83,7 +83,7 @@ contains
     if (info /= 0) return
     call to_full(sys%reduction, accel, .false., accel_full)
     do d = 1, size(phi)
-      call drive_value(sys%force_drive(d), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+      call drive_at(sys%drives, sys%force_drive(d), t, &
                        phi(d), dphi, ddphi, info)
       if (info /= 0) then
         info = 5

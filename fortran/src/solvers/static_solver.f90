@@ -308,7 +308,7 @@ contains
       if (ncon > 0) then
         call constraint_eval(ncon, sys%con_kind, sys%con_drive, sys%con_params, &
                              sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
-                             sys%drive_kinds, sys%drive_ptr, sys%drive_data, e, zero_rates, t, &
+                             sys%drives%kinds, sys%drives%ptr, sys%drives%data, e, zero_rates, t, &
                              phi, gradients, hessians, phi_t, phi_tt, gamma, info, &
                              first_order_only=.not. with_tangent)
         if (info /= 0) then

@@ -31,7 +31,7 @@
 !> No I/O; failures return codes.
 module mechanical_system
   use ancf_kinds, only: dp
-  use constraints, only: constraint_eval, operand_values, drive_value, constraint_value, &
+  use constraints, only: constraint_eval, operand_values, constraint_value, &
                          constraint_kind_coordinate, constraint_kind_distance, &
                          constraint_kind_cross, constraint_kind_dot
   use matrix3, only: cross
@@ -42,6 +42,7 @@ module mechanical_system
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
                           cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
+  use system_drives, only: drive_table, drive_at
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -96,8 +97,7 @@ module mechanical_system
     integer :: ndof = 0, nfull = 0
     type(set_slot), allocatable :: sets(:)             ! element sets of any family
     type(frame_def), allocatable :: frames(:)
-    integer, allocatable :: drive_kinds(:), drive_ptr(:)
-    real(dp), allocatable :: drive_data(:)
+    type(drive_table) :: drives                       ! the drive table (system_drives)
     type(mass_matrix) :: mass                         ! M and its forms (system_mass)
     type(coordinate_reduction) :: reduction  ! q = B e + q0, the plan (system_reduction)
     ! loads: constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
@@ -205,7 +205,7 @@ contains
     do f = 1, size(sys%frames)
       rotations(:, :, f) = sys%frames(f)%base
       if (sys%frames(f)%drive == 0) cycle
-      call drive_value(sys%frames(f)%drive, sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+      call drive_at(sys%drives, sys%frames(f)%drive, t, &
                        phi, rates(f), ddphi, info)
       if (info /= 0) then
         info = 5
@@ -488,7 +488,7 @@ contains
       force = force + reduced
     end if
     do d = 1, size(sys%force_drive)
-      call drive_value(sys%force_drive(d), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+      call drive_at(sys%drives, sys%force_drive(d), t, &
                        phi, dphi, ddphi, info)
       if (info /= 0) then
         info = 5
@@ -570,7 +570,7 @@ contains
     info = 0
     phi = 1.0_dp
     if (sys%vload_drive(l) > 0) then
-      call drive_value(sys%vload_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+      call drive_at(sys%drives, sys%vload_drive(l), &
                        t, phi, dphi, ddphi, info)
       if (info /= 0) then
         info = 5
@@ -688,7 +688,7 @@ contains
     length = 0.0_dp
     length_rate = 0.0_dp
     if (sys%fel_drive(l) > 0) then
-      call drive_value(sys%fel_drive(l), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+      call drive_at(sys%drives, sys%fel_drive(l), t, &
                        length, length_rate, ddl, info)
       if (info /= 0) then
         info = 5
@@ -763,7 +763,7 @@ contains
     do c = 1, sys%ncon
       drive_phi = 0.0_dp  ! (drive_value's value without a drive)
       if (sys%con_drive(c) /= 0) then
-        call drive_value(sys%con_drive(c), sys%drive_kinds, sys%drive_ptr, sys%drive_data, t, &
+        call drive_at(sys%drives, sys%con_drive(c), t, &
                          drive_phi, dphi, ddphi, drive_info)
         if (drive_info /= 0) then
           info = 5
@@ -1151,9 +1151,9 @@ contains
     !> The drive's values at the step's ends, phi0 at t0 and phi1 at t1 (info 5: failed).
     subroutine drive_ends(drive)
       integer, intent(in) :: drive
-      call drive_value(drive, sys%drive_kinds, sys%drive_ptr, sys%drive_data, t0, phi0, &
+      call drive_at(sys%drives, drive, t0, phi0, &
                        unused_rate, unused_accel, info)
-      if (info == 0) call drive_value(drive, sys%drive_kinds, sys%drive_ptr, sys%drive_data, &
+      if (info == 0) call drive_at(sys%drives, drive, &
                                       t1, phi1, unused_rate, unused_accel, info)
       if (info /= 0) info = 5
     end subroutine drive_ends
