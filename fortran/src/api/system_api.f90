@@ -31,9 +31,10 @@ subroutine system_create(ndof, nfull, handle, info, message)
   sys%constant_force = 0.0_dp
   allocate (sys%moment_dofs(3, 0), sys%moment_axis(3, 0), sys%moment_magnitude(0), &
             sys%moment_reference(3, 0))
-  allocate (sys%con_kind(0), sys%con_drive(0), sys%term_ptr(1), sys%term_dof(0), &
-            sys%con_params(8, 0), sys%operand_const(6, 0), sys%term_coef(0))
-  sys%term_ptr = 1
+  allocate (sys%constraints%kind(0), sys%constraints%drive(0), sys%constraints%term_ptr(1), &
+            sys%constraints%term_dof(0), sys%constraints%params(8, 0), &
+            sys%constraints%operand_const(6, 0), sys%constraints%term_coef(0))
+  sys%constraints%term_ptr = 1
   allocate (sys%probe_ptr(1), sys%probe_dof(0), sys%probe_frame(0), sys%probe_coef(0), &
             sys%probe_reference(3, 0))
   sys%probe_ptr = 1
@@ -980,20 +981,20 @@ subroutine system_set_constraints(handle, ncon, nterm, kinds, drives, params, op
       return
     end if
   end if
-  sys%ncon = ncon
-  sys%con_kind = kinds(1:ncon)
-  sys%con_drive = drives(1:ncon)
-  sys%con_params = params(:, 1:ncon)
-  sys%operand_const = operand_const(:, 1:ncon)
-  sys%term_ptr = term_ptr
-  sys%term_dof = term_dof(1:nterm)
-  sys%term_coef = term_coef(1:nterm)
-  if (allocated(sys%con_operands)) deallocate (sys%con_operands)
-  allocate (sys%con_operands(ncon))
+  sys%constraints%ncon = ncon
+  sys%constraints%kind = kinds(1:ncon)
+  sys%constraints%drive = drives(1:ncon)
+  sys%constraints%params = params(:, 1:ncon)
+  sys%constraints%operand_const = operand_const(:, 1:ncon)
+  sys%constraints%term_ptr = term_ptr
+  sys%constraints%term_dof = term_dof(1:nterm)
+  sys%constraints%term_coef = term_coef(1:nterm)
+  if (allocated(sys%constraints%operands)) deallocate (sys%constraints%operands)
+  allocate (sys%constraints%operands(ncon))
   do c = 1, ncon
-    sys%con_operands(c) = 0
+    sys%constraints%operands(c) = 0
     do s = 1, 6
-      if (term_ptr(6 * (c - 1) + s + 1) > term_ptr(6 * (c - 1) + s)) sys%con_operands(c) = s
+      if (term_ptr(6 * (c - 1) + s + 1) > term_ptr(6 * (c - 1) + s)) sys%constraints%operands(c) = s
     end do
   end do
 end subroutine system_set_constraints
@@ -1228,7 +1229,7 @@ subroutine system_output_row(handle, ndof, ncon, npoint, nrow, t, state, lam, wo
   call api_system(handle, sys, info, message)
   if (info /= 0) return
   nprobe = sys%nprobe
-  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. npoint /= sys%npoint .or. &
+  if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. npoint /= sys%npoint .or. &
       nrow /= row_size(ndof, ncon, nprobe, npoint, 0, .false.) .or. power_count /= 5) then
     info = 2
     message = 'system_output_row: sizes inconsistent with the system (ndof, ncon, npoint,' // &
@@ -1406,7 +1407,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
     return
   end if
   ndof = sys%ndof
-  ncon = sys%ncon
+  ncon = sys%constraints%ncon
   nprobe = sys%nprobe
   npoint = sys%npoint
   nanswer = answer_count(sys, run%answers)
@@ -1508,7 +1509,7 @@ subroutine system_consistent_acceleration(handle, ndof, ncon, npoint, t, state, 
   lam = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. npoint /= sys%npoint) then
+  if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. npoint /= sys%npoint) then
     info = 2
     message = 'system_consistent_acceleration: sizes inconsistent with the system (ndof, ' // &
               'ncon, npoint)'
@@ -1562,7 +1563,7 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
   call api_system(handle, sys, info, message)
   outcome(so_info) = info
   if (info /= 0) return
-  ncon = sys%ncon
+  ncon = sys%constraints%ncon
   npoint = sys%npoint
   if (ndof /= sys%ndof .or. nstate /= ndof + ncon + 2 * npoint .or. &
       nnz /= size(sys%mass_pattern) .or. max_iter < 1) then

@@ -280,11 +280,13 @@ contains
     real(dp), intent(in) :: turn(3, 3), gradients(:, :)
     real(dp), intent(out) :: columns(:, :), column(:)
     integer :: c, s, k
-    do c = 1, sys%ncon
+    do c = 1, sys%constraints%ncon
       column = 0.0_dp
       do s = 1, 6
-        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-          column(sys%term_dof(k)) = column(sys%term_dof(k)) + gradients(s, c) * sys%term_coef(k)
+        do k = sys%constraints%term_ptr(6 * (c - 1) + s), &
+               sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
+          column(sys%constraints%term_dof(k)) = column(sys%constraints%term_dof(k)) &
+                                                + gradients(s, c) * sys%constraints%term_coef(k)
         end do
       end do
       call carry_apply(sys, turn, column, .true., columns(:, c))
@@ -309,17 +311,19 @@ contains
     r21 = turn(1, 2)
     r22 = turn(2, 2)
     r23 = turn(3, 2) * 0.0_dp
-    do c = 1, sys%ncon
+    do c = 1, sys%constraints%ncon
       do p = 1, size(pairs)
         column(sys%carry_plane(1, pairs(p))) = 0.0_dp
         column(sys%carry_plane(2, pairs(p))) = 0.0_dp
       end do
       ! (the operands up to the last with terms, con_operands: the rest are empty)
       last = 6
-      if (allocated(sys%con_operands)) last = sys%con_operands(c)
+      if (allocated(sys%constraints%operands)) last = sys%constraints%operands(c)
       do s = 1, last
-        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-          column(sys%term_dof(k)) = column(sys%term_dof(k)) + gradients(s, c) * sys%term_coef(k)
+        do k = sys%constraints%term_ptr(6 * (c - 1) + s), &
+               sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
+          column(sys%constraints%term_dof(k)) = column(sys%constraints%term_dof(k)) &
+                                                + gradients(s, c) * sys%constraints%term_coef(k)
         end do
       end do
       do p = 1, size(pairs)

@@ -11,7 +11,7 @@ module consistent_start
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
                                external_forces, contact_record
-  use constraints, only: constraint_eval
+  use system_constraints, only: constraint_derivatives
   use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
                            solver_destroy
   use kernel_errors, only: failure_text, message_length
@@ -35,15 +35,17 @@ contains
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: internal(sys%ndof), external(sys%ndof), strain, potential, powers(2)
     real(dp) :: records(contact_record, max(1, sys%npoint))
-    real(dp) :: values(sys%ncon), gradients(6, sys%ncon), hessians(6, 6, sys%ncon)
-    real(dp) :: phi_t(sys%ncon), phi_tt(sys%ncon), gamma(sys%ncon)
+    real(dp) :: values(sys%constraints%ncon), gradients(6, sys%constraints%ncon)
+    real(dp) :: hessians(6, 6, sys%constraints%ncon)
+    real(dp) :: phi_t(sys%constraints%ncon), phi_tt(sys%constraints%ncon)
+    real(dp) :: gamma(sys%constraints%ncon)
     real(dp), allocatable :: entries(:), rhs(:, :)
     integer, allocatable :: rows(:), cols(:)
     integer :: n, ncon, nmass, nterm, k, c, s, i, row, handle, stage, ignored
     character(len=*), parameter :: what = "the consistent acceleration's saddle system " // &
                                            '[[M, -Phi_e^T], [-Phi_e, 0]]'
     n = sys%ndof
-    ncon = sys%ncon
+    ncon = sys%constraints%ncon
     accel = 0.0_dp
     lam = 0.0_dp
     detail = 0
@@ -59,10 +61,8 @@ contains
       return
     end if
     if (ncon > 0) then
-      call constraint_eval(ncon, sys%con_kind, sys%con_drive, sys%con_params, sys%operand_const, &
-                           sys%term_ptr, sys%term_dof, sys%term_coef, sys%drives%kinds, &
-                           sys%drives%ptr, sys%drives%data, e, v, t, values, gradients, hessians, &
-                           phi_t, phi_tt, gamma, info)
+      call constraint_derivatives(sys%constraints, sys%drives, e, v, t, values, gradients, &
+                                  hessians, phi_t, phi_tt, gamma, info)
       if (info /= 0) then
         info = 5
         message = 'the consistent acceleration: ' // failure_text(info)
@@ -73,7 +73,7 @@ contains
     ! Phi_e's (rows of lambda)
     nmass = size(sys%mass%saddle_col)
     nterm = 0
-    if (ncon > 0) nterm = sys%term_ptr(6 * ncon + 1) - sys%term_ptr(1)
+    if (ncon > 0) nterm = sys%constraints%term_ptr(6 * ncon + 1) - sys%constraints%term_ptr(1)
     allocate (rows(nmass + 2 * nterm), cols(nmass + 2 * nterm), entries(nmass + 2 * nterm))
     do row = 1, n
       do k = sys%mass%saddle_ptr(row), sys%mass%saddle_ptr(row + 1) - 1
@@ -85,13 +85,14 @@ contains
     i = nmass
     do c = 1, ncon
       do s = 1, 6
-        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
+        do k = sys%constraints%term_ptr(6 * (c - 1) + s), &
+               sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
           i = i + 1
-          rows(i) = sys%term_dof(k)
+          rows(i) = sys%constraints%term_dof(k)
           cols(i) = n + c
-          entries(i) = -(sys%term_coef(k) * gradients(s, c))
+          entries(i) = -(sys%constraints%term_coef(k) * gradients(s, c))
           rows(i + nterm) = n + c
-          cols(i + nterm) = sys%term_dof(k)
+          cols(i + nterm) = sys%constraints%term_dof(k)
           entries(i + nterm) = entries(i)
         end do
       end do

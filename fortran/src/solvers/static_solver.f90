@@ -21,8 +21,8 @@
 module static_solver
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
-                               external_forces, constraint_reaction, contact_record
-  use constraints, only: constraint_eval
+                               external_forces, contact_record
+  use system_constraints, only: constraint_derivatives, constraint_reaction
   use section_moment, only: moment_force
   use system_reduction, only: row_terms, reduced_col, reduced_coef, full_at
   use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
@@ -76,13 +76,14 @@ contains
     integer, allocatable :: srows(:), scols(:)
     real(dp), allocatable :: values(:), tangent(:), rhs(:, :)
     real(dp) :: internal(size(e)), loads(size(e)), reaction(size(e)), residual(size(e))
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), hessians(6, 6, sys%ncon)
+    real(dp) :: phi(sys%constraints%ncon), gradients(6, sys%constraints%ncon)
+    real(dp) :: hessians(6, 6, sys%constraints%ncon)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: step_size, size_now, scale, floor, previous, moment(3)
     real(dp) :: jacobian(3, 3), hessian(3, 3, 3)
     logical :: near, growing
     n = size(e)
-    ncon = sys%ncon
+    ncon = sys%constraints%ncon
     nnz = size(rows)
     iterations = 0
     converged_by = 0
@@ -108,7 +109,8 @@ contains
     do m = 1, size(sys%moment_magnitude)
       do i = 1, 3
         do j = 1, 3
-          nmom = nmom + row_terms(sys%reduction, sys%moment_dofs(i, m)) * row_terms(sys%reduction, sys%moment_dofs(j, m))
+          nmom = nmom + row_terms(sys%reduction, sys%moment_dofs(i, m)) &
+                      * row_terms(sys%reduction, sys%moment_dofs(j, m))
         end do
       end do
     end do
@@ -123,8 +125,8 @@ contains
           do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
             do k2 = first_term(c, s2), first_term(c, s2) + slot_terms(c, s2) - 1
               k = k + 1
-              srows(k) = sys%term_dof(k1)
-              scols(k) = sys%term_dof(k2)
+              srows(k) = sys%constraints%term_dof(k1)
+              scols(k) = sys%constraints%term_dof(k2)
             end do
           end do
         end do
@@ -146,10 +148,10 @@ contains
     do c = 1, ncon
       do s1 = 1, 6
         do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
-          srows(k + 1) = sys%term_dof(k1)
+          srows(k + 1) = sys%constraints%term_dof(k1)
           scols(k + 1) = n + c
           srows(k + 2) = n + c
-          scols(k + 2) = sys%term_dof(k1)
+          scols(k + 2) = sys%constraints%term_dof(k1)
           k = k + 2
         end do
       end do
@@ -193,7 +195,8 @@ contains
             do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
               do k2 = first_term(c, s2), first_term(c, s2) + slot_terms(c, s2) - 1
                 k = k + 1
-                values(k) = -lam(c) * hessians(s1, s2, c) * sys%term_coef(k1) * sys%term_coef(k2)
+                values(k) = -lam(c) * hessians(s1, s2, c) * sys%constraints%term_coef(k1) &
+                            * sys%constraints%term_coef(k2)
               end do
             end do
           end do
@@ -223,7 +226,7 @@ contains
       do c = 1, ncon
         do s1 = 1, 6
           do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
-            values(k + 1) = -gradients(s1, c) * sys%term_coef(k1)
+            values(k + 1) = -gradients(s1, c) * sys%constraints%term_coef(k1)
             values(k + 2) = values(k + 1)
             k = k + 2
           end do
@@ -306,18 +309,16 @@ contains
       call external_forces(sys, t, load_factor, loads, info, e)
       if (info /= 0) return
       if (ncon > 0) then
-        call constraint_eval(ncon, sys%con_kind, sys%con_drive, sys%con_params, &
-                             sys%operand_const, sys%term_ptr, sys%term_dof, sys%term_coef, &
-                             sys%drives%kinds, sys%drives%ptr, sys%drives%data, e, zero_rates, t, &
-                             phi, gradients, hessians, phi_t, phi_tt, gamma, info, &
-                             first_order_only=.not. with_tangent)
+        call constraint_derivatives(sys%constraints, sys%drives, e, zero_rates, t, phi, &
+                                    gradients, hessians, phi_t, phi_tt, gamma, info, &
+                                    first_order_only=.not. with_tangent)
         if (info /= 0) then
           info = 5
           return
         end if
       end if
       reaction = 0.0_dp
-      call constraint_reaction(sys, gradients, lam, reaction)
+      call constraint_reaction(sys%constraints, gradients, lam, reaction)
       reaction = -reaction
     end subroutine evaluate
 
@@ -371,12 +372,13 @@ contains
     !> the number of terms and the first term of slot s of constraint c
     integer function slot_terms(c, s)
       integer, intent(in) :: c, s
-      slot_terms = sys%term_ptr(6 * (c - 1) + s + 1) - sys%term_ptr(6 * (c - 1) + s)
+      slot_terms = sys%constraints%term_ptr(6 * (c - 1) + s + 1) &
+                   - sys%constraints%term_ptr(6 * (c - 1) + s)
     end function slot_terms
 
     integer function first_term(c, s)
       integer, intent(in) :: c, s
-      first_term = sys%term_ptr(6 * (c - 1) + s)
+      first_term = sys%constraints%term_ptr(6 * (c - 1) + s)
     end function first_term
 
   end subroutine static_newton

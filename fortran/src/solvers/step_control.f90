@@ -310,7 +310,7 @@ contains
     integer :: ndof, ncon, nprobe, npoint, nanswer, step, k, j, floor, answer_info
     integer :: at_lambda, at_energy, at_constraint, at_answers, at_q  ! (row_size)
     ndof = sys%ndof
-    ncon = sys%ncon
+    ncon = sys%constraints%ncon
     nprobe = sys%nprobe
     npoint = sys%npoint
     nanswer = answer_count(sys, run%answers)

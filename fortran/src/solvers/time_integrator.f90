@@ -61,13 +61,12 @@
 !> No I/O; failures return codes (see integrator_chunk).
 module time_integrator
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, contact_state, frame_rotations, &
-                               internal_forces, external_forces, evaluate_constraints, &
-                               constraint_reaction, gradient_product, refactorize, &
-                               to_solver_frame, &
-                               frame_gradients, energies, probe_output, policy_constant, &
-                               drive_step_work, power_drive, &
-                               power_count, energy_count, contact_record, contact_step_limit
+  use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
+                               external_forces, refactorize, to_solver_frame, frame_gradients, &
+                               energies, probe_output, policy_constant, drive_step_work, &
+                               power_drive, power_count, energy_count, contact_record, &
+                               contact_step_limit
+  use system_constraints, only: evaluate_constraints, constraint_reaction, gradient_product
   use system_mass, only: mass_product
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
                      jacobian_reuse, update_reuse_backoff, contraction_memory
@@ -154,19 +153,20 @@ contains
   pure subroutine allocate_work(sys, work)
     type(system_model), intent(in) :: sys
     type(step_work), intent(out) :: work
-    integer :: nb, b, j
+    integer :: nb, b, j, ncon
     nb = 3 * size(sys%block_first)
+    ncon = sys%constraints%ncon
     allocate (work%r(sys%ndof), work%z(sys%ndof, 1), work%direction(sys%ndof), &
-              work%correction(sys%ndof), work%back(sys%ndof), work%phi(sys%ncon), &
-              work%gradients(6, sys%ncon), work%w(nb, sys%ncon), work%flex_w(nb, sys%ncon), &
-              work%w_dlam(nb), work%schur(sys%ncon, sys%ncon), work%dlam(sys%ncon, 1), &
+              work%correction(sys%ndof), work%back(sys%ndof), work%phi(ncon), &
+              work%gradients(6, ncon), work%w(nb, ncon), work%flex_w(nb, ncon), &
+              work%w_dlam(nb), work%schur(ncon, ncon), work%dlam(ncon, 1), &
               work%internal(sys%ndof), work%loads(sys%ndof), &
-              work%records(contact_record, max(1, sys%npoint)), work%ipiv(sys%ncon), &
-              work%full(sys%nfull), work%row_phi(sys%ncon), work%row_gradients(6, sys%ncon), &
+              work%records(contact_record, max(1, sys%npoint)), work%ipiv(ncon), &
+              work%full(sys%nfull), work%row_phi(ncon), work%row_gradients(6, ncon), &
               work%row_ndof(sys%ndof), work%full_pair(sys%nfull, 2))
     if (carry_enabled(sys)) then
-      allocate (work%carry_columns(sys%ndof, sys%ncon), &
-                work%carry_flexibility(sys%ndof, sys%ncon), work%carry_lu(sys%ncon, sys%ncon), &
+      allocate (work%carry_columns(sys%ndof, ncon), &
+                work%carry_flexibility(sys%ndof, ncon), work%carry_lu(ncon, ncon), &
                 work%carry_column(sys%ndof), work%block_row(sys%ndof))
       work%block_row = 0
       do b = size(sys%block_first), 1, -1
@@ -194,7 +194,7 @@ contains
     logical :: reached(sys%ndof)
     work%scan_known = .false.
     allocate (work%scan_dofs(0))
-    if (sys%ncon == 0) return
+    if (sys%constraints%ncon == 0) return
     vector_of = 0
     do b = 1, size(sys%carry_map, 2)
       do i = 1, 3
@@ -207,8 +207,8 @@ contains
     end do
     if (any(vector_of == 0)) return
     reached = .false.
-    do k = sys%term_ptr(1), sys%term_ptr(6 * sys%ncon + 1) - 1
-      dof = sys%term_dof(k)
+    do k = sys%constraints%term_ptr(1), sys%constraints%term_ptr(6 * sys%constraints%ncon + 1) - 1
+      dof = sys%constraints%term_dof(k)
       if (dof < 1 .or. dof > sys%ndof) return
       b = vector_of(dof)
       do i = 1, 3
@@ -264,9 +264,9 @@ contains
       work%loads_time = t
     end if
     r = r + internal - loads
-    call evaluate_constraints(sys, e, t, phi, gradients, info)
+    call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, e, t, phi, gradients, info)
     if (info /= 0) return
-    call constraint_reaction(sys, gradients, lam, r)
+    call constraint_reaction(sys%constraints, gradients, lam, r)
     end associate
   end subroutine residual
 
@@ -303,7 +303,7 @@ contains
     integer, intent(out) :: floor_accepts  ! steps converged at the round-off floor
     type(newton_monitor) :: monitor
     real(dp) :: e_new(sys%ndof), a_new(sys%ndof), accel_new(sys%ndof), v_new(sys%ndof)
-    real(dp) :: lam_new(sys%ncon), predicted_internal(sys%ndof)
+    real(dp) :: lam_new(sys%constraints%ncon), predicted_internal(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
     real(dp) :: contact_potential, beta_prime, velocity_factor, step_drive_work
@@ -329,7 +329,8 @@ contains
       started_old = .false.
       do attempt = 1, 2
         call predict(sys, cfg, learned, h, e, v, a, accel, e_new, v_new, a_new, accel_new)
-        do i = 1, sys%ncon  ! (the multipliers' copies by loops: a few entries, no memcpy call)
+        ! (the multipliers' copies by loops: a few entries, no memcpy call)
+        do i = 1, sys%constraints%ncon
           lam_new(i) = lam(i)
         end do
         fresh_matrix = .false.
@@ -381,7 +382,7 @@ contains
       if (sys%npoint == 0 .and. sys%policy /= policy_constant) &
         call learn_predictor(learned, h, accel, accel_new)
       accel = accel_new
-      do i = 1, sys%ncon
+      do i = 1, sys%constraints%ncon
         lam(i) = lam_new(i)
       end do
       t = t + h
@@ -403,7 +404,7 @@ contains
       steps_done = step
       out_time(step) = t
       out_stats(:, step) = stats
-      do i = 1, sys%ncon
+      do i = 1, sys%constraints%ncon
         out_lambda(i, step) = lam(i)
       end do
       call probe_output(sys, rotations, e, v, work, strain, contact_potential, &
@@ -591,22 +592,23 @@ contains
       end if
       ! (with constraints both paths below overwrite the correction)
       ! (dlam: written whole by gradient_product in both paths below; empty without constraints)
-      if (sys%ncon == 0) correction = -direction
-      if (sys%ncon > 0 .and. learned%carry_on) then
+      if (sys%constraints%ncon == 0) correction = -direction
+      if (sys%constraints%ncon > 0 .and. learned%carry_on) then
         ! the Schur complement with the carried matrix: C = G^T S^{-1} G, G = T^T Phi_e^T
         call carry_schur()
         if (info /= 0) return
-      else if (sys%ncon > 0) then
+      else if (sys%constraints%ncon > 0) then
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
         call frame_gradients(sys, rotations, gradients, w)
         call schur_complement(sys%flexibility_cc, w, work%flex_w, schur)
-        call gradient_product(sys, gradients, direction, dlam(:, 1))
+        call gradient_product(sys%constraints, gradients, direction, dlam(:, 1))
         dlam(:, 1) = dlam(:, 1) - phi
-        if (sys%ncon <= small_dense_limit) then
+        if (sys%constraints%ncon <= small_dense_limit) then
           call small_lu(schur, ipiv, lapack_info)
           if (lapack_info == 0) call small_lu_solve(schur, ipiv, dlam(:, 1))
         else
-          call dgesv(sys%ncon, 1, schur, sys%ncon, ipiv, dlam, sys%ncon, lapack_info)
+          call dgesv(sys%constraints%ncon, 1, schur, sys%constraints%ncon, ipiv, dlam, &
+                     sys%constraints%ncon, lapack_info)
         end if
         if (lapack_info /= 0) then
           info = 4
@@ -654,8 +656,9 @@ contains
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
-        if (sys%ncon > 0 .and. last_correction > cfg%tol * cfg%length_scale) then
-          call evaluate_constraints(sys, e_new, t_new, phi, gradients, info)
+        if (sys%constraints%ncon > 0 .and. last_correction > cfg%tol * cfg%length_scale) then
+          call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, e_new, t_new, phi, &
+                                    gradients, info)
           if (info /= 0) return
           done = maxval(abs(phi)) <= cfg%tol * min(1.0_dp, cfg%length_scale)
           constraints_checked = done
@@ -742,15 +745,15 @@ contains
           ! hold each constrained vector whole): no solve
           ! (matmul's sums by the loops of sparse_columns_product and schur_complement:
           ! the same numbers without the library calls and the temporary)
-          do c = 1, sys%ncon
+          do c = 1, sys%constraints%ncon
             call sparse_columns_product(sys%flexibility, work%w(:, c), &
                                         work%carry_flexibility(:, c))
           end do
           call schur_complement(sys%flexibility_cc, work%w, work%flex_w, work%carry_lu)
         else
           work%carry_flexibility = work%carry_columns
-          call solver_solve(sys%solver_handle, sys%ndof, sys%ncon, work%carry_flexibility, info, &
-                            detail)
+          call solver_solve(sys%solver_handle, sys%ndof, sys%constraints%ncon, &
+                            work%carry_flexibility, info, detail)
           if (info /= 0) then
             detail = info
             info = 3
@@ -758,10 +761,11 @@ contains
           end if
           work%carry_lu = matmul(transpose(work%carry_columns), work%carry_flexibility)
         end if
-        if (sys%ncon <= small_dense_limit) then
+        if (sys%constraints%ncon <= small_dense_limit) then
           call small_lu(work%carry_lu, work%ipiv, lapack_info)
         else
-          call dgetrf(sys%ncon, sys%ncon, work%carry_lu, sys%ncon, work%ipiv, lapack_info)
+          call dgetrf(sys%constraints%ncon, sys%constraints%ncon, work%carry_lu, &
+                      sys%constraints%ncon, work%ipiv, lapack_info)
         end if
         if (lapack_info /= 0) then
           info = 4
@@ -770,13 +774,13 @@ contains
         end if
         carry_ready = .true.
       end if
-      call gradient_product(sys, work%gradients, work%direction, work%dlam(:, 1))
+      call gradient_product(sys%constraints, work%gradients, work%direction, work%dlam(:, 1))
       work%dlam(:, 1) = work%dlam(:, 1) - work%phi
-      if (sys%ncon <= small_dense_limit) then
+      if (sys%constraints%ncon <= small_dense_limit) then
         call small_lu_solve(work%carry_lu, work%ipiv, work%dlam(:, 1))
       else
-        call dgetrs('N', sys%ncon, 1, work%carry_lu, sys%ncon, work%ipiv, work%dlam, sys%ncon, &
-                    lapack_info)
+        call dgetrs('N', sys%constraints%ncon, 1, work%carry_lu, sys%constraints%ncon, work%ipiv, &
+                    work%dlam, sys%constraints%ncon, lapack_info)
       end if
       if (allocated(sys%carry_plane)) then
         call plane_carried_correction(sys%carry_plane, learned%carry_turn, &

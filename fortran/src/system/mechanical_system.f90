@@ -43,6 +43,7 @@ module mechanical_system
                           cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
   use system_drives, only: drive_table, drive_at
+  use system_constraints, only: constraint_table, evaluate_constraints
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -51,7 +52,6 @@ module mechanical_system
   public :: system_model, frame_def, contact_pair, contact_state
   public :: frame_rotations, internal_forces, &
             external_forces, &
-            evaluate_constraints, constraint_reaction, gradient_dot, gradient_product, &
             refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set, &
             tangent_frame_rates, damped_sets, force_element_reactions, contact_forces, &
@@ -124,12 +124,7 @@ module mechanical_system
     ! the tangent's positions in the full pattern's values (0: absent) in the loop order of
     ! force_element_forces, element l's from fel_pos_ptr(l); none given: searched
     integer, allocatable :: fel_pos_ptr(:), fel_pos(:)
-    ! constraints with multipliers (constraints module layout)
-    integer :: ncon = 0
-    integer, allocatable :: con_kind(:), con_drive(:), term_ptr(:), term_dof(:)
-    ! each constraint's last operand with terms (0: none), set with the constraints
-    integer, allocatable :: con_operands(:)
-    real(dp), allocatable :: con_params(:, :), operand_const(:, :), term_coef(:)
+    type(constraint_table) :: constraints  ! with multipliers (system_constraints)
     ! contact
     integer :: npoint = 0
     type(contact_pair), allocatable :: pairs(:)
@@ -740,138 +735,6 @@ contains
     end do
   end subroutine force_element_reactions
 
-  !> Constraint values and operand gradients at (e, t). info = 5 when a constraint or its
-  !> drive cannot be evaluated. constraint_eval's first-order results with the same
-  !> arithmetic (constraint_value, the operands summed as operand_values sums them), without
-  !> its argument descriptors, and a coordinate constraint's first operand alone (the only
-  !> one its value and gradient use): the Newton corrections of small systems evaluate it
-  !> in every correction.
-  subroutine evaluate_constraints(sys, e, t, phi, gradients, info)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: e(:), t
-    real(dp), intent(out) :: phi(:), gradients(:, :)
-    integer, intent(out) :: info
-    real(dp) :: x(6), drive_phi, dphi, ddphi, cos_phi, sin_phi
-    integer :: c, s, k, last_operand, drive_info
-    info = 0
-    if (sys%ncon == 0) return
-    ! (every term's coordinate lies in 1..ndof: system_set_constraints checked it once)
-    if (size(e) < sys%ndof) then
-      info = 5
-      return
-    end if
-    do c = 1, sys%ncon
-      drive_phi = 0.0_dp  ! (drive_value's value without a drive)
-      if (sys%con_drive(c) /= 0) then
-        call drive_at(sys%drives, sys%con_drive(c), t, &
-                         drive_phi, dphi, ddphi, drive_info)
-        if (drive_info /= 0) then
-          info = 5
-          return
-        end if
-      end if
-      last_operand = 6
-      if (sys%con_kind(c) == constraint_kind_coordinate) then
-        if (sys%term_ptr(6 * (c - 1) + 2) == sys%term_ptr(6 * (c - 1) + 1)) then
-          info = 5  ! no coordinate in the first operand
-          return
-        end if
-        last_operand = 1
-      else if (sys%con_kind(c) < constraint_kind_coordinate .or. sys%con_kind(c) > constraint_kind_dot) then
-        info = 5
-        return
-      end if
-      do s = 1, 6
-        x(s) = 0.0_dp
-      end do
-      do s = 1, last_operand
-        x(s) = sys%operand_const(s, c)
-        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-          x(s) = x(s) + sys%term_coef(k) * e(sys%term_dof(k))
-        end do
-      end do
-      cos_phi = 1.0_dp
-      sin_phi = 0.0_dp
-      if (sys%con_kind(c) == constraint_kind_coordinate .and. sys%con_drive(c) /= 0) then
-        cos_phi = cos(drive_phi)
-        sin_phi = sin(drive_phi)
-      end if
-      if (sys%con_kind(c) == constraint_kind_coordinate) then
-        ! (constraint_value's formula of the kind, written in place of the call)
-        phi(c) = x(1) - (sys%con_params(1, c) + sys%con_params(2, c) * cos_phi &
-                         + sys%con_params(3, c) * sin_phi + sys%con_params(4, c) * drive_phi)
-      else
-        phi(c) = constraint_value(sys%con_kind(c), sys%con_drive(c) /= 0, &
-                                  sys%con_params(:, c), x, drive_phi, cos_phi, sin_phi)
-      end if
-      do s = 1, 6
-        gradients(s, c) = 0.0_dp
-      end do
-      select case (sys%con_kind(c))
-      case (constraint_kind_coordinate)
-        gradients(1, c) = 1.0_dp
-      case (constraint_kind_distance)
-        gradients(1:3, c) = 2.0_dp * (x(1:3) - x(4:6))
-        gradients(4:6, c) = -2.0_dp * (x(1:3) - x(4:6))
-      case (constraint_kind_cross)
-        gradients(1:3, c) = cross(x(4:6), sys%con_params(1:3, c))
-        gradients(4:6, c) = cross(sys%con_params(1:3, c), x(1:3))
-      case default  ! constraint_kind_dot
-        gradients(1:3, c) = x(4:6)
-        gradients(4:6, c) = x(1:3)
-      end select
-    end do
-  end subroutine evaluate_constraints
-
-  !> r = r - Phi_e^T lambda.
-  pure subroutine constraint_reaction(sys, gradients, lam, r)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: gradients(:, :), lam(:)
-    real(dp), intent(inout) :: r(:)
-    integer :: c, s, k
-    do c = 1, sys%ncon
-      do s = 1, operand_count(sys, c)
-        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-          r(sys%term_dof(k)) = r(sys%term_dof(k)) - gradients(s, c) * sys%term_coef(k) * lam(c)
-        end do
-      end do
-    end do
-  end subroutine constraint_reaction
-
-  !> Phi_e x for every constraint.
-  pure function gradient_dot(sys, gradients, x) result(y)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: gradients(:, :), x(:)
-    real(dp) :: y(sys%ncon)
-    call gradient_product(sys, gradients, x, y)
-  end function gradient_dot
-
-  !> y = Phi_e x for every constraint (gradient_dot into a given array).
-  pure subroutine gradient_product(sys, gradients, x, y)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: gradients(:, :), x(:)
-    real(dp), intent(out) :: y(:)
-    integer :: c, s, k
-    y = 0.0_dp
-    do c = 1, sys%ncon
-      do s = 1, operand_count(sys, c)
-        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-          y(c) = y(c) + gradients(s, c) * sys%term_coef(k) * x(sys%term_dof(k))
-        end do
-      end do
-    end do
-  end subroutine gradient_product
-
-  !> The operands of constraint c up to the last with terms (con_operands, set with the
-  !> constraints; 6 without it): the loops over the operands' terms skip the empty rest
-  !> (a coordinate constraint's five unused operands).
-  pure integer function operand_count(sys, c) result(count_c)
-    type(system_model), intent(in) :: sys
-    integer, intent(in) :: c
-    count_c = 6
-    if (allocated(sys%con_operands)) count_c = sys%con_operands(c)
-  end function operand_count
-
   !> The solver frame: policy constant rotates each reduced 3-vector of a moving frame's
   !> bodies into that frame (U^T x, transpose_first) or back (U x); otherwise a copy.
   pure subroutine to_solver_frame(sys, rotations, x, transpose_first, y)
@@ -930,11 +793,12 @@ contains
     integer :: c, s, k, dof, b, comp, f, i
     real(dp) :: g
     w = 0.0_dp
-    do c = 1, sys%ncon
+    do c = 1, sys%constraints%ncon
       do s = 1, 6
-        do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-          dof = sys%term_dof(k)
-          g = gradients(s, c) * sys%term_coef(k)
+        do k = sys%constraints%term_ptr(6 * (c - 1) + s), &
+               sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
+          dof = sys%constraints%term_dof(k)
+          g = gradients(s, c) * sys%constraints%term_coef(k)
           do b = 1, size(sys%block_first)  ! the first block holding dof
             if (dof >= sys%block_first(b) .and. dof <= sys%block_first(b) + 2) exit
           end do
@@ -1040,7 +904,8 @@ contains
       phi => phi_work
       gradients => gradients_work
     else
-      allocate (own_full(sys%nfull), own_phi(sys%ncon), own_gradients(6, sys%ncon))
+      allocate (own_full(sys%nfull), own_phi(sys%constraints%ncon), &
+                own_gradients(6, sys%constraints%ncon))
       e_full => own_full
       phi => own_phi
       gradients => own_gradients
@@ -1050,11 +915,11 @@ contains
     if (known) then
       info = 0
     else
-      call evaluate_constraints(sys, e, t, phi, gradients, info)
+      call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, e, t, phi, gradients, info)
       if (info /= 0) return
     end if
     violation = 0.0_dp
-    if (sys%ncon > 0) violation = maxval(abs(phi))
+    if (sys%constraints%ncon > 0) violation = maxval(abs(phi))
     powers = 0.0_dp
     ! the driven constraints and the driven forces phi_d(t) f_d do their work per step
     ! (drive_step_work, the integrator's own discrete identity), not here as powers
@@ -1130,14 +995,14 @@ contains
     work = 0.0_dp
     info = 0
     origin = 0.0_dp
-    do c = 1, sys%ncon
-      if (sys%con_drive(c) == 0) cycle
-      call drive_ends(sys%con_drive(c))
+    do c = 1, sys%constraints%ncon
+      if (sys%constraints%drive(c) == 0) cycle
+      call drive_ends(sys%constraints%drive(c))
       if (info /= 0) return
-      before = constraint_value(sys%con_kind(c), .true., sys%con_params(:, c), origin, phi0, &
-                                cos(phi0), sin(phi0))
-      after = constraint_value(sys%con_kind(c), .true., sys%con_params(:, c), origin, phi1, &
-                               cos(phi1), sin(phi1))
+      before = constraint_value(sys%constraints%kind(c), .true., sys%constraints%params(:, c), &
+                                origin, phi0, cos(phi0), sin(phi0))
+      after = constraint_value(sys%constraints%kind(c), .true., sys%constraints%params(:, c), &
+                               origin, phi1, cos(phi1), sin(phi1))
       work = work - 0.5_dp * (lam0(c) + lam1(c)) * (after - before)
     end do
     do c = 1, size(sys%force_drive)
