@@ -27,10 +27,12 @@ subroutine system_create(ndof, nfull, handle, info, message)
   allocate (sys%sets(0), sys%frames(0), sys%pairs(0))
   allocate (sys%drives%kinds(0), sys%drives%ptr(1), sys%drives%data(0))
   sys%drives%ptr = 1
-  allocate (sys%constant_force(ndof), sys%force_drive(0), sys%force_vectors(ndof, 0))
-  sys%constant_force = 0.0_dp
-  allocate (sys%moment_dofs(3, 0), sys%moment_axis(3, 0), sys%moment_magnitude(0), &
-            sys%moment_reference(3, 0))
+  allocate (sys%loads%constant_force(ndof), sys%loads%force_drive(0), &
+            sys%loads%force_vectors(ndof, 0))
+  sys%loads%constant_force = 0.0_dp
+  allocate (sys%loads%moment_dofs(3, 0), sys%loads%moment_axis(3, 0), &
+            sys%loads%moment_magnitude(0), &
+            sys%loads%moment_reference(3, 0))
   allocate (sys%constraints%kind(0), sys%constraints%drive(0), sys%constraints%term_ptr(1), &
             sys%constraints%term_dof(0), sys%constraints%params(8, 0), &
             sys%constraints%operand_const(6, 0), sys%constraints%term_coef(0))
@@ -785,13 +787,13 @@ subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, f
       return
     end if
   end if
-  sys%constant_force = constant_force
-  sys%force_drive = force_drive(1:nforce)
-  sys%force_vectors = force_vectors(:, 1:nforce)
-  sys%moment_dofs = moment_dofs(:, 1:nmoment)
-  sys%moment_axis = moment_axis(:, 1:nmoment)
-  sys%moment_magnitude = moment_magnitude(1:nmoment)
-  sys%moment_reference = moment_reference(:, 1:nmoment)
+  sys%loads%constant_force = constant_force
+  sys%loads%force_drive = force_drive(1:nforce)
+  sys%loads%force_vectors = force_vectors(:, 1:nforce)
+  sys%loads%moment_dofs = moment_dofs(:, 1:nmoment)
+  sys%loads%moment_axis = moment_axis(:, 1:nmoment)
+  sys%loads%moment_magnitude = moment_magnitude(1:nmoment)
+  sys%loads%moment_reference = moment_reference(:, 1:nmoment)
 end subroutine system_set_loads
 
 !> Driven and follower point loads (vector_loads): kinds, drives (1-based, 0: none), vectors
@@ -829,14 +831,14 @@ subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors,
       return
     end if
   end if
-  sys%nvload = nload
-  sys%vload_kind = kinds(1:nload)
-  sys%vload_drive = drives(1:nload)
-  sys%vload_vector = vectors(:, 1:nload)
-  sys%vload_shares = shares(:, 1:nload)
-  sys%vload_ptr = ptr
-  sys%vload_dof = dofs(1:nterm)
-  sys%vload_coef = coefs(1:nterm)
+  sys%loads%nvload = nload
+  sys%loads%vload_kind = kinds(1:nload)
+  sys%loads%vload_drive = drives(1:nload)
+  sys%loads%vload_vector = vectors(:, 1:nload)
+  sys%loads%vload_shares = shares(:, 1:nload)
+  sys%loads%vload_ptr = ptr
+  sys%loads%vload_dof = dofs(1:nterm)
+  sys%loads%vload_coef = coefs(1:nterm)
 end subroutine system_set_vector_loads
 
 !> The slots of the force elements (set before system_set_force_elements): nslot slots with
@@ -1296,7 +1298,7 @@ subroutine system_answer_setup(handle, ncol, nnz, ndrive, columns, mass_ptr, mas
   info = 2
   message = 'system_answer_setup: sizes inconsistent with the system (the force drives) ' // &
             'or a column outside the full coordinates'
-  if (ncol < 0 .or. nnz < 0 .or. ndrive /= size(sys%force_drive)) return
+  if (ncol < 0 .or. nnz < 0 .or. ndrive /= size(sys%loads%force_drive)) return
   if (mass_ptr(1) /= 1 .or. mass_ptr(ncol + 1) /= nnz + 1) return
   if (ncol > 0) then
     if (any(columns(1:ncol) < 1) .or. any(columns(1:ncol) > sys%nfull)) return

@@ -83,7 +83,7 @@ contains
     if (info /= 0) return
     call to_full(sys%reduction, accel, .false., accel_full)
     do d = 1, size(phi)
-      call drive_at(sys%drives, sys%force_drive(d), t, &
+      call drive_at(sys%drives, sys%loads%force_drive(d), t, &
                        phi(d), dphi, ddphi, info)
       if (info /= 0) then
         info = 5

@@ -106,11 +106,11 @@ contains
       end do
     end do
     nmom = 0
-    do m = 1, size(sys%moment_magnitude)
+    do m = 1, size(sys%loads%moment_magnitude)
       do i = 1, 3
         do j = 1, 3
-          nmom = nmom + row_terms(sys%reduction, sys%moment_dofs(i, m)) &
-                      * row_terms(sys%reduction, sys%moment_dofs(j, m))
+          nmom = nmom + row_terms(sys%reduction, sys%loads%moment_dofs(i, m)) &
+                      * row_terms(sys%reduction, sys%loads%moment_dofs(j, m))
         end do
       end do
     end do
@@ -132,14 +132,14 @@ contains
         end do
       end do
     end do
-    do m = 1, size(sys%moment_magnitude)
+    do m = 1, size(sys%loads%moment_magnitude)
       do i = 1, 3
         do j = 1, 3
-          do a = 1, row_terms(sys%reduction, sys%moment_dofs(i, m))
-            do b = 1, row_terms(sys%reduction, sys%moment_dofs(j, m))
+          do a = 1, row_terms(sys%reduction, sys%loads%moment_dofs(i, m))
+            do b = 1, row_terms(sys%reduction, sys%loads%moment_dofs(j, m))
               k = k + 1
-              srows(k) = reduced_col(sys%reduction, sys%moment_dofs(i, m), a)
-              scols(k) = reduced_col(sys%reduction, sys%moment_dofs(j, m), b)
+              srows(k) = reduced_col(sys%reduction, sys%loads%moment_dofs(i, m), a)
+              scols(k) = reduced_col(sys%reduction, sys%loads%moment_dofs(j, m), b)
             end do
           end do
         end do
@@ -177,7 +177,8 @@ contains
       if (check_start .and. it == 1) then
         ! no load at all and the internal forces zero to their own round-off: the start is
         ! the equilibrium (a load, however small, is always solved for)
-        if (all(loads == 0.0_dp) .and. all(load_factor * sys%moment_magnitude == 0.0_dp) .and. &
+        if (all(loads == 0.0_dp) .and. &
+            all(load_factor * sys%loads%moment_magnitude == 0.0_dp) .and. &
             norm2(residual) <= residual_floor(1.0_dp) .and. &
             max_abs(phi) <= tol * length_scale) then
           converged_by = by_unloaded_start
@@ -202,21 +203,22 @@ contains
           end do
         end do
       end do
-      do m = 1, size(sys%moment_magnitude)
-        call moment_force(full_at(sys%reduction, e, sys%moment_dofs(:, m)), sys%moment_axis(:, m), &
-                          load_factor * sys%moment_magnitude(m), moment, jacobian, hessian, info)
+      do m = 1, size(sys%loads%moment_magnitude)
+        call moment_force(full_at(sys%reduction, e, sys%loads%moment_dofs(:, m)), &
+                          sys%loads%moment_axis(:, m), load_factor * sys%loads%moment_magnitude(m), &
+                          moment, jacobian, hessian, info)
         if (info /= 0) then
           info = 6
           exit
         end if
         do i = 1, 3
           do j = 1, 3
-            do a = 1, row_terms(sys%reduction, sys%moment_dofs(i, m))
-              do b = 1, row_terms(sys%reduction, sys%moment_dofs(j, m))
+            do a = 1, row_terms(sys%reduction, sys%loads%moment_dofs(i, m))
+              do b = 1, row_terms(sys%reduction, sys%loads%moment_dofs(j, m))
                 k = k + 1
                 values(k) = -jacobian(i, j) &
-                            * reduced_coef(sys%reduction, sys%moment_dofs(i, m), a) &
-                            * reduced_coef(sys%reduction, sys%moment_dofs(j, m), b)
+                            * reduced_coef(sys%reduction, sys%loads%moment_dofs(i, m), a) &
+                            * reduced_coef(sys%reduction, sys%loads%moment_dofs(j, m), b)
               end do
             end do
           end do

@@ -255,8 +255,8 @@ contains
     ! (loads of t alone, without point loads that follow e: once per time, kept for the
     ! step's later corrections; without driven loads (force_drive) they are constant_force
     ! at every time: once per chunk)
-    if (sys%nvload > 0 .or. .not. work%loads_ready .or. &
-        (work%loads_time /= t .and. size(sys%force_drive) > 0)) then
+    if (sys%loads%nvload > 0 .or. .not. work%loads_ready .or. &
+        (work%loads_time /= t .and. size(sys%loads%force_drive) > 0)) then
       work%loads_ready = .false.
       call external_forces(sys, t, 1.0_dp, loads, info, e)
       if (info /= 0) return

@@ -36,14 +36,14 @@ module mechanical_system
                          constraint_kind_cross, constraint_kind_dot
   use matrix3, only: cross
   use element_sets, only: element_set, set_slot, frame_omega
-  use section_moment, only: moment_force_only, moment_angle
-  use vector_loads, only: vector_load_force
   use force_elements, only: force_element_eval, force_element_slots, fe_reaction_count
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
                           cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
   use system_drives, only: drive_table, drive_at
   use system_constraints, only: constraint_table, evaluate_constraints
+  use system_loads, only: load_set, vector_load_forces, vector_load_tangent, &
+                          dead_moment_forces, dead_moment_energy
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -100,19 +100,7 @@ module mechanical_system
     type(drive_table) :: drives                       ! the drive table (system_drives)
     type(mass_matrix) :: mass                         ! M and its forms (system_mass)
     type(coordinate_reduction) :: reduction  ! q = B e + q0, the plan (system_reduction)
-    ! loads: constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
-    ! director coordinates
-    real(dp), allocatable :: constant_force(:)
-    integer, allocatable :: force_drive(:)
-    real(dp), allocatable :: force_vectors(:, :)
-    integer, allocatable :: moment_dofs(:, :)
-    real(dp), allocatable :: moment_axis(:, :), moment_magnitude(:), moment_reference(:, :)
-    ! driven and follower point loads (vector_loads): per load a kind, a drive (0: none), a
-    ! vector, the torsion shares, and the terms of its slots a, b, p on full coordinates
-    ! (vload_ptr(3 (l - 1) + s) .. vload_ptr(3 (l - 1) + s + 1) - 1)
-    integer :: nvload = 0
-    integer, allocatable :: vload_kind(:), vload_drive(:), vload_ptr(:), vload_dof(:)
-    real(dp), allocatable :: vload_vector(:, :), vload_shares(:, :), vload_coef(:)
+    type(load_set) :: loads                           ! forces and moments (system_loads)
     ! force elements (force_elements): per element a kind, a drive (0: none; the cylinder's
     ! length), its parameters (fel_param_ptr), a force-deflection table (fel_table_ptr; kind
     ! 0: none), its first slot (fel_slot_first); per slot a constant and the terms
@@ -298,17 +286,18 @@ contains
     real(dp), allocatable, target :: own_full(:, :)
     real(dp), pointer :: e_full(:), full_force(:)
     real(dp), allocatable :: v_full(:), values_full(:)
-    real(dp) :: set_energy, moment(3), director(3), rate, tangent_rate
+    real(dp) :: set_energy, rate, tangent_rate
     real(dp) :: fel_powers(2)
     logical :: want_tangent, done
-    integer :: s, m, k, f
+    integer :: s, f
     want_tangent = present(tangent_values)
     ! the force alone of undamped sets on a one-to-one selection, nothing else acting: each
     ! set straight on the independent coordinates (selected_forces), without q, the full
     ! force and B^T (the same numbers)
     done = .not. want_tangent .and. sys%reduction%select_one_to_one .and. sys%npoint == 0 .and. &
            sys%nfel == 0 .and. .not. present(full_out)
-    if (done .and. allocated(sys%moment_magnitude)) done = size(sys%moment_magnitude) == 0
+    if (done .and. allocated(sys%loads%moment_magnitude)) &
+      done = size(sys%loads%moment_magnitude) == 0
     if (done) then
       force = 0.0_dp
       strain = 0.0_dp
@@ -389,27 +378,14 @@ contains
                           contact_potential, contact_powers, info, values_full)
       if (info /= 0) return
     end if
-    do m = 1, size(sys%moment_magnitude)
-      ! (the director gathered and the force scattered by loops: vector subscripts made heap
-      ! temporaries; the force alone: the moment's Jacobian is not part of the tangent)
-      do k = 1, 3
-        director(k) = e_full(sys%moment_dofs(k, m))
-      end do
-      call moment_force_only(director, sys%moment_axis(:, m), &
-                             load_factor * sys%moment_magnitude(m), moment, info)
-      if (info /= 0) then
-        info = 6
-        return
-      end if
-      do k = 1, 3
-        full_force(sys%moment_dofs(k, m)) = full_force(sys%moment_dofs(k, m)) - moment(k)
-      end do
-    end do
+    call dead_moment_forces(sys%loads, e_full, load_factor, full_force, info)
+    if (info /= 0) return
     if (present(full_out)) full_out = full_force
     call to_reduced(sys%reduction, full_force, force)
     if (.not. want_tangent) return
-    if (present(t) .and. sys%nvload > 0) then
-      call vector_load_tangent(sys, t, e_full, load_factor, values_full, info)
+    if (present(t) .and. sys%loads%nvload > 0) then
+      call vector_load_tangent(sys%loads, sys%drives, sys%reduction, t, e_full, load_factor, &
+                               values_full, info)
       if (info /= 0) return
     end if
     call reduce_tangent(sys%reduction, values_full, tangent_values)
@@ -472,117 +448,26 @@ contains
     real(dp), allocatable :: e_full(:), full_force(:), reduced(:)
     integer :: d
     info = 0
-    force = load_factor * sys%constant_force
-    if (present(e) .and. sys%nvload > 0) then
+    force = load_factor * sys%loads%constant_force
+    if (present(e) .and. sys%loads%nvload > 0) then
       allocate (e_full(sys%nfull), full_force(sys%nfull), reduced(sys%ndof))
       call to_full(sys%reduction, e, .true., e_full)
       full_force = 0.0_dp
-      call vector_load_forces(sys, t, e_full, load_factor, full_force, info)
+      call vector_load_forces(sys%loads, sys%drives, t, e_full, load_factor, full_force, info)
       if (info /= 0) return
       call to_reduced(sys%reduction, full_force, reduced)
       force = force + reduced
     end if
-    do d = 1, size(sys%force_drive)
-      call drive_at(sys%drives, sys%force_drive(d), t, &
+    do d = 1, size(sys%loads%force_drive)
+      call drive_at(sys%drives, sys%loads%force_drive(d), t, &
                        phi, dphi, ddphi, info)
       if (info /= 0) then
         info = 5
         return
       end if
-      force = force + load_factor * phi * sys%force_vectors(:, d)
+      force = force + load_factor * phi * sys%loads%force_vectors(:, d)
     end do
   end subroutine external_forces
-
-  !> The driven and follower point loads at the full coordinates e_full and time t, times
-  !> load_factor, added to full_force. info = 5 when a drive fails, 6 for a malformed load.
-  subroutine vector_load_forces(sys, t, e_full, load_factor, full_force, info)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: t, e_full(:), load_factor
-    real(dp), intent(inout) :: full_force(:)
-    integer, intent(out) :: info
-    real(dp) :: force(3, 3), jacobian(3, 3, 3, 2)
-    integer :: l, s, k, dof
-    info = 0
-    do l = 1, sys%nvload
-      call vector_load_at(sys, l, t, e_full, load_factor, force, jacobian, info)
-      if (info /= 0) return
-      do s = 1, 3
-        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
-          dof = sys%vload_dof(k)
-          full_force(dof:dof + 2) = full_force(dof:dof + 2) + sys%vload_coef(k) * force(:, s)
-        end do
-      end do
-    end do
-  end subroutine vector_load_forces
-
-  !> Minus the Jacobian of the driven and follower point loads at (e_full, t), times
-  !> load_factor, added to values_full (the full pattern): the residual carries
-  !> internal - external. Entries outside the pattern (none: a load's slots lie in one
-  !> element or node) are skipped. info = 5 when a drive fails, 6 for a malformed load.
-  subroutine vector_load_tangent(sys, t, e_full, load_factor, values_full, info)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: t, e_full(:), load_factor
-    real(dp), intent(inout) :: values_full(:)
-    integer, intent(out) :: info
-    real(dp) :: force(3, 3), jacobian(3, 3, 3, 2)
-    integer :: l, s, w, k, m, i, j, row, col, pos, base
-    info = 0
-    do l = 1, sys%nvload
-      call vector_load_at(sys, l, t, e_full, load_factor, force, jacobian, info)
-      if (info /= 0) return
-      do s = 1, 3
-        do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
-          do w = 1, 2
-            base = 3 * (l - 1) + w
-            do m = sys%vload_ptr(base), sys%vload_ptr(base + 1) - 1
-              do i = 1, 3
-                row = sys%vload_dof(k) + i - 1
-                do j = 1, 3
-                  col = sys%vload_dof(m) + j - 1
-                  pos = pattern_position(sys%reduction, row, col)
-                  if (pos > 0) values_full(pos) = values_full(pos) - sys%vload_coef(k) &
-                                                  * sys%vload_coef(m) * jacobian(i, s, j, w)
-                end do
-              end do
-            end do
-          end do
-        end do
-      end do
-    end do
-  end subroutine vector_load_tangent
-
-  !> Load l of the driven and follower point loads at (e_full, t), times load_factor: its
-  !> generalized forces on its slots (a, b, p) and their Jacobian (vector_loads). info = 5
-  !> when its drive fails, 6 for a malformed load.
-  subroutine vector_load_at(sys, l, t, e_full, load_factor, force, jacobian, info)
-    type(system_model), intent(in) :: sys
-    integer, intent(in) :: l
-    real(dp), intent(in) :: t, e_full(:), load_factor
-    real(dp), intent(out) :: force(3, 3), jacobian(3, 3, 3, 2)
-    integer, intent(out) :: info
-    real(dp) :: phi, dphi, ddphi, x(3, 2)
-    integer :: s, k, dof
-    info = 0
-    phi = 1.0_dp
-    if (sys%vload_drive(l) > 0) then
-      call drive_at(sys%drives, sys%vload_drive(l), &
-                       t, phi, dphi, ddphi, info)
-      if (info /= 0) then
-        info = 5
-        return
-      end if
-    end if
-    x = 0.0_dp
-    do s = 1, 2
-      do k = sys%vload_ptr(3 * (l - 1) + s), sys%vload_ptr(3 * (l - 1) + s + 1) - 1
-        dof = sys%vload_dof(k)
-        x(:, s) = x(:, s) + sys%vload_coef(k) * e_full(dof:dof + 2)
-      end do
-    end do
-    call vector_load_force(sys%vload_kind(l), load_factor * phi * sys%vload_vector(:, l), &
-                           sys%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
-    if (info /= 0) info = 6
-  end subroutine vector_load_at
 
   !> The time an internal-force evaluation hands the force elements (0 when not given:
   !> only systems without driven force elements are evaluated so).
@@ -924,16 +809,16 @@ contains
     ! the driven constraints and the driven forces phi_d(t) f_d do their work per step
     ! (drive_step_work, the integrator's own discrete identity), not here as powers
     call to_full(sys%reduction, e, .true., e_full)
-    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0 .or. sys%nvload > 0) then
+    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0 .or. sys%loads%nvload > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys%reduction, v, .false., v_full)
     end if
     strain = 0.0_dp
-    if (sys%nvload > 0) then  ! the driven and follower point loads and a rigid body's dead
+    if (sys%loads%nvload > 0) then  ! the driven and follower point loads and a rigid body's dead
       ! moments have no potential: their power Q . q' is a work (of the drives)
       allocate (unused(sys%nfull))
       unused = 0.0_dp
-      call vector_load_forces(sys, t, e_full, 1.0_dp, unused, info)
+      call vector_load_forces(sys%loads, sys%drives, t, e_full, 1.0_dp, unused, info)
       if (info /= 0) return
       powers(power_drive) = powers(power_drive) + dot_product(unused, v_full)
       deallocate (unused)
@@ -1005,11 +890,11 @@ contains
                                origin, phi1, cos(phi1), sin(phi1))
       work = work - 0.5_dp * (lam0(c) + lam1(c)) * (after - before)
     end do
-    do c = 1, size(sys%force_drive)
-      call drive_ends(sys%force_drive(c))
+    do c = 1, size(sys%loads%force_drive)
+      call drive_ends(sys%loads%force_drive(c))
       if (info /= 0) return
       do k = 1, size(e0)  ! (a loop: e1 - e0 would make a temporary)
-        work = work + 0.5_dp * (phi0 + phi1) * sys%force_vectors(k, c) * (e1(k) - e0(k))
+        work = work + 0.5_dp * (phi0 + phi1) * sys%loads%force_vectors(k, c) * (e1(k) - e0(k))
       end do
     end do
   contains
@@ -1050,8 +935,8 @@ contains
     real(dp), intent(out), optional, target :: ndof_work(:)
     real(dp), allocatable, target :: own_full(:), own_ndof(:)
     real(dp), pointer :: e_full(:), mv(:)
-    real(dp) :: pivot(3), director(3), relative(3), total
-    integer :: p, k, f, m, j
+    real(dp) :: pivot(3), relative(3), total
+    integer :: p, k, f, j
     info = 0
     if (present(known_full)) then
       e_full => known_full
@@ -1085,14 +970,8 @@ contains
     energy = 0.0_dp
     call kinetic_energy(sys%mass, v, mv, energy(energy_kinetic))
     energy(energy_strain) = strain
-    energy(energy_loads) = -dot_product(sys%constant_force, e)
-    do m = 1, size(sys%moment_magnitude)
-      do k = 1, 3  ! (gathered by a loop: a vector subscript made a heap temporary)
-        director(k) = e_full(sys%moment_dofs(k, m))
-      end do
-      energy(energy_moment) = energy(energy_moment) - sys%moment_magnitude(m) * &
-        moment_angle(director, sys%moment_axis(:, m), sys%moment_reference(:, m))
-    end do
+    energy(energy_loads) = -dot_product(sys%loads%constant_force, e)
+    energy(energy_moment) = dead_moment_energy(sys%loads, e_full)
     energy(energy_contact) = contact_potential
     energy(energy_total) = sum(energy(energy_kinetic:energy_moment)) + contact_potential
     energy(work_drive) = work(power_drive)
