@@ -864,10 +864,10 @@ subroutine system_set_force_slots(handle, nslot, nterm, slot_const, term_ptr, te
     if (any(term_dof(1:nterm) < 1) .or. any(term_dof(1:nterm) + 2 > sys%nfull)) return
   end if
   info = 0
-  sys%fel_slot_const = slot_const(:, 1:nslot)
-  sys%fel_term_ptr = term_ptr
-  sys%fel_term_dof = term_dof(1:nterm)
-  sys%fel_term_coef = term_coef(1:nterm)
+  sys%force_elements%slot_const = slot_const(:, 1:nslot)
+  sys%force_elements%term_ptr = term_ptr
+  sys%force_elements%term_dof = term_dof(1:nterm)
+  sys%force_elements%term_coef = term_coef(1:nterm)
 end subroutine system_set_force_slots
 
 !> Force elements (force_elements) on the slots of system_set_force_slots: per element l
@@ -895,7 +895,7 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, npos, element
   call api_system(handle, sys, info)
   if (info /= 0) return
   info = 2
-  if (.not. allocated(sys%fel_slot_const)) return
+  if (.not. allocated(sys%force_elements%slot_const)) return
   if (pointers(nfel + 1, fp_param) /= nparam + 1 .or. pointers(nfel + 1, fp_table) /= ntable + 1 &
       .or. pointers(nfel + 1, fp_position) /= npos + 1) return
   if (npos > 0) then
@@ -906,21 +906,22 @@ subroutine system_set_force_elements(handle, nfel, nparam, ntable, npos, element
     first = elements(fl_slot_first, l)
     if (force_element_slots(kind) == 0) return
     if (pointers(l + 1, fp_param) - pointers(l, fp_param) < force_element_parameters(kind)) return
-    if (first < 1 .or. first + force_element_slots(kind) - 1 > size(sys%fel_slot_const, 2)) return
+    if (first < 1 .or. &
+        first + force_element_slots(kind) - 1 > size(sys%force_elements%slot_const, 2)) return
     if (elements(fl_drive, l) < 0 .or. elements(fl_drive, l) > size(sys%drives%kinds)) return
   end do
   info = 0
-  sys%nfel = nfel
-  sys%fel_kind = elements(fl_kind, 1:nfel)
-  sys%fel_drive = elements(fl_drive, 1:nfel)
-  sys%fel_table_kind = elements(fl_table_kind, 1:nfel)
-  sys%fel_param_ptr = pointers(:, fp_param)
-  sys%fel_params = params(1:nparam)
-  sys%fel_table_ptr = pointers(:, fp_table)
-  sys%fel_table = table(1:ntable)
-  sys%fel_slot_first = elements(fl_slot_first, 1:nfel)
-  sys%fel_pos_ptr = pointers(:, fp_position)
-  sys%fel_pos = positions(1:npos)
+  sys%force_elements%nfel = nfel
+  sys%force_elements%kind = elements(fl_kind, 1:nfel)
+  sys%force_elements%drive = elements(fl_drive, 1:nfel)
+  sys%force_elements%table_kind = elements(fl_table_kind, 1:nfel)
+  sys%force_elements%param_ptr = pointers(:, fp_param)
+  sys%force_elements%params = params(1:nparam)
+  sys%force_elements%table_ptr = pointers(:, fp_table)
+  sys%force_elements%table = table(1:ntable)
+  sys%force_elements%slot_first = elements(fl_slot_first, 1:nfel)
+  sys%force_elements%pos_ptr = pointers(:, fp_position)
+  sys%force_elements%pos = positions(1:npos)
 end subroutine system_set_force_elements
 
 !> The reactions (7, nfel) of the force elements at (t, e, e'): force and moment body1
@@ -942,7 +943,7 @@ subroutine system_force_element_reactions(handle, ndof, nfel, t, e, v, reactions
   reactions = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  if (ndof /= sys%ndof .or. nfel /= sys%nfel) then
+  if (ndof /= sys%ndof .or. nfel /= sys%force_elements%nfel) then
     info = 2
     message = 'system_force_element_reactions: sizes inconsistent with the system'
     return

@@ -41,7 +41,7 @@ contains
     type(answer_data), intent(in) :: answers
     answer_count = 0
     if (.not. answers%on) return
-    answer_count = element_answers * sys%nfel + size(answers%columns)
+    answer_count = element_answers * sys%force_elements%nfel + size(answers%columns)
   end function answer_count
 
   !> The answers of the state (t, e, e', e'') with the contact projections of `contact`
@@ -61,7 +61,7 @@ contains
     integer :: nfel, ncol, i, k, d
     info = 0
     out = 0.0_dp
-    nfel = sys%nfel
+    nfel = sys%force_elements%nfel
     if (nfel > 0) then
       allocate (elements(element_answers, nfel))
       call force_element_reactions(sys, t, e, v, elements, info)

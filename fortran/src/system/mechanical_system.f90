@@ -36,7 +36,7 @@ module mechanical_system
                          constraint_kind_cross, constraint_kind_dot
   use matrix3, only: cross
   use element_sets, only: element_set, set_slot, frame_omega
-  use force_elements, only: force_element_eval, force_element_slots, fe_reaction_count
+  use force_elements, only: force_element_slots
   use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
                           cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
@@ -44,6 +44,8 @@ module mechanical_system
   use system_constraints, only: constraint_table, evaluate_constraints
   use system_loads, only: load_set, vector_load_forces, vector_load_tangent, &
                           dead_moment_forces, dead_moment_energy
+  use system_force_elements, only: force_element_table, force_element_forces, &
+                                   force_element_at
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -101,17 +103,7 @@ module mechanical_system
     type(mass_matrix) :: mass                         ! M and its forms (system_mass)
     type(coordinate_reduction) :: reduction  ! q = B e + q0, the plan (system_reduction)
     type(load_set) :: loads                           ! forces and moments (system_loads)
-    ! force elements (force_elements): per element a kind, a drive (0: none; the cylinder's
-    ! length), its parameters (fel_param_ptr), a force-deflection table (fel_table_ptr; kind
-    ! 0: none), its first slot (fel_slot_first); per slot a constant and the terms
-    ! fel_term_ptr(slot) .. fel_term_ptr(slot + 1) - 1 on full coordinates
-    integer :: nfel = 0
-    integer, allocatable :: fel_kind(:), fel_drive(:), fel_table_kind(:), fel_param_ptr(:), &
-                            fel_table_ptr(:), fel_slot_first(:), fel_term_ptr(:), fel_term_dof(:)
-    real(dp), allocatable :: fel_params(:), fel_table(:), fel_slot_const(:, :), fel_term_coef(:)
-    ! the tangent's positions in the full pattern's values (0: absent) in the loop order of
-    ! force_element_forces, element l's from fel_pos_ptr(l); none given: searched
-    integer, allocatable :: fel_pos_ptr(:), fel_pos(:)
+    type(force_element_table) :: force_elements  ! (system_force_elements)
     type(constraint_table) :: constraints  ! with multipliers (system_constraints)
     ! contact
     integer :: npoint = 0
@@ -295,7 +287,7 @@ contains
     ! set straight on the independent coordinates (selected_forces), without q, the full
     ! force and B^T (the same numbers)
     done = .not. want_tangent .and. sys%reduction%select_one_to_one .and. sys%npoint == 0 .and. &
-           sys%nfel == 0 .and. .not. present(full_out)
+           sys%force_elements%nfel == 0 .and. .not. present(full_out)
     if (done .and. allocated(sys%loads%moment_magnitude)) &
       done = size(sys%loads%moment_magnitude) == 0
     if (done) then
@@ -330,16 +322,18 @@ contains
       allocate (values_full(size(sys%reduction%full_col)))
       values_full = 0.0_dp
     end if
-    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0) then
+    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%force_elements%nfel > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys%reduction, v, .false., v_full)
     end if
-    if (sys%nfel > 0) then
+    if (sys%force_elements%nfel > 0) then
       if (want_tangent) then
-        call force_element_forces(sys, merge_time(force_time), e_full, v_full, velocity_factor, &
+        call force_element_forces(sys%force_elements, sys%drives, sys%reduction, &
+                                  merge_time(force_time), e_full, v_full, velocity_factor, &
                                   full_force, set_energy, fel_powers, info, values_full)
       else
-        call force_element_forces(sys, merge_time(force_time), e_full, v_full, velocity_factor, &
+        call force_element_forces(sys%force_elements, sys%drives, sys%reduction, &
+                                  merge_time(force_time), e_full, v_full, velocity_factor, &
                                   full_force, set_energy, fel_powers, info)
       end if
       if (info /= 0) return
@@ -477,123 +471,6 @@ contains
     if (present(time)) merge_time = time
   end function merge_time
 
-  !> The force elements at (e_full, v_full, t): their generalized forces added to full_force
-  !> (the residual's internal sign), the potential energy, powers(1) the dissipated power
-  !> and powers(2) the cylinders' drive power into the system; with values_full the tangent
-  !> dF/dq + velocity_factor dF/dq' added on the full pattern (entries outside it: none,
-  !> the assembly adds each element's coordinates as one block). info = 5 (a drive failed)
-  !> or 10 (an element's points coincide or its table fails).
-  subroutine force_element_forces(sys, t, e_full, v_full, velocity_factor, full_force, &
-                                  energy, powers, info, values_full)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: t, e_full(:), v_full(:), velocity_factor
-    real(dp), intent(inout) :: full_force(:)
-    real(dp), intent(out) :: energy, powers(2)
-    integer, intent(out) :: info
-    real(dp), intent(inout), optional :: values_full(:)
-    real(dp), allocatable :: force(:, :), stiffness(:, :, :, :), damping(:, :, :, :)
-    real(dp) :: el_energy, el_dissipation, el_power, reaction(fe_reaction_count)
-    integer :: l, ns, s, w, k, m, i, j, row, col, pos, slot_s, slot_w, next
-    logical :: known
-    energy = 0.0_dp
-    powers = 0.0_dp
-    info = 0
-    if (sys%nfel == 0) return
-    ! one work space for every element, sized for the kind with the most slots
-    ns = maxval([(force_element_slots(sys%fel_kind(l)), l = 1, sys%nfel)])
-    allocate (force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns))
-    do l = 1, sys%nfel
-      ns = force_element_slots(sys%fel_kind(l))
-      call force_element_at(sys, l, t, e_full, v_full, force(:, 1:ns), &
-                            stiffness(:, 1:ns, :, 1:ns), damping(:, 1:ns, :, 1:ns), el_energy, &
-                            el_dissipation, el_power, reaction, info)
-      if (info /= 0) return
-      energy = energy + el_energy
-      powers = powers + [el_dissipation, el_power]
-      do s = 1, ns
-        slot_s = sys%fel_slot_first(l) + s - 1
-        do k = sys%fel_term_ptr(slot_s), sys%fel_term_ptr(slot_s + 1) - 1
-          row = sys%fel_term_dof(k)
-          full_force(row:row + 2) = full_force(row:row + 2) + sys%fel_term_coef(k) * force(:, s)
-        end do
-      end do
-      if (present(values_full)) then
-        stiffness(:, 1:ns, :, 1:ns) = stiffness(:, 1:ns, :, 1:ns) &
-                                      + velocity_factor * damping(:, 1:ns, :, 1:ns)
-        known = .false.
-        if (allocated(sys%fel_pos_ptr)) known = sys%fel_pos_ptr(l + 1) > sys%fel_pos_ptr(l)
-        next = 0
-        if (known) next = sys%fel_pos_ptr(l)
-        do s = 1, ns
-          slot_s = sys%fel_slot_first(l) + s - 1
-          do w = 1, ns
-            slot_w = sys%fel_slot_first(l) + w - 1
-            do k = sys%fel_term_ptr(slot_s), sys%fel_term_ptr(slot_s + 1) - 1
-              do m = sys%fel_term_ptr(slot_w), sys%fel_term_ptr(slot_w + 1) - 1
-                do i = 1, 3
-                  row = sys%fel_term_dof(k) + i - 1
-                  do j = 1, 3
-                    if (known) then
-                      pos = sys%fel_pos(next)
-                      next = next + 1
-                    else
-                      col = sys%fel_term_dof(m) + j - 1
-                      pos = pattern_position(sys%reduction, row, col)
-                    end if
-                    if (pos > 0) values_full(pos) = values_full(pos) + sys%fel_term_coef(k) &
-                                                    * sys%fel_term_coef(m) * stiffness(i, s, j, w)
-                  end do
-                end do
-              end do
-            end do
-          end do
-        end do
-      end if
-    end do
-  end subroutine force_element_forces
-
-  !> Force element l at (e_full, v_full, t): its slots gathered, its drive evaluated (the
-  !> cylinder's nominal length), force_elements' evaluation. info = 5 (drive) or 10.
-  subroutine force_element_at(sys, l, t, e_full, v_full, force, stiffness, damping, energy, &
-                              dissipation, drive_power, reaction, info)
-    type(system_model), intent(in) :: sys
-    integer, intent(in) :: l
-    real(dp), intent(in) :: t, e_full(:), v_full(:)
-    real(dp), intent(out) :: force(:, :), stiffness(:, :, :, :), damping(:, :, :, :)
-    real(dp), intent(out) :: energy, dissipation, drive_power, reaction(:)
-    integer, intent(out) :: info
-    real(dp) :: x(3, size(force, 2)), xd(3, size(force, 2)), length, length_rate, ddl
-    integer :: s, k, slot, dof
-    info = 0
-    length = 0.0_dp
-    length_rate = 0.0_dp
-    if (sys%fel_drive(l) > 0) then
-      call drive_at(sys%drives, sys%fel_drive(l), t, &
-                       length, length_rate, ddl, info)
-      if (info /= 0) then
-        info = 5
-        return
-      end if
-    end if
-    do s = 1, size(force, 2)
-      slot = sys%fel_slot_first(l) + s - 1
-      x(:, s) = sys%fel_slot_const(:, slot)
-      xd(:, s) = 0.0_dp
-      do k = sys%fel_term_ptr(slot), sys%fel_term_ptr(slot + 1) - 1
-        dof = sys%fel_term_dof(k)
-        x(:, s) = x(:, s) + sys%fel_term_coef(k) * e_full(dof:dof + 2)
-        xd(:, s) = xd(:, s) + sys%fel_term_coef(k) * v_full(dof:dof + 2)
-      end do
-    end do
-    call force_element_eval(sys%fel_kind(l), &
-                            sys%fel_params(sys%fel_param_ptr(l):sys%fel_param_ptr(l + 1) - 1), &
-                            sys%fel_table_kind(l), &
-                            sys%fel_table(sys%fel_table_ptr(l):sys%fel_table_ptr(l + 1) - 1), &
-                            x, xd, length, length_rate, force, stiffness, damping, energy, &
-                            dissipation, drive_power, reaction, info)
-    if (info /= 0) info = 10
-  end subroutine force_element_at
-
   !> The reactions of every force element at (e, e', t) (reduced coordinates): per element
   !> the force and moment body1 exerts on body2 (global) and the axial force (tension
   !> positive), force_elements' layout (7, nfel). info = 5 or 10 (force_element_at).
@@ -610,11 +487,11 @@ contains
     allocate (e_full(sys%nfull), v_full(sys%nfull))
     call to_full(sys%reduction, e, .true., e_full)
     call to_full(sys%reduction, v, .false., v_full)
-    do l = 1, sys%nfel
-      ns = force_element_slots(sys%fel_kind(l))
+    do l = 1, sys%force_elements%nfel
+      ns = force_element_slots(sys%force_elements%kind(l))
       allocate (force(3, ns), stiffness(3, ns, 3, ns), damping(3, ns, 3, ns))
-      call force_element_at(sys, l, t, e_full, v_full, force, stiffness, damping, energy, &
-                            dissipation, power, reactions(:, l), info)
+      call force_element_at(sys%force_elements, sys%drives, l, t, e_full, v_full, force, &
+                            stiffness, damping, energy, dissipation, power, reactions(:, l), info)
       if (info /= 0) return
       deallocate (force, stiffness, damping)
     end do
@@ -809,7 +686,8 @@ contains
     ! the driven constraints and the driven forces phi_d(t) f_d do their work per step
     ! (drive_step_work, the integrator's own discrete identity), not here as powers
     call to_full(sys%reduction, e, .true., e_full)
-    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%nfel > 0 .or. sys%loads%nvload > 0) then
+    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%force_elements%nfel > 0 .or. &
+        sys%loads%nvload > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys%reduction, v, .false., v_full)
     end if
@@ -823,11 +701,12 @@ contains
       powers(power_drive) = powers(power_drive) + dot_product(unused, v_full)
       deallocate (unused)
     end if
-    if (sys%nfel > 0) then  ! potential, dissipation (a lost work) and the cylinders' drives
+    ! potential, dissipation (a lost work) and the cylinders' drives
+    if (sys%force_elements%nfel > 0) then
       allocate (unused(sys%nfull))
       unused = 0.0_dp
-      call force_element_forces(sys, t, e_full, v_full, 0.0_dp, unused, set_energy, &
-                                fel_powers, info)
+      call force_element_forces(sys%force_elements, sys%drives, sys%reduction, t, e_full, &
+                                v_full, 0.0_dp, unused, set_energy, fel_powers, info)
       if (info /= 0) return
       deallocate (unused)
       strain = strain + set_energy
