@@ -24,7 +24,7 @@ subroutine system_create(ndof, nfull, handle, info, message)
   call api_system(handle, sys, info)
   sys%ndof = ndof
   sys%nfull = nfull
-  allocate (sys%sets(0), sys%frames(0), sys%pairs(0))
+  allocate (sys%sets(0), sys%frames(0), sys%contact%pairs(0))
   allocate (sys%drives%kinds(0), sys%drives%ptr(1), sys%drives%data(0))
   sys%drives%ptr = 1
   allocate (sys%loads%constant_force(ndof), sys%loads%force_drive(0), &
@@ -1027,20 +1027,20 @@ subroutine system_add_contact_pair(handle, nel, dofs, sizes, ngrid_l, ngrid_w, g
     message = 'system_add_contact_pair: dofs outside 1..nfull or inconsistent contact sizes'
     return
   end if
-  n = size(sys%pairs)
+  n = size(sys%contact%pairs)
   allocate (grown(n + 1))
-  grown(1:n) = sys%pairs
+  grown(1:n) = sys%contact%pairs
   grown(n + 1)%nel = nel
   grown(n + 1)%npoint = npoint
-  grown(n + 1)%first_point = sys%npoint
+  grown(n + 1)%first_point = sys%contact%npoint
   grown(n + 1)%dofs = dofs
   grown(n + 1)%sizes = sizes
   grown(n + 1)%grid = grid
   grown(n + 1)%point_element = point_element
   grown(n + 1)%point_local = point_local
   grown(n + 1)%params = params
-  call move_alloc(grown, sys%pairs)
-  sys%npoint = sys%npoint + npoint
+  call move_alloc(grown, sys%contact%pairs)
+  sys%contact%npoint = sys%contact%npoint + npoint
 end subroutine system_add_contact_pair
 
 !> Probes: positions sum_k coef_k q(dof_k:dof_k+2) over the terms ptr(p):ptr(p+1)-1, the
@@ -1116,7 +1116,7 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, state, factors, want_tange
   energies = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  if (ndof /= sys%ndof .or. npoint /= sys%npoint .or. (want_tangent /= 0 .and. &
+  if (ndof /= sys%ndof .or. npoint /= sys%contact%npoint .or. (want_tangent /= 0 .and. &
       nnz /= size(sys%mass_pattern))) then
     info = 2
     message = 'system_evaluate: sizes inconsistent with the system (ndof,' // &
@@ -1181,7 +1181,7 @@ subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor,
   full_force = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  if (ndof /= sys%ndof .or. nfull /= sys%nfull .or. npoint /= sys%npoint) then
+  if (ndof /= sys%ndof .or. nfull /= sys%nfull .or. npoint /= sys%contact%npoint) then
     info = 2
     message = 'system_full_forces: sizes inconsistent with the system (ndof, nfull, npoint)'
     return
@@ -1232,7 +1232,7 @@ subroutine system_output_row(handle, ndof, ncon, npoint, nrow, t, state, lam, wo
   call api_system(handle, sys, info, message)
   if (info /= 0) return
   nprobe = sys%nprobe
-  if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. npoint /= sys%npoint .or. &
+  if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. npoint /= sys%contact%npoint .or. &
       nrow /= row_size(ndof, ncon, nprobe, npoint, 0, .false.) .or. power_count /= 5) then
     info = 2
     message = 'system_output_row: sizes inconsistent with the system (ndof, ncon, npoint,' // &
@@ -1338,7 +1338,7 @@ subroutine system_answer_row(handle, ndof, npoint, nanswer, t, state, accel, gue
   answers = 0.0_dp
   call api_system(handle, sys, info, message, run)
   if (info /= 0) return
-  if (ndof /= sys%ndof .or. npoint /= sys%npoint .or. &
+  if (ndof /= sys%ndof .or. npoint /= sys%contact%npoint .or. &
       nanswer /= answer_count(sys, run%answers)) then
     info = 2
     message = 'system_answer_row: sizes inconsistent with the system or its run (ndof, ' // &
@@ -1412,7 +1412,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   ndof = sys%ndof
   ncon = sys%constraints%ncon
   nprobe = sys%nprobe
-  npoint = sys%npoint
+  npoint = sys%contact%npoint
   nanswer = answer_count(sys, run%answers)
   store_q = nrow == row_size(ndof, ncon, nprobe, npoint, nanswer, .true.)
   if (nstate /= state_size(ndof, ncon, npoint) .or. (.not. store_q .and. &
@@ -1512,7 +1512,7 @@ subroutine system_consistent_acceleration(handle, ndof, ncon, npoint, t, state, 
   lam = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. npoint /= sys%npoint) then
+  if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. npoint /= sys%contact%npoint) then
     info = 2
     message = 'system_consistent_acceleration: sizes inconsistent with the system (ndof, ' // &
               'ncon, npoint)'
@@ -1567,7 +1567,7 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
   outcome(so_info) = info
   if (info /= 0) return
   ncon = sys%constraints%ncon
-  npoint = sys%npoint
+  npoint = sys%contact%npoint
   if (ndof /= sys%ndof .or. nstate /= ndof + ncon + 2 * npoint .or. &
       nnz /= size(sys%mass_pattern) .or. max_iter < 1) then
     outcome(so_info) = 4
@@ -1634,7 +1634,7 @@ subroutine system_contact_forces(handle, nfull, nnz, npoint, state, velocity_fac
   values = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  if (nfull /= sys%nfull .or. npoint /= sys%npoint .or. (want_jacobian /= 0 .and. &
+  if (nfull /= sys%nfull .or. npoint /= sys%contact%npoint .or. (want_jacobian /= 0 .and. &
       nnz /= size(sys%reduction%full_col))) then
     info = 2
     message = 'system_contact_forces: sizes inconsistent with the system (nfull, npoint,' // &
@@ -1647,8 +1647,8 @@ subroutine system_contact_forces(handle, nfull, nnz, npoint, state, velocity_fac
     allocate (jacobian(nnz))
     jacobian = 0.0_dp
   end if
-  call contact_forces(sys, state(:, sv_coordinates), state(:, sv_rates), velocity_factor, &
-                      contact, force, records(:, 1:npoint), energies(ce_potential), &
+  call contact_forces(sys%contact, sys%reduction, state(:, sv_coordinates), state(:, sv_rates), &
+                      velocity_factor, contact, force, records(:, 1:npoint), energies(ce_potential), &
                       energies(ce_damping:ce_friction), info, jacobian)
   if (info /= 0) then
     message = failure_text(info)

@@ -34,7 +34,7 @@ contains
     character(len=message_length), intent(out) :: message
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: internal(sys%ndof), external(sys%ndof), strain, potential, powers(2)
-    real(dp) :: records(contact_record, max(1, sys%npoint))
+    real(dp) :: records(contact_record, max(1, sys%contact%npoint))
     real(dp) :: values(sys%constraints%ncon), gradients(6, sys%constraints%ncon)
     real(dp) :: hessians(6, 6, sys%constraints%ncon)
     real(dp) :: phi_t(sys%constraints%ncon), phi_tt(sys%constraints%ncon)

@@ -72,7 +72,7 @@ contains
     if (ncol == 0) return
     allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)), &
               reduced(sys%ndof), full_force(sys%nfull), accel_full(sys%nfull), &
-              records(contact_record, max(1, sys%npoint)), phi(size(answers%driven, 2)))
+              records(contact_record, max(1, sys%contact%npoint)), phi(size(answers%driven, 2)))
     call frame_rotations(sys, t, rotations, rates, info)
     if (info /= 0) return
     search%guesses = contact%guesses

@@ -295,7 +295,7 @@ contains
     !> internal (with the tangent on request), loads, constraints and reaction at e
     subroutine evaluate(with_tangent)
       logical, intent(in) :: with_tangent
-      real(dp) :: strain, potential, powers(2), records(contact_record, max(1, sys%npoint))
+      real(dp) :: strain, potential, powers(2), records(contact_record, max(1, sys%contact%npoint))
       real(dp) :: zero_rates(size(e)), phi_t(ncon), phi_tt(ncon), gamma(ncon)
       zero_rates = 0.0_dp
       if (with_tangent) then

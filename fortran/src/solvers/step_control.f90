@@ -312,7 +312,7 @@ contains
     ndof = sys%ndof
     ncon = sys%constraints%ncon
     nprobe = sys%nprobe
-    npoint = sys%npoint
+    npoint = sys%contact%npoint
     nanswer = answer_count(sys, run%answers)
     ! (the stepper writes time, lam, energy, constraint violation and q straight into their
     ! rows, zeroed by the caller; the probes, deflections and contact records are copied)

@@ -161,7 +161,7 @@ contains
               work%gradients(6, ncon), work%w(nb, ncon), work%flex_w(nb, ncon), &
               work%w_dlam(nb), work%schur(ncon, ncon), work%dlam(ncon, 1), &
               work%internal(sys%ndof), work%loads(sys%ndof), &
-              work%records(contact_record, max(1, sys%npoint)), work%ipiv(ncon), &
+              work%records(contact_record, max(1, sys%contact%npoint)), work%ipiv(ncon), &
               work%full(sys%nfull), work%row_phi(ncon), work%row_gradients(6, ncon), &
               work%row_ndof(sys%ndof), work%full_pair(sys%nfull, 2))
     if (carry_enabled(sys)) then
@@ -249,7 +249,7 @@ contains
                            potential, powers, records, info, rates=rates, force_time=t, &
                            full_work=work%full_pair)
       if (info /= 0) return
-      if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
+      if (sys%contact%npoint > 0) active = count(records(1, 1:sys%contact%npoint) > 0.0_dp)
     end if
     call mass_product(sys%mass, acceleration, r)
     ! (loads of t alone, without point loads that follow e: once per time, kept for the
@@ -379,7 +379,7 @@ contains
       end do
       ! the predictor of the next step: the extrapolation that came nearest e''_{n+1}
       ! (refactorized systems without contact only: the others never use it)
-      if (sys%npoint == 0 .and. sys%policy /= policy_constant) &
+      if (sys%contact%npoint == 0 .and. sys%policy /= policy_constant) &
         call learn_predictor(learned, h, accel, accel_new)
       accel = accel_new
       do i = 1, sys%constraints%ncon
@@ -424,7 +424,7 @@ contains
     real(dp), intent(in) :: h, e(:), v(:), a(:), accel(:)
     real(dp), intent(out) :: e_new(:), v_new(:), a_new(:), accel_new(:)
     integer :: i
-    if (sys%npoint == 0) then
+    if (sys%contact%npoint == 0) then
       call extrapolate(usable_predictor(learned, h, learned%predictor), accel, learned, &
                        accel_new)
       ! (one pass: each coordinate's a_new, e_new and v_new by the expressions of the array
@@ -437,7 +437,7 @@ contains
       end do
       return
     else
-      if (maxval(abs(h * v)) <= contact_step_limit(sys)) then
+      if (maxval(abs(h * v)) <= contact_step_limit(sys%contact)) then
         e_new = e + h * v
         a_new = -((0.5_dp - cfg%beta) * a) / cfg%beta
       else
@@ -565,7 +565,7 @@ contains
       use_known = .false.
       ! reuse: a changed contact set invalidates the matrix before it is used
       if (cfg%jacobian == jacobian_reuse .and. sys%policy /= policy_constant .and. &
-          sys%npoint > 0 .and. active /= sys%factor_active .and. it < cfg%max_newton) then
+          sys%contact%npoint > 0 .and. active /= sys%factor_active .and. it < cfg%max_newton) then
         call refresh_matrix()
         if (info /= 0) return
         refreshed_at = it - 1
@@ -621,11 +621,11 @@ contains
         correction = correction - direction
       end if
       capped = .false.
-      if (sys%npoint > 0) then
+      if (sys%contact%npoint > 0) then
         ! damped Newton with contact: no correction moves a coordinate by more than half a
         ! leaf thickness (a contact that is open at the linearization point has no stiffness
         ! there, and a full step would jump far through the other leaf)
-        step_cap = contact_step_limit(sys)
+        step_cap = contact_step_limit(sys%contact)
         if (maxval(abs(correction)) > step_cap) then
           capped = .true.
           dlam = dlam * (step_cap / maxval(abs(correction)))
@@ -1135,7 +1135,7 @@ contains
     ! evidence that the next would be as small
     if (it == 2 .and. sys%policy /= policy_constant) then
       step_theta = theta
-      if (ok .or. sys%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
+      if (ok .or. sys%contact%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
           learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
       known = min(learned%matrix_measured, contraction_memory)
       bound = maxval(learned%matrix_ratios(1:known))

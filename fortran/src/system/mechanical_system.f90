@@ -37,8 +37,6 @@ module mechanical_system
   use matrix3, only: cross
   use element_sets, only: element_set, set_slot, frame_omega
   use force_elements, only: force_element_slots
-  use leaf_contact, only: contact_assemble, cp_count, contact_counters, contact_record, &
-                          cp_upper_thickness, cp_lower_thickness
   use sparse_direct, only: solver_solve, solver_factorize
   use system_drives, only: drive_table, drive_at
   use system_constraints, only: constraint_table, evaluate_constraints
@@ -46,6 +44,8 @@ module mechanical_system
                           dead_moment_forces, dead_moment_energy
   use system_force_elements, only: force_element_table, force_element_forces, &
                                    force_element_at
+  use system_contact, only: contact_set, contact_pair, contact_state, contact_record, &
+                            contact_forces, contact_step_limit
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -80,21 +80,6 @@ module mechanical_system
     real(dp) :: pivot(3) = 0.0_dp
   end type frame_def
 
-  !> Points on one plate surface searched on another's mid-surface (leaf_contact). Element
-  !> columns 1..nel of dofs: the upper body's grid elements and the points' elements.
-  type :: contact_pair
-    integer :: nel = 0, npoint = 0, first_point = 0
-    integer, allocatable :: dofs(:, :), grid(:, :), point_element(:)
-    real(dp), allocatable :: sizes(:, :), point_local(:, :)
-    real(dp) :: params(cp_count) = 0.0_dp
-  end type contact_pair
-
-  !> What contact carries from iteration to iteration and step to step.
-  type :: contact_state
-    real(dp), allocatable :: guesses(:, :)     ! (2, npoint) leaf-level projections
-    integer :: counts(contact_counters) = 0
-  end type contact_state
-
   type :: system_model
     integer :: ndof = 0, nfull = 0
     type(set_slot), allocatable :: sets(:)             ! element sets of any family
@@ -105,9 +90,7 @@ module mechanical_system
     type(load_set) :: loads                           ! forces and moments (system_loads)
     type(force_element_table) :: force_elements  ! (system_force_elements)
     type(constraint_table) :: constraints  ! with multipliers (system_constraints)
-    ! contact
-    integer :: npoint = 0
-    type(contact_pair), allocatable :: pairs(:)
+    type(contact_set) :: contact                      ! plate-plate contact (system_contact)
     ! probes: positions sum coef q(dof:dof+2); deflection A_f(t)^T (p - pivot_f) - reference
     integer :: nprobe = 0
     integer, allocatable :: probe_ptr(:), probe_dof(:), probe_frame(:)
@@ -286,8 +269,8 @@ contains
     ! the force alone of undamped sets on a one-to-one selection, nothing else acting: each
     ! set straight on the independent coordinates (selected_forces), without q, the full
     ! force and B^T (the same numbers)
-    done = .not. want_tangent .and. sys%reduction%select_one_to_one .and. sys%npoint == 0 .and. &
-           sys%force_elements%nfel == 0 .and. .not. present(full_out)
+    done = .not. want_tangent .and. sys%reduction%select_one_to_one .and. &
+           sys%contact%npoint == 0 .and. sys%force_elements%nfel == 0 .and. .not. present(full_out)
     if (done .and. allocated(sys%loads%moment_magnitude)) &
       done = size(sys%loads%moment_magnitude) == 0
     if (done) then
@@ -322,7 +305,7 @@ contains
       allocate (values_full(size(sys%reduction%full_col)))
       values_full = 0.0_dp
     end if
-    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%force_elements%nfel > 0) then
+    if (sys%contact%npoint > 0 .or. damped_sets(sys) .or. sys%force_elements%nfel > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys%reduction, v, .false., v_full)
     end if
@@ -367,9 +350,10 @@ contains
     end do
     contact_potential = 0.0_dp
     contact_powers = 0.0_dp
-    if (sys%npoint > 0) then
-      call contact_forces(sys, e_full, v_full, velocity_factor, state, full_force, records, &
-                          contact_potential, contact_powers, info, values_full)
+    if (sys%contact%npoint > 0) then
+      call contact_forces(sys%contact, sys%reduction, e_full, v_full, velocity_factor, state, &
+                          full_force, records, contact_potential, contact_powers, info, &
+                          values_full)
       if (info /= 0) return
     end if
     call dead_moment_forces(sys%loads, e_full, load_factor, full_force, info)
@@ -384,50 +368,6 @@ contains
     end if
     call reduce_tangent(sys%reduction, values_full, tangent_values)
   end subroutine internal_forces
-
-  !> Contact forces of every pair subtracted from full_force (they are external: the
-  !> residual carries elastic minus contact), with the Jacobian of minus the forces added
-  !> to values_full when allocated. info = 7 (normal vanished) or 8 (projection failed).
-  subroutine contact_forces(sys, e_full, v_full, velocity_factor, state, full_force, records, &
-                            potential, powers, info, values_full)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: e_full(:), v_full(:), velocity_factor
-    type(contact_state), intent(inout) :: state
-    real(dp), intent(inout) :: full_force(:)
-    real(dp), intent(out) :: records(:, :), potential, powers(2)
-    integer, intent(out) :: info
-    real(dp), allocatable, intent(inout) :: values_full(:)
-    real(dp), allocatable :: pair_force(:)
-    real(dp) :: pair_potential, pair_powers(2)
-    integer :: p, first, last
-    potential = 0.0_dp
-    powers = 0.0_dp
-    info = 0
-    allocate (pair_force(sys%nfull))
-    do p = 1, size(sys%pairs)
-      first = sys%pairs(p)%first_point + 1
-      last = sys%pairs(p)%first_point + sys%pairs(p)%npoint
-      pair_force = 0.0_dp
-      if (allocated(values_full)) then
-        call contact_assemble(e_full, v_full, sys%pairs(p)%dofs, sys%pairs(p)%sizes, &
-                              sys%pairs(p)%grid, sys%pairs(p)%point_element, &
-                              sys%pairs(p)%point_local, sys%pairs(p)%params, velocity_factor, &
-                              state%guesses(:, first:last), pair_force, records(:, first:last), &
-                              pair_potential, pair_powers, state%counts, info, sys%reduction%full_ptr, &
-                              sys%reduction%full_col, values_full)
-      else
-        call contact_assemble(e_full, v_full, sys%pairs(p)%dofs, sys%pairs(p)%sizes, &
-                              sys%pairs(p)%grid, sys%pairs(p)%point_element, &
-                              sys%pairs(p)%point_local, sys%pairs(p)%params, velocity_factor, &
-                              state%guesses(:, first:last), pair_force, records(:, first:last), &
-                              pair_potential, pair_powers, state%counts, info)
-      end if
-      if (info /= 0) return
-      full_force = full_force - pair_force
-      potential = potential + pair_potential
-      powers = powers + pair_powers
-    end do
-  end subroutine contact_forces
 
   !> Configuration-independent external loads at t, times load_factor: the constant loads
   !> plus the driven forces. info = 5 when a drive fails.
@@ -592,7 +532,7 @@ contains
     real(dp) :: potential, powers(2), frame_rates(0:size(sys%frames))
     integer :: b, j
     detail = 0
-    allocate (values(size(sys%mass_pattern)), records(contact_record, max(1, sys%npoint)))
+    allocate (values(size(sys%mass_pattern)), records(contact_record, max(1, sys%contact%npoint)))
     frame_rates = 0.0_dp
     if (present(rates)) frame_rates = rates
     call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
@@ -601,7 +541,7 @@ contains
                          force_time=t)
     if (info /= 0) return
     active = 0
-    if (sys%npoint > 0) active = count(records(1, 1:sys%npoint) > 0.0_dp)
+    if (sys%contact%npoint > 0) active = count(records(1, 1:sys%contact%npoint) > 0.0_dp)
     values = values + beta_prime * sys%mass_pattern
     sys%factorized = .false.
     call solver_factorize(sys%solver_handle, size(values), values, info, detail)
@@ -686,7 +626,7 @@ contains
     ! the driven constraints and the driven forces phi_d(t) f_d do their work per step
     ! (drive_step_work, the integrator's own discrete identity), not here as powers
     call to_full(sys%reduction, e, .true., e_full)
-    if (sys%npoint > 0 .or. damped_sets(sys) .or. sys%force_elements%nfel > 0 .or. &
+    if (sys%contact%npoint > 0 .or. damped_sets(sys) .or. sys%force_elements%nfel > 0 .or. &
         sys%loads%nvload > 0) then
       allocate (v_full(sys%nfull))
       call to_full(sys%reduction, v, .false., v_full)
@@ -730,12 +670,12 @@ contains
       powers(power_frame) = powers(power_frame) + set_power
     end do
     contact_potential = 0.0_dp
-    if (sys%npoint > 0) then
+    if (sys%contact%npoint > 0) then
       allocate (unused(sys%nfull))
       unused = 0.0_dp
-      call contact_forces(sys, e_full, v_full, 0.0_dp, state, unused, records, &
-                          contact_potential, powers(power_contact_damping:power_friction), info, &
-                          values_unused)
+      call contact_forces(sys%contact, sys%reduction, e_full, v_full, 0.0_dp, state, unused, &
+                          records, contact_potential, powers(power_contact_damping:power_friction), &
+                          info, values_unused)
     end if
   end subroutine energies
 
@@ -859,20 +799,5 @@ contains
     energy(work_friction) = work(power_friction)
     energy(work_material_damping) = work(power_material_damping)
   end subroutine probe_output
-
-  !> The contact step limit: half the thinnest leaf of any contact pair (huge without
-  !> contact). No Newton correction of the stepper moves a coordinate further (a contact
-  !> open at the linearization point has no stiffness there, and a full step would jump far
-  !> through the other leaf), and the predictor of a contact system moves on at constant
-  !> velocity only while no coordinate moves further in the step.
-  pure real(dp) function contact_step_limit(sys) result(limit)
-    type(system_model), intent(in) :: sys
-    integer :: pair
-    limit = huge(1.0_dp)
-    do pair = 1, size(sys%pairs)
-      limit = min(limit, 0.5_dp * sys%pairs(pair)%params(cp_upper_thickness), &
-                  0.5_dp * sys%pairs(pair)%params(cp_lower_thickness))
-    end do
-  end function contact_step_limit
 
 end module mechanical_system
