@@ -37,9 +37,9 @@ subroutine system_create(ndof, nfull, handle, info, message)
             sys%constraints%term_dof(0), sys%constraints%params(8, 0), &
             sys%constraints%operand_const(6, 0), sys%constraints%term_coef(0))
   sys%constraints%term_ptr = 1
-  allocate (sys%probe_ptr(1), sys%probe_dof(0), sys%probe_frame(0), sys%probe_coef(0), &
-            sys%probe_reference(3, 0))
-  sys%probe_ptr = 1
+  allocate (sys%probes%ptr(1), sys%probes%dof(0), sys%probes%frame(0), sys%probes%coef(0), &
+            sys%probes%reference(3, 0))
+  sys%probes%ptr = 1
   allocate (sys%block_first(0), sys%flexibility(ndof, 0), sys%flexibility_cc(0, 0))
 end subroutine system_create
 
@@ -1072,12 +1072,12 @@ subroutine system_set_probes(handle, nprobe, nterm, ptr, dofs, coefs, frames, re
       return
     end if
   end if
-  sys%nprobe = nprobe
-  sys%probe_ptr = ptr
-  sys%probe_dof = dofs(1:nterm)
-  sys%probe_coef = coefs(1:nterm)
-  sys%probe_frame = frames(1:nprobe)
-  sys%probe_reference = reference(:, 1:nprobe)
+  sys%probes%nprobe = nprobe
+  sys%probes%ptr = ptr
+  sys%probes%dof = dofs(1:nterm)
+  sys%probes%coef = coefs(1:nterm)
+  sys%probes%frame = frames(1:nprobe)
+  sys%probes%reference = reference(:, 1:nprobe)
 end subroutine system_set_probes
 
 !> The configuration-dependent forces at (e, e', t): internal = B^T (Q_el - Q_c -
@@ -1231,7 +1231,7 @@ subroutine system_output_row(handle, ndof, ncon, npoint, nrow, t, state, lam, wo
   powers = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  nprobe = sys%nprobe
+  nprobe = sys%probes%nprobe
   if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. npoint /= sys%contact%npoint .or. &
       nrow /= row_size(ndof, ncon, nprobe, npoint, 0, .false.) .or. power_count /= 5) then
     info = 2
@@ -1411,7 +1411,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   end if
   ndof = sys%ndof
   ncon = sys%constraints%ncon
-  nprobe = sys%nprobe
+  nprobe = sys%probes%nprobe
   npoint = sys%contact%npoint
   nanswer = answer_count(sys, run%answers)
   store_q = nrow == row_size(ndof, ncon, nprobe, npoint, nanswer, .true.)

@@ -311,7 +311,7 @@ contains
     integer :: at_lambda, at_energy, at_constraint, at_answers, at_q  ! (row_size)
     ndof = sys%ndof
     ncon = sys%constraints%ncon
-    nprobe = sys%nprobe
+    nprobe = sys%probes%nprobe
     npoint = sys%contact%npoint
     nanswer = answer_count(sys, run%answers)
     ! (the stepper writes time, lam, energy, constraint violation and q straight into their

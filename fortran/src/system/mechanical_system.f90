@@ -46,6 +46,7 @@ module mechanical_system
                                    force_element_at
   use system_contact, only: contact_set, contact_pair, contact_state, contact_record, &
                             contact_forces, contact_step_limit
+  use system_probes, only: probe_set, probe_values
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -91,10 +92,7 @@ module mechanical_system
     type(force_element_table) :: force_elements  ! (system_force_elements)
     type(constraint_table) :: constraints  ! with multipliers (system_constraints)
     type(contact_set) :: contact                      ! plate-plate contact (system_contact)
-    ! probes: positions sum coef q(dof:dof+2); deflection A_f(t)^T (p - pivot_f) - reference
-    integer :: nprobe = 0
-    integer, allocatable :: probe_ptr(:), probe_dof(:), probe_frame(:)
-    real(dp), allocatable :: probe_coef(:), probe_reference(:, :)
+    type(probe_set) :: probes                         ! output points (system_probes)
     ! iteration matrix: solver handle (sparse_direct), M on its pattern, policy, the
     ! frame of each reduced 3-vector (policy constant), the touched 3-vector blocks
     integer :: solver_handle = 0, policy = policy_refactor
@@ -754,8 +752,8 @@ contains
     real(dp), intent(out), optional, target :: ndof_work(:)
     real(dp), allocatable, target :: own_full(:), own_ndof(:)
     real(dp), pointer :: e_full(:), mv(:)
-    real(dp) :: pivot(3), relative(3), total
-    integer :: p, k, f, j
+    real(dp) :: pivots(3, 0:size(sys%frames))
+    integer :: f
     info = 0
     if (present(known_full)) then
       e_full => known_full
@@ -766,26 +764,11 @@ contains
       e_full => own_full
       mv => own_ndof
     end if
-    do p = 1, sys%nprobe
-      probe(:, p) = 0.0_dp
-      do k = sys%probe_ptr(p), sys%probe_ptr(p + 1) - 1
-        probe(:, p) = probe(:, p) + sys%probe_coef(k) &
-                      * e_full(sys%probe_dof(k):sys%probe_dof(k) + 2)
-      end do
-      f = sys%probe_frame(p)
-      pivot = 0.0_dp
-      if (f > 0) pivot = sys%frames(f)%pivot
-      ! A_f^T (p - pivot) by its sums as matmul takes them (from 0, in the order of the
-      ! rows), without matmul's library call and temporaries
-      relative = probe(:, p) - pivot
-      do k = 1, 3
-        total = 0.0_dp
-        do j = 1, 3
-          total = total + rotations(j, k, f) * relative(j)
-        end do
-        deflection(k, p) = total - sys%probe_reference(k, p)
-      end do
+    pivots(:, 0) = 0.0_dp
+    do f = 1, size(sys%frames)
+      pivots(:, f) = sys%frames(f)%pivot
     end do
+    call probe_values(sys%probes, e_full, rotations, pivots, probe, deflection)
     energy = 0.0_dp
     call kinetic_energy(sys%mass, v, mv, energy(energy_kinetic))
     energy(energy_strain) = strain
