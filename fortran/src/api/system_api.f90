@@ -40,7 +40,8 @@ subroutine system_create(ndof, nfull, handle, info, message)
   allocate (sys%probes%ptr(1), sys%probes%dof(0), sys%probes%frame(0), sys%probes%coef(0), &
             sys%probes%reference(3, 0))
   sys%probes%ptr = 1
-  allocate (sys%block_first(0), sys%flexibility(ndof, 0), sys%flexibility_cc(0, 0))
+  allocate (sys%matrix%block_first(0), sys%matrix%flexibility(ndof, 0), &
+            sys%matrix%flexibility_cc(0, 0))
 end subroutine system_create
 
 subroutine system_destroy(handle, info, message)
@@ -111,7 +112,7 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
                      control_settings(dt=control(sk_dt), dt_min=control(sk_dt_min), &
                                       tolerance=control(sk_tolerance), &
                                       adaptive=control(sk_adaptive) /= 0.0_dp))
-  if (sys%policy /= policy_constant) sys%factorized = .false.
+  if (sys%matrix%policy /= policy_constant) sys%matrix%factorized = .false.
   call plane_mass_setup(sys%mass, sys%ndof, sys%carry_plane)
 end subroutine system_stepper_setup
 
@@ -564,11 +565,11 @@ subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_
     message = 'system_set_mass: the saddle mass is no CSR of ndof rows (1-based)'
     return
   end if
-  sys%mass_pattern = mass_pattern
+  sys%matrix%mass_pattern = mass_pattern
   sys%mass%saddle_ptr = saddle_ptr
   sys%mass%saddle_col = saddle_col
   sys%mass%saddle_values = saddle_values
-  sys%factorized = .false.
+  sys%matrix%factorized = .false.
 end subroutine system_set_mass
 
 !> The full pattern of the tangents (CSR, 1-based), the solver (api_support sl_*: its
@@ -595,19 +596,20 @@ subroutine system_set_solver(handle, nfull, nnz_full, full_row_ptr, full_col, so
   end if
   sys%reduction%full_ptr = full_row_ptr
   sys%reduction%full_col = full_col
-  sys%solver_handle = solver(sl_handle)
-  sys%policy = solver(sl_policy)
-  if (allocated(sys%vector_frame)) deallocate (sys%vector_frame)
-  sys%single_frame = -1
+  sys%matrix%solver_handle = solver(sl_handle)
+  sys%matrix%policy = solver(sl_policy)
+  if (allocated(sys%matrix%vector_frame)) deallocate (sys%matrix%vector_frame)
+  sys%matrix%single_frame = -1
   if (nvec > 0) then
-    sys%vector_frame = vector_frame(1:nvec)
+    sys%matrix%vector_frame = vector_frame(1:nvec)
     if (all(vector_frame(1:nvec) == vector_frame(1)) .and. vector_frame(1) > 0) &
-      sys%single_frame = vector_frame(1)
+      sys%matrix%single_frame = vector_frame(1)
   end if
-  sys%block_first = block_first(1:nblock)
-  deallocate (sys%flexibility, sys%flexibility_cc)
-  allocate (sys%flexibility(sys%ndof, 3 * nblock), sys%flexibility_cc(3 * nblock, 3 * nblock))
-  sys%factorized = .false.
+  sys%matrix%block_first = block_first(1:nblock)
+  deallocate (sys%matrix%flexibility, sys%matrix%flexibility_cc)
+  allocate (sys%matrix%flexibility(sys%ndof, 3 * nblock), &
+            sys%matrix%flexibility_cc(3 * nblock, 3 * nblock))
+  sys%matrix%factorized = .false.
 end subroutine system_set_solver
 
 !> The 3-vectors jacobian_reuse carries the iteration matrix with (carried_rotation): the
@@ -1117,7 +1119,7 @@ subroutine system_evaluate(handle, ndof, nnz, npoint, state, factors, want_tange
   call api_system(handle, sys, info, message)
   if (info /= 0) return
   if (ndof /= sys%ndof .or. npoint /= sys%contact%npoint .or. (want_tangent /= 0 .and. &
-      nnz /= size(sys%mass_pattern))) then
+      nnz /= size(sys%matrix%mass_pattern))) then
     info = 2
     message = 'system_evaluate: sizes inconsistent with the system (ndof,' // &
               ' npoint, or nnz of the tangent)'
@@ -1569,7 +1571,7 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
   ncon = sys%constraints%ncon
   npoint = sys%contact%npoint
   if (ndof /= sys%ndof .or. nstate /= ndof + ncon + 2 * npoint .or. &
-      nnz /= size(sys%mass_pattern) .or. max_iter < 1) then
+      nnz /= size(sys%matrix%mass_pattern) .or. max_iter < 1) then
     outcome(so_info) = 4
     message = 'system_static_solve: sizes inconsistent with the system (ndof, the packed' // &
               ' state, nnz of the pattern) or max_iter < 1'

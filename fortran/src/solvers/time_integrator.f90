@@ -154,7 +154,7 @@ contains
     type(system_model), intent(in) :: sys
     type(step_work), intent(out) :: work
     integer :: nb, b, j, ncon
-    nb = 3 * size(sys%block_first)
+    nb = 3 * size(sys%matrix%block_first)
     ncon = sys%constraints%ncon
     allocate (work%r(sys%ndof), work%z(sys%ndof, 1), work%direction(sys%ndof), &
               work%correction(sys%ndof), work%back(sys%ndof), work%phi(ncon), &
@@ -169,9 +169,9 @@ contains
                 work%carry_flexibility(sys%ndof, ncon), work%carry_lu(ncon, ncon), &
                 work%carry_column(sys%ndof), work%block_row(sys%ndof))
       work%block_row = 0
-      do b = size(sys%block_first), 1, -1
-        do j = 0, min(2, sys%ndof - sys%block_first(b))
-          work%block_row(sys%block_first(b) + j) = 3 * (b - 1) + j + 1
+      do b = size(sys%matrix%block_first), 1, -1
+        do j = 0, min(2, sys%ndof - sys%matrix%block_first(b))
+          work%block_row(sys%matrix%block_first(b) + j) = 3 * (b - 1) + j + 1
         end do
       end do
       work%touched_dofs = pack([(j, j = 1, sys%ndof)], work%block_row > 0)
@@ -340,9 +340,9 @@ contains
           if (info /= 0) return
           stats(stat_factorizations) = stats(stat_factorizations) + 1
           stats(stat_jacobians) = stats(stat_jacobians) + 1
-          fresh_matrix = sys%policy /= policy_constant
+          fresh_matrix = sys%matrix%policy /= policy_constant
         else if (attempt == 1) then
-          started_old = sys%policy /= policy_constant
+          started_old = sys%matrix%policy /= policy_constant
         end if
         call carry_step(sys, cfg, learned, fresh_matrix, e_new)
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
@@ -352,7 +352,7 @@ contains
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
         ! refreshed the matrix on the way) gets one retry from its start with a fresh one
-        if (done .or. cfg%jacobian /= jacobian_reuse .or. sys%policy == policy_constant &
+        if (done .or. cfg%jacobian /= jacobian_reuse .or. sys%matrix%policy == policy_constant &
             .or. fresh_matrix) exit
       end do
       if (.not. done) then
@@ -379,7 +379,7 @@ contains
       end do
       ! the predictor of the next step: the extrapolation that came nearest e''_{n+1}
       ! (refactorized systems without contact only: the others never use it)
-      if (sys%contact%npoint == 0 .and. sys%policy /= policy_constant) &
+      if (sys%contact%npoint == 0 .and. sys%matrix%policy /= policy_constant) &
         call learn_predictor(learned, h, accel, accel_new)
       accel = accel_new
       do i = 1, sys%constraints%ncon
@@ -463,8 +463,8 @@ contains
     integer, intent(out) :: info, detail
     real(dp), intent(in) :: rates(0:), t
     call refactorize(sys, beta_prime, velocity_factor, rotations, e, v, state, force, strain, &
-                     sys%factor_active, info, detail, rates, t)
-    if (info == 0 .or. (info == 3 .and. sys%factorized)) then
+                     sys%matrix%factor_active, info, detail, rates, t)
+    if (info == 0 .or. (info == 3 .and. sys%matrix%factorized)) then
       learned%theta = -1.0_dp
       learned%unconfirmed = 0
       learned%matrix_measured = 0
@@ -492,7 +492,7 @@ contains
     integer :: svd_info
     learned%carry_on = .false.
     if (fresh_matrix .or. cfg%jacobian /= jacobian_reuse .or. .not. carry_enabled(sys) .or. &
-        .not. sys%factorized .or. .not. allocated(learned%carry_reference)) return
+        .not. sys%matrix%factorized .or. .not. allocated(learned%carry_reference)) return
     call carry_vectors(sys, e, learned%carry_current)
     call carry_turn(sys, learned%carry_reference, learned%carry_current, learned%carry_turn, &
                     angle, svd_info)
@@ -505,8 +505,9 @@ contains
     type(stepper_settings), intent(in) :: cfg
     real(dp), intent(in) :: beta_prime
     integer, intent(in) :: attempt
-    needs_factorization = .not. sys%factorized .or. sys%factor_beta_prime /= beta_prime
-    if (sys%policy == policy_constant) return
+    needs_factorization = .not. sys%matrix%factorized .or. &
+                          sys%matrix%factor_beta_prime /= beta_prime
+    if (sys%matrix%policy == policy_constant) return
     if (cfg%jacobian /= jacobian_reuse .or. attempt > 1) needs_factorization = .true.
   end function needs_factorization
 
@@ -552,7 +553,7 @@ contains
     step_theta = 0.0_dp
     refreshed_at = 0
     measured = .false.
-    active = sys%factor_active
+    active = sys%matrix%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
@@ -564,8 +565,9 @@ contains
       if (info /= 0) return
       use_known = .false.
       ! reuse: a changed contact set invalidates the matrix before it is used
-      if (cfg%jacobian == jacobian_reuse .and. sys%policy /= policy_constant .and. &
-          sys%contact%npoint > 0 .and. active /= sys%factor_active .and. it < cfg%max_newton) then
+      if (cfg%jacobian == jacobian_reuse .and. sys%matrix%policy /= policy_constant .and. &
+          sys%contact%npoint > 0 .and. active /= sys%matrix%factor_active .and. &
+          it < cfg%max_newton) then
         call refresh_matrix()
         if (info /= 0) return
         refreshed_at = it - 1
@@ -577,9 +579,9 @@ contains
       if (learned%carry_on) then
         call carry_apply(sys, learned%carry_turn, r, .true., z(:, 1))
       else
-        call to_solver_frame(sys, rotations, r, .true., z(:, 1))
+        call to_solver_frame(sys%matrix, rotations, r, .true., z(:, 1))
       end if
-      call solver_solve(sys%solver_handle, sys%ndof, 1, z, info, detail)
+      call solver_solve(sys%matrix%solver_handle, sys%ndof, 1, z, info, detail)
       if (info /= 0) then
         detail = info
         info = 3
@@ -588,7 +590,7 @@ contains
       if (learned%carry_on) then
         call carry_apply(sys, learned%carry_turn, z(:, 1), .false., direction)
       else
-        call to_solver_frame(sys, rotations, z(:, 1), .false., direction)
+        call to_solver_frame(sys%matrix, rotations, z(:, 1), .false., direction)
       end if
       ! (with constraints both paths below overwrite the correction)
       ! (dlam: written whole by gradient_product in both paths below; empty without constraints)
@@ -600,7 +602,7 @@ contains
       else if (sys%constraints%ncon > 0) then
         ! Schur complement C dlam = Phi_e z - Phi, C = W^T (E_c^T S^{-1} E_c) W
         call frame_gradients(sys, rotations, gradients, w)
-        call schur_complement(sys%flexibility_cc, w, work%flex_w, schur)
+        call schur_complement(sys%matrix%flexibility_cc, w, work%flex_w, schur)
         call gradient_product(sys%constraints, gradients, direction, dlam(:, 1))
         dlam(:, 1) = dlam(:, 1) - phi
         if (sys%constraints%ncon <= small_dense_limit) then
@@ -616,8 +618,8 @@ contains
           return
         end if
         call sparse_columns_product(w, dlam(:, 1), work%w_dlam)
-        call sparse_columns_product(sys%flexibility, work%w_dlam, work%back)
-        call to_solver_frame(sys, rotations, work%back, .false., correction)
+        call sparse_columns_product(sys%matrix%flexibility, work%w_dlam, work%back)
+        call to_solver_frame(sys%matrix, rotations, work%back, .false., correction)
         correction = correction - direction
       end if
       capped = .false.
@@ -681,7 +683,7 @@ contains
           return
         end if
       end if
-      if (sys%policy == policy_constant .or. it >= cfg%max_newton) then
+      if (sys%matrix%policy == policy_constant .or. it >= cfg%max_newton) then
         previous_correction = last_correction
         cycle
       end if
@@ -746,13 +748,13 @@ contains
           ! (matmul's sums by the loops of sparse_columns_product and schur_complement:
           ! the same numbers without the library calls and the temporary)
           do c = 1, sys%constraints%ncon
-            call sparse_columns_product(sys%flexibility, work%w(:, c), &
+            call sparse_columns_product(sys%matrix%flexibility, work%w(:, c), &
                                         work%carry_flexibility(:, c))
           end do
-          call schur_complement(sys%flexibility_cc, work%w, work%flex_w, work%carry_lu)
+          call schur_complement(sys%matrix%flexibility_cc, work%w, work%flex_w, work%carry_lu)
         else
           work%carry_flexibility = work%carry_columns
-          call solver_solve(sys%solver_handle, sys%ndof, sys%constraints%ncon, &
+          call solver_solve(sys%matrix%solver_handle, sys%ndof, sys%constraints%ncon, &
                             work%carry_flexibility, info, detail)
           if (info /= 0) then
             detail = info
@@ -844,7 +846,7 @@ contains
       if (info /= 0) return
       stats(stat_factorizations) = stats(stat_factorizations) + 1
       stats(stat_jacobians) = stats(stat_jacobians) + 1
-      active = sys%factor_active
+      active = sys%matrix%factor_active
     end subroutine refresh_matrix
 
   end subroutine newton
@@ -1114,11 +1116,11 @@ contains
     integer :: slot, known  ! the ring's entry of this step; the entries measured
     limit = cfg%tol * cfg%length_scale
     ok = last <= limit
-    if (sys%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
+    if (sys%matrix%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
     if (it == 1) then
       ! (reuse: the first correction is never accepted on an estimate)
       if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every .or. &
-          sys%policy /= policy_constant) then
+          sys%matrix%policy /= policy_constant) then
         if (ok) learned%unconfirmed = learned%unconfirmed + 1
         return
       end if
@@ -1133,7 +1135,7 @@ contains
     ! the largest contraction of the step: a contact point that moves, sticks or slips
     ! makes the corrections fall irregularly, and a small ratio after a large one is no
     ! evidence that the next would be as small
-    if (it == 2 .and. sys%policy /= policy_constant) then
+    if (it == 2 .and. sys%matrix%policy /= policy_constant) then
       step_theta = theta
       if (ok .or. sys%contact%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
           learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
@@ -1145,7 +1147,7 @@ contains
       if (ok) learned%matrix_unconfirmed = learned%matrix_unconfirmed + 1
       return
     end if
-    if (sys%policy /= policy_constant .and. same_matrix) then
+    if (sys%matrix%policy /= policy_constant .and. same_matrix) then
       ! the step's entry in the ring: its largest ratio from the third correction on
       if (.not. measured) then
         learned%matrix_measured = learned%matrix_measured + 1

@@ -37,7 +37,6 @@ module mechanical_system
   use matrix3, only: cross
   use element_sets, only: element_set, set_slot, frame_omega
   use force_elements, only: force_element_slots
-  use sparse_direct, only: solver_solve, solver_factorize
   use system_drives, only: drive_table, drive_at
   use system_constraints, only: constraint_table, evaluate_constraints
   use system_loads, only: load_set, vector_load_forces, vector_load_tangent, &
@@ -47,6 +46,8 @@ module mechanical_system
   use system_contact, only: contact_set, contact_pair, contact_state, contact_record, &
                             contact_forces, contact_step_limit
   use system_probes, only: probe_set, probe_values
+  use system_iteration, only: iteration_matrix, policy_constant, policy_refactor, &
+                              to_solver_frame, dof_frame, factorize_matrix
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -62,7 +63,7 @@ module mechanical_system
   ! what the stepper asks of the system's contact (it uses no contact module itself)
   public :: contact_record, contact_step_limit
 
-  integer, parameter, public :: policy_constant = 0, policy_refactor = 1
+  public :: policy_constant, policy_refactor
   !> energy(:) layout of an output row
   integer, parameter, public :: energy_kinetic = 1, energy_strain = 2, energy_loads = 3, &
                                 energy_moment = 4, energy_total = 5, work_drive = 6, &
@@ -93,18 +94,7 @@ module mechanical_system
     type(constraint_table) :: constraints  ! with multipliers (system_constraints)
     type(contact_set) :: contact                      ! plate-plate contact (system_contact)
     type(probe_set) :: probes                         ! output points (system_probes)
-    ! iteration matrix: solver handle (sparse_direct), M on its pattern, policy, the
-    ! frame of each reduced 3-vector (policy constant), the touched 3-vector blocks
-    integer :: solver_handle = 0, policy = policy_refactor
-    real(dp), allocatable :: mass_pattern(:)
-    integer, allocatable :: vector_frame(:), block_first(:)
-    integer :: single_frame = -1                       ! the frame of every vector, or -1
-    ! the current factorization: its flexibility S^{-1} E_c and E_c^T S^{-1} E_c
-    logical :: factorized = .false.
-    real(dp) :: factor_beta_prime = 0.0_dp
-    integer :: factor_active = -1                      ! active contact points at it
-    ! (what the stepper learns from step to step lives apart: stepper.f90)
-    real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
+    type(iteration_matrix) :: matrix                  ! S and its solver (system_iteration)
     ! the matrix carried with the system's rotation (carried_rotation): the first full dof of
     ! each carried 3-vector, its weight in the rotation fit, whether it is a position (fitted
     ! about the centroid) or a gradient or director; none: not carried
@@ -185,7 +175,7 @@ contains
     real(dp) :: out(3, 3, 0:size(sys%frames))
     integer :: f
     out = rotations
-    if (sys%policy /= policy_constant) return
+    if (sys%matrix%policy /= policy_constant) return
     do f = 1, size(sys%frames)
       if (sys%frames(f)%drive /= 0) out(:, :, f) = rotations(:, :, 0)
     end do
@@ -200,7 +190,7 @@ contains
     real(dp) :: out(0:size(sys%frames))
     integer :: f
     out = rates
-    if (sys%policy /= policy_constant) return
+    if (sys%matrix%policy /= policy_constant) return
     do f = 1, size(sys%frames)
       if (sys%frames(f)%drive /= 0) out(f) = 0.0_dp
     end do
@@ -435,56 +425,6 @@ contains
     end do
   end subroutine force_element_reactions
 
-  !> The solver frame: policy constant rotates each reduced 3-vector of a moving frame's
-  !> bodies into that frame (U^T x, transpose_first) or back (U x); otherwise a copy.
-  pure subroutine to_solver_frame(sys, rotations, x, transpose_first, y)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: rotations(:, :, 0:), x(:)
-    logical, intent(in) :: transpose_first
-    real(dp), intent(out) :: y(:)
-    integer :: b, i, f
-    real(dp) :: r(3, 3)
-    if (sys%policy /= policy_constant .or. .not. allocated(sys%vector_frame)) then
-      y = x
-      return
-    end if
-    if (sys%single_frame > 0) then  ! every vector in one frame: one rotation, no look-up
-      r = rotations(:, :, sys%single_frame)
-      if (.not. transpose_first) r = transpose(r)
-      do b = 0, size(x) / 3 - 1
-        y(3 * b + 1) = r(1, 1) * x(3 * b + 1) + r(2, 1) * x(3 * b + 2) + r(3, 1) * x(3 * b + 3)
-        y(3 * b + 2) = r(1, 2) * x(3 * b + 1) + r(2, 2) * x(3 * b + 2) + r(3, 2) * x(3 * b + 3)
-        y(3 * b + 3) = r(1, 3) * x(3 * b + 1) + r(2, 3) * x(3 * b + 2) + r(3, 3) * x(3 * b + 3)
-      end do
-      return
-    end if
-    do b = 0, size(x) / 3 - 1
-      f = sys%vector_frame(b + 1)
-      if (f == 0) then
-        y(3 * b + 1:3 * b + 3) = x(3 * b + 1:3 * b + 3)
-      else if (transpose_first) then
-        do i = 1, 3  ! written out: a generic matmul per 3-vector cost a tenth of a step
-          y(3 * b + i) = rotations(1, i, f) * x(3 * b + 1) + rotations(2, i, f) * x(3 * b + 2) &
-                         + rotations(3, i, f) * x(3 * b + 3)
-        end do
-      else
-        do i = 1, 3
-          y(3 * b + i) = rotations(i, 1, f) * x(3 * b + 1) + rotations(i, 2, f) * x(3 * b + 2) &
-                         + rotations(i, 3, f) * x(3 * b + 3)
-        end do
-      end if
-    end do
-  end subroutine to_solver_frame
-
-  !> Frame of the reduced 3-vector holding dof (0: global).
-  pure integer function dof_frame(sys, dof)
-    type(system_model), intent(in) :: sys
-    integer, intent(in) :: dof
-    dof_frame = 0
-    if (sys%policy /= policy_constant .or. .not. allocated(sys%vector_frame)) return
-    dof_frame = sys%vector_frame((dof - 1) / 3 + 1)
-  end function dof_frame
-
   !> W(3 nblock, ncon): the solver-frame components of Phi_e^T at the touched blocks.
   pure subroutine frame_gradients(sys, rotations, gradients, w)
     type(system_model), intent(in) :: sys
@@ -499,11 +439,11 @@ contains
                sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
           dof = sys%constraints%term_dof(k)
           g = gradients(s, c) * sys%constraints%term_coef(k)
-          do b = 1, size(sys%block_first)  ! the first block holding dof
-            if (dof >= sys%block_first(b) .and. dof <= sys%block_first(b) + 2) exit
+          do b = 1, size(sys%matrix%block_first)  ! the first block holding dof
+            if (dof >= sys%matrix%block_first(b) .and. dof <= sys%matrix%block_first(b) + 2) exit
           end do
-          comp = dof - sys%block_first(b) + 1
-          f = dof_frame(sys, dof)
+          comp = dof - sys%matrix%block_first(b) + 1
+          f = dof_frame(sys%matrix, dof)
           do i = 1, 3  ! (written out: the strided row slice cost a third of the Schur set-up)
             w(3 * (b - 1) + i, c) = w(3 * (b - 1) + i, c) + rotations(comp, i, f) * g
           end do
@@ -528,9 +468,9 @@ contains
     real(dp), intent(in), optional :: t          ! the time (the point loads' Jacobian)
     real(dp), allocatable :: values(:), records(:, :)
     real(dp) :: potential, powers(2), frame_rates(0:size(sys%frames))
-    integer :: b, j
     detail = 0
-    allocate (values(size(sys%mass_pattern)), records(contact_record, max(1, sys%contact%npoint)))
+    allocate (values(size(sys%matrix%mass_pattern)), &
+              records(contact_record, max(1, sys%contact%npoint)))
     frame_rates = 0.0_dp
     if (present(rates)) frame_rates = rates
     call internal_forces(sys, rotations, e, v, 1.0_dp, velocity_factor, state, force, strain, &
@@ -540,36 +480,7 @@ contains
     if (info /= 0) return
     active = 0
     if (sys%contact%npoint > 0) active = count(records(1, 1:sys%contact%npoint) > 0.0_dp)
-    values = values + beta_prime * sys%mass_pattern
-    sys%factorized = .false.
-    call solver_factorize(sys%solver_handle, size(values), values, info, detail)
-    if (info /= 0) then
-      detail = info
-      info = 3
-      return
-    end if
-    sys%factorized = .true.
-    sys%factor_beta_prime = beta_prime
-    if (size(sys%block_first) == 0) return
-    sys%flexibility = 0.0_dp
-    do b = 1, size(sys%block_first)
-      do j = 1, min(3, sys%ndof - sys%block_first(b) + 1)  ! (fewer than 3 unknowns left)
-        sys%flexibility(sys%block_first(b) + j - 1, 3 * (b - 1) + j) = 1.0_dp
-      end do
-    end do
-    call solver_solve(sys%solver_handle, sys%ndof, 3 * size(sys%block_first), sys%flexibility, &
-                      info, detail)
-    if (info /= 0) then
-      detail = info
-      info = 3
-      return
-    end if
-    sys%flexibility_cc = 0.0_dp
-    do b = 1, size(sys%block_first)
-      do j = 1, min(3, sys%ndof - sys%block_first(b) + 1)
-        sys%flexibility_cc(3 * (b - 1) + j, :) = sys%flexibility(sys%block_first(b) + j - 1, :)
-      end do
-    end do
+    call factorize_matrix(sys%matrix, sys%ndof, beta_prime, values, info, detail)
   end subroutine refactorize
 
   !> Strain energy, the load potentials and the powers of the moving frames (FFR sets), of
