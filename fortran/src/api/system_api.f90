@@ -113,7 +113,7 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
                                       tolerance=control(sk_tolerance), &
                                       adaptive=control(sk_adaptive) /= 0.0_dp))
   if (sys%matrix%policy /= policy_constant) sys%matrix%factorized = .false.
-  call plane_mass_setup(sys%mass, sys%ndof, sys%carry_plane)
+  call plane_mass_setup(sys%mass, sys%ndof, sys%carry%plane)
 end subroutine system_stepper_setup
 
 !> Element sets: one routine per family builds the family's set (element_sets: an
@@ -621,6 +621,7 @@ end subroutine system_set_solver
 subroutine system_set_carry(handle, nvec, first, weight, position, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
+  use system_carry, only: carry_setup
   use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nvec, first(max(1, nvec)), position(max(1, nvec))
@@ -628,7 +629,6 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  integer :: i, k
   call api_system(handle, sys, info, message)
   if (info /= 0) return
   if (nvec > 0) then
@@ -640,65 +640,9 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
       return
     end if
   end if
-  sys%carry_first = first(1:max(0, nvec))
-  sys%carry_weight = weight(1:max(0, nvec))
-  sys%carry_position = position(1:max(0, nvec)) /= 0
-  if (allocated(sys%carry_map)) deallocate (sys%carry_map)
-  if (allocated(sys%carry_plane)) deallocate (sys%carry_plane)
-  if (allocated(sys%carry_source)) deallocate (sys%carry_source)
-  if (nvec == 0) return
-  allocate (sys%carry_map(3, sys%nfull / 3))
-  if (.not. sys%reduction%active) then
-    sys%carry_map = reshape([(i, i = 1, sys%nfull)], [3, sys%nfull / 3])
-    call carry_sources()
-    return
-  end if
-  sys%carry_map = 0
-  do i = 1, sys%nfull  ! a selection: at most one unit entry per row of B
-    k = sys%reduction%ptr(i)
-    if (sys%reduction%ptr(i + 1) - k /= 1) cycle
-    if (sys%reduction%values(k) /= 1.0_dp) cycle
-    sys%carry_map(mod(i - 1, 3) + 1, (i - 1) / 3 + 1) = sys%reduction%col(k)
-  end do
-  if (count(sys%carry_map > 0) /= sys%ndof .or. any(sys%reduction%ptr(2:) - &
-      sys%reduction%ptr(:sys%nfull) > 1)) then
-    info = 2
-    message = 'system_set_carry: the reduction is not a selection of coordinates'
-    deallocate (sys%carry_first, sys%carry_weight, sys%carry_position, sys%carry_map)
-    allocate (sys%carry_first(0), sys%carry_weight(0), sys%carry_position(0))
-    return
-  end if
-  call carry_sources()
-  ! every vector of the xy plane or fixed (a planar reduction): carry_apply by the pairs
-  if (all((sys%carry_map(1, :) > 0 .and. sys%carry_map(2, :) > 0 .and. &
-           sys%carry_map(3, :) == 0) .or. all(sys%carry_map == 0, dim=1))) then
-    k = count(sys%carry_map(1, :) > 0)
-    allocate (sys%carry_plane(2, k))
-    k = 0
-    do i = 1, size(sys%carry_map, 2)
-      if (sys%carry_map(1, i) == 0) cycle
-      k = k + 1
-      sys%carry_plane(:, k) = sys%carry_map(1:2, i)
-    end do
-  end if
-
-contains
-
-  !> sys%carry_source from carry_first and carry_map (carry_vectors' reads).
-  subroutine carry_sources()
-    integer :: vec, component, b
-    allocate (sys%carry_source(3, nvec))
-    do vec = 1, nvec
-      b = (sys%carry_first(vec) - 1) / 3 + 1
-      do component = 1, 3
-        if (sys%carry_map(component, b) > 0) then
-          sys%carry_source(component, vec) = sys%carry_map(component, b)
-        else
-          sys%carry_source(component, vec) = -(sys%carry_first(vec) + component - 1)
-        end if
-      end do
-    end do
-  end subroutine carry_sources
+  call carry_setup(sys%carry, sys%reduction, sys%ndof, sys%nfull, first(1:max(0, nvec)), &
+                   weight(1:max(0, nvec)), position(1:max(0, nvec)) /= 0, info)
+  if (info /= 0) message = 'system_set_carry: the reduction is not a selection of coordinates'
 end subroutine system_set_carry
 
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),

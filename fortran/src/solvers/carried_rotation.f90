@@ -41,7 +41,7 @@ contains
   pure logical function carry_enabled(sys)
     type(system_model), intent(in) :: sys
     carry_enabled = .false.
-    if (allocated(sys%carry_first)) carry_enabled = size(sys%carry_first) > 0
+    if (allocated(sys%carry%first)) carry_enabled = size(sys%carry%first) > 0
   end function carry_enabled
 
   !> The carried 3-vectors (3, nvec) of the system at the reduced coordinates e.
@@ -52,9 +52,9 @@ contains
     integer :: k, i, source
     ! (carry_source: carry_map's reduced coordinate or minus the fixed full dof, made once
     ! by system_set_carry)
-    do k = 1, size(sys%carry_first)
+    do k = 1, size(sys%carry%first)
       do i = 1, 3
-        source = sys%carry_source(i, k)
+        source = sys%carry%source(i, k)
         if (source > 0) then
           vectors(i, k) = e(source)
         else  ! a coordinate the reduction fixes
@@ -79,23 +79,23 @@ contains
     centre_ref = 0.0_dp
     centre_now = 0.0_dp
     weight_sum = 0.0_dp
-    do k = 1, size(sys%carry_first)
-      if (.not. sys%carry_position(k)) cycle
-      centre_ref = centre_ref + sys%carry_weight(k) * reference(:, k)
-      centre_now = centre_now + sys%carry_weight(k) * current(:, k)
-      weight_sum = weight_sum + sys%carry_weight(k)
+    do k = 1, size(sys%carry%first)
+      if (.not. sys%carry%position(k)) cycle
+      centre_ref = centre_ref + sys%carry%weight(k) * reference(:, k)
+      centre_now = centre_now + sys%carry%weight(k) * current(:, k)
+      weight_sum = weight_sum + sys%carry%weight(k)
     end do
     if (weight_sum > 0.0_dp) then
       centre_ref = centre_ref / weight_sum
       centre_now = centre_now / weight_sum
     end if
     correlation = 0.0_dp  ! sum w b a^T (b: reference, a: current)
-    do k = 1, size(sys%carry_first)
-      if (sys%carry_position(k)) then
-        b = sys%carry_weight(k) * (reference(:, k) - centre_ref)
+    do k = 1, size(sys%carry%first)
+      if (sys%carry%position(k)) then
+        b = sys%carry%weight(k) * (reference(:, k) - centre_ref)
         a = current(:, k) - centre_now
       else
-        b = sys%carry_weight(k) * reference(:, k)
+        b = sys%carry%weight(k) * reference(:, k)
         a = current(:, k)
       end if
       do j = 1, 3
@@ -231,7 +231,7 @@ contains
     integer :: b, i, first, second
     rotation = turn
     if (back) rotation = transpose(turn)
-    if (allocated(sys%carry_plane)) then
+    if (allocated(sys%carry%plane)) then
       ! every vector of the xy plane (or fixed): the plane path below by the list of pairs
       r11 = rotation(1, 1)
       r12 = rotation(1, 2)
@@ -239,9 +239,9 @@ contains
       r21 = rotation(2, 1)
       r22 = rotation(2, 2)
       r23 = rotation(2, 3) * 0.0_dp
-      do b = 1, size(sys%carry_plane, 2)
-        first = sys%carry_plane(1, b)
-        second = sys%carry_plane(2, b)
+      do b = 1, size(sys%carry%plane, 2)
+        first = sys%carry%plane(1, b)
+        second = sys%carry%plane(2, b)
         v(1) = x(first)
         v(2) = x(second)
         y(first) = r11 * v(1) + r12 * v(2) + r13
@@ -249,10 +249,10 @@ contains
       end do
       return
     end if
-    do b = 1, size(sys%carry_map, 2)
-      first = sys%carry_map(1, b)
-      second = sys%carry_map(2, b)
-      if (first > 0 .and. second > 0 .and. sys%carry_map(3, b) == 0) then
+    do b = 1, size(sys%carry%map, 2)
+      first = sys%carry%map(1, b)
+      second = sys%carry%map(2, b)
+      if (first > 0 .and. second > 0 .and. sys%carry%map(3, b) == 0) then
         ! a vector of the xy plane (a planar reduction): the same sums with v(3) = 0,
         ! without the general path's branches
         v(1) = x(first)
@@ -263,11 +263,11 @@ contains
       end if
       do i = 1, 3
         v(i) = 0.0_dp
-        if (sys%carry_map(i, b) > 0) v(i) = x(sys%carry_map(i, b))
+        if (sys%carry%map(i, b) > 0) v(i) = x(sys%carry%map(i, b))
       end do
       w = rotation(:, 1) * v(1) + rotation(:, 2) * v(2) + rotation(:, 3) * v(3)
       do i = 1, 3
-        if (sys%carry_map(i, b) > 0) y(sys%carry_map(i, b)) = w(i)
+        if (sys%carry%map(i, b) > 0) y(sys%carry%map(i, b)) = w(i)
       end do
     end do
   end subroutine carry_apply
@@ -313,8 +313,8 @@ contains
     r23 = turn(3, 2) * 0.0_dp
     do c = 1, sys%constraints%ncon
       do p = 1, size(pairs)
-        column(sys%carry_plane(1, pairs(p))) = 0.0_dp
-        column(sys%carry_plane(2, pairs(p))) = 0.0_dp
+        column(sys%carry%plane(1, pairs(p))) = 0.0_dp
+        column(sys%carry%plane(2, pairs(p))) = 0.0_dp
       end do
       ! (the operands up to the last with terms, con_operands: the rest are empty)
       last = 6
@@ -327,8 +327,8 @@ contains
         end do
       end do
       do p = 1, size(pairs)
-        first = sys%carry_plane(1, pairs(p))
-        second = sys%carry_plane(2, pairs(p))
+        first = sys%carry%plane(1, pairs(p))
+        second = sys%carry%plane(2, pairs(p))
         v1 = column(first)
         v2 = column(second)
         columns(first, c) = r11 * v1 + r12 * v2 + r13

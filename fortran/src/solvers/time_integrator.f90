@@ -196,9 +196,9 @@ contains
     allocate (work%scan_dofs(0))
     if (sys%constraints%ncon == 0) return
     vector_of = 0
-    do b = 1, size(sys%carry_map, 2)
+    do b = 1, size(sys%carry%map, 2)
       do i = 1, 3
-        dof = sys%carry_map(i, b)
+        dof = sys%carry%map(i, b)
         if (dof <= 0) cycle
         if (dof > sys%ndof) return
         if (vector_of(dof) /= 0) return
@@ -212,16 +212,16 @@ contains
       if (dof < 1 .or. dof > sys%ndof) return
       b = vector_of(dof)
       do i = 1, 3
-        if (sys%carry_map(i, b) > 0) reached(sys%carry_map(i, b)) = .true.
+        if (sys%carry%map(i, b) > 0) reached(sys%carry%map(i, b)) = .true.
       end do
     end do
     work%scan_dofs = pack([(dof, dof = 1, sys%ndof)], reached .and. work%block_row == 0)
     work%scan_known = .true.
-    if (.not. allocated(sys%carry_plane)) return
+    if (.not. allocated(sys%carry%plane)) return
     ! (every term dof is reached: its pair is among them)
     reached = reached .or. work%block_row > 0
-    work%carry_pairs = pack([(k, k = 1, size(sys%carry_plane, 2))], &
-                            reached(sys%carry_plane(1, :)) .or. reached(sys%carry_plane(2, :)))
+    work%carry_pairs = pack([(k, k = 1, size(sys%carry%plane, 2))], &
+                            reached(sys%carry%plane(1, :)) .or. reached(sys%carry%plane(2, :)))
   end subroutine carry_scan_setup
 
   !> Residual r = M e'' + B^T (Q_el - Q_c - Q_M) - Q(t) - Phi_e^T lambda at time t, with the
@@ -473,8 +473,8 @@ contains
     learned%carry_on = .false.
     if (info == 0 .and. carry_enabled(sys)) then
       if (.not. allocated(learned%carry_reference)) &
-        allocate (learned%carry_reference(3, size(sys%carry_first)), &
-                  learned%carry_current(3, size(sys%carry_first)))
+        allocate (learned%carry_reference(3, size(sys%carry%first)), &
+                  learned%carry_current(3, size(sys%carry%first)))
       call carry_vectors(sys, e, learned%carry_reference)
     end if
   end subroutine factorize
@@ -784,8 +784,8 @@ contains
         call dgetrs('N', sys%constraints%ncon, 1, work%carry_lu, sys%constraints%ncon, work%ipiv, &
                     work%dlam, sys%constraints%ncon, lapack_info)
       end if
-      if (allocated(sys%carry_plane)) then
-        call plane_carried_correction(sys%carry_plane, learned%carry_turn, &
+      if (allocated(sys%carry%plane)) then
+        call plane_carried_correction(sys%carry%plane, learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
                                       work%correction)
         return

@@ -48,6 +48,7 @@ module mechanical_system
   use system_probes, only: probe_set, probe_values
   use system_iteration, only: iteration_matrix, policy_constant, policy_refactor, &
                               to_solver_frame, dof_frame, factorize_matrix
+  use system_carry, only: carried_vectors
   use system_mass, only: mass_matrix, kinetic_energy
   use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
                               pattern_position
@@ -95,23 +96,7 @@ module mechanical_system
     type(contact_set) :: contact                      ! plate-plate contact (system_contact)
     type(probe_set) :: probes                         ! output points (system_probes)
     type(iteration_matrix) :: matrix                  ! S and its solver (system_iteration)
-    ! the matrix carried with the system's rotation (carried_rotation): the first full dof of
-    ! each carried 3-vector, its weight in the rotation fit, whether it is a position (fitted
-    ! about the centroid) or a gradient or director; none: not carried
-    integer, allocatable :: carry_first(:)
-    real(dp), allocatable :: carry_weight(:)
-    logical, allocatable :: carry_position(:)
-    ! the reduced coordinate of each component of every full 3-vector (0: fixed by the
-    ! reduction), (3, nfull / 3)
-    integer, allocatable :: carry_map(:, :)
-    ! when every 3-vector of carry_map is a vector of the xy plane (its x and y reduced, z
-    ! fixed) or wholly fixed: the reduced coordinates (x, y) of the plane vectors, (2, n);
-    ! unallocated otherwise
-    integer, allocatable :: carry_plane(:, :)
-    ! where carry_vectors reads each component of the carried vectors, (3, nvec): the
-    ! reduced coordinate (> 0) or minus the full dof whose reduction_offset it is (made by
-    ! system_set_carry with carry_map)
-    integer, allocatable :: carry_source(:, :)
+    type(carried_vectors) :: carry  ! what carries the matrix with the rotation (system_carry)
   end type system_model
 
 contains
