@@ -23,7 +23,7 @@ module step_control
   use mechanical_system, only: system_model, contact_state, power_count, energy_count, &
                                contact_record
   use stepper, only: stepper_run, control_settings, control_state
-  use time_integrator, only: integrator_chunk, newton_floor_stall
+  use time_integrator, only: integrator_chunk, newton_floor_stall, step_work, allocate_work
   use consistent_start, only: consistent_acceleration
   use kernel_errors, only: message_length
   use row_answers, only: answer_row, answer_count
@@ -88,11 +88,13 @@ contains
     type(control_settings), pointer :: cs
     type(control_state), pointer :: c
     type(stepper_point) :: before
+    type(step_work) :: scratch  ! the steps' work arrays, for every step_rows call
     real(dp) :: buffer(size(rows, 1), 1), t_before, h, remaining, error
     integer :: step_stats(3, 1), n, k, j, floor, max_tries
     logical :: retry, finished
     cs => run%control_settings
     c => run%control
+    call allocate_work(sys, scratch)
     rows = 0.0_dp
     stats = 0
     sizes = 0.0_dp
@@ -120,7 +122,7 @@ contains
         t_before = p%t
         call step_rows(sys, run, cs%dt, n, p, rows(:, done + 1:done + n), &
                        stats(1:3, done + 1:done + n), store_q, k, info, detail, last_correction, &
-                       floor)
+                       floor, scratch)
         floor_accepts = floor_accepts + floor
         tries = tries + k
         do j = 1, k
@@ -204,7 +206,7 @@ contains
         buffer = 0.0_dp
         step_stats = 0
         call step_rows(sys, run, h, 1, p, buffer, step_stats, store_q, k, info, detail, &
-                       last_correction, floor)
+                       last_correction, floor, scratch)
         floor_accepts = floor_accepts + floor
         tries = tries + 1
         c%tries = c%tries + 1
@@ -294,7 +296,7 @@ contains
   !> and writes each row's answers from the state it reached (e', e'' as the method has
   !> them); answers that cannot be evaluated are written as NaN (the step stands).
   subroutine step_rows(sys, run, h, n, p, rows, stats, store_q, steps_done, info, detail, &
-                       last_correction, floor_accepts)
+                       last_correction, floor_accepts, scratch)
     type(system_model), intent(inout) :: sys
     type(stepper_run), intent(inout) :: run
     real(dp), intent(in) :: h
@@ -305,6 +307,7 @@ contains
     logical, intent(in) :: store_q
     integer, intent(out) :: steps_done, info, detail, floor_accepts
     real(dp), intent(out) :: last_correction
+    type(step_work), intent(inout) :: scratch  ! (allocate_work, by the caller)
     real(dp), allocatable :: out_probe(:, :, :), out_deflection(:, :, :), out_contact(:, :, :)
     real(dp), allocatable :: no_q(:, :)
     integer :: ndof, ncon, nprobe, npoint, nanswer, step, k, j, floor, answer_info
@@ -378,7 +381,7 @@ contains
                               rows(at_constraint + 1, first:last), stats(:, first:last), &
                               out_contact(:, :, first:last), store_q, &
                               rows(at_q + 1:at_q + ndof, first:last), done, info, detail, &
-                              last_correction, floor)
+                              last_correction, floor, scratch)
       else
         call integrator_chunk(sys, run%settings, run%state, h, m, p%t, p%e, p%v, p%a, &
                               p%accel, p%lam, p%work, p%powers, p%contact, rows(1, first:last), &
@@ -387,7 +390,7 @@ contains
                               rows(at_energy + 1:at_energy + energy_count, first:last), &
                               rows(at_constraint + 1, first:last), stats(:, first:last), &
                               out_contact(:, :, first:last), store_q, no_q, done, info, &
-                              detail, last_correction, floor)
+                              detail, last_correction, floor, scratch)
       end if
       if (nanswer == 0) floor_accepts = floor
     end subroutine steps

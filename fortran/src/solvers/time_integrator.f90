@@ -77,7 +77,7 @@ module time_integrator
                               carry_gradients, carry_plane_gradients
   implicit none
   private
-  public :: integrator_chunk, output_row, step_failure_text
+  public :: integrator_chunk, output_row, step_failure_text, step_work, allocate_work
   !> per-step statistics: Newton corrections, factorizations, Jacobian evaluations
   integer, parameter, public :: stat_corrections = 1, stat_factorizations = 2, &
                                 stat_jacobians = 3, stat_count = 3
@@ -118,8 +118,11 @@ module time_integrator
     logical :: at_floor = .false.        ! converged at the round-off floor (counted)
   end type newton_monitor
 
-  !> The work arrays of a chunk's Newton iterations and residuals, allocated once per chunk
-  !> (automatic arrays and matmul temporaries were heap allocations in every step).
+  !> The work arrays of the steps' Newton iterations and residuals, allocated once by the
+  !> caller of integrator_chunk for all its chunks (step_control: once per call of
+  !> controlled_rows, which takes single steps when the rows answer or the step adapts;
+  !> automatic arrays and matmul temporaries were heap allocations in every step). What
+  !> they cache depends on the system and the time alone.
   type :: step_work
     real(dp), allocatable :: r(:), z(:, :), direction(:), correction(:), back(:)
     real(dp), allocatable :: phi(:), gradients(:, :), w(:, :), flex_w(:, :), w_dlam(:)
@@ -135,7 +138,7 @@ module time_integrator
     real(dp), allocatable :: carry_columns(:, :), carry_flexibility(:, :), carry_lu(:, :)
     ! carry_gradients' column of Phi_e^T (its work array), and the row of w (E_c^T) of each
     ! reduced coordinate (0: in no touched block; a dof in two blocks: the first), made once
-    ! per chunk for gather_blocks (automatic arrays were heap allocations in every step)
+    ! by allocate_work for gather_blocks (automatic arrays were heap allocations in every step)
     real(dp), allocatable :: carry_column(:)
     integer, allocatable :: block_row(:)
     ! the reduced coordinates in touched blocks (block_row > 0), and those outside them
@@ -254,7 +257,7 @@ contains
     call mass_product(sys%mass, acceleration, r)
     ! (loads of t alone, without point loads that follow e: once per time, kept for the
     ! step's later corrections; without driven loads (force_drive) they are constant_force
-    ! at every time: once per chunk)
+    ! at every time: once per work arrays)
     if (sys%loads%nvload > 0 .or. .not. work%loads_ready .or. &
         (work%loads_time /= t .and. size(sys%loads%force_drive) > 0)) then
       work%loads_ready = .false.
@@ -279,11 +282,13 @@ contains
   !> (detail = dgesv info); 5 constraint or drive evaluation failed; 6 moment undefined; 7 a
   !> plate element's normal vanished; 8 contact search failed. steps_done counts the
   !> completed steps; the state is that of the last completed step; last_correction is the
-  !> size of the last Newton correction (why a step failed to converge).
+  !> size of the last Newton correction (why a step failed to converge). scratch: the
+  !> steps' work arrays (allocate_work for sys), made once by the caller for all its calls.
   subroutine integrator_chunk(sys, cfg, learned, h, nsteps, t, e, v, a, accel, lam, work, &
                               powers, state, out_time, out_probe, out_deflection, out_lambda, &
                               out_energy, out_constraint, out_stats, out_contact, store_q, &
-                              out_q, steps_done, info, detail, last_correction, floor_accepts)
+                              out_q, steps_done, info, detail, last_correction, floor_accepts, &
+                              scratch)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -301,6 +306,7 @@ contains
     integer, intent(out) :: steps_done, info, detail
     real(dp), intent(out) :: last_correction  ! max |de| of the last Newton correction
     integer, intent(out) :: floor_accepts  ! steps converged at the round-off floor
+    type(step_work), intent(inout) :: scratch
     type(newton_monitor) :: monitor
     real(dp) :: e_new(sys%ndof), a_new(sys%ndof), accel_new(sys%ndof), v_new(sys%ndof)
     real(dp) :: lam_new(sys%constraints%ncon), predicted_internal(sys%ndof)
@@ -310,8 +316,6 @@ contains
     integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
     logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
-    type(step_work) :: scratch
-    call allocate_work(sys, scratch)
     info = 0
     detail = 0
     steps_done = 0
@@ -801,7 +805,7 @@ contains
       real(dp), intent(in) :: columns(:, :)
       real(dp), intent(out) :: w(:, :)
       integer :: dof, c, k
-      ! (work%block_row, touched_dofs and scan_dofs: made once per chunk by allocate_work;
+      ! (work%block_row, touched_dofs and scan_dofs: made once by allocate_work;
       ! with a finite turn only scan_dofs can hold a nonzero outside the blocks, see
       ! carry_scan_setup; the same w and the same answer as the test of every coordinate)
       w = 0.0_dp
