@@ -27,42 +27,17 @@
 module carried_rotation
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
+  use system_carry, only: carry_apply
+  use system_constraints, only: add_gradient_column, operand_count
   implicit none
   private
-  public :: carry_enabled, carry_vectors, carry_turn, carry_apply, carry_gradients, &
+  public :: carry_turn, carry_gradients, &
             carry_plane_gradients
 
   !> the identity's share of the fitted correlation (relative to its Frobenius norm)
   real(dp), parameter :: identity_share = 1e-6_dp
 
 contains
-
-  !> Whether the system carries its matrix (carried vectors were given).
-  pure logical function carry_enabled(sys)
-    type(system_model), intent(in) :: sys
-    carry_enabled = .false.
-    if (allocated(sys%carry%first)) carry_enabled = size(sys%carry%first) > 0
-  end function carry_enabled
-
-  !> The carried 3-vectors (3, nvec) of the system at the reduced coordinates e.
-  pure subroutine carry_vectors(sys, e, vectors)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: e(:)
-    real(dp), intent(out) :: vectors(:, :)
-    integer :: k, i, source
-    ! (carry_source: carry_map's reduced coordinate or minus the fixed full dof, made once
-    ! by system_set_carry)
-    do k = 1, size(sys%carry%first)
-      do i = 1, 3
-        source = sys%carry%source(i, k)
-        if (source > 0) then
-          vectors(i, k) = e(source)
-        else  ! a coordinate the reduction fixes
-          vectors(i, k) = sys%reduction%offset(-source)
-        end if
-      end do
-    end do
-  end subroutine carry_vectors
 
   !> The rotation turn (3, 3) that best maps the reference vectors onto the current ones
   !> (weighted; positions about their centroids) and its angle (rad). info = 1: the SVD
@@ -217,61 +192,6 @@ contains
                   + a(1, 3) * (a(2, 1) * a(3, 2) - a(3, 1) * a(2, 2))
   end function determinant
 
-  !> y = T_e x (back = .false.: from the factorization's axes to the current ones) or
-  !> y = T_e^T x (.true.), T_e = B^T blockdiag(turn) B on the reduced coordinates: every full
-  !> 3-vector turned, its fixed components (the reduction's) taken as zero (carry_map: the
-  !> reduced coordinate of each full component, 0 where fixed; B selects, so each reduced
-  !> coordinate is one full component).
-  pure subroutine carry_apply(sys, turn, x, back, y)
-    type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: turn(3, 3), x(sys%ndof)
-    logical, intent(in) :: back
-    real(dp), intent(out) :: y(sys%ndof)
-    real(dp) :: rotation(3, 3), v(3), w(3), r11, r12, r13, r21, r22, r23
-    integer :: b, i, first, second
-    rotation = turn
-    if (back) rotation = transpose(turn)
-    if (allocated(sys%carry%plane)) then
-      ! every vector of the xy plane (or fixed): the plane path below by the list of pairs
-      r11 = rotation(1, 1)
-      r12 = rotation(1, 2)
-      r13 = rotation(1, 3) * 0.0_dp
-      r21 = rotation(2, 1)
-      r22 = rotation(2, 2)
-      r23 = rotation(2, 3) * 0.0_dp
-      do b = 1, size(sys%carry%plane, 2)
-        first = sys%carry%plane(1, b)
-        second = sys%carry%plane(2, b)
-        v(1) = x(first)
-        v(2) = x(second)
-        y(first) = r11 * v(1) + r12 * v(2) + r13
-        y(second) = r21 * v(1) + r22 * v(2) + r23
-      end do
-      return
-    end if
-    do b = 1, size(sys%carry%map, 2)
-      first = sys%carry%map(1, b)
-      second = sys%carry%map(2, b)
-      if (first > 0 .and. second > 0 .and. sys%carry%map(3, b) == 0) then
-        ! a vector of the xy plane (a planar reduction): the same sums with v(3) = 0,
-        ! without the general path's branches
-        v(1) = x(first)
-        v(2) = x(second)
-        y(first) = rotation(1, 1) * v(1) + rotation(1, 2) * v(2) + rotation(1, 3) * 0.0_dp
-        y(second) = rotation(2, 1) * v(1) + rotation(2, 2) * v(2) + rotation(2, 3) * 0.0_dp
-        cycle
-      end if
-      do i = 1, 3
-        v(i) = 0.0_dp
-        if (sys%carry%map(i, b) > 0) v(i) = x(sys%carry%map(i, b))
-      end do
-      w = rotation(:, 1) * v(1) + rotation(:, 2) * v(2) + rotation(:, 3) * v(3)
-      do i = 1, 3
-        if (sys%carry%map(i, b) > 0) y(sys%carry%map(i, b)) = w(i)
-      end do
-    end do
-  end subroutine carry_apply
-
   !> columns (ndof, ncon): T_e^T Phi_e^T, the constraint gradients turned back to the
   !> factorization's axes (the right-hand sides of the Schur complement's flexibility);
   !> column (ndof): work (the caller's: an automatic array was a heap allocation a call).
@@ -279,17 +199,11 @@ contains
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: turn(3, 3), gradients(:, :)
     real(dp), intent(out) :: columns(:, :), column(:)
-    integer :: c, s, k
+    integer :: c
     do c = 1, sys%constraints%ncon
       column = 0.0_dp
-      do s = 1, 6
-        do k = sys%constraints%term_ptr(6 * (c - 1) + s), &
-               sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
-          column(sys%constraints%term_dof(k)) = column(sys%constraints%term_dof(k)) &
-                                                + gradients(s, c) * sys%constraints%term_coef(k)
-        end do
-      end do
-      call carry_apply(sys, turn, column, .true., columns(:, c))
+      call add_gradient_column(sys%constraints, gradients, c, 6, column)
+      call carry_apply(sys%carry, turn, column, .true., columns(:, c))
     end do
   end subroutine carry_gradients
 
@@ -303,7 +217,7 @@ contains
     integer, intent(in) :: pairs(:)
     real(dp), intent(inout) :: columns(:, :), column(:)
     real(dp) :: r11, r12, r13, r21, r22, r23, v1, v2
-    integer :: c, s, k, p, first, second, last
+    integer :: c, p, first, second
     ! (back: the transposed turn, as carry_apply(.., back = .true., ..))
     r11 = turn(1, 1)
     r12 = turn(2, 1)
@@ -316,16 +230,9 @@ contains
         column(sys%carry%plane(1, pairs(p))) = 0.0_dp
         column(sys%carry%plane(2, pairs(p))) = 0.0_dp
       end do
-      ! (the operands up to the last with terms, con_operands: the rest are empty)
-      last = 6
-      if (allocated(sys%constraints%operands)) last = sys%constraints%operands(c)
-      do s = 1, last
-        do k = sys%constraints%term_ptr(6 * (c - 1) + s), &
-               sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
-          column(sys%constraints%term_dof(k)) = column(sys%constraints%term_dof(k)) &
-                                                + gradients(s, c) * sys%constraints%term_coef(k)
-        end do
-      end do
+      ! (the operands up to the last with terms: the rest are empty)
+      call add_gradient_column(sys%constraints, gradients, c, operand_count(sys%constraints, c), &
+                               column)
       do p = 1, size(pairs)
         first = sys%carry%plane(1, pairs(p))
         second = sys%carry%plane(2, pairs(p))

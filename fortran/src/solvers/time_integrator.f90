@@ -73,8 +73,8 @@ module time_integrator
   use kernel_errors, only: failure_text, message_length
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
-  use carried_rotation, only: carry_enabled, carry_vectors, carry_turn, carry_apply, &
-                              carry_gradients, carry_plane_gradients
+  use carried_rotation, only: carry_turn, carry_gradients, carry_plane_gradients
+  use system_carry, only: carry_enabled, carry_vectors, carry_apply
   implicit none
   private
   public :: integrator_chunk, output_row, step_failure_text, step_work, allocate_work
@@ -167,7 +167,7 @@ contains
               work%records(contact_record, max(1, sys%contact%npoint)), work%ipiv(ncon), &
               work%full(sys%nfull), work%row_phi(ncon), work%row_gradients(6, ncon), &
               work%row_ndof(sys%ndof), work%full_pair(sys%nfull, 2))
-    if (carry_enabled(sys)) then
+    if (carry_enabled(sys%carry)) then
       allocate (work%carry_columns(sys%ndof, ncon), &
                 work%carry_flexibility(sys%ndof, ncon), work%carry_lu(ncon, ncon), &
                 work%carry_column(sys%ndof), work%block_row(sys%ndof))
@@ -475,11 +475,11 @@ contains
       learned%matrix_unconfirmed = 0
     end if
     learned%carry_on = .false.
-    if (info == 0 .and. carry_enabled(sys)) then
+    if (info == 0 .and. carry_enabled(sys%carry)) then
       if (.not. allocated(learned%carry_reference)) &
         allocate (learned%carry_reference(3, size(sys%carry%first)), &
                   learned%carry_current(3, size(sys%carry%first)))
-      call carry_vectors(sys, e, learned%carry_reference)
+      call carry_vectors(sys%carry, sys%reduction, e, learned%carry_reference)
     end if
   end subroutine factorize
 
@@ -495,9 +495,9 @@ contains
     real(dp) :: angle
     integer :: svd_info
     learned%carry_on = .false.
-    if (fresh_matrix .or. cfg%jacobian /= jacobian_reuse .or. .not. carry_enabled(sys) .or. &
+    if (fresh_matrix .or. cfg%jacobian /= jacobian_reuse .or. .not. carry_enabled(sys%carry) .or. &
         .not. sys%matrix%factorized .or. .not. allocated(learned%carry_reference)) return
-    call carry_vectors(sys, e, learned%carry_current)
+    call carry_vectors(sys%carry, sys%reduction, e, learned%carry_current)
     call carry_turn(sys, learned%carry_reference, learned%carry_current, learned%carry_turn, &
                     angle, svd_info)
     learned%carry_on = svd_info == 0 .and. angle > carry_threshold
@@ -581,7 +581,7 @@ contains
       end if
       ! z = U S^{-1} U^T r (carried: T S^{-1} T^T r)
       if (learned%carry_on) then
-        call carry_apply(sys, learned%carry_turn, r, .true., z(:, 1))
+        call carry_apply(sys%carry, learned%carry_turn, r, .true., z(:, 1))
       else
         call to_solver_frame(sys%matrix, rotations, r, .true., z(:, 1))
       end if
@@ -592,7 +592,7 @@ contains
         return
       end if
       if (learned%carry_on) then
-        call carry_apply(sys, learned%carry_turn, z(:, 1), .false., direction)
+        call carry_apply(sys%carry, learned%carry_turn, z(:, 1), .false., direction)
       else
         call to_solver_frame(sys%matrix, rotations, z(:, 1), .false., direction)
       end if
@@ -795,7 +795,7 @@ contains
         return
       end if
       call sparse_columns_product(work%carry_flexibility, work%dlam(:, 1), work%back)
-      call carry_apply(sys, learned%carry_turn, work%back, .false., work%correction)
+      call carry_apply(sys%carry, learned%carry_turn, work%back, .false., work%correction)
       work%correction = work%correction - work%direction
     end subroutine carry_schur
 

@@ -13,7 +13,8 @@ module system_constraints
   implicit none
   private
   public :: constraint_table, evaluate_constraints, constraint_derivatives, &
-            constraint_reaction, gradient_dot, gradient_product, operand_count
+            constraint_reaction, gradient_dot, gradient_product, operand_count, &
+            add_gradient_column
 
   type :: constraint_table
     integer :: ncon = 0
@@ -179,5 +180,21 @@ contains
     count_c = 6
     if (allocated(constraints%operands)) count_c = constraints%operands(c)
   end function operand_count
+
+  !> column += Phi_e^T's column of constraint c (its operands 1 .. last; the loops over the
+  !> operands' terms in order).
+  pure subroutine add_gradient_column(constraints, gradients, c, last, column)
+    type(constraint_table), intent(in) :: constraints
+    real(dp), intent(in) :: gradients(:, :)
+    integer, intent(in) :: c, last
+    real(dp), intent(inout) :: column(:)
+    integer :: s, k
+    do s = 1, last
+      do k = constraints%term_ptr(6 * (c - 1) + s), constraints%term_ptr(6 * (c - 1) + s + 1) - 1
+        column(constraints%term_dof(k)) = column(constraints%term_dof(k)) &
+                                          + gradients(s, c) * constraints%term_coef(k)
+      end do
+    end do
+  end subroutine add_gradient_column
 
 end module system_constraints
