@@ -1,7 +1,11 @@
 !> A mechanical system as the kernel holds it behind a handle (system_store): element sets
 !> of any kinds, rigid bodies (through their constant mass), floating frames, drives,
 !> loads, constraints with Lagrange multipliers, linear constraints eliminated by a
-!> constant matrix B, contact pairs, probes, and the iteration matrix's solver.
+!> constant matrix B, contact pairs, probes, and the iteration matrix's solver. Each of
+!> these is a component of system_model in its own module (system/system_*.f90: mass,
+!> reduction, drives, loads, force elements, constraints, contact, probes, iteration
+!> matrix, carried vectors) with the routines that own it; this module keeps what combines
+!> them: the forces, the energies, the refactorization and the output rows.
 !>
 !> Coordinates. The full vector q holds every body's coordinates; linear constraints give
 !> q = B e + q0 with the independent coordinates e, the unknowns of the solvers (without
@@ -31,10 +35,7 @@
 !> No I/O; failures return codes.
 module mechanical_system
   use ancf_kinds, only: dp
-  use constraints, only: constraint_eval, operand_values, constraint_value, &
-                         constraint_kind_coordinate, constraint_kind_distance, &
-                         constraint_kind_cross, constraint_kind_dot
-  use matrix3, only: cross
+  use constraints, only: constraint_value
   use element_sets, only: element_set, set_slot, frame_omega
   use force_elements, only: force_element_slots
   use system_drives, only: drive_table, drive_at
@@ -50,8 +51,7 @@ module mechanical_system
                               to_solver_frame, dof_frame, factorize_matrix
   use system_carry, only: carried_vectors
   use system_mass, only: mass_matrix, kinetic_energy
-  use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent, &
-                              pattern_position
+  use system_reduction, only: coordinate_reduction, to_full, to_reduced, reduce_tangent
   implicit none
   private
   public :: system_model, frame_def, contact_pair, contact_state
@@ -63,8 +63,8 @@ module mechanical_system
             drive_step_work
   ! what the stepper asks of the system's contact (it uses no contact module itself)
   public :: contact_record, contact_step_limit
+  public :: policy_constant, policy_refactor  ! (system_iteration's)
 
-  public :: policy_constant, policy_refactor
   !> energy(:) layout of an output row
   integer, parameter, public :: energy_kinetic = 1, energy_strain = 2, energy_loads = 3, &
                                 energy_moment = 4, energy_total = 5, work_drive = 6, &
@@ -83,20 +83,23 @@ module mechanical_system
     real(dp) :: pivot(3) = 0.0_dp
   end type frame_def
 
+  !> The system: its dimensions (ndof independent coordinates e, nfull full coordinates q),
+  !> element sets and frames, and one component per concern, each in its own module with
+  !> the routines that own it.
   type :: system_model
     integer :: ndof = 0, nfull = 0
     type(set_slot), allocatable :: sets(:)             ! element sets of any family
     type(frame_def), allocatable :: frames(:)
     type(drive_table) :: drives                       ! the drive table (system_drives)
     type(mass_matrix) :: mass                         ! M and its forms (system_mass)
-    type(coordinate_reduction) :: reduction  ! q = B e + q0, the plan (system_reduction)
+    type(coordinate_reduction) :: reduction           ! q = B e + q0 (system_reduction)
     type(load_set) :: loads                           ! forces and moments (system_loads)
-    type(force_element_table) :: force_elements  ! (system_force_elements)
-    type(constraint_table) :: constraints  ! with multipliers (system_constraints)
+    type(force_element_table) :: force_elements       ! (system_force_elements)
+    type(constraint_table) :: constraints             ! with multipliers (system_constraints)
     type(contact_set) :: contact                      ! plate-plate contact (system_contact)
     type(probe_set) :: probes                         ! output points (system_probes)
     type(iteration_matrix) :: matrix                  ! S and its solver (system_iteration)
-    type(carried_vectors) :: carry  ! what carries the matrix with the rotation (system_carry)
+    type(carried_vectors) :: carry                    ! the carried matrix's (system_carry)
   end type system_model
 
 contains
