@@ -23,8 +23,7 @@ module static_solver
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
                                external_forces, contact_record
   use system_constraints, only: constraint_derivatives, constraint_reaction
-  use section_moment, only: moment_force
-  use system_reduction, only: row_terms, reduced_col, reduced_coef, full_at
+  use system_loads, only: moment_pattern_size, moment_pattern, moment_tangent
   use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
                            solver_destroy
   use kernel_errors, only: failure_text, message_length
@@ -71,16 +70,15 @@ contains
     type(contact_state), intent(inout) :: state
     integer, intent(out) :: iterations, converged_by, factorizations, info, detail
     real(dp), intent(out) :: history(:), force_res, con_res
-    integer :: n, ncon, nnz, nhess, nmom, ngrad, total, handle, it, c, s1, s2, k1, k2, k, m
-    integer :: i, j, a, b, best, since, destroy_info
+    integer :: n, ncon, nnz, nhess, nmom, ngrad, total, handle, it, c, s1, s2, k1, k2, k
+    integer :: best, since, destroy_info
     integer, allocatable :: srows(:), scols(:)
     real(dp), allocatable :: values(:), tangent(:), rhs(:, :)
     real(dp) :: internal(size(e)), loads(size(e)), reaction(size(e)), residual(size(e))
     real(dp) :: phi(sys%constraints%ncon), gradients(6, sys%constraints%ncon)
     real(dp) :: hessians(6, 6, sys%constraints%ncon)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
-    real(dp) :: step_size, size_now, scale, floor, previous, moment(3)
-    real(dp) :: jacobian(3, 3), hessian(3, 3, 3)
+    real(dp) :: step_size, size_now, scale, floor, previous
     logical :: near, growing
     n = size(e)
     ncon = sys%constraints%ncon
@@ -105,15 +103,7 @@ contains
         end do
       end do
     end do
-    nmom = 0
-    do m = 1, size(sys%loads%moment_magnitude)
-      do i = 1, 3
-        do j = 1, 3
-          nmom = nmom + row_terms(sys%reduction, sys%loads%moment_dofs(i, m)) &
-                      * row_terms(sys%reduction, sys%loads%moment_dofs(j, m))
-        end do
-      end do
-    end do
+    nmom = moment_pattern_size(sys%loads, sys%reduction)
     total = nnz + nhess + nmom + 2 * ngrad
     allocate (srows(total), scols(total), values(total), tangent(nnz), rhs(n + ncon, 1))
     srows(1:nnz) = rows
@@ -132,19 +122,8 @@ contains
         end do
       end do
     end do
-    do m = 1, size(sys%loads%moment_magnitude)
-      do i = 1, 3
-        do j = 1, 3
-          do a = 1, row_terms(sys%reduction, sys%loads%moment_dofs(i, m))
-            do b = 1, row_terms(sys%reduction, sys%loads%moment_dofs(j, m))
-              k = k + 1
-              srows(k) = reduced_col(sys%reduction, sys%loads%moment_dofs(i, m), a)
-              scols(k) = reduced_col(sys%reduction, sys%loads%moment_dofs(j, m), b)
-            end do
-          end do
-        end do
-      end do
-    end do
+    call moment_pattern(sys%loads, sys%reduction, srows(k + 1:k + nmom), scols(k + 1:k + nmom))
+    k = k + nmom
     do c = 1, ncon
       do s1 = 1, 6
         do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1
@@ -203,28 +182,9 @@ contains
           end do
         end do
       end do
-      do m = 1, size(sys%loads%moment_magnitude)
-        call moment_force(full_at(sys%reduction, e, sys%loads%moment_dofs(:, m)), &
-                          sys%loads%moment_axis(:, m), load_factor * sys%loads%moment_magnitude(m), &
-                          moment, jacobian, hessian, info)
-        if (info /= 0) then
-          info = 6
-          exit
-        end if
-        do i = 1, 3
-          do j = 1, 3
-            do a = 1, row_terms(sys%reduction, sys%loads%moment_dofs(i, m))
-              do b = 1, row_terms(sys%reduction, sys%loads%moment_dofs(j, m))
-                k = k + 1
-                values(k) = -jacobian(i, j) &
-                            * reduced_coef(sys%reduction, sys%loads%moment_dofs(i, m), a) &
-                            * reduced_coef(sys%reduction, sys%loads%moment_dofs(j, m), b)
-              end do
-            end do
-          end do
-        end do
-      end do
+      call moment_tangent(sys%loads, sys%reduction, e, load_factor, values(k + 1:k + nmom), info)
       if (info /= 0) exit
+      k = k + nmom
       do c = 1, ncon
         do s1 = 1, 6
           do k1 = first_term(c, s1), first_term(c, s1) + slot_terms(c, s1) - 1

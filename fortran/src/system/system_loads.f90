@@ -4,14 +4,15 @@
 !> forces, the point loads' Jacobian and the dead moments' potential. No I/O.
 module system_loads
   use ancf_kinds, only: dp
-  use section_moment, only: moment_force_only, moment_angle
+  use section_moment, only: moment_force, moment_force_only, moment_angle
   use vector_loads, only: vector_load_force
   use system_drives, only: drive_table, drive_at
-  use system_reduction, only: coordinate_reduction, pattern_position
+  use system_reduction, only: coordinate_reduction, pattern_position, row_terms, reduced_col, &
+                              reduced_coef, full_at
   implicit none
   private
   public :: load_set, vector_load_forces, vector_load_tangent, dead_moment_forces, &
-            dead_moment_energy
+            dead_moment_energy, moment_pattern_size, moment_pattern, moment_tangent
 
   type :: load_set
     ! constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
@@ -170,5 +171,81 @@ contains
                            loads%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
     if (info /= 0) info = 6
   end subroutine vector_load_at
+
+  !> The entries of the dead moments' Jacobian on the independent coordinates e (each pair
+  !> of a moment's director components, every pair of the coordinates their full
+  !> coordinates depend on: q = B e + q0).
+  pure integer function moment_pattern_size(loads, reduction) result(nmom)
+    type(load_set), intent(in) :: loads
+    type(coordinate_reduction), intent(in) :: reduction
+    integer :: m, i, j
+    nmom = 0
+    do m = 1, size(loads%moment_magnitude)
+      do i = 1, 3
+        do j = 1, 3
+          nmom = nmom + row_terms(reduction, loads%moment_dofs(i, m)) &
+                      * row_terms(reduction, loads%moment_dofs(j, m))
+        end do
+      end do
+    end do
+  end function moment_pattern_size
+
+  !> The rows and columns (reduced coordinates) of the dead moments' Jacobian entries in the
+  !> order of moment_tangent (moment_pattern_size of them; duplicates summed by the caller).
+  pure subroutine moment_pattern(loads, reduction, rows, cols)
+    type(load_set), intent(in) :: loads
+    type(coordinate_reduction), intent(in) :: reduction
+    integer, intent(out) :: rows(:), cols(:)
+    integer :: m, i, j, a, b, k
+    k = 0
+    do m = 1, size(loads%moment_magnitude)
+      do i = 1, 3
+        do j = 1, 3
+          do a = 1, row_terms(reduction, loads%moment_dofs(i, m))
+            do b = 1, row_terms(reduction, loads%moment_dofs(j, m))
+              k = k + 1
+              rows(k) = reduced_col(reduction, loads%moment_dofs(i, m), a)
+              cols(k) = reduced_col(reduction, loads%moment_dofs(j, m), b)
+            end do
+          end do
+        end do
+      end do
+    end do
+  end subroutine moment_pattern
+
+  !> Minus the dead moments' Jacobian (times load_factor) at e on the independent
+  !> coordinates, the entries of moment_pattern (the residual carries minus the external
+  !> forces). info = 6: a moment is undefined.
+  subroutine moment_tangent(loads, reduction, e, load_factor, values, info)
+    type(load_set), intent(in) :: loads
+    type(coordinate_reduction), intent(in) :: reduction
+    real(dp), intent(in) :: e(:), load_factor
+    real(dp), intent(out) :: values(:)
+    integer, intent(out) :: info
+    real(dp) :: moment(3), jacobian(3, 3), hessian(3, 3, 3)
+    integer :: m, i, j, a, b, k
+    info = 0
+    k = 0
+    do m = 1, size(loads%moment_magnitude)
+      call moment_force(full_at(reduction, e, loads%moment_dofs(:, m)), &
+                        loads%moment_axis(:, m), load_factor * loads%moment_magnitude(m), &
+                        moment, jacobian, hessian, info)
+      if (info /= 0) then
+        info = 6
+        return
+      end if
+      do i = 1, 3
+        do j = 1, 3
+          do a = 1, row_terms(reduction, loads%moment_dofs(i, m))
+            do b = 1, row_terms(reduction, loads%moment_dofs(j, m))
+              k = k + 1
+              values(k) = -jacobian(i, j) * reduced_coef(reduction, loads%moment_dofs(i, m), a) &
+                          * reduced_coef(reduction, loads%moment_dofs(j, m), b)
+            end do
+          end do
+        end do
+      end do
+    end do
+  end subroutine moment_tangent
 
 end module system_loads
