@@ -11,7 +11,8 @@ module consistent_start
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, frame_rotations, internal_forces, &
                                external_forces, contact_record
-  use system_constraints, only: constraint_derivatives
+  use system_constraints, only: constraint_derivatives, term_count, saddle_gradient_entries
+  use system_mass, only: saddle_mass_entries
   use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
                            solver_destroy
   use kernel_errors, only: failure_text, message_length
@@ -41,7 +42,7 @@ contains
     real(dp) :: gamma(sys%constraints%ncon)
     real(dp), allocatable :: entries(:), rhs(:, :)
     integer, allocatable :: rows(:), cols(:)
-    integer :: n, ncon, nmass, nterm, k, c, s, i, row, handle, stage, ignored
+    integer :: n, ncon, nmass, nterm, handle, stage, ignored
     character(len=*), parameter :: what = "the consistent acceleration's saddle system " // &
                                            '[[M, -Phi_e^T], [-Phi_e, 0]]'
     n = sys%ndof
@@ -72,31 +73,11 @@ contains
     ! the saddle's coordinate list: M's entries, Phi_e^T's (rows of e, columns of lambda),
     ! Phi_e's (rows of lambda)
     nmass = size(sys%mass%saddle_col)
-    nterm = 0
-    if (ncon > 0) nterm = sys%constraints%term_ptr(6 * ncon + 1) - sys%constraints%term_ptr(1)
+    nterm = term_count(sys%constraints)
     allocate (rows(nmass + 2 * nterm), cols(nmass + 2 * nterm), entries(nmass + 2 * nterm))
-    do row = 1, n
-      do k = sys%mass%saddle_ptr(row), sys%mass%saddle_ptr(row + 1) - 1
-        rows(k) = row
-        cols(k) = sys%mass%saddle_col(k)
-        entries(k) = sys%mass%saddle_values(k)
-      end do
-    end do
-    i = nmass
-    do c = 1, ncon
-      do s = 1, 6
-        do k = sys%constraints%term_ptr(6 * (c - 1) + s), &
-               sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
-          i = i + 1
-          rows(i) = sys%constraints%term_dof(k)
-          cols(i) = n + c
-          entries(i) = -(sys%constraints%term_coef(k) * gradients(s, c))
-          rows(i + nterm) = n + c
-          cols(i + nterm) = sys%constraints%term_dof(k)
-          entries(i + nterm) = entries(i)
-        end do
-      end do
-    end do
+    call saddle_mass_entries(sys%mass, rows(1:nmass), cols(1:nmass), entries(1:nmass))
+    call saddle_gradient_entries(sys%constraints, gradients, n, rows(nmass + 1:), &
+                                 cols(nmass + 1:), entries(nmass + 1:))
     allocate (rhs(n + ncon, 1))
     rhs(1:n, 1) = external - internal
     rhs(n + 1:n + ncon, 1) = -gamma

@@ -14,7 +14,7 @@ module system_constraints
   private
   public :: constraint_table, evaluate_constraints, constraint_derivatives, &
             constraint_reaction, gradient_dot, gradient_product, operand_count, &
-            add_gradient_column
+            add_gradient_column, term_count, saddle_gradient_entries
 
   type :: constraint_table
     integer :: ncon = 0
@@ -196,5 +196,40 @@ contains
       end do
     end do
   end subroutine add_gradient_column
+
+  !> The number of terms of all the constraints' operands.
+  pure integer function term_count(constraints)
+    type(constraint_table), intent(in) :: constraints
+    term_count = 0
+    if (constraints%ncon > 0) term_count = constraints%term_ptr(6 * constraints%ncon + 1) &
+                                           - constraints%term_ptr(1)
+  end function term_count
+
+  !> Phi_e^T and Phi_e as coordinates of a saddle matrix whose rows and columns n + c are
+  !> the constraints': the first term_count entries Phi_e^T's (rows of e, columns of lambda,
+  !> minus the gradients), the next term_count the same values at Phi_e's positions.
+  pure subroutine saddle_gradient_entries(constraints, gradients, n, rows, cols, entries)
+    type(constraint_table), intent(in) :: constraints
+    real(dp), intent(in) :: gradients(:, :)
+    integer, intent(in) :: n
+    integer, intent(out) :: rows(:), cols(:)
+    real(dp), intent(out) :: entries(:)
+    integer :: c, s, k, i, nterm
+    nterm = term_count(constraints)
+    i = 0
+    do c = 1, constraints%ncon
+      do s = 1, 6
+        do k = constraints%term_ptr(6 * (c - 1) + s), constraints%term_ptr(6 * (c - 1) + s + 1) - 1
+          i = i + 1
+          rows(i) = constraints%term_dof(k)
+          cols(i) = n + c
+          entries(i) = -(constraints%term_coef(k) * gradients(s, c))
+          rows(i + nterm) = n + c
+          cols(i + nterm) = constraints%term_dof(k)
+          entries(i + nterm) = entries(i)
+        end do
+      end do
+    end do
+  end subroutine saddle_gradient_entries
 
 end module system_constraints

@@ -7,7 +7,8 @@ module system_mass
   use iso_fortran_env, only: int64
   implicit none
   private
-  public :: mass_matrix, mass_product, kinetic_energy, csr_matvec, plane_mass_setup
+  public :: mass_matrix, mass_product, kinetic_energy, csr_matvec, plane_mass_setup, &
+            saddle_mass_entries
 
   type :: mass_matrix
     ! mass M (reduced, CSR, 1-based), used for M a and the kinetic energy; when M is
@@ -178,5 +179,21 @@ contains
       y(i) = total
     end do
   end subroutine csr_matvec
+
+  !> The saddle mass (M as the model assembled it) as coordinates: rows, columns and values
+  !> of its entries in CSR order (size(saddle_col) of them).
+  pure subroutine saddle_mass_entries(mass, rows, cols, entries)
+    type(mass_matrix), intent(in) :: mass
+    integer, intent(out) :: rows(:), cols(:)
+    real(dp), intent(out) :: entries(:)
+    integer :: row, k
+    do row = 1, size(mass%saddle_ptr) - 1
+      do k = mass%saddle_ptr(row), mass%saddle_ptr(row + 1) - 1
+        rows(k) = row
+        cols(k) = mass%saddle_col(k)
+        entries(k) = mass%saddle_values(k)
+      end do
+    end do
+  end subroutine saddle_mass_entries
 
 end module system_mass
