@@ -17,7 +17,7 @@ DRIVE_RAMP, DRIVE_HERMITE = 10, 11
 SECTION_RECTANGLE, SECTION_BOX, SECTION_TUBE, SECTION_CIRCLE = 1, 2, 3, 4
 MAX_SECTION_POINTS = 18
 
-# fortran/src/system/mechanical_system.f90: the iteration matrix's policy
+# fortran/src/system/system_iteration.f90: the iteration matrix's policy
 POLICY_CONSTANT, POLICY_REFACTOR = 0, 1
 #: energy(:) of an output row (mechanical_system energy_* / work_* indices, 1-based there)
 ENERGY_NAMES = ("kinetic", "strain", "gravity", "moment", "total", "drive_work", "frame_work",
