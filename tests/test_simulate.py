@@ -230,6 +230,26 @@ def test_save_refuses_an_existing_file_and_input_files(tmp_path):
     assert scene.read_text().startswith("!") or "&scene" in scene.read_text()
 
 
+def test_a_failed_replacing_save_keeps_the_old_file(tmp_path, monkeypatch):
+    """save(replace=True) writes the new file beside the old one and moves it over only
+    when complete: a write that fails half-way leaves the old result byte for byte, and
+    no staging file behind."""
+    from ancfdrv.results import hdf5
+    scene, sets = PENDULUM
+    sim = ancfdrv.simulate(scene, sets, progress=False)
+    path = sim.save(tmp_path / "a.h5")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}   # a.h5 and its a.xdmf
+
+    def fail(*args, **kwargs):
+        raise OSError("disk gone")
+    monkeypatch.setattr(hdf5, "finish", fail)
+    with pytest.raises(OSError, match="disk gone"):
+        sim.save(path, replace=True)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    monkeypatch.undo()
+    assert sim.save(path, replace=True) == path and path.stat().st_size > 0
+
+
 def test_in_memory_run_writes_no_file(tmp_path):
     """No file anywhere: not the scene's default output (results/<scene>.h5), nothing in
     the working directory. ``import ancfdrv`` does not import the in-memory module (it is
