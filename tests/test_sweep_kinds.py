@@ -204,12 +204,16 @@ def test_reference_of_another_model_is_refused(tmp_path, capsys, modal_scene):
 
 
 def test_static_reference_comparing_another_probe_is_refused(tmp_path, capsys):
+    # the sweep names its response (tip, transverse); the reference compared tip, lateral.
+    # (A sweep that names none compares what moves most in the reference itself:
+    # test_a_reference_without_a_named_response_gives_the_compared_probe.)
     static = scene(tmp_path, "static")
     lateral = tmp_path / "lateral.h5"
     run_scene(static, ["scene.response=tip", "scene.response_component=2"], lateral,
               progress=False)
     refused(tmp_path, capsys, static, lateral, "compares probe 'tip' component 2",
-            "the sweep probe 'tip' component 1")
+            "the sweep probe 'tip' component 1",
+            extra=("--set", "scene.response=tip", "--set", "scene.response_component=1"))
 
 
 def test_reference_when_the_cases_run_different_analyses_is_refused(tmp_path, capsys,
@@ -383,3 +387,22 @@ def test_a_dynamic_sweep_picks_the_probe_whose_history_moves_most(tmp_path):
     assert all((r["response_probe"], r["response_component"]) == ("end", 0) for r in rows)
     assert rows[0]["err_vs_finest"] > 0.0
     assert rows[1]["err_vs_finest"] == 0.0      # the finest case against itself
+
+
+def test_a_reference_without_a_named_response_gives_the_compared_probe(tmp_path):
+    # no response named: the sweep compares what moves most in --reference (the tip's
+    # sag under the sideways push), whatever the reference's file compared itself
+    static = scene(tmp_path, "static")
+    push = ["load[push].vector=-100,-50,0"]
+    reference = tmp_path / "ref.h5"
+    run_scene(static, push + ["scene.response=tip", "scene.response_component=2",
+                              "beam.nodes=7"], reference, progress=False)
+    rows = run_sweep(str(static), ["beam.nodes=3,4"], tmp_path / "s", base=push, workers=1,
+                     progress=False, reference=reference)
+    with h5py.File(reference, "r") as h5:
+        sag = h5["static/deflection_support/tip"][1]
+    for row in rows:
+        assert (row["response_probe"], row["response_component"]) == ("tip", 1)
+        assert "moves most in the reference ref.h5" in row["response_picked"]
+        assert row["err_vs_reference"] == pytest.approx(
+            abs(row["tip_transverse"] - sag) / abs(sag), rel=1e-9)
