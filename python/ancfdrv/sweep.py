@@ -245,7 +245,7 @@ def largest_motion(path: str | Path) -> tuple[float, str, int, str]:
     (relative to the supports where the file has that, else from the rigid configuration
     or t = 0): (how much, m; probe; component; what was measured). A dynamic run's
     motion is the range of each component over its history, a static run's the
-    magnitude of its deflection. ('', 0) when the file has no probe."""
+    magnitude of its deflection; (0, '', 0, ...) when the file has no probe."""
     best = (0.0, "", 0)
     with h5py.File(path, "r") as h5:
         group = "dynamic" if "dynamic/deflection" in h5 else "static"
