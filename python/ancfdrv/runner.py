@@ -216,14 +216,14 @@ def _check_dynamic_plausibility(scene: Scene, model: Model, out: Path | MemoryOu
 
 
 def _answers_recorder(scene: Scene, model: Model):
-    """The recorder of the dynamic reactions, section forces and stress envelope (None
-    when the model has neither joints nor beams)."""
+    """The recorder of the dynamic reactions, section forces, stress envelope and cable
+    tension (None when the model has no joints, beams, force elements or cables)."""
     from .system.answers import DynamicAnswers, reaction_map
-    from .system.registry import reports_sections
+    from .system.registry import axial_forces, reports_sections
     if not scene["output"].get("answers", True):
         return None
-    if not reaction_map(model).joints and not any(reports_sections(b) for b in model.bodies) \
-            and not model.force_elements:
+    if not reaction_map(model).joints and not model.force_elements and not any(
+            reports_sections(b) or axial_forces(b) is not None for b in model.bodies):
         return None
     return DynamicAnswers(model, stations=scene["output"].get("stations", 3),
                           keep_sections=bool(scene["output"].get("sections", False)))

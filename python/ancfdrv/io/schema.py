@@ -106,7 +106,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "effects": Key("strs", [], doc="force effects to compute; nothing else is computed "
                        "(general scenes: default every effect their items belong to)"),
         "response": Key("str", None, doc="general scenes: the probe sweeps compare (default: "
-                        "the first probe)"),
+                        "a sweep compares the probe and component that move most in its "
+                        "--reference or first case and says so; a run's file names the first "
+                        "probe)"),
         "bounds": Key("str", "check", one_of("check", "off"),
                       "'check': drives, loads, force elements and modal.spin_rate must stay "
                       "within physical bounds (ancfdrv.io.validate.PHYSICAL_BOUNDS, e.g. a "
