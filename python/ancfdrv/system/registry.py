@@ -27,7 +27,8 @@ A kind declares
 - whether its bodies report section forces and stresses at stations (``sections``: the
   answers, :mod:`.answers`, and the dynamic run's recorder of them);
 - its elements' end forces at a static state (``end_forces``: the section forces from the
-  elements' equilibrium, :mod:`.answers`);
+  elements' equilibrium, :mod:`.answers`) and their initial-stress stiffness
+  (``stress_stiffness``: the classical linear buckling's geometric stiffness);
 - its mesh rows (``mesh``: the points and cells the XDMF writer shows for a body, through
   the writer's row builder, ``mesh_order``: the kinds' order in the mesh).
 
@@ -127,6 +128,12 @@ class Kind:
     #: static section forces from the elements' equilibrium (None: the kind has no beam
     #: sections)
     end_forces: Callable[[Any, Any, Any], tuple[Any, Any]] | None = None
+    #: ``stress_stiffness(set_info, q, dq) -> (tangent, initial_stress) | None``: the
+    #: elements' tangents at the full coordinates q and their initial-stress part with each
+    #: stress replaced by its increment for dq, both (nde, nde, nel) on the element dofs, for
+    #: the classical linear buckling (solvers/buckling.py); None (or a None answer for a set
+    #: kind): the kind gives no initial-stress part
+    stress_stiffness: Callable[[Any, Any, Any], tuple[Any, Any] | None] | None = None
 
 
 _KINDS: dict[str, Kind] = {}
