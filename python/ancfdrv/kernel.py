@@ -161,6 +161,15 @@ def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poi
                                          int(want_tangent))
 
 
+def beam_nonlinear_stress_stiffness(dofs, e, de, gradients, weights, nvolume: int, youngs,
+                                    poisson, shear_scales=(1.0, 0.0, 0.0)) -> np.ndarray:
+    """The initial-stress part of the continuum beam's element tangents (24, 24, nel) at e
+    with each stress replaced by its increment for the coordinate increment de."""
+    return _kernel.beam_nonlinear_stress_stiffness(nvolume, _f(dofs + 1, np.int32), _f(e),
+                                                   _f(de), gradients, weights, youngs, poisson,
+                                                   _f(shear_scales))
+
+
 class CubicBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
     (beam_cubic.cubic_setup) for a mesh with reference nodal vectors (3, 8, nel);
@@ -187,6 +196,12 @@ class CubicBeam:
         """Elastic force, strain energy and element tangents (24, 24, nel) at e."""
         return _kernel.beam_cubic_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
                                          self.strain0, self.stiffness, int(want_tangent))
+
+    def stress_stiffness(self, dofs, e, de) -> np.ndarray:
+        """The initial-stress part of the element tangents (24, 24, nel) at e, each strain
+        replaced by its increment for the coordinate increment de: sum k (C e . de) C x I3."""
+        return _kernel.beam_cubic_stress_stiffness(_f(dofs + 1, np.int32), _f(e), _f(de),
+                                                   self.forms, self.stiffness)
 
 
 def cable_element_arrays(lengths, mass_per_length: float, load) -> tuple[np.ndarray, np.ndarray]:

@@ -43,7 +43,8 @@ module beam_nonlinear
   use beam_stations, only: station_section, set_station_forces
   implicit none
   private
-  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, continuum_set
+  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, continuum_set, &
+            nonlinear_stress_stiffness
 
   !> The family's element set (element_sets): material gradients (8, 3, npts, nel) and
   !> weights (npts, nel) at the Gauss points, the first volume_points of them volume points.
@@ -167,6 +168,32 @@ contains
                           want_tangent, force, energy, tangent)
     end if
   end subroutine nonlinear_element
+
+  !> The initial-stress part of nonlinear_element's tangent for the stress increments of
+  !> the nodal increment dq(3, 8) at q(3, 8): sum_points w kron(G dS G^T, I3) with
+  !> dS = D B(q) dq (the tangent's geometric term with each stress replaced by its
+  !> increment): the geometric stiffness of classical linear buckling.
+  pure subroutine nonlinear_stress_stiffness(q, dq, gradients, weights, volume_points, &
+                                             youngs, poisson, shear_scales, tangent)
+    real(dp), intent(in) :: q(3, 8), dq(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
+    real(dp), intent(out) :: tangent(24, 24)
+    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3)
+    real(dp) :: law_twist_y(6, 6), law_twist_z(6, 6), b(6, 24)
+    integer :: p
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson, law_twist_y, &
+                    law_twist_z)
+    tangent = 0.0_dp
+    do p = 1, size(weights)
+      law = point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z)
+      if (p > volume_points .and. all(law == 0.0_dp)) cycle
+      call deformation_gradient(q, gradients(:, :, p), deformation)
+      call strain_matrix(deformation, gradients(:, :, p), b)
+      call add_geometric_stiffness(matmul(law, matmul(b, reshape(dq, [24]))), &
+                                   gradients(:, :, p), weights(p), tangent)
+    end do
+  end subroutine nonlinear_stress_stiffness
 
   !> nonlinear_element without damping (its loop over the Gauss points). The first
   !> volume_points points integrate the Poisson-free law over the volume, the

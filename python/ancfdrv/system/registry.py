@@ -27,7 +27,8 @@ A kind declares
 - whether its bodies report section forces and stresses at stations (``sections``: the
   answers, :mod:`.answers`, and the dynamic run's recorder of them);
 - its elements' end forces at a static state (``end_forces``: the section forces from the
-  elements' equilibrium, :mod:`.answers`);
+  elements' equilibrium, :mod:`.answers`) and their initial-stress stiffness
+  (``stress_stiffness``: the classical linear buckling's geometric stiffness);
 - its axial force along the body (``axial_forces``: a cable's and a rope's tension, which
   the dynamic run's recorder of the answers keeps per row);
 - its mesh rows (``mesh``: the points and cells the XDMF writer shows for a body, through
@@ -133,6 +134,12 @@ class Kind:
     #: at the body's integration points for full coordinates e_rows (nt, ndof), the tension
     #: series a dynamic run writes (/dynamic/tension; None: the kind carries none)
     axial_forces: Callable[[Any, Any], Any] | None = None
+    #: ``stress_stiffness(set_info, q, dq) -> (tangent, initial_stress) | None``: the
+    #: elements' tangents at the full coordinates q and their initial-stress part with each
+    #: stress replaced by its increment for dq, both (nde, nde, nel) on the element dofs, for
+    #: the classical linear buckling (solvers/buckling.py); None (or a None answer for a set
+    #: kind): the kind gives no initial-stress part
+    stress_stiffness: Callable[[Any, Any, Any], tuple[Any, Any] | None] | None = None
 
 
 _KINDS: dict[str, Kind] = {}
