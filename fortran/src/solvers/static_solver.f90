@@ -561,21 +561,23 @@ contains
     real(dp), intent(in) :: smallest, last, con_res, tol
     logical, intent(in) :: along_path
     character(len=message_length) :: text
-    character(len=40) :: where
+    character(len=40) :: where, shorter
     if (along_path) then
       write (where, '(a, i0)') 'at path step ', load_step
+      shorter = 'shorten solver.arc_length'
     else
       write (where, '(a, i0, a, i0)') 'at load step ', load_step, ' of ', load_steps
+      shorter = 'raise solver.load_steps'
     end if
     select case (info)
     case (static_limit)
-      write (text, '(a, i0, 7a)') 'static Newton did not converge in ', max_iter, &
+      write (text, '(a, i0, 9a)') 'static Newton did not converge in ', max_iter, &
         ' iterations ', trim(where), ' (relative residual ', sci(last), ', constraint ', &
-        sci(con_res), '); raise solver.load_steps or max_iter'
+        sci(con_res), '); ', trim(shorter), ' or max_iter'
     case (static_diverged)
       text = 'static Newton diverged ' // trim(where) // ': the relative residual grew ' // &
              'three times in a row to ' // sci(last) // ' (smallest ' // sci(smallest) // &
-             '); raise solver.load_steps'
+             '); ' // trim(shorter)
     case (static_floor_stall)
       text = 'static Newton stalled at the round-off floor ' // trim(where) // &
              ': the relative residual stays at ' // sci(smallest) // ' above solver.tol = ' // &
@@ -583,12 +585,12 @@ contains
     case (static_stall)
       text = 'static Newton stalled ' // trim(where) // ': no smaller residual in the last ' // &
              'iterations (smallest ' // sci(smallest) // ', tolerance ' // sci(tol) // &
-             '); raise solver.load_steps'
+             '); ' // trim(shorter)
     case (static_nonfinite)
       text = 'static Newton: non-finite step ' // trim(where)
     case (static_no_root)
       text = 'static Newton: the arc-length constraint ||Delta e|| = Delta l has no real ' // &
-             'root ' // trim(where) // '; the arc is too long'
+             'root ' // trim(where) // '; ' // trim(shorter)
     case (static_solve_failed)
       write (text, '(3a, i0, a)') 'static Newton: the saddle-point solve failed ', &
         trim(where), ' (solver code ', detail, ': -10 = singular matrix)'
