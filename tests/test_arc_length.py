@@ -1,5 +1,6 @@
 """Static path-following by arc length (``solver.static_method = 'arc_length'``,
-solvers/path.py; SPEC section 8.2 "Static paths", issue 34 item 2).
+solvers/path.py driving the kernel's static Newton, static_solver.f90; SPEC section 8.2
+"Static paths", issue 34 item 2, issue 36 item 4).
 
 * The shallow von Mises truss (two pinned bars of half-span a and rise h, a vertical load P
   at the apex): with the bars' Green-Lagrange axial strain (St. Venant-Kirchhoff, the

@@ -28,8 +28,9 @@ point (its load factor refined by a parabola in the path length through the thre
 about it); a change of the count with no extremum of P is a bifurcation point.
 
 The path ends at the first crossing of ``target_load_factor`` (the state there solved by
-the kernel's Newton at that load factor: the static result), or after ``max_steps`` steps (then the last
-point, with ``reached = False`` and a message: the run fails with exit 3 after writing it).
+the kernel's Newton at that load factor: the static result), or after ``max_steps`` steps
+(then the last point, with ``reached = False`` and a message: the run fails with exit 3
+after writing it).
 
 :func:`diagnose_stall` reads a failed load-controlled Newton solve: cut back from the last
 converged load step, it tells a limit point (the tangent stiffness along the loads falls
