@@ -100,12 +100,12 @@ def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: f
     return int(np.sum(w < -1e-10 * scale))
 
 
-def _newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float, tol: float,
-               max_iter: int, floor: float = -1.0) -> dict | None:
+def _kernel_newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
+                      tol: float, max_iter: int, floor: float = -1.0) -> dict | None:
     """The kernel's Newton at the fixed load factor ``factor`` from (e, lam): its result
     (e, lam, force_res, con_res, ...), or None when it does not converge (the kernel's
-    stall test ends a tolerance beyond round-off or an iteration limit of 1e8 early).
-    ``floor``: the residual's scale floor (< 0: the forces at the start)."""
+    stall test ends a tolerance beyond round-off early). ``floor``: the residual's scale
+    floor (< 0: the forces at the start)."""
     out = kernel_static(model, e, lam, factor, tol=tol, max_iter=max_iter, force_scale=floor)
     return None if out["info"] else out
 
@@ -172,7 +172,7 @@ def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                             force_scale=floor, check_start=True)
     if settled["info"]:
         raise SolverError("arc length: the state at load factor 0 did not converge ("
-                          f"{settled['message']})")
+                          f"{settled['message'].split('; raise')[0]})")
     force_res, con_res = settled["force_res"], settled["con_res"]
     if settled["iterations"]:
         e, lam = settled["e"], settled["lam"]
@@ -213,8 +213,9 @@ def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
             and factor_new != factor
         if crossed:
             w = (target_load_factor - factor) / (factor_new - factor)
-            landed = _newton_at(model, e + w * (e_new - e), lam + w * (lam_new - lam),
-                                target_load_factor, tol, max_iter, floor)
+            landed = _kernel_newton_at(model, e + w * (e_new - e),
+                                       lam + w * (lam_new - lam), target_load_factor, tol,
+                                       max_iter, floor)
             if landed is None:   # too close to a limit: a shorter arc first
                 arc *= 0.5
                 continue
@@ -261,12 +262,12 @@ def diagnose_stall(model: Model, failure: LoadStepFailure, *, tol: float, max_it
     e, lam, reached, above = failure.e, failure.lam, failure.last_factor, failure.factor
     for _ in range(cuts):
         middle = 0.5 * (reached + above)
-        trial = _newton_at(model, e, lam, middle, tol, max_iter)
+        trial = _kernel_newton_at(model, e, lam, middle, tol, max_iter)
         if trial is None:
             above = middle
         else:
             e, lam, reached = trial["e"], trial["lam"], middle
-    if _newton_at(model, e, lam, failure.factor, tol, max_iter) is not None:
+    if _kernel_newton_at(model, e, lam, failure.factor, tol, max_iter) is not None:
         return failure   # the whole step converges from closer: not a limit (load_steps helps)
     start = _load_tangent(model, model.e0, np.zeros(len(model.constraints)), 0.0)
     at = _load_tangent(model, e, lam, reached)
