@@ -125,15 +125,25 @@ def test_kernel_arc_step_meets_the_constraint_on_the_closed_form():
 
 def test_kernel_arc_step_failure_is_text():
     """An arc-length step the kernel cannot finish returns its failure as text naming the
-    path step and the arc, not the load steps (the path driver then cuts the arc)."""
+    path step and the arc, not the load steps (the path driver then cuts the arc): the
+    iteration limit; and a start 1e-3 off equilibrium (every coordinate shifted, the pins
+    torn) with an arc of 1e-6: the first correction must move e by about 1e-3, so no point
+    of the line du_r + dP du_q is within the arc of the step's start, the constraint's
+    quadratic has no real root."""
     from ancfdrv.solvers.static import ARC_STEP, kernel_static
     model = truss(1.5 * P_LIMIT).assemble()
-    step = kernel_static(model, model.e0.copy(), np.zeros(len(model.constraints)), 0.0,
-                         tol=1e-10, max_iter=2, mode=ARC_STEP, arc=0.15, load_step=7)
+    lam = np.zeros(len(model.constraints))
+    step = kernel_static(model, model.e0.copy(), lam, 0.0, tol=1e-10, max_iter=2,
+                         mode=ARC_STEP, arc=0.15, load_step=7)
     assert step["info"] == 1
     assert "did not converge in 2 iterations at path step 7" in step["message"]
     assert "shorten solver.arc_length" in step["message"]
     assert "load_steps" not in step["message"]
+    step = kernel_static(model, model.e0 + 1e-3, lam, 0.0, tol=1e-10, max_iter=50,
+                         mode=ARC_STEP, arc=1e-6, load_step=3)
+    assert step["info"] == 14 and step["iterations"] == 2
+    assert "arc-length constraint" in step["message"] and "no real root at path step 3" \
+        in step["message"] and "shorten solver.arc_length" in step["message"]
 
 
 def test_path_short_of_the_target_writes_it_and_fails(tmp_path):

@@ -5,8 +5,9 @@ Two solvers share one convergence test (:func:`residuals`):
 * :func:`solve_newton` - Newton-Raphson on the symmetric saddle-point system
   [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] with MUMPS, in the kernel
   (fortran/src/solvers/static_solver.f90: the stepper's residual with the inertia off, one
-  call per load step, the load factor an argument); the same Newton assembled in Python,
-  the reference it is tested against, lives with the tests
+  call per load step, the load factor an argument; with the load factor an unknown the
+  same kernel Newton takes the steps of an arc-length path, solvers/path.py); the same
+  Newton assembled in Python, the reference it is tested against, lives with the tests
   (tests/reference/static_newton.py).
 * :func:`solve_split` - the split iteration of seed 000 (eqs. 40-57) as implemented in
   docs/theory.md: coordinates split into dependent ones e_D (one per constraint, N1) and
