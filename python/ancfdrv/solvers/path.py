@@ -101,20 +101,24 @@ def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: f
 
 
 def _kernel_newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
-                      tol: float, max_iter: int, floor: float = -1.0) -> dict | None:
+                      tol: float, max_iter: int, floor: float = -1.0,
+                      account: bool = True) -> dict | None:
     """The kernel's Newton at the fixed load factor ``factor`` from (e, lam): its result
     (e, lam, force_res, con_res, ...), or None when it does not converge (the kernel's
     stall test ends a tolerance beyond round-off early). ``floor``: the residual's scale
-    floor (< 0: the forces at the start)."""
-    out = kernel_static(model, e, lam, factor, tol=tol, max_iter=max_iter, force_scale=floor)
+    floor (< 0: the forces at the start); ``account``: as :func:`~.static.kernel_static`."""
+    out = kernel_static(model, e, lam, factor, tol=tol, max_iter=max_iter, force_scale=floor,
+                        account=account)
     return None if out["info"] else out
 
 
-def _load_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> dict | None:
+def _load_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
+                  account: bool = True) -> dict | None:
     """The tangent along the loads at (e, lam, P) from the kernel: load_norm ||q||,
     tangent_norm ||du_q|| and flexibility q . du_q (du_q = K_T^{-1} q on the constraints),
     or None when the tangent cannot be factorized (singular)."""
-    out = kernel_static(model, e, lam, factor, tol=1.0, max_iter=1, mode=LOAD_TANGENT)
+    out = kernel_static(model, e, lam, factor, tol=1.0, max_iter=1, mode=LOAD_TANGENT,
+                        account=account)
     return None if out["info"] else out
 
 
@@ -258,19 +262,23 @@ def diagnose_stall(model: Model, failure: LoadStepFailure, *, tol: float, max_it
     load factor P* that converges; when there the tangent stiffness along the loads,
     q^T (K_T^{-1} q) at the start over the same at P*, has fallen below 0.1 or the
     tangent has a negative eigenvalue, the loads pass a maximum the structure cannot carry
-    under load control: say so and name arc_length. Otherwise the original failure."""
+    under load control: say so and name arc_length. Otherwise the original failure. The
+    diagnosis leaves the model as the failed solve left it (its counters and contact
+    guesses: the solves it tries are no part of the run's)."""
     e, lam, reached, above = failure.e, failure.lam, failure.last_factor, failure.factor
     for _ in range(cuts):
         middle = 0.5 * (reached + above)
-        trial = _kernel_newton_at(model, e, lam, middle, tol, max_iter)
+        trial = _kernel_newton_at(model, e, lam, middle, tol, max_iter, account=False)
         if trial is None:
             above = middle
         else:
             e, lam, reached = trial["e"], trial["lam"], middle
-    if _kernel_newton_at(model, e, lam, failure.factor, tol, max_iter) is not None:
+    if _kernel_newton_at(model, e, lam, failure.factor, tol, max_iter,
+                         account=False) is not None:
         return failure   # the whole step converges from closer: not a limit (load_steps helps)
-    start = _load_tangent(model, model.e0, np.zeros(len(model.constraints)), 0.0)
-    at = _load_tangent(model, e, lam, reached)
+    start = _load_tangent(model, model.e0, np.zeros(len(model.constraints)), 0.0,
+                          account=False)
+    at = _load_tangent(model, e, lam, reached, account=False)
     flex0 = start["flexibility"] if start is not None else np.nan
     flex = at["flexibility"] if at is not None else np.inf
     ratio = flex0 / flex if flex != 0 else 0.0

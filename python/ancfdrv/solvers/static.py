@@ -135,13 +135,14 @@ def kernel_static(model: Model, e: np.ndarray, lam: np.ndarray, load_factor: flo
                   tol: float, max_iter: int, force_scale: float = -1.0, mode: int = NEWTON,
                   check_start: bool = False, load_step: int = 1, load_steps: int = 1,
                   arc: float = 0.0, direction: float = 1.0,
-                  previous: np.ndarray | None = None) -> dict:
+                  previous: np.ndarray | None = None, account: bool = True) -> dict:
     """One call of the kernel's static Newton (:meth:`~ancfdrv.kernel.KernelSystem.
     static_solve`, fortran/src/solvers/static_solver.f90) from (e, lam) at ``load_factor``
-    in ``mode`` (:data:`NEWTON`, :data:`ARC_STEP`, :data:`LOAD_TANGENT`), the model's
-    contact guesses and counters carried on. Counts its force evaluations, assemblies and
-    factorizations on the model; returns the kernel's dict (info /= 0 with its message:
-    the caller decides what a failure means)."""
+    in ``mode`` (:data:`NEWTON`, :data:`ARC_STEP`, :data:`LOAD_TANGENT`), from the model's
+    contact guesses. ``account``: carry the contact guesses on and count the force
+    evaluations, assemblies and factorizations on the model (False: a look that leaves the
+    model as it was, the diagnosis of a failed solve). Returns the kernel's dict (info /= 0
+    with its message: the caller decides what a failure means)."""
     out = model.kernel.static_solve(
         t=0.0, load_factor=load_factor, e0=model.e0, rows=model.pattern.rows,
         cols=model.pattern.col_index, e=e, lam=lam, guesses=model.contact_guesses,
@@ -149,6 +150,8 @@ def kernel_static(model: Model, e: np.ndarray, lam: np.ndarray, load_factor: flo
         max_iter=max_iter, check_start=check_start, force_scale=force_scale,
         load_step=load_step, load_steps=load_steps, mode=mode, arc=arc, direction=direction,
         previous=previous)
+    if not account:
+        return out
     model.contact_guesses, model.contact_counts = out["guesses"], out["counts"]
     evaluations = out["iterations"] + 1
     # an arc-length call evaluates the forces once more per iteration for the load vector
