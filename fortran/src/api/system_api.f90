@@ -1548,39 +1548,46 @@ end subroutine system_consistent_acceleration
 
 !> One load step of the static Newton in the kernel (static_solver): equilibrium of the
 !> system at load factor and time from the packed state [e (ndof), lambda (ncon), contact
-!> guesses (2, npoint)] (updated in place; e0 the reference configuration), the tangent's
-!> reduced pattern (pattern(:, tp_rows), pattern(:, tp_cols), 1-based, the solvers' pattern).
-!> settings (ss_*): t, load_factor, tol, length_scale; controls (sc_*): check_start (/= 0: a
-!> start that is already the equilibrium ends with 0 iterations), load_step and load_steps
-!> (named in a failure's text). scales (sr_*): the residual's scale floor force_scale (< 0:
-!> set from the start and returned), the last relative residual and constraint violation
-!> (out). Returns the relative residual after each iteration (history) and outcome (so_*):
-!> info, the iterations, why it converged (static_solver's by_* codes), the factorizations;
-!> info /= 0 with the text in message.
-subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pattern, settings, &
-                               controls, max_iter, scales, history, outcome, message)
+!> guesses (2, npoint)] (updated in place; vectors(:, sx_reference) the reference
+!> configuration), the tangent's reduced pattern (pattern(:, tp_rows), pattern(:, tp_cols),
+!> 1-based, the solvers' pattern). settings (ss_*): t, load_factor, tol, length_scale, and
+!> for an arc-length step its arc and the sign of a first step's load increment; controls
+!> (sc_*): check_start (/= 0: a start that is already the equilibrium ends with 0
+!> iterations), load_step and load_steps (named in a failure's text), mode (0: Newton at
+!> load_factor; 1: one arc-length step from the converged state, the load factor an unknown,
+!> vectors(:, sx_previous) the previous step's increment of e, zero on the first; 2: the
+!> tangent along the loads at the state, no step). scales (sr_*): the residual's scale floor
+!> force_scale (< 0: set from the start and returned), the last relative residual and
+!> constraint violation, the load factor reached and, at the state on entry (modes 1, 2),
+!> ||q||, ||K_T^{-1} q|| and q . K_T^{-1} q (out). Returns the relative residual after each
+!> iteration (history) and outcome (so_*): info, the iterations, why it converged
+!> (static_solver's by_* codes), the factorizations; info /= 0 with the text in message.
+subroutine system_static_solve(handle, nstate, state, counts, ndof, vectors, nnz, pattern, &
+                               settings, controls, max_iter, scales, history, outcome, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state
-  use static_solver, only: static_newton, static_failure_text
-  use api_support, only: api_system, tp_rows, tp_cols, ss_time, &
-                         ss_load_factor, ss_tol, ss_length_scale, sc_check_start, &
-                         sc_load_step, sc_load_steps, sr_force_scale, sr_force_res, &
-                         sr_con_res, so_info, so_iterations, so_converged_by, &
-                         so_factorizations
+  use static_solver, only: static_newton, static_failure_text, path_request
+  use api_support, only: api_system, tp_rows, tp_cols, ss_time, ss_load_factor, ss_tol, &
+                         ss_length_scale, ss_arc, ss_direction, sc_check_start, &
+                         sc_load_step, sc_load_steps, sc_mode, sr_force_scale, &
+                         sr_force_res, sr_con_res, sr_load_factor, sr_load_norm, &
+                         sr_tangent_norm, sr_flexibility, sx_reference, sx_previous, &
+                         so_info, so_iterations, so_converged_by, so_factorizations
   implicit none
   integer, intent(in) :: handle, nstate, ndof, nnz, max_iter
-  real(dp), intent(inout) :: state(nstate), scales(3)
+  real(dp), intent(inout) :: state(nstate), scales(7)
   integer, intent(inout) :: counts(6)
   !f2py intent(in,out) :: state, counts, scales
-  real(dp), intent(in) :: e0(ndof), settings(4)
-  integer, intent(in) :: pattern(nnz, 2), controls(3)
+  real(dp), intent(in) :: vectors(ndof, 2), settings(6)
+  integer, intent(in) :: pattern(nnz, 2), controls(4)
   real(dp), intent(out) :: history(max_iter)
   integer, intent(out) :: outcome(4)
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(contact_state) :: contact
+  type(path_request) :: path
   real(dp), allocatable :: e(:), lam(:)
-  integer :: info, detail, ncon, npoint
+  integer :: info, detail, ncon, npoint, mode
   outcome = 0
   history = 0.0_dp
   call api_system(handle, sys, info, message)
@@ -1588,11 +1595,12 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
   if (info /= 0) return
   ncon = sys%ncon
   npoint = sys%npoint
+  mode = controls(sc_mode)
   if (ndof /= sys%ndof .or. nstate /= ndof + ncon + 2 * npoint .or. &
-      nnz /= size(sys%mass_pattern) .or. max_iter < 1) then
+      nnz /= size(sys%mass_pattern) .or. max_iter < 1 .or. mode < 0 .or. mode > 2) then
     outcome(so_info) = 4
     message = 'system_static_solve: sizes inconsistent with the system (ndof, the packed' // &
-              ' state, nnz of the pattern) or max_iter < 1'
+              ' state, nnz of the pattern), max_iter < 1 or a mode outside 0..2'
     return
   end if
   if (any(pattern < 1) .or. any(pattern > ndof)) then
@@ -1604,12 +1612,31 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
   lam = state(ndof + 1:ndof + ncon)
   contact%guesses = reshape(state(ndof + ncon + 1:nstate), [2, npoint])
   contact%counts = counts
-  call static_newton(sys, settings(ss_time), settings(ss_load_factor), e0, &
-                     pattern(:, tp_rows), pattern(:, tp_cols), e, lam, contact, &
-                     settings(ss_tol), settings(ss_length_scale), max_iter, &
-                     controls(sc_check_start) /= 0, scales(sr_force_scale), &
-                     outcome(so_iterations), history, scales(sr_force_res), scales(sr_con_res), &
-                     outcome(so_converged_by), outcome(so_factorizations), info, detail)
+  if (mode == 0) then
+    call static_newton(sys, settings(ss_time), settings(ss_load_factor), &
+                       vectors(:, sx_reference), pattern(:, tp_rows), pattern(:, tp_cols), e, &
+                       lam, contact, settings(ss_tol), settings(ss_length_scale), max_iter, &
+                       controls(sc_check_start) /= 0, scales(sr_force_scale), &
+                       outcome(so_iterations), history, scales(sr_force_res), &
+                       scales(sr_con_res), outcome(so_converged_by), &
+                       outcome(so_factorizations), info, detail)
+    scales(sr_load_factor) = settings(ss_load_factor)
+  else
+    path%mode = mode
+    path%arc = settings(ss_arc)
+    path%direction = settings(ss_direction)
+    path%previous = vectors(:, sx_previous)
+    call static_newton(sys, settings(ss_time), settings(ss_load_factor), &
+                       vectors(:, sx_reference), pattern(:, tp_rows), pattern(:, tp_cols), e, &
+                       lam, contact, settings(ss_tol), settings(ss_length_scale), max_iter, &
+                       .false., scales(sr_force_scale), outcome(so_iterations), history, &
+                       scales(sr_force_res), scales(sr_con_res), outcome(so_converged_by), &
+                       outcome(so_factorizations), info, detail, path)
+    scales(sr_load_factor) = path%load_factor
+    scales(sr_load_norm) = path%load_norm
+    scales(sr_tangent_norm) = path%tangent_norm
+    scales(sr_flexibility) = path%flexibility
+  end if
   state = [e, lam, reshape(contact%guesses, [2 * npoint])]
   counts = contact%counts
   outcome(so_info) = info
@@ -1617,7 +1644,7 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
                                                controls(sc_load_steps), max_iter, &
                                                minval(history(1:max(1, outcome(so_iterations)))), &
                                                scales(sr_force_res), scales(sr_con_res), &
-                                               settings(ss_tol))
+                                               settings(ss_tol), mode /= 0)
 end subroutine system_static_solve
 
 
