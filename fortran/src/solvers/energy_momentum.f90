@@ -13,14 +13,20 @@
 !> to the Newton tolerance, whatever h; and since f_dg, the loads' resultant moment aside, is
 !> made of invariants of rigid motion, momentum and angular momentum are conserved too.
 !> Newton with the exact Jacobian of this residual (the beam's and the rope's exact; the
-!> cable's curvature without the derivative of Gonzalez's correction), dense:
+!> cable's curvature without the derivative of Gonzalez's correction), assembled dense:
 !>   [ 2/h^2 M + df_dg/de1 - d(Phi_e(e_m)^T lambda)/de1   -Phi_e(e_m)^T ]
 !>   [ Phi_e(e1)                                           0            ],
-!> solved by LAPACK dgesv (O((ndof + ncon)^3) per correction: meant for the small hard
-!> cases, not for large meshes). The term of the multipliers is exact: the constraint
-!> gradients are affine in e, differenced over a half unit of each coordinate they touch.
+!> factorized through the Schur complement of the multipliers with a banded LU of its first
+!> block (LAPACK dgbtrf; O(ndof kd^2) for a half-bandwidth kd: beams and ropes numbered along
+!> their length) or, where the band is wide, by a dense LU of the whole (dgetrf,
+!> O((ndof + ncon)^3)). The term of the multipliers is exact: the constraint gradients are
+!> affine in e, differenced over a half unit of each coordinate they touch. Within a step the
+!> Jacobian is kept while each correction is at most keep_contraction times the one before
+!> (simplified Newton: a correction costs a force evaluation and a back-substitution), and
+!> refreshed at the iterate otherwise; the residual is always exact.
 !> Supported: undamped local element sets (the nonlinear beam, the cable, the rope; they
-!> take no frame, and frames that do not move are allowed), masses, constant loads, undriven constraints. Anything else (contact, force
+!> take no frame, and frames that do not move are allowed), masses, constant loads,
+!> undriven constraints. Anything else (contact, force
 !> elements, point loads that follow or are driven, driven forces, moments, moving frames,
 !> driven constraints, material damping, a family without a discrete gradient) is refused
 !> with info = em_unsupported (Python refuses such scenes before they reach the kernel).
@@ -43,6 +49,18 @@ module energy_momentum
 
   !> integrator_chunk's info of a model the energy-momentum stepper does not support
   integer, parameter, public :: em_unsupported = 14
+  !> a step's Jacobian is kept while each correction is at most this times the one before
+  !> (simplified Newton); a correction that contracts less refreshes it at the iterate
+  real(dp), parameter :: keep_contraction = 0.25_dp
+
+  !> The factors of a step's bordered Jacobian (factor_bordered): banded (A's band LU, Y =
+  !> A^{-1} B, C, the Schur complement's LU) or dense (the whole LU).
+  type :: bordered_factors
+    logical :: banded = .false.
+    integer :: kl = 0, ku = 0
+    real(dp), allocatable :: band(:, :), y(:, :), c(:, :), schur(:, :), dense(:, :)
+    integer, allocatable :: ipiv(:), schur_ipiv(:)
+  end type bordered_factors
 
 contains
 
@@ -220,6 +238,83 @@ contains
     end if
   end subroutine midpoint_residual
 
+  !> Factorizes the bordered matrix [A B; C 0] of jacobian ((n + m)^2, A: n x n) into
+  !> factors. Where A's band (half-bandwidths kl, ku of its nonzeros) makes LAPACK's banded LU
+  !> cheaper than a dense one: A = LU by dgbtrf, Y = A^{-1} B and the LU factors of the
+  !> multipliers' Schur complement C Y (m x m, dense); otherwise the dense LU of the whole
+  !> (dgetrf). info: LAPACK's (0: factorized).
+  subroutine factor_bordered(n, m, jacobian, factors, info)
+    integer, intent(in) :: n, m
+    real(dp), intent(in) :: jacobian(:, :)
+    type(bordered_factors), intent(inout) :: factors
+    integer, intent(out) :: info
+    integer :: i, j, kl, ku, rows
+    kl = 0
+    ku = 0
+    do j = 1, n
+      do i = 1, n
+        if (jacobian(i, j) == 0.0_dp) cycle
+        kl = max(kl, i - j)
+        ku = max(ku, j - i)
+      end do
+    end do
+    rows = 2 * kl + ku + 1
+    factors%banded = rows * (kl + ku + 1) < n * n / 3
+    if (.not. factors%banded) then
+      factors%dense = jacobian(1:n + m, 1:n + m)
+      if (allocated(factors%ipiv)) deallocate (factors%ipiv)
+      allocate (factors%ipiv(n + m))
+      call dgetrf(n + m, n + m, factors%dense, n + m, factors%ipiv, info)
+      return
+    end if
+    factors%kl = kl
+    factors%ku = ku
+    if (allocated(factors%band)) deallocate (factors%band)
+    if (allocated(factors%ipiv)) deallocate (factors%ipiv)
+    allocate (factors%band(rows, n), factors%ipiv(n))
+    factors%band = 0.0_dp
+    do j = 1, n
+      do i = max(1, j - ku), min(n, j + kl)
+        factors%band(kl + ku + 1 + i - j, j) = jacobian(i, j)
+      end do
+    end do
+    call dgbtrf(n, n, kl, ku, factors%band, rows, factors%ipiv, info)
+    if (info /= 0 .or. m == 0) return
+    factors%y = jacobian(1:n, n + 1:n + m)
+    call dgbtrs('N', n, kl, ku, m, factors%band, rows, factors%ipiv, factors%y, n, info)
+    if (info /= 0) return
+    factors%c = jacobian(n + 1:n + m, 1:n)
+    factors%schur = matmul(factors%c, factors%y)
+    if (allocated(factors%schur_ipiv)) deallocate (factors%schur_ipiv)
+    allocate (factors%schur_ipiv(m))
+    call dgetrf(m, m, factors%schur, m, factors%schur_ipiv, info)
+  end subroutine factor_bordered
+
+  !> Solves [A B; C 0] x = rhs with factor_bordered's factors (rhs overwritten by x): the
+  !> dense LU's, or z = A^{-1} rhs_1, x_2 = (C Y)^{-1} (C z - rhs_2), x_1 = z - Y x_2.
+  subroutine solve_bordered(n, m, factors, rhs)
+    integer, intent(in) :: n, m
+    type(bordered_factors), intent(in) :: factors
+    real(dp), intent(inout) :: rhs(:)
+    real(dp) :: z(n, 1), x2(m, 1)
+    integer :: info
+    if (.not. factors%banded) then
+      call dgetrs('N', n + m, 1, factors%dense, n + m, factors%ipiv, rhs, n + m, info)
+      return
+    end if
+    z(:, 1) = rhs(1:n)
+    call dgbtrs('N', n, factors%kl, factors%ku, 1, factors%band, size(factors%band, 1), &
+                factors%ipiv, z, n, info)
+    if (m == 0) then
+      rhs(1:n) = z(:, 1)
+      return
+    end if
+    x2(:, 1) = matmul(factors%c, z(:, 1)) - rhs(n + 1:n + m)
+    call dgetrs('N', m, 1, factors%schur, m, factors%schur_ipiv, x2, m, info)
+    rhs(n + 1:n + m) = x2(:, 1)
+    rhs(1:n) = z(:, 1) - matmul(factors%y, x2(:, 1))
+  end subroutine solve_bordered
+
   !> jacobian(1:ndof, 1:ndof) += B^T K B over an element's full dofs (q = B e + q0).
   pure subroutine add_reduced(sys, dofs, tangent, jacobian)
     type(system_model), intent(in) :: sys
@@ -290,11 +385,11 @@ contains
 
   !> nsteps energy-momentum steps of size h from (t, e, e' = v, lambda), in the form and with
   !> the outputs of time_integrator's integrator_chunk (whose arguments these are): a and
-  !> e'' both take the step's mean acceleration (v1 - v0) / h. Each step is full Newton from
-  !> the predictor e1 = e0 + h v0 + h^2/2 e''_0 until a correction max |de| <= tol *
-  !> length_scale. info: 1 Newton did not converge (detail 0: the iteration limit);
-  !> 2 non-finite state; 3 the dense solve failed (detail: dgesv's info); em_unsupported;
-  !> 5, 7 (midpoint_residual).
+  !> e'' both take the step's mean acceleration (v1 - v0) / h. Each step iterates from the
+  !> predictor e1 = e0 + h v0 + h^2/2 e''_0 (the Jacobian kept or refreshed: module header)
+  !> until a correction max |de| <= tol * length_scale. info: 1 Newton did not converge
+  !> (detail 0: the iteration limit); 2 non-finite state; 3 the factorization failed
+  !> (detail: LAPACK's info); em_unsupported; 5, 7 (midpoint_residual).
   subroutine energy_momentum_chunk(sys, cfg, h, nsteps, t, e, v, a, accel, lam, work, powers, &
                                    state, out_time, out_probe, out_deflection, out_lambda, &
                                    out_energy, out_constraint, out_stats, out_contact, store_q, &
@@ -316,12 +411,13 @@ contains
     real(dp), intent(out) :: last_correction
     real(dp), allocatable :: mass(:, :), jacobian(:, :), residual(:), internal(:), full(:)
     real(dp), allocatable :: phi(:), gradients(:, :)
-    integer, allocatable :: ipiv(:)
     real(dp) :: e1(sys%ndof), lam1(sys%ncon), v1(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain, contact_potential
     integer :: n, m, step, it, lapack_info
-    logical :: done
+    logical :: done, refresh
+    real(dp) :: previous
+    type(bordered_factors) :: factors
     n = sys%ndof
     m = sys%ncon
     info = 0
@@ -333,7 +429,7 @@ contains
       info = em_unsupported
       return
     end if
-    allocate (mass(n, n), jacobian(n + m, n + m), residual(n + m), internal(n), ipiv(n + m), &
+    allocate (mass(n, n), jacobian(n + m, n + m), residual(n + m), internal(n), &
               full(sys%nfull), phi(m), gradients(6, m))
     call dense_mass(sys, mass)
     do step = 1, nsteps
@@ -342,18 +438,28 @@ contains
       e1 = e + h * v + 0.5_dp * h * h * accel
       lam1 = lam
       done = .false.
+      refresh = .true.
+      previous = huge(1.0_dp)
       do it = 1, cfg%max_newton
-        call midpoint_residual(sys, h, t, e, v, e1, lam1, residual, internal, info, mass, &
-                               jacobian)
-        if (info /= 0) return
-        residual = -residual
-        call dgesv(n + m, 1, jacobian, n + m, ipiv, residual, n + m, lapack_info)
-        out_stats(1:3, step) = out_stats(1:3, step) + 1
-        if (lapack_info /= 0) then
-          info = 3
-          detail = lapack_info
-          return
+        if (refresh) then
+          call midpoint_residual(sys, h, t, e, v, e1, lam1, residual, internal, info, mass, &
+                                 jacobian)
+          if (info /= 0) return
+          call factor_bordered(n, m, jacobian, factors, lapack_info)
+          out_stats(2:3, step) = out_stats(2:3, step) + 1
+          if (lapack_info /= 0) then
+            info = 3
+            detail = lapack_info
+            return
+          end if
+          refresh = .false.
+        else
+          call midpoint_residual(sys, h, t, e, v, e1, lam1, residual, internal, info)
+          if (info /= 0) return
         end if
+        residual = -residual
+        call solve_bordered(n, m, factors, residual)
+        out_stats(1, step) = out_stats(1, step) + 1
         if (.not. all(abs(residual) < huge(1.0_dp))) then
           info = 2
           return
@@ -365,6 +471,8 @@ contains
           done = .true.
           exit
         end if
+        refresh = last_correction > keep_contraction * previous
+        previous = last_correction
       end do
       if (.not. done) then
         info = 1
