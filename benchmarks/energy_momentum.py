@@ -12,9 +12,11 @@ energy-momentum run at the finest step (ref_dt); the same step with generalized-
 rho_inf 0.8 is reported beside it (reference_spread: how far the two references lie apart,
 the reference's own uncertainty).
 
-Writes results/energy_momentum.json (or --output). --quick: coarser meshes, shorter runs.
+Writes results/energy_momentum.json (or --output) and, with --charts DIR, one chart a case
+of the probe's largest error against the run's wall time (DIR/energy_momentum_<case>.png;
+the runs that ended 'ok', labelled by their step). --quick: coarser meshes, shorter runs.
 Usage: python benchmarks/energy_momentum.py [--quick] [--only pendulum,rope,double]
-                                            [--output JSON]
+                                            [--output JSON] [--charts DIR]
 """
 from __future__ import annotations
 
@@ -143,6 +145,7 @@ def main() -> None:
     parser.add_argument("--only", default="pendulum,rope,double")
     parser.add_argument("--output", type=Path,
                         default=HERE / "results" / "energy_momentum.json")
+    parser.add_argument("--charts", type=Path, default=None)
     args = parser.parse_args()
     report: dict = {"machine": machine_info(), "quick": args.quick, "cases": {}}
     print("| case | method | dt | status | max error (m) | energy drift | ms/step | "
@@ -183,6 +186,26 @@ def main() -> None:
     args.output.parent.mkdir(parents=True, exist_ok=True)
     args.output.write_text(json.dumps(json_ready(report), indent=1))
     print(f"written {args.output}")
+    if args.charts is not None:
+        draw(report, args.charts)
+
+
+def draw(report: dict, folder: Path) -> None:
+    """The accuracy-against-time chart of each case (the runs that ended 'ok')."""
+    from ancfdrv.plots import pareto_chart
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, case in report["cases"].items():
+        rows = [r for r in case["runs"] if r["status"] == "ok" and r.get("max_error_m")]
+        if not rows:
+            continue
+        path = folder / f"energy_momentum_{name}.png"
+        pareto_chart(rows, lambda r: r["method"], lambda r: f"{r['dt']:g}", "max_error_m",
+                     path, time_key="wall_s", common_reference=True,
+                     title=f"{name}, {case['t_end']:g} s: the probe's largest error against "
+                           "the energy-momentum run at dt = "
+                           f"{case['reference']['dt']:g}\nvs wall time (labels: dt; "
+                           "runs that ended 'ok')")
+        print(f"written {path}")
 
 
 if __name__ == "__main__":
