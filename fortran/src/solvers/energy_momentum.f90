@@ -51,7 +51,7 @@ module energy_momentum
   integer, parameter, public :: em_unsupported = 14
   !> a step's Jacobian is kept while each correction is at most this times the one before
   !> (simplified Newton); a correction that contracts less refreshes it at the iterate
-  real(dp), parameter :: keep_contraction = 0.25_dp
+  real(dp), parameter :: keep_contraction = 0.1_dp
 
   !> The factors of a step's bordered Jacobian (factor_bordered): banded (A's band LU, Y =
   !> A^{-1} B, C, the Schur complement's LU) or dense (the whole LU).
