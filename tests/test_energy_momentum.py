@@ -246,3 +246,31 @@ def test_unsupported_scenes_are_refused_before_the_run(tmp_path, capsys, overrid
         assert word in err, err
     assert "&solver" in err
     assert not out.exists()
+
+
+def test_kernel_refuses_adaptive_steps_and_unsupported_models():
+    """Past the scene's validation (the Python API's DynamicSettings), the kernel itself
+    refuses: adaptive steps at the stepper's set-up (code 2), and a model with material
+    damping at the first step, its message naming the integrator."""
+    from ancfdrv.errors import SolverError
+    model = beam_model(nodes=2, formulation="nonlinear")
+    try:
+        settings = DynamicSettings(dt=1e-3, t_end=2e-3, integrator="energy_momentum",
+                                   step="adaptive")
+        with pytest.raises(SolverError, match="energy-momentum method takes fixed steps"):
+            integrate(model, settings, model.e0, progress=False)
+        assert model.kernel.energy_momentum_obstacle() == ""
+    finally:
+        model.close()
+    s = System("damped beam", effects=("damping",))
+    s.material("steel", youngs_modulus=2.1e11, density=7850.0, damping_time=1e-3)
+    s.beam("beam", material="steel", start=(0, 0, 0), end=(1, 0, 0), nodes=2,
+           section=Rectangle(0.02, 0.02), formulation="nonlinear")
+    damped = s.assemble(effects=("damping",))
+    try:
+        assert "material damping" in damped.kernel.energy_momentum_obstacle()
+        settings = DynamicSettings(dt=1e-3, t_end=2e-3, integrator="energy_momentum")
+        with pytest.raises(SolverError, match="energy-momentum integrator does not support"):
+            integrate(damped, settings, damped.e0, progress=False)
+    finally:
+        damped.close()

@@ -103,6 +103,12 @@ subroutine system_stepper_setup(handle, method, beta, gamma, alpha_m, alpha_f, t
               '(dt > 0, dt_min >= 0, tolerance > 0)'
     return
   end if
+  if (method == method_energy_momentum .and. control(sk_adaptive) /= 0.0_dp) then
+    info = 2
+    message = 'system_stepper_setup: the energy-momentum method takes fixed steps ' // &
+              '(no adaptive step control)'
+    return
+  end if
   call stepper_start(run, stepper_settings(method=method, beta=beta, gamma=gamma, &
                                            alpha_m=alpha_m, &
                                            alpha_f=alpha_f, tol=tol, &
@@ -1464,6 +1470,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   use stepper, only: stepper_run, state_size, row_size
   use row_answers, only: answer_count
   use time_integrator, only: stat_count, step_failure_text
+  use energy_momentum, only: em_unsupported
   use step_control, only: stepper_point, controlled_rows, control_failure
   use api_support, only: api_system, as_rows, as_info, as_detail, as_floor_accepts, as_tries, &
                          as_failure_cuts, as_failure_tries, as_failed_corrections, &
@@ -1536,7 +1543,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
                        figures(af_last_correction), status(as_floor_accepts), failure)
   if (status(as_info) /= 0) then
     message = failure%text
-    if (status(as_info) <= 10) &
+    if (status(as_info) <= 10 .or. status(as_info) == em_unsupported) &
       message = step_failure_text(status(as_info), status(as_detail), run%settings%max_newton)
     figures(af_failure_t) = failure%t
     figures(af_failure_h) = failure%h

@@ -68,10 +68,6 @@ class DynamicSettings:
 
     dt: float
     t_end: float
-    #: 'newmark' and 'generalized_alpha' (the kernel's alpha method with the parameters
-    #: below) or 'energy_momentum' (the midpoint rule with a discrete gradient:
-    #: ``fortran/src/solvers/energy_momentum.f90``; beta, gamma and the alphas unused)
-    integrator: str = "newmark"
     beta: float = 0.25
     gamma: float = 0.5
     alpha_m: float = 0.0
@@ -99,6 +95,10 @@ class DynamicSettings:
     #: row_answers.f90``: the force elements' reactions, the residual at the eliminated
     #: joints' coordinates) for :class:`~ancfdrv.system.answers.DynamicAnswers`
     answers: bool = False
+    #: 'newmark' and 'generalized_alpha' (the kernel's alpha method with beta, gamma
+    #: and the alphas) or 'energy_momentum' (the midpoint rule with a discrete gradient:
+    #: ``fortran/src/solvers/energy_momentum.f90``; beta, gamma and the alphas unused)
+    integrator: str = "newmark"
 
     @property
     def smallest_step(self) -> float:
