@@ -7,8 +7,9 @@ item 4): the midpoint rule with a discrete gradient of the strain energy.
   f_dg(e, e) = W'(e);
 - the Jacobian of the step's residual (with a pin's multipliers) against central
   differences;
-- the undamped, undriven flexible pendulum and a payload on a rope (and on a cable) keep their total energy
-  to 1e-6 of its scale at every step size;
+- the kernel's own refusals (adaptive steps, an unsupported model) past the validation;
+- the undamped, undriven flexible pendulum and a payload on a rope (and on a cable) keep
+  their total energy to 1e-6 of its scale at every step size;
 - a free, spinning and vibrating beam keeps its energy, momentum and angular momentum;
 - scenes it does not support are refused before the run (exit 2, naming the key and the
   item).

@@ -1029,8 +1029,9 @@ class KernelSystem:
         matrix factorized at another state, the step-size control's state) is forgotten: a
         run from a new initial state is reproducible."""
         info, message = _kernel.system_stepper_setup(
-            self.handle, int(settings.integrator == "energy_momentum"), settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f,
-            settings.tol, settings.length_scale, settings.max_newton, settings.jacobian_code,
+            self.handle, int(settings.integrator == "energy_momentum"), settings.beta,
+            settings.gamma, settings.alpha_m, settings.alpha_f, settings.tol,
+            settings.length_scale, settings.max_newton, settings.jacobian_code,
             settings.contraction,
             _pack("sk", dt=settings.dt, dt_min=settings.dt_min,
                   adaptive=float(settings.step == "adaptive"), tolerance=settings.tolerance))
