@@ -480,9 +480,9 @@ contains
   !>   |dI|^2 (the correction left out where |dI| <= gonzalez_floor |I_m|: its size there,
   !>   O(|dI|^3), is below the round-off of w).
   !> The invariants are unchanged by rigid motions, so the force conserves momentum and
-  !> angular momentum. The Jacobian df/dq1 (want_tangent) is exact but for the cable's
-  !> correction c (its derivative is left out; the residual stays exact). info = 2: a slope
-  !> vanished (the cable's curvature is undefined).
+  !> angular momentum. The Jacobian df/dq1 (want_tangent) is exact, the derivative of the
+  !> cable's correction c included. info = 2: a slope vanished (the cable's curvature is
+  !> undefined).
   pure subroutine cable_midpoint_force(q0, q1, length, rule, axial_stiffness, &
                                        bending_stiffness, rope, want_tangent, force, tangent, info)
     real(dp), intent(in) :: q0(3, 4), q1(3, 4), length, axial_stiffness, bending_stiffness
@@ -494,7 +494,7 @@ contains
     real(dp) :: slope(4), second(4), weight, a0(3), b0(3), a1(3), b1(3), am(3), bm(3)
     real(dp) :: inv0(3), inv1(3), invm(3), delta(3), sigma(3), dsigma(3, 3)
     real(dp) :: x0, x1, w0, w1, w_mid, grad(3), hess(3, 3), grad_end(3), hess_end(3, 3)
-    real(dp) :: correction
+    real(dp) :: correction, dcorrection(3)
     real(dp) :: grad_a(3), grad_b(3), hessian(6, 6), p_mid(3, 6), p_end(3, 6), identity(3, 3)
     integer :: p, i
     info = 0
@@ -552,6 +552,14 @@ contains
           call curvature_energy(inv1, bending_stiffness, w1, grad_end, hess_end)
           correction = (w1 - w0 - dot_product(grad, delta)) / dot_product(delta, delta)
           sigma = sigma + correction * delta
+          ! d(c dI)/dI1 = dI (dc/dI1)^T + c I, dc/dI1 = (grad w(I1) - grad w(I_m)
+          ! - H(I_m) dI / 2 - 2 c dI) / |dI|^2
+          dcorrection = (grad_end - grad - 0.5_dp * matmul(hess, delta) &
+                         - 2.0_dp * correction * delta) / dot_product(delta, delta)
+          do i = 1, 3
+            dsigma(:, i) = dsigma(:, i) + delta * dcorrection(i)
+            dsigma(i, i) = dsigma(i, i) + correction
+          end do
         end if
       end if
       ! f_p = P(q_m)^T sigma, P's rows the invariants' gradients in (a, b)

@@ -12,8 +12,7 @@
 !> Hence with Phi(e0) = 0 the total energy K + W - Q.e of each step is that of the step before
 !> to the Newton tolerance, whatever h; and since f_dg, the loads' resultant moment aside, is
 !> made of invariants of rigid motion, momentum and angular momentum are conserved too.
-!> Newton with the exact Jacobian of this residual (the beam's and the rope's exact; the
-!> cable's curvature without the derivative of Gonzalez's correction), assembled dense:
+!> Newton with the exact Jacobian of this residual, assembled dense:
 !>   [ 2/h^2 M + df_dg/de1 - d(Phi_e(e_m)^T lambda)/de1   -Phi_e(e_m)^T ]
 !>   [ Phi_e(e1)                                           0            ],
 !> factorized through the Schur complement of the multipliers with a banded LU of its first
