@@ -245,23 +245,28 @@ def test_free_spinning_beam_keeps_energy_momentum_and_angular_momentum():
         model.close()
 
 
-@pytest.mark.parametrize("override,words", [
-    (["material.damping_time=1e-3", "scene.effects=gravity,damping"],
-     ["solver.integrator", "'energy_momentum'", "material damping"]),
-    (["solver.step=adaptive"], ["solver.integrator", "'energy_momentum'", "fixed steps"]),
-    (["scene.formulation=ffr"], ["solver.integrator", "'energy_momentum'", "(FFR)"]),
+@pytest.mark.parametrize("scene,override,words", [
+    (PENDULUM, ["material.damping_time=1e-3", "scene.effects=gravity,damping"],
+     ["material damping"]),
+    (PENDULUM, ["solver.step=adaptive"], ["fixed steps"]),
+    (PENDULUM, ["scene.formulation=ffr"], ["(FFR)"]),
+    (PENDULUM, ["beam.bending=cubic"], ["'cubic' beam"]),
+    (INPUTS / "hard" / "spinup.nml", [], ["a driven (moving) frame"]),
 ])
-def test_unsupported_scenes_are_refused_before_the_run(tmp_path, capsys, override, words):
-    """Damping, adaptive steps and a floating-frame beam with 'energy_momentum': exit 2
-    before anything is written, the message naming the scene's &solver key and the item."""
+def test_unsupported_scenes_are_refused_before_the_run(tmp_path, capsys, scene, override,
+                                                       words):
+    """Damping, adaptive steps, a floating-frame beam, the 'cubic' beam and the spin-up's
+    driven hub with 'energy_momentum': exit 2 before anything is written, the message naming
+    the scene's &solver key, the integrator and the item."""
     out = tmp_path / "refused.h5"
-    argv = ["run", str(PENDULUM), "-o", str(out), "--set", "beam.nodes=3", "--set",
-            "solver.integrator=energy_momentum"]
+    argv = ["run", str(scene), "-o", str(out), "--set", "solver.integrator=energy_momentum"]
+    if scene == PENDULUM:
+        argv += ["--set", "beam.nodes=3"]
     for item in override:
         argv += ["--set", item]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    for word in words:
+    for word in ["solver.integrator", "'energy_momentum'", *words]:
         assert word in err, err
     assert "&solver" in err
     assert not out.exists()
