@@ -984,6 +984,31 @@ class KernelSystem:
             self._failure(info, "full force evaluation", message)
         return full
 
+    def energy_momentum_obstacle(self) -> str:
+        """What of the model the energy-momentum stepper does not support ('' when it
+        supports it): the kernel's own list (``fortran/src/solvers/energy_momentum.f90``)."""
+        obstacle, info, message = _kernel.system_energy_momentum_check(self.handle)
+        self._check(info, "energy_momentum_check", message)
+        if isinstance(obstacle, bytes):
+            obstacle = obstacle.decode("ascii", "replace")
+        return str(obstacle).strip()
+
+    def midpoint_residual(self, h: float, t: float, e0, v0, e1, lam,
+                          want_jacobian: bool = False) -> dict:
+        """The residual of one energy-momentum step (``fortran/src/solvers/
+        energy_momentum.f90``) from (e0, v0) at t with step h, at (e1, lam): ``residual``
+        (ndof + ncon), the reduced discrete-gradient force ``internal`` (ndof) and, on
+        request, the ``jacobian`` in (e1, lam)."""
+        ncon = len(lam)
+        residual, internal, jacobian, info, message = _kernel.system_midpoint_residual(
+            self.handle, ncon, h, t, np.asfortranarray(np.column_stack([e0, v0, e1]),
+                                                       dtype=float),
+            _f(lam) if ncon else np.zeros(1), int(want_jacobian), ndof=self.ndof)
+        if info:
+            self._failure(info, "midpoint residual", message)
+        return dict(residual=residual, internal=internal,
+                    jacobian=jacobian if want_jacobian else None)
+
     def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
         cut = self._layout(False)[1]
         out = _kernel.system_output_row(
@@ -1031,8 +1056,9 @@ class KernelSystem:
         matrix factorized at another state, the step-size control's state) is forgotten: a
         run from a new initial state is reproducible."""
         info, message = _kernel.system_stepper_setup(
-            self.handle, settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f,
-            settings.tol, settings.length_scale, settings.max_newton, settings.jacobian_code,
+            self.handle, int(settings.integrator == "energy_momentum"), settings.beta,
+            settings.gamma, settings.alpha_m, settings.alpha_f, settings.tol,
+            settings.length_scale, settings.max_newton, settings.jacobian_code,
             settings.contraction,
             _pack("sk", dt=settings.dt, dt_min=settings.dt_min,
                   adaptive=float(settings.step == "adaptive"), tolerance=settings.tolerance))

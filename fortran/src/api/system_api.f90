@@ -53,7 +53,8 @@ subroutine system_destroy(handle, info, message)
 end subroutine system_destroy
 
 !> Starts a run of the stepper (stepper.f90) with its settings, set once per run: the
-!> method's beta, gamma, alpha_m, alpha_f (Newmark: alpha_m = alpha_f = 0), the Newton
+!> method (0 generalized-alpha, 1 energy-momentum: energy_momentum.f90), the alpha method's
+!> beta, gamma, alpha_m, alpha_f (Newmark: alpha_m = alpha_f = 0), the Newton
 !> tolerance (max |de| <= tol * length_scale) and iteration limit, the Jacobian policy
 !> (1 per step, 2 per iteration, 3 reused across steps), the reuse policy's contraction
 !> limit and the step-size control (control(sk_*): the output grid's dt, dt_min (0: dt /
@@ -62,15 +63,16 @@ end subroutine system_destroy
 !> factorized at another state, except the constant policy's, which depends on the step
 !> alone): a run from a new initial state then gives the same result on any handle.
 !> info: 1 not a live handle; 2 a setting out of its range.
-subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, length_scale, &
-                                max_newton, jacobian, contraction, control, info, message)
+subroutine system_stepper_setup(handle, method, beta, gamma, alpha_m, alpha_f, tol, &
+                                length_scale, max_newton, jacobian, contraction, control, info, &
+                                message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, policy_constant, plane_mass_setup
   use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, &
-                     jacobian_reuse, control_settings
+                     jacobian_reuse, control_settings, method_alpha, method_energy_momentum
   use api_support, only: api_system, sk_dt, sk_dt_min, sk_adaptive, sk_tolerance
   implicit none
-  integer, intent(in) :: handle, max_newton, jacobian
+  integer, intent(in) :: handle, method, max_newton, jacobian
   real(dp), intent(in) :: beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
   real(dp), intent(in) :: control(4)
   integer, intent(out) :: info
@@ -87,9 +89,11 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
               'length_scale > 0; alpha_m, alpha_f < 1; 0 < contraction < 1)'
     return
   end if
-  if (max_newton < 1 .or. jacobian < jacobian_step .or. jacobian > jacobian_reuse) then
+  if (max_newton < 1 .or. jacobian < jacobian_step .or. jacobian > jacobian_reuse .or. &
+      (method /= method_alpha .and. method /= method_energy_momentum)) then
     info = 2
-    message = 'system_stepper_setup: max_newton < 1 or a Jacobian policy outside 1..3'
+    message = 'system_stepper_setup: max_newton < 1, a Jacobian policy outside 1..3 or ' // &
+              'a method outside 0..1'
     return
   end if
   if (.not. (control(sk_dt) > 0.0_dp .and. control(sk_dt_min) >= 0.0_dp .and. &
@@ -99,7 +103,14 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
               '(dt > 0, dt_min >= 0, tolerance > 0)'
     return
   end if
-  call stepper_start(run, stepper_settings(beta=beta, gamma=gamma, alpha_m=alpha_m, &
+  if (method == method_energy_momentum .and. control(sk_adaptive) /= 0.0_dp) then
+    info = 2
+    message = 'system_stepper_setup: the energy-momentum method takes fixed steps ' // &
+              '(no adaptive step control)'
+    return
+  end if
+  call stepper_start(run, stepper_settings(method=method, beta=beta, gamma=gamma, &
+                                           alpha_m=alpha_m, &
                                            alpha_f=alpha_f, tol=tol, &
                                            length_scale=length_scale, &
                                            max_newton=max_newton, jacobian=jacobian, &
@@ -1220,6 +1231,70 @@ subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor,
   if (info /= 0) message = failure_text(info)
 end subroutine system_full_forces
 
+!> What of the system the energy-momentum stepper (energy_momentum.f90) does not support,
+!> named in obstacle ('' when it supports the system): the run's validation refuses such a
+!> scene before anything is computed. info: 1 not a live handle.
+subroutine system_energy_momentum_check(handle, obstacle, info, message)
+  use mechanical_system, only: system_model
+  use energy_momentum, only: energy_momentum_obstacle
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle
+  character(len=200), intent(out) :: obstacle
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  obstacle = ''
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  obstacle = energy_momentum_obstacle(sys)
+end subroutine system_energy_momentum_check
+
+!> The residual of one energy-momentum step (energy_momentum.f90's midpoint_residual) from
+!> (e0, v0) = states(:, 1:2) at t with step h, at e1 = states(:, 3) and the multipliers lam:
+!> residual (ndof + ncon), the reduced discrete-gradient force alone (internal) and, with
+!> want_jacobian /= 0, the residual's Jacobian in (e1, lambda). For the tests of the
+!> discrete gradient and of its Jacobian. info: 2 sizes; the stepper's codes (14: the model
+!> is not supported).
+subroutine system_midpoint_residual(handle, ndof, ncon, h, t, states, lam, want_jacobian, &
+                                    residual, internal, jacobian, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use energy_momentum, only: midpoint_residual, dense_mass
+  use time_integrator, only: step_failure_text
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle, ndof, ncon, want_jacobian
+  real(dp), intent(in) :: h, t, states(ndof, 3), lam(max(1, ncon))
+  real(dp), intent(out) :: residual(ndof + ncon), internal(ndof)
+  real(dp), intent(out) :: jacobian(ndof + ncon, ndof + ncon)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  real(dp), allocatable :: mass(:, :)
+  residual = 0.0_dp
+  internal = 0.0_dp
+  jacobian = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. .not. h > 0.0_dp) then
+    info = 2
+    message = 'system_midpoint_residual: sizes inconsistent with the system (ndof, ncon) ' // &
+              'or h <= 0'
+    return
+  end if
+  if (want_jacobian /= 0) then
+    allocate (mass(ndof, ndof))
+    call dense_mass(sys, mass)
+    call midpoint_residual(sys, h, t, states(:, 1), states(:, 2), states(:, 3), lam(1:ncon), &
+                           residual, internal, info, mass, jacobian)
+  else
+    call midpoint_residual(sys, h, t, states(:, 1), states(:, 2), states(:, 3), lam(1:ncon), &
+                           residual, internal, info)
+  end if
+  if (info /= 0) message = step_failure_text(info, 0, 0)
+end subroutine system_midpoint_residual
+
 !> One output row of the state (t, e, e', lambda) with the accumulated works, in the layout
 !> of a row of system_advance without q (stepper.f90 row_size: time, probes, deflections,
 !> lambda, energies, constraint violation, contact records); state(:, sv_coordinates) = e,
@@ -1395,6 +1470,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   use stepper, only: stepper_run, state_size, row_size
   use row_answers, only: answer_count
   use time_integrator, only: stat_count, step_failure_text
+  use energy_momentum, only: em_unsupported
   use step_control, only: stepper_point, controlled_rows, control_failure
   use api_support, only: api_system, as_rows, as_info, as_detail, as_floor_accepts, as_tries, &
                          as_failure_cuts, as_failure_tries, as_failed_corrections, &
@@ -1467,7 +1543,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
                        figures(af_last_correction), status(as_floor_accepts), failure)
   if (status(as_info) /= 0) then
     message = failure%text
-    if (status(as_info) <= 10) &
+    if (status(as_info) <= 10 .or. status(as_info) == em_unsupported) &
       message = step_failure_text(status(as_info), status(as_detail), run%settings%max_newton)
     figures(af_failure_t) = failure%t
     figures(af_failure_h) = failure%h

@@ -18,6 +18,9 @@ module stepper
   public :: stepper_settings, stepper_state, stepper_run, stepper_start, update_reuse_backoff, &
             state_size, row_size, control_settings, control_state
 
+  !> the stepping method: generalized-alpha (Newmark its special case; time_integrator) or
+  !> the energy-momentum midpoint rule (energy_momentum)
+  integer, parameter, public :: method_alpha = 0, method_energy_momentum = 1
   !> when a refactorized system's iteration matrix is refreshed (time_integrator)
   integer, parameter, public :: jacobian_step = 1, jacobian_iteration = 2, jacobian_reuse = 3
   !> the most steps jacobian_reuse starts with a fresh matrix before trying an old one again
@@ -30,11 +33,13 @@ module stepper
   !> the steps whose measured contraction jacobian_reuse's bound remembers (their largest)
   integer, parameter, public :: contraction_memory = 16
 
-  !> The settings of a run: the method's parameters (Newmark: alpha_m = alpha_f = 0), the
+  !> The settings of a run: the method (method_alpha, method_energy_momentum), the
+  !> generalized-alpha parameters (Newmark: alpha_m = alpha_f = 0), the
   !> Newton tolerance (max |de| <= tol * length_scale), the iteration limit, the Jacobian
   !> policy and jacobian_reuse's limit on the ratio of successive corrections. The step h
   !> is not a setting: each chunk gives its own (step control cuts and grows it).
   type :: stepper_settings
+    integer :: method = method_alpha
     real(dp) :: beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
     real(dp) :: tol = 1e-10_dp, length_scale = 1.0_dp
     integer :: max_newton = 10

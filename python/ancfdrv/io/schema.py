@@ -307,8 +307,14 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "splitting parameter p of K_RR = K_RR1 + K_RR2, in [0, 1)"),
         "dt": Key("float", 1e-3, positive, "time step (s), dynamic analyses"),
         "t_end": Key("float", 10.0, non_negative, "end time (s), dynamic analyses"),
-        "integrator": Key("str", "newmark", one_of("newmark", "generalized_alpha"),
-                          "time integrator"),
+        "integrator": Key("str", "newmark", one_of("newmark", "generalized_alpha",
+                                                   "energy_momentum"),
+                          "time integrator: 'newmark', 'generalized_alpha' (rho_inf), or "
+                          "'energy_momentum' (the midpoint rule with a discrete gradient of "
+                          "the strain energy: conserves the energy of an undamped, undriven "
+                          "system to the Newton tolerance at any step, and its momenta; "
+                          "nonlinear beams, cables, ropes, masses, gravity, pins and revolute "
+                          "joints only, fixed steps; docs/theory.md)"),
         "rho_inf": Key("float", 0.9, within(0.0, 1.0),
                        "generalized-alpha: spectral radius at infinite frequency (1: no "
                        "numerical damping)"),

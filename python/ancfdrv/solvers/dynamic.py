@@ -95,6 +95,10 @@ class DynamicSettings:
     #: row_answers.f90``: the force elements' reactions, the residual at the eliminated
     #: joints' coordinates) for :class:`~ancfdrv.system.answers.DynamicAnswers`
     answers: bool = False
+    #: 'newmark' and 'generalized_alpha' (the kernel's alpha method with beta, gamma
+    #: and the alphas) or 'energy_momentum' (the midpoint rule with a discrete gradient:
+    #: ``fortran/src/solvers/energy_momentum.f90``; beta, gamma and the alphas unused)
+    integrator: str = "newmark"
 
     @property
     def smallest_step(self) -> float:
@@ -114,8 +118,9 @@ class DynamicSettings:
         alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
         alpha_f = rho_inf / (rho_inf + 1.0)
         gamma = 0.5 - alpha_m + alpha_f
-        return cls(dt=dt, t_end=t_end, beta=0.25 * (gamma + 0.5) ** 2, gamma=gamma,
-                   alpha_m=alpha_m, alpha_f=alpha_f, **kwargs)
+        return cls(dt=dt, t_end=t_end, integrator="generalized_alpha",
+                   beta=0.25 * (gamma + 0.5) ** 2, gamma=gamma, alpha_m=alpha_m,
+                   alpha_f=alpha_f, **kwargs)
 
     @property
     def beta_prime(self) -> float:
