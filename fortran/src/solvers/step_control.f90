@@ -327,8 +327,8 @@ contains
     call block_reset(run%control)
   end subroutine restart
 
-  !> After a restart on the oscillation (the module's notes): the contraction learned before the jump in
-  !> e'' is forgotten, so the next step is accepted on its own measured contraction.
+  !> After a restart on the oscillation (the module's notes): the contraction learned before
+  !> the jump in e'' is forgotten, so the next step is accepted on its own measured one.
   pure subroutine relearn(run)
     type(stepper_run), intent(inout) :: run
     run%state%theta = -1.0_dp
