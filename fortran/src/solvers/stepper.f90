@@ -124,6 +124,14 @@ module stepper
     integer :: rows = 0
     real(dp) :: t0 = 0.0_dp
     real(dp), allocatable :: restart_guesses(:, :)
+    ! the block of whole steps in progress of a method without numerical damping on a
+    ! constrained system (step_control's neutral_method): its steps so far, the largest
+    ! period-2 part of the multipliers and the largest |lambda| in it, and its last two
+    ! rows' multipliers (how many are held): carried from call to call, so the chunk sizes
+    ! do not change the run; the quietest full block's period-2 part of the run (huge: none)
+    integer :: block_steps = 0, block_held = 0
+    real(dp) :: block_swing = 0.0_dp, block_peak = 0.0_dp, quiet_swing = huge(1.0_dp)
+    real(dp), allocatable :: block_lambda(:, :)
   end type control_state
 
   !> A system's stepper: its run's settings, its learned state, its step-size control,
