@@ -76,6 +76,9 @@ BENCHES = [
     Bench("stability", "long-run stability suite: completion, step cuts, energy balance",
           out=None, fixed=("stability.json", "stability.md")),
     Bench("hard_case_suite", "hard cases of record: each run correct, refused or ok and wrong"),
+    Bench("energy_momentum", "energy-momentum against generalized-alpha on the pendulum, "
+          "a rope and the double pendulum: accuracy, energy drift, cost per step",
+          full=("--charts", "{out}")),
     Bench("command_cost", "a small ancf command's cost beyond its computing: start-up, "
           "imports, the XDMF", quick=("--repeats", "1"), out=None,
           fixed=("command_cost.json",)),

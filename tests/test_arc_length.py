@@ -1,5 +1,6 @@
 """Static path-following by arc length (``solver.static_method = 'arc_length'``,
-solvers/path.py; SPEC section 8.2 "Static paths", issue 34 item 2).
+solvers/path.py driving the kernel's static Newton, static_solver.f90; SPEC section 8.2
+"Static paths", issue 34 item 2, issue 36 item 4).
 
 * The shallow von Mises truss (two pinned bars of half-span a and rise h, a vertical load P
   at the apex): with the bars' Green-Lagrange axial strain (St. Venant-Kirchhoff, the
@@ -93,6 +94,56 @@ def test_von_mises_truss_follows_the_closed_form_through_both_limits(tmp_path):
     assert path["load_factor"][-1] == 1.0 and y[-1] < -RISE
     assert (result.probes["apex"][1] - RISE) == pytest.approx(path["displacement"][-1, 1],
                                                               abs=1e-12)
+
+
+def test_kernel_arc_step_meets_the_constraint_on_the_closed_form():
+    """One arc-length step of the kernel's static Newton (static_solver.f90, the load factor
+    an unknown) from the unloaded truss, before, near and past the upper limit: the
+    increment's norm is the arc to round-off (Crisfield's cylindrical constraint), the point
+    is on the closed form P(y) within 1e-9 P_limit, and the load factor's sign follows the
+    requested direction on a first step. The tangent along the loads at the start,
+    q . K_T^{-1} q, is the bars' linear flexibility P^2 / (2 EA h^2 / L0^3) within 1e-9."""
+    from ancfdrv.solvers.static import ARC_STEP, LOAD_TANGENT, kernel_static
+    load = 1.5 * P_LIMIT
+    model = truss(load).assemble()
+    e, lam = model.e0.copy(), np.zeros(len(model.constraints))
+    apex = model.probe_positions(model.e0)["apex"]
+    tangent = kernel_static(model, e, lam, 0.0, tol=1e-10, max_iter=1, mode=LOAD_TANGENT)
+    assert tangent["info"] == 0 and tangent["iterations"] == 0
+    stiffness = 2 * EA * RISE**2 / L0**3
+    assert tangent["flexibility"] == pytest.approx(load**2 / stiffness, rel=1e-9)
+    for arc, direction in ((0.01, 1.0), (0.05, 1.0), (0.15, 1.0), (0.05, -1.0)):
+        step = kernel_static(model, e, lam, 0.0, tol=1e-10, max_iter=50, mode=ARC_STEP,
+                             arc=arc, direction=direction, force_scale=load)
+        assert step["info"] == 0 and step["iterations"] >= 2   # predictor and corrections
+        assert np.linalg.norm(step["e"] - e) == pytest.approx(arc, rel=1e-12)
+        y = RISE + (model.probe_positions(step["e"])["apex"] - apex)[1]
+        closed = EA * y * (RISE**2 - y**2) / L0**3
+        assert abs(step["load_factor"] * load - closed) < 1e-9 * P_LIMIT
+        assert np.sign(step["load_factor"]) == direction
+
+
+def test_kernel_arc_step_failure_is_text():
+    """An arc-length step the kernel cannot finish returns its failure as text naming the
+    path step and the arc, not the load steps (the path driver then cuts the arc): the
+    iteration limit; and a start 1e-3 off equilibrium (every coordinate shifted, the pins
+    torn) with an arc of 1e-6: the first correction must move e by about 1e-3, so no point
+    of the line du_r + dP du_q is within the arc of the step's start, the constraint's
+    quadratic has no real root."""
+    from ancfdrv.solvers.static import ARC_STEP, kernel_static
+    model = truss(1.5 * P_LIMIT).assemble()
+    lam = np.zeros(len(model.constraints))
+    step = kernel_static(model, model.e0.copy(), lam, 0.0, tol=1e-10, max_iter=2,
+                         mode=ARC_STEP, arc=0.15, load_step=7)
+    assert step["info"] == 1
+    assert "did not converge in 2 iterations at path step 7" in step["message"]
+    assert "shorten solver.arc_length" in step["message"]
+    assert "load_steps" not in step["message"]
+    step = kernel_static(model, model.e0 + 1e-3, lam, 0.0, tol=1e-10, max_iter=50,
+                         mode=ARC_STEP, arc=1e-6, load_step=3)
+    assert step["info"] == 14 and step["iterations"] == 2
+    assert "arc-length constraint" in step["message"] and "no real root at path step 3" \
+        in step["message"] and "shorten solver.arc_length" in step["message"]
 
 
 def test_path_short_of_the_target_writes_it_and_fails(tmp_path):

@@ -174,7 +174,8 @@ def test_a_run_that_blows_up_ends_unstable_with_its_rows(tmp_path, capsys):
     assert error.exit_code == 3 and error.status == "unstable"
     text = str(error)
     for words in ("energy grew", "solver.energy_tolerance", "at t = 3.", "rho_inf",
-                  "solver.dt", "mesh"):
+                  "solver.dt", "mesh", "the kinetic energy grew most in body 'beam' (0 J at "
+                  "the start"):
         assert words in text
     with h5py.File(out) as h5:
         assert h5.attrs["status"] == "unstable"
@@ -223,5 +224,38 @@ def test_a_model_of_one_unknown_keeps_its_blocks_inside_it(tmp_path):
     try:
         assert model.ndof == 1
         assert model.touched_blocks().tolist() == [0]
+    finally:
+        model.close()
+
+
+def test_where_the_energy_grew_names_the_body_that_moves():
+    """The unstable run's message names where its energy grew (issue 39 item 2): the body
+    whose kinetic energy rose most (dynamic.where_energy_grew). Two hinged beams, one given
+    velocities: its share of 1/2 v^T M v is the whole of it (the mass matrix couples no two
+    bodies), the other's 0, and the words name it."""
+    from ancfdrv.solvers.dynamic import kinetic_by_body, where_energy_grew
+    s = System("two bars")
+    steel = s.material("steel", youngs_modulus=2.1e11, density=7850.0)
+    for name, x in (("left", 0.0), ("right", 2.0)):
+        s.beam(name, material=steel, start=(x, 0, 0), end=(x + 1.0, 0, 0), nodes=3,
+               section=Circle(0.01), formulation="nonlinear")
+        s.joint(f"{name} pin", "revolute", "ground", name, point=(x, 0, 0), axis=(0, 0, 1))
+    model = s.assemble()
+    try:
+        v = np.zeros(model.ndof)
+        full = (np.arange(model.ndof) if model.reduction is None
+                else np.asarray(model.reduction.independent))
+        right = model.bodies[[b.name for b in model.bodies].index("right")]
+        mine = (full >= right.first) & (full < right.first + right.ncoordinates)
+        v[mine] = 3.0
+        shares = kinetic_by_body(model, v)
+        total = 0.5 * v @ model.mass.matvec(v)
+        assert total > 0.0
+        assert shares.sum() == pytest.approx(total, rel=1e-12)
+        assert shares[[b.name for b in model.bodies].index("left")] == 0.0
+        words = where_energy_grew(model, np.zeros(model.ndof), 1.5, v)
+        assert words.startswith("the kinetic energy grew most in body 'right' (0 J at the "
+                                "start, ")
+        assert "at t = 1.5 s, 100% of the bodies' rise)" in words
     finally:
         model.close()

@@ -1,7 +1,7 @@
 """What the plots draw (issue 37 item 3). The deformed shape of a static result:
 /static/mesh_nodes holds the mesh points at the static state, and `ancf plot` draws it over a
 grey ghost of the undeformed mesh with the scale in the title. The default dynamic plot
-draws what moves, with each rope's swing angle.
+draws what moves, with each rope's swing angle and tension.
 
 Checked against an independent path: the tip point of a cantilever's mesh moves by the
 tip probe's deflection (the probe is evaluated from the element's shape functions, the
@@ -104,4 +104,47 @@ def test_the_dynamic_plot_draws_what_moves_and_the_ropes_swing(tmp_path):
     assert angle == pytest.approx(expected, abs=1e-6)
     assert angle.max() == pytest.approx(20.0, rel=1e-2)  # undamped: back to -10 degrees
     png = plot_general_dynamic(out, tmp_path / "pendulum.png")
+    assert png.stat().st_size > 20_000
+
+
+ROPE = """
+&scene  title = 'hanging payload', analysis = 'static+dynamic', formulation = 'nonlinear',
+        effects = 'gravity', 'tip_mass', planar = 'xy' /
+&material  name = 'wire rope', youngs_modulus = 1.0e11, density = 5000.0 /
+&cable  name = 'rope', material = 'wire rope', start = 0, 0, 0, end = 0, -2.0, 0, nodes = 3,
+        section = 'circle', diameter = 0.004, tension_only = .true., bending_stiffness = 0.5 /
+&joint  name = 'top', type = 'spherical', body1 = 'ground', body2 = 'rope', point = 0, 0, 0 /
+&load  name = 'g', type = 'gravity', vector = 0.0, -9.81, 0.0 /
+&load  name = 'payload', type = 'point_mass', body = 'rope', point = 0, -2.0, 0, mass = 200.0 /
+&probe  name = 'hook', body = 'rope', point = 0, -2.0, 0 /
+&solver  static_method = 'newton', dt = 5e-3, t_end = 0.05, newton_tol = 1e-10 /
+"""
+
+
+def test_the_dynamic_plot_draws_each_ropes_tension(tmp_path):
+    """A 200 kg payload at rest on a 2 m rope of two elements (d = 4 mm: w = 0.62 N/m, its
+    weight w L = 1.2 N), dynamics from the static state: the tension the run writes
+    (/dynamic/tension/rope, the cable kind's axial force at the rope's Gauss points) is the
+    payload's weight m g plus the rope below a point, m g + w s: its smallest at the lowest
+    Gauss point (s = the first 5-point Gauss abscissa of a 1 m element), its largest at the
+    highest (s = L less that), at every row, within 1e-9 of m g (the Newton tolerance's
+    scale; measured 8e-10 N); the plot draws that series (kN), and the PNG exists."""
+    from ancfdrv.plots import _rope_tension, plot_general_dynamic
+    scene = tmp_path / "payload.nml"
+    scene.write_text(ROPE)
+    out = tmp_path / "payload.h5"
+    run_scene(scene, [], out, progress=False)
+    weight = 200.0 * 9.81
+    w = 5000.0 * np.pi * 0.004**2 / 4 * 9.81
+    s = 0.5 * (np.polynomial.legendre.leggauss(5)[0][0] + 1.0)
+    with h5py.File(out, "r") as h5:
+        t = h5["dynamic/time"][()]
+        low, high = h5["dynamic/tension/rope/min"][()], h5["dynamic/tension/rope/max"][()]
+        assert h5["dynamic/tension/rope/max"].attrs["units"] == "N"
+        plotted = _rope_tension(h5["dynamic"])
+    assert len(low) == len(high) == len(t) > 5
+    assert low == pytest.approx(np.full(len(t), weight + w * s), abs=1e-9 * weight)
+    assert high == pytest.approx(np.full(len(t), weight + w * (2.0 - s)), abs=1e-9 * weight)
+    assert plotted["rope"] == pytest.approx(high / 1e3, rel=1e-15)
+    png = plot_general_dynamic(out, tmp_path / "payload.png")
     assert png.stat().st_size > 20_000

@@ -77,8 +77,8 @@ def _assert_series_equal_file(sim, path: Path) -> int:
                 names.append(name)
         h5["dynamic"].visititems(visit)
         # the answers, support deflections and XDMF frames are not row series of the writer
-        rows = [n for n in names if not n.startswith(("reactions/", "sections/", "mesh_",
-                                                      "deflection_support/"))]
+        rows = [n for n in names if not n.startswith(("reactions/", "sections/", "tension/",
+                                                      "mesh_", "deflection_support/"))]
         assert sorted(rows) == sim.names
         for name in rows:
             expected, got = h5["dynamic"][name][()], sim.series(name)
@@ -228,6 +228,26 @@ def test_save_refuses_an_existing_file_and_input_files(tmp_path):
     with pytest.raises(InputError):
         sim.save(scene, replace=True)     # never over the scene it ran
     assert scene.read_text().startswith("!") or "&scene" in scene.read_text()
+
+
+def test_a_failed_replacing_save_keeps_the_old_file(tmp_path, monkeypatch):
+    """save(replace=True) writes the new file beside the old one and moves it over only
+    when complete: a write that fails half-way leaves the old result byte for byte, and
+    no staging file behind."""
+    from ancfdrv.results import hdf5
+    scene, sets = PENDULUM
+    sim = ancfdrv.simulate(scene, sets, progress=False)
+    path = sim.save(tmp_path / "a.h5")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}   # a.h5 and its a.xdmf
+
+    def fail(*args, **kwargs):
+        raise OSError("disk gone")
+    monkeypatch.setattr(hdf5, "finish", fail)
+    with pytest.raises(OSError, match="disk gone"):
+        sim.save(path, replace=True)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    monkeypatch.undo()
+    assert sim.save(path, replace=True) == path and path.stat().st_size > 0
 
 
 def test_in_memory_run_writes_no_file(tmp_path):

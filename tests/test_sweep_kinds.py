@@ -204,12 +204,16 @@ def test_reference_of_another_model_is_refused(tmp_path, capsys, modal_scene):
 
 
 def test_static_reference_comparing_another_probe_is_refused(tmp_path, capsys):
+    # the sweep names its response (tip, transverse); the reference compared tip, lateral.
+    # (A sweep that names none compares what moves most in the reference itself:
+    # test_a_reference_without_a_named_response_gives_the_compared_probe.)
     static = scene(tmp_path, "static")
     lateral = tmp_path / "lateral.h5"
     run_scene(static, ["scene.response=tip", "scene.response_component=2"], lateral,
               progress=False)
     refused(tmp_path, capsys, static, lateral, "compares probe 'tip' component 2",
-            "the sweep probe 'tip' component 1")
+            "the sweep probe 'tip' component 1",
+            extra=("--set", "scene.response=tip", "--set", "scene.response_component=1"))
 
 
 def test_reference_when_the_cases_run_different_analyses_is_refused(tmp_path, capsys,
@@ -306,3 +310,99 @@ def test_reference_of_another_formulation_and_element_kind_is_accepted(tmp_path)
         assert loaded.values[0] == h5["static/deflection/tip"][1]
         assert loaded.length_scale == h5["model"].attrs["length_scale"] > 0
     assert loaded.family == "static" and loaded.probe == "tip"
+
+
+# --- the default response of a general scene: a quantity that moves ----------------------
+
+def test_without_a_named_response_the_sweep_compares_what_moves(tmp_path, capsys):
+    # the column pushed along its axis and sideways (-100, -50, 0 N) with the clamped
+    # 'root' probe first: the files' own default (the first probe) is zero by construction;
+    # the sweep compares instead what moves most in its first case, the tip's transverse
+    # sag (14 mm, far above its axial shortening), and says so
+    text = COLUMN.format(analysis="static", beam="arm", push=-100.0).replace(
+        "vector = -100.0, 0, 0", "vector = -100.0, -50.0, 0")
+    first, second = ("&probe  name = 'tip', body = 'arm', point = 2.0, 0, 0 /",
+                     "&probe  name = 'root', body = 'arm', point = 0, 0, 0 /")
+    path = tmp_path / "root_first.nml"
+    path.write_text(text.replace(first, "@").replace(second, first).replace("@", second))
+    out = tmp_path / "s"
+    assert main(["sweep", str(path), "--vary", "beam.nodes=3,4", "-o", str(out),
+                 "--workers", "1"]) == 0
+    printed = capsys.readouterr().out
+    rows = rows_of(out / "summary.csv")
+    why = ("compared: probe 'tip' component 1, picked because no &scene response is named: "
+           "of every probe's deflection components it moves most in case nodes-3")
+    assert why in printed and why in (out / "summary.md").read_text()
+    for case, row in rows.items():
+        with h5py.File(out / f"{case}.h5", "r") as h5:
+            assert h5.attrs["response_probe"] == "root"           # the file's own default
+            sag = h5["static/deflection_support/tip"][1]
+        assert (row["response_probe"], row["response_component"]) == ("tip", "1")
+        assert float(row["tip_transverse"]) == pytest.approx(sag, rel=1e-12)
+        assert why in row["response_picked"]
+    # the beam-column's tip deflection F (tan kL - kL) / (k^3 EI), k^2 = P / EI (strong axis)
+    ei, k = 2.1e11 * 0.02 * 0.03**3 / 12, np.sqrt(100.0 / (2.1e11 * 0.02 * 0.03**3 / 12))
+    beam_column = 50.0 * (np.tan(2 * k) - 2 * k) / (k**3 * ei)
+    assert float(rows["nodes-4"]["tip_transverse"]) == pytest.approx(-beam_column, rel=1e-3)
+    assert float(rows["nodes-3"]["err_vs_finest"]) > 0.0       # a number, not n/a
+    # a response the user names is compared as named: zero by construction, it stays n/a
+    # with the hint naming what moves, and nothing is picked
+    named = run_sweep(str(path), ["beam.nodes=3,4"], tmp_path / "named", workers=1,
+                      progress=False, base=["scene.response=root"])
+    for row in named:
+        assert "response_picked" not in row and "tip_transverse" not in row
+        assert "probe 'root'" in row["err_vs_finest_undefined"]
+        assert "compare it with &scene response = 'tip', response_component = 1" in \
+            row["err_vs_finest_undefined"]
+
+
+def test_a_dynamic_sweep_picks_the_probe_whose_history_moves_most(tmp_path):
+    # a rod released at 10 degrees on a pin: its 'top' probe (at the pin, the first) stays,
+    # its 'end' swings; the picked component is the one with the largest range over the run
+    from ancfdrv.sweep import pick_response
+    scene_file = tmp_path / "rod.nml"
+    scene_file.write_text("""
+&scene  title = 'rod on a pin', analysis = 'dynamic', formulation = 'nonlinear',
+        effects = 'gravity', planar = 'xy' /
+&material  name = 'steel', youngs_modulus = 2.1e11, density = 7850.0 /
+&cable  name = 'rod', material = 'steel', start = 0, 0, 0, end = 0.17364817766693033,
+        -0.984807753012208, 0, nodes = 3, section = 'circle', diameter = 0.02 /
+&joint  name = 'pin', type = 'spherical', body1 = 'ground', body2 = 'rod', point = 0, 0, 0 /
+&load  name = 'g', type = 'gravity', vector = 0.0, -9.81, 0.0 /
+&probe  name = 'top', body = 'rod', point = 0, 0, 0 /
+&probe  name = 'end', body = 'rod', point = 0.17364817766693033, -0.984807753012208, 0 /
+&solver  dt = 5e-3, t_end = 0.3 /
+""")
+    out = tmp_path / "s"
+    rows = run_sweep(str(scene_file), ["solver.dt=5e-3,2.5e-3"], out, workers=1,
+                     progress=False)
+    with h5py.File(rows[0]["file"], "r") as h5:
+        assert h5.attrs["response_probe"] == "top"
+        end = h5["dynamic/deflection/end"][()]
+    ranges = np.ptp(end, axis=0)
+    component = int(np.argmax(ranges))
+    (probe, picked), why = pick_response(rows[0]["file"], "case x")
+    assert (probe, picked) == ("end", component) and component == 0  # swings along x first
+    assert f"({1e3 * ranges[0]:.4g} mm, its range over the run)" in why
+    assert all((r["response_probe"], r["response_component"]) == ("end", 0) for r in rows)
+    assert rows[0]["err_vs_finest"] > 0.0
+    assert rows[1]["err_vs_finest"] == 0.0      # the finest case against itself
+
+
+def test_a_reference_without_a_named_response_gives_the_compared_probe(tmp_path):
+    # no response named: the sweep compares what moves most in --reference (the tip's
+    # sag under the sideways push), whatever the reference's file compared itself
+    static = scene(tmp_path, "static")
+    push = ["load[push].vector=-100,-50,0"]
+    reference = tmp_path / "ref.h5"
+    run_scene(static, push + ["scene.response=tip", "scene.response_component=2",
+                              "beam.nodes=7"], reference, progress=False)
+    rows = run_sweep(str(static), ["beam.nodes=3,4"], tmp_path / "s", base=push, workers=1,
+                     progress=False, reference=reference)
+    with h5py.File(reference, "r") as h5:
+        sag = h5["static/deflection_support/tip"][1]
+    for row in rows:
+        assert (row["response_probe"], row["response_component"]) == ("tip", 1)
+        assert "moves most in the reference ref.h5" in row["response_picked"]
+        assert row["err_vs_reference"] == pytest.approx(
+            abs(row["tip_transverse"] - sag) / abs(sag), rel=1e-9)

@@ -67,9 +67,14 @@ KERNEL_LAYOUTS: dict[str, tuple[str, ...]] = {
     "ff": ("internal", "external"),                      # system_evaluate's forces (columns)
     "ef": ("time", "load_factor", "velocity_factor"),    # system_evaluate's factors
     "ee": ("strain", "contact_potential"),               # system_evaluate's energies
-    "ss": ("time", "load_factor", "tol", "length_scale"),  # a static load step's settings
-    "sc": ("check_start", "load_step", "load_steps"),    # its controls
-    "sr": ("force_scale", "force_res", "con_res"),       # its residual scales
+    "ss": ("time", "load_factor", "tol", "length_scale", "arc", "direction"),  # a static
+    # load step's or arc-length step's settings, its controls (mode: 0 Newton at the load
+    # factor, 1 an arc-length step, 2 the tangent along the loads), its residual scales and
+    # the path's figures, its reference configuration and previous increment (columns)
+    "sc": ("check_start", "load_step", "load_steps", "mode"),
+    "sr": ("force_scale", "force_res", "con_res", "load_factor", "load_norm", "tangent_norm",
+           "flexibility"),
+    "sx": ("reference", "previous"),
     "so": ("info", "iterations", "converged_by", "factorizations"),  # its outcome
     "sk": ("dt", "dt_min", "adaptive", "tolerance"),     # the stepper's step-size control
     "at": ("corrections", "factorizations", "jacobians", "substeps", "cuts"),  # rows' stats

@@ -161,6 +161,15 @@ def beam_nonlinear_forces(dofs, e, gradients, weights, nvolume: int, youngs, poi
                                          int(want_tangent))
 
 
+def beam_nonlinear_stress_stiffness(dofs, e, de, gradients, weights, nvolume: int, youngs,
+                                    poisson, shear_scales=(1.0, 0.0, 0.0)) -> np.ndarray:
+    """The initial-stress part of the continuum beam's element tangents (24, 24, nel) at e
+    with each stress replaced by its increment for the coordinate increment de."""
+    return _kernel.beam_nonlinear_stress_stiffness(nvolume, _f(dofs + 1, np.int32), _f(e),
+                                                   _f(de), gradients, weights, youngs, poisson,
+                                                   _f(shear_scales))
+
+
 class CubicBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
     (beam_cubic.cubic_setup) for a mesh with reference nodal vectors (3, 8, nel);
@@ -187,6 +196,12 @@ class CubicBeam:
         """Elastic force, strain energy and element tangents (24, 24, nel) at e."""
         return _kernel.beam_cubic_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
                                          self.strain0, self.stiffness, int(want_tangent))
+
+    def stress_stiffness(self, dofs, e, de) -> np.ndarray:
+        """The initial-stress part of the element tangents (24, 24, nel) at e, each strain
+        replaced by its increment for the coordinate increment de: sum k (C e . de) C x I3."""
+        return _kernel.beam_cubic_stress_stiffness(_f(dofs + 1, np.int32), _f(e), _f(de),
+                                                   self.forms, self.stiffness)
 
 
 def cable_element_arrays(lengths, mass_per_length: float, load) -> tuple[np.ndarray, np.ndarray]:
@@ -914,37 +929,49 @@ class KernelSystem:
 
     def static_solve(self, *, t: float, load_factor: float, e0, rows, cols, e, lam, guesses,
                      counts, tol: float, length_scale: float, max_iter: int, check_start: bool,
-                     force_scale: float, load_step: int, load_steps: int) -> dict:
-        """One load step of the kernel's static Newton (``fortran/src/solvers/
-        static_solver.f90``): equilibrium at ``load_factor`` from (e, lam), the tangent's
-        pattern ``rows``, ``cols`` (0-based). ``force_scale`` < 0 is set from the start and
-        returned. Returns e, lam, the contact guesses and counters, force_scale, iterations,
-        the relative residual history, the last residual and constraint violation,
+                     force_scale: float, load_step: int, load_steps: int, mode: int = 0,
+                     arc: float = 0.0, direction: float = 1.0, previous=None) -> dict:
+        """One call of the kernel's static Newton (``fortran/src/solvers/static_solver.f90``)
+        from (e, lam) at ``load_factor``, the tangent's pattern ``rows``, ``cols`` (0-based).
+        ``mode`` 0: a load step, equilibrium at ``load_factor``; 1: one arc-length step of
+        length ``arc`` from the converged (e, lam), the load factor an unknown (``previous``
+        the previous step's increment of e, None on the first step, where ``direction`` is
+        the sign of the load increment); 2: no step, the tangent along the loads at the
+        state. ``force_scale`` < 0 is set from the start and returned. Returns e, lam, the
+        contact guesses and counters, force_scale, iterations, the relative residual
+        history, the last residual and constraint violation, the load factor reached,
         converged_by (static_solver's by_* code) and factorizations, with info and the
-        kernel's message (0 and '' when converged)."""
+        kernel's message (0 and '' when converged); modes 1 and 2 also ||q||, ||du_q|| and
+        q . du_q at the state on entry (load_norm, tangent_norm, flexibility; q = -dr/dP,
+        du_q = K_T^{-1} q on the constraints)."""
         e = np.asarray(e, dtype=float)
         n, ncon = len(e), len(lam)
         guesses = np.asarray(guesses, dtype=float)[:, :self.npoint]
         state = np.concatenate([e, np.asarray(lam, dtype=float), guesses.ravel(order="F")])
-        scales = _pack("sr", force_scale=force_scale, force_res=0.0, con_res=0.0)
+        scales = _pack("sr", force_scale=force_scale, force_res=0.0, con_res=0.0,
+                       load_factor=load_factor, load_norm=0.0, tangent_norm=0.0,
+                       flexibility=0.0)
+        vectors = np.zeros((n, len(KERNEL_LAYOUTS["sx"])), order="F")
+        vectors[:, _at("sx", "reference")] = e0
+        if previous is not None:
+            vectors[:, _at("sx", "previous")] = previous
         out = _kernel.system_static_solve(
-            self.handle, state, _i(np.array(counts)), _f(e0),
+            self.handle, state, _i(np.array(counts)), vectors,
             _i(np.column_stack([np.asarray(rows) + 1, np.asarray(cols) + 1])),
-            _pack("ss", time=t, load_factor=load_factor, tol=tol, length_scale=length_scale),
+            _pack("ss", time=t, load_factor=load_factor, tol=tol, length_scale=length_scale,
+                  arc=arc, direction=direction),
             _pack("sc", np.int32, check_start=int(check_start), load_step=load_step,
-                  load_steps=load_steps), max_iter, scales)
+                  load_steps=load_steps, mode=mode), max_iter, scales)
         state, counts, scales, history, outcome, message = out
         info, iterations = int(outcome[_at("so", "info")]), int(outcome[_at("so", "iterations")])
         guesses_out = np.zeros((2, max(1, self.npoint)), order="F")
         guesses_out[:, :self.npoint] = state[n + ncon:].reshape(2, self.npoint, order="F")
+        figures = {name: float(scales[_at("sr", name)]) for name in KERNEL_LAYOUTS["sr"]}
         return dict(e=state[:n].copy(), lam=state[n:n + ncon].copy(), guesses=guesses_out,
-                    counts=counts, force_scale=float(scales[_at("sr", "force_scale")]),
-                    iterations=iterations, history=history[:iterations].copy(),
-                    force_res=float(scales[_at("sr", "force_res")]),
-                    con_res=float(scales[_at("sr", "con_res")]),
+                    counts=counts, iterations=iterations, history=history[:iterations].copy(),
                     converged_by=int(outcome[_at("so", "converged_by")]),
                     factorizations=int(outcome[_at("so", "factorizations")]), info=info,
-                    message=_text(message) if info else "")
+                    message=_text(message) if info else "", **figures)
 
     def full_forces(self, t: float, e, v, guesses, *, load_factor: float = 1.0) -> np.ndarray:
         """Q_el - Q_c - lf Q_M at (t, e, e') in the full coordinates q (before B^T): what
@@ -956,6 +983,31 @@ class KernelSystem:
         if info:
             self._failure(info, "full force evaluation", message)
         return full
+
+    def energy_momentum_obstacle(self) -> str:
+        """What of the model the energy-momentum stepper does not support ('' when it
+        supports it): the kernel's own list (``fortran/src/solvers/energy_momentum.f90``)."""
+        obstacle, info, message = _kernel.system_energy_momentum_check(self.handle)
+        self._check(info, "energy_momentum_check", message)
+        if isinstance(obstacle, bytes):
+            obstacle = obstacle.decode("ascii", "replace")
+        return str(obstacle).strip()
+
+    def midpoint_residual(self, h: float, t: float, e0, v0, e1, lam,
+                          want_jacobian: bool = False) -> dict:
+        """The residual of one energy-momentum step (``fortran/src/solvers/
+        energy_momentum.f90``) from (e0, v0) at t with step h, at (e1, lam): ``residual``
+        (ndof + ncon), the reduced discrete-gradient force ``internal`` (ndof) and, on
+        request, the ``jacobian`` in (e1, lam)."""
+        ncon = len(lam)
+        residual, internal, jacobian, info, message = _kernel.system_midpoint_residual(
+            self.handle, ncon, h, t, np.asfortranarray(np.column_stack([e0, v0, e1]),
+                                                       dtype=float),
+            _f(lam) if ncon else np.zeros(1), int(want_jacobian), ndof=self.ndof)
+        if info:
+            self._failure(info, "midpoint residual", message)
+        return dict(residual=residual, internal=internal,
+                    jacobian=jacobian if want_jacobian else None)
 
     def output_row(self, t: float, e, v, lam, work, guesses, counts) -> dict:
         cut = self._layout(False)[1]
@@ -1004,8 +1056,9 @@ class KernelSystem:
         matrix factorized at another state, the step-size control's state) is forgotten: a
         run from a new initial state is reproducible."""
         info, message = _kernel.system_stepper_setup(
-            self.handle, settings.beta, settings.gamma, settings.alpha_m, settings.alpha_f,
-            settings.tol, settings.length_scale, settings.max_newton, settings.jacobian_code,
+            self.handle, int(settings.integrator == "energy_momentum"), settings.beta,
+            settings.gamma, settings.alpha_m, settings.alpha_f, settings.tol,
+            settings.length_scale, settings.max_newton, settings.jacobian_code,
             settings.contraction,
             _pack("sk", dt=settings.dt, dt_min=settings.dt_min,
                   adaptive=float(settings.step == "adaptive"), tolerance=settings.tolerance))

@@ -17,7 +17,7 @@ import numpy as np  # noqa: E402
 
 from .codes import mesh_parts  # noqa: E402
 from .io.safe_write import save_figure  # noqa: E402
-from .sweep_keys import is_resolution, static_value  # noqa: E402
+from .sweep_keys import is_resolution, row_response, static_value  # noqa: E402
 
 
 STAGE_COLOURS = {"start": "#dbe9f6", "luffing": "#fdf1d6", "braking": "#f8dcdc",
@@ -179,6 +179,15 @@ def _cable_swing(h5: h5py.File) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def _rope_tension(dyn: h5py.Group) -> dict[str, np.ndarray]:
+    """Each cable's (rope's) largest axial force along it per row (kN), as the run wrote it
+    (/dynamic/tension, the cable kind's law)."""
+    if "tension" not in dyn:
+        return {}
+    return {name: group["max"][()] / 1e3 for name, group in dyn["tension"].items()
+            if "max" in group}
+
+
 def _changing_reactions(dyn: h5py.Group) -> dict[str, np.ndarray]:
     """The reactions whose force magnitude (kN) changes most over the run."""
     if "reactions" not in dyn:
@@ -195,8 +204,8 @@ def _changing_reactions(dyn: h5py.Group) -> dict[str, np.ndarray]:
 def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
     """Any dynamic result, the quantities that move: each probe's deflection components
     (in its frame, the basis named once in the title; probes and components that do not
-    move are left out and named below), each rope's swing angle, the reactions whose force
-    changes most, and the energies the file holds."""
+    move are left out and named below), each rope's swing angle and tension, the reactions
+    whose force changes most, and the energies the file holds."""
     h5_path = Path(h5_path)
     png = Path(png) if png else h5_path.with_suffix(".png")
     with h5py.File(h5_path, "r") as h5:
@@ -209,6 +218,7 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
         label = _deflection_label(dyn)
         beam_frame = set(dyn.get("deflection_support", {}))
         swing = _cable_swing(h5)
+        tension = _rope_tension(dyn)
         reactions = _changing_reactions(dyn)
         size = float(h5["model"].attrs.get("length_scale", 1.0)) if "model" in h5 else 1.0
     peaks = {n: float(np.abs(d).max(initial=0.0)) for n, d in probes.items()}
@@ -216,7 +226,8 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
     moving = sorted((n for n in probes if n not in still), key=lambda n: -peaks[n])
     left_out = [n for n in moving[MAX_PROBE_PANELS:]]
     probes = {n: probes[n] for n in moving[:MAX_PROBE_PANELS]}
-    panels = len(probes) + (1 if swing else 0) + (1 if reactions else 0) + (1 if energy else 0)
+    panels = len(probes) + (1 if swing else 0) + (1 if tension else 0) + \
+        (1 if reactions else 0) + (1 if energy else 0)
     fig, axes = plt.subplots(max(panels, 1), 1, figsize=(9, 2.2 * max(panels, 1) + 0.9),
                              sharex=True, constrained_layout=True, squeeze=False)
     axes = list(axes[:, 0])
@@ -233,6 +244,13 @@ def plot_general_dynamic(h5_path: Path, png: str | Path | None = None) -> Path:
             ax.plot(times, angle, lw=1.0, label=name)
         ax.set_ylabel("rope swing (deg)")
         ax.legend(fontsize=8, ncol=4, loc="upper left", title="chord from its direction at t = 0",
+                  title_fontsize=7)
+    if tension:
+        ax = axes.pop(0)
+        for name, force in tension.items():
+            ax.plot(t, force, lw=1.0, label=name)
+        ax.set_ylabel("rope tension (kN)")
+        ax.legend(fontsize=8, ncol=4, loc="upper left", title="largest along the rope",
                   title_fontsize=7)
     if reactions:
         ax = axes.pop(0)
@@ -953,8 +971,9 @@ def plot_histories(rows: list[dict], keys: list[str], outdir: Path) -> list[Path
         for row in members:
             with _h5.File(row["file"], "r") as h5:
                 t = h5["dynamic/time"][()]
-                probe = h5.attrs.get("response_probe", "tip")
-                component = int(h5.attrs.get("response_component", 1))
+                probe, component = row_response(row) or (
+                    _text(h5.attrs.get("response_probe", "tip")),
+                    int(h5.attrs.get("response_component", 1)))
                 sag = 1e3 * h5[f"dynamic/deflection/{probe}"][:, component]
             label = _mesh_label(mesh_keys[0], row[mesh_keys[0]]) if mesh_keys else "model"
             whole.plot(t, sag, lw=0.9, label=label)

@@ -100,7 +100,8 @@ def writes_xdmf(scene: Scene) -> bool:
 
 
 def dynamic_settings(scene: Scene) -> DynamicSettings:
-    """Newmark with the scene's beta and gamma, or generalized-alpha from rho_inf."""
+    """Newmark with the scene's beta and gamma, generalized-alpha from rho_inf, or the
+    energy-momentum midpoint rule."""
     solver, output = scene["solver"], scene["output"]
     common = dict(tol=solver["newton_tol"], max_newton=solver["max_newton"],
                   chunk_steps=output["chunk_steps"], store_q=output["q"],
@@ -112,6 +113,9 @@ def dynamic_settings(scene: Scene) -> DynamicSettings:
     if solver["integrator"] == "generalized_alpha":
         return DynamicSettings.generalized_alpha(solver["dt"], solver["t_end"],
                                                  solver["rho_inf"], **common)
+    if solver["integrator"] == "energy_momentum":
+        return DynamicSettings(dt=solver["dt"], t_end=solver["t_end"],
+                               integrator="energy_momentum", **common)
     return DynamicSettings(dt=solver["dt"], t_end=solver["t_end"], beta=solver["beta"],
                            gamma=solver["gamma"], **common)
 
@@ -216,14 +220,14 @@ def _check_dynamic_plausibility(scene: Scene, model: Model, out: Path | MemoryOu
 
 
 def _answers_recorder(scene: Scene, model: Model):
-    """The recorder of the dynamic reactions, section forces and stress envelope (None
-    when the model has neither joints nor beams)."""
+    """The recorder of the dynamic reactions, section forces, stress envelope and cable
+    tension (None when the model has no joints, beams, force elements or cables)."""
     from .system.answers import DynamicAnswers, reaction_map
-    from .system.registry import reports_sections
+    from .system.registry import axial_forces, reports_sections
     if not scene["output"].get("answers", True):
         return None
-    if not reaction_map(model).joints and not any(reports_sections(b) for b in model.bodies) \
-            and not model.force_elements:
+    if not reaction_map(model).joints and not model.force_elements and not any(
+            reports_sections(b) or axial_forces(b) is not None for b in model.bodies):
         return None
     return DynamicAnswers(model, stations=scene["output"].get("stations", 3),
                           keep_sections=bool(scene["output"].get("sections", False)))
@@ -282,6 +286,29 @@ def check_reduction(scene: Scene, model: Model) -> None:
         check_scope(model, SimpleNamespace(e=model.e0))
     except SolverError as exc:
         raise _reduction_error(scene, beam, str(exc)) from None
+
+
+def check_integrator(scene: Scene, model: Model) -> None:
+    """Refuse, before anything is computed, ``solver.integrator = 'energy_momentum'`` on a
+    scene it does not support (InputError naming the key and the item: the kernel's list,
+    ``fortran/src/solvers/energy_momentum.f90``) or with ``solver.step = 'adaptive'`` (its
+    steps are fixed, cut only where Newton fails)."""
+    solver = scene["solver"]
+    if scene["scene"]["analysis"] not in ("dynamic", "static+dynamic") \
+            or solver["integrator"] != "energy_momentum":
+        return
+    if solver.get("step", "fixed") != "fixed":
+        raise InputError("solver.integrator = 'energy_momentum' takes fixed steps (solver.step "
+                         "= 'fixed'); its energy does not drift, and it has no local error "
+                         "estimate to size steps by", file=str(scene.path), group="solver",
+                         key="step")
+    obstacle = model.kernel.energy_momentum_obstacle()
+    if obstacle:
+        raise InputError(f"solver.integrator = 'energy_momentum' does not support {obstacle} "
+                         "(it conserves the energy of undamped, undriven systems of nonlinear "
+                         "beams, cables and ropes with masses, gravity, pins and revolute "
+                         "joints); take 'generalized_alpha'", file=str(scene.path),
+                         group="solver", key="integrator")
 
 
 def check_static_method(scene: Scene, model: Model) -> None:
@@ -552,6 +579,7 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
     try:
         check_reduction(scene, model)
         check_static_method(scene, model)
+        check_integrator(scene, model)
     except InputError as exc:
         model.close()
         raise locate_error(exc, scene) from None

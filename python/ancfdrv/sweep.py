@@ -36,11 +36,11 @@ from tqdm import tqdm
 from .errors import InputError
 from .results.lock import OutputLock
 from .io.safe_write import replace_atomically, write_bytes, write_text
-from .sweep_keys import is_resolution, resolution_rank, static_value
+from .sweep_keys import Response, is_resolution, resolution_rank, row_response, static_value
 from .io.scene import GENERAL_SCHEMA, SCHEMA, load_scene, parse_address
 from .sweep_exec import (CONNECT_TIMEOUT_S, INTERRUPTED_EXIT, Case, connect, eigen_values,
                          failure, remove_quietly, response_of, run_dask, run_inline,
-                         run_processes, worker_cap)
+                         run_processes, static_response, worker_cap)
 
 #: Case file names: these characters only, at most this long (before the hash suffix).
 _UNSAFE = re.compile(r"[^A-Za-z0-9._+-]")
@@ -192,18 +192,18 @@ def case_names(combos: list[dict[str, str]]) -> list[str]:
             else name for name, params in zip(names, combos)]
 
 
-def _history(h5: h5py.File) -> tuple[np.ndarray, np.ndarray]:
-    probe, component = response_of(h5.attrs)
+def _history(h5: h5py.File, response: Response | None = None) -> tuple[np.ndarray, np.ndarray]:
+    probe, component = response or response_of(h5.attrs)
     name = f"dynamic/deflection_support/{probe}"  # general scenes (supports' motion off)
     if name not in h5:
         name = f"dynamic/deflection/{probe}"
     return h5["dynamic/time"][()], h5[name][:, component]
 
 
-def _tip_history(path: str) -> tuple[np.ndarray, np.ndarray]:
-    """Time and the compared history (the tip sag for beams)."""
-    with h5py.File(path, "r") as h5:
-        return _history(h5)
+def _tip_history(row: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Time and the compared history of a case (the tip sag for beams)."""
+    with h5py.File(row["file"], "r") as h5:
+        return _history(h5, row_response(row))
 
 
 def _static_deflection(h5: h5py.File, probe: str) -> np.ndarray:
@@ -213,10 +213,11 @@ def _static_deflection(h5: h5py.File, probe: str) -> np.ndarray:
     return h5[name][()] if name in h5 else h5[f"static/deflection/{probe}"][()]
 
 
-def _probe_and_size(path: str) -> tuple[str, float]:
-    """The compared probe of a result file and its model's size (m)."""
-    with h5py.File(path, "r") as h5:
-        return response_of(h5.attrs)[0], float(h5["model"].attrs.get("length_scale", 0.0))
+def _probe_and_size(row: dict) -> tuple[str, float]:
+    """The compared probe of a case and its model's size (m)."""
+    with h5py.File(row["file"], "r") as h5:
+        return (row_response(row) or response_of(h5.attrs))[0], \
+            float(h5["model"].attrs.get("length_scale", 0.0))
 
 
 #: A deflection at most this fraction of the model's size is zero to the precision of a
@@ -239,32 +240,60 @@ def relative_error(absolute: float, scale: float, size: float, probe: str,
     return absolute / scale
 
 
-def moving_probe(path: str, size: float) -> str:
-    """A hint naming the probe and component that move most in a result file (its static
-    deflections, or the largest over its dynamic ones; relative to the supports where the
-    file has that), as the scene keys that would compare it; '' when none moves beyond
-    round-off."""
+def largest_motion(path: str | Path) -> tuple[float, str, int, str]:
+    """The probe and component that move most in a result file, as a sweep compares them
+    (relative to the supports where the file has that, else from the rigid configuration
+    or t = 0): (how much, m; probe; component; what was measured). A dynamic run's
+    motion is the range of each component over its history, a static run's the
+    magnitude of its deflection; (0, '', 0, ...) when the file has no probe."""
     best = (0.0, "", 0)
     with h5py.File(path, "r") as h5:
-        for group in ("dynamic", "static"):
-            if group not in h5:
-                continue
-            for name in ("deflection_support", "deflection"):
-                if name not in h5[group]:
-                    continue
-                for probe, data in h5[f"{group}/{name}"].items():
-                    values = np.abs(np.asarray(data[()], dtype=float)).reshape(-1, 3)
-                    peak = values.max(axis=0, initial=0.0)
-                    k = int(np.argmax(peak))
-                    if peak[k] > best[0]:
-                        best = (float(peak[k]), probe, k)
-                break
-            break
-    if best[0] <= ZERO_DEFLECTION * size:
+        group = "dynamic" if "dynamic/deflection" in h5 else "static"
+        measure = "its range over the run" if group == "dynamic" else "its static deflection"
+        for probe in h5.get(f"{group}/deflection", {}):
+            name = f"{group}/deflection_support/{probe}"
+            data = h5[name] if name in h5 else h5[f"{group}/deflection/{probe}"]
+            values = np.asarray(data[()], dtype=float).reshape(-1, 3)
+            moved = np.ptp(values, axis=0) if group == "dynamic" else np.abs(values[0])
+            k = int(np.argmax(moved))
+            if moved[k] > best[0]:
+                best = (float(moved[k]), probe, k)
+    return (*best, measure)
+
+
+def moving_probe(path: str, size: float) -> str:
+    """A hint naming the probe and component that move most in a result file
+    (:func:`largest_motion`), as the scene keys that would compare it; '' when none moves
+    beyond round-off."""
+    amount, probe, component, _ = largest_motion(path)
+    if amount <= ZERO_DEFLECTION * size:
         return ""
-    return (f"; probe {best[1]!r} moves {1e3 * best[0]:.4g} mm along its component "
-            f"{best[2]}: compare it with &scene response = {best[1]!r}, "
-            f"response_component = {best[2]}")
+    return (f"; probe {probe!r} moves {1e3 * amount:.4g} mm along its component "
+            f"{component}: compare it with &scene response = {probe!r}, "
+            f"response_component = {component}")
+
+
+def response_named(scene, varied: list[str]) -> bool:
+    """Whether a general scene's sweep compares a response the user named (&scene
+    response, by the scene, --set or --vary); a template scene's is its builder's."""
+    return scene.kind != "general" or bool(scene["scene"].get("response")) or \
+        "scene.response" in varied
+
+
+def pick_response(path: str | Path, case: str) -> tuple[Response, str] | None:
+    """The response a general scene's sweep compares when the user named none: the probe
+    and component that move most (:func:`largest_motion`) in the result file ``path`` (the
+    reference, or the sweep's first case, named ``case``), with the sentence saying so;
+    None when nothing moves beyond round-off (the files' own response is compared)."""
+    amount, probe, component, measure = largest_motion(path)
+    with h5py.File(path, "r") as h5:
+        size = float(h5["model"].attrs.get("length_scale", 0.0))
+    if not probe or amount <= ZERO_DEFLECTION * size:
+        return None
+    return (probe, component), (
+        f"compared: probe {probe!r} component {component}, picked because no &scene "
+        f"response is named: of every probe's deflection components it moves most in "
+        f"{case} ({1e3 * amount:.4g} mm, {measure})")
 
 
 def eigen_error(values: np.ndarray, reference: np.ndarray) -> float | str:
@@ -291,8 +320,8 @@ def add_history_errors(rows: list[dict], varied: list[str]) -> None:
     360 (f - f_ref) T_vib in degrees, from zero-crossing frequencies."""
     from .history import crossing_frequency
     for members, finest in _reference_groups(rows, varied):
-        t_ref, y_ref = _tip_history(finest["file"])
-        probe, size = _probe_and_size(finest["file"])
+        t_ref, y_ref = _tip_history(finest)
+        probe, size = _probe_and_size(finest)
         scale = float(np.abs(y_ref).max())
         t0, t1 = finest.get("stage_vibration_t0"), finest.get("stage_vibration_t1")
         f_ref = None
@@ -300,7 +329,7 @@ def add_history_errors(rows: list[dict], varied: list[str]) -> None:
             mask = t_ref >= t0
             f_ref = crossing_frequency(t_ref[mask], y_ref[mask])
         for row in members:
-            t, y = _tip_history(row["file"])
+            t, y = _tip_history(row)
             common = t_ref <= t[-1]
             absolute = float(np.abs(np.interp(t_ref[common], t, y) - y_ref[common]).max())
             _set_error(row, "err_vs_finest", relative_error(absolute, scale, size, probe,
@@ -368,15 +397,15 @@ def add_formulation_difference(rows: list[dict], varied: list[str]) -> None:
         if "analysis" in row:  # modal or buckling
             diff = eigen_error(eigen_values(row["file"])[1], eigen_values(ref["file"])[1])
         elif row.get("dynamic"):
-            t_ref, y_ref = _tip_history(ref["file"])
-            t, y = _tip_history(row["file"])
+            t_ref, y_ref = _tip_history(ref)
+            t, y = _tip_history(row)
             common = t_ref <= t[-1]
             diff = relative_error(float(np.abs(np.interp(t_ref[common], t, y)
                                                - y_ref[common]).max()),
-                                  float(np.abs(y_ref).max()), *_probe_and_size(ref["file"])[::-1])
+                                  float(np.abs(y_ref).max()), *_probe_and_size(ref)[::-1])
         else:
             diff = relative_error(abs(static_value(row) - static_value(ref)),
-                                  abs(static_value(ref)), *_probe_and_size(ref["file"])[::-1])
+                                  abs(static_value(ref)), *_probe_and_size(ref)[::-1])
         _set_error(row, "diff_vs_nonlinear", diff)
 
 
@@ -396,6 +425,8 @@ class Reference:
     time: np.ndarray | None  # dynamic: the times of ``values``
     probe: str  # the compared probe (static and dynamic)
     length_scale: float  # the model's size (m)
+    #: the response picked in it (:func:`pick_response`) and why; None: the files' own
+    picked: tuple[Response, str] | None = None
 
 
 def _file_family(h5: h5py.File) -> str | None:
@@ -425,7 +456,8 @@ def _expected_model(scene) -> tuple[list[str], list[str], tuple[str, int] | None
     return [b.name for b in bodies], list(probes), response
 
 
-def load_reference(reference: str | Path, scene, families: set[str]) -> Reference:
+def load_reference(reference: str | Path, scene, families: set[str], *,
+                   pick: bool = False) -> Reference:
     """Read ``--reference`` and check that it can stand for the sweep's cases; InputError
     (exit 2) naming the file and the mismatch otherwise. It must be
 
@@ -434,7 +466,9 @@ def load_reference(reference: str | Path, scene, families: set[str]) -> Referenc
       'modal' or 'buckling'), the same for every case;
     - of the same model. The rule: the same scene title, the same kind of scene (the
       template, or 'general'), the same bodies (by name), and for static and dynamic
-      sweeps the same probes and the same compared probe and component. What resolves or
+      sweeps the same probes and the same compared probe and component (``pick``: the
+      user named no response in a general scene: the sweep compares the one that moves
+      most in the reference, :func:`pick_response`). What resolves or
       approximates the model (nodes, modes, the formulation, the element kind of a body -
       beam or cable -, dt, the solver) may differ: that is what a reference is for. The
       physical values (lengths, materials, loads) are not compared: a reference of the
@@ -472,12 +506,14 @@ def load_reference(reference: str | Path, scene, families: set[str]) -> Referenc
                                  f"cases are {family} runs", file=where)
             length = float(h5["model"].attrs.get("length_scale", 0.0))
             probes = _file_probes(h5)
-            probe, component = response_of(h5.attrs)
+            picked = pick_response(path, f"the reference {path.name}") \
+                if pick and family in ("static", "dynamic") else None
+            probe, component = picked[0] if picked else response_of(h5.attrs)
             time = None
             if family == "static":
                 values = np.array([_static_deflection(h5, probe)[component]])
             elif family == "dynamic":
-                time, values = _history(h5)
+                time, values = _history(h5, (probe, component))
             else:
                 values = eigen_values(path)[1]
     except InputError:
@@ -502,13 +538,13 @@ def load_reference(reference: str | Path, scene, families: set[str]) -> Referenc
         if probes != set(scene_probes):
             mismatch.append(f"its probes are {', '.join(sorted(probes)) or 'none'}, the "
                             f"sweep's {', '.join(scene_probes) or 'none'}")
-        elif response is not None and (probe, component) != tuple(response):
+        elif not pick and response is not None and (probe, component) != tuple(response):
             mismatch.append(f"it compares probe {probe!r} component {component}, the sweep "
                             f"probe {response[0]!r} component {response[1]}")
     if mismatch:
         raise InputError("--reference is a run of another model: " + "; ".join(mismatch),
                          file=where)
-    return Reference(path, family, values, time, probe, length)
+    return Reference(path, family, values, time, probe, length, picked)
 
 
 def add_reference_errors(rows: list[dict], reference: Reference) -> None:
@@ -525,7 +561,7 @@ def add_reference_errors(rows: list[dict], reference: Reference) -> None:
             continue
         row["err_reference_file"] = str(reference.path)
         if reference.family == "dynamic":
-            t, y = _tip_history(row["file"])
+            t, y = _tip_history(row)
             common = reference.time <= t[-1] + 1e-12
             absolute = float(np.abs(np.interp(reference.time[common], t, y)
                                     - reference.values[common]).max())
@@ -553,7 +589,7 @@ def add_errors(rows: list[dict], varied: list[str]) -> None:
                            eigen_error(eigen_values(row["file"])[1], reference))
             continue
         ref = static_value(finest)
-        probe, size = _probe_and_size(finest["file"])
+        probe, size = _probe_and_size(finest)
         for row in members:
             absolute = abs(static_value(row) - ref)
             _set_error(row, "err_vs_finest", relative_error(absolute, abs(ref), size, probe,
@@ -590,8 +626,9 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
     for params in combos:  # validate every case before spending time on any
         case_scene = load_scene(scene_file, base + expand(params))
         families.add(ANALYSIS_FAMILY[case_scene["scene"]["analysis"]])
+    pick = not response_named(scene, keys) and bool(families & {"static", "dynamic"})
     if reference is not None:  # read and checked before the first case runs
-        reference = load_reference(reference, scene, families)
+        reference = load_reference(reference, scene, families, pick=pick)
     outdir = Path(outdir)
     check_sweep_dir(outdir, scene_file)
     sweep_id = uuid.uuid4().hex
@@ -615,6 +652,8 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
                                            progress=progress, scene_text=scene.text)
             signals.armed = False  # the report is written whatever comes now
             check_sweep_ids(rows, sweep_id)
+            if pick:
+                apply_picked_response(rows, reference)
             report(rows, keys, outdir, scene_file, base, reference)
     finally:
         if client is not None:
@@ -624,6 +663,29 @@ def run_sweep(scene_file: str, vary: list[str], outdir: str | Path, *,
     if interrupted or signals.signum is not None:
         raise SweepInterrupted(rows, outdir, signals.signum)
     return rows
+
+
+def apply_picked_response(rows: list[dict], reference: Reference | None) -> None:
+    """A general scene's sweep without a named response compares the probe and component
+    that move most in the reference (``--reference``), else in the first successful case
+    (:func:`pick_response`): each successful static or dynamic row records them
+    (response_probe, response_component, and why in response_picked), and a static row's
+    compared value is read again for them. Nothing moves: the files' own response."""
+    ok = [r for r in rows if r["status"] == "ok" and "analysis" not in r]
+    if not ok:
+        return
+    picked = reference.picked if reference is not None else \
+        pick_response(ok[0]["file"], f"case {ok[0]['case']}")
+    if picked is None:
+        return
+    (probe, component), why = picked
+    for row in ok:
+        row.update(response_probe=probe, response_component=component, response_picked=why)
+        if not row.get("dynamic"):
+            for key in ("tip_axial", "tip_transverse", "tip_lateral", "response"):
+                row.pop(key, None)
+            with h5py.File(row["file"], "r") as h5:
+                row.update(static_response(_static_deflection(h5, probe), probe, component))
 
 
 def check_sweep_dir(outdir: Path, scene_file: str) -> None:
@@ -823,8 +885,13 @@ def table_lines(rows: list[dict], keys: list[str]) -> list[str]:
                         not row.get("err_reference_is_finest", True):
                     cells[-1] += " *"
         lines.append("| " + " | ".join(cells) + " |")
-    notes = reference_notes(rows, keys) + undefined_notes(rows)
+    notes = response_notes(rows) + reference_notes(rows, keys) + undefined_notes(rows)
     return lines + ([""] + notes if notes else [])
+
+
+def response_notes(rows: list[dict]) -> list[str]:
+    """The response the sweep picked and why (:func:`apply_picked_response`), once."""
+    return sorted({r["response_picked"] for r in rows if "response_picked" in r})
 
 
 def undefined_notes(rows: list[dict]) -> list[str]:

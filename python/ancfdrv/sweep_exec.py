@@ -113,13 +113,9 @@ def _result_fields(outcome: Any, output: Path) -> dict:
         # general scenes: the deflection relative to the supports' rigid motion when the
         # file has it (ancfdrv.system.supports), not the mechanism's rigid motion
         probe, component = response_of(summary)
-        values = summary.get(f"static.deflection_support.{probe}",
-                             summary[f"static.deflection.{probe}"])
-        if (probe, component) == ("tip", 1):  # a beam's tip sag, with its other components
-            axial, transverse, lateral = values
-            row.update(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral)
-        else:  # the scene's response probe (scene.response), not a probe that is called tip
-            row["response"] = float(values[component])
+        row.update(static_response(summary.get(f"static.deflection_support.{probe}",
+                                                summary[f"static.deflection.{probe}"]),
+                                    probe, component))
     if dynamic is not None:
         row.update(dynamic=True, steps=dynamic.steps, newton_iterations=dynamic.newton_iterations,
                    factorizations=dynamic.factorizations, dynamic_time_s=dynamic.wall_time_s,
@@ -132,6 +128,17 @@ def _result_fields(outcome: Any, output: Path) -> dict:
         if len(values):
             row[EIGEN_HEADLINE[analysis]] = float(values[0])
     return row
+
+
+def static_response(values: Any, probe: str, component: int) -> dict[str, float]:
+    """A static case's compared fields from its probe's deflection ``values`` (3,): a
+    beam's tip sag with its other components (tip_axial, tip_transverse, tip_lateral) for
+    (tip, 1), else the compared component (response): the scene's response probe, not a
+    probe that is called tip."""
+    if (probe, component) == ("tip", 1):
+        axial, transverse, lateral = (float(v) for v in values)
+        return dict(tip_axial=axial, tip_transverse=transverse, tip_lateral=lateral)
+    return dict(response=float(values[component]))
 
 
 #: The row field of the headline of an eigenvalue analysis: the first elastic frequency (Hz)

@@ -1,6 +1,6 @@
 """What a sweep's keys and rows mean, shared by the sweep (:mod:`ancfdrv.sweep`) and its
 plots (:mod:`ancfdrv.plots`): which keys refine a model, in which sense, and the static
-quantity the rows compare."""
+quantity the rows compare, and the response a sweep picked for them."""
 from __future__ import annotations
 
 from .io.scene import parse_address
@@ -49,3 +49,15 @@ def static_value(row: dict) -> float:
         if key in row:
             return row[key]
     raise KeyError(f"case {row.get('case', '?')} has no compared quantity")
+
+
+#: A compared probe and component, (probe, component)
+Response = tuple[str, int]
+
+
+def row_response(row: dict) -> Response | None:
+    """The response the sweep picked for a row's case (``ancfdrv.sweep.pick_response``:
+    a general scene without a named response); None: the result file's own
+    (``response_probe``, ``response_component``)."""
+    return (row["response_probe"], int(row["response_component"])) \
+        if "response_probe" in row else None

@@ -69,13 +69,16 @@ module api_support
   integer, parameter, public :: ef_time = 1, ef_load_factor = 2, ef_velocity_factor = 3, &
                                 ef_count = 3
   integer, parameter, public :: ee_strain = 1, ee_contact_potential = 2, ee_count = 2
-  !> a static load step: settings, controls, the residual scales (in and out), outcome
+  !> a static load step or arc-length step: settings, controls, the residual scales and the
+  !> path's figures (in and out), outcome, the reference and previous increment (columns)
   integer, parameter, public :: ss_time = 1, ss_load_factor = 2, ss_tol = 3, &
-                                ss_length_scale = 4, ss_count = 4
+                                ss_length_scale = 4, ss_arc = 5, ss_direction = 6, ss_count = 6
   integer, parameter, public :: sc_check_start = 1, sc_load_step = 2, sc_load_steps = 3, &
-                                sc_count = 3
+                                sc_mode = 4, sc_count = 4
   integer, parameter, public :: sr_force_scale = 1, sr_force_res = 2, sr_con_res = 3, &
-                                sr_count = 3
+                                sr_load_factor = 4, sr_load_norm = 5, sr_tangent_norm = 6, &
+                                sr_flexibility = 7, sr_count = 7
+  integer, parameter, public :: sx_reference = 1, sx_previous = 2, sx_count = 2
   integer, parameter, public :: so_info = 1, so_iterations = 2, so_converged_by = 3, &
                                 so_factorizations = 4, so_count = 4
   !> the stepper's step-size control (system_stepper_setup), a controlled advance's per-row

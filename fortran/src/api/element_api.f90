@@ -132,6 +132,43 @@ subroutine beam_nonlinear_forces(ndof, nel, npts, nvolume, dofs, e, gradients, w
   energy = sum(element_energy)
 end subroutine beam_nonlinear_forces
 
+!> The initial-stress stiffness (24 x 24 x nel) of a continuum beam mesh at e for the
+!> increment de (beam_nonlinear.nonlinear_stress_stiffness per element).
+subroutine beam_nonlinear_stress_stiffness(ndof, nel, npts, nvolume, dofs, e, de, gradients, &
+                                           weights, youngs, poisson, shear_scales, tangent)
+  use ancf_kinds, only: dp
+  use beam_nonlinear, only: nonlinear_stress_stiffness
+  implicit none
+  integer, intent(in) :: ndof, nel, npts, nvolume, dofs(24, nel)
+  real(dp), intent(in) :: e(ndof), de(ndof), gradients(8, 3, npts, nel), weights(npts, nel)
+  real(dp), intent(in) :: youngs, poisson, shear_scales(3)
+  real(dp), intent(out) :: tangent(24, 24, nel)
+  integer :: el
+  do el = 1, nel
+    call nonlinear_stress_stiffness(reshape(e(dofs(:, el)), [3, 8]), &
+                                    reshape(de(dofs(:, el)), [3, 8]), gradients(:, :, :, el), &
+                                    weights(:, el), nvolume, youngs, poisson, shear_scales, &
+                                    tangent(:, :, el))
+  end do
+end subroutine beam_nonlinear_stress_stiffness
+
+!> The initial-stress stiffness (24 x 24 x nel) of a 'cubic' beam mesh at e for the
+!> increment de (beam_cubic.cubic_stress_stiffness per element).
+subroutine beam_cubic_stress_stiffness(ndof, nel, nterms, dofs, e, de, forms, stiffness, tangent)
+  use ancf_kinds, only: dp
+  use beam_cubic, only: cubic_stress_stiffness
+  implicit none
+  integer, intent(in) :: ndof, nel, nterms, dofs(24, nel)
+  real(dp), intent(in) :: e(ndof), de(ndof), forms(8, 8, nterms, nel), stiffness(nterms, nel)
+  real(dp), intent(out) :: tangent(24, 24, nel)
+  integer :: el
+  do el = 1, nel
+    call cubic_stress_stiffness(reshape(e(dofs(:, el)), [3, 8]), &
+                                reshape(de(dofs(:, el)), [3, 8]), forms(:, :, :, el), &
+                                stiffness(:, el), tangent(:, :, el))
+  end do
+end subroutine beam_cubic_stress_stiffness
+
 !> Number of strain terms per element of the 'cubic' bending beam.
 subroutine beam_cubic_size(nterms)
   use beam_cubic, only: cubic_terms

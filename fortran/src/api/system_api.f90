@@ -57,7 +57,8 @@ subroutine system_destroy(handle, info, message)
 end subroutine system_destroy
 
 !> Starts a run of the stepper (stepper.f90) with its settings, set once per run: the
-!> method's beta, gamma, alpha_m, alpha_f (Newmark: alpha_m = alpha_f = 0), the Newton
+!> method (0 generalized-alpha, 1 energy-momentum: energy_momentum.f90), the alpha method's
+!> beta, gamma, alpha_m, alpha_f (Newmark: alpha_m = alpha_f = 0), the Newton
 !> tolerance (max |de| <= tol * length_scale) and iteration limit, the Jacobian policy
 !> (1 per step, 2 per iteration, 3 reused across steps), the reuse policy's contraction
 !> limit and the step-size control (control(sk_*): the output grid's dt, dt_min (0: dt /
@@ -66,16 +67,17 @@ end subroutine system_destroy
 !> factorized at another state, except the constant policy's, which depends on the step
 !> alone): a run from a new initial state then gives the same result on any handle.
 !> info: 1 not a live handle; 2 a setting out of its range.
-subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, length_scale, &
-                                max_newton, jacobian, contraction, control, info, message)
+subroutine system_stepper_setup(handle, method, beta, gamma, alpha_m, alpha_f, tol, &
+                                length_scale, max_newton, jacobian, contraction, control, info, &
+                                message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, policy_constant
   use system_mass, only: plane_mass_setup
   use stepper, only: stepper_run, stepper_settings, stepper_start, jacobian_step, &
-                     jacobian_reuse, control_settings
+                     jacobian_reuse, control_settings, method_alpha, method_energy_momentum
   use api_support, only: api_system, sk_dt, sk_dt_min, sk_adaptive, sk_tolerance
   implicit none
-  integer, intent(in) :: handle, max_newton, jacobian
+  integer, intent(in) :: handle, method, max_newton, jacobian
   real(dp), intent(in) :: beta, gamma, alpha_m, alpha_f, tol, length_scale, contraction
   real(dp), intent(in) :: control(4)
   integer, intent(out) :: info
@@ -92,9 +94,11 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
               'length_scale > 0; alpha_m, alpha_f < 1; 0 < contraction < 1)'
     return
   end if
-  if (max_newton < 1 .or. jacobian < jacobian_step .or. jacobian > jacobian_reuse) then
+  if (max_newton < 1 .or. jacobian < jacobian_step .or. jacobian > jacobian_reuse .or. &
+      (method /= method_alpha .and. method /= method_energy_momentum)) then
     info = 2
-    message = 'system_stepper_setup: max_newton < 1 or a Jacobian policy outside 1..3'
+    message = 'system_stepper_setup: max_newton < 1, a Jacobian policy outside 1..3 or ' // &
+              'a method outside 0..1'
     return
   end if
   if (.not. (control(sk_dt) > 0.0_dp .and. control(sk_dt_min) >= 0.0_dp .and. &
@@ -104,7 +108,14 @@ subroutine system_stepper_setup(handle, beta, gamma, alpha_m, alpha_f, tol, leng
               '(dt > 0, dt_min >= 0, tolerance > 0)'
     return
   end if
-  call stepper_start(run, stepper_settings(beta=beta, gamma=gamma, alpha_m=alpha_m, &
+  if (method == method_energy_momentum .and. control(sk_adaptive) /= 0.0_dp) then
+    info = 2
+    message = 'system_stepper_setup: the energy-momentum method takes fixed steps ' // &
+              '(no adaptive step control)'
+    return
+  end if
+  call stepper_start(run, stepper_settings(method=method, beta=beta, gamma=gamma, &
+                                           alpha_m=alpha_m, &
                                            alpha_f=alpha_f, tol=tol, &
                                            length_scale=length_scale, &
                                            max_newton=max_newton, jacobian=jacobian, &
@@ -1146,6 +1157,70 @@ subroutine system_full_forces(handle, ndof, nfull, npoint, t, e, v, load_factor,
   if (info /= 0) message = failure_text(info)
 end subroutine system_full_forces
 
+!> What of the system the energy-momentum stepper (energy_momentum.f90) does not support,
+!> named in obstacle ('' when it supports the system): the run's validation refuses such a
+!> scene before anything is computed. info: 1 not a live handle.
+subroutine system_energy_momentum_check(handle, obstacle, info, message)
+  use mechanical_system, only: system_model
+  use energy_momentum, only: energy_momentum_obstacle
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle
+  character(len=200), intent(out) :: obstacle
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  obstacle = ''
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  obstacle = energy_momentum_obstacle(sys)
+end subroutine system_energy_momentum_check
+
+!> The residual of one energy-momentum step (energy_momentum.f90's midpoint_residual) from
+!> (e0, v0) = states(:, 1:2) at t with step h, at e1 = states(:, 3) and the multipliers lam:
+!> residual (ndof + ncon), the reduced discrete-gradient force alone (internal) and, with
+!> want_jacobian /= 0, the residual's Jacobian in (e1, lambda). For the tests of the
+!> discrete gradient and of its Jacobian. info: 2 sizes; the stepper's codes (14: the model
+!> is not supported).
+subroutine system_midpoint_residual(handle, ndof, ncon, h, t, states, lam, want_jacobian, &
+                                    residual, internal, jacobian, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use energy_momentum, only: midpoint_residual, dense_mass
+  use time_integrator, only: step_failure_text
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle, ndof, ncon, want_jacobian
+  real(dp), intent(in) :: h, t, states(ndof, 3), lam(max(1, ncon))
+  real(dp), intent(out) :: residual(ndof + ncon), internal(ndof)
+  real(dp), intent(out) :: jacobian(ndof + ncon, ndof + ncon)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  real(dp), allocatable :: mass(:, :)
+  residual = 0.0_dp
+  internal = 0.0_dp
+  jacobian = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. .not. h > 0.0_dp) then
+    info = 2
+    message = 'system_midpoint_residual: sizes inconsistent with the system (ndof, ncon) ' // &
+              'or h <= 0'
+    return
+  end if
+  if (want_jacobian /= 0) then
+    allocate (mass(ndof, ndof))
+    call dense_mass(sys, mass)
+    call midpoint_residual(sys, h, t, states(:, 1), states(:, 2), states(:, 3), lam(1:ncon), &
+                           residual, internal, info, mass, jacobian)
+  else
+    call midpoint_residual(sys, h, t, states(:, 1), states(:, 2), states(:, 3), lam(1:ncon), &
+                           residual, internal, info)
+  end if
+  if (info /= 0) message = step_failure_text(info, 0, 0)
+end subroutine system_midpoint_residual
+
 !> One output row of the state (t, e, e', lambda) with the accumulated works, in the layout
 !> of a row of system_advance without q (stepper.f90 row_size: time, probes, deflections,
 !> lambda, energies, constraint violation, contact records); state(:, sv_coordinates) = e,
@@ -1321,6 +1396,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
   use stepper, only: stepper_run, state_size, row_size
   use row_answers, only: answer_count
   use time_integrator, only: stat_count, step_failure_text
+  use energy_momentum, only: em_unsupported
   use step_control, only: stepper_point, controlled_rows, control_failure
   use api_support, only: api_system, as_rows, as_info, as_detail, as_floor_accepts, as_tries, &
                          as_failure_cuts, as_failure_tries, as_failed_corrections, &
@@ -1393,7 +1469,7 @@ subroutine system_advance(handle, nrows, budget, nstate, state, counts, nrow, ro
                        figures(af_last_correction), status(as_floor_accepts), failure)
   if (status(as_info) /= 0) then
     message = failure%text
-    if (status(as_info) <= 10) &
+    if (status(as_info) <= 10 .or. status(as_info) == em_unsupported) &
       message = step_failure_text(status(as_info), status(as_detail), run%settings%max_newton)
     figures(af_failure_t) = failure%t
     figures(af_failure_h) = failure%h
@@ -1474,39 +1550,46 @@ end subroutine system_consistent_acceleration
 
 !> One load step of the static Newton in the kernel (static_solver): equilibrium of the
 !> system at load factor and time from the packed state [e (ndof), lambda (ncon), contact
-!> guesses (2, npoint)] (updated in place; e0 the reference configuration), the tangent's
-!> reduced pattern (pattern(:, tp_rows), pattern(:, tp_cols), 1-based, the solvers' pattern).
-!> settings (ss_*): t, load_factor, tol, length_scale; controls (sc_*): check_start (/= 0: a
-!> start that is already the equilibrium ends with 0 iterations), load_step and load_steps
-!> (named in a failure's text). scales (sr_*): the residual's scale floor force_scale (< 0:
-!> set from the start and returned), the last relative residual and constraint violation
-!> (out). Returns the relative residual after each iteration (history) and outcome (so_*):
-!> info, the iterations, why it converged (static_solver's by_* codes), the factorizations;
-!> info /= 0 with the text in message.
-subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pattern, settings, &
-                               controls, max_iter, scales, history, outcome, message)
+!> guesses (2, npoint)] (updated in place; vectors(:, sx_reference) the reference
+!> configuration), the tangent's reduced pattern (pattern(:, tp_rows), pattern(:, tp_cols),
+!> 1-based, the solvers' pattern). settings (ss_*): t, load_factor, tol, length_scale, and
+!> for an arc-length step its arc and the sign of a first step's load increment; controls
+!> (sc_*): check_start (/= 0: a start that is already the equilibrium ends with 0
+!> iterations), load_step and load_steps (named in a failure's text), mode (0: Newton at
+!> load_factor; 1: one arc-length step from the converged state, the load factor an unknown,
+!> vectors(:, sx_previous) the previous step's increment of e, zero on the first; 2: the
+!> tangent along the loads at the state, no step). scales (sr_*): the residual's scale floor
+!> force_scale (< 0: set from the start and returned), the last relative residual and
+!> constraint violation, the load factor reached and, at the state on entry (modes 1, 2),
+!> ||q||, ||K_T^{-1} q|| and q . K_T^{-1} q (out). Returns the relative residual after each
+!> iteration (history) and outcome (so_*): info, the iterations, why it converged
+!> (static_solver's by_* codes), the factorizations; info /= 0 with the text in message.
+subroutine system_static_solve(handle, nstate, state, counts, ndof, vectors, nnz, pattern, &
+                               settings, controls, max_iter, scales, history, outcome, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state
-  use static_solver, only: static_newton, static_failure_text
-  use api_support, only: api_system, tp_rows, tp_cols, ss_time, &
-                         ss_load_factor, ss_tol, ss_length_scale, sc_check_start, &
-                         sc_load_step, sc_load_steps, sr_force_scale, sr_force_res, &
-                         sr_con_res, so_info, so_iterations, so_converged_by, &
-                         so_factorizations
+  use static_solver, only: static_newton, static_failure_text, path_request
+  use api_support, only: api_system, tp_rows, tp_cols, ss_time, ss_load_factor, ss_tol, &
+                         ss_length_scale, ss_arc, ss_direction, sc_check_start, &
+                         sc_load_step, sc_load_steps, sc_mode, sr_force_scale, &
+                         sr_force_res, sr_con_res, sr_load_factor, sr_load_norm, &
+                         sr_tangent_norm, sr_flexibility, sx_reference, sx_previous, &
+                         so_info, so_iterations, so_converged_by, so_factorizations
   implicit none
   integer, intent(in) :: handle, nstate, ndof, nnz, max_iter
-  real(dp), intent(inout) :: state(nstate), scales(3)
+  real(dp), intent(inout) :: state(nstate), scales(7)
   integer, intent(inout) :: counts(6)
   !f2py intent(in,out) :: state, counts, scales
-  real(dp), intent(in) :: e0(ndof), settings(4)
-  integer, intent(in) :: pattern(nnz, 2), controls(3)
+  real(dp), intent(in) :: vectors(ndof, 2), settings(6)
+  integer, intent(in) :: pattern(nnz, 2), controls(4)
   real(dp), intent(out) :: history(max_iter)
   integer, intent(out) :: outcome(4)
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   type(contact_state) :: contact
+  type(path_request) :: path
   real(dp), allocatable :: e(:), lam(:)
-  integer :: info, detail, ncon, npoint
+  integer :: info, detail, ncon, npoint, mode
   outcome = 0
   history = 0.0_dp
   call api_system(handle, sys, info, message)
@@ -1514,11 +1597,12 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
   if (info /= 0) return
   ncon = sys%constraints%ncon
   npoint = sys%contact%npoint
+  mode = controls(sc_mode)
   if (ndof /= sys%ndof .or. nstate /= ndof + ncon + 2 * npoint .or. &
-      nnz /= size(sys%matrix%mass_pattern) .or. max_iter < 1) then
+      nnz /= size(sys%matrix%mass_pattern) .or. max_iter < 1 .or. mode < 0 .or. mode > 2) then
     outcome(so_info) = 4
     message = 'system_static_solve: sizes inconsistent with the system (ndof, the packed' // &
-              ' state, nnz of the pattern) or max_iter < 1'
+              ' state, nnz of the pattern), max_iter < 1 or a mode outside 0..2'
     return
   end if
   if (any(pattern < 1) .or. any(pattern > ndof)) then
@@ -1530,12 +1614,31 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
   lam = state(ndof + 1:ndof + ncon)
   contact%guesses = reshape(state(ndof + ncon + 1:nstate), [2, npoint])
   contact%counts = counts
-  call static_newton(sys, settings(ss_time), settings(ss_load_factor), e0, &
-                     pattern(:, tp_rows), pattern(:, tp_cols), e, lam, contact, &
-                     settings(ss_tol), settings(ss_length_scale), max_iter, &
-                     controls(sc_check_start) /= 0, scales(sr_force_scale), &
-                     outcome(so_iterations), history, scales(sr_force_res), scales(sr_con_res), &
-                     outcome(so_converged_by), outcome(so_factorizations), info, detail)
+  if (mode == 0) then
+    call static_newton(sys, settings(ss_time), settings(ss_load_factor), &
+                       vectors(:, sx_reference), pattern(:, tp_rows), pattern(:, tp_cols), e, &
+                       lam, contact, settings(ss_tol), settings(ss_length_scale), max_iter, &
+                       controls(sc_check_start) /= 0, scales(sr_force_scale), &
+                       outcome(so_iterations), history, scales(sr_force_res), &
+                       scales(sr_con_res), outcome(so_converged_by), &
+                       outcome(so_factorizations), info, detail)
+    scales(sr_load_factor) = settings(ss_load_factor)
+  else
+    path%mode = mode
+    path%arc = settings(ss_arc)
+    path%direction = settings(ss_direction)
+    path%previous = vectors(:, sx_previous)
+    call static_newton(sys, settings(ss_time), settings(ss_load_factor), &
+                       vectors(:, sx_reference), pattern(:, tp_rows), pattern(:, tp_cols), e, &
+                       lam, contact, settings(ss_tol), settings(ss_length_scale), max_iter, &
+                       .false., scales(sr_force_scale), outcome(so_iterations), history, &
+                       scales(sr_force_res), scales(sr_con_res), outcome(so_converged_by), &
+                       outcome(so_factorizations), info, detail, path)
+    scales(sr_load_factor) = path%load_factor
+    scales(sr_load_norm) = path%load_norm
+    scales(sr_tangent_norm) = path%tangent_norm
+    scales(sr_flexibility) = path%flexibility
+  end if
   state = [e, lam, reshape(contact%guesses, [2 * npoint])]
   counts = contact%counts
   outcome(so_info) = info
@@ -1543,7 +1646,7 @@ subroutine system_static_solve(handle, nstate, state, counts, ndof, e0, nnz, pat
                                                controls(sc_load_steps), max_iter, &
                                                minval(history(1:max(1, outcome(so_iterations)))), &
                                                scales(sr_force_res), scales(sr_con_res), &
-                                               settings(ss_tol))
+                                               settings(ss_tol), mode /= 0)
 end subroutine system_static_solve
 
 

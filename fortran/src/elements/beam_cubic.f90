@@ -38,7 +38,7 @@ module beam_cubic
   use beam_stations, only: centreline_rows, station_section, set_station_forces
   implicit none
   private
-  public :: cubic_setup, cubic_element, cubic_pattern, cubic_set
+  public :: cubic_setup, cubic_element, cubic_stress_stiffness, cubic_pattern, cubic_set
 
   !> Axial points of the axial and bending strains, of the torsion.
   integer, parameter :: n_line = 3, n_axial = 3, n_torsion = 2
@@ -203,6 +203,25 @@ contains
                          pairs, npairs)
     end if
   end subroutine cubic_element
+
+  !> The initial-stress part of cubic_element's tangent for the strain increments of the
+  !> nodal increment dq(3, 8) at q(3, 8): sum_terms k (C q . dq) C x I3, the tangent's
+  !> s C x I3 with each strain s replaced by its increment (the stress of a load
+  !> increment): K_T = sum k g g^T + K_sigma(s), and K_sigma(ds) is the geometric
+  !> stiffness of classical linear buckling (python/ancfdrv/solvers/buckling.py).
+  pure subroutine cubic_stress_stiffness(q, dq, forms, stiffness, tangent)
+    real(dp), intent(in) :: q(3, 8), dq(3, 8), forms(8, 8, cubic_terms)
+    real(dp), intent(in) :: stiffness(cubic_terms)
+    real(dp), intent(out) :: tangent(24, 24)
+    real(dp) :: geometric(8, 8)
+    integer :: t
+    tangent = 0.0_dp
+    geometric = 0.0_dp
+    do t = 1, cubic_terms
+      geometric = geometric + stiffness(t) * sum(dq * matmul(q, forms(:, :, t))) * forms(:, :, t)
+    end do
+    call add_kron_identity(geometric, tangent)
+  end subroutine cubic_stress_stiffness
 
   !> cubic_element without damping (its loop over the strain terms). With the set's pattern (cubic_pattern)
   !> the gradients C q run over the forms' nonzero entries only.

@@ -43,7 +43,8 @@ module beam_nonlinear
   use beam_stations, only: station_section, set_station_forces
   implicit none
   private
-  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, continuum_set
+  public :: nonlinear_rule_size, nonlinear_setup, nonlinear_element, continuum_set, &
+            nonlinear_stress_stiffness, nonlinear_midpoint_element
 
   !> The family's element set (element_sets): material gradients (8, 3, npts, nel) and
   !> weights (npts, nel) at the Gauss points, the first volume_points of them volume points.
@@ -58,6 +59,7 @@ module beam_nonlinear
   contains
     procedure :: element_forces => continuum_element_forces
     procedure :: section_forces => continuum_section_forces
+    procedure :: midpoint_forces => continuum_midpoint_forces
   end type continuum_set
 
   !> Gauss points along the axis; the section rule comes from beam_section. The twist
@@ -168,6 +170,32 @@ contains
     end if
   end subroutine nonlinear_element
 
+  !> The initial-stress part of nonlinear_element's tangent for the stress increments of
+  !> the nodal increment dq(3, 8) at q(3, 8): sum_points w kron(G dS G^T, I3) with
+  !> dS = D B(q) dq (the tangent's geometric term with each stress replaced by its
+  !> increment): the geometric stiffness of classical linear buckling.
+  pure subroutine nonlinear_stress_stiffness(q, dq, gradients, weights, volume_points, &
+                                             youngs, poisson, shear_scales, tangent)
+    real(dp), intent(in) :: q(3, 8), dq(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
+    real(dp), intent(out) :: tangent(24, 24)
+    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), deformation(3, 3)
+    real(dp) :: law_twist_y(6, 6), law_twist_z(6, 6), b(6, 24)
+    integer :: p
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson, law_twist_y, &
+                    law_twist_z)
+    tangent = 0.0_dp
+    do p = 1, size(weights)
+      law = point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z)
+      if (p > volume_points .and. all(law == 0.0_dp)) cycle
+      call deformation_gradient(q, gradients(:, :, p), deformation)
+      call strain_matrix(deformation, gradients(:, :, p), b)
+      call add_geometric_stiffness(matmul(law, matmul(b, reshape(dq, [24]))), &
+                                   gradients(:, :, p), weights(p), tangent)
+    end do
+  end subroutine nonlinear_stress_stiffness
+
   !> nonlinear_element without damping (its loop over the Gauss points). The first
   !> volume_points points integrate the Poisson-free law over the volume, the
   !> others (the neutral-axis points) the Poisson part.
@@ -271,6 +299,69 @@ contains
                              want_tangent, force, energy, tangent)
     end if
   end subroutine continuum_element_forces
+
+  !> The discrete-gradient force of the energy-momentum stepper (Simo & Tarnow 1992, the
+  !> averaged stress): with F_m = (F0 + F1)/2 and S = D (E(F0) + E(F1))/2 at each point,
+  !>   f = sum_p w_p B(F_m)^T S,
+  !> and, since E is quadratic in q (E1 - E0 = B(F_m) (q1 - q0) exactly),
+  !> W(q1) - W(q0) = sum w (E1 - E0)^T D (E1 + E0)/2 = f . (q1 - q0) to round-off; at q0 = q1
+  !> it is the force of nonlinear_element. The points' laws are those of elastic_points
+  !> (undamped). The Jacobian df/dq1 (want_tangent): w [B(F_m)^T D B(F1) + kron(G S G^T, I3)] / 2
+  !> (not symmetric).
+  pure subroutine nonlinear_midpoint_element(q0, q1, gradients, weights, volume_points, &
+                                             youngs, poisson, shear_scales, want_tangent, &
+                                             force, tangent)
+    real(dp), intent(in) :: q0(3, 8), q1(3, 8), gradients(:, :, :), weights(:)
+    integer, intent(in) :: volume_points
+    real(dp), intent(in) :: youngs, poisson, shear_scales(3)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(24), tangent(24, 24)
+    real(dp) :: law_free(6, 6), law_poisson(6, 6), law(6, 6), law_twist_y(6, 6)
+    real(dp) :: law_twist_z(6, 6), deformation0(3, 3), deformation1(3, 3), middle(3, 3)
+    real(dp) :: strain0(6), strain1(6), stress(6), b_middle(6, 24), b_end(6, 24)
+    integer :: p
+    call split_laws(youngs, poisson, shear_scales, law_free, law_poisson, law_twist_y, &
+                    law_twist_z)
+    force = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
+    do p = 1, size(weights)
+      law = point_law(p, volume_points, law_free, law_poisson, law_twist_y, law_twist_z)
+      if (p > volume_points .and. all(law == 0.0_dp)) cycle
+      call deformation_gradient(q0, gradients(:, :, p), deformation0)
+      call deformation_gradient(q1, gradients(:, :, p), deformation1)
+      middle = 0.5_dp * (deformation0 + deformation1)
+      call green_lagrange(deformation0, strain0)
+      call green_lagrange(deformation1, strain1)
+      stress = matmul(law, 0.5_dp * (strain0 + strain1))
+      call add_nodal_force(middle, stress, gradients(:, :, p), weights(p), force)
+      if (.not. want_tangent) cycle
+      call strain_matrix(middle, gradients(:, :, p), b_middle)
+      call strain_matrix(deformation1, gradients(:, :, p), b_end)
+      tangent = tangent + 0.5_dp * weights(p) * matmul(transpose(b_middle), matmul(law, b_end))
+      call add_geometric_stiffness(stress, gradients(:, :, p), 0.5_dp * weights(p), tangent)
+    end do
+  end subroutine nonlinear_midpoint_element
+
+  !> The local_element_set midpoint_forces of a continuum set: nonlinear_midpoint_element of
+  !> element el (an undamped set; a damped one has no discrete gradient here: info = 1).
+  pure subroutine continuum_midpoint_forces(set, el, coords0, coords1, want_tangent, force, &
+                                            tangent, info)
+    class(continuum_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords0(:, :), coords1(:, :)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), tangent(:, :)
+    integer, intent(out) :: info
+    info = 0
+    if (set%damping_time > 0.0_dp) then
+      force = 0.0_dp
+      info = 1
+      return
+    end if
+    call nonlinear_midpoint_element(coords0, coords1, set%gradients(:, :, :, el), &
+                                    set%weights(:, el), set%volume_points, set%youngs, &
+                                    set%poisson, set%shear_scales, want_tangent, force, tangent)
+  end subroutine continuum_midpoint_forces
 
   !> The rate of the Green-Lagrange strain (Voigt, engineering shears) at the deformation
   !> gradient F and its rate F': the Voigt form of sym(F^T F'), i.e. B(F) q'.

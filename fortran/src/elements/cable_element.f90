@@ -49,7 +49,7 @@ module cable_element
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
-  public :: cable_rule, cable_element_rows
+  public :: cable_rule, cable_element_rows, cable_midpoint_force
 
   !> Gauss points per element.
   integer, parameter, public :: cable_points = 5
@@ -86,6 +86,7 @@ module cable_element
     procedure :: energy_power => cable_set_energy_power
     procedure :: element_forces => cable_element_forces
     procedure :: element_energy => cable_element_energy
+    procedure :: midpoint_forces => cable_midpoint_forces
   end type cable_set
 
 contains
@@ -462,6 +463,169 @@ contains
       m(:, j) = x * y(j)
     end do
   end function outer6
+
+  !> The discrete-gradient force of the energy-momentum stepper between q0 and q1 (3, 4).
+  !> The point energy is a function of the invariants I = (a.a, b.b, a.b) (a = r', b = r''),
+  !> each quadratic in q, so I(q1) - I(q0) = P(q_m) (q1 - q0) exactly with their gradients
+  !> P at the midpoint q_m; with a discrete gradient s(I0, I1) of the point energy in the
+  !> invariants (s . (I1 - I0) = w(I1) - w(I0)) the force f = sum w_p P(q_m)^T s satisfies
+  !> W(q1) - W(q0) = f . (q1 - q0) to round-off (Gonzalez 1996):
+  !> * axial EA/2 eps^2 (eps = (a.a - 1)/2, quadratic in I): its derivative at the mean I;
+  !>   the rope's EA/2 max(eps, 0)^2: the secant (w1 - w0) / (I1 - I0) where the strain
+  !>   changes sign within the step, the mean-I derivative where it does not (the same
+  !>   number without the cancellation);
+  !> * the rope's bending EI/2 ((a.a)(b.b) - (a.b)^2), quadratic in I: its gradient at the mean I;
+  !> * the cable's exact curvature EI/2 ((a.a)(b.b) - (a.b)^2) / (a.a)^3: Gonzalez's
+  !>   midpoint gradient in I, grad w(I_m) + c (I1 - I0), c = (w1 - w0 - grad w(I_m).dI) /
+  !>   |dI|^2 (the correction left out where |dI| <= gonzalez_floor |I_m|: its size there,
+  !>   O(|dI|^3), is below the round-off of w).
+  !> The invariants are unchanged by rigid motions, so the force conserves momentum and
+  !> angular momentum. The Jacobian df/dq1 (want_tangent) is exact, the derivative of the
+  !> cable's correction c included. info = 2: a slope vanished (the cable's curvature is
+  !> undefined).
+  pure subroutine cable_midpoint_force(q0, q1, length, rule, axial_stiffness, &
+                                       bending_stiffness, rope, want_tangent, force, tangent, info)
+    real(dp), intent(in) :: q0(3, 4), q1(3, 4), length, axial_stiffness, bending_stiffness
+    type(cable_point_rule), intent(in) :: rule
+    logical, intent(in) :: rope, want_tangent
+    real(dp), intent(out) :: force(cable_dofs), tangent(cable_dofs, cable_dofs)
+    integer, intent(out) :: info
+    real(dp), parameter :: gonzalez_floor = 1e-6_dp
+    real(dp) :: slope(4), second(4), weight, a0(3), b0(3), a1(3), b1(3), am(3), bm(3)
+    real(dp) :: inv0(3), inv1(3), invm(3), delta(3), sigma(3), dsigma(3, 3)
+    real(dp) :: x0, x1, w0, w1, w_mid, grad(3), hess(3, 3), grad_end(3), hess_end(3, 3)
+    real(dp) :: correction, dcorrection(3)
+    real(dp) :: grad_a(3), grad_b(3), hessian(6, 6), p_mid(3, 6), p_end(3, 6), identity(3, 3)
+    integer :: p, i
+    info = 0
+    force = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
+    hessian = 0.0_dp
+    identity = 0.0_dp
+    do i = 1, 3
+      identity(i, i) = 1.0_dp
+    end do
+    do p = 1, cable_points
+      call rule_rows(rule, p, length, slope, second)
+      weight = rule%half_weight(p) * length
+      a0 = matmul(q0, slope)
+      b0 = matmul(q0, second)
+      a1 = matmul(q1, slope)
+      b1 = matmul(q1, second)
+      am = 0.5_dp * (a0 + a1)
+      bm = 0.5_dp * (b0 + b1)
+      inv0 = [dot_product(a0, a0), dot_product(b0, b0), dot_product(a0, b0)]
+      inv1 = [dot_product(a1, a1), dot_product(b1, b1), dot_product(a1, b1)]
+      invm = 0.5_dp * (inv0 + inv1)
+      delta = inv1 - inv0
+      sigma = 0.0_dp
+      dsigma = 0.0_dp
+      ! axial: w = EA/8 x^2 (rope: max(x, 0)^2), x = a.a - 1
+      x0 = inv0(1) - 1.0_dp
+      x1 = inv1(1) - 1.0_dp
+      if (.not. rope .or. (x0 >= 0.0_dp .and. x1 >= 0.0_dp)) then
+        sigma(1) = 0.125_dp * axial_stiffness * (x0 + x1)
+        dsigma(1, 1) = 0.125_dp * axial_stiffness
+      else if (x0 > 0.0_dp .or. x1 > 0.0_dp) then
+        ! the strain changes sign within the step: the secant (x1 - x0 is at least |x0|, |x1|)
+        w0 = 0.125_dp * axial_stiffness * max(x0, 0.0_dp)**2
+        w1 = 0.125_dp * axial_stiffness * max(x1, 0.0_dp)**2
+        sigma(1) = (w1 - w0) / (x1 - x0)
+        dsigma(1, 1) = (0.25_dp * axial_stiffness * max(x1, 0.0_dp) - sigma(1)) / (x1 - x0)
+      end if
+      if (rope) then
+        ! bending EI/2 (i1 i2 - i3^2): its gradient at the mean invariants
+        sigma = sigma + 0.5_dp * bending_stiffness * [invm(2), invm(1), -2.0_dp * invm(3)]
+        dsigma(1, 2) = dsigma(1, 2) + 0.25_dp * bending_stiffness
+        dsigma(2, 1) = dsigma(2, 1) + 0.25_dp * bending_stiffness
+        dsigma(3, 3) = dsigma(3, 3) - 0.5_dp * bending_stiffness
+      else
+        if (min(inv0(1), inv1(1), invm(1)) <= 0.0_dp) then
+          info = 2
+          return
+        end if
+        call curvature_energy(invm, bending_stiffness, w_mid, grad, hess)
+        sigma = sigma + grad
+        dsigma = dsigma + 0.5_dp * hess
+        if (norm2(delta) > gonzalez_floor * norm2(invm)) then
+          call curvature_energy(inv0, bending_stiffness, w0, grad_end, hess_end)
+          call curvature_energy(inv1, bending_stiffness, w1, grad_end, hess_end)
+          correction = (w1 - w0 - dot_product(grad, delta)) / dot_product(delta, delta)
+          sigma = sigma + correction * delta
+          ! d(c dI)/dI1 = dI (dc/dI1)^T + c I, dc/dI1 = (grad w(I1) - grad w(I_m)
+          ! - H(I_m) dI / 2 - 2 c dI) / |dI|^2
+          dcorrection = (grad_end - grad - 0.5_dp * matmul(hess, delta) &
+                         - 2.0_dp * correction * delta) / dot_product(delta, delta)
+          do i = 1, 3
+            dsigma(:, i) = dsigma(:, i) + delta * dcorrection(i)
+            dsigma(i, i) = dsigma(i, i) + correction
+          end do
+        end if
+      end if
+      ! f_p = P(q_m)^T sigma, P's rows the invariants' gradients in (a, b)
+      grad_a = 2.0_dp * sigma(1) * am + sigma(3) * bm
+      grad_b = 2.0_dp * sigma(2) * bm + sigma(3) * am
+      if (want_tangent) then
+        p_mid = 0.0_dp
+        p_end = 0.0_dp
+        p_mid(1, 1:3) = 2.0_dp * am
+        p_mid(2, 4:6) = 2.0_dp * bm
+        p_mid(3, 1:3) = bm
+        p_mid(3, 4:6) = am
+        p_end(1, 1:3) = 2.0_dp * a1
+        p_end(2, 4:6) = 2.0_dp * b1
+        p_end(3, 1:3) = b1
+        p_end(3, 4:6) = a1
+        ! d/d(a1, b1) of P(q_m)^T sigma: P's own change (a half of the midpoint's) and sigma's
+        hessian = matmul(transpose(p_mid), matmul(dsigma, p_end))
+        hessian(1:3, 1:3) = hessian(1:3, 1:3) + sigma(1) * identity
+        hessian(4:6, 4:6) = hessian(4:6, 4:6) + sigma(2) * identity
+        hessian(1:3, 4:6) = hessian(1:3, 4:6) + 0.5_dp * sigma(3) * identity
+        hessian(4:6, 1:3) = hessian(4:6, 1:3) + 0.5_dp * sigma(3) * identity
+      end if
+      call add_point(slope, second, weight, grad_a, grad_b, hessian, want_tangent, force, &
+                     tangent)
+    end do
+  end subroutine cable_midpoint_force
+
+  !> The cable's bending energy EI/2 (i1 i2 - i3^2) / i1^3 as a function of the invariants
+  !> I = (a.a, b.b, a.b) (i1 > 0), its gradient and Hessian in I.
+  pure subroutine curvature_energy(inv, bending_stiffness, energy, grad, hess)
+    real(dp), intent(in) :: inv(3), bending_stiffness
+    real(dp), intent(out) :: energy, grad(3), hess(3, 3)
+    real(dp) :: c
+    c = 0.5_dp * bending_stiffness
+    energy = c * (inv(2) / inv(1)**2 - inv(3)**2 / inv(1)**3)
+    grad = c * [-2.0_dp * inv(2) / inv(1)**3 + 3.0_dp * inv(3)**2 / inv(1)**4, &
+                1.0_dp / inv(1)**2, -2.0_dp * inv(3) / inv(1)**3]
+    hess = 0.0_dp
+    hess(1, 1) = c * (6.0_dp * inv(2) / inv(1)**4 - 12.0_dp * inv(3)**2 / inv(1)**5)
+    hess(1, 2) = -2.0_dp * c / inv(1)**3
+    hess(2, 1) = hess(1, 2)
+    hess(1, 3) = 6.0_dp * c * inv(3) / inv(1)**4
+    hess(3, 1) = hess(1, 3)
+    hess(3, 3) = -2.0_dp * c / inv(1)**3
+  end subroutine curvature_energy
+
+  !> The local_element_set midpoint_forces of a cable set: cable_midpoint_force of element el
+  !> (undamped; a damped set has no discrete gradient here: info = 1; a vanished slope 2).
+  pure subroutine cable_midpoint_forces(set, el, coords0, coords1, want_tangent, force, &
+                                        tangent, info)
+    class(cable_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords0(:, :), coords1(:, :)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), tangent(:, :)
+    integer, intent(out) :: info
+    if (set%damping_time > 0.0_dp) then
+      force = 0.0_dp
+      info = 1
+      return
+    end if
+    call cable_midpoint_force(coords0, coords1, set%lengths(el), set%rule, set%axial_stiffness, &
+                              set%bending_stiffness, set%tension_only, want_tangent, force, &
+                              tangent, info)
+  end subroutine cable_midpoint_forces
 
   !> The element_set element_forces of a cable set: with rates (a damped set) the axial
   !> Kelvin-Voigt damping, else the elastic force alone.

@@ -17,6 +17,23 @@
 !> correction or the residual stopped falling there; the stagnation and divergence test
 !> watches the residuals (no step size to cut: the load stepping in Python does).
 !> One call solves one load step; the load stepping and its reporting stay in Python.
+!>
+!> The same Newton follows a static path by arc length (issue 34 item 2, issue 36 item 4:
+!> one static Newton): with the optional path_request the load factor P is an unknown beside
+!> (e, lambda) and each call takes one step of Crisfield's (1981) cylindrical method from the
+!> converged state on entry, ||Delta e|| = Delta l with Delta e the step's increment. Every
+!> iteration factorizes the same saddle-point matrix once and solves it for two right-hand
+!> sides, [-r; Phi] (du_r, dlambda_r) and [q; 0] (du_q, dlambda_q) with the load vector
+!> q = -dr/dP (r is linear in P: the difference of the residuals at P and P - 1); the
+!> correction is du = du_r + dP du_q with dP the root of the quadratic
+!> ||Delta e + du_r + dP du_q||^2 = Delta l^2 whose new increment makes the smaller angle
+!> with the step's increment so far. The predictor (the first iteration, at the converged
+!> state) is dP = +-Delta l / ||du_q|| along du_q, the sign that keeps the direction of the
+!> previous step's increment (Feng's criterion), or the requested direction on the first
+!> step. A quadratic without a real root fails with static_no_root. The path driver (arc
+!> adaptation and cuts, the target crossing, the stability count, the limit marks) stays
+!> in Python (solvers/path.py). The request path_tangent takes no step: it returns the
+!> tangent along the loads at the state (||q||, ||du_q|| and q . du_q).
 !> No I/O; failures return codes with their text (static_failure_text).
 module static_solver
   use ancf_kinds, only: dp
@@ -31,17 +48,34 @@ module static_solver
   private
   public :: static_newton, static_failure_text
 
+  !> path_request modes: an arc-length step; the tangent along the loads only (no step)
+  integer, parameter, public :: path_step = 1, path_tangent = 2
+
+  !> static_newton's arc-length request (module doc). In: mode, the arc Delta l, the sign of
+  !> the first step's load increment (direction) and the previous step's increment of e
+  !> (previous, all zero on the first step). Out: the load factor reached and, at the state
+  !> on entry, ||q||, ||du_q|| and the flexibility along the loads q . du_q.
+  type, public :: path_request
+    integer :: mode = path_step
+    real(dp) :: arc = 0.0_dp, direction = 1.0_dp
+    real(dp), allocatable :: previous(:)
+    real(dp) :: load_factor = 0.0_dp, load_norm = 0.0_dp, tangent_norm = 0.0_dp, &
+                flexibility = 0.0_dp
+  end type path_request
+
   !> why the iteration stopped (converged_by): the relative residual; the round-off floor
   !> with a correction below sqrt(tol); the correction below tol; the residual stopped
   !> falling below sqrt(tol); the start is the equilibrium (no load at all, an unstressed
-  !> start)
+  !> start); the tangent along the loads returned without a step (path_tangent)
   integer, parameter, public :: by_residual = 1, by_roundoff = 2, by_step = 3, by_floor = 4, &
-                                by_unloaded_start = 5
+                                by_unloaded_start = 5, by_tangent_only = 6
   !> failures (info): iteration limit, divergence, stall at the round-off floor, stall,
-  !> non-finite step, linear solve failed (detail: the solver code); 5..10: internal_forces
+  !> non-finite step, linear solve failed (detail: the solver code), the arc-length
+  !> constraint without a real root; 5..10: internal_forces
   integer, parameter, public :: static_limit = 1, static_diverged = 11, &
                                 static_floor_stall = 12, static_stall = 13, &
-                                static_nonfinite = 2, static_solve_failed = 3
+                                static_nonfinite = 2, static_solve_failed = 3, &
+                                static_no_root = 14
   !> iterations in a row without a new smallest residual: a stall once the residual is
   !> small (below stall_near or at the floor); far from it, far_stall_iterations
   integer, parameter :: stall_iterations = 4, far_stall_iterations = 25
@@ -57,11 +91,14 @@ contains
   !> that is already the equilibrium ends the call with 0 iterations - only when no load
   !> acts at all (external loads and dead moments exactly zero) and the internal forces
   !> there are zero to their round-off, eps || |K| |e| || (an unstressed start).
-  !> history(1:iterations): the relative residual after each correction.
+  !> history(1:iterations): the relative residual after each correction. path: an
+  !> arc-length step from the converged (e, lambda) at load_factor instead (module doc;
+  !> the predictor counts as the first iteration, and no convergence is taken before a
+  !> correction), or the tangent along the loads (path_tangent: 0 iterations).
   subroutine static_newton(sys, t, load_factor, e0, rows, cols, e, lam, state, tol, &
                            length_scale, max_iter, check_start, force_scale, iterations, &
                            history, force_res, con_res, converged_by, factorizations, info, &
-                           detail)
+                           detail, path)
     type(system_model), intent(in) :: sys
     real(dp), intent(in) :: t, load_factor, e0(:), tol, length_scale
     integer, intent(in) :: rows(:), cols(:), max_iter
@@ -70,17 +107,24 @@ contains
     type(contact_state), intent(inout) :: state
     integer, intent(out) :: iterations, converged_by, factorizations, info, detail
     real(dp), intent(out) :: history(:), force_res, con_res
-    integer :: n, ncon, nnz, nhess, nmom, ngrad, total, handle, it, c, s1, s2, k1, k2, k
-    integer :: best, since, destroy_info
+    type(path_request), intent(inout), optional :: path
+    integer :: n, ncon, nnz, nhess, nmom, ngrad, total, handle, it, c, s1, s2, k1, k2, k, m
+    integer :: i, j, a, b, best, since, destroy_info
     integer, allocatable :: srows(:), scols(:)
     real(dp), allocatable :: values(:), tangent(:), rhs(:, :)
     real(dp) :: internal(size(e)), loads(size(e)), reaction(size(e)), residual(size(e))
     real(dp) :: phi(sys%constraints%ncon), gradients(6, sys%constraints%ncon)
     real(dp) :: hessians(6, 6, sys%constraints%ncon)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
-    real(dp) :: step_size, size_now, scale, floor, previous
-    logical :: near, growing
+    real(dp) :: step_size, size_now, scale, floor, previous, moment(3)
+    real(dp) :: jacobian(3, 3), hessian(3, 3, 3)
+    real(dp) :: factor, base_factor, delta_factor, dfactor, a2, b2, c2, disc, root1, root2
+    real(dp), allocatable :: load(:), base_e(:), base_lam(:), delta_e(:), delta_lam(:), &
+                             ahead(:), change(:)
+    logical :: near, growing, arc
     n = size(e)
+    arc = present(path)
+    factor = load_factor
     ncon = sys%constraints%ncon
     nnz = size(rows)
     iterations = 0
@@ -105,7 +149,20 @@ contains
     end do
     nmom = moment_pattern_size(sys%loads, sys%reduction)
     total = nnz + nhess + nmom + 2 * ngrad
-    allocate (srows(total), scols(total), values(total), tangent(nnz), rhs(n + ncon, 1))
+    allocate (srows(total), scols(total), values(total), tangent(nnz))
+    if (arc) then
+      ! the second right-hand side [q; 0] and the step's increment from the state on entry
+      allocate (rhs(n + ncon, 2), load(n), delta_e(n), delta_lam(ncon), ahead(n), change(n))
+      base_e = e
+      base_lam = lam
+      delta_e = 0.0_dp
+      delta_lam = 0.0_dp
+      base_factor = load_factor
+      delta_factor = 0.0_dp
+      path%load_factor = load_factor
+    else
+      allocate (rhs(n + ncon, 1))
+    end if
     srows(1:nnz) = rows
     scols(1:nnz) = cols
     k = nnz
@@ -153,11 +210,15 @@ contains
       if (info /= 0) exit
       residual = internal - loads - reaction
       if (force_scale < 0.0_dp) force_scale = max(norm2(internal), norm2(loads))
+      if (arc) then
+        call load_vector()
+        if (info /= 0) exit
+      end if
       if (check_start .and. it == 1) then
         ! no load at all and the internal forces zero to their own round-off: the start is
         ! the equilibrium (a load, however small, is always solved for)
         if (all(loads == 0.0_dp) .and. &
-            all(load_factor * sys%loads%moment_magnitude == 0.0_dp) .and. &
+            all(factor * sys%loads%moment_magnitude == 0.0_dp) .and. &
             norm2(residual) <= residual_floor(1.0_dp) .and. &
             max_abs(phi) <= tol * length_scale) then
           converged_by = by_unloaded_start
@@ -182,7 +243,7 @@ contains
           end do
         end do
       end do
-      call moment_tangent(sys%loads, sys%reduction, e, load_factor, values(k + 1:k + nmom), info)
+      call moment_tangent(sys%loads, sys%reduction, e, factor, values(k + 1:k + nmom), info)
       if (info /= 0) exit
       k = k + nmom
       do c = 1, ncon
@@ -199,7 +260,11 @@ contains
       if (info == 0) then
         rhs(1:n, 1) = -residual
         rhs(n + 1:, 1) = phi
-        call solver_solve(handle, n + ncon, 1, rhs, info, detail)
+        if (arc) then
+          rhs(1:n, 2) = load
+          rhs(n + 1:, 2) = 0.0_dp
+        end if
+        call solver_solve(handle, n + ncon, size(rhs, 2), rhs, info, detail)
       end if
       if (info /= 0) then
         detail = info
@@ -207,12 +272,65 @@ contains
         exit
       end if
       iterations = it
-      if (.not. all(abs(rhs(:, 1)) < huge(1.0_dp))) then
+      if (.not. all(abs(rhs) < huge(1.0_dp))) then
         info = static_nonfinite
         exit
       end if
-      e = e + rhs(1:n, 1)
-      lam = lam + rhs(n + 1:, 1)
+      if (arc) then
+        if (it == 1) then
+          path%load_norm = norm2(load)
+          path%tangent_norm = norm2(rhs(1:n, 2))
+          path%flexibility = dot_product(load, rhs(1:n, 2))
+          if (path%mode == path_tangent) then
+            iterations = 0
+            converged_by = by_tangent_only
+            exit
+          end if
+          ! the predictor along du_q
+          if (.not. path%tangent_norm > 0.0_dp) then
+            info = static_no_root
+            exit
+          end if
+          dfactor = path%direction
+          if (any(path%previous /= 0.0_dp)) &
+            dfactor = merge(1.0_dp, -1.0_dp, dot_product(rhs(1:n, 2), path%previous) >= 0.0_dp)
+          dfactor = dfactor * path%arc / path%tangent_norm
+          change = dfactor * rhs(1:n, 2)
+        else
+          ! the corrector: the root of ||delta_e + du_r + dP du_q|| = arc at the smaller angle
+          ahead = delta_e + rhs(1:n, 1)
+          a2 = dot_product(rhs(1:n, 2), rhs(1:n, 2))
+          b2 = 2.0_dp * dot_product(rhs(1:n, 2), ahead)
+          c2 = dot_product(ahead, ahead) - path%arc**2
+          disc = b2 * b2 - 4.0_dp * a2 * c2
+          if (.not. a2 > 0.0_dp .or. disc < 0.0_dp) then
+            info = static_no_root
+            exit
+          end if
+          root1 = (-b2 + sqrt(disc)) / (2.0_dp * a2)
+          root2 = (-b2 - sqrt(disc)) / (2.0_dp * a2)
+          dfactor = root1
+          if (dot_product(ahead + root2 * rhs(1:n, 2), delta_e) > &
+              dot_product(ahead + root1 * rhs(1:n, 2), delta_e)) dfactor = root2
+          change = rhs(1:n, 1) + dfactor * rhs(1:n, 2)
+          delta_lam = delta_lam + rhs(n + 1:, 1)
+        end if
+        delta_e = delta_e + change
+        delta_lam = delta_lam + dfactor * rhs(n + 1:, 2)
+        delta_factor = delta_factor + dfactor
+        e = base_e + delta_e
+        lam = base_lam + delta_lam
+        factor = base_factor + delta_factor
+        path%load_factor = factor
+        rhs(1:n, 1) = change
+        if (.not. all(abs(e) < huge(1.0_dp))) then
+          info = static_nonfinite
+          exit
+        end if
+      else
+        e = e + rhs(1:n, 1)
+        lam = lam + rhs(n + 1:, 1)
+      end if
       call evaluate(.false.)
       if (info /= 0) exit
       scale = max(norm2(loads), norm2(reaction), norm2(internal), force_scale, 1.0e-300_dp)
@@ -226,7 +344,9 @@ contains
       floor = residual_floor(scale)
       step_size = norm2(rhs(1:n, 1))
       size_now = norm2(e - e0)
-      converged_by = converged(force_res, con_res, step_size, size_now, previous, floor)
+      ! an arc-length step converges on a correction, never on its predictor
+      if (.not. (arc .and. it == 1)) &
+        converged_by = converged(force_res, con_res, step_size, size_now, previous, floor)
       if (converged_by /= 0) exit
       best = minloc(history(1:it), dim=1)
       near = history(best) <= max(stall_near, floor)
@@ -252,6 +372,21 @@ contains
 
   contains
 
+    !> the load vector q = -dr/dP at e (load): r is linear in the load factor, q the
+    !> loads minus the internal forces at the factor less those at the factor - 1
+    subroutine load_vector()
+      real(dp) :: strain, potential, powers(2), records(contact_record, max(1, sys%contact%npoint))
+      real(dp) :: zero_rates(size(e)), below(size(e))
+      zero_rates = 0.0_dp
+      call internal_forces(sys, rotations, e, zero_rates, factor - 1.0_dp, 0.0_dp, state, &
+                           below, strain, potential, powers, records, info, rates=rates, &
+                           force_time=t)
+      if (info /= 0) return
+      call external_forces(sys, t, factor - 1.0_dp, load, info, e)
+      if (info /= 0) return
+      load = (loads - internal) - (load - below)
+    end subroutine load_vector
+
     !> internal (with the tangent on request), loads, constraints and reaction at e
     subroutine evaluate(with_tangent)
       logical, intent(in) :: with_tangent
@@ -259,16 +394,16 @@ contains
       real(dp) :: zero_rates(size(e)), phi_t(ncon), phi_tt(ncon), gamma(ncon)
       zero_rates = 0.0_dp
       if (with_tangent) then
-        call internal_forces(sys, rotations, e, zero_rates, load_factor, 0.0_dp, state, &
+        call internal_forces(sys, rotations, e, zero_rates, factor, 0.0_dp, state, &
                              internal, strain, potential, powers, records, info, rotations, &
                              tangent, rates, t=t, force_time=t)
       else
-        call internal_forces(sys, rotations, e, zero_rates, load_factor, 0.0_dp, state, &
+        call internal_forces(sys, rotations, e, zero_rates, factor, 0.0_dp, state, &
                              internal, strain, potential, powers, records, info, rates=rates, &
                              force_time=t)
       end if
       if (info /= 0) return
-      call external_forces(sys, t, load_factor, loads, info, e)
+      call external_forces(sys, t, factor, loads, info, e)
       if (info /= 0) return
       if (ncon > 0) then
         call constraint_derivatives(sys%constraints, sys%drives, e, zero_rates, t, phi, &
@@ -346,25 +481,33 @@ contains
   end subroutine static_newton
 
   !> The text of a failure of static_newton (info, detail) at load step load_step of
-  !> load_steps, with the smallest and last residuals and the iteration limit. Every text
+  !> load_steps (along_path: at step load_step of an arc-length path), with the smallest
+  !> and last residuals and the iteration limit. Every text
   !> fits message_length (200) with 10-digit counts and 3-digit exponents: a longer one
   !> is cut mid-word by the assignment (the floor stall's ended in 'raise solver.to').
   pure function static_failure_text(info, detail, load_step, load_steps, max_iter, smallest, &
-                                    last, con_res, tol) result(text)
+                                    last, con_res, tol, along_path) result(text)
     integer, intent(in) :: info, detail, load_step, load_steps, max_iter
     real(dp), intent(in) :: smallest, last, con_res, tol
+    logical, intent(in) :: along_path
     character(len=message_length) :: text
-    character(len=40) :: where
-    write (where, '(a, i0, a, i0)') 'at load step ', load_step, ' of ', load_steps
+    character(len=40) :: where, shorter
+    if (along_path) then
+      write (where, '(a, i0)') 'at path step ', load_step
+      shorter = 'shorten solver.arc_length'
+    else
+      write (where, '(a, i0, a, i0)') 'at load step ', load_step, ' of ', load_steps
+      shorter = 'raise solver.load_steps'
+    end if
     select case (info)
     case (static_limit)
-      write (text, '(a, i0, 7a)') 'static Newton did not converge in ', max_iter, &
+      write (text, '(a, i0, 9a)') 'static Newton did not converge in ', max_iter, &
         ' iterations ', trim(where), ' (relative residual ', sci(last), ', constraint ', &
-        sci(con_res), '); raise solver.load_steps or max_iter'
+        sci(con_res), '); ', trim(shorter), ' or max_iter'
     case (static_diverged)
       text = 'static Newton diverged ' // trim(where) // ': the relative residual grew ' // &
              'three times in a row to ' // sci(last) // ' (smallest ' // sci(smallest) // &
-             '); raise solver.load_steps'
+             '); ' // trim(shorter)
     case (static_floor_stall)
       text = 'static Newton stalled at the round-off floor ' // trim(where) // &
              ': the relative residual stays at ' // sci(smallest) // ' above solver.tol = ' // &
@@ -372,9 +515,12 @@ contains
     case (static_stall)
       text = 'static Newton stalled ' // trim(where) // ': no smaller residual in the last ' // &
              'iterations (smallest ' // sci(smallest) // ', tolerance ' // sci(tol) // &
-             '); raise solver.load_steps'
+             '); ' // trim(shorter)
     case (static_nonfinite)
       text = 'static Newton: non-finite step ' // trim(where)
+    case (static_no_root)
+      text = 'static Newton: the arc-length constraint ||Delta e|| = Delta l has no real ' // &
+             'root ' // trim(where) // '; ' // trim(shorter)
     case (static_solve_failed)
       write (text, '(3a, i0, a)') 'static Newton: the saddle-point solve failed ', &
         trim(where), ' (solver code ', detail, ': -10 = singular matrix)'

@@ -15,6 +15,16 @@
 !> multipliers of the state (consistent_start): at rho_inf = 1 the method leaves a period-2
 !> oscillation of a - e'' and of the multipliers undamped, and a change of the step turns it
 !> into an error of order (constraint violation) / h^2 that is never damped either.
+!> A method without numerical damping (neutral_method: rho_inf = 1, the trapezoidal rule)
+!> on a constrained system also restarts where that period-2 oscillation of its multipliers
+!> grows (issue 39: on the flexible double pendulum at dt = 2.5e-4 the nonlinear constraints
+!> of the turning elbow amplify it ~0.5 % a step from t = 4.4 s, 0.4 N -> 164 N by 5.5 s,
+!> until the steps fail and are cut by thousands): measured over blocks of
+!> neutral_block_steps whole steps, a restart after a block where it exceeds both
+!> neutral_growth times the run's quietest block and neutral_share of the block's largest
+!> multiplier. The restart removes it without moving the positions (they see a_{n+1} + a_n
+!> only), and the next step's Newton iteration is accepted on its own measured contraction,
+!> not on one learned before the jump in e'' (relearn).
 !> A call does at most `budget` tries (steps tried), so the caller can answer a stop request
 !> between calls; an output interval left unfinished is resumed by the next call. Tries in a
 !> row without an accepted step are bounded (control_tries). No I/O; failures return codes.
@@ -22,7 +32,7 @@ module step_control
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, power_count, energy_count, &
                                contact_record
-  use stepper, only: stepper_run, control_settings, control_state
+  use stepper, only: stepper_run, stepper_settings, control_settings, control_state
   use time_integrator, only: integrator_chunk, newton_floor_stall, step_work, allocate_work
   use consistent_start, only: consistent_acceleration
   use kernel_errors, only: message_length
@@ -46,6 +56,17 @@ module step_control
   !> was rejected, cut back to that same remainder, forever). 1e-9 covers k ulps of t for
   !> k t / h up to ~4e6, far below the factor 2 between the sizes the control chooses.
   real(dp), parameter, public :: step_rtol = 1e-9_dp
+  !> the restart of a method without numerical damping (the module's notes): blocks of
+  !> neutral_block_steps whole steps; a restart after one whose period-2 oscillation of the
+  !> multipliers exceeds neutral_growth times the run's quietest block's and neutral_share of
+  !> the block's largest |lambda|. Measured (docs/hard-cases.md): the double pendulum's is
+  !> 0.1-0.5 N (1-6 % of its multipliers) before it grows; the shipped scenes' stays below
+  !> 0.4 % of their multipliers; the 4-node cable boom released from its unloaded shape
+  !> rings at 194-225 N (0.4-2.8 %: not growing). A threshold of the quietest block since the
+  !> last restart (instead of the run's) came too late: each restart left a larger
+  !> oscillation behind, and it grew to kN.
+  integer, parameter, public :: neutral_block_steps = 64
+  real(dp), parameter, public :: neutral_growth = 2.0_dp, neutral_share = 1e-2_dp
 
   !> A stepper state: t; e, e', a (the generalized-alpha variable), e''; lambda; the works
   !> and the powers at the state; the contact guesses and counters.
@@ -90,8 +111,8 @@ contains
     type(stepper_point) :: before
     type(step_work) :: scratch  ! the steps' work arrays, for every step_rows call
     real(dp) :: buffer(size(rows, 1), 1), t_before, h, remaining, error
-    integer :: step_stats(3, 1), n, k, j, floor, max_tries
-    logical :: retry, finished
+    integer :: step_stats(3, 1), n, k, j, floor, max_tries, at_lambda
+    logical :: retry, finished, neutral, grew
     cs => run%control_settings
     c => run%control
     call allocate_work(sys, scratch)
@@ -119,6 +140,8 @@ contains
           c%last_h = cs%dt
         end if
         n = min(nrows - done, budget - tries)
+        neutral = neutral_method(run%settings) .and. sys%ncon > 0
+        if (neutral) n = min(n, neutral_block_steps - c%block_steps)
         t_before = p%t
         call step_rows(sys, run, cs%dt, n, p, rows(:, done + 1:done + n), &
                        stats(1:3, done + 1:done + n), store_q, k, info, detail, last_correction, &
@@ -137,6 +160,21 @@ contains
         if (k > 0) c%smallest = min(c%smallest, cs%dt)
         c%rows = c%rows + k
         done = done + k
+        if (neutral) then
+          at_lambda = 1 + 6 * sys%nprobe
+          call block_rows(c, rows(at_lambda + 1:at_lambda + sys%ncon, done - k + 1:done))
+          if (info /= 0) then
+            call block_reset(c)
+          else if (c%block_steps >= neutral_block_steps) then
+            call block_verdict(c, grew)
+            if (grew) then
+              call restart(sys, run, p, info, failure)
+              if (info /= 0) return
+              call relearn(run)
+            end if
+            call block_reset(c)
+          end if
+        end if
         if (info == 0) cycle
         tries = tries + 1
         failure%work = 0
@@ -288,7 +326,71 @@ contains
     run%control%restart_guesses = contact%guesses
     p%a = p%accel
     run%control%restarts = run%control%restarts + 1
+    call block_reset(run%control)
   end subroutine restart
+
+  !> After a restart on the oscillation (the module's notes): the contraction learned before
+  !> the jump in e'' is forgotten, so the next step is accepted on its own measured one.
+  pure subroutine relearn(run)
+    type(stepper_run), intent(inout) :: run
+    run%state%theta = -1.0_dp
+    run%state%unconfirmed = 0
+    run%state%matrix_measured = 0
+    run%state%matrix_unconfirmed = 0
+  end subroutine relearn
+
+  !> Whether the method leaves the infinite-frequency mode undamped (spectral radius 1 at
+  !> h omega -> infinity): generalized-alpha with alpha_m = alpha_f (rho_inf = 1) and
+  !> gamma = 1/2, Newmark's trapezoidal rule among them.
+  pure logical function neutral_method(cfg)
+    type(stepper_settings), intent(in) :: cfg
+    neutral_method = abs(cfg%alpha_m - cfg%alpha_f) <= 1e-12_dp .and. &
+                     abs(cfg%gamma - 0.5_dp) <= 1e-12_dp
+  end function neutral_method
+
+  !> The block's record of whole-step rows (their multipliers, columns, in order): the
+  !> period-2 part of the multipliers, max |lambda_{n+1} - 2 lambda_n + lambda_{n-1}| / 4
+  !> (c (-1)^n gives c; a smooth history ~h^2 lambda''), over the block's consecutive rows
+  !> (those of earlier calls included), and the block's largest |lambda|.
+  pure subroutine block_rows(c, lam)
+    type(control_state), intent(inout) :: c
+    real(dp), intent(in) :: lam(:, :)
+    integer :: n
+    if (.not. allocated(c%block_lambda)) then
+      allocate (c%block_lambda(size(lam, 1), 2))
+      c%block_lambda = 0.0_dp
+    end if
+    do n = 1, size(lam, 2)
+      if (c%block_held == 2) c%block_swing = max(c%block_swing, maxval(abs( &
+        lam(:, n) - 2.0_dp * c%block_lambda(:, 2) + c%block_lambda(:, 1))) / 4.0_dp)
+      c%block_peak = max(c%block_peak, maxval(abs(lam(:, n))))
+      c%block_lambda(:, 1) = c%block_lambda(:, 2)
+      c%block_lambda(:, 2) = lam(:, n)
+      c%block_held = min(c%block_held + 1, 2)
+    end do
+    c%block_steps = c%block_steps + size(lam, 2)
+  end subroutine block_rows
+
+  !> A full block's verdict (the module's notes): grew, its oscillation beyond neutral_growth
+  !> times the run's quietest full block's (none yet: false) and beyond neutral_share of its
+  !> largest multiplier; the quietest block is updated.
+  pure subroutine block_verdict(c, grew)
+    type(control_state), intent(inout) :: c
+    logical, intent(out) :: grew
+    grew = .false.
+    if (c%quiet_swing < huge(1.0_dp)) grew = c%block_swing > neutral_growth * c%quiet_swing &
+                                             .and. c%block_swing > neutral_share * c%block_peak
+    c%quiet_swing = min(c%quiet_swing, c%block_swing)
+  end subroutine block_verdict
+
+  !> A new block: after a full one, a failed step or a restart.
+  pure subroutine block_reset(c)
+    type(control_state), intent(inout) :: c
+    c%block_steps = 0
+    c%block_held = 0
+    c%block_swing = 0.0_dp
+    c%block_peak = 0.0_dp
+  end subroutine block_reset
 
   !> n steps of size h from p (integrator_chunk) with their output rows in the row layout of
   !> stepper.f90 (row_size) and their statistics (a failed step's: the column after the

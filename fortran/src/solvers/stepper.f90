@@ -18,6 +18,9 @@ module stepper
   public :: stepper_settings, stepper_state, stepper_run, stepper_start, update_reuse_backoff, &
             state_size, row_size, control_settings, control_state
 
+  !> the stepping method: generalized-alpha (Newmark its special case; time_integrator) or
+  !> the energy-momentum midpoint rule (energy_momentum)
+  integer, parameter, public :: method_alpha = 0, method_energy_momentum = 1
   !> when a refactorized system's iteration matrix is refreshed (time_integrator)
   integer, parameter, public :: jacobian_step = 1, jacobian_iteration = 2, jacobian_reuse = 3
   !> the most steps jacobian_reuse starts with a fresh matrix before trying an old one again
@@ -30,11 +33,13 @@ module stepper
   !> the steps whose measured contraction jacobian_reuse's bound remembers (their largest)
   integer, parameter, public :: contraction_memory = 16
 
-  !> The settings of a run: the method's parameters (Newmark: alpha_m = alpha_f = 0), the
+  !> The settings of a run: the method (method_alpha, method_energy_momentum), the
+  !> generalized-alpha parameters (Newmark: alpha_m = alpha_f = 0), the
   !> Newton tolerance (max |de| <= tol * length_scale), the iteration limit, the Jacobian
   !> policy and jacobian_reuse's limit on the ratio of successive corrections. The step h
   !> is not a setting: each chunk gives its own (step control cuts and grows it).
   type :: stepper_settings
+    integer :: method = method_alpha
     real(dp) :: beta = 0.25_dp, gamma = 0.5_dp, alpha_m = 0.0_dp, alpha_f = 0.0_dp
     real(dp) :: tol = 1e-10_dp, length_scale = 1.0_dp
     integer :: max_newton = 10
@@ -119,6 +124,14 @@ module stepper
     integer :: rows = 0
     real(dp) :: t0 = 0.0_dp
     real(dp), allocatable :: restart_guesses(:, :)
+    ! the block of whole steps in progress of a method without numerical damping on a
+    ! constrained system (step_control's neutral_method): its steps so far, the largest
+    ! period-2 part of the multipliers and the largest |lambda| in it, and its last two
+    ! rows' multipliers (how many are held): carried from call to call, so the chunk sizes
+    ! do not change the run; the quietest full block's period-2 part of the run (huge: none)
+    integer :: block_steps = 0, block_held = 0
+    real(dp) :: block_swing = 0.0_dp, block_peak = 0.0_dp, quiet_swing = huge(1.0_dp)
+    real(dp), allocatable :: block_lambda(:, :)
   end type control_state
 
   !> A system's stepper: its run's settings, its learned state, its step-size control,

@@ -69,7 +69,9 @@ module time_integrator
   use system_constraints, only: evaluate_constraints, constraint_reaction, gradient_product
   use system_mass, only: mass_product
   use stepper, only: stepper_settings, stepper_state, jacobian_step, jacobian_iteration, &
-                     jacobian_reuse, update_reuse_backoff, contraction_memory
+                     jacobian_reuse, update_reuse_backoff, contraction_memory, &
+                     method_energy_momentum
+  use energy_momentum, only: energy_momentum_chunk, em_unsupported
   use kernel_errors, only: failure_text, message_length
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
@@ -316,6 +318,15 @@ contains
     integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
     logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
+    if (cfg%method == method_energy_momentum) then
+      ! (its own Newton on the midpoint rule: energy_momentum.f90)
+      floor_accepts = 0
+      call energy_momentum_chunk(sys, cfg, h, nsteps, t, e, v, a, accel, lam, work, powers, &
+                                 state, out_time, out_probe, out_deflection, out_lambda, &
+                                 out_energy, out_constraint, out_stats, out_contact, store_q, &
+                                 out_q, steps_done, info, detail, last_correction)
+      return
+    end if
     info = 0
     detail = 0
     steps_done = 0
@@ -1218,6 +1229,10 @@ contains
     case (4)
       write (text, '(a, i0, a)') "the multipliers' Schur complement is singular (dgesv info ", &
         detail, '): the constraints are redundant or lost rank'
+    case (em_unsupported)
+      text = "the energy-momentum integrator does not support this model (contact, force " // &
+             'elements, driven or follower loads, moments, moving frames, driven ' // &
+             'constraints, damping, or an element family without a discrete gradient)'
     case default
       text = failure_text(info)
     end select

@@ -93,6 +93,7 @@ module element_sets
     procedure :: forces => local_set_forces
     procedure :: energy_power => local_energy_power
     procedure :: element_energy => local_element_energy
+    procedure :: midpoint_forces => no_midpoint_forces
   end type local_element_set
 
   abstract interface
@@ -388,6 +389,24 @@ contains
       call set%element_forces(el, coords, .false., force(1:set%nde), energy, tangent, info)
     end if
   end subroutine local_element_energy
+
+  !> The discrete-gradient force of element el between the nodal vectors coords0 and coords1
+  !> (3, nde / 3) for the energy-momentum stepper (energy_momentum): a force f with
+  !> W(q1) - W(q0) = f . (q1 - q0) exactly, equal to W'(q) when q0 = q1, and on request
+  !> (want_tangent) its Jacobian df/dq1 (nde, nde; not symmetric). info = 1 here: the family
+  !> has no discrete gradient (the families that have one override this).
+  pure subroutine no_midpoint_forces(set, el, coords0, coords1, want_tangent, force, tangent, &
+                                     info)
+    class(local_element_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords0(:, :), coords1(:, :)
+    logical, intent(in) :: want_tangent
+    real(dp), intent(out) :: force(:), tangent(:, :)
+    integer, intent(out) :: info
+    force = 0.0_dp
+    if (want_tangent) tangent = 0.0_dp
+    info = 1
+  end subroutine no_midpoint_forces
 
   !> Estimated work of one pass over a set's elements, microseconds on one thread.
   pure real(dp) function loop_work(set, want_tangent)

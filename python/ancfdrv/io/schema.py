@@ -106,7 +106,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "effects": Key("strs", [], doc="force effects to compute; nothing else is computed "
                        "(general scenes: default every effect their items belong to)"),
         "response": Key("str", None, doc="general scenes: the probe sweeps compare (default: "
-                        "the first probe)"),
+                        "a sweep compares the probe and component that move most in its "
+                        "--reference or first case and says so; a run's file names the first "
+                        "probe)"),
         "bounds": Key("str", "check", one_of("check", "off"),
                       "'check': drives, loads, force elements and modal.spin_rate must stay "
                       "within physical bounds (ancfdrv.io.validate.PHYSICAL_BOUNDS, e.g. a "
@@ -305,8 +307,14 @@ SCHEMA: dict[str, dict[str, Key]] = {
                        "splitting parameter p of K_RR = K_RR1 + K_RR2, in [0, 1)"),
         "dt": Key("float", 1e-3, positive, "time step (s), dynamic analyses"),
         "t_end": Key("float", 10.0, non_negative, "end time (s), dynamic analyses"),
-        "integrator": Key("str", "newmark", one_of("newmark", "generalized_alpha"),
-                          "time integrator"),
+        "integrator": Key("str", "newmark", one_of("newmark", "generalized_alpha",
+                                                   "energy_momentum"),
+                          "time integrator: 'newmark', 'generalized_alpha' (rho_inf), or "
+                          "'energy_momentum' (the midpoint rule with a discrete gradient of "
+                          "the strain energy: conserves the energy of an undamped, undriven "
+                          "system to the Newton tolerance at any step, and its momenta; "
+                          "nonlinear beams, cables, ropes, masses, gravity, pins and revolute "
+                          "joints only, fixed steps; docs/theory.md)"),
         "rho_inf": Key("float", 0.9, within(0.0, 1.0),
                        "generalized-alpha: spectral radius at infinite frequency (1: no "
                        "numerical damping)"),

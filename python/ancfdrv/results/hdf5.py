@@ -1354,7 +1354,8 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
 
 def write_dynamic_answers(path: Path, recorder) -> None:
     """/dynamic/reactions/<joint> (leading time axis), /dynamic/sections/<beam> (when the
-    recorder keeps them) and the stress envelope /dynamic/stress/<beam> (von_mises_max,
+    recorder keeps them), /dynamic/tension/<cable> (min and max along it per row) and the
+    stress envelope /dynamic/stress/<beam> (von_mises_max,
     t_max per station; attributes max, s_max, t_max) of a DynamicAnswers recorder (a
     chunk still waiting in it recorded first: ``recorder.complete()``; when that fails,
     as when a chunk fails in the runner's sink, the answers are not written and the
@@ -1363,9 +1364,20 @@ def write_dynamic_answers(path: Path, recorder) -> None:
         return
     with _open_write(path) as h5:
         group = _subgroup(h5, "dynamic")
-        for key in ("reactions", "sections", "stress"):
+        for key in ("reactions", "sections", "stress", "tension"):
             if _has(group, key):
                 del group[key]
+        if any(recorder.tension.values()):
+            tension_group = _subgroup(group, "tension")
+            tension_group.attrs["description"] = (
+                "each cable's axial force along it (tension positive; a rope's is never "
+                "negative, 0 where it is slack): min and max over its integration points "
+                "at each row of /dynamic/time")
+            for name, chunks in recorder.tension.items():
+                if chunks:
+                    sub = _subgroup(tension_group, name)
+                    _dataset(sub, "min", np.concatenate([c[0] for c in chunks]), "N")
+                    _dataset(sub, "max", np.concatenate([c[1] for c in chunks]), "N")
         if recorder.reactions:
             reactions_group = _subgroup(group, "reactions")
             elements = {f.name for f in recorder.force_elements}

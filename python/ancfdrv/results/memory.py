@@ -330,7 +330,6 @@ class MemoryOutput:
         (never an input file, never through a symbolic link); an existing file is
         refused unless ``replace``."""
         from ..io.validate import check_path
-        from . import hdf5
         from .output_path import check_output_path
         path = check_path(path, "Simulation.save(path)")
         if self.scene is None:
@@ -338,13 +337,28 @@ class MemoryOutput:
             raise InputError("nothing to save: the run stopped before its model was built",
                              file=str(path))
         check_output_path(path, self.input_files, xdmf=self.writes_xdmf)
-        if path.exists() or path.is_symlink():
-            if not replace:
-                from ..errors import InputError
-                raise InputError("the file exists (save(path, replace=True) replaces it)",
-                                 file=str(path))
-            path.unlink()
         path.parent.mkdir(parents=True, exist_ok=True)
+        if not (path.exists() or path.is_symlink()):
+            self._replay(path)
+            return path
+        if not replace:
+            from ..errors import InputError
+            raise InputError("the file exists (save(path, replace=True) replaces it)",
+                             file=str(path))
+        # the new files are written in a staging directory beside the old ones, under the
+        # same names (the XDMF names its HDF5 file), and moved over them only once complete:
+        # a save that fails leaves the old result as it was
+        import os
+        import tempfile
+        with tempfile.TemporaryDirectory(prefix=f".{path.name}.", dir=path.parent) as staging:
+            self._replay(Path(staging) / path.name)
+            for made in sorted(Path(staging).iterdir()):
+                os.replace(made, path.parent / made.name)
+        return path
+
+    def _replay(self, path: Path) -> None:
+        """Replay the recorded calls, in their order, into a new file at ``path``."""
+        from . import hdf5
         calls: dict[str, Callable[..., Any]] = {
             name: getattr(hdf5, name) for name in (
                 "create", "write_static", "write_support_deflections", "write_static_answers",
@@ -366,7 +380,6 @@ class MemoryOutput:
                         write_mode_xdmf(path, *args)
                 else:
                     calls[call](path, *args, **kwargs)
-        return path
 
     def iter_calls(self) -> Iterator[str]:
         """The names of the recorded calls, in order (for tests and inspection)."""

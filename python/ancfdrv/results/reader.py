@@ -120,6 +120,12 @@ class Analysis:
         return self._group("stress")
 
     @property
+    def tension(self) -> Record:
+        """Dynamic runs: each cable's (rope's) axial force by name, 'min' and 'max' (nt,) N
+        along it (tension positive; docs/results.md), when present."""
+        return self._group("tension")
+
+    @property
     def energy(self) -> Record:
         """Energies (J) by name (dynamic runs: kinetic, strain, gravity, total, ...)."""
         return self._group("energy")

@@ -9,7 +9,9 @@ With K_T(P) the tangent of the linearized equations at the static state under F 
 (:func:`~.modal.linearize`: elastic tangent with its initial-stress part, the dead moments'
 and follower loads' load stiffness and the constraint Hessians times the multipliers):
 
-* 'linear': K_g = (K_T(1 + s) - K_T(1)) / s (s = ``reference_factor``, default 1) and
+* 'linear': K_g = (K_T(1 + s) - K_T(1)) / s (s = ``reference_factor``, default 1), with
+  each large-deformation beam's part of that difference replaced by its initial-stress
+  stiffness K_sigma((e(1 + s) - e(1)) / s) from the kernel (:func:`stress_correction`), and
 
       (K_1 + nu K_g) phi = 0  on  G_1 phi = 0,    K_1 = K_T(1),    P = 1 + nu  (nu > 0);
 
@@ -40,6 +42,7 @@ from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
 from ..kernel import DirectSolver
 from ..system.model import Model
+from ..system.registry import kind_of
 from .modal import arpack_start, check_free, linearize, null_space
 from .static import StaticResult, solve_newton
 from .._lazy import LazyModule
@@ -101,6 +104,42 @@ def elastic_basis(k1: sp.spmatrix, g: sp.spmatrix) -> np.ndarray:
         raise SolverError("buckling: the structure has no stiffness at its static state "
                           "(every constrained direction is a free motion)")
     return basis @ v[:, keep]
+
+
+def stress_correction(model: Model, e1: np.ndarray, e2: np.ndarray, scale: float
+                      ) -> sp.csr_matrix:
+    """What turns the difference of tangents (K_T(e2) - K_T(e1)) / scale into the
+    initial-stress stiffness of the stress increment: for every element set whose kind
+    splits its tangent (K_T = K_material(q) + K_sigma(stress); the large-deformation beams),
+    K_sigma((q2 - q1) / scale) - (K_set(q2) - K_set(q1)) / scale, on the solver coordinates
+    (B^T K B). The difference of a set's tangents also holds the change of its material
+    stiffness by the displacement (the initial-displacement matrix), first order in the
+    load like K_sigma and large where stiff section or shear moduli turn with the sections
+    (docs/theory.md section 23); the classical linear buckling takes K_sigma alone."""
+    q1, q2 = model.expand(e1), model.expand(e2)
+    dq = (q2 - q1) / scale
+    rows, cols, vals = [], [], []
+    for info in model.sets:
+        split = kind_of(info.body).stress_stiffness
+        first = split(info, q1, dq) if split is not None else None
+        if first is None:
+            continue
+        tangent1, stress = first
+        tangent2 = split(info, q2, dq)[0]
+        local = stress - (tangent2 - tangent1) / scale
+        for el in range(info.nel):
+            dofs = info.dofs[:, el]
+            rows.append(np.repeat(dofs, len(dofs)))
+            cols.append(np.tile(dofs, len(dofs)))
+            vals.append(local[:, :, el].ravel())
+    if not rows:
+        return sp.csr_matrix((model.ndof, model.ndof))
+    full = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(model.nfull, model.nfull))
+    if model.reduction is None:
+        return full
+    b = model.reduction.matrix.to_scipy()
+    return (b.T @ full @ b).tocsr()
 
 
 def _dense(basis: np.ndarray, k1: sp.spmatrix, kg: sp.spmatrix):
@@ -377,6 +416,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     path = LoadPath(model, base_model, tol=tol, max_iter=max_iter, load_steps=load_steps)
     path.e, path.lam, path.factor = scene_state.e.copy(), scene_state.lam.copy(), 1.0
     base = scene_state
+    e_scene = scene_state.e.copy()
     k1 = path.tangent()
     g = path.constraints()
     free = model.ndof - g.shape[0]
@@ -398,7 +438,9 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         factor = path.factor
         k_t = path.tangent()
         if method == "linear":
-            kg = ((k_t - k1) / (factor - 1.0)).tocsr()
+            kg = ((k_t - k1) / (factor - 1.0)
+                  + stress_correction(model, e_scene, path.e, factor - 1.0)).tocsr()
+            kg = 0.5 * (kg + kg.T)
             theta, vectors = _pencil(basis, k1, kg, g, count, eigen_tol)
             history.append((factor, None))
             break

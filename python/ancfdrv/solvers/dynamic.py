@@ -95,6 +95,10 @@ class DynamicSettings:
     #: row_answers.f90``: the force elements' reactions, the residual at the eliminated
     #: joints' coordinates) for :class:`~ancfdrv.system.answers.DynamicAnswers`
     answers: bool = False
+    #: 'newmark' and 'generalized_alpha' (the kernel's alpha method with beta, gamma
+    #: and the alphas) or 'energy_momentum' (the midpoint rule with a discrete gradient:
+    #: ``fortran/src/solvers/energy_momentum.f90``; beta, gamma and the alphas unused)
+    integrator: str = "newmark"
 
     @property
     def smallest_step(self) -> float:
@@ -114,8 +118,9 @@ class DynamicSettings:
         alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
         alpha_f = rho_inf / (rho_inf + 1.0)
         gamma = 0.5 - alpha_m + alpha_f
-        return cls(dt=dt, t_end=t_end, beta=0.25 * (gamma + 0.5) ** 2, gamma=gamma,
-                   alpha_m=alpha_m, alpha_f=alpha_f, **kwargs)
+        return cls(dt=dt, t_end=t_end, integrator="generalized_alpha",
+                   beta=0.25 * (gamma + 0.5) ** 2, gamma=gamma, alpha_m=alpha_m,
+                   alpha_f=alpha_f, **kwargs)
 
     @property
     def beta_prime(self) -> float:
@@ -485,18 +490,49 @@ class EnergyWatch:
                 return float(times[above[0]])
         return self.last_time
 
-    def message(self) -> str:
-        """Why the run is unstable: when the energy grew, how much, and what to change."""
+    def message(self, where: str = "") -> str:
+        """Why the run is unstable: when the energy grew, how much, where (``where``: the
+        words of :func:`where_energy_grew`, '' for none) and what to change."""
         scale = self.scale
         level = self.tolerance * scale
+        where = f"; {where}" if where else ""
         return (f"the energy grew with no work to explain it: the balance (total - total(0) "
                 f"- works) exceeded solver.energy_tolerance = {self.tolerance:g} of the run's "
                 f"energy scale ({scale:.4g} J) at t = {self.first_above(level):.6g} s and "
                 f"reached {self.most:.4g} J ({self.created():.3g} times the scale) by t = "
-                f"{self.last_time:.6g} s: the integrator's numerical instability, not the "
+                f"{self.last_time:.6g} s{where}: the integrator's numerical instability, not the "
                 "physics (the rows computed are kept). Take solver.rho_inf < 1 (numerical "
                 "damping of the modes the step does not resolve), a smaller solver.dt, or a "
                 "mesh whose highest modes the step resolves")
+
+
+def kinetic_by_body(model: Model, v: np.ndarray) -> np.ndarray:
+    """Each body's share (model.bodies' order) of the kinetic energy 1/2 v^T M v at the
+    velocities v (solved coordinates): 1/2 sum of v_i (M v)_i over the coordinates i it owns
+    (a reduced coordinate is its independent full coordinate's body), exact for each body
+    where the mass matrix couples no two bodies; the shares sum to the total."""
+    terms = 0.5 * v * model.mass.matvec(v)
+    full = (np.arange(model.ndof) if model.reduction is None
+            else np.asarray(model.reduction.independent))
+    owner = np.full(max(len(model.q0), int(full.max(initial=-1)) + 1), len(model.bodies))
+    for k, body in enumerate(model.bodies):
+        owner[body.first:body.first + body.ncoordinates] = k
+    return np.bincount(owner[full], weights=terms, minlength=len(model.bodies) + 1)[:-1]
+
+
+def where_energy_grew(model: Model, v0: np.ndarray, t: float, v: np.ndarray) -> str:
+    """Where a run's energy grew (the unstable run's message): the body whose kinetic
+    energy (:func:`kinetic_by_body`) rose most from the start (v0) to the state (t, v) the
+    run ended at, with its share of the rise ('' without bodies)."""
+    if not model.bodies:
+        return ""
+    start, end = kinetic_by_body(model, v0), kinetic_by_body(model, v)
+    rise = end - start
+    k = int(np.argmax(rise))
+    total = float(np.fmax(rise, 0.0).sum())
+    share = f", {rise[k] / total:.0%} of the bodies' rise" if len(rise) > 1 and total > 0 else ""
+    return (f"the kinetic energy grew most in body '{model.bodies[k].name}' ({start[k]:.4g} J at "
+            f"the start, {end[k]:.4g} J at t = {t:.6g} s{share})")
 
 
 def energy_floor(model: Model, settings: DynamicSettings) -> float:
@@ -575,6 +611,7 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
         raise InputError(f"t_end = {settings.t_end} lies before the start time {t0}",
                          group="solver", key="t_end")
     v0 = np.zeros(model.ndof) if v0 is None else v0
+    v_start = v0.copy()   # (where the energy grew, should the run be unstable)
     integrator = TimeIntegrator(model, settings)
     a0, lam0 = initial_acceleration(model, e0, v0, t0) if initial is None else initial
     state = integrator.state(t0, e0, v0, a0, lam0)
@@ -634,11 +671,13 @@ def integrate(model: Model, settings: DynamicSettings, e0: np.ndarray,
                 jacobians += int(failed[2])
                 raise pending
             if energy_watch.runaway():  # the rows are in the sink: the run ends here
-                raise UnstableError(energy_watch.message())
+                raise UnstableError(energy_watch.message(
+                    where_energy_grew(model, v_start, state["t"], state["v"])))
             if should_stop is not None and should_stop():
                 raise Interrupted(f"stopped at t = {state['t']:.6g} s after {steps} steps")
         if energy_watch.unstable():
-            raise UnstableError(energy_watch.message())
+            raise UnstableError(energy_watch.message(
+                where_energy_grew(model, v_start, state["t"], state["v"])))
     finally:  # the counters hold what was done, also when a step failed
         bar.close()
         control = integrator.control_counts()

@@ -244,7 +244,12 @@ def _sparse_modes(lin: Linearization, count: int, shift: float, tol: float):
         op = spla.LinearOperator((n + ncon, n + ncon), matvec=lambda x: solver.solve(x),
                                  dtype=float)
         count = min(count, n - ncon - 1)  # ARPACK needs k below the free dimension
+        # and its Lanczos basis within the free dimension: scipy's default 2k + 1 vectors
+        # (up to n + ncon) failed to build (ARPACK error -9999) beyond half of it, where the
+        # basis meets the multipliers' directions, which B = diag(M, 0) does not see
+        basis = min(n - ncon, max(2 * count + 1, 20))
         w2, z = spla.eigsh(a, k=count, M=b, sigma=shift, OPinv=op, which="LM", tol=tol,
+                           ncv=basis,
                            **arpack_start(lambda r: solver.solve(b @ r), n + ncon, 12345))
         factorizations = solver.factorizations
     except spla.ArpackNoConvergence as exc:

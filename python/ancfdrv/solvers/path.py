@@ -5,7 +5,10 @@ coordinates e and the multipliers lambda. With the residual R(e, lambda, P) = r(
 Phi_e^T lambda, r = internal - external linear in P (the kernel's load factor), and the
 load vector q = -dr/dP, each step of the cylindrical arc-length method of Crisfield (1981)
 solves R = 0, Phi = 0 and ||Delta e|| = Delta l, where Delta e is the step's increment
-from the last converged point:
+from the last converged point. The step's predictor and corrector are the kernel's static
+Newton (fortran/src/solvers/static_solver.f90, its arc-length request: the same residual,
+tangent and MUMPS factorization as a load step, issue 36 item 4 "one static Newton"); this
+module drives the path:
 
 * predictor: Delta P = +-Delta l / ||du_q|| along the tangent du_q = K_T^{-1} q, the sign
   that keeps the direction of the previous increment (Feng's criterion: passes limit
@@ -14,8 +17,8 @@ from the last converged point:
   factorization, du = du_r + dP du_q, and dP is the root of the quadratic constraint whose
   new increment makes the smaller angle with the previous one (Crisfield's choice); no real
   root, or no convergence in ``max_iter`` iterations, halves the arc from the last point;
-* the arc adapts to the iteration count: times sqrt(5 / iterations), within [1/2, 2] per
-  step and at most 4 times the first arc.
+* the arc adapts to the iteration count (the corrections): times sqrt(5 / iterations),
+  within [1/2, 2] per step and at most 4 times the first arc.
 
 At every converged point the number of negative eigenvalues of the tangent on the
 constrained coordinates (the stability index: 0 on a stable branch) is counted from the
@@ -25,8 +28,9 @@ point (its load factor refined by a parabola in the path length through the thre
 about it); a change of the count with no extremum of P is a bifurcation point.
 
 The path ends at the first crossing of ``target_load_factor`` (the state there solved by
-Newton at that load factor: the static result), or after ``max_steps`` steps (then the last
-point, with ``reached = False`` and a message: the run fails with exit 3 after writing it).
+the kernel's Newton at that load factor: the static result), or after ``max_steps`` steps
+(then the last point, with ``reached = False`` and a message: the run fails with exit 3
+after writing it).
 
 :func:`diagnose_stall` reads a failed load-controlled Newton solve: cut back from the last
 converged load step, it tells a limit point (the tangent stiffness along the loads falls
@@ -43,10 +47,9 @@ import numpy as np
 from ..errors import InputError, SolverError
 from ..system.model import Model
 from .._lazy import LazyModule
-from .static import LoadStepFailure, StaticResult, converged, solve_static
+from .static import (ARC_STEP, LOAD_TANGENT, LoadStepFailure, StaticResult, kernel_static,
+                     solve_static)
 
-sp = LazyModule("scipy.sparse")
-spla = LazyModule("scipy.sparse.linalg")
 la = LazyModule("scipy.linalg")
 
 #: iterations per step the arc adapts to
@@ -76,55 +79,14 @@ class StaticPath:
     message: str = ""
 
 
-class _State:
-    """The residual, tangent, constraints and load vector at (e, lambda, P); the force
-    residual relative to the largest of the forces met and ``floor`` (the size of the
-    target loads: an unloaded start is not judged by its round-off alone)."""
-
-    def __init__(self, model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
-                 floor: float = 0.0) -> None:
-        from .modal import linearize  # arc length only: a Newton solve imports no modal code
-        n = model.ndof
-        lin = linearize(model, e, lam, load_factor=factor)
-        r0 = model.forces(e, load_factor=0.0)
-        r1 = model.forces(e, load_factor=1.0)
-        internal = r0["internal"] + factor * (r1["internal"] - r0["internal"])
-        external = r0["external"] + factor * (r1["external"] - r0["external"])
-        self.load = (r1["external"] - r0["external"]) - (r1["internal"] - r0["internal"])
-        self.stiffness, self.constraints = lin.stiffness, lin.constraints
-        reaction = self.constraints.T @ lam if len(lam) else np.zeros(n)
-        self.residual = internal - external - reaction
-        self.phi = model.constraints.jacobian(e, n)[0] if len(lam) else np.zeros(0)
-        scale = max(np.linalg.norm(external), np.linalg.norm(reaction),
-                    np.linalg.norm(internal), floor, 1e-300)
-        self.force_res = float(np.linalg.norm(self.residual) / scale)
-        self.con_res = float(np.max(np.abs(self.phi), initial=0.0) / model.length_scale)
-        self.n = n
-        g = self.constraints
-        mat = sp.bmat([[self.stiffness, -g.T], [-g, None]], format="csc") if g.shape[0] \
-            else self.stiffness.tocsc()
-        try:
-            self._lu = spla.splu(mat)
-        except RuntimeError:  # exactly singular
-            self._lu = None
-
-    def solve(self, residual_part: bool) -> tuple[np.ndarray, np.ndarray]:
-        """(du, dlam) of K du - G^T dlam = -R, -G du = Phi (``residual_part``), or of
-        K du - G^T dlam = q, G du = 0."""
-        if self._lu is None:
-            raise SolverError("arc length: the tangent is singular")
-        rhs = np.concatenate([-self.residual, self.phi]) if residual_part else \
-            np.concatenate([self.load, np.zeros(len(self.phi))])
-        x = self._lu.solve(rhs)
-        return x[:self.n], x[self.n:]
-
-
-def negative_eigenvalues(model: Model, state: _State) -> int:
-    """The number of negative eigenvalues of the tangent on the constraints' null space
-    (exact for models up to DENSE_LIMIT free coordinates; else among the lowest eight)."""
+def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> int:
+    """The number of negative eigenvalues of the tangent at (e, lambda, P) on the
+    constraints' null space (exact for models up to DENSE_LIMIT free coordinates; else
+    among the lowest eight)."""
     from .buckling import _lowest
-    from .modal import DENSE_LIMIT, null_space
-    k, g = state.stiffness, state.constraints
+    from .modal import DENSE_LIMIT, linearize, null_space  # a Newton solve imports no modal code
+    lin = linearize(model, e, lam, load_factor=factor)
+    k, g = lin.stiffness, lin.constraints
     free = model.ndof - g.shape[0]
     if free <= DENSE_LIMIT:
         basis = null_space(g, model.ndof)
@@ -138,36 +100,26 @@ def negative_eigenvalues(model: Model, state: _State) -> int:
     return int(np.sum(w < -1e-10 * scale))
 
 
-#: iterations in a row without a new smallest residual after which a Newton solve of the
-#: path is abandoned (the kernel's static Newton stops after 4 near the floor, 25 far)
-STALL_ITERATIONS = 25
+def _kernel_newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
+                      tol: float, max_iter: int, floor: float = -1.0,
+                      account: bool = True) -> dict | None:
+    """The kernel's Newton at the fixed load factor ``factor`` from (e, lam): its result
+    (e, lam, force_res, con_res, ...), or None when it does not converge (the kernel's
+    stall test ends a tolerance beyond round-off early). ``floor``: the residual's scale
+    floor (< 0: the forces at the start); ``account``: as :func:`~.static.kernel_static`."""
+    out = kernel_static(model, e, lam, factor, tol=tol, max_iter=max_iter, force_scale=floor,
+                        account=account)
+    return None if out["info"] else out
 
 
-def _newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float, tol: float,
-               max_iter: int, floor: float = 0.0) -> tuple[np.ndarray, np.ndarray, int] | None:
-    """Newton at the fixed load factor ``factor`` from (e, lam): (e, lam, iterations), or
-    None when it does not converge: the iteration limit, a non-finite step, or
-    STALL_ITERATIONS without a new smallest residual (a user's tolerance beyond round-off
-    or an iteration limit of 1e8 must not keep the path or the diagnosis running)."""
-    previous, smallest, since = np.inf, np.inf, 0
-    for iteration in range(1, max_iter + 1):
-        state = _State(model, e, lam, factor, floor)
-        if iteration > 1 and converged(state.force_res, state.con_res, step, size, tol,
-                                       previous):
-            return e, lam, iteration - 1
-        previous = state.force_res
-        if state.force_res < smallest:
-            smallest, since = state.force_res, 0
-        else:
-            since += 1
-            if since >= STALL_ITERATIONS:
-                return None
-        du, dl = state.solve(True)
-        if not np.all(np.isfinite(du)):
-            return None
-        e, lam = e + du, lam + dl
-        step, size = np.linalg.norm(du), np.linalg.norm(e - model.e0)
-    return None
+def _load_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
+                  account: bool = True) -> dict | None:
+    """The tangent along the loads at (e, lam, P) from the kernel: load_norm ||q||,
+    tangent_norm ||du_q|| and flexibility q . du_q (du_q = K_T^{-1} q on the constraints),
+    or None when the tangent cannot be factorized (singular)."""
+    out = kernel_static(model, e, lam, factor, tol=1.0, max_iter=1, mode=LOAD_TANGENT,
+                        account=account)
+    return None if out["info"] else out
 
 
 def _probe_displacement(model: Model, e: np.ndarray, probe: str) -> np.ndarray:
@@ -215,61 +167,72 @@ def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                          key="target_load_factor")
     start = time.perf_counter()
     e, lam, factor = model.e0.copy(), np.zeros(len(model.constraints)), 0.0
-    floor = abs(target_load_factor) * float(np.linalg.norm(
-        _State(model, e, lam, factor).load))
-    state = _State(model, e, lam, factor, floor)
-    if state.force_res > tol or state.con_res > tol:   # a prestressed start: settle it
-        settled = _newton_at(model, e, lam, 0.0, tol, max_iter, floor)
-        if settled is None:
-            raise SolverError("arc length: the state at load factor 0 did not converge")
-        e, lam = settled[0], settled[1]
-        state = _State(model, e, lam, factor, floor)
-    du_q, _ = state.solve(False)
+    tangent = _load_tangent(model, e, lam, factor)
+    if tangent is None:
+        raise SolverError("arc length: the tangent is singular at the start")
+    floor = abs(target_load_factor) * tangent["load_norm"]
+    # a prestressed start is settled at load factor 0 (an unstressed one ends at once)
+    settled = kernel_static(model, e, lam, 0.0, tol=tol, max_iter=max_iter,
+                            force_scale=floor, check_start=True)
+    if settled["info"]:
+        raise SolverError("arc length: the state at load factor 0 did not converge ("
+                          f"{settled['message'].split('; raise')[0]})")
+    force_res, con_res = settled["force_res"], settled["con_res"]
+    if settled["iterations"]:
+        e, lam = settled["e"], settled["lam"]
+        tangent = _load_tangent(model, e, lam, factor)
+        if tangent is None:
+            raise SolverError("arc length: the tangent is singular at the settled start")
     direction = np.sign(target_load_factor)
-    arc = arc_length if arc_length > 0 else abs(target_load_factor) * np.linalg.norm(du_q) / 20
+    arc = arc_length if arc_length > 0 else \
+        abs(target_load_factor) * tangent["tangent_norm"] / 20
     if not arc > 0:
         raise InputError("arc length: the loads move nothing (zero load vector); nothing to "
                          "follow", group="solver", key="static_method")
     largest = 4.0 * arc
     factors, disps, counts, lengths = [0.0], [_probe_displacement(model, e, probe)], \
-        [negative_eigenvalues(model, state)], [0.0]
+        [negative_eigenvalues(model, e, lam, factor)], [0.0]
     previous: np.ndarray | None = None   # the last step's increment of e
     iterations_total, history = 0, []
     reached, message = False, ""
-    for _ in range(max_steps):
-        base_state = state
+    for number in range(1, max_steps + 1):
         for cut in range(MAX_CUTS + 1):
-            step = _arc_step(model, e, lam, factor, base_state, arc, previous, direction, tol,
-                             max_iter, floor)
-            if step is not None:
+            step = kernel_static(model, e, lam, factor, tol=tol, max_iter=max_iter,
+                                 force_scale=floor, mode=ARC_STEP, arc=arc,
+                                 direction=direction, previous=previous, load_step=number)
+            if not step["info"]:
                 break
             arc *= 0.5
         else:
             message = (f"arc length: no step converged from load factor {factor:.6g} with the "
-                       f"arc cut {MAX_CUTS} times (to {arc:.3e}); the path ends there")
+                       f"arc cut {MAX_CUTS} times (to {arc:.3e}); the path ends there (last: "
+                       f"{step['message'].split('; ')[0]})")
             break
-        e_new, lam_new, factor_new, iterations, state = step
+        e_new, lam_new, factor_new = step["e"], step["lam"], step["load_factor"]
+        iterations = step["iterations"] - 1     # the corrections (the predictor is the first)
         iterations_total += iterations
-        history.append(state.force_res)
+        history.append(step["force_res"])
+        last = step
         crossed = (factor - target_load_factor) * (factor_new - target_load_factor) <= 0 \
             and factor_new != factor
         if crossed:
             w = (target_load_factor - factor) / (factor_new - factor)
-            landed = _newton_at(model, e + w * (e_new - e), lam + w * (lam_new - lam),
-                                target_load_factor, tol, max_iter, floor)
+            landed = _kernel_newton_at(model, e + w * (e_new - e),
+                                       lam + w * (lam_new - lam), target_load_factor, tol,
+                                       max_iter, floor)
             if landed is None:   # too close to a limit: a shorter arc first
                 arc *= 0.5
-                state = base_state
                 continue
-            e_new, lam_new, factor_new = landed[0], landed[1], target_load_factor
-            state = _State(model, e_new, lam_new, factor_new, floor)
+            e_new, lam_new, factor_new = landed["e"], landed["lam"], target_load_factor
+            last = landed
             reached = True
+        force_res, con_res = last["force_res"], last["con_res"]
         previous = e_new - e
         lengths.append(lengths[-1] + float(np.linalg.norm(previous)))
         e, lam, factor = e_new, lam_new, factor_new
         factors.append(factor)
         disps.append(_probe_displacement(model, e, probe))
-        counts.append(negative_eigenvalues(model, state))
+        counts.append(negative_eigenvalues(model, e, lam, factor))
         if reached:
             break
         arc = min(largest, arc * float(np.clip(np.sqrt(DESIRED_ITERATIONS / max(iterations, 1)),
@@ -283,52 +246,13 @@ def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     path = StaticPath(factors_a, np.asarray(disps), counts_a, probe, limits, refined,
                       bifurcations, float(target_load_factor), reached, message)
     wall = time.perf_counter() - start
-    result = StaticResult(e, lam, "arc_length", iterations_total, state.force_res,
-                          state.con_res, wall, history,
+    result = StaticResult(e, lam, "arc_length", iterations_total, force_res, con_res, wall,
+                          history,
                           {"assembly": 0.0, "factorization": 0.0, "solve": wall, "total": wall},
                           extra={"load_factor": factor, "path_points": len(factors),
                                  "reached": reached})
     result.path = path
     return result
-
-
-def _arc_step(model: Model, e0: np.ndarray, lam0: np.ndarray, p0: float, state: _State,
-              arc: float, previous: np.ndarray | None, direction: float, tol: float,
-              max_iter: int, floor: float):
-    """One arc-length step of length ``arc`` from the converged (e0, lam0, p0) whose state
-    is ``state``: (e, lam, P, iterations, state) or None when it does not converge."""
-    du_q, dl_q = state.solve(False)
-    norm = np.linalg.norm(du_q)
-    if not norm > 0 or not np.all(np.isfinite(du_q)):
-        return None
-    sign = direction if previous is None else (1.0 if du_q @ previous >= 0 else -1.0)
-    dp = sign * arc / norm
-    de, dlam = dp * du_q, dp * dl_q
-    previous_res = np.inf
-    for iteration in range(1, max_iter + 1):
-        e, lam, factor = e0 + de, lam0 + dlam, p0 + dp
-        current = _State(model, e, lam, factor, floor)
-        if not np.isfinite(current.force_res):
-            return None
-        if iteration > 1 and converged(current.force_res, current.con_res, step_size,
-                                       np.linalg.norm(e - model.e0), tol, previous_res):
-            return e, lam, factor, iteration - 1, current
-        previous_res = current.force_res
-        du_r, dl_r = current.solve(True)
-        du_q, dl_q = current.solve(False)
-        base = de + du_r
-        a, b, c = du_q @ du_q, 2.0 * du_q @ base, base @ base - arc * arc
-        disc = b * b - 4 * a * c
-        if not a > 0 or disc < 0:
-            return None
-        roots = [(-b + s * np.sqrt(disc)) / (2 * a) for s in (1.0, -1.0)]
-        ddp = max(roots, key=lambda x: (base + x * du_q) @ de)
-        change = du_r + ddp * du_q
-        de, dlam, dp = de + change, dlam + dl_r + ddp * dl_q, dp + ddp
-        step_size = np.linalg.norm(change)
-        if not np.all(np.isfinite(de)):
-            return None
-    return None
 
 
 def diagnose_stall(model: Model, failure: LoadStepFailure, *, tol: float, max_iter: int,
@@ -338,23 +262,27 @@ def diagnose_stall(model: Model, failure: LoadStepFailure, *, tol: float, max_it
     load factor P* that converges; when there the tangent stiffness along the loads,
     q^T (K_T^{-1} q) at the start over the same at P*, has fallen below 0.1 or the
     tangent has a negative eigenvalue, the loads pass a maximum the structure cannot carry
-    under load control: say so and name arc_length. Otherwise the original failure."""
+    under load control: say so and name arc_length. Otherwise the original failure. The
+    diagnosis leaves the model as the failed solve left it (its counters and contact
+    guesses: the solves it tries are no part of the run's)."""
     e, lam, reached, above = failure.e, failure.lam, failure.last_factor, failure.factor
     for _ in range(cuts):
         middle = 0.5 * (reached + above)
-        trial = _newton_at(model, e, lam, middle, tol, max_iter)
+        trial = _kernel_newton_at(model, e, lam, middle, tol, max_iter, account=False)
         if trial is None:
             above = middle
         else:
-            e, lam, reached = trial[0], trial[1], middle
-    if _newton_at(model, e, lam, failure.factor, tol, max_iter) is not None:
+            e, lam, reached = trial["e"], trial["lam"], middle
+    if _kernel_newton_at(model, e, lam, failure.factor, tol, max_iter,
+                         account=False) is not None:
         return failure   # the whole step converges from closer: not a limit (load_steps helps)
-    start = _State(model, model.e0, np.zeros(len(model.constraints)), 0.0)
-    at = _State(model, e, lam, reached)
-    flex0 = start.load @ start.solve(False)[0] if start._lu is not None else np.nan
-    flex = at.load @ at.solve(False)[0] if at._lu is not None else np.inf
+    start = _load_tangent(model, model.e0, np.zeros(len(model.constraints)), 0.0,
+                          account=False)
+    at = _load_tangent(model, e, lam, reached, account=False)
+    flex0 = start["flexibility"] if start is not None else np.nan
+    flex = at["flexibility"] if at is not None else np.inf
     ratio = flex0 / flex if flex != 0 else 0.0
-    negative = negative_eigenvalues(model, at)
+    negative = negative_eigenvalues(model, e, lam, reached)
     if not (ratio < 0.1 or negative > 0):
         return failure
     head = str(failure).split("; raise")[0]

@@ -5,8 +5,9 @@ Two solvers share one convergence test (:func:`residuals`):
 * :func:`solve_newton` - Newton-Raphson on the symmetric saddle-point system
   [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] with MUMPS, in the kernel
   (fortran/src/solvers/static_solver.f90: the stepper's residual with the inertia off, one
-  call per load step, the load factor an argument); the same Newton assembled in Python,
-  the reference it is tested against, lives with the tests
+  call per load step, the load factor an argument; with the load factor an unknown the
+  same kernel Newton takes the steps of an arc-length path, solvers/path.py); the same
+  Newton assembled in Python, the reference it is tested against, lives with the tests
   (tests/reference/static_newton.py).
 * :func:`solve_split` - the split iteration of seed 000 (eqs. 40-57) as implemented in
   docs/theory.md: coordinates split into dependent ones e_D (one per constraint, N1) and
@@ -121,7 +122,46 @@ def residuals(model: Model, d: np.ndarray, lam: np.ndarray, internal: np.ndarray
 
 
 #: static_solver.f90's converged_by codes
-_CONVERGED_BY = {1: "residual", 2: "roundoff", 3: "step", 4: "floor", 5: "unloaded start"}
+_CONVERGED_BY = {1: "residual", 2: "roundoff", 3: "step", 4: "floor", 5: "unloaded start",
+                 6: "tangent only"}
+
+#: the modes of a kernel static call (system_static_solve's controls 'mode'): Newton at a
+#: given load factor, one arc-length step (the load factor an unknown), the tangent along
+#: the loads at a state
+NEWTON, ARC_STEP, LOAD_TANGENT = 0, 1, 2
+
+
+def kernel_static(model: Model, e: np.ndarray, lam: np.ndarray, load_factor: float, *,
+                  tol: float, max_iter: int, force_scale: float = -1.0, mode: int = NEWTON,
+                  check_start: bool = False, load_step: int = 1, load_steps: int = 1,
+                  arc: float = 0.0, direction: float = 1.0,
+                  previous: np.ndarray | None = None, account: bool = True) -> dict:
+    """One call of the kernel's static Newton (:meth:`~ancfdrv.kernel.KernelSystem.
+    static_solve`, fortran/src/solvers/static_solver.f90) from (e, lam) at ``load_factor``
+    in ``mode`` (:data:`NEWTON`, :data:`ARC_STEP`, :data:`LOAD_TANGENT`), from the model's
+    contact guesses. ``account``: carry the contact guesses on and count the force
+    evaluations, assemblies and factorizations on the model (False: a look that leaves the
+    model as it was, the diagnosis of a failed solve). Returns the kernel's dict (info /= 0
+    with its message: the caller decides what a failure means)."""
+    out = model.kernel.static_solve(
+        t=0.0, load_factor=load_factor, e0=model.e0, rows=model.pattern.rows,
+        cols=model.pattern.col_index, e=e, lam=lam, guesses=model.contact_guesses,
+        counts=model.contact_counts, tol=tol, length_scale=model.length_scale,
+        max_iter=max_iter, check_start=check_start, force_scale=force_scale,
+        load_step=load_step, load_steps=load_steps, mode=mode, arc=arc, direction=direction,
+        previous=previous)
+    if not account:
+        return out
+    model.contact_guesses, model.contact_counts = out["guesses"], out["counts"]
+    evaluations = out["iterations"] + 1
+    # an arc-length call evaluates the forces once more per iteration for the load vector
+    model.counters["elastic_force"] += (3 if mode != NEWTON else 2) * evaluations
+    model.counters["stiffness_assembly"] += evaluations
+    for item in (*model.moments, *model.vector_loads):
+        model.counters[item.effect] += evaluations
+    model.counters["factorizations"] += out["factorizations"]
+    model.counters["solves"] += out["factorizations"]
+    return out
 
 
 def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
@@ -143,38 +183,24 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     ncon = len(model.constraints)
     e, lam = model.e0.copy(), np.zeros(ncon)
     history: list[float] = []
-    total, factorizations, force_scale = 0, 0, -1.0
+    total, force_scale = 0, -1.0
     how, force_res, con_res = "", np.inf, np.inf
-    try:
-        for load_step in range(1, load_steps + 1):
-            out = model.kernel.static_solve(
-                t=0.0, load_factor=loads * load_step / load_steps, e0=model.e0,
-                rows=model.pattern.rows, cols=model.pattern.col_index, e=e, lam=lam,
-                guesses=model.contact_guesses, counts=model.contact_counts, tol=tol,
-                length_scale=model.length_scale, max_iter=max_iter,
-                check_start=load_step == 1 and load_steps == 1, force_scale=force_scale,
-                load_step=load_step, load_steps=load_steps)
-            model.contact_guesses, model.contact_counts = out["guesses"], out["counts"]
-            factorizations += out["factorizations"]
-            evaluations = out["iterations"] + 1
-            model.counters["elastic_force"] += 2 * evaluations
-            model.counters["stiffness_assembly"] += evaluations
-            for item in (*model.moments, *model.vector_loads):
-                model.counters[item.effect] += evaluations
-            if out["info"] in NOT_A_LOAD_FAILURE:  # the tolerance or the numbers, not the path
-                raise SolverError(out["message"])
-            if out["info"]:
-                raise LoadStepFailure(out["message"], e=e.copy(), lam=lam.copy(),
-                                      last_factor=loads * (load_step - 1) / load_steps,
-                                      factor=loads * load_step / load_steps)
-            e, lam, force_scale = out["e"], out["lam"], out["force_scale"]
-            history += out["history"].tolist()
-            total += out["iterations"]
-            how, force_res, con_res = (_CONVERGED_BY[out["converged_by"]], out["force_res"],
-                                       out["con_res"])
-    finally:
-        model.counters["factorizations"] += factorizations
-        model.counters["solves"] += factorizations
+    for load_step in range(1, load_steps + 1):
+        out = kernel_static(model, e, lam, loads * load_step / load_steps, tol=tol,
+                            max_iter=max_iter, force_scale=force_scale,
+                            check_start=load_step == 1 and load_steps == 1,
+                            load_step=load_step, load_steps=load_steps)
+        if out["info"] in NOT_A_LOAD_FAILURE:  # the tolerance or the numbers, not the path
+            raise SolverError(out["message"])
+        if out["info"]:
+            raise LoadStepFailure(out["message"], e=e.copy(), lam=lam.copy(),
+                                  last_factor=loads * (load_step - 1) / load_steps,
+                                  factor=loads * load_step / load_steps)
+        e, lam, force_scale = out["e"], out["lam"], out["force_scale"]
+        history += out["history"].tolist()
+        total += out["iterations"]
+        how, force_res, con_res = (_CONVERGED_BY[out["converged_by"]], out["force_res"],
+                                   out["con_res"])
     check_ffr(model, e, 0.0, when="in the static equilibrium")
     wall = time.perf_counter() - start
     return StaticResult(e, lam, "newton", total, force_res, con_res, wall, history,

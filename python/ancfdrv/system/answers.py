@@ -64,7 +64,7 @@ from .constraint_set import ConstraintSet
 from .expressions import Scalar
 from .joints import Constraint, LinearEquation
 from .model import Model, SetInfo
-from .registry import kind_of, reports_sections
+from .registry import axial_forces, kind_of, reports_sections
 from .sections import Box, Circle, Rectangle, Tube
 from .._lazy import LazyModule
 
@@ -933,13 +933,15 @@ def answer_inputs(model: Model) -> tuple[np.ndarray, object, np.ndarray, np.ndar
 
 
 class DynamicAnswers:
-    """Reactions, section forces and the stress envelope of a dynamic run, from the chunks
+    """Reactions, section forces, the stress envelope and the cables' (ropes') tension of a
+    dynamic run, from the chunks
     of the stepper (a sink: ``recorder(chunk)``; the chunks carry q and, when the model has
     force elements or eliminated joints, the rows' answers: a run with
     ``DynamicSettings.answers``). The kernel writes each row's force-element reactions and
     the residual of the equations of motion at the eliminated joints' coordinates from the
-    state it reached (``fortran/src/solvers/row_answers.f90``); the joints' reactions and the
-    beams' section forces are formed over all rows of a chunk at once."""
+    state it reached (``fortran/src/solvers/row_answers.f90``); the joints' reactions, the
+    beams' section forces and the cables' axial forces (their kind's law,
+    ``Kind.axial_forces``) are formed over all rows of a chunk at once."""
 
     def __init__(self, model: Model, *, stations: int = DEFAULT_STATIONS,
                  keep_sections: bool = False) -> None:
@@ -960,6 +962,13 @@ class DynamicAnswers:
         self.beams = {b.name: b for b in model.bodies if reports_sections(b)}
         #: the beams' element sets (their section forces: the kernel's, per chunk)
         self.section_sets = [info for info in model.sets if reports_sections(info.body)]
+        #: the bodies whose kind carries an axial force (cables, ropes: ``Kind.axial_forces``)
+        self._axial = {b.name: (b, law) for b in model.bodies
+                       if (law := axial_forces(b)) is not None}
+        #: per cable, per chunk: the smallest and the largest axial force along it (N,
+        #: tension positive) at each row, (nt,) each
+        self.tension: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {
+            name: [] for name in self._axial}
 
     @property
     def needs_answers(self) -> bool:
@@ -1051,6 +1060,11 @@ class DynamicAnswers:
             for name, (force, moment, _, axial) in found.items():
                 self.reactions[name].append((force, moment, axial))
         self._time_blocks.append(np.array(times))   # (a list of floats made on request)
+        if self._axial:
+            full = e_rows if self.model.reduction is None else self.model.expand(e_rows)
+            for name, (body, law) in self._axial.items():
+                forces = law(body, full)
+                self.tension[name].append((forces.min(axis=1), forces.max(axis=1)))
         for info in self.section_sets:
             self._record_sections(info.body.name, beam_section_forces(
                 self.model, info, e_rows, times, self.stations), times)

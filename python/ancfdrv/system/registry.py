@@ -27,7 +27,10 @@ A kind declares
 - whether its bodies report section forces and stresses at stations (``sections``: the
   answers, :mod:`.answers`, and the dynamic run's recorder of them);
 - its elements' end forces at a static state (``end_forces``: the section forces from the
-  elements' equilibrium, :mod:`.answers`);
+  elements' equilibrium, :mod:`.answers`) and their initial-stress stiffness
+  (``stress_stiffness``: the classical linear buckling's geometric stiffness);
+- its axial force along the body (``axial_forces``: a cable's and a rope's tension, which
+  the dynamic run's recorder of the answers keeps per row);
 - its mesh rows (``mesh``: the points and cells the XDMF writer shows for a body, through
   the writer's row builder, ``mesh_order``: the kinds' order in the mesh).
 
@@ -52,7 +55,7 @@ from typing import Any, Callable
 from ..io.schema import Key, check_call, register_group
 
 __all__ = ["Kind", "SetContext", "register", "kinds", "kind", "kind_of", "checked_values",
-           "set_builder", "add_to_kernel", "reports_sections"]
+           "set_builder", "add_to_kernel", "reports_sections", "axial_forces"]
 
 
 @dataclass
@@ -127,6 +130,16 @@ class Kind:
     #: static section forces from the elements' equilibrium (None: the kind has no beam
     #: sections)
     end_forces: Callable[[Any, Any, Any], tuple[Any, Any]] | None = None
+    #: ``axial_forces(body, e_rows) -> (nt, npoints)``: the axial force (N, tension positive)
+    #: at the body's integration points for full coordinates e_rows (nt, ndof), the tension
+    #: series a dynamic run writes (/dynamic/tension; None: the kind carries none)
+    axial_forces: Callable[[Any, Any], Any] | None = None
+    #: ``stress_stiffness(set_info, q, dq) -> (tangent, initial_stress) | None``: the
+    #: elements' tangents at the full coordinates q and their initial-stress part with each
+    #: stress replaced by its increment for dq, both (nde, nde, nel) on the element dofs, for
+    #: the classical linear buckling (solvers/buckling.py); None (or a None answer for a set
+    #: kind): the kind gives no initial-stress part
+    stress_stiffness: Callable[[Any, Any, Any], tuple[Any, Any] | None] | None = None
 
 
 _KINDS: dict[str, Kind] = {}
@@ -177,6 +190,12 @@ def reports_sections(body) -> bool:
     """Whether the body's kind reports section forces and stresses (``Kind.sections``)."""
     found = kind_of(body)
     return found is not None and found.sections
+
+
+def axial_forces(body) -> Callable[[Any, Any], Any] | None:
+    """The body's kind's axial forces along it (``Kind.axial_forces``), or None."""
+    found = kind_of(body)
+    return None if found is None else found.axial_forces
 
 
 def set_builder(body) -> Callable[[Any, SetContext], Any] | None:

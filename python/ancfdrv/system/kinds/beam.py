@@ -490,6 +490,25 @@ def _end_forces(info: SetInfo, q: np.ndarray,
     return np.asarray(force).reshape(nel, 8, 3), vectors
 
 
+def _stress_stiffness(info: SetInfo, q: np.ndarray, dq: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The elements' tangents at the full coordinates q and their initial-stress part for
+    the increment dq (each (24, 24, nel)); None for an 'ffr' set (its constant stiffness
+    has no initial-stress part the kernel could split off)."""
+    own = np.arange(24 * info.nel).reshape(info.nel, 24).T
+    e, de = q[info.dofs].reshape(-1, order="F"), dq[info.dofs].reshape(-1, order="F")
+    mat = info.body.material
+    if info.kind == "cubic":
+        return info.cubic.forces(own, e, True)[2], info.cubic.stress_stiffness(own, e, de)
+    if info.kind == "continuum":
+        args = (info.gradients, info.weights, info.nvolume, mat.youngs_modulus,
+                mat.poisson_ratio)
+        tangent = kernel.beam_nonlinear_forces(own, e, *args, True, info.shear_scales)[2]
+        return tangent, kernel.beam_nonlinear_stress_stiffness(own, e, de, *args,
+                                                               info.shear_scales)
+    return None
+
+
 KIND = register(Kind(
     group="beam", body_class=Beam, keys=KEYS, build=build, api="beam", word="beam",
     objects=("material", "section", "frame_drive"), scene_defaults={"formulation": "formulation"},
@@ -499,4 +518,4 @@ KIND = register(Kind(
     check_dimensions=lambda body: check_axis_dimensions(body, "beam"),
     plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
     planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1, sections=True,
-    end_forces=_end_forces))
+    end_forces=_end_forces, stress_stiffness=_stress_stiffness))

@@ -310,4 +310,5 @@ KIND = register(Kind(
     adders={"cable": _add_cable},
     check_dimensions=lambda body: check_axis_dimensions(body, "cable"),
     plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
-    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1))
+    planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1,
+    axial_forces=lambda body, e_rows: body.axial_forces(e_rows).reshape(len(e_rows), -1)))
