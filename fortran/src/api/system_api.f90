@@ -1203,7 +1203,7 @@ subroutine system_midpoint_residual(handle, ndof, ncon, h, t, states, lam, want_
   jacobian = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
-  if (ndof /= sys%ndof .or. ncon /= sys%ncon .or. .not. h > 0.0_dp) then
+  if (ndof /= sys%ndof .or. ncon /= sys%constraints%ncon .or. .not. h > 0.0_dp) then
     info = 2
     message = 'system_midpoint_residual: sizes inconsistent with the system (ndof, ncon) ' // &
               'or h <= 0'

@@ -32,9 +32,11 @@
 !> No I/O; failures return codes (time_integrator's integrator_chunk's).
 module energy_momentum
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, contact_state, frame_rotations, mass_product, &
-                               external_forces, evaluate_constraints, constraint_reaction, &
-                               to_full, to_reduced, energies, probe_output, power_count
+  use mechanical_system, only: system_model, contact_state, frame_rotations, &
+                               external_forces, energies, probe_output, power_count
+  use system_mass, only: mass_product
+  use system_constraints, only: evaluate_constraints, constraint_reaction
+  use system_reduction, only: to_full, to_reduced
   use element_sets, only: local_element_set
   use beam_nonlinear, only: continuum_set
   use beam_cubic, only: cubic_set
@@ -70,16 +72,16 @@ contains
     character(len=message_length) :: text
     integer :: s
     text = ''
-    if (sys%npoint > 0) then
+    if (sys%contact%npoint > 0) then
       text = 'contact (a contact pair)'
-    else if (sys%nfel > 0) then
+    else if (sys%force_elements%nfel > 0) then
       text = 'force elements (springs, dampers, cylinders)'
-    else if (sys%nvload > 0) then
+    else if (sys%loads%nvload > 0) then
       text = 'driven or follower point loads'
-    else if (nonempty_real(sys%moment_magnitude)) then
+    else if (nonempty_real(sys%loads%moment_magnitude)) then
       text = 'applied moments'
-    else if (allocated(sys%force_drive)) then
-      if (size(sys%force_drive) > 0) text = 'driven forces'
+    else if (allocated(sys%loads%force_drive)) then
+      if (size(sys%loads%force_drive) > 0) text = 'driven forces'
     end if
     if (text /= '') return
     if (allocated(sys%frames)) then
@@ -88,8 +90,8 @@ contains
       end if
     end if
     if (text /= '') return
-    if (allocated(sys%con_drive) .and. sys%ncon > 0) then
-      if (any(sys%con_drive /= 0)) text = 'driven constraints (drives)'
+    if (allocated(sys%constraints%drive) .and. sys%constraints%ncon > 0) then
+      if (any(sys%constraints%drive /= 0)) text = 'driven constraints (drives)'
     end if
     if (text /= '' .or. .not. allocated(sys%sets)) return
     do s = 1, size(sys%sets)
@@ -135,7 +137,7 @@ contains
     real(dp), intent(out), optional :: jacobian(:, :)
     real(dp) :: full0(sys%nfull), full1(sys%nfull), full_force(sys%nfull)
     real(dp) :: step(sys%ndof), mid(sys%ndof), loads(sys%ndof), shifted(sys%ndof)
-    real(dp) :: phi(sys%ncon), gradients(6, sys%ncon), reaction(sys%ndof), moved(sys%ndof)
+    real(dp) :: phi(sys%constraints%ncon), gradients(6, sys%constraints%ncon), reaction(sys%ndof), moved(sys%ndof)
     real(dp), allocatable :: coords0(:, :), coords1(:, :), force(:), tangent(:, :)
     logical :: want, touched(sys%ndof)
     integer :: n, s, el, k, i, j, c, code, nde
@@ -149,8 +151,8 @@ contains
       return
     end if
     if (want) jacobian = 0.0_dp
-    call to_full(sys, e0, .true., full0)
-    call to_full(sys, e1, .true., full1)
+    call to_full(sys%reduction, e0, .true., full0)
+    call to_full(sys%reduction, e1, .true., full1)
     full_force = 0.0_dp
     do s = 1, size(sys%sets)
       select type (set => sys%sets(s)%item)
@@ -183,29 +185,29 @@ contains
         return
       end select
     end do
-    call to_reduced(sys, full_force, internal)
+    call to_reduced(sys%reduction, full_force, internal)
     step = (2.0_dp / (h * h)) * (e1 - e0 - h * v0)
-    call mass_product(sys, step, residual(1:n))
+    call mass_product(sys%mass, step, residual(1:n))
     mid = 0.5_dp * (e0 + e1)
     call external_forces(sys, t0 + 0.5_dp * h, 1.0_dp, loads, info, mid)
     if (info /= 0) return
     residual(1:n) = residual(1:n) + internal - loads
     if (want) jacobian(1:n, 1:n) = jacobian(1:n, 1:n) + (2.0_dp / (h * h)) * mass
-    if (sys%ncon == 0) return
+    if (sys%constraints%ncon == 0) return
     ! - Phi_e(e_m)^T lambda, and the multipliers' columns -Phi_e(e_m)^T
-    call evaluate_constraints(sys, mid, t0 + h, phi, gradients, info)
+    call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, mid, t0 + h, phi, gradients, info)
     if (info /= 0) return
     reaction = 0.0_dp
-    call constraint_reaction(sys, gradients, lam, reaction)
+    call constraint_reaction(sys%constraints, gradients, lam, reaction)
     residual(1:n) = residual(1:n) + reaction
     if (want) then
       touched = .false.
-      do c = 1, sys%ncon
+      do c = 1, sys%constraints%ncon
         do s = 1, 6
-          do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-            jacobian(sys%term_dof(k), n + c) = jacobian(sys%term_dof(k), n + c) &
-                                               - gradients(s, c) * sys%term_coef(k)
-            touched(sys%term_dof(k)) = .true.
+          do k = sys%constraints%term_ptr(6 * (c - 1) + s), sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
+            jacobian(sys%constraints%term_dof(k), n + c) = jacobian(sys%constraints%term_dof(k), n + c) &
+                                               - gradients(s, c) * sys%constraints%term_coef(k)
+            touched(sys%constraints%term_dof(k)) = .true.
           end do
         end do
       end do
@@ -215,22 +217,22 @@ contains
         if (.not. touched(j)) cycle
         shifted = mid
         shifted(j) = shifted(j) + 0.5_dp
-        call evaluate_constraints(sys, shifted, t0 + h, phi, gradients, info)
+        call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, shifted, t0 + h, phi, gradients, info)
         if (info /= 0) return
         moved = 0.0_dp
-        call constraint_reaction(sys, gradients, lam, moved)
+        call constraint_reaction(sys%constraints, gradients, lam, moved)
         jacobian(1:n, j) = jacobian(1:n, j) + (moved - reaction)
       end do
     end if
-    call evaluate_constraints(sys, e1, t0 + h, phi, gradients, info)
+    call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, e1, t0 + h, phi, gradients, info)
     if (info /= 0) return
-    residual(n + 1:n + sys%ncon) = phi
+    residual(n + 1:n + sys%constraints%ncon) = phi
     if (want) then
-      do c = 1, sys%ncon
+      do c = 1, sys%constraints%ncon
         do s = 1, 6
-          do k = sys%term_ptr(6 * (c - 1) + s), sys%term_ptr(6 * (c - 1) + s + 1) - 1
-            jacobian(n + c, sys%term_dof(k)) = jacobian(n + c, sys%term_dof(k)) &
-                                               + gradients(s, c) * sys%term_coef(k)
+          do k = sys%constraints%term_ptr(6 * (c - 1) + s), sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
+            jacobian(n + c, sys%constraints%term_dof(k)) = jacobian(n + c, sys%constraints%term_dof(k)) &
+                                               + gradients(s, c) * sys%constraints%term_coef(k)
           end do
         end do
       end do
@@ -348,22 +350,22 @@ contains
     real(dp), intent(out) :: coefs(:)
     integer :: k
     count = 0
-    if (.not. sys%reduced) then
+    if (.not. sys%reduction%active) then
       count = 1
       cols(1) = i
       coefs(1) = 1.0_dp
-    else if (allocated(sys%reduction_select)) then
-      if (sys%reduction_select(i) > 0) then
+    else if (allocated(sys%reduction%select)) then
+      if (sys%reduction%select(i) > 0) then
         count = 1
-        cols(1) = sys%reduction_select(i)
+        cols(1) = sys%reduction%select(i)
         coefs(1) = 1.0_dp
       end if
     else
-      do k = sys%reduction_ptr(i), min(sys%reduction_ptr(i + 1) - 1, &
-                                       sys%reduction_ptr(i) + size(cols) - 1)
+      do k = sys%reduction%ptr(i), min(sys%reduction%ptr(i + 1) - 1, &
+                                       sys%reduction%ptr(i) + size(cols) - 1)
         count = count + 1
-        cols(count) = sys%reduction_col(k)
-        coefs(count) = sys%reduction_values(k)
+        cols(count) = sys%reduction%col(k)
+        coefs(count) = sys%reduction%values(k)
       end do
     end if
   end subroutine reduction_row
@@ -377,7 +379,7 @@ contains
     unit = 0.0_dp
     do j = 1, sys%ndof
       unit(j) = 1.0_dp
-      call mass_product(sys, unit, mass(:, j))
+      call mass_product(sys%mass, unit, mass(:, j))
       unit(j) = 0.0_dp
     end do
   end subroutine dense_mass
@@ -410,7 +412,7 @@ contains
     real(dp), intent(out) :: last_correction
     real(dp), allocatable :: mass(:, :), jacobian(:, :), residual(:), internal(:), full(:)
     real(dp), allocatable :: phi(:), gradients(:, :)
-    real(dp) :: e1(sys%ndof), lam1(sys%ncon), v1(sys%ndof)
+    real(dp) :: e1(sys%ndof), lam1(sys%constraints%ncon), v1(sys%ndof)
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain, contact_potential
     integer :: n, m, step, it, lapack_info
@@ -418,7 +420,7 @@ contains
     real(dp) :: previous
     type(bordered_factors) :: factors
     n = sys%ndof
-    m = sys%ncon
+    m = sys%constraints%ncon
     info = 0
     detail = 0
     steps_done = 0

@@ -140,7 +140,7 @@ contains
           c%last_h = cs%dt
         end if
         n = min(nrows - done, budget - tries)
-        neutral = neutral_method(run%settings) .and. sys%ncon > 0
+        neutral = neutral_method(run%settings) .and. sys%constraints%ncon > 0
         if (neutral) n = min(n, neutral_block_steps - c%block_steps)
         t_before = p%t
         call step_rows(sys, run, cs%dt, n, p, rows(:, done + 1:done + n), &
@@ -161,8 +161,8 @@ contains
         c%rows = c%rows + k
         done = done + k
         if (neutral) then
-          at_lambda = 1 + 6 * sys%nprobe
-          call block_rows(c, rows(at_lambda + 1:at_lambda + sys%ncon, done - k + 1:done))
+          at_lambda = 1 + 6 * sys%probes%nprobe
+          call block_rows(c, rows(at_lambda + 1:at_lambda + sys%constraints%ncon, done - k + 1:done))
           if (info /= 0) then
             call block_reset(c)
           else if (c%block_steps >= neutral_block_steps) then
