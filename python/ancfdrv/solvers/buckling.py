@@ -212,17 +212,35 @@ class LoadPath:
     def tangent(self) -> sp.csr_matrix:
         return self._terms(self.e, self.lam, self.factor)[1]
 
+    def rate(self) -> np.ndarray:
+        """de/dP at the current state: the tangent of the path, [[K, -G^T], [-G, 0]]
+        [de; dlambda] = [-dr/dP; 0] (the residual is affine in P, so dr/dP = r(e, P + 1) -
+        r(e, P))."""
+        n = self.model.ndof
+        unloaded, k, g = self._terms(self.e, self.lam, self.factor)
+        loaded = self._terms(self.e, self.lam, self.factor + 1.0)[0]
+        mat = sp.bmat([[k, -g.T], [-g, None]], format="csc") if g.shape[0] else k.tocsc()
+        rhs = np.concatenate([-(loaded - unloaded), np.zeros(g.shape[0])])
+        return spla.splu(mat).solve(rhs)[:n]
+
     def constraints(self) -> sp.csr_matrix:
         return self._terms(self.e, self.lam, self.factor)[2]
 
-    def solve(self, factor: float) -> None:
-        """Move the state to the load factor ``factor`` (in load_steps increments)."""
+    def matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """The tangent and the constraints' Jacobian at the current state."""
+        _, k, g = self._terms(self.e, self.lam, self.factor)
+        return k, g
+
+    def solve(self, factor: float, max_iter: int | None = None) -> None:
+        """Move the state to the load factor ``factor`` (in load_steps increments), each
+        in at most ``max_iter`` Newton iterations (default: the path's)."""
         n = self.model.ndof
         start = self.factor
+        max_iter = self.max_iter if max_iter is None else max_iter
         for step in range(1, self.load_steps + 1):
             target = start + (factor - start) * step / self.load_steps
             e, lam = self.e.copy(), self.lam.copy()
-            for iteration in range(1, self.max_iter + 1):
+            for iteration in range(1, max_iter + 1):
                 residual, k, g = self._terms(e, lam, target)
                 phi = self.model.constraints.jacobian(e, n)[0] if g.shape[0] else np.zeros(0)
                 residual = residual - g.T @ lam
@@ -237,7 +255,7 @@ class LoadPath:
                     break
             else:
                 raise SolverError(f"buckling: the static state at load factor {target:.6g} "
-                                  f"did not converge in {self.max_iter} Newton iterations "
+                                  f"did not converge in {max_iter} Newton iterations "
                                   "(raise buckling.load_steps)")
             if not np.all(np.isfinite(e)):
                 raise SolverError(f"buckling: non-finite static state at load factor "
@@ -320,6 +338,75 @@ def _root(history: list[tuple[float, float]]) -> float | None:
     roots = [(-a + sg * np.sqrt(disc)) / (2 * b) for sg in (1.0, -1.0)] if disc >= 0 else []
     roots = [r for r in roots if r > 0]
     return float(p0 + min(roots, key=lambda r: abs(r - x2))) if roots else None
+
+
+def _follow_basis(basis: np.ndarray | None, g1: sp.spmatrix, g: sp.spmatrix
+                  ) -> np.ndarray | None:
+    """The elastic basis of the scene's state (:func:`elastic_basis`) carried to a state
+    whose constraints' Jacobian is ``g``: projected on its null space and orthonormalized.
+    Joints that turn with the structure (a welded corner of a frame) turn their null space;
+    the scene's basis would no longer satisfy the constraints there and would hide the
+    direction in which the tangent becomes singular at a limit point. Constraints that do
+    not turn (``g`` equal to the scene's ``g1``) keep it."""
+    if basis is None or g.shape[0] == 0 or abs(g - g1).max() == 0:
+        return basis
+    nullity = null_space(g, basis.shape[0])
+    if nullity.shape[1] == basis.shape[1]:   # no zero-stiffness direction was removed
+        return nullity
+    q, _ = np.linalg.qr(nullity.T @ basis)
+    return nullity @ q
+
+
+#: Newton iterations of a step of the 'nonlinear' path before it is halved: from the last
+#: state a step with an equilibrium converges in a few; past a limit point there is none
+#: and Newton wanders (Lee's frame: 50 iterations each)
+STEP_ITERATIONS = 15
+
+
+def _root_limit(history: list[tuple[float, np.ndarray]]) -> float | None:
+    """The limit point of the load from the last two stable states: there the lowest
+    stiffness vanishes as sqrt(P_c - P), so omega^4 is linear in P (the root of its
+    secant); None while the stiffness does not fall between them."""
+    stable = [(p, x[0]) for p, x in history if x[0] > 0]
+    if len(stable) < 2:
+        return None
+    (p1, w1), (p2, w2) = stable[-2], stable[-1]
+    if not (p2 > p1 and w2 < w1):
+        return None
+    return float(p2 + w2**2 * (p2 - p1) / (w1**2 - w2**2))
+
+
+def _step_on_path(path: LoadPath, factor: float, rate: np.ndarray) -> bool:
+    """Move the path to ``factor``; False when Newton does not converge there or converges
+    off the path: its correction from the path's tangent (e + dP de/dP) larger than that
+    predicted increment itself, as when load control steps over a snap-through onto a
+    distant branch. The caller restores the state."""
+    start_e, start_factor = path.e.copy(), path.factor
+    try:
+        path.solve(factor, min(path.max_iter, STEP_ITERATIONS))
+    except SolverError:
+        return False
+    predicted = (factor - start_factor) * rate
+    return bool(np.linalg.norm(path.e - start_e - predicted) <= np.linalg.norm(predicted))
+
+
+def _bracket(history: list[tuple[float, np.ndarray]]) -> tuple[float, float]:
+    """The highest load factor whose state has a positive lowest stiffness and the lowest
+    above it with a negative one (infinity while none): a bifurcation passed lies between."""
+    low = max(p for p, x in history if x[0] > 0)
+    high = min((p for p, x in history if x[0] <= 0 and p > low), default=np.inf)
+    return low, high
+
+
+def _limit_at(history: list[tuple[float, np.ndarray]], low: float, high: float) -> float:
+    """The zero of the lowest stiffness between a stable state at ``low`` and ``high``:
+    interpolated linearly where a state at ``high`` is on the path (past a bifurcation),
+    else the middle (``high`` has no equilibrium on the path: a limit point of the load,
+    bracketed to rtol by the halved steps)."""
+    values = dict((p, x[0]) for p, x in history)
+    if low in values and high in values and values[high] <= 0 < values[low]:
+        return float(low + (high - low) * values[low] / (values[low] - values[high]))
+    return 0.5 * (low + high)
 
 
 #: the arguments of :func:`buckling_analysis` that are namelist keys (argument -> its
@@ -433,18 +520,48 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     factor, previous, critical = 1.0 + reference_factor, None, None
     saved: dict[float, tuple[np.ndarray, np.ndarray]] = {}  # states on the path
     ceiling = np.inf  # a factor known to lie past a fall and rise of the stiffness
+    rate = path.rate() if method == "nonlinear" else None
+    step, attempts, limit_point = reference_factor, 0, False
     while True:
-        _advance(path, factor)
-        factor = path.factor
-        k_t = path.tangent()
         if method == "linear":
+            _advance(path, factor)
+            factor = path.factor
+            k_t = path.tangent()
             kg = ((k_t - k1) / (factor - 1.0)
                   + stress_correction(model, e_scene, path.e, factor - 1.0)).tocsr()
             kg = 0.5 * (kg + kg.T)
             theta, vectors = _pencil(basis, k1, kg, g, count, eigen_tol)
             history.append((factor, None))
             break
-        w, vectors = _lowest(k_t, mass, g, how, track, basis)
+        attempts += 1
+        if attempts > 3 * max_updates:
+            raise SolverError(f"buckling: the load factor did not settle in {attempts - 1} "
+                              f"steps of the static path (last state at {path.factor:.6g} "
+                              "times the reference loads)")
+        last = (path.e.copy(), path.lam.copy(), path.factor)
+        if not _step_on_path(path, factor, rate):
+            # no equilibrium on the path at this factor (Newton failed, or left the path
+            # for a distant branch): halve the step; a step that shrinks to rtol is a limit
+            path.e, path.lam, path.factor = last[0].copy(), last[1].copy(), last[2]
+            # from a stable state whose stiffness has fallen: a limit point of the load
+            limit_point = limit_point or 0 < history[-1][1][0] < max(
+                x[0] for _, x in history)
+            if abs(factor - last[2]) <= rtol * last[2]:
+                lowest = history[-1][1][0]
+                if 0 < lowest and lowest > 1e-2 * max(x[0] for _, x in history):
+                    raise SolverError(
+                        f"buckling: the static state at load factor {factor:.6g} did not "
+                        f"converge from {last[2]:.6g}, where the structure keeps "
+                        f"{lowest / history[0][1][0]:.3g} of its lowest stiffness (no limit "
+                        "there): raise buckling.load_steps")
+                critical = _limit_at(history, last[2], factor)
+                break
+            factor = last[2] + 0.5 * (factor - last[2])
+            continue
+        step = factor - last[2]
+        rate = path.rate()
+        k_t, g_t = path.matrices()
+        w, vectors = _lowest(k_t, mass, g_t, how, track, _follow_basis(basis, g, g_t))
         # a rise after a fall that stopped well above zero (near the limit, omega^2 ~ 0 is
         # round-off and may rise by noise): either the step passed over a limit or the path
         # has none; step back to the fallen state and halve the interval (geometrically)
@@ -457,7 +574,9 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                 ceiling = factor
                 path.e, path.lam = saved[low][0].copy(), saved[low][1].copy()
                 path.factor = low
+                rate = path.rate()
                 factor = float(np.sqrt(low * ceiling))
+                step = factor - low
                 continue
             raise SolverError(
                 f"buckling: no stability limit on the static path: the lowest stiffness fell "
@@ -469,8 +588,14 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         saved[factor] = (path.e.copy(), path.lam.copy())
         history.append((factor, w))
         critical = _root([(p, x[0]) for p, x in history])
-        if critical is not None and previous is not None and \
-                abs(critical - previous) <= rtol * critical:
+        if limit_point and w[0] > 0:
+            critical = _root_limit(history) or critical
+        low, high = _bracket(history)
+        if critical is not None and not low < critical < high:
+            # the fit left the bracket of a bifurcation passed (noise of omega^2 ~ 0)
+            critical = _limit_at(history, low, high)
+        if high - low <= rtol * low or (critical is not None and previous is not None and
+                                        abs(critical - previous) <= rtol * critical):
             break
         if len(history) > max_updates:
             raise SolverError(
@@ -485,11 +610,13 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                     f"buckling: no stability limit up to {factor:.6g} times the reference "
                     "loads (the lowest stiffness does not fall as they grow: e.g. a square "
                     "section bent in a plane of symmetry has no lateral-torsional buckling)")
-            factor = min(factor * 4.0, float(np.sqrt(factor * ceiling)))
+            target = min(factor * 4.0, float(np.sqrt(factor * ceiling)))
         else:  # approach the estimate from below: the state at the limit is singular
-            factor = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
-            if factor >= ceiling:
-                factor = float(np.sqrt(path.factor * ceiling))
+            target = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
+            if target >= ceiling:
+                target = float(np.sqrt(path.factor * ceiling))
+        # steps grow at most twofold: a step that left the path was halved for a reason
+        factor = factor + float(np.clip(target - factor, -2 * abs(step), 2 * abs(step)))
     timing["path"] = time.perf_counter() - start
     reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
                              0.0)
@@ -510,7 +637,10 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         factors = [critical]
         for i in range(1, min(count, len(history[-1][1]))):
             root = _root([(p, x[i]) for p, x in history])
-            if root is not None:
+            # a root below the limit is an extrapolation of a mode still stiff there,
+            # unless that mode vanishes with the first (a double root: a column's planes)
+            if root is not None and (root > critical or
+                                     history[-1][1][i] <= 1e-3 * history[0][1][i]):
                 factors.append(root)
         keep = np.argsort(factors, kind="stable")
         factors = np.asarray(factors)[keep]
