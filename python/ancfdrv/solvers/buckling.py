@@ -445,7 +445,8 @@ def _confirm_linear(path: "LoadPath", factor: float, k1: sp.spmatrix, mass: sp.s
             f"buckling: the 'linear' estimate {factor:.6g} is not confirmed: the static path "
             f"could not be followed to {target:.6g} times the loads ({exc}); the structure "
             "may have a limit below it: use buckling.method = 'nonlinear'") from None
-    w, _ = _lowest(path.tangent(), mass, g, how, 1, basis)
+    k_t, g_t = path.matrices()
+    w, _ = _lowest(k_t, mass, g_t, how, 1, _follow_basis(basis, g, g_t))
     kept = float(w[0] / w1[0]) if w1[0] > 0 else 0.0
     if kept > CONFIRM_STIFFNESS:
         raise SolverError(
