@@ -409,6 +409,44 @@ def _limit_at(history: list[tuple[float, np.ndarray]], low: float, high: float) 
     return 0.5 * (low + high)
 
 
+#: the state below the first limit about which 'nonlinear' linearizes for the further
+#: factors: the last whose lowest stiffness keeps this share of the scene's (its tangent
+#: well conditioned, the secant to the limit's state short)
+BELOW_LIMIT = 0.05
+
+
+def _beyond_the_limit(path: LoadPath, model: Model, history, saved, critical: float,
+                      basis: np.ndarray | None, g: sp.spmatrix, count: int,
+                      eigen_tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """The factors after the first limit of the 'nonlinear' path and their shapes
+    (columns): the path cannot be followed past that limit, and the i-th lowest
+    omega_i^2(P) is a vibration mode's stiffness, no buckling mode's (extrapolated from
+    near the limit it read the portal's non-sway factor 17-25% high). So: the classical
+    linear buckling (K_A + nu K_g) phi = 0 about the state A below the limit
+    (:data:`BELOW_LIMIT`), K_g the secant of the tangents from A to the last state with
+    the beams' initial-stress part (:func:`stress_correction`); its lowest factor is the
+    limit itself, the ones above it are returned."""
+    w1 = history[0][1][0]
+    below = [p for p, x in history if p < min(critical, path.factor) and
+             x[0] >= BELOW_LIMIT * w1 and p in saved]
+    if not below:
+        return np.zeros(0), np.zeros((model.ndof, 0))
+    p_a = max(below)
+    e_a, lam_a = saved[p_a]
+    _, k_a, g_a = path._terms(e_a, lam_a, p_a)
+    k_b = path.tangent()
+    span = path.factor - p_a
+    kg = ((k_b - k_a) / span + stress_correction(model, e_a, path.e, span)).tocsr()
+    kg = 0.5 * (kg + kg.T)
+    theta, vectors = _pencil(_follow_basis(basis, g, g_a), k_a, kg, g_a, count + 1, eigen_tol)
+    positive = theta > 1e-12 * max(np.abs(theta).max(initial=0.0), 1e-300)
+    factors = p_a + 1.0 / theta[positive]
+    order = np.argsort(factors)
+    factors, vectors = factors[order], vectors[:, positive][:, order]
+    # the lowest is the limit itself (the mode the path found); the rest lie above it
+    return factors[1:count], vectors[:, 1:count]
+
+
 #: the arguments of :func:`buckling_analysis` that are namelist keys (argument -> its
 #: group; ``modes`` is ``count``): checked with the namelist's rules, and the keywords
 #: ``System.buckling`` takes besides ``n``
@@ -519,7 +557,8 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     else:
         history = [(1.0, None)]
     factor, previous, critical = 1.0 + reference_factor, None, None
-    saved: dict[float, tuple[np.ndarray, np.ndarray]] = {}  # states on the path
+    # states on the path
+    saved: dict[float, tuple[np.ndarray, np.ndarray]] = {1.0: (path.e.copy(), path.lam.copy())}
     ceiling = np.inf  # a factor known to lie past a fall and rise of the stiffness
     rate = path.rate() if method == "nonlinear" else None
     step, attempts, limit_point = reference_factor, 0, False
@@ -634,18 +673,14 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         if len(factors):
             _confirm_linear(path, float(factors[0]), k1, mass, g, how, basis)
     else:
-        # the first: the limit; the others: each mode's omega^2(P) extrapolated likewise
-        factors = [critical]
-        for i in range(1, min(count, len(history[-1][1]))):
-            root = _root([(p, x[i]) for p, x in history])
-            # a root below the limit is an extrapolation of a mode still stiff there,
-            # unless that mode vanishes with the first (a double root: a column's planes)
-            if root is not None and (root > critical or
-                                     history[-1][1][i] <= 1e-3 * history[0][1][i]):
-                factors.append(root)
-        keep = np.argsort(factors, kind="stable")
-        factors = np.asarray(factors)[keep]
-        shapes = vectors[:, keep].T.copy()
+        # the first: the limit; the others: the classical linear buckling about a state
+        # below it (_beyond_the_limit)
+        factors, shapes = np.array([critical]), vectors[:, :1].T.copy()
+        if count > 1:
+            above, more = _beyond_the_limit(path, model, history, saved, critical, basis, g,
+                                            count, eigen_tol)
+            factors = np.concatenate([factors, above])
+            shapes = np.vstack([shapes, more.T]) if len(above) else shapes
         negative_factor = 0.0
     for i, x in enumerate(shapes):
         peak = x[np.argmax(np.abs(x))]
