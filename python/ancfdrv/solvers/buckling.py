@@ -17,9 +17,13 @@ and follower loads' load stiffness and the constraint Hessians times the multipl
 
   the classical linear buckling about the static state: exact where K_T is affine in P
   (small pre-buckling deformation).
-* 'nonlinear': the lowest omega^2 of (K_T(P), M) followed along the static path from P = 1
-  until its zero (fitted through the states) reproduces itself: the stability limit of
-  the model, pre-buckling deformation included.
+* 'nonlinear': the lowest omega^2 of (K_T(P), M) on the constraints' null space of each
+  state, followed along the static path from P = 1 until its zero (fitted through the
+  states) reproduces itself or is bracketed to rtol: the stability limit of the model,
+  pre-buckling deformation included. A limit point of the load (a snap-through), which load
+  control cannot pass, is found by halving the steps that find no equilibrium on the path
+  (Newton fails, or lands on a distant branch). Further factors: the classical linear
+  buckling about the last state below that limit.
 
 Directions with no stiffness at the static state (a mechanism's free motion, a rigid body's
 free rotation) are not buckling: both methods work on the constrained coordinates where
@@ -226,9 +230,12 @@ class LoadPath:
     def constraints(self) -> sp.csr_matrix:
         return self._terms(self.e, self.lam, self.factor)[2]
 
-    def matrices(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        """The tangent and the constraints' Jacobian at the current state."""
-        _, k, g = self._terms(self.e, self.lam, self.factor)
+    def matrices(self, state: tuple[np.ndarray, np.ndarray, float] | None = None
+                 ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """The tangent and the constraints' Jacobian at the current state, or at ``state``
+        (e, lambda, load factor) of the path."""
+        e, lam, factor = (self.e, self.lam, self.factor) if state is None else state
+        _, k, g = self._terms(e, lam, factor)
         return k, g
 
     def solve(self, factor: float, max_iter: int | None = None) -> None:
@@ -433,7 +440,7 @@ def _beyond_the_limit(path: LoadPath, model: Model, history, saved, critical: fl
         return np.zeros(0), np.zeros((model.ndof, 0))
     p_a = max(below)
     e_a, lam_a = saved[p_a]
-    _, k_a, g_a = path._terms(e_a, lam_a, p_a)
+    k_a, g_a = path.matrices((e_a, lam_a, p_a))
     k_b = path.tangent()
     span = path.factor - p_a
     kg = ((k_b - k_a) / span + stress_correction(model, e_a, path.e, span)).tocsr()
