@@ -357,3 +357,27 @@ def test_scene_door_and_plot(tmp_path):
     png = tmp_path / "truss.png"
     assert main(["plot", str(out), "-o", str(png)]) == 0
     assert png.with_name("truss_path.png").is_file()
+
+
+def test_lee_frame_nonlinear_buckling_is_the_limit_load():
+    """Issue 34: 'nonlinear' buckling of Lee's frame (31 nodes per member, the reference
+    load EI / L^2, so the factor is P L^2 / EI) finds the limit point of the snap-through:
+    within 1% of 18.56 (measured -0.53%: the 31-node discretization; 81 nodes -0.23%) and
+    within 0.01% of the 31-node displacement-control limit 18.4628, the independent
+    reference (measured -0.004%, that reference's load increments). Load control cannot
+    pass the limit: steps past it are halved (Newton fails there or lands on the far
+    branch) until the step is rtol, and the lowest stiffness vanishes there on the
+    constraints' null space of the deformed state (on the scene's, which the welded
+    corner's turn leaves, it stayed at 0.15 of its start: no limit was seen)."""
+    from ancfdrv.solvers.buckling import buckling_analysis
+    reference = json.loads(DISPLACEMENT_CONTROL.read_text())["paths"]["31"]["limit_load"]
+    model = lee_frame(31, 1.0).assemble()
+    try:
+        result = buckling_analysis(model, model, 1)
+    finally:
+        model.close()
+    limit = float(result.load_factor[0])
+    print(f"\nLee's frame, 31 nodes, 'nonlinear' buckling: {limit:.4f} EI/L^2 "
+          f"({limit / LIMIT_REFERENCE - 1:+.3%}; displacement control {reference:.4f})")
+    assert abs(limit / LIMIT_REFERENCE - 1) < 0.01
+    assert limit == pytest.approx(reference, rel=1e-4)

@@ -1520,7 +1520,7 @@ def write_buckling(path: Path, model: Model, result) -> None:
     load_factor[N] (multiples of the reference loads; ascending, positive) and shapes[N, ndof]
     (largest component 1); /static holds the scene's static state (load factor 1), on which
     the shapes are drawn (mesh_static: the state at the limit, static_q, is folded far
-    beyond anything the structure carries, 1429 times the crane's loads)."""
+    beyond anything the structure carries, 739 times the crane's loads)."""
     attrs = {"method": result.extra.get("method", ""), "solver": result.method,
              "fixed_loads": ",".join(result.fixed_loads), "modes": len(result.load_factor),
              "wall_time_s": result.wall_time_s,

@@ -17,9 +17,13 @@ and follower loads' load stiffness and the constraint Hessians times the multipl
 
   the classical linear buckling about the static state: exact where K_T is affine in P
   (small pre-buckling deformation).
-* 'nonlinear': the lowest omega^2 of (K_T(P), M) followed along the static path from P = 1
-  until its zero (fitted through the states) reproduces itself: the stability limit of
-  the model, pre-buckling deformation included.
+* 'nonlinear': the lowest omega^2 of (K_T(P), M) on the constraints' null space of each
+  state, followed along the static path from P = 1 until its zero (fitted through the
+  states) reproduces itself or is bracketed to rtol: the stability limit of the model,
+  pre-buckling deformation included. A limit point of the load (a snap-through), which load
+  control cannot pass, is found by halving the steps that find no equilibrium on the path
+  (Newton fails, or lands on a distant branch). Further factors: the classical linear
+  buckling about the last state below that limit.
 
 Directions with no stiffness at the static state (a mechanism's free motion, a rigid body's
 free rotation) are not buckling: both methods work on the constrained coordinates where
@@ -212,17 +216,38 @@ class LoadPath:
     def tangent(self) -> sp.csr_matrix:
         return self._terms(self.e, self.lam, self.factor)[1]
 
+    def rate(self) -> np.ndarray:
+        """de/dP at the current state: the tangent of the path, [[K, -G^T], [-G, 0]]
+        [de; dlambda] = [-dr/dP; 0] (the residual is affine in P, so dr/dP = r(e, P + 1) -
+        r(e, P))."""
+        n = self.model.ndof
+        unloaded, k, g = self._terms(self.e, self.lam, self.factor)
+        loaded = self._terms(self.e, self.lam, self.factor + 1.0)[0]
+        mat = sp.bmat([[k, -g.T], [-g, None]], format="csc") if g.shape[0] else k.tocsc()
+        rhs = np.concatenate([-(loaded - unloaded), np.zeros(g.shape[0])])
+        return spla.splu(mat).solve(rhs)[:n]
+
     def constraints(self) -> sp.csr_matrix:
         return self._terms(self.e, self.lam, self.factor)[2]
 
-    def solve(self, factor: float) -> None:
-        """Move the state to the load factor ``factor`` (in load_steps increments)."""
+    def matrices(self, state: tuple[np.ndarray, np.ndarray, float] | None = None
+                 ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """The tangent and the constraints' Jacobian at the current state, or at ``state``
+        (e, lambda, load factor) of the path."""
+        e, lam, factor = (self.e, self.lam, self.factor) if state is None else state
+        _, k, g = self._terms(e, lam, factor)
+        return k, g
+
+    def solve(self, factor: float, max_iter: int | None = None) -> None:
+        """Move the state to the load factor ``factor`` (in load_steps increments), each
+        in at most ``max_iter`` Newton iterations (default: the path's)."""
         n = self.model.ndof
         start = self.factor
+        max_iter = self.max_iter if max_iter is None else max_iter
         for step in range(1, self.load_steps + 1):
             target = start + (factor - start) * step / self.load_steps
             e, lam = self.e.copy(), self.lam.copy()
-            for iteration in range(1, self.max_iter + 1):
+            for iteration in range(1, max_iter + 1):
                 residual, k, g = self._terms(e, lam, target)
                 phi = self.model.constraints.jacobian(e, n)[0] if g.shape[0] else np.zeros(0)
                 residual = residual - g.T @ lam
@@ -237,7 +262,7 @@ class LoadPath:
                     break
             else:
                 raise SolverError(f"buckling: the static state at load factor {target:.6g} "
-                                  f"did not converge in {self.max_iter} Newton iterations "
+                                  f"did not converge in {max_iter} Newton iterations "
                                   "(raise buckling.load_steps)")
             if not np.all(np.isfinite(e)):
                 raise SolverError(f"buckling: non-finite static state at load factor "
@@ -322,6 +347,113 @@ def _root(history: list[tuple[float, float]]) -> float | None:
     return float(p0 + min(roots, key=lambda r: abs(r - x2))) if roots else None
 
 
+def _follow_basis(basis: np.ndarray | None, g1: sp.spmatrix, g: sp.spmatrix
+                  ) -> np.ndarray | None:
+    """The elastic basis of the scene's state (:func:`elastic_basis`) carried to a state
+    whose constraints' Jacobian is ``g``: projected on its null space and orthonormalized.
+    Joints that turn with the structure (a welded corner of a frame) turn their null space;
+    the scene's basis would no longer satisfy the constraints there and would hide the
+    direction in which the tangent becomes singular at a limit point. Constraints that do
+    not turn (``g`` equal to the scene's ``g1``) keep it."""
+    if basis is None or g.shape[0] == 0 or abs(g - g1).max() == 0:
+        return basis
+    nullity = null_space(g, basis.shape[0])
+    if nullity.shape[1] == basis.shape[1]:   # no zero-stiffness direction was removed
+        return nullity
+    q, _ = np.linalg.qr(nullity.T @ basis)
+    return nullity @ q
+
+
+#: Newton iterations of a step of the 'nonlinear' path before it is halved: from the last
+#: state a step with an equilibrium converges in a few; past a limit point there is none
+#: and Newton wanders (Lee's frame: 50 iterations each)
+STEP_ITERATIONS = 15
+
+
+def _root_limit(history: list[tuple[float, np.ndarray]]) -> float | None:
+    """The limit point of the load from the last two stable states: there the lowest
+    stiffness vanishes as sqrt(P_c - P), so omega^4 is linear in P (the root of its
+    secant); None while the stiffness does not fall between them."""
+    stable = [(p, x[0]) for p, x in history if x[0] > 0]
+    if len(stable) < 2:
+        return None
+    (p1, w1), (p2, w2) = stable[-2], stable[-1]
+    if not (p2 > p1 and w2 < w1):
+        return None
+    return float(p2 + w2**2 * (p2 - p1) / (w1**2 - w2**2))
+
+
+def _step_on_path(path: LoadPath, factor: float, rate: np.ndarray) -> bool:
+    """Move the path to ``factor``; False when Newton does not converge there or converges
+    off the path: its correction from the path's tangent (e + dP de/dP) larger than that
+    predicted increment itself, as when load control steps over a snap-through onto a
+    distant branch. The caller restores the state."""
+    start_e, start_factor = path.e.copy(), path.factor
+    try:
+        path.solve(factor, min(path.max_iter, STEP_ITERATIONS))
+    except SolverError:
+        return False
+    predicted = (factor - start_factor) * rate
+    return bool(np.linalg.norm(path.e - start_e - predicted) <= np.linalg.norm(predicted))
+
+
+def _bracket(history: list[tuple[float, np.ndarray]]) -> tuple[float, float]:
+    """The highest load factor whose state has a positive lowest stiffness and the lowest
+    above it with a negative one (infinity while none): a bifurcation passed lies between."""
+    low = max(p for p, x in history if x[0] > 0)
+    high = min((p for p, x in history if x[0] <= 0 and p > low), default=np.inf)
+    return low, high
+
+
+def _limit_at(history: list[tuple[float, np.ndarray]], low: float, high: float) -> float:
+    """The zero of the lowest stiffness between a stable state at ``low`` and ``high``:
+    interpolated linearly where a state at ``high`` is on the path (past a bifurcation),
+    else the middle (``high`` has no equilibrium on the path: a limit point of the load,
+    bracketed to rtol by the halved steps)."""
+    values = dict((p, x[0]) for p, x in history)
+    if low in values and high in values and values[high] <= 0 < values[low]:
+        return float(low + (high - low) * values[low] / (values[low] - values[high]))
+    return 0.5 * (low + high)
+
+
+#: the state below the first limit about which 'nonlinear' linearizes for the further
+#: factors: the last whose lowest stiffness keeps this share of the scene's (its tangent
+#: well conditioned, the secant to the limit's state short)
+BELOW_LIMIT = 0.05
+
+
+def _beyond_the_limit(path: LoadPath, model: Model, history, saved, critical: float,
+                      basis: np.ndarray | None, g: sp.spmatrix, count: int,
+                      eigen_tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """The factors after the first limit of the 'nonlinear' path and their shapes
+    (columns): the path cannot be followed past that limit, and the i-th lowest
+    omega_i^2(P) is a vibration mode's stiffness, no buckling mode's (extrapolated from
+    near the limit it read the portal's non-sway factor 17-25% high). So: the classical
+    linear buckling (K_A + nu K_g) phi = 0 about the state A below the limit
+    (:data:`BELOW_LIMIT`), K_g the secant of the tangents from A to the last state with
+    the beams' initial-stress part (:func:`stress_correction`); its lowest factor is the
+    limit itself, the ones above it are returned."""
+    w1 = history[0][1][0]
+    below = [p for p, x in history if p < min(critical, path.factor) and
+             x[0] >= BELOW_LIMIT * w1 and p in saved]
+    if not below:
+        return np.zeros(0), np.zeros((model.ndof, 0))
+    p_a = max(below)
+    e_a, lam_a = saved[p_a]
+    k_a, g_a = path.matrices((e_a, lam_a, p_a))
+    k_b = path.tangent()
+    span = path.factor - p_a
+    kg = ((k_b - k_a) / span + stress_correction(model, e_a, path.e, span)).tocsr()
+    kg = 0.5 * (kg + kg.T)
+    theta, vectors = _pencil(_follow_basis(basis, g, g_a), k_a, kg, g_a, count + 1, eigen_tol)
+    positive = theta > 1e-12 * max(np.abs(theta).max(initial=0.0), 1e-300)
+    factors = p_a + 1.0 / theta[positive]
+    order = np.argsort(factors)
+    factors, vectors = factors[order], vectors[:, positive][:, order]
+    # the lowest is the limit itself (the mode the path found); the rest lie above it
+    return factors[1:count], vectors[:, 1:count]
+
+
 #: the arguments of :func:`buckling_analysis` that are namelist keys (argument -> its
 #: group; ``modes`` is ``count``): checked with the namelist's rules, and the keywords
 #: ``System.buckling`` takes besides ``n``
@@ -358,7 +490,8 @@ def _confirm_linear(path: "LoadPath", factor: float, k1: sp.spmatrix, mass: sp.s
             f"buckling: the 'linear' estimate {factor:.6g} is not confirmed: the static path "
             f"could not be followed to {target:.6g} times the loads ({exc}); the structure "
             "may have a limit below it: use buckling.method = 'nonlinear'") from None
-    w, _ = _lowest(path.tangent(), mass, g, how, 1, basis)
+    k_t, g_t = path.matrices()
+    w, _ = _lowest(k_t, mass, g_t, how, 1, _follow_basis(basis, g, g_t))
     kept = float(w[0] / w1[0]) if w1[0] > 0 else 0.0
     if kept > CONFIRM_STIFFNESS:
         raise SolverError(
@@ -431,20 +564,51 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     else:
         history = [(1.0, None)]
     factor, previous, critical = 1.0 + reference_factor, None, None
-    saved: dict[float, tuple[np.ndarray, np.ndarray]] = {}  # states on the path
+    # states on the path
+    saved: dict[float, tuple[np.ndarray, np.ndarray]] = {1.0: (path.e.copy(), path.lam.copy())}
     ceiling = np.inf  # a factor known to lie past a fall and rise of the stiffness
+    rate = path.rate() if method == "nonlinear" else None
+    step, attempts, limit_point = reference_factor, 0, False
     while True:
-        _advance(path, factor)
-        factor = path.factor
-        k_t = path.tangent()
         if method == "linear":
+            _advance(path, factor)
+            factor = path.factor
+            k_t = path.tangent()
             kg = ((k_t - k1) / (factor - 1.0)
                   + stress_correction(model, e_scene, path.e, factor - 1.0)).tocsr()
             kg = 0.5 * (kg + kg.T)
             theta, vectors = _pencil(basis, k1, kg, g, count, eigen_tol)
             history.append((factor, None))
             break
-        w, vectors = _lowest(k_t, mass, g, how, track, basis)
+        attempts += 1
+        if attempts > 3 * max_updates:
+            raise SolverError(f"buckling: the load factor did not settle in {attempts - 1} "
+                              f"steps of the static path (last state at {path.factor:.6g} "
+                              "times the reference loads)")
+        last = (path.e.copy(), path.lam.copy(), path.factor)
+        if not _step_on_path(path, factor, rate):
+            # no equilibrium on the path at this factor (Newton failed, or left the path
+            # for a distant branch): halve the step; a step that shrinks to rtol is a limit
+            path.e, path.lam, path.factor = last[0].copy(), last[1].copy(), last[2]
+            # from a stable state whose stiffness has fallen: a limit point of the load
+            limit_point = limit_point or 0 < history[-1][1][0] < max(
+                x[0] for _, x in history)
+            if abs(factor - last[2]) <= rtol * last[2]:
+                lowest = history[-1][1][0]
+                if 0 < lowest and lowest > 1e-2 * max(x[0] for _, x in history):
+                    raise SolverError(
+                        f"buckling: the static state at load factor {factor:.6g} did not "
+                        f"converge from {last[2]:.6g}, where the structure keeps "
+                        f"{lowest / history[0][1][0]:.3g} of its lowest stiffness (no limit "
+                        "there): raise buckling.load_steps")
+                critical = _limit_at(history, last[2], factor)
+                break
+            factor = last[2] + 0.5 * (factor - last[2])
+            continue
+        step = factor - last[2]
+        rate = path.rate()
+        k_t, g_t = path.matrices()
+        w, vectors = _lowest(k_t, mass, g_t, how, track, _follow_basis(basis, g, g_t))
         # a rise after a fall that stopped well above zero (near the limit, omega^2 ~ 0 is
         # round-off and may rise by noise): either the step passed over a limit or the path
         # has none; step back to the fallen state and halve the interval (geometrically)
@@ -457,7 +621,9 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                 ceiling = factor
                 path.e, path.lam = saved[low][0].copy(), saved[low][1].copy()
                 path.factor = low
+                rate = path.rate()
                 factor = float(np.sqrt(low * ceiling))
+                step = factor - low
                 continue
             raise SolverError(
                 f"buckling: no stability limit on the static path: the lowest stiffness fell "
@@ -469,8 +635,14 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         saved[factor] = (path.e.copy(), path.lam.copy())
         history.append((factor, w))
         critical = _root([(p, x[0]) for p, x in history])
-        if critical is not None and previous is not None and \
-                abs(critical - previous) <= rtol * critical:
+        if limit_point and w[0] > 0:
+            critical = _root_limit(history) or critical
+        low, high = _bracket(history)
+        if critical is not None and not low < critical < high:
+            # the fit left the bracket of a bifurcation passed (noise of omega^2 ~ 0)
+            critical = _limit_at(history, low, high)
+        if high - low <= rtol * low or (critical is not None and previous is not None and
+                                        abs(critical - previous) <= rtol * critical):
             break
         if len(history) > max_updates:
             raise SolverError(
@@ -485,11 +657,13 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
                     f"buckling: no stability limit up to {factor:.6g} times the reference "
                     "loads (the lowest stiffness does not fall as they grow: e.g. a square "
                     "section bent in a plane of symmetry has no lateral-torsional buckling)")
-            factor = min(factor * 4.0, float(np.sqrt(factor * ceiling)))
+            target = min(factor * 4.0, float(np.sqrt(factor * ceiling)))
         else:  # approach the estimate from below: the state at the limit is singular
-            factor = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
-            if factor >= ceiling:
-                factor = float(np.sqrt(path.factor * ceiling))
+            target = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
+            if target >= ceiling:
+                target = float(np.sqrt(path.factor * ceiling))
+        # steps grow at most twofold: a step that left the path was halved for a reason
+        factor = factor + float(np.clip(target - factor, -2 * abs(step), 2 * abs(step)))
     timing["path"] = time.perf_counter() - start
     reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
                              0.0)
@@ -506,15 +680,14 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
         if len(factors):
             _confirm_linear(path, float(factors[0]), k1, mass, g, how, basis)
     else:
-        # the first: the limit; the others: each mode's omega^2(P) extrapolated likewise
-        factors = [critical]
-        for i in range(1, min(count, len(history[-1][1]))):
-            root = _root([(p, x[i]) for p, x in history])
-            if root is not None:
-                factors.append(root)
-        keep = np.argsort(factors, kind="stable")
-        factors = np.asarray(factors)[keep]
-        shapes = vectors[:, keep].T.copy()
+        # the first: the limit; the others: the classical linear buckling about a state
+        # below it (_beyond_the_limit)
+        factors, shapes = np.array([critical]), vectors[:, :1].T.copy()
+        if count > 1:
+            above, more = _beyond_the_limit(path, model, history, saved, critical, basis, g,
+                                            count, eigen_tol)
+            factors = np.concatenate([factors, above])
+            shapes = np.vstack([shapes, more.T]) if len(above) else shapes
         negative_factor = 0.0
     for i, x in enumerate(shapes):
         peak = x[np.argmax(np.abs(x))]
