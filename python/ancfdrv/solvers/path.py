@@ -17,6 +17,10 @@ module drives the path:
   factorization, du = du_r + dP du_q, and dP is the root of the quadratic constraint whose
   new increment makes the smaller angle with the previous one (Crisfield's choice); no real
   root, or no convergence in ``max_iter`` iterations, halves the arc from the last point;
+* a point whose stability index differs from the last one's is tried again at half the arc
+  (up to CONFIRM_CUTS times): a long arc near a bifurcation can converge onto the other
+  branch (a strip with a lateral imperfection, past its lateral-torsional buckling load,
+  onto the nearly plane, unstable branch), a true limit or bifurcation point stays;
 * the arc adapts to the iteration count (the corrections): times sqrt(5 / iterations),
   within [1/2, 2] per step and at most 4 times the first arc.
 
@@ -145,6 +149,76 @@ def _marks(factors: np.ndarray, counts: np.ndarray, lengths: np.ndarray):
     return limits, refined, bifurcations
 
 
+#: shorter arcs tried before a change of the stability index is accepted as the path's: a
+#: long arc near a bifurcation can converge onto the other branch (past a strip's
+#: lateral-torsional buckling, onto the nearly plane, unstable one), a true change of
+#: stability (a limit or bifurcation point on the path) persists at half the arc
+CONFIRM_CUTS = 3
+
+
+@dataclass
+class _Point:
+    """The path's next point (or why there is none: ``message``)."""
+    e: np.ndarray | None = None
+    lam: np.ndarray | None = None
+    factor: float = 0.0
+    count: int = 0
+    arc: float = 0.0
+    iterations: int = 0
+    step_residual: float = 0.0
+    last: dict = field(default_factory=dict)
+    reached: bool = False
+    message: str = ""
+
+
+def _next_point(model: Model, e: np.ndarray, lam: np.ndarray, factor: float, arc: float,
+                direction: float, previous: np.ndarray | None, number: int, count: int,
+                target: float, *, tol: float, max_iter: int,
+                floor: float) -> _Point:
+    """One arc-length step from the converged point (e, lam, factor) of stability index
+    ``count``: the kernel's corrector, the arc halved where it does not converge (MAX_CUTS
+    times at most) or where the index changes (CONFIRM_CUTS times, then the change is the
+    path's); a step that crosses ``target`` is landed on it by Newton at that factor."""
+    cuts = confirms = 0
+    while True:
+        step = kernel_static(model, e, lam, factor, tol=tol, max_iter=max_iter,
+                             force_scale=floor, mode=ARC_STEP, arc=arc, direction=direction,
+                             previous=previous, load_step=number)
+        if step["info"]:
+            cuts += 1
+            if cuts > MAX_CUTS:
+                return _Point(message=(
+                    f"arc length: no step converged from load factor {factor:.6g} with the "
+                    f"arc cut {MAX_CUTS} times (to {arc:.3e}); the path ends there (last: "
+                    f"{step['message'].split('; ')[0]})"))
+            arc *= 0.5
+            continue
+        e_new, lam_new, factor_new = step["e"], step["lam"], step["load_factor"]
+        last, reached = step, False
+        if (factor - target) * (factor_new - target) <= 0 and factor_new != factor:
+            w = (target - factor) / (factor_new - factor)
+            landed = _kernel_newton_at(model, e + w * (e_new - e), lam + w * (lam_new - lam),
+                                       target, tol, max_iter, floor)
+            if landed is None:   # too close to a limit: a shorter arc first
+                cuts += 1
+                if cuts > MAX_CUTS:
+                    return _Point(message=(
+                        f"arc length: the path crosses target_load_factor = {target:.6g} "
+                        f"but Newton at it did not converge with the arc cut {MAX_CUTS} "
+                        "times"))
+                arc *= 0.5
+                continue
+            e_new, lam_new, factor_new, last, reached = \
+                landed["e"], landed["lam"], target, landed, True
+        count_new = negative_eigenvalues(model, e_new, lam_new, factor_new)
+        if count_new != count and confirms < CONFIRM_CUTS:
+            confirms += 1
+            arc *= 0.5
+            continue
+        return _Point(e_new, lam_new, factor_new, count_new, arc, step["iterations"] - 1,
+                      step["force_res"], last, reached)
+
+
 def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                      arc_length: float = 0.0, max_steps: int = 200,
                      target_load_factor: float = 1.0, control_probe: str = "") -> StaticResult:
@@ -196,47 +270,25 @@ def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     iterations_total, history = 0, []
     reached, message = False, ""
     for number in range(1, max_steps + 1):
-        for cut in range(MAX_CUTS + 1):
-            step = kernel_static(model, e, lam, factor, tol=tol, max_iter=max_iter,
-                                 force_scale=floor, mode=ARC_STEP, arc=arc,
-                                 direction=direction, previous=previous, load_step=number)
-            if not step["info"]:
-                break
-            arc *= 0.5
-        else:
-            message = (f"arc length: no step converged from load factor {factor:.6g} with the "
-                       f"arc cut {MAX_CUTS} times (to {arc:.3e}); the path ends there (last: "
-                       f"{step['message'].split('; ')[0]})")
+        point = _next_point(model, e, lam, factor, arc, direction, previous, number, counts[-1],
+                            target_load_factor, tol=tol, max_iter=max_iter, floor=floor)
+        if point.message:
+            message = point.message
             break
-        e_new, lam_new, factor_new = step["e"], step["lam"], step["load_factor"]
-        iterations = step["iterations"] - 1     # the corrections (the predictor is the first)
-        iterations_total += iterations
-        history.append(step["force_res"])
-        last = step
-        crossed = (factor - target_load_factor) * (factor_new - target_load_factor) <= 0 \
-            and factor_new != factor
-        if crossed:
-            w = (target_load_factor - factor) / (factor_new - factor)
-            landed = _kernel_newton_at(model, e + w * (e_new - e),
-                                       lam + w * (lam_new - lam), target_load_factor, tol,
-                                       max_iter, floor)
-            if landed is None:   # too close to a limit: a shorter arc first
-                arc *= 0.5
-                continue
-            e_new, lam_new, factor_new = landed["e"], landed["lam"], target_load_factor
-            last = landed
-            reached = True
+        arc, last, reached = point.arc, point.last, point.reached
+        iterations_total += point.iterations
+        history.append(point.step_residual)
         force_res, con_res = last["force_res"], last["con_res"]
-        previous = e_new - e
+        previous = point.e - e
         lengths.append(lengths[-1] + float(np.linalg.norm(previous)))
-        e, lam, factor = e_new, lam_new, factor_new
+        e, lam, factor = point.e, point.lam, point.factor
         factors.append(factor)
         disps.append(_probe_displacement(model, e, probe))
-        counts.append(negative_eigenvalues(model, e, lam, factor))
+        counts.append(point.count)
         if reached:
             break
-        arc = min(largest, arc * float(np.clip(np.sqrt(DESIRED_ITERATIONS / max(iterations, 1)),
-                                               0.5, 2.0)))
+        arc = min(largest, arc * float(np.clip(
+            np.sqrt(DESIRED_ITERATIONS / max(point.iterations, 1)), 0.5, 2.0)))
     else:
         message = (f"arc length: the path did not reach target_load_factor = "
                    f"{target_load_factor:.6g} in max_steps = {max_steps} steps (last load "
