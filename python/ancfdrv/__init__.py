@@ -32,6 +32,9 @@ from . import _lazy  # noqa: E402
 # System's analyses (System.static, simulate, modes, buckling) live in ancfdrv.analyses,
 # above the system layer: it is named here, at the top, and imported on the first analysis
 _lazy.provide("analyses", "ancfdrv.analyses")
+# the general scenes' builder (ancfdrv.builders.general), which io.scene.load_scene needs to
+# check a general scene's effects: loaded by the reader on the first general scene
+_lazy.provide("general_builder", "ancfdrv.builders.general")
 
 #: the public names, each imported from its module on first use (``ancf run --help`` and
 #: ``ancf info`` import neither the system nor the solvers)

@@ -21,6 +21,7 @@ from typing import Any, Callable
 
 import f90nml
 
+from .. import _lazy
 from ..errors import InputError
 from . import validate
 from .parameters import CONSTANTS, POINT_KEYS, Definitions, ExpressionError
@@ -670,8 +671,8 @@ def _general_scene(path: Path, nml: f90nml.Namelist, applied: list[str],
     scene = Scene(path=path, values=values, text=partial(namelist_text, nml),
                   overrides=applied, items=items, parameters=defs.parameters,
                   expressions=defs.record)
-    if not GENERAL_BUILDER:
-        raise RuntimeError("import ancfdrv (the package) to read general scenes")
+    if not GENERAL_BUILDER and not _lazy.load("general_builder"):
+        raise RuntimeError("no general scene builder: import ancfdrv (the package)")
     effects_of = GENERAL_BUILDER["effects_of"]
     if not listed:
         values["scene"]["effects"] = sorted(effects_of(items))
