@@ -569,6 +569,10 @@ def load_scene(path: str | Path, overrides: list[str] | None = None) -> Scene:
             raise InputError(f"not a valid Fortran namelist: {message}", file=file) from None
         validate.check_ended(file, groups)
     general = is_general(nml)
+    if general and not GENERAL_BUILDER:
+        # the kinds' groups (GENERAL_SCHEMA) and the builder register themselves when
+        # imported: a reader used before anything imported them loads them by name
+        _lazy.load("general_builder")
     repeatable = (*GENERAL_SCHEMA, *DEFINITION_GROUPS) if general else DEFINITION_GROUPS
     # (in a plain namelist the text is scanned for its lines only when a group that may not
     # repeat does)
