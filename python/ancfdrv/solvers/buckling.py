@@ -1,7 +1,9 @@
 """Buckling about the scene's static state (SPEC section 10, docs/theory.md "Buckling").
 
-The loads are split into fixed loads F (kept at their value, e.g. gravity) and the
-reference loads R (the others); the structure carries F + P R, P the load factor. Both
+The loads are split into fixed loads F (kept at their value, e.g. gravity; flagged in the
+model by System.assemble's ``fixed_loads``, so the kernel's load factor leaves them alone)
+and the reference loads R (the others); the structure carries F + P R, P the load factor,
+and every static state on the path is the kernel's static Newton's (:class:`LoadPath`). Both
 methods start from the scene's own static state, P = 1 (solved as the scene's static
 solve does, :func:`~.static.solve_newton`), never from P = 0: a rope that hangs a payload,
 a mechanism held by its loads or a cylinder's preload has no stiffness without its loads.
