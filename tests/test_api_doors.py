@@ -238,7 +238,7 @@ def test_the_solver_functions_check_their_own_arguments():
             modal_analysis(model, 0)
         with pytest.raises(InputError, match=r"buckling: &buckling method: 'exact' must be "
                            r"one of"):
-            buckling_analysis(model, model, 1, method="exact")
+            buckling_analysis(model, 1, method="exact")
     finally:
         model.close()
 

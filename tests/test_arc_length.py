@@ -373,7 +373,7 @@ def test_lee_frame_nonlinear_buckling_is_the_limit_load():
     reference = json.loads(DISPLACEMENT_CONTROL.read_text())["paths"]["31"]["limit_load"]
     model = lee_frame(31, 1.0).assemble()
     try:
-        result = buckling_analysis(model, model, 1)
+        result = buckling_analysis(model, 1)
     finally:
         model.close()
     limit = float(result.load_factor[0])

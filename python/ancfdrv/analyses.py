@@ -199,27 +199,11 @@ def buckling(system, n: int = 3, *, fixed_loads=(), effects=None,
         raise InputError(f"buckling: fixed_loads names unknown load(s) or effect(s) "
                          f"{', '.join(map(repr, unknown))} (loads: "
                          f"{', '.join(system.loads) or 'none'})")
-    model = system.assemble(effects=effects, linear_joints=linear_joints)
-    base = model
-    if fixed:
-        every = system.loads
-        try:
-            system.loads = {k: v for k, v in every.items() if k in fixed or v.effect in fixed}
-            # the fixed loads' own model: an effect whose loads are all scaled has no item
-            # in it, which is no news for the user (the system's assembly above warned of
-            # what is really unused)
-            with warnings.catch_warnings():
-                warnings.filterwarnings("ignore", "effect .* is listed but no item",
-                                        UserWarning)
-                base = system.assemble(effects=effects, linear_joints=linear_joints)
-        finally:
-            system.loads = every
+    model = system.assemble(effects=effects, linear_joints=linear_joints, fixed_loads=fixed)
     try:
-        return buckling_analysis(model, base, n, fixed_loads=fixed, **options)
+        return buckling_analysis(model, n, **options)
     finally:
         model.close()
-        if base is not model:
-            base.close()
 
 
 def show(system: System, path=None):

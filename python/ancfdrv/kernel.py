@@ -825,6 +825,18 @@ class KernelSystem:
             ndof=self.ndof)
         self._check(info, "loads", message)
 
+    def set_fixed_loads(self, fixed_force, force_fixed, moment_fixed, vload_fixed) -> None:
+        """The fixed loads (kept at their value whatever the load factor), after
+        :meth:`set_loads` and :meth:`set_vector_loads`: the fixed share of the constant
+        force and per driven force, dead moment and vector load whether it is fixed."""
+        def flags(x):
+            return _pad_last(np.asarray(x, dtype=np.int32), np.int32)
+        info, message = _kernel.system_set_fixed_loads(
+            self.handle, _f(fixed_force), len(force_fixed), flags(force_fixed),
+            len(moment_fixed), flags(moment_fixed), len(vload_fixed), flags(vload_fixed),
+            ndof=self.ndof)
+        self._check(info, "fixed loads", message)
+
     def set_vector_loads(self, loads) -> None:
         """Driven and follower point loads (model.VectorLoadInfo)."""
         ptr, dofs, coefs = [0], [], []

@@ -684,25 +684,6 @@ def eigen_settings(scene: Scene, group: str) -> dict[str, Any]:
     return {k: given.get(k, spec.default) for k, spec in SCHEMA[group].items()}
 
 
-def fixed_load_model(scene: Scene, fixed: list[str]) -> Model:
-    """The scene's model with only the loads named in ``fixed`` (load names or effects);
-    an unknown name is an InputError naming buckling.fixed_loads."""
-    from .builders import build_system
-    built = build_system(scene)
-    system = built.system
-    known = set(system.loads) | {load.effect for load in system.loads.values()}
-    unknown = [name for name in fixed if name not in known]
-    if unknown:
-        raise InputError(f"unknown load or effect {', '.join(map(repr, unknown))} (loads: "
-                         f"{', '.join(system.loads) or 'none'})", file=str(scene.path),
-                         group="buckling", key="fixed_loads")
-    system.loads = {name: load for name, load in system.loads.items()
-                    if name in fixed or load.effect in fixed}
-    model = system.assemble(effects=scene.effects,
-                            linear_joints=scene["solver"].get("linear_joints", "auto"))
-    return model
-
-
 def run_eigen(scene: Scene, model: Model, out: Path | MemoryOutput, timing: dict[str, Any]) -> None:
     """analysis = 'modal' (about the static equilibrium) or 'buckling'; writes /modal or
     /buckling, /static, and the XDMF of the shapes."""
@@ -723,19 +704,12 @@ def run_eigen(scene: Scene, model: Model, out: Path | MemoryOutput, timing: dict
         _io(out).write_modal(out, model, result)
     else:
         settings = eigen_settings(scene, "buckling")
-        fixed = list(settings["fixed_loads"])
-        base = fixed_load_model(scene, fixed) if fixed else model
-        try:
-            result = buckling_analysis(model, base, settings["modes"],
-                                       fixed_loads=tuple(fixed), method=settings["method"],
-                                       solver=settings["solver"], tol=solver["tol"],
-                                       max_iter=solver["max_iter"],
-                                       load_steps=settings["load_steps"],
-                                       rtol=settings["rtol"],
-                                       reference_factor=settings["reference_factor"])
-        finally:
-            if base is not model:
-                base.close()
+        # the fixed loads are flagged in the model (builders.build_model)
+        result = buckling_analysis(model, settings["modes"], method=settings["method"],
+                                   solver=settings["solver"], tol=solver["tol"],
+                                   max_iter=solver["max_iter"],
+                                   load_steps=settings["load_steps"], rtol=settings["rtol"],
+                                   reference_factor=settings["reference_factor"])
         _io(out).write_buckling(out, model, result)
     timing[f"{analysis}_total"] = time.perf_counter() - t0
     for phase, seconds in result.timing.items():

@@ -27,12 +27,14 @@ subroutine system_create(ndof, nfull, handle, info, message)
   allocate (sys%sets(0), sys%frames(0), sys%contact%pairs(0))
   allocate (sys%drives%kinds(0), sys%drives%ptr(1), sys%drives%data(0))
   sys%drives%ptr = 1
-  allocate (sys%loads%constant_force(ndof), sys%loads%force_drive(0), &
-            sys%loads%force_vectors(ndof, 0))
+  allocate (sys%loads%constant_force(ndof), sys%loads%fixed_force(ndof), &
+            sys%loads%force_drive(0), sys%loads%force_vectors(ndof, 0), &
+            sys%loads%force_fixed(0), sys%loads%vload_fixed(0))
   sys%loads%constant_force = 0.0_dp
+  sys%loads%fixed_force = 0.0_dp
   allocate (sys%loads%moment_dofs(3, 0), sys%loads%moment_axis(3, 0), &
             sys%loads%moment_magnitude(0), &
-            sys%loads%moment_reference(3, 0))
+            sys%loads%moment_reference(3, 0), sys%loads%moment_fixed(0))
   allocate (sys%constraints%kind(0), sys%constraints%drive(0), sys%constraints%term_ptr(1), &
             sys%constraints%term_dof(0), sys%constraints%params(8, 0), &
             sys%constraints%operand_const(6, 0), sys%constraints%term_coef(0))
@@ -712,7 +714,7 @@ end subroutine system_set_reduction
 
 !> Loads: the constant force (independent coordinates), driven forces phi_d(t) f_d, dead
 !> moments on director coordinates of the full vector (axis, magnitude, the director at
-!> t = 0 for the potential).
+!> t = 0 for the potential); none fixed (system_set_fixed_loads).
 subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, force_vectors, &
                             nmoment, moment_dofs, moment_axis, moment_magnitude, moment_reference, &
                             info, message)
@@ -751,7 +753,41 @@ subroutine system_set_loads(handle, ndof, constant_force, nforce, force_drive, f
   sys%loads%moment_axis = moment_axis(:, 1:nmoment)
   sys%loads%moment_magnitude = moment_magnitude(1:nmoment)
   sys%loads%moment_reference = moment_reference(:, 1:nmoment)
+  sys%loads%fixed_force = 0.0_dp
+  sys%loads%force_fixed = spread(.false., 1, nforce)
+  sys%loads%moment_fixed = spread(.false., 1, nmoment)
 end subroutine system_set_loads
+
+!> The fixed loads, kept at their value whatever the load factor (buckling's, beside the
+!> reference loads the factor scales), after system_set_loads and system_set_vector_loads:
+!> the fixed share of the constant force and, per driven force, dead moment and driven or
+!> follower point load, 1 when it is fixed (else 0), in their order there.
+subroutine system_set_fixed_loads(handle, ndof, fixed_force, nforce, force_fixed, nmoment, &
+                                  moment_fixed, nload, vload_fixed, info, message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle, ndof, nforce, nmoment, nload
+  real(dp), intent(in) :: fixed_force(ndof)
+  integer, intent(in) :: force_fixed(max(1, nforce)), moment_fixed(max(1, nmoment)), &
+                         vload_fixed(max(1, nload))
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  if (ndof /= sys%ndof .or. nforce /= size(sys%loads%force_drive) .or. &
+      nmoment /= size(sys%loads%moment_magnitude) .or. nload /= sys%loads%nvload) then
+    info = 2
+    message = 'system_set_fixed_loads: sizes inconsistent with the loads set'
+    return
+  end if
+  sys%loads%fixed_force = fixed_force
+  sys%loads%force_fixed = force_fixed(1:nforce) /= 0
+  sys%loads%moment_fixed = moment_fixed(1:nmoment) /= 0
+  sys%loads%vload_fixed = vload_fixed(1:nload) /= 0
+end subroutine system_set_fixed_loads
 
 !> Driven and follower point loads (vector_loads): kinds, drives (1-based, 0: none), vectors
 !> (3, n), torsion shares (2, n), and per load and slot (a, b, p) the terms ptr(3 n + 1)
@@ -796,6 +832,7 @@ subroutine system_set_vector_loads(handle, nload, nterm, kinds, drives, vectors,
   sys%loads%vload_ptr = ptr
   sys%loads%vload_dof = dofs(1:nterm)
   sys%loads%vload_coef = coefs(1:nterm)
+  sys%loads%vload_fixed = spread(.false., 1, nload)
 end subroutine system_set_vector_loads
 
 !> The slots of the force elements (set before system_set_force_elements): nslot slots with

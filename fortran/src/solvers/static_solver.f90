@@ -218,7 +218,8 @@ contains
         ! no load at all and the internal forces zero to their own round-off: the start is
         ! the equilibrium (a load, however small, is always solved for)
         if (all(loads == 0.0_dp) .and. &
-            all(factor * sys%loads%moment_magnitude == 0.0_dp) .and. &
+            all(merge(1.0_dp, factor, sys%loads%moment_fixed) &
+                * sys%loads%moment_magnitude == 0.0_dp) .and. &
             norm2(residual) <= residual_floor(1.0_dp) .and. &
             max_abs(phi) <= tol * length_scale) then
           converged_by = by_unloaded_start

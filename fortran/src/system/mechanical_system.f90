@@ -41,7 +41,7 @@ module mechanical_system
   use system_drives, only: drive_table, drive_at
   use system_constraints, only: constraint_table, evaluate_constraints
   use system_loads, only: load_set, vector_load_forces, vector_load_tangent, &
-                          dead_moment_forces, dead_moment_energy
+                          dead_moment_forces, dead_moment_energy, load_scale
   use system_force_elements, only: force_element_table, force_element_forces, &
                                    force_element_at
   use system_contact, only: contact_set, contact_pair, contact_state, contact_record, &
@@ -345,8 +345,8 @@ contains
     call reduce_tangent(sys%reduction, values_full, tangent_values)
   end subroutine internal_forces
 
-  !> Configuration-independent external loads at t, times load_factor: the constant loads
-  !> plus the driven forces. info = 5 when a drive fails.
+  !> Configuration-independent external loads at t, times load_factor (the fixed loads at
+  !> their value): the constant loads plus the driven forces. info = 5 when a drive fails.
   !> With e, the driven and follower point loads at e are added (vector_load_forces).
   subroutine external_forces(sys, t, load_factor, force, info, e)
     type(system_model), intent(in) :: sys
@@ -358,7 +358,8 @@ contains
     real(dp), allocatable :: e_full(:), full_force(:), reduced(:)
     integer :: d
     info = 0
-    force = load_factor * sys%loads%constant_force
+    force = load_factor * sys%loads%constant_force &
+            + (1.0_dp - load_factor) * sys%loads%fixed_force
     if (present(e) .and. sys%loads%nvload > 0) then
       allocate (e_full(sys%nfull), full_force(sys%nfull), reduced(sys%ndof))
       call to_full(sys%reduction, e, .true., e_full)
@@ -375,7 +376,8 @@ contains
         info = 5
         return
       end if
-      force = force + load_factor * phi * sys%loads%force_vectors(:, d)
+      force = force + load_scale(sys%loads%force_fixed(d), load_factor) * phi &
+                      * sys%loads%force_vectors(:, d)
     end do
   end subroutine external_forces
 

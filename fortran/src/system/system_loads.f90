@@ -1,7 +1,9 @@
 !> The loads of a mechanical system (a component of system_model): constant loads and
 !> driven forces phi_d(t) f_d on the independent coordinates, dead moments on director
 !> coordinates of the full vector, and driven and follower point loads (vector_loads); the
-!> forces, the point loads' Jacobian and the dead moments' potential. No I/O.
+!> forces, the point loads' Jacobian and the dead moments' potential. A load may be fixed:
+!> kept at its value whatever the load factor (buckling's fixed loads, e.g. gravity, beside
+!> the reference loads the factor scales; load_scale). No I/O.
 module system_loads
   use ancf_kinds, only: dp
   use section_moment, only: moment_force, moment_force_only, moment_angle
@@ -12,27 +14,41 @@ module system_loads
   implicit none
   private
   public :: load_set, vector_load_forces, vector_load_tangent, dead_moment_forces, &
-            dead_moment_energy, moment_pattern_size, moment_pattern, moment_tangent
+            dead_moment_energy, moment_pattern_size, moment_pattern, moment_tangent, &
+            load_scale
 
   type :: load_set
-    ! constant (reduced), driven forces phi_d(t) f_d (reduced), dead moments on full
-    ! director coordinates (axis, magnitude, the director at t = 0 for the potential)
-    real(dp), allocatable :: constant_force(:)
+    ! constant (reduced; fixed_force: its fixed share), driven forces phi_d(t) f_d
+    ! (reduced), dead moments on full director coordinates (axis, magnitude, the director
+    ! at t = 0 for the potential); force_fixed, moment_fixed, vload_fixed: the fixed loads
+    real(dp), allocatable :: constant_force(:), fixed_force(:)
     integer, allocatable :: force_drive(:)
     real(dp), allocatable :: force_vectors(:, :)
+    logical, allocatable :: force_fixed(:)
     integer, allocatable :: moment_dofs(:, :)
     real(dp), allocatable :: moment_axis(:, :), moment_magnitude(:), moment_reference(:, :)
+    logical, allocatable :: moment_fixed(:)
     ! driven and follower point loads (vector_loads): per load a kind, a drive (0: none), a
     ! vector, the torsion shares, and the terms of its slots a, b, p on full coordinates
     ! (vload_ptr(3 (l - 1) + s) .. vload_ptr(3 (l - 1) + s + 1) - 1)
     integer :: nvload = 0
     integer, allocatable :: vload_kind(:), vload_drive(:), vload_ptr(:), vload_dof(:)
     real(dp), allocatable :: vload_vector(:, :), vload_shares(:, :), vload_coef(:)
+    logical, allocatable :: vload_fixed(:)
   end type load_set
 
 contains
 
-  !> The dead moments (times load_factor) at the full coordinates e_full subtracted from
+  !> The factor a load is applied with at the load factor load_factor: 1 for a fixed load
+  !> (kept at its value), load_factor for the others.
+  pure real(dp) function load_scale(fixed, load_factor) result(scale)
+    logical, intent(in) :: fixed
+    real(dp), intent(in) :: load_factor
+    scale = load_factor
+    if (fixed) scale = 1.0_dp
+  end function load_scale
+
+  !> The dead moments (times load_factor; the fixed ones at their value) at the full coordinates e_full subtracted from
   !> full_force (the residual's internal sign); the force alone: the moment's Jacobian is
   !> not part of the tangent. info = 6: a moment is undefined.
   subroutine dead_moment_forces(loads, e_full, load_factor, full_force, info)
@@ -50,7 +66,8 @@ contains
         director(k) = e_full(loads%moment_dofs(k, m))
       end do
       call moment_force_only(director, loads%moment_axis(:, m), &
-                             load_factor * loads%moment_magnitude(m), moment, info)
+                             load_scale(loads%moment_fixed(m), load_factor) &
+                             * loads%moment_magnitude(m), moment, info)
       if (info /= 0) then
         info = 6
         return
@@ -78,7 +95,7 @@ contains
   end function dead_moment_energy
 
   !> The driven and follower point loads at the full coordinates e_full and time t, times
-  !> load_factor, added to full_force. info = 5 when a drive fails, 6 for a malformed load.
+  !> load_factor (the fixed ones at their value), added to full_force. info = 5 when a drive fails, 6 for a malformed load.
   subroutine vector_load_forces(loads, drives, t, e_full, load_factor, full_force, info)
     type(load_set), intent(in) :: loads
     type(drive_table), intent(in) :: drives
@@ -138,7 +155,8 @@ contains
     end do
   end subroutine vector_load_tangent
 
-  !> Load l of the driven and follower point loads at (e_full, t), times load_factor: its
+  !> Load l of the driven and follower point loads at (e_full, t), times load_factor (a
+  !> fixed load at its value): its
   !> generalized forces on its slots (a, b, p) and their Jacobian (vector_loads). info = 5
   !> when its drive fails, 6 for a malformed load.
   subroutine vector_load_at(loads, drives, l, t, e_full, load_factor, force, jacobian, info)
@@ -167,7 +185,9 @@ contains
         x(:, s) = x(:, s) + loads%vload_coef(k) * e_full(dof:dof + 2)
       end do
     end do
-    call vector_load_force(loads%vload_kind(l), load_factor * phi * loads%vload_vector(:, l), &
+    call vector_load_force(loads%vload_kind(l), &
+                           load_scale(loads%vload_fixed(l), load_factor) * phi &
+                           * loads%vload_vector(:, l), &
                            loads%vload_shares(:, l), x(:, 1), x(:, 2), force, jacobian, info)
     if (info /= 0) info = 6
   end subroutine vector_load_at
@@ -213,7 +233,7 @@ contains
     end do
   end subroutine moment_pattern
 
-  !> Minus the dead moments' Jacobian (times load_factor) at e on the independent
+  !> Minus the dead moments' Jacobian (times load_factor; the fixed ones at their value) at e on the independent
   !> coordinates, the entries of moment_pattern (the residual carries minus the external
   !> forces). info = 6: a moment is undefined.
   subroutine moment_tangent(loads, reduction, e, load_factor, values, info)
@@ -228,7 +248,8 @@ contains
     k = 0
     do m = 1, size(loads%moment_magnitude)
       call moment_force(full_at(reduction, e, loads%moment_dofs(:, m)), &
-                        loads%moment_axis(:, m), load_factor * loads%moment_magnitude(m), &
+                        loads%moment_axis(:, m), &
+                        load_scale(loads%moment_fixed(m), load_factor) * loads%moment_magnitude(m), &
                         moment, jacobian, hessian, info)
       if (info /= 0) then
         info = 6

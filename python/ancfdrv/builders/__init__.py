@@ -31,8 +31,25 @@ def build_system(scene) -> BuiltSystem:
     return BUILDERS[scene.kind](scene)
 
 
+def fixed_loads(scene, system: System) -> tuple[str, ...]:
+    """The loads (names or effects) a buckling scene keeps at their value
+    (buckling.fixed_loads; none for other analyses): an unknown name is an InputError
+    naming buckling.fixed_loads."""
+    if scene["scene"]["analysis"] != "buckling":
+        return ()
+    fixed = tuple((scene.values.get("buckling") or {}).get("fixed_loads", ()))
+    known = set(system.loads) | {load.effect for load in system.loads.values()}
+    unknown = [name for name in fixed if name not in known]
+    if unknown:
+        raise InputError(f"unknown load or effect {', '.join(map(repr, unknown))} (loads: "
+                         f"{', '.join(system.loads) or 'none'})", file=str(scene.path),
+                         group="buckling", key="fixed_loads")
+    return fixed
+
+
 def build_model(scene) -> Model:
-    """The assembled model of a scene: only the scene's effects are computed."""
+    """The assembled model of a scene: only the scene's effects are computed; a buckling
+    scene's fixed loads are flagged (:func:`fixed_loads`)."""
     built = build_system(scene)
     built.system.planar = scene["scene"].get("planar", "off")  # system/planar.py
     return built.system.assemble(effects=scene.effects,
@@ -42,7 +59,8 @@ def build_model(scene) -> Model:
                                  bounds=scene["scene"].get("bounds", "check"),
                                  warnings=built.warnings, response=built.response,
                                  # deflection relative to the supports' rigid motion
-                                 supports=scene.kind == "general")
+                                 supports=scene.kind == "general",
+                                 fixed_loads=fixed_loads(scene, built.system))
 
 
 def stage_bounds(scene) -> dict[str, tuple[float, float]] | None:

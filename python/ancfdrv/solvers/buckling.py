@@ -1,7 +1,9 @@
 """Buckling about the scene's static state (SPEC section 10, docs/theory.md "Buckling").
 
-The loads are split into fixed loads F (kept at their value, e.g. gravity) and the
-reference loads R (the others); the structure carries F + P R, P the load factor. Both
+The loads are split into fixed loads F (kept at their value, e.g. gravity; flagged in the
+model by System.assemble's ``fixed_loads``, so the kernel's load factor leaves them alone)
+and the reference loads R (the others); the structure carries F + P R, P the load factor,
+and every static state on the path is the kernel's static Newton's (:class:`LoadPath`). Both
 methods start from the scene's own static state, P = 1 (solved as the scene's static
 solve does, :func:`~.static.solve_newton`), never from P = 0: a rope that hangs a payload,
 a mechanism held by its loads or a cylinder's preload has no stiffness without its loads.
@@ -48,7 +50,7 @@ from ..kernel import DirectSolver
 from ..system.model import Model
 from ..system.registry import kind_of
 from .modal import arpack_start, check_free, linearize, null_space
-from .static import StaticResult, solve_newton
+from .static import StaticResult, kernel_static, solve_newton
 from .._lazy import LazyModule
 
 # imported on first use (ancfdrv._lazy): ~10 MB most runs never need; scipy.sparse (~19 MB
@@ -178,96 +180,63 @@ def _sparse(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int, tol: f
 
 
 class LoadPath:
-    """Static states under F + P R (fixed loads F, reference loads R, load factor P) by
-    Newton with continuation from the last state. The loads enter linearly with the kernel's
-    load factor, so with ``model`` holding F + R and ``base_model`` F alone the residual is
-    r_model(e, P) + r_base(e, 1) - r_base(e, P) (the elastic parts cancel); without fixed
-    loads (``base_model is model``) it is r_model(e, P)."""
+    """Static states under F + P R (the fixed loads F flagged in the model, System.assemble's
+    ``fixed_loads``; the reference loads R; the load factor P) by the kernel's static Newton
+    (:func:`~.static.kernel_static`, the scene's static solve's) with continuation from the
+    last state. The kernel applies the load factor to the reference loads alone, so its
+    residual, the tangent of :func:`~.modal.linearize` (the fixed dead moments' and follower
+    loads' load stiffness at their value) and the load vector hold F at its value."""
 
-    def __init__(self, model: Model, base_model: Model, *, tol: float, max_iter: int,
-                 load_steps: int) -> None:
-        self.model, self.base = model, base_model
+    def __init__(self, model: Model, *, tol: float, max_iter: int, load_steps: int) -> None:
+        self.model = model
         self.tol, self.max_iter, self.load_steps = tol, max_iter, load_steps
         self.e = model.e0.copy()
         self.lam = np.zeros(len(model.constraints))
         self.factor = 0.0
         self.solves = 0
-        self.k0: sp.csr_matrix | None = None
-
-    def _terms(self, e, lam, factor):
-        parts = [(self.model, factor, 1.0)]
-        if self.base is not self.model:
-            parts += [(self.base, 1.0, 1.0), (self.base, factor, -1.0)]
-        residual = np.zeros(self.model.ndof)
-        stiffness = None
-        lin = None
-        for model, lf, sign in parts:
-            out = model.forces(e, load_factor=lf)
-            residual += sign * (out["internal"] - out["external"])
-            lin = linearize(model, e, lam if sign > 0 else np.zeros_like(lam), load_factor=lf)
-            stiffness = sign * lin.stiffness if stiffness is None else \
-                stiffness + sign * lin.stiffness
-        if self.base is not self.model:  # the constraint Hessian term once, not twice
-            lin_h = linearize(self.base, e, lam, load_factor=1.0)
-            lin_0 = linearize(self.base, e, np.zeros_like(lam), load_factor=1.0)
-            stiffness = stiffness - (lin_h.stiffness - lin_0.stiffness)
-        return residual, stiffness.tocsr(), lin.constraints
 
     def tangent(self) -> sp.csr_matrix:
-        return self._terms(self.e, self.lam, self.factor)[1]
+        return self.matrices()[0]
 
     def rate(self) -> np.ndarray:
         """de/dP at the current state: the tangent of the path, [[K, -G^T], [-G, 0]]
         [de; dlambda] = [-dr/dP; 0] (the residual is affine in P, so dr/dP = r(e, P + 1) -
         r(e, P))."""
         n = self.model.ndof
-        unloaded, k, g = self._terms(self.e, self.lam, self.factor)
-        loaded = self._terms(self.e, self.lam, self.factor + 1.0)[0]
+        k, g = self.matrices()
+        loaded, unloaded = (self.model.forces(self.e, load_factor=lf)
+                            for lf in (self.factor + 1.0, self.factor))
+        change = (loaded["internal"] - loaded["external"]) - \
+            (unloaded["internal"] - unloaded["external"])
         mat = sp.bmat([[k, -g.T], [-g, None]], format="csc") if g.shape[0] else k.tocsc()
-        rhs = np.concatenate([-(loaded - unloaded), np.zeros(g.shape[0])])
+        rhs = np.concatenate([-change, np.zeros(g.shape[0])])
         return spla.splu(mat).solve(rhs)[:n]
 
     def constraints(self) -> sp.csr_matrix:
-        return self._terms(self.e, self.lam, self.factor)[2]
+        return self.matrices()[1]
 
     def matrices(self, state: tuple[np.ndarray, np.ndarray, float] | None = None
                  ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """The tangent and the constraints' Jacobian at the current state, or at ``state``
         (e, lambda, load factor) of the path."""
         e, lam, factor = (self.e, self.lam, self.factor) if state is None else state
-        _, k, g = self._terms(e, lam, factor)
-        return k, g
+        lin = linearize(self.model, e, lam, load_factor=factor)
+        return lin.stiffness.tocsr(), lin.constraints
 
     def solve(self, factor: float, max_iter: int | None = None) -> None:
         """Move the state to the load factor ``factor`` (in load_steps increments), each
-        in at most ``max_iter`` Newton iterations (default: the path's)."""
-        n = self.model.ndof
+        in at most ``max_iter`` Newton iterations of the kernel (default: the path's)."""
         start = self.factor
         max_iter = self.max_iter if max_iter is None else max_iter
         for step in range(1, self.load_steps + 1):
             target = start + (factor - start) * step / self.load_steps
-            e, lam = self.e.copy(), self.lam.copy()
-            for iteration in range(1, max_iter + 1):
-                residual, k, g = self._terms(e, lam, target)
-                phi = self.model.constraints.jacobian(e, n)[0] if g.shape[0] else np.zeros(0)
-                residual = residual - g.T @ lam
-                mat = sp.bmat([[k, -g.T], [-g, None]], format="csc") if g.shape[0] else \
-                    k.tocsc()
-                dz = spla.splu(mat).solve(np.concatenate([-residual, phi]))
-                e += dz[:n]
-                lam += dz[n:]
-                if not np.all(np.isfinite(dz)):
-                    break
-                if np.linalg.norm(dz[:n]) <= self.tol * self.model.length_scale:
-                    break
-            else:
-                raise SolverError(f"buckling: the static state at load factor {target:.6g} "
-                                  f"did not converge in {max_iter} Newton iterations "
-                                  "(raise buckling.load_steps)")
-            if not np.all(np.isfinite(e)):
-                raise SolverError(f"buckling: non-finite static state at load factor "
-                                  f"{target:.6g}")
-            self.e, self.lam, self.factor = e, lam, target
+            out = kernel_static(self.model, self.e, self.lam, target, tol=self.tol,
+                                max_iter=max_iter)
+            if out["info"]:
+                raise SolverError(f"buckling: no static state found at load factor "
+                                  f"{target:.6g} ({out['message']}); raise "
+                                  "buckling.load_steps")
+            self.e, self.lam, self.factor = out["e"], out["lam"], target
             self.solves += 1
 
 
@@ -502,15 +471,13 @@ def _confirm_linear(path: "LoadPath", factor: float, k1: sp.spmatrix, mass: sp.s
             "use buckling.method = 'nonlinear'")
 
 
-def buckling_analysis(model: Model, base_model: Model, count: int, *,
-                      fixed_loads: tuple[str, ...] = (), method: str = "nonlinear",
+def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
                       solver: str = "auto", tol: float = 1e-10, max_iter: int = 50,
                       load_steps: int = 1, reference_factor: float = 1.0,
                       rtol: float = 1e-6, max_updates: int = 40, max_factor: float = 1e6,
                       eigen_tol: float = 0.0) -> BucklingResult:
-    """The ``count`` lowest positive load factors of ``model``'s loads beyond those of
-    ``base_model`` (the same system with the fixed loads alone; pass ``model`` itself
-    when no load is fixed).
+    """The ``count`` lowest positive load factors of ``model``'s reference loads: those
+    not flagged fixed (System.assemble's ``fixed_loads``, kept at their value).
 
     Both start from the scene's static state (load factor 1). ``method``: 'linear' solves
     (K_1 + nu K_g) phi = 0 once, P = 1 + nu, with K_g from the tangents at 1 and at
@@ -521,17 +488,12 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     (InputError).
     """
     args = check_keywords("buckling", dict(
-        modes=count, fixed_loads=fixed_loads, method=method, solver=solver, rtol=rtol,
-        load_steps=load_steps, reference_factor=reference_factor, tol=tol,
-        max_iter=max_iter), BUCKLING_KEYWORDS)
-    count, fixed_loads, method, solver = (args["modes"], tuple(args["fixed_loads"]),
-                                          args["method"], args["solver"])
+        modes=count, method=method, solver=solver, rtol=rtol, load_steps=load_steps,
+        reference_factor=reference_factor, tol=tol, max_iter=max_iter), BUCKLING_KEYWORDS)
+    count, method, solver = args["modes"], args["method"], args["solver"]
     rtol, load_steps, reference_factor = (args["rtol"], args["load_steps"],
                                           args["reference_factor"])
     tol, max_iter = args["tol"], args["max_iter"]
-    if model.ndof != base_model.ndof or not np.array_equal(model.e0, base_model.e0):
-        raise SolverError("buckling: the model with and without the reference loads differ "
-                          "in their coordinates")
     if not model.sets:
         raise InputError("buckling: the model has no flexible body (beam, cable, plate or "
                          "leaf); rigid bodies do not buckle", group="scene", key="analysis")
@@ -546,7 +508,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     timing: dict[str, float] = {}
     # the scene's own static state (P = 1), solved as the scene's static solve does
     scene_state = solve_newton(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
-    path = LoadPath(model, base_model, tol=tol, max_iter=max_iter, load_steps=load_steps)
+    path = LoadPath(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
     path.e, path.lam, path.factor = scene_state.e.copy(), scene_state.lam.copy(), 1.0
     base = scene_state
     e_scene = scene_state.e.copy()
@@ -692,7 +654,7 @@ def buckling_analysis(model: Model, base_model: Model, count: int, *,
     for i, x in enumerate(shapes):
         peak = x[np.argmax(np.abs(x))]
         shapes[i] = x / peak if peak else x
-    result = BucklingResult(np.asarray(factors, dtype=float), shapes, how, tuple(fixed_loads),
+    result = BucklingResult(np.asarray(factors, dtype=float), shapes, how, model.fixed_loads,
                             model.expand(shapes, with_offset=False), base, reference,
                             timing=timing,
                             extra={"method": method, "updates": len(history),

@@ -62,11 +62,13 @@ def _norm(v: np.ndarray) -> np.floating:
 
 def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "auto",
              check_frames: bool = True, warnings: Iterable[str] = (),
-             response: tuple[str, int] | None = None, supports: bool = False) -> Model:
+             response: tuple[str, int] | None = None, supports: bool = False,
+             fixed_loads: Iterable[str] = ()) -> Model:
     """The model of ``system`` with the listed effects (None: every effect it uses).
     ``check_frames=False`` assembles an 'ffr' beam whose frame nothing holds (for checks of
     joint equations alone); the solvers refuse to run such a model. ``warnings``,
-    ``response``, ``supports``: see :meth:`~ancfdrv.system.System.assemble`."""
+    ``response``, ``supports``, ``fixed_loads``: see
+    :meth:`~ancfdrv.system.System.assemble`."""
     prefix = list(warnings)
     if linear_joints not in LINEAR_JOINTS:
         raise InputError(f"linear_joints {linear_joints!r} must be one of {LINEAR_JOINTS}")
@@ -79,6 +81,11 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
     warnings: list[str] = prefix
     notes: list[str] = []
     act = _select(system, active_effects, warnings)
+    fixed_loads = tuple(fixed_loads)
+    named = frozenset(fixed_loads)
+
+    def fixed(load) -> bool:
+        return load.name in named or load.effect in named
 
     bodies = list(system.bodies.values())
     first = 0
@@ -107,9 +114,10 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
 
     # mass and loads in full coordinates
     mass_full = _mass(bodies, sets, act.masses, full_pattern, counters)
-    vector_loads = _vector_loads(act, q0, drive_index, counters)
-    gravity, constant, driven = _loads(bodies, sets, act, drive_index, counters, nfull)
-    moments = _moments(act.moments, q0, counters)
+    vector_loads = _vector_loads(act, q0, drive_index, counters, fixed)
+    gravity, constant, driven, fixed_full = _loads(bodies, sets, act, drive_index, counters,
+                                                   nfull, fixed)
+    moments = _moments(act.moments, q0, counters, fixed)
 
     # joints: eliminate or keep with multipliers
     has_rigid = any(b.rigid for b in bodies)
@@ -150,18 +158,22 @@ def assemble(system, effects: tuple[str, ...] | None, *, linear_joints: str = "a
         warnings=warnings, notes=notes, bodies=bodies, sets=sets, frames=frames, drives=drives,
         q0=q0, e0=e0, reduction=reduction, full_pattern=full_pattern, pattern=pattern, mass=mass,
         constant_force=reduce(constant + gravity),
-        driven_forces=[(i, reduce(v)) for i, v in driven],
+        driven_forces=[(i, reduce(v)) for (i, _), v in driven],
         moments=moments, constraints=constraints, contact_pairs=contact_pairs, probes=probes,
         point_masses=[(m.name, m.body.name, m.point, m.mass) for m in act.masses],
         linear_joints=mode, response=response,
         support_frames=support_frames(system) if supports else None)
     model.vector_loads = vector_loads
     model.force_elements = force_elements
+    if named:
+        model.fixed_loads = fixed_loads
+        model.fixed_force = reduce(fixed_full)
+        model.driven_fixed = [held for (_, held), _ in driven]
     # the uniform gravity (m/s^2) the beams' section forces integrate between nodes
     model.gravity = sum((load.vector for load in act.gravity), np.zeros(3))
     model.frame_problems = frame_problems
     _answer_inputs(model, system, owners, equations, elimination, reduction, mass_full,
-                   constant + gravity, driven)
+                   constant + gravity, [(i, v) for (i, _), v in driven])
     if planar_eqs:  # the rows eliminated are the planar fixes (+ the linear joints)
         kept = planar_eqs + (linear if mode == "eliminate" else [])
         model.eliminated = [eq for eq in kept if eq.name not in set(elimination.redundant)]
@@ -303,29 +315,46 @@ def _mass(bodies, sets: list[SetInfo], masses: list[PointMass], pattern: Pattern
     return pattern.to_csr(values)
 
 
+def _weight(bodies, sets: list[SetInfo], masses: list[PointMass], g: np.ndarray,
+            nfull: int) -> np.ndarray:
+    """The weight under the gravity g of the bodies and the point masses ``masses``."""
+    weight = np.zeros(nfull)
+    for info in sets:
+        np.add.at(weight, info.dofs.reshape(-1, order="F"),
+                  info.body.gravity_forces(g).reshape(-1, order="F"))
+    for body in bodies:
+        if body.rigid:
+            weight[body.first:body.first + 3] += body.mass * g
+    for pm in masses:
+        _add_point_vector(weight, pm.body, pm.point, pm.mass * g, pm.name)
+    return weight
+
+
 def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counters: Counter,
-           nfull: int):
-    """Gravity, constant point forces and pressures, and the driven forces (per drive) in
-    full coordinates."""
+           nfull: int, fixed):
+    """Gravity, constant point forces and pressures, the driven forces (per drive and
+    whether they are ``fixed``: {(drive, fixed): vector}) and the fixed loads' share of
+    the constant ones, in full coordinates. A weight is fixed when its gravity is and, for
+    a point mass, the point mass too."""
     gravity = np.zeros(nfull)
+    held = np.zeros(nfull)
     g = sum((load.vector for load in act.gravity), np.zeros(3))
     if act.gravity:
-        for info in sets:
-            np.add.at(gravity, info.dofs.reshape(-1, order="F"),
-                      info.body.gravity_forces(g).reshape(-1, order="F"))
-        for body in bodies:
-            if body.rigid:
-                gravity[body.first:body.first + 3] += body.mass * g
-        for pm in act.masses:
-            _add_point_vector(gravity, pm.body, pm.point, pm.mass * g, pm.name)
+        gravity = _weight(bodies, sets, act.masses, g, nfull)
+        g_fixed = sum((load.vector for load in act.gravity if fixed(load)), np.zeros(3))
+        if g_fixed.any():
+            held += _weight(bodies, sets, [pm for pm in act.masses if fixed(pm)], g_fixed,
+                            nfull)
         for load in act.gravity:
             counters[load.effect] += 1
     constant = np.zeros(nfull)
-    driven: dict[int, np.ndarray] = {}
+    driven: dict[tuple[int, bool], np.ndarray] = {}
     for load in act.forces:
         target = constant if load.drive is None else \
-            driven.setdefault(drive_index[id(load.drive)], np.zeros(nfull))
+            driven.setdefault((drive_index[id(load.drive)], fixed(load)), np.zeros(nfull))
         _add_point_vector(target, load.body, load.point, load.vector, load.name)
+        if load.drive is None and fixed(load):
+            _add_point_vector(held, load.body, load.point, load.vector, load.name)
         counters[load.effect] += 1
     for load in act.pressures:
         plate = load.body
@@ -335,8 +364,10 @@ def _loads(bodies, sets: list[SetInfo], act: _Active, drive_index: dict, counter
                 plate.mesh.a[el:el + 1], plate.mesh.b[el:el + 1], plate.thickness,
                 plate.material.density, -load.value * plate.initial_normal(el))
             np.add.at(constant, dofs[:, el], element[:, :, 0].reshape(-1, order="F"))
+            if fixed(load):
+                np.add.at(held, dofs[:, el], element[:, :, 0].reshape(-1, order="F"))
         counters[load.effect] += 1
-    return gravity, constant, sorted(driven.items())
+    return gravity, constant, sorted(driven.items()), held
 
 
 def _add_point_vector(target: np.ndarray, body: Body, point, vector, name: str) -> None:
@@ -347,7 +378,8 @@ def _add_point_vector(target: np.ndarray, body: Body, point, vector, name: str) 
         target[first:first + 3] += coef * np.asarray(vector)
 
 
-def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list[MomentInfo]:
+def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter,
+             fixed) -> list[MomentInfo]:
     """A dead moment acts on the nodal directors that measure the rotation about its axis.
 
     A rigid body's dead moments do not come here (:func:`_vector_loads`: exact at any
@@ -363,13 +395,13 @@ def _moments(loads: list[DeadMoment], q0: np.ndarray, counters: Counter) -> list
         axis = load.vector / np.linalg.norm(load.vector)
         for at, share in body.moment_attachments(load.point, f"load {load.name!r}"):
             out += _moment_parts(body, at, load, axis, share * float(np.linalg.norm(load.vector)),
-                                 q0)
+                                 q0, fixed(load))
         counters[load.effect] += 1
     return out
 
 
 def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
-                  q0: np.ndarray) -> list[MomentInfo]:
+                  q0: np.ndarray, fixed: bool) -> list[MomentInfo]:
     """The dead moment's parts on the directors of one node (see :func:`_moments`)."""
     out = []
     firsts = {which: next(iter(body.vector(at, which).terms))
@@ -392,7 +424,7 @@ def _moment_parts(body: Body, at, load, axis: np.ndarray, magnitude: float,
                  if abs(m) > 1e-14 * magnitude]
     for first, k, m in parts:
         out.append(MomentInfo(load.name, np.arange(first, first + 3), k, m, load.effect,
-                              q0[first:first + 3].copy()))
+                              q0[first:first + 3].copy(), fixed))
     return out
 
 
@@ -410,7 +442,7 @@ def _slope_for_moment(body: Body, at, load, axis: np.ndarray, q0: np.ndarray) ->
 
 
 def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
-                  counters: Counter) -> list[VectorLoadInfo]:
+                  counters: Counter, fixed) -> list[VectorLoadInfo]:
     """The driven and follower point loads (kernel module vector_loads), taken out of the
     dead forces and moments: a follower force, a moment with a drive or a follower moment,
     and every dead moment on a rigid body (its components on the body's current
@@ -446,7 +478,7 @@ def _vector_loads(act: _Active, q0: np.ndarray, drive_index: dict,
                  sorted(p.terms.items()) if force else []]
         drive = -1 if load.drive is None else drive_index[id(load.drive)]
         out.append(VectorLoadInfo(load.name, kind, drive, vector, np.array(shares, float),
-                                  slots, load.effect))
+                                  slots, load.effect, fixed(load)))
         counters[load.effect] += 1
     return out
 

@@ -83,6 +83,8 @@ class MomentInfo:
     magnitude: float
     effect: str
     reference: np.ndarray
+    #: kept at its value whatever the load factor (buckling's fixed loads)
+    fixed: bool = False
 
 
 #: kinds of the driven and follower point loads (fortran/src/system/vector_loads.f90)
@@ -103,6 +105,8 @@ class VectorLoadInfo:
     shares: np.ndarray
     slots: list[list[tuple[int, float]]]
     effect: str
+    #: kept at its value whatever the load factor (buckling's fixed loads)
+    fixed: bool = False
 
 
 @dataclass
@@ -193,6 +197,14 @@ class Model:
     force_elements: tuple | list = ()
     #: the uniform gravity of the active gravity loads (m/s^2; set by the assembly)
     gravity: tuple | np.ndarray = (0.0, 0.0, 0.0)
+    #: the fixed loads (System.assemble's ``fixed_loads``: kept at their value whatever the
+    #: load factor, buckling's F beside the reference loads): the share of the constant
+    #: force they make (None: no load is fixed) and per driven force whether it is fixed
+    #: (the moments and vector loads carry their own flag); set by the assembly
+    fixed_force: np.ndarray | None = None
+    #: the names (loads or effects) System.assemble was given as fixed
+    fixed_loads: tuple[str, ...] = ()
+    driven_fixed: tuple | list = ()
 
     def __init__(self, *, title: str, effects: tuple[str, ...], counters: Counter,
                  warnings: list[str], notes: list[str], bodies: list[Body], sets: list[SetInfo],
@@ -351,7 +363,7 @@ class Model:
         out = []
         for m in self.moments:
             self.counters[m.effect] += 1
-            f, j, h = kernel.moment_force(q[m.dofs], m.axis, lf * m.magnitude)
+            f, j, h = kernel.moment_force(q[m.dofs], m.axis, (1.0 if m.fixed else lf) * m.magnitude)
             cols, b = self._director_map(m.dofs)
             out.append((cols, b.T @ f, b.T @ j @ b, np.einsum("ijl,ia,jb,lc->abc", h, b, b, b)))
         return out
@@ -369,8 +381,9 @@ class Model:
             self.counters[load.effect] += 1
             phi = 1.0 if load.drive < 0 else self.drives[load.drive].value(t)
             x = [sum((c * q[d:d + 3] for d, c in slot), np.zeros(3)) for slot in load.slots[:2]]
-            force, jac = kernel.vector_load_force(load.kind, lf * phi * load.vector, load.shares,
-                                                  x[0], x[1])
+            scale = 1.0 if load.fixed else lf
+            force, jac = kernel.vector_load_force(load.kind, scale * phi * load.vector,
+                                                  load.shares, x[0], x[1])
             dofs = sorted({d + i for slot in load.slots for d, _ in slot for i in range(3)})
             where = {d: k for k, d in enumerate(dofs)}
             f = np.zeros(len(dofs))
@@ -602,6 +615,10 @@ class Model:
                      [m.magnitude for m in self.moments], [m.reference for m in self.moments])
         if self.vector_loads:
             ks.set_vector_loads(self.vector_loads)
+        if self.fixed_force is not None:
+            ks.set_fixed_loads(self.fixed_force, self.driven_fixed,
+                               [m.fixed for m in self.moments],
+                               [x.fixed for x in self.vector_loads])
         if self.force_elements:
             from .kinds.force_element import kernel_layout
             ks.set_force_elements(kernel_layout(self.force_elements, self.full_pattern))

@@ -578,7 +578,8 @@ class System:
     def assemble(self, *, effects: Iterable[str] | None = None, linear_joints: str = "auto",
                  check_frames: bool = True, unused_effects: str | None = None,
                  bounds: str | None = None, warnings: Iterable[str] = (),
-                 response: tuple[str, int] | None = None, supports: bool = False):
+                 response: tuple[str, int] | None = None, supports: bool = False,
+                 fixed_loads: Iterable[str] = ()):
         """The model of this system (``ancfdrv.system.assembly.assemble``): only the effects
         listed (default: the system's own list, else all it uses) are computed. An 'ffr'
         beam whose floating frame nothing holds is refused (InputError); with
@@ -595,7 +596,10 @@ class System:
         of 'ffr' frames turning near a bending frequency; ``response`` is the (probe,
         component) a sweep compares (default: the first probe's); ``supports`` records the
         rigid motion of each beam's supports (``model.support_frames``: general scenes and
-        Systems run from Python report deflections relative to it)."""
+        Systems run from Python report deflections relative to it). ``fixed_loads``: loads
+        (by name, or all loads of an effect) kept at their value whatever the load factor
+        (buckling's fixed loads; a weight is fixed with its gravity, a point mass's when the
+        point mass is named too); the names are not checked here."""
         from .assembly import assemble
         if effects is not None:
             effects = check_effects(effects)
@@ -633,7 +637,8 @@ class System:
         try:
             model = assemble(self, tuple(chosen) if chosen is not None else None,
                              linear_joints=linear_joints, check_frames=check_frames,
-                             warnings=list(warnings), response=response, supports=supports)
+                             warnings=list(warnings), response=response, supports=supports,
+                             fixed_loads=tuple(fixed_loads))
         except MemoryError:
             raise InputError("not enough memory to assemble this model: use a coarser mesh",
                              group="assemble") from None
