@@ -268,3 +268,25 @@ def test_dt_min_longer_than_dt_is_refused_by_the_api():
                       progress=False)
     finally:
         model.close()
+
+
+def test_cut_steps_stay_on_the_ladder_of_dt_over_powers_of_two(tmp_path):
+    """inputs/hard/pendulum.nml, 17 nodes, dt = 5e-3, rho_inf = 0.8 (issue 39's 'ok and
+    wrong' run) cuts its step 70 times by 4.7 s. Each step the control takes is dt / 2^k, or
+    such a step stretched by round-off onto its output time (a few ulps of t); a cut halves
+    that ladder step, so no step falls below dt_min = dt / 1024. Before, a cut halved the
+    stretched step: the control's step left the ladder and the shortfall grew with each cut
+    until every output interval from t = 4.655 s ended with a sliver step of 5.6e-12 s."""
+    out = tmp_path / "pendulum.h5"
+    dt = 5e-3
+    assert main(["run", str(INPUTS / "hard" / "pendulum.nml"), "--set", "beam.nodes=17",
+                 "--set", f"solver.dt={dt}", "--set", "solver.rho_inf=0.8", "--set",
+                 "solver.t_end=4.7", "--set", "output.xdmf=.false.", "--set",
+                 "output.answers=.false.", "-o", str(out)]) == 0
+    with h5py.File(out) as h5:
+        size, cuts = h5["dynamic/step_size"][1:], h5["dynamic/step_cuts"][1:]
+    assert cuts.sum() > 20
+    assert size.min() >= dt / 1024
+    ladder = dt / 2.0 ** np.round(np.log2(dt / size))
+    # the stretch onto the grid time: a few ulps of t <= 4.7 s
+    np.testing.assert_allclose(size, ladder, rtol=0, atol=8 * np.finfo(float).eps * 4.7)
