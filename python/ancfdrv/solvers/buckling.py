@@ -13,7 +13,8 @@ and follower loads' load stiffness and the constraint Hessians times the multipl
 
 * 'linear': K_g = (K_T(1 + s) - K_T(1)) / s (s = ``reference_factor``, default 1), with
   each large-deformation beam's part of that difference replaced by its initial-stress
-  stiffness K_sigma((e(1 + s) - e(1)) / s) from the kernel (:func:`stress_correction`), and
+  stiffness K_sigma((e(1 + s) - e(1)) / s) of the exact stress increment from the kernel
+  (:func:`stress_correction`), and
 
       (K_1 + nu K_g) phi = 0  on  G_1 phi = 0,    K_1 = K_T(1),    P = 1 + nu  (nu > 0);
 
