@@ -39,7 +39,8 @@ EXIT_CODES = """exit status:
   1    internal error (a bug): one line, the full trace in a file it names (--debug prints it)
   2    bad input (scene, override, output path refused or in use, not a result file)
   3    solver failure (the output file holds what was computed, status 'failed'; 'unstable'
-       when the energy grew beyond solver.energy_tolerance)
+       when the energy grew beyond solver.energy_tolerance or a load-controlled static
+       state is an unstable equilibrium)
   130  interrupted by SIGINT (Ctrl-C), 143 by SIGTERM (the output file holds every step
        computed, status 'interrupted')
   141  the pipe our output went to was closed (e.g. ancf info F | head -1)"""

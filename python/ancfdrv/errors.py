@@ -53,7 +53,9 @@ class SolverError(AncfError):
 
 class UnstableError(SolverError):
     """The energy of a run grew beyond ``solver.energy_tolerance`` with no work to explain
-    it (the integrator's numerical instability): exit 3, status 'unstable', the rows kept."""
+    it (the integrator's numerical instability), or a load-controlled static solve
+    converged onto an unstable equilibrium (its stability index > 0): exit 3, status
+    'unstable', the rows kept."""
 
     status = "unstable"
 

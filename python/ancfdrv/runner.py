@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from .errors import AncfError, InputError, Interrupted, SolverError
+from .errors import AncfError, InputError, Interrupted, SolverError, UnstableError
 from .io.safe_write import disk_full
 from .history import stage_summary
 from .interrupt import StopRequest, signal_name
@@ -41,7 +41,7 @@ from .builders import build_model, settle_mode, stage_bounds
 from .io.scene import Scene, load_scene
 from .system import Model
 from .solvers.dynamic import DynamicResult, DynamicSettings, integrate
-from .solvers.path import solve_static_path
+from .solvers.path import solve_static_path, unstable_static_message
 from .solvers.static import StaticResult, solve_newton
 
 if TYPE_CHECKING:
@@ -630,6 +630,8 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                                                    warn=warns_implausible(scene)))
                 if static.path is not None and not static.path.reached:
                     raise SolverError(static.path.message)   # the path and state written
+                if static.extra.get("stability_index", 0) > 0:   # written, then refused
+                    raise UnstableError(unstable_static_message(static.extra["stability_index"]))
                 e_start = static.e
                 if analysis == "static+dynamic":
                     stop.check()

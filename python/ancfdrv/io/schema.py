@@ -283,7 +283,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                              "'arc_length' (path-following with the load factor an "
                              "unknown: passes limit points and snap-backs, writes "
                              "/static/path; keys arc_length, max_steps, target_load_factor, "
-                             "control_probe)"),
+                             "control_probe); a load-controlled state ('split', 'newton') "
+                             "that is an unstable equilibrium (/static stability_index > 0) "
+                             "ends the run with exit 3, status 'unstable', the state kept"),
         "arc_length": Key("float", 0.0, non_negative,
                           "static_method = 'arc_length': the first step's length in the "
                           "coordinates (m; adapted to the iteration count after; 0: a "

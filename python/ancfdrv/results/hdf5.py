@@ -8,8 +8,9 @@ Conventions:
 * every dataset has a ``units`` attribute (SI: m, s, N, J, ...; '1' for dimensionless,
   'count' for counters, 'index' for connectivity); integer counters are stored as int64;
 * the root attribute ``status`` is 'running' while the run writes, then 'ok', 'failed'
-  (with ``message``), 'unstable' (the energy grew beyond solver.energy_tolerance, with
-  ``message``: :class:`~ancfdrv.errors.UnstableError`) or 'interrupted' (SIGINT/SIGTERM:
+  (with ``message``), 'unstable' (the energy grew beyond solver.energy_tolerance, or a
+  load-controlled static state has /static stability_index > 0, with ``message``:
+  :class:`~ancfdrv.errors.UnstableError`) or 'interrupted' (SIGINT/SIGTERM:
   every step computed before the signal is in the file); /dynamic has the same
   ``status``. A file that still says 'running' while no process holds its lock
   (:mod:`ancfdrv.results.lock`) was abandoned: its writer was killed (every flushed chunk

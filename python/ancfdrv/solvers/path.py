@@ -36,6 +36,14 @@ the kernel's Newton at that load factor: the static result), or after ``max_step
 (then the last point, with ``reached = False`` and a message: the run fails with exit 3
 after writing it).
 
+A load-controlled solve ('newton', 'split') converges onto any equilibrium, stable or not:
+a perfect column above its Euler load stays straight, a strip loaded past its
+lateral-torsional buckling load in large steps lands on the nearly plane branch (issue 39,
+"right or refused"). :func:`stability_index` counts the negative eigenvalues of the
+tangent on the constraints' null space at its converged state (a shifted Cholesky proves
+0 in milliseconds); :func:`solve_static_path` records it, and the run refuses a state
+with a count > 0 (:func:`unstable_static_message`).
+
 :func:`diagnose_stall` reads a failed load-controlled Newton solve: cut back from the last
 converged load step, it tells a limit point (the tangent stiffness along the loads falls
 toward zero, or a negative eigenvalue appears) from other failures and says so, naming
@@ -102,6 +110,83 @@ def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: f
     scale = max(np.abs(k.diagonal()).max(initial=0.0), 1e-300) if free > DENSE_LIMIT else \
         max(np.abs(w).max(initial=0.0), 1e-300)
     return int(np.sum(w < -1e-10 * scale))
+
+
+#: free coordinates up to which the stability index is counted from all the eigenvalues of
+#: the reduced tangent (dense, O(n^3)); and the largest dense Cholesky test (a model whose
+#: reduced tangent has no narrow band): above it the state is not checked
+STABILITY_DENSE_LIMIT = 3000
+#: eigenvalues of the reduced tangent above -STABILITY_TOL times its scale count as zero
+#: (a mechanism's zero-stiffness direction is round-off, not instability; as
+#: :func:`negative_eigenvalues`)
+STABILITY_TOL = 1e-10
+
+
+def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float):
+    """The tangent on the constraints' null space, sparse: the null space is the identity
+    on the coordinates no constraint touches and the SVD's of G on the touched ones."""
+    import scipy.sparse as sp
+    from .modal import linearize, null_space  # a Newton solve imports no modal code
+    lin = linearize(model, e, lam, load_factor=factor)
+    k, g = lin.stiffness.tocsr(), lin.constraints.tocsr()
+    touched = np.unique(g.indices)
+    free = np.setdiff1d(np.arange(model.ndof), touched)
+    basis = null_space(g[:, touched], len(touched))
+    k_free = k[free]
+    k_ft = sp.csr_matrix(k_free[:, touched] @ basis)
+    k_tt = sp.csr_matrix(basis.T @ (k[touched][:, touched] @ basis))
+    reduced = sp.bmat([[k_free[:, free], k_ft], [k_ft.T, k_tt]], format="csr")
+    return (0.5 * (reduced + reduced.T)).tocsr()
+
+
+def _positive_definite(a, shift: float) -> bool | None:
+    """Whether the sparse symmetric ``a`` + shift I is positive definite: a Cholesky
+    factorization, banded in the reverse Cuthill-McKee order (O(n b^2)) where the band is
+    narrow, else dense up to STABILITY_DENSE_LIMIT rows (None above it: not tried)."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    n = a.shape[0]
+    order = reverse_cuthill_mckee(a, symmetric_mode=True)
+    lower = sp.tril(a[order][:, order]).tocoo()
+    band = int((lower.row - lower.col).max(initial=0))
+    if band * band >= n * n / 3 and n > STABILITY_DENSE_LIMIT:
+        return None
+    try:
+        if band * band < n * n / 3:
+            ab = np.zeros((band + 1, n))
+            ab[lower.row - lower.col, lower.col] = lower.data
+            ab[0] += shift
+            la.cholesky_banded(ab, lower=True, check_finite=False)
+        else:
+            la.cholesky(a.toarray() + shift * np.eye(n), lower=True, check_finite=False)
+    except la.LinAlgError:
+        return False
+    return True
+
+
+def stability_index(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> int | None:
+    """The stability index of a converged static state: the number of eigenvalues of the
+    tangent on the constraints' null space below -STABILITY_TOL times its scale (0: a
+    stable equilibrium, or neutral in a mechanism's zero-stiffness directions). A Cholesky
+    factorization of the reduced tangent shifted by the tolerance proves the count 0 (the
+    usual case: milliseconds, banded); else the eigenvalues count it (all of them up to
+    STABILITY_DENSE_LIMIT free coordinates, above it :func:`negative_eigenvalues`' lowest
+    eight). None: not counted (a reduced tangent above STABILITY_DENSE_LIMIT rows without
+    a narrow band)."""
+    reduced = _reduced_tangent(model, e, lam, factor)
+    n = reduced.shape[0]
+    if n == 0:
+        return 0
+    scale = max(np.abs(reduced.diagonal()).max(), 1e-300)
+    definite = _positive_definite(reduced, STABILITY_TOL * scale)
+    if definite is None:
+        return None
+    if definite:
+        return 0
+    if n > STABILITY_DENSE_LIMIT:
+        return negative_eigenvalues(model, e, lam, factor)
+    w = la.eigvalsh(reduced.toarray(), check_finite=False)
+    return int(np.sum(w < -STABILITY_TOL * max(np.abs(w).max(), 1e-300)))
 
 
 def _kernel_newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
@@ -357,7 +442,9 @@ def solve_static_path(model: Model, method: str, *, tol: float, max_iter: int,
                       control_probe: str = "") -> StaticResult:
     """The static solve of a scene: 'arc_length' follows the path
     (:func:`solve_arc_length`), the other methods are :func:`~.static.solve_static`'s; a
-    load-controlled Newton that fails is diagnosed (:func:`diagnose_stall`)."""
+    load-controlled Newton that fails is diagnosed (:func:`diagnose_stall`), one that
+    converges has its state's :func:`stability_index` in ``extra['stability_index']``
+    (absent above STABILITY_LIMIT free coordinates)."""
     if method not in STATIC_METHODS:
         raise InputError(f"static_method {method!r} must be one of {', '.join(STATIC_METHODS)}",
                          group="solver", key="static_method")
@@ -368,7 +455,28 @@ def solve_static_path(model: Model, method: str, *, tol: float, max_iter: int,
         result.extra["method_setting"] = method
         return result
     try:
-        return solve_static(model, method, tol=tol, max_iter=max_iter, p=p,
-                            load_steps=load_steps)
+        result = solve_static(model, method, tol=tol, max_iter=max_iter, p=p,
+                              load_steps=load_steps)
     except LoadStepFailure as failure:
         raise diagnose_stall(model, failure, tol=tol, max_iter=max_iter) from None
+    # load control converges onto any equilibrium, stable or not (issue 39): count it
+    start = time.perf_counter()
+    index = stability_index(model, result.e, result.lam, result.extra.get("load_factor", 1.0))
+    result.timing["stability"] = time.perf_counter() - start
+    if index is not None:
+        result.extra["stability_index"] = index
+    return result
+
+
+def unstable_static_message(index: int) -> str:
+    """Why a load-controlled static state with stability index ``index`` > 0 is refused,
+    and what to do."""
+    return (f"the static state found is unstable: its tangent stiffness has {index} "
+            f"negative eigenvalue(s) on the constraints' null space ({index} direction(s) in "
+            f"which the structure leaves it); a load-controlled solve can pass a bifurcation "
+            f"or limit point without seeing it and converge onto an unstable equilibrium "
+            f"(e.g. a perfect column above its Euler load stays straight): use "
+            f"solver.static_method = 'arc_length' with a small imperfection (a load or "
+            f"geometry slightly off the perfect case) to follow the stable branch, or "
+            f"analysis = 'buckling' for the critical load; the state found is kept in /static "
+            f"(attribute stability_index)")
