@@ -112,81 +112,70 @@ def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: f
     return int(np.sum(w < -1e-10 * scale))
 
 
-#: free coordinates up to which the stability index is counted from all the eigenvalues of
-#: the reduced tangent (dense, O(n^3)); and the largest dense Cholesky test (a model whose
-#: reduced tangent has no narrow band): above it the state is not checked
-STABILITY_DENSE_LIMIT = 3000
+#: free coordinates up to which a load-controlled static state's stability index is counted
+#: (:func:`stability_index`: dense, O(n^3)); above it the check is skipped, its cost would
+#: pass a fifth of the solve's
+STABILITY_LIMIT = 1500
 #: eigenvalues of the reduced tangent above -STABILITY_TOL times its scale count as zero
 #: (a mechanism's zero-stiffness direction is round-off, not instability; as
 #: :func:`negative_eigenvalues`)
 STABILITY_TOL = 1e-10
 
 
-def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float):
-    """The tangent on the constraints' null space, sparse: the null space is the identity
-    on the coordinates no constraint touches and the SVD's of G on the touched ones."""
-    import scipy.sparse as sp
-    from .modal import linearize, null_space  # a Newton solve imports no modal code
-    lin = linearize(model, e, lam, load_factor=factor)
-    k, g = lin.stiffness.tocsr(), lin.constraints.tocsr()
-    touched = np.unique(g.indices)
-    free = np.setdiff1d(np.arange(model.ndof), touched)
-    basis = null_space(g[:, touched], len(touched))
-    k_free = k[free]
-    k_ft = sp.csr_matrix(k_free[:, touched] @ basis)
-    k_tt = sp.csr_matrix(basis.T @ (k[touched][:, touched] @ basis))
-    reduced = sp.bmat([[k_free[:, free], k_ft], [k_ft.T, k_tt]], format="csr")
-    return (0.5 * (reduced + reduced.T)).tocsr()
-
-
-def _positive_definite(a, shift: float) -> bool | None:
-    """Whether the sparse symmetric ``a`` + shift I is positive definite: a Cholesky
-    factorization, banded in the reverse Cuthill-McKee order (O(n b^2)) where the band is
-    narrow, else dense up to STABILITY_DENSE_LIMIT rows (None above it: not tried)."""
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import reverse_cuthill_mckee
-    n = a.shape[0]
-    order = reverse_cuthill_mckee(a, symmetric_mode=True)
-    lower = sp.tril(a[order][:, order]).tocoo()
-    band = int((lower.row - lower.col).max(initial=0))
-    if band * band >= n * n / 3 and n > STABILITY_DENSE_LIMIT:
-        return None
-    try:
-        if band * band < n * n / 3:
-            ab = np.zeros((band + 1, n))
-            ab[lower.row - lower.col, lower.col] = lower.data
-            ab[0] += shift
-            la.cholesky_banded(ab, lower=True, check_finite=False)
-        else:
-            la.cholesky(a.toarray() + shift * np.eye(n), lower=True, check_finite=False)
-    except la.LinAlgError:
-        return False
-    return True
+def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> np.ndarray:
+    """The symmetric part of the static tangent (modal.linearize's K: elastic and contact
+    tangent, minus the moments' and vector loads' Jacobians and the constraint Hessians
+    times the multipliers) on the constraints' null space, dense and in numpy alone (a
+    static run imports no scipy): the null space is the identity on the coordinates no
+    constraint touches and the SVD's of the constraint Jacobian on the touched ones."""
+    n, ncon = model.ndof, len(model.constraints)
+    out = model.forces(e, 0.0, want_tangent=True, load_factor=factor)
+    k = model.pattern.to_csr(out["tangent"]).toarray()
+    for dofs, _, jac, *_ in (*model.moment_terms(e, load_factor=factor),
+                             *model.vector_load_terms(e, 0.0, load_factor=factor)):
+        dofs = np.asarray(dofs)
+        np.add.at(k, (np.repeat(dofs, len(dofs)), np.tile(dofs, len(dofs))),
+                  -np.asarray(jac).ravel())
+    if not ncon:
+        return 0.5 * (k + k.T)
+    h_con, h_rows, h_cols, h_vals = model.constraints.hessian_triplets(e)
+    np.add.at(k, (h_rows, h_cols), -lam[h_con] * h_vals)
+    k = 0.5 * (k + k.T)
+    _, rows, cols, grads = model.constraints.jacobian(e, n)
+    g = np.zeros((ncon, n))
+    np.add.at(g, (rows, cols), grads)
+    touched = np.flatnonzero(np.abs(g).max(axis=0) > 0)
+    free = np.setdiff1d(np.arange(n), touched)
+    g = g[:, touched]
+    norms = np.abs(g).max(axis=1)
+    g = g[norms > 0] / norms[norms > 0, None]   # rows scaled to unit size (modal.null_space)
+    _, sing, vt = np.linalg.svd(g, full_matrices=True)
+    rank = int(np.sum(sing > 1e-10 * max(sing.max(initial=0.0), 1e-300)))
+    basis = vt[rank:].T
+    k_ft = k[np.ix_(free, touched)] @ basis
+    return np.block([[k[np.ix_(free, free)], k_ft],
+                     [k_ft.T, basis.T @ k[np.ix_(touched, touched)] @ basis]])
 
 
 def stability_index(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> int | None:
     """The stability index of a converged static state: the number of eigenvalues of the
-    tangent on the constraints' null space below -STABILITY_TOL times its scale (0: a
-    stable equilibrium, or neutral in a mechanism's zero-stiffness directions). A Cholesky
-    factorization of the reduced tangent shifted by the tolerance proves the count 0 (the
-    usual case: milliseconds, banded); else the eigenvalues count it (all of them up to
-    STABILITY_DENSE_LIMIT free coordinates, above it :func:`negative_eigenvalues`' lowest
-    eight). None: not counted (a reduced tangent above STABILITY_DENSE_LIMIT rows without
-    a narrow band)."""
-    reduced = _reduced_tangent(model, e, lam, factor)
-    n = reduced.shape[0]
-    if n == 0:
-        return 0
-    scale = max(np.abs(reduced.diagonal()).max(), 1e-300)
-    definite = _positive_definite(reduced, STABILITY_TOL * scale)
-    if definite is None:
+    tangent on the constraints' null space below -STABILITY_TOL times its largest (0: a
+    stable equilibrium, or neutral in a mechanism's zero-stiffness directions); None above
+    STABILITY_LIMIT free coordinates (not counted). A Cholesky factorization of the reduced
+    tangent shifted by the tolerance times its largest diagonal proves the count 0 (the
+    usual case, milliseconds); else the eigenvalues count it."""
+    if model.ndof - len(model.constraints) > STABILITY_LIMIT:
         return None
-    if definite:
+    reduced = _reduced_tangent(model, e, lam, factor)
+    if not reduced.size:
         return 0
-    if n > STABILITY_DENSE_LIMIT:
-        return negative_eigenvalues(model, e, lam, factor)
-    w = la.eigvalsh(reduced.toarray(), check_finite=False)
-    return int(np.sum(w < -STABILITY_TOL * max(np.abs(w).max(), 1e-300)))
+    shift = STABILITY_TOL * max(np.abs(reduced.diagonal()).max(), 1e-300)
+    try:
+        np.linalg.cholesky(reduced + shift * np.eye(len(reduced)))
+        return 0
+    except np.linalg.LinAlgError:
+        w = np.linalg.eigvalsh(reduced)
+        return int(np.sum(w < -STABILITY_TOL * max(np.abs(w).max(), 1e-300)))
 
 
 def _kernel_newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
