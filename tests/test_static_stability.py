@@ -59,6 +59,21 @@ def test_perfect_column_beyond_its_euler_load_is_refused(case, tmp_path):
         assert "unstable" in h5.attrs["message"]
 
 
+@pytest.mark.parametrize("nodes", [5, 33])
+def test_the_index_counts_the_euler_loads_below_the_load(nodes):
+    """At 4.5 P_cr the pinned-pinned column's Euler loads n^2 P_cr below the load are
+    n = 1 and 2, each in two planes: index 4 (5 nodes: the dense test; 33 nodes: the
+    banded one), as the arc-length path's own count (path.negative_eigenvalues)."""
+    from ancfdrv.solvers.path import negative_eigenvalues, solve_static_path
+    model = column("pinned-pinned", load=4.5 * _euler("pinned-pinned"), nodes=nodes).assemble()
+    try:
+        static = solve_static_path(model, "newton", tol=1e-10, max_iter=50)
+        assert static.extra["stability_index"] == 4
+        assert negative_eigenvalues(model, static.e, static.lam, 1.0) == 4
+    finally:
+        model.close()
+
+
 @pytest.mark.parametrize("case", ["pinned-pinned", "fixed-free"])
 def test_column_below_its_euler_load_is_ok_and_stable(case, tmp_path):
     error, status, index, _ = _static(column(case, load=0.5 * _euler(case)),

@@ -112,9 +112,11 @@ def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: f
     return int(np.sum(w < -1e-10 * scale))
 
 
-#: free coordinates up to which a load-controlled static state's stability index is counted
-#: (:func:`stability_index`: dense, O(n^3)); above it the check is skipped, its cost would
-#: pass a fifth of the solve's
+#: free coordinates up to which a load-controlled static state's stability index is
+#: counted where its reduced tangent has no narrow band (dense, O(n^3)), and up to which an
+#: unstable state's count is taken from all the eigenvalues (above: the lowest eight, as
+#: :func:`negative_eigenvalues`); a wide-banded model above it is not checked (the check
+#: would cost more than a fifth of the solve)
 STABILITY_LIMIT = 1500
 #: eigenvalues of the reduced tangent above -STABILITY_TOL times its scale count as zero
 #: (a mechanism's zero-stiffness direction is round-off, not instability; as
@@ -122,60 +124,164 @@ STABILITY_LIMIT = 1500
 STABILITY_TOL = 1e-10
 
 
-def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> np.ndarray:
+def _constraint_groups(g: np.ndarray) -> list[np.ndarray]:
+    """The columns of each group of rows of ``g`` that share columns (the constraints
+    acting on the same coordinates), each sorted."""
+    parent = list(range(len(g)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+    owner: dict[int, int] = {}
+    for c, row in enumerate(g):
+        for col in np.flatnonzero(row).tolist():
+            if col in owner:
+                parent[root(c)] = root(owner[col])
+            else:
+                owner[col] = c
+    groups: dict[int, list[int]] = {}
+    for col, c in owner.items():
+        groups.setdefault(root(c), []).append(col)
+    return [np.array(sorted(cols), dtype=np.int64) for cols in groups.values()]
+
+
+def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float):
     """The symmetric part of the static tangent (modal.linearize's K: elastic and contact
     tangent, minus the moments' and vector loads' Jacobians and the constraint Hessians
-    times the multipliers) on the constraints' null space, dense and in numpy alone (a
-    static run imports no scipy): the null space is the identity on the coordinates no
-    constraint touches and the SVD's of the constraint Jacobian on the touched ones."""
+    times the multipliers) on the constraints' null space, as triplets (rows, cols, values,
+    size) in an order of narrow band, sparse and in numpy alone (a static run imports no
+    scipy): the null space is the identity on the coordinates no constraint touches and,
+    per group of constraints sharing coordinates, the SVD's of their Jacobian, placed at
+    the group's middle among the coordinates."""
     n, ncon = model.ndof, len(model.constraints)
-    out = model.forces(e, 0.0, want_tangent=True, load_factor=factor)
-    k = model.pattern.to_csr(out["tangent"]).toarray()
+    tangent = model.pattern.to_csr(
+        model.forces(e, 0.0, want_tangent=True, load_factor=factor)["tangent"])
+    rows, cols, vals = [tangent.row_index()], [tangent.indices], [tangent.data]
     for dofs, _, jac, *_ in (*model.moment_terms(e, load_factor=factor),
                              *model.vector_load_terms(e, 0.0, load_factor=factor)):
         dofs = np.asarray(dofs)
-        np.add.at(k, (np.repeat(dofs, len(dofs)), np.tile(dofs, len(dofs))),
-                  -np.asarray(jac).ravel())
-    if not ncon:
-        return 0.5 * (k + k.T)
-    h_con, h_rows, h_cols, h_vals = model.constraints.hessian_triplets(e)
-    np.add.at(k, (h_rows, h_cols), -lam[h_con] * h_vals)
-    k = 0.5 * (k + k.T)
-    _, rows, cols, grads = model.constraints.jacobian(e, n)
-    g = np.zeros((ncon, n))
-    np.add.at(g, (rows, cols), grads)
-    touched = np.flatnonzero(np.abs(g).max(axis=0) > 0)
+        rows.append(np.repeat(dofs, len(dofs)))
+        cols.append(np.tile(dofs, len(dofs)))
+        vals.append(-np.asarray(jac).ravel())
+    touched = np.zeros(0, dtype=np.int64)
+    basis, where = np.zeros((0, 0)), np.zeros(0)
+    if ncon:
+        h_con, h_rows, h_cols, h_vals = model.constraints.hessian_triplets(e)
+        rows.append(h_rows)
+        cols.append(h_cols)
+        vals.append(-lam[h_con] * h_vals)
+        _, g_rows, g_cols, grads = model.constraints.jacobian(e, n)
+        nonzero = grads != 0
+        touched = np.unique(np.asarray(g_cols)[nonzero])
+        g = np.zeros((ncon, len(touched)))
+        np.add.at(g, (np.asarray(g_rows)[nonzero], np.searchsorted(touched, g_cols[nonzero])),
+                  grads[nonzero])
+        g = g[np.abs(g).max(axis=1, initial=0.0) > 0]
+        g /= np.abs(g).max(axis=1)[:, None]   # rows scaled to unit size (modal.null_space)
+        parts, positions = [], []
+        for group in _constraint_groups(g):
+            block = g[:, group]
+            block = block[np.abs(block).max(axis=1) > 0]
+            _, sing, vt = np.linalg.svd(block, full_matrices=True)
+            rank = int(np.sum(sing > 1e-10 * max(sing.max(initial=0.0), 1e-300)))
+            part = np.zeros((len(touched), len(group) - rank))
+            part[group] = vt[rank:].T
+            parts.append(part)
+            positions.append(np.full(len(group) - rank, touched[group].mean()))
+        basis = np.hstack(parts) if parts else np.zeros((len(touched), 0))
+        where = np.concatenate(positions) if positions else where
+    r, c, v = np.concatenate(rows), np.concatenate(cols), 0.5 * np.concatenate(vals)
+    r, c, v = np.concatenate([r, c]), np.concatenate([c, r]), np.concatenate([v, v])
+    # the symmetric part's triplets (duplicates add up where they are used)
     free = np.setdiff1d(np.arange(n), touched)
-    g = g[:, touched]
-    norms = np.abs(g).max(axis=1)
-    g = g[norms > 0] / norms[norms > 0, None]   # rows scaled to unit size (modal.null_space)
-    _, sing, vt = np.linalg.svd(g, full_matrices=True)
-    rank = int(np.sum(sing > 1e-10 * max(sing.max(initial=0.0), 1e-300)))
-    basis = vt[rank:].T
-    k_ft = k[np.ix_(free, touched)] @ basis
-    return np.block([[k[np.ix_(free, free)], k_ft],
-                     [k_ft.T, basis.T @ k[np.ix_(touched, touched)] @ basis]])
+    nf, size = len(free), len(free) + basis.shape[1]
+    rank_of = np.empty(size, dtype=np.int64)
+    rank_of[np.argsort(np.concatenate([free.astype(float), where]), kind="stable")] = \
+        np.arange(size)
+    slot = np.full(n, -1, dtype=np.int64)   # a coordinate's place among free or touched
+    slot[free] = np.arange(nf)
+    slot[touched] = np.arange(len(touched))
+    is_free = np.zeros(n, dtype=bool)
+    is_free[free] = True
+    both = is_free[r] & is_free[c]
+    out_r, out_c, out_v = [rank_of[slot[r[both]]]], [rank_of[slot[c[both]]]], [v[both]]
+    if basis.shape[1]:
+        mixed = is_free[r] & ~is_free[c]
+        k_ft = np.zeros((nf, len(touched)))
+        np.add.at(k_ft, (slot[r[mixed]], slot[c[mixed]]), v[mixed])
+        inner = ~is_free[r] & ~is_free[c]
+        k_tt = np.zeros((len(touched), len(touched)))
+        np.add.at(k_tt, (slot[r[inner]], slot[c[inner]]), v[inner])
+        k_fn = k_ft @ basis
+        coupled = np.flatnonzero(np.abs(k_fn).max(axis=1) > 0)
+        nn = nf + np.arange(basis.shape[1])
+        fr, nc = np.repeat(coupled, len(nn)), np.tile(nn, len(coupled))
+        fv = k_fn[coupled].ravel()
+        k_nn = basis.T @ k_tt @ basis
+        out_r += [rank_of[fr], rank_of[nc], rank_of[np.repeat(nn, len(nn))]]
+        out_c += [rank_of[nc], rank_of[fr], rank_of[np.tile(nn, len(nn))]]
+        out_v += [fv, fv, k_nn.ravel()]
+    return np.concatenate(out_r), np.concatenate(out_c), np.concatenate(out_v), size
+
+
+def _positive_definite(rows: np.ndarray, cols: np.ndarray, vals: np.ndarray, size: int,
+                       band: int) -> bool:
+    """Whether the symmetric matrix of the triplets is positive definite: its Cholesky
+    factorization, by blocks of the bandwidth ``band`` where it is narrow (the matrix is
+    then block tridiagonal: O(n b^2)), else dense."""
+    try:
+        if band == 0 or 4 * band > size:
+            dense = np.zeros((size, size))
+            np.add.at(dense, (rows, cols), vals)
+            np.linalg.cholesky(dense)
+            return True
+        count = -(-size // band)
+        diagonal = np.zeros((count, band, band))
+        below = np.zeros((count, band, band))   # below[i]: block (i + 1, i)
+        bi, bj = rows // band, cols // band
+        on = bi == bj
+        np.add.at(diagonal, (bi[on], rows[on] % band, cols[on] % band), vals[on])
+        sub = bi == bj + 1
+        np.add.at(below, (bj[sub], rows[sub] % band, cols[sub] % band), vals[sub])
+        pad = np.arange(size, count * band) - (count - 1) * band
+        diagonal[-1, pad, pad] = 1.0   # the last block's padding: positive, no coupling
+        carried = None
+        for i in range(count):
+            block = diagonal[i] if carried is None else diagonal[i] - carried @ carried.T
+            factor = np.linalg.cholesky(block)
+            carried = np.linalg.solve(factor, below[i].T).T   # L_{i+1,i} = A_{i+1,i} L_ii^-T
+    except np.linalg.LinAlgError:
+        return False
+    return True
 
 
 def stability_index(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> int | None:
     """The stability index of a converged static state: the number of eigenvalues of the
     tangent on the constraints' null space below -STABILITY_TOL times its largest (0: a
-    stable equilibrium, or neutral in a mechanism's zero-stiffness directions); None above
-    STABILITY_LIMIT free coordinates (not counted). A Cholesky factorization of the reduced
-    tangent shifted by the tolerance times its largest diagonal proves the count 0 (the
-    usual case, milliseconds); else the eigenvalues count it."""
-    if model.ndof - len(model.constraints) > STABILITY_LIMIT:
+    stable equilibrium, or neutral in a mechanism's zero-stiffness directions). A Cholesky
+    factorization of the reduced tangent shifted by the tolerance times its largest
+    diagonal proves the count 0 (the usual case; by blocks where the band is narrow); else
+    the eigenvalues count it. None: not counted (above STABILITY_LIMIT free coordinates
+    with no narrow band)."""
+    rows, cols, vals, size = _reduced_tangent(model, e, lam, factor)
+    if not size:
+        return 0
+    band = int(np.abs(rows - cols).max(initial=0))
+    if size > STABILITY_LIMIT and 4 * band > size:
         return None
-    reduced = _reduced_tangent(model, e, lam, factor)
-    if not reduced.size:
+    shift = STABILITY_TOL * max(np.abs(vals[rows == cols]).max(initial=0.0), 1e-300)
+    diagonal = np.arange(size)
+    if _positive_definite(np.concatenate([rows, diagonal]), np.concatenate([cols, diagonal]),
+                          np.concatenate([vals, np.full(size, shift)]), size, band):
         return 0
-    shift = STABILITY_TOL * max(np.abs(reduced.diagonal()).max(), 1e-300)
-    try:
-        np.linalg.cholesky(reduced + shift * np.eye(len(reduced)))
-        return 0
-    except np.linalg.LinAlgError:
-        w = np.linalg.eigvalsh(reduced)
-        return int(np.sum(w < -STABILITY_TOL * max(np.abs(w).max(), 1e-300)))
+    if size > STABILITY_LIMIT:
+        return negative_eigenvalues(model, e, lam, factor)
+    dense = np.zeros((size, size))
+    np.add.at(dense, (rows, cols), vals)
+    w = np.linalg.eigvalsh(dense)
+    return int(np.sum(w < -STABILITY_TOL * max(np.abs(w).max(), 1e-300)))
 
 
 def _kernel_newton_at(model: Model, e: np.ndarray, lam: np.ndarray, factor: float,
