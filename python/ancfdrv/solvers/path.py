@@ -173,11 +173,13 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
         cols.append(h_cols)
         vals.append(-lam[h_con] * h_vals)
         _, g_rows, g_cols, grads = model.constraints.jacobian(e, n)
+        grads = np.asarray(grads, dtype=float)
         nonzero = grads != 0
-        touched = np.unique(np.asarray(g_cols)[nonzero])
+        g_rows = np.asarray(g_rows, dtype=np.int64)[nonzero]
+        g_cols = np.asarray(g_cols, dtype=np.int64)[nonzero]
+        touched = np.unique(g_cols)
         g = np.zeros((ncon, len(touched)))
-        np.add.at(g, (np.asarray(g_rows)[nonzero], np.searchsorted(touched, g_cols[nonzero])),
-                  grads[nonzero])
+        np.add.at(g, (g_rows, np.searchsorted(touched, g_cols)), grads[nonzero])
         g = g[np.abs(g).max(axis=1, initial=0.0) > 0]
         g /= np.abs(g).max(axis=1)[:, None]   # rows scaled to unit size (modal.null_space)
         parts, positions = [], []
@@ -192,7 +194,9 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
             positions.append(np.full(len(group) - rank, touched[group].mean()))
         basis = np.hstack(parts) if parts else np.zeros((len(touched), 0))
         where = np.concatenate(positions) if positions else where
-    r, c, v = np.concatenate(rows), np.concatenate(cols), 0.5 * np.concatenate(vals)
+    r = np.concatenate(rows).astype(np.int64)
+    c = np.concatenate(cols).astype(np.int64)
+    v = 0.5 * np.concatenate(vals)
     r, c, v = np.concatenate([r, c]), np.concatenate([c, r]), np.concatenate([v, v])
     # the symmetric part's triplets (duplicates add up where they are used)
     free = np.setdiff1d(np.arange(n), touched)
