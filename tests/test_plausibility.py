@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from ancfdrv.cli import main
-from ancfdrv.errors import InputError
+from ancfdrv.errors import InputError, UnstableError
 from ancfdrv.io import validate
 
 from conftest import INPUTS
@@ -103,14 +103,18 @@ def largest_strain(out: Path) -> float:
 
 
 def test_youngs_modulus_in_mpa_warns_in_file_and_on_stderr(tmp_path, capsys):
+    """The state of the 4-node beam hanging under a load 1e6 times too large (stretched by
+    15 %) is also an unstable equilibrium of the model (a torsion direction of negative
+    stiffness, tests/test_static_stability.py): refused with exit 3, status 'unstable',
+    the refusal naming the implausibility (the likely cause: the units)."""
     code, out = run_cantilever(tmp_path, "mpa", "material.youngs_modulus=2.1e5")
-    assert code == 0
+    assert code == 3
     err = capsys.readouterr().err
     strain = largest_strain(out)
     assert strain > 0.005   # the file's own stresses: beyond the elastic limit
     with h5py.File(out) as h5:
         warnings = h5.attrs["warnings"]
-        assert h5.attrs["status"] == "ok"
+        assert h5.attrs["status"] == "unstable"
         length = 2.0   # the undeformed beam's bounding box
         moved = np.abs(h5["static/deflection/tip"][()]).max()
     assert moved > length
@@ -120,7 +124,7 @@ def test_youngs_modulus_in_mpa_warns_in_file_and_on_stderr(tmp_path, capsys):
         assert "probe 'tip' on beam 'beam' is displaced by" in text
         assert "check the units" in text and "Young's modulus in Pa" in text
         assert "scene.bounds = 'off' silences" in text
-    assert "warning: static result implausible" in err
+    assert "static state found is unstable" in err and "static result implausible" in err
 
 
 def test_youngs_modulus_in_pa_does_not_warn(tmp_path, capsys):
@@ -135,12 +139,13 @@ def test_youngs_modulus_in_pa_does_not_warn(tmp_path, capsys):
 def test_bounds_off_silences_the_warning(tmp_path, capsys):
     code, out = run_cantilever(tmp_path, "off", "material.youngs_modulus=2.1e5",
                                "scene.bounds=off")
-    assert code == 0
-    assert "implausible" not in capsys.readouterr().err
+    assert code == 3   # still an unstable state (the test above)
+    err = capsys.readouterr().err
+    assert "implausible" not in err and "static state found is unstable" in err
     assert largest_strain(out) > 0.005   # the same result, unwarned
     with h5py.File(out) as h5:
         assert "implausible" not in h5.attrs["warnings"]
-        assert h5.attrs["status"] == "ok"
+        assert h5.attrs["status"] == "unstable"
 
 
 # -- physical bounds and results that are no results ----------------------------------------
@@ -228,10 +233,19 @@ def api_cantilever(modulus: float, bounds: str = "check"):
 
 
 def test_python_runs_warn_alike_and_bounds_off_silences(recwarn):
-    with pytest.warns(UserWarning, match="static result implausible: beam 'b' is strained"):
+    """As the command line: the unstable state refused, the implausibility named unless
+    bounds are off; a stable implausible state (E = 2.1e6 Pa: the beam swings down 1.7 m,
+    strained beyond 0.5 %) is 'ok' with the warning."""
+    with pytest.raises(UnstableError, match="static result implausible: beam 'b' is strained"):
         api_cantilever(2.1e5).static(load_steps=10)
+    with pytest.raises(UnstableError) as refused:
+        api_cantilever(2.1e5, bounds="off").static(load_steps=10)
+    assert "implausible" not in str(refused.value)
     recwarn.clear()
-    result = api_cantilever(2.1e5, bounds="off").static(load_steps=10)
+    with pytest.warns(UserWarning, match="static result implausible: beam 'b' is strained"):
+        assert api_cantilever(2.1e6).static(load_steps=10).status == "ok"
+    recwarn.clear()
+    result = api_cantilever(2.1e6, bounds="off").static(load_steps=10)
     assert result.status == "ok"
     assert not [w for w in recwarn if "implausible" in str(w.message)]
 

@@ -626,12 +626,15 @@ def _run_locked(scene: Scene, out: Path | MemoryOutput, start: float, progress: 
                     with _io(out).released(out):
                         _write_grid_xdmf(scene, model, out, "static")
                 timing["output"] = time.perf_counter() - t0
-                model.warnings.extend(check_static(model, static.e, answers.stress,
-                                                   warn=warns_implausible(scene)))
+                implausible = check_static(model, static.e, answers.stress,
+                                           warn=warns_implausible(scene))
+                model.warnings.extend(implausible)
                 if static.path is not None and not static.path.reached:
                     raise SolverError(static.path.message)   # the path and state written
                 if static.extra.get("stability_index", 0) > 0:   # written, then refused
-                    raise UnstableError(unstable_static_message(static.extra["stability_index"]))
+                    # an implausible state (the units) is named: it may be the cause
+                    raise UnstableError("; ".join([unstable_static_message(
+                        static.extra["stability_index"]), *implausible]))
                 e_start = static.e
                 if analysis == "static+dynamic":
                     stop.check()
