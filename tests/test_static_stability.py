@@ -152,3 +152,20 @@ def test_cli_refuses_an_unstable_column_with_exit_3(tmp_path, capsys):
     with h5py.File(out) as h5:
         assert h5.attrs["status"] == "unstable"
         assert h5["static"].attrs["stability_index"] == 2 and "static/q" in h5
+
+
+def test_static_start_of_a_dynamic_run_is_checked_alike(tmp_path):
+    """analysis 'static+dynamic' (System.simulate(from_static=True)) solves the same static
+    state first: the perfect column at 1.5 P_cr is refused before any step, the static
+    state kept and no dynamic row written; at 0.5 P_cr the run is 'ok'."""
+    out = tmp_path / "unstable.h5"
+    with pytest.raises(UnstableError):
+        column("pinned-pinned", load=1.5 * _euler("pinned-pinned")).simulate(
+            0.002, 1e-3, from_static=True, output=out)
+    with h5py.File(out) as h5:
+        assert h5.attrs["status"] == "unstable" and "static/q" in h5
+        assert h5["static"].attrs["stability_index"] == 2
+        assert "dynamic/time" not in h5 or len(h5["dynamic/time"]) == 0
+    stable = column("pinned-pinned", load=0.5 * _euler("pinned-pinned")).simulate(
+        0.002, 1e-3, from_static=True, output=tmp_path / "stable.h5")
+    assert stable.status == "ok"
