@@ -65,13 +65,25 @@ through :func:`ancfdrv.runner.run_scene` (HDF5 to a temporary directory): ``solv
 dynamic solve's ``wall_time_s`` from the file's ``/dynamic`` attributes, ``whole`` the whole
 call (scene, model, static start, dynamics, output). Exudyn: ``solve`` is
 ``mbs.SolveDynamic``, ``whole`` builds the system, assembles it, solves the static start and
-the dynamics and reads the sensor. Interpreter start-up and imports are excluded. Ratios are
-Exudyn's time / ancfdrv's, both measured in this run (> 1: ancfdrv is faster). Exudyn runs
-on one thread with its sparse LU (EigenSparse), ancfdrv with its default of one OpenMP
-thread. ``spinup`` and ``pendulum`` time whole calls, repeated until 1 s or ``--repeats``:
-ancfdrv's compared call keeps its results in memory (:func:`ancfdrv.simulate`, as Exudyn's
-sensor does), and its call writing the HDF5 file (``run_scene``) is timed in the same
-repeats, interleaved, and reported beside it (``peer_exudyn.py``).
+the dynamics and reads the sensor. Interpreter start-up and imports are excluded (``levels``
+also times the command line: a fresh interpreter per call). Ratios are Exudyn's time /
+ancfdrv's, both measured in this run (> 1: ancfdrv is faster).
+
+Exudyn runs as a user tuning it would run it (issue 38): its ``exudynCPPfast`` module, one
+thread, no solution file, sensors every 0.01 s; the boom with Newton tolerances 1e-2
+(absolute) / 1e-5 (relative) and contractivity 0.05 (``levels`` also at 1e-3 / 1e-6), its
+dense LU below 6 elements (``levels``: both LUs below 10 elements); the pendulum at 1e-6 /
+1e-6; the spin-up updating its Jacobian at most once a step. ancfdrv runs with its defaults
+(one OpenMP thread, ``newton_tol = 1e-10``) without the XDMF file.
+
+``levels``
+    Each accuracy level's (3, 1, 0.3, 0.1, 0.03 % of the sag range) fastest configuration
+    of each code on the luffing boom (m = 50 and 0 kg, ``--masses``), chosen from a grid over
+    the mesh and the time step (5e-4 ... 2e-2 s) for both codes, against ancfdrv's cable
+    converged in space and time (55 nodes, dt 2.5e-4 s, checked against half the mesh and
+    twice the step) and against each code's own converged run; whole-call, solve and
+    command-line times. ``spinup`` and ``pendulum`` get the same level table from their
+    grids (coarse steps included).
 
 Output: ``benchmarks/results/peer_harness.json`` and ``peer_harness.md`` (with ``--quick``:
 ``peer_harness_quick.json``, ignored by git, and the Markdown inside the JSON only).
@@ -1539,7 +1551,7 @@ def _level_rounds(configs: list[LevelConfig], once_runs: set[str], onces: dict[s
             try:
                 solve_s, whole_s, payload = onces[c.label]()
             except errors as exc:
-                run.message = f"{type(exc).__name__}: {exc}"
+                run.message = " ".join(f"{type(exc).__name__}: {exc}".split())
                 continue
             run.solve_samples.append(solve_s)
             run.whole_samples.append(whole_s)
