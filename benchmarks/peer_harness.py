@@ -1534,10 +1534,11 @@ def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarr
             counts.update({k: int(model[k]) for k in ("ndof", "nconstraints", "nunknowns",
                                                      "nplanar_fixed") if k in model})
             payload = read(h5)
-            stepping = float(h5["timing"].attrs.get("dynamic_stepping", math.nan))
+            phases = {k: float(v) for k, v in h5["timing"].attrs.items()}
             solve = float(attrs["wall_time_s"])
         return solve, whole, {"counts": counts, "values": payload["values"],
-                              "stepping_s": stepping}
+                              "stepping_s": phases.get("dynamic_stepping", math.nan),
+                              "phases_s": phases}
     return once
 
 
@@ -1565,6 +1566,8 @@ def _level_rounds(configs: list[LevelConfig], once_runs: set[str], onces: dict[s
             if "stepping_s" in payload:
                 run.extra["stepping_s"] = min(run.extra.get("stepping_s", math.inf),
                                               payload["stepping_s"])
+            if "phases_s" in payload and whole_s == run.whole_s:   # the best call's phases
+                run.extra["phases_s"] = payload["phases_s"]
             if round_ == repeats - 1 or c.label in once_runs:
                 progress(tag, run)
 
@@ -1615,6 +1618,7 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
             rows.append({"code": c.code, "label": c.label, "config": asdict(c), "ok": run.ok,
                          "message": run.message, "solve_s": run.solve_s,
                          "whole_s": run.whole_s, "stepping_s": run.extra.get("stepping_s"),
+                         "phases_s": run.extra.get("phases_s"),
                          "repeats": len(run.solve_samples), "counts": run.counts,
                          "own_reference": own.label, "error_own_percent": error(run, own),
                          "error_common_percent": error(run, common)})
