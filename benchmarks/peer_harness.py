@@ -65,13 +65,25 @@ through :func:`ancfdrv.runner.run_scene` (HDF5 to a temporary directory): ``solv
 dynamic solve's ``wall_time_s`` from the file's ``/dynamic`` attributes, ``whole`` the whole
 call (scene, model, static start, dynamics, output). Exudyn: ``solve`` is
 ``mbs.SolveDynamic``, ``whole`` builds the system, assembles it, solves the static start and
-the dynamics and reads the sensor. Interpreter start-up and imports are excluded. Ratios are
-Exudyn's time / ancfdrv's, both measured in this run (> 1: ancfdrv is faster). Exudyn runs
-on one thread with its sparse LU (EigenSparse), ancfdrv with its default of one OpenMP
-thread. ``spinup`` and ``pendulum`` time whole calls, repeated until 1 s or ``--repeats``:
-ancfdrv's compared call keeps its results in memory (:func:`ancfdrv.simulate`, as Exudyn's
-sensor does), and its call writing the HDF5 file (``run_scene``) is timed in the same
-repeats, interleaved, and reported beside it (``peer_exudyn.py``).
+the dynamics and reads the sensor. Interpreter start-up and imports are excluded (``levels``
+also times the command line: a fresh interpreter per call). Ratios are Exudyn's time /
+ancfdrv's, both measured in this run (> 1: ancfdrv is faster).
+
+Exudyn runs as a user tuning it would run it (issue 38): its ``exudynCPPfast`` module, one
+thread, no solution file, sensors every 0.01 s; the boom with Newton tolerances 1e-2
+(absolute) / 1e-5 (relative) and contractivity 0.05 (``levels`` also at 1e-3 / 1e-6), its
+dense LU below 6 elements (``levels``: both LUs below 10 elements); the pendulum at 1e-6 /
+1e-6; the spin-up updating its Jacobian at most once a step. ancfdrv runs with its defaults
+(one OpenMP thread, ``newton_tol = 1e-10``) without the XDMF file.
+
+``levels``
+    Each accuracy level's (3, 1, 0.3, 0.1, 0.03 % of the sag range) fastest configuration
+    of each code on the luffing boom (m = 50 and 0 kg, ``--masses``), chosen from a grid over
+    the mesh and the time step (5e-4 ... 2e-2 s) for both codes, against ancfdrv's cable
+    converged in space and time (55 nodes, dt 2.5e-4 s, checked against half the mesh and
+    twice the step) and against each code's own converged run; whole-call, solve and
+    command-line times. ``spinup`` and ``pendulum`` get the same level table from their
+    grids (coarse steps included).
 
 Output: ``benchmarks/results/peer_harness.json`` and ``peer_harness.md`` (with ``--quick``:
 ``peer_harness_quick.json``, ignored by git, and the Markdown inside the JSON only).
@@ -99,13 +111,15 @@ import time
 import warnings
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
-import h5py
 import numpy as np
 
+if TYPE_CHECKING:
+    import h5py
+
 from _peer import (exudyn_build, exudyn_version, import_exudyn, quiet_settings,
-                   run_quietly)
+                   run_quietly, set_setting)
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
@@ -238,6 +252,8 @@ def run_ancfdrv(label: str, scene: str, overrides: list[str], out: Path,
                 budget_s: float) -> Timed:
     """run_scene on ``scene`` with ``overrides``; ``read`` takes the compared history
     (keys 'time', 'values' and any extras) from the result file."""
+    import h5py
+
     from ancfdrv.runner import run_scene
 
     timed = Timed("ancfdrv", label, {"scene": scene, "overrides": list(overrides)})
@@ -485,7 +501,45 @@ def attach_drive(exu: Any, model: dict[str, Any], boom: Boom, symbolic: bool) ->
         mbs.SetObjectParameter(constraint, "offsetUserFunction", function)
 
 
-def boom_settings(exu: Any, boom: Boom, full_newton: bool) -> Any:
+#: Exudyn's sensors store every 0.01 s (not every step: a sensor row costs time).
+EXUDYN_SENSOR_PERIOD = 0.01
+#: Exudyn's dense LU is the faster below about 6 elements, its sparse LU above.
+DENSE_BELOW_ELEMENTS = 6
+
+
+@dataclass(frozen=True)
+class ExudynNewton:
+    """Exudyn's Newton settings of one run; None keeps Exudyn's default."""
+
+    label: str
+    absolute: float | None = None
+    relative: float | None = None
+    contractivity: float | None = None
+    jacobian_update_per_step: bool = False
+
+    def apply(self, newton: Any) -> None:
+        """Set these values on ``settings.timeIntegration.newton``."""
+        for name, value in (("absoluteTolerance", self.absolute),
+                            ("relativeTolerance", self.relative),
+                            ("modifiedNewtonContractivity", self.contractivity)):
+            if value is not None:
+                setattr(newton, name, value)
+        if self.jacobian_update_per_step:
+            newton.modifiedNewtonJacUpdatePerStep = True
+
+
+#: The boom's loosest Newton settings that keep Exudyn's history (issue 38), and the
+#: tighter ones it is re-timed at; the converged reference runs at Exudyn's defaults.
+BOOM_NEWTON = ExudynNewton("tol 1e-2/1e-5", 1e-2, 1e-5, 0.05)
+BOOM_NEWTON_TIGHT = ExudynNewton("tol 1e-3/1e-6", 1e-3, 1e-6, 0.05)
+DEFAULT_NEWTON = ExudynNewton("default tol")
+
+
+def boom_settings(exu: Any, boom: Boom, full_newton: bool, dense: bool,
+                  newton: ExudynNewton = BOOM_NEWTON) -> Any:
+    """Exudyn's dynamic settings for the boom: fixed steps of ``boom.dt``, the scene's
+    integrator, one thread, sensors every EXUDYN_SENSOR_PERIOD, no solution file, the given
+    Newton tolerances and its dense or sparse LU."""
     settings = exu.SimulationSettings()
     integration = settings.timeIntegration
     integration.numberOfSteps = int(round(boom.t_end / boom.dt))
@@ -499,17 +553,27 @@ def boom_settings(exu: Any, boom: Boom, full_newton: bool) -> Any:
     else:
         alpha.spectralRadius = boom.rho_inf
     integration.newton.useModifiedNewton = not full_newton
-    quiet_settings(exu, settings, boom.dt)
+    newton.apply(integration.newton)
+    quiet_settings(exu, settings, EXUDYN_SENSOR_PERIOD)
+    if dense:
+        set_setting(settings, "linearSolver.solverType", exu.LinearSolverType.EigenDense)
     return settings
 
 
 def run_exudyn_boom(exu: Any, boom: Boom, per_segment: int, symbolic: bool, full_newton: bool,
-                    grid: np.ndarray, repeats: int, budget_s: float) -> Timed:
+                    grid: np.ndarray, repeats: int, budget_s: float,
+                    newton: ExudynNewton = BOOM_NEWTON, dense: bool | None = None) -> Timed:
+    """Exudyn's boom (``3 per_segment`` elements, steps of ``boom.dt``), timed: ``solve`` is
+    ``SolveDynamic``, ``whole`` the build, static start, dynamics and sensor read. ``dense``
+    None: the dense LU below DENSE_BELOW_ELEMENTS elements."""
+    elements = 3 * per_segment
+    dense = elements < DENSE_BELOW_ELEMENTS if dense is None else dense
     config = (f"{'symbolic' if symbolic else 'Python'} drive, "
               f"{'full' if full_newton else 'modified'} Newton")
-    timed = Timed("exudyn", f"{3 * per_segment} el, {config}",
-                  {"elements": 3 * per_segment, "drive": "symbolic" if symbolic else "python",
-                   "newton": "full" if full_newton else "modified"})
+    timed = Timed("exudyn", f"{elements} el, {config}",
+                  {"elements": elements, "drive": "symbolic" if symbolic else "python",
+                   "newton": "full" if full_newton else "modified", "dt": boom.dt,
+                   "tolerances": asdict(newton), "solver": "dense" if dense else "sparse"})
 
     def once() -> tuple[float, float, dict[str, Any]]:
         t0 = time.perf_counter()
@@ -517,12 +581,12 @@ def run_exudyn_boom(exu: Any, boom: Boom, per_segment: int, symbolic: bool, full
         mbs = model["mbs"]
         static = exu.SimulationSettings()
         static.staticSolver.verboseMode = 0
-        quiet_settings(exu, static, boom.dt)
+        quiet_settings(exu, static, EXUDYN_SENSOR_PERIOD)
         run_quietly(lambda: mbs.SolveStatic(static))
         mbs.systemData.SetODE2Coordinates(mbs.systemData.GetODE2Coordinates(),
                                           configuration=exu.ConfigurationType.Initial)
         attach_drive(exu, model, boom, symbolic)
-        settings = boom_settings(exu, boom, full_newton)
+        settings = boom_settings(exu, boom, full_newton, dense, newton)
         t1 = time.perf_counter()
         run_quietly(lambda: mbs.SolveDynamic(
             settings, solverType=exu.DynamicSolverType.GeneralizedAlpha))
@@ -572,7 +636,7 @@ class BoomRuns:
         self.scene = "inputs/boom_luffing.nml"
         self.base = ([f"solver.t_end={plan.boom_t_end!r}"] if plan.boom_t_end else [])
         self.boom = boom_from_scene(self.scene, self.base)
-        self.grid = uniform_grid(self.boom.t_end, self.boom.dt)
+        self.grid = uniform_grid(self.boom.t_end, EXUDYN_SENSOR_PERIOD)
         self.runs: dict[tuple[Any, ...], Timed] = {}
 
     def _get(self, key: tuple[Any, ...], make: Callable[[], Timed]) -> Timed:
@@ -603,7 +667,7 @@ class BoomRuns:
             self.args.repeats, self.args.budget))
 
     def record(self) -> dict[str, Any]:
-        return {"boom": asdict(self.boom), "sample_dt": self.boom.dt,
+        return {"boom": asdict(self.boom), "sample_dt": EXUDYN_SENSOR_PERIOD,
                 "static_sag_closed_form": static_closed_form(self.boom)}
 
 
@@ -937,10 +1001,12 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
     """peer_exudyn's comparison of one problem with ancfdrv's cubic option."""
     import peer_exudyn as pe
 
-    bending = args.pendulum_bending if problem.name == "pendulum" else args.hard_bending
+    bendings = ([args.pendulum_bending] if problem.name == "pendulum"
+                else list(args.hard_bending))
+    bending = bendings[0]
     pe_args = argparse.Namespace(min_time=args.hard_min_time, max_repeats=args.repeats,
                                  breakdown=False, kernel_min_time=0.05, svk_check=False,
-                                 bending=[bending], exudyn_symbolic_drive=True)
+                                 bending=bendings, exudyn_symbolic_drive=True)
     record = pe.compare_problem(problem, exu, workdir, pe_args)
     if problem.name.startswith("spinup"):
         try:
@@ -966,7 +1032,67 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
                         "ancfdrv_with_file_over_exudyn_time_min": min(with_file, default=None),
                         "ancfdrv_with_file_over_exudyn_time_max": max(with_file, default=None)}
     record["summary"] = summary
+    record["levels"] = hard_levels(record, bendings)
     return record
+
+
+def hard_levels(record: dict[str, Any], bendings: list[str]) -> list[dict[str, Any]]:
+    """Per accuracy level (in % of the range of ancfdrv's reference history) and error kind
+    ('common': against ancfdrv's reference; 'own': against each code's own finest run): each
+    code's fastest run (whole in-memory call) within the level, and the ratio."""
+    runs = [r for r in record["runs"] if not r["reference"] and r["ok"]
+            and (r["code"] == "exudyn" or r["bending"] in bendings)]
+    ref = next(r for r in record["runs"] if r["reference"] and r["code"] != "exudyn"
+               and r["bending"] == bendings[0])
+    size = float(np.ptp(record["histories"][f"{ref['code']}_{ref['mesh']}_{ref['dt']:g}"]))
+    table = []
+    for level in LEVELS:
+        entry: dict[str, Any] = {"level_percent": level, "range": size}
+        for key, field_name in (("common", "error"), ("own", "self_error")):
+            best = {}
+            for code in ("ancfdrv", "exudyn"):
+                ok = [r for r in runs if (r["code"] == "exudyn") == (code == "exudyn")
+                      and 100.0 * r[field_name] / size <= level]
+                pick = min(ok, key=lambda r: r["wall_s"]) if ok else None
+                best[code] = None if pick is None else {
+                    "mesh": pick["mesh"], "dt": pick["dt"], "bending": pick["bending"],
+                    "whole_s": pick["wall_s"],
+                    "whole_with_file_s": pick["wall_file_s"],
+                    "error_percent": 100.0 * pick[field_name] / size}
+            a, x = best["ancfdrv"], best["exudyn"]
+            entry[key] = {**best, "exudyn_over_ancfdrv": ratio(x["whole_s"], a["whole_s"])
+                          if a and x else None}
+        table.append(entry)
+    return table
+
+
+def hard_levels_markdown(problems: dict[str, Any]) -> list[str]:
+    out: list[str] = []
+    for name, rec in problems.items():
+        if "levels" not in rec or name == "levels":
+            continue
+        out += [f"## {name}: each accuracy level's fastest run", "",
+                "Error: max |y - y_ref| in % of the range of ancfdrv's reference history "
+                "('common': against ancfdrv's reference; 'own': against each code's finest "
+                "run). Time: the whole in-memory call (ancfdrv: `simulate`, with the HDF5 "
+                "file beside it; Exudyn: build and `SolveDynamic` with a sensor every 0.01 s), "
+                "best of the repeats. Ratio: Exudyn / ancfdrv.", "",
+                "| level | against | ancfdrv option nodes, dt | s | with file s | error % | "
+                "Exudyn elements, dt | s | error % | Exudyn / ancfdrv |",
+                "|---|---|---|---:|---:|---:|---|---:|---:|---:|"]
+        for entry in rec["levels"]:
+            for key in ("common", "own"):
+                e = entry[key]
+                a, x = e["ancfdrv"], e["exudyn"]
+                ac = (f"{a['bending']} {a['mesh']}, {a['dt']:g} | {_f(a['whole_s'])} | "
+                      f"{_f(a['whole_with_file_s'])} | {_f(a['error_percent'])}"
+                      if a else "none | - | - | -")
+                xc = (f"{x['mesh']}, {x['dt']:g} | {_f(x['whole_s'])} | "
+                      f"{_f(x['error_percent'])}" if x else "none | - | -")
+                out.append(f"| {entry['level_percent']:g} % | {key} | {ac} | {xc} | "
+                           f"{_ratio(e['exudyn_over_ancfdrv'])} |")
+        out.append("")
+    return out
 
 
 # -- the leaf spring ---------------------------------------------------------------------------
@@ -1317,69 +1443,89 @@ def _leaf_md(rec: dict[str, Any] | None) -> list[str]:
     return out + [""]
 
 
-# -- accuracy levels (issue 23) -----------------------------------------------------------------
+# -- accuracy levels (issues 23, 38) ------------------------------------------------------------
 #: the accuracy levels: error in % of the reference's sag range
 LEVELS = (3.0, 1.0, 0.3, 0.1, 0.03)
+#: the time steps each code is tried at (every one divides LEVEL_SAMPLE_DT)
+LEVEL_DTS = (5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2)
+#: histories are compared at these times (s): a step time of every dt of LEVEL_DTS
+LEVEL_SAMPLE_DT = 0.02
+#: the converged references' time step (s): 1/4 of the finest timed step
+REFERENCE_DT = 2.5e-4
+#: ancfdrv's overrides of a level run: the nonlinear cable reduced to the boom's plane
+CABLE = ("scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.",
+         "beam.bending=cable", "scene.planar=xy")
 
 
 @dataclass(frozen=True)
 class LevelConfig:
-    """One configuration of the level study: code, label, element family, the ancfdrv
-    overrides or the Exudyn elements per segment."""
+    """One configuration of the level study: code, mesh (ancfdrv nodes or Exudyn elements
+    per segment), time step and, for Exudyn, its Newton tolerances and linear solver."""
 
     code: str
-    label: str
-    family: str                      # 'ffr', 'cubic', 'cable' (ancfdrv) or 'exudyn'
-    overrides: tuple[str, ...] = ()
-    per_segment: int = 0
+    nodes: int = 0                   # ancfdrv
+    per_segment: int = 0             # Exudyn
+    dt: float = 1e-3
+    newton: ExudynNewton = BOOM_NEWTON
+    dense: bool = False
+
+    @property
+    def label(self) -> str:
+        if self.code == "ancfdrv":
+            return f"cable {self.nodes} nodes, dt {self.dt:g}"
+        solver = "dense" if self.dense else "sparse"
+        return (f"{3 * self.per_segment} el, dt {self.dt:g}, {self.newton.label}, {solver}")
+
+    @property
+    def overrides(self) -> list[str]:
+        """ancfdrv's overrides (beyond the mass and the end time)."""
+        return [*CABLE, f"beam.nodes={self.nodes}", f"solver.dt={self.dt!r}"]
 
 
-def level_configs(quick: bool) -> tuple[list[LevelConfig], dict[str, LevelConfig]]:
-    """The timed configurations and the converged references (family -> config)."""
-    nl = ("scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.")
+def level_configs(quick: bool) -> tuple[list[LevelConfig], dict[str, LevelConfig],
+                                        dict[str, LevelConfig]]:
+    """The timed grid (mesh x dt for both codes; Exudyn also its two tolerance sets and,
+    below 10 elements, both LU solvers), the converged references (code -> config) and the
+    checks of ancfdrv's reference (half its mesh, twice its step)."""
+    def a(nodes: int, dt: float) -> LevelConfig:
+        return LevelConfig("ancfdrv", nodes=nodes, dt=dt)
 
-    def a(family: str, nodes: int, planar: str) -> LevelConfig:
-        if family == "ffr":
-            return LevelConfig("ancfdrv", f"FFR {nodes} nodes", "ffr",
-                               (f"beam.nodes={nodes}", "output.xdmf=.false."))
-        tag = "" if planar == "off" else ", planar xy"
-        return LevelConfig("ancfdrv", f"{family} {nodes} nodes{tag}", family,
-                           nl + (f"beam.bending={family}", f"beam.nodes={nodes}",
-                                 f"scene.planar={planar}"))
-
-    def e(per_segment: int) -> LevelConfig:
-        return LevelConfig("exudyn", f"{3 * per_segment} el", "exudyn", (), per_segment)
+    def e(per_segment: int, dt: float, newton: ExudynNewton, dense: bool) -> LevelConfig:
+        return LevelConfig("exudyn", per_segment=per_segment, dt=dt, newton=newton, dense=dense)
 
     if quick:
-        timed = [a("cubic", 4, "xy"), a("cable", 4, "xy"), a("cable", 7, "xy"), e(1), e(2)]
-        refs = {"cubic": a("cubic", 10, "xy"), "cable": a("cable", 16, "xy"), "exudyn": e(6)}
-    else:
-        timed = [a("ffr", 28, "off"), a("cubic", 4, "off"), a("cubic", 10, "off"),
-                 a("cubic", 4, "xy"), a("cubic", 7, "xy"), a("cubic", 10, "xy"),
-                 a("cable", 4, "off"), a("cable", 4, "xy"), a("cable", 7, "xy"),
-                 a("cable", 10, "xy"), a("cable", 16, "xy"),
-                 e(1), e(2), e(3), e(6), e(9)]
-        refs = {"cubic": a("cubic", 28, "xy"), "cable": a("cable", 55, "xy"), "exudyn": e(18)}
-    refs["ffr"] = refs["cubic"]   # the FFR model is judged against the converged nonlinear one
-    return timed, refs
+        timed = [a(4, 1e-3), a(4, 1e-2), e(1, 1e-2, BOOM_NEWTON, True)]
+        refs = {"ancfdrv": a(10, 5e-4), "exudyn": e(2, 5e-4, DEFAULT_NEWTON, False)}
+        return timed, refs, {}
+    timed = [a(n, dt) for n in (4, 7, 10, 16) for dt in LEVEL_DTS]
+    timed += [e(ps, dt, newton, dense) for ps in (1, 2, 3, 6) for dt in LEVEL_DTS
+              for newton in (BOOM_NEWTON, BOOM_NEWTON_TIGHT)
+              for dense in ((True, False) if 3 * ps < 10 else (False,))]
+    refs = {"ancfdrv": a(55, REFERENCE_DT), "exudyn": e(18, REFERENCE_DT, DEFAULT_NEWTON, False)}
+    checks = {"half mesh": a(28, REFERENCE_DT), "twice the step": a(55, 2 * REFERENCE_DT)}
+    return timed, refs, checks
 
 
 def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarray,
                 exu: Any, out: Path) -> Callable[[], tuple[float, float, dict[str, Any]]]:
     """One timed run of a configuration (solve s, whole s, payload with 'values')."""
+    boom = replace(boom, dt=config.dt)
     if config.code == "exudyn":
         def once() -> tuple[float, float, dict[str, Any]]:
-            t = run_exudyn_boom(exu, boom, config.per_segment, True, False, grid, 1, 0.0)
+            t = run_exudyn_boom(exu, boom, config.per_segment, True, False, grid, 1, 0.0,
+                                config.newton, config.dense)
             if not t.ok:
                 raise RuntimeError(t.message)
             return t.solve_s, t.whole_s, {"counts": t.counts, "values": t.values}
         return once
+    import h5py
+
     from ancfdrv.runner import run_scene
     read = boom_reader(boom, grid)
 
     def once() -> tuple[float, float, dict[str, Any]]:
         t0 = time.perf_counter()
-        run_scene(REPO / "inputs/boom_luffing.nml", base + list(config.overrides), out,
+        run_scene(REPO / "inputs/boom_luffing.nml", base + config.overrides, out,
                   progress=False)
         whole = time.perf_counter() - t0
         with h5py.File(out, "r") as h5:
@@ -1388,164 +1534,270 @@ def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarr
             counts.update({k: int(model[k]) for k in ("ndof", "nconstraints", "nunknowns",
                                                      "nplanar_fixed") if k in model})
             payload = read(h5)
-            stepping = float(h5["timing"].attrs.get("dynamic_stepping", math.nan))
+            phases = {k: float(v) for k, v in h5["timing"].attrs.items()}
             solve = float(attrs["wall_time_s"])
         return solve, whole, {"counts": counts, "values": payload["values"],
-                              "stepping_s": stepping}
+                              "stepping_s": phases.get("dynamic_stepping", math.nan),
+                              "phases_s": phases}
     return once
+
+
+def _level_rounds(configs: list[LevelConfig], once_runs: set[str], onces: dict[str, Callable],
+                  runs: dict[str, Timed], repeats: int, tag: str) -> None:
+    """Interleaved rounds: every configuration once per round (those in ``once_runs`` only in
+    the first), the best time kept; a configuration that fails is not run again."""
+    errors = (RuntimeError, ValueError) + ancfdrv_errors()
+    for round_ in range(repeats):
+        for c in configs:
+            run = runs[c.label]
+            if (round_ and c.label in once_runs) or (run.message and not run.ok):
+                continue
+            try:
+                solve_s, whole_s, payload = onces[c.label]()
+            except errors as exc:
+                run.message = " ".join(f"{type(exc).__name__}: {exc}".split())
+                continue
+            run.solve_samples.append(solve_s)
+            run.whole_samples.append(whole_s)
+            run.ok, run.solve_s, run.whole_s = True, min(run.solve_samples), \
+                min(run.whole_samples)
+            run.counts = payload["counts"]
+            run.values = payload["values"]
+            if "stepping_s" in payload:
+                run.extra["stepping_s"] = min(run.extra.get("stepping_s", math.inf),
+                                              payload["stepping_s"])
+            if "phases_s" in payload and whole_s == run.whole_s:   # the best call's phases
+                run.extra["phases_s"] = payload["phases_s"]
+            if round_ == repeats - 1 or c.label in once_runs:
+                progress(tag, run)
 
 
 def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -> dict[str, Any]:
     """Each accuracy level's fastest configuration of each code on the luffing boom (m = 50
-    and 0 kg), against each code's own converged model and against a common reference
-    (ancfdrv's finest cable: the Euler-Bernoulli model that both codes' cables converge
-    to). Timed runs are interleaved (every configuration once per round, ``--repeats``
-    rounds, the best kept) so that a change of the machine's load hits all alike."""
-    timed_cfg, ref_cfg = level_configs(args.quick)
+    and 0 kg), chosen from a grid over mesh and time step, against each code's own converged
+    model and against a common reference (ancfdrv's cable converged in space and time: the
+    Euler-Bernoulli model both codes' cables converge to). Timed runs are interleaved (every
+    configuration once per round, ``--repeats`` rounds, the best kept) so that a change of
+    the machine's load hits all alike; then the chosen configurations are timed from the
+    command line (a fresh interpreter each, interleaved too)."""
+    timed_cfg, ref_cfg, check_cfg = level_configs(args.quick)
     if exu is None:
         timed_cfg = [c for c in timed_cfg if c.code != "exudyn"]
         ref_cfg = {k: v for k, v in ref_cfg.items() if v.code != "exudyn"}
-    out: dict[str, Any] = {"levels_percent": list(LEVELS), "masses": {}}
-    masses = (50.0,) if args.quick else (50.0, 0.0)
+    out: dict[str, Any] = {"levels_percent": list(LEVELS), "dts": list(LEVEL_DTS),
+                           "sample_dt": LEVEL_SAMPLE_DT, "reference_dt": REFERENCE_DT,
+                           "exudyn_sensor_period": EXUDYN_SENSOR_PERIOD, "masses": {}}
+    masses = (50.0,) if args.quick else tuple(args.masses)
     for mass in masses:
         base = ([f"solver.t_end={plan.boom_t_end!r}"] if plan.boom_t_end else []) + \
             [f"loads.tip_mass={mass!r}"]
         boom = boom_from_scene("inputs/boom_luffing.nml", base)
-        grid = uniform_grid(boom.t_end, boom.dt)
+        grid = uniform_grid(boom.t_end, LEVEL_SAMPLE_DT)
+        once_cfg = list(ref_cfg.values()) + list(check_cfg.values())
         runs: dict[str, Timed] = {}
         onces: dict[str, Callable] = {}
-        for k, c in enumerate(timed_cfg + list({id(v): v for v in ref_cfg.values()}.values())):
-            if c.label in runs:
-                continue
+        for k, c in enumerate(once_cfg + timed_cfg):
             runs[c.label] = Timed(c.code, c.label, asdict(c))
             onces[c.label] = _level_once(c, boom, base, grid, exu, workdir / f"level_{k}.h5")
-        errors = (RuntimeError, ValueError) + ancfdrv_errors()
-        references = {c.label for c in ref_cfg.values()} - {c.label for c in timed_cfg}
-        for round_ in range(args.repeats):
-            for label, once in onces.items():
-                run = runs[label]
-                if (round_ and label in references) or (run.message and not run.ok):
-                    continue
-                try:
-                    solve_s, whole_s, payload = once()
-                except errors as exc:
-                    run.message = f"{type(exc).__name__}: {exc}"
-                    continue
-                run.solve_samples.append(solve_s)
-                run.whole_samples.append(whole_s)
-                run.ok, run.solve_s, run.whole_s = True, min(run.solve_samples), \
-                    min(run.whole_samples)
-                run.counts = payload["counts"]
-                run.values = payload["values"]
-                if "stepping_s" in payload:
-                    run.extra["stepping_s"] = min(run.extra.get("stepping_s", math.inf),
-                                                  payload["stepping_s"])
-                if round_ == args.repeats - 1 or label in references:
-                    progress(f"levels m={mass:g}", run)
-        common = runs[ref_cfg["cable"].label]
-        sag_range = float(np.ptp(common.history)) if common.ok else math.nan
+        tag = f"levels m={mass:g}"
+        _level_rounds(once_cfg, {c.label for c in once_cfg}, onces, runs, 1, tag)
+        _level_rounds(timed_cfg, set(), onces, runs, args.repeats, tag)
+        common = runs[ref_cfg["ancfdrv"].label]
+        if not common.ok:
+            raise RuntimeError(f"ancfdrv's level reference failed: {common.message}")
+        sag_range = float(np.ptp(common.history))
+
+        def error(run: Timed, ref: Timed) -> float:
+            return (100.0 * max_difference(run.history, ref.history) / float(np.ptp(ref.history))
+                    if run.ok and ref.ok else math.nan)
+
         rows = []
         for c in timed_cfg:
             run = runs[c.label]
-            own = runs[ref_cfg[c.family].label]
-            row = {"code": c.code, "label": c.label, "family": c.family, "ok": run.ok,
-                   "message": run.message, "solve_s": run.solve_s, "whole_s": run.whole_s,
-                   "stepping_s": run.extra.get("stepping_s"), "repeats": len(run.solve_samples),
-                   "counts": run.counts, "own_reference": own.label}
-            for key, ref in (("own", own), ("common", common)):
-                ok = run.ok and ref.ok
-                rows_range = float(np.ptp(ref.history)) if ref.ok else math.nan
-                row[f"error_{key}_percent"] = (100.0 * max_difference(run.history, ref.history)
-                                               / rows_range) if ok else math.nan
-            rows.append(row)
-        refs = {family: {"label": c.label, "ok": runs[c.label].ok,
-                         "solve_s": runs[c.label].solve_s,
-                         "error_common_percent": (100.0 * max_difference(
-                             runs[c.label].history, common.history) / sag_range)
-                         if runs[c.label].ok and common.ok else math.nan}
-                for family, c in ref_cfg.items()}
+            own = runs[ref_cfg[c.code].label]
+            rows.append({"code": c.code, "label": c.label, "config": asdict(c), "ok": run.ok,
+                         "message": run.message, "solve_s": run.solve_s,
+                         "whole_s": run.whole_s, "stepping_s": run.extra.get("stepping_s"),
+                         "phases_s": run.extra.get("phases_s"),
+                         "repeats": len(run.solve_samples), "counts": run.counts,
+                         "own_reference": own.label, "error_own_percent": error(run, own),
+                         "error_common_percent": error(run, common)})
+        refs = {code: {"label": c.label, "ok": runs[c.label].ok, "message": runs[c.label].message,
+                       "solve_s": runs[c.label].solve_s, "whole_s": runs[c.label].whole_s,
+                       "error_common_percent": error(runs[c.label], common)}
+                for code, c in ref_cfg.items()}
+        checks = {name: {"label": c.label, "ok": runs[c.label].ok,
+                         "error_common_percent": error(runs[c.label], common)}
+                  for name, c in check_cfg.items()}
+        table = level_table(rows)
+        command_line(table, {c.label: c for c in timed_cfg}, boom, base, workdir, args)
         out["masses"][f"{mass:g}"] = {"sag_range_m": sag_range, "references": refs,
-                                      "runs": rows, "levels": level_table(rows)}
+                                      "reference_checks": checks, "runs": rows,
+                                      "levels": table}
     return out
 
 
-def _before(row: dict[str, Any]) -> bool:
-    """A configuration that existed before issue 23's knobs (no cable, no planar)."""
-    return row["code"] == "ancfdrv" and row["family"] != "cable" and "planar" not in row["label"]
-
-
 def level_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per level and error kind ('own', 'common'): the fastest run of each code within the
-    level, the ratio, and ancfdrv's fastest among the configurations before issue 23
-    ('ancfdrv_before': FFR and the unreduced cubic option, timed in the same rounds)."""
+    """Per level and error kind ('own', 'common'): each code's fastest run within the level
+    by whole call ('whole', the headline) and by solve alone ('solve'), and the ratios."""
     table = []
     for level in LEVELS:
         entry: dict[str, Any] = {"level_percent": level}
         for key in ("own", "common"):
-            best = {}
-            for code, pred in (("ancfdrv", lambda r: r["code"] == "ancfdrv"),
-                               ("exudyn", lambda r: r["code"] == "exudyn"),
-                               ("ancfdrv_before", _before)):
-                ok = [r for r in rows if pred(r) and r["ok"]
-                      and r[f"error_{key}_percent"] <= level]
-                pick = min(ok, key=lambda r: r["solve_s"]) if ok else None
-                best[code] = None if pick is None else {
-                    "label": pick["label"], "solve_s": pick["solve_s"],
-                    "error_percent": pick[f"error_{key}_percent"]}
-            x = best["exudyn"]
-            entry[key] = {**best, "exudyn_over_ancfdrv": (
-                x["solve_s"] / best["ancfdrv"]["solve_s"] if best["ancfdrv"] and x else None),
-                "exudyn_over_ancfdrv_before": (
-                    x["solve_s"] / best["ancfdrv_before"]["solve_s"]
-                    if best["ancfdrv_before"] and x else None)}
+            part: dict[str, Any] = {}
+            for time_key in ("whole_s", "solve_s"):
+                best = {}
+                for code in ("ancfdrv", "exudyn"):
+                    ok = [r for r in rows if r["code"] == code and r["ok"]
+                          and r[f"error_{key}_percent"] <= level]
+                    pick = min(ok, key=lambda r: r[time_key]) if ok else None
+                    best[code] = None if pick is None else {
+                        "label": pick["label"], "whole_s": pick["whole_s"],
+                        "solve_s": pick["solve_s"],
+                        "error_percent": pick[f"error_{key}_percent"]}
+                a, x = best["ancfdrv"], best["exudyn"]
+                part[time_key.removesuffix("_s")] = {
+                    **best, "exudyn_over_ancfdrv": x[time_key] / a[time_key] if a and x else None}
+            entry[key] = part
         table.append(entry)
     return table
 
 
+EXUDYN_SCRIPT = ("import sys; sys.path.insert(0, {bench!r}); import peer_harness as p; "
+                 "p.exudyn_script(sys.argv[1])")
+
+
+def exudyn_script(spec: str) -> None:
+    """What a user's Exudyn script does for one level configuration (run by
+    :func:`command_line` in a fresh interpreter): import Exudyn (its fast module), build the
+    boom, solve the static start and the dynamics, print the final sag."""
+    data = json.loads(spec)
+    exu, note = import_exudyn(fast=True)
+    if exu is None:
+        raise SystemExit(f"exudyn: {note}")
+    boom = Boom(**data["boom"])
+    c = data["config"]
+    newton = ExudynNewton(**c["newton"])
+    run = run_exudyn_boom(exu, boom, c["per_segment"], True, False,
+                          uniform_grid(boom.t_end, LEVEL_SAMPLE_DT), 1, 0.0, newton, c["dense"])
+    if not run.ok:
+        raise SystemExit(run.message)
+    print(f"final sag {run.history[-1]:.6e} m")
+
+
+def command_line(table: list[dict[str, Any]], configs: dict[str, LevelConfig], boom: Boom,
+                 base: list[str], workdir: Path, args: argparse.Namespace) -> None:
+    """Time each code's fastest configuration per level (common reference, by whole call)
+    from the command line: ``ancf run`` of the scene with the configuration's overrides, and
+    a Python script that builds and runs Exudyn's boom; a fresh interpreter per call, the
+    calls interleaved, best of ``--repeats``. Adds 'command_s' to the level table's picks."""
+    import subprocess
+
+    picks = {entry["common"]["whole"][code]["label"]
+             for entry in table for code in ("ancfdrv", "exudyn")
+             if entry["common"]["whole"][code]}
+    ancf = Path(sys.executable).parent / "ancf"
+    commands: dict[str, list[str]] = {}
+    for label in sorted(picks):
+        c = configs[label]
+        if c.code == "ancfdrv":
+            sets = [x for o in base + c.overrides for x in ("--set", o)]
+            commands[label] = [str(ancf), "run", str(REPO / "inputs/boom_luffing.nml"), *sets,
+                               "-o", str(workdir / "command.h5")]
+        else:
+            spec = json.dumps({"boom": asdict(replace(boom, dt=c.dt)), "config": asdict(c)})
+            commands[label] = [sys.executable, "-c",
+                               EXUDYN_SCRIPT.format(bench=str(REPO / "benchmarks")), spec]
+    best: dict[str, float] = {}
+    for _ in range(args.repeats):
+        for label, command in commands.items():
+            if label in best and math.isnan(best[label]):
+                continue
+            t0 = time.perf_counter()
+            done = subprocess.run(command, capture_output=True, text=True, cwd=workdir)
+            elapsed = time.perf_counter() - t0
+            if done.returncode != 0:
+                print(f"  command line {label}: exit {done.returncode}: {done.stderr[-300:]}",
+                      file=sys.stderr, flush=True)
+                best[label] = math.nan
+                continue
+            best[label] = min(best.get(label, math.inf), elapsed)
+    for entry in table:
+        part = entry["common"]["whole"]
+        for code in ("ancfdrv", "exudyn"):
+            if part[code]:
+                part[code]["command_s"] = best.get(part[code]["label"], math.nan)
+        a, x = part["ancfdrv"], part["exudyn"]
+        part["command_exudyn_over_ancfdrv"] = (ratio(x["command_s"], a["command_s"])
+                                               if a and x else None)
+
+
+def _ratio(value: float | None) -> str:
+    return _f(value, ".2f") if value is not None and math.isfinite(value) else "-"
+
+
 def levels_markdown(rec: dict[str, Any]) -> list[str]:
     out = ["## levels: each accuracy level's fastest configuration (luffing boom, 10 s)", "",
-           "Error: max |sag - sag_ref| over the history in % of the reference's sag range. "
-           "'own': each run against its own code's converged model (ancfdrv: the finest run "
-           "of the same element family, cubic 28 nodes for the FFR and cubic runs, cable 55 "
-           "nodes for the cable; Exudyn: its finest cable); 'common': every run against "
-           "ancfdrv's finest cable (the Euler-Bernoulli model both cables converge to). "
-           "Time: the dynamic solve (ancfdrv: `/dynamic` `wall_time_s`, with its HDF5 output "
-           "and answers, no XDMF; Exudyn: `SolveDynamic`), best of the interleaved rounds. "
-           "Ratio: Exudyn's time / ancfdrv's (> 1: ancfdrv faster). 'before': ancfdrv's "
-           "fastest among the configurations that existed before issue 23 (FFR, the unreduced "
-           "cubic option at 4 and 10 nodes), timed in the same rounds.", ""]
+           "Each code's configuration per level is its fastest (by whole call) that meets the "
+           f"level, from a grid over mesh and time step (dt {', '.join(f'{d:g}' for d in rec['dts'])} s): "
+           "ancfdrv's nonlinear cable reduced to the plane (`beam.bending = cable`, "
+           "`scene.planar = xy`) at 4, 7, 10, 16 nodes with its default Newton (`newton_tol = "
+           "1e-10`), output and answers (no XDMF); Exudyn's `ObjectANCFCable2D` at 3, 6, 9, 18 "
+           "elements in its `exudynCPPfast` module on one thread, modified Newton with "
+           "absolute/relative tolerance 1e-2/1e-5 or 1e-3/1e-6 (contractivity 0.05), its dense "
+           "and its sparse LU below 10 elements, sensors every "
+           f"{rec['exudyn_sensor_period']:g} s, no solution file. "
+           "Error: max |sag - sag_ref| at every "
+           f"{rec['sample_dt']:g} s in % of the reference's sag range; 'common': against "
+           "ancfdrv's cable at 55 nodes and dt "
+           f"{rec['reference_dt']:g} s (converged in space and time: see the checks), the "
+           "Euler-Bernoulli model both cables converge to; 'own': each code against its own "
+           f"finest run (Exudyn: 54 elements, dt {rec['reference_dt']:g} s, its default "
+           "tolerances). Times, best of the interleaved rounds: 'whole' the whole in-process "
+           "call (ancfdrv: `run_scene` with the HDF5 file; Exudyn: build, static start, "
+           "`SolveDynamic`, sensor read), 'solve' the dynamic solve alone (ancfdrv: `/dynamic` "
+           "`wall_time_s`; Exudyn: `SolveDynamic`), 'command' from the shell in a fresh "
+           "interpreter (`ancf run` with `--set`; a Python script building and running "
+           "Exudyn's model). Ratio: Exudyn's time / ancfdrv's (> 1: ancfdrv faster).", ""]
     for mass, m in rec["masses"].items():
+        checks = "; ".join(f"{name} ({c['label']}) {_f(c['error_common_percent'], '.4f')} %"
+                           for name, c in m["reference_checks"].items())
+        refs = "; ".join(f"{code}: {r['label']}, {_f(r['error_common_percent'], '.4f')} % from "
+                         "the common reference" for code, r in m["references"].items())
         out += [f"### tip mass {mass} kg (sag range {m['sag_range_m']:.4f} m)", "",
-                "| level | against | ancfdrv fastest | s | error % | Exudyn fastest | s | "
-                "error % | Exudyn / ancfdrv | before: ancfdrv fastest | Exudyn / before |",
-                "|---|---|---|---:|---:|---|---:|---:|---:|---|---:|"]
+                f"References: {refs}. Checks of the common reference (distance from it): "
+                f"{checks or 'none'}.", "",
+                "| level | against | ancfdrv fastest | whole s | solve s | command s | error % | "
+                "Exudyn fastest | whole s | solve s | command s | error % | ratio whole | "
+                "ratio solve | ratio command |",
+                "|---|---|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
         for entry in m["levels"]:
-            for key in ("own", "common"):
-                e = entry[key]
-                a, x = e["ancfdrv"], e["exudyn"]
-                out.append(
-                    f"| {entry['level_percent']:g} % | {key} | "
-                    f"{a['label'] if a else 'none'} | {_f(a['solve_s']) if a else '-'} | "
-                    f"{_f(a['error_percent']) if a else '-'} | {x['label'] if x else 'none'} | "
-                    f"{_f(x['solve_s']) if x else '-'} | {_f(x['error_percent']) if x else '-'} "
-                    f"| {_f(e['exudyn_over_ancfdrv'], '.2f') if e['exudyn_over_ancfdrv'] else '-'} "
-                    f"| {e['ancfdrv_before']['label'] if e.get('ancfdrv_before') else 'none'} | "
-                    f"{_f(e['exudyn_over_ancfdrv_before'], '.2f') if e.get('exudyn_over_ancfdrv_before') else '-'} |")
-        out += ["", "| code | run | solve s | stepping s | steps | Newton | factorizations | "
-                "unknowns | error own % | error common % |",
-                "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+            for key in ("common", "own"):
+                w, s = entry[key]["whole"], entry[key]["solve"]
+
+                def cells(p: dict[str, Any] | None) -> str:
+                    if p is None:
+                        return "none | - | - | - | -"
+                    return (f"{p['label']} | {_f(p['whole_s'])} | {_f(p['solve_s'])} | "
+                            f"{_f(p['command_s']) if 'command_s' in p else '-'} | "
+                            f"{_f(p['error_percent'], '.4f')}")
+                out.append(f"| {entry['level_percent']:g} % | {key} | {cells(w['ancfdrv'])} | "
+                           f"{cells(w['exudyn'])} | {_ratio(w['exudyn_over_ancfdrv'])} | "
+                           f"{_ratio(s['exudyn_over_ancfdrv'])} | "
+                           f"{_ratio(w.get('command_exudyn_over_ancfdrv'))} |")
+        out += ["", "| code | run | whole s | solve s | steps | Newton | factorizations | "
+                "error own % | error common % |",
+                "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
         for r in m["runs"]:
             c = r["counts"]
-            unknowns = c.get("nunknowns", "-")
-            out.append(f"| {r['code']} | {r['label']} | {_f(r['solve_s'])} | "
-                       f"{_f(r['stepping_s']) if r['stepping_s'] else '-'} | "
-                       f"{c.get('steps', '-')} | {c.get('newton_iterations', '-')} | "
-                       f"{c.get('factorizations', c.get('jacobians', '-'))} | {unknowns} | "
+            state = "" if r["ok"] else f" (failed: {r['message'][:80]})"
+            out.append(f"| {r['code']} | {r['label']}{state} | {_f(r['whole_s'])} | "
+                       f"{_f(r['solve_s'])} | {c.get('steps', '-')} | "
+                       f"{c.get('newton_iterations', '-')} | "
+                       f"{c.get('factorizations', c.get('jacobians', '-'))} | "
                        f"{_f(r['error_own_percent'], '.4f')} | "
                        f"{_f(r['error_common_percent'], '.4f')} |")
-        refs = "; ".join(f"{fam}: {r['label']} ({_f(r['error_common_percent'], '.4f')} % from "
-                         "the common reference)" for fam, r in m["references"].items())
-        out += ["", f"References: {refs}.", ""]
+        out.append("")
     return out
 
 
@@ -1575,18 +1827,19 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
                         help="spinup/pendulum: repeat a run until it took this long in all, at "
                              "most --repeats times (peer_exudyn.py's rule; default 1 s)")
     parser.add_argument("--hard-bending", choices=("cubic", "cubic-planar", "cable-planar"),
-                        default="cubic-planar",
-                        help="spinup: ancfdrv's option (default 'cubic-planar': the cubic "
-                             "option with scene.planar = 'xy', issue 23; 'cable-planar': the "
-                             "ANCF cable reduced to its plane, clamped to the hub by r and r_x, "
-                             "as Exudyn's ANCFCable2D)")
+                        nargs="+", default=["cubic-planar", "cable-planar"],
+                        help="spinup: ancfdrv's options, the first gives the reference and the "
+                             "dominance, the level table takes each level's fastest of all "
+                             "(default 'cubic-planar' 'cable-planar': the cubic option with "
+                             "scene.planar = 'xy', issue 23, and the ANCF cable reduced to its "
+                             "plane, clamped to the hub by r and r_x, as Exudyn's ANCFCable2D)")
     parser.add_argument("--pendulum-bending", choices=("cubic", "cubic-planar", "cable-planar"),
                         default="cable-planar",
                         help="pendulum: ancfdrv's option (default 'cable-planar': the ANCF "
                              "cable reduced to its plane, issue 23)")
     parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
-    parser.add_argument("--exudyn-fast", action="store_true",
-                        help="load Exudyn's exudynCPPfast build (no range checks)")
+    parser.add_argument("--masses", type=float, nargs="+", default=[50.0, 0.0],
+                        help="levels: the tip masses (kg; default 50 0)")
     parser.add_argument("--leaf-previous", type=Path, default=None,
                         help="JSON of an earlier harness run whose leaf-spring history to "
                              "compare with (default: the output file, before it is replaced)")
@@ -1624,7 +1877,7 @@ def main(argv: list[str] | None = None) -> int:
     from ancfdrv import _kernel
 
     exu, exudyn_note = ((None, "--no-exudyn") if args.no_exudyn
-                        else import_exudyn(fast=args.exudyn_fast))
+                        else import_exudyn(fast=True))
     plan = QUICK if args.quick else FULL
     machine = machine_info()
     kernel_file = Path(_kernel.__file__)
@@ -1675,6 +1928,7 @@ def main(argv: list[str] | None = None) -> int:
     text = markdown(report)
     if "levels" in problems:
         text += "\n".join(levels_markdown(problems["levels"])) + "\n"
+    text += "\n".join(hard_levels_markdown(problems)) + "\n"
     if reinstalled:
         text += ("\nWARNING: ancfdrv's kernel module changed during the run (a reinstall): the "
                  "runs may mix two builds.\n")

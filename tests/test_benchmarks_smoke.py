@@ -138,3 +138,47 @@ def test_make_bench_lists_every_benchmark_script(monkeypatch):
     spec.loader.exec_module(run_all)
     scripts = {p.stem for p in BENCHMARKS.glob("*.py") if not p.stem.startswith("_")}
     assert scripts - {"run_all"} == {b.name for b in run_all.BENCHES}
+
+
+def test_peer_harness_levels_smoke(tmp_path):
+    """benchmarks/peer_harness.py --quick --only levels (the boom for 2 s): every grid run
+    takes its own step count, the errors are measured against the converged reference, the
+    level table picks a run within each level it fills; with Exudyn, its 3-element cable at
+    dt 1e-2 runs at the fair settings and lands within 10 % of ancfdrv's 4-node cable's error
+    at the same step (the same model), and both codes' picks are timed from the command
+    line. Without Exudyn the peer's runs are absent and its picks empty."""
+    import importlib.util
+    out = tmp_path / "levels.json"
+    run_script("peer_harness.py", "--quick", "--only", "levels", "--repeats", "1",
+               "--output", str(out))
+    report = json.loads(out.read_text())
+    with_exudyn = importlib.util.find_spec("exudyn") is not None
+    assert report["exudyn"]["available"] is with_exudyn
+    rec = report["problems"]["levels"]["masses"]["50"]
+    assert rec["references"]["ancfdrv"]["ok"] and rec["sag_range_m"] > 0
+    runs = {r["label"]: r for r in rec["runs"]}
+    steps = {"cable 4 nodes, dt 0.001": 2000, "cable 4 nodes, dt 0.01": 200}
+    if with_exudyn:
+        steps["3 el, dt 0.01, tol 1e-2/1e-5, dense"] = 200
+    assert set(runs) == set(steps)
+    for label, run in runs.items():
+        assert run["ok"], run["message"]
+        assert run["counts"]["steps"] == steps[label]
+        assert positive(run["whole_s"]) and positive(run["solve_s"])
+        assert run["solve_s"] <= run["whole_s"]
+        assert 0 < run["error_common_percent"] < 3.0
+    for entry in rec["levels"]:
+        pick = entry["common"]["whole"]["ancfdrv"]
+        if pick is not None:
+            assert pick["error_percent"] <= entry["level_percent"]
+    three_percent = rec["levels"][0]["common"]["whole"]
+    assert three_percent["ancfdrv"]["label"] in steps
+    assert positive(three_percent["ancfdrv"]["command_s"])
+    if with_exudyn:
+        a = runs["cable 4 nodes, dt 0.01"]["error_common_percent"]
+        x = runs["3 el, dt 0.01, tol 1e-2/1e-5, dense"]["error_common_percent"]
+        assert abs(x - a) < 0.1 * a
+        assert positive(three_percent["exudyn"]["command_s"])
+        assert positive(three_percent["exudyn_over_ancfdrv"])
+    else:
+        assert three_percent["exudyn"] is None
