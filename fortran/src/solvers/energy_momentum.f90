@@ -35,8 +35,8 @@ module energy_momentum
   use mechanical_system, only: system_model, contact_state, frame_rotations, &
                                external_forces, energies, probe_output, power_count
   use system_mass, only: mass_product
-  use system_constraints, only: evaluate_constraints, constraint_reaction
-  use system_reduction, only: to_full, to_reduced
+  use system_constraints, only: evaluate_constraints, constraint_reaction, add_gradient_column
+  use system_reduction, only: to_full, to_reduced, row_terms, reduced_col, reduced_coef
   use element_sets, only: local_element_set
   use beam_nonlinear, only: continuum_set
   use beam_cubic, only: cubic_set
@@ -137,7 +137,8 @@ contains
     real(dp), intent(out), optional :: jacobian(:, :)
     real(dp) :: full0(sys%nfull), full1(sys%nfull), full_force(sys%nfull)
     real(dp) :: step(sys%ndof), mid(sys%ndof), loads(sys%ndof), shifted(sys%ndof)
-    real(dp) :: phi(sys%constraints%ncon), gradients(6, sys%constraints%ncon), reaction(sys%ndof), moved(sys%ndof)
+    real(dp) :: phi(sys%constraints%ncon), gradients(6, sys%constraints%ncon)
+    real(dp) :: reaction(sys%ndof), moved(sys%ndof), column(sys%ndof)
     real(dp), allocatable :: coords0(:, :), coords1(:, :), force(:), tangent(:, :)
     logical :: want, touched(sys%ndof)
     integer :: n, s, el, k, i, j, c, code, nde
@@ -203,13 +204,11 @@ contains
     if (want) then
       touched = .false.
       do c = 1, sys%constraints%ncon
-        do s = 1, 6
-          do k = sys%constraints%term_ptr(6 * (c - 1) + s), sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
-            jacobian(sys%constraints%term_dof(k), n + c) = jacobian(sys%constraints%term_dof(k), n + c) &
-                                               - gradients(s, c) * sys%constraints%term_coef(k)
-            touched(sys%constraints%term_dof(k)) = .true.
-          end do
-        end do
+        column = 0.0_dp
+        call add_gradient_column(sys%constraints, gradients, c, 6, column)
+        jacobian(1:n, n + c) = jacobian(1:n, n + c) - column
+        touched(sys%constraints%term_dof(sys%constraints%term_ptr(6 * c - 5): &
+                                         sys%constraints%term_ptr(6 * c + 1) - 1)) = .true.
       end do
       ! d(-Phi_e(e_m)^T lambda)/de1: the gradients are affine in e, so half a unit step of
       ! e_m along coordinate j gives the column exactly (to round-off)
@@ -229,12 +228,9 @@ contains
     residual(n + 1:n + sys%constraints%ncon) = phi
     if (want) then
       do c = 1, sys%constraints%ncon
-        do s = 1, 6
-          do k = sys%constraints%term_ptr(6 * (c - 1) + s), sys%constraints%term_ptr(6 * (c - 1) + s + 1) - 1
-            jacobian(n + c, sys%constraints%term_dof(k)) = jacobian(n + c, sys%constraints%term_dof(k)) &
-                                               + gradients(s, c) * sys%constraints%term_coef(k)
-          end do
-        end do
+        column = 0.0_dp
+        call add_gradient_column(sys%constraints, gradients, c, 6, column)
+        jacobian(n + c, 1:n) = jacobian(n + c, 1:n) + column
       end do
     end if
   end subroutine midpoint_residual
@@ -322,53 +318,22 @@ contains
     integer, intent(in) :: dofs(:)
     real(dp), intent(in) :: tangent(:, :)
     real(dp), intent(inout) :: jacobian(:, :)
-    integer :: a, b, ka, kb, na, nb
-    integer :: cols_a(64), cols_b(64)
-    real(dp) :: coefs_a(64), coefs_b(64)
+    integer :: a, b, ka, kb
     do b = 1, size(dofs)
-      call reduction_row(sys, dofs(b), cols_b, coefs_b, nb)
-      if (nb == 0) cycle
       do a = 1, size(dofs)
         if (tangent(a, b) == 0.0_dp) cycle
-        call reduction_row(sys, dofs(a), cols_a, coefs_a, na)
-        do kb = 1, nb
-          do ka = 1, na
-            jacobian(cols_a(ka), cols_b(kb)) = jacobian(cols_a(ka), cols_b(kb)) &
-                                               + coefs_a(ka) * tangent(a, b) * coefs_b(kb)
+        do kb = 1, row_terms(sys%reduction, dofs(b))
+          do ka = 1, row_terms(sys%reduction, dofs(a))
+            associate (i => reduced_col(sys%reduction, dofs(a), ka), &
+                       j => reduced_col(sys%reduction, dofs(b), kb))
+              jacobian(i, j) = jacobian(i, j) + reduced_coef(sys%reduction, dofs(a), ka) &
+                               * tangent(a, b) * reduced_coef(sys%reduction, dofs(b), kb)
+            end associate
           end do
         end do
       end do
     end do
   end subroutine add_reduced
-
-  !> Row i of the reduction B (q = B e + q0): its columns and coefficients (count of them; at
-  !> most 64, more are not written).
-  pure subroutine reduction_row(sys, i, cols, coefs, count)
-    type(system_model), intent(in) :: sys
-    integer, intent(in) :: i
-    integer, intent(out) :: cols(:), count
-    real(dp), intent(out) :: coefs(:)
-    integer :: k
-    count = 0
-    if (.not. sys%reduction%active) then
-      count = 1
-      cols(1) = i
-      coefs(1) = 1.0_dp
-    else if (allocated(sys%reduction%select)) then
-      if (sys%reduction%select(i) > 0) then
-        count = 1
-        cols(1) = sys%reduction%select(i)
-        coefs(1) = 1.0_dp
-      end if
-    else
-      do k = sys%reduction%ptr(i), min(sys%reduction%ptr(i + 1) - 1, &
-                                       sys%reduction%ptr(i) + size(cols) - 1)
-        count = count + 1
-        cols(count) = sys%reduction%col(k)
-        coefs(count) = sys%reduction%values(k)
-      end do
-    end if
-  end subroutine reduction_row
 
   !> The dense mass matrix M (ndof, ndof) of the system (its products with the unit vectors).
   pure subroutine dense_mass(sys, mass)
