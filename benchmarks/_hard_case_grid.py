@@ -97,22 +97,30 @@ def classify(case: Case, workdir: Path, references: dict | None = None) -> dict:
     reference = references[(case.scene, ref_sets)]
     code, t, got = run_scene(case.scene, case.sets + (f"solver.dt={case.dt:g}",),
                              workdir / f"{case.name}.h5")
-    record = {"case": case.name, "exit": code, "status": got.get("status", ""),
-              "corrections": got.get("corrections", 0), "cuts": got.get("cuts", 0),
-              "tolerance_m": case.tolerance, "horizon_s": case.horizon, "error_m": None,
-              "balance": got.get("balance"), "dissipated": got.get("dissipated")}
+    error = None
     if code == 0:
         ref_t, ref_p = reference["time"], reference[case.probe]
         keep = t <= case.horizon + 1e-9
         p = got[case.probe][keep]
         ref = np.stack([np.interp(t[keep], ref_t, ref_p[:, k]) for k in range(3)], axis=1)
-        record["error_m"] = float(np.abs(p - ref).max())
-        right = record["error_m"] <= case.tolerance and record["balance"] <= BALANCE_TOLERANCE
+        error = float(np.abs(p - ref).max())
+    return _record(case, code, got, case.horizon, error)
+
+
+def _record(case: Case, code: int, got: dict, horizon: float | None,
+            error: float | None) -> dict:
+    """A run's record and class: 'correct' (exit 0, the error within the case's tolerance
+    and the energy balance within BALANCE_TOLERANCE), 'ok and wrong' (exit 0 otherwise),
+    'refused' (exit 3) or 'error'."""
+    record = {"case": case.name, "exit": code, "status": got.get("status", ""),
+              "corrections": got.get("corrections", 0), "cuts": got.get("cuts", 0),
+              "tolerance_m": case.tolerance, "horizon_s": horizon, "error_m": error,
+              "balance": got.get("balance"), "dissipated": got.get("dissipated")}
+    if code == 0:
+        right = error <= case.tolerance and record["balance"] <= BALANCE_TOLERANCE
         record["class"] = "correct" if right else "ok and wrong"
-    elif code == 3:
-        record["class"] = "refused"
     else:
-        record["class"] = "error"
+        record["class"] = "refused" if code == 3 else "error"
     return record
 
 
@@ -121,23 +129,13 @@ def _against_closed_form(case: Case, workdir: Path) -> dict:
     against it."""
     code, t, got = run_scene(case.scene, case.sets + (f"solver.dt={case.dt:g}",),
                              workdir / f"{case.name}.h5")
-    record = {"case": case.name, "exit": code, "status": got.get("status", ""),
-              "corrections": got.get("corrections", 0), "cuts": got.get("cuts", 0),
-              "tolerance_m": case.tolerance, "horizon_s": float(t[-1]) if len(t) else None,
-              "error_m": None, "balance": got.get("balance"),
-              "dissipated": got.get("dissipated")}
+    error = None
     if code == 0:
         kind, value = case.closed_form
         height = got[case.probe][:, 1]
         extreme = height.max() if kind == "max" else height.min()
-        record["error_m"] = float(abs(extreme - value))
-        right = record["error_m"] <= case.tolerance and record["balance"] <= BALANCE_TOLERANCE
-        record["class"] = "correct" if right else "ok and wrong"
-    elif code == 3:
-        record["class"] = "refused"
-    else:
-        record["class"] = "error"
-    return record
+        error = float(abs(extreme - value))
+    return _record(case, code, got, float(t[-1]) if len(t) else None, error)
 
 
 #: the rope's closed forms (inputs/hard/rope_throw.nml, rope_drop.nml): the cable's law
