@@ -35,7 +35,8 @@ module energy_momentum
   use mechanical_system, only: system_model, contact_state, frame_rotations, &
                                external_forces, energies, probe_output, power_count
   use system_mass, only: mass_product
-  use system_constraints, only: evaluate_constraints, constraint_reaction, add_gradient_column
+  use system_constraints, only: evaluate_constraints, constraint_reaction, add_gradient_column, &
+                                constraint_derivatives
   use system_reduction, only: to_full, to_reduced, row_terms, reduced_col, reduced_coef
   use element_sets, only: local_element_set
   use beam_nonlinear, only: continuum_set
@@ -136,12 +137,14 @@ contains
     real(dp), intent(in), optional :: mass(:, :)
     real(dp), intent(out), optional :: jacobian(:, :)
     real(dp) :: full0(sys%nfull), full1(sys%nfull), full_force(sys%nfull)
-    real(dp) :: step(sys%ndof), mid(sys%ndof), loads(sys%ndof), shifted(sys%ndof)
+    real(dp) :: step(sys%ndof), mid(sys%ndof), loads(sys%ndof)
     real(dp) :: phi(sys%constraints%ncon), gradients(6, sys%constraints%ncon)
-    real(dp) :: reaction(sys%ndof), moved(sys%ndof), column(sys%ndof)
+    real(dp) :: reaction(sys%ndof), column(sys%ndof), zero_rates(sys%ndof)
+    real(dp) :: hessians(6, 6, sys%constraints%ncon), phi_t(sys%constraints%ncon)
+    real(dp) :: phi_tt(sys%constraints%ncon), gamma(sys%constraints%ncon)
     real(dp), allocatable :: coords0(:, :), coords1(:, :), force(:), tangent(:, :)
-    logical :: want, touched(sys%ndof)
-    integer :: n, s, el, k, i, j, c, code, nde
+    logical :: want
+    integer :: n, s, el, k, i, c, code, nde, s1, s2, k1, k2
     n = sys%ndof
     want = present(jacobian)
     info = 0
@@ -202,25 +205,33 @@ contains
     call constraint_reaction(sys%constraints, gradients, lam, reaction)
     residual(1:n) = residual(1:n) + reaction
     if (want) then
-      touched = .false.
       do c = 1, sys%constraints%ncon
         column = 0.0_dp
         call add_gradient_column(sys%constraints, gradients, c, 6, column)
         jacobian(1:n, n + c) = jacobian(1:n, n + c) - column
-        touched(sys%constraints%term_dof(sys%constraints%term_ptr(6 * c - 5): &
-                                         sys%constraints%term_ptr(6 * c + 1) - 1)) = .true.
       end do
-      ! d(-Phi_e(e_m)^T lambda)/de1: the gradients are affine in e, so half a unit step of
-      ! e_m along coordinate j gives the column exactly (to round-off)
-      do j = 1, n
-        if (.not. touched(j)) cycle
-        shifted = mid
-        shifted(j) = shifted(j) + 0.5_dp
-        call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, shifted, t0 + h, phi, gradients, info)
-        if (info /= 0) return
-        moved = 0.0_dp
-        call constraint_reaction(sys%constraints, gradients, lam, moved)
-        jacobian(1:n, j) = jacobian(1:n, j) + (moved - reaction)
+      zero_rates = 0.0_dp
+      ! d(-Phi_e(e_m)^T lambda)/de1 = -1/2 sum_c lambda_c Phi_c,ee (e_m = (e0 + e1) / 2), the
+      ! constraints' Hessians on their operands' terms (as the static Newton's tangent)
+      call constraint_derivatives(sys%constraints, sys%drives, mid, zero_rates, t0 + h, phi, &
+                                  gradients, hessians, phi_t, phi_tt, gamma, info)
+      if (info /= 0) return
+      do c = 1, sys%constraints%ncon
+        do s1 = 1, 6
+          do s2 = 1, 6
+            if (hessians(s1, s2, c) == 0.0_dp) cycle
+            do k1 = sys%constraints%term_ptr(6 * (c - 1) + s1), &
+                    sys%constraints%term_ptr(6 * (c - 1) + s1 + 1) - 1
+              do k2 = sys%constraints%term_ptr(6 * (c - 1) + s2), &
+                      sys%constraints%term_ptr(6 * (c - 1) + s2 + 1) - 1
+                associate (i => sys%constraints%term_dof(k1), j => sys%constraints%term_dof(k2))
+                  jacobian(i, j) = jacobian(i, j) - 0.5_dp * lam(c) * hessians(s1, s2, c) &
+                                   * sys%constraints%term_coef(k1) * sys%constraints%term_coef(k2)
+                end associate
+              end do
+            end do
+          end do
+        end do
       end do
     end if
     call evaluate_constraints(sys%constraints, sys%drives, sys%ndof, e1, t0 + h, phi, gradients, info)
