@@ -101,25 +101,8 @@ def linearize(model: Model, e: np.ndarray, lam: np.ndarray, t: float = 0.0,
     the constraint Hessians times the multipliers)."""
     n = model.ndof
     out = model.forces(e, t, want_tangent=True, load_factor=load_factor)
-    k = model.pattern.to_scipy(out["tangent"]).tocoo()
-    rows, cols, vals = [k.row], [k.col], [k.data]
-    for dofs, _, jac, _ in model.moment_terms(e, load_factor=load_factor):
-        rows.append(np.repeat(dofs, len(dofs)))
-        cols.append(np.tile(dofs, len(dofs)))
-        vals.append(-np.asarray(jac).ravel())
-    # the driven and follower point loads and a rigid body's dead moments (vector_loads):
-    # their exact, unsymmetric load stiffness
-    for dofs, _, jac in model.vector_load_terms(e, t, load_factor=load_factor):
-        rows.append(np.repeat(dofs, len(dofs)))
-        cols.append(np.tile(dofs, len(dofs)))
-        vals.append(-np.asarray(jac).ravel())
-    if len(model.constraints):
-        h_con, h_rows, h_cols, h_vals = model.constraints.hessian_triplets(e)
-        rows.append(h_rows)
-        cols.append(h_cols)
-        vals.append(-lam[h_con] * h_vals)
-    stiffness = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
-                                                      np.concatenate(cols))), shape=(n, n))
+    rows, cols, vals = model.stiffness_triplets(e, lam, t, load_factor, out["tangent"])
+    stiffness = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
     scale = max(abs(stiffness).max(), 1e-300)
     asymmetry = float(abs(stiffness - stiffness.T).max() / scale) if stiffness.nnz else 0.0
     stiffness = ((stiffness + stiffness.T) * 0.5).tocsr()

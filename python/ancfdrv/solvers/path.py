@@ -156,22 +156,10 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
     per group of constraints sharing coordinates, the SVD's of their Jacobian, placed at
     the group's middle among the coordinates."""
     n, ncon = model.ndof, len(model.constraints)
-    tangent = model.pattern.to_csr(
-        model.forces(e, 0.0, want_tangent=True, load_factor=factor)["tangent"])
-    rows, cols, vals = [tangent.row_index()], [tangent.indices], [tangent.data]
-    for dofs, _, jac, *_ in (*model.moment_terms(e, load_factor=factor),
-                             *model.vector_load_terms(e, 0.0, load_factor=factor)):
-        dofs = np.asarray(dofs)
-        rows.append(np.repeat(dofs, len(dofs)))
-        cols.append(np.tile(dofs, len(dofs)))
-        vals.append(-np.asarray(jac).ravel())
+    r, c, v = model.stiffness_triplets(e, lam, load_factor=factor)
     touched = np.zeros(0, dtype=np.int64)
     basis, where = np.zeros((0, 0)), np.zeros(0)
     if ncon:
-        h_con, h_rows, h_cols, h_vals = model.constraints.hessian_triplets(e)
-        rows.append(h_rows)
-        cols.append(h_cols)
-        vals.append(-lam[h_con] * h_vals)
         _, g_rows, g_cols, grads = model.constraints.jacobian(e, n)
         grads = np.asarray(grads, dtype=float)
         nonzero = grads != 0
@@ -194,9 +182,7 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
             positions.append(np.full(len(group) - rank, touched[group].mean()))
         basis = np.hstack(parts) if parts else np.zeros((len(touched), 0))
         where = np.concatenate(positions) if positions else where
-    r = np.concatenate(rows).astype(np.int64)
-    c = np.concatenate(cols).astype(np.int64)
-    v = 0.5 * np.concatenate(vals)
+    v = 0.5 * v
     r, c, v = np.concatenate([r, c]), np.concatenate([c, r]), np.concatenate([v, v])
     # the symmetric part's triplets (duplicates add up where they are used)
     free = np.setdiff1d(np.arange(n), touched)

@@ -368,6 +368,33 @@ class Model:
             out.append((cols, b.T @ f, b.T @ j @ b, np.einsum("ijl,ia,jb,lc->abc", h, b, b, b)))
         return out
 
+    def stiffness_triplets(self, e: np.ndarray, lam: np.ndarray, t: float = 0.0,
+                           load_factor: float | None = None,
+                           tangent: np.ndarray | None = None):
+        """The static Newton matrix's stiffness block at (e, lambda) as triplets (rows,
+        cols, values; duplicates add up): the elements' and contact tangent (``tangent``,
+        the pattern's values of ``forces(want_tangent=True)``, evaluated when not given),
+        minus the dead moments' and the driven and follower point loads' Jacobians (their
+        exact, unsymmetric load stiffness), minus the constraint Hessians times the
+        multipliers."""
+        if tangent is None:
+            tangent = self.forces(e, t, want_tangent=True, load_factor=load_factor)["tangent"]
+        k = self.pattern.to_csr(tangent)
+        rows, cols, vals = [k.row_index()], [k.indices], [k.data]
+        for dofs, _, jac, *_ in (*self.moment_terms(e, load_factor=load_factor),
+                                 *self.vector_load_terms(e, t, load_factor=load_factor)):
+            dofs = np.asarray(dofs)
+            rows.append(np.repeat(dofs, len(dofs)))
+            cols.append(np.tile(dofs, len(dofs)))
+            vals.append(-np.asarray(jac).ravel())
+        if len(self.constraints):
+            h_con, h_rows, h_cols, h_vals = self.constraints.hessian_triplets(e)
+            rows.append(h_rows)
+            cols.append(h_cols)
+            vals.append(-lam[h_con] * h_vals)
+        return (np.concatenate(rows).astype(np.int64), np.concatenate(cols).astype(np.int64),
+                np.concatenate(vals))
+
     def vector_load_terms(self, e: np.ndarray, t: float = 0.0,
                           load_factor: float | None = None):
         """Per driven or follower point load: (coordinates e, generalized force, its
