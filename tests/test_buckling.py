@@ -299,8 +299,9 @@ def test_knuckle_crane_from_its_static_state():
     stiffness grows with the loads) is not reported. The further factors (the classical
     linear buckling about a state below the limit, with the beams' K_sigma of the exact
     stress increment) lie above the limit and within 2% of the refined crane's too
-    (measured 1171.1 and 2954.9, refined 1183.1 and 2940.3; with K_sigma taken at the first
-    state 552.5 and 557.3, below the limit)."""
+    (measured 1170.5 and 2951.0, refined 1182.6 and 2936.4, with the cylinders' and the
+    rope's initial-stress stiffness; 1171.1 and 2954.9 with their tangents' difference; with
+    K_sigma taken at the first state 552.5 and 557.3, below the limit)."""
     coarse = crane_model()
     first = buckling_analysis(coarse, 3, rtol=1e-4)
     again = buckling_analysis(coarse, 3, rtol=1e-4)
@@ -512,7 +513,9 @@ def test_initial_stress_of_a_rigid_rotation_is_zero(bending):
     for el in range(info.nel):
         dofs = info.dofs[:, el]
         own[np.ix_(dofs, dofs)] += tangents[1][:, :, el] - tangents[0][:, :, el]
-    initial_stress = stress_correction(model, e1, e2, 1.0).toarray() + own
+    no_joint = np.zeros(0)
+    initial_stress = stress_correction(model, (e1, no_joint, 1.0), (e2, no_joint, 1.0),
+                                       1.0).toarray() + own
     assert np.abs(own).max() > 0
     assert np.abs(split(info, e1, dq)[1]).max() > 1e-3 * np.abs(own).max()  # at e1: not 0
     np.testing.assert_allclose(initial_stress, 0.0, atol=1e-9 * np.abs(own).max())
@@ -574,3 +577,114 @@ def test_crane_boom_linear_against_nonlinear():
     assert limit > factor * nonlinear
     with pytest.raises(SolverError, match="contradicted by the model.*'nonlinear'"):
         buckling_analysis(boom, 1, method="linear")
+
+
+def test_force_element_initial_stress_is_the_line_force_times_its_turn():
+    """A cylinder's initial-stress stiffness (kernel force_element_initial_stress): its
+    tension at the state x times the Hessian of its length at the configuration ``at``;
+    against central differences of f grad L(at) = f [-n, n] with f held (the geometric
+    stiffness of classical buckling, without the material part k n n^T the element's
+    tangent adds)."""
+    from ancfdrv import kernel
+    from ancfdrv.system.kinds.force_element import FE_CYLINDER
+    params, length = np.array([2.0e6, 0.0]), 2.1
+    x = np.array([[0.1, 0.2, -0.1], [1.3, 1.7, 0.4]]).T          # compressed: f < 0
+    at = np.array([[0.0, 0.1, 0.0], [1.2, 1.5, 0.3]]).T
+    got = kernel.force_element_initial_stress(FE_CYLINDER, params, 0, [], x, np.zeros((3, 2)),
+                                              at, length)
+    f = params[0] * (np.linalg.norm(x[:, 1] - x[:, 0]) - length)
+    assert f < 0
+
+    def force(y):
+        n = (y[:, 1] - y[:, 0]) / np.linalg.norm(y[:, 1] - y[:, 0])
+        return f * np.column_stack([-n, n])
+    h = 1e-6
+    expected = np.zeros((3, 2, 3, 2))
+    for j in range(3):
+        for w in range(2):
+            step = np.zeros((3, 2))
+            step[j, w] = h
+            expected[:, :, j, w] = (force(at + step) - force(at - step)) / (2 * h)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-7 * np.abs(expected).max())
+
+
+def test_cable_initial_stress_is_the_string_stiffness():
+    """A straight cable along x stretched uniformly from eps1 to eps2 (q2 = (1 + s) q1 on
+    the positions and slopes): its initial-stress stiffness (kernel cable_stress_stiffness
+    at the middle state along dq = q2 - q1) is the string's dN int S'^T S' on every
+    direction, dN = EA (eps2 - eps1) exactly (the Green strain is quadratic), with the
+    Hermite rows integrated here independently (numpy Gauss-Legendre); a rope adds the same
+    where taut and nothing where slack."""
+    from ancfdrv import kernel
+    length, ea = 0.7, 3.0e6
+    q1 = np.array([[0, 0, 0], [1, 0, 0], [length, 0, 0], [1, 0, 0]], float).T.ravel(order="F")
+    s = 0.01
+    dq = s * np.array([[0, 0, 0], [1, 0, 0], [length, 0, 0], [1, 0, 0]], float).T.ravel(
+        order="F")
+    dofs = np.arange(12).reshape(12, 1)
+    middle = q1 + 0.5 * dq
+    got = kernel.cable_stress_stiffness(dofs, middle, dq, [length], ea)[:, :, 0]
+    d_n = ea * (0.5 * ((1 + s) ** 2 - 1))
+    xg, wg = np.polynomial.legendre.leggauss(5)
+    string = np.zeros((4, 4))
+    for x, w in zip(0.5 * (xg + 1), 0.5 * wg):
+        rows = np.array([(-6 * x + 6 * x**2) / length, 1 - 4 * x + 3 * x**2,
+                         (6 * x - 6 * x**2) / length, 3 * x**2 - 2 * x])
+        string += w * length * np.outer(rows, rows)
+    expected = d_n * np.kron(string, np.eye(3))
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+    rope = kernel.cable_stress_stiffness(dofs, middle, dq, [length], ea, True)[:, :, 0]
+    np.testing.assert_allclose(rope, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+    slack = kernel.cable_stress_stiffness(dofs, 0.99 * middle, dq, [length], ea, True)
+    assert np.abs(slack).max() == 0.0
+
+
+def _stiffened_crane(tmp_path, in_plane: float, cylinder: float):
+    """The shipped knuckle crane with both beams' in-plane bending inertia I_z, area and
+    in-plane shear factor times ``in_plane`` ('general' sections with the boxes' other
+    properties and their weight) and the jib cylinder's oil column ``cylinder`` times
+    stiffer: the same structure without its pre-buckling deformation in its plane."""
+    from pathlib import Path
+    from ancfdrv.builders import build_system
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.system.sections import Box
+    text = (Path(__file__).resolve().parents[1] / "inputs" / "knuckle_crane_rope.nml").read_text()
+    for dims in ((0.25, 0.35, 0.010), (0.20, 0.25, 0.008)):
+        box = Box(*dims)
+        given = (f"section = 'box', width = {dims[0]:.2f}, height = {dims[1]:.2f}, "
+                 f"wall = {dims[2]:.3f}")
+        assert given in text
+        text = text.replace(given, (
+            f"section = 'general', area = {box.area * in_plane!r}, iy = {box.iy!r}, "
+            f"iz = {box.iz * in_plane!r}, torsion_constant = {box.torsion_constant!r}, "
+            f"shear_factor_y = {in_plane!r}, shear_factor_z = 1.0, "
+            f"mass_per_length = {box.area * 7850.0!r}"))
+    given = "stiffness = 9424777.96076938"
+    assert given in text
+    text = text.replace(given, f"stiffness = {9424777.96076938 * cylinder!r}")
+    path = tmp_path / "stiff_crane.nml"
+    path.write_text(text)
+    scene = load_scene(path, [])
+    return build_system(scene).system.assemble(effects=scene.effects)
+
+
+def test_knuckle_crane_linear_against_nonlinear(tmp_path):
+    """Issue 34: 'linear' about the crane's static state with the geometric stiffness of
+    every load-proportional term at that state (the beams' and the rope's K_sigma, the
+    cylinders' (f/L)(I - n n^T), the hinges' Hessians times their reactions): 297.65 (it
+    read 170 while the jib cylinder's material stiffness k n n^T, turned by the load,
+    counted as geometric). The crane's stability limit is 739.4 ('nonlinear',
+    test_knuckle_crane_from_its_static_state): on the way the jib folds on its compliant
+    cylinder (3.6 m down at the tip) and the beams bend in their plane, so the two
+    legitimately differ, and 'linear' is refused. Without that in-plane deformation (in-plane
+    inertia, area and shear 100 times, the cylinder 1000 times stiffer) the two agree within
+    1% (measured 294.27 and 295.78)."""
+    with pytest.raises(SolverError, match="contradicted by the model.*'nonlinear'"):
+        buckling_analysis(crane_model(), 1, method="linear")
+    stiff = _stiffened_crane(tmp_path, 100.0, 1000.0)
+    linear = buckling_analysis(stiff, 1, method="linear")
+    again = buckling_analysis(stiff, 1, method="linear")
+    assert linear.load_factor.tobytes() == again.load_factor.tobytes()
+    nonlinear = buckling_analysis(stiff, 1, method="nonlinear", rtol=1e-4).load_factor[0]
+    print(f"\nstiffened crane: linear {linear.load_factor[0]:.6g}, nonlinear {nonlinear:.6g}")
+    assert linear.load_factor[0] == pytest.approx(nonlinear, rel=1e-2)

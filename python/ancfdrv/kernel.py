@@ -240,6 +240,20 @@ def cable_forces(dofs, e, lengths, axial_stiffness: float, bending_stiffness: fl
     return force, float(energy), tangent, float(dissipation)
 
 
+
+def cable_stress_stiffness(dofs, e, de, lengths, axial_stiffness: float,
+                           tension_only: bool = False) -> np.ndarray:
+    """The cable elements' initial-stress stiffness (12, 12, nel) at e for the increment de
+    (cable_element.f90's cable_stress_stiffness: the axial force of the strain's derivative
+    along de, sum w dN S'^T S' x I3); dofs (12, nel) 0-based; tension_only: a rope (nothing
+    where it is slack at e)."""
+    tangent, info = _kernel.cable_stress_stiffness_set(
+        _f(np.asarray(dofs) + 1, np.int32), _f(e), _f(de), _f(np.atleast_1d(lengths)),
+        float(axial_stiffness), int(tension_only))
+    if info:
+        raise SolverError(f"cable element {info}: its Gauss rule is unavailable")
+    return tangent
+
 PLATE_VARIANTS = {"plain": 0, "completed": 1}
 
 
@@ -334,6 +348,26 @@ def force_element(kind: int, params, table_kind: int, table, x, xd, length: floa
     return dict(force=force, stiffness=stiffness, damping=damping, energy=energy,
                 dissipation=dissipation, drive_power=power, reaction=reaction)
 
+
+
+def force_element_initial_stress(kind: int, params, table_kind: int, table, x, xd, at,
+                                 length: float = 0.0, length_rate: float = 0.0) -> np.ndarray:
+    """One force element's initial-stress stiffness (3, ns, 3, ns) (force_elements.f90's
+    force_element_initial_stress): its measures' forces at the slot values x (3, ns) and
+    rates xd times the measures' Hessians at the slot values ``at``."""
+    params = np.asarray(params, dtype=float)
+    table = np.asarray(table, dtype=float)
+    stiffness, info = _kernel.force_element_initial_stress_generalized(
+        _pack("fk", np.int32, element=kind, table=table_kind), len(params), _pad_last(params),
+        len(table), _pad_last(table), _f(x), _f(xd),
+        _pack("fg", length=length, length_rate=length_rate), _f(at))
+    if info:
+        raise SolverError({1: f"force element of unknown kind {kind} or wrong sizes",
+                           2: "force element: its two points coincide (or its torsion "
+                              "has no angle)",
+                           3: "force element: its table cannot be evaluated"}.get(
+                               info, f"force element: code {info}"))
+    return stiffness
 
 def moment_force(director, axis, magnitude):
     """Dead moment on a section director: force (3,), Jacobian (3, 3), Hessian (3, 3, 3)."""

@@ -688,6 +688,51 @@ subroutine cable_forces(ndof, nel, dofs, e, v, lengths, properties, want_tangent
   end do
 end subroutine cable_forces
 
+!> The cable elements' initial-stress stiffness (cable_element's cable_stress_stiffness)
+!> (12 x 12 x nel) at e for the increment de; tension_only /= 0: a rope. info = element
+!> whose Gauss rule is unavailable.
+subroutine cable_stress_stiffness_set(ndof, nel, dofs, e, de, lengths, axial_stiffness, &
+                                      tension_only, tangent, info)
+  use ancf_kinds, only: dp
+  use cable_element, only: cable_stress_stiffness
+  implicit none
+  integer, intent(in) :: ndof, nel, dofs(12, nel), tension_only
+  real(dp), intent(in) :: e(ndof), de(ndof), lengths(nel), axial_stiffness
+  real(dp), intent(out) :: tangent(12, 12, nel)
+  integer, intent(out) :: info
+  integer :: el, code
+  info = 0
+  tangent = 0.0_dp
+  do el = 1, nel
+    call cable_stress_stiffness(reshape(e(dofs(:, el)), [3, 4]), reshape(de(dofs(:, el)), &
+                                [3, 4]), lengths(el), axial_stiffness, tension_only /= 0, &
+                                tangent(:, :, el), code)
+    if (code /= 0) then
+      info = el
+      return
+    end if
+  end do
+end subroutine cable_stress_stiffness_set
+
+!> One force element's initial-stress stiffness (force_elements'
+!> force_element_initial_stress): its measures' forces at the slot values x and rates xd
+!> times their Hessians at the slot values ``at``; arguments as force_element_generalized's.
+subroutine force_element_initial_stress_generalized(kinds, nparam, params, ntable, table, ns, &
+                                                    x, xd, geometry, at, stiffness, info)
+  use ancf_kinds, only: dp
+  use force_elements, only: force_element_initial_stress
+  use api_support, only: fk_element, fk_table, fg_length, fg_length_rate
+  implicit none
+  integer, intent(in) :: kinds(2), nparam, ntable, ns
+  real(dp), intent(in) :: params(max(1, nparam)), table(max(1, ntable)), x(3, ns), xd(3, ns)
+  real(dp), intent(in) :: geometry(2), at(3, ns)
+  real(dp), intent(out) :: stiffness(3, ns, 3, ns)
+  integer, intent(out) :: info
+  call force_element_initial_stress(kinds(fk_element), params(1:nparam), kinds(fk_table), &
+                                    table(1:ntable), x, xd, geometry(fg_length), &
+                                    geometry(fg_length_rate), at, stiffness, info)
+end subroutine force_element_initial_stress_generalized
+
 !> Newmark stepping of a modally reduced FFR model (reduced_ffr_stepper; python
 !> ancfdrv.solvers.ffr_reduced): eta and its rate (r, steps + 1) from rest at 0, per step
 !> counts(:, rn_corrections) Newton corrections and counts(:, rn_factorized)

@@ -49,7 +49,7 @@ module cable_element
   implicit none
   private
   public :: cable_shape, cable_mass, cable_gravity, cable_element_force, cable_set
-  public :: cable_rule, cable_element_rows, cable_midpoint_force
+  public :: cable_rule, cable_element_rows, cable_midpoint_force, cable_stress_stiffness
 
   !> Gauss points per element.
   integer, parameter, public :: cable_points = 5
@@ -210,6 +210,48 @@ contains
                             force, energy, tangent, info, rope, rates, damping_time, &
                             rate_factor, dissipation)
   end subroutine cable_element_force
+
+  !> The initial-stress stiffness of the axial force increment (the classical linear
+  !> buckling's geometric stiffness, python/ancfdrv/solvers/buckling.py) of one element:
+  !> sum over the Gauss points of w dN S'^T S' x I3 (12 x 12), dN = EA r'(q) . r'(dq) the
+  !> axial force of the strain's derivative at q along dq (exact for the difference of two
+  !> states when q is their middle: the Green strain is quadratic). The axial part of the
+  !> tangent is EA (a a^T + eps I): this is its N I part for the increment, without the
+  !> material part's change; the bending's (EI kappa, slender cables) is left out. A rope
+  !> (tension_only) adds nothing where the strain at q is not positive (slack).
+  pure subroutine cable_stress_stiffness(q, dq, length, axial_stiffness, tension_only, &
+                                         tangent, info)
+    real(dp), intent(in) :: q(3, 4), dq(3, 4), length, axial_stiffness
+    logical, intent(in) :: tension_only
+    real(dp), intent(out) :: tangent(cable_dofs, cable_dofs)
+    integer, intent(out) :: info
+    type(cable_point_rule) :: rule
+    real(dp) :: slope(4), second(4), a(3), geometric(4, 4), increment
+    integer :: p, i, j, r
+    tangent = 0.0_dp
+    call cable_rule(rule, info)
+    if (info /= 0) return
+    geometric = 0.0_dp
+    do p = 1, cable_points
+      call rule_rows(rule, p, length, slope, second)
+      a = matmul(q, slope)
+      if (tension_only .and. dot_product(a, a) <= 1.0_dp) cycle
+      increment = rule%half_weight(p) * length * axial_stiffness * &
+                  dot_product(a, matmul(dq, slope))
+      do j = 1, 4
+        do i = 1, 4
+          geometric(i, j) = geometric(i, j) + increment * slope(i) * slope(j)
+        end do
+      end do
+    end do
+    do j = 1, 4
+      do i = 1, 4
+        do r = 1, 3
+          tangent(3 * i - 3 + r, 3 * j - 3 + r) = geometric(i, j)
+        end do
+      end do
+    end do
+  end subroutine cable_stress_stiffness
 
   !> cable_element_force with the element's rule given (cable_rule); damped when the rates,
   !> damping_time, rate_factor and dissipation are present.

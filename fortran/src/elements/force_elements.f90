@@ -36,6 +36,7 @@ module force_elements
   implicit none
   private
   public :: force_element_eval, force_element_slots, force_element_parameters
+  public :: force_element_initial_stress
 
   integer, parameter, public :: fe_spring_damper = 1, fe_bushing = 2, fe_cylinder = 3, &
                                 fe_torsion = 4
@@ -91,7 +92,7 @@ contains
     integer, intent(out) :: info
     real(dp) :: grad(3, size(x, 2)), hess(3, size(x, 2), 3, size(x, 2))
     real(dp) :: d(3), span, unit(3), f, slope, c, rate, total, deflection, dummy, m, g_unit(3)
-    integer :: ns, i, j, k
+    integer :: ns, i
     info = 0
     force = 0.0_dp
     stiffness = 0.0_dp
@@ -152,30 +153,17 @@ contains
       reaction(7) = total
     case (fe_bushing)
       d = x(:, 2) - x(:, 1)
-      do i = 1, 3                      ! translations u_i = g_i . (p2 - p1)
-        grad = 0.0_dp
-        hess = 0.0_dp
-        call bilinear(2 + i, 2, 1.0_dp, x, grad, hess)
-        call bilinear(2 + i, 1, -1.0_dp, x, grad, hess)
-        m = dot_product(x(:, 2 + i), d)
+      do i = 1, 6                      ! translations u_i, then rotations theta_i
+        call bushing_measure(i, x, m, grad, hess)
         call elastic(params(i), params(6 + i), m, grad, hess, xd, force, stiffness, damping, &
                      energy, dissipation, total)
-        g_unit = x(:, 2 + i) / max(norm2(x(:, 2 + i)), tiny(1.0_dp))
-        reaction(1:3) = reaction(1:3) - total * g_unit
-      end do
-      do i = 1, 3                      ! rotations theta_i = (g_k . h_j - g_j . h_k) / 2
-        j = modulo(i, 3) + 1
-        k = modulo(i + 1, 3) + 1
-        grad = 0.0_dp
-        hess = 0.0_dp
-        call bilinear(2 + k, 5 + j, 0.5_dp, x, grad, hess)
-        call bilinear(2 + j, 5 + k, -0.5_dp, x, grad, hess)
-        m = 0.5_dp * (dot_product(x(:, 2 + k), x(:, 5 + j)) - dot_product(x(:, 2 + j), &
-                                                                          x(:, 5 + k)))
-        call elastic(params(3 + i), params(9 + i), m, grad, hess, xd, force, stiffness, &
-                     damping, energy, dissipation, total)
-        g_unit = x(:, 2 + i) / max(norm2(x(:, 2 + i)), tiny(1.0_dp))
-        reaction(4:6) = reaction(4:6) - total * g_unit
+        g_unit = x(:, 2 + modulo(i - 1, 3) + 1) / &
+                 max(norm2(x(:, 2 + modulo(i - 1, 3) + 1)), tiny(1.0_dp))
+        if (i <= 3) then
+          reaction(1:3) = reaction(1:3) - total * g_unit
+        else
+          reaction(4:6) = reaction(4:6) - total * g_unit
+        end if
       end do
     case (fe_torsion)
       call turn_measure(x, m, grad, hess, info)
@@ -187,6 +175,83 @@ contains
       reaction(4:6) = -total * g_unit / max(norm2(g_unit), tiny(1.0_dp))
     end select
   end subroutine force_element_eval
+
+  !> The initial-stress stiffness of one element (the classical linear buckling's geometric
+  !> stiffness, python/ancfdrv/solvers/buckling.py): each measure's force f_i at the state
+  !> (x, xd) (force_element_eval's: the line's tension, a bushing's or a torsion's force)
+  !> times the measure's Hessian at the configuration ``at`` (3, ns): sum f_i(x) d2m_i/dx2
+  !> (at), (3, ns, 3, ns). The difference of two states' values at one ``at`` is the
+  !> geometric stiffness of the force increment, for a line (f2 - f1) (I - n n^T) / L on
+  !> its two slots, without the change of the material part df/dm dm/dx dm/dx^T by the
+  !> turn of the line between the states (force_element_eval's stiffness holds both).
+  !> info: as force_element_eval's (2 also for ``at``'s points).
+  pure subroutine force_element_initial_stress(kind, params, table_kind, table, x, xd, &
+                                               length, length_rate, at, stiffness, info)
+    integer, intent(in) :: kind, table_kind
+    real(dp), intent(in) :: params(:), table(:), x(:, :), xd(:, :), length, length_rate
+    real(dp), intent(in) :: at(:, :)
+    real(dp), intent(out) :: stiffness(:, :, :, :)
+    integer, intent(out) :: info
+    real(dp) :: grad(3, size(x, 2)), hess(3, size(x, 2), 3, size(x, 2))
+    real(dp) :: force(3, size(x, 2)), tangent(3, size(x, 2), 3, size(x, 2))
+    real(dp) :: damping(3, size(x, 2), 3, size(x, 2)), energy, dissipation, power, m, span
+    real(dp) :: reaction(fe_reaction_count)
+    integer :: i
+    stiffness = 0.0_dp
+    if (size(at, 2) /= size(x, 2)) then
+      info = 1
+      return
+    end if
+    call force_element_eval(kind, params, table_kind, table, x, xd, length, length_rate, &
+                            force, tangent, damping, energy, dissipation, power, reaction, info)
+    if (info /= 0) return
+    select case (kind)
+    case (fe_spring_damper, fe_cylinder)
+      span = norm2(at(:, 2) - at(:, 1))
+      if (span <= tiny(1.0_dp) * 1.0e10_dp) then
+        info = 2
+        return
+      end if
+      call length_measure(at, span, grad, hess)
+      stiffness = reaction(7) * hess
+    case (fe_bushing)                  ! bilinear measures: their Hessians are constant
+      do i = 1, 6
+        call bushing_measure(i, x, m, grad, hess)
+        stiffness = stiffness + (params(i) * m + params(6 + i) * sum(grad * xd)) * hess
+      end do
+    case (fe_torsion)
+      call turn_measure(x, m, grad, hess, info)
+      if (info /= 0) return
+      m = params(1) * m + params(2) * sum(grad * xd)
+      call turn_measure(at, span, grad, hess, info)
+      if (info /= 0) return
+      stiffness = m * hess
+    end select
+  end subroutine force_element_initial_stress
+
+  !> The bushing's measure i (1-3: the translation u_i = g_i . (p2 - p1); 4-6: the small
+  !> rotation theta_{i-3} = (g_k . h_j - g_j . h_k) / 2, (i-3, j, k) cyclic), its gradient
+  !> and its (constant) Hessian on the slots.
+  pure subroutine bushing_measure(i, x, m, grad, hess)
+    integer, intent(in) :: i
+    real(dp), intent(in) :: x(:, :)
+    real(dp), intent(out) :: m, grad(:, :), hess(:, :, :, :)
+    integer :: r, j, k
+    grad = 0.0_dp
+    hess = 0.0_dp
+    if (i <= 3) then
+      call bilinear(2 + i, 2, 1.0_dp, x, grad, hess)
+      call bilinear(2 + i, 1, -1.0_dp, x, grad, hess)
+      m = dot_product(x(:, 2 + i), x(:, 2) - x(:, 1))
+      return
+    end if
+    r = i - 3
+    j = modulo(r, 3) + 1
+    k = modulo(r + 1, 3) + 1
+    call bilinear(2 + k, 5 + j, 0.5_dp, x, grad, hess)
+    call bilinear(2 + j, 5 + k, -0.5_dp, x, grad, hess)
+    m = 0.5_dp * (dot_product(x(:, 2 + k), x(:, 5 + j)) - dot_product(x(:, 2 + j), x(:, 5 + k)))
+  end subroutine bushing_measure
 
   !> The torsion's measure theta = atan2(s, c), s = g2 . h1, c = g1 . h1 (slots 3, 4, 5), its
   !> gradient and Hessian: theta_c grad c + theta_s grad s, and theta_c H_c + theta_s H_s +

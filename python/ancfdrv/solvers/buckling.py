@@ -12,9 +12,10 @@ With K_T(P) the tangent of the linearized equations at the static state under F 
 and follower loads' load stiffness and the constraint Hessians times the multipliers):
 
 * 'linear': K_g = (K_T(1 + s) - K_T(1)) / s (s = ``reference_factor``, default 1), with
-  each large-deformation beam's part of that difference replaced by its initial-stress
-  stiffness K_sigma((e(1 + s) - e(1)) / s) of the exact stress increment from the kernel
-  (:func:`stress_correction`), and
+  every load-proportional term of that difference taken at the scene's configuration
+  (:func:`stress_correction`: the beams' and cables' initial-stress stiffness of the exact
+  stress increment, the force elements' force increment times their measures' Hessians,
+  the loads' and joints' parts with the increment's loads and multipliers), and
 
       (K_1 + nu K_g) phi = 0  on  G_1 phi = 0,    K_1 = K_T(1),    P = 1 + nu  (nu > 0);
 
@@ -47,8 +48,10 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
+from .. import kernel
 from ..kernel import DirectSolver
 from ..system.model import Model
+from ..system.kinds.force_element import evaluate, slot_values
 from ..system.registry import kind_of
 from .modal import arpack_start, check_free, linearize, null_space
 from .static import StaticResult, kernel_static, solve_newton
@@ -113,23 +116,39 @@ def elastic_basis(k1: sp.spmatrix, g: sp.spmatrix) -> np.ndarray:
     return basis @ v[:, keep]
 
 
-def stress_correction(model: Model, e1: np.ndarray, e2: np.ndarray, scale: float
+def stress_correction(model: Model, state1: tuple[np.ndarray, np.ndarray, float],
+                      state2: tuple[np.ndarray, np.ndarray, float], scale: float
                       ) -> sp.csr_matrix:
-    """What turns the difference of tangents (K_T(e2) - K_T(e1)) / scale into the
-    initial-stress stiffness of the stress increment: for every element set whose kind
-    splits its tangent (K_T = K_material(q) + K_sigma(stress); the large-deformation beams),
-    K_sigma((q2 - q1) / scale) - (K_set(q2) - K_set(q1)) / scale, on the solver coordinates
-    (B^T K B). The difference of a set's tangents also holds the change of its material
-    stiffness by the displacement (the initial-displacement matrix), first order in the
-    load like K_sigma and large where stiff section or shear moduli turn with the sections
-    (docs/theory.md section 23); the classical linear buckling takes K_sigma alone.
+    """What turns the difference of tangents (K_T(state2) - K_T(state1)) / scale (states
+    (e, lambda, load factor) on the static path) into the geometric stiffness of classical
+    linear buckling about state1: every load-proportional term of the tangent with its
+    stress, force, multiplier or load scaled by the increment and its configuration held at
+    state1, on the solver coordinates (B^T K B where reduced). Term by term:
 
-    The stress increment is the exact one, (S(q2) - S(q1)) / scale: the kinds' strains are
-    quadratic in q and their stresses linear in the strains, so the strain's derivative at
-    the middle state (q1 + q2) / 2 along dq is the exact difference. Taken at q1 it would
-    add the strain of the increment's own rotation, (dq . C dq) scale / 2: a section that
-    turns by 0.075 rad between the states reads ~3e-3 of spurious strain, which took the
-    crane boom's (inputs/crane_boom_modes.nml) classical factor to 1.006 where it is 5.98."""
+    * element sets whose kind splits its tangent (K_T = K_material(q) + K_sigma(stress):
+      the large-deformation beams, the cables and ropes): K_sigma((q2 - q1) / scale) -
+      (K_set(q2) - K_set(q1)) / scale. The difference of a set's tangents also holds the
+      change of its material stiffness by the displacement (the initial-displacement
+      matrix), first order in the load like K_sigma and large where stiff section or shear
+      moduli turn with the sections (docs/theory.md section 23). The stress increment is the
+      exact one, (S(q2) - S(q1)) / scale: the kinds' strains are quadratic in q and their
+      stresses linear in the strains, so the strain's derivative at the middle state
+      (q1 + q2) / 2 along dq is the exact difference. Taken at q1 it would add the strain of
+      the increment's own rotation, (dq . C dq) scale / 2: a section that turns by 0.075 rad
+      between the states reads ~3e-3 of spurious strain, which took the crane boom's
+      (inputs/crane_boom_modes.nml) classical factor to 1.006 where it is 5.98.
+    * force elements (a cylinder, a spring, a bushing, a torsion spring): their measures'
+      force increment times the measures' Hessians at state1 (for a line (f2 - f1) (I - n
+      n^T) / L on its attachment points, kernel.force_element_initial_stress), in place of
+      their tangents' difference, which holds the turn of the line's material stiffness
+      k n n^T (the knuckle crane's classical factor: 170.4 with it, 297.7 without).
+    * the dead moments' and driven or follower point loads' Jacobians and the constraints'
+      Hessians times the multipliers: at state1's configuration with state2's loads and
+      multipliers (the loads are linear in the load factor, the joints' reactions scale
+      with it), in place of the same at state2's configuration.
+
+    Other sets (plates, rigid bodies, contact) keep their tangents' difference."""
+    (e1, lam1, factor1), (e2, lam2, factor2) = state1, state2
     q1, q2 = model.expand(e1), model.expand(e2)
     dq = (q2 - q1) / scale
     middle = 0.5 * (q1 + q2)
@@ -148,14 +167,49 @@ def stress_correction(model: Model, e1: np.ndarray, e2: np.ndarray, scale: float
             rows.append(np.repeat(dofs, len(dofs)))
             cols.append(np.tile(dofs, len(dofs)))
             vals.append(local[:, :, el].ravel())
-    if not rows:
-        return sp.csr_matrix((model.ndof, model.ndof))
-    full = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(model.nfull, model.nfull))
-    if model.reduction is None:
-        return full
-    b = model.reduction.matrix.to_scipy()
-    return (b.T @ full @ b).tocsr()
+    for info in model.force_elements:
+        length = model.drives[info.drive].value(0.0) if info.drive >= 0 else 0.0
+        x1, x2 = slot_values(info, q1), slot_values(info, q2)
+        still = np.zeros_like(x1)
+        geometric = [kernel.force_element_initial_stress(
+            info.kind, info.params, info.table_kind, info.table, x, still, x1, length)
+            for x in (x1, x2)]
+        tangents = [evaluate(info, x, length=length)["stiffness"] for x in (x1, x2)]
+        local = ((geometric[1] - geometric[0]) - (tangents[1] - tangents[0])) / scale
+        ns = local.shape[1]
+        local = local.reshape(3 * ns, 3 * ns, order="F")
+        # slot s's point is sum c q[d:d + 3]: d x_s / d q[d + i] = c e_i
+        where = [(3 * s + i, d + i, c) for s, slot in enumerate(info.slots)
+                 for d, c in slot.terms.items() for i in range(3)]
+        at = np.array([w[0] for w in where], dtype=np.int64)
+        dofs = np.array([w[1] for w in where], dtype=np.int64)
+        coef = np.array([w[2] for w in where])
+        rows.append(np.repeat(dofs, len(dofs)))
+        cols.append(np.tile(dofs, len(dofs)))
+        vals.append((coef[:, None] * coef[None, :] * local[np.ix_(at, at)]).ravel())
+    if rows:
+        full = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
+                                                     np.concatenate(cols))),
+                             shape=(model.nfull, model.nfull))
+        if model.reduction is not None:
+            b = model.reduction.matrix.to_scipy()
+            full = b.T @ full @ b
+    else:
+        full = sp.csr_matrix((model.ndof, model.ndof))
+    # loads and joints: [X(e1, lambda2, P2) - X(e2, lambda2, P2)] / scale, X their part of
+    # the tangent (stiffness_triplets without the elements' tangent)
+    return (full + (_loads_and_joints(model, e1, lam2, factor2) -
+                    _loads_and_joints(model, e2, lam2, factor2)) / scale).tocsr()
+
+
+def _loads_and_joints(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
+                      ) -> sp.csr_matrix:
+    """The loads' and joints' part of the tangent at (e, lambda, load factor): the static
+    Newton matrix's stiffness block without the elements' tangent."""
+    n = model.ndof
+    rows, cols, vals = model.stiffness_triplets(e, lam, 0.0, factor,
+                                                np.zeros(model.pattern.nnz))
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
 
 
 def _dense(basis: np.ndarray, k1: sp.spmatrix, kg: sp.spmatrix):
@@ -422,7 +476,8 @@ def _beyond_the_limit(path: LoadPath, model: Model, history, saved, critical: fl
     k_a, g_a = path.matrices((e_a, lam_a, p_a))
     k_b = path.tangent()
     span = path.factor - p_a
-    kg = ((k_b - k_a) / span + stress_correction(model, e_a, path.e, span)).tocsr()
+    kg = ((k_b - k_a) / span + stress_correction(
+        model, (e_a, lam_a, p_a), (path.e, path.lam, path.factor), span)).tocsr()
     kg = 0.5 * (kg + kg.T)
     theta, vectors = _pencil(_follow_basis(basis, g, g_a), k_a, kg, g_a, count + 1, eigen_tol)
     positive = theta > 1e-12 * max(np.abs(theta).max(initial=0.0), 1e-300)
@@ -441,26 +496,27 @@ BUCKLING_KEYWORDS = {"modes": "buckling", "fixed_loads": "buckling", "method": "
                      "reference_factor": "buckling", "tol": "solver", "max_iter": "solver"}
 
 
-#: 'linear' is confirmed where the tangent on the static path, at this fraction of its first
-#: factor, keeps less than CONFIRM_STIFFNESS of the lowest stiffness it had at the scene's
-#: loads (a linear softening leaves 1 - CONFIRM_AT P / (P - 1) of it: 0.02 P / (P - 1))
-CONFIRM_AT, CONFIRM_STIFFNESS = 0.98, 0.25
+#: 'linear' is confirmed where the classical estimate about the static state at CONFIRM_AT
+#: of its factor, with the same geometric stiffness, reproduces the factor to CONFIRM_TOL
+CONFIRM_AT, CONFIRM_TOL = 0.98, 0.02
 
 
-def _confirm_linear(path: "LoadPath", factor: float, k1: sp.spmatrix, mass: sp.spmatrix,
-                    g: sp.spmatrix, how: str, basis: np.ndarray | None) -> None:
+def _confirm_linear(path: "LoadPath", factor: float, kg: sp.spmatrix, g: sp.spmatrix,
+                    basis: np.ndarray | None, eigen_tol: float) -> None:
     """Refuse a 'linear' factor the model contradicts. The classical estimate extrapolates
-    the change of the tangent between the scene's loads and a step beyond them; where the
-    pre-buckling deformation turns the structure (a mechanism's arm swinging about its pin,
-    a stiff-shear frame), that change holds the initial-displacement matrix as well as the
-    initial-stress one and the estimate can be far too low (docs/theory.md section 23).
-    The check loads the static path to CONFIRM_AT of the factor: a factor the model
-    confirms leaves the lowest stiffness near zero there; one that leaves more than
-    CONFIRM_STIFFNESS of it (or a path that cannot be followed that far) is refused, naming
-    'nonlinear' (SolverError, exit 3): never a wrong factor with status ok."""
+    the tangent of the scene's state linearly in the load, K_T(P) = K_1 + (P - 1) K_g;
+    where the pre-buckling deformation changes the structure (a mechanism's arm swinging
+    about its pin, a beam bent in its plane before it buckles sideways, a knuckle crane's
+    jib folding on its compliant cylinder) the stability limit lies elsewhere
+    (docs/theory.md section 23). The check loads the static path to CONFIRM_AT of the
+    factor and solves (K_T(P_t) + nu K_g) phi = 0 there: a tangent that followed the
+    extrapolation gives P_t + nu = the factor again (within CONFIRM_TOL of it); one that
+    does not (or a path that cannot be followed that far) is refused, naming 'nonlinear'
+    (SolverError, exit 3): never a wrong factor with status ok. (The lowest vibration
+    stiffness is no measure here: it may be a payload's pendulum, which stiffens with the
+    load, and a stiffness lost relative to K_1 may be a lever arm shortened, no buckling.)"""
     if factor <= 1.0:
         return
-    w1, _ = _lowest(k1, mass, g, how, 1, basis)
     target = 1.0 + CONFIRM_AT * (factor - 1.0)
     try:
         _advance(path, target)
@@ -470,15 +526,16 @@ def _confirm_linear(path: "LoadPath", factor: float, k1: sp.spmatrix, mass: sp.s
             f"could not be followed to {target:.6g} times the loads ({exc}); the structure "
             "may have a limit below it: use buckling.method = 'nonlinear'") from None
     k_t, g_t = path.matrices()
-    w, _ = _lowest(k_t, mass, g_t, how, 1, _follow_basis(basis, g, g_t))
-    kept = float(w[0] / w1[0]) if w1[0] > 0 else 0.0
-    if kept > CONFIRM_STIFFNESS:
+    theta, _ = _pencil(_follow_basis(basis, g, g_t), k_t, kg, g_t, 1, eigen_tol)
+    theta = theta[theta > 1e-12 * max(np.abs(theta).max(initial=0.0), 1e-300)]
+    again = path.factor + 1.0 / theta.max() if len(theta) else np.inf
+    if not abs(again - factor) <= CONFIRM_TOL * factor:
         raise SolverError(
-            f"buckling: the 'linear' estimate {factor:.6g} is contradicted by the model: at "
-            f"{path.factor:.6g} times the loads the tangent keeps {kept:.2g} of its lowest "
-            "stiffness (a buckling load leaves ~0); the pre-buckling deformation turns the "
-            "structure, which the classical estimate misreads (docs/theory.md section 23): "
-            "use buckling.method = 'nonlinear'")
+            f"buckling: the 'linear' estimate {factor:.6g} is contradicted by the model: "
+            f"about the static state at {path.factor:.6g} times the loads the same estimate "
+            f"gives {again:.6g}; the pre-buckling deformation changes the structure, which "
+            "the classical estimate about the scene's state cannot see (docs/theory.md "
+            "section 23): use buckling.method = 'nonlinear'")
 
 
 def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
@@ -521,7 +578,7 @@ def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
     path = LoadPath(model, tol=tol, max_iter=max_iter, load_steps=load_steps)
     path.e, path.lam, path.factor = scene_state.e.copy(), scene_state.lam.copy(), 1.0
     base = scene_state
-    e_scene = scene_state.e.copy()
+    scene = (scene_state.e.copy(), scene_state.lam.copy(), 1.0)
     k1 = path.tangent()
     g = path.constraints()
     free = model.ndof - g.shape[0]
@@ -547,7 +604,8 @@ def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
             factor = path.factor
             k_t = path.tangent()
             kg = ((k_t - k1) / (factor - 1.0)
-                  + stress_correction(model, e_scene, path.e, factor - 1.0)).tocsr()
+                  + stress_correction(model, scene, (path.e, path.lam, factor),
+                                      factor - 1.0)).tocsr()
             kg = 0.5 * (kg + kg.T)
             theta, vectors = _pencil(basis, k1, kg, g, count, eigen_tol)
             history.append((factor, None))
@@ -650,7 +708,7 @@ def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
         negative = (theta < -1e-12 * max(scale, 1e-300)) & (theta > -1.0)
         negative_factor = float(1.0 + 1.0 / theta[negative].min()) if negative.any() else 0.0
         if len(factors):
-            _confirm_linear(path, float(factors[0]), k1, mass, g, how, basis)
+            _confirm_linear(path, float(factors[0]), kg, g, basis, eigen_tol)
     else:
         # the first: the limit; the others: the classical linear buckling about a state
         # below it (_beyond_the_limit)

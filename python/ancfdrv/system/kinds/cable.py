@@ -298,6 +298,19 @@ def _planar_fixed(body: Cable, j: int, q0) -> list[tuple[int, str]]:
             for node in range(body.nodes) for which in ("r", "r_x")]
 
 
+
+def _stress_stiffness(info: SetInfo, q: np.ndarray, dq: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """The elements' tangents at the full coordinates q and the initial-stress stiffness of
+    the axial force increment along dq (each (12, 12, nel); kernel.cable_stress_stiffness)."""
+    body = info.body
+    own = np.arange(12 * info.nel).reshape(info.nel, 12).T
+    e, de = q[info.dofs].reshape(-1, order="F"), dq[info.dofs].reshape(-1, order="F")
+    tangent = kernel.cable_forces(own, e, body.lengths, body.axial_stiffness,
+                                  body.bending_stiffness, True, body.tension_only)[2]
+    return tangent, kernel.cable_stress_stiffness(own, e, de, body.lengths,
+                                                  body.axial_stiffness, body.tension_only)
+
 def _mesh(body: Cable, rows) -> None:
     """XDMF: a 2-node line per element through the node positions r (a polyline)."""
     nodes = rows.node_points(body.first, body.nodes, CABLE_NODE_DOFS) + np.arange(body.nodes)
@@ -311,4 +324,5 @@ KIND = register(Kind(
     check_dimensions=lambda body: check_axis_dimensions(body, "cable"),
     plane=lambda body, j: float(body.start[j]), planar_problems=_planar_problems,
     planar_fixed=_planar_fixed, mesh=_mesh, mesh_order=1,
-    axial_forces=lambda body, e_rows: body.axial_forces(e_rows).reshape(len(e_rows), -1)))
+    axial_forces=lambda body, e_rows: body.axial_forces(e_rows).reshape(len(e_rows), -1),
+    stress_stiffness=_stress_stiffness))
