@@ -364,11 +364,11 @@ def test_lee_frame_nonlinear_buckling_is_the_limit_load():
     load EI / L^2, so the factor is P L^2 / EI) finds the limit point of the snap-through:
     within 1% of 18.56 (measured -0.53%: the 31-node discretization; 81 nodes -0.23%) and
     within 0.01% of the 31-node displacement-control limit 18.4628, the independent
-    reference (measured -0.004%, that reference's load increments). Load control cannot
-    pass the limit: steps past it are halved (Newton fails there or lands on the far
-    branch) until the step is rtol, and the lowest stiffness vanishes there on the
-    constraints' null space of the deformed state (on the scene's, which the welded
-    corner's turn leaves, it stayed at 0.15 of its start: no limit was seen)."""
+    reference (measured -0.004%, that reference's load increments). The path is followed by
+    arc length, which passes the limit (load control cannot: its steps were halved to rtol
+    below it, 18.462169 too), and the lowest stiffness vanishes there on the constraints'
+    null space of the deformed state (on the scene's, which the welded corner's turn
+    leaves, it stayed at 0.15 of its start: no limit was seen)."""
     from ancfdrv.solvers.buckling import buckling_analysis
     reference = json.loads(DISPLACEMENT_CONTROL.read_text())["paths"]["31"]["limit_load"]
     model = lee_frame(31, 1.0).assemble()

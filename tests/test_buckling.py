@@ -299,9 +299,10 @@ def test_knuckle_crane_from_its_static_state():
     stiffness grows with the loads) is not reported. The further factors (the classical
     linear buckling about a state below the limit, with the beams' K_sigma of the exact
     stress increment) lie above the limit and within 2% of the refined crane's too
-    (measured 1170.5 and 2951.0, refined 1182.6 and 2936.4, with the cylinders' and the
-    rope's initial-stress stiffness; 1171.1 and 2954.9 with their tangents' difference; with
-    K_sigma taken at the first state 552.5 and 557.3, below the limit)."""
+    (measured 1267.3 and 3080.7, refined 1285.4 and 3101.6, about the state at 732.9, the
+    arc-length path's last below the limit; 1170.5 and 2951.0, refined 1182.6 and 2936.4,
+    about the state at 512 of the load-controlled path before; with K_sigma taken at the
+    first state 552.5 and 557.3, below the limit)."""
     coarse = crane_model()
     first = buckling_analysis(coarse, 3, rtol=1e-4)
     again = buckling_analysis(coarse, 3, rtol=1e-4)
@@ -793,3 +794,16 @@ def test_linear_confirmation_by_the_sparse_solver():
     boom, _ = _crane_boom(1.0)
     with pytest.raises(SolverError, match="contradicted by the model.*'nonlinear'"):
         buckling_analysis(boom, 1, method="linear", solver="sparse")
+
+
+@pytest.mark.parametrize("lateral", [1.0, 20.0])
+def test_imperfect_column_has_no_stability_limit(lateral):
+    """A pinned-pinned column bent by a fixed lateral force at its middle (an imperfect
+    column) has no bifurcation: its lowest stiffness falls toward zero near the Euler load
+    and rises again on the bent path, so 'nonlinear' refuses with 'no stability limit' (the
+    load-controlled path returned an infinite factor with status ok at 1 N)."""
+    s = column("pinned-pinned")
+    s.load("side", "force", body="col", point=(1.0, 0, 0), vector=(0, lateral, 0))
+    model = s.assemble(fixed_loads=("side",))
+    with pytest.raises(SolverError, match="no stability limit"):
+        buckling_analysis(model, 1)

@@ -615,18 +615,21 @@ SCHEMA["buckling"] = {
                        "their value; the others are the reference loads the factor multiplies"),
     "method": Key("str", "nonlinear", one_of("nonlinear", "linear"),
                   "both start from the scene's static state (factor 1); 'nonlinear': the "
-                  "stability limit on the static path (the lowest stiffness followed until its "
-                  "zero reproduces itself); 'linear': (K_1 + nu K_g) phi = 0 once, factor "
+                  "stability limit on the static path, followed by arc length until the lowest "
+                  "stiffness vanishes (a limit point or a bifurcation); 'linear': "
+                  "(K_1 + nu K_g) phi = 0 once, factor "
                   "1 + nu, K_g from the tangents at factors 1 and 1 + reference_factor"),
     "solver": Key("str", "auto", one_of("auto", "dense", "sparse"),
                   "eigensolver, as modal.solver"),
     "rtol": Key("float", 1e-6, lambda v: None if 0 < v < 0.1 else "must lie in (0, 0.1)",
-                "method 'nonlinear': relative change of the load factor that ends the updates"),
-    "load_steps": Key("int", 1, positive, "Newton load increments between states on the "
-                      "static path"),
+                "method 'nonlinear': relative change of the load factor that ends the location of "
+                "the stability limit on the arc"),
+    "load_steps": Key("int", 1, positive, "Newton load increments of the load-controlled "
+                      "static solves (the scene's state; method 'linear''s states)"),
     "reference_factor": Key("float", 1.0, positive, "the first state on the path past "
-                            "the scene's own: its load factor is 1 + this (larger when the "
-                            "scene's loads are far below the limit)"),
+                            "the scene's own: its load factor is 1 + this ('linear'; "
+                            "'nonlinear': the first arc's increment of the factor along the "
+                            "tangent; larger when the scene's loads are far below the limit)"),
 }
 #: &modal and &buckling occur once in general scenes too
 GENERAL_SINGLE_GROUPS = GENERAL_SINGLE_GROUPS + ("modal", "buckling")

@@ -3,7 +3,8 @@
 The loads are split into fixed loads F (kept at their value, e.g. gravity; flagged in the
 model by System.assemble's ``fixed_loads``, so the kernel's load factor leaves them alone)
 and the reference loads R (the others); the structure carries F + P R, P the load factor,
-and every static state on the path is the kernel's static Newton's (:class:`LoadPath`). Both
+and every static state on the path is the kernel's static Newton's (:class:`LoadPath`: by
+load control; :class:`_ArcSteps`: by arc length, the load factor an unknown). Both
 methods start from the scene's own static state, P = 1 (solved as the scene's static
 solve does, :func:`~.static.solve_newton`), never from P = 0: a rope that hangs a payload,
 a mechanism held by its loads or a cylinder's preload has no stiffness without its loads.
@@ -22,12 +23,12 @@ and follower loads' load stiffness and the constraint Hessians times the multipl
   the classical linear buckling about the static state: exact where K_T is affine in P
   (small pre-buckling deformation).
 * 'nonlinear': the lowest omega^2 of (K_T(P), M) on the constraints' null space of each
-  state, followed along the static path from P = 1 until its zero (fitted through the
-  states) reproduces itself or is bracketed to rtol: the stability limit of the model,
-  pre-buckling deformation included. A limit point of the load (a snap-through), which load
-  control cannot pass, is found by halving the steps that find no equilibrium on the path
-  (Newton fails, or lands on a distant branch). Further factors: the classical linear
-  buckling about the last state below that limit.
+  state, followed along the static path from P = 1 by arc length (the kernel's
+  Crisfield step, as static_method = 'arc_length') until it changes sign: at a limit point
+  of the load (P passes a maximum along the arc, a snap-through) or at a bifurcation (P
+  still rises); the zero is then located on the arc by regula falsi to rtol: the
+  stability limit of the model, pre-buckling deformation included. Further factors: the
+  classical linear buckling about a state below that limit.
 
 Directions with no stiffness at the static state (a mechanism's free motion, a rigid body's
 free rotation) are not buckling: both methods work on the constrained coordinates where
@@ -54,7 +55,7 @@ from ..system.model import Model
 from ..system.kinds.force_element import evaluate, slot_values
 from ..system.registry import kind_of
 from .modal import arpack_start, check_free, linearize, null_space
-from .static import StaticResult, kernel_static, solve_newton
+from .static import ARC_STEP, LOAD_TANGENT, StaticResult, kernel_static, solve_newton
 from .._lazy import LazyModule
 
 # imported on first use (ancfdrv._lazy): ~10 MB most runs never need; scipy.sparse (~19 MB
@@ -262,20 +263,6 @@ class LoadPath:
     def tangent(self) -> sp.csr_matrix:
         return self.matrices()[0]
 
-    def rate(self) -> np.ndarray:
-        """de/dP at the current state: the tangent of the path, [[K, -G^T], [-G, 0]]
-        [de; dlambda] = [-dr/dP; 0] (the residual is affine in P, so dr/dP = r(e, P + 1) -
-        r(e, P))."""
-        n = self.model.ndof
-        k, g = self.matrices()
-        loaded, unloaded = (self.model.forces(self.e, load_factor=lf)
-                            for lf in (self.factor + 1.0, self.factor))
-        change = (loaded["internal"] - loaded["external"]) - \
-            (unloaded["internal"] - unloaded["external"])
-        mat = sp.bmat([[k, -g.T], [-g, None]], format="csc") if g.shape[0] else k.tocsc()
-        rhs = np.concatenate([-change, np.zeros(g.shape[0])])
-        return spla.splu(mat).solve(rhs)[:n]
-
     def constraints(self) -> sp.csr_matrix:
         return self.matrices()[1]
 
@@ -397,56 +384,181 @@ def _follow_basis(basis: np.ndarray | None, g1: sp.spmatrix, g: sp.spmatrix
     return nullity @ q
 
 
-#: Newton iterations of a step of the 'nonlinear' path before it is halved: from the last
-#: state a step with an equilibrium converges in a few; past a limit point there is none
-#: and Newton wanders (Lee's frame: 50 iterations each)
+#: Newton iterations of an arc-length step of the 'nonlinear' path before its arc is halved:
+#: a step with an equilibrium at its arc converges in a few
 STEP_ITERATIONS = 15
+#: halvings of the arc from one point of the 'nonlinear' path before the path is given up
+MAX_CUTS = 12
+#: secant steps on the arc that locate the zero of the lowest stiffness
+MAX_LOCATE = 40
 
 
-def _root_limit(history: list[tuple[float, np.ndarray]]) -> float | None:
-    """The limit point of the load from the last two stable states: there the lowest
-    stiffness vanishes as sqrt(P_c - P), so omega^4 is linear in P (the root of its
-    secant); None while the stiffness does not fall between them."""
-    stable = [(p, x[0]) for p, x in history if x[0] > 0]
-    if len(stable) < 2:
-        return None
-    (p1, w1), (p2, w2) = stable[-2], stable[-1]
-    if not (p2 > p1 and w2 < w1):
-        return None
-    return float(p2 + w2**2 * (p2 - p1) / (w1**2 - w2**2))
+@dataclass
+class _Point:
+    """A converged point of the 'nonlinear' path: its state, the lowest omega^2 of its
+    tangent on the constraints' null space and their vectors (columns), and the increment
+    of e that reached it (the path's direction there; None at the scene's state)."""
+
+    e: np.ndarray
+    lam: np.ndarray
+    factor: float
+    w: np.ndarray
+    vectors: np.ndarray
+    increment: np.ndarray | None = None
 
 
-def _step_on_path(path: LoadPath, factor: float, rate: np.ndarray) -> bool:
-    """Move the path to ``factor``; False when Newton does not converge there or converges
-    off the path: its correction from the path's tangent (e + dP de/dP) larger than that
-    predicted increment itself, as when load control steps over a snap-through onto a
-    distant branch. The caller restores the state."""
-    start_e, start_factor = path.e.copy(), path.factor
-    try:
-        path.solve(factor, min(path.max_iter, STEP_ITERATIONS))
-    except SolverError:
-        return False
-    predicted = (factor - start_factor) * rate
-    return bool(np.linalg.norm(path.e - start_e - predicted) <= np.linalg.norm(predicted))
+class _ArcSteps:
+    """Points of the static path at a given arc length ||Delta e|| from a converged point,
+    by the kernel's arc-length step (:data:`~.static.ARC_STEP`: Crisfield's cylindrical
+    method, the load factor an unknown; forward by Feng's criterion with the point's
+    increment, up the loads from the scene's state), each with its lowest stiffness."""
+
+    def __init__(self, path: LoadPath, mass: sp.spmatrix, how: str, track: int,
+                 basis: np.ndarray | None, g: sp.spmatrix) -> None:
+        self.path, self.mass, self.how, self.track = path, mass, how, track
+        self.basis, self.g = basis, g
+
+    def point(self, e: np.ndarray, lam: np.ndarray, factor: float,
+              increment: np.ndarray | None = None) -> _Point:
+        k, g_t = self.path.matrices((e, lam, factor))
+        w, vectors = _lowest(k, self.mass, g_t, self.how, self.track,
+                             _follow_basis(self.basis, self.g, g_t))
+        return _Point(e, lam, factor, w, vectors, increment)
+
+    def step(self, start: _Point, arc: float) -> _Point | None:
+        """The point at ``arc`` from ``start``; None where Newton does not converge."""
+        path = self.path
+        out = kernel_static(path.model, start.e, start.lam, start.factor, tol=path.tol,
+                            max_iter=min(path.max_iter, STEP_ITERATIONS), mode=ARC_STEP,
+                            arc=arc, direction=1.0, previous=start.increment)
+        path.solves += 1
+        if out["info"]:
+            return None
+        return self.point(out["e"], out["lam"], float(out["load_factor"]), out["e"] - start.e)
 
 
-def _bracket(history: list[tuple[float, np.ndarray]]) -> tuple[float, float]:
-    """The highest load factor whose state has a positive lowest stiffness and the lowest
-    above it with a negative one (infinity while none): a bifurcation passed lies between."""
-    low = max(p for p, x in history if x[0] > 0)
-    high = min((p for p, x in history if x[0] <= 0 and p > low), default=np.inf)
-    return low, high
+def _follow_to_limit(steps: _ArcSteps, first: _Point, reference_factor: float, rtol: float,
+                     max_updates: int, max_factor: float
+                     ) -> tuple[float, _Point, list[tuple[float, np.ndarray]],
+                                dict[float, tuple[np.ndarray, np.ndarray]]]:
+    """Follow the static path by arc length from the scene's state ``first`` (P = 1) until
+    the lowest stiffness omega^2 on the constraints' null space reaches zero: at a limit
+    point of the load (P passes a maximum along the arc; past it the tangent has a negative
+    eigenvalue) or at a bifurcation (P still rises, the stability index changes). The first
+    arc moves P by about ``reference_factor`` along the tangent; the next ones aim at 0.9
+    of the way to the zero of the stiffness fitted through the states (:func:`_root`),
+    at most twice the last increment of P (four times P while the stiffness does not fall).
+    A step that ends with omega^2 <= 0 brackets the zero on the arc, which
+    :func:`_locate_on_arc` finds. Returns the critical factor, the stable point nearest to
+    it, and the states (P, omega^2) and (P -> (e, lambda)) of the stable points passed."""
+    path = steps.path
+    tangent = kernel_static(path.model, first.e, first.lam, first.factor, tol=1.0,
+                            max_iter=1, mode=LOAD_TANGENT)
+    if tangent["info"] or not tangent["tangent_norm"] > 0:
+        raise SolverError("buckling: the reference loads move nothing at the scene's static "
+                          "state (zero load vector, or a singular tangent there)")
+    arc = reference_factor * tangent["tangent_norm"]
+    history = [(first.factor, first.w)]
+    saved = {first.factor: (first.e.copy(), first.lam.copy())}
+    point, cuts, w0 = first, 0, first.w[0]
+    while True:
+        trial = steps.step(point, arc)
+        # a stable point below the last: the arc jumped past a limit onto a far branch
+        retry = trial is None or (trial.factor <= point.factor and trial.w[0] > 0)
+        # a rise after a fall that stopped well above zero (near the limit omega^2 ~ 0 is
+        # round-off and may rise by noise): a long step may have passed over a limit
+        fell_and_rises = (not retry and len(history) >= 2 and
+                          1e-3 * w0 < point.w[0] < 0.99 * w0 and
+                          point.w[0] < trial.w[0] and trial.factor > point.factor)
+        if fell_and_rises and trial.factor / point.factor <= 1.05:
+            raise SolverError(
+                f"buckling: no stability limit on the static path: the lowest stiffness fell "
+                f"to {point.w[0] / w0:.3g} of its start at {point.factor:.6g} times the "
+                f"reference loads and rises again at {trial.factor:.6g} (an imperfect "
+                "structure: the fixed loads bend what the reference loads compress); "
+                "buckling.method = 'linear' gives the classical estimate, docs/theory.md "
+                "says when it holds")
+        if retry or fell_and_rises:
+            cuts += 1
+            if cuts > MAX_CUTS:
+                raise SolverError(
+                    f"buckling: the static path could not be followed beyond {point.factor:.6g}"
+                    f" times the reference loads (no arc-length step converged from there "
+                    f"with the arc cut {MAX_CUTS} times)")
+            arc *= 0.5
+            continue
+        if trial.w[0] <= 0:
+            critical, nearest, passed = _locate_on_arc(steps, point, trial, arc, rtol)
+            for stable in passed:
+                history.append((stable.factor, stable.w))
+                saved[stable.factor] = (stable.e.copy(), stable.lam.copy())
+            return critical, nearest, history, saved
+        cuts = 0
+        history.append((trial.factor, trial.w))
+        saved[trial.factor] = (trial.e.copy(), trial.lam.copy())
+        if len(history) > max_updates:
+            raise SolverError(
+                f"buckling: no stability limit found up to {trial.factor:.6g} times the "
+                f"reference loads in {max_updates} steps of the static path (the lowest "
+                f"stiffness there {trial.w[0] / w0:.3g} of its start)")
+        rise = trial.factor - point.factor
+        critical = _root([(p, x[0]) for p, x in history])
+        if critical is None:  # no softening yet: load further
+            if trial.factor * 4.0 > max_factor:
+                raise SolverError(
+                    f"buckling: no stability limit up to {trial.factor:.6g} times the reference "
+                    "loads (the lowest stiffness does not fall as they grow: e.g. a square "
+                    "section bent in a plane of symmetry has no lateral-torsional buckling)")
+            wanted = min(3.0 * trial.factor, 2.0 * rise)
+        else:  # approach the estimate: past it is no harm, the arc is bracketed
+            wanted = float(np.clip(0.9 * (critical - trial.factor), 0.25 * rise, 2.0 * rise))
+        arc *= wanted / rise
+        point = trial
 
 
-def _limit_at(history: list[tuple[float, np.ndarray]], low: float, high: float) -> float:
-    """The zero of the lowest stiffness between a stable state at ``low`` and ``high``:
-    interpolated linearly where a state at ``high`` is on the path (past a bifurcation),
-    else the middle (``high`` has no equilibrium on the path: a limit point of the load,
-    bracketed to rtol by the halved steps)."""
-    values = dict((p, x[0]) for p, x in history)
-    if low in values and high in values and values[high] <= 0 < values[low]:
-        return float(low + (high - low) * values[low] / (values[low] - values[high]))
-    return 0.5 * (low + high)
+def _locate_on_arc(steps: _ArcSteps, start: _Point, beyond: _Point, arc: float, rtol: float
+                   ) -> tuple[float, _Point, list[_Point]]:
+    """The zero of the lowest stiffness omega^2 between the stable point ``start`` and the
+    point ``beyond`` at ``arc`` from it (omega^2 <= 0): regula falsi (Illinois) on the arc
+    length s from ``start``, omega^2 being smooth in s through a limit point (where P(s)
+    is not: it turns) and a bifurcation alike. The critical factor is P interpolated
+    linearly in omega^2 between the bracket's ends (at a limit point, where P is flat in s,
+    its error is the product of their distances from the zero times P's curvature), once
+    two estimates agree to ``rtol``. Returns it, the stable end and the stable points
+    found."""
+    lo, hi, s_lo, s_hi = start, beyond, 0.0, arc
+    f_lo, f_hi, side = lo.w[0], hi.w[0], 0
+    passed: list[_Point] = []
+    previous = None
+    for _ in range(MAX_LOCATE):
+        estimate = lo.factor + (hi.factor - lo.factor) * lo.w[0] / (lo.w[0] - hi.w[0])
+        if previous is not None and abs(estimate - previous) <= rtol * abs(estimate):
+            return float(estimate), lo, passed
+        previous = estimate
+        s = s_lo + (s_hi - s_lo) * f_lo / (f_lo - f_hi)
+        if not s_lo < s < s_hi:
+            s = 0.5 * (s_lo + s_hi)
+        trial = steps.step(start, s)
+        if trial is None:   # Newton at the singular point itself: the middle instead
+            s = 0.5 * (s_lo + s_hi)
+            trial = steps.step(start, s)
+            if trial is None:
+                break
+        if trial.w[0] > 0:
+            lo, s_lo, f_lo = trial, s, trial.w[0]
+            passed.append(trial)
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+        else:
+            hi, s_hi, f_hi = trial, s, trial.w[0]
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+    raise SolverError(
+        f"buckling: the zero of the lowest stiffness between {lo.factor:.6g} and "
+        f"{hi.factor:.6g} times the reference loads did not settle to rtol = {rtol:g} on the "
+        "static path")
 
 
 #: the state below the first limit about which 'nonlinear' linearizes for the further
@@ -463,9 +575,10 @@ def _beyond_the_limit(path: LoadPath, model: Model, history, saved, critical: fl
     omega_i^2(P) is a vibration mode's stiffness, no buckling mode's (extrapolated from
     near the limit it read the portal's non-sway factor 17-25% high). So: the classical
     linear buckling (K_A + nu K_g) phi = 0 about the state A below the limit
-    (:data:`BELOW_LIMIT`), K_g the secant of the tangents from A to the last state with
-    the beams' initial-stress part (:func:`stress_correction`); its lowest factor is the
-    limit itself, the ones above it are returned."""
+    (:data:`BELOW_LIMIT`), K_g the secant of the tangents from A to the path's state (the
+    stable point nearest the limit, :func:`_follow_to_limit`) with the beams'
+    initial-stress part (:func:`stress_correction`); its lowest factor is the limit itself,
+    the ones above it are returned."""
     w1 = history[0][1][0]
     below = [p for p, x in history if p < min(critical, path.factor) and
              x[0] >= BELOW_LIMIT * w1 and p in saved]
@@ -548,9 +661,12 @@ def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
 
     Both start from the scene's static state (load factor 1). ``method``: 'linear' solves
     (K_1 + nu K_g) phi = 0 once, P = 1 + nu, with K_g from the tangents at 1 and at
-    1 + ``reference_factor``; 'nonlinear' (default) follows the lowest stiffness along the
-    static path until its zero reproduces itself: there the tangent on the static path is
-    singular (the stability limit of the model, pre-buckling deformation included). See the module doc and docs/theory.md.
+    1 + ``reference_factor``; 'nonlinear' (default) follows the static path by arc length
+    until the lowest stiffness vanishes (:func:`_follow_to_limit`): there the tangent on the
+    static path is singular (the stability limit of the model, pre-buckling deformation
+    included); its first arc moves the factor by about ``reference_factor``, ``rtol``
+    ends the location of the zero, ``max_updates`` bounds the points on the path and
+    ``max_factor`` the factor searched. See the module doc and docs/theory.md.
     The arguments of :data:`BUCKLING_KEYWORDS` pass the rules of their namelist keys
     (InputError).
     """
@@ -585,115 +701,23 @@ def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
     check_free("buckling", free)
     how = solver if solver != "auto" else ("dense" if free <= DENSE_LIMIT else "sparse")
     basis = elastic_basis(k1, g) if how == "dense" else None
-    mass = model.mass_matrix()
-    track = max(count, 1)
-    if method == "nonlinear":
-        w1, _ = _lowest(k1, mass, g, how, track, basis)
-        history = [(1.0, w1)]   # (P, the lowest omega^2 of K_T(P) over M)
+    if method == "linear":
+        _advance(path, 1.0 + reference_factor)
+        factor = path.factor
+        k_t = path.tangent()
+        kg = ((k_t - k1) / (factor - 1.0)
+              + stress_correction(model, scene, (path.e, path.lam, factor),
+                                  factor - 1.0)).tocsr()
+        kg = 0.5 * (kg + kg.T)
+        theta, vectors = _pencil(basis, k1, kg, g, count, eigen_tol)
+        history: list[tuple[float, np.ndarray | None]] = [(1.0, None), (factor, None)]
     else:
-        history = [(1.0, None)]
-    factor, previous, critical = 1.0 + reference_factor, None, None
-    # states on the path
-    saved: dict[float, tuple[np.ndarray, np.ndarray]] = {1.0: (path.e.copy(), path.lam.copy())}
-    ceiling = np.inf  # a factor known to lie past a fall and rise of the stiffness
-    rate = path.rate() if method == "nonlinear" else None
-    step, attempts, limit_point = reference_factor, 0, False
-    while True:
-        if method == "linear":
-            _advance(path, factor)
-            factor = path.factor
-            k_t = path.tangent()
-            kg = ((k_t - k1) / (factor - 1.0)
-                  + stress_correction(model, scene, (path.e, path.lam, factor),
-                                      factor - 1.0)).tocsr()
-            kg = 0.5 * (kg + kg.T)
-            theta, vectors = _pencil(basis, k1, kg, g, count, eigen_tol)
-            history.append((factor, None))
-            break
-        attempts += 1
-        if attempts > 3 * max_updates:
-            raise SolverError(f"buckling: the load factor did not settle in {attempts - 1} "
-                              f"steps of the static path (last state at {path.factor:.6g} "
-                              "times the reference loads)")
-        last = (path.e.copy(), path.lam.copy(), path.factor)
-        if not _step_on_path(path, factor, rate):
-            # no equilibrium on the path at this factor (Newton failed, or left the path
-            # for a distant branch): halve the step; a step that shrinks to rtol is a limit
-            path.e, path.lam, path.factor = last[0].copy(), last[1].copy(), last[2]
-            # from a stable state whose stiffness has fallen: a limit point of the load
-            limit_point = limit_point or 0 < history[-1][1][0] < max(
-                x[0] for _, x in history)
-            if abs(factor - last[2]) <= rtol * last[2]:
-                lowest = history[-1][1][0]
-                if 0 < lowest and lowest > 1e-2 * max(x[0] for _, x in history):
-                    raise SolverError(
-                        f"buckling: the static state at load factor {factor:.6g} did not "
-                        f"converge from {last[2]:.6g}, where the structure keeps "
-                        f"{lowest / history[0][1][0]:.3g} of its lowest stiffness (no limit "
-                        "there): raise buckling.load_steps")
-                critical = _limit_at(history, last[2], factor)
-                break
-            factor = last[2] + 0.5 * (factor - last[2])
-            continue
-        step = factor - last[2]
-        rate = path.rate()
-        k_t, g_t = path.matrices()
-        w, vectors = _lowest(k_t, mass, g_t, how, track, _follow_basis(basis, g, g_t))
-        # a rise after a fall that stopped well above zero (near the limit, omega^2 ~ 0 is
-        # round-off and may rise by noise): either the step passed over a limit or the path
-        # has none; step back to the fallen state and halve the interval (geometrically)
-        # until it is narrower than 5%, then refuse
-        if len(history) >= 2 and factor > history[-1][0] and \
-                1e-3 * history[0][1][0] < history[-1][1][0] < 0.99 * history[0][1][0] and \
-                w[0] > history[-1][1][0]:
-            low = history[-1][0]
-            if factor / low > 1.05 and len(history) <= max_updates:
-                ceiling = factor
-                path.e, path.lam = saved[low][0].copy(), saved[low][1].copy()
-                path.factor = low
-                rate = path.rate()
-                factor = float(np.sqrt(low * ceiling))
-                step = factor - low
-                continue
-            raise SolverError(
-                f"buckling: no stability limit on the static path: the lowest stiffness fell "
-                f"to {history[-1][1][0] / history[0][1][0]:.3g} of its start at "
-                f"{history[-1][0]:.6g} times the reference loads and rises again at "
-                f"{factor:.6g} (an imperfect structure: the fixed loads bend what the "
-                "reference loads compress); buckling.method = 'linear' gives the classical "
-                "estimate, docs/theory.md says when it holds")
-        saved[factor] = (path.e.copy(), path.lam.copy())
-        history.append((factor, w))
-        critical = _root([(p, x[0]) for p, x in history])
-        if limit_point and w[0] > 0:
-            critical = _root_limit(history) or critical
-        low, high = _bracket(history)
-        if critical is not None and not low < critical < high:
-            # the fit left the bracket of a bifurcation passed (noise of omega^2 ~ 0)
-            critical = _limit_at(history, low, high)
-        if high - low <= rtol * low or (critical is not None and previous is not None and
-                                        abs(critical - previous) <= rtol * critical):
-            break
-        if len(history) > max_updates:
-            raise SolverError(
-                f"buckling: no stability limit found up to {factor:.6g} times the reference "
-                "loads (the lowest stiffness does not decrease toward zero)" if critical is None
-                else f"buckling: the load factor did not settle in {max_updates} updates "
-                     f"(last estimates {previous:.6g}, {critical:.6g})")
-        previous = critical
-        if critical is None:  # no softening yet: load further
-            if factor * 4.0 > max_factor:
-                raise SolverError(
-                    f"buckling: no stability limit up to {factor:.6g} times the reference "
-                    "loads (the lowest stiffness does not fall as they grow: e.g. a square "
-                    "section bent in a plane of symmetry has no lateral-torsional buckling)")
-            target = min(factor * 4.0, float(np.sqrt(factor * ceiling)))
-        else:  # approach the estimate from below: the state at the limit is singular
-            target = float(np.clip(factor + 0.9 * (critical - factor), factor / 8, factor * 8))
-            if target >= ceiling:
-                target = float(np.sqrt(path.factor * ceiling))
-        # steps grow at most twofold: a step that left the path was halved for a reason
-        factor = factor + float(np.clip(target - factor, -2 * abs(step), 2 * abs(step)))
+        steps = _ArcSteps(path, model.mass_matrix(), how, max(count, 1), basis, g)
+        first = steps.point(path.e, path.lam, 1.0)
+        critical, nearest, history, saved = _follow_to_limit(
+            steps, first, reference_factor, rtol, max_updates, max_factor)
+        path.e, path.lam, path.factor = nearest.e.copy(), nearest.lam.copy(), nearest.factor
+        vectors = nearest.vectors
     timing["path"] = time.perf_counter() - start
     reference = StaticResult(path.e.copy(), path.lam.copy(), "newton", path.solves, 0.0, 0.0,
                              0.0)
