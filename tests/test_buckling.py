@@ -807,3 +807,11 @@ def test_imperfect_column_has_no_stability_limit(lateral):
     model = s.assemble(fixed_loads=("side",))
     with pytest.raises(SolverError, match="no stability limit"):
         buckling_analysis(model, 1)
+
+
+def test_nonlinear_with_every_load_fixed_is_refused():
+    """With its only load flagged fixed nothing is left for the factor to multiply: the
+    arc-length path has no direction (zero load vector), refused naming fixed_loads."""
+    model = column("pinned-pinned").assemble(fixed_loads=("P",))
+    with pytest.raises(SolverError, match="move nothing.*leave the loads .* out of fixed_loads"):
+        buckling_analysis(model, 1)

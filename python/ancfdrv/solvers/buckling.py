@@ -454,9 +454,13 @@ def _follow_to_limit(steps: _ArcSteps, first: _Point, reference_factor: float, r
     path = steps.path
     tangent = kernel_static(path.model, first.e, first.lam, first.factor, tol=1.0,
                             max_iter=1, mode=LOAD_TANGENT)
-    if tangent["info"] or not tangent["tangent_norm"] > 0:
-        raise SolverError("buckling: the reference loads move nothing at the scene's static "
-                          "state (zero load vector, or a singular tangent there)")
+    if tangent["info"]:
+        raise SolverError("buckling: the tangent along the loads at the scene's static state "
+                          f"cannot be solved ({tangent['message'].split('; ')[0]})")
+    if not tangent["tangent_norm"] > 0:
+        raise SolverError("buckling: the reference loads (those not in buckling.fixed_loads) "
+                          "move nothing at the scene's static state: none is left or they are "
+                          "zero; leave the loads the factor multiplies out of fixed_loads")
     arc = reference_factor * tangent["tangent_norm"]
     history = [(first.factor, first.w)]
     saved = {first.factor: (first.e.copy(), first.lam.copy())}
