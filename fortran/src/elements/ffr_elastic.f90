@@ -37,7 +37,7 @@
 module ffr_elastic
   use ancf_kinds, only: dp
   use element_sets, only: element_set, frame_omega, scatter_add
-  use beam_stations, only: station_section, station_forces
+  use beam_stations, only: station_section, station_map, small_station_map, map_forces
   implicit none
   private
   public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_set, ffr_second_order
@@ -53,6 +53,8 @@ module ffr_elastic
     real(dp), allocatable :: axial_rigidity(:), axis(:, :), length(:), slope_gram(:, :, :)
     !> the section data of its section forces (beam_stations)
     type(station_section) :: sections
+    !> its section forces' linear forms at the stations last asked for (built on first use)
+    type(station_map) :: stations
   contains
     procedure :: forces => ffr_set_forces
     procedure :: energy_power => ffr_set_energy_power
@@ -415,27 +417,35 @@ contains
     end do
   end subroutine add_second_order_power
 
-  !> The element_set section_forces of an FFR set: the small-strain measures (beam_stations)
-  !> of each element's displacement in the frame at each row, A^T e - e0 (frame_displacement:
-  !> the frame's pivot moves the positions uniformly, which no strain measure sees).
+  !> The element_set section_forces of an FFR set: linear forms (beam_stations station_map,
+  !> built at the first call with these stations and kept) of each element's displacement in
+  !> the frame at each row, A^T e - e0 (frame_displacement: the frame's pivot moves the
+  !> positions uniformly, which no strain measure sees).
   subroutine ffr_section_forces(set, rotations, q_rows, xi, forces, info)
-    class(ffr_set), intent(in) :: set
+    class(ffr_set), intent(inout) :: set
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info
-    real(dp) :: nodal(3, 8, size(q_rows, 2))
     integer :: el, row, ns
     forces = 0.0_dp
     info = 1
     if (.not. allocated(set%sections%reference)) return
     info = 0
     ns = size(xi)
-    do el = 1, set%nel
-      do row = 1, size(q_rows, 2)
-        nodal(:, :, row) = reshape(frame_displacement(rotations(:, :, row), q_rows(:, row), &
-                                                      set%dofs(:, el), set%reference(:, el)), [3, 8])
+    if (allocated(set%stations%xi)) then
+      if (size(set%stations%xi) /= ns) deallocate (set%stations%xi)
+    end if
+    if (allocated(set%stations%xi)) then
+      if (any(set%stations%xi /= xi)) deallocate (set%stations%xi)
+    end if
+    if (.not. allocated(set%stations%xi)) call small_station_map(set%sections, set%nel, xi, &
+                                                                 set%stations)
+    do row = 1, size(q_rows, 2)   ! (each row's state read once, from the cache)
+      do el = 1, set%nel
+        call map_forces(set%stations, el, frame_displacement(rotations(:, :, row), &
+                        q_rows(:, row), set%dofs(:, el), set%reference(:, el)), &
+                        forces(ns * (el - 1) + 1:ns * el, row, :))
       end do
-      call station_forces(set%sections, el, xi, nodal, .true., forces(ns * (el - 1) + 1:ns * el, :, :))
     end do
   end subroutine ffr_section_forces
 
