@@ -361,8 +361,8 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :)
-  integer :: row, frame, k, i
+  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :), total(:, :)
+  integer :: row, frame, k
   forces = 0.0_dp
   largest = 0.0_dp
   call api_system(handle, sys, info, message)
@@ -391,18 +391,15 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
     message = 'system_section_forces: the set reports no section forces'
     return
   end if
+  allocate (total(nst, 6))
+  total = 0.0_dp
   do k = 1, 6
     do row = 1, nrows
       largest(:, k) = max(largest(:, k), abs(forces(:, row, k)))
+      total(:, k) = total(:, k) + forces(:, row, k)   ! not a number when one is (or +-inf)
     end do
   end do
-  if (any(ieee_is_nan(forces))) then   ! (max may skip a NaN)
-    do k = 1, 6
-      do i = 1, nst
-        if (any(ieee_is_nan(forces(i, :, k)))) largest(i, k) = ieee_value(1.0_dp, ieee_quiet_nan)
-      end do
-    end do
-  end if
+  where (ieee_is_nan(total)) largest = ieee_value(1.0_dp, ieee_quiet_nan)   ! (max may skip it)
   message = ' '
 end subroutine system_section_forces
 

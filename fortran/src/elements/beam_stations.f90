@@ -237,24 +237,20 @@ contains
     map%coef = coef(:used)
   end subroutine small_station_map
 
-  !> The section forces (ns, 6) of element el of a station map at its displacement d (24)
-  !> in the frame.
+  !> The section forces (rows, 6 ns) (column i + ns (k - 1): station i, force k) of element
+  !> el of a station map at its displacements d (rows, 24) in the frame (a block of rows at
+  !> once: each product runs over the rows).
   pure subroutine map_forces(map, el, d, forces)
     type(station_map), intent(in) :: map
     integer, intent(in) :: el
-    real(dp), intent(in) :: d(24)
+    real(dp), intent(in) :: d(:, :)
     real(dp), intent(out) :: forces(:, :)
-    integer :: ns, i, k, o, p
-    real(dp) :: total
-    ns = size(map%xi)
-    do k = 1, 6
-      do i = 1, ns
-        o = i + ns * (k - 1) + 6 * ns * (el - 1)
-        total = 0.0_dp
-        do p = map%first(o), map%first(o + 1) - 1
-          total = total + map%coef(p) * d(map%col(p))
-        end do
-        forces(i, k) = total
+    integer :: o, p, base
+    base = 6 * size(map%xi) * (el - 1)
+    do o = 1, 6 * size(map%xi)
+      forces(:, o) = 0.0_dp
+      do p = map%first(base + o), map%first(base + o + 1) - 1
+        forces(:, o) = forces(:, o) + map%coef(p) * d(:, map%col(p))
       end do
     end do
   end subroutine map_forces

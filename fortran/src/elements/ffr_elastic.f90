@@ -53,8 +53,11 @@ module ffr_elastic
     real(dp), allocatable :: axial_rigidity(:), axis(:, :), length(:), slope_gram(:, :, :)
     !> the section data of its section forces (beam_stations)
     type(station_section) :: sections
-    !> its section forces' linear forms at the stations last asked for (built on first use)
+    !> its section forces' linear forms at the stations last asked for (built on first use),
+    !> and its elements' distinct nodal vectors: their dofs (3, nv) and each element's
+    !> (element_vector(8, nel)), turned into the frame once per row
     type(station_map) :: stations
+    integer, allocatable :: vector_dofs(:, :), element_vector(:, :)
   contains
     procedure :: forces => ffr_set_forces
     procedure :: energy_power => ffr_set_energy_power
@@ -419,17 +422,22 @@ contains
 
   !> The element_set section_forces of an FFR set: linear forms (beam_stations station_map,
   !> built at the first call with these stations and kept) of each element's displacement in
-  !> the frame at each row, A^T e - e0 (frame_displacement: the frame's pivot moves the
-  !> positions uniformly, which no strain measure sees).
+  !> the frame at each row, A^T e - e0 (frame_displacement's, each distinct nodal vector
+  !> turned once: the frame's pivot moves the positions uniformly, which no strain measure
+  !> sees).
   subroutine ffr_section_forces(set, rotations, q_rows, xi, forces, info)
     class(ffr_set), intent(inout) :: set
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info
-    integer :: el, row, ns
-    forces = 0.0_dp
+    integer, parameter :: block = 16
+    real(dp), allocatable :: turned(:, :, :), local(:, :), out(:, :)
+    integer :: el, row, ns, v, a, c, nv, first, nb, r, k, i
     info = 1
-    if (.not. allocated(set%sections%reference)) return
+    if (.not. allocated(set%sections%reference)) then
+      forces = 0.0_dp
+      return
+    end if
     info = 0
     ns = size(xi)
     if (allocated(set%stations%xi)) then
@@ -438,15 +446,59 @@ contains
     if (allocated(set%stations%xi)) then
       if (any(set%stations%xi /= xi)) deallocate (set%stations%xi)
     end if
-    if (.not. allocated(set%stations%xi)) call small_station_map(set%sections, set%nel, xi, &
-                                                                 set%stations)
-    do row = 1, size(q_rows, 2)   ! (each row's state read once, from the cache)
+    if (.not. allocated(set%stations%xi)) then
+      call small_station_map(set%sections, set%nel, xi, set%stations)
+      call distinct_vectors(set)
+    end if
+    nv = size(set%vector_dofs, 2)
+    allocate (turned(block, 3, nv), local(block, 24), out(block, 6 * ns))
+    do first = 1, size(q_rows, 2), block   ! blocks of rows: each product runs over them
+      nb = min(block, size(q_rows, 2) - first + 1)
+      do r = 1, nb   ! A^T e_v as frame_displacement writes it, turned once per row
+        row = first + r - 1
+        do v = 1, nv
+          turned(r, :, v) = rotations(1, :, row) * q_rows(set%vector_dofs(1, v), row) &
+                            + rotations(2, :, row) * q_rows(set%vector_dofs(2, v), row) &
+                            + rotations(3, :, row) * q_rows(set%vector_dofs(3, v), row)
+        end do
+      end do
       do el = 1, set%nel
-        call map_forces(set%stations, el, frame_displacement(rotations(:, :, row), &
-                        q_rows(:, row), set%dofs(:, el), set%reference(:, el)), &
-                        forces(ns * (el - 1) + 1:ns * el, row, :))
+        do a = 0, 7
+          do c = 1, 3
+            local(:nb, 3 * a + c) = turned(:nb, c, set%element_vector(a + 1, el)) &
+                                    - set%reference(3 * a + c, el)
+          end do
+        end do
+        call map_forces(set%stations, el, local(:nb, :), out(:nb, :))
+        do k = 1, 6
+          do i = 1, ns
+            forces(ns * (el - 1) + i, first:first + nb - 1, k) = out(:nb, i + ns * (k - 1))
+          end do
+        end do
       end do
     end do
   end subroutine ffr_section_forces
+
+  !> The set's distinct nodal vectors (dof triples) and each element's (ffr_set).
+  pure subroutine distinct_vectors(set)
+    class(ffr_set), intent(inout) :: set
+    integer :: found(3, 8 * set%nel), el, a, v, nv
+    allocate (set%element_vector(8, set%nel))
+    nv = 0
+    do el = 1, set%nel
+      do a = 0, 7
+        do v = nv, 1, -1   ! (neighbours share their common node's: look back)
+          if (all(found(:, v) == set%dofs(3 * a + 1:3 * a + 3, el))) exit
+        end do
+        if (v < 1) then
+          nv = nv + 1
+          found(:, nv) = set%dofs(3 * a + 1:3 * a + 3, el)
+          v = nv
+        end if
+        set%element_vector(a + 1, el) = v
+      end do
+    end do
+    set%vector_dofs = found(:, :nv)
+  end subroutine distinct_vectors
 
 end module ffr_elastic
