@@ -446,10 +446,9 @@ contains
     if (allocated(set%stations%xi)) then
       if (any(set%stations%xi /= xi)) deallocate (set%stations%xi)
     end if
-    if (.not. allocated(set%stations%xi)) then
-      call small_station_map(set%sections, set%nel, xi, set%stations)
-      call distinct_vectors(set)
-    end if
+    if (.not. allocated(set%stations%xi)) call small_station_map(set%sections, set%nel, xi, &
+                                                                 set%stations)
+    if (.not. allocated(set%element_vector)) call distinct_vectors(set)
     nv = size(set%vector_dofs, 2)
     allocate (turned(block, 3, nv), local(block, 24), out(block, 6 * ns))
     do first = 1, size(q_rows, 2), block   ! blocks of rows: each product runs over them
