@@ -554,8 +554,9 @@ def _section_rows(model: Model, info: SetInfo, e_rows: np.ndarray, times: np.nda
     [N, T, Q_height, Q_width, M_height, M_width] (the kernel's, for :func:`peak_rows`)."""
     xi, s = _stations(info.body, stations)
     f, largest = model.kernel.section_forces(info.index, times, e_rows, xi)
-    return SectionForces(s=s, N=f[0], T=f[1], Q=np.stack([f[2], f[3]], axis=-1),
-                         M=np.stack([f[4], f[5]], axis=-1)), largest
+    # Q and M (nt, ns, 2) as views of the kernel's array (its components' planes), not copies
+    return SectionForces(s=s, N=f[0], T=f[1], Q=np.moveaxis(f[2:4], 0, -1),
+                         M=np.moveaxis(f[4:6], 0, -1)), largest
 
 
 def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS, *,
