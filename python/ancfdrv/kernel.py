@@ -727,21 +727,22 @@ class KernelSystem:
         self._check(info, "beam section data", message)
         self._set_sizes[index] = len(lengths)
 
-    def section_forces(self, index: int, times, e_rows, xi) -> np.ndarray:
+    def section_forces(self, index: int, times, e_rows, xi) -> tuple[np.ndarray, np.ndarray]:
         """Section forces (6, nrows, ns nel) [N, T, Q_height, Q_width, M_height, M_width]
         of beam set ``index`` at the stations xi (ns,) of every element for the states
         e_rows (nrows, ndof) (independent coordinates) at the times (nrows,) (element_sets
         section_forces; station i of element el at el ns + i, 0-based), in one call for all
-        rows. Each component's (nrows, ns nel) is C-contiguous."""
+        rows, and each force's largest magnitude over the rows (6, ns nel) (NaN where a
+        row's is NaN). Each component's (nrows, ns nel) is C-contiguous."""
         nel = self._set_sizes[index]
         xi = np.asarray(xi, dtype=np.float64)
         # the rows (nrows, ndof) in C order are the kernel's (ndof, nrows) columns
-        forces, info, message = _kernel.system_section_forces(
+        forces, largest, info, message = _kernel.system_section_forces(
             self.handle, index, len(xi) * nel, np.asarray(times, dtype=np.float64),
             np.ascontiguousarray(e_rows, dtype=np.float64).T, xi)
         if info:
             raise SolverError(f"kernel section forces, code {info}: {_text(message)}")
-        return forces.T
+        return forces.T, largest.T
 
     def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
                       poisson: float, thickness: float, damping_time: float = 0.0) -> int:

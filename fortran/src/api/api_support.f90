@@ -136,6 +136,7 @@ contains
     select type (set)
     type is (ffr_set)
       set%sections = sections
+      if (allocated(set%stations%xi)) deallocate (set%stations%xi)   ! its forms: rebuilt
     type is (continuum_set)
       set%sections = sections
     type is (cubic_set)

@@ -343,10 +343,13 @@ end subroutine system_set_sections
 !> element) of the states e_rows (ndof, nrows) (the independent coordinates, expanded as
 !> to_full) at the times (nrows) (where the set's frame is): forces (ns nel, nrows, 6)
 !> [N, T, Q_height, Q_width, M_height, M_width], station i of element el in row
-!> i + ns (el - 1) (element_sets section_forces). info = 2: sizes inconsistent or a station
+!> i + ns (el - 1) (element_sets section_forces), and each one's largest magnitude over the
+!> rows, largest (nst, 6) (not a number where a row's is: the stress envelope's bound per
+!> station, answers.peak_rows). info = 2: sizes inconsistent or a station
 !> outside [0, 1]; 3: the set reports no section forces; 5: a frame's drive failed.
 subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_rows, xi, &
-                                 forces, info, message)
+                                 forces, largest, info, message)
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, frame_rotations
   use system_reduction, only: to_full
@@ -354,13 +357,14 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   implicit none
   integer, intent(in) :: handle, index, nrows, ndof, ns, nst
   real(dp), intent(in) :: times(nrows), e_rows(ndof, nrows), xi(ns)
-  real(dp), intent(out) :: forces(nst, nrows, 6)
+  real(dp), intent(out) :: forces(nst, nrows, 6), largest(nst, 6)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :)
-  integer :: row, frame
+  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :), total(:, :)
+  integer :: row, frame, k
   forces = 0.0_dp
+  largest = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
   info = 2
@@ -387,6 +391,15 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
     message = 'system_section_forces: the set reports no section forces'
     return
   end if
+  allocate (total(nst, 6))
+  total = 0.0_dp
+  do k = 1, 6
+    do row = 1, nrows
+      largest(:, k) = max(largest(:, k), abs(forces(:, row, k)))
+      total(:, k) = total(:, k) + forces(:, row, k)   ! not a number when one is (or +-inf)
+    end do
+  end do
+  where (ieee_is_nan(total)) largest = ieee_value(1.0_dp, ieee_quiet_nan)   ! (max may skip it)
   message = ' '
 end subroutine system_section_forces
 

@@ -341,7 +341,7 @@ contains
 
   !> The element_set section_forces of a cubic set (beam_stations, 'cubic' measures).
   subroutine cubic_section_forces(set, rotations, q_rows, xi, forces, info)
-    class(cubic_set), intent(in) :: set
+    class(cubic_set), intent(inout) :: set
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info

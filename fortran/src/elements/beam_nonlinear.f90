@@ -520,7 +520,7 @@ contains
   !> The element_set section_forces of a continuum set (beam_stations; its bending option
   !> in the section data: a nonlinear beam's 'cubic' bending is a cubic_set).
   subroutine continuum_section_forces(set, rotations, q_rows, xi, forces, info)
-    class(continuum_set), intent(in) :: set
+    class(continuum_set), intent(inout) :: set
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info

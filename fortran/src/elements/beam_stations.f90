@@ -27,6 +27,7 @@ module beam_stations
   implicit none
   private
   public :: centreline_rows, station_section, station_forces, set_station_forces
+  public :: station_map, small_station_map, map_forces
 
   !> A beam set's section data for its section forces: bending option, the section's
   !> stiffnesses and moments, the element lengths and the reference nodal vectors (3, 8, nel)
@@ -38,6 +39,18 @@ module beam_stations
     real(dp) :: youngs = 0.0_dp, inertia_y = 0.0_dp, inertia_z = 0.0_dp, polar = 0.0_dp
     real(dp), allocatable :: length(:), reference(:, :, :)
   end type station_section
+
+  !> The section forces of a small-strain (FFR) set at the stations xi as linear forms of
+  !> each element's displacement d (24) in its frame (they are linear in d: 2 B(q0, d) times
+  !> the section's stiffnesses), built once per set of stations: output o = (i, k, el)
+  !> (station i, force k, element el; o = i + ns (k - 1) + 6 ns (el - 1)) is
+  !> sum coef(p) d(col(p)) over p = first(o) .. first(o + 1) - 1, the forms' exact zeros
+  !> left out (a straight beam's forces each read 2 to 8 of the 24 coordinates).
+  type :: station_map
+    real(dp), allocatable :: xi(:)
+    integer, allocatable :: first(:), col(:)
+    real(dp), allocatable :: coef(:)
+  end type station_map
 
 contains
 
@@ -138,48 +151,109 @@ contains
   end subroutine station_measures
 
   !> Section forces (ns, nrows, 6) of element el at the stations xi for nrows states of its
-  !> nodal vectors (3, 8, nrows): the current vectors of a large-deformation set, or
-  !> (small) a small-strain set's displacements in its frame.
-  pure subroutine station_forces(sec, el, xi, nodal, small, forces)
+  !> nodal vectors (3, 8, nrows) (a large-deformation set's current vectors).
+  pure subroutine station_forces(sec, el, xi, nodal, forces)
     type(station_section), intent(in) :: sec
     integer, intent(in) :: el
     real(dp), intent(in) :: xi(:), nodal(:, :, :)
-    logical, intent(in) :: small
     real(dp), intent(out) :: forces(:, :, :)
-    real(dp) :: x0(3, 8), length, change(6, size(xi)), reference(6, size(xi))
+    real(dp) :: length, change(6, size(xi)), reference(6, size(xi))
     real(dp) :: f(3, 6), normal(3), c_y, c_z
     integer :: row, i
-    x0 = sec%reference(:, :, el)
     length = sec%length(el)
-    if (.not. small) call station_measures(sec, length, x0, x0, xi, reference)
+    call station_measures(sec, length, sec%reference(:, :, el), sec%reference(:, :, el), xi, &
+                          reference)
     do row = 1, size(nodal, 3)
-      if (small) then
-        call station_measures(sec, length, x0, nodal(:, :, row), xi, change)
-        change = 2.0_dp * change
-      else
-        call station_measures(sec, length, nodal(:, :, row), nodal(:, :, row), xi, change)
-        change = change - reference
-      end if
+      call station_measures(sec, length, nodal(:, :, row), nodal(:, :, row), xi, change)
+      change = change - reference
       do i = 1, size(xi)
-        forces(i, row, 1) = sec%axial * change(1, i)
-        if (.not. small) then
-          f = fields(nodal(:, :, row), xi(i), length)
-          normal = [f(2, 3) * f(3, 4) - f(3, 3) * f(2, 4), f(3, 3) * f(1, 4) - f(1, 3) * f(3, 4), &
-                    f(1, 3) * f(2, 4) - f(2, 3) * f(1, 4)]
-          normal = normal / norm2(normal)
-          c_y = -dot_product(f(:, 5), normal)
-          c_z = -dot_product(f(:, 6), normal)
-          forces(i, row, 1) = forces(i, row, 1) + sec%youngs * (sec%inertia_z * change(2, i) * c_y &
-                                                                + sec%inertia_y * change(3, i) * c_z)
-        end if
-        forces(i, row, 2) = sec%torsion * change(4, i)
-        forces(i, row, 3) = sec%shear_y * change(5, i)
-        forces(i, row, 4) = sec%shear_z * change(6, i)
-        forces(i, row, 5) = sec%moment_height * change(3, i)
-        forces(i, row, 6) = sec%moment_width * change(2, i)
+        f = fields(nodal(:, :, row), xi(i), length)
+        normal = [f(2, 3) * f(3, 4) - f(3, 3) * f(2, 4), f(3, 3) * f(1, 4) - f(1, 3) * f(3, 4), &
+                  f(1, 3) * f(2, 4) - f(2, 3) * f(1, 4)]
+        normal = normal / norm2(normal)
+        c_y = -dot_product(f(:, 5), normal)
+        c_z = -dot_product(f(:, 6), normal)
+        forces(i, row, 1) = sec%axial * change(1, i) + sec%youngs * (sec%inertia_z * change(2, i) &
+                            * c_y + sec%inertia_y * change(3, i) * c_z)
       end do
+      call forces_of_measures(sec, change, forces(:, row, :))
     end do
   end subroutine station_forces
+
+  !> The forces T, Q, M (ns, 2:6) of the measures' changes (6, ns) (N: the caller's).
+  pure subroutine forces_of_measures(sec, change, forces)
+    type(station_section), intent(in) :: sec
+    real(dp), intent(in) :: change(:, :)
+    real(dp), intent(inout) :: forces(:, :)
+    forces(:, 2) = sec%torsion * change(4, :)
+    forces(:, 3) = sec%shear_y * change(5, :)
+    forces(:, 4) = sec%shear_z * change(6, :)
+    forces(:, 5) = sec%moment_height * change(3, :)
+    forces(:, 6) = sec%moment_width * change(2, :)
+  end subroutine forces_of_measures
+
+  !> The station map (station_map) of a small-strain set with nel elements at the stations
+  !> xi: each element's forms from the measures' bilinear forms 2 B(q0, e_j) of the unit
+  !> displacements e_j (exact: the forms are linear).
+  pure subroutine small_station_map(sec, nel, xi, map)
+    type(station_section), intent(in) :: sec
+    integer, intent(in) :: nel
+    real(dp), intent(in) :: xi(:)
+    type(station_map), intent(out) :: map
+    real(dp) :: unit(24), change(6, size(xi)), forms(size(xi), 6, 24)
+    integer :: el, j, ns, o, p, i, k, used
+    integer, allocatable :: col(:)
+    real(dp), allocatable :: coef(:)
+    ns = size(xi)
+    map%xi = xi
+    allocate (map%first(6 * ns * nel + 1), col(6 * ns * nel * 24), coef(6 * ns * nel * 24))
+    used = 0
+    do el = 1, nel
+      do j = 1, 24
+        unit = 0.0_dp
+        unit(j) = 1.0_dp
+        call station_measures(sec, sec%length(el), sec%reference(:, :, el), &
+                              reshape(unit, [3, 8]), xi, change)
+        change = 2.0_dp * change
+        forms(:, 1, j) = sec%axial * change(1, :)
+        call forces_of_measures(sec, change, forms(:, :, j))
+      end do
+      do k = 1, 6
+        do i = 1, ns
+          o = i + ns * (k - 1) + 6 * ns * (el - 1)
+          map%first(o) = used + 1
+          do p = 1, 24
+            if (forms(i, k, p) /= 0.0_dp) then
+              used = used + 1
+              col(used) = p
+              coef(used) = forms(i, k, p)
+            end if
+          end do
+        end do
+      end do
+    end do
+    map%first(6 * ns * nel + 1) = used + 1
+    map%col = col(:used)
+    map%coef = coef(:used)
+  end subroutine small_station_map
+
+  !> The section forces (rows, 6 ns) (column i + ns (k - 1): station i, force k) of element
+  !> el of a station map at its displacements d (rows, 24) in the frame (a block of rows at
+  !> once: each product runs over the rows).
+  pure subroutine map_forces(map, el, d, forces)
+    type(station_map), intent(in) :: map
+    integer, intent(in) :: el
+    real(dp), intent(in) :: d(:, :)
+    real(dp), intent(out) :: forces(:, :)
+    integer :: o, p, base
+    base = 6 * size(map%xi) * (el - 1)
+    do o = 1, 6 * size(map%xi)
+      forces(:, o) = 0.0_dp
+      do p = map%first(base + o), map%first(base + o + 1) - 1
+        forces(:, o) = forces(:, o) + map%coef(p) * d(:, map%col(p))
+      end do
+    end do
+  end subroutine map_forces
 
   !> The section forces (ns nel, nrows, 6) of a large-deformation beam set (element_sets
   !> section_forces) from its element dofs (24, nel) and the states q_rows (nfull, nrows).
@@ -201,7 +275,7 @@ contains
       do row = 1, size(q_rows, 2)
         nodal(:, :, row) = reshape(q_rows(dofs(:, el), row), [3, 8])
       end do
-      call station_forces(sec, el, xi, nodal, .false., forces(ns * (el - 1) + 1:ns * el, :, :))
+      call station_forces(sec, el, xi, nodal, forces(ns * (el - 1) + 1:ns * el, :, :))
     end do
   end subroutine set_station_forces
 

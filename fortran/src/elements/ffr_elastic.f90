@@ -37,7 +37,7 @@
 module ffr_elastic
   use ancf_kinds, only: dp
   use element_sets, only: element_set, frame_omega, scatter_add
-  use beam_stations, only: station_section, station_forces
+  use beam_stations, only: station_section, station_map, small_station_map, map_forces
   implicit none
   private
   public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_set, ffr_second_order
@@ -53,6 +53,11 @@ module ffr_elastic
     real(dp), allocatable :: axial_rigidity(:), axis(:, :), length(:), slope_gram(:, :, :)
     !> the section data of its section forces (beam_stations)
     type(station_section) :: sections
+    !> its section forces' linear forms at the stations last asked for (built on first use),
+    !> and its elements' distinct nodal vectors: their dofs (3, nv) and each element's
+    !> (element_vector(8, nel)), turned into the frame once per row
+    type(station_map) :: stations
+    integer, allocatable :: vector_dofs(:, :), element_vector(:, :)
   contains
     procedure :: forces => ffr_set_forces
     procedure :: energy_power => ffr_set_energy_power
@@ -415,28 +420,84 @@ contains
     end do
   end subroutine add_second_order_power
 
-  !> The element_set section_forces of an FFR set: the small-strain measures (beam_stations)
-  !> of each element's displacement in the frame at each row, A^T e - e0 (frame_displacement:
-  !> the frame's pivot moves the positions uniformly, which no strain measure sees).
+  !> The element_set section_forces of an FFR set: linear forms (beam_stations station_map,
+  !> built at the first call with these stations and kept) of each element's displacement in
+  !> the frame at each row, A^T e - e0 (frame_displacement's, each distinct nodal vector
+  !> turned once: the frame's pivot moves the positions uniformly, which no strain measure
+  !> sees).
   subroutine ffr_section_forces(set, rotations, q_rows, xi, forces, info)
-    class(ffr_set), intent(in) :: set
+    class(ffr_set), intent(inout) :: set
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info
-    real(dp) :: nodal(3, 8, size(q_rows, 2))
-    integer :: el, row, ns
-    forces = 0.0_dp
+    integer, parameter :: block = 16
+    real(dp), allocatable :: turned(:, :, :), local(:, :), out(:, :)
+    integer :: el, row, ns, v, a, c, nv, first, nb, r, k, i
     info = 1
-    if (.not. allocated(set%sections%reference)) return
+    if (.not. allocated(set%sections%reference)) then
+      forces = 0.0_dp
+      return
+    end if
     info = 0
     ns = size(xi)
-    do el = 1, set%nel
-      do row = 1, size(q_rows, 2)
-        nodal(:, :, row) = reshape(frame_displacement(rotations(:, :, row), q_rows(:, row), &
-                                                      set%dofs(:, el), set%reference(:, el)), [3, 8])
+    if (allocated(set%stations%xi)) then
+      if (size(set%stations%xi) /= ns) deallocate (set%stations%xi)
+    end if
+    if (allocated(set%stations%xi)) then
+      if (any(set%stations%xi /= xi)) deallocate (set%stations%xi)
+    end if
+    if (.not. allocated(set%stations%xi)) call small_station_map(set%sections, set%nel, xi, &
+                                                                 set%stations)
+    if (.not. allocated(set%element_vector)) call distinct_vectors(set)
+    nv = size(set%vector_dofs, 2)
+    allocate (turned(block, 3, nv), local(block, 24), out(block, 6 * ns))
+    do first = 1, size(q_rows, 2), block   ! blocks of rows: each product runs over them
+      nb = min(block, size(q_rows, 2) - first + 1)
+      do r = 1, nb   ! A^T e_v as frame_displacement writes it, turned once per row
+        row = first + r - 1
+        do v = 1, nv
+          turned(r, :, v) = rotations(1, :, row) * q_rows(set%vector_dofs(1, v), row) &
+                            + rotations(2, :, row) * q_rows(set%vector_dofs(2, v), row) &
+                            + rotations(3, :, row) * q_rows(set%vector_dofs(3, v), row)
+        end do
       end do
-      call station_forces(set%sections, el, xi, nodal, .true., forces(ns * (el - 1) + 1:ns * el, :, :))
+      do el = 1, set%nel
+        do a = 0, 7
+          do c = 1, 3
+            local(:nb, 3 * a + c) = turned(:nb, c, set%element_vector(a + 1, el)) &
+                                    - set%reference(3 * a + c, el)
+          end do
+        end do
+        call map_forces(set%stations, el, local(:nb, :), out(:nb, :))
+        do k = 1, 6
+          do i = 1, ns
+            forces(ns * (el - 1) + i, first:first + nb - 1, k) = out(:nb, i + ns * (k - 1))
+          end do
+        end do
+      end do
     end do
   end subroutine ffr_section_forces
+
+  !> The set's distinct nodal vectors (dof triples) and each element's (ffr_set).
+  pure subroutine distinct_vectors(set)
+    class(ffr_set), intent(inout) :: set
+    integer :: found(3, 8 * set%nel), el, a, v, nv
+    allocate (set%element_vector(8, set%nel))
+    nv = 0
+    do el = 1, set%nel
+      do a = 0, 7
+        do v = nv, 1, -1   ! (neighbours share their common node's: look back)
+          if (all(found(:, v) == set%dofs(3 * a + 1:3 * a + 3, el))) exit
+        end do
+        if (v < 1) then
+          nv = nv + 1
+          found(:, nv) = set%dofs(3 * a + 1:3 * a + 3, el)
+          v = nv
+        end if
+        set%element_vector(a + 1, el) = v
+      end do
+    end do
+    set%vector_dofs = found(:, :nv)
+  end subroutine distinct_vectors
 
 end module ffr_elastic

@@ -144,10 +144,11 @@ contains
   !> The section forces (ns nel, nrows, 6) [N, T, Q_height, Q_width, M_height, M_width] at
   !> the stations xi (ns, in [0, 1] along each element; station i of element el in row
   !> i + ns (el - 1)) of the states q_rows (nfull, nrows), the set's frame at each row
-  !> rotations (3, 3, nrows): a beam family's (beam_stations). info = 1 here: the family
-  !> reports no section forces (or its set was given no section data).
+  !> rotations (3, 3, nrows): a beam family's (beam_stations; a family may keep what it
+  !> builds for these stations). info = 1 here: the family reports no section forces (or
+  !> its set was given no section data).
   subroutine no_section_forces(set, rotations, q_rows, xi, forces, info)
-    class(element_set), intent(in) :: set
+    class(element_set), intent(inout) :: set
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info

@@ -397,7 +397,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                         "either way"),
         "answers": Key("bool", True, doc="dynamic runs: record the joint reactions and the "
                        "stress envelope at every step (/dynamic/reactions, /dynamic/stress; "
-                       "about 0.1 ms of CPU per step for a 28-node beam)"),
+                       "about 10 microseconds of CPU per row for the 28-node FFR boom)"),
     },
 }
 

@@ -545,10 +545,18 @@ def beam_section_forces(model: Model, info: SetInfo, e_rows: np.ndarray, times: 
     reports from its own strain measures and the section's stiffness (the kernel's
     element_sets section_forces, ``fortran/src/elements/beam_stations.f90``; the module
     documentation gives the measures and the sign convention), all rows in one call."""
+    return _section_rows(model, info, e_rows, times, stations)[0]
+
+
+def _section_rows(model: Model, info: SetInfo, e_rows: np.ndarray, times: np.ndarray,
+                  stations: int) -> tuple[SectionForces, np.ndarray]:
+    """:func:`beam_section_forces` and each force's largest magnitude over the rows (6, ns)
+    [N, T, Q_height, Q_width, M_height, M_width] (the kernel's, for :func:`peak_rows`)."""
     xi, s = _stations(info.body, stations)
-    f = model.kernel.section_forces(info.index, times, e_rows, xi)
-    return SectionForces(s=s, N=f[0], T=f[1], Q=np.stack([f[2], f[3]], axis=-1),
-                         M=np.stack([f[4], f[5]], axis=-1))
+    f, largest = model.kernel.section_forces(info.index, times, e_rows, xi)
+    # Q and M (nt, ns, 2) as views of the kernel's array (its components' planes), not copies
+    return SectionForces(s=s, N=f[0], T=f[1], Q=np.moveaxis(f[2:4], 0, -1),
+                         M=np.moveaxis(f[4:6], 0, -1)), largest
 
 
 def section_forces(model: Model, e: np.ndarray, stations: int = DEFAULT_STATIONS, *,
@@ -816,8 +824,8 @@ def _stress_bounds(section) -> tuple[np.ndarray, np.ndarray]:
 BOUND_MARGIN = 1e-9
 
 
-def peak_rows(section, forces: SectionForces, floor: np.ndarray | None = None
-              ) -> tuple[np.ndarray, np.ndarray]:
+def peak_rows(section, forces: SectionForces, floor: np.ndarray | None = None,
+              largest: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(row, peak) per station of rows of section forces (nt, ns): the first row of the
     largest von Mises stress and that stress, as ``argmax`` of :func:`von_mises_peak`
     gives them (every value computed by the same operations: bitwise the same), without
@@ -826,25 +834,27 @@ def peak_rows(section, forces: SectionForces, floor: np.ndarray | None = None
     skips every row below the stress found at the row of the largest bound, or below
     ``floor`` (ns,) (the envelope of earlier rows: a station whose rows all stay below it
     may return any row with peak <= floor, -inf when a bound over all rows, from each
-    force's largest magnitude, lies below the floor)."""
+    force's largest magnitude, lies below the floor). ``largest`` (6, ns): those largest
+    magnitudes [N, T, Q_height, Q_width, M_height, M_width] when the caller has them (the
+    kernel's, with the section forces); found here otherwise."""
     nt, ns = forces.N.shape
     normal, shear = _stress_bounds(section)
     if floor is not None and nt > 1:
         # the block's bound per station from each force's largest magnitude over the rows
         # (reductions, no temporaries): stations that stay below the floor are done
-        def most(x: np.ndarray) -> np.ndarray:
-            return np.maximum(x.max(axis=0), -x.min(axis=0))
-        top_sig = (most(forces.N) * normal[0] + most(forces.M[..., 1]) * normal[1]
-                   + most(forces.M[..., 0]) * normal[2])
-        top_tau = (most(forces.T) * shear[0] + most(forces.Q[..., 0]) * shear[1]
-                   + most(forces.Q[..., 1]) * shear[2])
+        if largest is None:
+            largest = np.array([np.maximum(x.max(axis=0), -x.min(axis=0)) for x in (
+                forces.N, forces.T, forces.Q[..., 0], forces.Q[..., 1], forces.M[..., 0],
+                forces.M[..., 1])])
+        top_sig = (largest[0] * normal[0] + largest[5] * normal[1] + largest[4] * normal[2])
+        top_tau = (largest[1] * shear[0] + largest[2] * shear[1] + largest[3] * shear[2])
         live = ~(np.sqrt(top_sig**2 + 3.0 * top_tau**2) * (1.0 + BOUND_MARGIN) < floor)
         if not live.all():
             row, peak = np.zeros(ns, dtype=np.int64), np.full(ns, -np.inf)
             if live.any():
                 row[live], peak[live] = peak_rows(section, SectionForces(
                     s=forces.s[live], N=forces.N[:, live], T=forces.T[:, live],
-                    Q=forces.Q[:, live], M=forces.M[:, live]), floor[live])
+                    Q=forces.Q[:, live], M=forces.M[:, live]), floor[live], largest[:, live])
             return row, peak
     sig = np.abs(forces.N) * normal[0]
     sig += np.abs(forces.M[..., 1]) * normal[1]
@@ -1066,15 +1076,17 @@ class DynamicAnswers:
                 forces = law(body, full)
                 self.tension[name].append((forces.min(axis=1), forces.max(axis=1)))
         for info in self.section_sets:
-            self._record_sections(info.body.name, beam_section_forces(
+            self._record_sections(info.body.name, *_section_rows(
                 self.model, info, e_rows, times, self.stations), times)
 
-    def _record_sections(self, name: str, f: SectionForces, times: np.ndarray) -> None:
-        """Keep a block's section forces (output.sections) and lift the envelope."""
+    def _record_sections(self, name: str, f: SectionForces, largest: np.ndarray,
+                         times: np.ndarray) -> None:
+        """Keep a block's section forces (output.sections) and lift the envelope
+        (``largest``: each force's largest magnitude over the block's rows, (6, ns))."""
         if self.keep_sections:
             self.sections.setdefault(name, []).append(f)
         floor = self.envelope[name][1] if name in self.envelope else None
-        row, peak = peak_rows(self.beams[name].section, f, floor)   # (ns,) each
+        row, peak = peak_rows(self.beams[name].section, f, floor, largest)   # (ns,) each
         if name not in self.envelope:
             self.envelope[name] = (f.s, peak.copy(), times[row].copy())
         else:
