@@ -45,8 +45,6 @@ from ..io.scene import Scene
 from ..solvers.static import StaticResult
 
 if TYPE_CHECKING:
-    from types import ModuleType
-
     from ..solvers.path import StaticPath
 
 #: the statuses a result file can carry (root attribute and /dynamic attribute)
@@ -268,16 +266,17 @@ def _source_tree() -> Path | None:
     return None
 
 
-def _build_info() -> ModuleType | None:
-    """What the build recorded (``ancfdrv._build_info``, written by meson.build) for an
-    installed package; None when running from the checkout or when a copy lacks it."""
+def _build_info() -> tuple[str, str] | None:
+    """(commit, compiler) as the build recorded them (``ancfdrv._build_info``, written by
+    meson.build) for an installed package; None when running from the checkout or when a
+    copy lacks the record."""
     if _source_tree() is not None:
         return None
     try:
-        from .. import _build_info
+        from .._build_info import COMPILER, GIT_COMMIT
     except ImportError:
         return None
-    return _build_info
+    return GIT_COMMIT, COMPILER
 
 
 def _git_commit() -> str:
@@ -286,7 +285,7 @@ def _git_commit() -> str:
     what git says of the package's directory."""
     built = _build_info()
     if built is not None:
-        return built.GIT_COMMIT
+        return built[0]
     here = str(Path(__file__).resolve().parent)
     sha = _run(["git", "rev-parse", "HEAD"], cwd=here)
     if not sha:
@@ -300,8 +299,8 @@ def _compiler() -> str:
     build record, an editable build's Meson introspection), else the first line of
     ``gfortran --version`` on PATH."""
     built = _build_info()
-    if built is not None and built.COMPILER:
-        return built.COMPILER
+    if built is not None and built[1]:
+        return built[1]
     try:
         from ..kernel import _kernel
         for parent in Path(_kernel.__file__).resolve().parents[:3]:

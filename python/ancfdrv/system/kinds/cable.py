@@ -24,18 +24,13 @@ import numpy as np
 
 from ... import kernel
 from ...errors import InputError
+from ...gauss import leggauss
 from ...io.schema import Key, at_least, name_key, non_negative, one_of, positive, vector3
 from ..bodies import Attachment, Body, Material, _vec, axis_stations, check_axis_dimensions
 from ..expressions import Vec3
 from ..model import SetInfo
 from ..registry import Kind, SetContext, checked_values, register
 from ..sections import Rectangle, Section, section_of
-
-#: the 5 Gauss-Legendre points on [-1, 1] of :meth:`Cable.strains`, the values
-#: ``np.polynomial.legendre.leggauss(5)[0]`` returns (a float's repr reads back bit for bit;
-#: importing numpy.polynomial cost ~3 ms of a command's start)
-GAUSS5_POINTS = np.array([-0.906179845938664, -0.5384693101056831, 0.0, 0.5384693101056831,
-                          0.906179845938664])
 
 CABLE_NODE_DOFS = 6
 #: offsets of the nodal vectors within a node's coordinates
@@ -137,7 +132,7 @@ class Cable(Body):
         e = np.asarray(e, dtype=float)
         q = e[..., self.element_dofs()]                            # (..., 12, nel)
         q = np.moveaxis(q.reshape(*q.shape[:-2], 4, 3, self.nel), -1, -3)  # (..., nel, 4, 3)
-        xg = GAUSS5_POINTS
+        xg, _ = leggauss(5)
         out = np.empty((*q.shape[:-2], 5))
         for k, x in enumerate(0.5 * (xg + 1.0)):
             slopes = np.array([kernel.cable_shape(x, length)[1] for length in self.lengths])
