@@ -42,10 +42,15 @@ interpreter imports), ``--compare DIR`` (a directory holding ``ancfdrv/``) or
 when ``fortran/`` is unchanged since SHA). The machine's load average is recorded before
 and after.
 
+``--instructions``: also the instructions of the baseline and the matched boom per copy
+and of the peer's script, each one cold command under valgrind's callgrind with every
+process it starts (exact: the figure a loaded machine cannot distort).
+
 Output: ``benchmarks/results/command_cost.json`` and ``.md`` (the table, also printed).
 Run from the repository root::
 
-    python benchmarks/command_cost.py --compare-commit 79ddcfa   # ~3 minutes
+    python benchmarks/command_cost.py --compare-commit 79ddcfa   # ~1 minute
+    python benchmarks/command_cost.py --compare-commit 79ddcfa --repeats 9 --instructions
 """
 from __future__ import annotations
 
@@ -279,6 +284,23 @@ def _cold(copy: str | Path | None, args: list[str], out_dir: str) -> tuple[float
     return wall, usage.ru_utime + usage.ru_stime
 
 
+def _instructions(copy: str | Path, args: list[str], out_dir: str) -> int:
+    """The instructions one cold command executes, with every process it starts
+    (valgrind's callgrind, ``--trace-children``): exact and independent of the load."""
+    with tempfile.TemporaryDirectory() as counts:
+        command = ["valgrind", "--tool=callgrind", "--trace-children=yes",
+                   f"--callgrind-out-file={counts}/cg.%p", sys.executable, "-S",
+                   *[a.replace("{out}", os.path.join(out_dir, "counted.h5")) for a in args]]
+        subprocess.run(command, cwd=REPO, env=installed_env(copy), check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        total = 0
+        for path in Path(counts).glob("cg.*"):
+            for line in path.read_text(errors="replace").splitlines():
+                if line.startswith("summary:"):
+                    total += int(line.split()[1])
+        return total
+
+
 def _warm(copy: str | Path, repeats: int) -> dict[str, Any]:
     done = subprocess.run([sys.executable, "-S", "-c", WARM, SCENE, json.dumps(SETS),
                            json.dumps({"level_pick": LEVEL_PICK, "boom_matched": MATCHED}),
@@ -312,6 +334,15 @@ def markdown(result: dict[str, Any]) -> list[str]:
         e = result["exudyn"]
         out.append(f"| exudyn_matched (the peer's script) | {1e3 * e['wall_s']:.0f} / "
                    f"{1e3 * e['cpu_s']:.0f} |" + " |" * (len(copies) - 1))
+    if result.get("instructions"):
+        counted = result["instructions"]
+        out += ["", "Instructions of one cold command with every process it starts "
+                "(callgrind, exact, independent of the load), millions:", "",
+                "| command | " + " | ".join(counted) + " |", "|---|" + "---|" * len(counted)]
+        names = sorted({n for c in counted.values() for n in c})
+        for name in names:
+            out.append(f"| {name} | " + " | ".join(
+                f"{c[name] / 1e6:.0f}" if name in c else "" for c in counted.values()) + " |")
     out += ["", "Warm calls (one process per copy, after warm-up calls): the 5000-step boom "
             "with and without XDMF (best wall / its thread CPU, ms), and the phase split "
             "(median thread CPU per phase, ms; 'whole' the best wall time).", "",
@@ -343,6 +374,9 @@ def main() -> None:
     parser.add_argument("--compare-commit", help="the package of this commit (with this "
                         "build's kernel) as the other copy")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--instructions", action="store_true",
+                        help="also count the instructions of the baseline and of the "
+                        "matched boom (and the peer's script) under callgrind (~2 minutes)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
@@ -378,6 +412,14 @@ def main() -> None:
         result["exudyn"] = ({"wall_s": min(w for w, _ in peer), "cpu_s": min(c for _, c in peer)}
                             if peer else None)
         result["warm"] = {copy: _warm(where, args.repeats) for copy, where in copies.items()}
+        if args.instructions:
+            result["instructions"] = {
+                copy: {name: _instructions(where, COLD[name], tmp)
+                       for name in ("baseline", "boom_matched")}
+                for copy, where in copies.items()}
+            if exudyn is not None:
+                result["instructions"]["exudyn"] = {
+                    "exudyn_matched": _instructions(work / "peer", exudyn, tmp)}
     result["load_after"] = os.getloadavg()
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "command_cost.json").write_text(json.dumps(result, indent=2) + "\n")
