@@ -106,9 +106,6 @@ WARM = textwrap.dedent("""
     scene, repeats = sys.argv[1], int(sys.argv[4])
     sets, cases = json.loads(sys.argv[2]), json.loads(sys.argv[3])
     groups = json.loads(sys.argv[6])
-    # the static path's solve and the static answers (fixed_cost.PHASES predates them)
-    EXTRA = (("ancfdrv.runner", None, "solve_static_path", "static solve"),
-             ("ancfdrv.system.answers", None, "static_answers", "answers"))
     spent, stack = {}, ["glue"]
     mark = [time.thread_time()]
     def switch(label):
@@ -172,7 +169,7 @@ WARM = textwrap.dedent("""
                 row = (time.perf_counter() - w, time.thread_time() - c)
                 best = row if best is None or row[0] < best[0] else best
             out[label] = dict(zip(("wall_s", "thread_cpu_s"), best))
-        for module, owner, name, label in PHASES + EXTRA:
+        for module, owner, name, label in PHASES:
             target = importlib.import_module(module)
             target = target if owner is None else getattr(target, owner)
             if hasattr(target, name):   # (a copy may lack a later function)
