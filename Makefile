@@ -12,7 +12,8 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.ancfdrv-installed
 APT_PACKAGES := gfortran libmumps-seq-dev liblapack-dev libopenblas-dev pkg-config
-SOURCES := $(shell find fortran python -name '*.f90' -o -name '*.py' -o -name '.f2py_f2cmap' \
+SOURCES := $(shell find fortran python -name '*.f90' -o -name '*.py' -o -name '*.py.in' \
+           -o -name '.f2py_f2cmap' \
            -o -name meson.build) \
            meson.build pyproject.toml
 DEMO_STATIC := results/boom_static_sweep

@@ -66,7 +66,8 @@ dynamic solve's ``wall_time_s`` from the file's ``/dynamic`` attributes, ``whole
 call (scene, model, static start, dynamics, output). Exudyn: ``solve`` is
 ``mbs.SolveDynamic``, ``whole`` builds the system, assembles it, solves the static start and
 the dynamics and reads the sensor. Interpreter start-up and imports are excluded (``levels``
-also times the command line: a fresh interpreter per call). Ratios are Exudyn's time /
+also times the command line: a fresh interpreter per call, each code installed and
+byte-compiled as a user has it, see :func:`command_line`). Ratios are Exudyn's time /
 ancfdrv's, both measured in this run (> 1: ancfdrv is faster).
 
 Exudyn runs as a user tuning it would run it (issue 38): its ``exudynCPPfast`` module, one
@@ -1690,31 +1691,50 @@ def command_line(table: list[dict[str, Any]], configs: dict[str, LevelConfig], b
     """Time each code's fastest configuration per level (common reference, by whole call)
     from the command line: ``ancf run`` of the scene with the configuration's overrides, and
     a Python script that builds and runs Exudyn's boom; a fresh interpreter per call, the
-    calls interleaved, best of ``--repeats``. Adds 'command_s' to the level table's picks."""
+    calls interleaved, best of ``--repeats``. Adds 'command_s' to the level table's picks.
+
+    Both run as installed, byte-compiled code (``command_cost.installed_copy``): ancfdrv as
+    ``pip install .`` leaves it (not this workplace's editable install, whose loader runs
+    ninja on every start, nor uncompiled sources where PYTHONDONTWRITEBYTECODE is set), run
+    as its console script does, and the peer's script from a byte-compiled copy of this
+    harness; each with ``python -S`` and PYTHONPATH (the copy, then the site-packages)."""
     import subprocess
+
+    from command_cost import ENTRY, installed_copy, installed_env
 
     picks = {entry["common"]["whole"][code]["label"]
              for entry in table for code in ("ancfdrv", "exudyn")
              if entry["common"]["whole"][code]}
-    ancf = Path(sys.executable).parent / "ancf"
-    commands: dict[str, list[str]] = {}
+    package = workdir / "installed"
+    if not (package / "ancfdrv").exists():
+        installed_copy(package)
+    peer = workdir / "peer_script"
+    if not (peer / "peer_harness.py").exists():
+        peer.mkdir(parents=True, exist_ok=True)
+        for name in ("peer_harness.py", "_peer.py"):
+            (peer / name).write_bytes((REPO / "benchmarks" / name).read_bytes())
+        subprocess.run([sys.executable, "-m", "compileall", "-q", str(peer)], check=True)
+    commands: dict[str, tuple[list[str], dict[str, str]]] = {}
     for label in sorted(picks):
         c = configs[label]
         if c.code == "ancfdrv":
             sets = [x for o in base + c.overrides for x in ("--set", o)]
-            commands[label] = [str(ancf), "run", str(REPO / "inputs/boom_luffing.nml"), *sets,
-                               "-o", str(workdir / "command.h5")]
+            commands[label] = ([sys.executable, "-S", "-c", ENTRY, "run",
+                                str(REPO / "inputs/boom_luffing.nml"), *sets,
+                                "-o", str(workdir / "command.h5")], installed_env(package))
         else:
             spec = json.dumps({"boom": asdict(replace(boom, dt=c.dt)), "config": asdict(c)})
-            commands[label] = [sys.executable, "-c",
-                               EXUDYN_SCRIPT.format(bench=str(REPO / "benchmarks")), spec]
+            commands[label] = ([sys.executable, "-S", "-c",
+                                EXUDYN_SCRIPT.format(bench=str(peer)), spec],
+                               installed_env(peer))
     best: dict[str, float] = {}
     for _ in range(args.repeats):
         for label, command in commands.items():
             if label in best and math.isnan(best[label]):
                 continue
             t0 = time.perf_counter()
-            done = subprocess.run(command, capture_output=True, text=True, cwd=workdir)
+            done = subprocess.run(command[0], capture_output=True, text=True, cwd=workdir,
+                                  env=command[1])
             elapsed = time.perf_counter() - t0
             if done.returncode != 0:
                 print(f"  command line {label}: exit {done.returncode}: {done.stderr[-300:]}",
@@ -1758,7 +1778,9 @@ def levels_markdown(rec: dict[str, Any]) -> list[str]:
            "`SolveDynamic`, sensor read), 'solve' the dynamic solve alone (ancfdrv: `/dynamic` "
            "`wall_time_s`; Exudyn: `SolveDynamic`), 'command' from the shell in a fresh "
            "interpreter (`ancf run` with `--set`; a Python script building and running "
-           "Exudyn's model). Ratio: Exudyn's time / ancfdrv's (> 1: ancfdrv faster).", ""]
+           "Exudyn's model; both installed and byte-compiled as `pip install .` leaves them, "
+           "run with `python -S`, not from an editable install). Ratio: Exudyn's time / "
+           "ancfdrv's (> 1: ancfdrv faster).", ""]
     for mass, m in rec["masses"].items():
         checks = "; ".join(f"{name} ({c['label']}) {_f(c['error_common_percent'], '.4f')} %"
                            for name, c in m["reference_checks"].items())

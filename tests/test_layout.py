@@ -96,7 +96,8 @@ def test_cycle_detection_finds_a_cycle():
 #: a node may import only nodes of a lower layer (or itself). A subpackage is one node;
 #: a top-level module another; `ancfdrv` is the package's __init__ (the public API).
 LAYERS = [
-    {"_version", "errors", "_kernel", "history", "reference", "_lazy", "csr"},
+    {"_version", "errors", "_kernel", "history", "reference", "_lazy", "csr", "gauss",
+     "_build_info"},
     {"codes", "interrupt"},
     {"kernel"},                     # the typed binding over the compiled kernel
     {"io"},                         # schema, namelist reader, validation, safe writes

@@ -103,12 +103,36 @@ def test_provenance(boom):
     assert attrs["python_version"] == ".".join(map(str, sys.version_info[:3]))
     assert attrs["command"]  # the command line of the process
     package = Path(ancfdrv.__file__).resolve().parent
+    checkout = package.parents[1]
     git = shutil.which("git")
-    if git:
-        head = subprocess.run([git, "rev-parse", "HEAD"], cwd=package, capture_output=True,
-                              text=True)
-        if head.returncode == 0:
-            assert attrs["git_commit"].split()[0] == head.stdout.strip()
+    if (checkout / "meson.build").is_file():   # run from the checkout: its HEAD, from git
+        if git:
+            head = subprocess.run([git, "rev-parse", "HEAD"], cwd=package,
+                                  capture_output=True, text=True)
+            if head.returncode == 0:
+                assert attrs["git_commit"].split()[0] == head.stdout.strip()
+    else:   # an installed package: the commit and compiler its build recorded
+        from ancfdrv import _build_info
+        assert attrs["git_commit"] == _build_info.GIT_COMMIT
+        assert attrs["compiler"] == _build_info.COMPILER
+
+
+def test_installed_provenance_starts_no_process(monkeypatch):
+    """An installed package's provenance comes from its build's record
+    (``ancfdrv._build_info``): no git, no gfortran started per run (issue 38)."""
+    from ancfdrv.results import hdf5
+    started = []
+    monkeypatch.setattr(hdf5, "_source_tree", lambda: None)
+    monkeypatch.setattr(hdf5, "_run", lambda command, cwd=None: started.append(command) or "")
+    hdf5._static_provenance.cache_clear()
+    try:
+        record = hdf5.provenance()
+    finally:
+        hdf5._static_provenance.cache_clear()
+    from ancfdrv import _build_info
+    assert started == []
+    assert record["git_commit"] == _build_info.GIT_COMMIT
+    assert record["compiler"] == _build_info.COMPILER != ""   # the compiler's --version line
 
 
 def test_xdmf_is_valid_xml_with_every_data_item_formatted(plate):

@@ -164,7 +164,7 @@ class Csr:
         cols = np.asarray(cols, dtype=np.int64)
         where = np.full(self.shape[1], -1, dtype=np.int64)
         where[cols] = np.arange(len(cols))
-        if len(np.unique(cols)) != len(cols):
+        if len(sorted_unique(cols)) != len(cols):
             raise ValueError("take_columns: the columns must be distinct")
         new = where[self.indices]
         keep = new >= 0

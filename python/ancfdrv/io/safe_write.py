@@ -22,7 +22,6 @@ from __future__ import annotations
 import errno
 import os
 import signal
-import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any, Callable, Iterator
@@ -57,6 +56,7 @@ def _swap_in(path: str | Path) -> Iterator[tuple[int, Path]]:
     """A temporary file beside ``path`` (its open descriptor and name) that replaces
     ``path`` in one rename when the block ends normally (a symbolic link at ``path`` is
     replaced, not followed), and is removed otherwise, leaving ``path`` as it was."""
+    import tempfile   # (with shutil and random: ~2 ms of every command's start; few write so)
     path = Path(path)
     fd, temp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
                                 dir=str(path.parent) if str(path.parent) else ".")

@@ -256,8 +256,36 @@ def _run(command: list[str], cwd: str | None = None) -> str:
     return lines[0].strip() if done.returncode == 0 and lines else ""
 
 
+def _source_tree() -> Path | None:
+    """The checkout the package runs from (``<checkout>/python/ancfdrv``: an editable
+    install, a development run), None for an installed package."""
+    package = Path(__file__).resolve().parents[1]
+    root = package.parents[1]
+    if package.parent.name == "python" and (root / "meson.build").is_file():
+        return root
+    return None
+
+
+def _build_info() -> tuple[str, str] | None:
+    """(commit, compiler) as the build recorded them (``ancfdrv._build_info``, written by
+    meson.build) for an installed package; None when running from the checkout or when a
+    copy lacks the record."""
+    if _source_tree() is not None:
+        return None
+    try:
+        from .._build_info import COMPILER, GIT_COMMIT
+    except ImportError:
+        return None
+    return GIT_COMMIT, COMPILER
+
+
 def _git_commit() -> str:
-    """'<sha>' or '<sha> (modified)' when the package runs from a git checkout."""
+    """'<sha>' or '<sha> (modified)': of the checkout the package runs from (asked from
+    git), of the commit an installed package was built from (the build's record), else
+    what git says of the package's directory."""
+    built = _build_info()
+    if built is not None:
+        return built[0]
     here = str(Path(__file__).resolve().parent)
     sha = _run(["git", "rev-parse", "HEAD"], cwd=here)
     if not sha:
@@ -267,8 +295,12 @@ def _git_commit() -> str:
 
 
 def _compiler() -> str:
-    """The Fortran compiler that built the kernel (Meson's record in an editable build),
-    else the first line of ``gfortran --version`` on PATH."""
+    """The Fortran compiler that built the kernel (Meson's record: the installed package's
+    build record, an editable build's Meson introspection), else the first line of
+    ``gfortran --version`` on PATH."""
+    built = _build_info()
+    if built is not None and built[1]:
+        return built[1]
     try:
         from ..kernel import _kernel
         for parent in Path(_kernel.__file__).resolve().parents[:3]:
@@ -735,6 +767,25 @@ def read_summary(path: Path) -> dict[str, Any]:
             out.update({f"timing.{k}": v for k, v in h5["timing"].attrs.items()})
         if "counters" in h5:
             out.update({f"counters.{k}": v for k, v in h5["counters"].attrs.items()})
+    return out
+
+
+def run_figures(h5: h5py.File) -> dict[str, Any]:
+    """What ``ancf run`` prints of its result file (open), under :func:`read_summary`'s
+    keys: the model's counts, the static deflections (also relative to the supports) and
+    the dynamic step; read alone (the whole summary reads ~150 attributes)."""
+    model = h5["model"].attrs
+    out: dict[str, Any] = {f"model.{k}": _text(model[k])
+                           for k in ("nnodes", "ndof", "nconstraints")}
+    static = h5.get("static")
+    if static is not None:
+        for name in static.get("deflection", {}):
+            out[f"static.deflection.{name}"] = static["deflection"][name][()]
+        for name in static.get("deflection_support", {}):
+            out[f"static.deflection_support.{name}"] = static["deflection_support"][name][()]
+    dynamic = h5.get("dynamic")
+    if dynamic is not None and "dt" in dynamic.attrs:
+        out["dynamic.dt"] = _text(dynamic.attrs["dt"])
     return out
 
 

@@ -126,43 +126,49 @@ def read_answers(path: str | Path) -> dict[str, Any]:
     """The answers of a result file as a JSON-ready dict (module docstring): keys
     'static', 'dynamic', 'modal', 'buckling' for the analyses the file holds. Raises
     InputError when the file is missing, not HDF5 or not an ancfdrv result."""
-    out: dict[str, Any] = {}
     with open_result(Path(path)) as h5:
-        if "static" in h5:
-            group = h5["static"]
-            static: dict[str, Any] = {}
-            if "reactions" in group:
-                static["reactions"] = _static_reactions(group["reactions"])
-            if "stress" in group:
-                static["largest_von_mises"] = _largest_stress(group["stress"])
-            if "deflection" in group:
-                reference = _text(group["deflection"].attrs.get(
-                    "reference", "displacement from the rigid configuration"))
-                static["largest_displacement"] = _largest_displacement(group["deflection"],
-                                                                       reference)
-            if "deflection_support" in group and len(group["deflection_support"]):
-                static["largest_support_deflection"] = _largest_displacement(
-                    group["deflection_support"], "relative to the rigid motion of the "
-                    "beam's supports")
-            out["static"] = static
-        if "dynamic" in h5 and "time" in h5["dynamic"] and len(h5["dynamic/time"]):
-            group = h5["dynamic"]
-            time = np.asarray(group["time"][()], dtype=float)
-            dynamic: dict[str, Any] = {"t_reached": float(time[-1]),
-                                       "steps": int(group.attrs.get("steps", len(time) - 1))}
-            if "reactions" in group:
-                dynamic["reactions"] = _dynamic_reactions(group["reactions"], time)
-            if "stress" in group:
-                dynamic["largest_von_mises"] = _largest_stress(group["stress"])
-            if "energy" in group:
-                dynamic["energy_balance"] = _energy_balance(group["energy"])
-            out["dynamic"] = dynamic
-        for name, key in (("modal", "frequency"), ("buckling", "load_factor")):
-            if name in h5 and key in h5[name]:
-                entry = {key: _floats(h5[name][key][()])}
-                if "damping_ratio" in h5[name]:
-                    entry["damping_ratio"] = _floats(h5[name]["damping_ratio"][()])
-                out[name] = entry
+        return answers_of(h5)
+
+
+def answers_of(h5: h5py.File) -> dict[str, Any]:
+    """:func:`read_answers` of a result file already open (``ancf run`` reads its
+    figures and its answers in one opening)."""
+    out: dict[str, Any] = {}
+    if "static" in h5:
+        group = h5["static"]
+        static: dict[str, Any] = {}
+        if "reactions" in group:
+            static["reactions"] = _static_reactions(group["reactions"])
+        if "stress" in group:
+            static["largest_von_mises"] = _largest_stress(group["stress"])
+        if "deflection" in group:
+            reference = _text(group["deflection"].attrs.get(
+                "reference", "displacement from the rigid configuration"))
+            static["largest_displacement"] = _largest_displacement(group["deflection"],
+                                                                   reference)
+        if "deflection_support" in group and len(group["deflection_support"]):
+            static["largest_support_deflection"] = _largest_displacement(
+                group["deflection_support"], "relative to the rigid motion of the "
+                "beam's supports")
+        out["static"] = static
+    if "dynamic" in h5 and "time" in h5["dynamic"] and len(h5["dynamic/time"]):
+        group = h5["dynamic"]
+        time = np.asarray(group["time"][()], dtype=float)
+        dynamic: dict[str, Any] = {"t_reached": float(time[-1]),
+                                   "steps": int(group.attrs.get("steps", len(time) - 1))}
+        if "reactions" in group:
+            dynamic["reactions"] = _dynamic_reactions(group["reactions"], time)
+        if "stress" in group:
+            dynamic["largest_von_mises"] = _largest_stress(group["stress"])
+        if "energy" in group:
+            dynamic["energy_balance"] = _energy_balance(group["energy"])
+        out["dynamic"] = dynamic
+    for name, key in (("modal", "frequency"), ("buckling", "load_factor")):
+        if name in h5 and key in h5[name]:
+            entry = {key: _floats(h5[name][key][()])}
+            if "damping_ratio" in h5[name]:
+                entry["damping_ratio"] = _floats(h5[name]["damping_ratio"][()])
+            out[name] = entry
     return out
 
 

@@ -68,7 +68,9 @@ def _section_vectors(info) -> tuple[np.ndarray, np.ndarray]:
     reference = np.asarray(info.reference).reshape(3, 8, info.nel, order="F")
     reference = reference[:, directions].transpose(2, 1, 0)          # (el, vector, xyz)
     table = np.column_stack([dofs.T.reshape(-1), reference.reshape(-1, 3)])
-    table = np.unique(table, axis=0)
+    # np.unique(table, axis=0) (rows sorted by their columns, each once) without numpy.ma
+    table = table[np.lexsort(table.T[::-1])]
+    table = table[np.concatenate([[True], (table[1:] != table[:-1]).any(axis=1)])]
     found = (table[:, 0].astype(np.int64), np.ascontiguousarray(table[:, 1:]))
     if hasattr(info, "__dict__"):
         info.__dict__["_section_vectors"] = found

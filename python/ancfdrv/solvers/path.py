@@ -59,6 +59,7 @@ import numpy as np
 from ..errors import InputError, SolverError
 from ..system.model import Model
 from .._lazy import LazyModule
+from ..csr import sorted_unique
 from .static import (ARC_STEP, LOAD_TANGENT, LoadStepFailure, StaticResult, kernel_static,
                      solve_static)
 
@@ -165,7 +166,7 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
         nonzero = grads != 0
         g_rows = np.asarray(g_rows, dtype=np.int64)[nonzero]
         g_cols = np.asarray(g_cols, dtype=np.int64)[nonzero]
-        touched = np.unique(g_cols)
+        touched = sorted_unique(g_cols)   # np.unique(g_cols) (which imports numpy.ma: csr)
         g = np.zeros((ncon, len(touched)))
         np.add.at(g, (g_rows, np.searchsorted(touched, g_cols)), grads[nonzero])
         g = g[np.abs(g).max(axis=1, initial=0.0) > 0]
@@ -185,7 +186,9 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
     v = 0.5 * v
     r, c, v = np.concatenate([r, c]), np.concatenate([c, r]), np.concatenate([v, v])
     # the symmetric part's triplets (duplicates add up where they are used)
-    free = np.setdiff1d(np.arange(n), touched)
+    is_free = np.ones(n, dtype=bool)
+    is_free[touched] = False
+    free = np.flatnonzero(is_free)   # np.setdiff1d(np.arange(n), touched) without numpy.ma
     nf, size = len(free), len(free) + basis.shape[1]
     rank_of = np.empty(size, dtype=np.int64)
     rank_of[np.argsort(np.concatenate([free.astype(float), where]), kind="stable")] = \
@@ -193,8 +196,6 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
     slot = np.full(n, -1, dtype=np.int64)   # a coordinate's place among free or touched
     slot[free] = np.arange(nf)
     slot[touched] = np.arange(len(touched))
-    is_free = np.zeros(n, dtype=bool)
-    is_free[free] = True
     both = is_free[r] & is_free[c]
     out_r, out_c, out_v = [rank_of[slot[r[both]]]], [rank_of[slot[c[both]]]], [v[both]]
     if basis.shape[1]:

@@ -327,7 +327,9 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     timing = {"assembly": 0.0, "factorization": 0.0, "solve": 0.0}
     n, ncon = model.ndof, len(model.constraints)
     dep = np.array(model.constraints.dependent, dtype=int)
-    rest = np.setdiff1d(np.arange(n), dep)
+    is_rest = np.ones(n, dtype=bool)
+    is_rest[dep] = False
+    rest = np.flatnonzero(is_rest)   # np.setdiff1d(np.arange(n), dep) without numpy.ma
     nd, m = len(dep), len(dep) + ncon
     touched = set(model.constraints.touched().tolist()) | {
         int(k) for cols, *_ in model.moment_terms(model.e0) for k in cols}

@@ -59,6 +59,7 @@ import numpy as np
 from .. import kernel
 from ..codes import CONSTRAINT_COORDINATE
 from ..csr import sorted_unique
+from ..gauss import leggauss
 from .kinds import Beam
 from .constraint_set import ConstraintSet
 from .expressions import Scalar
@@ -625,7 +626,7 @@ def beam_equilibrium_forces(model: Model, info: SetInfo, q: np.ndarray, gravity:
     lengths = np.asarray(beam.lengths, dtype=float)
     per_length = (load[:, 0] + load[:, 4]) / lengths[:, None]          # p (nel, 3)
     xi = np.linspace(0.0, 1.0, stations)
-    points, weights = np.polynomial.legendre.leggauss(3)   # exact: r(x) is cubic
+    points, weights = leggauss(3)   # exact: r(x) is cubic
     r_s = _centreline(xi, lengths) @ vectors                          # (nel, nxi, 3)
     # int_0^xi r dx per station: Gauss on [0, xi]
     nodes = (0.5 * xi[:, None] * (points[None, :] + 1.0)).ravel()

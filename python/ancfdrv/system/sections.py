@@ -29,7 +29,12 @@ from .. import kernel
 from ..codes import SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
 from ..errors import InputError
 from ..io.schema import short_repr
-from . import section_tables
+from .._lazy import LazyModule
+
+#: the catalogue of standard sections (IPE200, ...), imported on the first standard
+#: designation: a scene of plain shapes never reads it (its import, with difflib's for the
+#: nearest names, was ~2 ms of a small ``ancf run``'s start)
+section_tables = LazyModule("ancfdrv.system.section_tables")
 
 
 def rectangle_torsion_constant(width: float, height: float, terms: int = 50) -> float:

@@ -9,6 +9,7 @@ import numpy as np
 
 from ... import kernel
 from ...errors import InputError
+from ...gauss import leggauss
 from ...io import validate
 from ...io.schema import (GEOMETRIC_STIFFNESS_DOC, MODES_DOC, Key, at_least, name_key,
                           non_negative, one_of,
@@ -360,7 +361,7 @@ def ffr_second_order_data(frame_ref: np.ndarray, lengths: np.ndarray, axial_rigi
     nel = len(lengths)
     chord = frame_ref[:, 4, :] - frame_ref[:, 0, :]
     axis = chord / np.linalg.norm(chord, axis=0)
-    points, weights = np.polynomial.legendre.leggauss(3)
+    points, weights = leggauss(3)
     xi, w = 0.5 * (points + 1.0), 0.5 * weights
     # d/dxi of N1, N2, N3, N4 (cubic Hermite)
     dn = np.array([-6 * xi + 6 * xi**2, 1 - 4 * xi + 3 * xi**2, 6 * xi - 6 * xi**2,

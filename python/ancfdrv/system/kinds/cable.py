@@ -24,6 +24,7 @@ import numpy as np
 
 from ... import kernel
 from ...errors import InputError
+from ...gauss import leggauss
 from ...io.schema import Key, at_least, name_key, non_negative, one_of, positive, vector3
 from ..bodies import Attachment, Body, Material, _vec, axis_stations, check_axis_dimensions
 from ..expressions import Vec3
@@ -131,7 +132,7 @@ class Cable(Body):
         e = np.asarray(e, dtype=float)
         q = e[..., self.element_dofs()]                            # (..., 12, nel)
         q = np.moveaxis(q.reshape(*q.shape[:-2], 4, 3, self.nel), -1, -3)  # (..., nel, 4, 3)
-        xg, _ = np.polynomial.legendre.leggauss(5)
+        xg, _ = leggauss(5)
         out = np.empty((*q.shape[:-2], 5))
         for k, x in enumerate(0.5 * (xg + 1.0)):
             slopes = np.array([kernel.cable_shape(x, length)[1] for length in self.lengths])
