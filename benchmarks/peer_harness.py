@@ -82,7 +82,8 @@ dense LU below 6 elements (``levels``: both LUs below 10 elements); the pendulum
     of each code on the luffing boom (m = 50 and 0 kg, ``--masses``), chosen from a grid over
     the mesh and the time step (5e-4 ... 2e-2 s) for both codes, against ancfdrv's cable
     converged in space and time (55 nodes, dt 2.5e-4 s, checked against half the mesh and
-    twice the step) and against each code's own converged run; whole-call, solve and
+    twice the step) and against each code's own converged run; whole-call (in memory, like
+    Exudyn's: ``ancfdrv.simulate``; the call writing the HDF5 file beside it), solve and
     command-line times. ``spinup`` and ``pendulum`` get the same level table from their
     grids (coarse steps included).
 
@@ -1521,25 +1522,37 @@ def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarr
         return once
     import h5py
 
+    import ancfdrv
     from ancfdrv.runner import run_scene
     read = boom_reader(boom, grid)
+    scene, overrides = REPO / "inputs/boom_luffing.nml", base + config.overrides
 
     def once() -> tuple[float, float, dict[str, Any]]:
+        # the like-for-like whole call: results kept in memory, as Exudyn's run keeps its
+        # sensors (no solution file); the call writing the HDF5 file is timed beside it
         t0 = time.perf_counter()
-        run_scene(REPO / "inputs/boom_luffing.nml", base + config.overrides, out,
-                  progress=False)
+        sim = ancfdrv.simulate(scene, overrides, progress=False)
         whole = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        run_scene(scene, overrides, out, progress=False)
+        with_file = time.perf_counter() - t0
+        if sim.status != "ok":
+            raise RuntimeError(sim.message)
         with h5py.File(out, "r") as h5:
-            attrs, model = h5["dynamic"].attrs, h5["model"].attrs
-            counts = {k: int(attrs[k]) for k in ("steps", "newton_iterations", "factorizations")}
+            model = h5["model"].attrs
+            counts = {k: int(h5["dynamic"].attrs[k])
+                      for k in ("steps", "newton_iterations", "factorizations")}
             counts.update({k: int(model[k]) for k in ("ndof", "nconstraints", "nunknowns",
                                                      "nplanar_fixed") if k in model})
             payload = read(h5)
-            phases = {k: float(v) for k, v in h5["timing"].attrs.items()}
-            solve = float(attrs["wall_time_s"])
-        return solve, whole, {"counts": counts, "values": payload["values"],
-                              "stepping_s": phases.get("dynamic_stepping", math.nan),
-                              "phases_s": phases}
+        memory_values = resample(grid, sim.time, sim.deflection("tip")[:, 1])
+        if not np.array_equal(memory_values, payload["values"]):
+            raise RuntimeError("the in-memory run's tip history differs from the file's")
+        phases = {k: float(v) for k, v in sim.timing.items()}
+        return sim.dynamic.wall_time_s, whole, {
+            "counts": counts, "values": payload["values"],
+            "stepping_s": phases.get("dynamic_stepping", math.nan), "phases_s": phases,
+            "with_file_s": with_file}
     return once
 
 
@@ -1564,6 +1577,9 @@ def _level_rounds(configs: list[LevelConfig], once_runs: set[str], onces: dict[s
                 min(run.whole_samples)
             run.counts = payload["counts"]
             run.values = payload["values"]
+            if "with_file_s" in payload:
+                run.extra["with_file_s"] = min(run.extra.get("with_file_s", math.inf),
+                                               payload["with_file_s"])
             if "stepping_s" in payload:
                 run.extra["stepping_s"] = min(run.extra.get("stepping_s", math.inf),
                                               payload["stepping_s"])
@@ -1618,7 +1634,8 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
             own = runs[ref_cfg[c.code].label]
             rows.append({"code": c.code, "label": c.label, "config": asdict(c), "ok": run.ok,
                          "message": run.message, "solve_s": run.solve_s,
-                         "whole_s": run.whole_s, "stepping_s": run.extra.get("stepping_s"),
+                         "whole_s": run.whole_s, "with_file_s": run.extra.get("with_file_s"),
+                         "stepping_s": run.extra.get("stepping_s"),
                          "phases_s": run.extra.get("phases_s"),
                          "repeats": len(run.solve_samples), "counts": run.counts,
                          "own_reference": own.label, "error_own_percent": error(run, own),
@@ -1654,11 +1671,15 @@ def level_table(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                     pick = min(ok, key=lambda r: r[time_key]) if ok else None
                     best[code] = None if pick is None else {
                         "label": pick["label"], "whole_s": pick["whole_s"],
-                        "solve_s": pick["solve_s"],
+                        "solve_s": pick["solve_s"], "with_file_s": pick.get("with_file_s"),
                         "error_percent": pick[f"error_{key}_percent"]}
                 a, x = best["ancfdrv"], best["exudyn"]
                 part[time_key.removesuffix("_s")] = {
                     **best, "exudyn_over_ancfdrv": x[time_key] / a[time_key] if a and x else None}
+                if time_key == "whole_s":
+                    part["whole"]["exudyn_over_ancfdrv_with_file"] = (
+                        x["whole_s"] / a["with_file_s"] if a and x and a.get("with_file_s")
+                        else None)
             entry[key] = part
         table.append(entry)
     return table
@@ -1774,8 +1795,10 @@ def levels_markdown(rec: dict[str, Any]) -> list[str]:
            "Euler-Bernoulli model both cables converge to; 'own': each code against its own "
            f"finest run (Exudyn: 54 elements, dt {rec['reference_dt']:g} s, its default "
            "tolerances). Times, best of the interleaved rounds: 'whole' the whole in-process "
-           "call (ancfdrv: `run_scene` with the HDF5 file; Exudyn: build, static start, "
-           "`SolveDynamic`, sensor read), 'solve' the dynamic solve alone (ancfdrv: `/dynamic` "
+           "call with the results kept in memory, like for like (ancfdrv: `ancfdrv.simulate`; "
+           "Exudyn: build, static start, `SolveDynamic`, sensor read, no solution file), "
+           "'with file' ancfdrv's call writing its HDF5 file (`run_scene`; ratio against "
+           "Exudyn's whole call), 'solve' the dynamic solve alone (ancfdrv: `/dynamic` "
            "`wall_time_s`; Exudyn: `SolveDynamic`), 'command' from the shell in a fresh "
            "interpreter (`ancf run` with `--set`; a Python script building and running "
            "Exudyn's model; both installed and byte-compiled as `pip install .` leaves them, "
@@ -1789,22 +1812,25 @@ def levels_markdown(rec: dict[str, Any]) -> list[str]:
         out += [f"### tip mass {mass} kg (sag range {m['sag_range_m']:.4f} m)", "",
                 f"References: {refs}. Checks of the common reference (distance from it): "
                 f"{checks or 'none'}.", "",
-                "| level | against | ancfdrv fastest | whole s | solve s | command s | error % | "
-                "Exudyn fastest | whole s | solve s | command s | error % | ratio whole | "
-                "ratio solve | ratio command |",
-                "|---|---|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
+                "| level | against | ancfdrv fastest | whole s | with file s | solve s | command s "
+                "| error % | Exudyn fastest | whole s | with file s | solve s | command s | error % "
+                "| ratio whole | ratio with file | ratio solve | ratio command |",
+                "|---|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:"
+                "|---:|"]
         for entry in m["levels"]:
             for key in ("common", "own"):
                 w, s = entry[key]["whole"], entry[key]["solve"]
 
                 def cells(p: dict[str, Any] | None) -> str:
                     if p is None:
-                        return "none | - | - | - | -"
-                    return (f"{p['label']} | {_f(p['whole_s'])} | {_f(p['solve_s'])} | "
+                        return "none | - | - | - | - | -"
+                    file_s = _f(p["with_file_s"]) if p.get("with_file_s") else "-"
+                    return (f"{p['label']} | {_f(p['whole_s'])} | {file_s} | {_f(p['solve_s'])} | "
                             f"{_f(p['command_s']) if 'command_s' in p else '-'} | "
                             f"{_f(p['error_percent'], '.4f')}")
                 out.append(f"| {entry['level_percent']:g} % | {key} | {cells(w['ancfdrv'])} | "
                            f"{cells(w['exudyn'])} | {_ratio(w['exudyn_over_ancfdrv'])} | "
+                           f"{_ratio(w.get('exudyn_over_ancfdrv_with_file'))} | "
                            f"{_ratio(s['exudyn_over_ancfdrv'])} | "
                            f"{_ratio(w.get('command_exudyn_over_ancfdrv'))} |")
         out += ["", "| code | run | whole s | solve s | steps | Newton | factorizations | "
