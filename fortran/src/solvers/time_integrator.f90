@@ -315,6 +315,7 @@ contains
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
     real(dp) :: contact_potential, beta_prime, velocity_factor, step_drive_work
+    real(dp) :: motion  ! max |e_new - e| of the step's predicted state
     integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
     logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
@@ -360,9 +361,13 @@ contains
           started_old = sys%matrix%policy /= policy_constant
         end if
         call carry_step(sys, cfg, learned, fresh_matrix, e_new)
+        motion = 0.0_dp
+        do i = 1, sys%ndof
+          motion = max(motion, abs(e_new(i) - e(i)))
+        end do
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, scratch, info, detail, &
+                    motion, stats, done, last_correction, monitor, scratch, info, detail, &
                     constraints_checked)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
@@ -530,7 +535,7 @@ contains
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, learned, t_new, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, work, info, detail, &
+                    motion, stats, done, last_correction, monitor, work, info, detail, &
                     constraints_checked)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
@@ -540,6 +545,7 @@ contains
     type(contact_state), intent(inout) :: state
     real(dp), intent(inout) :: predicted_internal(:)
     logical, intent(in) :: fresh_matrix
+    real(dp), intent(in) :: motion  ! max |e_new - e_n| of the predicted state
     integer, intent(inout) :: stats(stat_count)
     logical, intent(out) :: done
     real(dp), intent(inout) :: last_correction
@@ -669,7 +675,7 @@ contains
       end if
       last_correction = largest_correction
       if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta, &
-                    it - 1 > refreshed_at, measured)) then
+                    it - 1 > refreshed_at, measured, motion)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -1113,7 +1119,7 @@ contains
   !> the stagnation and divergence tests (stagnated) run on every correction not accepted.
   !> measured: this step has its entry in the bound's ring.
   logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix, &
-                             measured) result(ok)
+                             measured, motion) result(ok)
     type(system_model), intent(in) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -1122,6 +1128,7 @@ contains
     real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
     logical, intent(in) :: same_matrix     ! last and previous came from the same matrix
     logical, intent(inout) :: measured
+    real(dp), intent(in) :: motion  ! max |e_new - e_n| of the step's predicted state
     integer, parameter :: confirm_every = 20
     ! a steady contraction: at least steady_count measurements, the largest within
     ! steady_spread times the smallest
@@ -1132,10 +1139,12 @@ contains
     limit = cfg%tol * cfg%length_scale
     ok = last <= limit
     if (sys%matrix%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
+    if (it == 1 .and. sys%matrix%policy /= policy_constant) then
+      ok = ok .and. last <= sqrt(cfg%tol) * motion
+      return
+    end if
     if (it == 1) then
-      ! (reuse: the first correction is never accepted on an estimate)
-      if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every .or. &
-          sys%matrix%policy /= policy_constant) then
+      if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every) then
         if (ok) learned%unconfirmed = learned%unconfirmed + 1
         return
       end if
