@@ -94,6 +94,17 @@ module time_integrator
   !> the round-off floor of a correction, in ulps of the largest coordinate (or the length
   !> scale): a correction there is the solve of a residual that is round-off noise
   real(dp), parameter :: floor_ulps = 1000.0_dp
+  !> the largest error a refactorized system's step may keep, as a fraction of its motion
+  !> (max |e_new - e_n| of the predicted state), whatever newton_tol x L allows: the error
+  !> delta e left in e_{n+1} moves e'_{n+1} by gamma / (beta h) delta e and e''_{n+1} by
+  !> beta' delta e, a relative change of about 2 delta e / |e_{n+1} - e_n| in the velocity,
+  !> and the predictor extrapolates both into the next step. newton_tol x L alone allowed
+  !> 0.8 mm per step on the 7.8 m luffing boom at newton_tol = 1e-4, as much as the boom
+  !> moves in a step: the nonlinear cubic boom (10 nodes, dt 1e-3) failed at t = 6.2 s, the
+  !> 4-node one at 0.8 s; at 0.046 of the motion (first corrections accepted below
+  !> newton_tol^(1/3) of it at 1e-4) the 4-node boom's energy grew without bound. At
+  !> newton_tol = 1e-10 the fraction binds only below 1e-7 m of motion per step.
+  real(dp), parameter :: motion_fraction = 1e-2_dp
   !> the smallest newton_tol that double precision resolves: a stall at the floor with a
   !> tolerance at least this is converged (counted); below it the tolerance cannot be met
   real(dp), parameter :: resolvable_tol = 100.0_dp * epsilon(1.0_dp)
@@ -361,10 +372,14 @@ contains
           started_old = sys%matrix%policy /= policy_constant
         end if
         call carry_step(sys, cfg, learned, fresh_matrix, e_new)
+        ! (the step's motion: the scale of converged's test; the constant policy's
+        ! linear steps do not read it)
         motion = 0.0_dp
-        do i = 1, sys%ndof
-          motion = max(motion, abs(e_new(i) - e(i)))
-        end do
+        if (sys%matrix%policy /= policy_constant) then
+          do i = 1, sys%ndof
+            motion = max(motion, abs(e_new(i) - e(i)))
+          end do
+        end if
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
                     motion, stats, done, last_correction, monitor, scratch, info, detail, &
@@ -1088,9 +1103,14 @@ contains
   end subroutine stagnated
 
   !> Whether the Newton iteration of a step has converged after correction it of size
-  !> last (the one before: previous). jacobian_step and _iteration: last <= tol L. The
+  !> last (the one before: previous). The limit is tol L, for refactorized systems at most
+  !> motion_fraction of the step's motion (max |e_new - e_n| of its predicted state; never
+  !> below ten times the round-off floor): an error of tol L is as large as a step's whole
+  !> motion at a loose tolerance (1e-4 on the 7.8 m boom), and it enters the velocity and
+  !> the acceleration scaled by gamma / (beta h) and beta'. jacobian_step and _iteration:
+  !> last <= limit. The
   !> simplified Newton of the policy constant and of jacobian_reuse (Hairer & Wanner's
-  !> criterion): theta / (1 - theta) last <= tol L, the error left after the correction,
+  !> criterion): theta / (1 - theta) last <= limit, the error left after the correction,
   !> with the contraction theta = last / previous from the second correction on. With the
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
@@ -1103,7 +1123,7 @@ contains
   !> on (both corrections of a ratio made with the current factorization: same_matrix), one
   !> per measuring step (its largest), over the last contraction_memory measuring steps
   !> since the factorization (learned%matrix_ratios), when
-  !>   theta / (1 - theta) last <= tol L,  theta = max(last / previous, min(0.5, 2 theta_b)):
+  !>   theta / (1 - theta) last <= limit,  theta = max(last / previous, min(0.5, 2 theta_b)):
   !> twice the bound, never below the step's own first ratio; and only while the
   !> contraction is steady: at least steady_count measurements, the largest within
   !> steady_spread times the smallest (the 5-node cable pendulum: spreads 1.2-8, median 2,
@@ -1137,14 +1157,17 @@ contains
     real(dp) :: limit, theta, bound
     integer :: slot, known  ! the ring's entry of this step; the entries measured
     limit = cfg%tol * cfg%length_scale
+    ! (refactorized systems: also a fraction of the step's motion, never below ten times
+    ! the round-off floor, where a system at rest ends its steps)
+    if (sys%matrix%policy /= policy_constant) &
+      limit = min(limit, max(motion_fraction * motion, &
+                             10.0_dp * floor_ulps * epsilon(1.0_dp) * cfg%length_scale))
     ok = last <= limit
     if (sys%matrix%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
-    if (it == 1 .and. sys%matrix%policy /= policy_constant) then
-      ok = ok .and. last <= sqrt(cfg%tol) * motion
-      return
-    end if
     if (it == 1) then
-      if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every) then
+      ! (reuse: the first correction is never accepted on an estimate)
+      if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every .or. &
+          sys%matrix%policy /= policy_constant) then
         if (ok) learned%unconfirmed = learned%unconfirmed + 1
         return
       end if
