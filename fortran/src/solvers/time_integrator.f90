@@ -95,8 +95,8 @@ module time_integrator
   !> scale): a correction there is the solve of a residual that is round-off noise
   real(dp), parameter :: floor_ulps = 1000.0_dp
   !> the largest error a refactorized system's step without contact may keep, as a
-  !> fraction of its motion
-  !> (max |e_new - e_n| of the predicted state), whatever newton_tol x L allows: the error
+  !> fraction of its motion (max |e_new - e_n| of the predicted state; converged), whatever
+  !> newton_tol x L allows: the error
   !> delta e left in e_{n+1} moves e'_{n+1} by gamma / (beta h) delta e and e''_{n+1} by
   !> beta' delta e, a relative change of about 2 delta e / |e_{n+1} - e_n| in the velocity,
   !> and the predictor extrapolates both into the next step. newton_tol x L alone allowed
