@@ -29,8 +29,9 @@
 !> * jacobian_iteration: at every iterate (full Newton);
 !> * jacobian_reuse (modified Newton across steps): kept from step to step while Newton
 !>   contracts; refreshed at the current iterate when a correction is not below
-!>   `contraction` times the previous one (from the step's third correction on:
-!>   min(contraction, settled_contraction) times it), when the number of active contact points
+!>   `contraction` times the previous one of the same matrix (from the step's third
+!>   correction on: min(contraction, settled_contraction) times it), when the number of
+!>   active contact points
 !>   differs from the factorization's, when beta' changed; a step that fails with a
 !>   matrix from an earlier step is retried once from its start with a fresh one. Where the
 !>   matrix of an earlier step does not serve (two steps in a row that started with it had
