@@ -95,6 +95,8 @@ BENCHES = [
           needs="exudyn"),
     Bench("before_after", "", gate="compares two ancfdrv versions (--before/--after)"),
     Bench("history_gate", "", gate="compares the histories of two builds bitwise"),
+    Bench("newton_tolerance", "", gate="compares two ancfdrv versions' Newton control at "
+          "large steps and loose tolerances (--before/--after)"),
     Bench("h5_compare", "", gate="compares two directories of result files"),
     Bench("static_kernel_gate", "", gate="compares the kernel's static Newton with the "
           "Python reference"),

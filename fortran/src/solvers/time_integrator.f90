@@ -29,8 +29,9 @@
 !> * jacobian_iteration: at every iterate (full Newton);
 !> * jacobian_reuse (modified Newton across steps): kept from step to step while Newton
 !>   contracts; refreshed at the current iterate when a correction is not below
-!>   `contraction` times the previous one (from the step's third correction on:
-!>   min(contraction, settled_contraction) times it), when the number of active contact points
+!>   `contraction` times the previous one of the same matrix (from the step's third
+!>   correction on: min(contraction, settled_contraction) times it), when the number of
+!>   active contact points
 !>   differs from the factorization's, when beta' changed; a step that fails with a
 !>   matrix from an earlier step is retried once from its start with a fresh one. Where the
 !>   matrix of an earlier step does not serve (two steps in a row that started with it had
@@ -94,6 +95,21 @@ module time_integrator
   !> the round-off floor of a correction, in ulps of the largest coordinate (or the length
   !> scale): a correction there is the solve of a residual that is round-off noise
   real(dp), parameter :: floor_ulps = 1000.0_dp
+  !> the largest error a refactorized system's step without contact may keep, as a
+  !> fraction of its motion (max |e_new - e_n| of the predicted state; converged), whatever
+  !> newton_tol x L allows: the error
+  !> delta e left in e_{n+1} moves e'_{n+1} by gamma / (beta h) delta e and e''_{n+1} by
+  !> beta' delta e, a relative change of about 2 delta e / |e_{n+1} - e_n| in the velocity,
+  !> and the predictor extrapolates both into the next step. newton_tol x L alone allowed
+  !> 0.8 mm per step on the 7.8 m luffing boom at newton_tol = 1e-4, as much as the boom
+  !> moves in a step: the nonlinear cubic boom (10 nodes, dt 1e-3) failed at t = 6.2 s, the
+  !> 4-node one at 0.8 s; at 0.046 of the motion (first corrections accepted below
+  !> newton_tol^(1/3) of it at 1e-4) the 4-node boom's energy grew without bound. At
+  !> newton_tol = 1e-10 the fraction binds only below 100 tol L of motion per step (a
+  !> start from rest). Contact steps start from q + h v, without the accelerations'
+  !> extrapolation (the leaf spring runs at newton_tol = 1e-4 without it), and their
+  !> nearly static steps would pay up to 70 % more corrections for it.
+  real(dp), parameter :: motion_fraction = 1e-2_dp
   !> the smallest newton_tol that double precision resolves: a stall at the floor with a
   !> tolerance at least this is converged (counted); below it the tolerance cannot be met
   real(dp), parameter :: resolvable_tol = 100.0_dp * epsilon(1.0_dp)
@@ -315,6 +331,7 @@ contains
     real(dp) :: rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
     real(dp) :: powers_new(power_count), strain
     real(dp) :: contact_potential, beta_prime, velocity_factor, step_drive_work
+    real(dp) :: motion  ! max |e_new - e| of the step's predicted state
     integer :: step, attempt, stats(stat_count), i
     logical :: done, fresh_matrix, start_fresh, started_old
     logical :: constraints_checked  ! scratch's phi and gradients are those of the new state
@@ -360,9 +377,17 @@ contains
           started_old = sys%matrix%policy /= policy_constant
         end if
         call carry_step(sys, cfg, learned, fresh_matrix, e_new)
+        ! (the step's motion: the scale of converged's test; the constant policy's
+        ! linear steps and contact do not read it)
+        motion = 0.0_dp
+        if (sys%matrix%policy /= policy_constant .and. sys%contact%npoint == 0) then
+          do i = 1, sys%ndof
+            motion = max(motion, abs(e_new(i) - e(i)))
+          end do
+        end if
         call newton(sys, cfg, learned, t + h, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, scratch, info, detail, &
+                    motion, stats, done, last_correction, monitor, scratch, info, detail, &
                     constraints_checked)
         if (info /= 0) return
         ! a step that started with a matrix of an earlier step and failed (even if it
@@ -530,7 +555,7 @@ contains
   !> last correction met the tolerance.
   subroutine newton(sys, cfg, learned, t_new, rotations, rates, beta_prime, velocity_factor, &
                     e_new, v_new, accel_new, lam_new, state, predicted_internal, fresh_matrix, &
-                    stats, done, last_correction, monitor, work, info, detail, &
+                    motion, stats, done, last_correction, monitor, work, info, detail, &
                     constraints_checked)
     type(system_model), intent(inout) :: sys
     type(stepper_settings), intent(in) :: cfg
@@ -540,6 +565,7 @@ contains
     type(contact_state), intent(inout) :: state
     real(dp), intent(inout) :: predicted_internal(:)
     logical, intent(in) :: fresh_matrix
+    real(dp), intent(in) :: motion  ! max |e_new - e_n| of the predicted state
     integer, intent(inout) :: stats(stat_count)
     logical, intent(out) :: done
     real(dp), intent(inout) :: last_correction
@@ -669,7 +695,7 @@ contains
       end if
       last_correction = largest_correction
       if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta, &
-                    it - 1 > refreshed_at, measured)) then
+                    it - 1 > refreshed_at, measured, motion)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -714,6 +740,11 @@ contains
         else
           refresh = last_correction > cfg%contraction * previous_correction
         end if
+        ! (a ratio measures a matrix only when both its corrections came from it: the
+        ! first correction after a refresh, against the old matrix's last, measured what the
+        ! old one left, and refreshed again: the 9-node cable pendulum at dt 5e-3, 243 ->
+        ! 194 factorizations, 1089 -> 1111 corrections)
+        refresh = refresh .and. it - 1 > refreshed_at
       case default
         ! a step whose tangent no longer halves the correction (a strongly nonlinear step):
         ! update it at the current iterate
@@ -1082,9 +1113,14 @@ contains
   end subroutine stagnated
 
   !> Whether the Newton iteration of a step has converged after correction it of size
-  !> last (the one before: previous). jacobian_step and _iteration: last <= tol L. The
+  !> last (the one before: previous). The limit is tol L, without contact at most
+  !> motion_fraction of the step's motion (max |e_new - e_n| of its predicted state; never
+  !> below ten times the round-off floor): an error of tol L is as large as a step's whole
+  !> motion at a loose tolerance (1e-4 on the 7.8 m boom), and it enters the velocity and
+  !> the acceleration scaled by gamma / (beta h) and beta'. jacobian_step and _iteration:
+  !> last <= limit. The
   !> simplified Newton of the policy constant and of jacobian_reuse (Hairer & Wanner's
-  !> criterion): theta / (1 - theta) last <= tol L, the error left after the correction,
+  !> criterion): theta / (1 - theta) last <= limit, the error left after the correction,
   !> with the contraction theta = last / previous from the second correction on. With the
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
@@ -1097,7 +1133,7 @@ contains
   !> on (both corrections of a ratio made with the current factorization: same_matrix), one
   !> per measuring step (its largest), over the last contraction_memory measuring steps
   !> since the factorization (learned%matrix_ratios), when
-  !>   theta / (1 - theta) last <= tol L,  theta = max(last / previous, min(0.5, 2 theta_b)):
+  !>   theta / (1 - theta) last <= limit,  theta = max(last / previous, min(0.5, 2 theta_b)):
   !> twice the bound, never below the step's own first ratio; and only while the
   !> contraction is steady: at least steady_count measurements, the largest within
   !> steady_spread times the smallest (the 5-node cable pendulum: spreads 1.2-8, median 2,
@@ -1113,7 +1149,7 @@ contains
   !> the stagnation and divergence tests (stagnated) run on every correction not accepted.
   !> measured: this step has its entry in the bound's ring.
   logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix, &
-                             measured) result(ok)
+                             measured, motion) result(ok)
     type(system_model), intent(in) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -1122,6 +1158,7 @@ contains
     real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
     logical, intent(in) :: same_matrix     ! last and previous came from the same matrix
     logical, intent(inout) :: measured
+    real(dp), intent(in) :: motion  ! max |e_new - e_n| of the step's predicted state
     integer, parameter :: confirm_every = 20
     ! a steady contraction: at least steady_count measurements, the largest within
     ! steady_spread times the smallest
@@ -1130,6 +1167,11 @@ contains
     real(dp) :: limit, theta, bound
     integer :: slot, known  ! the ring's entry of this step; the entries measured
     limit = cfg%tol * cfg%length_scale
+    ! (refactorized systems without contact: also a fraction of the step's motion, never
+    ! below ten times the round-off floor, where a system at rest ends its steps)
+    if (sys%matrix%policy /= policy_constant .and. sys%contact%npoint == 0) &
+      limit = min(limit, max(motion_fraction * motion, &
+                             10.0_dp * floor_ulps * epsilon(1.0_dp) * cfg%length_scale))
     ok = last <= limit
     if (sys%matrix%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
     if (it == 1) then

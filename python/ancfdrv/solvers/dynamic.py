@@ -318,7 +318,7 @@ class TimeIntegrator:
                     f"{halvings}); the run stops")
         if info == CONTROL_TOLERANCE:
             allowed = s.tolerance * s.length_scale
-            return (f"time step from t = {t:.6g} s to t = {t + h:.6g} s: its local error "
+            return (f"time step {_interval(t, h)}: its local error "
                     f"estimate exceeds solver.tolerance x length = {allowed:.3g} m even at "
                     f"the smallest step, solver.dt_min = {s.smallest_step:.3g} s: the "
                     "tolerance cannot be met; raise solver.tolerance or lower solver.dt_min")
@@ -341,7 +341,19 @@ class TimeIntegrator:
             reason += (f"; the step was cut {cuts} times, the last from {2 * h:.3g} s to "
                        f"{h:.3g} s, and solver.dt_min = {s.smallest_step:.3g} s allows no "
                        "smaller one")
-        return f"time step from t = {t:.6g} s to t = {t + h:.6g} s failed: {reason}"
+        return f"time step {_interval(t, h)} failed: {reason}"
+
+
+def _interval(t: float, h: float) -> str:
+    """'from t = A s to t = B s' for the step of size ``h`` from ``t``, A and B with six
+    significant digits or as many more as they need to differ (six alone printed a step of
+    9.77e-07 s at t = 6.207 s as 'from t = 6.207 s to t = 6.207 s'), and the step's size
+    when six did not tell it."""
+    digits = 6
+    while digits < 17 and f"{t:.{digits}g}" == f"{t + h:.{digits}g}":
+        digits += 1
+    text = f"from t = {t:.{digits}g} s to t = {t + h:.{digits}g} s"
+    return text if digits == 6 else f"{text} (a step of {h:.3g} s)"
 
 
 def _row_fields(cols: np.ndarray, cuts: tuple, nprobe: int, npoint: int) -> dict:
