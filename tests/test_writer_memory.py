@@ -48,3 +48,29 @@ def test_waiting_rows_hold_no_coordinates(tmp_path, monkeypatch):
     run_scene(ROOT / "inputs/hard/pendulum.nml", OVERRIDES, tmp_path / "r.h5", progress=False)
     assert seen and all(q is None for q, _ in seen)
     assert all(last is not None and last.ndim == 1 for _, last in seen)
+
+
+def test_run_holds_only_the_last_kernel_row_buffer(tmp_path, monkeypatch):
+    """Every kernel call returns a fresh row buffer (mostly q); once its chunk went to the
+    sinks and the energy watch, nothing may keep it (a view of its time column waiting in
+    EnergyWatch kept a whole run's buffers, 16 MB at 2052 unknowns): when a call starts,
+    at most the previous call's buffer is alive. One step per call: 100 calls."""
+    import weakref
+
+    from ancfdrv import kernel
+    from ancfdrv.solvers import dynamic
+
+    monkeypatch.setattr(dynamic, "ROW_BUFFER_BYTES", 8)   # call_rows: one row per call
+    buffers: list[weakref.ref] = []
+    alive: list[int] = []
+    original = kernel.KernelSystem.advance_rows
+
+    def advance_rows(self, *args, **kwargs):
+        alive.append(sum(ref() is not None for ref in buffers))
+        result = original(self, *args, **kwargs)
+        buffers.append(weakref.ref(result[0]))
+        return result
+
+    monkeypatch.setattr(kernel.KernelSystem, "advance_rows", advance_rows)
+    run_scene(ROOT / "inputs/hard/pendulum.nml", OVERRIDES, tmp_path / "r.h5", progress=False)
+    assert len(alive) == 100 and max(alive) == 1
