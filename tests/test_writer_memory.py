@@ -1,7 +1,10 @@
-"""The dynamic writer keeps no coordinates of every step while rows wait for the next flush
-unless /dynamic/q is written (results/hdf5.py DynamicWriter._thinned, issue 23: a run's
-peak memory): the XDMF frames' points are computed when a chunk arrives and only the last
-row's q is kept. The file is the same as when the frames come from q at every step."""
+"""A dynamic run's peak memory (issues 23 and 38), structurally: the dynamic writer keeps no
+coordinates of every step while rows wait for the next flush unless /dynamic/q is written
+(results/hdf5.py DynamicWriter._thinned): the XDMF frames' points are computed when a chunk
+arrives and only the last row's q is kept, and the file is the same as when the frames
+come from q at every step; nothing keeps a kernel call's row buffer after its chunk went
+on; the cables' tension is formed a bounded block of rows at a time, with the values of
+one block; a cable run loads neither numpy.polynomial nor LAPACK's workspace."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -74,3 +77,58 @@ def test_run_holds_only_the_last_kernel_row_buffer(tmp_path, monkeypatch):
     monkeypatch.setattr(kernel.KernelSystem, "advance_rows", advance_rows)
     run_scene(ROOT / "inputs/hard/pendulum.nml", OVERRIDES, tmp_path / "r.h5", progress=False)
     assert len(alive) == 100 and max(alive) == 1
+
+
+def test_tension_blocks_are_bounded_and_bitwise_one_block(tmp_path, monkeypatch):
+    """DynamicAnswers forms the cables' tension from blocks of at most TENSION_BLOCK_BYTES
+    of full coordinates; the file is byte for byte that of blocks of a single row and of
+    one block per chunk (each row's values are its own)."""
+    from ancfdrv.system import answers
+    from ancfdrv.system.kinds.cable import Cable
+
+    sizes: list[int] = []
+    original = Cable.axial_forces
+
+    def axial_forces(self, e):
+        sizes.append(np.asarray(e).nbytes)
+        return original(self, e)
+
+    monkeypatch.setattr(Cable, "axial_forces", axial_forces)
+    scene = ROOT / "inputs/hard/cantilever_drop.nml"
+    overrides = ["beam.nodes=9", "solver.t_end=0.05"]
+    files = {}
+    for block in (8, answers.DynamicAnswers.TENSION_BLOCK_BYTES, 1 << 30):
+        monkeypatch.setattr(answers.DynamicAnswers, "TENSION_BLOCK_BYTES", block)
+        sizes.clear()
+        files[block] = tmp_path / f"{block}.h5"
+        run_scene(scene, overrides, files[block], progress=False)
+        # 9 nodes x 6 full coordinates a row: a block of at most max(1, block // 432) rows
+        assert sizes and max(sizes) <= max(block, 8 * 54)
+    with h5py.File(files[8], "r") as a:
+        assert a["dynamic/tension/beam/max"].shape == (51,)
+        for other in files.values():
+            with h5py.File(other, "r") as b:
+                for name in ("dynamic/tension/beam/min", "dynamic/tension/beam/max",
+                             "dynamic/time", "dynamic/probes/tip"):
+                    assert a[name][()].tobytes() == b[name][()].tobytes(), name
+
+
+def test_cable_gauss_points_and_no_eigenvalue_solver():
+    """The cable's 5 Gauss points in closed form are Gauss-Legendre's (numpy's leggauss,
+    an eigenvalue solve, to round-off), and a cable run loads no numpy.polynomial (whose
+    leggauss started LAPACK's workspace: 2.4 MB of the run's peak)."""
+    import subprocess
+    import sys
+
+    from ancfdrv.system.kinds.cable import GAUSS5_POINTS
+
+    points, _ = np.polynomial.legendre.leggauss(5)
+    assert np.allclose(GAUSS5_POINTS, points, rtol=0.0, atol=4e-16)
+    code = ("import sys; from ancfdrv import simulate; "
+            f"simulate({str(ROOT / 'inputs/hard/cantilever_drop.nml')!r}, "
+            "['beam.nodes=5', 'solver.t_end=0.01']); "
+            "print('numpy.polynomial' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split()[-1] == "False"

@@ -20,6 +20,8 @@ Newton matrix regular and may be 0 in dynamics, where the mass does that).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ... import kernel
@@ -34,6 +36,13 @@ from ..sections import Rectangle, Section, section_of
 CABLE_NODE_DOFS = 6
 #: offsets of the nodal vectors within a node's coordinates
 CABLE_OFFSETS = {"r": 0, "r_x": 3}
+#: the 5-point Gauss-Legendre points on [-1, 1] in closed form, +-sqrt(5 -+ 2 sqrt(10/7)) / 3
+#: and 0 (bitwise numpy's leggauss(5), which solves an eigenvalue problem: its first call
+#: in a run loaded numpy.polynomial and LAPACK's workspace, 2.4 MB of a run's peak)
+GAUSS5_POINTS = np.array([-math.sqrt(5.0 + 2.0 * math.sqrt(10.0 / 7.0)) / 3.0,
+                          -math.sqrt(5.0 - 2.0 * math.sqrt(10.0 / 7.0)) / 3.0, 0.0,
+                          math.sqrt(5.0 - 2.0 * math.sqrt(10.0 / 7.0)) / 3.0,
+                          math.sqrt(5.0 + 2.0 * math.sqrt(10.0 / 7.0)) / 3.0])
 
 
 class Cable(Body):
@@ -131,13 +140,23 @@ class Cable(Body):
         e = np.asarray(e, dtype=float)
         q = e[..., self.element_dofs()]                            # (..., 12, nel)
         q = np.moveaxis(q.reshape(*q.shape[:-2], 4, 3, self.nel), -1, -3)  # (..., nel, 4, 3)
-        xg, _ = np.polynomial.legendre.leggauss(5)
         out = np.empty((*q.shape[:-2], 5))
-        for k, x in enumerate(0.5 * (xg + 1.0)):
-            slopes = np.array([kernel.cable_shape(x, length)[1] for length in self.lengths])
+        for k, slopes in enumerate(self._gauss_slopes()):
             a = np.einsum("ij,...ijk->...ik", slopes, q)               # r' (..., nel, 3)
             out[..., k] = 0.5 * (np.einsum("...k,...k->...", a, a) - 1.0)
         return out
+
+    _slopes: list[np.ndarray] | None = None
+
+    def _gauss_slopes(self) -> list[np.ndarray]:
+        """Per Gauss point of :meth:`strains`, the shape functions' slopes (nel, 4) of every
+        element (kernel.cable_shape: nel calls each), made on the first call: a dynamic
+        run's tension is formed in blocks of rows (answers.DynamicAnswers)."""
+        if self._slopes is None:
+            self._slopes = [np.array([kernel.cable_shape(x, length)[1]
+                                      for length in self.lengths])
+                            for x in 0.5 * (GAUSS5_POINTS + 1.0)]
+        return self._slopes
 
     def axial_forces(self, e) -> np.ndarray:
         """The axial force (N, tension positive) at the Gauss points of :meth:`strains`:
