@@ -132,3 +132,34 @@ def test_cable_gauss_points_and_no_eigenvalue_solver():
                           timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split()[-1] == "False"
+
+
+def test_flush_writes_frames_in_bounded_groups(tmp_path, monkeypatch):
+    """A flush writes the waiting chunks' XDMF frames a group of at most FRAME_GROUP_BYTES
+    of points at a time (not all joined, with their displacements: three copies of them),
+    and the file is the one of a single group."""
+    from ancfdrv.results import hdf5
+    from ancfdrv.solvers import dynamic
+
+    monkeypatch.setattr(dynamic, "ROW_BUFFER_BYTES", 8)   # one row per chunk
+    monkeypatch.setattr(hdf5, "FLUSH_SECONDS", 1e9)   # one flush, at the end
+    written: list[int] = []
+    original = hdf5.DynamicWriter._write_frames
+
+    def write_frames(self, group, rows, nodes):
+        written.append(len(nodes))
+        return original(self, group, rows, nodes)
+
+    monkeypatch.setattr(hdf5.DynamicWriter, "_write_frames", write_frames)
+    files = []
+    for limit in (1, 1 << 30):
+        monkeypatch.setattr(hdf5, "FRAME_GROUP_BYTES", limit)
+        written.clear()
+        files.append(tmp_path / f"{limit}.h5")
+        run_scene(ROOT / "inputs/hard/pendulum.nml", OVERRIDES, files[-1], progress=False)
+        # the run's 7 frames, all written by its one flush
+        assert sum(written) == 7
+        assert max(written) == (1 if limit == 1 else 7)
+    with h5py.File(files[0], "r") as a, h5py.File(files[1], "r") as b:
+        for name in ("mesh_rows", "mesh_nodes", "mesh_displacement", "time", "q_last"):
+            assert a[f"dynamic/{name}"][()].tobytes() == b[f"dynamic/{name}"][()].tobytes()
