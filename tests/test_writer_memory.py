@@ -163,3 +163,36 @@ def test_flush_writes_frames_in_bounded_groups(tmp_path, monkeypatch):
     with h5py.File(files[0], "r") as a, h5py.File(files[1], "r") as b:
         for name in ("mesh_rows", "mesh_nodes", "mesh_displacement", "time", "q_last"):
             assert a[f"dynamic/{name}"][()].tobytes() == b[f"dynamic/{name}"][()].tobytes()
+
+
+def test_views_are_made_a_bounded_batch_per_opening(tmp_path, monkeypatch):
+    """A flush makes the XDMF views (virtual datasets, one per frame) at most
+    VIEWS_PER_OPENING in each opening of the file (HDF5 holds each view's memory until the
+    file closes): the pendulum's 7 frames as views, 3 an opening, in 3 openings; every view
+    reads its frame's row of /dynamic/mesh_displacement (and position/0 the first frame's
+    points)."""
+    from ancfdrv.results import hdf5, xdmf
+
+    monkeypatch.setattr(xdmf, "INLINE_VALUES", 0)     # views even for 7 small frames
+    monkeypatch.setattr(hdf5, "FLUSH_SECONDS", 1e9)   # one flush, at the end
+    monkeypatch.setattr(hdf5, "VIEWS_PER_OPENING", 3)
+    batches: list[tuple[int, int, object]] = []
+    original = xdmf.add_step_views
+
+    def add_step_views(h5, first, stop, **options):
+        batches.append((first, stop, h5))
+        return original(h5, first, stop, **options)
+
+    monkeypatch.setattr(xdmf, "add_step_views", add_step_views)
+    out = tmp_path / "views.h5"
+    run_scene(ROOT / "inputs/hard/pendulum.nml", OVERRIDES, out, progress=False)
+    made = [(first, stop) for first, stop, _ in batches if stop > first]
+    assert made[:3] == [(0, 3), (3, 6), (6, 7)]
+    openings = [h5 for first, stop, h5 in batches[:3]]
+    assert len({id(h5) for h5 in openings}) == 3 and not any(h5.id.valid for h5 in openings)
+    with h5py.File(out, "r") as h5:
+        displacement = h5["dynamic/mesh_displacement"][()]
+        assert len(h5["dynamic/xdmf/displacement"]) == len(displacement) == 7
+        for k in range(7):
+            assert np.array_equal(h5[f"dynamic/xdmf/displacement/{k}"][()], displacement[k])
+        assert np.array_equal(h5["dynamic/xdmf/position/0"][()], h5["dynamic/mesh_nodes"][0])
