@@ -208,7 +208,7 @@ def beam_arrays(kernel: Any, nel: int, poisson: float) -> dict[str, Any]:
     e[:, 6:9] = np.column_stack([-np.sin(angle) + 0.01, np.cos(angle), 0.0 * s])
     e[:, 9:12] = [0.0, 0.0, 1.0]
     return {"npts": int(continuum.weights.shape[0]), "nvolume": continuum.nvolume,
-            "ndof": models["nonlinear"].ndof, "cubic": cubic.cubic, "models": models,
+            "ndof": models["nonlinear"].ndof, "cubic": cubic.cubic.tables(), "models": models,
             "dofs": np.asfortranarray(continuum.dofs + 1, dtype=np.int32),
             "e": np.asfortranarray(e.ravel()), "reference": ffr.reference,
             "gradients": continuum.gradients, "weights": continuum.weights,
@@ -239,9 +239,9 @@ def measure_mesh(kernel: Any, nel: int, poisson: float, min_time: float,
         "nonlinear_force": nonlinear(0),
         "nonlinear_force_tangent": nonlinear(1),
         "cubic_force": lambda: kernel.beam_cubic_forces(
-            a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 0),
+            a["dofs"], a["e"], *a["cubic"], 0),
         "cubic_force_tangent": lambda: kernel.beam_cubic_forces(
-            a["dofs"], a["e"], a["cubic"].forms, a["cubic"].strain0, a["cubic"].stiffness, 1),
+            a["dofs"], a["e"], *a["cubic"], 1),
         "ffr_force": lambda: kernel.ffr_elastic_force(a["dofs"], a["stiffness0"],
                                                       a["reference"], a["rotation"], a["e"]),
         "ffr_stiffness": lambda: kernel.ffr_element_stiffness(a["stiffness0"], a["rotation"]),

@@ -121,6 +121,14 @@ def test_peer_cantilever_smoke(tmp_path):
             <= marks["after_solve"] == memory["peak_mb"]
     assert positive(row["ratios"]["ancfdrv/cable"])
     assert positive(row["memory_ratios"]["ancfdrv/cable"]["peak"])
+    # the like-for-like memory run (results in memory): the same model and steps
+    memory = row["memory"]["ancfdrv/cable in memory"]
+    assert memory["ok"], memory
+    assert memory["unknowns"] == 4 * 5 and memory["steps"] == 5
+    marks = memory["marks_mb"]
+    assert marks["start"] <= marks["after_imports"] <= marks["after_build"] \
+        <= marks["after_solve"] == memory["peak_mb"]
+    assert positive(row["memory_ratios"]["ancfdrv/cable in memory"]["peak"])
     # 5 steps of the drop: the tip has fallen g t^2 / 2 ~ 1.2e-4 m; the codes agree far closer
     same = row["comparison"]["cable_vs_exudyn"]
     assert 5e-5 < same["tip_y_range_m"] < 5e-4

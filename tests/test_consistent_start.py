@@ -2,8 +2,14 @@
 (``fortran/src/solvers/consistent_start.f90``: the start of a run and the step-size
 control's restarts). References: the equations of motion M a - Phi_e^T lambda = f and the
 constraints' acceleration equation Phi_e a = gamma, evaluated in Python from the model's
-forces, constraint gradients and mass matrix."""
+forces, constraint gradients and mass matrix. A model whose iteration matrix the banded
+solver factorizes solves it by that solver too (M banded, the multipliers by their Schur
+complement); any other by MUMPS on the saddle system: the cases cover both."""
 from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,7 +25,11 @@ CASES = [
     ("hard/spinup.nml", []),
     ("boom_luffing.nml", ["beam.nodes=4"]),
     ("general/cardan_shaft.nml", []),
+    ("general/boom_mounts.nml", []),       # MUMPS (its force elements), no constraints
+    ("knuckle_crane_rope.nml", []),        # MUMPS, 23 constraints
 ]
+#: the cases whose iteration matrix is banded (the rest: MUMPS)
+BANDED = 5
 
 
 def _residuals(model, e, v, t, a, lam):
@@ -47,6 +57,7 @@ def test_consistent_acceleration_meets_the_equations_of_motion(scene, overrides)
     (a, lambda) satisfy both equations to round-off of their terms."""
     model = build_model(load_scene(INPUTS / scene, overrides=overrides))
     try:
+        assert model.banded() == (CASES.index((scene, overrides)) < BANDED)
         rng = np.random.default_rng(7)
         states = [(model.e0, np.zeros(model.ndof), 0.0),
                   (model.e0 + 1e-4 * rng.standard_normal(model.ndof),
@@ -58,3 +69,55 @@ def test_consistent_acceleration_meets_the_equations_of_motion(scene, overrides)
             assert motion <= 1e-13 * motion_scale and acceleration <= 1e-13 * scale
     finally:
         model.close()
+
+
+MUMPS_PAGES = """
+import sys
+import numpy as np
+from ancfdrv import kernel
+from ancfdrv.builders import build_model
+from ancfdrv.io.scene import load_scene
+from ancfdrv.solvers import dynamic
+
+
+def mumps_kb():
+    \"\"\"Resident kB of the MUMPS libraries' mappings (/proc/self/smaps).\"\"\"
+    total, inside = 0, False
+    with open('/proc/self/smaps') as smaps:
+        for line in smaps:
+            words = line.split()
+            if words and '-' in words[0] and len(words) >= 5:
+                inside = len(words) >= 6 and 'mumps' in words[-1]
+            elif inside and words[0] == 'Rss:':
+                total += int(words[1])
+    return total
+
+
+model = build_model(load_scene(sys.argv[1], overrides=['beam.nodes=9', 'beam.bending=cable',
+                                                         'scene.planar=xy']))
+assert model.banded()
+before = mumps_kb()
+dynamic.initial_acceleration(model, model.e0, np.zeros(model.ndof), 0.0)
+banded = mumps_kb() - before
+with kernel.DirectSolver(2, np.array([0, 1]), np.array([0, 1])) as solver:
+    solver.factorize(np.array([2.0, 4.0]))
+    solver.solve(np.ones(2))
+print(before, banded, mumps_kb() - before - banded)
+"""
+
+
+@pytest.mark.skipif(not Path("/proc/self/smaps").exists(), reason="needs Linux's /proc")
+def test_a_banded_model_never_runs_mumps():
+    """The consistent acceleration of a banded model (the cantilever, 8 cable elements)
+    in a fresh interpreter leaves the MUMPS libraries' resident pages as they were (MUMPS's
+    code pages were ~2 MB of a small run's peak); one MUMPS solve afterwards in the same
+    process adds hundreds of kB of them (the measure sees MUMPS run)."""
+    done = subprocess.run([sys.executable, "-c", MUMPS_PAGES,
+                           str(INPUTS / "hard" / "cantilever_drop.nml")],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    mapped, banded, mumps = (int(word) for word in done.stdout.split())
+    if not mapped:
+        pytest.skip("MUMPS is linked statically (no mapping of its own)")
+    assert banded == 0
+    assert mumps >= 256

@@ -174,34 +174,51 @@ class CubicBeam:
     """Strain forms, reference strains and stiffnesses of the 'cubic' bending option
     (beam_cubic.cubic_setup) for a mesh with reference nodal vectors (3, 8, nel);
     ``torsion`` the Saint-Venant constant J (default: the polar moment) and
-    ``shear_factors`` (k_y, k_z) (default 1)."""
+    ``shear_factors`` (k_y, k_z) (default 1). The tables are made (and the geometry checked)
+    at construction and kept until :meth:`release`, after which :meth:`tables` makes them
+    anew: a model's set hands them to its kernel system, which keeps its own copy (the forms
+    are 10.8 kB an element), and releases them."""
 
     def __init__(self, reference, lengths, section: SectionData, youngs, poisson,
                  torsion: float | None = None, shear_factors=(1.0, 1.0)) -> None:
-        nterms = int(_kernel.beam_cubic_size())
         torsion = section.polar if torsion is None else torsion
-        (self.forms, self.strain0, self.stiffness,
-         info) = _kernel.beam_cubic_setup(
-             nterms, _f(reference), _f(lengths),
-             _pack("cs", area=section.area, inertia_y=section.inertia_y,
-                   inertia_z=section.inertia_z, torsion=torsion, shear_y=shear_factors[0],
-                   shear_z=shear_factors[1], youngs=youngs, poisson=poisson))
+        self._arguments = (_f(reference), _f(lengths),
+                           _pack("cs", area=section.area, inertia_y=section.inertia_y,
+                                 inertia_z=section.inertia_z, torsion=torsion,
+                                 shear_y=shear_factors[0], shear_z=shear_factors[1],
+                                 youngs=youngs, poisson=poisson))
+        self._tables: tuple[np.ndarray, np.ndarray, np.ndarray] | None = self._setup()
+
+    def _setup(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        forms, strain0, stiffness, info = _kernel.beam_cubic_setup(
+            int(_kernel.beam_cubic_size()), *self._arguments)
         if info:
             element, code = divmod(info, 10)
             reason = {1: "unsupported quadrature",
                       2: "degenerate reference geometry (r0_x vanishes)"}
             raise InputError(f"beam element {element}: {reason.get(code, f'code {code}')}")
+        return forms, strain0, stiffness
+
+    def tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(forms (8, 8, nterms, nel), reference strains and term stiffnesses (nterms, nel))."""
+        return self._setup() if self._tables is None else self._tables
+
+    def release(self) -> None:
+        """Forget the kept tables (:meth:`tables` makes them anew when asked)."""
+        self._tables = None
 
     def forces(self, dofs, e, want_tangent: bool):
         """Elastic force, strain energy and element tangents (24, 24, nel) at e."""
-        return _kernel.beam_cubic_forces(_f(dofs + 1, np.int32), _f(e), self.forms,
-                                         self.strain0, self.stiffness, int(want_tangent))
+        forms, strain0, stiffness = self.tables()
+        return _kernel.beam_cubic_forces(_f(dofs + 1, np.int32), _f(e), forms, strain0,
+                                         stiffness, int(want_tangent))
 
     def stress_stiffness(self, dofs, e, de) -> np.ndarray:
         """The initial-stress part of the element tangents (24, 24, nel) at e, each strain
         replaced by its increment for the coordinate increment de: sum k (C e . de) C x I3."""
+        forms, _, stiffness = self.tables()
         return _kernel.beam_cubic_stress_stiffness(_f(dofs + 1, np.int32), _f(e), _f(de),
-                                                   self.forms, self.stiffness)
+                                                   forms, stiffness)
 
 
 def cable_element_arrays(lengths, mass_per_length: float, load) -> tuple[np.ndarray, np.ndarray]:

@@ -256,7 +256,7 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, append_set
   use element_sets, only: element_set
-  use beam_cubic, only: cubic_set, cubic_pattern, cubic_terms
+  use beam_cubic, only: cubic_set, cubic_pattern, cubic_terms, cubic_set_with_forms
   use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nel, nterms, dofs(24, nel), scatter(24, 24, nel), frame
@@ -282,7 +282,6 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   built%frame = frame
   built%dofs = dofs
   built%scatter = scatter
-  built%forms = forms
   built%strain0 = strain0
   built%term_stiffness = stiffness
   allocate (built%form_pairs(2, 64, nterms), built%form_npairs(nterms))
@@ -290,7 +289,7 @@ subroutine system_add_cubic_set(handle, nel, nterms, dofs, scatter, forms, strai
   built%damping_time = damping_time
   built%force_cost = 1.2d0
   built%tangent_cost = 3.0d0
-  allocate (set, source=built)
+  call cubic_set_with_forms(built, forms, set)
   call append_set(sys, set, index)
 end subroutine system_add_cubic_set
 

@@ -34,11 +34,12 @@
 module beam_cubic
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use element_sets, only: local_element_set
+  use element_sets, only: element_set, local_element_set
   use beam_stations, only: centreline_rows, station_section, set_station_forces
   implicit none
   private
-  public :: cubic_setup, cubic_element, cubic_stress_stiffness, cubic_pattern, cubic_set
+  public :: cubic_setup, cubic_element, cubic_stress_stiffness, cubic_pattern, cubic_set, &
+            cubic_set_with_forms
 
   !> Axial points of the axial and bending strains, of the torsion.
   integer, parameter :: n_line = 3, n_axial = 3, n_torsion = 2
@@ -155,6 +156,20 @@ contains
       strain0(t) = 0.5_dp * sum(reference * matmul(reference, forms(:, :, t)))
     end do
   end subroutine cubic_setup
+
+  !> A system's set: built (everything but its forms) as a polymorphic element set with the
+  !> forms (10.8 kB an element) copied into it once (allocate's source= would copy forms held
+  !> by built a second time).
+  subroutine cubic_set_with_forms(built, forms, set)
+    type(cubic_set), intent(in) :: built
+    real(dp), intent(in) :: forms(:, :, :, :)
+    class(element_set), allocatable, intent(out) :: set
+    allocate (set, source=built)
+    select type (set)
+    type is (cubic_set)
+      set%forms = forms
+    end select
+  end subroutine cubic_set_with_forms
 
   !> The nonzero entries (a, b) of each term's form in any element of a set (forms (8, 8,
   !> cubic_terms, nel)): a term couples few of the eight nodal vectors (an axial

@@ -16,7 +16,8 @@ module sparse_direct
   private
   include 'mpif.h'
   include 'dmumps_struc.h'
-  public :: solver_create, solver_analyse, solver_factorize, solver_solve, solver_destroy
+  public :: solver_create, solver_analyse, solver_factorize, solver_solve, solver_destroy, &
+            solver_banded
 
   !> symmetry code that selects the banded LAPACK Cholesky
   integer, parameter, public :: banded_spd = 3
@@ -351,6 +352,14 @@ contains
     call dgbtrf(slot%n, slot%n, kd, kd, slot%general_band, 3 * kd + 1, slot%pivots, info_detail)
     if (info_detail /= 0) info = -10
   end subroutine banded_factorize
+
+  !> Whether handle is a solver of the banded kind (symmetry banded_spd): a model's other
+  !> solves go through the kind its iteration matrix uses.
+  logical function solver_banded(handle)
+    integer, intent(in) :: handle
+    solver_banded = .false.
+    if (valid(handle)) solver_banded = slots(handle)%banded
+  end function solver_banded
 
   logical function valid(handle)
     integer, intent(in) :: handle

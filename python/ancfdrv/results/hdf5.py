@@ -412,15 +412,18 @@ def _open_file(path: Path, mode: str = "a") -> h5py.File:
     """Open for writing. A reader holding HDF5's lock (``ancf info``, a viewer) delays a
     write by at most about a second; after that the writer goes on without HDF5's lock
     (the run's own lock, :mod:`ancfdrv.results.lock`, already excludes other writers), so a
-    reader never makes a run fail."""
+    reader never makes a run fail. No chunk cache (HDF5's default: up to 1 MB a dataset):
+    a writer writes each series once per opening, so the cache kept only what it was about
+    to write (the XDMF frames' chunks of 200 kB at 512 elements; 0.2-0.6 MB of the
+    cantilever's peak)."""
     for _ in range(50):
         try:
-            return h5py.File(path, mode)
+            return h5py.File(path, mode, rdcc_nbytes=0)
         except OSError as exc:
             if "lock" not in str(exc).lower():
                 raise
             time.sleep(0.02)
-    return h5py.File(path, mode, locking=False)
+    return h5py.File(path, mode, locking=False, rdcc_nbytes=0)
 
 
 #: files a run keeps open between its writes (:func:`holding`): absolute path -> the open
@@ -890,6 +893,50 @@ ROW_FIELDS = ("time", "probes", "deflections", "lam", "energy", "constraint", "s
               "contact", "step_size", "substeps", "cuts")
 
 
+#: the most XDMF views (virtual datasets) made in one opening of the file: HDF5 holds
+#: ~20 kB of memory for each view made until the file is closed (the 128-element
+#: cantilever's 201 views: 4 MB at the end of the run); each further opening costs ~1 ms
+VIEWS_PER_OPENING = 32
+
+
+def _add_views(path: Path, first: int, stop: int) -> None:
+    """The XDMF views of frames first <= k < stop (:func:`~.xdmf.add_step_views`), at most
+    VIEWS_PER_OPENING of them in each opening of the file (a held file is closed for it)."""
+    from .xdmf import add_step_views
+    with released(path):
+        for start in range(first, stop, VIEWS_PER_OPENING):
+            with _open_write(path) as h5:
+                add_step_views(h5, start, min(start + VIEWS_PER_OPENING, stop))
+
+
+#: the most bytes of XDMF frames' points a flush joins into one write (the writes of a
+#: group cost ~0.6 ms whatever its frames)
+FRAME_GROUP_BYTES = 1 << 18
+
+
+def _frame_groups(parts: list[tuple[np.ndarray, np.ndarray]], limit: int
+                  ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Consecutive frame parts (rows, points) joined into groups of at most ``limit``
+    bytes of points (a part larger than that alone), in order."""
+    group: list[tuple[np.ndarray, np.ndarray]] = []
+    size = 0
+    for part in parts:
+        if group and size + part[1].nbytes > limit:
+            yield _joined_frames(group)
+            group, size = [], 0
+        group.append(part)
+        size += part[1].nbytes
+    if group:
+        yield _joined_frames(group)
+
+
+def _joined_frames(group: list[tuple[np.ndarray, np.ndarray]]
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    if len(group) == 1:
+        return group[0]
+    return np.concatenate([g[0] for g in group]), np.concatenate([g[1] for g in group])
+
+
 def thinned_chunk(chunk, first_row: int, stride: int, last_row: int, frames: bool):
     """A chunk without q, as a writer keeps it when /dynamic/q is not stored: the
     :data:`ROW_FIELDS` copied, ``q_last`` (the last row's q) and ``q = None``; and its
@@ -1224,9 +1271,8 @@ class DynamicWriter:
             if self._unmade():
                 self._make_rest(group)
             _attrs(group.attrs, {"rows": np.int64(self.rows)})
-            if self.views:
-                from .xdmf import add_step_views
-                add_step_views(h5, first, self.frames)
+        if self.views and self.frames > first:
+            _add_views(self.path, first, self.frames)
         self._pending, self._pending_rows, self._pending_bytes = [], 0, 0
         self._last_write = time.monotonic()
 
@@ -1255,9 +1301,12 @@ class DynamicWriter:
         if any(hasattr(c, "q_last") for c in chunks):   # thinned chunks (:meth:`_thinned`)
             lasts = [c.q_last for c in chunks if getattr(c, "q_last", None) is not None]
             merged.q_last = lasts[-1] if lasts else None
-            frames = [c.frames for c in chunks if getattr(c, "frames", None) is not None]
-            merged.frames = (np.concatenate([f[0] for f in frames]),
-                             np.concatenate([f[1] for f in frames])) if frames else None
+            # the frames stay the chunks' parts, written a bounded group at a time
+            # (:meth:`_append`): joined whole, with their displacements, they were three
+            # copies of a second's frames (6 MB at the 512-element cantilever's 1539 points)
+            merged.frames = None
+            merged.frame_parts = [c.frames for c in chunks
+                                  if getattr(c, "frames", None) is not None]
         return merged
 
     def _append(self, group: h5py.Group, chunk) -> None:
@@ -1269,8 +1318,11 @@ class DynamicWriter:
             self._put(group, name, values)
         if self.store_q and getattr(chunk, "q_last", None) is not None:   # thinned
             self._put_q_last(group, chunk.q_last)
-            if chunk.frames is not None:
-                self._write_frames(group, *chunk.frames)
+            parts = getattr(chunk, "frame_parts", None)
+            if parts is None:
+                parts = [] if chunk.frames is None else [chunk.frames]
+            for rows, nodes in _frame_groups(parts, FRAME_GROUP_BYTES):
+                self._write_frames(group, rows, nodes)
         elif self.store_q and chunk.q is not None:
             if self.write_q:
                 self._put(group, "q", chunk.q)

@@ -57,6 +57,7 @@ quotes) gives valid XML; a ``:`` in the HDF5 file name cannot be expressed in XD
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -66,7 +67,7 @@ from h5py import h5a, h5d, h5p, h5s, h5t
 
 from ..csr import Csr
 from ..errors import InputError
-from ..io.safe_write import write_text
+from ..io.safe_write import replace_atomically, write_text
 from ..system.registry import kind_of
 
 _STEPS_GROUP = "dynamic/xdmf"
@@ -285,9 +286,12 @@ def _topology_xml(kind: str, ncells: int, dims: tuple[int, ...], h5_name: str,
             f'{_item(dims, h5_name, dataset, "Int")}</Topology>')
 
 
+_DOCUMENT_START = '<?xml version="1.0" encoding="utf-8"?>\n<Xdmf Version="3.0"><Domain>'
+_DOCUMENT_END = "</Domain></Xdmf>"
+
+
 def _document(grids: str) -> str:
-    return ('<?xml version="1.0" encoding="utf-8"?>\n<Xdmf Version="3.0"><Domain>'
-            f"{grids}</Domain></Xdmf>")
+    return f"{_DOCUMENT_START}{grids}{_DOCUMENT_END}"
 
 
 def add_step_views(h5: h5py.File, first: int, stop: int, *, existing: bool = False) -> None:
@@ -394,10 +398,12 @@ class Series:
         return cls(rows, times[()][rows] if nframes else np.zeros(0), stored, _topology_of(h5),
                    displacement, "dynamic/mesh_von_mises_max" in h5, values)
 
-    def xml(self, h5_name: str) -> str:
-        """The XDMF 3 text: a temporal collection of one uniform grid per frame, built as
-        text (an ElementTree of the same grids took ~0.2 ms per frame to build and write).
-        ``h5_name``: the HDF5 file's name, already checked for ``:``."""
+    def xml(self, h5_name: str) -> Iterator[str]:
+        """The XDMF 3 text in pieces, to be written one after the other: a temporal
+        collection of one uniform grid per frame, built as text (an ElementTree of the same
+        grids took ~0.2 ms per frame to build and write; the whole text joined, with its
+        copies, was ~0.6 MB of a small run's peak). ``h5_name``: the HDF5 file's name,
+        already checked for ``:``."""
         kind, dims, topology_data, ncells, npoints = self.topology
         name = _escape(h5_name)
         topology = _topology_xml(kind, ncells, dims, name, topology_data)
@@ -405,7 +411,8 @@ class Series:
         if self.stress_points:  # the run's von Mises envelope at the beam nodes (Pa)
             stress = ('<Attribute Name="von_mises_max" AttributeType="Scalar" Center="Node">'
                       f'{_item((npoints,), name, "/dynamic/mesh_von_mises_max")}</Attribute>')
-        grids = []
+        yield (f'{_DOCUMENT_START}<Grid Name="motion" GridType="Collection" '
+               'CollectionType="Temporal">')
         for k, (row, time) in enumerate(zip(self.rows, self.times)):
             motion = ""
             if self.displacement:
@@ -419,12 +426,10 @@ class Series:
                 where = _values(self.values[0])
             else:
                 where = _item((npoints, 3), name, f"/{_STEPS_GROUP}/position/0")
-            grids.append(
-                f'\n<Grid Name="step {row}" GridType="Uniform"><Time Value="{time:.17g}"/>'
-                f'{topology}<Geometry GeometryType="XYZ">{where}</Geometry>'
-                f"{motion}{stress}</Grid>")
-        return _document('<Grid Name="motion" GridType="Collection" '
-                         f'CollectionType="Temporal">{"".join(grids)}\n</Grid>')
+            yield (f'\n<Grid Name="step {row}" GridType="Uniform"><Time Value="{time:.17g}"/>'
+                   f'{topology}<Geometry GeometryType="XYZ">{where}</Geometry>'
+                   f"{motion}{stress}</Grid>")
+        yield f"\n</Grid>{_DOCUMENT_END}"
 
 
 def xdmf_target(path: Path, as_name: Path | None = None) -> Path:
@@ -440,7 +445,8 @@ def xdmf_target(path: Path, as_name: Path | None = None) -> Path:
 def write_series(series: Series, target: Path) -> Path:
     """The XDMF file of ``series`` beside ``target`` (the HDF5 file it names)."""
     out = target.with_suffix(".xdmf")
-    write_text(out, series.xml(target.name))
+    with replace_atomically(out, "w", encoding="utf-8") as fh:
+        fh.writelines(series.xml(target.name))
     return out
 
 

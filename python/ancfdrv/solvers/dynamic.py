@@ -426,8 +426,12 @@ class EnergyWatch:
     def add(self, energy: np.ndarray, time: np.ndarray) -> None:
         """A chunk's energy rows (rows, 11) at its times (rows,)."""
         # the chunk's columns copied contiguous once (they are strided views of the
-        # kernel's rows: each operation on them was a strided loop)
-        self._waiting.append((np.ascontiguousarray(energy.T), np.asarray(time, dtype=float)))
+        # kernel's rows: each operation on them was a strided loop), and the times: always
+        # copies (ascontiguousarray returns a single row's columns, asarray the times, as
+        # the views they are), since a view keeps the kernel's whole row buffer (mostly q)
+        # alive while the chunk waits: up to WAIT_ROWS rows, the 512-element cantilever's
+        # whole run (16 MB)
+        self._waiting.append((np.array(energy.T, order="C"), np.array(time, dtype=float)))
         self._waiting_rows += len(energy)
         if self._waiting_rows >= self.WAIT_ROWS:
             self.measure()

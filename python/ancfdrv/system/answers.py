@@ -1072,13 +1072,34 @@ class DynamicAnswers:
                 self.reactions[name].append((force, moment, axial))
         self._time_blocks.append(np.array(times))   # (a list of floats made on request)
         if self._axial:
-            full = e_rows if self.model.reduction is None else self.model.expand(e_rows)
-            for name, (body, law) in self._axial.items():
-                forces = law(body, full)
-                self.tension[name].append((forces.min(axis=1), forces.max(axis=1)))
+            self._record_tension(e_rows)
         for info in self.section_sets:
             self._record_sections(info.body.name, *_section_rows(
                 self.model, info, e_rows, times, self.stations), times)
+
+    #: the most bytes of full coordinates the cables' tension is formed from at once: a
+    #: chunk's rows (up to dynamic.ROW_BUFFER_BYTES of reduced rows) in blocks, since the
+    #: law's temporaries are several times its input (a cable's gathered element
+    #: coordinates twice, its strains, r' at a Gauss point: 4.5 MB of the 512-element
+    #: cantilever's peak). Each row's values are its own: the same in any block.
+    TENSION_BLOCK_BYTES = 1 << 17
+
+    def _record_tension(self, e_rows: np.ndarray) -> None:
+        """The smallest and largest axial force along every cable at each row of e_rows
+        (independent coordinates), formed a block of rows at a time."""
+        nt = len(e_rows)
+        step = max(1, self.TENSION_BLOCK_BYTES // (8 * self.model.nfull))
+        lows = {name: np.empty(nt) for name in self._axial}
+        highs = {name: np.empty(nt) for name in self._axial}
+        for first in range(0, nt, step):
+            block = e_rows[first:first + step]
+            full = block if self.model.reduction is None else self.model.expand(block)
+            for name, (body, law) in self._axial.items():
+                forces = law(body, full)
+                forces.min(axis=1, out=lows[name][first:first + step])
+                forces.max(axis=1, out=highs[name][first:first + step])
+        for name in self._axial:
+            self.tension[name].append((lows[name], highs[name]))
 
     def _record_sections(self, name: str, f: SectionForces, largest: np.ndarray,
                          times: np.ndarray) -> None:

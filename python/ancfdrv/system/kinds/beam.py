@@ -394,8 +394,8 @@ def _add_continuum(ks: kernel.KernelSystem, s: SetInfo) -> int:
 
 
 def _add_cubic(ks: kernel.KernelSystem, s: SetInfo) -> int:
-    index = ks.add_cubic_set(s.dofs, s.scatter, s.cubic.forms, s.cubic.strain0,
-                             s.cubic.stiffness, s.frame, s.damping_time)
+    index = ks.add_cubic_set(s.dofs, s.scatter, *s.cubic.tables(), s.frame, s.damping_time)
+    s.cubic.release()   # the kernel's set keeps the forms; the rare later uses remake them
     _add_sections(ks, index, s, s.body.coordinates()[s.dofs - s.body.first])
     return index
 

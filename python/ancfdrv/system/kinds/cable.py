@@ -132,13 +132,23 @@ class Cable(Body):
         e = np.asarray(e, dtype=float)
         q = e[..., self.element_dofs()]                            # (..., 12, nel)
         q = np.moveaxis(q.reshape(*q.shape[:-2], 4, 3, self.nel), -1, -3)  # (..., nel, 4, 3)
-        xg, _ = leggauss(5)
         out = np.empty((*q.shape[:-2], 5))
-        for k, x in enumerate(0.5 * (xg + 1.0)):
-            slopes = np.array([kernel.cable_shape(x, length)[1] for length in self.lengths])
+        for k, slopes in enumerate(self._gauss_slopes()):
             a = np.einsum("ij,...ijk->...ik", slopes, q)               # r' (..., nel, 3)
             out[..., k] = 0.5 * (np.einsum("...k,...k->...", a, a) - 1.0)
         return out
+
+    _slopes: list[np.ndarray] | None = None
+
+    def _gauss_slopes(self) -> list[np.ndarray]:
+        """Per Gauss point of :meth:`strains`, the shape functions' slopes (nel, 4) of every
+        element (kernel.cable_shape: nel calls each), made on the first call: a dynamic
+        run's tension is formed in blocks of rows (answers.DynamicAnswers)."""
+        if self._slopes is None:
+            self._slopes = [np.array([kernel.cable_shape(x, length)[1]
+                                      for length in self.lengths])
+                            for x in 0.5 * (leggauss(5)[0] + 1.0)]
+        return self._slopes
 
     def axial_forces(self, e) -> np.ndarray:
         """The axial force (N, tension positive) at the Gauss points of :meth:`strains`:
