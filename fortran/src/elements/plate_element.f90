@@ -39,7 +39,7 @@
 module plate_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use matrix3, only: cross, skew
+  use matrix3, only: skew
   use element_sets, only: local_element_set
   implicit none
   private
@@ -163,7 +163,7 @@ contains
     real(dp), intent(in) :: fields(3, plate_fields)
     real(dp), intent(out) :: curvatures(3)
     real(dp) :: g(3), norm3
-    g = cross(fields(:, f_x), fields(:, f_y))
+    g = point_cross(fields(:, f_x), fields(:, f_y))
     norm3 = norm2(g)**3
     curvatures = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
                   dot_product(fields(:, f_xy), g)] / norm3
@@ -195,13 +195,13 @@ contains
         curvature0(:, p) = 0.0_dp
         if (variant /= plate_variant_completed) cycle
         fields = matmul(reference, derivs(:, :, p))
-        g = cross(fields(:, f_x), fields(:, f_y))
+        g = point_cross(fields(:, f_x), fields(:, f_y))
         if (norm2(g) <= epsilon(1.0_dp) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
           info = 2
           return
         end if
         t1 = fields(:, f_x) / norm2(fields(:, f_x))
-        t2 = cross(g / norm2(g), t1)
+        t2 = point_cross(g / norm2(g), t1)
         metric = reshape([dot_product(t1, fields(:, f_x)), dot_product(t2, fields(:, f_x)), &
                           dot_product(t1, fields(:, f_y)), dot_product(t2, fields(:, f_y))], [2, 2])
         det = metric(1, 1) * metric(2, 2) - metric(1, 2) * metric(2, 1)
@@ -239,12 +239,13 @@ contains
     real(dp) :: b_strain(3, 6), g(3), gnorm, u(3), v(3), c(3), to_local(3, 3), kappa(3)
     real(dp) :: moment(3), omega(3), dcurv(3, 15), dkappa(3, 15), w_eff(3), wg, h_eff(3)
     real(dp) :: hwg(3, 3), hgg(3, 3), gu(3, 3), gv(3, 3), k(2, 2)
+    real(dp) :: du(3, 3), dv(3, 3), g_scaled(3)
     integer :: gamma, i, f
     damped = present(field_rates) .and. present(tau) .and. present(rate_factor) .and. &
              present(power)
     reference = curvature0
     if (damped) then  ! the curvatures' rates and the shifted reference curvature
-      g_now = cross(fields(:, f_x), fields(:, f_y))
+      g_now = point_cross(fields(:, f_x), fields(:, f_y))
       gnorm_now = norm2(g_now)
       c_now = [dot_product(fields(:, f_xx), g_now), dot_product(fields(:, f_yy), g_now), &
                dot_product(fields(:, f_xy), g_now)] / gnorm_now**3
@@ -285,7 +286,7 @@ contains
       end do
     end do
     ! bending: c_ab = r_ab . g / |g|^3, local kappa = K^T (c - c0) K in Voigt form
-    g = cross(u, v)
+    g = point_cross(u, v)
     gnorm = norm2(g)
     c = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
          dot_product(fields(:, f_xy), g)] / gnorm**3
@@ -300,19 +301,24 @@ contains
     moment = matmul(bending_d, kappa)
     energy = energy + 0.5_dp * dot_product(kappa, moment)
     omega = matmul(moment, to_local)        ! dW/dc
-    ! dc/dz: dc/du = v x h, dc/dv = h x u, dc/dw = g/|g|^3, h = dc/dg
-    dcurv = 0.0_dp
+    ! dc/dz: dc/du = v x h, dc/dv = h x u, dc/dw = g/|g|^3, h = dc/dg; curvature i
+    ! depends on one second derivative w_i alone, so the gradient of the w fields takes
+    ! one term each (the zero blocks of dc/dz are not added: the same sums)
+    g_scaled = g / gnorm**3
     do i = 1, 3
       h_eff = fields(:, f_xx + i - 1) / gnorm**3 &
               - 3.0_dp * dot_product(fields(:, f_xx + i - 1), g) * g / gnorm**5
-      dcurv(i, 1:3) = cross(v, h_eff)
-      dcurv(i, 4:6) = cross(h_eff, u)
-      dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g / gnorm**3
+      du(:, i) = point_cross(v, h_eff)
+      dv(:, i) = point_cross(h_eff, u)
     end do
-    do f = 1, plate_fields
-      do i = 1, 3
-        gradient(:, f) = gradient(:, f) + omega(i) * dcurv(i, 3 * f - 2:3 * f)
-      end do
+    do i = 1, 3
+      gradient(:, f_x) = gradient(:, f_x) + omega(i) * du(:, i)
+    end do
+    do i = 1, 3
+      gradient(:, f_y) = gradient(:, f_y) + omega(i) * dv(:, i)
+    end do
+    do i = 1, 3
+      gradient(:, f_xx + i - 1) = omega(i) * g_scaled
     end do
     if (damped) then
       ! membrane: the damping stress tau D eps', eps' = B(F) z'
@@ -342,6 +348,12 @@ contains
     geometric = matmul(k, matmul(stress_tensor, transpose(k)))
     call add_geometric_membrane(geometric, hessian)
     ! bending, material part
+    dcurv = 0.0_dp
+    do i = 1, 3
+      dcurv(i, 1:3) = du(:, i)
+      dcurv(i, 4:6) = dv(:, i)
+      dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g_scaled
+    end do
     dkappa = matmul(to_local, dcurv)
     hessian = hessian + matmul(transpose(dkappa), matmul(bending_d, dkappa))
     ! bending, geometric part: sum_c omega_c d2c/dz2; c is linear in w, so the (u, v)
@@ -582,8 +594,8 @@ contains
     do i = 1, 3
       h = fields(:, f_xx + i - 1) / gnorm**3 &
           - 3.0_dp * dot_product(fields(:, f_xx + i - 1), g) * g / gnorm**5
-      dcurv(i, 1:3) = cross(fields(:, f_y), h)
-      dcurv(i, 4:6) = cross(h, fields(:, f_x))
+      dcurv(i, 1:3) = point_cross(fields(:, f_y), h)
+      dcurv(i, 4:6) = point_cross(h, fields(:, f_x))
       dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g / gnorm**3
     end do
   end subroutine curvature_gradients
@@ -597,7 +609,8 @@ contains
     real(dp), intent(out) :: rate(3, 15)
     real(dp) :: g_rate(3), gg, w(3), w_rate(3), wg, h(3), h_rate(3)
     integer :: i, f
-    g_rate = cross(field_rates(:, f_x), fields(:, f_y)) + cross(fields(:, f_x), field_rates(:, f_y))
+    g_rate = point_cross(field_rates(:, f_x), fields(:, f_y)) &
+             + point_cross(fields(:, f_x), field_rates(:, f_y))
     gg = dot_product(g, g_rate)
     rate = 0.0_dp
     do i = 1, 3
@@ -609,8 +622,8 @@ contains
       h_rate = w_rate / gnorm**3 - 3.0_dp * gg * w / gnorm**5 &
                - 3.0_dp * ((dot_product(w_rate, g) + dot_product(w, g_rate)) * g + wg * g_rate) &
                  / gnorm**5 + 15.0_dp * wg * gg * g / gnorm**7
-      rate(i, 1:3) = cross(field_rates(:, f_y), h) + cross(fields(:, f_y), h_rate)
-      rate(i, 4:6) = cross(h_rate, fields(:, f_x)) + cross(h, field_rates(:, f_x))
+      rate(i, 1:3) = point_cross(field_rates(:, f_y), h) + point_cross(fields(:, f_y), h_rate)
+      rate(i, 4:6) = point_cross(h_rate, fields(:, f_x)) + point_cross(h, field_rates(:, f_x))
       rate(i, 3 * f - 2:3 * f) = g_rate / gnorm**3 - 3.0_dp * gg * g / gnorm**5
     end do
   end subroutine curvature_gradient_rate
@@ -640,11 +653,26 @@ contains
     end do
   end subroutine interpolate
 
-  !> Whether the normal r_x x r_y (nearly) vanishes: a degenerate configuration.
+  !> The vector product u x v, as matrix3's cross: written here because the point loops
+  !> call it 7 times per Gauss point for the force alone, and a procedure of another file
+  !> is never inlined (each call was a real call through the library's symbol table:
+  !> 15 % of the elastic force's time).
+  pure function point_cross(u, v) result(w)
+    real(dp), intent(in) :: u(3), v(3)
+    real(dp) :: w(3)
+    w = [u(2) * v(3) - u(3) * v(2), u(3) * v(1) - u(1) * v(3), u(1) * v(2) - u(2) * v(1)]
+  end function point_cross
+
+  !> Whether the normal r_x x r_y (nearly) vanishes, |r_x x r_y| <= sqrt(eps) |r_x| |r_y|:
+  !> a degenerate configuration (compared squared: no norm2, whose overflow-safe scaling
+  !> costs three divisions per vector, in the elastic force's point loop).
   pure logical function degenerate(fields)
     real(dp), intent(in) :: fields(3, plate_fields)
-    degenerate = norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
-                 sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))
+    real(dp) :: g(3)
+    g = point_cross(fields(:, f_x), fields(:, f_y))
+    degenerate = dot_product(g, g) <= epsilon(1.0_dp) &
+                 * dot_product(fields(:, f_x), fields(:, f_x)) &
+                 * dot_product(fields(:, f_y), fields(:, f_y))
   end function degenerate
 
   !> nodal += dS^T-weighted gradient: the point's share of the generalized force.
