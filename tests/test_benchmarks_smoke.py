@@ -182,3 +182,24 @@ def test_peer_harness_levels_smoke(tmp_path):
         assert positive(three_percent["exudyn_over_ancfdrv"])
     else:
         assert three_percent["exudyn"] is None
+
+
+def test_leaf_spring_time_same_version(tmp_path):
+    """benchmarks/leaf_spring_time.py, this build against itself over 20 ms: identical
+    chassis histories and counters (20 steps of 1 ms), and the accuracy part's error of the
+    shipped step against the 0.125 ms reference compared at the 6 output times 0, 4, ...,
+    20 ms, positive (the steps differ) and small against the run's range."""
+    stem = tmp_path / "leaf"
+    run_script("leaf_spring_time.py", "--baseline", sys.executable, "--rounds", "1",
+               "--t-end", "0.02", "--accuracy", "--grid", "1e-3/1e-8", "-o", str(stem))
+    report = json.loads(stem.with_suffix(".json").read_text())
+    builds = report["builds"]
+    assert builds["history_max_abs_diff_m"] == 0.0 and builds["counters_equal"]
+    for side in ("baseline", "current"):
+        summary = builds["summary"][side]
+        assert summary["steps"] == 20 and summary["newton_iterations"] >= 20
+        assert positive(summary["integrate_cpu_best_s"])
+    (row,) = report["accuracy"]["rows"]
+    assert row["shipped"] and row["compared_times"] == 6
+    assert 0.0 < row["z_error"] < 0.05
+    assert stem.with_suffix(".md").is_file() and stem.with_suffix(".png").is_file()
