@@ -57,8 +57,8 @@ Three extents of the sweep (``Study``; friction off and on in each):
   cores). It shows the study's point: the peak at the Rayleigh frequency, its height with
   friction off and on, the isolation above it. Measured: peak 18.17 at 2.832 Hz friction
   off, 16.83 at 2.832 Hz friction on (fitted damping ratios 0.0270 and 0.0292), against
-  the full sweep's 18.3 and 16.9 at 2.833 Hz; the transient near the resonance has decayed
-  to 1-3 % when the window starts (the ``settling`` column; below 0.3 % elsewhere);
+  the full sweep's 18.3 and 16.9 at 2.833 Hz; near the resonance the amplitude still changes
+  by 1-3 % between the last two windows (the ``settling`` column; below 0.3 % elsewhere);
 * ``--full`` (``FULL``): the full study, 19 frequencies from 1 to 6 Hz, denser near the
   resonance, 10 s runs and 16 s near it: 38 runs, about 7 minutes of CPU (estimated from
   the default's cost per simulated second; some 4 minutes on 2 idle cores);
