@@ -59,17 +59,19 @@ SAMPLE = 4e-3   # s: the comparison times, a multiple of every step of the grid
 
 
 # -- one run (a worker process) -------------------------------------------------------------
-def worker(args: argparse.Namespace) -> None:
-    """One run; prints its JSON record, writes the chassis history to args.history."""
+def one_run(history: Path, t_end: float,
+            setting: tuple[float, float] | None = None) -> dict[str, Any]:
+    """One run in this process at the scene's (dt, newton_tol) or ``setting``: its record;
+    writes the chassis history (t, x, z) to ``history`` (.npz)."""
     from ancfdrv.builders import build_model, settle_mode
     from ancfdrv.io.scene import load_scene
     from ancfdrv.runner import dynamic_settings
     from ancfdrv.solvers.dynamic import integrate
     from ancfdrv.solvers.static import solve_newton
 
-    overrides = [f"solver.t_end={args.t_end!r}"]
-    if args.dt is not None:
-        overrides += [f"solver.dt={args.dt!r}", f"solver.newton_tol={args.tol!r}"]
+    overrides = [f"solver.t_end={t_end!r}"]
+    if setting is not None:
+        overrides += [f"solver.dt={setting[0]!r}", f"solver.newton_tol={setting[1]!r}"]
     scene = load_scene(SCENE, overrides)
     model = build_model(scene)
     solver = scene["solver"]
@@ -85,14 +87,20 @@ def worker(args: argparse.Namespace) -> None:
     t = np.concatenate([c.time for c in chunks])
     chassis = np.concatenate([c.deflections for c in chunks])[:, list(model.probes).index(
         "chassis")]
-    np.savez(args.history, t=t, x=chassis[:, 0], z=chassis[:, 2])
-    print(json.dumps({"dt": settings.dt, "newton_tol": solver["newton_tol"],
-                      "t_end": settings.t_end, "settle": settle,
-                      "integrate_cpu_s": cpu, "integrate_wall_s": result.wall_time_s,
-                      "steps": result.steps, "newton_iterations": result.newton_iterations,
-                      "factorizations": result.factorizations,
-                      "chassis_z_end_m": float(chassis[-1, 2]),
-                      "chassis_z_min_m": float(chassis[:, 2].min())}))
+    np.savez(history, t=t, x=chassis[:, 0], z=chassis[:, 2])
+    model.close()
+    return {"dt": settings.dt, "newton_tol": solver["newton_tol"], "t_end": settings.t_end,
+            "settle": settle, "integrate_cpu_s": cpu, "integrate_wall_s": result.wall_time_s,
+            "steps": result.steps, "newton_iterations": result.newton_iterations,
+            "factorizations": result.factorizations,
+            "chassis_z_end_m": float(chassis[-1, 2]),
+            "chassis_z_min_m": float(chassis[:, 2].min())}
+
+
+def worker(args: argparse.Namespace) -> None:
+    """One run (a worker process); prints its JSON record."""
+    setting = None if args.dt is None else (args.dt, args.tol)
+    print(json.dumps(one_run(args.history, args.t_end, setting)))
 
 
 def run_worker(python: str, history: Path, t_end: float,

@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ROOT / "benchmarks"
 
@@ -184,14 +186,32 @@ def test_peer_harness_levels_smoke(tmp_path):
         assert three_percent["exudyn"] is None
 
 
-def test_leaf_spring_time_same_version(tmp_path):
-    """benchmarks/leaf_spring_time.py, this build against itself over 20 ms: identical
-    chassis histories and counters (20 steps of 1 ms), and the accuracy part's error of the
-    shipped step against the 0.125 ms reference compared at the 6 output times 0, 4, ...,
-    20 ms, positive (the steps differ) and small against the run's range."""
+def test_leaf_spring_time_same_version(tmp_path, monkeypatch):
+    """benchmarks/leaf_spring_time.py over 20 ms of the leaf spring, in this process but for
+    one worker: that worker (a fresh process, the script's --worker protocol) reports 20
+    steps of 1 ms and writes the 21-row chassis history; the script's main, its workers
+    replaced by the same runs in this process, compares this build with itself (identical
+    histories and counters) and finds the shipped step's error against the 0.125 ms
+    reference at the 6 output times 0, 4, ..., 20 ms positive (the steps differ) and small
+    against the run's range."""
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    import leaf_spring_time as script
+
+    record = script.run_worker(sys.executable, tmp_path / "worker.npz", 0.02)
+    assert record["steps"] == 20 and record["newton_iterations"] >= 20
+    assert positive(record["process_cpu_s"]) and positive(record["integrate_cpu_s"])
+    with np.load(tmp_path / "worker.npz") as h:
+        assert len(h["t"]) == len(h["z"]) == 21 and abs(h["t"][-1] - 0.02) < 1e-12
+
+    def in_process(python, history, t_end, setting=None):
+        assert python == sys.executable
+        record = script.one_run(history, t_end, setting)
+        return dict(record, process_cpu_s=record["integrate_cpu_s"])
+
+    monkeypatch.setattr(script, "run_worker", in_process)
     stem = tmp_path / "leaf"
-    run_script("leaf_spring_time.py", "--baseline", sys.executable, "--rounds", "1",
-               "--t-end", "0.02", "--accuracy", "--grid", "1e-3/1e-8", "-o", str(stem))
+    assert script.main(["--baseline", sys.executable, "--rounds", "1", "--t-end", "0.02",
+                        "--accuracy", "--grid", "1e-3/1e-8", "-o", str(stem)]) == 0
     report = json.loads(stem.with_suffix(".json").read_text())
     builds = report["builds"]
     assert builds["history_max_abs_diff_m"] == 0.0 and builds["counters_equal"]
