@@ -94,6 +94,39 @@ contains
     end do
   end subroutine cholesky_band_solve
 
+  !> Solves P L U x = b for dgbtrf's factors (kl = ku = kd: the multipliers in rows
+  !> 2 kd + 2 .. 3 kd + 1 of ab, U in rows 1 .. 2 kd + 1) in place: dgbtrs's arithmetic by
+  !> columns (row interchange and axpy of the multipliers, then U x = y by columns) written
+  !> out, without its per-column BLAS calls (dger, and dtbsv's daxpy per column: their call
+  !> overhead was most of a 370-unknown solve).
+  pure subroutine lu_band_solve(n, kd, nrhs, ab, pivots, rhs)
+    integer, intent(in) :: n, kd, nrhs, pivots(n)
+    real(dp), intent(in) :: ab(3 * kd + 1, n)
+    real(dp), intent(inout) :: rhs(n, nrhs)
+    integer :: i, j, k, l
+    real(dp) :: x
+    do k = 1, nrhs
+      do j = 1, n - 1  ! L y = P b
+        l = pivots(j)
+        x = rhs(l, k)
+        if (l /= j) then
+          rhs(l, k) = rhs(j, k)
+          rhs(j, k) = x
+        end if
+        do i = 1, min(kd, n - j)
+          rhs(j + i, k) = rhs(j + i, k) - x * ab(2 * kd + 1 + i, j)
+        end do
+      end do
+      do j = n, 1, -1  ! U x = y
+        x = rhs(j, k) / ab(2 * kd + 1, j)
+        rhs(j, k) = x
+        do i = max(1, j - 2 * kd), j - 1
+          rhs(i, k) = rhs(i, k) - x * ab(2 * kd + 1 + i - j, j)
+        end do
+      end do
+    end do
+  end subroutine lu_band_solve
+
   !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only),
   !> 3 = symmetric positive definite, banded LAPACK Cholesky (give both triangles or one),
   !> 4 = general, banded LAPACK LU (give every entry).
@@ -273,6 +306,7 @@ contains
     real(dp), intent(inout), target :: rhs(n, nrhs)
     integer, intent(out) :: info, info_detail
     real(dp), pointer :: flat(:)
+    real(dp), allocatable :: ordered(:, :)
     info_detail = 0
     if (.not. valid(handle)) then
       info = 1
@@ -293,14 +327,16 @@ contains
             if (size(slot%ordered, 2) /= nrhs) deallocate (slot%ordered)
           end if
           if (.not. allocated(slot%ordered)) allocate (slot%ordered(n, nrhs))
-          slot%ordered(slot%place, :) = rhs
-          call banded_solve(slot, nrhs, slot%ordered, info_detail)
-          rhs = slot%ordered(slot%place, :)
+          call move_alloc(slot%ordered, ordered)  ! (the factors stay read-only)
+          ordered(slot%place, :) = rhs
+          call banded_solve(slot, nrhs, ordered)
+          rhs = ordered(slot%place, :)
+          call move_alloc(ordered, slot%ordered)
         else
-          call banded_solve(slot, nrhs, rhs, info_detail)
+          call banded_solve(slot, nrhs, rhs)
         end if
       end associate
-      info = merge(0, 3, info_detail == 0)
+      info = 0
       return
     end if
     associate (id => slots(handle)%id)
@@ -357,15 +393,12 @@ contains
   end subroutine solver_destroy
 
   !> Solves with the banded factors for nrhs right-hand sides in the band's numbering.
-  subroutine banded_solve(slot, nrhs, rhs, info_detail)
-    type(solver_slot), intent(inout) :: slot
+  pure subroutine banded_solve(slot, nrhs, rhs)
+    type(solver_slot), intent(in) :: slot
     integer, intent(in) :: nrhs
     real(dp), intent(inout) :: rhs(slot%n, nrhs)
-    integer, intent(out) :: info_detail
-    info_detail = 0
     if (slot%pivoted_lu) then
-      call dgbtrs('N', slot%n, slot%bandwidth, slot%bandwidth, nrhs, slot%general_band, &
-                  3 * slot%bandwidth + 1, slot%pivots, rhs, slot%n, info_detail)
+      call lu_band_solve(slot%n, slot%bandwidth, nrhs, slot%general_band, slot%pivots, rhs)
     else
       call cholesky_band_solve(slot%n, slot%bandwidth, nrhs, slot%band, slot%lower, rhs)
     end if

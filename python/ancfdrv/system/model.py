@@ -617,8 +617,8 @@ class Model:
     #: of U's band, per column): about a millisecond at the BLAS-3 rate, where MUMPS's fixed
     #: costs per call (some 50 us per solve, whatever the size: it estimates the memory a
     #: save would take on each call) outweigh its savings on fill. The two-leaf spring
-    #: (n = 370, kd = 125 after reverse Cuthill-McKee: 2.3e7 flops): 0.50 against MUMPS's
-    #: 0.86 ms per factorization and 26 against 70 us per solve.
+    #: (n = 370, kd = 125 after reverse Cuthill-McKee: 2.3e7 flops): 0.58 against MUMPS's
+    #: 0.86 ms per factorization and 18 against 67 us per solve.
     BANDED_LU_FLOPS = 5.0e7
 
     def band_order(self) -> np.ndarray | None:
