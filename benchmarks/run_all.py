@@ -13,7 +13,7 @@ of hours; the figures of a quick run are not the ones benchmarks/README.md quote
 Benchmarks that need what the machine may not have are skipped, saying why: the peer
 comparisons need Exudyn (``pip install exudyn``), the instruction counts valgrind. The
 tools that compare two builds or two solvers (``before_after.py``, ``history_gate.py``,
-``h5_compare.py``, ``static_kernel_gate.py``) are gates, not benchmarks, and are listed
+``h5_compare.py``, ``static_kernel_gate.py``, ``leaf_spring_time.py``) are gates, not benchmarks, and are listed
 but not run. Exit status 1 when a benchmark that ran failed.
 """
 from __future__ import annotations
@@ -95,6 +95,8 @@ BENCHES = [
           needs="exudyn"),
     Bench("before_after", "", gate="compares two ancfdrv versions (--before/--after)"),
     Bench("history_gate", "", gate="compares the histories of two builds bitwise"),
+    Bench("leaf_spring_time", "", gate="compares two builds' CPU time on the two-leaf "
+          "spring's 5 s run (--baseline PYTHON; --accuracy: error against time)"),
     Bench("h5_compare", "", gate="compares two directories of result files"),
     Bench("static_kernel_gate", "", gate="compares the kernel's static Newton with the "
           "Python reference"),
