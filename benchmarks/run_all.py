@@ -13,7 +13,7 @@ of hours; the figures of a quick run are not the ones benchmarks/README.md quote
 Benchmarks that need what the machine may not have are skipped, saying why: the peer
 comparisons need Exudyn (``pip install exudyn``), the instruction counts valgrind. The
 tools that compare two builds or two solvers (``before_after.py``, ``history_gate.py``,
-``h5_compare.py``, ``static_kernel_gate.py``) are gates, not benchmarks, and are listed
+``h5_compare.py``, ``static_kernel_gate.py``, ``leaf_spring_time.py``) are gates, not benchmarks, and are listed
 but not run. Exit status 1 when a benchmark that ran failed.
 """
 from __future__ import annotations
@@ -69,6 +69,9 @@ BENCHES = [
           quick=("--repeats", "3", "--nodes", "5")),
     Bench("call_overhead", "fixed cost of a small in-memory call outside the stepping",
           quick=("--rounds", "2", "--calls", "3")),
+    Bench("answers_cost", "what the default answers add to whole runs; the FFR step with "
+          "them against one back-substitution", quick=("--rounds", "1", "--repeats", "1"),
+          out="-o"),
     Bench("step_times", "stepping time of the small planar cable systems",
           quick=("--rounds", "1", "--repeats", "1", "--cases", "pend5full,boom4")),
     Bench("step_instructions", "instructions per time step (callgrind)",
@@ -97,6 +100,8 @@ BENCHES = [
     Bench("history_gate", "", gate="compares the histories of two builds bitwise"),
     Bench("newton_tolerance", "", gate="compares two ancfdrv versions' Newton control at "
           "large steps and loose tolerances (--before/--after)"),
+    Bench("leaf_spring_time", "", gate="compares two builds' CPU time on the two-leaf "
+          "spring's 5 s run (--baseline PYTHON; --accuracy: error against time)"),
     Bench("h5_compare", "", gate="compares two directories of result files"),
     Bench("static_kernel_gate", "", gate="compares the kernel's static Newton with the "
           "Python reference"),

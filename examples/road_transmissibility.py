@@ -32,14 +32,14 @@ What it computes:
    amplitude: 0.08 at 2 Hz, 0.28 at 3.5 Hz, 0.68 at 4.5 Hz, against 0.156 / T in the static
    shape), a second shape the model does not have: it overestimates the transmissibility
    by 1.5 % at 3.5 Hz and 5.6 % at 4.5 Hz (0.6285 against 0.5954, steady to 4e-5) and
-   underestimates it by 3 % at 5 Hz and 6 % at 6 Hz. The full sweep (6 min on 2 cores):
+   underestimates it by 3 % at 5 Hz and 6 % at 6 Hz. The full sweep (``--full``):
    peak 18.3 at 2.833 Hz friction off, 16.9 at 2.833 Hz friction on (fitted damping ratios
    0.0267 and 0.0289: friction adds 0.002), against the Rayleigh frequency 2.837 Hz.
 3. **The sweep**: one run per road frequency and friction setting, in parallel processes;
    the chassis amplitude is the least-squares sine at the road frequency over the last
-   ``WINDOW`` s (a whole number of periods), its transmissibility that amplitude over the
+   ``window`` s (a whole number of periods), its transmissibility that amplitude over the
    road's; ``settling`` is the change of that amplitude against the window ending
-   ``SETTLE_SHIFT`` s earlier (a measure of how steady the response is). Runs near the
+   ``shift`` s earlier (a measure of how steady the response is). Runs near the
    resonance last longer (the transient decays as exp(-zeta omega t), zeta = 0.027).
 4. **The peaks**: the largest measured point and the peak of the one-degree-of-freedom
    curve fitted (f_n, damping, m_c / m_eff free) to the points within 12 % of it.
@@ -48,10 +48,22 @@ Files in results/examples/ (``--out``): road_transmissibility.{json,csv,md,png} 
 ``--keep-runs``, road_transmissibility_runs/*.h5 (one result file per run, ``ancf plot``
 reads them; 0.8 MB per simulated second, 280 MB for the full sweep).
 
-    python examples/road_transmissibility.py [--quick] [--out DIR] [--jobs N] [--keep-runs]
+    python examples/road_transmissibility.py [--quick | --full] [--out DIR] [--jobs N] [--keep-runs]
 
-``--quick`` runs two frequencies below the resonance, friction off and on, for 8 s each
-(the tests compare them with the reference curve).
+Three extents of the sweep (``Study``; friction off and on in each):
+
+* the default (``DEFAULT``): 8 frequencies from 1.5 to 5 Hz, five of them around the
+  resonance, 8 s runs and 12 s near it: 16 runs, 155 s of CPU (within 2 minutes on 2
+  cores). It shows the study's point: the peak at the Rayleigh frequency, its height with
+  friction off and on, the isolation above it. Measured: peak 18.17 at 2.832 Hz friction
+  off, 16.83 at 2.832 Hz friction on (fitted damping ratios 0.0270 and 0.0292), against
+  the full sweep's 18.3 and 16.9 at 2.833 Hz; near the resonance the amplitude still changes
+  by 1-3 % between the last two windows (the ``settling`` column; below 0.3 % elsewhere);
+* ``--full`` (``FULL``): the full study, 19 frequencies from 1 to 6 Hz, denser near the
+  resonance, 10 s runs and 16 s near it: 38 runs, about 7 minutes of CPU (estimated from
+  the default's cost per simulated second; some 4 minutes on 2 idle cores);
+* ``--quick`` (``QUICK``, the tests): two frequencies below the resonance for 8 s each,
+  compared with the reference curve.
 """
 from __future__ import annotations
 
@@ -84,15 +96,36 @@ SCENE = ROOT / "inputs" / "leaf_spring_road.nml"
 DELTA_FORCE = 200.0
 #: effects of the friction-off runs (the scene's list without 'friction')
 NO_FRICTION = "gravity,contact,prestress,damping"
-#: road frequencies (Hz): the full sweep, denser near the resonance (2.84 Hz)
-FREQUENCIES = (1.0, 1.5, 2.0, 2.3, 2.5, 2.65, 2.75, 2.8, 2.825, 2.85, 2.875, 2.9, 2.95,
-               3.05, 3.2, 3.5, 4.0, 5.0, 6.0)
-QUICK_FREQUENCIES = (1.5, 2.0)
-WINDOW, SETTLE_SHIFT = 4.0, 2.0          # s: amplitude window and its shifted twin
-QUICK_WINDOW, QUICK_SHIFT = 2.0, 1.0
-DURATION, NEAR_DURATION, QUICK_DURATION = 10.0, 16.0, 8.0   # s per run
-NEAR = 0.1                                # runs with |f / f_rayleigh - 1| < NEAR last longer
-QUICK_RAMP = 1.0
+#: runs with |f / f_rayleigh - 1| < NEAR last longer (the transient decays as exp(-zeta omega t))
+NEAR = 0.1
+
+
+@dataclass(frozen=True)
+class Study:
+    """The sweep's extent: road frequencies (Hz), run lengths (s; ``near_duration`` for
+    the runs within NEAR of the resonance), the amplitude window and its shift (s) and the
+    road's ramp (s; None: the scene's ``road_ramp``)."""
+
+    frequencies: tuple[float, ...]
+    duration: float
+    near_duration: float
+    window: float
+    shift: float
+    ramp: float | None
+
+
+#: the full study (``--full``): 19 frequencies, denser near the resonance (2.84 Hz), 10 s
+#: runs and 16 s near it; 38 runs, 452 simulated seconds (about 7 min of CPU, estimated from
+#: the default's 0.92 s of CPU per simulated second)
+FULL = Study((1.0, 1.5, 2.0, 2.3, 2.5, 2.65, 2.75, 2.8, 2.825, 2.85, 2.875, 2.9, 2.95,
+              3.05, 3.2, 3.5, 4.0, 5.0, 6.0), 10.0, 16.0, 4.0, 2.0, None)
+#: the default: 8 frequencies, five of them within NEAR of the resonance (at least 4 points
+#: within 12 % of the peak for its fit), 8 s runs and 12 s near it; 16 runs, 168 simulated
+#: seconds (155 s of CPU measured: some 80 s on 2 idle cores)
+DEFAULT = Study((1.5, 2.65, 2.75, 2.85, 2.95, 3.05, 3.5, 5.0), 8.0, 12.0, 4.0, 2.0, None)
+#: ``--quick`` (the tests): two frequencies below the resonance, 8 s each, a 1 s ramp
+QUICK = Study((1.5, 2.0), 8.0, 8.0, 2.0, 1.0, 1.0)
+STUDIES = {"quick": QUICK, "default": DEFAULT, "full": FULL}
 
 
 @dataclass(frozen=True)
@@ -286,17 +319,15 @@ def sweep(cases: list[Case], jobs: int, progress: bool = True) -> list[dict]:
     return rows
 
 
-def plan(lin: Linearization, quick: bool, runs: Path, keep: bool) -> list[Case]:
+def plan(lin: Linearization, study: Study, runs: Path, keep: bool) -> list[Case]:
     """The runs: the longest first, so that two processes finish together."""
-    frequencies = QUICK_FREQUENCIES if quick else FREQUENCIES
-    ramp = QUICK_RAMP if quick else float(load_scene(SCENE)["spring"]["road_ramp"])
+    ramp = float(load_scene(SCENE)["spring"]["road_ramp"]) if study.ramp is None else study.ramp
     cases = []
     for friction in (False, True):
-        for f in frequencies:
+        for f in study.frequencies:
             near = abs(f / lin.f_rayleigh - 1) < NEAR
-            duration = QUICK_DURATION if quick else (NEAR_DURATION if near else DURATION)
-            cases.append(Case(f, friction, duration, QUICK_WINDOW if quick else WINDOW,
-                              QUICK_SHIFT if quick else SETTLE_SHIFT, ramp,
+            cases.append(Case(f, friction, study.near_duration if near else study.duration,
+                              study.window, study.shift, ramp,
                               runs / f"road_{f:g}Hz_{'friction' if friction else 'frictionless'}.h5",
                               keep))
     return sorted(cases, key=lambda c: -c.duration)
@@ -344,12 +375,13 @@ class Report:
     files: list[Path]
 
 
-def run(quick: bool, out: Path, jobs: int = 2, keep_runs: bool = False) -> Report:
+def run(study: str, out: Path, jobs: int = 2, keep_runs: bool = False) -> Report:
+    """The sweep of ``STUDIES[study]`` ('quick', 'default' or 'full'), written to ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     runs = out / "road_transmissibility_runs"
     runs.mkdir(exist_ok=True)
     lin = linearize()
-    rows = sorted(sweep(plan(lin, quick, runs, keep_runs), jobs),
+    rows = sorted(sweep(plan(lin, STUDIES[study], runs, keep_runs), jobs),
                   key=lambda r: (r["friction"], r["frequency"]))
     if not keep_runs and not any(runs.iterdir()):
         runs.rmdir()
@@ -359,7 +391,7 @@ def run(quick: bool, out: Path, jobs: int = 2, keep_runs: bool = False) -> Repor
         if len(mine) >= 4:
             peaks["friction on" if friction else "friction off"] = fit_peak(lin, mine)
     stem = out / "road_transmissibility"
-    summary = {"scene": str(SCENE), "quick": quick,
+    summary = {"scene": str(SCENE), "study": study,
                "linearization": asdict(lin) | {"f_chassis": lin.f_chassis,
                                                "f_secant": lin.f_secant,
                                                "f_rayleigh": lin.f_rayleigh},
@@ -389,14 +421,20 @@ def run(quick: bool, out: Path, jobs: int = 2, keep_runs: bool = False) -> Repor
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
-    parser.add_argument("--quick", action="store_true",
-                        help=f"two frequencies, {QUICK_DURATION:g} s each (about a minute of CPU)")
+    level = parser.add_mutually_exclusive_group()
+    level.add_argument("--quick", action="store_const", dest="study", const="quick",
+                       help=f"{len(QUICK.frequencies)} frequencies below the resonance, "
+                            f"{QUICK.duration:g} s each (about 30 s of CPU)")
+    level.add_argument("--full", action="store_const", dest="study", const="full",
+                       help=f"the full study: {len(FULL.frequencies)} frequencies, "
+                            f"{FULL.duration:g}-{FULL.near_duration:g} s runs (about 7 min of CPU)")
+    parser.set_defaults(study="default")
     parser.add_argument("--out", type=Path, default=RESULTS, help=f"result folder ({RESULTS})")
     parser.add_argument("--jobs", type=int, default=2, help="parallel processes (2)")
     parser.add_argument("--keep-runs", action="store_true",
                         help="keep each run's HDF5 file (about 0.8 MB per simulated second)")
     args = parser.parse_args(argv)
-    run(args.quick, args.out, args.jobs, args.keep_runs)
+    run(args.study, args.out, args.jobs, args.keep_runs)
     return 0
 
 

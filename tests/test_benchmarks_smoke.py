@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ROOT / "benchmarks"
 
@@ -190,3 +192,42 @@ def test_peer_harness_levels_smoke(tmp_path):
         assert positive(three_percent["exudyn_over_ancfdrv"])
     else:
         assert three_percent["exudyn"] is None
+
+
+def test_leaf_spring_time_same_version(tmp_path, monkeypatch):
+    """benchmarks/leaf_spring_time.py over 20 ms of the leaf spring, in this process but for
+    one worker: that worker (a fresh process, the script's --worker protocol) reports 20
+    steps of 1 ms and writes the 21-row chassis history; the script's main, its workers
+    replaced by the same runs in this process, compares this build with itself (identical
+    histories and counters) and finds the shipped step's error against the 0.125 ms
+    reference at the 6 output times 0, 4, ..., 20 ms positive (the steps differ) and small
+    against the run's range."""
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    import leaf_spring_time as script
+
+    record = script.run_worker(sys.executable, tmp_path / "worker.npz", 0.02)
+    assert record["steps"] == 20 and record["newton_iterations"] >= 20
+    assert positive(record["process_cpu_s"]) and positive(record["integrate_cpu_s"])
+    with np.load(tmp_path / "worker.npz") as h:
+        assert len(h["t"]) == len(h["z"]) == 21 and abs(h["t"][-1] - 0.02) < 1e-12
+
+    def in_process(python, history, t_end, setting=None):
+        assert python == sys.executable
+        record = script.one_run(history, t_end, setting)
+        return dict(record, process_cpu_s=record["integrate_cpu_s"])
+
+    monkeypatch.setattr(script, "run_worker", in_process)
+    stem = tmp_path / "leaf"
+    assert script.main(["--baseline", sys.executable, "--rounds", "1", "--t-end", "0.02",
+                        "--accuracy", "--grid", "1e-3/1e-8", "-o", str(stem)]) == 0
+    report = json.loads(stem.with_suffix(".json").read_text())
+    builds = report["builds"]
+    assert builds["history_max_abs_diff_m"] == 0.0 and builds["counters_equal"]
+    for side in ("baseline", "current"):
+        summary = builds["summary"][side]
+        assert summary["steps"] == 20 and summary["newton_iterations"] >= 20
+        assert positive(summary["integrate_cpu_best_s"])
+    (row,) = report["accuracy"]["rows"]
+    assert row["shipped"] and row["compared_times"] == 6
+    assert 0.0 < row["z_error"] < 0.05
+    assert stem.with_suffix(".md").is_file() and stem.with_suffix(".png").is_file()

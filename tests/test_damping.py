@@ -303,8 +303,8 @@ def test_energy_balance_closes_with_dissipated_work(tmp_path, scene, overrides, 
 def test_refactorized_ffr_and_plate_converge_and_balance():
     """A luffing FFR beam (its hub driven) next to a steel plate pendulum: a refactorized
     model whose damped tangent is not symmetric (the FFR omega term, the plate's
-    tau B(e)^T D B(e')) and is factorized whole (MUMPS; with the banded Cholesky's upper
-    triangle Newton failed at t = 0.024 s). Newton converges at every step and the balance
+    tau B(e)^T D B(e')) and is factorized whole (a general LU, here LAPACK's banded LU; with
+    the banded Cholesky's upper triangle Newton failed at t = 0.024 s). Newton converges at every step and the balance
     closes to 4.2e-4 of the dissipated work (dt = 1 ms, 0.5 s)."""
     s = System("luffing beam and plate")
     m = s.material("steel", youngs_modulus=2.1e11, density=7850.0, damping_time=2e-3)

@@ -95,7 +95,7 @@ def test_bounce_frequency_is_the_static_stiffness_frequency(prestress, tmp_path)
 # -- 2. the road input: transmissibility off the resonance ------------------------------------
 @pytest.fixture(scope="module")
 def quick_sweep(tmp_path_factory):
-    return rt.run(quick=True, out=tmp_path_factory.mktemp("road"), jobs=2, keep_runs=True)
+    return rt.run("quick", out=tmp_path_factory.mktemp("road"), jobs=2, keep_runs=True)
 
 
 def test_road_transmissibility_quick_sweep_matches_one_dof_model(quick_sweep):
@@ -117,8 +117,8 @@ def test_road_transmissibility_quick_sweep_matches_one_dof_model(quick_sweep):
             assert read_summary(path)["status"] == "ok"
     lin = report.linearization
     rows = {(r["frequency"], r["friction"]): r for r in report.rows}
-    assert len(rows) == 2 * len(rt.QUICK_FREQUENCIES)
-    for f in rt.QUICK_FREQUENCIES:
+    assert len(rows) == 2 * len(rt.QUICK.frequencies)
+    for f in rt.QUICK.frequencies:
         off, on = rows[(f, False)], rows[(f, True)]
         expected = float(lin.transmissibility(f))
         print(f"\n{f} Hz: transmissibility {off['transmissibility']:.4f} (friction on "

@@ -538,6 +538,14 @@ subroutine direct_create(symmetry, handle, info, info_detail)
   call solver_create(symmetry, handle, info, info_detail)
 end subroutine direct_create
 
+subroutine direct_order(handle, n, place, info)
+  use sparse_direct, only: solver_order
+  implicit none
+  integer, intent(in) :: handle, n, place(n)
+  integer, intent(out) :: info
+  call solver_order(handle, n, place, info)
+end subroutine direct_order
+
 subroutine direct_analyse(handle, n, nnz, rows, cols, info, info_detail)
   use sparse_direct, only: solver_analyse
   implicit none

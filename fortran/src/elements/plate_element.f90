@@ -39,7 +39,7 @@
 module plate_element
   use ancf_kinds, only: dp
   use quadrature, only: gauss_legendre
-  use matrix3, only: cross, skew
+  use matrix3, only: skew
   use element_sets, only: local_element_set
   implicit none
   private
@@ -60,6 +60,7 @@ module plate_element
     real(dp) :: youngs = 0.0_dp, poisson = 0.0_dp, thickness = 0.0_dp
   contains
     procedure :: element_forces => plate_element_forces
+    procedure :: element_energy => plate_element_energy
   end type plate_set
   !> Field indices of z: r_x, r_y, r_xx, r_yy, r_xy.
   integer, parameter :: f_x = 1, f_y = 2, f_xx = 3, f_yy = 4, f_xy = 5
@@ -163,7 +164,7 @@ contains
     real(dp), intent(in) :: fields(3, plate_fields)
     real(dp), intent(out) :: curvatures(3)
     real(dp) :: g(3), norm3
-    g = cross(fields(:, f_x), fields(:, f_y))
+    g = point_cross(fields(:, f_x), fields(:, f_y))
     norm3 = norm2(g)**3
     curvatures = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
                   dot_product(fields(:, f_xy), g)] / norm3
@@ -195,13 +196,13 @@ contains
         curvature0(:, p) = 0.0_dp
         if (variant /= plate_variant_completed) cycle
         fields = matmul(reference, derivs(:, :, p))
-        g = cross(fields(:, f_x), fields(:, f_y))
+        g = point_cross(fields(:, f_x), fields(:, f_y))
         if (norm2(g) <= epsilon(1.0_dp) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))) then
           info = 2
           return
         end if
         t1 = fields(:, f_x) / norm2(fields(:, f_x))
-        t2 = cross(g / norm2(g), t1)
+        t2 = point_cross(g / norm2(g), t1)
         metric = reshape([dot_product(t1, fields(:, f_x)), dot_product(t2, fields(:, f_x)), &
                           dot_product(t1, fields(:, f_y)), dot_product(t2, fields(:, f_y))], [2, 2])
         det = metric(1, 1) * metric(2, 2) - metric(1, 2) * metric(2, 1)
@@ -212,6 +213,34 @@ contains
       end do
     end do
   end subroutine plate_setup
+
+  !> The strains at a Gauss point and the energy density (point_energy's first part, and
+  !> all of plate_element_energy): F = [r_x r_y] K and the membrane strain, its stress,
+  !> the normal g = r_x x r_y and |g|, the map to_local of curvature_map, kappa = to_local
+  !> (c - reference) with c_ab = r_ab . g / |g|^3 (local kappa = K^T (c - c0) K in Voigt
+  !> form), the bending moment and W.
+  pure subroutine point_strains(fields, k, reference, membrane_d, bending_d, deformation, &
+                                strain, stress, g, gnorm, to_local, kappa, moment, energy)
+    real(dp), intent(in) :: fields(3, plate_fields), k(2, 2), reference(3)
+    real(dp), intent(in) :: membrane_d(3, 3), bending_d(3, 3)
+    real(dp), intent(out) :: deformation(3, 2), strain(3), stress(3), g(3), gnorm
+    real(dp), intent(out) :: to_local(3, 3), kappa(3), moment(3), energy
+    real(dp) :: c(3)
+    deformation = matmul(fields(:, f_x:f_y), k)
+    strain = [0.5_dp * (dot_product(deformation(:, 1), deformation(:, 1)) - 1.0_dp), &
+              0.5_dp * (dot_product(deformation(:, 2), deformation(:, 2)) - 1.0_dp), &
+              dot_product(deformation(:, 1), deformation(:, 2))]
+    stress = matmul(membrane_d, strain)
+    energy = 0.5_dp * dot_product(strain, stress)
+    g = point_cross(fields(:, f_x), fields(:, f_y))
+    gnorm = norm2(g)
+    c = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
+         dot_product(fields(:, f_xy), g)] / gnorm**3
+    call curvature_map(k, to_local)
+    kappa = matmul(to_local, c - reference)
+    moment = matmul(bending_d, kappa)
+    energy = energy + 0.5_dp * dot_product(kappa, moment)
+  end subroutine point_strains
 
   !> Energy density W(z) at one Gauss point, its gradient (3, 5) and, on request, its
   !> Hessian (15, 15) with respect to z = (r_x, r_y, r_xx, r_yy, r_xy).
@@ -236,15 +265,16 @@ contains
     real(dp) :: g_now(3), gnorm_now, c_now(3)
     logical :: damped
     real(dp) :: deformation(3, 2), strain(3), stress(3), stress_tensor(2, 2), geometric(2, 2)
-    real(dp) :: b_strain(3, 6), g(3), gnorm, u(3), v(3), c(3), to_local(3, 3), kappa(3)
+    real(dp) :: b_strain(3, 6), g(3), gnorm, u(3), v(3), to_local(3, 3), kappa(3)
     real(dp) :: moment(3), omega(3), dcurv(3, 15), dkappa(3, 15), w_eff(3), wg, h_eff(3)
     real(dp) :: hwg(3, 3), hgg(3, 3), gu(3, 3), gv(3, 3), k(2, 2)
+    real(dp) :: du(3, 3), dv(3, 3), g_scaled(3)
     integer :: gamma, i, f
     damped = present(field_rates) .and. present(tau) .and. present(rate_factor) .and. &
              present(power)
     reference = curvature0
     if (damped) then  ! the curvatures' rates and the shifted reference curvature
-      g_now = cross(fields(:, f_x), fields(:, f_y))
+      g_now = point_cross(fields(:, f_x), fields(:, f_y))
       gnorm_now = norm2(g_now)
       c_now = [dot_product(fields(:, f_xx), g_now), dot_product(fields(:, f_yy), g_now), &
                dot_product(fields(:, f_xy), g_now)] / gnorm_now**3
@@ -264,19 +294,14 @@ contains
     k = frame
     u = fields(:, f_x)
     v = fields(:, f_y)
-    ! membrane: F = [r_x r_y] K
-    deformation = matmul(fields(:, f_x:f_y), k)
-    strain = [0.5_dp * (dot_product(deformation(:, 1), deformation(:, 1)) - 1.0_dp), &
-              0.5_dp * (dot_product(deformation(:, 2), deformation(:, 2)) - 1.0_dp), &
-              dot_product(deformation(:, 1), deformation(:, 2))]
-    stress = matmul(membrane_d, strain)
+    call point_strains(fields, k, reference, membrane_d, bending_d, deformation, strain, stress, &
+                       g, gnorm, to_local, kappa, moment, energy)
     do gamma = 1, 2
       b_strain(1, 3 * gamma - 2:3 * gamma) = k(gamma, 1) * deformation(:, 1)
       b_strain(2, 3 * gamma - 2:3 * gamma) = k(gamma, 2) * deformation(:, 2)
       b_strain(3, 3 * gamma - 2:3 * gamma) = k(gamma, 1) * deformation(:, 2) &
                                              + k(gamma, 2) * deformation(:, 1)
     end do
-    energy = 0.5_dp * dot_product(strain, stress)
     gradient = 0.0_dp
     do gamma = 1, 2
       do i = 1, 3
@@ -284,35 +309,25 @@ contains
                                        + stress(i) * b_strain(i, 3 * gamma - 2:3 * gamma)
       end do
     end do
-    ! bending: c_ab = r_ab . g / |g|^3, local kappa = K^T (c - c0) K in Voigt form
-    g = cross(u, v)
-    gnorm = norm2(g)
-    c = [dot_product(fields(:, f_xx), g), dot_product(fields(:, f_yy), g), &
-         dot_product(fields(:, f_xy), g)] / gnorm**3
-    to_local(1, :) = [k(1, 1)**2, k(2, 1)**2, 2 * k(1, 1) * k(2, 1)]
-    to_local(2, :) = [k(1, 2)**2, k(2, 2)**2, 2 * k(1, 2) * k(2, 2)]
-    to_local(3, :) = 2 * [k(1, 1) * k(1, 2), k(2, 1) * k(2, 2), k(1, 1) * k(2, 2) + k(2, 1) * k(1, 2)]
-    ! c = b / |g|^2 with b_ab = r_ab . n the covariant curvature tensor; K^T b K is the
-    ! curvature in the reference's orthonormal frame, so c is rescaled by the reference
-    ! |g0|^2 = 1 / det(K)^2 (1 for unit, orthogonal reference gradients and for plain)
-    to_local = to_local / (k(1, 1) * k(2, 2) - k(1, 2) * k(2, 1))**2
-    kappa = matmul(to_local, c - reference)
-    moment = matmul(bending_d, kappa)
-    energy = energy + 0.5_dp * dot_product(kappa, moment)
     omega = matmul(moment, to_local)        ! dW/dc
-    ! dc/dz: dc/du = v x h, dc/dv = h x u, dc/dw = g/|g|^3, h = dc/dg
-    dcurv = 0.0_dp
+    ! dc/dz: dc/du = v x h, dc/dv = h x u, dc/dw = g/|g|^3, h = dc/dg; curvature i
+    ! depends on one second derivative w_i alone, so the gradient of the w fields takes
+    ! one term each (the zero blocks of dc/dz are not added: the same sums)
+    g_scaled = g / gnorm**3
     do i = 1, 3
       h_eff = fields(:, f_xx + i - 1) / gnorm**3 &
               - 3.0_dp * dot_product(fields(:, f_xx + i - 1), g) * g / gnorm**5
-      dcurv(i, 1:3) = cross(v, h_eff)
-      dcurv(i, 4:6) = cross(h_eff, u)
-      dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g / gnorm**3
+      du(:, i) = point_cross(v, h_eff)
+      dv(:, i) = point_cross(h_eff, u)
     end do
-    do f = 1, plate_fields
-      do i = 1, 3
-        gradient(:, f) = gradient(:, f) + omega(i) * dcurv(i, 3 * f - 2:3 * f)
-      end do
+    do i = 1, 3
+      gradient(:, f_x) = gradient(:, f_x) + omega(i) * du(:, i)
+    end do
+    do i = 1, 3
+      gradient(:, f_y) = gradient(:, f_y) + omega(i) * dv(:, i)
+    end do
+    do i = 1, 3
+      gradient(:, f_xx + i - 1) = omega(i) * g_scaled
     end do
     if (damped) then
       ! membrane: the damping stress tau D eps', eps' = B(F) z'
@@ -342,6 +357,12 @@ contains
     geometric = matmul(k, matmul(stress_tensor, transpose(k)))
     call add_geometric_membrane(geometric, hessian)
     ! bending, material part
+    dcurv = 0.0_dp
+    do i = 1, 3
+      dcurv(i, 1:3) = du(:, i)
+      dcurv(i, 4:6) = dv(:, i)
+      dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g_scaled
+    end do
     dkappa = matmul(to_local, dcurv)
     hessian = hessian + matmul(transpose(dkappa), matmul(bending_d, dkappa))
     ! bending, geometric part: sum_c omega_c d2c/dz2; c is linear in w, so the (u, v)
@@ -531,6 +552,45 @@ contains
     end if
   end subroutine plate_element_forces
 
+  !> One element's strain energy (the stepper's energy balance, every step) without its
+  !> force: the Gauss points' strains alone (point_strains), the numbers of
+  !> plate_element_forces bit for bit at a third of its cost. With rates (a damped set)
+  !> through plate_element_forces, for the dissipated power.
+  pure subroutine plate_element_energy(set, el, coords, energy, info, rates, dissipation)
+    class(plate_set), intent(in) :: set
+    integer, intent(in) :: el
+    real(dp), intent(in) :: coords(:, :)
+    real(dp), intent(out) :: energy
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: rates(:, :)
+    real(dp), intent(out), optional :: dissipation
+    real(dp) :: force(plate_dofs), tangent(plate_dofs, plate_dofs), membrane_d(3, 3)
+    real(dp) :: bending_d(3, 3), fields(3, plate_fields), shape_d(plate_fields, plate_shapes)
+    real(dp) :: deformation(3, 2), strain(3), stress(3), g(3), gnorm, to_local(3, 3)
+    real(dp) :: kappa(3), moment(3), point_w
+    integer :: p
+    if (present(rates)) then
+      call plate_element_forces(set, el, coords, .false., force, energy, tangent, info, rates, &
+                                0.0_dp, dissipation)
+      return
+    end if
+    info = 0
+    call elastic_matrices(set%youngs, set%poisson, set%thickness, membrane_d, bending_d)
+    energy = 0.0_dp
+    do p = 1, plate_points
+      shape_d = transpose(set%derivs(:, :, p, el))
+      call interpolate(coords, shape_d, fields)
+      if (degenerate(fields)) then
+        info = 2
+        return
+      end if
+      call point_strains(fields, set%plate_frame(:, :, p, el), set%curvature0(:, p, el), &
+                         membrane_d, bending_d, deformation, strain, stress, g, gnorm, &
+                         to_local, kappa, moment, point_w)
+      energy = energy + set%weights(p, el) * point_w
+    end do
+  end subroutine plate_element_energy
+
   !> The geometric part of the membrane tangent, kron(G, I3) with G (2, 2) = K S K^T, added
   !> to the (6, 6) block of a point's Hessian on the two in-plane gradients.
   pure subroutine add_geometric_membrane(geometric, hessian)
@@ -561,7 +621,10 @@ contains
     end do
   end subroutine membrane_strain_matrix
 
-  !> The map kappa = to_local c of point_energy (Voigt, rescaled by the reference metric).
+  !> The map kappa = to_local c of point_energy (Voigt, rescaled by the reference metric:
+  !> c = b / |g|^2 with b_ab = r_ab . n the covariant curvature tensor; K^T b K is the
+  !> curvature in the reference's orthonormal frame, so c is rescaled by the reference
+  !> |g0|^2 = 1 / det(K)^2, 1 for unit, orthogonal reference gradients and for plain).
   pure subroutine curvature_map(k, to_local)
     real(dp), intent(in) :: k(2, 2)
     real(dp), intent(out) :: to_local(3, 3)
@@ -582,8 +645,8 @@ contains
     do i = 1, 3
       h = fields(:, f_xx + i - 1) / gnorm**3 &
           - 3.0_dp * dot_product(fields(:, f_xx + i - 1), g) * g / gnorm**5
-      dcurv(i, 1:3) = cross(fields(:, f_y), h)
-      dcurv(i, 4:6) = cross(h, fields(:, f_x))
+      dcurv(i, 1:3) = point_cross(fields(:, f_y), h)
+      dcurv(i, 4:6) = point_cross(h, fields(:, f_x))
       dcurv(i, 3 * (f_xx + i - 1) - 2:3 * (f_xx + i - 1)) = g / gnorm**3
     end do
   end subroutine curvature_gradients
@@ -597,7 +660,8 @@ contains
     real(dp), intent(out) :: rate(3, 15)
     real(dp) :: g_rate(3), gg, w(3), w_rate(3), wg, h(3), h_rate(3)
     integer :: i, f
-    g_rate = cross(field_rates(:, f_x), fields(:, f_y)) + cross(fields(:, f_x), field_rates(:, f_y))
+    g_rate = point_cross(field_rates(:, f_x), fields(:, f_y)) &
+             + point_cross(fields(:, f_x), field_rates(:, f_y))
     gg = dot_product(g, g_rate)
     rate = 0.0_dp
     do i = 1, 3
@@ -609,8 +673,8 @@ contains
       h_rate = w_rate / gnorm**3 - 3.0_dp * gg * w / gnorm**5 &
                - 3.0_dp * ((dot_product(w_rate, g) + dot_product(w, g_rate)) * g + wg * g_rate) &
                  / gnorm**5 + 15.0_dp * wg * gg * g / gnorm**7
-      rate(i, 1:3) = cross(field_rates(:, f_y), h) + cross(fields(:, f_y), h_rate)
-      rate(i, 4:6) = cross(h_rate, fields(:, f_x)) + cross(h, field_rates(:, f_x))
+      rate(i, 1:3) = point_cross(field_rates(:, f_y), h) + point_cross(fields(:, f_y), h_rate)
+      rate(i, 4:6) = point_cross(h_rate, fields(:, f_x)) + point_cross(h, field_rates(:, f_x))
       rate(i, 3 * f - 2:3 * f) = g_rate / gnorm**3 - 3.0_dp * gg * g / gnorm**5
     end do
   end subroutine curvature_gradient_rate
@@ -640,11 +704,26 @@ contains
     end do
   end subroutine interpolate
 
-  !> Whether the normal r_x x r_y (nearly) vanishes: a degenerate configuration.
+  !> The vector product u x v, as matrix3's cross: written here because the point loops
+  !> call it 7 times per Gauss point for the force alone, and a procedure of another file
+  !> is never inlined (each call was a real call through the library's symbol table:
+  !> 15 % of the elastic force's time).
+  pure function point_cross(u, v) result(w)
+    real(dp), intent(in) :: u(3), v(3)
+    real(dp) :: w(3)
+    w = [u(2) * v(3) - u(3) * v(2), u(3) * v(1) - u(1) * v(3), u(1) * v(2) - u(2) * v(1)]
+  end function point_cross
+
+  !> Whether the normal r_x x r_y (nearly) vanishes, |r_x x r_y| <= sqrt(eps) |r_x| |r_y|:
+  !> a degenerate configuration (compared squared: no norm2, whose overflow-safe scaling
+  !> costs three divisions per vector, in the elastic force's point loop).
   pure logical function degenerate(fields)
     real(dp), intent(in) :: fields(3, plate_fields)
-    degenerate = norm2(cross(fields(:, f_x), fields(:, f_y))) <= &
-                 sqrt(epsilon(1.0_dp)) * norm2(fields(:, f_x)) * norm2(fields(:, f_y))
+    real(dp) :: g(3)
+    g = point_cross(fields(:, f_x), fields(:, f_y))
+    degenerate = dot_product(g, g) <= epsilon(1.0_dp) &
+                 * dot_product(fields(:, f_x), fields(:, f_x)) &
+                 * dot_product(fields(:, f_y), fields(:, f_y))
   end function degenerate
 
   !> nodal += dS^T-weighted gradient: the point's share of the generalized force.

@@ -1,11 +1,15 @@
 !> Sparse direct solves behind integer handles: analyse a pattern once, factorize as often
 !> as the values change, solve many right-hand sides per factorization, release cleanly.
-!> Two kinds share the API: sequential MUMPS (any sparse matrix; it never prints, ICNTL
-!> 1-4), and LAPACK's banded Cholesky (dpbtrf/dpbtrs) for symmetric matrices with a narrow
-!> band, such as a beam's iteration matrix, whose solves cost O(n kd) with none of MUMPS's
-!> per-call overhead. When the Cholesky finds the matrix not positive definite (a tangent
-!> stiffness under compression), the same handle falls back to the banded LU with partial
-!> pivoting (dgbtrf/dgbtrs). The handle table is the kernel's only module state.
+!> Three kinds share the API: sequential MUMPS (any sparse matrix; it never prints, ICNTL
+!> 1-4), LAPACK's banded Cholesky (dpbtrf/dpbtrs) for symmetric matrices with a narrow
+!> band, such as a beam's iteration matrix, and LAPACK's banded LU with partial pivoting
+!> (dgbtrf/dgbtrs) for unsymmetric ones, both of whose solves cost O(n kd) with none of
+!> MUMPS's per-call overhead (every MUMPS call, a solve included, walks its whole structure
+!> to estimate the memory a save would take: tens of microseconds). When the Cholesky finds
+!> the matrix not positive definite (a tangent stiffness under compression), the same
+!> handle falls back to the banded LU. A banded kind may be given an ordering of the
+!> unknowns (solver_order, e.g. reverse Cuthill-McKee) that narrows the band; its callers
+!> keep the original numbering. The handle table is the kernel's only module state.
 !> info: 0 ok; 1 bad handle or no free slot; 2 call out of sequence (solve before
 !> factorize, ...); 3 size mismatch; < 0 MUMPS INFOG(1) (-10: numerically singular),
 !> with INFOG(2) in info_detail; the banded kind reports a non-positive-definite matrix
@@ -16,17 +20,23 @@ module sparse_direct
   private
   include 'mpif.h'
   include 'dmumps_struc.h'
-  public :: solver_create, solver_analyse, solver_factorize, solver_solve, solver_destroy, &
-            solver_banded
+  public :: solver_create, solver_order, solver_analyse, solver_factorize, solver_solve, &
+            solver_destroy, solver_banded
 
   !> symmetry code that selects the banded LAPACK Cholesky
   integer, parameter, public :: banded_spd = 3
+  !> symmetry code that selects the banded LAPACK LU (general matrices)
+  integer, parameter, public :: banded_general = 4
 
   type :: solver_slot
     type(dmumps_struc) :: id
     logical :: banded = .false.
+    logical :: general = .false.     ! banded LU from the start (no Cholesky attempt)
     integer :: n = 0, bandwidth = 0
-    integer, allocatable :: rows(:), cols(:), pivots(:)
+    ! rows and cols in the band's numbering; place(i): the band's unknown of unknown i
+    ! (none: the same numbering)
+    integer, allocatable :: rows(:), cols(:), pivots(:), place(:)
+    real(dp), allocatable :: ordered(:, :)           ! right-hand sides in the band's numbering
     real(dp), allocatable :: band(:, :), general_band(:, :)
     ! the Cholesky factor's rows (lower(1 + m, i) = U(i, i + m), m = 0 .. kd: the band
     ! transposed), for the forward substitution by contiguous columns of U^T
@@ -84,8 +94,42 @@ contains
     end do
   end subroutine cholesky_band_solve
 
+  !> Solves P L U x = b for dgbtrf's factors (kl = ku = kd: the multipliers in rows
+  !> 2 kd + 2 .. 3 kd + 1 of ab, U in rows 1 .. 2 kd + 1) in place: dgbtrs's arithmetic by
+  !> columns (row interchange and axpy of the multipliers, then U x = y by columns) written
+  !> out, without its per-column BLAS calls (dger, and dtbsv's daxpy per column: their call
+  !> overhead was most of a 370-unknown solve).
+  pure subroutine lu_band_solve(n, kd, nrhs, ab, pivots, rhs)
+    integer, intent(in) :: n, kd, nrhs, pivots(n)
+    real(dp), intent(in) :: ab(3 * kd + 1, n)
+    real(dp), intent(inout) :: rhs(n, nrhs)
+    integer :: i, j, k, l
+    real(dp) :: x
+    do k = 1, nrhs
+      do j = 1, n - 1  ! L y = P b
+        l = pivots(j)
+        x = rhs(l, k)
+        if (l /= j) then
+          rhs(l, k) = rhs(j, k)
+          rhs(j, k) = x
+        end if
+        do i = 1, min(kd, n - j)
+          rhs(j + i, k) = rhs(j + i, k) - x * ab(2 * kd + 1 + i, j)
+        end do
+      end do
+      do j = n, 1, -1  ! U x = y
+        x = rhs(j, k) / ab(2 * kd + 1, j)
+        rhs(j, k) = x
+        do i = max(1, j - 2 * kd), j - 1
+          rhs(i, k) = rhs(i, k) - x * ab(2 * kd + 1 + i - j, j)
+        end do
+      end do
+    end do
+  end subroutine lu_band_solve
+
   !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only),
-  !> 3 = symmetric positive definite, banded LAPACK Cholesky (give both triangles or one).
+  !> 3 = symmetric positive definite, banded LAPACK Cholesky (give both triangles or one),
+  !> 4 = general, banded LAPACK LU (give every entry).
   subroutine solver_create(symmetry, handle, info, info_detail)
     integer, intent(in) :: symmetry
     integer, intent(out) :: handle, info, info_detail
@@ -93,12 +137,13 @@ contains
     handle = 0
     info_detail = 0
     info = 1
-    if (symmetry < 0 .or. symmetry > 3) return
-    if (symmetry == banded_spd) then
+    if (symmetry < 0 .or. symmetry > 4) return
+    if (symmetry == banded_spd .or. symmetry == banded_general) then
       do h = 1, max_slots
         if (.not. slots(h)%in_use) then
           slots(h)%in_use = .true.
           slots(h)%banded = .true.
+          slots(h)%general = symmetry == banded_general
           slots(h)%analysed = .false.
           slots(h)%factorized = .false.
           handle = h
@@ -137,6 +182,30 @@ contains
     end do
   end subroutine solver_create
 
+  !> The banded kinds' ordering of the n unknowns, before solver_analyse: place(i) is the
+  !> position of unknown i in the band (a permutation of 1..n). info 1: bad handle or a
+  !> MUMPS handle; 3: not a permutation.
+  subroutine solver_order(handle, n, place, info)
+    integer, intent(in) :: handle, n, place(n)
+    integer, intent(out) :: info
+    logical :: seen(n)
+    integer :: i
+    info = 1
+    if (.not. valid(handle)) return
+    if (.not. slots(handle)%banded) return
+    info = 3
+    if (any(place < 1) .or. any(place > n)) return
+    seen = .false.
+    do i = 1, n
+      if (seen(place(i))) return
+      seen(place(i)) = .true.
+    end do
+    slots(handle)%place = place
+    slots(handle)%analysed = .false.
+    slots(handle)%factorized = .false.
+    info = 0
+  end subroutine solver_order
+
   !> Symbolic analysis of the n x n pattern given by 1-based coordinates (rows, cols).
   subroutine solver_analyse(handle, n, nnz, rows, cols, info, info_detail)
     integer, intent(in) :: handle, n, nnz, rows(nnz), cols(nnz)
@@ -151,12 +220,24 @@ contains
       return
     end if
     if (slots(handle)%banded) then
+      if (allocated(slots(handle)%place)) then
+        if (size(slots(handle)%place) /= n) then
+          info = 3
+          return
+        end if
+        slots(handle)%rows = slots(handle)%place(rows)
+        slots(handle)%cols = slots(handle)%place(cols)
+      else
+        slots(handle)%rows = rows
+        slots(handle)%cols = cols
+      end if
       slots(handle)%n = n
-      slots(handle)%rows = rows
-      slots(handle)%cols = cols
-      slots(handle)%bandwidth = maxval(abs(rows - cols))
+      slots(handle)%bandwidth = maxval(abs(slots(handle)%rows - slots(handle)%cols))
       if (allocated(slots(handle)%band)) deallocate (slots(handle)%band)
-      allocate (slots(handle)%band(slots(handle)%bandwidth + 1, n))
+      if (.not. slots(handle)%general) allocate (slots(handle)%band(slots(handle)%bandwidth + 1, n))
+      ! (the LU's band is sized by its first factorization)
+      if (allocated(slots(handle)%general_band)) &
+        deallocate (slots(handle)%general_band, slots(handle)%pivots)
       slots(handle)%analysed = .true.
       slots(handle)%factorized = .false.
       info = 0
@@ -225,6 +306,7 @@ contains
     real(dp), intent(inout), target :: rhs(n, nrhs)
     integer, intent(out) :: info, info_detail
     real(dp), pointer :: flat(:)
+    real(dp), allocatable :: ordered(:, :)
     info_detail = 0
     if (.not. valid(handle)) then
       info = 1
@@ -240,14 +322,21 @@ contains
         return
       end if
       associate (slot => slots(handle))
-        if (slot%pivoted_lu) then
-          call dgbtrs('N', n, slot%bandwidth, slot%bandwidth, nrhs, slot%general_band, &
-                      3 * slot%bandwidth + 1, slot%pivots, rhs, n, info_detail)
+        if (allocated(slot%place)) then
+          if (allocated(slot%ordered)) then
+            if (size(slot%ordered, 2) /= nrhs) deallocate (slot%ordered)
+          end if
+          if (.not. allocated(slot%ordered)) allocate (slot%ordered(n, nrhs))
+          call move_alloc(slot%ordered, ordered)  ! (the factors stay read-only)
+          ordered(slot%place, :) = rhs
+          call banded_solve(slot, nrhs, ordered)
+          rhs = ordered(slot%place, :)
+          call move_alloc(ordered, slot%ordered)
         else
-          call cholesky_band_solve(n, slot%bandwidth, nrhs, slot%band, slot%lower, rhs)
+          call banded_solve(slot, nrhs, rhs)
         end if
       end associate
-      info = merge(0, 3, info_detail == 0)
+      info = 0
       return
     end if
     associate (id => slots(handle)%id)
@@ -284,6 +373,8 @@ contains
       if (allocated(slots(handle)%lower)) deallocate (slots(handle)%lower)
       if (allocated(slots(handle)%pivots)) deallocate (slots(handle)%pivots)
       if (allocated(slots(handle)%rows)) deallocate (slots(handle)%rows, slots(handle)%cols)
+      if (allocated(slots(handle)%place)) deallocate (slots(handle)%place)
+      if (allocated(slots(handle)%ordered)) deallocate (slots(handle)%ordered)
       slots(handle)%in_use = .false.
       slots(handle)%analysed = .false.
       slots(handle)%factorized = .false.
@@ -301,10 +392,23 @@ contains
     slots(handle)%factorized = .false.
   end subroutine solver_destroy
 
+  !> Solves with the banded factors for nrhs right-hand sides in the band's numbering.
+  pure subroutine banded_solve(slot, nrhs, rhs)
+    type(solver_slot), intent(in) :: slot
+    integer, intent(in) :: nrhs
+    real(dp), intent(inout) :: rhs(slot%n, nrhs)
+    if (slot%pivoted_lu) then
+      call lu_band_solve(slot%n, slot%bandwidth, nrhs, slot%general_band, slot%pivots, rhs)
+    else
+      call cholesky_band_solve(slot%n, slot%bandwidth, nrhs, slot%band, slot%lower, rhs)
+    end if
+  end subroutine banded_solve
+
   !> Banded Cholesky of the upper triangle (entries below the diagonal are ignored, so
   !> both triangles or the upper one may be given; duplicates are summed). A matrix that
-  !> is not positive definite is factorized by the pivoted banded LU instead, which needs
-  !> both triangles; info = -10 only when that fails too (singular).
+  !> is not positive definite, or any matrix of the general kind, is factorized by the
+  !> pivoted banded LU instead, which needs both triangles; info = -10 only when that
+  !> fails (singular).
   subroutine banded_factorize(slot, nnz, values, info, info_detail)
     type(solver_slot), intent(inout) :: slot
     integer, intent(in) :: nnz
@@ -317,6 +421,12 @@ contains
       return
     end if
     kd = slot%bandwidth
+    info = 0
+    slot%pivoted_lu = slot%general
+    if (slot%general) then
+      call banded_lu(slot, nnz, values, info, info_detail)
+      return
+    end if
     slot%band = 0.0_dp
     do k = 1, nnz
       if (slot%rows(k) <= slot%cols(k)) slot%band(kd + 1 + slot%rows(k) - slot%cols(k), slot%cols(k)) = &
@@ -324,7 +434,6 @@ contains
     end do
     call dpbtrf('U', slot%n, kd, slot%band, kd + 1, info_detail)
     slot%pivoted_lu = info_detail /= 0
-    info = 0
     if (.not. slot%pivoted_lu) then
       if (allocated(slot%lower)) then
         if (size(slot%lower, 1) /= kd + 1 .or. size(slot%lower, 2) /= slot%n) &
@@ -339,7 +448,20 @@ contains
       end do
       return
     end if
-    ! not positive definite: general band storage, kl = ku = kd, with room for the fill-in
+    ! not positive definite: the banded LU
+    call banded_lu(slot, nnz, values, info, info_detail)
+  end subroutine banded_factorize
+
+  !> Banded LU with partial pivoting (general band storage, kl = ku = kd, with room for the
+  !> fill-in) of every given entry (duplicates summed); info = -10 when singular.
+  subroutine banded_lu(slot, nnz, values, info, info_detail)
+    type(solver_slot), intent(inout) :: slot
+    integer, intent(in) :: nnz
+    real(dp), intent(in) :: values(nnz)
+    integer, intent(out) :: info, info_detail
+    integer :: k, kd, row_in_band
+    kd = slot%bandwidth
+    info = 0
     if (.not. allocated(slot%general_band)) then
       allocate (slot%general_band(3 * kd + 1, slot%n), slot%pivots(slot%n))
     end if
@@ -351,14 +473,16 @@ contains
     end do
     call dgbtrf(slot%n, slot%n, kd, kd, slot%general_band, 3 * kd + 1, slot%pivots, info_detail)
     if (info_detail /= 0) info = -10
-  end subroutine banded_factorize
+  end subroutine banded_lu
 
-  !> Whether handle is a solver of the banded kind (symmetry banded_spd): a model's other
-  !> solves go through the kind its iteration matrix uses.
+  !> Whether handle is a solver of the banded Cholesky kind (symmetry banded_spd, whether or
+  !> not a factorization fell back to its LU): a model's other symmetric solves go through
+  !> the kind its iteration matrix uses. The general banded LU kind (banded_lu) answers no:
+  !> its models' saddle solves stay with MUMPS.
   logical function solver_banded(handle)
     integer, intent(in) :: handle
     solver_banded = .false.
-    if (valid(handle)) solver_banded = slots(handle)%banded
+    if (valid(handle)) solver_banded = slots(handle)%banded .and. .not. slots(handle)%general
   end function solver_banded
 
   logical function valid(handle)
