@@ -31,8 +31,9 @@ a quiet machine, the same in every count). Caveat: callgrind counts every iterat
 ``rep stos`` as an instruction, so large ``memset``s (HDF5 zeroes its caches) weigh more
 than their time.
 
-``--phases``: per case (the four above and ``PHASE_CASES``: the pendulum's 9 nodes, the
-hard spin-up, a general scene) the instructions of one whole call (after a warm-up call)
+``--phases``: per case (the four above, ``PHASE_CASES``: the pendulum's 9 nodes, the
+hard spin-up, a general scene, and ``MEMORY_CASES``: the boom's whole in-memory call at the
+peer harness's 3 % level, ``ancfdrv.simulate`` as the harness times it) the instructions of one whole call (after a warm-up call)
 split by phase: callgrind dumps at the entries and exits of the ``PHASES`` functions
 (scene load, model build and its parts, lock and path checks, answers, initial
 acceleration, dynamic set-up, static solves, HDF5, the kernel's stepping), each interval
@@ -83,6 +84,15 @@ PHASE_CASES: dict[str, tuple[str, list[str]]] = {
     "general_cardan_shaft": ("inputs/general/cardan_shaft.nml", [
         "solver.t_end=0.2", "output.xdmf=.false."]),
 }
+#: whole calls kept in memory (``ancfdrv.simulate``, no file: as ``peer_harness.py``'s boom
+#: levels time them, like Exudyn's run with no solution file), then the tip history read from
+#: the ``Simulation``: the boom at the harness's 3 % level (issue 38, "a model build and
+#: output path whose fixed cost is at most Exudyn's"); ``--phases --cases boom_memory_3pct``
+MEMORY_CASES: dict[str, tuple[str, list[str]]] = {
+    "boom_memory_3pct": ("inputs/boom_luffing.nml", [
+        "scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.",
+        "beam.bending=cable", "scene.planar=xy", "beam.nodes=4", "solver.dt=0.02"]),
+}
 QUICK = {"pendulum_cable_5": CASES["pendulum_cable_5"]}
 #: the whole calls counted per case by ``--instructions`` (after two warm-up calls)
 INSTRUCTION_CALLS = 2
@@ -94,6 +104,7 @@ _TOGGLE_C = ("#include <valgrind/callgrind.h>\n"
 #: phase running, "glue" outside all (the runner, the stepper's Python side, checks)
 PHASES = (
     ("ancfdrv.runner", None, "load_scene", "scene"),
+    ("ancfdrv.simulation", None, "load_scene", "scene"),
     ("ancfdrv.runner", None, "build_model", "model"),
     ("ancfdrv.builders", None, "build_system", "model: build_system"),
     ("ancfdrv.system.system", "System", "assemble", "model: assemble"),
@@ -103,6 +114,9 @@ PHASES = (
     ("ancfdrv.runner", "OutputLock", "__exit__", "lock and path checks"),
     ("ancfdrv.runner", None, "solve_static_path", "static solve"),
     ("ancfdrv.runner", None, "solve_newton", "static solve"),
+    ("ancfdrv.solvers.path", None, "stability_index", "static stability"),
+    ("ancfdrv.runner", None, "_check_dynamic_plausibility", "plausibility"),
+    ("ancfdrv.results.plausibility", None, "check_static", "plausibility"),
     ("ancfdrv.runner", None, "_answers_recorder", "answers"),
     ("ancfdrv.system.answers", None, "static_answers", "answers"),
     ("ancfdrv.system.answers", "DynamicAnswers", "__call__", "answers"),
@@ -125,6 +139,15 @@ PHASES = (
     ("ancfdrv.results.hdf5", "DynamicWriter", "flush", "HDF5"),
     ("ancfdrv.results.hdf5", "DynamicWriter", "flush_last", "HDF5"),
 )
+#: ``MEMORY_CASES``: the in-memory output's calls (what the file's HDF5 calls are to a file)
+MEMORY_PHASES = tuple(("ancfdrv.results.memory", "MemoryOutput", name, "output (memory)")
+                      for name in ("create", "write_static", "write_static_answers",
+                                   "write_support_deflections", "write_dynamic_answers",
+                                   "write_dynamic_attrs", "finish", "DynamicWriter")) + tuple(
+    ("ancfdrv.results.memory", "MemoryWriter", name, "output (memory)")
+    for name in ("__call__", "flush", "flush_last")) + (
+    ("ancfdrv.simulation", "Simulation", "__init__", "output (memory)"),
+    ("ancfdrv.simulation", "Simulation", "probe", "output (memory)"))
 #: context managers of the HDF5 layer (their entries and exits are HDF5's)
 PHASE_CONTEXTS = (("ancfdrv.results.hdf5", "holding"), ("ancfdrv.results.hdf5", "released"))
 
@@ -133,6 +156,11 @@ def _call(case: str, out: Path) -> None:
     """One whole call as the peer harness makes it: run, then read the tip history."""
     import h5py
     import ancfdrv.runner as runner
+    if case in MEMORY_CASES:
+        import ancfdrv
+        scene, overrides = MEMORY_CASES[case]
+        ancfdrv.simulate(REPO / scene, overrides, progress=False).probe("tip")
+        return
     scene, overrides = {**CASES, **PHASE_CASES}[case]
     runner.run_scene(REPO / scene, overrides, out, progress=False)
     with h5py.File(out, "r") as h5:
@@ -235,7 +263,7 @@ def phase_calls(case: str, helper: str) -> None:
                 finally:
                     leave()
         setattr(owner, name, counted)
-    for module, owner, name, label in PHASES:
+    for module, owner, name, label in PHASES + MEMORY_PHASES:
         target = importlib.import_module(module)
         target = target if owner is None else getattr(target, owner)
         if hasattr(target, name):   # (a copy to compare may lack a later function)
@@ -250,6 +278,12 @@ def phase_calls(case: str, helper: str) -> None:
 
     def call(out: Path) -> None:   # _call, its read-back of the tip history as HDF5's
         import h5py
+        if case in MEMORY_CASES:
+            import ancfdrv
+            scene, overrides = MEMORY_CASES[case]
+            sim = ancfdrv.simulate(REPO / scene, overrides, progress=False)
+            sim.probe("tip")
+            return
         scene, overrides = {**CASES, **PHASE_CASES}[case]
         runner.run_scene(REPO / scene, overrides, out, progress=False)
         enter("HDF5 (the read-back)")
@@ -292,6 +326,8 @@ def phase_instructions(case: str, work: Path) -> dict[str, float]:
     found["outside HDF5, the stepping and static solves"] = sum(
         v for k, v in found.items() if k not in ("stepping", "static solve")
         and not k.startswith("HDF5"))
+    found["non-stepping"] = sum(v for k, v in found.items() if k not in (
+        "stepping", "outside HDF5, the stepping and static solves"))
     return found
 
 
@@ -333,6 +369,19 @@ def instructions(case: str, work: Path) -> dict[str, Any]:
 
 def measure(case: str, repeats: int) -> dict[str, Any]:
     """Phases of ``repeats`` whole calls of one case in this process (after one warm-up)."""
+    if case in MEMORY_CASES:   # the whole in-memory call only (its phases: --phases)
+        out = Path(tempfile.mkdtemp()) / "run.h5"
+        _call(case, out)
+        walls, cpus = [], []
+        for _ in range(repeats):
+            w0, c0 = time.perf_counter(), time.thread_time()
+            _call(case, out)
+            cpus.append(time.thread_time() - c0)
+            walls.append(time.perf_counter() - w0)
+        return {"whole_wall_best_ms": 1e3 * min(walls),
+                "phases_thread_cpu_median_ms": {"whole (thread CPU)":
+                                                1e3 * statistics.median(cpus)},
+                "repeats": repeats}
     import ancfdrv.kernel as kernel
     import ancfdrv.results.hdf5 as h5
     import ancfdrv.runner as runner
@@ -390,7 +439,7 @@ def measure(case: str, repeats: int) -> dict[str, Any]:
 def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) -> int:
     """``--phases``: per case and version, the instructions of one whole call per phase
     and the best wall time of ``--repeats`` whole calls (interleaved case by case)."""
-    every = {**CASES, **PHASE_CASES}
+    every = {**CASES, **PHASE_CASES, **MEMORY_CASES}
     cases = [c for c in (args.cases.split(",") if args.cases else every)]
     record: dict[str, Any] = {"machine": machine_info(), "load_average_at_start":
                               load_average(), "cases": {}}
@@ -417,7 +466,8 @@ def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) 
             record["cases"].setdefault(case, {})[label] = {
                 "instructions_per_phase": counts, "load_average": load_average(), **timed}
             mine = counts["outside HDF5, the stepping and static solves"]
-            print(f"{case:22s} {label:8s} outside HDF5/stepping {mine / 1e6:7.2f} M Ir, "
+            print(f"{case:22s} {label:8s} non-stepping {counts['non-stepping'] / 1e6:7.2f} M Ir, "
+                  f"outside HDF5/stepping {mine / 1e6:7.2f} M Ir, "
                   f"stepping {counts.get('stepping', 0) / 1e6:8.2f} M Ir, whole call best "
                   f"{timed['whole_wall_best_ms']:7.1f} ms wall", flush=True)
     record["load_average_at_end"] = load_average()
