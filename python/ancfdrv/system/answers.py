@@ -324,18 +324,30 @@ class ReactionMap:
             mu = np.atleast_2d(self.factor.solve(rhs).T.reshape(nt, -1))
         out = {}
         for name, (terms, entries, first, size, slots) in self.selection.items():
-            # on the touched 3-vectors only (slots): column 3 k + j is component j of slot k
+            on_terms, on_entries = self._joint_scatter(name)
+            vec = contrib[:, terms] @ on_terms
+            if mu is not None and len(entries):
+                a = self.a_coo
+                vec = vec + (mu[:, a.row[entries]] * a.data[entries]) @ on_entries
+            out[name] = (vec, slots)
+        return out
+
+    def _joint_scatter(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
+        """The 0/1 matrices adding a joint's terms (and its eliminated-row entries) into
+        the touched 3-vectors of its body2 (column 3 k + j: component j of slot k), made
+        once per joint (the static state's and the dynamic rows' reactions share them)."""
+        made = self.__dict__.setdefault("_scatters", {})
+        if name not in made:
+            terms, entries, first, size, slots = self.selection[name]
             compact = 3 * len(slots)
 
             def column(dofs: np.ndarray) -> np.ndarray:
                 return 3 * np.searchsorted(slots, dofs // 3) + dofs % 3
-            vec = contrib[:, terms] @ _scatter(column(self.t_dof[terms] - first), compact)
-            if mu is not None and len(entries):
-                a = self.a_coo
-                vec = vec + (mu[:, a.row[entries]] * a.data[entries]) @ \
-                    _scatter(column(a.col[entries] - first), compact)
-            out[name] = (vec, slots)
-        return out
+            on_entries = None
+            if self.a_coo is not None and len(entries):
+                on_entries = _scatter(column(self.a_coo.col[entries] - first), compact)
+            made[name] = (_scatter(column(self.t_dof[terms] - first), compact), on_entries)
+        return made[name]
 
     def reaction_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
                       residual_rows: np.ndarray | None = None, *,
