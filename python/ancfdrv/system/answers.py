@@ -1066,6 +1066,7 @@ class DynamicAnswers:
             values = answers[:, 7 * i:7 * i + 7]
             self.reactions[info.name].append((values[:, 0:3].copy(), values[:, 3:6].copy(),
                                               values[:, 6].copy()))
+        full = None   # every row expanded to the full coordinates (made once, when needed)
         if self.map.joints:
             # read only: without eliminated joints q is e (no copy of every row); with them,
             # when the reactions need no kernel gradients, only the full coordinates they
@@ -1076,7 +1077,7 @@ class DynamicAnswers:
             elif (columns := self.map.row_columns()) is not None:
                 q_rows = self.model.reduction.expand_columns(e_rows, columns)
             else:
-                q_rows = self.model.expand(e_rows)
+                q_rows = full = self.model.expand(e_rows)
             residual = answers[:, 7 * nfel:] if self.need_residual else None
             found = self.map.reaction_rows(q_rows, np.asarray(chunk.lam, dtype=float), times,
                                            residual, columns=columns)
@@ -1084,7 +1085,8 @@ class DynamicAnswers:
                 self.reactions[name].append((force, moment, axial))
         self._time_blocks.append(np.array(times))   # (a list of floats made on request)
         if self._axial:
-            full = e_rows if self.model.reduction is None else self.model.expand(e_rows)
+            if full is None:
+                full = e_rows if self.model.reduction is None else self.model.expand(e_rows)
             for name, (body, law) in self._axial.items():
                 forces = law(body, full)
                 self.tension[name].append((forces.min(axis=1), forces.max(axis=1)))
