@@ -15,7 +15,9 @@ call's thread CPU time minus the stepping's.
 ``--compare PATH``: run the same cases with another copy of the package (a directory
 holding ``ancfdrv/``, e.g. ``git archive <commit> python/ancfdrv`` unpacked, with the
 built ``_kernel*.so`` copied in) in a subprocess, interleaved case by case, so both are
-measured under the same load.
+measured under the same load (the subprocess runs without the site hook, ``-S``, this
+interpreter's site-packages behind the copy on PYTHONPATH: an editable install's finder
+would load this worktree's package before anything on PYTHONPATH).
 
 ``--instructions``: also count, with valgrind's callgrind (exact and independent of the
 machine's load), the instructions of ``INSTRUCTION_CALLS`` whole calls of each case after
@@ -150,6 +152,21 @@ MEMORY_PHASES = tuple(("ancfdrv.results.memory", "MemoryOutput", name, "output (
     ("ancfdrv.simulation", "Simulation", "probe", "output (memory)"))
 #: context managers of the HDF5 layer (their entries and exits are HDF5's)
 PHASE_CONTEXTS = (("ancfdrv.results.hdf5", "holding"), ("ancfdrv.results.hdf5", "released"))
+
+
+def _compare_path(path: str) -> str:
+    """PYTHONPATH of a child running ``--compare``'s copy: the copy, then this
+    interpreter's site-packages (numpy, h5py; the child runs without the site hook:
+    :func:`_python`)."""
+    import site
+    return os.pathsep.join([str(Path(path).resolve()), *site.getsitepackages()])
+
+
+def _python() -> list[str]:
+    """A child's interpreter: with ``--compare``'s copy on PYTHONPATH (FIXED_COST_COMPARE
+    set), without the site hook (-S), since an editable install's finder would load this
+    worktree's package before anything on PYTHONPATH."""
+    return [sys.executable, "-S"] if os.environ.get("FIXED_COST_COMPARE") else [sys.executable]
 
 
 def _call(case: str, out: Path) -> None:
@@ -313,7 +330,7 @@ def phase_instructions(case: str, work: Path) -> dict[str, float]:
     target.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
     subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
-                    f"--callgrind-out-file={target / 'cg'}", sys.executable, __file__,
+                    f"--callgrind-out-file={target / 'cg'}", *_python(), __file__,
                     "--phase-counted", case, "--helper", str(helper)], env=env, check=True,
                    capture_output=True)
     found: dict[str, float] = {}
@@ -350,7 +367,7 @@ def instructions(case: str, work: Path) -> dict[str, Any]:
     profile = work / f"{case}.callgrind"
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
     subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
-                    f"--callgrind-out-file={profile}", sys.executable, __file__,
+                    f"--callgrind-out-file={profile}", *_python(), __file__,
                     "--counted", case, "--helper", str(helper)], env=env, check=True,
                    capture_output=True)
     text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100",
@@ -449,17 +466,20 @@ def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) 
             env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
             saved = os.environ.get("PYTHONPATH")
             if path:
-                env["PYTHONPATH"] = os.environ["PYTHONPATH"] = str(Path(path).resolve())
+                env["PYTHONPATH"] = os.environ["PYTHONPATH"] = _compare_path(path)
+                env["FIXED_COST_COMPARE"] = os.environ["FIXED_COST_COMPARE"] = "1"
             try:
                 with tempfile.TemporaryDirectory() as tmp:
                     counts = phase_instructions(case, Path(tmp))
             finally:
                 if path:
+                    os.environ.pop("FIXED_COST_COMPARE", None)
                     if saved is None:
                         os.environ.pop("PYTHONPATH", None)
                     else:
                         os.environ["PYTHONPATH"] = saved
-            done = subprocess.run([sys.executable, __file__, "--one", case, "--repeats",
+            done = subprocess.run([*(_python() if not path else [sys.executable, "-S"]),
+                                   __file__, "--one", case, "--repeats",
                                    str(args.repeats)], env=env, capture_output=True,
                                   text=True, check=True)
             timed = json.loads(done.stdout.strip().splitlines()[-1])
@@ -471,7 +491,7 @@ def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) 
                   f"stepping {counts.get('stepping', 0) / 1e6:8.2f} M Ir, whole call best "
                   f"{timed['whole_wall_best_ms']:7.1f} ms wall", flush=True)
     record["load_average_at_end"] = load_average()
-    target = REPO / "benchmarks" / "results" / "fixed_cost_phases.json"
+    target = REPO / "benchmarks" / "results" / args.out
     target.write_text(json.dumps(record, indent=1) + "\n")
     print(f"wrote {target}")
     return 0
@@ -488,6 +508,8 @@ def main() -> int:
                         help="instructions per phase (callgrind) and best wall times of "
                              "CASES and PHASE_CASES: results/fixed_cost_phases.json")
     parser.add_argument("--cases", help="--phases: these cases only (comma-separated)")
+    parser.add_argument("--out", default="fixed_cost_phases.json",
+                        help="--phases: the result file's name in benchmarks/results")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a subprocess: one case, JSON out
     parser.add_argument("--counted", help=argparse.SUPPRESS)  # under callgrind
     parser.add_argument("--phase-counted", help=argparse.SUPPRESS)  # under callgrind
@@ -513,8 +535,10 @@ def main() -> int:
         for label, path in versions.items():
             env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
             if path:
-                env["PYTHONPATH"] = str(Path(path).resolve())
-            done = subprocess.run([sys.executable, __file__, "--one", case, "--repeats",
+                env["PYTHONPATH"] = _compare_path(path)
+                env["FIXED_COST_COMPARE"] = "1"
+            done = subprocess.run([*([sys.executable, "-S"] if path else [sys.executable]),
+                                   __file__, "--one", case, "--repeats",
                                    str(2 if args.quick else args.repeats)], env=env,
                                   capture_output=True, text=True, check=True)
             result = json.loads(done.stdout.strip().splitlines()[-1])
@@ -527,11 +551,13 @@ def main() -> int:
                 with tempfile.TemporaryDirectory() as tmp:
                     if path:
                         env_path = os.environ.get("PYTHONPATH")
-                        os.environ["PYTHONPATH"] = str(Path(path).resolve())
+                        os.environ["PYTHONPATH"] = _compare_path(path)
+                        os.environ["FIXED_COST_COMPARE"] = "1"
                     try:
                         counts = instructions(case, Path(tmp))
                     finally:
                         if path:
+                            os.environ.pop("FIXED_COST_COMPARE", None)
                             if env_path is None:
                                 os.environ.pop("PYTHONPATH", None)
                             else:
