@@ -15,7 +15,9 @@ call's thread CPU time minus the stepping's.
 ``--compare PATH``: run the same cases with another copy of the package (a directory
 holding ``ancfdrv/``, e.g. ``git archive <commit> python/ancfdrv`` unpacked, with the
 built ``_kernel*.so`` copied in) in a subprocess, interleaved case by case, so both are
-measured under the same load.
+measured under the same load (the subprocess runs without the site hook, ``-S``, this
+interpreter's site-packages behind the copy on PYTHONPATH: an editable install's finder
+would load this worktree's package before anything on PYTHONPATH).
 
 ``--instructions``: also count, with valgrind's callgrind (exact and independent of the
 machine's load), the instructions of ``INSTRUCTION_CALLS`` whole calls of each case after
@@ -31,8 +33,9 @@ a quiet machine, the same in every count). Caveat: callgrind counts every iterat
 ``rep stos`` as an instruction, so large ``memset``s (HDF5 zeroes its caches) weigh more
 than their time.
 
-``--phases``: per case (the four above and ``PHASE_CASES``: the pendulum's 9 nodes, the
-hard spin-up, a general scene) the instructions of one whole call (after a warm-up call)
+``--phases``: per case (the four above, ``PHASE_CASES``: the pendulum's 9 nodes, the
+hard spin-up, a general scene, and ``MEMORY_CASES``: the boom's whole in-memory call at the
+peer harness's 3 % level, ``ancfdrv.simulate`` as the harness times it) the instructions of one whole call (after a warm-up call)
 split by phase: callgrind dumps at the entries and exits of the ``PHASES`` functions
 (scene load, model build and its parts, lock and path checks, answers, initial
 acceleration, dynamic set-up, static solves, HDF5, the kernel's stepping), each interval
@@ -83,6 +86,15 @@ PHASE_CASES: dict[str, tuple[str, list[str]]] = {
     "general_cardan_shaft": ("inputs/general/cardan_shaft.nml", [
         "solver.t_end=0.2", "output.xdmf=.false."]),
 }
+#: whole calls kept in memory (``ancfdrv.simulate``, no file: as ``peer_harness.py``'s boom
+#: levels time them, like Exudyn's run with no solution file), then the tip history read from
+#: the ``Simulation``: the boom at the harness's 3 % level (issue 38, "a model build and
+#: output path whose fixed cost is at most Exudyn's"); ``--phases --cases boom_memory_3pct``
+MEMORY_CASES: dict[str, tuple[str, list[str]]] = {
+    "boom_memory_3pct": ("inputs/boom_luffing.nml", [
+        "scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.",
+        "beam.bending=cable", "scene.planar=xy", "beam.nodes=4", "solver.dt=0.02"]),
+}
 QUICK = {"pendulum_cable_5": CASES["pendulum_cable_5"]}
 #: the whole calls counted per case by ``--instructions`` (after two warm-up calls)
 INSTRUCTION_CALLS = 2
@@ -94,6 +106,7 @@ _TOGGLE_C = ("#include <valgrind/callgrind.h>\n"
 #: phase running, "glue" outside all (the runner, the stepper's Python side, checks)
 PHASES = (
     ("ancfdrv.runner", None, "load_scene", "scene"),
+    ("ancfdrv.simulation", None, "load_scene", "scene"),
     ("ancfdrv.runner", None, "build_model", "model"),
     ("ancfdrv.builders", None, "build_system", "model: build_system"),
     ("ancfdrv.system.system", "System", "assemble", "model: assemble"),
@@ -103,6 +116,9 @@ PHASES = (
     ("ancfdrv.runner", "OutputLock", "__exit__", "lock and path checks"),
     ("ancfdrv.runner", None, "solve_static_path", "static solve"),
     ("ancfdrv.runner", None, "solve_newton", "static solve"),
+    ("ancfdrv.solvers.path", None, "stability_index", "static stability"),
+    ("ancfdrv.runner", None, "_check_dynamic_plausibility", "plausibility"),
+    ("ancfdrv.results.plausibility", None, "check_static", "plausibility"),
     ("ancfdrv.runner", None, "_answers_recorder", "answers"),
     ("ancfdrv.system.answers", None, "static_answers", "answers"),
     ("ancfdrv.system.answers", "DynamicAnswers", "__call__", "answers"),
@@ -125,14 +141,43 @@ PHASES = (
     ("ancfdrv.results.hdf5", "DynamicWriter", "flush", "HDF5"),
     ("ancfdrv.results.hdf5", "DynamicWriter", "flush_last", "HDF5"),
 )
+#: ``MEMORY_CASES``: the in-memory output's calls (what the file's HDF5 calls are to a file)
+MEMORY_PHASES = tuple(("ancfdrv.results.memory", "MemoryOutput", name, "output (memory)")
+                      for name in ("create", "write_static", "write_static_answers",
+                                   "write_support_deflections", "write_dynamic_answers",
+                                   "write_dynamic_attrs", "finish", "DynamicWriter")) + tuple(
+    ("ancfdrv.results.memory", "MemoryWriter", name, "output (memory)")
+    for name in ("__call__", "flush", "flush_last")) + (
+    ("ancfdrv.simulation", "Simulation", "__init__", "output (memory)"),
+    ("ancfdrv.simulation", "Simulation", "probe", "output (memory)"))
 #: context managers of the HDF5 layer (their entries and exits are HDF5's)
 PHASE_CONTEXTS = (("ancfdrv.results.hdf5", "holding"), ("ancfdrv.results.hdf5", "released"))
+
+
+def _compare_path(path: str) -> str:
+    """PYTHONPATH of a child running ``--compare``'s copy: the copy, then this
+    interpreter's site-packages (numpy, h5py; the child runs without the site hook:
+    :func:`_python`)."""
+    import site
+    return os.pathsep.join([str(Path(path).resolve()), *site.getsitepackages()])
+
+
+def _python() -> list[str]:
+    """A child's interpreter: with ``--compare``'s copy on PYTHONPATH (FIXED_COST_COMPARE
+    set), without the site hook (-S), since an editable install's finder would load this
+    worktree's package before anything on PYTHONPATH."""
+    return [sys.executable, "-S"] if os.environ.get("FIXED_COST_COMPARE") else [sys.executable]
 
 
 def _call(case: str, out: Path) -> None:
     """One whole call as the peer harness makes it: run, then read the tip history."""
     import h5py
     import ancfdrv.runner as runner
+    if case in MEMORY_CASES:
+        import ancfdrv
+        scene, overrides = MEMORY_CASES[case]
+        ancfdrv.simulate(REPO / scene, overrides, progress=False).probe("tip")
+        return
     scene, overrides = {**CASES, **PHASE_CASES}[case]
     runner.run_scene(REPO / scene, overrides, out, progress=False)
     with h5py.File(out, "r") as h5:
@@ -235,7 +280,7 @@ def phase_calls(case: str, helper: str) -> None:
                 finally:
                     leave()
         setattr(owner, name, counted)
-    for module, owner, name, label in PHASES:
+    for module, owner, name, label in PHASES + MEMORY_PHASES:
         target = importlib.import_module(module)
         target = target if owner is None else getattr(target, owner)
         if hasattr(target, name):   # (a copy to compare may lack a later function)
@@ -250,6 +295,12 @@ def phase_calls(case: str, helper: str) -> None:
 
     def call(out: Path) -> None:   # _call, its read-back of the tip history as HDF5's
         import h5py
+        if case in MEMORY_CASES:
+            import ancfdrv
+            scene, overrides = MEMORY_CASES[case]
+            sim = ancfdrv.simulate(REPO / scene, overrides, progress=False)
+            sim.probe("tip")
+            return
         scene, overrides = {**CASES, **PHASE_CASES}[case]
         runner.run_scene(REPO / scene, overrides, out, progress=False)
         enter("HDF5 (the read-back)")
@@ -279,7 +330,7 @@ def phase_instructions(case: str, work: Path) -> dict[str, float]:
     target.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
     subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
-                    f"--callgrind-out-file={target / 'cg'}", sys.executable, __file__,
+                    f"--callgrind-out-file={target / 'cg'}", *_python(), __file__,
                     "--phase-counted", case, "--helper", str(helper)], env=env, check=True,
                    capture_output=True)
     found: dict[str, float] = {}
@@ -292,6 +343,8 @@ def phase_instructions(case: str, work: Path) -> dict[str, float]:
     found["outside HDF5, the stepping and static solves"] = sum(
         v for k, v in found.items() if k not in ("stepping", "static solve")
         and not k.startswith("HDF5"))
+    found["non-stepping"] = sum(v for k, v in found.items() if k not in (
+        "stepping", "outside HDF5, the stepping and static solves"))
     return found
 
 
@@ -314,7 +367,7 @@ def instructions(case: str, work: Path) -> dict[str, Any]:
     profile = work / f"{case}.callgrind"
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
     subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
-                    f"--callgrind-out-file={profile}", sys.executable, __file__,
+                    f"--callgrind-out-file={profile}", *_python(), __file__,
                     "--counted", case, "--helper", str(helper)], env=env, check=True,
                    capture_output=True)
     text = subprocess.run(["callgrind_annotate", "--inclusive=yes", "--threshold=100",
@@ -333,6 +386,19 @@ def instructions(case: str, work: Path) -> dict[str, Any]:
 
 def measure(case: str, repeats: int) -> dict[str, Any]:
     """Phases of ``repeats`` whole calls of one case in this process (after one warm-up)."""
+    if case in MEMORY_CASES:   # the whole in-memory call only (its phases: --phases)
+        out = Path(tempfile.mkdtemp()) / "run.h5"
+        _call(case, out)
+        walls, cpus = [], []
+        for _ in range(repeats):
+            w0, c0 = time.perf_counter(), time.thread_time()
+            _call(case, out)
+            cpus.append(time.thread_time() - c0)
+            walls.append(time.perf_counter() - w0)
+        return {"whole_wall_best_ms": 1e3 * min(walls),
+                "phases_thread_cpu_median_ms": {"whole (thread CPU)":
+                                                1e3 * statistics.median(cpus)},
+                "repeats": repeats}
     import ancfdrv.kernel as kernel
     import ancfdrv.results.hdf5 as h5
     import ancfdrv.runner as runner
@@ -390,7 +456,7 @@ def measure(case: str, repeats: int) -> dict[str, Any]:
 def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) -> int:
     """``--phases``: per case and version, the instructions of one whole call per phase
     and the best wall time of ``--repeats`` whole calls (interleaved case by case)."""
-    every = {**CASES, **PHASE_CASES}
+    every = {**CASES, **PHASE_CASES, **MEMORY_CASES}
     cases = [c for c in (args.cases.split(",") if args.cases else every)]
     record: dict[str, Any] = {"machine": machine_info(), "load_average_at_start":
                               load_average(), "cases": {}}
@@ -400,28 +466,32 @@ def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) 
             env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
             saved = os.environ.get("PYTHONPATH")
             if path:
-                env["PYTHONPATH"] = os.environ["PYTHONPATH"] = str(Path(path).resolve())
+                env["PYTHONPATH"] = os.environ["PYTHONPATH"] = _compare_path(path)
+                env["FIXED_COST_COMPARE"] = os.environ["FIXED_COST_COMPARE"] = "1"
             try:
                 with tempfile.TemporaryDirectory() as tmp:
                     counts = phase_instructions(case, Path(tmp))
             finally:
                 if path:
+                    os.environ.pop("FIXED_COST_COMPARE", None)
                     if saved is None:
                         os.environ.pop("PYTHONPATH", None)
                     else:
                         os.environ["PYTHONPATH"] = saved
-            done = subprocess.run([sys.executable, __file__, "--one", case, "--repeats",
+            done = subprocess.run([*(_python() if not path else [sys.executable, "-S"]),
+                                   __file__, "--one", case, "--repeats",
                                    str(args.repeats)], env=env, capture_output=True,
                                   text=True, check=True)
             timed = json.loads(done.stdout.strip().splitlines()[-1])
             record["cases"].setdefault(case, {})[label] = {
                 "instructions_per_phase": counts, "load_average": load_average(), **timed}
             mine = counts["outside HDF5, the stepping and static solves"]
-            print(f"{case:22s} {label:8s} outside HDF5/stepping {mine / 1e6:7.2f} M Ir, "
+            print(f"{case:22s} {label:8s} non-stepping {counts['non-stepping'] / 1e6:7.2f} M Ir, "
+                  f"outside HDF5/stepping {mine / 1e6:7.2f} M Ir, "
                   f"stepping {counts.get('stepping', 0) / 1e6:8.2f} M Ir, whole call best "
                   f"{timed['whole_wall_best_ms']:7.1f} ms wall", flush=True)
     record["load_average_at_end"] = load_average()
-    target = REPO / "benchmarks" / "results" / "fixed_cost_phases.json"
+    target = REPO / "benchmarks" / "results" / args.out
     target.write_text(json.dumps(record, indent=1) + "\n")
     print(f"wrote {target}")
     return 0
@@ -438,6 +508,8 @@ def main() -> int:
                         help="instructions per phase (callgrind) and best wall times of "
                              "CASES and PHASE_CASES: results/fixed_cost_phases.json")
     parser.add_argument("--cases", help="--phases: these cases only (comma-separated)")
+    parser.add_argument("--out", default="fixed_cost_phases.json",
+                        help="--phases: the result file's name in benchmarks/results")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a subprocess: one case, JSON out
     parser.add_argument("--counted", help=argparse.SUPPRESS)  # under callgrind
     parser.add_argument("--phase-counted", help=argparse.SUPPRESS)  # under callgrind
@@ -463,8 +535,10 @@ def main() -> int:
         for label, path in versions.items():
             env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
             if path:
-                env["PYTHONPATH"] = str(Path(path).resolve())
-            done = subprocess.run([sys.executable, __file__, "--one", case, "--repeats",
+                env["PYTHONPATH"] = _compare_path(path)
+                env["FIXED_COST_COMPARE"] = "1"
+            done = subprocess.run([*([sys.executable, "-S"] if path else [sys.executable]),
+                                   __file__, "--one", case, "--repeats",
                                    str(2 if args.quick else args.repeats)], env=env,
                                   capture_output=True, text=True, check=True)
             result = json.loads(done.stdout.strip().splitlines()[-1])
@@ -477,11 +551,13 @@ def main() -> int:
                 with tempfile.TemporaryDirectory() as tmp:
                     if path:
                         env_path = os.environ.get("PYTHONPATH")
-                        os.environ["PYTHONPATH"] = str(Path(path).resolve())
+                        os.environ["PYTHONPATH"] = _compare_path(path)
+                        os.environ["FIXED_COST_COMPARE"] = "1"
                     try:
                         counts = instructions(case, Path(tmp))
                     finally:
                         if path:
+                            os.environ.pop("FIXED_COST_COMPARE", None)
                             if env_path is None:
                                 os.environ.pop("PYTHONPATH", None)
                             else:

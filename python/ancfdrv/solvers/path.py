@@ -173,6 +173,8 @@ def _reduced_tangent(model: Model, e: np.ndarray, lam: np.ndarray, factor: float
         g /= np.abs(g).max(axis=1)[:, None]   # rows scaled to unit size (modal.null_space)
         parts, positions = [], []
         for group in _constraint_groups(g):
+            if len(group) == 1:   # a coordinate fixed alone (a nonzero column: rank 1)
+                continue          # adds no direction: nothing to decompose
             block = g[:, group]
             block = block[np.abs(block).max(axis=1) > 0]
             _, sing, vt = np.linalg.svd(block, full_matrices=True)

@@ -324,18 +324,30 @@ class ReactionMap:
             mu = np.atleast_2d(self.factor.solve(rhs).T.reshape(nt, -1))
         out = {}
         for name, (terms, entries, first, size, slots) in self.selection.items():
-            # on the touched 3-vectors only (slots): column 3 k + j is component j of slot k
+            on_terms, on_entries = self._joint_scatter(name)
+            vec = contrib[:, terms] @ on_terms
+            if mu is not None and len(entries):
+                a = self.a_coo
+                vec = vec + (mu[:, a.row[entries]] * a.data[entries]) @ on_entries
+            out[name] = (vec, slots)
+        return out
+
+    def _joint_scatter(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
+        """The 0/1 matrices adding a joint's terms (and its eliminated-row entries) into
+        the touched 3-vectors of its body2 (column 3 k + j: component j of slot k), made
+        once per joint (the static state's and the dynamic rows' reactions share them)."""
+        made = self.__dict__.setdefault("_scatters", {})
+        if name not in made:
+            terms, entries, first, size, slots = self.selection[name]
             compact = 3 * len(slots)
 
             def column(dofs: np.ndarray) -> np.ndarray:
                 return 3 * np.searchsorted(slots, dofs // 3) + dofs % 3
-            vec = contrib[:, terms] @ _scatter(column(self.t_dof[terms] - first), compact)
-            if mu is not None and len(entries):
-                a = self.a_coo
-                vec = vec + (mu[:, a.row[entries]] * a.data[entries]) @ \
-                    _scatter(column(a.col[entries] - first), compact)
-            out[name] = (vec, slots)
-        return out
+            on_entries = None
+            if self.a_coo is not None and len(entries):
+                on_entries = _scatter(column(self.a_coo.col[entries] - first), compact)
+            made[name] = (_scatter(column(self.t_dof[terms] - first), compact), on_entries)
+        return made[name]
 
     def reaction_rows(self, q_rows: np.ndarray, lam_rows: np.ndarray, times: np.ndarray,
                       residual_rows: np.ndarray | None = None, *,
@@ -1054,6 +1066,7 @@ class DynamicAnswers:
             values = answers[:, 7 * i:7 * i + 7]
             self.reactions[info.name].append((values[:, 0:3].copy(), values[:, 3:6].copy(),
                                               values[:, 6].copy()))
+        full = None   # every row expanded to the full coordinates (made once, when needed)
         if self.map.joints:
             # read only: without eliminated joints q is e (no copy of every row); with them,
             # when the reactions need no kernel gradients, only the full coordinates they
@@ -1064,7 +1077,7 @@ class DynamicAnswers:
             elif (columns := self.map.row_columns()) is not None:
                 q_rows = self.model.reduction.expand_columns(e_rows, columns)
             else:
-                q_rows = self.model.expand(e_rows)
+                q_rows = full = self.model.expand(e_rows)
             residual = answers[:, 7 * nfel:] if self.need_residual else None
             found = self.map.reaction_rows(q_rows, np.asarray(chunk.lam, dtype=float), times,
                                            residual, columns=columns)
@@ -1072,7 +1085,7 @@ class DynamicAnswers:
                 self.reactions[name].append((force, moment, axial))
         self._time_blocks.append(np.array(times))   # (a list of floats made on request)
         if self._axial:
-            self._record_tension(e_rows)
+            self._record_tension(e_rows, full)
         for info in self.section_sets:
             self._record_sections(info.body.name, *_section_rows(
                 self.model, info, e_rows, times, self.stations), times)
@@ -1084,18 +1097,22 @@ class DynamicAnswers:
     #: cantilever's peak). Each row's values are its own: the same in any block.
     TENSION_BLOCK_BYTES = 1 << 17
 
-    def _record_tension(self, e_rows: np.ndarray) -> None:
+    def _record_tension(self, e_rows: np.ndarray, full: np.ndarray | None) -> None:
         """The smallest and largest axial force along every cable at each row of e_rows
-        (independent coordinates), formed a block of rows at a time."""
+        (independent coordinates; ``full``: their full coordinates when the reactions
+        expanded them already, else None), formed a block of rows at a time."""
         nt = len(e_rows)
         step = max(1, self.TENSION_BLOCK_BYTES // (8 * self.model.nfull))
         lows = {name: np.empty(nt) for name in self._axial}
         highs = {name: np.empty(nt) for name in self._axial}
         for first in range(0, nt, step):
             block = e_rows[first:first + step]
-            full = block if self.model.reduction is None else self.model.expand(block)
+            if full is not None:
+                block = full[first:first + step]
+            elif self.model.reduction is not None:
+                block = self.model.expand(block)
             for name, (body, law) in self._axial.items():
-                forces = law(body, full)
+                forces = law(body, block)
                 forces.min(axis=1, out=lows[name][first:first + step])
                 forces.max(axis=1, out=highs[name][first:first + step])
         for name in self._axial:

@@ -355,9 +355,11 @@ class Model:
             force += self.drives[index].value(0.0) * vector
         return force
 
-    def moment_terms(self, e: np.ndarray, load_factor: float | None = None):
+    def moment_terms(self, e: np.ndarray, load_factor: float | None = None, *,
+                     hessians: bool = True):
         """Per dead moment: (coordinates, force, Jacobian, Hessian) over the coordinates its
-        director depends on (through B when reduced)."""
+        director depends on (through B when reduced); ``hessians=False``: None for the
+        Hessian (its four-operand product not formed where only the Jacobian is used)."""
         lf = 1.0 if load_factor is None else load_factor
         q = self.expand(e)
         out = []
@@ -365,7 +367,8 @@ class Model:
             self.counters[m.effect] += 1
             f, j, h = kernel.moment_force(q[m.dofs], m.axis, (1.0 if m.fixed else lf) * m.magnitude)
             cols, b = self._director_map(m.dofs)
-            out.append((cols, b.T @ f, b.T @ j @ b, np.einsum("ijl,ia,jb,lc->abc", h, b, b, b)))
+            out.append((cols, b.T @ f, b.T @ j @ b,
+                        np.einsum("ijl,ia,jb,lc->abc", h, b, b, b) if hessians else None))
         return out
 
     def stiffness_triplets(self, e: np.ndarray, lam: np.ndarray, t: float = 0.0,
@@ -381,8 +384,9 @@ class Model:
             tangent = self.forces(e, t, want_tangent=True, load_factor=load_factor)["tangent"]
         k = self.pattern.to_csr(tangent)
         rows, cols, vals = [k.row_index()], [k.indices], [k.data]
-        for dofs, _, jac, *_ in (*self.moment_terms(e, load_factor=load_factor),
-                                 *self.vector_load_terms(e, t, load_factor=load_factor)):
+        moments = self.moment_terms(e, load_factor=load_factor, hessians=False)
+        for dofs, _, jac, *_ in (*moments, *self.vector_load_terms(e, t,
+                                                                    load_factor=load_factor)):
             dofs = np.asarray(dofs)
             rows.append(np.repeat(dofs, len(dofs)))
             cols.append(np.tile(dofs, len(dofs)))

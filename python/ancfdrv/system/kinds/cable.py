@@ -20,6 +20,8 @@ Newton matrix regular and may be 0 in dynamics, where the mass does that).
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ... import kernel
@@ -35,6 +37,20 @@ from ..sections import Rectangle, Section, section_of
 CABLE_NODE_DOFS = 6
 #: offsets of the nodal vectors within a node's coordinates
 CABLE_OFFSETS = {"r": 0, "r_x": 3}
+
+
+@functools.lru_cache(maxsize=64)
+def _gauss_slopes(lengths: tuple[float, ...]) -> tuple[np.ndarray, ...]:
+    """Per Gauss point of the 5-point rule, the slope shape rows (nel, 4) of elements of
+    these lengths (the kernel's ``cable_shape``; a pure function of the point and the
+    length: made once per mesh of a process, read only)."""
+    xg, _ = leggauss(5)
+    out = []
+    for x in 0.5 * (xg + 1.0):
+        slopes = np.array([kernel.cable_shape(x, length)[1] for length in lengths])
+        slopes.flags.writeable = False
+        out.append(slopes)
+    return tuple(out)
 
 
 class Cable(Body):
@@ -133,22 +149,10 @@ class Cable(Body):
         q = e[..., self.element_dofs()]                            # (..., 12, nel)
         q = np.moveaxis(q.reshape(*q.shape[:-2], 4, 3, self.nel), -1, -3)  # (..., nel, 4, 3)
         out = np.empty((*q.shape[:-2], 5))
-        for k, slopes in enumerate(self._gauss_slopes()):
+        for k, slopes in enumerate(_gauss_slopes(tuple(self.lengths.tolist()))):
             a = np.einsum("ij,...ijk->...ik", slopes, q)               # r' (..., nel, 3)
             out[..., k] = 0.5 * (np.einsum("...k,...k->...", a, a) - 1.0)
         return out
-
-    _slopes: list[np.ndarray] | None = None
-
-    def _gauss_slopes(self) -> list[np.ndarray]:
-        """Per Gauss point of :meth:`strains`, the shape functions' slopes (nel, 4) of every
-        element (kernel.cable_shape: nel calls each), made on the first call: a dynamic
-        run's tension is formed in blocks of rows (answers.DynamicAnswers)."""
-        if self._slopes is None:
-            self._slopes = [np.array([kernel.cable_shape(x, length)[1]
-                                      for length in self.lengths])
-                            for x in 0.5 * (leggauss(5)[0] + 1.0)]
-        return self._slopes
 
     def axial_forces(self, e) -> np.ndarray:
         """The axial force (N, tension positive) at the Gauss points of :meth:`strains`:
