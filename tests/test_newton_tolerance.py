@@ -1,10 +1,4 @@
-"""Newton control at large steps and loose tolerances (issue 38, item 3).
-
-A refresh of jacobian_reuse's matrix needs two corrections of that matrix: the first
-correction after a refresh is not measured against the old matrix's last (counters on the
-9-node cable pendulum at dt 5e-3).
-
-A loose Newton tolerance on a large-deformation model: the step's error
+"""A loose Newton tolerance on a large-deformation model (issue 38, item 3): the step's error
 is held to 1 % of the step's motion as well as to ``newton_tol x L`` (time_integrator's
 ``motion_fraction``), so ``newton_tol = 1e-4`` runs, and costs no more corrections than the
 default; and a failed step's message names an interval whose ends differ.
@@ -57,28 +51,6 @@ def test_a_loose_tolerance_runs_the_cubic_boom_within_it(tight, tol):
     assert float(np.abs(tip - ref).max()) <= tol * span
     assert loose.dynamic.newton_iterations <= tight.dynamic.newton_iterations
     assert loose.dynamic.factorizations <= 0.01 * loose.dynamic.steps
-
-
-def test_a_fresh_matrix_is_not_judged_by_the_old_ones_correction():
-    """The flexible pendulum as a planar cable, 9 nodes, dt 5e-3 (200 steps; issue 38's
-    coarse step): the predictor misses by 1e-2 .. 4e-1 m, the back-off starts most steps
-    with a fresh matrix, and each refresh cost another when the next correction was
-    compared with the old matrix's last: 243 factorizations in 200 steps on main 79ddcfa.
-    A refresh now follows a ratio of two corrections of one matrix, so a step refactorizes
-    at most once per two corrections after its first and the run takes fewer
-    factorizations than steps (measured 194, 1111 corrections against 1089), and its tip
-    stays converged."""
-    overrides = ["beam.nodes=9", "solver.dt=5e-3", "beam.bending=cable", "scene.planar=xy",
-                 "output.xdmf=.false."]
-    sim = simulate(INPUTS / "hard" / "pendulum.nml", overrides, progress=False)
-    assert sim.dynamic is not None and sim.dynamic.steps == 200
-    assert sim.dynamic.factorizations < sim.dynamic.steps
-    assert sim.dynamic.newton_iterations <= 1.05 * 1089
-    tight = simulate(INPUTS / "hard" / "pendulum.nml",
-                     overrides + ["solver.newton_tol=1e-12"], progress=False)
-    # newton_tol = 1e-10 and L = 1.2 m: each step's error is below tol L, and 200 steps
-    # keep the tip within 10 tol L of the newton_tol = 1e-12 run (measured 1.7 tol L)
-    assert float(np.abs(sim.probe("tip") - tight.probe("tip")).max()) <= 10 * 1e-10 * 1.2
 
 
 def test_a_failed_steps_interval_has_two_different_ends():

@@ -29,9 +29,8 @@
 !> * jacobian_iteration: at every iterate (full Newton);
 !> * jacobian_reuse (modified Newton across steps): kept from step to step while Newton
 !>   contracts; refreshed at the current iterate when a correction is not below
-!>   `contraction` times the previous one of the same matrix (from the step's third
-!>   correction on: min(contraction, settled_contraction) times it), when the number of
-!>   active contact points
+!>   `contraction` times the previous one (from the step's third correction on:
+!>   min(contraction, settled_contraction) times it), when the number of active contact points
 !>   differs from the factorization's, when beta' changed; a step that fails with a
 !>   matrix from an earlier step is retried once from its start with a fresh one. Where the
 !>   matrix of an earlier step does not serve (two steps in a row that started with it had
@@ -740,11 +739,6 @@ contains
         else
           refresh = last_correction > cfg%contraction * previous_correction
         end if
-        ! (a ratio measures a matrix only when both its corrections came from it: the
-        ! first correction after a refresh, against the old matrix's last, measured what the
-        ! old one left, and refreshed again: the 9-node cable pendulum at dt 5e-3, 243 ->
-        ! 194 factorizations, 1089 -> 1111 corrections)
-        refresh = refresh .and. it - 1 > refreshed_at
       case default
         ! a step whose tangent no longer halves the correction (a strongly nonlinear step):
         ! update it at the current iterate
