@@ -100,23 +100,41 @@ def test_a_spinning_beam_keeps_its_matrix_and_full_newtons_answer(tmp_path):
     kept matrix stops contracting within a step or two of the hub's turn and 'reuse'
     refactorizes in most steps; carried, a few matrices serve the run. Both answers are
     full Newton's within the Newton tolerance (ten times closer at a 1e-4 times tighter
-    tolerance, as tests/test_jacobian_reuse.py demands of reuse)."""
+    tolerance, as tests/test_jacobian_reuse.py demands of reuse).
+
+    The bound at newton_tol = 1e-8: a step ends when its correction is below newton_tol x
+    length (the model's length scale), and a contracting simplified Newton keeps at most
+    about that much error in the step's state, so the run's answer is within steps x
+    newton_tol x length of full Newton's (each step's kept error carried by the stable
+    motion, not amplified). Which steps refresh the kept matrix, and so where within that
+    bound the answer lands, follows round-off (main and a build differing from it only in
+    the last bits of the initial acceleration read 9.6e-6 and 1.7e-5 of the span for the
+    unturned matrix): the test asserts the bound and its scaling with the tolerance, not
+    one machine's sample."""
     off, fact_off, steps = run(tmp_path, "off", ["solver.carry=off", "solver.newton_tol=1e-8"])
+    off_tight, *_ = run(tmp_path, "off_tight", ["solver.carry=off", "solver.newton_tol=1e-12"])
     on, fact_on, _ = run(tmp_path, "on", ["solver.carry=rotation", "solver.newton_tol=1e-8"])
     full, *_ = run(tmp_path, "full", ["solver.jacobian=iteration", "solver.newton_tol=1e-8"])
     on_tight, *_ = run(tmp_path, "on_tight", ["solver.newton_tol=1e-12"])
     full_tight, *_ = run(tmp_path, "full_tight", ["solver.jacobian=iteration",
                                                   "solver.newton_tol=1e-12"])
     span = np.ptp(full, axis=0).max()
+    length = build_model(load_scene(SPINUP, ["spinup.omega=6", "beam.nodes=6",
+                                             "scene.planar=xy"])).length_scale
+    bound = steps * 1e-8 * length / span
     d_loose = np.abs(on - full).max() / span
     d_tight = np.abs(on_tight - full_tight).max() / span
+    d_off = np.abs(off - full).max() / span
+    d_off_tight = np.abs(off_tight - full_tight).max() / span
     print(f"\nfactorizations: carried {fact_on}, unturned {fact_off}, {steps} steps; "
-          f"carried - full Newton {d_loose:.2e} (1e-8), {d_tight:.2e} (1e-12)")
+          f"carried - full Newton {d_loose:.2e} (1e-8), {d_tight:.2e} (1e-12); unturned "
+          f"{d_off:.2e}, {d_off_tight:.2e}; bound {bound:.2e}")
     assert fact_off > 0.5 * steps
     assert fact_on < 0.05 * steps
-    assert d_loose < 1e-5
+    assert d_loose < bound
     assert d_tight < max(d_loose / 10, 1e-11)
-    assert np.abs(off - full).max() / span < 1e-5
+    assert d_off < bound
+    assert d_off_tight < max(d_off / 10, 1e-11)
 
 
 def test_a_planar_spinning_cable_keeps_its_matrix_turned_in_closed_form(tmp_path):
