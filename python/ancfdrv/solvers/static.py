@@ -347,8 +347,8 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     timing["assembly"] += time.perf_counter() - t0
     solved = np.zeros((0, 1 + nl + nd))  # the constraints hold every coordinate: no e_R
     if len(rest):
-        with DirectSolver(len(rest), k_rr.row_index(), k_rr.indices,
-                          what="split iteration K_RR") as solver:
+        with DirectSolver.by_cost(len(rest), k_rr.row_index(), k_rr.indices,
+                                  what="split iteration K_RR") as solver:
             try:
                 t0 = time.perf_counter()
                 solver.factorize(k_rr.data)
