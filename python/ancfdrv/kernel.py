@@ -478,7 +478,8 @@ _MUMPS_MESSAGES = {-10: "the matrix is numerically singular",
 
 
 class DirectSolver:
-    """Sparse direct solver (sequential MUMPS) behind a kernel handle.
+    """Sparse direct solver (sequential MUMPS, LAPACK's banded Cholesky or LU) behind a
+    kernel handle.
 
     Analyse a coordinate pattern once, factorize as values change, solve many right-hand
     sides per factorization. Use as a context manager or call :meth:`close`.
