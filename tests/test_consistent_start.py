@@ -2,9 +2,9 @@
 (``fortran/src/solvers/consistent_start.f90``: the start of a run and the step-size
 control's restarts). References: the equations of motion M a - Phi_e^T lambda = f and the
 constraints' acceleration equation Phi_e a = gamma, evaluated in Python from the model's
-forces, constraint gradients and mass matrix. A model whose iteration matrix the banded
-solver factorizes solves it by that solver too (M banded, the multipliers by their Schur
-complement); any other by MUMPS on the saddle system: the cases cover both."""
+forces, constraint gradients and mass matrix. The saddle system is solved by the cost
+rule's solver for its pattern (banded LU in reverse Cuthill-McKee order, else MUMPS);
+the cases cover iteration matrices of both the banded and the MUMPS kinds."""
 from __future__ import annotations
 
 import subprocess

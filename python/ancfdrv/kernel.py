@@ -478,7 +478,8 @@ _MUMPS_MESSAGES = {-10: "the matrix is numerically singular",
 
 
 class DirectSolver:
-    """Sparse direct solver (sequential MUMPS) behind a kernel handle.
+    """Sparse direct solver (sequential MUMPS, LAPACK's banded Cholesky or LU) behind a
+    kernel handle.
 
     Analyse a coordinate pattern once, factorize as values change, solve many right-hand
     sides per factorization. Use as a context manager or call :meth:`close`.
@@ -508,6 +509,26 @@ class DirectSolver:
         info, detail = _kernel.direct_analyse(handle, n, _f(np.asarray(rows) + 1, np.int32),
                                               _f(np.asarray(cols) + 1, np.int32))
         self._check(info, detail, "analyse")
+
+    @classmethod
+    def by_cost(cls, n: int, rows: np.ndarray, cols: np.ndarray, *,
+                what: str = "system matrix") -> "DirectSolver":
+        """The solver the kernel's cost rule picks for any (e.g. saddle-point) pattern, the
+        rule of the static Newton and the consistent start (``sparse_direct``'s
+        solver_create_for): LAPACK's banded LU in the reverse Cuthill-McKee order of the
+        pattern's symmetric closure when 4 n kd^2 <= ``Model.BANDED_LU_FLOPS``, else MUMPS
+        (general; give every entry). ``banded_lu`` and ``width`` (kd in that order) say
+        which."""
+        self = cls.__new__(cls)
+        self.what, self.n, self.nnz = what, n, len(rows)
+        self.factorizations = 0
+        self.solves = 0
+        self.handle = 0
+        handle, width, banded, info, detail = _kernel.direct_create_for(
+            n, _f(np.asarray(rows) + 1, np.int32), _f(np.asarray(cols) + 1, np.int32))
+        self._check(info, detail, "creation and analysis")
+        self.handle, self.width, self.banded_lu = handle, int(width), bool(banded)
+        return self
 
     def analyse(self, n: int, rows: np.ndarray, cols: np.ndarray) -> None:
         """Another pattern on the same solver (MUMPS analyses it anew; no new instance),

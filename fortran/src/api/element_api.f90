@@ -538,6 +538,18 @@ subroutine direct_create(symmetry, handle, info, info_detail)
   call solver_create(symmetry, handle, info, info_detail)
 end subroutine direct_create
 
+!> A solver of the kind the cost rule picks for the pattern (sparse_direct's
+!> solver_create_for), analysed; banded: 1 for the banded LU, 0 for MUMPS; width: the
+!> pattern's half-bandwidth in its reverse Cuthill-McKee order.
+subroutine direct_create_for(n, nnz, rows, cols, handle, width, banded, info, info_detail)
+  use sparse_direct, only: solver_create_for, solver_banded_lu
+  implicit none
+  integer, intent(in) :: n, nnz, rows(nnz), cols(nnz)
+  integer, intent(out) :: handle, width, banded, info, info_detail
+  call solver_create_for(n, nnz, rows, cols, handle, width, info, info_detail)
+  banded = merge(1, 0, solver_banded_lu(handle))
+end subroutine direct_create_for
+
 subroutine direct_order(handle, n, place, info)
   use sparse_direct, only: solver_order
   implicit none

@@ -9,7 +9,11 @@
 !> the matrix not positive definite (a tangent stiffness under compression), the same
 !> handle falls back to the banded LU. A banded kind may be given an ordering of the
 !> unknowns (solver_order, e.g. reverse Cuthill-McKee) that narrows the band; its callers
-!> keep the original numbering. The handle table is the kernel's only module state.
+!> keep the original numbering. solver_create_for picks the kind for a model's unsymmetric
+!> or indefinite systems (the saddle-point systems of the static Newton and the consistent
+!> start) by the rule the iteration matrix's kind is chosen by (Model.band_order): the banded
+!> LU in the pattern's reverse Cuthill-McKee order when its factorization costs at most
+!> banded_lu_flops (4 n kd^2), else MUMPS. The handle table is the kernel's only module state.
 !> info: 0 ok; 1 bad handle or no free slot; 2 call out of sequence (solve before
 !> factorize, ...); 3 size mismatch; < 0 MUMPS INFOG(1) (-10: numerically singular),
 !> with INFOG(2) in info_detail; the banded kind reports a non-positive-definite matrix
@@ -21,12 +25,15 @@ module sparse_direct
   include 'mpif.h'
   include 'dmumps_struc.h'
   public :: solver_create, solver_order, solver_analyse, solver_factorize, solver_solve, &
-            solver_destroy, solver_banded
+            solver_destroy, solver_create_for, solver_banded_lu
 
   !> symmetry code that selects the banded LAPACK Cholesky
   integer, parameter, public :: banded_spd = 3
   !> symmetry code that selects the banded LAPACK LU (general matrices)
   integer, parameter, public :: banded_general = 4
+  !> the banded LU replaces MUMPS when its factorization takes at most this many flops
+  !> (4 n kd^2): python/ancfdrv/system/model.py's Model.BANDED_LU_FLOPS, the same rule
+  real(dp), parameter, public :: banded_lu_flops = 5.0e7_dp
 
   type :: solver_slot
     type(dmumps_struc) :: id
@@ -126,6 +133,193 @@ contains
       end do
     end do
   end subroutine lu_band_solve
+
+  !> A solver for the n x n pattern (rows, cols: 1-based coordinates, duplicates allowed),
+  !> analysed, of the kind the cost rule picks: LAPACK's banded LU in the reverse
+  !> Cuthill-McKee order of the pattern's symmetric closure (band_order) when
+  !> 4 n kd^2 <= banded_lu_flops, else MUMPS (general). width: kd in that order (whichever
+  !> kind was chosen). info as solver_create and solver_analyse (3: an entry outside 1..n);
+  !> on failure no handle is left behind (handle 0).
+  subroutine solver_create_for(n, nnz, rows, cols, handle, width, info, info_detail)
+    integer, intent(in) :: n, nnz, rows(nnz), cols(nnz)
+    integer, intent(out) :: handle, width, info, info_detail
+    integer, allocatable :: place(:)
+    integer :: ignored
+    allocate (place(n))
+    handle = 0
+    width = 0
+    info_detail = 0
+    info = 3
+    if (any(rows < 1) .or. any(rows > n) .or. any(cols < 1) .or. any(cols > n)) return
+    call band_order(n, nnz, rows, cols, place, width)
+    if (4.0_dp * real(n, dp) * real(width, dp)**2 <= banded_lu_flops) then
+      call solver_create(banded_general, handle, info, info_detail)
+      if (info == 0) call solver_order(handle, n, place, info)
+    else
+      call solver_create(0, handle, info, info_detail)
+    end if
+    if (info == 0) call solver_analyse(handle, n, nnz, rows, cols, info, info_detail)
+    if (info /= 0 .and. handle /= 0) then
+      call solver_destroy(handle, ignored)
+      handle = 0
+    end if
+  end subroutine solver_create_for
+
+  !> Reverse Cuthill-McKee order of the symmetric closure of the pattern (rows, cols), as
+  !> python/ancfdrv/system/patterns.py's Pattern.band_order: each connected component from a
+  !> pseudo-peripheral start (George and Liu: the last level's node of lowest degree, lowest
+  !> index among equals, until the number of levels stops growing), seeds and neighbours
+  !> in increasing (degree, index); the degree counts a node's distinct neighbours, itself
+  !> included when the pattern has its diagonal entry. place(i): the position (1..n) of
+  !> unknown i; width: max |place(i) - place(j)| over the entries.
+  subroutine band_order(n, nnz, rows, cols, place, width)
+    integer, intent(in) :: n, nnz, rows(nnz), cols(nnz)
+    integer, intent(out) :: place(n), width
+    integer, allocatable :: ptr(:), fill(:), adj(:), degree(:), mark(:), seeds(:), order(:), &
+                            level(:), queue(:), start_count(:)
+    logical, allocatable :: visited(:)
+    integer :: k, i, j, p, q, head, seed, start, candidate, nlevels, deeper, count, found, &
+               first
+    allocate (ptr(n + 1), fill(n), adj(2 * nnz), degree(n), mark(n), seeds(n), order(n), &
+              level(n), queue(n), start_count(0:n), visited(n))
+    ! the symmetric closure, duplicates dropped (each row's neighbours in any order: every
+    ! ordering below sorts by (degree, index))
+    ptr = 0
+    do k = 1, nnz
+      ptr(rows(k)) = ptr(rows(k)) + 1
+      if (rows(k) /= cols(k)) ptr(cols(k)) = ptr(cols(k)) + 1
+    end do
+    p = 1
+    do i = 1, n
+      q = ptr(i)
+      ptr(i) = p
+      p = p + q
+    end do
+    ptr(n + 1) = p
+    fill = ptr(1:n)
+    do k = 1, nnz
+      adj(fill(rows(k))) = cols(k)
+      fill(rows(k)) = fill(rows(k)) + 1
+      if (rows(k) /= cols(k)) then
+        adj(fill(cols(k))) = rows(k)
+        fill(cols(k)) = fill(cols(k)) + 1
+      end if
+    end do
+    mark = 0
+    p = 1
+    do i = 1, n
+      first = p
+      do k = ptr(i), ptr(i + 1) - 1
+        j = adj(k)
+        if (mark(j) == i) cycle
+        mark(j) = i
+        adj(p) = j
+        p = p + 1
+      end do
+      ptr(i) = first
+      degree(i) = p - first
+    end do
+    ptr(n + 1) = p
+    ! the seeds in increasing (degree, index): a counting sort by degree
+    start_count = 0
+    do i = 1, n
+      start_count(degree(i)) = start_count(degree(i)) + 1
+    end do
+    p = 1
+    do k = 0, n
+      q = start_count(k)
+      start_count(k) = p
+      p = p + q
+    end do
+    do i = 1, n
+      seeds(start_count(degree(i))) = i
+      start_count(degree(i)) = start_count(degree(i)) + 1
+    end do
+    visited = .false.
+    count = 0
+    do k = 1, n
+      seed = seeds(k)
+      if (visited(seed)) cycle
+      start = seed
+      call levels_from(start, nlevels, candidate)
+      do
+        call levels_from(candidate, deeper, found)
+        if (deeper <= nlevels) exit
+        start = candidate
+        nlevels = deeper
+        candidate = found
+      end do
+      ! Cuthill-McKee from start: each node's unvisited neighbours in (degree, index) order
+      head = count + 1
+      count = count + 1
+      order(count) = start
+      visited(start) = .true.
+      do while (head <= count)
+        i = order(head)
+        head = head + 1
+        first = count + 1
+        do p = ptr(i), ptr(i + 1) - 1
+          j = adj(p)
+          if (visited(j)) cycle
+          visited(j) = .true.
+          count = count + 1
+          order(count) = j
+          ! insertion into the sorted tail first .. count
+          q = count
+          do while (q > first)
+            if (before(order(q - 1), j)) exit
+            order(q) = order(q - 1)
+            q = q - 1
+          end do
+          order(q) = j
+        end do
+      end do
+    end do
+    do k = 1, n
+      place(order(k)) = n + 1 - k
+    end do
+    width = 0
+    if (nnz > 0) width = maxval(abs(place(rows) - place(cols)))
+
+  contains
+
+    !> a precedes b in (degree, index)
+    pure logical function before(a, b)
+      integer, intent(in) :: a, b
+      before = degree(a) < degree(b) .or. (degree(a) == degree(b) .and. a < b)
+    end function before
+
+    !> breadth-first levels from s: their number and the last level's first node in
+    !> (degree, index)
+    subroutine levels_from(s, number, last_first)
+      integer, intent(in) :: s
+      integer, intent(out) :: number, last_first
+      integer :: h, t, u, v, r
+      level = 0
+      level(s) = 1
+      queue(1) = s
+      h = 1
+      t = 1
+      do while (h <= t)
+        u = queue(h)
+        h = h + 1
+        do r = ptr(u), ptr(u + 1) - 1
+          v = adj(r)
+          if (level(v) /= 0) cycle
+          level(v) = level(u) + 1
+          t = t + 1
+          queue(t) = v
+        end do
+      end do
+      number = level(queue(t))
+      last_first = queue(t)
+      do r = t, 1, -1
+        if (level(queue(r)) /= number) exit
+        if (before(queue(r), last_first)) last_first = queue(r)
+      end do
+    end subroutine levels_from
+
+  end subroutine band_order
 
   !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only),
   !> 3 = symmetric positive definite, banded LAPACK Cholesky (give both triangles or one),
@@ -475,15 +669,12 @@ contains
     if (info_detail /= 0) info = -10
   end subroutine banded_lu
 
-  !> Whether handle is a solver of the banded Cholesky kind (symmetry banded_spd, whether or
-  !> not a factorization fell back to its LU): a model's other symmetric solves go through
-  !> the kind its iteration matrix uses. The general banded LU kind (banded_lu) answers no:
-  !> its models' saddle solves stay with MUMPS.
-  logical function solver_banded(handle)
+  !> Whether handle is a solver of the banded LU kind (banded_general).
+  logical function solver_banded_lu(handle)
     integer, intent(in) :: handle
-    solver_banded = .false.
-    if (valid(handle)) solver_banded = slots(handle)%banded .and. .not. slots(handle)%general
-  end function solver_banded
+    solver_banded_lu = .false.
+    if (valid(handle)) solver_banded_lu = slots(handle)%banded .and. slots(handle)%general
+  end function solver_banded_lu
 
   logical function valid(handle)
     integer, intent(in) :: handle

@@ -8,8 +8,11 @@
 !> symmetric saddle-point system
 !>   [[K - dQ/de - sum_k lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] [de; dlambda] = [-r; Phi]
 !> (K: the tangent of internal_forces with the point loads' Jacobian; dQ/de: the dead
-!> moments' Jacobian; H_k: the constraint Hessians), factorized by sequential MUMPS
-!> (sparse_direct: the pattern analysed once per call) - the stepper's iteration matrix
+!> moments' Jacobian; H_k: the constraint Hessians), factorized by the solver the cost rule
+!> picks for its pattern (sparse_direct's solver_create_for: the banded LU in reverse
+!> Cuthill-McKee order when cheap, else MUMPS), one instance per model kept in its
+!> iteration_matrix (saddle_handle) and analysed once while the pattern stays (every load
+!> step and path step of a static solve reuses it) - the stepper's iteration matrix
 !> beta' M + K regularizes the rigid modes, the static one has the multipliers for them.
 !> The convergence test is static.py's converged (its floor as tests/reference/
 !> static_newton.py's residual_floor): the relative force residual and the constraint
@@ -41,8 +44,7 @@ module static_solver
                                external_forces, contact_record
   use system_constraints, only: constraint_derivatives, constraint_reaction
   use system_loads, only: moment_pattern_size, moment_pattern, moment_tangent
-  use sparse_direct, only: solver_create, solver_analyse, solver_factorize, solver_solve, &
-                           solver_destroy
+  use sparse_direct, only: solver_create_for, solver_factorize, solver_solve, solver_destroy
   use kernel_errors, only: failure_text, message_length
   implicit none
   private
@@ -99,7 +101,7 @@ contains
                            length_scale, max_iter, check_start, force_scale, iterations, &
                            history, force_res, con_res, converged_by, factorizations, info, &
                            detail, path)
-    type(system_model), intent(in) :: sys
+    type(system_model), intent(inout) :: sys
     real(dp), intent(in) :: t, load_factor, e0(:), tol, length_scale
     integer, intent(in) :: rows(:), cols(:), max_iter
     logical, intent(in) :: check_start
@@ -109,7 +111,7 @@ contains
     real(dp), intent(out) :: history(:), force_res, con_res
     type(path_request), intent(inout), optional :: path
     integer :: n, ncon, nnz, nhess, nmom, ngrad, total, handle, it, c, s1, s2, k1, k2, k, m
-    integer :: i, j, a, b, best, since, destroy_info
+    integer :: i, j, a, b, best, since, destroy_info, width
     integer, allocatable :: srows(:), scols(:)
     real(dp), allocatable :: values(:), tangent(:), rhs(:, :)
     real(dp) :: internal(size(e)), loads(size(e)), reaction(size(e)), residual(size(e))
@@ -192,19 +194,30 @@ contains
         end do
       end do
     end do
-    call solver_create(0, handle, info, detail)
-    if (info /= 0) then
-      detail = info
-      info = static_solve_failed
-      return
-    end if
-    call solver_analyse(handle, n + ncon, total, srows, scols, info, detail)
-    if (info /= 0) then
-      detail = info
-      info = static_solve_failed
-      call solver_destroy(handle, destroy_info)
-      return
-    end if
+    ! the model's saddle-point solver, analysed anew only for a new pattern
+    associate (m => sys%matrix)
+      if (m%saddle_handle /= 0) then
+        if (size(m%saddle_rows) /= total) then
+          call solver_destroy(m%saddle_handle, destroy_info)
+          m%saddle_handle = 0
+        else if (any(m%saddle_rows /= srows) .or. any(m%saddle_cols /= scols)) then
+          call solver_destroy(m%saddle_handle, destroy_info)
+          m%saddle_handle = 0
+        end if
+      end if
+      if (m%saddle_handle == 0) then
+        call solver_create_for(n + ncon, total, srows, scols, m%saddle_handle, width, info, &
+                               detail)
+        if (info /= 0) then
+          detail = info
+          info = static_solve_failed
+          return
+        end if
+        m%saddle_rows = srows
+        m%saddle_cols = scols
+      end if
+      handle = m%saddle_handle
+    end associate
     do it = 1, max_iter
       call evaluate(.true.)
       if (info /= 0) exit
@@ -369,7 +382,6 @@ contains
       end if
     end do
     if (info == 0 .and. converged_by == 0) info = static_limit
-    call solver_destroy(handle, destroy_info)
 
   contains
 

@@ -24,6 +24,11 @@ module system_iteration
     logical :: factorized = .false.
     real(dp) :: factor_beta_prime = 0.0_dp
     integer :: factor_active = -1                      ! active contact points at it
+    ! the static Newton's saddle-point solver (sparse_direct's solver_create_for) and the
+    ! pattern it analysed: made by the first static call, kept while the pattern stays,
+    ! released with the system (system_store)
+    integer :: saddle_handle = 0
+    integer, allocatable :: saddle_rows(:), saddle_cols(:)
     ! (what the stepper learns from step to step lives apart: stepper.f90)
     real(dp), allocatable :: flexibility(:, :), flexibility_cc(:, :)
   end type iteration_matrix

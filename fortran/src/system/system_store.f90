@@ -6,6 +6,7 @@
 module system_store
   use mechanical_system, only: system_model
   use stepper, only: stepper_run
+  use sparse_direct, only: solver_destroy
   implicit none
   private
   public :: store_create, store_destroy, store_get
@@ -40,13 +41,17 @@ contains
     end do
   end subroutine store_create
 
-  !> Releases a system (its arrays). info = 1: not a live handle.
+  !> Releases a system (its arrays and the static Newton's solver, which the system owns;
+  !> its iteration matrix's solver is its creator's). info = 1: not a live handle.
   subroutine store_destroy(handle, info)
     integer, intent(in) :: handle
     integer, intent(out) :: info
+    integer :: ignored
     info = 1
     if (handle < 1 .or. handle > max_systems) return
     if (.not. slots(handle)%in_use) return
+    if (slots(handle)%model%matrix%saddle_handle /= 0) &
+      call solver_destroy(slots(handle)%model%matrix%saddle_handle, ignored)
     slots(handle)%model = system_model()
     slots(handle)%stepper = stepper_run()
     slots(handle)%in_use = .false.

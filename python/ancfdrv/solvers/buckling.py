@@ -224,8 +224,8 @@ def _dense(basis: np.ndarray, k1: sp.spmatrix, kg: sp.spmatrix):
 def _sparse(k0: sp.spmatrix, kg: sp.spmatrix, g: sp.spmatrix, count: int, tol: float):
     n, ncon = k0.shape[0], g.shape[0]
     aug = sp.bmat([[k0, g.T], [g, None]], format="coo")
-    solver = DirectSolver(n + ncon, aug.row, aug.col,
-                          what="buckling matrix [[K_0, G^T], [G, 0]]")
+    solver = DirectSolver.by_cost(n + ncon, aug.row, aug.col,
+                                  what="buckling matrix [[K_0, G^T], [G, 0]]")
     try:
         solver.factorize(aug.data)
 
@@ -315,7 +315,8 @@ def _lowest(k: sp.spmatrix, m: sp.spmatrix, g: sp.spmatrix, method: str,
     aug = sp.bmat([[k, g.T], [g, None]], format="csr")
     b = sp.bmat([[m, None], [None, sp.csr_matrix((ncon, ncon))]], format="csr")
     shifted = (aug - sigma * b).tocoo()
-    solver = DirectSolver(n + ncon, shifted.row, shifted.col, what="buckling softest modes")
+    solver = DirectSolver.by_cost(n + ncon, shifted.row, shifted.col,
+                                  what="buckling softest modes")
     try:
         solver.factorize(shifted.data)
         op = spla.LinearOperator((n + ncon, n + ncon), matvec=solver.solve, dtype=float)

@@ -220,8 +220,8 @@ def _sparse_modes(lin: Linearization, count: int, shift: float, tol: float):
     shifted = sp.bmat([[lin.stiffness - shift * lin.mass, g.T], [g, None]], format="coo")
     b = sp.bmat([[lin.mass, None], [None, sp.csr_matrix((ncon, ncon))]], format="csr")
     a = sp.bmat([[lin.stiffness, g.T], [g, None]], format="csr")
-    solver = DirectSolver(n + ncon, shifted.row, shifted.col,
-                          what="modal shift-invert matrix [[K - sigma M, G^T], [G, 0]]")
+    solver = DirectSolver.by_cost(n + ncon, shifted.row, shifted.col,
+                                  what="modal shift-invert matrix [[K - sigma M, G^T], [G, 0]]")
     try:
         solver.factorize(shifted.data)
         op = spla.LinearOperator((n + ncon, n + ncon), matvec=lambda x: solver.solve(x),

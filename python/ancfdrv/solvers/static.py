@@ -3,7 +3,8 @@
 Two solvers share one convergence test (:func:`residuals`):
 
 * :func:`solve_newton` - Newton-Raphson on the symmetric saddle-point system
-  [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] with MUMPS, in the kernel
+  [[K - dQ/de - sum lambda_k H_k, -Phi_e^T], [-Phi_e, 0]] (banded LU or MUMPS by the
+  cost rule, one solver per model across load steps), in the kernel
   (fortran/src/solvers/static_solver.f90: the stepper's residual with the inertia off, one
   call per load step, the load factor an argument; with the load factor an unknown the
   same kernel Newton takes the steps of an arc-length path, solvers/path.py); the same
@@ -169,7 +170,7 @@ def solve_newton(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
     """Full Newton-Raphson on (e, lambda) from the rigid configuration, in the kernel
     (``fortran/src/solvers/static_solver.f90``, issue 25 item 4): the stepper's residual with
     the inertia terms off, the saddle-point matrix [[K - dQ/de - sum lambda_k H_k,
-    -Phi_e^T], [-Phi_e, 0]] factorized by MUMPS, the convergence test of :func:`converged`
+    -Phi_e^T], [-Phi_e, 0]] factorized by the cost rule's solver, the convergence test of :func:`converged`
     with the residual's round-off floor eps || |K| |e| || / scale. The loads are applied in ``load_steps`` equal increments
     (large deformation), each solved to tol by one kernel call with its load factor as an
     argument. ``loads`` scales the external loads (gravity, forces, moments, pressure) of
@@ -347,8 +348,8 @@ def solve_split(model: Model, *, tol: float = 1e-10, max_iter: int = 50, p: floa
     timing["assembly"] += time.perf_counter() - t0
     solved = np.zeros((0, 1 + nl + nd))  # the constraints hold every coordinate: no e_R
     if len(rest):
-        with DirectSolver(len(rest), k_rr.row_index(), k_rr.indices,
-                          what="split iteration K_RR") as solver:
+        with DirectSolver.by_cost(len(rest), k_rr.row_index(), k_rr.indices,
+                                  what="split iteration K_RR") as solver:
             try:
                 t0 = time.perf_counter()
                 solver.factorize(k_rr.data)

@@ -622,7 +622,9 @@ class Model:
     #: costs per call (some 50 us per solve, whatever the size: it estimates the memory a
     #: save would take on each call) outweigh its savings on fill. The two-leaf spring
     #: (n = 370, kd = 125 after reverse Cuthill-McKee: 2.3e7 flops): 0.58 against MUMPS's
-    #: 0.86 ms per factorization and 18 against 67 us per solve.
+    #: 0.86 ms per factorization and 18 against 67 us per solve. The kernel applies the same
+    #: rule (fortran/src/linalg/sparse_direct.f90, banded_lu_flops) to the saddle-point
+    #: systems it factorizes (static Newton, consistent start; DirectSolver.by_cost).
     BANDED_LU_FLOPS = 5.0e7
 
     def band_order(self) -> np.ndarray | None:
