@@ -27,7 +27,8 @@ import numpy as np
 
 #: (scene, short t_end in s)
 SCENES = [
-    ("inputs/boom_luffing.nml", 0.3), ("inputs/curved_leaf.nml", 0.005),
+    ("inputs/boom_luffing.nml", 0.3), ("inputs/boom_luffing_cable.nml", 0.3),
+    ("inputs/curved_leaf.nml", 0.005),
     ("inputs/leaf_spring.nml", 0.15), ("inputs/leaf_spring_cycle.nml", 0.1),
     ("inputs/leaf_spring_road.nml", 0.1), ("inputs/plate_pendulum.nml", 0.1),
     ("inputs/general/boom_luffing.nml", 0.3), ("inputs/general/curved_leaf.nml", 0.005),

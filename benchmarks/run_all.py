@@ -91,6 +91,8 @@ BENCHES = [
     Bench("accuracy_chart", "every accuracy knob of the luffing boom on one chart",
           full=("--chart", "{out}/boom_accuracy_vs_time.png", "-o", "{out}/accuracy_chart"),
           quick=None, out=None),
+    Bench("boom_front", "the luffing boom's error-against-time front over step, mesh, Newton "
+          "tolerance and output; each accuracy level's fastest configuration", quick=None),
     Bench("peer_harness", "ancfdrv against Exudyn on the same problems", needs="exudyn"),
     Bench("peer_exudyn", "accuracy against time with Exudyn's ANCFCable2D, hard cases",
           needs="exudyn"),
