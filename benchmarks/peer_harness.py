@@ -1665,7 +1665,9 @@ def choose_level_tolerances(configs: list[LevelConfig], boom: Boom, base: list[s
                        else t["setting"].label} for t in record]
         change = next(t["change"] for t in record if t["setting"] == setting)
         name = f"{setting:g}" if c.code == "ancfdrv" else setting.label
-        print(f"  tolerance {c.code:>7} {c.label:<40} -> {name} (history change "
+        where = (f"cable {c.nodes} nodes" if c.code == "ancfdrv"
+                 else f"{3 * c.per_segment} el") + f", dt {c.dt:g}"
+        print(f"  tolerance {c.code:>7} {where:<24} -> {name} (history change "
               f"{change:.2e} of the range)", flush=True)
     result, by_label = [], {}
     for c in configs:
