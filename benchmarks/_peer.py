@@ -1,13 +1,49 @@
 """Helpers shared by the benchmarks that run the peer code Exudyn (``peer_exudyn.py``,
 ``peer_harness.py``): importing it (optional dependency), its version, and its simulation
-settings by their current names."""
+settings by their current names, and the one rule both codes' Newton tolerances are chosen
+by (:func:`loosest_keeping`)."""
 from __future__ import annotations
 
 import contextlib
 import io
 import sys
 import warnings
-from typing import Any, Callable
+from typing import Any, Callable, Sequence, TypeVar
+
+import numpy as np
+
+T = TypeVar("T")
+
+#: A Newton tolerance keeps the history when the history moves by at most this fraction of
+#: its range against the same configuration at a tight tolerance (issue 38: 0.004 %).
+HISTORY_KEEP = 4e-5
+
+
+def loosest_keeping(history_at: Callable[[T], np.ndarray], loosest_first: Sequence[T],
+                    tight: T, fraction: float = HISTORY_KEEP,
+                    errors: tuple[type[BaseException], ...] = (RuntimeError, ValueError),
+                    ) -> tuple[T, list[dict[str, Any]]]:
+    """The loosest of ``loosest_first`` whose history (``history_at(setting)``, the compared
+    samples of one configuration) differs from ``history_at(tight)`` by at most ``fraction``
+    of the tight history's range (max over the samples), and what each setting tried gave:
+    ``{"setting", "change" (max difference / range, None if the run failed), "message"}``,
+    the tight run first (change 0). Settings are tried loosest first and the first that keeps
+    the history is chosen (none: ``tight``). The same rule for both codes; a failure of the
+    tight run raises."""
+    reference = history_at(tight)
+    scale = float(np.ptp(reference))
+    tried: list[dict[str, Any]] = [{"setting": tight, "change": 0.0, "message": ""}]
+    for setting in loosest_first:
+        try:
+            change = float(np.max(np.abs(history_at(setting) - reference))) / scale
+        except errors as exc:
+            tried.append({"setting": setting, "change": None,
+                          "message": " ".join(f"{type(exc).__name__}: {exc}".split())})
+            continue
+        tried.append({"setting": setting, "change": change, "message": ""})
+        if change <= fraction:
+            return setting, tried
+    return tight, tried
 
 
 def import_exudyn(fast: bool = False) -> tuple[Any, str | None]:

@@ -105,19 +105,26 @@ from typing import Any, Callable
 
 import h5py
 import numpy as np
-from _peer import exudyn_version, import_exudyn, quiet_settings, run_quietly
+from _peer import (HISTORY_KEEP, exudyn_version, import_exudyn, loosest_keeping,
+                   quiet_settings, run_quietly)
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
 #: Another engineer reinstalls ancfdrv from time to time: how long to wait before retrying.
-#: Exudyn's Newton: (absolute, relative) tolerances tried in turn, the first that works is
-#: recorded with the run. Its default absolute tolerance (1e-10) lies below the round-off
-#: floor of the spin-up's residual (EA = 2.8e7 N): Newton then never converges and the
-#: fixed-step solve stops. The pendulum runs at its loosest tolerances that keep the history
-#: (issue 38: 1e-6 / 1e-6).
+#: Exudyn's Newton: (absolute, relative) tolerances, tightest first. The first that works is
+#: the run's tight setting (Exudyn's default absolute tolerance, 1e-10, lies below the
+#: round-off floor of the spin-up's residual, EA = 2.8e7 N: Newton then never converges and
+#: the fixed-step solve stops); of the looser ones, the timed run takes the loosest that keeps
+#: its history within HISTORY_KEEP of the range of the tight run's (_peer.loosest_keeping,
+#: the rule ancfdrv's newton_tol is chosen by). The code's reference (a grid's last run)
+#: runs at the tight setting.
 EXUDYN_TOLERANCES: dict[str, tuple[tuple[float, float], ...]] = {
-    "pendulum": ((1e-6, 1e-6),),
+    "pendulum": ((1e-10, 1e-8), (1e-6, 1e-6), (1e-3, 1e-6), (1e-2, 1e-5)),
     "spinup": ((1e-10, 1e-8), (1e-8, 1e-8), (1e-6, 1e-8), (1e-4, 1e-8))}
+#: ancfdrv's newton_tol: the candidates (loosest first) and the tight setting of the same
+#: rule; the code's reference runs at the scene's newton_tol (1e-10).
+ANCFDRV_NEWTON_TOLS = (1e-4, 1e-6, 1e-8, 1e-10)
+ANCFDRV_TIGHT_TOL = 1e-12
 #: Problems whose Exudyn runs update the modified Newton's Jacobian at most once a step.
 EXUDYN_JACOBIAN_PER_STEP = frozenset({"spinup"})
 #: Exudyn's sensors store every 0.01 s (or every step if that is longer).
@@ -252,15 +259,17 @@ def import_ancfdrv() -> None:
     importlib.import_module("ancfdrv.simulation")
 
 
-def ancfdrv_overrides(problem: Problem, nodes: int, dt: float, bending: str) -> list[str]:
+def ancfdrv_overrides(problem: Problem, nodes: int, dt: float, bending: str,
+                      newton_tol: float | None = None) -> list[str]:
     """``bending``: 'cubic' or 'continuum', with '-planar' the scene reduced to its plane
     (``scene.planar = 'xy'``, issue 23); 'cable-planar': the pendulum or the spin-up as an
     ANCF cable (bending about the plane's normal; the spin-up's hub holds r and r_x),
-    reduced."""
+    reduced. ``newton_tol`` None: the scene's."""
     option, _, planar = bending.partition("-")
     return [*problem.overrides, f"beam.nodes={nodes}", f"solver.dt={dt!r}",
             f"solver.t_end={problem.t_end!r}", f"beam.bending={option}"] + \
-        (["scene.planar=xy"] if planar == "planar" else [])
+        (["scene.planar=xy"] if planar == "planar" else []) + \
+        ([f"solver.newton_tol={newton_tol!r}"] if newton_tol is not None else [])
 
 
 def tip_history(problem: Problem, path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -273,14 +282,16 @@ def tip_history(problem: Problem, path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def run_ancfdrv(problem: Problem, nodes: int, dt: float, bending: str, workdir: Path,
-                args: argparse.Namespace) -> Run:
+                args: argparse.Namespace, choose_tol: bool = False) -> Run:
     """The in-memory call (:func:`ancfdrv.simulate`, the compared time ``wall_s``) repeated
     back to back as Exudyn's call is (:func:`best_of`), then the
     :func:`ancfdrv.runner.run_scene` call writing the HDF5 file (``wall_file_s``) repeated
     the same way; a SolverError is recorded, not raised. (Until the sixth wave the file call
     ran after each in-memory repeat: every in-memory repeat then started on the caches the
     file's writer left, a condition Exudyn's back-to-back repeats never saw; on the sixth
-    wave's code the difference measured within noise, benchmarks/README.md.)"""
+    wave's code the difference measured within noise, benchmarks/README.md.) ``choose_tol``:
+    the run's newton_tol is the loosest of ANCFDRV_NEWTON_TOLS that keeps the history (one
+    untimed run per setting tried, :func:`_peer.loosest_keeping`), else the scene's."""
     from ancfdrv.errors import AncfError
     from ancfdrv.runner import run_scene
     from ancfdrv.simulation import simulate
@@ -288,7 +299,22 @@ def run_ancfdrv(problem: Problem, nodes: int, dt: float, bending: str, workdir: 
     run = Run(f"ancfdrv/{bending}", nodes, nodes - 1, dt, bending)
     out = workdir / f"{problem.name}_{bending}_{nodes}_{dt:g}.h5"
     scene = REPO / problem.scene
-    overrides = ancfdrv_overrides(problem, nodes, dt, bending)
+    newton_tol: float | None = None
+    if choose_tol:
+        def history_at(tol: float) -> np.ndarray:
+            sim = simulate(scene, ancfdrv_overrides(problem, nodes, dt, bending, tol),
+                           progress=False)
+            tip = sim.probe("tip") if problem.name == "pendulum" else sim.deflection("tip")
+            return resample(problem, sim.time, tip[:, 1])
+        try:
+            newton_tol, tried = loosest_keeping(history_at, ANCFDRV_NEWTON_TOLS,
+                                                ANCFDRV_TIGHT_TOL, errors=(AncfError, ValueError))
+        except (AncfError, ValueError) as exc:
+            run.message = f"newton_tol {ANCFDRV_TIGHT_TOL:g}: {exc}"
+            return run
+        run.details["newton_tol"] = newton_tol
+        run.details["newton_tol_tried"] = tried
+    overrides = ancfdrv_overrides(problem, nodes, dt, bending, newton_tol)
 
     def solve() -> tuple[np.ndarray, dict[str, Any]]:
         # timed: the run and the compared history read from it (as Exudyn's call ends
@@ -559,24 +585,40 @@ def exudyn_history(problem: Problem, beam: Beam, data: np.ndarray) -> tuple[np.n
 
 
 def run_exudyn(exu: Any, problem: Problem, beam: Beam, nel: int, dt: float,
-               args: argparse.Namespace, svk_axial: bool = False) -> Run:
-    """One Exudyn solve (repeated for timing) at the first tolerances that work."""
+               args: argparse.Namespace, svk_axial: bool = False,
+               choose_tol: bool = False) -> Run:
+    """One Exudyn solve (repeated for timing) at the first tolerances that work; with
+    ``choose_tol``, at the loosest of the looser ones that keeps the history of that first
+    (:func:`_peer.loosest_keeping`, one untimed run per setting tried)."""
     run = Run("exudyn-svk" if svk_axial else "exudyn", nel, nel, dt)
     symbolic = bool(getattr(args, "exudyn_symbolic_drive", False))
     failures: list[str] = []
     failed_s = 0.0
-    for tol in EXUDYN_TOLERANCES[problem.name.split("_")[0]]:
+    def solve_at(tol: tuple[float, float]) -> tuple[np.ndarray, dict[str, Any]]:
+        _, mbs, sensor = exudyn_model(exu, problem, beam, nel, svk_axial,
+                                      symbolic_drive=symbolic)
+        settings = exudyn_settings(exu, problem, beam, dt, tol)
+        run_quietly(lambda: mbs.SolveDynamic(
+            settings, solverType=exu.DynamicSolverType.GeneralizedAlpha))
+        it = mbs.sys["dynamicSolver"].it
+        t, y = exudyn_history(problem, beam, mbs.GetSensorStoredData(sensor))
+        return resample(problem, t, y), {"steps": int(it.currentStepIndex) - 1,
+                                         "newton": int(it.newtonStepsCount),
+                                         "jacobians": int(it.newtonJacobiCount)}
+
+    tolerances = EXUDYN_TOLERANCES[problem.name.split("_")[0]]
+    for k, tol in enumerate(tolerances):
+        if choose_tol:
+            try:
+                tol, tried = loosest_keeping(lambda t: solve_at(t)[0], tolerances[:k:-1], tol)
+            except (RuntimeError, ValueError) as exc:
+                failures.append(f"tolerances {tol[0]:g}/{tol[1]:g}: {exc}")
+                continue
+            run.details["tolerances_tried"] = [{**t, "setting": list(t["setting"])}
+                                               for t in tried]
+
         def solve(tol: tuple[float, float] = tol) -> tuple[np.ndarray, dict[str, Any]]:
-            _, mbs, sensor = exudyn_model(exu, problem, beam, nel, svk_axial,
-                                          symbolic_drive=symbolic)
-            settings = exudyn_settings(exu, problem, beam, dt, tol)
-            run_quietly(lambda: mbs.SolveDynamic(
-                settings, solverType=exu.DynamicSolverType.GeneralizedAlpha))
-            it = mbs.sys["dynamicSolver"].it
-            t, y = exudyn_history(problem, beam, mbs.GetSensorStoredData(sensor))
-            return resample(problem, t, y), {"steps": int(it.currentStepIndex) - 1,
-                                             "newton": int(it.newtonStepsCount),
-                                             "jacobians": int(it.newtonJacobiCount)}
+            return solve_at(tol)
         t0 = time.perf_counter()
         try:
             run.wall_s, run.repeats, run.history, details = best_of(solve, args.min_time,
@@ -671,8 +713,10 @@ def compare_problem(problem: Problem, exu: Any, workdir: Path,
     groups: dict[str, list[Run]] = {}
     for bending in args.bending:
         groups[bending] = []
-        for nodes, dt in problem.ancfdrv_runs:
-            run = run_ancfdrv(problem, nodes, dt, bending, workdir, args)
+        for k, (nodes, dt) in enumerate(problem.ancfdrv_runs):
+            run = run_ancfdrv(problem, nodes, dt, bending, workdir, args,
+                              choose_tol=getattr(args, "choose_tol", False)
+                              and k < len(problem.ancfdrv_runs) - 1)
             if run.ok and args.breakdown:
                 run.details["breakdown"] = ancfdrv_breakdown(problem, run, args)
             groups[bending].append(run)
@@ -681,8 +725,10 @@ def compare_problem(problem: Problem, exu: Any, workdir: Path,
     exudyn_runs: list[Run] = []
     svk: Run | None = None
     if exu is not None:
-        for nel, dt in problem.exudyn_runs:
-            exudyn_runs.append(run_exudyn(exu, problem, beam, nel, dt, args))
+        for k, (nel, dt) in enumerate(problem.exudyn_runs):
+            exudyn_runs.append(run_exudyn(exu, problem, beam, nel, dt, args,
+                                          choose_tol=getattr(args, "choose_tol", False)
+                                          and k < len(problem.exudyn_runs) - 1))
             _progress(problem, exudyn_runs[-1])
         if problem.svk_check and args.svk_check:
             svk = run_exudyn(exu, problem, beam, *problem.svk_check, args, svk_axial=True)
@@ -857,6 +903,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--no-svk-check", dest="svk_check", action="store_false",
                         help="skip Exudyn with the St. Venant-Kirchhoff axial force")
     parser.add_argument("--no-exudyn", action="store_true", help="ancfdrv only")
+    parser.add_argument("--choose-tol", action="store_true",
+                        help="each code's Newton tolerance per run (not the references): the "
+                             "loosest that keeps the history within 0.004 %% of the range of "
+                             "a tight run's (ancfdrv: 1e-4 ... 1e-10 against 1e-12; Exudyn: "
+                             "EXUDYN_TOLERANCES against their first that works)")
     parser.add_argument("--exudyn-symbolic-drive", action="store_true",
                         help="the spin-up's hub drive in Exudyn as a symbolic user function "
                              "(evaluated in C++) instead of a Python one")
@@ -919,8 +970,8 @@ def main(argv: list[str] | None = None) -> int:
                      "max_repeats": args.max_repeats, "breakdown": args.breakdown,
                      "svk_check": args.svk_check, "bending": args.bending,
                      "exudyn_symbolic_drive": args.exudyn_symbolic_drive,
-                     "exudyn_relative_tol": EXUDYN_RELATIVE_TOL,
-                     "exudyn_absolute_tols_tried": EXUDYN_ABSOLUTE_TOLS},
+                     "exudyn_tolerances_tried": EXUDYN_TOLERANCES,
+                     "choose_tol": args.choose_tol, "history_keep": HISTORY_KEEP},
         "units": "seconds, metres",
         "machine": machine,
         "ancfdrv_kernel": {"module": str(kernel_file), "reinstalled_during_run": reinstalled,

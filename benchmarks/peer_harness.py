@@ -72,10 +72,16 @@ ancfdrv's, both measured in this run (> 1: ancfdrv is faster).
 
 Exudyn runs as a user tuning it would run it (issue 38): its ``exudynCPPfast`` module, one
 thread, no solution file, sensors every 0.01 s; the boom with Newton tolerances 1e-2
-(absolute) / 1e-5 (relative) and contractivity 0.05 (``levels`` also at 1e-3 / 1e-6), its
-dense LU below 6 elements (``levels``: both LUs below 10 elements); the pendulum at 1e-6 /
-1e-6; the spin-up updating its Jacobian at most once a step. ancfdrv runs with its defaults
-(one OpenMP thread, ``newton_tol = 1e-10``) without the XDMF file.
+(absolute) / 1e-5 (relative) and contractivity 0.05, its dense LU below 6 elements
+(``levels``: both LUs below 10 elements); the spin-up updating its Jacobian at most once a
+step. ancfdrv runs with its defaults (one OpenMP thread, ``newton_tol = 1e-10``) without the
+XDMF file. In ``levels``, ``spinup`` and ``pendulum`` both codes' Newton tolerances are
+chosen in the run by one rule (``_peer.loosest_keeping``, issue 38): per timed
+configuration, the loosest of a fixed list whose history stays within 0.004 % of its range
+of the same configuration at a tight setting (ancfdrv: ``newton_tol`` 1e-4, 1e-6, 1e-8,
+1e-10 against 1e-12; Exudyn: the boom's 1e-2/1e-5 or 1e-3/1e-6 against its defaults, the
+pendulum's and the spin-up's lists in ``peer_exudyn.EXUDYN_TOLERANCES``); the references
+keep each code's default (the spin-up's Exudyn: its first tolerances that work).
 
 ``levels``
     Each accuracy level's (3, 1, 0.3, 0.1, 0.03 % of the sag range) fastest configuration
@@ -120,8 +126,8 @@ import numpy as np
 if TYPE_CHECKING:
     import h5py
 
-from _peer import (exudyn_build, exudyn_version, import_exudyn, quiet_settings,
-                   run_quietly, set_setting)
+from _peer import (HISTORY_KEEP, exudyn_build, exudyn_version, import_exudyn,
+                   loosest_keeping, quiet_settings, run_quietly, set_setting)
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
@@ -530,8 +536,9 @@ class ExudynNewton:
             newton.modifiedNewtonJacUpdatePerStep = True
 
 
-#: The boom's loosest Newton settings that keep Exudyn's history (issue 38), and the
-#: tighter ones it is re-timed at; the converged reference runs at Exudyn's defaults.
+#: The boom's Newton settings of issue 38 (the loosest that kept Exudyn's history there) and
+#: the tighter ones it was re-timed at; the converged reference runs at Exudyn's defaults.
+#: ``levels`` chooses among them per configuration (LEVEL_EXUDYN_NEWTON).
 BOOM_NEWTON = ExudynNewton("tol 1e-2/1e-5", 1e-2, 1e-5, 0.05)
 BOOM_NEWTON_TIGHT = ExudynNewton("tol 1e-3/1e-6", 1e-3, 1e-6, 0.05)
 DEFAULT_NEWTON = ExudynNewton("default tol")
@@ -1008,7 +1015,8 @@ def compare_hard(problem: Any, exu: Any, workdir: Path, args: argparse.Namespace
     bending = bendings[0]
     pe_args = argparse.Namespace(min_time=args.hard_min_time, max_repeats=args.repeats,
                                  breakdown=False, kernel_min_time=0.05, svk_check=False,
-                                 bending=bendings, exudyn_symbolic_drive=True)
+                                 bending=bendings, exudyn_symbolic_drive=True,
+                                 choose_tol=True)
     record = pe.compare_problem(problem, exu, workdir, pe_args)
     if problem.name.startswith("spinup"):
         try:
@@ -1058,6 +1066,7 @@ def hard_levels(record: dict[str, Any], bendings: list[str]) -> list[dict[str, A
                 pick = min(ok, key=lambda r: r["wall_s"]) if ok else None
                 best[code] = None if pick is None else {
                     "mesh": pick["mesh"], "dt": pick["dt"], "bending": pick["bending"],
+                    "newton": newton_setting(pick),
                     "whole_s": pick["wall_s"],
                     "whole_with_file_s": pick["wall_file_s"],
                     "error_percent": 100.0 * pick[field_name] / size}
@@ -1066,6 +1075,49 @@ def hard_levels(record: dict[str, Any], bendings: list[str]) -> list[dict[str, A
                           if a and x else None}
         table.append(entry)
     return table
+
+
+def newton_setting(run: dict[str, Any]) -> str:
+    """A peer_exudyn run's Newton tolerance as a short text (ancfdrv: newton_tol, 'scene'
+    when the scene's; Exudyn: absolute/relative)."""
+    d = run.get("details", {})
+    if run["code"] == "exudyn":
+        return f"{d.get('absolute_tol', math.nan):g}/{d.get('relative_tol', math.nan):g}"
+    return f"{d['newton_tol']:g}" if d.get("newton_tol") is not None else "scene"
+
+
+def tolerance_rows(record: dict[str, Any]) -> list[dict[str, Any]]:
+    """Each run's chosen Newton tolerance and what each tried gave (change of the history /
+    its range against the tight run; None: that run failed)."""
+    rows = []
+    for r in record["runs"]:
+        tried = r["details"].get("newton_tol_tried") or r["details"].get("tolerances_tried")
+        if tried:
+            rows.append({"code": r["code"], "mesh": r["mesh"], "dt": r["dt"],
+                         "chosen": newton_setting(r), "tried": tried})
+    return rows
+
+
+def tolerance_markdown(rows: list[dict[str, Any]], title: str) -> list[str]:
+    """The table of chosen tolerances (tight setting first in each 'tried' list)."""
+    def setting(value: Any) -> str:
+        if isinstance(value, (list, tuple)):
+            return "/".join(f"{v:g}" for v in value)
+        return f"{value:g}" if isinstance(value, float) else str(value)
+
+    out = [f"{title}: each timed run's Newton tolerance, the loosest that keeps its history "
+           f"within {100 * HISTORY_KEEP:g} % of the range of the same run at the tight "
+           "setting (listed first); the history change each setting tried gave, in % of the "
+           "range (failed: the run failed).", "",
+           "| code | run | chosen | tight | tried: change % |", "|---|---|---|---|---|"]
+    for r in rows:
+        tight, *rest = r["tried"]
+        tried = ", ".join(f"{setting(t['setting'])}: "
+                          + ("failed" if t["change"] is None else f"{100 * t['change']:.2g}")
+                          for t in rest)
+        out.append(f"| {r['code']} | {r['run']} | {setting(r['chosen'])} | {setting(tight['setting'])} "
+                   f"| {tried} |")
+    return out + [""]
 
 
 def hard_levels_markdown(problems: dict[str, Any]) -> list[str]:
@@ -1079,21 +1131,25 @@ def hard_levels_markdown(problems: dict[str, Any]) -> list[str]:
                 "run). Time: the whole in-memory call (ancfdrv: `simulate`, with the HDF5 "
                 "file beside it; Exudyn: build and `SolveDynamic` with a sensor every 0.01 s), "
                 "best of the repeats. Ratio: Exudyn / ancfdrv.", "",
-                "| level | against | ancfdrv option nodes, dt | s | with file s | error % | "
-                "Exudyn elements, dt | s | error % | Exudyn / ancfdrv |",
+                "| level | against | ancfdrv option nodes, dt, newton_tol | s | with file s | "
+                "error % | Exudyn elements, dt, tolerances | s | error % | Exudyn / ancfdrv |",
                 "|---|---|---|---:|---:|---:|---|---:|---:|---:|"]
         for entry in rec["levels"]:
             for key in ("common", "own"):
                 e = entry[key]
                 a, x = e["ancfdrv"], e["exudyn"]
-                ac = (f"{a['bending']} {a['mesh']}, {a['dt']:g} | {_f(a['whole_s'])} | "
+                ac = (f"{a['bending']} {a['mesh']}, {a['dt']:g}, {a.get('newton', '-')} | "
+                      f"{_f(a['whole_s'])} | "
                       f"{_f(a['whole_with_file_s'])} | {_f(a['error_percent'])}"
                       if a else "none | - | - | -")
-                xc = (f"{x['mesh']}, {x['dt']:g} | {_f(x['whole_s'])} | "
+                xc = (f"{x['mesh']}, {x['dt']:g}, {x.get('newton', '-')} | {_f(x['whole_s'])} | "
                       f"{_f(x['error_percent'])}" if x else "none | - | -")
                 out.append(f"| {entry['level_percent']:g} % | {key} | {ac} | {xc} | "
                            f"{_ratio(e['exudyn_over_ancfdrv'])} |")
         out.append("")
+        rows = [{**r, "run": f"{r['mesh']}, dt {r['dt']:g}"} for r in tolerance_rows(rec)]
+        if rows:
+            out += tolerance_markdown(rows, f"{name}, Newton tolerances")
     return out
 
 
@@ -1459,10 +1515,20 @@ CABLE = ("scene.formulation=nonlinear", "solver.static_method=newton", "output.x
          "beam.bending=cable", "scene.planar=xy")
 
 
+#: The Newton settings each code's level runs choose from, loosest first, and the tight
+#: setting their histories are compared with (:func:`choose_level_tolerances`, one rule for
+#: both: the loosest that keeps the history within HISTORY_KEEP of its range).
+LEVEL_ANCFDRV_TOLS = (1e-4, 1e-6, 1e-8, 1e-10)
+LEVEL_ANCFDRV_TIGHT = 1e-12
+LEVEL_EXUDYN_NEWTON = (BOOM_NEWTON, BOOM_NEWTON_TIGHT)
+LEVEL_EXUDYN_TIGHT = DEFAULT_NEWTON
+
+
 @dataclass(frozen=True)
 class LevelConfig:
     """One configuration of the level study: code, mesh (ancfdrv nodes or Exudyn elements
-    per segment), time step and, for Exudyn, its Newton tolerances and linear solver."""
+    per segment), time step and the Newton tolerance (ancfdrv: ``newton_tol``, None the
+    scene's; Exudyn: its tolerances) and, for Exudyn, its linear solver."""
 
     code: str
     nodes: int = 0                   # ancfdrv
@@ -1470,25 +1536,29 @@ class LevelConfig:
     dt: float = 1e-3
     newton: ExudynNewton = BOOM_NEWTON
     dense: bool = False
+    newton_tol: float | None = None  # ancfdrv
 
     @property
     def label(self) -> str:
         if self.code == "ancfdrv":
-            return f"cable {self.nodes} nodes, dt {self.dt:g}"
+            tol = "" if self.newton_tol is None else f", tol {self.newton_tol:g}"
+            return f"cable {self.nodes} nodes, dt {self.dt:g}{tol}"
         solver = "dense" if self.dense else "sparse"
         return (f"{3 * self.per_segment} el, dt {self.dt:g}, {self.newton.label}, {solver}")
 
     @property
     def overrides(self) -> list[str]:
         """ancfdrv's overrides (beyond the mass and the end time)."""
-        return [*CABLE, f"beam.nodes={self.nodes}", f"solver.dt={self.dt!r}"]
+        tol = [] if self.newton_tol is None else [f"solver.newton_tol={self.newton_tol!r}"]
+        return [*CABLE, f"beam.nodes={self.nodes}", f"solver.dt={self.dt!r}", *tol]
 
 
 def level_configs(quick: bool) -> tuple[list[LevelConfig], dict[str, LevelConfig],
                                         dict[str, LevelConfig]]:
-    """The timed grid (mesh x dt for both codes; Exudyn also its two tolerance sets and,
-    below 10 elements, both LU solvers), the converged references (code -> config) and the
-    checks of ancfdrv's reference (half its mesh, twice its step)."""
+    """The timed grid (mesh x dt for both codes; Exudyn below 10 elements with both LU
+    solvers; the Newton settings are chosen later, :func:`choose_level_tolerances`), the
+    converged references (code -> config, at each code's default Newton) and the checks of
+    ancfdrv's reference (half its mesh, twice its step)."""
     def a(nodes: int, dt: float) -> LevelConfig:
         return LevelConfig("ancfdrv", nodes=nodes, dt=dt)
 
@@ -1500,8 +1570,7 @@ def level_configs(quick: bool) -> tuple[list[LevelConfig], dict[str, LevelConfig
         refs = {"ancfdrv": a(10, 5e-4), "exudyn": e(2, 5e-4, DEFAULT_NEWTON, False)}
         return timed, refs, {}
     timed = [a(n, dt) for n in (4, 7, 10, 16) for dt in LEVEL_DTS]
-    timed += [e(ps, dt, newton, dense) for ps in (1, 2, 3, 6) for dt in LEVEL_DTS
-              for newton in (BOOM_NEWTON, BOOM_NEWTON_TIGHT)
+    timed += [e(ps, dt, BOOM_NEWTON, dense) for ps in (1, 2, 3, 6) for dt in LEVEL_DTS
               for dense in ((True, False) if 3 * ps < 10 else (False,))]
     refs = {"ancfdrv": a(55, REFERENCE_DT), "exudyn": e(18, REFERENCE_DT, DEFAULT_NEWTON, False)}
     checks = {"half mesh": a(28, REFERENCE_DT), "twice the step": a(55, 2 * REFERENCE_DT)}
@@ -1509,8 +1578,10 @@ def level_configs(quick: bool) -> tuple[list[LevelConfig], dict[str, LevelConfig
 
 
 def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarray,
-                exu: Any, out: Path) -> Callable[[], tuple[float, float, dict[str, Any]]]:
-    """One timed run of a configuration (solve s, whole s, payload with 'values')."""
+                exu: Any, out: Path, file_call: bool = True
+                ) -> Callable[[], tuple[float, float, dict[str, Any]]]:
+    """One timed run of a configuration (solve s, whole s, payload with 'values');
+    ``file_call`` False: ancfdrv's in-memory call alone (its payload only 'values')."""
     boom = replace(boom, dt=config.dt)
     if config.code == "exudyn":
         def once() -> tuple[float, float, dict[str, Any]]:
@@ -1533,6 +1604,11 @@ def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarr
         t0 = time.perf_counter()
         sim = ancfdrv.simulate(scene, overrides, progress=False)
         whole = time.perf_counter() - t0
+        if not file_call:
+            if sim.status != "ok":
+                raise RuntimeError(sim.message)
+            return sim.dynamic.wall_time_s, whole, {"values": resample(
+                grid, sim.time, sim.deflection("tip")[:, 1])}
         t0 = time.perf_counter()
         run_scene(scene, overrides, out, progress=False)
         with_file = time.perf_counter() - t0
@@ -1554,6 +1630,53 @@ def _level_once(config: LevelConfig, boom: Boom, base: list[str], grid: np.ndarr
             "stepping_s": phases.get("dynamic_stepping", math.nan), "phases_s": phases,
             "with_file_s": with_file}
     return once
+
+
+def choose_level_tolerances(configs: list[LevelConfig], boom: Boom, base: list[str],
+                            grid: np.ndarray, exu: Any, out: Path
+                            ) -> tuple[list[LevelConfig], dict[str, list[dict[str, Any]]]]:
+    """Each timed configuration with its code's Newton setting chosen by one rule
+    (:func:`_peer.loosest_keeping`): the loosest of LEVEL_ANCFDRV_TOLS (ancfdrv's
+    ``newton_tol``) or LEVEL_EXUDYN_NEWTON (Exudyn's tolerances) whose sag history stays
+    within HISTORY_KEEP of its range of the same configuration's at LEVEL_ANCFDRV_TIGHT or
+    LEVEL_EXUDYN_TIGHT (untimed runs; Exudyn's chosen once per mesh and step on its sparse
+    LU, for both LUs). Also what each setting tried gave, per chosen label."""
+    errors = (RuntimeError, ValueError) + ancfdrv_errors()
+    chosen: dict[tuple[Any, ...], Any] = {}
+    tried: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
+    for c in configs:
+        key = (c.code, c.nodes, c.per_segment, c.dt)
+        if key in chosen:
+            continue
+        if c.code == "ancfdrv":
+            def history_at(tol: float, c: LevelConfig = c) -> np.ndarray:
+                return _level_once(replace(c, newton_tol=tol), boom, base, grid, exu, out,
+                                   file_call=False)()[2]["values"]
+            setting, record = loosest_keeping(history_at, LEVEL_ANCFDRV_TOLS,
+                                              LEVEL_ANCFDRV_TIGHT, errors=errors)
+        else:
+            def history_at(newton: ExudynNewton, c: LevelConfig = c) -> np.ndarray:
+                return _level_once(replace(c, newton=newton, dense=False), boom, base, grid,
+                                   exu, out)()[2]["values"]
+            setting, record = loosest_keeping(history_at, LEVEL_EXUDYN_NEWTON,
+                                              LEVEL_EXUDYN_TIGHT, errors=errors)
+        chosen[key] = setting
+        tried[key] = [{**t, "setting": t["setting"] if c.code == "ancfdrv"
+                       else t["setting"].label} for t in record]
+        change = next(t["change"] for t in record if t["setting"] == setting)
+        name = f"{setting:g}" if c.code == "ancfdrv" else setting.label
+        where = (f"cable {c.nodes} nodes" if c.code == "ancfdrv"
+                 else f"{3 * c.per_segment} el") + f", dt {c.dt:g}"
+        print(f"  tolerance {c.code:>7} {where:<24} -> {name} (history change "
+              f"{change:.2e} of the range)", flush=True)
+    result, by_label = [], {}
+    for c in configs:
+        key = (c.code, c.nodes, c.per_segment, c.dt)
+        c = (replace(c, newton_tol=chosen[key]) if c.code == "ancfdrv"
+             else replace(c, newton=chosen[key]))
+        result.append(c)
+        by_label[c.label] = tried[key]
+    return result, by_label
 
 
 def _level_rounds(configs: list[LevelConfig], once_runs: set[str], onces: dict[str, Callable],
@@ -1603,7 +1726,12 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
         ref_cfg = {k: v for k, v in ref_cfg.items() if v.code != "exudyn"}
     out: dict[str, Any] = {"levels_percent": list(LEVELS), "dts": list(LEVEL_DTS),
                            "sample_dt": LEVEL_SAMPLE_DT, "reference_dt": REFERENCE_DT,
-                           "exudyn_sensor_period": EXUDYN_SENSOR_PERIOD, "masses": {}}
+                           "exudyn_sensor_period": EXUDYN_SENSOR_PERIOD,
+                           "history_keep": HISTORY_KEEP,
+                           "ancfdrv_newton_tols": [*LEVEL_ANCFDRV_TOLS, LEVEL_ANCFDRV_TIGHT],
+                           "exudyn_newton": [n.label for n in (*LEVEL_EXUDYN_NEWTON,
+                                                               LEVEL_EXUDYN_TIGHT)],
+                           "masses": {}}
     masses = (50.0,) if args.quick else tuple(args.masses)
     for mass in masses:
         base = ([f"solver.t_end={plan.boom_t_end!r}"] if plan.boom_t_end else []) + \
@@ -1611,14 +1739,16 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
         boom = boom_from_scene("inputs/boom_luffing.nml", base)
         grid = uniform_grid(boom.t_end, LEVEL_SAMPLE_DT)
         once_cfg = list(ref_cfg.values()) + list(check_cfg.values())
+        mass_cfg, tolerances = choose_level_tolerances(timed_cfg, boom, base, grid, exu,
+                                                       workdir / "level_tolerance.h5")
         runs: dict[str, Timed] = {}
         onces: dict[str, Callable] = {}
-        for k, c in enumerate(once_cfg + timed_cfg):
+        for k, c in enumerate(once_cfg + mass_cfg):
             runs[c.label] = Timed(c.code, c.label, asdict(c))
             onces[c.label] = _level_once(c, boom, base, grid, exu, workdir / f"level_{k}.h5")
         tag = f"levels m={mass:g}"
         _level_rounds(once_cfg, {c.label for c in once_cfg}, onces, runs, 1, tag)
-        _level_rounds(timed_cfg, set(), onces, runs, args.repeats, tag)
+        _level_rounds(mass_cfg, set(), onces, runs, args.repeats, tag)
         common = runs[ref_cfg["ancfdrv"].label]
         if not common.ok:
             raise RuntimeError(f"ancfdrv's level reference failed: {common.message}")
@@ -1629,7 +1759,7 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
                     if run.ok and ref.ok else math.nan)
 
         rows = []
-        for c in timed_cfg:
+        for c in mass_cfg:
             run = runs[c.label]
             own = runs[ref_cfg[c.code].label]
             rows.append({"code": c.code, "label": c.label, "config": asdict(c), "ok": run.ok,
@@ -1638,6 +1768,7 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
                          "stepping_s": run.extra.get("stepping_s"),
                          "phases_s": run.extra.get("phases_s"),
                          "repeats": len(run.solve_samples), "counts": run.counts,
+                         "newton_tried": tolerances[c.label],
                          "own_reference": own.label, "error_own_percent": error(run, own),
                          "error_common_percent": error(run, common)})
         refs = {code: {"label": c.label, "ok": runs[c.label].ok, "message": runs[c.label].message,
@@ -1648,7 +1779,7 @@ def boom_levels(plan: Plan, exu: Any, workdir: Path, args: argparse.Namespace) -
                          "error_common_percent": error(runs[c.label], common)}
                   for name, c in check_cfg.items()}
         table = level_table(rows)
-        command_line(table, {c.label: c for c in timed_cfg}, boom, base, workdir, args)
+        command_line(table, {c.label: c for c in mass_cfg}, boom, base, workdir, args)
         out["masses"][f"{mass:g}"] = {"sag_range_m": sag_range, "references": refs,
                                       "reference_checks": checks, "runs": rows,
                                       "levels": table}
@@ -1782,12 +1913,18 @@ def levels_markdown(rec: dict[str, Any]) -> list[str]:
            "Each code's configuration per level is its fastest (by whole call) that meets the "
            f"level, from a grid over mesh and time step (dt {', '.join(f'{d:g}' for d in rec['dts'])} s): "
            "ancfdrv's nonlinear cable reduced to the plane (`beam.bending = cable`, "
-           "`scene.planar = xy`) at 4, 7, 10, 16 nodes with its default Newton (`newton_tol = "
-           "1e-10`), output and answers (no XDMF); Exudyn's `ObjectANCFCable2D` at 3, 6, 9, 18 "
-           "elements in its `exudynCPPfast` module on one thread, modified Newton with "
-           "absolute/relative tolerance 1e-2/1e-5 or 1e-3/1e-6 (contractivity 0.05), its dense "
+           "`scene.planar = xy`) at 4, 7, 10, 16 nodes, output and answers (no XDMF); "
+           "Exudyn's `ObjectANCFCable2D` at 3, 6, 9, 18 "
+           "elements in its `exudynCPPfast` module on one thread, modified Newton, its dense "
            "and its sparse LU below 10 elements, sensors every "
-           f"{rec['exudyn_sensor_period']:g} s, no solution file. "
+           f"{rec['exudyn_sensor_period']:g} s, no solution file. Newton tolerances, one rule "
+           "for both codes (each configuration's loosest that keeps its sag history within "
+           f"{100 * rec['history_keep']:g} % of the range of the same configuration at a "
+           "tight setting, chosen in this run; the table after each mass's runs): ancfdrv's "
+           f"`newton_tol` of {', '.join(f'{t:g}' for t in rec['ancfdrv_newton_tols'][:-1])} "
+           f"against {rec['ancfdrv_newton_tols'][-1]:g}; Exudyn's absolute/relative "
+           f"tolerances {' or '.join(rec['exudyn_newton'][:-1])} (contractivity 0.05) against "
+           f"its defaults. "
            "Error: max |sag - sag_ref| at every "
            f"{rec['sample_dt']:g} s in % of the reference's sag range; 'common': against "
            "ancfdrv's cable at 55 nodes and dt "
@@ -1846,6 +1983,12 @@ def levels_markdown(rec: dict[str, Any]) -> list[str]:
                        f"{_f(r['error_own_percent'], '.4f')} | "
                        f"{_f(r['error_common_percent'], '.4f')} |")
         out.append("")
+        rows = [{"code": r["code"], "run": r["label"], "tried": r["newton_tried"],
+                 "chosen": r["config"]["newton_tol"] if r["code"] == "ancfdrv"
+                 else r["config"]["newton"]["label"]}
+                for r in m["runs"] if r.get("newton_tried")]
+        out += tolerance_markdown(rows, f"Tip mass {mass} kg, Newton tolerances (Exudyn's "
+                                  "chosen on its sparse LU, for both LUs)")
     return out
 
 

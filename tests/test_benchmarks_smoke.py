@@ -156,7 +156,10 @@ def test_peer_harness_levels_smoke(tmp_path):
     level table picks a run within each level it fills; with Exudyn, its 3-element cable at
     dt 1e-2 runs at the fair settings and lands within 10 % of ancfdrv's 4-node cable's error
     at the same step (the same model), and both codes' picks are timed from the command
-    line. Without Exudyn the peer's runs are absent and its picks empty."""
+    line. Each run's Newton tolerance follows the one rule of both codes: after the tight
+    run, the settings tried loosest first all moved the history by more than 0.004 % of its
+    range but the last, which is the one used unless it did too (then the tight one).
+    Without Exudyn the peer's runs are absent and its picks empty."""
     import importlib.util
     out = tmp_path / "levels.json"
     run_script("peer_harness.py", "--quick", "--only", "levels", "--repeats", "1",
@@ -166,14 +169,29 @@ def test_peer_harness_levels_smoke(tmp_path):
     assert report["exudyn"]["available"] is with_exudyn
     rec = report["problems"]["levels"]["masses"]["50"]
     assert rec["references"]["ancfdrv"]["ok"] and rec["sag_range_m"] > 0
-    runs = {r["label"]: r for r in rec["runs"]}
-    steps = {"cable 4 nodes, dt 0.001": 2000, "cable 4 nodes, dt 0.01": 200}
+    def key(run):
+        c = run["config"]
+        return c["code"], c["nodes"] or c["per_segment"], c["dt"]
+
+    runs = {key(r): r for r in rec["runs"]}
+    steps = {("ancfdrv", 4, 1e-3): 2000, ("ancfdrv", 4, 1e-2): 200}
     if with_exudyn:
-        steps["3 el, dt 0.01, tol 1e-2/1e-5, dense"] = 200
+        steps[("exudyn", 1, 1e-2)] = 200
     assert set(runs) == set(steps)
-    for label, run in runs.items():
+    for k, run in runs.items():
         assert run["ok"], run["message"]
-        assert run["counts"]["steps"] == steps[label]
+        assert run["counts"]["steps"] == steps[k]
+        # one rule for both codes' Newton tolerance: the tight run first, then loosest
+        # first until one keeps the history within 0.004 % of its range; that one is used
+        tight, *tried = run["newton_tried"]
+        assert tight["change"] == 0.0 and tried
+        assert all(t["change"] is None or t["change"] > 4e-5 for t in tried[:-1])
+        chosen = run["config"]["newton_tol"] if k[0] == "ancfdrv" else \
+            run["config"]["newton"]["label"]
+        if tried[-1]["change"] is not None and tried[-1]["change"] <= 4e-5:
+            assert tried[-1]["setting"] == chosen
+        else:
+            assert tight["setting"] == chosen
         assert positive(run["whole_s"]) and positive(run["solve_s"])
         assert run["solve_s"] <= run["whole_s"]
         assert 0 < run["error_common_percent"] < 3.0
@@ -182,11 +200,11 @@ def test_peer_harness_levels_smoke(tmp_path):
         if pick is not None:
             assert pick["error_percent"] <= entry["level_percent"]
     three_percent = rec["levels"][0]["common"]["whole"]
-    assert three_percent["ancfdrv"]["label"] in steps
+    assert three_percent["ancfdrv"]["label"] in {r["label"] for r in rec["runs"]}
     assert positive(three_percent["ancfdrv"]["command_s"])
     if with_exudyn:
-        a = runs["cable 4 nodes, dt 0.01"]["error_common_percent"]
-        x = runs["3 el, dt 0.01, tol 1e-2/1e-5, dense"]["error_common_percent"]
+        a = runs[("ancfdrv", 4, 1e-2)]["error_common_percent"]
+        x = runs[("exudyn", 1, 1e-2)]["error_common_percent"]
         assert abs(x - a) < 0.1 * a
         assert positive(three_percent["exudyn"]["command_s"])
         assert positive(three_percent["exudyn_over_ancfdrv"])
