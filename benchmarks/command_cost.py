@@ -99,10 +99,10 @@ COLD = {
 GROUPS = {"scene": "scene", "model": "model", "static solve": "static solve",
           "answers": "answers", "stepping": "stepping"}
 WARM = textwrap.dedent("""
-    import contextlib, functools, importlib, json, os, statistics, sys, tempfile, time
+    import json, os, statistics, sys, tempfile, time
     sys.path.insert(0, sys.argv[5])   # benchmarks/: fixed_cost's phase table
-    from fixed_cost import PHASES, PHASE_CONTEXTS
-    from ancfdrv import kernel, runner
+    from fixed_cost import instrument   # the phase table and its wrappers
+    from ancfdrv import runner
     scene, repeats = sys.argv[1], int(sys.argv[4])
     sets, cases = json.loads(sys.argv[2]), json.loads(sys.argv[3])
     groups = json.loads(sys.argv[6])
@@ -121,42 +121,6 @@ WARM = textwrap.dedent("""
     def group(label):
         head = label.split(":")[0]
         return groups.get(head, "HDF5" if head.startswith("HDF5") else "glue")
-    def wrap(owner, name, label):
-        real = getattr(owner, name)
-        @functools.wraps(real)
-        def timed(*args, **kwargs):
-            enter(label)
-            try:
-                return real(*args, **kwargs)
-            finally:
-                leave()
-        setattr(owner, name, timed)
-    def wrap_context(owner, name):
-        real = getattr(owner, name)
-        @contextlib.contextmanager
-        def timed(*args, **kwargs):
-            enter("HDF5")
-            try:
-                manager = real(*args, **kwargs)
-                manager.__enter__()
-            finally:
-                leave()
-            try:
-                yield
-            except BaseException as exc:
-                enter("HDF5")
-                try:
-                    if not manager.__exit__(type(exc), exc, exc.__traceback__):
-                        raise
-                finally:
-                    leave()
-            else:
-                enter("HDF5")
-                try:
-                    manager.__exit__(None, None, None)
-                finally:
-                    leave()
-        setattr(owner, name, timed)
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
         for label, extra in (("xdmf", []), ("no_xdmf", ["output.xdmf=.false."])):
@@ -169,16 +133,7 @@ WARM = textwrap.dedent("""
                 row = (time.perf_counter() - w, time.thread_time() - c)
                 best = row if best is None or row[0] < best[0] else best
             out[label] = dict(zip(("wall_s", "thread_cpu_s"), best))
-        for module, owner, name, label in PHASES:
-            target = importlib.import_module(module)
-            target = target if owner is None else getattr(target, owner)
-            if hasattr(target, name):   # (a copy may lack a later function)
-                wrap(target, name, group(label))
-        for module, name in PHASE_CONTEXTS:
-            wrap_context(importlib.import_module(module), name)
-        for value in vars(kernel).values():
-            if isinstance(value, type) and "advance_rows" in vars(value):
-                wrap(value, "advance_rows", "stepping")
+        instrument(enter, leave, group)
         for case, case_sets in cases.items():
             rows, walls = [], []
             for i in range(repeats + 2):   # two warm-up calls

@@ -62,7 +62,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 REPO = Path(__file__).resolve().parents[1]
 CASES: dict[str, tuple[str, list[str]]] = {
@@ -218,35 +218,22 @@ def quiet_clock() -> None:
                                          monotonic=time.monotonic, time=time.time)
 
 
-def phase_calls(case: str, helper: str) -> None:
-    """The child of :func:`phase_instructions`: one warm-up call, then one counted call
-    with a callgrind dump at every entry and exit of a :data:`PHASES` function (each dump
-    named after the phase whose instructions it holds)."""
+def instrument(enter: Callable[[str], None], leave: Callable[[], None],
+               label: Callable[[str], str] = lambda phase: phase) -> None:
+    """Wrap every :data:`PHASES` and :data:`MEMORY_PHASES` function, the
+    :data:`PHASE_CONTEXTS` (as "HDF5") and the kernel's ``advance_rows`` (as "stepping") so
+    that each call runs between ``enter(label(phase))`` and ``leave()``: what a phase
+    split counts at those boundaries (callgrind dumps here, thread time in
+    ``command_cost.py``'s warm worker) is the caller's."""
     import contextlib
-    import ctypes
     import importlib
-    quiet_clock()
-    lib = ctypes.CDLL(helper)
-    stack, on = ["glue"], [False]
 
-    def boundary() -> None:
-        if on[0]:
-            lib.callgrind_dump(stack[-1].encode())
-
-    def enter(label: str) -> None:
-        boundary()
-        stack.append(label)
-
-    def leave() -> None:
-        boundary()
-        stack.pop()
-
-    def wrap(owner: Any, name: str, label: str) -> None:
+    def wrap(owner: Any, name: str, phase: str) -> None:
         real = getattr(owner, name)
 
         @functools.wraps(real)
         def counted(*args: Any, **kwargs: Any) -> Any:
-            enter(label)
+            enter(phase)
             try:
                 return real(*args, **kwargs)
             finally:
@@ -280,17 +267,41 @@ def phase_calls(case: str, helper: str) -> None:
                 finally:
                     leave()
         setattr(owner, name, counted)
-    for module, owner, name, label in PHASES + MEMORY_PHASES:
+    for module, owner, name, phase in PHASES + MEMORY_PHASES:
         target = importlib.import_module(module)
         target = target if owner is None else getattr(target, owner)
         if hasattr(target, name):   # (a copy to compare may lack a later function)
-            wrap(target, name, label)
+            wrap(target, name, label(phase))
     for module, name in PHASE_CONTEXTS:
         wrap_context(importlib.import_module(module), name)
     import ancfdrv.kernel as kernel
     for value in vars(kernel).values():
         if isinstance(value, type) and "advance_rows" in vars(value):
             wrap(value, "advance_rows", "stepping")
+
+
+def phase_calls(case: str, helper: str) -> None:
+    """The child of :func:`phase_instructions`: one warm-up call, then one counted call
+    with a callgrind dump at every entry and exit of a :data:`PHASES` function (each dump
+    named after the phase whose instructions it holds)."""
+    import ctypes
+    quiet_clock()
+    lib = ctypes.CDLL(helper)
+    stack, on = ["glue"], [False]
+
+    def boundary() -> None:
+        if on[0]:
+            lib.callgrind_dump(stack[-1].encode())
+
+    def enter(label: str) -> None:
+        boundary()
+        stack.append(label)
+
+    def leave() -> None:
+        boundary()
+        stack.pop()
+
+    instrument(enter, leave)
     import ancfdrv.runner as runner
 
     def call(out: Path) -> None:   # _call, its read-back of the tip history as HDF5's
