@@ -7,14 +7,10 @@ rule's solver for its pattern (banded LU in reverse Cuthill-McKee order, else MU
 the cases cover iteration matrices of both the banded and the MUMPS kinds."""
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from conftest import INPUTS
+from conftest import INPUTS, mumps_pages
 from ancfdrv.builders import build_model
 from ancfdrv.io.scene import load_scene
 from ancfdrv.solvers import dynamic
@@ -71,53 +67,15 @@ def test_consistent_acceleration_meets_the_equations_of_motion(scene, overrides)
         model.close()
 
 
-MUMPS_PAGES = """
-import sys
-import numpy as np
-from ancfdrv import kernel
-from ancfdrv.builders import build_model
-from ancfdrv.io.scene import load_scene
-from ancfdrv.solvers import dynamic
-
-
-def mumps_kb():
-    \"\"\"Resident kB of the MUMPS libraries' mappings (/proc/self/smaps).\"\"\"
-    total, inside = 0, False
-    with open('/proc/self/smaps') as smaps:
-        for line in smaps:
-            words = line.split()
-            if words and '-' in words[0] and len(words) >= 5:
-                inside = len(words) >= 6 and 'mumps' in words[-1]
-            elif inside and words[0] == 'Rss:':
-                total += int(words[1])
-    return total
-
-
-model = build_model(load_scene(sys.argv[1], overrides=['beam.nodes=9', 'beam.bending=cable',
-                                                         'scene.planar=xy']))
-assert model.banded()
-before = mumps_kb()
-dynamic.initial_acceleration(model, model.e0, np.zeros(model.ndof), 0.0)
-banded = mumps_kb() - before
-with kernel.DirectSolver(2, np.array([0, 1]), np.array([0, 1])) as solver:
-    solver.factorize(np.array([2.0, 4.0]))
-    solver.solve(np.ones(2))
-print(before, banded, mumps_kb() - before - banded)
-"""
-
-
-@pytest.mark.skipif(not Path("/proc/self/smaps").exists(), reason="needs Linux's /proc")
 def test_a_banded_model_never_runs_mumps():
     """The consistent acceleration of a banded model (the cantilever, 8 cable elements)
     in a fresh interpreter leaves the MUMPS libraries' resident pages as they were (MUMPS's
     code pages were ~2 MB of a small run's peak); one MUMPS solve afterwards in the same
     process adds hundreds of kB of them (the measure sees MUMPS run)."""
-    done = subprocess.run([sys.executable, "-c", MUMPS_PAGES,
-                           str(INPUTS / "hard" / "cantilever_drop.nml")],
-                          capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    mapped, banded, mumps = (int(word) for word in done.stdout.split())
-    if not mapped:
-        pytest.skip("MUMPS is linked statically (no mapping of its own)")
+    banded, mumps = mumps_pages(
+        INPUTS / "hard" / "cantilever_drop.nml",
+        ["beam.nodes=9", "beam.bending=cable", "scene.planar=xy"],
+        "assert model.banded()\n"
+        "dynamic.initial_acceleration(model, model.e0, np.zeros(model.ndof), 0.0)")
     assert banded == 0
     assert mumps >= 256

@@ -7,14 +7,10 @@ Cuthill-McKee (``Pattern.band_order``) for the half-bandwidth the kernel's order
 and the MUMPS libraries' resident pages for which kind ran."""
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from conftest import INPUTS
+from conftest import INPUTS, mumps_pages
 from ancfdrv.builders import build_model
 from ancfdrv.csr import Csr
 from ancfdrv.errors import SolverError
@@ -129,54 +125,16 @@ def test_the_kernel_order_matches_pythons_on_model_patterns():
             model.close()
 
 
-MUMPS_PAGES = """
-import sys
-import numpy as np
-from ancfdrv import kernel
-from ancfdrv.builders import build_model
-from ancfdrv.io.scene import load_scene
-from ancfdrv.solvers import dynamic, static
-
-
-def mumps_kb():
-    \"\"\"Resident kB of the MUMPS libraries' mappings (/proc/self/smaps).\"\"\"
-    total, inside = 0, False
-    with open('/proc/self/smaps') as smaps:
-        for line in smaps:
-            words = line.split()
-            if words and '-' in words[0] and len(words) >= 5:
-                inside = len(words) >= 6 and 'mumps' in words[-1]
-            elif inside and words[0] == 'Rss:':
-                total += int(words[1])
-    return total
-
-
-model = build_model(load_scene(sys.argv[1], overrides=[
-    'scene.formulation=nonlinear', 'solver.static_method=newton', 'beam.bending=cable',
-    'scene.planar=xy', 'beam.nodes=4']))
-before = mumps_kb()
-result = static.solve_newton(model, load_steps=3)
-dynamic.initial_acceleration(model, result.e, np.zeros(model.ndof), 0.0)
-small = mumps_kb() - before
-with kernel.DirectSolver(2, np.array([0, 1]), np.array([0, 1])) as solver:
-    solver.factorize(np.array([2.0, 4.0]))
-    solver.solve(np.ones(2))
-print(before, small, mumps_kb() - before - small)
-"""
-
-
-@pytest.mark.skipif(not Path("/proc/self/smaps").exists(), reason="needs Linux's /proc")
 def test_a_small_models_static_solve_and_start_never_run_mumps():
     """The 4-node boom's static Newton (three load steps, a 16-unknown saddle) and its
     consistent start in a fresh interpreter leave the MUMPS libraries' resident pages as
     they were (their saddles take the banded LU); one MUMPS solve afterwards adds hundreds
     of kB of them (the measure sees MUMPS run)."""
-    done = subprocess.run([sys.executable, "-c", MUMPS_PAGES,
-                           str(INPUTS / "boom_luffing.nml")],
-                          capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr
-    mapped, small, mumps = (int(word) for word in done.stdout.split())
-    if not mapped:
-        pytest.skip("MUMPS is linked statically (no mapping of its own)")
+    small, mumps = mumps_pages(
+        INPUTS / "boom_luffing.nml",
+        ["scene.formulation=nonlinear", "solver.static_method=newton", "beam.bending=cable",
+         "scene.planar=xy", "beam.nodes=4"],
+        "result = static.solve_newton(model, load_steps=3)\n"
+        "dynamic.initial_acceleration(model, result.e, np.zeros(model.ndof), 0.0)")
     assert small == 0
     assert mumps >= 256
