@@ -186,30 +186,20 @@ def _plate_on_plate(k=1e5, c=0.0, mu=0.0, v_t=0.08, push=0.0, friction=False):
     return model, weight
 
 
-def test_contact_iteration_matrix_by_banded_lu_or_mumps_alike(monkeypatch):
+def test_contact_iteration_matrix_by_banded_lu():
     """The contact Jacobian is unsymmetric, so no banded Cholesky; a model this small takes
-    LAPACK's banded LU in reverse Cuthill-McKee order (4 n kd^2 flops within the budget),
-    one whose budget is a flop short takes MUMPS; the two drop the plate alike (the
-    centre's history over 0.1 s within 1e-9 of the 10 mm thickness: round-off against a
-    Newton tolerance of 1e-10)."""
-    from ancfdrv.system.model import Model
+    the kernel's banded LU in reverse Cuthill-McKee order (4 n kd^2 flops within its
+    budget; the banded LU's solves against numpy's dense ones: tests/test_sparse.py) and
+    drops the plate (51 rows over 0.1 s, the centre moving)."""
     banded, _ = _plate_on_plate(k=1e5, c=2e3)
-    order, width = banded.pattern.band_order()
     assert "(banded LU)" in banded.solver.what
-    np.testing.assert_array_equal(banded.band_order(), order)
-    monkeypatch.setattr(Model, "BANDED_LU_FLOPS", 4.0 * banded.ndof * width**2 - 1.0)
-    mumps, _ = _plate_on_plate(k=1e5, c=2e3)
-    assert "(MUMPS)" in mumps.solver.what and mumps.band_order() is None
-    histories = []
-    for model in (banded, mumps):
-        rows = Rows()
-        integrate(model, DynamicSettings.generalized_alpha(2e-3, 0.1, 0.0, tol=1e-10,
-                                                           max_newton=40), model.e0,
-                  sink=rows, progress=False)
-        histories.append(rows.stack("deflections")[:, 0, 2])
-    assert len(histories[0]) == len(histories[1]) == 51
-    assert np.ptp(histories[0]) > 1e-6                    # it moves
-    assert np.abs(histories[0] - histories[1]).max() < 1e-9 * 0.01
+    rows = Rows()
+    integrate(banded, DynamicSettings.generalized_alpha(2e-3, 0.1, 0.0, tol=1e-10,
+                                                        max_newton=40), banded.e0,
+              sink=rows, progress=False)
+    history = rows.stack("deflections")[:, 0, 2]
+    assert len(history) == 51
+    assert np.ptp(history) > 1e-6                    # it moves
 
 
 def test_plate_dropped_on_plate_rests_at_mg_over_k():

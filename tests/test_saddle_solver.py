@@ -1,23 +1,18 @@
 """The solver a model's saddle-point systems are factorized by (the static Newton's and the
 consistent start's; ``fortran/src/linalg/sparse_direct.f90``'s solver_create_for, reached
 through :meth:`ancfdrv.kernel.DirectSolver.by_cost`): LAPACK's banded LU in the reverse
-Cuthill-McKee order of the pattern when 4 n kd^2 <= ``Model.BANDED_LU_FLOPS``, else MUMPS.
-References: numpy's dense solve, the residual of the system itself, the Python reverse
-Cuthill-McKee (``Pattern.band_order``) for the half-bandwidth the kernel's order reaches,
-and the MUMPS libraries' resident pages for which kind ran."""
+Cuthill-McKee order of the pattern when 4 n kd^2 <= 5e7 (``banded_lu_flops``), else MUMPS.
+References: numpy's dense solve, the residual of the system itself, a grid's half-bandwidth
+for the one the kernel's order reaches, and the MUMPS libraries' resident pages for which
+kind ran."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from conftest import INPUTS, mumps_pages
-from ancfdrv.builders import build_model
-from ancfdrv.csr import Csr
 from ancfdrv.errors import SolverError
-from ancfdrv.io.scene import load_scene
 from ancfdrv.kernel import DirectSolver
-from ancfdrv.system.model import Model
-from ancfdrv.system.patterns import Pattern
 
 
 def _saddle(n: int, links: list[list[tuple[int, float]]], seed: int,
@@ -89,40 +84,29 @@ def _grid(side: int) -> tuple[int, np.ndarray, np.ndarray]:
     return n, rows, cols
 
 
+#: the kernel's budget of the banded LU's factorization (sparse_direct's banded_lu_flops)
+BANDED_LU_FLOPS = 5.0e7
+
+
 @pytest.mark.parametrize("side,banded", [(40, True), (80, False)])
 def test_the_choice_follows_the_cost_rule(side, banded):
-    """The kernel's reverse Cuthill-McKee reaches Python's half-bandwidth on the same
-    pattern, and the kind follows 4 n kd^2 <= BANDED_LU_FLOPS: a 40 x 40 grid (kd 40,
-    1e7 flops) takes the banded LU, an 80 x 80 one (kd 80, 1.6e8) MUMPS; both solve the
-    shifted Laplacian to a residual at round-off."""
+    """The kernel's reverse Cuthill-McKee reaches a side x side grid's half-bandwidth (kd =
+    side, the least: a row of the grid lies between a node and its neighbour in the next
+    row), and the kind follows 4 n kd^2 <= 5e7: a 40 x 40 grid (1e7 flops) takes the banded
+    LU, an 80 x 80 one (1.6e8) MUMPS; both solve the shifted Laplacian to a residual at
+    round-off."""
     n, rows, cols = _grid(side)
-    structure = Csr.structure(n, rows, cols)
-    _, width = Pattern(n, structure.indptr, structure.indices).band_order()
-    assert (4.0 * n * width**2 <= Model.BANDED_LU_FLOPS) == banded
+    assert (4.0 * n * side**2 <= BANDED_LU_FLOPS) == banded
     values = np.where(rows == cols, 4.5, -1.0)
     b = np.sin(np.arange(n))
     with DirectSolver.by_cost(n, rows, cols) as solver:
-        assert solver.width == width
+        assert solver.width == side
         assert solver.banded_lu == banded
         solver.factorize(values)
         x = solver.solve(b)
     residual = np.zeros(n)
     np.add.at(residual, rows, values * x[cols])
     assert np.abs(residual - b).max() <= 1e-13 * np.abs(b).max() * 10
-
-
-def test_the_kernel_order_matches_pythons_on_model_patterns():
-    """On real iteration-matrix patterns (the boom, the knuckle crane's rope model) the
-    kernel's order reaches the half-bandwidth of Pattern.band_order."""
-    for scene, overrides in [("boom_luffing.nml", ["beam.nodes=4"]),
-                             ("knuckle_crane_rope.nml", [])]:
-        model = build_model(load_scene(INPUTS / scene, overrides=overrides))
-        try:
-            p = model.pattern
-            with DirectSolver.by_cost(p.n, p.rows, p.col_index) as solver:
-                assert solver.width == p.band_order()[1]
-        finally:
-            model.close()
 
 
 def test_a_small_models_static_solve_and_start_never_run_mumps():

@@ -108,16 +108,17 @@ def _shuffled_band(n: int, kd: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def test_banded_lu_with_an_ordering_solves_in_the_callers_numbering():
-    """The general banded kind (LAPACK's pivoted banded LU) given an ordering of the
-    unknowns: solutions for one and several right-hand sides in the original numbering
-    against numpy's dense solve, a refactorization on the same handle, and a singular
-    matrix and a non-permutation refused with the error's words."""
+    """The general banded kind (LAPACK's pivoted banded LU) in the kernel's ordering of the
+    unknowns (DirectSolver.by_cost on a shuffled band): solutions for one and several
+    right-hand sides in the original numbering against numpy's dense solve, a
+    refactorization on the same handle, and a singular matrix refused with the error's
+    words."""
     n = 40
     a, perm = _shuffled_band(n, 2, seed=5)
     rows, cols = np.nonzero(a)
-    order = np.argsort(perm)     # unknown perm[k] of the shuffled matrix is the band's k
     rhs = RNG.standard_normal((n, 3))
-    with DirectSolver(n, rows, cols, banded_order=order, what="band") as solver:
+    with DirectSolver.by_cost(n, rows, cols, what="band") as solver:
+        assert solver.banded_lu
         solver.factorize(a[rows, cols])
         np.testing.assert_allclose(solver.solve(rhs), np.linalg.solve(a, rhs), rtol=1e-10,
                                    atol=1e-12)
@@ -130,22 +131,14 @@ def test_banded_lu_with_an_ordering_solves_in_the_callers_numbering():
         singular[:, 7] = 0.0
         with pytest.raises(SolverError, match="band: factorization failed: .*singular"):
             solver.factorize(singular[rows, cols])
-    with pytest.raises(SolverError, match="ordering failed: size mismatch"):
-        DirectSolver(n, rows, cols, banded_order=np.zeros(n, dtype=int))
 
 
 def test_band_order_recovers_a_hidden_band():
-    """Reverse Cuthill-McKee on shuffled banded patterns of half-bandwidth 1, 2 and 3 finds
-    the band again: width kd, the least possible (an inner unknown has 2 kd neighbours, so
-    some neighbour lies at least kd places away in any order); the ordering is a
-    permutation and the returned width is the ordering's."""
-    from ancfdrv.system.patterns import Pattern
+    """The kernel's reverse Cuthill-McKee on shuffled banded patterns of half-bandwidth 1,
+    2 and 3 finds the band again: width kd, the least possible (an inner unknown has 2 kd
+    neighbours, so some neighbour lies at least kd places away in any order)."""
     for kd in (1, 2, 3):
         a, _ = _shuffled_band(50, kd, seed=kd)
         rows, cols = np.nonzero(a)
-        ptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=50))])
-        order, width = Pattern(50, ptr, cols).band_order()
-        assert sorted(order.tolist()) == list(range(50))
-        place = np.empty(50, dtype=int)
-        place[order] = np.arange(50)
-        assert width == np.abs(place[rows] - place[cols]).max() == kd
+        with DirectSolver.by_cost(50, rows, cols) as solver:
+            assert solver.banded_lu and solver.width == kd

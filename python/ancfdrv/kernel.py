@@ -486,26 +486,19 @@ class DirectSolver:
     """
 
     def __init__(self, n: int, rows: np.ndarray, cols: np.ndarray, *, symmetric: bool = False,
-                 banded_spd: bool = False, banded_order: np.ndarray | None = None,
-                 what: str = "system matrix") -> None:
+                 banded_spd: bool = False, what: str = "system matrix") -> None:
         """``banded_spd`` selects LAPACK's banded Cholesky for a symmetric matrix with a narrow
         band (O(n kd) solves without MUMPS's per-call overhead); a matrix that turns out not
         to be positive definite is factorized by the pivoted banded LU instead (give both
-        triangles). ``banded_order`` (0-based, the unknowns in the band's order, e.g. a
-        reverse Cuthill-McKee ordering) selects LAPACK's banded LU with partial pivoting for
-        any matrix (give every entry) in that numbering; the solves take and return the
-        original numbering."""
+        triangles). :meth:`by_cost` lets the kernel choose between its banded LU (in its
+        reverse Cuthill-McKee order) and MUMPS."""
         self.what = what
-        kind = 3 if banded_spd else 4 if banded_order is not None else 2 if symmetric else 0
+        kind = 3 if banded_spd else 2 if symmetric else 0
         handle, info, detail = _kernel.direct_create(kind)
         self._check(info, detail, "create")
         self.handle, self.n, self.nnz = handle, n, len(rows)
         self.factorizations = 0
         self.solves = 0
-        if banded_order is not None:
-            place = np.empty(n, dtype=np.int32)
-            place[np.asarray(banded_order)] = np.arange(1, n + 1, dtype=np.int32)
-            self._check(_kernel.direct_order(handle, place), 0, "ordering")
         info, detail = _kernel.direct_analyse(handle, n, _f(np.asarray(rows) + 1, np.int32),
                                               _f(np.asarray(cols) + 1, np.int32))
         self._check(info, detail, "analyse")
@@ -516,7 +509,7 @@ class DirectSolver:
         """The solver the kernel's cost rule picks for any (e.g. saddle-point) pattern, the
         rule of the static Newton and the consistent start (``sparse_direct``'s
         solver_create_for): LAPACK's banded LU in the reverse Cuthill-McKee order of the
-        pattern's symmetric closure when 4 n kd^2 <= ``Model.BANDED_LU_FLOPS``, else MUMPS
+        pattern's symmetric closure when 4 n kd^2 <= 5e7 (``banded_lu_flops``), else MUMPS
         (general; give every entry). ``banded_lu`` and ``width`` (kd in that order) say
         which."""
         self = cls.__new__(cls)

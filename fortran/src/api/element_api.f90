@@ -550,14 +550,6 @@ subroutine direct_create_for(n, nnz, rows, cols, handle, width, banded, info, in
   banded = merge(1, 0, solver_banded_lu(handle))
 end subroutine direct_create_for
 
-subroutine direct_order(handle, n, place, info)
-  use sparse_direct, only: solver_order
-  implicit none
-  integer, intent(in) :: handle, n, place(n)
-  integer, intent(out) :: info
-  call solver_order(handle, n, place, info)
-end subroutine direct_order
-
 subroutine direct_analyse(handle, n, nnz, rows, cols, info, info_detail)
   use sparse_direct, only: solver_analyse
   implicit none

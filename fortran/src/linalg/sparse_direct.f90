@@ -7,13 +7,12 @@
 !> MUMPS's per-call overhead (every MUMPS call, a solve included, walks its whole structure
 !> to estimate the memory a save would take: tens of microseconds). When the Cholesky finds
 !> the matrix not positive definite (a tangent stiffness under compression), the same
-!> handle falls back to the banded LU. A banded kind may be given an ordering of the
-!> unknowns (solver_order, e.g. reverse Cuthill-McKee) that narrows the band; its callers
-!> keep the original numbering. solver_create_for picks the kind for a model's unsymmetric
-!> or indefinite systems (the saddle-point systems of the static Newton and the consistent
-!> start) by the rule the iteration matrix's kind is chosen by (Model.band_order): the banded
-!> LU in the pattern's reverse Cuthill-McKee order when its factorization costs at most
-!> banded_lu_flops (4 n kd^2), else MUMPS. The handle table is the kernel's only module state.
+!> handle falls back to the banded LU. solver_create_for picks the kind for every system a
+!> model factorizes that is not for the banded Cholesky (the iteration matrix of an
+!> unsymmetric or wide-banded model, the saddle-point systems of the static Newton and the
+!> consistent start): the banded LU in the pattern's reverse Cuthill-McKee order
+!> (band_order; its callers keep the original numbering) when its factorization costs at
+!> most banded_lu_flops (4 n kd^2), else MUMPS. The handle table is the kernel's only module state.
 !> info: 0 ok; 1 bad handle or no free slot; 2 call out of sequence (solve before
 !> factorize, ...); 3 size mismatch; < 0 MUMPS INFOG(1) (-10: numerically singular),
 !> with INFOG(2) in info_detail; the banded kind reports a non-positive-definite matrix
@@ -24,7 +23,7 @@ module sparse_direct
   private
   include 'mpif.h'
   include 'dmumps_struc.h'
-  public :: solver_create, solver_order, solver_analyse, solver_factorize, solver_solve, &
+  public :: solver_create, solver_analyse, solver_factorize, solver_solve, &
             solver_destroy, solver_create_for, solver_banded_lu
 
   !> symmetry code that selects the banded LAPACK Cholesky
@@ -32,7 +31,11 @@ module sparse_direct
   !> symmetry code that selects the banded LAPACK LU (general matrices)
   integer, parameter, public :: banded_general = 4
   !> the banded LU replaces MUMPS when its factorization takes at most this many flops
-  !> (4 n kd^2): python/ancfdrv/system/model.py's Model.BANDED_LU_FLOPS, the same rule
+  !> (4 n kd^2: kd rows below the diagonal times the 2 kd columns of U's band, per column):
+  !> about a millisecond at the BLAS-3 rate, where MUMPS's fixed costs per call (some 50 us
+  !> per solve, whatever the size: it estimates the memory a save would take on each call)
+  !> outweigh its savings on fill. The two-leaf spring (n = 370, kd = 125): 0.58 against
+  !> MUMPS's 0.86 ms per factorization and 18 against 67 us per solve
   real(dp), parameter, public :: banded_lu_flops = 5.0e7_dp
 
   type :: solver_slot
@@ -165,8 +168,8 @@ contains
     end if
   end subroutine solver_create_for
 
-  !> Reverse Cuthill-McKee order of the symmetric closure of the pattern (rows, cols), as
-  !> python/ancfdrv/system/patterns.py's Pattern.band_order: each connected component from a
+  !> Reverse Cuthill-McKee order of the symmetric closure of the pattern (rows, cols): each
+  !> connected component from a
   !> pseudo-peripheral start (George and Liu: the last level's node of lowest degree, lowest
   !> index among equals, until the number of levels stops growing), seeds and neighbours
   !> in increasing (degree, index); the degree counts a node's distinct neighbours, itself

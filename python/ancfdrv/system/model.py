@@ -616,27 +616,6 @@ class Model:
             return False
         return not self.contact_pairs and self.pattern.bandwidth() <= max(64, self.ndof // 4)
 
-    #: the banded LU replaces MUMPS for an iteration matrix whose banded factorization takes
-    #: at most this many flops (4 n kd^2: kd rows below the diagonal times the 2 kd columns
-    #: of U's band, per column): about a millisecond at the BLAS-3 rate, where MUMPS's fixed
-    #: costs per call (some 50 us per solve, whatever the size: it estimates the memory a
-    #: save would take on each call) outweigh its savings on fill. The two-leaf spring
-    #: (n = 370, kd = 125 after reverse Cuthill-McKee: 2.3e7 flops): 0.58 against MUMPS's
-    #: 0.86 ms per factorization and 18 against 67 us per solve. The kernel applies the same
-    #: rule (fortran/src/linalg/sparse_direct.f90, banded_lu_flops) to the saddle-point
-    #: systems it factorizes (static Newton, consistent start; DirectSolver.by_cost).
-    BANDED_LU_FLOPS = 5.0e7
-
-    def band_order(self) -> np.ndarray | None:
-        """The unknowns' reverse Cuthill-McKee order for LAPACK's banded LU when the
-        iteration matrix is not for the banded Cholesky (:meth:`banded`) and its banded
-        factorization is cheap (:data:`BANDED_LU_FLOPS`); None: MUMPS. Decided once per
-        model from the pattern."""
-        if self.banded():
-            return None
-        ordering, width = self.pattern.band_order()
-        return ordering if 4.0 * self.ndof * width**2 <= self.BANDED_LU_FLOPS else None
-
     def build_kernel(self) -> None:
         """Hand the system to the kernel (once) and analyse the iteration matrix's pattern."""
         ks = kernel.KernelSystem(self.ndof, self.nfull)
@@ -645,12 +624,15 @@ class Model:
         ks.set_frames([f.drive for f in self.frames], [f.axis for f in self.frames],
                       [f.base for f in self.frames], [f.pivot for f in self.frames])
         ks.set_drives([d.kind for d in self.drives], [d.params() for d in self.drives])
-        banded = self.banded()
-        order = self.band_order()
-        self.solver = kernel.DirectSolver(
-            self.ndof, self.pattern.rows, self.pattern.col_index, banded_spd=banded,
-            banded_order=order, what="iteration matrix beta' M + K " + (
-                "(banded Cholesky)" if banded else "(MUMPS)" if order is None else "(banded LU)"))
+        what = "iteration matrix beta' M + K "
+        if self.banded():
+            self.solver = kernel.DirectSolver(self.ndof, self.pattern.rows,
+                                              self.pattern.col_index, banded_spd=True,
+                                              what=what + "(banded Cholesky)")
+        else:   # the kernel's cost rule, as for every other system the model factorizes
+            self.solver = kernel.DirectSolver.by_cost(self.ndof, self.pattern.rows,
+                                                      self.pattern.col_index, what=what)
+            self.solver.what += "(banded LU)" if self.solver.banded_lu else "(MUMPS)"
         mass = self.mass.copy()
         mass.eliminate_zeros()  # the x, y, z blocks of M are decoupled: 2/3 of it is 0
         mass.sort_indices()

@@ -117,58 +117,6 @@ class Pattern:
     def bandwidth(self) -> int:
         return int(np.abs(self.rows - self.col_index).max(initial=0))
 
-    def _levels(self, start: int) -> list[np.ndarray]:
-        """Breadth-first level sets from ``start`` (its connected component)."""
-        seen = np.zeros(self.n, dtype=bool)
-        seen[start] = True
-        levels = [np.array([start])]
-        while True:
-            front = levels[-1]
-            nexts = np.concatenate([self.col_index[self.row_ptr[i]:self.row_ptr[i + 1]]
-                                    for i in front])
-            nexts = np.unique(nexts[~seen[nexts]])
-            if not len(nexts):
-                return levels
-            seen[nexts] = True
-            levels.append(nexts)
-
-    def band_order(self) -> tuple[np.ndarray, int]:
-        """Reverse Cuthill-McKee ordering of this structurally symmetric pattern (each
-        component from a pseudo-peripheral start, George and Liu's: the last level's
-        lowest-degree node until the level count stops growing; neighbours in increasing
-        degree) and the half-bandwidth max |place(i) - place(j)| in that order. No scipy
-        (a dynamic run does not import scipy.sparse)."""
-        degree = self.row_ptr[1:] - self.row_ptr[:-1]
-        visited = np.zeros(self.n, dtype=bool)
-        order: list[int] = []
-        for seed in np.argsort(degree, kind="stable"):
-            if visited[seed]:
-                continue
-            start, levels = int(seed), self._levels(int(seed))
-            while True:
-                last = levels[-1]
-                candidate = int(last[np.argmin(degree[last])])
-                deeper = self._levels(candidate)
-                if len(deeper) <= len(levels):
-                    break
-                start, levels = candidate, deeper
-            queue, head = [start], 0
-            visited[start] = True
-            while head < len(queue):
-                i = queue[head]
-                head += 1
-                nb = self.col_index[self.row_ptr[i]:self.row_ptr[i + 1]]
-                nb = nb[~visited[nb]]
-                nb = nb[np.argsort(degree[nb], kind="stable")]
-                visited[nb] = True
-                queue.extend(nb.tolist())
-            order.extend(queue)
-        ordering = np.array(order[::-1], dtype=np.int64)
-        place = np.empty(self.n, dtype=np.int64)
-        place[ordering] = np.arange(self.n)
-        width = int(np.abs(place[self.rows] - place[self.col_index]).max(initial=0))
-        return ordering, width
-
 
 @dataclass
 class Reduction:
