@@ -102,6 +102,31 @@ def test_buckling_run_with_a_fixed_load(tmp_path, capsys):
     assert "buckling.first_load_factor" in capsys.readouterr().out
 
 
+def test_linear_buckling_run_prints_and_writes_its_check(tmp_path, capsys):
+    """method = 'linear' on the column of test_buckling_run_with_a_fixed_load (straight, a
+    push along its axis: K_T affine in the load) is 'confirmed': the estimate about the
+    state at 0.98 of the factor gives the factor again, within 2 % (Dunkerley's reference
+    to 0.1 %, as there); the verdict and both factors are /buckling attributes and are
+    printed."""
+    scene = write(tmp_path, "buckling",
+                  "&buckling modes = 1, fixed_loads = 'g', method = 'linear' /")
+    out = tmp_path / "linear.h5"
+    capsys.readouterr()
+    assert main(["run", str(scene), "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    with h5py.File(out, "r") as h5:
+        factor = float(h5["buckling/load_factor"][0])
+        attrs = dict(h5["buckling"].attrs)
+    ei = 2.1e11 * 0.03 * 0.02**3 / 12
+    euler, weight = np.pi**2 * ei / (4 * 4.0), 7850 * 6e-4 * 2.0 * 9.81
+    assert factor * 100 == pytest.approx(euler * (1 - weight / (7.837 * ei / 4.0)), rel=1e-3)
+    assert attrs["linear_check"] == "confirmed"
+    assert attrs["checked_load_factor"] == pytest.approx(1 + 0.98 * (factor - 1), rel=1e-12)
+    assert attrs["relinearized_load_factor"] == pytest.approx(factor, rel=0.02)
+    assert "'linear' check (confirmed): the static path carries" in printed
+    assert "lies above" not in printed
+
+
 @pytest.mark.parametrize("extra, fragment", [
     ("&modal modes = 0 /", "modes"),
     ("&buckling fixed_loads = 'wind' /", "wind"),

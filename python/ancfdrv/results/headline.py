@@ -32,6 +32,15 @@ def _floats(values: Any) -> list[float]:
     return [float(v) for v in np.ravel(values)]
 
 
+#: the /buckling attributes of a 'linear' run's check (solvers.buckling._check_linear)
+LINEAR_CHECK = ("linear_check", "checked_load_factor", "relinearized_load_factor")
+
+
+def _scalar(value: Any) -> str | float:
+    """An attribute as text or a float (the JSON's and the printed table's)."""
+    return _text(value) if isinstance(value, (bytes, str)) else float(value)
+
+
 def _reaction_groups(group: h5py.Group, prefix: str = "") -> list[tuple[str, h5py.Group]]:
     """The reactions under /<phase>/reactions by name, in file order: a name with '/'
     (a plate's 'support dw/dx') is a nested group in HDF5."""
@@ -168,6 +177,9 @@ def answers_of(h5: h5py.File) -> dict[str, Any]:
             entry = {key: _floats(h5[name][key][()])}
             if "damping_ratio" in h5[name]:
                 entry["damping_ratio"] = _floats(h5[name]["damping_ratio"][()])
+            if "linear_check" in h5[name].attrs:
+                entry["linear_check"] = {k: _scalar(h5[name].attrs[k]) for k in LINEAR_CHECK
+                                         if k in h5[name].attrs}
             out[name] = entry
     return out
 
@@ -287,4 +299,13 @@ def answer_lines(answers: dict[str, Any]) -> list[str]:
     if buckling:
         lines.append(f"buckling answers ({len(buckling['load_factor'])} modes)")
         lines += _value_lines("load factors", buckling["load_factor"])
+        check = buckling.get("linear_check")
+        if check:
+            lines.append(
+                f"  'linear' check ({check['linear_check']}): the static path carries "
+                f"{check['checked_load_factor']:.6g} times the loads stably; the estimate "
+                f"about that state gives {check['relinearized_load_factor']:.6g}")
+            if check["linear_check"] == "conservative":
+                lines.append("  so the stability limit lies above the classical factor "
+                             "(buckling.method = 'nonlinear' gives it)")
     return lines

@@ -21,7 +21,9 @@ and follower loads' load stiffness and the constraint Hessians times the multipl
       (K_1 + nu K_g) phi = 0  on  G_1 phi = 0,    K_1 = K_T(1),    P = 1 + nu  (nu > 0);
 
   the classical linear buckling about the static state: exact where K_T is affine in P
-  (small pre-buckling deformation).
+  (small pre-buckling deformation). Reported only where the static path carries 0.98 of
+  the first factor stably, so never above the model's limit by more than 2 %
+  (:func:`_check_linear`: 'confirmed', or 'conservative' where the limit lies above).
 * 'nonlinear': the lowest omega^2 of (K_T(P), M) on the constraints' null space of each
   state, followed along the static path from P = 1 by arc length (the kernel's
   Crisfield step, as static_method = 'arc_length') until it changes sign: at a limit point
@@ -614,46 +616,61 @@ BUCKLING_KEYWORDS = {"modes": "buckling", "fixed_loads": "buckling", "method": "
                      "reference_factor": "buckling", "tol": "solver", "max_iter": "solver"}
 
 
-#: 'linear' is confirmed where the classical estimate about the static state at CONFIRM_AT
-#: of its factor, with the same geometric stiffness, reproduces the factor to CONFIRM_TOL
+#: a 'linear' factor P is reported when the model's static path carries 1 + CONFIRM_AT (P - 1)
+#: times the loads stably; it is 'confirmed' when the same estimate about that state
+#: reproduces P within CONFIRM_TOL of it, else the stability limit lies above P
 CONFIRM_AT, CONFIRM_TOL = 0.98, 0.02
 
 
-def _confirm_linear(path: "LoadPath", factor: float, kg: sp.spmatrix, g: sp.spmatrix,
-                    basis: np.ndarray | None, eigen_tol: float) -> None:
-    """Refuse a 'linear' factor the model contradicts. The classical estimate extrapolates
-    the tangent of the scene's state linearly in the load, K_T(P) = K_1 + (P - 1) K_g;
-    where the pre-buckling deformation changes the structure (a mechanism's arm swinging
-    about its pin, a beam bent in its plane before it buckles sideways, a knuckle crane's
-    jib folding on its compliant cylinder) the stability limit lies elsewhere
-    (docs/theory.md section 23). The check loads the static path to CONFIRM_AT of the
-    factor and solves (K_T(P_t) + nu K_g) phi = 0 there: a tangent that followed the
-    extrapolation gives P_t + nu = the factor again (within CONFIRM_TOL of it); one that
-    does not (or a path that cannot be followed that far) is refused, naming 'nonlinear'
-    (SolverError, exit 3): never a wrong factor with status ok. (The lowest vibration
-    stiffness is no measure here: it may be a payload's pendulum, which stiffens with the
-    load, and a stiffness lost relative to K_1 may be a lever arm shortened, no buckling.)"""
+def _check_linear(path: "LoadPath", factor: float, kg: sp.spmatrix, g: sp.spmatrix,
+                  basis: np.ndarray | None, eigen_tol: float) -> dict[str, object]:
+    """What the model says of a 'linear' factor P, or its refusal. The classical estimate
+    extrapolates the tangent of the scene's state linearly in the load, K_T(P) = K_1 +
+    (P - 1) K_g; where the pre-buckling deformation changes the structure (a mechanism's arm
+    swinging about its pin, a beam bent in its plane before it buckles sideways, a knuckle
+    crane's jib folding on its compliant cylinder) the stability limit lies elsewhere
+    (docs/theory.md section 23), above P or below it. The check loads the static path to
+    P_t = 1 + CONFIRM_AT (P - 1) and counts the negative eigenvalues of the tangent there
+    (:func:`~.path.negative_eigenvalues`): a path that carries P_t stably has no stability
+    limit below P_t, so P is at most 2 % above the model's limit and is reported; a path
+    that cannot be followed to P_t (a limit point below it: Lee's frame loaded near its
+    snap-through) or is unstable there (a bifurcation passed) is refused, naming 'nonlinear'
+    (SolverError, exit 3): never a factor above the limit with status ok. About the state at
+    P_t the same estimate is solved again, (K_T(P_t) + nu K_g) phi = 0: P_t + nu within
+    CONFIRM_TOL of P confirms the extrapolation ('confirmed'); above it, the structure
+    stiffens on its way and the limit lies above P ('conservative': the classical factor is
+    on the safe side; 'nonlinear' gives the limit). Returned as /buckling attributes:
+    linear_check, checked_load_factor (P_t), relinearized_load_factor (P_t + nu)."""
+    from .path import negative_eigenvalues
     if factor <= 1.0:
-        return
+        return {}
     target = 1.0 + CONFIRM_AT * (factor - 1.0)
+    advice = ("the structure has a stability limit below the estimate (a limit point or a "
+              "bifurcation on its static path, docs/theory.md section 23): use "
+              "buckling.method = 'nonlinear'")
     try:
         _advance(path, target)
     except SolverError as exc:
         raise SolverError(
-            f"buckling: the 'linear' estimate {factor:.6g} is not confirmed: the static path "
-            f"could not be followed to {target:.6g} times the loads ({exc}); the structure "
-            "may have a limit below it: use buckling.method = 'nonlinear'") from None
+            f"buckling: the 'linear' estimate {factor:.6g} is refused: the static path could "
+            f"not be followed to {target:.6g} times the loads ({exc}); {advice}") from None
+    if path.factor < target:    # _advance halved its step: no state at the target
+        raise SolverError(
+            f"buckling: the 'linear' estimate {factor:.6g} is refused: the static path ends "
+            f"at {path.factor:.6g} times the loads, below {target:.6g}; {advice}")
+    unstable = negative_eigenvalues(path.model, path.e, path.lam, path.factor)
+    if unstable:
+        raise SolverError(
+            f"buckling: the 'linear' estimate {factor:.6g} is refused: the static state at "
+            f"{path.factor:.6g} times the loads is unstable ({unstable} negative "
+            f"eigenvalue(s) of its tangent); {advice}")
     k_t, g_t = path.matrices()
     theta, _ = _pencil(_follow_basis(basis, g, g_t), k_t, kg, g_t, 1, eigen_tol)
     theta = theta[theta > 1e-12 * max(np.abs(theta).max(initial=0.0), 1e-300)]
     again = path.factor + 1.0 / theta.max() if len(theta) else np.inf
-    if not abs(again - factor) <= CONFIRM_TOL * factor:
-        raise SolverError(
-            f"buckling: the 'linear' estimate {factor:.6g} is contradicted by the model: "
-            f"about the static state at {path.factor:.6g} times the loads the same estimate "
-            f"gives {again:.6g}; the pre-buckling deformation changes the structure, which "
-            "the classical estimate about the scene's state cannot see (docs/theory.md "
-            "section 23): use buckling.method = 'nonlinear'")
+    check = "confirmed" if abs(again - factor) <= CONFIRM_TOL * factor else "conservative"
+    return {"linear_check": check, "checked_load_factor": float(path.factor),
+            "relinearized_load_factor": float(again)}
 
 
 def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
@@ -736,11 +753,12 @@ def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
         factors, shapes = mus[order], vectors[:, positive][:, order].T.copy()
         negative = (theta < -1e-12 * max(scale, 1e-300)) & (theta > -1.0)
         negative_factor = float(1.0 + 1.0 / theta[negative].min()) if negative.any() else 0.0
-        if len(factors):
-            _confirm_linear(path, float(factors[0]), kg, g, basis, eigen_tol)
+        checked = _check_linear(path, float(factors[0]), kg, g, basis, eigen_tol) \
+            if len(factors) else {}
     else:
         # the first: the limit; the others: the classical linear buckling about a state
         # below it (_beyond_the_limit)
+        checked = {}
         factors, shapes = np.array([critical]), vectors[:, :1].T.copy()
         if count > 1:
             above, more = _beyond_the_limit(path, model, history, saved, critical, basis, g,
@@ -757,7 +775,7 @@ def buckling_analysis(model: Model, count: int, *, method: str = "nonlinear",
                             extra={"method": method, "updates": len(history),
                                    "reference_factor": history[-1][0],
                                    "static_solves": path.solves,
-                                   "negative_load_factor": negative_factor})
+                                   "negative_load_factor": negative_factor, **checked})
     model.counters["buckling_analyses"] += 1
     result.wall_time_s = time.perf_counter() - start
     timing["total"] = result.wall_time_s
