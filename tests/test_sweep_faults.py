@@ -372,7 +372,10 @@ def dask_cluster(tmp_path_factory):
         address = json.loads(scheduler_file.read_text())["address"]
         preload = root / "kill_once.py"
         preload.write_text(KILL_ONCE)
-        env = dict(os.environ, ANCF_TEST_KILL_MARKER=str(root / "killed"))
+        # the workers' temporary directories in the test's own: a worker killed mid-case
+        # cannot clean its case directory up (it left one in /tmp per run of the suite)
+        (root / "tmp").mkdir()
+        env = dict(os.environ, ANCF_TEST_KILL_MARKER=str(root / "killed"), TMPDIR=str(root / "tmp"))
         workers = [root / "worker-a", root / "worker-b"]
         for cwd in workers:
             start(["worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard",
