@@ -63,8 +63,9 @@ def test_perfect_column_beyond_its_euler_load_is_refused(case, tmp_path):
 def test_the_index_counts_the_euler_loads_below_the_load(nodes):
     """At 4.5 P_cr the pinned-pinned column's Euler loads n^2 P_cr below the load are
     n = 1 and 2, each in two planes: index 4 (5 nodes: the dense test; 33 nodes: the
-    banded one), as the arc-length path's own count (path.negative_eigenvalues)."""
-    from ancfdrv.solvers.path import negative_eigenvalues, solve_static_path
+    banded one), as the arc-length path's own count (buckling.negative_eigenvalues)."""
+    from ancfdrv.solvers.buckling import negative_eigenvalues
+    from ancfdrv.solvers.path import solve_static_path
     model = column("pinned-pinned", load=4.5 * _euler("pinned-pinned"), nodes=nodes).assemble()
     try:
         static = solve_static_path(model, "newton", tol=1e-10, max_iter=50)

@@ -56,6 +56,7 @@ from ..kernel import DirectSolver
 from ..system.model import Model
 from ..system.kinds.force_element import evaluate, slot_values
 from ..system.registry import kind_of
+from .modal import DENSE_LIMIT as MODAL_DENSE_LIMIT
 from .modal import arpack_start, check_free, linearize, null_space
 from .static import ARC_STEP, LOAD_TANGENT, StaticResult, kernel_static, solve_newton
 from .._lazy import LazyModule
@@ -328,6 +329,25 @@ def _lowest(k: sp.spmatrix, m: sp.spmatrix, g: sp.spmatrix, method: str,
         solver.close()
     order = np.argsort(w)
     return w[order], z[:n, order]
+
+
+def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> int:
+    """The number of negative eigenvalues of the tangent at (e, lambda, P) on the
+    constraints' null space (the stability index; exact for models up to the modal
+    DENSE_LIMIT free coordinates; else among the lowest eight)."""
+    lin = linearize(model, e, lam, load_factor=factor)
+    k, g = lin.stiffness, lin.constraints
+    free = model.ndof - g.shape[0]
+    if free <= MODAL_DENSE_LIMIT:
+        basis = null_space(g, model.ndof)
+        reduced = basis.T @ (k @ basis)
+        w = la.eigvalsh(0.5 * (reduced + reduced.T))
+    else:
+        w, _ = _lowest(k, model.mass_matrix(), g, "sparse", min(8, free - 1))
+        w = np.asarray(w)
+    scale = max(np.abs(k.diagonal()).max(initial=0.0), 1e-300) if free > MODAL_DENSE_LIMIT \
+        else max(np.abs(w).max(initial=0.0), 1e-300)
+    return int(np.sum(w < -1e-10 * scale))
 
 
 def _advance(path: "LoadPath", factor: float, tries: int = 6) -> None:
@@ -631,7 +651,7 @@ def _check_linear(path: "LoadPath", factor: float, kg: sp.spmatrix, g: sp.spmatr
     crane's jib folding on its compliant cylinder) the stability limit lies elsewhere
     (docs/theory.md section 23), above P or below it. The check loads the static path to
     P_t = 1 + CONFIRM_AT (P - 1) and counts the negative eigenvalues of the tangent there
-    (:func:`~.path.negative_eigenvalues`): a path that carries P_t stably has no stability
+    (:func:`negative_eigenvalues`): a path that carries P_t stably has no stability
     limit below P_t, so P is at most 2 % above the model's limit and is reported; a path
     that cannot be followed to P_t (a limit point below it: Lee's frame loaded near its
     snap-through) or is unstable there (a bifurcation passed) is refused, naming 'nonlinear'
@@ -641,7 +661,6 @@ def _check_linear(path: "LoadPath", factor: float, kg: sp.spmatrix, g: sp.spmatr
     stiffens on its way and the limit lies above P ('conservative': the classical factor is
     on the safe side; 'nonlinear' gives the limit). Returned as /buckling attributes:
     linear_check, checked_load_factor (P_t), relinearized_load_factor (P_t + nu)."""
-    from .path import negative_eigenvalues
     if factor <= 1.0:
         return {}
     target = 1.0 + CONFIRM_AT * (factor - 1.0)

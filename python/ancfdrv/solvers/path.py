@@ -64,6 +64,9 @@ from .static import (ARC_STEP, LOAD_TANGENT, LoadStepFailure, StaticResult, kern
                      solve_static)
 
 la = LazyModule("scipy.linalg")
+# the stability index (buckling.negative_eigenvalues) on first use: a Newton solve imports
+# no modal or buckling code
+buckling = LazyModule("ancfdrv.solvers.buckling")
 
 #: iterations per step the arc adapts to
 DESIRED_ITERATIONS = 5
@@ -92,36 +95,15 @@ class StaticPath:
     message: str = ""
 
 
-def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: float) -> int:
-    """The number of negative eigenvalues of the tangent at (e, lambda, P) on the
-    constraints' null space (exact for models up to DENSE_LIMIT free coordinates; else
-    among the lowest eight)."""
-    from .buckling import _lowest
-    from .modal import DENSE_LIMIT, linearize, null_space  # a Newton solve imports no modal code
-    lin = linearize(model, e, lam, load_factor=factor)
-    k, g = lin.stiffness, lin.constraints
-    free = model.ndof - g.shape[0]
-    if free <= DENSE_LIMIT:
-        basis = null_space(g, model.ndof)
-        reduced = basis.T @ (k @ basis)
-        w = la.eigvalsh(0.5 * (reduced + reduced.T))
-    else:
-        w, _ = _lowest(k, model.mass_matrix(), g, "sparse", min(8, free - 1))
-        w = np.asarray(w)
-    scale = max(np.abs(k.diagonal()).max(initial=0.0), 1e-300) if free > DENSE_LIMIT else \
-        max(np.abs(w).max(initial=0.0), 1e-300)
-    return int(np.sum(w < -1e-10 * scale))
-
-
 #: free coordinates up to which a load-controlled static state's stability index is
 #: counted where its reduced tangent has no narrow band (dense, O(n^3)), and up to which an
 #: unstable state's count is taken from all the eigenvalues (above: the lowest eight, as
-#: :func:`negative_eigenvalues`); a wide-banded model above it is not checked (the check
+#: :func:`~.buckling.negative_eigenvalues`); a wide-banded model above it is not checked (the check
 #: would cost more than a fifth of the solve)
 STABILITY_LIMIT = 1500
 #: eigenvalues of the reduced tangent above -STABILITY_TOL times its scale count as zero
 #: (a mechanism's zero-stiffness direction is round-off, not instability; as
-#: :func:`negative_eigenvalues`)
+#: :func:`~.buckling.negative_eigenvalues`)
 STABILITY_TOL = 1e-10
 
 
@@ -270,7 +252,7 @@ def stability_index(model: Model, e: np.ndarray, lam: np.ndarray, factor: float)
                           np.concatenate([vals, np.full(size, shift)]), size, band):
         return 0
     if size > STABILITY_LIMIT:
-        return negative_eigenvalues(model, e, lam, factor)
+        return buckling.negative_eigenvalues(model, e, lam, factor)
     dense = np.zeros((size, size))
     np.add.at(dense, (rows, cols), vals)
     w = np.linalg.eigvalsh(dense)
@@ -383,7 +365,7 @@ def _next_point(model: Model, e: np.ndarray, lam: np.ndarray, factor: float, arc
                 continue
             e_new, lam_new, factor_new, last, reached = \
                 landed["e"], landed["lam"], target, landed, True
-        count_new = negative_eigenvalues(model, e_new, lam_new, factor_new)
+        count_new = buckling.negative_eigenvalues(model, e_new, lam_new, factor_new)
         if count_new != count and confirms < CONFIRM_CUTS:
             confirms += 1
             arc *= 0.5
@@ -438,7 +420,7 @@ def solve_arc_length(model: Model, *, tol: float = 1e-10, max_iter: int = 50,
                          "follow", group="solver", key="static_method")
     largest = 4.0 * arc
     factors, disps, counts, lengths = [0.0], [_probe_displacement(model, e, probe)], \
-        [negative_eigenvalues(model, e, lam, factor)], [0.0]
+        [buckling.negative_eigenvalues(model, e, lam, factor)], [0.0]
     previous: np.ndarray | None = None   # the last step's increment of e
     iterations_total, history = 0, []
     reached, message = False, ""
@@ -507,7 +489,7 @@ def diagnose_stall(model: Model, failure: LoadStepFailure, *, tol: float, max_it
     flex0 = start["flexibility"] if start is not None else np.nan
     flex = at["flexibility"] if at is not None else np.inf
     ratio = flex0 / flex if flex != 0 else 0.0
-    negative = negative_eigenvalues(model, e, lam, reached)
+    negative = buckling.negative_eigenvalues(model, e, lam, reached)
     if not (ratio < 0.1 or negative > 0):
         return failure
     head = str(failure).split("; raise")[0]
