@@ -88,12 +88,16 @@ PHASE_CASES: dict[str, tuple[str, list[str]]] = {
 }
 #: whole calls kept in memory (``ancfdrv.simulate``, no file: as ``peer_harness.py``'s boom
 #: levels time them, like Exudyn's run with no solution file), then the tip history read from
-#: the ``Simulation``: the boom at the harness's 3 % level (issue 38, "a model build and
-#: output path whose fixed cost is at most Exudyn's"); ``--phases --cases boom_memory_3pct``
+#: the ``Simulation``: the boom and the flexible pendulum at the harness's 3 % level (issue
+#: 38, "a model build and output path whose fixed cost is at most Exudyn's"); ``--phases
+#: --cases boom_memory_3pct,pendulum_memory_3pct``
 MEMORY_CASES: dict[str, tuple[str, list[str]]] = {
     "boom_memory_3pct": ("inputs/boom_luffing.nml", [
         "scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.",
         "beam.bending=cable", "scene.planar=xy", "beam.nodes=4", "solver.dt=0.02"]),
+    "pendulum_memory_3pct": ("inputs/hard/pendulum.nml", [
+        "beam.nodes=5", "solver.dt=0.01", "solver.t_end=1.0", "beam.bending=cable",
+        "scene.planar=xy"]),
 }
 QUICK = {"pendulum_cable_5": CASES["pendulum_cable_5"]}
 #: the whole calls counted per case by ``--instructions`` (after two warm-up calls)

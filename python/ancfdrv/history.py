@@ -18,15 +18,35 @@ def luffing_stage_bounds(omega: float, t_start: float, t_brake: float, sweep: fl
             "vibration": (t2, t_end)}
 
 
+def fast_length(n: int) -> int:
+    """The smallest 5-smooth number (2^a 3^b 5^c) at least ``n``: a length the FFT
+    transforms in O(n log n) with small radices (a length with a large prime factor takes
+    Bluestein's algorithm, several times slower)."""
+    best = 1 << max(n - 1, 0).bit_length()   # the next power of two: an upper bound
+    five = 1
+    while five < best:
+        three = five
+        while three < best:
+            two = three
+            while two < n:
+                two *= 2
+            best = min(best, two)
+            three *= 3
+        five *= 5
+    return best
+
+
 def dominant_frequency(time: np.ndarray, signal: np.ndarray) -> tuple[float, float]:
     """Dominant frequency (Hz) of a uniformly sampled signal, from the peak of its
     Hann-windowed spectrum refined by parabolic interpolation, and the amplitude
-    (half the peak-to-peak of the mean-free signal)."""
+    (half the peak-to-peak of the mean-free signal). The record is zero-padded to at
+    least 8 times its length (bins 1/8 of the record's resolution), to a fast length
+    (:func:`fast_length`)."""
     if len(time) < 8:
         return float("nan"), float("nan")
     y = signal - signal.mean()
     dt = float(np.mean(np.diff(time)))
-    n = 8 * len(y)
+    n = fast_length(8 * len(y))
     spectrum = np.abs(np.fft.rfft(y * np.hanning(len(y)), n))
     k = int(np.argmax(spectrum[1:])) + 1
     if 1 <= k < len(spectrum) - 1:
