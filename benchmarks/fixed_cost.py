@@ -41,7 +41,9 @@ split by phase: callgrind dumps at the entries and exits of the ``PHASES`` funct
 acceleration, dynamic set-up, static solves, HDF5, the kernel's stepping), each interval
 counted to the innermost phase running, the rest "glue"; and the best wall time of
 ``--repeats`` whole calls (``--one``). ``--cases a,b`` selects cases; ``--compare`` as
-above. Output ``benchmarks/results/fixed_cost_phases.json``.
+above; ``--fine`` also counts the phases' parts apart (``FINE_PHASES``: the namelist text,
+the joint equations, the reactions' gradient rows, the cables' tension, ...). Output
+``benchmarks/results/fixed_cost_phases.json``.
 
 Output: ``benchmarks/results/fixed_cost.json`` (``--quick``: ``fixed_cost_quick.json``,
 ignored by git). Run from the repository root::
@@ -88,12 +90,16 @@ PHASE_CASES: dict[str, tuple[str, list[str]]] = {
 }
 #: whole calls kept in memory (``ancfdrv.simulate``, no file: as ``peer_harness.py``'s boom
 #: levels time them, like Exudyn's run with no solution file), then the tip history read from
-#: the ``Simulation``: the boom at the harness's 3 % level (issue 38, "a model build and
-#: output path whose fixed cost is at most Exudyn's"); ``--phases --cases boom_memory_3pct``
+#: the ``Simulation``: the boom and the flexible pendulum at the harness's 3 % level (issue
+#: 38, "a model build and output path whose fixed cost is at most Exudyn's"); ``--phases
+#: --cases boom_memory_3pct,pendulum_memory_3pct``
 MEMORY_CASES: dict[str, tuple[str, list[str]]] = {
     "boom_memory_3pct": ("inputs/boom_luffing.nml", [
         "scene.formulation=nonlinear", "solver.static_method=newton", "output.xdmf=.false.",
         "beam.bending=cable", "scene.planar=xy", "beam.nodes=4", "solver.dt=0.02"]),
+    "pendulum_memory_3pct": ("inputs/hard/pendulum.nml", [
+        "beam.nodes=5", "solver.dt=0.01", "solver.t_end=1.0", "beam.bending=cable",
+        "scene.planar=xy"]),
 }
 QUICK = {"pendulum_cable_5": CASES["pendulum_cable_5"]}
 #: the whole calls counted per case by ``--instructions`` (after two warm-up calls)
@@ -152,6 +158,36 @@ MEMORY_PHASES = tuple(("ancfdrv.results.memory", "MemoryOutput", name, "output (
     ("ancfdrv.simulation", "Simulation", "probe", "output (memory)"))
 #: context managers of the HDF5 layer (their entries and exits are HDF5's)
 PHASE_CONTEXTS = (("ancfdrv.results.hdf5", "holding"), ("ancfdrv.results.hdf5", "released"))
+#: ``--phases --fine``: the parts of the phases above, each counted apart (the instructions
+#: go to the innermost part running; the phases' sums "non-stepping" and "outside HDF5, the
+#: stepping and static solves" are the same): where a small call's fixed cost sits
+FINE_PHASES = (
+    ("ancfdrv.io.scene", None, "fast_reads", "scene: namelist text"),
+    ("ancfdrv.io.scene", None, "_typed", "scene: typed values"),
+    ("ancfdrv.io.scene", None, "_apply_override", "scene: overrides"),
+    ("ancfdrv.io.validate", None, "available_memory", "scene and model: available memory"),
+    ("ancfdrv.system.system", "System", "check_bounds", "model: check bounds"),
+    ("ancfdrv.system.assembly", None, "_element_sets", "model: element sets"),
+    ("ancfdrv.system.patterns", "Pattern", "from_blocks", "model: pattern"),
+    ("ancfdrv.system.assembly", None, "_mass", "model: mass"),
+    ("ancfdrv.system.assembly", None, "_planar", "model: planar"),
+    ("ancfdrv.system.assembly", None, "_equations", "model: joint equations"),
+    ("ancfdrv.system.assembly", None, "_linear_joints", "model: linear joints"),
+    ("ancfdrv.system.assembly", None, "_constraint_set", "model: constraint set"),
+    ("ancfdrv.system.assembly", None, "_probes", "model: probes"),
+    ("ancfdrv.solvers.path", None, "_reduced_tangent", "static stability: reduced tangent"),
+    ("ancfdrv.system.model", "Model", "stiffness_triplets", "static stability: K triplets"),
+    ("ancfdrv.system.answers", "ReactionMap", "__init__", "answers: reaction map"),
+    ("ancfdrv.system.answers", "ReactionMap", "_term_arrays", "answers: term arrays"),
+    ("ancfdrv.system.answers", "ReactionMap", "_gradient_rows", "answers: gradient rows"),
+    ("ancfdrv.system.answers", None, "_reduce_components", "answers: force and moment"),
+    ("ancfdrv.system.answers", "DynamicAnswers", "_record_tension", "answers: cable tension"),
+    ("ancfdrv.system.answers", None, "static_section_forces", "answers: static sections"),
+    ("ancfdrv.runner", None, "integrate", "dynamic: integrate (Python)"),
+    ("ancfdrv.solvers.dynamic", "EnergyWatch", "measure", "dynamic: energy watch"),
+    ("ancfdrv.results.memory", "MemoryWriter", "series_parts", "output (memory): series"),
+    ("ancfdrv.runner", None, "stage_summary", "stage summary"),
+)
 
 
 def _compare_path(path: str) -> str:
@@ -219,8 +255,9 @@ def quiet_clock() -> None:
 
 
 def instrument(enter: Callable[[str], None], leave: Callable[[], None],
-               label: Callable[[str], str] = lambda phase: phase) -> None:
-    """Wrap every :data:`PHASES` and :data:`MEMORY_PHASES` function, the
+               label: Callable[[str], str] = lambda phase: phase, fine: bool = False) -> None:
+    """Wrap every :data:`PHASES` and :data:`MEMORY_PHASES` function (``fine``: and the
+    :data:`FINE_PHASES` parts), the
     :data:`PHASE_CONTEXTS` (as "HDF5") and the kernel's ``advance_rows`` (as "stepping") so
     that each call runs between ``enter(label(phase))`` and ``leave()``: what a phase
     split counts at those boundaries (callgrind dumps here, thread time in
@@ -267,7 +304,7 @@ def instrument(enter: Callable[[str], None], leave: Callable[[], None],
                 finally:
                     leave()
         setattr(owner, name, counted)
-    for module, owner, name, phase in PHASES + MEMORY_PHASES:
+    for module, owner, name, phase in PHASES + MEMORY_PHASES + (FINE_PHASES if fine else ()):
         target = importlib.import_module(module)
         target = target if owner is None else getattr(target, owner)
         if hasattr(target, name):   # (a copy to compare may lack a later function)
@@ -280,7 +317,7 @@ def instrument(enter: Callable[[str], None], leave: Callable[[], None],
             wrap(value, "advance_rows", "stepping")
 
 
-def phase_calls(case: str, helper: str) -> None:
+def phase_calls(case: str, helper: str, fine: bool = False) -> None:
     """The child of :func:`phase_instructions`: one warm-up call, then one counted call
     with a callgrind dump at every entry and exit of a :data:`PHASES` function (each dump
     named after the phase whose instructions it holds)."""
@@ -301,7 +338,7 @@ def phase_calls(case: str, helper: str) -> None:
         boundary()
         stack.pop()
 
-    instrument(enter, leave)
+    instrument(enter, leave, fine=fine)
     import ancfdrv.runner as runner
 
     def call(out: Path) -> None:   # _call, its read-back of the tip history as HDF5's
@@ -332,9 +369,10 @@ def phase_calls(case: str, helper: str) -> None:
     lib.callgrind_toggle()
 
 
-def phase_instructions(case: str, work: Path) -> dict[str, float]:
+def phase_instructions(case: str, work: Path, fine: bool = False) -> dict[str, float]:
     """Instructions of one whole call of ``case`` per phase (callgrind; after a warm-up
-    call, so imports and reused MUMPS instances are those of a process's later calls)."""
+    call, so imports and reused MUMPS instances are those of a process's later calls;
+    ``fine``: the :data:`FINE_PHASES` parts apart)."""
     import re
     helper = _helper(work)
     target = work / case
@@ -342,7 +380,8 @@ def phase_instructions(case: str, work: Path) -> dict[str, float]:
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", PYTHONHASHSEED="0")
     subprocess.run(["valgrind", "--tool=callgrind", "--collect-atstart=no",
                     f"--callgrind-out-file={target / 'cg'}", *_python(), __file__,
-                    "--phase-counted", case, "--helper", str(helper)], env=env, check=True,
+                    "--phase-counted", case, "--helper", str(helper),
+                    *(["--fine"] if fine else [])], env=env, check=True,
                    capture_output=True)
     found: dict[str, float] = {}
     for dump in target.glob("cg*"):
@@ -481,7 +520,7 @@ def phases_main(args: argparse.Namespace, load_average: Any, machine_info: Any) 
                 env["FIXED_COST_COMPARE"] = os.environ["FIXED_COST_COMPARE"] = "1"
             try:
                 with tempfile.TemporaryDirectory() as tmp:
-                    counts = phase_instructions(case, Path(tmp))
+                    counts = phase_instructions(case, Path(tmp), args.fine)
             finally:
                 if path:
                     os.environ.pop("FIXED_COST_COMPARE", None)
@@ -519,6 +558,8 @@ def main() -> int:
                         help="instructions per phase (callgrind) and best wall times of "
                              "CASES and PHASE_CASES: results/fixed_cost_phases.json")
     parser.add_argument("--cases", help="--phases: these cases only (comma-separated)")
+    parser.add_argument("--fine", action="store_true",
+                        help="--phases: the phases' parts (FINE_PHASES) counted apart")
     parser.add_argument("--out", default="fixed_cost_phases.json",
                         help="--phases: the result file's name in benchmarks/results")
     parser.add_argument("--one", help=argparse.SUPPRESS)  # a subprocess: one case, JSON out
@@ -533,7 +574,7 @@ def main() -> int:
         counted_calls(args.counted, args.helper)
         return 0
     if args.phase_counted:
-        phase_calls(args.phase_counted, args.helper)
+        phase_calls(args.phase_counted, args.helper, args.fine)
         return 0
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from _common import load_average, machine_info

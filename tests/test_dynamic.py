@@ -18,7 +18,7 @@ import pytest
 from ancfdrv.reference import analytic
 from ancfdrv.cli import main
 from ancfdrv.solvers.dynamic import DynamicSettings, integrate
-from ancfdrv.history import crossing_frequency
+from ancfdrv.history import crossing_frequency, dominant_frequency, fast_length
 from ancfdrv.builders import build_model
 from ancfdrv.runner import run_scene
 from ancfdrv.io.scene import load_scene
@@ -152,6 +152,29 @@ def test_stage_summary_and_layout(tmp_path):
     # SPEC section 5: t_c = phi_end/omega - (t_s + t_b)/2, t1 = t_s + t_c, t2 = t1 + t_b
     assert stages["luffing_t1"] == pytest.approx(np.pi / 3 / 0.2, rel=1e-12)
     assert stages["vibration_t0"] == pytest.approx(np.pi / 3 / 0.2 + 1.0, rel=1e-12)
+
+
+def test_fast_length_is_the_next_5_smooth_number():
+    def smooth(n: int) -> bool:
+        for p in (2, 3, 5):
+            while n % p == 0:
+                n //= p
+        return n == 1
+    for n in range(1, 5000):
+        m = fast_length(n)
+        assert m >= n and smooth(m) and not any(smooth(k) for k in range(n, m))
+    # the boom's vibration stage at dt = 1 ms pads 3765 samples: 8 * 3765 = 30120 = 2^3 3 5 251
+    assert fast_length(30120) == 30375
+
+
+@pytest.mark.parametrize("samples", [188, 941, 1883])   # 8 n: prime factors 47, 941, 269
+def test_dominant_frequency_of_a_sine(samples):
+    dt, f = 0.02, 1.7
+    t = dt * np.arange(samples)
+    freq, amplitude = dominant_frequency(t, 0.1 + 0.3 * np.sin(2 * np.pi * f * t + 0.4))
+    # within a tenth of the padded spectrum's bin, 1 / (8 n dt)
+    assert abs(freq - f) < 0.1 / (8 * samples * dt)
+    assert amplitude == pytest.approx(0.3, rel=1e-3)
 
 
 @pytest.mark.parametrize("override,key", [("solver.dt=0", "&solver dt"),

@@ -71,6 +71,36 @@ def test_state_dependent_gradients_are_evaluated():
         model.close()
 
 
+@pytest.mark.parametrize("name", ["boom_luffing.nml", "general/boom_luffing.nml"])
+def test_gradient_rows_are_the_full_evaluations(name):
+    """The reactions' gradients at the output rows (the kernel's constraint_gradients: no
+    drive evaluated, since no gradient depends on one) are, row by row, those of the full
+    evaluation with the drives (constraint_evaluate): the boom's coordinate, distance and
+    cross constraints with its luffing drive, the general boom's coordinate and dot ones."""
+    model = _model(name, ["solver.t_end=0.05"])
+    try:
+        rm = answers.reaction_map(model)
+        kinds = set(rm.full.kinds)
+        assert kinds == ({1, 2, 3} if name == "boom_luffing.nml" else {1, 4})
+        assert any(d >= 0 for d in rm.full.drives)   # a driven constraint among them
+        q_rows, _, times = _rows(model, n=9)
+        rows = rm._gradient_rows(q_rows, times)
+        assert rows.shape == (6, len(rm.full), len(times))
+        for r, t in enumerate(times):
+            assert np.array_equal(rows[:, :, r], rm.full.evaluate(q_rows[r], float(t))[1])
+        # a distance constraint's gradient is 2 (x1 - x2), -2 (x1 - x2) at its operands
+        distance = np.flatnonzero(np.array(rm.full.kinds) == 2)
+        assert len(distance) == (1 if name == "boom_luffing.nml" else 0)
+        for c in distance:
+            x = np.array([rm.full.operand_const[c][s] + sum(a * q_rows[0][d]
+                                                            for d, a in rm.full.terms[c][s])
+                          for s in range(6)])
+            assert rows[:3, c, 0] == pytest.approx(2 * (x[:3] - x[3:]), rel=1e-12)
+            assert rows[3:, c, 0] == pytest.approx(-2 * (x[:3] - x[3:]), rel=1e-12)
+    finally:
+        model.close()
+
+
 def test_handed_initial_acceleration_gives_the_same_run(tmp_path, monkeypatch):
     """A run whose answers recorder needs the accelerations (the boom's eliminated joints)
     solves the initial acceleration once, and integrate handed it steps exactly as

@@ -53,17 +53,17 @@ def test_cable_strains_of_a_uniform_stretch(stretch):
 
 
 def test_the_cached_slope_rows_are_the_kernels():
-    """The slope rows of the 5-point rule cached per mesh are the kernel's cable_shape
-    slopes at each point and element length (the same floats), read only."""
+    """The slope rows of the 5-point rule cached per mesh ((4, nel, 5, 1): shape function,
+    element, point) are the kernel's cable_shape slopes at each point and element length
+    (the same floats), read only."""
     from ancfdrv import kernel
     from ancfdrv.gauss import leggauss
     lengths = (0.5, 1.2, 1.3)
     rows = _gauss_slopes(lengths)
-    assert len(rows) == 5
-    for x, slopes in zip(0.5 * (leggauss(5)[0] + 1.0), rows):
-        assert not slopes.flags.writeable
+    assert rows.shape == (4, 3, 5, 1) and not rows.flags.writeable
+    for g, x in enumerate(0.5 * (leggauss(5)[0] + 1.0)):
         for k, length in enumerate(lengths):
-            assert np.array_equal(slopes[k], kernel.cable_shape(x, length)[1])
+            assert np.array_equal(rows[:, k, g, 0], kernel.cable_shape(x, length)[1])
     assert _gauss_slopes(lengths) is rows
 
 

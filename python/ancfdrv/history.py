@@ -2,6 +2,8 @@
 min/max, and the dominant frequency and amplitude of the vibration stage."""
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 STAGES = ("start", "luffing", "braking", "vibration")
@@ -18,15 +20,36 @@ def luffing_stage_bounds(omega: float, t_start: float, t_brake: float, sweep: fl
             "vibration": (t2, t_end)}
 
 
+@functools.lru_cache(maxsize=64)
+def fast_length(n: int) -> int:
+    """The smallest 5-smooth number (2^a 3^b 5^c) at least ``n``: a length the FFT
+    transforms in O(n log n) with small radices (a length with a large prime factor takes
+    Bluestein's algorithm, several times slower)."""
+    best = 1 << max(n - 1, 0).bit_length()   # the next power of two: an upper bound
+    five = 1
+    while five < best:
+        three = five
+        while three < best:
+            two = three
+            while two < n:
+                two *= 2
+            best = min(best, two)
+            three *= 3
+        five *= 5
+    return best
+
+
 def dominant_frequency(time: np.ndarray, signal: np.ndarray) -> tuple[float, float]:
     """Dominant frequency (Hz) of a uniformly sampled signal, from the peak of its
     Hann-windowed spectrum refined by parabolic interpolation, and the amplitude
-    (half the peak-to-peak of the mean-free signal)."""
+    (half the peak-to-peak of the mean-free signal). The record is zero-padded to at
+    least 8 times its length (bins 1/8 of the record's resolution), to a fast length
+    (:func:`fast_length`)."""
     if len(time) < 8:
         return float("nan"), float("nan")
     y = signal - signal.mean()
     dt = float(np.mean(np.diff(time)))
-    n = 8 * len(y)
+    n = fast_length(8 * len(y))
     spectrum = np.abs(np.fft.rfft(y * np.hanning(len(y)), n))
     k = int(np.argmax(spectrum[1:])) + 1
     if 1 <= k < len(spectrum) - 1:
@@ -38,20 +61,26 @@ def dominant_frequency(time: np.ndarray, signal: np.ndarray) -> tuple[float, flo
 def stage_summary(time: np.ndarray, transverse: np.ndarray,
                   bounds: dict[str, tuple[float, float]]) -> dict[str, float]:
     """min/max of the transverse tip deflection per stage; frequency and amplitude of the
-    vibration stage."""
+    vibration stage. ``time`` ascends (the output rows): each stage is a slice of the rows,
+    [t0, t1) (the vibration stage [t0, t1])."""
     out: dict[str, float] = {}
     for stage, (t0, t1) in bounds.items():
-        mask = (time >= t0) & ((time < t1) if stage != "vibration" else (time <= t1))
-        if not mask.any():
+        first = int(np.searchsorted(time, t0, side="left"))
+        stop = int(np.searchsorted(time, t1, side="right" if stage == "vibration" else "left"))
+        if stop <= first:
             continue
+        values = transverse[first:stop]
         out[f"{stage}_t0"], out[f"{stage}_t1"] = t0, t1
-        out[f"{stage}_min"] = float(transverse[mask].min())
-        out[f"{stage}_max"] = float(transverse[mask].max())
+        out[f"{stage}_min"] = float(values.min())
+        out[f"{stage}_max"] = float(values.max())
         if stage == "vibration":
-            freq, amp = dominant_frequency(time[mask], transverse[mask])
+            # contiguous copies, as the stage's rows picked by a mask were (the sums of
+            # the mean and the spectrum run over them in the same order)
+            values = np.array(values)
+            freq, amp = dominant_frequency(np.array(time[first:stop]), values)
             out["vibration_frequency_hz"] = freq
             out["vibration_amplitude"] = amp
-            out["vibration_mean"] = float(transverse[mask].mean())
+            out["vibration_mean"] = float(values.mean())
     return out
 
 

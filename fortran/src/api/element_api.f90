@@ -804,37 +804,29 @@ subroutine reduced_ffr_energy_rows(r, nrow, nused, nmono, frame, eta, velocity, 
                            energies(:, re_power), energies(:, re_load))
 end subroutine reduced_ffr_energy_rows
 
-!> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r); the
-!> velocities zero): gradients(:, :, r) as constraint_evaluate returns them (first order
-!> only: no Hessians, Phi_t, gamma), of the packed constraint layout (ints, reals:
-!> api_support unpack_constraints). One call for a chunk of output rows (the reactions of
-!> every step, python/ancfdrv/system/answers.py).
+!> The constraints' operand gradients at each of nrow states (q_rows(:, r), times(r)):
+!> gradients(:, :, r) as constraint_evaluate returns them (constraints' constraint_gradients:
+!> the operand gradients alone, no drive evaluated: they depend on none), of the packed
+!> constraint layout (ints, reals: api_support unpack_constraints). One call for a chunk of
+!> output rows (the reactions of every step, python/ancfdrv/system/answers.py); ``times``
+!> is kept in the interface for the callers (the gradients do not depend on t).
 subroutine constraint_gradient_rows(nint, ints, nreal, reals, ncon, ndof, nrow, q_rows, times, &
                                     gradients, info)
   use ancf_kinds, only: dp
-  use constraints, only: constraint_eval
+  use constraints, only: constraint_gradients
   use api_support, only: constraint_layout, unpack_constraints
   implicit none
   integer, intent(in) :: nint, ints(nint), nreal, ncon, ndof, nrow
   real(dp), intent(in) :: reals(nreal), q_rows(ndof, nrow), times(nrow)
   real(dp), intent(out) :: gradients(6, ncon, nrow)
   integer, intent(out) :: info
-  real(dp) :: values(ncon), hessians(6, 6, ncon), phi_t(ncon), phi_tt(ncon), gamma(ncon)
-  real(dp) :: velocity(ndof)
   type(constraint_layout) :: lay
-  integer :: row
-  velocity = 0.0_dp
   gradients = 0.0_dp
   call unpack_constraints(ints, reals, ncon, lay, info)
   if (info /= 0) return
-  do row = 1, nrow
-    call constraint_eval(ncon, lay%kinds, lay%drives, lay%params, lay%operand_const, &
-                         lay%term_ptr, lay%term_dof, lay%term_coef, lay%drive_kinds, &
-                         lay%drive_ptr, lay%drive_data, q_rows(:, row), velocity, times(row), &
-                         values, gradients(:, :, row), hessians, phi_t, phi_tt, gamma, info, &
-                         first_order_only=.true.)
-    if (info /= 0) return
-  end do
+  call constraint_gradients(ncon, nrow, lay%kinds, lay%drives, lay%params, lay%operand_const, &
+                            lay%term_ptr, lay%term_dof, lay%term_coef, size(lay%drive_kinds), &
+                            q_rows, gradients, info)
 end subroutine constraint_gradient_rows
 
 !> The constraint violation max |Phi| at each of nrow states (q_rows(:, r), times(r)) of the

@@ -21,7 +21,8 @@ module constraints
   use matrix3, only: cross
   implicit none
   private
-  public :: constraint_eval, constraint_values, operand_values, drive_value, constraint_value
+  public :: constraint_eval, constraint_values, constraint_gradients, operand_values, &
+            drive_value, constraint_value, constraint_gradient
 
   integer, parameter, public :: constraint_kind_coordinate = 1, constraint_kind_distance = 2, &
                                 constraint_kind_cross = 3, constraint_kind_dot = 4
@@ -83,7 +84,7 @@ contains
     !> stepper's residual needs no more
     logical, intent(in), optional :: first_order_only
     integer :: c, m, drive_info
-    real(dp) :: phi, dphi, ddphi, x(6), v(6), a(3), k(3), length, cos_phi, sin_phi
+    real(dp) :: phi, dphi, ddphi, x(6), v(6), k(3), length, cos_phi, sin_phi
     logical :: second
     second = .true.
     if (present(first_order_only)) second = .not. first_order_only
@@ -129,18 +130,16 @@ contains
         end if
         values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, cos_phi, &
                                      sin_phi)
-        gradients(1, c) = 1.0_dp
+        gradients(:, c) = constraint_gradient(kinds(c), params(:, c), x)
         if (.not. second) cycle
         phi_t(c) = -(-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * dphi
         phi_tt(c) = -((-params(2, c) * cos(phi) - params(3, c) * sin(phi)) * dphi**2 &
                       + (-params(2, c) * sin(phi) + params(3, c) * cos(phi) + params(4, c)) * ddphi)
       case (constraint_kind_distance)
-        a = x(1:3) - x(4:6)
         length = params(1, c) + params(2, c) * phi
         values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, 1.0_dp, &
                                      0.0_dp)
-        gradients(1:3, c) = 2.0_dp * a
-        gradients(4:6, c) = -2.0_dp * a
+        gradients(:, c) = constraint_gradient(kinds(c), params(:, c), x)
         if (.not. second) cycle
         do m = 1, 3
           hessians(m, m, c) = 2.0_dp
@@ -154,8 +153,7 @@ contains
         k = params(1:3, c)
         values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, 1.0_dp, &
                                      0.0_dp)
-        gradients(1:3, c) = cross(x(4:6), k)
-        gradients(4:6, c) = cross(k, x(1:3))
+        gradients(:, c) = constraint_gradient(kinds(c), params(:, c), x)
         if (.not. second) cycle
         ! d2/da db of k.(a x b) = a^T S b with S(i, j) = k . (u_i x u_j)
         hessians(1:3, 4:6, c) = reshape([0.0_dp, -k(3), k(2), k(3), 0.0_dp, -k(1), &
@@ -164,8 +162,7 @@ contains
       case (constraint_kind_dot)
         values(c) = constraint_value(kinds(c), drives(c) /= 0, params(:, c), x, phi, 1.0_dp, &
                                      0.0_dp)
-        gradients(1:3, c) = x(4:6)
-        gradients(4:6, c) = x(1:3)
+        gradients(:, c) = constraint_gradient(kinds(c), params(:, c), x)
         if (.not. second) cycle
         do m = 1, 3
           hessians(m, m + 3, c) = 1.0_dp
@@ -211,6 +208,74 @@ contains
       value = 0.0_dp
     end select
   end function constraint_value
+
+  !> The gradient of one constraint of kind ``kind`` with respect to its six operands at x
+  !> (it depends on no drive: a driven term is a function of t alone). The one formula of
+  !> constraint_eval and constraint_gradients; an unknown kind gives 0 (the callers refuse
+  !> it).
+  pure function constraint_gradient(kind, p, x) result(gradient)
+    integer, intent(in) :: kind
+    real(dp), intent(in) :: p(:), x(6)
+    real(dp) :: gradient(6)
+    real(dp) :: a(3)
+    gradient = 0.0_dp
+    select case (kind)
+    case (constraint_kind_coordinate)
+      gradient(1) = 1.0_dp
+    case (constraint_kind_distance)
+      a = x(1:3) - x(4:6)
+      gradient(1:3) = 2.0_dp * a
+      gradient(4:6) = -2.0_dp * a
+    case (constraint_kind_cross)
+      gradient(1:3) = cross(x(4:6), p(1:3))
+      gradient(4:6) = cross(p(1:3), x(1:3))
+    case (constraint_kind_dot)
+      gradient(1:3) = x(4:6)
+      gradient(4:6) = x(1:3)
+    end select
+  end function constraint_gradient
+
+  !> The operand gradients alone at nrow states (e_rows(:, row)): what constraint_eval
+  !> returns as gradients, with the same arithmetic (operand_values, constraint_gradient),
+  !> for the reactions of the output rows. The gradients depend on no drive, so none is
+  !> evaluated; the layout is checked once. info: 0 ok, 1 a term index outside e_rows, k > 0
+  !> constraint k is malformed (kind, drive index, a coordinate constraint without a
+  !> coordinate), as constraint_eval reports them.
+  pure subroutine constraint_gradients(ncon, nrow, kinds, drives, params, operand_const, &
+                                       term_ptr, term_dof, term_coef, ndrive, e_rows, &
+                                       gradients, info)
+    integer, intent(in) :: ncon, nrow, kinds(:), drives(:), term_ptr(:), term_dof(:), ndrive
+    real(dp), intent(in) :: params(:, :), operand_const(:, :), term_coef(:), e_rows(:, :)
+    real(dp), intent(out) :: gradients(6, ncon, nrow)
+    integer, intent(out) :: info
+    integer :: c, row
+    gradients = 0.0_dp
+    info = 0
+    if (ncon == 0) return
+    if (any(term_dof(1:term_ptr(6 * ncon + 1) - 1) < 1) .or. &
+        any(term_dof(1:term_ptr(6 * ncon + 1) - 1) > size(e_rows, 1))) then
+      info = 1
+      return
+    end if
+    do c = 1, ncon
+      if (kinds(c) < constraint_kind_coordinate .or. kinds(c) > constraint_kind_dot .or. &
+          drives(c) < 0 .or. drives(c) > ndrive) then
+        info = c
+        return
+      end if
+      if (kinds(c) == constraint_kind_coordinate .and. &
+          term_ptr(6 * (c - 1) + 2) == term_ptr(6 * (c - 1) + 1)) then
+        info = c  ! no coordinate in the first operand
+        return
+      end if
+    end do
+    do row = 1, nrow
+      do c = 1, ncon
+        gradients(:, c, row) = constraint_gradient(kinds(c), params(:, c), operand_values( &
+          c, operand_const, term_ptr, term_dof, term_coef, e_rows(:, row), .true.))
+      end do
+    end do
+  end subroutine constraint_gradients
 
   !> The values Phi(e, t) alone at nrow states (e_rows(:, row), times(row)): what
   !> constraint_eval returns as values, with the same arithmetic (constraint_value), for

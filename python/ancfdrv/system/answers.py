@@ -235,11 +235,11 @@ class ReactionMap:
             slots = sorted_unique(touched // 3)
             self.selection[name] = (terms, entries, first, size, slots)
 
-    def _gradients(self, q_full: np.ndarray, t: float) -> np.ndarray:
-        """The multiplier constraints' operand gradients (6, ncon) at (q, t) from the kernel
-        (ConstraintSet.evaluate with the layout arrays built once)."""
+    def _layout_args(self) -> tuple:
+        """The multiplier constraints' packed layout for the kernel's constraint calls
+        (constraint_arrays and the count; built once)."""
         if not hasattr(self, "_args"):
-            from ..kernel import _kernel, _state, constraint_arrays
+            from ..kernel import _kernel, constraint_arrays
             full = self.full
             lay = full.layout()
             ptr = np.concatenate([[0], np.cumsum([len(p) for p in full.drive_params])]) + 1
@@ -252,19 +252,16 @@ class ReactionMap:
                 lay.term_dof + 1 if len(lay.term_dof) else np.ones(1),
                 lay.term_coef if len(lay.term_coef) else np.zeros(1), kinds,
                 ptr if len(full.drive_kinds) else np.ones(2), data), len(lay.kinds))
-            self._zero = np.zeros(len(q_full))
-        out = self._kernel.constraint_evaluate(*self._args, _state(q_full, self._zero), t)
-        if out[-1]:
-            raise ValueError(f"constraint evaluation failed (code {out[-1]})")
-        return out[1]
+        return self._args
 
     def _gradient_rows(self, q_rows: np.ndarray, times: np.ndarray) -> np.ndarray:
-        """:meth:`_gradients` at every row of q_rows (nt, nfull) and times (nt,), in one
-        kernel call: (6, ncon, nt)."""
-        if not hasattr(self, "_args"):
-            self._gradients(q_rows[0], float(times[0]))   # builds the layout arrays
+        """The multiplier constraints' operand gradients (6, ncon, nt) at every row of
+        q_rows (nt, nfull) and times (nt,), in one kernel call (the gradients of
+        ConstraintSet.evaluate's full evaluation, with no drive evaluated: they depend on
+        none)."""
+        args = self._layout_args()
         out = self._kernel.constraint_gradient_rows(
-            *self._args, np.asfortranarray(np.asarray(q_rows, dtype=float).T),
+            *args, np.asfortranarray(np.asarray(q_rows, dtype=float).T),
             np.asarray(times, dtype=float))
         if out[-1]:
             raise ValueError(f"constraint evaluation failed (code {out[-1]})")
