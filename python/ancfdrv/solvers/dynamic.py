@@ -135,7 +135,7 @@ class DynamicSettings:
         return JACOBIAN_POLICIES[self.jacobian]
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class Chunk:
     """Outputs of consecutive steps (one row per step)."""
 
@@ -168,7 +168,7 @@ class Chunk:
         return self.stats[:, 0]
 
 
-@dataclass
+@dataclass(eq=False)
 class DynamicResult:
     """Statistics of a completed run."""
 
