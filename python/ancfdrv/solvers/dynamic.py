@@ -56,7 +56,7 @@ JACOBIAN_POLICIES = {"step": JACOBIAN_STEP, "iteration": JACOBIAN_ITERATION,
                      "reuse": JACOBIAN_REUSE}
 
 
-@dataclass
+@dataclass(eq=False)
 class DynamicSettings:
     """Integrator settings (``&solver`` and ``&output`` of a scene). Newmark is
     alpha_m = alpha_f = 0; :meth:`generalized_alpha` sets all four from rho_inf.

@@ -70,7 +70,7 @@ class SetContext:
     warnings: list[str] = field(default_factory=list)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Kind:
     """One kind of item (see the module documentation)."""
 
