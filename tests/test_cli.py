@@ -219,3 +219,34 @@ def test_sweep_compares_formulations_side_by_side(tmp_path):
     # without the carry)
     assert 1 <= int(rows["nonlinear"]["factorizations"]) < 50
     assert int(rows["ffr"]["factorizations"]) == 1  # one per run
+
+
+@pytest.mark.parametrize("line", [
+    ["run", "scene.nml", "-o", "out.h5", "--set", "beam.nodes=4", "--set", "solver.dt=2e-3",
+     "--plot"],
+    ["--debug", "run", "scene.nml", "--force"],
+    ["sweep", "s.nml", "--vary", "beam.nodes=4,7", "--workers", "2", "--reference", "r.h5"],
+    ["info", "out.h5", "--json"], ["plot", "a.h5", "b.h5", "-o", "c.png"],
+    ["show", "s.nml", "--set", "scene.planar=xy"],
+    ["animate", "out.h5", "--mode", "2", "--view", "xy"]])
+def test_the_parser_of_the_named_command_parses_as_the_whole_parser(line):
+    """ancf builds only the named command's arguments (cli._named_command): the line parses
+    to the same namespace as with every command's arguments, and its help is the same."""
+    from ancfdrv.cli import _named_command, build_parser
+    named = _named_command(line)
+    assert named == next(w for w in line if not w.startswith("-"))
+    assert vars(build_parser(named).parse_args(line)) == vars(build_parser().parse_args(line))
+    helps = []
+    for parser in (build_parser(named), build_parser()):
+        sub = next(a for a in parser._actions if a.dest == "command")
+        helps.append(sub.choices[named].format_help())
+    assert helps[0] == helps[1] and "usage: ancf " + named in helps[0]
+
+
+def test_a_line_without_a_command_gets_every_command():
+    """``ancf --help``, ``ancf --version`` and an unknown command name no command: the
+    parser then has every command's arguments (argparse's own messages)."""
+    from ancfdrv.cli import _named_command
+    assert _named_command(["--help"]) is None and _named_command([]) is None
+    assert _named_command(["--debug", "bogus", "run"]) is None
+    assert _named_command(["--debug", "info", "run"]) == "info"

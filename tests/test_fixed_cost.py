@@ -88,11 +88,15 @@ def test_attributes_as_h5py_writes_them(tmp_path, value):
 
 
 def test_datasets_as_h5py_writes_them(tmp_path):
-    """_dataset stores what h5py's create_dataset stores: values, type, layout, times
-    tracked or not, the units attribute; names with a group path make the groups."""
+    """_dataset stores what h5py's create_dataset stores: values, type (class, size,
+    character set, padding), shape (a scalar stays scalar), layout, times tracked or not,
+    the units attribute; names with a group path make the groups. Also for a strided
+    column (a reaction's force) and fixed-length byte strings (the constraints' joints)."""
     path = tmp_path / "d.h5"
     data = {"a": np.linspace(0, 1, 7), "b/c": np.arange(6).reshape(2, 3),
-            "d": np.array([True, False]), "e": np.zeros((0, 3))}
+            "d": np.array([True, False]), "e": np.zeros((0, 3)),
+            "f": np.arange(12.0).reshape(4, 3)[:, 1], "g": np.asarray(-2.5),
+            "h": np.array(["A1", "", "joint_b"], dtype="S")}
     with h5py.File(path, "w") as h5:
         for name, values in data.items():
             results._dataset(h5.require_group("ours"), name, values, "m")
@@ -105,6 +109,13 @@ def test_datasets_as_h5py_writes_them(tmp_path):
             a, b = h5["ours"][name], h5["h5py"][name]
             assert a.dtype == b.dtype and a.shape == b.shape and a.chunks == b.chunks
             assert a[()].tobytes() == b[()].tobytes()
+            ta, tb = a.id.get_type(), b.id.get_type()
+            assert (ta.get_class(), ta.get_size()) == (tb.get_class(), tb.get_size())
+            if ta.get_class() == h5py.h5t.STRING:
+                assert (ta.get_cset(), ta.get_strpad(), ta.is_variable_str()) == \
+                    (tb.get_cset(), tb.get_strpad(), tb.is_variable_str())
+            assert a.id.get_space().get_simple_extent_type() == \
+                b.id.get_space().get_simple_extent_type()
             pa, pb = a.id.get_create_plist(), b.id.get_create_plist()
             assert pa.get_layout() == pb.get_layout()
             assert pa.get_obj_track_times() == pb.get_obj_track_times()
@@ -285,12 +296,15 @@ def test_a_short_run_is_complete_after_its_one_flush(tmp_path):
 def test_subgroup_is_the_group_h5py_makes(tmp_path):
     """_subgroup (low-level) makes the group h5py's create_group makes: the same times
     tracking, creation order not tracked, an ASCII link; an existing group is returned as
-    is."""
+    is, an existing dataset of the name refused."""
     path = tmp_path / "g.h5"
     with h5py.File(path, "w") as h5:
         ours = results._subgroup(h5, "ours")
         theirs = h5.create_group("theirs")
         assert results._subgroup(h5, "ours") == ours
+        h5["values"] = np.zeros(2)   # an existing dataset is no group: refused
+        with pytest.raises(ValueError, match="not a group"):
+            results._subgroup(h5, "values")
         results._subgroup(ours, "inner")
         assert results._has(h5, "ours") and not results._has(h5, "none")
         assert results._has(ours, "inner")

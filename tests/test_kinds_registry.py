@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import ast
 import inspect
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -304,3 +305,20 @@ def test_the_typed_method_refuses_an_unknown_keyword_naming_it(api, args):
     with pytest.raises(InputError, match=r"force_element\[f\].*unknown key 'stifness'"):
         s.force_element("f", "spring_damper", "ground", "ground", point1=(0, 0, 0),
                         point2=(1, 0, 0), stifness=1.0)
+
+
+def test_the_typed_methods_key_lines_wrap_as_textwrap_does():
+    """The typed methods' key lines (system._fill, a plain word wrap at 88 characters) break
+    where textwrap.fill breaks them when it splits no word at a hyphen, and keep every
+    word."""
+    from ancfdrv.system.system import _fill
+    lines = []
+    for found in kinds():
+        doc = getattr(System, found.api).__doc__.split("an unknown one is refused):")[1]
+        lines += ["- " + part.replace("\n  ", " ").strip() for part in doc.split("\n- ")[1:]]
+    assert len(lines) > 50
+    for line in lines:
+        ours = _fill(line)
+        assert ours.replace("\n  ", " ") == line
+        theirs = textwrap.fill(line, 88, subsequent_indent="  ", break_on_hyphens=False)
+        assert ours == theirs, line

@@ -305,17 +305,7 @@ def _sections_png(output: str | None, h5_path: Path) -> Path:
     return base.with_name(base.stem + "_sections.png")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="ancf", description="ANCF flexible multibody "
-                                     "simulations from Fortran namelist scenes",
-                                     epilog=EXIT_CODES,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--version", action="version", version=f"ancf (ancfdrv) {__version__}")
-    parser.add_argument("--debug", action="store_true",
-                        help="print the full trace of an internal error (exit status 1)")
-    sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("run", help="run one scene", epilog=EXIT_CODES,
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+def _run_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scene")
     p.add_argument("-o", "--output", help="HDF5 result file (default from &output); never "
                    "an input file; refused while another run writes it")
@@ -327,7 +317,9 @@ def build_parser() -> argparse.ArgumentParser:
                    "(OUT.png; the same as output.plot = .true.; ancf plot draws any result "
                    "later)")
     p.set_defaults(func=_cmd_run)
-    p = sub.add_parser("sweep", help="run every combination of --vary values")
+
+
+def _sweep_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scene")
     p.add_argument("--vary", action="append", required=True, metavar="GROUP.KEY=V1,V2,...")
     p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE")
@@ -341,30 +333,33 @@ def build_parser() -> argparse.ArgumentParser:
                    "compared with (column 'err vs reference'; the error-against-time chart "
                    "shows it): e.g. a converged model of another formulation")
     p.set_defaults(func=_cmd_sweep)
-    p = sub.add_parser("info", help="summarize a result file; the first line says whether "
-                       "the run finished (ok), failed, was interrupted, is running or was "
-                       "abandoned (its writer was killed)")
+
+
+def _info_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file")
     p.add_argument("--json", action="store_true", help="write the figures and the answers "
                    "as one JSON object (every reaction, frequency and load factor; arrays "
                    "whole)")
     p.set_defaults(func=_cmd_info)
-    p = sub.add_parser("plot", help="plot a result file (several: leaf spring runs overlaid)")
+
+
+def _plot_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", nargs="+", help="HDF5 result file; several only for leaf spring "
                    "runs (kind 'spring'), e.g. prestress on and off")
     p.add_argument("-o", "--output", help="PNG file (default: beside the (first) HDF5, "
                    "<first>_compare.png for several)")
     p.set_defaults(func=_cmd_plot)
-    p = sub.add_parser("show", help="draw the model of a scene before any solve: three "
-                       "views and an isometric one with the names of bodies, joints, loads "
-                       "and probes (nothing is solved)")
+
+
+def _show_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scene")
     p.add_argument("-o", "--output", help="PNG file (default: SCENE.png beside the scene)")
     p.add_argument("--set", action="append", default=[], metavar="GROUP.KEY=VALUE",
                    help="override a namelist value (repeatable)")
     p.set_defaults(func=_cmd_show)
-    p = sub.add_parser("animate", help="animate a result: the whole mesh through a dynamic "
-                       "run, or a mode or buckling shape (--mode N) oscillating")
+
+
+def _animate_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file")
     p.add_argument("-o", "--output", help="a .gif or .mp4 (default: beside the file; MP4 "
                    "when ffmpeg is installed, else GIF)")
@@ -373,6 +368,53 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--view", default="auto", choices=["auto", "xy", "yz", "zx"],
                    help="the plane drawn (default: the mesh's two largest extents)")
     p.set_defaults(func=_cmd_animate)
+
+
+#: each command: the options of its parser (help, epilog) and what adds its arguments
+_COMMANDS = {
+    "run": (dict(help="run one scene", epilog=EXIT_CODES,
+                 formatter_class=argparse.RawDescriptionHelpFormatter), _run_arguments),
+    "sweep": (dict(help="run every combination of --vary values"), _sweep_arguments),
+    "info": (dict(help="summarize a result file; the first line says whether the run "
+                  "finished (ok), failed, was interrupted, is running or was abandoned "
+                  "(its writer was killed)"), _info_arguments),
+    "plot": (dict(help="plot a result file (several: leaf spring runs overlaid)"),
+             _plot_arguments),
+    "show": (dict(help="draw the model of a scene before any solve: three views and an "
+                  "isometric one with the names of bodies, joints, loads and probes "
+                  "(nothing is solved)"), _show_arguments),
+    "animate": (dict(help="animate a result: the whole mesh through a dynamic run, or a "
+                     "mode or buckling shape (--mode N) oscillating"), _animate_arguments),
+}
+
+
+def _named_command(argv: list[str]) -> str | None:
+    """The command a command line names: its first word that is not an option (only flags
+    come before the command); None when there is none or it is no command (argparse then
+    says so)."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word if word in _COMMANDS else None
+    return None
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``ancf`` parser. ``command``: the command the line names (:func:`_named_command`):
+    only its arguments are added, the other commands listed with their help as ``ancf
+    --help`` shows them (building every command's arguments was ~13 M instructions of
+    each command's start); None: every command's."""
+    parser = argparse.ArgumentParser(prog="ancf", description="ANCF flexible multibody "
+                                     "simulations from Fortran namelist scenes",
+                                     epilog=EXIT_CODES,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"ancf (ancfdrv) {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="print the full trace of an internal error (exit status 1)")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for name, (options, arguments) in _COMMANDS.items():
+        p = sub.add_parser(name, **options)
+        if command is None or command == name:
+            arguments(p)
     return parser
 
 
@@ -417,7 +459,8 @@ def _terminate(signum: int, frame: object) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """The ``ancf`` command; returns the exit status (see the module docstring)."""
-    args = build_parser().parse_args(argv)
+    words = sys.argv[1:] if argv is None else argv
+    args = build_parser(_named_command(words)).parse_args(words)
     command = args.command
     from .io.safe_write import ignore_file_size_signal
     if threading.current_thread() is threading.main_thread():

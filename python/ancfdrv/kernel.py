@@ -61,7 +61,7 @@ def constraint_arrays(kinds, drives, params, operand_const, term_ptr, term_dof, 
     return _f(ints, np.int32), _f(reals if reals.size else np.zeros(1))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False, repr=False)
 class SectionData:
     """A beam cross-section as the kernel integrates it (beam_section.f90): the quadrature
     points (y along the section height, z along its width) with area weights, and the

@@ -58,7 +58,7 @@ def _io(out: "Path | MemoryOutput") -> Any:
     return results if isinstance(out, Path) else out
 
 
-@dataclass
+@dataclass(eq=False)
 class RunOutcome:
     """What a run produced: the output file (or the
     :class:`~ancfdrv.results.memory.MemoryOutput` of a run kept in memory) and the results

@@ -11,7 +11,7 @@ from ..system import Beam, System
 from ..system.sections import Rectangle
 
 
-@dataclass
+@dataclass(eq=False)
 class BuiltSystem:
     """A system, the probe and component sweeps compare, and the builder's warnings."""
 

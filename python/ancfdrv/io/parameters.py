@@ -223,7 +223,7 @@ def _written(value: Any) -> str:
     return ", ".join(repr(x) if isinstance(x, str) else str(x) for x in items)
 
 
-@dataclass
+@dataclass(eq=False)
 class Definitions:
     """A scene's parameters and named points, and a record of every key whose value used
     them (what the result file stores)."""

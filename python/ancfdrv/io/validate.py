@@ -81,7 +81,7 @@ MEMORY_FRACTION = 0.5
 
 # -- 1. repeated groups and keys ---------------------------------------------------------
 
-@dataclass
+@dataclass(eq=False)
 class KeyText:
     """One ``key = `` of a group in the text."""
 
@@ -90,7 +90,7 @@ class KeyText:
     line: int
 
 
-@dataclass
+@dataclass(eq=False)
 class GroupText:
     """One ``&group ... /`` of the text: its keys in order and the value of its ``name``."""
 
@@ -408,7 +408,7 @@ def check_time(solver: dict[str, Any], analysis: str, file: str) -> None:
 
 # -- 5. size -------------------------------------------------------------------------------
 
-@dataclass
+@dataclass(eq=False)
 class Part:
     """A part of the model for the estimate: where it is given and its size."""
 
@@ -422,7 +422,7 @@ class Part:
     sections: bool = False
 
 
-@dataclass
+@dataclass(eq=False)
 class Estimate:
     """The size of a model before it is built."""
 

@@ -46,6 +46,7 @@ from ..solvers.static import StaticResult
 
 if TYPE_CHECKING:
     from ..solvers.path import StaticPath
+    from .xdmf import MeshLayout
 
 #: the statuses a result file can carry (root attribute and /dynamic attribute)
 STATUSES = ("running", "ok", "failed", "unstable", "interrupted")
@@ -170,8 +171,8 @@ def _subgroup(group: h5py.Group, name: str) -> h5py.Group:
     if "/" in name or not name.isascii() or h5py.get_config().track_order:
         return group.require_group(name)
     key = name.encode("ascii")
-    if group.id.links.exists(key):
-        return group.require_group(name)   # an existing member: h5py's checks
+    if group.id.links.exists(key):   # an existing member (HDF5 refuses to open a non-group)
+        return h5py.Group(h5py.h5g.open(group.id, key))
     gcpl, lcpl = _group_plists()
     return h5py.Group(h5py.h5g.create(group.id, key, lcpl=lcpl, gcpl=gcpl))
 
@@ -235,13 +236,19 @@ def _new_dataset(group: h5py.Group, name: str, data: np.ndarray | None = None, *
 
 
 def _dataset(group: h5py.Group, name: str, data: Any, units: str) -> h5py.Dataset:
+    """A new dataset holding ``data`` (integers and booleans as int64) with its ``units``;
+    numbers and fixed-length byte strings through h5py's low-level API (:func:`_new_dataset`:
+    a strided array, such as a reaction's force columns, copied contiguous first), other
+    kinds through ``create_dataset``."""
     data = np.asarray(data)
     if data.dtype.kind in "iub":
         data = data.astype(np.int64)
-    if data.dtype.kind not in "fi" or not data.flags.c_contiguous:
+    if data.dtype.kind not in "fiS":
         dataset = group.create_dataset(name, data=data)
         dataset.attrs["units"] = units
         return dataset
+    if not data.flags.c_contiguous:   # (ascontiguousarray would make a scalar 1-d)
+        data = np.ascontiguousarray(data)
     return h5py.Dataset(_new_dataset(group, name, data, units=units))
 
 
@@ -574,6 +581,29 @@ def create(path: Path, scene: Scene, model: Model) -> None:
         _attrs(group.attrs, model_attrs, fresh=True)
 
 
+def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
+    """/model/mesh: the initial points, the connectivity and what each point belongs to
+    (:class:`~.xdmf.MeshLayout`)."""
+    model = _subgroup(h5, "model")
+    if _has(model, "mesh"):
+        del model["mesh"]
+    group = _subgroup(model, "mesh")
+    _dataset(group, "points", layout.points, "m")
+    kind, connectivity, ncells = layout.topology()
+    topology = _dataset(group, "topology", connectivity, "index")
+    _attrs(topology.attrs, {"description": (
+        "XDMF connectivity (0-based rows of points): " + {
+            "Quadrilateral": "the corner points of each plate element",
+            "Polyline": "2-point lines (beam and cable elements, rigid body axes and "
+                        "boxes, force elements, distance joints; a line from a point to "
+                        "itself: a lone point, a point mass or a joint)",
+            "Mixed": "per cell its XDMF code, then quad: 4 points; line: 2, 2 points (a "
+                     "line from a point to itself: a lone point, a point mass or a "
+                     "joint)"}[kind])}, fresh=True)
+    _attrs(group.attrs, {"topology_type": kind, "ncells": np.int64(ncells),
+                         "bodies": "\n".join(layout.bodies)}, fresh=True)
+
+
 def write_static(path: Path, model: Model, result: StaticResult) -> None:
     """The /static group: q, lambda, probes, deflections, solver statistics and the mesh
     points at the state (``mesh_nodes``, ``mesh_displacement`` from /model/mesh/points)."""
@@ -585,12 +615,13 @@ def write_static(path: Path, model: Model, result: StaticResult) -> None:
         _dataset(group, "lambda", result.lam, MULTIPLIER_UNITS)
         history = _dataset(group, "residual_history", np.asarray(result.history, dtype=float),
                            "1")
-        history.attrs["description"] = "relative force residual per iteration"
+        _attrs(history.attrs, {"description": "relative force residual per iteration"},
+               fresh=True)
         for name, position in model.probe_positions(result.e).items():
             _dataset(group, f"probes/{name}", position, "m")
         for name, deflection in model.deflections(result.e).items():
             _dataset(group, f"deflection/{name}", deflection, "m")
-        from .xdmf import MeshLayout, write_layout
+        from .xdmf import MeshLayout
         layout = MeshLayout.from_model(model)
         if layout is not None:  # the deformed shape (ancf plot, the static XDMF)
             if "model/mesh" not in h5:
@@ -1011,7 +1042,7 @@ class DynamicWriter:
         at most ``frames`` of the ``total_rows`` rows the run will write
         (:func:`~.xdmf.frame_rows`)."""
         from ..solvers.dynamic import CONTACT_FIELDS, ENERGY_NAMES
-        from .xdmf import MeshLayout, frame_count, frame_rows, inline, write_layout
+        from .xdmf import MeshLayout, frame_count, frame_rows, inline
         self.path, self.names, self.store_q = path, list(model.probes), store_q
         self.write_q = store_q if write_q is None else bool(write_q and store_q)
         self.flush_rows = max(1, int(flush_rows))
@@ -1407,8 +1438,9 @@ def _section_group(group: h5py.Group, name: str, forces) -> None:
     _dataset(sub, "s", forces.s, "m")
     for key, units in (("N", "N"), ("T", "N m"), ("Q", "N"), ("M", "N m")):
         _dataset(sub, key, getattr(forces, key), units)
-    sub.attrs["description"] = ("what the part beyond s exerts on the part before it; Q and M: "
-                                "components along the section's height and width axes")
+    _attrs(sub.attrs, {"description": "what the part beyond s exerts on the part before it; "
+                                      "Q and M: components along the section's height and "
+                                      "width axes"}, fresh=True)
 
 
 def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarray,
@@ -1445,15 +1477,14 @@ def write_static_answers(path: Path, model: Model, e: np.ndarray, lam: np.ndarra
                 k = int(np.argmax(stress[name].von_mises))
                 _attrs(sub.attrs, {"max": float(stress[name].von_mises[k]),
                                    "s_max": float(f.s[k])})
-        if "model" in h5 and len(model.constraints):
-            if "constraint_joints" in h5["model"]:
-                del h5["model/constraint_joints"]
-            names = h5["model"].create_dataset("constraint_joints",
-                                               data=np.array(constraint_joints(model),
-                                                             dtype="S"))
-            names.attrs["units"] = "name"
-            names.attrs["description"] = ("the joint each row of lambda belongs to (empty: "
-                                          "a body's own constraint)")
+        if _has(h5, "model") and len(model.constraints):
+            model_group = _subgroup(h5, "model")
+            if _has(model_group, "constraint_joints"):
+                del model_group["constraint_joints"]
+            names = _dataset(model_group, "constraint_joints",
+                             np.array(constraint_joints(model), dtype="S"), "name")
+            _attrs(names.attrs, {"description": "the joint each row of lambda belongs to "
+                                                "(empty: a body's own constraint)"}, fresh=True)
 
 
 def write_dynamic_answers(path: Path, recorder) -> None:
@@ -1473,10 +1504,10 @@ def write_dynamic_answers(path: Path, recorder) -> None:
                 del group[key]
         if any(recorder.tension.values()):
             tension_group = _subgroup(group, "tension")
-            tension_group.attrs["description"] = (
+            _attrs(tension_group.attrs, {"description": (
                 "each cable's axial force along it (tension positive; a rope's is never "
                 "negative, 0 where it is slack): min and max over its integration points "
-                "at each row of /dynamic/time")
+                "at each row of /dynamic/time")}, fresh=True)
             for name, chunks in recorder.tension.items():
                 if chunks:
                     sub = _subgroup(tension_group, name)
@@ -1546,7 +1577,7 @@ def _write_eigen(path: Path, model: Model, name: str, shapes: np.ndarray,
     (static_q), and for XDMF and plots the mesh points at ``drawn_on`` (default: that
     state; mesh_static) with each shape on them (mesh_shapes[N, npoints, 3], scaled to a
     largest displacement of 1)."""
-    from .xdmf import MeshLayout, write_layout
+    from .xdmf import MeshLayout
     layout = MeshLayout.from_model(model)
     # a full disk or ``ulimit -f``: refused before HDF5 writes (a write that fails inside
     # HDF5 left a file no reader could open: the model and the statics lost)

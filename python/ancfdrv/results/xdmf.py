@@ -78,7 +78,7 @@ INLINE_VALUES = 30_000
 _QUAD, _LINE = 5, 2
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class MeshLayout:
     """The points and cells XDMF shows for a model, and the affine map from full
     coordinates to the points' positions."""
@@ -242,30 +242,6 @@ def inline(npoints: int, nframes: int) -> bool:
     return 3 * npoints * nframes <= INLINE_VALUES
 
 
-def write_layout(h5: h5py.File, layout: MeshLayout) -> None:
-    """/model/mesh: the initial points, the connectivity and what each point belongs to."""
-    if "model/mesh" in h5:
-        del h5["model/mesh"]
-    group = h5.create_group("model/mesh")
-    points = group.create_dataset("points", data=layout.points)
-    points.attrs["units"] = "m"
-    kind, connectivity, ncells = layout.topology()
-    topology = group.create_dataset("topology", data=connectivity.astype(np.int64))
-    topology.attrs["units"] = "index"
-    topology.attrs["description"] = (
-        "XDMF connectivity (0-based rows of points): " + {
-            "Quadrilateral": "the corner points of each plate element",
-            "Polyline": "2-point lines (beam and cable elements, rigid body axes and "
-                        "boxes, force elements, distance joints; a line from a point to "
-                        "itself: a lone point, a point mass or a joint)",
-            "Mixed": "per cell its XDMF code, then quad: 4 points; line: 2, 2 points (a "
-                     "line from a point to itself: a lone point, a point mass or a "
-                     "joint)"}[kind])
-    group.attrs["topology_type"] = kind
-    group.attrs["ncells"] = np.int64(ncells)
-    group.attrs["bodies"] = "\n".join(layout.bodies)
-
-
 def _escape(text: str) -> str:
     """``text`` as XML character data or a double-quoted attribute value."""
     return (text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
@@ -362,7 +338,7 @@ def _topology_of(h5: h5py.File) -> tuple[str, tuple[int, ...], str, int, int]:
     return "Quadrilateral", shape, "/model/elements", shape[0], len(h5["model/nodes"])
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class Series:
     """What the XDMF description of a dynamic run names: its frames (output rows and
     times), its mesh and which per-point series the file holds."""

@@ -56,7 +56,7 @@ JACOBIAN_POLICIES = {"step": JACOBIAN_STEP, "iteration": JACOBIAN_ITERATION,
                      "reuse": JACOBIAN_REUSE}
 
 
-@dataclass
+@dataclass(eq=False)
 class DynamicSettings:
     """Integrator settings (``&solver`` and ``&output`` of a scene). Newmark is
     alpha_m = alpha_f = 0; :meth:`generalized_alpha` sets all four from rho_inf.
@@ -135,7 +135,7 @@ class DynamicSettings:
         return JACOBIAN_POLICIES[self.jacobian]
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class Chunk:
     """Outputs of consecutive steps (one row per step)."""
 
@@ -168,7 +168,7 @@ class Chunk:
         return self.stats[:, 0]
 
 
-@dataclass
+@dataclass(eq=False)
 class DynamicResult:
     """Statistics of a completed run."""
 

@@ -74,7 +74,7 @@ DESIRED_ITERATIONS = 5
 MAX_CUTS = 12
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class StaticPath:
     """The converged points of an arc-length path (HDF5: /static/path). ``displacement``
     (npoints, 3): the control probe's displacement from the assembled configuration
@@ -311,7 +311,7 @@ def _marks(factors: np.ndarray, counts: np.ndarray, lengths: np.ndarray):
 CONFIRM_CUTS = 3
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class _Point:
     """The path's next point (or why there is none: ``message``)."""
     e: np.ndarray | None = None

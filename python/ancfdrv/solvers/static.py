@@ -35,7 +35,7 @@ from ..system.model import Model
 from .assumptions import check_ffr
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class StaticResult:
     """Equilibrium state and solver statistics."""
 

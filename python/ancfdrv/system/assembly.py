@@ -41,7 +41,7 @@ EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_
 LINEAR_JOINTS = ("auto", "eliminate", "multipliers")
 
 
-@dataclass
+@dataclass(eq=False)
 class _Active:
     """The items of the listed effects."""
 

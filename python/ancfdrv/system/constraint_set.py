@@ -17,7 +17,7 @@ from ..errors import InputError
 from ..kernel import _kernel, _state, constraint_arrays
 
 
-@dataclass
+@dataclass(eq=False)
 class ConstraintSet:
     """Constraints in the kernel's layout; ``dependent`` holds per constraint the coordinate
     the split iteration treats as dependent (the set N1 of seed 000, eq. 40)."""
@@ -200,7 +200,7 @@ class ConstraintSet:
         return matrix, np.asarray(self.operand_const[c])
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class ConstraintLayout:
     """The arrays system_set_constraints takes (0-based indices)."""
 

@@ -17,7 +17,7 @@ from ..errors import InputError
 PLATE_NODE_DOFS = 9
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class PlateMesh:
     """Nodes (initial configuration), connectivity, element sizes and named node sets.
 

@@ -24,7 +24,7 @@ from .registry import add_to_kernel
 from .patterns import Pattern, Reduction
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class FrameInfo:
     """A beam's frame: A(t) = Rot(axis, phi(t)) base about pivot (drive -1: A = base)."""
 
@@ -40,7 +40,7 @@ class FrameInfo:
         return rotation_about(self.axis, self.drive_obj.value(t)) @ self.base
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class SetInfo:
     """An element set as assembled (one per flexible body)."""
 
@@ -73,7 +73,7 @@ class SetInfo:
     index: int = 0
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class MomentInfo:
     """A dead moment on the nodal director q[dofs] (full coordinates)."""
 
@@ -91,7 +91,7 @@ class MomentInfo:
 VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_MOMENT, VLOAD_FOLLOWER_FORCE = 1, 2, 3
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class VectorLoadInfo:
     """A driven or follower point load (kernel module vector_loads): kind, 0-based drive
     (-1: none), vector (a dead moment's global vector, or a follower's components on the
@@ -109,7 +109,7 @@ class VectorLoadInfo:
     fixed: bool = False
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class ProbeInfo:
     """p = sum coef q[first:first+3]; deflection A_f(t)^T (p - pivot) - reference."""
 

@@ -118,7 +118,7 @@ class Pattern:
         return int(np.abs(self.rows - self.col_index).max(initial=0))
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class Reduction:
     """q = B e + q0 and the plan of B^T S B (source: full-pattern positions, target: reduced
     pattern positions, coefficient)."""
@@ -188,7 +188,7 @@ class Reduction:
         return self.matrix.rmatvec(full)
 
 
-@dataclass
+@dataclass(eq=False)
 class Elimination:
     """The outcome of :func:`eliminate`: relations q_d = c + sum a_j q_j over independent
     coordinates, the dropped (redundant) equations' names."""

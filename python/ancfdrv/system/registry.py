@@ -58,7 +58,7 @@ __all__ = ["Kind", "SetContext", "register", "kinds", "kind", "kind_of", "checke
            "set_builder", "add_to_kernel", "reports_sections", "axial_forces"]
 
 
-@dataclass
+@dataclass(eq=False)
 class SetContext:
     """What a set builder may need besides its body: the body's floating frame (FrameInfo,
     or None) and its 1-based id (0: none), the active effects, the counters and warnings."""
@@ -70,7 +70,7 @@ class SetContext:
     warnings: list[str] = field(default_factory=list)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Kind:
     """One kind of item (see the module documentation)."""
 

@@ -41,7 +41,7 @@ DISPLACEMENT_REFERENCE = (
     "axes for other bodies; includes the mechanism's rigid motion")
 
 
-@dataclass
+@dataclass(eq=False)
 class SupportFrame:
     """The support frame of one beam (see the module documentation)."""
 

@@ -112,7 +112,7 @@ class ForceElement:
         return FORCE_ELEMENT_KINDS[self.type]
 
 
-@dataclass
+@dataclass(eq=False, repr=False)
 class ForceElementInfo:
     """A force element as assembled: kernel kind, 0-based drive (-1: none), parameters,
     table (kind 0: none), and its slots (Vec3 on the full coordinates)."""
