@@ -178,3 +178,24 @@ def test_meshio_reads_the_xdmf(plate):
             assert t == time[k]
             np.testing.assert_array_equal(point_data["displacement"], nodes[k] - reference)
     assert np.abs(nodes[-1] - reference).max() > 1e-4  # the plate did move
+
+
+def test_model_nodes_count_every_body_with_a_mesh():
+    """/model nnodes (printed by ancf run as 'model  N nodes') counts the nodes of every
+    flexible body: the knuckle crane's boom (9), jib (13) and rope (6), a cable included
+    (a cable-only model printed '0 nodes')."""
+    from ancfdrv.builders import build_system
+    from ancfdrv.io.scene import load_scene
+    scene = load_scene(INPUTS / "knuckle_crane_rope.nml", [])
+    model = build_system(scene).system.assemble(effects=scene.effects)
+    try:
+        assert model.summary()["nnodes"] == 9 + 13 + 6
+    finally:
+        model.close()
+    scene = load_scene(INPUTS / "boom_luffing_cable.nml", [])
+    model = build_system(scene).system.assemble(effects=scene.effects)
+    try:
+        nodes = [b.nodes for b in model.bodies if getattr(b, "nodes", 0)]
+        assert len(nodes) == 1 and model.summary()["nnodes"] == nodes[0] > 0
+    finally:
+        model.close()

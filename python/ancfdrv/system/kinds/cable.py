@@ -70,6 +70,10 @@ class Cable(Body):
         return self.nodes
 
     @property
+    def mesh_nodes(self) -> int:
+        return self.nodes
+
+    @property
     def extent(self) -> float:
         return self.length
 
