@@ -186,7 +186,7 @@ def slider_crank(carry: str, newton_tol: float = 1e-10):
     """The stiff (40 mm rod) flexible slider-crank of examples/slider_crank.py: a rigid crank
     driven to 60 rad/s in 0.05 s, a cubic-beam rod (5 nodes) whose end pins the reduction
     eliminates (the rod's first position is 0.15 times the crank's director, its last x the
-    slider's), a slider on a guide; to 0.5 s at dt 1e-3. Returns the rod's midpoint history,
+    slider's), a slider on a guide; to 1 s at dt 1e-3. Returns the rod's midpoint history,
     the factorizations, the steps and the length scale."""
     from ancfdrv import Circle, System
     r, l = 0.15, 0.45
@@ -208,7 +208,7 @@ def slider_crank(carry: str, newton_tol: float = 1e-10):
     s.joint("guide", "fix", "ground", "slider", point=wrist, axis=(0, 1, 0))
     s.joint("no turn", "fix", "ground", "slider", point=wrist, vector="r_x")
     s.probe("midpoint", "rod", (pin + wrist) / 2)
-    res = s.simulate(0.5, 1e-3, integrator="generalized_alpha", rho_inf=0.8, max_newton=20,
+    res = s.simulate(1.0, 1e-3, integrator="generalized_alpha", rho_inf=0.8, max_newton=20,
                      carry=carry, newton_tol=newton_tol)
     return (np.asarray(res.probes["midpoint"]), res.counters["factorizations"],
             res.counters["time_steps"], float(res.model.attrs["length_scale"]))
