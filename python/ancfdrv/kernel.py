@@ -860,19 +860,21 @@ class KernelSystem:
                                             _i(scalar_csr.indices + 1), _f(scalar_csr.data))
         self._check(info, "kron mass", message)
 
-    def set_carry(self, vectors: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> None:
+    def set_carry(self, vectors: tuple[np.ndarray, ...] | None) -> None:
         """The 3-vectors jacobian 'reuse' carries its iteration matrix with under rotation
         (``fortran/src/solvers/carried_rotation.f90``): (first full dof 0-based, weight,
-        1 position / 0 gradient or director) of each, or None: not carried."""
+        1 position / 0 gradient or director, group 0-based: each group is fitted its own
+        rotation) of each, or None: not carried."""
         if vectors is None:
-            first, weight, position = (np.zeros(0, dtype=np.int64), np.zeros(0),
-                                       np.zeros(0, dtype=np.int64))
+            first, weight, position, group = (np.zeros(0, dtype=np.int64), np.zeros(0),
+                                              np.zeros(0, dtype=np.int64),
+                                              np.zeros(0, dtype=np.int64))
         else:
-            first, weight, position = vectors
+            first, weight, position, group = vectors
         info, message = _kernel.system_set_carry(
             self.handle, len(first), _pad_last(np.asarray(first) + 1, np.int32),
             _pad_last(np.asarray(weight, dtype=float)),
-            _pad_last(np.asarray(position), np.int32))
+            _pad_last(np.asarray(position), np.int32), _pad_last(np.asarray(group) + 1, np.int32))
         self._check(info, "carry", message)
 
     def set_reduction(self, b_csr, offset, plan_source, plan_target, plan_coef) -> None:

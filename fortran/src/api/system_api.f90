@@ -638,18 +638,21 @@ subroutine system_set_solver(handle, nfull, nnz_full, full_row_ptr, full_col, so
 end subroutine system_set_solver
 
 !> The 3-vectors jacobian_reuse carries the iteration matrix with (carried_rotation): the
-!> first full dof of each (1-based), its weight in the rotation fit and whether it is a
-!> position (1) or a gradient or director (0); nvec = 0: the matrix is not carried. The
-!> model layer decides where the carry is exact (every full coordinate a 3-vector, the
-!> reduction a selection). info: 1 not a live handle; 2 a dof outside 1..nfull - 2 or a
-!> negative weight.
-subroutine system_set_carry(handle, nvec, first, weight, position, info, message)
+!> first full dof of each (1-based), its weight in the rotation fit, whether it is a
+!> position (1) or a gradient or director (0) and its group (1 .. : a body, fitted its own
+!> rotation; a reduced coordinate several vectors hold turns with the first listed); nvec
+!> = 0: the matrix is not carried. The model layer decides where the carry applies (every
+!> full coordinate a 3-vector, each row of the reduction at most one entry). info: 1 not a
+!> live handle; 2 a dof outside 1..nfull - 2, a negative weight or a group below 1, or a
+!> row of the reduction that mixes coordinates.
+subroutine system_set_carry(handle, nvec, first, weight, position, group, info, message)
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
   use system_carry, only: carry_setup
   use api_support, only: api_system
   implicit none
   integer, intent(in) :: handle, nvec, first(max(1, nvec)), position(max(1, nvec))
+  integer, intent(in) :: group(max(1, nvec))
   real(dp), intent(in) :: weight(max(1, nvec))
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
@@ -658,16 +661,18 @@ subroutine system_set_carry(handle, nvec, first, weight, position, info, message
   if (info /= 0) return
   if (nvec > 0) then
     if (any(first(1:nvec) < 1 .or. first(1:nvec) > sys%nfull - 2) .or. &
-        any(weight(1:nvec) < 0.0_dp) .or. mod(sys%nfull, 3) /= 0) then
+        any(weight(1:nvec) < 0.0_dp) .or. any(group(1:nvec) < 1) .or. &
+        mod(sys%nfull, 3) /= 0) then
       info = 2
       message = 'system_set_carry: a carried vector outside the full coordinates, a ' // &
-                'negative weight, or full coordinates that are not 3-vectors'
+                'negative weight, a group below 1, or full coordinates that are not 3-vectors'
       return
     end if
   end if
   call carry_setup(sys%carry, sys%reduction, sys%ndof, sys%nfull, first(1:max(0, nvec)), &
-                   weight(1:max(0, nvec)), position(1:max(0, nvec)) /= 0, info)
-  if (info /= 0) message = 'system_set_carry: the reduction is not a selection of coordinates'
+                   weight(1:max(0, nvec)), position(1:max(0, nvec)) /= 0, &
+                   group(1:max(0, nvec)), info)
+  if (info /= 0) message = 'system_set_carry: a row of the reduction mixes coordinates'
 end subroutine system_set_carry
 
 !> The mass as kron(Mbar, I3): Mbar's CSR over the nvec = ndof / 3 vectors (1-based),

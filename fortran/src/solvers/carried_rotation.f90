@@ -1,4 +1,5 @@
-!> The iteration matrix carried with the system's rotation (issue 23, item 3).
+!> The iteration matrix carried with the system's rotation (issue 23, item 3), each body
+!> (a group of system_carry) with its own.
 !>
 !> Every coordinate of an absolute-coordinate system (ANCF positions and gradients, a rigid
 !> body's position and directors) is a 3-vector in the global axes, the mass matrix is
@@ -11,14 +12,21 @@
 !> (axial, in-plane) misaligned by the whole turn: modified Newton then stops contracting
 !> and the stepper refactorizes in every step of a spinning or swinging body.
 !>
-!> R is fitted to the system's carried 3-vectors (weighted orthogonal Procrustes, the Kabsch
-!> algorithm: positions about their weighted centroid, gradients and directors as they are):
-!> the rotation that best maps the vectors at the factorization onto the current ones. A
-!> small multiple of the identity added to their correlation keeps directions the vectors
-!> do not determine (a straight cable's own axis) unturned. On reduced coordinates
-!> e (q = B e + q0) the turn is T_e = B^T T B, exact where B selects coordinates and the turn
-!> keeps the selection (the planar reduction, turned about the plane's normal); the model
-!> layer enables the carry only then (python/ancfdrv/system/model.py, carry_vectors).
+!> R is fitted to the carried 3-vectors of each body (weighted orthogonal Procrustes, the
+!> Kabsch algorithm: positions about their weighted centroid, gradients and directors as
+!> they are): the rotation that best maps the body's vectors at the factorization onto the
+!> current ones. A small multiple of the identity added to their correlation keeps
+!> directions the vectors do not determine (a straight cable's own axis) unturned. Joints
+!> are constraints (their gradients exact in every correction), so S is block-diagonal over
+!> the bodies and each block turns with its own body: T = blockdiag(R_b) (issue 38: the
+!> slider-crank's rod swings +-19 degrees while its crank turns, and one rotation fitted to
+!> both served neither). On reduced coordinates e (q = B e + q0) the turn is T_e = B^T T B,
+!> exact where B selects coordinates and the turn keeps the selection (the planar
+!> reduction, turned about the plane's normal); a joint the reduction eliminated
+!> (a coordinate scaled or shared between bodies) turns with one owner (system_carry), an
+!> approximation the simplified iteration's contraction measures. The model layer enables
+!> the carry where each row of B holds at most one entry (python/ancfdrv/system/model.py,
+!> carry_vectors).
 !>
 !> The turned matrix is a preconditioner of the simplified Newton iteration: the residual
 !> and the constraints are exact, so the converged state does not depend on it; only the
@@ -39,11 +47,28 @@ module carried_rotation
 
 contains
 
-  !> The rotation turn (3, 3) that best maps the reference vectors onto the current ones
-  !> (weighted; positions about their centroids) and its angle (rad). info = 1: the SVD
-  !> failed (turn = identity).
+  !> The rotation of each group (turn(:, :, g), system_carry) that best maps its reference
+  !> vectors onto its current ones (weighted; positions about their centroids) and the
+  !> largest of their angles (rad). info = 1: an SVD failed (that turn = identity).
   subroutine carry_turn(sys, reference, current, turn, angle, info)
     type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: reference(:, :), current(:, :)
+    real(dp), intent(out) :: turn(:, :, :), angle
+    integer, intent(out) :: info
+    real(dp) :: group_angle
+    integer :: g
+    angle = 0.0_dp
+    do g = 1, size(turn, 3)
+      call group_turn(sys, g, reference, current, turn(:, :, g), group_angle, info)
+      if (info /= 0) return
+      angle = max(angle, group_angle)
+    end do
+  end subroutine carry_turn
+
+  !> carry_turn of group g's vectors.
+  subroutine group_turn(sys, g, reference, current, turn, angle, info)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: g
     real(dp), intent(in) :: reference(:, :), current(:, :)
     real(dp), intent(out) :: turn(3, 3), angle
     integer, intent(out) :: info
@@ -55,7 +80,7 @@ contains
     centre_now = 0.0_dp
     weight_sum = 0.0_dp
     do k = 1, size(sys%carry%first)
-      if (.not. sys%carry%position(k)) cycle
+      if (.not. sys%carry%position(k) .or. sys%carry%group(k) /= g) cycle
       centre_ref = centre_ref + sys%carry%weight(k) * reference(:, k)
       centre_now = centre_now + sys%carry%weight(k) * current(:, k)
       weight_sum = weight_sum + sys%carry%weight(k)
@@ -66,6 +91,7 @@ contains
     end if
     correlation = 0.0_dp  ! sum w b a^T (b: reference, a: current)
     do k = 1, size(sys%carry%first)
+      if (sys%carry%group(k) /= g) cycle
       if (sys%carry%position(k)) then
         b = sys%carry%weight(k) * (reference(:, k) - centre_ref)
         a = current(:, k) - centre_now
@@ -104,7 +130,7 @@ contains
     end if
     angle = acos(max(-1.0_dp, min(1.0_dp, 0.5_dp * (turn(1, 1) + turn(2, 2) + turn(3, 3) &
                                                      - 1.0_dp))))
-  end subroutine carry_turn
+  end subroutine group_turn
 
   !> The rotation about z, turn = [c -s 0; s c 0; 0 0 1], that maximizes
   !> trace(turn^T correlation^T) = c (C11 + C22) + s (C12 - C21): the angle
@@ -197,7 +223,7 @@ contains
   !> column (ndof): work (the caller's: an automatic array was a heap allocation a call).
   pure subroutine carry_gradients(sys, turn, gradients, columns, column)
     type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: turn(3, 3), gradients(:, :)
+    real(dp), intent(in) :: turn(:, :, :), gradients(:, :)
     real(dp), intent(out) :: columns(:, :), column(:)
     integer :: c
     do c = 1, sys%constraints%ncon
@@ -213,18 +239,11 @@ contains
   !> column, the same turn as carry_apply's plane path), the other rows not written.
   pure subroutine carry_plane_gradients(sys, turn, gradients, pairs, columns, column)
     type(system_model), intent(in) :: sys
-    real(dp), intent(in) :: turn(3, 3), gradients(:, :)
+    real(dp), intent(in) :: turn(:, :, :), gradients(:, :)
     integer, intent(in) :: pairs(:)
     real(dp), intent(inout) :: columns(:, :), column(:)
     real(dp) :: r11, r12, r13, r21, r22, r23, v1, v2
-    integer :: c, p, first, second
-    ! (back: the transposed turn, as carry_apply(.., back = .true., ..))
-    r11 = turn(1, 1)
-    r12 = turn(2, 1)
-    r13 = turn(3, 1) * 0.0_dp
-    r21 = turn(1, 2)
-    r22 = turn(2, 2)
-    r23 = turn(3, 2) * 0.0_dp
+    integer :: c, p, first, second, g, current
     do c = 1, sys%constraints%ncon
       do p = 1, size(pairs)
         column(sys%carry%plane(1, pairs(p))) = 0.0_dp
@@ -233,7 +252,19 @@ contains
       ! (the operands up to the last with terms: the rest are empty)
       call add_gradient_column(sys%constraints, gradients, c, operand_count(sys%constraints, c), &
                                column)
+      current = 0
       do p = 1, size(pairs)
+        ! (back: the transposed turn of the pair's group, as carry_apply(.., back = .true., ..))
+        g = sys%carry%plane_group(pairs(p))
+        if (g /= current) then
+          r11 = turn(1, 1, g)
+          r12 = turn(2, 1, g)
+          r13 = turn(3, 1, g) * 0.0_dp
+          r21 = turn(1, 2, g)
+          r22 = turn(2, 2, g)
+          r23 = turn(3, 2, g) * 0.0_dp
+          current = g
+        end if
         first = sys%carry%plane(1, pairs(p))
         second = sys%carry%plane(2, pairs(p))
         v1 = column(first)

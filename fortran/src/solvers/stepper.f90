@@ -85,10 +85,10 @@ module stepper
     integer :: matrix_unconfirmed = 0
     ! the matrix carried with the system's rotation (carried_rotation): the carried vectors
     ! at the factorization and at the current step (3, nvec), the turn from them to the current step's predicted
-    ! state and whether the step uses it (a turn above carry_threshold)
+    ! state of each group (body) and whether the step uses them (a turn above
+    ! carry_threshold)
     real(dp), allocatable :: carry_reference(:, :), carry_current(:, :)
-    real(dp) :: carry_turn(3, 3) = reshape([1.0_dp, 0.0_dp, 0.0_dp, 0.0_dp, 1.0_dp, 0.0_dp, &
-                                            0.0_dp, 0.0_dp, 1.0_dp], [3, 3])
+    real(dp), allocatable :: carry_turn(:, :, :)  ! (3, 3, groups)
     logical :: carry_on = .false.
   end type stepper_state
 

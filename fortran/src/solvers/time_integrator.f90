@@ -513,7 +513,8 @@ contains
     if (info == 0 .and. carry_enabled(sys%carry)) then
       if (.not. allocated(learned%carry_reference)) &
         allocate (learned%carry_reference(3, size(sys%carry%first)), &
-                  learned%carry_current(3, size(sys%carry%first)))
+                  learned%carry_current(3, size(sys%carry%first)), &
+                  learned%carry_turn(3, 3, sys%carry%ngroups))
       call carry_vectors(sys%carry, sys%reduction, e, learned%carry_reference)
     end if
   end subroutine factorize
@@ -825,7 +826,8 @@ contains
                     work%dlam, sys%constraints%ncon, lapack_info)
       end if
       if (allocated(sys%carry%plane)) then
-        call plane_carried_correction(sys%carry%plane, learned%carry_turn, &
+        call plane_carried_correction(sys%carry%plane, sys%carry%plane_group, &
+                                      learned%carry_turn, &
                                       work%carry_flexibility, work%dlam(:, 1), work%direction, &
                                       work%correction)
         return
@@ -980,22 +982,17 @@ contains
   end subroutine schur_complement
 
   !> The carried correction T F dlam - z of a planar reduction (pairs: carry_plane, every
-  !> reduced coordinate in one) in one pass over the pairs: each pair's F dlam as
-  !> sparse_columns_product sums it, turned as carry_apply turns a plane vector, less z:
-  !> the same numbers.
-  pure subroutine plane_carried_correction(pairs, turn, flexibility, dlam, direction, &
+  !> reduced coordinate in one; groups: the group whose turn turns each) in one pass over
+  !> the pairs: each pair's F dlam as sparse_columns_product sums it, turned as carry_apply
+  !> turns a plane vector, less z: the same numbers.
+  pure subroutine plane_carried_correction(pairs, groups, turn, flexibility, dlam, direction, &
                                            correction)
-    integer, intent(in) :: pairs(:, :)
-    real(dp), intent(in) :: turn(3, 3), flexibility(:, :), dlam(:), direction(:)
+    integer, intent(in) :: pairs(:, :), groups(:)
+    real(dp), intent(in) :: turn(:, :, :), flexibility(:, :), dlam(:), direction(:)
     real(dp), intent(out) :: correction(:)
     real(dp) :: back_x, back_y, r11, r12, r13, r21, r22, r23, d1, d2
-    integer :: p, c, first, second, c1, c2, nonzero
-    r11 = turn(1, 1)
-    r12 = turn(1, 2)
-    r13 = turn(1, 3) * 0.0_dp
-    r21 = turn(2, 1)
-    r22 = turn(2, 2)
-    r23 = turn(2, 3) * 0.0_dp
+    integer :: p, c, first, second, c1, c2, nonzero, current
+    current = 0
     ! one or two nonzero multiplier corrections (a pin in the plane): their sums written
     ! out, the same terms in the same order as the loop below (zero ones skipped there too)
     nonzero = count(dlam /= 0.0_dp)
@@ -1013,6 +1010,15 @@ contains
       d1 = dlam(c1)
       if (nonzero == 1) then
         do p = 1, size(pairs, 2)
+          if (groups(p) /= current) then  ! (the turn of the pair's group)
+            current = groups(p)
+            r11 = turn(1, 1, current)
+            r12 = turn(1, 2, current)
+            r13 = turn(1, 3, current) * 0.0_dp
+            r21 = turn(2, 1, current)
+            r22 = turn(2, 2, current)
+            r23 = turn(2, 3, current) * 0.0_dp
+          end if
           first = pairs(1, p)
           second = pairs(2, p)
           back_x = 0.0_dp + flexibility(first, c1) * d1
@@ -1024,6 +1030,15 @@ contains
       end if
       d2 = dlam(c2)
       do p = 1, size(pairs, 2)
+        if (groups(p) /= current) then  ! (the turn of the pair's group)
+          current = groups(p)
+          r11 = turn(1, 1, current)
+          r12 = turn(1, 2, current)
+          r13 = turn(1, 3, current) * 0.0_dp
+          r21 = turn(2, 1, current)
+          r22 = turn(2, 2, current)
+          r23 = turn(2, 3, current) * 0.0_dp
+        end if
         first = pairs(1, p)
         second = pairs(2, p)
         back_x = 0.0_dp + flexibility(first, c1) * d1 + flexibility(first, c2) * d2
@@ -1034,6 +1049,15 @@ contains
       return
     end if
     do p = 1, size(pairs, 2)
+      if (groups(p) /= current) then  ! (the turn of the pair's group)
+        current = groups(p)
+        r11 = turn(1, 1, current)
+        r12 = turn(1, 2, current)
+        r13 = turn(1, 3, current) * 0.0_dp
+        r21 = turn(2, 1, current)
+        r22 = turn(2, 2, current)
+        r23 = turn(2, 3, current) * 0.0_dp
+      end if
       first = pairs(1, p)
       second = pairs(2, p)
       back_x = 0.0_dp
@@ -1046,6 +1070,7 @@ contains
       correction(first) = (r11 * back_x + r12 * back_y + r13) - direction(first)
       correction(second) = (r21 * back_x + r22 * back_y + r23) - direction(second)
     end do
+
   end subroutine plane_carried_correction
 
   !> y = A x (matmul's sums over the columns in increasing order, from 0) without the

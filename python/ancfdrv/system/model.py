@@ -524,7 +524,7 @@ class Model:
         ok_m = _turned_difference(mass, mass, u) <= 1e-12 * max(mass.max_abs(), 1e-300)
         return bool(ok_k and ok_m)
 
-    def carry_vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    def carry_vectors(self) -> tuple[np.ndarray, ...] | None:
         """:meth:`made_carry_vectors`, made once per state of what they depend on (the
         policy, the length scale, the contact pairs, sets, bodies and reduction; read-only
         arrays): the kernel's hand-over (:meth:`touched_blocks`) and each run's start ask
@@ -541,26 +541,30 @@ class Model:
         self.__dict__["_carry_vectors"] = (key, self.reduction, made)
         return made
 
-    def made_carry_vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The 3-vectors the stepper fits the system's rotation to when it carries its
+    def made_carry_vectors(self) -> tuple[np.ndarray, ...] | None:
+        """The 3-vectors the stepper fits the bodies' rotations to when it carries its
         iteration matrix under rotation (``solver.carry``, docs/theory.md "The iteration
         matrix carried with the rotation"): (first full coordinate of each vector, weight,
-        1 for a position / 0 for a gradient or director), or None where turning the matrix
-        does not follow the system: FFR sets (their frames already carry theirs), contact,
-        bodies whose coordinates are not all global 3-vectors, a reduction that does more
-        than select coordinates (eliminated joints). Positions weigh 1, the unit-size
-        gradients and directors the model's length squared, so both shares compare."""
+        1 for a position / 0 for a gradient or director, its body's group), or None where
+        turning the matrix does not follow the system: FFR sets (their frames already carry
+        theirs), contact, bodies whose coordinates are not all global 3-vectors, a
+        reduction that mixes coordinates (a row of B with more than one entry). Positions
+        weigh 1, the unit-size gradients and directors the model's length squared, so both
+        shares compare. Each body is a group, fitted its own rotation; the flexible bodies
+        are listed first, so a coordinate the reduction shares between a flexible and a
+        rigid body (an eliminated joint) turns with the flexible one's stiffness (the rigid
+        body's mass turns exactly with any rotation; fortran/src/system/system_carry.f90)."""
         if self.policy != POLICY_REFACTOR or self.contact_pairs or self.nfull % 3:
             return None
         if any(s.floating for s in self.sets):   # (other kinds ignore their frame)
             return None
         if self.reduction is not None and self.reduction.selects is None:
-            if self.reduction.matrix.selection_columns() is None:
+            rows = self.reduction.matrix.indptr
+            if len(rows) > 1 and (rows[1:] - rows[:-1]).max() > 1:
                 return None
-        first, weight, position = [], [], []
-        for body in self.bodies:
-            if body.ncoordinates == 0:   # the ground
-                continue
+        first, weight, position, group = [], [], [], []
+        bodies = [b for b in self.bodies if b.ncoordinates]   # (not the ground)
+        for index, body in enumerate(sorted(bodies, key=lambda b: not b.flexible)):
             nodes = body.nnodes
             if not nodes:
                 return None
@@ -572,10 +576,11 @@ class Model:
                     first.append(body.first + 3 * (per_node * node + k))
                     position.append(1 if k == 0 else 0)
                     weight.append(1.0 if k == 0 else self.length_scale**2)
+                    group.append(index)
         if not first:
             return None
         return (np.array(first, dtype=np.int64), np.array(weight),
-                np.array(position, dtype=np.int64))
+                np.array(position, dtype=np.int64), np.array(group, dtype=np.int64))
 
     def touched_blocks(self) -> np.ndarray:
         """First coordinates (0-based) of the 3-vector blocks holding every constrained
