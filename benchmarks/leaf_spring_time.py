@@ -216,7 +216,9 @@ def markdown(report: dict[str, Any]) -> str:
         s = part["summary"]
         lines += ["", f"Load average {part['load_average_start']} at the start of part 1, "
                   f"{part['load_average_end']} at its end. {report['settings']['rounds']} "
-                  "rounds, baseline and current alternating, each run a fresh process.", "",
+                  "rounds, baseline and current alternating, each run a fresh process; "
+                  + ("the rows carry the answers (as ancf run)." if report["settings"].get("answers")
+                     else "no answers in the rows (integrate alone)."), "",
                   "| build | integrate CPU best [s] | median [s] | process CPU best [s] | "
                   "steps | Newton iterations | factorizations |",
                   "|---|---|---|---|---|---|---|"]
