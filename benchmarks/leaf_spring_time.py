@@ -17,7 +17,9 @@ rusage, start-up and imports included). The two builds alternate, baseline first
 and the median of each side are reported, with the load average at the start and the end.
 Checks: both builds' steps, Newton iterations and factorizations, and the chassis's
 displacement history compared value for value (``history_max_abs_diff``, 0 when the
-builds compute the same numbers).
+builds compute the same numbers). ``--answers``: the rows carry the kernel's part of the
+engineering answers (row_answers.f90), as ``ancf run`` computes them; ``integrate`` alone
+(the library call) does not.
 
 Part 2 (``--accuracy``), accuracy against time: the current build at (dt, newton_tol) in
 ``--grid`` (default: 5e-4/1e-8, the shipped 1e-3/1e-8, 2e-3/1e-8, 4e-3/1e-8, 1e-3/1e-6,
@@ -60,9 +62,10 @@ SAMPLE = 4e-3   # s: the comparison times, a multiple of every step of the grid
 
 # -- one run (a worker process) -------------------------------------------------------------
 def one_run(history: Path, t_end: float,
-            setting: tuple[float, float] | None = None) -> dict[str, Any]:
+            setting: tuple[float, float] | None = None, answers: bool = False) -> dict[str, Any]:
     """One run in this process at the scene's (dt, newton_tol) or ``setting``: its record;
-    writes the chassis history (t, x, z) to ``history`` (.npz)."""
+    writes the chassis history (t, x, z) to ``history`` (.npz). ``answers``: the rows carry
+    the kernel's part of the answers, as in ``ancf run`` (DynamicSettings.answers)."""
     from ancfdrv.builders import build_model, settle_mode
     from ancfdrv.io.scene import load_scene
     from ancfdrv.runner import dynamic_settings
@@ -80,6 +83,7 @@ def one_run(history: Path, t_end: float,
                          load_steps=solver["load_steps"],
                          loads=0.0 if settle == "unloaded" else 1.0).e
     settings = dynamic_settings(scene)
+    settings.answers = answers
     chunks: list[Any] = []
     cpu0 = time.process_time()
     result = integrate(model, settings, start, sink=chunks.append, progress=False)
@@ -90,7 +94,7 @@ def one_run(history: Path, t_end: float,
     np.savez(history, t=t, x=chassis[:, 0], z=chassis[:, 2])
     model.close()
     return {"dt": settings.dt, "newton_tol": solver["newton_tol"], "t_end": settings.t_end,
-            "settle": settle, "integrate_cpu_s": cpu, "integrate_wall_s": result.wall_time_s,
+            "settle": settle, "answers": answers, "integrate_cpu_s": cpu, "integrate_wall_s": result.wall_time_s,
             "steps": result.steps, "newton_iterations": result.newton_iterations,
             "factorizations": result.factorizations,
             "chassis_z_end_m": float(chassis[-1, 2]),
@@ -100,16 +104,18 @@ def one_run(history: Path, t_end: float,
 def worker(args: argparse.Namespace) -> None:
     """One run (a worker process); prints its JSON record."""
     setting = None if args.dt is None else (args.dt, args.tol)
-    print(json.dumps(one_run(args.history, args.t_end, setting)))
+    print(json.dumps(one_run(args.history, args.t_end, setting, args.answers)))
 
 
 def run_worker(python: str, history: Path, t_end: float,
-               setting: tuple[float, float] | None = None) -> dict[str, Any]:
+               setting: tuple[float, float] | None = None, answers: bool = False) -> dict[str, Any]:
     """A worker in a fresh process of ``python``; its record plus the process's CPU time."""
     command = [python, str(Path(__file__).resolve()), "--worker", "--history", str(history),
                "--t-end", repr(t_end)]
     if setting is not None:
         command += ["--dt", repr(setting[0]), "--tol", repr(setting[1])]
+    if answers:
+        command.append("--answers")
     proc = subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
     _, status, usage = os.wait4(proc.pid, 0)
@@ -130,7 +136,8 @@ def compare_builds(args: argparse.Namespace, work: Path) -> dict[str, Any]:
     load_start = load_average()
     for r in range(args.rounds):
         for side, python in sides.items():
-            record = run_worker(python, work / f"{side}_{r}.npz", args.t_end)
+            record = run_worker(python, work / f"{side}_{r}.npz", args.t_end,
+                                answers=args.answers)
             runs[side].append(record)
             print(f"round {r + 1}/{args.rounds} {side:8s}: integrate {record['integrate_cpu_s']:.3f} s "
                   f"CPU, process {record['process_cpu_s']:.3f} s", flush=True)
@@ -209,7 +216,9 @@ def markdown(report: dict[str, Any]) -> str:
         s = part["summary"]
         lines += ["", f"Load average {part['load_average_start']} at the start of part 1, "
                   f"{part['load_average_end']} at its end. {report['settings']['rounds']} "
-                  "rounds, baseline and current alternating, each run a fresh process.", "",
+                  "rounds, baseline and current alternating, each run a fresh process; "
+                  + ("the rows carry the answers (as ancf run)." if report["settings"].get("answers")
+                     else "no answers in the rows (integrate alone)."), "",
                   "| build | integrate CPU best [s] | median [s] | process CPU best [s] | "
                   "steps | Newton iterations | factorizations |",
                   "|---|---|---|---|---|---|---|"]
@@ -246,6 +255,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--rounds", type=int, default=3, help="baseline/current pairs (3)")
     p.add_argument("--t-end", type=float, default=5.0, help="simulated time (the scene's 5 s)")
     p.add_argument("--accuracy", action="store_true", help="part 2: accuracy against time")
+    p.add_argument("--answers", action="store_true",
+                   help="part 1 with the rows' answers, as ancf run computes them")
     p.add_argument("--grid", type=lambda s: tuple(float(v) for v in s.split("/")), nargs="+",
                    default=GRID, help="part 2: dt/newton_tol pairs")
     p.add_argument("-o", "--output", type=Path, default=None,
@@ -268,7 +279,8 @@ def main(argv: list[str] | None = None) -> int:
         "benchmark": "leaf_spring_time",
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "scene": str(SCENE.relative_to(REPO)), "machine": machine_info(),
-        "settings": {"rounds": args.rounds, "t_end": args.t_end, "grid": args.grid,
+        "settings": {"rounds": args.rounds, "t_end": args.t_end, "answers": args.answers,
+                     "grid": args.grid,
                      "reference": REFERENCE},
         "units": "CPU and wall times in s; errors as fractions of the reference's range"}
     with tempfile.TemporaryDirectory() as tmp:

@@ -82,3 +82,39 @@ def test_recording_the_answers_leaves_the_motion_alone(tmp_path):
         assert "dynamic/reactions" in a and "dynamic/reactions" not in b
         for name in ("dynamic/q", "dynamic/lambda", "dynamic/contact/normal_force"):
             assert np.array_equal(a[name][()], b[name][()]), name
+
+
+def test_the_residual_at_a_few_columns_is_that_of_every_element():
+    """The rows' residual at the eliminated joints' coordinates is evaluated from the
+    elements that touch them alone (mechanical_system column_forces): at those coordinates
+    it is the residual the kernel forms when every full coordinate is asked for (every
+    element of both leaves evaluated), bit for bit, at a state off the assembled one with
+    rates and accelerations (the two-leaf spring: plates, contact, rigid bodies)."""
+    from ancfdrv.builders import build_model
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.runner import dynamic_settings
+
+    scene = load_scene(ROOT / "inputs/leaf_spring.nml", [])
+    model = build_model(scene)
+    try:
+        model.kernel.stepper_setup(dynamic_settings(scene))
+        few = answers.answer_inputs(model)[0]
+        every = np.arange(model.nfull)
+        assert 0 < len(few) < model.nfull // 4
+        constant = np.asarray(model.full_loads[0], dtype=float)
+        mass = model.mass_full.to_scipy().tocsr()
+        rng = np.random.default_rng(7)
+        e = model.e0 + 1e-4 * rng.standard_normal(model.ndof)
+        v = 1e-2 * rng.standard_normal(model.ndof)
+        accel = rng.standard_normal(model.ndof)
+
+        def residual(columns):
+            model.kernel.answer_setup(columns, mass[columns], constant[columns],
+                                      np.zeros((len(columns), 0)))
+            return model.kernel.answer_row(0.1, e, v, accel, model.contact_guesses.copy())
+
+        at_few, at_every = residual(few), residual(every)
+        assert np.abs(at_every[few]).max() > 0.0
+        assert np.array_equal(at_few, at_every[few])
+    finally:
+        model.close()

@@ -82,6 +82,7 @@ module cable_element
     real(dp), allocatable :: slope_rows(:, :, :), second_rows(:, :, :), weights(:, :)
   contains
     procedure :: forces => cable_set_forces
+    procedure :: column_forces => cable_column_forces
     procedure :: selected_forces => cable_selected_forces
     procedure :: energy_power => cable_set_energy_power
     procedure :: element_forces => cable_element_forces
@@ -862,6 +863,19 @@ contains
       energy = energy + element_energy
     end do
   end subroutine cable_set_forces
+
+  !> The element_set column_forces of a cable set: its whole forces pass (cable_set_forces'
+  !> lean pass is not element_forces': local_column_forces would not give its sums).
+  subroutine cable_column_forces(set, rotation, e, wanted, force, info, v, omega_local)
+    class(cable_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    logical, intent(in) :: wanted(:)
+    real(dp), intent(inout) :: force(:)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:), omega_local(3)
+    real(dp) :: energy
+    call set%forces(rotation, e, force, energy, info, v=v, omega_local=omega_local)
+  end subroutine cable_column_forces
 
   !> The element_set selected_forces of a cable set: cable_set_forces' lean pass (an
   !> undamped elastic set below the threading threshold; done = .false. otherwise) on the

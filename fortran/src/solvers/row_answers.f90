@@ -4,8 +4,9 @@
 !> - per force element the force and moment body1 exerts on body2 and the axial force
 !>   (mechanical_system force_element_reactions at (t, e, e'): 7 values each);
 !> - the residual of the equations of motion in the full coordinates q,
-!>   r = M q'' + Q_int(q, q') - Q(t) (Q_int: internal_forces' full force: elastic, damping,
-!>   force elements, minus contact and applied moments; Q: the constant loads with gravity
+!>   r = M q'' + Q_int(q, q') - Q(t) (Q_int: internal_forces' full force, evaluated there
+!>   alone by column_forces: elastic, damping, force elements, minus contact and applied
+!>   moments; Q: the constant loads with gravity
 !>   and the driven loads), at the full coordinates the eliminated linear joints' rows touch
 !>   (python/ancfdrv/system/answers.py recovers those joints' multipliers from it).
 !> The run sets the data once (system_answer_setup): those columns, the full mass's rows and
@@ -13,7 +14,7 @@
 module row_answers
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model, contact_state, contact_record, frame_rotations, &
-                               internal_forces, force_element_reactions
+                               column_forces, force_element_reactions
   use system_reduction, only: to_full
   use system_drives, only: drive_at
   implicit none
@@ -55,9 +56,10 @@ contains
     real(dp), intent(out) :: out(:)
     integer, intent(out) :: info
     type(contact_state) :: search
-    real(dp), allocatable :: rotations(:, :, :), rates(:), reduced(:), full_force(:), &
+    real(dp), allocatable :: rotations(:, :, :), rates(:), full_force(:), &
                              accel_full(:), records(:, :), elements(:, :), phi(:)
-    real(dp) :: strain, potential, powers(2), dphi, ddphi, external, inertia
+    logical, allocatable :: wanted(:)
+    real(dp) :: dphi, ddphi, external, inertia
     integer :: nfel, ncol, i, k, d
     info = 0
     out = 0.0_dp
@@ -71,15 +73,16 @@ contains
     ncol = size(answers%columns)
     if (ncol == 0) return
     allocate (rotations(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames)), &
-              reduced(sys%ndof), full_force(sys%nfull), accel_full(sys%nfull), &
+              full_force(sys%nfull), accel_full(sys%nfull), wanted(sys%nfull), &
               records(contact_record, max(1, sys%contact%npoint)), phi(size(answers%driven, 2)))
     call frame_rotations(sys, t, rotations, rates, info)
     if (info /= 0) return
     search%guesses = contact%guesses
     search%counts = 0
-    call internal_forces(sys, rotations, e, v, 1.0_dp, 0.0_dp, search, reduced, strain, &
-                         potential, powers, records, info, rates=rates, full_out=full_force, &
-                         force_time=t)
+    ! (the forces at the columns alone: the elements that touch them, the same sums there)
+    wanted = .false.
+    wanted(answers%columns) = .true.
+    call column_forces(sys, rotations, rates, e, v, t, wanted, search, full_force, records, info)
     if (info /= 0) return
     call to_full(sys%reduction, accel, .false., accel_full)
     do d = 1, size(phi)

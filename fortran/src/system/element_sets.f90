@@ -54,6 +54,7 @@ module element_sets
     procedure :: energy_power => set_energy_power
     procedure :: selected_forces => no_selected_forces
     procedure :: section_forces => no_section_forces
+    procedure :: column_forces => set_column_forces
   end type element_set
 
   abstract interface
@@ -91,6 +92,7 @@ module element_sets
   contains
     procedure(element_forces_interface), deferred :: element_forces
     procedure :: forces => local_set_forces
+    procedure :: column_forces => local_column_forces
     procedure :: energy_power => local_energy_power
     procedure :: element_energy => local_element_energy
     procedure :: midpoint_forces => no_midpoint_forces
@@ -140,6 +142,60 @@ contains
     info = 0
     done = .false.
   end subroutine no_selected_forces
+
+  !> The set's force added to force where wanted (nfull) is true, as forces adds it there
+  !> (the same sums, bit for bit); elsewhere force may hold any partial sum. A damped set
+  !> is given v and omega_local as forces is (rate factor 0, no tangent). The default: the
+  !> whole forces pass.
+  subroutine set_column_forces(set, rotation, e, wanted, force, info, v, omega_local)
+    class(element_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    logical, intent(in) :: wanted(:)
+    real(dp), intent(inout) :: force(:)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:), omega_local(3)
+    real(dp) :: energy
+    call set%forces(rotation, e, force, energy, info, v=v, omega_local=omega_local)
+  end subroutine set_column_forces
+
+  !> column_forces of a local set: the elements with a wanted coordinate alone, in element
+  !> order (the order in which local_set_forces adds them: the same sums at those
+  !> coordinates). info = 7: such an element is degenerate.
+  subroutine local_column_forces(set, rotation, e, wanted, force, info, v, omega_local)
+    class(local_element_set), intent(in) :: set
+    real(dp), intent(in) :: rotation(3, 3), e(:)
+    logical, intent(in) :: wanted(:)
+    real(dp), intent(inout) :: force(:)
+    integer, intent(out) :: info
+    real(dp), intent(in), optional :: v(:), omega_local(3)
+    real(dp), allocatable :: element_force(:), tangent(:, :)
+    real(dp) :: element_energy, element_power
+    logical :: damped, touched
+    integer :: el, a
+    info = 0
+    damped = present(v) .and. set%damping_time > 0.0_dp
+    allocate (element_force(set%nde), tangent(set%nde, set%nde))
+    do el = 1, set%nel
+      touched = .false.
+      do a = 1, set%nde
+        touched = touched .or. wanted(set%dofs(a, el))
+      end do
+      if (.not. touched) cycle
+      if (damped) then
+        call gathered_forces(set, el, e, .false., element_force, element_energy, tangent, info, &
+                             v, 0.0_dp, element_power)
+      else
+        call gathered_forces(set, el, e, .false., element_force, element_energy, tangent, info)
+      end if
+      if (info /= 0) then
+        info = 7
+        return
+      end if
+      do a = 1, set%nde
+        force(set%dofs(a, el)) = force(set%dofs(a, el)) + element_force(a)
+      end do
+    end do
+  end subroutine local_column_forces
 
   !> The section forces (ns nel, nrows, 6) [N, T, Q_height, Q_width, M_height, M_width] at
   !> the stations xi (ns, in [0, 1] along each element; station i of element el in row

@@ -368,7 +368,7 @@ contains
     real(dp) :: force_upper(36), force_lower(36), jacobian(72, 72), record(4), point_potential
     real(dp) :: point_powers(2), p(3), shape(plate_shapes), point_derivs(plate_shapes, 5)
     real(dp) :: xi_q, eta_q
-    integer :: c, upper, lower, index(72), i, j, pos
+    integer :: c, upper, lower, index(72), order(72), place(72), i, j, k, m, last
     logical :: active, want_jacobian
     info = 0
     potential = 0.0_dp
@@ -415,38 +415,51 @@ contains
       if (.not. want_jacobian) cycle
       index(1:36) = dofs(:, upper)
       index(37:72) = dofs(:, lower)
+      call ascending_order(index, order)
       do i = 1, 72
+        ! the positions of row index(i)'s 72 entries in the pattern (place 0: absent) by one
+        ! merge of its sorted columns with the sorted index, in place of a binary search each
+        m = row_ptr(index(i))
+        last = row_ptr(index(i) + 1) - 1
+        do k = 1, 72
+          j = order(k)
+          do while (m <= last)
+            if (col(m) >= index(j)) exit
+            m = m + 1
+          end do
+          place(j) = 0
+          if (m <= last) then
+            if (col(m) == index(j)) place(j) = m
+          end if
+        end do
         do j = 1, 72
           if (jacobian(i, j) == 0.0_dp) cycle
-          pos = pattern_position(row_ptr, col, index(i), index(j))
-          if (pos == 0) then
+          if (place(j) == 0) then
             counts(cc_dropped) = counts(cc_dropped) + 1
           else
-            values(pos) = values(pos) + jacobian(i, j)
+            values(place(j)) = values(place(j)) + jacobian(i, j)
           end if
         end do
       end do
     end do
   end subroutine contact_assemble
 
-  !> Position of (row, column) in a CSR pattern with sorted columns; 0 when absent.
-  pure integer function pattern_position(row_ptr, col, row, column) result(pos)
-    integer, intent(in) :: row_ptr(:), col(:), row, column
-    integer :: low, high, mid
-    pos = 0
-    low = row_ptr(row)
-    high = row_ptr(row + 1) - 1
-    do while (low <= high)
-      mid = (low + high) / 2
-      if (col(mid) == column) then
-        pos = mid
-        return
-      else if (col(mid) < column) then
-        low = mid + 1
-      else
-        high = mid - 1
-      end if
+  !> order: the permutation that sorts values ascending (values(order) non-decreasing;
+  !> insertion sort, equal values in their given order).
+  pure subroutine ascending_order(values, order)
+    integer, intent(in) :: values(:)
+    integer, intent(out) :: order(:)
+    integer :: i, k, held
+    do i = 1, size(values)
+      held = i
+      k = i - 1
+      do while (k >= 1)
+        if (values(order(k)) <= values(held)) exit
+        order(k + 1) = order(k)
+        k = k - 1
+      end do
+      order(k + 1) = held
     end do
-  end function pattern_position
+  end subroutine ascending_order
 
 end module leaf_contact

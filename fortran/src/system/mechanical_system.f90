@@ -55,7 +55,7 @@ module mechanical_system
   implicit none
   private
   public :: system_model, frame_def, contact_pair, contact_state
-  public :: frame_rotations, internal_forces, &
+  public :: frame_rotations, internal_forces, column_forces, &
             external_forces, &
             refactorize, to_solver_frame, &
             frame_gradients, energies, probe_output, tangent_rotations, append_set, &
@@ -383,6 +383,55 @@ contains
 
   !> The time an internal-force evaluation hands the force elements (0 when not given:
   !> only systems without driven force elements are evaluated so).
+  !> internal_forces' full force (its full_out at load factor 1, velocity factor 0, rates
+  !> and force time t) at the full coordinates marked in wanted (nfull), bit for bit: the
+  !> sets' elements that touch a wanted coordinate (element_set column_forces), the whole
+  !> contact (its search from state's guesses, records as internal_forces'), force
+  !> elements and dead moments; the other entries of full_force hold partial sums. The
+  !> answers' residual at a few coordinates (row_answers) without every element's force.
+  !> info as internal_forces.
+  subroutine column_forces(sys, rotations, rates, e, v, t, wanted, state, full_force, records, &
+                           info)
+    type(system_model), intent(in) :: sys
+    real(dp), intent(in) :: rotations(:, :, 0:), rates(0:), e(:), v(:), t
+    logical, intent(in) :: wanted(:)
+    type(contact_state), intent(inout) :: state
+    real(dp), intent(out) :: full_force(:), records(:, :)
+    integer, intent(out) :: info
+    real(dp), allocatable :: e_full(:), v_full(:), no_values(:)
+    real(dp) :: energy, powers(2)
+    integer :: s, f
+    allocate (e_full(sys%nfull))
+    call to_full(sys%reduction, e, .true., e_full)
+    full_force = 0.0_dp
+    info = 0
+    if (sys%contact%npoint > 0 .or. damped_sets(sys) .or. sys%force_elements%nfel > 0) then
+      allocate (v_full(sys%nfull))
+      call to_full(sys%reduction, v, .false., v_full)
+    end if
+    if (sys%force_elements%nfel > 0) then
+      call force_element_forces(sys%force_elements, sys%drives, sys%reduction, t, e_full, v_full, &
+                                0.0_dp, full_force, energy, powers, info)
+      if (info /= 0) return
+    end if
+    do s = 1, size(sys%sets)
+      f = sys%sets(s)%item%frame
+      if (sys%sets(s)%item%damping_time > 0.0_dp) then
+        call sys%sets(s)%item%column_forces(rotations(:, :, f), e_full, wanted, full_force, info, &
+                                            v_full, set_omega(sys, f, rotations(:, :, f), rates(f)))
+      else
+        call sys%sets(s)%item%column_forces(rotations(:, :, f), e_full, wanted, full_force, info)
+      end if
+      if (info /= 0) return
+    end do
+    if (sys%contact%npoint > 0) then
+      call contact_forces(sys%contact, sys%reduction, e_full, v_full, 0.0_dp, state, full_force, &
+                          records, energy, powers, info, no_values)
+      if (info /= 0) return
+    end if
+    call dead_moment_forces(sys%loads, e_full, 1.0_dp, full_force, info)
+  end subroutine column_forces
+
   pure real(dp) function merge_time(time)
     real(dp), intent(in), optional :: time
     merge_time = 0.0_dp
