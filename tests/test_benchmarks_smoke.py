@@ -229,9 +229,9 @@ def test_leaf_spring_time_same_version(tmp_path, monkeypatch):
     with np.load(tmp_path / "worker.npz") as h:
         assert len(h["t"]) == len(h["z"]) == 21 and abs(h["t"][-1] - 0.02) < 1e-12
 
-    def in_process(python, history, t_end, setting=None):
+    def in_process(python, history, t_end, setting=None, answers=False):
         assert python == sys.executable
-        record = script.one_run(history, t_end, setting)
+        record = script.one_run(history, t_end, setting, answers)
         return dict(record, process_cpu_s=record["integrate_cpu_s"])
 
     monkeypatch.setattr(script, "run_worker", in_process)
