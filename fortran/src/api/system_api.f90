@@ -582,6 +582,7 @@ subroutine system_set_mass(handle, ndof, nnz_mass, mass_row_ptr, mass_col, mass_
   sys%mass%row_ptr = mass_row_ptr
   sys%mass%col = mass_col
   sys%mass%values = mass_values
+  if (allocated(sys%mass%band)) deallocate (sys%mass%band)
   if (allocated(sys%mass%pair_ptr)) deallocate (sys%mass%pair_ptr, sys%mass%pair_col, &
                                                 sys%mass%pair_row, sys%mass%pair_values)
   if (any(saddle_col < 1) .or. any(saddle_col > ndof) .or. saddle_ptr(1) /= 1 .or. &
@@ -679,6 +680,7 @@ end subroutine system_set_carry
 !> replacing the CSR of system_set_mass in products (a ninth of the entries).
 subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, message)
   use ancf_kinds, only: dp
+  use system_mass, only: kron_band_setup
   use mechanical_system, only: system_model
   use api_support, only: api_system
   implicit none
@@ -698,6 +700,7 @@ subroutine system_set_kron_mass(handle, nvec, nnz, row_ptr, col, values, info, m
   sys%mass%col = col
   sys%mass%values = values
   sys%mass%kron = .true.
+  call kron_band_setup(sys%mass)
   if (allocated(sys%mass%pair_ptr)) deallocate (sys%mass%pair_ptr, sys%mass%pair_col, &
                                                 sys%mass%pair_row, sys%mass%pair_values)
 end subroutine system_set_kron_mass
