@@ -39,7 +39,7 @@ module carried_rotation
   use system_constraints, only: add_gradient_column, operand_count
   implicit none
   private
-  public :: carry_turn, carry_gradients, &
+  public :: carry_turn, carry_gradients, plane_turn_rows, &
             carry_plane_gradients
 
   !> the identity's share of the fitted correlation (relative to its Frobenius norm)
@@ -257,12 +257,7 @@ contains
         ! (back: the transposed turn of the pair's group, as carry_apply(.., back = .true., ..))
         g = sys%carry%plane_group(pairs(p))
         if (g /= current) then
-          r11 = turn(1, 1, g)
-          r12 = turn(2, 1, g)
-          r13 = turn(3, 1, g) * 0.0_dp
-          r21 = turn(1, 2, g)
-          r22 = turn(2, 2, g)
-          r23 = turn(3, 2, g) * 0.0_dp
+          call plane_turn_rows(transpose(turn(:, :, g)), r11, r12, r13, r21, r22, r23)
           current = g
         end if
         first = sys%carry%plane(1, pairs(p))
@@ -274,5 +269,19 @@ contains
       end do
     end do
   end subroutine carry_plane_gradients
+
+  !> The in-plane rows of a turn as carry_apply applies it to a plane vector (its third
+  !> column times the vector's zero third component kept, so the sums are carry_apply's;
+  !> the transposed turn gives carry_apply's back turn).
+  pure subroutine plane_turn_rows(turn, r11, r12, r13, r21, r22, r23)
+    real(dp), intent(in) :: turn(3, 3)
+    real(dp), intent(out) :: r11, r12, r13, r21, r22, r23
+    r11 = turn(1, 1)
+    r12 = turn(1, 2)
+    r13 = turn(1, 3) * 0.0_dp
+    r21 = turn(2, 1)
+    r22 = turn(2, 2)
+    r23 = turn(2, 3) * 0.0_dp
+  end subroutine plane_turn_rows
 
 end module carried_rotation

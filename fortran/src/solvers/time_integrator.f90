@@ -75,7 +75,8 @@ module time_integrator
   use kernel_errors, only: failure_text, message_length
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
-  use carried_rotation, only: carry_turn, carry_gradients, carry_plane_gradients
+  use carried_rotation, only: carry_turn, carry_gradients, carry_plane_gradients, &
+                              plane_turn_rows
   use system_carry, only: carry_enabled, carry_vectors, carry_apply
   implicit none
   private
@@ -1012,12 +1013,7 @@ contains
         do p = 1, size(pairs, 2)
           if (groups(p) /= current) then  ! (the turn of the pair's group)
             current = groups(p)
-            r11 = turn(1, 1, current)
-            r12 = turn(1, 2, current)
-            r13 = turn(1, 3, current) * 0.0_dp
-            r21 = turn(2, 1, current)
-            r22 = turn(2, 2, current)
-            r23 = turn(2, 3, current) * 0.0_dp
+            call plane_turn_rows(turn(:, :, current), r11, r12, r13, r21, r22, r23)
           end if
           first = pairs(1, p)
           second = pairs(2, p)
@@ -1032,12 +1028,7 @@ contains
       do p = 1, size(pairs, 2)
         if (groups(p) /= current) then  ! (the turn of the pair's group)
           current = groups(p)
-          r11 = turn(1, 1, current)
-          r12 = turn(1, 2, current)
-          r13 = turn(1, 3, current) * 0.0_dp
-          r21 = turn(2, 1, current)
-          r22 = turn(2, 2, current)
-          r23 = turn(2, 3, current) * 0.0_dp
+          call plane_turn_rows(turn(:, :, current), r11, r12, r13, r21, r22, r23)
         end if
         first = pairs(1, p)
         second = pairs(2, p)
@@ -1051,12 +1042,7 @@ contains
     do p = 1, size(pairs, 2)
       if (groups(p) /= current) then  ! (the turn of the pair's group)
         current = groups(p)
-        r11 = turn(1, 1, current)
-        r12 = turn(1, 2, current)
-        r13 = turn(1, 3, current) * 0.0_dp
-        r21 = turn(2, 1, current)
-        r22 = turn(2, 2, current)
-        r23 = turn(2, 3, current) * 0.0_dp
+        call plane_turn_rows(turn(:, :, current), r11, r12, r13, r21, r22, r23)
       end if
       first = pairs(1, p)
       second = pairs(2, p)
