@@ -235,6 +235,31 @@ contains
     end select
   end function constraint_gradient
 
+  !> The layout check of the row evaluators (constraint_gradients, constraint_values), once
+  !> for all rows: 1 when a term's coordinate lies outside 1..ncoord, else the first
+  !> constraint whose kind or drive index is invalid or that is a coordinate constraint
+  !> without a coordinate (as constraint_eval reports them), else 0.
+  pure integer function rows_layout_error(ncon, kinds, drives, ndrive, term_ptr, term_dof, &
+                                          ncoord) result(info)
+    integer, intent(in) :: ncon, kinds(:), drives(:), ndrive, term_ptr(:), term_dof(:), ncoord
+    integer :: c
+    info = 0
+    if (any(term_dof(1:term_ptr(6 * ncon + 1) - 1) < 1) .or. &
+        any(term_dof(1:term_ptr(6 * ncon + 1) - 1) > ncoord)) then
+      info = 1
+      return
+    end if
+    do c = 1, ncon
+      if (kinds(c) < constraint_kind_coordinate .or. kinds(c) > constraint_kind_dot .or. &
+          drives(c) < 0 .or. drives(c) > ndrive .or. &
+          (kinds(c) == constraint_kind_coordinate .and. &
+           term_ptr(6 * (c - 1) + 2) == term_ptr(6 * (c - 1) + 1))) then
+        info = c
+        return
+      end if
+    end do
+  end function rows_layout_error
+
   !> The operand gradients alone at nrow states (e_rows(:, row)): what constraint_eval
   !> returns as gradients, with the same arithmetic (operand_values, constraint_gradient),
   !> for the reactions of the output rows. The gradients depend on no drive, so none is
@@ -252,23 +277,8 @@ contains
     gradients = 0.0_dp
     info = 0
     if (ncon == 0) return
-    if (any(term_dof(1:term_ptr(6 * ncon + 1) - 1) < 1) .or. &
-        any(term_dof(1:term_ptr(6 * ncon + 1) - 1) > size(e_rows, 1))) then
-      info = 1
-      return
-    end if
-    do c = 1, ncon
-      if (kinds(c) < constraint_kind_coordinate .or. kinds(c) > constraint_kind_dot .or. &
-          drives(c) < 0 .or. drives(c) > ndrive) then
-        info = c
-        return
-      end if
-      if (kinds(c) == constraint_kind_coordinate .and. &
-          term_ptr(6 * (c - 1) + 2) == term_ptr(6 * (c - 1) + 1)) then
-        info = c  ! no coordinate in the first operand
-        return
-      end if
-    end do
+    info = rows_layout_error(ncon, kinds, drives, ndrive, term_ptr, term_dof, size(e_rows, 1))
+    if (info /= 0) return
     do row = 1, nrow
       do c = 1, ncon
         gradients(:, c, row) = constraint_gradient(kinds(c), params(:, c), operand_values( &
@@ -297,26 +307,9 @@ contains
     values = 0.0_dp
     info = 0
     if (ncon == 0) return
-    if (any(term_dof(1:term_ptr(6 * ncon + 1) - 1) < 1) .or. &
-        any(term_dof(1:term_ptr(6 * ncon + 1) - 1) > size(e_rows, 1))) then
-      info = 1
-      return
-    end if
-    do c = 1, ncon
-      if (kinds(c) < constraint_kind_coordinate .or. kinds(c) > constraint_kind_dot) then
-        info = c
-        return
-      end if
-      if (kinds(c) == constraint_kind_coordinate .and. &
-          term_ptr(6 * (c - 1) + 2) == term_ptr(6 * (c - 1) + 1)) then
-        info = c  ! no coordinate in the first operand
-        return
-      end if
-      if (drives(c) < 0 .or. drives(c) > size(drive_kinds)) then
-        info = c
-        return
-      end if
-    end do
+    info = rows_layout_error(ncon, kinds, drives, size(drive_kinds), term_ptr, term_dof, &
+                             size(e_rows, 1))
+    if (info /= 0) return
     do row = 1, nrow
       evaluated = .false.
       turned = .false.
