@@ -35,11 +35,11 @@
 module carried_rotation
   use ancf_kinds, only: dp
   use mechanical_system, only: system_model
-  use system_carry, only: carry_apply
+  use system_carry, only: carry_apply, plane_turn_rows
   use system_constraints, only: add_gradient_column, operand_count
   implicit none
   private
-  public :: carry_turn, carry_gradients, plane_turn_rows, &
+  public :: carry_turn, carry_gradients, &
             carry_plane_gradients
 
   !> the identity's share of the fitted correlation (relative to its Frobenius norm)
@@ -269,19 +269,5 @@ contains
       end do
     end do
   end subroutine carry_plane_gradients
-
-  !> The in-plane rows of a turn as carry_apply applies it to a plane vector (its third
-  !> column times the vector's zero third component kept, so the sums are carry_apply's;
-  !> the transposed turn gives carry_apply's back turn).
-  pure subroutine plane_turn_rows(turn, r11, r12, r13, r21, r22, r23)
-    real(dp), intent(in) :: turn(3, 3)
-    real(dp), intent(out) :: r11, r12, r13, r21, r22, r23
-    r11 = turn(1, 1)
-    r12 = turn(1, 2)
-    r13 = turn(1, 3) * 0.0_dp
-    r21 = turn(2, 1)
-    r22 = turn(2, 2)
-    r23 = turn(2, 3) * 0.0_dp
-  end subroutine plane_turn_rows
 
 end module carried_rotation

@@ -75,9 +75,8 @@ module time_integrator
   use kernel_errors, only: failure_text, message_length
   use acceleration_predictor, only: extrapolate, usable_predictor, learn_predictor
   use sparse_direct, only: solver_solve
-  use carried_rotation, only: carry_turn, carry_gradients, carry_plane_gradients, &
-                              plane_turn_rows
-  use system_carry, only: carry_enabled, carry_vectors, carry_apply
+  use carried_rotation, only: carry_turn, carry_gradients, carry_plane_gradients
+  use system_carry, only: carry_enabled, carry_vectors, carry_apply, plane_turn_rows
   implicit none
   private
   public :: integrator_chunk, output_row, step_failure_text, step_work, allocate_work

@@ -16,7 +16,8 @@ module system_carry
   use system_reduction, only: coordinate_reduction
   implicit none
   private
-  public :: carried_vectors, carry_setup, carry_enabled, carry_vectors, carry_apply
+  public :: carried_vectors, carry_setup, carry_enabled, carry_vectors, carry_apply, &
+            plane_turn_rows
 
   type :: carried_vectors
     ! the first full dof of each carried 3-vector, its weight and whether it is a position;
@@ -231,12 +232,7 @@ contains
         if (g /= current) then
           rotation = turn(:, :, g)
           if (back) rotation = transpose(turn(:, :, g))
-          r11 = rotation(1, 1)
-          r12 = rotation(1, 2)
-          r13 = rotation(1, 3) * 0.0_dp
-          r21 = rotation(2, 1)
-          r22 = rotation(2, 2)
-          r23 = rotation(2, 3) * 0.0_dp
+          call plane_turn_rows(rotation, r11, r12, r13, r21, r22, r23)
           current = g
         end if
         first = carry%plane(1, b)
@@ -279,5 +275,19 @@ contains
       end do
     end do
   end subroutine carry_apply
+
+  !> The in-plane rows of a turn as carry_apply applies them to a plane vector (its third
+  !> column times the vector's zero third component kept, so the sums are carry_apply's;
+  !> the transposed turn gives carry_apply's back turn).
+  pure subroutine plane_turn_rows(turn, r11, r12, r13, r21, r22, r23)
+    real(dp), intent(in) :: turn(3, 3)
+    real(dp), intent(out) :: r11, r12, r13, r21, r22, r23
+    r11 = turn(1, 1)
+    r12 = turn(1, 2)
+    r13 = turn(1, 3) * 0.0_dp
+    r21 = turn(2, 1)
+    r22 = turn(2, 2)
+    r23 = turn(2, 3) * 0.0_dp
+  end subroutine plane_turn_rows
 
 end module system_carry
