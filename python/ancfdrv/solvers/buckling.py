@@ -336,7 +336,12 @@ def negative_eigenvalues(model: Model, e: np.ndarray, lam: np.ndarray, factor: f
     constraints' null space (the stability index; exact for models up to the modal
     DENSE_LIMIT free coordinates; else among the lowest eight)."""
     lin = linearize(model, e, lam, load_factor=factor)
-    k, g = lin.stiffness, lin.constraints
+    return stability_index(model, lin.stiffness, lin.constraints)
+
+
+def stability_index(model: Model, k: sp.spmatrix, g: sp.spmatrix) -> int:
+    """:func:`negative_eigenvalues` of a tangent ``k`` and constraints' Jacobian ``g``
+    already linearized."""
     free = model.ndof - g.shape[0]
     if free <= MODAL_DENSE_LIMIT:
         basis = null_space(g, model.ndof)
@@ -651,7 +656,7 @@ def _check_linear(path: "LoadPath", factor: float, kg: sp.spmatrix, g: sp.spmatr
     crane's jib folding on its compliant cylinder) the stability limit lies elsewhere
     (docs/theory.md section 23), above P or below it. The check loads the static path to
     P_t = 1 + CONFIRM_AT (P - 1) and counts the negative eigenvalues of the tangent there
-    (:func:`negative_eigenvalues`): a path that carries P_t stably has no stability
+    (:func:`stability_index`): a path that carries P_t stably has no stability
     limit below P_t, so P is at most 2 % above the model's limit and is reported; a path
     that cannot be followed to P_t (a limit point below it: Lee's frame loaded near its
     snap-through) or is unstable there (a bifurcation passed) is refused, naming 'nonlinear'
@@ -677,13 +682,13 @@ def _check_linear(path: "LoadPath", factor: float, kg: sp.spmatrix, g: sp.spmatr
         raise SolverError(
             f"buckling: the 'linear' estimate {factor:.6g} is refused: the static path ends "
             f"at {path.factor:.6g} times the loads, below {target:.6g}; {advice}")
-    unstable = negative_eigenvalues(path.model, path.e, path.lam, path.factor)
+    k_t, g_t = path.matrices()
+    unstable = stability_index(path.model, k_t, g_t)
     if unstable:
         raise SolverError(
             f"buckling: the 'linear' estimate {factor:.6g} is refused: the static state at "
             f"{path.factor:.6g} times the loads is unstable ({unstable} negative "
             f"eigenvalue(s) of its tangent); {advice}")
-    k_t, g_t = path.matrices()
     theta, _ = _pencil(_follow_basis(basis, g, g_t), k_t, kg, g_t, 1, eigen_tol)
     theta = theta[theta > 1e-12 * max(np.abs(theta).max(initial=0.0), 1e-300)]
     again = path.factor + 1.0 / theta.max() if len(theta) else np.inf
