@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataclasses import dataclass
-
+from .records import record
 from . import _kernel
 from .codes import (CONTACT_RECORD, DRIVE_HERMITE, DRIVE_TABLE, ENERGY_NAMES, KERNEL_LAYOUTS,
                     POWER_NAMES, SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE)
@@ -61,7 +60,7 @@ def constraint_arrays(kinds, drives, params, operand_const, term_ptr, term_dof, 
     return _f(ints, np.int32), _f(reals if reals.size else np.zeros(1))
 
 
-@dataclass(frozen=True, eq=False, repr=False)
+@record(frozen=True, eq=False, repr=False)
 class SectionData:
     """A beam cross-section as the kernel integrates it (beam_section.f90): the quadrature
     points (y along the section height, z along its width) with area weights, and the

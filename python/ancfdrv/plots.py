@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import textwrap
 
-from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
@@ -15,6 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .records import record
 from .codes import mesh_parts  # noqa: E402
 from .io.safe_write import save_figure  # noqa: E402
 from .sweep_keys import is_resolution, row_response, static_value  # noqa: E402
@@ -361,7 +361,7 @@ def plot_results(h5_paths: list[str | Path], png: str | Path | None = None) -> P
     return plot_spring(paths, png)
 
 
-@dataclass
+@record
 class SpringRun:
     """What the leaf spring plots read from one result file."""
 

@@ -22,12 +22,13 @@ writer calls and replays them into a file when asked): :func:`ancfdrv.simulate`.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
+from .records import record
 from .errors import AncfError, InputError, Interrupted, SolverError, UnstableError
 from .io.safe_write import disk_full
 from .history import stage_summary
@@ -58,7 +59,7 @@ def _io(out: "Path | MemoryOutput") -> Any:
     return results if isinstance(out, Path) else out
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class RunOutcome:
     """What a run produced: the output file (or the
     :class:`~ancfdrv.results.memory.MemoryOutput` of a run kept in memory) and the results

@@ -25,7 +25,6 @@ import re
 import sys
 import uuid
 from collections import Counter
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +32,7 @@ import h5py
 import numpy as np
 from tqdm import tqdm
 
+from .records import record
 from .errors import InputError
 from .results.lock import OutputLock
 from .io.safe_write import replace_atomically, write_bytes, write_text
@@ -414,7 +414,7 @@ ANALYSIS_FAMILY = {"static": "static", "dynamic": "dynamic", "static+dynamic": "
                    "modal": "modal", "buckling": "buckling"}
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Reference:
     """A result file every case of a sweep is compared with (``--reference``), read and
     checked before the first case runs (:func:`load_reference`)."""

@@ -30,11 +30,11 @@ import threading
 import time
 import traceback
 from collections import deque
-from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Any, Callable
 
+from .records import record
 from .errors import AncfError, InputError, Interrupted
 
 #: Seconds a Dask client waits for the scheduler before the sweep gives up (exit 2).
@@ -44,7 +44,7 @@ CONNECT_TIMEOUT_S = 5.0
 INTERRUPTED_EXIT = 130
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Case:
     """One combination of a sweep."""
 

@@ -2,16 +2,17 @@
 loads of the beam templates."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError
 from ..system import Beam, System
 from ..system.sections import Rectangle
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class BuiltSystem:
     """A system, the probe and component sweeps compare, and the builder's warnings."""
 

@@ -18,8 +18,9 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any, Callable
+from ..records import record
 
 __all__ = ["ExpressionError", "FUNCTIONS", "POINT_KEYS", "Definitions", "evaluate"]
 
@@ -223,7 +224,7 @@ def _written(value: Any) -> str:
     return ", ".join(repr(x) if isinstance(x, str) else str(x) for x in items)
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class Definitions:
     """A scene's parameters and named points, and a record of every key whose value used
     them (what the result file stores)."""

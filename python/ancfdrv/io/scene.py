@@ -14,13 +14,14 @@ import os
 import re
 import stat
 from collections import Counter, OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import partial
 from pathlib import Path
 from typing import Any, Callable
 
 import f90nml
 
+from ..records import record
 from .. import _lazy
 from ..errors import InputError
 from . import validate
@@ -33,7 +34,7 @@ __all__ = ["Scene", "load_scene", "parse_address", "is_general", "SCHEMA", "GENE
            "EFFECTS_AVAILABLE", "MODEL_GROUPS", "PLATE_KINDS"]
 
 
-@dataclass
+@record
 class Scene:
     """A validated scene: typed values per group, the source path and namelist text."""
 

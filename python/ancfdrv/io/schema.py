@@ -10,9 +10,9 @@ one call of the System API, :mod:`ancfdrv.builders.general`) with ``&scene``, ``
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, Callable
 
+from ..records import record
 from ..errors import InputError
 from .validate import INT32_MAX, MAX_MAGNITUDE, check_int32, check_magnitude, check_name
 
@@ -55,7 +55,7 @@ EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_
 EFFECTS_PLANNED: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Key:
     """One namelist key: its type, default (or REQUIRED), check and meaning."""
 

@@ -45,10 +45,11 @@ from __future__ import annotations
 import math
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any, Iterable
 
+from ..records import record
 from ..errors import InputError
 
 #: the kernel's integers are 32-bit (f2py passes Python ints as C int)
@@ -81,7 +82,7 @@ MEMORY_FRACTION = 0.5
 
 # -- 1. repeated groups and keys ---------------------------------------------------------
 
-@dataclass(eq=False)
+@record(eq=False)
 class KeyText:
     """One ``key = `` of a group in the text."""
 
@@ -90,7 +91,7 @@ class KeyText:
     line: int
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class GroupText:
     """One ``&group ... /`` of the text: its keys in order and the value of its ``name``."""
 
@@ -408,7 +409,7 @@ def check_time(solver: dict[str, Any], analysis: str, file: str) -> None:
 
 # -- 5. size -------------------------------------------------------------------------------
 
-@dataclass(eq=False)
+@record(eq=False)
 class Part:
     """A part of the model for the estimate: where it is given and its size."""
 
@@ -422,7 +423,7 @@ class Part:
     sections: bool = False
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class Estimate:
     """The size of a model before it is built."""
 

@@ -27,10 +27,10 @@ Units are SI throughout (m, kg, s, N, Pa).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from ..records import record
 
 __all__ = [
     "BoomSolution",
@@ -74,7 +74,7 @@ _NCONST = 6  # constants per segment
 _FIELDS = ("u", "v", "slope", "theta", "N", "M", "Q")
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class _BoomParams:
     EA: float
     EI: float
@@ -117,7 +117,7 @@ def _field_row(name: str, x: float, p: _BoomParams) -> tuple[FloatArray, float]:
     return row, part
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class BoomSolution:
     """Exact linear static solution of the boom, in the frame rotated by the boom angle.
 

@@ -21,9 +21,9 @@ import os
 import shlex
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
+from ..records import record
 from ..errors import InputError
 
 #: how long a writer retries a busy lock before giving up: long enough to ride out a
@@ -31,7 +31,7 @@ from ..errors import InputError
 _RETRY_SECONDS = 0.3
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class LockHolder:
     """Who holds (or held) the lock of a result file."""
 

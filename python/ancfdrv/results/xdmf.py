@@ -58,13 +58,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
 import numpy as np
 from h5py import h5a, h5d, h5p, h5s, h5t
 
+from ..records import record
 from ..csr import Csr
 from ..errors import InputError
 from ..io.safe_write import replace_atomically, write_text
@@ -78,7 +78,7 @@ INLINE_VALUES = 30_000
 _QUAD, _LINE = 5, 2
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class MeshLayout:
     """The points and cells XDMF shows for a model, and the affine map from full
     coordinates to the points' positions."""
@@ -338,7 +338,7 @@ def _topology_of(h5: h5py.File) -> tuple[str, tuple[int, ...], str, int, int]:
     return "Quadrilateral", shape, "/model/elements", shape[0], len(h5["model/nodes"])
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class Series:
     """What the XDMF description of a dynamic run names: its frames (output rows and
     times), its mesh and which per-point series the file holds."""

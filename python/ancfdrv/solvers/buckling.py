@@ -45,10 +45,11 @@ below 1 belongs to unloading, e.g. a pendulum that loses its gravity stiffness);
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
 from .. import kernel
@@ -75,7 +76,7 @@ DENSE_LIMIT = 600
 ZERO_STIFFNESS = 1e-11
 
 
-@dataclass
+@record
 class BucklingResult:
     """The lowest positive load factors and their mode shapes (plain record; HDF5:
     /buckling). ``shapes`` (N, ndof) in the solver coordinates, scaled to a largest
@@ -421,7 +422,7 @@ MAX_CUTS = 12
 MAX_LOCATE = 40
 
 
-@dataclass
+@record
 class _Point:
     """A converged point of the 'nonlinear' path: its state, the lowest omega^2 of its
     tangent on the constraints' null space and their vectors (columns), and the increment

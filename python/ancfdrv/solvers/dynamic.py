@@ -37,11 +37,12 @@ from __future__ import annotations
 import functools
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Callable
 
 import numpy as np
 
+from ..records import record
 from ..codes import (CONTACT_COUNTERS, CONTACT_RECORD, ENERGY_NAMES, JACOBIAN_ITERATION,
                      JACOBIAN_REUSE, JACOBIAN_STEP, KERNEL_LAYOUTS, STAT_NAMES)
 from ..errors import InputError, Interrupted, SolverError, UnstableError
@@ -56,7 +57,7 @@ JACOBIAN_POLICIES = {"step": JACOBIAN_STEP, "iteration": JACOBIAN_ITERATION,
                      "reuse": JACOBIAN_REUSE}
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class DynamicSettings:
     """Integrator settings (``&solver`` and ``&output`` of a scene). Newmark is
     alpha_m = alpha_f = 0; :meth:`generalized_alpha` sets all four from rho_inf.
@@ -135,7 +136,7 @@ class DynamicSettings:
         return JACOBIAN_POLICIES[self.jacobian]
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class Chunk:
     """Outputs of consecutive steps (one row per step)."""
 
@@ -168,7 +169,7 @@ class Chunk:
         return self.stats[:, 0]
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class DynamicResult:
     """Statistics of a completed run."""
 

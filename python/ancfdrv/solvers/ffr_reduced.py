@@ -37,10 +37,11 @@ R = C eta + T(eta, eta), C = sum c d^T, T_ijk = sum B_ij d_k (constant). Newmark
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from .. import kernel
 from ..codes import KERNEL_LAYOUTS
 from ..errors import SolverError
@@ -54,7 +55,7 @@ from .._lazy import LazyModule
 la = LazyModule("scipy.linalg")
 
 
-@dataclass
+@record
 class ReducedFFR:
     """Constant reduced matrices of an FFR model in one prescribed frame (module doc)."""
 

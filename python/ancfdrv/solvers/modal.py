@@ -37,10 +37,11 @@ from __future__ import annotations
 import inspect
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError, SolverError
 from ..io.schema import check_keywords
 from ..kernel import DirectSolver
@@ -58,7 +59,7 @@ spla = LazyModule("scipy.sparse.linalg")
 DENSE_LIMIT = 150
 
 
-@dataclass
+@record
 class Linearization:
     """The matrices of the linearized equations at a state (coordinates e of the solvers)."""
 
@@ -69,7 +70,7 @@ class Linearization:
     asymmetry: float = 0.0        # |K - K^T|_max / |K|_max before symmetrizing
 
 
-@dataclass
+@record
 class ModalResult:
     """The lowest modes of a linearized model (plain record; HDF5: /modal).
 

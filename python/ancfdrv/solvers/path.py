@@ -52,10 +52,11 @@ toward zero, or a negative eigenvalue appears) from other failures and says so, 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError, SolverError
 from ..system.model import Model
 from .._lazy import LazyModule
@@ -74,7 +75,7 @@ DESIRED_ITERATIONS = 5
 MAX_CUTS = 12
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class StaticPath:
     """The converged points of an arc-length path (HDF5: /static/path). ``displacement``
     (npoints, 3): the control probe's displacement from the assembled configuration
@@ -311,7 +312,7 @@ def _marks(factors: np.ndarray, counts: np.ndarray, lengths: np.ndarray):
 CONFIRM_CUTS = 3
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class _Point:
     """The path's next point (or why there is none: ``message``)."""
     e: np.ndarray | None = None

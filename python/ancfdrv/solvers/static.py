@@ -24,10 +24,11 @@ Two solvers share one convergence test (:func:`residuals`):
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError, SolverError
 from ..io.validate import check_arguments
 from ..kernel import DirectSolver
@@ -35,7 +36,7 @@ from ..system.model import Model
 from .assumptions import check_ffr
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class StaticResult:
     """Equilibrium state and solver statistics."""
 

@@ -51,11 +51,11 @@ Stresses
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
 
+from ..records import record
 from .. import kernel
 from ..codes import CONSTRAINT_COORDINATE
 from ..csr import sorted_unique
@@ -78,7 +78,7 @@ spla = LazyModule("scipy.sparse.linalg")
 DEFAULT_STATIONS = 3
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class Reaction:
     """What body1 exerts on body2 at a joint (global axes, N and N m about ``point``)."""
 
@@ -88,7 +88,7 @@ class Reaction:
     axial: float | None = None   # distance joints: tension positive (N)
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class SectionForces:
     """Section forces along a beam: arc length s (m), N, T, Q (ns, 2) and M (ns, 2)
     (components along the section's height and width axes); N, N m."""
@@ -100,7 +100,7 @@ class SectionForces:
     M: np.ndarray
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class Stress:
     """Stresses at the outer fibres along a beam (Pa): the signed normal stress of largest
     magnitude and the largest von Mises stress per station."""
@@ -912,7 +912,7 @@ def stresses(model: Model, forces: dict[str, SectionForces]) -> dict[str, Stress
     return {name: beam_stress(beams[name].section, f) for name, f in forces.items()}
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class Answers:
     """Everything SPEC section 10 asks of one state, by name."""
 

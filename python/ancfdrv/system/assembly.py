@@ -7,11 +7,11 @@ holds it all (SPEC section 9: System -> Assembly -> Solver).
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
 from typing import Iterable
 
 import numpy as np
 
+from ..records import record
 from .. import kernel
 from ..codes import (CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE,
                      CONTACT_COUNTERS, POLICY_CONSTANT, POLICY_REFACTOR)
@@ -41,7 +41,7 @@ EFFECTS_AVAILABLE = ("gravity", "tip_mass", "bending_moment", "tip_force", "end_
 LINEAR_JOINTS = ("auto", "eliminate", "multipliers")
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class _Active:
     """The items of the listed effects."""
 

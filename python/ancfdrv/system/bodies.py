@@ -15,10 +15,10 @@ body coordinates u is at r + J u; J = I at t = 0, the body axes are the global a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError
 from ..io import validate
 from .expressions import Vec3
@@ -113,7 +113,7 @@ def rotation_about(axis, angle: float) -> np.ndarray:
     return np.eye(3) + np.sin(angle) * skew + (1.0 - np.cos(angle)) * skew @ skew
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Material:
     """Isotropic elastic material, with optional Kelvin-Voigt damping: the stress is
     D (strain + damping_time * strain rate) for every strain the elements use (applied only
@@ -138,7 +138,7 @@ class Material:
                              "be a finite number >= 0 (s)")
 
 
-@dataclass
+@record
 class Attachment:
     """Where a joint, load or probe acts on a body: a node (flexible bodies) and/or the
     material point's element and local coordinates."""

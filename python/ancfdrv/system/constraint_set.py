@@ -8,16 +8,17 @@ them to the coordinates for the static solvers.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..csr import sorted_unique
 from ..errors import InputError
 from ..kernel import _kernel, _state, constraint_arrays
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class ConstraintSet:
     """Constraints in the kernel's layout; ``dependent`` holds per constraint the coordinate
     the split iteration treats as dependent (the set N1 of seed 000, eq. 40)."""
@@ -200,7 +201,7 @@ class ConstraintSet:
         return matrix, np.asarray(self.operand_const[c])
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class ConstraintLayout:
     """The arrays system_set_constraints takes (0-based indices)."""
 

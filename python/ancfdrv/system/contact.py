@@ -7,15 +7,15 @@ effect 'friction' (mu = 0 or the effect off: frictionless).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError
 from .bodies import Body
 
 
-@dataclass
+@record
 class ContactPair:
     name: str
     body1: Body             # the searched (upper) surface (a plate or leaf)

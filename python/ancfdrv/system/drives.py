@@ -21,11 +21,11 @@ scale loads.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..records import record
 from .. import kernel
 from ..codes import DRIVE_CONSTANT, DRIVE_CYCLE, DRIVE_LUFFING, DRIVE_SINE, DRIVE_SPINUP, DRIVE_TABLE
 from ..codes import DRIVE_HERMITE, DRIVE_RAMP
@@ -56,7 +56,7 @@ class Drive:
             raise InputError(f"drive {self.name!r}: {exc}") from None
 
 
-@dataclass
+@record
 class Constant(Drive):
     name: str
     value_: float = 0.0
@@ -66,7 +66,7 @@ class Constant(Drive):
         return [float(self.value_)]
 
 
-@dataclass
+@record
 class Luffing(Drive):
     """SPEC section 5: rate omega (rad/s, sign gives the direction), smooth start over
     t_start, braking over t_brake, total ``sweep`` (rad) from the angle ``start``."""
@@ -93,7 +93,7 @@ class Luffing(Drive):
         super().check()
 
 
-@dataclass
+@record
 class SpinUp(Drive):
     """phi = (W/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)) for t < T, W t - W T/2 after,
     plus ``start``."""
@@ -108,7 +108,7 @@ class SpinUp(Drive):
         return [self.omega, self.period, self.start]
 
 
-@dataclass
+@record
 class Cycle(Drive):
     """amplitude (1 - cos(2 pi (t - t0)/period))/2 on [t0, t0 + period], 0 outside."""
 
@@ -122,7 +122,7 @@ class Cycle(Drive):
         return [self.amplitude, self.period, self.t0]
 
 
-@dataclass
+@record
 class Sine(Drive):
     """offset + amplitude r(t) sin(2 pi frequency (t - t0) + phase), r rising smoothly from 0
     to 1 over ``ramp`` seconds (0: at once)."""
@@ -197,7 +197,7 @@ def pchip_slopes(t: np.ndarray, v: np.ndarray) -> np.ndarray:
     return slopes
 
 
-@dataclass
+@record
 class Table(Drive):
     """Through (times, values), times strictly increasing, constant outside;
     ``interpolation`` 'linear' (default), 'cubic' (C2 spline, zero end slopes) or 'pchip'
@@ -290,7 +290,7 @@ def _is_number(text: str) -> bool:
     return True
 
 
-@dataclass
+@record
 class Ramp(Drive):
     """From ``start`` (held until ``t0``) the rate rises smoothly to ``rate`` (units/s)
     over ``t_ramp`` seconds, then stays: phi = start + (rate/T) (tau^2/2 + (T/(2 pi))^2

@@ -8,12 +8,13 @@ point: its shape functions; a rigid body's point r + J u: 1, u_1, u_2, u_3). A
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
+from ..records import record
 
 
-@dataclass
+@record
 class Scalar:
     """c + sum a_k q[d_k] (terms: {dof: coefficient})."""
 
@@ -36,7 +37,7 @@ class Scalar:
         return self.const + sum(c * q[d] for d, c in self.terms.items())
 
 
-@dataclass
+@record
 class Vec3:
     """c + sum a_k q[d_k : d_k + 3] (terms: {first dof of a 3-vector: coefficient})."""
 

@@ -52,10 +52,11 @@ its mid-surface).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..codes import CONSTRAINT_COORDINATE, CONSTRAINT_CROSS, CONSTRAINT_DISTANCE, CONSTRAINT_DOT
 from ..errors import InputError
 from .bodies import Attachment, Body, Ground, rotation_about
@@ -70,7 +71,7 @@ JOINT_TYPES = ("weld", "revolute", "spherical", "distance", "prescribed", "fix",
 EDGES = ("x0", "x1", "y0", "y1")
 
 
-@dataclass
+@record
 class LinearEquation:
     """expr(q) = 0, time-independent; ``prefer``: full coordinates to make dependent when it
     is eliminated, best first."""
@@ -80,7 +81,7 @@ class LinearEquation:
     prefer: list[int] = field(default_factory=list)
 
 
-@dataclass
+@record
 class Constraint:
     """A constraint of the kernel's kinds (constraints.f90) over six scalar operands affine
     in q; ``prefer``: the coordinate the split iteration should take as dependent."""
@@ -143,7 +144,7 @@ def _rotation_terms(v: np.ndarray, axis: np.ndarray, pivot: np.ndarray) -> np.nd
     return np.column_stack([pivot + along, v - along, np.cross(k, v), np.zeros(3)])
 
 
-@dataclass
+@record
 class Joint:
     """A joint; see the module documentation for the types and their keys."""
 

@@ -15,10 +15,10 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError
 from .bodies import Body
 from .drives import Drive
@@ -44,7 +44,7 @@ class Load:
     effect: str
 
 
-@dataclass
+@record
 class Gravity(Load):
     name: str
     vector: np.ndarray
@@ -54,7 +54,7 @@ class Gravity(Load):
         self.vector = _vector(self.vector, f"load {self.name!r}: vector")
 
 
-@dataclass
+@record
 class PointForce(Load):
     name: str
     body: Body
@@ -71,7 +71,7 @@ class PointForce(Load):
         self.follower = _flag(self.follower, f"load {self.name!r}: follower")
 
 
-@dataclass
+@record
 class DeadMoment(Load):
     """A moment (vector: axis times magnitude, N m) on the section at a material point:
     without drive nor follower the constant moment of seed 000 (its rotation measured about
@@ -96,7 +96,7 @@ class DeadMoment(Load):
                              "the axis)")
 
 
-@dataclass
+@record
 class PointMass(Load):
     name: str
     body: Body
@@ -110,7 +110,7 @@ class PointMass(Load):
             raise InputError(f"load {self.name!r}: mass {self.mass!r} must not be negative")
 
 
-@dataclass
+@record
 class Pressure(Load):
     name: str
     body: Body

@@ -8,16 +8,17 @@ which keeps the band of the iteration matrix narrow.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..errors import InputError
 
 PLATE_NODE_DOFS = 9
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class PlateMesh:
     """Nodes (initial configuration), connectivity, element sizes and named node sets.
 

@@ -9,10 +9,11 @@ kernel; the constraints are a :class:`~.constraint_set.ConstraintSet`.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from .. import kernel
 from ..codes import POLICY_CONSTANT, POLICY_REFACTOR
 from ..csr import Csr, sorted_unique, unique_keys
@@ -24,7 +25,7 @@ from .registry import add_to_kernel
 from .patterns import Pattern, Reduction
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class FrameInfo:
     """A beam's frame: A(t) = Rot(axis, phi(t)) base about pivot (drive -1: A = base)."""
 
@@ -40,7 +41,7 @@ class FrameInfo:
         return rotation_about(self.axis, self.drive_obj.value(t)) @ self.base
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class SetInfo:
     """An element set as assembled (one per flexible body)."""
 
@@ -73,7 +74,7 @@ class SetInfo:
     index: int = 0
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class MomentInfo:
     """A dead moment on the nodal director q[dofs] (full coordinates)."""
 
@@ -91,7 +92,7 @@ class MomentInfo:
 VLOAD_DEAD_MOMENT, VLOAD_FOLLOWER_MOMENT, VLOAD_FOLLOWER_FORCE = 1, 2, 3
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class VectorLoadInfo:
     """A driven or follower point load (kernel module vector_loads): kind, 0-based drive
     (-1: none), vector (a dead moment's global vector, or a follower's components on the
@@ -109,7 +110,7 @@ class VectorLoadInfo:
     fixed: bool = False
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class ProbeInfo:
     """p = sum coef q[first:first+3]; deflection A_f(t)^T (p - pivot) - reference."""
 

@@ -14,10 +14,11 @@ from __future__ import annotations
 
 import math
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..csr import Csr
 from ..errors import InputError
 from .expressions import Scalar
@@ -118,7 +119,7 @@ class Pattern:
         return int(np.abs(self.rows - self.col_index).max(initial=0))
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class Reduction:
     """q = B e + q0 and the plan of B^T S B (source: full-pattern positions, target: reduced
     pattern positions, coefficient)."""
@@ -188,7 +189,7 @@ class Reduction:
         return self.matrix.rmatvec(full)
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class Elimination:
     """The outcome of :func:`eliminate`: relations q_d = c + sum a_j q_j over independent
     coordinates, the dropped (redundant) equations' names."""

@@ -1,14 +1,14 @@
 """Probes: named material points whose positions (and deflections) are recorded."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record
 from .bodies import Body
 
 
-@dataclass
+@record
 class Probe:
     """A material point of a body (any point of a rigid body, a point of a beam's volume or
     of a plate's mid-surface). Beams resolve its deflection in their frame, other bodies in

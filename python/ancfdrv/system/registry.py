@@ -49,16 +49,17 @@ plus one Python module in :mod:`.kinds`.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any, Callable
 
+from ..records import record
 from ..io.schema import Key, check_call, register_group
 
 __all__ = ["Kind", "SetContext", "register", "kinds", "kind", "kind_of", "checked_values",
            "set_builder", "add_to_kernel", "reports_sections", "axial_forces"]
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class SetContext:
     """What a set builder may need besides its body: the body's floating frame (FrameInfo,
     or None) and its 1-based id (0: none), the active effects, the counters and warnings."""
@@ -70,7 +71,7 @@ class SetContext:
     warnings: list[str] = field(default_factory=list)
 
 
-@dataclass(frozen=True, eq=False)
+@record(frozen=True, eq=False)
 class Kind:
     """One kind of item (see the module documentation)."""
 

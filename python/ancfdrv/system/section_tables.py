@@ -44,7 +44,7 @@ from __future__ import annotations
 import difflib
 import math
 import re
-from dataclasses import dataclass
+from ..records import record
 
 #: density of the standards' tabulated masses (kg/m^3)
 STEEL_DENSITY = 7850.0
@@ -121,7 +121,7 @@ SOURCES = {"IPE": "EN 10365:2017", "HEA": "EN 10365:2017", "HEB": "EN 10365:2017
            "RHS": "EN 10219-2:2006", "SHS": "EN 10219-2:2006", "CHS": "EN 10219-2:2006"}
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class StandardProperties:
     """A standard section's properties (SI: m, m^2, m^4, kg/m). ``major`` bends about the
     axis across the web (EN's y-y), ``minor`` about the web's own axis (EN's z-z);

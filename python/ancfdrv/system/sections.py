@@ -20,11 +20,11 @@ Cowper 1966, which depend on Poisson's ratio) and
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
+from ..records import record
 from .. import kernel
 from ..codes import SECTION_BOX, SECTION_CIRCLE, SECTION_RECTANGLE, SECTION_TUBE
 from ..errors import InputError
@@ -160,7 +160,7 @@ class Section:
         return self.data, density
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Rectangle(Section):
     """Solid rectangle: width along r_z, height along r_y (m)."""
 
@@ -190,7 +190,7 @@ class Rectangle(Section):
         return np.array([[hy, hz], [-hy, hz], [-hy, -hz], [hy, -hz]])
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Box(Section):
     """Hollow rectangle (box girder): outer width and height, wall thickness (m)."""
 
@@ -222,7 +222,7 @@ class Box(Section):
         return np.array([[hy, hz], [-hy, hz], [-hy, -hz], [hy, -hz]])
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Tube(Section):
     """Circular tube: outer diameter and wall thickness (m)."""
 
@@ -253,7 +253,7 @@ class Tube(Section):
         return _circle_points(0.5 * self.diameter)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Circle(Section):
     """Solid circle: diameter (m)."""
 

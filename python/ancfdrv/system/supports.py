@@ -19,10 +19,10 @@ motion. Probes on beams without joints, rigid bodies, plates and leaves get none
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record
 from .bodies import Attachment
 from .kinds import Beam
 from .expressions import Vec3
@@ -41,7 +41,7 @@ DISPLACEMENT_REFERENCE = (
     "axes for other bodies; includes the mechanism's rigid motion")
 
 
-@dataclass(eq=False)
+@record(eq=False)
 class SupportFrame:
     """The support frame of one beam (see the module documentation)."""
 

@@ -47,10 +47,11 @@ before.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ...records import record
 from ... import kernel
 from ...errors import InputError
 from ...io.schema import Key, name_key, non_negative, one_of, positive, short_repr, vector3
@@ -86,7 +87,7 @@ FORCE_ELEMENT_MEANING = {
 }
 
 
-@dataclass
+@record
 class ForceElement:
     """A force element as the user gave it (see the module documentation); vector
     parameters of a bushing have 3 entries, the others 1."""
@@ -112,7 +113,7 @@ class ForceElement:
         return FORCE_ELEMENT_KINDS[self.type]
 
 
-@dataclass(eq=False, repr=False)
+@record(eq=False, repr=False)
 class ForceElementInfo:
     """A force element as assembled: kernel kind, 0-based drive (-1: none), parameters,
     table (kind 0: none), and its slots (Vec3 on the full coordinates)."""
