@@ -265,3 +265,31 @@ def test_dynamic_result_strained_beyond_the_limit_warns_with_its_time(tmp_path, 
     for text in (warnings, err):
         assert f"dynamic result implausible: beam 'beam' is strained by {strain:.3g}" in text
         assert f"at t = {when:.6g} s" in text
+
+
+def test_a_swinging_double_pendulum_is_not_flagged(tmp_path, capsys):
+    """Issue 39: the hard double pendulum (two hinged 1 m beams, 'nonlinear', no drive)
+    swings its tip 3.7 m in 1 s, farther than the model's size (2 m) as any pendulum may:
+    its beams' frames are constant, so the deflection is the whole motion, not the elastic
+    part the check reads (plausibility.moving_frame); no warning."""
+    out = tmp_path / "double.h5"
+    code = main(["run", str(INPUTS / "hard" / "double_pendulum.nml"), "-o", str(out),
+                 "--set", "solver.t_end=1.0", "--set", "solver.dt=1e-3"])
+    assert code == 0
+    assert "implausible" not in capsys.readouterr().err
+    with h5py.File(out) as h5:
+        moved = np.abs(h5["dynamic/deflection/tip"][()]).max()
+        assert "implausible" not in h5.attrs["warnings"]
+    assert moved > 2.0 * 1.5      # beyond the 2 m model: the check would have fired
+
+
+def test_moving_frame_is_a_driven_beam_frame():
+    """The boom's beam turns with its luffing drive (checked); the double pendulum's
+    beams keep their frames (not checked)."""
+    from ancfdrv.builders import build_model
+    from ancfdrv.io.scene import load_scene
+    from ancfdrv.results.plausibility import moving_frame
+    boom = build_model(load_scene(INPUTS / "boom_luffing.nml"))
+    assert all(moving_frame(boom, p.frame) for p in boom.probes.values())
+    double = build_model(load_scene(INPUTS / "hard" / "double_pendulum.nml"))
+    assert not any(moving_frame(double, p.frame) for p in double.probes.values())

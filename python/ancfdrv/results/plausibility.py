@@ -15,8 +15,8 @@ result can:
   - a probe displaced by more than the structure's size (:func:`structure_size`: the
     diagonal of the bounding box of the undeformed model). Static results: every probe;
     dynamic results: the probes whose deflection is measured in a beam's moving frame
-    (the elastic part of the motion), as a pendulum or a dropped body legitimately moves
-    farther than its size.
+    (the elastic part of the motion: a frame with a drive, :func:`moving_frame`), as a
+    pendulum or a dropped body legitimately moves farther than its size.
 
 * **Failures** (:class:`~ancfdrv.errors.SolverError`, exit 3, status 'failed', the rows
   kept), whatever ``scene.bounds`` says: a result that is not finite, or a displacement
@@ -139,6 +139,16 @@ def check_static(model: "Model", e: np.ndarray, stress: dict, *, warn: bool) -> 
     return out
 
 
+def moving_frame(model: "Model", frame: int) -> bool:
+    """Whether a probe's deflection (frame: its 1-based frame, 0 none) is resolved in a
+    frame that turns with its body (a beam frame with a drive: the FFR frame, a luffing
+    boom's), so that it is the elastic part of the motion. A beam's constant frame (no
+    drive: a free, hinged or clamped 'nonlinear' beam) resolves its whole motion, which a
+    pendulum legitimately carries farther than its size (issue 39: the double pendulum's
+    tip, 3.66 m on a 2 m model, was flagged as a unit slip)."""
+    return frame != 0 and model.frames[frame - 1].drive >= 0
+
+
 def check_dynamic(model: "Model", deflection: dict[str, np.ndarray],
                   envelope: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]], *,
                   warn: bool) -> list[str]:
@@ -149,7 +159,8 @@ def check_dynamic(model: "Model", deflection: dict[str, np.ndarray],
     check_finite(model, [(f"deflection of probe {name!r}", value)
                          for name, value in deflection.items()], "dynamic")
     framed = {name: float(np.abs(value).max(initial=0.0))   # the largest component
-              for name, value in deflection.items() if model.probes[name].frame != 0}
+              for name, value in deflection.items()
+              if moving_frame(model, model.probes[name].frame)}
     out = displacement_check(model, framed, "dynamic", warn=warn)
     if warn:
         peaks = {}
