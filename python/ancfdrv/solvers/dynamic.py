@@ -342,7 +342,27 @@ class TimeIntegrator:
             reason += (f"; the step was cut {cuts} times, the last from {2 * h:.3g} s to "
                        f"{h:.3g} s, and solver.dt_min = {s.smallest_step:.3g} s allows no "
                        "smaller one")
+            reason += _rope_advice(self.model, s)
         return f"time step {_interval(t, h)} failed: {reason}"
+
+
+def _rope_advice(model, settings: DynamicSettings) -> str:
+    """What helps a run with tension-only ropes whose step failed however small it was cut,
+    unless its method already damps unresolved modes fully (rho_inf = 0): a rope that goes
+    slack and taut faster than the step resolves excites its axial modes (a light rope's
+    reach some 1e4 rad/s), and only full numerical damping of them steadies the iteration.
+    Measured (docs/hard-cases.md): the knuckle crane without its payload fails at t = 0.97 s
+    at rho_inf 0.8 (dt 5e-3, cut 20 times) and at 0.37 s with newton_tol 1e-6, and at dt
+    1e-3 grinds through cuts; at rho_inf 0 it runs; the rope's throw and drop are right at
+    rho_inf 0 at both grid steps and refused at 0.8 and 1."""
+    ropes = [b.name for b in model.bodies if getattr(b, "tension_only", False)]
+    full_damping = settings.integrator == "generalized_alpha" and settings.alpha_f == 0.0
+    if not ropes or full_damping:
+        return ""
+    return (f"; the model's tension-only rope{'s' if len(ropes) > 1 else ''} "
+            f"{', '.join(repr(n) for n in ropes)} can switch between slack and taut faster "
+            "than any step resolves: solver.rho_inf = 0 damps the axial modes this excites "
+            "(generalized-alpha; docs/hard-cases.md)")
 
 
 def _interval(t: float, h: float) -> str:
