@@ -784,6 +784,18 @@ class KernelSystem:
             raise SolverError(f"kernel section forces, code {info}: {_text(message)}")
         return forces.T, largest.T
 
+    def ffr_departures(self, index: int, times, e_rows) -> np.ndarray:
+        """The small-strain measure of FFR set ``index`` at the states e_rows (nrows, ndof)
+        (independent coordinates) at the times (nrows,): per row the largest change of a
+        section vector r_x, r_y, r_z from its reference in the frame (ffr_elastic
+        ffr_departures), (nrows,), in one call for all rows."""
+        rows = np.ascontiguousarray(e_rows, dtype=np.float64)
+        departure, info, message = _kernel.system_ffr_departures(
+            self.handle, index, np.asarray(times, dtype=np.float64), rows.T)
+        if info:
+            raise SolverError(f"kernel small-strain measure, code {info}: {_text(message)}")
+        return departure
+
     def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
                       poisson: float, thickness: float, damping_time: float = 0.0) -> int:
         index, info, message = _kernel.system_add_plate_set(

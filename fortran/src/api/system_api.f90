@@ -402,6 +402,56 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   message = ' '
 end subroutine system_section_forces
 
+!> The small-strain measure of the FFR set `index` (ffr_elastic ffr_departures: the largest
+!> change of a section vector in its frame) at the states e_rows (ndof, nrows) (independent
+!> coordinates, expanded as to_full) at the times (nrows), in departure (nrows): the check of
+!> solvers/assumptions.py for a run's rows in one call. info = 2: sizes inconsistent or the
+!> set is not an FFR set; 5: a frame's drive failed.
+subroutine system_ffr_departures(handle, index, nrows, ndof, times, e_rows, departure, info, &
+                                 message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, frame_rotations
+  use system_reduction, only: to_full
+  use ffr_elastic, only: ffr_departures
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle, index, nrows, ndof
+  real(dp), intent(in) :: times(nrows), e_rows(ndof, nrows)
+  real(dp), intent(out) :: departure(nrows)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :)
+  integer :: row, frame
+  departure = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  info = 2
+  message = 'system_ffr_departures: set index (an FFR set) or rows (ndof per row, one per' // &
+            ' time) inconsistent'
+  if (index < 1 .or. index > size(sys%sets)) return
+  if (ndof /= sys%ndof) return
+  frame = sys%sets(index)%item%frame
+  allocate (rotations(3, 3, nrows), frames(3, 3, 0:size(sys%frames)), &
+            rates(0:size(sys%frames)), q_rows(sys%nfull, nrows))
+  do row = 1, nrows
+    call frame_rotations(sys, times(row), frames, rates, info)
+    if (info /= 0) then
+      info = 5
+      message = "system_ffr_departures: a frame's drive failed"
+      return
+    end if
+    rotations(:, :, row) = frames(:, :, frame)
+    call to_full(sys%reduction, e_rows(:, row), .true., q_rows(:, row))
+  end do
+  call ffr_departures(sys%sets(index)%item, rotations, q_rows, departure, info)
+  if (info /= 0) then
+    info = 2
+    return
+  end if
+  message = ' '
+end subroutine system_ffr_departures
+
 !> Thin plate elements (plate_element): reference data at npts Gauss points; material
 !> (api_support pm_*): Young's modulus, Poisson's ratio, thickness.
 subroutine system_add_plate_set(handle, nel, npts, dofs, scatter, derivs, plate_frame, curvature0, &

@@ -41,7 +41,7 @@ module ffr_elastic
   implicit none
   private
   public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_set, ffr_second_order
-  public :: ffr_enable_second_order
+  public :: ffr_enable_second_order, ffr_departures
 
   !> ANCF-FFR beam elements: K0 (24, 24, nel) and the rigid configuration in the body's
   !> floating frame (24, nel). With second_order, the geometric stiffness of the current
@@ -419,6 +419,77 @@ contains
       end do
     end do
   end subroutine add_second_order_power
+
+  !> The small-strain measure of an FFR set at rows of states (solvers/assumptions.py): per
+  !> row the largest change of a section vector r_x, r_y, r_z from its reference in the
+  !> frame, |A^T r - r0|, over its elements' vectors; a vector a neighbour listed already
+  !> (the same dofs and reference: a shared node's) is not measured twice. rotations
+  !> (3, 3, nrows): the frame at each row; q_rows (nfull, nrows). Not a number at a row whose
+  !> change is not one (also when another vector's is larger). info = 1: `item` is not an
+  !> FFR set (departure 0).
+  pure subroutine ffr_departures(item, rotations, q_rows, departure, info)
+    class(element_set), intent(in) :: item
+    real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :)
+    real(dp), intent(out) :: departure(:)
+    integer, intent(out) :: info
+    departure = 0.0_dp
+    info = 1
+    select type (item)
+    type is (ffr_set)
+      call set_departures(item, rotations, q_rows, departure)
+      info = 0
+    end select
+  end subroutine ffr_departures
+
+  !> ffr_departures of an FFR set.
+  pure subroutine set_departures(set, rotations, q_rows, departure)
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    type(ffr_set), intent(in) :: set
+    real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :)
+    real(dp), intent(out) :: departure(:)
+    integer, parameter :: directions(6) = [1, 2, 3, 5, 6, 7]   ! r_x, r_y, r_z of both nodes
+    logical :: skip(6, set%nel), bad
+    real(dp) :: x(3), square, largest, turn(3, 3), v1, v2, v3
+    integer :: el, k, a, row
+    ! a first node's vector equal to the previous element's second node's (dofs and
+    ! reference) is that one: measured once
+    skip = .false.
+    do el = 2, set%nel
+      do k = 1, 3
+        a = directions(k)
+        skip(k, el) = all(set%dofs(3 * a + 1:3 * a + 3, el) &
+                          == set%dofs(3 * a + 13:3 * a + 15, el - 1)) .and. &
+                      all(set%reference(3 * a + 1:3 * a + 3, el) &
+                          == set%reference(3 * a + 13:3 * a + 15, el - 1))
+      end do
+    end do
+    do row = 1, size(q_rows, 2)
+      largest = 0.0_dp
+      bad = .false.
+      turn = rotations(:, :, row)
+      do el = 1, set%nel
+        do k = 1, 6
+          if (skip(k, el)) cycle
+          a = directions(k)
+          ! (A^T v)_j = sum_i A(i, j) v_i, as frame_displacement writes it (in scalars)
+          v1 = q_rows(set%dofs(3 * a + 1, el), row)
+          v2 = q_rows(set%dofs(3 * a + 2, el), row)
+          v3 = q_rows(set%dofs(3 * a + 3, el), row)
+          x(1) = (turn(1, 1) * v1 + turn(2, 1) * v2 + turn(3, 1) * v3) &
+                 - set%reference(3 * a + 1, el)
+          x(2) = (turn(1, 2) * v1 + turn(2, 2) * v2 + turn(3, 2) * v3) &
+                 - set%reference(3 * a + 2, el)
+          x(3) = (turn(1, 3) * v1 + turn(2, 3) * v2 + turn(3, 3) * v3) &
+                 - set%reference(3 * a + 3, el)
+          square = (x(1) * x(1) + x(2) * x(2)) + x(3) * x(3)
+          if (square > largest) largest = square
+          if (.not. (square == square)) bad = .true.
+        end do
+      end do
+      departure(row) = sqrt(largest)
+      if (bad) departure(row) = ieee_value(1.0_dp, ieee_quiet_nan)
+    end do
+  end subroutine set_departures
 
   !> The element_set section_forces of an FFR set: linear forms (beam_stations station_map,
   !> built at the first call with these stations and kept) of each element's displacement in
