@@ -37,7 +37,7 @@
 module ffr_elastic
   use ancf_kinds, only: dp
   use element_sets, only: element_set, frame_omega, scatter_add
-  use beam_stations, only: station_section, station_map, small_station_map, map_forces
+  use beam_stations, only: station_section, station_map, small_station_map
   implicit none
   private
   public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_set, ffr_second_order
@@ -501,9 +501,10 @@ contains
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info
-    integer, parameter :: block = 16
-    real(dp), allocatable :: turned(:, :, :), local(:, :), out(:, :)
-    integer :: el, row, ns, v, a, c, nv, first, nb, r, k, i
+    integer, parameter :: block = 32
+    real(dp), allocatable :: turned(:, :, :)
+    real(dp) :: acc(block), turn(3, 3), x1, x2, x3
+    integer :: el, row, ns, v, nv, first, nb, r, k, i, o, p, col, a, c, base
     info = 1
     if (.not. allocated(set%sections%reference)) then
       forces = 0.0_dp
@@ -521,28 +522,40 @@ contains
                                                                  set%stations)
     if (.not. allocated(set%element_vector)) call distinct_vectors(set)
     nv = size(set%vector_dofs, 2)
-    allocate (turned(block, 3, nv), local(block, 24), out(block, 6 * ns))
+    allocate (turned(block, 3, nv))
     do first = 1, size(q_rows, 2), block   ! blocks of rows: each product runs over them
       nb = min(block, size(q_rows, 2) - first + 1)
       do r = 1, nb   ! A^T e_v as frame_displacement writes it, turned once per row
         row = first + r - 1
+        turn = rotations(:, :, row)
         do v = 1, nv
-          turned(r, :, v) = rotations(1, :, row) * q_rows(set%vector_dofs(1, v), row) &
-                            + rotations(2, :, row) * q_rows(set%vector_dofs(2, v), row) &
-                            + rotations(3, :, row) * q_rows(set%vector_dofs(3, v), row)
+          ! (A^T x)_j = A(1, j) x_1 + A(2, j) x_2 + A(3, j) x_3, in scalars: the array
+          ! expression's loop over j cost ~80 instructions a vector
+          x1 = q_rows(set%vector_dofs(1, v), row)
+          x2 = q_rows(set%vector_dofs(2, v), row)
+          x3 = q_rows(set%vector_dofs(3, v), row)
+          turned(r, 1, v) = turn(1, 1) * x1 + turn(2, 1) * x2 + turn(3, 1) * x3
+          turned(r, 2, v) = turn(1, 2) * x1 + turn(2, 2) * x2 + turn(3, 2) * x3
+          turned(r, 3, v) = turn(1, 3) * x1 + turn(2, 3) * x2 + turn(3, 3) * x3
         end do
       end do
+      ! each station's force: the map's form (beam_stations station_map) of the element's
+      ! displacement A^T e - e0, each term's coordinate read from the turned vectors (the
+      ! same sums in the same order, without the element's copy)
       do el = 1, set%nel
-        do a = 0, 7
-          do c = 1, 3
-            local(:nb, 3 * a + c) = turned(:nb, c, set%element_vector(a + 1, el)) &
-                                    - set%reference(3 * a + c, el)
-          end do
-        end do
-        call map_forces(set%stations, el, local(:nb, :), out(:nb, :))
+        base = 6 * ns * (el - 1)
         do k = 1, 6
           do i = 1, ns
-            forces(ns * (el - 1) + i, first:first + nb - 1, k) = out(:nb, i + ns * (k - 1))
+            o = i + ns * (k - 1)
+            acc(:nb) = 0.0_dp
+            do p = set%stations%first(base + o), set%stations%first(base + o + 1) - 1
+              col = set%stations%col(p)
+              a = (col - 1) / 3
+              c = col - 3 * a
+              acc(:nb) = acc(:nb) + set%stations%coef(p) * (turned(:nb, c, &
+                         set%element_vector(a + 1, el)) - set%reference(col, el))
+            end do
+            forces(ns * (el - 1) + i, first:first + nb - 1, k) = acc(:nb)
           end do
         end do
       end do
