@@ -94,9 +94,9 @@ def _ffr_beam(nodes: int = 7):
 
 
 def test_ffr_departure_rows_is_the_per_element_measure():
-    """The small-strain check on each node's section vectors once equals the measure
-    element by element, |A^T r_i - r_i0| maximized over all elements' r_x, r_y, r_z, bit
-    for bit (shared nodes counted once change nothing)."""
+    """The kernel's small-strain check (each shared node's section vectors once) equals
+    the measure element by element, |A^T r_i - r_i0| maximized over all elements' r_x,
+    r_y, r_z (numpy's products: the same up to the round-off of a unit vector's turn)."""
     model = _ffr_beam()
     info = [s for s in model.sets if s.kind == "ffr"][0]
     rng = np.random.default_rng(4)
@@ -111,7 +111,9 @@ def test_ffr_departure_rows_is_the_per_element_measure():
     plain = np.linalg.norm(current @ rotation - reference[None], axis=-1).reshape(25, -1)
     (name, change), = ffr_departure_rows(model, rows, times)
     assert name == "arm"
-    assert change.tobytes() == plain.max(axis=1).tobytes()
+    # the vectors are unit length: their turned values round at ~1e-16, the change ~1e-2
+    np.testing.assert_allclose(change, plain.max(axis=1), rtol=0.0, atol=1e-14)
+    assert change.min() > 1e-3
     model.close()
 
 

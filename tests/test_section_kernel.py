@@ -81,8 +81,9 @@ def test_a_set_without_section_forces_and_a_station_outside_are_refused():
                    for name in ("arm", "sheet"))
     with pytest.raises(SolverError, match="stations"):
         model.kernel.section_forces(beam.index, [0.0], model.e0[None], [0.0, 1.5])
-    _, _, info, message = _kernel.system_section_forces(
-        model.kernel.handle, plate.index, 2 * plate.nel, [0.0], model.e0[:, None], [0.0, 1.0])
+    forces = np.empty((2 * plate.nel, 1, 6), order="F")   # (the caller gives it)
+    _, info, message = _kernel.system_section_forces(
+        model.kernel.handle, plate.index, [0.0], model.e0[:, None], [0.0, 1.0], forces)
     assert info == 3 and "reports no section forces" in message.decode()
     model.close()
 

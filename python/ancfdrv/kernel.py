@@ -775,13 +775,29 @@ class KernelSystem:
         row's is NaN). Each component's (nrows, ns nel) is C-contiguous."""
         nel = self._set_sizes[index]
         xi = np.asarray(xi, dtype=np.float64)
+        times = np.asarray(times, dtype=np.float64)
+        # the kernel writes every entry: numpy.empty, not f2py's zero-filled output (a
+        # chunk's forces, 700 kB for the FFR boom, were zeroed twice beyond the cache)
+        forces = np.empty((len(xi) * nel, len(times), 6), order="F")
         # the rows (nrows, ndof) in C order are the kernel's (ndof, nrows) columns
-        forces, largest, info, message = _kernel.system_section_forces(
-            self.handle, index, len(xi) * nel, np.asarray(times, dtype=np.float64),
-            np.ascontiguousarray(e_rows, dtype=np.float64).T, xi)
+        largest, info, message = _kernel.system_section_forces(
+            self.handle, index, times, np.ascontiguousarray(e_rows, dtype=np.float64).T, xi,
+            forces)
         if info:
             raise SolverError(f"kernel section forces, code {info}: {_text(message)}")
         return forces.T, largest.T
+
+    def ffr_departures(self, index: int, times, e_rows) -> np.ndarray:
+        """The small-strain measure of FFR set ``index`` at the states e_rows (nrows, ndof)
+        (independent coordinates) at the times (nrows,): per row the largest change of a
+        section vector r_x, r_y, r_z from its reference in the frame (ffr_elastic
+        ffr_departures), (nrows,), in one call for all rows."""
+        rows = np.ascontiguousarray(e_rows, dtype=np.float64)
+        departure, info, message = _kernel.system_ffr_departures(
+            self.handle, index, np.asarray(times, dtype=np.float64), rows.T)
+        if info:
+            raise SolverError(f"kernel small-strain measure, code {info}: {_text(message)}")
+        return departure
 
     def add_plate_set(self, dofs, scatter, reference: "PlateReference", youngs: float,
                       poisson: float, thickness: float, damping_time: float = 0.0) -> int:

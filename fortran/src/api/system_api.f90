@@ -344,8 +344,11 @@ end subroutine system_set_sections
 !> [N, T, Q_height, Q_width, M_height, M_width], station i of element el in row
 !> i + ns (el - 1) (element_sets section_forces), and each one's largest magnitude over the
 !> rows, largest (nst, 6) (not a number where a row's is: the stress envelope's bound per
-!> station, answers.peak_rows). info = 2: sizes inconsistent or a station
-!> outside [0, 1]; 3: the set reports no section forces; 5: a frame's drive failed.
+!> station, answers.peak_rows). `forces` is the caller's (numpy.empty: neither f2py nor this
+!> routine zero-fills it, since every family writes all its entries; 700 kB per chunk of the
+!> FFR boom's rows, twice, beyond the cache); undefined where info /= 0. info = 2: sizes
+!> inconsistent or a station outside [0, 1]; 3: the set reports no section forces; 5: a
+!> frame's drive failed.
 subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_rows, xi, &
                                  forces, largest, info, message)
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan
@@ -356,13 +359,13 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   implicit none
   integer, intent(in) :: handle, index, nrows, ndof, ns, nst
   real(dp), intent(in) :: times(nrows), e_rows(ndof, nrows), xi(ns)
-  real(dp), intent(out) :: forces(nst, nrows, 6), largest(nst, 6)
+  real(dp), intent(inout) :: forces(nst, nrows, 6)
+  real(dp), intent(out) :: largest(nst, 6)
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
   real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :), total(:, :)
   integer :: row, frame, k
-  forces = 0.0_dp
   largest = 0.0_dp
   call api_system(handle, sys, info, message)
   if (info /= 0) return
@@ -374,7 +377,7 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   if (any(xi < 0.0_dp) .or. any(xi > 1.0_dp)) return
   frame = sys%sets(index)%item%frame
   allocate (rotations(3, 3, nrows), frames(3, 3, 0:size(sys%frames)), &
-            rates(0:size(sys%frames)), q_rows(sys%nfull, nrows))
+            rates(0:size(sys%frames)))
   do row = 1, nrows
     call frame_rotations(sys, times(row), frames, rates, info)
     if (info /= 0) then
@@ -382,9 +385,16 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
       return
     end if
     rotations(:, :, row) = frames(:, :, frame)
-    call to_full(sys%reduction, e_rows(:, row), .true., q_rows(:, row))
   end do
-  call sys%sets(index)%item%section_forces(rotations, q_rows, xi, forces, info)
+  if (sys%reduction%active) then
+    allocate (q_rows(sys%nfull, nrows))
+    do row = 1, nrows
+      call to_full(sys%reduction, e_rows(:, row), .true., q_rows(:, row))
+    end do
+    call sys%sets(index)%item%section_forces(rotations, q_rows, xi, forces, info)
+  else   ! (the rows are the full coordinates: to_full's copy, not made)
+    call sys%sets(index)%item%section_forces(rotations, e_rows, xi, forces, info)
+  end if
   if (info /= 0) then
     info = 3
     message = 'system_section_forces: the set reports no section forces'
@@ -401,6 +411,63 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   where (ieee_is_nan(total)) largest = ieee_value(1.0_dp, ieee_quiet_nan)   ! (max may skip it)
   message = ' '
 end subroutine system_section_forces
+
+!> The small-strain measure of the FFR set `index` (ffr_elastic ffr_departures: the largest
+!> change of a section vector in its frame) at the states e_rows (ndof, nrows) (independent
+!> coordinates, expanded as to_full) at the times (nrows), in departure (nrows): the check of
+!> solvers/assumptions.py for a run's rows in one call. info = 2: sizes inconsistent or the
+!> set is not an FFR set; 5: a frame's drive failed.
+subroutine system_ffr_departures(handle, index, nrows, ndof, times, e_rows, departure, info, &
+                                 message)
+  use ancf_kinds, only: dp
+  use mechanical_system, only: system_model, frame_rotations
+  use system_reduction, only: to_full
+  use ffr_elastic, only: ffr_departures
+  use api_support, only: api_system
+  implicit none
+  integer, intent(in) :: handle, index, nrows, ndof
+  real(dp), intent(in) :: times(nrows), e_rows(ndof, nrows)
+  real(dp), intent(out) :: departure(nrows)
+  integer, intent(out) :: info
+  character(len=200), intent(out) :: message
+  type(system_model), pointer :: sys
+  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :)
+  integer :: row, frame
+  departure = 0.0_dp
+  call api_system(handle, sys, info, message)
+  if (info /= 0) return
+  info = 2
+  message = 'system_ffr_departures: set index (an FFR set) or rows (ndof per row, one per' // &
+            ' time) inconsistent'
+  if (index < 1 .or. index > size(sys%sets)) return
+  if (ndof /= sys%ndof) return
+  frame = sys%sets(index)%item%frame
+  allocate (rotations(3, 3, nrows), frames(3, 3, 0:size(sys%frames)), &
+            rates(0:size(sys%frames)))
+  do row = 1, nrows
+    call frame_rotations(sys, times(row), frames, rates, info)
+    if (info /= 0) then
+      info = 5
+      message = "system_ffr_departures: a frame's drive failed"
+      return
+    end if
+    rotations(:, :, row) = frames(:, :, frame)
+  end do
+  if (sys%reduction%active) then
+    allocate (q_rows(sys%nfull, nrows))
+    do row = 1, nrows
+      call to_full(sys%reduction, e_rows(:, row), .true., q_rows(:, row))
+    end do
+    call ffr_departures(sys%sets(index)%item, rotations, q_rows, departure, info)
+  else   ! (the rows are the full coordinates: to_full's copy, not made)
+    call ffr_departures(sys%sets(index)%item, rotations, e_rows, departure, info)
+  end if
+  if (info /= 0) then
+    info = 2
+    return
+  end if
+  message = ' '
+end subroutine system_ffr_departures
 
 !> Thin plate elements (plate_element): reference data at npts Gauss points; material
 !> (api_support pm_*): Young's modulus, Poisson's ratio, thickness.

@@ -27,7 +27,7 @@ module beam_stations
   implicit none
   private
   public :: centreline_rows, station_section, station_forces, set_station_forces
-  public :: station_map, small_station_map, map_forces
+  public :: station_map, small_station_map
 
   !> A beam set's section data for its section forces: bending option, the section's
   !> stiffnesses and moments, the element lengths and the reference nodal vectors (3, 8, nel)
@@ -236,24 +236,6 @@ contains
     map%col = col(:used)
     map%coef = coef(:used)
   end subroutine small_station_map
-
-  !> The section forces (rows, 6 ns) (column i + ns (k - 1): station i, force k) of element
-  !> el of a station map at its displacements d (rows, 24) in the frame (a block of rows at
-  !> once: each product runs over the rows).
-  pure subroutine map_forces(map, el, d, forces)
-    type(station_map), intent(in) :: map
-    integer, intent(in) :: el
-    real(dp), intent(in) :: d(:, :)
-    real(dp), intent(out) :: forces(:, :)
-    integer :: o, p, base
-    base = 6 * size(map%xi) * (el - 1)
-    do o = 1, 6 * size(map%xi)
-      forces(:, o) = 0.0_dp
-      do p = map%first(base + o), map%first(base + o + 1) - 1
-        forces(:, o) = forces(:, o) + map%coef(p) * d(:, map%col(p))
-      end do
-    end do
-  end subroutine map_forces
 
   !> The section forces (ns nel, nrows, 6) of a large-deformation beam set (element_sets
   !> section_forces) from its element dofs (24, nel) and the states q_rows (nfull, nrows).

@@ -37,11 +37,11 @@
 module ffr_elastic
   use ancf_kinds, only: dp
   use element_sets, only: element_set, frame_omega, scatter_add
-  use beam_stations, only: station_section, station_map, small_station_map, map_forces
+  use beam_stations, only: station_section, station_map, small_station_map
   implicit none
   private
   public :: ffr_force, ffr_stiffness, ffr_energy_power, ffr_set, ffr_second_order
-  public :: ffr_enable_second_order
+  public :: ffr_enable_second_order, ffr_departures
 
   !> ANCF-FFR beam elements: K0 (24, 24, nel) and the rigid configuration in the body's
   !> floating frame (24, nel). With second_order, the geometric stiffness of the current
@@ -71,12 +71,17 @@ contains
     real(dp), intent(in) :: rotation(3, 3), e(:), reference(24)
     integer, intent(in) :: dofs(24)
     real(dp) :: local(24)
+    real(dp) :: x1, x2, x3
     integer :: a
     do a = 0, 7
-      ! (A^T v)_j = sum_i A(i, j) v_i, written out
-      local(3 * a + 1:3 * a + 3) = rotation(1, :) * e(dofs(3 * a + 1)) &
-                                   + rotation(2, :) * e(dofs(3 * a + 2)) &
-                                   + rotation(3, :) * e(dofs(3 * a + 3))
+      ! (A^T v)_j = A(1, j) v_1 + A(2, j) v_2 + A(3, j) v_3, in scalars (as an array
+      ! expression over j, ~80 instructions a vector)
+      x1 = e(dofs(3 * a + 1))
+      x2 = e(dofs(3 * a + 2))
+      x3 = e(dofs(3 * a + 3))
+      local(3 * a + 1) = rotation(1, 1) * x1 + rotation(2, 1) * x2 + rotation(3, 1) * x3
+      local(3 * a + 2) = rotation(1, 2) * x1 + rotation(2, 2) * x2 + rotation(3, 2) * x3
+      local(3 * a + 3) = rotation(1, 3) * x1 + rotation(2, 3) * x2 + rotation(3, 3) * x3
     end do
     local = local - reference
   end function frame_displacement
@@ -420,6 +425,77 @@ contains
     end do
   end subroutine add_second_order_power
 
+  !> The small-strain measure of an FFR set at rows of states (solvers/assumptions.py): per
+  !> row the largest change of a section vector r_x, r_y, r_z from its reference in the
+  !> frame, |A^T r - r0|, over its elements' vectors; a vector a neighbour listed already
+  !> (the same dofs and reference: a shared node's) is not measured twice. rotations
+  !> (3, 3, nrows): the frame at each row; q_rows (nfull, nrows). Not a number at a row whose
+  !> change is not one (also when another vector's is larger). info = 1: `item` is not an
+  !> FFR set (departure 0).
+  pure subroutine ffr_departures(item, rotations, q_rows, departure, info)
+    class(element_set), intent(in) :: item
+    real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :)
+    real(dp), intent(out) :: departure(:)
+    integer, intent(out) :: info
+    departure = 0.0_dp
+    info = 1
+    select type (item)
+    type is (ffr_set)
+      call set_departures(item, rotations, q_rows, departure)
+      info = 0
+    end select
+  end subroutine ffr_departures
+
+  !> ffr_departures of an FFR set.
+  pure subroutine set_departures(set, rotations, q_rows, departure)
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+    type(ffr_set), intent(in) :: set
+    real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :)
+    real(dp), intent(out) :: departure(:)
+    integer, parameter :: directions(6) = [1, 2, 3, 5, 6, 7]   ! r_x, r_y, r_z of both nodes
+    logical :: skip(6, set%nel), bad
+    real(dp) :: x(3), square, largest, turn(3, 3), v1, v2, v3
+    integer :: el, k, a, row
+    ! a first node's vector equal to the previous element's second node's (dofs and
+    ! reference) is that one: measured once
+    skip = .false.
+    do el = 2, set%nel
+      do k = 1, 3
+        a = directions(k)
+        skip(k, el) = all(set%dofs(3 * a + 1:3 * a + 3, el) &
+                          == set%dofs(3 * a + 13:3 * a + 15, el - 1)) .and. &
+                      all(set%reference(3 * a + 1:3 * a + 3, el) &
+                          == set%reference(3 * a + 13:3 * a + 15, el - 1))
+      end do
+    end do
+    do row = 1, size(q_rows, 2)
+      largest = 0.0_dp
+      bad = .false.
+      turn = rotations(:, :, row)
+      do el = 1, set%nel
+        do k = 1, 6
+          if (skip(k, el)) cycle
+          a = directions(k)
+          ! (A^T v)_j = sum_i A(i, j) v_i, as frame_displacement writes it (in scalars)
+          v1 = q_rows(set%dofs(3 * a + 1, el), row)
+          v2 = q_rows(set%dofs(3 * a + 2, el), row)
+          v3 = q_rows(set%dofs(3 * a + 3, el), row)
+          x(1) = (turn(1, 1) * v1 + turn(2, 1) * v2 + turn(3, 1) * v3) &
+                 - set%reference(3 * a + 1, el)
+          x(2) = (turn(1, 2) * v1 + turn(2, 2) * v2 + turn(3, 2) * v3) &
+                 - set%reference(3 * a + 2, el)
+          x(3) = (turn(1, 3) * v1 + turn(2, 3) * v2 + turn(3, 3) * v3) &
+                 - set%reference(3 * a + 3, el)
+          square = (x(1) * x(1) + x(2) * x(2)) + x(3) * x(3)
+          if (square > largest) largest = square
+          if (.not. (square == square)) bad = .true.
+        end do
+      end do
+      departure(row) = sqrt(largest)
+      if (bad) departure(row) = ieee_value(1.0_dp, ieee_quiet_nan)
+    end do
+  end subroutine set_departures
+
   !> The element_set section_forces of an FFR set: linear forms (beam_stations station_map,
   !> built at the first call with these stations and kept) of each element's displacement in
   !> the frame at each row, A^T e - e0 (frame_displacement's, each distinct nodal vector
@@ -430,9 +506,10 @@ contains
     real(dp), intent(in) :: rotations(:, :, :), q_rows(:, :), xi(:)
     real(dp), intent(out) :: forces(:, :, :)
     integer, intent(out) :: info
-    integer, parameter :: block = 16
-    real(dp), allocatable :: turned(:, :, :), local(:, :), out(:, :)
-    integer :: el, row, ns, v, a, c, nv, first, nb, r, k, i
+    integer, parameter :: block = 32
+    real(dp), allocatable :: turned(:, :, :)
+    real(dp) :: acc(block), turn(3, 3), x1, x2, x3
+    integer :: el, row, ns, v, nv, first, nb, r, k, i, o, p, col, a, c, base
     info = 1
     if (.not. allocated(set%sections%reference)) then
       forces = 0.0_dp
@@ -450,28 +527,40 @@ contains
                                                                  set%stations)
     if (.not. allocated(set%element_vector)) call distinct_vectors(set)
     nv = size(set%vector_dofs, 2)
-    allocate (turned(block, 3, nv), local(block, 24), out(block, 6 * ns))
+    allocate (turned(block, 3, nv))
     do first = 1, size(q_rows, 2), block   ! blocks of rows: each product runs over them
       nb = min(block, size(q_rows, 2) - first + 1)
       do r = 1, nb   ! A^T e_v as frame_displacement writes it, turned once per row
         row = first + r - 1
+        turn = rotations(:, :, row)
         do v = 1, nv
-          turned(r, :, v) = rotations(1, :, row) * q_rows(set%vector_dofs(1, v), row) &
-                            + rotations(2, :, row) * q_rows(set%vector_dofs(2, v), row) &
-                            + rotations(3, :, row) * q_rows(set%vector_dofs(3, v), row)
+          ! (A^T x)_j = A(1, j) x_1 + A(2, j) x_2 + A(3, j) x_3, in scalars: the array
+          ! expression's loop over j cost ~80 instructions a vector
+          x1 = q_rows(set%vector_dofs(1, v), row)
+          x2 = q_rows(set%vector_dofs(2, v), row)
+          x3 = q_rows(set%vector_dofs(3, v), row)
+          turned(r, 1, v) = turn(1, 1) * x1 + turn(2, 1) * x2 + turn(3, 1) * x3
+          turned(r, 2, v) = turn(1, 2) * x1 + turn(2, 2) * x2 + turn(3, 2) * x3
+          turned(r, 3, v) = turn(1, 3) * x1 + turn(2, 3) * x2 + turn(3, 3) * x3
         end do
       end do
+      ! each station's force: the map's form (beam_stations station_map) of the element's
+      ! displacement A^T e - e0, each term's coordinate read from the turned vectors (the
+      ! same sums in the same order, without the element's copy)
       do el = 1, set%nel
-        do a = 0, 7
-          do c = 1, 3
-            local(:nb, 3 * a + c) = turned(:nb, c, set%element_vector(a + 1, el)) &
-                                    - set%reference(3 * a + c, el)
-          end do
-        end do
-        call map_forces(set%stations, el, local(:nb, :), out(:nb, :))
+        base = 6 * ns * (el - 1)
         do k = 1, 6
           do i = 1, ns
-            forces(ns * (el - 1) + i, first:first + nb - 1, k) = out(:nb, i + ns * (k - 1))
+            o = i + ns * (k - 1)
+            acc(:nb) = 0.0_dp
+            do p = set%stations%first(base + o), set%stations%first(base + o + 1) - 1
+              col = set%stations%col(p)
+              a = (col - 1) / 3
+              c = col - 3 * a
+              acc(:nb) = acc(:nb) + set%stations%coef(p) * (turned(:nb, c, &
+                         set%element_vector(a + 1, el)) - set%reference(col, el))
+            end do
+            forces(ns * (el - 1) + i, first:first + nb - 1, k) = acc(:nb)
           end do
         end do
       end do

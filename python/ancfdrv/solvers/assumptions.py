@@ -28,32 +28,17 @@ def ffr_departures(model, e: np.ndarray, t: float) -> list[tuple[str, float]]:
 
 def ffr_departure_rows(model, rows: np.ndarray, times: np.ndarray) -> list[tuple[str, np.ndarray]]:
     """(beam, largest change of a section vector in its frame at each row) of every 'ffr'
-    beam for the states rows (n, ndof) at the times (n,): a run's chunk at once (the frame
-    rotations from the drive's vectorized values, no loop over the rows)."""
+    beam for the states rows (n, ndof) at the times (n,): a run's chunk at once, one kernel
+    call per beam (``ffr_elastic.f90`` ffr_departures: each section vector turned into the
+    frame at the row's rotation, as the elastic forces turn it; a vector shared by
+    neighbouring elements measured once)."""
     sets = [s for s in model.sets if s.floating]
     if not sets:
         return []
-    # read only: without eliminated joints q is e (no copy of every row)
-    q = np.atleast_2d(np.asarray(rows, dtype=float) if model.reduction is None
-                      else model.expand(rows))
-    times = np.asarray(times, dtype=float)
-    out = []
-    for info in sets:
-        frame = model.frames[info.frame - 1]
-        rotations = _frame_rotations(frame, times)                      # (n, 3, 3)
-        first, reference = _section_vectors(info)
-        current = q[:, first[:, None] + np.arange(3)]                   # (n, vector, xyz)
-        # A^T v of every vector, as a batched matrix product (einsum's generic loop took
-        # ~60 times as long: 0.12 s per 1000 rows of the 27-element boom)
-        local = np.matmul(current, rotations)
-        local -= reference
-        # |change|^2 summed as np.linalg.norm sums it, the root of the largest only (it is
-        # monotonic and correctly rounded: the same maximum bit for bit)
-        np.multiply(local, local, out=local)
-        square = local[..., 0] + local[..., 1]
-        square += local[..., 2]
-        out.append((info.body.name, np.sqrt(square.max(axis=1, initial=0.0))))
-    return out
+    rows = np.atleast_2d(np.asarray(rows, dtype=float))
+    times = np.atleast_1d(np.asarray(times, dtype=float))
+    return [(info.body.name, model.kernel.ffr_departures(info.index, times, rows))
+            for info in sets]
 
 
 def _section_vectors(info) -> tuple[np.ndarray, np.ndarray]:
@@ -75,19 +60,6 @@ def _section_vectors(info) -> tuple[np.ndarray, np.ndarray]:
     if hasattr(info, "__dict__"):
         info.__dict__["_section_vectors"] = found
     return found
-
-
-def _frame_rotations(frame, times: np.ndarray) -> np.ndarray:
-    """A floating frame's rotations A(t) (n, 3, 3) at the times (Rodrigues, vectorized)."""
-    base = np.asarray(frame.base, dtype=float)
-    if frame.drive_obj is None:
-        return np.broadcast_to(base, (len(times), 3, 3))
-    angle = frame.drive_obj.values(times)[0]
-    k = np.asarray(frame.axis, dtype=float) / np.linalg.norm(frame.axis)
-    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    turn = (np.eye(3)[None] + np.sin(angle)[:, None, None] * skew
-            + (1.0 - np.cos(angle))[:, None, None] * (skew @ skew))
-    return turn @ base
 
 
 def check_ffr(model, e: np.ndarray, t: float, *, when: str) -> None:

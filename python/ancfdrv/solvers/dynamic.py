@@ -754,6 +754,10 @@ def _check_assumptions(model: Model, chunk: Chunk, state: dict,
     if not any(s.floating for s in model.sets) or not len(chunk.time):
         return chunk, ""
     if chunk.q is not None:  # every row at once; the first row outside ends the run
+        # q in one contiguous copy (a view of the kernel's rows, strided by the row's
+        # length): the kernel's check and the answers' kernel calls then read it in place
+        # instead of copying it each (the FFR boom's chunk: 486 kB, three times)
+        chunk.q = np.ascontiguousarray(chunk.q)
         outside = np.zeros(len(chunk.time), dtype=bool)
         for _, change in ffr_departure_rows(model, chunk.q, chunk.time):
             outside |= ~(change <= FFR_LIMIT)      # beyond the limit, or not finite
