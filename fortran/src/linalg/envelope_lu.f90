@@ -165,6 +165,7 @@ contains
       s3 = s3 + a(k + 2) * b(k + 2)
       s4 = s4 + a(k + 3) * b(k + 3)
     end do
+    !GCC$ novector
     do k = 4 * blocks + 1, length
       s1 = s1 + a(k) * b(k)
     end do
