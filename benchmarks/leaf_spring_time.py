@@ -17,7 +17,10 @@ rusage, start-up and imports included). The two builds alternate, baseline first
 and the median of each side are reported, with the load average at the start and the end.
 Checks: both builds' steps, Newton iterations and factorizations, and the chassis's
 displacement history compared value for value (``history_max_abs_diff``, 0 when the
-builds compute the same numbers). ``--answers``: the rows carry the kernel's part of the
+builds compute the same numbers; ``history_max_diff_over_range``: the largest difference of
+x and of z over the baseline's range of each, round-off when the arithmetic order
+changed). The integrate's wall time (best) is reported beside its CPU time, and each
+build's iteration-matrix solver. ``--answers``: the rows carry the kernel's part of the
 engineering answers (row_answers.f90), as ``ancf run`` computes them; ``integrate`` alone
 (the library call) does not.
 
@@ -97,6 +100,7 @@ def one_run(history: Path, t_end: float,
             "settle": settle, "answers": answers, "integrate_cpu_s": cpu, "integrate_wall_s": result.wall_time_s,
             "steps": result.steps, "newton_iterations": result.newton_iterations,
             "factorizations": result.factorizations,
+            "solver": model.solver.what, "fallbacks": getattr(model.solver, "fallbacks", 0),
             "chassis_z_end_m": float(chassis[-1, 2]),
             "chassis_z_min_m": float(chassis[:, 2].min())}
 
@@ -130,6 +134,13 @@ def run_worker(python: str, history: Path, t_end: float,
 
 
 # -- part 1 ------------------------------------------------------------------------------------
+def over_range(difference: float, spread: float) -> float:
+    """difference / spread (0 when both are 0, inf for a difference over no spread)."""
+    if difference == 0.0:
+        return 0.0
+    return float(difference / spread) if spread > 0.0 else float("inf")
+
+
 def compare_builds(args: argparse.Namespace, work: Path) -> dict[str, Any]:
     sides = {"baseline": args.baseline, "current": args.current}
     runs: dict[str, list[dict[str, Any]]] = {side: [] for side in sides}
@@ -146,12 +157,17 @@ def compare_builds(args: argparse.Namespace, work: Path) -> dict[str, Any]:
     same_shape = a["z"].shape == b["z"].shape
     diff = (float(max(np.abs(a["z"] - b["z"]).max(), np.abs(a["x"] - b["x"]).max()))
             if same_shape else None)
+    # the largest difference of each coordinate over the baseline's range of it
+    relative = ({key: over_range(np.abs(a[key] - b[key]).max(), np.ptp(a[key]))
+                 for key in ("x", "z")} if same_shape else None)
     summary = {}
     for side in sides:
         cpu = [r["integrate_cpu_s"] for r in runs[side]]
         proc = [r["process_cpu_s"] for r in runs[side]]
         first = runs[side][0]
+        wall = [r["integrate_wall_s"] for r in runs[side]]
         summary[side] = {"python": sides[side], "integrate_cpu_best_s": min(cpu),
+                         "integrate_wall_best_s": min(wall), "solver": runs[side][0]["solver"],
                          "integrate_cpu_median_s": statistics.median(cpu),
                          "process_cpu_best_s": min(proc),
                          "process_cpu_median_s": statistics.median(proc),
@@ -161,6 +177,7 @@ def compare_builds(args: argparse.Namespace, work: Path) -> dict[str, Any]:
     ratio = summary["current"]["integrate_cpu_best_s"] / summary["baseline"]["integrate_cpu_best_s"]
     return {"runs": runs, "summary": summary, "current_over_baseline_best": ratio,
             "history_same_length": same_shape, "history_max_abs_diff_m": diff,
+            "history_max_diff_over_range": relative,
             "counters_equal": all(summary["baseline"][k] == summary["current"][k]
                                   for k in ("steps", "newton_iterations", "factorizations")),
             "load_average_start": load_start, "load_average_end": load_end}
@@ -219,18 +236,21 @@ def markdown(report: dict[str, Any]) -> str:
                   "rounds, baseline and current alternating, each run a fresh process; "
                   + ("the rows carry the answers (as ancf run)." if report["settings"].get("answers")
                      else "no answers in the rows (integrate alone)."), "",
-                  "| build | integrate CPU best [s] | median [s] | process CPU best [s] | "
-                  "steps | Newton iterations | factorizations |",
-                  "|---|---|---|---|---|---|---|"]
+                  "| build | integrate CPU best [s] | median [s] | integrate wall best [s] | "
+                  "process CPU best [s] | steps | Newton iterations | factorizations | "
+                  "iteration matrix |",
+                  "|---|---|---|---|---|---|---|---|---|"]
         for side in ("baseline", "current"):
             r = s[side]
             lines.append(f"| {side} (`{r['python']}`) | {r['integrate_cpu_best_s']:.3f} | "
-                         f"{r['integrate_cpu_median_s']:.3f} | {r['process_cpu_best_s']:.3f} | "
-                         f"{r['steps']} | {r['newton_iterations']} | {r['factorizations']} |")
+                         f"{r['integrate_cpu_median_s']:.3f} | {r['integrate_wall_best_s']:.3f} | "
+                         f"{r['process_cpu_best_s']:.3f} | {r['steps']} | "
+                         f"{r['newton_iterations']} | {r['factorizations']} | {r['solver']} |")
         lines += ["", f"Current / baseline (best integrate CPU): "
                   f"{part['current_over_baseline_best']:.3f}; counters equal: "
                   f"{part['counters_equal']}; chassis history max |difference| "
-                  f"{part['history_max_abs_diff_m']} m."]
+                  f"{part['history_max_abs_diff_m']} m (over the baseline's range: "
+                  f"{part['history_max_diff_over_range']})."]
     acc = report.get("accuracy")
     if acc:
         lines += ["", f"## Accuracy against CPU time (reference dt = {REFERENCE[0]:g} s, "

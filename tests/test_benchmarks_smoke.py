@@ -217,9 +217,9 @@ def test_leaf_spring_time_same_version(tmp_path, monkeypatch):
     one worker: that worker (a fresh process, the script's --worker protocol) reports 20
     steps of 1 ms and writes the 21-row chassis history; the script's main, its workers
     replaced by the same runs in this process, compares this build with itself (identical
-    histories and counters) and finds the shipped step's error against the 0.125 ms
-    reference at the 6 output times 0, 4, ..., 20 ms positive (the steps differ) and small
-    against the run's range."""
+    histories and counters, the iteration matrix by the envelope LU) and finds the shipped
+    step's error against the 0.125 ms reference at the 6 output times 0, 4, ..., 20 ms
+    positive (the steps differ) and small against the run's range."""
     monkeypatch.syspath_prepend(str(BENCHMARKS))
     import leaf_spring_time as script
 
@@ -241,10 +241,13 @@ def test_leaf_spring_time_same_version(tmp_path, monkeypatch):
     report = json.loads(stem.with_suffix(".json").read_text())
     builds = report["builds"]
     assert builds["history_max_abs_diff_m"] == 0.0 and builds["counters_equal"]
+    assert builds["history_max_diff_over_range"] == {"x": 0.0, "z": 0.0}
     for side in ("baseline", "current"):
         summary = builds["summary"][side]
         assert summary["steps"] == 20 and summary["newton_iterations"] >= 20
         assert positive(summary["integrate_cpu_best_s"])
+        assert positive(summary["integrate_wall_best_s"])
+        assert summary["solver"].endswith("(envelope LU)")
     (row,) = report["accuracy"]["rows"]
     assert row["shipped"] and row["compared_times"] == 6
     assert 0.0 < row["z_error"] < 0.05

@@ -303,7 +303,7 @@ def test_energy_balance_closes_with_dissipated_work(tmp_path, scene, overrides, 
 def test_refactorized_ffr_and_plate_converge_and_balance():
     """A luffing FFR beam (its hub driven) next to a steel plate pendulum: a refactorized
     model whose damped tangent is not symmetric (the FFR omega term, the plate's
-    tau B(e)^T D B(e')) and is factorized whole (a general LU, here LAPACK's banded LU; with
+    tau B(e)^T D B(e')) and is factorized whole (a general LU, here the envelope LU; with
     the banded Cholesky's upper triangle Newton failed at t = 0.024 s). Newton converges at every step and the balance
     closes to 4.2e-4 of the dissipated work (dt = 1 ms, 0.5 s)."""
     s = System("luffing beam and plate")

@@ -186,13 +186,14 @@ def _plate_on_plate(k=1e5, c=0.0, mu=0.0, v_t=0.08, push=0.0, friction=False):
     return model, weight
 
 
-def test_contact_iteration_matrix_by_banded_lu():
-    """The contact Jacobian is unsymmetric, so no banded Cholesky; a model this small takes
-    the kernel's banded LU in reverse Cuthill-McKee order (4 n kd^2 flops within its
-    budget; the banded LU's solves against numpy's dense ones: tests/test_sparse.py) and
-    drops the plate (51 rows over 0.1 s, the centre moving)."""
+def test_contact_iteration_matrix_by_envelope_lu():
+    """The contact Jacobian is unsymmetric, so no banded Cholesky; a model this small (4 n
+    kd^2 flops within the banded LU's budget) takes the kernel's envelope LU without
+    pivoting (beta' M keeps every pivot positive: no fallback to the pivoted banded LU; its
+    solves against LAPACK's: tests/test_envelope_lu.py) and drops the plate (51 rows over
+    0.1 s, the centre moving)."""
     banded, _ = _plate_on_plate(k=1e5, c=2e3)
-    assert "(banded LU)" in banded.solver.what
+    assert "(envelope LU)" in banded.solver.what
     rows = Rows()
     integrate(banded, DynamicSettings.generalized_alpha(2e-3, 0.1, 0.0, tol=1e-10,
                                                         max_newton=40), banded.e0,
@@ -200,6 +201,7 @@ def test_contact_iteration_matrix_by_banded_lu():
     history = rows.stack("deflections")[:, 0, 2]
     assert len(history) == 51
     assert np.ptp(history) > 1e-6                    # it moves
+    assert banded.solver.fallbacks == 0
 
 
 def test_plate_dropped_on_plate_rests_at_mg_over_k():

@@ -477,8 +477,8 @@ _MUMPS_MESSAGES = {-10: "the matrix is numerically singular",
 
 
 class DirectSolver:
-    """Sparse direct solver (sequential MUMPS, LAPACK's banded Cholesky or LU) behind a
-    kernel handle.
+    """Sparse direct solver (sequential MUMPS, LAPACK's banded Cholesky or LU, the kernel's
+    envelope LU) behind a kernel handle.
 
     Analyse a coordinate pattern once, factorize as values change, solve many right-hand
     sides per factorization. Use as a context manager or call :meth:`close`.
@@ -496,6 +496,8 @@ class DirectSolver:
         handle, info, detail = _kernel.direct_create(kind)
         self._check(info, detail, "create")
         self.handle, self.n, self.nnz = handle, n, len(rows)
+        self.kind = "banded Cholesky" if banded_spd else "MUMPS"
+        self.banded_lu = self.envelope_lu = False
         self.factorizations = 0
         self.solves = 0
         info, detail = _kernel.direct_analyse(handle, n, _f(np.asarray(rows) + 1, np.int32),
@@ -504,23 +506,44 @@ class DirectSolver:
 
     @classmethod
     def by_cost(cls, n: int, rows: np.ndarray, cols: np.ndarray, *,
-                what: str = "system matrix") -> "DirectSolver":
+                what: str = "system matrix", positive: bool = False) -> "DirectSolver":
         """The solver the kernel's cost rule picks for any (e.g. saddle-point) pattern, the
         rule of the static Newton and the consistent start (``sparse_direct``'s
         solver_create_for): LAPACK's banded LU in the reverse Cuthill-McKee order of the
         pattern's symmetric closure when 4 n kd^2 <= 5e7 (``banded_lu_flops``), else MUMPS
-        (general; give every entry). ``banded_lu`` and ``width`` (kd in that order) say
-        which."""
+        (general; give every entry). ``positive``: every matrix it will factorize has a
+        positive definite symmetric part (an iteration matrix beta' M + ...): the envelope
+        LU without pivoting (``envelope_lu.f90``, in a profile-reducing order) replaces the
+        banded LU, which factorizes any matrix that meets a pivot that is not positive
+        (:attr:`fallbacks` counts them). ``kind`` ('banded LU', 'envelope LU', 'MUMPS'),
+        ``banded_lu``, ``envelope_lu`` and ``width`` (kd in the reverse Cuthill-McKee
+        order) say which."""
         self = cls.__new__(cls)
         self.what, self.n, self.nnz = what, n, len(rows)
         self.factorizations = 0
         self.solves = 0
         self.handle = 0
-        handle, width, banded, info, detail = _kernel.direct_create_for(
-            n, _f(np.asarray(rows) + 1, np.int32), _f(np.asarray(cols) + 1, np.int32))
+        handle, width, kind, info, detail = _kernel.direct_create_for(
+            n, _f(np.asarray(rows) + 1, np.int32), _f(np.asarray(cols) + 1, np.int32),
+            int(positive))
         self._check(info, detail, "creation and analysis")
-        self.handle, self.width, self.banded_lu = handle, int(width), bool(banded)
+        self.handle, self.width = handle, int(width)
+        self.kind = {0: "MUMPS", 2: "banded LU", 3: "envelope LU"}[int(kind)]
+        self.banded_lu = self.kind == "banded LU"
+        self.envelope_lu = self.kind == "envelope LU"
         return self
+
+    @property
+    def fallbacks(self) -> int:
+        """Factorizations of the envelope LU that fell back to the pivoted banded LU (0 for
+        the other kinds)."""
+        return int(_kernel.direct_envelope_counts(self.handle)[0]) if self.handle else 0
+
+    @property
+    def envelope(self) -> int:
+        """The envelope LU's entries below the diagonal in its order (as many above it; 0
+        for the other kinds): its solve takes about twice this many multiply-adds."""
+        return int(_kernel.direct_envelope_counts(self.handle)[1]) if self.handle else 0
 
     def analyse(self, n: int, rows: np.ndarray, cols: np.ndarray) -> None:
         """Another pattern on the same solver (MUMPS analyses it anew; no new instance),

@@ -539,16 +539,30 @@ subroutine direct_create(symmetry, handle, info, info_detail)
 end subroutine direct_create
 
 !> A solver of the kind the cost rule picks for the pattern (sparse_direct's
-!> solver_create_for), analysed; banded: 1 for the banded LU, 0 for MUMPS; width: the
-!> pattern's half-bandwidth in its reverse Cuthill-McKee order.
-subroutine direct_create_for(n, nnz, rows, cols, handle, width, banded, info, info_detail)
-  use sparse_direct, only: solver_create_for, solver_banded_lu
+!> solver_create_for), analysed; positive: 1 when every matrix to factorize has a positive
+!> definite symmetric part (an iteration matrix: the envelope LU may replace the banded
+!> LU); kind: sparse_direct's solver_kind (0 MUMPS, 2 banded LU, 3 envelope LU); width:
+!> the pattern's half-bandwidth in its reverse Cuthill-McKee order.
+subroutine direct_create_for(n, nnz, rows, cols, positive, handle, width, kind, info, &
+                             info_detail)
+  use sparse_direct, only: solver_create_for, solver_kind
   implicit none
-  integer, intent(in) :: n, nnz, rows(nnz), cols(nnz)
-  integer, intent(out) :: handle, width, banded, info, info_detail
-  call solver_create_for(n, nnz, rows, cols, handle, width, info, info_detail)
-  banded = merge(1, 0, solver_banded_lu(handle))
+  integer, intent(in) :: n, nnz, rows(nnz), cols(nnz), positive
+  integer, intent(out) :: handle, width, kind, info, info_detail
+  call solver_create_for(n, nnz, rows, cols, handle, width, info, info_detail, positive /= 0)
+  kind = solver_kind(handle)
 end subroutine direct_create_for
+
+!> An envelope LU solver's factorizations that fell back to the pivoted banded LU and its
+!> envelope's entries below the diagonal (0 and 0 for other kinds).
+subroutine direct_envelope_counts(handle, fallbacks, entries)
+  use sparse_direct, only: solver_fallbacks, solver_envelope
+  implicit none
+  integer, intent(in) :: handle
+  integer, intent(out) :: fallbacks, entries
+  fallbacks = solver_fallbacks(handle)
+  entries = solver_envelope(handle)
+end subroutine direct_envelope_counts
 
 subroutine direct_analyse(handle, n, nnz, rows, cols, info, info_detail)
   use sparse_direct, only: solver_analyse

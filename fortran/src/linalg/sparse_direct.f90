@@ -11,25 +11,41 @@
 !> model factorizes that is not for the banded Cholesky (the iteration matrix of an
 !> unsymmetric or wide-banded model, the saddle-point systems of the static Newton and the
 !> consistent start): the banded LU in the pattern's reverse Cuthill-McKee order
-!> (band_order; its callers keep the original numbering) when its factorization costs at
-!> most banded_lu_flops (4 n kd^2), else MUMPS. The handle table is the kernel's only module state.
+!> (graph_order's band_order; its callers keep the original numbering) when its
+!> factorization costs at most banded_lu_flops (4 n kd^2), else MUMPS. An iteration
+!> matrix (beta' M + ..., whose symmetric part the mass keeps positive definite: the
+!> caller says so) that the banded LU would factorize takes the envelope LU without
+!> pivoting instead (envelope_lu, in Sloan's profile order or the reverse Cuthill-McKee
+!> one, whichever envelope is smaller), a tenth of the banded LU's work on the two-leaf
+!> spring; a factorization that meets a pivot that is not positive falls back to the
+!> pivoted banded LU of the same handle (counted: solver_fallbacks). The handle table is
+!> the kernel's only module state.
 !> info: 0 ok; 1 bad handle or no free slot; 2 call out of sequence (solve before
 !> factorize, ...); 3 size mismatch; < 0 MUMPS INFOG(1) (-10: numerically singular),
 !> with INFOG(2) in info_detail; the banded kind reports a non-positive-definite matrix
 !> as -10 with the failing column in info_detail.
 module sparse_direct
   use ancf_kinds, only: dp
+  use graph_order, only: band_order, profile_order, envelope_entries
+  use envelope_lu, only: envelope_layout, envelope_factorize, envelope_solve
   implicit none
   private
   include 'mpif.h'
   include 'dmumps_struc.h'
   public :: solver_create, solver_analyse, solver_factorize, solver_solve, &
-            solver_destroy, solver_create_for, solver_banded_lu
+            solver_destroy, solver_create_for, solver_kind, &
+            solver_fallbacks, solver_envelope
 
   !> symmetry code that selects the banded LAPACK Cholesky
   integer, parameter, public :: banded_spd = 3
   !> symmetry code that selects the banded LAPACK LU (general matrices)
   integer, parameter, public :: banded_general = 4
+  !> symmetry code that selects the envelope LU without pivoting (general matrices whose
+  !> symmetric part is positive definite), the banded LU with pivoting its fallback
+  integer, parameter, public :: envelope_general = 5
+  !> the kinds solver_kind reports
+  integer, parameter, public :: kind_mumps = 0, kind_banded_cholesky = 1, &
+                                kind_banded_lu = 2, kind_envelope_lu = 3
   !> the banded LU replaces MUMPS when its factorization takes at most this many flops
   !> (4 n kd^2: kd rows below the diagonal times the 2 kd columns of U's band, per column):
   !> about a millisecond at the BLAS-3 rate, where MUMPS's fixed costs per call (some 50 us
@@ -52,6 +68,13 @@ module sparse_direct
     ! transposed), for the forward substitution by contiguous columns of U^T
     real(dp), allocatable :: lower(:, :)
     logical :: pivoted_lu = .false.
+    ! the envelope LU (kind envelope_general): its order (env_place(i): the envelope's
+    ! unknown of unknown i), layout (envelope_layout: first, ptr, the entries' positions)
+    ! and factors; fallbacks: factorizations that fell back to the banded LU
+    logical :: envelope = .false.
+    integer, allocatable :: env_place(:), env_first(:), env_ptr(:), env_position(:)
+    real(dp), allocatable :: env_factor(:)
+    integer :: fallbacks = 0
     logical :: in_use = .false.
     logical :: analysed = .false.
     logical :: factorized = .false.
@@ -140,22 +163,38 @@ contains
   !> A solver for the n x n pattern (rows, cols: 1-based coordinates, duplicates allowed),
   !> analysed, of the kind the cost rule picks: LAPACK's banded LU in the reverse
   !> Cuthill-McKee order of the pattern's symmetric closure (band_order) when
-  !> 4 n kd^2 <= banded_lu_flops, else MUMPS (general). width: kd in that order (whichever
-  !> kind was chosen). info as solver_create and solver_analyse (3: an entry outside 1..n);
-  !> on failure no handle is left behind (handle 0).
-  subroutine solver_create_for(n, nnz, rows, cols, handle, width, info, info_detail)
+  !> 4 n kd^2 <= banded_lu_flops, else MUMPS (general). positive (optional, default
+  !> .false.): every matrix to factorize has a positive definite symmetric part (an
+  !> iteration matrix beta' M + ...): the envelope LU instead of the banded LU, in whichever
+  !> of Sloan's and the reverse Cuthill-McKee order has the smaller envelope, with the
+  !> banded LU as its fallback. width: kd in the reverse Cuthill-McKee order (whichever
+  !> kind was chosen). info as solver_create and solver_analyse (3: an entry outside
+  !> 1..n); on failure no handle is left behind (handle 0).
+  subroutine solver_create_for(n, nnz, rows, cols, handle, width, info, info_detail, positive)
     integer, intent(in) :: n, nnz, rows(nnz), cols(nnz)
     integer, intent(out) :: handle, width, info, info_detail
-    integer, allocatable :: place(:)
+    logical, intent(in), optional :: positive
+    integer, allocatable :: place(:), profile(:)
     integer :: ignored
+    logical :: envelope
     allocate (place(n))
     handle = 0
     width = 0
     info_detail = 0
     info = 3
     if (any(rows < 1) .or. any(rows > n) .or. any(cols < 1) .or. any(cols > n)) return
+    envelope = .false.
+    if (present(positive)) envelope = positive
     call band_order(n, nnz, rows, cols, place, width)
-    if (4.0_dp * real(n, dp) * real(width, dp)**2 <= banded_lu_flops) then
+    if (4.0_dp * real(n, dp) * real(width, dp)**2 <= banded_lu_flops .and. envelope) then
+      allocate (profile(n))
+      call profile_order(n, nnz, rows, cols, profile)
+      if (envelope_entries(n, nnz, rows, cols, place) &
+          < envelope_entries(n, nnz, rows, cols, profile)) profile = place
+      call solver_create(envelope_general, handle, info, info_detail)
+      if (info == 0) call solver_order(handle, n, place, info)
+      if (info == 0) slots(handle)%env_place = profile
+    else if (4.0_dp * real(n, dp) * real(width, dp)**2 <= banded_lu_flops) then
       call solver_create(banded_general, handle, info, info_detail)
       if (info == 0) call solver_order(handle, n, place, info)
     else
@@ -168,165 +207,11 @@ contains
     end if
   end subroutine solver_create_for
 
-  !> Reverse Cuthill-McKee order of the symmetric closure of the pattern (rows, cols): each
-  !> connected component from a
-  !> pseudo-peripheral start (George and Liu: the last level's node of lowest degree, lowest
-  !> index among equals, until the number of levels stops growing), seeds and neighbours
-  !> in increasing (degree, index); the degree counts a node's distinct neighbours, itself
-  !> included when the pattern has its diagonal entry. place(i): the position (1..n) of
-  !> unknown i; width: max |place(i) - place(j)| over the entries.
-  subroutine band_order(n, nnz, rows, cols, place, width)
-    integer, intent(in) :: n, nnz, rows(nnz), cols(nnz)
-    integer, intent(out) :: place(n), width
-    integer, allocatable :: ptr(:), fill(:), adj(:), degree(:), mark(:), seeds(:), order(:), &
-                            level(:), queue(:), start_count(:)
-    logical, allocatable :: visited(:)
-    integer :: k, i, j, p, q, head, seed, start, candidate, nlevels, deeper, count, found, &
-               first
-    allocate (ptr(n + 1), fill(n), adj(2 * nnz), degree(n), mark(n), seeds(n), order(n), &
-              level(n), queue(n), start_count(0:n), visited(n))
-    ! the symmetric closure, duplicates dropped (each row's neighbours in any order: every
-    ! ordering below sorts by (degree, index))
-    ptr = 0
-    do k = 1, nnz
-      ptr(rows(k)) = ptr(rows(k)) + 1
-      if (rows(k) /= cols(k)) ptr(cols(k)) = ptr(cols(k)) + 1
-    end do
-    p = 1
-    do i = 1, n
-      q = ptr(i)
-      ptr(i) = p
-      p = p + q
-    end do
-    ptr(n + 1) = p
-    fill = ptr(1:n)
-    do k = 1, nnz
-      adj(fill(rows(k))) = cols(k)
-      fill(rows(k)) = fill(rows(k)) + 1
-      if (rows(k) /= cols(k)) then
-        adj(fill(cols(k))) = rows(k)
-        fill(cols(k)) = fill(cols(k)) + 1
-      end if
-    end do
-    mark = 0
-    p = 1
-    do i = 1, n
-      first = p
-      do k = ptr(i), ptr(i + 1) - 1
-        j = adj(k)
-        if (mark(j) == i) cycle
-        mark(j) = i
-        adj(p) = j
-        p = p + 1
-      end do
-      ptr(i) = first
-      degree(i) = p - first
-    end do
-    ptr(n + 1) = p
-    ! the seeds in increasing (degree, index): a counting sort by degree
-    start_count = 0
-    do i = 1, n
-      start_count(degree(i)) = start_count(degree(i)) + 1
-    end do
-    p = 1
-    do k = 0, n
-      q = start_count(k)
-      start_count(k) = p
-      p = p + q
-    end do
-    do i = 1, n
-      seeds(start_count(degree(i))) = i
-      start_count(degree(i)) = start_count(degree(i)) + 1
-    end do
-    visited = .false.
-    count = 0
-    do k = 1, n
-      seed = seeds(k)
-      if (visited(seed)) cycle
-      start = seed
-      call levels_from(start, nlevels, candidate)
-      do
-        call levels_from(candidate, deeper, found)
-        if (deeper <= nlevels) exit
-        start = candidate
-        nlevels = deeper
-        candidate = found
-      end do
-      ! Cuthill-McKee from start: each node's unvisited neighbours in (degree, index) order
-      head = count + 1
-      count = count + 1
-      order(count) = start
-      visited(start) = .true.
-      do while (head <= count)
-        i = order(head)
-        head = head + 1
-        first = count + 1
-        do p = ptr(i), ptr(i + 1) - 1
-          j = adj(p)
-          if (visited(j)) cycle
-          visited(j) = .true.
-          count = count + 1
-          order(count) = j
-          ! insertion into the sorted tail first .. count
-          q = count
-          do while (q > first)
-            if (before(order(q - 1), j)) exit
-            order(q) = order(q - 1)
-            q = q - 1
-          end do
-          order(q) = j
-        end do
-      end do
-    end do
-    do k = 1, n
-      place(order(k)) = n + 1 - k
-    end do
-    width = 0
-    if (nnz > 0) width = maxval(abs(place(rows) - place(cols)))
-
-  contains
-
-    !> a precedes b in (degree, index)
-    pure logical function before(a, b)
-      integer, intent(in) :: a, b
-      before = degree(a) < degree(b) .or. (degree(a) == degree(b) .and. a < b)
-    end function before
-
-    !> breadth-first levels from s: their number and the last level's first node in
-    !> (degree, index)
-    subroutine levels_from(s, number, last_first)
-      integer, intent(in) :: s
-      integer, intent(out) :: number, last_first
-      integer :: h, t, u, v, r
-      level = 0
-      level(s) = 1
-      queue(1) = s
-      h = 1
-      t = 1
-      do while (h <= t)
-        u = queue(h)
-        h = h + 1
-        do r = ptr(u), ptr(u + 1) - 1
-          v = adj(r)
-          if (level(v) /= 0) cycle
-          level(v) = level(u) + 1
-          t = t + 1
-          queue(t) = v
-        end do
-      end do
-      number = level(queue(t))
-      last_first = queue(t)
-      do r = t, 1, -1
-        if (level(queue(r)) /= number) exit
-        if (before(queue(r), last_first)) last_first = queue(r)
-      end do
-    end subroutine levels_from
-
-  end subroutine band_order
-
   !> New solver; symmetry 0 = general, 2 = symmetric (give one triangle only),
   !> 3 = symmetric positive definite, banded LAPACK Cholesky (give both triangles or one),
-  !> 4 = general, banded LAPACK LU (give every entry).
+  !> 4 = general, banded LAPACK LU (give every entry), 5 = general with a positive definite
+  !> symmetric part, envelope LU (give every entry; its order from solver_create_for,
+  !> else the natural one).
   subroutine solver_create(symmetry, handle, info, info_detail)
     integer, intent(in) :: symmetry
     integer, intent(out) :: handle, info, info_detail
@@ -334,13 +219,16 @@ contains
     handle = 0
     info_detail = 0
     info = 1
-    if (symmetry < 0 .or. symmetry > 4) return
-    if (symmetry == banded_spd .or. symmetry == banded_general) then
+    if (symmetry < 0 .or. symmetry > 5) return
+    if (symmetry == banded_spd .or. symmetry == banded_general .or. &
+        symmetry == envelope_general) then
       do h = 1, max_slots
         if (.not. slots(h)%in_use) then
           slots(h)%in_use = .true.
           slots(h)%banded = .true.
-          slots(h)%general = symmetry == banded_general
+          slots(h)%general = symmetry == banded_general .or. symmetry == envelope_general
+          slots(h)%envelope = symmetry == envelope_general
+          slots(h)%fallbacks = 0
           slots(h)%analysed = .false.
           slots(h)%factorized = .false.
           handle = h
@@ -417,6 +305,7 @@ contains
       return
     end if
     if (slots(handle)%banded) then
+      info = 0
       if (allocated(slots(handle)%place)) then
         if (size(slots(handle)%place) /= n) then
           info = 3
@@ -435,6 +324,8 @@ contains
       ! (the LU's band is sized by its first factorization)
       if (allocated(slots(handle)%general_band)) &
         deallocate (slots(handle)%general_band, slots(handle)%pivots)
+      if (slots(handle)%envelope) call envelope_analyse(slots(handle), nnz, rows, cols, info)
+      if (info /= 0) return
       slots(handle)%analysed = .true.
       slots(handle)%factorized = .false.
       info = 0
@@ -519,7 +410,17 @@ contains
         return
       end if
       associate (slot => slots(handle))
-        if (allocated(slot%place)) then
+        if (slot%envelope .and. .not. slot%pivoted_lu) then
+          if (allocated(slot%ordered)) then
+            if (size(slot%ordered, 2) /= nrhs) deallocate (slot%ordered)
+          end if
+          if (.not. allocated(slot%ordered)) allocate (slot%ordered(n, nrhs))
+          call move_alloc(slot%ordered, ordered)  ! (the factors stay read-only)
+          ordered(slot%env_place, :) = rhs
+          call envelope_solve(n, slot%env_first, slot%env_ptr, slot%env_factor, nrhs, ordered)
+          rhs = ordered(slot%env_place, :)
+          call move_alloc(ordered, slot%ordered)
+        else if (allocated(slot%place)) then
           if (allocated(slot%ordered)) then
             if (size(slot%ordered, 2) /= nrhs) deallocate (slot%ordered)
           end if
@@ -572,6 +473,11 @@ contains
       if (allocated(slots(handle)%rows)) deallocate (slots(handle)%rows, slots(handle)%cols)
       if (allocated(slots(handle)%place)) deallocate (slots(handle)%place)
       if (allocated(slots(handle)%ordered)) deallocate (slots(handle)%ordered)
+      if (allocated(slots(handle)%env_place)) deallocate (slots(handle)%env_place)
+      if (allocated(slots(handle)%env_first)) &
+        deallocate (slots(handle)%env_first, slots(handle)%env_ptr, slots(handle)%env_position, &
+                    slots(handle)%env_factor)
+      slots(handle)%envelope = .false.
       slots(handle)%in_use = .false.
       slots(handle)%analysed = .false.
       slots(handle)%factorized = .false.
@@ -619,6 +525,20 @@ contains
     end if
     kd = slot%bandwidth
     info = 0
+    if (slot%envelope) then
+      slot%env_factor = 0.0_dp
+      do k = 1, nnz
+        slot%env_factor(slot%env_position(k)) = slot%env_factor(slot%env_position(k)) + values(k)
+      end do
+      call envelope_factorize(slot%n, slot%env_first, slot%env_ptr, slot%env_factor, info, &
+                              info_detail)
+      slot%pivoted_lu = info /= 0
+      if (.not. slot%pivoted_lu) return
+      ! a pivot that is not positive: the pivoted banded LU of the same matrix
+      slot%fallbacks = slot%fallbacks + 1
+      info = 0
+      info_detail = 0
+    end if
     slot%pivoted_lu = slot%general
     if (slot%general) then
       call banded_lu(slot, nnz, values, info, info_detail)
@@ -672,12 +592,61 @@ contains
     if (info_detail /= 0) info = -10
   end subroutine banded_lu
 
-  !> Whether handle is a solver of the banded LU kind (banded_general).
-  logical function solver_banded_lu(handle)
+  !> The envelope LU's layout of the pattern (rows, cols: the caller's numbering) in the
+  !> slot's envelope order (env_place; none: the natural one), and its factor's storage.
+  !> info 3: the order is not of size n.
+  subroutine envelope_analyse(slot, nnz, rows, cols, info)
+    type(solver_slot), intent(inout) :: slot
+    integer, intent(in) :: nnz, rows(nnz), cols(nnz)
+    integer, intent(out) :: info
+    integer :: i, m
+    info = 3
+    if (.not. allocated(slot%env_place)) slot%env_place = [(i, i = 1, slot%n)]
+    if (size(slot%env_place) /= slot%n) return
+    if (allocated(slot%env_first)) &
+      deallocate (slot%env_first, slot%env_ptr, slot%env_position, slot%env_factor)
+    allocate (slot%env_first(slot%n), slot%env_ptr(slot%n + 1), slot%env_position(nnz))
+    call envelope_layout(slot%n, nnz, slot%env_place(rows), slot%env_place(cols), &
+                         slot%env_first, slot%env_ptr, slot%env_position)
+    m = slot%env_ptr(slot%n + 1) - 1
+    allocate (slot%env_factor(2 * m + slot%n))
+    info = 0
+  end subroutine envelope_analyse
+
+  !> The kind of handle's solver (kind_mumps, kind_banded_cholesky, kind_banded_lu,
+  !> kind_envelope_lu); -1 for a bad handle.
+  integer function solver_kind(handle)
     integer, intent(in) :: handle
-    solver_banded_lu = .false.
-    if (valid(handle)) solver_banded_lu = slots(handle)%banded .and. slots(handle)%general
-  end function solver_banded_lu
+    solver_kind = -1
+    if (.not. valid(handle)) return
+    if (.not. slots(handle)%banded) then
+      solver_kind = kind_mumps
+    else if (slots(handle)%envelope) then
+      solver_kind = kind_envelope_lu
+    else if (slots(handle)%general) then
+      solver_kind = kind_banded_lu
+    else
+      solver_kind = kind_banded_cholesky
+    end if
+  end function solver_kind
+
+  !> The factorizations of an envelope LU handle that fell back to the pivoted banded LU
+  !> (a pivot not positive); 0 for other kinds and bad handles.
+  integer function solver_fallbacks(handle)
+    integer, intent(in) :: handle
+    solver_fallbacks = 0
+    if (valid(handle)) solver_fallbacks = slots(handle)%fallbacks
+  end function solver_fallbacks
+
+  !> The entries below the diagonal of an envelope LU handle's envelope (its L's, as many
+  !> in U), in the order it chose; 0 for other kinds, bad handles and before analysis.
+  integer function solver_envelope(handle)
+    integer, intent(in) :: handle
+    solver_envelope = 0
+    if (.not. valid(handle)) return
+    if (.not. allocated(slots(handle)%env_ptr)) return
+    solver_envelope = slots(handle)%env_ptr(slots(handle)%n + 1) - 1
+  end function solver_envelope
 
   logical function valid(handle)
     integer, intent(in) :: handle

@@ -636,9 +636,12 @@ class Model:
                                               self.pattern.col_index, banded_spd=True,
                                               what=what + "(banded Cholesky)")
         else:   # the kernel's cost rule, as for every other system the model factorizes
+            # (beta' M keeps the symmetric part positive definite: the envelope LU may
+            # replace the banded LU)
             self.solver = kernel.DirectSolver.by_cost(self.ndof, self.pattern.rows,
-                                                      self.pattern.col_index, what=what)
-            self.solver.what += "(banded LU)" if self.solver.banded_lu else "(MUMPS)"
+                                                      self.pattern.col_index, what=what,
+                                                      positive=True)
+            self.solver.what += f"({self.solver.kind})"
         mass = self.mass.copy()
         mass.eliminate_zeros()  # the x, y, z blocks of M are decoupled: 2/3 of it is 0
         mass.sort_indices()
