@@ -1213,11 +1213,12 @@ contains
       ! the limit, and only when it is itself below first_fraction of the step's motion
       ! (what the matrix's contraction here may leave of it is then negligible however
       ! the contraction changed since)
-      if (exact_tangent) return
+      ! (contact steps keep the plain test: they start from q + h v, without the
+      ! accelerations' extrapolation, under no motion cap, and damp their corrections)
+      if (exact_tangent .or. sys%contact%npoint > 0) return
       ok = ok .and. learned%theta >= 0.0_dp .and. learned%theta < 1.0_dp .and. &
-           (sys%contact%npoint > 0 .or. last <= max(first_fraction * motion, &
-                                                    10.0_dp * floor_ulps * epsilon(1.0_dp) &
-                                                    * cfg%length_scale))
+           last <= max(first_fraction * motion, &
+                       10.0_dp * floor_ulps * epsilon(1.0_dp) * cfg%length_scale)
       if (ok) ok = learned%theta / (1.0_dp - learned%theta) * last <= limit
       return
     end if
@@ -1251,7 +1252,7 @@ contains
       step_theta = theta
       ! the plain test only with the step's own ratio of one matrix bounding the error
       ! left below the limit too (a ratio near 1 left several times the last correction)
-      if (ok .and. same_matrix .and. .not. exact_tangent) &
+      if (ok .and. same_matrix .and. .not. exact_tangent .and. sys%contact%npoint == 0) &
         ok = theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit
       if (ok .or. sys%contact%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
           learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
