@@ -13,7 +13,8 @@
 !> algebra (small_lu; LAPACK dgesv for many multipliers). The Jacobians of the dead moments
 !> and of lambda . Phi_ee are left out of S; the residual is exact. A correction with
 !> max |de| <= tol * length_scale ends the step (jacobian_reuse and the constant policy: an
-!> error estimate below it, see converged).
+!> error estimate below it, see converged; jacobian_reuse ends no step on a correction of a
+!> kept matrix without a measured contraction).
 !>
 !> The run's settings and what the stepper learns from step to step (contraction estimate,
 !> reuse back-off, predictor) live apart from the system, in stepper.f90's stepper_run; the
@@ -109,6 +110,14 @@ module time_integrator
   !> extrapolation (the leaf spring runs at newton_tol = 1e-4 without it), and their
   !> nearly static steps would pay up to 70 % more corrections for it.
   real(dp), parameter :: motion_fraction = 1e-2_dp
+  !> jacobian_reuse: the largest first correction of a matrix kept from earlier steps that
+  !> may end a step, as a fraction of the step's motion (converged; the square of
+  !> motion_fraction): a first correction shows no contraction, and what it leaves enters
+  !> the velocity as 2 delta e / h unchecked. At newton_tol = 1e-10 it binds only below
+  !> 1e-5 L of motion per step; at 1e-2 .. 1e-5, where the limit is the motion cap, steps
+  !> whose first corrections ended them on the plain test failed (the 10-node cubic boom at
+  !> dt 5e-3 at t = 6.03 s; the W = 4 spin-up at 1e-2 .. 1e-5, issue 38)
+  real(dp), parameter :: first_fraction = motion_fraction**2
   !> the smallest newton_tol that double precision resolves: a stall at the floor with a
   !> tolerance at least this is converged (counted); below it the tolerance cannot be met
   real(dp), parameter :: resolvable_tol = 100.0_dp * epsilon(1.0_dp)
@@ -578,6 +587,8 @@ contains
     integer :: it, lapack_info, active, i
     integer :: refreshed_at  ! the correction after which the matrix was last refreshed
     logical :: measured      ! the step's contraction entered the learned bound (converged)
+    logical :: exact_tangent ! the matrix was factorized at the iterate being corrected
+    logical :: theta_seen    ! the step has set learned%theta (converged)
     logical :: use_known, refresh, capped, halt, finite
     real(dp) :: largest_correction, largest_coordinate, step_part
     logical :: carry_ready  ! the carried Schur complement is built for this step
@@ -594,6 +605,8 @@ contains
     step_theta = 0.0_dp
     refreshed_at = 0
     measured = .false.
+    exact_tangent = fresh_matrix
+    theta_seen = .false.
     active = sys%matrix%factor_active
     do it = 1, cfg%max_newton
       if (use_known) then
@@ -612,6 +625,7 @@ contains
         call refresh_matrix()
         if (info /= 0) return
         refreshed_at = it - 1
+        exact_tangent = .true.
         call residual(sys, t_new, rotations, rates, e_new, v_new, accel_new, lam_new, state, r, &
                       phi, gradients, strain, active, work, info, predicted_internal)
         if (info /= 0) return
@@ -695,7 +709,7 @@ contains
       end if
       last_correction = largest_correction
       if (converged(sys, cfg, learned, it, last_correction, previous_correction, step_theta, &
-                    it - 1 > refreshed_at, measured, motion)) then
+                    it - 1 > refreshed_at, exact_tangent, measured, theta_seen, motion)) then
         ! accepted on the contraction estimate with a correction larger than the tolerance:
         ! the constraints (linearized exactly, not contracted by the matrix) must hold to it
         ! too, in the units of the tightest of length and angle
@@ -710,6 +724,7 @@ contains
         end if
         if (done) return
       end if
+      exact_tangent = .false.
       ! (a correction cut to the contact cap says nothing about convergence)
       if (.not. capped) then
         ! (the largest |e_new| only here, where it is read: e_new is finite, max is exact)
@@ -749,6 +764,7 @@ contains
         call refresh_matrix()
         if (info /= 0) return
         use_known = .true.
+        exact_tangent = .true.
         refreshed_at = it
       end if
       previous_correction = last_correction
@@ -1129,7 +1145,13 @@ contains
   !> constant policy's matrix (the same for the whole run, its contraction with it) the first
   !> correction uses twice the theta last measured, and a confirming correction re-measures
   !> it every confirm_every accepted steps.
-  !> jacobian_reuse measures the contraction in every step that reaches its third
+  !> jacobian_reuse accepts no correction of a matrix kept from earlier steps on the plain
+  !> test alone (it leaves about theta / (1 - theta) of itself, theta unmeasured): the
+  !> first one only on the largest ratio the matrix showed in the last step that measured
+  !> one (learned%theta) and below first_fraction of the step's motion, the second only
+  !> with its own ratio to the first bounding the error too (the first correction of a
+  !> matrix factorized at the iterate is Newton's: the plain test; issue 38). It
+  !> measures the contraction in every step that reaches its third
   !> correction and accepts from there on the step's largest ratio (the first ratio, from
   !> the predictor's error, mostly measures its linear part). At the second correction it
   !> accepts on the contraction bound theta_b learned from earlier steps (issue 26;
@@ -1153,7 +1175,7 @@ contains
   !> the stagnation and divergence tests (stagnated) run on every correction not accepted.
   !> measured: this step has its entry in the bound's ring.
   logical function converged(sys, cfg, learned, it, last, previous, step_theta, same_matrix, &
-                             measured, motion) result(ok)
+                             exact_tangent, measured, theta_seen, motion) result(ok)
     type(system_model), intent(in) :: sys
     type(stepper_settings), intent(in) :: cfg
     type(stepper_state), intent(inout) :: learned
@@ -1161,7 +1183,11 @@ contains
     real(dp), intent(in) :: last, previous
     real(dp), intent(inout) :: step_theta  ! the largest contraction measured in this step
     logical, intent(in) :: same_matrix     ! last and previous came from the same matrix
+    !> last was made with a matrix factorized at the iterate it corrects
+    logical, intent(in) :: exact_tangent
     logical, intent(inout) :: measured
+    !> this step has set learned%theta (jacobian_reuse: from a ratio of one matrix)
+    logical, intent(inout) :: theta_seen
     real(dp), intent(in) :: motion  ! max |e_new - e_n| of the step's predicted state
     integer, parameter :: confirm_every = 20
     ! a steady contraction: at least steady_count measurements, the largest within
@@ -1178,10 +1204,26 @@ contains
                              10.0_dp * floor_ulps * epsilon(1.0_dp) * cfg%length_scale))
     ok = last <= limit
     if (sys%matrix%policy /= policy_constant .and. cfg%jacobian /= jacobian_reuse) return
+    if (it == 1 .and. sys%matrix%policy /= policy_constant) then
+      ! reuse: the first correction of a matrix factorized at the predicted state is
+      ! Newton's (the plain test). One of a matrix kept from earlier steps leaves about
+      ! theta / (1 - theta) of itself, theta the matrix's contraction in this step, which
+      ! one correction does not show: it ends the step only when the contraction the
+      ! matrix showed in the last step that measured one (learned%theta) puts that below
+      ! the limit, and only when it is itself below first_fraction of the step's motion
+      ! (what the matrix's contraction here may leave of it is then negligible however
+      ! the contraction changed since)
+      ! (contact steps keep the plain test: they start from q + h v, without the
+      ! accelerations' extrapolation, under no motion cap, and damp their corrections)
+      if (exact_tangent .or. sys%contact%npoint > 0) return
+      ok = ok .and. learned%theta >= 0.0_dp .and. learned%theta < 1.0_dp .and. &
+           last <= max(first_fraction * motion, &
+                       10.0_dp * floor_ulps * epsilon(1.0_dp) * cfg%length_scale)
+      if (ok) ok = learned%theta / (1.0_dp - learned%theta) * last <= limit
+      return
+    end if
     if (it == 1) then
-      ! (reuse: the first correction is never accepted on an estimate)
-      if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every .or. &
-          sys%matrix%policy /= policy_constant) then
+      if (ok .or. learned%theta < 0.0_dp .or. learned%unconfirmed >= confirm_every) then
         if (ok) learned%unconfirmed = learned%unconfirmed + 1
         return
       end if
@@ -1191,13 +1233,27 @@ contains
       return
     end if
     theta = last / previous
-    learned%theta = theta
+    if (sys%matrix%policy == policy_constant) then
+      learned%theta = theta
+    else if (same_matrix) then
+      ! (reuse: the step's largest ratio of two corrections of the current matrix)
+      if (theta_seen) then
+        learned%theta = max(learned%theta, theta)
+      else
+        learned%theta = theta
+        theta_seen = .true.
+      end if
+    end if
     learned%unconfirmed = 0
     ! the largest contraction of the step: a contact point that moves, sticks or slips
     ! makes the corrections fall irregularly, and a small ratio after a large one is no
     ! evidence that the next would be as small
     if (it == 2 .and. sys%matrix%policy /= policy_constant) then
       step_theta = theta
+      ! the plain test only with the step's own ratio of one matrix bounding the error
+      ! left below the limit too (a ratio near 1 left several times the last correction)
+      if (ok .and. same_matrix .and. .not. exact_tangent .and. sys%contact%npoint == 0) &
+        ok = theta < 1.0_dp .and. theta / (1.0_dp - theta) * last <= limit
       if (ok .or. sys%contact%npoint > 0 .or. learned%matrix_measured < steady_count .or. &
           learned%matrix_unconfirmed >= confirm_every .or. .not. same_matrix) return
       known = min(learned%matrix_measured, contraction_memory)

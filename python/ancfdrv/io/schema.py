@@ -324,7 +324,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                     "Newmark beta (1/4: average acceleration, the paper's choice)"),
         "gamma": Key("float", 0.5, within(0.5, 1.0), "Newmark gamma (1/2: no damping)"),
         "newton_tol": Key("float", 1e-10, lambda v: None if 0 < v < 1 else "must lie in (0, 1)",
-                          "a step ends when its Newton correction is below newton_tol * length"),
+                          "a step ends when its Newton correction is below newton_tol * length "
+                          "(without contact also below 1 % of the step's motion; with jacobian "
+                          "= 'reuse' a correction of a matrix kept from earlier steps needs a "
+                          "measured contraction too: docs/theory.md, 'Loose tolerances')"),
         "max_newton": Key("int", 10, positive, "Newton iterations allowed per step"),
         "jacobian": Key("str", "reuse", one_of("step", "iteration", "reuse"),
                         "when a refactorized model's iteration matrix is refreshed: 'reuse' "
