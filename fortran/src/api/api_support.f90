@@ -5,7 +5,7 @@
 !> python/ancfdrv/codes.py KERNEL_LAYOUTS mirrors every one (tests/test_codes.py checks).
 module api_support
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model
+  use mechanical_system, only: system_model, frame_rotations
   use stepper, only: stepper_run
   use system_store, only: store_get
   use kernel_errors, only: handle_text
@@ -16,7 +16,7 @@ module api_support
   use beam_cubic, only: cubic_set
   implicit none
   private
-  public :: api_system, unpack_constraints, give_sections
+  public :: api_system, unpack_constraints, give_sections, frame_at_rows
 
   !> The arrays of a constraint set (constraints module layout)
   type, public :: constraint_layout
@@ -105,6 +105,25 @@ module api_support
                                 ce_count = 3
 
 contains
+
+  !> The rotation of the system's frame `frame` (0: none, the identity) at each of the
+  !> times, for the routines that read a set's stored rows in its frame
+  !> (system_section_forces, system_ffr_departures). info /= 0: a frame's drive failed.
+  subroutine frame_at_rows(sys, frame, times, rotations, info)
+    type(system_model), intent(in) :: sys
+    integer, intent(in) :: frame
+    real(dp), intent(in) :: times(:)
+    real(dp), intent(out) :: rotations(:, :, :)
+    integer, intent(out) :: info
+    real(dp) :: frames(3, 3, 0:size(sys%frames)), rates(0:size(sys%frames))
+    integer :: row
+    info = 0
+    do row = 1, size(times)
+      call frame_rotations(sys, times(row), frames, rates, info)
+      if (info /= 0) return
+      rotations(:, :, row) = frames(:, :, frame)
+    end do
+  end subroutine frame_at_rows
 
   !> The system (and on request its stepper run) behind handle; info = 1 with the text in
   !> message when it is not a live handle, else info = 0 and message blank.

@@ -353,9 +353,9 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
                                  forces, largest, info, message)
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, frame_rotations
+  use mechanical_system, only: system_model
   use system_reduction, only: to_full
-  use api_support, only: api_system
+  use api_support, only: api_system, frame_at_rows
   implicit none
   integer, intent(in) :: handle, index, nrows, ndof, ns, nst
   real(dp), intent(in) :: times(nrows), e_rows(ndof, nrows), xi(ns)
@@ -364,7 +364,7 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :), total(:, :)
+  real(dp), allocatable :: rotations(:, :, :), q_rows(:, :), total(:, :)
   integer :: row, frame, k
   largest = 0.0_dp
   call api_system(handle, sys, info, message)
@@ -376,16 +376,12 @@ subroutine system_section_forces(handle, index, nrows, ndof, ns, nst, times, e_r
   if (ndof /= sys%ndof .or. ns < 1 .or. nst /= ns * sys%sets(index)%item%nel) return
   if (any(xi < 0.0_dp) .or. any(xi > 1.0_dp)) return
   frame = sys%sets(index)%item%frame
-  allocate (rotations(3, 3, nrows), frames(3, 3, 0:size(sys%frames)), &
-            rates(0:size(sys%frames)))
-  do row = 1, nrows
-    call frame_rotations(sys, times(row), frames, rates, info)
-    if (info /= 0) then
-      message = "system_section_forces: a frame's drive failed"
-      return
-    end if
-    rotations(:, :, row) = frames(:, :, frame)
-  end do
+  allocate (rotations(3, 3, nrows))
+  call frame_at_rows(sys, frame, times, rotations, info)
+  if (info /= 0) then
+    message = "system_section_forces: a frame's drive failed"
+    return
+  end if
   if (sys%reduction%active) then
     allocate (q_rows(sys%nfull, nrows))
     do row = 1, nrows
@@ -420,10 +416,10 @@ end subroutine system_section_forces
 subroutine system_ffr_departures(handle, index, nrows, ndof, times, e_rows, departure, info, &
                                  message)
   use ancf_kinds, only: dp
-  use mechanical_system, only: system_model, frame_rotations
+  use mechanical_system, only: system_model
   use system_reduction, only: to_full
   use ffr_elastic, only: ffr_departures
-  use api_support, only: api_system
+  use api_support, only: api_system, frame_at_rows
   implicit none
   integer, intent(in) :: handle, index, nrows, ndof
   real(dp), intent(in) :: times(nrows), e_rows(ndof, nrows)
@@ -431,7 +427,7 @@ subroutine system_ffr_departures(handle, index, nrows, ndof, times, e_rows, depa
   integer, intent(out) :: info
   character(len=200), intent(out) :: message
   type(system_model), pointer :: sys
-  real(dp), allocatable :: rotations(:, :, :), frames(:, :, :), rates(:), q_rows(:, :)
+  real(dp), allocatable :: rotations(:, :, :), q_rows(:, :)
   integer :: row, frame
   departure = 0.0_dp
   call api_system(handle, sys, info, message)
@@ -442,17 +438,13 @@ subroutine system_ffr_departures(handle, index, nrows, ndof, times, e_rows, depa
   if (index < 1 .or. index > size(sys%sets)) return
   if (ndof /= sys%ndof) return
   frame = sys%sets(index)%item%frame
-  allocate (rotations(3, 3, nrows), frames(3, 3, 0:size(sys%frames)), &
-            rates(0:size(sys%frames)))
-  do row = 1, nrows
-    call frame_rotations(sys, times(row), frames, rates, info)
-    if (info /= 0) then
-      info = 5
-      message = "system_ffr_departures: a frame's drive failed"
-      return
-    end if
-    rotations(:, :, row) = frames(:, :, frame)
-  end do
+  allocate (rotations(3, 3, nrows))
+  call frame_at_rows(sys, frame, times, rotations, info)
+  if (info /= 0) then
+    info = 5
+    message = "system_ffr_departures: a frame's drive failed"
+    return
+  end if
   if (sys%reduction%active) then
     allocate (q_rows(sys%nfull, nrows))
     do row = 1, nrows
