@@ -351,9 +351,9 @@ def _rope_advice(model, settings: DynamicSettings) -> str:
     unless its method already damps unresolved modes fully (rho_inf = 0): a rope that goes
     slack and taut faster than the step resolves excites its axial modes (a light rope's
     reach some 1e4 rad/s), and only full numerical damping of them steadies the iteration.
-    Measured (docs/hard-cases.md): the knuckle crane without its payload fails at t = 0.97 s
-    at rho_inf 0.8 (dt 5e-3, cut 20 times) and at 0.37 s with newton_tol 1e-6, and at dt
-    1e-3 grinds through cuts; at rho_inf 0 it runs; the rope's throw and drop are right at
+    Measured (docs/hard-cases.md): the knuckle crane without its payload fails at t = 2.03 s
+    at rho_inf 0.8 (dt 5e-3, cut to dt_min; 0.97 s before the kept matrix's contraction
+    check), and at dt 1e-3 grinds through cuts; at rho_inf 0 it runs; the rope's throw and drop are right at
     rho_inf 0 at both grid steps and refused at 0.8 and 1."""
     ropes = [b.name for b in model.bodies if getattr(b, "tension_only", False)]
     full_damping = settings.integrator == "generalized_alpha" and settings.alpha_f == 0.0
